@@ -1,0 +1,13 @@
+// vista bake (placeholder until its issue lands: reports that it is not available yet).
+#include <cstdio>
+
+#include "runtime/commands.h"
+
+namespace vista {
+
+int runBake(int argc, char** argv) {
+    std::fprintf(stderr, "vista bake: not available in this build yet\n");
+    return 1;
+}
+
+}  // namespace vista

@@ -1,0 +1,147 @@
+#include "citygen/generate.h"
+
+#include <chrono>
+#include <mutex>
+
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "citygen/blocks.h"
+#include "citygen/buildings.h"
+#include "citygen/mesh_builder.h"
+#include "citygen/polygon.h"
+#include "citygen/streets.h"
+#include "citygen/surfaces.h"
+#include "citygen/trees.h"
+
+namespace vista {
+
+namespace {
+
+class StageTimer {
+public:
+    StageTimer(City& city, Progress* progress, const char* name) : _city(city), _progress(progress), _name(name) {
+        if (_progress) _progress->begin(name);
+        _t0 = std::chrono::steady_clock::now();
+    }
+    ~StageTimer() {
+        double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - _t0).count();
+        _city.stageTimes.push_back({_name, s});
+        if (_progress) _progress->end();
+    }
+
+private:
+    City& _city;
+    Progress* _progress;
+    const char* _name;
+    std::chrono::steady_clock::time_point _t0;
+};
+
+void buildTiles(City& city, Progress* progress) {
+    const CityParams& p = city.params;
+    TileGrid grid(p);
+    Lighting light(p);
+    // Assign buildings and trees to tiles by anchor point (stable order).
+    std::vector<std::vector<uint32_t>> buildingsOf(size_t(grid.count())), treesOf(size_t(grid.count()));
+    for (uint32_t i = 0; i < city.buildings.size(); ++i)
+        buildingsOf[size_t(grid.tileOf(centroid(city.buildings[i].footprint)))].push_back(i);
+    for (uint32_t i = 0; i < city.trees.size(); ++i)
+        treesOf[size_t(grid.tileOf(glm::dvec2(city.trees[i].position)))].push_back(i);
+
+    std::vector<Tile> tiles(size_t(grid.count()));
+    std::mutex m;
+    size_t done = 0;
+    tbb::parallel_for(0, grid.count(), [&](int t) {
+        Tile& tile = tiles[size_t(t)];
+        tile.ix = grid.ix(t);
+        tile.iy = grid.iy(t);
+        tile.origin = grid.origin(t);
+        meshSurfaces(city, grid, t, light, tile);
+        BuildingMeshes out{&tile.meshes[size_t(Material::Wall)], &tile.meshes[size_t(Material::Window)],
+                           &tile.meshes[size_t(Material::Roof)]};
+        for (uint32_t b : buildingsOf[size_t(t)]) meshBuilding(city.buildings[b], b, p, light, tile.origin, out);
+        tile.trees = treesOf[size_t(t)];
+        std::lock_guard<std::mutex> lock(m);
+        ++done;
+    });
+    if (progress) progress->update(1.0);
+    city.tiles.clear();
+    for (auto& t : tiles) {
+        bool any = !t.trees.empty();
+        for (const auto& mesh : t.meshes) any = any || !mesh.empty();
+        if (any) city.tiles.push_back(std::move(t));
+    }
+}
+
+}  // namespace
+
+Result<City> generateCity(const CityParams& params, const GenerateOptions& options) {
+    Status s = validateParams(params);
+    if (!s) return s;
+    int threads = params.threads > 0 ? params.threads : int(tbb::info::default_concurrency());
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+
+    City city;
+    city.params = params;
+    Progress* pr = options.progress;
+    {
+        StageTimer t(city, pr, "streets");
+        city.streets = options.streets ? *options.streets : growStreets(params, pr);
+    }
+    {
+        StageTimer t(city, pr, "blocks");
+        city.blocks = extractBlocks(city.streets, params, pr);
+    }
+    {
+        StageTimer t(city, pr, "lots");
+        city.lots = subdivideLots(city.blocks, params, pr);
+    }
+    {
+        StageTimer t(city, pr, "buildings");
+        city.buildings = placeBuildings(city.lots, city.blocks, params, pr);
+    }
+    {
+        StageTimer t(city, pr, "trees");
+        city.treePrototypes = makeTreePrototypes(params, Lighting(params));
+        city.trees = placeTrees(city, pr);
+    }
+    {
+        StageTimer t(city, pr, "meshes");
+        buildTiles(city, pr);
+    }
+    return city;
+}
+
+CityCounts countCity(const City& c) {
+    CityCounts n;
+    n.streetNodes = c.streets.nodes.size();
+    n.streetEdges = c.streets.edges.size();
+    n.blocks = c.blocks.size();
+    n.lots = c.lots.size();
+    n.buildings = c.buildings.size();
+    n.trees = c.trees.size();
+    for (const auto& t : c.tiles)
+        for (const auto& m : t.meshes) {
+            n.triangles += m.triangleCount();
+            n.vertices += m.positions.size();
+            n.drawCalls += m.empty() ? 0 : 1;
+        }
+    n.storedTriangles = n.triangles;
+    for (const auto& p : c.treePrototypes) n.storedTriangles += p.mesh.triangleCount();
+    // Trees are drawn instanced: one draw per (tile, prototype) pair.
+    for (const auto& t : c.tiles) {
+        std::vector<bool> u(c.treePrototypes.size(), false);
+        for (uint32_t i : t.trees)
+            if (c.trees[i].prototype < u.size() && !u[c.trees[i].prototype]) { u[c.trees[i].prototype] = true; ++n.drawCalls; }
+    }
+    for (const auto& tr : c.trees) {
+        if (tr.prototype < c.treePrototypes.size()) {
+            n.triangles += c.treePrototypes[tr.prototype].mesh.triangleCount();
+            n.vertices += c.treePrototypes[tr.prototype].mesh.positions.size();
+        }
+    }
+    return n;
+}
+
+}  // namespace vista

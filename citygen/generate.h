@@ -1,0 +1,33 @@
+// generateCity(): the whole pipeline params -> City.
+//
+// Stages: streets (grown, or `streets` given e.g. from OSM) -> blocks ->
+// lots -> buildings -> trees -> meshes per tile (parallel over tiles).
+// Contract: params must pass validateParams() (checked; error otherwise).
+// Output is byte-for-byte identical for the same params whatever
+// params.threads is. Stage timings go to City::stageTimes.
+#pragma once
+#include <optional>
+
+#include "citygen/city.h"
+#include "citygen/progress.h"
+
+namespace vista {
+
+struct GenerateOptions {
+    Progress* progress = nullptr;
+    std::optional<StreetGraph> streets;  // use these streets instead of growing them
+};
+
+Result<City> generateCity(const CityParams& params, const GenerateOptions& options = {});
+
+// Summary numbers of a city (stats file fields).
+struct CityCounts {
+    size_t streetNodes = 0, streetEdges = 0, blocks = 0, lots = 0, buildings = 0, trees = 0;
+    size_t triangles = 0;        // rendered: tile meshes + every tree instance
+    size_t storedTriangles = 0;  // stored: tile meshes + each prototype once
+    size_t vertices = 0;         // rendered vertices, same convention as triangles
+    size_t drawCalls = 0;        // non-empty tile meshes + one instanced draw per (tile, tree prototype)
+};
+CityCounts countCity(const City& city);
+
+}  // namespace vista

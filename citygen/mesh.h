@@ -1,0 +1,33 @@
+// Mesh: indexed triangles with prelit per-vertex colours, in a local frame.
+//
+// Contract: positions are float metres relative to an origin held by the
+// owner (a tile origin in double precision), so floats stay small anywhere on
+// Earth. Colours are final prelit sRGB (see lighting.h): the rasteriser and the
+// ray caster both show them unlit, so their images match. Triangles are
+// counter-clockwise seen from outside. indices.size() is a multiple of 3 and
+// every index < positions.size(); colors.size() == positions.size().
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace vista {
+
+// Surface materials; one output Geometry per tile and material.
+enum class Material : uint8_t { Ground, Road, Marking, Sidewalk, Grass, Wall, Window, Roof, Trunk, Leaves, Count };
+constexpr int kMaterialCount = int(Material::Count);
+const char* materialName(Material m);
+
+struct Mesh {
+    std::vector<glm::vec3> positions;
+    std::vector<glm::vec3> normals;   // per vertex, unit length (used for prelighting and export)
+    std::vector<glm::u8vec4> colors;  // prelit
+    std::vector<uint32_t> indices;
+
+    size_t triangleCount() const { return indices.size() / 3; }
+    bool empty() const { return indices.empty(); }
+    void append(const Mesh& other);  // concatenates, offsetting indices
+};
+
+}  // namespace vista

@@ -1,0 +1,88 @@
+#include "citygen/mesh_builder.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "citygen/polygon.h"
+
+namespace vista {
+
+TileGrid::TileGrid(const CityParams& p) : _half(p.size_m * 0.5), _size(p.tile_size_m) {
+    _n = std::max(1, int(std::ceil(p.size_m / p.tile_size_m - 1e-9)));
+}
+
+int TileGrid::tileOf(const glm::dvec2& p) const {
+    int x = std::clamp(int(std::floor((p.x + _half) / _size)), 0, _n - 1);
+    int y = std::clamp(int(std::floor((p.y + _half) / _size)), 0, _n - 1);
+    return y * _n + x;
+}
+
+glm::dvec3 TileGrid::origin(int tile) const {
+    return {-_half + ix(tile) * _size, -_half + iy(tile) * _size, 0.0};
+}
+
+MeshBuilder::MeshBuilder(Mesh& target, const glm::dvec3& origin, Material material, const Lighting& light, double variation)
+    : _mesh(target), _origin(origin), _material(material), _light(light), _variation(variation) {}
+
+uint32_t MeshBuilder::vertex(const glm::dvec3& p, const glm::vec3& n, const glm::u8vec4& c) {
+    _mesh.positions.push_back(glm::vec3(p - _origin));
+    _mesh.normals.push_back(n);
+    _mesh.colors.push_back(c);
+    return uint32_t(_mesh.positions.size() - 1);
+}
+
+void MeshBuilder::triangle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+    glm::dvec3 n = glm::cross(b - a, c - a);
+    double len = glm::length(n);
+    if (!(len > 1e-12)) return;
+    n /= len;
+    auto col = prelitColor(_material, n, _light, _variation);
+    glm::vec3 nf(n);
+    uint32_t i0 = vertex(a, nf, col), i1 = vertex(b, nf, col), i2 = vertex(c, nf, col);
+    _mesh.indices.insert(_mesh.indices.end(), {i0, i1, i2});
+}
+
+void MeshBuilder::quad(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& d) {
+    glm::dvec3 n = glm::cross(c - a, d - b);
+    double len = glm::length(n);
+    if (!(len > 1e-12)) return;
+    n /= len;
+    auto col = prelitColor(_material, n, _light, _variation);
+    glm::vec3 nf(n);
+    uint32_t i0 = vertex(a, nf, col), i1 = vertex(b, nf, col), i2 = vertex(c, nf, col), i3 = vertex(d, nf, col);
+    _mesh.indices.insert(_mesh.indices.end(), {i0, i1, i2, i0, i2, i3});
+}
+
+void MeshBuilder::polygon(const std::vector<glm::dvec3>& pts, const glm::dvec3& normal) {
+    if (pts.size() < 3) return;
+    glm::dvec3 n = glm::normalize(normal);
+    glm::dvec3 u = std::abs(n.z) < 0.9 ? glm::normalize(glm::cross(glm::dvec3(0, 0, 1), n)) : glm::dvec3(1, 0, 0);
+    glm::dvec3 v = glm::cross(n, u);
+    std::vector<glm::dvec2> p2;
+    p2.reserve(pts.size());
+    for (const auto& p : pts) p2.emplace_back(glm::dot(p - pts[0], u), glm::dot(p - pts[0], v));
+    auto tris = triangulate(p2);
+    if (tris.empty()) return;
+    auto col = prelitColor(_material, n, _light, _variation);
+    glm::vec3 nf(n);
+    uint32_t base = uint32_t(_mesh.positions.size());
+    for (const auto& p : pts) vertex(p, nf, col);
+    for (uint32_t t : tris) _mesh.indices.push_back(base + t);
+}
+
+void MeshBuilder::prism(const std::vector<glm::dvec2>& fp, double z0, double z1, bool top) {
+    size_t n = fp.size();
+    if (n < 3 || !(z1 > z0)) return;
+    bool ccw = signedArea(fp) > 0;
+    for (size_t i = 0; i < n; ++i) {
+        glm::dvec2 a = fp[ccw ? i : n - 1 - i], b = fp[ccw ? (i + 1) % n : (2 * n - 2 - i) % n];
+        quad({a, z0}, {b, z0}, {b, z1}, {a, z1});
+    }
+    if (top) {
+        std::vector<glm::dvec3> t;
+        for (size_t i = 0; i < n; ++i) t.emplace_back(fp[ccw ? i : n - 1 - i], z1);
+        polygon(t, {0, 0, 1});
+    }
+}
+
+}  // namespace vista

@@ -1,0 +1,54 @@
+// StreetGraph: the planar street network of a city.
+//
+// Contract: node positions are double metres in the city frame (centre of the
+// city at (0,0), x east, y north). After generation or import the graph is
+// planar: edges meet only at shared nodes, no edge is shorter than the
+// configured minimum, no duplicate edges, no self loops, all coordinates
+// finite. Edge ids and node ids are stable for a given (params, seed).
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "citygen/status.h"
+
+namespace vista {
+
+enum class RoadClass : uint8_t { Highway = 0, Arterial = 1, Local = 2 };
+const char* roadClassName(RoadClass c);
+// Default carriageway width (metres) and lanes per class.
+double roadWidth(RoadClass c);
+int roadLanes(RoadClass c);
+
+struct StreetEdge {
+    uint32_t a = 0, b = 0;   // node indices
+    RoadClass cls = RoadClass::Local;
+    float width = 8.0f;      // carriageway width, metres (without sidewalks)
+    uint8_t lanes = 2;
+};
+
+struct StreetGraph {
+    std::vector<glm::dvec2> nodes;
+    std::vector<StreetEdge> edges;
+
+    double edgeLength(size_t e) const { return glm::length(nodes[edges[e].b] - nodes[edges[e].a]); }
+    // Degree of every node.
+    std::vector<int> degrees() const;
+};
+
+// Checks the invariants above; returns a message naming the first violation.
+// `minSegment` is the shortest allowed edge length.
+Status checkPlanarGraph(const StreetGraph& g, double minSegment);
+
+// Serialisation used inside the city file and by tools (compact JSON:
+// {"nodes":[[x,y],...],"edges":[[a,b,cls,width,lanes],...]}).
+std::string streetGraphToJson(const StreetGraph& g);
+Result<StreetGraph> streetGraphFromJson(const std::string& text);
+
+// GeoJSON FeatureCollection of LineStrings in the city frame offset by
+// (originX, originY) metres; properties: class, width, lanes.
+std::string streetGraphToGeoJson(const StreetGraph& g, double originX, double originY);
+
+}  // namespace vista

@@ -1,0 +1,19 @@
+// Ground, road and sidewalk surfaces, per tile.
+//
+// meshSurfaces(): for tile `tile` of `grid`, the ground (a grid following the
+// terrain, Grass inside parks), road carriageways with their width (pieces of
+// at most ~50 m assigned to the tile of their midpoint, joined at
+// intersections by node discs), lane markings on arterials/highways, and
+// sidewalks along each block outline. Heights follow terrainHeight(); roads
+// sit 2 cm above the ground, sidewalks 12 cm, to avoid z-fighting.
+// Writes into the tile's meshes (tile-local). Thread-safe per tile.
+#pragma once
+#include "citygen/city.h"
+#include "citygen/lighting.h"
+#include "citygen/mesh_builder.h"
+
+namespace vista {
+
+void meshSurfaces(const City& city, const TileGrid& grid, int tile, const Lighting& light, Tile& out);
+
+}  // namespace vista

@@ -1,0 +1,81 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "citygen/params.h"
+
+using namespace vista;
+
+TEST(Params, DefaultsAreValid) { EXPECT_TRUE(validateParams(CityParams()).isOk()); }
+
+TEST(Params, SizeZeroRejectedWithRange) {
+    CityParams p;
+    p.size_m = 0;
+    Status s = validateParams(p);
+    ASSERT_FALSE(s.isOk());
+    EXPECT_NE(s.message().find("size_m"), std::string::npos);
+    EXPECT_NE(s.message().find("[100, 16000]"), std::string::npos);
+}
+
+TEST(Params, TinyAndHugeSizesRejected) {
+    for (double v : {1.0, 99.9, 16000.1, 1e9, -5.0}) {
+        CityParams p;
+        p.size_m = v;
+        EXPECT_FALSE(validateParams(p).isOk()) << v;
+    }
+}
+
+TEST(Params, NanRejected) {
+    CityParams p;
+    p.sun_elevation_deg = std::nan("");
+    EXPECT_FALSE(validateParams(p).isOk());
+}
+
+TEST(Params, JsonOverridesBase) {
+    auto r = parseParamsJson(R"({"size_m": 500, "seed": 7, "detail": 0})", "x.json");
+    ASSERT_TRUE(r.isOk()) << r.status().message();
+    EXPECT_EQ(r->size_m, 500);
+    EXPECT_EQ(r->seed, 7u);
+    EXPECT_EQ(r->detail, 0);
+    EXPECT_EQ(r->tile_size_m, CityParams().tile_size_m);
+}
+
+TEST(Params, UnknownKeyNamed) {
+    auto r = parseParamsJson(R"({"sise_m": 500})", "x.json");
+    ASSERT_FALSE(r.isOk());
+    EXPECT_NE(r.status().message().find("'sise_m'"), std::string::npos);
+}
+
+TEST(Params, MalformedJsonReportsLineAndColumn) {
+    auto r = parseParamsJson("{\n  \"size_m\": 500,\n  \"seed\": ,\n}", "bad.json");
+    ASSERT_FALSE(r.isOk());
+    EXPECT_NE(r.status().message().find("bad.json:3:"), std::string::npos) << r.status().message();
+}
+
+TEST(Params, WrongTypes) {
+    EXPECT_FALSE(parseParamsJson(R"({"size_m": "big"})", "x").isOk());
+    EXPECT_FALSE(parseParamsJson(R"({"detail": 1.5})", "x").isOk());
+    EXPECT_FALSE(parseParamsJson(R"({"seed": -1})", "x").isOk());
+    EXPECT_FALSE(parseParamsJson(R"([1,2])", "x").isOk());
+}
+
+TEST(Params, CanonicalJsonRoundTripsAndOmitsThreads) {
+    CityParams p;
+    p.seed = 42;
+    p.size_m = 1234.5;
+    p.threads = 3;
+    std::string j = paramsToJson(p);
+    EXPECT_EQ(j.find("threads"), std::string::npos);
+    auto r = parseParamsJson(j, "canon");
+    ASSERT_TRUE(r.isOk()) << r.status().message();
+    EXPECT_EQ(r->seed, 42u);
+    EXPECT_EQ(r->size_m, 1234.5);
+    EXPECT_EQ(paramsToJson(*r), j);
+}
+
+TEST(Params, ExampleFilesParse) {
+    for (const char* f : {"village", "town", "downtown", "metropolis", "default"}) {
+        auto r = loadParamsFile(std::string(VISTA_SOURCE_DIR) + "/data/" + f + ".json");
+        EXPECT_TRUE(r.isOk()) << f << ": " << r.status().message();
+    }
+}
