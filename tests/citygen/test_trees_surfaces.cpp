@@ -1,0 +1,2 @@
+// Tests arrive with this module's work.
+#include <gtest/gtest.h>
