@@ -1,6 +1,512 @@
-// STUB
+// Trees: procedural prototypes (recursive branching + low-poly leaf clusters)
+// and their placement along streets and in parks. See trees.h for the
+// contract and docs/trees-and-surfaces.md for budgets and rules.
 #include "citygen/trees.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+#include "citygen/mesh_builder.h"
+#include "citygen/polygon.h"
+#include "citygen/rng.h"
+#include "citygen/terrain.h"
+
 namespace vista {
-std::vector<TreePrototype> makeTreePrototypes(const CityParams&, const Lighting&) { return {}; }
-std::vector<TreeInstance> placeTrees(const City&, Progress*) { return {}; }
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr int kSpecies = 3;   // 0 broadleaf, 1 conifer, 2 columnar
+constexpr int kVariants = 3;  // small, medium, large
+constexpr double kMinBranchRadius = 0.035;  // thinnest twig, metres
+
+// Nominal prototype heights (metres) per species and size variant; instances
+// scale by 0.85..1.15, so every tree stays within 5..22 m.
+constexpr double kHeights[kSpecies][kVariants] = {{7.5, 11.5, 16.0}, {8.5, 13.0, 19.0}, {7.0, 11.0, 15.5}};
+
+// Writes the prototype geometry with one MeshBuilder whose material switches
+// between Trunk and Leaves.
+class TreeShaper {
+public:
+    TreeShaper(Mesh& mesh, const Lighting& light, Rng& rng)
+        : _b(mesh, glm::dvec3(0.0), Material::Trunk, light), _rng(rng) {}
+
+    // Tapered prism from p0 (radius r0) to p1 (radius r1) with `sides` faces, no caps.
+    void limb(const glm::dvec3& p0, const glm::dvec3& p1, double r0, double r1, int sides) {
+        glm::dvec3 dir = p1 - p0;
+        double len = glm::length(dir);
+        if (!(len > 1e-4)) return;
+        glm::dvec3 d = dir / len;
+        glm::dvec3 helper = std::abs(d.z) < 0.9 ? glm::dvec3(0, 0, 1) : glm::dvec3(1, 0, 0);
+        glm::dvec3 u = glm::normalize(glm::cross(d, helper));
+        glm::dvec3 v = glm::cross(d, u);  // (u, v, d) right-handed
+        _b.setMaterial(Material::Trunk);
+        _b.setVariation(_barkVariation);
+        double phase = _rng.uniform(0.0, 2 * kPi);
+        for (int i = 0; i < sides; ++i) {
+            double a0 = phase + 2 * kPi * i / sides, a1 = phase + 2 * kPi * (i + 1) / sides;
+            glm::dvec3 e0 = u * std::cos(a0) + v * std::sin(a0), e1 = u * std::cos(a1) + v * std::sin(a1);
+            _b.quad(p0 + e0 * r0, p0 + e1 * r0, p1 + e1 * r1, p1 + e0 * r1);
+        }
+    }
+
+    // Closed low-poly leaf cluster: an irregular bipyramid over a `ring`-gon
+    // (2 * ring triangles) with half-extents rx, ry (horizontal) and rz.
+    void blob(const glm::dvec3& c, double rh, double rz, int ring = 4) {
+        _b.setMaterial(Material::Leaves);
+        _b.setVariation(std::clamp(_leafVariation + _rng.uniform(-0.35, 0.35), -1.0, 1.0));
+        double phase = _rng.uniform(0.0, 2 * kPi);
+        std::vector<glm::dvec3> rim(size_t(ring));
+        for (int i = 0; i < ring; ++i) {
+            double a = phase + 2 * kPi * (i + _rng.uniform(-0.15, 0.15)) / ring;
+            double r = rh * _rng.uniform(0.8, 1.15);
+            rim[size_t(i)] = c + glm::dvec3(r * std::cos(a), r * std::sin(a), rz * _rng.uniform(-0.2, 0.2));
+        }
+        glm::dvec3 top = c + glm::dvec3(_rng.uniform(-0.15, 0.15) * rh, _rng.uniform(-0.15, 0.15) * rh, rz * _rng.uniform(0.85, 1.15));
+        glm::dvec3 bot = c - glm::dvec3(0, 0, rz * _rng.uniform(0.6, 0.9));
+        for (int i = 0; i < ring; ++i) {
+            const glm::dvec3& a = rim[size_t(i)];
+            const glm::dvec3& b = rim[size_t((i + 1) % ring)];
+            _b.triangle(a, b, top);
+            _b.triangle(b, a, bot);
+        }
+    }
+
+    // Conifer foliage tier: a double cone (apex above the trunk, skirt ring
+    // around it, flat-ish underside), 2 * ring triangles.
+    void tier(const glm::dvec3& trunkAt, double radius, double up, double down, int ring) {
+        _b.setMaterial(Material::Leaves);
+        _b.setVariation(std::clamp(_leafVariation + _rng.uniform(-0.25, 0.25), -1.0, 1.0));
+        double phase = _rng.uniform(0.0, 2 * kPi);
+        std::vector<glm::dvec3> rim(size_t(ring));
+        for (int i = 0; i < ring; ++i) {
+            double a = phase + 2 * kPi * i / ring;
+            double r = radius * _rng.uniform(0.8, 1.1);
+            rim[size_t(i)] = trunkAt + glm::dvec3(r * std::cos(a), r * std::sin(a), -down * _rng.uniform(0.7, 1.0));
+        }
+        glm::dvec3 top = trunkAt + glm::dvec3(0, 0, up), bot = trunkAt + glm::dvec3(0, 0, -0.35 * down);
+        for (int i = 0; i < ring; ++i) {
+            const glm::dvec3& a = rim[size_t(i)];
+            const glm::dvec3& b = rim[size_t((i + 1) % ring)];
+            _b.triangle(a, b, top);
+            _b.triangle(b, a, bot);
+        }
+    }
+
+    void setBarkVariation(double v) { _barkVariation = v; }
+    void setLeafVariation(double v) { _leafVariation = v; }
+    Rng& rng() { return _rng; }
+
+private:
+    MeshBuilder _b;
+    Rng& _rng;
+    double _barkVariation = 0, _leafVariation = 0;
+};
+
+// Unit vector at angle `tilt` from `d`, rotated by `az` around it.
+glm::dvec3 deviate(const glm::dvec3& d, double tilt, double az) {
+    glm::dvec3 helper = std::abs(d.z) < 0.9 ? glm::dvec3(0, 0, 1) : glm::dvec3(1, 0, 0);
+    glm::dvec3 u = glm::normalize(glm::cross(d, helper));
+    glm::dvec3 v = glm::cross(d, u);
+    return glm::normalize(d * std::cos(tilt) + (u * std::cos(az) + v * std::sin(az)) * std::sin(tilt));
 }
+
+struct BranchStyle {
+    int maxDepth = 3;
+    int minChildren = 2, maxChildren = 3;
+    double tiltMin = 0.45, tiltMax = 0.85;  // child angle from parent (radians)
+    double lenRatio = 0.72;                  // child length / parent length
+    double leafRadius = 1.0;                 // horizontal half-extent of a tip cluster
+    double leafFlatten = 0.7;                // vertical / horizontal extent
+    double upBias = 0.15;                    // pull of children towards +z
+    int leafRing = 4;
+};
+
+// Recursive branch: two slightly bent tapered segments, then children; leaf
+// clusters on the last two levels.
+void branch(TreeShaper& t, const BranchStyle& s, const glm::dvec3& p, const glm::dvec3& d, double len, double r,
+            int depth) {
+    Rng& rng = t.rng();
+    double rEnd = std::max(kMinBranchRadius, r * 0.62);
+    int sides = depth <= 1 ? 4 : 3;
+    glm::dvec3 bend = deviate(d, rng.uniform(0.05, 0.25), rng.uniform(0.0, 2 * kPi));
+    glm::dvec3 mid = p + d * (0.5 * len);
+    glm::dvec3 end = mid + bend * (0.5 * len);
+    if (depth >= s.maxDepth) {
+        t.limb(p, end, r, rEnd, 3);
+        t.blob(end, s.leafRadius * rng.uniform(0.85, 1.15), s.leafRadius * s.leafFlatten, s.leafRing);
+        return;
+    }
+    t.limb(p, mid, r, 0.5 * (r + rEnd), sides);
+    t.limb(mid, end, 0.5 * (r + rEnd), rEnd, sides);
+    if (depth == s.maxDepth - 1 && rng.chance(0.6))
+        t.blob(end, s.leafRadius * rng.uniform(0.9, 1.25), s.leafRadius * s.leafFlatten, s.leafRing);
+    int n = int(rng.range(s.minChildren, s.maxChildren));
+    double az0 = rng.uniform(0.0, 2 * kPi);
+    for (int i = 0; i < n; ++i) {
+        double az = az0 + 2 * kPi * (i + rng.uniform(-0.2, 0.2)) / n;
+        glm::dvec3 cd = deviate(bend, rng.uniform(s.tiltMin, s.tiltMax), az);
+        cd = glm::normalize(cd + glm::dvec3(0, 0, s.upBias));
+        branch(t, s, end, cd, len * s.lenRatio * rng.uniform(0.85, 1.1), std::max(kMinBranchRadius, rEnd * 0.8),
+               depth + 1);
+    }
+}
+
+void makeBroadleaf(TreeShaper& t, int variant, double h) {
+    Rng& rng = t.rng();
+    BranchStyle s;
+    s.maxDepth = variant == 0 ? 3 : 4;
+    s.minChildren = 2;
+    s.maxChildren = variant == 1 ? 2 : 3;
+    s.leafRadius = h * (variant == 0 ? 0.085 : 0.065);
+    s.leafFlatten = 0.7;
+    s.leafRing = variant == 0 ? 5 : 4;
+    double trunkH = h * 0.36, r0 = h * 0.019;
+    glm::dvec3 lean(rng.uniform(-0.03, 0.03) * h, rng.uniform(-0.03, 0.03) * h, trunkH);
+    t.limb({0, 0, -0.1}, lean * 0.5 + glm::dvec3(0, 0, -0.05), r0, r0 * 0.9, 6);
+    t.limb(lean * 0.5 + glm::dvec3(0, 0, -0.05), lean, r0 * 0.9, r0 * 0.75, 6);
+    int mains = variant == 2 ? 5 : 4;
+    double az0 = rng.uniform(0.0, 2 * kPi);
+    // Main limbs spread outwards; total reach ~ crown radius 0.38 h.
+    double len = h * (s.maxDepth == 3 ? 0.26 : 0.2);
+    for (int i = 0; i < mains; ++i) {
+        double az = az0 + 2 * kPi * (i + rng.uniform(-0.2, 0.2)) / mains;
+        double elev = rng.uniform(0.55, 0.95);
+        glm::dvec3 d(std::cos(az) * std::cos(elev), std::sin(az) * std::cos(elev), std::sin(elev));
+        glm::dvec3 start = lean * rng.uniform(0.85, 1.0);
+        branch(t, s, start, d, len * rng.uniform(0.9, 1.1), r0 * 0.55, 1);
+    }
+}
+
+void makeConifer(TreeShaper& t, int variant, double h) {
+    Rng& rng = t.rng();
+    double r0 = h * 0.016;
+    // Trunk to the tip in 4 tapering segments.
+    const int segs = 4;
+    for (int i = 0; i < segs; ++i) {
+        double z0 = i == 0 ? -0.1 : h * 0.97 * i / segs, z1 = h * 0.97 * (i + 1) / segs;
+        double ra = std::max(kMinBranchRadius, r0 * (1.0 - 0.85 * i / segs));
+        double rb = std::max(kMinBranchRadius, r0 * (1.0 - 0.85 * (i + 1) / segs));
+        t.limb({0, 0, z0}, {0, 0, z1}, ra, rb, 6);
+    }
+    int whorls = 7 + 3 * variant;
+    double zStart = h * rng.uniform(0.18, 0.26), crownR = h * 0.22;
+    int perWhorl = 5 + variant / 2;
+    for (int w = 0; w < whorls; ++w) {
+        double f = double(w) / whorls;  // 0 at the bottom whorl
+        double z = zStart + (h * 0.95 - zStart) * f;
+        double reach = crownR * std::pow(1.0 - f, 0.9) + 0.35;
+        double spacing = (h * 0.95 - zStart) / whorls;
+        double az0 = rng.uniform(0.0, 2 * kPi);
+        for (int k = 0; k < perWhorl; ++k) {
+            double az = az0 + 2 * kPi * (k + rng.uniform(-0.2, 0.2)) / perWhorl;
+            double droop = rng.uniform(0.1, 0.35);
+            glm::dvec3 dir(std::cos(az) * std::cos(droop), std::sin(az) * std::cos(droop), -std::sin(droop));
+            double rb = std::max(kMinBranchRadius, r0 * 0.35 * (1.0 - f));
+            t.limb({0, 0, z}, glm::dvec3(0, 0, z) + dir * (reach * 0.95), rb, kMinBranchRadius, 3);
+        }
+        t.tier({0, 0, z}, reach, spacing * 1.6, spacing * 0.7, variant == 2 ? 8 : 7);
+    }
+    t.blob({0, 0, h * 0.96}, 0.35 + 0.05 * h * 0.05, h * 0.05, 4);
+}
+
+void makeColumnar(TreeShaper& t, int variant, double h) {
+    Rng& rng = t.rng();
+    double r0 = h * 0.017;
+    const int segs = 3;
+    for (int i = 0; i < segs; ++i) {
+        double z0 = i == 0 ? -0.1 : h * 0.9 * i / segs, z1 = h * 0.9 * (i + 1) / segs;
+        t.limb({0, 0, z0}, {0, 0, z1}, std::max(kMinBranchRadius, r0 * (1.0 - 0.7 * i / segs)),
+               std::max(kMinBranchRadius, r0 * (1.0 - 0.7 * (i + 1) / segs)), 6);
+    }
+    int n = 14 + 6 * variant;
+    double crownR = h * 0.13, z0 = h * 0.14, z1 = h * 0.88;
+    double leaf = h * 0.055;
+    for (int i = 0; i < n; ++i) {
+        double f = (i + rng.uniform(0.0, 1.0)) / n;
+        double z = z0 + (z1 - z0) * f;
+        double az = i * 2.39996 + rng.uniform(-0.3, 0.3);  // golden angle spiral
+        double profile = std::sin(kPi * (0.15 + 0.8 * f));  // spindle-shaped crown
+        double elev = rng.uniform(1.0, 1.25);                // steep, upward branches
+        glm::dvec3 dir(std::cos(az) * std::cos(elev), std::sin(az) * std::cos(elev), std::sin(elev));
+        double len = (crownR * profile + 0.4) / std::cos(elev);
+        glm::dvec3 a(0, 0, z), b = a + dir * len;
+        double rb = std::max(kMinBranchRadius, r0 * 0.3);
+        t.limb(a, b, rb, kMinBranchRadius, 3);
+        t.blob(b, leaf * (0.8 + profile * 0.5), leaf * 1.8, 4);
+        if (variant > 0 && rng.chance(0.6)) {
+            glm::dvec3 twig = deviate(dir, rng.uniform(0.4, 0.7), rng.uniform(0.0, 2 * kPi));
+            glm::dvec3 c = a + dir * (len * 0.5);
+            t.limb(c, c + twig * (len * 0.5), kMinBranchRadius, kMinBranchRadius, 3);
+            t.blob(c + twig * (len * 0.5), leaf * 0.8, leaf * 1.5, 4);
+        }
+    }
+    t.blob({0, 0, h * 0.9}, leaf * 1.2, h * 0.08, 5);
+}
+
+double meshTop(const Mesh& m) {
+    double top = 0;
+    for (const auto& p : m.positions) top = std::max(top, double(p.z));
+    return top;
+}
+
+}  // namespace
+
+std::vector<TreePrototype> makeTreePrototypes(const CityParams& params, const Lighting& light) {
+    std::vector<TreePrototype> out;
+    out.reserve(size_t(kSpecies * kVariants));
+    for (int species = 0; species < kSpecies; ++species) {
+        for (int variant = 0; variant < kVariants; ++variant) {
+            int id = species * kVariants + variant;
+            Rng rng(params.seed, uint64_t(id) + 0x7EE0000ull, Stream::Trees);
+            TreePrototype p;
+            p.species = species;
+            p.variant = variant;
+            double h = kHeights[species][variant];
+            TreeShaper t(p.mesh, light, rng);
+            t.setBarkVariation(rng.uniform(-0.3, 0.3));
+            if (species == 0) {
+                t.setLeafVariation(rng.uniform(-0.1, 0.3));
+                makeBroadleaf(t, variant, h);
+            } else if (species == 1) {
+                t.setBarkVariation(-0.4);
+                t.setLeafVariation(rng.uniform(-0.9, -0.6));
+                makeConifer(t, variant, h);
+            } else {
+                t.setLeafVariation(rng.uniform(0.2, 0.5));
+                makeColumnar(t, variant, h);
+            }
+            p.height = meshTop(p.mesh);
+            out.push_back(std::move(p));
+        }
+    }
+    return out;
+}
+
+// ---------------------------------------------------------------------------
+// Placement
+
+namespace {
+
+// Uniform grid over the city square holding item indices per cell (CSR).
+class CellIndex {
+public:
+    CellIndex(double half, double cell) : _half(half), _cell(cell) {
+        _n = std::max(1, int(std::ceil(2 * half / cell)));
+        _start.assign(size_t(_n) * size_t(_n) + 1, 0);
+    }
+    int cx(double x) const { return std::clamp(int(std::floor((x + _half) / _cell)), 0, _n - 1); }
+    int cy(double y) const { return std::clamp(int(std::floor((y + _half) / _cell)), 0, _n - 1); }
+    // Two passes: count(...) for every item, then finishCounts(), then fill(...) for every item in the same order.
+    template <class F>
+    void forCells(const glm::dvec2& lo, const glm::dvec2& hi, F f) const {
+        for (int y = cy(lo.y), y1 = cy(hi.y); y <= y1; ++y)
+            for (int x = cx(lo.x), x1 = cx(hi.x); x <= x1; ++x) f(size_t(y) * size_t(_n) + size_t(x));
+    }
+    void count(const glm::dvec2& lo, const glm::dvec2& hi) {
+        forCells(lo, hi, [&](size_t c) { ++_start[c + 1]; });
+    }
+    void finishCounts() {
+        for (size_t i = 1; i < _start.size(); ++i) _start[i] += _start[i - 1];
+        _items.resize(_start.back());
+        _fill.assign(_start.begin(), _start.end() - 1);
+    }
+    void fill(const glm::dvec2& lo, const glm::dvec2& hi, uint32_t item) {
+        forCells(lo, hi, [&](size_t c) { _items[_fill[c]++] = item; });
+    }
+    template <class F>
+    bool any(const glm::dvec2& p, F pred) const {
+        size_t c = size_t(cy(p.y)) * size_t(_n) + size_t(cx(p.x));
+        for (uint32_t i = _start[c]; i < _start[c + 1]; ++i)
+            if (pred(_items[i])) return true;
+        return false;
+    }
+
+private:
+    double _half, _cell;
+    int _n;
+    std::vector<uint32_t> _start, _fill, _items;
+};
+
+uint64_t quantKey(const glm::dvec2& p) {
+    int64_t qx = std::llround(p.x * 10.0), qy = std::llround(p.y * 10.0);  // 10 cm
+    return hashKeys(uint64_t(qx), uint64_t(qy), 0x7EEull);
+}
+
+constexpr double kRoadClearance = 1.0;      // trunk to carriageway edge, metres
+constexpr double kBuildingClearance = 1.5;  // trunk to building footprint, metres
+constexpr double kIntersectionClearance = 10.0;
+constexpr double kMinTreeDistance = 3.0;    // between any two trees
+constexpr double kParkEdgeClearance = 2.0;  // park trees from the park outline
+
+struct Candidate {
+    glm::dvec2 p;
+    uint64_t key;
+    bool street;
+    int species;  // -1: choose per tree
+};
+
+}  // namespace
+
+std::vector<TreeInstance> placeTrees(const City& city, Progress* progress) {
+    const CityParams& P = city.params;
+    const StreetGraph& g = city.streets;
+    const double half = P.size_m * 0.5;
+    const int protoCount = city.treePrototypes.empty() ? kSpecies * kVariants : int(city.treePrototypes.size());
+    std::vector<TreeInstance> out;
+    if (progress) progress->update(0.0);
+
+    // Spatial indices over buildings and carriageways (cell 32 m).
+    const double cell = 32.0;
+    CellIndex bIdx(half, cell), eIdx(half, cell);
+    std::vector<std::pair<glm::dvec2, glm::dvec2>> bBox(city.buildings.size());
+    for (size_t i = 0; i < city.buildings.size(); ++i) {
+        glm::dvec2 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+        for (const auto& q : city.buildings[i].footprint) lo = glm::min(lo, q), hi = glm::max(hi, q);
+        bBox[i] = {lo - kBuildingClearance, hi + kBuildingClearance};
+    }
+    for (const auto& b : bBox) if (b.first.x <= b.second.x) bIdx.count(b.first, b.second);
+    bIdx.finishCounts();
+    for (size_t i = 0; i < bBox.size(); ++i) if (bBox[i].first.x <= bBox[i].second.x) bIdx.fill(bBox[i].first, bBox[i].second, uint32_t(i));
+    auto edgeBox = [&](size_t e) {
+        const auto& a = g.nodes[g.edges[e].a];
+        const auto& b = g.nodes[g.edges[e].b];
+        double m = 0.5 * g.edges[e].width + kRoadClearance;
+        return std::make_pair(glm::min(a, b) - m, glm::max(a, b) + m);
+    };
+    for (size_t e = 0; e < g.edges.size(); ++e) { auto bb = edgeBox(e); eIdx.count(bb.first, bb.second); }
+    eIdx.finishCounts();
+    for (size_t e = 0; e < g.edges.size(); ++e) { auto bb = edgeBox(e); eIdx.fill(bb.first, bb.second, uint32_t(e)); }
+
+    auto onRoad = [&](const glm::dvec2& p) {
+        return eIdx.any(p, [&](uint32_t e) {
+            const auto& E = g.edges[e];
+            return pointSegmentDistance(p, g.nodes[E.a], g.nodes[E.b]) < 0.5 * E.width + kRoadClearance;
+        });
+    };
+    auto inBuilding = [&](const glm::dvec2& p) {
+        return bIdx.any(p, [&](uint32_t i) {
+            const auto& fp = city.buildings[i].footprint;
+            if (p.x < bBox[i].first.x || p.y < bBox[i].first.y || p.x > bBox[i].second.x || p.y > bBox[i].second.y) return false;
+            if (fp.size() >= 3 && pointInPolygon(fp, p)) return true;
+            for (size_t k = 0; k < fp.size(); ++k)
+                if (pointSegmentDistance(p, fp[k], fp[(k + 1) % fp.size()]) < kBuildingClearance) return true;
+            return false;
+        });
+    };
+    auto inCity = [&](const glm::dvec2& p) { return std::abs(p.x) <= half - 1.0 && std::abs(p.y) <= half - 1.0; };
+
+    std::vector<Candidate> cand;
+    // Street trees.
+    if (P.street_tree_spacing_m > 0 && !g.edges.empty()) {
+        std::vector<int> deg = g.degrees();
+        const double spacing = P.street_tree_spacing_m;
+        for (size_t e = 0; e < g.edges.size(); ++e) {
+            const auto& E = g.edges[e];
+            glm::dvec2 A = g.nodes[E.a], B = g.nodes[E.b];
+            double L = glm::length(B - A);
+            if (!(L > 1e-6)) continue;
+            glm::dvec2 d = (B - A) / L, n(-d.y, d.x);
+            auto clearance = [&](uint32_t node) {
+                int k = deg[node];
+                return k >= 3 ? kIntersectionClearance : (k == 2 ? 4.0 : 3.0);
+            };
+            double ca = clearance(E.a), cb = clearance(E.b);
+            double usable = L - ca - cb;
+            if (usable < 0) continue;
+            // Evenly spaced, centred in the usable stretch.
+            int count = int(std::floor(usable / spacing)) + 1;
+            double first = ca + 0.5 * (usable - (count - 1) * spacing);
+            // Species per street (stable key: quantised end points, order-independent).
+            uint64_t ka = quantKey(A), kb = quantKey(B);
+            Rng srng(P.seed, hashKeys(std::min(ka, kb), std::max(ka, kb), 0x57EE7ull), Stream::Trees);
+            int streetSpecies = int(srng.range(0, kSpecies - 1));
+            double off = 0.5 * E.width + 0.5 * P.sidewalk_m;
+            for (int side = -1; side <= 1; side += 2) {
+                for (int i = 0; i < count; ++i) {
+                    glm::dvec2 p = A + d * (first + i * spacing) + n * (side * off);
+                    if (!inCity(p)) continue;
+                    cand.push_back({p, quantKey(p), true, streetSpecies});
+                }
+            }
+        }
+    }
+    if (progress) progress->update(0.3);
+    // Park trees: a jittered grid anchored to the city frame (cells seeded by
+    // their lattice index, so a park's trees do not depend on other blocks).
+    if (P.park_tree_density > 0) {
+        const double c = 1.0 / std::sqrt(P.park_tree_density);
+        for (const auto& blk : city.blocks) {
+            if (!blk.park || blk.outline.size() < 3) continue;
+            glm::dvec2 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+            for (const auto& q : blk.outline) lo = glm::min(lo, q), hi = glm::max(hi, q);
+            int64_t i0 = int64_t(std::floor(lo.x / c)), i1 = int64_t(std::floor(hi.x / c));
+            int64_t j0 = int64_t(std::floor(lo.y / c)), j1 = int64_t(std::floor(hi.y / c));
+            for (int64_t j = j0; j <= j1; ++j) {
+                for (int64_t i = i0; i <= i1; ++i) {
+                    Rng r(P.seed, hashKeys(uint64_t(i), uint64_t(j), 0x9A2Cull), Stream::Trees);
+                    glm::dvec2 p((double(i) + r.uniform(0.1, 0.9)) * c, (double(j) + r.uniform(0.1, 0.9)) * c);
+                    if (!pointInPolygon(blk.outline, p) || !inCity(p)) continue;
+                    bool nearEdge = false;
+                    for (size_t k = 0; k < blk.outline.size() && !nearEdge; ++k)
+                        nearEdge = pointSegmentDistance(p, blk.outline[k], blk.outline[(k + 1) % blk.outline.size()]) <
+                                   kParkEdgeClearance;
+                    if (nearEdge) continue;
+                    cand.push_back({p, quantKey(p), false, -1});
+                }
+            }
+        }
+    }
+    if (progress) progress->update(0.5);
+
+    // Canonical order (by position), then reject conflicts; the greedy
+    // spacing filter runs in this order so it does not depend on edge order.
+    TileGrid grid(P);
+    std::sort(cand.begin(), cand.end(), [&](const Candidate& a, const Candidate& b) {
+        int ta = grid.tileOf(a.p), tb = grid.tileOf(b.p);
+        if (ta != tb) return ta < tb;
+        if (a.p.y != b.p.y) return a.p.y < b.p.y;
+        if (a.p.x != b.p.x) return a.p.x < b.p.x;
+        return a.street > b.street;
+    });
+    std::unordered_map<uint64_t, std::vector<glm::dvec2>> kept;  // hash grid of accepted trunks (cell = kMinTreeDistance)
+    auto cellKey = [](int64_t x, int64_t y) { return hashKeys(uint64_t(x), uint64_t(y)); };
+    out.reserve(cand.size());
+    for (const auto& c : cand) {
+        if (onRoad(c.p) || inBuilding(c.p)) continue;
+        int64_t gx = int64_t(std::floor(c.p.x / kMinTreeDistance)), gy = int64_t(std::floor(c.p.y / kMinTreeDistance));
+        bool close = false;
+        for (int64_t y = gy - 1; y <= gy + 1 && !close; ++y)
+            for (int64_t x = gx - 1; x <= gx + 1 && !close; ++x) {
+                auto it = kept.find(cellKey(x, y));
+                if (it == kept.end()) continue;
+                for (const auto& q : it->second)
+                    if (glm::length(q - c.p) < kMinTreeDistance) { close = true; break; }
+            }
+        if (close) continue;
+        kept[cellKey(gx, gy)].push_back(c.p);
+
+        Rng r(P.seed, c.key, Stream::Trees);
+        int species;
+        if (c.species >= 0) {
+            species = r.chance(0.85) ? c.species : int(r.range(0, kSpecies - 1));
+        } else {
+            double u = r.uniform();  // parks: mostly broadleaf
+            species = u < 0.55 ? 0 : (u < 0.85 ? 1 : 2);
+        }
+        int variant = c.street ? (r.chance(0.6) ? 1 : int(r.range(0, 1)) * 2) : int(r.range(0, kVariants - 1));
+        TreeInstance t;
+        t.position = glm::dvec3(c.p, terrainHeight(P, c.p));
+        t.yaw = float(r.uniform(0.0, 2 * kPi));
+        t.scale = float(r.uniform(0.85, 1.15));
+        t.prototype = uint16_t(std::min(species * kVariants + variant, protoCount - 1));
+        t.street = c.street;
+        out.push_back(t);
+    }
+    if (progress) progress->update(1.0);
+    return out;
+}
+
+}  // namespace vista

@@ -21,7 +21,7 @@ int runGen(int argc, char** argv) {
     std::optional<uint64_t> seed;
     std::optional<double> size;
     std::optional<int> detail, threads;
-    bool quiet = false;
+    bool quiet = false, listParams = false;
     app.add_option("--params", paramsFile, "JSON parameter file (see docs/params.md; examples in data/)");
     app.add_option("--seed", seed, "random seed (overrides the params file)");
     app.add_option("--size", size, "side of the square city area in metres, 100..16000 (default 2000)");
@@ -31,11 +31,26 @@ int runGen(int argc, char** argv) {
     app.add_option("--geojson", geojsonFile, "also write the street graph as GeoJSON");
     app.add_option("--gltf", gltfFile, "also write the city as binary glTF 2.0 (.glb)");
     app.add_option("--stats", statsFile, "write statistics (counts, timings, peak memory) as JSON");
-    app.add_option("-o,--output", out, "output scene file (.osgb)")->required();
+    auto* outOpt = app.add_option("-o,--output", out, "output scene file (.osgb)");
+    app.add_flag("--list-params", listParams, "print every parameter with unit, range and default (Markdown) and exit");
     app.add_flag("-q,--quiet", quiet, "no progress on stderr");
     int rc = parseOrExit(app, argc, argv);
     if (rc >= 0) return rc;
     const std::string cmd = "vista gen";
+    if (listParams) {
+        CityParams d;
+        auto defaults = nlohmann::json::parse(paramsToJson(d));
+        std::printf("| parameter | unit | range | default | meaning |\n|---|---|---|---|---|\n");
+        for (const auto& s : paramSpecs()) {
+            std::string def = std::string(s.name) == "threads" ? "0" : defaults[s.name].dump();
+            char range[64];
+            if (std::string(s.name) == "seed") std::snprintf(range, sizeof range, "0 .. 2^64-1");
+            else std::snprintf(range, sizeof range, "%g .. %g", s.min, s.max);
+            std::printf("| `%s` | %s | %s | %s | %s |\n", s.name, s.unit, range, def.c_str(), s.help);
+        }
+        return 0;
+    }
+    if (outOpt->count() == 0) return reportBadInput(cmd, Status::error("option -o/--output is required (the .osgb to write)"));
 
     auto t0 = std::chrono::steady_clock::now();
     CityParams params;
