@@ -49,6 +49,7 @@ void buildTiles(City& city, Progress* progress) {
     for (uint32_t i = 0; i < city.trees.size(); ++i)
         treesOf[size_t(grid.tileOf(glm::dvec2(city.trees[i].position)))].push_back(i);
 
+    const SurfaceIndex surfaceIndex = buildSurfaceIndex(city, grid);
     std::vector<Tile> tiles(size_t(grid.count()));
     std::mutex m;
     size_t done = 0;
@@ -57,7 +58,7 @@ void buildTiles(City& city, Progress* progress) {
         tile.ix = grid.ix(t);
         tile.iy = grid.iy(t);
         tile.origin = grid.origin(t);
-        meshSurfaces(city, grid, t, light, tile);
+        meshSurfaces(city, grid, t, light, tile, &surfaceIndex);
         BuildingMeshes out{&tile.meshes[size_t(Material::Wall)], &tile.meshes[size_t(Material::Window)],
                            &tile.meshes[size_t(Material::Roof)]};
         for (uint32_t b : buildingsOf[size_t(t)]) meshBuilding(city.buildings[b], b, p, light, tile.origin, out);

@@ -13,16 +13,16 @@ Lighting::Lighting(const CityParams& p) {
 
 glm::dvec3 materialAlbedo(Material m) {
     switch (m) {
-        case Material::Ground: return {0.42, 0.40, 0.36};
+        case Material::Ground: return {0.41, 0.40, 0.34};
         case Material::Road: return {0.22, 0.22, 0.24};
         case Material::Marking: return {0.85, 0.85, 0.80};
         case Material::Sidewalk: return {0.62, 0.60, 0.57};
-        case Material::Grass: return {0.30, 0.50, 0.22};
+        case Material::Grass: return {0.27, 0.46, 0.18};
         case Material::Wall: return {0.78, 0.70, 0.60};
         case Material::Window: return {0.22, 0.30, 0.40};
         case Material::Roof: return {0.55, 0.30, 0.25};
-        case Material::Trunk: return {0.36, 0.26, 0.18};
-        case Material::Leaves: return {0.20, 0.42, 0.16};
+        case Material::Trunk: return {0.33, 0.24, 0.17};
+        case Material::Leaves: return {0.15, 0.33, 0.11};
         case Material::Count: break;
     }
     return {1, 0, 1};

@@ -1,5 +1,285 @@
-// STUB
+// planarize(): exact arrangement (CGAL Epeck) of arbitrary segments, then a
+// cleanup in double precision (snap, contract short edges, dedup) that is
+// re-checked with exact predicates and repeated until the graph is planar;
+// a last-resort pass drops conflicting edges so the contract always holds.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <numeric>
+#include <tuple>
+#include <unordered_map>
+
+#include <CGAL/Arr_curve_data_traits_2.h>
+#include <CGAL/Arr_segment_traits_2.h>
+#include <CGAL/Arrangement_2.h>
+#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+
+#include "citygen/street_geometry.h"
 #include "citygen/streets.h"
+
 namespace vista {
-StreetGraph planarize(const std::vector<RawSegment>&, double, double) { return {}; }
+
+namespace {
+
+using Epeck = CGAL::Exact_predicates_exact_constructions_kernel;
+using SegTraits = CGAL::Arr_segment_traits_2<Epeck>;
+struct KeepHighestClass {
+    int operator()(int a, int b) const { return std::min(a, b); }
+};
+using Traits = CGAL::Arr_curve_data_traits_2<SegTraits, int, KeepHighestClass>;
+using Arrangement = CGAL::Arrangement_2<Traits>;
+
+struct WorkEdge {
+    uint32_t a, b;
+    int cls;
+};
+struct WorkGraph {
+    std::vector<glm::dvec2> nodes;
+    std::vector<WorkEdge> edges;
+};
+
+bool lessPoint(const glm::dvec2& p, const glm::dvec2& q) { return p.x < q.x || (p.x == q.x && p.y < q.y); }
+
+// Exact arrangement of the segments; vertices rounded to double.
+WorkGraph arrange(const std::vector<RawSegment>& segs) {
+    std::vector<Traits::Curve_2> curves;
+    curves.reserve(segs.size());
+    for (const auto& s : segs) {
+        if (s.a == s.b) continue;
+        curves.emplace_back(SegTraits::Curve_2(Epeck::Point_2(s.a.x, s.a.y), Epeck::Point_2(s.b.x, s.b.y)), int(s.cls));
+    }
+    WorkGraph g;
+    if (curves.empty()) return g;
+    Arrangement arr;
+    CGAL::insert(arr, curves.begin(), curves.end());
+    std::unordered_map<const void*, uint32_t> index;
+    index.reserve(arr.number_of_vertices() * 2);
+    for (auto v = arr.vertices_begin(); v != arr.vertices_end(); ++v) {
+        index[&*v] = uint32_t(g.nodes.size());
+        g.nodes.emplace_back(CGAL::to_double(v->point().x()), CGAL::to_double(v->point().y()));
+    }
+    for (auto e = arr.edges_begin(); e != arr.edges_end(); ++e) {
+        uint32_t a = index[&*e->source()], b = index[&*e->target()];
+        g.edges.push_back({a, b, std::clamp(e->curve().data(), 0, 2)});
+    }
+    return g;
 }
+
+struct UnionFind {
+    std::vector<uint32_t> p;
+    explicit UnionFind(size_t n) : p(n) { std::iota(p.begin(), p.end(), 0u); }
+    uint32_t find(uint32_t x) {
+        while (p[x] != x) { p[x] = p[p[x]]; x = p[x]; }
+        return x;
+    }
+};
+
+// Applies a node mapping (old -> representative), removes self loops,
+// duplicates (keeping the highest class) and isolated nodes.
+void rebuild(WorkGraph& g, const std::vector<uint32_t>& rep) {
+    std::map<std::pair<uint32_t, uint32_t>, int> best;
+    for (const auto& e : g.edges) {
+        uint32_t a = rep[e.a], b = rep[e.b];
+        if (a == b) continue;
+        auto key = std::make_pair(std::min(a, b), std::max(a, b));
+        auto it = best.find(key);
+        if (it == best.end()) best.emplace(key, e.cls);
+        else it->second = std::min(it->second, e.cls);
+    }
+    std::vector<uint32_t> newIndex(g.nodes.size(), UINT32_MAX);
+    WorkGraph out;
+    for (const auto& [key, cls] : best) {
+        for (uint32_t v : {key.first, key.second})
+            if (newIndex[v] == UINT32_MAX) { newIndex[v] = uint32_t(out.nodes.size()); out.nodes.push_back(g.nodes[v]); }
+        out.edges.push_back({newIndex[key.first], newIndex[key.second], cls});
+    }
+    g = std::move(out);
+}
+
+// Node priority for snapping/merging: higher class first, then higher degree.
+std::vector<std::pair<int, int>> nodeRank(const WorkGraph& g) {
+    std::vector<std::pair<int, int>> r(g.nodes.size(), {3, 0});  // (best class, -degree)
+    for (const auto& e : g.edges)
+        for (uint32_t v : {e.a, e.b}) { r[v].first = std::min(r[v].first, e.cls); r[v].second--; }
+    return r;
+}
+
+bool better(const WorkGraph& g, const std::vector<std::pair<int, int>>& rank, uint32_t a, uint32_t b) {
+    if (rank[a] != rank[b]) return rank[a] < rank[b];
+    return lessPoint(g.nodes[a], g.nodes[b]);
+}
+
+// Merges nodes closer than `snap` onto the best-ranked node nearby.
+bool snapNodes(WorkGraph& g, double snap) {
+    const size_t n = g.nodes.size();
+    auto rank = nodeRank(g);
+    std::vector<uint32_t> order(n);
+    std::iota(order.begin(), order.end(), 0u);
+    std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return better(g, rank, a, b); });
+    std::vector<uint32_t> rep(n);
+    std::iota(rep.begin(), rep.end(), 0u);
+    bool changed = false;
+    const double cell = std::max(snap, 1e-9);
+    std::unordered_map<uint64_t, std::vector<uint32_t>> grid;
+    grid.reserve(n * 2);
+    auto key = [](int64_t x, int64_t y) { return (uint64_t(x) << 32) ^ (uint64_t(y) & 0xffffffffull); };
+    for (uint32_t v : order) {
+        const glm::dvec2 p = g.nodes[v];
+        int64_t cx = int64_t(std::floor(p.x / cell)), cy = int64_t(std::floor(p.y / cell));
+        uint32_t found = UINT32_MAX;
+        double bestD = 0;
+        for (int64_t dy = -1; dy <= 1; ++dy)
+            for (int64_t dx = -1; dx <= 1; ++dx) {
+                auto it = grid.find(key(cx + dx, cy + dy));
+                if (it == grid.end()) continue;
+                for (uint32_t r : it->second) {
+                    double d = glm::length(g.nodes[r] - p);
+                    if (d <= snap && (found == UINT32_MAX || d < bestD || (d == bestD && better(g, rank, r, found)))) {
+                        found = r;
+                        bestD = d;
+                    }
+                }
+            }
+        if (found != UINT32_MAX) { rep[v] = found; changed = true; }
+        else grid[key(cx, cy)].push_back(v);
+    }
+    if (changed) rebuild(g, rep);
+    return changed;
+}
+
+// Contracts edges shorter than minSegment (the better-ranked end survives).
+bool contractShort(WorkGraph& g, double minSegment) {
+    bool any = false;
+    for (int pass = 0; pass < 50; ++pass) {
+        auto rank = nodeRank(g);
+        std::vector<uint32_t> order(g.edges.size());
+        std::iota(order.begin(), order.end(), 0u);
+        auto len = [&](uint32_t e) { return glm::length(g.nodes[g.edges[e].b] - g.nodes[g.edges[e].a]); };
+        std::sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) {
+            double lx = len(x), ly = len(y);
+            return lx < ly || (lx == ly && x < y);
+        });
+        UnionFind uf(g.nodes.size());
+        bool changed = false;
+        for (uint32_t e : order) {
+            if (len(e) >= minSegment) break;
+            uint32_t a = uf.find(g.edges[e].a), b = uf.find(g.edges[e].b);
+            if (a == b) continue;
+            if (glm::length(g.nodes[a] - g.nodes[b]) >= minSegment) continue;
+            if (better(g, rank, b, a)) std::swap(a, b);
+            uf.p[b] = a;  // a survives at its own position
+            changed = true;
+        }
+        if (!changed) break;
+        any = true;
+        std::vector<uint32_t> rep(g.nodes.size());
+        for (uint32_t v = 0; v < g.nodes.size(); ++v) rep[v] = uf.find(v);
+        rebuild(g, rep);
+    }
+    return any;
+}
+
+StreetGraph toStreetGraph(const WorkGraph& w) {
+    // Canonical order: nodes by (x, y), edges by (a, b) with a < b.
+    std::vector<uint32_t> order(w.nodes.size());
+    std::iota(order.begin(), order.end(), 0u);
+    std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return lessPoint(w.nodes[a], w.nodes[b]); });
+    std::vector<uint32_t> newIndex(w.nodes.size());
+    StreetGraph g;
+    g.nodes.reserve(w.nodes.size());
+    for (uint32_t i = 0; i < order.size(); ++i) { newIndex[order[i]] = i; g.nodes.push_back(w.nodes[order[i]]); }
+    g.edges.reserve(w.edges.size());
+    for (const auto& e : w.edges) {
+        StreetEdge se;
+        se.a = std::min(newIndex[e.a], newIndex[e.b]);
+        se.b = std::max(newIndex[e.a], newIndex[e.b]);
+        se.cls = RoadClass(uint8_t(e.cls));
+        se.width = float(roadWidth(se.cls));
+        se.lanes = uint8_t(roadLanes(se.cls));
+        g.edges.push_back(se);
+    }
+    std::sort(g.edges.begin(), g.edges.end(),
+              [](const StreetEdge& x, const StreetEdge& y) { return std::tie(x.a, x.b) < std::tie(y.a, y.b); });
+    return g;
+}
+
+std::vector<RawSegment> toSegments(const WorkGraph& g) {
+    std::vector<RawSegment> s;
+    s.reserve(g.edges.size());
+    for (const auto& e : g.edges) s.push_back({g.nodes[e.a], g.nodes[e.b], RoadClass(uint8_t(e.cls))});
+    return s;
+}
+
+}  // namespace
+
+StreetGraph planarize(const std::vector<RawSegment>& segments, double snap, double minSegment) {
+    if (!std::isfinite(snap) || snap < 0) snap = 0;
+    if (!std::isfinite(minSegment) || minSegment < 0) minSegment = 0;
+    // Input hygiene: finite, bounded coordinates; valid classes; zero-length dropped.
+    WorkGraph g;
+    {
+        std::map<std::pair<double, double>, uint32_t> ids;
+        auto node = [&](const glm::dvec2& p) {
+            auto [it, inserted] = ids.emplace(std::make_pair(p.x, p.y), uint32_t(g.nodes.size()));
+            if (inserted) g.nodes.push_back(p);
+            return it->second;
+        };
+        for (const auto& s : segments) {
+            auto ok = [](const glm::dvec2& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::abs(p.x) < 1e9 && std::abs(p.y) < 1e9; };
+            if (!ok(s.a) || !ok(s.b) || s.a == s.b) continue;
+            // +0.0 canonicalises -0.0 so the map key matches.
+            glm::dvec2 a(s.a.x + 0.0, s.a.y + 0.0), b(s.b.x + 0.0, s.b.y + 0.0);
+            g.edges.push_back({node(a), node(b), std::clamp(int(s.cls), 0, 2)});
+        }
+    }
+    // Pre-snap input endpoints, so near-coincident ends meet before the exact arrangement.
+    std::vector<uint32_t> id(g.nodes.size());
+    std::iota(id.begin(), id.end(), 0u);
+    rebuild(g, id);
+    snapNodes(g, snap);
+
+    for (int iter = 0; iter < 6; ++iter) {
+        g = arrange(toSegments(g));
+        // Exact rounding to double may make distinct vertices coincide: snap handles it (distance 0 <= snap).
+        for (int k = 0; k < 10; ++k) {
+            bool c1 = snapNodes(g, snap);
+            bool c2 = contractShort(g, minSegment);
+            if (!c1 && !c2) break;
+        }
+        StreetGraph sg = toStreetGraph(g);
+        if (findConflictingEdges(sg, 1).empty()) return sg;
+    }
+
+    // Last resort: drop conflicting edges (lowest class, then shortest) until planar.
+    for (int guard = 0; guard < 1000; ++guard) {
+        StreetGraph sg = toStreetGraph(g);
+        auto bad = findConflictingEdges(sg, SIZE_MAX);
+        if (bad.empty()) break;
+        std::vector<char> drop(sg.edges.size(), 0);
+        for (auto [e, f] : bad) {
+            if (drop[e] || drop[f]) continue;
+            auto key = [&](uint32_t x) { return std::make_pair(-int(sg.edges[x].cls), sg.edgeLength(x)); };
+            drop[key(e) < key(f) ? e : f] = 1;
+        }
+        WorkGraph w;
+        w.nodes = sg.nodes;
+        for (size_t i = 0; i < sg.edges.size(); ++i)
+            if (!drop[i]) w.edges.push_back({sg.edges[i].a, sg.edges[i].b, int(sg.edges[i].cls)});
+        std::vector<uint32_t> ident(w.nodes.size());
+        std::iota(ident.begin(), ident.end(), 0u);
+        rebuild(w, ident);
+        g = std::move(w);
+    }
+    // Deleting (not contracting) edges that are still short keeps planarity.
+    WorkGraph w;
+    w.nodes = g.nodes;
+    for (const auto& e : g.edges)
+        if (glm::length(g.nodes[e.b] - g.nodes[e.a]) >= minSegment) w.edges.push_back(e);
+    std::vector<uint32_t> ident(w.nodes.size());
+    std::iota(ident.begin(), ident.end(), 0u);
+    rebuild(w, ident);
+    return toStreetGraph(w);
+}
+
+}  // namespace vista

@@ -12,8 +12,22 @@
 #include "citygen/lighting.h"
 #include "citygen/mesh_builder.h"
 
+#include <cstdint>
+#include <vector>
+
 namespace vista {
 
 void meshSurfaces(const City& city, const TileGrid& grid, int tile, const Lighting& light, Tile& out);
+
+// Per-tile candidate lists of the street edges, blocks and parks a tile may
+// draw, built once per city (linear time) so that meshSurfaces does not scan
+// the whole city for every tile. Output is identical with or without it.
+struct SurfaceIndex {
+    int tiles = 0;
+    std::vector<std::vector<uint32_t>> edges, blocks, parks;
+};
+SurfaceIndex buildSurfaceIndex(const City& city, const TileGrid& grid);
+void meshSurfaces(const City& city, const TileGrid& grid, int tile, const Lighting& light, Tile& out,
+                  const SurfaceIndex* index);
 
 }  // namespace vista

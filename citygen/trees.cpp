@@ -21,10 +21,11 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr int kSpecies = 3;   // 0 broadleaf, 1 conifer, 2 columnar
 constexpr int kVariants = 3;  // small, medium, large
 constexpr double kMinBranchRadius = 0.035;  // thinnest twig, metres
+constexpr size_t kMinTriangles = 400, kMaxTriangles = 1500;  // per prototype
 
 // Nominal prototype heights (metres) per species and size variant; instances
 // scale by 0.85..1.15, so every tree stays within 5..22 m.
-constexpr double kHeights[kSpecies][kVariants] = {{7.5, 11.5, 16.0}, {8.5, 13.0, 19.0}, {7.0, 11.0, 15.5}};
+constexpr double kHeights[kSpecies][kVariants] = {{7.5, 11.5, 16.0}, {8.5, 13.0, 18.5}, {7.0, 11.0, 15.5}};
 
 // Writes the prototype geometry with one MeshBuilder whose material switches
 // between Trunk and Leaves.
@@ -58,7 +59,7 @@ public:
         _b.setMaterial(Material::Leaves);
         _b.setVariation(std::clamp(_leafVariation + _rng.uniform(-0.35, 0.35), -1.0, 1.0));
         double phase = _rng.uniform(0.0, 2 * kPi);
-        std::vector<glm::dvec3> rim(size_t(ring));
+        std::vector<glm::dvec3> rim(static_cast<size_t>(ring));
         for (int i = 0; i < ring; ++i) {
             double a = phase + 2 * kPi * (i + _rng.uniform(-0.15, 0.15)) / ring;
             double r = rh * _rng.uniform(0.8, 1.15);
@@ -80,7 +81,7 @@ public:
         _b.setMaterial(Material::Leaves);
         _b.setVariation(std::clamp(_leafVariation + _rng.uniform(-0.25, 0.25), -1.0, 1.0));
         double phase = _rng.uniform(0.0, 2 * kPi);
-        std::vector<glm::dvec3> rim(size_t(ring));
+        std::vector<glm::dvec3> rim(static_cast<size_t>(ring));
         for (int i = 0; i < ring; ++i) {
             double a = phase + 2 * kPi * i / ring;
             double r = radius * _rng.uniform(0.8, 1.1);
@@ -122,6 +123,8 @@ struct BranchStyle {
     double leafFlatten = 0.7;                // vertical / horizontal extent
     double upBias = 0.15;                    // pull of children towards +z
     int leafRing = 4;
+    int deepMaxChildren = 3;                 // cap on children from depth 2 on
+    double midLeafChance = 0.0;              // cluster at the middle of outer branches
 };
 
 // Recursive branch: two slightly bent tapered segments, then children; leaf
@@ -139,11 +142,19 @@ void branch(TreeShaper& t, const BranchStyle& s, const glm::dvec3& p, const glm:
         t.blob(end, s.leafRadius * rng.uniform(0.85, 1.15), s.leafRadius * s.leafFlatten, s.leafRing);
         return;
     }
-    t.limb(p, mid, r, 0.5 * (r + rEnd), sides);
-    t.limb(mid, end, 0.5 * (r + rEnd), rEnd, sides);
-    if (depth == s.maxDepth - 1 && rng.chance(0.6))
+    if (depth <= 1) {
+        t.limb(p, mid, r, 0.5 * (r + rEnd), sides);
+        t.limb(mid, end, 0.5 * (r + rEnd), rEnd, sides);
+    } else {
+        t.limb(p, end, r, rEnd, sides);
+    }
+    // Clusters along the outer branches (not only at the tips) round the crown.
+    if (depth >= s.maxDepth - 2 && depth >= 2 && rng.chance(s.midLeafChance))
+        t.blob(mid - glm::dvec3(0, 0, 0.3 * s.leafRadius), s.leafRadius * rng.uniform(0.8, 1.1),
+               s.leafRadius * s.leafFlatten, s.leafRing);
+    if (depth == s.maxDepth - 1 && rng.chance(0.85))
         t.blob(end, s.leafRadius * rng.uniform(0.9, 1.25), s.leafRadius * s.leafFlatten, s.leafRing);
-    int n = int(rng.range(s.minChildren, s.maxChildren));
+    int n = int(rng.range(s.minChildren, depth >= 2 ? std::min(s.maxChildren, s.deepMaxChildren) : s.maxChildren));
     double az0 = rng.uniform(0.0, 2 * kPi);
     for (int i = 0; i < n; ++i) {
         double az = az0 + 2 * kPi * (i + rng.uniform(-0.2, 0.2)) / n;
@@ -157,23 +168,27 @@ void branch(TreeShaper& t, const BranchStyle& s, const glm::dvec3& p, const glm:
 void makeBroadleaf(TreeShaper& t, int variant, double h) {
     Rng& rng = t.rng();
     BranchStyle s;
-    s.maxDepth = variant == 0 ? 3 : 4;
+    s.maxDepth = variant == 2 ? 4 : 3;
     s.minChildren = 2;
-    s.maxChildren = variant == 1 ? 2 : 3;
-    s.leafRadius = h * (variant == 0 ? 0.085 : 0.065);
-    s.leafFlatten = 0.7;
+    s.maxChildren = variant == 0 ? 2 : 3;
+    s.leafRadius = h * (variant == 0 ? 0.11 : (variant == 1 ? 0.095 : 0.075));
+    s.leafFlatten = 0.75;
+    s.upBias = 0.3;
     s.leafRing = variant == 0 ? 5 : 4;
+    s.deepMaxChildren = variant == 2 ? 2 : 3;
+    s.midLeafChance = 0.7;
+    s.tiltMax = 0.75;
     double trunkH = h * 0.36, r0 = h * 0.019;
     glm::dvec3 lean(rng.uniform(-0.03, 0.03) * h, rng.uniform(-0.03, 0.03) * h, trunkH);
     t.limb({0, 0, -0.1}, lean * 0.5 + glm::dvec3(0, 0, -0.05), r0, r0 * 0.9, 6);
     t.limb(lean * 0.5 + glm::dvec3(0, 0, -0.05), lean, r0 * 0.9, r0 * 0.75, 6);
-    int mains = variant == 2 ? 5 : 4;
+    int mains = 4;
     double az0 = rng.uniform(0.0, 2 * kPi);
     // Main limbs spread outwards; total reach ~ crown radius 0.38 h.
-    double len = h * (s.maxDepth == 3 ? 0.26 : 0.2);
+    double len = h * (s.maxDepth == 3 ? 0.22 : 0.17);
     for (int i = 0; i < mains; ++i) {
         double az = az0 + 2 * kPi * (i + rng.uniform(-0.2, 0.2)) / mains;
-        double elev = rng.uniform(0.55, 0.95);
+        double elev = rng.uniform(0.7, 1.05);
         glm::dvec3 d(std::cos(az) * std::cos(elev), std::sin(az) * std::cos(elev), std::sin(elev));
         glm::dvec3 start = lean * rng.uniform(0.85, 1.0);
         branch(t, s, start, d, len * rng.uniform(0.9, 1.1), r0 * 0.55, 1);
@@ -191,9 +206,9 @@ void makeConifer(TreeShaper& t, int variant, double h) {
         double rb = std::max(kMinBranchRadius, r0 * (1.0 - 0.85 * (i + 1) / segs));
         t.limb({0, 0, z0}, {0, 0, z1}, ra, rb, 6);
     }
-    int whorls = 7 + 3 * variant;
+    int whorls = 9 + 3 * variant;
     double zStart = h * rng.uniform(0.18, 0.26), crownR = h * 0.22;
-    int perWhorl = 5 + variant / 2;
+    int perWhorl = 4;
     for (int w = 0; w < whorls; ++w) {
         double f = double(w) / whorls;  // 0 at the bottom whorl
         double z = zStart + (h * 0.95 - zStart) * f;
@@ -207,7 +222,7 @@ void makeConifer(TreeShaper& t, int variant, double h) {
             double rb = std::max(kMinBranchRadius, r0 * 0.35 * (1.0 - f));
             t.limb({0, 0, z}, glm::dvec3(0, 0, z) + dir * (reach * 0.95), rb, kMinBranchRadius, 3);
         }
-        t.tier({0, 0, z}, reach, spacing * 1.6, spacing * 0.7, variant == 2 ? 8 : 7);
+        t.tier({0, 0, z}, reach, spacing * 1.6, spacing * 0.7, 8);
     }
     t.blob({0, 0, h * 0.96}, 0.35 + 0.05 * h * 0.05, h * 0.05, 4);
 }
@@ -221,7 +236,7 @@ void makeColumnar(TreeShaper& t, int variant, double h) {
         t.limb({0, 0, z0}, {0, 0, z1}, std::max(kMinBranchRadius, r0 * (1.0 - 0.7 * i / segs)),
                std::max(kMinBranchRadius, r0 * (1.0 - 0.7 * (i + 1) / segs)), 6);
     }
-    int n = 14 + 6 * variant;
+    int n = 18 + 4 * variant;
     double crownR = h * 0.13, z0 = h * 0.14, z1 = h * 0.88;
     double leaf = h * 0.055;
     for (int i = 0; i < n; ++i) {
@@ -235,8 +250,8 @@ void makeColumnar(TreeShaper& t, int variant, double h) {
         glm::dvec3 a(0, 0, z), b = a + dir * len;
         double rb = std::max(kMinBranchRadius, r0 * 0.3);
         t.limb(a, b, rb, kMinBranchRadius, 3);
-        t.blob(b, leaf * (0.8 + profile * 0.5), leaf * 1.8, 4);
-        if (variant > 0 && rng.chance(0.6)) {
+        t.blob(b, leaf * (0.8 + profile * 0.5), leaf * 1.8, 5);
+        if (rng.chance(0.6)) {
             glm::dvec3 twig = deviate(dir, rng.uniform(0.4, 0.7), rng.uniform(0.0, 2 * kPi));
             glm::dvec3 c = a + dir * (len * 0.5);
             t.limb(c, c + twig * (len * 0.5), kMinBranchRadius, kMinBranchRadius, 3);
@@ -260,25 +275,31 @@ std::vector<TreePrototype> makeTreePrototypes(const CityParams& params, const Li
     for (int species = 0; species < kSpecies; ++species) {
         for (int variant = 0; variant < kVariants; ++variant) {
             int id = species * kVariants + variant;
-            Rng rng(params.seed, uint64_t(id) + 0x7EE0000ull, Stream::Trees);
             TreePrototype p;
-            p.species = species;
-            p.variant = variant;
-            double h = kHeights[species][variant];
-            TreeShaper t(p.mesh, light, rng);
-            t.setBarkVariation(rng.uniform(-0.3, 0.3));
-            if (species == 0) {
-                t.setLeafVariation(rng.uniform(-0.1, 0.3));
-                makeBroadleaf(t, variant, h);
-            } else if (species == 1) {
-                t.setBarkVariation(-0.4);
-                t.setLeafVariation(rng.uniform(-0.9, -0.6));
-                makeConifer(t, variant, h);
-            } else {
-                t.setLeafVariation(rng.uniform(0.2, 0.5));
-                makeColumnar(t, variant, h);
+            // Deterministic retries keep every prototype inside the triangle budget.
+            for (uint64_t attempt = 0; attempt < 8; ++attempt) {
+                Rng rng(params.seed, uint64_t(id) + 0x7EE0000ull + (attempt << 8), Stream::Trees);
+                p = TreePrototype();
+                p.species = species;
+                p.variant = variant;
+                double h = kHeights[species][variant];
+                TreeShaper t(p.mesh, light, rng);
+                t.setBarkVariation(rng.uniform(-0.3, 0.3));
+                if (species == 0) {
+                    t.setLeafVariation(rng.uniform(-0.1, 0.3));
+                    makeBroadleaf(t, variant, h);
+                } else if (species == 1) {
+                    t.setBarkVariation(-0.4);
+                    t.setLeafVariation(rng.uniform(-0.9, -0.6));
+                    makeConifer(t, variant, h);
+                } else {
+                    t.setLeafVariation(rng.uniform(0.2, 0.5));
+                    makeColumnar(t, variant, h);
+                }
+                p.height = meshTop(p.mesh);
+                size_t n = p.mesh.triangleCount();
+                if (n >= kMinTriangles && n <= kMaxTriangles) break;
             }
-            p.height = meshTop(p.mesh);
             out.push_back(std::move(p));
         }
     }
@@ -317,6 +338,10 @@ public:
         forCells(lo, hi, [&](size_t c) { _items[_fill[c]++] = item; });
     }
     template <class F>
+    void forItems(size_t c, F f) const {
+        for (uint32_t i = _start[c]; i < _start[c + 1]; ++i) f(_items[i]);
+    }
+    template <class F>
     bool any(const glm::dvec2& p, F pred) const {
         size_t c = size_t(cy(p.y)) * size_t(_n) + size_t(cx(p.x));
         for (uint32_t i = _start[c]; i < _start[c + 1]; ++i)
@@ -330,6 +355,12 @@ private:
     std::vector<uint32_t> _start, _fill, _items;
 };
 
+// Carriageway width as drawn by meshSurfaces (invalid widths fall back to the class default).
+double edgeWidth(const StreetEdge& e) {
+    double w = double(e.width);
+    return std::isfinite(w) && w > 0.5 ? w : roadWidth(e.cls);
+}
+
 uint64_t quantKey(const glm::dvec2& p) {
     int64_t qx = std::llround(p.x * 10.0), qy = std::llround(p.y * 10.0);  // 10 cm
     return hashKeys(uint64_t(qx), uint64_t(qy), 0x7EEull);
@@ -340,9 +371,12 @@ constexpr double kBuildingClearance = 1.5;  // trunk to building footprint, metr
 constexpr double kIntersectionClearance = 10.0;
 constexpr double kMinTreeDistance = 3.0;    // between any two trees
 constexpr double kParkEdgeClearance = 2.0;  // park trees from the park outline
+constexpr double kCrownSearch = 12.0;       // search radius for facades near a crown
+constexpr double kCrownOverlap = 1.0;       // a crown may touch a facade by this much
 
 struct Candidate {
     glm::dvec2 p;
+    int tile;
     uint64_t key;
     bool street;
     int species;  // -1: choose per tree
@@ -366,24 +400,32 @@ std::vector<TreeInstance> placeTrees(const City& city, Progress* progress) {
         glm::dvec2 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
         for (const auto& q : city.buildings[i].footprint) lo = glm::min(lo, q), hi = glm::max(hi, q);
         bBox[i] = {lo - kBuildingClearance, hi + kBuildingClearance};
+        if (!std::isfinite(lo.x + lo.y + hi.x + hi.y)) bBox[i] = {glm::dvec2(1.0), glm::dvec2(0.0)};  // skipped
     }
     for (const auto& b : bBox) if (b.first.x <= b.second.x) bIdx.count(b.first, b.second);
     bIdx.finishCounts();
     for (size_t i = 0; i < bBox.size(); ++i) if (bBox[i].first.x <= bBox[i].second.x) bIdx.fill(bBox[i].first, bBox[i].second, uint32_t(i));
+    // Edges with valid, finite end points (the graph contract guarantees this; be safe anyway).
+    std::vector<uint8_t> edgeOk(g.edges.size(), 0);
+    for (size_t e = 0; e < g.edges.size(); ++e) {
+        const auto& E = g.edges[e];
+        edgeOk[e] = E.a < g.nodes.size() && E.b < g.nodes.size() &&
+                    std::isfinite(g.nodes[E.a].x + g.nodes[E.a].y + g.nodes[E.b].x + g.nodes[E.b].y);
+    }
     auto edgeBox = [&](size_t e) {
         const auto& a = g.nodes[g.edges[e].a];
         const auto& b = g.nodes[g.edges[e].b];
-        double m = 0.5 * g.edges[e].width + kRoadClearance;
+        double m = 0.5 * edgeWidth(g.edges[e]) + kRoadClearance;
         return std::make_pair(glm::min(a, b) - m, glm::max(a, b) + m);
     };
-    for (size_t e = 0; e < g.edges.size(); ++e) { auto bb = edgeBox(e); eIdx.count(bb.first, bb.second); }
+    for (size_t e = 0; e < g.edges.size(); ++e) if (edgeOk[e]) { auto bb = edgeBox(e); eIdx.count(bb.first, bb.second); }
     eIdx.finishCounts();
-    for (size_t e = 0; e < g.edges.size(); ++e) { auto bb = edgeBox(e); eIdx.fill(bb.first, bb.second, uint32_t(e)); }
+    for (size_t e = 0; e < g.edges.size(); ++e) if (edgeOk[e]) { auto bb = edgeBox(e); eIdx.fill(bb.first, bb.second, uint32_t(e)); }
 
     auto onRoad = [&](const glm::dvec2& p) {
         return eIdx.any(p, [&](uint32_t e) {
             const auto& E = g.edges[e];
-            return pointSegmentDistance(p, g.nodes[E.a], g.nodes[E.b]) < 0.5 * E.width + kRoadClearance;
+            return pointSegmentDistance(p, g.nodes[E.a], g.nodes[E.b]) < 0.5 * edgeWidth(E) + kRoadClearance;
         });
     };
     auto inBuilding = [&](const glm::dvec2& p) {
@@ -396,14 +438,42 @@ std::vector<TreeInstance> placeTrees(const City& city, Progress* progress) {
             return false;
         });
     };
+    // Crown radius (max horizontal extent) of every prototype.
+    std::vector<double> crown(size_t(kSpecies * kVariants), 0.0);
+    for (int i = 0; i < kSpecies * kVariants; ++i) {
+        if (size_t(i) < city.treePrototypes.size()) {
+            for (const auto& q : city.treePrototypes[size_t(i)].mesh.positions)
+                crown[size_t(i)] = std::max(crown[size_t(i)], std::hypot(double(q.x), double(q.y)));
+        } else {
+            crown[size_t(i)] = 0.3 * kHeights[i / kVariants][i % kVariants];  // nominal
+        }
+    }
+    auto crownRadius = [&](int species, int variant) { return crown[size_t(species * kVariants + variant)]; };
+    // Distance from p to the nearest building footprint, capped at kCrownSearch.
+    auto clearance = [&](const glm::dvec2& p) {
+        double best = kCrownSearch;
+        const glm::dvec2 lo = p - kCrownSearch, hi = p + kCrownSearch;
+        bIdx.forCells(lo, hi, [&](size_t cellId) {
+            bIdx.forItems(cellId, [&](uint32_t i) {
+                const auto& fp = city.buildings[i].footprint;
+                if (bBox[i].second.x < lo.x || bBox[i].second.y < lo.y || bBox[i].first.x > hi.x || bBox[i].first.y > hi.y) return;
+                for (size_t k = 0; k < fp.size(); ++k)
+                    best = std::min(best, pointSegmentDistance(p, fp[k], fp[(k + 1) % fp.size()]));
+            });
+        });
+        return best;
+    };
     auto inCity = [&](const glm::dvec2& p) { return std::abs(p.x) <= half - 1.0 && std::abs(p.y) <= half - 1.0; };
 
     std::vector<Candidate> cand;
     // Street trees.
     if (P.street_tree_spacing_m > 0 && !g.edges.empty()) {
-        std::vector<int> deg = g.degrees();
+        std::vector<int> deg(g.nodes.size(), 0);
+        for (size_t e = 0; e < g.edges.size(); ++e)
+            if (edgeOk[e]) ++deg[g.edges[e].a], ++deg[g.edges[e].b];
         const double spacing = P.street_tree_spacing_m;
         for (size_t e = 0; e < g.edges.size(); ++e) {
+            if (!edgeOk[e]) continue;
             const auto& E = g.edges[e];
             glm::dvec2 A = g.nodes[E.a], B = g.nodes[E.b];
             double L = glm::length(B - A);
@@ -423,12 +493,12 @@ std::vector<TreeInstance> placeTrees(const City& city, Progress* progress) {
             uint64_t ka = quantKey(A), kb = quantKey(B);
             Rng srng(P.seed, hashKeys(std::min(ka, kb), std::max(ka, kb), 0x57EE7ull), Stream::Trees);
             int streetSpecies = int(srng.range(0, kSpecies - 1));
-            double off = 0.5 * E.width + 0.5 * P.sidewalk_m;
+            double off = 0.5 * edgeWidth(E) + 0.5 * P.sidewalk_m;
             for (int side = -1; side <= 1; side += 2) {
                 for (int i = 0; i < count; ++i) {
                     glm::dvec2 p = A + d * (first + i * spacing) + n * (side * off);
                     if (!inCity(p)) continue;
-                    cand.push_back({p, quantKey(p), true, streetSpecies});
+                    cand.push_back({p, 0, quantKey(p), true, streetSpecies});
                 }
             }
         }
@@ -442,6 +512,10 @@ std::vector<TreeInstance> placeTrees(const City& city, Progress* progress) {
             if (!blk.park || blk.outline.size() < 3) continue;
             glm::dvec2 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
             for (const auto& q : blk.outline) lo = glm::min(lo, q), hi = glm::max(hi, q);
+            if (!std::isfinite(lo.x + lo.y + hi.x + hi.y)) continue;
+            // Clamp to the city square (park blocks lie inside it; guards huge loops on bad input).
+            lo = glm::max(lo, glm::dvec2(-half)), hi = glm::min(hi, glm::dvec2(half));
+            if (!(hi.x > lo.x && hi.y > lo.y)) continue;
             int64_t i0 = int64_t(std::floor(lo.x / c)), i1 = int64_t(std::floor(hi.x / c));
             int64_t j0 = int64_t(std::floor(lo.y / c)), j1 = int64_t(std::floor(hi.y / c));
             for (int64_t j = j0; j <= j1; ++j) {
@@ -454,7 +528,7 @@ std::vector<TreeInstance> placeTrees(const City& city, Progress* progress) {
                         nearEdge = pointSegmentDistance(p, blk.outline[k], blk.outline[(k + 1) % blk.outline.size()]) <
                                    kParkEdgeClearance;
                     if (nearEdge) continue;
-                    cand.push_back({p, quantKey(p), false, -1});
+                    cand.push_back({p, 0, quantKey(p), false, -1});
                 }
             }
         }
@@ -464,29 +538,36 @@ std::vector<TreeInstance> placeTrees(const City& city, Progress* progress) {
     // Canonical order (by position), then reject conflicts; the greedy
     // spacing filter runs in this order so it does not depend on edge order.
     TileGrid grid(P);
+    for (auto& c : cand) c.tile = grid.tileOf(c.p);
     std::sort(cand.begin(), cand.end(), [&](const Candidate& a, const Candidate& b) {
-        int ta = grid.tileOf(a.p), tb = grid.tileOf(b.p);
-        if (ta != tb) return ta < tb;
+        if (a.tile != b.tile) return a.tile < b.tile;
         if (a.p.y != b.p.y) return a.p.y < b.p.y;
         if (a.p.x != b.p.x) return a.p.x < b.p.x;
         return a.street > b.street;
     });
-    std::unordered_map<uint64_t, std::vector<glm::dvec2>> kept;  // hash grid of accepted trunks (cell = kMinTreeDistance)
-    auto cellKey = [](int64_t x, int64_t y) { return hashKeys(uint64_t(x), uint64_t(y)); };
+    // Accepted trunks in a hash grid (cell = kMinTreeDistance): head per cell + linked list.
+    std::unordered_map<uint64_t, uint32_t> head;
+    head.reserve(cand.size());
+    std::vector<glm::dvec2> keptPos;
+    std::vector<uint32_t> keptNext;
+    constexpr uint32_t kNone = 0xFFFFFFFFu;
+    auto cellKey = [](int64_t x, int64_t y) { return (uint64_t(x) << 32) ^ (uint64_t(y) & 0xFFFFFFFFull); };
     out.reserve(cand.size());
     for (const auto& c : cand) {
-        if (onRoad(c.p) || inBuilding(c.p)) continue;
         int64_t gx = int64_t(std::floor(c.p.x / kMinTreeDistance)), gy = int64_t(std::floor(c.p.y / kMinTreeDistance));
         bool close = false;
         for (int64_t y = gy - 1; y <= gy + 1 && !close; ++y)
             for (int64_t x = gx - 1; x <= gx + 1 && !close; ++x) {
-                auto it = kept.find(cellKey(x, y));
-                if (it == kept.end()) continue;
-                for (const auto& q : it->second)
-                    if (glm::length(q - c.p) < kMinTreeDistance) { close = true; break; }
+                auto it = head.find(cellKey(x, y));
+                if (it == head.end()) continue;
+                for (uint32_t k = it->second; k != kNone && !close; k = keptNext[k])
+                    close = glm::length(keptPos[k] - c.p) < kMinTreeDistance;
             }
-        if (close) continue;
-        kept[cellKey(gx, gy)].push_back(c.p);
+        if (close || onRoad(c.p) || inBuilding(c.p)) continue;
+        auto ins = head.emplace(cellKey(gx, gy), kNone);
+        keptNext.push_back(ins.first->second);
+        keptPos.push_back(c.p);
+        ins.first->second = uint32_t(keptPos.size() - 1);
 
         Rng r(P.seed, c.key, Stream::Trees);
         int species;
@@ -500,7 +581,14 @@ std::vector<TreeInstance> placeTrees(const City& city, Progress* progress) {
         TreeInstance t;
         t.position = glm::dvec3(c.p, terrainHeight(P, c.p));
         t.yaw = float(r.uniform(0.0, 2 * kPi));
-        t.scale = float(r.uniform(0.85, 1.15));
+        double scale = r.uniform(0.85, 1.15);
+        // Crowns should not grow into facades: near buildings take a smaller
+        // variant (then a smaller scale) so the crown radius fits the clearance.
+        double room = clearance(c.p) + kCrownOverlap;
+        while (variant > 0 && crownRadius(species, variant) * scale > room) --variant;
+        if (crownRadius(species, variant) * scale > room)
+            scale = std::max(0.85, room / std::max(crownRadius(species, variant), 1e-6));
+        t.scale = float(scale);
         t.prototype = uint16_t(std::min(species * kVariants + variant, protoCount - 1));
         t.street = c.street;
         out.push_back(t);

@@ -72,49 +72,6 @@ std::string errnoText() { return std::strerror(errno); }
 
 std::string tempPathFor(const std::string& path) { return path + ".tmp." + std::to_string(::getpid()); }
 
-// Output stream buffer that writes to a file descriptor and hashes every byte.
-class HashingFileBuf : public std::streambuf {
-public:
-    explicit HashingFileBuf(int fd) : _fd(fd), _buf(1 << 20) { setp(_buf.data(), _buf.data() + _buf.size()); }
-    bool ok() const { return _ok; }
-    uint64_t size() const { return _written; }
-    uint64_t hash() const { return _hasher.finish(); }
-    bool flushBuffer() {
-        size_t n = size_t(pptr() - pbase());
-        if (n == 0) return _ok;
-        _hasher.update(reinterpret_cast<unsigned char*>(pbase()), n);
-        if (!writeAll(pbase(), n)) _ok = false;
-        _written += n;
-        setp(_buf.data(), _buf.data() + _buf.size());
-        return _ok;
-    }
-    bool writeAll(const char* p, size_t n) {
-        while (n > 0) {
-            ssize_t w = ::write(_fd, p, n);
-            if (w < 0) { if (errno == EINTR) continue; _errno = errno; return false; }
-            p += w; n -= size_t(w);
-        }
-        return true;
-    }
-    int savedErrno() const { return _errno; }
-
-protected:
-    int_type overflow(int_type ch) override {
-        if (!flushBuffer()) return traits_type::eof();
-        if (ch != traits_type::eof()) { *pptr() = char(ch); pbump(1); }
-        return ch == traits_type::eof() ? traits_type::not_eof(ch) : ch;
-    }
-    int sync() override { return flushBuffer() ? 0 : -1; }
-
-private:
-    int _fd;
-    std::vector<char> _buf;
-    Hasher _hasher;
-    uint64_t _written = 0;
-    bool _ok = true;
-    int _errno = 0;
-};
-
 // Read-only stream buffer over memory, with seeking (OSG may seek).
 class MemoryBuf : public std::streambuf {
 public:
@@ -191,45 +148,56 @@ Status writeSceneFile(const osg::Node& node, const std::string& path, bool compr
     osgDB::ReaderWriter* rw = osgbReaderWriter();
     if (!rw) return Status::error("cannot write '" + path + "': OpenSceneGraph osgb plugin not found");
     const std::string tmp = tempPathFor(path);
-    int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0) return Status::error("cannot write '" + path + "': " + errnoText());
     auto fail = [&](const std::string& why) {
-        ::close(fd);
         ::unlink(tmp.c_str());
         return Status::error("cannot write '" + path + "': " + why);
     };
-    HashingFileBuf buf(fd);
-    bool written = false;
-    std::string why;
-    try {
-        std::ostream out(&buf);
-        osg::ref_ptr<osgDB::Options> opts = new osgDB::Options(compress ? "Compressor=zlib" : "");
-        osgDB::ReaderWriter::WriteResult wr = rw->writeNode(node, out, opts.get());
-        out.flush();
-        written = wr.success() && out.good();
-        if (!wr.success()) why = "osgb writer failed: " + wr.message();
-    } catch (const std::exception& e) {
-        why = std::string("osgb writer failed: ") + e.what();
+    // 1. osgb payload. OSG's binary writer seeks back to patch block sizes, so
+    //    it needs a seekable stream: write the temp file first.
+    {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        if (!out) return Status::error("cannot write '" + path + "': " + errnoText());
+        std::string why;
+        bool written = false;
+        try {
+            osg::ref_ptr<osgDB::Options> opts = new osgDB::Options(compress ? "Compressor=zlib" : "");
+            osgDB::ReaderWriter::WriteResult wr = rw->writeNode(node, out, opts.get());
+            out.flush();
+            written = wr.success() && out.good();
+            if (!written) why = "osgb writer failed" + (wr.message().empty() ? std::string() : ": " + wr.message());
+        } catch (const std::exception& e) {
+            why = std::string("osgb writer failed: ") + e.what();
+        }
+        out.close();
+        if (!written || out.fail()) return fail(why.empty() ? "write error" : why);
     }
-    if (!written) return fail(why.empty() ? "osgb writer failed" : why);
-    if (!buf.flushBuffer()) { errno = buf.savedErrno(); return fail(errnoText()); }
+    // 2. Hash the payload as written, append the trailer, sync, rename.
+    int fd = ::open(tmp.c_str(), O_RDWR | O_CLOEXEC);
+    if (fd < 0) return fail(errnoText());
+    Hasher hasher;
+    uint64_t size = 0;
+    std::vector<char> chunk(1 << 20);
+    for (;;) {
+        ssize_t r = ::read(fd, chunk.data(), chunk.size());
+        if (r < 0) { if (errno == EINTR) continue; std::string e = errnoText(); ::close(fd); return fail(e); }
+        if (r == 0) break;
+        hasher.update(reinterpret_cast<unsigned char*>(chunk.data()), size_t(r));
+        size += uint64_t(r);
+    }
     unsigned char trailer[kSceneTrailerSize];
     std::memcpy(trailer, kTrailerHead, 8);
-    storeLE64(trailer + 8, buf.size());
-    storeLE64(trailer + 16, buf.hash());
+    storeLE64(trailer + 8, size);
+    storeLE64(trailer + 16, hasher.finish());
     std::memcpy(trailer + 24, kTrailerTail, 8);
-    if (!buf.writeAll(reinterpret_cast<const char*>(trailer), sizeof trailer)) { errno = buf.savedErrno(); return fail(errnoText()); }
-    if (::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) return fail("fsync failed: " + errnoText());
-    if (::close(fd) != 0) {
-        std::string e = errnoText();
-        ::unlink(tmp.c_str());
-        return Status::error("cannot write '" + path + "': " + e);
+    size_t done = 0;
+    while (done < sizeof trailer) {
+        ssize_t w = ::pwrite(fd, trailer + done, sizeof trailer - done, off_t(size + done));
+        if (w < 0) { if (errno == EINTR) continue; std::string e = errnoText(); ::close(fd); return fail(e); }
+        done += size_t(w);
     }
-    if (::rename(tmp.c_str(), path.c_str()) != 0) {
-        std::string e = errnoText();
-        ::unlink(tmp.c_str());
-        return Status::error("cannot write '" + path + "': rename failed: " + e);
-    }
+    if (::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) { std::string e = errnoText(); ::close(fd); return fail("fsync failed: " + e); }
+    if (::close(fd) != 0) return fail(errnoText());
+    if (::rename(tmp.c_str(), path.c_str()) != 0) return fail("rename failed: " + errnoText());
     return Status::ok();
 }
 

@@ -1,13 +1,296 @@
-// vista view (placeholder until its issue lands: reports that it is not available yet).
+// vista view: interactive OSG viewer of a city (a real window on a GPU, or
+// under Xvfb). Drive / walk / fly manipulators, path playback, on-screen
+// stats (osgViewer StatsHandler, key s), render-mode switch (key m),
+// screenshots (key p, or --screenshot with --frames for headless use).
+#include <cmath>
 #include <cstdio>
+#include <memory>
+#include <string>
 
+#include <osg/Camera>
+#include <osg/Geode>
+#include <osg/GL>
+#include <osg/MatrixTransform>
+#include <osgGA/AnimationPathManipulator>
+#include <osgGA/DriveManipulator>
+#include <osgGA/FirstPersonManipulator>
+#include <osgGA/FlightManipulator>
+#include <osgGA/KeySwitchMatrixManipulator>
+#include <osgGA/StateSetManipulator>
+#include <osgGA/TrackballManipulator>
+#include <osgSim/Impostor>
+#include <osgText/Text>
+#include <osgViewer/Viewer>
+#include <osgViewer/ViewerEventHandlers>
+
+#include <glm/gtc/type_ptr.hpp>
+
+#include "runtime/city_file.h"
+#include "runtime/cli.h"
 #include "runtime/commands.h"
+#include "runtime/image.h"
+#include "runtime/paths.h"
 
 namespace vista {
 
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Reads the back buffer after the next frame and writes a PNG.
+struct Capture : public osg::Camera::DrawCallback {
+    mutable std::string pending;
+    mutable std::string lastWritten;
+    void operator()(osg::RenderInfo& ri) const override {
+        if (pending.empty()) return;
+        const osg::Viewport* vp = ri.getCurrentCamera()->getViewport();
+        int w = int(vp->width()), h = int(vp->height());
+        Image img(w, h);
+        std::vector<uint8_t> buf(size_t(w) * size_t(h) * 4);
+        glPixelStorei(GL_PACK_ALIGNMENT, 1);
+        glReadBuffer(GL_BACK);
+        glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, buf.data());
+        for (int y = 0; y < h; ++y)
+            std::copy_n(&buf[size_t(h - 1 - y) * size_t(w) * 4], size_t(w) * 4, &img.rgba[size_t(y) * size_t(w) * 4]);
+        for (size_t i = 3; i < img.rgba.size(); i += 4) img.rgba[i] = 255;
+        Status s = writePng(img, pending);
+        if (s) std::fprintf(stderr, "vista view: screenshot -> %s\n", pending.c_str());
+        else std::fprintf(stderr, "vista view: %s\n", s.message().c_str());
+        lastWritten = s ? pending : std::string();
+        pending.clear();
+    }
+};
+
+struct ViewState {
+    int mode = 0;  // 0 full, 1 near, 2 osgimpostor
+    double nearDistance = 100.0;
+    int shots = 0;
+    osg::ref_ptr<osg::Switch> modes;
+    osg::ref_ptr<Capture> capture;
+    osg::ref_ptr<osgText::Text> hud;
+};
+const char* kModeNames[] = {"full", "near", "osgimpostor"};
+
+class ViewKeys : public osgGA::GUIEventHandler {
+public:
+    explicit ViewKeys(ViewState& s) : _s(s) {}
+    bool handle(const osgGA::GUIEventAdapter& ea, osgGA::GUIActionAdapter&) override {
+        if (ea.getEventType() != osgGA::GUIEventAdapter::KEYDOWN) return false;
+        if (ea.getKey() == 'm') {
+            _s.mode = (_s.mode + 1) % 3;
+            _s.modes->setSingleChildOn(_s.mode == 2 ? 1 : 0);
+            return true;
+        }
+        if (ea.getKey() == 'p') {
+            _s.capture->pending = "vista_screenshot_" + std::to_string(_s.shots++) + ".png";
+            return true;
+        }
+        return false;
+    }
+    void getUsage(osg::ApplicationUsage& u) const override {
+        u.addKeyboardMouseBinding("m", "cycle render mode: full / near / osgimpostor");
+        u.addKeyboardMouseBinding("p", "screenshot to vista_screenshot_N.png");
+    }
+
+private:
+    ViewState& _s;
+};
+
+osg::ref_ptr<osg::Node> makeImpostorScene(osg::Node* scene, double nearD) {
+    osg::ref_ptr<osg::Group> root = new osg::Group;
+    osg::Group* g = scene ? scene->asGroup() : nullptr;
+    if (!g) return scene;
+    for (unsigned i = 0; i < g->getNumChildren(); ++i) {
+        osg::Node* c = g->getChild(i);
+        osg::ref_ptr<osgSim::Impostor> imp = new osgSim::Impostor;
+        if (auto* mt = dynamic_cast<osg::MatrixTransform*>(c)) {
+            osg::ref_ptr<osg::MatrixTransform> copy = new osg::MatrixTransform(mt->getMatrix());
+            for (unsigned k = 0; k < mt->getNumChildren(); ++k) imp->addChild(mt->getChild(k), 0.0f, 1e30f);
+            copy->addChild(imp.get());
+            root->addChild(copy.get());
+        } else {
+            imp->addChild(c, 0.0f, 1e30f);
+            root->addChild(imp.get());
+        }
+        imp->setImpostorThreshold(float(nearD + imp->getBound().radius()));
+    }
+    root->setStateSet(g->getStateSet());
+    return root;
+}
+
+osg::Matrixd toOsg(const glm::dmat4& m) { return osg::Matrixd(glm::value_ptr(m)); }
+
+}  // namespace
+
 int runView(int argc, char** argv) {
-    std::fprintf(stderr, "vista view: not available in this build yet\n");
-    return 1;
+    CLI::App app{"Interactive viewer: drive (1), walk (2), fly (3), orbit (4), path playback (5); s = stats, "
+                 "m = render mode, p = screenshot, h = help.",
+                 "vista view"};
+    std::string city, pathFile, sizeStr = "1280x720", screenshot, kind = "car";
+    int frames = 0;
+    uint64_t seed = 0;
+    double fovDeg = 60.0, nearD = 100.0;
+    app.add_option("city", city, "city scene file (.osgb)")->required();
+    app.add_option("--path", pathFile, "play back this path CSV (key 5)");
+    app.add_option("--seed", seed, "make a path from this seed and play it back");
+    app.add_option("--kind", kind, "path kind for --seed: walk, car, fly");
+    app.add_option("--size", sizeStr, "window size WIDTHxHEIGHT (default 1280x720)");
+    app.add_option("--fov", fovDeg, "vertical field of view in degrees (default 60)");
+    app.add_option("--near", nearD, "near-field distance of the `near` mode in metres (default 100)");
+    app.add_option("--frames", frames, "quit after N frames (0 = run until Esc)");
+    app.add_option("--screenshot", screenshot, "write a PNG of the last frame (use with --frames)");
+    int rc = parseOrExit(app, argc, argv);
+    if (rc >= 0) return rc;
+    const std::string cmd = "vista view";
+    int w = 0, h = 0;
+    char x = 0, extra = 0;
+    if (std::sscanf(sizeStr.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' || w < 1 || h < 1 || w > 8192 || h > 8192)
+        return reportBadInput(cmd, Status::error("--size '" + sizeStr + "': expected WIDTHxHEIGHT within 1x1 .. 8192x8192"));
+    if (frames < 0) return reportBadInput(cmd, Status::error("--frames " + std::to_string(frames) + " must be >= 0"));
+    if (!(fovDeg > 1 && fovDeg < 179)) return reportBadInput(cmd, Status::error("--fov out of range (1, 179) degrees"));
+    if (!(nearD > 0)) return reportBadInput(cmd, Status::error("--near must be > 0 metres"));
+    if (!screenshot.empty())
+        if (Status s = checkWritablePath("--screenshot", screenshot); !s) return reportBadInput(cmd, s);
+    auto c = loadCityFile(city);
+    if (!c) return reportBadInput(cmd, c.status());
+    Path path;
+    bool havePath = false;
+    if (!pathFile.empty()) {
+        auto p = loadPathCsv(pathFile);
+        if (!p) return reportBadInput(cmd, p.status());
+        path = std::move(p.value());
+        havePath = true;
+    }
+    {
+        auto k = parsePathKind(kind);
+        if (!k) return reportBadInput(cmd, Status::error("--kind: " + k.status().message()));
+        PathOptions po;
+        po.seed = seed ? seed : 1;
+        po.kind = k.value();
+        if (!havePath && !c->streets.edges.empty()) {
+            auto p = generatePath(c->streets, c->params, po);
+            if (p) {
+                path = std::move(p.value());
+                havePath = seed != 0;  // playback only when asked; otherwise just the start position
+                if (!havePath && !path.samples.empty()) path.samples.resize(1);
+            }
+        }
+    }
+    const char* display = std::getenv("DISPLAY");
+    if (!display || !*display) {
+        std::fprintf(stderr, "vista view: no X display (DISPLAY is not set); run under `xvfb-run -a` without a screen\n");
+        return 1;
+    }
+
+    ViewState st;
+    st.nearDistance = nearD;
+    st.modes = new osg::Switch;
+    st.modes->addChild(c->scene.get(), true);
+    st.modes->addChild(makeImpostorScene(c->scene.get(), nearD).get(), false);
+    osg::ref_ptr<osg::Group> root = new osg::Group;
+    root->addChild(st.modes.get());
+
+    // HUD: mode and frame time.
+    osg::ref_ptr<osg::Camera> hudCam = new osg::Camera;
+    hudCam->setReferenceFrame(osg::Transform::ABSOLUTE_RF);
+    hudCam->setProjectionMatrixAsOrtho2D(0, w, 0, h);
+    hudCam->setViewMatrix(osg::Matrix::identity());
+    hudCam->setClearMask(GL_DEPTH_BUFFER_BIT);
+    hudCam->setRenderOrder(osg::Camera::POST_RENDER);
+    hudCam->setAllowEventFocus(false);
+    st.hud = new osgText::Text;
+    st.hud->setCharacterSize(16.0f);
+    st.hud->setPosition(osg::Vec3(10.0f, float(h) - 24.0f, 0.0f));
+    st.hud->setColor(osg::Vec4(1, 1, 1, 1));
+    st.hud->setDataVariance(osg::Object::DYNAMIC);
+    osg::ref_ptr<osg::Geode> hudGeode = new osg::Geode;
+    hudGeode->addDrawable(st.hud.get());
+    hudGeode->getOrCreateStateSet()->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
+    hudCam->addChild(hudGeode.get());
+    root->addChild(hudCam.get());
+
+    osgViewer::Viewer viewer;
+    viewer.setThreadingModel(osgViewer::ViewerBase::SingleThreaded);
+    viewer.setUpViewInWindow(0, 0, w, h);
+    viewer.setSceneData(root.get());
+    osg::Camera* cam = viewer.getCamera();
+    cam->setComputeNearFarMode(osg::CullSettings::DO_NOT_COMPUTE_NEAR_FAR);
+    cam->setClearColor(osg::Vec4(0.62f, 0.75f, 0.9f, 1.0f));
+    st.capture = new Capture;
+    cam->setFinalDrawCallback(st.capture.get());
+
+    // Manipulators.
+    osg::ref_ptr<osgGA::KeySwitchMatrixManipulator> ks = new osgGA::KeySwitchMatrixManipulator;
+    osg::Vec3d start(0, 0, 0), dir(0, 1, 0);
+    if (!path.samples.empty()) {
+        const auto& s0 = path.samples.front();
+        start = osg::Vec3d(s0.position.x, s0.position.y, s0.position.z);
+        dir = osg::Vec3d(std::sin(s0.heading), std::cos(s0.heading), 0.0);
+    } else {
+        start = osg::Vec3d(c->params.origin_x, c->params.origin_y, 1.7);
+    }
+    auto drive = new osgGA::DriveManipulator;
+    auto walk = new osgGA::FirstPersonManipulator;
+    auto fly = new osgGA::FlightManipulator;
+    auto orbit = new osgGA::TrackballManipulator;
+    for (osgGA::CameraManipulator* m : std::initializer_list<osgGA::CameraManipulator*>{drive, walk, fly})
+        m->setHomePosition(start, start + dir * 10.0, osg::Vec3d(0, 0, 1));
+    drive->setModelScale(1.0);
+    ks->addMatrixManipulator('1', "Drive", drive);
+    ks->addMatrixManipulator('2', "Walk", walk);
+    ks->addMatrixManipulator('3', "Fly", fly);
+    ks->addMatrixManipulator('4', "Orbit", orbit);
+    if (havePath && path.samples.size() > 1) {
+        osg::ref_ptr<osg::AnimationPath> ap = new osg::AnimationPath;
+        ap->setLoopMode(osg::AnimationPath::LOOP);
+        for (const auto& s : path.samples) {
+            Camera cc;
+            cc.eye = s.position;
+            cc.heading = s.heading;
+            cc.pitch = s.pitch;
+            osg::Matrixd inv = osg::Matrixd::inverse(toOsg(cc.view()));
+            ap->insert(s.t, osg::AnimationPath::ControlPoint(inv.getTrans(), inv.getRotate()));
+        }
+        ks->addMatrixManipulator('5', "Path", new osgGA::AnimationPathManipulator(ap.get()));
+        ks->selectMatrixManipulator(4);
+    }
+    viewer.setCameraManipulator(ks.get());
+    viewer.addEventHandler(new osgViewer::StatsHandler);
+    viewer.addEventHandler(new osgViewer::HelpHandler(new osg::ApplicationUsage));
+    viewer.addEventHandler(new osgViewer::WindowSizeHandler);
+    viewer.addEventHandler(new osgGA::StateSetManipulator(cam->getOrCreateStateSet()));
+    viewer.addEventHandler(new ViewKeys(st));
+    viewer.realize();
+    if (!viewer.isRealized()) {
+        std::fprintf(stderr, "vista view: cannot open a window on display '%s'\n", display);
+        return 1;
+    }
+
+    int n = 0;
+    double lastMs = 0;
+    osg::Timer_t t0 = osg::Timer::instance()->tick();
+    while (!viewer.done()) {
+        Camera pc;
+        const osg::Viewport* vp = cam->getViewport();
+        pc.width = vp ? int(vp->width()) : w;
+        pc.height = vp ? int(vp->height()) : h;
+        pc.fovY = fovDeg * kPi / 180.0;
+        cam->setProjectionMatrix(toOsg(pc.projection(st.mode == 1 ? st.nearDistance : 0.0)));
+        char buf[160];
+        std::snprintf(buf, sizeof(buf), "mode %s (m)   %.1f ms/frame   keys: 1 drive 2 walk 3 fly 4 orbit%s, s stats, p shot",
+                      kModeNames[st.mode], lastMs, havePath ? " 5 path" : "");
+        st.hud->setText(buf);
+        bool last = frames > 0 && n + 1 >= frames;
+        if (last && !screenshot.empty()) st.capture->pending = screenshot;
+        viewer.frame();
+        osg::Timer_t t1 = osg::Timer::instance()->tick();
+        lastMs = osg::Timer::instance()->delta_m(t0, t1);
+        t0 = t1;
+        if (last) break;
+        ++n;
+    }
+    if (!screenshot.empty() && st.capture->lastWritten != screenshot) return 1;
+    return 0;
 }
 
 }  // namespace vista

@@ -48,7 +48,7 @@ Status writePng(const Image& img, const std::string& path) {
     std::vector<png_bytep> rows(size_t(img.height));
     for (int y = 0; y < img.height; ++y)
         rows[size_t(y)] = const_cast<png_bytep>(&img.rgba[size_t(y) * size_t(img.width) * 4]);
-    bool failed = false;
+    volatile bool failed = false;
     if (setjmp(png_jmpbuf(png))) {
         failed = true;
     } else {
@@ -87,7 +87,7 @@ Result<Image> readPng(const std::string& path) {
     png_infop info = png_create_info_struct(png);
     Image img;
     std::vector<png_bytep> rows;
-    bool failed = false;
+    volatile bool failed = false;
     if (setjmp(png_jmpbuf(png))) {
         failed = true;
     } else {

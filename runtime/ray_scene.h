@@ -7,6 +7,8 @@
 // to a scene-local float frame around `frameOrigin()` (the city centre), so
 // precision holds 1,000 km from the world origin. Hits return the
 // interpolated prelit vertex colour: the same colour the rasteriser shows.
+// Back faces (triangles clockwise as seen along the ray) are culled, as the
+// rasteriser culls them (CullFace BACK on the city root).
 // Embree errors are mapped to Status at construction; nothing throws from a
 // ray-casting loop. FTZ/DAZ are set on every thread that casts.
 #pragma once

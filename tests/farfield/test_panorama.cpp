@@ -1,2 +1,293 @@
-// Tests arrive with this module's work.
+// Panoramic image cache and far-field pipeline tests: rotation-invariant
+// indexing, azimuth wrap, confidence ordering, every-n-th rule, graceful
+// degradation and convergence of a still viewer to the exact ray-cast image.
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "runtime/far_field.h"
+#include "runtime/horizon.h"
+#include "runtime/panorama_cache.h"
+#include "runtime/ray_scene.h"
+#include "tests/farfield/fixtures.h"
+
+using namespace vista;
+using namespace vista::test;
+
+namespace {
+
+Camera cam(const glm::dvec3& eye, double heading, double pitch = 0.0, int w = 96, int h = 64) {
+    Camera c;
+    c.eye = eye;
+    c.heading = heading;
+    c.pitch = pitch;
+    c.width = w;
+    c.height = h;
+    c.fovY = 0.8;
+    return c;
+}
+
+// Reference: every pixel cast individually, sky on a miss (as FarField shades).
+Image exactImage(const RayScene& rs, const Camera& c, const FarField& ff, const Image& farImage) {
+    Image out(c.width, c.height);
+    glm::vec3 org(c.eye - rs.frameOrigin());
+    for (int y = 0; y < c.height; ++y)
+        for (int x = 0; x < c.width; ++x) {
+            RayHit h = rs.intersect(org, glm::vec3(c.rayDirection(x + 0.5, y + 0.5)));
+            if (h.hit) out.set(x, y, glm::u8vec4(h.color.x, h.color.y, h.color.z, 255));
+            else out.set(x, y, farImage.at(x, y));  // sky pixels: compared separately below
+        }
+    (void)ff;
+    return out;
+}
+
+int countDiff(const Image& a, const Image& b) {
+    int n = 0;
+    for (size_t i = 0; i < a.rgba.size(); i += 4)
+        if (std::abs(int(a.rgba[i]) - int(b.rgba[i])) > 1 || std::abs(int(a.rgba[i + 1]) - int(b.rgba[i + 1])) > 1 ||
+            std::abs(int(a.rgba[i + 2]) - int(b.rgba[i + 2])) > 1)
+            ++n;
+    return n;
+}
+
+}  // namespace
+
+TEST(Panorama, IndexIsInvariantUnderViewRotation) {
+    PanoramaCache pc = PanoramaCache::forCamera(cam(glm::dvec3(0), 0.0, 0.0, 640, 480));
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> a(-M_PI, M_PI);
+    // The same world direction seen from differently rotated cameras maps to
+    // the same cell; the cell depends only on the world direction.
+    for (int i = 0; i < 200; ++i) {
+        Camera c1 = cam(glm::dvec3(0), a(rng), 0.1 * a(rng) / M_PI, 640, 480);
+        glm::dvec3 d = c1.rayDirection(100.5 + i, 200.5);
+        int64_t i1 = pc.index(d);
+        // A second camera rotated by some angle sees d through another pixel.
+        Camera c2 = c1;
+        c2.heading += a(rng);
+        // Find d's pixel in c2 is not needed: index is a function of d alone.
+        EXPECT_EQ(pc.index(d), i1);
+        // Rotating d about the vertical axis by a whole number of cells moves the column only.
+        double step = 2 * M_PI / pc.width() * 7;
+        glm::dvec3 r(d.x * std::cos(-step) - d.y * std::sin(-step), d.x * std::sin(-step) + d.y * std::cos(-step), d.z);
+        glm::dvec2 m1 = pc.mapCoord(d), m2 = pc.mapCoord(r);
+        EXPECT_NEAR(std::fmod(m2.x - m1.x + pc.width(), double(pc.width())), 7.0, 1e-6);
+        EXPECT_NEAR(m2.y, m1.y, 1e-9);
+    }
+    // Pixels of one frame: distinct pixels rarely share a cell (oversampled map).
+    Camera c = cam(glm::dvec3(0), 0.7, 0.0, 640, 480);
+    std::vector<int64_t> idx;
+    for (int y = 0; y < 480; ++y)
+        for (int x = 0; x < 640; ++x) idx.push_back(pc.index(c.rayDirection(x + 0.5, y + 0.5)));
+    std::sort(idx.begin(), idx.end());
+    EXPECT_EQ(std::adjacent_find(idx.begin(), idx.end()), idx.end());
+}
+
+TEST(Panorama, AzimuthWrapsAtZeroAndTwoPi) {
+    PanoramaCache pc(1000, 100, 1.0);
+    // Directions just either side of north (+y): first and last column.
+    double e = 1e-9;
+    glm::dvec3 right(std::sin(e), std::cos(e), 0), left(std::sin(-e), std::cos(-e), 0), north(0, 1, 0);
+    EXPECT_EQ(pc.index(north) % 1000, 0);
+    EXPECT_EQ(pc.index(right) % 1000, 0);
+    EXPECT_EQ(pc.index(left) % 1000, 999);
+    EXPECT_EQ(pc.index(right) / 1000, pc.index(left) / 1000);
+    // Exactly 2 pi after rounding stays in range.
+    glm::dvec3 almost(-1e-17, 1, 0);
+    int64_t i = pc.index(almost);
+    EXPECT_GE(i % 1000, 0);
+    EXPECT_LT(i, 1000 * 100);
+    // Too steep / degenerate directions are not cacheable.
+    EXPECT_EQ(pc.index(glm::dvec3(0, 0, 1)), -1);
+    EXPECT_EQ(pc.index(glm::dvec3(0, 0.1, 0.9)), -1);
+    EXPECT_EQ(pc.index(glm::dvec3(NAN, 1, 0)), -1);
+}
+
+TEST(Panorama, ConfidenceOrderingAndEveryNthRule) {
+    PanoramaCache pc(100, 10, 1.0);
+    // Three observer positions; cells 0..29 traced at A, 30..59 at B, 60..89 at C.
+    auto at = [](double x) { return cam(glm::dvec3(x, 0, 1.7), 0.0); };
+    auto storeRange = [&](int a, int b) {
+        std::vector<int64_t> cells;
+        std::vector<glm::u8vec4> cols;
+        for (int i = a; i < b; ++i) {
+            cells.push_back(i);
+            cols.push_back(glm::u8vec4(uint8_t(i), 0, 0, 255));
+        }
+        pc.store(cells, cols);
+    };
+    pc.beginFrame(at(0));
+    storeRange(0, 30);
+    pc.beginFrame(at(50));
+    storeRange(30, 60);
+    pc.beginFrame(at(90));
+    storeRange(60, 90);
+    // Now at x = 100: distances A = 100, B = 50, C = 10; cells 90..99 never traced.
+    pc.beginFrame(at(100));
+    std::vector<CacheCandidate> cand;
+    for (int i = 0; i < 100; ++i) cand.push_back({i, uint32_t(i)});
+    std::vector<uint8_t> tr;
+    // Budget 40: never-traced (10) then A (30) exactly.
+    EXPECT_EQ(pc.selectForTracing(cand, 40, tr), 40);
+    for (int i = 0; i < 100; ++i) EXPECT_EQ(tr[size_t(i)], (i < 30 || i >= 90) ? 1 : 0) << i;
+    // Budget 25: never-traced (10) + every 2nd of A (15 of 30).
+    EXPECT_EQ(pc.selectForTracing(cand, 25, tr), 25);
+    int a = 0;
+    for (int i = 0; i < 30; ++i) a += tr[size_t(i)];
+    EXPECT_EQ(a, 15);
+    for (int i = 30; i < 90; ++i) EXPECT_EQ(tr[size_t(i)], 0);
+    // Budget 0: nothing (graceful degradation: all from cache).
+    EXPECT_EQ(pc.selectForTracing(cand, 0, tr), 0);
+    // Unlimited: everything that is not exact (nothing is exact at x = 100).
+    EXPECT_EQ(pc.selectForTracing(cand, -1, tr), 100);
+    // Stored colours come back.
+    EXPECT_EQ(pc.color(42).x, 42);
+}
+
+TEST(Panorama, StillViewerConvergesToTheExactImage) {
+    LoadedCity city = randomCity(4, 70, 400.0, 1.0e6, 0.0);  // 1,000 km from the origin
+    auto rs = RayScene::build(city);
+    ASSERT_TRUE(rs.isOk());
+    HeightGrid grid = HeightGrid::build(city, rs.value()->frameOrigin(), 64);
+    FarFieldOptions o;
+    o.nearDistance = 0;
+    o.pixelBudget = 700;
+    FarField ff(*rs.value(), &grid, o);
+    // Walk a few frames, then stop.
+    Image img;
+    for (int f = 0; f < 4; ++f) {
+        FrameStats st;
+        ff.render(cam(glm::dvec3(1.0e6 + 2.0 * f, -180, 1.7), 0.2 + 0.05 * f), nullptr, img, st);
+        EXPECT_LE(st.pixels.rayHit + st.pixels.rayMiss, 700u);
+    }
+    Camera still = cam(glm::dvec3(1.0e6 + 8.0, -180, 1.7), 0.4);
+    const uint64_t N = uint64_t(still.width) * still.height;
+    int frames = 0;
+    uint64_t traced = 1;
+    while (traced > 0 && frames < 100) {
+        FrameStats st;
+        ff.render(still, nullptr, img, st);
+        EXPECT_EQ(st.pixels.covered + st.pixels.horizonCulled + st.pixels.cache + st.pixels.rayHit + st.pixels.rayMiss, N);
+        traced = st.pixels.rayHit + st.pixels.rayMiss;
+        EXPECT_LE(traced, 700u);
+        ++frames;
+    }
+    EXPECT_GT(frames, 2);    // the budget forced progressive refinement
+    EXPECT_LT(frames, 100);  // ... and it finished
+    Image ref = exactImage(*rs.value(), still, ff, img);
+    EXPECT_EQ(countDiff(img, ref), 0);
+    // Sky pixels equal an unlimited-budget frame (no cache) of the same camera.
+    FarFieldOptions u = o;
+    u.pixelBudget = -1;
+    FarField direct(*rs.value(), &grid, u);
+    Image img2;
+    FrameStats st2;
+    direct.render(still, nullptr, img2, st2);
+    EXPECT_EQ(countDiff(img, img2), 0);
+    EXPECT_EQ(st2.pixels.cache, 0u);
+}
+
+TEST(FarField, PixelClassesPartitionTheImageAndStagesRunOnlyWhenNeeded) {
+    LoadedCity city = randomCity(6, 50);
+    auto rs = RayScene::build(city);
+    ASSERT_TRUE(rs.isOk());
+    HeightGrid grid = HeightGrid::build(city, glm::dvec3(0), 64);
+    FarFieldOptions o;
+    o.nearDistance = 0;
+    FarField ff(*rs.value(), &grid, o);
+    Camera c = cam(glm::dvec3(0, -190, 1.7), 0.0);
+    const size_t N = size_t(c.width) * size_t(c.height);
+    // Half the image covered by a fake near field (bottom half).
+    std::vector<float> depth(N, 1.0f);
+    for (size_t i = N / 2; i < N; ++i) depth[i] = 0.5f;
+    Image img(c.width, c.height);
+    FrameStats st;
+    ff.render(c, depth.data(), img, st);
+    EXPECT_EQ(st.pixels.covered, N - N / 2);
+    EXPECT_EQ(st.pixels.covered + st.pixels.horizonCulled + st.pixels.cache + st.pixels.rayHit + st.pixels.rayMiss, N);
+    EXPECT_GT(st.pixels.horizonCulled, 0u);
+    EXPECT_TRUE(st.stagesMs.count("horizon"));
+    EXPECT_TRUE(st.stagesMs.count("rays"));
+    // Fully covered: only the opacity stage runs.
+    std::vector<float> full(N, 0.2f);
+    FrameStats s2;
+    ff.render(c, full.data(), img, s2);
+    EXPECT_EQ(s2.pixels.covered, N);
+    EXPECT_EQ(s2.stagesMs.size(), 1u);
+    // Rolled camera: horizon off, says so, still a complete classification.
+    Camera r = c;
+    r.roll = 0.2;
+    FrameStats s3;
+    ff.render(r, nullptr, img, s3);
+    EXPECT_FALSE(s3.stagesMs.count("horizon"));
+    ASSERT_FALSE(s3.notes.empty());
+    EXPECT_EQ(s3.pixels.horizonCulled, 0u);
+    EXPECT_EQ(s3.pixels.rayHit + s3.pixels.rayMiss, N);
+    // Near distance beyond the whole city: no far geometry -> no ray stage.
+    FarFieldOptions far = o;
+    far.nearDistance = 5000;
+    ff.setOptions(far);
+    FrameStats s4;
+    ff.render(c, depth.data(), img, s4);
+    EXPECT_FALSE(s4.stagesMs.count("rays"));
+    EXPECT_EQ(s4.pixels.rayHit + s4.pixels.rayMiss, 0u);
+    EXPECT_EQ(s4.pixels.covered + s4.pixels.horizonCulled, N);
+}
+
+TEST(FarField, HardCasesStayFinite) {
+    LoadedCity city = randomCity(8, 40);
+    auto rs = RayScene::build(city);
+    ASSERT_TRUE(rs.isOk());
+    HeightGrid grid = HeightGrid::build(city, glm::dvec3(0), 32);
+    FarFieldOptions o;
+    o.pixelBudget = 5000;
+    FarField ff(*rs.value(), &grid, o);
+    const double s = grid.cellSize();
+    std::vector<Camera> cams = {
+        cam(glm::dvec3(grid.gridMin().x + 10 * s, grid.gridMin().y + 7 * s, 1.7), 0.0),  // on grid lines, axis rays
+        cam(glm::dvec3(0, 0, 1.7), 0.5 * M_PI),
+        cam(glm::dvec3(0, 0, 1.7), 0.0, 0.5 * M_PI),   // straight up
+        cam(glm::dvec3(0, 0, 30.0), 0.0, -0.5 * M_PI), // straight down
+        cam(glm::dvec3(0, -100, 1.7), 0.0, 0.0, 1, 1),
+    };
+    for (const Camera& c : cams) {
+        Image img;
+        FrameStats st;
+        ff.render(c, nullptr, img, st);
+        const uint64_t N = uint64_t(c.width) * c.height;
+        EXPECT_EQ(st.pixels.covered + st.pixels.horizonCulled + st.pixels.cache + st.pixels.rayHit + st.pixels.rayMiss, N);
+        for (size_t i = 3; i < img.rgba.size(); i += 4) ASSERT_EQ(img.rgba[i], 255);  // every pixel written
+    }
+    // Empty city: nothing to trace, all sky.
+    LoadedCity empty;
+    auto er = RayScene::build(empty);
+    ASSERT_TRUE(er.isOk());
+    HeightGrid eg = HeightGrid::build(empty, glm::dvec3(0), 16);
+    FarField ef(*er.value(), &eg, o);
+    Image img;
+    FrameStats st;
+    ef.render(cam(glm::dvec3(0, 0, 1.7), 0.0), nullptr, img, st);
+    EXPECT_EQ(st.pixels.rayHit + st.pixels.rayMiss, 0u);
+    EXPECT_EQ(st.pixels.horizonCulled, uint64_t(96 * 64));
+}
+
+TEST(FarField, LargeViewport) {
+    LoadedCity city = randomCity(10, 30);
+    auto rs = RayScene::build(city);
+    ASSERT_TRUE(rs.isOk());
+    HeightGrid grid = HeightGrid::build(city, glm::dvec3(0), 64);
+    FarFieldOptions o;
+    o.pixelBudget = 20000;
+    FarField ff(*rs.value(), &grid, o);
+    Camera c = cam(glm::dvec3(0, -190, 1.7), 0.0, 0.0, 4096, 2160);
+    std::vector<float> depth(size_t(4096) * 2160, 1.0f);
+    for (size_t i = depth.size() / 3; i < depth.size(); ++i) depth[i] = 0.5f;  // cover most
+    Image img;
+    FrameStats st;
+    ff.render(c, depth.data(), img, st);
+    EXPECT_EQ(img.width, 4096);
+    EXPECT_EQ(st.pixels.covered + st.pixels.horizonCulled + st.pixels.cache + st.pixels.rayHit + st.pixels.rayMiss,
+              uint64_t(4096) * 2160);
+    EXPECT_LE(st.pixels.rayHit + st.pixels.rayMiss, 20000u);
+}

@@ -1,2 +1,195 @@
-// Tests arrive with this module's work.
+// Walkthrough paths: determinism, speed / yaw-rate limits, staying on the
+// streets, CSV round trip and bad input.
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+#include "runtime/paths.h"
+
+using namespace vista;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// A 6 x 6 grid of streets, 120 m apart, plus one dead-end spur.
+StreetGraph gridGraph() {
+    StreetGraph g;
+    const int n = 6;
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) g.nodes.push_back({(i - 2.5) * 120.0, (j - 2.5) * 120.0});
+    auto add = [&](uint32_t a, uint32_t b) {
+        StreetEdge e;
+        e.a = a;
+        e.b = b;
+        e.width = 8.0f;
+        g.edges.push_back(e);
+    };
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            if (i + 1 < n) add(uint32_t(j * n + i), uint32_t(j * n + i + 1));
+            if (j + 1 < n) add(uint32_t(j * n + i), uint32_t((j + 1) * n + i));
+        }
+    g.nodes.push_back({-2.5 * 120.0 - 80.0, 0.5 * 120.0});
+    add(uint32_t(3 * n), uint32_t(g.nodes.size() - 1));
+    return g;
+}
+
+CityParams flatParams() {
+    CityParams p;
+    p.hills_amplitude_m = 0.0;
+    return p;
+}
+
+double wrap(double a) {
+    while (a > kPi) a -= 2 * kPi;
+    while (a < -kPi) a += 2 * kPi;
+    return a;
+}
+
+std::string tmpFile(const std::string& name) {
+    return (std::filesystem::temp_directory_path() / ("vista_test_paths_" + std::to_string(::getpid()) + "_" + name)).string();
+}
+
+}  // namespace
+
+TEST(Paths, DeterministicPerSeed) {
+    StreetGraph g = gridGraph();
+    PathOptions o;
+    o.duration = 40;
+    auto a = generatePath(g, flatParams(), o), b = generatePath(g, flatParams(), o);
+    ASSERT_TRUE(a.isOk()) << a.status().message();
+    ASSERT_TRUE(b.isOk());
+    ASSERT_EQ(a->samples.size(), b->samples.size());
+    for (size_t i = 0; i < a->samples.size(); ++i) {
+        EXPECT_EQ(a->samples[i].position, b->samples[i].position);
+        EXPECT_EQ(a->samples[i].heading, b->samples[i].heading);
+    }
+    o.seed = 2;
+    auto c = generatePath(g, flatParams(), o);
+    ASSERT_TRUE(c.isOk());
+    bool differs = false;
+    for (size_t i = 0; i < c->samples.size(); ++i) differs = differs || c->samples[i].position != a->samples[i].position;
+    EXPECT_TRUE(differs);
+}
+
+TEST(Paths, RespectsSpeedAndYawLimitsAndStaysOnStreets) {
+    StreetGraph g = gridGraph();
+    for (uint64_t seed : {1u, 2u, 3u, 4u, 5u}) {
+        PathOptions o;
+        o.seed = seed;
+        o.duration = 90;
+        auto p = generatePath(g, flatParams(), o);
+        ASSERT_TRUE(p.isOk()) << p.status().message();
+        ASSERT_EQ(p->samples.size(), size_t(std::floor(o.duration / o.dt + 1e-9)) + 1);
+        double turned = 0, travelled = 0, maxTurn = 0;
+        for (size_t i = 0; i < p->samples.size(); ++i) {
+            const auto& s = p->samples[i];
+            EXPECT_NEAR(s.position.z, 1.2, 1e-9);  // car eye height on flat ground
+            double d = distanceToStreets(g, glm::dvec2(s.position));
+            EXPECT_LE(d, 4.0) << "seed " << seed << " sample " << i << " is " << d << " m off the centre line (half width 4 m)";
+            if (i == 0) continue;
+            const auto& q = p->samples[i - 1];
+            double v = glm::length(glm::dvec2(s.position - q.position)) / o.dt;
+            EXPECT_LE(v, o.maxSpeed + 1e-9);
+            double dh = std::abs(wrap(s.heading - q.heading));
+            EXPECT_LE(dh, o.maxYawRate * o.dt + 1e-9);
+            turned += dh;
+            maxTurn = std::max(maxTurn, dh);
+            travelled += v * o.dt;
+        }
+        // It drives (at least a third of top speed on average) and turns at intersections.
+        EXPECT_GT(travelled, o.maxSpeed * o.duration / 3);
+        EXPECT_GT(turned, kPi / 2) << "seed " << seed << " never turned";
+    }
+}
+
+TEST(Paths, EyeHeightsAndFlyOver) {
+    StreetGraph g = gridGraph();
+    CityParams p = flatParams();
+    p.origin_x = 1.0e6;
+    p.origin_y = -2.0e6;
+    PathOptions o;
+    o.duration = 5;
+    o.kind = PathKind::Walk;
+    auto w = generatePath(g, p, o);
+    ASSERT_TRUE(w.isOk());
+    EXPECT_NEAR(w->samples[0].position.z, 1.7, 1e-9);
+    EXPECT_NEAR(w->samples[0].pitch, 0.0, 1e-12);
+    // World coordinates carry the city origin.
+    EXPECT_GE(distanceToStreets(g, glm::dvec2(w->samples[3].position)), 1e5);
+    EXPECT_LE(distanceToStreets(g, glm::dvec2(w->samples[3].position) - glm::dvec2(1.0e6, -2.0e6)), 4.0);
+    o.kind = PathKind::Fly;
+    o.flyHeight = 60;
+    auto f = generatePath(g, p, o);
+    ASSERT_TRUE(f.isOk());
+    EXPECT_NEAR(f->samples[10].position.z, 60.0, 1e-9);
+    EXPECT_NEAR(f->samples[10].pitch, o.flyPitch, 1e-12);
+}
+
+TEST(Paths, CsvRoundTrip) {
+    StreetGraph g = gridGraph();
+    PathOptions o;
+    o.duration = 3;
+    o.kind = PathKind::Fly;
+    auto p = generatePath(g, flatParams(), o);
+    ASSERT_TRUE(p.isOk());
+    std::string f = tmpFile("rt.csv");
+    ASSERT_TRUE(savePathCsv(p.value(), f).isOk());
+    auto q = loadPathCsv(f);
+    ASSERT_TRUE(q.isOk()) << q.status().message();
+    ASSERT_EQ(q->samples.size(), p->samples.size());
+    for (size_t i = 0; i < p->samples.size(); ++i) {
+        EXPECT_NEAR(q->samples[i].t, p->samples[i].t, 1e-6);
+        EXPECT_NEAR(glm::length(q->samples[i].position - p->samples[i].position), 0.0, 1e-3);
+        EXPECT_NEAR(wrap(q->samples[i].heading - p->samples[i].heading), 0.0, 1e-7);
+        EXPECT_NEAR(q->samples[i].pitch, p->samples[i].pitch, 1e-7);
+    }
+    std::filesystem::remove(f);
+}
+
+TEST(Paths, BadInput) {
+    EXPECT_FALSE(loadPathCsv(tmpFile("does_not_exist.csv")).isOk());
+    auto write = [](const std::string& name, const std::string& text) {
+        std::string f = tmpFile(name);
+        std::ofstream(f) << text;
+        return f;
+    };
+    std::string f1 = write("bad1.csv", "t_s,x_m,y_m,z_m,heading_deg,pitch_deg\n0,1,2,3,4,5\n0.1,1,2,abc,4,5\n");
+    auto r1 = loadPathCsv(f1);
+    ASSERT_FALSE(r1.isOk());
+    EXPECT_NE(r1.status().message().find("line 3"), std::string::npos) << r1.status().message();
+    std::string f2 = write("bad2.csv", "0,1,2,3,4,5\n0,1,2,3,4,5\n");
+    auto r2 = loadPathCsv(f2);
+    ASSERT_FALSE(r2.isOk());
+    EXPECT_NE(r2.status().message().find("does not increase"), std::string::npos);
+    std::string f3 = write("bad3.csv", "0,1,2,3,4\n");
+    EXPECT_FALSE(loadPathCsv(f3).isOk());
+    std::string f4 = write("bad4.csv", "t_s,x_m,y_m,z_m,heading_deg,pitch_deg\n");
+    EXPECT_FALSE(loadPathCsv(f4).isOk());
+    std::string f5 = write("bad5.csv", "0,1,2,nan,4,5\n");
+    EXPECT_FALSE(loadPathCsv(f5).isOk());
+    for (const auto& f : {f1, f2, f3, f4, f5}) std::filesystem::remove(f);
+
+    PathOptions o;
+    EXPECT_FALSE(generatePath(StreetGraph{}, flatParams(), o).isOk());
+    o.maxSpeed = 0;
+    auto r = generatePath(gridGraph(), flatParams(), o);
+    ASSERT_FALSE(r.isOk());
+    EXPECT_NE(r.status().message().find("speed"), std::string::npos);
+    EXPECT_FALSE(parsePathKind("boat").isOk());
+}
+
+TEST(Paths, SpreadCoversThePath) {
+    Path p;
+    for (int i = 0; i < 100; ++i) p.samples.push_back({double(i), {}, 0, 0});
+    auto s = p.spread(5);
+    ASSERT_EQ(s.size(), 5u);
+    EXPECT_EQ(s.front(), 0u);
+    EXPECT_EQ(s.back(), 99u);
+    for (size_t i = 1; i < s.size(); ++i) EXPECT_GT(s[i], s[i - 1]);
+}

@@ -1,0 +1,181 @@
+#include "bake/appearance.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+#include <tbb/parallel_for.h>
+
+#include "citygen/lighting.h"
+#include "citygen/rng.h"
+
+namespace vista {
+namespace {
+
+inline double luma(const glm::dvec3& c) { return 0.299 * c.x + 0.587 * c.y + 0.114 * c.z; }
+
+glm::u8vec4 toU8(const glm::dvec3& c) {
+    auto q = [](double v) { return uint8_t(std::lround(std::clamp(v, 0.0, 1.0) * 255.0)); };
+    return {q(c.x), q(c.y), q(c.z), 255};
+}
+
+struct TexelAcc {
+    glm::dvec3 sum{0.0};
+    double l = 0, l2 = 0;
+    int n = 0, attempts = 0;
+    glm::dvec3 mean() const { return n > 0 ? sum / double(n) : glm::dvec3(0.0); }
+    double stdErr() const {
+        if (n < 2) return 1e300;
+        const double m = l / n;
+        const double var = std::max(0.0, (l2 - n * m * m) / (n - 1));
+        return std::sqrt(var / n);
+    }
+};
+
+struct PointResult {
+    bool visible = false, single = true;
+    glm::dvec3 mean{0.0};
+    std::vector<glm::dvec3> texels;
+    int64_t rays = 0, samples = 0;
+};
+
+}  // namespace
+
+void computeAppearance(const FarScene& scene, const SamplingSetup& s, const std::vector<glm::vec3>& points,
+                       const AppearanceParams& p, uint64_t seed, uint64_t entity, PointImpostorData& out,
+                       AppearanceStats& stats, std::vector<uint32_t>* kept, const Box3* cell) {
+    VISTA_CHECK(p.texelsX >= 1 && p.texelsY >= 1 && p.minSamples >= 1 && p.maxSamples >= p.minSamples);
+    const int nt = p.texelsX * p.texelsY;
+    const glm::dvec2 lo = s.rectLo, size = glm::max(s.rectHi - s.rectLo, glm::dvec2(1e-6));
+    const glm::dvec2 texel(size.x / p.texelsX, size.y / p.texelsY);
+    std::vector<PointResult> res(points.size());
+
+    tbb::parallel_for(size_t(0), points.size(), [&](size_t k) {
+        Rng rng(seed, hashKeys(entity, k), Stream::Bake);
+        PointResult& r = res[k];
+        const glm::dvec3 pt(points[k]);
+        if (cell && p.cellVisibilityRays > 0) {
+            bool seen = false;
+            for (int v = 0; v < p.cellVisibilityRays && !seen; ++v) {
+                glm::dvec3 e;
+                if (v < 8) e = cell->corner(v);
+                else if (v == 8) e = cell->center();
+                else
+                    for (int a = 0; a < 3; ++a) e[a] = rng.uniform(cell->lo[a], cell->hi[a]);
+                glm::dvec3 d = pt - e;
+                const double dist = glm::length(d);
+                if (dist < 1e-6) { seen = true; break; }
+                d /= dist;
+                ++r.rays;
+                seen = !scene.occluded(glm::vec3(e), glm::vec3(d), 0.0f, float(dist - std::max(0.05, 2e-4 * dist)));
+            }
+            if (!seen) { r.visible = false; return; }
+        }
+        std::vector<TexelAcc> acc(static_cast<size_t>(nt));
+        // One sample for texel t; returns false if the point was hidden.
+        auto sample = [&](int t) {
+            const int ti = t % p.texelsX, tj = t / p.texelsX;
+            glm::dvec2 q = lo + glm::dvec2((ti + 0.5) * texel.x, (tj + 0.5) * texel.y);
+            q.x += rng.normal() * p.viewSigma * texel.x;
+            q.y += rng.normal() * p.viewSigma * texel.y;
+            q = glm::clamp(q, lo, lo + size);
+            const glm::dvec3 sp = s.toFrame(q);
+            glm::dvec3 d = pt - sp;
+            const double dist = glm::length(d);
+            TexelAcc& a = acc[size_t(t)];
+            ++a.attempts;
+            if (dist < 1e-6) return;
+            d /= dist;
+            ++r.rays;
+            const double gap = std::max(0.05, 2e-4 * dist);
+            if (scene.occluded(glm::vec3(sp), glm::vec3(d), 0.0f, float(dist - gap))) return;
+            glm::dvec3 e1 = glm::cross(d, glm::dvec3(0, 0, 1));
+            if (glm::length(e1) < 1e-9) e1 = glm::dvec3(1, 0, 0);
+            e1 = glm::normalize(e1);
+            const glm::dvec3 e2 = glm::cross(e1, d);
+            const double ox = rng.uniform(-0.5, 0.5) + rng.normal() * p.pixelSigma;
+            const double oy = rng.uniform(-0.5, 0.5) + rng.normal() * p.pixelSigma;
+            const glm::dvec3 dir = glm::normalize(d + p.pixelAngle * (ox * e1 + oy * e2));
+            ++r.rays;
+            const FarHit h = scene.intersect(glm::vec3(sp), glm::vec3(dir), 0.0f, 1e30f);
+            glm::dvec3 c;
+            if (h.hit) c = glm::dvec3(h.color);
+            else c = glm::dvec3(glm::vec3(skyColor(std::asin(std::clamp(dir.z, -1.0, 1.0))))) / 255.0;
+            a.sum += c;
+            const double l = luma(c);
+            a.l += l;
+            a.l2 += l * l;
+            ++a.n;
+        };
+        const int maxAttempts = 4 * p.maxSamples;
+        // Pass 1: minSamples visible samples per texel.
+        for (int t = 0; t < nt; ++t)
+            while (acc[size_t(t)].n < p.minSamples && acc[size_t(t)].attempts < 4 * p.minSamples) sample(t);
+        int64_t n = 0;
+        double l = 0, l2 = 0;
+        for (const auto& a : acc) { n += a.n; l += a.l; l2 += a.l2; }
+        if (n == 0) { r.visible = false; return; }
+        r.visible = true;
+        const double pooledStd = n > 1 ? std::sqrt(std::max(0.0, (l2 - l * l / double(n)) / double(n - 1))) : 0.0;
+        if (!(pooledStd < p.singleColorThreshold) && nt > 1) {
+            for (int t = 0; t < nt; ++t) {
+                TexelAcc& a = acc[size_t(t)];
+                while (a.n < p.maxSamples && a.attempts < maxAttempts && !(a.n >= p.minSamples && a.stdErr() < p.varianceThreshold))
+                    sample(t);
+            }
+        } else if (nt == 1) {
+            TexelAcc& a = acc[0];
+            while (a.n < p.maxSamples && a.attempts < maxAttempts && !(a.n >= p.minSamples && a.stdErr() < p.varianceThreshold))
+                sample(0);
+        }
+        glm::dvec3 sum(0.0);
+        int64_t cnt = 0;
+        int seen = 0;
+        for (const auto& a : acc) {
+            sum += a.sum;
+            cnt += a.n;
+            seen += a.n > 0 ? 1 : 0;
+        }
+        r.samples = cnt;
+        r.mean = sum / double(cnt);
+        // Texel means; unseen texels take the mean of the seen ones.
+        glm::dvec3 tm(0.0);
+        for (const auto& a : acc) if (a.n > 0) tm += a.mean();
+        tm /= double(seen);
+        r.texels.resize(size_t(nt));
+        for (int t = 0; t < nt; ++t) r.texels[size_t(t)] = acc[size_t(t)].n > 0 ? acc[size_t(t)].mean() : tm;
+        glm::dvec3 var(0.0);
+        for (const auto& c : r.texels) var += (c - tm) * (c - tm);
+        var /= double(nt);
+        const double maxStd = std::sqrt(std::max(var.x, std::max(var.y, var.z)));
+        r.single = nt == 1 || maxStd < p.singleColorThreshold;
+        if (r.single) r.mean = tm;
+    });
+
+    out.texelsX = p.texelsX;
+    out.texelsY = p.texelsY;
+    out.planeOrigin = glm::vec3(s.toFrame(lo));
+    out.planeU = glm::vec3(s.U * size.x);
+    out.planeV = glm::vec3(s.V * size.y);
+    out.positions.clear(); out.colors.clear(); out.block.clear(); out.texels.clear();
+    if (kept) kept->clear();
+    for (size_t k = 0; k < points.size(); ++k) {
+        const PointResult& r = res[k];
+        stats.rays += r.rays;
+        stats.samples += r.samples;
+        if (!r.visible) { ++stats.dropped; continue; }
+        if (kept) kept->push_back(uint32_t(k));
+        out.positions.push_back(points[k]);
+        out.colors.push_back(toU8(r.mean));
+        if (r.single) {
+            ++stats.singleColor;
+            out.block.push_back(-1);
+        } else {
+            ++stats.textured;
+            out.block.push_back(int32_t(out.texels.size() / size_t(nt)));
+            for (const auto& c : r.texels) out.texels.push_back(toU8(c));
+        }
+    }
+}
+
+}  // namespace vista

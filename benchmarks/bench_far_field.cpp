@@ -1,0 +1,133 @@
+// Google Benchmark: Embree ray casting (packets vs single rays) and horizon
+// tracing on a loaded city. Usage:
+//   bench_far_field --city city.osgb [--benchmark_filter=...]
+// Without --city a synthetic random box city is used.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <random>
+#include <string>
+
+#include "runtime/city_file.h"
+#include "runtime/horizon.h"
+#include "runtime/ray_scene.h"
+
+using namespace vista;
+
+namespace {
+
+std::string gCityPath;
+struct World {
+    LoadedCity city;
+    std::unique_ptr<RayScene> rays;
+};
+
+LoadedCity syntheticCity() {
+    LoadedCity c;
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<float> pos(-900, 900), sz(5, 30), h(5, 80);
+    LoadedMesh m;
+    auto quad = [&](glm::vec3 a, glm::vec3 b, glm::vec3 cc, glm::vec3 d) {
+        uint32_t base = uint32_t(m.positions.size());
+        for (auto p : {a, b, cc, d}) {
+            m.positions.push_back(p);
+            m.colors.push_back({120, 120, 120, 255});
+        }
+        for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) m.indices.push_back(base + i);
+    };
+    quad({-1000, -1000, 0}, {1000, -1000, 0}, {1000, 1000, 0}, {-1000, 1000, 0});
+    for (int i = 0; i < 20000; ++i) {
+        glm::vec3 lo(pos(rng), pos(rng), 0), hi = lo + glm::vec3(sz(rng), sz(rng), h(rng));
+        quad({lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, lo.y, hi.z}, {lo.x, lo.y, hi.z});
+        quad({hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {hi.x, hi.y, hi.z}, {hi.x, lo.y, hi.z});
+        quad({hi.x, hi.y, lo.z}, {lo.x, hi.y, lo.z}, {lo.x, hi.y, hi.z}, {hi.x, hi.y, hi.z});
+        quad({lo.x, hi.y, lo.z}, {lo.x, lo.y, lo.z}, {lo.x, lo.y, hi.z}, {lo.x, hi.y, hi.z});
+        quad({lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z});
+    }
+    c.meshes.push_back(m);
+    return c;
+}
+
+World& world() {
+    static World w = [] {
+        World x;
+        if (!gCityPath.empty()) {
+            auto c = loadCityFile(gCityPath);
+            if (!c) {
+                std::fprintf(stderr, "%s\n", c.status().message().c_str());
+                std::exit(2);
+            }
+            x.city = std::move(*c);
+        } else {
+            x.city = syntheticCity();
+        }
+        auto r = RayScene::build(x.city);
+        if (!r) {
+            std::fprintf(stderr, "%s\n", r.status().message().c_str());
+            std::exit(2);
+        }
+        x.rays = std::move(*r);
+        return x;
+    }();
+    return w;
+}
+
+Camera streetCamera(int w, int h) {
+    Camera c;
+    c.eye = glm::dvec3(world().city.params.origin_x + 3.0, world().city.params.origin_y + 1.0, 1.7);
+    c.heading = 0.3;
+    c.width = w;
+    c.height = h;
+    c.fovY = 60.0 * M_PI / 180.0;
+    return c;
+}
+
+void BM_PrimaryPackets(benchmark::State& st) {
+    Camera cam = streetCamera(640, 480);
+    const RayScene& rs = *world().rays;
+    glm::vec3 org(cam.eye - rs.frameOrigin());
+    std::vector<glm::vec3> orgs(640 * 480, org), dirs(640 * 480);
+    for (int y = 0; y < 480; ++y)
+        for (int x = 0; x < 640; ++x) dirs[size_t(y) * 640 + size_t(x)] = glm::vec3(cam.rayDirection(x + 0.5, y + 0.5));
+    std::vector<RayHit> hits(640);
+    for (auto _ : st) {
+        for (int y = 0; y < 480; ++y) rs.intersectMany(orgs.data() + y * 640, dirs.data() + y * 640, 640, hits.data());
+    }
+    st.SetItemsProcessed(int64_t(st.iterations()) * 640 * 480);
+}
+BENCHMARK(BM_PrimaryPackets)->Unit(benchmark::kMillisecond);
+
+void BM_PrimarySingle(benchmark::State& st) {
+    Camera cam = streetCamera(640, 480);
+    const RayScene& rs = *world().rays;
+    glm::vec3 org(cam.eye - rs.frameOrigin());
+    std::vector<glm::vec3> dirs(640 * 480);
+    for (int y = 0; y < 480; ++y)
+        for (int x = 0; x < 640; ++x) dirs[size_t(y) * 640 + size_t(x)] = glm::vec3(cam.rayDirection(x + 0.5, y + 0.5));
+    for (auto _ : st) {
+        for (const auto& d : dirs) benchmark::DoNotOptimize(rs.intersect(org, d));
+    }
+    st.SetItemsProcessed(int64_t(st.iterations()) * 640 * 480);
+}
+BENCHMARK(BM_PrimarySingle)->Unit(benchmark::kMillisecond);
+
+void BM_Horizon(benchmark::State& st) {
+    const int cells = int(st.range(0));
+    HeightGrid g = HeightGrid::build(world().city, world().rays->frameOrigin(), cells);
+    Camera cam = streetCamera(640, 480);
+    for (auto _ : st) benchmark::DoNotOptimize(traceHorizon(g, cam));
+}
+BENCHMARK(BM_Horizon)->Arg(64)->Arg(128)->Arg(256)->Arg(512)->Arg(1024)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    for (int i = 1; i < argc; ++i)
+        if (std::strncmp(argv[i], "--city=", 7) == 0) gCityPath = argv[i] + 7;
+        else if (std::strcmp(argv[i], "--city") == 0 && i + 1 < argc) gCityPath = argv[++i];
+    benchmark::Initialize(&argc, argv);
+    benchmark::RunSpecifiedBenchmarks();
+    return 0;
+}

@@ -1,0 +1,389 @@
+// far_field_sweep: the measurements of docs/results.md "Issue 4: ray-cast far
+// field" in one command. Runs the bench (runBenchmark, modes interleaved per
+// frame in one process) on consecutive samples of one car walkthrough (30 fps
+// spacing, so the panoramic cache sees real frame-to-frame coherence) for:
+//   modes640 / modes320  full, near, raycast, osgimpostor, hybrid (Figs 4.8, 4.10)
+//   near                 hybrid at near = 25, 50, 100, 200, 400 m and auto (Fig 4.9)
+//   budget, grid, cache  pixel budgets, horizon grid resolutions, cache on/off
+// and writes OUT/far_field.md (tables: Table 4.1 layout, frame times, speedups,
+// PSNR vs frame time with the Pareto front), OUT/far_field.json, and plots
+// OUT/fig_4_9_near.png, OUT/accuracy_vs_time.png (+ each run's bench output
+// in OUT/<run>/).
+//
+// Usage: far_field_sweep CITY.osgb OUT [--frames N] [--only a,b] [--budget B]
+// Needs an X display (xvfb-run -a).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "runtime/bench.h"
+#include "runtime/city_file.h"
+#include "runtime/paths.h"
+#include "runtime/plot.h"
+
+using namespace vista;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct RunSpec {
+    std::string name, group, label;
+    int width = 640, height = 480;
+    std::vector<std::string> modes;
+    BenchOptions options;
+    double x = 0;  // parameter value (for plots)
+};
+
+struct ModeAgg {
+    double medianMs = 0, meanMs = 0, p95Ms = 0, psnrMedian = 0, psnrMin = 0, psnrMean = 0;
+    std::vector<double> frameMs;
+    // Pixel classes: min/mean/max % and mean count.
+    double pct[5][3] = {};
+    double meanCount[5] = {};
+    std::map<std::string, double> stageMean;
+    std::vector<std::string> notes;
+};
+
+double median(std::vector<double> v) { return percentile(std::move(v), 0.5); }
+
+ModeAgg aggregate(const BenchResult& r, const std::string& mode, int w, int h) {
+    ModeAgg a;
+    std::vector<double> psnr;
+    const double N = double(w) * h;
+    for (auto& c : a.pct) c[0] = 1e9, c[1] = 0, c[2] = -1;
+    int n = 0;
+    std::map<std::string, int> noteCount;
+    for (const auto& f : r.frames) {
+        if (f.mode != mode) continue;
+        ++n;
+        a.frameMs.push_back(f.stats.frameMs);
+        psnr.push_back(f.psnrDb);
+        const uint64_t v[5] = {f.stats.pixels.rayHit, f.stats.pixels.rayMiss, f.stats.pixels.cache,
+                               f.stats.pixels.horizonCulled, f.stats.pixels.covered};
+        for (int k = 0; k < 5; ++k) {
+            double p = 100.0 * double(v[k]) / N;
+            a.pct[k][0] = std::min(a.pct[k][0], p);
+            a.pct[k][1] += p;
+            a.pct[k][2] = std::max(a.pct[k][2], p);
+            a.meanCount[k] += double(v[k]);
+        }
+        for (const auto& [s, ms] : f.stats.stagesMs) a.stageMean[s] += ms;
+        for (const auto& note : f.stats.notes) noteCount[note]++;
+    }
+    if (n == 0) return a;
+    for (int k = 0; k < 5; ++k) {
+        a.pct[k][1] /= n;
+        a.meanCount[k] /= n;
+    }
+    for (auto& [s, ms] : a.stageMean) ms /= n;
+    for (const auto& [note, c] : noteCount) a.notes.push_back(note + " (" + std::to_string(c) + " frames)");
+    a.medianMs = median(a.frameMs);
+    a.p95Ms = percentile(a.frameMs, 0.95);
+    for (double x : a.frameMs) a.meanMs += x / n;
+    a.psnrMedian = median(psnr);
+    a.psnrMin = *std::min_element(psnr.begin(), psnr.end());
+    for (double x : psnr) a.psnrMean += x / n;
+    return a;
+}
+
+std::string fmt(double v, int prec = 1) {
+    char b[64];
+    std::snprintf(b, sizeof b, "%.*f", prec, v);
+    return b;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc < 3) {
+        std::fprintf(stderr, "usage: far_field_sweep CITY.osgb OUT [--frames N] [--only a,b] [--budget B]\n");
+        return 2;
+    }
+    std::string cityPath = argv[1], out = argv[2];
+    int frames = 40;
+    int64_t budget = 20000;
+    std::set<std::string> only;
+    for (int i = 3; i < argc; ++i) {
+        if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) frames = std::atoi(argv[++i]);
+        else if (!std::strcmp(argv[i], "--budget") && i + 1 < argc) budget = std::atoll(argv[++i]);
+        else if (!std::strcmp(argv[i], "--only") && i + 1 < argc) {
+            std::stringstream ss(argv[++i]);
+            std::string t;
+            while (std::getline(ss, t, ',')) only.insert(t);
+        }
+    }
+    auto city = loadCityFile(cityPath);
+    if (!city) {
+        std::fprintf(stderr, "%s\n", city.status().message().c_str());
+        return 2;
+    }
+    PathOptions po;
+    po.seed = 1;
+    po.kind = PathKind::Car;
+    po.duration = (frames - 1) * po.dt;
+    auto path = generatePath(city->streets, city->params, po);
+    if (!path) {
+        std::fprintf(stderr, "%s\n", path.status().message().c_str());
+        return 2;
+    }
+    fs::create_directories(out);
+
+    BenchOptions base;
+    base.nearDistance = 100;
+    base.pixelBudget = budget;
+    base.horizonGrid = 512;
+    base.cache = true;
+    std::vector<RunSpec> runs;
+    auto add = [&](RunSpec r) {
+        if (only.empty() || only.count(r.group)) runs.push_back(std::move(r));
+    };
+    for (int res : {640, 320}) {
+        RunSpec r;
+        r.group = res == 640 ? "modes640" : "modes320";
+        r.name = r.group;
+        r.label = std::to_string(res) + "x" + std::to_string(res * 3 / 4);
+        r.width = res;
+        r.height = res * 3 / 4;
+        r.modes = {"full", "near", "raycast", "osgimpostor", "hybrid"};
+        r.options = base;
+        add(r);
+    }
+    for (double d : {25.0, 50.0, 100.0, 200.0, 400.0, -1.0}) {
+        RunSpec r;
+        r.group = "near";
+        r.name = d > 0 ? "near_" + std::to_string(int(d)) : "near_auto";
+        r.label = d > 0 ? "near " + std::to_string(int(d)) + " m" : "near auto";
+        r.modes = {"full", "hybrid"};
+        r.options = base;
+        r.options.nearDistance = d;
+        r.x = d;
+        add(r);
+    }
+    for (int64_t b : {int64_t(2000), int64_t(5000), int64_t(50000), int64_t(-1)}) {
+        RunSpec r;
+        r.group = "budget";
+        r.name = b >= 0 ? "budget_" + std::to_string(b) : "budget_unlimited";
+        r.label = b >= 0 ? "budget " + std::to_string(b) : "budget unlimited (cache bypassed)";
+        r.modes = {"full", "hybrid"};
+        r.options = base;
+        r.options.pixelBudget = b;
+        r.x = double(b);
+        add(r);
+    }
+    for (int g : {64, 128, 256, 1024}) {
+        RunSpec r;
+        r.group = "grid";
+        r.name = "grid_" + std::to_string(g);
+        r.label = "horizon grid " + std::to_string(g);
+        r.modes = {"full", "hybrid"};
+        r.options = base;
+        r.options.horizonGrid = g;
+        r.x = g;
+        add(r);
+    }
+    {
+        RunSpec r;
+        r.group = "cache";
+        r.name = "cache_off";
+        r.label = "cache off";
+        r.modes = {"full", "hybrid"};
+        r.options = base;
+        r.options.cache = false;
+        add(r);
+    }
+
+    nlohmann::json J;
+    J["city"] = fs::path(cityPath).filename().string();
+    J["city_triangles"] = city->triangles;
+    J["frames"] = frames;
+    J["default_budget"] = budget;
+    std::ostringstream md;
+    // Accuracy vs time: x = speedup of hybrid over full measured in the same
+    // run (frames interleaved), robust against the machine's load changing
+    // between runs; absolute medians are listed too.
+    struct Point {
+        std::string label;
+        double speedup, ms, psnr;
+    };
+    std::vector<Point> accuracy;
+    std::map<std::string, std::map<std::string, ModeAgg>> all;
+    for (const RunSpec& rs : runs) {
+        BenchConfig cfg;
+        cfg.width = rs.width;
+        cfg.height = rs.height;
+        cfg.frames = frames;
+        cfg.modes = rs.modes;
+        cfg.outDir = (fs::path(out) / rs.name).string();
+        cfg.options = rs.options;
+        cfg.quiet = true;
+        cfg.worstFrames = 1;
+        cfg.cityLabel = J["city"];
+        cfg.command = "far_field_sweep " + cityPath + " (run " + rs.name + ")";
+        std::fprintf(stderr, "run %s ...\n", rs.name.c_str());
+        auto r = runBenchmark(&*city, city->scene.get(), *path, cfg);
+        if (!r) {
+            std::fprintf(stderr, "run %s failed: %s\n", rs.name.c_str(), r.status().message().c_str());
+            return 1;
+        }
+        for (const auto& m : rs.modes) all[rs.name][m] = aggregate(*r, m, rs.width, rs.height);
+        const ModeAgg& h = all[rs.name]["hybrid"];
+        const ModeAgg& f = all[rs.name]["full"];
+        nlohmann::json jr;
+        jr["label"] = rs.label;
+        jr["size"] = {rs.width, rs.height};
+        for (const auto& m : rs.modes) {
+            const ModeAgg& a = all[rs.name][m];
+            jr["modes"][m] = {{"frame_ms_median", a.medianMs}, {"frame_ms_mean", a.meanMs}, {"frame_ms_p95", a.p95Ms},
+                              {"psnr_db_median", a.psnrMedian}, {"psnr_db_min", a.psnrMin}, {"frame_ms", a.frameMs}};
+        }
+        jr["hybrid_speedup_vs_full_median"] = f.medianMs / h.medianMs;
+        const char* names[5] = {"ray_hit", "ray_miss", "cache", "horizon_culled", "covered"};
+        for (int k = 0; k < 5; ++k)
+            jr["pixels"][names[k]] = {{"min_pct", h.pct[k][0]}, {"mean_pct", h.pct[k][1]}, {"max_pct", h.pct[k][2]},
+                                     {"mean_count", h.meanCount[k]}};
+        jr["stages_ms_mean"] = h.stageMean;
+        jr["notes"] = h.notes;
+        J["runs"][rs.name] = jr;
+        if (rs.group != "modes320" && rs.group != "modes640")
+            accuracy.push_back({rs.label, f.medianMs / h.medianMs, h.medianMs, h.psnrMedian});
+        if (rs.name == "modes640")
+            accuracy.push_back({"default (near 100, budget " + std::to_string(budget) + ", grid 512)", f.medianMs / h.medianMs,
+                                h.medianMs, h.psnrMedian});
+    }
+
+    // ---- markdown -------------------------------------------------------------
+    md << "City: `" << J["city"].get<std::string>() << "` (" << city->triangles << " triangles), car walkthrough seed 1, "
+       << frames << " consecutive frames at 30 fps spacing; hybrid defaults: near 100 m, pixel budget " << budget
+       << ", horizon grid 512, cache on.\n\n";
+    const char* rowNames[5] = {"ray cast and hit an object", "ray cast and missed", "taken from the image cache",
+                               "culled by horizon tracing", "covered by polygons"};
+    for (const char* run : {"modes640", "modes320"}) {
+        if (!all.count(run)) continue;
+        const ModeAgg& h = all[run]["hybrid"];
+        const RunSpec* rs = nullptr;
+        for (const auto& x : runs)
+            if (x.name == run) rs = &x;
+        md << "**Table 4.1 (" << rs->label << ")** — of " << rs->width * rs->height << " pixels:\n\n";
+        md << "| Of " << rs->width * rs->height << " pixels ... | Min [%] | Avg. [%] | Max [%] | Avg. [#] |\n|---|---:|---:|---:|---:|\n";
+        for (int k = 0; k < 5; ++k)
+            md << "| " << rowNames[k] << " | " << fmt(h.pct[k][0], 2) << " | " << fmt(h.pct[k][1], 2) << " | "
+               << fmt(h.pct[k][2], 2) << " | " << fmt(h.meanCount[k], 0) << " |\n";
+        md << "\nHybrid stage times (mean ms per frame):";
+        for (const auto& [s, ms] : h.stageMean) md << " " << s << " " << fmt(ms, 2) << ";";
+        md << "\n\n";
+        md << "**Frame times (" << rs->label << ")**\n\n| mode | median ms | mean ms | p95 ms | speedup vs full (median) | PSNR median dB | PSNR min dB |\n|---|---:|---:|---:|---:|---:|---:|\n";
+        for (const auto& m : rs->modes) {
+            const ModeAgg& a = all[run][m];
+            md << "| " << m << " | " << fmt(a.medianMs) << " | " << fmt(a.meanMs) << " | " << fmt(a.p95Ms) << " | "
+               << fmt(all[run]["full"].medianMs / a.medianMs, 2) << " | " << fmt(a.psnrMedian) << " | " << fmt(a.psnrMin)
+               << " |\n";
+        }
+        md << "\nFrame time per frame: `" << run << "/frame_time.png`.\n\n";
+    }
+    // Parameter sweeps.
+    auto sweepTable = [&](const std::string& group, const std::string& title) {
+        bool any = false;
+        for (const auto& rs : runs) any = any || rs.group == group;
+        if (!any) return;
+        md << "**" << title << "**\n\n| run | hybrid median ms | hybrid p95 ms | full median ms | speedup | PSNR median dB | PSNR min dB | rays/frame (mean) | cache px (mean) |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        for (const auto& rs : runs) {
+            if (rs.group != group) continue;
+            const ModeAgg& h = all[rs.name]["hybrid"];
+            const ModeAgg& f = all[rs.name]["full"];
+            md << "| " << rs.label << " | " << fmt(h.medianMs) << " | " << fmt(h.p95Ms) << " | " << fmt(f.medianMs) << " | "
+               << fmt(f.medianMs / h.medianMs, 2) << " | " << fmt(h.psnrMedian) << " | " << fmt(h.psnrMin) << " | "
+               << fmt(h.meanCount[0] + h.meanCount[1], 0) << " | " << fmt(h.meanCount[2], 0) << " |\n";
+        }
+        md << "\n";
+    };
+    sweepTable("near", "Fig. 4.9: frame time vs near distance (640x480)");
+    sweepTable("budget", "Pixel budget (640x480)");
+    sweepTable("grid", "Horizon grid resolution (640x480)");
+    sweepTable("cache", "Cache off (640x480; every far pixel traced)");
+
+    // Fig 4.9 plot: frame time per frame per near distance.
+    {
+        PlotSpec ps;
+        ps.title = "hybrid frame time vs near distance (640x480)";
+        ps.xLabel = "frame";
+        ps.yLabel = "ms";
+        size_t ci = 0;
+        for (const auto& rs : runs) {
+            if (rs.group != "near") continue;
+            PlotSeries s;
+            s.label = rs.label;
+            s.color = plotColor(ci++);
+            s.y = all[rs.name]["hybrid"].frameMs;
+            for (size_t i = 0; i < s.y.size(); ++i) s.x.push_back(double(i));
+            ps.series.push_back(s);
+        }
+        if (!ps.series.empty()) {
+            writePng(renderPlot(ps), (fs::path(out) / "fig_4_9_near.png").string());
+            md << "Plot: `fig_4_9_near.png` (frame time per frame for each near distance).\n\n";
+        }
+    }
+    // Accuracy vs time with the Pareto front (min time, max PSNR).
+    if (!accuracy.empty()) {
+        std::vector<Point> sorted = accuracy;
+        std::sort(sorted.begin(), sorted.end(), [](const Point& a, const Point& b) { return a.speedup > b.speedup; });
+        std::vector<Point> front;  // fastest first; on the front if more accurate than every faster one
+        double best = -1e9;
+        for (const auto& p : sorted)
+            if (p.psnr > best) {
+                front.push_back(p);
+                best = p.psnr;
+            }
+        PlotSpec ps;
+        ps.title = "what accuracy costs: PSNR vs speedup over full (640x480)";
+        ps.xLabel = "speedup of hybrid over full (median, same run)";
+        ps.yLabel = "median PSNR dB";
+        ps.yFromZero = false;
+        PlotSeries pts;
+        pts.label = "configurations";
+        pts.line = false;
+        pts.points = true;
+        pts.color = plotColor(0);
+        for (const auto& p : accuracy) {
+            pts.x.push_back(p.speedup);
+            pts.y.push_back(p.psnr);
+        }
+        PlotSeries fr;
+        fr.label = "pareto front";
+        fr.points = true;
+        fr.color = plotColor(1);
+        for (const auto& p : front) {
+            fr.x.push_back(p.speedup);
+            fr.y.push_back(p.psnr);
+        }
+        ps.series = {pts, fr};
+        writePng(renderPlot(ps), (fs::path(out) / "accuracy_vs_time.png").string());
+        md << "**What accuracy costs** (`accuracy_vs_time.png`; * = on the Pareto front: no other configuration is both "
+              "faster and more accurate)\n\n| configuration | speedup vs full | hybrid median ms | median PSNR dB | Pareto |\n"
+              "|---|---:|---:|---:|:---:|\n";
+        for (const auto& p : sorted) {
+            bool onFront = false;
+            for (const auto& q : front) onFront = onFront || (q.label == p.label);
+            md << "| " << p.label << " | " << fmt(p.speedup, 2) << " | " << fmt(p.ms) << " | " << fmt(p.psnr) << " | "
+               << (onFront ? "*" : "") << " |\n";
+        }
+        md << "\n";
+    }
+    {
+        std::ofstream f(fs::path(out) / "far_field.md");
+        f << md.str();
+        std::ofstream j(fs::path(out) / "far_field.json");
+        j << J.dump(1) << "\n";
+    }
+    std::printf("%s", md.str().c_str());
+    return 0;
+}

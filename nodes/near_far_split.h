@@ -1,0 +1,67 @@
+// NearFarSplit: an osg::Group whose cull traversal visits only the near field
+// (thesis §4.3.1); every other traversal (update, bounds, intersection,
+// serialisation) sees all children.
+//
+// Near field, by distance (default, 100 m): every child whose world-space
+// bounding box comes within nearDistance of the eye. Straddling children are
+// drawn whole (no popping). By triangle budget (setTriangleBudget > 0): the
+// nearest children (box distance) until the budget would be exceeded (the
+// nearest child is always drawn). Children's boxes and triangle counts are
+// computed lazily on the first cull after a child changes (ComputeBoundsVisitor;
+// instanced primitive sets count instances). The eye is the cull visitor's eye
+// point in this node's coordinate frame; put the node where the local frame is
+// the world frame (no transform above it), or the boxes are local too.
+//
+// Thread safety: OSG's single-threaded or CullDrawThreadPerContext models (one
+// cull at a time); lastNearCount()/lastNearTriangles() report the last cull.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <osg/Group>
+#include <osg/NodeVisitor>
+
+#include "runtime/adaptive_split.h"
+
+namespace vista {
+
+class NearFarSplit : public osg::Group {
+public:
+    NearFarSplit();
+    NearFarSplit(const NearFarSplit& o, const osg::CopyOp& copyop = osg::CopyOp::SHALLOW_COPY);
+    META_Node(vista, NearFarSplit);
+
+    void setNearDistance(double metres) { _nearDistance = metres; }
+    double getNearDistance() const { return _nearDistance; }
+    // > 0: near field = nearest children up to this many triangles (distance ignored).
+    void setTriangleBudget(uint64_t triangles) { _triangleBudget = triangles; }
+    uint64_t getTriangleBudget() const { return _triangleBudget; }
+
+    void traverse(osg::NodeVisitor& nv) override;
+
+    unsigned lastNearCount() const { return _lastCount; }
+    uint64_t lastNearTriangles() const { return _lastTriangles; }
+    // The per-child boxes (world frame) used for the split; refreshed on demand.
+    const std::vector<SplitObject>& objects();
+
+protected:
+    ~NearFarSplit() override = default;
+    bool insertChild(unsigned int index, osg::Node* child) override;
+    bool removeChildren(unsigned int pos, unsigned int numChildrenToRemove) override;
+    bool setChild(unsigned int i, osg::Node* node) override;
+
+private:
+    void refresh();
+    double _nearDistance = 100.0;
+    uint64_t _triangleBudget = 0;
+    std::vector<SplitObject> _objects;
+    bool _dirty = true;
+    unsigned _lastCount = 0;
+    uint64_t _lastTriangles = 0;
+};
+
+// Triangles drawn by a subgraph (DrawElements/DrawArrays of triangle modes,
+// instanced sets multiplied by their instance count).
+uint64_t countTriangles(osg::Node* node);
+
+}  // namespace vista

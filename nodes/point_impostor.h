@@ -1,0 +1,79 @@
+// PointImpostor: a point-based impostor (thesis ch. 5) as an osg::Geometry.
+//
+// Data (PointImpostorData, plain arrays, model-local float frame):
+//   points with a mean colour each; textured points also own a block of
+//   texelsX x texelsY colours over the sampling rectangle
+//   planeOrigin + a*planeU + b*planeV (a, b in [0, 1]), texel (i, j) centred at
+//   ((i + 0.5) / texelsX, (j + 0.5) / texelsY), row j = 0 at the bottom (b = 0).
+// Drawing: GL_POINTS (1 pixel by default). A GLSL 1.20 shader intersects the
+// ray from the viewer to the point with the sampling plane, maps it to the
+// point's block in a packed atlas texture (offset per point in texcoord 0,
+// x < 0 = single colour) and samples it bilinearly, clamped to the block so
+// neighbours never bleed in. Uniform "vista_useTexture" (int, 1) switches to
+// the single-colour preview when 0 (set it with OVERRIDE on a parent).
+// Everything the GPU needs is ordinary OSG state (program, uniforms,
+// Texture2D with its image stored inline), so the osgb file carries it; the
+// wrapper "vista::PointImpostor" adds the plane and texel layout as
+// properties. Atlas: width kAtlasBlocksPerRow * texelsX texels, rows of
+// texelsY; more than kMaxAtlasHeight rows is a contract violation
+// (VISTA_CHECK) — the bake never produces it.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <osg/Geometry>
+#include <osg/Image>
+
+namespace vista {
+
+struct PointImpostorData {
+    glm::vec3 planeOrigin{0.0f}, planeU{0.0f}, planeV{0.0f};
+    int texelsX = 8, texelsY = 2;
+    std::vector<glm::vec3> positions;
+    std::vector<glm::u8vec4> colors;   // per point (mean over the texels)
+    std::vector<int32_t> block;        // per point: -1 = single colour, else block index
+    std::vector<glm::u8vec4> texels;   // blocks of texelsX * texelsY, row-major (j, then i)
+};
+
+constexpr int kAtlasBlocksPerRow = 256;
+constexpr int kMaxAtlasHeight = 8192;
+
+class PointImpostor : public osg::Geometry {
+public:
+    PointImpostor();
+    PointImpostor(const PointImpostor& o, const osg::CopyOp& op = osg::CopyOp::SHALLOW_COPY);
+    META_Object(vista, PointImpostor)
+
+    // Builds vertex arrays, atlas and state from `d` (replaces any previous content).
+    void setData(const PointImpostorData& d);
+    size_t pointCount() const;
+    size_t texturedCount() const { return _textured; }
+
+    // The packed atlas of `d` (texel blocks laid out as the shader expects).
+    static osg::ref_ptr<osg::Image> buildAtlas(const PointImpostorData& d, std::vector<glm::vec2>& offsets);
+
+    // Serialized properties.
+    const osg::Vec3f& getPlaneOrigin() const { return _planeOrigin; }
+    void setPlaneOrigin(const osg::Vec3f& v) { _planeOrigin = v; }
+    const osg::Vec3f& getPlaneU() const { return _planeU; }
+    void setPlaneU(const osg::Vec3f& v) { _planeU = v; }
+    const osg::Vec3f& getPlaneV() const { return _planeV; }
+    void setPlaneV(const osg::Vec3f& v) { _planeV = v; }
+    int getTexelsX() const { return _texelsX; }
+    void setTexelsX(int v) { _texelsX = v; }
+    int getTexelsY() const { return _texelsY; }
+    void setTexelsY(int v) { _texelsY = v; }
+    unsigned getTexturedCount() const { return unsigned(_textured); }
+    void setTexturedCount(unsigned v) { _textured = v; }
+
+protected:
+    ~PointImpostor() override = default;
+
+private:
+    osg::Vec3f _planeOrigin, _planeU, _planeV;
+    int _texelsX = 8, _texelsY = 2;
+    size_t _textured = 0;
+};
+
+}  // namespace vista

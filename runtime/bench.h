@@ -1,0 +1,98 @@
+// The bench: renders a walkthrough path in several modes side by side
+// (interleaved frame by frame in one process) and writes frames.csv,
+// summary.json, plots and difference images.
+//
+// Modes are created through makeMode() from a table (kModeTable in
+// bench.cpp). Other modules add theirs there: `hybrid` (runtime/mode_hybrid.h)
+// and `impostor` (bake/mode_impostor.h) — see the commented hook.
+//
+// Reference: every frame is compared with the `full` image of the same
+// camera (or, with referenceSsaa = k > 1, with the average of k x k
+// sub-pixel-jittered `full` renders = a box-filtered supersampled image).
+// Metrics: luma PSNR (metrics.h, capped at 99 dB for identical images) and
+// the fraction of pixels differing by more than diffThreshold.
+// Timing: frame_ms per mode as reported by the mode (glFinish included);
+// one warm-up frame per mode is rendered and discarded before frame 0.
+// Errors: bad configuration or setup failures (no display, unknown mode,
+// Embree failure) return a Status; nothing throws.
+#pragma once
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "citygen/status.h"
+#include "runtime/bench_mode.h"
+#include "runtime/paths.h"
+
+namespace vista {
+
+// ---- Mode factory -----------------------------------------------------------
+using ModeFactory = Result<std::unique_ptr<BenchMode>> (*)(BenchContext& ctx);
+struct ModeInfo {
+    const char* name;
+    const char* summary;
+    bool needsRays;     // the bench builds ctx.rays (RayScene) before creating it
+    ModeFactory make;
+};
+// All registered modes, in display order.
+const std::vector<ModeInfo>& modeTable();
+std::vector<std::string> availableModes();
+const ModeInfo* findMode(const std::string& name);
+// Creates a mode. Unknown name -> error listing the available modes. The
+// caller must have built ctx.rays when the mode needs rays.
+Result<std::unique_ptr<BenchMode>> makeMode(const std::string& name, BenchContext& ctx);
+// Parses "full,near,raycast" (comma-separated, no duplicates, known names).
+Result<std::vector<std::string>> parseModeList(const std::string& list);
+
+// ---- The bench loop ---------------------------------------------------------
+struct BenchConfig {
+    int width = 640, height = 480;
+    int frames = 120;
+    double fovYDeg = 60.0;
+    double zNear = 0.3;
+    std::vector<std::string> modes{"full", "near"};
+    std::string outDir;            // created if missing; empty = write nothing
+    int referenceSsaa = 0;         // 0/1 = `full` image; k >= 2 = k x k supersampled full
+    int diffThreshold = 8;         // for the differing-pixel fraction (0..255)
+    int worstFrames = 2;           // difference images for the N worst frames per mode
+    bool warmup = true;
+    bool quiet = false;            // no progress on stderr
+    BenchOptions options;
+    std::string command;           // recorded in summary.json
+    std::string cityLabel;         // recorded in summary.json
+};
+Status validateBenchConfig(const BenchConfig& c);
+
+struct BenchFrameRecord {
+    int frame = 0;
+    size_t pathIndex = 0;
+    double t = 0;
+    std::string mode;
+    FrameStats stats;
+    double psnrDb = 0, diffFraction = 0;
+};
+
+struct ModeSummary {
+    std::string mode;
+    double frameMsMedian = 0, frameMsP95 = 0, frameMsMean = 0;
+    double speedupVsFullMedian = 0;
+    double psnrDbMedian = 0, psnrDbMin = 0;
+    double diffFractionMedian = 0;
+    double trianglesMedian = 0, drawCallsMedian = 0, cullMsMedian = 0, drawMsMedian = 0;
+};
+
+struct BenchResult {
+    std::vector<BenchFrameRecord> frames;
+    std::vector<ModeSummary> modes;
+    std::string glRenderer;
+};
+
+// Runs the bench. `city` may be null (synthetic scene: then ray modes fail
+// with an error); `scene` is the scene graph rendered by the GL modes.
+Result<BenchResult> runBenchmark(const LoadedCity* city, osg::Node* scene, const Path& path, const BenchConfig& config);
+
+// Median / percentile (linear interpolation) of a copy of v; NaN if empty.
+double percentile(std::vector<double> v, double p);
+
+}  // namespace vista

@@ -1,0 +1,69 @@
+// Near/far split selection and the adaptive near distance.
+#include <gtest/gtest.h>
+
+#include "runtime/adaptive_split.h"
+#include "runtime/ray_scene.h"
+#include "tests/farfield/fixtures.h"
+
+using namespace vista;
+using namespace vista::test;
+
+namespace {
+SplitObject box(glm::dvec3 lo, glm::dvec3 hi, uint64_t tris) {
+    SplitObject o;
+    o.lo = lo;
+    o.hi = hi;
+    o.triangles = tris;
+    return o;
+}
+}  // namespace
+
+TEST(Split, DistanceSelectionDrawsStraddlingObjectsWhole) {
+    std::vector<SplitObject> objs = {
+        box({10, -1, 0}, {20, 1, 5}, 10),     // 10 m away
+        box({95, -1, 0}, {120, 1, 5}, 20),    // straddles 100 m
+        box({101, -1, 0}, {130, 1, 5}, 30),   // just beyond
+        box({-5, -5, 0}, {5, 5, 50}, 40),     // contains the eye
+    };
+    auto sel = selectNearField(objs, glm::dvec3(0, 0, 2), 100.0);
+    EXPECT_EQ(sel, (std::vector<uint32_t>{0, 1, 3}));
+    // Every object with a point within the near distance is selected (independent check).
+    for (uint32_t i = 0; i < objs.size(); ++i) {
+        bool inside = false;
+        for (double x = objs[i].lo.x; x <= objs[i].hi.x; x += 0.25) inside |= std::abs(x) <= 100.0;
+        EXPECT_EQ(inside, std::find(sel.begin(), sel.end(), i) != sel.end()) << i;
+    }
+    auto byBudget = selectNearFieldByBudget(objs, glm::dvec3(0, 0, 2), 55);
+    EXPECT_EQ(byBudget, (std::vector<uint32_t>{0, 3}));  // nearest first: 3 (0 m, 40) + 0 (10 m, 10) = 50; +20 > 55
+    EXPECT_EQ(selectNearFieldByBudget(objs, glm::dvec3(0, 0, 2), 1).size(), 1u);  // nearest always drawn
+}
+
+TEST(Split, AdaptiveChoiceFollowsTheMeasuredCosts) {
+    LoadedCity city = randomCity(12, 150, 800.0);
+    auto rs = RayScene::build(city);
+    ASSERT_TRUE(rs.isOk());
+    // One object per 50 m square of boxes, with their triangles.
+    std::vector<SplitObject> objs;
+    for (int x = -8; x < 8; ++x)
+        for (int y = -8; y < 8; ++y) objs.push_back(box({x * 50.0, y * 50.0, 0}, {x * 50.0 + 50, y * 50.0 + 50, 60}, 1000));
+    Camera c;
+    c.eye = glm::dvec3(0, -350, 1.7);
+    c.width = 64;
+    c.height = 48;
+    AdaptiveSplitOptions o;
+    o.exploreEvery = 0;
+    AdaptiveSplit cheapRays(objs, rs.value().get(), o), cheapTris(objs, rs.value().get(), o);
+    // Rays expensive, triangles nearly free -> a large near field.
+    for (int i = 0; i < 10; ++i) {
+        cheapTris.record(uint64_t(20000 + 4000 * i), 1.0 + 1e-7 * (20000 + 4000 * i), 5000, 5000 * 0.01);
+        cheapRays.record(uint64_t(20000 + 4000 * i), 1.0 + 1e-2 * (20000 + 4000 * i), 5000, 5000 * 1e-6);
+    }
+    double dT = cheapTris.choose(c, -1), dR = cheapRays.choose(c, -1);
+    EXPECT_GT(dT, dR);
+    EXPECT_NEAR(cheapTris.msPerTriangle(), 1e-7, 1e-9);  // the fit separates fixed and per-triangle cost
+    EXPECT_GE(dT, o.minDistance);
+    EXPECT_LE(dT, o.maxDistance * 1.0001);
+    // Predictions: more distance, more triangles, fewer rays.
+    EXPECT_LE(cheapTris.predictedTriangles(c.eye, 50), cheapTris.predictedTriangles(c.eye, 400));
+    EXPECT_GE(cheapTris.predictedRays(50), cheapTris.predictedRays(400));
+}
