@@ -81,6 +81,10 @@ public:
         if (out.width != camera.width || out.height != camera.height) out = Image(camera.width, camera.height);
         const glm::vec3 org(camera.eye - rays.frameOrigin());
         const int W = camera.width;
+        // Camera::rayDirection with the basis hoisted out of the pixel loop
+        // (same operations in the same order: bit-identical directions).
+        const glm::dvec3 fw = camera.forward(), rt = camera.right(), up = camera.up();
+        const double tanHalf = std::tan(0.5 * camera.fovY), aspect = double(camera.width) / double(camera.height);
         tbb::combinable<uint64_t> hits([] { return uint64_t(0); });
         tbb::parallel_for(tbb::blocked_range<int>(0, camera.height, 4), [&](const tbb::blocked_range<int>& r) {
             const size_t n = static_cast<size_t>(W);
@@ -90,7 +94,9 @@ public:
             uint64_t nh = 0;
             for (int y = r.begin(); y != r.end(); ++y) {
                 for (int x = 0; x < W; ++x) {
-                    ddirs[size_t(x)] = camera.rayDirection(x + 0.5, y + 0.5);
+                    double sx = (2.0 * (x + 0.5) / camera.width - 1.0) * tanHalf * aspect;
+                    double sy = (1.0 - 2.0 * (y + 0.5) / camera.height) * tanHalf;
+                    ddirs[size_t(x)] = glm::normalize(fw + sx * rt + sy * up);
                     dirs[size_t(x)] = glm::vec3(ddirs[size_t(x)]);
                 }
                 rays.intersectMany(orgs.data(), dirs.data(), W, res.data());
