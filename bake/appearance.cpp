@@ -54,8 +54,9 @@ void computeAppearance(const FarScene& scene, const SamplingSetup& s, const std:
         Rng rng(seed, hashKeys(entity, k), Stream::Bake);
         PointResult& r = res[k];
         const glm::dvec3 pt(points[k]);
+        bool seen = false;
+        glm::dvec3 seenFrom(0.0);
         if (cell && p.cellVisibilityRays > 0) {
-            bool seen = false;
             for (int v = 0; v < p.cellVisibilityRays && !seen; ++v) {
                 glm::dvec3 e;
                 if (v < 8) e = cell->corner(v);
@@ -67,7 +68,8 @@ void computeAppearance(const FarScene& scene, const SamplingSetup& s, const std:
                 if (dist < 1e-6) { seen = true; break; }
                 d /= dist;
                 ++r.rays;
-                seen = !scene.occluded(glm::vec3(e), glm::vec3(d), 0.0f, float(dist - std::max(0.05, 2e-4 * dist)));
+                seen = !scene.occluded(glm::vec3(e), glm::vec3(d), 0.0f, float(dist - std::max(0.1, 2e-3 * dist)));
+                if (seen) seenFrom = e;
             }
             if (!seen) { r.visible = false; return; }
         }
@@ -114,7 +116,32 @@ void computeAppearance(const FarScene& scene, const SamplingSetup& s, const std:
         int64_t n = 0;
         double l = 0, l2 = 0;
         for (const auto& a : acc) { n += a.n; l += a.l; l2 += a.l2; }
-        if (n == 0) { r.visible = false; return; }
+        if (n == 0 && !seen) { r.visible = false; return; }
+        if (n == 0) {
+            // Seen from the cell but from no sampled viewpoint on the plane: one
+            // colour from pixel rays at the cell position that sees it (never a hole).
+            glm::dvec3 d = glm::normalize(pt - seenFrom);
+            glm::dvec3 e1 = glm::cross(d, glm::dvec3(0, 0, 1));
+            if (glm::length(e1) < 1e-9) e1 = glm::dvec3(1, 0, 0);
+            e1 = glm::normalize(e1);
+            const glm::dvec3 e2 = glm::cross(e1, d);
+            glm::dvec3 sum(0.0);
+            const int k = std::max(4, p.minSamples);
+            for (int i = 0; i < k; ++i) {
+                const double ox = rng.uniform(-0.5, 0.5) + rng.normal() * p.pixelSigma;
+                const double oy = rng.uniform(-0.5, 0.5) + rng.normal() * p.pixelSigma;
+                const glm::dvec3 dir = glm::normalize(d + p.pixelAngle * (ox * e1 + oy * e2));
+                ++r.rays;
+                const FarHit h = scene.intersect(glm::vec3(seenFrom), glm::vec3(dir), 0.0f, 1e30f);
+                sum += h.hit ? glm::dvec3(h.color) : glm::dvec3(glm::vec3(skyColor(std::asin(std::clamp(dir.z, -1.0, 1.0))))) / 255.0;
+            }
+            r.visible = true;
+            r.single = true;
+            r.samples = k;
+            r.mean = sum / double(k);
+            r.texels.assign(size_t(nt), r.mean);
+            return;
+        }
         r.visible = true;
         const double pooledStd = n > 1 ? std::sqrt(std::max(0.0, (l2 - l * l / double(n)) / double(n - 1))) : 0.0;
         if (!(pooledStd < p.singleColorThreshold) && nt > 1) {
@@ -130,18 +157,18 @@ void computeAppearance(const FarScene& scene, const SamplingSetup& s, const std:
         }
         glm::dvec3 sum(0.0);
         int64_t cnt = 0;
-        int seen = 0;
+        int seenTexels = 0;
         for (const auto& a : acc) {
             sum += a.sum;
             cnt += a.n;
-            seen += a.n > 0 ? 1 : 0;
+            seenTexels += a.n > 0 ? 1 : 0;
         }
         r.samples = cnt;
         r.mean = sum / double(cnt);
         // Texel means; unseen texels take the mean of the seen ones.
         glm::dvec3 tm(0.0);
         for (const auto& a : acc) if (a.n > 0) tm += a.mean();
-        tm /= double(seen);
+        tm /= double(seenTexels);
         r.texels.resize(size_t(nt));
         for (int t = 0; t < nt; ++t) r.texels[size_t(t)] = acc[size_t(t)].n > 0 ? acc[size_t(t)].mean() : tm;
         glm::dvec3 var(0.0);

@@ -312,7 +312,9 @@ std::vector<uint8_t> removeRedundant(const LdiResult& ldi, const SamplingSetup& 
             if (m == a.camera) continue;
             const LdiCamera& c = ldi.cams[size_t(m)];
             const double sm = footprint(c, s, pos, nrm);
-            const bool better = sm < sk * (1 - 1e-9) || (std::abs(sm - sk) <= sk * 1e-9 && m < a.camera);
+            // A 5 % margin: where the footprints are nearly equal both cameras keep their
+            // points, so two cameras never remove each other's samples of one surface.
+            const bool better = sm < sk * 0.95;
             if (!better || !(sm <= limit * dmin)) continue;
             const glm::dvec3 d = pos - c.pos;
             const double z = glm::dot(s.n, d);

@@ -52,8 +52,8 @@ struct CityParams {
     double window_recess_m = 0.25;
 
     // Trees.
-    double street_tree_spacing_m = 24.0;  // 0 = no street trees
-    double park_tree_density = 0.0025;    // trees per square metre of park
+    double street_tree_spacing_m = 30.0;  // 0 = no street trees
+    double park_tree_density = 0.002;     // trees per square metre of park
 
     // Terrain.
     double hills_amplitude_m = 0.0;       // 0 = flat ground

@@ -180,6 +180,70 @@ bool contractShort(WorkGraph& g, double minSegment) {
     return any;
 }
 
+// Splits edges at nodes lying within a tolerance of their interior (the node
+// is not incident to the edge): T-junctions that stop just short of / just
+// past a street, and near-collinear overlaps left by rounding exact vertices.
+// Dead ends (degree 1) use `snap`, other nodes min(snap, minSegment/2); both at
+// least 1e-6 m.
+bool snapNodesToEdges(WorkGraph& g, double snap, double minSegment) {
+    const size_t nn = g.nodes.size(), ne = g.edges.size();
+    if (ne == 0) return false;
+    std::vector<int> deg(nn, 0);
+    for (const auto& e : g.edges) { deg[e.a]++; deg[e.b]++; }
+    const double tolDead = std::max(snap, 1e-6), tolOther = std::max(std::min(snap, 0.5 * minSegment), 1e-6);
+    double sumLen = 0;
+    for (const auto& e : g.edges) sumLen += glm::length(g.nodes[e.b] - g.nodes[e.a]);
+    const double cell = std::max({sumLen / double(ne), tolDead, 1e-3});
+    std::unordered_map<uint64_t, std::vector<uint32_t>> grid;
+    auto key = [](int64_t x, int64_t y) { return (uint64_t(x) << 32) ^ (uint64_t(y) & 0xffffffffull); };
+    for (uint32_t i = 0; i < ne; ++i) {
+        glm::dvec2 a = g.nodes[g.edges[i].a], b = g.nodes[g.edges[i].b];
+        glm::dvec2 lo = glm::min(a, b) - tolDead, hi = glm::max(a, b) + tolDead;
+        int64_t x0 = int64_t(std::floor(lo.x / cell)), x1 = int64_t(std::floor(hi.x / cell));
+        int64_t y0 = int64_t(std::floor(lo.y / cell)), y1 = int64_t(std::floor(hi.y / cell));
+        if ((x1 - x0 + 1) * (y1 - y0 + 1) > 4096) continue;  // absurdly long edge: skip
+        for (int64_t y = y0; y <= y1; ++y)
+            for (int64_t x = x0; x <= x1; ++x) grid[key(x, y)].push_back(i);
+    }
+    std::vector<std::vector<std::pair<double, uint32_t>>> splits(ne);
+    bool any = false;
+    for (uint32_t v = 0; v < nn; ++v) {
+        const glm::dvec2 p = g.nodes[v];
+        const double tol = deg[v] <= 1 ? tolDead : tolOther;
+        auto it = grid.find(key(int64_t(std::floor(p.x / cell)), int64_t(std::floor(p.y / cell))));
+        if (it == grid.end()) continue;
+        uint32_t best = UINT32_MAX;
+        double bestD = tol, bestT = 0;
+        for (uint32_t ei : it->second) {
+            const auto& e = g.edges[ei];
+            if (e.a == v || e.b == v) continue;
+            glm::dvec2 a = g.nodes[e.a], d = g.nodes[e.b] - a;
+            double dd = glm::dot(d, d);
+            if (dd <= 0) continue;
+            double t = glm::dot(p - a, d) / dd;
+            if (t <= 0 || t >= 1) continue;
+            double dist = glm::length(p - (a + t * d));
+            if (dist < bestD || (dist == bestD && best != UINT32_MAX && ei < best)) { bestD = dist; best = ei; bestT = t; }
+        }
+        if (best != UINT32_MAX) { splits[best].emplace_back(bestT, v); any = true; }
+    }
+    if (!any) return false;
+    std::vector<WorkEdge> edges;
+    for (uint32_t i = 0; i < ne; ++i) {
+        const auto& e = g.edges[i];
+        if (splits[i].empty()) { edges.push_back(e); continue; }
+        std::sort(splits[i].begin(), splits[i].end());
+        uint32_t prev = e.a;
+        for (auto [t, v] : splits[i]) { if (v != prev) edges.push_back({prev, v, e.cls}); prev = v; }
+        edges.push_back({prev, e.b, e.cls});
+    }
+    g.edges = std::move(edges);
+    std::vector<uint32_t> ident(g.nodes.size());
+    std::iota(ident.begin(), ident.end(), 0u);
+    rebuild(g, ident);
+    return true;
+}
+
 StreetGraph toStreetGraph(const WorkGraph& w) {
     // Canonical order: nodes by (x, y), edges by (a, b) with a < b.
     std::vector<uint32_t> order(w.nodes.size());
@@ -244,8 +308,9 @@ StreetGraph planarize(const std::vector<RawSegment>& segments, double snap, doub
         // Exact rounding to double may make distinct vertices coincide: snap handles it (distance 0 <= snap).
         for (int k = 0; k < 10; ++k) {
             bool c1 = snapNodes(g, snap);
-            bool c2 = contractShort(g, minSegment);
-            if (!c1 && !c2) break;
+            bool c2 = snapNodesToEdges(g, snap, minSegment);
+            bool c3 = contractShort(g, minSegment);
+            if (!c1 && !c2 && !c3) break;
         }
         StreetGraph sg = toStreetGraph(g);
         if (findConflictingEdges(sg, 1).empty()) return sg;

@@ -12,8 +12,8 @@
 // Progress is reported through `progress` (may be null).
 //
 // importOsm(): ways tagged highway=* from an .osm / .osm.pbf file, projected
-// to local metres (equirectangular about the data's centre, or about
-// (lat0, lon0) when given) then planarized exactly like grown streets.
+// to local metres (equirectangular about the centre of the data's bounding
+// box) then planarized exactly like grown streets.
 // Unreadable or corrupt files return an error naming the file.
 #pragma once
 #include <string>

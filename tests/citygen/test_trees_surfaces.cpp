@@ -199,6 +199,8 @@ TEST(TreePrototypes, DeterministicAndSeeded) {
 
 TEST(TreePlacement, StreetAndParkTreesRespectRoadsBuildingsParks) {
     City c = makeTestCity(100.0, 15.0);
+    c.params.street_tree_spacing_m = 14.0;  // the counts below are stated for these values
+    c.params.park_tree_density = 0.004;
     c.treePrototypes = makeTreePrototypes(c.params, Lighting(c.params));
     auto trees = placeTrees(c, nullptr);
     size_t street = 0, park = 0;

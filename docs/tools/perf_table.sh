@@ -2,9 +2,9 @@
 # Regenerates the generation-throughput table of docs/performance.md:
 # generates cities of 0.5, 1, 2, 4, 8 km side (default params otherwise) and
 # prints a Markdown table of triangles, seconds and peak memory from --stats.
-# Usage: scripts/perf_table.sh [sizes...]   (default: 500 1000 2000 4000 8000)
+# Usage: docs/tools/perf_table.sh [sizes...]   (default: 500 1000 2000 4000 8000)
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 VISTA="${VISTA:-build/runtime/vista}"
 SIZES="${*:-500 1000 2000 4000 8000}"
 TMP="$(mktemp -d)"

@@ -3,7 +3,7 @@
 # Prints the generation figures and the per-mode frame times; writes out/demo/ (scene, stats, PNGs).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-./scripts/setup.sh
+./.ci/setup.sh
 BUILD="${VISTA_BUILD_DIR:-build}"
 VISTA="$BUILD/runtime/vista"
 OUT=out/demo

@@ -3,7 +3,7 @@
 # the 2 km city's four modes side by side at 640x480 and 320x240 (car path), the
 # fly-over, and the size sweep. Prints the Markdown tables on stdout.
 #
-# usage: scripts/sweep.sh [VISTA_BINARY] [OUT_DIR]
+# usage: docs/tools/sweep.sh [VISTA_BINARY] [OUT_DIR]
 #   VISTA_BINARY defaults to build/runtime/vista, OUT_DIR to ./results-issue3.
 # Needs an X display; without one it re-runs itself under `xvfb-run -a`.
 # Needs jq. Takes about 10 minutes on 2 cores with llvmpipe.
