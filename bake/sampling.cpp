@@ -312,9 +312,11 @@ std::vector<uint8_t> removeRedundant(const LdiResult& ldi, const SamplingSetup& 
             if (m == a.camera) continue;
             const LdiCamera& c = ldi.cams[size_t(m)];
             const double sm = footprint(c, s, pos, nrm);
-            // A 5 % margin: where the footprints are nearly equal both cameras keep their
-            // points, so two cameras never remove each other's samples of one surface.
-            const bool better = sm < sk * 0.95;
+            // Footprints within 1 % count as a tie, decided by the camera index (lower
+            // wins). On a plane parallel to the sampling plane all three footprints are
+            // equal; an exact comparison would let rounding flip the decision from one
+            // sample to the next and two cameras remove each other's samples (a hole).
+            const bool better = sm < sk * 0.99 || (std::abs(sm - sk) <= 0.01 * sk && m < a.camera);
             if (!better || !(sm <= limit * dmin)) continue;
             const glm::dvec3 d = pos - c.pos;
             const double z = glm::dot(s.n, d);

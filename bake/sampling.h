@@ -55,7 +55,7 @@ struct SamplingParams {
     double oversample = 1.0;              // multiplies the LDI resolution (per axis)
     bool perspectiveFactor = true;        // x fp
     bool diagonalFactor = true;           // x sqrt(2)
-    int maxLayers = 3;                    // LDI layers per pixel
+    int maxLayers = 6;                    // LDI layers per pixel (3 left holes behind adjacent boxes: test)
     int64_t maxRaysPerCamera = 1000000;   // resolution cap (the step grows if exceeded)
     bool removeRedundant = true;
 };
