@@ -1,7 +1,9 @@
 #include "runtime/bench.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <cstdlib>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -297,7 +299,41 @@ Status validateBenchConfig(const BenchConfig& c) {
     if (c.modes.empty()) return Status::error("--modes: no mode given; available modes: " + joinModes());
     for (const auto& m : c.modes)
         if (!findMode(m)) return Status::error("--modes: unknown mode '" + m + "'; available modes: " + joinModes());
+    const BenchOptions& o = c.options;
+    if (!(o.nearDistance < 0) && !(o.nearDistance >= kMinNearDistance && o.nearDistance <= kMaxNearDistance))
+        return Status::error("--near " + std::to_string(o.nearDistance) + " out of range 1 .. 100000 metres (or 'auto')");
+    if (o.pixelBudget > kMaxPixelBudget)
+        return Status::error("--budget " + std::to_string(o.pixelBudget) + " out of range 0 .. " +
+                             std::to_string(kMaxPixelBudget) + " rays per frame (or 'unlimited' / -1)");
+    if (o.horizonGrid < 1 || o.horizonGrid > 8192)
+        return Status::error("--horizon-grid " + std::to_string(o.horizonGrid) + " out of range 1 .. 8192 cells per side");
+    if (o.threads < 0 || o.threads > 1024)
+        return Status::error("--threads " + std::to_string(o.threads) + " out of range 0 .. 1024 (0 = all cores)");
     return Status::ok();
+}
+
+Result<double> parseNearDistance(const std::string& s) {
+    if (s == "auto") return -1.0;
+    char* end = nullptr;
+    double v = std::strtod(s.c_str(), &end);
+    if (s.empty() || !end || *end || !std::isfinite(v))
+        return Status::error("--near '" + s + "': expected a distance in metres (1 .. 100000) or 'auto'");
+    if (v < kMinNearDistance || v > kMaxNearDistance)
+        return Status::error("--near " + s + " out of range 1 .. 100000 metres (or 'auto')");
+    return v;
+}
+
+Result<int64_t> parsePixelBudget(const std::string& s) {
+    const std::string range = " rays per frame, or 'unlimited' / -1";
+    if (s == "unlimited" || s == "-1") return int64_t(-1);
+    char* end = nullptr;
+    errno = 0;
+    long long v = std::strtoll(s.c_str(), &end, 10);
+    if (s.empty() || !end || *end || errno == ERANGE)
+        return Status::error("--budget '" + s + "': expected an integer 0 .. " + std::to_string(kMaxPixelBudget) + range);
+    if (v < 0 || v > kMaxPixelBudget)
+        return Status::error("--budget " + s + " out of range 0 .. " + std::to_string(kMaxPixelBudget) + range);
+    return int64_t(v);
 }
 
 double percentile(std::vector<double> v, double p) {
@@ -459,6 +495,36 @@ Result<BenchResult> runBenchmark(const LoadedCity* city, osg::Node* scene, const
         s.drawCallsMedian = percentile(calls, 0.5);
         s.cullMsMedian = percentile(cull, 0.5);
         s.drawMsMedian = percentile(draw, 0.5);
+        // Pixel classes and stage times.
+        {
+            const double npx = double(cfg.width) * double(cfg.height);
+            PixelClassSummary* cls[5] = {&s.covered, &s.horizonCulled, &s.cache, &s.rayHit, &s.rayMiss};
+            double sumPct[5] = {0, 0, 0, 0, 0}, sumCount[5] = {0, 0, 0, 0, 0};
+            for (int k = 0; k < 5; ++k) cls[k]->minPct = std::numeric_limits<double>::infinity();
+            std::map<std::string, double> stageSum;
+            for (size_t f = 0; f < idx.size(); ++f) {
+                const FrameStats& frs = result.frames[f * M + mi].stats;
+                const PixelCounts& p = frs.pixels;
+                const uint64_t c[5] = {p.covered, p.horizonCulled, p.cache, p.rayHit, p.rayMiss};
+                for (int k = 0; k < 5; ++k) {
+                    const double pct = 100.0 * double(c[k]) / npx;
+                    cls[k]->minPct = std::min(cls[k]->minPct, pct);
+                    cls[k]->maxPct = std::max(cls[k]->maxPct, pct);
+                    sumPct[k] += pct;
+                    sumCount[k] += double(c[k]);
+                    if (c[k] > 0) s.hasPixels = true;
+                }
+                for (const auto& kv : frs.stagesMs) {
+                    stageSum[kv.first] += kv.second;
+                    ++s.stageRuns[kv.first];
+                }
+            }
+            for (int k = 0; k < 5; ++k) {
+                cls[k]->meanPct = sumPct[k] / double(idx.size());
+                cls[k]->meanCount = sumCount[k] / double(idx.size());
+            }
+            for (const auto& kv : stageSum) s.stagesMsMean[kv.first] = kv.second / double(s.stageRuns[kv.first]);
+        }
         result.modes.push_back(s);
     }
     if (cfg.outDir.empty()) return result;
@@ -496,7 +562,13 @@ Result<BenchResult> runBenchmark(const LoadedCity* city, osg::Node* scene, const
     j["size"] = {cfg.width, cfg.height};
     j["frames"] = cfg.frames;
     j["fov_y_deg"] = cfg.fovYDeg;
-    j["near_m"] = cfg.options.nearDistance;
+    j["near_m"] = cfg.options.nearDistance;  // < 0 = auto (kept for older readers; see "options")
+    j["options"] = {
+        {"near_m", cfg.options.nearDistance < 0 ? nlohmann::json("auto") : nlohmann::json(cfg.options.nearDistance)},
+        {"pixel_budget", cfg.options.pixelBudget < 0 ? nlohmann::json("unlimited") : nlohmann::json(cfg.options.pixelBudget)},
+        {"horizon_grid", cfg.options.horizonGrid},
+        {"cache", cfg.options.cache},
+        {"threads", cfg.options.threads}};
     j["reference"] = cfg.referenceSsaa >= 2 ? "ssaa:" + std::to_string(cfg.referenceSsaa) : std::string("full");
     j["psnr_cap_db"] = kPsnrCapDb;
     j["diff_threshold"] = cfg.diffThreshold;
@@ -520,6 +592,24 @@ Result<BenchResult> runBenchmark(const LoadedCity* city, osg::Node* scene, const
                       {"draw_calls_median", num(s.drawCallsMedian)},
                       {"cull_ms_median", num(s.cullMsMedian)},
                       {"draw_ms_median", num(s.drawMsMedian)}};
+        if (s.hasPixels) {
+            auto cls = [&](const PixelClassSummary& c) {
+                return nlohmann::json{{"min_pct", num(c.minPct)},
+                                      {"mean_pct", num(c.meanPct)},
+                                      {"max_pct", num(c.maxPct)},
+                                      {"mean_count", num(c.meanCount)}};
+            };
+            jm[s.mode]["pixels"] = {{"covered", cls(s.covered)},
+                                    {"horizon_culled", cls(s.horizonCulled)},
+                                    {"cache", cls(s.cache)},
+                                    {"ray_hit", cls(s.rayHit)},
+                                    {"ray_miss", cls(s.rayMiss)}};
+        }
+        nlohmann::json stages = nlohmann::json::object(), runs = nlohmann::json::object();
+        for (const auto& kv : s.stagesMsMean) stages[kv.first] = num(kv.second);
+        for (const auto& kv : s.stageRuns) runs[kv.first] = kv.second;
+        jm[s.mode]["stages_ms"] = stages;
+        jm[s.mode]["stage_runs"] = runs;
     }
     j["modes"] = jm;
     std::vector<std::string> order;

@@ -16,7 +16,9 @@
 // Errors: bad configuration or setup failures (no display, unknown mode,
 // Embree failure) return a Status; nothing throws.
 #pragma once
+#include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -62,7 +64,19 @@ struct BenchConfig {
     std::string command;           // recorded in summary.json
     std::string cityLabel;         // recorded in summary.json
 };
+// Also checks the far-field options: nearDistance < 0 (auto) or 1 .. 100000
+// metres; pixelBudget < 0 (unlimited) or 0 .. kMaxPixelBudget; horizonGrid
+// 1 .. 8192; threads 0 .. 1024. Messages name the command-line flag.
 Status validateBenchConfig(const BenchConfig& c);
+
+// Command-line values of the far-field options (messages name the flag, the
+// value and the allowed range):
+//   --near M|auto      -> metres in 1 .. 100000, or -1 for "auto"
+//   --budget N|unlimited -> 0 .. kMaxPixelBudget, or -1 (also "-1") for unlimited
+constexpr double kMinNearDistance = 1.0, kMaxNearDistance = 100000.0;
+constexpr int64_t kMaxPixelBudget = 1000000000;
+Result<double> parseNearDistance(const std::string& s);
+Result<int64_t> parsePixelBudget(const std::string& s);
 
 struct BenchFrameRecord {
     int frame = 0;
@@ -73,6 +87,12 @@ struct BenchFrameRecord {
     double psnrDb = 0, diffFraction = 0;
 };
 
+// One pixel class over the frames of a mode: percent of the frame's pixels
+// (min / mean / max over frames) and the mean count per frame.
+struct PixelClassSummary {
+    double minPct = 0, meanPct = 0, maxPct = 0, meanCount = 0;
+};
+
 struct ModeSummary {
     std::string mode;
     double frameMsMedian = 0, frameMsP95 = 0, frameMsMean = 0;
@@ -80,6 +100,13 @@ struct ModeSummary {
     double psnrDbMedian = 0, psnrDbMin = 0;
     double diffFractionMedian = 0;
     double trianglesMedian = 0, drawCallsMedian = 0, cullMsMedian = 0, drawMsMedian = 0;
+    // Pixel classes (thesis Table 4.1); hasPixels = false when the mode
+    // classified no pixel in any frame (full, near, osgimpostor).
+    bool hasPixels = false;
+    PixelClassSummary covered, horizonCulled, cache, rayHit, rayMiss;
+    // Per stage: mean ms over the frames in which it ran, and in how many it ran.
+    std::map<std::string, double> stagesMsMean;
+    std::map<std::string, int> stageRuns;
 };
 
 struct BenchResult {

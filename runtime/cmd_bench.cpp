@@ -94,7 +94,17 @@ int runBench(int argc, char** argv) {
     app.add_option("--frames", cfg.frames, "frames rendered, spread evenly over the whole path (default 120)");
     app.add_option("--size", sizeStr, "image size WIDTHxHEIGHT (default 640x480)");
     app.add_option("--modes", modesStr, modeHelp);
-    app.add_option("--near", cfg.options.nearDistance, "near-field distance in metres (default 100)");
+    std::string nearStr = "100", budgetStr = "unlimited";
+    bool noCache = false;
+    app.add_option("--near", nearStr,
+                   "near-field distance in metres, 1 .. 100000, or 'auto' (hybrid: adaptive split per frame; "
+                   "near/osgimpostor then use 100) (default 100)");
+    app.add_option("--budget", budgetStr,
+                   "hybrid: far-field rays per frame through the panoramic cache, 0 .. 1000000000, or "
+                   "'unlimited' / -1 = trace every far pixel, cache bypassed (default unlimited)");
+    app.add_option("--horizon-grid", cfg.options.horizonGrid,
+                   "hybrid: horizon height-grid resolution, cells per side, 1 .. 8192 (default 512)");
+    app.add_flag("--no-cache", noCache, "hybrid: panoramic image cache off (every far pixel traced)");
     app.add_option("--fov", cfg.fovYDeg, "vertical field of view in degrees (default 60)");
     app.add_option("--reference", refStr, "reference for the quality metrics: full (default) or ssaa:K (K x K supersampled full)");
     app.add_option("--diff-threshold", cfg.diffThreshold, "per-channel difference counted as a differing pixel (default 8)");
@@ -112,6 +122,11 @@ int runBench(int argc, char** argv) {
     cfg.command = commandLine(argc, argv);
     if (Status s = parseSize(sizeStr, cfg.width, cfg.height); !s) return reportBadInput(cmd, s);
     if (Status s = parseReference(refStr, cfg.referenceSsaa); !s) return reportBadInput(cmd, s);
+    if (auto nd = parseNearDistance(nearStr); !nd) return reportBadInput(cmd, nd.status());
+    else cfg.options.nearDistance = nd.value();
+    if (auto pb = parsePixelBudget(budgetStr); !pb) return reportBadInput(cmd, pb.status());
+    else cfg.options.pixelBudget = pb.value();
+    cfg.options.cache = !noCache;
     auto modes = parseModeList(modesStr);
     if (!modes) return reportBadInput(cmd, modes.status());
     cfg.modes = modes.value();

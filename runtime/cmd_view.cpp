@@ -2,7 +2,9 @@
 // under Xvfb). Drive / walk / fly manipulators, path playback, on-screen
 // stats (osgViewer StatsHandler, key s), render-mode switch (key m),
 // screenshots (key p, or --screenshot with --frames for headless use).
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -25,11 +27,14 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
+#include "nodes/far_field_node.h"
+#include "nodes/near_far_split.h"
 #include "runtime/city_file.h"
 #include "runtime/cli.h"
 #include "runtime/commands.h"
 #include "runtime/image.h"
 #include "runtime/paths.h"
+#include "runtime/ray_scene.h"
 
 namespace vista {
 
@@ -62,14 +67,20 @@ struct Capture : public osg::Camera::DrawCallback {
 };
 
 struct ViewState {
-    int mode = 0;  // 0 full, 1 near, 2 osgimpostor
+    int mode = 0;  // 0 full, 1 near, 2 osgimpostor, 3 hybrid (if the ray scene could be built)
+    int numModes = 3;
     double nearDistance = 100.0;
     int shots = 0;
     osg::ref_ptr<osg::Switch> modes;
     osg::ref_ptr<Capture> capture;
     osg::ref_ptr<osgText::Text> hud;
+    FarFieldNode* far = nullptr;      // owned by the scene graph (hybrid mode)
+    NearFarSplit* split = nullptr;
 };
-const char* kModeNames[] = {"full", "near", "osgimpostor"};
+const char* kModeNames[] = {"full", "near", "osgimpostor", "hybrid"};
+// Switch child drawn by each mode (full and near share the city scene; near
+// differs only by the projection's far plane).
+unsigned switchChild(int mode) { return mode == 2 ? 1u : mode == 3 ? 2u : 0u; }
 
 class ViewKeys : public osgGA::GUIEventHandler {
 public:
@@ -77,8 +88,8 @@ public:
     bool handle(const osgGA::GUIEventAdapter& ea, osgGA::GUIActionAdapter&) override {
         if (ea.getEventType() != osgGA::GUIEventAdapter::KEYDOWN) return false;
         if (ea.getKey() == 'm') {
-            _s.mode = (_s.mode + 1) % 3;
-            _s.modes->setSingleChildOn(_s.mode == 2 ? 1 : 0);
+            _s.mode = (_s.mode + 1) % _s.numModes;
+            _s.modes->setSingleChildOn(switchChild(_s.mode));
             return true;
         }
         if (ea.getKey() == 'p') {
@@ -88,7 +99,7 @@ public:
         return false;
     }
     void getUsage(osg::ApplicationUsage& u) const override {
-        u.addKeyboardMouseBinding("m", "cycle render mode: full / near / osgimpostor");
+        u.addKeyboardMouseBinding("m", "cycle render mode: full / near / osgimpostor / hybrid");
         u.addKeyboardMouseBinding("p", "screenshot to vista_screenshot_N.png");
     }
 
@@ -126,7 +137,7 @@ int runView(int argc, char** argv) {
     CLI::App app{"Interactive viewer: drive (1), walk (2), fly (3), orbit (4), path playback (5); s = stats, "
                  "m = render mode, p = screenshot, h = help.",
                  "vista view"};
-    std::string city, pathFile, sizeStr = "1280x720", screenshot, kind = "car";
+    std::string city, pathFile, sizeStr = "1280x720", screenshot, kind = "car", modeStr = "full", budgetStr = "20000";
     int frames = 0;
     uint64_t seed = 0;
     double fovDeg = 60.0, nearD = 100.0;
@@ -136,7 +147,11 @@ int runView(int argc, char** argv) {
     app.add_option("--kind", kind, "path kind for --seed: walk, car, fly");
     app.add_option("--size", sizeStr, "window size WIDTHxHEIGHT (default 1280x720)");
     app.add_option("--fov", fovDeg, "vertical field of view in degrees (default 60)");
-    app.add_option("--near", nearD, "near-field distance of the `near` mode in metres (default 100)");
+    app.add_option("--near", nearD, "near-field distance of the `near` and `hybrid` modes in metres (default 100)");
+    app.add_option("--mode", modeStr, "start in this render mode: full, near, osgimpostor, hybrid (default full)");
+    app.add_option("--budget", budgetStr,
+                   "hybrid: far-field rays per frame through the panoramic cache, 0 .. 1000000000, or "
+                   "'unlimited' / -1 (default 20000)");
     app.add_option("--frames", frames, "quit after N frames (0 = run until Esc)");
     app.add_option("--screenshot", screenshot, "write a PNG of the last frame (use with --frames)");
     int rc = parseOrExit(app, argc, argv);
@@ -149,6 +164,20 @@ int runView(int argc, char** argv) {
     if (frames < 0) return reportBadInput(cmd, Status::error("--frames " + std::to_string(frames) + " must be >= 0"));
     if (!(fovDeg > 1 && fovDeg < 179)) return reportBadInput(cmd, Status::error("--fov out of range (1, 179) degrees"));
     if (!(nearD > 0)) return reportBadInput(cmd, Status::error("--near must be > 0 metres"));
+    int startMode = -1;
+    for (int i = 0; i < 4; ++i)
+        if (modeStr == kModeNames[i]) startMode = i;
+    if (startMode < 0)
+        return reportBadInput(cmd, Status::error("--mode '" + modeStr + "': expected full, near, osgimpostor or hybrid"));
+    int64_t budget = -1;
+    if (budgetStr != "unlimited" && budgetStr != "-1") {
+        char* end = nullptr;
+        long long v = std::strtoll(budgetStr.c_str(), &end, 10);
+        if (budgetStr.empty() || *end || v < 0 || v > 1000000000LL)
+            return reportBadInput(cmd, Status::error("--budget '" + budgetStr +
+                                                     "' out of range 0 .. 1000000000 rays per frame, or 'unlimited' / -1"));
+        budget = v;
+    }
     if (!screenshot.empty())
         if (Status s = checkWritablePath("--screenshot", screenshot); !s) return reportBadInput(cmd, s);
     auto c = loadCityFile(city);
@@ -182,11 +211,33 @@ int runView(int argc, char** argv) {
         return 1;
     }
 
+    std::unique_ptr<RayScene> rays;  // declared before the scene graph that references them
+    HeightGrid grid;
     ViewState st;
     st.nearDistance = nearD;
     st.modes = new osg::Switch;
     st.modes->addChild(c->scene.get(), true);
     st.modes->addChild(makeImpostorScene(c->scene.get(), nearD).get(), false);
+    // Hybrid: near field under a NearFarSplit + the far-field drawable. The
+    // ray scene and the height grid outlive the viewer (declared before it).
+    {
+        auto r = RayScene::build(*c);
+        if (r) {
+            rays = std::move(r.value());
+            grid = HeightGrid::build(*c, rays->frameOrigin(), 512);
+            HybridSceneOptions ho;
+            ho.nearDistance = nearD;
+            ho.far.nearDistance = nearD;
+            ho.far.pixelBudget = budget;
+            st.modes->addChild(buildHybridScene(*c, *rays, grid, ho, &st.split, &st.far).get(), false);
+            st.numModes = 4;
+        } else {
+            std::fprintf(stderr, "vista view: hybrid mode unavailable: %s\n", r.status().message().c_str());
+            if (startMode == 3) return reportBadInput(cmd, Status::error("--mode hybrid: " + r.status().message()));
+        }
+    }
+    st.mode = startMode;
+    st.modes->setSingleChildOn(switchChild(st.mode));
     osg::ref_ptr<osg::Group> root = new osg::Group;
     root->addChild(st.modes.get());
 
@@ -240,6 +291,11 @@ int runView(int argc, char** argv) {
     ks->addMatrixManipulator('2', "Walk", walk);
     ks->addMatrixManipulator('3', "Fly", fly);
     ks->addMatrixManipulator('4', "Orbit", orbit);
+    // The key switch auto-computes every child's home from the scene bounds
+    // by default (OSG), which would override the street start position set
+    // above: only the orbit manipulator computes its home.
+    ks->setAutoComputeHomePosition(false);
+    orbit->setAutoComputeHomePosition(true);
     if (havePath && path.samples.size() > 1) {
         osg::ref_ptr<osg::AnimationPath> ap = new osg::AnimationPath;
         ap->setLoopMode(osg::AnimationPath::LOOP);
@@ -275,11 +331,34 @@ int runView(int argc, char** argv) {
         pc.width = vp ? int(vp->width()) : w;
         pc.height = vp ? int(vp->height()) : h;
         pc.fovY = fovDeg * kPi / 180.0;
-        cam->setProjectionMatrix(toOsg(pc.projection(st.mode == 1 ? st.nearDistance : 0.0)));
-        char buf[160];
-        std::snprintf(buf, sizeof(buf), "mode %s (m)   %.1f ms/frame   keys: 1 drive 2 walk 3 fly 4 orbit%s, s stats, p shot",
-                      kModeNames[st.mode], lastMs, havePath ? " 5 path" : "");
-        st.hud->setText(buf);
+        cam->setProjectionMatrix(toOsg(pc.projection(st.mode == 1 ? st.nearDistance : 0.0)));  // hybrid: infinite far plane
+        // HUD: short lines (they must fit a 640-pixel-wide window at 16 px).
+        std::string text;
+        char buf[256];
+        std::snprintf(buf, sizeof(buf), "mode %s (m)   %.1f ms/frame", kModeNames[st.mode], lastMs);
+        text += buf;
+        std::snprintf(buf, sizeof(buf), "\nkeys: 1 drive 2 walk 3 fly 4 orbit%s s stats p shot", havePath ? " 5 path" : "");
+        text += buf;
+        if (st.mode == 3 && st.far) {
+            // Last drawn frame's pixel classes (thesis Table 4.1) and far-field stage times.
+            FrameStats fs = st.far->lastStats();
+            const PixelCounts& p = fs.pixels;
+            const double n = std::max<double>(1.0, double(p.covered + p.horizonCulled + p.cache + p.rayHit + p.rayMiss));
+            std::snprintf(buf, sizeof(buf), "\npixels %%: covered %.1f horizon %.1f cache %.1f\n          ray hit %.1f ray miss %.1f",
+                          100.0 * double(p.covered) / n, 100.0 * double(p.horizonCulled) / n, 100.0 * double(p.cache) / n,
+                          100.0 * double(p.rayHit) / n, 100.0 * double(p.rayMiss) / n);
+            text += buf;
+            std::snprintf(buf, sizeof(buf), "\nnear chunks drawn %u   stages ms:", st.split ? st.split->lastNearCount() : 0u);
+            text += buf;
+            int k = 0;
+            for (const auto& kv : fs.stagesMs) {
+                std::snprintf(buf, sizeof(buf), "%s%s %.1f", k % 4 == 0 ? "\n  " : "  ", kv.first.c_str(), kv.second);
+                text += buf;
+                ++k;
+            }
+        if (std::getenv("VISTA_VIEW_DEBUG")) { osg::Vec3d e, ce, u; cam->getViewMatrixAsLookAt(e, ce, u); std::fprintf(stderr, "DEBUG eye %.3f %.3f %.3f\n", e.x(), e.y(), e.z()); }
+        }
+        st.hud->setText(text);
         bool last = frames > 0 && n + 1 >= frames;
         if (last && !screenshot.empty()) st.capture->pending = screenshot;
         viewer.frame();

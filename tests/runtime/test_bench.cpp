@@ -391,3 +391,113 @@ TEST(BenchCli, TinyGeneratedCity) {
     EXPECT_EQ(runVista("view " + dir + "/missing.osgb --frames 1", &out), 2) << out;
     fs::remove_all(dir);
 }
+
+TEST(Bench, FarFieldOptionParsing) {
+    auto n = parseNearDistance("auto");
+    ASSERT_TRUE(n.isOk());
+    EXPECT_LT(n.value(), 0.0);
+    EXPECT_DOUBLE_EQ(parseNearDistance("250").value(), 250.0);
+    for (const char* bad : {"-5", "0", "0.5", "100001", "abc", "", "12m", "nan"}) {
+        auto r = parseNearDistance(bad);
+        ASSERT_FALSE(r.isOk()) << bad;
+        EXPECT_NE(r.status().message().find("--near"), std::string::npos) << r.status().message();
+    }
+    EXPECT_EQ(parsePixelBudget("unlimited").value(), -1);
+    EXPECT_EQ(parsePixelBudget("-1").value(), -1);
+    EXPECT_EQ(parsePixelBudget("0").value(), 0);
+    EXPECT_EQ(parsePixelBudget("1000").value(), 1000);
+    for (const char* bad : {"-7", "1e3", "x", "", "1000000001"}) {
+        auto r = parsePixelBudget(bad);
+        ASSERT_FALSE(r.isOk()) << bad;
+        EXPECT_NE(r.status().message().find("--budget"), std::string::npos) << r.status().message();
+    }
+    BenchConfig c;
+    c.options.horizonGrid = 0;
+    auto s = validateBenchConfig(c);
+    ASSERT_FALSE(s.isOk());
+    EXPECT_NE(s.message().find("--horizon-grid"), std::string::npos) << s.message();
+    c.options.horizonGrid = 8192;
+    c.options.nearDistance = -1;  // auto
+    EXPECT_TRUE(validateBenchConfig(c).isOk());
+    c.options.nearDistance = 0.5;
+    EXPECT_FALSE(validateBenchConfig(c).isOk());
+}
+
+TEST(BenchCli, FarFieldFlagsRejectBadValues) {
+    if (!fs::exists(VISTA_BINARY)) GTEST_SKIP() << "vista binary not built";
+    std::string dir = tmpDir("badff"), out;
+    std::string dummy = dir + "/dummy.osgb";
+    std::ofstream(dummy) << "x";
+    const std::pair<const char*, const char*> bad[] = {
+        {"--near -5", "--near"}, {"--near abc", "--near"}, {"--horizon-grid 0", "--horizon-grid"},
+        {"--budget -7", "--budget"}, {"--horizon-grid 9000", "--horizon-grid"}};
+    for (const auto& [args, flag] : bad) {
+        EXPECT_EQ(runVista("bench " + dummy + " " + args + " --out " + dir + "/o", &out), 2) << args << ": " << out;
+        EXPECT_NE(out.find(flag), std::string::npos) << args << ": " << out;
+    }
+    fs::remove_all(dir);
+}
+
+// Hybrid on a generated tiny city: per-mode pixel classes and stage times in
+// summary.json; the far-field flags are accepted and recorded.
+TEST(BenchCli, HybridPixelClassesAndOptions) {
+    REQUIRE_DISPLAY();
+    if (!fs::exists(VISTA_BINARY)) GTEST_SKIP() << "vista binary not built";
+    std::string dir = tmpDir("hybrid"), out;
+    std::string city = dir + "/tiny.osgb";
+    if (runVista("gen --size 300 --seed 3 -q -o " + city, &out) != 0) GTEST_SKIP() << "vista gen not available: " << out;
+    struct Run {
+        std::string flags;
+        nlohmann::json near, budget;
+        int grid;
+        bool cache;
+    };
+    const Run runs[] = {
+        {"--near auto --budget 1000 --no-cache --horizon-grid 64", "auto", 1000, 64, false},
+        {"--near 60 --budget unlimited", 60.0, "unlimited", 512, true},
+    };
+    for (size_t i = 0; i < 2; ++i) {
+        const Run& r = runs[i];
+        std::string o = dir + "/b" + std::to_string(i);
+        ASSERT_EQ(runVista("bench " + city + " --seed 4 --duration 10 --frames 3 --size 160x120 -q --modes full,hybrid " +
+                               r.flags + " --out " + o,
+                           &out),
+                  0)
+            << r.flags << ": " << out;
+        std::ifstream f(o + "/summary.json");
+        ASSERT_TRUE(f.good()) << r.flags;
+        auto j = nlohmann::json::parse(f);
+        const auto& opt = j["options"];
+        EXPECT_EQ(opt["near_m"], r.near) << r.flags;
+        EXPECT_EQ(opt["pixel_budget"], r.budget) << r.flags;
+        EXPECT_EQ(opt["horizon_grid"], r.grid) << r.flags;
+        EXPECT_EQ(opt["cache"], r.cache) << r.flags;
+        ASSERT_TRUE(j["modes"]["hybrid"].contains("pixels")) << j["modes"]["hybrid"].dump();
+        const auto& px = j["modes"]["hybrid"]["pixels"];
+        double sum = 0;
+        for (const char* cls : {"covered", "horizon_culled", "cache", "ray_hit", "ray_miss"}) {
+            ASSERT_TRUE(px.contains(cls)) << cls;
+            for (const char* k : {"min_pct", "mean_pct", "max_pct", "mean_count"})
+                ASSERT_TRUE(px[cls][k].is_number()) << cls << "." << k;
+            EXPECT_LE(px[cls]["min_pct"].get<double>(), px[cls]["mean_pct"].get<double>() + 1e-9) << cls;
+            EXPECT_LE(px[cls]["mean_pct"].get<double>(), px[cls]["max_pct"].get<double>() + 1e-9) << cls;
+            EXPECT_NEAR(px[cls]["mean_count"].get<double>(), px[cls]["mean_pct"].get<double>() / 100.0 * 160 * 120, 1e-6);
+            sum += px[cls]["mean_pct"].get<double>();
+        }
+        EXPECT_NEAR(sum, 100.0, 0.1) << px.dump();
+        if (!r.cache) {
+            EXPECT_EQ(px["cache"]["max_pct"].get<double>(), 0.0);
+        }
+        // Stage times: every stage that ran has a mean and a run count within the frame count.
+        const auto& stages = j["modes"]["hybrid"]["stages_ms"];
+        ASSERT_TRUE(stages.contains("opacity")) << stages.dump();
+        for (auto it = stages.begin(); it != stages.end(); ++it) {
+            EXPECT_GE(it.value().get<double>(), 0.0) << it.key();
+            int runsN = j["modes"]["hybrid"]["stage_runs"][it.key()].get<int>();
+            EXPECT_GE(runsN, 1) << it.key();
+            EXPECT_LE(runsN, 3) << it.key();
+        }
+        EXPECT_FALSE(j["modes"]["full"].contains("pixels"));  // full classifies nothing (documented)
+    }
+    fs::remove_all(dir);
+}
