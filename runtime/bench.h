@@ -13,6 +13,11 @@
 // the fraction of pixels differing by more than diffThreshold.
 // Timing: frame_ms per mode as reported by the mode (glFinish included);
 // one warm-up frame per mode is rendered and discarded before frame 0.
+// summary.json per mode: frame-time, quality and triangle statistics, plus
+// `pixels` (Table 4.1 classes as min/mean/max percent of the frame and mean
+// count; only for modes that classify pixels: hybrid, raycast, impostor),
+// `stages_ms` (mean ms per stage over the frames it ran in) and `stage_runs`;
+// top level `options` records the BenchOptions used (docs/user-guide.md).
 // Errors: bad configuration or setup failures (no display, unknown mode,
 // Embree failure) return a Status; nothing throws.
 #pragma once

@@ -1,6 +1,8 @@
 // vista view: interactive OSG viewer of a city (a real window on a GPU, or
 // under Xvfb). Drive / walk / fly manipulators, path playback, on-screen
-// stats (osgViewer StatsHandler, key s), render-mode switch (key m),
+// stats (osgViewer StatsHandler, key s), render-mode switch (key m: full,
+// near, osgimpostor, hybrid = NearFarSplit + FarFieldNode; the HUD then shows
+// the far field's pixel classes and stage times),
 // screenshots (key p, or --screenshot with --frames for headless use).
 #include <algorithm>
 #include <cmath>
@@ -295,6 +297,7 @@ int runView(int argc, char** argv) {
     // by default (OSG), which would override the street start position set
     // above: only the orbit manipulator computes its home.
     ks->setAutoComputeHomePosition(false);
+    ks->setHomePosition(start, start + dir * 10.0, osg::Vec3d(0, 0, 1));  // the switch pushes its home to the children
     orbit->setAutoComputeHomePosition(true);
     if (havePath && path.samples.size() > 1) {
         osg::ref_ptr<osg::AnimationPath> ap = new osg::AnimationPath;
@@ -356,7 +359,6 @@ int runView(int argc, char** argv) {
                 text += buf;
                 ++k;
             }
-        if (std::getenv("VISTA_VIEW_DEBUG")) { osg::Vec3d e, ce, u; cam->getViewMatrixAsLookAt(e, ce, u); std::fprintf(stderr, "DEBUG eye %.3f %.3f %.3f\n", e.x(), e.y(), e.z()); }
         }
         st.hud->setText(text);
         bool last = frames > 0 && n + 1 >= frames;

@@ -499,5 +499,26 @@ TEST(BenchCli, HybridPixelClassesAndOptions) {
         }
         EXPECT_FALSE(j["modes"]["full"].contains("pixels"));  // full classifies nothing (documented)
     }
+
+    // The viewer's hybrid mode: from the (static) street start position it
+    // shows the same picture as full below the HUD text.
+    Image shots[2];
+    const char* viewModes[2] = {"full", "hybrid"};
+    for (int i = 0; i < 2; ++i) {
+        std::string png = dir + "/view_" + viewModes[i] + ".png";
+        ASSERT_EQ(runVista("view " + city + " --mode " + viewModes[i] + " --size 320x240 --frames 3 --screenshot " + png, &out), 0)
+            << out;
+        auto img = readPng(png);
+        ASSERT_TRUE(img.isOk()) << img.status().message();
+        ASSERT_EQ(img->width, 320);
+        ASSERT_EQ(img->height, 240);
+        Image crop(320, 100);  // rows 140 .. 239: below the HUD lines
+        for (int y = 0; y < 100; ++y)
+            for (int x = 0; x < 320; ++x) crop.set(x, y, img->at(x, 140 + y));
+        shots[i] = crop;
+    }
+    const double viewPsnr = lumaPsnr(shots[1], shots[0]);
+    EXPECT_GE(viewPsnr, 30.0) << "view hybrid vs full";
+    std::printf("vista view hybrid vs full (rows below the HUD): %.2f dB\n", viewPsnr);
     fs::remove_all(dir);
 }
