@@ -4,7 +4,7 @@
 //
 // Modes are created through makeMode() from a table (kModeTable in
 // bench.cpp). Other modules add theirs there: `hybrid` (runtime/mode_hybrid.h)
-// and `impostor` (bake/mode_impostor.h) — see the commented hook.
+// and `impostor` (bake/mode_impostor.h, registered by the `vista` tool's main).
 //
 // Reference: every frame is compared with the `full` image of the same
 // camera (or, with referenceSsaa = k > 1, with the average of k x k
@@ -44,6 +44,10 @@ struct ModeInfo {
 };
 // All registered modes, in display order.
 const std::vector<ModeInfo>& modeTable();
+// Adds a mode (or replaces one of the same name). Call at start-up, before
+// any bench runs; not thread-safe. Used for modes of libraries that depend on
+// runtime, such as the bake's `impostor`.
+void registerBenchMode(const ModeInfo& mode);
 std::vector<std::string> availableModes();
 const ModeInfo* findMode(const std::string& name);
 // Creates a mode. Unknown name -> error listing the available modes. The

@@ -2,6 +2,7 @@
 // summary.json, plots, difference images. Also the size sweep (--sweep).
 #include <cmath>
 #include <cstdio>
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -105,6 +106,7 @@ int runBench(int argc, char** argv) {
     app.add_option("--horizon-grid", cfg.options.horizonGrid,
                    "hybrid: horizon height-grid resolution, cells per side, 1 .. 8192 (default 512)");
     app.add_flag("--no-cache", noCache, "hybrid: panoramic image cache off (every far pixel traced)");
+    app.add_option("--baked", cfg.options.bakedFile, "impostor: the baked file of this city (from `vista bake`)");
     app.add_option("--fov", cfg.fovYDeg, "vertical field of view in degrees (default 60)");
     app.add_option("--reference", refStr, "reference for the quality metrics: full (default) or ssaa:K (K x K supersampled full)");
     app.add_option("--diff-threshold", cfg.diffThreshold, "per-channel difference counted as a differing pixel (default 8)");
@@ -127,9 +129,14 @@ int runBench(int argc, char** argv) {
     if (auto pb = parsePixelBudget(budgetStr); !pb) return reportBadInput(cmd, pb.status());
     else cfg.options.pixelBudget = pb.value();
     cfg.options.cache = !noCache;
+    if (!cfg.options.bakedFile.empty() && access(cfg.options.bakedFile.c_str(), R_OK) != 0)
+        return reportBadInput(cmd, Status::error("--baked '" + cfg.options.bakedFile + "': cannot read the file"));
     auto modes = parseModeList(modesStr);
     if (!modes) return reportBadInput(cmd, modes.status());
     cfg.modes = modes.value();
+    for (const auto& m : cfg.modes)
+        if (m == "impostor" && cfg.options.bakedFile.empty())
+            return reportBadInput(cmd, Status::error("mode impostor needs --baked city.baked.osgb (from 'vista bake')"));
     if (Status s = validateBenchConfig(cfg); !s) return reportBadInput(cmd, s);
     if (cfg.worstFrames < 0 || cfg.worstFrames > 100)
         return reportBadInput(cmd, Status::error("--worst " + std::to_string(cfg.worstFrames) + " out of range 0 .. 100"));

@@ -3,6 +3,8 @@
 #include <cstring>
 #include <string>
 
+#include "bake/mode_impostor.h"
+#include "runtime/bench.h"
 #include "runtime/commands.h"
 
 namespace {
@@ -31,6 +33,7 @@ void usage(FILE* f) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    vista::registerBenchMode({"impostor", "near field + baked point impostors (needs --baked)", false, vista::makeImpostorMode});
     if (argc < 2) {
         usage(stderr);
         return 2;
