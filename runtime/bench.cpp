@@ -200,25 +200,6 @@ std::string joinModes() {
     return s;
 }
 
-Status writeTextAtomic(const std::string& path, const std::string& text) {
-    std::string tmp = path + ".tmp." + std::to_string(getpid());
-    {
-        std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-        if (!f) return Status::error("cannot write '" + path + "'");
-        f << text;
-        f.flush();
-        if (!f) {
-            std::remove(tmp.c_str());
-            return Status::error("write failed for '" + path + "'");
-        }
-    }
-    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-        std::remove(tmp.c_str());
-        return Status::error("cannot rename into '" + path + "'");
-    }
-    return Status::ok();
-}
-
 std::string cpuModel() {
     std::ifstream f("/proc/cpuinfo");
     std::string line;
@@ -559,7 +540,7 @@ Result<BenchResult> runBenchmark(const LoadedCity* city, osg::Node* scene, const
         std::replace(notes.begin(), notes.end(), ',', ' ');
         csv << st << "," << notes << "\n";
     }
-    VISTA_RETURN_IF_ERROR(writeTextAtomic((fs::path(cfg.outDir) / "frames.csv").string(), csv.str()));
+    VISTA_RETURN_IF_ERROR(writeFileAtomic((fs::path(cfg.outDir) / "frames.csv").string(), csv.str()));
 
     // summary.json
     nlohmann::json j;
@@ -622,7 +603,7 @@ Result<BenchResult> runBenchmark(const LoadedCity* city, osg::Node* scene, const
     std::vector<std::string> order;
     for (const auto& s : result.modes) order.push_back(s.mode);
     j["mode_order"] = order;
-    VISTA_RETURN_IF_ERROR(writeTextAtomic((fs::path(cfg.outDir) / "summary.json").string(), j.dump(2) + "\n"));
+    VISTA_RETURN_IF_ERROR(writeFileAtomic((fs::path(cfg.outDir) / "summary.json").string(), j.dump(2) + "\n"));
 
     // Plots: frame time per frame (thesis Fig. 4.8) and quality per frame.
     PlotSpec pt, pq;
