@@ -10,5 +10,5 @@ OUT=out/demo
 mkdir -p "$OUT"
 "$VISTA" gen --params data/default.json --stats "$OUT/city.stats.json" -o "$OUT/city.osgb"
 run() { if [ -z "${DISPLAY:-}" ]; then xvfb-run -a -s "-screen 0 1280x1024x24" "$@"; else "$@"; fi; }
-run "$VISTA" bench "$OUT/city.osgb" --seed 1 --frames 40 --size 640x480 --modes full,near,raycast --out "$OUT/bench"
+run "$VISTA" bench "$OUT/city.osgb" --seed 1 --frames 40 --size 640x480 --modes full,near,raycast,hybrid --out "$OUT/bench"
 echo "pictures: $OUT/bench/*.png   figures: $OUT/bench/summary.json   city: $OUT/city.osgb"

@@ -447,8 +447,11 @@ Result<BenchResult> runBenchmark(const LoadedCity* city, osg::Node* scene, const
             result.frames.push_back(std::move(rec));
         }
         if (!cfg.quiet && ((f + 1) % 10 == 0 || f + 1 == idx.size())) {
-            std::fprintf(stderr, "\rframe %zu/%zu (%.0f s)", f + 1, idx.size(), msSince(tStart) / 1000.0);
-            if (f + 1 == idx.size()) std::fprintf(stderr, "\n");
+            const double el = msSince(tStart) / 1000.0, eta = el * double(idx.size() - f - 1) / double(f + 1);
+            const bool tty = isatty(2);
+            std::fprintf(stderr, tty ? "\rframe %zu/%zu (%.0f s, eta %.0f s)   " : "frame %zu/%zu (%.0f s, eta %.0f s)\n", f + 1,
+                         idx.size(), el, eta);
+            if (tty && f + 1 == idx.size()) std::fprintf(stderr, "\n");
         }
     }
     result.glRenderer = renderer->glRenderer();
