@@ -312,8 +312,8 @@ glm::dvec2 projectDelta(const SamplingSetup& s, const glm::dvec3& eye, const glm
 // every viewpoint tested: the camera's two pixel steps, moved onto the surface
 // plane (exact derivative of the ray-plane intersection), projected into the
 // viewer's image (exact derivative of the perspective projection); the longest
-// edge of the local sampling triangulation (pixel edges and, with the diagonal
-// factor, the shorter diagonal) must be at most `limit` (tangent units).
+// edge of the local sampling triangulation (reduced lattice basis and, with the
+// diagonal factor, the shorter diagonal) must be at most `limit` (tangent units).
 bool sufficient(const LdiCamera& c, const SamplingSetup& s, const glm::dvec3& pos, const glm::dvec3& nrm,
                 const std::array<glm::dvec3, 8>& corners, const glm::dvec3& nearest, double limit, bool diagonal) {
     const glm::dvec3 d = pos - c.pos;
@@ -325,7 +325,20 @@ bool sufficient(const LdiCamera& c, const SamplingSetup& s, const glm::dvec3& po
     const glm::dvec3 du = zc * c.step * (s.U - glm::dot(s.U, nrm) / rm * r);
     const glm::dvec3 dv = zc * c.step * (s.V - glm::dot(s.V, nrm) / rm * r);
     auto ok = [&](const glm::dvec3& eye) {
-        const glm::dvec2 a = projectDelta(s, eye, pos, du), b = projectDelta(s, eye, pos, dv);
+        glm::dvec2 a = projectDelta(s, eye, pos, du), b = projectDelta(s, eye, pos, dv);
+        if (!(std::abs(a.x) < 1e100 && std::abs(b.x) < 1e100)) return false;
+        // The projected samples form (locally) the lattice spanned by a and b; its
+        // Delaunay triangulation uses the reduced basis (Lagrange-Gauss), not the
+        // pixel edges: a sheared lattice (grazing surface seen from a laterally
+        // offset viewpoint) has long pixel edges but short triangulation edges.
+        for (int it = 0; it < 64; ++it) {
+            if (glm::dot(a, a) > glm::dot(b, b)) std::swap(a, b);
+            const double aa = glm::dot(a, a);
+            if (aa <= 0) break;
+            const double mu = std::round(glm::dot(a, b) / aa);
+            if (mu == 0) break;
+            b -= mu * a;
+        }
         double e = std::max(glm::length(a), glm::length(b));
         if (diagonal) e = std::max(e, std::min(glm::length(a + b), glm::length(a - b)));
         return e <= limit;

@@ -20,8 +20,11 @@
 //     fp = 1 / cos^2(fovY/2) (thesis: 1.17 for 45 deg), sqrt2 = pixel diagonal.
 //  5. Multi-layer hits (FarScene::allHits) clipped to the far box.
 //  6. Removal of points sampled better (smaller footprint) and sufficiently
-//     (footprint * sqrt2 below one output pixel from the nearest cell point)
 //     by another camera that has a sample of the same surface there.
+//     Sufficient: that camera's pixel steps, moved onto the surface plane and
+//     projected into the target view from the nearest cell point and the 8
+//     cell corners, span a lattice whose triangulation edges (reduced basis,
+//     plus the shorter diagonal with the sqrt2 factor) are <= 1 pixel / fp.
 // Contract: setupSampling() returns an error when the far box is not strictly
 // in front of the sampling plane (cell touching or intersecting the far box)
 // or a box is empty/non-finite; otherwise the cameras lie on the plane, never

@@ -352,6 +352,78 @@ TEST(Sampling, NoHolesFromCellCornersAndCentre) {
     EXPECT_GT(interior, 5000u);
 }
 
+// Point removal on surfaces seen at grazing angles (streets and squares of the
+// far field seen from eye height): the viewer sees them as obliquely as the
+// cameras, so one camera's samples are sufficient there and the others' are
+// removed. Checked against an independent count (samples of the best camera,
+// i.e. the camera highest above the ground, lowest index on ties) and for holes
+// from the cell's corners and centre.
+TEST(Sampling, RemovalOnGrazingGroundKeepsOneCameraWithoutHoles) {
+    TriangleSoup soup;
+    addBox(soup, {150, -40, -1}, {400, 40, 0}, [](glm::vec3) { return glm::u8vec4(90, 120, 80, 255); });
+    auto scene = FarScene::build(soup);
+    ASSERT_TRUE(scene.isOk()) << scene.status().message();
+    const Box3 cell{{-100, -5, 1.2}, {0, 5, 2.0}};
+    const Box3 far{{150, -40, -1}, {400, 40, 0}};
+    auto s = setupSampling(cell, far);
+    ASSERT_TRUE(s.isOk());
+    SamplingParams sp;
+    LdiResult ldi = sampleLdi(**scene, *s, far, sp);
+    auto keep = removeRedundant(ldi, *s, cell, sp);
+    // Ground-top samples of the cameras above the ground (a camera below it only
+    // records the top face from behind, through the box). Those cameras sample
+    // the ground sufficiently for every viewpoint of the cell, so after removal
+    // about one camera's worth of samples is left: at most 10 % more than the
+    // larger of their counts (before the fix: all of them, about twice that).
+    std::array<size_t, 3> top{0, 0, 0}, kept{0, 0, 0};
+    for (size_t i = 0; i < ldi.samples.size(); ++i) {
+        const auto& smp = ldi.samples[i];
+        if (smp.normal.z < 0.9f || std::abs(smp.pos.z) > 1e-3f) continue;
+        ++top[smp.camera];
+        kept[smp.camera] += keep[i];
+    }
+    size_t above = 0, topAbove = 0, keptAbove = 0;
+    for (int k = 0; k < 3; ++k)
+        if (s->cameras[size_t(k)].z > 0.1) {
+            ++above;
+            topAbove = std::max(topAbove, top[size_t(k)]);
+            keptAbove += kept[size_t(k)];
+        }
+    ASSERT_GE(above, 2u);
+    ASSERT_GT(topAbove, 1000u);
+    EXPECT_LE(double(keptAbove), 1.1 * double(topAbove));
+    // No holes in the ground from the cell's corners and centre.
+    std::vector<glm::dvec3> pts;
+    for (size_t i = 0; i < ldi.samples.size(); ++i)
+        if (keep[i]) pts.emplace_back(ldi.samples[i].pos);
+    std::vector<glm::dvec3> eyes;
+    for (int i = 0; i < 8; ++i) eyes.push_back(cell.corner(i));
+    eyes.push_back(cell.center());
+    size_t interior = 0;
+    for (const auto& eye : eyes) {
+        ProjView v = viewFrom(eye, glm::dvec3(275, 0, 0), 640, 480, 60.0);
+        std::vector<uint8_t> geo(size_t(v.w) * size_t(v.h), 0), cov(geo.size(), 0);
+        for (int y = 0; y < v.h; ++y)
+            for (int x = 0; x < v.w; ++x)
+                geo[size_t(y) * size_t(v.w) + size_t(x)] = (*scene)->intersect(glm::vec3(eye), glm::vec3(v.ray(x + 0.5, y + 0.5)), 0, 1e30f).hit;
+        for (const auto& q : pts) {
+            int x, y;
+            if (v.project(q, x, y)) cov[size_t(y) * size_t(v.w) + size_t(x)] = 1;
+        }
+        for (int y = 1; y + 1 < v.h; ++y)
+            for (int x = 1; x + 1 < v.w; ++x) {
+                bool all = true;
+                for (int dy = -1; dy <= 1 && all; ++dy)
+                    for (int dx = -1; dx <= 1 && all; ++dx) all = geo[size_t(y + dy) * size_t(v.w) + size_t(x + dx)] != 0;
+                if (!all) continue;
+                ++interior;
+                ASSERT_TRUE(cov[size_t(y) * size_t(v.w) + size_t(x)]) << "hole at " << x << "," << y << " from eye " << eye.x << ","
+                                                                       << eye.y << "," << eye.z;
+            }
+    }
+    EXPECT_GT(interior, 2000u);
+}
+
 // ---------------------------------------------------------------- appearance
 TEST(Appearance, ConstantColourSceneIsExactAndCompressesToOneColour) {
     TriangleSoup soup = testFarField(true);
