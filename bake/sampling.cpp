@@ -187,8 +187,13 @@ double perspectiveFactor(const SamplingParams& p) {
 }
 
 double ldiStep(const SamplingSetup& s, const SamplingParams& p) {
-    const double D = s.dNear, R = s.circumradius;
-    double a = outputPixelAngle(p) * D * D / (R * R + D * D);
+    // The LDI cameras' image planes are parallel to the sampling plane with a
+    // uniform step in tangent units, so off-axis pixels already shrink by
+    // cos^2: a tangent step a gives samples a*D apart on a plane at depth D in
+    // front of every corner, which subtends a seen from the circumcentre. So
+    // the step is the output pixel angle itself (no D^2/(R^2+D^2) term),
+    // refined by the perspective and diagonal factors.
+    double a = outputPixelAngle(p);
     if (p.perspectiveFactor) a /= perspectiveFactor(p);
     if (p.diagonalFactor) a /= std::sqrt(2.0);
     return a / std::max(p.oversample, 1e-6);

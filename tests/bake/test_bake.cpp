@@ -215,9 +215,9 @@ TEST(Sampling, ResolutionFactors) {
     p.fovYDeg = 45;
     EXPECT_NEAR(perspectiveFactor(p), 1.17, 0.005);  // the thesis' value for 45 degrees
     const double delta = outputPixelAngle(p);
-    EXPECT_NEAR(ldiStep(s, p), delta * 1e4 / (2500 + 1e4) / perspectiveFactor(p) / std::sqrt(2.0), 1e-12);
+    EXPECT_NEAR(ldiStep(s, p), delta / perspectiveFactor(p) / std::sqrt(2.0), 1e-12);
     p.oversample = 2;
-    EXPECT_NEAR(ldiStep(s, p), delta * 1e4 / (2500 + 1e4) / perspectiveFactor(p) / std::sqrt(2.0) / 2, 1e-12);
+    EXPECT_NEAR(ldiStep(s, p), delta / perspectiveFactor(p) / std::sqrt(2.0) / 2, 1e-12);
 }
 
 // A far field: a building with a window pattern on ground, in an impostor frame.
