@@ -302,7 +302,7 @@ TEST(Bench, RaycastAgreesWithFull) {
     REQUIRE_DISPLAY();
     LoadedCity city = tinyCity();
     auto rs = RayScene::build(city);
-    if (!rs) GTEST_SKIP() << "RayScene not available yet: " << rs.status().message();
+    ASSERT_TRUE(rs.isOk()) << rs.status().message();
     auto r = OffscreenRenderer::create(160, 120);
     ASSERT_TRUE(r.isOk()) << r.status().message();
     BenchContext ctx;
@@ -329,7 +329,7 @@ TEST(Bench, RaycastAgreesWithFull) {
 }
 
 TEST(BenchCli, BadInputExitsWithTwo) {
-    if (!fs::exists(VISTA_BINARY)) GTEST_SKIP() << "vista binary not built";
+    ASSERT_TRUE(fs::exists(VISTA_BINARY)) << "the vista binary is a build dependency of this test";
     std::string dir = tmpDir("badcli"), out;
     std::string dummy = dir + "/dummy.osgb";
     std::ofstream(dummy) << "x";
@@ -349,12 +349,12 @@ TEST(BenchCli, BadInputExitsWithTwo) {
 // End to end on a generated tiny city: gen -> path -> bench (all modes).
 TEST(BenchCli, TinyGeneratedCity) {
     REQUIRE_DISPLAY();
-    if (!fs::exists(VISTA_BINARY)) GTEST_SKIP() << "vista binary not built";
+    ASSERT_TRUE(fs::exists(VISTA_BINARY)) << "the vista binary is a build dependency of this test";
     std::string dir = tmpDir("e2e"), out;
     std::string city = dir + "/tiny.osgb";
-    if (runVista("gen --size 300 --seed 3 -q -o " + city, &out) != 0) GTEST_SKIP() << "vista gen not available: " << out;
+    ASSERT_EQ(runVista("gen --size 300 --seed 3 -q -o " + city, &out), 0) << out;
     auto loaded = loadCityFile(city);
-    if (!loaded) GTEST_SKIP() << "city files cannot be loaded yet: " << loaded.status().message();
+    ASSERT_TRUE(loaded.isOk()) << loaded.status().message();
     ASSERT_EQ(runVista("path " + city + " --seed 4 --duration 10 -o " + dir + "/p.csv", &out), 0) << out;
     {  // the path drives on the generated city's streets
         auto p = loadPathCsv(dir + "/p.csv");
@@ -424,7 +424,7 @@ TEST(Bench, FarFieldOptionParsing) {
 }
 
 TEST(BenchCli, FarFieldFlagsRejectBadValues) {
-    if (!fs::exists(VISTA_BINARY)) GTEST_SKIP() << "vista binary not built";
+    ASSERT_TRUE(fs::exists(VISTA_BINARY)) << "the vista binary is a build dependency of this test";
     std::string dir = tmpDir("badff"), out;
     std::string dummy = dir + "/dummy.osgb";
     std::ofstream(dummy) << "x";
@@ -442,10 +442,10 @@ TEST(BenchCli, FarFieldFlagsRejectBadValues) {
 // summary.json; the far-field flags are accepted and recorded.
 TEST(BenchCli, HybridPixelClassesAndOptions) {
     REQUIRE_DISPLAY();
-    if (!fs::exists(VISTA_BINARY)) GTEST_SKIP() << "vista binary not built";
+    ASSERT_TRUE(fs::exists(VISTA_BINARY)) << "the vista binary is a build dependency of this test";
     std::string dir = tmpDir("hybrid"), out;
     std::string city = dir + "/tiny.osgb";
-    if (runVista("gen --size 300 --seed 3 -q -o " + city, &out) != 0) GTEST_SKIP() << "vista gen not available: " << out;
+    ASSERT_EQ(runVista("gen --size 300 --seed 3 -q -o " + city, &out), 0) << out;
     struct Run {
         std::string flags;
         nlohmann::json near, budget;
