@@ -66,25 +66,20 @@ std::vector<CityTile> indexTiles(const LoadedCity& city) {
         }
         return tiles;
     }
-    // Mirror loadCityFile's traversal order to attribute meshes and instances to tiles.
+    // tileGeometries() walks the file in loadCityFile's order, so meshes and
+    // instances are attributed to their tiles by position.
     uint32_t nextMesh = 0, nextInst = 0;
     for (unsigned ci = 0; ci < root->getNumChildren(); ++ci) {
-        auto* xf = dynamic_cast<osg::MatrixTransform*>(root->getChild(ci));
-        if (!xf || xf->getName().rfind("tile_", 0) != 0) continue;
+        osg::MatrixTransform* xf = asCityTile(root->getChild(ci));
+        if (!xf) continue;
         CityTile t;
         t.child = ci;
-        for (unsigned gi = 0; gi < xf->getNumChildren(); ++gi) {
-            osg::Geode* geode = xf->getChild(gi)->asGeode();
-            if (!geode) continue;
-            for (unsigned di = 0; di < geode->getNumDrawables(); ++di) {
-                osg::Geometry* g = geode->getDrawable(di)->asGeometry();
-                if (!g || g->getNumPrimitiveSets() == 0) continue;
-                if (g->getName().rfind("tree_prototype_", 0) == 0) {
-                    const int n = std::max(0, g->getPrimitiveSet(0)->getNumInstances());
-                    for (int k = 0; k < n && nextInst < city.instances.size(); ++k) addInstance(t, nextInst++);
-                } else if (nextMesh < city.meshes.size()) {
-                    addMesh(t, nextMesh++);
-                }
+        for (osg::Geometry* g : tileGeometries(*xf)) {
+            if (g->getName().rfind(kTreeGeometryPrefix, 0) == 0) {
+                const int n = std::max(0, g->getPrimitiveSet(0)->getNumInstances());
+                for (int k = 0; k < n && nextInst < city.instances.size(); ++k) addInstance(t, nextInst++);
+            } else if (nextMesh < city.meshes.size()) {
+                addMesh(t, nextMesh++);
             }
         }
         tiles.push_back(t);

@@ -30,8 +30,6 @@ namespace {
 constexpr int kFormatVersion = 1;
 // Generic vertex attribute locations of the four columns of the per-instance
 // matrix (texture-coordinate aliases 4..7 on drivers that alias).
-constexpr unsigned kInstanceAttrib0 = 12;
-const char* const kTreeGeometryPrefix = "tree_prototype_";
 
 // Vertex shader of instanced tree drawing (compatibility profile; works with
 // GLSL 1.20 since the per-instance data are plain attributes with divisor 1).
@@ -261,64 +259,76 @@ Result<LoadedCity> loadCityFile(const std::string& path) {
     std::vector<bool> protoSeen(size_t(protoCount), false);
 
     for (unsigned ci = 0; ci < root->getNumChildren(); ++ci) {
-        auto* xf = dynamic_cast<osg::MatrixTransform*>(root->getChild(ci));
-        if (!xf || xf->getName().rfind("tile_", 0) != 0) continue;
+        osg::MatrixTransform* xf = asCityTile(root->getChild(ci));
+        if (!xf) continue;
         const osg::Vec3d t = xf->getMatrix().getTrans();
         const glm::dvec3 tileOrigin(t.x(), t.y(), t.z());
         const glm::dmat4 tileM = glm::translate(glm::dmat4(1.0), tileOrigin);
-        for (unsigned gi = 0; gi < xf->getNumChildren(); ++gi) {
-            osg::Geode* geode = xf->getChild(gi)->asGeode();
-            if (!geode) continue;
-            for (unsigned di = 0; di < geode->getNumDrawables(); ++di) {
-                osg::Geometry* g = geode->getDrawable(di)->asGeometry();
-                if (!g || g->getNumPrimitiveSets() == 0) continue;
-                auto* verts = dynamic_cast<osg::Vec3Array*>(g->getVertexArray());
-                auto* colors = dynamic_cast<osg::Vec4ubArray*>(g->getColorArray());
-                auto* de = dynamic_cast<osg::DrawElements*>(g->getPrimitiveSet(0));
-                if (!verts || !de || de->getMode() != GL_TRIANGLES) return bad("geometry '" + g->getName() + "' in " + xf->getName() + " is malformed");
-                if (colors && colors->size() != verts->size()) return bad("geometry '" + g->getName() + "': colour count != vertex count");
-                LoadedMesh mesh;
-                mesh.positions.resize(verts->size());
-                for (size_t i = 0; i < verts->size(); ++i) mesh.positions[i] = glm::vec3((*verts)[i].x(), (*verts)[i].y(), (*verts)[i].z());
-                mesh.colors.assign(verts->size(), glm::u8vec4(255));
-                if (colors)
-                    for (size_t i = 0; i < colors->size(); ++i) mesh.colors[i] = glm::u8vec4((*colors)[i].r(), (*colors)[i].g(), (*colors)[i].b(), (*colors)[i].a());
-                mesh.indices.resize(de->getNumIndices());
-                for (unsigned i = 0; i < de->getNumIndices(); ++i) {
-                    mesh.indices[i] = de->getElement(i);
-                    if (mesh.indices[i] >= verts->size()) return bad("geometry '" + g->getName() + "': index out of range");
-                }
-                if (mesh.indices.size() % 3 != 0) return bad("geometry '" + g->getName() + "': index count not a multiple of 3");
-                const std::string& name = g->getName();
-                if (name.rfind(kTreeGeometryPrefix, 0) == 0) {
-                    long pi = std::strtol(name.c_str() + std::strlen(kTreeGeometryPrefix), nullptr, 10);
-                    if (pi < 0 || pi >= protoCount) return bad("tree geometry '" + name + "' names an unknown prototype");
-                    osg::Vec4Array* cols[4];
-                    for (unsigned c = 0; c < 4; ++c) {
-                        cols[c] = dynamic_cast<osg::Vec4Array*>(g->getVertexAttribArray(kInstanceAttrib0 + c));
-                        if (!cols[c]) return bad("tree geometry '" + name + "' has no instance matrices");
-                    }
-                    size_t n = size_t(std::max(0, de->getNumInstances()));
-                    for (auto* c : cols) if (c->size() != n) return bad("tree geometry '" + name + "': instance count mismatch");
-                    for (size_t k = 0; k < n; ++k) {
-                        glm::dmat4 m(1.0);
-                        for (int c = 0; c < 4; ++c) {
-                            const osg::Vec4& v = (*cols[c])[unsigned(k)];
-                            m[c] = glm::dvec4(v.x(), v.y(), v.z(), v.w());
-                        }
-                        out.instances.push_back({uint32_t(pi), tileM * m});
-                    }
-                    out.triangles += n * (mesh.indices.size() / 3);
-                    if (!protoSeen[size_t(pi)]) {
-                        protoSeen[size_t(pi)] = true;
-                        out.prototypes[size_t(pi)] = std::move(mesh);
-                    }
-                } else {
-                    mesh.origin = tileOrigin;
-                    out.triangles += mesh.indices.size() / 3;
-                    out.meshes.push_back(std::move(mesh));
-                }
+        for (osg::Geometry* g : tileGeometries(*xf)) {
+            auto* verts = dynamic_cast<osg::Vec3Array*>(g->getVertexArray());
+            auto* colors = dynamic_cast<osg::Vec4ubArray*>(g->getColorArray());
+            auto* de = dynamic_cast<osg::DrawElements*>(g->getPrimitiveSet(0));
+            if (!verts || !de || de->getMode() != GL_TRIANGLES) return bad("geometry '" + g->getName() + "' in " + xf->getName() + " is malformed");
+            if (colors && colors->size() != verts->size()) return bad("geometry '" + g->getName() + "': colour count != vertex count");
+            LoadedMesh mesh;
+            mesh.positions.resize(verts->size());
+            for (size_t i = 0; i < verts->size(); ++i) mesh.positions[i] = glm::vec3((*verts)[i].x(), (*verts)[i].y(), (*verts)[i].z());
+            mesh.colors.assign(verts->size(), glm::u8vec4(255));
+            if (colors)
+                for (size_t i = 0; i < colors->size(); ++i) mesh.colors[i] = glm::u8vec4((*colors)[i].r(), (*colors)[i].g(), (*colors)[i].b(), (*colors)[i].a());
+            mesh.indices.resize(de->getNumIndices());
+            for (unsigned i = 0; i < de->getNumIndices(); ++i) {
+                mesh.indices[i] = de->getElement(i);
+                if (mesh.indices[i] >= verts->size()) return bad("geometry '" + g->getName() + "': index out of range");
             }
+            if (mesh.indices.size() % 3 != 0) return bad("geometry '" + g->getName() + "': index count not a multiple of 3");
+            const std::string& name = g->getName();
+            if (name.rfind(kTreeGeometryPrefix, 0) == 0) {
+                long pi = std::strtol(name.c_str() + std::strlen(kTreeGeometryPrefix), nullptr, 10);
+                if (pi < 0 || pi >= protoCount) return bad("tree geometry '" + name + "' names an unknown prototype");
+                osg::Vec4Array* cols[4];
+                for (unsigned c = 0; c < 4; ++c) {
+                    cols[c] = dynamic_cast<osg::Vec4Array*>(g->getVertexAttribArray(kInstanceAttrib0 + c));
+                    if (!cols[c]) return bad("tree geometry '" + name + "' has no instance matrices");
+                }
+                size_t n = size_t(std::max(0, de->getNumInstances()));
+                for (auto* c : cols) if (c->size() != n) return bad("tree geometry '" + name + "': instance count mismatch");
+                for (size_t k = 0; k < n; ++k) {
+                    glm::dmat4 m(1.0);
+                    for (int c = 0; c < 4; ++c) {
+                        const osg::Vec4& v = (*cols[c])[unsigned(k)];
+                        m[c] = glm::dvec4(v.x(), v.y(), v.z(), v.w());
+                    }
+                    out.instances.push_back({uint32_t(pi), tileM * m});
+                }
+                out.triangles += n * (mesh.indices.size() / 3);
+                if (!protoSeen[size_t(pi)]) {
+                    protoSeen[size_t(pi)] = true;
+                    out.prototypes[size_t(pi)] = std::move(mesh);
+                }
+            } else {
+                mesh.origin = tileOrigin;
+                out.triangles += mesh.indices.size() / 3;
+                out.meshes.push_back(std::move(mesh));
+            }
+        }
+    }
+    return out;
+}
+
+osg::MatrixTransform* asCityTile(osg::Node* node) {
+    auto* xf = dynamic_cast<osg::MatrixTransform*>(node);
+    return xf && xf->getName().rfind("tile_", 0) == 0 ? xf : nullptr;
+}
+
+std::vector<osg::Geometry*> tileGeometries(osg::MatrixTransform& tile) {
+    std::vector<osg::Geometry*> out;
+    for (unsigned gi = 0; gi < tile.getNumChildren(); ++gi) {
+        osg::Geode* geode = tile.getChild(gi)->asGeode();
+        if (!geode) continue;
+        for (unsigned di = 0; di < geode->getNumDrawables(); ++di) {
+            osg::Geometry* g = geode->getDrawable(di)->asGeometry();
+            if (g && g->getNumPrimitiveSets() > 0) out.push_back(g);
         }
     }
     return out;

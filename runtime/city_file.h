@@ -18,6 +18,8 @@
 #include <string>
 #include <vector>
 
+#include <osg/Geometry>
+#include <osg/MatrixTransform>
 #include <osg/Node>
 #include <osg/ref_ptr>
 
@@ -53,6 +55,18 @@ struct LoadedCity {
 };
 
 Result<LoadedCity> loadCityFile(const std::string& path);
+
+// Scene-file layout shared by every reader of city files (loader, hybrid
+// re-chunking, bake): tree geometries are named kTreeGeometryPrefix + prototype
+// index and carry their per-instance matrix columns in vertex attributes
+// kInstanceAttrib0 .. kInstanceAttrib0 + 3.
+constexpr const char* kTreeGeometryPrefix = "tree_prototype_";
+constexpr unsigned kInstanceAttrib0 = 12;
+// The tile transform ("tile_IX_IY") if `node` is one, else null.
+osg::MatrixTransform* asCityTile(osg::Node* node);
+// The geometries with at least one primitive set under a tile transform, in
+// file order: the order in which loadCityFile() lists meshes and instances.
+std::vector<osg::Geometry*> tileGeometries(osg::MatrixTransform& tile);
 
 // glTF 2.0 binary (.glb) of the city: one mesh per tile and material with
 // COLOR_0, tree prototypes as meshes referenced by instance nodes. Atomic write.

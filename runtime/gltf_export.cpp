@@ -105,7 +105,7 @@ Status writeGltf(const City& city, const std::string& path) {
         if (m.empty()) continue;
         checkMesh(m);
         nlohmann::ordered_json mesh;
-        mesh["name"] = "tree_prototype_" + std::to_string(i);
+        mesh["name"] = kTreeGeometryPrefix + std::to_string(i);
         mesh["primitives"] = nlohmann::ordered_json::array({b.addPrimitive(m)});
         meshes.push_back(mesh);
         protoMesh[i] = long(meshes.size() - 1);

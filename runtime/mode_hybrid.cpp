@@ -24,9 +24,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
-constexpr unsigned kInstanceAttrib0 = 12;  // as in city_file.cpp (instance matrix columns)
-const char* const kTreePrefix = "tree_prototype_";
-
 struct TreeBatch {
     osg::Geometry* source = nullptr;
     std::vector<osg::Vec4> cols[4];
@@ -81,104 +78,98 @@ NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk) {
     int64_t tileId = 0;
     for (unsigned ci = 0; ci < root->getNumChildren(); ++ci) {
         osg::Node* child = root->getChild(ci);
-        auto* xf = dynamic_cast<osg::MatrixTransform*>(child);
-        if (!xf || xf->getName().rfind("tile_", 0) != 0) {
+        osg::MatrixTransform* xf = asCityTile(child);
+        if (!xf) {
             keep(child);
             continue;
         }
         ++tileId;
         const osg::Vec3d tt = xf->getMatrix().getTrans();
         const glm::dvec3 tileOrigin(tt.x(), tt.y(), tt.z());
-        for (unsigned gi = 0; gi < xf->getNumChildren(); ++gi) {
-            osg::Geode* geode = xf->getChild(gi)->asGeode();
-            if (!geode) continue;
-            for (unsigned di = 0; di < geode->getNumDrawables(); ++di) {
-                osg::Geometry* g = geode->getDrawable(di)->asGeometry();
-                if (!g || g->getNumPrimitiveSets() == 0) continue;
-                auto* verts = dynamic_cast<osg::Vec3Array*>(g->getVertexArray());
-                auto* colors = dynamic_cast<osg::Vec4ubArray*>(g->getColorArray());
-                auto* de = dynamic_cast<osg::DrawElements*>(g->getPrimitiveSet(0));
-                if (!verts || !de || de->getMode() != GL_TRIANGLES) continue;
-                if (g->getName().rfind(kTreePrefix, 0) == 0) {
-                    osg::Vec4Array* cols[4];
-                    bool ok = true;
-                    for (unsigned c = 0; c < 4; ++c) {
-                        cols[c] = dynamic_cast<osg::Vec4Array*>(g->getVertexAttribArray(kInstanceAttrib0 + c));
-                        ok = ok && cols[c];
-                    }
-                    if (!ok) continue;
-                    osg::BoundingBox pb;
-                    for (const auto& v : *verts) pb.expandBy(v);
-                    size_t n = std::min<size_t>(cols[0]->size(), size_t(std::max(0, de->getNumInstances())));
-                    uint64_t protoTris = de->getNumIndices() / 3;
-                    for (size_t k = 0; k < n; ++k) {
-                        glm::mat4 m;
-                        for (int c = 0; c < 4; ++c) {
-                            const osg::Vec4& v = (*cols[c])[unsigned(k)];
-                            m[c] = glm::vec4(v.x(), v.y(), v.z(), v.w());
-                        }
-                        glm::dvec3 world = tileOrigin + glm::dvec3(m[3]);
-                        int64_t cx = int64_t(std::floor(world.x / chunk)), cy = int64_t(std::floor(world.y / chunk));
-                        ChunkBuild& cb = chunkFor({cx, cy, 0}, glm::dvec3(cx * chunk, cy * chunk, 0.0));
-                        TreeBatch& tb = cb.trees[g];
-                        tb.source = g;
-                        glm::dvec3 shift = tileOrigin - cb.origin;
-                        glm::mat4 ml = m;
-                        ml[3] = glm::vec4(glm::dvec3(m[3]) + shift, 1.0);
-                        for (int c = 0; c < 4; ++c) tb.cols[c].push_back(osg::Vec4(ml[c].x, ml[c].y, ml[c].z, ml[c].w));
-                        for (int corner = 0; corner < 8; ++corner) {
-                            osg::Vec3 v = pb.corner(unsigned(corner));
-                            glm::dvec4 w = glm::dmat4(m) * glm::dvec4(v.x(), v.y(), v.z(), 1.0);
-                            cb.expand(tileOrigin + glm::dvec3(w));
-                        }
-                        cb.triangles += protoTris;
-                    }
-                    continue;
+        for (osg::Geometry* g : tileGeometries(*xf)) {
+            auto* verts = dynamic_cast<osg::Vec3Array*>(g->getVertexArray());
+            auto* colors = dynamic_cast<osg::Vec4ubArray*>(g->getColorArray());
+            auto* de = dynamic_cast<osg::DrawElements*>(g->getPrimitiveSet(0));
+            if (!verts || !de || de->getMode() != GL_TRIANGLES) continue;
+            if (g->getName().rfind(kTreeGeometryPrefix, 0) == 0) {
+                osg::Vec4Array* cols[4];
+                bool ok = true;
+                for (unsigned c = 0; c < 4; ++c) {
+                    cols[c] = dynamic_cast<osg::Vec4Array*>(g->getVertexAttribArray(kInstanceAttrib0 + c));
+                    ok = ok && cols[c];
                 }
-                // Plain mesh: triangles to chunks by centroid (large ones to the tile's own chunk).
-                const unsigned ni = de->getNumIndices();
-                std::vector<std::pair<ChunkKey, unsigned>> tris;
-                tris.reserve(ni / 3);
-                for (unsigned t = 0; t + 2 < ni; t += 3) {
-                    osg::Vec3 a = (*verts)[de->index(t)], b = (*verts)[de->index(t + 1)], c = (*verts)[de->index(t + 2)];
-                    osg::BoundingBox bb;
-                    bb.expandBy(a);
-                    bb.expandBy(b);
-                    bb.expandBy(c);
-                    glm::dvec3 cen = tileOrigin + glm::dvec3((a.x() + b.x() + c.x()) / 3.0, (a.y() + b.y() + c.y()) / 3.0, 0.0);
-                    bool large = std::max(bb.xMax() - bb.xMin(), bb.yMax() - bb.yMin()) > chunk;
-                    int64_t cx = int64_t(std::floor(cen.x / chunk)), cy = int64_t(std::floor(cen.y / chunk));
-                    tris.push_back({large ? ChunkKey{0, 0, tileId} : ChunkKey{cx, cy, 0}, t});
-                }
-                std::stable_sort(tris.begin(), tris.end(),
-                                 [](const auto& x, const auto& y) { return x.first < y.first; });
-                std::vector<int64_t> remap(verts->size(), -1);
-                std::vector<unsigned> touched;
-                for (size_t s = 0; s < tris.size();) {
-                    const ChunkKey key = tris[s].first;
-                    glm::dvec3 origin = std::get<2>(key) ? tileOrigin
-                                                         : glm::dvec3(std::get<0>(key) * chunk, std::get<1>(key) * chunk, 0.0);
-                    ChunkBuild& cb = chunkFor(key, origin);
-                    const glm::dvec3 shift = tileOrigin - cb.origin;
-                    for (; s < tris.size() && tris[s].first == key; ++s) {
-                        for (unsigned k = 0; k < 3; ++k) {
-                            unsigned vi = de->index(tris[s].second + k);
-                            if (remap[vi] < 0) {
-                                remap[vi] = int64_t(cb.verts->size());
-                                touched.push_back(vi);
-                                const osg::Vec3& p = (*verts)[vi];
-                                glm::dvec3 local = glm::dvec3(p.x(), p.y(), p.z()) + shift;
-                                cb.verts->push_back(osg::Vec3(float(local.x), float(local.y), float(local.z)));
-                                cb.colors->push_back(colors && vi < colors->size() ? (*colors)[vi] : osg::Vec4ub(255, 255, 255, 255));
-                                cb.expand(cb.origin + local);
-                            }
-                            cb.indices.push_back(GLuint(remap[vi]));
-                        }
-                        ++cb.triangles;
+                if (!ok) continue;
+                osg::BoundingBox pb;
+                for (const auto& v : *verts) pb.expandBy(v);
+                size_t n = std::min<size_t>(cols[0]->size(), size_t(std::max(0, de->getNumInstances())));
+                uint64_t protoTris = de->getNumIndices() / 3;
+                for (size_t k = 0; k < n; ++k) {
+                    glm::mat4 m;
+                    for (int c = 0; c < 4; ++c) {
+                        const osg::Vec4& v = (*cols[c])[unsigned(k)];
+                        m[c] = glm::vec4(v.x(), v.y(), v.z(), v.w());
                     }
-                    for (unsigned vi : touched) remap[vi] = -1;
-                    touched.clear();
+                    glm::dvec3 world = tileOrigin + glm::dvec3(m[3]);
+                    int64_t cx = int64_t(std::floor(world.x / chunk)), cy = int64_t(std::floor(world.y / chunk));
+                    ChunkBuild& cb = chunkFor({cx, cy, 0}, glm::dvec3(cx * chunk, cy * chunk, 0.0));
+                    TreeBatch& tb = cb.trees[g];
+                    tb.source = g;
+                    glm::dvec3 shift = tileOrigin - cb.origin;
+                    glm::mat4 ml = m;
+                    ml[3] = glm::vec4(glm::dvec3(m[3]) + shift, 1.0);
+                    for (int c = 0; c < 4; ++c) tb.cols[c].push_back(osg::Vec4(ml[c].x, ml[c].y, ml[c].z, ml[c].w));
+                    for (int corner = 0; corner < 8; ++corner) {
+                        osg::Vec3 v = pb.corner(unsigned(corner));
+                        glm::dvec4 w = glm::dmat4(m) * glm::dvec4(v.x(), v.y(), v.z(), 1.0);
+                        cb.expand(tileOrigin + glm::dvec3(w));
+                    }
+                    cb.triangles += protoTris;
                 }
+                continue;
+            }
+            // Plain mesh: triangles to chunks by centroid (large ones to the tile's own chunk).
+            const unsigned ni = de->getNumIndices();
+            std::vector<std::pair<ChunkKey, unsigned>> tris;
+            tris.reserve(ni / 3);
+            for (unsigned t = 0; t + 2 < ni; t += 3) {
+                osg::Vec3 a = (*verts)[de->index(t)], b = (*verts)[de->index(t + 1)], c = (*verts)[de->index(t + 2)];
+                osg::BoundingBox bb;
+                bb.expandBy(a);
+                bb.expandBy(b);
+                bb.expandBy(c);
+                glm::dvec3 cen = tileOrigin + glm::dvec3((a.x() + b.x() + c.x()) / 3.0, (a.y() + b.y() + c.y()) / 3.0, 0.0);
+                bool large = std::max(bb.xMax() - bb.xMin(), bb.yMax() - bb.yMin()) > chunk;
+                int64_t cx = int64_t(std::floor(cen.x / chunk)), cy = int64_t(std::floor(cen.y / chunk));
+                tris.push_back({large ? ChunkKey{0, 0, tileId} : ChunkKey{cx, cy, 0}, t});
+            }
+            std::stable_sort(tris.begin(), tris.end(),
+                             [](const auto& x, const auto& y) { return x.first < y.first; });
+            std::vector<int64_t> remap(verts->size(), -1);
+            std::vector<unsigned> touched;
+            for (size_t s = 0; s < tris.size();) {
+                const ChunkKey key = tris[s].first;
+                glm::dvec3 origin = std::get<2>(key) ? tileOrigin
+                                                     : glm::dvec3(std::get<0>(key) * chunk, std::get<1>(key) * chunk, 0.0);
+                ChunkBuild& cb = chunkFor(key, origin);
+                const glm::dvec3 shift = tileOrigin - cb.origin;
+                for (; s < tris.size() && tris[s].first == key; ++s) {
+                    for (unsigned k = 0; k < 3; ++k) {
+                        unsigned vi = de->index(tris[s].second + k);
+                        if (remap[vi] < 0) {
+                            remap[vi] = int64_t(cb.verts->size());
+                            touched.push_back(vi);
+                            const osg::Vec3& p = (*verts)[vi];
+                            glm::dvec3 local = glm::dvec3(p.x(), p.y(), p.z()) + shift;
+                            cb.verts->push_back(osg::Vec3(float(local.x), float(local.y), float(local.z)));
+                            cb.colors->push_back(colors && vi < colors->size() ? (*colors)[vi] : osg::Vec4ub(255, 255, 255, 255));
+                            cb.expand(cb.origin + local);
+                        }
+                        cb.indices.push_back(GLuint(remap[vi]));
+                    }
+                    ++cb.triangles;
+                }
+                for (unsigned vi : touched) remap[vi] = -1;
+                touched.clear();
             }
         }
     }
