@@ -29,29 +29,16 @@
 #include "runtime/metrics.h"
 #include "runtime/offscreen.h"
 
+#include "tests/common/temp_dir.h"
+
 namespace vista {
 namespace {
 
-std::string readBytes(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
+using test::readBytes;
 
-class TempDir {
+class TempDir : public test::TempDir {
 public:
-    TempDir() {
-        char tmpl[] = "/tmp/vista_bake_test_XXXXXX";
-        const char* d = ::mkdtemp(tmpl);
-        EXPECT_NE(d, nullptr);
-        _path = d ? d : "/tmp";
-    }
-    ~TempDir() { std::system(("rm -rf '" + _path + "'").c_str()); }
-    std::string file(const std::string& name) const { return _path + "/" + name; }
-
-private:
-    std::string _path;
+    TempDir() : test::TempDir("vista_bake_test") {}
 };
 
 // Box triangles (outward faces) appended to a soup, one colour per vertex from `color`.

@@ -23,34 +23,21 @@
 #include "runtime/city_file.h"
 #include "runtime/city_file_io.h"
 
+#include "tests/common/temp_dir.h"
+
 namespace vista {
 namespace {
 
-std::string readBytes(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
 bool fileExists(const std::string& path) {
     struct stat st;
     return ::stat(path.c_str(), &st) == 0;
 }
 
-class TempDir {
-public:
-    TempDir() {
-        char tmpl[] = "/tmp/vista_city_file_XXXXXX";
-        const char* d = ::mkdtemp(tmpl);
-        EXPECT_NE(d, nullptr);
-        _path = d ? d : "/tmp";
-    }
-    ~TempDir() { std::system(("chmod -R u+w '" + _path + "' && rm -rf '" + _path + "'").c_str()); }
-    std::string file(const std::string& name) const { return _path + "/" + name; }
-    const std::string& path() const { return _path; }
+using test::readBytes;
 
-private:
-    std::string _path;
+class TempDir : public test::TempDir {
+public:
+    TempDir() : test::TempDir("vista_city_file") {}
 };
 
 // A box mesh (8 corners, 12 triangles) with a colour derived from `tag`.
