@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 
+#include <boost/math/distributions/fisher_f.hpp>
 #include <tbb/parallel_for.h>
 
 #include "citygen/lighting.h"
@@ -32,8 +33,52 @@ struct TexelAcc {
     }
 };
 
+// Critical values of F(d1, d2) at 1 - alpha, tabulated for the degrees of
+// freedom one point can reach (d1 < texels, d2 < texels * maxSamples).
+class FTable {
+public:
+    FTable(double alpha, int maxD1, int maxD2) : _d2(maxD2) {
+        if (alpha <= 0) return;
+        _q.resize(size_t(maxD1) * size_t(maxD2));
+        for (int a = 1; a <= maxD1; ++a)
+            for (int b = 1; b <= maxD2; ++b)
+                _q[size_t(a - 1) * size_t(maxD2) + size_t(b - 1)] =
+                    boost::math::quantile(boost::math::fisher_f(double(a), double(b)), 1.0 - alpha);
+    }
+    bool enabled() const { return !_q.empty(); }
+    double at(int d1, int d2) const { return _q[size_t(d1 - 1) * size_t(_d2) + size_t(d2 - 1)]; }
+
+private:
+    int _d2;
+    std::vector<double> _q;
+};
+
+// One-way ANOVA on the texels' luma: true when the texel means differ more
+// than their samples' scatter explains at this level (or the test cannot be
+// made: fewer than 2 seen texels or no within-texel degrees of freedom).
+template <class Acc>
+bool viewDependent(const std::vector<Acc>& acc, const FTable& table) {
+    int k = 0;
+    int64_t n = 0;
+    double l = 0, ssw = 0, ssb = 0;
+    for (const auto& a : acc) {
+        if (a.n == 0) continue;
+        ++k;
+        n += a.n;
+        l += a.l;
+        ssw += std::max(0.0, a.l2 - a.l * a.l / a.n);
+    }
+    if (k < 2 || n - k < 1) return true;
+    const double grand = l / double(n);
+    for (const auto& a : acc)
+        if (a.n > 0) ssb += a.n * (a.l / a.n - grand) * (a.l / a.n - grand);
+    const double msb = ssb / double(k - 1), msw = ssw / double(n - k);
+    if (msw <= 1e-18) return msb > 1e-18;
+    return msb / msw > table.at(k - 1, int(n - k));
+}
+
 struct PointResult {
-    bool visible = false, single = true;
+    bool visible = false, single = true, noise = false;
     glm::dvec3 mean{0.0};
     std::vector<glm::dvec3> texels;
     int64_t rays = 0, samples = 0;
@@ -49,6 +94,7 @@ void computeAppearance(const FarScene& scene, const SamplingSetup& s, const std:
     const glm::dvec2 lo = s.rectLo, size = glm::max(s.rectHi - s.rectLo, glm::dvec2(1e-6));
     const glm::dvec2 texel(size.x / p.texelsX, size.y / p.texelsY);
     std::vector<PointResult> res(points.size());
+    const FTable fTable(p.significance, std::max(1, nt - 1), std::max(1, nt * p.maxSamples));
 
     tbb::parallel_for(size_t(0), points.size(), [&](size_t k) {
         Rng rng(seed, hashKeys(entity, k), Stream::Bake);
@@ -144,7 +190,8 @@ void computeAppearance(const FarScene& scene, const SamplingSetup& s, const std:
         }
         r.visible = true;
         const double pooledStd = n > 1 ? std::sqrt(std::max(0.0, (l2 - l * l / double(n)) / double(n - 1))) : 0.0;
-        if (!(pooledStd < p.singleColorThreshold) && nt > 1) {
+        const bool noiseOnly = nt > 1 && fTable.enabled() && !(pooledStd < p.singleColorThreshold) && !viewDependent(acc, fTable);
+        if (!(pooledStd < p.singleColorThreshold) && nt > 1 && !noiseOnly) {
             for (int t = 0; t < nt; ++t) {
                 TexelAcc& a = acc[size_t(t)];
                 while (a.n < p.maxSamples && a.attempts < maxAttempts && !(a.n >= p.minSamples && a.stdErr() < p.varianceThreshold))
@@ -175,8 +222,10 @@ void computeAppearance(const FarScene& scene, const SamplingSetup& s, const std:
         for (const auto& c : r.texels) var += (c - tm) * (c - tm);
         var /= double(nt);
         const double maxStd = std::sqrt(std::max(var.x, std::max(var.y, var.z)));
-        r.single = nt == 1 || maxStd < p.singleColorThreshold;
-        if (r.single) r.mean = tm;
+        r.noise = noiseOnly || (nt > 1 && fTable.enabled() && !(maxStd < p.singleColorThreshold) && !viewDependent(acc, fTable));
+        r.single = nt == 1 || maxStd < p.singleColorThreshold || r.noise;
+        // One colour: the mean of every sample (noise) or of the texel means.
+        if (r.single && !r.noise) r.mean = tm;
     });
 
     out.texelsX = p.texelsX;
@@ -196,6 +245,7 @@ void computeAppearance(const FarScene& scene, const SamplingSetup& s, const std:
         out.colors.push_back(toU8(r.mean));
         if (r.single) {
             ++stats.singleColor;
+            if (r.noise) ++stats.noiseOnly;
             out.block.push_back(-1);
         } else {
             ++stats.textured;

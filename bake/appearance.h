@@ -10,8 +10,15 @@
 // pixels (the monitor filter q_j); its first hit's prelit colour, or the sky
 // colour (lighting.h) on a miss. Pass 1 takes minSamples visible samples per
 // texel; if the pooled luma standard deviation is below singleColorThreshold
-// the point gets one colour. Otherwise each texel continues until the standard
-// error of its luma mean is below varianceThreshold (or maxSamples). Texels
+// the point gets one colour. With significance > 0 a one-way analysis of
+// variance over the texels decides whether the colour depends on the viewpoint
+// at all: if the F statistic of the texels' luma (between-texel over
+// within-texel mean square) is below the F(k-1, N-k) quantile at 1 -
+// significance, the spread is Monte Carlo noise (e.g. a pixel filter covering
+// several surfaces, the same from every viewpoint) and the point gets one
+// colour, the mean of all its samples. Otherwise each texel continues until the
+// standard error of its luma mean is below varianceThreshold (or maxSamples),
+// and the test is repeated on the final samples. Texels
 // whose samples never see p take the mean of the others; a point never seen
 // from any sample is dropped (not visible from the view cell).
 // Visibility pre-pass (when `cell` is given): a point hidden (within the far
@@ -40,6 +47,7 @@ struct AppearanceParams {
     int maxSamples = 8;                     // per texel
     double varianceThreshold = 2.0 / 255;   // std error of the texel luma mean (0..1)
     double singleColorThreshold = 3.0 / 255;// std dev (0..1) below which one colour suffices
+    double significance = 0.01;             // F-test level for view dependence (0 = off)
     double viewSigma = 0.5;                 // texel widths
     double pixelSigma = 0.5;                // output pixels
     double pixelAngle = 0.0024;             // radians per output pixel (from SamplingParams)
@@ -52,6 +60,7 @@ struct AppearanceStats {
     size_t dropped = 0;        // points never visible
     size_t singleColor = 0;
     size_t textured = 0;
+    size_t noiseOnly = 0;      // points made single-coloured by the F test
 };
 
 // Fills `out` (positions, colours, blocks, texels, plane) from `points` (frame

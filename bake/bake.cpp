@@ -21,11 +21,11 @@ std::string BakeParams::canonical() const {
     o.precision(17);
     o << "eye=" << cells.eyeMin << "," << cells.eyeMax << ";minLen=" << cells.minLength << ";minW=" << cells.minWidth
       << ";out=" << sampling.outWidth << "x" << sampling.outHeight << ";fov=" << sampling.fovYDeg << ";os=" << sampling.oversample
-      << ";fp=" << sampling.perspectiveFactor << ";diag=" << sampling.diagonalFactor << ";layers=" << sampling.maxLayers
+      << ";fp=" << sampling.perspective << ";diag=" << sampling.diagonalFactor << ";layers=" << sampling.maxLayers
       << ";maxRays=" << sampling.maxRaysPerCamera << ";removal=" << sampling.removeRedundant << ";texels=" << appearance.texelsX
       << "x" << appearance.texelsY << ";mc=" << appearance.minSamples << "," << appearance.maxSamples << ","
       << appearance.varianceThreshold << "," << appearance.singleColorThreshold << "," << appearance.viewSigma << ","
-      << appearance.pixelSigma << ";margin=" << margin << ";depth=" << farDepth << ";opening=" << openingExtra
+      << appearance.pixelSigma << "," << appearance.significance << ";margin=" << margin << ";depth=" << farDepth << ";opening=" << openingExtra
       << ";minTri=" << minTriangles << ";seed=" << seed;
     return o.str();
 }
@@ -232,6 +232,7 @@ Status bakeImpostor(const TriangleSoup& soup, const Box3& cellBox, const BakePar
     r.stats.points = r.data.positions.size();
     r.stats.textured = size_t(std::count_if(r.data.block.begin(), r.data.block.end(), [](int32_t b) { return b >= 0; }));
     r.stats.dropped = as.dropped;
+    r.stats.noiseSingle = as.noiseOnly;
     screenStats(r.data, cellBox, s, p.sampling, r.stats);
     return Status::ok();
 }

@@ -68,6 +68,7 @@ struct ImpostorStats {
     double requiredStep = 0, usedStep = 0;    // LDI angular step (tangent units)
     int64_t ldiRays = 0, mcRays = 0, mcSamples = 0;
     size_t ldiSamples = 0, afterRemoval = 0, points = 0, textured = 0, dropped = 0;
+    size_t noiseSingle = 0;                          // single-coloured by the F test (appearance.h)
     size_t screenPixels = 0, screenBBoxPixels = 0;  // from the cell centre, 640x480 target view
     double bakeMs = 0;                               // not part of the baked scene
 };

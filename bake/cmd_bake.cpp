@@ -91,6 +91,7 @@ nlohmann::json statsJson(const ImpostorResult& r) {
     j["points"] = s.points;
     j["textured_points"] = s.textured;
     j["dropped_invisible"] = s.dropped;
+    j["noise_single_points"] = s.noiseSingle;
     j["mc_rays"] = s.mcRays;
     j["mc_samples"] = s.mcSamples;
     j["screen_pixels"] = s.screenPixels;
@@ -127,6 +128,11 @@ int runBake(int argc, char** argv) {
     app.add_option("--far-depth", p.farDepth, "metres of far field beyond the margin")->capture_default_str();
     app.add_option("--min-triangles", p.minTriangles, "skip street ends whose far field has fewer triangles")->capture_default_str();
     app.add_option("--oversample", p.sampling.oversample, "LDI resolution factor over the criterion")->capture_default_str();
+    app.add_option("--perspective", p.sampling.perspective, "perspective factor fp of the sampling criterion (thesis: 1.17)")
+        ->capture_default_str();
+    app.add_option("--texel-significance", p.appearance.significance,
+                   "F-test level for view-dependent texels (0 = off: the colour spread alone decides)")
+        ->capture_default_str();
     app.add_option("--layers", p.sampling.maxLayers, "LDI layers per pixel")->capture_default_str();
     app.add_option("--max-rays", p.sampling.maxRaysPerCamera, "cap on LDI rays per camera")->capture_default_str();
     bool noRemoval = false;
@@ -152,7 +158,8 @@ int runBake(int argc, char** argv) {
         return Status::error(std::string(opt) + " " + std::to_string(v) + " out of range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
     };
     for (Status s : {range("--jobs", jobs, 0, 1024), range("--margin", p.margin, 0, 1e5), range("--far-depth", p.farDepth, 1, 1e6),
-                     range("--oversample", p.sampling.oversample, 0.05, 16), range("--layers", p.sampling.maxLayers, 1, 64),
+                     range("--oversample", p.sampling.oversample, 0.05, 16), range("--perspective", p.sampling.perspective, 1, 4),
+                     range("--texel-significance", p.appearance.significance, 0, 0.5), range("--layers", p.sampling.maxLayers, 1, 64),
                      range("--max-rays", double(p.sampling.maxRaysPerCamera), 1, 1e9),
                      range("--mc-threshold", p.appearance.varianceThreshold, 0, 1), range("--mc-min", p.appearance.minSamples, 1, 4096),
                      range("--mc-max", p.appearance.maxSamples, p.appearance.minSamples, 65536),

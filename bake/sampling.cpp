@@ -181,7 +181,7 @@ double outputPixelAngle(const SamplingParams& p) {
     return 2.0 * std::tan(0.5 * p.fovYDeg * 3.14159265358979323846 / 180.0) / double(p.outHeight);
 }
 
-double perspectiveFactor(const SamplingParams& p) {
+double exactPerspectiveFactor(const SamplingParams& p) {
     const double c = std::cos(0.5 * p.fovYDeg * 3.14159265358979323846 / 180.0);
     return 1.0 / (c * c);
 }
@@ -194,7 +194,7 @@ double ldiStep(const SamplingSetup& s, const SamplingParams& p) {
     // the step is the output pixel angle itself (no D^2/(R^2+D^2) term),
     // refined by the perspective and diagonal factors.
     double a = outputPixelAngle(p);
-    if (p.perspectiveFactor) a /= perspectiveFactor(p);
+    a /= std::max(p.perspective, 1e-6);
     if (p.diagonalFactor) a /= std::sqrt(2.0);
     return a / std::max(p.oversample, 1e-6);
 }
@@ -363,7 +363,7 @@ std::vector<uint8_t> removeRedundant(const LdiResult& ldi, const SamplingSetup& 
     // (pixel edges, and the shorter pixel diagonal when the diagonal factor is on)
     // projects to at most one output pixel (/ fp) from every viewpoint tested.
     double limit = outputPixelAngle(p);
-    if (p.perspectiveFactor) limit /= perspectiveFactor(p);
+    limit /= std::max(p.perspective, 1e-6);
     limit *= 1.01;  // rounding: on planes parallel to the sampling plane the diagonal is exactly the limit
     std::array<glm::dvec3, 8> corners;
     for (int i = 0; i < 8; ++i) corners[size_t(i)] = cell.corner(i);

@@ -17,7 +17,10 @@
 //     circumcentre criterion: alpha = delta * D^2 / (R^2 + D^2) / (fp * sqrt2)
 //     / oversample, where delta = output pixel angle (2 tan(fovY/2) / H),
 //     D = nearest far-box depth in front of the plane, R = circumradius,
-//     fp = 1 / cos^2(fovY/2) (thesis: 1.17 for 45 deg), sqrt2 = pixel diagonal.
+//     fp = SamplingParams::perspective (default 1.17, the thesis' factor; the
+//     exact 1 / cos^2(fovY/2) would be 1.33 at the image corner for 60 deg, but
+//     a far field seen along the street lies near the image centre), sqrt2 =
+//     pixel diagonal.
 //  5. Multi-layer hits (FarScene::allHits) clipped to the far box.
 //  6. Removal of points sampled better (smaller footprint) and sufficiently
 //     by another camera that has a sample of the same surface there.
@@ -56,7 +59,7 @@ struct SamplingParams {
     int outWidth = 640, outHeight = 480;  // target output resolution
     double fovYDeg = 60.0;                // target output vertical field of view
     double oversample = 1.0;              // multiplies the LDI resolution (per axis)
-    bool perspectiveFactor = true;        // x fp
+    double perspective = 1.17;            // fp, the perspective factor (1 = off)
     bool diagonalFactor = true;           // x sqrt(2)
     int maxLayers = 6;                    // LDI layers per pixel (3 left holes behind adjacent boxes: test)
     int64_t maxRaysPerCamera = 1000000;   // resolution cap (the step grows if exceeded)
@@ -88,7 +91,7 @@ std::array<glm::dvec2, 3> boundingTriangle(const std::vector<glm::dvec2>& poly);
 Result<SamplingSetup> setupSampling(const Box3& cell, const Box3& far);
 
 double outputPixelAngle(const SamplingParams& p);  // radians per output pixel at the image centre
-double perspectiveFactor(const SamplingParams& p);   // 1 / cos^2(fovY / 2)
+double exactPerspectiveFactor(const SamplingParams& p);   // 1 / cos^2(fovY / 2), for reference
 // The LDI angular step (tangent units) from the circumcentre criterion.
 double ldiStep(const SamplingSetup& s, const SamplingParams& p);
 

@@ -200,11 +200,18 @@ TEST(Sampling, ResolutionFactors) {
     s.circumradius = 50;
     SamplingParams p;
     p.fovYDeg = 45;
-    EXPECT_NEAR(perspectiveFactor(p), 1.17, 0.005);  // the thesis' value for 45 degrees
+    EXPECT_NEAR(exactPerspectiveFactor(p), 1.17, 0.005);  // the thesis' value for 45 degrees
+    p.fovYDeg = 60;
+    EXPECT_NEAR(exactPerspectiveFactor(p), 4.0 / 3.0, 1e-12);  // 1 / cos^2(30 deg)
+    EXPECT_DOUBLE_EQ(p.perspective, 1.17);                      // the default is the thesis' factor
     const double delta = outputPixelAngle(p);
-    EXPECT_NEAR(ldiStep(s, p), delta / perspectiveFactor(p) / std::sqrt(2.0), 1e-12);
+    EXPECT_NEAR(delta, 2 * std::tan(M_PI / 6) / 480, 1e-15);
+    EXPECT_NEAR(ldiStep(s, p), delta / 1.17 / std::sqrt(2.0), 1e-12);
     p.oversample = 2;
-    EXPECT_NEAR(ldiStep(s, p), delta / perspectiveFactor(p) / std::sqrt(2.0) / 2, 1e-12);
+    EXPECT_NEAR(ldiStep(s, p), delta / 1.17 / std::sqrt(2.0) / 2, 1e-12);
+    p.perspective = 1;
+    p.diagonalFactor = false;
+    EXPECT_NEAR(ldiStep(s, p), delta / 2, 1e-12);
 }
 
 // A far field: a building with a window pattern on ground, in an impostor frame.
@@ -439,7 +446,7 @@ TEST(Appearance, ConstantColourSceneIsExactAndCompressesToOneColour) {
     }
 }
 
-TEST(Appearance, SilhouettesAreTexturedAndInvisiblePointsDropped) {
+TEST(Appearance, InvisiblePointsDroppedAndVisibleOnesKept) {
     TriangleSoup soup = testFarField(false);
     auto scene = FarScene::build(soup);
     const Box3 cell{{-100, -5, 1.2}, {0, 5, 2.0}};
@@ -458,8 +465,84 @@ TEST(Appearance, SilhouettesAreTexturedAndInvisiblePointsDropped) {
     ASSERT_EQ(kept.size(), 2u);
     EXPECT_EQ(kept[0], 0u);
     EXPECT_EQ(kept[1], 1u);
-    EXPECT_GE(st.textured, 1u);
     EXPECT_EQ(d.texels.size(), st.textured * 16);
+}
+
+// View dependence vs Monte Carlo noise. A wall 300 m away is dark for y < 0
+// and bright for y > 0; a 10 cm post 200 m away stands in front of y = 0.
+//  - Points on the post: their pixel filter sees mostly the wall beside the
+//    post, which is bright from viewpoints with y < 0 and dark from y > 0
+//    (parallax): the colour depends on the viewpoint, so they must be textured,
+//    with the texel luma falling from the y < 0 side to the y > 0 side.
+//  - Points on the wall's colour boundary, above the post: a 50/50 mix from
+//    every viewpoint; the per-sample spread is large but the same everywhere,
+//    so the F test makes them single-coloured (the old spread-only rule, level
+//    0, textures them).
+struct ParallaxScene {
+    TriangleSoup soup;
+    Box3 cell{{-100, -5, 1.2}, {0, 5, 2.0}};
+    Box3 far{{199, -20, -0.5}, {302, 20, 12.5}};
+    ParallaxScene() {
+        addBox(soup, {300, -20, 0}, {301, 0, 12}, [](glm::vec3) { return glm::u8vec4(20, 20, 20, 255); });
+        addBox(soup, {300, 0, 0}, {301, 20, 12}, [](glm::vec3) { return glm::u8vec4(235, 235, 235, 255); });
+        addBox(soup, {200, -0.05f, 0}, {200.1f, 0.05f, 6}, [](glm::vec3) { return glm::u8vec4(128, 128, 128, 255); });
+    }
+};
+
+TEST(Appearance, ViewDependentPointsTexturedNoiseOnlyPointsOneColour) {
+    ParallaxScene ps;
+    auto scene = FarScene::build(ps.soup);
+    ASSERT_TRUE(scene.isOk());
+    auto s = setupSampling(ps.cell, ps.far);
+    ASSERT_TRUE(s.isOk());
+    std::vector<glm::vec3> pts;
+    for (int k = 0; k < 5; ++k) pts.emplace_back(200.0f, 0.0f, 1.0f + float(k));      // post
+    for (int k = 0; k < 10; ++k) pts.emplace_back(300.0f, 0.0f, 7.0f + 0.4f * float(k));  // boundary
+    AppearanceParams ap;
+    ASSERT_GT(ap.significance, 0.0);
+    AppearanceStats st;
+    PointImpostorData d;
+    std::vector<uint32_t> kept;
+    computeAppearance(**scene, *s, pts, ap, 1, 9, d, st, &kept);
+    ASSERT_EQ(kept.size(), pts.size());
+    const int nt = ap.texelsX * ap.texelsY;
+    auto texelY = [&](int t) {  // frame y of the texel centre on the sampling plane
+        const glm::dvec2 size = s->rectHi - s->rectLo;
+        const glm::dvec2 q = s->rectLo + glm::dvec2((t % ap.texelsX + 0.5) * size.x / ap.texelsX, (t / ap.texelsX + 0.5) * size.y / ap.texelsY);
+        return s->toFrame(q).y;
+    };
+    auto luma = [](glm::u8vec4 c) { return (0.299 * c.x + 0.587 * c.y + 0.114 * c.z) / 255.0; };
+    for (int k = 0; k < 5; ++k) {
+        ASSERT_GE(d.block[size_t(k)], 0) << "post point " << k << " not textured";
+        double left = 0, right = 0;
+        int nl = 0, nr = 0;
+        for (int t = 0; t < nt; ++t) {
+            const double l = luma(d.texels[size_t(d.block[size_t(k)]) * size_t(nt) + size_t(t)]);
+            if (texelY(t) < -2) { left += l; ++nl; }
+            if (texelY(t) > 2) { right += l; ++nr; }
+        }
+        ASSERT_GT(nl, 0);
+        ASSERT_GT(nr, 0);
+        EXPECT_GT(left / nl - right / nr, 0.3) << "post point " << k;  // wall beside the post: bright vs dark
+    }
+    int boundarySingle = 0;
+    for (int k = 5; k < 15; ++k) {
+        if (d.block[size_t(k)] >= 0) continue;
+        ++boundarySingle;
+        EXPECT_NEAR(luma(d.colors[size_t(k)]), (20 + 235) / 2 / 255.0, 0.15) << "boundary point " << k;
+    }
+    EXPECT_GE(boundarySingle, 8);  // expected false-positive rate of the test: 1 %
+    EXPECT_GE(st.noiseOnly, size_t(boundarySingle));
+
+    // Level 0 (spread-only rule): the same boundary points are textured.
+    ap.significance = 0;
+    AppearanceStats st0;
+    PointImpostorData d0;
+    computeAppearance(**scene, *s, pts, ap, 1, 9, d0, st0);
+    int boundaryTextured = 0;
+    for (int k = 5; k < 15; ++k) boundaryTextured += d0.block[size_t(k)] >= 0 ? 1 : 0;
+    EXPECT_GE(boundaryTextured, 8);
+    EXPECT_EQ(st0.noiseOnly, 0u);
 }
 
 // ------------------------------------------------------ determinism, encoding
