@@ -474,6 +474,7 @@ Result<BakedFile> loadBakedFile(const std::string& path) {
         osg::Geode* g = xf && xf->getNumChildren() == 1 ? xf->getChild(0)->asGeode() : nullptr;
         auto* pi = g && g->getNumDrawables() == 1 ? dynamic_cast<PointImpostor*>(g->getDrawable(0)) : nullptr;
         if (!pi) return bad("child " + std::to_string(i) + " is not an impostor node");
+        if (const std::string w = pi->validate(); !w.empty()) return bad("child " + std::to_string(i) + ": " + w);
         ++bf.impostors;
         bf.points += pi->pointCount();
     }

@@ -97,9 +97,9 @@ nlohmann::json statsJson(const ImpostorResult& r) {
     j["screen_pixels"] = s.screenPixels;
     j["screen_bbox_pixels"] = s.screenBBoxPixels;
     j["points_per_screen_pixel"] = s.screenPixels ? double(s.points) / double(s.screenPixels) : 0.0;
-    const size_t bytes = r.data.positions.size() * (12 + 4 + 8) + r.data.texels.size() * 4;
+    const size_t bytes = r.data.positions.size() * kPointBytes + r.data.texels.size() * 4;
     j["memory_mb"] = double(bytes) / (1024.0 * 1024.0);
-    j["memory_mb_uncompressed"] = double(r.data.positions.size() * (12 + 4 + 8 + 4 * size_t(r.data.texelsX * r.data.texelsY))) / (1024.0 * 1024.0);
+    j["memory_mb_uncompressed"] = double(r.data.positions.size() * (kPointBytes + 4 * size_t(r.data.texelsX * r.data.texelsY))) / (1024.0 * 1024.0);
     j["bake_s"] = s.bakeMs / 1000.0;
     return j;
 }

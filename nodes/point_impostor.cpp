@@ -1,6 +1,7 @@
 #include "nodes/point_impostor.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include <osg/Point>
 #include <osg/Program>
@@ -23,12 +24,13 @@ uniform vec3 vista_planeV;
 uniform vec2 vista_texels;
 uniform vec2 vista_atlasSize;
 uniform int vista_useTexture;
+uniform vec4 vista_dequant;
 varying vec2 vUv;
 varying float vTextured;
 void main() {
     vec4 e4 = gl_ModelViewMatrixInverse * vec4(0.0, 0.0, 0.0, 1.0);
     vec3 eye = e4.xyz / e4.w;
-    vec3 p = gl_Vertex.xyz;
+    vec3 p = vista_dequant.xyz + vista_dequant.w * gl_Vertex.xyz;
     vec3 n = cross(vista_planeU, vista_planeV);
     float denom = dot(n, p - eye);
     vec2 ab = vec2(0.5);
@@ -41,7 +43,7 @@ void main() {
     vTextured = (vista_useTexture != 0 && gl_MultiTexCoord0.x >= 0.0) ? 1.0 : 0.0;
     vUv = (gl_MultiTexCoord0.xy + tc) / vista_atlasSize;
     gl_FrontColor = gl_Color;
-    gl_Position = ftransform();
+    gl_Position = gl_ModelViewProjectionMatrix * vec4(p, 1.0);
 }
 )";
 
@@ -62,12 +64,56 @@ PointImpostor::PointImpostor() {
 }
 
 PointImpostor::PointImpostor(const PointImpostor& o, const osg::CopyOp& op)
-    : osg::Geometry(o, op), _planeOrigin(o._planeOrigin), _planeU(o._planeU), _planeV(o._planeV), _texelsX(o._texelsX),
+    : osg::Geometry(o, op), _planeOrigin(o._planeOrigin), _planeU(o._planeU), _planeV(o._planeV), _dequant(o._dequant), _texelsX(o._texelsX),
       _texelsY(o._texelsY), _textured(o._textured) {}
 
 size_t PointImpostor::pointCount() const {
     const osg::Array* v = getVertexArray();
     return v ? v->getNumElements() : 0;
+}
+
+osg::Vec3f PointImpostor::position(size_t k) const {
+    const auto* v = dynamic_cast<const osg::Vec3sArray*>(getVertexArray());
+    VISTA_CHECK(v && k < v->size());
+    const osg::Vec3s& q = (*v)[unsigned(k)];
+    return osg::Vec3f(_dequant.x(), _dequant.y(), _dequant.z()) + osg::Vec3f(q.x(), q.y(), q.z()) * _dequant.w();
+}
+
+osg::BoundingBox PointImpostor::computeBoundingBox() const {
+    osg::BoundingBox bb;
+    const auto* v = dynamic_cast<const osg::Vec3sArray*>(getVertexArray());
+    if (!v) return bb;
+    for (size_t k = 0; k < v->size(); ++k) bb.expandBy(position(k));
+    return bb;
+}
+
+std::string PointImpostor::validate() const {
+    const auto* v = dynamic_cast<const osg::Vec3sArray*>(getVertexArray());
+    if (!v) return "impostor without 16-bit positions";
+    const size_t n = v->size();
+    const osg::Array* c = getColorArray();
+    const auto* t = dynamic_cast<const osg::Vec2sArray*>(getTexCoordArray(0));
+    if (!c || c->getNumElements() != n || c->getBinding() != osg::Array::BIND_PER_VERTEX)
+        return "impostor colour array missing or not one per point";
+    if (!t || t->size() != n) return "impostor atlas offsets missing or not one per point";
+    if (getNumPrimitiveSets() != 1) return "impostor without exactly one point set";
+    const auto* da = dynamic_cast<const osg::DrawArrays*>(getPrimitiveSet(0));
+    if (!da || da->getMode() != GL_POINTS || da->getFirst() != 0 || size_t(da->getCount()) != n)
+        return "impostor point set does not cover its points";
+    if (!(_dequant.w() > 0) || !std::isfinite(_dequant.w()) || _dequant.isNaN()) return "impostor dequantization invalid";
+    if (_texelsX < 1 || _texelsY < 1 || _texelsX > 32 || _texelsY > 32) return "impostor texel layout out of range";
+    const osg::StateSet* ss = getStateSet();
+    const auto* tex = ss ? dynamic_cast<const osg::Texture2D*>(ss->getTextureAttribute(0, osg::StateAttribute::TEXTURE)) : nullptr;
+    const osg::Image* img = tex ? tex->getImage() : nullptr;
+    if (!img || img->s() < _texelsX || img->t() < _texelsY) return "impostor atlas missing";
+    size_t textured = 0;
+    for (const auto& o : *t) {
+        if (o.x() < 0) continue;
+        ++textured;
+        if (o.x() + _texelsX > img->s() || o.y() < 0 || o.y() + _texelsY > img->t()) return "impostor atlas offset outside the atlas";
+    }
+    if (textured != _textured) return "impostor textured count does not match its offsets";
+    return "";
 }
 
 osg::ref_ptr<osg::Image> PointImpostor::buildAtlas(const PointImpostorData& d, std::vector<glm::vec2>& offsets) {
@@ -113,14 +159,24 @@ void PointImpostor::setData(const PointImpostorData& d) {
     osg::ref_ptr<osg::Image> atlas = buildAtlas(d, offsets);
     _textured = 0;
     for (const auto& o : offsets) _textured += o.x >= 0 ? 1 : 0;
+    // Quantization: centre of the bounding box, one step for all axes.
+    glm::vec3 lo(0.0f), hi(0.0f);
+    if (!d.positions.empty()) {
+        lo = hi = d.positions[0];
+        for (const auto& q : d.positions) { lo = glm::min(lo, q); hi = glm::max(hi, q); }
+    }
+    const glm::vec3 mid = 0.5f * (lo + hi), half = 0.5f * (hi - lo);
+    const float step = std::max(std::max(half.x, std::max(half.y, half.z)) / 32767.0f, 1e-6f);
+    _dequant.set(mid.x, mid.y, mid.z, step);
 
-    osg::ref_ptr<osg::Vec3Array> v = new osg::Vec3Array(unsigned(d.positions.size()));
+    osg::ref_ptr<osg::Vec3sArray> v = new osg::Vec3sArray(unsigned(d.positions.size()));
     osg::ref_ptr<osg::Vec4ubArray> c = new osg::Vec4ubArray(unsigned(d.positions.size()));
-    osg::ref_ptr<osg::Vec2Array> t = new osg::Vec2Array(unsigned(d.positions.size()));
+    osg::ref_ptr<osg::Vec2sArray> t = new osg::Vec2sArray(unsigned(d.positions.size()));
+    auto quant = [&](float x, float m) { return short(std::clamp(std::lround((x - m) / step), -32767L, 32767L)); };
     for (size_t k = 0; k < d.positions.size(); ++k) {
-        (*v)[unsigned(k)].set(d.positions[k].x, d.positions[k].y, d.positions[k].z);
+        (*v)[unsigned(k)].set(quant(d.positions[k].x, mid.x), quant(d.positions[k].y, mid.y), quant(d.positions[k].z, mid.z));
         (*c)[unsigned(k)].set(d.colors[k].x, d.colors[k].y, d.colors[k].z, 255);
-        (*t)[unsigned(k)].set(offsets[k].x, offsets[k].y);
+        (*t)[unsigned(k)].set(short(offsets[k].x), short(offsets[k].y));
     }
     c->setNormalize(true);
     setVertexArray(v.get());
@@ -150,6 +206,7 @@ void PointImpostor::setData(const PointImpostorData& d) {
     ss->addUniform(new osg::Uniform("vista_texels", osg::Vec2f(float(_texelsX), float(_texelsY))));
     ss->addUniform(new osg::Uniform("vista_atlasSize", osg::Vec2f(float(atlas->s()), float(atlas->t()))));
     ss->addUniform(new osg::Uniform("vista_useTexture", 1));
+    ss->addUniform(new osg::Uniform("vista_dequant", _dequant));
     ss->setAttributeAndModes(new osg::Point(1.0f), osg::StateAttribute::ON);
     ss->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
     setStateSet(ss.get());
@@ -165,6 +222,7 @@ REGISTER_OBJECT_WRAPPER(vista_PointImpostor, new vista::PointImpostor, vista::Po
     ADD_VEC3F_SERIALIZER(PlaneOrigin, osg::Vec3f());
     ADD_VEC3F_SERIALIZER(PlaneU, osg::Vec3f());
     ADD_VEC3F_SERIALIZER(PlaneV, osg::Vec3f());
+    ADD_VEC4F_SERIALIZER(Dequant, osg::Vec4f(0, 0, 0, 1));
     ADD_INT_SERIALIZER(TexelsX, 8);
     ADD_INT_SERIALIZER(TexelsY, 2);
     ADD_UINT_SERIALIZER(TexturedCount, 0);

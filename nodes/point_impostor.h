@@ -5,6 +5,10 @@
 //   texelsX x texelsY colours over the sampling rectangle
 //   planeOrigin + a*planeU + b*planeV (a, b in [0, 1]), texel (i, j) centred at
 //   ((i + 0.5) / texelsX, (j + 0.5) / texelsY), row j = 0 at the bottom (b = 0).
+// Storage (14 bytes per point): positions quantized to 16-bit integers,
+// p = dequant.xyz + dequant.w * q (one scale for all axes, so the shader's
+// plane projection stays orthogonal; step = largest half-extent / 32767, e.g.
+// 1.2 cm for a 800 m far field), 8-bit RGBA colours, 16-bit atlas offsets.
 // Drawing: GL_POINTS (1 pixel by default). A GLSL 1.20 shader intersects the
 // ray from the viewer to the point with the sampling plane, maps it to the
 // point's block in a packed atlas texture (offset per point in texcoord 0,
@@ -19,6 +23,7 @@
 // (VISTA_CHECK) — the bake never produces it.
 #pragma once
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -38,6 +43,7 @@ struct PointImpostorData {
 
 constexpr int kAtlasBlocksPerRow = 256;
 constexpr int kMaxAtlasHeight = 8192;
+constexpr size_t kPointBytes = 6 + 4 + 4;  // position, colour, atlas offset (texels: 4 bytes each, extra)
 
 class PointImpostor : public osg::Geometry {
 public:
@@ -49,6 +55,12 @@ public:
     void setData(const PointImpostorData& d);
     size_t pointCount() const;
     size_t texturedCount() const { return _textured; }
+    // Dequantized position of point k (model coordinates).
+    osg::Vec3f position(size_t k) const;
+    // "" if arrays, primitive set and properties are consistent, else the reason
+    // (for files read from disk: a corrupt impostor is reported, never drawn).
+    std::string validate() const;
+    osg::BoundingBox computeBoundingBox() const override;
 
     // The packed atlas of `d` (texel blocks laid out as the shader expects).
     static osg::ref_ptr<osg::Image> buildAtlas(const PointImpostorData& d, std::vector<glm::vec2>& offsets);
@@ -64,6 +76,8 @@ public:
     void setTexelsX(int v) { _texelsX = v; }
     int getTexelsY() const { return _texelsY; }
     void setTexelsY(int v) { _texelsY = v; }
+    const osg::Vec4f& getDequant() const { return _dequant; }
+    void setDequant(const osg::Vec4f& v) { _dequant = v; }
     unsigned getTexturedCount() const { return unsigned(_textured); }
     void setTexturedCount(unsigned v) { _textured = v; }
 
@@ -72,6 +86,7 @@ protected:
 
 private:
     osg::Vec3f _planeOrigin, _planeU, _planeV;
+    osg::Vec4f _dequant{0, 0, 0, 1};
     int _texelsX = 8, _texelsY = 2;
     size_t _textured = 0;
 };

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <set>
 #include <sstream>
 
@@ -650,6 +651,47 @@ TEST(Nodes, SerializersRoundTrip) {
     // Bad per-cell indices are reported, not followed.
     sw2->setCellChildren(0, {5}, {1});
     EXPECT_NE(sw2->validate(), "");
+}
+
+TEST(Nodes, PointImpostorQuantizesWithinHalfAStepAndValidates) {
+    PointImpostorData d;
+    Rng rng(5, 0, Stream::Bake);
+    for (int k = 0; k < 2000; ++k)
+        d.positions.emplace_back(float(rng.uniform(100, 700)), float(rng.uniform(-300, 300)), float(rng.uniform(0, 80)));
+    d.positions.emplace_back(100.0f, -300.0f, 0.0f);  // the extremes are representable exactly up to rounding
+    d.positions.emplace_back(700.0f, 300.0f, 80.0f);
+    d.colors.assign(d.positions.size(), glm::u8vec4(10, 20, 30, 255));
+    d.block.assign(d.positions.size(), -1);
+    d.block[7] = 0;
+    d.texels.assign(16, glm::u8vec4(200, 0, 0, 255));
+    osg::ref_ptr<PointImpostor> pi = new PointImpostor;
+    pi->setData(d);
+    ASSERT_EQ(pi->validate(), "");
+    const float step = pi->getDequant().w();
+    EXPECT_LE(step, 300.0f / 32767.0f * 1.0001f);  // largest half-extent / 32767
+    const osg::BoundingBox bb = pi->getBoundingBox();
+    double worst = 0;
+    for (size_t k = 0; k < d.positions.size(); ++k) {
+        const osg::Vec3f q = pi->position(k);
+        const glm::vec3& p = d.positions[k];
+        worst = std::max({worst, std::abs(double(q.x()) - p.x), std::abs(double(q.y()) - p.y), std::abs(double(q.z()) - p.z)});
+        EXPECT_TRUE(bb.contains(q)) << k;
+    }
+    EXPECT_LE(worst, 0.5 * step * 1.001 + 1e-4);  // float rounding of the dequantized value
+    EXPECT_EQ(pi->getTexturedCount(), 1u);
+    // Corruptions are reported.
+    auto broken = [&](const std::function<void(PointImpostor&)>& f) {
+        osg::ref_ptr<PointImpostor> b = new PointImpostor;
+        b->setData(d);
+        f(*b);
+        return b->validate();
+    };
+    EXPECT_NE(broken([](PointImpostor& b) { b.setColorArray(new osg::Vec4ubArray(3), osg::Array::BIND_PER_VERTEX); }), "");
+    EXPECT_NE(broken([](PointImpostor& b) { (*static_cast<osg::Vec2sArray*>(b.getTexCoordArray(0)))[0].set(30000, 0); }), "");
+    EXPECT_NE(broken([](PointImpostor& b) { b.setDequant(osg::Vec4f(0, 0, 0, 0)); }), "");
+    EXPECT_NE(broken([](PointImpostor& b) { b.setTexturedCount(5); }), "");
+    EXPECT_NE(broken([&](PointImpostor& b) { b.setVertexArray(new osg::Vec3Array(unsigned(d.positions.size()))); }), "");
+    EXPECT_NE(broken([](PointImpostor& b) { static_cast<osg::DrawArrays*>(b.getPrimitiveSet(0))->setCount(5000); }), "");
 }
 
 // ---------------------------------------------------- whole pipeline, CLI
