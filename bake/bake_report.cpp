@@ -1,7 +1,8 @@
 // vista_bake_report: measurements of baked point impostors (docs/results.md,
 // "Issue 5: bake"). For one view cell of one or more baked files (same city,
 // different bake parameters) it renders, through OffscreenRenderer, from the
-// cell's 8 corners (inset 2 %) and centre towards the cell's impostors:
+// cell's 8 corners and the midpoints of its 4 vertical side edges (inset 2 %,
+// the edges at mid height) and its centre towards the cell's impostors:
 //   ref  = the replaced tiles only, rendered at ssaa x the size and box-filtered
 //   geom = the replaced tiles at 1x (plain geometry: aliased)
 //   imp  = the cell's impostors, textured; pts = the same, single colour
@@ -15,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -115,7 +117,16 @@ int main(int argc, char** argv) {
         inset.halfLength *= 0.98; inset.halfWidth *= 0.98; inset.halfHeight *= 0.98;
         inset.corners(corners);
         std::vector<glm::dvec3> eyes(corners, corners + 8);
+        std::vector<std::string> views;
+        for (int k = 0; k < 8; ++k) views.push_back("corner" + std::to_string(k));
+        const glm::dvec3 ax(cb.axis, 0.0), sd(cb.side(), 0.0);
+        for (int k = 0; k < 4; ++k) {
+            const double a = (k == 0 ? 1 : k == 1 ? -1 : 0) * inset.halfLength, b = (k == 2 ? 1 : k == 3 ? -1 : 0) * inset.halfWidth;
+            eyes.push_back(cb.center + a * ax + b * sd);
+            views.push_back(k < 2 ? (k == 0 ? "edge+axis" : "edge-axis") : (k == 2 ? "edge+side" : "edge-side"));
+        }
         eyes.push_back(cb.center);
+        views.push_back("centre");
         std::vector<double> pg, pi, pp;
         FrameStats fs;
         size_t covered = 0;
@@ -174,6 +185,7 @@ int main(int argc, char** argv) {
         j["geom_ms"] = median(tg);
         j["imp_ms"] = median(ti);
         j["pts_ms"] = median(tp);
+        j["views"] = views;
         j["psnr_geom_db"] = pg;
         j["psnr_imp_db"] = pi;
         j["psnr_pts_db"] = pp;
