@@ -133,6 +133,9 @@ int runBake(int argc, char** argv) {
     app.add_option("--texel-significance", p.appearance.significance,
                    "F-test level for view-dependent texels (0 = off: the colour spread alone decides)")
         ->capture_default_str();
+    app.add_option("--pixel-sigma", p.appearance.pixelSigma,
+                   "Monte Carlo pixel filter: Gaussian sigma in output pixels added to the box (the monitor filter; 0 = box only)")
+        ->capture_default_str();
     app.add_option("--layers", p.sampling.maxLayers, "LDI layers per pixel")->capture_default_str();
     app.add_option("--max-rays", p.sampling.maxRaysPerCamera, "cap on LDI rays per camera")->capture_default_str();
     bool noRemoval = false;
@@ -159,7 +162,8 @@ int runBake(int argc, char** argv) {
     };
     for (Status s : {range("--jobs", jobs, 0, 1024), range("--margin", p.margin, 0, 1e5), range("--far-depth", p.farDepth, 1, 1e6),
                      range("--oversample", p.sampling.oversample, 0.05, 16), range("--perspective", p.sampling.perspective, 1, 4),
-                     range("--texel-significance", p.appearance.significance, 0, 0.5), range("--layers", p.sampling.maxLayers, 1, 64),
+                     range("--texel-significance", p.appearance.significance, 0, 0.5),
+                     range("--pixel-sigma", p.appearance.pixelSigma, 0, 4), range("--layers", p.sampling.maxLayers, 1, 64),
                      range("--max-rays", double(p.sampling.maxRaysPerCamera), 1, 1e9),
                      range("--mc-threshold", p.appearance.varianceThreshold, 0, 1), range("--mc-min", p.appearance.minSamples, 1, 4096),
                      range("--mc-max", p.appearance.maxSamples, p.appearance.minSamples, 65536),

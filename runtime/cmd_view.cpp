@@ -2,7 +2,8 @@
 // under Xvfb). Drive / walk / fly manipulators, path playback, on-screen
 // stats (osgViewer StatsHandler, key s), render-mode switch (key m: full,
 // near, osgimpostor, hybrid = NearFarSplit + FarFieldNode; the HUD then shows
-// the far field's pixel classes and stage times),
+// the far field's pixel classes and stage times; impostor = the baked
+// ViewCellSwitch of a file from `vista bake`, the HUD shows the current cell),
 // screenshots (key p, or --screenshot with --frames for headless use).
 #include <algorithm>
 #include <cmath>
@@ -31,6 +32,7 @@
 
 #include "nodes/far_field_node.h"
 #include "nodes/near_far_split.h"
+#include "nodes/view_cell_switch.h"
 #include "runtime/city_file.h"
 #include "runtime/cli.h"
 #include "runtime/commands.h"
@@ -69,8 +71,10 @@ struct Capture : public osg::Camera::DrawCallback {
 };
 
 struct ViewState {
-    int mode = 0;  // 0 full, 1 near, 2 osgimpostor, 3 hybrid (if the ray scene could be built)
-    int numModes = 3;
+    int mode = 0;  // index into kModeNames
+    bool available[5] = {true, true, true, false, false};  // hybrid: ray scene built; impostor: baked file
+    unsigned child[5] = {0, 0, 1, 0, 0};                   // switch child drawn by each mode
+    ViewCellSwitch* baked = nullptr;                       // owned by the scene graph (impostor mode)
     double nearDistance = 100.0;
     int shots = 0;
     osg::ref_ptr<osg::Switch> modes;
@@ -79,10 +83,10 @@ struct ViewState {
     FarFieldNode* far = nullptr;      // owned by the scene graph (hybrid mode)
     NearFarSplit* split = nullptr;
 };
-const char* kModeNames[] = {"full", "near", "osgimpostor", "hybrid"};
-// Switch child drawn by each mode (full and near share the city scene; near
-// differs only by the projection's far plane).
-unsigned switchChild(int mode) { return mode == 2 ? 1u : mode == 3 ? 2u : 0u; }
+// full and near share the city scene (near differs only by the projection's
+// far plane); a baked file's full mode draws its tiles without the switch.
+const char* kModeNames[] = {"full", "near", "osgimpostor", "hybrid", "impostor"};
+constexpr int kNumModes = 5;
 
 class ViewKeys : public osgGA::GUIEventHandler {
 public:
@@ -90,8 +94,9 @@ public:
     bool handle(const osgGA::GUIEventAdapter& ea, osgGA::GUIActionAdapter&) override {
         if (ea.getEventType() != osgGA::GUIEventAdapter::KEYDOWN) return false;
         if (ea.getKey() == 'm') {
-            _s.mode = (_s.mode + 1) % _s.numModes;
-            _s.modes->setSingleChildOn(switchChild(_s.mode));
+            do _s.mode = (_s.mode + 1) % kNumModes;
+            while (!_s.available[_s.mode]);
+            _s.modes->setSingleChildOn(_s.child[_s.mode]);
             return true;
         }
         if (ea.getKey() == 'p') {
@@ -101,7 +106,7 @@ public:
         return false;
     }
     void getUsage(osg::ApplicationUsage& u) const override {
-        u.addKeyboardMouseBinding("m", "cycle render mode: full / near / osgimpostor / hybrid");
+        u.addKeyboardMouseBinding("m", "cycle render mode: full / near / osgimpostor / hybrid / impostor (baked file)");
         u.addKeyboardMouseBinding("p", "screenshot to vista_screenshot_N.png");
     }
 
@@ -143,14 +148,14 @@ int runView(int argc, char** argv) {
     int frames = 0;
     uint64_t seed = 0;
     double fovDeg = 60.0, nearD = 100.0;
-    app.add_option("city", city, "city scene file (.osgb)")->required();
+    app.add_option("city", city, "city scene file (.osgb), or a baked file from 'vista bake' (adds the impostor mode)")->required();
     app.add_option("--path", pathFile, "play back this path CSV (key 5)");
     app.add_option("--seed", seed, "make a path from this seed and play it back");
     app.add_option("--kind", kind, "path kind for --seed: walk, car, fly");
     app.add_option("--size", sizeStr, "window size WIDTHxHEIGHT (default 1280x720)");
     app.add_option("--fov", fovDeg, "vertical field of view in degrees (default 60)");
     app.add_option("--near", nearD, "near-field distance of the `near` and `hybrid` modes in metres (default 100)");
-    app.add_option("--mode", modeStr, "start in this render mode: full, near, osgimpostor, hybrid (default full)");
+    app.add_option("--mode", modeStr, "start in this render mode: full, near, osgimpostor, hybrid, impostor (default full)");
     app.add_option("--budget", budgetStr,
                    "hybrid: far-field rays per frame through the panoramic cache, 0 .. 1000000000, or "
                    "'unlimited' / -1 (default 20000)");
@@ -167,10 +172,10 @@ int runView(int argc, char** argv) {
     if (!(fovDeg > 1 && fovDeg < 179)) return reportBadInput(cmd, Status::error("--fov out of range (1, 179) degrees"));
     if (!(nearD > 0)) return reportBadInput(cmd, Status::error("--near must be > 0 metres"));
     int startMode = -1;
-    for (int i = 0; i < 4; ++i)
+    for (int i = 0; i < kNumModes; ++i)
         if (modeStr == kModeNames[i]) startMode = i;
     if (startMode < 0)
-        return reportBadInput(cmd, Status::error("--mode '" + modeStr + "': expected full, near, osgimpostor or hybrid"));
+        return reportBadInput(cmd, Status::error("--mode '" + modeStr + "': expected full, near, osgimpostor, hybrid or impostor"));
     int64_t budget = -1;
     if (budgetStr != "unlimited" && budgetStr != "-1") {
         char* end = nullptr;
@@ -218,8 +223,20 @@ int runView(int argc, char** argv) {
     ViewState st;
     st.nearDistance = nearD;
     st.modes = new osg::Switch;
-    st.modes->addChild(c->scene.get(), true);
-    st.modes->addChild(makeImpostorScene(c->scene.get(), nearD).get(), false);
+    // A baked file: its root is the view-cell switch; the plain modes draw its
+    // city tiles (the children before the impostors) without it.
+    osg::ref_ptr<osg::Node> plain = c->scene;
+    st.baked = dynamic_cast<ViewCellSwitch*>(c->scene.get());
+    if (st.baked) {
+        osg::ref_ptr<osg::Group> tiles = new osg::Group;
+        tiles->setStateSet(st.baked->getStateSet());
+        for (unsigned i = 0; i < st.baked->getTileCount() && i < st.baked->getNumChildren(); ++i) tiles->addChild(st.baked->getChild(i));
+        plain = tiles;
+    } else if (startMode == 4) {
+        return reportBadInput(cmd, Status::error("--mode impostor: '" + city + "' is not baked (run 'vista bake' and view its output)"));
+    }
+    st.modes->addChild(plain.get(), true);
+    st.modes->addChild(makeImpostorScene(plain.get(), nearD).get(), false);
     // Hybrid: near field under a NearFarSplit + the far-field drawable. The
     // ray scene and the height grid outlive the viewer (declared before it).
     {
@@ -231,15 +248,21 @@ int runView(int argc, char** argv) {
             ho.nearDistance = nearD;
             ho.far.nearDistance = nearD;
             ho.far.pixelBudget = budget;
+            st.child[3] = st.modes->getNumChildren();
             st.modes->addChild(buildHybridScene(*c, *rays, grid, ho, &st.split, &st.far).get(), false);
-            st.numModes = 4;
+            st.available[3] = true;
         } else {
             std::fprintf(stderr, "vista view: hybrid mode unavailable: %s\n", r.status().message().c_str());
             if (startMode == 3) return reportBadInput(cmd, Status::error("--mode hybrid: " + r.status().message()));
         }
     }
+    if (st.baked) {
+        st.child[4] = st.modes->getNumChildren();
+        st.modes->addChild(st.baked, false);
+        st.available[4] = true;
+    }
     st.mode = startMode;
-    st.modes->setSingleChildOn(switchChild(st.mode));
+    st.modes->setSingleChildOn(st.child[st.mode]);
     osg::ref_ptr<osg::Group> root = new osg::Group;
     root->addChild(st.modes.get());
 
@@ -342,6 +365,14 @@ int runView(int argc, char** argv) {
         text += buf;
         std::snprintf(buf, sizeof(buf), "\nkeys: 1 drive 2 walk 3 fly 4 orbit%s s stats p shot", havePath ? " 5 path" : "");
         text += buf;
+        if (st.mode == 4 && st.baked) {
+            const int cell = st.baked->lastCell();
+            if (cell >= 0)
+                std::snprintf(buf, sizeof(buf), "\nview cell %d: %zu impostors", cell, st.baked->impostorsOf(uint32_t(cell)).size());
+            else
+                std::snprintf(buf, sizeof(buf), "\noutside the view cells: plain city");
+            text += buf;
+        }
         if (st.mode == 3 && st.far) {
             // Last drawn frame's pixel classes (thesis Table 4.1) and far-field stage times.
             FrameStats fs = st.far->lastStats();

@@ -73,6 +73,7 @@ VARIANTS=(
     "LDI oversample 0.7|--oversample 0.7"
     "LDI oversample 1.4|--oversample 1.4"
     "fp = 1.33 (exact for 60°)|--perspective 1.3333333"
+    "box pixel filter (no monitor Gaussian)|--pixel-sigma 0"
 )
 files=()
 labels=()

@@ -27,6 +27,7 @@
 #include "runtime/city_file.h"
 #include "runtime/city_file_io.h"
 #include "bake/mode_impostor.h"
+#include "runtime/image.h"
 #include "runtime/metrics.h"
 #include "runtime/offscreen.h"
 
@@ -883,6 +884,25 @@ TEST(BakeCli, ResumeShardsAndJobsGiveIdenticalBytes) {
     EXPECT_EQ(run(common + "-o " + dir.file("e.osgb") + " --texels 3"), 2);
     EXPECT_EQ(run(dir.file("missing.osgb") + " -o " + dir.file("e.osgb")), 2);
     EXPECT_EQ(run(dir.file("a.osgb") + " -o " + dir.file("e.osgb")), 2);  // already baked
+}
+
+// `vista view` opens a baked file and offers the impostor mode (needs a display).
+TEST(BakeCli, ViewOpensTheBakedFileInImpostorMode) {
+    const char* display = std::getenv("DISPLAY");
+    if (!display || !*display) GTEST_SKIP() << "no X display (run under xvfb-run -a)";
+    TempDir dir;
+    ASSERT_TRUE(writeCityFile(makeBakeCity(), dir.file("city.osgb")).isOk());
+    ASSERT_EQ(run(dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q -o " + dir.file("a.osgb")), 0);
+    auto view = [&](const std::string& args) {
+        const std::string cmd = std::string(VISTA_BINARY) + " view " + args + " > /dev/null 2>&1";
+        const int rc = std::system(cmd.c_str());
+        return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+    };
+    const std::string png = dir.file("shot.png");
+    ASSERT_EQ(view(dir.file("a.osgb") + " --mode impostor --size 160x120 --frames 3 --screenshot " + png), 0);
+    EXPECT_TRUE(readPng(png).isOk());
+    // The plain city has no impostor mode: a clear error, exit 2.
+    EXPECT_EQ(view(dir.file("city.osgb") + " --mode impostor --size 160x120 --frames 3"), 2);
 }
 
 }  // namespace
