@@ -56,8 +56,7 @@ private:
 // One-way ANOVA on the texels' luma: true when the texel means differ more
 // than their samples' scatter explains at this level (or the test cannot be
 // made: fewer than 2 seen texels or no within-texel degrees of freedom).
-template <class Acc>
-bool viewDependent(const std::vector<Acc>& acc, const FTable& table) {
+bool viewDependent(const std::vector<TexelAcc>& acc, const FTable& table) {
     int k = 0;
     int64_t n = 0;
     double l = 0, ssw = 0, ssb = 0;

@@ -72,18 +72,21 @@ size_t PointImpostor::pointCount() const {
     return v ? v->getNumElements() : 0;
 }
 
+osg::Vec3f PointImpostor::dequantize(const osg::Vec3s& q) const {
+    return osg::Vec3f(_dequant.x(), _dequant.y(), _dequant.z()) + osg::Vec3f(q.x(), q.y(), q.z()) * _dequant.w();
+}
+
 osg::Vec3f PointImpostor::position(size_t k) const {
     const auto* v = dynamic_cast<const osg::Vec3sArray*>(getVertexArray());
     VISTA_CHECK(v && k < v->size());
-    const osg::Vec3s& q = (*v)[unsigned(k)];
-    return osg::Vec3f(_dequant.x(), _dequant.y(), _dequant.z()) + osg::Vec3f(q.x(), q.y(), q.z()) * _dequant.w();
+    return dequantize((*v)[unsigned(k)]);
 }
 
 osg::BoundingBox PointImpostor::computeBoundingBox() const {
     osg::BoundingBox bb;
     const auto* v = dynamic_cast<const osg::Vec3sArray*>(getVertexArray());
     if (!v) return bb;
-    for (size_t k = 0; k < v->size(); ++k) bb.expandBy(position(k));
+    for (const osg::Vec3s& q : *v) bb.expandBy(dequantize(q));
     return bb;
 }
 

@@ -85,6 +85,8 @@ protected:
     ~PointImpostor() override = default;
 
 private:
+    osg::Vec3f dequantize(const osg::Vec3s& q) const;
+
     osg::Vec3f _planeOrigin, _planeU, _planeV;
     osg::Vec4f _dequant{0, 0, 0, 1};
     int _texelsX = 8, _texelsY = 2;
