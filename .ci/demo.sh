@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 ./.ci/setup.sh
 BUILD="${VISTA_BUILD_DIR:-build}"
-VISTA="$BUILD/runtime/vista"
+VISTA="$BUILD/vista"
 OUT=out/demo
 mkdir -p "$OUT"
 "$VISTA" gen --params data/default.json --stats "$OUT/city.stats.json" -o "$OUT/city.osgb"

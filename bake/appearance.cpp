@@ -8,7 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include "citygen/lighting.h"
-#include "citygen/rng.h"
+#include "foundation/rng.h"
 
 namespace vista {
 namespace {

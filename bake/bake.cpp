@@ -1,4 +1,5 @@
 #include "bake/bake.h"
+#include "foundation/units.h"
 
 #include <algorithm>
 #include <chrono>
@@ -10,9 +11,10 @@
 #include <osg/MatrixTransform>
 #include <osg/UserDataContainer>
 
-#include "citygen/rng.h"
+#include "foundation/rng.h"
+#include "runtime/scene/scene_graph.h"
 #include "citygen/terrain.h"
-#include "runtime/city_file_io.h"
+#include "runtime/scene/scene_file.h"
 
 namespace vista {
 
@@ -30,27 +32,27 @@ std::string BakeParams::canonical() const {
     return o.str();
 }
 
-std::vector<CityTile> indexTiles(const LoadedCity& city) {
+std::vector<CityTile> indexTiles(const SceneModel& city) {
     std::vector<CityTile> tiles;
     auto expand = [](CityTile& t, const glm::dvec3& w) {
         t.lo = glm::min(t.lo, glm::dvec2(w));
         t.hi = glm::max(t.hi, glm::dvec2(w));
     };
     auto addMesh = [&](CityTile& t, uint32_t mi) {
-        const LoadedMesh& m = city.meshes[mi];
+        const SceneMesh& m = city.meshes[mi];
         t.meshes.push_back(mi);
         t.triangles += m.indices.size() / 3;
         for (const auto& p : m.positions) expand(t, m.origin + glm::dvec3(p));
     };
     auto addInstance = [&](CityTile& t, uint32_t ii) {
-        const LoadedInstance& in = city.instances[ii];
+        const SceneInstance& in = city.instances[ii];
         t.instances.push_back(ii);
         if (in.prototype >= city.prototypes.size()) return;
-        const LoadedMesh& pm = city.prototypes[in.prototype];
+        const SceneMesh& pm = city.prototypes[in.prototype];
         t.triangles += pm.indices.size() / 3;
         for (const auto& p : pm.positions) expand(t, glm::dvec3(in.transform * glm::dvec4(glm::dvec3(p), 1.0)));
     };
-    osg::Group* root = city.scene ? city.scene->asGroup() : nullptr;
+    osg::Group* root = sceneRoot(city) ? sceneRoot(city)->asGroup() : nullptr;
     if (!root) {  // hand-built city (tests): one tile per mesh, then per instance
         for (uint32_t i = 0; i < city.meshes.size(); ++i) {
             CityTile t;
@@ -87,7 +89,7 @@ std::vector<CityTile> indexTiles(const LoadedCity& city) {
     return tiles;
 }
 
-BakeInput prepareBake(const LoadedCity& city, const BakeParams& p) {
+BakeInput prepareBake(const SceneModel& city, const BakeParams& p) {
     BakeInput in;
     in.city = &city;
     in.tiles = indexTiles(city);
@@ -119,7 +121,7 @@ Box3 cellInFrame(const ViewCell& c, const ImpostorResult& r) {
 }
 
 TriangleSoup farFieldSoup(const BakeInput& in, const ViewCell& cell, int end, const BakeParams& p, ImpostorResult& r) {
-    const LoadedCity& city = *in.city;
+    const SceneModel& city = *in.city;
     const glm::dvec2 u = end == 1 ? cell.box.axis : -cell.box.axis;
     const glm::dvec2 e = glm::dvec2(cell.box.center) + u * cell.box.halfLength;
     r.cell = cell.id;
@@ -144,7 +146,7 @@ TriangleSoup farFieldSoup(const BakeInput& in, const ViewCell& cell, int end, co
         if (x0 < p.margin || x1 > p.margin + p.farDepth) continue;
         if (!inWedge && !(y0 <= 0 && y1 >= 0)) continue;
         r.hiddenTiles.push_back(t.child);
-        auto addMesh = [&](const LoadedMesh& m, const glm::dmat4* xf) {
+        auto addMesh = [&](const SceneMesh& m, const glm::dmat4* xf) {
             const uint32_t base = uint32_t(soup.positions.size());
             for (size_t i = 0; i < m.positions.size(); ++i) {
                 glm::dvec3 w = xf ? glm::dvec3(*xf * glm::dvec4(glm::dvec3(m.positions[i]), 1.0)) : m.origin + glm::dvec3(m.positions[i]);
@@ -155,7 +157,7 @@ TriangleSoup farFieldSoup(const BakeInput& in, const ViewCell& cell, int end, co
         };
         for (uint32_t mi : t.meshes) addMesh(city.meshes[mi], nullptr);
         for (uint32_t ii : t.instances) {
-            const LoadedInstance& inst = city.instances[ii];
+            const SceneInstance& inst = city.instances[ii];
             if (inst.prototype < city.prototypes.size()) addMesh(city.prototypes[inst.prototype], &inst.transform);
         }
     }
@@ -169,7 +171,7 @@ namespace {
 // along the sampling-plane normal): covered pixels and screen bounding box.
 void screenStats(const PointImpostorData& d, const Box3& cell, const SamplingSetup& s, const SamplingParams& sp, ImpostorStats& st) {
     const glm::dvec3 eye = cell.center();
-    const double f = 1.0 / std::tan(0.5 * sp.fovYDeg * 3.14159265358979323846 / 180.0);
+    const double f = 1.0 / std::tan(0.5 * sp.fovYDeg * kPi / 180.0);
     const double aspect = double(sp.outWidth) / sp.outHeight;
     std::vector<uint8_t> hit(size_t(sp.outWidth) * size_t(sp.outHeight), 0);
     int bx0 = sp.outWidth, bx1 = -1, by0 = sp.outHeight, by1 = -1;
@@ -395,11 +397,11 @@ Result<CellResult> decodeCellResult(const std::string& bytes, uint64_t configHas
 }
 
 // ---------------------------------------------------------------- assembly
-osg::ref_ptr<ViewCellSwitch> assembleBakedScene(const LoadedCity& city, const std::vector<ViewCell>& cells,
+osg::ref_ptr<ViewCellSwitch> assembleBakedScene(const SceneModel& city, const std::vector<ViewCell>& cells,
                                                 const std::vector<CellResult>& results, const std::string& paramsText) {
     osg::ref_ptr<ViewCellSwitch> root = new ViewCellSwitch;
     root->setName("vista.city");
-    osg::Group* cityRoot = city.scene ? city.scene->asGroup() : nullptr;
+    osg::Group* cityRoot = sceneRoot(city) ? sceneRoot(city)->asGroup() : nullptr;
     if (cityRoot) {
         if (cityRoot->getUserDataContainer())
             root->setUserDataContainer(osg::clone(cityRoot->getUserDataContainer(), osg::CopyOp::DEEP_COPY_ALL));
@@ -455,31 +457,6 @@ osg::ref_ptr<ViewCellSwitch> assembleBakedScene(const LoadedCity& city, const st
     root->setImpostorStart(is.get());
     root->setImpostorItems(ii.get());
     return root;
-}
-
-Result<BakedFile> loadBakedFile(const std::string& path) {
-    auto city = loadCityFile(path);
-    if (!city) return city.status();
-    BakedFile bf;
-    bf.city = std::move(*city);
-    auto bad = [&](const std::string& why) { return Status::error("'" + path + "' is not a vista baked file: " + why); };
-    auto* root = dynamic_cast<ViewCellSwitch*>(bf.city.scene.get());
-    if (!root) return bad("the root is a plain city (run 'vista bake' first)");
-    int baked = 0;
-    if (!root->getUserValue("vista.baked", baked) || baked != 1) return bad("missing or unsupported user value vista.baked");
-    const std::string why = root->validate();
-    if (!why.empty()) return bad(why);
-    for (unsigned i = root->getTileCount(); i < root->getNumChildren(); ++i) {
-        auto* xf = dynamic_cast<osg::MatrixTransform*>(root->getChild(i));
-        osg::Geode* g = xf && xf->getNumChildren() == 1 ? xf->getChild(0)->asGeode() : nullptr;
-        auto* pi = g && g->getNumDrawables() == 1 ? dynamic_cast<PointImpostor*>(g->getDrawable(0)) : nullptr;
-        if (!pi) return bad("child " + std::to_string(i) + " is not an impostor node");
-        if (const std::string w = pi->validate(); !w.empty()) return bad("child " + std::to_string(i) + ": " + w);
-        ++bf.impostors;
-        bf.points += pi->pointCount();
-    }
-    bf.root = root;
-    return bf;
 }
 
 }  // namespace vista

@@ -32,10 +32,10 @@
 #include "bake/appearance.h"
 #include "bake/sampling.h"
 #include "bake/view_cells.h"
-#include "citygen/status.h"
+#include "foundation/status.h"
 #include "nodes/point_impostor.h"
 #include "nodes/view_cell_switch.h"
-#include "runtime/city_file.h"
+#include "runtime/scene/city_file.h"
 
 namespace vista {
 
@@ -53,14 +53,14 @@ struct BakeParams {
 };
 
 // One tile of the city file: its root child index, world xy bounds and the
-// LoadedCity meshes/instances it holds.
+// SceneModel meshes/instances it holds.
 struct CityTile {
     uint32_t child = 0;
     glm::dvec2 lo{1e300}, hi{-1e300};
     std::vector<uint32_t> meshes, instances;
     size_t triangles = 0;
 };
-std::vector<CityTile> indexTiles(const LoadedCity& city);
+std::vector<CityTile> indexTiles(const SceneModel& city);
 
 struct ImpostorStats {
     size_t farTriangles = 0, tiles = 0;
@@ -91,12 +91,12 @@ struct CellResult {
 };
 
 struct BakeInput {
-    const LoadedCity* city = nullptr;
+    const SceneModel* city = nullptr;
     std::vector<CityTile> tiles;
     std::vector<ViewCell> cells;
     std::vector<SkippedCell> skipped;
 };
-BakeInput prepareBake(const LoadedCity& city, const BakeParams& p);
+BakeInput prepareBake(const SceneModel& city, const BakeParams& p);
 
 // Frame helpers (world <-> impostor frame).
 glm::dvec3 toImpostorFrame(const ImpostorResult& r, const glm::dvec3& world);
@@ -119,15 +119,7 @@ Result<CellResult> decodeCellResult(const std::string& bytes, uint64_t configHas
 // root's user values and state (so loadCityFile() reads it as a city), the
 // tiles, then one impostor node per result (MatrixTransform "impostor_C_E" ->
 // Geode -> PointImpostor). `results` must be sorted by cell id.
-osg::ref_ptr<ViewCellSwitch> assembleBakedScene(const LoadedCity& city, const std::vector<ViewCell>& cells,
+osg::ref_ptr<ViewCellSwitch> assembleBakedScene(const SceneModel& city, const std::vector<ViewCell>& cells,
                                                 const std::vector<CellResult>& results, const std::string& paramsText);
-
-struct BakedFile {
-    LoadedCity city;                   // the city part (tiles) as loadCityFile reads it
-    osg::ref_ptr<ViewCellSwitch> root;
-    size_t impostors = 0, points = 0;
-};
-// Loads and checks a baked file; errors name the path and the problem.
-Result<BakedFile> loadBakedFile(const std::string& path);
 
 }  // namespace vista

@@ -17,7 +17,7 @@
 
 #include <glm/glm.hpp>
 
-#include "citygen/status.h"
+#include "foundation/status.h"
 
 namespace vista {
 

@@ -1,4 +1,5 @@
 #include "bake/sampling.h"
+#include "foundation/units.h"
 
 #include <algorithm>
 #include <cmath>
@@ -92,7 +93,6 @@ std::array<glm::dvec2, 3> boundingTriangle(const std::vector<glm::dvec2>& poly) 
             for (int i = 0; i < 4; ++i) q.push_back(p + glm::dvec2((i & 1) ? eps : -eps, (i & 2) ? eps : -eps));
         top += eps;
     }
-    const double kPi = 3.14159265358979323846;
     const double m = 1e-4;
     double bestA = 1.25 * kPi, bestB = 1.75 * kPi, best = 1e300;
     std::array<glm::dvec2, 3> bestT{};
@@ -178,11 +178,11 @@ Result<SamplingSetup> setupSampling(const Box3& cell, const Box3& far) {
 }
 
 double outputPixelAngle(const SamplingParams& p) {
-    return 2.0 * std::tan(0.5 * p.fovYDeg * 3.14159265358979323846 / 180.0) / double(p.outHeight);
+    return 2.0 * std::tan(0.5 * p.fovYDeg * kPi / 180.0) / double(p.outHeight);
 }
 
 double exactPerspectiveFactor(const SamplingParams& p) {
-    const double c = std::cos(0.5 * p.fovYDeg * 3.14159265358979323846 / 180.0);
+    const double c = std::cos(0.5 * p.fovYDeg * kPi / 180.0);
     return 1.0 / (c * c);
 }
 

@@ -42,7 +42,7 @@
 #include <glm/glm.hpp>
 
 #include "bake/far_scene.h"
-#include "citygen/status.h"
+#include "foundation/status.h"
 
 namespace vista {
 

@@ -27,7 +27,7 @@
 
 #include "citygen/building_geometry.h"
 #include "citygen/polygon.h"
-#include "citygen/rng.h"
+#include "foundation/rng.h"
 #include "citygen/terrain.h"
 
 namespace vista {

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "citygen/city.h"
-#include "citygen/progress.h"
+#include "foundation/progress.h"
 
 namespace vista {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "citygen/polygon.h"
-#include "citygen/rng.h"
+#include "foundation/rng.h"
 
 namespace vista {
 

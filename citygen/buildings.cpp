@@ -1,6 +1,7 @@
 // placeBuildings() and meshBuilding(); see buildings.h for the contract and
 // docs/buildings.md for the algorithms and the triangle budget.
 #include "citygen/buildings.h"
+#include "foundation/units.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +11,7 @@
 #include "citygen/building_geometry.h"
 #include "citygen/mesh_builder.h"
 #include "citygen/polygon.h"
-#include "citygen/rng.h"
+#include "foundation/rng.h"
 #include "citygen/terrain.h"
 
 namespace vista {
@@ -19,7 +20,6 @@ namespace {
 
 constexpr double kMinFootprintArea = 30.0;
 constexpr double kMinFootprintWidth = 4.0;
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDowntown = 0.65;  // density from which buildings are mid/high-rise
 constexpr double kSuburb = 0.35;    // density below which buildings are houses
 

@@ -9,7 +9,7 @@
 #include <optional>
 
 #include "citygen/city.h"
-#include "citygen/progress.h"
+#include "foundation/progress.h"
 
 namespace vista {
 

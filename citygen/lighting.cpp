@@ -1,4 +1,5 @@
 #include "citygen/lighting.h"
+#include "foundation/units.h"
 
 #include <algorithm>
 #include <cmath>
@@ -39,7 +40,7 @@ glm::u8vec4 prelitColor(Material m, const glm::dvec3& normal, const Lighting& li
 }
 
 glm::u8vec4 skyColor(double elev) {
-    double t = std::clamp(elev / 1.5707963267948966, 0.0, 1.0);
+    double t = std::clamp(elev / kHalfPi, 0.0, 1.0);
     t = std::sqrt(t);
     glm::dvec3 horizon(0.78, 0.85, 0.93), zenith(0.36, 0.56, 0.86);
     glm::dvec3 c = horizon * (1 - t) + zenith * t;

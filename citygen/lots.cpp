@@ -19,7 +19,7 @@
 #include "citygen/blocks.h"
 #include "citygen/building_geometry.h"
 #include "citygen/polygon.h"
-#include "citygen/rng.h"
+#include "foundation/rng.h"
 
 namespace vista {
 

@@ -12,6 +12,7 @@
 #include <osmium/visitor.hpp>
 
 #include "citygen/streets.h"
+#include "foundation/units.h"
 
 namespace vista {
 
@@ -83,7 +84,7 @@ Result<StreetGraph> importOsm(const std::string& path, const CityParams& params)
             latMin = std::min(latMin, p.y); latMax = std::max(latMax, p.y);
         }
     const double lon0 = 0.5 * (lonMin + lonMax), lat0 = 0.5 * (latMin + latMax);
-    const double kEarthRadius = 6371008.8, kDeg = 3.14159265358979323846 / 180.0;
+    const double kEarthRadius = 6371008.8, kDeg = kPi / 180.0;
     const double cosLat = std::cos(lat0 * kDeg);
     std::vector<RawSegment> segs;
     for (const auto& w : collector.ways) {

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "citygen/status.h"
+#include "foundation/status.h"
 
 namespace vista {
 

@@ -12,7 +12,7 @@
 
 #include <glm/glm.hpp>
 
-#include "citygen/status.h"
+#include "foundation/status.h"
 
 namespace vista {
 

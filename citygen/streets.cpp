@@ -17,7 +17,8 @@
 #include <cmath>
 #include <numeric>
 
-#include "citygen/rng.h"
+#include "foundation/rng.h"
+#include "foundation/units.h"
 #include "citygen/street_geometry.h"
 #include "citygen/streets.h"
 #include "citygen/terrain.h"
@@ -26,7 +27,6 @@ namespace vista {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 uint64_t cellId(uint64_t tag, int64_t i, int64_t j) { return hashKeys(tag, uint64_t(i), uint64_t(j)); }
 

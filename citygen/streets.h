@@ -20,8 +20,8 @@
 #include <vector>
 
 #include "citygen/params.h"
-#include "citygen/progress.h"
-#include "citygen/status.h"
+#include "foundation/progress.h"
+#include "foundation/status.h"
 #include "citygen/street_graph.h"
 
 namespace vista {

@@ -7,6 +7,7 @@
 // positions to the border tiles), a park polygon is clipped to the tile
 // rectangle. The ground grid covers the tile rectangle.
 #include "citygen/surfaces.h"
+#include "foundation/units.h"
 
 #include <algorithm>
 #include <cmath>
@@ -21,7 +22,6 @@ namespace vista {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kRoadLift = 0.02;      // carriageway above ground
 constexpr double kMarkingLift = 0.03;   // markings above ground
 constexpr double kGrassLift = 0.05;     // park lawn above ground

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "citygen/rng.h"
+#include "foundation/rng.h"
 
 namespace vista {
 

@@ -2,6 +2,7 @@
 // and their placement along streets and in parks. See trees.h for the
 // contract and docs/trees-and-surfaces.md for budgets and rules.
 #include "citygen/trees.h"
+#include "foundation/units.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,14 +11,13 @@
 
 #include "citygen/mesh_builder.h"
 #include "citygen/polygon.h"
-#include "citygen/rng.h"
+#include "foundation/rng.h"
 #include "citygen/terrain.h"
 
 namespace vista {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kSpecies = 3;   // 0 broadleaf, 1 conifer, 2 columnar
 constexpr int kVariants = 3;  // small, medium, large
 constexpr double kMinBranchRadius = 0.035;  // thinnest twig, metres

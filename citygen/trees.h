@@ -13,7 +13,7 @@
 
 #include "citygen/city.h"
 #include "citygen/lighting.h"
-#include "citygen/progress.h"
+#include "foundation/progress.h"
 
 namespace vista {
 

@@ -3,6 +3,7 @@
 #define GL_GLEXT_PROTOTYPES 1
 #endif
 #include "nodes/far_field_node.h"
+#include "foundation/units.h"
 
 #include <algorithm>
 #include <cmath>
@@ -16,9 +17,10 @@
 #include <GL/glext.h>
 
 #include "nodes/near_far_split.h"
-#include "runtime/city_file.h"
-#include "runtime/mode_hybrid.h"
-#include "runtime/ray_scene.h"
+#include "runtime/scene/city_file.h"
+#include "runtime/scene/scene_graph.h"
+#include "nodes/render/mode_hybrid.h"
+#include "runtime/engine/ray_scene.h"
 
 namespace vista {
 
@@ -75,7 +77,7 @@ bool cameraFromOsg(const osg::Matrixd& view, const osg::Matrixd& proj, int w, in
     glm::dvec3 right = glm::cross(fg, ug);
     c.roll = std::atan2(-glm::dot(right, u0), glm::dot(right, r0));
     if (std::abs(c.roll) < 1e-9) c.roll = 0;
-    c.fovY = fovy * 3.14159265358979323846 / 180.0;
+    c.fovY = fovy * kPi / 180.0;
     c.width = w;
     c.height = h;
     c.zNear = zn;
@@ -152,12 +154,12 @@ void FarFieldNode::drawImplementation(osg::RenderInfo& ri) const {
     (void)ri.getState();
 }
 
-osg::ref_ptr<osg::Group> buildHybridScene(const LoadedCity& city, const RayScene& rays, const HeightGrid& grid,
+osg::ref_ptr<osg::Group> buildHybridScene(const SceneModel& city, const RayScene& rays, const HeightGrid& grid,
                                           const HybridSceneOptions& options, NearFarSplit** splitOut,
                                           FarFieldNode** farOut) {
     osg::ref_ptr<osg::Group> root = new osg::Group;
     root->setName("vista.hybrid");
-    NearFieldScene nf = buildNearFieldScene(city.scene.get());
+    NearFieldScene nf = buildNearFieldScene(sceneRoot(city));
     if (nf.rootState) root->setStateSet(nf.rootState.get());
     osg::ref_ptr<NearFarSplit> split = new NearFarSplit;
     split->setNearDistance(options.nearDistance);

@@ -24,15 +24,15 @@
 #include <osg/Group>
 #include <osg/observer_ptr>
 
-#include "runtime/bench_mode.h"
-#include "runtime/far_field.h"
-#include "runtime/horizon.h"
+#include "runtime/engine/frame_stats.h"
+#include "runtime/engine/far_field.h"
+#include "runtime/engine/horizon.h"
 
 namespace vista {
 
 class RayScene;
 class NearFarSplit;
-struct LoadedCity;
+struct SceneModel;
 
 constexpr int kFarFieldRenderBin = 10000;
 
@@ -81,7 +81,7 @@ struct HybridSceneOptions {
     uint64_t triangleBudget = 0;  // > 0: split by triangle budget instead
     FarFieldOptions far;
 };
-osg::ref_ptr<osg::Group> buildHybridScene(const LoadedCity& city, const RayScene& rays, const HeightGrid& grid,
+osg::ref_ptr<osg::Group> buildHybridScene(const SceneModel& city, const RayScene& rays, const HeightGrid& grid,
                                           const HybridSceneOptions& options, NearFarSplit** splitOut = nullptr,
                                           FarFieldNode** farOut = nullptr);
 

@@ -21,7 +21,7 @@
 #include <osg/Group>
 #include <osg/NodeVisitor>
 
-#include "runtime/adaptive_split.h"
+#include "runtime/engine/adaptive_split.h"
 
 namespace vista {
 

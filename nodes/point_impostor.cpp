@@ -12,7 +12,7 @@
 #include <osgDB/ObjectWrapper>
 #include <osgDB/OutputStream>
 
-#include "citygen/status.h"
+#include "foundation/status.h"
 
 namespace vista {
 namespace {

@@ -15,8 +15,8 @@ set -euo pipefail
 BUILD=$(realpath "${1:-build}")
 OUT=${2:-results-issue5}
 WHOLE=${3:-}
-VISTA=$BUILD/runtime/vista
-REPORT=$BUILD/bake/vista_bake_report
+VISTA=$BUILD/vista
+REPORT=$BUILD/vista_bake_report
 if [ -z "${DISPLAY:-}" ]; then exec xvfb-run -a "$0" "$BUILD" "$OUT" $WHOLE; fi
 mkdir -p "$OUT" && cd "$OUT"
 [ -f city.osgb ] || "$VISTA" gen --size 2000 --seed 1 -q -o city.osgb

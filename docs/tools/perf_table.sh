@@ -5,7 +5,7 @@
 # Usage: docs/tools/perf_table.sh [sizes...]   (default: 500 1000 2000 4000 8000)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-VISTA="${VISTA:-build/runtime/vista}"
+VISTA="${VISTA:-build/vista}"
 SIZES="${*:-500 1000 2000 4000 8000}"
 TMP="$(mktemp -d)"
 trap 'rm -rf "$TMP"' EXIT

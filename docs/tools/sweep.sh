@@ -4,11 +4,11 @@
 # fly-over, and the size sweep. Prints the Markdown tables on stdout.
 #
 # usage: docs/tools/sweep.sh [VISTA_BINARY] [OUT_DIR]
-#   VISTA_BINARY defaults to build/runtime/vista, OUT_DIR to ./results-issue3.
+#   VISTA_BINARY defaults to build/vista, OUT_DIR to ./results-issue3.
 # Needs an X display; without one it re-runs itself under `xvfb-run -a`.
 # Needs jq. Takes about 10 minutes on 2 cores with llvmpipe.
 set -euo pipefail
-VISTA=$(realpath "${1:-build/runtime/vista}")
+VISTA=$(realpath "${1:-build/vista}")
 OUT=${2:-results-issue3}
 MODES=full,near,raycast,osgimpostor
 if [ -z "${DISPLAY:-}" ]; then exec xvfb-run -a "$0" "$VISTA" "$OUT"; fi

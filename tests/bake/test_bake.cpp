@@ -19,17 +19,19 @@
 #include <tbb/global_control.h>
 
 #include "bake/appearance.h"
+#include "foundation/units.h"
 #include "bake/bake.h"
+#include "nodes/baked_file.h"
 #include "bake/far_scene.h"
 #include "bake/sampling.h"
 #include "bake/view_cells.h"
-#include "citygen/rng.h"
-#include "runtime/city_file.h"
-#include "runtime/city_file_io.h"
-#include "bake/mode_impostor.h"
-#include "runtime/image.h"
-#include "runtime/metrics.h"
-#include "runtime/offscreen.h"
+#include "foundation/rng.h"
+#include "runtime/scene/city_file.h"
+#include "runtime/scene/scene_file.h"
+#include "nodes/render/mode_impostor.h"
+#include "runtime/engine/image.h"
+#include "runtime/engine/metrics.h"
+#include "nodes/render/offscreen.h"
 
 #include "tests/common/temp_dir.h"
 
@@ -95,7 +97,7 @@ TEST(ViewCells, GridLookupMatchesBruteForce) {
     for (int i = 0; i < 200; ++i) {
         ViewCellBox b;
         b.center = {rng.uniform(-500, 500), rng.uniform(-500, 500), 1.6};
-        const double a = rng.uniform(0, 6.283185307179586);
+        const double a = rng.uniform(0, kTwoPi);
         b.axis = {std::cos(a), std::sin(a)};
         b.halfLength = rng.uniform(0.3, 80);
         b.halfWidth = rng.uniform(2, 12);
@@ -809,7 +811,7 @@ TEST(ImpostorMode, DrawsImpostorsInTheCellAndResemblesTheGeometry) {
     ASSERT_TRUE(mode.isOk()) << mode.status().message();
     Camera cam;
     cam.eye = {50, 0, 1.6};
-    cam.heading = 1.5707963267948966;  // east, towards the far tile at x = 300
+    cam.heading = kHalfPi;  // east, towards the far tile at x = 300
     cam.fovY = 60 * 3.14159265358979 / 180;
     cam.width = 160;
     cam.height = 120;

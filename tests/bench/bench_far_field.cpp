@@ -10,9 +10,9 @@
 #include <random>
 #include <string>
 
-#include "runtime/city_file.h"
-#include "runtime/horizon.h"
-#include "runtime/ray_scene.h"
+#include "runtime/scene/city_file.h"
+#include "runtime/engine/horizon.h"
+#include "runtime/engine/ray_scene.h"
 
 using namespace vista;
 
@@ -20,15 +20,15 @@ namespace {
 
 std::string gCityPath;
 struct World {
-    LoadedCity city;
+    SceneModel city;
     std::unique_ptr<RayScene> rays;
 };
 
-LoadedCity syntheticCity() {
-    LoadedCity c;
+SceneModel syntheticCity() {
+    SceneModel c;
     std::mt19937 rng(1);
     std::uniform_real_distribution<float> pos(-900, 900), sz(5, 30), h(5, 80);
-    LoadedMesh m;
+    SceneMesh m;
     auto quad = [&](glm::vec3 a, glm::vec3 b, glm::vec3 cc, glm::vec3 d) {
         uint32_t base = uint32_t(m.positions.size());
         for (auto p : {a, b, cc, d}) {

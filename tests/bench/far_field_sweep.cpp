@@ -26,10 +26,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "runtime/bench.h"
-#include "runtime/city_file.h"
-#include "runtime/paths.h"
-#include "runtime/plot.h"
+#include "cmd/bench.h"
+#include "runtime/scene/city_file.h"
+#include "runtime/scene/scene_graph.h"
+#include "runtime/scene/paths.h"
+#include "cmd/plot.h"
 
 using namespace vista;
 namespace fs = std::filesystem;
@@ -77,7 +78,7 @@ ModeAgg aggregate(const BenchResult& r, const std::string& mode, int w, int h) {
             a.pct[k][2] = std::max(a.pct[k][2], p);
             a.meanCount[k] += double(v[k]);
         }
-        for (const auto& [s, ms] : f.stats.stagesMs) a.stageMean[s] += ms;
+        f.stats.stages.forEach([&](Stage s, double ms) { a.stageMean[stageName(s)] += ms; });
         for (const auto& note : f.stats.notes) noteCount[note]++;
     }
     if (n == 0) return a;
@@ -230,7 +231,7 @@ int main(int argc, char** argv) {
         cfg.cityLabel = J["city"];
         cfg.command = "far_field_sweep " + cityPath + " (run " + rs.name + ")";
         std::fprintf(stderr, "run %s ...\n", rs.name.c_str());
-        auto r = runBenchmark(&*city, city->scene.get(), *path, cfg);
+        auto r = runBenchmark(&*city, sceneRoot(*city), *path, cfg);
         if (!r) {
             std::fprintf(stderr, "run %s failed: %s\n", rs.name.c_str(), r.status().message().c_str());
             return 1;

@@ -1,7 +1,8 @@
 #include <gtest/gtest.h>
 
 #include "citygen/polygon.h"
-#include "citygen/rng.h"
+#include "foundation/units.h"
+#include "foundation/rng.h"
 
 using namespace vista;
 
@@ -19,7 +20,7 @@ TEST(Polygon, TriangulationCoversAreaOfRandomStarPolygons) {
         int n = int(rng.range(3, 24));
         std::vector<glm::dvec2> p;
         for (int i = 0; i < n; ++i) {
-            double a = 6.283185307179586 * i / n, r = rng.uniform(0.3, 1.0);
+            double a = kTwoPi * i / n, r = rng.uniform(0.3, 1.0);
             p.push_back({r * std::cos(a), r * std::sin(a)});
         }
         auto tris = triangulate(p);

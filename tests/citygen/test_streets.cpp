@@ -9,7 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "citygen/rng.h"
+#include "foundation/rng.h"
 #include "citygen/streets.h"
 
 using namespace vista;

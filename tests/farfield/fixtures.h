@@ -1,4 +1,4 @@
-// Hand-built LoadedCity fixtures for the far-field tests (no generator, no GL).
+// Hand-built SceneModel fixtures for the far-field tests (no generator, no GL).
 #pragma once
 #include <cstdint>
 #include <random>
@@ -6,12 +6,12 @@
 
 #include <glm/glm.hpp>
 
-#include "runtime/city_file.h"
+#include "runtime/scene/city_file.h"
 
 namespace vista::test {
 
 // Appends an axis-aligned box [lo, hi] (relative to mesh.origin) with one colour per face.
-inline void addBox(LoadedMesh& m, const glm::vec3& lo, const glm::vec3& hi, glm::u8vec4 color) {
+inline void addBox(SceneMesh& m, const glm::vec3& lo, const glm::vec3& hi, glm::u8vec4 color) {
     const glm::vec3 c[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {lo.x, hi.y, lo.z},
                             {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}};
     const int faces[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
@@ -26,7 +26,7 @@ inline void addBox(LoadedMesh& m, const glm::vec3& lo, const glm::vec3& hi, glm:
 }
 
 // Appends a horizontal quad at height z covering [lo, hi] in x/y.
-inline void addGround(LoadedMesh& m, const glm::vec2& lo, const glm::vec2& hi, float z, glm::u8vec4 color) {
+inline void addGround(SceneMesh& m, const glm::vec2& lo, const glm::vec2& hi, float z, glm::u8vec4 color) {
     uint32_t base = uint32_t(m.positions.size());
     m.positions.push_back({lo.x, lo.y, z});
     m.positions.push_back({hi.x, lo.y, z});
@@ -38,20 +38,20 @@ inline void addGround(LoadedMesh& m, const glm::vec2& lo, const glm::vec2& hi, f
 
 // A random "city": ground plane plus `boxes` boxes of random size and height in
 // [-extent/2, extent/2]^2, world origin (ox, oy).
-inline LoadedCity randomCity(uint32_t seed, int boxes, double extent = 400.0, double ox = 0.0, double oy = 0.0) {
+inline SceneModel randomCity(uint32_t seed, int boxes, double extent = 400.0, double ox = 0.0, double oy = 0.0) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> pos(float(-extent / 2), float(extent / 2)), size(3.0f, 25.0f),
         height(3.0f, 60.0f);
     std::uniform_int_distribution<int> col(30, 220);
-    LoadedCity city;
+    SceneModel city;
     city.params.origin_x = ox;
     city.params.origin_y = oy;
     city.params.size_m = extent;
-    LoadedMesh ground;
+    SceneMesh ground;
     ground.origin = glm::dvec3(ox, oy, 0.0);
     addGround(ground, glm::vec2(float(-extent / 2)), glm::vec2(float(extent / 2)), 0.0f, {90, 90, 90, 255});
     city.meshes.push_back(ground);
-    LoadedMesh b;
+    SceneMesh b;
     b.origin = glm::dvec3(ox, oy, 0.0);
     for (int i = 0; i < boxes; ++i) {
         glm::vec3 lo(pos(rng), pos(rng), 0.0f);

@@ -7,8 +7,8 @@
 #include <cmath>
 #include <random>
 
-#include "runtime/horizon.h"
-#include "runtime/ray_scene.h"
+#include "runtime/engine/horizon.h"
+#include "runtime/engine/ray_scene.h"
 #include "tests/farfield/fixtures.h"
 
 using namespace vista;
@@ -66,7 +66,7 @@ TEST(Horizon, NeverBelowGeometryOnRandomScenes) {
     long culledTotal = 0;
     for (uint32_t seed = 1; seed <= 6; ++seed) {
         const double ox = seed % 2 ? 0.0 : 2.5e5, oy = seed % 3 ? 0.0 : -1.0e5;
-        LoadedCity city = randomCity(seed, 80, 400.0, ox, oy);
+        SceneModel city = randomCity(seed, 80, 400.0, ox, oy);
         auto rs = RayScene::build(city);
         ASSERT_TRUE(rs.isOk());
         std::mt19937 rng(seed * 77);
@@ -94,8 +94,8 @@ TEST(Horizon, ConservativeWithCameraOnGridLinesAndAxisParallelRays) {
     // Thin walls lying exactly on grid lines, camera exactly on grid lines and
     // at grid corners, looking along the axes (odd width: the centre column's
     // ray is exactly axis-parallel).
-    LoadedCity city;
-    LoadedMesh m;
+    SceneModel city;
+    SceneMesh m;
     addGround(m, {-100, -100}, {100, 100}, 0, {80, 80, 80, 255});
     addBox(m, {-100, -100, 0}, {100, -99.999f, 2}, {200, 0, 0, 255});  // marks the grid extent
     addBox(m, {0, 20, 0}, {0.0005f, 60, 30}, {0, 200, 0, 255});         // wall on x = 0
@@ -129,7 +129,7 @@ TEST(Horizon, ConservativeWithCameraOnGridLinesAndAxisParallelRays) {
 }
 
 TEST(Horizon, OffForRolledCameraAndZenithOrNadirViews) {
-    LoadedCity city = randomCity(2, 20);
+    SceneModel city = randomCity(2, 20);
     HeightGrid hg = HeightGrid::build(city, glm::dvec3(0), 32);
     Camera c = cameraAt(glm::dvec3(0, 0, 2), 0, 0);
     c.roll = 0.1;
@@ -149,7 +149,7 @@ TEST(Horizon, OffForRolledCameraAndZenithOrNadirViews) {
 }
 
 TEST(Horizon, EmptyCityIsAllSkyAndInsideBuildingCullsNothing) {
-    LoadedCity empty;
+    SceneModel empty;
     HeightGrid e = HeightGrid::build(empty, glm::dvec3(0), 64);
     EXPECT_TRUE(e.empty());
     Camera c = cameraAt(glm::dvec3(0, 0, 2), 0.3, 0.1);
@@ -157,8 +157,8 @@ TEST(Horizon, EmptyCityIsAllSkyAndInsideBuildingCullsNothing) {
     ASSERT_TRUE(r.active);
     for (int v : r.row) EXPECT_EQ(v, c.height);
     // Camera inside a tall box: geometry above the eye at distance 0 -> nothing culled.
-    LoadedCity city;
-    LoadedMesh m;
+    SceneModel city;
+    SceneMesh m;
     addBox(m, {-10, -10, 0}, {10, 10, 50}, {100, 100, 100, 255});
     city.meshes.push_back(m);
     HeightGrid hg = HeightGrid::build(city, glm::dvec3(0), 16);
@@ -167,7 +167,7 @@ TEST(Horizon, EmptyCityIsAllSkyAndInsideBuildingCullsNothing) {
 }
 
 TEST(Horizon, ViewportExtremes) {
-    LoadedCity city = randomCity(5, 40);
+    SceneModel city = randomCity(5, 40);
     auto rs = RayScene::build(city);
     ASSERT_TRUE(rs.isOk());
     HeightGrid hg = HeightGrid::build(city, glm::dvec3(0), 64);
@@ -195,7 +195,7 @@ TEST(Horizon, SubsamplingNeverCullsMoreThanOnItsOwnLattice) {
     // Subsampled horizon = max of the neighbouring samples: per column it is
     // at least as high (row <= ) as the exact one at the sampled rays only,
     // and it culls something in an open scene.
-    LoadedCity city = randomCity(9, 60);
+    SceneModel city = randomCity(9, 60);
     HeightGrid hg = HeightGrid::build(city, glm::dvec3(0), 64);
     Camera c = cameraAt(glm::dvec3(10, -230, 3), 0.1, 0.0, 121, 81);
     HorizonOptions o1, o4;

@@ -6,10 +6,10 @@
 #include <cmath>
 #include <random>
 
-#include "runtime/far_field.h"
-#include "runtime/horizon.h"
-#include "runtime/panorama_cache.h"
-#include "runtime/ray_scene.h"
+#include "runtime/engine/far_field.h"
+#include "runtime/engine/horizon.h"
+#include "runtime/engine/panorama_cache.h"
+#include "runtime/engine/ray_scene.h"
 #include "tests/farfield/fixtures.h"
 
 using namespace vista;
@@ -146,7 +146,7 @@ TEST(Panorama, ConfidenceOrderingAndEveryNthRule) {
 }
 
 TEST(Panorama, StillViewerConvergesToTheExactImage) {
-    LoadedCity city = randomCity(4, 70, 400.0, 1.0e6, 0.0);  // 1,000 km from the origin
+    SceneModel city = randomCity(4, 70, 400.0, 1.0e6, 0.0);  // 1,000 km from the origin
     auto rs = RayScene::build(city);
     ASSERT_TRUE(rs.isOk());
     HeightGrid grid = HeightGrid::build(city, rs.value()->frameOrigin(), 64);
@@ -189,7 +189,7 @@ TEST(Panorama, StillViewerConvergesToTheExactImage) {
 }
 
 TEST(FarField, PixelClassesPartitionTheImageAndStagesRunOnlyWhenNeeded) {
-    LoadedCity city = randomCity(6, 50);
+    SceneModel city = randomCity(6, 50);
     auto rs = RayScene::build(city);
     ASSERT_TRUE(rs.isOk());
     HeightGrid grid = HeightGrid::build(city, glm::dvec3(0), 64);
@@ -207,20 +207,20 @@ TEST(FarField, PixelClassesPartitionTheImageAndStagesRunOnlyWhenNeeded) {
     EXPECT_EQ(st.pixels.covered, N - N / 2);
     EXPECT_EQ(st.pixels.covered + st.pixels.horizonCulled + st.pixels.cache + st.pixels.rayHit + st.pixels.rayMiss, N);
     EXPECT_GT(st.pixels.horizonCulled, 0u);
-    EXPECT_TRUE(st.stagesMs.count("horizon"));
-    EXPECT_TRUE(st.stagesMs.count("rays"));
+    EXPECT_TRUE(st.stages.ran(Stage::Horizon));
+    EXPECT_TRUE(st.stages.ran(Stage::Rays));
     // Fully covered: only the opacity stage runs.
     std::vector<float> full(N, 0.2f);
     FrameStats s2;
     ff.render(c, full.data(), img, s2);
     EXPECT_EQ(s2.pixels.covered, N);
-    EXPECT_EQ(s2.stagesMs.size(), 1u);
+    EXPECT_EQ(s2.stages.count(), 1u);
     // Rolled camera: horizon off, says so, still a complete classification.
     Camera r = c;
     r.roll = 0.2;
     FrameStats s3;
     ff.render(r, nullptr, img, s3);
-    EXPECT_FALSE(s3.stagesMs.count("horizon"));
+    EXPECT_FALSE(s3.stages.ran(Stage::Horizon));
     ASSERT_FALSE(s3.notes.empty());
     EXPECT_EQ(s3.pixels.horizonCulled, 0u);
     EXPECT_EQ(s3.pixels.rayHit + s3.pixels.rayMiss, N);
@@ -230,13 +230,13 @@ TEST(FarField, PixelClassesPartitionTheImageAndStagesRunOnlyWhenNeeded) {
     ff.setOptions(far);
     FrameStats s4;
     ff.render(c, depth.data(), img, s4);
-    EXPECT_FALSE(s4.stagesMs.count("rays"));
+    EXPECT_FALSE(s4.stages.ran(Stage::Rays));
     EXPECT_EQ(s4.pixels.rayHit + s4.pixels.rayMiss, 0u);
     EXPECT_EQ(s4.pixels.covered + s4.pixels.horizonCulled, N);
 }
 
 TEST(FarField, HardCasesStayFinite) {
-    LoadedCity city = randomCity(8, 40);
+    SceneModel city = randomCity(8, 40);
     auto rs = RayScene::build(city);
     ASSERT_TRUE(rs.isOk());
     HeightGrid grid = HeightGrid::build(city, glm::dvec3(0), 32);
@@ -260,7 +260,7 @@ TEST(FarField, HardCasesStayFinite) {
         for (size_t i = 3; i < img.rgba.size(); i += 4) ASSERT_EQ(img.rgba[i], 255);  // every pixel written
     }
     // Empty city: nothing to trace, all sky.
-    LoadedCity empty;
+    SceneModel empty;
     auto er = RayScene::build(empty);
     ASSERT_TRUE(er.isOk());
     HeightGrid eg = HeightGrid::build(empty, glm::dvec3(0), 16);
@@ -273,7 +273,7 @@ TEST(FarField, HardCasesStayFinite) {
 }
 
 TEST(FarField, LargeViewport) {
-    LoadedCity city = randomCity(10, 30);
+    SceneModel city = randomCity(10, 30);
     auto rs = RayScene::build(city);
     ASSERT_TRUE(rs.isOk());
     HeightGrid grid = HeightGrid::build(city, glm::dvec3(0), 64);

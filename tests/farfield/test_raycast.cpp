@@ -7,7 +7,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "runtime/ray_scene.h"
+#include "runtime/engine/ray_scene.h"
+#include "runtime/scene/scene_graph.h"
 #include "tests/farfield/fixtures.h"
 
 using namespace vista;
@@ -15,11 +16,11 @@ using namespace vista::test;
 
 namespace {
 
-LoadedCity oneBox(double ox = 0, double oy = 0) {
-    LoadedCity c;
+SceneModel oneBox(double ox = 0, double oy = 0) {
+    SceneModel c;
     c.params.origin_x = ox;
     c.params.origin_y = oy;
-    LoadedMesh m;
+    SceneMesh m;
     m.origin = glm::dvec3(ox, oy, 0);
     addBox(m, {-5, -10, 0}, {5, 10, 20}, {200, 100, 50, 255});
     c.meshes.push_back(m);
@@ -46,8 +47,8 @@ TEST(RayScene, HitsBoxFaceWithDistanceColourAndNormal) {
 }
 
 TEST(RayScene, InterpolatesVertexColoursLikeTheRasteriser) {
-    LoadedCity c;
-    LoadedMesh m;
+    SceneModel c;
+    SceneMesh m;
     m.positions = {{0, 0, 0}, {10, 0, 0}, {0, 10, 0}};
     m.colors = {{255, 0, 0, 255}, {0, 255, 0, 255}, {0, 0, 255, 255}};
     m.indices = {0, 1, 2};
@@ -69,7 +70,7 @@ TEST(RayScene, InterpolatesVertexColoursLikeTheRasteriser) {
 }
 
 TEST(RayScene, PacketsAgreeWithSingleRays) {
-    LoadedCity city = randomCity(3, 60);
+    SceneModel city = randomCity(3, 60);
     auto rs = RayScene::build(city);
     ASSERT_TRUE(rs.isOk()) << rs.status().message();
     std::mt19937 rng(11);
@@ -97,14 +98,14 @@ TEST(RayScene, PacketsAgreeWithSingleRays) {
 }
 
 TEST(RayScene, InstancesUseWorldTransformAndNormals) {
-    LoadedCity c;
-    LoadedMesh proto;
+    SceneModel c;
+    SceneMesh proto;
     addBox(proto, {-1, -1, 0}, {1, 1, 4}, {10, 150, 20, 255});
     c.prototypes.push_back(proto);
-    LoadedInstance a;
+    SceneInstance a;
     a.prototype = 0;
     a.transform = glm::translate(glm::dmat4(1.0), glm::dvec3(0, 30, 0));
-    LoadedInstance b;
+    SceneInstance b;
     b.prototype = 0;
     b.transform = glm::rotate(glm::translate(glm::dmat4(1.0), glm::dvec3(30, 0, 0)), 0.5 * M_PI, glm::dvec3(0, 0, 1)) *
                   glm::scale(glm::dmat4(1.0), glm::dvec3(2.0));
@@ -142,7 +143,7 @@ TEST(RayScene, PreciseOneThousandKilometresFromOrigin) {
 }
 
 TEST(RayScene, EmptyCityBuildsAndMisses) {
-    LoadedCity c;
+    SceneModel c;
     auto rs = RayScene::build(c);
     ASSERT_TRUE(rs.isOk()) << rs.status().message();
     EXPECT_EQ(rs.value()->triangleCount(), 0u);
@@ -155,14 +156,14 @@ TEST(RayScene, EmptyCityBuildsAndMisses) {
 }
 
 TEST(RayScene, RejectsMalformedMeshes) {
-    LoadedCity c = oneBox();
+    SceneModel c = oneBox();
     c.meshes[0].indices.push_back(999);
     c.meshes[0].indices.push_back(0);
     c.meshes[0].indices.push_back(1);
     auto rs = RayScene::build(c);
     ASSERT_FALSE(rs.isOk());
     EXPECT_NE(rs.status().message().find("mesh 0"), std::string::npos);
-    LoadedCity d = oneBox();
+    SceneModel d = oneBox();
     d.instances.push_back({3, glm::dmat4(1.0)});
     EXPECT_FALSE(RayScene::build(d).isOk());
 }
@@ -187,11 +188,11 @@ TEST(RayScene, CullsBackFacesLikeTheRasteriser) {
 #include <unistd.h>
 
 #include "citygen/generate.h"
-#include "runtime/far_field.h"
-#include "runtime/horizon.h"
-#include "runtime/metrics.h"
-#include "runtime/mode_hybrid.h"
-#include "runtime/offscreen.h"
+#include "runtime/engine/far_field.h"
+#include "runtime/engine/horizon.h"
+#include "runtime/engine/metrics.h"
+#include "nodes/render/mode_hybrid.h"
+#include "nodes/render/offscreen.h"
 #include "nodes/far_field_node.h"
 #include "nodes/near_far_split.h"
 
@@ -216,7 +217,7 @@ TEST(RayRaster, StillFrameOfHybridAndRaysMatchTheRasteriser) {
     if (!renderer) GTEST_SKIP() << renderer.status().message();
     BenchContext ctx;
     ctx.city = &*loaded;
-    ctx.scene = loaded->scene.get();
+    ctx.scene = sceneRoot(*loaded);
     ctx.renderer = renderer->get();
     ctx.rays = rs->get();
     ctx.options.nearDistance = 60;
@@ -242,7 +243,7 @@ TEST(RayRaster, StillFrameOfHybridAndRaysMatchTheRasteriser) {
     for (const Camera& c : cams) {
         Image full, hyb, rays;
         FrameStats fs, hs, rsStats;
-        ASSERT_TRUE(renderer.value()->render(loaded->scene.get(), c, 0.0, &full, nullptr, fs).isOk());
+        ASSERT_TRUE(renderer.value()->render(sceneRoot(*loaded), c, 0.0, &full, nullptr, fs).isOk());
         ASSERT_TRUE(hybrid.value()->renderFrame(c, hyb, hs).isOk());
         FarFieldOptions o;
         o.nearDistance = 0;
@@ -294,7 +295,7 @@ TEST(RayRaster, OsgNodesCompositeTheFarFieldInsideAnOsgFrame) {
     c.fovY = 60.0 * M_PI / 180.0;
     Image full, hyb;
     FrameStats fs, hs;
-    ASSERT_TRUE(renderer.value()->render(loaded->scene.get(), c, 0.0, &full, nullptr, fs).isOk());
+    ASSERT_TRUE(renderer.value()->render(sceneRoot(*loaded), c, 0.0, &full, nullptr, fs).isOk());
     ASSERT_TRUE(renderer.value()->render(hybrid.get(), c, 0.0, &hyb, nullptr, hs).isOk());
     // The split drew only part of the city; the far field filled the rest.
     EXPECT_LT(split->lastNearTriangles(), loaded->triangles);

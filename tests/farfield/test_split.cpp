@@ -1,8 +1,8 @@
 // Near/far split selection and the adaptive near distance.
 #include <gtest/gtest.h>
 
-#include "runtime/adaptive_split.h"
-#include "runtime/ray_scene.h"
+#include "runtime/engine/adaptive_split.h"
+#include "runtime/engine/ray_scene.h"
 #include "tests/farfield/fixtures.h"
 
 using namespace vista;
@@ -39,7 +39,7 @@ TEST(Split, DistanceSelectionDrawsStraddlingObjectsWhole) {
 }
 
 TEST(Split, AdaptiveChoiceFollowsTheMeasuredCosts) {
-    LoadedCity city = randomCity(12, 150, 800.0);
+    SceneModel city = randomCity(12, 150, 800.0);
     auto rs = RayScene::build(city);
     ASSERT_TRUE(rs.isOk());
     // One object per 50 m square of boxes, with their triangles.

@@ -20,8 +20,10 @@
 #include <osg/MatrixTransform>
 
 #include "citygen/generate.h"
-#include "runtime/city_file.h"
-#include "runtime/city_file_io.h"
+#include "foundation/atomic_file.h"
+#include "runtime/scene/city_file.h"
+#include "runtime/scene/scene_graph.h"
+#include "runtime/scene/scene_file.h"
 
 #include "tests/common/temp_dir.h"
 
@@ -150,7 +152,7 @@ TEST(CityFile, RoundTrip) {
     ASSERT_TRUE(s.isOk()) << s.message();
     auto r = loadCityFile(path);
     ASSERT_TRUE(r.isOk()) << r.status().message();
-    const LoadedCity& lc = *r;
+    const SceneModel& lc = *r;
     EXPECT_EQ(paramsToJson(lc.params), paramsToJson(c.params));
     // Meshes: one per tile and non-empty material, in tile/material order.
     std::vector<std::pair<const Tile*, const Mesh*>> expected;
@@ -160,7 +162,7 @@ TEST(CityFile, RoundTrip) {
     ASSERT_EQ(lc.meshes.size(), expected.size());
     for (size_t i = 0; i < expected.size(); ++i) {
         const Mesh& m = *expected[i].second;
-        const LoadedMesh& l = lc.meshes[i];
+        const SceneMesh& l = lc.meshes[i];
         EXPECT_EQ(l.origin, glm::dvec3(5000 + expected[i].first->origin.x, -3000 + expected[i].first->origin.y, expected[i].first->origin.z));
         EXPECT_EQ(l.positions, m.positions);
         EXPECT_EQ(l.colors, m.colors);
@@ -175,7 +177,7 @@ TEST(CityFile, RoundTrip) {
     // Instances: world transform of the prototype origin = world tree base.
     ASSERT_EQ(lc.instances.size(), c.trees.size());
     std::vector<bool> matched(c.trees.size(), false);
-    for (const LoadedInstance& li : lc.instances) {
+    for (const SceneInstance& li : lc.instances) {
         glm::dvec3 base = glm::dvec3(li.transform * glm::dvec4(0, 0, 0, 1));
         glm::dvec3 top = glm::dvec3(li.transform * glm::dvec4(0, 0, 1, 1)) - base;
         bool found = false;
@@ -207,7 +209,7 @@ TEST(CityFile, RoundTrip) {
         EXPECT_EQ(lc.streets.nodes.size(), c.streets.nodes.size());
         EXPECT_EQ(lc.streets.edges.size(), c.streets.edges.size());
     }
-    ASSERT_TRUE(lc.scene.valid());
+    ASSERT_NE(sceneRoot(lc), nullptr);
 }
 
 TEST(CityFile, DeterministicBytes) {
@@ -238,7 +240,7 @@ TEST(CityFile, FarFromOriginKeepsMillimetres) {
         for (const Mesh& m : t.meshes) {
             if (m.empty()) continue;
             ASSERT_LT(mi, r->meshes.size());
-            const LoadedMesh& l = r->meshes[mi++];
+            const SceneMesh& l = r->meshes[mi++];
             for (size_t i = 0; i < m.positions.size(); ++i) {
                 glm::dvec3 expect = glm::dvec3(ox, oy, 0) + t.origin + glm::dvec3(m.positions[i]);
                 glm::dvec3 got = l.origin + glm::dvec3(l.positions[i]);
@@ -246,7 +248,7 @@ TEST(CityFile, FarFromOriginKeepsMillimetres) {
             }
         }
     EXPECT_LT(worst, 1e-3);
-    for (const LoadedInstance& li : r->instances) {
+    for (const SceneInstance& li : r->instances) {
         glm::dvec3 base = glm::dvec3(li.transform * glm::dvec4(0, 0, 0, 1));
         double best = 1e30;
         for (const TreeInstance& t : c.trees) best = std::min(best, glm::length(base - (t.position + glm::dvec3(ox, oy, 0))));
@@ -384,8 +386,8 @@ TEST(CityFile, GeneratedCityRoundTrip) {
     EXPECT_EQ(r->streets.edges.size(), city->streets.edges.size());
     EXPECT_EQ(paramsToJson(r->params), paramsToJson(city->params));
     size_t stored = 0;
-    for (const LoadedMesh& m : r->meshes) stored += m.indices.size() / 3;
-    for (const LoadedMesh& m : r->prototypes) stored += m.indices.size() / 3;
+    for (const SceneMesh& m : r->meshes) stored += m.indices.size() / 3;
+    for (const SceneMesh& m : r->prototypes) stored += m.indices.size() / 3;
     // Prototypes that no tile uses are not in the file.
     size_t unused = 0;
     std::vector<bool> used(city->treePrototypes.size(), false);

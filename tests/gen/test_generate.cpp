@@ -6,7 +6,7 @@
 
 #include "citygen/generate.h"
 #include "citygen/polygon.h"
-#include "citygen/rng.h"
+#include "foundation/rng.h"
 
 using namespace vista;
 

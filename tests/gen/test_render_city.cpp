@@ -8,9 +8,10 @@
 
 #include "citygen/generate.h"
 #include "citygen/lighting.h"
-#include "runtime/city_file.h"
-#include "runtime/offscreen.h"
-#include "runtime/paths.h"
+#include "runtime/scene/city_file.h"
+#include "runtime/scene/scene_graph.h"
+#include "nodes/render/offscreen.h"
+#include "runtime/scene/paths.h"
 
 using namespace vista;
 

@@ -16,19 +16,20 @@
 #include <nlohmann/json.hpp>
 
 #include "citygen/lighting.h"
-#include "runtime/bench.h"
-#include "runtime/city_file.h"
-#include "runtime/metrics.h"
-#include "runtime/offscreen.h"
-#include "runtime/paths.h"
-#include "runtime/ray_scene.h"
+#include "foundation/units.h"
+#include "cmd/bench.h"
+#include "runtime/scene/city_file.h"
+#include "runtime/scene/scene_graph.h"
+#include "runtime/engine/metrics.h"
+#include "nodes/render/offscreen.h"
+#include "runtime/scene/paths.h"
+#include "runtime/engine/ray_scene.h"
 
 using namespace vista;
 namespace fs = std::filesystem;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 #define REQUIRE_DISPLAY()                                                                        \
     do {                                                                                         \
@@ -36,8 +37,8 @@ constexpr double kPi = 3.14159265358979323846;
         if (!d || !*d) GTEST_SKIP() << "no X display: run the rendering tests under xvfb-run -a"; \
     } while (0)
 
-// Axis-aligned box (5 faces, no bottom) as a LoadedMesh in a local frame.
-void addBox(LoadedMesh& m, glm::vec3 lo, glm::vec3 hi, glm::u8vec4 c) {
+// Axis-aligned box (5 faces, no bottom) as a SceneMesh in a local frame.
+void addBox(SceneMesh& m, glm::vec3 lo, glm::vec3 hi, glm::u8vec4 c) {
     glm::vec3 p[8];
     for (int i = 0; i < 8; ++i) p[i] = {i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z};
     const int faces[5][4] = {{0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}, {4, 5, 7, 6}};
@@ -50,7 +51,7 @@ void addBox(LoadedMesh& m, glm::vec3 lo, glm::vec3 hi, glm::u8vec4 c) {
         for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) m.indices.push_back(base + i);
     }
 }
-void addQuad(LoadedMesh& m, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, glm::u8vec4 col) {
+void addQuad(SceneMesh& m, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, glm::u8vec4 col) {
     uint32_t base = uint32_t(m.positions.size());
     for (auto v : {a, b, c, d}) {
         m.positions.push_back(v);
@@ -61,7 +62,7 @@ void addQuad(LoadedMesh& m, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, 
 
 // The OSG scene of a set of meshes, structured like a city file (tiles as
 // double MatrixTransforms, prelit colours, lighting off).
-osg::ref_ptr<osg::Group> sceneOf(const std::vector<LoadedMesh>& meshes) {
+osg::ref_ptr<osg::Group> sceneOf(const std::vector<SceneMesh>& meshes) {
     osg::ref_ptr<osg::Group> root = new osg::Group;
     root->getOrCreateStateSet()->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
     for (const auto& m : meshes) {
@@ -91,20 +92,20 @@ osg::ref_ptr<osg::Group> sceneOf(const std::vector<LoadedMesh>& meshes) {
 
 // A little "city": ground and a few coloured blocks, far from the world origin.
 const glm::dvec3 kWorld(1.0e6, 2.0e6, 0.0);
-LoadedCity tinyCity() {
-    LoadedCity c;
-    LoadedMesh ground;
+SceneModel tinyCity() {
+    SceneModel c;
+    SceneMesh ground;
     ground.origin = kWorld;
     addQuad(ground, {-400, -400, 0}, {400, -400, 0}, {400, 400, 0}, {-400, 400, 0}, {90, 110, 80, 255});
     c.meshes.push_back(ground);
-    LoadedMesh blocks;
+    SceneMesh blocks;
     blocks.origin = kWorld + glm::dvec3(0, 100, 0);
     addBox(blocks, {-60, -20, 0}, {-20, 20, 30}, {200, 80, 60, 255});
     addBox(blocks, {10, -10, 0}, {40, 30, 55}, {60, 90, 200, 255});
     addBox(blocks, {-15, 80, 0}, {25, 120, 90}, {220, 210, 170, 255});
     c.meshes.push_back(blocks);
     for (const auto& m : c.meshes) c.triangles += m.indices.size() / 3;
-    c.scene = sceneOf(c.meshes);
+    setSceneRoot(c, sceneOf(c.meshes));
     return c;
 }
 
@@ -159,7 +160,7 @@ TEST(Offscreen, ColourDepthOrientationAndCounts) {
     ASSERT_TRUE(r.isOk()) << r.status().message();
     // A red wall 50 m ahead (north) covering the upper half of a level view
     // (from eye height up), in a tile far from the world origin.
-    LoadedMesh wall;
+    SceneMesh wall;
     wall.origin = kWorld + glm::dvec3(0, 50, 0);
     addQuad(wall, {-500, 0, 1.7f}, {500, 0, 1.7f}, {500, 0, 900}, {-500, 0, 900}, {255, 0, 0, 255});
     auto scene = sceneOf({wall});
@@ -184,7 +185,7 @@ TEST(Offscreen, ColourDepthOrientationAndCounts) {
     ASSERT_TRUE(r.value()->render(scene.get(), cam, 40.0, &img, nullptr, st).isOk());
     EXPECT_EQ(img.at(48, 0), skyColor(std::asin(cam.rayDirection(48.5, 0.5).z)));
     // A small object wholly beyond the near plane is culled, not just clipped.
-    LoadedMesh far;
+    SceneMesh far;
     far.origin = kWorld + glm::dvec3(0, 200, 0);
     addQuad(far, {-5, 0, 0}, {5, 0, 0}, {5, 0, 10}, {-5, 0, 10}, {0, 255, 0, 255});
     auto farScene = sceneOf({far});
@@ -228,7 +229,7 @@ TEST(Bench, ModeTableAndParsing) {
 
 TEST(Bench, SyntheticSceneSmokeRun) {
     REQUIRE_DISPLAY();
-    LoadedCity city = tinyCity();
+    SceneModel city = tinyCity();
     Path path;
     for (int i = 0; i < 4; ++i) {
         PathSample s;
@@ -245,7 +246,7 @@ TEST(Bench, SyntheticSceneSmokeRun) {
     cfg.options.nearDistance = 120;
     cfg.outDir = tmpDir("smoke");
     cfg.quiet = true;
-    auto r = runBenchmark(nullptr, city.scene.get(), path, cfg);
+    auto r = runBenchmark(nullptr, sceneRoot(city), path, cfg);
     ASSERT_TRUE(r.isOk()) << r.status().message();
     ASSERT_EQ(r->modes.size(), 3u);
     EXPECT_EQ(r->modes[0].mode, "full");
@@ -275,7 +276,7 @@ TEST(Bench, SyntheticSceneSmokeRun) {
 
 TEST(Bench, SupersampledReferenceIsCloserToItselfThanAliasedFrames) {
     REQUIRE_DISPLAY();
-    LoadedCity city = tinyCity();
+    SceneModel city = tinyCity();
     Path path;
     PathSample s;
     s.position = kWorld + glm::dvec3(0, -20, 1.7);
@@ -287,7 +288,7 @@ TEST(Bench, SupersampledReferenceIsCloserToItselfThanAliasedFrames) {
     cfg.modes = {"full"};
     cfg.referenceSsaa = 3;
     cfg.quiet = true;
-    auto r = runBenchmark(nullptr, city.scene.get(), path, cfg);
+    auto r = runBenchmark(nullptr, sceneRoot(city), path, cfg);
     ASSERT_TRUE(r.isOk()) << r.status().message();
     // The aliased full frame differs from the 3x3 supersampled reference
     // (edges), but stays close to it.
@@ -300,14 +301,14 @@ TEST(Bench, SupersampledReferenceIsCloserToItselfThanAliasedFrames) {
 // on different sides of a triangle edge).
 TEST(Bench, RaycastAgreesWithFull) {
     REQUIRE_DISPLAY();
-    LoadedCity city = tinyCity();
+    SceneModel city = tinyCity();
     auto rs = RayScene::build(city);
     ASSERT_TRUE(rs.isOk()) << rs.status().message();
     auto r = OffscreenRenderer::create(160, 120);
     ASSERT_TRUE(r.isOk()) << r.status().message();
     BenchContext ctx;
     ctx.city = &city;
-    ctx.scene = city.scene.get();
+    ctx.scene = sceneRoot(city);
     ctx.renderer = r.value().get();
     ctx.rays = rs.value().get();
     auto full = makeMode("full", ctx), ray = makeMode("raycast", ctx);

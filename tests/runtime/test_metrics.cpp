@@ -7,9 +7,9 @@
 #include <random>
 #include <unistd.h>
 
-#include "runtime/image.h"
-#include "runtime/metrics.h"
-#include "runtime/plot.h"
+#include "runtime/engine/image.h"
+#include "runtime/engine/metrics.h"
+#include "cmd/plot.h"
 
 using namespace vista;
 

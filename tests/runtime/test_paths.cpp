@@ -8,13 +8,13 @@
 #include <fstream>
 #include <unistd.h>
 
-#include "runtime/paths.h"
+#include "runtime/scene/paths.h"
+#include "foundation/units.h"
 
 using namespace vista;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // A 6 x 6 grid of streets, 120 m apart, plus one dead-end spur.
 StreetGraph gridGraph() {

@@ -1,0 +1,52 @@
+// vista path: a deterministic walkthrough path along the city's streets -> CSV.
+#include <cstdio>
+#include <string>
+
+#include "runtime/scene/city_file.h"
+#include "foundation/units.h"
+#include "cmd/cli.h"
+#include "cmd/commands.h"
+#include "runtime/scene/paths.h"
+
+namespace vista {
+
+int runPath(int argc, char** argv) {
+    CLI::App app{"Make a deterministic walkthrough path along the city's street graph (CSV: t_s,x_m,y_m,z_m,heading_deg,pitch_deg).",
+                 "vista path"};
+    std::string city, out, kind = "car";
+    PathOptions o;
+    double yawDeg = 45.0, pitchDeg = o.flyPitch * 180.0 / kPi;
+    app.add_option("city", city, "city scene file (.osgb) written by `vista gen`")->required();
+    app.add_option("--seed", o.seed, "random seed of the route (default 1)");
+    app.add_option("--kind", kind, "walk (eye 1.7 m), car (eye 1.2 m) or fly (elevated fly-over); default car");
+    app.add_option("--duration", o.duration, "path length in seconds (default 60)");
+    app.add_option("--dt", o.dt, "seconds between samples (default 1/30)");
+    app.add_option("--speed", o.maxSpeed, "maximum speed in m/s (default 14)");
+    app.add_option("--yaw-rate", yawDeg, "maximum yaw rate in degrees/s (default 45)");
+    app.add_option("--fly-height", o.flyHeight, "fly-over height above the terrain in metres (default 80)");
+    app.add_option("--fly-pitch", pitchDeg, "fly-over pitch in degrees (default -11.5)");
+    app.add_option("-o,--output", out, "output CSV file")->required();
+    int rc = parseOrExit(app, argc, argv);
+    if (rc >= 0) return rc;
+
+    auto k = parsePathKind(kind);
+    if (!k) return reportBadInput("vista path", Status::error("--kind: " + k.status().message()));
+    o.kind = k.value();
+    o.maxYawRate = yawDeg * kPi / 180.0;
+    o.flyPitch = pitchDeg * kPi / 180.0;
+    if (Status s = validatePathOptions(o); !s) return reportBadInput("vista path", s);
+    if (Status s = checkWritablePath("--output", out); !s) return reportBadInput("vista path", s);
+    auto c = loadCityFile(city);
+    if (!c) return reportBadInput("vista path", c.status());
+    auto p = generatePath(c->streets, c->params, o);
+    if (!p) return reportBadInput("vista path", p.status());
+    if (Status s = savePathCsv(p.value(), out); !s) {
+        std::fprintf(stderr, "vista path: %s\n", s.message().c_str());
+        return 1;
+    }
+    std::fprintf(stderr, "vista path: %zu samples (%.1f s, %s) -> %s\n", p->samples.size(), o.duration, pathKindName(o.kind),
+                 out.c_str());
+    return 0;
+}
+
+}  // namespace vista

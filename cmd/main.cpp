@@ -1,0 +1,64 @@
+// vista: procedural cities and fast walkthroughs. Git-style subcommands.
+#include <cstdio>
+#include <cstring>
+#include <string>
+
+#include "nodes/render/mode_impostor.h"
+#include "cmd/bench.h"
+#include "cmd/commands.h"
+
+namespace {
+
+struct Command {
+    const char* name;
+    int (*run)(int, char**);
+    const char* summary;
+};
+
+const Command kCommands[] = {
+    {"gen", vista::runGen, "generate a city: params -> city.osgb (+ GeoJSON, glTF, stats)"},
+    {"path", vista::runPath, "make a deterministic walkthrough path along the streets (CSV)"},
+    {"bench", vista::runBench, "headless walkthrough: render modes side by side, write CSV/JSON/PNG"},
+    {"view", vista::runView, "interactive viewer (window; works under Xvfb)"},
+    {"bake", vista::runBake, "bake view cells and point impostors into city.baked.osgb"},
+};
+
+void usage(FILE* f) {
+    std::fprintf(f, "usage: vista <command> [options]\n\ncommands:\n");
+    for (const auto& c : kCommands) std::fprintf(f, "  %-7s %s\n", c.name, c.summary);
+    std::fprintf(f, "  help    show this list, or `vista help <command>` for a command's options\n");
+    std::fprintf(f, "\nRun `vista <command> --help` for the options of one command.\n");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    vista::registerBenchMode({"impostor", "near field + baked point impostors (needs --baked)", false, vista::makeImpostorMode});
+    if (argc < 2) {
+        usage(stderr);
+        return 2;
+    }
+    std::string cmd = argv[1];
+    if (cmd == "help" || cmd == "--help" || cmd == "-h") {
+        if (argc >= 3) {
+            for (const auto& c : kCommands)
+                if (std::strcmp(argv[2], c.name) == 0) {
+                    char* args[] = {argv[2], const_cast<char*>("--help"), nullptr};
+                    return c.run(2, args);
+                }
+            std::fprintf(stderr, "vista: unknown command '%s'\n", argv[2]);
+            return 2;
+        }
+        usage(stdout);
+        return 0;
+    }
+    if (cmd == "--version") {
+        std::printf("vista 0.1.0\n");
+        return 0;
+    }
+    for (const auto& c : kCommands)
+        if (cmd == c.name) return c.run(argc - 1, argv + 1);
+    std::fprintf(stderr, "vista: unknown command '%s'\n\n", cmd.c_str());
+    usage(stderr);
+    return 2;
+}

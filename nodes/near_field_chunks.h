@@ -1,0 +1,43 @@
+// Near-field chunker: the city re-chunked into small square chunks so that
+// the near/far split (NearFarSplit, the hybrid mode) can draw exactly the
+// geometry within the near distance.
+//
+// Near field granularity: the city's 250 m tiles are far coarser than a 100 m
+// near distance, so the chunker re-chunks the loaded scene into square chunks
+// (kNearChunkSize metres, by triangle centroid; triangles larger than a chunk
+// go to a per-tile "large" chunk; trees by trunk position, drawn with the
+// city file's own instanced state set). Same vertices, colours and state as
+// the loaded scene, so near-field pixels equal the `full` mode's.
+//
+// Contract: buildNearFieldScene() keeps the vertices, colours and state of the
+// graph it is given, so a chunked draw shows the same pixels as the unchunked
+// one. Chunks and objects are index-aligned: chunks[i] is drawn iff objects[i]
+// is selected. Pure (builds new nodes; the input graph is not modified).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <osg/Group>
+#include <osg/Node>
+#include <osg/StateSet>
+
+#include "runtime/engine/adaptive_split.h"
+
+namespace vista {
+
+constexpr double kNearChunkSize = 40.0;  // metres
+
+// The city re-chunked for a fine near/far split: chunks[i] is drawn iff
+// objects[i] is selected. rootState = the city root's state set.
+struct NearFieldScene {
+    osg::ref_ptr<osg::StateSet> rootState;
+    std::vector<osg::ref_ptr<osg::Node>> chunks;
+    std::vector<SplitObject> objects;
+    uint64_t triangles = 0;
+};
+// Builds chunks from a scene graph written by buildCityScene()/loaded by
+// loadCityFile(). Unknown node layouts are kept as single chunks (bounds from
+// OSG), so any scene works, only more coarsely.
+NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunkSize = kNearChunkSize);
+
+}  // namespace vista

@@ -1,0 +1,369 @@
+// OffscreenRenderer: osgViewer window (works under Xvfb + llvmpipe) with
+// explicit view/projection, CPU sky background, glFinish timing and readback.
+#include "nodes/render/offscreen.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <thread>
+
+#include <osg/Depth>
+#include <osg/GL>
+#include <osg/Geometry>
+#include <osg/Texture2D>
+#include <osgUtil/RenderStage>
+#include <osgUtil/SceneView>
+#include <osgUtil/StateGraph>
+#include <osgViewer/Renderer>
+#include <osgViewer/Viewer>
+
+#include <glm/gtc/type_ptr.hpp>
+
+#include "citygen/lighting.h"
+
+namespace vista {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+// Final draw callback: waits for the GL, reads colour and depth back.
+struct Readback : public osg::Camera::DrawCallback {
+    int width = 0, height = 0;
+    std::vector<uint8_t>* color = nullptr;
+    std::vector<float>* depth = nullptr;
+    mutable Clock::time_point finished;
+    mutable double readMs = 0;
+    mutable std::string renderer;
+    void operator()(osg::RenderInfo&) const override {
+        glFinish();
+        finished = Clock::now();
+        if (renderer.empty()) {
+            const char* r = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+            const char* v = reinterpret_cast<const char*>(glGetString(GL_VERSION));
+            renderer = std::string(r ? r : "?") + " / OpenGL " + (v ? v : "?");
+        }
+        glPixelStorei(GL_PACK_ALIGNMENT, 1);
+        glReadBuffer(GL_BACK);
+        if (color) {
+            color->resize(size_t(width) * size_t(height) * 4);
+            glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, color->data());
+        }
+        if (depth) {
+            depth->resize(size_t(width) * size_t(height));
+            glReadPixels(0, 0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, depth->data());
+        }
+        readMs = msSince(finished);
+    }
+};
+
+// Counts triangles and draw calls of everything culled into a render stage.
+struct PrimitiveCounter {
+    const osg::Drawable* skip = nullptr;
+    uint64_t triangles = 0, drawCalls = 0;
+    void leaf(const osgUtil::RenderLeaf* l) {
+        const osg::Drawable* d = l->getDrawable();
+        if (!d || d == skip) return;
+        const osg::Geometry* g = d->asGeometry();
+        if (!g) {  // e.g. impostor sprites: one quad
+            triangles += 2;
+            drawCalls += 1;
+            return;
+        }
+        for (unsigned i = 0; i < g->getNumPrimitiveSets(); ++i) {
+            const osg::PrimitiveSet* ps = g->getPrimitiveSet(i);
+            uint64_t n = ps->getNumIndices(), inst = uint64_t(std::max(1, ps->getNumInstances())), t = 0;
+            switch (ps->getMode()) {
+                case GL_TRIANGLES: t = n / 3; break;
+                case GL_TRIANGLE_STRIP:
+                case GL_TRIANGLE_FAN: t = n >= 3 ? n - 2 : 0; break;
+                case GL_QUADS: t = n / 2; break;
+                case GL_QUAD_STRIP: t = n >= 4 ? n - 2 : 0; break;
+                default: t = 0;
+            }
+            triangles += t * inst;
+            drawCalls += 1;
+        }
+    }
+    void bin(const osgUtil::RenderBin* b) {
+        if (!b) return;
+        for (const auto& kv : b->getRenderBinList()) bin(kv.second.get());
+        for (const auto* l : b->getRenderLeafList()) leaf(l);
+        for (const auto* sg : b->getStateGraphList())
+            for (const auto& l : sg->_leaves) leaf(l.get());
+    }
+    void stage(const osgUtil::RenderStage* s) {
+        if (!s) return;
+        for (const auto& p : s->getPreRenderList()) stage(p.second.get());
+        bin(s);
+        for (const auto& p : s->getPostRenderList()) stage(p.second.get());
+    }
+};
+
+osg::Matrixd toOsg(const glm::dmat4& m) { return osg::Matrixd(glm::value_ptr(m)); }
+
+}  // namespace
+
+void renderSky(const Camera& camera, Image& out, double jx, double jy) {
+    if (out.width != camera.width || out.height != camera.height) out = Image(camera.width, camera.height);
+    // Elevation depends only on the row/column, pitch, roll and fov: one
+    // skyColor per pixel, no world position involved.
+    for (int y = 0; y < camera.height; ++y)
+        for (int x = 0; x < camera.width; ++x) {
+            glm::dvec3 d = camera.rayDirection(x + 0.5 + jx, y + 0.5 + jy);
+            out.set(x, y, skyColor(std::asin(std::clamp(d.z, -1.0, 1.0))));
+        }
+}
+
+struct OffscreenRenderer::Impl {
+    int width = 0, height = 0;
+    osg::ref_ptr<osgViewer::Viewer> viewer;
+    osg::ref_ptr<osg::Group> root, slot;
+    osg::ref_ptr<osg::Camera> bgCamera;
+    osg::ref_ptr<osg::Geometry> bgQuad;
+    osg::ref_ptr<osg::Image> bgImage;
+    osg::ref_ptr<osg::Texture2D> bgTexture;
+    osg::ref_ptr<Readback> readback;
+    std::vector<uint8_t> colorBuf;
+    double jx = 0, jy = 0;
+    // Sky cache: the sky image depends on (pitch, roll, fov, size, jitter) only.
+    Image sky;
+    bool skyValid = false;
+    double skyPitch = 0, skyRoll = 0, skyFov = 0, skyJx = 0, skyJy = 0;
+    // Identity of the last background uploaded (to skip redundant uploads).
+    const void* bgKey = nullptr;
+
+    void setBackground(const Image& img, const void* key) {
+        if (key && key == bgKey) return;
+        bgKey = key;
+        // Image row 0 (top) goes to texture row 0; the quad maps t=0 to the top.
+        std::memcpy(bgImage->data(), img.rgba.data(), img.rgba.size());
+        bgImage->dirty();
+    }
+
+    Status draw(osg::Node* scene, const Camera& camera, double zFar, Image* color, std::vector<float>* depth,
+                FrameStats& stats) {
+        if (camera.width != width || camera.height != height)
+            return Status::error("camera size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                                 " differs from the renderer's " + std::to_string(width) + "x" + std::to_string(height));
+        osg::Camera* cam = viewer->getCamera();
+        cam->setViewMatrix(toOsg(camera.view()));
+        osg::Matrixd proj = toOsg(camera.projection(zFar));
+        if (jx != 0 || jy != 0) proj = proj * osg::Matrixd::translate(-2.0 * jx / width, 2.0 * jy / height, 0.0);
+        cam->setProjectionMatrix(proj);
+        if (slot->getNumChildren() != 1 || slot->getChild(0) != scene) {
+            slot->removeChildren(0, slot->getNumChildren());
+            if (scene) slot->addChild(scene);
+        }
+        readback->color = color ? &colorBuf : nullptr;
+        readback->depth = depth;
+        auto t0 = Clock::now();
+        viewer->frame();
+        double frameMs = msSince(t0);
+        if (!readback->renderer.size()) return Status::error("offscreen render: the draw callback did not run");
+
+        stats.frameMs = frameMs;
+        double cull = 0, drawSec = 0;
+        osg::Stats* st = cam->getStats();
+        unsigned fn = viewer->getFrameStamp()->getFrameNumber();
+        if (st && st->getAttribute(fn, "Cull traversal time taken", cull)) stats.cullMs = cull * 1000.0;
+        (void)drawSec;
+        double untilFinish = std::chrono::duration<double, std::milli>(readback->finished - t0).count();
+        stats.drawMs = std::max(0.0, untilFinish - stats.cullMs);
+        stats.stages.set(Stage::Readback, readback->readMs);
+
+        PrimitiveCounter pc;
+        pc.skip = bgQuad.get();
+        if (auto* r = dynamic_cast<osgViewer::Renderer*>(cam->getRenderer()))
+            if (osgUtil::SceneView* sv = r->getSceneView(0)) pc.stage(sv->getRenderStage());
+        stats.triangles = pc.triangles;
+        stats.drawCalls = pc.drawCalls;
+
+        if (color) {
+            if (color->width != width || color->height != height) *color = Image(width, height);
+            size_t row = size_t(width) * 4;
+            for (int y = 0; y < height; ++y)
+                std::memcpy(&color->rgba[size_t(y) * row], &colorBuf[size_t(height - 1 - y) * row], row);
+        }
+        if (depth) {  // flip in place: row 0 at top
+            for (int y = 0; y < height / 2; ++y)
+                std::swap_ranges(depth->begin() + ptrdiff_t(y) * width, depth->begin() + ptrdiff_t(y + 1) * width,
+                                 depth->begin() + ptrdiff_t(height - 1 - y) * width);
+        }
+        return Status::ok();
+    }
+};
+
+OffscreenRenderer::OffscreenRenderer() : _impl(new Impl) {}
+OffscreenRenderer::~OffscreenRenderer() {
+    if (_impl && _impl->viewer) {
+        _impl->viewer->setSceneData(nullptr);
+        _impl->viewer = nullptr;
+    }
+}
+
+Result<std::unique_ptr<OffscreenRenderer>> OffscreenRenderer::create(int width, int height) {
+    if (width < 1 || height < 1 || width > 8192 || height > 8192)
+        return Status::error("render size " + std::to_string(width) + "x" + std::to_string(height) +
+                             " out of range 1x1 .. 8192x8192");
+    const char* display = std::getenv("DISPLAY");
+    if (!display || !*display)
+        return Status::error("no X display (DISPLAY is not set): run under `xvfb-run -a` on a machine without a screen");
+    osg::ref_ptr<osg::GraphicsContext::Traits> traits = new osg::GraphicsContext::Traits;
+    traits->readDISPLAY();
+    traits->setUndefinedScreenDetailsToDefaultScreen();
+    traits->x = 0;
+    traits->y = 0;
+    traits->width = width;
+    traits->height = height;
+    traits->windowDecoration = false;
+    traits->doubleBuffer = true;
+    traits->pbuffer = false;
+    traits->red = traits->green = traits->blue = 8;
+    traits->alpha = 8;
+    traits->depth = 24;
+    traits->vsync = false;
+    traits->windowName = "vista offscreen";
+    // Opening the window fails now and then under a busy Xvfb (the X
+    // connection is refused right after another context closed): retry a few times.
+    osg::ref_ptr<osg::GraphicsContext> gc;
+    for (int attempt = 0; attempt < 20; ++attempt) {
+        gc = osg::GraphicsContext::createGraphicsContext(traits.get());
+        if (gc && gc->valid()) break;
+        gc = nullptr;
+        std::this_thread::sleep_for(std::chrono::milliseconds(50 + 50 * attempt));
+    }
+    if (!gc || !gc->valid())
+        return Status::error(std::string("cannot create an OpenGL window on display '") + display +
+                             "' (no GLX visual with RGBA8 + depth24?); try `xvfb-run -a -s \"-screen 0 1920x1080x24\"`");
+
+    std::unique_ptr<OffscreenRenderer> r(new OffscreenRenderer);
+    Impl& m = *r->_impl;
+    m.width = width;
+    m.height = height;
+    m.viewer = new osgViewer::Viewer;
+    m.viewer->setThreadingModel(osgViewer::ViewerBase::SingleThreaded);
+    m.viewer->setKeyEventSetsDone(0);
+    m.viewer->setQuitEventSetsDone(false);
+    osg::Camera* cam = m.viewer->getCamera();
+    cam->setGraphicsContext(gc.get());
+    cam->setViewport(new osg::Viewport(0, 0, width, height));
+    cam->setDrawBuffer(GL_BACK);
+    cam->setReadBuffer(GL_BACK);
+    cam->setComputeNearFarMode(osg::CullSettings::DO_NOT_COMPUTE_NEAR_FAR);
+    // Exact frustum culling incl. near/far planes (the `near` mode relies on
+    // the far plane); no small-feature culling (the ray caster has none).
+    cam->setCullingMode((cam->getCullingMode() | osg::CullSettings::NEAR_PLANE_CULLING |
+                         osg::CullSettings::FAR_PLANE_CULLING) & ~osg::CullSettings::SMALL_FEATURE_CULLING);
+    cam->setClearColor(osg::Vec4(0, 0, 0, 1));
+    cam->setClearMask(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    cam->setProjectionResizePolicy(osg::Camera::FIXED);
+    if (cam->getStats()) cam->getStats()->collectStats("rendering", true);
+    m.readback = new Readback;
+    m.readback->width = width;
+    m.readback->height = height;
+    cam->setFinalDrawCallback(m.readback.get());
+
+    // Background: a screen-aligned textured quad drawn first, no depth.
+    m.bgImage = new osg::Image;
+    m.bgImage->allocateImage(width, height, 1, GL_RGBA, GL_UNSIGNED_BYTE);
+    m.bgImage->setInternalTextureFormat(GL_RGBA8);
+    std::memset(m.bgImage->data(), 0, size_t(width) * size_t(height) * 4);
+    m.bgTexture = new osg::Texture2D(m.bgImage.get());
+    m.bgTexture->setFilter(osg::Texture::MIN_FILTER, osg::Texture::NEAREST);
+    m.bgTexture->setFilter(osg::Texture::MAG_FILTER, osg::Texture::NEAREST);
+    m.bgTexture->setWrap(osg::Texture::WRAP_S, osg::Texture::CLAMP_TO_EDGE);
+    m.bgTexture->setWrap(osg::Texture::WRAP_T, osg::Texture::CLAMP_TO_EDGE);
+    m.bgTexture->setResizeNonPowerOfTwoHint(false);
+    m.bgTexture->setUnRefImageDataAfterApply(false);
+    m.bgTexture->setDataVariance(osg::Object::DYNAMIC);
+    m.bgQuad = new osg::Geometry;
+    osg::ref_ptr<osg::Vec3Array> v = new osg::Vec3Array;
+    v->push_back({0, 0, 0}); v->push_back({1, 0, 0}); v->push_back({1, 1, 0}); v->push_back({0, 1, 0});
+    osg::ref_ptr<osg::Vec2Array> tc = new osg::Vec2Array;
+    tc->push_back({0, 1}); tc->push_back({1, 1}); tc->push_back({1, 0}); tc->push_back({0, 0});
+    osg::ref_ptr<osg::Vec4Array> c = new osg::Vec4Array;
+    c->push_back({1, 1, 1, 1});
+    m.bgQuad->setVertexArray(v.get());
+    m.bgQuad->setTexCoordArray(0, tc.get());
+    m.bgQuad->setColorArray(c.get(), osg::Array::BIND_OVERALL);
+    m.bgQuad->addPrimitiveSet(new osg::DrawArrays(GL_QUADS, 0, 4));
+    m.bgQuad->setCullingActive(false);
+    m.bgQuad->setUseDisplayList(false);
+    m.bgQuad->setUseVertexBufferObjects(true);
+    osg::StateSet* ss = m.bgQuad->getOrCreateStateSet();
+    ss->setTextureAttributeAndModes(0, m.bgTexture.get(), osg::StateAttribute::ON);
+    ss->setMode(GL_LIGHTING, osg::StateAttribute::OFF | osg::StateAttribute::PROTECTED);
+    ss->setMode(GL_DEPTH_TEST, osg::StateAttribute::OFF | osg::StateAttribute::PROTECTED);
+    ss->setMode(GL_BLEND, osg::StateAttribute::OFF);
+    ss->setAttributeAndModes(new osg::Depth(osg::Depth::ALWAYS, 0, 1, false));
+    ss->setRenderBinDetails(-1000, "RenderBin");
+    m.bgCamera = new osg::Camera;
+    m.bgCamera->setReferenceFrame(osg::Transform::ABSOLUTE_RF);
+    m.bgCamera->setProjectionMatrixAsOrtho2D(0, 1, 0, 1);
+    m.bgCamera->setViewMatrix(osg::Matrixd::identity());
+    m.bgCamera->setRenderOrder(osg::Camera::NESTED_RENDER);
+    m.bgCamera->setClearMask(0);
+    m.bgCamera->setComputeNearFarMode(osg::CullSettings::DO_NOT_COMPUTE_NEAR_FAR);
+    m.bgCamera->setCullingActive(false);
+    m.bgCamera->addChild(m.bgQuad.get());
+
+    m.root = new osg::Group;
+    m.slot = new osg::Group;
+    m.root->addChild(m.bgCamera.get());
+    m.root->addChild(m.slot.get());
+    m.viewer->setSceneData(m.root.get());
+    m.viewer->realize();
+    if (!m.viewer->isRealized()) return Status::error("cannot realize the OpenGL window (display problem)");
+    return r;
+}
+
+Status OffscreenRenderer::render(osg::Node* scene, const Camera& camera, double zFar, Image* color,
+                                 std::vector<float>* depth, FrameStats& stats) {
+    Impl& m = *_impl;
+    auto t0 = Clock::now();
+    if (!m.skyValid || m.skyPitch != camera.pitch || m.skyRoll != camera.roll || m.skyFov != camera.fovY ||
+        m.skyJx != m.jx || m.skyJy != m.jy || m.sky.width != camera.width || m.sky.height != camera.height) {
+        renderSky(camera, m.sky, m.jx, m.jy);
+        m.skyValid = true;
+        m.skyPitch = camera.pitch;
+        m.skyRoll = camera.roll;
+        m.skyFov = camera.fovY;
+        m.skyJx = m.jx;
+        m.skyJy = m.jy;
+        m.bgKey = nullptr;
+    }
+    if (m.sky.width != m.width || m.sky.height != m.height)
+        return Status::error("camera size differs from the renderer's");
+    m.setBackground(m.sky, &m.sky);
+    double skyMs = msSince(t0);
+    Status s = m.draw(scene, camera, zFar, color, depth, stats);
+    stats.frameMs += skyMs;
+    return s;
+}
+
+Status OffscreenRenderer::renderOver(osg::Node* scene, const Camera& camera, double zFar, const Image& background,
+                                     Image* color, std::vector<float>* depth, FrameStats& stats) {
+    Impl& m = *_impl;
+    if (background.width != m.width || background.height != m.height || !background.valid())
+        return Status::error("background image " + std::to_string(background.width) + "x" +
+                             std::to_string(background.height) + " differs from the renderer's size");
+    auto t0 = Clock::now();
+    m.setBackground(background, nullptr);
+    double upMs = msSince(t0);
+    Status s = m.draw(scene, camera, zFar, color, depth, stats);
+    stats.frameMs += upMs;
+    return s;
+}
+
+int OffscreenRenderer::width() const { return _impl->width; }
+int OffscreenRenderer::height() const { return _impl->height; }
+void OffscreenRenderer::setSubpixelOffset(double dx, double dy) {
+    _impl->jx = dx;
+    _impl->jy = dy;
+}
+std::string OffscreenRenderer::glRenderer() const { return _impl->readback ? _impl->readback->renderer : std::string(); }
+
+}  // namespace vista

@@ -1,0 +1,143 @@
+// Near/far split selection and the adaptive near distance (see adaptive_split.h).
+#include "runtime/engine/adaptive_split.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "runtime/engine/ray_scene.h"
+
+namespace vista {
+
+double boxDistance(const SplitObject& o, const glm::dvec3& p) {
+    glm::dvec3 d = glm::max(glm::max(o.lo - p, p - o.hi), glm::dvec3(0.0));
+    return glm::length(d);
+}
+
+std::vector<uint32_t> selectNearField(const std::vector<SplitObject>& objects, const glm::dvec3& eye,
+                                      double nearDistance) {
+    std::vector<uint32_t> out;
+    for (uint32_t i = 0; i < objects.size(); ++i)
+        if (boxDistance(objects[i], eye) <= nearDistance) out.push_back(i);
+    return out;
+}
+
+std::vector<uint32_t> selectNearFieldByBudget(const std::vector<SplitObject>& objects, const glm::dvec3& eye,
+                                              uint64_t budget) {
+    std::vector<std::pair<double, uint32_t>> byDist;
+    byDist.reserve(objects.size());
+    for (uint32_t i = 0; i < objects.size(); ++i) byDist.push_back({boxDistance(objects[i], eye), i});
+    std::sort(byDist.begin(), byDist.end());
+    std::vector<uint32_t> out;
+    uint64_t sum = 0;
+    for (const auto& [d, i] : byDist) {
+        if (!out.empty() && sum + objects[i].triangles > budget) break;
+        sum += objects[i].triangles;
+        out.push_back(i);
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+AdaptiveSplit::AdaptiveSplit(const std::vector<SplitObject>& objects, const RayScene* rays,
+                             const AdaptiveSplitOptions& o)
+    : _objects(objects), _rays(rays), _o(o), _current(o.initialDistance) {}
+
+uint64_t AdaptiveSplit::predictedTriangles(const glm::dvec3& eye, double d) const {
+    uint64_t n = 0;
+    for (const auto& ob : _objects)
+        if (boxDistance(ob, eye) <= d) n += ob.triangles;
+    return n;
+}
+
+double AdaptiveSplit::predictedRays(double d) const {
+    double n = 0;
+    for (float t : _probeT)
+        if (t > d) n += 1;  // beyond the near field, or a miss (t = inf)
+    return n * _probeScale;
+}
+
+void AdaptiveSplit::probe(const Camera& camera) {
+    _probeT.clear();
+    if (!_rays) return;
+    const int s = std::max(1, _o.probeStride);
+    const glm::vec3 org(camera.eye - _rays->frameOrigin());
+    std::vector<glm::vec3> orgs, dirs;
+    for (int y = s / 2; y < camera.height; y += s)
+        for (int x = s / 2; x < camera.width; x += s) {
+            orgs.push_back(org);
+            dirs.push_back(glm::vec3(camera.rayDirection(x + 0.5, y + 0.5)));
+        }
+    std::vector<RayHit> hits(dirs.size());
+    if (!dirs.empty()) _rays->intersectMany(orgs.data(), dirs.data(), int(dirs.size()), hits.data());
+    _probeT.resize(hits.size());
+    size_t misses = 0;
+    for (size_t i = 0; i < hits.size(); ++i) {
+        // A miss pointing up is sky the horizon culls; one pointing down is a ray cast in vain.
+        if (hits[i].hit) {
+            _probeT[i] = hits[i].t;
+        } else {
+            _probeT[i] = dirs[i].z < 0 ? std::numeric_limits<float>::infinity() : 0.0f;
+            ++misses;
+        }
+    }
+    _probeScale = dirs.empty() ? 0.0 : double(camera.width) * camera.height / double(dirs.size());
+}
+
+double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
+    (void)pixelBudget;  // see the header: the model aims at full accuracy
+    if (_frame % std::max(1, _o.probeInterval) == 0 || _probeT.empty()) probe(camera);
+    const int frame = _frame++;
+    if (_probeT.empty()) return _current;
+    const int n = std::max(2, _o.candidates);
+    // Sort objects by distance once, then sweep the candidates.
+    std::vector<std::pair<double, uint64_t>> byDist;
+    byDist.reserve(_objects.size());
+    for (const auto& ob : _objects) byDist.push_back({boxDistance(ob, camera.eye), ob.triangles});
+    std::sort(byDist.begin(), byDist.end());
+    std::vector<double> cand(static_cast<size_t>(n)), cost(static_cast<size_t>(n));
+    size_t k = 0;
+    uint64_t tris = 0;
+    int bestI = 0;
+    for (int i = 0; i < n; ++i) {
+        double d = _o.minDistance * std::pow(_o.maxDistance / _o.minDistance, double(i) / (n - 1));
+        while (k < byDist.size() && byDist[k].first <= d) tris += byDist[k++].second;
+        cand[size_t(i)] = d;
+        cost[size_t(i)] = _a * double(tris) + _b * predictedRays(d);
+        if (cost[size_t(i)] < cost[size_t(bestI)]) bestI = i;
+    }
+    if (_o.exploreEvery > 0 && frame % _o.exploreEvery == _o.exploreEvery - 1)
+        bestI = std::clamp(bestI + ((frame / _o.exploreEvery) % 2 ? 1 : -1), 0, n - 1);
+    _current = cand[size_t(bestI)];
+    return _current;
+}
+
+void AdaptiveSplit::record(uint64_t triangles, double rasterMs, uint64_t rays, double rayMs) {
+    const double w = _o.smoothing;
+    if (rasterMs > 0) {
+        _rasterSamples.push_back({double(triangles), rasterMs});
+        if (int(_rasterSamples.size()) > std::max(2, _o.window)) _rasterSamples.erase(_rasterSamples.begin());
+        // Least squares ms = c + a * tris; keep the prior unless the triangle counts vary enough.
+        double n = double(_rasterSamples.size()), sx = 0, sy = 0, sxx = 0, sxy = 0;
+        for (const auto& [x, y] : _rasterSamples) {
+            sx += x;
+            sy += y;
+            sxx += x * x;
+            sxy += x * y;
+        }
+        double var = sxx / n - (sx / n) * (sx / n);
+        double mean = sx / n;
+        if (n >= 5 && var > 0 && std::sqrt(var) > 0.1 * std::max(mean, 1.0)) {
+            double a = (sxy / n - (sx / n) * (sy / n)) / var;
+            if (a > 0) _a = a;
+        }
+    }
+    if (rays > 100 && rayMs > 0) {
+        double b = rayMs / double(rays);
+        _b = _haveB ? (1 - w) * _b + w * b : b;
+        _haveB = true;
+    }
+}
+
+}  // namespace vista

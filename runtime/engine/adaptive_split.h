@@ -1,0 +1,89 @@
+// The near/far split (thesis §4.3.1) and its automatic choice (§6.4.3).
+//
+// selectNearField(): which objects the rasteriser draws. By distance: every
+// object whose axis-aligned bounding box comes within `nearDistance` of the
+// eye (objects straddling the boundary are drawn whole: no popping, and every
+// geometry point closer than nearDistance is drawn). By triangle budget: the
+// nearest objects (by box distance) until the budget would be exceeded (the
+// first object is always drawn). Pure; thread-safe.
+//
+// AdaptiveSplit: picks the near distance per frame from the measured cost of
+// this machine: raster ms = c + a * triangles (least-squares fit over the
+// last `window` frames, whose near distances differ as the walk goes on; the
+// prior ratio is used until the fit is well conditioned) and b = ms per cast
+// ray (exponential moving average), predicted triangles(d) from the objects'
+// boxes (exact) and predicted rays(d) from a sparse probe of the view (every
+// `probeStride`-th pixel cast once per `probeInterval` frames: a pixel whose
+// first hit lies beyond d, or that misses below the horizon, needs a ray). It
+// minimises a * triangles(d) + b * rays(d) over candidate distances
+// (geometric steps between minDistance and maxDistance). rays(d) is not capped
+// by the pixel budget: the aim is the lowest frame time at full accuracy (a
+// budget-capped model would always pick the smallest near field and let the
+// cache's error grow). Every `exploreEvery`-th choice steps one candidate up
+// or down from the optimum so that the fit sees varied triangle counts.
+// Not thread-safe; deterministic for given measurements.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "runtime/scene/camera.h"
+
+namespace vista {
+
+class RayScene;
+
+struct SplitObject {
+    glm::dvec3 lo{0.0}, hi{0.0};  // world bounding box
+    uint64_t triangles = 0;
+};
+
+double boxDistance(const SplitObject& o, const glm::dvec3& p);
+
+// Returns the indices of the near-field objects (ascending).
+std::vector<uint32_t> selectNearField(const std::vector<SplitObject>& objects, const glm::dvec3& eye,
+                                      double nearDistance);
+std::vector<uint32_t> selectNearFieldByBudget(const std::vector<SplitObject>& objects, const glm::dvec3& eye,
+                                              uint64_t triangleBudget);
+
+struct AdaptiveSplitOptions {
+    double minDistance = 15.0, maxDistance = 800.0;
+    int candidates = 16;        // geometric steps between min and max
+    int probeStride = 8;        // probe every 8th pixel in x and y
+    int probeInterval = 10;     // frames between probes
+    double smoothing = 0.2;     // EMA weight of a new measurement
+    double initialDistance = 100.0;
+    int window = 60;            // frames in the raster-cost fit
+    int exploreEvery = 7;       // every n-th choice explores a neighbouring candidate (0 = never)
+};
+
+class AdaptiveSplit {
+public:
+    AdaptiveSplit(const std::vector<SplitObject>& objects, const RayScene* rays, const AdaptiveSplitOptions& o = {});
+    // Near distance to use for this frame.
+    double choose(const Camera& camera, int64_t pixelBudget);
+    // Measurements of the frame just rendered.
+    void record(uint64_t triangles, double rasterMs, uint64_t rays, double rayMs);
+    double msPerTriangle() const { return _a; }
+    double msPerRay() const { return _b; }
+    double current() const { return _current; }
+    // Predictions (exposed for tests/docs).
+    uint64_t predictedTriangles(const glm::dvec3& eye, double d) const;
+    double predictedRays(double d) const;
+
+private:
+    void probe(const Camera& camera);
+    const std::vector<SplitObject>& _objects;
+    const RayScene* _rays;
+    AdaptiveSplitOptions _o;
+    double _a = 2e-5, _b = 5e-4;  // priors: ms per triangle, ms per ray (replaced by measurements)
+    bool _haveB = false;
+    std::vector<std::pair<double, double>> _rasterSamples;  // (triangles, ms), last `window` frames
+    double _current;
+    int _frame = 0;
+    std::vector<float> _probeT;  // per probe pixel: first hit distance (inf = miss)
+    double _probeScale = 1;      // screen pixels per probe pixel
+};
+
+}  // namespace vista

@@ -1,0 +1,95 @@
+// FarField: the per-frame far-field pipeline of thesis ch. 4 on plain arrays
+// (no OSG, no GL): opacity from the near field's depth, horizon tracing,
+// panoramic cache, Embree ray casting, composite, pixel counts, stage times.
+//
+// Per frame, every pixel is classified exactly once (thesis Table 4.1):
+//   covered        near-field depth < 1 (drawn by the rasteriser; left as is,
+//                  except seam-checked pixels that far geometry occludes)
+//   horizonCulled  above the horizon row of its column, or no far geometry
+//                  exists at all: sky colour without tracing
+//   cache          taken from the panoramic cache
+//   rayHit/rayMiss traced this frame (miss -> sky colour)
+// Sky colour = lighting.h skyColor(elevation of the pixel-centre ray), the same
+// as the OffscreenRenderer's background, so sky pixels agree across modes.
+//
+// Stages run only when called for: no uncovered pixel -> nothing after
+// opacity; no far geometry (city bounds within the near distance, or an empty
+// city) -> no horizon/cache/ray stage (note "rays off: no far geometry");
+// camera rolled / zenith or nadir in view -> no horizon stage (note says why);
+// pixelBudget < 0 (unlimited) or cache off -> cache bypassed, every remaining
+// pixel traced. stats.stages records every stage that ran ("opacity",
+// "seam", "horizon", "cache", "rays", "composite"); stats.notes explains
+// skipped stages.
+//
+// Determinism: the image and counts do not depend on thread count. Ray casting
+// runs in a tbb::task_arena with `threads` workers (0 = all cores); FTZ/DAZ are
+// set in every casting thread (RayScene). Not thread-safe itself; nothing
+// throws. Contract: depth (if not null) has width*height entries.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "runtime/engine/frame_stats.h"
+#include "runtime/scene/camera.h"
+#include "runtime/engine/horizon.h"
+#include "runtime/engine/image.h"
+#include "runtime/engine/panorama_cache.h"
+
+namespace vista {
+
+class RayScene;
+
+struct FarFieldOptions {
+    double nearDistance = 100.0;  // metres (>= 0): horizon skips geometry the near field draws; 0 = skip nothing
+    bool nearIsDistance = true;   // false when the near field is a triangle budget (then no horizon skipping)
+    int64_t pixelBudget = -1;     // rays per frame through the cache; < 0 = unlimited (cache bypassed)
+    bool cache = true;
+    bool horizon = true;
+    int horizonSubsampleMoving = 1;  // >= 1: subsample factor of the horizon while the camera moves
+    double cacheOversample = 1.5;
+    int threads = 0;
+    // Far plane of the projection the near-field depth was rendered with
+    // (camera.zNear is the near plane); <= 0 = infinite. Used to turn depth into
+    // distance for the seam check below.
+    double depthZFar = 0.0;
+    // Seam check: a near-field object straddling the near distance is drawn,
+    // but its parts beyond the near distance may lie behind far geometry the
+    // rasteriser never saw. Covered pixels whose surface is farther than
+    // nearDistance are re-cast with tfar = that distance; a hit replaces the
+    // pixel (counted as rayHit instead of covered). Off = trust coverage.
+    bool verifySeam = true;
+};
+
+class FarField {
+public:
+    // `grid` may be null (no horizon stage). Both must outlive the FarField.
+    FarField(const RayScene& rays, const HeightGrid* grid, const FarFieldOptions& options);
+    ~FarField();
+    void setOptions(const FarFieldOptions& options);
+    const FarFieldOptions& options() const { return _options; }
+    // Fills every uncovered pixel of `out` (resized to the camera if needed;
+    // covered pixels keep their colour). depth: near-field window depth, 1 =
+    // nothing drawn; null = nothing covered. Adds counts, stage times, notes.
+    void render(const Camera& camera, const float* depth, Image& out, FrameStats& stats);
+    // Drops the cache (walkthrough jump).
+    void reset();
+    // Per pixel of the last frame: 0 covered, 1 horizon, 2 cache, 3 hit, 4 miss.
+    const std::vector<uint8_t>& classification() const { return _class; }
+
+private:
+    const RayScene& _rays;
+    const HeightGrid* _grid;
+    FarFieldOptions _options;
+    std::unique_ptr<PanoramaCache> _cache;
+    double _cacheKey[4] = {0, 0, 0, 0};  // fovY, width, height, oversample of the cache
+    Camera _last;
+    bool _haveLast = false;
+    std::vector<uint8_t> _class;
+    Image _prev;  // last composited frame (cache mode): shown for never-traced cache cells
+    // Sky image cache (depends on orientation, fov and size only).
+    Image _sky;
+    double _skyKey[4] = {1e300, 0, 0, 0};
+};
+
+}  // namespace vista

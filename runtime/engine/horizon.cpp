@@ -1,0 +1,345 @@
+// Horizon tracing: height grid + conservative 2D rays (see horizon.h).
+#include "runtime/engine/horizon.h"
+#include "foundation/units.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <tbb/parallel_for.h>
+
+namespace vista {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kTieEps = 1e-9;  // relative tolerance for "the ray crosses a grid corner"
+
+struct Box2 {
+    glm::dvec3 lo{kInf}, hi{-kInf};
+    void add(const glm::dvec3& p) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    bool valid() const { return lo.x <= hi.x; }
+};
+
+}  // namespace
+
+HeightGrid HeightGrid::build(const SceneModel& city, const glm::dvec3& frameOrigin, int cells) {
+    cells = std::clamp(cells, 1, 8192);
+    HeightGrid g;
+    g._origin = frameOrigin;
+    // Pass 1: bounds of everything (scene-local).
+    Box2 all;
+    for (const SceneMesh& m : city.meshes) {
+        glm::dvec3 shift = m.origin - frameOrigin;
+        for (uint32_t i : m.indices)
+            if (i < m.positions.size()) all.add(glm::dvec3(m.positions[i]) + shift);
+    }
+    std::vector<Box2> protoBox(city.prototypes.size());
+    for (size_t p = 0; p < city.prototypes.size(); ++p) {
+        const SceneMesh& m = city.prototypes[p];
+        for (uint32_t i : m.indices)
+            if (i < m.positions.size()) protoBox[p].add(glm::dvec3(m.positions[i]) + m.origin);
+    }
+    std::vector<Box2> instBox(city.instances.size());
+    for (size_t k = 0; k < city.instances.size(); ++k) {
+        const SceneInstance& inst = city.instances[k];
+        if (inst.prototype >= protoBox.size() || !protoBox[inst.prototype].valid()) continue;
+        const Box2& pb = protoBox[inst.prototype];
+        for (int c = 0; c < 8; ++c) {
+            glm::dvec4 v((c & 1) ? pb.hi.x : pb.lo.x, (c & 2) ? pb.hi.y : pb.lo.y, (c & 4) ? pb.hi.z : pb.lo.z, 1.0);
+            glm::dvec4 w = inst.transform * v;
+            instBox[k].add(glm::dvec3(w) - frameOrigin);
+        }
+        all.add(instBox[k].lo);
+        all.add(instBox[k].hi);
+    }
+    if (!all.valid()) return g;  // empty
+    g._boundsMin = all.lo;
+    g._boundsMax = all.hi;
+    double extent = std::max(all.hi.x - all.lo.x, all.hi.y - all.lo.y) + 4 * kCellMargin;
+    extent = std::max(extent, 1e-3);
+    g._cells = cells;
+    g._cellSize = extent / cells;
+    g._min = glm::dvec2(all.lo.x, all.lo.y) - glm::dvec2(2 * kCellMargin);
+    const size_t n = size_t(cells) * size_t(cells);
+    g._maxZ.assign(n, -std::numeric_limits<float>::infinity());
+    g._minZ.assign(n, std::numeric_limits<float>::infinity());
+    auto splat = [&](const glm::dvec3& lo, const glm::dvec3& hi) {
+        int x0 = int(std::floor((lo.x - kCellMargin - g._min.x) / g._cellSize));
+        int x1 = int(std::floor((hi.x + kCellMargin - g._min.x) / g._cellSize));
+        int y0 = int(std::floor((lo.y - kCellMargin - g._min.y) / g._cellSize));
+        int y1 = int(std::floor((hi.y + kCellMargin - g._min.y) / g._cellSize));
+        x0 = std::clamp(x0, 0, cells - 1);
+        x1 = std::clamp(x1, 0, cells - 1);
+        y0 = std::clamp(y0, 0, cells - 1);
+        y1 = std::clamp(y1, 0, cells - 1);
+        // Round heights outwards so the float grid never understates the double geometry.
+        float zmax = std::nextafter(float(hi.z), std::numeric_limits<float>::infinity());
+        float zmin = std::nextafter(float(lo.z), -std::numeric_limits<float>::infinity());
+        for (int y = y0; y <= y1; ++y)
+            for (int x = x0; x <= x1; ++x) {
+                size_t i = size_t(y) * size_t(cells) + size_t(x);
+                g._maxZ[i] = std::max(g._maxZ[i], zmax);
+                g._minZ[i] = std::min(g._minZ[i], zmin);
+            }
+    };
+    for (const SceneMesh& m : city.meshes) {
+        glm::dvec3 shift = m.origin - frameOrigin;
+        for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+            Box2 b;
+            for (int k = 0; k < 3; ++k) {
+                uint32_t i = m.indices[t + size_t(k)];
+                if (i < m.positions.size()) b.add(glm::dvec3(m.positions[i]) + shift);
+            }
+            if (b.valid()) splat(b.lo, b.hi);
+        }
+    }
+    // Instances: conservative per-instance bounding box (tree crowns are compact).
+    for (const Box2& b : instBox)
+        if (b.valid()) splat(b.lo, b.hi);
+    return g;
+}
+
+double HeightGrid::cellBound(int ix, int iy, const glm::dvec3& eye, double nearDistance) const {
+    size_t i = size_t(iy) * size_t(_cells) + size_t(ix);
+    double hmax = double(_maxZ[i]);
+    if (hmax == -kInf) return -kInf;
+    double x0 = _min.x + ix * _cellSize - kCellMargin, x1 = x0 + _cellSize + 2 * kCellMargin;
+    double y0 = _min.y + iy * _cellSize - kCellMargin, y1 = y0 + _cellSize + 2 * kCellMargin;
+    double nx = std::max({x0 - eye.x, 0.0, eye.x - x1}), ny = std::max({y0 - eye.y, 0.0, eye.y - y1});
+    double fx = std::max(std::abs(eye.x - x0), std::abs(eye.x - x1)), fy = std::max(std::abs(eye.y - y0), std::abs(eye.y - y1));
+    double dmin2 = nx * nx + ny * ny, dmax2 = fx * fx + fy * fy;
+    double dz = hmax - eye.z;
+    if (nearDistance > 0) {
+        double dzLo = double(_minZ[i]) - eye.z;
+        double dzMax = std::max(std::abs(dz), std::abs(dzLo));
+        if (dmax2 + dzMax * dzMax < nearDistance * nearDistance) return -kInf;
+    }
+    if (dz >= 0) return dmin2 > 0 ? dz / std::sqrt(dmin2) : kInf;
+    return dz / std::sqrt(dmax2);
+}
+
+double HeightGrid::traceRay(const glm::dvec3& eye, double azimuth, double nearDistance) const {
+    if (_cells == 0) return -kInf;
+    const int n = _cells;
+    const double s = _cellSize;
+    // Cell units.
+    const double px = (eye.x - _min.x) / s, py = (eye.y - _min.y) / s;
+    double dx = std::sin(azimuth), dy = std::cos(azimuth);
+    if (std::abs(dx) < 1e-15) dx = 0;
+    if (std::abs(dy) < 1e-15) dy = 0;
+    // Clip the ray (t >= 0) against the grid square [0, n]^2.
+    double t0 = 0, t1 = kInf;
+    auto clip = [&](double p, double d) {
+        if (d == 0) return p >= 0 && p <= n;
+        double a = (0 - p) / d, b = (n - p) / d;
+        if (a > b) std::swap(a, b);
+        t0 = std::max(t0, a);
+        t1 = std::min(t1, b);
+        return t0 <= t1;
+    };
+    if (!clip(px, dx) || !clip(py, dy)) return -kInf;
+    // Highest geometry anywhere: bounds the remaining cells for early exit.
+    const double zTop = _boundsMax.z + 1e-3;
+    double best = -kInf;
+
+    auto run = [&](int ix, int iy) {
+        const int stepX = dx > 0 ? 1 : -1, stepY = dy > 0 ? 1 : -1;
+        const double sx0 = px + dx * t0, sy0 = py + dy * t0;
+        const double tDeltaX = dx != 0 ? 1.0 / std::abs(dx) : kInf, tDeltaY = dy != 0 ? 1.0 / std::abs(dy) : kInf;
+        double tMaxX = dx > 0 ? (ix + 1 - sx0) / dx : dx < 0 ? (sx0 - ix) / -dx : kInf;
+        double tMaxY = dy > 0 ? (iy + 1 - sy0) / dy : dy < 0 ? (sy0 - iy) / -dy : kInf;
+        tMaxX = std::max(tMaxX, 0.0);
+        tMaxY = std::max(tMaxY, 0.0);
+        const double tLen = t1 - t0;
+        auto inGrid = [&](int x, int y) { return x >= 0 && y >= 0 && x < n && y < n; };
+        while (inGrid(ix, iy)) {
+            best = std::max(best, cellBound(ix, iy, eye, nearDistance));
+            double tNext = std::min(tMaxX, tMaxY);
+            if (tNext > tLen + kTieEps) break;
+            // Early exit: nothing farther can beat `best` (only valid when best > 0: farther is lower).
+            double distM = (t0 + tNext - 1.5) * s - 2 * kCellMargin;  // nearest point of any later cell
+            if (best > 0 && distM > 0 && (zTop - eye.z) / distM < best) break;
+            if (std::abs(tMaxX - tMaxY) <= kTieEps * std::max(1.0, tNext)) {
+                // Through a grid corner: both side cells touch the ray.
+                if (inGrid(ix + stepX, iy)) best = std::max(best, cellBound(ix + stepX, iy, eye, nearDistance));
+                if (inGrid(ix, iy + stepY)) best = std::max(best, cellBound(ix, iy + stepY, eye, nearDistance));
+                ix += stepX;
+                iy += stepY;
+                tMaxX += tDeltaX;
+                tMaxY += tDeltaY;
+            } else if (tMaxX < tMaxY) {
+                ix += stepX;
+                tMaxX += tDeltaX;
+            } else {
+                iy += stepY;
+                tMaxY += tDeltaY;
+            }
+        }
+    };
+    // Start cell: the cell the ray enters just after t0.
+    const double ex = px + dx * t0, ey = py + dy * t0;
+    auto startCell = [&](double p, double d) {
+        double c = std::floor(p);
+        if (d < 0 && c == p) c -= 1;  // on a line heading down: the lower cell
+        return std::clamp(int(c), 0, n - 1);
+    };
+    int ix = startCell(ex, dx), iy = startCell(ey, dy);
+    run(ix, iy);
+    // A ray running along a grid line touches the cells on both sides.
+    auto onLine = [&](double p) { return std::abs(p - std::round(p)) <= kTieEps * std::max(1.0, std::abs(p)); };
+    if (dx == 0 && onLine(ex)) {
+        int l = int(std::round(ex));
+        if (l - 1 >= 0 && l - 1 != ix) run(l - 1, iy);
+        if (l < n && l != ix) run(l, iy);
+    }
+    if (dy == 0 && onLine(ey)) {
+        int l = int(std::round(ey));
+        if (l - 1 >= 0 && l - 1 != iy) run(ix, l - 1);
+        if (l < n && l != iy) run(ix, l);
+    }
+    // Starting on a corner/line (eye on a grid line): the neighbour cells the
+    // start point touches may hold geometry arbitrarily close to the ray start.
+    if (onLine(ex) || onLine(ey)) {
+        int cx = int(std::round(ex)), cy = int(std::round(ey));
+        for (int yy = (onLine(ey) ? cy - 1 : iy); yy <= (onLine(ey) ? cy : iy); ++yy)
+            for (int xx = (onLine(ex) ? cx - 1 : ix); xx <= (onLine(ex) ? cx : ix); ++xx)
+                if (xx >= 0 && yy >= 0 && xx < n && yy < n) best = std::max(best, cellBound(xx, yy, eye, nearDistance));
+    }
+    return best;
+}
+
+bool horizonApplies(const Camera& camera, std::string* reason) {
+    if (!camera.upright()) {
+        if (reason) *reason = "horizon off: camera rolled";
+        return false;
+    }
+    if (std::abs(camera.pitch) + 0.5 * camera.fovY >= kHalfPi - 1e-3) {
+        if (reason) *reason = camera.pitch > 0 ? "horizon off: zenith in view" : "horizon off: nadir in view";
+        return false;
+    }
+    return true;
+}
+
+namespace {
+
+struct ColumnGeometry {
+    double cp, sp, t, aspect;
+    int W, H;
+    ColumnGeometry(const Camera& c)
+        : cp(std::cos(c.pitch)), sp(std::sin(c.pitch)), t(std::tan(0.5 * c.fovY)),
+          aspect(double(c.width) / double(c.height)), W(c.width), H(c.height) {}
+    double sx(double px) const { return (2.0 * px / W - 1.0) * t * aspect; }
+    double sy(double py) const { return (1.0 - 2.0 * py / H) * t; }
+    // Azimuth relative to the heading, and tan(elevation), of the ray through (px, py).
+    double relAzimuth(double px, double py) const { return std::atan2(sx(px), cp - sy(py) * sp); }
+    double tanElev(double px, double py) const {
+        double a = cp - sy(py) * sp, b = sx(px);
+        return (sp + sy(py) * cp) / std::sqrt(a * a + b * b);
+    }
+};
+
+}  // namespace
+
+double pixelTanElevation(const Camera& camera, double px, double py) {
+    glm::dvec3 d = camera.rayDirection(px, py);
+    double h = std::sqrt(d.x * d.x + d.y * d.y);
+    return h > 0 ? d.z / h : (d.z > 0 ? kInf : -kInf);
+}
+
+HorizonResult traceHorizon(const HeightGrid& grid, const Camera& camera, const HorizonOptions& options) {
+    VISTA_CHECK(camera.width >= 1 && camera.height >= 1);
+    const int W = camera.width, H = camera.height;
+    HorizonResult r;
+    r.row.assign(size_t(W), 0);
+    if (!horizonApplies(camera, &r.reason)) return r;
+    r.active = true;
+    auto needed = [&](int x) { return !options.columnNeeded || (*options.columnNeeded)[size_t(x)] != 0; };
+    if (grid.empty()) {  // no geometry anywhere: every pixel is sky
+        for (int x = 0; x < W; ++x) r.row[size_t(x)] = H;
+        return r;
+    }
+    const ColumnGeometry cg(camera);
+    const glm::dvec3 eye = camera.eye - grid.frameOrigin();
+    // Azimuth range of each needed column (pixel centres, top and bottom rows).
+    std::vector<double> lo(static_cast<size_t>(W)), hi(static_cast<size_t>(W));
+    double relMin = kInf, relMax = -kInf;
+    for (int x = 0; x < W; ++x) {
+        if (!needed(x)) continue;
+        double a = cg.relAzimuth(x + 0.5, 0.5), b = cg.relAzimuth(x + 0.5, H - 0.5);
+        lo[size_t(x)] = std::min(a, b);
+        hi[size_t(x)] = std::max(a, b);
+        relMin = std::min(relMin, lo[size_t(x)]);
+        relMax = std::max(relMax, hi[size_t(x)]);
+    }
+    if (relMin > relMax) return r;  // no column needed
+    // Ray spacing: wedge width at the farthest grid point below half a cell.
+    const double s = grid.cellSize();
+    const glm::dvec2 g0 = grid.gridMin(), g1 = g0 + glm::dvec2(s * grid.cells());
+    double dmax = 0;
+    for (int c = 0; c < 4; ++c) {
+        glm::dvec2 corner((c & 1) ? g1.x : g0.x, (c & 2) ? g1.y : g0.y);
+        dmax = std::max(dmax, glm::length(corner - glm::dvec2(eye.x, eye.y)));
+    }
+    const double delta = 0.5 * s / std::max(dmax, s);
+    const int sub = std::max(1, options.subsample);
+    const double a0 = relMin - delta;
+    const double span = relMax - relMin + 2 * delta;
+    const int64_t nRays64 = int64_t(std::ceil(span / delta)) + 2;
+    if (nRays64 > (int64_t(1) << 22)) {
+        r.active = false;
+        r.reason = "horizon off: too many horizon rays for this grid";
+        return r;
+    }
+    const int nRays = int(nRays64);
+    // Which rays are needed: per column [kLo, kHi] widened to the subsampling lattice.
+    std::vector<int> kLo(static_cast<size_t>(W)), kHi(static_cast<size_t>(W));
+    std::vector<uint8_t> want(size_t(nRays) + size_t(sub) + 1, 0);
+    for (int x = 0; x < W; ++x) {
+        if (!needed(x)) continue;
+        int a = int(std::floor((lo[size_t(x)] - a0) / delta)), b = int(std::ceil((hi[size_t(x)] - a0) / delta));
+        a = std::max(0, (a / sub) * sub);
+        b = std::min(int(want.size()) - 1, ((b + sub - 1) / sub) * sub);
+        kLo[size_t(x)] = a;
+        kHi[size_t(x)] = b;
+        for (int k = a; k <= b; k += sub) want[size_t(k)] = 1;
+    }
+    std::vector<int> list;
+    for (int k = 0; k < int(want.size()); ++k)
+        if (want[size_t(k)]) list.push_back(k);
+    std::vector<double> value(want.size(), -kInf);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, list.size(), 16), [&](const tbb::blocked_range<size_t>& br) {
+        for (size_t i = br.begin(); i != br.end(); ++i) {
+            int k = list[i];
+            value[size_t(k)] = grid.traceRay(eye, camera.heading + a0 + k * delta, options.nearDistance);
+        }
+    });
+    r.raysTraced = int(list.size());
+    // Per column: bound -> first row whose centre ray may reach geometry.
+    for (int x = 0; x < W; ++x) {
+        if (!needed(x)) continue;
+        double bound = -kInf;
+        for (int k = kLo[size_t(x)]; k <= kHi[size_t(x)]; k += sub) bound = std::max(bound, value[size_t(k)]);
+        if (bound == kInf) {
+            r.row[size_t(x)] = 0;
+            continue;
+        }
+        const double limit = bound + 1e-9 * (1.0 + std::abs(bound));
+        // tanElev decreases with y: binary search for the first y with tanElev <= limit.
+        int a = 0, b = H;
+        while (a < b) {
+            int m = (a + b) / 2;
+            if (cg.tanElev(x + 0.5, m + 0.5) > limit)
+                a = m + 1;
+            else
+                b = m;
+        }
+        r.row[size_t(x)] = a;
+    }
+    return r;
+}
+
+}  // namespace vista

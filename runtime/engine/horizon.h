@@ -1,0 +1,101 @@
+// Horizon tracing (thesis §4.5): a 2D height grid of the city and, per frame,
+// the highest screen row far geometry can reach in every pixel column.
+// Pixels above that row are sky and need no ray.
+//
+// HeightGrid: cells x cells square cells over the xy bounding square of all
+// geometry, in the scene-local frame (world minus `frameOrigin`, as RayScene).
+// Each cell stores the max and min z of every triangle whose (slightly
+// enlarged, kCellMargin) xy bounding box overlaps it: conservative, so geometry
+// touching a cell border counts in both cells. Built once; immutable; thread-safe.
+//
+// traceHorizon(): for an upright camera (roll == 0, zenith and nadir outside
+// the view: |pitch| + fovY/2 < pi/2) casts 2D rays through the grid at
+// azimuth steps fine enough (spacing * farthest grid distance < cell size / 2)
+// that every cell inside the wedge between two adjacent rays is touched by
+// one of them; each ray records the largest tan(elevation) any geometry in a
+// touched cell can have (cell max height over the cell's nearest distance, or
+// over its farthest distance when the cell lies below the eye). Each column's
+// bound is the max over the rays spanning its azimuth range (the column's
+// pixel-centre rays change azimuth with row when the camera is pitched), and
+// the horizon row is the first row (from the top) whose pixel-centre ray may
+// reach geometry. Hence with subsample == 1 the result is conservative: no
+// pixel with geometry on its centre ray is ever above the horizon.
+// Cells whose every point lies within `nearDistance` of the eye are skipped:
+// that geometry is drawn by the near field (objects straddling the near
+// distance are drawn whole), so it covers its pixels anyway.
+// subsample > 1 traces only every n-th ray and fills between with the max of
+// the neighbours (thesis: used while the viewer moves; then not strictly
+// conservative). `columnNeeded` (optional, one flag per column) limits the
+// work to columns that still have uncovered pixels.
+// A camera with roll or with zenith/nadir in view returns active = false and a
+// reason; rows are then all 0 (nothing culled). Bad cameras (width/height < 1)
+// are contract violations.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "runtime/scene/camera.h"
+#include "runtime/scene/scene_model.h"
+
+namespace vista {
+
+class HeightGrid {
+public:
+    static constexpr double kCellMargin = 1e-3;  // metres added around every triangle's bounding box
+
+    HeightGrid() = default;
+    // cells: 1..8192 (clamped). frameOrigin: world position of the scene-local origin.
+    static HeightGrid build(const SceneModel& city, const glm::dvec3& frameOrigin, int cells);
+
+    bool empty() const { return _cells == 0; }  // no geometry at all
+    int cells() const { return _cells; }
+    double cellSize() const { return _cellSize; }
+    glm::dvec2 gridMin() const { return _min; }           // scene-local xy of cell (0,0)'s corner
+    glm::dvec3 boundsMin() const { return _boundsMin; }   // scene-local bounding box of all geometry
+    glm::dvec3 boundsMax() const { return _boundsMax; }
+    glm::dvec3 frameOrigin() const { return _origin; }
+    // -inf / +inf for a cell without geometry. ix, iy in [0, cells).
+    float maxZ(int ix, int iy) const { return _maxZ[size_t(iy) * size_t(_cells) + size_t(ix)]; }
+    float minZ(int ix, int iy) const { return _minZ[size_t(iy) * size_t(_cells) + size_t(ix)]; }
+
+    // Largest tan(elevation) seen from `eye` (scene-local) of any geometry in
+    // cells touched by the 2D ray at `azimuth` (radians clockwise from +y),
+    // skipping cells entirely within `nearDistance`. -inf if nothing; +inf if
+    // geometry above the eye may lie at distance 0 (eye inside a cell with
+    // geometry above it).
+    double traceRay(const glm::dvec3& eye, double azimuth, double nearDistance) const;
+
+private:
+    double cellBound(int ix, int iy, const glm::dvec3& eye, double nearDistance) const;
+    int _cells = 0;
+    double _cellSize = 0;
+    glm::dvec2 _min{0.0};
+    glm::dvec3 _boundsMin{0.0}, _boundsMax{0.0}, _origin{0.0};
+    std::vector<float> _maxZ, _minZ;
+};
+
+struct HorizonOptions {
+    double nearDistance = 0;                    // metres; 0 = consider all geometry
+    int subsample = 1;                          // >= 1
+    const std::vector<uint8_t>* columnNeeded = nullptr;  // size camera.width, or null = all
+};
+
+struct HorizonResult {
+    bool active = false;
+    std::string reason;        // why inactive ("camera rolled", ...)
+    std::vector<int> row;      // per column: rows y < row[x] are sky (0..height)
+    int raysTraced = 0;        // 2D rays cast this frame
+};
+
+// True if horizon tracing applies to this camera (upright, no zenith/nadir in view).
+bool horizonApplies(const Camera& camera, std::string* reason = nullptr);
+
+HorizonResult traceHorizon(const HeightGrid& grid, const Camera& camera, const HorizonOptions& options = {});
+
+// tan(elevation) of the centre ray of pixel (x + 0.5, y + 0.5): exposed for tests.
+double pixelTanElevation(const Camera& camera, double px, double py);
+
+}  // namespace vista

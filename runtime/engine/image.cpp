@@ -1,0 +1,121 @@
+// PNG I/O for Image (libpng). See image.h for the contract.
+#include "runtime/engine/image.h"
+
+#include <png.h>
+
+#include <cerrno>
+#include <csetjmp>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+
+#include <unistd.h>
+
+namespace vista {
+
+namespace {
+
+struct FileCloser {
+    void operator()(FILE* f) const { if (f) std::fclose(f); }
+};
+
+// libpng reports errors through longjmp; we keep the message for the Status.
+struct PngErr {
+    char message[256] = {0};
+};
+
+void pngErrorFn(png_structp png, png_const_charp msg) {
+    auto* e = static_cast<PngErr*>(png_get_error_ptr(png));
+    if (e) std::snprintf(e->message, sizeof(e->message), "%s", msg ? msg : "unknown libpng error");
+    png_longjmp(png, 1);
+}
+void pngWarnFn(png_structp, png_const_charp) {}
+
+}  // namespace
+
+Status writePng(const Image& img, const std::string& path) {
+    if (!img.valid())
+        return Status::error("writePng '" + path + "': invalid image " + std::to_string(img.width) + "x" +
+                             std::to_string(img.height));
+    std::string tmp = path + ".tmp." + std::to_string(getpid());
+    std::unique_ptr<FILE, FileCloser> f(std::fopen(tmp.c_str(), "wb"));
+    if (!f) return Status::error("writePng '" + path + "': cannot create file: " + std::strerror(errno));
+    PngErr err;
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &err, pngErrorFn, pngWarnFn);
+    if (!png) return Status::error("writePng '" + path + "': libpng init failed");
+    png_infop info = png_create_info_struct(png);
+    std::vector<png_bytep> rows(size_t(img.height));
+    for (int y = 0; y < img.height; ++y)
+        rows[size_t(y)] = const_cast<png_bytep>(&img.rgba[size_t(y) * size_t(img.width) * 4]);
+    volatile bool failed = false;
+    if (setjmp(png_jmpbuf(png))) {
+        failed = true;
+    } else {
+        png_init_io(png, f.get());
+        png_set_compression_level(png, 3);
+        png_set_IHDR(png, info, png_uint_32(img.width), png_uint_32(img.height), 8, PNG_COLOR_TYPE_RGBA,
+                     PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+        png_write_info(png, info);
+        png_write_image(png, rows.data());
+        png_write_end(png, nullptr);
+    }
+    png_destroy_write_struct(&png, &info);
+    bool closeFailed = std::fclose(f.release()) != 0;
+    if (failed || closeFailed) {
+        std::remove(tmp.c_str());
+        return Status::error("writePng '" + path + "': write failed" + (failed ? std::string(": ") + err.message : ""));
+    }
+    std::error_code ec;
+    std::filesystem::rename(tmp, path, ec);
+    if (ec) {
+        std::remove(tmp.c_str());
+        return Status::error("writePng '" + path + "': rename failed: " + ec.message());
+    }
+    return Status::ok();
+}
+
+Result<Image> readPng(const std::string& path) {
+    std::unique_ptr<FILE, FileCloser> f(std::fopen(path.c_str(), "rb"));
+    if (!f) return Status::error("readPng '" + path + "': cannot open: " + std::strerror(errno));
+    unsigned char sig[8];
+    if (std::fread(sig, 1, 8, f.get()) != 8 || png_sig_cmp(sig, 0, 8) != 0)
+        return Status::error("readPng '" + path + "': not a PNG file");
+    PngErr err;
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &err, pngErrorFn, pngWarnFn);
+    if (!png) return Status::error("readPng '" + path + "': libpng init failed");
+    png_infop info = png_create_info_struct(png);
+    Image img;
+    std::vector<png_bytep> rows;
+    volatile bool failed = false;
+    if (setjmp(png_jmpbuf(png))) {
+        failed = true;
+    } else {
+        png_init_io(png, f.get());
+        png_set_sig_bytes(png, 8);
+        png_set_user_limits(png, 1u << 16, 1u << 16);
+        png_read_info(png, info);
+        png_uint_32 w = png_get_image_width(png, info), h = png_get_image_height(png, info);
+        int ct = png_get_color_type(png, info), bd = png_get_bit_depth(png, info);
+        if (bd == 16) png_set_strip_16(png);
+        if (ct == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png);
+        if (ct == PNG_COLOR_TYPE_GRAY && bd < 8) png_set_expand_gray_1_2_4_to_8(png);
+        if (png_get_valid(png, info, PNG_INFO_tRNS)) png_set_tRNS_to_alpha(png);
+        if (ct == PNG_COLOR_TYPE_GRAY || ct == PNG_COLOR_TYPE_GRAY_ALPHA) png_set_gray_to_rgb(png);
+        if (!(ct & PNG_COLOR_MASK_ALPHA) && !png_get_valid(png, info, PNG_INFO_tRNS))
+            png_set_filler(png, 0xFF, PNG_FILLER_AFTER);
+        png_read_update_info(png, info);
+        if (png_get_rowbytes(png, info) != size_t(w) * 4) png_error(png, "unsupported pixel format");
+        img = Image(int(w), int(h));
+        rows.resize(h);
+        for (png_uint_32 y = 0; y < h; ++y) rows[y] = &img.rgba[size_t(y) * size_t(w) * 4];
+        png_read_image(png, rows.data());
+        png_read_end(png, nullptr);
+    }
+    png_destroy_read_struct(&png, &info, nullptr);
+    if (failed) return Status::error("readPng '" + path + "': corrupt or truncated PNG: " + err.message);
+    if (!img.valid()) return Status::error("readPng '" + path + "': empty image");
+    return img;
+}
+
+}  // namespace vista

@@ -1,0 +1,354 @@
+// RayScene: Embree 3 scene of a loaded city (see ray_scene.h for the contract).
+//
+// Layout: one RTCScene; one triangle geometry per tile mesh (vertices in a
+// scene-local float frame around frameOrigin); one child scene per tree
+// prototype, instanced with RTC_GEOMETRY_TYPE_INSTANCE per SceneInstance.
+// Hit colours: barycentric interpolation of the prelit vertex colours, rounded
+// to 8 bits exactly as the fixed-function rasteriser does.
+#include "runtime/engine/ray_scene.h"
+
+#include <embree3/rtcore.h>
+#include <pmmintrin.h>
+#include <xmmintrin.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace vista {
+
+namespace {
+
+void enableFtzDaz() {
+    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+}
+
+const char* embreeErrorName(RTCError e) {
+    switch (e) {
+        case RTC_ERROR_NONE: return "none";
+        case RTC_ERROR_UNKNOWN: return "unknown";
+        case RTC_ERROR_INVALID_ARGUMENT: return "invalid argument";
+        case RTC_ERROR_INVALID_OPERATION: return "invalid operation";
+        case RTC_ERROR_OUT_OF_MEMORY: return "out of memory";
+        case RTC_ERROR_UNSUPPORTED_CPU: return "unsupported CPU";
+        case RTC_ERROR_CANCELLED: return "cancelled";
+    }
+    return "?";
+}
+
+struct ErrorSink {
+    std::mutex mutex;
+    std::string first;  // first error message reported by the device
+};
+
+void errorCallback(void* userPtr, RTCError code, const char* str) {
+    auto* sink = static_cast<ErrorSink*>(userPtr);
+    std::lock_guard<std::mutex> lock(sink->mutex);
+    if (sink->first.empty())
+        sink->first = std::string("Embree error (") + embreeErrorName(code) + "): " + (str ? str : "");
+}
+
+// Colour of a hit: barycentric interpolation, rounded like GL's unorm conversion.
+glm::u8vec4 interpolateColor(const std::vector<glm::u8vec4>& colors, const std::vector<uint32_t>& indices,
+                             uint32_t prim, float u, float v) {
+    size_t base = size_t(prim) * 3;
+    if (base + 2 >= indices.size()) return {255, 0, 255, 255};  // cannot happen for a valid scene
+    const glm::u8vec4& c0 = colors[indices[base]];
+    const glm::u8vec4& c1 = colors[indices[base + 1]];
+    const glm::u8vec4& c2 = colors[indices[base + 2]];
+    float w = 1.0f - u - v;
+    glm::u8vec4 out;
+    for (int k = 0; k < 4; ++k) {
+        float c = w * float(c0[k]) + u * float(c1[k]) + v * float(c2[k]);
+        c = std::min(255.0f, std::max(0.0f, c));
+        out[k] = uint8_t(std::lround(c));
+    }
+    return out;
+}
+
+// Back-face culling, as the rasteriser does (the city's root state set enables
+// CullFace BACK; triangles are counter-clockwise seen from outside, which is
+// Embree's Ng = (v1 - v0) x (v2 - v0) side). Runs for intersect and occluded
+// queries; for instances both Ng and the ray are in object space.
+void cullBackFaces(const RTCFilterFunctionNArguments* args) {
+    int* valid = args->valid;
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (valid[i] != -1) continue;
+        float nx = RTCHitN_Ng_x(args->hit, args->N, i), ny = RTCHitN_Ng_y(args->hit, args->N, i),
+              nz = RTCHitN_Ng_z(args->hit, args->N, i);
+        float dx = RTCRayN_dir_x(args->ray, args->N, i), dy = RTCRayN_dir_y(args->ray, args->N, i),
+              dz = RTCRayN_dir_z(args->ray, args->N, i);
+        if (nx * dx + ny * dy + nz * dz >= 0.0f) valid[i] = 0;
+    }
+}
+
+}  // namespace
+
+struct RayScene::Impl {
+    RTCDevice device = nullptr;
+    RTCScene scene = nullptr;
+    std::vector<RTCScene> protoScenes;
+    ErrorSink errors;
+    glm::dvec3 origin{0.0};
+    size_t triangles = 0;
+
+    // Per top-level geometry id: what it is.
+    struct GeomInfo {
+        int mesh = -1;       // index into meshColors/meshIndices, or -1 for an instance
+        int prototype = -1;  // prototype index for an instance
+        glm::mat3 normalMatrix{1.0f};
+    };
+    std::vector<GeomInfo> geoms;
+    std::vector<std::vector<glm::u8vec4>> meshColors, protoColors;
+    std::vector<std::vector<uint32_t>> meshIndices, protoIndices;
+
+    ~Impl() {
+        if (scene) rtcReleaseScene(scene);
+        for (RTCScene s : protoScenes)
+            if (s) rtcReleaseScene(s);
+        if (device) rtcReleaseDevice(device);
+    }
+
+    Status checkDevice(const char* what) {
+        RTCError e = rtcGetDeviceError(device);
+        std::lock_guard<std::mutex> lock(errors.mutex);
+        if (!errors.first.empty()) return Status::error(std::string("ray scene: ") + what + ": " + errors.first);
+        if (e != RTC_ERROR_NONE) return Status::error(std::string("ray scene: ") + what + ": Embree error " + embreeErrorName(e));
+        return Status::ok();
+    }
+
+    void fill(RayHit& h, unsigned geomID, unsigned primID, unsigned instID, float u, float v, float t, float nx,
+              float ny, float nz) const {
+        h.hit = true;
+        h.t = t;
+        h.primId = primID;
+        glm::vec3 n(nx, ny, nz);
+        if (instID != RTC_INVALID_GEOMETRY_ID) {
+            h.instId = instID;
+            h.geomId = geomID;
+            const GeomInfo& gi = geoms[instID];
+            h.color = interpolateColor(protoColors[size_t(gi.prototype)], protoIndices[size_t(gi.prototype)], primID, u, v);
+            n = gi.normalMatrix * n;
+        } else {
+            h.instId = 0xFFFFFFFFu;
+            h.geomId = geomID;
+            const GeomInfo& gi = geoms[geomID];
+            h.color = interpolateColor(meshColors[size_t(gi.mesh)], meshIndices[size_t(gi.mesh)], primID, u, v);
+        }
+        float len = glm::length(n);
+        h.normal = len > 0 ? n / len : glm::vec3(0, 0, 1);
+    }
+};
+
+RayScene::RayScene() : _impl(new Impl) {}
+RayScene::~RayScene() = default;
+
+namespace {
+
+// Builds one triangle geometry; returns false (and leaves no geometry) for empty/invalid meshes.
+bool addTriangles(RTCDevice device, RTCScene scene, const SceneMesh& mesh, const glm::dvec3& shift,
+                  unsigned* geomIdOut) {
+    size_t nv = mesh.positions.size(), nt = mesh.indices.size() / 3;
+    if (nv == 0 || nt == 0) return false;
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    if (!g) return false;
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                           3 * sizeof(float), nv));
+    auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                              3 * sizeof(uint32_t), nt));
+    if (!vb || !ib) {
+        rtcReleaseGeometry(g);
+        return false;
+    }
+    for (size_t i = 0; i < nv; ++i) {
+        glm::dvec3 p = glm::dvec3(mesh.positions[i]) + shift;
+        vb[3 * i] = float(p.x);
+        vb[3 * i + 1] = float(p.y);
+        vb[3 * i + 2] = float(p.z);
+    }
+    for (size_t i = 0; i < nt * 3; ++i) ib[i] = mesh.indices[i] < nv ? mesh.indices[i] : 0;
+    rtcSetGeometryIntersectFilterFunction(g, cullBackFaces);
+    rtcSetGeometryOccludedFilterFunction(g, cullBackFaces);
+    rtcCommitGeometry(g);
+    *geomIdOut = rtcAttachGeometry(scene, g);
+    rtcReleaseGeometry(g);
+    return true;
+}
+
+bool validMesh(const SceneMesh& m) {
+    if (m.indices.size() % 3 != 0 || m.colors.size() != m.positions.size()) return false;
+    for (uint32_t i : m.indices)
+        if (i >= m.positions.size()) return false;
+    return true;
+}
+
+}  // namespace
+
+Result<std::unique_ptr<RayScene>> RayScene::build(const SceneModel& city) {
+    enableFtzDaz();
+    std::unique_ptr<RayScene> rs(new RayScene());
+    Impl& im = *rs->_impl;
+    im.origin = glm::dvec3(city.params.origin_x, city.params.origin_y, 0.0);
+    im.device = rtcNewDevice("");
+    if (!im.device) {
+        return Status::error(std::string("ray scene: cannot create Embree device (") +
+                             embreeErrorName(rtcGetDeviceError(nullptr)) + ")");
+    }
+    rtcSetDeviceErrorFunction(im.device, errorCallback, &im.errors);
+    im.scene = rtcNewScene(im.device);
+    rtcSetSceneFlags(im.scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(im.scene, RTC_BUILD_QUALITY_HIGH);
+
+    for (size_t mi = 0; mi < city.meshes.size(); ++mi) {
+        const SceneMesh& m = city.meshes[mi];
+        if (!validMesh(m))
+            return Status::error("ray scene: mesh " + std::to_string(mi) + " is malformed (index out of range, "
+                                 "index count not a multiple of 3 or colour count != vertex count)");
+        unsigned id = 0;
+        if (!addTriangles(im.device, im.scene, m, m.origin - im.origin, &id)) {
+            VISTA_RETURN_IF_ERROR(im.checkDevice("building tile geometry"));
+            continue;
+        }
+        if (im.geoms.size() <= id) im.geoms.resize(id + 1);
+        im.geoms[id].mesh = int(im.meshColors.size());
+        im.meshColors.push_back(m.colors);
+        im.meshIndices.push_back(m.indices);
+        im.triangles += m.indices.size() / 3;
+    }
+
+    // Prototypes: one child scene each.
+    std::vector<size_t> protoTris(city.prototypes.size(), 0);
+    im.protoScenes.assign(city.prototypes.size(), nullptr);
+    for (size_t pi = 0; pi < city.prototypes.size(); ++pi) {
+        const SceneMesh& p = city.prototypes[pi];
+        if (!validMesh(p)) return Status::error("ray scene: tree prototype " + std::to_string(pi) + " is malformed");
+        im.protoColors.push_back(p.colors);
+        im.protoIndices.push_back(p.indices);
+        if (p.indices.empty()) continue;
+        RTCScene s = rtcNewScene(im.device);
+        rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
+        unsigned id = 0;
+        if (!addTriangles(im.device, s, p, p.origin, &id)) {
+            rtcReleaseScene(s);
+            VISTA_RETURN_IF_ERROR(im.checkDevice("building prototype geometry"));
+            continue;
+        }
+        rtcCommitScene(s);
+        im.protoScenes[pi] = s;
+        protoTris[pi] = p.indices.size() / 3;
+    }
+    VISTA_RETURN_IF_ERROR(im.checkDevice("building tree prototypes"));
+
+    for (size_t ii = 0; ii < city.instances.size(); ++ii) {
+        const SceneInstance& inst = city.instances[ii];
+        if (inst.prototype >= city.prototypes.size())
+            return Status::error("ray scene: instance " + std::to_string(ii) + " refers to prototype " +
+                                 std::to_string(inst.prototype) + " (have " +
+                                 std::to_string(city.prototypes.size()) + ")");
+        RTCScene child = im.protoScenes[inst.prototype];
+        if (!child) continue;
+        glm::dmat4 xf = inst.transform;
+        xf[3] -= glm::dvec4(im.origin, 0.0);  // scene-local translation
+        float m[12];
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 3; ++r) m[c * 3 + r] = float(xf[c][r]);
+        RTCGeometry g = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_INSTANCE);
+        rtcSetGeometryInstancedScene(g, child);
+        rtcSetGeometryTimeStepCount(g, 1);
+        rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, m);
+        rtcCommitGeometry(g);
+        unsigned id = rtcAttachGeometry(im.scene, g);
+        rtcReleaseGeometry(g);
+        if (im.geoms.size() <= id) im.geoms.resize(id + 1);
+        im.geoms[id].prototype = int(inst.prototype);
+        glm::mat3 lin(glm::dmat3(inst.transform));
+        im.geoms[id].normalMatrix = glm::transpose(glm::inverse(lin));
+        im.triangles += protoTris[inst.prototype];
+    }
+    rtcCommitScene(im.scene);
+    VISTA_RETURN_IF_ERROR(im.checkDevice("committing the scene"));
+    return rs;
+}
+
+glm::dvec3 RayScene::frameOrigin() const { return _impl->origin; }
+
+RayHit RayScene::intersect(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar) const {
+    enableFtzDaz();
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh;
+    std::memset(&rh, 0, sizeof(rh));
+    rh.ray.org_x = org.x; rh.ray.org_y = org.y; rh.ray.org_z = org.z;
+    rh.ray.dir_x = dir.x; rh.ray.dir_y = dir.y; rh.ray.dir_z = dir.z;
+    rh.ray.tnear = tnear;
+    rh.ray.tfar = tfar;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    RayHit out;
+    if (!(tnear <= tfar)) return out;
+    rtcIntersect1(_impl->scene, &ctx, &rh);
+    if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
+        _impl->fill(out, rh.hit.geomID, rh.hit.primID, rh.hit.instID[0], rh.hit.u, rh.hit.v, rh.ray.tfar, rh.hit.Ng_x,
+                    rh.hit.Ng_y, rh.hit.Ng_z);
+    return out;
+}
+
+void RayScene::intersectMany(const glm::vec3* org, const glm::vec3* dir, int n, RayHit* out, float tfar) const {
+    enableFtzDaz();
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    alignas(32) RTCRayHit8 rh;
+    alignas(32) int valid[8];
+    for (int base = 0; base < n; base += 8) {
+        int m = std::min(8, n - base);
+        for (int k = 0; k < 8; ++k) {
+            int i = base + (k < m ? k : 0);
+            valid[k] = k < m ? -1 : 0;
+            rh.ray.org_x[k] = org[i].x; rh.ray.org_y[k] = org[i].y; rh.ray.org_z[k] = org[i].z;
+            rh.ray.dir_x[k] = dir[i].x; rh.ray.dir_y[k] = dir[i].y; rh.ray.dir_z[k] = dir[i].z;
+            rh.ray.tnear[k] = 0.0f;
+            rh.ray.tfar[k] = tfar;
+            rh.ray.time[k] = 0.0f;
+            rh.ray.mask[k] = 0xFFFFFFFFu;
+            rh.ray.id[k] = unsigned(k);
+            rh.ray.flags[k] = 0;
+            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect8(valid, _impl->scene, &ctx, &rh);
+        for (int k = 0; k < m; ++k) {
+            RayHit& h = out[base + k];
+            h = RayHit();
+            if (rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID)
+                _impl->fill(h, rh.hit.geomID[k], rh.hit.primID[k], rh.hit.instID[0][k], rh.hit.u[k], rh.hit.v[k],
+                            rh.ray.tfar[k], rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]);
+        }
+    }
+}
+
+bool RayScene::occluded(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar) const {
+    enableFtzDaz();
+    if (!(tnear <= tfar)) return false;
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRay r;
+    std::memset(&r, 0, sizeof(r));
+    r.org_x = org.x; r.org_y = org.y; r.org_z = org.z;
+    r.dir_x = dir.x; r.dir_y = dir.y; r.dir_z = dir.z;
+    r.tnear = tnear;
+    r.tfar = tfar;
+    r.mask = 0xFFFFFFFFu;
+    rtcOccluded1(_impl->scene, &ctx, &r);
+    return r.tfar < 0.0f;  // Embree sets tfar = -inf on occlusion
+}
+
+size_t RayScene::triangleCount() const { return _impl->triangles; }
+
+}  // namespace vista

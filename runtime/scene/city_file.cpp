@@ -1,0 +1,377 @@
+// The city scene file (.osgb): building the scene graph from a City, writing
+// it atomically and loading it back for the runtime. See city_file.h and
+// docs/formats.md for the layout.
+#include "runtime/scene/city_file.h"
+#include "runtime/scene/scene_graph.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <osg/BlendFunc>
+#include <osg/CullFace>
+#include <osg/Geode>
+#include <osg/Geometry>
+#include <osg/Group>
+#include <osg/MatrixTransform>
+#include <osg/Program>
+#include <osg/Shader>
+#include <osg/StateSet>
+#include <osg/UserDataContainer>
+#include <osg/VertexAttribDivisor>
+
+#include "runtime/scene/scene_file.h"
+
+namespace vista {
+namespace {
+
+constexpr int kFormatVersion = 1;
+// Generic vertex attribute locations of the four columns of the per-instance
+// matrix (texture-coordinate aliases 4..7 on drivers that alias).
+
+// Vertex shader of instanced tree drawing (compatibility profile; works with
+// GLSL 1.20 since the per-instance data are plain attributes with divisor 1).
+const char* const kInstanceVertexShader = R"(#version 120
+attribute vec4 vista_instance0;
+attribute vec4 vista_instance1;
+attribute vec4 vista_instance2;
+attribute vec4 vista_instance3;
+void main() {
+    mat4 instance = mat4(vista_instance0, vista_instance1, vista_instance2, vista_instance3);
+    gl_Position = gl_ModelViewProjectionMatrix * (instance * gl_Vertex);
+    gl_FrontColor = gl_Color;
+    gl_BackColor = gl_Color;
+}
+)";
+const char* const kInstanceFragmentShader = R"(#version 120
+void main() {
+    gl_FragColor = gl_Color;
+}
+)";
+
+osg::ref_ptr<osg::Vec3Array> toVec3Array(const std::vector<glm::vec3>& v) {
+    osg::ref_ptr<osg::Vec3Array> a = new osg::Vec3Array(unsigned(v.size()));
+    for (size_t i = 0; i < v.size(); ++i) (*a)[i].set(v[i].x, v[i].y, v[i].z);
+    return a;
+}
+osg::ref_ptr<osg::Vec4ubArray> toColorArray(const std::vector<glm::u8vec4>& v) {
+    osg::ref_ptr<osg::Vec4ubArray> a = new osg::Vec4ubArray(unsigned(v.size()));
+    for (size_t i = 0; i < v.size(); ++i) (*a)[i].set(v[i].x, v[i].y, v[i].z, v[i].w);
+    a->setNormalize(true);
+    return a;
+}
+osg::ref_ptr<osg::Vec3Array> normalsFor(const Mesh& m) {
+    if (m.normals.size() == m.positions.size()) return toVec3Array(m.normals);
+    // Missing normals (should not happen): up vectors keep the arrays consistent.
+    osg::ref_ptr<osg::Vec3Array> a = new osg::Vec3Array(unsigned(m.positions.size()));
+    std::fill(a->begin(), a->end(), osg::Vec3(0, 0, 1));
+    return a;
+}
+
+osg::BoundingBox boundsOf(const std::vector<glm::vec3>& p) {
+    osg::BoundingBox b;
+    for (const auto& v : p) b.expandBy(v.x, v.y, v.z);
+    return b;
+}
+
+void checkMesh(const Mesh& m) {
+    VISTA_CHECK(m.indices.size() % 3 == 0);
+    VISTA_CHECK(m.colors.size() == m.positions.size());
+    for (uint32_t i : m.indices) VISTA_CHECK(i < m.positions.size());
+}
+
+osg::ref_ptr<osg::Geometry> makeGeometry(const std::string& name, osg::Vec3Array* verts, osg::Vec3Array* normals,
+                                         osg::Vec4ubArray* colors, const std::vector<uint32_t>& indices) {
+    osg::ref_ptr<osg::Geometry> g = new osg::Geometry;
+    g->setName(name);
+    g->setUseDisplayList(false);
+    g->setUseVertexBufferObjects(true);
+    g->setVertexArray(verts);
+    g->setNormalArray(normals, osg::Array::BIND_PER_VERTEX);
+    g->setColorArray(colors, osg::Array::BIND_PER_VERTEX);
+    osg::ref_ptr<osg::DrawElementsUInt> de = new osg::DrawElementsUInt(GL_TRIANGLES, indices.begin(), indices.end());
+    g->addPrimitiveSet(de.get());
+    return g;
+}
+
+struct ProtoArrays {
+    osg::ref_ptr<osg::Vec3Array> verts, normals;
+    osg::ref_ptr<osg::Vec4ubArray> colors;
+    osg::BoundingBox bounds;
+};
+
+// Float matrix placing a tree (prototype frame) in its tile's frame.
+glm::mat4 instanceMatrix(const TreeInstance& t, const glm::dvec3& tileOrigin) {
+    glm::dvec3 local = t.position - tileOrigin;
+    glm::dmat4 m = glm::translate(glm::dmat4(1.0), local);
+    m = glm::rotate(m, double(t.yaw), glm::dvec3(0, 0, 1));
+    m = glm::scale(m, glm::dvec3(double(t.scale)));
+    return glm::mat4(m);
+}
+
+osg::ref_ptr<osg::StateSet> instancedStateSet() {
+    osg::ref_ptr<osg::StateSet> ss = new osg::StateSet;
+    osg::ref_ptr<osg::Program> prog = new osg::Program;
+    prog->setName("vista.instanced_trees");
+    prog->addShader(new osg::Shader(osg::Shader::VERTEX, kInstanceVertexShader));
+    prog->addShader(new osg::Shader(osg::Shader::FRAGMENT, kInstanceFragmentShader));
+    for (unsigned c = 0; c < 4; ++c) prog->addBindAttribLocation("vista_instance" + std::to_string(c), kInstanceAttrib0 + c);
+    ss->setAttributeAndModes(prog.get(), osg::StateAttribute::ON);
+    for (unsigned c = 0; c < 4; ++c) ss->setAttribute(new osg::VertexAttribDivisor(kInstanceAttrib0 + c, 1));
+    return ss;
+}
+
+std::string tileName(const Tile& t) { return "tile_" + std::to_string(t.ix) + "_" + std::to_string(t.iy); }
+
+bool tileEmpty(const Tile& t) {
+    if (!t.trees.empty()) return false;
+    for (const Mesh& m : t.meshes) if (!m.empty()) return false;
+    return true;
+}
+
+template <class T>
+bool getUser(const osg::Object& o, const std::string& key, T& out) {
+    return o.getUserValue(key, out);
+}
+
+}  // namespace
+
+osg::ref_ptr<osg::Node> buildCityScene(const City& city) {
+    const CityParams& p = city.params;
+    osg::ref_ptr<osg::Group> root = new osg::Group;
+    root->setName("vista.city");
+    root->setUserValue("vista.format", kFormatVersion);
+    root->setUserValue("vista.params", paramsToJson(p));
+    root->setUserValue("vista.streets", streetGraphToJson(city.streets));
+    root->setUserValue("vista.origin_x", p.origin_x);
+    root->setUserValue("vista.origin_y", p.origin_y);
+    root->setUserValue("vista.tile_size_m", p.tile_size_m);
+    root->setUserValue("vista.tree_prototypes", int(city.treePrototypes.size()));
+    osg::StateSet* rs = root->getOrCreateStateSet();
+    rs->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
+    rs->setAttributeAndModes(new osg::CullFace(osg::CullFace::BACK), osg::StateAttribute::ON);
+
+    // Tree prototypes: arrays shared by every tile that uses them (osgb stores them once).
+    std::vector<ProtoArrays> protos(city.treePrototypes.size());
+    for (size_t i = 0; i < city.treePrototypes.size(); ++i) {
+        const Mesh& m = city.treePrototypes[i].mesh;
+        checkMesh(m);
+        protos[i].verts = toVec3Array(m.positions);
+        protos[i].normals = normalsFor(m);
+        protos[i].colors = toColorArray(m.colors);
+        protos[i].bounds = boundsOf(m.positions);
+    }
+    osg::ref_ptr<osg::StateSet> instSS;  // shared by all instanced geometries
+
+    for (const Tile& tile : city.tiles) {
+        if (tileEmpty(tile)) continue;
+        osg::ref_ptr<osg::MatrixTransform> xf = new osg::MatrixTransform;
+        xf->setName(tileName(tile));
+        // DYNAMIC keeps osgUtil::Optimizer (run by osgviewer) from flattening
+        // the tile transform into the float vertices.
+        xf->setDataVariance(osg::Object::DYNAMIC);
+        xf->setMatrix(osg::Matrixd::translate(p.origin_x + tile.origin.x, p.origin_y + tile.origin.y, tile.origin.z));
+        osg::ref_ptr<osg::Geode> geode = new osg::Geode;
+        geode->setName(tileName(tile));
+        for (int mi = 0; mi < kMaterialCount; ++mi) {
+            const Mesh& m = tile.meshes[size_t(mi)];
+            if (m.empty()) continue;
+            checkMesh(m);
+            auto g = makeGeometry(materialName(Material(mi)), toVec3Array(m.positions).get(), normalsFor(m).get(),
+                                  toColorArray(m.colors).get(), m.indices);
+            g->setInitialBound(boundsOf(m.positions));
+            geode->addDrawable(g.get());
+        }
+        // Trees: one instanced draw per prototype used in this tile.
+        std::map<uint32_t, std::vector<uint32_t>> byProto;
+        for (uint32_t ti : tile.trees) {
+            VISTA_CHECK(ti < city.trees.size());
+            VISTA_CHECK(city.trees[ti].prototype < city.treePrototypes.size());
+            byProto[city.trees[ti].prototype].push_back(ti);
+        }
+        for (const auto& [pi, list] : byProto) {
+            const Mesh& pm = city.treePrototypes[pi].mesh;
+            if (pm.empty()) continue;
+            if (!instSS) instSS = instancedStateSet();
+            auto g = makeGeometry(kTreeGeometryPrefix + std::to_string(pi), protos[pi].verts.get(), protos[pi].normals.get(),
+                                  protos[pi].colors.get(), pm.indices);
+            g->getPrimitiveSet(0)->setNumInstances(int(list.size()));
+            osg::ref_ptr<osg::Vec4Array> cols[4];
+            for (auto& c : cols) c = new osg::Vec4Array(unsigned(list.size()));
+            osg::BoundingBox bb;
+            const osg::BoundingBox& pb = protos[pi].bounds;
+            for (size_t k = 0; k < list.size(); ++k) {
+                glm::mat4 m = instanceMatrix(city.trees[list[k]], tile.origin);
+                for (int c = 0; c < 4; ++c) (*cols[c])[unsigned(k)].set(m[c][0], m[c][1], m[c][2], m[c][3]);
+                for (int corner = 0; corner < 8; ++corner) {
+                    osg::Vec3 v = pb.corner(unsigned(corner));
+                    glm::vec4 w = m * glm::vec4(v.x(), v.y(), v.z(), 1.0f);
+                    bb.expandBy(w.x, w.y, w.z);
+                }
+            }
+            for (unsigned c = 0; c < 4; ++c) g->setVertexAttribArray(kInstanceAttrib0 + c, cols[c].get(), osg::Array::BIND_PER_VERTEX);
+            g->setInitialBound(bb);
+            g->setStateSet(instSS.get());
+            geode->addDrawable(g.get());
+        }
+        if (geode->getNumDrawables() == 0) continue;
+        xf->addChild(geode.get());
+        root->addChild(xf.get());
+    }
+    return root;
+}
+
+Status writeCityFile(const City& city, const std::string& path) {
+    osg::ref_ptr<osg::Node> scene = buildCityScene(city);
+    return writeSceneFile(*scene, path, false);
+}
+
+Result<SceneModel> loadCityFile(const std::string& path) {
+    auto rn = readSceneFile(path);
+    if (!rn) return rn.status();
+    return decodeCityScene(rn->get(), path);
+}
+
+osg::Node* sceneRoot(const SceneModel& model) { return model.graph ? model.graph->root.get() : nullptr; }
+
+void setSceneRoot(SceneModel& model, osg::Node* root) {
+    model.graph = std::make_shared<SceneGraph>();
+    model.graph->root = root;
+}
+
+void expandBounds(const SceneMesh& m, glm::dvec2& lo, glm::dvec2& hi) {
+    for (const auto& p : m.positions) {
+        const glm::dvec2 w = glm::dvec2(m.origin) + glm::dvec2(p);
+        lo = glm::min(lo, w);
+        hi = glm::max(hi, w);
+    }
+}
+
+void expandBounds(const SceneModel& city, const SceneInstance& in, glm::dvec2& lo, glm::dvec2& hi) {
+    if (in.prototype >= city.prototypes.size()) return;
+    for (const auto& p : city.prototypes[in.prototype].positions) {
+        const glm::dvec2 w(in.transform * glm::dvec4(glm::dvec3(p), 1.0));
+        lo = glm::min(lo, w);
+        hi = glm::max(hi, w);
+    }
+}
+
+Result<SceneModel> decodeCityScene(osg::Node* node, const std::string& path) {
+    auto bad = [&](const std::string& why) { return Status::error("'" + path + "' is not a vista city file: " + why); };
+    osg::Group* root = node ? node->asGroup() : nullptr;
+    if (!root || root->getName() != "vista.city") return bad("root node is not the group 'vista.city'");
+    int format = 0;
+    if (!getUser(*root, "vista.format", format)) return bad("missing user value vista.format");
+    if (format != kFormatVersion)
+        return Status::error("city file '" + path + "': vista.format = " + std::to_string(format) + " is not supported (expected " +
+                             std::to_string(kFormatVersion) + ")");
+    SceneModel out;
+    setSceneRoot(out, node);
+    std::string paramsJson, streetsJson;
+    if (!getUser(*root, "vista.params", paramsJson)) return bad("missing user value vista.params");
+    auto params = parseParamsJson(paramsJson, path + " (vista.params)");
+    if (!params) return params.status();
+    out.params = *params;
+    if (getUser(*root, "vista.streets", streetsJson) && !streetsJson.empty() && streetsJson != "{}") {
+        auto g = streetGraphFromJson(streetsJson);
+        if (!g) return Status::error("city file '" + path + "': vista.streets: " + g.status().message());
+        out.streets = std::move(*g);
+    }
+    int protoCount = 0;
+    getUser(*root, "vista.tree_prototypes", protoCount);
+    if (protoCount < 0 || protoCount > 1000000) return bad("vista.tree_prototypes = " + std::to_string(protoCount) + " out of range");
+    out.prototypes.resize(size_t(protoCount));
+    std::vector<bool> protoSeen(size_t(protoCount), false);
+
+    for (unsigned ci = 0; ci < root->getNumChildren(); ++ci) {
+        osg::MatrixTransform* xf = asCityTile(root->getChild(ci));
+        if (!xf) continue;
+        const osg::Vec3d t = xf->getMatrix().getTrans();
+        const glm::dvec3 tileOrigin(t.x(), t.y(), t.z());
+        const glm::dmat4 tileM = glm::translate(glm::dmat4(1.0), tileOrigin);
+        SceneTile tile;
+        tile.child = ci;
+        tile.origin = tileOrigin;
+        for (osg::Geometry* g : tileGeometries(*xf)) {
+            auto* verts = dynamic_cast<osg::Vec3Array*>(g->getVertexArray());
+            auto* colors = dynamic_cast<osg::Vec4ubArray*>(g->getColorArray());
+            auto* de = dynamic_cast<osg::DrawElements*>(g->getPrimitiveSet(0));
+            if (!verts || !de || de->getMode() != GL_TRIANGLES) return bad("geometry '" + g->getName() + "' in " + xf->getName() + " is malformed");
+            if (colors && colors->size() != verts->size()) return bad("geometry '" + g->getName() + "': colour count != vertex count");
+            SceneMesh mesh;
+            mesh.positions.resize(verts->size());
+            for (size_t i = 0; i < verts->size(); ++i) mesh.positions[i] = glm::vec3((*verts)[i].x(), (*verts)[i].y(), (*verts)[i].z());
+            mesh.colors.assign(verts->size(), glm::u8vec4(255));
+            if (colors)
+                for (size_t i = 0; i < colors->size(); ++i) mesh.colors[i] = glm::u8vec4((*colors)[i].r(), (*colors)[i].g(), (*colors)[i].b(), (*colors)[i].a());
+            mesh.indices.resize(de->getNumIndices());
+            for (unsigned i = 0; i < de->getNumIndices(); ++i) {
+                mesh.indices[i] = de->getElement(i);
+                if (mesh.indices[i] >= verts->size()) return bad("geometry '" + g->getName() + "': index out of range");
+            }
+            if (mesh.indices.size() % 3 != 0) return bad("geometry '" + g->getName() + "': index count not a multiple of 3");
+            const std::string& name = g->getName();
+            if (name.rfind(kTreeGeometryPrefix, 0) == 0) {
+                long pi = std::strtol(name.c_str() + std::strlen(kTreeGeometryPrefix), nullptr, 10);
+                if (pi < 0 || pi >= protoCount) return bad("tree geometry '" + name + "' names an unknown prototype");
+                osg::Vec4Array* cols[4];
+                for (unsigned c = 0; c < 4; ++c) {
+                    cols[c] = dynamic_cast<osg::Vec4Array*>(g->getVertexAttribArray(kInstanceAttrib0 + c));
+                    if (!cols[c]) return bad("tree geometry '" + name + "' has no instance matrices");
+                }
+                size_t n = size_t(std::max(0, de->getNumInstances()));
+                for (auto* c : cols) if (c->size() != n) return bad("tree geometry '" + name + "': instance count mismatch");
+                for (size_t k = 0; k < n; ++k) {
+                    glm::dmat4 m(1.0);
+                    for (int c = 0; c < 4; ++c) {
+                        const osg::Vec4& v = (*cols[c])[unsigned(k)];
+                        m[c] = glm::dvec4(v.x(), v.y(), v.z(), v.w());
+                    }
+                    tile.instances.push_back(uint32_t(out.instances.size()));
+                    out.instances.push_back({uint32_t(pi), tileM * m});
+                }
+                out.triangles += n * (mesh.indices.size() / 3);
+                tile.triangles += n * (mesh.indices.size() / 3);
+                if (!protoSeen[size_t(pi)]) {
+                    protoSeen[size_t(pi)] = true;
+                    out.prototypes[size_t(pi)] = std::move(mesh);
+                }
+            } else {
+                mesh.origin = tileOrigin;
+                out.triangles += mesh.indices.size() / 3;
+                tile.triangles += mesh.indices.size() / 3;
+                tile.meshes.push_back(uint32_t(out.meshes.size()));
+                out.meshes.push_back(std::move(mesh));
+            }
+        }
+        for (uint32_t mi : tile.meshes) expandBounds(out.meshes[mi], tile.lo, tile.hi);
+        out.tiles.push_back(std::move(tile));
+    }
+    // Instance bounds need the prototypes, which a later tile may define first.
+    for (SceneTile& t : out.tiles)
+        for (uint32_t ii : t.instances) expandBounds(out, out.instances[ii], t.lo, t.hi);
+    return out;
+}
+
+osg::MatrixTransform* asCityTile(osg::Node* node) {
+    auto* xf = dynamic_cast<osg::MatrixTransform*>(node);
+    return xf && xf->getName().rfind("tile_", 0) == 0 ? xf : nullptr;
+}
+
+std::vector<osg::Geometry*> tileGeometries(osg::MatrixTransform& tile) {
+    std::vector<osg::Geometry*> out;
+    for (unsigned gi = 0; gi < tile.getNumChildren(); ++gi) {
+        osg::Geode* geode = tile.getChild(gi)->asGeode();
+        if (!geode) continue;
+        for (unsigned di = 0; di < geode->getNumDrawables(); ++di) {
+            osg::Geometry* g = geode->getDrawable(di)->asGeometry();
+            if (g && g->getNumPrimitiveSets() > 0) out.push_back(g);
+        }
+    }
+    return out;
+}
+
+}  // namespace vista

@@ -1,0 +1,332 @@
+#include "runtime/scene/paths.h"
+#include "foundation/units.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include <unistd.h>
+
+#include "foundation/rng.h"
+#include "citygen/terrain.h"
+
+namespace vista {
+
+namespace {
+
+constexpr double kMinSpeed = 2.0;       // m/s while turning sharply
+constexpr double kTurnRadius = 6.0;     // metres of corner cut we allow at full yaw rate
+
+double headingOf(const glm::dvec2& d) { return std::atan2(d.x, d.y); }  // clockwise from north
+
+// The route: node sequence chosen by a seeded walk, extended on demand.
+class Route {
+public:
+    Route(const StreetGraph& g, uint64_t seed) : _g(g), _rng(seed, 0, Stream::Paths) {
+        _adj.resize(g.nodes.size());
+        for (size_t e = 0; e < g.edges.size(); ++e) {
+            _adj[g.edges[e].a].push_back(uint32_t(e));
+            _adj[g.edges[e].b].push_back(uint32_t(e));
+        }
+        // Start on a random edge whose ends both continue (avoid dead ends).
+        std::vector<uint32_t> good;
+        for (size_t e = 0; e < g.edges.size(); ++e)
+            if (_adj[g.edges[e].a].size() > 1 && _adj[g.edges[e].b].size() > 1) good.push_back(uint32_t(e));
+        uint32_t e0 = good.empty() ? uint32_t(_rng.range(0, int64_t(g.edges.size()) - 1))
+                                   : good[size_t(_rng.range(0, int64_t(good.size()) - 1))];
+        bool flip = _rng.chance(0.5);
+        push(flip ? g.edges[e0].b : g.edges[e0].a, e0);
+        push(flip ? g.edges[e0].a : g.edges[e0].b, e0);
+    }
+    // Makes sure the route extends at least `s` metres.
+    void ensure(double s) {
+        while (_cum.back() < s) extend();
+    }
+    size_t segments() const { return _pts.size() - 1; }
+    const glm::dvec2& point(size_t i) const { return _pts[i]; }
+    double cum(size_t i) const { return _cum[i]; }
+    glm::dvec2 at(double s) {
+        ensure(s);
+        size_t i = size_t(std::upper_bound(_cum.begin(), _cum.end(), s) - _cum.begin());
+        i = std::clamp<size_t>(i, 1, _pts.size() - 1);
+        double len = _cum[i] - _cum[i - 1];
+        double f = len > 0 ? (s - _cum[i - 1]) / len : 0.0;
+        return glm::mix(_pts[i - 1], _pts[i], std::clamp(f, 0.0, 1.0));
+    }
+    double segHeading(size_t i) const { return headingOf(_pts[i + 1] - _pts[i]); }
+
+private:
+    void push(uint32_t node, uint32_t edge) {
+        if (!_pts.empty()) _cum.push_back(_cum.back() + glm::length(_g.nodes[node] - _pts.back()));
+        else _cum.push_back(0.0);
+        _pts.push_back(_g.nodes[node]);
+        _nodes.push_back(node);
+        _edges.push_back(edge);
+    }
+    void extend() {
+        uint32_t n = _nodes.back(), prev = _nodes[_nodes.size() - 2], inEdge = _edges.back();
+        glm::dvec2 inDir = _g.nodes[n] - _g.nodes[prev];
+        double inH = headingOf(inDir);
+        std::vector<uint32_t> cand;
+        std::vector<double> weight;
+        for (uint32_t e : _adj[n]) {
+            if (e == inEdge) continue;
+            uint32_t m = _g.edges[e].a == n ? _g.edges[e].b : _g.edges[e].a;
+            double turn = std::abs(wrapAngle(headingOf(_g.nodes[m] - _g.nodes[n]) - inH));
+            double w = turn < 0.5 ? 3.0 : 1.0;
+            if (_adj[m].size() <= 1) w *= 0.05;  // avoid dead ends
+            cand.push_back(e);
+            weight.push_back(w);
+        }
+        if (cand.empty()) {  // dead end: U-turn
+            push(prev, inEdge);
+            return;
+        }
+        double total = 0;
+        for (double w : weight) total += w;
+        double r = _rng.uniform() * total;
+        size_t pick = cand.size() - 1;
+        for (size_t i = 0; i < cand.size(); ++i) {
+            if (r < weight[i]) { pick = i; break; }
+            r -= weight[i];
+        }
+        uint32_t e = cand[pick];
+        push(_g.edges[e].a == n ? _g.edges[e].b : _g.edges[e].a, e);
+    }
+
+    const StreetGraph& _g;
+    Rng _rng;
+    std::vector<std::vector<uint32_t>> _adj;
+    std::vector<glm::dvec2> _pts;
+    std::vector<double> _cum;
+    std::vector<uint32_t> _nodes, _edges;
+};
+
+double segDistance(const glm::dvec2& p, const glm::dvec2& a, const glm::dvec2& b, double* tOut = nullptr) {
+    glm::dvec2 ab = b - a;
+    double l2 = glm::dot(ab, ab);
+    double t = l2 > 0 ? std::clamp(glm::dot(p - a, ab) / l2, 0.0, 1.0) : 0.0;
+    if (tOut) *tOut = t;
+    return glm::length(p - (a + t * ab));
+}
+
+std::string fmtNum(double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof(buf), "%.6g", v);
+    return buf;
+}
+
+}  // namespace
+
+const char* pathKindName(PathKind k) {
+    switch (k) {
+        case PathKind::Walk: return "walk";
+        case PathKind::Car: return "car";
+        case PathKind::Fly: return "fly";
+    }
+    return "?";
+}
+
+Result<PathKind> parsePathKind(const std::string& s) {
+    if (s == "walk") return PathKind::Walk;
+    if (s == "car") return PathKind::Car;
+    if (s == "fly") return PathKind::Fly;
+    return Status::error("path kind '" + s + "' unknown; expected one of: walk, car, fly");
+}
+
+Status validatePathOptions(const PathOptions& o) {
+    auto bad = [](const char* name, double v, const char* range) {
+        return Status::error(std::string("path option ") + name + " = " + fmtNum(v) + " out of range " + range);
+    };
+    if (!(o.duration > 0 && o.duration <= 86400)) return bad("duration", o.duration, "(0, 86400] s");
+    if (!(o.dt > 0 && o.dt <= 10)) return bad("dt", o.dt, "(0, 10] s");
+    if (!(o.maxSpeed > 0 && o.maxSpeed <= 1000)) return bad("speed", o.maxSpeed, "(0, 1000] m/s");
+    if (!(o.maxYawRate > 0 && o.maxYawRate <= 4 * kPi)) return bad("yaw rate", o.maxYawRate, "(0, 720] deg/s (in rad/s)");
+    if (!(o.accel > 0) || !(o.decel > 0)) return bad("accel/decel", std::min(o.accel, o.decel), "> 0 m/s^2");
+    if (!(o.flyHeight > 0 && o.flyHeight < 10000)) return bad("fly height", o.flyHeight, "(0, 10000) m");
+    if (!(o.flyPitch > -kPi / 2 && o.flyPitch < kPi / 2)) return bad("fly pitch", o.flyPitch, "(-90, 90) deg");
+    if (o.duration / o.dt > 1e7) return bad("duration/dt", o.duration / o.dt, "<= 1e7 samples");
+    return Status::ok();
+}
+
+Camera Path::camera(size_t i, const Camera& base) const {
+    VISTA_CHECK(i < samples.size());
+    Camera c = base;
+    c.eye = samples[i].position;
+    c.heading = samples[i].heading;
+    c.pitch = samples[i].pitch;
+    return c;
+}
+
+std::vector<size_t> Path::spread(size_t n) const {
+    std::vector<size_t> out;
+    if (samples.empty() || n == 0) return out;
+    for (size_t i = 0; i < n; ++i)
+        out.push_back(n == 1 ? 0 : size_t(std::llround(double(i) * double(samples.size() - 1) / double(n - 1))));
+    return out;
+}
+
+double distanceToStreets(const StreetGraph& g, const glm::dvec2& p, int* edge) {
+    double best = -1;
+    if (edge) *edge = -1;
+    for (size_t e = 0; e < g.edges.size(); ++e) {
+        double d = segDistance(p, g.nodes[g.edges[e].a], g.nodes[g.edges[e].b]);
+        if (best < 0 || d < best) {
+            best = d;
+            if (edge) *edge = int(e);
+        }
+    }
+    return best;
+}
+
+Result<Path> generatePath(const StreetGraph& g, const CityParams& params, const PathOptions& o) {
+    VISTA_RETURN_IF_ERROR(validatePathOptions(o));
+    if (g.edges.empty()) return Status::error("cannot make a path: the city has no streets (street graph has 0 edges)");
+    for (const auto& e : g.edges)
+        if (e.a >= g.nodes.size() || e.b >= g.nodes.size())
+            return Status::error("cannot make a path: street graph edge refers to a missing node");
+
+    Route route(g, o.seed);
+    glm::dvec2 pos = route.point(0);
+    double h = route.segHeading(0);
+    double v = 0.0;
+    double sp = 0.0;      // progress along the route (arc length of the closest point)
+    size_t seg = 0;
+    const double w = o.maxYawRate, dt = o.dt;
+    const size_t n = size_t(std::floor(o.duration / dt + 1e-9)) + 1;
+    const glm::dvec2 origin(params.origin_x, params.origin_y);
+
+    Path path;
+    path.samples.reserve(n);
+    for (size_t i = 0; i < n; ++i) {
+        PathSample s;
+        s.t = double(i) * dt;
+        double ground = terrainHeight(params, pos);
+        s.position = glm::dvec3(pos + origin, ground + o.eyeHeight());
+        s.heading = wrapAngle(h);
+        s.pitch = o.kind == PathKind::Fly ? o.flyPitch : 0.0;
+        path.samples.push_back(s);
+
+        // Progress: closest point on the next few route segments.
+        route.ensure(sp + 200.0);
+        double bestD = 1e300;
+        size_t bestSeg = seg;
+        double bestS = sp;
+        for (size_t k = seg; k < std::min(route.segments(), seg + 4); ++k) {
+            double t;
+            double d = segDistance(pos, route.point(k), route.point(k + 1), &t);
+            if (d < bestD - 1e-9) {
+                bestD = d;
+                bestSeg = k;
+                bestS = route.cum(k) + t * (route.cum(k + 1) - route.cum(k));
+            }
+        }
+        seg = bestSeg;
+        sp = std::max(sp, bestS);
+
+        // Steering: pure pursuit of a point ahead, yaw rate clamped.
+        double look = std::max(3.0, 0.6 * v + 2.0);
+        glm::dvec2 target = route.at(sp + look);
+        double err = glm::length(target - pos) > 1e-6 ? wrapAngle(headingOf(target - pos) - h) : 0.0;
+        double dh = std::clamp(err, -w * dt, w * dt);
+        h = wrapAngle(h + dh);
+
+        // Speed: slow down for the sharpest turn within braking distance.
+        double horizon = v * v / (2.0 * o.decel) + look + 8.0;
+        double turn = 0.0;
+        route.ensure(sp + horizon + 1.0);
+        for (size_t k = seg; k < route.segments() && route.cum(k) < sp + horizon; ++k) {
+            if (route.cum(k + 1) - route.cum(k) < 1e-9) continue;
+            turn = std::max(turn, std::abs(wrapAngle(route.segHeading(k) - h)));
+        }
+        double vt = o.maxSpeed;
+        if (turn > 0.26) vt = std::clamp(w * kTurnRadius * (kPi / 2) / turn, std::min(kMinSpeed, o.maxSpeed), o.maxSpeed);
+        vt = std::min(vt, o.maxSpeed * std::max(0.15, std::cos(std::min(std::abs(err), kPi / 2))));
+        vt = std::min(vt, o.maxSpeed);
+        v += std::clamp(vt - v, -o.decel * dt, o.accel * dt);
+        v = std::clamp(v, 0.0, o.maxSpeed);
+        pos += v * dt * glm::dvec2(std::sin(h), std::cos(h));
+    }
+    return path;
+}
+
+Status savePathCsv(const Path& path, const std::string& file) {
+    std::string out = "t_s,x_m,y_m,z_m,heading_deg,pitch_deg\n";
+    char buf[256];
+    for (const auto& s : path.samples) {
+        std::snprintf(buf, sizeof(buf), "%.6f,%.4f,%.4f,%.4f,%.6f,%.6f\n", s.t, s.position.x, s.position.y,
+                      s.position.z, s.heading * 180.0 / kPi, s.pitch * 180.0 / kPi);
+        out += buf;
+    }
+    std::string tmp = file + ".tmp." + std::to_string(getpid());
+    {
+        std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+        if (!f) return Status::error("cannot write path file '" + file + "'");
+        f << out;
+        f.flush();
+        if (!f) {
+            std::remove(tmp.c_str());
+            return Status::error("write failed for path file '" + file + "'");
+        }
+    }
+    if (std::rename(tmp.c_str(), file.c_str()) != 0) {
+        std::remove(tmp.c_str());
+        return Status::error("cannot rename into path file '" + file + "'");
+    }
+    return Status::ok();
+}
+
+Result<Path> loadPathCsv(const std::string& file) {
+    std::ifstream f(file);
+    if (!f) return Status::error("path file '" + file + "' cannot be opened (missing or unreadable)");
+    std::string line;
+    Path path;
+    int lineNo = 0;
+    while (std::getline(f, line)) {
+        ++lineNo;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (line.empty() || line[0] == '#') continue;
+        if (lineNo == 1 && line.rfind("t_s", 0) == 0) continue;  // header
+        double v[6];
+        const char* p = line.c_str();
+        for (int k = 0; k < 6; ++k) {
+            char* end = nullptr;
+            errno = 0;
+            v[k] = std::strtod(p, &end);
+            if (end == p || errno == ERANGE || !std::isfinite(v[k]))
+                return Status::error("path file '" + file + "' line " + std::to_string(lineNo) + ": field " +
+                                     std::to_string(k + 1) + " is not a finite number (expected t_s,x_m,y_m,z_m,heading_deg,pitch_deg)");
+            p = end;
+            while (*p == ' ' || *p == '\t') ++p;
+            if (k < 5) {
+                if (*p != ',')
+                    return Status::error("path file '" + file + "' line " + std::to_string(lineNo) +
+                                         ": expected 6 comma-separated fields");
+                ++p;
+            }
+        }
+        while (*p == ' ' || *p == '\t') ++p;
+        if (*p != '\0')
+            return Status::error("path file '" + file + "' line " + std::to_string(lineNo) + ": more than 6 fields");
+        if (!path.samples.empty() && !(v[0] > path.samples.back().t))
+            return Status::error("path file '" + file + "' line " + std::to_string(lineNo) + ": time " + fmtNum(v[0]) +
+                                 " s does not increase");
+        if (std::abs(v[5]) >= 90.0)
+            return Status::error("path file '" + file + "' line " + std::to_string(lineNo) + ": pitch " + fmtNum(v[5]) +
+                                 " deg out of range (-90, 90)");
+        PathSample s;
+        s.t = v[0];
+        s.position = {v[1], v[2], v[3]};
+        s.heading = v[4] * kPi / 180.0;
+        s.pitch = v[5] * kPi / 180.0;
+        path.samples.push_back(s);
+    }
+    if (path.samples.empty()) return Status::error("path file '" + file + "' has no samples");
+    return path;
+}
+
+}  // namespace vista

@@ -1,0 +1,82 @@
+// Walkthrough paths: deterministic drives along the street graph, and their
+// CSV form.
+//
+// A path is a list of samples at a fixed time step (PathOptions::dt): time
+// (s), eye position (world metres: city frame + params.origin), heading
+// (radians clockwise from north, as Camera) and pitch (radians). The vehicle
+// follows a route of street-graph edges chosen by a seeded random walk
+// (vista::Rng(seed, 0, Stream::Paths); U-turns only at dead ends, straight
+// continuations preferred), steering with pure pursuit of a point ahead on
+// the route centre line. Limits hold at every step by construction:
+// |speed| <= maxSpeed, |heading change| <= maxYawRate * dt, |dv| <= accel * dt;
+// the vehicle slows before turns so that it stays on the carriageway.
+// Eye height above the terrain: walk 1.7 m, car 1.2 m, fly flyHeight (the
+// elevated fly-over where occlusion is weak; pitched down by flyPitch).
+// Output depends only on (graph, params, options): no threads, no clocks.
+//
+// CSV: header `t_s,x_m,y_m,z_m,heading_deg,pitch_deg`, one sample per line
+// (degrees at this user interface). loadPathCsv rejects missing files,
+// malformed lines, non-finite values and non-increasing time with a message
+// naming the line. savePathCsv writes atomically.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "citygen/params.h"
+#include "foundation/status.h"
+#include "citygen/street_graph.h"
+#include "runtime/scene/camera.h"
+
+namespace vista {
+
+enum class PathKind { Walk, Car, Fly };
+const char* pathKindName(PathKind k);
+Result<PathKind> parsePathKind(const std::string& s);  // "walk" | "car" | "fly"
+
+struct PathOptions {
+    uint64_t seed = 1;
+    PathKind kind = PathKind::Car;
+    double duration = 60.0;                       // seconds, > 0
+    double dt = 1.0 / 30.0;                       // seconds between samples, > 0
+    double maxSpeed = 14.0;                       // m/s, > 0
+    double maxYawRate = 0.7853981633974483;       // rad/s (45 deg/s), > 0
+    double accel = 2.5;                           // m/s^2 speeding up
+    double decel = 4.0;                           // m/s^2 braking
+    double flyHeight = 80.0;                      // metres above the terrain (Fly)
+    double flyPitch = -0.2;                       // radians (Fly)
+    double eyeHeight() const { return kind == PathKind::Walk ? 1.7 : kind == PathKind::Car ? 1.2 : flyHeight; }
+};
+// Checks ranges; message names the option.
+Status validatePathOptions(const PathOptions& o);
+
+struct PathSample {
+    double t = 0;
+    glm::dvec3 position{0.0};  // world metres
+    double heading = 0;        // radians
+    double pitch = 0;          // radians
+};
+
+struct Path {
+    std::vector<PathSample> samples;
+    // Camera at sample i: eye/heading/pitch from the sample, the rest (fov,
+    // size, zNear) from `base`.
+    Camera camera(size_t i, const Camera& base) const;
+    // Indices of n samples spread evenly over the whole path (first and last
+    // included; repeats when n exceeds the sample count).
+    std::vector<size_t> spread(size_t n) const;
+};
+
+// Generates a drive. Errors: invalid options, a graph without edges.
+Result<Path> generatePath(const StreetGraph& streets, const CityParams& params, const PathOptions& options);
+
+Status savePathCsv(const Path& path, const std::string& file);
+Result<Path> loadPathCsv(const std::string& file);
+
+// Distance (metres, 2D) from city-frame point p to the nearest street centre
+// line, and that edge's index (for tests and diagnostics). -1 if no edges.
+double distanceToStreets(const StreetGraph& streets, const glm::dvec2& p, int* edge = nullptr);
+
+}  // namespace vista

@@ -1,0 +1,50 @@
+// The OSG side of the city file: building the scene graph from a City, and
+// the layout every reader of the graph shares (tiles, tree geometries).
+//
+// Graph (docs/formats.md): root osg::Group "vista.city" with user values
+//   vista.format (int, 1), vista.params (canonical params JSON),
+//   vista.streets (street graph JSON, street_graph.h), vista.origin_x/_y (double),
+//   vista.tile_size_m (double)
+// and children: one osg::MatrixTransform per tile (name "tile_IX_IY", double
+// translation = world tile origin) holding an osg::Geode with one
+// osg::Geometry per material (name = material name; VBOs; per-vertex prelit
+// colours; lighting off) and the tile's trees drawn instanced per prototype:
+// geometries named kTreeGeometryPrefix + prototype index carrying their
+// per-instance matrix columns in vertex attributes kInstanceAttrib0 .. +3.
+// Only OSG-side rooms (nodes/, bake/, the vista tool) include this header.
+#pragma once
+#include <vector>
+
+#include <osg/Geometry>
+#include <osg/MatrixTransform>
+#include <osg/Node>
+#include <osg/ref_ptr>
+
+#include "citygen/city.h"
+#include "runtime/scene/scene_model.h"
+
+namespace vista {
+
+struct SceneGraph {
+    osg::ref_ptr<osg::Node> root;
+};
+// The graph a model was decoded from, or null (hand-built model).
+osg::Node* sceneRoot(const SceneModel& model);
+// Attaches `root` as the model's graph (for models built from a graph in memory).
+void setSceneRoot(SceneModel& model, osg::Node* root);
+
+osg::ref_ptr<osg::Node> buildCityScene(const City& city);
+
+constexpr const char* kTreeGeometryPrefix = "tree_prototype_";
+constexpr unsigned kInstanceAttrib0 = 12;
+// The tile transform ("tile_IX_IY") if `node` is one, else null.
+osg::MatrixTransform* asCityTile(osg::Node* node);
+// The geometries with at least one primitive set under a tile transform, in
+// file order: the order in which loadCityFile() lists meshes and instances.
+std::vector<osg::Geometry*> tileGeometries(osg::MatrixTransform& tile);
+
+// Decodes a graph in the city layout into plain arrays (what loadCityFile
+// does after reading the file). `what` names the source in messages.
+Result<SceneModel> decodeCityScene(osg::Node* root, const std::string& what);
+
+}  // namespace vista
