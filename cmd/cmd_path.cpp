@@ -20,6 +20,7 @@ int runPath(int argc, char** argv) {
     app.add_option("--seed", o.seed, "random seed of the route (default 1)");
     app.add_option("--kind", kind, "walk (eye 1.7 m), car (eye 1.2 m) or fly (elevated fly-over); default car");
     app.add_option("--duration", o.duration, "path length in seconds (default 60)");
+    app.add_option("--run-up", o.runUp, "seconds driven before the path starts and dropped, so it starts at cruising speed, 0 .. 600 (default 8)");
     app.add_option("--dt", o.dt, "seconds between samples (default 1/30)");
     app.add_option("--speed", o.maxSpeed, "maximum speed in m/s (default 14)");
     app.add_option("--yaw-rate", yawDeg, "maximum yaw rate in degrees/s (default 45)");

@@ -1,4 +1,5 @@
 #include "runtime/scene/paths.h"
+#include "foundation/atomic_file.h"
 #include "foundation/units.h"
 
 #include <algorithm>
@@ -149,7 +150,8 @@ Status validatePathOptions(const PathOptions& o) {
     if (!(o.accel > 0) || !(o.decel > 0)) return bad("accel/decel", std::min(o.accel, o.decel), "> 0 m/s^2");
     if (!(o.flyHeight > 0 && o.flyHeight < 10000)) return bad("fly height", o.flyHeight, "(0, 10000) m");
     if (!(o.flyPitch > -kPi / 2 && o.flyPitch < kPi / 2)) return bad("fly pitch", o.flyPitch, "(-90, 90) deg");
-    if (o.duration / o.dt > 1e7) return bad("duration/dt", o.duration / o.dt, "<= 1e7 samples");
+    if (!(o.runUp >= 0 && o.runUp <= 600)) return bad("run-up", o.runUp, "[0, 600] s");
+    if ((o.duration + o.runUp) / o.dt > 1e7) return bad("(duration + run-up)/dt", (o.duration + o.runUp) / o.dt, "<= 1e7 samples");
     return Status::ok();
 }
 
@@ -160,6 +162,31 @@ Camera Path::camera(size_t i, const Camera& base) const {
     c.heading = samples[i].heading;
     c.pitch = samples[i].pitch;
     return c;
+}
+
+PathMotion pathMotion(const Path& path, const std::vector<size_t>& frames) {
+    PathMotion m;
+    std::vector<double> metres, degrees;
+    for (size_t k = 1; k < frames.size(); ++k) {
+        VISTA_CHECK(frames[k] < path.samples.size() && frames[k - 1] < path.samples.size());
+        const PathSample& a = path.samples[frames[k - 1]];
+        const PathSample& b = path.samples[frames[k]];
+        metres.push_back(glm::length(b.position - a.position));
+        const double dh = wrapAngle(b.heading - a.heading), dp = b.pitch - a.pitch;
+        degrees.push_back(radToDeg(std::sqrt(dh * dh + dp * dp)));
+    }
+    if (metres.empty()) return m;
+    auto median = [](std::vector<double> v) {
+        std::sort(v.begin(), v.end());
+        const size_t h = v.size() / 2;
+        return v.size() % 2 ? v[h] : 0.5 * (v[h - 1] + v[h]);
+    };
+    m.frames = frames.size();
+    m.metresMedian = median(metres);
+    m.metresMax = *std::max_element(metres.begin(), metres.end());
+    m.degreesMedian = median(degrees);
+    m.degreesMax = *std::max_element(degrees.begin(), degrees.end());
+    return m;
 }
 
 std::vector<size_t> Path::spread(size_t n) const {
@@ -198,18 +225,23 @@ Result<Path> generatePath(const StreetGraph& g, const CityParams& params, const 
     size_t seg = 0;
     const double w = o.maxYawRate, dt = o.dt;
     const size_t n = size_t(std::floor(o.duration / dt + 1e-9)) + 1;
+    // The run-up is simulated exactly like the path and then dropped, so the
+    // first kept sample is where the vehicle is after runUp seconds, at speed.
+    const size_t skip = size_t(std::floor(o.runUp / dt + 1e-9));
     const glm::dvec2 origin(params.origin_x, params.origin_y);
 
     Path path;
     path.samples.reserve(n);
-    for (size_t i = 0; i < n; ++i) {
-        PathSample s;
-        s.t = double(i) * dt;
-        double ground = terrainHeight(params, pos);
-        s.position = glm::dvec3(pos + origin, ground + o.eyeHeight());
-        s.heading = wrapAngle(h);
-        s.pitch = o.kind == PathKind::Fly ? o.flyPitch : 0.0;
-        path.samples.push_back(s);
+    for (size_t i = 0; i < n + skip; ++i) {
+        if (i >= skip) {
+            PathSample s;
+            s.t = double(i - skip) * dt;
+            double ground = terrainHeight(params, pos);
+            s.position = glm::dvec3(pos + origin, ground + o.eyeHeight());
+            s.heading = wrapAngle(h);
+            s.pitch = o.kind == PathKind::Fly ? o.flyPitch : 0.0;
+            path.samples.push_back(s);
+        }
 
         // Progress: closest point on the next few route segments.
         route.ensure(sp + 200.0);
@@ -262,22 +294,7 @@ Status savePathCsv(const Path& path, const std::string& file) {
                       s.position.z, s.heading * 180.0 / kPi, s.pitch * 180.0 / kPi);
         out += buf;
     }
-    std::string tmp = file + ".tmp." + std::to_string(getpid());
-    {
-        std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-        if (!f) return Status::error("cannot write path file '" + file + "'");
-        f << out;
-        f.flush();
-        if (!f) {
-            std::remove(tmp.c_str());
-            return Status::error("write failed for path file '" + file + "'");
-        }
-    }
-    if (std::rename(tmp.c_str(), file.c_str()) != 0) {
-        std::remove(tmp.c_str());
-        return Status::error("cannot rename into path file '" + file + "'");
-    }
-    return Status::ok();
+    return writeFileAtomic(file, out);
 }
 
 Result<Path> loadPathCsv(const std::string& file) {

@@ -10,6 +10,10 @@
 // the route centre line. Limits hold at every step by construction:
 // |speed| <= maxSpeed, |heading change| <= maxYawRate * dt, |dv| <= accel * dt;
 // the vehicle slows before turns so that it stays on the carriageway.
+// The vehicle starts at rest at the route's first node; the first
+// PathOptions::runUp seconds are simulated and dropped, so that the returned
+// path starts at cruising speed (measurements must not be flattered by a
+// slow start, where frame-to-frame coherence is highest).
 // Eye height above the terrain: walk 1.7 m, car 1.2 m, fly flyHeight (the
 // elevated fly-over where occlusion is weak; pitched down by flyPitch).
 // Output depends only on (graph, params, options): no threads, no clocks.
@@ -47,6 +51,9 @@ struct PathOptions {
     double decel = 4.0;                           // m/s^2 braking
     double flyHeight = 80.0;                      // metres above the terrain (Fly)
     double flyPitch = -0.2;                       // radians (Fly)
+    // Seconds driven before t = 0 and dropped, so that a measured path starts
+    // at cruising speed instead of at rest (0 = start at rest), 0 .. 600.
+    double runUp = 8.0;
     double eyeHeight() const { return kind == PathKind::Walk ? 1.7 : kind == PathKind::Car ? 1.2 : flyHeight; }
 };
 // Checks ranges; message names the option.
@@ -68,6 +75,18 @@ struct Path {
     // included; repeats when n exceeds the sample count).
     std::vector<size_t> spread(size_t n) const;
 };
+
+// How far the camera moves between consecutive rendered frames (the samples
+// `frames`, in order): metres of eye travel and degrees of view rotation
+// (heading and pitch combined), median and maximum. All 0 for < 2 frames.
+// Measurements report it beside their figures: a cache or an impostor is
+// only as good as the motion it was measured under.
+struct PathMotion {
+    size_t frames = 0;
+    double metresMedian = 0, metresMax = 0;
+    double degreesMedian = 0, degreesMax = 0;
+};
+PathMotion pathMotion(const Path& path, const std::vector<size_t>& frames);
 
 // Generates a drive. Errors: invalid options, a graph without edges.
 Result<Path> generatePath(const StreetGraph& streets, const CityParams& params, const PathOptions& options);

@@ -193,3 +193,61 @@ TEST(Paths, SpreadCoversThePath) {
     EXPECT_EQ(s.back(), 99u);
     for (size_t i = 1; i < s.size(); ++i) EXPECT_GT(s[i], s[i - 1]);
 }
+
+TEST(Paths, RunUpStartsAtCruisingSpeedAndIsTheSameDrive) {
+    // The run-up is the same simulation with its first runUp seconds dropped:
+    // the path with run-up equals the tail of the path without it, and its
+    // first step already moves at a good fraction of the top speed.
+    StreetGraph g = gridGraph();
+    PathOptions rest;
+    rest.runUp = 0;
+    rest.duration = 20;
+    PathOptions cruise = rest;
+    cruise.runUp = 6;
+    cruise.duration = 14;
+    auto a = generatePath(g, flatParams(), rest), b = generatePath(g, flatParams(), cruise);
+    ASSERT_TRUE(a.isOk() && b.isOk());
+    const size_t skip = size_t(std::floor(6.0 / rest.dt + 1e-9));
+    ASSERT_EQ(a->samples.size(), b->samples.size() + skip);
+    for (size_t i = 0; i < b->samples.size(); ++i) {
+        EXPECT_EQ(b->samples[i].position, a->samples[i + skip].position) << i;
+        EXPECT_NEAR(b->samples[i].t, a->samples[i + skip].t - 6.0, 1e-9);
+    }
+    const double v0rest = glm::length(a->samples[1].position - a->samples[0].position) / rest.dt;
+    const double v0cruise = glm::length(b->samples[1].position - b->samples[0].position) / rest.dt;
+    EXPECT_LT(v0rest, 0.1 * rest.maxSpeed);
+    EXPECT_GT(v0cruise, 0.3 * rest.maxSpeed);
+    PathOptions bad = rest;
+    bad.runUp = -1;
+    auto r = generatePath(g, flatParams(), bad);
+    ASSERT_FALSE(r.isOk());
+    EXPECT_NE(r.status().message().find("run-up"), std::string::npos);
+}
+
+TEST(Paths, MotionPerFrameMatchesAnIndependentSum) {
+    Path p;
+    // Straight line at 2 m per sample, heading turning 3 degrees per sample,
+    // except one jump of 10 m and 30 degrees.
+    for (int i = 0; i < 6; ++i) {
+        PathSample s;
+        s.t = i;
+        s.position = glm::dvec3(2.0 * i + (i >= 5 ? 8.0 : 0.0), 0, 1.2);
+        s.heading = degToRad(3.0 * i + (i >= 5 ? 27.0 : 0.0));
+        p.samples.push_back(s);
+    }
+    PathMotion m = pathMotion(p, {0, 1, 2, 3, 4, 5});
+    EXPECT_EQ(m.frames, 6u);
+    EXPECT_NEAR(m.metresMedian, 2.0, 1e-12);
+    EXPECT_NEAR(m.metresMax, 10.0, 1e-12);
+    EXPECT_NEAR(m.degreesMedian, 3.0, 1e-9);
+    EXPECT_NEAR(m.degreesMax, 30.0, 1e-9);
+    // Every other frame: twice the motion.
+    PathMotion h = pathMotion(p, {0, 2, 4});
+    EXPECT_NEAR(h.metresMedian, 4.0, 1e-12);
+    EXPECT_NEAR(h.degreesMax, 6.0, 1e-9);
+    // Heading wrap: 179 -> -179 degrees is 2 degrees of rotation, not 358.
+    p.samples[1].heading = degToRad(179.0);
+    p.samples[2].heading = degToRad(-179.0);
+    EXPECT_NEAR(pathMotion(p, {1, 2}).degreesMax, 2.0, 1e-9);
+    EXPECT_EQ(pathMotion(p, {3}).frames, 0u);
+}
