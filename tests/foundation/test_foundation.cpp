@@ -1,0 +1,141 @@
+// foundation/: hashing, atomic writes, units, RNG streams, stopwatch.
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "foundation/atomic_file.h"
+#include "foundation/hash.h"
+#include "foundation/rng.h"
+#include "foundation/timing.h"
+#include "foundation/units.h"
+#include "tests/common/temp_dir.h"
+
+namespace vista {
+namespace {
+
+TEST(Hash, StreamingEqualsOneShotForEverySplit) {
+    std::string data;
+    for (int i = 0; i < 97; ++i) data.push_back(char((i * 37 + 11) & 0xFF));
+    const uint64_t whole = hashBytes64(data.data(), data.size(), 5);
+    for (size_t a = 0; a <= data.size(); a += 7)
+        for (size_t b = a; b <= data.size(); b += 5) {
+            Hasher64 h(5);
+            const auto* p = reinterpret_cast<const unsigned char*>(data.data());
+            h.update(p, a);
+            h.update(p + a, b - a);
+            h.update(p + b, data.size() - b);
+            ASSERT_EQ(h.finish(), whole) << a << "," << b;
+        }
+}
+
+TEST(Hash, SensitiveToEveryByteLengthAndSeed) {
+    std::string data(64, 'x');
+    const uint64_t base = hashBytes64(data.data(), data.size());
+    std::set<uint64_t> seen{base};
+    for (size_t i = 0; i < data.size(); ++i) {
+        std::string d = data;
+        d[i] ^= 1;
+        EXPECT_TRUE(seen.insert(hashBytes64(d.data(), d.size())).second) << "byte " << i;
+    }
+    EXPECT_NE(hashBytes64(data.data(), data.size() - 1), base);  // length counts
+    EXPECT_NE(hashBytes64(data.data(), data.size(), 1), base);   // seed counts
+    // Zero padding is not the same input: "ab" vs "ab\0".
+    const char ab[3] = {'a', 'b', 0};
+    EXPECT_NE(hashBytes64(ab, 2), hashBytes64(ab, 3));
+}
+
+TEST(Hash, LittleEndianRoundTripAndKnownLayout) {
+    unsigned char b[8];
+    storeLE64(b, 0x0102030405060708ull);
+    EXPECT_EQ(b[0], 0x08);
+    EXPECT_EQ(b[7], 0x01);
+    EXPECT_EQ(loadLE64(b), 0x0102030405060708ull);
+    EXPECT_NE(hashKeys(1, 2, 3), hashKeys(2, 1, 3));  // order matters
+}
+
+TEST(AtomicFile, WritesWholeFileAndLeavesNoTemporary) {
+    test::TempDir dir("vista_foundation");
+    const std::string f = dir.file("out.bin");
+    std::string bytes(100000, '\0');
+    for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = char(i * 31);
+    ASSERT_TRUE(writeFileAtomic(f, bytes).isOk());
+    EXPECT_EQ(test::readBytes(f), bytes);
+    ASSERT_TRUE(writeFileAtomic(f, "short").isOk());  // replaces
+    EXPECT_EQ(test::readBytes(f), "short");
+    size_t entries = 0;
+    for (const auto& e : std::filesystem::directory_iterator(dir.path())) { (void)e; ++entries; }
+    EXPECT_EQ(entries, 1u);
+}
+
+TEST(AtomicFile, FailureNamesThePathAndKeepsTheOldFile) {
+    test::TempDir dir("vista_foundation");
+    const std::string f = dir.file("keep.txt");
+    ASSERT_TRUE(writeFileAtomic(f, "old").isOk());
+    Status s = writeFileAtomic(dir.file("missing_dir/x.txt"), "new");
+    ASSERT_FALSE(s.isOk());
+    EXPECT_NE(s.message().find("missing_dir/x.txt"), std::string::npos) << s.message();
+    EXPECT_FALSE(writeFileAtomic("", "x").isOk());
+    // A directory in the way of the rename: error, old content untouched.
+    std::filesystem::create_directory(dir.file("adir"));
+    EXPECT_FALSE(writeFileAtomic(dir.file("adir"), "x").isOk());
+    EXPECT_EQ(test::readBytes(f), "old");
+    EXPECT_FALSE(std::filesystem::exists(tempPathFor(dir.file("adir"))));
+}
+
+TEST(Units, ConversionsAndWrapAgreeWithLibm) {
+    EXPECT_DOUBLE_EQ(kPi, std::acos(-1.0));
+    EXPECT_DOUBLE_EQ(degToRad(180.0), kPi);
+    EXPECT_DOUBLE_EQ(radToDeg(kHalfPi), 90.0);
+    for (double a = -20.0; a <= 20.0; a += 0.37) {
+        const double w = wrapAngle(a);
+        EXPECT_GE(w, -kPi);
+        EXPECT_LE(w, kPi);
+        EXPECT_NEAR(std::sin(w), std::sin(a), 1e-12);
+        EXPECT_NEAR(std::cos(w), std::cos(a), 1e-12);
+    }
+}
+
+TEST(Rng, StreamsDependOnlyOnTheirKeys) {
+    Rng a(7, 42, Stream::Trees), b(7, 42, Stream::Trees), c(7, 43, Stream::Trees), d(7, 42, Stream::Buildings);
+    int sameC = 0, sameD = 0;
+    for (int i = 0; i < 100; ++i) {
+        const uint64_t x = a.next();
+        EXPECT_EQ(x, b.next());
+        sameC += x == c.next();
+        sameD += x == d.next();
+    }
+    EXPECT_LT(sameC, 2);
+    EXPECT_LT(sameD, 2);
+    // uniform() stays in [0, 1) and its mean is near 1/2 (binomial bound, 6 sigma).
+    Rng u(1, 1, Stream::Paths);
+    double sum = 0;
+    const int n = 20000;
+    for (int i = 0; i < n; ++i) {
+        const double v = u.uniform();
+        ASSERT_GE(v, 0.0);
+        ASSERT_LT(v, 1.0);
+        sum += v;
+    }
+    EXPECT_NEAR(sum / n, 0.5, 6.0 * std::sqrt(1.0 / 12.0 / n));
+}
+
+TEST(Stopwatch, LapsAddUpToTheTotal) {
+    Stopwatch total, laps;
+    double sum = 0;
+    for (int i = 0; i < 3; ++i) {
+        volatile double x = 0;
+        for (int k = 0; k < 100000; ++k) x = x + std::sqrt(double(k));
+        sum += laps.lap();
+    }
+    const double t = total.ms();
+    EXPECT_GE(sum, 0.0);
+    EXPECT_LE(sum, t + 1e-6);  // the laps lie inside the total
+}
+
+}  // namespace
+}  // namespace vista
