@@ -186,6 +186,8 @@ TEST(Panorama, StillViewerConvergesToTheExactImage) {
     direct.render(still, nullptr, img2, st2);
     EXPECT_EQ(countDiff(img, img2), 0);
     EXPECT_EQ(st2.pixels.cache, 0u);
+    EXPECT_GT(st2.pixels.rayHit, st2.pixels.rayMiss);  // the far field was traced: mostly buildings, not sky
+    EXPECT_EQ(st2.raysCast, st2.pixels.rayHit + st2.pixels.rayMiss);
 }
 
 TEST(FarField, PixelClassesPartitionTheImageAndStagesRunOnlyWhenNeeded) {
