@@ -2,13 +2,14 @@
 // per-pixel reference (Camera::rayDirection + RayScene::intersect, depth
 // unprojected with the camera's own matrices), truthful ray counts (seam
 // rays that miss), stages run only when called for, and the primary-ray
-// caster shared with the `raycast` mode (per-pixel rays, the raycast loop,
-// pixel lists, thread counts).
+// caster shared with the `raycast` mode (per-pixel rays, the raycast mode's
+// row batches, pixel lists, thread counts).
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <random>
 #include <string>
 
@@ -24,16 +25,25 @@ using namespace vista::test;
 
 namespace {
 
+// A random city (world origin (ox, 0)) with its ray scene and a 64-cell height grid.
+struct TestCity {
+    SceneModel model;
+    std::unique_ptr<RayScene> rays;
+    HeightGrid grid;
+};
+TestCity testCity(uint32_t seed, int boxes, double ox = 0.0) {
+    TestCity t;
+    t.model = randomCity(seed, boxes, 400.0, ox, 0.0);
+    auto r = RayScene::build(t.model);
+    EXPECT_TRUE(r.isOk()) << r.status().message();
+    if (!r.isOk()) return t;
+    t.rays = std::move(r.value());
+    t.grid = HeightGrid::build(t.model, t.rays->frameOrigin(), 64);
+    return t;
+}
+
 Camera cam(const glm::dvec3& eye, double heading, double pitch = 0.0, int w = 120, int h = 80, double roll = 0.0) {
-    Camera c;
-    c.eye = eye;
-    c.heading = heading;
-    c.pitch = pitch;
-    c.roll = roll;
-    c.width = w;
-    c.height = h;
-    c.fovY = 0.8;
-    return c;
+    return testCamera(eye, heading, pitch, w, h, 0.8, roll);
 }
 
 glm::u8vec4 skyOf(const glm::dvec3& d) { return skyColor(std::asin(std::clamp(d.z, -1.0, 1.0))); }
@@ -123,11 +133,9 @@ TEST(FarFieldFrame, MatchesAPerPixelReferenceWithTruthfulCounts) {
     uint64_t seamHitsTotal = 0, seamMissesTotal = 0, horizonTotal = 0, hitsTotal = 0, badTotal = 0;
     for (uint32_t seed : {3u, 6u}) {
         const double ox = seed == 6 ? 1.0e6 : 0.0;  // also 1,000 km from the origin
-        SceneModel city = randomCity(seed, 70, 400.0, ox, 0.0);
-        auto rs = RayScene::build(city);
-        ASSERT_TRUE(rs.isOk()) << rs.status().message();
-        const glm::dvec3 o = rs.value()->frameOrigin();
-        HeightGrid grid = HeightGrid::build(city, o, 64);
+        const TestCity t = testCity(seed, 70, ox);
+        ASSERT_TRUE(t.rays);
+        const glm::dvec3 o = t.rays->frameOrigin();
         struct Case {
             Camera camera;
             double nearD, zFar;
@@ -144,18 +152,18 @@ TEST(FarFieldFrame, MatchesAPerPixelReferenceWithTruthfulCounts) {
             const Camera& c = k.camera;
             const size_t N = size_t(c.width) * size_t(c.height);
             Image start;
-            std::vector<float> depth = fakeNearField(*rs.value(), c, k.nearD * 1.4, k.zFar, start);
+            std::vector<float> depth = fakeNearField(*t.rays, c, k.nearD * 1.4, k.zFar, start);
             const float* dp = k.nearField ? depth.data() : nullptr;
             if (!k.nearField) start = Image(c.width, c.height);
             FarFieldOptions opt;
             opt.nearDistance = k.nearD;
             opt.depthZFar = k.zFar;
             opt.pixelBudget = -1;
-            const Reference ref = reference(*rs.value(), c, dp, start, opt);
+            const Reference ref = reference(*t.rays, c, dp, start, opt);
             Image first;
             for (int threads : {2, 1}) {
                 opt.threads = threads;
-                FarField ff(*rs.value(), &grid, opt);
+                FarField ff(*t.rays, &t.grid, opt);
                 Image img = start;
                 FrameStats st;
                 ff.render(c, dp, img, st);
@@ -213,23 +221,21 @@ TEST(FarFieldFrame, MatchesAPerPixelReferenceWithTruthfulCounts) {
 }
 
 TEST(FarFieldFrame, SeamRaysThatMissAreCountedAsRaysAndStayCovered) {
-    SceneModel city = randomCity(5, 60);
-    auto rs = RayScene::build(city);
-    ASSERT_TRUE(rs.isOk());
-    HeightGrid grid = HeightGrid::build(city, glm::dvec3(0), 64);
+    const TestCity t = testCity(5, 60);
+    ASSERT_TRUE(t.rays);
     Camera c = cam(glm::dvec3(0, -150, 1.7), 0.3);
     const size_t N = size_t(c.width) * size_t(c.height);
     // The near field's true depth (no push-back): nothing lies in front of any
     // drawn surface, so every seam ray misses.
     std::vector<float> depth(N, 1.0f);
     const glm::dmat4 pv = c.projection(80.0) * c.view();
-    const glm::vec3 org(c.eye - rs.value()->frameOrigin());
+    const glm::vec3 org(c.eye - t.rays->frameOrigin());
     uint64_t beyond = 0, coveredPixels = 0;
     const double nearD = 20.0;
     for (int y = 0; y < c.height; ++y)
         for (int x = 0; x < c.width; ++x) {
             const glm::dvec3 d = c.rayDirection(x + 0.5, y + 0.5);
-            const RayHit h = rs.value()->intersect(org, glm::vec3(d));
+            const RayHit h = t.rays->intersect(org, glm::vec3(d));
             if (!h.hit || h.t > 70.0f) continue;
             const glm::dvec4 clip = pv * glm::dvec4(c.eye + d * double(h.t), 1.0);
             depth[size_t(y) * size_t(c.width) + size_t(x)] = float(0.5 * (clip.z / clip.w) + 0.5);
@@ -240,7 +246,7 @@ TEST(FarFieldFrame, SeamRaysThatMissAreCountedAsRaysAndStayCovered) {
     FarFieldOptions o;
     o.nearDistance = nearD;
     o.depthZFar = 80.0;
-    FarField ff(*rs.value(), &grid, o);
+    FarField ff(*t.rays, &t.grid, o);
     Image img(c.width, c.height);
     FrameStats st;
     ff.render(c, depth.data(), img, st);
@@ -260,15 +266,13 @@ TEST(FarFieldFrame, SeamRaysThatMissAreCountedAsRaysAndStayCovered) {
 }
 
 TEST(FarFieldFrame, StagesRunOnlyWhenCalledFor) {
-    SceneModel city = randomCity(7, 50);
-    auto rs = RayScene::build(city);
-    ASSERT_TRUE(rs.isOk());
-    HeightGrid grid = HeightGrid::build(city, glm::dvec3(0), 64);
+    const TestCity t = testCity(7, 50);
+    ASSERT_TRUE(t.rays);
     Camera c = cam(glm::dvec3(0, -190, 1.7), 0.0);
     const size_t N = size_t(c.width) * size_t(c.height);
     FarFieldOptions o;
     o.nearDistance = 0;
-    FarField ff(*rs.value(), &grid, o);
+    FarField ff(*t.rays, &t.grid, o);
     Image img;
     auto has = [](const FrameStats& s, const std::string& what) {
         for (const auto& n : s.notes)
@@ -334,31 +338,22 @@ TEST(FarFieldFrame, StagesRunOnlyWhenCalledFor) {
 
 namespace {
 
-// The raycast mode's loop as it was (cmd/bench.cpp RaycastMode): rows, the
-// basis hoisted, RayScene::intersectMany over each whole row.
-Image raycastModeLoop(const RayScene& rays, const Camera& camera, uint64_t& hits) {
-    Image out(camera.width, camera.height);
-    const glm::vec3 org(camera.eye - rays.frameOrigin());
-    const int W = camera.width;
-    const glm::dvec3 fw = camera.forward(), rt = camera.right(), up = camera.up();
-    const double tanHalf = std::tan(0.5 * camera.fovY), aspect = double(camera.width) / double(camera.height);
-    const size_t n = static_cast<size_t>(W);
-    std::vector<glm::vec3> orgs(n, org), dirs(n);
-    std::vector<glm::dvec3> ddirs(n);
+// What the raycast mode computes: every image row cast as one
+// RayScene::intersectMany batch (packets of 8 from the row's first pixel),
+// directions Camera::rayDirection(x + 0.5, y + 0.5), sky on a miss.
+Image rowBatches(const RayScene& rays, const Camera& c, uint64_t& hits) {
+    Image out(c.width, c.height);
+    const size_t n = static_cast<size_t>(c.width);
+    std::vector<glm::vec3> orgs(n, glm::vec3(c.eye - rays.frameOrigin())), dirs(n);
     std::vector<RayHit> res(n);
     hits = 0;
-    for (int y = 0; y < camera.height; ++y) {
-        for (int x = 0; x < W; ++x) {
-            double sx = (2.0 * (x + 0.5) / camera.width - 1.0) * tanHalf * aspect;
-            double sy = (1.0 - 2.0 * (y + 0.5) / camera.height) * tanHalf;
-            ddirs[size_t(x)] = glm::normalize(fw + sx * rt + sy * up);
-            dirs[size_t(x)] = glm::vec3(ddirs[size_t(x)]);
-        }
-        rays.intersectMany(orgs.data(), dirs.data(), W, res.data());
-        for (int x = 0; x < W; ++x) {
+    for (int y = 0; y < c.height; ++y) {
+        for (size_t x = 0; x < n; ++x) dirs[x] = glm::vec3(c.rayDirection(double(x) + 0.5, y + 0.5));
+        rays.intersectMany(orgs.data(), dirs.data(), c.width, res.data());
+        for (int x = 0; x < c.width; ++x) {
             const RayHit& h = res[size_t(x)];
             hits += h.hit ? 1 : 0;
-            out.set(x, y, h.hit ? opaque(h) : skyOf(ddirs[size_t(x)]));
+            out.set(x, y, h.hit ? opaque(h) : skyOf(c.rayDirection(x + 0.5, y + 0.5)));
         }
     }
     return out;
@@ -366,24 +361,23 @@ Image raycastModeLoop(const RayScene& rays, const Camera& camera, uint64_t& hits
 
 }  // namespace
 
-TEST(PrimaryRays, CastFrameEqualsPerPixelRaysAndTheRaycastLoop) {
+TEST(PrimaryRays, CastFrameEqualsPerPixelRaysAndRowBatches) {
     for (uint32_t seed : {2u, 9u}) {
         const double ox = seed == 9 ? 2.5e5 : 0.0;
-        SceneModel city = randomCity(seed, 80, 400.0, ox, 0.0);
-        auto rs = RayScene::build(city);
-        ASSERT_TRUE(rs.isOk());
-        const glm::dvec3 o = rs.value()->frameOrigin();
+        const TestCity t = testCity(seed, 80, ox);
+        ASSERT_TRUE(t.rays);
+        const glm::dvec3 o = t.rays->frameOrigin();
         for (const Camera& c : {cam(o + glm::dvec3(0, -180, 1.7), 0.3, 0.0, 133, 77),
                                 cam(o + glm::dvec3(40, -120, 30), 1.0, -0.3, 64, 48, 0.15)}) {
             RayCounts counts;
             Image frame;
-            castFrame(*rs.value(), c, frame, counts, 2);
+            castFrame(*t.rays, c, frame, counts, 2);
             const uint64_t N = uint64_t(c.width) * uint64_t(c.height);
             EXPECT_EQ(counts.rays, N);
-            // Bit-identical to the raycast mode's loop (same packets).
-            uint64_t loopHits = 0;
-            EXPECT_TRUE(frame.rgba == raycastModeLoop(*rs.value(), c, loopHits).rgba);
-            EXPECT_EQ(counts.hits, loopHits);
+            // Bit-identical to the raycast mode's row batches (same packets).
+            uint64_t rowHits = 0;
+            EXPECT_TRUE(frame.rgba == rowBatches(*t.rays, c, rowHits).rgba);
+            EXPECT_EQ(counts.hits, rowHits);
             // Per pixel: Camera::rayDirection + RayScene::intersect.
             const glm::vec3 org(c.eye - o);
             uint64_t hits = 0;
@@ -391,7 +385,7 @@ TEST(PrimaryRays, CastFrameEqualsPerPixelRaysAndTheRaycastLoop) {
             for (int y = 0; y < c.height; ++y)
                 for (int x = 0; x < c.width; ++x) {
                     const glm::dvec3 d = c.rayDirection(x + 0.5, y + 0.5);
-                    const RayHit h = rs.value()->intersect(org, glm::vec3(d));
+                    const RayHit h = t.rays->intersect(org, glm::vec3(d));
                     hits += h.hit ? 1 : 0;
                     differ += frame.at(x, y) != (h.hit ? opaque(h) : skyOf(d)) ? 1 : 0;
                 }
@@ -403,7 +397,7 @@ TEST(PrimaryRays, CastFrameEqualsPerPixelRaysAndTheRaycastLoop) {
             for (int threads : {1, 0}) {
                 RayCounts c2;
                 Image f2;
-                castFrame(*rs.value(), c, f2, c2, threads);
+                castFrame(*t.rays, c, f2, c2, threads);
                 EXPECT_TRUE(f2.rgba == frame.rgba) << threads;
                 EXPECT_EQ(c2.hits, counts.hits);
             }
@@ -412,14 +406,13 @@ TEST(PrimaryRays, CastFrameEqualsPerPixelRaysAndTheRaycastLoop) {
 }
 
 TEST(PrimaryRays, PixelListWritesExactlyTheListedPixels) {
-    SceneModel city = randomCity(4, 70);
-    auto rs = RayScene::build(city);
-    ASSERT_TRUE(rs.isOk());
+    const TestCity t = testCity(4, 70);
+    ASSERT_TRUE(t.rays);
     const Camera c = cam(glm::dvec3(10, -170, 1.7), 0.2, 0.02, 97, 61);
     const uint32_t N = uint32_t(c.width * c.height);
     Image frame;
     RayCounts all;
-    castFrame(*rs.value(), c, frame, all, 2);
+    castFrame(*t.rays, c, frame, all, 2);
     std::mt19937 rng(17);
     std::vector<uint32_t> list;
     for (uint32_t i = 0; i < N; ++i)
@@ -432,7 +425,7 @@ TEST(PrimaryRays, PixelListWritesExactlyTheListedPixels) {
         std::vector<uint8_t> hit(px->size(), 2);
         RayCounts counts;
         counts.rays = 5;  // counts are added to
-        castPrimaryRays(*rs.value(), c, px->data(), px->size(), out, counts, 2, hit.data());
+        castPrimaryRays(*t.rays, c, px->data(), px->size(), out, counts, 2, hit.data());
         EXPECT_EQ(counts.rays, 5 + px->size());
         std::vector<uint8_t> listed(N, 0);
         uint64_t hits = 0;
@@ -458,7 +451,7 @@ TEST(PrimaryRays, PixelListWritesExactlyTheListedPixels) {
     // An empty list casts nothing.
     Image out(c.width, c.height);
     RayCounts none;
-    castPrimaryRays(*rs.value(), c, nullptr, 0, out, none, 0);
+    castPrimaryRays(*t.rays, c, nullptr, 0, out, none, 0);
     EXPECT_EQ(none.rays, 0u);
     EXPECT_EQ(none.hits, 0u);
 }

@@ -18,14 +18,7 @@ using namespace vista::test;
 namespace {
 
 Camera cam(const glm::dvec3& eye, double heading, double pitch = 0.0, int w = 96, int h = 64) {
-    Camera c;
-    c.eye = eye;
-    c.heading = heading;
-    c.pitch = pitch;
-    c.width = w;
-    c.height = h;
-    c.fovY = 0.8;
-    return c;
+    return testCamera(eye, heading, pitch, w, h, 0.8);
 }
 
 // Reference: every pixel cast individually, sky on a miss (as FarField shades).
