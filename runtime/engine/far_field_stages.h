@@ -65,8 +65,9 @@ struct FarFrame {
 // cls (every pixel covered or pending), covered, columnNeeded. Records Opacity.
 void opacityStage(FarFrame& f, FrameStats& stats);
 
-// Seam check (far_field_seam.cpp) applies when the near field is a distance,
-// depth exists, something is covered and the scene has triangles.
+// Seam check (far_field_seam.cpp) applies when o.verifySeam, the near field
+// is a distance > 0, depth exists, something is covered and the scene has
+// triangles.
 bool seamCheckApplies(const FarFrame& f, const RayScene& rays, const FarFieldOptions& o);
 // In: cls, depth, o.nearDistance, o.depthZFar, camera.zNear. Every covered
 // pixel whose surface lies beyond the near distance casts one ray with tfar =
