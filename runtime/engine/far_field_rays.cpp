@@ -27,6 +27,7 @@ namespace {
 
 // Rays per parallel task (whole rows of 640 pixels: 4 rows a task).
 constexpr size_t kRaysPerTask = 2048;
+constexpr size_t kPacket = 8;  // RayScene::intersectMany's packet width
 
 // The pixel list: explicit indices, or (null) the whole frame in order.
 struct PixelList {
@@ -34,7 +35,7 @@ struct PixelList {
     uint32_t operator[](size_t k) const { return idx ? idx[k] : uint32_t(k); }
 };
 
-// Casts runs[r] .. runs[r + 1] (entries of one row each) in packets of 8.
+// Casts the entries runs[r] .. runs[r + 1] - 1 of every run r in packets of 8.
 void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, const std::vector<size_t>& runs, Image& out,
               RayCounts& counts, int threads, uint8_t* hit) {
     const size_t nRuns = runs.size() - 1, n = runs.back();
@@ -83,10 +84,12 @@ void castPrimaryRays(const RayScene& scene, const Camera& camera, const uint32_t
                      RayCounts& counts, int threads, uint8_t* hit) {
     VISTA_CHECK(out.width == camera.width && out.height == camera.height && out.valid());
     const uint32_t W = uint32_t(camera.width), N = uint32_t(size_t(camera.width) * size_t(camera.height));
-    std::vector<size_t> runs;  // start of every run of one row, then n
+    // Runs: a new run starts at a row change once the current one fills a
+    // packet (dense rows stay alone; sparse rows share packets).
+    std::vector<size_t> runs;  // start of every run, then n
     for (size_t k = 0; k < n; ++k) {
         VISTA_CHECK(pixels[k] < N);
-        if (k == 0 || pixels[k] / W != pixels[k - 1] / W) runs.push_back(k);
+        if (k == 0 || (pixels[k] / W != pixels[k - 1] / W && k - runs.back() >= kPacket)) runs.push_back(k);
     }
     runs.push_back(n);
     castRuns(scene, camera, PixelList{pixels}, runs, out, counts, threads, hit);

@@ -7,11 +7,13 @@
 // the eye in the scene's local frame. A miss shows primarySkyColor(dir) =
 // skyColor(asin(dir.z)), the rasteriser's background, alpha 255.
 //
-// Coherence: the pixel list is cut into runs of consecutive entries on one
-// image row; each run is cast in 8-wide packets (RayScene::intersectMany), runs
-// in parallel in a tbb::task_arena of `threads` workers (0 = the caller's
-// arena, all cores). A pixel's packet depends on the list only, never on the
-// thread count, so images and counts are deterministic. Any order is correct;
+// Coherence: the pixel list is cut into runs at image-row changes (a run
+// closes at a row change once it holds a packet, so a dense row is one run and
+// sparse rows share packets); each run is cast in 8-wide packets
+// (RayScene::intersectMany), runs in parallel in a tbb::task_arena of
+// `threads` workers (0 = the caller's arena, all cores). castFrame casts one
+// run per row. A pixel's packet depends on the list only, never on the thread
+// count, so images and counts are deterministic. Any order is correct;
 // ascending order (rows contiguous) gives the coherent packets.
 //
 // Contract (VISTA_CHECK): out has the camera's size; every pixel index

@@ -417,9 +417,10 @@ TEST(PrimaryRays, PixelListWritesExactlyTheListedPixels) {
     std::vector<uint32_t> list;
     for (uint32_t i = 0; i < N; ++i)
         if (rng() % 3 == 0) list.push_back(i);
-    std::vector<uint32_t> shuffled = list;
+    std::vector<uint32_t> shuffled = list, sparse;  // sparse: rows with 1 or 2 pixels share packets
     std::shuffle(shuffled.begin(), shuffled.end(), rng);
-    for (const auto* px : {&list, &shuffled}) {
+    for (uint32_t i = 5; i < N; i += uint32_t(c.width) / 2 + 3) sparse.push_back(i);
+    for (const auto* px : {&list, &shuffled, &sparse}) {
         Image out(c.width, c.height);
         std::fill(out.rgba.begin(), out.rgba.end(), uint8_t(7));
         std::vector<uint8_t> hit(px->size(), 2);
