@@ -2,29 +2,41 @@
 // (no OSG, no GL): opacity from the near field's depth, horizon tracing,
 // panoramic cache, Embree ray casting, composite, pixel counts, stage times.
 //
-// Per frame, every pixel is classified exactly once (thesis Table 4.1):
-//   covered        near-field depth < 1 (drawn by the rasteriser; left as is,
-//                  except seam-checked pixels that far geometry occludes)
-//   horizonCulled  above the horizon row of its column, or no far geometry
-//                  exists at all: sky colour without tracing
-//   cache          taken from the panoramic cache
-//   rayHit/rayMiss traced this frame (miss -> sky colour)
+// Per frame, every pixel is classified exactly once (thesis Table 4.1);
+// classification() holds the class per pixel, FrameStats::pixels the counts:
+//   covered        the near field drew it (depth < 1) and the frame leaves its
+//                  colour as is. This includes seam-checked pixels whose ray
+//                  missed (nothing far lies in front of the drawn surface).
+//   horizonCulled  sky colour without a ray: above the horizon row of its
+//                  column, or no far geometry exists beyond the near distance.
+//   cache          colour taken from the panoramic cache (no ray this frame).
+//   rayHit         a ray cast this frame hit geometry; the pixel shows its
+//                  prelit colour. Either an uncovered pixel traced by the ray
+//                  stage, or a covered pixel whose seam-check ray hit far
+//                  geometry in front of the near field's surface (replaced).
+//   rayMiss        an uncovered pixel traced this frame that hit nothing: sky.
+// FrameStats::raysCast += every Embree ray of the frame, hit or miss: the ray
+// stage's (rayHit + rayMiss of uncovered pixels) plus every seam-check ray
+// (those that hit are also rayHit; those that missed are counted only here).
+// So raysCast >= rayHit + rayMiss, with equality when no seam ray missed.
 // Sky colour = lighting.h skyColor(elevation of the pixel-centre ray), the same
 // as the OffscreenRenderer's background, so sky pixels agree across modes.
 //
-// Stages run only when called for: no uncovered pixel -> nothing after
-// opacity; no far geometry (city bounds within the near distance, or an empty
-// city) -> no horizon/cache/ray stage (note "rays off: no far geometry");
-// camera rolled / zenith or nadir in view -> no horizon stage (note says why);
-// pixelBudget < 0 (unlimited) or cache off -> cache bypassed, every remaining
-// pixel traced. stats.stages records every stage that ran ("opacity",
-// "seam", "horizon", "cache", "rays", "composite"); stats.notes explains
-// skipped stages.
+// The frame runs as named stages, one file each (far_field_<stage>.cpp, see
+// far_field_stages.h and docs/far-field.md): opacity, seam, horizon, cache,
+// rays, composite. Stages run only when called for: no uncovered pixel ->
+// nothing after opacity; no far geometry (city bounds within the near
+// distance, or an empty city) -> no horizon/cache/ray stage (note "rays off:
+// no far geometry"); camera rolled / zenith or nadir in view -> no horizon
+// stage (note says why); pixelBudget < 0 (unlimited) or cache off -> cache
+// bypassed, every remaining pixel traced. stats.stages records the time of
+// every stage that ran (Stage::Opacity, Seam, Horizon, Cache, Rays,
+// Composite); stats.notes explains skipped stages.
 //
-// Determinism: the image and counts do not depend on thread count. Ray casting
-// runs in a tbb::task_arena with `threads` workers (0 = all cores); FTZ/DAZ are
-// set in every casting thread (RayScene). Not thread-safe itself; nothing
-// throws. Contract: depth (if not null) has width*height entries.
+// Determinism: the image, classes and counts do not depend on thread count.
+// Ray casting runs in a tbb::task_arena with `threads` workers (0 = all cores);
+// FTZ/DAZ are set in every casting thread (RayScene). Not thread-safe itself;
+// nothing throws. Contract: depth (if not null) has width*height entries.
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -34,11 +46,14 @@
 #include "runtime/scene/camera.h"
 #include "runtime/engine/horizon.h"
 #include "runtime/engine/image.h"
-#include "runtime/engine/panorama_cache.h"
 
 namespace vista {
 
 class RayScene;
+struct FarFieldMemory;
+
+// Pixel classes of classification() (see above).
+enum FarPixelClass : uint8_t { kFarCovered = 0, kFarHorizon = 1, kFarCache = 2, kFarRayHit = 3, kFarRayMiss = 4 };
 
 struct FarFieldOptions {
     double nearDistance = 100.0;  // metres (>= 0): horizon skips geometry the near field draws; 0 = skip nothing
@@ -57,7 +72,8 @@ struct FarFieldOptions {
     // but its parts beyond the near distance may lie behind far geometry the
     // rasteriser never saw. Covered pixels whose surface is farther than
     // nearDistance are re-cast with tfar = that distance; a hit replaces the
-    // pixel (counted as rayHit instead of covered). Off = trust coverage.
+    // pixel (counted as rayHit instead of covered); every such ray, hit or
+    // miss, counts in raysCast. Off = trust coverage.
     bool verifySeam = true;
 };
 
@@ -70,26 +86,20 @@ public:
     const FarFieldOptions& options() const { return _options; }
     // Fills every uncovered pixel of `out` (resized to the camera if needed;
     // covered pixels keep their colour). depth: near-field window depth, 1 =
-    // nothing drawn; null = nothing covered. Adds counts, stage times, notes.
+    // nothing drawn; null = nothing covered. Adds pixel counts, raysCast,
+    // stage times and notes to `stats`.
     void render(const Camera& camera, const float* depth, Image& out, FrameStats& stats);
     // Drops the cache (walkthrough jump).
     void reset();
-    // Per pixel of the last frame: 0 covered, 1 horizon, 2 cache, 3 hit, 4 miss.
+    // Per pixel of the last frame: a FarPixelClass (0 covered, 1 horizon, 2 cache, 3 hit, 4 miss).
     const std::vector<uint8_t>& classification() const { return _class; }
 
 private:
     const RayScene& _rays;
     const HeightGrid* _grid;
     FarFieldOptions _options;
-    std::unique_ptr<PanoramaCache> _cache;
-    double _cacheKey[4] = {0, 0, 0, 0};  // fovY, width, height, oversample of the cache
-    Camera _last;
-    bool _haveLast = false;
+    std::unique_ptr<FarFieldMemory> _mem;  // cache, last frame, sky (far_field_stages.h)
     std::vector<uint8_t> _class;
-    Image _prev;  // last composited frame (cache mode): shown for never-traced cache cells
-    // Sky image cache (depends on orientation, fov and size only).
-    Image _sky;
-    double _skyKey[4] = {1e300, 0, 0, 0};
 };
 
 }  // namespace vista

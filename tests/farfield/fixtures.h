@@ -6,9 +6,24 @@
 
 #include <glm/glm.hpp>
 
+#include "runtime/scene/camera.h"
 #include "runtime/scene/city_file.h"
 
 namespace vista::test {
+
+// A camera at `eye` (world) looking along heading/pitch/roll (radians).
+inline Camera testCamera(const glm::dvec3& eye, double heading, double pitch, int w, int h, double fovY,
+                         double roll = 0.0) {
+    Camera c;
+    c.eye = eye;
+    c.heading = heading;
+    c.pitch = pitch;
+    c.roll = roll;
+    c.width = w;
+    c.height = h;
+    c.fovY = fovY;
+    return c;
+}
 
 // Appends an axis-aligned box [lo, hi] (relative to mesh.origin) with one colour per face.
 inline void addBox(SceneMesh& m, const glm::vec3& lo, const glm::vec3& hi, glm::u8vec4 color) {

@@ -50,14 +50,7 @@ Check compare(const HorizonResult& hr, const std::vector<int>& top) {
 }
 
 Camera cameraAt(const glm::dvec3& eye, double heading, double pitch, int w = 61, int h = 41) {
-    Camera c;
-    c.eye = eye;
-    c.heading = heading;
-    c.pitch = pitch;
-    c.width = w;
-    c.height = h;
-    c.fovY = 0.9;
-    return c;
+    return testCamera(eye, heading, pitch, w, h, 0.9);
 }
 
 }  // namespace

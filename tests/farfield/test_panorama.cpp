@@ -18,14 +18,7 @@ using namespace vista::test;
 namespace {
 
 Camera cam(const glm::dvec3& eye, double heading, double pitch = 0.0, int w = 96, int h = 64) {
-    Camera c;
-    c.eye = eye;
-    c.heading = heading;
-    c.pitch = pitch;
-    c.width = w;
-    c.height = h;
-    c.fovY = 0.8;
-    return c;
+    return testCamera(eye, heading, pitch, w, h, 0.8);
 }
 
 // Reference: every pixel cast individually, sky on a miss (as FarField shades).
@@ -186,6 +179,8 @@ TEST(Panorama, StillViewerConvergesToTheExactImage) {
     direct.render(still, nullptr, img2, st2);
     EXPECT_EQ(countDiff(img, img2), 0);
     EXPECT_EQ(st2.pixels.cache, 0u);
+    EXPECT_GT(st2.pixels.rayHit, st2.pixels.rayMiss);  // the far field was traced: mostly buildings, not sky
+    EXPECT_EQ(st2.raysCast, st2.pixels.rayHit + st2.pixels.rayMiss);
 }
 
 TEST(FarField, PixelClassesPartitionTheImageAndStagesRunOnlyWhenNeeded) {

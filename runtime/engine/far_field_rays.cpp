@@ -1,0 +1,120 @@
+// Primary rays (far_field_rays.h) and the far field's ray stage (far_field_stages.h).
+#include "runtime/engine/far_field_rays.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <vector>
+
+#include <tbb/combinable.h>
+#include <tbb/parallel_for.h>
+
+#include "citygen/lighting.h"
+#include "foundation/status.h"
+#include "foundation/timing.h"
+#include "runtime/engine/far_field_stages.h"
+#include "runtime/engine/ray_scene.h"
+
+namespace vista {
+
+PixelRays::PixelRays(const Camera& c)
+    : _f(c.forward()), _r(c.right()), _u(c.up()), _tanHalf(std::tan(0.5 * c.fovY)),
+      _aspect(double(c.width) / double(c.height)), _width(c.width), _height(c.height) {}
+
+glm::u8vec4 primarySkyColor(const glm::dvec3& dir) { return skyColor(std::asin(std::clamp(dir.z, -1.0, 1.0))); }
+
+namespace {
+
+// Rays per parallel task (whole rows of 640 pixels: 4 rows a task).
+constexpr size_t kRaysPerTask = 2048;
+constexpr size_t kPacket = 8;  // RayScene::intersectMany's packet width
+
+// The pixel list: explicit indices, or (null) the whole frame in order.
+struct PixelList {
+    const uint32_t* idx;
+    uint32_t operator[](size_t k) const { return idx ? idx[k] : uint32_t(k); }
+};
+
+// Casts the entries runs[r] .. runs[r + 1] - 1 of every run r in packets of 8.
+void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, const std::vector<size_t>& runs, Image& out,
+              RayCounts& counts, int threads, uint8_t* hit) {
+    const size_t nRuns = runs.size() - 1, n = runs.back();
+    if (n == 0) return;
+    const PixelRays gen(camera);
+    const uint32_t W = uint32_t(camera.width);
+    const glm::vec3 org(camera.eye - scene.frameOrigin());
+    const size_t grain = std::max<size_t>(1, (kRaysPerTask * nRuns + n - 1) / n);
+    tbb::combinable<uint64_t> hits([] { return uint64_t(0); });
+    inArena(threads, [&] {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, nRuns, grain), [&](const tbb::blocked_range<size_t>& br) {
+            std::vector<glm::vec3> orgs, dirs;
+            std::vector<glm::dvec3> ddirs;
+            std::vector<RayHit> res;
+            uint64_t nh = 0;
+            for (size_t r = br.begin(); r != br.end(); ++r) {
+                const size_t b = runs[r], m = runs[r + 1] - b;
+                orgs.assign(m, org);
+                dirs.resize(m);
+                ddirs.resize(m);
+                res.resize(m);
+                for (size_t k = 0; k < m; ++k) {
+                    const uint32_t i = pixels[b + k];
+                    ddirs[k] = gen.dir(int(i % W), int(i / W));
+                    dirs[k] = glm::vec3(ddirs[k]);
+                }
+                scene.intersectMany(orgs.data(), dirs.data(), int(m), res.data());
+                for (size_t k = 0; k < m; ++k) {
+                    const RayHit& h = res[k];
+                    const glm::u8vec4 c = h.hit ? glm::u8vec4(h.color.x, h.color.y, h.color.z, 255) : primarySkyColor(ddirs[k]);
+                    std::copy_n(&c[0], 4, &out.rgba[size_t(pixels[b + k]) * 4]);
+                    if (hit) hit[b + k] = h.hit ? 1 : 0;
+                    nh += h.hit ? 1 : 0;
+                }
+            }
+            hits.local() += nh;
+        });
+    });
+    counts.rays += n;
+    counts.hits += hits.combine(std::plus<uint64_t>());
+}
+
+}  // namespace
+
+void castPrimaryRays(const RayScene& scene, const Camera& camera, const uint32_t* pixels, size_t n, Image& out,
+                     RayCounts& counts, int threads, uint8_t* hit) {
+    VISTA_CHECK(out.width == camera.width && out.height == camera.height && out.valid());
+    const uint32_t W = uint32_t(camera.width), N = uint32_t(size_t(camera.width) * size_t(camera.height));
+    // Runs: a new run starts at a row change once the current one fills a
+    // packet (dense rows stay alone; sparse rows share packets).
+    std::vector<size_t> runs;  // start of every run, then n
+    for (size_t k = 0; k < n; ++k) {
+        VISTA_CHECK(pixels[k] < N);
+        if (k == 0 || (pixels[k] / W != pixels[k - 1] / W && k - runs.back() >= kPacket)) runs.push_back(k);
+    }
+    runs.push_back(n);
+    castRuns(scene, camera, PixelList{pixels}, runs, out, counts, threads, hit);
+}
+
+void castFrame(const RayScene& scene, const Camera& camera, Image& out, RayCounts& counts, int threads) {
+    VISTA_CHECK(camera.width >= 1 && camera.height >= 1);
+    if (out.width != camera.width || out.height != camera.height || !out.valid()) out = Image(camera.width, camera.height);
+    std::vector<size_t> runs(size_t(camera.height) + 1);
+    for (size_t y = 0; y < runs.size(); ++y) runs[y] = y * size_t(camera.width);
+    castRuns(scene, camera, PixelList{nullptr}, runs, out, counts, threads, nullptr);
+}
+
+// ---- the far field's ray stage -------------------------------------------------
+
+void raysStage(FarFrame& f, const RayScene& rays, int threads, FrameStats& stats) {
+    Stopwatch sw;
+    std::vector<uint8_t> hit(f.trace.size(), 0);
+    RayCounts counts;
+    castPrimaryRays(rays, f.camera, f.trace.data(), f.trace.size(), f.out, counts, threads, hit.data());
+    for (size_t j = 0; j < f.trace.size(); ++j) f.cls[f.trace[j]] = hit[j] ? kFarRayHit : kFarRayMiss;
+    stats.raysCast += counts.rays;
+    stats.pixels.rayHit += counts.hits;
+    stats.pixels.rayMiss += counts.rays - counts.hits;
+    stats.stages.add(Stage::Rays, sw.ms());
+}
+
+}  // namespace vista

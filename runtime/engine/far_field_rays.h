@@ -1,0 +1,68 @@
+// Primary rays: the camera's pixel-centre rays cast into a RayScene, written
+// as colours (prelit colour on a hit, sky colour on a miss). One loop serves
+// the far field's ray stage and the `raycast` render mode.
+//
+// Directions: PixelRays::dir(x, y) == Camera::rayDirection(x + 0.5, y + 0.5)
+// bit for bit (the same operations in the same order, basis hoisted). Origin:
+// the eye in the scene's local frame. A miss shows primarySkyColor(dir) =
+// skyColor(asin(dir.z)), the rasteriser's background, alpha 255.
+//
+// Coherence: the pixel list is cut into runs at image-row changes (a run
+// closes at a row change once it holds a packet, so a dense row is one run and
+// sparse rows share packets); each run is cast in 8-wide packets
+// (RayScene::intersectMany), runs in parallel in a tbb::task_arena of
+// `threads` workers (0 = the caller's arena, all cores). castFrame casts one
+// run per row. A pixel's packet depends on the list only, never on the thread
+// count, so images and counts are deterministic. Any order is correct;
+// ascending order (rows contiguous) gives the coherent packets.
+//
+// Contract (VISTA_CHECK): out has the camera's size; every pixel index
+// (y * width + x) is < width * height. Nothing throws; thread-safe for
+// distinct outputs (the RayScene is immutable).
+#pragma once
+#include <cstddef>
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "runtime/engine/image.h"
+#include "runtime/scene/camera.h"
+
+namespace vista {
+
+class RayScene;
+
+// The camera's pixel-centre ray directions with the view basis computed once.
+class PixelRays {
+public:
+    explicit PixelRays(const Camera& camera);
+    // Image-plane offsets of pixel centres at unit distance along forward:
+    // dir = normalize(forward + screenX * right + screenY * up).
+    double screenX(int x) const { return (2.0 * (x + 0.5) / _width - 1.0) * _tanHalf * _aspect; }
+    double screenY(int y) const { return (1.0 - 2.0 * (y + 0.5) / _height) * _tanHalf; }
+    glm::dvec3 dir(int x, int y) const { return glm::normalize(_f + screenX(x) * _r + screenY(y) * _u); }
+
+private:
+    glm::dvec3 _f, _r, _u;
+    double _tanHalf, _aspect;
+    int _width, _height;
+};
+
+// Sky colour of a ray that hits nothing (unit direction, world frame).
+glm::u8vec4 primarySkyColor(const glm::dvec3& dir);
+
+struct RayCounts {
+    uint64_t rays = 0;  // rays cast (hit or miss)
+    uint64_t hits = 0;  // rays that hit geometry
+};
+
+// Casts the rays of the n listed pixels (indices y * width + x) and writes
+// their colours into `out`; other pixels are untouched. Adds to `counts`.
+// hit (optional, n entries): 1 where entry k's ray hit geometry, else 0.
+void castPrimaryRays(const RayScene& scene, const Camera& camera, const uint32_t* pixels, size_t n, Image& out,
+                     RayCounts& counts, int threads, uint8_t* hit = nullptr);
+
+// Every pixel of the camera, row by row (out is resized to the camera).
+void castFrame(const RayScene& scene, const Camera& camera, Image& out, RayCounts& counts, int threads);
+
+}  // namespace vista

@@ -1,0 +1,112 @@
+// Far-field stages (internal to runtime/engine): the frame of FarField::render
+// as named stage functions on plain arrays, one file each
+// (far_field_<stage>.cpp), sharing one FarFrame. Pixel classes as in
+// far_field.h; kFarPending marks a pixel no stage has classified yet. Each
+// stage adds its pixel counts to FrameStats::pixels, its rays to raysCast and
+// its wall time to FrameStats::stages. Not thread-safe (one frame, one writer);
+// nothing throws.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <tbb/task_arena.h>
+
+#include "runtime/engine/far_field.h"
+#include "runtime/engine/far_field_rays.h"
+#include "runtime/engine/panorama_cache.h"
+
+namespace vista {
+
+constexpr uint8_t kFarPending = 5;
+
+// Runs body() in a task arena of `threads` workers (0 = the caller's arena).
+template <class F>
+void inArena(int threads, const F& body) {
+    if (threads > 0) {
+        tbb::task_arena arena(threads);
+        arena.execute(body);
+    } else {
+        body();
+    }
+}
+
+// What a FarField keeps from frame to frame.
+struct FarFieldMemory {
+    std::unique_ptr<PanoramaCache> cache;
+    double cacheKey[4] = {0, 0, 0, 0};  // fovY, width, height, oversample of the cache
+    Image prev;                          // last composited frame (cache mode)
+    Image sky;                           // sky colours (depend on pitch, roll, fov, size only)
+    double skyKey[4] = {1e300, 0, 0, 0};
+    Camera last;
+    bool haveLast = false;
+};
+
+// Working state of one frame, filled stage by stage.
+struct FarFrame {
+    FarFrame(const Camera& camera, const float* depth, Image& out, std::vector<uint8_t>& cls);
+    const Camera& camera;
+    const PixelRays rays;          // pixel-centre directions
+    const int width, height;
+    const size_t pixelCount;
+    const float* depth;            // near-field window depth (1 = nothing drawn), or null
+    Image& out;                    // the frame (camera size)
+    std::vector<uint8_t>& cls;     // per pixel: a FarPixelClass or kFarPending
+    bool moving = false;           // camera differs from the last frame's
+    const Image* sky = nullptr;    // sky colour per pixel (set before the horizon stage)
+    std::vector<uint8_t> columnNeeded;  // per column: has a pending pixel (opacity)
+    uint64_t covered = 0;          // pixels of class covered (opacity, seam)
+    std::vector<uint32_t> pending; // pending pixels after the horizon, ascending
+    std::vector<uint32_t> trace;   // pixels to trace this frame, ascending (cache)
+    std::vector<int64_t> traceCells;  // their panorama cells (cache stage only)
+};
+
+// Opacity (far_field_opacity.cpp). In: depth (null = nothing covered). Out:
+// cls (every pixel covered or pending), covered, columnNeeded. Records Opacity.
+void opacityStage(FarFrame& f, FrameStats& stats);
+
+// Seam check (far_field_seam.cpp) applies when o.verifySeam, the near field
+// is a distance > 0, depth exists, something is covered and the scene has
+// triangles.
+bool seamCheckApplies(const FarFrame& f, const RayScene& rays, const FarFieldOptions& o);
+// In: cls, depth, o.nearDistance, o.depthZFar, camera.zNear. Every covered
+// pixel whose surface lies beyond the near distance casts one ray with tfar =
+// that distance: a hit turns it rayHit (colour written, covered decremented,
+// pixels.rayHit counted), a miss leaves it covered. Every such ray, hit or
+// miss, is added to raysCast. Records Seam.
+void seamStage(FarFrame& f, const RayScene& rays, const FarFieldOptions& o, FrameStats& stats);
+
+// Horizon (far_field_horizon.cpp), run when o.horizon. In: grid,
+// columnNeeded, moving, camera. When horizon tracing applies, pending pixels
+// above their column's row become horizonCulled and Horizon is recorded; when
+// it does not (no grid, camera rolled, zenith/nadir in view) a note says why,
+// nothing is culled and no time is recorded.
+void horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o, FrameStats& stats);
+// No far geometry: every pending pixel becomes horizonCulled (sky). No time.
+void cullAllPending(FarFrame& f, FrameStats& stats);
+
+// Lists the pending pixels in f.pending (ascending). No time.
+void listPending(FarFrame& f);
+// Cache (far_field_cache.cpp), run when the cache is on with a budget >= 0 and
+// f.pending is not empty. In: f.pending, o.pixelBudget, o.cacheOversample,
+// m.prev, f.sky. (Re)creates the panorama for the camera, selects the pixels
+// to trace (f.trace, f.traceCells); the others become cache and get their
+// cell's colour (never traced: last frame's pixel, else sky). Records Cache.
+void cacheStage(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, FrameStats& stats);
+// Cache bypassed: f.trace = f.pending; a note when the cache is on but the
+// budget unlimited. No class, no time.
+void bypassCache(FarFrame& f, const FarFieldOptions& o, FrameStats& stats);
+
+// Rays (far_field_rays.cpp). In: f.trace. Casts them with castPrimaryRays;
+// each becomes rayHit or rayMiss, its colour (prelit or sky) written to out;
+// raysCast += rays. Records Rays.
+void raysStage(FarFrame& f, const RayScene& rays, int threads, FrameStats& stats);
+
+// Sky colours of the camera (far_field_composite.cpp), cached in m.sky.
+const Image& skyImage(FarFieldMemory& m, const FarFrame& f);
+// Composite (far_field_composite.cpp). Writes sky into every horizonCulled
+// pixel; in cache mode, stores the traced pixels' colours (now in out) into
+// m.cache and keeps the frame in m.prev. Assigns no class. Records Composite.
+void compositeStage(FarFrame& f, FarFieldMemory& m, bool cacheMode, FrameStats& stats);
+
+}  // namespace vista
