@@ -32,25 +32,25 @@ uint32_t MeshBuilder::vertex(const glm::dvec3& p, const glm::vec3& n, const glm:
 }
 
 void MeshBuilder::triangle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
-    glm::dvec3 n = glm::cross(b - a, c - a);
-    double len = glm::length(n);
-    if (!(len > 1e-12)) return;
-    n /= len;
-    auto col = prelitColor(_material, n, _light, _variation);
-    glm::vec3 nf(n);
-    uint32_t i0 = vertex(a, nf, col), i1 = vertex(b, nf, col), i2 = vertex(c, nf, col);
-    _mesh.indices.insert(_mesh.indices.end(), {i0, i1, i2});
+    const glm::dvec3 v[3] = {a, b, c};
+    face(glm::cross(b - a, c - a), v, 3);
 }
 
 void MeshBuilder::quad(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& d) {
-    glm::dvec3 n = glm::cross(c - a, d - b);
-    double len = glm::length(n);
+    const glm::dvec3 v[4] = {a, b, c, d};
+    face(glm::cross(c - a, d - b), v, 4);
+}
+
+void MeshBuilder::face(glm::dvec3 n, const glm::dvec3* v, int count) {
+    const double len = glm::length(n);
     if (!(len > 1e-12)) return;
     n /= len;
-    auto col = prelitColor(_material, n, _light, _variation);
-    glm::vec3 nf(n);
-    uint32_t i0 = vertex(a, nf, col), i1 = vertex(b, nf, col), i2 = vertex(c, nf, col), i3 = vertex(d, nf, col);
-    _mesh.indices.insert(_mesh.indices.end(), {i0, i1, i2, i0, i2, i3});
+    const auto col = prelitColor(_material, n, _light, _variation);
+    const glm::vec3 nf(n);
+    uint32_t i[4];
+    for (int k = 0; k < count; ++k) i[k] = vertex(v[k], nf, col);
+    if (count == 3) _mesh.indices.insert(_mesh.indices.end(), {i[0], i[1], i[2]});
+    else _mesh.indices.insert(_mesh.indices.end(), {i[0], i[1], i[2], i[0], i[2], i[3]});
 }
 
 void MeshBuilder::polygon(const std::vector<glm::dvec3>& pts, const glm::dvec3& normal) {

@@ -50,6 +50,8 @@ public:
 
 private:
     uint32_t vertex(const glm::dvec3& p, const glm::vec3& n, const glm::u8vec4& c);
+    // One flat face of `count` (3 or 4) vertices with normal direction n (any length; degenerate faces are dropped).
+    void face(glm::dvec3 n, const glm::dvec3* v, int count);
     Mesh& _mesh;
     glm::dvec3 _origin;
     Material _material;

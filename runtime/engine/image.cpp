@@ -1,16 +1,15 @@
 // PNG I/O for Image (libpng). See image.h for the contract.
 #include "runtime/engine/image.h"
 
+#include "foundation/atomic_file.h"
+
 #include <png.h>
 
 #include <cerrno>
 #include <csetjmp>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <memory>
-
-#include <unistd.h>
 
 namespace vista {
 
@@ -32,15 +31,18 @@ void pngErrorFn(png_structp png, png_const_charp msg) {
 }
 void pngWarnFn(png_structp, png_const_charp) {}
 
+// libpng writes into a string; the file is then written atomically.
+void pngWriteToString(png_structp png, png_bytep data, png_size_t n) {
+    static_cast<std::string*>(png_get_io_ptr(png))->append(reinterpret_cast<const char*>(data), n);
+}
+void pngFlushNothing(png_structp) {}
+
 }  // namespace
 
 Status writePng(const Image& img, const std::string& path) {
     if (!img.valid())
         return Status::error("writePng '" + path + "': invalid image " + std::to_string(img.width) + "x" +
                              std::to_string(img.height));
-    std::string tmp = path + ".tmp." + std::to_string(getpid());
-    std::unique_ptr<FILE, FileCloser> f(std::fopen(tmp.c_str(), "wb"));
-    if (!f) return Status::error("writePng '" + path + "': cannot create file: " + std::strerror(errno));
     PngErr err;
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &err, pngErrorFn, pngWarnFn);
     if (!png) return Status::error("writePng '" + path + "': libpng init failed");
@@ -48,11 +50,12 @@ Status writePng(const Image& img, const std::string& path) {
     std::vector<png_bytep> rows(size_t(img.height));
     for (int y = 0; y < img.height; ++y)
         rows[size_t(y)] = const_cast<png_bytep>(&img.rgba[size_t(y) * size_t(img.width) * 4]);
+    std::string bytes;
     volatile bool failed = false;
     if (setjmp(png_jmpbuf(png))) {
         failed = true;
     } else {
-        png_init_io(png, f.get());
+        png_set_write_fn(png, &bytes, pngWriteToString, pngFlushNothing);
         png_set_compression_level(png, 3);
         png_set_IHDR(png, info, png_uint_32(img.width), png_uint_32(img.height), 8, PNG_COLOR_TYPE_RGBA,
                      PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
@@ -61,18 +64,8 @@ Status writePng(const Image& img, const std::string& path) {
         png_write_end(png, nullptr);
     }
     png_destroy_write_struct(&png, &info);
-    bool closeFailed = std::fclose(f.release()) != 0;
-    if (failed || closeFailed) {
-        std::remove(tmp.c_str());
-        return Status::error("writePng '" + path + "': write failed" + (failed ? std::string(": ") + err.message : ""));
-    }
-    std::error_code ec;
-    std::filesystem::rename(tmp, path, ec);
-    if (ec) {
-        std::remove(tmp.c_str());
-        return Status::error("writePng '" + path + "': rename failed: " + ec.message());
-    }
-    return Status::ok();
+    if (failed) return Status::error("writePng '" + path + "': encoding failed: " + err.message);
+    return writeFileAtomic(path, bytes);
 }
 
 Result<Image> readPng(const std::string& path) {
