@@ -25,7 +25,6 @@
 #include <osg/Program>
 #include <osg/Uniform>
 
-#include "bake/bake.h"
 #include "nodes/baked_file.h"
 #include "foundation/atomic_file.h"
 #include "foundation/units.h"
