@@ -6,8 +6,6 @@
 // (float points, double set-up); the baked node's MatrixTransform holds it.
 // Plain value type; pure.
 #pragma once
-#include <algorithm>
-
 #include <glm/glm.hpp>
 
 #include "bake/box3.h"

@@ -26,6 +26,7 @@
 #include <osg/Uniform>
 
 #include "nodes/baked_file.h"
+#include "nodes/point_impostor.h"
 #include "foundation/atomic_file.h"
 #include "foundation/units.h"
 #include "cmd/cli.h"

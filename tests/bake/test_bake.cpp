@@ -1,5 +1,6 @@
-// Bake: view cells, geometric sampling (plane, triangle, cameras, LDI, point
-// removal), Monte Carlo appearance, cell results, baked file, CLI.
+// Bake: view cells, the ray scene of a soup, geometric sampling (plane,
+// triangle, cameras, LDI, point removal), Monte Carlo appearance, cell
+// results and their codec, baked file, the driver as a library call, CLI.
 #include <gtest/gtest.h>
 
 #include <algorithm>
