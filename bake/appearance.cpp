@@ -85,7 +85,7 @@ struct PointResult {
 
 }  // namespace
 
-void computeAppearance(const FarScene& scene, const SamplingSetup& s, const std::vector<glm::vec3>& points,
+void computeAppearance(const RayScene& scene, const SamplingSetup& s, const std::vector<glm::vec3>& points,
                        const AppearanceParams& p, uint64_t seed, uint64_t entity, PointImpostorData& out,
                        AppearanceStats& stats, std::vector<uint32_t>* kept, const Box3* cell) {
     VISTA_CHECK(p.texelsX >= 1 && p.texelsY >= 1 && p.minSamples >= 1 && p.maxSamples >= p.minSamples);
@@ -144,9 +144,9 @@ void computeAppearance(const FarScene& scene, const SamplingSetup& s, const std:
             const double oy = rng.uniform(-0.5, 0.5) + rng.normal() * p.pixelSigma;
             const glm::dvec3 dir = glm::normalize(d + p.pixelAngle * (ox * e1 + oy * e2));
             ++r.rays;
-            const FarHit h = scene.intersect(glm::vec3(sp), glm::vec3(dir), 0.0f, 1e30f);
+            const RayHit h = scene.intersect(glm::vec3(sp), glm::vec3(dir), 0.0f, 1e30f);
             glm::dvec3 c;
-            if (h.hit) c = glm::dvec3(h.color);
+            if (h.hit) c = glm::dvec3(scene.hitColor(h));
             else c = glm::dvec3(glm::vec3(skyColor(std::asin(std::clamp(dir.z, -1.0, 1.0))))) / 255.0;
             a.sum += c;
             const double l = luma(c);
@@ -177,8 +177,8 @@ void computeAppearance(const FarScene& scene, const SamplingSetup& s, const std:
                 const double oy = rng.uniform(-0.5, 0.5) + rng.normal() * p.pixelSigma;
                 const glm::dvec3 dir = glm::normalize(d + p.pixelAngle * (ox * e1 + oy * e2));
                 ++r.rays;
-                const FarHit h = scene.intersect(glm::vec3(seenFrom), glm::vec3(dir), 0.0f, 1e30f);
-                sum += h.hit ? glm::dvec3(h.color) : glm::dvec3(glm::vec3(skyColor(std::asin(std::clamp(dir.z, -1.0, 1.0))))) / 255.0;
+                const RayHit h = scene.intersect(glm::vec3(seenFrom), glm::vec3(dir), 0.0f, 1e30f);
+                sum += h.hit ? glm::dvec3(scene.hitColor(h)) : glm::dvec3(glm::vec3(skyColor(std::asin(std::clamp(dir.z, -1.0, 1.0))))) / 255.0;
             }
             r.visible = true;
             r.single = true;

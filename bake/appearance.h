@@ -26,7 +26,8 @@
 // random cell positions is dropped before any Monte Carlo work.
 // Compression: a point whose texel colours differ by less than
 // singleColorThreshold (max channel std dev) becomes single-coloured.
-// Colours are 0..1 floats of the 8-bit prelit values (no gamma).
+// Colours are 0..1 floats of the 8-bit prelit values (no gamma;
+// RayScene::hitColor).
 // Determinism: point k draws from Rng(seed, hashKeys(entity, k), Stream::Bake);
 // points are processed in parallel into fixed slots.
 #pragma once
@@ -35,8 +36,8 @@
 
 #include <glm/glm.hpp>
 
-#include "bake/far_scene.h"
-#include "bake/sampling.h"
+#include "bake/sampling_plane.h"
+#include "runtime/engine/ray_scene.h"
 #include "nodes/point_impostor.h"
 
 namespace vista {
@@ -65,7 +66,8 @@ struct AppearanceStats {
 
 // Fills `out` (positions, colours, blocks, texels, plane) from `points` (frame
 // coordinates). Returns the indices of the kept points in `kept` (ascending).
-void computeAppearance(const FarScene& scene, const SamplingSetup& s, const std::vector<glm::vec3>& points,
+// `scene` holds the far field in the impostor frame (RayScene::build(soup)).
+void computeAppearance(const RayScene& scene, const SamplingSetup& s, const std::vector<glm::vec3>& points,
                        const AppearanceParams& p, uint64_t seed, uint64_t entity, PointImpostorData& out,
                        AppearanceStats& stats, std::vector<uint32_t>* kept = nullptr, const Box3* cell = nullptr);
 

@@ -25,8 +25,8 @@
 #include <osg/Program>
 #include <osg/Uniform>
 
-#include "bake/bake.h"
 #include "nodes/baked_file.h"
+#include "nodes/point_impostor.h"
 #include "foundation/atomic_file.h"
 #include "foundation/units.h"
 #include "cmd/cli.h"

@@ -5,6 +5,8 @@
 // prototype, instanced with RTC_GEOMETRY_TYPE_INSTANCE per SceneInstance.
 // Hit colours: barycentric interpolation of the prelit vertex colours, rounded
 // to 8 bits exactly as the fixed-function rasteriser does.
+// A soup scene: one triangle geometry on a device shared by all soup scenes
+// (so the bake does not create a device per impostor); no robust flag.
 #include "runtime/engine/ray_scene.h"
 
 #include <embree3/rtcore.h>
@@ -90,6 +92,7 @@ void cullBackFaces(const RTCFilterFunctionNArguments* args) {
 
 struct RayScene::Impl {
     RTCDevice device = nullptr;
+    bool ftz = true;  // set FTZ/DAZ on casting threads (city scenes)
     RTCScene scene = nullptr;
     std::vector<RTCScene> protoScenes;
     ErrorSink errors;
@@ -125,6 +128,8 @@ struct RayScene::Impl {
               float ny, float nz) const {
         h.hit = true;
         h.t = t;
+        h.u = u;
+        h.v = v;
         h.primId = primID;
         glm::vec3 n(nx, ny, nz);
         if (instID != RTC_INVALID_GEOMETRY_ID) {
@@ -150,9 +155,9 @@ RayScene::~RayScene() = default;
 namespace {
 
 // Builds one triangle geometry; returns false (and leaves no geometry) for empty/invalid meshes.
-bool addTriangles(RTCDevice device, RTCScene scene, const SceneMesh& mesh, const glm::dvec3& shift,
-                  unsigned* geomIdOut) {
-    size_t nv = mesh.positions.size(), nt = mesh.indices.size() / 3;
+bool addTriangles(RTCDevice device, RTCScene scene, const std::vector<glm::vec3>& positions,
+                  const std::vector<uint32_t>& indices, const glm::dvec3& shift, bool cullBack, unsigned* geomIdOut) {
+    size_t nv = positions.size(), nt = indices.size() / 3;
     if (nv == 0 || nt == 0) return false;
     RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
     if (!g) return false;
@@ -165,14 +170,16 @@ bool addTriangles(RTCDevice device, RTCScene scene, const SceneMesh& mesh, const
         return false;
     }
     for (size_t i = 0; i < nv; ++i) {
-        glm::dvec3 p = glm::dvec3(mesh.positions[i]) + shift;
+        glm::dvec3 p = glm::dvec3(positions[i]) + shift;
         vb[3 * i] = float(p.x);
         vb[3 * i + 1] = float(p.y);
         vb[3 * i + 2] = float(p.z);
     }
-    for (size_t i = 0; i < nt * 3; ++i) ib[i] = mesh.indices[i] < nv ? mesh.indices[i] : 0;
-    rtcSetGeometryIntersectFilterFunction(g, cullBackFaces);
-    rtcSetGeometryOccludedFilterFunction(g, cullBackFaces);
+    for (size_t i = 0; i < nt * 3; ++i) ib[i] = indices[i] < nv ? indices[i] : 0;
+    if (cullBack) {
+        rtcSetGeometryIntersectFilterFunction(g, cullBackFaces);
+        rtcSetGeometryOccludedFilterFunction(g, cullBackFaces);
+    }
     rtcCommitGeometry(g);
     *geomIdOut = rtcAttachGeometry(scene, g);
     rtcReleaseGeometry(g);
@@ -184,6 +191,22 @@ bool validMesh(const SceneMesh& m) {
     for (uint32_t i : m.indices)
         if (i >= m.positions.size()) return false;
     return true;
+}
+
+RTCDevice sharedSoupDevice() {
+    static std::once_flag once;
+    static RTCDevice device = nullptr;
+    std::call_once(once, [] { device = rtcNewDevice("threads=0"); });
+    return device;
+}
+
+RTCBuildQuality embreeQuality(RayBuildQuality q) {
+    switch (q) {
+        case RayBuildQuality::Low: return RTC_BUILD_QUALITY_LOW;
+        case RayBuildQuality::Medium: return RTC_BUILD_QUALITY_MEDIUM;
+        case RayBuildQuality::High: return RTC_BUILD_QUALITY_HIGH;
+    }
+    return RTC_BUILD_QUALITY_MEDIUM;
 }
 
 }  // namespace
@@ -209,7 +232,7 @@ Result<std::unique_ptr<RayScene>> RayScene::build(const SceneModel& city) {
             return Status::error("ray scene: mesh " + std::to_string(mi) + " is malformed (index out of range, "
                                  "index count not a multiple of 3 or colour count != vertex count)");
         unsigned id = 0;
-        if (!addTriangles(im.device, im.scene, m, m.origin - im.origin, &id)) {
+        if (!addTriangles(im.device, im.scene, m.positions, m.indices, m.origin - im.origin, true, &id)) {
             VISTA_RETURN_IF_ERROR(im.checkDevice("building tile geometry"));
             continue;
         }
@@ -232,7 +255,7 @@ Result<std::unique_ptr<RayScene>> RayScene::build(const SceneModel& city) {
         RTCScene s = rtcNewScene(im.device);
         rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
         unsigned id = 0;
-        if (!addTriangles(im.device, s, p, p.origin, &id)) {
+        if (!addTriangles(im.device, s, p.positions, p.indices, p.origin, true, &id)) {
             rtcReleaseScene(s);
             VISTA_RETURN_IF_ERROR(im.checkDevice("building prototype geometry"));
             continue;
@@ -274,10 +297,50 @@ Result<std::unique_ptr<RayScene>> RayScene::build(const SceneModel& city) {
     return rs;
 }
 
+Result<std::unique_ptr<RayScene>> RayScene::build(const TriangleSoup& soup, const SoupSceneOptions& options) {
+    if (soup.colors.size() != soup.positions.size())
+        return Status::error("ray scene: soup colour count " + std::to_string(soup.colors.size()) + " != vertex count " +
+                             std::to_string(soup.positions.size()));
+    if (soup.indices.size() % 3 != 0)
+        return Status::error("ray scene: soup index count " + std::to_string(soup.indices.size()) + " is not a multiple of 3");
+    for (uint32_t i : soup.indices)
+        if (i >= soup.positions.size())
+            return Status::error("ray scene: soup index " + std::to_string(i) + " out of range (" +
+                                 std::to_string(soup.positions.size()) + " vertices)");
+    for (const auto& p : soup.positions)
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+            return Status::error("ray scene: soup has a non-finite vertex");
+    std::unique_ptr<RayScene> rs(new RayScene());
+    Impl& im = *rs->_impl;
+    im.ftz = false;
+    im.origin = options.frameOrigin;
+    RTCDevice device = sharedSoupDevice();
+    if (!device) return Status::error("ray scene: cannot create the Embree device for soups");
+    rtcRetainDevice(device);
+    im.device = device;
+    im.scene = rtcNewScene(device);
+    rtcSetSceneBuildQuality(im.scene, embreeQuality(options.quality));
+    if (soup.triangleCount() > 0) {
+        unsigned id = 0;
+        if (!addTriangles(device, im.scene, soup.positions, soup.indices, glm::dvec3(0.0), options.cullBackFaces, &id))
+            return Status::error("ray scene: Embree buffer allocation failed for a soup of " +
+                                 std::to_string(soup.triangleCount()) + " triangles");
+        if (im.geoms.size() <= id) im.geoms.resize(id + 1);
+        im.geoms[id].mesh = 0;
+        im.meshColors.push_back(soup.colors);
+        im.meshIndices.push_back(soup.indices);
+        im.triangles = soup.triangleCount();
+    }
+    rtcCommitScene(im.scene);
+    const RTCError e = rtcGetDeviceError(device);  // per thread: this build's error
+    if (e != RTC_ERROR_NONE) return Status::error(std::string("ray scene: Embree error while building a soup: ") + embreeErrorName(e));
+    return rs;
+}
+
 glm::dvec3 RayScene::frameOrigin() const { return _impl->origin; }
 
 RayHit RayScene::intersect(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar) const {
-    enableFtzDaz();
+    if (_impl->ftz) enableFtzDaz();
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRayHit rh;
@@ -300,7 +363,7 @@ RayHit RayScene::intersect(const glm::vec3& org, const glm::vec3& dir, float tne
 }
 
 void RayScene::intersectMany(const glm::vec3* org, const glm::vec3* dir, int n, RayHit* out, float tfar) const {
-    enableFtzDaz();
+    if (_impl->ftz) enableFtzDaz();
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
@@ -334,7 +397,7 @@ void RayScene::intersectMany(const glm::vec3* org, const glm::vec3* dir, int n, 
 }
 
 bool RayScene::occluded(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar) const {
-    enableFtzDaz();
+    if (_impl->ftz) enableFtzDaz();
     if (!(tnear <= tfar)) return false;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
@@ -347,6 +410,32 @@ bool RayScene::occluded(const glm::vec3& org, const glm::vec3& dir, float tnear,
     r.mask = 0xFFFFFFFFu;
     rtcOccluded1(_impl->scene, &ctx, &r);
     return r.tfar < 0.0f;  // Embree sets tfar = -inf on occlusion
+}
+
+int RayScene::allHits(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar, int maxHits, float minGap,
+                      RayHit* out) const {
+    int n = 0;
+    float t0 = tnear;
+    while (n < maxHits) {
+        const RayHit h = intersect(org, dir, t0, tfar);
+        if (!h.hit) break;
+        out[n++] = h;
+        t0 = h.t + std::max(minGap, h.t * 1e-5f);
+    }
+    return n;
+}
+
+glm::vec3 RayScene::hitColor(const RayHit& h) const {
+    if (!h.hit) return glm::vec3(0.0f);
+    const bool inst = h.instId != 0xFFFFFFFFu;
+    const Impl::GeomInfo& gi = _impl->geoms[inst ? h.instId : h.geomId];
+    const auto& colors = inst ? _impl->protoColors[size_t(gi.prototype)] : _impl->meshColors[size_t(gi.mesh)];
+    const auto& indices = inst ? _impl->protoIndices[size_t(gi.prototype)] : _impl->meshIndices[size_t(gi.mesh)];
+    const size_t base = size_t(h.primId) * 3;
+    if (base + 2 >= indices.size()) return {1.0f, 0.0f, 1.0f};  // cannot happen for a hit of this scene
+    const glm::vec3 c0 = glm::vec3(colors[indices[base]]) / 255.0f, c1 = glm::vec3(colors[indices[base + 1]]) / 255.0f,
+                    c2 = glm::vec3(colors[indices[base + 2]]) / 255.0f;
+    return (1.0f - h.u - h.v) * c0 + h.u * c1 + h.v * c2;
 }
 
 size_t RayScene::triangleCount() const { return _impl->triangles; }

@@ -1,7 +1,8 @@
-// RayScene: the Embree scene of a loaded city, shared by the raycast mode,
-// the hybrid far field and the bake.
+// RayScene: the one Embree wrapper: the scene of a loaded city (raycast mode,
+// hybrid far field) or of a triangle soup (the bake's far field of one
+// impostor, in the impostor's float frame).
 //
-// Contract: built once from a SceneModel (tile meshes as triangle geometry,
+// Contract: a city scene is built once from a SceneModel (tile meshes as triangle geometry,
 // tree prototypes as instanced geometry); immutable afterwards, so every
 // method is thread-safe. Coordinates: world double positions are converted
 // to a scene-local float frame around `frameOrigin()` (the city centre), so
@@ -11,9 +12,17 @@
 // rasteriser culls them (CullFace BACK on the city root).
 // Embree errors are mapped to Status at construction; nothing throws from a
 // ray-casting loop. FTZ/DAZ are set on every thread that casts.
+// Soup scenes (build(TriangleSoup, SoupSceneOptions)): the soup's positions
+// are used as they are (the caller's float frame; frameOrigin() reports the
+// option's value), one triangle geometry, no robust traversal, the build
+// quality and back-face culling as the options say (default: medium, no
+// culling), and the caller's floating-point mode is left alone (no FTZ/DAZ).
+// Bad soups (colour count != vertex count, index out of range or not a
+// multiple of 3, non-finite vertex) are a returned Status.
 #pragma once
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -28,11 +37,29 @@ struct RayHit {
     glm::u8vec4 color{0};       // prelit colour at the hit
     glm::vec3 normal{0.0f};     // geometric normal, scene-local frame
     uint32_t geomId = 0, primId = 0, instId = 0xFFFFFFFFu;
+    float u = 0, v = 0;         // barycentric coordinates of the hit in its triangle
+};
+
+// Triangles in one float frame, a prelit colour per vertex.
+struct TriangleSoup {
+    std::vector<glm::vec3> positions;
+    std::vector<glm::u8vec4> colors;  // per vertex (same size as positions)
+    std::vector<uint32_t> indices;    // 3 per triangle
+    size_t triangleCount() const { return indices.size() / 3; }
+};
+
+enum class RayBuildQuality { Low, Medium, High };
+
+struct SoupSceneOptions {
+    RayBuildQuality quality = RayBuildQuality::Medium;
+    bool cullBackFaces = false;    // true: as the rasteriser and the city build
+    glm::dvec3 frameOrigin{0.0};   // reported by frameOrigin(); not applied to the positions
 };
 
 class RayScene {
 public:
     static Result<std::unique_ptr<RayScene>> build(const SceneModel& city);
+    static Result<std::unique_ptr<RayScene>> build(const TriangleSoup& soup, const SoupSceneOptions& options = {});
     ~RayScene();
     glm::dvec3 frameOrigin() const;  // world position of the scene-local origin
     // Single ray in scene-local coordinates. dir must be unit length.
@@ -41,6 +68,12 @@ public:
     void intersectMany(const glm::vec3* org, const glm::vec3* dir, int n, RayHit* out, float tfar = 1e30f) const;
     // Occlusion test: true if anything lies within (tnear, tfar).
     bool occluded(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar) const;
+    // All surfaces along the ray in (tnear, tfar), nearest first, at most
+    // maxHits: each next cast starts max(minGap, 1e-5 t) beyond the last hit.
+    int allHits(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar, int maxHits, float minGap,
+                RayHit* out) const;
+    // The prelit colour at a hit, interpolated and not rounded: RGB 0..1.
+    glm::vec3 hitColor(const RayHit& h) const;
     size_t triangleCount() const;  // rendered triangles (instances expanded)
 
 private:

@@ -1,0 +1,37 @@
+// Baking one view cell: for each street end, far-field selection
+// (bake/far_set.h), sampling plane and cameras (bake/sampling_plane.h), LDI
+// sampling (bake/ldi_sampling.h), redundant-point removal
+// (bake/point_removal.h), appearance (bake/appearance.h), in that order.
+//
+// Contract: bakeCell() depends only on (city, cell, params) — not on thread
+// count, timing (apart from the *Ms fields) or the other cells — so cells can
+// be baked in any order, on any machine, and merged. An end whose far field
+// is too small, whose set-up is ill-defined (cell touching the far field) or
+// that yields no visible point gets no impostor and a note saying why.
+// Thread-safe on a const BakeInput; runs its own loops in parallel (TBB).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "bake/bake_params.h"
+#include "bake/cell_result.h"
+#include "foundation/status.h"
+
+namespace vista {
+
+struct BakeInput {
+    const SceneModel* city = nullptr;
+    std::vector<SceneTile> tiles;      // bakeTiles(city)
+    std::vector<ViewCell> cells;       // one per street edge that is not degenerate
+    std::vector<SkippedCell> skipped;  // the degenerate edges
+};
+BakeInput prepareBake(const SceneModel& city, const BakeParams& p);
+
+CellResult bakeCell(const BakeInput& in, const ViewCell& cell, const BakeParams& p);
+
+// Steps 1-6 for one far field (soup and cell box in the impostor frame):
+// fills r.data and r.stats (not the frame, tiles or ids). `entity` keys the
+// random streams. Error only for an ill-defined set-up or a bad soup.
+Status bakeImpostor(const TriangleSoup& soup, const Box3& cellBox, const BakeParams& p, uint64_t entity, ImpostorResult& r);
+
+}  // namespace vista

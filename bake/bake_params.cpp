@@ -1,0 +1,21 @@
+#include "bake/bake_params.h"
+
+#include <sstream>
+
+namespace vista {
+
+std::string BakeParams::canonical() const {
+    std::ostringstream o;
+    o.precision(17);
+    o << "eye=" << cells.eyeMin << "," << cells.eyeMax << ";minLen=" << cells.minLength << ";minW=" << cells.minWidth
+      << ";out=" << sampling.outWidth << "x" << sampling.outHeight << ";fov=" << sampling.fovYDeg << ";os=" << sampling.oversample
+      << ";fp=" << sampling.perspective << ";diag=" << sampling.diagonalFactor << ";layers=" << sampling.maxLayers
+      << ";maxRays=" << sampling.maxRaysPerCamera << ";removal=" << sampling.removeRedundant << ";texels=" << appearance.texelsX
+      << "x" << appearance.texelsY << ";mc=" << appearance.minSamples << "," << appearance.maxSamples << ","
+      << appearance.varianceThreshold << "," << appearance.singleColorThreshold << "," << appearance.viewSigma << ","
+      << appearance.pixelSigma << "," << appearance.significance << ";margin=" << far.margin << ";depth=" << far.farDepth
+      << ";opening=" << far.openingExtra << ";minTri=" << far.minTriangles << ";seed=" << seed;
+    return o.str();
+}
+
+}  // namespace vista

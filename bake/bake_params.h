@@ -1,0 +1,27 @@
+// BakeParams: every parameter that changes a bake's result, grouped by step
+// (docs/bake.md; `vista bake --help` for ranges and defaults).
+//
+// canonical() is the text stored in the baked file (vista.bake_params) and
+// hashed into each cell result's config hash: two bakes with equal text give
+// the same bytes. Its text is a file format: extend it, never reorder it.
+#pragma once
+#include <cstdint>
+#include <string>
+
+#include "bake/appearance.h"
+#include "bake/far_set.h"
+#include "bake/ldi_sampling.h"
+#include "bake/view_cells.h"
+
+namespace vista {
+
+struct BakeParams {
+    ViewCellParams cells;
+    FarSetParams far;
+    SamplingParams sampling;
+    AppearanceParams appearance;
+    uint64_t seed = 1;  // the city's seed (set from the city file by the driver)
+    std::string canonical() const;
+};
+
+}  // namespace vista

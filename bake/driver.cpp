@@ -1,0 +1,302 @@
+#include "bake/driver.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+#include <thread>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "bake/assembly.h"
+#include "bake/bake_cell.h"
+#include "foundation/atomic_file.h"
+#include "foundation/hash.h"
+#include "foundation/timing.h"
+#include "runtime/scene/city_file.h"
+#include "runtime/scene/scene_file.h"
+#include "runtime/scene/scene_graph.h"
+
+namespace vista {
+
+Result<std::vector<uint32_t>> parseCellList(const std::string& s) {
+    std::vector<uint32_t> out;
+    std::stringstream ss(s);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        if (item.empty()) continue;
+        char* end = nullptr;
+        const size_t dash = item.find('-');
+        long a = std::strtol(item.c_str(), &end, 10);
+        long b = a;
+        bool ok = end && end != item.c_str();
+        if (dash != std::string::npos && dash > 0) {
+            ok = ok && size_t(end - item.c_str()) == dash;
+            char* e2 = nullptr;
+            b = std::strtol(item.c_str() + dash + 1, &e2, 10);
+            ok = ok && e2 && *e2 == 0 && e2 != item.c_str() + dash + 1;
+        } else {
+            ok = ok && *end == 0;
+        }
+        if (!ok || a < 0 || b < a || b > 100000000)
+            return Status::error("--cells '" + s + "': bad item '" + item + "' (expected ids or ranges like 3,7,10-20)");
+        for (long v = a; v <= b; ++v) out.push_back(uint32_t(v));
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    if (out.empty()) return Status::error("--cells '" + s + "': no cell id given");
+    return out;
+}
+
+Status parseShard(const std::string& s, int& k, int& n) {
+    char slash = 0;
+    int a = 0, b = 0;
+    if (std::sscanf(s.c_str(), "%d%c%d", &a, &slash, &b) != 3 || slash != '/' || b < 1 || a < 1 || a > b)
+        return Status::error("--shard '" + s + "': expected K/N with 1 <= K <= N (e.g. 2/4)");
+    k = a;
+    n = b;
+    return Status::ok();
+}
+
+Status parseTexels(const std::string& s, int& x, int& y) {
+    if (s == "1") { x = y = 1; return Status::ok(); }
+    int a = 0, b = 0;
+    char c = 0;
+    if (std::sscanf(s.c_str(), "%d%c%d", &a, &c, &b) == 3 && (c == 'x' || c == 'X') && a >= 1 && b >= 1 && a <= 32 && b <= 32) {
+        x = a; y = b;
+        return Status::ok();
+    }
+    return Status::error("--texels '" + s + "': expected 1 or AxB with 1 <= A, B <= 32 (e.g. 8x2, 4x1)");
+}
+
+Status validateBakeJob(const BakeJob& j) {
+    const BakeParams& p = j.params;
+    auto range = [](const char* opt, double v, double lo, double hi) -> Status {
+        if (v >= lo && v <= hi) return Status::ok();
+        return Status::error(std::string(opt) + " " + std::to_string(v) + " out of range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    };
+    if (j.input.empty()) return Status::error("input city file: no path given");
+    if (j.output.empty()) return Status::error("--output: no path given");
+    for (Status s : {range("--jobs", j.jobs, 0, 1024), range("--margin", p.far.margin, 0, 1e5), range("--far-depth", p.far.farDepth, 1, 1e6),
+                     range("--oversample", p.sampling.oversample, 0.05, 16), range("--perspective", p.sampling.perspective, 1, 4),
+                     range("--texel-significance", p.appearance.significance, 0, 0.5),
+                     range("--pixel-sigma", p.appearance.pixelSigma, 0, 4), range("--layers", p.sampling.maxLayers, 1, 64),
+                     range("--max-rays", double(p.sampling.maxRaysPerCamera), 1, 1e9),
+                     range("--mc-threshold", p.appearance.varianceThreshold, 0, 1), range("--mc-min", p.appearance.minSamples, 1, 4096),
+                     range("--mc-max", p.appearance.maxSamples, p.appearance.minSamples, 65536),
+                     range("--single-threshold", p.appearance.singleColorThreshold, 0, 1), range("--out-size", p.sampling.outHeight, 16, 8192),
+                     range("--fov", p.sampling.fovYDeg, 1, 170), range("--texels (A)", p.appearance.texelsX, 1, 32),
+                     range("--texels (B)", p.appearance.texelsY, 1, 32)})
+        if (!s) return s;
+    if (j.shardN < 1 || j.shardK < 1 || j.shardK > j.shardN)
+        return Status::error("--shard " + std::to_string(j.shardK) + "/" + std::to_string(j.shardN) + ": expected K/N with 1 <= K <= N");
+    if (j.merge && j.shardN > 1) return Status::error("--merge and --shard exclude each other");
+    return Status::ok();
+}
+
+namespace {
+
+Result<std::string> readAll(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    if (!f) return Status::error("cannot read '" + path + "'");
+    std::ostringstream o;
+    o << f.rdbuf();
+    return o.str();
+}
+
+std::string cellPath(const std::string& dir, uint32_t id) { return dir + "/cell_" + std::to_string(id) + ".vbc"; }
+
+nlohmann::json statsJson(const ImpostorResult& r) {
+    const ImpostorStats& s = r.stats;
+    nlohmann::json j;
+    j["cell"] = r.cell;
+    j["end"] = int(r.end);
+    j["tiles"] = s.tiles;
+    j["far_triangles"] = s.farTriangles;
+    j["ldi_cameras"] = {{s.camW[0], s.camH[0]}, {s.camW[1], s.camH[1]}, {s.camW[2], s.camH[2]}};
+    j["ldi_step_required"] = s.requiredStep;
+    j["ldi_step_used"] = s.usedStep;
+    j["ldi_rays"] = s.ldiRays;
+    j["ldi_samples"] = s.ldiSamples;
+    j["after_removal"] = s.afterRemoval;
+    j["points"] = s.points;
+    j["textured_points"] = s.textured;
+    j["dropped_invisible"] = s.dropped;
+    j["noise_single_points"] = s.noiseSingle;
+    j["mc_rays"] = s.mcRays;
+    j["mc_samples"] = s.mcSamples;
+    j["screen_pixels"] = s.screenPixels;
+    j["screen_bbox_pixels"] = s.screenBBoxPixels;
+    j["points_per_screen_pixel"] = s.screenPixels ? double(s.points) / double(s.screenPixels) : 0.0;
+    const size_t bytes = r.data.positions.size() * kPointBytes + r.data.texels.size() * 4;
+    j["memory_mb"] = double(bytes) / (1024.0 * 1024.0);
+    j["memory_mb_uncompressed"] = double(r.data.positions.size() * (kPointBytes + 4 * size_t(r.data.texelsX * r.data.texelsY))) / (1024.0 * 1024.0);
+    j["bake_s"] = s.bakeMs / 1000.0;
+    return j;
+}
+
+// Bakes in.cells[todo[k]] on `arena`, each result written atomically as soon
+// as it is done; progress from this thread while a worker thread runs the loop.
+Status bakeCells(const BakeInput& in, const std::vector<size_t>& todo, const BakeParams& p, uint64_t configHash,
+                 const std::string& workDir, tbb::task_arena& arena, Progress* progress) {
+    std::atomic<size_t> done{0};
+    std::atomic<bool> failed{false};
+    std::string failure;
+    std::mutex failMu;
+    if (progress) progress->begin("bake");
+    std::thread worker([&] {
+        arena.execute([&] {
+            tbb::parallel_for(size_t(0), todo.size(), size_t(1), [&](size_t k) {
+                if (failed) return;
+                const ViewCell& c = in.cells[todo[k]];
+                const CellResult r = bakeCell(in, c, p);
+                if (Status s = writeFileAtomic(cellPath(workDir, c.id), encodeCellResult(r, configHash)); !s) {
+                    std::lock_guard<std::mutex> l(failMu);
+                    failure = s.message();
+                    failed = true;
+                }
+                ++done;
+            });
+        });
+    });
+    while (done.load() < todo.size() && !failed) {
+        if (progress) progress->update(double(done.load()) / double(std::max<size_t>(todo.size(), 1)));
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    worker.join();
+    if (progress) progress->end();
+    return failed ? Status::error(failure) : Status::ok();
+}
+
+}  // namespace
+
+Result<BakeReport> runBakeJob(const BakeJob& job, Progress* progress, const std::function<void(const std::string&)>& log) {
+    VISTA_RETURN_IF_ERROR(validateBakeJob(job));
+    const Stopwatch wall;
+    BakeReport rep;
+    rep.workDir = job.workDir.empty() ? job.output + ".work" : job.workDir;
+    const std::string& workDir = rep.workDir;
+    auto city = loadCityFile(job.input);
+    if (!city) return city.status();
+    if (dynamic_cast<ViewCellSwitch*>(sceneRoot(*city)))
+        return Status::error("'" + job.input + "' is already baked; bake the plain city file");
+    BakeParams p = job.params;
+    p.seed = city->params.seed;
+    const std::string canon = p.canonical();
+    uint64_t configHash = 0;
+    {
+        auto bytes = readAll(job.input);
+        if (!bytes) return bytes.status();
+        configHash = hashBytes64(bytes->data(), bytes->size(), hashBytes64(canon.data(), canon.size()));
+    }
+    const BakeInput in = prepareBake(*city, p);
+    rep.skippedEdges = in.skipped.size();
+
+    // Cell selection: indices into in.cells, then this shard's part.
+    std::vector<size_t> selected;
+    if (!job.cells.empty()) {
+        for (uint32_t id : job.cells) {
+            auto it = std::find_if(in.cells.begin(), in.cells.end(), [&](const ViewCell& c) { return c.id == id; });
+            if (it == in.cells.end())
+                return Status::error("--cells: cell " + std::to_string(id) + " does not exist (cells are street edges 0.." +
+                                     std::to_string(city->streets.edges.size()) + ", minus degenerate ones)");
+            selected.push_back(size_t(it - in.cells.begin()));
+        }
+    } else {
+        for (size_t i = 0; i < in.cells.size(); ++i) selected.push_back(i);
+    }
+    std::vector<size_t> mine;
+    for (size_t k = 0; k < selected.size(); ++k)
+        if (int(k % size_t(job.shardN)) == job.shardK - 1) mine.push_back(selected[k]);
+    rep.cells = selected.size();
+    rep.shardCells = mine.size();
+
+    std::error_code ec;
+    std::filesystem::create_directories(workDir, ec);
+    if (ec || access(workDir.c_str(), W_OK) != 0)
+        return Status::error("--work '" + workDir + "': cannot create or write the directory");
+
+    if (!job.merge) {
+        std::vector<size_t> todo;
+        for (size_t ci : mine) {
+            auto b = readAll(cellPath(workDir, in.cells[ci].id));
+            if (b && decodeCellResult(*b, configHash, "").isOk()) continue;
+            todo.push_back(ci);
+        }
+        rep.baked = todo.size();
+        rep.resumed = mine.size() - todo.size();
+        if (log)
+            log(std::to_string(mine.size()) + " cells (" + std::to_string(todo.size()) + " in this run, " + std::to_string(rep.resumed) +
+                " already done), " + std::to_string(in.skipped.size()) + " degenerate edges skipped");
+        tbb::task_arena arena(job.jobs > 0 ? job.jobs : tbb::task_arena::automatic);
+        VISTA_RETURN_IF_ERROR(bakeCells(in, todo, p, configHash, workDir, arena, progress));
+        if (job.shardN > 1) {
+            rep.wallS = wall.ms() / 1000.0;
+            return rep;
+        }
+    }
+
+    // Assembly from the work directory.
+    std::vector<CellResult> results;
+    std::vector<uint32_t> missing;
+    for (size_t ci : selected) {
+        const uint32_t id = in.cells[ci].id;
+        auto b = readAll(cellPath(workDir, id));
+        auto r = b ? decodeCellResult(*b, configHash, cellPath(workDir, id)) : Result<CellResult>(b.status());
+        if (r) results.push_back(std::move(*r));
+        else missing.push_back(id);
+    }
+    if (!missing.empty()) {
+        std::string list;
+        for (size_t i = 0; i < missing.size() && i < 20; ++i) list += (i ? "," : "") + std::to_string(missing[i]);
+        if (missing.size() > 20) list += ",...";
+        return Status::error(std::to_string(missing.size()) + " cell results missing or stale in '" + workDir + "' (cells " + list +
+                             "); bake them first (all shards with the same parameters)");
+    }
+    std::sort(results.begin(), results.end(), [](const CellResult& a, const CellResult& b) { return a.cell < b.cell; });
+    osg::ref_ptr<ViewCellSwitch> root = assembleBakedScene(*city, in.cells, results, canon);
+    VISTA_RETURN_IF_ERROR(writeSceneFile(*root, job.output, false));
+    rep.assembled = true;
+    double cellMs = 0;
+    nlohmann::json js = nlohmann::json::array();
+    for (const auto& r : results) {
+        cellMs += r.bakeMs;
+        for (const auto& im : r.impostors) {
+            ++rep.impostors;
+            rep.points += im.stats.points;
+            js.push_back(statsJson(im));
+        }
+    }
+    rep.cellBakeS = cellMs / 1000.0;
+    const auto size = std::filesystem::file_size(job.output, ec);
+    rep.outputBytes = ec ? 0 : uint64_t(size);
+    rep.wallS = wall.ms() / 1000.0;
+    if (!job.statsFile.empty()) {
+        nlohmann::json top;
+        top["input"] = job.input;
+        top["cells"] = results.size();
+        top["impostors"] = rep.impostors;
+        top["points"] = rep.points;
+        top["cell_bake_s_sum"] = rep.cellBakeS;
+        top["wall_s"] = rep.wallS;
+        top["output_bytes"] = rep.outputBytes;
+        top["params"] = canon;
+        top["impostor_stats"] = js;
+        VISTA_RETURN_IF_ERROR(writeFileAtomic(job.statsFile, top.dump(1)));
+    }
+    if (!job.keepWork) {
+        for (size_t ci : selected) std::filesystem::remove(cellPath(workDir, in.cells[ci].id), ec);
+        std::filesystem::remove(workDir, ec);  // only if empty
+    }
+    return rep;
+}
+
+}  // namespace vista

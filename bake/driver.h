@@ -1,0 +1,69 @@
+// The bake driver: a whole bake (`vista bake`) as one library call
+// (docs/bake.md "Work directory, resume, shards").
+//
+// runBakeJob() loads the city file, selects the cells (job.cells, or all;
+// then every shardN-th from offset shardK - 1), bakes those of this shard
+// whose result file WORK/cell_ID.vbc is missing, stale (other config hash) or
+// damaged — each written atomically when done, `jobs` threads — and then,
+// unless it is one shard of several, assembles the output from the work
+// directory (every selected cell must be there), writes it atomically,
+// writes the stats JSON and removes the cell files (and the work directory
+// when empty) unless keepWork. With merge it bakes nothing, only assembles.
+// Config hash = hash(input file bytes, params.canonical()).
+// Determinism: output bytes depend only on (input file, params, cells), not
+// on jobs, shards, interruptions or resumption. A kill at any moment leaves
+// only whole cell files.
+// Errors (Status naming the option, value and range, or the file): every
+// value of the job (validateBakeJob), a missing, baked or malformed input, a
+// cell that does not exist, cell results missing at assembly, failed writes.
+// progress: begin/update (fraction of this run's cells; ETA)/end, called from
+// the calling thread. log: one line before baking (cells, already done,
+// skipped edges). One run per work directory at a time.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "bake/bake_params.h"
+#include "foundation/progress.h"
+#include "foundation/status.h"
+
+namespace vista {
+
+struct BakeJob {
+    std::string input;            // city file from `vista gen`
+    std::string output;           // baked file
+    std::string workDir;          // per-cell results; "" = output + ".work"
+    std::string statsFile;        // per-impostor statistics (JSON); "" = none
+    std::vector<uint32_t> cells;  // cell ids (= street edge ids) to bake; empty = all
+    int shardK = 1, shardN = 1;   // this run bakes shard K of N (1 <= K <= N)
+    bool merge = false;           // only assemble from the work directory
+    bool keepWork = false;        // keep the work directory after assembly
+    int jobs = 0;                 // worker threads, 0 = all cores (0 .. 1024)
+    BakeParams params;            // params.seed is taken from the city file
+};
+
+struct BakeReport {
+    std::string workDir;               // as resolved
+    size_t cells = 0;                  // selected cells
+    size_t shardCells = 0;             // cells of this shard
+    size_t baked = 0, resumed = 0;     // of this shard: baked now / found done in the work directory
+    size_t skippedEdges = 0;           // degenerate street edges (no cell)
+    bool assembled = false;            // false after one shard of several
+    size_t impostors = 0, points = 0;  // in the output
+    uint64_t outputBytes = 0;
+    double wallS = 0;                  // this call
+    double cellBakeS = 0;              // sum of the assembled cells' bake times
+};
+
+Status validateBakeJob(const BakeJob& job);
+Result<BakeReport> runBakeJob(const BakeJob& job, Progress* progress = nullptr,
+                              const std::function<void(const std::string&)>& log = {});
+
+// Option values as typed on a command line.
+Result<std::vector<uint32_t>> parseCellList(const std::string& s);  // "3,7,10-20" -> sorted unique ids
+Status parseShard(const std::string& s, int& k, int& n);            // "K/N"
+Status parseTexels(const std::string& s, int& x, int& y);           // "1" or "AxB", 1 .. 32 each
+
+}  // namespace vista
