@@ -1,4 +1,5 @@
 #include "bake/sampling_plane.h"
+#include "citygen/polygon.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,28 +7,6 @@
 #include "foundation/units.h"
 
 namespace vista {
-
-static double cross2(const glm::dvec2& o, const glm::dvec2& a, const glm::dvec2& b) {
-    return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
-}
-
-std::vector<glm::dvec2> convexHull2D(std::vector<glm::dvec2> pts) {
-    std::sort(pts.begin(), pts.end(), [](const glm::dvec2& a, const glm::dvec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
-    pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
-    if (pts.size() < 3) return pts;
-    std::vector<glm::dvec2> h(2 * pts.size());
-    size_t k = 0;
-    for (size_t i = 0; i < pts.size(); ++i) {
-        while (k >= 2 && cross2(h[k - 2], h[k - 1], pts[i]) <= 0) --k;
-        h[k++] = pts[i];
-    }
-    for (size_t i = pts.size() - 1, t = k + 1; i-- > 0;) {
-        while (k >= t && cross2(h[k - 2], h[k - 1], pts[i]) <= 0) --k;
-        h[k++] = pts[i];
-    }
-    h.resize(k - 1);
-    return h;
-}
 
 double trianglePerimeter(const std::array<glm::dvec2, 3>& t) {
     return glm::length(t[1] - t[0]) + glm::length(t[2] - t[1]) + glm::length(t[0] - t[2]);
@@ -139,7 +118,7 @@ Result<SamplingSetup> setupSampling(const Box3& cell, const Box3& far) {
             cuts.emplace_back(glm::dot(s.U, x), glm::dot(s.V, x));
         }
     }
-    s.polygon = convexHull2D(cuts);
+    s.polygon = convexHull(cuts);
     s.rectLo = glm::dvec2(1e300);
     s.rectHi = glm::dvec2(-1e300);
     for (const auto& p : s.polygon) {

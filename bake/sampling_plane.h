@@ -47,8 +47,6 @@ struct SamplingSetup {
 
 Result<SamplingSetup> setupSampling(const Box3& cell, const Box3& far);
 
-// Convex hull (counter-clockwise, no collinear points). Exposed for tests.
-std::vector<glm::dvec2> convexHull2D(std::vector<glm::dvec2> pts);
 double trianglePerimeter(const std::array<glm::dvec2, 3>& t);
 // Minimum-circumference triangle with a top edge parallel to the x axis that
 // contains the convex polygon `poly` (non-empty). Returns top-left, top-right, bottom.

@@ -28,24 +28,6 @@ double segmentDistance(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec
                     std::min(pointSegmentDistance(c, a, b), pointSegmentDistance(d, a, b)));
 }
 
-std::vector<glm::dvec2> convexHull(std::vector<glm::dvec2> p) {
-    std::sort(p.begin(), p.end(), [](const glm::dvec2& a, const glm::dvec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
-    p.erase(std::unique(p.begin(), p.end()), p.end());
-    if (p.size() < 3) return p;
-    std::vector<glm::dvec2> h(2 * p.size());
-    size_t k = 0;
-    for (size_t i = 0; i < p.size(); ++i) {
-        while (k >= 2 && orient(h[k - 2], h[k - 1], p[i]) <= 0) --k;
-        h[k++] = p[i];
-    }
-    for (size_t i = p.size() - 1, t = k + 1; i > 0; --i) {
-        while (k >= t && orient(h[k - 2], h[k - 1], p[i - 1]) <= 0) --k;
-        h[k++] = p[i - 1];
-    }
-    h.resize(k - 1);
-    return h;
-}
-
 }  // namespace
 
 Polygon2 makeCounterClockwise(Polygon2 poly) {

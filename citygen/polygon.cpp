@@ -171,4 +171,25 @@ std::vector<uint32_t> triangulate(const std::vector<glm::dvec2>& poly) {
     return out;
 }
 
+std::vector<glm::dvec2> convexHull(std::vector<glm::dvec2> pts, double collinearEps) {
+    std::sort(pts.begin(), pts.end(), [](const glm::dvec2& a, const glm::dvec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+    pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+    if (pts.size() < 3) return pts;
+    auto turn = [](const glm::dvec2& o, const glm::dvec2& a, const glm::dvec2& b) {
+        return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+    };
+    std::vector<glm::dvec2> h(2 * pts.size());
+    size_t k = 0;
+    for (size_t i = 0; i < pts.size(); ++i) {  // lower hull
+        while (k >= 2 && turn(h[k - 2], h[k - 1], pts[i]) <= collinearEps) --k;
+        h[k++] = pts[i];
+    }
+    for (size_t i = pts.size() - 1, t = k + 1; i-- > 0;) {  // upper hull
+        while (k >= t && turn(h[k - 2], h[k - 1], pts[i]) <= collinearEps) --k;
+        h[k++] = pts[i];
+    }
+    h.resize(k - 1);
+    return h;
+}
+
 }  // namespace vista

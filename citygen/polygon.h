@@ -24,6 +24,11 @@ bool polygonsOverlap(const std::vector<glm::dvec2>& a, const std::vector<glm::dv
 double pointSegmentDistance(const glm::dvec2& p, const glm::dvec2& a, const glm::dvec2& b);
 // Removes consecutive duplicates (within eps) and collinear vertices.
 std::vector<glm::dvec2> cleanPolygon(const std::vector<glm::dvec2>& poly, double eps = 1e-7);
+// Convex hull (Andrew's monotone chain), counter-clockwise. A point stays on
+// the hull only where the turn's cross product exceeds collinearEps, so
+// collinear and duplicate points are dropped. Fewer than 3 distinct points
+// come back sorted and deduplicated (callers that need a polygon check size).
+std::vector<glm::dvec2> convexHull(std::vector<glm::dvec2> pts, double collinearEps = 0.0);
 // Ear clipping; returns index triples into `poly` oriented counter-clockwise.
 std::vector<uint32_t> triangulate(const std::vector<glm::dvec2>& poly);
 

@@ -203,27 +203,6 @@ void SurfaceContext::parks() {
     });
 }
 
-// Convex hull (Andrew's monotone chain), counter-clockwise, no collinear points.
-Polygon2 convexHull(Polygon2 pts) {
-    std::sort(pts.begin(), pts.end(), [](const glm::dvec2& a, const glm::dvec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
-    if (pts.size() < 3) return {};
-    auto cross = [](const glm::dvec2& o, const glm::dvec2& a, const glm::dvec2& b) {
-        return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
-    };
-    Polygon2 h(2 * pts.size());
-    size_t k = 0;
-    for (size_t i = 0; i < pts.size(); ++i) {
-        while (k >= 2 && cross(h[k - 2], h[k - 1], pts[i]) <= 1e-12) --k;
-        h[k++] = pts[i];
-    }
-    for (size_t i = pts.size() - 1, t = k + 1; i-- > 0;) {
-        while (k >= t && cross(h[k - 2], h[k - 1], pts[i]) <= 1e-12) --k;
-        h[k++] = pts[i];
-    }
-    h.resize(k > 0 ? k - 1 : 0);
-    return h.size() >= 3 ? h : Polygon2{};
-}
-
 double safeWidth(const StreetEdge& e) {
     double w = double(e.width);
     return std::isfinite(w) && w > 0.5 ? w : roadWidth(e.cls);
@@ -355,7 +334,8 @@ void SurfaceContext::roads() {
                 if (glm::length(q - c) <= r + sw + 1e-9) pts.push_back(q);
             }
         }
-        Polygon2 hull = convexHull(pts);
+        Polygon2 hull = convexHull(pts, 1e-12);
+        if (hull.size() < 3) hull.clear();
         if (hull.size() >= 3) {
             glm::dvec2 m(0.0);
             for (const auto& q : hull) m += q;

@@ -19,6 +19,7 @@
 #include <osgDB/Registry>
 #include <tbb/global_control.h>
 
+#include "citygen/polygon.h"
 #include "bake/appearance.h"
 #include "bake/assembly.h"
 #include "bake/bake_cell.h"
@@ -185,7 +186,7 @@ TEST(Sampling, BoundingTriangleContainsPolygonWithMinimalCircumference) {
     for (int trial = 0; trial < 20; ++trial) {
         std::vector<glm::dvec2> pts;
         for (int i = 0; i < 12; ++i) pts.emplace_back(rng.uniform(-20, 20), rng.uniform(-3, 8));
-        auto poly = convexHull2D(pts);
+        auto poly = convexHull(pts);
         auto tri = boundingTriangle(poly);
         double top = -1e300;
         for (auto& q : poly) top = std::max(top, q.y);
