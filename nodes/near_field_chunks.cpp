@@ -41,7 +41,11 @@ struct ChunkBuild {
     }
 };
 
-using ChunkKey = std::tuple<int64_t, int64_t, int64_t>;  // (cx, cy, large-tile id or 0)
+// (tile, 0 = the tile's large triangles / 1 = a square chunk, cx, cy): a
+// chunk never mixes tiles and keeps its tile's origin, so its vertices are
+// the loaded floats, bit for bit; a tile's large triangles (ground, long
+// roads) come first, as in the tile's own draw order.
+using ChunkKey = std::tuple<int64_t, int64_t, int, int64_t, int64_t>;
 
 }  // namespace
 
@@ -84,7 +88,9 @@ NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk) {
         ++tileId;
         const osg::Vec3d tt = xf->getMatrix().getTrans();
         const glm::dvec3 tileOrigin(tt.x(), tt.y(), tt.z());
+        int64_t geomIndex = 0;
         for (osg::Geometry* g : tileGeometries(*xf)) {
+            ++geomIndex;
             auto* verts = dynamic_cast<osg::Vec3Array*>(g->getVertexArray());
             auto* colors = dynamic_cast<osg::Vec4ubArray*>(g->getColorArray());
             auto* de = dynamic_cast<osg::DrawElements*>(g->getPrimitiveSet(0));
@@ -109,13 +115,10 @@ NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk) {
                     }
                     glm::dvec3 world = tileOrigin + glm::dvec3(m[3]);
                     int64_t cx = int64_t(std::floor(world.x / chunk)), cy = int64_t(std::floor(world.y / chunk));
-                    ChunkBuild& cb = chunkFor({cx, cy, 0}, glm::dvec3(cx * chunk, cy * chunk, 0.0));
+                    ChunkBuild& cb = chunkFor({tileId, geomIndex, 1, cx, cy}, tileOrigin);
                     TreeBatch& tb = cb.trees[g];
                     tb.source = g;
-                    glm::dvec3 shift = tileOrigin - cb.origin;
-                    glm::mat4 ml = m;
-                    ml[3] = glm::vec4(glm::dvec3(m[3]) + shift, 1.0);
-                    for (int c = 0; c < 4; ++c) tb.cols[c].push_back(osg::Vec4(ml[c].x, ml[c].y, ml[c].z, ml[c].w));
+                    for (int c = 0; c < 4; ++c) tb.cols[c].push_back((*cols[c])[unsigned(k)]);
                     for (int corner = 0; corner < 8; ++corner) {
                         osg::Vec3 v = pb.corner(unsigned(corner));
                         glm::dvec4 w = glm::dmat4(m) * glm::dvec4(v.x(), v.y(), v.z(), 1.0);
@@ -138,7 +141,7 @@ NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk) {
                 glm::dvec3 cen = tileOrigin + glm::dvec3((a.x() + b.x() + c.x()) / 3.0, (a.y() + b.y() + c.y()) / 3.0, 0.0);
                 bool large = std::max(bb.xMax() - bb.xMin(), bb.yMax() - bb.yMin()) > chunk;
                 int64_t cx = int64_t(std::floor(cen.x / chunk)), cy = int64_t(std::floor(cen.y / chunk));
-                tris.push_back({large ? ChunkKey{0, 0, tileId} : ChunkKey{cx, cy, 0}, t});
+                tris.push_back({large ? ChunkKey{tileId, geomIndex, 0, 0, 0} : ChunkKey{tileId, geomIndex, 1, cx, cy}, t});
             }
             std::stable_sort(tris.begin(), tris.end(),
                              [](const auto& x, const auto& y) { return x.first < y.first; });
@@ -146,10 +149,7 @@ NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk) {
             std::vector<unsigned> touched;
             for (size_t s = 0; s < tris.size();) {
                 const ChunkKey key = tris[s].first;
-                glm::dvec3 origin = std::get<2>(key) ? tileOrigin
-                                                     : glm::dvec3(std::get<0>(key) * chunk, std::get<1>(key) * chunk, 0.0);
-                ChunkBuild& cb = chunkFor(key, origin);
-                const glm::dvec3 shift = tileOrigin - cb.origin;
+                ChunkBuild& cb = chunkFor(key, tileOrigin);
                 for (; s < tris.size() && tris[s].first == key; ++s) {
                     for (unsigned k = 0; k < 3; ++k) {
                         unsigned vi = de->index(tris[s].second + k);
@@ -157,10 +157,9 @@ NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk) {
                             remap[vi] = int64_t(cb.verts->size());
                             touched.push_back(vi);
                             const osg::Vec3& p = (*verts)[vi];
-                            glm::dvec3 local = glm::dvec3(p.x(), p.y(), p.z()) + shift;
-                            cb.verts->push_back(osg::Vec3(float(local.x), float(local.y), float(local.z)));
+                            cb.verts->push_back(p);
                             cb.colors->push_back(colors && vi < colors->size() ? (*colors)[vi] : osg::Vec4ub(255, 255, 255, 255));
-                            cb.expand(cb.origin + local);
+                            cb.expand(cb.origin + glm::dvec3(p.x(), p.y(), p.z()));
                         }
                         cb.indices.push_back(GLuint(remap[vi]));
                     }

@@ -1,0 +1,29 @@
+// `full`: the chunked city, far plane at infinity (mode_full.h).
+#include "nodes/render/mode_full.h"
+
+namespace vista {
+namespace {
+
+class FullMode : public GraphMode {
+public:
+    explicit FullMode(ModeContext& ctx) : GraphMode(ctx) {
+        _graph = ctx.chunkedCity();
+        _setup.push_back({"chunking", ctx.chunkingMs()});
+    }
+    std::string name() const override { return "full"; }
+
+protected:
+    osg::Node* graph() override { return _graph.get(); }
+
+private:
+    osg::ref_ptr<osg::Node> _graph;
+};
+
+}  // namespace
+
+Result<std::unique_ptr<RenderMode>> makeFullMode(ModeContext& ctx) {
+    if (!ctx.scene) return Status::error("mode full needs a scene graph, none was loaded");
+    return std::unique_ptr<RenderMode>(new FullMode(ctx));
+}
+
+}  // namespace vista
