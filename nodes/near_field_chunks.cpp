@@ -3,7 +3,6 @@
 #include "nodes/near_field_chunks.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -18,9 +17,6 @@
 namespace vista {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 struct TreeBatch {
     osg::Geometry* source = nullptr;
@@ -41,10 +37,10 @@ struct ChunkBuild {
     }
 };
 
-// (tile, 0 = the tile's large triangles / 1 = a square chunk, cx, cy): a
-// chunk never mixes tiles and keeps its tile's origin, so its vertices are
-// the loaded floats, bit for bit; a tile's large triangles (ground, long
-// roads) come first, as in the tile's own draw order.
+// (tile, material geometry, 0 = its large triangles / 1 = a square chunk,
+// cx, cy): a chunk never mixes tiles or materials and keeps its tile's
+// origin, so its vertices are the loaded floats, bit for bit, and the map
+// order is the tile's own draw order (materials in file order).
 using ChunkKey = std::tuple<int64_t, int64_t, int, int64_t, int64_t>;
 
 }  // namespace

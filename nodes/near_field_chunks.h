@@ -6,13 +6,17 @@
 // near distance, so the chunker re-chunks the loaded scene into square chunks
 // (kNearChunkSize metres, by triangle centroid; triangles larger than a chunk
 // go to a per-tile "large" chunk; trees by trunk position, drawn with the
-// city file's own instanced state set). Same vertices, colours and state as
-// the loaded scene, so near-field pixels equal the `full` mode's.
+// city file's own instanced state set). A chunk holds one tile's triangles of
+// one material geometry and keeps the tile's origin, so its vertices are the
+// loaded floats bit for bit, and chunks come in the tile's own draw order
+// (tile, material, large first, then cells): `full` drawn from the chunks
+// shows the loaded graph's pixels (tested), including which of two coplanar
+// surfaces wins a depth tie.
 //
 // Contract: buildNearFieldScene() keeps the vertices, colours and state of the
-// graph it is given, so a chunked draw shows the same pixels as the unchunked
-// one. Chunks and objects are index-aligned: chunks[i] is drawn iff objects[i]
-// is selected. Pure (builds new nodes; the input graph is not modified).
+// graph it is given. Chunks and objects are index-aligned: chunks[i] is drawn
+// iff objects[i] is selected. Pure (builds new nodes; the input graph is not
+// modified); the output does not depend on timing or threads.
 #pragma once
 #include <cstdint>
 #include <vector>
