@@ -11,19 +11,10 @@ public:
         _setup.push_back({"chunking", ctx.chunkingMs()});
     }
     std::string name() const override { return "full"; }
-
-protected:
-    osg::Node* graph() override { return _graph.get(); }
-
-private:
-    osg::ref_ptr<osg::Node> _graph;
 };
 
 }  // namespace
 
-Result<std::unique_ptr<RenderMode>> makeFullMode(ModeContext& ctx) {
-    if (!ctx.scene) return Status::error("mode full needs a scene graph, none was loaded");
-    return std::unique_ptr<RenderMode>(new FullMode(ctx));
-}
+Result<std::unique_ptr<RenderMode>> makeFullMode(ModeContext& ctx) { return std::unique_ptr<RenderMode>(new FullMode(ctx)); }
 
 }  // namespace vista

@@ -12,11 +12,11 @@ public:
     ImpostorMode(ModeContext& ctx, osg::ref_ptr<ViewCellSwitch> root, const SetupTimes& setup)
         : GraphMode(ctx), _root(std::move(root)) {
         _setup = setup;
+        _graph = _root;
     }
     std::string name() const override { return "impostor"; }
 
 protected:
-    osg::Node* graph() override { return _root.get(); }
     void describe(FrameStats& stats) const override {
         const int cell = _root->lastCell();
         stats.notes.push_back(cell >= 0 ? "cell " + std::to_string(cell) + " (" +

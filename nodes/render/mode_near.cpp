@@ -9,29 +9,20 @@ namespace {
 class NearMode : public GraphMode {
 public:
     explicit NearMode(ModeContext& ctx) : GraphMode(ctx) {
-        _graph = ctx.chunkedCity();
+        _graph = ctx.chunkedCity();  // full's graph: only the far plane differs
         _setup.push_back({"chunking", ctx.chunkingMs()});
     }
     std::string name() const override { return "near"; }
 
 protected:
-    osg::Node* graph() override { return _graph.get(); }
-    double prepare(const Camera& camera) override {
-        return std::max(_ctx.options.fixedNearDistance(), camera.zNear * 2.0);
-    }
+    double prepare(const Camera& camera) override { return std::max(_ctx.options.fixedNearDistance(), camera.zNear * 2.0); }
     void describe(FrameStats& stats) const override {
         if (_ctx.options.nearDistance <= 0) stats.notes.push_back("near distance auto -> 100 m");
     }
-
-private:
-    osg::ref_ptr<osg::Node> _graph;
 };
 
 }  // namespace
 
-Result<std::unique_ptr<RenderMode>> makeNearMode(ModeContext& ctx) {
-    if (!ctx.scene) return Status::error("mode near needs a scene graph, none was loaded");
-    return std::unique_ptr<RenderMode>(new NearMode(ctx));
-}
+Result<std::unique_ptr<RenderMode>> makeNearMode(ModeContext& ctx) { return std::unique_ptr<RenderMode>(new NearMode(ctx)); }
 
 }  // namespace vista

@@ -60,11 +60,11 @@ public:
             _root->setStateSet(g->getStateSet());
         }
         _setup.push_back({"impostors", sw.ms()});
+        _graph = _root;
     }
     std::string name() const override { return "osgimpostor"; }
 
 protected:
-    osg::Node* graph() override { return _root.get(); }
     double prepare(const Camera&) override {
         _counter->sprites = _counter->geometry = 0;
         return 0.0;
@@ -89,7 +89,6 @@ private:
 }  // namespace
 
 Result<std::unique_ptr<RenderMode>> makeOsgImpostorMode(ModeContext& ctx) {
-    if (!ctx.scene) return Status::error("mode osgimpostor needs a scene graph, none was loaded");
     return std::unique_ptr<RenderMode>(new OsgImpostorMode(ctx));
 }
 

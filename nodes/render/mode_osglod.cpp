@@ -196,11 +196,9 @@ public:
             t->addChild(lod.get());
             _root->addChild(t.get());
         }
+        _graph = _root;
     }
     std::string name() const override { return "osglod"; }
-
-protected:
-    osg::Node* graph() override { return _root.get(); }
 
 private:
     // A nested camera that only changes the culling: small features culled.
@@ -223,9 +221,6 @@ private:
 
 }  // namespace
 
-Result<std::unique_ptr<RenderMode>> makeOsgLodMode(ModeContext& ctx) {
-    if (!ctx.scene) return Status::error("mode osglod needs a scene graph, none was loaded");
-    return std::unique_ptr<RenderMode>(new OsgLodMode(ctx));
-}
+Result<std::unique_ptr<RenderMode>> makeOsgLodMode(ModeContext& ctx) { return std::unique_ptr<RenderMode>(new OsgLodMode(ctx)); }
 
 }  // namespace vista

@@ -50,7 +50,7 @@ osg::Group* ModeContext::chunkedCity() {
 Status GraphMode::renderFrame(const Camera& camera, Image& out, FrameStats& stats) {
     if (!_ctx.renderer) return Status::error("mode " + name() + " needs an OpenGL renderer (run under `xvfb-run -a`)");
     const double zFar = prepare(camera);
-    VISTA_RETURN_IF_ERROR(_ctx.renderer->render(graph(), camera, zFar, &out, nullptr, stats));
+    VISTA_RETURN_IF_ERROR(_ctx.renderer->render(_graph.get(), camera, zFar, &out, nullptr, stats));
     describe(stats);
     return Status::ok();
 }
@@ -84,6 +84,7 @@ std::string renderModeNames() {
 Result<std::unique_ptr<RenderMode>> createRenderMode(const std::string& name, ModeContext& ctx) {
     const ModeInfo* m = findRenderMode(name);
     if (!m) return Status::error("unknown mode '" + name + "'; available modes: " + renderModeNames());
+    if (!ctx.scene) return Status::error("mode " + name + " needs a scene graph, none was loaded");
     if (m->needsRays && !ctx.rays) return Status::error("mode " + name + " needs the city's ray scene, which is not available");
     return m->make(ctx);
 }

@@ -115,13 +115,13 @@ protected:
 };
 
 // A mode that draws one scene graph in both faces (full, near, osgimpostor,
-// osglod, impostor): renderFrame() renders graph() through ctx.renderer with
+// osglod, impostor): renderFrame() renders _graph through ctx.renderer with
 // the far plane that prepare() returns; the viewer draws the same graph with
 // the same far plane. describe() adds the mode's notes to a frame's stats.
 class GraphMode : public RenderMode {
 public:
     Status renderFrame(const Camera& camera, Image& out, FrameStats& stats) override;
-    osg::Node* viewerScene() override { return graph(); }
+    osg::Node* viewerScene() override { return _graph.get(); }
     double beginViewerFrame(const Camera& camera) override { return prepare(camera); }
     FrameStats lastViewerStats() const override {
         FrameStats s;
@@ -131,7 +131,6 @@ public:
 
 protected:
     explicit GraphMode(ModeContext& ctx) : _ctx(ctx) {}
-    virtual osg::Node* graph() = 0;
     // Called before every frame of either face; returns the far plane (0 = infinite).
     virtual double prepare(const Camera& camera) {
         (void)camera;
@@ -139,6 +138,7 @@ protected:
     }
     virtual void describe(FrameStats& stats) const { (void)stats; }
     ModeContext& _ctx;
+    osg::ref_ptr<osg::Node> _graph;  // set by the mode's constructor
 };
 
 // ---- the registry ------------------------------------------------------------
@@ -155,8 +155,8 @@ const std::vector<ModeInfo>& renderModes();
 const ModeInfo* findRenderMode(const std::string& name);
 // "full, near, raycast, ..." (for messages and help).
 std::string renderModeNames();
-// Creates a mode. Unknown name -> error listing the modes; a mode that needs
-// rays without ctx.rays -> error naming what is missing.
+// Creates a mode. Unknown name -> error listing the modes; no ctx.scene, or
+// a mode that needs rays without ctx.rays -> error naming what is missing.
 Result<std::unique_ptr<RenderMode>> createRenderMode(const std::string& name, ModeContext& ctx);
 
 }  // namespace vista
