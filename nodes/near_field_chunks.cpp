@@ -37,11 +37,12 @@ struct ChunkBuild {
     }
 };
 
-// (tile, material geometry, 0 = its large triangles / 1 = a square chunk,
-// cx, cy): a chunk never mixes tiles or materials and keeps its tile's
-// origin, so its vertices are the loaded floats, bit for bit, and the map
-// order is the tile's own draw order (materials in file order).
-using ChunkKey = std::tuple<int64_t, int64_t, int, int64_t, int64_t>;
+// (tile, 0 = a square chunk / 1 = the tile's large triangles, cx, cy): a
+// chunk never mixes tiles and keeps its tile's origin, so its vertices are
+// the loaded floats, bit for bit. Materials stay merged (one draw call per
+// chunk). Index order puts a tile's large triangles last, draw order first
+// (NearFieldScene::drawOrder).
+using ChunkKey = std::tuple<int64_t, int, int64_t, int64_t>;
 
 }  // namespace
 
@@ -84,9 +85,7 @@ NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk) {
         ++tileId;
         const osg::Vec3d tt = xf->getMatrix().getTrans();
         const glm::dvec3 tileOrigin(tt.x(), tt.y(), tt.z());
-        int64_t geomIndex = 0;
         for (osg::Geometry* g : tileGeometries(*xf)) {
-            ++geomIndex;
             auto* verts = dynamic_cast<osg::Vec3Array*>(g->getVertexArray());
             auto* colors = dynamic_cast<osg::Vec4ubArray*>(g->getColorArray());
             auto* de = dynamic_cast<osg::DrawElements*>(g->getPrimitiveSet(0));
@@ -111,7 +110,7 @@ NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk) {
                     }
                     glm::dvec3 world = tileOrigin + glm::dvec3(m[3]);
                     int64_t cx = int64_t(std::floor(world.x / chunk)), cy = int64_t(std::floor(world.y / chunk));
-                    ChunkBuild& cb = chunkFor({tileId, geomIndex, 1, cx, cy}, tileOrigin);
+                    ChunkBuild& cb = chunkFor({tileId, 0, cx, cy}, tileOrigin);
                     TreeBatch& tb = cb.trees[g];
                     tb.source = g;
                     for (int c = 0; c < 4; ++c) tb.cols[c].push_back((*cols[c])[unsigned(k)]);
@@ -137,7 +136,7 @@ NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk) {
                 glm::dvec3 cen = tileOrigin + glm::dvec3((a.x() + b.x() + c.x()) / 3.0, (a.y() + b.y() + c.y()) / 3.0, 0.0);
                 bool large = std::max(bb.xMax() - bb.xMin(), bb.yMax() - bb.yMin()) > chunk;
                 int64_t cx = int64_t(std::floor(cen.x / chunk)), cy = int64_t(std::floor(cen.y / chunk));
-                tris.push_back({large ? ChunkKey{tileId, geomIndex, 0, 0, 0} : ChunkKey{tileId, geomIndex, 1, cx, cy}, t});
+                tris.push_back({large ? ChunkKey{tileId, 1, 0, 0} : ChunkKey{tileId, 0, cx, cy}, t});
             }
             std::stable_sort(tris.begin(), tris.end(),
                              [](const auto& x, const auto& y) { return x.first < y.first; });
@@ -166,6 +165,9 @@ NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk) {
             }
         }
     }
+    // Draw order: unknown nodes, then per tile its large triangles, then its squares.
+    std::vector<std::tuple<int64_t, int, uint32_t>> drawKeys;
+    for (uint32_t i = 0; i < out.chunks.size(); ++i) drawKeys.push_back({-1, 0, i});
     // Materialise the chunks as nodes.
     for (auto& [key, cb] : chunks) {
         if (cb.triangles == 0) continue;
@@ -220,8 +222,11 @@ NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk) {
         o.triangles = cb.triangles;
         out.triangles += cb.triangles;
         out.objects.push_back(o);
+        drawKeys.push_back({std::get<0>(key), std::get<1>(key) == 1 ? 0 : 1, uint32_t(out.chunks.size())});
         out.chunks.push_back(xf);
     }
+    std::stable_sort(drawKeys.begin(), drawKeys.end());
+    for (const auto& k : drawKeys) out.drawOrder.push_back(std::get<2>(k));
     return out;
 }
 

@@ -176,7 +176,7 @@ public:
         _root = smallFeatureCulling();
         if (nf.rootState) _root->setStateSet(nf.rootState.get());
         const double nearD = ctx.options.fixedNearDistance();
-        for (size_t i = 0; i < nf.chunks.size(); ++i) {
+        for (uint32_t i : nf.drawOrder) {  // full's order: level 0 draws as full does
             osg::Geode* geode = chunkGeode(nf.chunks[i].get());
             if (!geode) {
                 _root->addChild(nf.chunks[i].get());

@@ -42,7 +42,7 @@ osg::Group* ModeContext::chunkedCity() {
         _chunked = new osg::Group;
         _chunked->setName("vista.chunked_city");
         if (nf.rootState) _chunked->setStateSet(nf.rootState.get());
-        for (const auto& c : nf.chunks) _chunked->addChild(c.get());
+        for (uint32_t i : nf.drawOrder) _chunked->addChild(nf.chunks[i].get());
     }
     return _chunked.get();
 }
