@@ -44,6 +44,13 @@ struct ChunkBuild {
 // (NearFieldScene::drawOrder).
 using ChunkKey = std::tuple<int64_t, int, int64_t, int64_t>;
 
+// The bound of an instanced tree geometry is its instances' box alone (OSG
+// would add the prototype's box around the tile origin, far from the chunk,
+// and cull almost nothing).
+struct InstancesBound : public osg::Drawable::ComputeBoundingBoxCallback {
+    osg::BoundingBox computeBound(const osg::Drawable& d) const override { return d.getInitialBound(); }
+};
+
 }  // namespace
 
 NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk) {
@@ -168,6 +175,7 @@ NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk) {
     // Draw order: unknown nodes, then per tile its large triangles, then its squares.
     std::vector<std::tuple<int64_t, int, uint32_t>> drawKeys;
     for (uint32_t i = 0; i < out.chunks.size(); ++i) drawKeys.push_back({-1, 0, i});
+    osg::ref_ptr<InstancesBound> instancesBound = new InstancesBound;
     // Materialise the chunks as nodes.
     for (auto& [key, cb] : chunks) {
         if (cb.triangles == 0) continue;
@@ -209,6 +217,7 @@ NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk) {
                 for (unsigned corner = 0; corner < 8; ++corner) bb.expandBy(pb.corner(corner) * m);
             }
             g->setInitialBound(bb);
+            g->setComputeBoundingBoxCallback(instancesBound.get());
             g->setStateSet(src->getStateSet());
             geode->addDrawable(g.get());
         }

@@ -127,6 +127,7 @@ public:
             g->setVertexAttribArray(kInstanceAttrib0 + c, const_cast<osg::Array*>(tree.getVertexAttribArray(kInstanceAttrib0 + c)),
                                     osg::Array::BIND_PER_VERTEX);
         g->setInitialBound(tree.getInitialBound());
+        g->setComputeBoundingBoxCallback(const_cast<osg::Drawable::ComputeBoundingBoxCallback*>(tree.getComputeBoundingBoxCallback()));
         g->setStateSet(const_cast<osg::StateSet*>(tree.getStateSet()));
         return g;
     }
