@@ -2,13 +2,15 @@
 // field" in one command. Runs the bench (runBenchmark, modes interleaved per
 // frame in one process) on consecutive samples of one car walkthrough (30 fps
 // spacing, so the panoramic cache sees real frame-to-frame coherence) for:
-//   modes640 / modes320  full, near, raycast, osgimpostor, hybrid (Figs 4.8, 4.10)
+//   modes640 / modes320  full, near, raycast, osgimpostor, osglod, hybrid (Figs 4.8, 4.10)
 //   near                 hybrid at near = 25, 50, 100, 200, 400 m and auto (Fig 4.9)
 //   budget, grid, cache  pixel budgets, horizon grid resolutions, cache on/off
 // and writes OUT/far_field.md (tables: Table 4.1 layout, frame times, speedups,
 // PSNR vs frame time with the Pareto front), OUT/far_field.json, and plots
 // OUT/fig_4_9_near.png, OUT/accuracy_vs_time.png (+ each run's bench output
-// in OUT/<run>/).
+// in OUT/<run>/). Every figure comes from the bench's own summaries
+// (ModeSummary: speedups are medians of same-frame ratios, as in summary.json);
+// nothing is recomputed here.
 //
 // Usage: far_field_sweep CITY.osgb OUT [--frames N] [--only a,b] [--budget B]
 // Needs an X display (xvfb-run -a).
@@ -114,7 +116,7 @@ int main(int argc, char** argv) {
         r.label = std::to_string(res) + "x" + std::to_string(res * 3 / 4);
         r.width = res;
         r.height = res * 3 / 4;
-        r.modes = {"full", "near", "raycast", "osgimpostor", "hybrid"};
+        r.modes = {"full", "near", "raycast", "osgimpostor", "osglod", "hybrid"};
         r.options = base;
         add(r);
     }
@@ -213,6 +215,8 @@ int main(int argc, char** argv) {
                               {"speedup_vs_full_median_of_ratios", speedup(a)}};
         }
         jr["hybrid_speedup_vs_full_median_of_ratios"] = speedup(h);
+        jr["path_motion"] = {{"metres_per_frame_median", r->motion.metresMedian},
+                             {"degrees_per_frame_median", r->motion.degreesMedian}};
         const char* names[5] = {"ray_hit", "ray_miss", "cache", "horizon_culled", "covered"};
         for (int k = 0; k < 5; ++k) {
             const PixelClassSummary& c = *pixelRows(h, k);
