@@ -354,7 +354,7 @@ int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path,
         } else {
             Camera fromOsg;
             double zf = 0;
-            if (cameraFromOsg(cam->getViewMatrix(), toOsg(c.projection(0.0)), c.width, c.height, fromOsg, zf)) {
+            if (cameraFromOsg(cam->getViewMatrix(), toOsg(c.projection(0.0)), c.width, c.height, fromOsg, zf)) {  // the pose
                 c.eye = fromOsg.eye;
                 c.heading = fromOsg.heading;
                 c.pitch = fromOsg.pitch;

@@ -15,6 +15,7 @@
 #include <osg/Geode>
 #include <osg/Geometry>
 #include <osg/MatrixTransform>
+#include <glm/gtc/type_ptr.hpp>
 #include <nlohmann/json.hpp>
 
 #include "citygen/lighting.h"
@@ -23,6 +24,7 @@
 #include "runtime/scene/city_file.h"
 #include "runtime/scene/scene_graph.h"
 #include "runtime/engine/metrics.h"
+#include "nodes/far_field_node.h"
 #include "nodes/render/offscreen.h"
 #include "runtime/scene/paths.h"
 #include "runtime/engine/ray_scene.h"
@@ -460,6 +462,28 @@ TEST(OsgImpostor, SpritesOnlyBeyondTheThreshold) {
     EXPECT_LT(beyond.psnrVsFull, kPsnrCapDb) << "the sprite made from the first viewpoint is not the geometry";
     EXPECT_GT(beyond.psnrVsFull, 20.0) << "the sprite shows the far tile";
     std::printf("osgimpostor with one sprite vs full: %.2f dB\n", beyond.psnrVsFull);
+}
+
+// The viewer derives the camera of its modes' frame hook from OSG's matrices.
+TEST(ViewCamera, PoseFromOsgMatricesRoundTrips) {
+    Camera c = testCamera(320, 240);
+    c.eye = kWorld + glm::dvec3(12.5, -40.25, 31.0);
+    c.heading = 2.1;
+    c.pitch = -0.3;
+    c.roll = 0.05;
+    for (double zFar : {0.0, 1.0e5}) {
+        Camera back;
+        double zf = -1;
+        ASSERT_TRUE(cameraFromOsg(osg::Matrixd(glm::value_ptr(c.view())), osg::Matrixd(glm::value_ptr(c.projection(zFar))),
+                                  c.width, c.height, back, zf))
+            << zFar;
+        EXPECT_NEAR(glm::length(back.eye - c.eye), 0.0, 1e-6) << zFar;
+        EXPECT_NEAR(back.heading, c.heading, 1e-9) << zFar;
+        EXPECT_NEAR(back.pitch, c.pitch, 1e-9) << zFar;
+        EXPECT_NEAR(back.roll, c.roll, 1e-9) << zFar;
+        EXPECT_NEAR(back.fovY, c.fovY, 1e-9) << zFar;
+        EXPECT_NEAR(zf, zFar, 1e-3 * zFar) << zFar;
+    }
 }
 
 TEST(Bench, SupersampledReferenceIsCloserToItselfThanAliasedFrames) {
