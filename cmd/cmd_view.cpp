@@ -62,6 +62,7 @@ void declareFlags(CLI::App& app, ViewArgs& a) {
     a.modeFlags.budget = "20000";
     app.add_option("city", a.city, "city scene file (.osgb), or a baked file from 'vista bake' (adds the impostor mode)")->required();
     addPathFlags(app, a.path, true);
+    app.get_option("--seed")->description("play back the path of this seed (key 5); default 0 = none, start where seed 1's path starts");
     app.add_option("--size", a.size, "window size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 1280x720)");
     app.add_option("--fov", a.fov, "vertical field of view in degrees, (1, 179) (default 60)");
     app.add_option("--mode", a.mode, "start in this render mode: " + renderModeNames() + " (default full)");
