@@ -19,6 +19,7 @@
 #include "nodes/near_far_split.h"
 #include "runtime/scene/city_file.h"
 #include "runtime/scene/scene_graph.h"
+#include "nodes/near_field_chunks.h"
 #include "runtime/engine/ray_scene.h"
 
 namespace vista {
