@@ -77,8 +77,8 @@ struct ModeContext {
     // shared by full, near, osglod and hybrid; its cost in chunkingMs().
     const NearFieldScene& nearField();
     double chunkingMs() const { return _chunkingMs; }
-    // Every chunk of nearField() under one group with the city's root state:
-    // the chunked full city (full and near draw it).
+    // Every chunk of nearField(), in its drawOrder, under one group with the
+    // city's root state: the chunked full city (full and near draw it).
     osg::Group* chunkedCity();
 
 private:
