@@ -10,7 +10,7 @@
 // frame times (median over --frames renders from the centre), covered pixels
 // (pixels differing from an empty render) and the point count.
 // Usage: xvfb-run -a vista_bake_report --cell C --baked A.osgb [--baked B.osgb ...]
-//        [--label NAME ...] [--frames 20] [--ssaa 4] [--json out.json]
+//        [--label NAME ...] [--frames 20] [--ssaa 4] [--size 640x480] [--json out.json]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -30,6 +30,7 @@
 #include "foundation/atomic_file.h"
 #include "foundation/units.h"
 #include "cmd/cli.h"
+#include "cmd/options.h"
 #include "runtime/engine/metrics.h"
 #include "nodes/render/offscreen.h"
 
@@ -69,8 +70,9 @@ int main(int argc, char** argv) {
     std::vector<std::string> baked, labels;
     int cell = -1, frames = 20, ssaa = 4, width = 640, height = 480;
     double fov = 60;
-    std::string jsonOut;
+    std::string jsonOut, size = "640x480";
     app.add_option("--baked", baked, "baked files (same city)")->required();
+    app.add_option("--size", size, "image size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 640x480)");
     app.add_option("--label", labels, "a label per baked file");
     app.add_option("--cell", cell, "view cell id")->required();
     app.add_option("--frames", frames, "timed renders per mode");
@@ -79,6 +81,10 @@ int main(int argc, char** argv) {
     app.add_option("--json", jsonOut, "also write the results as JSON");
     const int rc = parseOrExit(app, argc, argv);
     if (rc >= 0) return rc;
+    auto wh = parseImageSize(size);
+    if (!wh) return reportBadInput("vista_bake_report", wh.status());
+    width = wh->width;
+    height = wh->height;
     auto r1 = OffscreenRenderer::create(width, height);
     if (!r1) return reportBadInput("vista_bake_report", r1.status());
     auto rs = OffscreenRenderer::create(width * ssaa, height * ssaa);

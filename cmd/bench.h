@@ -1,30 +1,26 @@
-// The bench: renders a walkthrough path in several modes side by side
-// (interleaved frame by frame in one process) and writes frames.csv,
-// summary.json, plots and difference images.
+// The bench: renders a walkthrough path in several render modes side by side
+// (interleaved frame by frame in one process, one GL context), scores every
+// frame against a reference and writes frames.csv, summary.json, plots and
+// difference images (bench_output.cpp). Modes come from the registry
+// (nodes/render/render_mode.h); nothing here is specific to one mode.
 //
-// Modes are created through makeMode() from a table (kModeTable in
-// bench.cpp). Other modules add theirs there: `hybrid` (runtime/mode_hybrid.h)
-// and `impostor` (bake/mode_impostor.h, registered by the `vista` tool's main).
-//
+// Steps of runBenchmark(): set up (renderer, ray scene if a mode needs it,
+// the modes; every set-up cost timed), warm up (one frame per mode,
+// discarded, then reset), the frame loop, summarise (summariseMode), write.
 // Reference: every frame is compared with the `full` image of the same
 // camera (or, with referenceSsaa = k > 1, with the average of k x k
 // sub-pixel-jittered `full` renders = a box-filtered supersampled image).
 // Metrics: luma PSNR (metrics.h, capped at 99 dB for identical images) and
 // the fraction of pixels differing by more than diffThreshold.
-// Timing: frame_ms per mode as reported by the mode (glFinish included);
-// one warm-up frame per mode is rendered and discarded before frame 0.
-// summary.json per mode: frame-time, quality and triangle statistics, plus
-// `pixels` (Table 4.1 classes as min/mean/max percent of the frame and mean
-// count; only for modes that classify pixels: hybrid, raycast, impostor),
-// `stages_ms` (mean ms per stage over the frames it ran in) and `stage_runs`;
-// top level `options` records the BenchOptions used (docs/user-guide.md).
+// Timing: frame_ms per mode as reported by the mode (glFinish included).
+// Speedups: the median over frames of same-frame ratios base_ms[f] /
+// mode_ms[f] (never a ratio of medians), against `full` always and against
+// `near` and `raycast` when they ran (docs/user-guide.md).
 // Errors: bad configuration or setup failures (no display, unknown mode,
 // Embree failure) return a Status; nothing throws.
 #pragma once
 #include <cstdint>
-#include <functional>
 #include <map>
-#include <memory>
 #include <string>
 #include <vector>
 
@@ -34,29 +30,6 @@
 
 namespace vista {
 
-// ---- Mode factory -----------------------------------------------------------
-using ModeFactory = Result<std::unique_ptr<BenchMode>> (*)(BenchContext& ctx);
-struct ModeInfo {
-    const char* name;
-    const char* summary;
-    bool needsRays;     // the bench builds ctx.rays (RayScene) before creating it
-    ModeFactory make;
-};
-// All registered modes, in display order.
-const std::vector<ModeInfo>& modeTable();
-// Adds a mode (or replaces one of the same name). Call at start-up, before
-// any bench runs; not thread-safe. Used for modes of libraries that depend on
-// runtime, such as the bake's `impostor`.
-void registerBenchMode(const ModeInfo& mode);
-std::vector<std::string> availableModes();
-const ModeInfo* findMode(const std::string& name);
-// Creates a mode. Unknown name -> error listing the available modes. The
-// caller must have built ctx.rays when the mode needs rays.
-Result<std::unique_ptr<BenchMode>> makeMode(const std::string& name, BenchContext& ctx);
-// Parses "full,near,raycast" (comma-separated, no duplicates, known names).
-Result<std::vector<std::string>> parseModeList(const std::string& list);
-
-// ---- The bench loop ---------------------------------------------------------
 struct BenchConfig {
     int width = 640, height = 480;
     int frames = 120;
@@ -69,23 +42,15 @@ struct BenchConfig {
     int worstFrames = 2;           // difference images for the N worst frames per mode
     bool warmup = true;
     bool quiet = false;            // no progress on stderr
-    BenchOptions options;
+    ModeOptions options;
     std::string command;           // recorded in summary.json
     std::string cityLabel;         // recorded in summary.json
+    double loadMs = -1;            // city load time measured by the caller (set-up "load"); < 0 = not reported
+    double runUpS = -1;            // the path's run-up (PathOptions::runUp) when the bench made it; < 0 = unknown
 };
-// Also checks the far-field options: nearDistance < 0 (auto) or 1 .. 100000
-// metres; pixelBudget < 0 (unlimited) or 0 .. kMaxPixelBudget; horizonGrid
-// 1 .. 8192; threads 0 .. 1024. Messages name the command-line flag.
+// Checks sizes, frame count, fov, reference, modes and the mode options
+// (options.h ranges); messages name the command-line flag.
 Status validateBenchConfig(const BenchConfig& c);
-
-// Command-line values of the far-field options (messages name the flag, the
-// value and the allowed range):
-//   --near M|auto      -> metres in 1 .. 100000, or -1 for "auto"
-//   --budget N|unlimited -> 0 .. kMaxPixelBudget, or -1 (also "-1") for unlimited
-constexpr double kMinNearDistance = 1.0, kMaxNearDistance = 100000.0;
-constexpr int64_t kMaxPixelBudget = 1000000000;
-Result<double> parseNearDistance(const std::string& s);
-Result<int64_t> parsePixelBudget(const std::string& s);
 
 struct BenchFrameRecord {
     int frame = 0;
@@ -105,30 +70,52 @@ struct PixelClassSummary {
 struct ModeSummary {
     std::string mode;
     double frameMsMedian = 0, frameMsP95 = 0, frameMsMean = 0;
-    double speedupVsFullMedian = 0;
+    // Base mode -> median over frames f of base_ms[f] / mode_ms[f].
+    std::map<std::string, double> speedupMedianOfRatios;
     double psnrDbMedian = 0, psnrDbMin = 0;
     double diffFractionMedian = 0;
     double trianglesMedian = 0, drawCallsMedian = 0, cullMsMedian = 0, drawMsMedian = 0;
+    double raysMedian = 0;  // FrameStats::raysCast per frame
     // Pixel classes (thesis Table 4.1); hasPixels = false when the mode
-    // classified no pixel in any frame (full, near, osgimpostor).
+    // classified no pixel in any frame (full, near, osgimpostor, osglod).
     bool hasPixels = false;
     PixelClassSummary covered, horizonCulled, cache, rayHit, rayMiss;
     // Per stage: mean ms over the frames in which it ran, and in how many it ran.
     std::map<std::string, double> stagesMsMean;
     std::map<std::string, int> stageRuns;
+    std::map<std::string, int> noteCounts;  // frame notes and in how many frames each appeared
+    SetupTimes setupMs;                     // load, bvh, then the mode's own
 };
 
 struct BenchResult {
-    std::vector<BenchFrameRecord> frames;
-    std::vector<ModeSummary> modes;
+    std::vector<BenchFrameRecord> frames;  // frame-major: all modes of frame 0, then frame 1, ...
+    std::vector<ModeSummary> modes;        // `full` first
     std::string glRenderer;
+    PathMotion motion;                     // of the rendered frames
+    double loadAvgStart = -1, loadAvgEnd = -1;
 };
 
-// Runs the bench. `city` may be null (synthetic scene: then ray modes fail
-// with an error); `scene` is the scene graph rendered by the GL modes.
+// Runs the bench. `city` may be null (hand-built graph: then ray modes fail
+// with an error); `scene` is the scene graph the GL modes draw.
 Result<BenchResult> runBenchmark(const SceneModel* city, osg::Node* scene, const Path& path, const BenchConfig& config);
 
-// Median / percentile (linear interpolation) of a copy of v; NaN if empty.
+// Median over frames of baseMs[f] / modeMs[f]; frames where either time is
+// not positive are skipped; NaN when none is left. Sizes must match.
+double medianOfSameFrameRatios(const std::vector<double>& baseMs, const std::vector<double>& modeMs);
+// Frame times of one mode in frame order (empty if it did not run).
+std::vector<double> modeFrameTimes(const BenchResult& r, const std::string& mode);
+// The summary of one mode over r.frames (pixels = width * height); speedups
+// against every mode of `bases` that ran (itself included).
+ModeSummary summariseMode(const BenchResult& r, const std::string& mode, const std::vector<std::string>& bases,
+                          double pixels);
+// The bases of speedups in summaries: full, near, raycast.
+const std::vector<std::string>& speedupBases();
+
+// frames.csv, summary.json, frame_time.png, quality.png (bench_output.cpp).
+Status writeBenchOutputs(const BenchResult& r, const BenchConfig& cfg, const SceneModel* city, const Path& path);
+
+// Median / percentile (linear interpolation) of a copy of v, non-finite
+// values ignored; NaN if none is left.
 double percentile(std::vector<double> v, double p);
 
 }  // namespace vista

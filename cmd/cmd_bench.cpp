@@ -1,66 +1,60 @@
 // vista bench: headless walkthrough, modes side by side -> frames.csv,
 // summary.json, plots, difference images. Also the size sweep (--sweep).
-#include <cmath>
+// Every mode comes from the registry (nodes/render/render_mode.h); the
+// options are parsed by cmd/options.h.
 #include <cstdio>
-#include <unistd.h>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
+#include <map>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
 #include "cmd/bench.h"
-#include "runtime/scene/city_file.h"
-#include "runtime/scene/scene_graph.h"
 #include "cmd/cli.h"
 #include "cmd/commands.h"
-#include "runtime/scene/paths.h"
+#include "cmd/options.h"
 #include "cmd/plot.h"
+#include "foundation/atomic_file.h"
+#include "foundation/timing.h"
+#include "runtime/scene/city_file.h"
+#include "runtime/scene/scene_graph.h"
 
 namespace vista {
 
 namespace {
 
-Status parseSize(const std::string& s, int& w, int& h) {
-    int a = 0, b = 0;
-    char x = 0, extra = 0;
-    if (std::sscanf(s.c_str(), "%d%c%d%c", &a, &x, &b, &extra) != 3 || (x != 'x' && x != 'X'))
-        return Status::error("--size '" + s + "': expected WIDTHxHEIGHT, e.g. 640x480");
-    if (a < 1 || b < 1 || a > 8192 || b > 8192)
-        return Status::error("--size " + s + " out of range 1x1 .. 8192x8192");
-    w = a;
-    h = b;
-    return Status::ok();
-}
+namespace fs = std::filesystem;
+const char* const kCmd = "vista bench";
 
-Status parseReference(const std::string& s, int& k) {
-    if (s == "full") { k = 0; return Status::ok(); }
-    int v = 0;
-    char extra = 0;
-    if (std::sscanf(s.c_str(), "ssaa:%d%c", &v, &extra) == 1 && v >= 2 && v <= 8) { k = v; return Status::ok(); }
-    return Status::error("--reference '" + s + "': expected 'full' or 'ssaa:K' with K in 2..8");
-}
+struct BenchArgs {
+    std::string city, size = "640x480", modes = "full,near", out, reference = "full", fov = "60", sweep;
+    bool quiet = false;
+    PathFlags path;
+    ModeFlags mode;
+    BenchConfig cfg;
+    PathOptions pathOptions;
+};
 
-Result<std::vector<int>> parseSweep(const std::string& s) {
-    const std::string prefix = "sizes=";
-    if (s.rfind(prefix, 0) != 0) return Status::error("--sweep '" + s + "': expected sizes=S1,S2,... (metres)");
-    std::vector<int> out;
-    std::stringstream ss(s.substr(prefix.size()));
-    std::string item;
-    while (std::getline(ss, item, ',')) {
-        char* end = nullptr;
-        long v = std::strtol(item.c_str(), &end, 10);
-        if (item.empty() || *end || v < 100 || v > 16000)
-            return Status::error("--sweep: size '" + item + "' out of range 100 .. 16000 metres");
-        out.push_back(int(v));
-    }
-    if (out.empty()) return Status::error("--sweep '" + s + "': no sizes");
-    return out;
+void declareFlags(CLI::App& app, BenchArgs& a) {
+    std::string modeHelp = "comma-separated modes (default full,near); available:";
+    for (const auto& m : renderModes()) modeHelp += std::string("\n    ") + m.name + ": " + m.summary;
+    app.add_option("city", a.city, "city scene file (.osgb); not needed with --sweep");
+    addPathFlags(app, a.path, true);
+    app.add_option("--frames", a.cfg.frames, "frames rendered, spread evenly over the whole path (default 120)");
+    app.add_option("--size", a.size, "image size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 640x480)");
+    app.add_option("--modes", a.modes, modeHelp);
+    addModeFlags(app, a.mode);
+    app.add_option("--fov", a.fov, "vertical field of view in degrees, (1, 179) (default 60)");
+    app.add_option("--reference", a.reference, "reference for the quality metrics: full (default) or ssaa:K (K x K supersampled full)");
+    app.add_option("--diff-threshold", a.cfg.diffThreshold, "per-channel difference counted as a differing pixel (default 8)");
+    app.add_option("--worst", a.cfg.worstFrames, "difference images for the N worst frames per mode (default 2)");
+    app.add_option("--out", a.out, "output directory (created if missing)")->required();
+    app.add_option("--sweep", a.sweep, "scaling sweep: sizes=500,1000,2000 generates a city per size (seed --seed) and benches each");
+    app.add_flag("-q,--quiet", a.quiet, "no progress on stderr");
 }
 
 std::string commandLine(int argc, char** argv) {
-    std::string s = "vista bench";
+    std::string s = kCmd;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
         s += " " + (a.find(' ') != std::string::npos ? "'" + a + "'" : a);
@@ -68,12 +62,149 @@ std::string commandLine(int argc, char** argv) {
     return s;
 }
 
+// Turns the parsed flags into the bench configuration; errors name the flag.
+Status configure(BenchArgs& a) {
+    auto size = parseImageSize(a.size);
+    if (!size) return size.status();
+    a.cfg.width = size->width;
+    a.cfg.height = size->height;
+    auto fov = parseFov(a.fov);
+    if (!fov) return fov.status();
+    a.cfg.fovYDeg = fov.value();
+    auto ref = parseReference(a.reference);
+    if (!ref) return ref.status();
+    a.cfg.referenceSsaa = ref.value();
+    VISTA_RETURN_IF_ERROR(parseModeFlags(a.mode, a.cfg.options));
+    auto modes = parseModeList(a.modes);
+    if (!modes) return modes.status();
+    a.cfg.modes = modes.value();
+    for (const auto& m : a.cfg.modes)
+        if (findRenderMode(m)->needsBaked && a.cfg.options.bakedFile.empty())
+            return Status::error("mode " + m + " needs --baked city.baked.osgb (from 'vista bake')");
+    a.cfg.quiet = a.quiet;
+    VISTA_RETURN_IF_ERROR(validateBenchConfig(a.cfg));
+    auto po = parsePathFlags(a.path);
+    if (!po) return po.status();
+    a.pathOptions = po.value();
+    if (a.sweep.empty()) {
+        if (a.city.empty()) return Status::error("missing the city file argument (or use --sweep)");
+        if (!fs::exists(a.city)) return Status::error("city file '" + a.city + "' does not exist");
+    }
+    std::error_code ec;
+    fs::create_directories(a.out, ec);
+    if (ec || !fs::is_directory(a.out)) return Status::error("--out '" + a.out + "': cannot create directory");
+    return Status::ok();
+}
+
 void printTable(const BenchResult& r) {
     std::printf("%-12s %10s %10s %9s %10s %10s %12s\n", "mode", "median_ms", "p95_ms", "speedup", "psnr_med", "psnr_min",
                 "triangles");
     for (const auto& m : r.modes)
         std::printf("%-12s %10.2f %10.2f %9.2f %10.2f %10.2f %12.0f\n", m.mode.c_str(), m.frameMsMedian, m.frameMsP95,
-                    m.speedupVsFullMedian, m.psnrDbMedian, m.psnrDbMin, m.trianglesMedian);
+                    m.speedupMedianOfRatios.at("full"), m.psnrDbMedian, m.psnrDbMin, m.trianglesMedian);
+}
+
+// One bench of one city file into one directory: load, path, run, print.
+int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string& outDir, BenchResult* res) {
+    Stopwatch sw;
+    auto city = loadCityFile(cityFile);
+    if (!city) return reportBadInput(kCmd, city.status());
+    BenchConfig cfg = a.cfg;
+    cfg.loadMs = sw.ms();
+    auto path = walkthroughPath(a.path, a.pathOptions, city.value());
+    if (!path) return reportBadInput(kCmd, path.status());
+    cfg.runUpS = a.path.file.empty() ? a.pathOptions.runUp : -1.0;
+    cfg.outDir = outDir;
+    cfg.cityLabel = fs::path(cityFile).filename().string();
+    auto r = runBenchmark(&city.value(), sceneRoot(city.value()), path.value(), cfg);
+    if (!r) {
+        std::fprintf(stderr, "%s: %s\n", kCmd, r.status().message().c_str());
+        return 1;
+    }
+    if (!a.quiet) printTable(r.value());
+    if (res) *res = std::move(r.value());
+    return 0;
+}
+
+// `vista gen --size S --seed N` into `cityFile`.
+int generateSweepCity(const BenchArgs& a, int size, const std::string& cityFile) {
+    const std::string sz = std::to_string(size), sd = std::to_string(a.path.seed);
+    std::vector<std::string> args = {"vista gen", "--size", sz, "--seed", sd, "-q", "-o", cityFile};
+    std::vector<char*> av;
+    for (auto& s : args) av.push_back(s.data());
+    av.push_back(nullptr);
+    if (!a.quiet) std::fprintf(stderr, "sweep: generating %d m city (seed %s)\n", size, sd.c_str());
+    const int rc = runGen(int(args.size()), av.data());
+    if (rc != 0) std::fprintf(stderr, "%s --sweep: `vista gen --size %d` failed (exit %d)\n", kCmd, size, rc);
+    return rc;
+}
+
+struct SweepTable {
+    nlohmann::json rows = nlohmann::json::array();
+    std::map<std::string, PlotSeries> series;
+    std::string markdown =
+        "| city size (m) | triangles | mode | median ms | p95 ms | speedup vs full (median of same-frame ratios) | "
+        "PSNR median (dB) | triangles drawn (median) |\n|---|---|---|---|---|---|---|---|\n";
+    void add(int size, double tris, const ModeSummary& m) {
+        const double speedup = m.speedupMedianOfRatios.at("full");
+        rows.push_back({{"size_m", size}, {"city_triangles", tris}, {"mode", m.mode}, {"frame_ms_median", m.frameMsMedian},
+                        {"frame_ms_p95", m.frameMsP95}, {"speedup_vs_full_median_of_ratios", speedup},
+                        {"psnr_db_median", m.psnrDbMedian}, {"triangles_median", m.trianglesMedian}});
+        char buf[256];
+        std::snprintf(buf, sizeof(buf), "| %d | %.0f | %s | %.1f | %.1f | %.2f | %.1f | %.0f |\n", size, tris, m.mode.c_str(),
+                      m.frameMsMedian, m.frameMsP95, speedup, m.psnrDbMedian, m.trianglesMedian);
+        markdown += buf;
+        PlotSeries& s = series[m.mode];
+        s.label = m.mode;
+        s.x.push_back(tris);
+        s.y.push_back(m.frameMsMedian);
+    }
+    Status write(const BenchArgs& a, const std::vector<std::string>& modes) {
+        PlotSpec ps;
+        ps.title = "Median frame time vs city triangles";
+        ps.xLabel = "city triangles";
+        ps.yLabel = "ms";
+        ps.logX = ps.logY = true;
+        for (size_t ci = 0; ci < modes.size(); ++ci) {  // same colours as the per-bench plots
+            auto it = series.find(modes[ci]);
+            if (it == series.end()) continue;
+            it->second.color = plotColor(ci);
+            it->second.points = true;
+            ps.series.push_back(it->second);
+        }
+        const nlohmann::json j = {{"command", a.cfg.command}, {"rows", rows}};
+        VISTA_RETURN_IF_ERROR(writeFileAtomic((fs::path(a.out) / "sweep.json").string(), j.dump(2) + "\n"));
+        VISTA_RETURN_IF_ERROR(writeFileAtomic((fs::path(a.out) / "sweep.md").string(), markdown));
+        return writePng(renderPlot(ps), (fs::path(a.out) / "sweep.png").string());
+    }
+};
+
+// --sweep sizes=...: a generated city per size, benched into out/size_S.
+int runSweep(const BenchArgs& a) {
+    auto sizes = parseSweep(a.sweep);
+    if (!sizes) return reportBadInput(kCmd, sizes.status());
+    if (!a.path.file.empty()) return reportBadInput(kCmd, Status::error("--sweep makes its own paths: do not give --path"));
+    SweepTable table;
+    for (int size : sizes.value()) {
+        const std::string cityFile = (fs::path(a.out) / ("city_" + std::to_string(size) + ".osgb")).string();
+        if (int rc = generateSweepCity(a, size, cityFile); rc != 0) return rc;
+        BenchResult r;
+        if (int rc = benchCity(a, cityFile, (fs::path(a.out) / ("size_" + std::to_string(size))).string(), &r); rc != 0)
+            return rc;
+        auto lc = loadCityFile(cityFile);
+        for (const auto& m : r.modes) table.add(size, lc ? double(lc->triangles) : 0.0, m);
+        std::error_code ec;
+        fs::remove(cityFile, ec);  // cities are large; regenerate from the command if needed
+    }
+    std::vector<std::string> order = a.cfg.modes;
+    order.erase(std::remove(order.begin(), order.end(), "full"), order.end());
+    order.insert(order.begin(), "full");
+    if (Status s = table.write(a, order); !s) {
+        std::fprintf(stderr, "%s: %s\n", kCmd, s.message().c_str());
+        return 1;
+    }
+    std::printf("%s", table.markdown.c_str());
+    return 0;
 }
 
 }  // namespace
@@ -81,188 +212,13 @@ void printTable(const BenchResult& r) {
 int runBench(int argc, char** argv) {
     CLI::App app{"Headless walkthrough: render modes side by side (interleaved per frame), write frames.csv, "
                  "summary.json, plots and difference images.",
-                 "vista bench"};
-    std::string city, pathFile, sizeStr = "640x480", modesStr = "full,near", out, refStr = "full", kind = "car", sweep;
-    uint64_t seed = 1;
-    BenchConfig cfg;
-    double duration = 60.0;
-    std::string modeHelp = "comma-separated modes (default full,near); available:";
-    for (const auto& m : modeTable()) modeHelp += std::string("\n    ") + m.name + ": " + m.summary;
-    app.add_option("city", city, "city scene file (.osgb); not needed with --sweep");
-    auto* pathOpt = app.add_option("--path", pathFile, "walkthrough path CSV (from `vista path`)");
-    app.add_option("--seed", seed, "make the path from this seed instead of --path (default 1)")->excludes(pathOpt);
-    app.add_option("--kind", kind, "path kind when made from --seed: walk, car, fly (default car)");
-    app.add_option("--duration", duration, "path duration in seconds when made from --seed (default 60)");
-    app.add_option("--frames", cfg.frames, "frames rendered, spread evenly over the whole path (default 120)");
-    app.add_option("--size", sizeStr, "image size WIDTHxHEIGHT (default 640x480)");
-    app.add_option("--modes", modesStr, modeHelp);
-    std::string nearStr = "100", budgetStr = "unlimited";
-    bool noCache = false;
-    app.add_option("--near", nearStr,
-                   "near-field distance in metres, 1 .. 100000, or 'auto' (hybrid: adaptive split per frame; "
-                   "near/osgimpostor then use 100) (default 100)");
-    app.add_option("--budget", budgetStr,
-                   "hybrid: far-field rays per frame through the panoramic cache, 0 .. 1000000000, or "
-                   "'unlimited' / -1 = trace every far pixel, cache bypassed (default unlimited)");
-    app.add_option("--horizon-grid", cfg.options.horizonGrid,
-                   "hybrid: horizon height-grid resolution, cells per side, 1 .. 8192 (default 512)");
-    app.add_flag("--no-cache", noCache, "hybrid: panoramic image cache off (every far pixel traced)");
-    app.add_option("--baked", cfg.options.bakedFile, "impostor: the baked file of this city (from `vista bake`)");
-    app.add_option("--fov", cfg.fovYDeg, "vertical field of view in degrees (default 60)");
-    app.add_option("--reference", refStr, "reference for the quality metrics: full (default) or ssaa:K (K x K supersampled full)");
-    app.add_option("--diff-threshold", cfg.diffThreshold, "per-channel difference counted as a differing pixel (default 8)");
-    app.add_option("--worst", cfg.worstFrames, "difference images for the N worst frames per mode (default 2)");
-    app.add_option("--threads", cfg.options.threads, "worker threads for ray casting (0 = all cores)");
-    app.add_option("--out", out, "output directory (created if missing)")->required();
-    app.add_option("--sweep", sweep, "scaling sweep: sizes=500,1000,2000 generates a city per size (seed --seed) and benches each");
-    bool quiet = false;
-    app.add_flag("-q,--quiet", quiet, "no progress on stderr");
-    int rc = parseOrExit(app, argc, argv);
-    if (rc >= 0) return rc;
-
-    const std::string cmd = "vista bench";
-    cfg.quiet = quiet;
-    cfg.command = commandLine(argc, argv);
-    if (Status s = parseSize(sizeStr, cfg.width, cfg.height); !s) return reportBadInput(cmd, s);
-    if (Status s = parseReference(refStr, cfg.referenceSsaa); !s) return reportBadInput(cmd, s);
-    if (auto nd = parseNearDistance(nearStr); !nd) return reportBadInput(cmd, nd.status());
-    else cfg.options.nearDistance = nd.value();
-    if (auto pb = parsePixelBudget(budgetStr); !pb) return reportBadInput(cmd, pb.status());
-    else cfg.options.pixelBudget = pb.value();
-    cfg.options.cache = !noCache;
-    if (!cfg.options.bakedFile.empty() && access(cfg.options.bakedFile.c_str(), R_OK) != 0)
-        return reportBadInput(cmd, Status::error("--baked '" + cfg.options.bakedFile + "': cannot read the file"));
-    auto modes = parseModeList(modesStr);
-    if (!modes) return reportBadInput(cmd, modes.status());
-    cfg.modes = modes.value();
-    for (const auto& m : cfg.modes)
-        if (m == "impostor" && cfg.options.bakedFile.empty())
-            return reportBadInput(cmd, Status::error("mode impostor needs --baked city.baked.osgb (from 'vista bake')"));
-    if (Status s = validateBenchConfig(cfg); !s) return reportBadInput(cmd, s);
-    if (cfg.worstFrames < 0 || cfg.worstFrames > 100)
-        return reportBadInput(cmd, Status::error("--worst " + std::to_string(cfg.worstFrames) + " out of range 0 .. 100"));
-    auto k = parsePathKind(kind);
-    if (!k) return reportBadInput(cmd, Status::error("--kind: " + k.status().message()));
-    PathOptions po;
-    po.seed = seed;
-    po.kind = k.value();
-    po.duration = duration;
-    if (Status s = validatePathOptions(po); !s) return reportBadInput(cmd, s);
-    std::error_code ec;
-    std::filesystem::create_directories(out, ec);
-    if (ec || !std::filesystem::is_directory(out))
-        return reportBadInput(cmd, Status::error("--out '" + out + "': cannot create directory"));
-
-    // One bench of one city file into one directory.
-    auto benchOne = [&](const std::string& cityFile, const std::string& outDir, BenchResult* res) -> int {
-        Path path;
-        if (!pathFile.empty()) {
-            auto p = loadPathCsv(pathFile);
-            if (!p) return reportBadInput(cmd, p.status());
-            path = std::move(p.value());
-        }
-        auto c = loadCityFile(cityFile);
-        if (!c) return reportBadInput(cmd, c.status());
-        if (pathFile.empty()) {
-            auto p = generatePath(c->streets, c->params, po);
-            if (!p) return reportBadInput(cmd, p.status());
-            path = std::move(p.value());
-        }
-        BenchConfig cc = cfg;
-        cc.outDir = outDir;
-        cc.cityLabel = std::filesystem::path(cityFile).filename().string();
-        auto r = runBenchmark(&c.value(), sceneRoot(*c), path, cc);
-        if (!r) {
-            std::fprintf(stderr, "vista bench: %s\n", r.status().message().c_str());
-            return 1;
-        }
-        if (!quiet) printTable(r.value());
-        if (res) *res = std::move(r.value());
-        return 0;
-    };
-
-    if (sweep.empty()) {
-        if (city.empty()) return reportBadInput(cmd, Status::error("missing the city file argument (or use --sweep)"));
-        if (!std::filesystem::exists(city)) return reportBadInput(cmd, Status::error("city file '" + city + "' does not exist"));
-        return benchOne(city, out, nullptr);
-    }
-
-    auto sizes = parseSweep(sweep);
-    if (!sizes) return reportBadInput(cmd, sizes.status());
-    if (!pathFile.empty()) return reportBadInput(cmd, Status::error("--sweep makes its own paths: do not give --path"));
-    nlohmann::json rows = nlohmann::json::array();
-    std::map<std::string, PlotSeries> series;
-    std::string table = "| city size (m) | triangles | mode | median ms | p95 ms | speedup vs full | PSNR median (dB) | triangles drawn (median) |\n"
-                        "|---|---|---|---|---|---|---|---|\n";
-    for (int size : sizes.value()) {
-        std::string cityFile = (std::filesystem::path(out) / ("city_" + std::to_string(size) + ".osgb")).string();
-        std::string sz = std::to_string(size), sd = std::to_string(seed);
-        std::vector<std::string> args = {"vista gen", "--size", sz, "--seed", sd, "-q", "-o", cityFile};
-        std::vector<char*> av;
-        for (auto& a : args) av.push_back(a.data());
-        av.push_back(nullptr);
-        if (!quiet) std::fprintf(stderr, "sweep: generating %d m city (seed %s)\n", size, sd.c_str());
-        int grc = runGen(int(args.size()), av.data());
-        if (grc != 0) {
-            std::fprintf(stderr, "vista bench --sweep: `vista gen --size %d` failed (exit %d)\n", size, grc);
-            return grc;
-        }
-        BenchResult r;
-        int brc = benchOne(cityFile, (std::filesystem::path(out) / ("size_" + sz)).string(), &r);
-        if (brc != 0) return brc;
-        auto lc = loadCityFile(cityFile);
-        double tris = lc ? double(lc->triangles) : 0.0;
-        for (const auto& m : r.modes) {
-            rows.push_back({{"size_m", size}, {"city_triangles", tris}, {"mode", m.mode},
-                            {"frame_ms_median", m.frameMsMedian}, {"frame_ms_p95", m.frameMsP95},
-                            {"speedup_vs_full_median", m.speedupVsFullMedian}, {"psnr_db_median", m.psnrDbMedian},
-                            {"triangles_median", m.trianglesMedian}});
-            char buf[256];
-            std::snprintf(buf, sizeof(buf), "| %d | %.0f | %s | %.1f | %.1f | %.2f | %.1f | %.0f |\n", size, tris,
-                          m.mode.c_str(), m.frameMsMedian, m.frameMsP95, m.speedupVsFullMedian, m.psnrDbMedian,
-                          m.trianglesMedian);
-            table += buf;
-            auto& s = series[m.mode];
-            s.label = m.mode;
-            s.x.push_back(tris);
-            s.y.push_back(m.frameMsMedian);
-        }
-        std::filesystem::remove(cityFile, ec);  // cities are large; regenerate from the command if needed
-    }
-    PlotSpec ps;
-    ps.title = "Median frame time vs city triangles";
-    ps.xLabel = "city triangles";
-    ps.yLabel = "ms";
-    ps.logX = true;
-    ps.logY = true;
-    size_t ci = 0;
-    std::vector<std::string> order{"full"};  // same colours as the per-bench plots
-    for (const auto& m : cfg.modes)
-        if (m != "full") order.push_back(m);
-    for (const auto& name : order) {
-        auto it = series.find(name);
-        size_t colour = ci++;
-        if (it == series.end()) continue;
-        it->second.color = plotColor(colour);
-        it->second.points = true;
-        ps.series.push_back(it->second);
-    }
-    nlohmann::json j = {{"command", cfg.command}, {"rows", rows}};
-    for (const auto& [name, text] : {std::pair<std::string, std::string>{"sweep.json", j.dump(2) + "\n"}, {"sweep.md", table}}) {
-        std::string dst = (std::filesystem::path(out) / name).string(), tmp = dst + ".tmp";
-        std::ofstream(tmp, std::ios::binary | std::ios::trunc) << text;
-        std::filesystem::rename(tmp, dst, ec);
-        if (ec) {
-            std::fprintf(stderr, "vista bench: cannot write %s\n", dst.c_str());
-            return 1;
-        }
-    }
-    if (Status s = writePng(renderPlot(ps), (std::filesystem::path(out) / "sweep.png").string()); !s) {
-        std::fprintf(stderr, "vista bench: %s\n", s.message().c_str());
-        return 1;
-    }
-    std::printf("%s", table.c_str());
-    return 0;
+                 kCmd};
+    BenchArgs a;
+    declareFlags(app, a);
+    if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;
+    a.cfg.command = commandLine(argc, argv);
+    if (Status s = configure(a); !s) return reportBadInput(kCmd, s);
+    return a.sweep.empty() ? benchCity(a, a.city, a.out, nullptr) : runSweep(a);
 }
 
 }  // namespace vista

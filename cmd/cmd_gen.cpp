@@ -1,5 +1,4 @@
 // vista gen: params -> city.osgb (+ optional GeoJSON streets, glTF, stats).
-#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <optional>
@@ -9,6 +8,7 @@
 
 #include "citygen/generate.h"
 #include "foundation/atomic_file.h"
+#include "foundation/timing.h"
 #include "citygen/streets.h"
 #include "runtime/scene/city_file.h"
 #include "cmd/cli.h"
@@ -16,91 +16,83 @@
 
 namespace vista {
 
-int runGen(int argc, char** argv) {
-    CLI::App app("Generate a city (deterministic by seed) and write it as one .osgb scene file.", "vista gen");
+namespace {
+
+const char* const kCmd = "vista gen";
+
+struct GenArgs {
     std::string paramsFile, out, statsFile, osmFile, geojsonFile, gltfFile;
     std::optional<uint64_t> seed;
     std::optional<double> size;
     std::optional<int> detail, threads;
     bool quiet = false, listParams = false;
-    app.add_option("--params", paramsFile, "JSON parameter file (see docs/params.md; examples in data/)");
-    app.add_option("--seed", seed, "random seed (overrides the params file)");
-    app.add_option("--size", size, "side of the square city area in metres, 100..16000 (default 2000)");
-    app.add_option("--detail", detail, "facade detail 0..3 (0 = plain boxes, default 2)");
-    app.add_option("--threads", threads, "worker threads (0 = all; output never depends on it)");
-    app.add_option("--osm", osmFile, "take the streets from an OpenStreetMap extract (.osm/.osm.pbf, highway=* ways)");
-    app.add_option("--geojson", geojsonFile, "also write the street graph as GeoJSON");
-    app.add_option("--gltf", gltfFile, "also write the city as binary glTF 2.0 (.glb)");
-    app.add_option("--stats", statsFile, "write statistics (counts, timings, peak memory) as JSON");
-    auto* outOpt = app.add_option("-o,--output", out, "output scene file (.osgb)");
-    app.add_flag("--list-params", listParams, "print every parameter with unit, range and default (Markdown) and exit");
-    app.add_flag("-q,--quiet", quiet, "no progress on stderr");
-    int rc = parseOrExit(app, argc, argv);
-    if (rc >= 0) return rc;
-    const std::string cmd = "vista gen";
-    if (listParams) {
-        CityParams d;
-        auto defaults = nlohmann::json::parse(paramsToJson(d));
-        std::printf("| parameter | unit | range | default | meaning |\n|---|---|---|---|---|\n");
-        for (const auto& s : paramSpecs()) {
-            std::string def = std::string(s.name) == "threads" ? "0" : defaults[s.name].dump();
-            char range[64];
-            if (std::string(s.name) == "seed") std::snprintf(range, sizeof range, "0 .. 2^64-1");
-            else std::snprintf(range, sizeof range, "%g .. %g", s.min, s.max);
-            std::printf("| `%s` | %s | %s | %s | %s |\n", s.name, s.unit, range, def.c_str(), s.help);
-        }
-        return 0;
-    }
-    if (outOpt->count() == 0) return reportBadInput(cmd, Status::error("option -o/--output is required (the .osgb to write)"));
+};
 
-    auto t0 = std::chrono::steady_clock::now();
+CLI::Option* declareFlags(CLI::App& app, GenArgs& a) {
+    app.add_option("--params", a.paramsFile, "JSON parameter file (see docs/params.md; examples in data/)");
+    app.add_option("--seed", a.seed, "random seed (overrides the params file)");
+    app.add_option("--size", a.size, "side of the square city area in metres, 100..16000 (default 2000)");
+    app.add_option("--detail", a.detail, "facade detail 0..3 (0 = plain boxes, default 2)");
+    app.add_option("--threads", a.threads, "worker threads (0 = all; output never depends on it)");
+    app.add_option("--osm", a.osmFile, "take the streets from an OpenStreetMap extract (.osm/.osm.pbf, highway=* ways)");
+    app.add_option("--geojson", a.geojsonFile, "also write the street graph as GeoJSON");
+    app.add_option("--gltf", a.gltfFile, "also write the city as binary glTF 2.0 (.glb)");
+    app.add_option("--stats", a.statsFile, "write statistics (counts, timings, peak memory) as JSON");
+    auto* out = app.add_option("-o,--output", a.out, "output scene file (.osgb)");
+    app.add_flag("--list-params", a.listParams, "print every parameter with unit, range and default (Markdown) and exit");
+    app.add_flag("-q,--quiet", a.quiet, "no progress on stderr");
+    return out;
+}
+
+void printParamTable() {
+    CityParams d;
+    auto defaults = nlohmann::json::parse(paramsToJson(d));
+    std::printf("| parameter | unit | range | default | meaning |\n|---|---|---|---|---|\n");
+    for (const auto& s : paramSpecs()) {
+        std::string def = std::string(s.name) == "threads" ? "0" : defaults[s.name].dump();
+        char range[64];
+        if (std::string(s.name) == "seed") std::snprintf(range, sizeof range, "0 .. 2^64-1");
+        else std::snprintf(range, sizeof range, "%g .. %g", s.min, s.max);
+        std::printf("| `%s` | %s | %s | %s | %s |\n", s.name, s.unit, range, def.c_str(), s.help);
+    }
+}
+
+// The parameters (file, then the flags over it) and the output paths, checked.
+Result<CityParams> resolveParams(GenArgs& a) {
     CityParams params;
-    if (!paramsFile.empty()) {
-        auto r = loadParamsFile(paramsFile);
-        if (!r) return reportBadInput(cmd, r.status());
+    if (!a.paramsFile.empty()) {
+        auto r = loadParamsFile(a.paramsFile);
+        if (!r) return r.status();
         params = *r;
     }
-    if (seed) params.seed = *seed;
-    if (size) params.size_m = *size;
-    if (detail) params.detail = *detail;
-    if (threads) params.threads = *threads;
+    if (a.seed) params.seed = *a.seed;
+    if (a.size) params.size_m = *a.size;
+    if (a.detail) params.detail = *a.detail;
+    if (a.threads) params.threads = *a.threads;
     if (Status s = validateParams(params); !s) {
         std::string m = s.message();
-        if (size && m.find("'size_m'") != std::string::npos) m = "option --size: " + m;
-        return reportBadInput(cmd, Status::error(m));
+        if (a.size && m.find("'size_m'") != std::string::npos) m = "option --size: " + m;
+        return Status::error(m);
     }
-    if (out.size() < 5 || out.substr(out.size() - 5) != ".osgb")
-        return reportBadInput(cmd, Status::error("option -o = '" + out + "': the output must end in .osgb"));
-    for (auto [opt, path] : {std::pair<const char*, std::string*>{"-o", &out}, {"--stats", &statsFile},
-                             {"--geojson", &geojsonFile}, {"--gltf", &gltfFile}}) {
-        if (path->empty()) continue;
-        if (Status s = checkWritablePath(opt, *path); !s) return reportBadInput(cmd, s);
+    if (a.out.size() < 5 || a.out.substr(a.out.size() - 5) != ".osgb")
+        return Status::error("option -o = '" + a.out + "': the output must end in .osgb");
+    for (auto [opt, path] : {std::pair<const char*, std::string*>{"-o", &a.out}, {"--stats", &a.statsFile},
+                             {"--geojson", &a.geojsonFile}, {"--gltf", &a.gltfFile}}) {
+        if (!path->empty()) VISTA_RETURN_IF_ERROR(checkWritablePath(opt, *path));
     }
+    return params;
+}
 
-    StderrProgress progress(isatty(2));
-    GenerateOptions opts;
-    opts.progress = quiet ? nullptr : &progress;
-    if (!osmFile.empty()) {
-        auto g = importOsm(osmFile, params);
-        if (!g) return reportBadInput(cmd, g.status());
-        opts.streets = std::move(*g);
-    }
-    auto city = generateCity(params, opts);
-    if (!city) return reportBadInput(cmd, city.status());
+Status writeOutputs(const GenArgs& a, const City& city, const CityParams& params) {
+    VISTA_RETURN_IF_ERROR(writeCityFile(city, a.out));
+    if (!a.geojsonFile.empty())
+        VISTA_RETURN_IF_ERROR(writeFileAtomic(a.geojsonFile, streetGraphToGeoJson(city.streets, params.origin_x, params.origin_y)));
+    if (!a.gltfFile.empty()) VISTA_RETURN_IF_ERROR(writeGltf(city, a.gltfFile));
+    return Status::ok();
+}
 
-    auto tw = std::chrono::steady_clock::now();
-    if (Status s = writeCityFile(*city, out); !s) return reportBadInput(cmd, s);
-    if (!geojsonFile.empty()) {
-        if (Status s = writeFileAtomic(geojsonFile, streetGraphToGeoJson(city->streets, params.origin_x, params.origin_y)); !s)
-            return reportBadInput(cmd, s);
-    }
-    if (!gltfFile.empty()) {
-        if (Status s = writeGltf(*city, gltfFile); !s) return reportBadInput(cmd, s);
-    }
-    double writeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tw).count();
-    double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-
-    CityCounts n = countCity(*city);
+nlohmann::ordered_json statsJson(const City& city, const CityParams& params, const CityCounts& n, double writeSeconds,
+                                 double total) {
     nlohmann::ordered_json j;
     j["seed"] = params.seed;
     j["size_m"] = params.size_m;
@@ -111,23 +103,56 @@ int runGen(int argc, char** argv) {
     j["lots"] = n.lots;
     j["buildings"] = n.buildings;
     j["trees"] = n.trees;
-    j["tiles"] = city->tiles.size();
+    j["tiles"] = city.tiles.size();
     j["triangles"] = n.triangles;
     j["stored_triangles"] = n.storedTriangles;
     j["vertices"] = n.vertices;
     j["draw_calls"] = n.drawCalls;
     nlohmann::ordered_json st;
-    for (const auto& s : city->stageTimes) st[s.name] = s.seconds;
+    for (const auto& s : city.stageTimes) st[s.name] = s.seconds;
     st["write"] = writeSeconds;
     j["seconds"] = {{"total", total}, {"stages", st}};
     j["peak_rss_mb"] = peakRssMb();
     j["threads"] = params.threads;
-    if (!statsFile.empty()) {
-        if (Status s = writeFileAtomic(statsFile, j.dump(2) + "\n"); !s) return reportBadInput(cmd, s);
+    return j;
+}
+
+}  // namespace
+
+int runGen(int argc, char** argv) {
+    CLI::App app("Generate a city (deterministic by seed) and write it as one .osgb scene file.", kCmd);
+    GenArgs a;
+    CLI::Option* outOpt = declareFlags(app, a);
+    if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;
+    if (a.listParams) {
+        printParamTable();
+        return 0;
     }
-    if (!quiet)
+    if (outOpt->count() == 0) return reportBadInput(kCmd, Status::error("option -o/--output is required (the .osgb to write)"));
+    Stopwatch total;
+    auto params = resolveParams(a);
+    if (!params) return reportBadInput(kCmd, params.status());
+    StderrProgress progress(isatty(2));
+    GenerateOptions opts;
+    opts.progress = a.quiet ? nullptr : &progress;
+    if (!a.osmFile.empty()) {
+        auto g = importOsm(a.osmFile, *params);
+        if (!g) return reportBadInput(kCmd, g.status());
+        opts.streets = std::move(*g);
+    }
+    auto city = generateCity(*params, opts);
+    if (!city) return reportBadInput(kCmd, city.status());
+    Stopwatch write;
+    if (Status s = writeOutputs(a, *city, *params); !s) return reportBadInput(kCmd, s);
+    const double writeSeconds = write.ms() / 1000.0, totalSeconds = total.ms() / 1000.0;
+    const CityCounts n = countCity(*city);
+    if (!a.statsFile.empty()) {
+        const auto j = statsJson(*city, *params, n, writeSeconds, totalSeconds);
+        if (Status s = writeFileAtomic(a.statsFile, j.dump(2) + "\n"); !s) return reportBadInput(kCmd, s);
+    }
+    if (!a.quiet)
         std::fprintf(stderr, "wrote %s: %zu street edges, %zu blocks, %zu buildings, %zu trees, %.2f M triangles, %zu draw calls, %.1fs, peak %.0f MiB\n",
-                     out.c_str(), n.streetEdges, n.blocks, n.buildings, n.trees, n.triangles / 1e6, n.drawCalls, total,
+                     a.out.c_str(), n.streetEdges, n.blocks, n.buildings, n.trees, n.triangles / 1e6, n.drawCalls, totalSeconds,
                      peakRssMb());
     return 0;
 }

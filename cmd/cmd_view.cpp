@@ -1,21 +1,20 @@
 // vista view: interactive OSG viewer of a city (a real window on a GPU, or
-// under Xvfb). Drive / walk / fly manipulators, path playback, on-screen
-// stats (osgViewer StatsHandler, key s), render-mode switch (key m: full,
-// near, osgimpostor, hybrid = NearFarSplit + FarFieldNode; the HUD then shows
-// the far field's pixel classes and stage times; impostor = the baked
-// ViewCellSwitch of a file from `vista bake`, the HUD shows the current cell),
-// screenshots (key p, or --screenshot with --frames for headless use).
-#include <algorithm>
-#include <cmath>
-#include <cstdlib>
+// under Xvfb). Drive / walk / fly / orbit manipulators, path playback,
+// on-screen stats (osgViewer StatsHandler, key s), the render modes of the
+// registry (key m cycles them; each mode's viewer face, created on first
+// use; the HUD shows what the mode reports: pixel classes, stage times,
+// notes), screenshots (key p, or --screenshot with --frames for headless
+// use). --step shows exactly the bench's frames of the path (the camera of
+// `vista bench --frames N`), so view and bench can be compared image to image.
 #include <cstdio>
+#include <cstdlib>
+#include <map>
 #include <memory>
 #include <string>
 
 #include <osg/Camera>
 #include <osg/Geode>
 #include <osg/GL>
-#include <osg/MatrixTransform>
 #include <osgGA/AnimationPathManipulator>
 #include <osgGA/DriveManipulator>
 #include <osgGA/FirstPersonManipulator>
@@ -23,38 +22,130 @@
 #include <osgGA/KeySwitchMatrixManipulator>
 #include <osgGA/StateSetManipulator>
 #include <osgGA/TrackballManipulator>
-#include <osgSim/Impostor>
 #include <osgText/Text>
 #include <osgViewer/Viewer>
 #include <osgViewer/ViewerEventHandlers>
 
 #include <glm/gtc/type_ptr.hpp>
 
-#include "nodes/far_field_node.h"
-#include "foundation/units.h"
-#include "nodes/near_far_split.h"
-#include "nodes/view_cell_switch.h"
-#include "runtime/scene/city_file.h"
-#include "runtime/scene/scene_graph.h"
 #include "cmd/cli.h"
 #include "cmd/commands.h"
-#include "runtime/engine/image.h"
-#include "runtime/scene/paths.h"
+#include "cmd/options.h"
+#include "foundation/timing.h"
+#include "foundation/units.h"
+#include "nodes/far_field_node.h"
+#include "nodes/render/offscreen.h"
 #include "runtime/engine/ray_scene.h"
+#include "runtime/scene/city_file.h"
+#include "runtime/scene/scene_graph.h"
 
 namespace vista {
 
 namespace {
 
+const char* const kCmd = "vista view";
 
-// Reads the back buffer after the next frame and writes a PNG.
+osg::Matrixd toOsg(const glm::dmat4& m) { return osg::Matrixd(glm::value_ptr(m)); }
+
+struct ViewArgs {
+    std::string city, size = "1280x720", screenshot, mode = "full", fov = "60";
+    int frames = 0;
+    bool step = false, noHud = false;
+    PathFlags path;
+    ModeFlags modeFlags;
+    ImageSize window;
+    double fovDeg = 60.0;
+};
+
+void declareFlags(CLI::App& app, ViewArgs& a) {
+    a.path.seed = 0;  // no playback unless asked
+    a.modeFlags.budget = "20000";
+    app.add_option("city", a.city, "city scene file (.osgb), or a baked file from 'vista bake' (adds the impostor mode)")->required();
+    addPathFlags(app, a.path, true);
+    app.get_option("--seed")->description("play back the path of this seed (key 5); default 0 = none, start where seed 1's path starts");
+    app.add_option("--size", a.size, "window size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 1280x720)");
+    app.add_option("--fov", a.fov, "vertical field of view in degrees, (1, 179) (default 60)");
+    app.add_option("--mode", a.mode, "start in this render mode: " + renderModeNames() + " (default full)");
+    addModeFlags(app, a.modeFlags);
+    app.add_option("--frames", a.frames, "quit after N frames (0 = run until Esc)");
+    app.add_flag("--step", a.step,
+                 "with --frames N and a path: show the N frames `vista bench --frames N` renders (one path sample per frame)");
+    app.add_flag("--no-hud", a.noHud, "no text overlay (for screenshots compared with `vista bench`)");
+    app.add_option("--screenshot", a.screenshot, "write a PNG of the last frame (use with --frames)");
+}
+
+Status configure(ViewArgs& a, ModeOptions& options) {
+    auto size = parseImageSize(a.size);
+    if (!size) return size.status();
+    a.window = size.value();
+    auto fov = parseFov(a.fov);
+    if (!fov) return fov.status();
+    a.fovDeg = fov.value();
+    if (auto m = parseModeName(a.mode); !m) return m.status();
+    if (a.frames < 0) return Status::error("--frames " + std::to_string(a.frames) + " out of range 0 .. (0 = until Esc)");
+    if (a.step && (a.frames < 1 || (a.path.file.empty() && a.path.seed == 0)))
+        return Status::error("--step needs --frames N >= 1 and a path (--path or --seed)");
+    if (!a.screenshot.empty()) VISTA_RETURN_IF_ERROR(checkWritablePath("--screenshot", a.screenshot));
+    return parseModeFlags(a.modeFlags, options);
+}
+
+// The registry's modes in the viewer, each created on first use (its ray
+// scene too, when the mode needs one).
+class ViewModes {
+public:
+    explicit ViewModes(ModeContext& ctx) : _ctx(ctx) {}
+    Result<RenderMode*> get(const std::string& name) {
+        auto it = _modes.find(name);
+        if (it != _modes.end()) return it->second.get();
+        const ModeInfo* info = findRenderMode(name);
+        if (!info) return Status::error("unknown mode '" + name + "'");
+        if (info->needsRays) VISTA_RETURN_IF_ERROR(buildRays());
+        Stopwatch sw;
+        auto m = createRenderMode(name, _ctx);
+        if (!m) return m.status();
+        std::fprintf(stderr, "%s: mode %s set up in %.0f ms\n", kCmd, name.c_str(), sw.ms());
+        return (_modes[name] = std::move(m.value())).get();
+    }
+    // The mode after `current` that can be created (stays on `current` if none).
+    std::string next(const std::string& current) {
+        const auto& all = renderModes();
+        size_t i = 0;
+        while (i < all.size() && current != all[i].name) ++i;
+        for (size_t k = 1; k <= all.size(); ++k) {
+            const std::string name = all[(i + k) % all.size()].name;
+            if (auto m = get(name)) return name;
+            else std::fprintf(stderr, "%s: mode %s unavailable: %s\n", kCmd, name.c_str(), m.status().message().c_str());
+        }
+        return current;
+    }
+
+private:
+    Status buildRays() {
+        if (_ctx.rays) return Status::ok();
+        if (!_raysError.empty()) return Status::error(_raysError);
+        if (!_ctx.city) return Status::error("no city for the ray scene");
+        auto r = RayScene::build(*_ctx.city);
+        if (!r) {
+            _raysError = "the ray scene could not be built: " + r.status().message();
+            return Status::error(_raysError);
+        }
+        _rays = std::move(r.value());
+        _ctx.rays = _rays.get();
+        return Status::ok();
+    }
+    ModeContext& _ctx;
+    std::unique_ptr<RayScene> _rays;  // before _modes: destroyed after them
+    std::string _raysError;
+    std::map<std::string, std::unique_ptr<RenderMode>> _modes;
+};
+
+// Reads the back buffer after the frame (HUD included) and writes a PNG.
 struct Capture : public osg::Camera::DrawCallback {
-    mutable std::string pending;
-    mutable std::string lastWritten;
+    mutable std::string pending, lastWritten;
     void operator()(osg::RenderInfo& ri) const override {
         if (pending.empty()) return;
         const osg::Viewport* vp = ri.getCurrentCamera()->getViewport();
-        int w = int(vp->width()), h = int(vp->height());
+        const int w = int(vp->width()), h = int(vp->height());
         Image img(w, h);
         std::vector<uint8_t> buf(size_t(w) * size_t(h) * 4);
         glPixelStorei(GL_PACK_ALIGNMENT, 1);
@@ -64,266 +155,102 @@ struct Capture : public osg::Camera::DrawCallback {
             std::copy_n(&buf[size_t(h - 1 - y) * size_t(w) * 4], size_t(w) * 4, &img.rgba[size_t(y) * size_t(w) * 4]);
         for (size_t i = 3; i < img.rgba.size(); i += 4) img.rgba[i] = 255;
         Status s = writePng(img, pending);
-        if (s) std::fprintf(stderr, "vista view: screenshot -> %s\n", pending.c_str());
-        else std::fprintf(stderr, "vista view: %s\n", s.message().c_str());
+        if (s) std::fprintf(stderr, "%s: screenshot -> %s\n", kCmd, pending.c_str());
+        else std::fprintf(stderr, "%s: %s\n", kCmd, s.message().c_str());
         lastWritten = s ? pending : std::string();
         pending.clear();
     }
 };
 
-struct ViewState {
-    int mode = 0;  // index into kModeNames
-    bool available[5] = {true, true, true, false, false};  // hybrid: ray scene built; impostor: baked file
-    unsigned child[5] = {0, 0, 1, 0, 0};                   // switch child drawn by each mode
-    ViewCellSwitch* baked = nullptr;                       // owned by the scene graph (impostor mode)
-    double nearDistance = 100.0;
-    int shots = 0;
-    osg::ref_ptr<osg::Switch> modes;
-    osg::ref_ptr<Capture> capture;
-    osg::ref_ptr<osgText::Text> hud;
-    FarFieldNode* far = nullptr;      // owned by the scene graph (hybrid mode)
-    NearFarSplit* split = nullptr;
-};
-// full and near share the city scene (near differs only by the projection's
-// far plane); a baked file's full mode draws its tiles without the switch.
-const char* kModeNames[] = {"full", "near", "osgimpostor", "hybrid", "impostor"};
-constexpr int kNumModes = 5;
-
-class ViewKeys : public osgGA::GUIEventHandler {
-public:
-    explicit ViewKeys(ViewState& s) : _s(s) {}
-    bool handle(const osgGA::GUIEventAdapter& ea, osgGA::GUIActionAdapter&) override {
-        if (ea.getEventType() != osgGA::GUIEventAdapter::KEYDOWN) return false;
-        if (ea.getKey() == 'm') {
-            do _s.mode = (_s.mode + 1) % kNumModes;
-            while (!_s.available[_s.mode]);
-            _s.modes->setSingleChildOn(_s.child[_s.mode]);
-            return true;
-        }
-        if (ea.getKey() == 'p') {
-            _s.capture->pending = "vista_screenshot_" + std::to_string(_s.shots++) + ".png";
-            return true;
-        }
-        return false;
-    }
-    void getUsage(osg::ApplicationUsage& u) const override {
-        u.addKeyboardMouseBinding("m", "cycle render mode: full / near / osgimpostor / hybrid / impostor (baked file)");
-        u.addKeyboardMouseBinding("p", "screenshot to vista_screenshot_N.png");
-    }
-
-private:
-    ViewState& _s;
+struct Hud {
+    osg::ref_ptr<osg::Camera> camera;
+    osg::ref_ptr<osgText::Text> text;
 };
 
-osg::ref_ptr<osg::Node> makeImpostorScene(osg::Node* scene, double nearD) {
-    osg::ref_ptr<osg::Group> root = new osg::Group;
-    osg::Group* g = scene ? scene->asGroup() : nullptr;
-    if (!g) return scene;
-    for (unsigned i = 0; i < g->getNumChildren(); ++i) {
-        osg::Node* c = g->getChild(i);
-        osg::ref_ptr<osgSim::Impostor> imp = new osgSim::Impostor;
-        if (auto* mt = dynamic_cast<osg::MatrixTransform*>(c)) {
-            osg::ref_ptr<osg::MatrixTransform> copy = new osg::MatrixTransform(mt->getMatrix());
-            for (unsigned k = 0; k < mt->getNumChildren(); ++k) imp->addChild(mt->getChild(k), 0.0f, 1e30f);
-            copy->addChild(imp.get());
-            root->addChild(copy.get());
-        } else {
-            imp->addChild(c, 0.0f, 1e30f);
-            root->addChild(imp.get());
-        }
-        imp->setImpostorThreshold(float(nearD + imp->getBound().radius()));
-    }
-    root->setStateSet(g->getStateSet());
-    return root;
+Hud makeHud(int w, int h) {
+    Hud hud;
+    hud.camera = new osg::Camera;
+    hud.camera->setReferenceFrame(osg::Transform::ABSOLUTE_RF);
+    hud.camera->setProjectionMatrixAsOrtho2D(0, w, 0, h);
+    hud.camera->setViewMatrix(osg::Matrix::identity());
+    hud.camera->setClearMask(GL_DEPTH_BUFFER_BIT);
+    hud.camera->setRenderOrder(osg::Camera::POST_RENDER);
+    hud.camera->setAllowEventFocus(false);
+    hud.text = new osgText::Text;
+    hud.text->setCharacterSize(16.0f);
+    hud.text->setPosition(osg::Vec3(10.0f, float(h) - 24.0f, 0.0f));
+    hud.text->setColor(osg::Vec4(1, 1, 1, 1));
+    hud.text->setDataVariance(osg::Object::DYNAMIC);
+    osg::ref_ptr<osg::Geode> geode = new osg::Geode;
+    geode->addDrawable(hud.text.get());
+    geode->getOrCreateStateSet()->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
+    hud.camera->addChild(geode.get());
+    return hud;
 }
 
-osg::Matrixd toOsg(const glm::dmat4& m) { return osg::Matrixd(glm::value_ptr(m)); }
+// HUD lines (short: they must fit a 640-pixel-wide window at 16 px).
+std::string hudText(const std::string& mode, double lastMs, const FrameStats& fs, bool havePath) {
+    char buf[256];
+    std::snprintf(buf, sizeof(buf), "mode %s (m)   %.1f ms/frame\nkeys: 1 drive 2 walk 3 fly 4 orbit%s s stats p shot",
+                  mode.c_str(), lastMs, havePath ? " 5 path" : "");
+    std::string text = buf;
+    const PixelCounts& p = fs.pixels;
+    if (p.total() > 0) {
+        const double n = double(p.total());
+        std::snprintf(buf, sizeof(buf), "\npixels %%: covered %.1f horizon %.1f cache %.1f\n          ray hit %.1f ray miss %.1f",
+                      100.0 * double(p.covered) / n, 100.0 * double(p.horizonCulled) / n, 100.0 * double(p.cache) / n,
+                      100.0 * double(p.rayHit) / n, 100.0 * double(p.rayMiss) / n);
+        text += buf;
+    }
+    for (const auto& note : fs.notes) text += "\n" + note;
+    if (fs.stages.count() > 0) text += "\nstages ms:";
+    int k = 0;
+    fs.stages.forEach([&](Stage stage, double ms) {
+        std::snprintf(buf, sizeof(buf), "%s%s %.1f", k++ % 4 == 0 ? "\n  " : "  ", stageName(stage), ms);
+        text += buf;
+    });
+    return text;
+}
 
-}  // namespace
+struct Keys : public osgGA::GUIEventHandler {
+    bool nextMode = false;
+    int shots = 0;
+    osg::ref_ptr<Capture> capture;
+    bool handle(const osgGA::GUIEventAdapter& ea, osgGA::GUIActionAdapter&) override {
+        if (ea.getEventType() != osgGA::GUIEventAdapter::KEYDOWN) return false;
+        if (ea.getKey() == 'm') nextMode = true;
+        else if (ea.getKey() == 'p') capture->pending = "vista_screenshot_" + std::to_string(shots++) + ".png";
+        else return false;
+        return true;
+    }
+    void getUsage(osg::ApplicationUsage& u) const override {
+        u.addKeyboardMouseBinding("m", "cycle the render modes (" + renderModeNames() + ")");
+        u.addKeyboardMouseBinding("p", "screenshot to vista_screenshot_N.png");
+    }
+};
 
-int runView(int argc, char** argv) {
-    CLI::App app{"Interactive viewer: drive (1), walk (2), fly (3), orbit (4), path playback (5); s = stats, "
-                 "m = render mode, p = screenshot, h = help.",
-                 "vista view"};
-    std::string city, pathFile, sizeStr = "1280x720", screenshot, kind = "car", modeStr = "full", budgetStr = "20000";
-    int frames = 0;
-    uint64_t seed = 0;
-    double fovDeg = 60.0, nearD = 100.0;
-    app.add_option("city", city, "city scene file (.osgb), or a baked file from 'vista bake' (adds the impostor mode)")->required();
-    app.add_option("--path", pathFile, "play back this path CSV (key 5)");
-    app.add_option("--seed", seed, "make a path from this seed and play it back");
-    app.add_option("--kind", kind, "path kind for --seed: walk, car, fly");
-    app.add_option("--size", sizeStr, "window size WIDTHxHEIGHT (default 1280x720)");
-    app.add_option("--fov", fovDeg, "vertical field of view in degrees (default 60)");
-    app.add_option("--near", nearD, "near-field distance of the `near` and `hybrid` modes in metres (default 100)");
-    app.add_option("--mode", modeStr, "start in this render mode: full, near, osgimpostor, hybrid, impostor (default full)");
-    app.add_option("--budget", budgetStr,
-                   "hybrid: far-field rays per frame through the panoramic cache, 0 .. 1000000000, or "
-                   "'unlimited' / -1 (default 20000)");
-    app.add_option("--frames", frames, "quit after N frames (0 = run until Esc)");
-    app.add_option("--screenshot", screenshot, "write a PNG of the last frame (use with --frames)");
-    int rc = parseOrExit(app, argc, argv);
-    if (rc >= 0) return rc;
-    const std::string cmd = "vista view";
-    int w = 0, h = 0;
-    char x = 0, extra = 0;
-    if (std::sscanf(sizeStr.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' || w < 1 || h < 1 || w > 8192 || h > 8192)
-        return reportBadInput(cmd, Status::error("--size '" + sizeStr + "': expected WIDTHxHEIGHT within 1x1 .. 8192x8192"));
-    if (frames < 0) return reportBadInput(cmd, Status::error("--frames " + std::to_string(frames) + " must be >= 0"));
-    if (!(fovDeg > 1 && fovDeg < 179)) return reportBadInput(cmd, Status::error("--fov out of range (1, 179) degrees"));
-    if (!(nearD > 0)) return reportBadInput(cmd, Status::error("--near must be > 0 metres"));
-    int startMode = -1;
-    for (int i = 0; i < kNumModes; ++i)
-        if (modeStr == kModeNames[i]) startMode = i;
-    if (startMode < 0)
-        return reportBadInput(cmd, Status::error("--mode '" + modeStr + "': expected full, near, osgimpostor, hybrid or impostor"));
-    int64_t budget = -1;
-    if (budgetStr != "unlimited" && budgetStr != "-1") {
-        char* end = nullptr;
-        long long v = std::strtoll(budgetStr.c_str(), &end, 10);
-        if (budgetStr.empty() || *end || v < 0 || v > 1000000000LL)
-            return reportBadInput(cmd, Status::error("--budget '" + budgetStr +
-                                                     "' out of range 0 .. 1000000000 rays per frame, or 'unlimited' / -1"));
-        budget = v;
-    }
-    if (!screenshot.empty())
-        if (Status s = checkWritablePath("--screenshot", screenshot); !s) return reportBadInput(cmd, s);
-    auto c = loadCityFile(city);
-    if (!c) return reportBadInput(cmd, c.status());
-    Path path;
-    bool havePath = false;
-    if (!pathFile.empty()) {
-        auto p = loadPathCsv(pathFile);
-        if (!p) return reportBadInput(cmd, p.status());
-        path = std::move(p.value());
-        havePath = true;
-    }
-    {
-        auto k = parsePathKind(kind);
-        if (!k) return reportBadInput(cmd, Status::error("--kind: " + k.status().message()));
-        PathOptions po;
-        po.seed = seed ? seed : 1;
-        po.kind = k.value();
-        if (!havePath && !c->streets.edges.empty()) {
-            auto p = generatePath(c->streets, c->params, po);
-            if (p) {
-                path = std::move(p.value());
-                havePath = seed != 0;  // playback only when asked; otherwise just the start position
-                if (!havePath && !path.samples.empty()) path.samples.resize(1);
-            }
-        }
-    }
-    const char* display = std::getenv("DISPLAY");
-    if (!display || !*display) {
-        std::fprintf(stderr, "vista view: no X display (DISPLAY is not set); run under `xvfb-run -a` without a screen\n");
-        return 1;
-    }
-
-    std::unique_ptr<RayScene> rays;  // declared before the scene graph that references them
-    HeightGrid grid;
-    ViewState st;
-    st.nearDistance = nearD;
-    st.modes = new osg::Switch;
-    // A baked file: its root is the view-cell switch; the plain modes draw its
-    // city tiles (the children before the impostors) without it.
-    osg::ref_ptr<osg::Node> plain = sceneRoot(*c);
-    st.baked = dynamic_cast<ViewCellSwitch*>(sceneRoot(*c));
-    if (st.baked) {
-        osg::ref_ptr<osg::Group> tiles = new osg::Group;
-        tiles->setStateSet(st.baked->getStateSet());
-        for (unsigned i = 0; i < st.baked->getTileCount() && i < st.baked->getNumChildren(); ++i) tiles->addChild(st.baked->getChild(i));
-        plain = tiles;
-    } else if (startMode == 4) {
-        return reportBadInput(cmd, Status::error("--mode impostor: '" + city + "' is not baked (run 'vista bake' and view its output)"));
-    }
-    st.modes->addChild(plain.get(), true);
-    st.modes->addChild(makeImpostorScene(plain.get(), nearD).get(), false);
-    // Hybrid: near field under a NearFarSplit + the far-field drawable. The
-    // ray scene and the height grid outlive the viewer (declared before it).
-    {
-        auto r = RayScene::build(*c);
-        if (r) {
-            rays = std::move(r.value());
-            grid = HeightGrid::build(*c, rays->frameOrigin(), 512);
-            HybridSceneOptions ho;
-            ho.nearDistance = nearD;
-            ho.far.nearDistance = nearD;
-            ho.far.pixelBudget = budget;
-            st.child[3] = st.modes->getNumChildren();
-            st.modes->addChild(buildHybridScene(*c, *rays, grid, ho, &st.split, &st.far).get(), false);
-            st.available[3] = true;
-        } else {
-            std::fprintf(stderr, "vista view: hybrid mode unavailable: %s\n", r.status().message().c_str());
-            if (startMode == 3) return reportBadInput(cmd, Status::error("--mode hybrid: " + r.status().message()));
-        }
-    }
-    if (st.baked) {
-        st.child[4] = st.modes->getNumChildren();
-        st.modes->addChild(st.baked, false);
-        st.available[4] = true;
-    }
-    st.mode = startMode;
-    st.modes->setSingleChildOn(st.child[st.mode]);
-    osg::ref_ptr<osg::Group> root = new osg::Group;
-    root->addChild(st.modes.get());
-
-    // HUD: mode and frame time.
-    osg::ref_ptr<osg::Camera> hudCam = new osg::Camera;
-    hudCam->setReferenceFrame(osg::Transform::ABSOLUTE_RF);
-    hudCam->setProjectionMatrixAsOrtho2D(0, w, 0, h);
-    hudCam->setViewMatrix(osg::Matrix::identity());
-    hudCam->setClearMask(GL_DEPTH_BUFFER_BIT);
-    hudCam->setRenderOrder(osg::Camera::POST_RENDER);
-    hudCam->setAllowEventFocus(false);
-    st.hud = new osgText::Text;
-    st.hud->setCharacterSize(16.0f);
-    st.hud->setPosition(osg::Vec3(10.0f, float(h) - 24.0f, 0.0f));
-    st.hud->setColor(osg::Vec4(1, 1, 1, 1));
-    st.hud->setDataVariance(osg::Object::DYNAMIC);
-    osg::ref_ptr<osg::Geode> hudGeode = new osg::Geode;
-    hudGeode->addDrawable(st.hud.get());
-    hudGeode->getOrCreateStateSet()->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
-    hudCam->addChild(hudGeode.get());
-    root->addChild(hudCam.get());
-
-    osgViewer::Viewer viewer;
-    viewer.setThreadingModel(osgViewer::ViewerBase::SingleThreaded);
-    viewer.setUpViewInWindow(0, 0, w, h);
-    viewer.setSceneData(root.get());
-    osg::Camera* cam = viewer.getCamera();
-    cam->setComputeNearFarMode(osg::CullSettings::DO_NOT_COMPUTE_NEAR_FAR);
-    cam->setClearColor(osg::Vec4(0.62f, 0.75f, 0.9f, 1.0f));
-    st.capture = new Capture;
-    cam->setFinalDrawCallback(st.capture.get());
-
-    // Manipulators.
+// Drive / walk / fly from `start` looking along `dir`, orbit, and path playback.
+osg::ref_ptr<osgGA::KeySwitchMatrixManipulator> makeManipulators(const Path& path, bool playback, const SceneModel& city) {
     osg::ref_ptr<osgGA::KeySwitchMatrixManipulator> ks = new osgGA::KeySwitchMatrixManipulator;
-    osg::Vec3d start(0, 0, 0), dir(0, 1, 0);
+    osg::Vec3d start(city.params.origin_x, city.params.origin_y, 1.7), dir(0, 1, 0);
     if (!path.samples.empty()) {
         const auto& s0 = path.samples.front();
         start = osg::Vec3d(s0.position.x, s0.position.y, s0.position.z);
         dir = osg::Vec3d(std::sin(s0.heading), std::cos(s0.heading), 0.0);
-    } else {
-        start = osg::Vec3d(c->params.origin_x, c->params.origin_y, 1.7);
     }
     auto drive = new osgGA::DriveManipulator;
-    auto walk = new osgGA::FirstPersonManipulator;
-    auto fly = new osgGA::FlightManipulator;
     auto orbit = new osgGA::TrackballManipulator;
-    for (osgGA::CameraManipulator* m : std::initializer_list<osgGA::CameraManipulator*>{drive, walk, fly})
-        m->setHomePosition(start, start + dir * 10.0, osg::Vec3d(0, 0, 1));
     drive->setModelScale(1.0);
     ks->addMatrixManipulator('1', "Drive", drive);
-    ks->addMatrixManipulator('2', "Walk", walk);
-    ks->addMatrixManipulator('3', "Fly", fly);
+    ks->addMatrixManipulator('2', "Walk", new osgGA::FirstPersonManipulator);
+    ks->addMatrixManipulator('3', "Fly", new osgGA::FlightManipulator);
     ks->addMatrixManipulator('4', "Orbit", orbit);
-    // The key switch auto-computes every child's home from the scene bounds
-    // by default (OSG), which would override the street start position set
-    // above: only the orbit manipulator computes its home.
+    // The key switch would compute every child's home from the scene bounds
+    // (OSG default), overriding the street start: only the orbit computes its own.
     ks->setAutoComputeHomePosition(false);
-    ks->setHomePosition(start, start + dir * 10.0, osg::Vec3d(0, 0, 1));  // the switch pushes its home to the children
+    ks->setHomePosition(start, start + dir * 10.0, osg::Vec3d(0, 0, 1));  // pushed to the children
     orbit->setAutoComputeHomePosition(true);
-    if (havePath && path.samples.size() > 1) {
+    if (playback && path.samples.size() > 1) {
         osg::ref_ptr<osg::AnimationPath> ap = new osg::AnimationPath;
         ap->setLoopMode(osg::AnimationPath::LOOP);
         for (const auto& s : path.samples) {
@@ -331,79 +258,157 @@ int runView(int argc, char** argv) {
             cc.eye = s.position;
             cc.heading = s.heading;
             cc.pitch = s.pitch;
-            osg::Matrixd inv = osg::Matrixd::inverse(toOsg(cc.view()));
+            const osg::Matrixd inv = osg::Matrixd::inverse(toOsg(cc.view()));
             ap->insert(s.t, osg::AnimationPath::ControlPoint(inv.getTrans(), inv.getRotate()));
         }
         ks->addMatrixManipulator('5', "Path", new osgGA::AnimationPathManipulator(ap.get()));
         ks->selectMatrixManipulator(4);
     }
-    viewer.setCameraManipulator(ks.get());
-    viewer.addEventHandler(new osgViewer::StatsHandler);
-    viewer.addEventHandler(new osgViewer::HelpHandler(new osg::ApplicationUsage));
-    viewer.addEventHandler(new osgViewer::WindowSizeHandler);
-    viewer.addEventHandler(new osgGA::StateSetManipulator(cam->getOrCreateStateSet()));
-    viewer.addEventHandler(new ViewKeys(st));
-    viewer.realize();
-    if (!viewer.isRealized()) {
-        std::fprintf(stderr, "vista view: cannot open a window on display '%s'\n", display);
+    return ks;
+}
+
+// The walkthrough: --path, or the path of --seed (played back), or only the
+// start position of seed 1's path.
+Result<Path> viewPath(const ViewArgs& a, const SceneModel& city, bool& playback) {
+    playback = !a.path.file.empty() || a.path.seed != 0;
+    PathFlags f = a.path;
+    if (f.seed == 0) f.seed = 1;
+    auto po = parsePathFlags(f);
+    if (!po) return po.status();
+    if (f.file.empty() && city.streets.edges.empty()) return Path();
+    auto p = walkthroughPath(f, po.value(), city);
+    if (!p) return p;
+    if (!playback && !p->samples.empty()) p->samples.resize(1);
+    return p;
+}
+
+struct ViewState {
+    osgViewer::Viewer viewer;
+    osg::ref_ptr<osg::Group> slot;  // the current mode's viewer scene
+    std::unique_ptr<SkyBackground> sky;
+    Hud hud;
+    osg::ref_ptr<Keys> keys;
+    std::string mode;
+    RenderMode* current = nullptr;
+};
+
+Status setUpWindow(ViewState& v, const ViewArgs& a, osg::ref_ptr<osgGA::KeySwitchMatrixManipulator> manips) {
+    v.sky = std::make_unique<SkyBackground>(a.window.width, a.window.height);
+    v.slot = new osg::Group;
+    osg::ref_ptr<osg::Group> root = new osg::Group;
+    root->addChild(v.sky->node());
+    root->addChild(v.slot.get());
+    v.hud = makeHud(a.window.width, a.window.height);
+    if (!a.noHud) root->addChild(v.hud.camera.get());
+    v.viewer.setThreadingModel(osgViewer::ViewerBase::SingleThreaded);
+    v.viewer.setUpViewInWindow(0, 0, a.window.width, a.window.height);
+    v.viewer.setSceneData(root.get());
+    osg::Camera* cam = v.viewer.getCamera();
+    setExactCulling(*cam);  // the bench renderer's culling: same pictures
+    cam->setClearColor(osg::Vec4(0, 0, 0, 1));
+    v.keys = new Keys;
+    v.keys->capture = new Capture;
+    cam->setFinalDrawCallback(v.keys->capture.get());
+    v.viewer.setCameraManipulator(manips.get());
+    v.viewer.addEventHandler(new osgViewer::StatsHandler);
+    v.viewer.addEventHandler(new osgViewer::HelpHandler(new osg::ApplicationUsage));
+    v.viewer.addEventHandler(new osgViewer::WindowSizeHandler);
+    v.viewer.addEventHandler(new osgGA::StateSetManipulator(cam->getOrCreateStateSet()));
+    v.viewer.addEventHandler(v.keys.get());
+    v.viewer.realize();
+    if (!v.viewer.isRealized()) return Status::error("cannot open a window on display '" + std::string(std::getenv("DISPLAY")) + "'");
+    return Status::ok();
+}
+
+void showMode(ViewState& v, ViewModes& modes, const std::string& name) {
+    auto m = modes.get(name);
+    if (!m) return;
+    v.mode = name;
+    v.current = m.value();
+    v.slot->removeChildren(0, v.slot->getNumChildren());
+    v.slot->addChild(v.current->viewerScene());
+}
+
+// The frame loop: events, camera (manipulator or --step), the mode's frame
+// hook and far plane, sky, HUD, draw; the screenshot after the last frame.
+int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path, bool playback) {
+    osg::Camera* cam = v.viewer.getCamera();
+    const std::vector<size_t> stepFrames = a.step ? path.spread(size_t(a.frames)) : std::vector<size_t>();
+    Stopwatch sw;
+    double lastMs = 0;
+    for (int n = 0; !v.viewer.done(); ++n) {
+        if (v.keys->nextMode) {
+            v.keys->nextMode = false;
+            showMode(v, modes, modes.next(v.mode));
+        }
+        v.viewer.advance();
+        v.viewer.eventTraversal();
+        v.viewer.updateTraversal();
+        const osg::Viewport* vp = cam->getViewport();
+        Camera c;
+        c.width = vp ? int(vp->width()) : a.window.width;
+        c.height = vp ? int(vp->height()) : a.window.height;
+        c.fovY = degToRad(a.fovDeg);
+        if (a.step) {
+            c = path.camera(stepFrames[size_t(n)], c);
+            cam->setViewMatrix(toOsg(c.view()));
+        } else {
+            Camera fromOsg;
+            double zf = 0;
+            if (cameraFromOsg(cam->getViewMatrix(), toOsg(c.projection(0.0)), c.width, c.height, fromOsg, zf)) {  // the pose
+                c.eye = fromOsg.eye;
+                c.heading = fromOsg.heading;
+                c.pitch = fromOsg.pitch;
+                c.roll = fromOsg.roll;
+            }
+        }
+        cam->setProjectionMatrix(toOsg(c.projection(v.current->beginViewerFrame(c))));
+        v.sky->showSky(c);
+        v.hud.text->setText(hudText(v.mode, lastMs, v.current->lastViewerStats(), playback));
+        const bool last = a.frames > 0 && n + 1 >= a.frames;
+        if (last && !a.screenshot.empty()) v.keys->capture->pending = a.screenshot;
+        v.viewer.renderingTraversals();
+        lastMs = sw.lap();
+        if (last) break;
+    }
+    if (!a.screenshot.empty() && v.keys->capture->lastWritten != a.screenshot) return 1;
+    return 0;
+}
+
+}  // namespace
+
+int runView(int argc, char** argv) {
+    CLI::App app{"Interactive viewer: drive (1), walk (2), fly (3), orbit (4), path playback (5); s = stats, "
+                 "m = render mode, p = screenshot, h = help.",
+                 kCmd};
+    ViewArgs a;
+    declareFlags(app, a);
+    if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;
+    ModeContext ctx;
+    if (Status s = configure(a, ctx.options); !s) return reportBadInput(kCmd, s);
+    auto city = loadCityFile(a.city);
+    if (!city) return reportBadInput(kCmd, city.status());
+    bool playback = false;
+    auto path = viewPath(a, city.value(), playback);
+    if (!path) return reportBadInput(kCmd, path.status());
+    if (a.step && path->samples.empty()) return reportBadInput(kCmd, Status::error("--step: the path has no samples"));
+    const char* display = std::getenv("DISPLAY");
+    if (!display || !*display) {
+        std::fprintf(stderr, "%s: no X display (DISPLAY is not set); run under `xvfb-run -a` without a screen\n", kCmd);
         return 1;
     }
-
-    int n = 0;
-    double lastMs = 0;
-    osg::Timer_t t0 = osg::Timer::instance()->tick();
-    while (!viewer.done()) {
-        Camera pc;
-        const osg::Viewport* vp = cam->getViewport();
-        pc.width = vp ? int(vp->width()) : w;
-        pc.height = vp ? int(vp->height()) : h;
-        pc.fovY = fovDeg * kPi / 180.0;
-        cam->setProjectionMatrix(toOsg(pc.projection(st.mode == 1 ? st.nearDistance : 0.0)));  // hybrid: infinite far plane
-        // HUD: short lines (they must fit a 640-pixel-wide window at 16 px).
-        std::string text;
-        char buf[256];
-        std::snprintf(buf, sizeof(buf), "mode %s (m)   %.1f ms/frame", kModeNames[st.mode], lastMs);
-        text += buf;
-        std::snprintf(buf, sizeof(buf), "\nkeys: 1 drive 2 walk 3 fly 4 orbit%s s stats p shot", havePath ? " 5 path" : "");
-        text += buf;
-        if (st.mode == 4 && st.baked) {
-            const int cell = st.baked->lastCell();
-            if (cell >= 0)
-                std::snprintf(buf, sizeof(buf), "\nview cell %d: %zu impostors", cell, st.baked->impostorsOf(uint32_t(cell)).size());
-            else
-                std::snprintf(buf, sizeof(buf), "\noutside the view cells: plain city");
-            text += buf;
-        }
-        if (st.mode == 3 && st.far) {
-            // Last drawn frame's pixel classes (thesis Table 4.1) and far-field stage times.
-            FrameStats fs = st.far->lastStats();
-            const PixelCounts& p = fs.pixels;
-            const double n = std::max<double>(1.0, double(p.covered + p.horizonCulled + p.cache + p.rayHit + p.rayMiss));
-            std::snprintf(buf, sizeof(buf), "\npixels %%: covered %.1f horizon %.1f cache %.1f\n          ray hit %.1f ray miss %.1f",
-                          100.0 * double(p.covered) / n, 100.0 * double(p.horizonCulled) / n, 100.0 * double(p.cache) / n,
-                          100.0 * double(p.rayHit) / n, 100.0 * double(p.rayMiss) / n);
-            text += buf;
-            std::snprintf(buf, sizeof(buf), "\nnear chunks drawn %u   stages ms:", st.split ? st.split->lastNearCount() : 0u);
-            text += buf;
-            int k = 0;
-            fs.stages.forEach([&](Stage stage, double ms) {
-                std::snprintf(buf, sizeof(buf), "%s%s %.1f", k % 4 == 0 ? "\n  " : "  ", stageName(stage), ms);
-                text += buf;
-                ++k;
-            });
-        }
-        st.hud->setText(text);
-        bool last = frames > 0 && n + 1 >= frames;
-        if (last && !screenshot.empty()) st.capture->pending = screenshot;
-        viewer.frame();
-        osg::Timer_t t1 = osg::Timer::instance()->tick();
-        lastMs = osg::Timer::instance()->delta_m(t0, t1);
-        t0 = t1;
-        if (last) break;
-        ++n;
+    ctx.city = &city.value();
+    ctx.scene = sceneRoot(city.value());
+    ViewModes modes(ctx);
+    auto start = modes.get(a.mode);
+    if (!start) return reportBadInput(kCmd, Status::error("--mode " + a.mode + ": " + start.status().message()));
+    ViewState v;
+    if (Status s = setUpWindow(v, a, makeManipulators(path.value(), playback && !a.step, city.value())); !s) {
+        std::fprintf(stderr, "%s: %s\n", kCmd, s.message().c_str());
+        return 1;
     }
-    if (!screenshot.empty() && st.capture->lastWritten != screenshot) return 1;
-    return 0;
+    showMode(v, modes, a.mode);
+    return runLoop(v, modes, a, path.value(), playback);
 }
 
 }  // namespace vista

@@ -3,8 +3,6 @@
 #include <cstring>
 #include <string>
 
-#include "nodes/render/mode_impostor.h"
-#include "cmd/bench.h"
 #include "cmd/commands.h"
 
 namespace {
@@ -33,7 +31,6 @@ void usage(FILE* f) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    vista::registerBenchMode({"impostor", "near field + baked point impostors (needs --baked)", false, vista::makeImpostorMode});
     if (argc < 2) {
         usage(stderr);
         return 2;

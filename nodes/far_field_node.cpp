@@ -56,8 +56,6 @@ osg::BoundingBox FarFieldNode::computeBoundingBox() const {
     return osg::BoundingBox();
 }
 
-namespace {
-
 // vista::Camera from OSG matrices (world frame, x east, y north, z up).
 bool cameraFromOsg(const osg::Matrixd& view, const osg::Matrixd& proj, int w, int h, Camera& c, double& zFar) {
     double fovy = 0, aspect = 0, zn = 0, zf = 0;
@@ -85,7 +83,38 @@ bool cameraFromOsg(const osg::Matrixd& view, const osg::Matrixd& proj, int w, in
     return std::isfinite(c.eye.x) && c.fovY > 0;
 }
 
-}  // namespace
+void drawImageOverViewport(const osg::Viewport& vp, const Image& image, const std::vector<uint8_t>* mask,
+                           std::vector<uint8_t>& upload) {
+    const int W = image.width, H = image.height;
+    if (W != int(vp.width()) || H != int(vp.height()) || !image.valid()) return;
+    // GL rows bottom-up; pixels to keep get alpha 0 and are alpha-tested away.
+    upload.resize(size_t(W) * size_t(H) * 4);
+    for (int y = 0; y < H; ++y) {
+        const size_t src = size_t(y) * size_t(W), dst = size_t(H - 1 - y) * size_t(W);
+        for (int x = 0; x < W; ++x) {
+            const uint8_t* p = &image.rgba[(src + size_t(x)) * 4];
+            uint8_t* q = &upload[(dst + size_t(x)) * 4];
+            q[0] = p[0];
+            q[1] = p[1];
+            q[2] = p[2];
+            q[3] = mask && (*mask)[src + size_t(x)] == 0 ? 0 : 255;
+        }
+    }
+    glPushAttrib(GL_ALL_ATTRIB_BITS);
+    glPushClientAttrib(GL_CLIENT_PIXEL_STORE_BIT);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_LIGHTING);
+    glDisable(GL_TEXTURE_2D);
+    glDisable(GL_BLEND);
+    glEnable(GL_ALPHA_TEST);
+    glAlphaFunc(GL_GREATER, 0.5f);
+    glDepthMask(GL_FALSE);
+    glWindowPos2i(GLint(vp.x()), GLint(vp.y()));
+    glDrawPixels(W, H, GL_RGBA, GL_UNSIGNED_BYTE, upload.data());
+    glPopClientAttrib();
+    glPopAttrib();
+}
 
 void FarFieldNode::drawImplementation(osg::RenderInfo& ri) const {
     std::lock_guard<std::mutex> lock(_mutex);
@@ -122,34 +151,8 @@ void FarFieldNode::drawImplementation(osg::RenderInfo& ri) const {
     if (_image.width != W || _image.height != H) _image = Image(W, H);
     _far->render(c, _depth.data(), _image, _stats);
 
-    // Upload: far-field pixels opaque, covered pixels alpha 0 (alpha-tested away).
-    const std::vector<uint8_t>& cls = _far->classification();
-    _upload.resize(N * 4);
-    for (int y = 0; y < H; ++y) {
-        const size_t src = size_t(y) * size_t(W), dst = size_t(H - 1 - y) * size_t(W);
-        for (int x = 0; x < W; ++x) {
-            const uint8_t* p = &_image.rgba[(src + size_t(x)) * 4];
-            uint8_t* q = &_upload[(dst + size_t(x)) * 4];
-            q[0] = p[0];
-            q[1] = p[1];
-            q[2] = p[2];
-            q[3] = cls[src + size_t(x)] == 0 ? 0 : 255;
-        }
-    }
-    glPushAttrib(GL_ALL_ATTRIB_BITS);
-    glPushClientAttrib(GL_CLIENT_PIXEL_STORE_BIT);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_LIGHTING);
-    glDisable(GL_TEXTURE_2D);
-    glDisable(GL_BLEND);
-    glEnable(GL_ALPHA_TEST);
-    glAlphaFunc(GL_GREATER, 0.5f);
-    glDepthMask(GL_FALSE);
-    glWindowPos2i(GLint(vp->x()), GLint(vp->y()));
-    glDrawPixels(W, H, GL_RGBA, GL_UNSIGNED_BYTE, _upload.data());
-    glPopClientAttrib();
-    glPopAttrib();
+    // Far-field pixels drawn, covered pixels (class 0) kept.
+    drawImageOverViewport(*vp, _image, &_far->classification(), _upload);
     // Anything OSG believes about bound programs/textures is unchanged (fixed function only used here).
     (void)ri.getState();
 }
@@ -157,14 +160,19 @@ void FarFieldNode::drawImplementation(osg::RenderInfo& ri) const {
 osg::ref_ptr<osg::Group> buildHybridScene(const SceneModel& city, const RayScene& rays, const HeightGrid& grid,
                                           const HybridSceneOptions& options, NearFarSplit** splitOut,
                                           FarFieldNode** farOut) {
+    return buildHybridScene(buildNearFieldScene(sceneRoot(city)), rays, grid, options, splitOut, farOut);
+}
+
+osg::ref_ptr<osg::Group> buildHybridScene(const NearFieldScene& nf, const RayScene& rays, const HeightGrid& grid,
+                                          const HybridSceneOptions& options, NearFarSplit** splitOut,
+                                          FarFieldNode** farOut) {
     osg::ref_ptr<osg::Group> root = new osg::Group;
     root->setName("vista.hybrid");
-    NearFieldScene nf = buildNearFieldScene(sceneRoot(city));
     if (nf.rootState) root->setStateSet(nf.rootState.get());
     osg::ref_ptr<NearFarSplit> split = new NearFarSplit;
     split->setNearDistance(options.nearDistance);
     split->setTriangleBudget(options.triangleBudget);
-    for (auto& n : nf.chunks) split->addChild(n.get());
+    for (const auto& n : nf.chunks) split->addChild(n.get());
     root->addChild(split.get());
     osg::ref_ptr<FarFieldNode> far = new FarFieldNode(rays, &grid, options.far);
     far->setSplit(split.get());

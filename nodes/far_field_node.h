@@ -22,17 +22,32 @@
 
 #include <osg/Drawable>
 #include <osg/Group>
+#include <osg/Viewport>
 #include <osg/observer_ptr>
 
 #include "runtime/engine/frame_stats.h"
 #include "runtime/engine/far_field.h"
 #include "runtime/engine/horizon.h"
+#include "nodes/near_far_split.h"
+#include "nodes/near_field_chunks.h"
 
 namespace vista {
 
 class RayScene;
-class NearFarSplit;
 struct SceneModel;
+
+// The vista::Camera of an OSG camera's view and projection matrices (world
+// frame, x east, y north, z up) for a width x height viewport. zFar = the
+// projection's far plane (0 = infinite). False for a non-perspective
+// projection or a non-finite eye.
+bool cameraFromOsg(const osg::Matrixd& view, const osg::Matrixd& proj, int width, int height, Camera& camera,
+                   double& zFar);
+// Draws `image` (row 0 at top, the viewport's size) into the current frame
+// buffer over `vp`, leaving pixels with mask[i] == 0 untouched (mask null:
+// every pixel drawn). Fixed-function GL (glDrawPixels, alpha test), state
+// saved and restored; `scratch` is reused between calls. GL thread only.
+void drawImageOverViewport(const osg::Viewport& vp, const Image& image, const std::vector<uint8_t>* mask,
+                           std::vector<uint8_t>& scratch);
 
 constexpr int kFarFieldRenderBin = 10000;
 
@@ -73,15 +88,20 @@ private:
     mutable std::mutex _mutex;
 };
 
-// Everything `vista view` needs for the hybrid renderer: the city re-chunked
-// under a NearFarSplit plus a FarFieldNode, under a group carrying the city's
-// root state set. `grid` must outlive the returned graph (as must `rays`).
+// The hybrid renderer as one graph (the viewer face of the `hybrid` mode and
+// stock viewers): the city re-chunked under a NearFarSplit plus a
+// FarFieldNode, under a group carrying the city's root state set. `grid`
+// must outlive the returned graph (as must `rays`). The second form reuses
+// chunks already built (nodes are shared, not copied).
 struct HybridSceneOptions {
     double nearDistance = 100.0;
     uint64_t triangleBudget = 0;  // > 0: split by triangle budget instead
     FarFieldOptions far;
 };
 osg::ref_ptr<osg::Group> buildHybridScene(const SceneModel& city, const RayScene& rays, const HeightGrid& grid,
+                                          const HybridSceneOptions& options, NearFarSplit** splitOut = nullptr,
+                                          FarFieldNode** farOut = nullptr);
+osg::ref_ptr<osg::Group> buildHybridScene(const NearFieldScene& nearField, const RayScene& rays, const HeightGrid& grid,
                                           const HybridSceneOptions& options, NearFarSplit** splitOut = nullptr,
                                           FarFieldNode** farOut = nullptr);
 

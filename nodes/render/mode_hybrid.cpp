@@ -1,112 +1,156 @@
-// `hybrid` bench mode: chunked near field + FarField (see mode_hybrid.h).
+// `hybrid`: chunked near field + FarField (mode_hybrid.h).
 #include "nodes/render/mode_hybrid.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <cstring>
-#include <map>
-#include <tuple>
 
-#include <osg/Geode>
-#include <osg/Geometry>
-#include <osg/MatrixTransform>
-
+#include "foundation/timing.h"
+#include "nodes/far_field_node.h"
+#include "nodes/near_far_split.h"
+#include "nodes/render/offscreen.h"
+#include "runtime/engine/adaptive_split.h"
 #include "runtime/engine/far_field.h"
 #include "runtime/engine/horizon.h"
-#include "nodes/render/offscreen.h"
 #include "runtime/engine/ray_scene.h"
 
 namespace vista {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+std::string nearAutoNote(double nearD) { return "near auto: " + std::to_string(int(std::lround(nearD))) + " m"; }
 
-
-class HybridMode : public BenchMode {
+class HybridMode : public RenderMode {
 public:
-    explicit HybridMode(BenchContext& ctx) : _ctx(ctx) {
-        _near = buildNearFieldScene(ctx.scene, kNearChunkSize);
+    explicit HybridMode(ModeContext& ctx) : _ctx(ctx), _near(ctx.nearField()) {
+        _setup.push_back({"chunking", ctx.chunkingMs()});
+        Stopwatch sw;
         _grid = HeightGrid::build(*ctx.city, ctx.rays->frameOrigin(), ctx.options.horizonGrid);
-        _far = std::make_unique<FarField>(*ctx.rays, &_grid, farOptions(ctx.options.nearDistance));
+        _setup.push_back({"height_grid", sw.ms()});
+        _far = std::make_unique<FarField>(*ctx.rays, &_grid, farOptions(ctx.options.fixedNearDistance(), 0.0));
         _adaptive = std::make_unique<AdaptiveSplit>(_near.objects, ctx.rays);
         _root = new osg::Group;
         if (_near.rootState) _root->setStateSet(_near.rootState.get());
     }
     std::string name() const override { return "hybrid"; }
 
-    FarFieldOptions farOptions(double nearD) const {
-        FarFieldOptions o;
-        o.nearDistance = std::max(0.0, nearD);
-        o.pixelBudget = _ctx.options.pixelBudget;
-        o.cache = _ctx.options.cache;
-        o.threads = _ctx.options.threads;
-        return o;
-    }
-
     Status renderFrame(const Camera& camera, Image& out, FrameStats& stats) override {
-        auto t0 = Clock::now();
+        if (!_ctx.renderer) return Status::error("mode hybrid needs an OpenGL renderer (run under `xvfb-run -a`)");
+        Stopwatch sw;
         // Cull: the near/far split.
-        const bool autoSplit = _ctx.options.nearDistance < 0;
-        double nearD = autoSplit ? _adaptive->choose(camera, _ctx.options.pixelBudget) : _ctx.options.nearDistance;
-        std::vector<uint32_t> sel = selectNearField(_near.objects, camera.eye, nearD);
+        const double nearD = chooseNear(camera);
+        std::vector<uint32_t> sel = byBudget() ? selectNearFieldByBudget(_near.objects, camera.eye, _ctx.options.triangleBudget)
+                                               : selectNearField(_near.objects, camera.eye, nearD);
         _root->removeChildren(0, _root->getNumChildren());
         uint64_t tris = 0;
         for (uint32_t i : sel) {
             _root->addChild(_near.chunks[i].get());
             tris += _near.objects[i].triangles;
         }
-        stats.stages.set(Stage::Cull, msSince(t0));
-        if (autoSplit) stats.notes.push_back("near auto: " + std::to_string(int(std::lround(nearD))) + " m");
-        // Near field: GL draw + colour/depth readback (sky background where uncovered).
+        stats.stages.set(Stage::Cull, sw.ms());
+        if (autoSplit()) stats.notes.push_back(nearAutoNote(nearD));
+        // Near field: GL draw + colour/depth readback (sky where uncovered).
+        // Far plane at the near distance: straddling chunks are drawn up to
+        // it, the far field fills the rest with the same shading; FarField's
+        // seam check covers the band between the plane and the near sphere.
+        const double zFar = farPlane(nearD, camera);
         FrameStats ns;
-        // Far plane at the near distance: straddling objects are drawn up to it,
-        // the far field fills the rest seamlessly (same shading); FarField's seam
-        // check covers the band between the plane and the near sphere.
-        const double zFar = std::max(nearD, camera.zNear * 4.0);
-        Status s = _ctx.renderer->render(_root.get(), camera, zFar, &out, &_depth, ns);
-        if (!s) return s;
+        VISTA_RETURN_IF_ERROR(_ctx.renderer->render(_root.get(), camera, zFar, &out, &_depth, ns));
         stats.stages.set(Stage::Near, ns.frameMs);
         stats.cullMs = ns.cullMs;
         stats.drawMs = ns.drawMs;
         stats.triangles = ns.triangles ? ns.triangles : tris;
         stats.drawCalls = ns.drawCalls;
         // Far field on the CPU.
-        FarFieldOptions fo = farOptions(nearD);
-        fo.depthZFar = zFar;
-        _far->setOptions(fo);
-        _far->render(camera, _depth.size() == size_t(camera.width) * size_t(camera.height) ? _depth.data() : nullptr, out,
-                     stats);
-        stats.frameMs = msSince(t0);
-        if (autoSplit) {
+        _far->setOptions(farOptions(nearD, zFar));
+        const bool haveDepth = _depth.size() == size_t(camera.width) * size_t(camera.height);
+        _far->render(camera, haveDepth ? _depth.data() : nullptr, out, stats);
+        // Every traced pixel is a ray; FarField adds its seam-check rays itself
+        // where it counts them (then this does nothing).
+        if (stats.raysCast == 0) stats.raysCast = stats.pixels.rayHit + stats.pixels.rayMiss;
+        stats.frameMs = sw.ms();
+        if (autoSplit())
             _adaptive->record(tris, ns.frameMs, stats.pixels.rayHit + stats.pixels.rayMiss, stats.stages.ms(Stage::Rays));
-        }
         return Status::ok();
     }
     void reset() override { _far->reset(); }
 
+    osg::Node* viewerScene() override {
+        if (!_viewer) {
+            HybridSceneOptions ho;
+            ho.nearDistance = _ctx.options.fixedNearDistance();
+            ho.triangleBudget = _ctx.options.triangleBudget;
+            ho.far = farOptions(ho.nearDistance, 0.0);
+            _viewer = buildHybridScene(_near, *_ctx.rays, _grid, ho, &_split, &_farNode);
+        }
+        return _viewer.get();
+    }
+    double beginViewerFrame(const Camera& camera) override {
+        const double wallMs = _viewerClock.lap();
+        if (autoSplit() && _viewerFrames++ > 0 && _farNode && _split) {
+            const FrameStats fs = _farNode->lastStats();
+            double farMs = 0;
+            fs.stages.forEach([&](Stage, double ms) { farMs += ms; });
+            _adaptive->record(_split->lastNearTriangles(), std::max(0.0, wallMs - farMs), fs.pixels.rayHit + fs.pixels.rayMiss,
+                              fs.stages.ms(Stage::Rays));
+        }
+        _viewerNear = chooseNear(camera);
+        if (_split) _split->setNearDistance(_viewerNear);
+        return farPlane(_viewerNear, camera);
+    }
+    FrameStats lastViewerStats() const override {
+        FrameStats s = _farNode ? _farNode->lastStats() : FrameStats();
+        s.notes.push_back("near chunks drawn " + std::to_string(_split ? _split->lastNearCount() : 0u));
+        if (autoSplit()) s.notes.push_back(nearAutoNote(_viewerNear));
+        return s;
+    }
+
 private:
-    BenchContext& _ctx;
-    NearFieldScene _near;
+    bool byBudget() const { return _ctx.options.triangleBudget > 0; }
+    bool autoSplit() const { return !byBudget() && _ctx.options.nearDistance < 0; }
+    double chooseNear(const Camera& camera) {
+        if (byBudget()) return 0.0;
+        return autoSplit() ? _adaptive->choose(camera, _ctx.options.pixelBudget) : _ctx.options.nearDistance;
+    }
+    double farPlane(double nearD, const Camera& camera) const {
+        return byBudget() ? 0.0 : std::max(nearD, camera.zNear * 4.0);
+    }
+    FarFieldOptions farOptions(double nearD, double zFar) const {
+        FarFieldOptions o;
+        o.nearDistance = std::max(0.0, nearD);
+        o.nearIsDistance = !byBudget();
+        o.pixelBudget = _ctx.options.pixelBudget;
+        o.cache = _ctx.options.cache;
+        o.threads = _ctx.options.threads;
+        o.depthZFar = zFar;
+        return o;
+    }
+
+    ModeContext& _ctx;
+    const NearFieldScene& _near;
     HeightGrid _grid;
     std::unique_ptr<FarField> _far;
     std::unique_ptr<AdaptiveSplit> _adaptive;
     osg::ref_ptr<osg::Group> _root;
     std::vector<float> _depth;
+    // Viewer face.
+    osg::ref_ptr<osg::Node> _viewer;
+    NearFarSplit* _split = nullptr;     // owned by _viewer
+    FarFieldNode* _farNode = nullptr;   // owned by _viewer
+    Stopwatch _viewerClock;
+    int _viewerFrames = 0;
+    double _viewerNear = 0;
 };
 
 }  // namespace
 
-Result<std::unique_ptr<BenchMode>> makeHybridMode(BenchContext& ctx) {
+Result<std::unique_ptr<RenderMode>> makeHybridMode(ModeContext& ctx) {
     if (!ctx.rays) return Status::error("mode hybrid needs the city's ray scene, which is not available");
     if (!ctx.city) return Status::error("mode hybrid needs the loaded city (height grid), which is not available");
-    if (!ctx.renderer) return Status::error("mode hybrid needs an OpenGL renderer (run under `xvfb-run -a`)");
+    if (!ctx.scene) return Status::error("mode hybrid needs a scene graph, none was loaded");
     if (ctx.options.horizonGrid < 1 || ctx.options.horizonGrid > 8192)
         return Status::error("option horizon grid = " + std::to_string(ctx.options.horizonGrid) +
                              " is out of range [1, 8192] (cells per side)");
-    return std::unique_ptr<BenchMode>(new HybridMode(ctx));
+    return std::unique_ptr<RenderMode>(new HybridMode(ctx));
 }
 
 }  // namespace vista

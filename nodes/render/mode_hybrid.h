@@ -1,28 +1,29 @@
-// `hybrid` bench mode (issue 4, thesis ch. 4): near field rasterised through
-// the OffscreenRenderer, far field filled per pixel by FarField (opacity from
-// the near field's depth, horizon, panoramic cache, Embree rays), composited
-// on the CPU (uncovered pixels of the read-back near image are replaced).
+// `hybrid` (thesis ch. 4): the near field rasterised by OSG, the far field
+// filled per pixel by FarField on the CPU (opacity from the near field's
+// depth, seam check, horizon, panoramic cache, Embree rays, composite).
 //
-// Near field: the city re-chunked by nodes/near_field_chunks.h.
-// Options (BenchOptions): nearDistance (< 0 = auto: AdaptiveSplit),
-// pixelBudget, horizonGrid, cache, threads. FrameStats: pixel classes (Table
-// 4.1), stages: cull, near (GL draw + readback), opacity, horizon, cache,
-// rays, composite; notes: skipped stages, chosen near distance in auto mode.
-// Errors: missing ray scene / renderer / city -> error Status from the factory.
+// Near field: the city re-chunked (ModeContext::nearField, 40 m chunks).
+//   By distance (default): chunks whose box comes within the near distance,
+//   drawn with the far plane at max(nearD, 4 zNear); --near auto: the
+//   AdaptiveSplit picks nearD per frame (note "near auto: N m").
+//   By triangle budget (ModeOptions::triangleBudget > 0): the nearest chunks
+//   up to the budget, infinite far plane, no horizon skipping.
+// Options: nearDistance, triangleBudget, pixelBudget, horizonGrid, cache,
+// threads. Stats: pixel classes (Table 4.1), stages cull, near, opacity,
+// seam, horizon, cache, rays, composite; notes: skipped stages, auto choice.
+// Set-up: "chunking" (shared), "height_grid"; needs ctx.rays ("bvh").
+// Viewer: the same chunks under a NearFarSplit + a FarFieldNode
+// (buildHybridScene); beginViewerFrame() applies the same split and far
+// plane (auto: records the previous viewer frame's costs — near ms taken as
+// the frame's wall time minus its far-field stages — and chooses again).
+// Errors: missing ray scene / city, horizon grid out of 1 .. 8192.
 #pragma once
 #include <memory>
-#include <vector>
 
-#include <osg/Group>
-#include <osg/Node>
-#include <osg/StateSet>
-
-#include "foundation/status.h"
-#include "nodes/near_field_chunks.h"
 #include "nodes/render/render_mode.h"
 
 namespace vista {
 
-Result<std::unique_ptr<BenchMode>> makeHybridMode(BenchContext& ctx);
+Result<std::unique_ptr<RenderMode>> makeHybridMode(ModeContext& ctx);
 
 }  // namespace vista

@@ -1,43 +1,48 @@
+// `impostor`: the baked ViewCellSwitch (mode_impostor.h).
 #include "nodes/render/mode_impostor.h"
 
+#include "foundation/timing.h"
 #include "nodes/baked_file.h"
-#include "nodes/render/offscreen.h"
 
 namespace vista {
 namespace {
 
-class ImpostorMode : public BenchMode {
+class ImpostorMode : public GraphMode {
 public:
-    ImpostorMode(BenchContext& ctx, osg::ref_ptr<ViewCellSwitch> root) : _ctx(ctx), _root(std::move(root)) {}
+    ImpostorMode(ModeContext& ctx, osg::ref_ptr<ViewCellSwitch> root, const SetupTimes& setup)
+        : GraphMode(ctx), _root(std::move(root)) {
+        _setup = setup;
+        _graph = _root;
+    }
     std::string name() const override { return "impostor"; }
-    Status renderFrame(const Camera& camera, Image& out, FrameStats& stats) override {
-        if (!_ctx.renderer) return Status::error("mode impostor needs an OpenGL renderer");
-        Status s = _ctx.renderer->render(_root.get(), camera, 0.0, &out, nullptr, stats);
-        if (!s) return s;
+
+protected:
+    void describe(FrameStats& stats) const override {
         const int cell = _root->lastCell();
-        stats.notes.push_back(cell >= 0 ? "cell " + std::to_string(cell) + " (" + std::to_string(_root->impostorsOf(uint32_t(cell)).size()) +
-                                              " impostors)"
+        stats.notes.push_back(cell >= 0 ? "cell " + std::to_string(cell) + " (" +
+                                              std::to_string(_root->impostorsOf(uint32_t(cell)).size()) + " impostors)"
                                         : "no cell");
-        return Status::ok();
     }
 
 private:
-    BenchContext& _ctx;
     osg::ref_ptr<ViewCellSwitch> _root;
 };
 
 }  // namespace
 
-Result<std::unique_ptr<BenchMode>> makeImpostorMode(BenchContext& ctx) {
+Result<std::unique_ptr<RenderMode>> makeImpostorMode(ModeContext& ctx) {
     osg::ref_ptr<ViewCellSwitch> root = dynamic_cast<ViewCellSwitch*>(ctx.scene);
+    SetupTimes setup;
     if (!root) {
         if (ctx.options.bakedFile.empty())
             return Status::error("mode impostor: the city is not baked; pass --baked city.baked.osgb (from 'vista bake')");
+        Stopwatch sw;
         auto bf = loadBakedFile(ctx.options.bakedFile);
         if (!bf) return bf.status();
         root = bf->root;
+        setup.push_back({"baked_load", sw.ms()});
     }
-    return std::unique_ptr<BenchMode>(new ImpostorMode(ctx, root));
+    return std::unique_ptr<RenderMode>(new ImpostorMode(ctx, root, setup));
 }
 
 }  // namespace vista

@@ -1,21 +1,19 @@
-// `impostor` mode of `vista bench`: the walkthrough drawn from a baked file.
-// In a view cell: the city tiles not replaced by the cell's impostors plus the
+// `impostor` (thesis ch. 5): the walkthrough drawn from a baked file. In a
+// view cell: the city tiles the cell's impostors do not replace plus the
 // cell's point impostors; outside every cell: the plain city.
 //
-// Contract: the baked scene comes from ctx.scene when it is a baked root
-// (bench run on a baked file), else from ctx.options.bakedFile (loaded and
-// checked by loadBakedFile); neither -> setup error naming the option.
-// Renders through ctx.renderer (single-threaded, the bench thread).
-// Stats: the renderer's timing/counters, pixels.covered = pixels drawn (not
-// sky), a note "cell N" or "no cell" per frame.
+// Contract: the baked scene is ctx.scene when that is a baked root (a baked
+// file was loaded), else ctx.options.bakedFile (loaded and checked by
+// loadBakedFile; its cost is set-up "baked_load"); neither -> error naming
+// --baked. Notes per frame: "cell N (K impostors)" or "no cell".
+// Viewer: the same ViewCellSwitch, infinite far plane.
 #pragma once
 #include <memory>
 
-#include "foundation/status.h"
 #include "nodes/render/render_mode.h"
 
 namespace vista {
 
-Result<std::unique_ptr<BenchMode>> makeImpostorMode(BenchContext& ctx);
+Result<std::unique_ptr<RenderMode>> makeImpostorMode(ModeContext& ctx);
 
 }  // namespace vista

@@ -8,10 +8,8 @@
 #include <cstring>
 #include <thread>
 
-#include <osg/Depth>
 #include <osg/GL>
 #include <osg/Geometry>
-#include <osg/Texture2D>
 #include <osgUtil/RenderStage>
 #include <osgUtil/SceneView>
 #include <osgUtil/StateGraph>
@@ -20,7 +18,7 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
-#include "citygen/lighting.h"
+#include "foundation/timing.h"
 
 namespace vista {
 
@@ -106,48 +104,23 @@ osg::Matrixd toOsg(const glm::dmat4& m) { return osg::Matrixd(glm::value_ptr(m))
 
 }  // namespace
 
-void renderSky(const Camera& camera, Image& out, double jx, double jy) {
-    if (out.width != camera.width || out.height != camera.height) out = Image(camera.width, camera.height);
-    // Elevation depends only on the row/column, pitch, roll and fov: one
-    // skyColor per pixel, no world position involved.
-    for (int y = 0; y < camera.height; ++y)
-        for (int x = 0; x < camera.width; ++x) {
-            glm::dvec3 d = camera.rayDirection(x + 0.5 + jx, y + 0.5 + jy);
-            out.set(x, y, skyColor(std::asin(std::clamp(d.z, -1.0, 1.0))));
-        }
+void setExactCulling(osg::Camera& cam) {
+    cam.setComputeNearFarMode(osg::CullSettings::DO_NOT_COMPUTE_NEAR_FAR);
+    cam.setCullingMode((cam.getCullingMode() | osg::CullSettings::NEAR_PLANE_CULLING | osg::CullSettings::FAR_PLANE_CULLING) &
+                       ~osg::CullSettings::SMALL_FEATURE_CULLING);
 }
 
 struct OffscreenRenderer::Impl {
     int width = 0, height = 0;
     osg::ref_ptr<osgViewer::Viewer> viewer;
     osg::ref_ptr<osg::Group> root, slot;
-    osg::ref_ptr<osg::Camera> bgCamera;
-    osg::ref_ptr<osg::Geometry> bgQuad;
-    osg::ref_ptr<osg::Image> bgImage;
-    osg::ref_ptr<osg::Texture2D> bgTexture;
+    std::unique_ptr<SkyBackground> sky;
     osg::ref_ptr<Readback> readback;
     std::vector<uint8_t> colorBuf;
     double jx = 0, jy = 0;
-    // Sky cache: the sky image depends on (pitch, roll, fov, size, jitter) only.
-    Image sky;
-    bool skyValid = false;
-    double skyPitch = 0, skyRoll = 0, skyFov = 0, skyJx = 0, skyJy = 0;
-    // Identity of the last background uploaded (to skip redundant uploads).
-    const void* bgKey = nullptr;
-
-    void setBackground(const Image& img, const void* key) {
-        if (key && key == bgKey) return;
-        bgKey = key;
-        // Image row 0 (top) goes to texture row 0; the quad maps t=0 to the top.
-        std::memcpy(bgImage->data(), img.rgba.data(), img.rgba.size());
-        bgImage->dirty();
-    }
 
     Status draw(osg::Node* scene, const Camera& camera, double zFar, Image* color, std::vector<float>* depth,
                 FrameStats& stats) {
-        if (camera.width != width || camera.height != height)
-            return Status::error("camera size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
-                                 " differs from the renderer's " + std::to_string(width) + "x" + std::to_string(height));
         osg::Camera* cam = viewer->getCamera();
         cam->setViewMatrix(toOsg(camera.view()));
         osg::Matrixd proj = toOsg(camera.projection(zFar));
@@ -175,7 +148,7 @@ struct OffscreenRenderer::Impl {
         stats.stages.set(Stage::Readback, readback->readMs);
 
         PrimitiveCounter pc;
-        pc.skip = bgQuad.get();
+        pc.skip = sky->drawable();
         if (auto* r = dynamic_cast<osgViewer::Renderer*>(cam->getRenderer()))
             if (osgUtil::SceneView* sv = r->getSceneView(0)) pc.stage(sv->getRenderStage());
         stats.triangles = pc.triangles;
@@ -252,11 +225,7 @@ Result<std::unique_ptr<OffscreenRenderer>> OffscreenRenderer::create(int width, 
     cam->setViewport(new osg::Viewport(0, 0, width, height));
     cam->setDrawBuffer(GL_BACK);
     cam->setReadBuffer(GL_BACK);
-    cam->setComputeNearFarMode(osg::CullSettings::DO_NOT_COMPUTE_NEAR_FAR);
-    // Exact frustum culling incl. near/far planes (the `near` mode relies on
-    // the far plane); no small-feature culling (the ray caster has none).
-    cam->setCullingMode((cam->getCullingMode() | osg::CullSettings::NEAR_PLANE_CULLING |
-                         osg::CullSettings::FAR_PLANE_CULLING) & ~osg::CullSettings::SMALL_FEATURE_CULLING);
+    setExactCulling(*cam);
     cam->setClearColor(osg::Vec4(0, 0, 0, 1));
     cam->setClearMask(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     cam->setProjectionResizePolicy(osg::Camera::FIXED);
@@ -266,53 +235,11 @@ Result<std::unique_ptr<OffscreenRenderer>> OffscreenRenderer::create(int width, 
     m.readback->height = height;
     cam->setFinalDrawCallback(m.readback.get());
 
-    // Background: a screen-aligned textured quad drawn first, no depth.
-    m.bgImage = new osg::Image;
-    m.bgImage->allocateImage(width, height, 1, GL_RGBA, GL_UNSIGNED_BYTE);
-    m.bgImage->setInternalTextureFormat(GL_RGBA8);
-    std::memset(m.bgImage->data(), 0, size_t(width) * size_t(height) * 4);
-    m.bgTexture = new osg::Texture2D(m.bgImage.get());
-    m.bgTexture->setFilter(osg::Texture::MIN_FILTER, osg::Texture::NEAREST);
-    m.bgTexture->setFilter(osg::Texture::MAG_FILTER, osg::Texture::NEAREST);
-    m.bgTexture->setWrap(osg::Texture::WRAP_S, osg::Texture::CLAMP_TO_EDGE);
-    m.bgTexture->setWrap(osg::Texture::WRAP_T, osg::Texture::CLAMP_TO_EDGE);
-    m.bgTexture->setResizeNonPowerOfTwoHint(false);
-    m.bgTexture->setUnRefImageDataAfterApply(false);
-    m.bgTexture->setDataVariance(osg::Object::DYNAMIC);
-    m.bgQuad = new osg::Geometry;
-    osg::ref_ptr<osg::Vec3Array> v = new osg::Vec3Array;
-    v->push_back({0, 0, 0}); v->push_back({1, 0, 0}); v->push_back({1, 1, 0}); v->push_back({0, 1, 0});
-    osg::ref_ptr<osg::Vec2Array> tc = new osg::Vec2Array;
-    tc->push_back({0, 1}); tc->push_back({1, 1}); tc->push_back({1, 0}); tc->push_back({0, 0});
-    osg::ref_ptr<osg::Vec4Array> c = new osg::Vec4Array;
-    c->push_back({1, 1, 1, 1});
-    m.bgQuad->setVertexArray(v.get());
-    m.bgQuad->setTexCoordArray(0, tc.get());
-    m.bgQuad->setColorArray(c.get(), osg::Array::BIND_OVERALL);
-    m.bgQuad->addPrimitiveSet(new osg::DrawArrays(GL_QUADS, 0, 4));
-    m.bgQuad->setCullingActive(false);
-    m.bgQuad->setUseDisplayList(false);
-    m.bgQuad->setUseVertexBufferObjects(true);
-    osg::StateSet* ss = m.bgQuad->getOrCreateStateSet();
-    ss->setTextureAttributeAndModes(0, m.bgTexture.get(), osg::StateAttribute::ON);
-    ss->setMode(GL_LIGHTING, osg::StateAttribute::OFF | osg::StateAttribute::PROTECTED);
-    ss->setMode(GL_DEPTH_TEST, osg::StateAttribute::OFF | osg::StateAttribute::PROTECTED);
-    ss->setMode(GL_BLEND, osg::StateAttribute::OFF);
-    ss->setAttributeAndModes(new osg::Depth(osg::Depth::ALWAYS, 0, 1, false));
-    ss->setRenderBinDetails(-1000, "RenderBin");
-    m.bgCamera = new osg::Camera;
-    m.bgCamera->setReferenceFrame(osg::Transform::ABSOLUTE_RF);
-    m.bgCamera->setProjectionMatrixAsOrtho2D(0, 1, 0, 1);
-    m.bgCamera->setViewMatrix(osg::Matrixd::identity());
-    m.bgCamera->setRenderOrder(osg::Camera::NESTED_RENDER);
-    m.bgCamera->setClearMask(0);
-    m.bgCamera->setComputeNearFarMode(osg::CullSettings::DO_NOT_COMPUTE_NEAR_FAR);
-    m.bgCamera->setCullingActive(false);
-    m.bgCamera->addChild(m.bgQuad.get());
+    m.sky = std::make_unique<SkyBackground>(width, height);
 
     m.root = new osg::Group;
     m.slot = new osg::Group;
-    m.root->addChild(m.bgCamera.get());
+    m.root->addChild(m.sky->node());
     m.root->addChild(m.slot.get());
     m.viewer->setSceneData(m.root.get());
     m.viewer->realize();
@@ -323,38 +250,14 @@ Result<std::unique_ptr<OffscreenRenderer>> OffscreenRenderer::create(int width, 
 Status OffscreenRenderer::render(osg::Node* scene, const Camera& camera, double zFar, Image* color,
                                  std::vector<float>* depth, FrameStats& stats) {
     Impl& m = *_impl;
-    auto t0 = Clock::now();
-    if (!m.skyValid || m.skyPitch != camera.pitch || m.skyRoll != camera.roll || m.skyFov != camera.fovY ||
-        m.skyJx != m.jx || m.skyJy != m.jy || m.sky.width != camera.width || m.sky.height != camera.height) {
-        renderSky(camera, m.sky, m.jx, m.jy);
-        m.skyValid = true;
-        m.skyPitch = camera.pitch;
-        m.skyRoll = camera.roll;
-        m.skyFov = camera.fovY;
-        m.skyJx = m.jx;
-        m.skyJy = m.jy;
-        m.bgKey = nullptr;
-    }
-    if (m.sky.width != m.width || m.sky.height != m.height)
-        return Status::error("camera size differs from the renderer's");
-    m.setBackground(m.sky, &m.sky);
-    double skyMs = msSince(t0);
+    if (camera.width != m.width || camera.height != m.height)
+        return Status::error("camera size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                             " differs from the renderer's " + std::to_string(m.width) + "x" + std::to_string(m.height));
+    Stopwatch sw;
+    m.sky->showSky(camera, m.jx, m.jy);
+    const double skyMs = sw.ms();
     Status s = m.draw(scene, camera, zFar, color, depth, stats);
     stats.frameMs += skyMs;
-    return s;
-}
-
-Status OffscreenRenderer::renderOver(osg::Node* scene, const Camera& camera, double zFar, const Image& background,
-                                     Image* color, std::vector<float>* depth, FrameStats& stats) {
-    Impl& m = *_impl;
-    if (background.width != m.width || background.height != m.height || !background.valid())
-        return Status::error("background image " + std::to_string(background.width) + "x" +
-                             std::to_string(background.height) + " differs from the renderer's size");
-    auto t0 = Clock::now();
-    m.setBackground(background, nullptr);
-    double upMs = msSince(t0);
-    Status s = m.draw(scene, camera, zFar, color, depth, stats);
-    stats.frameMs += upMs;
     return s;
 }
 

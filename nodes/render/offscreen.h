@@ -3,8 +3,8 @@
 // Camera into an Image, with colour and optional depth read back.
 //
 // Contract: create() fails with a clear Status when no display is available
-// (message says to use `xvfb-run -a`). render() draws the sky gradient
-// (lighting.h skyColor) as background, then `scene` with the camera's view
+// (message says to use `xvfb-run -a`). render() draws the sky (SkyBackground)
+// as background, then `scene` with the camera's view
 // and projection (zFar <= 0: infinite far plane), waits for the GPU
 // (glFinish) and reads back colour (RGBA8, row 0 at top) and, if `depth` is
 // non-null, window-space depth in [0,1] (row 0 at top, 1 = nothing drawn).
@@ -17,8 +17,7 @@
 // stays exact 1,000 km from the origin (tested at 1e6/2e6 m).
 // Depth: standard 24-bit depth with the infinite far plane: resolution
 // ~ d^2 / (zNear * 2^24) metres at distance d (0.3 m at 1.2 km for zNear 0.3).
-// Culling: exact frustum culling including the near and far planes; small-
-// feature culling is off (the ray caster has none either).
+// Culling: setExactCulling() (near and far planes, no small-feature culling).
 // Triangles/draw calls count every leaf of OSG's render bins after cull
 // (instanced primitive sets count every instance; the background is excluded).
 #pragma once
@@ -28,15 +27,21 @@
 
 #include <osg/Node>
 
+#include <osg/Camera>
+
 #include "foundation/status.h"
-#include "nodes/render/render_mode.h"
+#include "nodes/render/sky_background.h"
+#include "runtime/engine/frame_stats.h"
+#include "runtime/engine/image.h"
+#include "runtime/scene/camera.h"
 
 namespace vista {
 
-// Sky background of `camera` (camera.width x camera.height, row 0 at top):
-// skyColor(elevation of the ray through each pixel centre + (jx, jy)).
-// Shared by the GL modes and the ray caster so sky pixels agree exactly.
-void renderSky(const Camera& camera, Image& out, double jx = 0.0, double jy = 0.0);
+// The culling of every vista picture (the bench's renderer and the viewer's
+// camera): exact frustum culling including the near and far planes; no
+// small-feature culling (the ray caster has none). A mode that wants more
+// culling adds it inside its own graph (osglod).
+void setExactCulling(osg::Camera& camera);
 
 class OffscreenRenderer {
 public:
@@ -44,10 +49,6 @@ public:
     ~OffscreenRenderer();
     Status render(osg::Node* scene, const Camera& camera, double zFar, Image* color, std::vector<float>* depth,
                   FrameStats& stats);
-    // Draws `background` (row 0 at top; RGBA8) as a full-screen layer behind
-    // `scene` instead of the sky gradient (the hybrid composite path).
-    Status renderOver(osg::Node* scene, const Camera& camera, double zFar, const Image& background, Image* color,
-                      std::vector<float>* depth, FrameStats& stats);
     int width() const;
     int height() const;
     // Shifts the sample point of every pixel by (dx, dy) pixels (x right,

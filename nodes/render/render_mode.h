@@ -1,26 +1,41 @@
-// BenchMode: one way of rendering a walkthrough frame, compared side by side
-// by `vista bench` (full, near, raycast, osgimpostor, hybrid, impostor).
+// RenderMode: one way of drawing a walkthrough frame (full, near, raycast,
+// osgimpostor, osglod, hybrid, impostor), written once, in nodes/render/
+// mode_<name>.{h,cpp}, and used by both programs through this registry:
+//   `vista bench` times renderFrame() through the shared OffscreenRenderer;
+//   `vista view`  draws viewerScene() in its window, calling
+//                 beginViewerFrame() before every frame (the far plane it
+//                 returns goes into the projection) and lastViewerStats()
+//                 for the HUD.
+// For the same camera both faces draw the same picture (same graph, same far
+// plane, same culling, same sky; tested within 0.5 dB).
 //
-// Contract: a mode is created once per bench run from a BenchContext and then
-// asked for frames in path order, interleaved with the other modes.
-// renderFrame() fills `out` (camera.width x camera.height, row 0 at top) and
-// `stats`; frame_ms is wall time from the start of the frame to an image
-// ready on the CPU side (GL work finished: glFinish before the clock stops).
-// It returns an error Status only for setup problems (no display, Embree
-// failure); never throws. Modes are not thread-safe; one bench thread calls them.
+// Contract: a mode is created once from a ModeContext (which must outlive
+// it) and then asked for frames in path order. renderFrame() fills `out`
+// (camera.width x camera.height, row 0 at top) and `stats`; stats.frameMs is
+// wall time from the start of the frame to an image on the CPU (glFinish
+// included). renderFrame() needs ctx.renderer (error Status without one);
+// viewerScene() needs none. Errors are Status values (setup problems: no
+// display, no ray scene, no baked file); nothing throws. Modes are not
+// thread-safe: one bench thread, or the viewer's single-threaded loop.
+// setupMs() lists the set-up costs the mode itself measured (ms), e.g.
+// {"chunking", "height_grid", "simplify", "impostors", "baked_load"}; the
+// program adds the costs it paid for the mode ("load", "bvh").
 #pragma once
 #include <cstdint>
-#include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
-#include "foundation/status.h"
-#include "runtime/engine/frame_stats.h"
-#include "runtime/scene/camera.h"
-#include "runtime/engine/image.h"
+#include <osg/Group>
+#include <osg/Node>
+#include <osg/ref_ptr>
 
-namespace osg { class Node; }
+#include "foundation/status.h"
+#include "nodes/near_field_chunks.h"
+#include "runtime/engine/frame_stats.h"
+#include "runtime/engine/image.h"
+#include "runtime/scene/camera.h"
 
 namespace vista {
 
@@ -28,30 +43,120 @@ struct SceneModel;
 class RayScene;
 class OffscreenRenderer;
 
-struct BenchOptions {
-    double nearDistance = 100.0;  // metres; < 0 means "auto" (adaptive split)
-    int64_t pixelBudget = -1;     // far-field rays per frame; < 0 = unlimited
-    int horizonGrid = 512;        // horizon height grid resolution (cells per side)
-    bool cache = true;            // panoramic image cache on/off
-    int threads = 0;              // 0 = all cores
-    std::string bakedFile;        // for the impostor mode
+// The near distance of modes that need one when --near is auto (only hybrid
+// chooses per frame).
+constexpr double kDefaultNearDistance = 100.0;
+
+struct ModeOptions {
+    double nearDistance = kDefaultNearDistance;  // metres, 1 .. 100000; < 0 = auto (hybrid: adaptive split)
+    uint64_t triangleBudget = 0;  // hybrid: > 0 = near field = nearest chunks up to this many triangles
+    int64_t pixelBudget = -1;     // hybrid: far-field rays per frame through the cache; < 0 = unlimited
+    int horizonGrid = 512;        // hybrid: horizon height-grid cells per side, 1 .. 8192
+    bool cache = true;            // hybrid: panoramic image cache on/off
+    int threads = 0;              // ray-casting threads; 0 = all cores
+    std::string bakedFile;        // impostor: the baked file (unless the scene itself is baked)
+    // The near distance of modes without an adaptive split.
+    double fixedNearDistance() const { return nearDistance > 0 ? nearDistance : kDefaultNearDistance; }
 };
 
-struct BenchContext {
-    const SceneModel* city = nullptr;
-    osg::Node* scene = nullptr;          // the full scene graph as loaded
-    OffscreenRenderer* renderer = nullptr;  // shared GL context (all GL modes render through it)
-    RayScene* rays = nullptr;            // built on demand by the bench when a mode needs it
-    BenchOptions options;
-};
+// Set-up costs in milliseconds, by name, in the order they were paid.
+using SetupTimes = std::vector<std::pair<std::string, double>>;
 
-class BenchMode {
+// What the modes of one program run share. Public fields are set by the
+// program before the first mode is created; everything must outlive the modes.
+struct ModeContext {
+    const SceneModel* city = nullptr;       // the decoded city (ray scene, height grid); null for hand-built graphs
+    osg::Node* scene = nullptr;             // the city's graph as loaded (a baked file's root is fine)
+    OffscreenRenderer* renderer = nullptr;  // bench: the GL context of renderFrame(); viewer: null
+    const RayScene* rays = nullptr;         // built by the program for modes that need rays
+    ModeOptions options;
+
+    // The plain city: a baked root's tiles without its impostors, else `scene`.
+    osg::Node* plainScene();
+    // The plain city re-chunked (kNearChunkSize), built on the first call and
+    // shared by full, near, osglod and hybrid; its cost in chunkingMs().
+    const NearFieldScene& nearField();
+    double chunkingMs() const { return _chunkingMs; }
+    // Every chunk of nearField(), in its drawOrder, under one group with the
+    // city's root state: the chunked full city (full and near draw it).
+    osg::Group* chunkedCity();
+
+private:
+    osg::ref_ptr<osg::Node> _plain;
+    std::shared_ptr<NearFieldScene> _nearField;
+    osg::ref_ptr<osg::Group> _chunked;
+    double _chunkingMs = 0;
+};
+// Older name of ModeContext (kept for callers not yet renamed).
+using BenchContext = ModeContext;
+
+class RenderMode {
 public:
-    virtual ~BenchMode() = default;
+    virtual ~RenderMode() = default;
     virtual std::string name() const = 0;
+    // Bench face: one timed frame into `out`.
     virtual Status renderFrame(const Camera& camera, Image& out, FrameStats& stats) = 0;
-    // Called when the walkthrough restarts or jumps (caches must be dropped).
+    // The walkthrough restarts or jumps: caches are dropped.
     virtual void reset() {}
+    // Viewer face: the graph to draw (built on the first call, owned by the mode).
+    virtual osg::Node* viewerScene() = 0;
+    // Before every viewer frame, with the camera about to be drawn: returns
+    // the projection's far plane in metres (0 = infinite).
+    virtual double beginViewerFrame(const Camera& camera) {
+        (void)camera;
+        return 0.0;
+    }
+    // What the last viewer frame did (pixel classes, stage times, notes) for the HUD.
+    virtual FrameStats lastViewerStats() const { return FrameStats(); }
+    const SetupTimes& setupMs() const { return _setup; }
+
+protected:
+    SetupTimes _setup;
 };
+
+// A mode that draws one scene graph in both faces (full, near, osgimpostor,
+// osglod, impostor): renderFrame() renders _graph through ctx.renderer with
+// the far plane that prepare() returns; the viewer draws the same graph with
+// the same far plane. describe() adds the mode's notes to a frame's stats.
+class GraphMode : public RenderMode {
+public:
+    Status renderFrame(const Camera& camera, Image& out, FrameStats& stats) override;
+    osg::Node* viewerScene() override { return _graph.get(); }
+    double beginViewerFrame(const Camera& camera) override { return prepare(camera); }
+    FrameStats lastViewerStats() const override {
+        FrameStats s;
+        describe(s);
+        return s;
+    }
+
+protected:
+    explicit GraphMode(ModeContext& ctx) : _ctx(ctx) {}
+    // Called before every frame of either face; returns the far plane (0 = infinite).
+    virtual double prepare(const Camera& camera) {
+        (void)camera;
+        return 0.0;
+    }
+    virtual void describe(FrameStats& stats) const { (void)stats; }
+    ModeContext& _ctx;
+    osg::ref_ptr<osg::Node> _graph;  // set by the mode's constructor
+};
+
+// ---- the registry ------------------------------------------------------------
+using ModeFactory = Result<std::unique_ptr<RenderMode>> (*)(ModeContext& ctx);
+struct ModeInfo {
+    const char* name;
+    const char* summary;  // one line for --help
+    bool needsRays;       // the program builds ctx.rays (RayScene) before creating it
+    bool needsBaked;      // needs a baked scene or options.bakedFile
+    ModeFactory make;
+};
+// Every mode, in display order: full, near, raycast, osgimpostor, osglod, hybrid, impostor.
+const std::vector<ModeInfo>& renderModes();
+const ModeInfo* findRenderMode(const std::string& name);
+// "full, near, raycast, ..." (for messages and help).
+std::string renderModeNames();
+// Creates a mode. Unknown name -> error listing the modes; no ctx.scene, or
+// a mode that needs rays without ctx.rays -> error naming what is missing.
+Result<std::unique_ptr<RenderMode>> createRenderMode(const std::string& name, ModeContext& ctx);
 
 }  // namespace vista

@@ -2,13 +2,15 @@
 // field" in one command. Runs the bench (runBenchmark, modes interleaved per
 // frame in one process) on consecutive samples of one car walkthrough (30 fps
 // spacing, so the panoramic cache sees real frame-to-frame coherence) for:
-//   modes640 / modes320  full, near, raycast, osgimpostor, hybrid (Figs 4.8, 4.10)
+//   modes640 / modes320  full, near, raycast, osgimpostor, osglod, hybrid (Figs 4.8, 4.10)
 //   near                 hybrid at near = 25, 50, 100, 200, 400 m and auto (Fig 4.9)
 //   budget, grid, cache  pixel budgets, horizon grid resolutions, cache on/off
 // and writes OUT/far_field.md (tables: Table 4.1 layout, frame times, speedups,
 // PSNR vs frame time with the Pareto front), OUT/far_field.json, and plots
 // OUT/fig_4_9_near.png, OUT/accuracy_vs_time.png (+ each run's bench output
-// in OUT/<run>/).
+// in OUT/<run>/). Every figure comes from the bench's own summaries
+// (ModeSummary: speedups are medians of same-frame ratios, as in summary.json);
+// nothing is recomputed here.
 //
 // Usage: far_field_sweep CITY.osgb OUT [--frames N] [--only a,b] [--budget B]
 // Needs an X display (xvfb-run -a).
@@ -41,60 +43,19 @@ struct RunSpec {
     std::string name, group, label;
     int width = 640, height = 480;
     std::vector<std::string> modes;
-    BenchOptions options;
+    ModeOptions options;
     double x = 0;  // parameter value (for plots)
 };
 
-struct ModeAgg {
-    double medianMs = 0, meanMs = 0, p95Ms = 0, psnrMedian = 0, psnrMin = 0, psnrMean = 0;
-    std::vector<double> frameMs;
-    // Pixel classes: min/mean/max % and mean count.
-    double pct[5][3] = {};
-    double meanCount[5] = {};
-    std::map<std::string, double> stageMean;
-    std::vector<std::string> notes;
-};
+// Table 4.1 rows in the thesis' order.
+const PixelClassSummary* pixelRows(const ModeSummary& s, int k) {
+    const PixelClassSummary* rows[5] = {&s.rayHit, &s.rayMiss, &s.cache, &s.horizonCulled, &s.covered};
+    return rows[k];
+}
 
-double median(std::vector<double> v) { return percentile(std::move(v), 0.5); }
-
-ModeAgg aggregate(const BenchResult& r, const std::string& mode, int w, int h) {
-    ModeAgg a;
-    std::vector<double> psnr;
-    const double N = double(w) * h;
-    for (auto& c : a.pct) c[0] = 1e9, c[1] = 0, c[2] = -1;
-    int n = 0;
-    std::map<std::string, int> noteCount;
-    for (const auto& f : r.frames) {
-        if (f.mode != mode) continue;
-        ++n;
-        a.frameMs.push_back(f.stats.frameMs);
-        psnr.push_back(f.psnrDb);
-        const uint64_t v[5] = {f.stats.pixels.rayHit, f.stats.pixels.rayMiss, f.stats.pixels.cache,
-                               f.stats.pixels.horizonCulled, f.stats.pixels.covered};
-        for (int k = 0; k < 5; ++k) {
-            double p = 100.0 * double(v[k]) / N;
-            a.pct[k][0] = std::min(a.pct[k][0], p);
-            a.pct[k][1] += p;
-            a.pct[k][2] = std::max(a.pct[k][2], p);
-            a.meanCount[k] += double(v[k]);
-        }
-        f.stats.stages.forEach([&](Stage s, double ms) { a.stageMean[stageName(s)] += ms; });
-        for (const auto& note : f.stats.notes) noteCount[note]++;
-    }
-    if (n == 0) return a;
-    for (int k = 0; k < 5; ++k) {
-        a.pct[k][1] /= n;
-        a.meanCount[k] /= n;
-    }
-    for (auto& [s, ms] : a.stageMean) ms /= n;
-    for (const auto& [note, c] : noteCount) a.notes.push_back(note + " (" + std::to_string(c) + " frames)");
-    a.medianMs = median(a.frameMs);
-    a.p95Ms = percentile(a.frameMs, 0.95);
-    for (double x : a.frameMs) a.meanMs += x / n;
-    a.psnrMedian = median(psnr);
-    a.psnrMin = *std::min_element(psnr.begin(), psnr.end());
-    for (double x : psnr) a.psnrMean += x / n;
-    return a;
+double speedup(const ModeSummary& s) {
+    auto it = s.speedupMedianOfRatios.find("full");
+    return it == s.speedupMedianOfRatios.end() ? std::nan("") : it->second;
 }
 
 std::string fmt(double v, int prec = 1) {
@@ -139,7 +100,7 @@ int main(int argc, char** argv) {
     }
     fs::create_directories(out);
 
-    BenchOptions base;
+    ModeOptions base;
     base.nearDistance = 100;
     base.pixelBudget = budget;
     base.horizonGrid = 512;
@@ -155,7 +116,7 @@ int main(int argc, char** argv) {
         r.label = std::to_string(res) + "x" + std::to_string(res * 3 / 4);
         r.width = res;
         r.height = res * 3 / 4;
-        r.modes = {"full", "near", "raycast", "osgimpostor", "hybrid"};
+        r.modes = {"full", "near", "raycast", "osgimpostor", "osglod", "hybrid"};
         r.options = base;
         add(r);
     }
@@ -210,14 +171,16 @@ int main(int argc, char** argv) {
     J["default_budget"] = budget;
     std::ostringstream md;
     // Accuracy vs time: x = speedup of hybrid over full measured in the same
-    // run (frames interleaved), robust against the machine's load changing
-    // between runs; absolute medians are listed too.
+    // run (frames interleaved; the median of same-frame ratios, as `vista
+    // bench` reports it), robust against the machine's load changing between
+    // runs; absolute medians are listed too.
     struct Point {
         std::string label;
         double speedup, ms, psnr;
     };
     std::vector<Point> accuracy;
-    std::map<std::string, std::map<std::string, ModeAgg>> all;
+    std::map<std::string, std::map<std::string, ModeSummary>> all;
+    std::map<std::string, std::map<std::string, std::vector<double>>> frameMs;
     for (const RunSpec& rs : runs) {
         BenchConfig cfg;
         cfg.width = rs.width;
@@ -236,30 +199,39 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "run %s failed: %s\n", rs.name.c_str(), r.status().message().c_str());
             return 1;
         }
-        for (const auto& m : rs.modes) all[rs.name][m] = aggregate(*r, m, rs.width, rs.height);
-        const ModeAgg& h = all[rs.name]["hybrid"];
-        const ModeAgg& f = all[rs.name]["full"];
+        for (const auto& m : r->modes) {
+            all[rs.name][m.mode] = m;
+            frameMs[rs.name][m.mode] = modeFrameTimes(*r, m.mode);
+        }
+        const ModeSummary& h = all[rs.name]["hybrid"];
         nlohmann::json jr;
         jr["label"] = rs.label;
         jr["size"] = {rs.width, rs.height};
         for (const auto& m : rs.modes) {
-            const ModeAgg& a = all[rs.name][m];
-            jr["modes"][m] = {{"frame_ms_median", a.medianMs}, {"frame_ms_mean", a.meanMs}, {"frame_ms_p95", a.p95Ms},
-                              {"psnr_db_median", a.psnrMedian}, {"psnr_db_min", a.psnrMin}, {"frame_ms", a.frameMs}};
+            const ModeSummary& a = all[rs.name][m];
+            jr["modes"][m] = {{"frame_ms_median", a.frameMsMedian}, {"frame_ms_mean", a.frameMsMean},
+                              {"frame_ms_p95", a.frameMsP95},       {"psnr_db_median", a.psnrDbMedian},
+                              {"psnr_db_min", a.psnrDbMin},         {"frame_ms", frameMs[rs.name][m]},
+                              {"speedup_vs_full_median_of_ratios", speedup(a)}};
         }
-        jr["hybrid_speedup_vs_full_median"] = f.medianMs / h.medianMs;
+        jr["hybrid_speedup_vs_full_median_of_ratios"] = speedup(h);
+        jr["path_motion"] = {{"metres_per_frame_median", r->motion.metresMedian},
+                             {"degrees_per_frame_median", r->motion.degreesMedian}};
         const char* names[5] = {"ray_hit", "ray_miss", "cache", "horizon_culled", "covered"};
-        for (int k = 0; k < 5; ++k)
-            jr["pixels"][names[k]] = {{"min_pct", h.pct[k][0]}, {"mean_pct", h.pct[k][1]}, {"max_pct", h.pct[k][2]},
-                                     {"mean_count", h.meanCount[k]}};
-        jr["stages_ms_mean"] = h.stageMean;
-        jr["notes"] = h.notes;
+        for (int k = 0; k < 5; ++k) {
+            const PixelClassSummary& c = *pixelRows(h, k);
+            jr["pixels"][names[k]] = {{"min_pct", c.minPct}, {"mean_pct", c.meanPct}, {"max_pct", c.maxPct}, {"mean_count", c.meanCount}};
+        }
+        jr["stages_ms_mean"] = h.stagesMsMean;
+        std::vector<std::string> notes;
+        for (const auto& [note, n] : h.noteCounts) notes.push_back(note + " (" + std::to_string(n) + " frames)");
+        jr["notes"] = notes;
         J["runs"][rs.name] = jr;
         if (rs.group != "modes320" && rs.group != "modes640")
-            accuracy.push_back({rs.label, f.medianMs / h.medianMs, h.medianMs, h.psnrMedian});
+            accuracy.push_back({rs.label, speedup(h), h.frameMsMedian, h.psnrDbMedian});
         if (rs.name == "modes640")
-            accuracy.push_back({"default (near 100, budget " + std::to_string(budget) + ", grid 512)", f.medianMs / h.medianMs,
-                                h.medianMs, h.psnrMedian});
+            accuracy.push_back({"default (near 100, budget " + std::to_string(budget) + ", grid 512)", speedup(h),
+                                h.frameMsMedian, h.psnrDbMedian});
     }
 
     // ---- markdown -------------------------------------------------------------
@@ -270,24 +242,25 @@ int main(int argc, char** argv) {
                                "culled by horizon tracing", "covered by polygons"};
     for (const char* run : {"modes640", "modes320"}) {
         if (!all.count(run)) continue;
-        const ModeAgg& h = all[run]["hybrid"];
+        const ModeSummary& h = all[run]["hybrid"];
         const RunSpec* rs = nullptr;
         for (const auto& x : runs)
             if (x.name == run) rs = &x;
         md << "**Table 4.1 (" << rs->label << ")** — of " << rs->width * rs->height << " pixels:\n\n";
         md << "| Of " << rs->width * rs->height << " pixels ... | Min [%] | Avg. [%] | Max [%] | Avg. [#] |\n|---|---:|---:|---:|---:|\n";
-        for (int k = 0; k < 5; ++k)
-            md << "| " << rowNames[k] << " | " << fmt(h.pct[k][0], 2) << " | " << fmt(h.pct[k][1], 2) << " | "
-               << fmt(h.pct[k][2], 2) << " | " << fmt(h.meanCount[k], 0) << " |\n";
-        md << "\nHybrid stage times (mean ms per frame):";
-        for (const auto& [s, ms] : h.stageMean) md << " " << s << " " << fmt(ms, 2) << ";";
+        for (int k = 0; k < 5; ++k) {
+            const PixelClassSummary& c = *pixelRows(h, k);
+            md << "| " << rowNames[k] << " | " << fmt(c.minPct, 2) << " | " << fmt(c.meanPct, 2) << " | " << fmt(c.maxPct, 2)
+               << " | " << fmt(c.meanCount, 0) << " |\n";
+        }
+        md << "\nHybrid stage times (mean ms over the frames each ran in):";
+        for (const auto& [st, ms] : h.stagesMsMean) md << " " << st << " " << fmt(ms, 2) << ";";
         md << "\n\n";
-        md << "**Frame times (" << rs->label << ")**\n\n| mode | median ms | mean ms | p95 ms | speedup vs full (median) | PSNR median dB | PSNR min dB |\n|---|---:|---:|---:|---:|---:|---:|\n";
+        md << "**Frame times (" << rs->label << ")**\n\n| mode | median ms | mean ms | p95 ms | speedup vs full (median of same-frame ratios) | PSNR median dB | PSNR min dB |\n|---|---:|---:|---:|---:|---:|---:|\n";
         for (const auto& m : rs->modes) {
-            const ModeAgg& a = all[run][m];
-            md << "| " << m << " | " << fmt(a.medianMs) << " | " << fmt(a.meanMs) << " | " << fmt(a.p95Ms) << " | "
-               << fmt(all[run]["full"].medianMs / a.medianMs, 2) << " | " << fmt(a.psnrMedian) << " | " << fmt(a.psnrMin)
-               << " |\n";
+            const ModeSummary& a = all[run][m];
+            md << "| " << m << " | " << fmt(a.frameMsMedian) << " | " << fmt(a.frameMsMean) << " | " << fmt(a.frameMsP95)
+               << " | " << fmt(speedup(a), 2) << " | " << fmt(a.psnrDbMedian) << " | " << fmt(a.psnrDbMin) << " |\n";
         }
         md << "\nFrame time per frame: `" << run << "/frame_time.png`.\n\n";
     }
@@ -296,14 +269,15 @@ int main(int argc, char** argv) {
         bool any = false;
         for (const auto& rs : runs) any = any || rs.group == group;
         if (!any) return;
-        md << "**" << title << "**\n\n| run | hybrid median ms | hybrid p95 ms | full median ms | speedup | PSNR median dB | PSNR min dB | rays/frame (mean) | cache px (mean) |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        md << "**" << title << "**\n\n| run | hybrid median ms | hybrid p95 ms | full median ms | speedup (median of same-frame ratios) | PSNR median dB | PSNR min dB | traced px/frame (mean) | cache px (mean) |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
         for (const auto& rs : runs) {
             if (rs.group != group) continue;
-            const ModeAgg& h = all[rs.name]["hybrid"];
-            const ModeAgg& f = all[rs.name]["full"];
-            md << "| " << rs.label << " | " << fmt(h.medianMs) << " | " << fmt(h.p95Ms) << " | " << fmt(f.medianMs) << " | "
-               << fmt(f.medianMs / h.medianMs, 2) << " | " << fmt(h.psnrMedian) << " | " << fmt(h.psnrMin) << " | "
-               << fmt(h.meanCount[0] + h.meanCount[1], 0) << " | " << fmt(h.meanCount[2], 0) << " |\n";
+            const ModeSummary& h = all[rs.name]["hybrid"];
+            const ModeSummary& f = all[rs.name]["full"];
+            md << "| " << rs.label << " | " << fmt(h.frameMsMedian) << " | " << fmt(h.frameMsP95) << " | "
+               << fmt(f.frameMsMedian) << " | " << fmt(speedup(h), 2) << " | " << fmt(h.psnrDbMedian) << " | "
+               << fmt(h.psnrDbMin) << " | " << fmt(h.rayHit.meanCount + h.rayMiss.meanCount, 0) << " | "
+               << fmt(h.cache.meanCount, 0) << " |\n";
         }
         md << "\n";
     };
@@ -324,7 +298,7 @@ int main(int argc, char** argv) {
             PlotSeries s;
             s.label = rs.label;
             s.color = plotColor(ci++);
-            s.y = all[rs.name]["hybrid"].frameMs;
+            s.y = frameMs[rs.name]["hybrid"];
             for (size_t i = 0; i < s.y.size(); ++i) s.x.push_back(double(i));
             ps.series.push_back(s);
         }
@@ -346,7 +320,7 @@ int main(int argc, char** argv) {
             }
         PlotSpec ps;
         ps.title = "what accuracy costs: PSNR vs speedup over full (640x480)";
-        ps.xLabel = "speedup of hybrid over full (median, same run)";
+        ps.xLabel = "speedup of hybrid over full (median of same-frame ratios)";
         ps.yLabel = "median PSNR dB";
         ps.yFromZero = false;
         PlotSeries pts;

@@ -3,16 +3,19 @@
 // with a message when DISPLAY is unset).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <unistd.h>
 
 #include <osg/Geode>
 #include <osg/Geometry>
 #include <osg/MatrixTransform>
+#include <glm/gtc/type_ptr.hpp>
 #include <nlohmann/json.hpp>
 
 #include "citygen/lighting.h"
@@ -21,6 +24,7 @@
 #include "runtime/scene/city_file.h"
 #include "runtime/scene/scene_graph.h"
 #include "runtime/engine/metrics.h"
+#include "nodes/far_field_node.h"
 #include "nodes/render/offscreen.h"
 #include "runtime/scene/paths.h"
 #include "runtime/engine/ray_scene.h"
@@ -206,26 +210,131 @@ TEST(Offscreen, BadSizesAndMismatchedCameras) {
     EXPECT_FALSE(r.value()->render(empty.get(), testCamera(64, 48), 0.0, &img, nullptr, st).isOk());
 }
 
-TEST(Bench, ModeTableAndParsing) {
-    auto m = parseModeList("full,near,raycast,osgimpostor");
-    ASSERT_TRUE(m.isOk());
-    EXPECT_EQ(m->size(), 4u);
-    auto bad = parseModeList("full,warp");
-    ASSERT_FALSE(bad.isOk());
-    EXPECT_NE(bad.status().message().find("available modes: full, near, raycast, osgimpostor"), std::string::npos)
-        << bad.status().message();
-    EXPECT_FALSE(parseModeList("full,full").isOk());
-    BenchContext ctx;
-    EXPECT_FALSE(makeMode("nope", ctx).isOk());
+TEST(RenderModes, RegistryListsEveryModeOnce) {
+    std::vector<std::string> names;
+    for (const auto& m : renderModes()) names.push_back(m.name);
+    EXPECT_EQ(names, (std::vector<std::string>{"full", "near", "raycast", "osgimpostor", "osglod", "hybrid", "impostor"}));
+    EXPECT_EQ(renderModeNames(), "full, near, raycast, osgimpostor, osglod, hybrid, impostor");
+    EXPECT_TRUE(findRenderMode("raycast")->needsRays);
+    EXPECT_TRUE(findRenderMode("hybrid")->needsRays);
+    EXPECT_FALSE(findRenderMode("osglod")->needsRays);
+    EXPECT_TRUE(findRenderMode("impostor")->needsBaked);
+    EXPECT_FALSE(findRenderMode("full")->needsBaked);
+    EXPECT_EQ(findRenderMode("warp"), nullptr);
+    ModeContext ctx;
+    auto unknown = createRenderMode("nope", ctx);
+    ASSERT_FALSE(unknown.isOk());
+    EXPECT_NE(unknown.status().message().find("available modes: full, near"), std::string::npos);
+    auto noScene = createRenderMode("full", ctx);
+    ASSERT_FALSE(noScene.isOk());
+    EXPECT_NE(noScene.status().message().find("scene graph"), std::string::npos) << noScene.status().message();
+    osg::ref_ptr<osg::Group> empty = new osg::Group;
+    ctx.scene = empty.get();
+    auto noRays = createRenderMode("hybrid", ctx);
+    ASSERT_FALSE(noRays.isOk());
+    EXPECT_NE(noRays.status().message().find("ray scene"), std::string::npos) << noRays.status().message();
+    auto noBaked = createRenderMode("impostor", ctx);
+    ASSERT_FALSE(noBaked.isOk());
+    EXPECT_NE(noBaked.status().message().find("--baked"), std::string::npos) << noBaked.status().message();
+    EXPECT_TRUE(createRenderMode("osgimpostor", ctx).isOk()) << "GL modes are created without a renderer (viewer)";
     BenchConfig c;
     c.frames = 0;
     EXPECT_FALSE(validateBenchConfig(c).isOk());
     c.frames = 1;
     c.width = 0;
     EXPECT_FALSE(validateBenchConfig(c).isOk());
+    c.width = 64;
+    c.options.horizonGrid = 0;
+    auto s = validateBenchConfig(c);
+    ASSERT_FALSE(s.isOk());
+    EXPECT_NE(s.message().find("--horizon-grid"), std::string::npos) << s.message();
+    c.options.horizonGrid = 8192;
+    c.options.nearDistance = -1;  // auto
+    EXPECT_TRUE(validateBenchConfig(c).isOk());
+    c.options.nearDistance = 0.5;
+    EXPECT_FALSE(validateBenchConfig(c).isOk());
     EXPECT_DOUBLE_EQ(percentile({3, 1, 2}, 0.5), 2.0);
     EXPECT_DOUBLE_EQ(percentile({1, 2, 3, 4, 5}, 0.95), 4.8);
 }
+
+// The speedup is the median of same-frame ratios, not the ratio of medians.
+TEST(BenchSummary, SpeedupIsTheMedianOfSameFrameRatios) {
+    const double fullMs[5] = {10, 20, 30, 40, 50}, modeMs[5] = {5, 40, 10, 20, 100};
+    BenchResult r;
+    for (int f = 0; f < 5; ++f)
+        for (const char* m : {"full", "x"}) {
+            BenchFrameRecord rec;
+            rec.frame = f;
+            rec.mode = m;
+            rec.stats.frameMs = std::string(m) == "full" ? fullMs[f] : modeMs[f];
+            rec.stats.raysCast = uint64_t(10 * f);
+            r.frames.push_back(rec);
+        }
+    const ModeSummary s = summariseMode(r, "x", speedupBases(), 100.0);
+    ASSERT_EQ(s.speedupMedianOfRatios.count("full"), 1u);
+    EXPECT_DOUBLE_EQ(s.speedupMedianOfRatios.at("full"), 2.0);  // ratios 2, 0.5, 3, 2, 0.5
+    EXPECT_NE(s.speedupMedianOfRatios.at("full"), 30.0 / 20.0);  // the ratio of the medians
+    EXPECT_EQ(s.speedupMedianOfRatios.count("near"), 0u);        // near did not run
+    EXPECT_DOUBLE_EQ(s.frameMsMedian, 20.0);
+    EXPECT_DOUBLE_EQ(s.raysMedian, 20.0);
+    EXPECT_DOUBLE_EQ(medianOfSameFrameRatios({10, 0, 30}, {5, 5, 0}), 2.0);  // frames without a time are skipped
+    EXPECT_TRUE(std::isnan(medianOfSameFrameRatios({}, {})));
+    EXPECT_EQ(modeFrameTimes(r, "x"), (std::vector<double>{5, 40, 10, 20, 100}));
+}
+
+namespace {
+
+std::vector<std::vector<std::string>> readCsv(const std::string& file) {
+    std::ifstream f(file);
+    std::vector<std::vector<std::string>> rows;
+    for (std::string line; std::getline(f, line);) {
+        std::vector<std::string> cells;
+        std::stringstream ss(line);
+        for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+        rows.push_back(cells);
+    }
+    return rows;
+}
+
+// Per mode, the frame_ms column of frames.csv in frame order.
+std::map<std::string, std::vector<double>> frameTimesFromCsv(const std::string& file) {
+    auto rows = readCsv(file);
+    std::map<std::string, std::vector<double>> out;
+    if (rows.empty()) return out;
+    const auto& h = rows[0];
+    const size_t mode = size_t(std::find(h.begin(), h.end(), "mode") - h.begin());
+    const size_t ms = size_t(std::find(h.begin(), h.end(), "frame_ms") - h.begin());
+    for (size_t i = 1; i < rows.size(); ++i) out[rows[i][mode]].push_back(std::stod(rows[i][ms]));
+    return out;
+}
+
+double medianOf(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const size_t h = v.size() / 2;
+    return v.size() % 2 ? v[h] : 0.5 * (v[h - 1] + v[h]);
+}
+
+// The speedups of summary.json recomputed from frames.csv.
+void expectSpeedupsFromCsv(const std::string& dir) {
+    std::ifstream f(dir + "/summary.json");
+    ASSERT_TRUE(f.good()) << dir;
+    const auto j = nlohmann::json::parse(f);
+    const auto times = frameTimesFromCsv(dir + "/frames.csv");
+    for (const auto& [mode, ms] : times)
+        for (const char* base : {"full", "near", "raycast"}) {
+            const std::string key = std::string("speedup_vs_") + base + "_median_of_ratios";
+            if (!times.count(base)) {
+                EXPECT_FALSE(j["modes"][mode].contains(key)) << mode << "." << key;
+                continue;
+            }
+            std::vector<double> ratios;
+            for (size_t k = 0; k < ms.size(); ++k) ratios.push_back(times.at(base)[k] / ms[k]);
+            ASSERT_TRUE(j["modes"][mode][key].is_number()) << mode << "." << key;
+            EXPECT_NEAR(j["modes"][mode][key].get<double>(), medianOf(ratios), 1e-3 * medianOf(ratios)) << mode << "." << key;
+        }
+}
+
+}  // namespace
 
 TEST(Bench, SyntheticSceneSmokeRun) {
     REQUIRE_DISPLAY();
@@ -242,36 +351,139 @@ TEST(Bench, SyntheticSceneSmokeRun) {
     cfg.width = 96;
     cfg.height = 72;
     cfg.frames = 3;
-    cfg.modes = {"near", "osgimpostor"};  // full is added as the reference
-    cfg.options.nearDistance = 120;
+    cfg.modes = {"near", "osgimpostor", "osglod"};  // full is added as the reference
+    cfg.options.nearDistance = 40;                   // the blocks (100 m ahead) lie beyond it
     cfg.outDir = tmpDir("smoke");
     cfg.quiet = true;
+    cfg.loadMs = 12.5;
     auto r = runBenchmark(nullptr, sceneRoot(city), path, cfg);
     ASSERT_TRUE(r.isOk()) << r.status().message();
-    ASSERT_EQ(r->modes.size(), 3u);
+    ASSERT_EQ(r->modes.size(), 4u);
     EXPECT_EQ(r->modes[0].mode, "full");
     EXPECT_EQ(r->modes[0].psnrDbMin, kPsnrCapDb);
-    EXPECT_DOUBLE_EQ(r->modes[0].speedupVsFullMedian, 1.0);
+    EXPECT_DOUBLE_EQ(r->modes[0].speedupMedianOfRatios.at("full"), 1.0);
     EXPECT_GT(r->modes[0].trianglesMedian, 0.0);
-    EXPECT_LE(r->modes[1].trianglesMedian, r->modes[0].trianglesMedian);
+    EXPECT_LT(r->modes[1].trianglesMedian, r->modes[0].trianglesMedian) << "near draws fewer triangles than full";
+    EXPECT_LT(r->modes[1].psnrDbMedian, kPsnrCapDb) << "near misses the blocks beyond 40 m";
+    EXPECT_DOUBLE_EQ(r->modes[1].speedupMedianOfRatios.at("near"), 1.0);
+    EXPECT_EQ(r->motion.frames, 3u);
+    EXPECT_NEAR(r->motion.metresMedian, 7.5, 1e-9);  // samples 0, 2, 3 (spread) are 10 m and 5 m apart
 
     std::ifstream f(cfg.outDir + "/summary.json");
     ASSERT_TRUE(f.good());
     auto j = nlohmann::json::parse(f);
-    for (const char* mode : {"full", "near", "osgimpostor"})
-        for (const char* key : {"frame_ms_median", "frame_ms_p95", "speedup_vs_full_median", "psnr_db_median",
-                                "psnr_db_min", "triangles_median"}) {
-            ASSERT_TRUE(j["modes"].contains(mode)) << mode;
-            EXPECT_TRUE(j["modes"][mode].contains(key)) << mode << "." << key;
-            EXPECT_TRUE(j["modes"][mode][key].is_number()) << mode << "." << key;
-        }
-    std::ifstream csv(cfg.outDir + "/frames.csv");
-    int lines = 0;
-    for (std::string l; std::getline(csv, l);) ++lines;
-    EXPECT_EQ(lines, 1 + 3 * 3);
-    for (const char* file : {"frame_time.png", "quality.png", "images/first_full.png"})
+    for (const char* mode : {"full", "near", "osgimpostor", "osglod"}) {
+        ASSERT_TRUE(j["modes"].contains(mode)) << mode;
+        const auto& m = j["modes"][mode];
+        for (const char* key : {"frame_ms_median", "frame_ms_p95", "speedup_vs_full_median_of_ratios",
+                                "speedup_vs_near_median_of_ratios", "psnr_db_median", "psnr_db_min", "triangles_median",
+                                "rays_per_frame_median"})
+            EXPECT_TRUE(m[key].is_number()) << mode << "." << key;
+        EXPECT_FALSE(m.contains("speedup_vs_full_median")) << "the old name would hide what the number is";
+        EXPECT_FALSE(m.contains("speedup_vs_raycast_median_of_ratios")) << "raycast did not run";
+        EXPECT_EQ(m["setup_ms"]["load"].get<double>(), 12.5) << mode;
+        EXPECT_EQ(m["rays_per_frame_median"].get<double>(), 0.0) << mode;
+    }
+    EXPECT_TRUE(j["modes"]["full"]["setup_ms"].contains("chunking"));
+    EXPECT_TRUE(j["modes"]["osglod"]["setup_ms"].contains("simplify"));
+    EXPECT_TRUE(j["modes"]["osgimpostor"]["setup_ms"].contains("impostors"));
+    EXPECT_NEAR(j["path_motion"]["metres_per_frame_median"].get<double>(), 7.5, 1e-9);
+    EXPECT_TRUE(j["path_motion"]["degrees_per_frame_max"].is_number());
+    EXPECT_TRUE(j["path_run_up_s"].is_null()) << "a hand-made path: run-up unknown";
+    expectSpeedupsFromCsv(cfg.outDir);
+    auto rows = readCsv(cfg.outDir + "/frames.csv");
+    EXPECT_EQ(rows.size(), 1u + 4u * 3u);
+    EXPECT_NE(std::find(rows[0].begin(), rows[0].end(), "rays_cast"), rows[0].end());
+    for (const char* file : {"frame_time.png", "quality.png", "images/first_full.png", "images/first_osglod.png"})
         EXPECT_TRUE(fs::exists(cfg.outDir + "/" + file)) << file;
     fs::remove_all(cfg.outDir);
+}
+
+namespace {
+
+// A tile (double MatrixTransform) holding one coloured box, as a city file's tiles are.
+osg::ref_ptr<osg::Node> boxTile(const glm::dvec3& origin, glm::vec3 lo, glm::vec3 hi, glm::u8vec4 colour) {
+    SceneMesh m;
+    m.origin = origin;
+    addBox(m, lo, hi, colour);
+    osg::ref_ptr<osg::Group> g = sceneOf({m});
+    return g->getChild(0);
+}
+
+struct ImpostorFrame {
+    std::string note;
+    uint64_t triangles = 0, fullTriangles = 0;
+    double psnrVsFull = 0;
+};
+
+// osgimpostor at `first` (sprites made there), then at `cam`, against full at `cam`.
+ImpostorFrame renderOsgImpostor(osg::Group* scene, OffscreenRenderer& renderer, const Camera& first, const Camera& cam) {
+    ModeContext ctx;
+    ctx.scene = scene;
+    ctx.renderer = &renderer;
+    ctx.options.nearDistance = 100;
+    auto imp = createRenderMode("osgimpostor", ctx), full = createRenderMode("full", ctx);
+    EXPECT_TRUE(imp.isOk() && full.isOk());
+    if (!imp.isOk() || !full.isOk()) return {};
+    Image a, b;
+    FrameStats sa, sb;
+    EXPECT_TRUE(imp.value()->renderFrame(first, a, sa).isOk());
+    sa = FrameStats();
+    EXPECT_TRUE(imp.value()->renderFrame(cam, a, sa).isOk());
+    EXPECT_TRUE(full.value()->renderFrame(cam, b, sb).isOk());
+    return {sa.notes.empty() ? "" : sa.notes.back(), sa.triangles, sb.triangles, lumaPsnr(a, b)};
+}
+
+}  // namespace
+
+// Why osgimpostor scored 99 dB on small cities: osgSim::Impostor draws the
+// real geometry while the eye is within nearD + r (or sqrt(2) r) of a tile's
+// centre; when every tile is that close no sprite is ever drawn and the
+// image is exactly `full`'s. A tile beyond the threshold is drawn as a sprite.
+TEST(OsgImpostor, SpritesOnlyBeyondTheThreshold) {
+    REQUIRE_DISPLAY();
+    auto r = OffscreenRenderer::create(160, 120);
+    ASSERT_TRUE(r.isOk()) << r.status().message();
+    Camera first = testCamera(160, 120), cam = first;
+    cam.eye.x += 6.0;  // the sprite made at `first` is reused (its pixel error stays small)
+    osg::ref_ptr<osg::Group> scene = new osg::Group;
+    scene->getOrCreateStateSet()->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
+    scene->addChild(boxTile(kWorld + glm::dvec3(0, 60, 0), {-10, -5, 0}, {10, 5, 12}, {200, 80, 60, 255}));
+    const ImpostorFrame within = renderOsgImpostor(scene.get(), *r.value(), first, cam);
+    EXPECT_EQ(within.note, "impostors: 0 sprites, 1 geometry");
+    EXPECT_EQ(within.triangles, within.fullTriangles);
+    EXPECT_EQ(within.psnrVsFull, kPsnrCapDb) << "within the threshold osgimpostor is full";
+    // A tall block 700 m ahead, right of the near one: beyond 100 m + its radius.
+    scene->addChild(boxTile(kWorld + glm::dvec3(250, 700, 0), {-40, -20, 0}, {40, 20, 120}, {60, 90, 200, 255}));
+    const ImpostorFrame beyond = renderOsgImpostor(scene.get(), *r.value(), first, cam);
+    EXPECT_EQ(beyond.note, "impostors: 1 sprites, 1 geometry");
+    EXPECT_EQ(beyond.triangles, within.triangles + 2) << "the far tile is one sprite quad, not its 10 triangles";
+    EXPECT_EQ(beyond.fullTriangles, within.fullTriangles + 10);
+    EXPECT_LT(beyond.psnrVsFull, kPsnrCapDb) << "the sprite made from the first viewpoint is not the geometry";
+    EXPECT_GT(beyond.psnrVsFull, 20.0) << "the sprite shows the far tile";
+    std::printf("osgimpostor with one sprite vs full: %.2f dB\n", beyond.psnrVsFull);
+}
+
+// The viewer derives the camera of its modes' frame hook from OSG's matrices.
+TEST(ViewCamera, PoseFromOsgMatricesRoundTrips) {
+    Camera c = testCamera(320, 240);
+    c.eye = kWorld + glm::dvec3(12.5, -40.25, 31.0);
+    c.heading = 2.1;
+    c.pitch = -0.3;
+    c.roll = 0.05;
+    for (double zFar : {0.0, 1.0e5}) {
+        Camera back;
+        double zf = -1;
+        ASSERT_TRUE(cameraFromOsg(osg::Matrixd(glm::value_ptr(c.view())), osg::Matrixd(glm::value_ptr(c.projection(zFar))),
+                                  c.width, c.height, back, zf))
+            << zFar;
+        EXPECT_NEAR(glm::length(back.eye - c.eye), 0.0, 1e-6) << zFar;
+        EXPECT_NEAR(back.heading, c.heading, 1e-9) << zFar;
+        EXPECT_NEAR(back.pitch, c.pitch, 1e-9) << zFar;
+        EXPECT_NEAR(back.roll, c.roll, 1e-9) << zFar;
+        EXPECT_NEAR(back.fovY, c.fovY, 1e-9) << zFar;
+        EXPECT_NEAR(zf, zFar, 1e-3 * zFar) << zFar;
+    }
 }
 
 TEST(Bench, SupersampledReferenceIsCloserToItselfThanAliasedFrames) {
@@ -306,12 +518,12 @@ TEST(Bench, RaycastAgreesWithFull) {
     ASSERT_TRUE(rs.isOk()) << rs.status().message();
     auto r = OffscreenRenderer::create(160, 120);
     ASSERT_TRUE(r.isOk()) << r.status().message();
-    BenchContext ctx;
+    ModeContext ctx;
     ctx.city = &city;
     ctx.scene = sceneRoot(city);
     ctx.renderer = r.value().get();
     ctx.rays = rs.value().get();
-    auto full = makeMode("full", ctx), ray = makeMode("raycast", ctx);
+    auto full = createRenderMode("full", ctx), ray = createRenderMode("raycast", ctx);
     ASSERT_TRUE(full.isOk());
     ASSERT_TRUE(ray.isOk()) << ray.status().message();
     Camera cam = testCamera(160, 120);
@@ -327,6 +539,7 @@ TEST(Bench, RaycastAgreesWithFull) {
     EXPECT_GT(sb.pixels.rayHit, 0u);
     EXPECT_GT(sb.pixels.rayMiss, 0u);
     EXPECT_EQ(sb.pixels.rayHit + sb.pixels.rayMiss, uint64_t(160 * 120));
+    EXPECT_EQ(sb.raysCast, uint64_t(160 * 120));
 }
 
 TEST(BenchCli, BadInputExitsWithTwo) {
@@ -344,10 +557,25 @@ TEST(BenchCli, BadInputExitsWithTwo) {
     EXPECT_NE(out.find("--frames"), std::string::npos) << out;
     EXPECT_EQ(runVista("path " + dir + "/missing.osgb -o " + dir + "/p.csv", &out), 2) << out;
     EXPECT_EQ(runVista("bench " + dummy + " --reference ssaa:99 --out " + dir + "/o", &out), 2) << out;
+    EXPECT_EQ(runVista("bench " + dummy + " --fov 0 --out " + dir + "/o", &out), 2) << out;
+    EXPECT_NE(out.find("--fov"), std::string::npos) << out;
+    EXPECT_EQ(runVista("bench " + dummy + " --modes full,impostor --out " + dir + "/o", &out), 2) << out;
+    EXPECT_NE(out.find("--baked"), std::string::npos) << out;
+    // The viewer parses the same options with the same parsers.
+    const std::pair<const char*, const char*> view[] = {{"--size 0x0", "--size"},          {"--size 640", "--size"},
+                                                        {"--mode warp", "available modes"}, {"--near 0", "--near"},
+                                                        {"--budget x", "--budget"},         {"--fov 200", "--fov"},
+                                                        {"--triangle-budget -1", "--triangle-budget"},
+                                                        {"--step --frames 2", "--step"}};
+    for (const auto& [args, what] : view) {
+        EXPECT_EQ(runVista("view " + dummy + " " + args, &out), 2) << args << ": " << out;
+        EXPECT_NE(out.find(what), std::string::npos) << args << ": " << out;
+    }
     fs::remove_all(dir);
 }
 
-// End to end on a generated tiny city: gen -> path -> bench (all modes).
+// End to end on a generated tiny city: gen -> path -> bench (every mode but
+// impostor), checking values: what each mode draws, traces and costs.
 TEST(BenchCli, TinyGeneratedCity) {
     REQUIRE_DISPLAY();
     ASSERT_TRUE(fs::exists(VISTA_BINARY)) << "the vista binary is a build dependency of this test";
@@ -369,59 +597,84 @@ TEST(BenchCli, TinyGeneratedCity) {
             EXPECT_LE(d, 0.5 * L.streets.edges[size_t(e)].width + 0.5) << "t = " << s.t;
         }
     }
-    std::string modes = "full,near,osgimpostor";
-    if (RayScene::build(loaded.value()).isOk()) modes += ",raycast";
-    ASSERT_EQ(runVista("bench " + city + " --path " + dir + "/p.csv --frames 3 --size 96x72 -q --modes " + modes +
-                           " --out " + dir + "/bench",
+    // A short near distance: most of the city is far field (traced by hybrid,
+    // simplified by osglod).
+    ASSERT_EQ(runVista("bench " + city + " --path " + dir + "/p.csv --frames 4 --size 160x120 -q --near 10 "
+                       "--modes full,near,raycast,osgimpostor,osglod,hybrid --out " + dir + "/bench",
                        &out),
               0)
         << out;
     std::ifstream f(dir + "/bench/summary.json");
     auto j = nlohmann::json::parse(f);
-    EXPECT_EQ(j["modes"].size(), size_t(std::count(modes.begin(), modes.end(), ',') + 1));
-    EXPECT_TRUE(j["modes"]["full"]["frame_ms_median"].is_number());
+    ASSERT_EQ(j["modes"].size(), 6u);
+    const auto& m = j["modes"];
+    auto tri = [&](const char* mode) { return m[mode]["triangles_median"].get<double>(); };
+    EXPECT_LT(tri("near"), tri("full")) << "near draws fewer triangles than full";
+    EXPECT_LT(tri("osglod"), tri("full")) << "osglod draws simplified chunks beyond 10 m";
+    EXPECT_LT(tri("hybrid"), tri("full")) << "hybrid rasterises only the near field";
+    const double lodPsnr = m["osglod"]["psnr_db_median"].get<double>();
+    EXPECT_TRUE(std::isfinite(lodPsnr));
+    EXPECT_LT(lodPsnr, kPsnrCapDb) << "osglod is lossy";
+    EXPECT_GT(lodPsnr, 15.0) << "osglod still shows the city";
+    EXPECT_GT(m["hybrid"]["pixels"]["ray_hit"]["mean_count"].get<double>(), 0.0) << "hybrid traced far pixels";
+    EXPECT_EQ(m["raycast"]["rays_per_frame_median"].get<double>(), 160.0 * 120.0);
+    EXPECT_EQ(m["osgimpostor"]["psnr_db_min"].get<double>(), kPsnrCapDb)
+        << "a 300 m city lies within osgimpostor's threshold: geometry, no sprite (see mode_osgimpostor.h)";
+    for (const char* mode : {"raycast", "hybrid"}) EXPECT_GT(m[mode]["setup_ms"]["bvh"].get<double>(), 0.0) << mode;
+    EXPECT_FALSE(m["full"]["setup_ms"].contains("bvh"));
+    EXPECT_GT(m["hybrid"]["setup_ms"]["height_grid"].get<double>(), 0.0);
+    EXPECT_GT(m["osglod"]["setup_ms"]["simplify"].get<double>(), 0.0);
+    EXPECT_GT(m["full"]["setup_ms"]["load"].get<double>(), 0.0);
+    for (const char* mode : {"full", "near", "osgimpostor", "osglod", "hybrid"})
+        EXPECT_TRUE(m[mode]["speedup_vs_raycast_median_of_ratios"].is_number()) << mode;
+    EXPECT_GT(j["path_motion"]["metres_per_frame_median"].get<double>(), 0.0);
+    expectSpeedupsFromCsv(dir + "/bench");
     EXPECT_TRUE(fs::exists(dir + "/bench/frame_time.png"));
-
-    // The viewer runs headless for a few frames and writes a screenshot.
-    ASSERT_EQ(runVista("view " + city + " --seed 2 --size 160x120 --frames 3 --screenshot " + dir + "/shot.png", &out), 0)
-        << out;
-    auto shot = readPng(dir + "/shot.png");
-    ASSERT_TRUE(shot.isOk()) << shot.status().message();
-    EXPECT_EQ(shot->width, 160);
-    EXPECT_EQ(shot->height, 120);
     EXPECT_EQ(runVista("view " + dir + "/missing.osgb --frames 1", &out), 2) << out;
     fs::remove_all(dir);
 }
 
-TEST(Bench, FarFieldOptionParsing) {
-    auto n = parseNearDistance("auto");
-    ASSERT_TRUE(n.isOk());
-    EXPECT_LT(n.value(), 0.0);
-    EXPECT_DOUBLE_EQ(parseNearDistance("250").value(), 250.0);
-    for (const char* bad : {"-5", "0", "0.5", "100001", "abc", "", "12m", "nan"}) {
-        auto r = parseNearDistance(bad);
-        ASSERT_FALSE(r.isOk()) << bad;
-        EXPECT_NE(r.status().message().find("--near"), std::string::npos) << r.status().message();
+// `vista view --frames N --screenshot` works for every mode, and the viewer
+// shows the bench's picture for the same camera and mode (--step: the bench's
+// frames; window size = bench size; no HUD).
+TEST(ViewCli, EveryModeShowsTheBenchPicture) {
+    REQUIRE_DISPLAY();
+    ASSERT_TRUE(fs::exists(VISTA_BINARY)) << "the vista binary is a build dependency of this test";
+    std::string dir = tmpDir("view"), out;
+    const std::string city = dir + "/tiny.osgb", baked = dir + "/tiny.baked.osgb", path = dir + "/p.csv";
+    ASSERT_EQ(runVista("gen --size 300 --seed 3 -q -o " + city, &out), 0) << out;
+    ASSERT_EQ(runVista("bake " + city + " -o " + baked + " --out-size 120 --min-triangles 1 --max-rays 20000 -q", &out), 0)
+        << out;
+    ASSERT_EQ(runVista("path " + city + " --seed 4 --duration 10 -o " + path, &out), 0) << out;
+    const std::string common = " --path " + path + " --size 160x120 --near 30 --budget unlimited --baked " + baked;
+    std::string all;
+    for (const auto& info : renderModes()) all += (all.empty() ? "" : ",") + std::string(info.name);
+    ASSERT_EQ(runVista("bench " + city + common + " --frames 1 -q --modes " + all + " --out " + dir + "/b", &out), 0) << out;
+    for (const auto& info : renderModes()) {
+        const std::string mode = info.name, png = dir + "/view_" + mode + ".png";
+        ASSERT_EQ(runVista("view " + city + common + " --mode " + mode + " --step --frames 1 --no-hud --screenshot " + png, &out), 0)
+            << mode << ": " << out;
+        auto view = readPng(png);
+        ASSERT_TRUE(view.isOk()) << mode << ": " << view.status().message();
+        auto bench = readPng(dir + "/b/images/first_" + mode + ".png");
+        ASSERT_TRUE(bench.isOk()) << mode << ": " << bench.status().message();
+        ASSERT_EQ(view->width, 160);
+        ASSERT_EQ(view->height, 120);
+        const double psnr = lumaPsnr(view.value(), bench.value());
+        EXPECT_GE(psnr, kPsnrCapDb - 0.5) << mode << ": view and bench differ";
+        std::printf("view vs bench, %s: %.2f dB\n", mode.c_str(), psnr);
     }
-    EXPECT_EQ(parsePixelBudget("unlimited").value(), -1);
-    EXPECT_EQ(parsePixelBudget("-1").value(), -1);
-    EXPECT_EQ(parsePixelBudget("0").value(), 0);
-    EXPECT_EQ(parsePixelBudget("1000").value(), 1000);
-    for (const char* bad : {"-7", "1e3", "x", "", "1000000001"}) {
-        auto r = parsePixelBudget(bad);
-        ASSERT_FALSE(r.isOk()) << bad;
-        EXPECT_NE(r.status().message().find("--budget"), std::string::npos) << r.status().message();
+    // Interactive playback (not --step) of every mode runs headless too, with the HUD.
+    for (const auto& info : renderModes()) {
+        const std::string png = dir + "/play.png";
+        EXPECT_EQ(runVista("view " + city + " --seed 2 --size 160x120 --frames 3 --baked " + baked + " --mode " + info.name +
+                               " --screenshot " + png, &out),
+                  0)
+            << info.name << ": " << out;
+        EXPECT_TRUE(readPng(png).isOk()) << info.name;
+        fs::remove(png);
     }
-    BenchConfig c;
-    c.options.horizonGrid = 0;
-    auto s = validateBenchConfig(c);
-    ASSERT_FALSE(s.isOk());
-    EXPECT_NE(s.message().find("--horizon-grid"), std::string::npos) << s.message();
-    c.options.horizonGrid = 8192;
-    c.options.nearDistance = -1;  // auto
-    EXPECT_TRUE(validateBenchConfig(c).isOk());
-    c.options.nearDistance = 0.5;
-    EXPECT_FALSE(validateBenchConfig(c).isOk());
+    fs::remove_all(dir);
 }
 
 TEST(BenchCli, FarFieldFlagsRejectBadValues) {
@@ -452,12 +705,14 @@ TEST(BenchCli, HybridPixelClassesAndOptions) {
         nlohmann::json near, budget;
         int grid;
         bool cache;
+        uint64_t triangleBudget;
     };
     const Run runs[] = {
-        {"--near auto --budget 1000 --no-cache --horizon-grid 64", "auto", 1000, 64, false},
-        {"--near 60 --budget unlimited", 60.0, "unlimited", 512, true},
+        {"--near auto --budget 1000 --no-cache --horizon-grid 64", "auto", 1000, 64, false, 0},
+        {"--near 60 --budget unlimited", 60.0, "unlimited", 512, true, 0},
+        {"--triangle-budget 5000", 100.0, "unlimited", 512, true, 5000},
     };
-    for (size_t i = 0; i < 2; ++i) {
+    for (size_t i = 0; i < 3; ++i) {
         const Run& r = runs[i];
         std::string o = dir + "/b" + std::to_string(i);
         ASSERT_EQ(runVista("bench " + city + " --seed 4 --duration 10 --frames 3 --size 160x120 -q --modes full,hybrid " +
@@ -473,6 +728,10 @@ TEST(BenchCli, HybridPixelClassesAndOptions) {
         EXPECT_EQ(opt["pixel_budget"], r.budget) << r.flags;
         EXPECT_EQ(opt["horizon_grid"], r.grid) << r.flags;
         EXPECT_EQ(opt["cache"], r.cache) << r.flags;
+        EXPECT_EQ(opt["triangle_budget"], r.triangleBudget) << r.flags;
+        if (r.triangleBudget > 0) {  // the nearest chunks up to the budget
+            EXPECT_LT(j["modes"]["hybrid"]["triangles_median"].get<double>(), j["modes"]["full"]["triangles_median"].get<double>());
+        }
         ASSERT_TRUE(j["modes"]["hybrid"].contains("pixels")) << j["modes"]["hybrid"].dump();
         const auto& px = j["modes"]["hybrid"]["pixels"];
         double sum = 0;
@@ -501,25 +760,5 @@ TEST(BenchCli, HybridPixelClassesAndOptions) {
         EXPECT_FALSE(j["modes"]["full"].contains("pixels"));  // full classifies nothing (documented)
     }
 
-    // The viewer's hybrid mode: from the (static) street start position it
-    // shows the same picture as full below the HUD text.
-    Image shots[2];
-    const char* viewModes[2] = {"full", "hybrid"};
-    for (int i = 0; i < 2; ++i) {
-        std::string png = dir + "/view_" + viewModes[i] + ".png";
-        ASSERT_EQ(runVista("view " + city + " --mode " + viewModes[i] + " --size 320x240 --frames 3 --screenshot " + png, &out), 0)
-            << out;
-        auto img = readPng(png);
-        ASSERT_TRUE(img.isOk()) << img.status().message();
-        ASSERT_EQ(img->width, 320);
-        ASSERT_EQ(img->height, 240);
-        Image crop(320, 100);  // rows 140 .. 239: below the HUD lines
-        for (int y = 0; y < 100; ++y)
-            for (int x = 0; x < 320; ++x) crop.set(x, y, img->at(x, 140 + y));
-        shots[i] = crop;
-    }
-    const double viewPsnr = lumaPsnr(shots[1], shots[0]);
-    EXPECT_GE(viewPsnr, 30.0) << "view hybrid vs full";
-    std::printf("vista view hybrid vs full (rows below the HUD): %.2f dB\n", viewPsnr);
     fs::remove_all(dir);
 }

@@ -1,0 +1,180 @@
+// The files of a bench run: frames.csv, summary.json and the plots (bench.h;
+// the keys are documented in docs/user-guide.md). All writes are atomic.
+#include "cmd/bench.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "cmd/plot.h"
+#include "foundation/atomic_file.h"
+#include "runtime/engine/metrics.h"
+#include "runtime/scene/scene_model.h"
+
+namespace vista {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::string cpuModel() {
+    std::ifstream f("/proc/cpuinfo");
+    std::string line;
+    while (std::getline(f, line))
+        if (line.rfind("model name", 0) == 0) {
+            auto p = line.find(':');
+            if (p != std::string::npos) return line.substr(p + 2);
+        }
+    return "unknown";
+}
+
+json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+std::string framesCsv(const BenchResult& result) {
+    std::ostringstream csv;
+    csv << "frame,path_index,t_s,mode,frame_ms,cull_ms,draw_ms,triangles,draw_calls,rays_cast,psnr_db,diff_fraction,"
+           "px_covered,px_horizon_culled,px_cache,px_ray_hit,px_ray_miss,stages_ms,notes\n";
+    char buf[512];
+    for (const auto& r : result.frames) {
+        const FrameStats& s = r.stats;
+        std::snprintf(buf, sizeof(buf), "%d,%zu,%.4f,%s,%.4f,%.4f,%.4f,%llu,%llu,%llu,%.3f,%.6f,%llu,%llu,%llu,%llu,%llu,", r.frame,
+                      r.pathIndex, r.t, r.mode.c_str(), s.frameMs, s.cullMs, s.drawMs, (unsigned long long)s.triangles,
+                      (unsigned long long)s.drawCalls, (unsigned long long)s.raysCast, r.psnrDb, r.diffFraction,
+                      (unsigned long long)s.pixels.covered, (unsigned long long)s.pixels.horizonCulled,
+                      (unsigned long long)s.pixels.cache, (unsigned long long)s.pixels.rayHit,
+                      (unsigned long long)s.pixels.rayMiss);
+        csv << buf;
+        std::string st;
+        s.stages.forEach([&](Stage stage, double ms) {
+            std::snprintf(buf, sizeof(buf), "%s%s=%.3f", st.empty() ? "" : ";", stageName(stage), ms);
+            st += buf;
+        });
+        std::string notes;
+        for (const auto& n : s.notes) notes += (notes.empty() ? "" : ";") + n;
+        std::replace(notes.begin(), notes.end(), ',', ' ');
+        csv << st << "," << notes << "\n";
+    }
+    return csv.str();
+}
+
+json pixelClasses(const ModeSummary& s) {
+    auto cls = [](const PixelClassSummary& c) {
+        return json{{"min_pct", num(c.minPct)}, {"mean_pct", num(c.meanPct)}, {"max_pct", num(c.maxPct)},
+                    {"mean_count", num(c.meanCount)}};
+    };
+    return {{"covered", cls(s.covered)}, {"horizon_culled", cls(s.horizonCulled)}, {"cache", cls(s.cache)},
+            {"ray_hit", cls(s.rayHit)}, {"ray_miss", cls(s.rayMiss)}};
+}
+
+json modeJson(const ModeSummary& s) {
+    json m = {{"frame_ms_median", num(s.frameMsMedian)},
+              {"frame_ms_p95", num(s.frameMsP95)},
+              {"frame_ms_mean", num(s.frameMsMean)},
+              {"psnr_db_median", num(s.psnrDbMedian)},
+              {"psnr_db_min", num(s.psnrDbMin)},
+              {"diff_fraction_median", num(s.diffFractionMedian)},
+              {"triangles_median", num(s.trianglesMedian)},
+              {"draw_calls_median", num(s.drawCallsMedian)},
+              {"cull_ms_median", num(s.cullMsMedian)},
+              {"draw_ms_median", num(s.drawMsMedian)},
+              {"rays_per_frame_median", num(s.raysMedian)}};
+    for (const auto& [base, v] : s.speedupMedianOfRatios) m["speedup_vs_" + base + "_median_of_ratios"] = num(v);
+    if (s.hasPixels) m["pixels"] = pixelClasses(s);
+    json stages = json::object(), runs = json::object(), setup = json::object();
+    for (const auto& kv : s.stagesMsMean) stages[kv.first] = num(kv.second);
+    for (const auto& kv : s.stageRuns) runs[kv.first] = kv.second;
+    for (const auto& kv : s.setupMs) setup[kv.first] = num(kv.second);
+    m["stages_ms"] = stages;
+    m["stage_runs"] = runs;
+    m["setup_ms"] = setup;
+    return m;
+}
+
+json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneModel* city, const Path& path) {
+    const ModeOptions& o = cfg.options;
+    json j;
+    j["command"] = cfg.command;
+    j["city"] = cfg.cityLabel;
+    j["city_triangles"] = city ? city->triangles : 0;
+    j["size"] = {cfg.width, cfg.height};
+    j["frames"] = cfg.frames;
+    j["fov_y_deg"] = cfg.fovYDeg;
+    j["near_m"] = o.nearDistance;  // < 0 = auto (kept for older readers; see "options")
+    j["options"] = {{"near_m", o.nearDistance < 0 ? json("auto") : json(o.nearDistance)},
+                    {"triangle_budget", o.triangleBudget},
+                    {"pixel_budget", o.pixelBudget < 0 ? json("unlimited") : json(o.pixelBudget)},
+                    {"horizon_grid", o.horizonGrid},
+                    {"cache", o.cache},
+                    {"threads", o.threads}};
+    j["reference"] = cfg.referenceSsaa >= 2 ? "ssaa:" + std::to_string(cfg.referenceSsaa) : std::string("full");
+    j["psnr_cap_db"] = kPsnrCapDb;
+    j["diff_threshold"] = cfg.diffThreshold;
+    j["path_samples"] = path.samples.size();
+    j["path_run_up_s"] = cfg.runUpS >= 0 ? json(cfg.runUpS) : json(nullptr);
+    const PathMotion& pm = result.motion;
+    j["path_motion"] = {{"frames", pm.frames},
+                        {"metres_per_frame_median", pm.metresMedian},
+                        {"metres_per_frame_max", pm.metresMax},
+                        {"degrees_per_frame_median", pm.degreesMedian},
+                        {"degrees_per_frame_max", pm.degreesMax}};
+    j["machine"] = {{"gl_renderer", result.glRenderer},
+                    {"cpu", cpuModel()},
+                    {"hardware_threads", std::thread::hardware_concurrency()},
+                    {"load_avg_1min_start", result.loadAvgStart},
+                    {"load_avg_1min_end", result.loadAvgEnd}};
+    json modes = json::object();
+    std::vector<std::string> order;
+    for (const auto& s : result.modes) {
+        modes[s.mode] = modeJson(s);
+        order.push_back(s.mode);
+    }
+    j["modes"] = modes;
+    j["mode_order"] = order;
+    return j;
+}
+
+// Frame time per frame (thesis Fig. 4.8) and quality per frame.
+Status writePlots(const BenchResult& result, const BenchConfig& cfg) {
+    PlotSpec pt, pq;
+    pt.title = "Frame time per frame";
+    pt.xLabel = "frame";
+    pt.yLabel = "ms";
+    pq.title = "Quality vs reference (luma PSNR, cap 99 dB)";
+    pq.xLabel = "frame";
+    pq.yLabel = "dB";
+    pq.yFromZero = false;
+    for (size_t mi = 0; mi < result.modes.size(); ++mi) {
+        PlotSeries st, sq;
+        st.label = sq.label = result.modes[mi].mode;
+        st.color = sq.color = plotColor(mi);
+        for (const auto& r : result.frames) {
+            if (r.mode != st.label) continue;
+            st.x.push_back(double(r.frame));
+            st.y.push_back(r.stats.frameMs);
+            sq.x.push_back(double(r.frame));
+            sq.y.push_back(r.psnrDb);
+        }
+        pt.series.push_back(st);
+        if (mi > 0 || cfg.referenceSsaa >= 2) pq.series.push_back(sq);
+    }
+    VISTA_RETURN_IF_ERROR(writePng(renderPlot(pt), (fs::path(cfg.outDir) / "frame_time.png").string()));
+    return writePng(renderPlot(pq), (fs::path(cfg.outDir) / "quality.png").string());
+}
+
+}  // namespace
+
+Status writeBenchOutputs(const BenchResult& result, const BenchConfig& cfg, const SceneModel* city, const Path& path) {
+    const fs::path dir(cfg.outDir);
+    VISTA_RETURN_IF_ERROR(writeFileAtomic((dir / "frames.csv").string(), framesCsv(result)));
+    VISTA_RETURN_IF_ERROR(
+        writeFileAtomic((dir / "summary.json").string(), summaryJson(result, cfg, city, path).dump(2) + "\n"));
+    return writePlots(result, cfg);
+}
+
+}  // namespace vista

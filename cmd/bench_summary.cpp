@@ -1,0 +1,117 @@
+// Per-mode summaries of a bench run (bench.h): frame-time statistics,
+// same-frame speedups, quality, pixel classes, rays and stage times. The
+// far-field sweep (tests/bench/far_field_sweep.cpp) reads these summaries
+// instead of computing its own.
+#include "cmd/bench.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace vista {
+
+double percentile(std::vector<double> v, double p) {
+    v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
+    if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+    std::sort(v.begin(), v.end());
+    double pos = std::clamp(p, 0.0, 1.0) * double(v.size() - 1);
+    size_t i = size_t(std::floor(pos));
+    double f = pos - double(i);
+    return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v[i];
+}
+
+double medianOfSameFrameRatios(const std::vector<double>& baseMs, const std::vector<double>& modeMs) {
+    std::vector<double> ratios;
+    for (size_t f = 0; f < std::min(baseMs.size(), modeMs.size()); ++f)
+        if (baseMs[f] > 0 && modeMs[f] > 0) ratios.push_back(baseMs[f] / modeMs[f]);
+    return percentile(std::move(ratios), 0.5);
+}
+
+std::vector<double> modeFrameTimes(const BenchResult& r, const std::string& mode) {
+    std::vector<double> ms;
+    for (const auto& f : r.frames)
+        if (f.mode == mode) ms.push_back(f.stats.frameMs);
+    return ms;
+}
+
+const std::vector<std::string>& speedupBases() {
+    static const std::vector<std::string> kBases = {"full", "near", "raycast"};
+    return kBases;
+}
+
+namespace {
+
+// Pixel classes (min / mean / max percent, mean count) over the frames of a mode.
+void summarisePixels(const std::vector<const BenchFrameRecord*>& frames, double npx, ModeSummary& s) {
+    PixelClassSummary* cls[5] = {&s.covered, &s.horizonCulled, &s.cache, &s.rayHit, &s.rayMiss};
+    for (auto* c : cls) c->minPct = std::numeric_limits<double>::infinity();
+    for (const BenchFrameRecord* r : frames) {
+        const PixelCounts& p = r->stats.pixels;
+        const uint64_t c[5] = {p.covered, p.horizonCulled, p.cache, p.rayHit, p.rayMiss};
+        for (int k = 0; k < 5; ++k) {
+            const double pct = 100.0 * double(c[k]) / npx;
+            cls[k]->minPct = std::min(cls[k]->minPct, pct);
+            cls[k]->maxPct = std::max(cls[k]->maxPct, pct);
+            cls[k]->meanPct += pct / double(frames.size());
+            cls[k]->meanCount += double(c[k]) / double(frames.size());
+            s.hasPixels = s.hasPixels || c[k] > 0;
+        }
+    }
+}
+
+void summariseStagesAndNotes(const std::vector<const BenchFrameRecord*>& frames, ModeSummary& s) {
+    std::map<std::string, double> sum;
+    for (const BenchFrameRecord* r : frames) {
+        r->stats.stages.forEach([&](Stage stage, double ms) {
+            sum[stageName(stage)] += ms;
+            ++s.stageRuns[stageName(stage)];
+        });
+        for (const auto& n : r->stats.notes) ++s.noteCounts[n];
+    }
+    for (const auto& kv : sum) s.stagesMsMean[kv.first] = kv.second / double(s.stageRuns[kv.first]);
+}
+
+}  // namespace
+
+ModeSummary summariseMode(const BenchResult& r, const std::string& mode, const std::vector<std::string>& bases,
+                          double npx) {
+    ModeSummary s;
+    s.mode = mode;
+    std::vector<const BenchFrameRecord*> frames;
+    for (const auto& f : r.frames)
+        if (f.mode == mode) frames.push_back(&f);
+    if (frames.empty()) return s;
+    std::vector<double> ms, psnr, diff, tri, calls, cull, draw, rays;
+    for (const BenchFrameRecord* f : frames) {
+        ms.push_back(f->stats.frameMs);
+        psnr.push_back(f->psnrDb);
+        diff.push_back(f->diffFraction);
+        tri.push_back(double(f->stats.triangles));
+        calls.push_back(double(f->stats.drawCalls));
+        cull.push_back(f->stats.cullMs);
+        draw.push_back(f->stats.drawMs);
+        rays.push_back(double(f->stats.raysCast));
+    }
+    s.frameMsMedian = percentile(ms, 0.5);
+    s.frameMsP95 = percentile(ms, 0.95);
+    double sum = 0;
+    for (double v : ms) sum += v;
+    s.frameMsMean = sum / double(ms.size());
+    for (const auto& base : bases) {
+        const std::vector<double> baseMs = modeFrameTimes(r, base);
+        if (baseMs.size() == ms.size()) s.speedupMedianOfRatios[base] = medianOfSameFrameRatios(baseMs, ms);
+    }
+    s.psnrDbMedian = percentile(psnr, 0.5);
+    s.psnrDbMin = *std::min_element(psnr.begin(), psnr.end());
+    s.diffFractionMedian = percentile(diff, 0.5);
+    s.trianglesMedian = percentile(tri, 0.5);
+    s.drawCallsMedian = percentile(calls, 0.5);
+    s.cullMsMedian = percentile(cull, 0.5);
+    s.drawMsMedian = percentile(draw, 0.5);
+    s.raysMedian = percentile(rays, 0.5);
+    summarisePixels(frames, npx, s);
+    summariseStagesAndNotes(frames, s);
+    return s;
+}
+
+}  // namespace vista

@@ -1,0 +1,234 @@
+// Command-line value parsers (options.h).
+#include "cmd/options.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+#include <unistd.h>
+
+#include "runtime/scene/scene_model.h"
+
+namespace vista {
+
+namespace {
+
+// A whole string as a signed integer; false on anything else (sign, spaces, overflow).
+bool toInteger(const std::string& s, long long& v) {
+    if (s.empty()) return false;
+    char* end = nullptr;
+    errno = 0;
+    v = std::strtoll(s.c_str(), &end, 10);
+    return end && *end == 0 && errno != ERANGE;
+}
+
+bool toNumber(const std::string& s, double& v) {
+    if (s.empty()) return false;
+    char* end = nullptr;
+    v = std::strtod(s.c_str(), &end);
+    return end && *end == 0 && std::isfinite(v);
+}
+
+std::string num(double v) {
+    std::ostringstream o;
+    o << v;
+    return o.str();
+}
+
+}  // namespace
+
+Status checkImageSize(int w, int h) {
+    if (w < 1 || h < 1 || w > kMaxImageSide || h > kMaxImageSide)
+        return Status::error("--size " + std::to_string(w) + "x" + std::to_string(h) + " out of range 1x1 .. 8192x8192 pixels");
+    return Status::ok();
+}
+
+Result<ImageSize> parseImageSize(const std::string& s) {
+    const size_t x = s.find_first_of("xX");
+    auto digits = [](const std::string& t) {
+        return !t.empty() && t.size() <= 9 && std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
+    };
+    if (x == std::string::npos || !digits(s.substr(0, x)) || !digits(s.substr(x + 1)))
+        return Status::error("--size '" + s + "': expected WIDTHxHEIGHT, e.g. 640x480 (each 1 .. 8192 pixels)");
+    const long w = std::stol(s.substr(0, x)), h = std::stol(s.substr(x + 1));
+    if (w < 1 || h < 1 || w > kMaxImageSide || h > kMaxImageSide)
+        return Status::error("--size " + s + " out of range 1x1 .. 8192x8192 pixels");
+    return ImageSize{int(w), int(h)};
+}
+
+Status checkNearDistance(double v) {
+    if (v < 0 || (v >= kMinNearDistance && v <= kMaxNearDistance)) return Status::ok();
+    return Status::error("--near " + num(v) + " out of range 1 .. 100000 metres (or 'auto')");
+}
+
+Result<double> parseNearDistance(const std::string& s) {
+    if (s == "auto") return -1.0;
+    double v = 0;
+    if (!toNumber(s, v)) return Status::error("--near '" + s + "': expected a distance in metres (1 .. 100000) or 'auto'");
+    if (v < kMinNearDistance || v > kMaxNearDistance)
+        return Status::error("--near " + s + " out of range 1 .. 100000 metres (or 'auto')");
+    return v;
+}
+
+Status checkPixelBudget(int64_t v) {
+    if (v >= -1 && v <= kMaxPixelBudget) return Status::ok();
+    return Status::error("--budget " + std::to_string(v) + " out of range 0 .. " + std::to_string(kMaxPixelBudget) +
+                         " rays per frame (or 'unlimited' / -1)");
+}
+
+Result<int64_t> parsePixelBudget(const std::string& s) {
+    const std::string range = " rays per frame, or 'unlimited' / -1";
+    if (s == "unlimited" || s == "-1") return int64_t(-1);
+    long long v = 0;
+    if (!toInteger(s, v))
+        return Status::error("--budget '" + s + "': expected an integer 0 .. " + std::to_string(kMaxPixelBudget) + range);
+    if (v < 0 || v > kMaxPixelBudget)
+        return Status::error("--budget " + s + " out of range 0 .. " + std::to_string(kMaxPixelBudget) + range);
+    return int64_t(v);
+}
+
+Result<uint64_t> parseTriangleBudget(const std::string& s) {
+    long long v = 0;
+    if (!toInteger(s, v) || v < 0 || uint64_t(v) > kMaxTriangleBudget)
+        return Status::error("--triangle-budget '" + s + "' out of range 0 .. " + std::to_string(kMaxTriangleBudget) +
+                             " triangles (0 = near field by distance)");
+    return uint64_t(v);
+}
+
+Status checkFov(double deg) {
+    if (deg > kMinFovDeg && deg < kMaxFovDeg) return Status::ok();
+    return Status::error("--fov " + num(deg) + " out of range (1, 179) degrees");
+}
+
+Result<double> parseFov(const std::string& s) {
+    double v = 0;
+    if (!toNumber(s, v)) return Status::error("--fov '" + s + "': expected degrees in (1, 179)");
+    VISTA_RETURN_IF_ERROR(checkFov(v));
+    return v;
+}
+
+Result<int> parseReference(const std::string& s) {
+    if (s == "full") return 0;
+    long long k = 0;
+    if (s.rfind("ssaa:", 0) == 0 && toInteger(s.substr(5), k) && k >= 2 && k <= kMaxReferenceSsaa) return int(k);
+    return Status::error("--reference '" + s + "': expected 'full' or 'ssaa:K' with K in 2 .. 8");
+}
+
+Result<std::string> parseModeName(const std::string& s) {
+    if (!findRenderMode(s)) return Status::error("--mode '" + s + "': unknown mode; available modes: " + renderModeNames());
+    return s;
+}
+
+Result<std::vector<std::string>> parseModeList(const std::string& list) {
+    std::vector<std::string> out;
+    std::stringstream ss(list);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        item.erase(0, item.find_first_not_of(" \t"));
+        if (!item.empty()) item.erase(item.find_last_not_of(" \t") + 1);
+        if (item.empty()) continue;
+        if (!findRenderMode(item))
+            return Status::error("--modes: unknown mode '" + item + "'; available modes: " + renderModeNames());
+        if (std::find(out.begin(), out.end(), item) != out.end())
+            return Status::error("--modes: mode '" + item + "' listed twice");
+        out.push_back(item);
+    }
+    if (out.empty()) return Status::error("--modes '" + list + "': no mode given; available modes: " + renderModeNames());
+    return out;
+}
+
+Result<std::vector<int>> parseSweep(const std::string& s) {
+    const std::string prefix = "sizes=";
+    if (s.rfind(prefix, 0) != 0) return Status::error("--sweep '" + s + "': expected sizes=S1,S2,... (metres)");
+    std::vector<int> out;
+    std::stringstream ss(s.substr(prefix.size()));
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        char* end = nullptr;
+        long v = std::strtol(item.c_str(), &end, 10);
+        if (item.empty() || *end || v < 100 || v > 16000)
+            return Status::error("--sweep: size '" + item + "' out of range 100 .. 16000 metres");
+        out.push_back(int(v));
+    }
+    if (out.empty()) return Status::error("--sweep '" + s + "': no sizes");
+    return out;
+}
+
+void addModeFlags(CLI::App& app, ModeFlags& f) {
+    app.add_option("--near", f.near,
+                   "near-field distance in metres, 1 .. 100000, or 'auto' (hybrid: adaptive split per frame; the other "
+                   "modes then use 100) (default " + f.near + ")");
+    app.add_option("--triangle-budget", f.triangleBudget,
+                   "hybrid: near field = the nearest 40 m chunks up to N triangles instead of --near, 0 .. 10000000000 "
+                   "(default " + f.triangleBudget + " = off)");
+    app.add_option("--budget", f.budget,
+                   "hybrid: far-field rays per frame through the panoramic cache, 0 .. 1000000000, or 'unlimited' / -1 = "
+                   "trace every far pixel, cache bypassed (default " + f.budget + ")");
+    app.add_option("--horizon-grid", f.horizonGrid, "hybrid: horizon height-grid resolution, cells per side, 1 .. 8192 (default 512)");
+    app.add_flag("--no-cache", f.noCache, "hybrid: panoramic image cache off (every far pixel traced)");
+    app.add_option("--baked", f.baked, "impostor: the baked file of this city (from `vista bake`)");
+    app.add_option("--threads", f.threads, "worker threads for ray casting, 0 .. 1024 (0 = all cores)");
+}
+
+Status checkModeOptions(const ModeOptions& o) {
+    VISTA_RETURN_IF_ERROR(checkNearDistance(o.nearDistance));
+    VISTA_RETURN_IF_ERROR(checkPixelBudget(o.pixelBudget));
+    if (o.triangleBudget > kMaxTriangleBudget)
+        return Status::error("--triangle-budget " + std::to_string(o.triangleBudget) + " out of range 0 .. " +
+                             std::to_string(kMaxTriangleBudget) + " triangles");
+    if (o.horizonGrid < 1 || o.horizonGrid > 8192)
+        return Status::error("--horizon-grid " + std::to_string(o.horizonGrid) + " out of range 1 .. 8192 cells per side");
+    if (o.threads < 0 || o.threads > 1024)
+        return Status::error("--threads " + std::to_string(o.threads) + " out of range 0 .. 1024 (0 = all cores)");
+    return Status::ok();
+}
+
+Status parseModeFlags(const ModeFlags& f, ModeOptions& o) {
+    auto nd = parseNearDistance(f.near);
+    if (!nd) return nd.status();
+    auto tb = parseTriangleBudget(f.triangleBudget);
+    if (!tb) return tb.status();
+    auto pb = parsePixelBudget(f.budget);
+    if (!pb) return pb.status();
+    if (!f.baked.empty() && access(f.baked.c_str(), R_OK) != 0)
+        return Status::error("--baked '" + f.baked + "': cannot read the file");
+    o.nearDistance = nd.value();
+    o.triangleBudget = tb.value();
+    o.pixelBudget = pb.value();
+    o.horizonGrid = f.horizonGrid;
+    o.cache = !f.noCache;
+    o.bakedFile = f.baked;
+    o.threads = f.threads;
+    return checkModeOptions(o);
+}
+
+void addPathFlags(CLI::App& app, PathFlags& f, bool timing) {
+    auto* path = app.add_option("--path", f.file, "walkthrough path CSV (from `vista path`)");
+    app.add_option("--seed", f.seed, "make the path from this seed instead of --path (default " + std::to_string(f.seed) + ")")
+        ->excludes(path);
+    app.add_option("--kind", f.kind, "path kind when made from --seed: walk, car, fly (default " + f.kind + ")");
+    if (!timing) return;
+    app.add_option("--duration", f.duration, "path duration in seconds when made from --seed (default 60)");
+    app.add_option("--run-up", f.runUp,
+                   "seconds driven before the path starts and dropped, so it starts at cruising speed, 0 .. 600 (default 8)");
+}
+
+Result<PathOptions> parsePathFlags(const PathFlags& f) {
+    auto k = parsePathKind(f.kind);
+    if (!k) return Status::error("--kind: " + k.status().message());
+    PathOptions po;
+    po.seed = f.seed;
+    po.kind = k.value();
+    po.duration = f.duration;
+    po.runUp = f.runUp;
+    VISTA_RETURN_IF_ERROR(validatePathOptions(po));
+    return po;
+}
+
+Result<Path> walkthroughPath(const PathFlags& f, const PathOptions& po, const SceneModel& city) {
+    if (!f.file.empty()) return loadPathCsv(f.file);
+    return generatePath(city.streets, city.params, po);
+}
+
+}  // namespace vista

@@ -1,0 +1,86 @@
+// Command-line values of the `vista` commands: one parser per option kind,
+// used by every command that takes the option (bench, view, bake_report).
+// Each parser returns the value or an error whose message names the flag,
+// the value and the allowed range; the command prints it and exits with
+// code 2 (reportBadInput). The check* functions apply the same ranges to
+// values set in code (BenchConfig), so a range is written once.
+//
+// PathFlags: the walkthrough options (--path, --seed, --kind, --duration,
+// --run-up) of bench and view. ModeFlags: the render-mode options both `vista bench` and `vista view`
+// accept (--near, --triangle-budget, --budget, --horizon-grid, --no-cache,
+// --baked, --threads), declared once by addModeFlags() and turned into
+// ModeOptions by parseModeFlags().
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "foundation/status.h"
+#include "nodes/render/render_mode.h"
+#include "runtime/scene/paths.h"
+
+namespace vista {
+
+struct ImageSize {
+    int width = 0, height = 0;
+};
+constexpr int kMaxImageSide = 8192;
+constexpr double kMinNearDistance = 1.0, kMaxNearDistance = 100000.0;
+constexpr int64_t kMaxPixelBudget = 1000000000;
+constexpr uint64_t kMaxTriangleBudget = 10000000000ull;
+constexpr double kMinFovDeg = 1.0, kMaxFovDeg = 179.0;
+constexpr int kMaxReferenceSsaa = 8;
+
+// --size WxH (x or X): each side 1 .. 8192 pixels.
+Result<ImageSize> parseImageSize(const std::string& s);
+Status checkImageSize(int width, int height);
+// --near M|auto: metres in 1 .. 100000, or "auto" -> -1.
+Result<double> parseNearDistance(const std::string& s);
+Status checkNearDistance(double metres);  // < 0 = auto
+// --budget N|unlimited: rays per frame 0 .. 1e9, or "unlimited" / "-1" -> -1.
+Result<int64_t> parsePixelBudget(const std::string& s);
+Status checkPixelBudget(int64_t rays);
+// --triangle-budget N: 0 (off: the near field by distance) .. 1e10 triangles.
+Result<uint64_t> parseTriangleBudget(const std::string& s);
+// --fov D: vertical field of view in degrees, strictly between 1 and 179.
+Result<double> parseFov(const std::string& s);
+Status checkFov(double degrees);
+// --reference full|ssaa:K: 0 for `full`, else K in 2 .. 8.
+Result<int> parseReference(const std::string& s);
+// --modes a,b,c: registered modes (render_mode.h), comma-separated, no duplicates.
+Result<std::vector<std::string>> parseModeList(const std::string& s);
+// --mode NAME: one registered mode.
+Result<std::string> parseModeName(const std::string& s);
+// --sweep sizes=S1,S2,...: city sizes in metres, each 100 .. 16000.
+Result<std::vector<int>> parseSweep(const std::string& s);
+
+struct ModeFlags {
+    std::string near = "100", triangleBudget = "0", budget = "unlimited";
+    int horizonGrid = 512;
+    bool noCache = false;
+    std::string baked;
+    int threads = 0;
+};
+// Declares the flags on `app`; the defaults shown are the values in `flags`.
+void addModeFlags(CLI::App& app, ModeFlags& flags);
+// Parses and range-checks the flags into `out`.
+Status parseModeFlags(const ModeFlags& flags, ModeOptions& out);
+// Range checks of ModeOptions (for options set in code).
+Status checkModeOptions(const ModeOptions& o);
+
+struct PathFlags {
+    std::string file, kind = "car";
+    uint64_t seed = 1;
+    double duration = 60.0, runUp = PathOptions().runUp;
+};
+// Declares --path, --seed, --kind and, with `timing`, --duration and --run-up.
+void addPathFlags(CLI::App& app, PathFlags& flags, bool timing);
+// The path options of the flags (kind and ranges checked; messages name the flag).
+Result<PathOptions> parsePathFlags(const PathFlags& flags);
+// The walkthrough: the CSV of --path if given, else a path generated on the
+// city's streets with `options`.
+Result<Path> walkthroughPath(const PathFlags& flags, const PathOptions& options, const SceneModel& city);
+
+}  // namespace vista

@@ -1,0 +1,20 @@
+// `full`: the chunked city, far plane at infinity (mode_full.h).
+#include "nodes/render/mode_full.h"
+
+namespace vista {
+namespace {
+
+class FullMode : public GraphMode {
+public:
+    explicit FullMode(ModeContext& ctx) : GraphMode(ctx) {
+        _graph = ctx.chunkedCity();
+        _setup.push_back({"chunking", ctx.chunkingMs()});
+    }
+    std::string name() const override { return "full"; }
+};
+
+}  // namespace
+
+Result<std::unique_ptr<RenderMode>> makeFullMode(ModeContext& ctx) { return std::unique_ptr<RenderMode>(new FullMode(ctx)); }
+
+}  // namespace vista

@@ -1,0 +1,122 @@
+// The command-line value parsers of cmd/options.h: good values parse, bad
+// ones are errors naming the flag and the allowed range.
+#include <gtest/gtest.h>
+
+#include "cmd/options.h"
+
+using namespace vista;
+
+namespace {
+
+// The error of a failed parse names `flag` and `range`.
+template <class R>
+void expectBad(const R& r, const std::string& input, const std::string& flag, const std::string& range) {
+    ASSERT_FALSE(r.isOk()) << input;
+    EXPECT_NE(r.status().message().find(flag), std::string::npos) << input << ": " << r.status().message();
+    EXPECT_NE(r.status().message().find(range), std::string::npos) << input << ": " << r.status().message();
+}
+
+}  // namespace
+
+TEST(Options, ImageSize) {
+    auto s = parseImageSize("640x480");
+    ASSERT_TRUE(s.isOk());
+    EXPECT_EQ(s->width, 640);
+    EXPECT_EQ(s->height, 480);
+    EXPECT_EQ(parseImageSize("1X1")->height, 1);
+    EXPECT_EQ(parseImageSize("8192x8192")->width, 8192);
+    for (const char* bad : {"0x0", "8193x10", "10x8193", "640", "640x", "x480", "-5x4", "640x480x3", "64 0x480", "ax b", "",
+                            "99999999999x1"})
+        expectBad(parseImageSize(bad), bad, "--size", "8192");
+    EXPECT_TRUE(checkImageSize(1, 1).isOk());
+    EXPECT_FALSE(checkImageSize(0, 5).isOk());
+}
+
+TEST(Options, NearDistanceAndBudgets) {
+    EXPECT_LT(parseNearDistance("auto").value(), 0.0);
+    EXPECT_DOUBLE_EQ(parseNearDistance("250").value(), 250.0);
+    EXPECT_DOUBLE_EQ(parseNearDistance("1").value(), 1.0);
+    for (const char* bad : {"-5", "0", "0.5", "100001", "abc", "", "12m", "nan", "inf"})
+        expectBad(parseNearDistance(bad), bad, "--near", "100000");
+    EXPECT_EQ(parsePixelBudget("unlimited").value(), -1);
+    EXPECT_EQ(parsePixelBudget("-1").value(), -1);
+    EXPECT_EQ(parsePixelBudget("0").value(), 0);
+    EXPECT_EQ(parsePixelBudget("1000000000").value(), 1000000000);
+    for (const char* bad : {"-7", "1e3", "x", "", "1000000001", "99999999999999999999"})
+        expectBad(parsePixelBudget(bad), bad, "--budget", "1000000000");
+    EXPECT_EQ(parseTriangleBudget("0").value(), 0u);
+    EXPECT_EQ(parseTriangleBudget("200000").value(), 200000u);
+    for (const char* bad : {"-1", "1.5", "many", "", "10000000001"})
+        expectBad(parseTriangleBudget(bad), bad, "--triangle-budget", "10000000000");
+}
+
+TEST(Options, FovReferenceAndModes) {
+    EXPECT_DOUBLE_EQ(parseFov("60").value(), 60.0);
+    EXPECT_DOUBLE_EQ(parseFov("1.5").value(), 1.5);
+    for (const char* bad : {"1", "179", "0", "-60", "200", "wide", ""}) expectBad(parseFov(bad), bad, "--fov", "179");
+    EXPECT_EQ(parseReference("full").value(), 0);
+    EXPECT_EQ(parseReference("ssaa:2").value(), 2);
+    EXPECT_EQ(parseReference("ssaa:8").value(), 8);
+    for (const char* bad : {"ssaa:1", "ssaa:9", "ssaa:", "ssaa:x", "ssaa:4x", "half", ""})
+        expectBad(parseReference(bad), bad, "--reference", "2 .. 8");
+    auto m = parseModeList("full, near,osglod ,hybrid");
+    ASSERT_TRUE(m.isOk()) << m.status().message();
+    EXPECT_EQ(m.value(), (std::vector<std::string>{"full", "near", "osglod", "hybrid"}));
+    expectBad(parseModeList("full,warp"), "full,warp", "--modes", "available modes: full, near, raycast, osgimpostor, osglod, hybrid, impostor");
+    expectBad(parseModeList("full,full"), "full,full", "--modes", "twice");
+    expectBad(parseModeList(","), ",", "--modes", "available modes");
+    EXPECT_EQ(parseModeName("raycast").value(), "raycast");
+    expectBad(parseModeName("fast"), "fast", "--mode", "available modes");
+    EXPECT_EQ(parseSweep("sizes=500,1000").value(), (std::vector<int>{500, 1000}));
+    for (const char* bad : {"sizes=50", "sizes=", "500,1000", "sizes=1000,x"}) EXPECT_FALSE(parseSweep(bad).isOk()) << bad;
+}
+
+TEST(Options, ModeFlagsBecomeModeOptions) {
+    ModeFlags f;
+    f.near = "auto";
+    f.triangleBudget = "50000";
+    f.budget = "2000";
+    f.horizonGrid = 64;
+    f.noCache = true;
+    f.threads = 2;
+    ModeOptions o;
+    ASSERT_TRUE(parseModeFlags(f, o).isOk());
+    EXPECT_LT(o.nearDistance, 0.0);
+    EXPECT_EQ(o.fixedNearDistance(), kDefaultNearDistance);
+    EXPECT_EQ(o.triangleBudget, 50000u);
+    EXPECT_EQ(o.pixelBudget, 2000);
+    EXPECT_EQ(o.horizonGrid, 64);
+    EXPECT_FALSE(o.cache);
+    EXPECT_EQ(o.threads, 2);
+    struct Bad {
+        ModeFlags flags;
+        const char* flag;
+    };
+    ModeFlags grid, threads, baked, near;
+    grid.horizonGrid = 0;
+    threads.threads = 5000;
+    baked.baked = "/nonexistent/city.baked.osgb";
+    near.near = "-5";
+    for (const Bad& b : {Bad{grid, "--horizon-grid"}, Bad{threads, "--threads"}, Bad{baked, "--baked"}, Bad{near, "--near"}}) {
+        Status s = parseModeFlags(b.flags, o);
+        ASSERT_FALSE(s.isOk()) << b.flag;
+        EXPECT_NE(s.message().find(b.flag), std::string::npos) << s.message();
+    }
+}
+
+TEST(Options, PathFlags) {
+    PathFlags f;
+    f.kind = "walk";
+    f.runUp = 0;
+    auto po = parsePathFlags(f);
+    ASSERT_TRUE(po.isOk()) << po.status().message();
+    EXPECT_EQ(po->kind, PathKind::Walk);
+    EXPECT_EQ(po->runUp, 0.0);
+    f.kind = "boat";
+    EXPECT_FALSE(parsePathFlags(f).isOk());
+    f.kind = "car";
+    f.runUp = 601;
+    auto bad = parsePathFlags(f);
+    ASSERT_FALSE(bad.isOk());
+    EXPECT_NE(bad.status().message().find("run-up"), std::string::npos) << bad.status().message();
+}
