@@ -99,6 +99,8 @@ Status validateBakeJob(const BakeJob& j) {
     if (j.shardN < 1 || j.shardK < 1 || j.shardK > j.shardN)
         return Status::error("--shard " + std::to_string(j.shardK) + "/" + std::to_string(j.shardN) + ": expected K/N with 1 <= K <= N");
     if (j.merge && j.shardN > 1) return Status::error("--merge and --shard exclude each other");
+    VISTA_RETURN_IF_ERROR(checkWritablePath("--output", j.output));
+    if (!j.statsFile.empty()) VISTA_RETURN_IF_ERROR(checkWritablePath("--stats", j.statsFile));
     return Status::ok();
 }
 

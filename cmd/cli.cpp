@@ -29,19 +29,6 @@ int reportBadInput(const std::string& cmd, const Status& s) {
     return 2;
 }
 
-Status checkWritablePath(const std::string& option, const std::string& path) {
-    namespace fs = std::filesystem;
-    if (path.empty()) return Status::error("option " + option + ": empty path");
-    std::error_code ec;
-    fs::path p(path);
-    if (fs::is_directory(p, ec)) return Status::error("option " + option + " = '" + path + "' is a directory, expected a file path");
-    fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
-    if (!fs::is_directory(dir, ec))
-        return Status::error("option " + option + " = '" + path + "': directory '" + dir.string() + "' does not exist");
-    if (access(dir.c_str(), W_OK) != 0)
-        return Status::error("option " + option + " = '" + path + "': directory '" + dir.string() + "' is not writable");
-    return Status::ok();
-}
 
 double peakRssMb() {
     struct rusage ru {};

@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "foundation/atomic_file.h"
 #include "foundation/status.h"
 
 namespace vista {
@@ -15,9 +16,6 @@ namespace vista {
 int parseOrExit(CLI::App& app, int argc, char** argv);
 // Prints "vista <cmd>: <message>" to stderr and returns 2.
 int reportBadInput(const std::string& cmd, const Status& s);
-// Checks that `path` can be created (its directory exists and is writable)
-// without creating it. Error names the option.
-Status checkWritablePath(const std::string& option, const std::string& path);
 // Peak resident set size of this process in MiB.
 double peakRssMb();
 

@@ -61,9 +61,6 @@ int runBake(int argc, char** argv) {
     if (!shard.empty())
         if (Status s = parseShard(shard, job.shardK, job.shardN); !s) return reportBadInput(cmd, s);
     if (job.merge && !shard.empty()) return reportBadInput(cmd, Status::error("--merge and --shard exclude each other"));
-    if (Status s = checkWritablePath("--output", job.output); !s) return reportBadInput(cmd, s);
-    if (!job.statsFile.empty())
-        if (Status s = checkWritablePath("--stats", job.statsFile); !s) return reportBadInput(cmd, s);
     if (!cellList.empty()) {
         auto ids = parseCellList(cellList);
         if (!ids) return reportBadInput(cmd, ids.status());

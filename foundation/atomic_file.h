@@ -16,6 +16,11 @@ namespace vista {
 
 Status writeFileAtomic(const std::string& path, const std::string& bytes);
 std::string tempPathFor(const std::string& path);
+// Checks, without creating anything, that a file can be written at `path`:
+// not a directory, its directory exists and is writable. The error names
+// `option` (the flag or field that gave the path), the path and the reason.
+// Long jobs call it before they start, so they never fail at the end.
+Status checkWritablePath(const std::string& option, const std::string& path);
 // strerror(errno) as a string (for messages).
 std::string errnoText();
 

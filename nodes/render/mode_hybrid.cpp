@@ -64,9 +64,6 @@ public:
         _far->setOptions(farOptions(nearD, zFar));
         const bool haveDepth = _depth.size() == size_t(camera.width) * size_t(camera.height);
         _far->render(camera, haveDepth ? _depth.data() : nullptr, out, stats);
-        // Every traced pixel is a ray; FarField adds its seam-check rays itself
-        // where it counts them (then this does nothing).
-        if (stats.raysCast == 0) stats.raysCast = stats.pixels.rayHit + stats.pixels.rayMiss;
         stats.frameMs = sw.ms();
         if (autoSplit())
             _adaptive->record(tris, ns.frameMs, stats.pixels.rayHit + stats.pixels.rayMiss, stats.stages.ms(Stage::Rays));

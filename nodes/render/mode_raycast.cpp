@@ -7,62 +7,26 @@
 
 #include <osg/Geode>
 #include <osg/RenderInfo>
-#include <tbb/blocked_range.h>
-#include <tbb/combinable.h>
-#include <tbb/parallel_for.h>
 
-#include "citygen/lighting.h"
 #include "foundation/timing.h"
 #include "nodes/far_field_node.h"
+#include "runtime/engine/far_field_rays.h"
 #include "runtime/engine/ray_scene.h"
 
 namespace vista {
 namespace {
 
-// One primary ray per pixel centre into `rays`; fills `out` and the pixel
-// classes, rays and the "rays" stage of `stats`.
-// TODO(merge): call castFrame() / castPrimaryRays() of
-// runtime/engine/far_field_rays.h (branch `far`) instead of this loop.
-void castEveryPixel(const RayScene& rays, const Camera& camera, Image& out, FrameStats& stats) {
+// One primary ray per pixel centre into `rays` (the engine's castFrame: the
+// same packets and colours as the far field's ray stage); fills `out` and the
+// pixel classes, rays and the "rays" stage of `stats`.
+void castEveryPixel(const RayScene& rays, const Camera& camera, Image& out, FrameStats& stats, int threads) {
     Stopwatch sw;
     if (out.width != camera.width || out.height != camera.height) out = Image(camera.width, camera.height);
-    const glm::vec3 org(camera.eye - rays.frameOrigin());
-    const int W = camera.width;
-    // Camera::rayDirection with the basis hoisted out of the pixel loop
-    // (same operations in the same order: bit-identical directions).
-    const glm::dvec3 fw = camera.forward(), rt = camera.right(), up = camera.up();
-    const double tanHalf = std::tan(0.5 * camera.fovY), aspect = double(camera.width) / double(camera.height);
-    tbb::combinable<uint64_t> hits([] { return uint64_t(0); });
-    tbb::parallel_for(tbb::blocked_range<int>(0, camera.height, 4), [&](const tbb::blocked_range<int>& r) {
-        const size_t n = static_cast<size_t>(W);
-        std::vector<glm::vec3> orgs(n, org), dirs(n);
-        std::vector<glm::dvec3> ddirs(n);
-        std::vector<RayHit> res(n);
-        uint64_t nh = 0;
-        for (int y = r.begin(); y != r.end(); ++y) {
-            for (int x = 0; x < W; ++x) {
-                double sx = (2.0 * (x + 0.5) / camera.width - 1.0) * tanHalf * aspect;
-                double sy = (1.0 - 2.0 * (y + 0.5) / camera.height) * tanHalf;
-                ddirs[size_t(x)] = glm::normalize(fw + sx * rt + sy * up);
-                dirs[size_t(x)] = glm::vec3(ddirs[size_t(x)]);
-            }
-            rays.intersectMany(orgs.data(), dirs.data(), W, res.data());
-            for (int x = 0; x < W; ++x) {
-                const RayHit& h = res[size_t(x)];
-                if (h.hit) {
-                    out.set(x, y, glm::u8vec4(h.color.x, h.color.y, h.color.z, 255));
-                    ++nh;
-                } else {
-                    out.set(x, y, skyColor(std::asin(std::clamp(ddirs[size_t(x)].z, -1.0, 1.0))));
-                }
-            }
-        }
-        hits.local() += nh;
-    });
-    const uint64_t pixels = uint64_t(camera.width) * uint64_t(camera.height);
-    stats.pixels.rayHit = hits.combine(std::plus<uint64_t>());
-    stats.pixels.rayMiss = pixels - stats.pixels.rayHit;
-    stats.raysCast += pixels;
+    RayCounts counts;
+    castFrame(rays, camera, out, counts, threads);
+    stats.pixels.rayHit = counts.hits;
+    stats.pixels.rayMiss = counts.rays - counts.hits;
+    stats.raysCast += counts.rays;
     stats.stages.set(Stage::Rays, sw.ms());
 }
 
@@ -94,7 +58,7 @@ public:
         double zFar = 0;
         if (!cameraFromOsg(cam->getViewMatrix(), cam->getProjectionMatrix(), int(vp.width()), int(vp.height()), c, zFar)) return;
         _stats = FrameStats();
-        castEveryPixel(_rays, c, _image, _stats);
+        castEveryPixel(_rays, c, _image, _stats, 0);
         drawImageOverViewport(vp, _image, nullptr, _upload);
     }
     osg::BoundingBox computeBoundingBox() const override { return osg::BoundingBox(); }
@@ -113,7 +77,7 @@ public:
     std::string name() const override { return "raycast"; }
     Status renderFrame(const Camera& camera, Image& out, FrameStats& stats) override {
         Stopwatch sw;
-        castEveryPixel(*_ctx.rays, camera, out, stats);
+        castEveryPixel(*_ctx.rays, camera, out, stats, _ctx.options.threads);
         stats.frameMs = sw.ms();
         stats.drawMs = stats.frameMs;
         return Status::ok();

@@ -87,8 +87,6 @@ private:
     osg::ref_ptr<osg::Group> _chunked;
     double _chunkingMs = 0;
 };
-// Older name of ModeContext (kept for callers not yet renamed).
-using BenchContext = ModeContext;
 
 class RenderMode {
 public:

@@ -959,7 +959,7 @@ TEST(ImpostorMode, DrawsImpostorsInTheCellAndResemblesTheGeometry) {
     CellResult cr = bakeCell(in, in.cells[0], p);
     ASSERT_EQ(cr.impostors.size(), 2u);
     auto root = assembleBakedScene(*city, in.cells, {cr}, p.canonical());
-    BenchContext ctx;
+    ModeContext ctx;
     ctx.scene = root.get();
     ctx.renderer = renderer->get();
     auto mode = makeImpostorMode(ctx);
@@ -982,7 +982,7 @@ TEST(ImpostorMode, DrawsImpostorsInTheCellAndResemblesTheGeometry) {
     EXPECT_LT(psnr, kPsnrCapDb) << "the impostor was not drawn (identical to the plain city)";
     EXPECT_GT(psnr, 25.0) << "the impostor does not resemble the geometry it replaces";
     // Without a baked scene or file, the mode explains what is missing.
-    BenchContext none;
+    ModeContext none;
     none.renderer = renderer->get();
     auto bad = makeImpostorMode(none);
     ASSERT_FALSE(bad.isOk());

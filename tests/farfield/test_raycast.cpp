@@ -216,7 +216,7 @@ TEST(RayRaster, StillFrameOfHybridAndRaysMatchTheRasteriser) {
     auto renderer = OffscreenRenderer::create(W, H);
     ASSERT_TRUE(renderer.isOk()) << "DISPLAY=" << d << " is set, but the renderer did not start: "
                                  << renderer.status().message();
-    BenchContext ctx;
+    ModeContext ctx;
     ctx.city = &*loaded;
     ctx.scene = sceneRoot(*loaded);
     ctx.renderer = renderer->get();
