@@ -1,26 +1,26 @@
 #!/usr/bin/env bash
 # Regenerates the measurements of docs/results.md, "Issue 3: measuring instrument":
-# the 2 km city's four modes side by side at 640x480 and 320x240 (car path), the
+# the 2 km city's six modes side by side at 640x480 and 320x240 (car path), the
 # fly-over, and the size sweep. Prints the Markdown tables on stdout.
 #
 # usage: docs/tools/sweep.sh [VISTA_BINARY] [OUT_DIR]
 #   VISTA_BINARY defaults to build/vista, OUT_DIR to ./results-issue3.
 # Needs an X display; without one it re-runs itself under `xvfb-run -a`.
-# Needs jq. Takes about 10 minutes on 2 cores with llvmpipe.
+# Needs jq. Takes about 20 minutes on 2 cores with llvmpipe.
 set -euo pipefail
 VISTA=$(realpath "${1:-build/vista}")
 OUT=${2:-results-issue3}
-MODES=full,near,raycast,osgimpostor
+MODES=full,near,raycast,osgimpostor,osglod,hybrid
 if [ -z "${DISPLAY:-}" ]; then exec xvfb-run -a "$0" "$VISTA" "$OUT"; fi
 mkdir -p "$OUT" && cd "$OUT"
 
 "$VISTA" gen --size 2000 --seed 1 -q -o city.osgb
 "$VISTA" path city.osgb --seed 1 -o car1.csv
 "$VISTA" path city.osgb --seed 1 --kind fly -o fly1.csv
-"$VISTA" bench city.osgb --path car1.csv --frames 120 --size 640x480 --modes $MODES --out bench640 -q
-"$VISTA" bench city.osgb --path car1.csv --frames 120 --size 320x240 --modes $MODES --out bench320 -q
-"$VISTA" bench city.osgb --path fly1.csv --frames 60 --size 640x480 --modes $MODES --out benchfly640 -q
-"$VISTA" bench --sweep sizes=500,1000,2000,4000 --seed 1 --frames 60 --size 320x240 --modes $MODES --out sweep -q > /dev/null
+"$VISTA" bench city.osgb --path car1.csv --frames 60 --size 640x480 --modes $MODES --out bench640 -q
+"$VISTA" bench city.osgb --path car1.csv --frames 60 --size 320x240 --modes $MODES --out bench320 -q
+"$VISTA" bench city.osgb --path fly1.csv --frames 40 --size 640x480 --modes $MODES --out benchfly640 -q
+"$VISTA" bench --sweep sizes=500,1000,2000,4000 --seed 1 --frames 30 --size 320x240 --modes $MODES --out sweep -q > /dev/null
 
 table() {  # $1 = bench directory
     echo "Command: \`$(jq -r .command "$1/summary.json")\`"
