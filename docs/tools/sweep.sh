@@ -20,7 +20,7 @@ mkdir -p "$OUT" && cd "$OUT"
 "$VISTA" bench city.osgb --path car1.csv --frames 60 --size 640x480 --modes $MODES --out bench640 -q
 "$VISTA" bench city.osgb --path car1.csv --frames 60 --size 320x240 --modes $MODES --out bench320 -q
 "$VISTA" bench city.osgb --path fly1.csv --frames 40 --size 640x480 --modes $MODES --out benchfly640 -q
-"$VISTA" bench --sweep sizes=500,1000,2000,4000 --seed 1 --frames 30 --size 320x240 --modes $MODES --out sweep -q > /dev/null
+"$VISTA" bench --sweep sizes=500,1000,2000,4000 --seed 1 --frames 30 --size 320x240 --modes full,near,raycast,hybrid --out sweep -q > /dev/null
 
 table() {  # $1 = bench directory
     echo "Command: \`$(jq -r .command "$1/summary.json")\`"
@@ -33,6 +33,6 @@ table() {  # $1 = bench directory
 echo "### 640x480, car path"; echo; table bench640
 echo "### 320x240, car path"; echo; table bench320
 echo "### 640x480, fly-over path"; echo; table benchfly640
-echo "### Size sweep (320x240, 60 frames)"; echo
+echo "### Size sweep (320x240, 30 frames; full, near, raycast, hybrid)"; echo
 echo "Command: \`$(jq -r .command sweep/sweep.json)\`"; echo
 cat sweep/sweep.md
