@@ -227,6 +227,8 @@ void makeConifer(TreeShaper& t, int variant, double h) {
     t.blob({0, 0, h * 0.96}, 0.35 + 0.05 * h * 0.05, h * 0.05, 4);
 }
 
+// Kept apart from makeConifer on purpose (duplicates lists the trunk loops as
+// alike): each species' taper and segment count are tuned on their own.
 void makeColumnar(TreeShaper& t, int variant, double h) {
     Rng& rng = t.rng();
     double r0 = h * 0.017;

@@ -16,6 +16,7 @@ int runPath(int argc, char** argv) {
     std::string city, out, kind = "car";
     PathOptions o;
     double yawDeg = 45.0, pitchDeg = o.flyPitch * 180.0 / kPi;
+    // Option declarations (alike in shape to every command's: one CLI11 call per flag, kept).
     app.add_option("city", city, "city scene file (.osgb) written by `vista gen`")->required();
     app.add_option("--seed", o.seed, "random seed of the route (default 1)");
     app.add_option("--kind", kind, "walk (eye 1.7 m), car (eye 1.2 m) or fly (elevated fly-over); default car");

@@ -377,6 +377,7 @@ int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path,
 
 }  // namespace
 
+// The command's entry: parse, then the named steps (alike in shape to runBench's; kept).
 int runView(int argc, char** argv) {
     CLI::App app{"Interactive viewer: drive (1), walk (2), fly (3), orbit (4), path playback (5); s = stats, "
                  "m = render mode, p = screenshot, h = help.",

@@ -123,6 +123,7 @@ std::string fmtNum(double v) {
 
 }  // namespace
 
+// An enum's name table (alike in shape to roadClassName in street_graph.cpp: kept, one per enum).
 const char* pathKindName(PathKind k) {
     switch (k) {
         case PathKind::Walk: return "walk";
