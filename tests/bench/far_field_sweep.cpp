@@ -12,11 +12,14 @@
 // (ModeSummary: speedups are medians of same-frame ratios, as in summary.json);
 // nothing is recomputed here.
 //
-// Usage: far_field_sweep CITY.osgb OUT [--frames N] [--only a,b] [--budget B]
+// Usage: far_field_sweep CITY.osgb OUT [--frames N] [--only a,b] [--budget B] [--seed N] [--run-up S]
+// (--seed: the car path's seed, default 1; --run-up: seconds driven before the
+// first frame, default that of `vista path`, 8).
 // Needs an X display (xvfb-run -a).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -68,15 +71,20 @@ std::string fmt(double v, int prec = 1) {
 
 int main(int argc, char** argv) {
     if (argc < 3) {
-        std::fprintf(stderr, "usage: far_field_sweep CITY.osgb OUT [--frames N] [--only a,b] [--budget B]\n");
+        std::fprintf(stderr, "usage: far_field_sweep CITY.osgb OUT [--frames N] [--only a,b] [--budget B] [--seed N] [--run-up S]\n");
         return 2;
     }
     std::string cityPath = argv[1], out = argv[2];
     int frames = 40;
+    PathOptions po;
+    po.seed = 1;
+    po.kind = PathKind::Car;
     int64_t budget = 20000;
     std::set<std::string> only;
     for (int i = 3; i < argc; ++i) {
         if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) frames = std::atoi(argv[++i]);
+        else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc) po.seed = std::strtoull(argv[++i], nullptr, 10);
+        else if (!std::strcmp(argv[i], "--run-up") && i + 1 < argc) po.runUp = std::atof(argv[++i]);
         else if (!std::strcmp(argv[i], "--budget") && i + 1 < argc) budget = std::atoll(argv[++i]);
         else if (!std::strcmp(argv[i], "--only") && i + 1 < argc) {
             std::stringstream ss(argv[++i]);
@@ -89,9 +97,6 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "%s\n", city.status().message().c_str());
         return 2;
     }
-    PathOptions po;
-    po.seed = 1;
-    po.kind = PathKind::Car;
     po.duration = (frames - 1) * po.dt;
     auto path = generatePath(city->streets, city->params, po);
     if (!path) {
@@ -235,7 +240,7 @@ int main(int argc, char** argv) {
     }
 
     // ---- markdown -------------------------------------------------------------
-    md << "City: `" << J["city"].get<std::string>() << "` (" << city->triangles << " triangles), car walkthrough seed 1, "
+    md << "City: `" << J["city"].get<std::string>() << "` (" << city->triangles << " triangles), car walkthrough seed " << po.seed << " (run-up " << po.runUp << " s), "
        << frames << " consecutive frames at 30 fps spacing; hybrid defaults: near 100 m, pixel budget " << budget
        << ", horizon grid 512, cache on.\n\n";
     const char* rowNames[5] = {"ray cast and hit an object", "ray cast and missed", "taken from the image cache",
