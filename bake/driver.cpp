@@ -27,56 +27,6 @@
 
 namespace vista {
 
-Result<std::vector<uint32_t>> parseCellList(const std::string& s) {
-    std::vector<uint32_t> out;
-    std::stringstream ss(s);
-    std::string item;
-    while (std::getline(ss, item, ',')) {
-        if (item.empty()) continue;
-        char* end = nullptr;
-        const size_t dash = item.find('-');
-        long a = std::strtol(item.c_str(), &end, 10);
-        long b = a;
-        bool ok = end && end != item.c_str();
-        if (dash != std::string::npos && dash > 0) {
-            ok = ok && size_t(end - item.c_str()) == dash;
-            char* e2 = nullptr;
-            b = std::strtol(item.c_str() + dash + 1, &e2, 10);
-            ok = ok && e2 && *e2 == 0 && e2 != item.c_str() + dash + 1;
-        } else {
-            ok = ok && *end == 0;
-        }
-        if (!ok || a < 0 || b < a || b > 100000000)
-            return Status::error("--cells '" + s + "': bad item '" + item + "' (expected ids or ranges like 3,7,10-20)");
-        for (long v = a; v <= b; ++v) out.push_back(uint32_t(v));
-    }
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
-    if (out.empty()) return Status::error("--cells '" + s + "': no cell id given");
-    return out;
-}
-
-Status parseShard(const std::string& s, int& k, int& n) {
-    char slash = 0;
-    int a = 0, b = 0;
-    if (std::sscanf(s.c_str(), "%d%c%d", &a, &slash, &b) != 3 || slash != '/' || b < 1 || a < 1 || a > b)
-        return Status::error("--shard '" + s + "': expected K/N with 1 <= K <= N (e.g. 2/4)");
-    k = a;
-    n = b;
-    return Status::ok();
-}
-
-Status parseTexels(const std::string& s, int& x, int& y) {
-    if (s == "1") { x = y = 1; return Status::ok(); }
-    int a = 0, b = 0;
-    char c = 0;
-    if (std::sscanf(s.c_str(), "%d%c%d", &a, &c, &b) == 3 && (c == 'x' || c == 'X') && a >= 1 && b >= 1 && a <= 32 && b <= 32) {
-        x = a; y = b;
-        return Status::ok();
-    }
-    return Status::error("--texels '" + s + "': expected 1 or AxB with 1 <= A, B <= 32 (e.g. 8x2, 4x1)");
-}
-
 Status validateBakeJob(const BakeJob& j) {
     const BakeParams& p = j.params;
     auto range = [](const char* opt, double v, double lo, double hi) -> Status {

@@ -61,9 +61,4 @@ Status validateBakeJob(const BakeJob& job);
 Result<BakeReport> runBakeJob(const BakeJob& job, Progress* progress = nullptr,
                               const std::function<void(const std::string&)>& log = {});
 
-// Option values as typed on a command line.
-Result<std::vector<uint32_t>> parseCellList(const std::string& s);  // "3,7,10-20" -> sorted unique ids
-Status parseShard(const std::string& s, int& k, int& n);            // "K/N"
-Status parseTexels(const std::string& s, int& x, int& y);           // "1" or "AxB", 1 .. 32 each
-
 }  // namespace vista

@@ -6,6 +6,7 @@
 #include "bake/driver.h"
 #include "cmd/cli.h"
 #include "cmd/commands.h"
+#include "cmd/options.h"
 
 namespace vista {
 

@@ -30,6 +30,18 @@ bool toNumber(const std::string& s, double& v) {
     return end && *end == 0 && std::isfinite(v);
 }
 
+// "AsepB" with decimal digits only on both sides (at most 9 each); false otherwise.
+bool splitPair(const std::string& s, const char* seps, long& a, long& b) {
+    const size_t k = s.find_first_of(seps);
+    auto digits = [](const std::string& t) {
+        return !t.empty() && t.size() <= 9 && std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
+    };
+    if (k == std::string::npos || !digits(s.substr(0, k)) || !digits(s.substr(k + 1))) return false;
+    a = std::stol(s.substr(0, k));
+    b = std::stol(s.substr(k + 1));
+    return true;
+}
+
 std::string num(double v) {
     std::ostringstream o;
     o << v;
@@ -45,17 +57,65 @@ Status checkImageSize(int w, int h) {
 }
 
 Result<ImageSize> parseImageSize(const std::string& s) {
-    const size_t x = s.find_first_of("xX");
-    auto digits = [](const std::string& t) {
-        return !t.empty() && t.size() <= 9 && std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
-    };
-    if (x == std::string::npos || !digits(s.substr(0, x)) || !digits(s.substr(x + 1)))
+    long w = 0, h = 0;
+    if (!splitPair(s, "xX", w, h))
         return Status::error("--size '" + s + "': expected WIDTHxHEIGHT, e.g. 640x480 (each 1 .. 8192 pixels)");
-    const long w = std::stol(s.substr(0, x)), h = std::stol(s.substr(x + 1));
     if (w < 1 || h < 1 || w > kMaxImageSide || h > kMaxImageSide)
         return Status::error("--size " + s + " out of range 1x1 .. 8192x8192 pixels");
     return ImageSize{int(w), int(h)};
 }
+
+Status parseTexels(const std::string& s, int& x, int& y) {
+    if (s == "1") {
+        x = y = 1;
+        return Status::ok();
+    }
+    long a = 0, b = 0;
+    if (!splitPair(s, "xX", a, b) || a < 1 || b < 1 || a > 32 || b > 32)
+        return Status::error("--texels '" + s + "': expected 1 or AxB with 1 <= A, B <= 32 (e.g. 8x2, 4x1)");
+    x = int(a);
+    y = int(b);
+    return Status::ok();
+}
+
+Status parseShard(const std::string& s, int& k, int& n) {
+    long a = 0, b = 0;
+    if (!splitPair(s, "/", a, b) || b < 1 || a < 1 || a > b)
+        return Status::error("--shard '" + s + "': expected K/N with 1 <= K <= N (e.g. 2/4)");
+    k = int(a);
+    n = int(b);
+    return Status::ok();
+}
+
+Result<std::vector<uint32_t>> parseCellList(const std::string& s) {
+    std::vector<uint32_t> out;
+    std::stringstream ss(s);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        if (item.empty()) continue;
+        char* end = nullptr;
+        const size_t dash = item.find('-');
+        long a = std::strtol(item.c_str(), &end, 10);
+        long b = a;
+        bool ok = end && end != item.c_str();
+        if (dash != std::string::npos && dash > 0) {
+            ok = ok && size_t(end - item.c_str()) == dash;
+            char* e2 = nullptr;
+            b = std::strtol(item.c_str() + dash + 1, &e2, 10);
+            ok = ok && e2 && *e2 == 0 && e2 != item.c_str() + dash + 1;
+        } else {
+            ok = ok && *end == 0;
+        }
+        if (!ok || a < 0 || b < a || b > 100000000)
+            return Status::error("--cells '" + s + "': bad item '" + item + "' (expected ids or ranges like 3,7,10-20)");
+        for (long v = a; v <= b; ++v) out.push_back(uint32_t(v));
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    if (out.empty()) return Status::error("--cells '" + s + "': no cell id given (expected ids or ranges like 3,7,10-20)");
+    return out;
+}
+
 
 Status checkNearDistance(double v) {
     if (v < 0 || (v >= kMinNearDistance && v <= kMaxNearDistance)) return Status::ok();

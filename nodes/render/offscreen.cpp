@@ -24,20 +24,19 @@ namespace vista {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
-
 // Final draw callback: waits for the GL, reads colour and depth back.
 struct Readback : public osg::Camera::DrawCallback {
     int width = 0, height = 0;
     std::vector<uint8_t>* color = nullptr;
     std::vector<float>* depth = nullptr;
-    mutable Clock::time_point finished;
+    const Stopwatch* frame = nullptr;  // started when the frame began
+    mutable double finishedMs = 0;     // frame time at which the GL finished drawing
     mutable double readMs = 0;
     mutable std::string renderer;
     void operator()(osg::RenderInfo&) const override {
         glFinish();
-        finished = Clock::now();
+        finishedMs = frame ? frame->ms() : 0.0;
+        Stopwatch read;
         if (renderer.empty()) {
             const char* r = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
             const char* v = reinterpret_cast<const char*>(glGetString(GL_VERSION));
@@ -53,7 +52,7 @@ struct Readback : public osg::Camera::DrawCallback {
             depth->resize(size_t(width) * size_t(height));
             glReadPixels(0, 0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, depth->data());
         }
-        readMs = msSince(finished);
+        readMs = read.ms();
     }
 };
 
@@ -132,19 +131,19 @@ struct OffscreenRenderer::Impl {
         }
         readback->color = color ? &colorBuf : nullptr;
         readback->depth = depth;
-        auto t0 = Clock::now();
+        Stopwatch frame;
+        readback->frame = &frame;
         viewer->frame();
-        double frameMs = msSince(t0);
+        readback->frame = nullptr;
+        const double frameMs = frame.ms();
         if (!readback->renderer.size()) return Status::error("offscreen render: the draw callback did not run");
 
         stats.frameMs = frameMs;
-        double cull = 0, drawSec = 0;
+        double cull = 0;
         osg::Stats* st = cam->getStats();
         unsigned fn = viewer->getFrameStamp()->getFrameNumber();
         if (st && st->getAttribute(fn, "Cull traversal time taken", cull)) stats.cullMs = cull * 1000.0;
-        (void)drawSec;
-        double untilFinish = std::chrono::duration<double, std::milli>(readback->finished - t0).count();
-        stats.drawMs = std::max(0.0, untilFinish - stats.cullMs);
+        stats.drawMs = std::max(0.0, readback->finishedMs - stats.cullMs);
         stats.stages.set(Stage::Readback, readback->readMs);
 
         PrimitiveCounter pc;

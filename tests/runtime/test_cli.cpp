@@ -120,3 +120,35 @@ TEST(Options, PathFlags) {
     ASSERT_FALSE(bad.isOk());
     EXPECT_NE(bad.status().message().find("run-up"), std::string::npos) << bad.status().message();
 }
+
+TEST(Options, BakeCellsShardAndTexels) {
+    auto cells = parseCellList("7,3,10-12,3");
+    ASSERT_TRUE(cells.isOk());
+    EXPECT_EQ(*cells, (std::vector<uint32_t>{3, 7, 10, 11, 12}));
+    for (const char* bad : {"", ",", "a", "3-", "-3", "5-2", "1-2-3", "3x", "100000001"})
+        expectBad(parseCellList(bad), bad, "--cells", "10-20");
+
+    int k = 0, n = 0;
+    ASSERT_TRUE(parseShard("2/4", k, n).isOk());
+    EXPECT_EQ(k, 2);
+    EXPECT_EQ(n, 4);
+    for (const char* bad : {"0/4", "5/4", "2/0", "2", "2/", "/4", "2/4x", " 2/4", "+2/4", "a/b", "2\\4"}) {
+        Status s = parseShard(bad, k, n);
+        ASSERT_FALSE(s.isOk()) << bad;
+        EXPECT_NE(s.message().find("1 <= K <= N"), std::string::npos) << s.message();
+    }
+
+    int x = 0, y = 0;
+    ASSERT_TRUE(parseTexels("8x2", x, y).isOk());
+    EXPECT_EQ(x, 8);
+    EXPECT_EQ(y, 2);
+    ASSERT_TRUE(parseTexels("1", x, y).isOk());
+    EXPECT_EQ(x * y, 1);
+    ASSERT_TRUE(parseTexels("32X32", x, y).isOk());
+    for (const char* bad : {"0x2", "33x1", "8x", "8", "8x2junk", "8*2", ""}) {
+        Status s = parseTexels(bad, x, y);
+        ASSERT_FALSE(s.isOk()) << bad;
+        EXPECT_NE(s.message().find("--texels"), std::string::npos) << s.message();
+        EXPECT_NE(s.message().find("32"), std::string::npos) << s.message();
+    }
+}
