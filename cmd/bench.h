@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "foundation/statistics.h"
 #include "foundation/status.h"
 #include "nodes/render/render_mode.h"
 #include "runtime/scene/paths.h"
@@ -114,8 +115,5 @@ const std::vector<std::string>& speedupBases();
 // frames.csv, summary.json, frame_time.png, quality.png (bench_output.cpp).
 Status writeBenchOutputs(const BenchResult& r, const BenchConfig& cfg, const SceneModel* city, const Path& path);
 
-// Median / percentile (linear interpolation) of a copy of v, non-finite
-// values ignored; NaN if none is left.
-double percentile(std::vector<double> v, double p);
 
 }  // namespace vista

@@ -10,16 +10,6 @@
 
 namespace vista {
 
-double percentile(std::vector<double> v, double p) {
-    v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
-    if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
-    std::sort(v.begin(), v.end());
-    double pos = std::clamp(p, 0.0, 1.0) * double(v.size() - 1);
-    size_t i = size_t(std::floor(pos));
-    double f = pos - double(i);
-    return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v[i];
-}
-
 double medianOfSameFrameRatios(const std::vector<double>& baseMs, const std::vector<double>& modeMs) {
     std::vector<double> ratios;
     for (size_t f = 0; f < std::min(baseMs.size(), modeMs.size()); ++f)

@@ -1,5 +1,6 @@
 #include "runtime/scene/paths.h"
 #include "foundation/atomic_file.h"
+#include "foundation/statistics.h"
 #include "foundation/units.h"
 
 #include <algorithm>
@@ -177,11 +178,6 @@ PathMotion pathMotion(const Path& path, const std::vector<size_t>& frames) {
         degrees.push_back(radToDeg(std::sqrt(dh * dh + dp * dp)));
     }
     if (metres.empty()) return m;
-    auto median = [](std::vector<double> v) {
-        std::sort(v.begin(), v.end());
-        const size_t h = v.size() / 2;
-        return v.size() % 2 ? v[h] : 0.5 * (v[h - 1] + v[h]);
-    };
     m.frames = frames.size();
     m.metresMedian = median(metres);
     m.metresMax = *std::max_element(metres.begin(), metres.end());

@@ -2,6 +2,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <set>
 #include <string>
 #include <vector>
@@ -11,6 +12,7 @@
 #include "foundation/atomic_file.h"
 #include "foundation/hash.h"
 #include "foundation/rng.h"
+#include "foundation/statistics.h"
 #include "foundation/timing.h"
 #include "foundation/units.h"
 #include "tests/common/temp_dir.h"
@@ -140,6 +142,18 @@ TEST(Stopwatch, LapsAreNonOverlappingPiecesOfTheTotal) {
     const double t = total.ms();
     EXPECT_LE(sum, t + 1e-6);
     EXPECT_GT(t, 0.0);
+}
+
+TEST(Statistics, PercentileInterpolatesBetweenRanksAndIgnoresNonFinite) {
+    EXPECT_DOUBLE_EQ(median({3, 1, 2}), 2.0);
+    EXPECT_DOUBLE_EQ(median({4, 1, 3, 2}), 2.5);  // even count: mean of the middle two
+    EXPECT_DOUBLE_EQ(percentile({1, 2, 3, 4, 5}, 0.95), 4.8);
+    EXPECT_DOUBLE_EQ(percentile({1, 2, 3}, 0.0), 1.0);
+    EXPECT_DOUBLE_EQ(percentile({1, 2, 3}, 7.0), 3.0);  // p clamped
+    const double inf = std::numeric_limits<double>::infinity(), nan = std::nan("");
+    EXPECT_DOUBLE_EQ(median({nan, 5, inf, 1}), 3.0);
+    EXPECT_TRUE(std::isnan(median({})));
+    EXPECT_TRUE(std::isnan(median({nan, -inf})));
 }
 
 }  // namespace
