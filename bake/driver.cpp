@@ -128,75 +128,53 @@ Status bakeCells(const BakeInput& in, const std::vector<size_t>& todo, const Bak
     return failed ? Status::error(failure) : Status::ok();
 }
 
-}  // namespace
-
-Result<BakeReport> runBakeJob(const BakeJob& job, Progress* progress, const std::function<void(const std::string&)>& log) {
-    VISTA_RETURN_IF_ERROR(validateBakeJob(job));
-    const Stopwatch wall;
-    BakeReport rep;
-    rep.workDir = job.workDir.empty() ? job.output + ".work" : job.workDir;
-    const std::string& workDir = rep.workDir;
-    auto city = loadCityFile(job.input);
-    if (!city) return city.status();
-    if (dynamic_cast<ViewCellSwitch*>(sceneRoot(*city)))
-        return Status::error("'" + job.input + "' is already baked; bake the plain city file");
-    BakeParams p = job.params;
-    p.seed = city->params.seed;
-    const std::string canon = p.canonical();
-    uint64_t configHash = 0;
-    {
-        auto bytes = readAll(job.input);
-        if (!bytes) return bytes.status();
-        configHash = hashBytes64(bytes->data(), bytes->size(), hashBytes64(canon.data(), canon.size()));
-    }
-    const BakeInput in = prepareBake(*city, p);
-    rep.skippedEdges = in.skipped.size();
-
-    // Cell selection: indices into in.cells, then this shard's part.
+// The cells of the job (indices into in.cells): --cells or all, in order.
+Result<std::vector<size_t>> selectCells(const BakeJob& job, const BakeInput& in, size_t edges) {
     std::vector<size_t> selected;
-    if (!job.cells.empty()) {
-        for (uint32_t id : job.cells) {
-            auto it = std::find_if(in.cells.begin(), in.cells.end(), [&](const ViewCell& c) { return c.id == id; });
-            if (it == in.cells.end())
-                return Status::error("--cells: cell " + std::to_string(id) + " does not exist (cells are street edges 0.." +
-                                     std::to_string(city->streets.edges.size()) + ", minus degenerate ones)");
-            selected.push_back(size_t(it - in.cells.begin()));
-        }
-    } else {
+    if (job.cells.empty()) {
         for (size_t i = 0; i < in.cells.size(); ++i) selected.push_back(i);
+        return selected;
     }
+    for (uint32_t id : job.cells) {
+        auto it = std::find_if(in.cells.begin(), in.cells.end(), [&](const ViewCell& c) { return c.id == id; });
+        if (it == in.cells.end())
+            return Status::error("--cells: cell " + std::to_string(id) + " does not exist (cells are street edges 0.." +
+                                 std::to_string(edges) + ", minus degenerate ones)");
+        selected.push_back(size_t(it - in.cells.begin()));
+    }
+    return selected;
+}
+
+// This shard's part of the selected cells (every N-th, starting at K - 1).
+std::vector<size_t> shardOf(const BakeJob& job, const std::vector<size_t>& selected) {
     std::vector<size_t> mine;
     for (size_t k = 0; k < selected.size(); ++k)
         if (int(k % size_t(job.shardN)) == job.shardK - 1) mine.push_back(selected[k]);
-    rep.cells = selected.size();
-    rep.shardCells = mine.size();
+    return mine;
+}
 
-    std::error_code ec;
-    std::filesystem::create_directories(workDir, ec);
-    if (ec || access(workDir.c_str(), W_OK) != 0)
-        return Status::error("--work '" + workDir + "': cannot create or write the directory");
-
-    if (!job.merge) {
-        std::vector<size_t> todo;
-        for (size_t ci : mine) {
-            auto b = readAll(cellPath(workDir, in.cells[ci].id));
-            if (b && decodeCellResult(*b, configHash, "").isOk()) continue;
-            todo.push_back(ci);
-        }
-        rep.baked = todo.size();
-        rep.resumed = mine.size() - todo.size();
-        if (log)
-            log(std::to_string(mine.size()) + " cells (" + std::to_string(todo.size()) + " in this run, " + std::to_string(rep.resumed) +
-                " already done), " + std::to_string(in.skipped.size()) + " degenerate edges skipped");
-        tbb::task_arena arena(job.jobs > 0 ? job.jobs : tbb::task_arena::automatic);
-        VISTA_RETURN_IF_ERROR(bakeCells(in, todo, p, configHash, workDir, arena, progress));
-        if (job.shardN > 1) {
-            rep.wallS = wall.ms() / 1000.0;
-            return rep;
-        }
+// Bakes the cells of `mine` that have no valid result in the work directory yet.
+Status bakeMissingCells(const BakeJob& job, const BakeInput& in, const std::vector<size_t>& mine, const BakeParams& p,
+                        uint64_t configHash, BakeReport& rep, Progress* progress, const std::function<void(const std::string&)>& log) {
+    std::vector<size_t> todo;
+    for (size_t ci : mine) {
+        auto b = readAll(cellPath(rep.workDir, in.cells[ci].id));
+        if (b && decodeCellResult(*b, configHash, "").isOk()) continue;
+        todo.push_back(ci);
     }
+    rep.baked = todo.size();
+    rep.resumed = mine.size() - todo.size();
+    if (log)
+        log(std::to_string(mine.size()) + " cells (" + std::to_string(todo.size()) + " in this run, " + std::to_string(rep.resumed) +
+            " already done), " + std::to_string(in.skipped.size()) + " degenerate edges skipped");
+    tbb::task_arena arena(job.jobs > 0 ? job.jobs : tbb::task_arena::automatic);
+    return bakeCells(in, todo, p, configHash, rep.workDir, arena, progress);
+}
 
-    // Assembly from the work directory.
+// Every selected cell's result from the work directory, sorted by cell id;
+// an error listing the missing or stale ones.
+Result<std::vector<CellResult>> readCellResults(const BakeInput& in, const std::vector<size_t>& selected, uint64_t configHash,
+                                                const std::string& workDir) {
     std::vector<CellResult> results;
     std::vector<uint32_t> missing;
     for (size_t ci : selected) {
@@ -214,9 +192,11 @@ Result<BakeReport> runBakeJob(const BakeJob& job, Progress* progress, const std:
                              "); bake them first (all shards with the same parameters)");
     }
     std::sort(results.begin(), results.end(), [](const CellResult& a, const CellResult& b) { return a.cell < b.cell; });
-    osg::ref_ptr<ViewCellSwitch> root = assembleBakedScene(*city, in.cells, results, canon);
-    VISTA_RETURN_IF_ERROR(writeSceneFile(*root, job.output, false));
-    rep.assembled = true;
+    return results;
+}
+
+// Totals of the assembled results into `rep`; the per-impostor statistics as JSON.
+nlohmann::json tallyResults(const std::vector<CellResult>& results, BakeReport& rep) {
     double cellMs = 0;
     nlohmann::json js = nlohmann::json::array();
     for (const auto& r : results) {
@@ -228,25 +208,77 @@ Result<BakeReport> runBakeJob(const BakeJob& job, Progress* progress, const std:
         }
     }
     rep.cellBakeS = cellMs / 1000.0;
+    return js;
+}
+
+Status writeStatsFile(const BakeJob& job, const BakeReport& rep, size_t cells, const std::string& canon, nlohmann::json impostorStats) {
+    nlohmann::json top;
+    top["input"] = job.input;
+    top["cells"] = cells;
+    top["impostors"] = rep.impostors;
+    top["points"] = rep.points;
+    top["cell_bake_s_sum"] = rep.cellBakeS;
+    top["wall_s"] = rep.wallS;
+    top["output_bytes"] = rep.outputBytes;
+    top["params"] = canon;
+    top["impostor_stats"] = std::move(impostorStats);
+    return writeFileAtomic(job.statsFile, top.dump(1));
+}
+
+}  // namespace
+
+Result<BakeReport> runBakeJob(const BakeJob& job, Progress* progress, const std::function<void(const std::string&)>& log) {
+    VISTA_RETURN_IF_ERROR(validateBakeJob(job));
+    const Stopwatch wall;
+    BakeReport rep;
+    rep.workDir = job.workDir.empty() ? job.output + ".work" : job.workDir;
+    auto city = loadCityFile(job.input);
+    if (!city) return city.status();
+    if (dynamic_cast<ViewCellSwitch*>(sceneRoot(*city)))
+        return Status::error("'" + job.input + "' is already baked; bake the plain city file");
+    BakeParams p = job.params;
+    p.seed = city->params.seed;
+    const std::string canon = p.canonical();
+    uint64_t configHash = 0;  // of the input's bytes and the parameters: a cell result is reused only under both
+    {
+        auto bytes = readAll(job.input);
+        if (!bytes) return bytes.status();
+        configHash = hashBytes64(bytes->data(), bytes->size(), hashBytes64(canon.data(), canon.size()));
+    }
+    const BakeInput in = prepareBake(*city, p);
+    rep.skippedEdges = in.skipped.size();
+
+    auto selected = selectCells(job, in, city->streets.edges.size());
+    if (!selected) return selected.status();
+    const std::vector<size_t> mine = shardOf(job, *selected);
+    rep.cells = selected->size();
+    rep.shardCells = mine.size();
+    std::error_code ec;
+    std::filesystem::create_directories(rep.workDir, ec);
+    if (ec || access(rep.workDir.c_str(), W_OK) != 0)
+        return Status::error("--work '" + rep.workDir + "': cannot create or write the directory");
+
+    if (!job.merge) {
+        VISTA_RETURN_IF_ERROR(bakeMissingCells(job, in, mine, p, configHash, rep, progress, log));
+        if (job.shardN > 1) {  // a shard bakes; --merge assembles
+            rep.wallS = wall.ms() / 1000.0;
+            return rep;
+        }
+    }
+
+    auto results = readCellResults(in, *selected, configHash, rep.workDir);
+    if (!results) return results.status();
+    osg::ref_ptr<ViewCellSwitch> root = assembleBakedScene(*city, in.cells, *results, canon);
+    VISTA_RETURN_IF_ERROR(writeSceneFile(*root, job.output, false));
+    rep.assembled = true;
+    nlohmann::json impostorStats = tallyResults(*results, rep);
     const auto size = std::filesystem::file_size(job.output, ec);
     rep.outputBytes = ec ? 0 : uint64_t(size);
     rep.wallS = wall.ms() / 1000.0;
-    if (!job.statsFile.empty()) {
-        nlohmann::json top;
-        top["input"] = job.input;
-        top["cells"] = results.size();
-        top["impostors"] = rep.impostors;
-        top["points"] = rep.points;
-        top["cell_bake_s_sum"] = rep.cellBakeS;
-        top["wall_s"] = rep.wallS;
-        top["output_bytes"] = rep.outputBytes;
-        top["params"] = canon;
-        top["impostor_stats"] = js;
-        VISTA_RETURN_IF_ERROR(writeFileAtomic(job.statsFile, top.dump(1)));
-    }
+    if (!job.statsFile.empty()) VISTA_RETURN_IF_ERROR(writeStatsFile(job, rep, results->size(), canon, std::move(impostorStats)));
     if (!job.keepWork) {
-        for (size_t ci : selected) std::filesystem::remove(cellPath(workDir, in.cells[ci].id), ec);
-        std::filesystem::remove(workDir, ec);  // only if empty
+        for (size_t ci : *selected) std::filesystem::remove(cellPath(rep.workDir, in.cells[ci].id), ec);
+        std::filesystem::remove(rep.workDir, ec);  // only if empty
     }
     return rep;
 }
