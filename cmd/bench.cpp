@@ -41,13 +41,6 @@ struct BenchRun {
     std::vector<SetupTimes> setup;  // per mode: load, bvh, the mode's own
 };
 
-// `full` first: the reference of every frame is rendered before the others.
-BenchConfig withFullFirst(BenchConfig cfg) {
-    cfg.modes.erase(std::remove(cfg.modes.begin(), cfg.modes.end(), "full"), cfg.modes.end());
-    cfg.modes.insert(cfg.modes.begin(), "full");
-    return cfg;
-}
-
 Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene, const BenchConfig& cfg) {
     auto run = std::make_unique<BenchRun>();
     auto renderer = OffscreenRenderer::create(cfg.width, cfg.height);
@@ -195,6 +188,13 @@ Status renderFrames(BenchRun& run, const Path& path, const std::vector<size_t>& 
 }
 
 }  // namespace
+
+// `full` first: the reference of every frame is rendered before the others.
+BenchConfig withFullFirst(BenchConfig cfg) {
+    cfg.modes.erase(std::remove(cfg.modes.begin(), cfg.modes.end(), "full"), cfg.modes.end());
+    cfg.modes.insert(cfg.modes.begin(), "full");
+    return cfg;
+}
 
 Status validateBenchConfig(const BenchConfig& c) {
     VISTA_RETURN_IF_ERROR(checkImageSize(c.width, c.height));

@@ -96,6 +96,10 @@ struct BenchResult {
     double loadAvgStart = -1, loadAvgEnd = -1;
 };
 
+// The config with `full` moved to the front of the modes (the reference of
+// every frame is rendered before the others; summaries list it first).
+BenchConfig withFullFirst(BenchConfig cfg);
+
 // Runs the bench. `city` may be null (hand-built graph: then ray modes fail
 // with an error); `scene` is the scene graph the GL modes draw.
 Result<BenchResult> runBenchmark(const SceneModel* city, osg::Node* scene, const Path& path, const BenchConfig& config);

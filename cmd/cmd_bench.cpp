@@ -105,7 +105,8 @@ void printTable(const BenchResult& r) {
 }
 
 // One bench of one city file into one directory: load, path, run, print.
-int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string& outDir, BenchResult* res) {
+int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string& outDir, BenchResult* res,
+              size_t* cityTriangles = nullptr) {
     Stopwatch sw;
     auto city = loadCityFile(cityFile);
     if (!city) return reportBadInput(kCmd, city.status());
@@ -123,6 +124,7 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
     }
     if (!a.quiet) printTable(r.value());
     if (res) *res = std::move(r.value());
+    if (cityTriangles) *cityTriangles = city->triangles;
     return 0;
 }
 
@@ -189,17 +191,14 @@ int runSweep(const BenchArgs& a) {
         const std::string cityFile = (fs::path(a.out) / ("city_" + std::to_string(size) + ".osgb")).string();
         if (int rc = generateSweepCity(a, size, cityFile); rc != 0) return rc;
         BenchResult r;
-        if (int rc = benchCity(a, cityFile, (fs::path(a.out) / ("size_" + std::to_string(size))).string(), &r); rc != 0)
+        size_t triangles = 0;
+        if (int rc = benchCity(a, cityFile, (fs::path(a.out) / ("size_" + std::to_string(size))).string(), &r, &triangles); rc != 0)
             return rc;
-        auto lc = loadCityFile(cityFile);
-        for (const auto& m : r.modes) table.add(size, lc ? double(lc->triangles) : 0.0, m);
+        for (const auto& m : r.modes) table.add(size, double(triangles), m);
         std::error_code ec;
         fs::remove(cityFile, ec);  // cities are large; regenerate from the command if needed
     }
-    std::vector<std::string> order = a.cfg.modes;
-    order.erase(std::remove(order.begin(), order.end(), "full"), order.end());
-    order.insert(order.begin(), "full");
-    if (Status s = table.write(a, order); !s) {
+    if (Status s = table.write(a, withFullFirst(a.cfg).modes); !s) {
         std::fprintf(stderr, "%s: %s\n", kCmd, s.message().c_str());
         return 1;
     }

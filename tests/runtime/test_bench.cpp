@@ -762,3 +762,26 @@ TEST(BenchCli, HybridPixelClassesAndOptions) {
 
     fs::remove_all(dir);
 }
+
+TEST(BenchCli, SweepTableListsEveryCityWithItsTrianglesAndFullFirst) {
+    REQUIRE_DISPLAY();
+    std::string dir = tmpDir("sweep"), out;
+    ASSERT_EQ(runVista("bench --sweep sizes=300,400 --seed 2 --frames 2 --size 160x120 --modes near,full --out " + dir + "/s -q",
+                       &out),
+              0)
+        << out;
+    const auto top = nlohmann::json::parse(std::ifstream(dir + "/s/sweep.json"));
+    const auto& j = top.at("rows");
+    ASSERT_TRUE(j.is_array()) << top.dump();
+    ASSERT_EQ(j.size(), 4u) << j.dump();  // 2 cities x 2 modes
+    std::map<int, double> trianglesOf;
+    for (size_t i = 0; i < j.size(); ++i) {
+        const int size = j[i]["size_m"].get<int>();
+        const double tris = j[i]["city_triangles"].get<double>();
+        EXPECT_GT(tris, 1000.0) << "city " << size << ": its triangle count comes from the benched city";
+        trianglesOf[size] = tris;
+        EXPECT_EQ(j[i]["mode"].get<std::string>(), i % 2 == 0 ? "full" : "near") << "full is listed first for every city";
+    }
+    ASSERT_EQ(trianglesOf.size(), 2u);
+    EXPECT_GT(trianglesOf[400], trianglesOf[300]) << "a larger city has more triangles";
+}
