@@ -360,6 +360,38 @@ bool hippedRoof(MeshBuilder& roof, const Polygon2& fp, double z, double rh) {
     return true;
 }
 
+// Materials effect: facade and roof albedo by district (population density at
+// the footprint) and building type (tower, mid-rise, house; roof shape), drawn
+// from a stream of its own so the geometry does not change.
+struct BuildingPalette {
+    glm::dvec3 wall, roof;
+};
+
+BuildingPalette buildingPalette(const Building& b, uint32_t buildingId, const CityParams& params) {
+    static const glm::dvec3 kTower[] = {{0.55, 0.55, 0.56}, {0.36, 0.42, 0.50}, {0.70, 0.64, 0.52}, {0.31, 0.33, 0.36},
+                                        {0.80, 0.80, 0.78}, {0.47, 0.50, 0.47}};
+    static const glm::dvec3 kMid[] = {{0.55, 0.28, 0.20}, {0.45, 0.30, 0.22}, {0.72, 0.58, 0.35}, {0.82, 0.76, 0.62},
+                                      {0.62, 0.62, 0.60}, {0.66, 0.45, 0.33}};
+    static const glm::dvec3 kHouse[] = {{0.85, 0.78, 0.55}, {0.60, 0.70, 0.78}, {0.86, 0.85, 0.82}, {0.62, 0.68, 0.55},
+                                        {0.82, 0.62, 0.52}, {0.78, 0.70, 0.60}};
+    static const glm::dvec3 kFlatRoof[] = {{0.45, 0.45, 0.43}, {0.20, 0.20, 0.22}, {0.55, 0.54, 0.50}, {0.30, 0.42, 0.22}};
+    static const glm::dvec3 kPitchedRoof[] = {{0.60, 0.30, 0.22}, {0.28, 0.30, 0.34}, {0.42, 0.28, 0.20}, {0.50, 0.22, 0.18}};
+    Rng rng(params.seed, buildingId, uint64_t(0x4D415445ull));  // "MATE"
+    const double density = populationDensity(params, centroid(b.footprint));
+    // Districts: downtown towers in dense areas; the type follows the floors.
+    const bool tower = b.floors >= 10 || (density > 0.6 && b.floors >= 6);
+    const bool house = !tower && b.floors <= 3;
+    const glm::dvec3* walls = tower ? kTower : (house ? kHouse : kMid);
+    glm::dvec3 wall = walls[rng.range(0, 5)] * rng.uniform(0.9, 1.1);
+    const bool pitched = b.roof != RoofType::Flat;
+    glm::dvec3 roof = pitched ? kPitchedRoof[rng.range(0, 3)] : kFlatRoof[rng.range(0, density > 0.5 ? 2 : 3)];
+    roof *= rng.uniform(0.92, 1.08);
+    const double v = params.effects.materials->variety;
+    const double var = rng.uniform(-0.6, 0.6) * 0.18;
+    const glm::dvec3 baseWall = materialAlbedo(Material::Wall) * (1.0 + var), baseRoof = materialAlbedo(Material::Roof) * (1.0 + var);
+    return {glm::clamp(baseWall + (wall - baseWall) * v, 0.0, 1.0), glm::clamp(baseRoof + (roof - baseRoof) * v, 0.0, 1.0)};
+}
+
 }  // namespace
 
 void meshBuilding(const Building& b, uint32_t buildingId, const CityParams& params, const Lighting& light,
@@ -373,6 +405,11 @@ void meshBuilding(const Building& b, uint32_t buildingId, const CityParams& para
     MeshBuilder wall(*out.walls, origin, Material::Wall, light, variation);
     MeshBuilder win(*out.windows, origin, Material::Window, light, 0.3 * variation);
     MeshBuilder roof(*out.roofs, origin, Material::Roof, light, variation);
+    if (params.effects.materials) {
+        const BuildingPalette pal = buildingPalette(b, buildingId, params);
+        wall.setAlbedo(pal.wall);
+        roof.setAlbedo(pal.roof);
+    }
     const int floors = std::max(1, b.floors);
     FacadeStyle s;
     s.floorH = b.height / floors;

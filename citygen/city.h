@@ -68,6 +68,7 @@ struct Tile {
     glm::dvec3 origin{0.0};
     std::array<Mesh, kMaterialCount> meshes;  // one per material
     std::vector<uint32_t> trees;               // indices into City::trees whose base lies in this tile
+    std::vector<uint32_t> streetLights;        // indices into City::streetLights in this tile
 };
 
 struct StageTime {
@@ -83,6 +84,7 @@ struct City {
     std::vector<Building> buildings;
     std::vector<TreePrototype> treePrototypes;
     std::vector<TreeInstance> trees;
+    std::vector<glm::dvec3> streetLights;  // night effect: lamp pole bases, city frame (empty otherwise)
     std::vector<Tile> tiles;        // row-major by (iy, ix); only non-empty tiles
     std::vector<StageTime> stageTimes;
 };

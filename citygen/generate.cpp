@@ -11,6 +11,7 @@
 #include "citygen/buildings.h"
 #include "citygen/mesh_builder.h"
 #include "citygen/polygon.h"
+#include "citygen/street_lights.h"
 #include "citygen/streets.h"
 #include "citygen/surfaces.h"
 #include "citygen/trees.h"
@@ -48,6 +49,9 @@ void buildTiles(City& city, Progress* progress) {
         buildingsOf[size_t(grid.tileOf(centroid(city.buildings[i].footprint)))].push_back(i);
     for (uint32_t i = 0; i < city.trees.size(); ++i)
         treesOf[size_t(grid.tileOf(glm::dvec2(city.trees[i].position)))].push_back(i);
+    std::vector<std::vector<uint32_t>> lightsOf(size_t(grid.count()));
+    for (uint32_t i = 0; i < city.streetLights.size(); ++i)
+        lightsOf[size_t(grid.tileOf(glm::dvec2(city.streetLights[i])))].push_back(i);
 
     const SurfaceIndex surfaceIndex = buildSurfaceIndex(city, grid);
     std::vector<Tile> tiles(size_t(grid.count()));
@@ -63,6 +67,9 @@ void buildTiles(City& city, Progress* progress) {
                            &tile.meshes[size_t(Material::Roof)]};
         for (uint32_t b : buildingsOf[size_t(t)]) meshBuilding(city.buildings[b], b, p, light, tile.origin, out);
         tile.trees = treesOf[size_t(t)];
+        tile.streetLights = lightsOf[size_t(t)];
+        for (uint32_t l : tile.streetLights)
+            meshStreetLight(city.streetLights[l], tile.origin, light, tile.meshes[size_t(Material::Lamp)]);
         std::lock_guard<std::mutex> lock(m);
         ++done;
     });
@@ -106,6 +113,10 @@ Result<City> generateCity(const CityParams& params, const GenerateOptions& optio
         StageTimer t(city, pr, "trees");
         city.treePrototypes = makeTreePrototypes(params, Lighting(params));
         city.trees = placeTrees(city, pr);
+    }
+    if (params.effects.night) {
+        StageTimer t(city, pr, "street lights");
+        city.streetLights = placeStreetLights(city);
     }
     {
         StageTimer t(city, pr, "meshes");

@@ -3,7 +3,7 @@
 namespace vista {
 
 const char* materialName(Material m) {
-    static const char* kNames[] = {"ground", "road", "marking", "sidewalk", "grass", "wall", "window", "roof", "trunk", "leaves"};
+    static const char* kNames[] = {"ground", "road", "marking", "sidewalk", "grass", "wall", "window", "roof", "trunk", "leaves", "lamp"};
     int i = int(m);
     return i >= 0 && i < kMaterialCount ? kNames[i] : "unknown";
 }

@@ -15,7 +15,8 @@
 namespace vista {
 
 // Surface materials; one output Geometry per tile and material.
-enum class Material : uint8_t { Ground, Road, Marking, Sidewalk, Grass, Wall, Window, Roof, Trunk, Leaves, Count };
+// Lamp: street lights of the `night` effect (pole and emissive head); absent otherwise.
+enum class Material : uint8_t { Ground, Road, Marking, Sidewalk, Grass, Wall, Window, Roof, Trunk, Leaves, Lamp, Count };
 constexpr int kMaterialCount = int(Material::Count);
 const char* materialName(Material m);
 

@@ -31,6 +31,13 @@ uint32_t MeshBuilder::vertex(const glm::dvec3& p, const glm::vec3& n, const glm:
     return uint32_t(_mesh.positions.size() - 1);
 }
 
+glm::u8vec4 MeshBuilder::faceColor(const glm::dvec3& n, const glm::dvec3& c) const {
+    if (_material == Material::Window && _light.night && windowLit(c, _light)) return litWindowColor();
+    if (!_hasAlbedo) return prelitColor(_material, n, _light, _variation);
+    const uint8_t alpha = _light.glass && _material == Material::Window ? kGlassAlpha : 255;
+    return prelitAlbedo(_albedo, n, _light, alpha);
+}
+
 void MeshBuilder::triangle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
     const glm::dvec3 v[3] = {a, b, c};
     face(glm::cross(b - a, c - a), v, 3);
@@ -45,7 +52,9 @@ void MeshBuilder::face(glm::dvec3 n, const glm::dvec3* v, int count) {
     const double len = glm::length(n);
     if (!(len > 1e-12)) return;
     n /= len;
-    const auto col = prelitColor(_material, n, _light, _variation);
+    glm::dvec3 centre(0.0);
+    for (int k = 0; k < count; ++k) centre += v[k];
+    const auto col = faceColor(n, centre / double(count));
     const glm::vec3 nf(n);
     uint32_t i[4];
     for (int k = 0; k < count; ++k) i[k] = vertex(v[k], nf, col);
@@ -63,7 +72,9 @@ void MeshBuilder::polygon(const std::vector<glm::dvec3>& pts, const glm::dvec3& 
     for (const auto& p : pts) p2.emplace_back(glm::dot(p - pts[0], u), glm::dot(p - pts[0], v));
     auto tris = triangulate(p2);
     if (tris.empty()) return;
-    auto col = prelitColor(_material, n, _light, _variation);
+    glm::dvec3 centre(0.0);
+    for (const auto& p : pts) centre += p;
+    auto col = faceColor(n, centre / double(pts.size()));
     glm::vec3 nf(n);
     uint32_t base = uint32_t(_mesh.positions.size());
     for (const auto& p : pts) vertex(p, nf, col);

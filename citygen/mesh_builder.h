@@ -39,6 +39,8 @@ public:
     MeshBuilder(Mesh& target, const glm::dvec3& origin, Material material, const Lighting& light, double variation = 0.0);
     void setMaterial(Material m) { _material = m; }
     void setVariation(double v) { _variation = v; }
+    // Materials effect: this albedo (linear RGB) instead of the material's palette x variation.
+    void setAlbedo(const glm::dvec3& albedo) { _albedo = albedo; _hasAlbedo = true; }
     // Flat triangle/quad, counter-clockwise seen from the side the normal points to.
     void triangle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c);
     void quad(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& d);
@@ -50,6 +52,8 @@ public:
 
 private:
     uint32_t vertex(const glm::dvec3& p, const glm::vec3& n, const glm::u8vec4& c);
+    // The prelit colour of a face with unit normal n and centre c (night: lit windows glow).
+    glm::u8vec4 faceColor(const glm::dvec3& n, const glm::dvec3& c) const;
     // One flat face of `count` (3 or 4) vertices with normal direction n (any length; degenerate faces are dropped).
     void face(glm::dvec3 n, const glm::dvec3* v, int count);
     Mesh& _mesh;
@@ -57,6 +61,8 @@ private:
     Material _material;
     const Lighting& _light;
     double _variation;
+    glm::dvec3 _albedo{0.0};
+    bool _hasAlbedo = false;
 };
 
 }  // namespace vista

@@ -116,6 +116,7 @@ Status validateParams(const CityParams& p) {
                              " must not exceed 'max_floors' = " + std::to_string(p.max_floors));
     if (p.pattern_grid + p.pattern_radial + p.pattern_organic <= 0)
         return Status::error("parameters 'pattern_grid', 'pattern_radial', 'pattern_organic' must not all be 0");
+    if (Status e = validateEffects(p.effects); !e) return e;
     if (p.local_spacing_m > p.arterial_spacing_m)
         return Status::error("parameter 'local_spacing_m' = " + fmt(p.local_spacing_m) +
                              " must not exceed 'arterial_spacing_m' = " + fmt(p.arterial_spacing_m));
@@ -139,13 +140,19 @@ Result<CityParams> parseParamsJson(const std::string& text, const std::string& s
     for (auto it = j.begin(); it != j.end(); ++it) {
         const std::string& key = it.key();
         if (!key.empty() && key[0] == '_') continue;  // "_comment" and the like
+        if (key == "effects") {
+            auto e = parseEffectsJson(it.value().dump(), source);
+            if (!e) return e.status();
+            p.effects = *e;
+            continue;
+        }
         const Field* f = nullptr;
         for (const auto& cand : fields())
             if (key == cand.spec.name) f = &cand;
         if (!f) {
             std::string known;
             for (const auto& cand : fields()) known += std::string(known.empty() ? "" : ", ") + cand.spec.name;
-            return Status::error(source + ": unknown parameter '" + key + "' (known: " + known + ")");
+            return Status::error(source + ": unknown parameter '" + key + "' (known: " + known + ", effects)");
         }
         const auto& val = it.value();
         if (!val.is_number()) return Status::error(source + ": parameter '" + key + "' must be a number, got " + val.dump());
@@ -188,6 +195,7 @@ std::string paramsToJson(const CityParams& p) {
             case Kind::U64: j[f.spec.name] = p.*(f.u); break;
         }
     }
+    if (p.effects.any()) j["effects"] = nlohmann::ordered_json::parse(effectsToJson(p.effects));
     return j.dump(1);
 }
 

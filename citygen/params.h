@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "citygen/effects.h"
 #include "foundation/status.h"
 
 namespace vista {
@@ -63,6 +64,9 @@ struct CityParams {
     double sun_azimuth_deg = 135.0;       // clockwise from north
     double sun_elevation_deg = 40.0;
     double ambient = 0.45;                // 0..1 share of ambient light
+
+    // Effects the scene declares (citygen/effects.h); none by default.
+    Effects effects;
 };
 
 // Describes one parameter for validation, help text and docs.
@@ -87,7 +91,7 @@ Result<CityParams> loadParamsFile(const std::string& path, const CityParams& bas
 
 // Canonical JSON of all fields (sorted keys, stable formatting): stored in the
 // output file and used in determinism hashes. Omits `threads`, which never
-// changes the output.
+// changes the output, and `effects` when none is declared.
 std::string paramsToJson(const CityParams& p);
 
 }  // namespace vista

@@ -10,6 +10,8 @@
 #include "foundation/atomic_file.h"
 #include "foundation/timing.h"
 #include "citygen/streets.h"
+#include "cmd/options.h"
+#include "runtime/engine/baked_lighting.h"
 #include "runtime/scene/city_file.h"
 #include "cmd/cli.h"
 #include "cmd/commands.h"
@@ -21,7 +23,7 @@ namespace {
 const char* const kCmd = "vista gen";
 
 struct GenArgs {
-    std::string paramsFile, out, statsFile, osmFile, geojsonFile, gltfFile;
+    std::string paramsFile, out, statsFile, osmFile, geojsonFile, gltfFile, effects;
     std::optional<uint64_t> seed;
     std::optional<double> size;
     std::optional<int> detail, threads;
@@ -34,6 +36,9 @@ CLI::Option* declareFlags(CLI::App& app, GenArgs& a) {
     app.add_option("--size", a.size, "side of the square city area in metres, 100..16000 (default 2000)");
     app.add_option("--detail", a.detail, "facade detail 0..3 (0 = plain boxes, default 2)");
     app.add_option("--threads", a.threads, "worker threads (0 = all; output never depends on it)");
+    app.add_option("--effects", a.effects,
+                   "effects the scene declares, over the params file's: 'none', names (" + effectNames() +
+                       ") or a JSON object as in the params file (see docs/params.md)");
     app.add_option("--osm", a.osmFile, "take the streets from an OpenStreetMap extract (.osm/.osm.pbf, highway=* ways)");
     app.add_option("--geojson", a.geojsonFile, "also write the street graph as GeoJSON");
     app.add_option("--gltf", a.gltfFile, "also write the city as binary glTF 2.0 (.glb)");
@@ -55,6 +60,18 @@ void printParamTable() {
         else std::snprintf(range, sizeof range, "%g .. %g", s.min, s.max);
         std::printf("| `%s` | %s | %s | %s | %s |\n", s.name, s.unit, range, def.c_str(), s.help);
     }
+    std::printf("\n### Effects\n\nThe `effects` object: an effect is on when its key is present; its object holds "
+                "its parameters (absent ones keep these defaults), e.g. `\"effects\": {\"haze\": "
+                "{\"visibility_m\": 1500}, \"glass\": {}}`. Baked effects change the prelit colours at "
+                "generation and cost nothing per frame; run-time effects are applied per frame, only where on screen.\n\n");
+    std::printf("| effect | kind | field | unit | range | default | meaning |\n|---|---|---|---|---|---|---|\n");
+    for (const auto& f : effectSpecs()) {
+        char range[64], def[32];
+        std::snprintf(range, sizeof range, "%g .. %g", f.min, f.max);
+        std::snprintf(def, sizeof def, "%g", f.defaultValue);
+        std::printf("| `%s` | %s | `%s` | %s | %s | %s | %s |\n", effectName(f.effect),
+                    effectIsBaked(f.effect) ? "baked" : "run time", f.name, f.unit, range, def, f.help);
+    }
 }
 
 // The parameters (file, then the flags over it) and the output paths, checked.
@@ -69,6 +86,11 @@ Result<CityParams> resolveParams(GenArgs& a) {
     if (a.size) params.size_m = *a.size;
     if (a.detail) params.detail = *a.detail;
     if (a.threads) params.threads = *a.threads;
+    if (!a.effects.empty()) {
+        auto e = parseEffectsOption(a.effects, params.effects);
+        if (!e) return e.status();
+        params.effects = *e;
+    }
     if (Status s = validateParams(params); !s) {
         std::string m = s.message();
         if (a.size && m.find("'size_m'") != std::string::npos) m = "option --size: " + m;
@@ -91,8 +113,8 @@ Status writeOutputs(const GenArgs& a, const City& city, const CityParams& params
     return Status::ok();
 }
 
-nlohmann::ordered_json statsJson(const City& city, const CityParams& params, const CityCounts& n, double writeSeconds,
-                                 double total) {
+nlohmann::ordered_json statsJson(const City& city, const CityParams& params, const CityCounts& n,
+                                 const BakedLightingStats& lighting, double writeSeconds, double total) {
     nlohmann::ordered_json j;
     j["seed"] = params.seed;
     j["size_m"] = params.size_m;
@@ -112,6 +134,13 @@ nlohmann::ordered_json statsJson(const City& city, const CityParams& params, con
     for (const auto& s : city.stageTimes) st[s.name] = s.seconds;
     st["write"] = writeSeconds;
     j["seconds"] = {{"total", total}, {"stages", st}};
+    j["effects"] = nlohmann::ordered_json::parse(effectsToJson(params.effects));
+    if (lighting.ran)
+        j["baked_lighting"] = {{"seconds", lighting.seconds},
+                               {"ray_scene_seconds", lighting.sceneSeconds},
+                               {"triangles_before", lighting.trianglesBefore},
+                               {"triangles_after", lighting.trianglesAfter},
+                               {"rays", lighting.rays}};
     j["peak_rss_mb"] = peakRssMb();
     j["threads"] = params.threads;
     return j;
@@ -142,18 +171,27 @@ int runGen(int argc, char** argv) {
     }
     auto city = generateCity(*params, opts);
     if (!city) return reportBadInput(kCmd, city.status());
+    BakedLightingStats lighting;
+    if (bakedLightingCalledFor(*params)) {
+        if (opts.progress) opts.progress->begin("lighting");
+        Status s = bakeLighting(*city, opts.progress, lighting);
+        if (opts.progress) opts.progress->end();
+        if (!s) return reportBadInput(kCmd, s);
+        city->stageTimes.push_back({"lighting", lighting.seconds});
+    }
     Stopwatch write;
     if (Status s = writeOutputs(a, *city, *params); !s) return reportBadInput(kCmd, s);
     const double writeSeconds = write.ms() / 1000.0, totalSeconds = total.ms() / 1000.0;
     const CityCounts n = countCity(*city);
     if (!a.statsFile.empty()) {
-        const auto j = statsJson(*city, *params, n, writeSeconds, totalSeconds);
+        const auto j = statsJson(*city, *params, n, lighting, writeSeconds, totalSeconds);
         if (Status s = writeFileAtomic(a.statsFile, j.dump(2) + "\n"); !s) return reportBadInput(kCmd, s);
     }
     if (!a.quiet)
-        std::fprintf(stderr, "wrote %s: %zu street edges, %zu blocks, %zu buildings, %zu trees, %.2f M triangles, %zu draw calls, %.1fs, peak %.0f MiB\n",
+        std::fprintf(stderr, "wrote %s: %zu street edges, %zu blocks, %zu buildings, %zu trees, %.2f M triangles, %zu draw calls, %.1fs, peak %.0f MiB%s%s\n",
                      a.out.c_str(), n.streetEdges, n.blocks, n.buildings, n.trees, n.triangles / 1e6, n.drawCalls, totalSeconds,
-                     peakRssMb());
+                     peakRssMb(), params->effects.any() ? ", effects: " : "",
+                     params->effects.any() ? params->effects.list().c_str() : "");
     return 0;
 }
 

@@ -291,4 +291,33 @@ Result<Path> walkthroughPath(const PathFlags& f, const PathOptions& po, const Sc
     return generatePath(city.streets, city.params, po);
 }
 
+Result<Effects> parseEffectsOption(const std::string& s, const Effects& base) {
+    if (s == "none") return Effects();
+    if (!s.empty() && s[0] == '{') return parseEffectsJson(s, "option --effects");
+    Effects out;
+    std::stringstream ss(s);
+    std::string name;
+    while (std::getline(ss, name, ',')) {
+        EffectId id;
+        if (!findEffect(name, id))
+            return Status::error("option --effects: unknown effect '" + name + "' (known: " + effectNames() +
+                                 "; or 'none', or a JSON object)");
+        if (base.has(id)) {
+            switch (id) {
+                case EffectId::SunShadows: out.sun_shadows = base.sun_shadows; break;
+                case EffectId::AmbientOcclusion: out.ambient_occlusion = base.ambient_occlusion; break;
+                case EffectId::Haze: out.haze = base.haze; break;
+                case EffectId::Glass: out.glass = base.glass; break;
+                case EffectId::Night: out.night = base.night; break;
+                case EffectId::Materials: out.materials = base.materials; break;
+                case EffectId::Count: break;
+            }
+        } else {
+            out.enable(id);
+        }
+    }
+    if (s.empty() || s.back() == ',') return Status::error("option --effects = '" + s + "': empty effect name");
+    return out;
+}
+
 }  // namespace vista

@@ -17,6 +17,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "citygen/effects.h"
 #include "foundation/status.h"
 #include "nodes/render/render_mode.h"
 #include "runtime/scene/paths.h"
@@ -60,6 +61,12 @@ Status parseShard(const std::string& s, int& k, int& n);
 Status parseTexels(const std::string& s, int& x, int& y);
 // --sweep sizes=S1,S2,...: city sizes in metres, each 100 .. 16000.
 Result<std::vector<int>> parseSweep(const std::string& s);
+
+// --effects: "none", a comma list of effect names (each keeps the parameters
+// `base` declares for it, else its defaults), or a JSON object as in the
+// parameter file's "effects". Unknown names / fields / values out of range ->
+// error naming them and the known effects.
+Result<Effects> parseEffectsOption(const std::string& s, const Effects& base);
 
 struct ModeFlags {
     std::string near = "100", triangleBudget = "0", budget = "unlimited";
