@@ -36,7 +36,7 @@ const std::vector<Field>& fields() {
         VISTA_EFFECT_FIELD(AmbientOcclusion, ambient_occlusion, resolution_m, "metres", 0.1, 50, 2.0, false,
                            "surfaces are refined down to this edge length where occlusion changes"),
         VISTA_EFFECT_FIELD(Haze, haze, visibility_m, "metres", 20, 1e6, 1500.0, false,
-                           "meteorological visibility (contrast falls to 2 %); nothing beyond ~1.42x is traced or drawn"),
+                           "meteorological visibility (contrast falls to 2 %); nothing beyond it is traced or drawn"),
         VISTA_EFFECT_FIELD(Glass, glass, reflectance, "", 0, 1, 0.2, false,
                            "window reflectance at normal incidence (Schlick F0; 1 at grazing angles)"),
         VISTA_EFFECT_FIELD(Glass, glass, ray_budget, "rays/frame", 0, 1e8, 50000, true,

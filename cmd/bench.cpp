@@ -51,7 +51,10 @@ Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene
     run->ctx.renderer = run->renderer.get();
     run->ctx.options = cfg.options;
     double bvhMs = -1;
-    const bool needRays = std::any_of(cfg.modes.begin(), cfg.modes.end(), [](const std::string& m) { return findRenderMode(m)->needsRays; });
+    const bool fxRays = effectsNeedRays(cfg.options.effects);
+    const bool needRays = fxRays || std::any_of(cfg.modes.begin(), cfg.modes.end(), [](const std::string& m) {
+                              return findRenderMode(m)->needsRays;
+                          });
     if (needRays) {
         if (!city) return Status::error("modes that cast rays need a loaded city file (no city given)");
         Stopwatch sw;
@@ -67,7 +70,7 @@ Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene
         if (!m) return m.status();
         SetupTimes s;
         if (cfg.loadMs >= 0) s.push_back({"load", cfg.loadMs});
-        if (findRenderMode(name)->needsRays) s.push_back({"bvh", bvhMs});
+        if (fxRays || findRenderMode(name)->needsRays) s.push_back({"bvh", bvhMs});
         for (const auto& kv : m.value()->setupMs()) s.push_back(kv);
         run->setup.push_back(s);
         run->modes.push_back(std::move(m.value()));

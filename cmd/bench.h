@@ -48,6 +48,7 @@ struct BenchConfig {
     std::string cityLabel;         // recorded in summary.json
     double loadMs = -1;            // city load time measured by the caller (set-up "load"); < 0 = not reported
     double runUpS = -1;            // the path's run-up (PathOptions::runUp) when the bench made it; < 0 = unknown
+    std::string effectsDeclared = "{}";  // the scene's effects (JSON, effects.h), recorded in summary.json
 };
 // Checks sizes, frame count, fov, reference, modes and the mode options
 // (options.h ranges); messages name the command-line flag.
@@ -84,6 +85,10 @@ struct ModeSummary {
     // Per stage: mean ms over the frames in which it ran, and in how many it ran.
     std::map<std::string, double> stagesMsMean;
     std::map<std::string, int> stageRuns;
+    // Run-time effects: mean ms over the frames each ran in, and in how many frames it ran.
+    std::map<std::string, double> effectsMsMean;
+    std::map<std::string, int> effectRuns;
+    double glassPixelsMean = 0, reflectionRaysMean = 0;
     std::map<std::string, int> noteCounts;  // frame notes and in how many frames each appeared
     SetupTimes setupMs;                     // load, bvh, then the mode's own
 };

@@ -92,6 +92,13 @@ json modeJson(const ModeSummary& s) {
     for (const auto& kv : s.setupMs) setup[kv.first] = num(kv.second);
     m["stages_ms"] = stages;
     m["stage_runs"] = runs;
+    json fxMs = json::object(), fxRuns = json::object();
+    for (const auto& kv : s.effectsMsMean) fxMs[kv.first] = num(kv.second);
+    for (const auto& kv : s.effectRuns) fxRuns[kv.first] = kv.second;
+    m["effects_ms"] = fxMs;
+    m["effect_runs"] = fxRuns;
+    m["glass_pixels_mean"] = num(s.glassPixelsMean);
+    m["reflection_rays_mean"] = num(s.reflectionRaysMean);
     m["setup_ms"] = setup;
     return m;
 }
@@ -112,6 +119,12 @@ json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneM
                     {"horizon_grid", o.horizonGrid},
                     {"cache", o.cache},
                     {"threads", o.threads}};
+    j["effects"] = json::parse(cfg.effectsDeclared);
+    const FrameEffects& fx = o.effects;
+    j["effects_run_time"] = {{"haze", fx.haze ? json(fx.visibility) : json(nullptr)},
+                             {"glass_reflections", fx.glass && fx.glassMarked},
+                             {"reflection_ray_budget", fx.rayBudget},
+                             {"night_sky", fx.night}};
     j["reference"] = cfg.referenceSsaa >= 2 ? "ssaa:" + std::to_string(cfg.referenceSsaa) : std::string("full");
     j["psnr_cap_db"] = kPsnrCapDb;
     j["diff_threshold"] = cfg.diffThreshold;

@@ -59,6 +59,17 @@ void summariseStagesAndNotes(const std::vector<const BenchFrameRecord*>& frames,
         for (const auto& n : r->stats.notes) ++s.noteCounts[n];
     }
     for (const auto& kv : sum) s.stagesMsMean[kv.first] = kv.second / double(s.stageRuns[kv.first]);
+    // Effects: mean ms over the frames it ran in; frames it ran in.
+    std::map<std::string, double> fx;
+    for (const BenchFrameRecord* r : frames) {
+        r->stats.effects.forEach([&](EffectId e, double ms) {
+            fx[effectName(e)] += ms;
+            ++s.effectRuns[effectName(e)];
+        });
+        s.glassPixelsMean += double(r->stats.glassPixels) / double(frames.size());
+        s.reflectionRaysMean += double(r->stats.reflectionRays) / double(frames.size());
+    }
+    for (const auto& kv : fx) s.effectsMsMean[kv.first] = kv.second / double(s.effectRuns[kv.first]);
 }
 
 }  // namespace

@@ -27,7 +27,7 @@ namespace fs = std::filesystem;
 const char* const kCmd = "vista bench";
 
 struct BenchArgs {
-    std::string city, size = "640x480", modes = "full,near", out, reference = "full", fov = "60", sweep;
+    std::string city, size = "640x480", modes = "full,near", out, reference = "full", fov = "60", sweep, effects;
     bool quiet = false;
     PathFlags path;
     ModeFlags mode;
@@ -49,6 +49,10 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
     app.add_option("--diff-threshold", a.cfg.diffThreshold, "per-channel difference counted as a differing pixel (default 8)");
     app.add_option("--worst", a.cfg.worstFrames, "difference images for the N worst frames per mode (default 2)");
     app.add_option("--out", a.out, "output directory (created if missing)")->required();
+    app.add_option("--effects", a.effects,
+                   "run-time effects for this run instead of the scene's: 'none', names (haze, glass, night) or a JSON "
+                   "object as in the params file; baked effects (sun_shadows, ambient_occlusion, materials, night's "
+                   "lights) follow the scene file");
     app.add_option("--sweep", a.sweep, "scaling sweep: sizes=500,1000,2000 generates a city per size (seed --seed) and benches each");
     app.add_flag("-q,--quiet", a.quiet, "no progress on stderr");
 }
@@ -104,6 +108,29 @@ void printTable(const BenchResult& r) {
                     m.speedupMedianOfRatios.at("full"), m.psnrDbMedian, m.psnrDbMin, m.trianglesMedian);
 }
 
+// The run-time effects of a bench: the scene's, or --effects over them.
+// Marks for glass exist only where the scene declared glass at generation.
+Result<FrameEffects> runTimeEffects(const std::string& option, const Effects& declared, bool quiet) {
+    if (option.empty()) return FrameEffects::fromScene(declared);
+    auto e = parseEffectsOption(option, declared);
+    if (!e) return e.status();
+    FrameEffects fx = FrameEffects::fromScene(*e);
+    fx.glassMarked = declared.glass.has_value();
+    if (!fx.glassMarked) fx.glass = false;
+    if (!quiet) {
+        for (int i = 0; i < kEffectCount; ++i) {
+            const EffectId id = EffectId(i);
+            if (id == EffectId::Night || !effectIsBaked(id) || e->has(id) == declared.has(id)) continue;
+            std::fprintf(stderr, "%s: note: %s is baked into the scene's colours at generation; it stays %s (regenerate with "
+                                 "`vista gen --effects` to change it)\n",
+                         kCmd, effectName(id), declared.has(id) ? "on" : "off");
+        }
+        if (e->glass && !declared.glass)
+            std::fprintf(stderr, "%s: note: the scene declares no glass, so no window is marked: no reflections\n", kCmd);
+    }
+    return fx;
+}
+
 // One bench of one city file into one directory: load, path, run, print.
 int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string& outDir, BenchResult* res,
               size_t* cityTriangles = nullptr) {
@@ -117,6 +144,10 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
     cfg.runUpS = a.path.file.empty() ? a.pathOptions.runUp : -1.0;
     cfg.outDir = outDir;
     cfg.cityLabel = fs::path(cityFile).filename().string();
+    auto fx = runTimeEffects(a.effects, city->params.effects, a.quiet);
+    if (!fx) return reportBadInput(kCmd, fx.status());
+    cfg.options.effects = *fx;
+    cfg.effectsDeclared = effectsToJson(city->params.effects);
     auto r = runBenchmark(&city.value(), sceneRoot(city.value()), path.value(), cfg);
     if (!r) {
         std::fprintf(stderr, "%s: %s\n", kCmd, r.status().message().c_str());

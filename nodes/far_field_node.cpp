@@ -3,6 +3,8 @@
 #define GL_GLEXT_PROTOTYPES 1
 #endif
 #include "nodes/far_field_node.h"
+
+#include <osg/Program>
 #include "foundation/units.h"
 
 #include <algorithm>
@@ -31,6 +33,12 @@ FarFieldNode::FarFieldNode(const RayScene& rays, const HeightGrid* grid, const F
     setCullingActive(false);
     setDataVariance(osg::Object::DYNAMIC);
     getOrCreateStateSet()->setRenderBinDetails(kFarFieldRenderBin, "RenderBin");
+    useFixedFunction(*getOrCreateStateSet());
+}
+
+void useFixedFunction(osg::StateSet& ss) {
+    // An osg::Program without shaders applies as glUseProgram(0).
+    ss.setAttributeAndModes(new osg::Program, osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE | osg::StateAttribute::PROTECTED);
 }
 
 FarFieldNode::FarFieldNode(const FarFieldNode& o, const osg::CopyOp& copyop)
@@ -97,7 +105,8 @@ void drawImageOverViewport(const osg::Viewport& vp, const Image& image, const st
             q[0] = p[0];
             q[1] = p[1];
             q[2] = p[2];
-            q[3] = mask && (*mask)[src + size_t(x)] == 0 ? 0 : 255;
+            // Kept pixels keep their alpha (glass marks >= kGlassAlpha pass the alpha test).
+            q[3] = mask && (*mask)[src + size_t(x)] == 0 ? 0 : std::max<uint8_t>(p[3], 129);
         }
     }
     glPushAttrib(GL_ALL_ATTRIB_BITS);
@@ -107,6 +116,7 @@ void drawImageOverViewport(const osg::Viewport& vp, const Image& image, const st
     glDisable(GL_LIGHTING);
     glDisable(GL_TEXTURE_2D);
     glDisable(GL_BLEND);
+    glDisable(GL_FOG);  // the far-field image is hazed already
     glEnable(GL_ALPHA_TEST);
     glAlphaFunc(GL_GREATER, 0.5f);
     glDepthMask(GL_FALSE);

@@ -36,6 +36,9 @@ namespace vista {
 class RayScene;
 struct SceneModel;
 
+// Makes drawables under `ss` draw with the fixed-function pipeline whatever
+// program the graph above sets (images drawn with glDrawPixels are final).
+void useFixedFunction(osg::StateSet& ss);
 // The vista::Camera of an OSG camera's view and projection matrices (world
 // frame, x east, y north, z up) for a width x height viewport. zFar = the
 // projection's far plane (0 = infinite). False for a non-perspective

@@ -119,6 +119,7 @@ private:
         o.cache = _ctx.options.cache;
         o.threads = _ctx.options.threads;
         o.depthZFar = zFar;
+        o.effects = _ctx.options.effects;
         return o;
     }
 

@@ -19,28 +19,35 @@ namespace {
 // One primary ray per pixel centre into `rays` (the engine's castFrame: the
 // same packets and colours as the far field's ray stage); fills `out` and the
 // pixel classes, rays and the "rays" stage of `stats`.
-void castEveryPixel(const RayScene& rays, const Camera& camera, Image& out, FrameStats& stats, int threads) {
+void castEveryPixel(const RayScene& rays, const Camera& camera, Image& out, FrameStats& stats, int threads,
+                    const FrameEffects& fx) {
     Stopwatch sw;
     if (out.width != camera.width || out.height != camera.height) out = Image(camera.width, camera.height);
     RayCounts counts;
-    castFrame(rays, camera, out, counts, threads);
+    std::vector<float> depth(fx.haze ? size_t(camera.width) * size_t(camera.height) : 0);
+    RayShading shading;
+    shading.effects = &fx;
+    shading.depth = depth.empty() ? nullptr : depth.data();
+    castFrame(rays, camera, out, counts, threads, shading);
     stats.pixels.rayHit = counts.hits;
     stats.pixels.rayMiss = counts.rays - counts.hits;
     stats.raysCast += counts.rays;
     stats.stages.set(Stage::Rays, sw.ms());
+    if (!depth.empty()) hazeStage(fx, nullptr, depth.size(), depth.data(), out, stats);
 }
 
 // Viewer face: casts the OSG camera's frame and draws it over the viewport.
 class RaycastDrawable : public osg::Drawable {
 public:
-    explicit RaycastDrawable(const RayScene& rays) : _rays(rays) {
+    RaycastDrawable(const RayScene& rays, const FrameEffects* fx) : _rays(rays), _fx(fx) {
+        useFixedFunction(*getOrCreateStateSet());
         setUseDisplayList(false);
         setUseVertexBufferObjects(false);
         setCullingActive(false);
         setDataVariance(osg::Object::DYNAMIC);
     }
-    RaycastDrawable(const RaycastDrawable& o, const osg::CopyOp& op) : osg::Drawable(o, op), _rays(o._rays) {}
-    osg::Object* cloneType() const override { return new RaycastDrawable(_rays); }
+    RaycastDrawable(const RaycastDrawable& o, const osg::CopyOp& op) : osg::Drawable(o, op), _rays(o._rays), _fx(o._fx) {}
+    osg::Object* cloneType() const override { return new RaycastDrawable(_rays, _fx); }
     osg::Object* clone(const osg::CopyOp& op) const override { return new RaycastDrawable(*this, op); }
     bool isSameKindAs(const osg::Object* o) const override { return dynamic_cast<const RaycastDrawable*>(o) != nullptr; }
     const char* libraryName() const override { return "vista"; }
@@ -58,13 +65,15 @@ public:
         double zFar = 0;
         if (!cameraFromOsg(cam->getViewMatrix(), cam->getProjectionMatrix(), int(vp.width()), int(vp.height()), c, zFar)) return;
         _stats = FrameStats();
-        castEveryPixel(_rays, c, _image, _stats, 0);
+        static const FrameEffects kNone;
+        castEveryPixel(_rays, c, _image, _stats, 0, _fx ? *_fx : kNone);
         drawImageOverViewport(vp, _image, nullptr, _upload);
     }
     osg::BoundingBox computeBoundingBox() const override { return osg::BoundingBox(); }
 
 private:
     const RayScene& _rays;
+    const FrameEffects* _fx;
     mutable Image _image;
     mutable std::vector<uint8_t> _upload;
     mutable FrameStats _stats;
@@ -77,14 +86,14 @@ public:
     std::string name() const override { return "raycast"; }
     Status renderFrame(const Camera& camera, Image& out, FrameStats& stats) override {
         Stopwatch sw;
-        castEveryPixel(*_ctx.rays, camera, out, stats, _ctx.options.threads);
+        castEveryPixel(*_ctx.rays, camera, out, stats, _ctx.options.threads, _ctx.options.effects);
         stats.frameMs = sw.ms();
         stats.drawMs = stats.frameMs;
         return Status::ok();
     }
     osg::Node* viewerScene() override {
         if (!_viewer) {
-            _drawable = new RaycastDrawable(*_ctx.rays);
+            _drawable = new RaycastDrawable(*_ctx.rays, &_ctx.options.effects);
             osg::ref_ptr<osg::Geode> geode = new osg::Geode;
             geode->setCullingActive(false);
             geode->addDrawable(_drawable.get());

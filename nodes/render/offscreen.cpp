@@ -1,6 +1,7 @@
 // OffscreenRenderer: osgViewer window (works under Xvfb + llvmpipe) with
 // explicit view/projection, CPU sky background, glFinish timing and readback.
 #include "nodes/render/offscreen.h"
+#include "nodes/render/effects_state.h"
 
 #include <chrono>
 #include <cmath>
@@ -117,12 +118,13 @@ struct OffscreenRenderer::Impl {
     osg::ref_ptr<Readback> readback;
     std::vector<uint8_t> colorBuf;
     double jx = 0, jy = 0;
+    FrameEffects effects;
 
     Status draw(osg::Node* scene, const Camera& camera, double zFar, Image* color, std::vector<float>* depth,
                 FrameStats& stats) {
         osg::Camera* cam = viewer->getCamera();
         cam->setViewMatrix(toOsg(camera.view()));
-        osg::Matrixd proj = toOsg(camera.projection(zFar));
+        osg::Matrixd proj = toOsg(camera.projection(effectsFarPlane(zFar, effects)));
         if (jx != 0 || jy != 0) proj = proj * osg::Matrixd::translate(-2.0 * jx / width, 2.0 * jy / height, 0.0);
         cam->setProjectionMatrix(proj);
         if (slot->getNumChildren() != 1 || slot->getChild(0) != scene) {
@@ -258,6 +260,13 @@ Status OffscreenRenderer::render(osg::Node* scene, const Camera& camera, double 
     Status s = m.draw(scene, camera, zFar, color, depth, stats);
     stats.frameMs += skyMs;
     return s;
+}
+
+void OffscreenRenderer::setEffects(const FrameEffects& fx) {
+    Impl& m = *_impl;
+    m.effects = fx;
+    applyEffectsState(*m.slot->getOrCreateStateSet(), fx);
+    m.sky->setNight(fx.night);
 }
 
 int OffscreenRenderer::width() const { return _impl->width; }

@@ -31,6 +31,7 @@
 
 #include "foundation/status.h"
 #include "nodes/render/sky_background.h"
+#include "runtime/engine/frame_effects.h"
 #include "runtime/engine/frame_stats.h"
 #include "runtime/engine/image.h"
 #include "runtime/scene/camera.h"
@@ -54,6 +55,9 @@ public:
     // Shifts the sample point of every pixel by (dx, dy) pixels (x right,
     // y down) for the following renders (jittered supersampling); sky included.
     void setSubpixelOffset(double dx, double dy);
+    // Run-time effects of the following renders: haze (fog on the drawn
+    // scene, far plane at fx.hazeFar()) and the night sky (effects_state.h).
+    void setEffects(const FrameEffects& fx);
     // GL_RENDERER / GL_VERSION strings of the context (for result files).
     std::string glRenderer() const;
 

@@ -1,7 +1,16 @@
 // The render-mode registry and the shared parts of ModeContext (render_mode.h).
 #include "nodes/render/render_mode.h"
 
+#include <algorithm>
+#include <mutex>
+
+#include <osg/Geode>
+#include <osg/RenderInfo>
+
 #include "foundation/timing.h"
+#include "nodes/far_field_node.h"
+#include "nodes/render/effects_state.h"
+#include "runtime/engine/reflections.h"
 #include "nodes/render/offscreen.h"
 #include "nodes/render/mode_full.h"
 #include "nodes/render/mode_hybrid.h"
@@ -81,12 +90,137 @@ std::string renderModeNames() {
     return s;
 }
 
+bool effectsNeedRays(const FrameEffects& fx) { return fx.glass && fx.glassMarked && fx.rayBudget > 0; }
+
+namespace {
+
+// Viewer face of the reflection stage: after everything else is drawn, reads
+// the frame back, runs reflectionStage() on it and draws it over the viewport.
+class ReflectionDrawable : public osg::Drawable {
+public:
+    ReflectionDrawable(const RayScene* rays, const FrameEffects* fx) : _rays(rays), _fx(fx) {
+        useFixedFunction(*getOrCreateStateSet());
+        setUseDisplayList(false);
+        setUseVertexBufferObjects(false);
+        setCullingActive(false);
+        setDataVariance(osg::Object::DYNAMIC);
+    }
+    ReflectionDrawable(const ReflectionDrawable& o, const osg::CopyOp& op)
+        : osg::Drawable(o, op), _rays(o._rays), _fx(o._fx) {}
+    META_Object(vista, ReflectionDrawable);
+    FrameStats lastStats() const {
+        std::lock_guard<std::mutex> lock(_mutex);
+        return _stats;
+    }
+    void drawImplementation(osg::RenderInfo& ri) const override {
+        std::lock_guard<std::mutex> lock(_mutex);
+        const osg::Camera* cam = ri.getCurrentCamera();
+        if (!cam || !cam->getViewport() || !_fx) return;
+        const osg::Viewport& vp = *cam->getViewport();
+        const int W = int(vp.width()), H = int(vp.height());
+        Camera c;
+        double zFar = 0;
+        if (W < 1 || H < 1 || !cameraFromOsg(cam->getViewMatrix(), cam->getProjectionMatrix(), W, H, c, zFar)) return;
+        _image = Image(W, H);
+        _gl.resize(size_t(W) * size_t(H) * 4);
+        glPixelStorei(GL_PACK_ALIGNMENT, 1);
+        glReadPixels(GLint(vp.x()), GLint(vp.y()), W, H, GL_RGBA, GL_UNSIGNED_BYTE, _gl.data());
+        for (int y = 0; y < H; ++y)
+            std::copy_n(&_gl[size_t(H - 1 - y) * size_t(W) * 4], size_t(W) * 4, &_image.rgba[size_t(y) * size_t(W) * 4]);
+        _stats = FrameStats();
+        if (!hasGlassPixels(_image)) return;
+        reflectionStage(_rays, c, *_fx, _image, _stats);
+        drawImageOverViewport(vp, _image, nullptr, _upload);
+    }
+    osg::BoundingBox computeBoundingBox() const override { return osg::BoundingBox(); }
+
+private:
+    ReflectionDrawable() = default;
+    const RayScene* _rays = nullptr;
+    const FrameEffects* _fx = nullptr;
+    mutable Image _image;
+    mutable std::vector<uint8_t> _gl, _upload;
+    mutable FrameStats _stats;
+    mutable std::mutex _mutex;
+};
+
+// Every mode wrapped with the run-time effects (render_mode.h).
+class EffectsMode : public RenderMode {
+public:
+    EffectsMode(std::unique_ptr<RenderMode> inner, ModeContext& ctx) : _inner(std::move(inner)), _ctx(ctx) {
+        _setup = _inner->setupMs();
+    }
+    std::string name() const override { return _inner->name(); }
+    Status renderFrame(const Camera& camera, Image& out, FrameStats& stats) override {
+        const FrameEffects& fx = _ctx.options.effects;
+        if (_ctx.renderer) _ctx.renderer->setEffects(fx);
+        Stopwatch sw;
+        VISTA_RETURN_IF_ERROR(_inner->renderFrame(camera, out, stats));
+        if (fx.haze && !stats.effects.ran(EffectId::Haze)) {
+            stats.effects.add(EffectId::Haze, 0.0);  // fog inside the rasteriser's draw
+        }
+        if (fx.glassMarked) {
+            const double before = stats.stages.ms(Stage::Reflect);
+            reflectionStage(_ctx.rays, camera, fx, out, stats);
+            stats.frameMs += stats.stages.ms(Stage::Reflect) - before;
+        }
+        (void)sw;
+        return Status::ok();
+    }
+    void reset() override { _inner->reset(); }
+    osg::Node* viewerScene() override {
+        if (!_viewer) {
+            _viewer = new osg::Group;
+            _viewer->setName("vista.effects");
+            applyEffectsState(*_viewer->getOrCreateStateSet(), _ctx.options.effects);
+            _viewer->addChild(_inner->viewerScene());
+            if (_ctx.options.effects.glassMarked) {
+                _reflect = new ReflectionDrawable(_ctx.rays, &_ctx.options.effects);
+                osg::ref_ptr<osg::Geode> g = new osg::Geode;
+                g->addDrawable(_reflect.get());
+                g->getOrCreateStateSet()->setRenderBinDetails(100000, "RenderBin");
+                g->setCullingActive(false);
+                _viewer->addChild(g.get());
+            }
+        }
+        return _viewer.get();
+    }
+    double beginViewerFrame(const Camera& camera) override {
+        if (_viewer) applyEffectsState(*_viewer->getOrCreateStateSet(), _ctx.options.effects);  // live toggles
+        return effectsFarPlane(_inner->beginViewerFrame(camera), _ctx.options.effects);
+    }
+    FrameStats lastViewerStats() const override {
+        FrameStats s = _inner->lastViewerStats();
+        if (_reflect) {
+            const FrameStats r = _reflect->lastStats();
+            r.stages.forEach([&](Stage st, double ms) { s.stages.add(st, ms); });
+            r.effects.forEach([&](EffectId e, double ms) { s.effects.add(e, ms); });
+            s.glassPixels += r.glassPixels;
+            s.reflectionRays += r.reflectionRays;
+        }
+        if (_ctx.options.effects.haze) s.effects.add(EffectId::Haze, 0.0);
+        return s;
+    }
+
+private:
+    std::unique_ptr<RenderMode> _inner;
+    ModeContext& _ctx;
+    osg::ref_ptr<osg::Group> _viewer;
+    osg::ref_ptr<ReflectionDrawable> _reflect;
+};
+
+}  // namespace
+
 Result<std::unique_ptr<RenderMode>> createRenderMode(const std::string& name, ModeContext& ctx) {
     const ModeInfo* m = findRenderMode(name);
     if (!m) return Status::error("unknown mode '" + name + "'; available modes: " + renderModeNames());
     if (!ctx.scene) return Status::error("mode " + name + " needs a scene graph, none was loaded");
     if (m->needsRays && !ctx.rays) return Status::error("mode " + name + " needs the city's ray scene, which is not available");
-    return m->make(ctx);
+    if (effectsNeedRays(ctx.options.effects) && !ctx.rays)
+        return Status::error("mode " + name + ": glass reflections need the city's ray scene, which is not available");
+    auto inner = m->make(ctx);
+    if (!inner) return inner.status();
+    return std::unique_ptr<RenderMode>(new EffectsMode(std::move(*inner), ctx));
 }
 
 }  // namespace vista

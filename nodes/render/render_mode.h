@@ -33,6 +33,7 @@
 
 #include "foundation/status.h"
 #include "nodes/near_field_chunks.h"
+#include "runtime/engine/frame_effects.h"
 #include "runtime/engine/frame_stats.h"
 #include "runtime/engine/image.h"
 #include "runtime/scene/camera.h"
@@ -55,6 +56,7 @@ struct ModeOptions {
     bool cache = true;            // hybrid: panoramic image cache on/off
     int threads = 0;              // ray-casting threads; 0 = all cores
     std::string bakedFile;        // impostor: the baked file (unless the scene itself is baked)
+    FrameEffects effects;         // run-time effects of every mode (haze, glass reflections, night sky)
     // The near distance of modes without an adaptive split.
     double fixedNearDistance() const { return nearDistance > 0 ? nearDistance : kDefaultNearDistance; }
 };
@@ -155,6 +157,12 @@ const ModeInfo* findRenderMode(const std::string& name);
 std::string renderModeNames();
 // Creates a mode. Unknown name -> error listing the modes; no ctx.scene, or
 // a mode that needs rays without ctx.rays -> error naming what is missing.
+// Every mode comes wrapped with the run-time effects of ctx.options.effects
+// (one implementation for all modes and both faces): the renderer's fog and
+// night sky, the haze far plane, and the reflection stage (reflections.h)
+// after every frame when the scene marks glass (needs ctx.rays when
+// reflections are on: effectsNeedRays()).
 Result<std::unique_ptr<RenderMode>> createRenderMode(const std::string& name, ModeContext& ctx);
+bool effectsNeedRays(const FrameEffects& fx);
 
 }  // namespace vista

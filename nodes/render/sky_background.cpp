@@ -11,14 +11,14 @@
 
 namespace vista {
 
-void renderSky(const Camera& camera, Image& out, double jx, double jy) {
+void renderSky(const Camera& camera, Image& out, double jx, double jy, bool night) {
     if (out.width != camera.width || out.height != camera.height) out = Image(camera.width, camera.height);
     // Elevation depends only on the row/column, pitch, roll and fov: one
     // skyColor per pixel, no world position involved.
     for (int y = 0; y < camera.height; ++y)
         for (int x = 0; x < camera.width; ++x) {
             glm::dvec3 d = camera.rayDirection(x + 0.5 + jx, y + 0.5 + jy);
-            out.set(x, y, skyColor(std::asin(std::clamp(d.z, -1.0, 1.0))));
+            out.set(x, y, skyColor(std::asin(std::clamp(d.z, -1.0, 1.0)), night));
         }
 }
 
@@ -42,6 +42,7 @@ SkyBackground::SkyBackground(int width, int height) {
     ss->setMode(GL_LIGHTING, osg::StateAttribute::OFF | osg::StateAttribute::PROTECTED);
     ss->setMode(GL_DEPTH_TEST, osg::StateAttribute::OFF | osg::StateAttribute::PROTECTED);
     ss->setMode(GL_BLEND, osg::StateAttribute::OFF);
+    ss->setMode(GL_FOG, osg::StateAttribute::OFF | osg::StateAttribute::PROTECTED);
     ss->setAttributeAndModes(new osg::Depth(osg::Depth::ALWAYS, 0, 1, false));
     ss->setRenderBinDetails(-1000, "RenderBin");
     _camera = new osg::Camera;
@@ -85,8 +86,11 @@ void SkyBackground::upload(const Image& image) {
 void SkyBackground::showSky(const Camera& camera, double jx, double jy) {
     resize(camera.width, camera.height);
     const double key[5] = {camera.pitch, camera.roll, camera.fovY, jx, jy};
-    if (_skyShown && std::equal(key, key + 5, _key) && _sky.width == camera.width && _sky.height == camera.height) return;
-    renderSky(camera, _sky, jx, jy);
+    if (_skyShown && _shownNight == _night && std::equal(key, key + 5, _key) && _sky.width == camera.width &&
+        _sky.height == camera.height)
+        return;
+    renderSky(camera, _sky, jx, jy, _night);
+    _shownNight = _night;
     upload(_sky);
     std::copy(key, key + 5, _key);
     _skyShown = true;

@@ -26,7 +26,8 @@ namespace vista {
 // Sky of `camera` (camera.width x camera.height, row 0 at top): skyColor of
 // the elevation of the ray through each pixel centre + (jx, jy). Shared by
 // the GL modes and the ray caster so sky pixels agree exactly.
-void renderSky(const Camera& camera, Image& out, double jx = 0.0, double jy = 0.0);
+// night: the night sky (skyColor(elev, true)).
+void renderSky(const Camera& camera, Image& out, double jx = 0.0, double jy = 0.0, bool night = false);
 
 class SkyBackground {
 public:
@@ -35,6 +36,8 @@ public:
     // The quad's drawable (excluded from triangle counts).
     const osg::Drawable* drawable() const { return _quad.get(); }
     void showSky(const Camera& camera, double jx = 0.0, double jy = 0.0);
+    // Day or night sky for the following showSky() calls.
+    void setNight(bool night) { _night = night; }
     Status showImage(const Image& image);
 
 private:
@@ -46,6 +49,7 @@ private:
     osg::ref_ptr<osg::Texture2D> _texture;
     Image _sky;
     bool _skyShown = false;
+    bool _night = false, _shownNight = false;
     double _key[5] = {0, 0, 0, 0, 0};  // pitch, roll, fov, jx, jy of the sky shown
 };
 

@@ -39,7 +39,9 @@ FarField::FarField(const RayScene& rays, const HeightGrid* grid, const FarFieldO
 FarField::~FarField() = default;
 
 void FarField::setOptions(const FarFieldOptions& o) {
-    const bool cacheChanged = o.cache != _options.cache || o.cacheOversample != _options.cacheOversample;
+    const bool cacheChanged = o.cache != _options.cache || o.cacheOversample != _options.cacheOversample ||
+                              o.effects.haze != _options.effects.haze || o.effects.visibility != _options.effects.visibility ||
+                              o.effects.night != _options.effects.night;
     _options = o;
     if (cacheChanged) _mem->cache.reset();
 }
@@ -54,6 +56,7 @@ void FarField::render(const Camera& camera, const float* depth, Image& out, Fram
     VISTA_CHECK(camera.width >= 1 && camera.height >= 1);
     if (out.width != camera.width || out.height != camera.height || !out.valid()) out = Image(camera.width, camera.height);
     FarFrame f(camera, depth, out, _class);
+    f.fx = &_options.effects;
     f.moving = _mem->haveLast && !sameCamera(_mem->last, camera);
     _mem->last = camera;
     _mem->haveLast = true;

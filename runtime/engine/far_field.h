@@ -42,6 +42,7 @@
 #include <memory>
 #include <vector>
 
+#include "runtime/engine/frame_effects.h"
 #include "runtime/engine/frame_stats.h"
 #include "runtime/scene/camera.h"
 #include "runtime/engine/horizon.h"
@@ -75,6 +76,10 @@ struct FarFieldOptions {
     // pixel (counted as rayHit instead of covered); every such ray, hit or
     // miss, counts in raysCast. Off = trust coverage.
     bool verifySeam = true;
+    // Run-time effects: haze (rays, horizon and seam stop at hazeFar; haze
+    // stage after the rays), night sky. Glass marks pass through untouched
+    // (the reflection stage after the frame handles them).
+    FrameEffects effects;
 };
 
 class FarField {

@@ -11,12 +11,12 @@ const Image& skyImage(FarFieldMemory& m, const FarFrame& f) {
     // Elevations depend on pitch, roll, fov and size only: heading rotates the
     // world around the vertical axis.
     const Camera& c = f.camera;
-    const double key[4] = {c.pitch, c.roll, c.fovY, double(f.width) * 65536.0 + f.height};
-    if (!std::equal(key, key + 4, m.skyKey)) {
+    const double key[5] = {c.pitch, c.roll, c.fovY, double(f.width) * 65536.0 + f.height, f.fx->night ? 1.0 : 0.0};
+    if (!std::equal(key, key + 5, m.skyKey)) {
         m.sky = Image(f.width, f.height);
         for (int y = 0; y < f.height; ++y)
-            for (int x = 0; x < f.width; ++x) m.sky.set(x, y, primarySkyColor(f.rays.dir(x, y)));
-        std::copy(key, key + 4, m.skyKey);
+            for (int x = 0; x < f.width; ++x) m.sky.set(x, y, f.fx->sky(f.rays.dir(x, y)));
+        std::copy(key, key + 5, m.skyKey);
     }
     return m.sky;
 }

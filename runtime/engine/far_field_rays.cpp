@@ -23,6 +23,15 @@ PixelRays::PixelRays(const Camera& c)
 
 glm::u8vec4 primarySkyColor(const glm::dvec3& dir) { return skyColor(std::asin(std::clamp(dir.z, -1.0, 1.0))); }
 
+double minForwardCosine(const Camera& c) {
+    const PixelRays g(c);
+    const glm::dvec3 f = c.forward();
+    double m = 1.0;
+    for (int y : {0, c.height - 1})
+        for (int x : {0, c.width - 1}) m = std::min(m, glm::dot(g.dir(x, y), f));
+    return std::max(m, 1e-3);
+}
+
 namespace {
 
 // Rays per parallel task (whole rows of 640 pixels: 4 rows a task).
@@ -37,10 +46,17 @@ struct PixelList {
 
 // Casts the entries runs[r] .. runs[r + 1] - 1 of every run r in packets of 8.
 void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, const std::vector<size_t>& runs, Image& out,
-              RayCounts& counts, int threads, uint8_t* hit) {
+              RayCounts& counts, int threads, uint8_t* hit, const RayShading& shading) {
     const size_t nRuns = runs.size() - 1, n = runs.back();
     if (n == 0) return;
     const PixelRays gen(camera);
+    static const FrameEffects kNone;
+    const FrameEffects& fx = shading.effects ? *shading.effects : kNone;
+    const glm::dvec3 fwd = camera.forward();
+    // Haze: nothing beyond hazeFar of eye-plane depth is traced (rays stop at
+    // the farthest the corner pixels can need; hits beyond show the sky).
+    const double zMax = fx.haze ? fx.hazeFar() : 0.0;
+    const float tfar = fx.haze ? float(zMax / minForwardCosine(camera)) : 1e30f;
     const uint32_t W = uint32_t(camera.width);
     const glm::vec3 org(camera.eye - scene.frameOrigin());
     const size_t grain = std::max<size_t>(1, (kRaysPerTask * nRuns + n - 1) / n);
@@ -62,13 +78,16 @@ void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, con
                     ddirs[k] = gen.dir(int(i % W), int(i / W));
                     dirs[k] = glm::vec3(ddirs[k]);
                 }
-                scene.intersectMany(orgs.data(), dirs.data(), int(m), res.data());
+                scene.intersectMany(orgs.data(), dirs.data(), int(m), res.data(), tfar);
                 for (size_t k = 0; k < m; ++k) {
                     const RayHit& h = res[k];
-                    const glm::u8vec4 c = h.hit ? glm::u8vec4(h.color.x, h.color.y, h.color.z, 255) : primarySkyColor(ddirs[k]);
+                    const double z = h.hit ? double(h.t) * glm::dot(ddirs[k], fwd) : 0.0;
+                    const bool shown = h.hit && !(fx.haze && z > zMax);
+                    const glm::u8vec4 c = shown ? h.color : fx.sky(ddirs[k]);
                     std::copy_n(&c[0], 4, &out.rgba[size_t(pixels[b + k]) * 4]);
-                    if (hit) hit[b + k] = h.hit ? 1 : 0;
-                    nh += h.hit ? 1 : 0;
+                    if (shading.depth) shading.depth[b + k] = shown ? float(z) : INFINITY;
+                    if (hit) hit[b + k] = shown ? 1 : 0;
+                    nh += shown ? 1 : 0;
                 }
             }
             hits.local() += nh;
@@ -81,7 +100,7 @@ void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, con
 }  // namespace
 
 void castPrimaryRays(const RayScene& scene, const Camera& camera, const uint32_t* pixels, size_t n, Image& out,
-                     RayCounts& counts, int threads, uint8_t* hit) {
+                     RayCounts& counts, int threads, uint8_t* hit, const RayShading& shading) {
     VISTA_CHECK(out.width == camera.width && out.height == camera.height && out.valid());
     const uint32_t W = uint32_t(camera.width), N = uint32_t(size_t(camera.width) * size_t(camera.height));
     // Runs: a new run starts at a row change once the current one fills a
@@ -92,29 +111,59 @@ void castPrimaryRays(const RayScene& scene, const Camera& camera, const uint32_t
         if (k == 0 || (pixels[k] / W != pixels[k - 1] / W && k - runs.back() >= kPacket)) runs.push_back(k);
     }
     runs.push_back(n);
-    castRuns(scene, camera, PixelList{pixels}, runs, out, counts, threads, hit);
+    castRuns(scene, camera, PixelList{pixels}, runs, out, counts, threads, hit, shading);
 }
 
-void castFrame(const RayScene& scene, const Camera& camera, Image& out, RayCounts& counts, int threads) {
+void castFrame(const RayScene& scene, const Camera& camera, Image& out, RayCounts& counts, int threads,
+               const RayShading& shading) {
     VISTA_CHECK(camera.width >= 1 && camera.height >= 1);
     if (out.width != camera.width || out.height != camera.height || !out.valid()) out = Image(camera.width, camera.height);
     std::vector<size_t> runs(size_t(camera.height) + 1);
     for (size_t y = 0; y < runs.size(); ++y) runs[y] = y * size_t(camera.width);
-    castRuns(scene, camera, PixelList{nullptr}, runs, out, counts, threads, nullptr);
+    castRuns(scene, camera, PixelList{nullptr}, runs, out, counts, threads, nullptr, shading);
 }
 
 // ---- the far field's ray stage -------------------------------------------------
 
+void hazeStage(const FrameEffects& fx, const uint32_t* pixels, size_t n, const float* depth, Image& out,
+               FrameStats& stats) {
+    if (!fx.haze || n == 0) return;
+    Stopwatch sw;
+    // Transmittance per 1/1024 of the haze range (linear interpolation: error
+    // < 1e-6, far below an 8-bit step), then the same blend as applyHaze.
+    constexpr int kSteps = 1024;
+    const double zMax = fx.hazeFar(), step = zMax / kSteps;
+    float table[kSteps + 2];
+    for (int i = 0; i <= kSteps + 1; ++i) table[i] = fx.transmittance(i * step);
+    const glm::u8vec4 h = fx.hazeColor();
+    for (size_t k = 0; k < n; ++k) {
+        if (!std::isfinite(depth[k])) continue;
+        uint8_t* p = &out.rgba[size_t(pixels ? pixels[k] : uint32_t(k)) * 4];
+        const double u = std::clamp(double(depth[k]) / step, 0.0, double(kSteps));
+        const int i = int(u);
+        const float f = float(u - i), t = table[i] + (table[i + 1] - table[i]) * f;
+        for (int c = 0; c < 3; ++c) p[c] = uint8_t(std::lround(std::clamp(p[c] * t + h[c] * (1.0f - t), 0.0f, 255.0f)));
+    }
+    const double ms = sw.ms();
+    stats.stages.add(Stage::Haze, ms);
+    stats.effects.add(EffectId::Haze, ms);
+}
+
 void raysStage(FarFrame& f, const RayScene& rays, int threads, FrameStats& stats) {
     Stopwatch sw;
     std::vector<uint8_t> hit(f.trace.size(), 0);
+    std::vector<float> depth(f.fx->haze ? f.trace.size() : 0);
     RayCounts counts;
-    castPrimaryRays(rays, f.camera, f.trace.data(), f.trace.size(), f.out, counts, threads, hit.data());
+    RayShading shading;
+    shading.effects = f.fx;
+    shading.depth = depth.empty() ? nullptr : depth.data();
+    castPrimaryRays(rays, f.camera, f.trace.data(), f.trace.size(), f.out, counts, threads, hit.data(), shading);
     for (size_t j = 0; j < f.trace.size(); ++j) f.cls[f.trace[j]] = hit[j] ? kFarRayHit : kFarRayMiss;
     stats.raysCast += counts.rays;
     stats.pixels.rayHit += counts.hits;
     stats.pixels.rayMiss += counts.rays - counts.hits;
     stats.stages.add(Stage::Rays, sw.ms());
+    if (!depth.empty()) hazeStage(*f.fx, f.trace.data(), f.trace.size(), depth.data(), f.out, stats);
 }
 
 }  // namespace vista

@@ -25,6 +25,8 @@
 
 #include <glm/glm.hpp>
 
+#include "runtime/engine/frame_effects.h"
+#include "runtime/engine/frame_stats.h"
 #include "runtime/engine/image.h"
 #include "runtime/scene/camera.h"
 
@@ -51,18 +53,37 @@ private:
 // Sky colour of a ray that hits nothing (unit direction, world frame).
 glm::u8vec4 primarySkyColor(const glm::dvec3& dir);
 
+// Smallest cos(angle to the forward axis) of any pixel-centre ray of the camera (the corners).
+double minForwardCosine(const Camera& camera);
+
 struct RayCounts {
     uint64_t rays = 0;  // rays cast (hit or miss)
     uint64_t hits = 0;  // rays that hit geometry
+};
+
+// What the rays of a frame shade with: run-time effects (haze clips rays at
+// fx.hazeFar() of eye-plane depth, hits beyond show the sky; night sky) and,
+// optionally, the eye-plane depth of every entry (+inf on a miss) for the
+// haze stage. Glass marks (alpha) of hit colours are kept.
+struct RayShading {
+    const FrameEffects* effects = nullptr;  // null = none
+    float* depth = nullptr;                 // n entries (castPrimaryRays) or width*height (castFrame)
 };
 
 // Casts the rays of the n listed pixels (indices y * width + x) and writes
 // their colours into `out`; other pixels are untouched. Adds to `counts`.
 // hit (optional, n entries): 1 where entry k's ray hit geometry, else 0.
 void castPrimaryRays(const RayScene& scene, const Camera& camera, const uint32_t* pixels, size_t n, Image& out,
-                     RayCounts& counts, int threads, uint8_t* hit = nullptr);
+                     RayCounts& counts, int threads, uint8_t* hit = nullptr, const RayShading& shading = {});
 
 // Every pixel of the camera, row by row (out is resized to the camera).
-void castFrame(const RayScene& scene, const Camera& camera, Image& out, RayCounts& counts, int threads);
+void castFrame(const RayScene& scene, const Camera& camera, Image& out, RayCounts& counts, int threads,
+               const RayShading& shading = {});
+
+// Haze stage: fx.applyHaze to the n listed pixels (null list = every pixel)
+// at their eye-plane depth (one entry per listed pixel; +inf = sky, left
+// alone). Records Stage::Haze and the haze effect when fx.haze and n > 0.
+void hazeStage(const FrameEffects& fx, const uint32_t* pixels, size_t n, const float* depth, Image& out,
+               FrameStats& stats);
 
 }  // namespace vista

@@ -49,7 +49,9 @@ void seamStage(FarFrame& f, const RayScene& rays, const FarFieldOptions& o, Fram
             if (!res[k].hit) continue;
             const uint32_t i = check[k];
             f.cls[i] = kFarRayHit;
-            f.out.set(int(i % W), int(i / W), glm::u8vec4(res[k].color.x, res[k].color.y, res[k].color.z, 255));
+            // Eye-plane depth of the hit for haze (the seam lies within the near distance).
+            const glm::dvec3 d = f.rays.dir(int(i % W), int(i / W));
+            f.out.set(int(i % W), int(i / W), f.fx->applyHaze(res[k].color, double(res[k].t) * glm::dot(d, f.camera.forward())));
             ++replaced;
         }
         f.covered -= replaced;

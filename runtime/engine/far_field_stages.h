@@ -37,7 +37,7 @@ struct FarFieldMemory {
     double cacheKey[4] = {0, 0, 0, 0};  // fovY, width, height, oversample of the cache
     Image prev;                          // last composited frame (cache mode)
     Image sky;                           // sky colours (depend on pitch, roll, fov, size only)
-    double skyKey[4] = {1e300, 0, 0, 0};
+    double skyKey[5] = {1e300, 0, 0, 0, 0};
     Camera last;
     bool haveLast = false;
 };
@@ -54,6 +54,7 @@ struct FarFrame {
     std::vector<uint8_t>& cls;     // per pixel: a FarPixelClass or kFarPending
     bool moving = false;           // camera differs from the last frame's
     const Image* sky = nullptr;    // sky colour per pixel (set before the horizon stage)
+    const FrameEffects* fx = nullptr;  // run-time effects (haze, night sky); never null during render()
     std::vector<uint8_t> columnNeeded;  // per column: has a pending pixel (opacity)
     uint64_t covered = 0;          // pixels of class covered (opacity, seam)
     std::vector<uint32_t> pending; // pending pixels after the horizon, ascending

@@ -12,6 +12,8 @@ const char* stageName(Stage s) {
         case Stage::Seam: return "seam";
         case Stage::Horizon: return "horizon";
         case Stage::Cache: return "cache";
+        case Stage::Haze: return "haze";
+        case Stage::Reflect: return "reflect";
         case Stage::Rays: return "rays";
         case Stage::Composite: return "composite";
         case Stage::Count: break;

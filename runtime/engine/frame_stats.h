@@ -19,6 +19,8 @@
 #include <string>
 #include <vector>
 
+#include "citygen/effects.h"
+
 namespace vista {
 
 struct PixelCounts {
@@ -40,10 +42,12 @@ enum class Stage : uint8_t {
     Cache,      // panoramic cache lookup and selection
     Rays,       // Embree ray casting of the far field
     Composite,  // far-field image written behind the near field
+    Haze,       // haze applied to ray-cast pixels (the rasteriser fogs inside its draw)
+    Reflect,    // glass reflections: reflection rays for marked pixels, blended in
     Count
 };
 constexpr size_t kStageCount = size_t(Stage::Count);
-// "cull", "near", "readback", "opacity", "seam", "horizon", "cache", "rays", "composite".
+// "cull", "near", "readback", "opacity", "seam", "horizon", "cache", "rays", "composite", "haze", "reflect".
 const char* stageName(Stage s);
 
 class StageTimes {
@@ -69,12 +73,34 @@ private:
     std::array<bool, kStageCount> _ran{};
 };
 
+// Which effects ran in a frame and their time (ms), indexed by EffectId. An
+// effect that did not run (not declared, switched off, or nothing of it on
+// screen) is absent. Baked effects never run per frame.
+class EffectTimes {
+public:
+    void add(EffectId e, double ms) { _ms[size_t(e)] += ms; _ran[size_t(e)] = true; }
+    bool ran(EffectId e) const { return _ran[size_t(e)]; }
+    double ms(EffectId e) const { return _ms[size_t(e)]; }
+    template <class F>
+    void forEach(F&& f) const {
+        for (size_t i = 0; i < size_t(kEffectCount); ++i)
+            if (_ran[i]) f(EffectId(i), _ms[i]);
+    }
+
+private:
+    std::array<double, size_t(kEffectCount)> _ms{};
+    std::array<bool, size_t(kEffectCount)> _ran{};
+};
+
 struct FrameStats {
     double frameMs = 0, cullMs = 0, drawMs = 0;
     uint64_t triangles = 0, drawCalls = 0;
     uint64_t raysCast = 0;                    // every ray cast this frame (far field, seam check, probes)
     PixelCounts pixels;
     StageTimes stages;
+    EffectTimes effects;
+    uint64_t glassPixels = 0;                 // pixels marked as glass on screen
+    uint64_t reflectionRays = 0;              // reflection rays (also counted in raysCast)
     std::vector<std::string> notes;           // e.g. "horizon off: camera rolled"
 };
 

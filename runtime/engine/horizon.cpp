@@ -103,7 +103,7 @@ HeightGrid HeightGrid::build(const SceneModel& city, const glm::dvec3& frameOrig
     return g;
 }
 
-double HeightGrid::cellBound(int ix, int iy, const glm::dvec3& eye, double nearDistance) const {
+double HeightGrid::cellBound(int ix, int iy, const glm::dvec3& eye, double nearDistance, double maxDistance) const {
     size_t i = size_t(iy) * size_t(_cells) + size_t(ix);
     double hmax = double(_maxZ[i]);
     if (hmax == -kInf) return -kInf;
@@ -112,6 +112,7 @@ double HeightGrid::cellBound(int ix, int iy, const glm::dvec3& eye, double nearD
     double nx = std::max({x0 - eye.x, 0.0, eye.x - x1}), ny = std::max({y0 - eye.y, 0.0, eye.y - y1});
     double fx = std::max(std::abs(eye.x - x0), std::abs(eye.x - x1)), fy = std::max(std::abs(eye.y - y0), std::abs(eye.y - y1));
     double dmin2 = nx * nx + ny * ny, dmax2 = fx * fx + fy * fy;
+    if (dmin2 > maxDistance * maxDistance) return -kInf;
     double dz = hmax - eye.z;
     if (nearDistance > 0) {
         double dzLo = double(_minZ[i]) - eye.z;
@@ -122,7 +123,7 @@ double HeightGrid::cellBound(int ix, int iy, const glm::dvec3& eye, double nearD
     return dz / std::sqrt(dmax2);
 }
 
-double HeightGrid::traceRay(const glm::dvec3& eye, double azimuth, double nearDistance) const {
+double HeightGrid::traceRay(const glm::dvec3& eye, double azimuth, double nearDistance, double maxDistance) const {
     if (_cells == 0) return -kInf;
     const int n = _cells;
     const double s = _cellSize;
@@ -157,16 +158,17 @@ double HeightGrid::traceRay(const glm::dvec3& eye, double azimuth, double nearDi
         const double tLen = t1 - t0;
         auto inGrid = [&](int x, int y) { return x >= 0 && y >= 0 && x < n && y < n; };
         while (inGrid(ix, iy)) {
-            best = std::max(best, cellBound(ix, iy, eye, nearDistance));
+            best = std::max(best, cellBound(ix, iy, eye, nearDistance, maxDistance));
             double tNext = std::min(tMaxX, tMaxY);
             if (tNext > tLen + kTieEps) break;
             // Early exit: nothing farther can beat `best` (only valid when best > 0: farther is lower).
             double distM = (t0 + tNext - 1.5) * s - 2 * kCellMargin;  // nearest point of any later cell
             if (best > 0 && distM > 0 && (zTop - eye.z) / distM < best) break;
+            if (distM > maxDistance) break;  // every later cell lies beyond the haze limit
             if (std::abs(tMaxX - tMaxY) <= kTieEps * std::max(1.0, tNext)) {
                 // Through a grid corner: both side cells touch the ray.
-                if (inGrid(ix + stepX, iy)) best = std::max(best, cellBound(ix + stepX, iy, eye, nearDistance));
-                if (inGrid(ix, iy + stepY)) best = std::max(best, cellBound(ix, iy + stepY, eye, nearDistance));
+                if (inGrid(ix + stepX, iy)) best = std::max(best, cellBound(ix + stepX, iy, eye, nearDistance, maxDistance));
+                if (inGrid(ix, iy + stepY)) best = std::max(best, cellBound(ix, iy + stepY, eye, nearDistance, maxDistance));
                 ix += stepX;
                 iy += stepY;
                 tMaxX += tDeltaX;
@@ -207,7 +209,7 @@ double HeightGrid::traceRay(const glm::dvec3& eye, double azimuth, double nearDi
         int cx = int(std::round(ex)), cy = int(std::round(ey));
         for (int yy = (onLine(ey) ? cy - 1 : iy); yy <= (onLine(ey) ? cy : iy); ++yy)
             for (int xx = (onLine(ex) ? cx - 1 : ix); xx <= (onLine(ex) ? cx : ix); ++xx)
-                if (xx >= 0 && yy >= 0 && xx < n && yy < n) best = std::max(best, cellBound(xx, yy, eye, nearDistance));
+                if (xx >= 0 && yy >= 0 && xx < n && yy < n) best = std::max(best, cellBound(xx, yy, eye, nearDistance, maxDistance));
     }
     return best;
 }
@@ -314,7 +316,7 @@ HorizonResult traceHorizon(const HeightGrid& grid, const Camera& camera, const H
     tbb::parallel_for(tbb::blocked_range<size_t>(0, list.size(), 16), [&](const tbb::blocked_range<size_t>& br) {
         for (size_t i = br.begin(); i != br.end(); ++i) {
             int k = list[i];
-            value[size_t(k)] = grid.traceRay(eye, camera.heading + a0 + k * delta, options.nearDistance);
+            value[size_t(k)] = grid.traceRay(eye, camera.heading + a0 + k * delta, options.nearDistance, options.maxDistance);
         }
     });
     r.raysTraced = int(list.size());

@@ -32,6 +32,7 @@
 // are contract violations.
 #pragma once
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -66,10 +67,13 @@ public:
     // skipping cells entirely within `nearDistance`. -inf if nothing; +inf if
     // geometry above the eye may lie at distance 0 (eye inside a cell with
     // geometry above it).
-    double traceRay(const glm::dvec3& eye, double azimuth, double nearDistance) const;
+    // Cells whose nearest xy point lies beyond `maxDistance` are skipped too
+    // (haze: nothing there is drawn or traced).
+    double traceRay(const glm::dvec3& eye, double azimuth, double nearDistance,
+                    double maxDistance = std::numeric_limits<double>::infinity()) const;
 
 private:
-    double cellBound(int ix, int iy, const glm::dvec3& eye, double nearDistance) const;
+    double cellBound(int ix, int iy, const glm::dvec3& eye, double nearDistance, double maxDistance) const;
     int _cells = 0;
     double _cellSize = 0;
     glm::dvec2 _min{0.0};
@@ -79,6 +83,7 @@ private:
 
 struct HorizonOptions {
     double nearDistance = 0;                    // metres; 0 = consider all geometry
+    double maxDistance = std::numeric_limits<double>::infinity();  // metres: ignore geometry beyond (haze)
     int subsample = 1;                          // >= 1
     const std::vector<uint8_t>* columnNeeded = nullptr;  // size camera.width, or null = all
 };

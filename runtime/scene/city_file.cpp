@@ -13,6 +13,9 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <osg/BlendFunc>
 #include <osg/CullFace>
+#include <osg/NodeVisitor>
+#include <osg/Program>
+#include <set>
 #include <osg/Geode>
 #include <osg/Geometry>
 #include <osg/Group>
@@ -26,6 +29,15 @@
 #include "runtime/scene/scene_file.h"
 
 namespace vista {
+
+const char* const kHazeGlsl = R"(#version 120
+uniform float vista_haze_density;
+uniform vec3 vista_haze_color;
+vec4 vistaHaze(vec4 c, float eyeDepth) {
+    float t = exp(-vista_haze_density * max(eyeDepth, 0.0));
+    return vec4(mix(vista_haze_color, c.rgb, t), c.a);
+}
+)";
 namespace {
 
 constexpr int kFormatVersion = 1;
@@ -51,6 +63,51 @@ void main() {
     gl_FragColor = gl_Color;
 }
 )";
+
+// Loaded form of the trees' program: the same instancing, plus haze.
+const char* const kInstanceVertexShaderHaze = R"(#version 120
+attribute vec4 vista_instance0;
+attribute vec4 vista_instance1;
+attribute vec4 vista_instance2;
+attribute vec4 vista_instance3;
+varying float vista_eye_depth;
+void main() {
+    mat4 instance = mat4(vista_instance0, vista_instance1, vista_instance2, vista_instance3);
+    vec4 p = instance * gl_Vertex;
+    gl_Position = gl_ModelViewProjectionMatrix * p;
+    vista_eye_depth = -(gl_ModelViewMatrix * p).z;
+    gl_FrontColor = gl_Color;
+    gl_BackColor = gl_Color;
+}
+)";
+
+// Gives every instanced-tree program under `root` the haze uniforms.
+void addHazeToTreePrograms(osg::Node* root) {
+    struct Visitor : osg::NodeVisitor {
+        Visitor() : osg::NodeVisitor(TRAVERSE_ALL_CHILDREN) {}
+        std::set<osg::Program*> seen;
+        void fix(osg::StateSet* ss) {
+            if (!ss) return;
+            auto* prog = dynamic_cast<osg::Program*>(ss->getAttribute(osg::StateAttribute::PROGRAM));
+            if (!prog || prog->getName() != "vista.instanced_trees" || !seen.insert(prog).second) return;
+            while (prog->getNumShaders() > 0) prog->removeShader(prog->getShader(0));
+            prog->addShader(new osg::Shader(osg::Shader::VERTEX, kInstanceVertexShaderHaze));
+            prog->addShader(new osg::Shader(osg::Shader::FRAGMENT, std::string(kHazeGlsl) +
+                                                                      "varying float vista_eye_depth;\n"
+                                                                      "void main() { gl_FragColor = vistaHaze(gl_Color, vista_eye_depth); }\n"));
+        }
+        void apply(osg::Node& n) override {
+            fix(n.getStateSet());
+            traverse(n);
+        }
+        void apply(osg::Geode& g) override {
+            fix(g.getStateSet());
+            for (unsigned i = 0; i < g.getNumDrawables(); ++i) fix(g.getDrawable(i)->getStateSet());
+            traverse(g);
+        }
+    } v;
+    if (root) root->accept(v);
+}
 
 osg::ref_ptr<osg::Vec3Array> toVec3Array(const std::vector<glm::vec3>& v) {
     osg::ref_ptr<osg::Vec3Array> a = new osg::Vec3Array(unsigned(v.size()));
@@ -269,6 +326,7 @@ Result<SceneModel> decodeCityScene(osg::Node* node, const std::string& path) {
         return Status::error("city file '" + path + "': vista.format = " + std::to_string(format) + " is not supported (expected " +
                              std::to_string(kFormatVersion) + ")");
     SceneModel out;
+    addHazeToTreePrograms(node);
     setSceneRoot(out, node);
     std::string paramsJson, streetsJson;
     if (!getUser(*root, "vista.params", paramsJson)) return bad("missing user value vista.params");

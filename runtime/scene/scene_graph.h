@@ -37,6 +37,15 @@ osg::ref_ptr<osg::Node> buildCityScene(const City& city);
 
 constexpr const char* kTreeGeometryPrefix = "tree_prototype_";
 constexpr unsigned kInstanceAttrib0 = 12;
+// Haze uniforms read by every vista shader that draws city geometry (the
+// instanced trees' program as loaded, the haze program of nodes/render):
+// colour = mix(vista_haze_color, colour, exp(-vista_haze_density * eye-plane depth)).
+// Unset (0) = no haze: the colour passes unchanged.
+constexpr const char* kHazeDensityUniform = "vista_haze_density";
+constexpr const char* kHazeColorUniform = "vista_haze_color";
+// GLSL 1.20 fragment-stage haze shared by those shaders (declares the uniforms
+// and `vec4 vistaHaze(vec4 colour, float eyeDepth)`).
+extern const char* const kHazeGlsl;
 // The tile transform ("tile_IX_IY") if `node` is one, else null.
 osg::MatrixTransform* asCityTile(osg::Node* node);
 // The geometries with at least one primitive set under a tile transform, in
@@ -45,6 +54,9 @@ std::vector<osg::Geometry*> tileGeometries(osg::MatrixTransform& tile);
 
 // Decodes a graph in the city layout into plain arrays (what loadCityFile
 // does after reading the file). `what` names the source in messages.
+// Decoding also gives the instanced trees' program (stored in the file
+// without haze) the haze uniforms, so the file's bytes stay as written and
+// the trees are hazed like everything else.
 Result<SceneModel> decodeCityScene(osg::Node* root, const std::string& what);
 
 }  // namespace vista

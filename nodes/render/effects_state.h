@@ -1,0 +1,22 @@
+// The GL side of the run-time effects (frame_effects.h), one implementation
+// for the bench's renderer and the viewer:
+//   applyEffectsState(): haze on `ss`: the uniforms of scene_graph.h
+//     (density = fx.extinction(), colour = fx.hazeColor(); 0 = none) and, while
+//     haze is on, a GLSL program that hazes per fragment at the eye-plane
+//     depth exactly as FrameEffects::applyHaze does (fixed-function fog is
+//     interpolated per vertex on some drivers, which the ray caster cannot
+//     match); haze off = no program (fixed function, as without effects).
+//     Idempotent. Programs below `ss` (the instanced trees) read the same uniforms.
+//   effectsFarPlane(): the projection's far plane with haze: nothing beyond
+//     fx.hazeFar() is drawn (zFar <= 0 means infinite).
+#pragma once
+#include <osg/StateSet>
+
+#include "runtime/engine/frame_effects.h"
+
+namespace vista {
+
+void applyEffectsState(osg::StateSet& ss, const FrameEffects& fx);
+double effectsFarPlane(double zFar, const FrameEffects& fx);
+
+}  // namespace vista
