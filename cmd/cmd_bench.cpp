@@ -108,29 +108,6 @@ void printTable(const BenchResult& r) {
                     m.speedupMedianOfRatios.at("full"), m.psnrDbMedian, m.psnrDbMin, m.trianglesMedian);
 }
 
-// The run-time effects of a bench: the scene's, or --effects over them.
-// Marks for glass exist only where the scene declared glass at generation.
-Result<FrameEffects> runTimeEffects(const std::string& option, const Effects& declared, bool quiet) {
-    if (option.empty()) return FrameEffects::fromScene(declared);
-    auto e = parseEffectsOption(option, declared);
-    if (!e) return e.status();
-    FrameEffects fx = FrameEffects::fromScene(*e);
-    fx.glassMarked = declared.glass.has_value();
-    if (!fx.glassMarked) fx.glass = false;
-    if (!quiet) {
-        for (int i = 0; i < kEffectCount; ++i) {
-            const EffectId id = EffectId(i);
-            if (id == EffectId::Night || !effectIsBaked(id) || e->has(id) == declared.has(id)) continue;
-            std::fprintf(stderr, "%s: note: %s is baked into the scene's colours at generation; it stays %s (regenerate with "
-                                 "`vista gen --effects` to change it)\n",
-                         kCmd, effectName(id), declared.has(id) ? "on" : "off");
-        }
-        if (e->glass && !declared.glass)
-            std::fprintf(stderr, "%s: note: the scene declares no glass, so no window is marked: no reflections\n", kCmd);
-    }
-    return fx;
-}
-
 // One bench of one city file into one directory: load, path, run, print.
 int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string& outDir, BenchResult* res,
               size_t* cityTriangles = nullptr) {
@@ -144,7 +121,7 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
     cfg.runUpS = a.path.file.empty() ? a.pathOptions.runUp : -1.0;
     cfg.outDir = outDir;
     cfg.cityLabel = fs::path(cityFile).filename().string();
-    auto fx = runTimeEffects(a.effects, city->params.effects, a.quiet);
+    auto fx = runTimeEffects(a.effects, city->params.effects, a.quiet, kCmd);
     if (!fx) return reportBadInput(kCmd, fx.status());
     cfg.options.effects = *fx;
     cfg.effectsDeclared = effectsToJson(city->params.effects);

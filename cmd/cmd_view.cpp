@@ -48,7 +48,7 @@ const char* const kCmd = "vista view";
 osg::Matrixd toOsg(const glm::dmat4& m) { return osg::Matrixd(glm::value_ptr(m)); }
 
 struct ViewArgs {
-    std::string city, size = "1280x720", screenshot, mode = "full", fov = "60";
+    std::string city, size = "1280x720", screenshot, mode = "full", fov = "60", effects;
     int frames = 0;
     bool step = false, noHud = false;
     PathFlags path;
@@ -72,6 +72,9 @@ void declareFlags(CLI::App& app, ViewArgs& a) {
                  "with --frames N and a path: show the N frames `vista bench --frames N` renders (one path sample per frame)");
     app.add_flag("--no-hud", a.noHud, "no text overlay (for screenshots compared with `vista bench`)");
     app.add_option("--screenshot", a.screenshot, "write a PNG of the last frame (use with --frames)");
+    app.add_option("--effects", a.effects,
+                   "run-time effects instead of the scene's: 'none', names (haze, glass, night) or a JSON object; "
+                   "keys y / g / n toggle haze, glass reflections and the night sky");
 }
 
 Status configure(ViewArgs& a, ModeOptions& options) {
@@ -99,7 +102,7 @@ public:
         if (it != _modes.end()) return it->second.get();
         const ModeInfo* info = findRenderMode(name);
         if (!info) return Status::error("unknown mode '" + name + "'");
-        if (info->needsRays) VISTA_RETURN_IF_ERROR(buildRays());
+        if (info->needsRays || _ctx.options.effects.glassMarked) VISTA_RETURN_IF_ERROR(buildRays());
         Stopwatch sw;
         auto m = createRenderMode(name, _ctx);
         if (!m) return m.status();
@@ -209,6 +212,12 @@ std::string hudText(const std::string& mode, double lastMs, const FrameStats& fs
         std::snprintf(buf, sizeof(buf), "%s%s %.1f", k++ % 4 == 0 ? "\n  " : "  ", stageName(stage), ms);
         text += buf;
     });
+    std::string fx;
+    fs.effects.forEach([&](EffectId e, double ms) {
+        std::snprintf(buf, sizeof(buf), "  %s %.1f", effectName(e), ms);
+        fx += buf;
+    });
+    if (!fx.empty()) text += "\neffects ms (y g n):" + fx;
     return text;
 }
 
@@ -216,16 +225,31 @@ struct Keys : public osgGA::GUIEventHandler {
     bool nextMode = false;
     int shots = 0;
     osg::ref_ptr<Capture> capture;
+    FrameEffects* effects = nullptr;  // live toggles (the modes read it every frame)
+    FrameEffects declared;            // what the scene declares (toggling back on restores it)
     bool handle(const osgGA::GUIEventAdapter& ea, osgGA::GUIActionAdapter&) override {
         if (ea.getEventType() != osgGA::GUIEventAdapter::KEYDOWN) return false;
         if (ea.getKey() == 'm') nextMode = true;
         else if (ea.getKey() == 'p') capture->pending = "vista_screenshot_" + std::to_string(shots++) + ".png";
-        else return false;
+        else if (ea.getKey() == 'y' && effects) {
+            effects->haze = !effects->haze;
+            if (effects->haze && !(effects->visibility < 1e29)) effects->visibility = declared.haze ? declared.visibility : 1500.0;
+        } else if (ea.getKey() == 'g' && effects) {
+            effects->glass = !effects->glass && effects->glassMarked;
+            if (effects->glass && effects->rayBudget <= 0) effects->rayBudget = declared.rayBudget > 0 ? declared.rayBudget : 50000;
+        } else if (ea.getKey() == 'n' && effects) {
+            effects->night = !effects->night;
+        } else {
+            return false;
+        }
         return true;
     }
     void getUsage(osg::ApplicationUsage& u) const override {
         u.addKeyboardMouseBinding("m", "cycle the render modes (" + renderModeNames() + ")");
         u.addKeyboardMouseBinding("p", "screenshot to vista_screenshot_N.png");
+        u.addKeyboardMouseBinding("y", "haze on/off (the scene's visibility, else 1500 m)");
+        u.addKeyboardMouseBinding("g", "glass reflections on/off (scenes generated with glass)");
+        u.addKeyboardMouseBinding("n", "night sky on/off");
     }
 };
 
@@ -363,6 +387,7 @@ int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path,
             }
         }
         cam->setProjectionMatrix(toOsg(c.projection(v.current->beginViewerFrame(c))));
+        if (v.keys->effects) v.sky->setNight(v.keys->effects->night);
         v.sky->showSky(c);
         v.hud.text->setText(hudText(v.mode, lastMs, v.current->lastViewerStats(), playback));
         const bool last = a.frames > 0 && n + 1 >= a.frames;
@@ -400,6 +425,9 @@ int runView(int argc, char** argv) {
     }
     ctx.city = &city.value();
     ctx.scene = sceneRoot(city.value());
+    auto fx = runTimeEffects(a.effects, city->params.effects, false, kCmd);
+    if (!fx) return reportBadInput(kCmd, fx.status());
+    ctx.options.effects = *fx;
     ViewModes modes(ctx);
     auto start = modes.get(a.mode);
     if (!start) return reportBadInput(kCmd, Status::error("--mode " + a.mode + ": " + start.status().message()));
@@ -408,6 +436,8 @@ int runView(int argc, char** argv) {
         std::fprintf(stderr, "%s: %s\n", kCmd, s.message().c_str());
         return 1;
     }
+    v.keys->effects = &ctx.options.effects;
+    v.keys->declared = FrameEffects::fromScene(city->params.effects);
     showMode(v, modes, a.mode);
     return runLoop(v, modes, a, path.value(), playback);
 }

@@ -2,6 +2,7 @@
 #include "cmd/options.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -319,5 +320,27 @@ Result<Effects> parseEffectsOption(const std::string& s, const Effects& base) {
     if (s.empty() || s.back() == ',') return Status::error("option --effects = '" + s + "': empty effect name");
     return out;
 }
+
+Result<FrameEffects> runTimeEffects(const std::string& option, const Effects& declared, bool quiet, const char* cmd) {
+    if (option.empty()) return FrameEffects::fromScene(declared);
+    auto e = parseEffectsOption(option, declared);
+    if (!e) return e.status();
+    FrameEffects fx = FrameEffects::fromScene(*e);
+    fx.glassMarked = declared.glass.has_value();
+    if (!fx.glassMarked) fx.glass = false;
+    if (!quiet) {
+        for (int i = 0; i < kEffectCount; ++i) {
+            const EffectId id = EffectId(i);
+            if (id == EffectId::Night || !effectIsBaked(id) || e->has(id) == declared.has(id)) continue;
+            std::fprintf(stderr, "%s: note: %s is baked into the scene's colours at generation; it stays %s (regenerate with "
+                                 "`vista gen --effects` to change it)\n",
+                         cmd, effectName(id), declared.has(id) ? "on" : "off");
+        }
+        if (e->glass && !declared.glass)
+            std::fprintf(stderr, "%s: note: the scene declares no glass, so no window is marked: no reflections\n", cmd);
+    }
+    return fx;
+}
+
 
 }  // namespace vista

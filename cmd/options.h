@@ -67,6 +67,11 @@ Result<std::vector<int>> parseSweep(const std::string& s);
 // parameter file's "effects". Unknown names / fields / values out of range ->
 // error naming them and the known effects.
 Result<Effects> parseEffectsOption(const std::string& s, const Effects& base);
+// The run-time effects of a run (bench, viewer): the scene's `declared`
+// ones, or --effects over them. Glass marks exist only where the scene
+// declared glass at generation; baked effects follow the scene file (a note
+// on stderr says so unless quiet; `cmd` prefixes it).
+Result<FrameEffects> runTimeEffects(const std::string& option, const Effects& declared, bool quiet, const char* cmd);
 
 struct ModeFlags {
     std::string near = "100", triangleBudget = "0", budget = "unlimited";

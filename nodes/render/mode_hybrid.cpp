@@ -92,6 +92,7 @@ public:
         }
         _viewerNear = chooseNear(camera);
         if (_split) _split->setNearDistance(_viewerNear);
+        if (_farNode) _farNode->setOptions(farOptions(_viewerNear, 0.0));  // live effect toggles
         return farPlane(_viewerNear, camera);
     }
     FrameStats lastViewerStats() const override {
