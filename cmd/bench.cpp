@@ -116,6 +116,13 @@ public:
     Status add(size_t mi, const BenchFrameRecord& rec, const Image& img, const Image& ref) {
         if (_cfg.outDir.empty()) return Status::ok();
         if (rec.frame == 0) VISTA_RETURN_IF_ERROR(writePng(img, path("first_" + rec.mode + ".png")));
+        if (_cfg.saveFrames) {
+            char name[64];
+            std::snprintf(name, sizeof name, "f%04d_", rec.frame);
+            std::error_code ec;
+            std::filesystem::create_directories(std::filesystem::path(_cfg.outDir) / "frames", ec);
+            VISTA_RETURN_IF_ERROR(writePng(img, (std::filesystem::path(_cfg.outDir) / "frames" / (name + rec.mode + ".png")).string()));
+        }
         if (_cfg.worstFrames <= 0 || (mi == 0 && _cfg.referenceSsaa < 2)) return Status::ok();
         auto& w = _worst[mi];
         if (int(w.size()) < _cfg.worstFrames || rec.psnrDb < w.back().psnr) {

@@ -41,6 +41,7 @@ struct BenchConfig {
     int referenceSsaa = 0;         // 0/1 = `full` image; k >= 2 = k x k supersampled full
     int diffThreshold = 8;         // for the differing-pixel fraction (0..255)
     int worstFrames = 2;           // difference images for the N worst frames per mode
+    bool saveFrames = false;       // every frame of every mode as frames/f<NNNN>_<mode>.png
     bool warmup = true;
     bool quiet = false;            // no progress on stderr
     ModeOptions options;

@@ -48,6 +48,7 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
     app.add_option("--reference", a.reference, "reference for the quality metrics: full (default) or ssaa:K (K x K supersampled full)");
     app.add_option("--diff-threshold", a.cfg.diffThreshold, "per-channel difference counted as a differing pixel (default 8)");
     app.add_option("--worst", a.cfg.worstFrames, "difference images for the N worst frames per mode (default 2)");
+    app.add_flag("--save-frames", a.cfg.saveFrames, "also write every frame of every mode as OUT/frames/fNNNN_MODE.png");
     app.add_option("--out", a.out, "output directory (created if missing)")->required();
     app.add_option("--effects", a.effects,
                    "run-time effects for this run instead of the scene's: 'none', names (haze, glass, night) or a JSON "
