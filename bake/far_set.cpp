@@ -51,6 +51,9 @@ FarSet selectFarSet(const SceneModel& city, const std::vector<SceneTile>& tiles,
     out.frame = impostorFrame(cell, end);
     const double hw0 = cell.box.halfWidth + p.openingExtra;
     const double slope = hw0 / (cell.box.halfLength + p.margin);
+    // Haze: nothing beyond the visibility is drawn, so the far field ends there too.
+    double farDepth = p.farDepth;
+    if (city.params.effects.haze) farDepth = std::min(farDepth, std::max(0.0, city.params.effects.haze->visibility_m - p.margin));
     for (const SceneTile& t : tiles) {
         if (t.triangles == 0 || t.lo.x > t.hi.x) continue;
         double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
@@ -61,7 +64,7 @@ FarSet selectFarSet(const SceneModel& city, const std::vector<SceneTile>& tiles,
             y0 = std::min(y0, l.y); y1 = std::max(y1, l.y);
             if (std::abs(l.y) <= hw0 + slope * (l.x - p.margin)) inWedge = true;
         }
-        if (x0 < p.margin || x1 > p.margin + p.farDepth) continue;
+        if (x0 < p.margin || x1 > p.margin + farDepth) continue;
         if (!inWedge && !(y0 <= 0 && y1 >= 0)) continue;
         out.tiles.push_back(t.child);
         for (uint32_t mi : t.meshes) appendMesh(out.soup, out.frame, city.meshes[mi], nullptr);

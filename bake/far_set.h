@@ -11,6 +11,8 @@
 // replaces exactly these tiles: only their triangles are sampled, and the
 // view-cell switch hides them in the cell. Ends whose far field has fewer than
 // max(minTriangles, 1) triangles get no impostor (bake/bake_cell.h).
+// A city with the `haze` effect ends the far field at the visibility
+// distance (depth min(farDepth, visibility - margin)): nothing beyond is drawn.
 //
 // Tiles: SceneModel::tiles as loadCityFile decoded them; a hand-built model
 // (tests; no tiles) gets one tile per mesh, then one per instance, numbered

@@ -63,7 +63,8 @@ void printParamTable() {
     std::printf("\n### Effects\n\nThe `effects` object: an effect is on when its key is present; its object holds "
                 "its parameters (absent ones keep these defaults), e.g. `\"effects\": {\"haze\": "
                 "{\"visibility_m\": 1500}, \"glass\": {}}`. Baked effects change the prelit colours at "
-                "generation and cost nothing per frame; run-time effects are applied per frame, only where on screen.\n\n");
+                "generation and cost nothing per frame beyond the triangles their refinement adds; run-time effects "
+                "are applied per frame, only where on screen (docs/effects.md measures both).\n\n");
     std::printf("| effect | kind | field | unit | range | default | meaning |\n|---|---|---|---|---|---|---|\n");
     for (const auto& f : effectSpecs()) {
         char range[64], def[32];

@@ -113,6 +113,24 @@ Status writeGltf(const City& city, const std::string& path) {
         protoMesh[i] = long(meshes.size() - 1);
     }
 
+    // Effects glTF can say: glass windows as a smooth dielectric material (a
+    // viewer with environment lighting reflects in them), street-light lamps
+    // as emissive. Haze, shadows and occlusion are in the colours or in
+    // asset.extras.vista.params.effects. No material without those effects.
+    nlohmann::ordered_json materials = nlohmann::ordered_json::array();
+    long glassMaterial = -1, lampMaterial = -1;
+    if (city.params.effects.glass) {
+        materials.push_back({{"name", "vista.glass"},
+                             {"pbrMetallicRoughness", {{"baseColorFactor", {1.0, 1.0, 1.0, 1.0}},
+                                                       {"metallicFactor", 0.0},
+                                                       {"roughnessFactor", 0.05}}}});
+        glassMaterial = long(materials.size() - 1);
+    }
+    if (city.params.effects.night) {
+        materials.push_back({{"name", "vista.lamp"}, {"emissiveFactor", {1.0, 0.95, 0.85}}});
+        lampMaterial = long(materials.size() - 1);
+    }
+
     for (const Tile& tile : city.tiles) {
         const std::string tname = "tile_" + std::to_string(tile.ix) + "_" + std::to_string(tile.iy);
         nlohmann::ordered_json children = nlohmann::ordered_json::array();
@@ -122,7 +140,10 @@ Status writeGltf(const City& city, const std::string& path) {
             checkMesh(m);
             nlohmann::ordered_json mesh;
             mesh["name"] = tname + "_" + materialName(Material(mi));
-            mesh["primitives"] = nlohmann::ordered_json::array({b.addPrimitive(m)});
+            nlohmann::ordered_json prim = b.addPrimitive(m);
+            if (Material(mi) == Material::Window && glassMaterial >= 0) prim["material"] = glassMaterial;
+            if (Material(mi) == Material::Lamp && lampMaterial >= 0) prim["material"] = lampMaterial;
+            mesh["primitives"] = nlohmann::ordered_json::array({prim});
             meshes.push_back(mesh);
             nodes.push_back({{"name", mesh["name"]}, {"mesh", meshes.size() - 1}});
             children.push_back(nodes.size() - 1);
@@ -162,6 +183,7 @@ Status writeGltf(const City& city, const std::string& path) {
     j["scenes"] = nlohmann::ordered_json::array({{{"name", "vista.city"}, {"nodes", {0}}}});
     j["nodes"] = nodes;
     if (!meshes.empty()) j["meshes"] = meshes;
+    if (!materials.empty()) j["materials"] = materials;
     if (!b.accessors.empty()) j["accessors"] = b.accessors;
     if (!b.views.empty()) j["bufferViews"] = b.views;
     while (b.bin.size() % 4) b.bin.push_back('\0');
