@@ -1,5 +1,6 @@
 #include "citygen/params.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -90,6 +91,31 @@ void lineCol(const std::string& text, size_t byte, size_t& line, size_t& col) {
     }
 }
 
+// Deepest nesting of arrays/objects in `text` (outside strings), stopping at `limit` + 1.
+int nestingDepth(const std::string& text, int limit, size_t& where) {
+    int depth = 0, worst = 0;
+    bool inString = false;
+    for (size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (inString) {
+            if (c == '\\') ++i;
+            else if (c == '"') inString = false;
+            continue;
+        }
+        if (c == '"') inString = true;
+        else if (c == '[' || c == '{') {
+            if (++depth > worst) worst = depth;
+            if (worst > limit) {
+                where = i;
+                return worst;
+            }
+        } else if (c == ']' || c == '}') {
+            --depth;
+        }
+    }
+    return worst;
+}
+
 }  // namespace
 
 const std::vector<ParamSpec>& paramSpecs() {
@@ -124,9 +150,32 @@ Status validateParams(const CityParams& p) {
 }
 
 Result<CityParams> parseParamsJson(const std::string& text, const std::string& source, const CityParams& base) {
+    // Bounded nesting (a parameter file is 3 levels deep): deeper input would
+    // only cost stack in the parser and in messages.
+    constexpr int kMaxDepth = 16;
+    size_t deepAt = 0;
+    if (nestingDepth(text, kMaxDepth, deepAt) > kMaxDepth) {
+        size_t line = 0, col = 0;
+        lineCol(text, deepAt, line, col);
+        return Status::error(source + ":" + std::to_string(line) + ":" + std::to_string(col) +
+                             ": JSON nested deeper than " + std::to_string(kMaxDepth) + " levels");
+    }
     nlohmann::json j;
+    std::string duplicate;
+    std::vector<std::vector<std::string>> keys;  // per open object: its keys so far
+    auto callback = [&](int, nlohmann::json::parse_event_t ev, nlohmann::json& parsed) {
+        using E = nlohmann::json::parse_event_t;
+        if (ev == E::object_start) keys.emplace_back();
+        else if (ev == E::object_end && !keys.empty()) keys.pop_back();
+        else if (ev == E::key && !keys.empty() && parsed.is_string()) {
+            const std::string k = parsed.get<std::string>();
+            if (std::find(keys.back().begin(), keys.back().end(), k) != keys.back().end() && duplicate.empty()) duplicate = k;
+            keys.back().push_back(k);
+        }
+        return true;
+    };
     try {
-        j = nlohmann::json::parse(text);
+        j = nlohmann::json::parse(text, callback);
     } catch (const nlohmann::json::parse_error& e) {
         size_t line = 0, col = 0;
         lineCol(text, e.byte == 0 ? 0 : e.byte - 1, line, col);
@@ -134,7 +183,15 @@ Result<CityParams> parseParamsJson(const std::string& text, const std::string& s
         auto pos = what.find("syntax error");
         return Status::error(source + ":" + std::to_string(line) + ":" + std::to_string(col) +
                              ": malformed JSON: " + (pos == std::string::npos ? what : what.substr(pos)));
+    } catch (const nlohmann::json::exception& e) {
+        // out_of_range 406: a number beyond the range of a double (1e999, 400 digits).
+        std::string what = e.what();
+        auto pos = what.find("number overflow");
+        what = pos == std::string::npos ? what : what.substr(pos);
+        if (what.size() > 80) what = what.substr(0, 77) + "...";
+        return Status::error(source + ": malformed JSON: " + what + " (numbers must fit a double)");
     }
+    if (!duplicate.empty()) return Status::error(source + ": key '" + duplicate + "' appears twice in one object");
     if (!j.is_object()) return Status::error(source + ": parameters must be a JSON object");
     CityParams p = base;
     for (auto it = j.begin(); it != j.end(); ++it) {
@@ -162,7 +219,8 @@ Result<CityParams> parseParamsJson(const std::string& text, const std::string& s
             if (!val.is_number_integer() && !val.is_number_unsigned())
                 return Status::error(source + ": parameter '" + key + "' must be an integer, got " + val.dump());
             if (f->kind == Kind::U64) {
-                if (val.is_number_integer() && val.get<int64_t>() < 0)
+                // Unsigned first: 2^63 .. 2^64-1 are in range (is_number_integer() is true for them too).
+                if (!val.is_number_unsigned() && val.get<int64_t>() < 0)
                     return Status::error(source + ": " + rangeMessage(f->spec, val.dump()));
                 p.*(f->u) = val.get<uint64_t>();
             } else {

@@ -329,6 +329,14 @@ Result<Path> loadPathCsv(const std::string& file) {
         if (!path.samples.empty() && !(v[0] > path.samples.back().t))
             return Status::error("path file '" + file + "' line " + std::to_string(lineNo) + ": time " + fmtNum(v[0]) +
                                  " s does not increase");
+        // Coordinates a renderer and a ray caster can represent: on Earth
+        // (|x|, |y| <= 2e7 m, as the city origin), |z| <= 1e5 m, bounded time and heading.
+        const char* const names[6] = {"time", "x", "y", "z", "heading", "pitch"};
+        const double limits[6] = {1e9, 2e7, 2e7, 1e5, 36000.0, 90.0};
+        for (int k = 0; k < 5; ++k)
+            if (std::abs(v[k]) > limits[k])
+                return Status::error("path file '" + file + "' line " + std::to_string(lineNo) + ": " + names[k] + " " +
+                                     fmtNum(v[k]) + " out of range [-" + fmtNum(limits[k]) + ", " + fmtNum(limits[k]) + "]");
         if (std::abs(v[5]) >= 90.0)
             return Status::error("path file '" + file + "' line " + std::to_string(lineNo) + ": pitch " + fmtNum(v[5]) +
                                  " deg out of range (-90, 90)");

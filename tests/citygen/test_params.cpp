@@ -8,6 +8,33 @@ using namespace vista;
 
 TEST(Params, DefaultsAreValid) { EXPECT_TRUE(validateParams(CityParams()).isOk()); }
 
+// Found by trying malformed files as a new user would (issue 12): each was a
+// crash, an uncaught exception, a silent acceptance or a wrong rejection.
+TEST(Params, HostileJsonIsRefusedCleanlyAndTheFullSeedRangeAccepted) {
+    const std::pair<std::string, std::string> bad[] = {
+        {R"({"seed": 1e999})", "number overflow"},
+        {"{\"size_m\": 1" + std::string(400, '0') + "}", "number overflow"},
+        {R"({"seed": 1, "seed": 2})", "key 'seed' appears twice"},
+        {R"({"effects": {"haze": {}, "haze": {"visibility_m": 30}}})", "key 'haze' appears twice"},
+        {"{\"_c\": " + std::string(100000, '[') + std::string(100000, ']') + "}", "nested deeper than 16"},
+        {R"({"seed": -1})", "out of range"},
+    };
+    for (const auto& [text, says] : bad) {
+        auto r = parseParamsJson(text, "p.json");
+        ASSERT_FALSE(r.isOk()) << text.substr(0, 60);
+        EXPECT_NE(r.status().message().find(says), std::string::npos) << r.status().message();
+        EXPECT_LT(r.status().message().size(), 300u) << "messages stay short";
+    }
+    auto top = parseParamsJson(R"({"seed": 18446744073709551615})", "p.json");
+    ASSERT_TRUE(top.isOk()) << top.status().message();
+    EXPECT_EQ(top->seed, 18446744073709551615ull);
+    auto mid = parseParamsJson(R"({"seed": 9223372036854775808})", "p.json");
+    ASSERT_TRUE(mid.isOk()) << mid.status().message();
+    EXPECT_EQ(mid->seed, 9223372036854775808ull);
+    // Strings may hold brackets: they do not count as nesting.
+    EXPECT_TRUE(parseParamsJson("{\"_c\": \"" + std::string(100, '[') + "\"}", "p.json").isOk());
+}
+
 TEST(Params, SizeZeroRejectedWithRange) {
     CityParams p;
     p.size_m = 0;

@@ -174,6 +174,23 @@ TEST(Paths, BadInput) {
     std::string f5 = write("bad5.csv", "0,1,2,nan,4,5\n");
     EXPECT_FALSE(loadPathCsv(f5).isOk());
     for (const auto& f : {f1, f2, f3, f4, f5}) std::filesystem::remove(f);
+    // Finite but huge coordinates (the renderer and the ray caster could not
+    // represent them) are refused with the field and its range; Earth-sized ones load.
+    const std::pair<std::string, std::string> huge[] = {{"0,1e20,0,1.7,0,0\n", "x 1e+20 out of range"},
+                                                         {"0,0,-3e7,1.7,0,0\n", "y -3e+07 out of range"},
+                                                         {"0,0,0,1e6,0,0\n", "z 1e+06 out of range"},
+                                                         {"0,0,0,1.7,1e300,0\n", "heading 1e+300 out of range"},
+                                                         {"1e300,0,0,1.7,0,0\n", "time 1e+300 out of range"}};
+    for (const auto& [text, says] : huge) {
+        const std::string f = write("huge.csv", text);
+        auto r = loadPathCsv(f);
+        ASSERT_FALSE(r.isOk()) << text;
+        EXPECT_NE(r.status().message().find(says), std::string::npos) << r.status().message();
+        std::filesystem::remove(f);
+    }
+    const std::string fOk = write("earth.csv", "0,-2e7,2e7,1e5,-36000,89\n");
+    EXPECT_TRUE(loadPathCsv(fOk).isOk());
+    std::filesystem::remove(fOk);
 
     PathOptions o;
     EXPECT_FALSE(generatePath(StreetGraph{}, flatParams(), o).isOk());
