@@ -28,6 +28,7 @@ const char* const kCmd = "vista bench";
 
 struct BenchArgs {
     std::string city, size = "640x480", modes = "full,near", out, reference = "full", fov = "60", sweep, effects;
+    bool createdOut = false;  // --out did not exist before this run
     bool quiet = false;
     PathFlags path;
     ModeFlags mode;
@@ -96,6 +97,7 @@ Status configure(BenchArgs& a) {
         if (!fs::exists(a.city)) return Status::error("city file '" + a.city + "' does not exist");
     }
     std::error_code ec;
+    a.createdOut = !fs::exists(a.out, ec);
     fs::create_directories(a.out, ec);
     if (ec || !fs::is_directory(a.out)) return Status::error("--out '" + a.out + "': cannot create directory");
     return Status::ok();
@@ -226,7 +228,11 @@ int runBench(int argc, char** argv) {
     if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;
     a.cfg.command = commandLine(argc, argv);
     if (Status s = configure(a); !s) return reportBadInput(kCmd, s);
-    return a.sweep.empty() ? benchCity(a, a.city, a.out, nullptr) : runSweep(a);
+    const int rc = a.sweep.empty() ? benchCity(a, a.city, a.out, nullptr) : runSweep(a);
+    // A failed run leaves no empty output folder behind (one it made itself).
+    std::error_code ec;
+    if (rc != 0 && a.createdOut && fs::is_empty(a.out, ec)) fs::remove(a.out, ec);
+    return rc;
 }
 
 }  // namespace vista

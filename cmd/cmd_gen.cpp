@@ -106,12 +106,15 @@ Result<CityParams> resolveParams(GenArgs& a) {
     return params;
 }
 
+// Every output of the command, or none: each is staged, then all renamed together.
 Status writeOutputs(const GenArgs& a, const City& city, const CityParams& params) {
-    VISTA_RETURN_IF_ERROR(writeCityFile(city, a.out));
+    OutputBatch batch;
+    VISTA_RETURN_IF_ERROR(writeCityFile(city, batch.stage(a.out)));
     if (!a.geojsonFile.empty())
-        VISTA_RETURN_IF_ERROR(writeFileAtomic(a.geojsonFile, streetGraphToGeoJson(city.streets, params.origin_x, params.origin_y)));
-    if (!a.gltfFile.empty()) VISTA_RETURN_IF_ERROR(writeGltf(city, a.gltfFile));
-    return Status::ok();
+        VISTA_RETURN_IF_ERROR(
+            writeFileAtomic(batch.stage(a.geojsonFile), streetGraphToGeoJson(city.streets, params.origin_x, params.origin_y)));
+    if (!a.gltfFile.empty()) VISTA_RETURN_IF_ERROR(writeGltf(city, batch.stage(a.gltfFile)));
+    return batch.commit();
 }
 
 nlohmann::ordered_json statsJson(const City& city, const CityParams& params, const CityCounts& n,

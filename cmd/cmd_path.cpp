@@ -42,10 +42,7 @@ int runPath(int argc, char** argv) {
     if (!c) return reportBadInput("vista path", c.status());
     auto p = generatePath(c->streets, c->params, o);
     if (!p) return reportBadInput("vista path", p.status());
-    if (Status s = savePathCsv(p.value(), out); !s) {
-        std::fprintf(stderr, "vista path: %s\n", s.message().c_str());
-        return 1;
-    }
+    if (Status s = savePathCsv(p.value(), out); !s) return reportBadInput("vista path", s);
     std::fprintf(stderr, "vista path: %zu samples (%.1f s, %s) -> %s\n", p->samples.size(), o.duration, pathKindName(o.kind),
                  out.c_str());
     return 0;

@@ -1,6 +1,8 @@
 // Atomic file writes (atomic_file.h).
 #include "foundation/atomic_file.h"
 
+#include <signal.h>
+
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -15,8 +17,62 @@ std::string errnoText() { return std::strerror(errno); }
 
 std::string tempPathFor(const std::string& path) { return path + ".tmp." + std::to_string(::getpid()); }
 
+int removeStaleTemps(const std::string& path) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    const fs::path p(path);
+    const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+    const std::string name = p.filename().string();
+    if (name.empty()) return 0;
+    int removed = 0;
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+        const std::string f = it->path().filename().string();
+        for (const char* tag : {".tmp.", ".stage."}) {
+            const std::string prefix = name + tag;
+            if (f.size() <= prefix.size() || f.compare(0, prefix.size(), prefix) != 0) continue;
+            std::string digits = f.substr(prefix.size());
+            // A staged file's own temporary: "<path>.stage.<pid>.tmp.<pid>".
+            const size_t inner = digits.find(".tmp.");
+            if (std::string(tag) == ".stage." && inner != std::string::npos) {
+                const std::string rest = digits.substr(inner + 5);
+                if (rest.empty() || rest.find_first_not_of("0123456789") != std::string::npos) continue;
+                digits = digits.substr(0, inner);
+            }
+            if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+            const long pid = std::stol(digits);
+            if (pid <= 0 || pid == long(::getpid())) continue;
+            if (::kill(pid_t(pid), 0) == 0 || errno != ESRCH) continue;  // alive (or not ours to judge)
+            if (fs::remove(it->path(), ec)) ++removed;
+        }
+    }
+    return removed;
+}
+
+OutputBatch::~OutputBatch() {
+    if (_committed) return;
+    for (const auto& f : _files) ::unlink(f.first.c_str());
+}
+
+std::string OutputBatch::stage(const std::string& path) {
+    removeStaleTemps(path);
+    const std::string staged = path + ".stage." + std::to_string(::getpid());
+    _files.emplace_back(staged, path);
+    return staged;
+}
+
+Status OutputBatch::commit() {
+    for (const auto& f : _files)
+        if (::access(f.first.c_str(), F_OK) != 0) return Status::error("cannot write '" + f.second + "': its staged file is missing");
+    for (const auto& f : _files)
+        if (::rename(f.first.c_str(), f.second.c_str()) != 0)
+            return Status::error("cannot write '" + f.second + "': rename failed: " + errnoText());
+    _committed = true;
+    return Status::ok();
+}
+
 Status writeFileAtomic(const std::string& path, const std::string& bytes) {
     if (path.empty()) return Status::error("cannot write file: empty path");
+    removeStaleTemps(path);
     const std::string tmp = tempPathFor(path);
     int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (fd < 0) return Status::error("cannot write '" + path + "': " + errnoText());

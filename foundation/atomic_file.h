@@ -9,6 +9,8 @@
 // written concurrently.
 #pragma once
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "foundation/status.h"
 
@@ -23,5 +25,32 @@ std::string tempPathFor(const std::string& path);
 Status checkWritablePath(const std::string& option, const std::string& path);
 // strerror(errno) as a string (for messages).
 std::string errnoText();
+
+// Removes the leftovers of killed runs next to `path`: "<path>.tmp.<pid>",
+// "<path>.stage.<pid>" and "<path>.stage.<pid>.tmp.<pid>" whose process no longer exists (kill(pid, 0) fails
+// with ESRCH). Files of live processes (a concurrent writer) are kept.
+// Returns how many were removed. Called by every writer before it writes.
+int removeStaleTemps(const std::string& path);
+
+// Several outputs of one command committed together or not at all: write each
+// output to stage(path) (with any atomic writer), then commit() renames every
+// staged file over its path. If commit() is never reached (an error, an
+// exception) the destructor removes the staged files, so no output of a
+// failed command appears. A rename failure in commit() is reported; files
+// renamed before it stay (rename is the only step that can still fail and
+// it does not fail for lack of space).
+class OutputBatch {
+public:
+    OutputBatch() = default;
+    OutputBatch(const OutputBatch&) = delete;
+    OutputBatch& operator=(const OutputBatch&) = delete;
+    ~OutputBatch();
+    std::string stage(const std::string& path);
+    Status commit();
+
+private:
+    std::vector<std::pair<std::string, std::string>> _files;  // (staged, final)
+    bool _committed = false;
+};
 
 }  // namespace vista

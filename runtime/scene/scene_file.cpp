@@ -58,6 +58,7 @@ Status writeSceneFile(const osg::Node& node, const std::string& path, bool compr
     if (path.empty()) return Status::error("cannot write scene file: empty path");
     osgDB::ReaderWriter* rw = osgbReaderWriter();
     if (!rw) return Status::error("cannot write '" + path + "': OpenSceneGraph osgb plugin not found");
+    removeStaleTemps(path);
     const std::string tmp = tempPathFor(path);
     auto fail = [&](const std::string& why) {
         ::unlink(tmp.c_str());
@@ -73,9 +74,17 @@ Status writeSceneFile(const osg::Node& node, const std::string& path, bool compr
         try {
             osg::ref_ptr<osgDB::Options> opts = new osgDB::Options(compress ? "Compressor=zlib" : "");
             osgDB::ReaderWriter::WriteResult wr = rw->writeNode(node, out, opts.get());
+            errno = 0;
             out.flush();
+            const int flushErrno = errno;
             written = wr.success() && out.good();
-            if (!written) why = "osgb writer failed" + (wr.message().empty() ? std::string() : ": " + wr.message());
+            // The true cause (e.g. "No space left on device") when the stream failed.
+            if (!written && flushErrno != 0) {
+                errno = flushErrno;
+                why = "osgb writer failed: " + errnoText();
+            } else if (!written) {
+                why = "osgb writer failed" + (wr.message().empty() ? std::string() : ": " + wr.message());
+            }
         } catch (const std::exception& e) {
             why = std::string("osgb writer failed: ") + e.what();
         }

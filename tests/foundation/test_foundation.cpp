@@ -7,6 +7,10 @@
 #include <string>
 #include <vector>
 
+#include <fstream>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include "foundation/atomic_file.h"
@@ -72,6 +76,55 @@ TEST(AtomicFile, WritesWholeFileAndLeavesNoTemporary) {
     size_t entries = 0;
     for (const auto& e : std::filesystem::directory_iterator(dir.path())) { (void)e; ++entries; }
     EXPECT_EQ(entries, 1u);
+}
+
+// A pid that certainly belongs to no process: a child that has exited and been reaped.
+pid_t deadPid() {
+    const pid_t p = ::fork();
+    if (p == 0) ::_exit(0);
+    int st = 0;
+    ::waitpid(p, &st, 0);
+    return p;
+}
+
+TEST(AtomicFile, StaleTemporariesOfKilledRunsAreRemovedAndLiveOnesKept) {
+    vista::test::TempDir dir("vista_stale");
+    const std::string target = dir.file("city.osgb");
+    const std::string dead = target + ".tmp." + std::to_string(deadPid());
+    const std::string deadStage = target + ".stage." + std::to_string(deadPid());
+    const std::string live = target + ".tmp." + std::to_string(::getppid());  // the parent runs
+    const std::string other = dir.file("other.osgb.tmp.1");                    // another file's
+    for (const auto& f : {dead, deadStage, live, other}) std::ofstream(f) << "partial";
+    ASSERT_TRUE(writeFileAtomic(target, "whole"));
+    EXPECT_FALSE(std::filesystem::exists(dead));
+    EXPECT_FALSE(std::filesystem::exists(deadStage));
+    EXPECT_TRUE(std::filesystem::exists(live)) << "a concurrent writer's file is not touched";
+    EXPECT_TRUE(std::filesystem::exists(other));
+    EXPECT_EQ(vista::test::readBytes(target), "whole");
+}
+
+TEST(AtomicFile, OutputBatchCommitsAllOrNothing) {
+    vista::test::TempDir dir("vista_batch");
+    const std::string a = dir.file("a.osgb"), b = dir.file("b.glb");
+    std::ofstream(a) << "old";
+    {
+        OutputBatch batch;
+        ASSERT_TRUE(writeFileAtomic(batch.stage(a), "new a"));
+        ASSERT_TRUE(writeFileAtomic(batch.stage(b), "new b"));
+        // The command fails before commit(): nothing of it appears.
+    }
+    EXPECT_EQ(vista::test::readBytes(a), "old");
+    EXPECT_FALSE(std::filesystem::exists(b));
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 1) << "no staged file left";
+    OutputBatch batch;
+    ASSERT_TRUE(writeFileAtomic(batch.stage(a), "new a"));
+    ASSERT_TRUE(writeFileAtomic(batch.stage(b), "new b"));
+    ASSERT_TRUE(batch.commit());
+    EXPECT_EQ(vista::test::readBytes(a), "new a");
+    EXPECT_EQ(vista::test::readBytes(b), "new b");
+    OutputBatch missing;
+    missing.stage(dir.file("never_written"));
+    EXPECT_FALSE(missing.commit());
 }
 
 TEST(AtomicFile, FailureNamesThePathAndKeepsTheOldFile) {

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <csignal>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -138,4 +139,63 @@ TEST_F(GenCli, SameSeedSameBytesWhateverThreads) {
     std::string sa((std::istreambuf_iterator<char>(fa)), {}), sb((std::istreambuf_iterator<char>(fb)), {});
     ASSERT_FALSE(sa.empty());
     EXPECT_TRUE(sa == sb) << "outputs differ between 1 and 2 threads";
+}
+
+// kill -9 at several points of `vista gen` (issue 12): the older output stays
+// intact and whole, no partial output appears, and the next run removes the
+// killed run's temporary files. Also with --geojson and --gltf: the outputs of
+// one command appear together or not at all.
+TEST_F(GenCli, KillNineKeepsTheOldOutputAndTheNextRunCleansUp) {
+    const std::string out = file("city.osgb"), geo = file("city.geojson"), glb = file("city.glb");
+    ASSERT_EQ(vista("gen --size 300 -q -o " + out).code, 0);
+    const std::string old = [&] {
+        std::ifstream in(out, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    }();
+    ASSERT_FALSE(old.empty());
+    int killedWhileRunning = 0;
+    for (int delayMs : {150, 700, 1500, 2500, 3500}) {
+        const pid_t pid = ::fork();
+        if (pid == 0) {
+            ::execl(VISTA_BINARY, VISTA_BINARY, "gen", "--size", "2000", "-q", "-o", out.c_str(), "--geojson", geo.c_str(),
+                    "--gltf", glb.c_str(), (char*)nullptr);
+            ::_exit(127);
+        }
+        ASSERT_GT(pid, 0);
+        ::usleep(useconds_t(delayMs) * 1000);
+        ::kill(pid, SIGKILL);
+        int st = 0;
+        ::waitpid(pid, &st, 0);
+        if (WIFSIGNALED(st)) ++killedWhileRunning;
+        // Either the run finished before the kill (all three outputs, whole) or
+        // it did not: then the old city is untouched and the others are absent.
+        std::ifstream in(out, std::ios::binary);
+        const std::string now(std::istreambuf_iterator<char>(in), {});
+        if (WIFSIGNALED(st)) {
+            EXPECT_EQ(now, old) << "killed after " << delayMs << " ms";
+            EXPECT_FALSE(fs::exists(geo)) << delayMs;
+            EXPECT_FALSE(fs::exists(glb)) << delayMs;
+        } else {
+            EXPECT_TRUE(fs::exists(geo) && fs::exists(glb)) << delayMs;
+            fs::remove(geo);
+            fs::remove(glb);
+            std::ofstream(out, std::ios::binary) << old;
+        }
+    }
+    EXPECT_GE(killedWhileRunning, 3) << "the kills should land while the generator runs";
+    // The next run removes what the killed runs left.
+    ASSERT_EQ(vista("gen --size 300 -q -o " + out + " --geojson " + geo + " --gltf " + glb).code, 0);
+    for (const auto& e : fs::directory_iterator(dir)) {
+        const std::string n = e.path().filename().string();
+        EXPECT_EQ(n.find(".tmp."), std::string::npos) << n;
+        EXPECT_EQ(n.find(".stage."), std::string::npos) << n;
+    }
+}
+
+TEST_F(GenCli, BenchOfABadSceneLeavesNoOutputFolder) {
+    const std::string bad = file("bad.osgb", "not a scene file at all");
+    const std::string out = (dir / "bench_out").string();
+    CliRun r = vista("bench " + bad + " --frames 1 --out " + out);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_FALSE(fs::exists(out));
 }
