@@ -64,8 +64,12 @@ bool onPath(const std::string& tool) {
 
 // Runs stock osgconv in a child process with OSG_LIBRARY_PATH = libPath (the
 // optimizer off so the node types reach the writer as they are). Returns the exit code.
+// Under the sanitizer build (.ci/sanitize.sh) VISTA_TEST_PRELOAD names the
+// ASan runtime: stock osgconv is not sanitized but loads our sanitized plugin.
 int runOsgconv(const std::string& libPath, const std::string& in, const std::string& out, const std::string& log) {
-    const std::string cmd = "env OSG_LIBRARY_PATH='" + libPath + "' OSG_OPTIMIZER=OFF osgconv '" + in + "' '" + out +
+    const char* preload = std::getenv("VISTA_TEST_PRELOAD");
+    const std::string pre = preload && *preload ? " LD_PRELOAD='" + std::string(preload) + "'" : std::string();
+    const std::string cmd = "env OSG_LIBRARY_PATH='" + libPath + "'" + pre + " OSG_OPTIMIZER=OFF osgconv '" + in + "' '" + out +
                             "' > '" + log + "' 2>&1";
     const int rc = std::system(cmd.c_str());
     return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
