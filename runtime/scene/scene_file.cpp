@@ -1,6 +1,9 @@
 // Scene file I/O: atomic writes, osgb payload + integrity trailer (city_file_io.h).
 #include "runtime/scene/scene_file.h"
 
+#include <cstdlib>
+#include <sys/wait.h>
+
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -153,6 +156,26 @@ Result<osg::ref_ptr<osg::Node>> readSceneFile(const std::string& path) {
         return Status::error("scene file '" + path + "' is corrupted: checksum mismatch");
     osgDB::ReaderWriter* rw = osgbReaderWriter();
     if (!rw) return Status::error("cannot read '" + path + "': OpenSceneGraph osgb plugin not found");
+    // Trust model (docs/reliability.md): a matching trailer proves the file is
+    // whole, not that its payload is well formed. With VISTA_UNTRUSTED_FILES=1
+    // the payload is first decoded in a child process, so a payload that
+    // crashes OSG's reader is refused instead of taking vista down.
+    if (const char* u = std::getenv("VISTA_UNTRUSTED_FILES"); u && *u && std::string(u) != "0") {
+        const pid_t pid = ::fork();
+        if (pid == 0) {
+            MemoryBuf mb(data.data(), size_t(payload));
+            std::istream is(&mb);
+            osgDB::ReaderWriter::ReadResult rr = rw->readNode(is, nullptr);
+            ::_exit(rr.validNode() ? 0 : 3);
+        }
+        if (pid > 0) {
+            int st = 0;
+            while (::waitpid(pid, &st, 0) < 0 && errno == EINTR) {}
+            if (WIFSIGNALED(st))
+                return Status::error("scene file '" + path + "' is malformed: its payload crashes the osgb reader (signal " +
+                                     std::to_string(WTERMSIG(st)) + "; checked in a child process)");
+        }
+    }
     osg::ref_ptr<osg::Node> node;
     try {
         MemoryBuf mb(data.data(), size_t(payload));
@@ -165,6 +188,15 @@ Result<osg::ref_ptr<osg::Node>> readSceneFile(const std::string& path) {
         return Status::error("cannot read scene file '" + path + "': " + e.what());
     }
     return node;
+}
+
+std::string sceneFileTrailer(const std::string& payload) {
+    unsigned char trailer[kSceneTrailerSize];
+    std::memcpy(trailer, kTrailerHead, 8);
+    storeLE64(trailer + 8, payload.size());
+    storeLE64(trailer + 16, hashBytes64(reinterpret_cast<const unsigned char*>(payload.data()), payload.size()));
+    std::memcpy(trailer + 24, kTrailerTail, 8);
+    return std::string(reinterpret_cast<const char*>(trailer), kSceneTrailerSize);
 }
 
 }  // namespace vista

@@ -36,6 +36,12 @@ constexpr size_t kSceneTrailerSize = 32;
 Status writeSceneFile(const osg::Node& node, const std::string& path, bool compress = false);
 
 // Reads a file written by writeSceneFile(); verifies magic, size and hash.
+// VISTA_UNTRUSTED_FILES=1 (environment): the payload is decoded once in a
+// child process first; one that crashes OSG's reader is an error (trust
+// model: docs/reliability.md).
 Result<osg::ref_ptr<osg::Node>> readSceneFile(const std::string& path);
+
+// The trailer writeSceneFile() appends to `payload` (fuzzing, tests).
+std::string sceneFileTrailer(const std::string& payload);
 
 }  // namespace vista

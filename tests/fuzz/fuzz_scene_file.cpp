@@ -11,10 +11,15 @@
 #include <osgDB/WriteFile>
 
 #include "runtime/scene/city_file.h"
+#include "runtime/scene/scene_file.h"
 #include "tests/fuzz/fuzz_common.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-    const std::string path = vista::fuzz::inputFile(".osgb", data, size);
+    static const bool trusted = std::getenv("VISTA_FUZZ_TRUSTED_TRAILER") != nullptr;
+    std::string bytes(reinterpret_cast<const char*>(data), size);
+    if (trusted) bytes += vista::sceneFileTrailer(bytes);
+    const std::string path =
+        vista::fuzz::inputFile(".osgb", reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size());
     auto m = vista::loadCityFile(path);
     (void)m;
     return 0;

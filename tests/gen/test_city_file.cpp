@@ -514,5 +514,33 @@ TEST(Gltf, UnwritablePathIsAnError) {
     EXPECT_NE(s.message().find("city.glb"), std::string::npos);
 }
 
+// Trust model (docs/reliability.md): a payload with a matching trailer (as
+// another tool could write) that is not a valid osgb graph is refused; with
+// VISTA_UNTRUSTED_FILES=1 it is decoded in a child process first, and a good
+// file still loads.
+TEST(CityFile, MalformedPayloadWithAValidTrailerIsRefused) {
+    TempDir dir;
+    std::mt19937 rng(7);
+    for (int k = 0; k < 20; ++k) {
+        std::string payload(size_t(64 + k * 37), '\0');
+        for (auto& c : payload) c = char(rng());
+        std::memcpy(payload.data(), "\x10\x2c\x3a\x1a\x00\x00\x00\x00", 8);  // an osgb-like header start
+        const std::string f = dir.file("crafted.osgb");
+        std::ofstream(f, std::ios::binary) << payload << sceneFileTrailer(payload);
+        ::setenv("VISTA_UNTRUSTED_FILES", k % 2 ? "1" : "0", 1);
+        EXPECT_FALSE(loadCityFile(f).isOk()) << k;
+    }
+    ::setenv("VISTA_UNTRUSTED_FILES", "1", 1);
+    CityParams p;
+    p.size_m = 300;
+    auto city = generateCity(p);
+    ASSERT_TRUE(city.isOk());
+    const std::string good = dir.file("good.osgb");
+    ASSERT_TRUE(writeCityFile(*city, good));
+    auto m = loadCityFile(good);
+    EXPECT_TRUE(m.isOk()) << m.status().message();
+    ::unsetenv("VISTA_UNTRUSTED_FILES");
+}
+
 }  // namespace
 }  // namespace vista
