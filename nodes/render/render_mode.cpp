@@ -154,7 +154,6 @@ public:
     Status renderFrame(const Camera& camera, Image& out, FrameStats& stats) override {
         const FrameEffects& fx = _ctx.options.effects;
         if (_ctx.renderer) _ctx.renderer->setEffects(fx);
-        Stopwatch sw;
         VISTA_RETURN_IF_ERROR(_inner->renderFrame(camera, out, stats));
         if (fx.haze && !stats.effects.ran(EffectId::Haze)) {
             stats.effects.add(EffectId::Haze, 0.0);  // fog inside the rasteriser's draw
@@ -164,7 +163,6 @@ public:
             reflectionStage(_ctx.rays, camera, fx, out, stats);
             stats.frameMs += stats.stages.ms(Stage::Reflect) - before;
         }
-        (void)sw;
         return Status::ok();
     }
     void reset() override { _inner->reset(); }
