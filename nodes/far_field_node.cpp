@@ -126,16 +126,20 @@ void drawImageOverViewport(const osg::Viewport& vp, const Image& image, const st
     glPopAttrib();
 }
 
+bool currentView(osg::RenderInfo& ri, Camera& camera, const osg::Viewport*& vp, double& zFar) {
+    const osg::Camera* cam = ri.getCurrentCamera();
+    vp = cam ? cam->getViewport() : nullptr;
+    if (!vp || vp->width() < 1 || vp->height() < 1) return false;
+    return cameraFromOsg(cam->getViewMatrix(), cam->getProjectionMatrix(), int(vp->width()), int(vp->height()), camera, zFar);
+}
+
 void FarFieldNode::drawImplementation(osg::RenderInfo& ri) const {
     std::lock_guard<std::mutex> lock(_mutex);
-    osg::Camera* cam = ri.getCurrentCamera();
-    if (!cam || !cam->getViewport()) return;
-    const osg::Viewport* vp = cam->getViewport();
-    const int W = int(vp->width()), H = int(vp->height());
-    if (W < 1 || H < 1) return;
     Camera c;
+    const osg::Viewport* vp = nullptr;
     double zFar = 0;
-    if (!cameraFromOsg(cam->getViewMatrix(), cam->getProjectionMatrix(), W, H, c, zFar)) return;
+    if (!currentView(ri, c, vp, zFar)) return;
+    const int W = int(vp->width()), H = int(vp->height());
     if (!_far) _far = std::make_unique<FarField>(_rays, _grid, _options);
     FarFieldOptions o = _options;
     if (_split.valid()) {

@@ -23,6 +23,7 @@
 #include <osg/Drawable>
 #include <osg/Group>
 #include <osg/Viewport>
+#include <osg/RenderInfo>
 #include <osg/observer_ptr>
 
 #include "runtime/engine/frame_stats.h"
@@ -45,6 +46,10 @@ void useFixedFunction(osg::StateSet& ss);
 // projection or a non-finite eye.
 bool cameraFromOsg(const osg::Matrixd& view, const osg::Matrixd& proj, int width, int height, Camera& camera,
                    double& zFar);
+// The vista::Camera and the viewport of the camera being drawn (for a
+// drawable's drawImplementation). False without a camera, a viewport of at
+// least 1x1 or a perspective projection.
+bool currentView(osg::RenderInfo& ri, Camera& camera, const osg::Viewport*& viewport, double& zFar);
 // Draws `image` (row 0 at top, the viewport's size) into the current frame
 // buffer over `vp`, leaving pixels with mask[i] == 0 untouched (mask null:
 // every pixel drawn). Fixed-function GL (glDrawPixels, alpha test), state

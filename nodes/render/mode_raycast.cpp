@@ -58,12 +58,11 @@ public:
     }
     void drawImplementation(osg::RenderInfo& ri) const override {
         std::lock_guard<std::mutex> lock(_mutex);
-        const osg::Camera* cam = ri.getCurrentCamera();
-        if (!cam || !cam->getViewport()) return;
-        const osg::Viewport& vp = *cam->getViewport();
         Camera c;
+        const osg::Viewport* vpp = nullptr;
         double zFar = 0;
-        if (!cameraFromOsg(cam->getViewMatrix(), cam->getProjectionMatrix(), int(vp.width()), int(vp.height()), c, zFar)) return;
+        if (!currentView(ri, c, vpp, zFar)) return;
+        const osg::Viewport& vp = *vpp;
         _stats = FrameStats();
         static const FrameEffects kNone;
         castEveryPixel(_rays, c, _image, _stats, 0, _fx ? *_fx : kNone);

@@ -114,13 +114,12 @@ public:
     }
     void drawImplementation(osg::RenderInfo& ri) const override {
         std::lock_guard<std::mutex> lock(_mutex);
-        const osg::Camera* cam = ri.getCurrentCamera();
-        if (!cam || !cam->getViewport() || !_fx) return;
-        const osg::Viewport& vp = *cam->getViewport();
-        const int W = int(vp.width()), H = int(vp.height());
         Camera c;
+        const osg::Viewport* vpp = nullptr;
         double zFar = 0;
-        if (W < 1 || H < 1 || !cameraFromOsg(cam->getViewMatrix(), cam->getProjectionMatrix(), W, H, c, zFar)) return;
+        if (!_fx || !currentView(ri, c, vpp, zFar)) return;
+        const osg::Viewport& vp = *vpp;
+        const int W = int(vp.width()), H = int(vp.height());
         _image = Image(W, H);
         _gl.resize(size_t(W) * size_t(H) * 4);
         glPixelStorei(GL_PACK_ALIGNMENT, 1);
