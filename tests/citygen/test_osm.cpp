@@ -15,7 +15,7 @@ TEST(OsmImport, HardCasesGivePlanarGraph) {
     CityParams p;
     auto r = importOsm(fixture("hard_cases.osm"), p);
     ASSERT_TRUE(r.isOk()) << r.status().message();
-    const StreetGraph& g = r.value();
+    const StreetGraph& g = r->streets;
     EXPECT_TRUE(checkPlanarGraph(g, p.min_segment_m).isOk()) << checkPlanarGraph(g, p.min_segment_m).message();
     for (const auto& n : g.nodes) EXPECT_TRUE(std::isfinite(n.x) && std::isfinite(n.y));
     // Footways are skipped, primary/secondary/residential kept: all three classes present.
