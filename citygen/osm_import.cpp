@@ -340,10 +340,12 @@ StreetGraph segmentGraph(const std::vector<Way>& ways, size_t first, size_t last
     return g;
 }
 
-std::string km(double m) {
+// "74.3 m", "22.6 km".
+std::string distance(double m) {
     std::ostringstream s;
-    s.precision(m < 1e5 ? 3 : 6);
-    s << m / 1000.0 << " km";
+    s.precision(3);
+    if (m < 1000) s << m << " m";
+    else s << m / 1000.0 << " km";
     return s.str();
 }
 
@@ -363,7 +365,7 @@ std::string OsmImport::dropSummary() const {
     };
     add(nodes, invalidNodes, "with invalid coordinates");
     add(nodes, missingNodes, "missing from the file");
-    add(nodes, outlierNodes, std::string(outlierNodes == 1 ? "outlier" : "outliers") + " farther than " + km(outlierRadius_m) +
+    add(nodes, outlierNodes, std::string(outlierNodes == 1 ? "outlier" : "outliers") + " farther than " + distance(outlierRadius_m) +
                                  " from the median position");
     std::string out;
     const size_t total = invalidNodes + missingNodes + outlierNodes;
@@ -437,13 +439,15 @@ Result<OsmImport> importOsm(const std::string& path, const CityParams& params) {
     out.outlierNodes = outliers.size();
     if (ways.empty()) return Status::error(noRoads);
 
-    // Frame: transverse Mercator about the centroid, then re-centred on the bounding box (rounded to 1e-7 deg).
+    // Frame: transverse Mercator about the centroid, moved to the centre of the bounding box (repeated:
+    // near a pole moving the reference turns the frame), rounded to 1e-7 deg.
     glm::dvec3 sum(0.0);
     for (const auto& w : ways)
         for (const auto& n : w.nodes) sum += unitVector(n.geo);
-    GeoReference ref{fromUnitVector(glm::normalize(sum)).lat_deg, fromUnitVector(glm::normalize(sum)).lon_deg};
+    const GeoPoint centroid = fromUnitVector(glm::normalize(sum));
+    GeoReference ref{centroid.lat_deg, centroid.lon_deg};
     glm::dvec2 lo(0.0), hi(0.0);
-    for (int pass = 0; pass < 2; ++pass) {
+    auto bounds = [&] {
         lo = glm::dvec2(1e300);
         hi = glm::dvec2(-1e300);
         for (auto& w : ways)
@@ -452,20 +456,25 @@ Result<OsmImport> importOsm(const std::string& path, const CityParams& params) {
                 lo = glm::min(lo, n.xy);
                 hi = glm::max(hi, n.xy);
             }
-        if (pass == 0) {
-            const GeoPoint c = localToGeo(ref, 0.5 * (lo + hi));
-            ref = {roundTo1e7(c.lat_deg), roundTo1e7(c.lon_deg)};
-        }
+    };
+    for (int pass = 0; pass < 10; ++pass) {
+        bounds();
+        const glm::dvec2 centre = 0.5 * (lo + hi);
+        if (glm::length(centre) < 1e-3) break;
+        const GeoPoint c = localToGeo(ref, centre);
+        ref = {c.lat_deg, c.lon_deg};
     }
+    ref = {roundTo1e7(ref.lat0_deg), roundTo1e7(ref.lon0_deg)};
+    bounds();
     out.geo = ref;
     out.extentX_m = hi.x - lo.x;
     out.extentY_m = hi.y - lo.y;
     if (std::max(out.extentX_m, out.extentY_m) > limit) {
         std::string dropped = out.outlierNodes ? " after dropping " + std::to_string(out.outlierNodes) + " outlier nodes farther than " +
-                                                     km(out.outlierRadius_m) + " from the median position" : "";
-        return Status::error("OSM file '" + path + "': the roads span " + km(out.extentX_m) + " east-west by " + km(out.extentY_m) +
+                                                     distance(out.outlierRadius_m) + " from the median position" : "";
+        return Status::error("OSM file '" + path + "': the roads span " + distance(out.extentX_m) + " east-west by " + distance(out.extentY_m) +
                              " north-south" + dropped + ", more than the largest city vista gen builds (size_m up to " +
-                             std::to_string(int(limit)) + " m = " + km(limit) + "); crop the extract");
+                             std::to_string(int(limit)) + " m = " + distance(limit) + "); crop the extract");
     }
 
     // Bounded planarization: simplify, drop ways tangled with themselves, refuse a tangle of many ways.
