@@ -101,6 +101,7 @@ Result<std::vector<NodeId>> sanitizeXml(std::string& xml, const std::string& pat
         std::find(xml.begin(), xml.begin() + std::min<size_t>(n, 4), '\0') != xml.begin() + std::min<size_t>(n, 4))
         return fail(0, "UTF-16/UTF-32 XML is not supported (use UTF-8)");
     std::vector<NodeId> blanked;
+    std::vector<CoordinateAttribute> coords;  // of the current tag
     size_t i = 0;
     while (true) {
         const size_t lt = xml.find('<', i);
@@ -118,7 +119,7 @@ Result<std::vector<NodeId>> sanitizeXml(std::string& xml, const std::string& pat
         size_t p = lt + 1;
         while (p < n && !xmlSpace(xml[p]) && xml[p] != '>' && xml[p] != '/') ++p;
         const bool isNode = std::string_view(xml).substr(lt + 1, p - lt - 1) == "node";
-        std::vector<CoordinateAttribute> coords;
+        coords.clear();
         NodeId id = 0;
         bool hasId = false, closed = false;
         while (p < n) {
