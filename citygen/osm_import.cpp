@@ -1,9 +1,28 @@
-// importOsm(): highway=* ways from .osm / .osm.pbf via libosmium, projected
-// equirectangularly about the data's bbox centre, then planarize().
+// importOsm(): highway=* ways from .osm (XML, optionally .gz/.bz2) or .osm.pbf
+// via libosmium -> drop invalid, missing and outlier nodes -> transverse
+// Mercator about the centre of the data (geodesy.h) -> extent check ->
+// simplification -> tangle bounds -> planarize(). Contract in streets.h.
+//
+// XML is read into memory and pre-scanned before libosmium parses it: every
+// attribute libosmium would parse as a coordinate (lat, lon; the bounds' and
+// changesets' min/max ones) must be plain decimal text in range; otherwise
+// the element's coordinate attributes are overwritten with spaces, so
+// libosmium's coordinate parser (which overflows a signed integer on values
+// like 1e300) never sees them and the node has no location (counted as
+// invalid). DOCTYPE declarations (entities, default attributes) and UTF-16/32
+// text are refused, as are tags the scanner cannot follow.
+#include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <exception>
+#include <fcntl.h>
 #include <fstream>
+#include <iterator>
+#include <set>
+#include <sstream>
+#include <string_view>
+#include <unordered_map>
 
 #include <osmium/handler.hpp>
 #include <osmium/handler/node_locations_for_ways.hpp>
@@ -11,6 +30,7 @@
 #include <osmium/io/any_input.hpp>
 #include <osmium/visitor.hpp>
 
+#include "citygen/street_geometry.h"
 #include "citygen/streets.h"
 #include "foundation/units.h"
 
@@ -20,6 +40,147 @@ namespace {
 
 using Index = osmium::index::map::FlexMem<osmium::unsigned_object_id_type, osmium::Location>;
 using LocationHandler = osmium::handler::NodeLocationsForWays<Index>;
+using NodeId = osmium::object_id_type;
+
+constexpr double kEarthRadius_m = 6371008.8;      // mean radius: only for the outlier test
+constexpr double kSimplifyTolerance_m = 0.5;      // Douglas-Peucker tolerance
+constexpr size_t kSimplifyChunk = 1024;           // Douglas-Peucker works on runs of at most this many nodes
+constexpr size_t kMaxSelfConflicts = 16;          // a way crossing itself more often is dropped
+constexpr size_t kMaxConflicts = 100000;          // more crossings in all is refused
+constexpr size_t kMaxXmlBytes = size_t(4) << 30;  // decompressed XML read into memory
+
+// ---- XML pre-scan ---------------------------------------------------------
+
+bool xmlSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+
+// Attributes libosmium's XML parser hands to its coordinate parser; 0 = none, 1 = latitude, 2 = longitude.
+int coordinateKind(std::string_view name) {
+    static const char* lat[] = {"lat", "minlat", "maxlat", "min_lat", "max_lat"};
+    static const char* lon[] = {"lon", "minlon", "maxlon", "min_lon", "max_lon"};
+    for (const char* s : lat) if (name == s) return 1;
+    for (const char* s : lon) if (name == s) return 2;
+    return 0;
+}
+
+// -?digits[.digits][(e|E)-?digits], at most 32 characters, finite and |value| <= limit.
+// Such text cannot overflow libosmium's parser: it scales the digits to value * 1e8.
+bool saneCoordinate(std::string_view s, double limit) {
+    if (s.empty() || s.size() > 32) return false;
+    size_t p = 0, digits = 0;
+    auto run = [&] { size_t k = 0; while (p < s.size() && s[p] >= '0' && s[p] <= '9') { ++p; ++k; } return k; };
+    if (s[p] == '-') ++p;
+    digits += run();
+    if (p < s.size() && s[p] == '.') { ++p; digits += run(); }
+    if (digits == 0) return false;
+    if (p < s.size() && (s[p] == 'e' || s[p] == 'E')) {
+        ++p;
+        if (p < s.size() && s[p] == '-') ++p;
+        if (run() == 0) return false;
+    }
+    if (p != s.size()) return false;
+    double v = 0;
+    auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+    return r.ec == std::errc() && std::isfinite(v) && std::abs(v) <= limit;
+}
+
+struct CoordinateAttribute {
+    size_t begin, end;       // the whole name="value" text
+    size_t valueBegin, valueEnd;
+    int kind;
+};
+
+// Blanks bad coordinate attributes in place; returns the ids of nodes that lost their location.
+Result<std::vector<NodeId>> sanitizeXml(std::string& xml, const std::string& path) {
+    auto fail = [&](size_t at, const std::string& what) {
+        const size_t line = 1 + size_t(std::count(xml.begin(), xml.begin() + std::min(at, xml.size()), '\n'));
+        return Status::error("OSM file '" + path + "': " + what + " (line " + std::to_string(line) + ")");
+    };
+    const size_t n = xml.size();
+    const auto* u = reinterpret_cast<const unsigned char*>(xml.data());
+    if ((n >= 2 && ((u[0] == 0xFE && u[1] == 0xFF) || (u[0] == 0xFF && u[1] == 0xFE))) ||
+        std::find(xml.begin(), xml.begin() + std::min<size_t>(n, 4), '\0') != xml.begin() + std::min<size_t>(n, 4))
+        return fail(0, "UTF-16/UTF-32 XML is not supported (use UTF-8)");
+    std::vector<NodeId> blanked;
+    std::vector<CoordinateAttribute> coords;  // of the current tag
+    size_t i = 0;
+    while (true) {
+        const size_t lt = xml.find('<', i);
+        if (lt == std::string::npos) break;
+        auto skipTo = [&](const char* close) {
+            size_t e = xml.find(close, lt + 1);
+            return e == std::string::npos ? n : e + std::strlen(close);
+        };
+        if (xml.compare(lt, 4, "<!--") == 0) { i = skipTo("-->"); continue; }
+        if (xml.compare(lt, 9, "<![CDATA[") == 0) { i = skipTo("]]>"); continue; }
+        if (xml.compare(lt, 2, "<!") == 0) return fail(lt, "DOCTYPE and other declarations are not supported");
+        if (xml.compare(lt, 2, "<?") == 0) { i = skipTo("?>"); continue; }
+        if (xml.compare(lt, 2, "</") == 0) { i = skipTo(">"); continue; }
+        // A start tag: name, then name="value" / name='value' pairs, then > or />.
+        size_t p = lt + 1;
+        while (p < n && !xmlSpace(xml[p]) && xml[p] != '>' && xml[p] != '/') ++p;
+        const bool isNode = std::string_view(xml).substr(lt + 1, p - lt - 1) == "node";
+        coords.clear();
+        NodeId id = 0;
+        bool hasId = false, closed = false;
+        while (p < n) {
+            while (p < n && xmlSpace(xml[p])) ++p;
+            if (p >= n) break;
+            if (xml[p] == '>') { ++p; closed = true; break; }
+            if (xml[p] == '/') {
+                if (p + 1 < n && xml[p + 1] == '>') { p += 2; closed = true; break; }
+                return fail(p, "malformed XML tag");
+            }
+            const size_t nameBegin = p;
+            while (p < n && !xmlSpace(xml[p]) && xml[p] != '=' && xml[p] != '>' && xml[p] != '/') ++p;
+            const std::string_view name = std::string_view(xml).substr(nameBegin, p - nameBegin);
+            while (p < n && xmlSpace(xml[p])) ++p;
+            if (p >= n) break;
+            if (name.empty() || xml[p] != '=') return fail(p, "malformed XML attribute");
+            ++p;
+            while (p < n && xmlSpace(xml[p])) ++p;
+            if (p >= n) break;
+            if (xml[p] != '"' && xml[p] != '\'') return fail(p, "malformed XML attribute");
+            const size_t valueBegin = p + 1, valueEnd = xml.find(xml[p], valueBegin);
+            if (valueEnd == std::string::npos) { p = n; break; }
+            p = valueEnd + 1;
+            if (int kind = coordinateKind(name)) coords.push_back({nameBegin, p, valueBegin, valueEnd, kind});
+            else if (isNode && name == "id")
+                hasId = std::from_chars(xml.data() + valueBegin, xml.data() + valueEnd, id).ec == std::errc();
+        }
+        // An unfinished tag at the end of the text: expat rejects it before reporting it.
+        if (!closed) break;
+        bool bad = false;
+        for (const auto& c : coords)
+            bad = bad || !saneCoordinate(std::string_view(xml).substr(c.valueBegin, c.valueEnd - c.valueBegin), c.kind == 1 ? 90.0 : 180.0);
+        if (bad) {
+            for (const auto& c : coords) std::fill(xml.begin() + long(c.begin), xml.begin() + long(c.end), ' ');
+            if (isNode && hasId) blanked.push_back(id);
+        }
+        i = p;
+    }
+    std::sort(blanked.begin(), blanked.end());
+    return blanked;
+}
+
+// The whole (decompressed) XML text.
+Result<std::string> readXml(const osmium::io::File& file, const std::string& path) {
+    std::string text;
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return Status::error("OSM file '" + path + "' cannot be opened");
+    auto dec = osmium::io::CompressionFactory::instance().create_decompressor(file.compression(), fd);
+    for (std::string chunk = dec->read(); !chunk.empty(); chunk = dec->read()) {
+        if (text.size() + chunk.size() > kMaxXmlBytes) {
+            dec->close();
+            return Status::error("OSM file '" + path + "' holds more than " + std::to_string(kMaxXmlBytes >> 30) +
+                                 " GiB of XML: use .osm.pbf for extracts this large");
+        }
+        text += chunk;
+    }
+    dec->close();
+    return text;
+}
+
+// ---- reading ways -----------------------------------------------------------
 
 bool classify(const char* hw, RoadClass& cls) {
     static const char* highway[] = {"motorway", "motorway_link", "trunk", "trunk_link", "primary", "primary_link"};
@@ -33,39 +194,215 @@ bool classify(const char* hw, RoadClass& cls) {
     return true;
 }
 
+struct WayNode {
+    NodeId id = 0;
+    osmium::Location loc;
+    GeoPoint geo;
+    glm::dvec2 xy{0.0};
+};
+
 struct Way {
-    std::vector<glm::dvec2> lonlat;
-    RoadClass cls;
+    NodeId id = 0;
+    RoadClass cls = RoadClass::Local;
+    std::vector<WayNode> nodes;
 };
 
 struct WayCollector : public osmium::handler::Handler {
     std::vector<Way> ways;
     void way(const osmium::Way& w) {
         const char* hw = w.tags()["highway"];
-        if (!hw) return;
         RoadClass cls;
-        if (!classify(hw, cls)) return;
+        if (!hw || !classify(hw, cls) || w.nodes().empty()) return;
         Way out;
+        out.id = w.id();
         out.cls = cls;
-        for (const auto& nr : w.nodes()) {
-            const osmium::Location& loc = nr.location();
-            if (!loc.valid()) continue;  // node missing from the file
-            out.lonlat.emplace_back(loc.lon(), loc.lat());
-        }
-        if (!out.lonlat.empty()) ways.push_back(std::move(out));
+        for (const auto& nr : w.nodes()) out.nodes.push_back({nr.ref(), nr.location(), {}, {}});
+        ways.push_back(std::move(out));
     }
 };
 
+// Splits ways where `keep` is false, keeping pieces of at least two nodes.
+template <class Keep>
+std::vector<Way> splitWays(std::vector<Way>&& ways, Keep keep) {
+    std::vector<Way> out;
+    for (auto& w : ways) {
+        Way piece{w.id, w.cls, {}};
+        auto flush = [&] {
+            if (piece.nodes.size() >= 2) out.push_back(piece);
+            piece.nodes.clear();
+        };
+        for (const auto& n : w.nodes) {
+            if (keep(n)) piece.nodes.push_back(n);
+            else flush();
+        }
+        flush();
+    }
+    return out;
+}
+
+glm::dvec3 unitVector(const GeoPoint& g) {
+    const double lat = degToRad(g.lat_deg), lon = degToRad(g.lon_deg);
+    return {std::cos(lat) * std::cos(lon), std::cos(lat) * std::sin(lon), std::sin(lat)};
+}
+
+GeoPoint fromUnitVector(const glm::dvec3& v) {
+    return {radToDeg(std::atan2(v.z, std::hypot(v.x, v.y))), radToDeg(std::atan2(v.y, v.x))};
+}
+
+// Median position: the normalised component-wise median of the unit vectors (robust, no seam at +-180).
+glm::dvec3 medianDirection(const std::vector<Way>& ways) {
+    std::vector<double> c[3];
+    for (const auto& w : ways)
+        for (const auto& n : w.nodes) {
+            const glm::dvec3 v = unitVector(n.geo);
+            for (int k = 0; k < 3; ++k) c[k].push_back(v[k]);
+        }
+    glm::dvec3 m(0.0);
+    for (int k = 0; k < 3; ++k) {
+        auto mid = c[k].begin() + long(c[k].size() / 2);
+        std::nth_element(c[k].begin(), mid, c[k].end());
+        m[k] = *mid;
+    }
+    // Degenerate (data spread evenly over opposite sides of the globe): the first node.
+    return glm::length(m) > 1e-6 ? glm::normalize(m) : unitVector(ways.front().nodes.front().geo);
+}
+
+double roundTo1e7(double deg) { return std::round(deg * 1e7) / 1e7; }
+
+// ---- simplification -----------------------------------------------------------
+
+double pointSegmentDistance(const glm::dvec2& p, const glm::dvec2& a, const glm::dvec2& b) {
+    const glm::dvec2 d = b - a;
+    const double dd = glm::dot(d, d);
+    const double t = dd > 0 ? std::clamp(glm::dot(p - a, d) / dd, 0.0, 1.0) : 0.0;
+    return glm::length(p - (a + t * d));
+}
+
+// Douglas-Peucker on nodes[first..last] (both kept); marks kept nodes.
+void douglasPeucker(const std::vector<WayNode>& nodes, size_t first, size_t last, std::vector<char>& keep) {
+    std::vector<std::pair<size_t, size_t>> stack{{first, last}};
+    while (!stack.empty()) {
+        auto [s, e] = stack.back();
+        stack.pop_back();
+        double worst = 0;
+        size_t at = s;
+        for (size_t k = s + 1; k < e; ++k) {
+            const double d = pointSegmentDistance(nodes[k].xy, nodes[s].xy, nodes[e].xy);
+            if (d > worst) { worst = d; at = k; }
+        }
+        if (worst > kSimplifyTolerance_m) {
+            keep[at] = 1;
+            stack.push_back({s, at});
+            stack.push_back({at, e});
+        }
+    }
+}
+
+// Drops nodes closer than minSegment to the previous kept node, then Douglas-Peucker; junctions
+// (nodes used more than once) and the ends of every piece stay. Returns the number of nodes removed.
+size_t simplify(std::vector<Way>& ways, double minSegment) {
+    std::unordered_map<NodeId, int> uses;
+    for (const auto& w : ways)
+        for (const auto& n : w.nodes) uses[n.id]++;
+    size_t removed = 0;
+    for (auto& w : ways) {
+        const size_t count = w.nodes.size();
+        auto fixed = [&](size_t k) { return k == 0 || k + 1 == count || uses[w.nodes[k].id] > 1; };
+        std::vector<WayNode> spaced;
+        for (size_t k = 0; k < count; ++k)
+            if (fixed(k) || glm::length(w.nodes[k].xy - spaced.back().xy) >= minSegment) spaced.push_back(w.nodes[k]);
+        std::vector<char> keep(spaced.size(), 0);
+        for (size_t k = 0, run = 0; k < spaced.size(); ++k, ++run)
+            if (k == 0 || k + 1 == spaced.size() || uses[spaced[k].id] > 1 || run == kSimplifyChunk) { keep[k] = 1; run = 0; }
+        for (size_t s = 0, e = 1; e < spaced.size(); ++e)
+            if (keep[e]) { douglasPeucker(spaced, s, e, keep); s = e; }
+        w.nodes.clear();
+        for (size_t k = 0; k < spaced.size(); ++k)
+            if (keep[k]) w.nodes.push_back(spaced[k]);
+        removed += count - w.nodes.size();
+    }
+    return removed;
+}
+
+// The segments of `ways` as a graph (one node per OSM node id), for the conflict counts.
+StreetGraph segmentGraph(const std::vector<Way>& ways, size_t first, size_t last) {
+    StreetGraph g;
+    std::unordered_map<NodeId, uint32_t> index;
+    auto node = [&](const WayNode& n) {
+        auto [it, inserted] = index.emplace(n.id, uint32_t(g.nodes.size()));
+        if (inserted) g.nodes.push_back(n.xy);
+        return it->second;
+    };
+    for (size_t w = first; w < last; ++w)
+        for (size_t k = 1; k < ways[w].nodes.size(); ++k) {
+            const uint32_t a = node(ways[w].nodes[k - 1]), b = node(ways[w].nodes[k]);
+            if (a != b && g.nodes[a] != g.nodes[b]) g.edges.push_back({a, b, ways[w].cls});
+        }
+    return g;
+}
+
+// "74.3 m", "22.6 km".
+std::string distance(double m) {
+    std::ostringstream s;
+    s.precision(3);
+    if (m < 1000) s << m << " m";
+    else s << m / 1000.0 << " km";
+    return s.str();
+}
+
+double maxExtent_m() {
+    for (const auto& s : paramSpecs())
+        if (std::string(s.name) == "size_m") return s.max;
+    VISTA_CHECK(false);
+    return 0;
+}
+
 }  // namespace
 
-Result<StreetGraph> importOsm(const std::string& path, const CityParams& params) {
+std::string OsmImport::dropSummary() const {
+    std::string nodes;
+    auto add = [&](std::string& to, size_t count, const std::string& what) {
+        if (count) to += (to.empty() ? "" : ", ") + std::to_string(count) + " " + what;
+    };
+    add(nodes, invalidNodes, "with invalid coordinates");
+    add(nodes, missingNodes, "missing from the file");
+    add(nodes, outlierNodes, std::string(outlierNodes == 1 ? "outlier" : "outliers") + " farther than " + distance(outlierRadius_m) +
+                                 " from the median position");
+    std::string out;
+    const size_t total = invalidNodes + missingNodes + outlierNodes;
+    if (total) out = "dropped " + std::to_string(total) + (total == 1 ? " node (" : " nodes (") + nodes + ")";
+    if (tangledWays)
+        out += (out.empty() ? "dropped " : "; dropped ") + std::to_string(tangledWays) +
+               (tangledWays == 1 ? " way" : " ways") + " crossing itself more than " + std::to_string(kMaxSelfConflicts) + " times";
+    return out;
+}
+
+Result<OsmImport> importOsm(const std::string& path, const CityParams& params) {
     {
         std::ifstream probe(path, std::ios::binary);
         if (!probe) return Status::error("OSM file '" + path + "' cannot be opened");
     }
+    OsmImport out;
+    const double limit = maxExtent_m();
+    out.outlierRadius_m = limit * std::sqrt(2.0);
     WayCollector collector;
+    std::vector<NodeId> blanked;
     try {
         osmium::io::File file(path);
+        const auto format = file.format();
+        if (format != osmium::io::file_format::xml && format != osmium::io::file_format::pbf)
+            return Status::error("OSM file '" + path + "': format '" + osmium::io::as_string(format) +
+                                 "' is not supported (use .osm, .osm.gz, .osm.bz2 or .osm.pbf)");
+        std::string xml;
+        if (format == osmium::io::file_format::xml) {
+            auto text = readXml(file, path);
+            if (!text) return text.status();
+            xml = std::move(*text);
+            auto scan = sanitizeXml(xml, path);
+            if (!scan) return scan.status();
+            blanked = std::move(*scan);
+            file = osmium::io::File(xml.data(), xml.size(), "osm");
+        }
         osmium::io::Reader reader(file, osmium::osm_entity_bits::node | osmium::osm_entity_bits::way);
         Index index;
         LocationHandler locations(index);
@@ -75,31 +412,96 @@ Result<StreetGraph> importOsm(const std::string& path, const CityParams& params)
     } catch (const std::exception& e) {
         return Status::error("OSM file '" + path + "' could not be read: " + e.what());
     }
-    if (collector.ways.empty())
-        return Status::error("OSM file '" + path + "' contains no usable highway=* ways (roads with node locations)");
-    double lonMin = 1e300, lonMax = -1e300, latMin = 1e300, latMax = -1e300;
-    for (const auto& w : collector.ways)
-        for (const auto& p : w.lonlat) {
-            lonMin = std::min(lonMin, p.x); lonMax = std::max(lonMax, p.x);
-            latMin = std::min(latMin, p.y); latMax = std::max(latMax, p.y);
-        }
-    const double lon0 = 0.5 * (lonMin + lonMax), lat0 = 0.5 * (latMin + latMax);
-    const double kEarthRadius = 6371008.8, kDeg = kPi / 180.0;
-    const double cosLat = std::cos(lat0 * kDeg);
-    std::vector<RawSegment> segs;
-    for (const auto& w : collector.ways) {
-        for (size_t k = 1; k < w.lonlat.size(); ++k) {
-            auto proj = [&](const glm::dvec2& ll) {
-                return glm::dvec2((ll.x - lon0) * kDeg * kEarthRadius * cosLat, (ll.y - lat0) * kDeg * kEarthRadius);
-            };
-            segs.push_back({proj(w.lonlat[k - 1]), proj(w.lonlat[k]), w.cls});
-        }
+    const std::string noRoads = "OSM file '" + path + "' contains no usable highway=* ways (roads with node locations)";
+    if (collector.ways.empty()) return Status::error(noRoads);
+
+    // Nodes without a valid location: invalid coordinates (blanked by the scan, or out of range in PBF) or missing.
+    std::set<NodeId> invalid, missing, outliers;
+    std::vector<Way> ways = splitWays(std::move(collector.ways), [&](const WayNode& n) {
+        if (n.loc.valid()) return true;
+        const bool bad = n.loc.is_defined() || std::binary_search(blanked.begin(), blanked.end(), n.id);
+        (bad ? invalid : missing).insert(n.id);
+        return false;
+    });
+    if (ways.empty()) return Status::error(noRoads);
+    for (auto& w : ways)
+        for (auto& n : w.nodes) n.geo = {n.loc.lat(), n.loc.lon()};
+
+    // Outliers: farther than limit * sqrt(2) (a city of the largest size never loses a node) from the median.
+    const glm::dvec3 median = medianDirection(ways);
+    ways = splitWays(std::move(ways), [&](const WayNode& n) {
+        const glm::dvec3 v = unitVector(n.geo);
+        if (std::atan2(glm::length(glm::cross(v, median)), glm::dot(v, median)) * kEarthRadius_m <= out.outlierRadius_m) return true;
+        outliers.insert(n.id);
+        return false;
+    });
+    out.invalidNodes = invalid.size();
+    out.missingNodes = missing.size();
+    out.outlierNodes = outliers.size();
+    if (ways.empty()) return Status::error(noRoads);
+
+    // Frame: transverse Mercator about the centroid, moved to the centre of the bounding box (repeated:
+    // near a pole moving the reference turns the frame), rounded to 1e-7 deg.
+    glm::dvec3 sum(0.0);
+    for (const auto& w : ways)
+        for (const auto& n : w.nodes) sum += unitVector(n.geo);
+    const GeoPoint centroid = fromUnitVector(glm::normalize(sum));
+    GeoReference ref{centroid.lat_deg, centroid.lon_deg};
+    glm::dvec2 lo(0.0), hi(0.0);
+    auto bounds = [&] {
+        lo = glm::dvec2(1e300);
+        hi = glm::dvec2(-1e300);
+        for (auto& w : ways)
+            for (auto& n : w.nodes) {
+                n.xy = projectToLocal(ref, n.geo);
+                lo = glm::min(lo, n.xy);
+                hi = glm::max(hi, n.xy);
+            }
+    };
+    for (int pass = 0; pass < 10; ++pass) {
+        bounds();
+        const glm::dvec2 centre = 0.5 * (lo + hi);
+        if (glm::length(centre) < 1e-3) break;
+        const GeoPoint c = localToGeo(ref, centre);
+        ref = {c.lat_deg, c.lon_deg};
     }
-    StreetGraph g = planarize(segs, params.snap_radius_m, params.min_segment_m);
-    if (g.edges.empty())
+    ref = {roundTo1e7(ref.lat0_deg), roundTo1e7(ref.lon0_deg)};
+    bounds();
+    out.geo = ref;
+    out.extentX_m = hi.x - lo.x;
+    out.extentY_m = hi.y - lo.y;
+    if (std::max(out.extentX_m, out.extentY_m) > limit) {
+        std::string dropped = out.outlierNodes ? " after dropping " + std::to_string(out.outlierNodes) + " outlier nodes farther than " +
+                                                     distance(out.outlierRadius_m) + " from the median position" : "";
+        return Status::error("OSM file '" + path + "': the roads span " + distance(out.extentX_m) + " east-west by " + distance(out.extentY_m) +
+                             " north-south" + dropped + ", more than the largest city vista gen builds (size_m up to " +
+                             std::to_string(int(limit)) + " m = " + distance(limit) + "); crop the extract");
+    }
+
+    // Bounded planarization: simplify, drop ways tangled with themselves, refuse a tangle of many ways.
+    out.simplifiedNodes = simplify(ways, params.min_segment_m);
+    std::set<NodeId> tangled;
+    std::vector<Way> kept;
+    for (size_t w = 0; w < ways.size(); ++w) {
+        if (findConflictingEdges(segmentGraph(ways, w, w + 1), kMaxSelfConflicts + 1).size() > kMaxSelfConflicts)
+            tangled.insert(ways[w].id);
+        else
+            kept.push_back(std::move(ways[w]));
+    }
+    out.tangledWays = tangled.size();
+    if (kept.empty()) return Status::error(noRoads + "; " + out.dropSummary());
+    if (findConflictingEdges(segmentGraph(kept, 0, kept.size()), kMaxConflicts + 1).size() > kMaxConflicts)
+        return Status::error("OSM file '" + path + "': the roads cross or touch each other away from shared nodes more than " +
+                             std::to_string(kMaxConflicts) + " times; planarizing that many crossings is refused");
+
+    std::vector<RawSegment> segs;
+    for (const auto& w : kept)
+        for (size_t k = 1; k < w.nodes.size(); ++k) segs.push_back({w.nodes[k - 1].xy, w.nodes[k].xy, w.cls});
+    out.streets = planarize(segs, params.snap_radius_m, params.min_segment_m);
+    if (out.streets.edges.empty())
         return Status::error("OSM file '" + path + "' has highway ways but none longer than min_segment_m = " +
                              std::to_string(params.min_segment_m) + " m");
-    return g;
+    return out;
 }
 
 }  // namespace vista

@@ -116,6 +116,45 @@ int nestingDepth(const std::string& text, int limit, size_t& where) {
     return worst;
 }
 
+const ParamSpec kGeoLat{"geo.lat0_deg", "degrees", -90, 90, "WGS84 latitude of the city frame's origin"};
+const ParamSpec kGeoLon{"geo.lon0_deg", "degrees", -180, 180, "WGS84 longitude of the city frame's origin"};
+
+Status validateGeo(const GeoReference& g) {
+    for (auto [spec, v] : {std::pair<const ParamSpec*, double>{&kGeoLat, g.lat0_deg}, {&kGeoLon, g.lon0_deg}})
+        if (!std::isfinite(v) || v < spec->min || v > spec->max) return Status::error(rangeMessage(*spec, fmt(v)));
+    return Status::ok();
+}
+
+// The "geo" object: {"projection": "tmerc", "lat0_deg": .., "lon0_deg": ..}, every key required.
+Result<GeoReference> parseGeo(const nlohmann::json& j, const std::string& source) {
+    const std::string shape = std::string("{\"projection\": \"") + kGeoProjection + "\", \"lat0_deg\": .., \"lon0_deg\": ..}";
+    if (!j.is_object()) return Status::error(source + ": parameter 'geo' must be an object " + shape);
+    GeoReference g;
+    bool projection = false, lat = false, lon = false;
+    for (auto it = j.begin(); it != j.end(); ++it) {
+        const std::string& key = it.key();
+        const auto& val = it.value();
+        if (!key.empty() && key[0] == '_') continue;
+        if (key == "projection") {
+            if (!val.is_string() || val.get<std::string>() != kGeoProjection)
+                return Status::error(source + ": parameter 'geo.projection' = " + val.dump() + " is not supported (known: \"" +
+                                     kGeoProjection + "\")");
+            projection = true;
+        } else if (key == "lat0_deg" || key == "lon0_deg") {
+            if (!val.is_number()) return Status::error(source + ": parameter 'geo." + key + "' must be a number, got " + val.dump());
+            (key == "lat0_deg" ? g.lat0_deg : g.lon0_deg) = val.get<double>();
+            (key == "lat0_deg" ? lat : lon) = true;
+        } else {
+            return Status::error(source + ": unknown parameter 'geo." + key + "' (known: projection, lat0_deg, lon0_deg)");
+        }
+    }
+    if (!projection || !lat || !lon)
+        return Status::error(source + ": parameter 'geo' lacks '" + (!projection ? "projection" : !lat ? "lat0_deg" : "lon0_deg") +
+                             "' (it must be " + shape + ")");
+    if (Status s = validateGeo(g); !s) return Status::error(source + ": " + s.message());
+    return g;
+}
+
 }  // namespace
 
 const std::vector<ParamSpec>& paramSpecs() {
@@ -143,6 +182,7 @@ Status validateParams(const CityParams& p) {
     if (p.pattern_grid + p.pattern_radial + p.pattern_organic <= 0)
         return Status::error("parameters 'pattern_grid', 'pattern_radial', 'pattern_organic' must not all be 0");
     if (Status e = validateEffects(p.effects); !e) return e;
+    if (p.geo) VISTA_RETURN_IF_ERROR(validateGeo(*p.geo));
     if (p.local_spacing_m > p.arterial_spacing_m)
         return Status::error("parameter 'local_spacing_m' = " + fmt(p.local_spacing_m) +
                              " must not exceed 'arterial_spacing_m' = " + fmt(p.arterial_spacing_m));
@@ -203,13 +243,19 @@ Result<CityParams> parseParamsJson(const std::string& text, const std::string& s
             p.effects = *e;
             continue;
         }
+        if (key == "geo") {
+            auto g = parseGeo(it.value(), source);
+            if (!g) return g.status();
+            p.geo = *g;
+            continue;
+        }
         const Field* f = nullptr;
         for (const auto& cand : fields())
             if (key == cand.spec.name) f = &cand;
         if (!f) {
             std::string known;
             for (const auto& cand : fields()) known += std::string(known.empty() ? "" : ", ") + cand.spec.name;
-            return Status::error(source + ": unknown parameter '" + key + "' (known: " + known + ", effects)");
+            return Status::error(source + ": unknown parameter '" + key + "' (known: " + known + ", effects, geo)");
         }
         const auto& val = it.value();
         if (!val.is_number()) return Status::error(source + ": parameter '" + key + "' must be a number, got " + val.dump());
@@ -254,6 +300,7 @@ std::string paramsToJson(const CityParams& p) {
         }
     }
     if (p.effects.any()) j["effects"] = nlohmann::ordered_json::parse(effectsToJson(p.effects));
+    if (p.geo) j["geo"] = {{"projection", kGeoProjection}, {"lat0_deg", p.geo->lat0_deg}, {"lon0_deg", p.geo->lon0_deg}};
     return j.dump(1);
 }
 

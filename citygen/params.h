@@ -8,10 +8,12 @@
 // Units: metres, degrees at this user-facing boundary only (converted inside).
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "citygen/effects.h"
+#include "citygen/geodesy.h"
 #include "foundation/status.h"
 
 namespace vista {
@@ -67,6 +69,11 @@ struct CityParams {
 
     // Effects the scene declares (citygen/effects.h); none by default.
     Effects effects;
+
+    // Where the city frame lies on Earth (citygen/geodesy.h): set by the OSM
+    // import, absent for a generated city. JSON: "geo": {"projection": "tmerc",
+    // "lat0_deg": -90..90, "lon0_deg": -180..180}, all three keys required.
+    std::optional<GeoReference> geo;
 };
 
 // Describes one parameter for validation, help text and docs.
@@ -91,7 +98,7 @@ Result<CityParams> loadParamsFile(const std::string& path, const CityParams& bas
 
 // Canonical JSON of all fields (sorted keys, stable formatting): stored in the
 // output file and used in determinism hashes. Omits `threads`, which never
-// changes the output, and `effects` when none is declared.
+// changes the output, `effects` when none is declared and `geo` when absent.
 std::string paramsToJson(const CityParams& p);
 
 }  // namespace vista

@@ -1,5 +1,5 @@
 // Internal helpers shared by the street-graph files (street_graph.cpp,
-// planarize.cpp, streets.cpp). Not part of the public citygen contract.
+// planarize.cpp, streets.cpp, osm_import.cpp). Not part of the public citygen contract.
 //
 // findConflictingEdges(): every pair of edges (e < f) that violates
 // planarity: edges without a shared node that intersect at all (crossing,

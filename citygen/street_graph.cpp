@@ -267,7 +267,33 @@ Result<StreetGraph> streetGraphFromJson(const std::string& text) {
     }
 }
 
-std::string streetGraphToGeoJson(const StreetGraph& g, double originX, double originY) {
+namespace {
+
+// WGS84 geometry of edge a-b: a LineString, or a MultiLineString cut where it crosses +-180 degrees.
+nlohmann::json geoEdge(const GeoReference& ref, const glm::dvec2& a, const glm::dvec2& b) {
+    const GeoPoint ga = localToGeo(ref, a), gb = localToGeo(ref, b);
+    const double dl = std::remainder(gb.lon_deg - ga.lon_deg, 360.0);
+    const double end = ga.lon_deg + dl;  // b's longitude unwrapped next to a's
+    if (std::abs(end) <= 180.0)
+        return {{"type", "LineString"}, {"coordinates", {{ga.lon_deg, ga.lat_deg}, {gb.lon_deg, gb.lat_deg}}}};
+    // Bisection for the crossing on the straight city-frame edge.
+    const double cut = end > 0 ? 180.0 : -180.0;
+    double t0 = 0, t1 = 1;
+    for (int i = 0; i < 60; ++i) {
+        const double t = 0.5 * (t0 + t1);
+        const double lon = localToGeo(ref, a + t * (b - a)).lon_deg;
+        const double unwrapped = ga.lon_deg + std::remainder(lon - ga.lon_deg, 360.0);
+        ((unwrapped - cut) * (ga.lon_deg - cut) > 0 ? t0 : t1) = t;
+    }
+    const double lat = localToGeo(ref, a + 0.5 * (t0 + t1) * (b - a)).lat_deg;
+    return {{"type", "MultiLineString"},
+            {"coordinates", {{{ga.lon_deg, ga.lat_deg}, {cut, lat}}, {{-cut, lat}, {gb.lon_deg, gb.lat_deg}}}}};
+}
+
+}  // namespace
+
+std::string streetGraphToGeoJson(const StreetGraph& g, double originX, double originY,
+                                 const std::optional<GeoReference>& geo) {
     nlohmann::json features = nlohmann::json::array();
     for (size_t i = 0; i < g.edges.size(); ++i) {
         const auto& e = g.edges[i];
@@ -275,8 +301,11 @@ std::string streetGraphToGeoJson(const StreetGraph& g, double originX, double or
         const auto& b = g.nodes[e.b];
         nlohmann::json f;
         f["type"] = "Feature";
-        f["geometry"] = {{"type", "LineString"},
-                         {"coordinates", {{a.x + originX, a.y + originY}, {b.x + originX, b.y + originY}}}};
+        if (geo)
+            f["geometry"] = geoEdge(*geo, a, b);
+        else
+            f["geometry"] = {{"type", "LineString"},
+                             {"coordinates", {{a.x + originX, a.y + originY}, {b.x + originX, b.y + originY}}}};
         f["properties"] = {{"id", i}, {"class", roadClassName(e.cls)}, {"width", double(e.width)}, {"lanes", int(e.lanes)}};
         features.push_back(std::move(f));
     }

@@ -7,11 +7,13 @@
 // finite. Edge ids and node ids are stable for a given (params, seed).
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
 
+#include "citygen/geodesy.h"
 #include "foundation/status.h"
 
 namespace vista {
@@ -47,8 +49,14 @@ Status checkPlanarGraph(const StreetGraph& g, double minSegment);
 std::string streetGraphToJson(const StreetGraph& g);
 Result<StreetGraph> streetGraphFromJson(const std::string& text);
 
-// GeoJSON FeatureCollection of LineStrings in the city frame offset by
-// (originX, originY) metres; properties: class, width, lanes.
-std::string streetGraphToGeoJson(const StreetGraph& g, double originX, double originY);
+// GeoJSON FeatureCollection, one feature per edge; properties: id (edge
+// index), class, width, lanes. Without a geo reference: LineStrings in world
+// metres (the city frame offset by (originX, originY)). With one (a city
+// imported from OSM): WGS84 [lon, lat] in degrees as RFC 7946 requires, of
+// the city-frame positions (the origin only places the city in the rendering
+// world and is not applied); an edge crossing the antimeridian becomes a
+// MultiLineString cut at +-180 degrees (RFC 7946, 3.1.9).
+std::string streetGraphToGeoJson(const StreetGraph& g, double originX, double originY,
+                                 const std::optional<GeoReference>& geo = std::nullopt);
 
 }  // namespace vista

@@ -11,10 +11,31 @@
 // larger city matches a smaller one with the same seed as far as possible.
 // Progress is reported through `progress` (may be null).
 //
-// importOsm(): ways tagged highway=* from an .osm / .osm.pbf file, projected
-// to local metres (equirectangular about the centre of the data's bounding
-// box) then planarized exactly like grown streets.
-// Unreadable or corrupt files return an error naming the file.
+// importOsm(): ways tagged highway=* from an OpenStreetMap extract (.osm XML,
+// also .osm.gz / .osm.bz2, or .osm.pbf) as a planar street graph in a local
+// metric frame. Steps (docs/streets.md):
+// 1. Nodes are dropped, and their ways split there, when their coordinates
+//    are invalid (unparsable, non-finite, lat outside [-90, 90], lon outside
+//    [-180, 180]; XML coordinates are checked as text before libosmium parses
+//    them, see osm_import.cpp), when they are missing from the file, or when
+//    they lie farther than sqrt(2) x the largest city side (size_m's maximum
+//    in paramSpecs(), 16 km: 22.6 km) from the median position of all way
+//    nodes, so an extract the largest city could hold never loses a node.
+// 2. Projection (geodesy.h): WGS84 transverse Mercator about the centre of
+//    the kept roads' bounding box (found from their centroid; rounded to
+//    1e-7 degrees), so the frame holds at the poles and across +-180 degrees.
+// 3. A bounding box wider or taller than the largest city side is refused
+//    with an error naming both extents and the limit.
+// 4. Simplification: nodes closer than min_segment_m to the previous kept
+//    node, then Douglas-Peucker at 0.5 m; junction nodes and way ends stay.
+// 5. Bounded planarization work: a way crossing or touching itself more than
+//    16 times is dropped (counted); more than 100,000 conflicts among all
+//    segments (crossings away from shared nodes) are refused; then
+//    planarize(segments, snap_radius_m, min_segment_m).
+// Unreadable, corrupt, unsupported (DOCTYPE, UTF-16, other formats) or
+// road-less files return an error naming the file. Every drop is counted in
+// the result; dropSummary() words them ("" when nothing was dropped).
+// Deterministic: the same file and params give the same bytes.
 #pragma once
 #include <string>
 #include <vector>
@@ -39,6 +60,16 @@ struct RawSegment {
 // Never crashes or produces NaN; output satisfies checkPlanarGraph().
 StreetGraph planarize(const std::vector<RawSegment>& segments, double snap, double minSegment);
 
-Result<StreetGraph> importOsm(const std::string& path, const CityParams& params);
+struct OsmImport {
+    StreetGraph streets;         // city frame: metres, x east, y north, (0,0) at `geo`
+    GeoReference geo;            // the projection's reference (store it as CityParams::geo)
+    double extentX_m = 0, extentY_m = 0;  // bounding box of the kept road nodes
+    double outlierRadius_m = 0;  // nodes farther than this from the median position were dropped
+    // Distinct OSM nodes / ways of highway=* ways that were dropped, by reason.
+    size_t invalidNodes = 0, missingNodes = 0, outlierNodes = 0, tangledWays = 0;
+    size_t simplifiedNodes = 0;  // removed by simplification (shape kept within its tolerances)
+    std::string dropSummary() const;  // "dropped 2 nodes (1 with invalid coordinates, ...)"
+};
+Result<OsmImport> importOsm(const std::string& path, const CityParams& params);
 
 }  // namespace vista

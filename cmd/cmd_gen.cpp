@@ -111,8 +111,8 @@ Status writeOutputs(const GenArgs& a, const City& city, const CityParams& params
     OutputBatch batch;
     VISTA_RETURN_IF_ERROR(writeCityFile(city, batch.stage(a.out)));
     if (!a.geojsonFile.empty())
-        VISTA_RETURN_IF_ERROR(
-            writeFileAtomic(batch.stage(a.geojsonFile), streetGraphToGeoJson(city.streets, params.origin_x, params.origin_y)));
+        VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage(a.geojsonFile),
+                                              streetGraphToGeoJson(city.streets, params.origin_x, params.origin_y, params.geo)));
     if (!a.gltfFile.empty()) VISTA_RETURN_IF_ERROR(writeGltf(city, batch.stage(a.gltfFile)));
     return batch.commit();
 }
@@ -171,7 +171,9 @@ int runGen(int argc, char** argv) {
     if (!a.osmFile.empty()) {
         auto g = importOsm(a.osmFile, *params);
         if (!g) return reportBadInput(kCmd, g.status());
-        opts.streets = std::move(*g);
+        if (const std::string dropped = g->dropSummary(); !dropped.empty()) std::fprintf(stderr, "osm: %s\n", dropped.c_str());
+        params->geo = g->geo;
+        opts.streets = std::move(g->streets);
     }
     auto city = generateCity(*params, opts);
     if (!city) return reportBadInput(kCmd, city.status());
