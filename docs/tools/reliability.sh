@@ -6,6 +6,8 @@
 # (run from the repository root; needs the normal build in build/ and an X
 # display or xvfb-run; the full run takes about 2 hours on 2 cores: 7 fuzz
 # targets x FUZZ_SECONDS, a sanitizer build and test run, the soak).
+# Reuse results of a step run separately (the doc says which were reused):
+#   FUZZ_TSV=summary.tsv (from .ci/fuzz.sh), SANITIZE_LOG=log (of .ci/sanitize.sh), SOAK_CSV=csv (of soak).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 FUZZ_SECONDS="${1:-600}"
@@ -19,20 +21,32 @@ echo "== regression tests of the findings" >&2
 "${XVFB[@]}" ctest --test-dir build -R 'Hostile|Huge|BadInput|Kill|Stale|OutputBatch|Malformed|BadScene|BadEffects|Unwritable|Osm|Params|Paths|CellResult|Damaged|Corrupt' \
   --output-on-failure -j2 > "$OUT/regression.txt" 2>&1 || true
 
-echo "== fuzzing, $FUZZ_SECONDS s per target" >&2
-FUZZ_SECONDS="$FUZZ_SECONDS" FUZZ_OUT="$OUT/fuzz" ./.ci/fuzz.sh > "$OUT/fuzz.txt" 2>&1 || true
-cp "$OUT/fuzz/summary.tsv" "$OUT/fuzz.tsv" 2>/dev/null || printf "target\tseconds\texecutions\tcorpus\tresult\n" > "$OUT/fuzz.tsv"
+if [ -n "${FUZZ_TSV:-}" ]; then
+  cp "$FUZZ_TSV" "$OUT/fuzz.tsv"
+else
+  echo "== fuzzing, $FUZZ_SECONDS s per target" >&2
+  FUZZ_SECONDS="$FUZZ_SECONDS" FUZZ_OUT="$OUT/fuzz" ./.ci/fuzz.sh > "$OUT/fuzz.txt" 2>&1 || true
+  cp "$OUT/fuzz/summary.tsv" "$OUT/fuzz.tsv" 2>/dev/null || printf "target\tseconds\texecutions\tcorpus\tresult\n" > "$OUT/fuzz.tsv"
+fi
 
-echo "== sanitizer build and test suite" >&2
-./.ci/sanitize.sh > "$OUT/sanitize.txt" 2>&1 || true
+if [ -n "${SANITIZE_LOG:-}" ]; then
+  cp "$SANITIZE_LOG" "$OUT/sanitize.txt"
+else
+  echo "== sanitizer build and test suite" >&2
+  ./.ci/sanitize.sh > "$OUT/sanitize.txt" 2>&1 || true
+fi
 
-echo "== soak: $SOAK_FRAMES hybrid frames at 64x48" >&2
-build/vista gen --params data/default.json -q -o "$OUT/soak.osgb"
-"${XVFB[@]}" build/tests/bench/soak "$OUT/soak.osgb" "$SOAK_FRAMES" 64x48 > "$OUT/soak.csv"
+if [ -n "${SOAK_CSV:-}" ]; then
+  cp "$SOAK_CSV" "$OUT/soak.csv"
+else
+  echo "== soak: $SOAK_FRAMES hybrid frames at 64x48" >&2
+  build/vista gen --params data/default.json -q -o "$OUT/soak.osgb"
+  "${XVFB[@]}" build/tests/bench/soak "$OUT/soak.osgb" "$SOAK_FRAMES" 64x48 > "$OUT/soak.csv"
+fi
 
-python3 - "$OUT" "$FUZZ_SECONDS" "$SOAK_FRAMES" > docs/reliability.md.tmp <<'PY'
+python3 - "$OUT" "$FUZZ_SECONDS" "$SOAK_FRAMES" "${FUZZ_TSV:+fuzz }${SANITIZE_LOG:+sanitizer }${SOAK_CSV:+soak}" > docs/reliability.md.tmp <<'PY'
 import csv, os, re, sys, datetime, subprocess
-out, fuzz_s, soak_n = sys.argv[1], sys.argv[2], sys.argv[3]
+out, fuzz_s, soak_n, reused = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4].split()
 def read(n):
     p = os.path.join(out, n)
     return open(p, errors="replace").read() if os.path.exists(p) else ""
@@ -42,7 +56,8 @@ def tests_summary(text):
 print("# Reliability: fuzzing, sanitizers, faults, soak")
 print()
 print("Regenerate with `docs/tools/reliability.sh [FUZZ_SECONDS] [SOAK_FRAMES]` (this run: "
-      f"{fuzz_s} s per fuzz target, {soak_n} soak frames; {datetime.date.today()}; 2 cores, no GPU, Mesa llvmpipe).")
+      f"{fuzz_s} s per fuzz target, {soak_n} soak frames; {datetime.date.today()}; 2 cores, no GPU, Mesa llvmpipe)."
+      + (f" Results of the {', '.join(reused)} step(s) were run separately and passed in (FUZZ_TSV / SANITIZE_LOG / SOAK_CSV)." if reused else ""))
 print()
 print("## Findings and their regression tests")
 print()
@@ -82,8 +97,9 @@ print()
 print("## Sanitizers")
 print()
 ok, n = tests_summary(read("sanitize.txt"))
+result = f"**{ok} of {n} tests passed**" if n else "**did not run to completion in this run** (no ctest summary in its log)"
 print(f"`.ci/sanitize.sh` (GCC, `-fsanitize=address,undefined -fno-sanitize-recover=all`, leak detection on): "
-      f"**{ok} of {n} tests passed**. Suppressions (tests/sanitizers/): UBSan `vptr` inside CGAL's Arrangement_2 "
+      f"{result}. Suppressions (tests/sanitizers/): UBSan `vptr` inside CGAL's Arrangement_2 "
       "(header-only system library; its handle casts are by design); LSan: process-lifetime singletons of "
       "OpenSceneGraph, Mesa/LLVM, X11, fontconfig. Each with its reason in the file.")
 fails = re.findall(r"\d+ - (\S+) \(Failed\)", read("sanitize.txt"))
