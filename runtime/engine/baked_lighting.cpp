@@ -159,6 +159,11 @@ struct Vert {
 struct Refine {
     double direct = 1e300, ao = 1e300, lamp = 1e300;  // resolution (edge length) per criterion
     double coarse = 1e300;
+    // Occlusion is estimated from `samples` rays: two neighbours differ by
+    // about 0.7 strength / sqrt(samples) from sampling noise alone, so the
+    // tolerance is twice that (never below kAoTolerance): refinement follows
+    // occlusion, not its noise.
+    double aoTolerance = kAoTolerance;
 };
 
 uint64_t edgeKey(const Vert& a, const Vert& b) {
@@ -195,7 +200,7 @@ void refineAndRelight(Mesh& mesh, const glm::dvec3& origin, const Refine& rf, Co
             if (it != mids.end()) return it->second;
             const Sample &sa = vs[a].s, &sb = vs[b].s;
             const bool endsDiffer = (len > rf.direct && std::abs(sa.direct - sb.direct) > kDirectTolerance) ||
-                                    (len > rf.ao && std::abs(sa.open - sb.open) > kAoTolerance) ||
+                                    (len > rf.ao && std::abs(sa.open - sb.open) > rf.aoTolerance) ||
                                     (len > rf.lamp && std::abs(sa.lampLum() - sb.lampLum()) > kLampTolerance);
             // Probe the midpoint only on long edges whose ends agree (a feature between them).
             const bool probe = !forced && !endsDiffer && len > kProbeFactor * minRes;
@@ -211,7 +216,7 @@ void refineAndRelight(Mesh& mesh, const glm::dvec3& origin, const Refine& rf, Co
             auto bent = [](double x, double y, double z, double tol) { return std::abs(z - 0.5 * (x + y)) > tol; };
             const bool split = forced || endsDiffer ||
                                (len > rf.direct && bent(sa.direct, sb.direct, m.s.direct, kDirectTolerance)) ||
-                               (len > rf.ao && bent(sa.open, sb.open, m.s.open, kAoTolerance)) ||
+                               (len > rf.ao && bent(sa.open, sb.open, m.s.open, rf.aoTolerance)) ||
                                (len > rf.lamp && bent(sa.lampLum(), sb.lampLum(), m.s.lampLum(), kLampTolerance));
             uint32_t r = kNone;
             if (split) {
@@ -323,7 +328,10 @@ Status bakeLighting(City& city, Progress* progress, BakedLightingStats& stats) {
     Context ctx(*scene, city.params, city.streetLights);
     Refine rf;
     if (ctx.shadows) rf.direct = ctx.shadows->resolution_m;
-    if (ctx.ao) rf.ao = ctx.ao->resolution_m;
+    if (ctx.ao) {
+        rf.ao = ctx.ao->resolution_m;
+        rf.aoTolerance = std::max(kAoTolerance, 1.4 * ctx.ao->strength / std::sqrt(double(ctx.ao->samples)));
+    }
     if (ctx.night && !city.streetLights.empty()) rf.lamp = kLampResolution;
     rf.coarse = std::max(4.0, 8.0 * std::min({rf.direct, rf.ao, rf.lamp}));
 
