@@ -55,7 +55,9 @@ void reflectionStage(const RayScene* rays, const Camera& camera, const FrameEffe
         return;
     }
     Stopwatch sw;
-    int s = 1;
+    // Every stride below sqrt(glass / budget) has more blocks than the budget
+    // (a block holds at most s^2 pixels): start there, then step up.
+    int s = std::clamp(int(std::sqrt(double(glass.size()) / double(fx.rayBudget))), 1, 64);
     while (s < 64 && blocksAt(glass, W, s) > size_t(fx.rayBudget)) ++s;
     // Blocks: marked pixels grouped by block, in pixel order.
     const int bw = (W + s - 1) / s;
