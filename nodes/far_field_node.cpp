@@ -163,10 +163,19 @@ void FarFieldNode::drawImplementation(osg::RenderInfo& ri) const {
 
     _stats = FrameStats();
     if (_image.width != W || _image.height != H) _image = Image(W, H);
+    // Near-field haze done by the far field (FarFieldOptions::hazeCovered):
+    // it needs the drawn colours, and then every pixel is drawn back.
+    const bool hazeCovered = o.hazeCovered && o.effects.haze;
+    if (hazeCovered) {
+        _upload.resize(N * 4);
+        glReadPixels(GLint(vp->x()), GLint(vp->y()), W, H, GL_RGBA, GL_UNSIGNED_BYTE, _upload.data());
+        for (int y = 0; y < H; ++y)
+            std::copy_n(&_upload[size_t(H - 1 - y) * size_t(W) * 4], size_t(W) * 4, &_image.rgba[size_t(y) * size_t(W) * 4]);
+    }
     _far->render(c, _depth.data(), _image, _stats);
 
-    // Far-field pixels drawn, covered pixels (class 0) kept.
-    drawImageOverViewport(*vp, _image, &_far->classification(), _upload);
+    // Far-field pixels drawn, covered pixels (class 0) kept unless hazed here.
+    drawImageOverViewport(*vp, _image, hazeCovered ? nullptr : &_far->classification(), _upload);
     // Anything OSG believes about bound programs/textures is unchanged (fixed function only used here).
     (void)ri.getState();
 }

@@ -37,13 +37,14 @@ osg::Program* hazeProgram() {
 
 }  // namespace
 
-void applyEffectsState(osg::StateSet& ss, const FrameEffects& fx) {
+void applyEffectsState(osg::StateSet& ss, const FrameEffects& fx, bool hazeInRaster) {
+    const bool haze = fx.haze && hazeInRaster;
     // The uniforms stay set (density 0 = no haze) so programs that kept an
     // older value (GL keeps uniform values per program) are reset too.
     const glm::u8vec4 c = fx.hazeColor();
-    ss.getOrCreateUniform(kHazeDensityUniform, osg::Uniform::FLOAT)->set(float(fx.extinction()));
+    ss.getOrCreateUniform(kHazeDensityUniform, osg::Uniform::FLOAT)->set(haze ? float(fx.extinction()) : 0.0f);
     ss.getOrCreateUniform(kHazeColorUniform, osg::Uniform::FLOAT_VEC3)->set(osg::Vec3(c.x / 255.0f, c.y / 255.0f, c.z / 255.0f));
-    if (fx.haze) ss.setAttributeAndModes(hazeProgram(), osg::StateAttribute::ON);
+    if (haze) ss.setAttributeAndModes(hazeProgram(), osg::StateAttribute::ON);
     else ss.removeAttribute(osg::StateAttribute::PROGRAM);
 }
 

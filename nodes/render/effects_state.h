@@ -7,6 +7,9 @@
 //     interpolated per vertex on some drivers, which the ray caster cannot
 //     match); haze off = no program (fixed function, as without effects).
 //     Idempotent. Programs below `ss` (the instanced trees) read the same uniforms.
+//     hazeInRaster = false: the drawn scene stays unhazed (no program,
+//     density uniform 0) because a later pass hazes the read-back pixels
+//     (hybrid: FarFieldOptions::hazeCovered); the far plane still applies.
 //   effectsFarPlane(): the projection's far plane with haze: nothing beyond
 //     fx.hazeFar() is drawn (zFar <= 0 means infinite).
 #pragma once
@@ -16,7 +19,7 @@
 
 namespace vista {
 
-void applyEffectsState(osg::StateSet& ss, const FrameEffects& fx);
+void applyEffectsState(osg::StateSet& ss, const FrameEffects& fx, bool hazeInRaster = true);
 double effectsFarPlane(double zFar, const FrameEffects& fx);
 
 }  // namespace vista

@@ -7,6 +7,7 @@
 #include "foundation/timing.h"
 #include "nodes/far_field_node.h"
 #include "nodes/near_far_split.h"
+#include "nodes/render/effects_state.h"
 #include "nodes/render/offscreen.h"
 #include "runtime/engine/adaptive_split.h"
 #include "runtime/engine/far_field.h"
@@ -70,6 +71,7 @@ public:
         return Status::ok();
     }
     void reset() override { _far->reset(); }
+    bool hazesRasterPixels() const override { return true; }  // FarFieldOptions::hazeCovered
 
     osg::Node* viewerScene() override {
         if (!_viewer) {
@@ -119,8 +121,9 @@ private:
         o.pixelBudget = _ctx.options.pixelBudget;
         o.cache = _ctx.options.cache;
         o.threads = _ctx.options.threads;
-        o.depthZFar = zFar;
         o.effects = _ctx.options.effects;
+        o.depthZFar = effectsFarPlane(zFar, o.effects);  // the projection the renderer used
+        o.hazeCovered = true;
         return o;
     }
 

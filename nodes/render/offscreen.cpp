@@ -262,10 +262,10 @@ Status OffscreenRenderer::render(osg::Node* scene, const Camera& camera, double 
     return s;
 }
 
-void OffscreenRenderer::setEffects(const FrameEffects& fx) {
+void OffscreenRenderer::setEffects(const FrameEffects& fx, bool hazeInRaster) {
     Impl& m = *_impl;
     m.effects = fx;
-    applyEffectsState(*m.slot->getOrCreateStateSet(), fx);
+    applyEffectsState(*m.slot->getOrCreateStateSet(), fx, hazeInRaster);
     m.sky->setNight(fx.night);
 }
 

@@ -56,8 +56,9 @@ public:
     // y down) for the following renders (jittered supersampling); sky included.
     void setSubpixelOffset(double dx, double dy);
     // Run-time effects of the following renders: haze (fog on the drawn
-    // scene, far plane at fx.hazeFar()) and the night sky (effects_state.h).
-    void setEffects(const FrameEffects& fx);
+    // scene, far plane at fx.hazeFar()) and the night sky (effects_state.h);
+    // hazeInRaster = false: far plane only, the caller hazes the pixels.
+    void setEffects(const FrameEffects& fx, bool hazeInRaster = true);
     // GL_RENDERER / GL_VERSION strings of the context (for result files).
     std::string glRenderer() const;
 

@@ -152,7 +152,7 @@ public:
     std::string name() const override { return _inner->name(); }
     Status renderFrame(const Camera& camera, Image& out, FrameStats& stats) override {
         const FrameEffects& fx = _ctx.options.effects;
-        if (_ctx.renderer) _ctx.renderer->setEffects(fx);
+        if (_ctx.renderer) _ctx.renderer->setEffects(fx, !_inner->hazesRasterPixels());
         VISTA_RETURN_IF_ERROR(_inner->renderFrame(camera, out, stats));
         if (fx.haze && !stats.effects.ran(EffectId::Haze)) {
             stats.effects.add(EffectId::Haze, 0.0);  // fog inside the rasteriser's draw
@@ -169,7 +169,7 @@ public:
         if (!_viewer) {
             _viewer = new osg::Group;
             _viewer->setName("vista.effects");
-            applyEffectsState(*_viewer->getOrCreateStateSet(), _ctx.options.effects);
+            applyEffectsState(*_viewer->getOrCreateStateSet(), _ctx.options.effects, !_inner->hazesRasterPixels());
             _viewer->addChild(_inner->viewerScene());
             if (_ctx.options.effects.glassMarked) {
                 _reflect = new ReflectionDrawable(_ctx.rays, &_ctx.options.effects);
@@ -183,7 +183,7 @@ public:
         return _viewer.get();
     }
     double beginViewerFrame(const Camera& camera) override {
-        if (_viewer) applyEffectsState(*_viewer->getOrCreateStateSet(), _ctx.options.effects);  // live toggles
+        if (_viewer) applyEffectsState(*_viewer->getOrCreateStateSet(), _ctx.options.effects, !_inner->hazesRasterPixels());  // live toggles
         return effectsFarPlane(_inner->beginViewerFrame(camera), _ctx.options.effects);
     }
     FrameStats lastViewerStats() const override {

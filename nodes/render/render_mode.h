@@ -108,6 +108,9 @@ public:
     }
     // What the last viewer frame did (pixel classes, stage times, notes) for the HUD.
     virtual FrameStats lastViewerStats() const { return FrameStats(); }
+    // True when the mode hazes its drawn pixels itself (both faces): the
+    // effects wrapper then keeps the haze program out of the rasteriser.
+    virtual bool hazesRasterPixels() const { return false; }
     const SetupTimes& setupMs() const { return _setup; }
 
 protected:

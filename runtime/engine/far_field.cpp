@@ -63,6 +63,7 @@ void FarField::render(const Camera& camera, const float* depth, Image& out, Fram
 
     opacityStage(f, stats);
     if (seamCheckApplies(f, _rays, _options)) seamStage(f, _rays, _options, stats);
+    if (_options.hazeCovered && _options.effects.haze && depth && f.covered > 0) hazeCoveredStage(f, _options, stats);
     stats.pixels.covered += f.covered;
     if (f.covered == f.pixelCount) return;  // no sky, no far field visible: nothing else runs
 

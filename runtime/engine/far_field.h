@@ -80,6 +80,12 @@ struct FarFieldOptions {
     // stage after the rays), night sky. Glass marks pass through untouched
     // (the reflection stage after the frame handles them).
     FrameEffects effects;
+    // Haze of the near field done here instead of in the rasteriser: the
+    // covered pixels of `out` arrive unhazed and are hazed from the depth
+    // buffer (hybrid: the colour is read back anyway, and a per-fragment
+    // haze program costs more on a CPU rasteriser than one pass over the
+    // pixels). No effect without haze or without depth.
+    bool hazeCovered = false;
 };
 
 class FarField {

@@ -24,8 +24,7 @@ void seamStage(FarFrame& f, const RayScene& rays, const FarFieldOptions& o, Fram
     std::vector<float> dist;
     for (size_t i = 0; i < f.pixelCount; ++i) {
         if (f.cls[i] != kFarCovered) continue;
-        const double zn = 2.0 * double(f.depth[i]) - 1.0;
-        const double ze = zf > 0 ? 2.0 * zf * n / ((zf + n) - zn * (zf - n)) : 2.0 * n / (1.0 - zn);
+        const double ze = eyeDepthOfWindowDepth(double(f.depth[i]), n, zf);
         const double sx = f.rays.screenX(int(i % W)), sy = f.rays.screenY(int(i / W));
         const double t = ze * std::sqrt(1.0 + sx * sx + sy * sy);
         if (t > o.nearDistance) {

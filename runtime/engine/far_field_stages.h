@@ -31,6 +31,13 @@ void inArena(int threads, const F& body) {
     }
 }
 
+// Eye-plane depth (metres) of an OpenGL window depth d in [0, 1) rendered with
+// near plane n > 0 and far plane zf (<= 0: infinite far plane).
+inline double eyeDepthOfWindowDepth(double d, double n, double zf) {
+    const double zn = 2.0 * d - 1.0;
+    return zf > 0 ? 2.0 * zf * n / ((zf + n) - zn * (zf - n)) : 2.0 * n / (1.0 - zn);
+}
+
 // What a FarField keeps from frame to frame.
 struct FarFieldMemory {
     std::unique_ptr<PanoramaCache> cache;
@@ -76,6 +83,12 @@ bool seamCheckApplies(const FarFrame& f, const RayScene& rays, const FarFieldOpt
 // pixels.rayHit counted), a miss leaves it covered. Every such ray, hit or
 // miss, is added to raysCast. Records Seam.
 void seamStage(FarFrame& f, const RayScene& rays, const FarFieldOptions& o, FrameStats& stats);
+
+// Haze of the covered pixels (far_field_rays.cpp), run when o.hazeCovered,
+// haze is on and depth exists: every pixel still covered gets the haze of its
+// eye-plane depth (from depth, camera.zNear, o.depthZFar), the blend of
+// FrameEffects::applyHaze. Records Haze (stage and effect).
+void hazeCoveredStage(FarFrame& f, const FarFieldOptions& o, FrameStats& stats);
 
 // Horizon (far_field_horizon.cpp), run when o.horizon. In: grid,
 // columnNeeded, moving, camera. When horizon tracing applies, pending pixels

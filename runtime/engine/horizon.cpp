@@ -329,6 +329,10 @@ HorizonResult traceHorizon(const HeightGrid& grid, const Camera& camera, const H
             r.row[size_t(x)] = 0;
             continue;
         }
+        if (bound == -kInf) {  // nothing in the column's wedge (beyond the near distance): all sky
+            r.row[size_t(x)] = H;
+            continue;
+        }
         const double limit = bound + 1e-9 * (1.0 + std::abs(bound));
         // tanElev decreases with y: binary search for the first y with tanElev <= limit.
         int a = 0, b = H;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "foundation/units.h"
 #include "runtime/engine/horizon.h"
 #include "runtime/engine/ray_scene.h"
 #include "tests/farfield/fixtures.h"
@@ -157,6 +158,32 @@ TEST(Horizon, EmptyCityIsAllSkyAndInsideBuildingCullsNothing) {
     HeightGrid hg = HeightGrid::build(city, glm::dvec3(0), 16);
     r = traceHorizon(hg, c);
     for (int v : r.row) EXPECT_EQ(v, 0);
+}
+
+// Looking out of the city from its edge: no geometry beyond the near distance
+// in any column's wedge, so every pixel is sky without a ray (a bound of -inf
+// once gave a NaN limit and culled nothing). Looking back in culls less.
+TEST(Horizon, LookingOutOfTheCityIsAllSky) {
+    SceneModel city = randomCity(7, 40, 400.0);
+    SceneMesh ground;
+    addGround(ground, {-200, -200}, {200, 200}, 0.0f, {90, 90, 90, 255});
+    city.meshes.push_back(ground);
+    auto rs = RayScene::build(city);
+    ASSERT_TRUE(rs.isOk());
+    HeightGrid hg = HeightGrid::build(city, glm::dvec3(0), 64);
+    // At the south edge (y = -195), heading south (pi), eye 1.5 m above the ground.
+    const Camera out = cameraAt(glm::dvec3(0, -195, 1.5), kPi, 0.0);
+    HorizonOptions o;
+    o.nearDistance = 30.0;
+    HorizonResult r = traceHorizon(hg, out, o);
+    ASSERT_TRUE(r.active);
+    for (int v : r.row) EXPECT_EQ(v, out.height);
+    EXPECT_EQ(compare(r, bruteForceTopHit(*rs.value(), out, o.nearDistance)).violations, 0);
+    const Camera in = cameraAt(glm::dvec3(0, -195, 1.5), 0.0, 0.0);
+    r = traceHorizon(hg, in, o);
+    const Check c = compare(r, bruteForceTopHit(*rs.value(), in, o.nearDistance));
+    EXPECT_EQ(c.violations, 0);
+    EXPECT_LT(c.culled, long(in.width) * in.height);
 }
 
 TEST(Horizon, ViewportExtremes) {

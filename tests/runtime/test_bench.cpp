@@ -677,6 +677,31 @@ TEST(ViewCli, EveryModeShowsTheBenchPicture) {
     fs::remove_all(dir);
 }
 
+// Haze in hybrid is applied to the read-back pixels (FarFieldOptions::
+// hazeCovered) in both faces: the viewer shows the bench's hazed picture, and
+// the hazed hybrid picture agrees with full (which hazes in the rasteriser).
+TEST(ViewCli, HybridHazeShowsTheBenchPicture) {
+    REQUIRE_DISPLAY();
+    ASSERT_TRUE(fs::exists(VISTA_BINARY)) << "the vista binary is a build dependency of this test";
+    std::string dir = tmpDir("viewhaze"), out;
+    const std::string city = dir + "/tiny.osgb", path = dir + "/p.csv";
+    ASSERT_EQ(runVista("gen --size 300 --seed 5 -q -o " + city, &out), 0) << out;
+    ASSERT_EQ(runVista("path " + city + " --seed 2 --duration 10 -o " + path, &out), 0) << out;
+    const std::string common = " --path " + path + " --size 160x120 --near 40 --effects '{\"haze\":{\"visibility_m\":80}}'";
+    ASSERT_EQ(runVista("bench " + city + common + " --frames 1 -q --modes full,hybrid --out " + dir + "/b", &out), 0) << out;
+    ASSERT_EQ(runVista("bench " + city + " --path " + path + " --size 160x120 --near 40 --effects none --frames 1 -q --modes hybrid --out " +
+                           dir + "/clear", &out), 0) << out;
+    const std::string png = dir + "/view_hybrid.png";
+    ASSERT_EQ(runVista("view " + city + common + " --mode hybrid --step --frames 1 --no-hud --screenshot " + png, &out), 0) << out;
+    auto view = readPng(png), hybrid = readPng(dir + "/b/images/first_hybrid.png"), full = readPng(dir + "/b/images/first_full.png"),
+         clear = readPng(dir + "/clear/images/first_hybrid.png");
+    ASSERT_TRUE(view.isOk() && hybrid.isOk() && full.isOk() && clear.isOk());
+    EXPECT_GE(lumaPsnr(view.value(), hybrid.value()), kPsnrCapDb - 0.5) << "view and bench differ with haze";
+    EXPECT_GE(lumaPsnr(hybrid.value(), full.value()), 40.0) << "hybrid's haze pass and the rasteriser's haze differ";
+    EXPECT_LT(lumaPsnr(hybrid.value(), clear.value()), 28.0) << "80 m haze must change the picture";
+    fs::remove_all(dir);
+}
+
 TEST(BenchCli, FarFieldFlagsRejectBadValues) {
     ASSERT_TRUE(fs::exists(VISTA_BINARY)) << "the vista binary is a build dependency of this test";
     std::string dir = tmpDir("badff"), out;
