@@ -53,10 +53,9 @@ void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, con
     static const FrameEffects kNone;
     const FrameEffects& fx = shading.effects ? *shading.effects : kNone;
     const glm::dvec3 fwd = camera.forward();
-    // Haze: nothing beyond hazeFar of eye-plane depth is traced (rays stop at
-    // the farthest the corner pixels can need; hits beyond show the sky).
+    // Haze: nothing beyond hazeFar of eye-plane depth is traced (each ray
+    // stops where its eye-plane depth reaches it; hits beyond show the sky).
     const double zMax = fx.haze ? fx.hazeFar() : 0.0;
-    const float tfar = fx.haze ? float(zMax / minForwardCosine(camera)) : 1e30f;
     const uint32_t W = uint32_t(camera.width);
     const glm::vec3 org(camera.eye - scene.frameOrigin());
     const size_t grain = std::max<size_t>(1, (kRaysPerTask * nRuns + n - 1) / n);
@@ -65,6 +64,7 @@ void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, con
         tbb::parallel_for(tbb::blocked_range<size_t>(0, nRuns, grain), [&](const tbb::blocked_range<size_t>& br) {
             std::vector<glm::vec3> orgs, dirs;
             std::vector<glm::dvec3> ddirs;
+            std::vector<float> tfars;
             std::vector<RayHit> res;
             uint64_t nh = 0;
             for (size_t r = br.begin(); r != br.end(); ++r) {
@@ -73,12 +73,14 @@ void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, con
                 dirs.resize(m);
                 ddirs.resize(m);
                 res.resize(m);
+                if (fx.haze) tfars.resize(m);
                 for (size_t k = 0; k < m; ++k) {
                     const uint32_t i = pixels[b + k];
                     ddirs[k] = gen.dir(int(i % W), int(i / W));
                     dirs[k] = glm::vec3(ddirs[k]);
+                    if (fx.haze) tfars[k] = float(zMax / std::max(glm::dot(ddirs[k], fwd), 1e-6)) * (1.0f + 1e-6f);
                 }
-                scene.intersectMany(orgs.data(), dirs.data(), int(m), res.data(), tfar);
+                scene.intersectMany(orgs.data(), dirs.data(), int(m), res.data(), 1e30f, fx.haze ? tfars.data() : nullptr);
                 for (size_t k = 0; k < m; ++k) {
                     const RayHit& h = res[k];
                     const double z = h.hit ? double(h.t) * glm::dot(ddirs[k], fwd) : 0.0;

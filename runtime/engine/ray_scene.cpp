@@ -362,7 +362,8 @@ RayHit RayScene::intersect(const glm::vec3& org, const glm::vec3& dir, float tne
     return out;
 }
 
-void RayScene::intersectMany(const glm::vec3* org, const glm::vec3* dir, int n, RayHit* out, float tfar) const {
+void RayScene::intersectMany(const glm::vec3* org, const glm::vec3* dir, int n, RayHit* out, float tfar,
+                             const float* tfars) const {
     if (_impl->ftz) enableFtzDaz();
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
@@ -377,7 +378,7 @@ void RayScene::intersectMany(const glm::vec3* org, const glm::vec3* dir, int n, 
             rh.ray.org_x[k] = org[i].x; rh.ray.org_y[k] = org[i].y; rh.ray.org_z[k] = org[i].z;
             rh.ray.dir_x[k] = dir[i].x; rh.ray.dir_y[k] = dir[i].y; rh.ray.dir_z[k] = dir[i].z;
             rh.ray.tnear[k] = 0.0f;
-            rh.ray.tfar[k] = tfar;
+            rh.ray.tfar[k] = tfars ? tfars[i] : tfar;
             rh.ray.time[k] = 0.0f;
             rh.ray.mask[k] = 0xFFFFFFFFu;
             rh.ray.id[k] = unsigned(k);

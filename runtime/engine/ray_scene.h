@@ -65,7 +65,9 @@ public:
     // Single ray in scene-local coordinates. dir must be unit length.
     RayHit intersect(const glm::vec3& org, const glm::vec3& dir, float tnear = 0.0f, float tfar = 1e30f) const;
     // Coherent batch (packets of 8 internally): n rays sharing no constraints.
-    void intersectMany(const glm::vec3* org, const glm::vec3* dir, int n, RayHit* out, float tfar = 1e30f) const;
+    // tfars (optional, n values): a far limit per ray instead of `tfar`.
+    void intersectMany(const glm::vec3* org, const glm::vec3* dir, int n, RayHit* out, float tfar = 1e30f,
+                       const float* tfars = nullptr) const;
     // Occlusion test: true if anything lies within (tnear, tfar).
     bool occluded(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar) const;
     // All surfaces along the ray in (tnear, tfar), nearest first, at most
