@@ -14,7 +14,6 @@
 #include <fstream>
 #include <functional>
 #include <regex>
-#include <set>
 #include <string>
 #include <thread>
 
@@ -27,17 +26,9 @@ namespace {
 
 namespace fs = std::filesystem;
 using test::CliRun;
+using test::listTree;
 using test::readBytes;
 using test::runVista;
-
-// Every entry under `dir`, relative to it (for "nothing was created" checks).
-std::set<std::string> listTree(const std::string& dir) {
-    std::set<std::string> names;
-    std::error_code ec;
-    for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::recursive_directory_iterator(); it.increment(ec))
-        names.insert(fs::relative(it->path(), dir).string());
-    return names;
-}
 
 // Whole cell results ("cell_ID.vbc") in a work directory; 0 when it does not exist.
 size_t countCells(const std::string& workDir) {
@@ -197,18 +188,10 @@ TEST(BakeFaults, DiskFullGivesTheCauseAndLeavesNoPartialOutput) {
     for (const std::string& n : listTree(small)) EXPECT_TRUE(std::regex_match(n, allowed)) << n;
 }
 
-// The input is a file that is not a scene: a run that read it would fail
-// with that. An unwritable output, work or stats path must be reported
-// instead, with exit code 2, naming the option, and nothing created.
+// The input is a file that is not a scene; the output, work or stats path cannot be written.
 void expectRefusedBeforeTheInput(const test::TempDir& dir, const std::string& junk, const std::string& args, const std::string& option,
                                  const std::string& reason) {
-    const std::set<std::string> before = listTree(dir.path());
-    const CliRun r = runVista("bake " + junk + " -q " + args);
-    EXPECT_EQ(r.code, 2) << args << ": " << r.err;
-    EXPECT_NE(r.err.find(option), std::string::npos) << args << ": " << r.err;
-    EXPECT_NE(r.err.find(reason), std::string::npos) << args << ": " << r.err;
-    EXPECT_EQ(r.err.find("junk.osgb"), std::string::npos) << args << ": the input was read first: " << r.err;
-    EXPECT_EQ(listTree(dir.path()), before) << args;
+    test::expectRefusedBeforeTheInput(dir.path(), "bake " + junk + " -q " + args, junk, option, reason);
 }
 
 TEST(BakeFaults, UnwritableOutputWorkOrStatsIsRefusedBeforeTheInputIsRead) {

@@ -6,6 +6,10 @@
 // what it wrote to stderr; stdout is discarded.
 // startVista(): starts a run without a shell and returns its pid at once (for
 // tests that kill it); stdout and stderr go to /dev/null. The caller waits for it.
+// expectRefusedBeforeTheInput(): for a run whose input is not a valid file
+// (a run that read it would fail with that) and whose output cannot be
+// written: exit code 2, the message names `option` and `reason` and not the
+// input (the output is checked before any work), nothing new under `dir`.
 #pragma once
 #include <fcntl.h>
 #include <sys/types.h>
@@ -13,6 +17,8 @@
 #include <unistd.h>
 
 #include <cstdlib>
+#include <filesystem>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -48,6 +54,18 @@ inline pid_t startVista(const std::vector<std::string>& args) {
         ::_exit(127);
     }
     return pid;
+}
+
+inline void expectRefusedBeforeTheInput(const std::string& dir, const std::string& args, const std::string& input,
+                                        const std::string& option, const std::string& reason) {
+    const std::set<std::string> before = listTree(dir);
+    const CliRun r = runVista(args);
+    EXPECT_EQ(r.code, 2) << args << ": " << r.err;
+    EXPECT_NE(r.err.find(option), std::string::npos) << args << ": " << r.err;
+    EXPECT_NE(r.err.find(reason), std::string::npos) << args << ": " << r.err;
+    const std::string inputName = std::filesystem::path(input).filename().string();
+    EXPECT_EQ(r.err.find(inputName), std::string::npos) << args << ": the input was read first: " << r.err;
+    EXPECT_EQ(listTree(dir), before) << args;
 }
 
 }  // namespace vista::test

@@ -18,14 +18,9 @@ namespace {
 
 namespace fs = std::filesystem;
 using test::CliRun;
+using test::listTree;
 using test::readBytes;
 using test::runVista;
-
-std::set<std::string> listDir(const std::string& dir) {
-    std::set<std::string> names;
-    for (const auto& e : fs::directory_iterator(dir)) names.insert(e.path().filename().string());
-    return names;
-}
 
 TEST(GenFaults, DiskFullGivesTheCauseAndLeavesTheOldOutputAndNoTemporary) {
     test::TempDir dir("vista_gen_faults");
@@ -41,7 +36,7 @@ TEST(GenFaults, DiskFullGivesTheCauseAndLeavesTheOldOutputAndNoTemporary) {
     EXPECT_NE(r.err.find("No space left on device"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("c.osgb"), std::string::npos) << r.err;
     EXPECT_EQ(readBytes(small + "/c.osgb"), "old city");
-    EXPECT_EQ(listDir(small), std::set<std::string>{"c.osgb"});
+    EXPECT_EQ(listTree(small), std::set<std::string>{"c.osgb"});
 
     // Several outputs: the city and the GeoJSON fit elsewhere, the glTF does
     // not; none of them appears (they are committed together).
@@ -49,21 +44,13 @@ TEST(GenFaults, DiskFullGivesTheCauseAndLeavesTheOldOutputAndNoTemporary) {
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_NE(r.err.find("No space left on device"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("d.glb"), std::string::npos) << r.err;
-    EXPECT_EQ(listDir(small), std::set<std::string>{"c.osgb"});
-    EXPECT_EQ(listDir(dir.path()), std::set<std::string>{"small"});
+    EXPECT_EQ(listTree(small), std::set<std::string>{"c.osgb"});
+    EXPECT_EQ(listTree(dir.path()), (std::set<std::string>{"small", "small/c.osgb"}));
 }
 
-// The scene is a file that is not a scene: a run that loaded it would fail
-// with that. An --out bench cannot write must be reported instead, with exit
-// code 2, naming --out, and nothing created.
+// The scene is a file that is not a scene; --out cannot be written.
 void expectOutRefused(const test::TempDir& dir, const std::string& junk, const std::string& out, const std::string& reason) {
-    const std::set<std::string> before = listDir(dir.path());
-    const CliRun r = runVista("bench " + junk + " --frames 1 -q --out " + out);
-    EXPECT_EQ(r.code, 2) << out << ": " << r.err;
-    EXPECT_NE(r.err.find("--out"), std::string::npos) << out << ": " << r.err;
-    EXPECT_NE(r.err.find(reason), std::string::npos) << out << ": " << r.err;
-    EXPECT_EQ(r.err.find("junk.osgb"), std::string::npos) << out << ": the scene was loaded first: " << r.err;
-    EXPECT_EQ(listDir(dir.path()), before) << out;
+    test::expectRefusedBeforeTheInput(dir.path(), "bench " + junk + " --frames 1 -q --out " + out, junk, "--out", reason);
 }
 
 TEST(BenchFaults, UnwritableOutIsRefusedBeforeTheSceneIsLoaded) {
