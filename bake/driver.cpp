@@ -51,6 +51,7 @@ Status validateBakeJob(const BakeJob& j) {
     if (j.merge && j.shardN > 1) return Status::error("--merge and --shard exclude each other");
     VISTA_RETURN_IF_ERROR(checkWritablePath("--output", j.output));
     if (!j.statsFile.empty()) VISTA_RETURN_IF_ERROR(checkWritablePath("--stats", j.statsFile));
+    VISTA_RETURN_IF_ERROR(checkWritableDirectory("--work", j.workDir.empty() ? j.output + ".work" : j.workDir));
     return Status::ok();
 }
 

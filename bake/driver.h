@@ -14,8 +14,10 @@
 // on jobs, shards, interruptions or resumption. A kill at any moment leaves
 // only whole cell files.
 // Errors (Status naming the option, value and range, or the file): every
-// value of the job (validateBakeJob), a missing, baked or malformed input, a
-// cell that does not exist, cell results missing at assembly, failed writes.
+// value of the job (validateBakeJob; it also refuses an output, stats or work
+// path that cannot be written, before the input is read), a missing, baked or
+// malformed input, a cell that does not exist, cell results missing at
+// assembly, failed writes (with the cause, e.g. a full disk).
 // progress: begin/update (fraction of this run's cells; ETA)/end, called from
 // the calling thread. log: one line before baking (cells, already done,
 // skipped edges). One run per work directory at a time.

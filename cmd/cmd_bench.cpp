@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -28,7 +29,7 @@ const char* const kCmd = "vista bench";
 
 struct BenchArgs {
     std::string city, size = "640x480", modes = "full,near", out, reference = "full", fov = "60", sweep, effects;
-    bool createdOut = false;  // --out did not exist before this run
+    std::vector<fs::path> createdOut;  // directories of --out made by this run, deepest first
     bool quiet = false;
     PathFlags path;
     ModeFlags mode;
@@ -96,8 +97,14 @@ Status configure(BenchArgs& a) {
         if (a.city.empty()) return Status::error("missing the city file argument (or use --sweep)");
         if (!fs::exists(a.city)) return Status::error("city file '" + a.city + "' does not exist");
     }
+    VISTA_RETURN_IF_ERROR(checkWritableDirectory("--out", a.out));  // before any work, so a run never fails at its end
     std::error_code ec;
-    a.createdOut = !fs::exists(a.out, ec);
+    fs::path top = fs::path(a.out).lexically_normal();
+    if (!top.has_filename()) top = top.parent_path();  // "out/" -> "out"
+    for (fs::path d = top; !d.empty() && !fs::exists(d, ec); d = d.parent_path()) {
+        a.createdOut.push_back(d);
+        if (!d.has_parent_path() || d.parent_path() == d) break;
+    }
     fs::create_directories(a.out, ec);
     if (ec || !fs::is_directory(a.out)) return Status::error("--out '" + a.out + "': cannot create directory");
     return Status::ok();
@@ -231,7 +238,9 @@ int runBench(int argc, char** argv) {
     const int rc = a.sweep.empty() ? benchCity(a, a.city, a.out, nullptr) : runSweep(a);
     // A failed run leaves no empty output folder behind (one it made itself).
     std::error_code ec;
-    if (rc != 0 && a.createdOut && fs::is_empty(a.out, ec)) fs::remove(a.out, ec);
+    if (rc != 0)
+        for (const fs::path& d : a.createdOut)
+            if (!fs::is_empty(d, ec) || !fs::remove(d, ec)) break;
     return rc;
 }
 

@@ -122,4 +122,18 @@ Status checkWritablePath(const std::string& option, const std::string& path) {
     return Status::ok();
 }
 
+Status checkWritableDirectory(const std::string& option, const std::string& path) {
+    namespace fs = std::filesystem;
+    if (path.empty()) return Status::error("option " + option + ": empty path");
+    std::error_code ec;
+    fs::path dir = fs::path(path).lexically_normal();  // up to the nearest existing ancestor
+    while (!fs::exists(fs::symlink_status(dir, ec)) && dir.has_parent_path() && dir.parent_path() != dir) dir = dir.parent_path();
+    if (!fs::exists(fs::symlink_status(dir, ec))) dir = ".";
+    if (!fs::is_directory(dir, ec))
+        return Status::error("option " + option + " = '" + path + "': '" + dir.string() + "' exists and is not a directory");
+    if (access(dir.c_str(), W_OK) != 0)
+        return Status::error("option " + option + " = '" + path + "': directory '" + dir.string() + "' is not writable");
+    return Status::ok();
+}
+
 }  // namespace vista

@@ -23,6 +23,10 @@ std::string tempPathFor(const std::string& path);
 // `option` (the flag or field that gave the path), the path and the reason.
 // Long jobs call it before they start, so they never fail at the end.
 Status checkWritablePath(const std::string& option, const std::string& path);
+// The same for an output directory that the job creates if missing: `path`
+// is a writable directory, or it does not exist and its nearest existing
+// ancestor is a writable directory.
+Status checkWritableDirectory(const std::string& option, const std::string& path);
 // strerror(errno) as a string (for messages).
 std::string errnoText();
 

@@ -76,14 +76,14 @@ Status writeSceneFile(const osg::Node& node, const std::string& path, bool compr
         bool written = false;
         try {
             osg::ref_ptr<osgDB::Options> opts = new osgDB::Options(compress ? "Compressor=zlib" : "");
+            errno = 0;  // a failed write(2), inside the writer or at the flush, leaves its cause here
             osgDB::ReaderWriter::WriteResult wr = rw->writeNode(node, out, opts.get());
-            errno = 0;
             out.flush();
-            const int flushErrno = errno;
+            const int streamErrno = errno;
             written = wr.success() && out.good();
             // The true cause (e.g. "No space left on device") when the stream failed.
-            if (!written && flushErrno != 0) {
-                errno = flushErrno;
+            if (!out.good() && streamErrno != 0) {
+                errno = streamErrno;
                 why = "osgb writer failed: " + errnoText();
             } else if (!written) {
                 why = "osgb writer failed" + (wr.message().empty() ? std::string() : ": " + wr.message());

@@ -1,8 +1,10 @@
 // Test helpers shared by the test executables: a private temporary directory
-// (removed with everything in it, read-only entries included) and whole-file reads.
+// (removed with everything in it, read-only entries included), whole-file reads
+// and the list of entries under a directory.
 #pragma once
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 #include <system_error>
@@ -17,6 +19,16 @@ inline std::string readBytes(const std::string& path) {
     std::stringstream ss;
     ss << in.rdbuf();
     return ss.str();
+}
+
+// Every entry under `dir`, relative to it ("sub/file"); empty when `dir` does not exist.
+inline std::set<std::string> listTree(const std::string& dir) {
+    namespace fs = std::filesystem;
+    std::set<std::string> names;
+    std::error_code ec;
+    for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::recursive_directory_iterator(); it.increment(ec))
+        names.insert(fs::relative(it->path(), dir).string());
+    return names;
 }
 
 class TempDir {

@@ -12,26 +12,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tests/common/run_vista.h"
+
 namespace fs = std::filesystem;
+using vista::test::CliRun;
+using vista::test::runVista;
 
 namespace {
-
-struct CliRun {
-    int code = -1;
-    std::string err;
-};
-
-CliRun vista(const std::string& args) {
-    fs::path errFile = fs::temp_directory_path() / ("vista_cli_err_" + std::to_string(::getpid()));
-    std::string cmd = std::string(VISTA_BINARY) + " " + args + " 2>" + errFile.string() + " >/dev/null";
-    int st = std::system(cmd.c_str());
-    CliRun r;
-    r.code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-    std::ifstream in(errFile);
-    r.err.assign(std::istreambuf_iterator<char>(in), {});
-    fs::remove(errFile);
-    return r;
-}
 
 class GenCli : public ::testing::Test {
 protected:
@@ -52,67 +39,67 @@ protected:
 }  // namespace
 
 TEST_F(GenCli, HelpExitsZero) {
-    EXPECT_EQ(vista("gen --help").code, 0);
-    EXPECT_EQ(vista("help").code, 0);
-    EXPECT_EQ(vista("help gen").code, 0);
+    EXPECT_EQ(runVista("gen --help").code, 0);
+    EXPECT_EQ(runVista("help").code, 0);
+    EXPECT_EQ(runVista("help gen").code, 0);
 }
 
-TEST_F(GenCli, UnknownCommandIsBadInput) { EXPECT_EQ(vista("frobnicate").code, 2); }
+TEST_F(GenCli, UnknownCommandIsBadInput) { EXPECT_EQ(runVista("frobnicate").code, 2); }
 
 TEST_F(GenCli, SizeOutOfRange) {
     for (const char* s : {"0", "1", "1e9", "-3"}) {
         std::string out = file("c.osgb");
-        CliRun r = vista(std::string("gen --size ") + s + " -o " + out);
+        CliRun r = runVista(std::string("gen --size ") + s + " -o " + out);
         EXPECT_EQ(r.code, 2) << s;
         EXPECT_NE(r.err.find("size"), std::string::npos) << r.err;
         EXPECT_FALSE(fs::exists(out));
     }
-    CliRun r = vista("gen --size big -o " + file("c.osgb"));
+    CliRun r = runVista("gen --size big -o " + file("c.osgb"));
     EXPECT_EQ(r.code, 2);
 }
 
 TEST_F(GenCli, MalformedJsonReportsLineAndColumn) {
     std::string params = file("p.json", "{\n  \"size_m\": 500,\n  \"seed\": 1,,\n}\n");
     std::string out = file("c.osgb");
-    CliRun r = vista("gen --params " + params + " -o " + out);
+    CliRun r = runVista("gen --params " + params + " -o " + out);
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("p.json:3:"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out));
 }
 
 TEST_F(GenCli, UnknownAndOutOfRangeParameters) {
-    CliRun r = vista("gen --params " + file("p.json", R"({"sise_m": 3})") + " -o " + file("c.osgb"));
+    CliRun r = runVista("gen --params " + file("p.json", R"({"sise_m": 3})") + " -o " + file("c.osgb"));
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("sise_m"), std::string::npos);
-    r = vista("gen --params " + file("q.json", R"({"detail": 9})") + " -o " + file("c.osgb"));
+    r = runVista("gen --params " + file("q.json", R"({"detail": 9})") + " -o " + file("c.osgb"));
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("detail"), std::string::npos);
     EXPECT_NE(r.err.find("[0, 3]"), std::string::npos) << r.err;
 }
 
 TEST_F(GenCli, MissingParamsAndOsmFiles) {
-    CliRun r = vista("gen --params " + (dir / "nope.json").string() + " -o " + file("c.osgb"));
+    CliRun r = runVista("gen --params " + (dir / "nope.json").string() + " -o " + file("c.osgb"));
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("nope.json"), std::string::npos);
-    r = vista("gen --osm " + (dir / "nope.osm").string() + " -o " + file("c.osgb"));
+    r = runVista("gen --osm " + (dir / "nope.osm").string() + " -o " + file("c.osgb"));
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("nope.osm"), std::string::npos);
     EXPECT_FALSE(fs::exists(dir / "c.osgb"));
 }
 
 TEST_F(GenCli, UnwritableOutput) {
-    CliRun r = vista("gen --size 300 -q -o " + (dir / "no" / "such" / "dir" / "c.osgb").string());
+    CliRun r = runVista("gen --size 300 -q -o " + (dir / "no" / "such" / "dir" / "c.osgb").string());
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("does not exist"), std::string::npos) << r.err;
-    r = vista("gen --size 300 -q -o " + dir.string());
+    r = runVista("gen --size 300 -q -o " + dir.string());
     EXPECT_EQ(r.code, 2);
-    r = vista("gen --size 300 -q -o " + file("c.txt"));
+    r = runVista("gen --size 300 -q -o " + file("c.txt"));
     EXPECT_EQ(r.code, 2);
 }
 
 TEST_F(GenCli, WritesSceneAndStats) {
     std::string out = file("c.osgb"), stats = file("s.json"), geo = file("s.geojson");
-    CliRun r = vista("gen --size 400 --seed 3 -q --stats " + stats + " --geojson " + geo + " -o " + out);
+    CliRun r = runVista("gen --size 400 --seed 3 -q --stats " + stats + " --geojson " + geo + " -o " + out);
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(fs::exists(out));
     std::ifstream in(stats);
@@ -133,8 +120,8 @@ TEST_F(GenCli, WritesSceneAndStats) {
 
 TEST_F(GenCli, SameSeedSameBytesWhateverThreads) {
     std::string a = file("a.osgb"), b = file("b.osgb");
-    ASSERT_EQ(vista("gen --size 400 --seed 5 -q --threads 1 -o " + a).code, 0);
-    ASSERT_EQ(vista("gen --size 400 --seed 5 -q --threads 2 -o " + b).code, 0);
+    ASSERT_EQ(runVista("gen --size 400 --seed 5 -q --threads 1 -o " + a).code, 0);
+    ASSERT_EQ(runVista("gen --size 400 --seed 5 -q --threads 2 -o " + b).code, 0);
     std::ifstream fa(a, std::ios::binary), fb(b, std::ios::binary);
     std::string sa((std::istreambuf_iterator<char>(fa)), {}), sb((std::istreambuf_iterator<char>(fb)), {});
     ASSERT_FALSE(sa.empty());
@@ -147,7 +134,7 @@ TEST_F(GenCli, SameSeedSameBytesWhateverThreads) {
 // one command appear together or not at all.
 TEST_F(GenCli, KillNineKeepsTheOldOutputAndTheNextRunCleansUp) {
     const std::string out = file("city.osgb"), geo = file("city.geojson"), glb = file("city.glb");
-    ASSERT_EQ(vista("gen --size 300 -q -o " + out).code, 0);
+    ASSERT_EQ(runVista("gen --size 300 -q -o " + out).code, 0);
     const std::string old = [&] {
         std::ifstream in(out, std::ios::binary);
         return std::string(std::istreambuf_iterator<char>(in), {});
@@ -155,12 +142,7 @@ TEST_F(GenCli, KillNineKeepsTheOldOutputAndTheNextRunCleansUp) {
     ASSERT_FALSE(old.empty());
     int killedWhileRunning = 0;
     for (int delayMs : {150, 700, 1500, 2500, 3500}) {
-        const pid_t pid = ::fork();
-        if (pid == 0) {
-            ::execl(VISTA_BINARY, VISTA_BINARY, "gen", "--size", "2000", "-q", "-o", out.c_str(), "--geojson", geo.c_str(),
-                    "--gltf", glb.c_str(), (char*)nullptr);
-            ::_exit(127);
-        }
+        const pid_t pid = vista::test::startVista({"gen", "--size", "2000", "-q", "-o", out, "--geojson", geo, "--gltf", glb});
         ASSERT_GT(pid, 0);
         ::usleep(useconds_t(delayMs) * 1000);
         ::kill(pid, SIGKILL);
@@ -184,7 +166,7 @@ TEST_F(GenCli, KillNineKeepsTheOldOutputAndTheNextRunCleansUp) {
     }
     EXPECT_GE(killedWhileRunning, 3) << "the kills should land while the generator runs";
     // The next run removes what the killed runs left.
-    ASSERT_EQ(vista("gen --size 300 -q -o " + out + " --geojson " + geo + " --gltf " + glb).code, 0);
+    ASSERT_EQ(runVista("gen --size 300 -q -o " + out + " --geojson " + geo + " --gltf " + glb).code, 0);
     for (const auto& e : fs::directory_iterator(dir)) {
         const std::string n = e.path().filename().string();
         EXPECT_EQ(n.find(".tmp."), std::string::npos) << n;
@@ -195,7 +177,7 @@ TEST_F(GenCli, KillNineKeepsTheOldOutputAndTheNextRunCleansUp) {
 TEST_F(GenCli, BenchOfABadSceneLeavesNoOutputFolder) {
     const std::string bad = file("bad.osgb", "not a scene file at all");
     const std::string out = (dir / "bench_out").string();
-    CliRun r = vista("bench " + bad + " --frames 1 --out " + out);
+    CliRun r = runVista("bench " + bad + " --frames 1 --out " + out);
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_FALSE(fs::exists(out));
 }
