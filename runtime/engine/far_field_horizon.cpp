@@ -17,7 +17,7 @@ void horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o,
     ho.nearDistance = o.nearIsDistance ? o.nearDistance : 0.0;
     ho.subsample = f.moving ? std::max(1, o.horizonSubsampleMoving) : 1;
     ho.columnNeeded = &f.columnNeeded;
-    if (f.fx->haze) ho.maxDistance = f.fx->hazeFar() / minForwardCosine(f.camera);  // nothing beyond is traced
+    if (f.fx->haze) ho.maxEyeDepth = f.fx->hazeFar();  // nothing beyond is traced
     const HorizonResult hr = traceHorizon(*grid, f.camera, ho);
     if (!hr.active) {
         stats.notes.push_back(hr.reason);

@@ -312,11 +312,29 @@ HorizonResult traceHorizon(const HeightGrid& grid, const Camera& camera, const H
     std::vector<int> list;
     for (int k = 0; k < int(want.size()); ++k)
         if (want[size_t(k)]) list.push_back(k);
+    // Per 2D ray: the horizontal distance its columns' pixels reach before
+    // the eye-plane depth limit (|d_xy| / (d . forward) per unit depth is
+    // monotonic along a column: its top and bottom pixels bound it).
+    std::vector<double> reach(want.size(), options.maxDistance);
+    if (std::isfinite(options.maxEyeDepth)) {
+        std::fill(reach.begin(), reach.end(), 0.0);
+        const glm::dvec3 fwd = camera.forward();
+        auto horizontalReach = [&](double px, double py) {
+            const glm::dvec3 d = camera.rayDirection(px, py);
+            return options.maxEyeDepth * std::sqrt(d.x * d.x + d.y * d.y) / std::max(glm::dot(d, fwd), 1e-9);
+        };
+        for (int x = 0; x < W; ++x) {
+            if (!needed(x)) continue;
+            const double rx = std::max(horizontalReach(x + 0.5, 0.5), horizontalReach(x + 0.5, H - 0.5)) * (1.0 + 1e-6);
+            for (int k = kLo[size_t(x)]; k <= kHi[size_t(x)]; k += sub) reach[size_t(k)] = std::max(reach[size_t(k)], rx);
+        }
+        for (double& v : reach) v = std::min(v, options.maxDistance);
+    }
     std::vector<double> value(want.size(), -kInf);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, list.size(), 16), [&](const tbb::blocked_range<size_t>& br) {
         for (size_t i = br.begin(); i != br.end(); ++i) {
             int k = list[i];
-            value[size_t(k)] = grid.traceRay(eye, camera.heading + a0 + k * delta, options.nearDistance, options.maxDistance);
+            value[size_t(k)] = grid.traceRay(eye, camera.heading + a0 + k * delta, options.nearDistance, reach[size_t(k)]);
         }
     });
     r.raysTraced = int(list.size());

@@ -84,6 +84,10 @@ private:
 struct HorizonOptions {
     double nearDistance = 0;                    // metres; 0 = consider all geometry
     double maxDistance = std::numeric_limits<double>::infinity();  // metres: ignore geometry beyond (haze)
+    // Eye-plane depth beyond which nothing is traced (haze; metres): each
+    // column ignores geometry horizontally farther than its pixels reach
+    // before that depth (tighter than one maxDistance for the whole view).
+    double maxEyeDepth = std::numeric_limits<double>::infinity();
     int subsample = 1;                          // >= 1
     const std::vector<uint8_t>* columnNeeded = nullptr;  // size camera.width, or null = all
 };

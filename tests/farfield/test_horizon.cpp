@@ -20,13 +20,16 @@ namespace {
 // Brute force: for each column, the first row (from the top) whose centre ray
 // hits geometry farther than `nearDistance` (H if none). The horizon row must
 // never exceed it.
-std::vector<int> bruteForceTopHit(const RayScene& rs, const Camera& cam, double nearDistance) {
+// maxEyeDepth: hits deeper (eye-plane depth) than this do not count (haze).
+std::vector<int> bruteForceTopHit(const RayScene& rs, const Camera& cam, double nearDistance,
+                                  double maxEyeDepth = 1e300) {
     std::vector<int> top(size_t(cam.width), cam.height);
     glm::vec3 org(cam.eye - rs.frameOrigin());
     for (int x = 0; x < cam.width; ++x)
         for (int y = 0; y < cam.height; ++y) {
-            glm::vec3 d(cam.rayDirection(x + 0.5, y + 0.5));
-            RayHit h = rs.intersect(org, d);
+            const glm::dvec3 dd = cam.rayDirection(x + 0.5, y + 0.5);
+            glm::vec3 d(dd);
+            RayHit h = rs.intersect(org, d, 0.0f, float(std::min(1e30, maxEyeDepth / glm::dot(dd, cam.forward()))));
             if (h.hit && h.t >= nearDistance) {
                 top[size_t(x)] = y;
                 break;
@@ -82,6 +85,50 @@ TEST(Horizon, NeverBelowGeometryOnRandomScenes) {
         }
     }
     EXPECT_GT(culledTotal, 0);  // the horizon does cull sky
+}
+
+// Haze: with an eye-plane depth limit the horizon stays conservative against
+// brute force with the same limit, and culls at least as much as one
+// horizontal limit for the whole view (the corner pixels' reach) would.
+TEST(Horizon, EyeDepthLimitIsConservativeAndTighterThanOneDistance) {
+    long culledDepth = 0, culledDistance = 0;
+    for (uint32_t seed = 1; seed <= 4; ++seed) {
+        SceneModel city = randomCity(seed, 120, 800.0);
+        auto rs = RayScene::build(city);
+        ASSERT_TRUE(rs.isOk());
+        HeightGrid hg = HeightGrid::build(city, rs.value()->frameOrigin(), 64);
+        std::mt19937 rng(seed * 31);
+        std::uniform_real_distribution<double> pos(-300, 300), hd(-M_PI, M_PI), pt(-0.5, 0.3), hz(1.0, 120.0);
+        for (int k = 0; k < 4; ++k) {
+            Camera cam = cameraAt(glm::dvec3(pos(rng), pos(rng), hz(rng)), hd(rng), pt(rng));
+            for (double depth : {60.0, 200.0}) {
+                HorizonOptions opt;
+                opt.nearDistance = 20.0;
+                opt.maxEyeDepth = depth;
+                HorizonResult hr = traceHorizon(hg, cam, opt);
+                ASSERT_TRUE(hr.active) << hr.reason;
+                Check c = compare(hr, bruteForceTopHit(*rs.value(), cam, opt.nearDistance, depth));
+                EXPECT_EQ(c.violations, 0) << "seed " << seed << " depth " << depth;
+                culledDepth += c.culled;
+                // One limit for the view: the largest horizontal reach of any pixel.
+                double reach = 0;
+                for (double px : {0.5, cam.width - 0.5})
+                    for (double py : {0.5, cam.height - 0.5}) {
+                        const glm::dvec3 d = cam.rayDirection(px, py);
+                        reach = std::max(reach, depth * std::hypot(d.x, d.y) / glm::dot(d, cam.forward()));
+                    }
+                HorizonOptions one;
+                one.nearDistance = 20.0;
+                one.maxDistance = reach;
+                HorizonResult h1 = traceHorizon(hg, cam, one);
+                for (size_t x = 0; x < hr.row.size(); ++x) {
+                    EXPECT_GE(hr.row[x], h1.row[x]) << "column " << x;
+                    culledDistance += h1.row[x];
+                }
+            }
+        }
+    }
+    EXPECT_GT(culledDepth, culledDistance);  // strictly tighter somewhere
 }
 
 TEST(Horizon, ConservativeWithCameraOnGridLinesAndAxisParallelRays) {
