@@ -2,7 +2,7 @@
 # Regenerates docs/effects.md: what each declared effect (sun_shadows, ambient_occlusion,
 # haze, glass, night, materials) costs at generation and per frame, how its quality knobs
 # trade time for PSNR (with one Pareto plot per effect in docs/img/effects_pareto_*.svg),
-# the haze payoff on a 2 km and a 4 km city, reflection rays vs glass in view, and raster
+# the haze payoff on a 2 km, a 4 km and an 8 km city, reflection rays vs glass in view, and raster
 # vs ray-caster agreement; plus the README pictures docs/img/effect_{shadows,haze,glass,night}.png.
 #
 # usage: docs/tools/effects.sh [OUT_DIR] [VISTA_BIN]     (run from anywhere; works in the repo root)
@@ -120,6 +120,14 @@ for k in car fly; do
   bench "haze4k_${k}_none" haze4k "$k" $FH --effects none
 done
 drop haze4k
+
+# 3. haze payoff, 8 km (64 km2): much of the city lies beyond the visibility.
+gen haze8k haze --size 8000
+for k in car fly; do
+  bench "haze8k_${k}_haze" haze8k "$k" $FH
+  bench "haze8k_${k}_none" haze8k "$k" $FH --effects none
+done
+drop haze8k
 
 # 2. Baked knobs on the 1 km centre of the same parameters (the 2 km references would take
 # ~10 more minutes): sun_shadows resolution_m {8,4,2,1} (samples 8), reference 0.5 m with 16
