@@ -18,7 +18,7 @@ XVFB=(xvfb-run -a -s "-screen 0 1280x1024x24")
 [ -n "${DISPLAY:-}" ] && XVFB=()
 
 echo "== regression tests of the findings" >&2
-"${XVFB[@]}" ctest --test-dir build -R 'Hostile|Huge|BadInput|Kill|Stale|OutputBatch|Malformed|BadScene|BadEffects|Unwritable|Osm|Geodesy|Params|Paths|CellResult|Damaged|Corrupt' \
+"${XVFB[@]}" ctest --test-dir build -R 'Hostile|Huge|BadInput|Kill|Stale|OutputBatch|Malformed|BadScene|BadEffects|Unwritable|Osm|Geodesy|Params|Paths|CellResult|Damaged|Corrupt|Faults|LookingOut' \
   --output-on-failure -j2 > "$OUT/regression.txt" 2>&1 || true
 
 if [ -n "${FUZZ_TSV:-}" ]; then
@@ -74,10 +74,12 @@ rows = [
  ("OSM", "one far node or `lon=\"1e300\"`: a network thousands of km long, exit 0; signed overflow inside libosmium", "coordinates pre-scanned as text and blanked before libosmium parses them; invalid, missing and outlier nodes (> 22.6 km from the median) dropped with a count; extents beyond the largest city (16 km) refused", "OsmImport.InvalidMissingAndOutlierNodesAreDroppedAndCounted, OsmImport.ExtentBeyondTheLargestCityIsRefused, OsmImport.UnsafeXmlIsRefused"),
  ("OSM", "an extract across ±180° became a city spanning the globe", "WGS84 transverse Mercator about the data (equal to PROJ's tmerc to 1 µm), continuous across 180° and at the poles; the geo reference stored in the scene file; lon/lat round trip < 1 cm (about 6 nm)", "OsmImport.ExtractAcrossTheAntimeridianHasItsRealExtent, Geodesy.RoundTripWithinOneCentimetre, Geodesy.ProjectedDistancesMatchVincentyAnywhere"),
  ("faults", "kill -9 left `*.tmp.<pid>` files of 100-340 MB", "the next write of the same output removes temporaries of dead processes", "AtomicFile.StaleTemporariesOfKilledRunsAreRemovedAndLiveOnesKept, GenCli.KillNineKeepsTheOldOutputAndTheNextRunCleansUp"),
- ("faults", "disk full said only 'osgb writer failed'", "the errno text (e.g. 'No space left on device')", "(needs a full file system; see below)"),
+ ("faults", "disk full said only 'osgb writer failed'", "the errno text ('No space left on device'; the writer's errno was lost before it was read)", "GenFaults.DiskFullGivesTheCauseAndLeavesTheOldOutputAndNoTemporary, BakeFaults.DiskFullGivesTheCauseAndLeavesNoPartialOutput"),
  ("faults", "`--gltf` failure left .osgb and .geojson written", "all outputs of `vista gen` are staged and renamed together, or none", "AtomicFile.OutputBatchCommitsAllOrNothing, GenCli.KillNine..."),
  ("faults", "`vista path` exited 1 on a write failure", "exit 2 like every user-facing failure", "(code path shared with reportBadInput)"),
- ("faults", "`vista bench` left an empty output folder for a bad scene file", "the folder is removed when this run created it and wrote nothing", "GenCli.BenchOfABadSceneLeavesNoOutputFolder"),
+ ("faults", "`vista bench` left an empty output folder for a bad scene file", "every `--out` directory this run created is removed when it wrote nothing", "GenCli.BenchOfABadSceneLeavesNoOutputFolder"),
+ ("faults", "`vista bake --work` and `vista bench --out` (read-only, or a file) were refused only after the scene was loaded (bench: exit 1)", "refused before the input is read, exit 2, naming the option", "BakeFaults.UnwritableOutputWorkOrStatsIsRefusedBeforeTheInputIsRead, BakeFaults.ReadOnlyDirectoryIsRefusedBeforeTheInputIsRead, BenchFaults.*"),
+ ("faults", "horizon stage: a column with nothing in view gave a NaN limit and culled nothing (every sky pixel at a city's edge was traced)", "all sky", "Horizon.LookingOutOfTheCityIsAllSky"),
 ]
 for r in rows: print("| " + " | ".join(r) + " |")
 ok, n = tests_summary(read("regression.txt"))
@@ -87,7 +89,9 @@ print()
 print("## Fuzzing (libFuzzer, ASan + UBSan)")
 print()
 print("Targets in tests/fuzz (`-DVISTA_FUZZ=ON`, Clang), seed corpora in tests/fuzz/corpus/<target>/, run by "
-      "`.ci/fuzz.sh` (`FUZZ_SECONDS` per target). A crash, a sanitizer report or a broken round-trip fails the target.")
+      "`.ci/fuzz.sh` (`FUZZ_SECONDS` per target, or `FUZZ_RUNS` executions with FUZZ_SECONDS as a cap; seconds = the "
+      "time it took). A crash, a sanitizer report or a broken round-trip fails the target. `.ci/run` runs every target "
+      "for 15 s on each CI run.")
 print()
 print("| target | input | seconds | executions | corpus after | result |")
 print("|---|---|---|---|---|---|")
@@ -124,10 +128,17 @@ print()
 print("- kill -9 at five points of `vista gen --geojson --gltf` (150 ms .. 3.5 s into a 2 km city): each time the "
       "older .osgb stays byte-identical and no .geojson/.glb appears; the next run leaves no temporary file "
       "(GenCli.KillNineKeepsTheOldOutputAndTheNextRunCleansUp).")
-print("- The bake writes every cell result atomically in its work directory and resumes after a kill (docs/bake.md).")
-print("- An unwritable output directory is refused before any work (GenCli.UnwritableOutput; checkWritablePath in every command).")
-print("- Disk full: the message carries the errno text. A test on a small tmpfs needs mount rights the CI container "
-      "does not grant; it is not automated (left open).")
+print("- kill -9 at four points of `vista bake` (loading, first cell result, 10 cell results later, during the output "
+      "write), each triggered by the event, not a delay: the older output stays byte-identical and the work directory "
+      "holds only whole cell results; the next run reuses them all and writes the bytes of an uninterrupted bake "
+      "(BakeFaults.KillNineLeavesTheOldOutputOrTheWholeNewOneAndTheNextRunResumes).")
+print("- Disk full (a 2 MB tmpfs; the tests run as root, else they skip and say why): `vista gen` (also with a .glb that "
+      "does not fit after the city and GeoJSON did) and `vista bake` (output or work directory on the full disk) exit 2 "
+      "with 'No space left on device'; the older output stays, no output or temporary file is left, and whole cell "
+      "results stay for the next run (GenFaults.DiskFull..., BakeFaults.DiskFull...).")
+print("- An unwritable output (missing directory, a file, a directory, read-only) is refused before the input is read, "
+      "exit 2 naming the option: `vista gen`, `path`, `view --screenshot`, `bake -o/--work/--stats`, `bench --out` "
+      "(checkWritablePath / checkWritableDirectory; the tests give a junk input that must not be reported).")
 print()
 print("## Soak")
 print()
