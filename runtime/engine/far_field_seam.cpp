@@ -1,5 +1,6 @@
 // Seam-check stage (far_field_stages.h): covered pixels beyond the near
 // distance re-cast against the far geometry the rasteriser never drew.
+#include <algorithm>
 #include <cmath>
 
 #include <tbb/parallel_for.h>
@@ -22,14 +23,29 @@ void seamStage(FarFrame& f, const RayScene& rays, const FarFieldOptions& o, Fram
     // the pixel's ray) lies beyond the near distance; tfar just before it.
     std::vector<uint32_t> check;
     std::vector<float> dist;
-    for (size_t i = 0; i < f.pixelCount; ++i) {
-        if (f.cls[i] != kFarCovered) continue;
-        const double ze = eyeDepthOfWindowDepth(double(f.depth[i]), n, zf);
-        const double sx = f.rays.screenX(int(i % W)), sy = f.rays.screenY(int(i / W));
-        const double t = ze * std::sqrt(1.0 + sx * sx + sy * sy);
-        if (t > o.nearDistance) {
-            check.push_back(uint32_t(i));
-            dist.push_back(float(t * (1.0 - 1e-3)));
+    // Quick rejection: a pixel's distance is its eye depth times
+    // sqrt(1 + sx^2 + sy^2) <= kMax (the corner pixels'), so no surface with
+    // eye depth <= nearDistance / kMax reaches beyond the near distance. Its
+    // window depth (minus a margin for float rounding) is one compare per pixel.
+    std::vector<double> sx2(W), sy2(size_t(f.height));
+    for (uint32_t x = 0; x < W; ++x) sx2[x] = f.rays.screenX(int(x)) * f.rays.screenX(int(x));
+    for (int y = 0; y < f.height; ++y) sy2[size_t(y)] = f.rays.screenY(y) * f.rays.screenY(y);
+    const double kMax = std::sqrt(1.0 + std::max(sx2.front(), sx2.back()) + std::max(sy2.front(), sy2.back()));
+    const double zMin = o.nearDistance / kMax;
+    // Window depth of eye depth z (inverse of eyeDepthOfWindowDepth).
+    const double dMin = zf > 0 ? (zf / (zf - n)) * (1.0 - n / zMin) : 1.0 - n / zMin;
+    const float reject = zMin <= n ? -1.0f : float(dMin - 1e-6);
+    for (size_t y = 0; y < size_t(f.height); ++y) {
+        const float* d = f.depth + y * W;
+        const uint8_t* c = &f.cls[y * W];
+        for (uint32_t x = 0; x < W; ++x) {
+            if (c[x] != kFarCovered || d[x] < reject) continue;
+            const double ze = eyeDepthOfWindowDepth(double(d[x]), n, zf);
+            const double t = ze * std::sqrt(1.0 + sx2[x] + sy2[y]);
+            if (t > o.nearDistance) {
+                check.push_back(uint32_t(y * W + x));
+                dist.push_back(float(t * (1.0 - 1e-3)));
+            }
         }
     }
     if (!check.empty()) {
