@@ -133,7 +133,7 @@ namespace {
 // < 1e-6, far below an 8-bit step), then the same blend as applyHaze.
 class HazeTable {
 public:
-    explicit HazeTable(const FrameEffects& fx) {
+    explicit HazeTable(const FrameEffects& fx) : _beta(float(fx.extinction())) {
         const glm::u8vec4 h = fx.hazeColor();
         for (int c = 0; c < 3; ++c) _h[c] = float(h[c]);
         const double step = fx.hazeFar() / kSteps;
@@ -142,9 +142,15 @@ public:
     }
     // p: an RGBA pixel hazed in place for eye-plane depth z (metres).
     void apply(uint8_t* p, float z) const {
-        const float u = std::clamp(z * _invStep, 0.0f, float(kSteps));
-        const int i = int(u);
-        const float f = u - float(i), t = _t[i] + (_t[i + 1] - _t[i]) * f, s = 1.0f - t;
+        const float u = std::max(z * _invStep, 0.0f);
+        float t;
+        if (u < float(kSteps)) {
+            const int i = int(u);
+            t = _t[i] + (_t[i + 1] - _t[i]) * (u - float(i));
+        } else {
+            t = std::exp(-_beta * z);  // beyond the visibility (callers normally stop there)
+        }
+        const float s = 1.0f - t;
         // Round half up; the blend of two values in [0, 255] stays in range.
         for (int c = 0; c < 3; ++c) p[c] = uint8_t(float(p[c]) * t + _h[c] * s + 0.5f);
     }
@@ -152,6 +158,7 @@ public:
 private:
     static constexpr int kSteps = 1024;
     float _t[kSteps + 2];
+    float _beta = 0;
     float _invStep = 1;
     float _h[3];
 };

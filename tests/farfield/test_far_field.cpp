@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <random>
 #include <string>
@@ -455,4 +456,64 @@ TEST(PrimaryRays, PixelListWritesExactlyTheListedPixels) {
     castPrimaryRays(*t.rays, c, nullptr, 0, out, none, 0);
     EXPECT_EQ(none.rays, 0u);
     EXPECT_EQ(none.hits, 0u);
+}
+
+// hazeCovered: covered pixels arrive unhazed and leave hazed for the eye depth
+// their window depth encodes (finite and infinite far plane), within one 8-bit
+// level of FrameEffects::applyHaze (exp evaluated directly); uncovered pixels
+// and alpha are not touched by that pass; without haze nothing changes.
+TEST(FarFieldFrame, HazeOfCoveredPixelsMatchesTheFormulaAtTheirDepth) {
+    const TestCity t = testCity(3, 20);
+    ASSERT_TRUE(t.rays);
+    Camera c = cam(glm::dvec3(0, -150, 1.7), 0.3, 0.0, 64, 48);
+    c.zNear = 0.5;
+    const size_t N = size_t(c.width) * size_t(c.height);
+    for (double zFar : {400.0, 0.0}) {
+        std::vector<float> depth(N, 1.0f);
+        std::vector<double> eyeZ(N, 0.0);
+        std::mt19937 rng(7);
+        std::uniform_real_distribution<double> z(0.6, 390.0);  // also beyond the visibility (300 m)
+        Image in(c.width, c.height);
+        for (size_t i = 0; i < N; ++i) {
+            if (i % 7 == 3) continue;  // some pixels uncovered
+            eyeZ[i] = z(rng);
+            // Window depth of eye depth z (OpenGL perspective, [0, 1]).
+            const double d = zFar > 0 ? (zFar / (zFar - c.zNear)) * (1.0 - c.zNear / eyeZ[i]) : 1.0 - c.zNear / eyeZ[i];
+            depth[i] = float(d);
+            in.rgba[i * 4 + 0] = uint8_t(rng() % 256);
+            in.rgba[i * 4 + 1] = uint8_t(rng() % 256);
+            in.rgba[i * 4 + 2] = uint8_t(rng() % 256);
+            in.rgba[i * 4 + 3] = i % 5 == 0 ? 128 : 255;
+        }
+        FarFieldOptions o;
+        o.nearDistance = 400.0;
+        o.verifySeam = false;
+        o.depthZFar = zFar;
+        o.hazeCovered = true;
+        o.effects.haze = true;
+        o.effects.visibility = 300.0;
+        FarField ff(*t.rays, &t.grid, o);
+        Image out = in;
+        FrameStats st;
+        ff.render(c, depth.data(), out, st);
+        EXPECT_TRUE(st.effects.ran(EffectId::Haze));
+        int worst = 0;
+        for (size_t i = 0; i < N; ++i) {
+            if (ff.classification()[i] != kFarCovered) continue;
+            const glm::u8vec4 src(in.rgba[i * 4], in.rgba[i * 4 + 1], in.rgba[i * 4 + 2], in.rgba[i * 4 + 3]);
+            const glm::u8vec4 want = o.effects.applyHaze(src, eyeZ[i]);
+            for (int k = 0; k < 3; ++k) worst = std::max(worst, std::abs(int(out.rgba[i * 4 + k]) - int(want[k])));
+            EXPECT_EQ(out.rgba[i * 4 + 3], src[3]) << "alpha (glass marks) must pass through";
+        }
+        EXPECT_LE(worst, 1) << "zFar " << zFar;
+        // Without haze the covered pixels are left as they were.
+        o.effects.haze = false;
+        ff.setOptions(o);
+        Image plain = in;
+        FrameStats s2;
+        ff.render(c, depth.data(), plain, s2);
+        for (size_t i = 0; i < N; ++i)
+            if (ff.classification()[i] == kFarCovered)
+                ASSERT_EQ(std::memcmp(&plain.rgba[i * 4], &in.rgba[i * 4], 4), 0);
+    }
 }
