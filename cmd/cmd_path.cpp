@@ -23,7 +23,7 @@ int runPath(int argc, char** argv) {
     app.add_option("--duration", o.duration, "path length in seconds (default 60)");
     app.add_option("--run-up", o.runUp, "seconds driven before the path starts and dropped, so it starts at cruising speed, 0 .. 600 (default 8)");
     app.add_option("--dt", o.dt, "seconds between samples (default 1/30)");
-    app.add_option("--speed", o.maxSpeed, "maximum speed in m/s (default 14)");
+    auto* speed = app.add_option("--speed", o.maxSpeed, "maximum speed in m/s (default: walk 1.4, car and fly 14)");
     app.add_option("--yaw-rate", yawDeg, "maximum yaw rate in degrees/s (default 45)");
     app.add_option("--fly-height", o.flyHeight, "fly-over height above the terrain in metres (default 80)");
     app.add_option("--fly-pitch", pitchDeg, "fly-over pitch in degrees (default -11.5)");
@@ -34,6 +34,7 @@ int runPath(int argc, char** argv) {
     auto k = parsePathKind(kind);
     if (!k) return reportBadInput("vista path", Status::error("--kind: " + k.status().message()));
     o.kind = k.value();
+    if (speed->count() == 0) o.maxSpeed = defaultSpeed(o.kind);
     o.maxYawRate = yawDeg * kPi / 180.0;
     o.flyPitch = pitchDeg * kPi / 180.0;
     if (Status s = validatePathOptions(o); !s) return reportBadInput("vista path", s);

@@ -281,6 +281,7 @@ Result<PathOptions> parsePathFlags(const PathFlags& f) {
     PathOptions po;
     po.seed = f.seed;
     po.kind = k.value();
+    po.maxSpeed = defaultSpeed(po.kind);
     po.duration = f.duration;
     po.runUp = f.runUp;
     VISTA_RETURN_IF_ERROR(validatePathOptions(po));

@@ -134,6 +134,8 @@ const char* pathKindName(PathKind k) {
     return "?";
 }
 
+double defaultSpeed(PathKind k) { return k == PathKind::Walk ? 1.4 : 14.0; }
+
 Result<PathKind> parsePathKind(const std::string& s) {
     if (s == "walk") return PathKind::Walk;
     if (s == "car") return PathKind::Car;

@@ -39,13 +39,16 @@ namespace vista {
 enum class PathKind { Walk, Car, Fly };
 const char* pathKindName(PathKind k);
 Result<PathKind> parsePathKind(const std::string& s);  // "walk" | "car" | "fly"
+// The kind's pace when the user gives none: walk 1.4 m/s (a walker), car and
+// fly 14 m/s (about 50 km/h).
+double defaultSpeed(PathKind k);
 
 struct PathOptions {
     uint64_t seed = 1;
     PathKind kind = PathKind::Car;
     double duration = 60.0;                       // seconds, > 0
     double dt = 1.0 / 30.0;                       // seconds between samples, > 0
-    double maxSpeed = 14.0;                       // m/s, > 0
+    double maxSpeed = 14.0;                       // m/s, > 0 (programs set defaultSpeed(kind))
     double maxYawRate = 0.7853981633974483;       // rad/s (45 deg/s), > 0
     double accel = 2.5;                           // m/s^2 speeding up
     double decel = 4.0;                           // m/s^2 braking

@@ -112,6 +112,11 @@ TEST(Options, PathFlags) {
     ASSERT_TRUE(po.isOk()) << po.status().message();
     EXPECT_EQ(po->kind, PathKind::Walk);
     EXPECT_EQ(po->runUp, 0.0);
+    EXPECT_LT(po->maxSpeed, 2.0) << "a walk goes at a walker's pace";
+    f.kind = "car";
+    auto car = parsePathFlags(f);
+    ASSERT_TRUE(car.isOk());
+    EXPECT_GT(car->maxSpeed, 5.0 * po->maxSpeed);
     f.kind = "boat";
     EXPECT_FALSE(parsePathFlags(f).isOk());
     f.kind = "car";
