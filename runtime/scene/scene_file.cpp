@@ -5,6 +5,9 @@
 #include <sys/wait.h>
 
 #include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <thread>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -169,8 +172,26 @@ Result<osg::ref_ptr<osg::Node>> readSceneFile(const std::string& path) {
             ::_exit(rr.validNode() ? 0 : 3);
         }
         if (pid > 0) {
+            // A payload can also keep the reader busy for long (a 3.8 KB file
+            // found by fuzzing: 9 s): the child gets a time limit (5 s plus
+            // 1 s per 10 MB, VISTA_UNTRUSTED_DECODE_SECONDS overrides).
+            double limitS = 5.0 + double(payload) / 1e7;
+            if (const char* l = std::getenv("VISTA_UNTRUSTED_DECODE_SECONDS"); l && std::atof(l) > 0) limitS = std::atof(l);
+            const auto start = std::chrono::steady_clock::now();
             int st = 0;
-            while (::waitpid(pid, &st, 0) < 0 && errno == EINTR) {}
+            for (;;) {
+                const pid_t r = ::waitpid(pid, &st, WNOHANG);
+                if (r == pid || (r < 0 && errno != EINTR)) break;
+                if (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > limitS) {
+                    ::kill(pid, SIGKILL);
+                    while (::waitpid(pid, &st, 0) < 0 && errno == EINTR) {}
+                    char buf[32];
+                    std::snprintf(buf, sizeof buf, "%.0f", limitS);
+                    return Status::error("scene file '" + path + "' is malformed: its payload keeps the osgb reader busy beyond " +
+                                         buf + " s (checked in a child process; VISTA_UNTRUSTED_DECODE_SECONDS sets the limit)");
+                }
+                std::this_thread::sleep_for(std::chrono::milliseconds(5));
+            }
             if (WIFSIGNALED(st))
                 return Status::error("scene file '" + path + "' is malformed: its payload crashes the osgb reader (signal " +
                                      std::to_string(WTERMSIG(st)) + "; checked in a child process)");

@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <chrono>
 #include <cstring>
 #include <fstream>
 #include <random>
@@ -540,6 +541,24 @@ TEST(CityFile, MalformedPayloadWithAValidTrailerIsRefused) {
     auto m = loadCityFile(good);
     EXPECT_TRUE(m.isOk()) << m.status().message();
     ::unsetenv("VISTA_UNTRUSTED_FILES");
+}
+
+// Found by fuzz_scene_file (its trailer forged by libFuzzer's comparison
+// tracing): a 3.8 KB payload that keeps OSG's osgb reader busy for seconds.
+// Untrusted mode refuses it when the child's time limit runs out.
+TEST(CityFile, PayloadThatKeepsTheReaderBusyIsRefusedInUntrustedMode) {
+    const std::string f = std::string(VISTA_SOURCE_DIR) + "/tests/data/fuzz_findings/scene_slow_reader.osgb";
+    ::setenv("VISTA_UNTRUSTED_FILES", "1", 1);
+    ::setenv("VISTA_UNTRUSTED_DECODE_SECONDS", "0.3", 1);
+    const auto start = std::chrono::steady_clock::now();
+    auto m = loadCityFile(f);
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ::unsetenv("VISTA_UNTRUSTED_DECODE_SECONDS");
+    ::unsetenv("VISTA_UNTRUSTED_FILES");
+    ASSERT_FALSE(m.isOk());
+    // Refused by the time limit (the reader alone takes seconds on it).
+    EXPECT_NE(m.status().message().find("busy"), std::string::npos) << m.status().message();
+    EXPECT_LT(s, 5.0);
 }
 
 }  // namespace
