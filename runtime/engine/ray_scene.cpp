@@ -441,4 +441,6 @@ glm::vec3 RayScene::hitColor(const RayHit& h) const {
 
 size_t RayScene::triangleCount() const { return _impl->triangles; }
 
+RTCSceneTy* RayScene::embreeScene() const { return _impl->scene; }
+
 }  // namespace vista
