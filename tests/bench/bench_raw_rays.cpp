@@ -5,12 +5,17 @@
 // (or VISTA_CITY / VISTA_RAYS in the environment). DIR holds RaySet files
 // (`vista bench CITY --modes hybrid --dump-rays DIR`); each iteration casts
 // every ray of every set, so items_per_second is rays/s. Variants, each with
-// threads:1 (a one-worker arena) and threads:0 (all cores), wall time:
+// threads:1 (a one-worker arena; CPU time) and threads:0 (all cores; wall
+// time):
 //   Raw1       rtcIntersect1 one ray at a time (rays from precomputed arrays)
 //   Raw8       rtcIntersect8 in the stage's packets (coherentRuns), the SoA
 //              packet filled from precomputed arrays
 //   Raw8Dense  rtcIntersect8 on every 8 consecutive rays regardless of rows
-//              (Raw8 / Raw8Dense = the cost of partly filled packets)
+//              (full packets, but packets that straddle row breaks)
+//   Raw8Serial Raw8 in a plain loop, no TBB (threads:1 only: Raw8 minus
+//              Raw8Serial = the one-worker arena and parallel_for)
+//   Raw8Color  Raw8 plus every hit's colour (RayScene::hitColor: the colour
+//              fetch and interpolation the wrapper does per hit)
 //   Many       RayScene::intersectMany on the stage's runs (the wrapper: lane
 //              fill, and per hit the colour, normal and RayHit fill)
 //   Dirs       the rays' directions and tfars from the pixel list
@@ -18,7 +23,9 @@
 //   Stage      castPrimaryRays on the pixel list: the in-frame path
 //              (directions, intersectMany, shading, colour writes), with
 //              the frame's haze limit and a hit list as raysStage passes
-// Counters: rays (per iteration), frames, packet_fill (rays / (8 x packets)).
+// Interleaved runs every variant on one core frame by frame (counters
+// <Variant>_ns = CPU ns per ray). Counters: rays (per iteration), frames,
+// packet_fill (rays / (8 x packets)).
 // Before timing, the variants' hit counts are compared (printed on stderr).
 #include <benchmark/benchmark.h>
 #include <embree3/rtcore.h>
@@ -30,6 +37,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -171,7 +179,8 @@ uint64_t raw1(RTCScene scene, const PrimaryRays& r, size_t b, size_t e) {
 }
 
 // Raw rtcIntersect8 on rays [b, e) of a frame, in packets of 8 from b.
-uint64_t raw8(RTCScene scene, const PrimaryRays& r, size_t b, size_t e) {
+// colours (optional): each hit's colour fetched through RayScene::hitColor.
+uint64_t raw8(RTCScene scene, const PrimaryRays& r, size_t b, size_t e, const RayScene* colours = nullptr) {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
@@ -196,6 +205,20 @@ uint64_t raw8(RTCScene scene, const PrimaryRays& r, size_t b, size_t e) {
         }
         rtcIntersect8(valid, scene, &ctx, &rh);
         for (int k = 0; k < m; ++k) hits += rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
+        if (!colours) continue;
+        glm::vec3 sum(0.0f);
+        for (int k = 0; k < m; ++k) {
+            if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) continue;
+            RayHit h;
+            h.hit = true;
+            h.geomId = rh.hit.geomID[k];
+            h.primId = rh.hit.primID[k];
+            h.instId = rh.hit.instID[0][k];
+            h.u = rh.hit.u[k];
+            h.v = rh.hit.v[k];
+            sum += colours->hitColor(h);
+        }
+        benchmark::DoNotOptimize(sum);
     }
     return hits;
 }
@@ -207,13 +230,18 @@ size_t runGrain(const Frame& f) {
 }
 
 // One pass of a variant over every frame; returns the hit count.
-enum class Variant { Raw1, Raw8, Raw8Dense, Many, Dirs, Stage };
+enum class Variant { Raw1, Raw8, Raw8Dense, Raw8Serial, Raw8Color, Many, Dirs, Stage };
 
-uint64_t pass(Variant v, int threads) {
+constexpr Variant kVariants[] = {Variant::Raw1, Variant::Raw8, Variant::Raw8Dense, Variant::Raw8Serial,
+                                 Variant::Raw8Color, Variant::Many, Variant::Dirs, Variant::Stage};
+constexpr const char* kVariantNames[] = {"Raw1", "Raw8", "Raw8Dense", "Raw8Serial", "Raw8Color", "Many", "Dirs", "Stage"};
+
+// One variant on one frame; returns the hit count.
+uint64_t passFrame(Variant v, Frame& f, int threads) {
     World& w = world();
     RTCScene scene = w.scene->embreeScene();
     uint64_t hits = 0;
-    for (Frame& f : w.frames) {
+    {
         const size_t n = f.runs.back(), nRuns = f.runs.size() - 1;
         switch (v) {
             case Variant::Raw1:
@@ -223,6 +251,17 @@ uint64_t pass(Variant v, int threads) {
                 hits += parallelHits(threads, nRuns, runGrain(f), [&](size_t b, size_t e) {
                     uint64_t h = 0;
                     for (size_t r = b; r < e; ++r) h += raw8(scene, f.rays, f.runs[r], f.runs[r + 1]);
+                    return h;
+                });
+                break;
+            case Variant::Raw8Serial:
+                enableFtzDaz();
+                for (size_t r = 0; r < nRuns; ++r) hits += raw8(scene, f.rays, f.runs[r], f.runs[r + 1]);
+                break;
+            case Variant::Raw8Color:
+                hits += parallelHits(threads, nRuns, runGrain(f), [&](size_t b, size_t e) {
+                    uint64_t h = 0;
+                    for (size_t r = b; r < e; ++r) h += raw8(scene, f.rays, f.runs[r], f.runs[r + 1], w.scene.get());
                     return h;
                 });
                 break;
@@ -264,6 +303,46 @@ uint64_t pass(Variant v, int threads) {
     return hits;
 }
 
+// One variant on every frame.
+uint64_t pass(Variant v, int threads) {
+    uint64_t hits = 0;
+    for (Frame& f : world().frames) hits += passFrame(v, f, threads);
+    return hits;
+}
+
+double threadCpuNs() {
+    timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) * 1e9 + double(ts.tv_nsec);
+}
+
+// Every variant on one core, interleaved frame by frame (the order rotates
+// from frame to frame), each call timed by this thread's CPU clock (a
+// one-worker arena runs on the calling thread): the variants see the same
+// machine load, so their differences are the steadiest attribution.
+// Counters <Variant>_ns: CPU ns per ray.
+void BM_Interleaved(benchmark::State& st) {
+    World& w = world();
+    constexpr size_t kN = sizeof(kVariants) / sizeof(kVariants[0]);
+    double ns[kN] = {};
+    size_t rot = 0;
+    for (auto _ : st)
+        for (Frame& f : w.frames) {
+            for (size_t j = 0; j < kN; ++j) {
+                const size_t i = (j + rot) % kN;
+                const double t0 = threadCpuNs();
+                benchmark::DoNotOptimize(passFrame(kVariants[i], f, 1));
+                ns[i] += threadCpuNs() - t0;
+            }
+            ++rot;
+        }
+    st.SetItemsProcessed(int64_t(st.iterations()) * int64_t(w.rays));
+    for (size_t i = 0; i < kN; ++i) st.counters[std::string(kVariantNames[i]) + "_ns"] = ns[i] / (double(st.iterations()) * double(w.rays));
+    st.counters["rays"] = double(w.rays);
+    st.counters["frames"] = double(w.frames.size());
+    st.counters["packet_fill"] = double(w.rays) / (8.0 * double(w.packets));
+}
+
 void run(benchmark::State& st, Variant v) {
     World& w = world();
     const int threads = int(st.range(0));
@@ -271,24 +350,33 @@ void run(benchmark::State& st, Variant v) {
     st.SetItemsProcessed(int64_t(st.iterations()) * int64_t(w.rays));
     st.counters["rays"] = double(w.rays);
     st.counters["frames"] = double(w.frames.size());
-    if (v == Variant::Raw8 || v == Variant::Many || v == Variant::Stage)
+    if (v == Variant::Raw8 || v == Variant::Raw8Serial || v == Variant::Many || v == Variant::Stage)
         st.counters["packet_fill"] = double(w.rays) / (8.0 * double(w.packets));
 }
 
 void BM_Raw1(benchmark::State& st) { run(st, Variant::Raw1); }
 void BM_Raw8(benchmark::State& st) { run(st, Variant::Raw8); }
 void BM_Raw8Dense(benchmark::State& st) { run(st, Variant::Raw8Dense); }
+void BM_Raw8Serial(benchmark::State& st) { run(st, Variant::Raw8Serial); }
 void BM_Many(benchmark::State& st) { run(st, Variant::Many); }
 void BM_Dirs(benchmark::State& st) { run(st, Variant::Dirs); }
 void BM_Stage(benchmark::State& st) { run(st, Variant::Stage); }
 
-#define VISTA_RAW_BENCH(fn) BENCHMARK(fn)->ArgName("threads")->Arg(1)->Arg(0)->UseRealTime()->Unit(benchmark::kMillisecond)
+// One core: this thread's CPU time (steady when other jobs share the cores;
+// a one-worker arena runs on the calling thread); all cores: wall time (the
+// frame's throughput).
+#define VISTA_RAW_BENCH1(fn) BENCHMARK(fn)->ArgName("threads")->Arg(1)->Unit(benchmark::kMillisecond)
+#define VISTA_RAW_BENCH(fn) \
+    VISTA_RAW_BENCH1(fn);   \
+    BENCHMARK(fn)->ArgName("threads")->Arg(0)->UseRealTime()->Unit(benchmark::kMillisecond)
 VISTA_RAW_BENCH(BM_Raw1);
 VISTA_RAW_BENCH(BM_Raw8);
 VISTA_RAW_BENCH(BM_Raw8Dense);
+VISTA_RAW_BENCH1(BM_Raw8Serial);
 VISTA_RAW_BENCH(BM_Many);
-BENCHMARK(BM_Dirs)->ArgName("threads")->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+VISTA_RAW_BENCH1(BM_Dirs);
 VISTA_RAW_BENCH(BM_Stage);
+BENCHMARK(BM_Interleaved)->Unit(benchmark::kMillisecond);
 
 // The variants trace the same rays: their hit counts agree (Stage counts
 // shown hits, which haze may lower; the raw casts stop at the same tfar).
