@@ -44,9 +44,9 @@
 #include <vector>
 
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include "runtime/engine/far_field_rays.h"
+#include "runtime/engine/far_field_stages.h"  // inArena: the stage's arena
 #include "runtime/engine/ray_scene.h"
 #include "runtime/engine/ray_set.h"
 #include "runtime/scene/city_file.h"
@@ -129,17 +129,6 @@ World& world() {
 void enableFtzDaz() {
     _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
     _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
-}
-
-// body() in an arena of `threads` workers (0 = the default arena: all cores).
-template <class F>
-void inArena(int threads, const F& body) {
-    if (threads > 0) {
-        tbb::task_arena arena(threads);
-        arena.execute(body);
-    } else {
-        body();
-    }
 }
 
 // Parallel over [0, n) in blocks of `grain`; f(begin, end) returns its hit count.
