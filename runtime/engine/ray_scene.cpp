@@ -11,6 +11,8 @@
 // (so the bake does not create a device per impostor); no robust flag.
 #include "runtime/engine/ray_scene.h"
 
+#include "runtime/engine/ray_packet.h"
+
 #include <embree3/rtcore.h>
 #include <pmmintrin.h>
 #include <xmmintrin.h>
@@ -383,20 +385,7 @@ void RayScene::intersectMany(const glm::vec3* org, const glm::vec3* dir, int n, 
     alignas(32) int valid[8];
     for (int base = 0; base < n; base += 8) {
         int m = std::min(8, n - base);
-        for (int k = 0; k < 8; ++k) {
-            int i = base + (k < m ? k : 0);
-            valid[k] = k < m ? -1 : 0;
-            rh.ray.org_x[k] = org[i].x; rh.ray.org_y[k] = org[i].y; rh.ray.org_z[k] = org[i].z;
-            rh.ray.dir_x[k] = dir[i].x; rh.ray.dir_y[k] = dir[i].y; rh.ray.dir_z[k] = dir[i].z;
-            rh.ray.tnear[k] = 0.0f;
-            rh.ray.tfar[k] = tfars ? tfars[i] : tfar;
-            rh.ray.time[k] = 0.0f;
-            rh.ray.mask[k] = 0xFFFFFFFFu;
-            rh.ray.id[k] = unsigned(k);
-            rh.ray.flags[k] = 0;
-            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
-        }
+        fillPacket8(rh, valid, org, dir, tfars, tfar, size_t(base), m);
         rtcIntersect8(valid, _impl->scene, &ctx, &rh);
         for (int k = 0; k < m; ++k) {
             RayHit& h = out[base + k];

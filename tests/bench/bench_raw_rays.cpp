@@ -47,6 +47,7 @@
 
 #include "runtime/engine/far_field_rays.h"
 #include "runtime/engine/far_field_stages.h"  // inArena: the stage's arena
+#include "runtime/engine/ray_packet.h"
 #include "runtime/engine/ray_scene.h"
 #include "runtime/engine/ray_set.h"
 #include "runtime/scene/city_file.h"
@@ -169,7 +170,7 @@ uint64_t raw1(RTCScene scene, const PrimaryRays& r, size_t b, size_t e) {
 
 // Raw rtcIntersect8 on rays [b, e) of a frame, in packets of 8 from b.
 // colours (optional): each hit's colour fetched through RayScene::hitColor.
-uint64_t raw8(RTCScene scene, const PrimaryRays& r, size_t b, size_t e, const RayScene* colours = nullptr) {
+uint64_t raw8(RTCScene scene, const Frame& f, size_t b, size_t e, const RayScene* colours = nullptr) {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
@@ -178,20 +179,7 @@ uint64_t raw8(RTCScene scene, const PrimaryRays& r, size_t b, size_t e, const Ra
     uint64_t hits = 0;
     for (size_t p = b; p < e; p += 8) {
         const int m = int(std::min<size_t>(8, e - p));
-        for (int k = 0; k < 8; ++k) {
-            const size_t i = p + size_t(k < m ? k : 0);
-            valid[k] = k < m ? -1 : 0;
-            rh.ray.org_x[k] = r.org.x; rh.ray.org_y[k] = r.org.y; rh.ray.org_z[k] = r.org.z;
-            rh.ray.dir_x[k] = r.dirs[i].x; rh.ray.dir_y[k] = r.dirs[i].y; rh.ray.dir_z[k] = r.dirs[i].z;
-            rh.ray.tnear[k] = 0.0f;
-            rh.ray.tfar[k] = r.tfars[i];
-            rh.ray.time[k] = 0.0f;
-            rh.ray.mask[k] = 0xFFFFFFFFu;
-            rh.ray.id[k] = unsigned(k);
-            rh.ray.flags[k] = 0;
-            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
-        }
+        fillPacket8(rh, valid, f.orgs.data(), f.rays.dirs.data(), f.rays.tfars.data(), 0.0f, p, m);
         rtcIntersect8(valid, scene, &ctx, &rh);
         for (int k = 0; k < m; ++k) hits += rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
         if (!colours) continue;
@@ -239,24 +227,24 @@ uint64_t passFrame(Variant v, Frame& f, int threads) {
             case Variant::Raw8:
                 hits += parallelHits(threads, nRuns, runGrain(f), [&](size_t b, size_t e) {
                     uint64_t h = 0;
-                    for (size_t r = b; r < e; ++r) h += raw8(scene, f.rays, f.runs[r], f.runs[r + 1]);
+                    for (size_t r = b; r < e; ++r) h += raw8(scene, f, f.runs[r], f.runs[r + 1]);
                     return h;
                 });
                 break;
             case Variant::Raw8Serial:
                 enableFtzDaz();
-                for (size_t r = 0; r < nRuns; ++r) hits += raw8(scene, f.rays, f.runs[r], f.runs[r + 1]);
+                for (size_t r = 0; r < nRuns; ++r) hits += raw8(scene, f, f.runs[r], f.runs[r + 1]);
                 break;
             case Variant::Raw8Color:
                 hits += parallelHits(threads, nRuns, runGrain(f), [&](size_t b, size_t e) {
                     uint64_t h = 0;
-                    for (size_t r = b; r < e; ++r) h += raw8(scene, f.rays, f.runs[r], f.runs[r + 1], w.scene.get());
+                    for (size_t r = b; r < e; ++r) h += raw8(scene, f, f.runs[r], f.runs[r + 1], w.scene.get());
                     return h;
                 });
                 break;
             case Variant::Raw8Dense:
                 hits += parallelHits(threads, (n + 7) / 8, kRaysPerTask / 8, [&](size_t b, size_t e) {
-                    return raw8(scene, f.rays, 8 * b, std::min(n, 8 * e));
+                    return raw8(scene, f, 8 * b, std::min(n, 8 * e));
                 });
                 break;
             case Variant::Many:
