@@ -17,6 +17,7 @@
 #include "nodes/render/offscreen.h"
 #include "runtime/engine/metrics.h"
 #include "runtime/engine/ray_scene.h"
+#include "runtime/engine/ray_set.h"
 
 namespace vista {
 
@@ -164,6 +165,20 @@ void reportProgress(const BenchConfig& cfg, size_t done, size_t total, const Sto
     if (tty && done == total) std::fprintf(stderr, "\n");
 }
 
+// --dump-rays: the pixels mode `m` traced in frame f as a RaySet file.
+Status dumpRays(const RenderMode& m, int f, const Camera& cam, const BenchConfig& cfg) {
+    const std::vector<uint32_t>* traced = m.lastTracedPixels();
+    if (cfg.dumpRaysDir.empty() || !traced || f % cfg.dumpRaysEvery != 0) return Status::ok();
+    RaySet set;
+    set.frame = uint32_t(f);
+    set.camera = cam;
+    set.hazeFar = cfg.options.effects.haze ? cfg.options.effects.hazeFar() : 0.0;
+    set.pixels = *traced;
+    char name[64];
+    std::snprintf(name, sizeof name, "_f%04d.rays", f);
+    return writeRaySet((fs::path(cfg.dumpRaysDir) / (m.name() + name)).string(), set);
+}
+
 // Renders every frame in every mode (interleaved) and scores it.
 Status renderFrames(BenchRun& run, const Path& path, const std::vector<size_t>& idx, const Camera& base,
                     const BenchConfig& cfg, BenchResult& result, FrameImages& images) {
@@ -184,6 +199,7 @@ Status renderFrames(BenchRun& run, const Path& path, const std::vector<size_t>& 
             rec.mode = run.modes[mi]->name();
             Status st = run.modes[mi]->renderFrame(cam, img, rec.stats);
             if (!st) return Status::error("mode " + rec.mode + ", frame " + std::to_string(f) + ": " + st.message());
+            VISTA_RETURN_IF_ERROR(dumpRays(*run.modes[mi], int(f), cam, cfg));
             if (!img.valid() || img.width != cfg.width || img.height != cfg.height)
                 return Status::error("mode " + rec.mode + " returned an image of the wrong size");
             if (mi == 0 && cfg.referenceSsaa < 2) ref = img;
@@ -217,6 +233,8 @@ Status validateBenchConfig(const BenchConfig& c) {
         return Status::error("--diff-threshold " + std::to_string(c.diffThreshold) + " out of range 0 .. 255");
     if (c.worstFrames < 0 || c.worstFrames > 100)
         return Status::error("--worst " + std::to_string(c.worstFrames) + " out of range 0 .. 100");
+    if (c.dumpRaysEvery < 1 || c.dumpRaysEvery > 1000000)
+        return Status::error("--dump-rays-every " + std::to_string(c.dumpRaysEvery) + " out of range 1 .. 1000000");
     if (c.modes.empty()) return Status::error("--modes: no mode given; available modes: " + renderModeNames());
     for (const auto& m : c.modes)
         if (!findRenderMode(m)) return Status::error("--modes: unknown mode '" + m + "'; available modes: " + renderModeNames());
@@ -232,6 +250,14 @@ Result<BenchResult> runBenchmark(const SceneModel* city, osg::Node* scene, const
         threads.reset(new tbb::global_control(tbb::global_control::max_allowed_parallelism, size_t(cfg.options.threads)));
     auto run = setUp(city, scene, cfg);
     if (!run) return run.status();
+    if (!cfg.dumpRaysDir.empty()) {
+        const auto& ms = (*run)->modes;
+        if (std::none_of(ms.begin(), ms.end(), [](const auto& m) { return m->lastTracedPixels() != nullptr; }))
+            return Status::error("--dump-rays: no mode among --modes has a far-field ray stage (hybrid has)");
+        std::error_code ec;
+        fs::create_directories(cfg.dumpRaysDir, ec);
+        if (ec) return Status::error("--dump-rays '" + cfg.dumpRaysDir + "': cannot create directory: " + ec.message());
+    }
     if (!cfg.outDir.empty()) {
         std::error_code ec;
         fs::create_directories(fs::path(cfg.outDir) / "images", ec);

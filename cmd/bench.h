@@ -42,6 +42,12 @@ struct BenchConfig {
     int diffThreshold = 8;         // for the differing-pixel fraction (0..255)
     int worstFrames = 2;           // difference images for the N worst frames per mode
     bool saveFrames = false;       // every frame of every mode as frames/f<NNNN>_<mode>.png
+    // Non-empty: every dumpRaysEvery-th frame (0, N, 2N, ...) of every mode
+    // with a far-field ray stage (RenderMode::lastTracedPixels: hybrid) is
+    // written as <dir>/<mode>_f<NNNN>.rays (RaySet, runtime/engine/ray_set.h),
+    // outside the timed frame. No such mode among `modes` is an error.
+    std::string dumpRaysDir;
+    int dumpRaysEvery = 1;         // 1 .. 1000000
     bool warmup = true;
     bool quiet = false;            // no progress on stderr
     ModeOptions options;

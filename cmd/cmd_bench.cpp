@@ -51,6 +51,9 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
     app.add_option("--diff-threshold", a.cfg.diffThreshold, "per-channel difference counted as a differing pixel (default 8)");
     app.add_option("--worst", a.cfg.worstFrames, "difference images for the N worst frames per mode (default 2)");
     app.add_flag("--save-frames", a.cfg.saveFrames, "also write every frame of every mode as OUT/frames/fNNNN_MODE.png");
+    app.add_option("--dump-rays", a.cfg.dumpRaysDir,
+                   "write the far-field rays each hybrid frame traced as DIR/MODE_fNNNN.rays (ray sets for bench_raw_rays)");
+    app.add_option("--dump-rays-every", a.cfg.dumpRaysEvery, "with --dump-rays: only every N-th frame, 1 .. 1000000 (default 1)");
     app.add_option("--out", a.out, "output directory (created if missing)")->required();
     app.add_option("--effects", a.effects,
                    "run-time effects for this run instead of the scene's: 'none', names (haze, glass, night) or a JSON "
@@ -98,6 +101,10 @@ Status configure(BenchArgs& a) {
         if (!fs::exists(a.city)) return Status::error("city file '" + a.city + "' does not exist");
     }
     VISTA_RETURN_IF_ERROR(checkWritableDirectory("--out", a.out));  // before any work, so a run never fails at its end
+    if (!a.cfg.dumpRaysDir.empty()) {
+        if (!a.sweep.empty()) return Status::error("--dump-rays is not supported with --sweep (one city per run)");
+        VISTA_RETURN_IF_ERROR(checkWritableDirectory("--dump-rays", a.cfg.dumpRaysDir));
+    }
     std::error_code ec;
     fs::path top = fs::path(a.out).lexically_normal();
     if (!top.has_filename()) top = top.parent_path();  // "out/" -> "out"

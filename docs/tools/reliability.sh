@@ -97,7 +97,8 @@ print("| target | input | seconds | executions | corpus after | result |")
 print("|---|---|---|---|---|---|")
 what = {"fuzz_params": "parameter file JSON (with effects)", "fuzz_street_graph": "street graph JSON in scene files",
         "fuzz_osm": "OSM XML extract", "fuzz_path_csv": "walkthrough path CSV", "fuzz_scene_file": "scene file (.osgb + trailer)",
-        "fuzz_cell_result": "bake work-directory cell result", "fuzz_baked_file": "baked scene file"}
+        "fuzz_cell_result": "bake work-directory cell result", "fuzz_baked_file": "baked scene file",
+        "fuzz_ray_set": "ray-set file (bench_raw_rays)"}
 for row in csv.DictReader(read("fuzz.tsv").splitlines(), delimiter="\t"):
     print(f"| {row['target']} | {what.get(row['target'], '')} | {row['seconds']} | {int(row['executions'] or 0):,} | {row['corpus']} | {row['result']} |")
 print()

@@ -72,6 +72,7 @@ public:
     }
     void reset() override { _far->reset(); }
     bool hazesRasterPixels() const override { return true; }  // FarFieldOptions::hazeCovered
+    const std::vector<uint32_t>* lastTracedPixels() const override { return &_far->lastTraced(); }
 
     osg::Node* viewerScene() override {
         if (!_viewer) {

@@ -165,6 +165,7 @@ public:
         return Status::ok();
     }
     void reset() override { _inner->reset(); }
+    const std::vector<uint32_t>* lastTracedPixels() const override { return _inner->lastTracedPixels(); }
     osg::Node* viewerScene() override {
         if (!_viewer) {
             _viewer = new osg::Group;

@@ -111,6 +111,10 @@ public:
     // True when the mode hazes its drawn pixels itself (both faces): the
     // effects wrapper then keeps the haze program out of the rasteriser.
     virtual bool hazesRasterPixels() const { return false; }
+    // The pixels the far-field ray stage of the last renderFrame() cast
+    // (FarField::lastTraced(), ascending), or null for a mode without one
+    // (all but hybrid). `vista bench --dump-rays` writes them as RaySet files.
+    virtual const std::vector<uint32_t>* lastTracedPixels() const { return nullptr; }
     const SetupTimes& setupMs() const { return _setup; }
 
 protected:

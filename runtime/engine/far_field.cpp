@@ -60,7 +60,12 @@ void FarField::render(const Camera& camera, const float* depth, Image& out, Fram
     f.moving = _mem->haveLast && !sameCamera(_mem->last, camera);
     _mem->last = camera;
     _mem->haveLast = true;
+    renderStages(f, depth, stats);
+    _traced = std::move(f.trace);
+}
 
+void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) {
+    const Camera& camera = f.camera;
     opacityStage(f, stats);
     if (seamCheckApplies(f, _rays, _options)) seamStage(f, _rays, _options, stats);
     if (_options.hazeCovered && _options.effects.haze && depth && f.covered > 0) hazeCoveredStage(f, _options, stats);

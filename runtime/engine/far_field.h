@@ -52,6 +52,7 @@ namespace vista {
 
 class RayScene;
 struct FarFieldMemory;
+struct FarFrame;
 
 // Pixel classes of classification() (see above).
 enum FarPixelClass : uint8_t { kFarCovered = 0, kFarHorizon = 1, kFarCache = 2, kFarRayHit = 3, kFarRayMiss = 4 };
@@ -104,13 +105,19 @@ public:
     void reset();
     // Per pixel of the last frame: a FarPixelClass (0 covered, 1 horizon, 2 cache, 3 hit, 4 miss).
     const std::vector<uint8_t>& classification() const { return _class; }
+    // The pixels the ray stage of the last frame cast (ascending indices
+    // y * width + x; empty when it did not run): rayHit/rayMiss pixels that
+    // were not covered. Seam-check rays are not in it. RaySet files record it.
+    const std::vector<uint32_t>& lastTraced() const { return _traced; }
 
 private:
+    void renderStages(FarFrame& f, const float* depth, FrameStats& stats);
     const RayScene& _rays;
     const HeightGrid* _grid;
     FarFieldOptions _options;
     std::unique_ptr<FarFieldMemory> _mem;  // cache, last frame, sky (far_field_stages.h)
     std::vector<uint8_t> _class;
+    std::vector<uint32_t> _traced;
 };
 
 }  // namespace vista

@@ -44,6 +44,11 @@ struct PixelList {
     uint32_t operator[](size_t k) const { return idx ? idx[k] : uint32_t(k); }
 };
 
+// Far limit of a ray (unit direction d) that stops at eye-plane depth zMax.
+float hazeTfar(const glm::dvec3& d, const glm::dvec3& fwd, double zMax) {
+    return float(zMax / std::max(glm::dot(d, fwd), 1e-6)) * (1.0f + 1e-6f);
+}
+
 // Casts the entries runs[r] .. runs[r + 1] - 1 of every run r in packets of 8.
 void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, const std::vector<size_t>& runs, Image& out,
               RayCounts& counts, int threads, uint8_t* hit, const RayShading& shading) {
@@ -78,7 +83,7 @@ void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, con
                     const uint32_t i = pixels[b + k];
                     ddirs[k] = gen.dir(int(i % W), int(i / W));
                     dirs[k] = glm::vec3(ddirs[k]);
-                    if (fx.haze) tfars[k] = float(zMax / std::max(glm::dot(ddirs[k], fwd), 1e-6)) * (1.0f + 1e-6f);
+                    if (fx.haze) tfars[k] = hazeTfar(ddirs[k], fwd, zMax);
                 }
                 scene.intersectMany(orgs.data(), dirs.data(), int(m), res.data(), 1e30f, fx.haze ? tfars.data() : nullptr);
                 for (size_t k = 0; k < m; ++k) {
@@ -104,16 +109,37 @@ void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, con
 void castPrimaryRays(const RayScene& scene, const Camera& camera, const uint32_t* pixels, size_t n, Image& out,
                      RayCounts& counts, int threads, uint8_t* hit, const RayShading& shading) {
     VISTA_CHECK(out.width == camera.width && out.height == camera.height && out.valid());
-    const uint32_t W = uint32_t(camera.width), N = uint32_t(size_t(camera.width) * size_t(camera.height));
-    // Runs: a new run starts at a row change once the current one fills a
-    // packet (dense rows stay alone; sparse rows share packets).
-    std::vector<size_t> runs;  // start of every run, then n
-    for (size_t k = 0; k < n; ++k) {
-        VISTA_CHECK(pixels[k] < N);
+    const uint32_t N = uint32_t(size_t(camera.width) * size_t(camera.height));
+    for (size_t k = 0; k < n; ++k) VISTA_CHECK(pixels[k] < N);
+    castRuns(scene, camera, PixelList{pixels}, coherentRuns(pixels, n, camera.width), out, counts, threads, hit, shading);
+}
+
+std::vector<size_t> coherentRuns(const uint32_t* pixels, size_t n, int width) {
+    const uint32_t W = uint32_t(width);
+    // A new run starts at a row change once the current one fills a packet
+    // (dense rows stay alone; sparse rows share packets).
+    std::vector<size_t> runs;
+    for (size_t k = 0; k < n; ++k)
         if (k == 0 || (pixels[k] / W != pixels[k - 1] / W && k - runs.back() >= kPacket)) runs.push_back(k);
-    }
     runs.push_back(n);
-    castRuns(scene, camera, PixelList{pixels}, runs, out, counts, threads, hit, shading);
+    return runs;
+}
+
+PrimaryRays primaryRays(const Camera& camera, const glm::dvec3& frameOrigin, const uint32_t* pixels, size_t n,
+                        double hazeFar) {
+    const PixelRays gen(camera);
+    const glm::dvec3 fwd = camera.forward();
+    const uint32_t W = uint32_t(camera.width);
+    PrimaryRays r;
+    r.org = glm::vec3(camera.eye - frameOrigin);
+    r.dirs.resize(n);
+    r.tfars.assign(n, 1e30f);
+    for (size_t k = 0; k < n; ++k) {
+        const glm::dvec3 d = gen.dir(int(pixels[k] % W), int(pixels[k] / W));
+        r.dirs[k] = glm::vec3(d);
+        if (hazeFar > 0) r.tfars[k] = hazeTfar(d, fwd, hazeFar);
+    }
+    return r;
 }
 
 void castFrame(const RayScene& scene, const Camera& camera, Image& out, RayCounts& counts, int threads,

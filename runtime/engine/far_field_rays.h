@@ -22,6 +22,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -55,6 +56,22 @@ glm::u8vec4 primarySkyColor(const glm::dvec3& dir);
 
 // Smallest cos(angle to the forward axis) of any pixel-centre ray of the camera (the corners).
 double minForwardCosine(const Camera& camera);
+
+// The packet grouping of castPrimaryRays for a pixel list: the start of
+// every run (see Coherence above), then n. Empty list: {0}.
+std::vector<size_t> coherentRuns(const uint32_t* pixels, size_t n, int width);
+
+// The rays castPrimaryRays casts for the listed pixels, bit for bit: the eye
+// in the scene-local frame around `frameOrigin`, unit float directions, and
+// far limits (hazeFar > 0: where the ray's eye-plane depth reaches hazeFar;
+// else 1e30). For timing the stage against raw Embree (bench_raw_rays).
+struct PrimaryRays {
+    glm::vec3 org{0.0f};
+    std::vector<glm::vec3> dirs;
+    std::vector<float> tfars;
+};
+PrimaryRays primaryRays(const Camera& camera, const glm::dvec3& frameOrigin, const uint32_t* pixels, size_t n,
+                        double hazeFar);
 
 struct RayCounts {
     uint64_t rays = 0;  // rays cast (hit or miss)

@@ -4,10 +4,14 @@
 // scene-local float frame around frameOrigin); one child scene per tree
 // prototype, instanced with RTC_GEOMETRY_TYPE_INSTANCE per SceneInstance.
 // Hit colours: barycentric interpolation of the prelit vertex colours, rounded
-// to 8 bits exactly as the fixed-function rasteriser does.
+// to 8 bits exactly as the fixed-function rasteriser does; the colours are kept
+// per triangle (primID -> its three corners), so a hit costs one memory fetch
+// (docs/raw-rays.md: the colour fetch was the wrapper's largest cost).
 // A soup scene: one triangle geometry on a device shared by all soup scenes
 // (so the bake does not create a device per impostor); no robust flag.
 #include "runtime/engine/ray_scene.h"
+
+#include "runtime/engine/ray_packet.h"
 
 #include <embree3/rtcore.h>
 #include <pmmintrin.h>
@@ -54,20 +58,33 @@ void errorCallback(void* userPtr, RTCError code, const char* str) {
         sink->first = std::string("Embree error (") + embreeErrorName(code) + "): " + (str ? str : "");
 }
 
-// Colour of a hit: barycentric interpolation, rounded like GL's unorm conversion.
-glm::u8vec4 interpolateColor(const std::vector<glm::u8vec4>& colors, const std::vector<uint32_t>& indices,
-                             uint32_t prim, float u, float v) {
-    size_t base = size_t(prim) * 3;
-    if (base + 2 >= indices.size()) return {255, 0, 255, 255};  // cannot happen for a valid scene
-    const glm::u8vec4& c0 = colors[indices[base]];
-    const glm::u8vec4& c1 = colors[indices[base + 1]];
-    const glm::u8vec4& c2 = colors[indices[base + 2]];
+// The prelit colours of a triangle's corners, stored per triangle: a hit
+// reads one 12-byte record instead of an index and then three vertex colours
+// (one dependent cache miss instead of two on a large city).
+struct TriColors {
+    glm::u8vec4 c[3];
+};
+
+std::vector<TriColors> triangleColors(const std::vector<glm::u8vec4>& colors, const std::vector<uint32_t>& indices) {
+    std::vector<TriColors> t(indices.size() / 3);
+    for (size_t i = 0; i < t.size(); ++i)
+        for (int k = 0; k < 3; ++k) t[i].c[k] = colors[indices[3 * i + size_t(k)]];
+    return t;
+}
+
+// Colour of a hit: barycentric interpolation, rounded like GL's unorm
+// conversion (half away from zero, as std::lround, for c in [0, 255]:
+// c - trunc(c) is exact there).
+glm::u8vec4 interpolateColor(const std::vector<TriColors>& tris, uint32_t prim, float u, float v) {
+    if (prim >= tris.size()) return {255, 0, 255, 255};  // cannot happen for a valid scene
+    const TriColors& t = tris[prim];
     float w = 1.0f - u - v;
     glm::u8vec4 out;
     for (int k = 0; k < 4; ++k) {
-        float c = w * float(c0[k]) + u * float(c1[k]) + v * float(c2[k]);
+        float c = w * float(t.c[0][k]) + u * float(t.c[1][k]) + v * float(t.c[2][k]);
         c = std::min(255.0f, std::max(0.0f, c));
-        out[k] = uint8_t(std::lround(c));
+        const int r = int(c);
+        out[k] = uint8_t(r + (c - float(r) >= 0.5f ? 1 : 0));
     }
     return out;
 }
@@ -101,13 +118,12 @@ struct RayScene::Impl {
 
     // Per top-level geometry id: what it is.
     struct GeomInfo {
-        int mesh = -1;       // index into meshColors/meshIndices, or -1 for an instance
+        int mesh = -1;       // index into meshColors, or -1 for an instance
         int prototype = -1;  // prototype index for an instance
         glm::mat3 normalMatrix{1.0f};
     };
     std::vector<GeomInfo> geoms;
-    std::vector<std::vector<glm::u8vec4>> meshColors, protoColors;
-    std::vector<std::vector<uint32_t>> meshIndices, protoIndices;
+    std::vector<std::vector<TriColors>> meshColors, protoColors;  // per triangle (primID)
 
     ~Impl() {
         if (scene) rtcReleaseScene(scene);
@@ -136,13 +152,13 @@ struct RayScene::Impl {
             h.instId = instID;
             h.geomId = geomID;
             const GeomInfo& gi = geoms[instID];
-            h.color = interpolateColor(protoColors[size_t(gi.prototype)], protoIndices[size_t(gi.prototype)], primID, u, v);
+            h.color = interpolateColor(protoColors[size_t(gi.prototype)], primID, u, v);
             n = gi.normalMatrix * n;
         } else {
             h.instId = 0xFFFFFFFFu;
             h.geomId = geomID;
             const GeomInfo& gi = geoms[geomID];
-            h.color = interpolateColor(meshColors[size_t(gi.mesh)], meshIndices[size_t(gi.mesh)], primID, u, v);
+            h.color = interpolateColor(meshColors[size_t(gi.mesh)], primID, u, v);
         }
         float len = glm::length(n);
         h.normal = len > 0 ? n / len : glm::vec3(0, 0, 1);
@@ -238,8 +254,7 @@ Result<std::unique_ptr<RayScene>> RayScene::build(const SceneModel& city) {
         }
         if (im.geoms.size() <= id) im.geoms.resize(id + 1);
         im.geoms[id].mesh = int(im.meshColors.size());
-        im.meshColors.push_back(m.colors);
-        im.meshIndices.push_back(m.indices);
+        im.meshColors.push_back(triangleColors(m.colors, m.indices));
         im.triangles += m.indices.size() / 3;
     }
 
@@ -249,8 +264,7 @@ Result<std::unique_ptr<RayScene>> RayScene::build(const SceneModel& city) {
     for (size_t pi = 0; pi < city.prototypes.size(); ++pi) {
         const SceneMesh& p = city.prototypes[pi];
         if (!validMesh(p)) return Status::error("ray scene: tree prototype " + std::to_string(pi) + " is malformed");
-        im.protoColors.push_back(p.colors);
-        im.protoIndices.push_back(p.indices);
+        im.protoColors.push_back(triangleColors(p.colors, p.indices));
         if (p.indices.empty()) continue;
         RTCScene s = rtcNewScene(im.device);
         rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
@@ -327,8 +341,7 @@ Result<std::unique_ptr<RayScene>> RayScene::build(const TriangleSoup& soup, cons
                                  std::to_string(soup.triangleCount()) + " triangles");
         if (im.geoms.size() <= id) im.geoms.resize(id + 1);
         im.geoms[id].mesh = 0;
-        im.meshColors.push_back(soup.colors);
-        im.meshIndices.push_back(soup.indices);
+        im.meshColors.push_back(triangleColors(soup.colors, soup.indices));
         im.triangles = soup.triangleCount();
     }
     rtcCommitScene(im.scene);
@@ -372,20 +385,7 @@ void RayScene::intersectMany(const glm::vec3* org, const glm::vec3* dir, int n, 
     alignas(32) int valid[8];
     for (int base = 0; base < n; base += 8) {
         int m = std::min(8, n - base);
-        for (int k = 0; k < 8; ++k) {
-            int i = base + (k < m ? k : 0);
-            valid[k] = k < m ? -1 : 0;
-            rh.ray.org_x[k] = org[i].x; rh.ray.org_y[k] = org[i].y; rh.ray.org_z[k] = org[i].z;
-            rh.ray.dir_x[k] = dir[i].x; rh.ray.dir_y[k] = dir[i].y; rh.ray.dir_z[k] = dir[i].z;
-            rh.ray.tnear[k] = 0.0f;
-            rh.ray.tfar[k] = tfars ? tfars[i] : tfar;
-            rh.ray.time[k] = 0.0f;
-            rh.ray.mask[k] = 0xFFFFFFFFu;
-            rh.ray.id[k] = unsigned(k);
-            rh.ray.flags[k] = 0;
-            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
-        }
+        fillPacket8(rh, valid, org, dir, tfars, tfar, size_t(base), m);
         rtcIntersect8(valid, _impl->scene, &ctx, &rh);
         for (int k = 0; k < m; ++k) {
             RayHit& h = out[base + k];
@@ -430,15 +430,15 @@ glm::vec3 RayScene::hitColor(const RayHit& h) const {
     if (!h.hit) return glm::vec3(0.0f);
     const bool inst = h.instId != 0xFFFFFFFFu;
     const Impl::GeomInfo& gi = _impl->geoms[inst ? h.instId : h.geomId];
-    const auto& colors = inst ? _impl->protoColors[size_t(gi.prototype)] : _impl->meshColors[size_t(gi.mesh)];
-    const auto& indices = inst ? _impl->protoIndices[size_t(gi.prototype)] : _impl->meshIndices[size_t(gi.mesh)];
-    const size_t base = size_t(h.primId) * 3;
-    if (base + 2 >= indices.size()) return {1.0f, 0.0f, 1.0f};  // cannot happen for a hit of this scene
-    const glm::vec3 c0 = glm::vec3(colors[indices[base]]) / 255.0f, c1 = glm::vec3(colors[indices[base + 1]]) / 255.0f,
-                    c2 = glm::vec3(colors[indices[base + 2]]) / 255.0f;
+    const auto& tris = inst ? _impl->protoColors[size_t(gi.prototype)] : _impl->meshColors[size_t(gi.mesh)];
+    if (h.primId >= tris.size()) return {1.0f, 0.0f, 1.0f};  // cannot happen for a hit of this scene
+    const TriColors& t = tris[h.primId];
+    const glm::vec3 c0 = glm::vec3(t.c[0]) / 255.0f, c1 = glm::vec3(t.c[1]) / 255.0f, c2 = glm::vec3(t.c[2]) / 255.0f;
     return (1.0f - h.u - h.v) * c0 + h.u * c1 + h.v * c2;
 }
 
 size_t RayScene::triangleCount() const { return _impl->triangles; }
+
+RTCSceneTy* RayScene::embreeScene() const { return _impl->scene; }
 
 }  // namespace vista

@@ -29,6 +29,8 @@
 #include "foundation/status.h"
 #include "runtime/scene/scene_model.h"
 
+struct RTCSceneTy;  // Embree's scene handle (RTCScene), opaque here
+
 namespace vista {
 
 struct RayHit {
@@ -77,6 +79,10 @@ public:
     // The prelit colour at a hit, interpolated and not rounded: RGB 0..1.
     glm::vec3 hitColor(const RayHit& h) const;
     size_t triangleCount() const;  // rendered triangles (instances expanded)
+    // The committed Embree scene (RTCScene), for timing raw Embree on the same
+    // BVH (tests/bench/bench_raw_rays.cpp). Read-only queries only; owned
+    // here (never release or modify it); the caller sets FTZ/DAZ itself.
+    RTCSceneTy* embreeScene() const;
 
 private:
     RayScene();
