@@ -56,7 +56,7 @@ def tests_summary(text):
 print("# Reliability: fuzzing, sanitizers, faults, soak")
 print()
 print("Regenerate with `docs/tools/reliability.sh [FUZZ_SECONDS] [SOAK_FRAMES]` (this run: "
-      f"{fuzz_s} s per fuzz target, {soak_n} soak frames; {datetime.date.today()}; 2 cores, no GPU, Mesa llvmpipe)."
+      f"up to {fuzz_s} s per fuzz target (FUZZ_RUNS stops a target earlier), {soak_n} soak frames; {datetime.date.today()}; 2 cores, no GPU, Mesa llvmpipe)."
       + (f" Results of the {', '.join(reused)} step(s) were run separately and passed in (FUZZ_TSV / SANITIZE_LOG / SOAK_CSV)." if reused else ""))
 print()
 print("## Findings and their regression tests")
