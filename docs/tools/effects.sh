@@ -113,21 +113,15 @@ bench haze2k_fly_haze haze fly $FH
 bench haze2k_fly_none haze fly $FH --effects none
 drop haze
 
-# 3. haze payoff, 4 km.
-gen haze4k haze --size 4000
-for k in car fly; do
-  bench "haze4k_${k}_haze" haze4k "$k" $FH
-  bench "haze4k_${k}_none" haze4k "$k" $FH --effects none
+# 3. haze payoff, 4 km and 8 km (64 km2: much of the city lies beyond the visibility).
+for km in 4 8; do
+  gen "haze${km}k" haze --size "${km}000"
+  for k in car fly; do
+    bench "haze${km}k_${k}_haze" "haze${km}k" "$k" $FH
+    bench "haze${km}k_${k}_none" "haze${km}k" "$k" $FH --effects none
+  done
+  drop "haze${km}k"
 done
-drop haze4k
-
-# 3. haze payoff, 8 km (64 km2): much of the city lies beyond the visibility.
-gen haze8k haze --size 8000
-for k in car fly; do
-  bench "haze8k_${k}_haze" haze8k "$k" $FH
-  bench "haze8k_${k}_none" haze8k "$k" $FH --effects none
-done
-drop haze8k
 
 # 2. Baked knobs on the 1 km centre of the same parameters (the 2 km references would take
 # ~10 more minutes): sun_shadows resolution_m {8,4,2,1} (samples 8), reference 0.5 m with 16
