@@ -233,6 +233,8 @@ Status validateBenchConfig(const BenchConfig& c) {
         return Status::error("--diff-threshold " + std::to_string(c.diffThreshold) + " out of range 0 .. 255");
     if (c.worstFrames < 0 || c.worstFrames > 100)
         return Status::error("--worst " + std::to_string(c.worstFrames) + " out of range 0 .. 100");
+    if (c.sampleRuns < 0 || c.sampleRuns > 100000)
+        return Status::error("--sampling runs:" + std::to_string(c.sampleRuns) + " out of range 1 .. 100000");
     if (c.dumpRaysEvery < 1 || c.dumpRaysEvery > 1000000)
         return Status::error("--dump-rays-every " + std::to_string(c.dumpRaysEvery) + " out of range 1 .. 1000000");
     if (c.modes.empty()) return Status::error("--modes: no mode given; available modes: " + renderModeNames());
@@ -268,7 +270,7 @@ Result<BenchResult> runBenchmark(const SceneModel* city, osg::Node* scene, const
     base.height = cfg.height;
     base.fovY = degToRad(cfg.fovYDeg);
     base.zNear = cfg.zNear;
-    const std::vector<size_t> idx = path.spread(size_t(cfg.frames));
+    const std::vector<size_t> idx = path.frames(size_t(cfg.frames), cfg.sampleRuns);
     if (cfg.warmup) VISTA_RETURN_IF_ERROR(warmUp(**run, path.camera(idx[0], base)));
 
     BenchResult result;

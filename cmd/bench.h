@@ -34,6 +34,7 @@ namespace vista {
 struct BenchConfig {
     int width = 640, height = 480;
     int frames = 120;
+    int sampleRuns = kDefaultSampleRuns;  // 0 = frames spread over the path; k = k runs of consecutive samples
     double fovYDeg = 60.0;
     double zNear = 0.3;
     std::vector<std::string> modes{"full", "near"};

@@ -29,6 +29,7 @@ const char* const kCmd = "vista bench";
 
 struct BenchArgs {
     std::string city, size = "640x480", modes = "full,near", out, reference = "full", fov = "60", sweep, effects;
+    std::string sampling = "runs:" + std::to_string(kDefaultSampleRuns);
     std::vector<fs::path> createdOut;  // directories of --out made by this run, deepest first
     bool quiet = false;
     PathFlags path;
@@ -42,7 +43,11 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
     for (const auto& m : renderModes()) modeHelp += std::string("\n    ") + m.name + ": " + m.summary;
     app.add_option("city", a.city, "city scene file (.osgb); not needed with --sweep");
     addPathFlags(app, a.path, true);
-    app.add_option("--frames", a.cfg.frames, "frames rendered, spread evenly over the whole path (default 120)");
+    app.add_option("--frames", a.cfg.frames, "frames rendered, sampled from the path as --sampling says (default 120)");
+    app.add_option("--sampling", a.sampling,
+                   "which path samples are the frames: 'spread' (evenly over the whole path), 'consecutive' (the first "
+                   "N samples, as a simulator renders them) or 'runs:K' (K runs of consecutive samples, their starts "
+                   "spread over the path) (default runs:" + std::to_string(kDefaultSampleRuns) + ")");
     app.add_option("--size", a.size, "image size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 640x480)");
     app.add_option("--modes", a.modes, modeHelp);
     addModeFlags(app, a.mode);
@@ -81,6 +86,9 @@ Status configure(BenchArgs& a) {
     auto fov = parseFov(a.fov);
     if (!fov) return fov.status();
     a.cfg.fovYDeg = fov.value();
+    auto sampling = parseSampling(a.sampling);
+    if (!sampling) return sampling.status();
+    a.cfg.sampleRuns = sampling.value();
     auto ref = parseReference(a.reference);
     if (!ref) return ref.status();
     a.cfg.referenceSsaa = ref.value();

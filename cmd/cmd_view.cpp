@@ -51,6 +51,8 @@ struct ViewArgs {
     std::string city, size = "1280x720", screenshot, mode = "full", fov = "60", effects;
     int frames = 0;
     bool step = false, noHud = false;
+    std::string sampling = "runs:" + std::to_string(kDefaultSampleRuns);
+    int sampleRuns = kDefaultSampleRuns;
     PathFlags path;
     ModeFlags modeFlags;
     ImageSize window;
@@ -59,7 +61,6 @@ struct ViewArgs {
 
 void declareFlags(CLI::App& app, ViewArgs& a) {
     a.path.seed = 0;  // no playback unless asked
-    a.modeFlags.budget = "20000";
     app.add_option("city", a.city, "city scene file (.osgb), or a baked file from 'vista bake' (adds the impostor mode)")->required();
     addPathFlags(app, a.path, true);
     app.get_option("--seed")->description("play back the path of this seed (key 5); default 0 = none, start where seed 1's path starts");
@@ -70,6 +71,9 @@ void declareFlags(CLI::App& app, ViewArgs& a) {
     app.add_option("--frames", a.frames, "quit after N frames (0 = run until Esc)");
     app.add_flag("--step", a.step,
                  "with --frames N and a path: show the N frames `vista bench --frames N` renders (one path sample per frame)");
+    app.add_option("--sampling", a.sampling,
+                   "with --step: the path samples shown, as vista bench's --sampling: spread, consecutive or runs:K "
+                   "(default runs:" + std::to_string(kDefaultSampleRuns) + ")");
     app.add_flag("--no-hud", a.noHud, "no text overlay (for screenshots compared with `vista bench`)");
     app.add_option("--screenshot", a.screenshot, "write a PNG of the last frame (use with --frames)");
     app.add_option("--effects", a.effects,
@@ -86,6 +90,9 @@ Status configure(ViewArgs& a, ModeOptions& options) {
     a.fovDeg = fov.value();
     if (auto m = parseModeName(a.mode); !m) return m.status();
     if (a.frames < 0) return Status::error("--frames " + std::to_string(a.frames) + " out of range 0 .. (0 = until Esc)");
+    auto sampling = parseSampling(a.sampling);
+    if (!sampling) return sampling.status();
+    a.sampleRuns = sampling.value();
     if (a.step && (a.frames < 1 || (a.path.file.empty() && a.path.seed == 0)))
         return Status::error("--step needs --frames N >= 1 and a path (--path or --seed)");
     if (!a.screenshot.empty()) VISTA_RETURN_IF_ERROR(checkWritablePath("--screenshot", a.screenshot));
@@ -357,7 +364,7 @@ void showMode(ViewState& v, ViewModes& modes, const std::string& name) {
 // hook and far plane, sky, HUD, draw; the screenshot after the last frame.
 int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path, bool playback) {
     osg::Camera* cam = v.viewer.getCamera();
-    const std::vector<size_t> stepFrames = a.step ? path.spread(size_t(a.frames)) : std::vector<size_t>();
+    const std::vector<size_t> stepFrames = a.step ? path.frames(size_t(a.frames), a.sampleRuns) : std::vector<size_t>();
     Stopwatch sw;
     double lastMs = 0;
     for (int n = 0; !v.viewer.done(); ++n) {

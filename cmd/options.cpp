@@ -199,6 +199,21 @@ Result<std::vector<std::string>> parseModeList(const std::string& list) {
     return out;
 }
 
+Result<int> parseSampling(const std::string& s) {
+    if (s == "spread") return 0;
+    if (s == "consecutive") return 1;
+    const std::string prefix = "runs:";
+    if (s.rfind(prefix, 0) == 0) {
+        const std::string k = s.substr(prefix.size());
+        char* end = nullptr;
+        errno = 0;
+        const long v = std::strtol(k.c_str(), &end, 10);
+        if (!k.empty() && *end == 0 && errno == 0 && v >= 1 && v <= 100000) return int(v);
+        return Status::error("--sampling '" + s + "': K out of range 1 .. 100000 (runs:K)");
+    }
+    return Status::error("--sampling '" + s + "': expected spread, consecutive or runs:K (K in 1 .. 100000)");
+}
+
 Result<std::vector<int>> parseSweep(const std::string& s) {
     const std::string prefix = "sizes=";
     if (s.rfind(prefix, 0) != 0) return Status::error("--sweep '" + s + "': expected sizes=S1,S2,... (metres)");
@@ -224,10 +239,16 @@ void addModeFlags(CLI::App& app, ModeFlags& f) {
                    "hybrid: near field = the nearest 40 m chunks up to N triangles instead of --near, 0 .. 10000000000 "
                    "(default " + f.triangleBudget + " = off)");
     app.add_option("--budget", f.budget,
-                   "hybrid: far-field rays per frame through the panoramic cache, 0 .. 1000000000, or 'unlimited' / -1 = "
-                   "trace every far pixel, cache bypassed (default " + f.budget + ")");
+                   "hybrid: most far-field rays per frame (the cache re-traces its worst pixels first), 0 .. 1000000000, "
+                   "or 'unlimited' / -1 = no cap: every pixel over --cache-error is re-traced (default " + f.budget + ")");
     app.add_option("--horizon-grid", f.horizonGrid, "hybrid: horizon height-grid resolution, cells per side, 1 .. 8192 (default 512)");
     app.add_flag("--no-cache", f.noCache, "hybrid: panoramic image cache off (every far pixel traced)");
+    app.add_option("--cache-error", f.cacheError,
+                   "hybrid: reuse a cached far pixel while its estimated reprojection error is below this many pixels, "
+                   "0 .. 100 (0 = only pixels traced by this very camera) (default 0.5)");
+    app.add_option("--frame-ms", f.frameMs,
+                   "hybrid: frame-time target in ms, 0 .. 10000: the far-field ray budget adapts to what the target leaves "
+                   "after the near field (0 = no target) (default 0)");
     app.add_option("--baked", f.baked, "impostor: the baked file of this city (from `vista bake`)");
     app.add_option("--threads", f.threads, "worker threads for ray casting, 0 .. 1024 (0 = all cores)");
 }
@@ -240,6 +261,10 @@ Status checkModeOptions(const ModeOptions& o) {
                              std::to_string(kMaxTriangleBudget) + " triangles");
     if (o.horizonGrid < 1 || o.horizonGrid > 8192)
         return Status::error("--horizon-grid " + std::to_string(o.horizonGrid) + " out of range 1 .. 8192 cells per side");
+    if (!(o.cacheErrorPx >= 0 && o.cacheErrorPx <= 100))
+        return Status::error("--cache-error " + std::to_string(o.cacheErrorPx) + " out of range 0 .. 100 pixels");
+    if (!(o.frameMsTarget >= 0 && o.frameMsTarget <= 10000))
+        return Status::error("--frame-ms " + std::to_string(o.frameMsTarget) + " out of range 0 .. 10000 ms (0 = no target)");
     if (o.threads < 0 || o.threads > 1024)
         return Status::error("--threads " + std::to_string(o.threads) + " out of range 0 .. 1024 (0 = all cores)");
     return Status::ok();
@@ -259,6 +284,8 @@ Status parseModeFlags(const ModeFlags& f, ModeOptions& o) {
     o.pixelBudget = pb.value();
     o.horizonGrid = f.horizonGrid;
     o.cache = !f.noCache;
+    o.cacheErrorPx = f.cacheError;
+    o.frameMsTarget = f.frameMs;
     o.bakedFile = f.baked;
     o.threads = f.threads;
     return checkModeOptions(o);

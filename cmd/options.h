@@ -8,7 +8,7 @@
 // PathFlags: the walkthrough options (--path, --seed, --kind, --duration,
 // --run-up) of bench and view. ModeFlags: the render-mode options both `vista bench` and `vista view`
 // accept (--near, --triangle-budget, --budget, --horizon-grid, --no-cache,
-// --baked, --threads), declared once by addModeFlags() and turned into
+// --cache-error, --frame-ms, --baked, --threads), declared once by addModeFlags() and turned into
 // ModeOptions by parseModeFlags().
 #pragma once
 #include <cstdint>
@@ -52,6 +52,9 @@ Status checkFov(double degrees);
 Result<int> parseReference(const std::string& s);
 // --modes a,b,c: registered modes (render_mode.h), comma-separated, no duplicates.
 Result<std::vector<std::string>> parseModeList(const std::string& s);
+// --sampling spread|consecutive|runs:K (K in 1 .. 100000): 0 = spread, 1 =
+// consecutive, K = runs (Path::frames).
+Result<int> parseSampling(const std::string& s);
 // --mode NAME: one registered mode.
 Result<std::string> parseModeName(const std::string& s);
 // vista bake: --cells "3,7,10-20" -> sorted unique ids (0 .. 1e8); --shard K/N
@@ -77,6 +80,7 @@ struct ModeFlags {
     std::string near = "100", triangleBudget = "0", budget = "unlimited";
     int horizonGrid = 512;
     bool noCache = false;
+    double cacheError = 0.5, frameMs = 0.0;
     std::string baked;
     int threads = 0;
 };

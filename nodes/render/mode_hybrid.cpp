@@ -121,6 +121,8 @@ private:
         o.nearIsDistance = !byBudget();
         o.pixelBudget = _ctx.options.pixelBudget;
         o.cache = _ctx.options.cache;
+        o.cacheErrorPx = _ctx.options.cacheErrorPx;
+        o.frameMsTarget = _ctx.options.frameMsTarget;
         o.threads = _ctx.options.threads;
         o.effects = _ctx.options.effects;
         o.depthZFar = effectsFarPlane(zFar, o.effects);  // the projection the renderer used

@@ -81,11 +81,19 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
     }
     if (_options.horizon) horizonStage(f, _grid, _options, stats);
     listPending(f);
-    const bool useCache = _options.cache && _options.pixelBudget >= 0;
+    const bool useCache = _options.cache;
     if (useCache && !f.pending.empty()) cacheStage(f, *_mem, _options, stats);
-    else bypassCache(f, _options, stats);
-    if (!f.trace.empty()) raysStage(f, _rays, _options.threads, stats);
+    else bypassCache(f);
+    if (!f.trace.empty()) {
+        const double before = stats.stages.ms(Stage::Rays);
+        raysStage(f, _rays, _options.threads, stats);
+        const double perRay = (stats.stages.ms(Stage::Rays) - before) / double(f.trace.size());
+        _mem->msPerRay = _mem->msPerRay > 0 ? 0.8 * _mem->msPerRay + 0.2 * perRay : perRay;
+    }
+    const double before = stats.stages.ms(Stage::Composite);
     compositeStage(f, *_mem, useCache, stats);
+    const double composite = stats.stages.ms(Stage::Composite) - before;
+    _mem->compositeMs = _mem->compositeMs > 0 ? 0.8 * _mem->compositeMs + 0.2 * composite : composite;
 }
 
 }  // namespace vista

@@ -28,8 +28,7 @@
 // nothing after opacity; no far geometry (city bounds within the near
 // distance, or an empty city) -> no horizon/cache/ray stage (note "rays off:
 // no far geometry"); camera rolled / zenith or nadir in view -> no horizon
-// stage (note says why); pixelBudget < 0 (unlimited) or cache off -> cache
-// bypassed, every remaining pixel traced. stats.stages records the time of
+// stage (note says why); cache off -> every remaining pixel traced. stats.stages records the time of
 // every stage that ran (Stage::Opacity, Seam, Horizon, Cache, Rays,
 // Composite); stats.notes explains skipped stages.
 //
@@ -60,7 +59,15 @@ enum FarPixelClass : uint8_t { kFarCovered = 0, kFarHorizon = 1, kFarCache = 2, 
 struct FarFieldOptions {
     double nearDistance = 100.0;  // metres (>= 0): horizon skips geometry the near field draws; 0 = skip nothing
     bool nearIsDistance = true;   // false when the near field is a triangle budget (then no horizon skipping)
-    int64_t pixelBudget = -1;     // rays per frame through the cache; < 0 = unlimited (cache bypassed)
+    // Panoramic cache (panorama_cache.h): a cached far pixel is reused while
+    // its estimated reprojection error is below cacheErrorPx (0 = only
+    // pixels traced by this very camera), else re-traced, the worst first, up
+    // to pixelBudget rays (< 0 = no cap) and, with frameMsTarget > 0, up to
+    // what the target leaves after the stages before the cache stage (ms per
+    // ray measured as the frames go; at least 1 % of the pixels).
+    int64_t pixelBudget = -1;
+    double cacheErrorPx = 0.5;
+    double frameMsTarget = 0.0;
     bool cache = true;
     bool horizon = true;
     int horizonSubsampleMoving = 1;  // >= 1: subsample factor of the horizon while the camera moves

@@ -1,6 +1,8 @@
 // Cache stage (far_field_stages.h): pending pixels looked up in the panoramic
-// cache; the confidence records and the pixel budget pick the ones to trace.
+// cache; the quality-bounded policy (panorama_cache.h) and the per-frame
+// budget pick the ones to trace.
 #include <algorithm>
+#include <cmath>
 
 #include "foundation/timing.h"
 #include "runtime/engine/far_field_stages.h"
@@ -13,13 +15,28 @@ void listPending(FarFrame& f) {
         if (f.cls[i] == kFarPending) f.pending.push_back(uint32_t(i));
 }
 
-void bypassCache(FarFrame& f, const FarFieldOptions& o, FrameStats& stats) {
+void bypassCache(FarFrame& f) {
     f.trace = f.pending;
     f.traceCells.clear();
-    if (o.cache && !f.pending.empty()) stats.notes.push_back("cache bypassed: unlimited pixel budget");
+    f.traceSubs.clear();
+}
+
+int64_t cacheBudget(const FarFrame& f, const FarFieldMemory& m, const FarFieldOptions& o, double spentMs) {
+    int64_t budget = o.pixelBudget;
+    if (o.frameMsTarget > 0 && m.msPerRay > 0) {
+        // What is left of the target after the stages so far and the composite, in rays;
+        // never below 1 % of the frame, so that a late frame still converges.
+        const double left = o.frameMsTarget - spentMs - m.compositeMs;
+        const int64_t floor = std::max<int64_t>(64, int64_t(f.pixelCount / 100));
+        const int64_t byTime = std::max<int64_t>(floor, int64_t(std::max(0.0, left) / m.msPerRay));
+        budget = budget < 0 ? byTime : std::min(budget, byTime);
+    }
+    return budget;
 }
 
 void cacheStage(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, FrameStats& stats) {
+    double spentMs = 0;
+    stats.stages.forEach([&](Stage, double ms) { spentMs += ms; });
     Stopwatch sw;
     const double key[4] = {f.camera.fovY, double(f.width), double(f.height), o.cacheOversample};
     if (!m.cache || !std::equal(key, key + 4, m.cacheKey)) {
@@ -33,12 +50,21 @@ void cacheStage(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, FrameS
     for (size_t k = 0; k < f.pending.size(); ++k) {
         const uint32_t i = f.pending[k];
         cand[k].pixel = i;
-        cand[k].cell = cache.index(f.rays.dir(int(i % W), int(i / W)));
+        cand[k].cell = cache.index(f.rays.dir(int(i % W), int(i / W)), &cand[k].sub);
     }
+    CachePolicy policy;
+    policy.maxErrorPx = o.cacheErrorPx;
+    policy.radPerPixel = 2.0 * std::tan(0.5 * f.camera.fovY) / std::max(1, f.height);
+    policy.lowerDepth = o.nearIsDistance && o.nearDistance > 0 ? o.nearDistance : m.lastMinDepth;
+    policy.windowPx = kCacheWindowPx;
+    policy.budget = cacheBudget(f, m, o, spentMs);
+    if (o.frameMsTarget > 0) stats.notes.push_back("cache budget " + std::to_string(policy.budget) + " rays");
+    f.farDepth.assign(f.pixelCount, INFINITY);
     std::vector<uint8_t> trace;
-    cache.selectForTracing(cand, o.pixelBudget, trace);
+    cache.selectForTracing(cand, policy, trace);
     f.trace.clear();
     f.traceCells.clear();
+    f.traceSubs.clear();
     const bool havePrev = m.prev.width == f.width && m.prev.height == f.height;
     uint64_t fromCache = 0;
     for (size_t k = 0; k < f.pending.size(); ++k) {
@@ -46,6 +72,7 @@ void cacheStage(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, FrameS
         if (trace[k]) {
             f.trace.push_back(i);
             f.traceCells.push_back(cand[k].cell);
+            f.traceSubs.push_back(cand[k].sub);
             continue;
         }
         f.cls[i] = kFarCache;
@@ -55,6 +82,7 @@ void cacheStage(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, FrameS
             c = glm::u8vec4(s[0], s[1], s[2], 255);
         }
         std::copy_n(&c[0], 4, &f.out.rgba[size_t(i) * 4]);
+        f.farDepth[i] = cache.nearDistance(cand[k].cell);
         ++fromCache;
     }
     stats.pixels.cache += fromCache;

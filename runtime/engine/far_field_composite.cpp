@@ -1,6 +1,7 @@
 // Composite stage (far_field_stages.h): sky behind the horizon, traced colours
 // into the panoramic cache, the frame kept for the next cache frame.
 #include <algorithm>
+#include <cmath>
 
 #include "foundation/timing.h"
 #include "runtime/engine/far_field_stages.h"
@@ -26,10 +27,33 @@ void compositeStage(FarFrame& f, FarFieldMemory& m, bool cacheMode, FrameStats& 
     for (size_t i = 0; i < f.pixelCount; ++i)
         if (f.cls[i] == kFarHorizon) std::copy_n(&f.sky->rgba[i * 4], 4, &f.out.rgba[i * 4]);
     if (cacheMode) {
-        if (m.cache && !f.trace.empty()) {
+        if (m.cache && !f.trace.empty() && f.farDepth.size() == f.pixelCount) {
+            // Nearest far surface around every traced pixel: minimum over the 3 x 3 blocks of
+            // kCacheWindowPx pixels around its block (a window of radius >= kCacheWindowPx).
+            const int B = int(kCacheWindowPx), bw = (f.width + B - 1) / B, bh = (f.height + B - 1) / B;
+            std::vector<float> block(size_t(bw) * size_t(bh), INFINITY);
+            for (int y = 0; y < f.height; ++y) {
+                float* row = &block[size_t(y / B) * size_t(bw)];
+                const float* d = &f.farDepth[size_t(y) * size_t(f.width)];
+                for (int x = 0; x < f.width; ++x) row[x / B] = std::min(row[x / B], d[x]);
+            }
+            float lowest = INFINITY;
+            for (float v : block) lowest = std::min(lowest, v);
+            if (std::isfinite(lowest)) m.lastMinDepth = lowest;
             std::vector<glm::u8vec4> traced(f.trace.size());
-            for (size_t j = 0; j < f.trace.size(); ++j) std::copy_n(&f.out.rgba[size_t(f.trace[j]) * 4], 4, &traced[j][0]);
-            m.cache->store(f.traceCells, traced);
+            std::vector<float> nearest(f.trace.size());
+            const uint32_t W = uint32_t(f.width);
+            for (size_t j = 0; j < f.trace.size(); ++j) {
+                const uint32_t i = f.trace[j];
+                std::copy_n(&f.out.rgba[size_t(i) * 4], 4, &traced[j][0]);
+                const int bx = int(i % W) / B, by = int(i / W) / B;
+                float v = INFINITY;
+                for (int yy = std::max(0, by - 1); yy <= std::min(bh - 1, by + 1); ++yy)
+                    for (int xx = std::max(0, bx - 1); xx <= std::min(bw - 1, bx + 1); ++xx)
+                        v = std::min(v, block[size_t(yy) * size_t(bw) + size_t(xx)]);
+                nearest[j] = v;
+            }
+            m.cache->store(f.traceCells, f.traceSubs, traced, nearest);
         }
         m.prev = f.out;  // fallback for never-traced cache cells next frame
     }

@@ -231,7 +231,7 @@ void hazeCoveredStage(FarFrame& f, const FarFieldOptions& o, FrameStats& stats) 
 void raysStage(FarFrame& f, const RayScene& rays, int threads, FrameStats& stats) {
     Stopwatch sw;
     std::vector<uint8_t> hit(f.trace.size(), 0);
-    std::vector<float> depth(f.fx->haze ? f.trace.size() : 0);
+    std::vector<float> depth(f.fx->haze || !f.farDepth.empty() ? f.trace.size() : 0);
     RayCounts counts;
     RayShading shading;
     shading.effects = f.fx;
@@ -242,7 +242,9 @@ void raysStage(FarFrame& f, const RayScene& rays, int threads, FrameStats& stats
     stats.pixels.rayHit += counts.hits;
     stats.pixels.rayMiss += counts.rays - counts.hits;
     stats.stages.add(Stage::Rays, sw.ms());
-    if (!depth.empty()) hazeStage(*f.fx, f.trace.data(), f.trace.size(), depth.data(), f.out, stats);
+    if (!f.farDepth.empty())
+        for (size_t j = 0; j < f.trace.size(); ++j) f.farDepth[f.trace[j]] = depth[j];
+    if (f.fx->haze) hazeStage(*f.fx, f.trace.data(), f.trace.size(), depth.data(), f.out, stats);
 }
 
 }  // namespace vista

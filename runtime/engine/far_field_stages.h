@@ -47,7 +47,13 @@ struct FarFieldMemory {
     double skyKey[5] = {1e300, 0, 0, 0, 0};
     Camera last;
     bool haveLast = false;
+    double lastMinDepth = 0;   // nearest far surface of the last cache frame (m; 0 = none yet)
+    double msPerRay = 0;       // ray stage ms per ray (moving average; 0 = not measured)
+    double compositeMs = 0;    // composite stage ms (moving average)
 };
+
+// Radius (pixels) of the screen window whose nearest far surface a cached cell records.
+constexpr double kCacheWindowPx = 8.0;
 
 // Working state of one frame, filled stage by stage.
 struct FarFrame {
@@ -67,6 +73,8 @@ struct FarFrame {
     std::vector<uint32_t> pending; // pending pixels after the horizon, ascending
     std::vector<uint32_t> trace;   // pixels to trace this frame, ascending (cache)
     std::vector<int64_t> traceCells;  // their panorama cells (cache stage only)
+    std::vector<glm::u8vec2> traceSubs;  // where their rays fall in those cells (cache stage only)
+    std::vector<float> farDepth;   // cache mode: per pixel, eye-plane depth of its far colour (+inf = sky/none)
 };
 
 // Opacity (far_field_opacity.cpp). In: depth (null = nothing covered). Out:
@@ -101,26 +109,36 @@ void cullAllPending(FarFrame& f, FrameStats& stats);
 
 // Lists the pending pixels in f.pending (ascending). No time.
 void listPending(FarFrame& f);
-// Cache (far_field_cache.cpp), run when the cache is on with a budget >= 0 and
-// f.pending is not empty. In: f.pending, o.pixelBudget, o.cacheOversample,
-// m.prev, f.sky. (Re)creates the panorama for the camera, selects the pixels
-// to trace (f.trace, f.traceCells); the others become cache and get their
-// cell's colour (never traced: last frame's pixel, else sky). Records Cache.
+// Cache (far_field_cache.cpp), run when the cache is on and f.pending is not
+// empty. In: f.pending, o.cacheErrorPx, o.pixelBudget, o.frameMsTarget,
+// o.cacheOversample, m.prev, f.sky; the stage times already in `stats`.
+// (Re)creates the panorama for the camera, selects the pixels to trace under
+// the quality-bounded policy (f.trace, f.traceCells); the others become cache
+// and get their cell's colour (never traced: last frame's pixel, else sky).
+// Sets f.farDepth (every pixel, +inf except cache pixels: their cell's
+// nearest surface; the ray stage fills the traced ones). Records Cache; with
+// a frame-time target, a note gives the budget.
 void cacheStage(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, FrameStats& stats);
-// Cache bypassed: f.trace = f.pending; a note when the cache is on but the
-// budget unlimited. No class, no time.
-void bypassCache(FarFrame& f, const FarFieldOptions& o, FrameStats& stats);
+// The pixel budget of this frame: o.pixelBudget, capped with a frame-time
+// target by what is left of it after spentMs at m.msPerRay (at least 1 % of
+// the pixels); < 0 = no cap.
+int64_t cacheBudget(const FarFrame& f, const FarFieldMemory& m, const FarFieldOptions& o, double spentMs);
+// Cache off: f.trace = f.pending. No class, no time.
+void bypassCache(FarFrame& f);
 
 // Rays (far_field_rays.cpp). In: f.trace. Casts them with castPrimaryRays;
-// each becomes rayHit or rayMiss, its colour (prelit or sky) written to out;
-// raysCast += rays. Records Rays.
+// each becomes rayHit or rayMiss, its colour (prelit or sky) written to out,
+// its eye-plane depth to f.farDepth when that is set; raysCast += rays.
+// Records Rays.
 void raysStage(FarFrame& f, const RayScene& rays, int threads, FrameStats& stats);
 
 // Sky colours of the camera (far_field_composite.cpp), cached in m.sky.
 const Image& skyImage(FarFieldMemory& m, const FarFrame& f);
 // Composite (far_field_composite.cpp). Writes sky into every horizonCulled
 // pixel; in cache mode, stores the traced pixels' colours (now in out) into
-// m.cache and keeps the frame in m.prev. Assigns no class. Records Composite.
+// m.cache with the nearest far surface of their window (f.farDepth), sets
+// m.lastMinDepth and keeps the frame in m.prev. Assigns no class. Records
+// Composite.
 void compositeStage(FarFrame& f, FarFieldMemory& m, bool cacheMode, FrameStats& stats);
 
 }  // namespace vista

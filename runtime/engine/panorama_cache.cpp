@@ -49,45 +49,53 @@ glm::dvec2 PanoramaCache::mapCoord(const glm::dvec3& d) const {
     return {u, row};
 }
 
-int64_t PanoramaCache::index(const glm::dvec3& d) const {
+int64_t PanoramaCache::index(const glm::dvec3& d, glm::u8vec2* sub) const {
     if (!std::isfinite(d.x) || !std::isfinite(d.y) || !std::isfinite(d.z)) return -1;
     if (d.x == 0 && d.y == 0) return -1;
     glm::dvec2 c = mapCoord(d);
     if (!(c.y >= 0 && c.y < _height)) return -1;
-    int64_t col = int64_t(std::floor(c.x));
+    const double fx = std::floor(c.x), fy = std::floor(c.y);
+    int64_t col = int64_t(fx);
     col %= _width;  // az == 2 pi after rounding wraps to 0
     if (col < 0) col += _width;
-    int64_t row = std::min<int64_t>(_height - 1, int64_t(std::floor(c.y)));
+    int64_t row = std::min<int64_t>(_height - 1, int64_t(fy));
+    if (sub) *sub = glm::u8vec2(uint8_t(std::min(255.0, (c.x - fx) * 256.0)), uint8_t(std::min(255.0, (c.y - fy) * 256.0)));
     return row * _width + col;
 }
 
 void PanoramaCache::clear() {
     size_t n = size_t(_width) * size_t(_height);
     _color.assign(n, glm::u8vec4(0));
+    _near.assign(n, INFINITY);
+    _sub.assign(n, glm::u8vec2(128));
     _record.assign(n, 0);
     _records.assign(1, Record{});
+    _baseline.assign(1, INFINITY);
     _current = 0;
 }
 
 void PanoramaCache::beginFrame(const Camera& c) {
-    ++_frame;
-    if (_current != 0) {
+    const bool same = _current != 0 && [&] {
         const Record& r = _records[_current];
-        if (r.eye == c.eye && r.heading == c.heading && r.pitch == c.pitch && r.roll == c.roll && r.fovY == c.fovY &&
-            r.width == c.width && r.height == c.height)
-            return;  // same camera: same record
+        return r.eye == c.eye && r.heading == c.heading && r.pitch == c.pitch && r.roll == c.roll && r.fovY == c.fovY &&
+               r.width == c.width && r.height == c.height;
+    }();
+    if (!same) {
+        if (_records.size() >= kMaxRecords) compact();
+        Record r;
+        r.eye = c.eye;
+        r.heading = c.heading;
+        r.pitch = c.pitch;
+        r.roll = c.roll;
+        r.fovY = c.fovY;
+        r.width = c.width;
+        r.height = c.height;
+        _records.push_back(r);
+        _current = uint32_t(_records.size() - 1);
     }
-    if (_records.size() >= kMaxRecords) compact();
-    Record r;
-    r.eye = c.eye;
-    r.heading = c.heading;
-    r.pitch = c.pitch;
-    r.roll = c.roll;
-    r.fovY = c.fovY;
-    r.width = c.width;
-    r.height = c.height;
-    _records.push_back(r);
-    _current = uint32_t(_records.size() - 1);
+    _baseline.resize(_records.size());
+    _baseline[0] = INFINITY;
+    for (size_t i = 1; i < _records.size(); ++i) _baseline[i] = glm::length(_records[i].eye - c.eye);
 }
 
 void PanoramaCache::compact() {
@@ -113,67 +121,63 @@ void PanoramaCache::compact() {
     _records = std::move(kept);
 }
 
-int64_t PanoramaCache::selectForTracing(const std::vector<CacheCandidate>& cand, int64_t budget,
+double PanoramaCache::error(int64_t cell, glm::u8vec2 sub, const CachePolicy& p) const {
+    const uint32_t r = _record[size_t(cell)];
+    if (r == 0) return INFINITY;
+    if (r == _current) return -1.0;  // traced by this very camera
+    // Resampling: the angle between the cell's traced ray and this one. On the
+    // cylinder a column step is 2 pi / width of azimuth (times cos elevation
+    // on the sphere), a row step 2 vMax / height of tan(elevation) (times cos^2).
+    const glm::u8vec2 s = _sub[size_t(cell)];
+    const double v = _vMax - (double(cell / _width) + 0.5) * 2.0 * _vMax / _height;
+    const double c2 = 1.0 / (1.0 + v * v);
+    const double du = (double(sub.x) - double(s.x)) / 256.0 * kTwoPi / _width * std::sqrt(c2);
+    const double dv = (double(sub.y) - double(s.y)) / 256.0 * 2.0 * _vMax / _height * c2;
+    const double offset = std::sqrt(du * du + dv * dv);
+    const double b = _baseline[r];
+    if (b == 0) return offset / p.radPerPixel;  // rotation only
+    const double own = b / double(_near[size_t(cell)]);  // 0 when the window was all sky
+    const double outside = p.lowerDepth > 0 ? b / p.lowerDepth - p.windowPx * p.radPerPixel : INFINITY;
+    return (std::max(own, outside) + offset) / p.radPerPixel;
+}
+
+int64_t PanoramaCache::selectForTracing(const std::vector<CacheCandidate>& cand, const CachePolicy& p,
                                         std::vector<uint8_t>& trace) {
     trace.assign(cand.size(), 0);
-    const size_t R = _records.size();
-    const Record& cur = _records[_current];
-    // Per record: distance to the current observer; exact = this very camera.
-    auto exact = [&](uint32_t r) { return r != 0 && r == _current; };
-    _count.assign(R, 0);
-    int64_t marked = 0;
+    int64_t forced = 0;
+    // Candidates over the bound, with their errors (largest traced first under a budget).
+    std::vector<std::pair<double, uint32_t>> over;
     for (size_t i = 0; i < cand.size(); ++i) {
         if (cand[i].cell < 0) {  // not cacheable: always traced
             trace[i] = 1;
-            ++marked;
+            ++forced;
             continue;
         }
-        ++_count[_record[size_t(cand[i].cell)]];
+        const double e = error(cand[i].cell, cand[i].sub, p);
+        if (e < 0 || e < p.maxErrorPx) continue;
+        over.push_back({e, uint32_t(i)});
     }
-    int64_t left = budget < 0 ? INT64_MAX : std::max<int64_t>(0, budget - marked);
-    // Records in use, worst first: record 0 (never traced), then by distance,
-    // then same position with another orientation (distance 0) last.
-    std::vector<uint32_t> order;
-    for (uint32_t r = 0; r < R; ++r)
-        if (_count[r] > 0 && !exact(r)) order.push_back(r);
-    std::vector<double> dist(R, 0.0);
-    for (uint32_t r : order) dist[r] = r == 0 ? INFINITY : glm::length(_records[r].eye - cur.eye);
-    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return dist[a] > dist[b]; });
-    // Decide per record: all, every n-th, or none.
-    std::vector<uint32_t> nth(R, 0);  // 0 = none, 1 = all, n = every n-th
-    for (uint32_t r : order) {
-        if (left <= 0) break;
-        if (int64_t(_count[r]) <= left) {
-            nth[r] = 1;
-            left -= _count[r];
-        } else {
-            nth[r] = uint32_t((int64_t(_count[r]) + left - 1) / left);
-            left = 0;
-        }
+    size_t take = over.size();
+    if (p.budget >= 0) take = size_t(std::min<int64_t>(int64_t(over.size()), std::max<int64_t>(0, p.budget - forced)));
+    if (take < over.size()) {
+        // Largest errors first; ties (e.g. never traced) by candidate order, so the choice is deterministic.
+        std::nth_element(over.begin(), over.begin() + long(take), over.end(), [](const auto& a, const auto& b) {
+            return a.first != b.first ? a.first > b.first : a.second < b.second;
+        });
     }
-    std::vector<uint32_t> seen(R, 0);
-    const uint64_t phase = _frame;
-    for (size_t i = 0; i < cand.size(); ++i) {
-        if (cand[i].cell < 0) continue;
-        uint32_t r = _record[size_t(cand[i].cell)];
-        uint32_t n = nth[r];
-        if (n == 0) continue;
-        uint32_t k = seen[r]++;
-        if (n == 1 || (k + phase) % n == 0) {
-            trace[i] = 1;
-            ++marked;
-        }
-    }
-    return marked;
+    for (size_t k = 0; k < take; ++k) trace[over[k].second] = 1;
+    return forced + int64_t(take);
 }
 
-void PanoramaCache::store(const std::vector<int64_t>& cells, const std::vector<glm::u8vec4>& colors) {
-    VISTA_CHECK(cells.size() == colors.size());
-    std::vector<int64_t> dup;
+void PanoramaCache::store(const std::vector<int64_t>& cells, const std::vector<glm::u8vec2>& subs,
+                          const std::vector<glm::u8vec4>& colors, const std::vector<float>& nearDistance) {
+    VISTA_CHECK(cells.size() == colors.size() && cells.size() == nearDistance.size() && cells.size() == subs.size());
     for (size_t i = 0; i < cells.size(); ++i) {
         int64_t c = cells[i];
         if (c < 0) continue;
         _color[size_t(c)] = colors[i];
+        _sub[size_t(c)] = subs[i];
+        _near[size_t(c)] = nearDistance[i];
         _record[size_t(c)] = _current;
     }
     // Cells hit by two pixels this frame hold only one of them: not exact.

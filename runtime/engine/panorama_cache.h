@@ -1,7 +1,10 @@
-// Panoramic image cache (thesis §4.4): a cylindrical map of traced far-field
-// colours, indexed by world direction, so its contents stay valid when the
-// viewer only rotates; confidence records decide which pixels to re-trace
-// under a per-frame pixel budget.
+// Panoramic image cache (thesis §4.4) with a quality-bounded reuse policy: a
+// cylindrical map of traced far-field colours, indexed by world direction (so
+// its contents stay valid while the viewer only rotates), where every cell
+// also records the observer position it was traced from and how near the
+// surfaces around it were. A cached colour is reused while its estimated
+// reprojection error stays below a bound in pixels; otherwise it is
+// re-traced, the worst first, within an optional per-frame pixel budget.
 //
 // Map: `width` azimuth columns over [0, 2 pi) (clockwise from +y, wrapping),
 // `height` rows over v = tan(elevation) in [-vMax, vMax] (a cylinder around
@@ -10,20 +13,29 @@
 // screen's pixel spacing at the image centre (so pixels of one frame rarely
 // share a cell), capped at kMaxCells cells.
 //
-// Confidence records (thesis Fig. 4.6): one per distinct camera (position and
-// orientation) for which pixels were traced; each traced cell points to the
-// record of its frame. A pixel's error estimate is the distance between its
-// record's observer position and the current one (rotation is ignored, as in
-// the thesis); record 0 = never traced = worst. selectForTracing() orders the
-// candidate pixels' records from worst to best and marks all pixels of the
-// worst records for tracing until the budget is met; the record where the
-// budget runs out gets every n-th of its pixels traced (n = ceil(count /
-// remaining budget), phase rotating per frame), and the rest next frame
-// (graceful degradation). Pixels whose record is this very camera (same
-// position and orientation) are exact and never re-traced; pixels of the same
-// position but another orientation are re-traced last (only with budget
-// left), so a viewer who stops converges to the exact image. Cells written by
-// two pixels in one frame are reset to record 0, so both keep being traced.
+// Records: one per distinct camera (position and orientation) for which
+// pixels were traced; each traced cell points to the record of its frame;
+// record 0 = never traced. Per cell the cache also keeps where in the cell
+// its ray went (the sub-cell position, 1/256 of a cell) and `near` (metres):
+// the nearest far-field surface within the screen window of its pixel when it
+// was traced (+inf when all was sky).
+//
+// Error of reusing a cell for a pixel whose ray falls at sub-cell position s,
+// seen from eye e (CachePolicy), with b = |e - record eye|:
+//   error_px = (max(b / near, b / lowerDepth - windowPx * radPerPixel) + offset(s)) / radPerPixel
+// A point at distance d moves by at most b / d radians when the eye moves by
+// b, so the first term bounds how far the cell's own content and every
+// surface of its window have moved; the second bounds a surface from outside
+// the window (no far surface is nearer than lowerDepth, e.g. the near
+// distance, so it moves at most b / lowerDepth and must cross windowPx
+// pixels first). offset(s) is the angle between the cell's traced ray and
+// the pixel's ray (the resampling error, also when only rotating). Never
+// traced = +inf; the very camera of the record = exact (never re-traced).
+// selectForTracing() marks every non-exact candidate whose error is not
+// below maxErrorPx (so maxErrorPx = 0 re-traces all but exact cells); with a
+// budget >= 0 only the `budget` largest errors among them (cells not
+// cacheable always count first). Cells written by two pixels in one frame are
+// reset to record 0, so both keep being traced.
 //
 // Not thread-safe (one far-field pipeline owns it). Bad input (non-finite
 // direction) returns index -1.
@@ -40,6 +52,15 @@ namespace vista {
 struct CacheCandidate {
     int64_t cell;    // panorama cell index, or -1 (not cacheable: always traced)
     uint32_t pixel;  // screen pixel index (y * width + x)
+    glm::u8vec2 sub{128, 128};  // where the pixel's ray falls in the cell (1/256 of a cell; index())
+};
+
+struct CachePolicy {
+    double maxErrorPx = 0.5;     // reuse while the error is below this (pixels, >= 0)
+    double radPerPixel = 1e-3;   // angular size of a pixel at the image centre (> 0)
+    double lowerDepth = 0.0;     // no far surface is nearer (metres); 0 = unknown (then the window term is +inf when moving)
+    double windowPx = 8.0;       // radius of the screen window that `near` of a cell covers (pixels)
+    int64_t budget = -1;         // most cells re-traced per frame; < 0 = no cap
 };
 
 class PanoramaCache {
@@ -53,7 +74,8 @@ public:
     int width() const { return _width; }
     int height() const { return _height; }
     double vMax() const { return _vMax; }
-    int64_t index(const glm::dvec3& worldDir) const;
+    // The cell of a direction (and, if `sub` is given, where in the cell it falls, in 1/256 of a cell).
+    int64_t index(const glm::dvec3& worldDir, glm::u8vec2* sub = nullptr) const;
     // Fractional map coordinates (column, row) of a direction (for tests).
     glm::dvec2 mapCoord(const glm::dvec3& worldDir) const;
 
@@ -61,13 +83,19 @@ public:
     void clear();
     // Starts a frame for `camera`: picks or creates the current record.
     void beginFrame(const Camera& camera);
-    // Marks trace[i] (resized to candidates.size()) for the candidates to trace
-    // this frame; budget < 0 = unlimited (every non-exact pixel).
-    // Returns the number marked.
-    int64_t selectForTracing(const std::vector<CacheCandidate>& candidates, int64_t budget, std::vector<uint8_t>& trace);
-    // Stores traced colours (cells of one frame; duplicates are reset to record 0).
-    void store(const std::vector<int64_t>& cells, const std::vector<glm::u8vec4>& colors);
+    // The reprojection error (pixels) of reusing `cell` now for a ray at `sub` (see above); -1 = exact.
+    double error(int64_t cell, glm::u8vec2 sub, const CachePolicy& policy) const;
+    // Marks trace[i] (resized to candidates.size()) for the candidates to
+    // trace this frame under `policy`. Returns the number marked.
+    int64_t selectForTracing(const std::vector<CacheCandidate>& candidates, const CachePolicy& policy,
+                             std::vector<uint8_t>& trace);
+    // Stores traced colours of this frame with where their rays fell in the
+    // cells and the nearest far surface of their window (nearDistance,
+    // metres, +inf = none); duplicates are reset to record 0.
+    void store(const std::vector<int64_t>& cells, const std::vector<glm::u8vec2>& subs,
+               const std::vector<glm::u8vec4>& colors, const std::vector<float>& nearDistance);
     glm::u8vec4 color(int64_t cell) const { return _color[size_t(cell)]; }
+    float nearDistance(int64_t cell) const { return _near[size_t(cell)]; }
     uint32_t record(int64_t cell) const { return _record[size_t(cell)]; }
     size_t recordCount() const { return _records.size(); }
     uint32_t currentRecord() const { return _current; }
@@ -82,11 +110,12 @@ private:
     int _width = 0, _height = 0;
     double _vMax = 1;
     std::vector<glm::u8vec4> _color;
+    std::vector<float> _near;
+    std::vector<glm::u8vec2> _sub;
     std::vector<uint32_t> _record;
     std::vector<Record> _records;  // [0] = never traced
     uint32_t _current = 0;
-    uint64_t _frame = 0;
-    std::vector<uint32_t> _count;  // scratch per record
+    std::vector<double> _baseline;  // per record: distance to the current eye (beginFrame)
 };
 
 }  // namespace vista

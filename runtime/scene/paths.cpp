@@ -196,6 +196,20 @@ std::vector<size_t> Path::spread(size_t n) const {
     return out;
 }
 
+std::vector<size_t> Path::runs(size_t n, size_t k) const {
+    std::vector<size_t> out;
+    if (samples.empty() || n == 0) return out;
+    k = std::clamp<size_t>(k, 1, n);
+    const size_t S = samples.size();
+    for (size_t r = 0; r < k; ++r) {
+        const size_t len = n / k + (r < n % k ? 1 : 0);
+        const size_t room = S > len ? S - len : 0;  // last possible start
+        const size_t start = k == 1 ? 0 : size_t(std::llround(double(r) * double(room) / double(k - 1)));
+        for (size_t i = 0; i < len; ++i) out.push_back(std::min(S - 1, start + i));
+    }
+    return out;
+}
+
 double distanceToStreets(const StreetGraph& g, const glm::dvec2& p, int* edge) {
     double best = -1;
     if (edge) *edge = -1;

@@ -77,7 +77,18 @@ struct Path {
     // Indices of n samples spread evenly over the whole path (first and last
     // included; repeats when n exceeds the sample count).
     std::vector<size_t> spread(size_t n) const;
+    // Indices of n samples in `runs` runs of consecutive samples (the frames a
+    // simulator renders), the runs' starts spread evenly over the path (first
+    // run at 0, last ending at the last sample when the path is long enough);
+    // runs = 1: the first n samples. Run lengths differ by at most one; runs
+    // is clamped to 1 .. n; repeats the last sample when n exceeds the count.
+    std::vector<size_t> runs(size_t n, size_t runs) const;
+    // The frames a bench renders: spread(n) when runs == 0, else runs(n, runs).
+    std::vector<size_t> frames(size_t n, int runs) const { return runs <= 0 ? spread(n) : this->runs(n, size_t(runs)); }
 };
+// How `vista bench` samples its frames (--sampling): 0 = spread evenly over
+// the path, k >= 1 = k runs of consecutive samples.
+constexpr int kDefaultSampleRuns = 8;
 
 // How far the camera moves between consecutive rendered frames (the samples
 // `frames`, in order): metres of eye travel and degrees of view rotation

@@ -280,30 +280,50 @@ TEST(FarFieldFrame, StagesRunOnlyWhenCalledFor) {
             if (n.find(what) != std::string::npos) return true;
         return false;
     };
-    // Unlimited budget: cache bypassed (note), every far pixel traced.
+    // Cache on, no cap: the first frame traces every far pixel (nothing cached yet).
     FrameStats a;
     ff.render(c, nullptr, img, a);
-    EXPECT_FALSE(a.stages.ran(Stage::Cache));
-    EXPECT_TRUE(has(a, "cache bypassed"));
+    EXPECT_TRUE(a.stages.ran(Stage::Cache));
+    EXPECT_EQ(a.pixels.cache, 0u);
     EXPECT_TRUE(a.stages.ran(Stage::Opacity));
     EXPECT_FALSE(a.stages.ran(Stage::Seam));  // nothing covered
     EXPECT_EQ(a.raysCast, a.pixels.rayHit + a.pixels.rayMiss);
     EXPECT_EQ(a.pixels.horizonCulled + a.pixels.rayHit + a.pixels.rayMiss, N);
-    // A budget: the cache stage runs and caps the rays.
+    // The same camera again: every far pixel is exact in the cache, no ray.
+    const Image first = img;
+    FrameStats a2;
+    ff.render(c, nullptr, img, a2);
+    EXPECT_EQ(a2.raysCast, 0u);
+    EXPECT_EQ(a2.pixels.cache, a.pixels.rayHit + a.pixels.rayMiss);
+    EXPECT_EQ(img.rgba, first.rgba);
+    // A budget caps the rays of a moved camera.
     o.pixelBudget = 500;
     ff.setOptions(o);
     FrameStats b;
-    ff.render(c, nullptr, img, b);
+    Camera moved = c;
+    moved.eye.x += 5.0;
+    ff.render(moved, nullptr, img, b);
     EXPECT_TRUE(b.stages.ran(Stage::Cache));
     EXPECT_LE(b.raysCast, 500u);
     EXPECT_GT(b.pixels.cache, 0u);
-    // Cache off: bypassed without a note.
+    // A frame-time target below what the frame costs: the budget falls to its floor (1 % of the pixels, >= 64).
+    o.pixelBudget = -1;
+    o.frameMsTarget = 1e-6;
+    ff.setOptions(o);
+    FrameStats tight;
+    moved.eye.x += 5.0;
+    ff.render(moved, nullptr, img, tight);
+    const uint64_t floor = std::max<uint64_t>(64, N / 100);
+    EXPECT_TRUE(has(tight, "cache budget " + std::to_string(floor) + " rays"));
+    EXPECT_LE(tight.raysCast, floor);
+    o.frameMsTarget = 0;
+    // Cache off: no cache stage, every far pixel traced.
     o.cache = false;
     ff.setOptions(o);
     FrameStats d;
     ff.render(c, nullptr, img, d);
     EXPECT_FALSE(d.stages.ran(Stage::Cache));
-    EXPECT_FALSE(has(d, "cache bypassed"));
+    EXPECT_EQ(d.pixels.cache, 0u);
     EXPECT_EQ(d.raysCast, d.pixels.rayHit + d.pixels.rayMiss);
     // Horizon switched off by option: no stage, nothing culled.
     o.horizon = false;

@@ -1,6 +1,7 @@
 // Panoramic image cache and far-field pipeline tests: rotation-invariant
-// indexing, azimuth wrap, confidence ordering, every-n-th rule, graceful
-// degradation and convergence of a still viewer to the exact ray-cast image.
+// indexing, azimuth wrap, the reprojection-error bound and the budget,
+// graceful degradation, convergence of a still viewer to the exact ray-cast
+// image, and a moving viewer staying close to the uncached image.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -8,6 +9,7 @@
 
 #include "runtime/engine/far_field.h"
 #include "runtime/engine/horizon.h"
+#include "runtime/engine/metrics.h"
 #include "runtime/engine/panorama_cache.h"
 #include "runtime/engine/ray_scene.h"
 #include "tests/farfield/fixtures.h"
@@ -97,45 +99,92 @@ TEST(Panorama, AzimuthWrapsAtZeroAndTwoPi) {
     EXPECT_EQ(pc.index(glm::dvec3(NAN, 1, 0)), -1);
 }
 
-TEST(Panorama, ConfidenceOrderingAndEveryNthRule) {
+TEST(Panorama, ErrorBoundAndBudgetRetraceTheWorstCells) {
     PanoramaCache pc(100, 10, 1.0);
-    // Three observer positions; cells 0..29 traced at A, 30..59 at B, 60..89 at C.
-    auto at = [](double x) { return cam(glm::dvec3(x, 0, 1.7), 0.0); };
-    auto storeRange = [&](int a, int b) {
+    auto at = [](double x, double heading = 0.0) { return cam(glm::dvec3(x, 0, 1.7), heading); };
+    // Cells 0..29 traced at x = 0 with surfaces 1000 m away, 30..59 at x = 0 with
+    // surfaces 50 m away, 60..89 at x = 9 (near 1000 m); 90..99 never traced.
+    auto storeRange = [&](int a, int b, float near) {
         std::vector<int64_t> cells;
         std::vector<glm::u8vec4> cols;
+        std::vector<float> nears;
         for (int i = a; i < b; ++i) {
             cells.push_back(i);
             cols.push_back(glm::u8vec4(uint8_t(i), 0, 0, 255));
+            nears.push_back(near);
         }
-        pc.store(cells, cols);
+        pc.store(cells, std::vector<glm::u8vec2>(cells.size(), glm::u8vec2(128)), cols, nears);
     };
     pc.beginFrame(at(0));
-    storeRange(0, 30);
-    pc.beginFrame(at(50));
-    storeRange(30, 60);
-    pc.beginFrame(at(90));
-    storeRange(60, 90);
-    // Now at x = 100: distances A = 100, B = 50, C = 10; cells 90..99 never traced.
-    pc.beginFrame(at(100));
+    storeRange(0, 30, 1000.0f);
+    storeRange(30, 60, 50.0f);
+    pc.beginFrame(at(9));
+    storeRange(60, 90, 1000.0f);
+    pc.beginFrame(at(10));
+    CachePolicy p;
+    p.radPerPixel = 1e-3;
+    p.windowPx = 8;
+    p.lowerDepth = 40.0;
+    p.maxErrorPx = 0.5;
+    // Independent computation of the bound: eye moved b since tracing; own term b / near,
+    // outside-the-window term b / lowerDepth - 8 px.
+    const glm::u8vec2 mid(128, 128);
+    auto expected = [&](double b, double near) { return std::max(b / near, b / 40.0 - 8e-3) / 1e-3; };
+    EXPECT_NEAR(pc.error(5, mid, p), expected(10, 1000), 1e-9);   // 242 px: the window term dominates
+    EXPECT_NEAR(pc.error(45, mid, p), expected(10, 50), 1e-9);    // 242 px as well
+    EXPECT_NEAR(pc.error(70, mid, p), expected(1, 1000), 1e-9);   // max(1, 17) px
+    EXPECT_TRUE(std::isinf(pc.error(95, mid, p)));
+    // Far lower bound (nothing nearer than 2 km): the own term decides.
+    p.lowerDepth = 2000.0;
+    EXPECT_NEAR(pc.error(45, mid, p), 10.0 / 50.0 / 1e-3, 1e-9);   // 200 px
+    EXPECT_NEAR(pc.error(5, mid, p), 10.0 / 1000.0 / 1e-3, 1e-9);  // 10 px
+    EXPECT_NEAR(pc.error(70, mid, p), 1.0 / 1000.0 / 1e-3, 1e-9);  // 1 px
     std::vector<CacheCandidate> cand;
     for (int i = 0; i < 100; ++i) cand.push_back({i, uint32_t(i)});
+    cand.push_back({-1, 100u});  // not cacheable: always traced
     std::vector<uint8_t> tr;
-    // Budget 40: never-traced (10) then A (30) exactly.
-    EXPECT_EQ(pc.selectForTracing(cand, 40, tr), 40);
-    for (int i = 0; i < 100; ++i) EXPECT_EQ(tr[size_t(i)], (i < 30 || i >= 90) ? 1 : 0) << i;
-    // Budget 25: never-traced (10) + every 2nd of A (15 of 30).
-    EXPECT_EQ(pc.selectForTracing(cand, 25, tr), 25);
-    int a = 0;
-    for (int i = 0; i < 30; ++i) a += tr[size_t(i)];
-    EXPECT_EQ(a, 15);
-    for (int i = 30; i < 90; ++i) EXPECT_EQ(tr[size_t(i)], 0);
-    // Budget 0: nothing (graceful degradation: all from cache).
-    EXPECT_EQ(pc.selectForTracing(cand, 0, tr), 0);
-    // Unlimited: everything that is not exact (nothing is exact at x = 100).
-    EXPECT_EQ(pc.selectForTracing(cand, -1, tr), 100);
-    // Stored colours come back.
+    auto marked = [&](int a, int b) {
+        int n = 0;
+        for (int i = a; i < b; ++i) n += tr[size_t(i)];
+        return n;
+    };
+    // Bound 5 px: all but the 1-px cells (60..89) are re-traced.
+    p.maxErrorPx = 5.0;
+    EXPECT_EQ(pc.selectForTracing(cand, p, tr), 71);
+    EXPECT_EQ(marked(0, 60), 60);
+    EXPECT_EQ(marked(60, 90), 0);
+    EXPECT_EQ(marked(90, 100), 10);
+    EXPECT_EQ(tr[100], 1);
+    // Budget 41: the uncacheable one, never traced (10), then the 200-px cells (30).
+    p.budget = 41;
+    EXPECT_EQ(pc.selectForTracing(cand, p, tr), 41);
+    EXPECT_EQ(marked(90, 100), 10);
+    EXPECT_EQ(marked(30, 60), 30);
+    EXPECT_EQ(marked(0, 30), 0);
+    // Budget 0: only what cannot be cached (graceful degradation).
+    p.budget = 0;
+    EXPECT_EQ(pc.selectForTracing(cand, p, tr), 1);
+    // Bound 0, no cap: everything that is not exact.
+    p.budget = -1;
+    p.maxErrorPx = 0.0;
+    EXPECT_EQ(pc.selectForTracing(cand, p, tr), 101);
+    // The same eye, another heading: error 0, reused under any bound > 0, re-traced under bound 0.
+    pc.beginFrame(at(10, 0.3));
+    storeRange(0, 10, 1000.0f);
+    storeRange(400, 410, 1000.0f);  // row 4: v = 1 - 4.5 * 0.2 = 0.1
+    pc.beginFrame(at(10, 0.6));
+    EXPECT_EQ(pc.error(3, mid, p), 0.0);
+    // ... unless the pixel's ray falls elsewhere in the cell: half a column at elevation
+    // atan(0.1) is pi / 100 radians of azimuth, times cos(elevation).
+    const double halfColumn = M_PI / 100.0 / std::sqrt(1.0 + 0.1 * 0.1) / 1e-3;
+    EXPECT_NEAR(pc.error(403, glm::u8vec2(0, 128), p), halfColumn, 1e-9);
+    EXPECT_EQ(pc.error(403, mid, p), 0.0);
+    // This very camera: exact.
+    storeRange(10, 20, 1000.0f);
+    EXPECT_EQ(pc.error(15, mid, p), -1.0);
+    // Stored colours and distances come back.
     EXPECT_EQ(pc.color(42).x, 42);
+    EXPECT_EQ(pc.nearDistance(42), 50.0f);
 }
 
 TEST(Panorama, StillViewerConvergesToTheExactImage) {
@@ -146,6 +195,7 @@ TEST(Panorama, StillViewerConvergesToTheExactImage) {
     FarFieldOptions o;
     o.nearDistance = 0;
     o.pixelBudget = 700;
+    o.cacheErrorPx = 0;  // reuse only what this very camera traced: converges to exact
     FarField ff(*rs.value(), &grid, o);
     // Walk a few frames, then stop.
     Image img;
@@ -218,7 +268,7 @@ TEST(FarField, PixelClassesPartitionTheImageAndStagesRunOnlyWhenNeeded) {
     EXPECT_FALSE(s3.stages.ran(Stage::Horizon));
     ASSERT_FALSE(s3.notes.empty());
     EXPECT_EQ(s3.pixels.horizonCulled, 0u);
-    EXPECT_EQ(s3.pixels.rayHit + s3.pixels.rayMiss, N);
+    EXPECT_EQ(s3.pixels.rayHit + s3.pixels.rayMiss + s3.pixels.cache, N);  // same eye: some reused from the cache
     // Near distance beyond the whole city: no far geometry -> no ray stage.
     FarFieldOptions far = o;
     far.nearDistance = 5000;
@@ -285,4 +335,70 @@ TEST(FarField, LargeViewport) {
     EXPECT_EQ(st.pixels.covered + st.pixels.horizonCulled + st.pixels.cache + st.pixels.rayHit + st.pixels.rayMiss,
               uint64_t(4096) * 2160);
     EXPECT_LE(st.pixels.rayHit + st.pixels.rayMiss, 20000u);
+}
+
+// A viewer moving 0.2 m a frame through a ring of buildings 300 .. 1500 m
+// away (nothing within the 100 m near distance): with the quality-bounded
+// cache every frame stays close to the uncached frame of the same camera,
+// while far fewer rays are cast; a looser bound reuses more and costs PSNR;
+// bound 0 gives the uncached image exactly.
+TEST(Panorama, MovingViewerStaysCloseToTheUncachedImage) {
+    std::mt19937 rng(21);
+    std::uniform_real_distribution<double> ang(0, 2 * M_PI), rad(300, 1500), size(10, 60), height(10, 120);
+    std::uniform_int_distribution<int> col(30, 220);
+    SceneModel city;
+    city.params.size_m = 3200;
+    SceneMesh m;
+    for (int i = 0; i < 300; ++i) {
+        const double a = ang(rng), r = rad(rng), s = size(rng);
+        const glm::vec3 lo(float(r * std::sin(a)), float(r * std::cos(a)), 0.0f);
+        addBox(m, lo, lo + glm::vec3(float(s), float(s), float(height(rng))),
+               glm::u8vec4(uint8_t(col(rng)), uint8_t(col(rng)), uint8_t(col(rng)), 255));
+    }
+    city.meshes.push_back(m);
+    city.triangles = m.indices.size() / 3;
+    auto rs = RayScene::build(city);
+    ASSERT_TRUE(rs.isOk());
+    HeightGrid grid = HeightGrid::build(city, rs.value()->frameOrigin(), 128);
+    FarFieldOptions plain;
+    plain.nearDistance = 100;
+    plain.cache = false;
+    auto run = [&](double bound, double& psnrMin, double& psnrMean, uint64_t& rays, uint64_t& raysPlain) {
+        FarFieldOptions o = plain;
+        o.cache = true;
+        o.cacheErrorPx = bound;
+        FarField cached(*rs.value(), &grid, o), direct(*rs.value(), &grid, plain);
+        psnrMin = 1e9;
+        psnrMean = 0;
+        rays = raysPlain = 0;
+        const int frames = 40;
+        for (int f = 0; f < frames; ++f) {
+            Camera c = cam(glm::dvec3(0.2 * f, -0.1 * f, 1.7), 0.3 + 0.01 * f, 0.0, 192, 128);
+            Image a, b;
+            FrameStats sa, sb;
+            cached.render(c, nullptr, a, sa);
+            direct.render(c, nullptr, b, sb);
+            const uint64_t N = uint64_t(c.width) * c.height;
+            EXPECT_EQ(sa.pixels.covered + sa.pixels.horizonCulled + sa.pixels.cache + sa.pixels.rayHit + sa.pixels.rayMiss, N);
+            const double p = std::min(99.0, lumaPsnr(a, b));
+            psnrMin = std::min(psnrMin, p);
+            psnrMean += p / frames;
+            rays += sa.raysCast;
+            raysPlain += sb.raysCast;
+        }
+    };
+    double tightMin, tightMean, looseMin, looseMean, exactMin, exactMean;
+    uint64_t tightRays, looseRays, plainRays, exactRays;
+    // Bound 0: nothing but this very camera's pixels is reused: the uncached image, bit for bit.
+    run(0.0, exactMin, exactMean, exactRays, plainRays);
+    EXPECT_EQ(exactMin, 99.0);
+    EXPECT_EQ(exactRays, plainRays);
+    run(0.5, tightMin, tightMean, tightRays, plainRays);
+    run(4.0, looseMin, looseMean, looseRays, plainRays);
+    EXPECT_GE(tightMin, 33.0) << "mean " << tightMean;
+    EXPECT_GE(tightMean, 40.0);
+    EXPECT_LT(double(tightRays), 0.7 * double(plainRays));
+    // A looser bound: fewer rays, lower quality.
+    EXPECT_LT(looseRays, tightRays);
+    EXPECT_LT(looseMean, tightMean);
 }
