@@ -164,15 +164,28 @@ Result<std::vector<NodeId>> sanitizeXml(std::string& xml, const std::string& pat
 
 // The whole (decompressed) XML text.
 Result<std::string> readXml(const osmium::io::File& file, const std::string& path) {
+    const std::string tooLarge = "OSM file '" + path + "' holds more than " + std::to_string(kMaxXmlBytes >> 30) +
+                                 " GiB of XML: use .osm.pbf for extracts this large";
     std::string text;
+    if (file.compression() == osmium::io::file_compression::none) {
+        // Plain XML: read exactly the file (libosmium's decompressor would zero a 1 MiB buffer per read).
+        std::ifstream in(path, std::ios::binary | std::ios::ate);
+        if (!in) return Status::error("OSM file '" + path + "' cannot be opened");
+        const std::streamoff size = in.tellg();
+        if (size < 0) return Status::error("OSM file '" + path + "' cannot be read");
+        if (uint64_t(size) > kMaxXmlBytes) return Status::error(tooLarge);
+        text.resize(size_t(size));
+        in.seekg(0);
+        if (size > 0 && !in.read(text.data(), size)) return Status::error("OSM file '" + path + "' cannot be read");
+        return text;
+    }
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd < 0) return Status::error("OSM file '" + path + "' cannot be opened");
     auto dec = osmium::io::CompressionFactory::instance().create_decompressor(file.compression(), fd);
     for (std::string chunk = dec->read(); !chunk.empty(); chunk = dec->read()) {
         if (text.size() + chunk.size() > kMaxXmlBytes) {
             dec->close();
-            return Status::error("OSM file '" + path + "' holds more than " + std::to_string(kMaxXmlBytes >> 30) +
-                                 " GiB of XML: use .osm.pbf for extracts this large");
+            return Status::error(tooLarge);
         }
         text += chunk;
     }

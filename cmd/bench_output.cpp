@@ -111,6 +111,8 @@ json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneM
     j["city_triangles"] = city ? city->triangles : 0;
     j["size"] = {cfg.width, cfg.height};
     j["frames"] = cfg.frames;
+    j["sampling"] = cfg.sampleRuns == 0 ? std::string("spread") : cfg.sampleRuns == 1 ? std::string("consecutive")
+                                                                   : "runs:" + std::to_string(cfg.sampleRuns);
     j["fov_y_deg"] = cfg.fovYDeg;
     j["near_m"] = o.nearDistance;  // < 0 = auto (kept for older readers; see "options")
     j["options"] = {{"near_m", o.nearDistance < 0 ? json("auto") : json(o.nearDistance)},
@@ -118,6 +120,8 @@ json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneM
                     {"pixel_budget", o.pixelBudget < 0 ? json("unlimited") : json(o.pixelBudget)},
                     {"horizon_grid", o.horizonGrid},
                     {"cache", o.cache},
+                    {"cache_error_px", o.cacheErrorPx},
+                    {"frame_ms_target", o.frameMsTarget},
                     {"threads", o.threads}};
     j["effects"] = json::parse(cfg.effectsDeclared);
     const FrameEffects& fx = o.effects;

@@ -2,6 +2,8 @@
 // ones are errors naming the flag and the allowed range.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "cmd/options.h"
 
 using namespace vista;
@@ -48,6 +50,25 @@ TEST(Options, NearDistanceAndBudgets) {
     EXPECT_EQ(parseTriangleBudget("200000").value(), 200000u);
     for (const char* bad : {"-1", "1.5", "many", "", "10000000001"})
         expectBad(parseTriangleBudget(bad), bad, "--triangle-budget", "10000000000");
+}
+
+TEST(Options, SamplingAndCacheKnobs) {
+    EXPECT_EQ(parseSampling("spread").value(), 0);
+    EXPECT_EQ(parseSampling("consecutive").value(), 1);
+    EXPECT_EQ(parseSampling("runs:8").value(), 8);
+    EXPECT_EQ(parseSampling("runs:100000").value(), 100000);
+    for (const char* bad : {"runs:0", "runs:", "runs:x", "runs:100001", "runs:-3", "every", ""})
+        expectBad(parseSampling(bad), bad, "--sampling", "100000");
+    ModeOptions o;
+    EXPECT_TRUE(checkModeOptions(o).isOk());
+    o.cacheErrorPx = -0.1;
+    EXPECT_NE(checkModeOptions(o).message().find("--cache-error"), std::string::npos);
+    o.cacheErrorPx = NAN;
+    EXPECT_NE(checkModeOptions(o).message().find("0 .. 100"), std::string::npos);
+    o.cacheErrorPx = 100;
+    EXPECT_TRUE(checkModeOptions(o).isOk());
+    o.frameMsTarget = 10001;
+    EXPECT_NE(checkModeOptions(o).message().find("--frame-ms"), std::string::npos);
 }
 
 TEST(Options, FovReferenceAndModes) {

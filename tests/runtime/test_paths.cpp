@@ -211,6 +211,26 @@ TEST(Paths, SpreadCoversThePath) {
     for (size_t i = 1; i < s.size(); ++i) EXPECT_GT(s[i], s[i - 1]);
 }
 
+TEST(Paths, RunsAreConsecutiveSamplesSpreadOverThePath) {
+    Path p;
+    for (int i = 0; i < 100; ++i) p.samples.push_back({double(i), {}, 0, 0});
+    // 10 frames in 3 runs: lengths 4, 3, 3; starts 0, (100 - 3) / 2 rounded, 97.
+    auto r = p.runs(10, 3);
+    const std::vector<size_t> want = {0, 1, 2, 3, 49, 50, 51, 97, 98, 99};
+    EXPECT_EQ(r, want);
+    // One run: the first n samples; n runs: spread.
+    auto c = p.frames(5, 1);
+    EXPECT_EQ(c, (std::vector<size_t>{0, 1, 2, 3, 4}));
+    EXPECT_EQ(p.frames(5, 0), p.spread(5));
+    EXPECT_EQ(p.runs(5, 5), p.spread(5));
+    // More runs than frames are clamped; more frames than samples repeat the last one.
+    EXPECT_EQ(p.runs(3, 50).size(), 3u);
+    auto longer = p.runs(150, 1);
+    ASSERT_EQ(longer.size(), 150u);
+    EXPECT_EQ(longer.back(), 99u);
+    for (size_t i = 1; i < r.size(); ++i) EXPECT_GT(r[i], r[i - 1]);
+}
+
 TEST(Paths, RunUpStartsAtCruisingSpeedAndIsTheSameDrive) {
     // The run-up is the same simulation with its first runUp seconds dropped:
     // the path with run-up equals the tail of the path without it, and its
