@@ -121,6 +121,7 @@ json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneM
                     {"horizon_grid", o.horizonGrid},
                     {"cache", o.cache},
                     {"cache_error_px", o.cacheErrorPx},
+                    {"overlap", o.overlap},
                     {"frame_ms_target", o.frameMsTarget},
                     {"threads", o.threads}};
     j["effects"] = json::parse(cfg.effectsDeclared);

@@ -243,9 +243,11 @@ void addModeFlags(CLI::App& app, ModeFlags& f) {
                    "or 'unlimited' / -1 = no cap: every pixel over --cache-error is re-traced (default " + f.budget + ")");
     app.add_option("--horizon-grid", f.horizonGrid, "hybrid: horizon height-grid resolution, cells per side, 1 .. 8192 (default 512)");
     app.add_flag("--no-cache", f.noCache, "hybrid: panoramic image cache off (every far pixel traced)");
+    app.add_flag("--no-overlap", f.noOverlap,
+                 "hybrid: trace the horizon after the near field is drawn instead of on another thread during the draw");
     app.add_option("--cache-error", f.cacheError,
                    "hybrid: reuse a cached far pixel while its estimated reprojection error is below this many pixels, "
-                   "0 .. 100 (0 = only pixels traced by this very camera) (default 0.5)");
+                   "0 .. 100 (0 = only pixels traced by this very camera) (default 0.25)");
     app.add_option("--frame-ms", f.frameMs,
                    "hybrid: frame-time target in ms, 0 .. 10000: the far-field ray budget adapts to what the target leaves "
                    "after the near field (0 = no target) (default 0)");
@@ -285,6 +287,7 @@ Status parseModeFlags(const ModeFlags& f, ModeOptions& o) {
     o.horizonGrid = f.horizonGrid;
     o.cache = !f.noCache;
     o.cacheErrorPx = f.cacheError;
+    o.overlap = !f.noOverlap;
     o.frameMsTarget = f.frameMs;
     o.bakedFile = f.baked;
     o.threads = f.threads;

@@ -8,7 +8,7 @@
 // PathFlags: the walkthrough options (--path, --seed, --kind, --duration,
 // --run-up) of bench and view. ModeFlags: the render-mode options both `vista bench` and `vista view`
 // accept (--near, --triangle-budget, --budget, --horizon-grid, --no-cache,
-// --cache-error, --frame-ms, --baked, --threads), declared once by addModeFlags() and turned into
+// --cache-error, --frame-ms, --no-overlap, --baked, --threads), declared once by addModeFlags() and turned into
 // ModeOptions by parseModeFlags().
 #pragma once
 #include <cstdint>
@@ -79,8 +79,8 @@ Result<FrameEffects> runTimeEffects(const std::string& option, const Effects& de
 struct ModeFlags {
     std::string near = "100", triangleBudget = "0", budget = "unlimited";
     int horizonGrid = 512;
-    bool noCache = false;
-    double cacheError = 0.5, frameMs = 0.0;
+    bool noCache = false, noOverlap = false;
+    double cacheError = 0.25, frameMs = 0.0;
     std::string baked;
     int threads = 0;
 };

@@ -54,6 +54,9 @@ public:
         // it, the far field fills the rest with the same shading; FarField's
         // seam check covers the band between the plane and the near sphere.
         const double zFar = farPlane(nearD, camera);
+        // The horizon depends on the camera only: traced on another thread while the near field is drawn.
+        _far->setOptions(farOptions(nearD, zFar));
+        if (_ctx.options.overlap) _far->beginFrame(camera);
         FrameStats ns;
         VISTA_RETURN_IF_ERROR(_ctx.renderer->render(_root.get(), camera, zFar, &out, &_depth, ns));
         stats.stages.set(Stage::Near, ns.frameMs);
@@ -62,7 +65,6 @@ public:
         stats.triangles = ns.triangles ? ns.triangles : tris;
         stats.drawCalls = ns.drawCalls;
         // Far field on the CPU.
-        _far->setOptions(farOptions(nearD, zFar));
         const bool haveDepth = _depth.size() == size_t(camera.width) * size_t(camera.height);
         _far->render(camera, haveDepth ? _depth.data() : nullptr, out, stats);
         stats.frameMs = sw.ms();

@@ -46,6 +46,17 @@ void FarField::setOptions(const FarFieldOptions& o) {
     if (cacheChanged) _mem->cache.reset();
 }
 
+void FarField::beginFrame(const Camera& camera) {
+    if (_mem->earlyHorizon.valid()) _mem->earlyHorizon.wait();  // never two at once
+    _mem->earlyHorizon = std::future<HorizonResult>();
+    if (!_grid || _grid->empty() || !_options.horizon || !horizonApplies(camera)) return;
+    const bool moving = _mem->haveLast && !sameCamera(_mem->last, camera);
+    const HorizonOptions ho = horizonOptions(camera, _options, moving);
+    const HeightGrid* grid = _grid;
+    _mem->earlyCamera = camera;
+    _mem->earlyHorizon = std::async(std::launch::async, [grid, camera, ho] { return traceHorizon(*grid, camera, ho); });
+}
+
 void FarField::reset() {
     if (_mem->cache) _mem->cache->clear();
     _mem->prev = Image();
@@ -79,11 +90,21 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
         compositeStage(f, *_mem, false, stats);
         return;
     }
-    if (_options.horizon) horizonStage(f, _grid, _options, stats);
+    std::future<HorizonResult>* early = nullptr;
+    if (_mem->earlyHorizon.valid()) {
+        if (sameCamera(_mem->earlyCamera, camera)) early = &_mem->earlyHorizon;
+        else _mem->earlyHorizon.wait();
+    }
+    if (_options.horizon) horizonStage(f, _grid, _options, stats, early);
+    if (_mem->earlyHorizon.valid()) _mem->earlyHorizon.get();  // not used (all covered before, or horizon off)
     listPending(f);
     const bool useCache = _options.cache;
+    f.farDepth.swap(_mem->farDepth);  // reuse last frame's buffer (cacheStage refills it)
     if (useCache && !f.pending.empty()) cacheStage(f, *_mem, _options, stats);
-    else bypassCache(f);
+    else {
+        f.farDepth.clear();
+        bypassCache(f);
+    }
     if (!f.trace.empty()) {
         const double before = stats.stages.ms(Stage::Rays);
         raysStage(f, _rays, _options.threads, stats);
@@ -94,6 +115,7 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
     compositeStage(f, *_mem, useCache, stats);
     const double composite = stats.stages.ms(Stage::Composite) - before;
     _mem->compositeMs = _mem->compositeMs > 0 ? 0.8 * _mem->compositeMs + 0.2 * composite : composite;
+    f.farDepth.swap(_mem->farDepth);
 }
 
 }  // namespace vista

@@ -66,7 +66,7 @@ struct FarFieldOptions {
     // what the target leaves after the stages before the cache stage (ms per
     // ray measured as the frames go; at least 1 % of the pixels).
     int64_t pixelBudget = -1;
-    double cacheErrorPx = 0.5;
+    double cacheErrorPx = 0.25;
     double frameMsTarget = 0.0;
     bool cache = true;
     bool horizon = true;
@@ -108,6 +108,13 @@ public:
     // nothing drawn; null = nothing covered. Adds pixel counts, raysCast,
     // stage times and notes to `stats`.
     void render(const Camera& camera, const float* depth, Image& out, FrameStats& stats);
+    // Optional, before the near field of a frame is drawn: starts the horizon
+    // of `camera` on another thread (all columns), so that it overlaps the
+    // draw; render() of the same camera then waits for it instead of tracing
+    // (the Horizon stage time is the wait; a note says so). A render() of
+    // another camera discards it. No effect without a grid or with the
+    // horizon off or not applicable to the camera.
+    void beginFrame(const Camera& camera);
     // Drops the cache (walkthrough jump).
     void reset();
     // Per pixel of the last frame: a FarPixelClass (0 covered, 1 horizon, 2 cache, 3 hit, 4 miss).
@@ -122,7 +129,7 @@ private:
     const RayScene& _rays;
     const HeightGrid* _grid;
     FarFieldOptions _options;
-    std::unique_ptr<FarFieldMemory> _mem;  // cache, last frame, sky (far_field_stages.h)
+    std::unique_ptr<FarFieldMemory> _mem;  // cache, last frame, sky, early horizon (far_field_stages.h)
     std::vector<uint8_t> _class;
     std::vector<uint32_t> _traced;
 };

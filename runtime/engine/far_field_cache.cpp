@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "foundation/timing.h"
 #include "runtime/engine/far_field_stages.h"
 
@@ -46,12 +49,17 @@ void cacheStage(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, FrameS
     PanoramaCache& cache = *m.cache;
     cache.beginFrame(f.camera);
     const uint32_t W = uint32_t(f.width);
-    std::vector<CacheCandidate> cand(f.pending.size());
-    for (size_t k = 0; k < f.pending.size(); ++k) {
-        const uint32_t i = f.pending[k];
-        cand[k].pixel = i;
-        cand[k].cell = cache.index(f.rays.dir(int(i % W), int(i / W)), &cand[k].sub);
-    }
+    std::vector<CacheCandidate>& cand = m.cand;  // scratch kept across frames (no fresh pages per frame)
+    cand.resize(f.pending.size());
+    inArena(o.threads, [&] {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, cand.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t k = r.begin(); k != r.end(); ++k) {
+                const uint32_t i = f.pending[k];
+                cand[k].pixel = i;
+                cand[k].cell = cache.index(f.rays.dir(int(i % W), int(i / W)), &cand[k].sub);
+            }
+        });
+    });
     CachePolicy policy;
     policy.maxErrorPx = o.cacheErrorPx;
     policy.radPerPixel = 2.0 * std::tan(0.5 * f.camera.fovY) / std::max(1, f.height);
@@ -60,8 +68,8 @@ void cacheStage(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, FrameS
     policy.budget = cacheBudget(f, m, o, spentMs);
     if (o.frameMsTarget > 0) stats.notes.push_back("cache budget " + std::to_string(policy.budget) + " rays");
     f.farDepth.assign(f.pixelCount, INFINITY);
-    std::vector<uint8_t> trace;
-    cache.selectForTracing(cand, policy, trace);
+    std::vector<uint8_t>& trace = m.traceMarks;
+    inArena(o.threads, [&] { cache.selectForTracing(cand, policy, trace); });
     f.trace.clear();
     f.traceCells.clear();
     f.traceSubs.clear();

@@ -7,18 +7,31 @@
 
 namespace vista {
 
-void horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o, FrameStats& stats) {
+HorizonOptions horizonOptions(const Camera& camera, const FarFieldOptions& o, bool moving) {
+    (void)camera;
+    HorizonOptions ho;
+    ho.nearDistance = o.nearIsDistance ? o.nearDistance : 0.0;
+    ho.subsample = moving ? std::max(1, o.horizonSubsampleMoving) : 1;
+    if (o.effects.haze) ho.maxEyeDepth = o.effects.hazeFar();  // nothing beyond is traced
+    return ho;
+}
+
+void horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o, FrameStats& stats,
+                  std::future<HorizonResult>* early) {
     if (!grid) {
         stats.notes.push_back("horizon off: no height grid");
         return;
     }
     Stopwatch sw;
-    HorizonOptions ho;
-    ho.nearDistance = o.nearIsDistance ? o.nearDistance : 0.0;
-    ho.subsample = f.moving ? std::max(1, o.horizonSubsampleMoving) : 1;
-    ho.columnNeeded = &f.columnNeeded;
-    if (f.fx->haze) ho.maxEyeDepth = f.fx->hazeFar();  // nothing beyond is traced
-    const HorizonResult hr = traceHorizon(*grid, f.camera, ho);
+    HorizonResult hr;
+    if (early && early->valid()) {
+        hr = early->get();  // traced while the near field was drawn; the stage time is the wait
+        stats.notes.push_back("horizon overlapped with the near field");
+    } else {
+        HorizonOptions ho = horizonOptions(f.camera, o, f.moving);
+        ho.columnNeeded = &f.columnNeeded;
+        hr = traceHorizon(*grid, f.camera, ho);
+    }
     if (!hr.active) {
         stats.notes.push_back(hr.reason);
         return;

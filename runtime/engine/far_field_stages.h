@@ -7,6 +7,7 @@
 // nothing throws.
 #pragma once
 #include <cstdint>
+#include <future>
 #include <memory>
 #include <vector>
 
@@ -47,9 +48,15 @@ struct FarFieldMemory {
     double skyKey[5] = {1e300, 0, 0, 0, 0};
     Camera last;
     bool haveLast = false;
+    std::future<HorizonResult> earlyHorizon;  // FarField::beginFrame
+    Camera earlyCamera;
     double lastMinDepth = 0;   // nearest far surface of the last cache frame (m; 0 = none yet)
     double msPerRay = 0;       // ray stage ms per ray (moving average; 0 = not measured)
     double compositeMs = 0;    // composite stage ms (moving average)
+    // Scratch of the cache stage, kept so that a frame does not fault in fresh pages.
+    std::vector<CacheCandidate> cand;
+    std::vector<uint8_t> traceMarks;
+    std::vector<float> farDepth;  // swapped into FarFrame::farDepth for the frame
 };
 
 // Radius (pixels) of the screen window whose nearest far surface a cached cell records.
@@ -103,7 +110,13 @@ void hazeCoveredStage(FarFrame& f, const FarFieldOptions& o, FrameStats& stats);
 // above their column's row become horizonCulled and Horizon is recorded; when
 // it does not (no grid, camera rolled, zenith/nadir in view) a note says why,
 // nothing is culled and no time is recorded.
-void horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o, FrameStats& stats);
+// early (optional): the horizon of this very camera traced ahead of the
+// frame (FarField::beginFrame, all columns); then the stage waits for it
+// (the wait is the recorded time) and notes "horizon overlapped".
+void horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o, FrameStats& stats,
+                  std::future<HorizonResult>* early = nullptr);
+// The horizon options of a frame (near distance, haze depth, subsampling while moving).
+HorizonOptions horizonOptions(const Camera& camera, const FarFieldOptions& o, bool moving);
 // No far geometry: every pending pixel becomes horizonCulled (sky). No time.
 void cullAllPending(FarFrame& f, FrameStats& stats);
 

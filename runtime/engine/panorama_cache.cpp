@@ -6,6 +6,9 @@
 #include <cmath>
 #include <numeric>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "foundation/status.h"
 
 namespace vista {
@@ -68,6 +71,8 @@ void PanoramaCache::clear() {
     _color.assign(n, glm::u8vec4(0));
     _near.assign(n, INFINITY);
     _sub.assign(n, glm::u8vec2(128));
+    _stamped.assign(n, 0u);
+    _stamp = 0;
     _record.assign(n, 0);
     _records.assign(1, Record{});
     _baseline.assign(1, INFINITY);
@@ -144,16 +149,22 @@ double PanoramaCache::error(int64_t cell, glm::u8vec2 sub, const CachePolicy& p)
 int64_t PanoramaCache::selectForTracing(const std::vector<CacheCandidate>& cand, const CachePolicy& p,
                                         std::vector<uint8_t>& trace) {
     trace.assign(cand.size(), 0);
+    // Errors in parallel (pure reads), then the selection in candidate order (deterministic).
+    _error.resize(cand.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, cand.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i)
+            _error[i] = cand[i].cell < 0 ? -2.0 : error(cand[i].cell, cand[i].sub, p);
+    });
     int64_t forced = 0;
     // Candidates over the bound, with their errors (largest traced first under a budget).
     std::vector<std::pair<double, uint32_t>> over;
     for (size_t i = 0; i < cand.size(); ++i) {
-        if (cand[i].cell < 0) {  // not cacheable: always traced
+        const double e = _error[i];
+        if (e == -2.0) {  // not cacheable: always traced
             trace[i] = 1;
             ++forced;
             continue;
         }
-        const double e = error(cand[i].cell, cand[i].sub, p);
         if (e < 0 || e < p.maxErrorPx) continue;
         over.push_back({e, uint32_t(i)});
     }
@@ -172,22 +183,23 @@ int64_t PanoramaCache::selectForTracing(const std::vector<CacheCandidate>& cand,
 void PanoramaCache::store(const std::vector<int64_t>& cells, const std::vector<glm::u8vec2>& subs,
                           const std::vector<glm::u8vec4>& colors, const std::vector<float>& nearDistance) {
     VISTA_CHECK(cells.size() == colors.size() && cells.size() == nearDistance.size() && cells.size() == subs.size());
+    // Cells hit by two pixels this frame hold only one of them: not exact (record 0).
+    ++_stamp;
+    if (_stamp == 0) {  // wrapped: forget old stamps
+        std::fill(_stamped.begin(), _stamped.end(), 0u);
+        _stamp = 1;
+    }
     for (size_t i = 0; i < cells.size(); ++i) {
         int64_t c = cells[i];
         if (c < 0) continue;
-        _color[size_t(c)] = colors[i];
-        _sub[size_t(c)] = subs[i];
-        _near[size_t(c)] = nearDistance[i];
-        _record[size_t(c)] = _current;
+        const size_t k = size_t(c);
+        const bool twice = _stamped[k] == _stamp;
+        _stamped[k] = _stamp;
+        _color[k] = colors[i];
+        _sub[k] = subs[i];
+        _near[k] = nearDistance[i];
+        _record[k] = twice ? 0 : _current;
     }
-    // Cells hit by two pixels this frame hold only one of them: not exact.
-    std::vector<int64_t> sorted;
-    sorted.reserve(cells.size());
-    for (int64_t c : cells)
-        if (c >= 0) sorted.push_back(c);
-    std::sort(sorted.begin(), sorted.end());
-    for (size_t i = 1; i < sorted.size(); ++i)
-        if (sorted[i] == sorted[i - 1]) _record[size_t(sorted[i])] = 0;
 }
 
 }  // namespace vista

@@ -56,7 +56,7 @@ struct CacheCandidate {
 };
 
 struct CachePolicy {
-    double maxErrorPx = 0.5;     // reuse while the error is below this (pixels, >= 0)
+    double maxErrorPx = 0.25;    // reuse while the error is below this (pixels, >= 0)
     double radPerPixel = 1e-3;   // angular size of a pixel at the image centre (> 0)
     double lowerDepth = 0.0;     // no far surface is nearer (metres); 0 = unknown (then the window term is +inf when moving)
     double windowPx = 8.0;       // radius of the screen window that `near` of a cell covers (pixels)
@@ -116,6 +116,9 @@ private:
     std::vector<Record> _records;  // [0] = never traced
     uint32_t _current = 0;
     std::vector<double> _baseline;  // per record: distance to the current eye (beginFrame)
+    std::vector<uint32_t> _stamped;  // per cell: the store() call that last wrote it
+    uint32_t _stamp = 0;
+    std::vector<double> _error;      // scratch of selectForTracing
 };
 
 }  // namespace vista

@@ -537,3 +537,49 @@ TEST(FarFieldFrame, HazeOfCoveredPixelsMatchesTheFormulaAtTheirDepth) {
                 ASSERT_EQ(std::memcmp(&plain.rgba[i * 4], &in.rgba[i * 4], 4), 0);
     }
 }
+
+// The horizon traced ahead of the frame (FarField::beginFrame, overlapping the
+// near-field draw) gives the very frame the in-frame horizon gives; a
+// beginFrame for another camera is not used.
+TEST(FarFieldFrame, EarlyHorizonGivesTheSameFrame) {
+    const TestCity t = testCity(9, 60);
+    ASSERT_TRUE(t.rays);
+    Camera c = cam(glm::dvec3(0, -190, 1.7), 0.2);
+    const size_t N = size_t(c.width) * size_t(c.height);
+    std::vector<float> depth(N, 1.0f);
+    for (size_t i = N * 2 / 3; i < N; ++i) depth[i] = 0.5f;  // bottom third covered
+    FarFieldOptions o;
+    o.nearDistance = 0;
+    o.cache = false;
+    FarField early(*t.rays, &t.grid, o), plain(*t.rays, &t.grid, o);
+    auto has = [](const FrameStats& s, const std::string& what) {
+        for (const auto& n : s.notes)
+            if (n.find(what) != std::string::npos) return true;
+        return false;
+    };
+    for (int f = 0; f < 3; ++f) {
+        c.eye.x += 3.0;
+        Image a, b;
+        FrameStats sa, sb;
+        early.beginFrame(c);
+        early.render(c, depth.data(), a, sa);
+        plain.render(c, depth.data(), b, sb);
+        EXPECT_TRUE(has(sa, "horizon overlapped"));
+        EXPECT_FALSE(has(sb, "horizon overlapped"));
+        EXPECT_GT(sa.pixels.horizonCulled, 0u);
+        EXPECT_EQ(sa.pixels.horizonCulled, sb.pixels.horizonCulled);
+        EXPECT_EQ(sa.raysCast, sb.raysCast);
+        EXPECT_EQ(a.rgba, b.rgba);
+        EXPECT_EQ(early.classification(), plain.classification());
+    }
+    // Begun for one camera, rendered for another: traced in the frame as usual.
+    Camera other = c;
+    other.heading += 0.3;
+    early.beginFrame(c);
+    Image a, b;
+    FrameStats sa, sb;
+    early.render(other, depth.data(), a, sa);
+    plain.render(other, depth.data(), b, sb);
+    EXPECT_FALSE(has(sa, "horizon overlapped"));
+    EXPECT_EQ(a.rgba, b.rgba);
+}
