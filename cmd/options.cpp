@@ -233,7 +233,7 @@ Result<std::vector<int>> parseSweep(const std::string& s) {
 
 void addModeFlags(CLI::App& app, ModeFlags& f) {
     app.add_option("--near", f.near,
-                   "near-field distance in metres, 1 .. 100000, or 'auto' (hybrid: adaptive split per frame; the other "
+                   "near-field distance in metres, 1 .. 100000, or 'auto' (hybrid: adaptive split per frame among 0 = ray casting, 15 .. 800 m and everything; the other "
                    "modes then use 100) (default " + f.near + ")");
     app.add_option("--triangle-budget", f.triangleBudget,
                    "hybrid: near field = the nearest 40 m chunks up to N triangles instead of --near, 0 .. 10000000000 "

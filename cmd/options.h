@@ -77,7 +77,7 @@ Result<Effects> parseEffectsOption(const std::string& s, const Effects& base);
 Result<FrameEffects> runTimeEffects(const std::string& option, const Effects& declared, bool quiet, const char* cmd);
 
 struct ModeFlags {
-    std::string near = "100", triangleBudget = "0", budget = "unlimited";
+    std::string near = "auto", triangleBudget = "0", budget = "unlimited";
     int horizonGrid = 512;
     bool noCache = false, noOverlap = false;
     double cacheError = 0.25, frameMs = 0.0;

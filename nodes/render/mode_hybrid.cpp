@@ -18,7 +18,11 @@ namespace vista {
 
 namespace {
 
-std::string nearAutoNote(double nearD) { return "near auto: " + std::to_string(int(std::lround(nearD))) + " m"; }
+std::string nearAutoNote(double nearD) {
+    if (!std::isfinite(nearD)) return "near auto: everything (no far field)";
+    if (nearD <= 0) return "near auto: 0 m (ray casting)";
+    return "near auto: " + std::to_string(int(std::lround(nearD))) + " m";
+}
 
 class HybridMode : public RenderMode {
 public:
@@ -115,7 +119,7 @@ private:
         return autoSplit() ? _adaptive->choose(camera, _ctx.options.pixelBudget) : _ctx.options.nearDistance;
     }
     double farPlane(double nearD, const Camera& camera) const {
-        return byBudget() ? 0.0 : std::max(nearD, camera.zNear * 4.0);
+        return byBudget() || !std::isfinite(nearD) ? 0.0 : std::max(nearD, camera.zNear * 4.0);  // 0 = infinite
     }
     FarFieldOptions farOptions(double nearD, double zFar) const {
         FarFieldOptions o;

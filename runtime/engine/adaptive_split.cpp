@@ -90,20 +90,24 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
     if (_frame % std::max(1, _o.probeInterval) == 0 || _probeT.empty()) probe(camera);
     const int frame = _frame++;
     if (_probeT.empty()) return _current;
-    const int n = std::max(2, _o.candidates);
+    const int g = std::max(2, _o.candidates);
     // Sort objects by distance once, then sweep the candidates.
     std::vector<std::pair<double, uint64_t>> byDist;
     byDist.reserve(_objects.size());
     for (const auto& ob : _objects) byDist.push_back({boxDistance(ob, camera.eye), ob.triangles});
     std::sort(byDist.begin(), byDist.end());
-    std::vector<double> cand(static_cast<size_t>(n)), cost(static_cast<size_t>(n));
+    std::vector<double> cand;
+    if (_o.rayCastOnly) cand.push_back(0.0);
+    for (int i = 0; i < g; ++i) cand.push_back(_o.minDistance * std::pow(_o.maxDistance / _o.minDistance, double(i) / (g - 1)));
+    if (_o.everythingNear) cand.push_back(std::numeric_limits<double>::infinity());
+    const int n = int(cand.size());
+    std::vector<double> cost(cand.size());
     size_t k = 0;
     uint64_t tris = 0;
     int bestI = 0;
     for (int i = 0; i < n; ++i) {
-        double d = _o.minDistance * std::pow(_o.maxDistance / _o.minDistance, double(i) / (n - 1));
+        const double d = cand[size_t(i)];
         while (k < byDist.size() && byDist[k].first <= d) tris += byDist[k++].second;
-        cand[size_t(i)] = d;
         cost[size_t(i)] = _a * double(tris) + _b * predictedRays(d);
         if (cost[size_t(i)] < cost[size_t(bestI)]) bestI = i;
     }

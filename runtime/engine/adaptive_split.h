@@ -16,7 +16,8 @@
 // `probeStride`-th pixel cast once per `probeInterval` frames: a pixel whose
 // first hit lies beyond d, or that misses below the horizon, needs a ray). It
 // minimises a * triangles(d) + b * rays(d) over candidate distances
-// (geometric steps between minDistance and maxDistance). rays(d) is not capped
+// (geometric steps between minDistance and maxDistance, plus 0 = ray casting
+// and +infinity = everything rasterised when the options allow them). rays(d) is not capped
 // by the pixel budget: the aim is the lowest frame time at full accuracy (a
 // budget-capped model would always pick the smallest near field and let the
 // cache's error grow). Every `exploreEvery`-th choice steps one candidate up
@@ -56,12 +57,15 @@ struct AdaptiveSplitOptions {
     double initialDistance = 100.0;
     int window = 60;            // frames in the raster-cost fit
     int exploreEvery = 7;       // every n-th choice explores a neighbouring candidate (0 = never)
+    // Two more candidates at the ends: 0 (nothing rasterised beyond the eye's
+    // own chunk: ray casting) and +infinity (everything rasterised, no far field).
+    bool rayCastOnly = true, everythingNear = true;
 };
 
 class AdaptiveSplit {
 public:
     AdaptiveSplit(const std::vector<SplitObject>& objects, const RayScene* rays, const AdaptiveSplitOptions& o = {});
-    // Near distance to use for this frame.
+    // Near distance to use for this frame (0 and +infinity possible, see the options).
     double choose(const Camera& camera, int64_t pixelBudget);
     // Measurements of the frame just rendered.
     void record(uint64_t triangles, double rasterMs, uint64_t rays, double rayMs);

@@ -49,7 +49,7 @@ void FarField::setOptions(const FarFieldOptions& o) {
 void FarField::beginFrame(const Camera& camera) {
     if (_mem->earlyHorizon.valid()) _mem->earlyHorizon.wait();  // never two at once
     _mem->earlyHorizon = std::future<HorizonResult>();
-    if (!_grid || _grid->empty() || !_options.horizon || !horizonApplies(camera)) return;
+    if (!_grid || _grid->empty() || !_options.horizon || !std::isfinite(_options.nearDistance) || !horizonApplies(camera)) return;
     const bool moving = _mem->haveLast && !sameCamera(_mem->last, camera);
     const HorizonOptions ho = horizonOptions(camera, _options, moving);
     const HeightGrid* grid = _grid;
@@ -112,7 +112,9 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
         _mem->msPerRay = _mem->msPerRay > 0 ? 0.8 * _mem->msPerRay + 0.2 * perRay : perRay;
     }
     const double before = stats.stages.ms(Stage::Composite);
-    compositeStage(f, *_mem, useCache, stats);
+    // The last frame is the fallback of never-traced cells left out by a budget: kept only under one.
+    const bool budgeted = _options.pixelBudget >= 0 || _options.frameMsTarget > 0;
+    compositeStage(f, *_mem, useCache, stats, useCache && budgeted);
     const double composite = stats.stages.ms(Stage::Composite) - before;
     _mem->compositeMs = _mem->compositeMs > 0 ? 0.8 * _mem->compositeMs + 0.2 * composite : composite;
     f.farDepth.swap(_mem->farDepth);

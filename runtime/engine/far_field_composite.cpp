@@ -22,7 +22,7 @@ const Image& skyImage(FarFieldMemory& m, const FarFrame& f) {
     return m.sky;
 }
 
-void compositeStage(FarFrame& f, FarFieldMemory& m, bool cacheMode, FrameStats& stats) {
+void compositeStage(FarFrame& f, FarFieldMemory& m, bool cacheMode, FrameStats& stats, bool keepFrame) {
     Stopwatch sw;
     for (size_t i = 0; i < f.pixelCount; ++i)
         if (f.cls[i] == kFarHorizon) std::copy_n(&f.sky->rgba[i * 4], 4, &f.out.rgba[i * 4]);
@@ -55,7 +55,8 @@ void compositeStage(FarFrame& f, FarFieldMemory& m, bool cacheMode, FrameStats& 
             }
             m.cache->store(f.traceCells, f.traceSubs, traced, nearest);
         }
-        m.prev = f.out;  // fallback for never-traced cache cells next frame
+        if (keepFrame) m.prev = f.out;  // fallback for never-traced cache cells next frame
+        else m.prev = Image();
     }
     stats.stages.add(Stage::Composite, sw.ms());
 }

@@ -12,7 +12,8 @@
 namespace vista {
 
 bool seamCheckApplies(const FarFrame& f, const RayScene& rays, const FarFieldOptions& o) {
-    return f.depth && f.covered > 0 && o.verifySeam && o.nearIsDistance && o.nearDistance > 0 && rays.triangleCount() > 0;
+    return f.depth && f.covered > 0 && o.verifySeam && o.nearIsDistance && o.nearDistance > 0 && std::isfinite(o.nearDistance) &&
+           rays.triangleCount() > 0;
 }
 
 void seamStage(FarFrame& f, const RayScene& rays, const FarFieldOptions& o, FrameStats& stats) {

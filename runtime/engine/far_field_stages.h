@@ -150,8 +150,9 @@ const Image& skyImage(FarFieldMemory& m, const FarFrame& f);
 // Composite (far_field_composite.cpp). Writes sky into every horizonCulled
 // pixel; in cache mode, stores the traced pixels' colours (now in out) into
 // m.cache with the nearest far surface of their window (f.farDepth), sets
-// m.lastMinDepth and keeps the frame in m.prev. Assigns no class. Records
-// Composite.
-void compositeStage(FarFrame& f, FarFieldMemory& m, bool cacheMode, FrameStats& stats);
+// m.lastMinDepth and keeps the frame in m.prev (when keepFrame). Assigns no
+// class. Records Composite.
+// keepFrame: keep the frame in m.prev (else m.prev is emptied; then never-traced cells left out show the sky).
+void compositeStage(FarFrame& f, FarFieldMemory& m, bool cacheMode, FrameStats& stats, bool keepFrame = true);
 
 }  // namespace vista

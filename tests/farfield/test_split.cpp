@@ -1,6 +1,8 @@
 // Near/far split selection and the adaptive near distance.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "runtime/engine/adaptive_split.h"
 #include "runtime/engine/ray_scene.h"
 #include "tests/farfield/fixtures.h"
@@ -61,8 +63,31 @@ TEST(Split, AdaptiveChoiceFollowsTheMeasuredCosts) {
     double dT = cheapTris.choose(c, -1), dR = cheapRays.choose(c, -1);
     EXPECT_GT(dT, dR);
     EXPECT_NEAR(cheapTris.msPerTriangle(), 1e-7, 1e-9);  // the fit separates fixed and per-triangle cost
-    EXPECT_GE(dT, o.minDistance);
-    EXPECT_LE(dT, o.maxDistance * 1.0001);
+    // Ray casting never draws more than the smallest geometric candidate.
+    EXPECT_LE(cheapRays.predictedTriangles(c.eye, dR), cheapRays.predictedTriangles(c.eye, o.minDistance));
+    // The ends, from outside the city (every box 300 m or more away): rays nearly free -> 0 (ray
+    // casting); triangles nearly free and boxes beyond 800 m -> everything rasterised.
+    Camera out = c;
+    out.eye = glm::dvec3(0, -700, 1.7);
+    AdaptiveSplit endRays(objs, rs.value().get(), o), endTris(objs, rs.value().get(), o);
+    for (int i = 0; i < 10; ++i) {
+        endTris.record(uint64_t(20000 + 4000 * i), 1.0 + 1e-7 * (20000 + 4000 * i), 5000, 5000 * 0.01);
+        endRays.record(uint64_t(20000 + 4000 * i), 1.0 + 1e-2 * (20000 + 4000 * i), 5000, 5000 * 1e-6);
+    }
+    EXPECT_EQ(endRays.choose(out, -1), 0.0);
+    EXPECT_TRUE(std::isinf(endTris.choose(out, -1)));
+    // Without the ends, the choice stays within the geometric candidates.
+    AdaptiveSplitOptions inner = o;
+    inner.rayCastOnly = inner.everythingNear = false;
+    AdaptiveSplit innerTris(objs, rs.value().get(), inner), innerRays(objs, rs.value().get(), inner);
+    for (int i = 0; i < 10; ++i) {
+        innerTris.record(uint64_t(20000 + 4000 * i), 1.0 + 1e-7 * (20000 + 4000 * i), 5000, 5000 * 0.01);
+        innerRays.record(uint64_t(20000 + 4000 * i), 1.0 + 1e-2 * (20000 + 4000 * i), 5000, 5000 * 1e-6);
+    }
+    const double iT = innerTris.choose(c, -1), iR = innerRays.choose(c, -1);
+    EXPECT_GT(iT, iR);
+    EXPECT_GE(iR, o.minDistance);
+    EXPECT_LE(iT, o.maxDistance * 1.0001);
     // Predictions: more distance, more triangles, fewer rays.
     EXPECT_LE(cheapTris.predictedTriangles(c.eye, 50), cheapTris.predictedTriangles(c.eye, 400));
     EXPECT_GE(cheapTris.predictedRays(50), cheapTris.predictedRays(400));

@@ -735,7 +735,7 @@ TEST(BenchCli, HybridPixelClassesAndOptions) {
     const Run runs[] = {
         {"--near auto --budget 1000 --no-cache --horizon-grid 64", "auto", 1000, 64, false, 0},
         {"--near 60 --budget unlimited", 60.0, "unlimited", 512, true, 0},
-        {"--triangle-budget 5000", 100.0, "unlimited", 512, true, 5000},
+        {"--triangle-budget 5000", "auto", "unlimited", 512, true, 5000},  // the default --near (unused: a budget)
     };
     for (size_t i = 0; i < 3; ++i) {
         const Run& r = runs[i];
