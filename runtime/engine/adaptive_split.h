@@ -58,7 +58,8 @@ struct AdaptiveSplitOptions {
     int window = 60;            // frames in the raster-cost fit
     int exploreEvery = 7;       // every n-th choice explores a neighbouring candidate (0 = never)
     // Two more candidates at the ends: 0 (nothing rasterised beyond the eye's
-    // own chunk: ray casting) and +infinity (everything rasterised, no far field).
+    // own chunk: ray casting) and +infinity (everything rasterised, no far
+    // field), offered once both costs have been measured (not on the priors).
     bool rayCastOnly = true, everythingNear = true;
 };
 
@@ -82,7 +83,7 @@ private:
     const RayScene* _rays;
     AdaptiveSplitOptions _o;
     double _a = 2e-5, _b = 5e-4;  // priors: ms per triangle, ms per ray (replaced by measurements)
-    bool _haveB = false;
+    bool _haveA = false, _haveB = false;  // measured (not the priors)
     std::vector<std::pair<double, double>> _rasterSamples;  // (triangles, ms), last `window` frames
     double _current;
     int _frame = 0;

@@ -55,6 +55,13 @@ TEST(Split, AdaptiveChoiceFollowsTheMeasuredCosts) {
     AdaptiveSplitOptions o;
     o.exploreEvery = 0;
     AdaptiveSplit cheapRays(objs, rs.value().get(), o), cheapTris(objs, rs.value().get(), o);
+    {
+        // Nothing measured yet: the ends (0, everything) are not offered on the priors.
+        AdaptiveSplit fresh(objs, rs.value().get(), o);
+        const double d = fresh.choose(c, -1);
+        EXPECT_GE(d, o.minDistance);
+        EXPECT_TRUE(std::isfinite(d));
+    }
     // Rays expensive, triangles nearly free -> a large near field.
     for (int i = 0; i < 10; ++i) {
         cheapTris.record(uint64_t(20000 + 4000 * i), 1.0 + 1e-7 * (20000 + 4000 * i), 5000, 5000 * 0.01);
