@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cmd/options.h"
 #include "cmd/plot.h"
 #include "foundation/atomic_file.h"
 #include "runtime/engine/metrics.h"
@@ -111,8 +112,7 @@ json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneM
     j["city_triangles"] = city ? city->triangles : 0;
     j["size"] = {cfg.width, cfg.height};
     j["frames"] = cfg.frames;
-    j["sampling"] = cfg.sampleRuns == 0 ? std::string("spread") : cfg.sampleRuns == 1 ? std::string("consecutive")
-                                                                   : "runs:" + std::to_string(cfg.sampleRuns);
+    j["sampling"] = samplingName(cfg.sampleRuns);
     j["fov_y_deg"] = cfg.fovYDeg;
     j["near_m"] = o.nearDistance;  // < 0 = auto (kept for older readers; see "options")
     j["options"] = {{"near_m", o.nearDistance < 0 ? json("auto") : json(o.nearDistance)},

@@ -29,7 +29,7 @@ const char* const kCmd = "vista bench";
 
 struct BenchArgs {
     std::string city, size = "640x480", modes = "full,near", out, reference = "full", fov = "60", sweep, effects;
-    std::string sampling = "runs:" + std::to_string(kDefaultSampleRuns);
+    std::string sampling = samplingName(kDefaultSampleRuns);
     std::vector<fs::path> createdOut;  // directories of --out made by this run, deepest first
     bool quiet = false;
     PathFlags path;
@@ -47,7 +47,7 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
     app.add_option("--sampling", a.sampling,
                    "which path samples are the frames: 'spread' (evenly over the whole path), 'consecutive' (the first "
                    "N samples, as a simulator renders them) or 'runs:K' (K runs of consecutive samples, their starts "
-                   "spread over the path) (default runs:" + std::to_string(kDefaultSampleRuns) + ")");
+                   "spread over the path) (default " + samplingName(kDefaultSampleRuns) + ")");
     app.add_option("--size", a.size, "image size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 640x480)");
     app.add_option("--modes", a.modes, modeHelp);
     addModeFlags(app, a.mode);

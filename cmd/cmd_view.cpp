@@ -51,7 +51,7 @@ struct ViewArgs {
     std::string city, size = "1280x720", screenshot, mode = "full", fov = "60", effects;
     int frames = 0;
     bool step = false, noHud = false;
-    std::string sampling = "runs:" + std::to_string(kDefaultSampleRuns);
+    std::string sampling = samplingName(kDefaultSampleRuns);
     int sampleRuns = kDefaultSampleRuns;
     PathFlags path;
     ModeFlags modeFlags;
@@ -73,7 +73,7 @@ void declareFlags(CLI::App& app, ViewArgs& a) {
                  "with --frames N and a path: show the N frames `vista bench --frames N` renders (one path sample per frame)");
     app.add_option("--sampling", a.sampling,
                    "with --step: the path samples shown, as vista bench's --sampling: spread, consecutive or runs:K "
-                   "(default runs:" + std::to_string(kDefaultSampleRuns) + ")");
+                   "(default " + samplingName(kDefaultSampleRuns) + ")");
     app.add_flag("--no-hud", a.noHud, "no text overlay (for screenshots compared with `vista bench`)");
     app.add_option("--screenshot", a.screenshot, "write a PNG of the last frame (use with --frames)");
     app.add_option("--effects", a.effects,

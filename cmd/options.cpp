@@ -214,6 +214,10 @@ Result<int> parseSampling(const std::string& s) {
     return Status::error("--sampling '" + s + "': expected spread, consecutive or runs:K (K in 1 .. 100000)");
 }
 
+std::string samplingName(int runs) {
+    return runs <= 0 ? "spread" : runs == 1 ? "consecutive" : "runs:" + std::to_string(runs);
+}
+
 Result<std::vector<int>> parseSweep(const std::string& s) {
     const std::string prefix = "sizes=";
     if (s.rfind(prefix, 0) != 0) return Status::error("--sweep '" + s + "': expected sizes=S1,S2,... (metres)");

@@ -55,6 +55,8 @@ Result<std::vector<std::string>> parseModeList(const std::string& s);
 // --sampling spread|consecutive|runs:K (K in 1 .. 100000): 0 = spread, 1 =
 // consecutive, K = runs (Path::frames).
 Result<int> parseSampling(const std::string& s);
+// The --sampling text of a value of parseSampling (its inverse).
+std::string samplingName(int runs);
 // --mode NAME: one registered mode.
 Result<std::string> parseModeName(const std::string& s);
 // vista bake: --cells "3,7,10-20" -> sorted unique ids (0 .. 1e8); --shard K/N

@@ -14,28 +14,13 @@
 # docs/effects.md is replaced only when every step succeeded (written to a temp file, then moved).
 set -euo pipefail
 
-START=$SECONDS
 INVOCATION="docs/tools/effects.sh${1:+ $1}${2:+ $2}"
-KEEP_OUT=1
-if [ -n "${1:-}" ]; then OUT=$(realpath -m "$1"); else OUT=$(mktemp -d /tmp/vista-effects.XXXXXX); KEEP_OUT=0; fi
-VISTA=$(realpath -m "${2:-build/vista}")
-REPO=$(cd "$(dirname "$0")/../.." && pwd)
-cd "$REPO"
+source "$(dirname "$0")/lib.sh"
+doc_setup effects.sh effects 1280x1024x24 "$@"
+DOC_TMP_FILES=(docs/.effects.md.tmp)
 IMAGE_PSNR=${IMAGE_PSNR:-$(dirname "$VISTA")/tests/bench/image_psnr}
 
-die() { echo "effects.sh: error: $*" >&2; exit 1; }
-log() { printf '[effects.sh %4ds] %s\n' $((SECONDS - START)) "$*" >&2; }
-[ -x "$VISTA" ] || die "vista binary not found: $VISTA"
 [ -x "$IMAGE_PSNR" ] || die "image_psnr not found: $IMAGE_PSNR"
-command -v python3 >/dev/null || die "python3 is needed"
-XVFB=()
-if [ -z "${DISPLAY:-}" ]; then
-  command -v xvfb-run >/dev/null || die "no DISPLAY and no xvfb-run"
-  XVFB=(xvfb-run -a -s "-screen 0 1280x1024x24")
-fi
-cleanup() { if [ "$KEEP_OUT" = 0 ]; then rm -rf "$OUT"; fi; rm -f "$REPO/docs/.effects.md.tmp"; }
-trap cleanup EXIT
-trap 'echo "effects.sh: failed at line $LINENO: $BASH_COMMAND" >&2' ERR
 
 PARAMS=data/default.json
 FRAMES=24

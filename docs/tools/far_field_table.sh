@@ -15,12 +15,9 @@
 #        PARETO_IMAGE (default 640x480), PARETO_CITY (default the first of CITY_SIZES)
 # Needs python3 and, without a display, xvfb-run. About 45 minutes on 2 cores with llvmpipe.
 set -euo pipefail
-START=$SECONDS
-KEEP_OUT=1
-if [ -n "${1:-}" ]; then OUT=$(realpath -m "$1"); else OUT=$(mktemp -d /tmp/vista-fftable.XXXXXX); KEEP_OUT=0; fi
-VISTA=$(realpath -m "${2:-build/vista}")
-REPO=$(cd "$(dirname "$0")/../.." && pwd)
-cd "$REPO"
+source "$(dirname "$0")/lib.sh"
+doc_setup far_field_table.sh fftable 1920x1080x24 "$@"
+DOC_TMP_FILES=(docs/.results.md.tmp docs/img/.cache_pareto.svg.tmp)
 CITY_SIZES=${CITY_SIZES:-"2000 8000"}
 KINDS=${KINDS:-"car walk fly"}
 IMAGES=${IMAGES:-"320x240 640x480 1280x720"}
@@ -33,18 +30,6 @@ read -r -a SIZES_ARR <<< "$CITY_SIZES"
 PARETO_CITY=${PARETO_CITY:-${SIZES_ARR[0]}}
 INVOCATION="CITY_SIZES='$CITY_SIZES' KINDS='$KINDS' IMAGES='$IMAGES' FRAMES=$FRAMES SAMPLING=$SAMPLING SEED=$SEED BOUNDS='$BOUNDS' docs/tools/far_field_table.sh"
 
-die() { echo "far_field_table.sh: error: $*" >&2; exit 1; }
-log() { printf '[far_field_table.sh %4ds] %s\n' $((SECONDS - START)) "$*" >&2; }
-[ -x "$VISTA" ] || die "vista binary not found: $VISTA"
-command -v python3 >/dev/null || die "python3 is needed"
-XVFB=()
-if [ -z "${DISPLAY:-}" ]; then
-  command -v xvfb-run >/dev/null || die "no DISPLAY and no xvfb-run"
-  XVFB=(xvfb-run -a -s "-screen 0 1920x1080x24")
-fi
-cleanup() { if [ "$KEEP_OUT" = 0 ]; then rm -rf "$OUT"; fi; rm -f "$REPO/docs/.results.md.tmp" "$REPO/docs/img/.cache_pareto.svg.tmp"; }
-trap cleanup EXIT
-trap 'echo "far_field_table.sh: failed at line $LINENO: $BASH_COMMAND" >&2' ERR
 mkdir -p "$OUT/gen" "$OUT/bench"
 : > "$OUT/commands.log"
 

@@ -22,31 +22,16 @@
 # only when every step succeeded.
 set -euo pipefail
 
-START=$SECONDS
 INVOCATION="docs/tools/raw_rays.sh${1:+ $1}${2:+ $2}"
-KEEP_OUT=1
-if [ -n "${1:-}" ]; then OUT=$(realpath -m "$1"); else OUT=$(mktemp -d /tmp/vista-rawrays.XXXXXX); KEEP_OUT=0; fi
-VISTA=$(realpath -m "${2:-build/vista}")
-REPO=$(cd "$(dirname "$0")/../.." && pwd)
-cd "$REPO"
+source "$(dirname "$0")/lib.sh"
+doc_setup raw_rays.sh rawrays 1280x1024x24 "$@"
+DOC_TMP_FILES=(docs/.raw-rays.md.tmp)
 RAW=${BENCH_RAW_RAYS:-$(dirname "$VISTA")/tests/bench/bench_raw_rays}
 FRAMES=${FRAMES:-6}
 REPS=${REPS:-10}
 MIN_TIME=${MIN_TIME:-0.5}
 
-die() { echo "raw_rays.sh: error: $*" >&2; exit 1; }
-log() { printf '[raw_rays.sh %4ds] %s\n' $((SECONDS - START)) "$*" >&2; }
-[ -x "$VISTA" ] || die "vista binary not found: $VISTA"
 [ -x "$RAW" ] || die "bench_raw_rays not found: $RAW (build it: ninja bench_raw_rays)"
-command -v python3 >/dev/null || die "python3 is needed"
-XVFB=()
-if [ -z "${DISPLAY:-}" ]; then
-  command -v xvfb-run >/dev/null || die "no DISPLAY and no xvfb-run"
-  XVFB=(xvfb-run -a -s "-screen 0 1280x1024x24")
-fi
-cleanup() { if [ "$KEEP_OUT" = 0 ]; then rm -rf "$OUT"; fi; rm -f "$REPO/docs/.raw-rays.md.tmp"; }
-trap cleanup EXIT
-trap 'echo "raw_rays.sh: failed at line $LINENO: $BASH_COMMAND" >&2' ERR
 
 mkdir -p "$OUT"
 if [ -s "$OUT/commands.log" ]; then cp "$OUT/commands.log" "$OUT/commands.prev"; fi

@@ -47,11 +47,11 @@ void FarField::setOptions(const FarFieldOptions& o) {
 }
 
 void FarField::beginFrame(const Camera& camera) {
-    if (_mem->earlyHorizon.valid()) _mem->earlyHorizon.wait();  // never two at once
+    // Dropping an std::async future waits for its task: never two at once.
     _mem->earlyHorizon = std::future<HorizonResult>();
-    if (!_grid || _grid->empty() || !_options.horizon || !std::isfinite(_options.nearDistance) || !horizonApplies(camera)) return;
+    if (!_grid || !_options.horizon || !farGeometryExists(_rays, _grid, camera, _options) || !horizonApplies(camera)) return;
     const bool moving = _mem->haveLast && !sameCamera(_mem->last, camera);
-    const HorizonOptions ho = horizonOptions(camera, _options, moving);
+    const HorizonOptions ho = horizonOptions(_options, moving);
     const HeightGrid* grid = _grid;
     _mem->earlyCamera = camera;
     _mem->earlyHorizon = std::async(std::launch::async, [grid, camera, ho] { return traceHorizon(*grid, camera, ho); });
@@ -77,6 +77,9 @@ void FarField::render(const Camera& camera, const float* depth, Image& out, Fram
 
 void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) {
     const Camera& camera = f.camera;
+    // The horizon beginFrame started is this frame's, used or not: consumed here (its
+    // destructor waits for the task if no stage took it).
+    std::future<HorizonResult> early = std::move(_mem->earlyHorizon);
     opacityStage(f, stats);
     if (seamCheckApplies(f, _rays, _options)) seamStage(f, _rays, _options, stats);
     if (_options.hazeCovered && _options.effects.haze && depth && f.covered > 0) hazeCoveredStage(f, _options, stats);
@@ -90,13 +93,8 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
         compositeStage(f, *_mem, false, stats);
         return;
     }
-    std::future<HorizonResult>* early = nullptr;
-    if (_mem->earlyHorizon.valid()) {
-        if (sameCamera(_mem->earlyCamera, camera)) early = &_mem->earlyHorizon;
-        else _mem->earlyHorizon.wait();
-    }
-    if (_options.horizon) horizonStage(f, _grid, _options, stats, early);
-    if (_mem->earlyHorizon.valid()) _mem->earlyHorizon.get();  // not used (all covered before, or horizon off)
+    const bool useEarly = early.valid() && sameCamera(_mem->earlyCamera, camera);
+    if (_options.horizon) horizonStage(f, _grid, _options, stats, useEarly ? &early : nullptr);
     listPending(f);
     const bool useCache = _options.cache;
     f.farDepth.swap(_mem->farDepth);  // reuse last frame's buffer (cacheStage refills it)

@@ -7,8 +7,7 @@
 
 namespace vista {
 
-HorizonOptions horizonOptions(const Camera& camera, const FarFieldOptions& o, bool moving) {
-    (void)camera;
+HorizonOptions horizonOptions(const FarFieldOptions& o, bool moving) {
     HorizonOptions ho;
     ho.nearDistance = o.nearIsDistance ? o.nearDistance : 0.0;
     ho.subsample = moving ? std::max(1, o.horizonSubsampleMoving) : 1;
@@ -28,7 +27,7 @@ void horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o,
         hr = early->get();  // traced while the near field was drawn; the stage time is the wait
         stats.notes.push_back("horizon overlapped with the near field");
     } else {
-        HorizonOptions ho = horizonOptions(f.camera, o, f.moving);
+        HorizonOptions ho = horizonOptions(o, f.moving);
         ho.columnNeeded = &f.columnNeeded;
         hr = traceHorizon(*grid, f.camera, ho);
     }

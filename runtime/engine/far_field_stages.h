@@ -116,7 +116,7 @@ void hazeCoveredStage(FarFrame& f, const FarFieldOptions& o, FrameStats& stats);
 void horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o, FrameStats& stats,
                   std::future<HorizonResult>* early = nullptr);
 // The horizon options of a frame (near distance, haze depth, subsampling while moving).
-HorizonOptions horizonOptions(const Camera& camera, const FarFieldOptions& o, bool moving);
+HorizonOptions horizonOptions(const FarFieldOptions& o, bool moving);
 // No far geometry: every pending pixel becomes horizonCulled (sky). No time.
 void cullAllPending(FarFrame& f, FrameStats& stats);
 

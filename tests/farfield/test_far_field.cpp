@@ -26,6 +26,13 @@ using namespace vista::test;
 
 namespace {
 
+// True when one of the frame's notes contains `what`.
+bool has(const FrameStats& s, const std::string& what) {
+    for (const auto& n : s.notes)
+        if (n.find(what) != std::string::npos) return true;
+    return false;
+}
+
 // A random city (world origin (ox, 0)) with its ray scene and a 64-cell height grid.
 struct TestCity {
     SceneModel model;
@@ -275,11 +282,6 @@ TEST(FarFieldFrame, StagesRunOnlyWhenCalledFor) {
     o.nearDistance = 0;
     FarField ff(*t.rays, &t.grid, o);
     Image img;
-    auto has = [](const FrameStats& s, const std::string& what) {
-        for (const auto& n : s.notes)
-            if (n.find(what) != std::string::npos) return true;
-        return false;
-    };
     // Cache on, no cap: the first frame traces every far pixel (nothing cached yet).
     FrameStats a;
     ff.render(c, nullptr, img, a);
@@ -552,11 +554,6 @@ TEST(FarFieldFrame, EarlyHorizonGivesTheSameFrame) {
     o.nearDistance = 0;
     o.cache = false;
     FarField early(*t.rays, &t.grid, o), plain(*t.rays, &t.grid, o);
-    auto has = [](const FrameStats& s, const std::string& what) {
-        for (const auto& n : s.notes)
-            if (n.find(what) != std::string::npos) return true;
-        return false;
-    };
     for (int f = 0; f < 3; ++f) {
         c.eye.x += 3.0;
         Image a, b;

@@ -57,6 +57,7 @@ TEST(Options, SamplingAndCacheKnobs) {
     EXPECT_EQ(parseSampling("consecutive").value(), 1);
     EXPECT_EQ(parseSampling("runs:8").value(), 8);
     EXPECT_EQ(parseSampling("runs:100000").value(), 100000);
+    for (const char* text : {"spread", "consecutive", "runs:8"}) EXPECT_EQ(samplingName(parseSampling(text).value()), text);
     for (const char* bad : {"runs:0", "runs:", "runs:x", "runs:100001", "runs:-3", "every", ""})
         expectBad(parseSampling(bad), bad, "--sampling", "100000");
     ModeOptions o;
