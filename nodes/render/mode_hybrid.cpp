@@ -73,7 +73,7 @@ public:
         _far->render(camera, haveDepth ? _depth.data() : nullptr, out, stats);
         stats.frameMs = sw.ms();
         if (autoSplit())
-            _adaptive->record(tris, ns.frameMs, stats.pixels.rayHit + stats.pixels.rayMiss, stats.stages.ms(Stage::Rays));
+            recordCosts(tris, ns.frameMs, stats);
         return Status::ok();
     }
     void reset() override { _far->reset(); }
@@ -96,8 +96,7 @@ public:
             const FrameStats fs = _farNode->lastStats();
             double farMs = 0;
             fs.stages.forEach([&](Stage, double ms) { farMs += ms; });
-            _adaptive->record(_split->lastNearTriangles(), std::max(0.0, wallMs - farMs), fs.pixels.rayHit + fs.pixels.rayMiss,
-                              fs.stages.ms(Stage::Rays));
+            recordCosts(_split->lastNearTriangles(), std::max(0.0, wallMs - farMs), fs);
         }
         _viewerNear = chooseNear(camera);
         if (_split) _split->setNearDistance(_viewerNear);
@@ -112,6 +111,15 @@ public:
     }
 
 private:
+    // The adaptive split's cost model: far pixels (cached or traced) against the stages that
+    // scale with them; the far field's other stages as its fixed cost.
+    void recordCosts(uint64_t tris, double rasterMs, const FrameStats& fs) {
+        const uint64_t farPixels = fs.pixels.cache + fs.pixels.rayHit + fs.pixels.rayMiss;
+        const double farMs = fs.stages.ms(Stage::Rays) + fs.stages.ms(Stage::Cache);
+        const double fixedMs = fs.stages.ms(Stage::Opacity) + fs.stages.ms(Stage::Seam) + fs.stages.ms(Stage::Horizon) +
+                               fs.stages.ms(Stage::Composite);
+        _adaptive->record(tris, rasterMs, farPixels, farMs, fixedMs);
+    }
     bool byBudget() const { return _ctx.options.triangleBudget > 0; }
     bool autoSplit() const { return !byBudget() && _ctx.options.nearDistance < 0; }
     double chooseNear(const Camera& camera) {

@@ -5,10 +5,37 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 
+#include "foundation/timing.h"
 #include "runtime/engine/ray_scene.h"
 
 namespace vista {
+namespace {
+
+// Least-squares slope of y = c + slope * x over the samples; nullopt unless
+// there are 5 or more and x varies by more than 10 % of its mean.
+std::optional<double> fitSlope(const std::vector<std::pair<double, double>>& samples) {
+    const double n = double(samples.size());
+    if (n < 5) return std::nullopt;
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (const auto& [x, y] : samples) {
+        sx += x;
+        sy += y;
+        sxx += x * x;
+        sxy += x * y;
+    }
+    const double var = sxx / n - (sx / n) * (sx / n), mean = sx / n;
+    if (!(var > 0) || std::sqrt(var) <= 0.1 * std::max(mean, 1.0)) return std::nullopt;
+    return (sxy / n - (sx / n) * (sy / n)) / var;
+}
+
+void pushWindow(std::vector<std::pair<double, double>>& w, std::pair<double, double> s, int window) {
+    w.push_back(s);
+    if (int(w.size()) > std::max(2, window)) w.erase(w.begin());
+}
+
+}  // namespace
 
 double boxDistance(const SplitObject& o, const glm::dvec3& p) {
     glm::dvec3 d = glm::max(glm::max(o.lo - p, p - o.hi), glm::dvec3(0.0));
@@ -70,7 +97,13 @@ void AdaptiveSplit::probe(const Camera& camera) {
             dirs.push_back(glm::vec3(camera.rayDirection(x + 0.5, y + 0.5)));
         }
     std::vector<RayHit> hits(dirs.size());
+    Stopwatch sw;
     if (!dirs.empty()) _rays->intersectMany(orgs.data(), dirs.data(), int(dirs.size()), hits.data());
+    if (_o.timeProbe && dirs.size() >= 100) {
+        // Bulk ms per ray on one thread: independent of how many rays the split let through.
+        const double b = sw.ms() / double(dirs.size());
+        _bProbe = _bProbe > 0 ? (1 - _o.smoothing) * _bProbe + _o.smoothing * b : b;
+    }
     _probeT.resize(hits.size());
     size_t misses = 0;
     for (size_t i = 0; i < hits.size(); ++i) {
@@ -104,6 +137,7 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
     for (int i = 0; i < g; ++i) cand.push_back(_o.minDistance * std::pow(_o.maxDistance / _o.minDistance, double(i) / (g - 1)));
     if (_o.everythingNear && measured) cand.push_back(std::numeric_limits<double>::infinity());
     const int n = int(cand.size());
+    const double b = msPerRay();
     std::vector<double> cost(cand.size());
     size_t k = 0;
     uint64_t tris = 0;
@@ -111,7 +145,7 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
     for (int i = 0; i < n; ++i) {
         const double d = cand[size_t(i)];
         while (k < byDist.size() && byDist[k].first <= d) tris += byDist[k++].second;
-        cost[size_t(i)] = _a * double(tris) + _b * predictedRays(d);
+        cost[size_t(i)] = _a * double(tris) + b * predictedRays(d) + (std::isinf(d) ? 0.0 : _f);
         if (cost[size_t(i)] < cost[size_t(bestI)]) bestI = i;
     }
     if (_o.exploreEvery > 0 && frame % _o.exploreEvery == _o.exploreEvery - 1)
@@ -120,33 +154,35 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
     return _current;
 }
 
-void AdaptiveSplit::record(uint64_t triangles, double rasterMs, uint64_t rays, double rayMs) {
+double AdaptiveSplit::msPerRay() const {
+    if (_bProbe > 0) return _haveB ? std::min(_b, _bProbe) : _bProbe;
+    return _b;
+}
+
+void AdaptiveSplit::record(uint64_t triangles, double rasterMs, uint64_t farPixels, double farMs, double fixedMs) {
     const double w = _o.smoothing;
     if (rasterMs > 0) {
-        _rasterSamples.push_back({double(triangles), rasterMs});
-        if (int(_rasterSamples.size()) > std::max(2, _o.window)) _rasterSamples.erase(_rasterSamples.begin());
-        // Least squares ms = c + a * tris; keep the prior unless the triangle counts vary enough.
-        double n = double(_rasterSamples.size()), sx = 0, sy = 0, sxx = 0, sxy = 0;
-        for (const auto& [x, y] : _rasterSamples) {
-            sx += x;
-            sy += y;
-            sxx += x * x;
-            sxy += x * y;
-        }
-        double var = sxx / n - (sx / n) * (sx / n);
-        double mean = sx / n;
-        if (n >= 5 && var > 0 && std::sqrt(var) > 0.1 * std::max(mean, 1.0)) {
-            double a = (sxy / n - (sx / n) * (sy / n)) / var;
-            if (a > 0) {
-                _a = a;
-                _haveA = true;
-            }
+        pushWindow(_rasterSamples, {double(triangles), rasterMs}, _o.window);
+        if (auto a = fitSlope(_rasterSamples); a && *a > 0) {  // keep the prior until the counts vary enough
+            _a = *a;
+            _haveA = true;
         }
     }
-    if (rays > 100 && rayMs > 0) {
-        double b = rayMs / double(rays);
-        _b = _haveB ? (1 - w) * _b + w * b : b;
+    if (farPixels > 100 && farMs > 0) {
+        pushWindow(_farSamples, {double(farPixels), farMs}, _o.window);
+        double sx = 0, sy = 0;
+        for (const auto& [x, y] : _farSamples) {
+            sx += x;
+            sy += y;
+        }
+        const double mean = sy / sx;  // ms per far pixel, fixed costs included: an upper bound
+        const auto b = fitSlope(_farSamples);
+        _b = b ? std::clamp(*b, mean / 5, mean) : mean;
         _haveB = true;
+    }
+    if (farPixels > 0 || fixedMs > 0) {
+        _f = _haveF ? (1 - w) * _f + w * fixedMs : fixedMs;
+        _haveF = true;
     }
 }
 

@@ -8,14 +8,20 @@
 // first object is always drawn). Pure; thread-safe.
 //
 // AdaptiveSplit: picks the near distance per frame from the measured cost of
-// this machine: raster ms = c + a * triangles (least-squares fit over the
-// last `window` frames, whose near distances differ as the walk goes on; the
-// prior ratio is used until the fit is well conditioned) and b = ms per cast
-// ray (exponential moving average), predicted triangles(d) from the objects'
+// this machine: raster ms = c + a * triangles and far ms = c' + b * far
+// pixels (least-squares fits over the last `window` frames, whose near
+// distances differ as the walk goes on; priors until a fit is well
+// conditioned; b falls back to the mean ms per far pixel, and a fitted b is
+// kept within [1/5, 1] of that mean; b is capped by the probe's bulk ms per
+// ray (timed on one thread): a fixed cost per frame (thread start, packet
+// set-up) divided by a few hundred rays would otherwise make rays look dearer
+// than they are, push the near field out, and so starve the fit), the far
+// field's fixed cost F (opacity, seam, horizon, composite: exponential moving
+// average) paid by every candidate but "everything near", predicted triangles(d) from the objects'
 // boxes (exact) and predicted rays(d) from a sparse probe of the view (every
 // `probeStride`-th pixel cast once per `probeInterval` frames: a pixel whose
 // first hit lies beyond d, or that misses below the horizon, needs a ray). It
-// minimises a * triangles(d) + b * rays(d) over candidate distances
+// minimises a * triangles(d) + b * rays(d) (+ F unless d = infinity) over candidate distances
 // (geometric steps between minDistance and maxDistance, plus 0 = ray casting
 // and +infinity = everything rasterised when the options allow them). rays(d) is not capped
 // by the pixel budget: the aim is the lowest frame time at full accuracy (a
@@ -61,6 +67,8 @@ struct AdaptiveSplitOptions {
     // own chunk: ray casting) and +infinity (everything rasterised, no far
     // field), offered once both costs have been measured (not on the priors).
     bool rayCastOnly = true, everythingNear = true;
+    // Time the probe: its bulk ms per ray caps b (off: b from the frames alone, deterministic).
+    bool timeProbe = true;
 };
 
 class AdaptiveSplit {
@@ -68,10 +76,14 @@ public:
     AdaptiveSplit(const std::vector<SplitObject>& objects, const RayScene* rays, const AdaptiveSplitOptions& o = {});
     // Near distance to use for this frame (0 and +infinity possible, see the options).
     double choose(const Camera& camera, int64_t pixelBudget);
-    // Measurements of the frame just rendered.
-    void record(uint64_t triangles, double rasterMs, uint64_t rays, double rayMs);
+    // Measurements of the frame just rendered: the near field's triangles and
+    // raster ms; the far pixels filled (cached or traced) and the ms of the
+    // stages that scale with them (cache + rays); the far field's other
+    // stages' ms (fixedMs; 0 when the frame had no far field).
+    void record(uint64_t triangles, double rasterMs, uint64_t farPixels, double farMs, double fixedMs = 0);
     double msPerTriangle() const { return _a; }
-    double msPerRay() const { return _b; }
+    double msPerRay() const;  // per far pixel: the frames' model, capped by the probe's bulk rate
+    double farFixedMs() const { return _f; }
     double current() const { return _current; }
     // Predictions (exposed for tests/docs).
     uint64_t predictedTriangles(const glm::dvec3& eye, double d) const;
@@ -82,9 +94,10 @@ private:
     const std::vector<SplitObject>& _objects;
     const RayScene* _rays;
     AdaptiveSplitOptions _o;
-    double _a = 2e-5, _b = 5e-4;  // priors: ms per triangle, ms per ray (replaced by measurements)
-    bool _haveA = false, _haveB = false;  // measured (not the priors)
+    double _a = 2e-5, _b = 5e-4, _f = 0, _bProbe = 0;  // priors: ms per triangle, ms per far pixel, fixed far ms
+    bool _haveA = false, _haveB = false, _haveF = false;  // measured (not the priors)
     std::vector<std::pair<double, double>> _rasterSamples;  // (triangles, ms), last `window` frames
+    std::vector<std::pair<double, double>> _farSamples;     // (far pixels, ms), last `window` frames
     double _current;
     int _frame = 0;
     std::vector<float> _probeT;  // per probe pixel: first hit distance (inf = miss)

@@ -100,22 +100,31 @@ HeightGrid HeightGrid::build(const SceneModel& city, const glm::dvec3& frameOrig
     // Instances: conservative per-instance bounding box (tree crowns are compact).
     for (const Box2& b : instBox)
         if (b.valid()) splat(b.lo, b.hi);
+    // Blocks: max / min over their cells.
+    g._blocks = (cells + kBlock - 1) / kBlock;
+    const size_t nb = size_t(g._blocks) * size_t(g._blocks);
+    g._blockMaxZ.assign(nb, -std::numeric_limits<float>::infinity());
+    g._blockMinZ.assign(nb, std::numeric_limits<float>::infinity());
+    for (int y = 0; y < cells; ++y)
+        for (int x = 0; x < cells; ++x) {
+            const size_t i = size_t(y) * size_t(cells) + size_t(x);
+            const size_t b = size_t(y / kBlock) * size_t(g._blocks) + size_t(x / kBlock);
+            g._blockMaxZ[b] = std::max(g._blockMaxZ[b], g._maxZ[i]);
+            g._blockMinZ[b] = std::min(g._blockMinZ[b], g._minZ[i]);
+        }
     return g;
 }
 
-double HeightGrid::cellBound(int ix, int iy, const glm::dvec3& eye, double nearDistance, double maxDistance) const {
-    size_t i = size_t(iy) * size_t(_cells) + size_t(ix);
-    double hmax = double(_maxZ[i]);
-    if (hmax == -kInf) return -kInf;
-    double x0 = _min.x + ix * _cellSize - kCellMargin, x1 = x0 + _cellSize + 2 * kCellMargin;
-    double y0 = _min.y + iy * _cellSize - kCellMargin, y1 = y0 + _cellSize + 2 * kCellMargin;
+double HeightGrid::rectBound(double x0, double x1, double y0, double y1, double zLo, double zHi, const glm::dvec3& eye,
+                             double nearDistance, double maxDistance) {
+    if (zHi == -kInf) return -kInf;
     double nx = std::max({x0 - eye.x, 0.0, eye.x - x1}), ny = std::max({y0 - eye.y, 0.0, eye.y - y1});
     double fx = std::max(std::abs(eye.x - x0), std::abs(eye.x - x1)), fy = std::max(std::abs(eye.y - y0), std::abs(eye.y - y1));
     double dmin2 = nx * nx + ny * ny, dmax2 = fx * fx + fy * fy;
     if (dmin2 > maxDistance * maxDistance) return -kInf;
-    double dz = hmax - eye.z;
+    double dz = zHi - eye.z;
     if (nearDistance > 0) {
-        double dzLo = double(_minZ[i]) - eye.z;
+        double dzLo = zLo - eye.z;
         double dzMax = std::max(std::abs(dz), std::abs(dzLo));
         if (dmax2 + dzMax * dzMax < nearDistance * nearDistance) return -kInf;
     }
@@ -123,7 +132,34 @@ double HeightGrid::cellBound(int ix, int iy, const glm::dvec3& eye, double nearD
     return dz / std::sqrt(dmax2);
 }
 
+double HeightGrid::cellBound(int ix, int iy, const glm::dvec3& eye, double nearDistance, double maxDistance) const {
+    const size_t i = size_t(iy) * size_t(_cells) + size_t(ix);
+    const double x0 = _min.x + ix * _cellSize - kCellMargin, y0 = _min.y + iy * _cellSize - kCellMargin;
+    return rectBound(x0, x0 + _cellSize + 2 * kCellMargin, y0, y0 + _cellSize + 2 * kCellMargin, double(_minZ[i]),
+                     double(_maxZ[i]), eye, nearDistance, maxDistance);
+}
+
+// A block's rectangle contains its cells' rectangles and its heights bound
+// theirs, so its bound is >= each cell's (nearer or equal nearest point,
+// farther or equal farthest point, higher or equal top).
+double HeightGrid::blockBound(int bx, int by, const glm::dvec3& eye, double nearDistance, double maxDistance) const {
+    const size_t b = size_t(by) * size_t(_blocks) + size_t(bx);
+    const double x0 = _min.x + bx * kBlock * _cellSize - kCellMargin;
+    const double x1 = _min.x + std::min(_cells, (bx + 1) * kBlock) * _cellSize + kCellMargin;
+    const double y0 = _min.y + by * kBlock * _cellSize - kCellMargin;
+    const double y1 = _min.y + std::min(_cells, (by + 1) * kBlock) * _cellSize + kCellMargin;
+    return rectBound(x0, x1, y0, y1, double(_blockMinZ[b]), double(_blockMaxZ[b]), eye, nearDistance, maxDistance);
+}
+
 double HeightGrid::traceRay(const glm::dvec3& eye, double azimuth, double nearDistance, double maxDistance) const {
+    return trace(eye, azimuth, nearDistance, maxDistance, true);
+}
+
+double HeightGrid::traceRayFlat(const glm::dvec3& eye, double azimuth, double nearDistance, double maxDistance) const {
+    return trace(eye, azimuth, nearDistance, maxDistance, false);
+}
+
+double HeightGrid::trace(const glm::dvec3& eye, double azimuth, double nearDistance, double maxDistance, bool blocks) const {
     if (_cells == 0) return -kInf;
     const int n = _cells;
     const double s = _cellSize;
@@ -182,6 +218,103 @@ double HeightGrid::traceRay(const glm::dvec3& eye, double azimuth, double nearDi
             }
         }
     };
+    // The same walk over blocks of kBlock x kBlock cells: a block whose bound
+    // cannot beat `best` is passed over whole; otherwise its cells along the
+    // ray's stretch [tIn, tOut] inside it are walked as in run(). A ray
+    // through a block corner touches the four cells around that corner.
+    auto runBlocks = [&](int ix, int iy) {
+        const int B = kBlock;
+        const int stepX = dx > 0 ? 1 : -1, stepY = dy > 0 ? 1 : -1;
+        const double sx0 = px + dx * t0, sy0 = py + dy * t0;
+        const double tDeltaX = dx != 0 ? 1.0 / std::abs(dx) : kInf, tDeltaY = dy != 0 ? 1.0 / std::abs(dy) : kInf;
+        const double tLen = t1 - t0;
+        auto inGrid = [&](int x, int y) { return x >= 0 && y >= 0 && x < n && y < n; };
+        auto visit = [&](int x, int y) {
+            if (inGrid(x, y)) best = std::max(best, cellBound(x, y, eye, nearDistance, maxDistance));
+        };
+        int bx = ix / B, by = iy / B;
+        double bMaxX = dx > 0 ? ((bx + 1) * B - sx0) / dx : dx < 0 ? (sx0 - bx * B) / -dx : kInf;
+        double bMaxY = dy > 0 ? ((by + 1) * B - sy0) / dy : dy < 0 ? (sy0 - by * B) / -dy : kInf;
+        bMaxX = std::max(bMaxX, 0.0);
+        bMaxY = std::max(bMaxY, 0.0);
+        const double bDeltaX = tDeltaX * B, bDeltaY = tDeltaY * B;
+        double tIn = 0;
+        bool first = true;
+        while (bx >= 0 && by >= 0 && bx < _blocks && by < _blocks) {
+            const double tOut = std::min({bMaxX, bMaxY, tLen});
+            if (blockBound(bx, by, eye, nearDistance, maxDistance) > best) {
+                // Walk the block's cells from where the ray enters it.
+                int cx = ix, cy = iy;
+                if (!first) {
+                    auto cellAt = [&](double p, double d, int lo, int hi) {
+                        double c = std::floor(p);
+                        if (d < 0 && c == p) c -= 1;
+                        return std::clamp(int(c), lo, hi);
+                    };
+                    const double qx = sx0 + dx * tIn, qy = sy0 + dy * tIn;
+                    cx = cellAt(qx, dx, bx * B, std::min(n, (bx + 1) * B) - 1);
+                    cy = cellAt(qy, dy, by * B, std::min(n, (by + 1) * B) - 1);
+                    // Entering through a cell corner: the cells around it touch the ray there.
+                    auto onGridLine = [](double p) { return std::abs(p - std::round(p)) <= kTieEps * std::max(1.0, std::abs(p)); };
+                    if (onGridLine(qx) && onGridLine(qy)) {
+                        const int rx = int(std::round(qx)), ry = int(std::round(qy));
+                        visit(rx - 1, ry - 1);
+                        visit(rx, ry - 1);
+                        visit(rx - 1, ry);
+                        visit(rx, ry);
+                    }
+                }
+                double tMaxX = dx > 0 ? (cx + 1 - sx0) / dx : dx < 0 ? (sx0 - cx) / -dx : kInf;
+                double tMaxY = dy > 0 ? (cy + 1 - sy0) / dy : dy < 0 ? (sy0 - cy) / -dy : kInf;
+                tMaxX = std::max(tMaxX, 0.0);
+                tMaxY = std::max(tMaxY, 0.0);
+                while (inGrid(cx, cy) && cx / B == bx && cy / B == by) {
+                    best = std::max(best, cellBound(cx, cy, eye, nearDistance, maxDistance));
+                    const double tNext = std::min(tMaxX, tMaxY);
+                    if (tNext > tOut + kTieEps * std::max(1.0, tOut)) break;
+                    if (std::abs(tMaxX - tMaxY) <= kTieEps * std::max(1.0, tNext)) {
+                        visit(cx + stepX, cy);
+                        visit(cx, cy + stepY);
+                        cx += stepX;
+                        cy += stepY;
+                        tMaxX += tDeltaX;
+                        tMaxY += tDeltaY;
+                    } else if (tMaxX < tMaxY) {
+                        cx += stepX;
+                        tMaxX += tDeltaX;
+                    } else {
+                        cy += stepY;
+                        tMaxY += tDeltaY;
+                    }
+                }
+            }
+            first = false;
+            const double tNext = std::min(bMaxX, bMaxY);
+            if (tNext > tLen + kTieEps) break;
+            const double distM = (t0 + tNext - 1.5) * s - 2 * kCellMargin;  // nearest point of any later cell
+            if (best > 0 && distM > 0 && (zTop - eye.z) / distM < best) break;
+            if (distM > maxDistance) break;
+            tIn = tNext;
+            if (std::abs(bMaxX - bMaxY) <= kTieEps * std::max(1.0, tNext)) {
+                // Through a block corner: the four cells around it touch the ray.
+                const int qx = dx > 0 ? (bx + 1) * B : bx * B, qy = dy > 0 ? (by + 1) * B : by * B;
+                visit(qx - 1, qy - 1);
+                visit(qx, qy - 1);
+                visit(qx - 1, qy);
+                visit(qx, qy);
+                bx += stepX;
+                by += stepY;
+                bMaxX += bDeltaX;
+                bMaxY += bDeltaY;
+            } else if (bMaxX < bMaxY) {
+                bx += stepX;
+                bMaxX += bDeltaX;
+            } else {
+                by += stepY;
+                bMaxY += bDeltaY;
+            }
+        }
+    };
     // Start cell: the cell the ray enters just after t0.
     const double ex = px + dx * t0, ey = py + dy * t0;
     auto startCell = [&](double p, double d) {
@@ -190,7 +323,10 @@ double HeightGrid::traceRay(const glm::dvec3& eye, double azimuth, double nearDi
         return std::clamp(int(c), 0, n - 1);
     };
     int ix = startCell(ex, dx), iy = startCell(ey, dy);
-    run(ix, iy);
+    if (blocks)
+        runBlocks(ix, iy);
+    else
+        run(ix, iy);
     // A ray running along a grid line touches the cells on both sides.
     auto onLine = [&](double p) { return std::abs(p - std::round(p)) <= kTieEps * std::max(1.0, std::abs(p)); };
     if (dx == 0 && onLine(ex)) {

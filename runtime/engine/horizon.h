@@ -69,16 +69,30 @@ public:
     // geometry above it).
     // Cells whose nearest xy point lies beyond `maxDistance` are skipped too
     // (haze: nothing there is drawn or traced).
+    // Walks blocks of kBlock x kBlock cells first and visits the cells of a
+    // block only if the block's bound (its max height, its nearest and
+    // farthest points) could beat the best so far: the same value as visiting
+    // every cell (traceRayFlat, kept for tests), at a fraction of the visits.
     double traceRay(const glm::dvec3& eye, double azimuth, double nearDistance,
                     double maxDistance = std::numeric_limits<double>::infinity()) const;
+    double traceRayFlat(const glm::dvec3& eye, double azimuth, double nearDistance,
+                        double maxDistance = std::numeric_limits<double>::infinity()) const;
+    static constexpr int kBlock = 8;
 
 private:
+    double trace(const glm::dvec3& eye, double azimuth, double nearDistance, double maxDistance, bool blocks) const;
     double cellBound(int ix, int iy, const glm::dvec3& eye, double nearDistance, double maxDistance) const;
+    // The bound of any geometry in the xy rectangle [x0, x1] x [y0, y1] (scene-local metres) with heights in [zLo, zHi].
+    static double rectBound(double x0, double x1, double y0, double y1, double zLo, double zHi, const glm::dvec3& eye,
+                            double nearDistance, double maxDistance);
+    double blockBound(int bx, int by, const glm::dvec3& eye, double nearDistance, double maxDistance) const;
     int _cells = 0;
     double _cellSize = 0;
     glm::dvec2 _min{0.0};
     glm::dvec3 _boundsMin{0.0}, _boundsMax{0.0}, _origin{0.0};
     std::vector<float> _maxZ, _minZ;
+    int _blocks = 0;                           // blocks per side: ceil(cells / kBlock)
+    std::vector<float> _blockMaxZ, _blockMinZ;  // over each block's cells
 };
 
 struct HorizonOptions {

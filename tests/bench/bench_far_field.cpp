@@ -121,6 +121,28 @@ void BM_Horizon(benchmark::State& st) {
 }
 BENCHMARK(BM_Horizon)->Arg(64)->Arg(128)->Arg(256)->Arg(512)->Arg(1024)->Unit(benchmark::kMillisecond);
 
+// One horizon 2D ray per azimuth step around the eye (street level, 80 m near
+// distance), walking blocks (arg 1 = 1) or every cell (arg 1 = 0): the same
+// bound (tested), the cost of the walk.
+void BM_HorizonRayWalk(benchmark::State& st) {
+    const int cells = int(st.range(0));
+    const bool blocks = st.range(1) != 0;
+    HeightGrid g = HeightGrid::build(world().city, world().rays->frameOrigin(), cells);
+    const glm::dvec3 eye = streetCamera(640, 480).eye - g.frameOrigin();
+    const int n = 4096;
+    for (auto _ : st) {
+        double sum = 0;
+        for (int k = 0; k < n; ++k) {
+            const double a = 2.0 * M_PI * k / n;
+            const double b = blocks ? g.traceRay(eye, a, 80.0) : g.traceRayFlat(eye, a, 80.0);
+            if (std::isfinite(b)) sum += b;
+        }
+        benchmark::DoNotOptimize(sum);
+    }
+    st.SetItemsProcessed(int64_t(st.iterations()) * n);
+}
+BENCHMARK(BM_HorizonRayWalk)->Args({512, 0})->Args({512, 1})->Args({1024, 0})->Args({1024, 1})->Unit(benchmark::kMillisecond);
+
 }  // namespace
 
 int main(int argc, char** argv) {

@@ -169,6 +169,68 @@ TEST(Horizon, ConservativeWithCameraOnGridLinesAndAxisParallelRays) {
     EXPECT_GE(b, (30.0 - 1.7) / 60.0);
 }
 
+// The block walk returns exactly the flat walk's bound (the max over the same
+// touched cells) on random scenes, random eyes and azimuths, eyes on cell and
+// block corners, rays through block corners (45 degrees from a block corner)
+// and along grid lines, with and without a near distance and a distance limit.
+TEST(Horizon, BlockWalkEqualsTheFlatWalk) {
+    long compared = 0, nonTrivial = 0;
+    for (uint32_t seed = 1; seed <= 4; ++seed) {
+        SceneModel city = randomCity(seed, 120, 400.0);
+        auto rs = RayScene::build(city);
+        ASSERT_TRUE(rs.isOk());
+        std::mt19937 rng(seed * 31);
+        std::uniform_real_distribution<double> pos(-250, 250), az(-M_PI, M_PI), hz(0.5, 60.0);
+        for (int grid : {7, 64, 130}) {
+            HeightGrid hg = HeightGrid::build(city, rs.value()->frameOrigin(), grid);
+            const double s = hg.cellSize();
+            const glm::dvec2 g0 = hg.gridMin();
+            std::vector<glm::dvec3> eyes;
+            for (int k = 0; k < 6; ++k) eyes.push_back({pos(rng), pos(rng), hz(rng)});
+            const int B = HeightGrid::kBlock;
+            eyes.push_back({g0.x + B * s, g0.y + B * s, 1.7});              // on a block corner
+            eyes.push_back({g0.x + (B + 3) * s, g0.y + 5 * s, 20.0});       // on a cell corner
+            eyes.push_back({g0.x + (grid / 2) * s, g0.y + 0.37 * s, 3.0});  // on a grid line
+            for (const glm::dvec3& e : eyes) {
+                std::vector<double> azimuths = {0.0, 0.5 * M_PI, M_PI, -0.5 * M_PI, 0.25 * M_PI, 0.75 * M_PI, -0.25 * M_PI};
+                for (int k = 0; k < 40; ++k) azimuths.push_back(az(rng));
+                for (double a : azimuths)
+                    for (double nearD : {0.0, 45.0})
+                        for (double maxD : {std::numeric_limits<double>::infinity(), 150.0}) {
+                            const double flat = hg.traceRayFlat(e, a, nearD, maxD), block = hg.traceRay(e, a, nearD, maxD);
+                            EXPECT_EQ(block, flat) << "seed " << seed << " grid " << grid << " eye " << e.x << "," << e.y
+                                                   << " azimuth " << a << " near " << nearD << " max " << maxD;
+                            ++compared;
+                            if (std::isfinite(flat)) ++nonTrivial;
+                        }
+            }
+        }
+    }
+    EXPECT_GT(nonTrivial, compared / 2);  // most rays see something: the comparison has teeth
+    // A ray entering a block through a cell corner, where the only cell that
+    // beats the best so far touches the ray at that corner alone: grid of 1 m
+    // cells over [0, 64]^2; eye on the corner (0, 3), ray at 45 degrees
+    // (y = x + 3) enters block (1, 1) at the corner (8, 11); the tower in
+    // cell (8, 10) touches the ray only there, and the tower in cell (1, 4)
+    // makes the block before it (ground only) one to pass over.
+    {
+        SceneModel city;
+        SceneMesh m;
+        addGround(m, {0, 0}, {64, 64}, 0, {80, 80, 80, 255});
+        addBox(m, {1.3f, 4.3f, 0}, {1.7f, 4.7f, 10}, {200, 0, 0, 255});
+        addBox(m, {8.3f, 10.3f, 0}, {8.7f, 10.7f, 200}, {0, 200, 0, 255});
+        city.meshes.push_back(m);
+        auto rs = RayScene::build(city);
+        ASSERT_TRUE(rs.isOk());
+        HeightGrid hg = HeightGrid::build(city, rs.value()->frameOrigin(), 64);
+        const glm::dvec2 g0 = hg.gridMin();
+        const glm::dvec3 eye(g0.x, g0.y + 3 * hg.cellSize(), 1.7);
+        const double flat = hg.traceRayFlat(eye, 0.25 * M_PI, 0.0), block = hg.traceRay(eye, 0.25 * M_PI, 0.0);
+        EXPECT_GT(flat, 15.0);  // the corner cell's tower: (200 - 1.7) / |(8, 7)|
+        EXPECT_EQ(block, flat);
+    }
+}
+
 TEST(Horizon, OffForRolledCameraAndZenithOrNadirViews) {
     SceneModel city = randomCity(2, 20);
     HeightGrid hg = HeightGrid::build(city, glm::dvec3(0), 32);

@@ -54,6 +54,7 @@ TEST(Split, AdaptiveChoiceFollowsTheMeasuredCosts) {
     c.height = 48;
     AdaptiveSplitOptions o;
     o.exploreEvery = 0;
+    o.timeProbe = false;  // the costs below are the only measurements
     AdaptiveSplit cheapRays(objs, rs.value().get(), o), cheapTris(objs, rs.value().get(), o);
     {
         // Nothing measured yet: the ends (0, everything) are not offered on the priors.
@@ -95,6 +96,28 @@ TEST(Split, AdaptiveChoiceFollowsTheMeasuredCosts) {
     EXPECT_GT(iT, iR);
     EXPECT_GE(iR, o.minDistance);
     EXPECT_LE(iT, o.maxDistance * 1.0001);
+    // The far cost is fitted as c' + b * far pixels: a fixed 0.5 ms per frame does not count as
+    // per-pixel cost (the mean ms per pixel would be about 3.5 times b here).
+    AdaptiveSplit fitted(objs, rs.value().get(), o);
+    double sumMs = 0, sumPx = 0;
+    for (int i = 0; i < 12; ++i) {
+        const double px = 8000 + 2500 * i, ms = 0.5 + 1e-5 * px;
+        sumMs += ms;
+        sumPx += px;
+        fitted.record(uint64_t(20000 + 4000 * i), 1.0 + 1e-6 * (20000 + 4000 * i), uint64_t(px), ms);
+    }
+    EXPECT_NEAR(fitted.msPerRay(), 1e-5, 1e-7);
+    EXPECT_LT(fitted.msPerRay(), 0.5 * sumMs / sumPx);
+    // The far field's fixed cost is paid by every candidate but "everything near": a large one
+    // (same per-triangle and per-ray costs) tips the choice to rasterising everything.
+    AdaptiveSplit noFixed(objs, rs.value().get(), o), bigFixed(objs, rs.value().get(), o);
+    for (int i = 0; i < 10; ++i) {
+        noFixed.record(uint64_t(20000 + 4000 * i), 1.0 + 1e-5 * (20000 + 4000 * i), 5000, 5000 * 1e-4, 0.0);
+        bigFixed.record(uint64_t(20000 + 4000 * i), 1.0 + 1e-5 * (20000 + 4000 * i), 5000, 5000 * 1e-4, 1e4);
+    }
+    EXPECT_NEAR(bigFixed.farFixedMs(), 1e4, 1e-6);
+    EXPECT_TRUE(std::isinf(bigFixed.choose(out, -1)));
+    EXPECT_TRUE(std::isfinite(noFixed.choose(out, -1)));
     // Predictions: more distance, more triangles, fewer rays.
     EXPECT_LE(cheapTris.predictedTriangles(c.eye, 50), cheapTris.predictedTriangles(c.eye, 400));
     EXPECT_GE(cheapTris.predictedRays(50), cheapTris.predictedRays(400));
