@@ -89,7 +89,7 @@ struct ModeSummary {
     // Pixel classes (thesis Table 4.1); hasPixels = false when the mode
     // classified no pixel in any frame (full, near, osgimpostor, osglod).
     bool hasPixels = false;
-    PixelClassSummary covered, horizonCulled, cache, rayHit, rayMiss;
+    PixelClassSummary covered, horizonCulled, cache, rayHit, rayMiss, interpolated;
     // Per stage: mean ms over the frames in which it ran, and in how many it ran.
     std::map<std::string, double> stagesMsMean;
     std::map<std::string, int> stageRuns;

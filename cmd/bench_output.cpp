@@ -40,16 +40,16 @@ json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 std::string framesCsv(const BenchResult& result) {
     std::ostringstream csv;
     csv << "frame,path_index,t_s,mode,frame_ms,cull_ms,draw_ms,triangles,draw_calls,rays_cast,psnr_db,diff_fraction,"
-           "px_covered,px_horizon_culled,px_cache,px_ray_hit,px_ray_miss,stages_ms,notes\n";
+           "px_covered,px_horizon_culled,px_cache,px_ray_hit,px_ray_miss,px_interpolated,stages_ms,notes\n";
     char buf[512];
     for (const auto& r : result.frames) {
         const FrameStats& s = r.stats;
-        std::snprintf(buf, sizeof(buf), "%d,%zu,%.4f,%s,%.4f,%.4f,%.4f,%llu,%llu,%llu,%.3f,%.6f,%llu,%llu,%llu,%llu,%llu,", r.frame,
+        std::snprintf(buf, sizeof(buf), "%d,%zu,%.4f,%s,%.4f,%.4f,%.4f,%llu,%llu,%llu,%.3f,%.6f,%llu,%llu,%llu,%llu,%llu,%llu,", r.frame,
                       r.pathIndex, r.t, r.mode.c_str(), s.frameMs, s.cullMs, s.drawMs, (unsigned long long)s.triangles,
                       (unsigned long long)s.drawCalls, (unsigned long long)s.raysCast, r.psnrDb, r.diffFraction,
                       (unsigned long long)s.pixels.covered, (unsigned long long)s.pixels.horizonCulled,
                       (unsigned long long)s.pixels.cache, (unsigned long long)s.pixels.rayHit,
-                      (unsigned long long)s.pixels.rayMiss);
+                      (unsigned long long)s.pixels.rayMiss, (unsigned long long)s.pixels.interpolated);
         csv << buf;
         std::string st;
         s.stages.forEach([&](Stage stage, double ms) {
@@ -70,7 +70,7 @@ json pixelClasses(const ModeSummary& s) {
                     {"mean_count", num(c.meanCount)}};
     };
     return {{"covered", cls(s.covered)}, {"horizon_culled", cls(s.horizonCulled)}, {"cache", cls(s.cache)},
-            {"ray_hit", cls(s.rayHit)}, {"ray_miss", cls(s.rayMiss)}};
+            {"ray_hit", cls(s.rayHit)}, {"ray_miss", cls(s.rayMiss)}, {"interpolated", cls(s.interpolated)}};
 }
 
 json modeJson(const ModeSummary& s) {
@@ -121,6 +121,7 @@ json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneM
                     {"horizon_grid", o.horizonGrid},
                     {"cache", o.cache},
                     {"cache_error_px", o.cacheErrorPx},
+                    {"far_step", o.farStep},
                     {"overlap", o.overlap},
                     {"frame_ms_target", o.frameMsTarget},
                     {"threads", o.threads}};

@@ -33,12 +33,12 @@ namespace {
 
 // Pixel classes (min / mean / max percent, mean count) over the frames of a mode.
 void summarisePixels(const std::vector<const BenchFrameRecord*>& frames, double npx, ModeSummary& s) {
-    PixelClassSummary* cls[5] = {&s.covered, &s.horizonCulled, &s.cache, &s.rayHit, &s.rayMiss};
+    PixelClassSummary* cls[6] = {&s.covered, &s.horizonCulled, &s.cache, &s.rayHit, &s.rayMiss, &s.interpolated};
     for (auto* c : cls) c->minPct = std::numeric_limits<double>::infinity();
     for (const BenchFrameRecord* r : frames) {
         const PixelCounts& p = r->stats.pixels;
-        const uint64_t c[5] = {p.covered, p.horizonCulled, p.cache, p.rayHit, p.rayMiss};
-        for (int k = 0; k < 5; ++k) {
+        const uint64_t c[6] = {p.covered, p.horizonCulled, p.cache, p.rayHit, p.rayMiss, p.interpolated};
+        for (int k = 0; k < 6; ++k) {
             const double pct = 100.0 * double(c[k]) / npx;
             cls[k]->minPct = std::min(cls[k]->minPct, pct);
             cls[k]->maxPct = std::max(cls[k]->maxPct, pct);

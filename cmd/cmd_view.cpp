@@ -207,9 +207,10 @@ std::string hudText(const std::string& mode, double lastMs, const FrameStats& fs
     const PixelCounts& p = fs.pixels;
     if (p.total() > 0) {
         const double n = double(p.total());
-        std::snprintf(buf, sizeof(buf), "\npixels %%: covered %.1f horizon %.1f cache %.1f\n          ray hit %.1f ray miss %.1f",
+        std::snprintf(buf, sizeof(buf),
+                      "\npixels %%: covered %.1f horizon %.1f cache %.1f\n          ray hit %.1f ray miss %.1f interpolated %.1f",
                       100.0 * double(p.covered) / n, 100.0 * double(p.horizonCulled) / n, 100.0 * double(p.cache) / n,
-                      100.0 * double(p.rayHit) / n, 100.0 * double(p.rayMiss) / n);
+                      100.0 * double(p.rayHit) / n, 100.0 * double(p.rayMiss) / n, 100.0 * double(p.interpolated) / n);
         text += buf;
     }
     for (const auto& note : fs.notes) text += "\n" + note;

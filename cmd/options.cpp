@@ -255,6 +255,9 @@ void addModeFlags(CLI::App& app, ModeFlags& f) {
     app.add_option("--frame-ms", f.frameMs,
                    "hybrid: frame-time target in ms, 0 .. 10000: the far-field ray budget adapts to what the target leaves "
                    "after the near field (0 = no target) (default 0)");
+    app.add_option("--far-step", f.farStep,
+                   "hybrid: far-field ray spacing, 1 or 2: 2 = rays on every other pixel and row first, pixels between "
+                   "lattice pixels that showed one triangle (or sky) blended from them (lossy: PSNR in the bench) (default 1)");
     app.add_option("--baked", f.baked, "impostor: the baked file of this city (from `vista bake`)");
     app.add_option("--threads", f.threads, "worker threads for ray casting, 0 .. 1024 (0 = all cores)");
 }
@@ -271,6 +274,8 @@ Status checkModeOptions(const ModeOptions& o) {
         return Status::error("--cache-error " + std::to_string(o.cacheErrorPx) + " out of range 0 .. 100 pixels");
     if (!(o.frameMsTarget >= 0 && o.frameMsTarget <= 10000))
         return Status::error("--frame-ms " + std::to_string(o.frameMsTarget) + " out of range 0 .. 10000 ms (0 = no target)");
+    if (o.farStep < 1 || o.farStep > 2)
+        return Status::error("--far-step " + std::to_string(o.farStep) + " out of range 1 .. 2 pixels");
     if (o.threads < 0 || o.threads > 1024)
         return Status::error("--threads " + std::to_string(o.threads) + " out of range 0 .. 1024 (0 = all cores)");
     return Status::ok();
@@ -293,6 +298,7 @@ Status parseModeFlags(const ModeFlags& f, ModeOptions& o) {
     o.cacheErrorPx = f.cacheError;
     o.overlap = !f.noOverlap;
     o.frameMsTarget = f.frameMs;
+    o.farStep = f.farStep;
     o.bakedFile = f.baked;
     o.threads = f.threads;
     return checkModeOptions(o);

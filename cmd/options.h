@@ -83,6 +83,7 @@ struct ModeFlags {
     int horizonGrid = 512;
     bool noCache = false, noOverlap = false;
     double cacheError = 0.25, frameMs = 0.0;
+    int farStep = 1;
     std::string baked;
     int threads = 0;
 };

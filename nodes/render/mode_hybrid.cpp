@@ -114,7 +114,7 @@ private:
     // The adaptive split's cost model: far pixels (cached or traced) against the stages that
     // scale with them; the far field's other stages as its fixed cost.
     void recordCosts(uint64_t tris, double rasterMs, const FrameStats& fs) {
-        const uint64_t farPixels = fs.pixels.cache + fs.pixels.rayHit + fs.pixels.rayMiss;
+        const uint64_t farPixels = fs.pixels.cache + fs.pixels.rayHit + fs.pixels.rayMiss + fs.pixels.interpolated;
         const double farMs = fs.stages.ms(Stage::Rays) + fs.stages.ms(Stage::Cache);
         const double fixedMs = fs.stages.ms(Stage::Opacity) + fs.stages.ms(Stage::Seam) + fs.stages.ms(Stage::Horizon) +
                                fs.stages.ms(Stage::Composite);
@@ -136,6 +136,7 @@ private:
         o.pixelBudget = _ctx.options.pixelBudget;
         o.cache = _ctx.options.cache;
         o.cacheErrorPx = _ctx.options.cacheErrorPx;
+        o.rayStep = _ctx.options.farStep;
         o.frameMsTarget = _ctx.options.frameMsTarget;
         o.threads = _ctx.options.threads;
         o.effects = _ctx.options.effects;

@@ -57,6 +57,7 @@ struct ModeOptions {
     double cacheErrorPx = 0.25;   // hybrid: reuse a cached far pixel while its reprojection error is below this, 0 .. 100
     bool overlap = true;          // hybrid: trace the horizon on another thread while the near field is drawn
     double frameMsTarget = 0.0;   // hybrid: > 0 = the ray budget adapts so the frame takes about this long (ms), 0 .. 10000
+    int farStep = 1;              // hybrid: far-field ray spacing, 1 (a ray per pixel) or 2 (FarFieldOptions::rayStep)
     int threads = 0;              // ray-casting threads; 0 = all cores
     std::string bakedFile;        // impostor: the baked file (unless the scene itself is baked)
     FrameEffects effects;         // run-time effects of every mode (haze, glass reflections, night sky)

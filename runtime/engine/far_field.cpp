@@ -105,7 +105,7 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
     }
     if (!f.trace.empty()) {
         const double before = stats.stages.ms(Stage::Rays);
-        raysStage(f, _rays, _options.threads, stats);
+        raysStage(f, *_mem, _rays, _options, stats);
         const double perRay = (stats.stages.ms(Stage::Rays) - before) / double(f.trace.size());
         _mem->msPerRay = _mem->msPerRay > 0 ? 0.8 * _mem->msPerRay + 0.2 * perRay : perRay;
     }

@@ -73,6 +73,13 @@ struct FarFieldOptions {
     int horizonSubsampleMoving = 1;  // >= 1: subsample factor of the horizon while the camera moves
     double cacheOversample = 1.5;
     int threads = 0;
+    // Ray spacing of the far field: 1 = a ray per far pixel (exact); 2 = rays
+    // on the even pixel lattice first, and a pixel between lattice pixels
+    // that were all cast this frame and all showed the same triangle (or all
+    // the sky) takes their perspective-correct blend instead of a ray (its
+    // own sky colour when they showed sky). Lossy: a feature narrower than
+    // two pixels between lattice pixels on one triangle is missed.
+    int rayStep = 1;
     // Far plane of the projection the near-field depth was rendered with
     // (camera.zNear is the near plane); <= 0 = infinite. Used to turn depth into
     // distance for the seam check below.

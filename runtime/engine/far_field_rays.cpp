@@ -93,6 +93,7 @@ void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, con
                     const glm::u8vec4 c = shown ? h.color : fx.sky(ddirs[k]);
                     std::copy_n(&c[0], 4, &out.rgba[size_t(pixels[b + k]) * 4]);
                     if (shading.depth) shading.depth[b + k] = shown ? float(z) : INFINITY;
+                    if (shading.keys) shading.keys[b + k] = shown ? SurfaceKey{h.geomId, h.primId, h.instId} : SurfaceKey{};
                     if (hit) hit[b + k] = shown ? 1 : 0;
                     nh += shown ? 1 : 0;
                 }
@@ -228,23 +229,140 @@ void hazeCoveredStage(FarFrame& f, const FarFieldOptions& o, FrameStats& stats) 
     recordHaze(sw.ms(), stats);
 }
 
-void raysStage(FarFrame& f, const RayScene& rays, int threads, FrameStats& stats) {
+namespace {
+
+// rayStep 2: rays for the entries on the even lattice (x and y even) first;
+// an entry between lattice entries whose lattice neighbours (2 on a lattice
+// row or column, else the 4 around it) were all cast this frame and all
+// showed the same triangle takes their perspective-correct blend (colour
+// and depth: 1/z is affine in screen space on a plane), or the sky of its own
+// direction when they all showed sky; every other entry casts its own ray.
+// Returns the number of interpolated entries; `hit`, `depth`, `keys` get one
+// value per entry of f.trace, colours go to f.out.
+uint64_t castOnLattice(FarFrame& f, FarFieldMemory& m, const RayScene& rays, int threads, RayCounts& counts,
+                       uint8_t* hit, float* depth) {
+    const size_t n = f.trace.size();
+    const uint32_t W = uint32_t(f.width), H = uint32_t(f.height);
+    std::vector<uint32_t> lattice, rest;  // indices into f.trace
+    lattice.reserve(n / 4 + 1);
+    rest.reserve(n);
+    for (size_t j = 0; j < n; ++j) {
+        const uint32_t i = f.trace[j];
+        ((i % W) % 2 == 0 && (i / W) % 2 == 0 ? lattice : rest).push_back(uint32_t(j));
+    }
+    auto castSubset = [&](const std::vector<uint32_t>& sub, std::vector<SurfaceKey>* keys) {
+        if (sub.empty()) return;
+        std::vector<uint32_t> pix(sub.size());
+        std::vector<uint8_t> h(sub.size());
+        std::vector<float> d(sub.size());
+        for (size_t k = 0; k < sub.size(); ++k) pix[k] = f.trace[sub[k]];
+        RayShading sh;
+        sh.effects = f.fx;
+        sh.depth = d.data();
+        if (keys) {
+            keys->resize(sub.size());
+            sh.keys = keys->data();
+        }
+        castPrimaryRays(rays, f.camera, pix.data(), pix.size(), f.out, counts, threads, h.data(), sh);
+        for (size_t k = 0; k < sub.size(); ++k) {
+            hit[sub[k]] = h[k];
+            depth[sub[k]] = d[k];
+        }
+    };
+    std::vector<SurfaceKey> latticeKeys;
+    castSubset(lattice, &latticeKeys);
+    // Which pixels were cast on the lattice this frame: slot into lattice (kept
+    // across frames all ~0, reset below).
+    std::vector<uint32_t>& slot = m.raySlot;
+    if (slot.size() != f.pixelCount) slot.assign(f.pixelCount, ~0u);
+    for (size_t k = 0; k < lattice.size(); ++k) slot[f.trace[lattice[k]]] = uint32_t(k);
+    std::vector<uint8_t> done(rest.size(), 0);
+    tbb::combinable<uint64_t> blended([] { return uint64_t(0); });
+    inArena(threads, [&] {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, rest.size(), 4096), [&](const tbb::blocked_range<size_t>& br) {
+            uint64_t nb = 0;
+            for (size_t r = br.begin(); r != br.end(); ++r) {
+                const uint32_t j = rest[r], i = f.trace[j], x = i % W, y = i / W;
+                // Lattice neighbours: x (even) or x -+ 1 (odd), times the same for y.
+                const uint32_t xs[2] = {x & 1u ? x - 1 : x, x + 1}, ys[2] = {y & 1u ? y - 1 : y, y + 1};
+                const int nx = int(x & 1u) + 1, ny = int(y & 1u) + 1;
+                uint32_t nbr[4];
+                int cnt = 0;
+                bool ok = true;
+                for (int a = 0; a < ny && ok; ++a)
+                    for (int b = 0; b < nx && ok; ++b) {
+                        if (xs[b] >= W || ys[a] >= H) {
+                            ok = false;
+                            break;
+                        }
+                        const uint32_t s = slot[ys[a] * W + xs[b]];
+                        if (s == ~0u || (cnt > 0 && !(latticeKeys[s] == latticeKeys[nbr[0]])))
+                            ok = false;
+                        else
+                            nbr[cnt++] = s;
+                    }
+                if (!ok || cnt == 0) continue;
+                uint8_t* px = &f.out.rgba[size_t(i) * 4];
+                if (latticeKeys[nbr[0]].sky()) {
+                    const glm::u8vec4 c = f.fx->sky(f.rays.dir(int(x), int(y)));
+                    std::copy_n(&c[0], 4, px);
+                    hit[j] = 0;
+                    depth[j] = INFINITY;
+                } else {
+                    double wsum = 0, c[4] = {0, 0, 0, 0};
+                    for (int k = 0; k < cnt; ++k) {
+                        const float z = depth[lattice[nbr[k]]];
+                        const double w = 1.0 / std::max(double(z), 1e-6);
+                        const uint8_t* q = &f.out.rgba[size_t(f.trace[lattice[nbr[k]]]) * 4];
+                        for (int ch = 0; ch < 3; ++ch) c[ch] += w * q[ch];
+                        wsum += w;
+                    }
+                    for (int ch = 0; ch < 3; ++ch) px[ch] = uint8_t(std::clamp(c[ch] / wsum + 0.5, 0.0, 255.0));
+                    px[3] = f.out.rgba[size_t(f.trace[lattice[nbr[0]]]) * 4 + 3];  // glass mark: one triangle, one mark
+                    hit[j] = 1;
+                    depth[j] = float(double(cnt) / wsum);
+                }
+                done[r] = 1;
+                ++nb;
+            }
+            blended.local() += nb;
+        });
+    });
+    for (size_t k = 0; k < lattice.size(); ++k) slot[f.trace[lattice[k]]] = ~0u;
+    std::vector<uint32_t> left;
+    for (size_t r = 0; r < rest.size(); ++r)
+        if (!done[r]) left.push_back(rest[r]);
+    castSubset(left, nullptr);
+    return blended.combine(std::plus<uint64_t>());
+}
+
+}  // namespace
+
+void raysStage(FarFrame& f, FarFieldMemory& m, const RayScene& rays, const FarFieldOptions& o, FrameStats& stats) {
     Stopwatch sw;
-    std::vector<uint8_t> hit(f.trace.size(), 0);
-    std::vector<float> depth(f.fx->haze || !f.farDepth.empty() ? f.trace.size() : 0);
+    const size_t n = f.trace.size();
+    std::vector<uint8_t> hit(n, 0);
+    const bool lattice = o.rayStep >= 2;
+    std::vector<float> depth(lattice || f.fx->haze || !f.farDepth.empty() ? n : 0);
     RayCounts counts;
-    RayShading shading;
-    shading.effects = f.fx;
-    shading.depth = depth.empty() ? nullptr : depth.data();
-    castPrimaryRays(rays, f.camera, f.trace.data(), f.trace.size(), f.out, counts, threads, hit.data(), shading);
-    for (size_t j = 0; j < f.trace.size(); ++j) f.cls[f.trace[j]] = hit[j] ? kFarRayHit : kFarRayMiss;
+    uint64_t blended = 0;
+    if (lattice) {
+        blended = castOnLattice(f, m, rays, o.threads, counts, hit.data(), depth.data());
+    } else {
+        RayShading shading;
+        shading.effects = f.fx;
+        shading.depth = depth.empty() ? nullptr : depth.data();
+        castPrimaryRays(rays, f.camera, f.trace.data(), n, f.out, counts, o.threads, hit.data(), shading);
+    }
+    for (size_t j = 0; j < n; ++j) f.cls[f.trace[j]] = hit[j] ? kFarRayHit : kFarRayMiss;
     stats.raysCast += counts.rays;
     stats.pixels.rayHit += counts.hits;
     stats.pixels.rayMiss += counts.rays - counts.hits;
+    stats.pixels.interpolated += blended;
     stats.stages.add(Stage::Rays, sw.ms());
     if (!f.farDepth.empty())
-        for (size_t j = 0; j < f.trace.size(); ++j) f.farDepth[f.trace[j]] = depth[j];
-    if (f.fx->haze) hazeStage(*f.fx, f.trace.data(), f.trace.size(), depth.data(), f.out, stats);
+        for (size_t j = 0; j < n; ++j) f.farDepth[f.trace[j]] = depth[j];
+    if (f.fx->haze) hazeStage(*f.fx, f.trace.data(), n, depth.data(), f.out, stats);
 }
 
 }  // namespace vista

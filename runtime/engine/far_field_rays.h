@@ -82,9 +82,18 @@ struct RayCounts {
 // fx.hazeFar() of eye-plane depth, hits beyond show the sky; night sky) and,
 // optionally, the eye-plane depth of every entry (+inf on a miss) for the
 // haze stage. Glass marks (alpha) of hit colours are kept.
+// The surface a ray showed: its triangle (geometry, primitive, instance), or
+// all ~0 for a ray that showed the sky (a miss, or a hit beyond the haze).
+struct SurfaceKey {
+    uint32_t geom = ~0u, prim = ~0u, inst = ~0u;
+    bool sky() const { return geom == ~0u; }
+    bool operator==(const SurfaceKey& o) const { return geom == o.geom && prim == o.prim && inst == o.inst; }
+};
+
 struct RayShading {
     const FrameEffects* effects = nullptr;  // null = none
     float* depth = nullptr;                 // n entries (castPrimaryRays) or width*height (castFrame)
+    SurfaceKey* keys = nullptr;             // optional, like depth: the surface each entry showed
 };
 
 // Casts the rays of the n listed pixels (indices y * width + x) and writes

@@ -57,6 +57,7 @@ struct FarFieldMemory {
     std::vector<CacheCandidate> cand;
     std::vector<uint8_t> traceMarks;
     std::vector<float> farDepth;  // swapped into FarFrame::farDepth for the frame
+    std::vector<uint32_t> raySlot;  // ray stage (rayStep 2): per pixel, ~0 between frames
 };
 
 // Radius (pixels) of the screen window whose nearest far surface a cached cell records.
@@ -139,11 +140,14 @@ int64_t cacheBudget(const FarFrame& f, const FarFieldMemory& m, const FarFieldOp
 // Cache off: f.trace = f.pending. No class, no time.
 void bypassCache(FarFrame& f);
 
-// Rays (far_field_rays.cpp). In: f.trace. Casts them with castPrimaryRays;
-// each becomes rayHit or rayMiss, its colour (prelit or sky) written to out,
-// its eye-plane depth to f.farDepth when that is set; raysCast += rays.
-// Records Rays.
-void raysStage(FarFrame& f, const RayScene& rays, int threads, FrameStats& stats);
+// Rays (far_field_rays.cpp). In: f.trace, o.rayStep, o.threads. Casts them
+// with castPrimaryRays (rayStep 2: the even lattice first, the pixels between
+// lattice pixels that showed one triangle blended, see FarFieldOptions); each
+// becomes rayHit or rayMiss class, its colour (prelit or sky) written to out,
+// its eye-plane depth to f.farDepth when that is set; raysCast += rays cast,
+// pixels.rayHit / rayMiss count cast rays, pixels.interpolated the blended
+// ones. Records Rays.
+void raysStage(FarFrame& f, FarFieldMemory& m, const RayScene& rays, const FarFieldOptions& o, FrameStats& stats);
 
 // Sky colours of the camera (far_field_composite.cpp), cached in m.sky.
 const Image& skyImage(FarFieldMemory& m, const FarFrame& f);

@@ -29,7 +29,8 @@ struct PixelCounts {
     uint64_t cache = 0;          // taken from the panoramic cache
     uint64_t rayHit = 0;         // traced this frame, hit geometry
     uint64_t rayMiss = 0;        // traced this frame, hit nothing (sky)
-    uint64_t total() const { return covered + horizonCulled + cache + rayHit + rayMiss; }
+    uint64_t interpolated = 0;   // blended from ray-cast neighbours (FarFieldOptions::rayStep 2)
+    uint64_t total() const { return covered + horizonCulled + cache + rayHit + rayMiss + interpolated; }
 };
 
 enum class Stage : uint8_t {

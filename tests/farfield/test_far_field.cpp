@@ -18,6 +18,7 @@
 #include "runtime/engine/far_field.h"
 #include "runtime/engine/far_field_rays.h"
 #include "runtime/engine/horizon.h"
+#include "runtime/engine/metrics.h"
 #include "runtime/engine/ray_scene.h"
 #include "tests/farfield/fixtures.h"
 
@@ -579,4 +580,58 @@ TEST(FarFieldFrame, EarlyHorizonGivesTheSameFrame) {
     plain.render(other, depth.data(), b, sb);
     EXPECT_FALSE(has(sa, "horizon overlapped"));
     EXPECT_EQ(a.rgba, b.rgba);
+}
+
+// rayStep 2 (the lattice): fewer rays, the frame close to the exact one, and
+// where the lattice neighbours show one flat-coloured triangle, or sky, the
+// blend equals the exact pixel.
+TEST(FarFieldFrame, LatticeRaysBlendOnlyWithinOneSurface) {
+    const TestCity t = testCity(12, 60);
+    ASSERT_TRUE(t.rays);
+    FarFieldOptions o;
+    o.nearDistance = 0;
+    o.cache = false;
+    FarFieldOptions o2 = o;
+    o2.rayStep = 2;
+    for (double pitch : {0.0, -0.3}) {
+        Camera c = cam(glm::dvec3(0, -190, 25.0), 0.2, pitch, 161, 121);
+        const size_t N = size_t(c.width) * size_t(c.height);
+        FarField exact(*t.rays, &t.grid, o), lattice(*t.rays, &t.grid, o2);
+        Image a, b;
+        FrameStats sa, sb;
+        exact.render(c, nullptr, a, sa);
+        lattice.render(c, nullptr, b, sb);
+        EXPECT_EQ(sb.pixels.total(), N);
+        EXPECT_EQ(sa.pixels.interpolated, 0u);
+        EXPECT_GT(sb.pixels.interpolated, 0u);
+        EXPECT_EQ(sb.raysCast + sb.pixels.interpolated, sa.raysCast);  // every far pixel: a ray or a blend
+        EXPECT_LT(double(sb.raysCast), 0.7 * double(sa.raysCast));
+        EXPECT_GE(lumaPsnr(a, b), 35.0) << "pitch " << pitch;
+        // Lattice pixels are cast exactly as before.
+        for (int y = 0; y < c.height; y += 2)
+            for (int x = 0; x < c.width; x += 2) {
+                const size_t i = size_t(y) * size_t(c.width) + size_t(x);
+                if (lattice.classification()[i] == kFarRayHit || lattice.classification()[i] == kFarRayMiss)
+                    ASSERT_EQ(channelDiff(a, b, i), 0) << x << "," << y;
+            }
+    }
+    // One flat-coloured wall filling the view, and sky above it: every blended
+    // pixel equals the exact one (the blend of equal colours, the sky of its own direction).
+    SceneModel wall;
+    SceneMesh m;
+    addBox(m, {-500, 100, 0}, {500, 110, 40}, {90, 120, 150, 255});
+    wall.meshes.push_back(m);
+    auto rs = RayScene::build(wall);
+    ASSERT_TRUE(rs.isOk());
+    HeightGrid g = HeightGrid::build(wall, rs.value()->frameOrigin(), 64);
+    Camera c = cam(glm::dvec3(0, 0, 20.0), 0.0, 0.0, 121, 81);
+    FarField exact(*rs.value(), &g, o), lattice(*rs.value(), &g, o2);
+    Image a, b;
+    FrameStats sa, sb;
+    exact.render(c, nullptr, a, sa);
+    lattice.render(c, nullptr, b, sb);
+    EXPECT_GT(sb.pixels.interpolated, sa.raysCast / 2);
+    int worst = 0;
+    for (size_t i = 0; i < size_t(c.width) * size_t(c.height); ++i) worst = std::max(worst, channelDiff(a, b, i));
+    EXPECT_LE(worst, 1);
 }
