@@ -1,0 +1,84 @@
+// The lane model: see lanes.h.
+#include "citygen/lanes.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace vista {
+
+double carriagewayWidth(const StreetEdge& e) {
+    double w = double(e.width);
+    return std::isfinite(w) && w > 0.5 ? w : roadWidth(e.cls);
+}
+
+LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params) {
+    LaneModel m;
+    const size_t N = g.nodes.size();
+    m.degree.assign(N, 0);
+    m.nodeJunction.assign(N, -1);
+    m.edges.resize(g.edges.size());
+    const double sw = params.sidewalk_m > 0.01 ? params.sidewalk_m : 0.0;
+    std::vector<std::vector<uint32_t>> incident(N);
+    for (size_t e = 0; e < g.edges.size(); ++e) {
+        const StreetEdge& E = g.edges[e];
+        EdgeLanes& L = m.edges[e];
+        if (E.a >= N || E.b >= N || E.a == E.b) continue;
+        const glm::dvec2 A = g.nodes[E.a], B = g.nodes[E.b];
+        if (!std::isfinite(A.x + A.y + B.x + B.y)) continue;
+        const double len = glm::length(B - A);
+        if (!(len > 1e-6)) continue;
+        L.valid = true;
+        L.dir = (B - A) / len;
+        const int n = std::max<int>(E.lanes, 2);
+        L.right = (n + 1) / 2;
+        L.left = n / 2;
+        L.laneWidth = carriagewayWidth(E) / n;
+        L.sidewalk = sw;
+        L.start = A;
+        L.end = B;
+        L.length = len;
+        ++m.degree[E.a];
+        ++m.degree[E.b];
+        incident[E.a].push_back(uint32_t(e));
+        incident[E.b].push_back(uint32_t(e));
+    }
+    for (uint32_t v = 0; v < N; ++v) {
+        if (m.degree[v] < 3) continue;
+        Junction J;
+        J.node = v;
+        J.arms = incident[v];
+        for (uint32_t e : J.arms) J.radius = std::max(J.radius, m.edges[e].halfWidth() + sw);
+        auto angle = [&](uint32_t e) {
+            const EdgeLanes& L = m.edges[e];
+            glm::dvec2 d = g.edges[e].a == v ? L.dir : -L.dir;
+            return std::atan2(d.y, d.x);
+        };
+        std::stable_sort(J.arms.begin(), J.arms.end(), [&](uint32_t x, uint32_t y) { return angle(x) < angle(y); });
+        m.nodeJunction[v] = int(m.junctions.size());
+        m.junctions.push_back(std::move(J));
+    }
+    for (size_t e = 0; e < g.edges.size(); ++e) {
+        EdgeLanes& L = m.edges[e];
+        if (!L.valid) continue;
+        const StreetEdge& E = g.edges[e];
+        L.junctionA = m.nodeJunction[E.a];
+        L.junctionB = m.nodeJunction[E.b];
+        double ta = L.junctionA >= 0 ? m.junctions[size_t(L.junctionA)].radius : 0.0;
+        double tb = L.junctionB >= 0 ? m.junctions[size_t(L.junctionB)].radius : 0.0;
+        const double len = L.length, room = std::max(0.0, len - kMinRoadLength);
+        if (ta + tb > room) {
+            const double f = ta + tb > 0 ? room / (ta + tb) : 0.0;
+            ta *= f;
+            tb *= f;
+        }
+        L.trimA = ta;
+        L.trimB = tb;
+        const glm::dvec2 A = g.nodes[E.a];
+        L.start = A + L.dir * ta;
+        L.end = A + L.dir * (len - tb);
+        L.length = len - ta - tb;
+    }
+    return m;
+}
+
+}  // namespace vista
