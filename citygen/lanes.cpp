@@ -34,6 +34,7 @@ LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params) {
         L.left = n / 2;
         L.laneWidth = carriagewayWidth(E) / n;
         L.sidewalk = sw;
+        L.offset = 0.5 * (L.right - L.left) * L.laneWidth;
         L.start = A;
         L.end = B;
         L.length = len;

@@ -49,12 +49,17 @@ struct EdgeLanes {
     int right = 1, left = 1;          // driving lanes a->b / b->a
     double laneWidth = 3.5;
     double sidewalk = 0;              // each side, 0 = none
+    // Lateral position of the centre lane (lane 0) relative to the street's
+    // centre line (left positive): (right - left) / 2 x laneWidth, so the
+    // lanes span exactly the carriageway [-w/2, w/2] for odd lane counts too
+    // (OpenDRIVE <laneOffset>).
+    double offset = 0;
     int junctionA = -1, junctionB = -1;  // index into LaneModel::junctions, -1 = none
     glm::dvec2 normal() const { return {-dir.y, dir.x}; }  // left of a -> b
     double halfWidth() const { return 0.5 * laneWidth * (right + left); }
     // Lateral offset (left positive) of the centre of driving lane `id`
     // (OpenDRIVE numbering: -1..-right to the right, 1..left to the left).
-    double laneCentre(int id) const { return id < 0 ? (id + 0.5) * laneWidth : (id - 0.5) * laneWidth; }
+    double laneCentre(int id) const { return offset + (id < 0 ? (id + 0.5) * laneWidth : (id - 0.5) * laneWidth); }
 };
 
 struct Junction {

@@ -194,7 +194,8 @@ void Writer::road(uint32_t e) {
     o += "    <planView>\n      <geometry s=\"0\" x=\"" + num(w.x) + "\" y=\"" + num(w.y) + "\" hdg=\"" + num(hdg) +
          "\" length=\"" + num(L.length) + "\">\n        <line/>\n      </geometry>\n    </planView>\n";
     elevation(L.start, L.dir, L.length);
-    o += "    <lanes>\n      <laneSection s=\"0\">\n";
+    o += "    <lanes>\n      <laneOffset s=\"0\" a=\"" + num(L.offset) + "\" b=\"0\" c=\"0\" d=\"0\"/>\n";
+    o += "      <laneSection s=\"0\">\n";
     laneSide(L, E, true, e);
     o += "        <center>\n          <lane id=\"0\" type=\"none\" level=\"false\">\n            " + roadMarkCentre(E.cls) +
          "\n          </lane>\n        </center>\n";
@@ -257,7 +258,10 @@ void Writer::junction(size_t j) {
                  num(c.y) + "\" dV=\"" + num(d.y) + "\" pRange=\"normalized\"/>\n      </geometry>\n    </planView>\n";
             o += "    <elevationProfile>\n      <elevation s=\"0\" a=\"" + num(z0) + "\" b=\"" + num((z1 - z0) / len) +
                  "\" c=\"0\" d=\"0\"/>\n    </elevationProfile>\n";
-            o += "    <lanes>\n      <laneSection s=\"0\">\n        <center>\n          <lane id=\"0\" type=\"none\" "
+            // Centre lane position in this road's frame (reversed roads flip its sign).
+            const double off0 = inEnd ? Li.offset : -Li.offset, off1 = outStart ? Lo.offset : -Lo.offset;
+            o += "    <lanes>\n      <laneOffset s=\"0\" a=\"" + num(off0) + "\" b=\"" + num((off1 - off0) / len) +
+                 "\" c=\"0\" d=\"0\"/>\n      <laneSection s=\"0\">\n        <center>\n          <lane id=\"0\" type=\"none\" "
                  "level=\"false\">\n            <roadMark sOffset=\"0\" type=\"none\"/>\n          </lane>\n        </center>\n"
                  "        <right>\n";
             jx += "    <connection id=\"" + std::to_string(connection++) + "\" incomingRoad=\"" + std::to_string(in) +

@@ -128,6 +128,19 @@ City osmCity(const std::string& file) {
     return std::move(*c);
 }
 
+// A generated city's streets with every third edge given an odd lane count
+// (3 or 5: asymmetric lanes about the centre line, OpenDRIVE laneOffset).
+City oddLanes(const CityParams& p) {
+    City c = generated(p);
+    StreetGraph g = c.streets;
+    for (size_t e = 0; e < g.edges.size(); e += 3) g.edges[e].lanes = uint8_t(g.edges[e].lanes >= 4 ? 5 : 3);
+    GenerateOptions o;
+    o.streets = std::move(g);
+    auto r = generateCity(p, o);
+    EXPECT_TRUE(r.isOk()) << r.status().message();
+    return std::move(*r);
+}
+
 // ---- netconvert --------------------------------------------------------------
 std::string shellOut(const std::string& cmd) {
     std::string out;
@@ -293,7 +306,8 @@ struct RoadTriangles {
             }
         }
     }
-    // Smallest |z - mesh z| over the road triangles containing p (xy); NaN if none.
+    // Smallest |z - mesh z| over the road triangles containing p (xy, 1e-4
+    // barycentric slack); NaN if none.
     double heightError(const glm::dvec3& p) const {
         auto it = grid.find({int(std::floor(p.x / cell)), int(std::floor(p.y / cell))});
         double best = std::nan("");
@@ -305,7 +319,9 @@ struct RoadTriangles {
             double l0 = ((b.y - c.y) * (p.x - c.x) + (c.x - b.x) * (p.y - c.y)) / den;
             double l1 = ((c.y - a.y) * (p.x - c.x) + (a.x - c.x) * (p.y - c.y)) / den;
             double l2 = 1 - l0 - l1;
-            if (l0 < -1e-9 || l1 < -1e-9 || l2 < -1e-9) continue;
+            // 1e-4 of a triangle (~1 mm): points on a seam between two tiles'
+            // float meshes (a crack of float rounding) count as covered.
+            if (l0 < -1e-4 || l1 < -1e-4 || l2 < -1e-4) continue;
             double z = l0 * a.z + l1 * b.z + l2 * c.z, err = std::abs(z - p.z);
             if (!(err >= best)) best = err;
         }
@@ -319,11 +335,12 @@ TEST(OpenDrive, NetconvertReadsGeneratedCity) { checkNet(generated(smallParams(3
 
 TEST(OpenDrive, NetconvertReadsHillyCity) { checkNet(generated(smallParams(7, 500, 25)), "generated 500 m seed 7, hills 25 m"); }
 
+TEST(OpenDrive, NetconvertReadsOddLaneCounts) { checkNet(oddLanes(smallParams(5, 400, 0)), "generated 400 m seed 5, odd lane counts"); }
+
 TEST(OpenDrive, NetconvertReadsOsmImport) { checkNet(osmCity("hard_cases.osm"), "osm hard_cases.osm"); }
 
-TEST(OpenDrive, LaneCentresLieOnTheRoadMesh) {
-    for (double hills : {0.0, 25.0}) {
-        const City city = generated(smallParams(7, 500, hills));
+static void checkLaneCentres(const City& city, const std::string& label) {
+    {
         auto xodr = openDriveXml(city.streets, city.params);
         ASSERT_TRUE(xodr.isOk());
         std::string err;
@@ -352,9 +369,13 @@ TEST(OpenDrive, LaneCentresLieOnTheRoadMesh) {
                     type[std::abs(id)] = lane->str("type");
                 }
                 const double sgn = std::string(sideName) == "left" ? 1.0 : -1.0;
+                const Element* laneOffset = road->first("lanes")->first("laneOffset");
+                ASSERT_TRUE(laneOffset);
+                const double offset = laneOffset->num("a");  // constant on street roads
+                EXPECT_EQ(laneOffset->num("b"), 0.0);
                 double inner = 0;
                 for (auto& [k, w] : width) {
-                    const double t = sgn * (inner + 0.5 * w);
+                    const double t = offset + sgn * (inner + 0.5 * w);
                     inner += w;
                     if (type[k] != "driving") continue;
                     for (double f : {0.1, 0.5, 0.9}) {
@@ -366,7 +387,8 @@ TEST(OpenDrive, LaneCentresLieOnTheRoadMesh) {
                         ++samples;
                         if (std::isnan(e)) {
                             ++missing;
-                            ADD_FAILURE() << "no road triangle under lane " << k << " of road " << road->str("id") << " at s " << s;
+                            ADD_FAILURE() << label << ": no road triangle under lane " << k << " of road " << road->str("id") << " at s " << s
+                                          << " (city frame " << q.x << ", " << q.y << ")";
                             continue;
                         }
                         worst = std::max(worst, e);
@@ -375,11 +397,18 @@ TEST(OpenDrive, LaneCentresLieOnTheRoadMesh) {
                 }
             }
         }
-        EXPECT_GT(samples, 100u);
+        EXPECT_GT(samples, 20u);
         EXPECT_EQ(missing, 0u);
-        std::printf("[ hills %g m ] %zu lane-centre samples, worst vertical distance to the road mesh %.4f m\n", hills, samples,
-                    worst);
+        std::printf("[ %s ] %zu lane-centre samples, worst vertical distance to the road mesh %.4f m\n", label.c_str(),
+                    samples, worst);
     }
+}
+
+TEST(OpenDrive, LaneCentresLieOnTheRoadMesh) {
+    checkLaneCentres(generated(smallParams(7, 500, 0)), "generated, flat");
+    checkLaneCentres(generated(smallParams(7, 500, 25)), "generated, hills 25 m / 500 m");
+    checkLaneCentres(osmCity("hard_cases.osm"), "osm hard_cases.osm");
+    checkLaneCentres(oddLanes(smallParams(5, 400, 10)), "generated, odd lane counts, hills 10 m");
 }
 
 TEST(OpenDrive, DeterministicAndWellFormed) {
