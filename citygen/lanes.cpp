@@ -3,6 +3,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <utility>
+
+#include "citygen/polygon.h"
 
 namespace vista {
 
@@ -11,7 +15,39 @@ double carriagewayWidth(const StreetEdge& e) {
     return std::isfinite(w) && w > 0.5 ? w : roadWidth(e.cls);
 }
 
-LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params) {
+namespace {
+
+// Point-in-block queries over a uniform grid of block bounding boxes.
+class BlockLookup {
+public:
+    explicit BlockLookup(const std::vector<Block>& blocks) : _blocks(blocks) {
+        for (size_t b = 0; b < blocks.size(); ++b) {
+            const Polygon2& o = blocks[b].outline;
+            if (o.size() < 3) continue;
+            glm::dvec2 lo(1e300), hi(-1e300);
+            for (const auto& q : o) lo = glm::min(lo, q), hi = glm::max(hi, q);
+            if (!std::isfinite(lo.x + lo.y + hi.x + hi.y)) continue;
+            for (long y = cell(lo.y); y <= cell(hi.y); ++y)
+                for (long x = cell(lo.x); x <= cell(hi.x); ++x) _grid[{x, y}].push_back(uint32_t(b));
+        }
+    }
+    bool inside(const glm::dvec2& p) const {
+        auto it = _grid.find({cell(p.x), cell(p.y)});
+        if (it == _grid.end()) return false;
+        for (uint32_t b : it->second)
+            if (pointInPolygon(_blocks[b].outline, p)) return true;
+        return false;
+    }
+
+private:
+    static long cell(double v) { return long(std::floor(v / 64.0)); }
+    const std::vector<Block>& _blocks;
+    std::map<std::pair<long, long>, std::vector<uint32_t>> _grid;
+};
+
+}  // namespace
+
+LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks) {
     LaneModel m;
     const size_t N = g.nodes.size();
     m.degree.assign(N, 0);
@@ -78,6 +114,17 @@ LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params) {
         L.start = A + L.dir * ta;
         L.end = A + L.dir * (len - tb);
         L.length = len - ta - tb;
+    }
+    if (blocks && sw > 0) {
+        const BlockLookup lookup(*blocks);
+        for (size_t e = 0; e < g.edges.size(); ++e) {
+            EdgeLanes& L = m.edges[e];
+            if (!L.valid) continue;
+            const glm::dvec2 mid = 0.5 * (g.nodes[g.edges[e].a] + g.nodes[g.edges[e].b]);
+            const double reach = L.halfWidth() + sw + 1.0;
+            L.walkLeft = lookup.inside(mid + L.normal() * reach);
+            L.walkRight = lookup.inside(mid - L.normal() * reach);
+        }
     }
     return m;
 }

@@ -16,8 +16,11 @@
 //   laneWidth = carriageway / n, so they sum to the carriageway width the
 //   road mesh uses (edge.width, or the class default for a non-finite or
 //   < 0.5 m width, as surfaces.cpp does).
-// - Sidewalk: one per side of width params.sidewalk_m (0 when <= 0.01, as the
-//   sidewalk mesh), directly outside the carriageway.
+// - Sidewalk: width params.sidewalk_m (0 when <= 0.01, as the sidewalk mesh),
+//   directly outside the carriageway, on each side that borders a block
+//   (the sidewalk mesh runs along block outlines): with `blocks` given, a side
+//   has a sidewalk when the point a metre past the sidewalk at the edge's
+//   midpoint lies inside a block outline; without blocks, both sides.
 // - Junction: one per node of degree >= 3, radius = max over its edges of
 //   (half carriageway + sidewalk): the corner points of the sidewalks of
 //   neighbouring streets lie inside it; its arms are the incident edges in
@@ -30,8 +33,7 @@
 
 #include <glm/glm.hpp>
 
-#include "citygen/params.h"
-#include "citygen/street_graph.h"
+#include "citygen/city.h"
 
 namespace vista {
 
@@ -48,7 +50,8 @@ struct EdgeLanes {
     double length = 0;                // |end - start|
     int right = 1, left = 1;          // driving lanes a->b / b->a
     double laneWidth = 3.5;
-    double sidewalk = 0;              // each side, 0 = none
+    double sidewalk = 0;              // sidewalk width, 0 = none
+    bool walkLeft = true, walkRight = true;  // sidewalk present on that side (when sidewalk > 0)
     // Lateral position of the centre lane (lane 0) relative to the street's
     // centre line (left positive): (right - left) / 2 x laneWidth, so the
     // lanes span exactly the carriageway [-w/2, w/2] for odd lane counts too
@@ -56,6 +59,7 @@ struct EdgeLanes {
     double offset = 0;
     int junctionA = -1, junctionB = -1;  // index into LaneModel::junctions, -1 = none
     glm::dvec2 normal() const { return {-dir.y, dir.x}; }  // left of a -> b
+    bool hasWalk(int side) const { return sidewalk > 0 && (side > 0 ? walkLeft : walkRight); }
     double halfWidth() const { return 0.5 * laneWidth * (right + left); }
     // Lateral offset (left positive) of the centre of driving lane `id`
     // (OpenDRIVE numbering: -1..-right to the right, 1..left to the left).
@@ -75,6 +79,6 @@ struct LaneModel {
     std::vector<int> degree;           // per node
 };
 
-LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params);
+LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks = nullptr);
 
 }  // namespace vista

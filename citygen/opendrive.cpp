@@ -26,7 +26,8 @@ std::string num(double v) {
 
 class Writer {
 public:
-    Writer(const StreetGraph& g, const CityParams& p) : g(g), P(p), M(buildLaneModel(g, p)) {}
+    Writer(const StreetGraph& g, const CityParams& p, const std::vector<Block>* blocks)
+        : g(g), P(p), M(buildLaneModel(g, p, blocks)) {}
     Result<std::string> run(OpenDriveCounts* counts);
 
 private:
@@ -118,7 +119,7 @@ int Writer::linkedLane(uint32_t e, uint32_t v, int id) const {
     const int ne = side > 0 ? Le.left : Le.right;
     const int nf = (side * sign) > 0 ? Lf.left : Lf.right;
     if (k <= ne) return k <= nf ? side * sign * k : 0;
-    if (k == ne + 1 && Le.sidewalk > 0 && Lf.sidewalk > 0) return side * sign * (nf + 1);
+    if (k == ne + 1 && Le.hasWalk(side) && Lf.hasWalk(side * sign)) return side * sign * (nf + 1);
     return 0;
 }
 
@@ -158,11 +159,11 @@ void Writer::laneSide(const EdgeLanes& L, const StreetEdge& E, bool left, uint32
     };
     o += left ? "          <left>\n" : "          <right>\n";
     if (left) {
-        if (L.sidewalk > 0) laneXml(count + 1, true);
+        if (L.hasWalk(1)) laneXml(count + 1, true);
         for (int k = count; k >= 1; --k) laneXml(k, false);
     } else {
         for (int k = 1; k <= count; ++k) laneXml(k, false);
-        if (L.sidewalk > 0) laneXml(count + 1, true);
+        if (L.hasWalk(-1)) laneXml(count + 1, true);
     }
     o += left ? "          </left>\n" : "          </right>\n";
 }
@@ -324,8 +325,9 @@ std::string openDriveGeoReference(const CityParams& p) {
            " +y_0=" + num(p.origin_y) + " +ellps=WGS84 +units=m +no_defs";
 }
 
-Result<std::string> openDriveXml(const StreetGraph& g, const CityParams& params, OpenDriveCounts* counts) {
-    Writer w(g, params);
+Result<std::string> openDriveXml(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks,
+                                 OpenDriveCounts* counts) {
+    Writer w(g, params, blocks);
     return w.run(counts);
 }
 

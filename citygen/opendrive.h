@@ -9,7 +9,8 @@
 //   cubic pieces (<= 10 m) through the road surface height (terrainHeight +
 //   2 cm, as the road mesh) and a <lateralProfile> superelevation for the
 //   cross slope of the terrain (positive = road falls to the right); one
-//   laneSection: left/right driving lanes and type="sidewalk" lanes with
+//   laneSection: left/right driving lanes and type="sidewalk" lanes (on the
+//   sides that have a sidewalk mesh) with
 //   constant <width>, road marks on the centre lane and lane dividers.
 // - One <junction> per node of degree >= 3 (id = road count + junction
 //   index) with one connecting road (junction attribute set) per ordered pair
@@ -27,8 +28,9 @@
 #include <cstddef>
 #include <string>
 
-#include "citygen/params.h"
-#include "citygen/street_graph.h"
+#include <vector>
+
+#include "citygen/city.h"
 #include "foundation/status.h"
 
 namespace vista {
@@ -41,7 +43,10 @@ struct OpenDriveCounts {
     size_t sidewalks = 0;        // sidewalk lanes over the street-edge roads
 };
 
-Result<std::string> openDriveXml(const StreetGraph& g, const CityParams& params, OpenDriveCounts* counts = nullptr);
+// `blocks` (the city's, or extractBlocks() of the same graph and params)
+// decide on which sides sidewalk lanes are written (lanes.h); null: both.
+Result<std::string> openDriveXml(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks,
+                                 OpenDriveCounts* counts = nullptr);
 
 // The PROJ string written into <geoReference> (see above).
 std::string openDriveGeoReference(const CityParams& params);

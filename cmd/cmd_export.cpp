@@ -1,10 +1,12 @@
 // vista export: a scene file's road network in an exchange format (today:
 // ASAM OpenDRIVE, --xodr; docs/formats.md "OpenDRIVE"). Reads the street
-// graph and parameters the scene file carries, so the output equals
+// graph and parameters the scene file carries (blocks, which decide the
+// sidewalk sides, are derived again from them), so the output equals
 // `vista gen ... --xodr` of the same city byte for byte.
 #include <cstdio>
 #include <string>
 
+#include "citygen/blocks.h"
 #include "citygen/opendrive.h"
 #include "cmd/cli.h"
 #include "cmd/commands.h"
@@ -43,8 +45,10 @@ int runExport(int argc, char** argv) {
     if (!model) return reportBadInput(cmd, model.status());
     if (model->streets.edges.empty())
         return reportBadInput(cmd, Status::error("scene file '" + input + "' has no street graph (no streets to export)"));
+    // The blocks decide the sidewalk sides; they are a function of (streets, params).
+    const std::vector<Block> blocks = extractBlocks(model->streets, model->params, nullptr);
     OpenDriveCounts n;
-    auto text = openDriveXml(model->streets, model->params, &n);
+    auto text = openDriveXml(model->streets, model->params, &blocks, &n);
     if (!text) return reportBadInput(cmd, Status::error("scene file '" + input + "': " + text.status().message()));
     if (Status s = writeFileAtomic(xodr, *text); !s) return reportBadInput(cmd, s);
     if (!quiet)

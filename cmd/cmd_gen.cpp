@@ -118,7 +118,7 @@ Status writeOutputs(const GenArgs& a, const City& city, const CityParams& params
                                               streetGraphToGeoJson(city.streets, params.origin_x, params.origin_y, params.geo)));
     if (!a.gltfFile.empty()) VISTA_RETURN_IF_ERROR(writeGltf(city, batch.stage(a.gltfFile)));
     if (!a.xodrFile.empty()) {
-        auto xodr = openDriveXml(city.streets, params);
+        auto xodr = openDriveXml(city.streets, params, &city.blocks);
         if (!xodr) return Status::error("option --xodr = '" + a.xodrFile + "': " + xodr.status().message());
         VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage(a.xodrFile), *xodr));
     }

@@ -206,7 +206,7 @@ void checkNet(const City& city, const std::string& label) {
     if (netconvert.empty()) GTEST_SKIP() << "netconvert (SUMO) is not on PATH: install the Debian package 'sumo'";
     TempDir dir("vista_xodr");
     OpenDriveCounts n;
-    auto xodr = openDriveXml(city.streets, city.params, &n);
+    auto xodr = openDriveXml(city.streets, city.params, &city.blocks, &n);
     ASSERT_TRUE(xodr.isOk()) << xodr.status().message();
     {
         std::ofstream f(dir.file("city.xodr"), std::ios::binary);
@@ -217,7 +217,7 @@ void checkNet(const City& city, const std::string& label) {
     EXPECT_EQ(r.errors, 0) << label << "\n" << r.log;
     ASSERT_TRUE(r.net);
 
-    const LaneModel M = buildLaneModel(city.streets, city.params);
+    const LaneModel M = buildLaneModel(city.streets, city.params, &city.blocks);
     size_t graphJunctions = 0, deadEnds = 0, links = 0;
     for (int d : M.degree) {
         graphJunctions += d >= 3;
@@ -288,9 +288,9 @@ struct RoadTriangles {
     std::vector<glm::dvec3> v;  // 3 per triangle, city frame
     double cell = 20;
     std::map<std::pair<int, int>, std::vector<size_t>> grid;
-    explicit RoadTriangles(const City& c) {
+    explicit RoadTriangles(const City& c, Material mat = Material::Road) {
         for (const Tile& t : c.tiles) {
-            const Mesh& m = t.meshes[size_t(Material::Road)];
+            const Mesh& m = t.meshes[size_t(mat)];
             for (size_t i = 0; i + 2 < m.indices.size(); i += 3) {
                 size_t id = v.size() / 3;
                 glm::dvec2 lo(1e300), hi(-1e300);
@@ -306,6 +306,7 @@ struct RoadTriangles {
             }
         }
     }
+    bool covers(const glm::dvec2& p) const { return !std::isnan(heightError({p, 0.0})); }
     // Smallest |z - mesh z| over the road triangles containing p (xy, 1e-4
     // barycentric slack); NaN if none.
     double heightError(const glm::dvec3& p) const {
@@ -341,14 +342,14 @@ TEST(OpenDrive, NetconvertReadsOsmImport) { checkNet(osmCity("hard_cases.osm"), 
 
 static void checkLaneCentres(const City& city, const std::string& label) {
     {
-        auto xodr = openDriveXml(city.streets, city.params);
+        auto xodr = openDriveXml(city.streets, city.params, &city.blocks);
         ASSERT_TRUE(xodr.isOk());
         std::string err;
         auto doc = parseXml(*xodr, &err);
         ASSERT_TRUE(doc) << err;
-        const RoadTriangles mesh(city);
+        const RoadTriangles mesh(city), walks(city, Material::Sidewalk);
         const glm::dvec2 origin(city.params.origin_x, city.params.origin_y);
-        size_t samples = 0, missing = 0;
+        size_t samples = 0, missing = 0, walkSamples = 0, walkCovered = 0;
         double worst = 0;
         for (const Element* road : doc->all("road")) {
             if (road->str("junction") != "-1") continue;
@@ -377,6 +378,14 @@ static void checkLaneCentres(const City& city, const std::string& label) {
                 for (auto& [k, w] : width) {
                     const double t = offset + sgn * (inner + 0.5 * w);
                     inner += w;
+                    if (type[k] == "sidewalk") {
+                        // The sidewalk lane lies on the sidewalk mesh (except
+                        // where a crossing street's sidewalk corner is cut).
+                        for (double f : {0.25, 0.5, 0.75}) {
+                            ++walkSamples;
+                            walkCovered += walks.covers(p0 + d * (f * len) + nrm * t);
+                        }
+                    }
                     if (type[k] != "driving") continue;
                     for (double f : {0.1, 0.5, 0.9}) {
                         const double s = f * len;
@@ -398,9 +407,13 @@ static void checkLaneCentres(const City& city, const std::string& label) {
             }
         }
         EXPECT_GT(samples, 20u);
+        if (!city.blocks.empty()) {  // (an OSM fixture may enclose no block)
+            EXPECT_GT(walkSamples, 10u) << label;
+        }
+        EXPECT_GE(double(walkCovered), 0.95 * double(walkSamples)) << label;
         EXPECT_EQ(missing, 0u);
-        std::printf("[ %s ] %zu lane-centre samples, worst vertical distance to the road mesh %.4f m\n", label.c_str(),
-                    samples, worst);
+        std::printf("[ %s ] %zu lane-centre samples, worst vertical distance to the road mesh %.4f m; sidewalk lanes on "
+                    "the sidewalk mesh %zu of %zu\n", label.c_str(), samples, worst, walkCovered, walkSamples);
     }
 }
 
@@ -413,7 +426,7 @@ TEST(OpenDrive, LaneCentresLieOnTheRoadMesh) {
 
 TEST(OpenDrive, DeterministicAndWellFormed) {
     const City city = generated(smallParams(3, 400, 10));
-    auto a = openDriveXml(city.streets, city.params), b = openDriveXml(city.streets, city.params);
+    auto a = openDriveXml(city.streets, city.params, &city.blocks), b = openDriveXml(city.streets, city.params, &city.blocks);
     ASSERT_TRUE(a.isOk());
     EXPECT_EQ(*a, *b);
     std::string err;
@@ -440,7 +453,7 @@ TEST(OpenDrive, DeterministicAndWellFormed) {
     }
     EXPECT_GT(connections, 0u);
     StreetGraph empty;
-    EXPECT_FALSE(openDriveXml(empty, city.params).isOk());
+    EXPECT_FALSE(openDriveXml(empty, city.params, nullptr).isOk());
 }
 
 TEST(OpenDrive, GeoReferenceOfAnOsmImportIsItsProjection) {
@@ -485,4 +498,75 @@ TEST(OpenDrive, ExportBadInputIsExit2WithoutFile) {
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("--xodr"), std::string::npos) << r.err;
     EXPECT_TRUE(vista::test::listTree(dir.path()).empty());
+}
+
+// The rendered markings follow the same lane model as the .xodr: stop lines
+// across the incoming lanes before every junction, centre lines (solid on
+// arterials and highways, dashed on local streets), dashed dividers between
+// lanes of one direction, zebra crossings inside the junction boundary; the
+// lane centres themselves stay clear.
+TEST(OpenDrive, MarkingsFollowTheLaneModel) {
+    const City city = generated(smallParams(3, 600, 0));
+    const LaneModel M = buildLaneModel(city.streets, city.params, &city.blocks);
+    const RoadTriangles marks(city, Material::Marking);
+    size_t stops = 0, centres = 0, dividers = 0, crossings = 0, clear = 0;
+    size_t markingTriangles = 0, roadTriangles = 0;
+    for (const Tile& t : city.tiles) {
+        markingTriangles += t.meshes[size_t(Material::Marking)].triangleCount();
+        roadTriangles += t.meshes[size_t(Material::Road)].triangleCount();
+    }
+    for (size_t e = 0; e < M.edges.size(); ++e) {
+        const EdgeLanes& L = M.edges[e];
+        if (!L.valid || L.length < 8) continue;
+        auto at = [&](double s, double t) { return L.start + L.dir * s + L.normal() * t; };
+        const double lw = L.laneWidth, off = L.offset;
+        if (L.junctionB >= 0) {
+            EXPECT_TRUE(marks.covers(at(L.length - 0.7, L.laneCentre(-1)))) << "stop line, edge " << e;
+            ++stops;
+            if (L.trimB > 2.5) {
+                const double s = L.length + 0.5 * (0.3 + std::min(L.trimB - 0.5, L.sidewalk));
+                int hit = 0, n = 0;
+                for (double t = -L.halfWidth() + 0.05; t < L.halfWidth(); t += 0.1, ++n) hit += marks.covers(at(s, t));
+                EXPECT_GT(hit, n / 4) << "crossing, edge " << e;
+                EXPECT_LT(hit, 3 * n / 4) << "crossing stripes, edge " << e;
+                ++crossings;
+            }
+        }
+        if (L.junctionA >= 0) {
+            EXPECT_TRUE(marks.covers(at(0.7, L.laneCentre(1)))) << "stop line, edge " << e;
+            ++stops;
+        }
+        const RoadClass cls = city.streets.edges[e].cls;
+        const double s = 2.0;  // inside the first dash (dashes [0, 3] of every 9 m)
+        if (L.length > 6 && M.degree[city.streets.edges[e].a] != 1) {
+            if (cls == RoadClass::Highway) {
+                EXPECT_TRUE(marks.covers(at(s, off + 0.15)) && marks.covers(at(s, off - 0.15))) << "double centre line " << e;
+                EXPECT_FALSE(marks.covers(at(s, off))) << "gap of the double line " << e;
+            } else {
+                EXPECT_TRUE(marks.covers(at(s, off))) << "centre line, edge " << e;
+            }
+            ++centres;
+            if (cls != RoadClass::Arterial && cls != RoadClass::Highway) {
+                EXPECT_FALSE(marks.covers(at(s + 4.5, off))) << "dash gap, edge " << e;
+            }
+            if (L.right >= 2) {
+                EXPECT_TRUE(marks.covers(at(s, off - lw))) << "divider, edge " << e;
+                EXPECT_FALSE(marks.covers(at(s + 4.5, off - lw))) << "divider gap, edge " << e;
+                ++dividers;
+            }
+        }
+        for (int id = -L.right; id <= L.left; ++id) {
+            if (id == 0) continue;
+            EXPECT_FALSE(marks.covers(at(0.5 * L.length, L.laneCentre(id)))) << "lane " << id << " of edge " << e;
+            ++clear;
+        }
+    }
+    EXPECT_GT(stops, 50u);
+    EXPECT_GT(crossings, 20u);
+    EXPECT_GT(centres, 50u);
+    EXPECT_GT(dividers, 5u);
+    // Modest: markings stay a small share of the road surface triangles' order of magnitude.
+    EXPECT_LT(markingTriangles, 20 * roadTriangles);
+    std::printf("[ markings ] %zu stop lines, %zu crossings, %zu centre lines, %zu dividers checked, %zu clear lane centres; "
+                "%zu marking triangles (road: %zu)\n", stops, crossings, centres, dividers, clear, markingTriangles, roadTriangles);
 }
