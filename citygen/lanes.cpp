@@ -88,7 +88,7 @@ LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const s
         auto angle = [&](uint32_t e) {
             const EdgeLanes& L = m.edges[e];
             glm::dvec2 d = g.edges[e].a == v ? L.dir : -L.dir;
-            return std::atan2(d.y, d.x);
+            return std::atan2(d.y + 0.0, d.x + 0.0);  // + 0.0: no -0, so west is +pi, not -pi
         };
         std::stable_sort(J.arms.begin(), J.arms.end(), [&](uint32_t x, uint32_t y) { return angle(x) < angle(y); });
         m.nodeJunction[v] = int(m.junctions.size());

@@ -24,7 +24,7 @@
 // - Junction: one per node of degree >= 3, radius = max over its edges of
 //   (half carriageway + sidewalk): the corner points of the sidewalks of
 //   neighbouring streets lie inside it; its arms are the incident edges in
-//   counter-clockwise angle order.
+//   counter-clockwise angle order (angles in (-pi, pi]).
 // Edges with invalid node indices, non-finite coordinates or zero length are
 // kept with `valid = false` (no lanes written or drawn). Deterministic; pure.
 #pragma once
