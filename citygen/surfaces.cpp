@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "citygen/lanes.h"
 #include "citygen/polygon.h"
 #include "citygen/terrain.h"
 
@@ -28,6 +29,13 @@ constexpr double kGrassLift = 0.05;     // park lawn above ground
 constexpr double kSidewalkLift = 0.12;  // sidewalk top above ground
 constexpr double kMaxPiece = 50.0;      // longest road piece
 constexpr double kMinArea = 1e-6;       // smallest triangle emitted (m^2)
+// Markings (metres): line width, dashes, stop lines, zebra crossings.
+constexpr double kLineWidth = 0.15;     // as the OpenDRIVE road marks
+constexpr double kDashPeriod = 9.0, kDash = 3.0;
+constexpr double kStopSetback = 0.5, kStopDepth = 0.4;  // stop line before the junction boundary
+constexpr double kCrossingDepth = 3.0;  // crossing length without sidewalks
+constexpr double kCrossingGap = 0.3;    // junction boundary to the crossing
+constexpr double kZebraStripe = 0.5, kZebraGap = 0.6;
 
 bool finitePolygon(const Polygon2& p) {
     for (const auto& q : p)
@@ -51,6 +59,10 @@ public:
             edgeList = &index->edges[size_t(tile)];
             blockList = &index->blocks[size_t(tile)];
             parkList = &index->parks[size_t(tile)];
+            lanes = &index->lanes;
+        } else {
+            ownLanes = buildLaneModel(city.streets, city.params, &city.blocks);
+            lanes = &ownLanes;
         }
         const double T = P.tile_size_m, half = 0.5 * P.size_m;
         glm::dvec3 o = grid.origin(tile);
@@ -86,6 +98,7 @@ public:
     }
 
     void groundMesh();
+    void edgeMarkings(MeshBuilder& mark, size_t e, const glm::dvec2& A, const glm::dvec2& d, double L, int pieces);
     void parks();
     void roads();
     void sidewalks();
@@ -101,6 +114,8 @@ public:
     const std::vector<uint32_t>* edgeList = nullptr;
     const std::vector<uint32_t>* blockList = nullptr;
     const std::vector<uint32_t>* parkList = nullptr;
+    const LaneModel* lanes = nullptr;  // the index's, or ownLanes
+    LaneModel ownLanes;
     template <class F>
     void forEach(const std::vector<uint32_t>* list, size_t n, F f) const {
         if (list) {
@@ -203,9 +218,95 @@ void SurfaceContext::parks() {
     });
 }
 
-double safeWidth(const StreetEdge& e) {
-    double w = double(e.width);
-    return std::isfinite(w) && w > 0.5 ? w : roadWidth(e.cls);
+double safeWidth(const StreetEdge& e) { return carriagewayWidth(e); }
+
+// Lane markings of edge e from the lane model (lanes.h), in the frame of its
+// trimmed reference line (s along it from L.start, t to the left): centre
+// line at the centre lane (double solid on highways, solid on arterials,
+// dashed on local streets), dashed dividers between lanes of one direction,
+// and at every junction end a stop line across the incoming lanes and a
+// zebra crossing between the stop line and the junction, where the
+// sidewalks of the neighbouring streets meet. Every marking piece belongs to
+// the road piece (<= kMaxPiece, same split as the carriageway) it lies on,
+// so it is drawn by exactly one tile: the one that draws that road piece.
+void SurfaceContext::edgeMarkings(MeshBuilder& mark, size_t e, const glm::dvec2& A, const glm::dvec2& d, double L,
+                                  int pieces) {
+    if (!lanes || e >= lanes->edges.size()) return;
+    const EdgeLanes& ln = lanes->edges[e];
+    if (!ln.valid) return;
+    const StreetEdge& E = city.streets.edges[e];
+    const glm::dvec2 n(-d.y, d.x);
+    const double pieceLen = L / pieces;
+    // The tile of the road piece at distance u from node a.
+    auto ownsAt = [&](double u) {
+        int k = std::clamp(int(std::floor(u / pieceLen)), 0, pieces - 1);
+        return mine(A + d * ((k + 0.5) * pieceLen));
+    };
+    auto point = [&](double s, double t) { return A + d * (ln.trimA + s) + n * t; };
+    // A quad from s0 to s1 (reference line s) and t0 to t1, drawn by the
+    // owner of its middle; subdivided along s to follow the terrain.
+    auto rect = [&](double s0, double s1, double t0, double t1) {
+        if (!(s1 - s0 > 0.02) || !ownsAt(ln.trimA + 0.5 * (s0 + s1))) return;
+        int sub = flat ? 1 : std::max(1, int(std::ceil((s1 - s0) / step)));
+        for (int k = 0; k < sub; ++k) {
+            double a0 = s0 + (s1 - s0) * k / sub, a1 = s0 + (s1 - s0) * (k + 1) / sub;
+            quad(mark, at(point(a0, t0), kMarkingLift), at(point(a1, t0), kMarkingLift), at(point(a1, t1), kMarkingLift),
+                 at(point(a0, t1), kMarkingLift));
+        }
+    };
+    // A line of half width hw at lateral t from s0 to s1, cut at the road pieces.
+    auto strip = [&](double s0, double s1, double t, double hw) {
+        for (int k = 0; k < pieces; ++k) {
+            double a = std::max(s0, k * pieceLen - ln.trimA), b = std::min(s1, (k + 1) * pieceLen - ln.trimA);
+            if (b > a) rect(a, b, t - hw, t + hw);
+        }
+    };
+    auto dashed = [&](double s0, double s1, double t, double hw) {
+        for (double k0 = std::floor(s0 / kDashPeriod) * kDashPeriod; k0 < s1; k0 += kDashPeriod) {
+            double a = std::max(k0, s0), b = std::min(k0 + kDash, s1);
+            if (b - a > 0.3) strip(a, b, t, hw);
+        }
+    };
+    const double Lr = ln.length, lw = ln.laneWidth, off = ln.offset, hw = ln.halfWidth();
+    const double lineHw = 0.5 * kLineWidth;
+    const bool jA = ln.junctionA >= 0, jB = ln.junctionB >= 0;
+    const auto& deg = lanes->degree;
+    // Lines stop behind the stop lines at junctions and short of a dead end's cap.
+    double s0 = jA ? kStopSetback + kStopDepth : (deg[E.a] == 1 ? hw : 0.0);
+    double s1 = Lr - (jB ? kStopSetback + kStopDepth : (deg[E.b] == 1 ? hw : 0.0));
+    if (s1 > s0) {
+        if (E.cls == RoadClass::Highway) {
+            strip(s0, s1, off - 0.15, lineHw);
+            strip(s0, s1, off + 0.15, lineHw);
+        } else if (E.cls == RoadClass::Arterial) {
+            strip(s0, s1, off, lineHw);
+        } else {
+            dashed(s0, s1, off, lineHw);
+        }
+        for (int k = 1; k < ln.right; ++k) dashed(s0, s1, off - k * lw, lineHw);
+        for (int k = 1; k < ln.left; ++k) dashed(s0, s1, off + k * lw, lineHw);
+    }
+    // Stop lines and crossings at junction ends. trim = the junction radius
+    // (or less on a short edge); the crossing spans the last `depth` metres
+    // of it, where the corner sidewalks are.
+    const double depth = ln.sidewalk > 0 ? ln.sidewalk : kCrossingDepth;
+    auto zebra = [&](double sNear, double sFar) {  // s range of the crossing band
+        if (!(sFar - sNear > 1.0)) return;
+        const int stripes = std::max(1, int(std::floor((2 * hw - kZebraGap) / (kZebraStripe + kZebraGap) + 1e-9)));
+        const double total = stripes * kZebraStripe + (stripes - 1) * kZebraGap, first = -0.5 * total;
+        for (int k = 0; k < stripes; ++k) {
+            double t0 = first + k * (kZebraStripe + kZebraGap);
+            rect(sNear, sFar, t0, t0 + kZebraStripe);
+        }
+    };
+    if (jA && Lr > 2 * (kStopSetback + kStopDepth)) {
+        rect(kStopSetback, kStopSetback + kStopDepth, off, off + ln.left * lw);
+        zebra(-ln.trimA + std::max(0.5, ln.trimA - depth), -kCrossingGap);
+    }
+    if (jB && Lr > 2 * (kStopSetback + kStopDepth)) {
+        rect(Lr - kStopSetback - kStopDepth, Lr - kStopSetback, off - ln.right * lw, off);
+        zebra(Lr + kCrossingGap, Lr + std::min(ln.trimB - 0.5, depth));
+    }
 }
 
 void SurfaceContext::roads() {
@@ -230,8 +331,6 @@ void SurfaceContext::roads() {
         const glm::dvec2 d = (B - A) / L, n(-d.y, d.x);
         const double hw = 0.5 * safeWidth(E);
         const int pieces = std::max(1, int(std::ceil(L / kMaxPiece)));
-        const bool marked = E.cls == RoadClass::Arterial || E.cls == RoadClass::Highway;
-        const double clear = std::max(hw + 2.0, 8.0);  // no markings inside junctions
         for (int k = 0; k < pieces; ++k) {
             double t0 = L * k / pieces, t1 = L * (k + 1) / pieces;
             if (!mine(A + d * (0.5 * (t0 + t1)))) continue;
@@ -242,44 +341,8 @@ void SurfaceContext::roads() {
                 quad(road, at(p0 - n * hw, kRoadLift), at(p1 - n * hw, kRoadLift), at(p1 + n * hw, kRoadLift),
                      at(p0 + n * hw, kRoadLift));
             }
-            if (!marked) continue;
-            // Lines: (offset from centre, half width, dashed?)
-            struct Line { double off, hw; bool dashed; };
-            std::vector<Line> lines;
-            if (E.cls == RoadClass::Highway) {
-                lines.push_back({-0.15, 0.07, false});
-                lines.push_back({0.15, 0.07, false});
-                if (E.lanes >= 4) {
-                    lines.push_back({-0.5 * hw, 0.075, true});
-                    lines.push_back({0.5 * hw, 0.075, true});
-                }
-            } else {
-                lines.push_back({0.0, 0.075, true});
-            }
-            const double period = 9.0, dash = 3.0;
-            double a0 = std::max(t0, clear), a1 = std::min(t1, L - clear);
-            if (!(a1 > a0)) continue;
-            for (const Line& ln : lines) {
-                auto strip = [&](double u0, double u1) {
-                    int sub2 = flat ? 1 : std::max(1, int(std::ceil((u1 - u0) / step)));
-                    for (int s = 0; s < sub2; ++s) {
-                        double v0 = u0 + (u1 - u0) * s / sub2, v1 = u0 + (u1 - u0) * (s + 1) / sub2;
-                        glm::dvec2 c0 = A + d * v0 + n * ln.off, c1 = A + d * v1 + n * ln.off;
-                        quad(mark, at(c0 - n * ln.hw, kMarkingLift), at(c1 - n * ln.hw, kMarkingLift),
-                             at(c1 + n * ln.hw, kMarkingLift), at(c0 + n * ln.hw, kMarkingLift));
-                    }
-                };
-                if (!ln.dashed) {
-                    strip(a0, a1);
-                    continue;
-                }
-                // Dashes anchored at the edge start, clipped to this piece.
-                for (double k0 = std::floor(a0 / period) * period; k0 < a1; k0 += period) {
-                    double u0 = std::max(k0, a0), u1 = std::min(k0 + dash, a1);
-                    if (u1 - u0 > 0.05) strip(u0, u1);
-                }
-            }
         }
+        edgeMarkings(mark, e, A, d, L, pieces);
     }
     // Junction polygons, drawn by the node's tile: the convex hull of the
     // carriageway corners at the node and a sidewalk width further along every
@@ -448,6 +511,7 @@ SurfaceIndex buildSurfaceIndex(const City& city, const TileGrid& grid) {
     idx.edges.resize(size_t(idx.tiles));
     idx.blocks.resize(size_t(idx.tiles));
     idx.parks.resize(size_t(idx.tiles));
+    idx.lanes = buildLaneModel(city.streets, city.params, &city.blocks);
     const StreetGraph& g = city.streets;
     auto addUnique = [](std::vector<uint32_t>& v, uint32_t i) { if (v.empty() || v.back() != i) v.push_back(i); };
     std::vector<int> touched;

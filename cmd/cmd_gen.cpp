@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "citygen/generate.h"
+#include "citygen/opendrive.h"
 #include "foundation/atomic_file.h"
 #include "foundation/timing.h"
 #include "citygen/streets.h"
@@ -23,7 +24,7 @@ namespace {
 const char* const kCmd = "vista gen";
 
 struct GenArgs {
-    std::string paramsFile, out, statsFile, osmFile, geojsonFile, gltfFile, effects;
+    std::string paramsFile, out, statsFile, osmFile, geojsonFile, gltfFile, xodrFile, effects;
     std::optional<uint64_t> seed;
     std::optional<double> size;
     std::optional<int> detail, threads;
@@ -42,6 +43,7 @@ CLI::Option* declareFlags(CLI::App& app, GenArgs& a) {
     app.add_option("--osm", a.osmFile, "take the streets from an OpenStreetMap extract (.osm/.osm.pbf, highway=* ways)");
     app.add_option("--geojson", a.geojsonFile, "also write the street graph as GeoJSON");
     app.add_option("--gltf", a.gltfFile, "also write the city as binary glTF 2.0 (.glb)");
+    app.add_option("--xodr", a.xodrFile, "also write the road network as ASAM OpenDRIVE 1.6 (.xodr, see docs/formats.md)");
     app.add_option("--stats", a.statsFile, "write statistics (counts, timings, peak memory) as JSON");
     auto* out = app.add_option("-o,--output", a.out, "output scene file (.osgb)");
     app.add_flag("--list-params", a.listParams, "print every parameter with unit, range and default (Markdown) and exit");
@@ -99,8 +101,9 @@ Result<CityParams> resolveParams(GenArgs& a) {
     }
     if (a.out.size() < 5 || a.out.substr(a.out.size() - 5) != ".osgb")
         return Status::error("option -o = '" + a.out + "': the output must end in .osgb");
+    if (!a.xodrFile.empty()) VISTA_RETURN_IF_ERROR(checkXodrPath("--xodr", a.xodrFile));
     for (auto [opt, path] : {std::pair<const char*, std::string*>{"-o", &a.out}, {"--stats", &a.statsFile},
-                             {"--geojson", &a.geojsonFile}, {"--gltf", &a.gltfFile}}) {
+                             {"--geojson", &a.geojsonFile}, {"--gltf", &a.gltfFile}, {"--xodr", &a.xodrFile}}) {
         if (!path->empty()) VISTA_RETURN_IF_ERROR(checkWritablePath(opt, *path));
     }
     return params;
@@ -114,6 +117,11 @@ Status writeOutputs(const GenArgs& a, const City& city, const CityParams& params
         VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage(a.geojsonFile),
                                               streetGraphToGeoJson(city.streets, params.origin_x, params.origin_y, params.geo)));
     if (!a.gltfFile.empty()) VISTA_RETURN_IF_ERROR(writeGltf(city, batch.stage(a.gltfFile)));
+    if (!a.xodrFile.empty()) {
+        auto xodr = openDriveXml(city.streets, params, &city.blocks);
+        if (!xodr) return Status::error("option --xodr = '" + a.xodrFile + "': " + xodr.status().message());
+        VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage(a.xodrFile), *xodr));
+    }
     return batch.commit();
 }
 

@@ -2,6 +2,9 @@
 // (argv[0] = "vista <name>") and returns the process exit code:
 // 0 success, 2 bad input (message already printed), 1 internal failure.
 #pragma once
+#include <string>
+
+#include "foundation/status.h"
 
 namespace vista {
 
@@ -10,5 +13,8 @@ int runPath(int argc, char** argv);
 int runBench(int argc, char** argv);
 int runView(int argc, char** argv);
 int runBake(int argc, char** argv);
+int runExport(int argc, char** argv);
+// The --xodr path check shared by gen and export: ends in .xodr, writable.
+Status checkXodrPath(const std::string& option, const std::string& path);
 
 }  // namespace vista

@@ -113,7 +113,11 @@ TEST(RenderCity, DefaultStyleCityMakesASensiblePicture) {
     // the same triangles and vertex floats, so the picture of the city graph
     // as loaded (up to depth ties of far coplanar surfaces, whose winner the
     // draw order decides: a few pixels from 500 m above), with fewer
-    // triangles submitted after culling.
+    // triangles submitted after culling. From 500 m a pixel spans metres and
+    // the 15 cm lane markings (centre lines, stop lines, zebra stripes) are
+    // sub-pixel: whether one covers a pixel centre flips with the float
+    // rounding of the chunk transform (about 20 of 76,800 pixels, road grey
+    // vs marking white: ~44 dB), hence 40 dB there.
     ModeContext ctx;
     ctx.scene = scene.get();
     ctx.renderer = &renderer;
@@ -124,7 +128,7 @@ TEST(RenderCity, DefaultStyleCityMakesASensiblePicture) {
     std::sort(order.begin(), order.end());
     ASSERT_EQ(order.size(), ctx.nearField().chunks.size());
     for (uint32_t i = 0; i < order.size(); ++i) ASSERT_EQ(order[i], i) << "drawOrder lists every chunk once";
-    const std::pair<Camera, double> views[] = {{cam, 60.0}, {top, 50.0}};
+    const std::pair<Camera, double> views[] = {{cam, 60.0}, {top, 40.0}};
     for (const auto& [c, minPsnr] : views) {
         Image tiles, chunks;
         FrameStats ts, cs;
