@@ -186,7 +186,9 @@ int runGen(int argc, char** argv) {
     StderrProgress progress(isatty(2));
     GenerateOptions opts;
     opts.progress = a.quiet ? nullptr : &progress;
+    double osmSeconds = -1;
     if (!a.osmFile.empty()) {
+        Stopwatch osmTime;
         auto g = importOsm(a.osmFile, *params, a.osmBuildings == "on");
         if (!g) return reportBadInput(kCmd, g.status());
         if (const std::string dropped = g->dropSummary(); !dropped.empty()) std::fprintf(stderr, "osm: %s\n", dropped.c_str());
@@ -200,9 +202,11 @@ int runGen(int argc, char** argv) {
             opts.osmBuildings = std::move(g->buildings);
             opts.osmStats = b;
         }
+        osmSeconds = osmTime.ms() / 1000.0;
     }
     auto city = generateCity(*params, opts);
     if (!city) return reportBadInput(kCmd, city.status());
+    if (osmSeconds >= 0) city->stageTimes.insert(city->stageTimes.begin(), {"osm import", osmSeconds});
     BakedLightingStats lighting;
     if (bakedLightingCalledFor(*params)) {
         if (opts.progress) opts.progress->begin("lighting");

@@ -833,16 +833,28 @@ TEST(OsmBuildings, CourtyardStaysOpen) {
     EXPECT_GT(roofTris, 0u);
     EXPECT_GE(near, 4u);
     // Walls stand around the courtyard: wall vertices on the inner ring.
-    size_t onHole = 0;
+    // Faces of those walls (normal across the ring edge) face into the courtyard (the yard is convex).
+    size_t onHole = 0, facingIn = 0;
+    const Polygon2& ring = b->holes[0];
     for (const auto& t : c.tiles) {
         const Mesh& m = t.meshes[size_t(Material::Wall)];
-        for (const auto& q : m.positions) {
-            const glm::dvec2 p = glm::dvec2(t.origin) + glm::dvec2(q);
-            for (size_t k = 0; k < b->holes[0].size(); ++k)
-                if (pointSegmentDistance(p, b->holes[0][k], b->holes[0][(k + 1) % b->holes[0].size()]) < 1e-3) { ++onHole; break; }
+        for (size_t v = 0; v < m.positions.size(); ++v) {
+            const glm::dvec2 p = glm::dvec2(t.origin) + glm::dvec2(m.positions[v]);
+            for (size_t k = 0; k < ring.size(); ++k) {
+                const glm::dvec2 a = ring[k], e = ring[(k + 1) % ring.size()];
+                if (pointSegmentDistance(p, a, e) >= 1e-3) continue;
+                ++onHole;
+                const glm::dvec2 n(m.normals[v].x, m.normals[v].y), dir = glm::normalize(e - a);
+                if (glm::length(n) > 0.9 && std::abs(glm::dot(n, dir)) < 0.1) {
+                    EXPECT_GT(glm::dot(n, yard - p), 0.0) << "a courtyard wall faces away from the courtyard";
+                    ++facingIn;
+                }
+                break;
+            }
         }
     }
     EXPECT_GT(onHole, 16u);
+    EXPECT_GT(facingIn, 8u);
 }
 
 TEST(OsmBuildings, NoProceduralBuildingOverlapsAnImportedOne) {
