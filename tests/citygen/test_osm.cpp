@@ -914,3 +914,52 @@ TEST(OsmGen, BuildingsAreDeterministicCountedAndCanBeTurnedOff) {
     EXPECT_EQ(code, 2);
     EXPECT_NE(err.find("--osm-buildings"), std::string::npos) << err;
 }
+
+TEST(FootprintRepair, RandomRingsGiveSimpleCounterClockwiseRingsOrNothing) {
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> u(-20.0, 20.0);
+    std::uniform_int_distribution<int> count(3, 24);
+    size_t repaired = 0, kept = 0;
+    for (int k = 0; k < 400; ++k) {
+        Polygon2 ring;
+        const int n = count(rng);
+        for (int i = 0; i < n; ++i) {
+            // Snap some vertices to a coarse grid, so touching and collinear cases occur.
+            glm::dvec2 p(u(rng), u(rng));
+            if (i % 3 == 0) p = glm::round(p / 10.0) * 10.0;
+            ring.push_back(p);
+        }
+        if (k % 5 == 0) ring.push_back(ring[size_t(n / 2)]);  // a repeated vertex further on
+        bool split = false;
+        const Polygon2 r = makeSimpleRing(ring, split);
+        if (r.empty()) continue;
+        ++kept;
+        repaired += split ? 1 : 0;
+        EXPECT_TRUE(isSimpleRingExact(r)) << k;
+        EXPECT_GT(signedArea(r), 0.0) << k;
+        // Every vertex of the result is an input vertex or lies on an input edge (a split point).
+        for (const auto& q : r) {
+            double best = 1e300;
+            for (size_t i = 0; i < ring.size(); ++i) best = std::min(best, pointSegmentDistance(q, ring[i], ring[(i + 1) % ring.size()]));
+            EXPECT_LT(best, 1e-9) << k;
+        }
+    }
+    EXPECT_GT(kept, 300u);
+    EXPECT_GT(repaired, 200u);
+}
+
+TEST(OsmBuildings, PbfGivesTheSameFootprintsAsXml) {
+    // buildings.osm.pbf: buildings.osm converted to PBF by libosmium's writer.
+    CityParams p;
+    p.size_m = 800;
+    auto x = importOsm(fixture("buildings.osm"), p, true), b = importOsm(fixture("buildings.osm.pbf"), p, true);
+    ASSERT_TRUE(x.isOk() && b.isOk());
+    ASSERT_EQ(x->buildings.size(), b->buildings.size());
+    for (size_t i = 0; i < x->buildings.size(); ++i) {
+        EXPECT_EQ(x->buildings[i].osm_id, b->buildings[i].osm_id);
+        EXPECT_EQ(x->buildings[i].outer, b->buildings[i].outer);
+        EXPECT_EQ(x->buildings[i].holes, b->buildings[i].holes);
+    }
+    EXPECT_EQ(x->buildingStats.missingNodes, b->buildingStats.missingNodes);
+    EXPECT_EQ(x->buildingStats.innerRingsDropped, b->buildingStats.innerRingsDropped);
+}
