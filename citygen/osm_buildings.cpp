@@ -6,6 +6,8 @@
 #include <cmath>
 #include <string>
 
+#include <tbb/parallel_for.h>
+
 #include "citygen/building_geometry.h"
 #include "citygen/buildings.h"
 #include "citygen/polygon.h"
@@ -261,9 +263,18 @@ OsmRoofShape parseOsmRoofShape(std::string_view text) {
 
 std::vector<Building> resolveOsmBuildings(const std::vector<OsmFootprint>& footprints, const CityParams& params,
                                           OsmBuildingStats& stats) {
-    std::vector<Building> out;
-    out.reserve(footprints.size());
-    for (const auto& f : footprints) out.push_back(resolveOne(f, params, stats));
+    // In parallel (the roof checks run the straight skeleton); counts per footprint, summed in order.
+    std::vector<Building> out(footprints.size());
+    std::vector<OsmBuildingStats> counts(footprints.size());
+    tbb::parallel_for(size_t(0), footprints.size(), [&](size_t i) { out[i] = resolveOne(footprints[i], params, counts[i]); });
+    for (const auto& c : counts) {
+        stats.heightFromTag += c.heightFromTag;
+        stats.heightFromLevels += c.heightFromLevels;
+        stats.heightProcedural += c.heightProcedural;
+        stats.roofFromTag += c.roofFromTag;
+        stats.roofProcedural += c.roofProcedural;
+        stats.roofFallbackFlat += c.roofFallbackFlat;
+    }
     return out;
 }
 
