@@ -90,10 +90,6 @@ int chooseFloors(Rng& rng, double density, double width, const CityParams& param
 
 }  // namespace
 
-int proceduralFloors(Rng& rng, double density, double width, const CityParams& params) {
-    return chooseFloors(rng, density, width, params);
-}
-
 std::vector<Building> placeBuildings(const std::vector<Lot>& lots, const std::vector<Block>& blocks,
                                      const CityParams& params, Progress* progress) {
     std::vector<Building> out(lots.size());

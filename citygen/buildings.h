@@ -21,15 +21,8 @@
 #include "citygen/city.h"
 #include "citygen/lighting.h"
 #include "foundation/progress.h"
-#include "foundation/rng.h"
 
 namespace vista {
-
-// Procedural storey count of a footprint whose narrow side is `width` metres at
-// population density `density` (0..1), as placeBuildings() draws it from `rng`:
-// towers downtown, 2-5 floors in between, 1-3 in the suburbs; within
-// [min_floors, max_floors] and at most ~7 x width tall.
-int proceduralFloors(Rng& rng, double density, double width, const CityParams& params);
 
 std::vector<Building> placeBuildings(const std::vector<Lot>& lots, const std::vector<Block>& blocks,
                                      const CityParams& params, Progress* progress);

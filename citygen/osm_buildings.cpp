@@ -9,7 +9,6 @@
 #include <tbb/parallel_for.h>
 
 #include "citygen/building_geometry.h"
-#include "citygen/buildings.h"
 #include "citygen/polygon.h"
 #include "citygen/terrain.h"
 #include "foundation/hash.h"
@@ -23,6 +22,7 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kFoot_m = 0.3048;
 constexpr double kDowntown = 0.65;  // as placeBuildings: denser areas get no houses
+constexpr double kSuburb = 0.35;    // as placeBuildings: below this, houses
 constexpr double kMinEaves_m = 0.5;
 
 std::string_view trim(std::string_view s) {
@@ -51,6 +51,19 @@ bool leadingNumber(std::string_view& s, double& v) {
 }
 
 bool pitched(RoofType r) { return r != RoofType::Flat; }
+
+// Storeys of an untagged footprint: mapped buildings without height tags are mostly ordinary
+// ones, so no towers: 4-8 downtown, 2-5 in between, 1-3 in the suburbs (as lots there), at most
+// ~4 x the footprint's narrow side tall, within [min_floors, max_floors].
+int untaggedFloors(Rng& rng, double density, double width, const CityParams& params) {
+    int floors;
+    if (density >= kDowntown) floors = 4 + int(rng.range(0, 4));
+    else if (density >= kSuburb) floors = 2 + int(4.0 * std::pow(rng.uniform(), 1.5));
+    else floors = std::min(3, 1 + int(rng.range(0, 2)) * int(rng.range(0, 1)) + int(rng.chance(0.5)));
+    floors = std::min(floors, std::max(1, int(4.0 * width / params.floor_height_m)));
+    const int lo = std::max(1, params.min_floors);
+    return std::clamp(floors, lo, std::max(lo, params.max_floors));
+}
 
 RoofType toRoofType(OsmRoofShape s) {
     switch (s) {
@@ -100,7 +113,7 @@ Building resolveOne(const OsmFootprint& f, const CityParams& params, OsmBuilding
         floors = std::max(1, int(std::lround(f.levels)));
         ++st.heightFromLevels;
     } else {
-        floors = proceduralFloors(rng, density, 2.0 * box.halfV, params);
+        floors = untaggedFloors(rng, density, 2.0 * box.halfV, params);
         ++st.heightProcedural;
     }
     // 2. Roof shape: the tag, else houses (low, small, outside downtown) pitched, the rest flat.

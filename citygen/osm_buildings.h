@@ -63,7 +63,8 @@ OsmRoofShape parseOsmRoofShape(std::string_view text);
 // the eaves lie roof:height (else roof:levels storeys, else a seeded pitch)
 // below it; else building:levels storeys (+ roof:levels as the roof height of
 // pitched roofs, as wall height of flat ones); else procedural floors from
-// the density as for lots. min_height, else building:min_level storeys, lifts
+// the density (no towers: 4-8 downtown, 2-5 in between, 1-3 in the suburbs,
+// at most ~4 x the narrow side). min_height, else building:min_level storeys, lifts
 // the wall bottom (ignored when not below the eaves). Roof: roof:shape, else
 // procedural (houses gabled or hipped, larger buildings flat). Footprints with
 // holes, and shapes the roof code cannot build, get a flat roof at the top
