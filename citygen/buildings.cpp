@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 
 #include "citygen/building_geometry.h"
+#include "citygen/footprint_repair.h"
 #include "citygen/mesh_builder.h"
 #include "citygen/polygon.h"
 #include "foundation/rng.h"
@@ -400,6 +401,14 @@ void meshBuilding(const Building& b, uint32_t buildingId, const CityParams& para
     Polygon2 fp = cleanPolygon(makeCounterClockwise(b.footprint), 1e-7);
     if (fp.size() < 3 || !(b.height > 0) || !std::isfinite(b.height) || !std::isfinite(b.base_z)) return;
     if (!isSimplePolygon(fp, 1e-9)) return;  // contract: footprints are simple; bad ones add nothing
+    if (!(b.min_height >= 0) || !(b.min_height < b.height)) return;
+    std::vector<Polygon2> holes;
+    for (const auto& h : b.holes) {
+        Polygon2 c = cleanPolygon(h, 1e-7);
+        if (c.size() < 3) continue;
+        if (signedArea(c) > 0) std::reverse(c.begin(), c.end());
+        holes.push_back(std::move(c));
+    }
     Rng rng(params.seed, buildingId, Stream::Facades);
     double variation = rng.uniform(-0.6, 0.6);
     MeshBuilder wall(*out.walls, origin, Material::Wall, light, variation);
@@ -412,7 +421,7 @@ void meshBuilding(const Building& b, uint32_t buildingId, const CityParams& para
     }
     const int floors = std::max(1, b.floors);
     FacadeStyle s;
-    s.floorH = b.height / floors;
+    s.floorH = (b.height - b.min_height) / floors;
     s.sillH = 0.3 * s.floorH;
     s.winH = 0.48 * s.floorH;
     s.winW = params.window_width_m * rng.uniform(0.85, 1.2);
@@ -420,8 +429,24 @@ void meshBuilding(const Building& b, uint32_t buildingId, const CityParams& para
     s.depth = params.window_recess_m;
     s.spacing = std::max(s.winW + 0.8, floors <= 3 ? rng.uniform(3.8, 5.0) : rng.uniform(3.3, 4.3));
     s.detail = params.detail;
-    const double z0 = b.base_z, zTop = b.base_z + b.height;
+    const double z0 = b.base_z + b.min_height, zTop = b.base_z + b.height;
     for (size_t i = 0; i < fp.size(); ++i) meshFacade(wall, win, fp[i], fp[(i + 1) % fp.size()], z0, floors, s);
+    // Courtyards: the inner rings run clockwise, so their outside (the courtyard) is on the right as for the outer ring.
+    for (const auto& h : holes)
+        for (size_t i = 0; i < h.size(); ++i) meshFacade(wall, win, h[i], h[(i + 1) % h.size()], z0, floors, s);
+    if (b.min_height > 0) {  // a lifted building (OSM min_height): its underside
+        if (holes.empty()) {
+            std::vector<glm::dvec3> under;
+            for (auto it = fp.rbegin(); it != fp.rend(); ++it) under.push_back(at(*it, z0));
+            wall.polygon(under, {0, 0, -1});
+        } else {
+            for (const auto& t : triangulateWithHoles(fp, holes)) wall.triangle(at(t[0], z0), at(t[2], z0), at(t[1], z0));
+        }
+    }
+    if (!holes.empty()) {  // flat roof over the polygon with holes (pitched shapes were resolved to flat)
+        for (const auto& t : triangulateWithHoles(fp, holes)) roof.triangle(at(t[0], zTop), at(t[1], zTop), at(t[2], zTop));
+        return;
+    }
     bool done = false;
     if (b.roof == RoofType::Gabled) done = gabledRoof(wall, roof, fp, zTop, b.roof_height);
     else if (b.roof == RoofType::Hipped) done = hippedRoof(roof, fp, zTop, b.roof_height);

@@ -9,6 +9,10 @@
 // skeleton, falling back to flat on failure) and facades at params.detail:
 // 0 plain prism, 1 window bands, 2 window recesses as geometry (the
 // microgeometry the far-field methods must handle), 3 adds sills.
+// Imported (OSM) buildings may have holes (courtyards): their walls are built
+// along every inner ring too, facing into the courtyard, and their roof is flat
+// over the polygon with holes (constrained triangulation, footprint_repair.h);
+// a min_height > 0 lifts the walls and adds an underside.
 // Geometry goes to `walls`, `windows` and `roofs` meshes relative to origin.
 // Thread-safe for distinct target meshes.
 #pragma once

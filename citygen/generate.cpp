@@ -107,7 +107,16 @@ Result<City> generateCity(const CityParams& params, const GenerateOptions& optio
     }
     {
         StageTimer t(city, pr, "buildings");
+        std::vector<Building> imported;
+        if (options.osmBuildings) {
+            city.osmBuildings = options.osmStats;
+            city.osmBuildings.enabled = true;
+            imported = resolveOsmBuildings(*options.osmBuildings, params, city.osmBuildings);
+            city.osmBuildings.lotsDropped = dropCoveredLots(city.lots, imported);
+            city.osmBuildings.onCarriageway = countOnCarriageway(imported, city.streets);
+        }
         city.buildings = placeBuildings(city.lots, city.blocks, params, pr);
+        for (auto& b : imported) city.buildings.push_back(std::move(b));
     }
     {
         StageTimer t(city, pr, "trees");

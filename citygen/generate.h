@@ -1,7 +1,7 @@
 // generateCity(): the whole pipeline params -> City.
 //
 // Stages: streets (grown, or `streets` given e.g. from OSM) -> blocks ->
-// lots -> buildings -> trees -> meshes per tile (parallel over tiles).
+// lots -> buildings (imported ones from OSM first take their land) -> trees -> meshes per tile (parallel over tiles).
 // Contract: params must pass validateParams() (checked; error otherwise).
 // Output is byte-for-byte identical for the same params whatever
 // params.threads is. Stage timings go to City::stageTimes.
@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "citygen/city.h"
+#include "citygen/osm_buildings.h"
 #include "foundation/progress.h"
 
 namespace vista {
@@ -16,6 +17,11 @@ namespace vista {
 struct GenerateOptions {
     Progress* progress = nullptr;
     std::optional<StreetGraph> streets;  // use these streets instead of growing them
+    // Building footprints imported from OSM (importOsm with buildings): they are completed into
+    // buildings (resolveOsmBuildings), appended after the procedural ones, and every lot
+    // overlapping one of them is dropped before the procedural buildings are placed.
+    std::optional<std::vector<OsmFootprint>> osmBuildings;
+    OsmBuildingStats osmStats;  // the import's counts, carried into City::osmBuildings
 };
 
 Result<City> generateCity(const CityParams& params, const GenerateOptions& options = {});

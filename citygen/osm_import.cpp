@@ -19,10 +19,12 @@
 #include <fcntl.h>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <string_view>
 #include <unordered_map>
+#include <unordered_set>
 
 #include <osmium/handler.hpp>
 #include <osmium/handler/node_locations_for_ways.hpp>
@@ -30,6 +32,8 @@
 #include <osmium/io/any_input.hpp>
 #include <osmium/visitor.hpp>
 
+#include "citygen/footprint_repair.h"
+#include "citygen/polygon.h"
 #include "citygen/street_geometry.h"
 #include "citygen/streets.h"
 #include "foundation/units.h"
@@ -220,9 +224,77 @@ struct Way {
     std::vector<WayNode> nodes;
 };
 
+bool isBuilding(const osmium::TagList& tags) {
+    const char* b = tags["building"];
+    return b && *b && std::strcmp(b, "no") != 0;
+}
+
+// The height and roof tags of a building way or relation (absent / unparsable -> NaN).
+void readBuildingTags(const osmium::TagList& tags, OsmFootprint& f) {
+    constexpr double kAbsent = std::numeric_limits<double>::quiet_NaN();
+    auto length = [&](const char* key) { const char* v = tags[key]; return v ? parseOsmLength(v) : kAbsent; };
+    auto levels = [&](const char* key) { const char* v = tags[key]; return v ? parseOsmLevels(v) : kAbsent; };
+    f.height_m = length("height");
+    f.min_height_m = length("min_height");
+    f.roof_height_m = length("roof:height");
+    f.levels = levels("building:levels");
+    f.min_level = levels("building:min_level");
+    f.roof_levels = levels("roof:levels");
+    const char* shape = tags["roof:shape"];
+    f.roof = shape ? parseOsmRoofShape(shape) : OsmRoofShape::Absent;
+}
+
+// A way kept for the buildings: tagged building=* itself, or a member of a building relation.
+struct BuildingWay {
+    NodeId id = 0;
+    bool building = false;  // tagged building=* (a footprint of its own)
+    OsmFootprint tags;      // its parsed tags (when `building`)
+    std::vector<WayNode> nodes;
+};
+
+struct BuildingRelation {
+    NodeId id = 0;
+    OsmFootprint tags;
+    std::vector<std::pair<NodeId, bool>> members;  // way id, inner (else outer)
+};
+
+// Multipolygon relations tagged building=* (the first pass over the file).
+struct RelationCollector : public osmium::handler::Handler {
+    std::vector<BuildingRelation> relations;
+    void relation(const osmium::Relation& r) {
+        const char* type = r.tags()["type"];
+        if (!type || std::strcmp(type, "multipolygon") != 0 || !isBuilding(r.tags())) return;
+        BuildingRelation br;
+        br.id = r.id();
+        readBuildingTags(r.tags(), br.tags);
+        for (const auto& m : r.members()) {
+            if (m.type() != osmium::item_type::way) continue;
+            const char* role = m.role();
+            const bool inner = std::strcmp(role, "inner") == 0;
+            if (!inner && *role && std::strcmp(role, "outer") != 0) continue;  // other roles are not rings
+            br.members.push_back({m.ref(), inner});
+        }
+        relations.push_back(std::move(br));
+    }
+};
+
 struct WayCollector : public osmium::handler::Handler {
     std::vector<Way> ways;
+    bool buildings = false;
+    std::unordered_set<NodeId> memberWays;  // ways of building relations
+    std::vector<BuildingWay> buildingWays;
     void way(const osmium::Way& w) {
+        if (buildings) {
+            const bool building = isBuilding(w.tags());
+            if (building || memberWays.count(w.id())) {
+                BuildingWay bw;
+                bw.id = w.id();
+                bw.building = building;
+                if (building) readBuildingTags(w.tags(), bw.tags);
+                for (const auto& nr : w.nodes()) bw.nodes.push_back({nr.ref(), nr.location(), {}, {}});
+                buildingWays.push_back(std::move(bw));
+            }
+        }
         const char* hw = w.tags()["highway"];
         RoadClass cls;
         if (!hw || !classify(hw, cls) || w.nodes().empty()) return;
@@ -370,6 +442,187 @@ double maxExtent_m() {
     return 0;
 }
 
+// ---- buildings ------------------------------------------------------------------
+
+enum class RingFail { None, Missing, Outside, TooFew, TooSmall, SelfIntersecting };
+
+struct RingRepairs {
+    bool duplicates = false, unclosed = false, split = false;
+    RingRepairs& operator|=(const RingRepairs& o) {
+        duplicates |= o.duplicates; unclosed |= o.unclosed; split |= o.split;
+        return *this;
+    }
+};
+
+struct BuildingContext {
+    GeoReference ref;
+    glm::dvec3 median{0.0};
+    double outlierRadius_m = 0;
+    double half_m = 0;  // half the city side: footprints must lie inside the square
+};
+
+// One ring from its nodes (closed or not, in order) -> a simple counter-clockwise polygon.
+RingFail makeRing(const std::vector<WayNode>& nodes, const BuildingContext& ctx, Polygon2& out, RingRepairs& rep) {
+    for (const auto& n : nodes)
+        if (!n.loc.valid()) return RingFail::Missing;
+    std::vector<WayNode> d;
+    for (const auto& n : nodes) {
+        if (!d.empty() && (n.id == d.back().id || n.loc == d.back().loc)) { rep.duplicates = true; continue; }
+        d.push_back(n);
+    }
+    if (d.size() >= 2 && (d.front().id == d.back().id || d.front().loc == d.back().loc)) d.pop_back();
+    else if (d.size() >= 2) rep.unclosed = true;
+    Polygon2 poly;
+    for (auto& n : d) {
+        const GeoPoint g{n.loc.lat(), n.loc.lon()};
+        const glm::dvec3 v = unitVector(g);
+        if (std::atan2(glm::length(glm::cross(v, ctx.median)), glm::dot(v, ctx.median)) * kEarthRadius_m > ctx.outlierRadius_m)
+            return RingFail::Outside;
+        poly.push_back(projectToLocal(ctx.ref, g));
+    }
+    if (poly.size() < 3) return RingFail::TooFew;
+    bool split = false;
+    Polygon2 r = makeSimpleRing(poly, split);
+    if (r.empty()) return poly.size() <= kMaxRepairRingNodes && std::abs(signedArea(poly)) < kOsmMinFootprintArea_m2
+                              ? RingFail::TooSmall : RingFail::SelfIntersecting;
+    if (std::abs(signedArea(r)) < kOsmMinFootprintArea_m2) return RingFail::TooSmall;
+    rep.split = split;
+    out = std::move(r);
+    return RingFail::None;
+}
+
+void countSkip(RingFail f, OsmBuildingStats& st) {
+    switch (f) {
+        case RingFail::Missing: ++st.missingNodes; break;
+        case RingFail::Outside: ++st.outsideCity; break;
+        case RingFail::TooFew: ++st.tooFewNodes; break;
+        case RingFail::TooSmall: ++st.tooSmall; break;
+        case RingFail::SelfIntersecting: ++st.selfIntersecting; break;
+        case RingFail::None: break;
+    }
+}
+
+bool insideCity(const Polygon2& r, double half) {
+    for (const auto& p : r)
+        if (!(std::abs(p.x) <= half && std::abs(p.y) <= half)) return false;
+    return true;
+}
+
+// Joins member ways into rings by their end node ids (reversing ways as needed), in member
+// order; a chain whose ends never meet comes back open (makeRing closes it).
+std::vector<std::vector<WayNode>> assembleRings(std::vector<const std::vector<WayNode>*> parts) {
+    std::vector<std::vector<WayNode>> rings;
+    std::vector<char> used(parts.size(), 0);
+    for (size_t i = 0; i < parts.size(); ++i) {
+        if (used[i] || parts[i]->empty()) continue;
+        used[i] = 1;
+        std::vector<WayNode> ring = *parts[i];
+        while (ring.size() < 2 || ring.front().id != ring.back().id) {
+            bool found = false;
+            for (size_t j = 0; j < parts.size() && !found; ++j) {
+                if (used[j] || parts[j]->empty()) continue;
+                const auto& p = *parts[j];
+                if (p.front().id == ring.back().id) ring.insert(ring.end(), p.begin() + 1, p.end());
+                else if (p.back().id == ring.back().id) ring.insert(ring.end(), p.rbegin() + 1, p.rend());
+                else continue;
+                used[j] = 1;
+                found = true;
+            }
+            if (!found) break;
+        }
+        rings.push_back(std::move(ring));
+    }
+    return rings;
+}
+
+void addRepairs(const RingRepairs& r, OsmBuildingStats& st) {
+    st.duplicateNodes += r.duplicates ? 1 : 0;
+    st.unclosedRings += r.unclosed ? 1 : 0;
+    st.selfIntersections += r.split ? 1 : 0;
+}
+
+// Footprints of the building ways (file order), then of the relations (file order).
+void importBuildings(const std::vector<BuildingWay>& ways, const std::vector<BuildingRelation>& relations,
+                     const BuildingContext& ctx, OsmImport& out) {
+    OsmBuildingStats& st = out.buildingStats;
+    st.enabled = true;
+    std::unordered_map<NodeId, size_t> wayIndex;
+    for (size_t i = 0; i < ways.size(); ++i) wayIndex.emplace(ways[i].id, i);
+    std::unordered_set<NodeId> outerOfRelation;
+    for (const auto& r : relations)
+        for (const auto& [id, inner] : r.members)
+            if (!inner) outerOfRelation.insert(id);
+    auto accept = [&](OsmFootprint f, const RingRepairs& rep) {
+        if (!insideCity(f.outer, ctx.half_m)) { ++st.outsideCity; return; }
+        addRepairs(rep, st);
+        ++st.imported;
+        out.buildings.push_back(std::move(f));
+    };
+    for (const auto& w : ways) {
+        if (!w.building || outerOfRelation.count(w.id)) continue;
+        ++st.ways;
+        ++st.candidates;
+        OsmFootprint f = w.tags;
+        f.source = BuildingSource::OsmWay;
+        f.osm_id = w.id;
+        RingRepairs rep;
+        const RingFail fail = makeRing(w.nodes, ctx, f.outer, rep);
+        if (fail != RingFail::None) { countSkip(fail, st); continue; }
+        accept(std::move(f), rep);
+    }
+    for (const auto& r : relations) {
+        ++st.relations;
+        std::vector<const std::vector<WayNode>*> outerParts, innerParts;
+        bool outerMissing = false;
+        for (const auto& [id, inner] : r.members) {
+            auto it = wayIndex.find(id);
+            if (it == wayIndex.end()) {
+                if (inner) ++st.innerRingsDropped;
+                else outerMissing = true;
+                continue;
+            }
+            (inner ? innerParts : outerParts).push_back(&ways[it->second].nodes);
+        }
+        if (outerMissing) { ++st.candidates; ++st.missingNodes; continue; }
+        const auto outerRings = assembleRings(outerParts);
+        if (outerRings.empty()) { ++st.candidates; ++st.noOuterRing; continue; }
+        std::vector<OsmFootprint> made;
+        std::vector<RingRepairs> reps;
+        for (size_t k = 0; k < outerRings.size(); ++k) {
+            ++st.candidates;
+            OsmFootprint f = r.tags;
+            f.source = BuildingSource::OsmRelation;
+            f.osm_id = r.id;
+            f.ring = uint32_t(k);
+            RingRepairs rep;
+            const RingFail fail = makeRing(outerRings[k], ctx, f.outer, rep);
+            if (fail != RingFail::None) { countSkip(fail, st); continue; }
+            made.push_back(std::move(f));
+            reps.push_back(rep);
+        }
+        // Inner rings go to the first outer ring that holds them strictly inside, clear of its other holes.
+        for (const auto& nodes : assembleRings(innerParts)) {
+            Polygon2 hole;
+            RingRepairs rep;
+            bool placed = false;
+            if (makeRing(nodes, ctx, hole, rep) == RingFail::None) {
+                for (size_t k = 0; k < made.size() && !placed; ++k) {
+                    if (!ringStrictlyInside(hole, made[k].outer)) continue;
+                    bool clear = true;
+                    for (const auto& h : made[k].holes) clear = clear && ringsDisjoint(hole, h);
+                    if (!clear) continue;
+                    std::reverse(hole.begin(), hole.end());  // clockwise
+                    made[k].holes.push_back(hole);
+                    reps[k] |= rep;
+                    placed = true;
+                }
+            }
+            if (!placed) ++st.innerRingsDropped;
+        }
+        for (size_t k = 0; k < made.size(); ++k) accept(std::move(made[k]), reps[k]);
+    }
+}
+
 }  // namespace
 
 std::string OsmImport::dropSummary() const {
@@ -390,7 +643,7 @@ std::string OsmImport::dropSummary() const {
     return out;
 }
 
-Result<OsmImport> importOsm(const std::string& path, const CityParams& params) {
+Result<OsmImport> importOsm(const std::string& path, const CityParams& params, bool buildings) {
     {
         std::ifstream probe(path, std::ios::binary);
         if (!probe) return Status::error("OSM file '" + path + "' cannot be opened");
@@ -399,6 +652,7 @@ Result<OsmImport> importOsm(const std::string& path, const CityParams& params) {
     const double limit = maxExtent_m();
     out.outlierRadius_m = limit * std::sqrt(2.0);
     WayCollector collector;
+    RelationCollector relationCollector;
     std::vector<NodeId> blanked;
     try {
         osmium::io::File file(path);
@@ -415,6 +669,14 @@ Result<OsmImport> importOsm(const std::string& path, const CityParams& params) {
             if (!scan) return scan.status();
             blanked = std::move(*scan);
             file = osmium::io::File(xml.data(), xml.size(), "osm");
+        }
+        collector.buildings = buildings;
+        if (buildings) {  // first pass: the building relations, so the second keeps their member ways
+            osmium::io::Reader relReader(file, osmium::osm_entity_bits::relation);
+            osmium::apply(relReader, relationCollector);
+            relReader.close();
+            for (const auto& r : relationCollector.relations)
+                for (const auto& m : r.members) collector.memberWays.insert(m.first);
         }
         osmium::io::Reader reader(file, osmium::osm_entity_bits::node | osmium::osm_entity_bits::way);
         Index index;
@@ -490,6 +752,10 @@ Result<OsmImport> importOsm(const std::string& path, const CityParams& params) {
                              " north-south" + dropped + ", more than the largest city vista gen builds (size_m up to " +
                              std::to_string(int(limit)) + " m = " + distance(limit) + "); crop the extract");
     }
+
+    if (buildings)
+        importBuildings(collector.buildingWays, relationCollector.relations,
+                        {ref, median, out.outlierRadius_m, 0.5 * params.size_m}, out);
 
     // Bounded planarization: simplify, drop ways tangled with themselves, refuse a tangle of many ways.
     out.simplifiedNodes = simplify(ways, params.min_segment_m);

@@ -40,6 +40,7 @@
 #include <string>
 #include <vector>
 
+#include "citygen/osm_buildings.h"
 #include "citygen/params.h"
 #include "foundation/progress.h"
 #include "foundation/status.h"
@@ -69,7 +70,14 @@ struct OsmImport {
     size_t invalidNodes = 0, missingNodes = 0, outlierNodes = 0, tangledWays = 0;
     size_t simplifiedNodes = 0;  // removed by simplification (shape kept within its tolerances)
     std::string dropSummary() const;  // "dropped 2 nodes (1 with invalid coordinates, ...)"
+    // Building footprints (osm_buildings.h), in the streets' frame; empty unless asked for.
+    std::vector<OsmFootprint> buildings;
+    OsmBuildingStats buildingStats;  // the import counts (candidates, repaired, skipped by reason)
 };
-Result<OsmImport> importOsm(const std::string& path, const CityParams& params);
+// `buildings`: also read the building footprints (docs/buildings.md "Buildings
+// from OSM"): closed ways and multipolygon relations tagged building=*,
+// repaired or skipped per reason (never an error), those with a vertex outside
+// the city square [-size_m/2, size_m/2]^2 skipped.
+Result<OsmImport> importOsm(const std::string& path, const CityParams& params, bool buildings = false);
 
 }  // namespace vista

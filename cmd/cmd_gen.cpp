@@ -25,6 +25,7 @@ const char* const kCmd = "vista gen";
 
 struct GenArgs {
     std::string paramsFile, out, statsFile, osmFile, geojsonFile, gltfFile, xodrFile, effects;
+    std::string osmBuildings = "on";
     std::optional<uint64_t> seed;
     std::optional<double> size;
     std::optional<int> detail, threads;
@@ -40,7 +41,10 @@ CLI::Option* declareFlags(CLI::App& app, GenArgs& a) {
     app.add_option("--effects", a.effects,
                    "effects the scene declares, over the params file's: 'none', names (" + effectNames() +
                        ") or a JSON object as in the params file (see docs/params.md)");
-    app.add_option("--osm", a.osmFile, "take the streets from an OpenStreetMap extract (.osm/.osm.pbf, highway=* ways)");
+    app.add_option("--osm", a.osmFile, "take the streets (highway=* ways) and buildings (building=*, see --osm-buildings) from an OpenStreetMap extract (.osm/.osm.pbf)");
+    app.add_option("--osm-buildings", a.osmBuildings,
+                   "with --osm: 'on' (default) imports building=* footprints and keeps procedural lots only where the "
+                   "data has no building; 'off' fills every block procedurally (docs/buildings.md)");
     app.add_option("--geojson", a.geojsonFile, "also write the street graph as GeoJSON");
     app.add_option("--gltf", a.gltfFile, "also write the city as binary glTF 2.0 (.glb)");
     app.add_option("--xodr", a.xodrFile, "also write the road network as ASAM OpenDRIVE 1.6 (.xodr, see docs/formats.md)");
@@ -99,6 +103,8 @@ Result<CityParams> resolveParams(GenArgs& a) {
         if (a.size && m.find("'size_m'") != std::string::npos) m = "option --size: " + m;
         return Status::error(m);
     }
+    if (a.osmBuildings != "on" && a.osmBuildings != "off")
+        return Status::error("option --osm-buildings = '" + a.osmBuildings + "': must be 'on' or 'off'");
     if (a.out.size() < 5 || a.out.substr(a.out.size() - 5) != ".osgb")
         return Status::error("option -o = '" + a.out + "': the output must end in .osgb");
     if (!a.xodrFile.empty()) VISTA_RETURN_IF_ERROR(checkXodrPath("--xodr", a.xodrFile));
@@ -153,6 +159,18 @@ nlohmann::ordered_json statsJson(const City& city, const CityParams& params, con
                                {"triangles_before", lighting.trianglesBefore},
                                {"triangles_after", lighting.trianglesAfter},
                                {"rays", lighting.rays}};
+    if (const OsmBuildingStats& o = city.osmBuildings; o.enabled)
+        j["osm_buildings"] = {
+            {"ways", o.ways}, {"relations", o.relations}, {"candidates", o.candidates}, {"imported", o.imported},
+            {"repaired", {{"duplicate_nodes", o.duplicateNodes}, {"unclosed_rings", o.unclosedRings},
+                          {"self_intersections", o.selfIntersections}, {"inner_rings_dropped", o.innerRingsDropped}}},
+            {"skipped", {{"missing_nodes", o.missingNodes}, {"too_few_nodes", o.tooFewNodes}, {"too_small", o.tooSmall},
+                         {"self_intersecting", o.selfIntersecting}, {"outside_city", o.outsideCity},
+                         {"no_outer_ring", o.noOuterRing}}},
+            {"height", {{"tag", o.heightFromTag}, {"levels", o.heightFromLevels}, {"procedural", o.heightProcedural}}},
+            {"roof", {{"tag", o.roofFromTag}, {"procedural", o.roofProcedural}, {"fallback_flat", o.roofFallbackFlat}}},
+            {"lots_dropped", o.lotsDropped},
+            {"on_carriageway", o.onCarriageway}};
     j["peak_rss_mb"] = peakRssMb();
     j["threads"] = params.threads;
     return j;
@@ -176,15 +194,27 @@ int runGen(int argc, char** argv) {
     StderrProgress progress(isatty(2));
     GenerateOptions opts;
     opts.progress = a.quiet ? nullptr : &progress;
+    double osmSeconds = -1;
     if (!a.osmFile.empty()) {
-        auto g = importOsm(a.osmFile, *params);
+        Stopwatch osmTime;
+        auto g = importOsm(a.osmFile, *params, a.osmBuildings == "on");
         if (!g) return reportBadInput(kCmd, g.status());
         if (const std::string dropped = g->dropSummary(); !dropped.empty()) std::fprintf(stderr, "osm: %s\n", dropped.c_str());
         params->geo = g->geo;
         opts.streets = std::move(g->streets);
+        if (a.osmBuildings == "on") {
+            const OsmBuildingStats& b = g->buildingStats;
+            const size_t skipped = b.candidates - b.imported;
+            if (skipped) std::fprintf(stderr, "osm: skipped %zu of %zu building footprints (see --stats osm_buildings.skipped)\n",
+                                      skipped, b.candidates);
+            opts.osmBuildings = std::move(g->buildings);
+            opts.osmStats = b;
+        }
+        osmSeconds = osmTime.ms() / 1000.0;
     }
     auto city = generateCity(*params, opts);
     if (!city) return reportBadInput(kCmd, city.status());
+    if (osmSeconds >= 0) city->stageTimes.insert(city->stageTimes.begin(), {"osm import", osmSeconds});
     BakedLightingStats lighting;
     if (bakedLightingCalledFor(*params)) {
         if (opts.progress) opts.progress->begin("lighting");

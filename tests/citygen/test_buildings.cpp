@@ -455,3 +455,47 @@ TEST(BuildingGeometry, OrientedBoxOfRotatedRectangle) {
     EXPECT_NEAR(std::abs(glm::dot(b.u, u)), 1.0, 1e-9);
     EXPECT_LT(glm::length(b.centre - c), 1e-9);
 }
+
+TEST(BuildingMesh, CourtyardAndLiftedBuildingAreClosed) {
+    // 30 x 30 m with a 10 x 10 m courtyard, walls from 3 m (min_height) to 12 m, flat roof.
+    Building b = box(30, 30, 3);
+    b.holes = {{{-5, -5}, {-5, 5}, {5, 5}, {5, -5}}};  // clockwise
+    b.min_height = 3.0;
+    b.height = 12.0;
+    b.source = BuildingSource::OsmWay;
+    b.lot = kNoLot;
+    for (int detail : {0, 2}) {
+        const Meshes m = meshOf(b, detail);
+        expectWellFormed(m.walls);
+        expectWellFormed(m.windows);
+        expectWellFormed(m.roofs);
+        // Roof: up-facing at the top, area = outer - courtyard, nothing over the courtyard.
+        double roofArea = 0;
+        for (const auto& t : trianglesOf(m.roofs)) {
+            EXPECT_GT(glm::normalize(t.normal()).z, 0.999);
+            EXPECT_NEAR(t.centre().z, b.base_z + 12.0, 1e-4);
+            EXPECT_FALSE(std::abs(t.centre().x) < 5 && std::abs(t.centre().y) < 5);
+            roofArea += t.area();
+        }
+        EXPECT_NEAR(roofArea, 900.0 - 100.0, 1e-3);
+        // Underside at min_height, facing down, same area; no wall below it.
+        double under = 0, courtyardWall = 0;
+        for (const auto& t : trianglesOf(m.walls)) {
+            for (const auto* p : {&t.a, &t.b, &t.c}) EXPECT_GE(p->z, b.base_z + 3.0 - 1e-4);
+            const glm::dvec3 n = glm::normalize(t.normal());
+            if (n.z < -0.999 && std::abs(t.centre().z - (b.base_z + 3.0)) < 1e-4) under += t.area();
+            // Courtyard walls (on the inner ring) face into the courtyard.
+            const glm::dvec2 c(t.centre());
+            if (std::abs(n.z) < 1e-3 && std::max(std::abs(c.x), std::abs(c.y)) > 5 - 1e-4 && std::max(std::abs(c.x), std::abs(c.y)) < 5 + 1e-4) {
+                EXPECT_LT(glm::dot(glm::dvec2(n), c), 0.0);
+                courtyardWall += t.area();
+            }
+        }
+        EXPECT_NEAR(under, 800.0, 1e-3);
+        if (detail == 0) {
+            EXPECT_NEAR(courtyardWall, 4 * 10.0 * 9.0, 1e-3);  // 4 walls 10 m wide, 9 m high
+        } else {
+            EXPECT_GT(courtyardWall, 0.0);
+        }
+    }
+}
