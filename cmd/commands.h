@@ -10,5 +10,6 @@ int runPath(int argc, char** argv);
 int runBench(int argc, char** argv);
 int runView(int argc, char** argv);
 int runBake(int argc, char** argv);
+int runRender(int argc, char** argv);
 
 }  // namespace vista

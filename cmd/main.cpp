@@ -19,6 +19,7 @@ const Command kCommands[] = {
     {"bench", vista::runBench, "headless walkthrough: render modes side by side, write CSV/JSON/PNG"},
     {"view", vista::runView, "interactive viewer (window; works under Xvfb)"},
     {"bake", vista::runBake, "bake view cells and point impostors into city.baked.osgb"},
+    {"render", vista::runRender, "ground truth per frame: rgb, depth, semantic, instance (+ cameras.json)"},
 };
 
 void usage(FILE* f) {
