@@ -124,16 +124,20 @@ struct Staging {
     }
 };
 
-// World xy of every frame inside the city square (params.origin +- size/2).
+// A frame's eye may stand this far outside the city square (streets run up
+// to its border and a vehicle drives beside their centre line).
+constexpr double kPathMargin = 50.0;
+
+// World xy of every frame inside the city square (params.origin +- size/2) grown by kPathMargin.
 Status checkPathInCity(const Path& path, const std::vector<size_t>& idx, const SceneModel& city) {
-    const double half = 0.5 * city.params.size_m;
+    const double half = 0.5 * city.params.size_m + kPathMargin;
     for (size_t f = 0; f < idx.size(); ++f) {
         const glm::dvec3& p = path.samples[idx[f]].position;
         const double x = p.x - city.params.origin_x, y = p.y - city.params.origin_y;
         if (!(std::abs(x) <= half && std::abs(y) <= half)) {
             char b[256];
             std::snprintf(b, sizeof b,
-                          "path sample %zu (frame %zu) at city-frame (%.1f, %.1f) m lies outside the city square [-%.0f, %.0f] m",
+                          "path sample %zu (frame %zu) at city-frame (%.1f, %.1f) m lies outside the city square (+ 50 m) [-%.0f, %.0f] m",
                           idx[f], f, x, y, half, half);
             return Status::error(b);
         }
