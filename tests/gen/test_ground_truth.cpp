@@ -18,12 +18,15 @@
 #include <vector>
 
 #include <nlohmann/json.hpp>
+#include <osg/UserDataContainer>
 
 #include "citygen/labels.h"
 #include "runtime/engine/far_field_rays.h"
 #include "runtime/engine/image.h"
 #include "runtime/engine/ray_scene.h"
 #include "runtime/scene/city_file.h"
+#include "runtime/scene/scene_file.h"
+#include "runtime/scene/scene_graph.h"
 #include "runtime/scene/paths.h"
 #include "tests/common/run_vista.h"
 #include "tests/common/temp_dir.h"
@@ -115,6 +118,11 @@ void checkAgainstRays(const std::string& cityFile, const std::string& out, const
         const auto ids = loadNpy<uint32_t>(out + "/instance/" + name + ".npy", "<u4");
         const auto cls = loadSemantic(out + "/semantic/" + name + ".png");
         ASSERT_EQ(cls.size(), size_t(kW * kH));
+        for (size_t p = 0; p < cls.size(); ++p) {  // every pixel: sky or a surface class, depth +inf iff sky
+            ASSERT_LT(cls[p], kSemanticClassCount) << "pixel " << p << " without a class";
+            ASSERT_EQ(cls[p] == 0, std::isinf(depth[p])) << "pixel " << p;
+            if (cls[p] == 0) ASSERT_EQ(ids[p], 0u);
+        }
         Camera cam;
         cam.width = kW;
         cam.height = kH;
@@ -254,6 +262,28 @@ TEST_F(GroundTruth, BadInputExitsTwoAndLeavesNothing) {
     std::set<std::string> left;
     for (const auto& e : fs::directory_iterator(t.path())) left.insert(e.path().filename().string());
     EXPECT_EQ(left, (std::set<std::string>{"far.csv", "plain"}));
+}
+
+TEST_F(GroundTruth, OldFileWithoutLabelsAsksToRegenerate) {
+    // The same city without the vista.labels marker: a file of an older version.
+    auto model = loadCityFile(city);
+    ASSERT_TRUE(bool(model));
+    osg::Node* root = sceneRoot(*model);
+    osg::UserDataContainer* udc = root->getUserDataContainer();
+    ASSERT_NE(udc, nullptr);
+    const unsigned i = udc->getUserObjectIndex("vista.labels");
+    ASSERT_LT(i, udc->getNumUserObjects());
+    udc->removeUserObject(i);
+    const std::string old = dir->file("old.osgb");
+    ASSERT_TRUE(bool(writeSceneFile(*root, old)));
+    auto r = runVista("render " + old + " --path " + pathCsv + " --frames 1 --size 64x48 -q --out " + dir->file("old_sem"));
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("regenerate the city"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir->file("old_sem")));
+    // rgb and depth need no labels.
+    r = runVista("render " + old + " --path " + pathCsv + " --frames 1 --size 64x48 --channels rgb,depth -q --out " + dir->file("old_rgb"));
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(dir->file("old_rgb/depth/000000.npy")));
 }
 
 TEST(GroundTruthLabels, InstanceIdEncodingRoundTrips) {
