@@ -1,6 +1,7 @@
 // placeBuildings() and meshBuilding(); see buildings.h for the contract and
 // docs/buildings.md for the algorithms and the triangle budget.
 #include "citygen/buildings.h"
+#include "citygen/labels.h"
 #include "foundation/units.h"
 
 #include <algorithm>
@@ -414,6 +415,7 @@ void meshBuilding(const Building& b, uint32_t buildingId, const CityParams& para
     MeshBuilder wall(*out.walls, origin, Material::Wall, light, variation);
     MeshBuilder win(*out.windows, origin, Material::Window, light, 0.3 * variation);
     MeshBuilder roof(*out.roofs, origin, Material::Roof, light, variation);
+    for (MeshBuilder* mb : {&wall, &win, &roof}) mb->setId(makeInstanceId(InstanceKind::Building, buildingId));
     if (params.effects.materials) {
         const BuildingPalette pal = buildingPalette(b, buildingId, params);
         wall.setAlbedo(pal.wall);

@@ -9,6 +9,7 @@
 
 #include "citygen/blocks.h"
 #include "citygen/buildings.h"
+#include "citygen/labels.h"
 #include "citygen/mesh_builder.h"
 #include "citygen/polygon.h"
 #include "citygen/street_lights.h"
@@ -69,7 +70,8 @@ void buildTiles(City& city, Progress* progress) {
         tile.trees = treesOf[size_t(t)];
         tile.streetLights = lightsOf[size_t(t)];
         for (uint32_t l : tile.streetLights)
-            meshStreetLight(city.streetLights[l], tile.origin, light, tile.meshes[size_t(Material::Lamp)]);
+            meshStreetLight(city.streetLights[l], tile.origin, light, tile.meshes[size_t(Material::Lamp)],
+                            makeInstanceId(InstanceKind::StreetLight, l));
         std::lock_guard<std::mutex> lock(m);
         ++done;
     });

@@ -6,6 +6,9 @@
 // ray caster both show them unlit, so their images match. Triangles are
 // counter-clockwise seen from outside. indices.size() is a multiple of 3 and
 // every index < positions.size(); colors.size() == positions.size().
+// ids: the ground-truth label of each vertex (citygen/labels.h: the entity's
+// instance id in tile meshes, the part's Material in tree prototypes), either
+// empty (untagged: every id 0) or ids.size() == positions.size().
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -19,12 +22,15 @@ namespace vista {
 enum class Material : uint8_t { Ground, Road, Marking, Sidewalk, Grass, Wall, Window, Roof, Trunk, Leaves, Lamp, Count };
 constexpr int kMaterialCount = int(Material::Count);
 const char* materialName(Material m);
+// The Material named `name` (materialName's inverse); Material::Count if none.
+Material materialFromName(const char* name);
 
 struct Mesh {
     std::vector<glm::vec3> positions;
     std::vector<glm::vec3> normals;   // per vertex, unit length (used for prelighting and export)
     std::vector<glm::u8vec4> colors;  // prelit
     std::vector<uint32_t> indices;
+    std::vector<uint32_t> ids;        // per vertex label id (labels.h), or empty
 
     size_t triangleCount() const { return indices.size() / 3; }
     bool empty() const { return indices.empty(); }

@@ -28,6 +28,8 @@ uint32_t MeshBuilder::vertex(const glm::dvec3& p, const glm::vec3& n, const glm:
     _mesh.positions.push_back(glm::vec3(p - _origin));
     _mesh.normals.push_back(n);
     _mesh.colors.push_back(c);
+    if (_mesh.ids.size() + 1 != _mesh.positions.size()) _mesh.ids.resize(_mesh.positions.size() - 1, 0u);
+    _mesh.ids.push_back(_id);
     return uint32_t(_mesh.positions.size() - 1);
 }
 

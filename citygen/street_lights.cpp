@@ -13,7 +13,8 @@ constexpr double kIntersectionClear = 6.0;
 
 // Axis-aligned box [lo, hi] with one colour per face direction.
 void box(Mesh& m, const glm::dvec3& origin, const glm::dvec3& lo, const glm::dvec3& hi, const glm::u8vec4& side,
-         const glm::u8vec4& top, const glm::u8vec4& bottom, bool withBottom) {
+         const glm::u8vec4& top, const glm::u8vec4& bottom, bool withBottom, uint32_t id) {
+    m.ids.resize(m.positions.size(), 0u);
     const glm::dvec3 c[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {lo.x, hi.y, lo.z},
                              {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}};
     struct Face { int v[4]; glm::vec3 n; };
@@ -27,6 +28,7 @@ void box(Mesh& m, const glm::dvec3& origin, const glm::dvec3& lo, const glm::dve
             m.positions.push_back(glm::vec3(c[faces[f].v[k]] - origin));
             m.normals.push_back(faces[f].n);
             m.colors.push_back(col);
+            m.ids.push_back(id);
         }
         m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
     }
@@ -62,13 +64,13 @@ std::vector<glm::dvec3> placeStreetLights(const City& city) {
     return out;
 }
 
-void meshStreetLight(const glm::dvec3& base, const glm::dvec3& origin, const Lighting& light, Mesh& mesh) {
+void meshStreetLight(const glm::dvec3& base, const glm::dvec3& origin, const Lighting& light, Mesh& mesh, uint32_t id) {
     const double r = 0.09, h = kStreetLightHeight;
     const glm::u8vec4 side = prelitColor(Material::Lamp, {1, 0, 0}, light), top = prelitColor(Material::Lamp, {0, 0, 1}, light);
-    box(mesh, origin, base + glm::dvec3(-r, -r, 0), base + glm::dvec3(r, r, h - 0.15), side, top, side, false);
+    box(mesh, origin, base + glm::dvec3(-r, -r, 0), base + glm::dvec3(r, r, h - 0.15), side, top, side, false, id);
     const glm::u8vec4 glow = lampHeadColor();
     box(mesh, origin, base + glm::dvec3(-0.35, -0.35, h - 0.15), base + glm::dvec3(0.35, 0.35, h + 0.1), glow,
-        prelitColor(Material::Lamp, {0, 0, 1}, light), glow, true);
+        prelitColor(Material::Lamp, {0, 0, 1}, light), glow, true, id);
 }
 
 }  // namespace vista

@@ -8,7 +8,8 @@
 // city declares no night or a spacing of 0.
 // meshStreetLight(): a pole (kStreetLightHeight tall, Material::Lamp, prelit)
 // and an emissive head (lampHeadColor) into `mesh`, positions relative to
-// `origin` (city frame), counter-clockwise outward faces.
+// `origin` (city frame), counter-clockwise outward faces; its vertices carry
+// the label `id` (labels.h).
 #pragma once
 #include <vector>
 
@@ -22,6 +23,6 @@ namespace vista {
 constexpr double kStreetLightHeight = 6.5;  // lamp head centre above the ground, metres
 
 std::vector<glm::dvec3> placeStreetLights(const City& city);
-void meshStreetLight(const glm::dvec3& base, const glm::dvec3& origin, const Lighting& light, Mesh& mesh);
+void meshStreetLight(const glm::dvec3& base, const glm::dvec3& origin, const Lighting& light, Mesh& mesh, uint32_t id = 0);
 
 }  // namespace vista

@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "citygen/labels.h"
 #include "citygen/lanes.h"
 #include "citygen/polygon.h"
 #include "citygen/terrain.h"
@@ -198,6 +199,7 @@ void SurfaceContext::parks() {
     forEach(parkList, city.blocks.size(), [&](size_t bi) {
         const Block& blk = city.blocks[bi];
         if (!blk.park || blk.outline.size() < 3 || !finitePolygon(blk.outline)) return;
+        b.setId(makeInstanceId(InstanceKind::Park, bi));
         glm::dvec2 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
         for (const auto& q : blk.outline) lo = glm::min(lo, q), hi = glm::max(hi, q);
         if (!rect.overlaps(lo, hi)) return;
@@ -329,6 +331,8 @@ void SurfaceContext::roads() {
         double L = glm::length(B - A);
         if (!(L > 1e-6)) continue;
         const glm::dvec2 d = (B - A) / L, n(-d.y, d.x);
+        road.setId(makeInstanceId(InstanceKind::Road, e));
+        mark.setId(makeInstanceId(InstanceKind::Road, e));
         const double hw = 0.5 * safeWidth(E);
         const int pieces = std::max(1, int(std::ceil(L / kMaxPiece)));
         for (int k = 0; k < pieces; ++k) {
@@ -400,6 +404,7 @@ void SurfaceContext::roads() {
         Polygon2 hull = convexHull(pts, 1e-12);
         if (hull.size() < 3) hull.clear();
         if (hull.size() >= 3) {
+            road.setId(makeInstanceId(InstanceKind::Junction, node));
             glm::dvec2 m(0.0);
             for (const auto& q : hull) m += q;
             glm::dvec3 centre = at(m / double(hull.size()), kRoadLift);
@@ -449,6 +454,7 @@ void SurfaceContext::sidewalks() {
         Polygon2 poly = cleanPolygon(raw, 1e-7);
         if (poly.size() < 3) continue;
         if (signedArea(poly) < 0) std::reverse(poly.begin(), poly.end());
+        b.setId(makeInstanceId(InstanceKind::Sidewalk, bidx));
         const size_t n = poly.size();
         std::vector<glm::dvec2> dir(n), nrm(n);  // per segment i: poly[i] -> poly[i+1]; outward = right
         for (size_t i = 0; i < n; ++i) {

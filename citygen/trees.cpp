@@ -44,6 +44,7 @@ public:
         glm::dvec3 u = glm::normalize(glm::cross(d, helper));
         glm::dvec3 v = glm::cross(d, u);  // (u, v, d) right-handed
         _b.setMaterial(Material::Trunk);
+        _b.setId(uint32_t(Material::Trunk));  // prototypes: the part (labels.h)
         _b.setVariation(_barkVariation);
         double phase = _rng.uniform(0.0, 2 * kPi);
         for (int i = 0; i < sides; ++i) {
@@ -57,6 +58,7 @@ public:
     // (2 * ring triangles) with half-extents rx, ry (horizontal) and rz.
     void blob(const glm::dvec3& c, double rh, double rz, int ring = 4) {
         _b.setMaterial(Material::Leaves);
+        _b.setId(uint32_t(Material::Leaves));
         _b.setVariation(std::clamp(_leafVariation + _rng.uniform(-0.35, 0.35), -1.0, 1.0));
         double phase = _rng.uniform(0.0, 2 * kPi);
         std::vector<glm::dvec3> rim(static_cast<size_t>(ring));
@@ -79,6 +81,7 @@ public:
     // around it, flat-ish underside), 2 * ring triangles.
     void tier(const glm::dvec3& trunkAt, double radius, double up, double down, int ring) {
         _b.setMaterial(Material::Leaves);
+        _b.setId(uint32_t(Material::Leaves));
         _b.setVariation(std::clamp(_leafVariation + _rng.uniform(-0.25, 0.25), -1.0, 1.0));
         double phase = _rng.uniform(0.0, 2 * kPi);
         std::vector<glm::dvec3> rim(static_cast<size_t>(ring));

@@ -20,6 +20,7 @@ const Command kCommands[] = {
     {"view", vista::runView, "interactive viewer (window; works under Xvfb)"},
     {"bake", vista::runBake, "bake view cells and point impostors into city.baked.osgb"},
     {"export", vista::runExport, "export a scene file's road network (OpenDRIVE .xodr)"},
+    {"render", vista::runRender, "ground truth per frame: rgb, depth, semantic, instance (+ cameras.json)"},
 };
 
 void usage(FILE* f) {

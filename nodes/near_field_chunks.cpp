@@ -12,6 +12,8 @@
 #include <osg/Geometry>
 #include <osg/MatrixTransform>
 
+#include "citygen/labels.h"
+#include "nodes/label_pass.h"
 #include "runtime/scene/scene_graph.h"
 
 namespace vista {
@@ -21,12 +23,14 @@ namespace {
 struct TreeBatch {
     osg::Geometry* source = nullptr;
     std::vector<osg::Vec4> cols[4];
+    std::vector<GLuint> ids;  // labels: per-instance tree id
 };
 
 struct ChunkBuild {
     glm::dvec3 origin{0.0};
     osg::ref_ptr<osg::Vec3Array> verts = new osg::Vec3Array;
     osg::ref_ptr<osg::Vec4ubArray> colors = new osg::Vec4ubArray;
+    osg::ref_ptr<osg::UIntArray> labelIds, labelClasses;  // labels only: per vertex
     std::vector<GLuint> indices;
     std::map<osg::Geometry*, TreeBatch> trees;
     glm::dvec3 lo{1e300}, hi{-1e300};
@@ -55,7 +59,9 @@ struct InstancesBound : public osg::Drawable::ComputeBoundingBoxCallback {
 // then materialised as nodes.
 class Chunker {
 public:
-    explicit Chunker(double chunk) : _chunk(chunk) {}
+    Chunker(double chunk, bool labels) : _chunk(chunk), _labels(labels) {
+        if (labels) _treeLabelState = labelTreeState();
+    }
 
     // Instanced trees: each instance to the square of its trunk position.
     void addTrees(osg::Geometry* g, int64_t tileId, const glm::dvec3& tileOrigin) {
@@ -67,6 +73,7 @@ public:
         osg::BoundingBox pb;
         for (const auto& v : *verts) pb.expandBy(v);
         const size_t n = std::min<size_t>(cols[0]->size(), size_t(std::max(0, de->getNumInstances())));
+        auto* treeIds = _labels ? dynamic_cast<osg::UIntArray*>(g->getVertexAttribArray(kTreeIdAttrib)) : nullptr;
         const uint64_t protoTris = de->getNumIndices() / 3;
         for (size_t k = 0; k < n; ++k) {
             glm::mat4 m;
@@ -79,6 +86,7 @@ public:
             TreeBatch& tb = cb.trees[g];
             tb.source = g;
             for (int c = 0; c < 4; ++c) tb.cols[c].push_back((*cols[c])[unsigned(k)]);
+            if (_labels) tb.ids.push_back(treeIds && k < treeIds->size() ? (*treeIds)[unsigned(k)] : 0u);
             for (int corner = 0; corner < 8; ++corner) {
                 const osg::Vec3 v = pb.corner(unsigned(corner));
                 cb.expand(tileOrigin + glm::dvec3(glm::dmat4(m) * glm::dvec4(v.x(), v.y(), v.z(), 1.0)));
@@ -92,6 +100,8 @@ public:
         auto* verts = dynamic_cast<osg::Vec3Array*>(g->getVertexArray());
         auto* colors = dynamic_cast<osg::Vec4ubArray*>(g->getColorArray());
         auto* de = dynamic_cast<osg::DrawElements*>(g->getPrimitiveSet(0));
+        auto* ids = _labels ? dynamic_cast<osg::UIntArray*>(g->getVertexAttribArray(kLabelAttrib)) : nullptr;
+        const GLuint cls = GLuint(semanticClass(materialFromName(g->getName().c_str())));
         const unsigned ni = de->getNumIndices();
         std::vector<std::pair<ChunkKey, unsigned>> tris;
         tris.reserve(ni / 3);
@@ -120,6 +130,14 @@ public:
                         const osg::Vec3& p = (*verts)[vi];
                         cb.verts->push_back(p);
                         cb.colors->push_back(colors && vi < colors->size() ? (*colors)[vi] : osg::Vec4ub(255, 255, 255, 255));
+                        if (_labels) {
+                            if (!cb.labelIds) {
+                                cb.labelIds = new osg::UIntArray;
+                                cb.labelClasses = new osg::UIntArray;
+                            }
+                            cb.labelIds->push_back(ids && vi < ids->size() ? (*ids)[vi] : 0u);
+                            cb.labelClasses->push_back(cls);
+                        }
                         cb.expand(cb.origin + glm::dvec3(p.x(), p.y(), p.z()));
                     }
                     cb.indices.push_back(GLuint(remap[vi]));
@@ -139,13 +157,28 @@ public:
         for (uint32_t i = 0; i < out.chunks.size(); ++i) drawKeys.push_back({-1, 0, i});
         for (auto& [key, cb] : _chunks) {
             if (cb.triangles == 0) continue;
-            osg::ref_ptr<osg::Geode> geode = new osg::Geode;
-            if (!cb.indices.empty()) geode->addDrawable(meshGeometry(cb).get());
-            for (auto& [src, tb] : cb.trees) geode->addDrawable(treeGeometry(*src, tb).get());
+            osg::ref_ptr<osg::Geode> geode = new osg::Geode, labelGeode = _labels ? new osg::Geode : nullptr;
+            if (!cb.indices.empty()) {
+                auto g = meshGeometry(cb);
+                geode->addDrawable(g.get());
+                if (_labels) labelGeode->addDrawable(labelMeshGeometry(*g, cb).get());
+            }
+            for (auto& [src, tb] : cb.trees) {
+                auto g = treeGeometry(*src, tb);
+                geode->addDrawable(g.get());
+                if (_labels) labelGeode->addDrawable(labelTreeGeometry(*g, *src, tb).get());
+            }
             osg::ref_ptr<osg::MatrixTransform> xf = new osg::MatrixTransform;
             xf->setDataVariance(osg::Object::DYNAMIC);
             xf->setMatrix(osg::Matrixd::translate(cb.origin.x, cb.origin.y, cb.origin.z));
             xf->addChild(geode.get());
+            if (_labels) {
+                osg::ref_ptr<osg::MatrixTransform> lx = new osg::MatrixTransform;
+                lx->setDataVariance(osg::Object::DYNAMIC);
+                lx->setMatrix(xf->getMatrix());
+                lx->addChild(labelGeode.get());
+                out.labelChunks.push_back(lx);
+            }
             SplitObject o;
             o.lo = cb.lo;
             o.hi = cb.hi;
@@ -207,7 +240,60 @@ private:
         return g;
     }
 
+    // The label twin of a chunk's mesh geometry: the same vertex array and
+    // primitive set, plus the per-vertex ids and classes (label_pass.h).
+    static osg::ref_ptr<osg::Geometry> labelMeshGeometry(osg::Geometry& colour, ChunkBuild& cb) {
+        osg::ref_ptr<osg::Geometry> g = new osg::Geometry;
+        g->setUseDisplayList(false);
+        g->setUseVertexBufferObjects(true);
+        g->setVertexArray(colour.getVertexArray());
+        g->addPrimitiveSet(colour.getPrimitiveSet(0));
+        if (!cb.labelIds) {
+            cb.labelIds = new osg::UIntArray(unsigned(cb.verts->size()));
+            cb.labelClasses = new osg::UIntArray(unsigned(cb.verts->size()));
+        }
+        for (osg::UIntArray* a : {cb.labelIds.get(), cb.labelClasses.get()}) {
+            a->setPreserveDataType(true);
+            a->setBinding(osg::Array::BIND_PER_VERTEX);
+        }
+        g->setVertexAttribArray(kLabelAttrib, cb.labelIds.get(), osg::Array::BIND_PER_VERTEX);
+        g->setVertexAttribArray(kLabelClassAttrib, cb.labelClasses.get(), osg::Array::BIND_PER_VERTEX);
+        g->setInitialBound(colour.getInitialBound());
+        return g;
+    }
+    // The label twin of an instanced tree geometry: the same vertices and
+    // instance matrices, per-vertex classes from the prototype's parts and
+    // the per-instance tree ids.
+    osg::ref_ptr<osg::Geometry> labelTreeGeometry(osg::Geometry& colour, osg::Geometry& src, const TreeBatch& tb) const {
+        osg::ref_ptr<osg::Geometry> g = new osg::Geometry;
+        g->setName(colour.getName());
+        g->setUseDisplayList(false);
+        g->setUseVertexBufferObjects(true);
+        g->setVertexArray(colour.getVertexArray());
+        g->addPrimitiveSet(colour.getPrimitiveSet(0));
+        for (unsigned c = 0; c < 4; ++c)
+            g->setVertexAttribArray(kInstanceAttrib0 + c, colour.getVertexAttribArray(kInstanceAttrib0 + c), osg::Array::BIND_PER_VERTEX);
+        const unsigned nv = colour.getVertexArray()->getNumElements();
+        osg::ref_ptr<osg::UIntArray> classes = new osg::UIntArray(nv);
+        auto* parts = dynamic_cast<osg::UIntArray*>(src.getVertexAttribArray(kLabelAttrib));
+        for (unsigned i = 0; i < nv; ++i) {
+            const uint32_t part = parts && i < parts->size() ? (*parts)[i] : uint32_t(Material::Leaves);
+            const SemanticClass c = part < uint32_t(kMaterialCount) ? semanticClass(Material(part)) : SemanticClass::TreeLeaves;
+            (*classes)[i] = GLuint(c);
+        }
+        osg::ref_ptr<osg::UIntArray> ids = new osg::UIntArray(tb.ids.begin(), tb.ids.end());
+        for (osg::UIntArray* a : {classes.get(), ids.get()}) a->setPreserveDataType(true);
+        g->setVertexAttribArray(kLabelClassAttrib, classes.get(), osg::Array::BIND_PER_VERTEX);
+        g->setVertexAttribArray(kTreeIdAttrib, ids.get(), osg::Array::BIND_PER_VERTEX);
+        g->setInitialBound(colour.getInitialBound());
+        g->setComputeBoundingBoxCallback(_instancesBound.get());
+        g->setStateSet(_treeLabelState.get());
+        return g;
+    }
+
     double _chunk;
+    bool _labels = false;
+    osg::ref_ptr<osg::StateSet> _treeLabelState;
     std::map<ChunkKey, ChunkBuild> _chunks;
     osg::ref_ptr<InstancesBound> _instancesBound = new InstancesBound;
 };
@@ -221,21 +307,23 @@ void keepWhole(osg::Node* n, NearFieldScene& out) {
     o.hi = glm::dvec3(bs.center().x(), bs.center().y(), bs.center().z()) + glm::dvec3(bs.radius());
     out.objects.push_back(o);
     out.chunks.push_back(n);
+    if (out.labelRootState) out.labelChunks.push_back(new osg::Group);  // unknown layout: no labels
 }
 
 }  // namespace
 
-NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk) {
+NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk, bool labels) {
     NearFieldScene out;
     if (!cityScene) return out;
     out.rootState = cityScene->getStateSet();
+    if (labels) out.labelRootState = labelRootState();
     osg::Group* root = cityScene->asGroup();
     if (!root) {
         keepWhole(cityScene, out);
         out.drawOrder.assign(out.chunks.size(), 0);
         return out;
     }
-    Chunker chunker(chunk > 0 ? chunk : kNearChunkSize);
+    Chunker chunker(chunk > 0 ? chunk : kNearChunkSize, labels);
     int64_t tileId = 0;
     for (unsigned ci = 0; ci < root->getNumChildren(); ++ci) {
         osg::MatrixTransform* xf = asCityTile(root->getChild(ci));

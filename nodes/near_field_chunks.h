@@ -45,10 +45,18 @@ struct NearFieldScene {
     // triangle budget then pick the squares around the eye).
     std::vector<uint32_t> drawOrder;
     uint64_t triangles = 0;
+    // Built with labels only (else empty / null): labelChunks[i] is the label
+    // twin of chunks[i] (nodes/label_pass.h: the same vertex arrays, primitive
+    // sets and transform, drawn with the label programs under labelRootState);
+    // an unknown node layout gets an empty group.
+    osg::ref_ptr<osg::StateSet> labelRootState;
+    std::vector<osg::ref_ptr<osg::Node>> labelChunks;
 };
 // Builds chunks from a scene graph written by buildCityScene()/loaded by
 // loadCityFile(). Unknown node layouts are kept as single chunks (bounds from
 // OSG), so any scene works, only more coarsely.
-NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunkSize = kNearChunkSize);
+// labels: also build the label twins (a city file with vista.labels; other
+// files get id 0 and the class of their geometry's material name).
+NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunkSize = kNearChunkSize, bool labels = false);
 
 }  // namespace vista

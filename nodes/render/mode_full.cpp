@@ -9,8 +9,13 @@ public:
     explicit FullMode(ModeContext& ctx) : GraphMode(ctx) {
         _graph = ctx.chunkedCity();
         _setup.push_back({"chunking", ctx.chunkingMs()});
+        _raster.chunks = ctx.nearField().drawOrder;
     }
     std::string name() const override { return "full"; }
+    const RasterSelection* lastRaster() const override { return &_raster; }
+
+private:
+    RasterSelection _raster;  // every chunk, infinite far plane
 };
 
 }  // namespace

@@ -58,6 +58,9 @@ public:
         // it, the far field fills the rest with the same shading; FarField's
         // seam check covers the band between the plane and the near sphere.
         const double zFar = farPlane(nearD, camera);
+        _raster.chunks = sel;
+        _raster.zFar = zFar;
+        _raster.nearDistance = byBudget() ? 1e300 : std::max(0.0, nearD);
         // The horizon depends on the camera only: traced on another thread while the near field is drawn.
         _far->setOptions(farOptions(nearD, zFar));
         if (_ctx.options.overlap) _far->beginFrame(camera);
@@ -79,6 +82,7 @@ public:
     void reset() override { _far->reset(); }
     bool hazesRasterPixels() const override { return true; }  // FarFieldOptions::hazeCovered
     const std::vector<uint32_t>* lastTracedPixels() const override { return &_far->lastTraced(); }
+    const RasterSelection* lastRaster() const override { return &_raster; }
 
     osg::Node* viewerScene() override {
         if (!_viewer) {
@@ -152,6 +156,7 @@ private:
     std::unique_ptr<AdaptiveSplit> _adaptive;
     osg::ref_ptr<osg::Group> _root;
     std::vector<float> _depth;
+    RasterSelection _raster;
     // Viewer face.
     osg::ref_ptr<osg::Node> _viewer;
     NearFarSplit* _split = nullptr;     // owned by _viewer

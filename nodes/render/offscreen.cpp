@@ -11,6 +11,8 @@
 
 #include <osg/GL>
 #include <osg/Geometry>
+#include <osg/Image>
+#include <osg/Texture>
 #include <osgUtil/RenderStage>
 #include <osgUtil/SceneView>
 #include <osgUtil/StateGraph>
@@ -119,6 +121,35 @@ struct OffscreenRenderer::Impl {
     std::vector<uint8_t> colorBuf;
     double jx = 0, jy = 0;
     FrameEffects effects;
+    // Label pass (created on first use): an FBO camera drawn before the main one.
+    osg::ref_ptr<osg::Camera> labelCam;
+    osg::ref_ptr<osg::Group> labelSlot;
+    osg::ref_ptr<osg::Image> labelIds, labelDepth;
+
+    void makeLabelCamera() {
+        labelCam = new osg::Camera;
+        labelCam->setName("vista.label_pass");
+        labelCam->setReferenceFrame(osg::Transform::ABSOLUTE_RF);
+        labelCam->setRenderOrder(osg::Camera::PRE_RENDER);
+        labelCam->setRenderTargetImplementation(osg::Camera::FRAME_BUFFER_OBJECT);
+        labelCam->setViewport(0, 0, width, height);
+        labelCam->setClearColor(osg::Vec4(0, 0, 0, 0));
+        labelCam->setClearMask(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        setExactCulling(*labelCam);
+        labelIds = new osg::Image;
+        labelIds->allocateImage(width, height, 1, GL_RGBA, GL_UNSIGNED_BYTE);
+        labelIds->setInternalTextureFormat(GL_RGBA8);
+        labelDepth = new osg::Image;
+        labelDepth->allocateImage(width, height, 1, GL_RGBA, GL_FLOAT);
+        labelDepth->setInternalTextureFormat(GL_RGBA32F_ARB);
+        labelCam->attach(osg::Camera::COLOR_BUFFER0, labelIds.get());
+        labelCam->attach(osg::Camera::COLOR_BUFFER1, labelDepth.get());
+        labelCam->attach(osg::Camera::DEPTH_BUFFER, GL_DEPTH_COMPONENT24);
+        labelSlot = new osg::Group;
+        labelCam->addChild(labelSlot.get());
+        labelCam->setNodeMask(0);
+        root->addChild(labelCam.get());
+    }
 
     Status draw(osg::Node* scene, const Camera& camera, double zFar, Image* color, std::vector<float>* depth,
                 FrameStats& stats) {
@@ -267,6 +298,56 @@ void OffscreenRenderer::setEffects(const FrameEffects& fx, bool hazeInRaster) {
     m.effects = fx;
     applyEffectsState(*m.slot->getOrCreateStateSet(), fx, hazeInRaster);
     m.sky->setNight(fx.night);
+}
+
+Status OffscreenRenderer::renderLabels(osg::Node* labelScene, const Camera& camera, double zFar, LabelFrame& out,
+                                       FrameStats& stats) {
+    Impl& m = *_impl;
+    if (camera.width != m.width || camera.height != m.height)
+        return Status::error("camera size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                             " differs from the renderer's " + std::to_string(m.width) + "x" + std::to_string(m.height));
+    if (!m.labelCam) m.makeLabelCamera();
+    Stopwatch sw;
+    m.labelCam->setViewMatrix(toOsg(camera.view()));
+    m.labelCam->setProjectionMatrix(toOsg(camera.projection(zFar)));
+    m.labelSlot->removeChildren(0, m.labelSlot->getNumChildren());
+    if (labelScene) m.labelSlot->addChild(labelScene);
+    // Only the label camera draws: sky and colour scene masked off, no colour read-back.
+    m.labelCam->setNodeMask(~0u);
+    m.sky->node()->setNodeMask(0);
+    m.slot->setNodeMask(0);
+    m.readback->color = nullptr;
+    m.readback->depth = nullptr;
+    m.readback->frame = &sw;
+    m.viewer->frame();
+    m.readback->frame = nullptr;
+    m.labelCam->setNodeMask(0);
+    m.sky->node()->setNodeMask(~0u);
+    m.slot->setNodeMask(~0u);
+    m.labelSlot->removeChildren(0, m.labelSlot->getNumChildren());
+    const int W = m.width, H = m.height;
+    const size_t n = size_t(W) * size_t(H);
+    out.width = W;
+    out.height = H;
+    out.ids.resize(n);
+    out.classes.resize(n);
+    out.depth.resize(n);
+    const uint8_t* ib = m.labelIds->data();
+    const float* db = reinterpret_cast<const float*>(m.labelDepth->data());
+    if (!ib || !db) return Status::error("label pass: the FBO read-back returned no data");
+    for (int y = 0; y < H; ++y) {
+        const size_t src = size_t(H - 1 - y) * size_t(W), dst = size_t(y) * size_t(W);
+        for (int x = 0; x < W; ++x) {
+            const uint8_t* p = ib + 4 * (src + size_t(x));
+            out.ids[dst + size_t(x)] = uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+            const float* d = db + 4 * (src + size_t(x));
+            out.depth[dst + size_t(x)] = d[0];
+            const float c = d[1];
+            out.classes[dst + size_t(x)] = c > 0.0f && c < 255.5f ? uint8_t(c + 0.5f) : 0;
+        }
+    }
+    stats.frameMs = sw.ms();
+    return Status::ok();
 }
 
 int OffscreenRenderer::width() const { return _impl->width; }

@@ -44,12 +44,27 @@ namespace vista {
 // culling adds it inside its own graph (osglod).
 void setExactCulling(osg::Camera& camera);
 
+// One frame of ground-truth labels (renderLabels), row 0 at the top.
+struct LabelFrame {
+    int width = 0, height = 0;
+    std::vector<uint32_t> ids;     // instance ids (citygen/labels.h), 0 = nothing drawn
+    std::vector<uint8_t> classes;  // semantic classes, 0 (sky) = nothing drawn
+    std::vector<float> depth;      // eye depth (metres along the optical axis), 0 = nothing drawn
+};
+
 class OffscreenRenderer {
 public:
     static Result<std::unique_ptr<OffscreenRenderer>> create(int width, int height);
     ~OffscreenRenderer();
     Status render(osg::Node* scene, const Camera& camera, double zFar, Image* color, std::vector<float>* depth,
                   FrameStats& stats);
+    // The label pass (nodes/label_pass.h): draws `labelScene` (label twins of
+    // chunks under a group with NearFieldScene::labelRootState) into an FBO
+    // (RGBA8 ids + RGBA32F depth/class + 24-bit depth test) with the camera's
+    // view and projection (zFar <= 0: infinite; run-time effects do not
+    // apply) and reads it back into `out`. stats.frameMs = wall time incl.
+    // glFinish and read-back.
+    Status renderLabels(osg::Node* labelScene, const Camera& camera, double zFar, LabelFrame& out, FrameStats& stats);
     int width() const;
     int height() const;
     // Shifts the sample point of every pixel by (dx, dy) pixels (x right,

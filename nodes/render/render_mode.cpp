@@ -39,7 +39,7 @@ osg::Node* ModeContext::plainScene() {
 const NearFieldScene& ModeContext::nearField() {
     if (!_nearField) {
         Stopwatch sw;
-        _nearField = std::make_shared<NearFieldScene>(buildNearFieldScene(plainScene(), kNearChunkSize));
+        _nearField = std::make_shared<NearFieldScene>(buildNearFieldScene(plainScene(), kNearChunkSize, labels));
         _chunkingMs = sw.ms();
     }
     return *_nearField;
@@ -166,6 +166,7 @@ public:
     }
     void reset() override { _inner->reset(); }
     const std::vector<uint32_t>* lastTracedPixels() const override { return _inner->lastTracedPixels(); }
+    const RasterSelection* lastRaster() const override { return _inner->lastRaster(); }
     osg::Node* viewerScene() override {
         if (!_viewer) {
             _viewer = new osg::Group;

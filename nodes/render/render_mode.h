@@ -74,6 +74,7 @@ struct ModeContext {
     const SceneModel* city = nullptr;       // the decoded city (ray scene, height grid); null for hand-built graphs
     osg::Node* scene = nullptr;             // the city's graph as loaded (a baked file's root is fine)
     OffscreenRenderer* renderer = nullptr;  // bench: the GL context of renderFrame(); viewer: null
+    bool labels = false;                    // nearField() also builds the label twins (vista render)
     const RayScene* rays = nullptr;         // built by the program for modes that need rays
     ModeOptions options;
 
@@ -92,6 +93,17 @@ private:
     std::shared_ptr<NearFieldScene> _nearField;
     osg::ref_ptr<osg::Group> _chunked;
     double _chunkingMs = 0;
+};
+
+// What a mode's last renderFrame() rasterised, for the ground-truth label
+// pass of `vista render`: the chunks of ModeContext::nearField() it drew (in
+// draw order), the far plane (metres, 0 = infinite) and the near distance
+// (metres from the eye) beyond which its pixels came from the far field
+// (+inf: every drawn pixel is final; uncovered pixels are far field or sky).
+struct RasterSelection {
+    std::vector<uint32_t> chunks;
+    double zFar = 0;
+    double nearDistance = 1e300;
 };
 
 class RenderMode {
@@ -119,6 +131,9 @@ public:
     // (FarField::lastTraced(), ascending), or null for a mode without one
     // (all but hybrid). `vista bench --dump-rays` writes them as RaySet files.
     virtual const std::vector<uint32_t>* lastTracedPixels() const { return nullptr; }
+    // The raster part of the last renderFrame() (full, hybrid), or null for
+    // modes whose picture is not the chunked near field plus rays.
+    virtual const RasterSelection* lastRaster() const { return nullptr; }
     const SetupTimes& setupMs() const { return _setup; }
 
 protected:

@@ -154,6 +154,7 @@ struct Vert {
     glm::vec3 n;
     glm::u8vec4 c;
     Sample s;
+    uint32_t id = 0;  // ground-truth label (citygen/labels.h), kept by refinement
 };
 
 struct Refine {
@@ -170,7 +171,9 @@ uint64_t edgeKey(const Vert& a, const Vert& b) {
     uint64_t ka = pointHash(a.p) ^ (uint64_t(a.c.x) << 8 | uint64_t(a.c.y) << 16 | uint64_t(a.c.z) << 24);
     uint64_t kb = pointHash(b.p) ^ (uint64_t(b.c.x) << 8 | uint64_t(b.c.y) << 16 | uint64_t(b.c.z) << 24);
     auto qn = [](float v) { return uint64_t(int64_t(std::lround(v * 1000.0f))); };
-    return hashKeys(std::min(ka, kb), std::max(ka, kb), hashKeys(qn(a.n.x), qn(a.n.y), qn(a.n.z)));
+    // Entities never share a midpoint (labels stay exact); id 0 leaves the key as it was.
+    const uint64_t h = hashKeys(std::min(ka, kb), std::max(ka, kb), hashKeys(qn(a.n.x), qn(a.n.y), qn(a.n.z)));
+    return a.id == 0 ? h : hashKeys(h, uint64_t(a.id), 0x1abe1ull);
 }
 
 // Refines `mesh` (positions relative to origin) where light changes, then relights every vertex.
@@ -181,6 +184,7 @@ void refineAndRelight(Mesh& mesh, const glm::dvec3& origin, const Refine& rf, Co
         vs[i].p = origin + glm::dvec3(mesh.positions[i]);
         vs[i].n = mesh.normals.size() == vs.size() ? mesh.normals[i] : glm::vec3(0, 0, 1);
         vs[i].c = mesh.colors[i];
+        vs[i].id = mesh.ids.size() == vs.size() ? mesh.ids[i] : 0u;
         vs[i].s = ctx.evaluate(vs[i].p, glm::dvec3(vs[i].n));
     }
     std::vector<uint32_t> idx = mesh.indices;
@@ -211,6 +215,7 @@ void refineAndRelight(Mesh& mesh, const glm::dvec3& origin, const Refine& rf, Co
             Vert m;
             m.p = 0.5 * (vs[a].p + vs[b].p);
             m.n = vs[a].n;
+            m.id = vs[a].id;
             m.c = glm::u8vec4((glm::uvec4(vs[a].c) + glm::uvec4(vs[b].c) + 1u) / 2u);
             m.s = ctx.evaluate(m.p, glm::dvec3(m.n));
             auto bent = [](double x, double y, double z, double tol) { return std::abs(z - 0.5 * (x + y)) > tol; };
@@ -263,11 +268,14 @@ void refineAndRelight(Mesh& mesh, const glm::dvec3& origin, const Refine& rf, Co
     mesh.positions.resize(vs.size());
     mesh.normals.resize(vs.size());
     mesh.colors.resize(vs.size());
+    const bool tagged = !mesh.ids.empty();
+    if (tagged) mesh.ids.resize(vs.size());
     const Lighting& L = ctx.light;
     for (size_t i = 0; i < vs.size(); ++i) {
         const Vert& v = vs[i];
         mesh.positions[i] = glm::vec3(v.p - origin);
         mesh.normals[i] = v.n;
+        if (tagged) mesh.ids[i] = v.id;
         const double l0 = lightLevel(glm::dvec3(v.n), L);
         const double l = L.ambient * v.s.open + (1.0 - L.ambient) * L.sun * v.s.direct;
         glm::u8vec4 c = v.c;

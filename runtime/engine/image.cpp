@@ -1,6 +1,8 @@
 // PNG I/O for Image (libpng). See image.h for the contract.
 #include "runtime/engine/image.h"
 
+#include <algorithm>
+
 #include "foundation/atomic_file.h"
 
 #include <png.h>
@@ -39,17 +41,17 @@ void pngFlushNothing(png_structp) {}
 
 }  // namespace
 
-Status writePng(const Image& img, const std::string& path) {
-    if (!img.valid())
-        return Status::error("writePng '" + path + "': invalid image " + std::to_string(img.width) + "x" +
-                             std::to_string(img.height));
+namespace {
+
+// PNG bytes of 8-bit rows (`channels` 1 = gray, 3 = RGB, 4 = RGBA), written atomically to `path`.
+Status writePngRows(const uint8_t* data, int width, int height, int channels, const std::string& path) {
     PngErr err;
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &err, pngErrorFn, pngWarnFn);
     if (!png) return Status::error("writePng '" + path + "': libpng init failed");
     png_infop info = png_create_info_struct(png);
-    std::vector<png_bytep> rows(size_t(img.height));
-    for (int y = 0; y < img.height; ++y)
-        rows[size_t(y)] = const_cast<png_bytep>(&img.rgba[size_t(y) * size_t(img.width) * 4]);
+    std::vector<png_bytep> rows(static_cast<size_t>(height));
+    for (int y = 0; y < height; ++y)
+        rows[size_t(y)] = const_cast<png_bytep>(data + size_t(y) * size_t(width) * size_t(channels));
     std::string bytes;
     volatile bool failed = false;
     if (setjmp(png_jmpbuf(png))) {
@@ -57,8 +59,9 @@ Status writePng(const Image& img, const std::string& path) {
     } else {
         png_set_write_fn(png, &bytes, pngWriteToString, pngFlushNothing);
         png_set_compression_level(png, 3);
-        png_set_IHDR(png, info, png_uint_32(img.width), png_uint_32(img.height), 8, PNG_COLOR_TYPE_RGBA,
-                     PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+        png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8,
+                     channels == 1 ? PNG_COLOR_TYPE_GRAY : channels == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGBA, PNG_INTERLACE_NONE,
+                     PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
         png_write_info(png, info);
         png_write_image(png, rows.data());
         png_write_end(png, nullptr);
@@ -66,6 +69,31 @@ Status writePng(const Image& img, const std::string& path) {
     png_destroy_write_struct(&png, &info);
     if (failed) return Status::error("writePng '" + path + "': encoding failed: " + err.message);
     return writeFileAtomic(path, bytes);
+}
+
+}  // namespace
+
+Status writePng(const Image& img, const std::string& path) {
+    if (!img.valid())
+        return Status::error("writePng '" + path + "': invalid image " + std::to_string(img.width) + "x" +
+                             std::to_string(img.height));
+    return writePngRows(img.rgba.data(), img.width, img.height, 4, path);
+}
+
+Status writePngRgb(const Image& img, const std::string& path) {
+    if (!img.valid())
+        return Status::error("writePngRgb '" + path + "': invalid image " + std::to_string(img.width) + "x" +
+                             std::to_string(img.height));
+    std::vector<uint8_t> rgb(size_t(img.width) * size_t(img.height) * 3);
+    for (size_t i = 0, n = rgb.size() / 3; i < n; ++i) std::copy_n(&img.rgba[4 * i], 3, &rgb[3 * i]);
+    return writePngRows(rgb.data(), img.width, img.height, 3, path);
+}
+
+Status writePngGray8(const std::vector<uint8_t>& pixels, int width, int height, const std::string& path) {
+    if (width < 1 || height < 1 || pixels.size() != size_t(width) * size_t(height))
+        return Status::error("writePngGray8 '" + path + "': " + std::to_string(pixels.size()) + " pixels for " +
+                             std::to_string(width) + "x" + std::to_string(height));
+    return writePngRows(pixels.data(), width, height, 1, path);
 }
 
 Result<Image> readPng(const std::string& path) {

@@ -32,6 +32,10 @@ struct Image {
 };
 
 Status writePng(const Image& img, const std::string& path);
+// RGB PNG (alpha dropped); atomic.
+Status writePngRgb(const Image& img, const std::string& path);
+// 8-bit grayscale PNG of width x height pixels (row 0 at the top); atomic.
+Status writePngGray8(const std::vector<uint8_t>& pixels, int width, int height, const std::string& path);
 Result<Image> readPng(const std::string& path);
 
 }  // namespace vista

@@ -120,6 +120,8 @@ struct RayScene::Impl {
     struct GeomInfo {
         int mesh = -1;       // index into meshColors, or -1 for an instance
         int prototype = -1;  // prototype index for an instance
+        int sceneMesh = -1;  // SceneModel::meshes index (city scenes)
+        int instance = -1;   // SceneModel::instances index (city scenes)
         glm::mat3 normalMatrix{1.0f};
     };
     std::vector<GeomInfo> geoms;
@@ -254,6 +256,7 @@ Result<std::unique_ptr<RayScene>> RayScene::build(const SceneModel& city) {
         }
         if (im.geoms.size() <= id) im.geoms.resize(id + 1);
         im.geoms[id].mesh = int(im.meshColors.size());
+        im.geoms[id].sceneMesh = int(mi);
         im.meshColors.push_back(triangleColors(m.colors, m.indices));
         im.triangles += m.indices.size() / 3;
     }
@@ -302,6 +305,7 @@ Result<std::unique_ptr<RayScene>> RayScene::build(const SceneModel& city) {
         rtcReleaseGeometry(g);
         if (im.geoms.size() <= id) im.geoms.resize(id + 1);
         im.geoms[id].prototype = int(inst.prototype);
+        im.geoms[id].instance = int(ii);
         glm::mat3 lin(glm::dmat3(inst.transform));
         im.geoms[id].normalMatrix = glm::transpose(glm::inverse(lin));
         im.triangles += protoTris[inst.prototype];
@@ -351,6 +355,18 @@ Result<std::unique_ptr<RayScene>> RayScene::build(const TriangleSoup& soup, cons
 }
 
 glm::dvec3 RayScene::frameOrigin() const { return _impl->origin; }
+
+HitSource RayScene::source(const RayHit& h) const {
+    HitSource s;
+    if (!h.hit) return s;
+    const bool inst = h.instId != 0xFFFFFFFFu;
+    const uint32_t g = inst ? h.instId : h.geomId;
+    if (g >= _impl->geoms.size()) return s;
+    const Impl::GeomInfo& gi = _impl->geoms[g];
+    if (inst) s.instance = gi.instance;
+    else s.mesh = gi.sceneMesh;
+    return s;
+}
 
 RayHit RayScene::intersect(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar) const {
     if (_impl->ftz) enableFtzDaz();

@@ -50,6 +50,14 @@ struct TriangleSoup {
     size_t triangleCount() const { return indices.size() / 3; }
 };
 
+// What a hit of a city scene struck: the SceneModel mesh index (tile
+// meshes) or the instance index (trees), the other -1; both -1 for a miss or
+// a soup scene. primId of the hit indexes the mesh's / prototype's triangles.
+struct HitSource {
+    int mesh = -1;
+    int instance = -1;
+};
+
 enum class RayBuildQuality { Low, Medium, High };
 
 struct SoupSceneOptions {
@@ -78,6 +86,8 @@ public:
                 RayHit* out) const;
     // The prelit colour at a hit, interpolated and not rounded: RGB 0..1.
     glm::vec3 hitColor(const RayHit& h) const;
+    // The SceneModel entity a hit struck (ground-truth labels).
+    HitSource source(const RayHit& h) const;
     size_t triangleCount() const;  // rendered triangles (instances expanded)
     // The committed Embree scene (RTCScene), for timing raw Embree on the same
     // BVH (tests/bench/bench_raw_rays.cpp). Read-only queries only; owned

@@ -26,6 +26,7 @@
 #include <osg/UserDataContainer>
 #include <osg/VertexAttribDivisor>
 
+#include "citygen/labels.h"
 #include "runtime/scene/scene_file.h"
 
 namespace vista {
@@ -128,6 +129,15 @@ osg::ref_ptr<osg::Vec3Array> normalsFor(const Mesh& m) {
     return a;
 }
 
+// Per-vertex label ids as an integer vertex attribute (empty ids: all 0).
+osg::ref_ptr<osg::UIntArray> labelArray(const Mesh& m) {
+    osg::ref_ptr<osg::UIntArray> a = new osg::UIntArray(unsigned(m.positions.size()));
+    if (m.ids.size() == m.positions.size()) std::copy(m.ids.begin(), m.ids.end(), a->begin());
+    a->setPreserveDataType(true);
+    a->setBinding(osg::Array::BIND_PER_VERTEX);
+    return a;
+}
+
 osg::BoundingBox boundsOf(const std::vector<glm::vec3>& p) {
     osg::BoundingBox b;
     for (const auto& v : p) b.expandBy(v.x, v.y, v.z);
@@ -157,6 +167,7 @@ osg::ref_ptr<osg::Geometry> makeGeometry(const std::string& name, osg::Vec3Array
 struct ProtoArrays {
     osg::ref_ptr<osg::Vec3Array> verts, normals;
     osg::ref_ptr<osg::Vec4ubArray> colors;
+    osg::ref_ptr<osg::UIntArray> labels;
     osg::BoundingBox bounds;
 };
 
@@ -178,6 +189,7 @@ osg::ref_ptr<osg::StateSet> instancedStateSet() {
     for (unsigned c = 0; c < 4; ++c) prog->addBindAttribLocation("vista_instance" + std::to_string(c), kInstanceAttrib0 + c);
     ss->setAttributeAndModes(prog.get(), osg::StateAttribute::ON);
     for (unsigned c = 0; c < 4; ++c) ss->setAttribute(new osg::VertexAttribDivisor(kInstanceAttrib0 + c, 1));
+    ss->setAttribute(new osg::VertexAttribDivisor(kTreeIdAttrib, 1));
     return ss;
 }
 
@@ -207,6 +219,7 @@ osg::ref_ptr<osg::Node> buildCityScene(const City& city) {
     root->setUserValue("vista.origin_y", p.origin_y);
     root->setUserValue("vista.tile_size_m", p.tile_size_m);
     root->setUserValue("vista.tree_prototypes", int(city.treePrototypes.size()));
+    root->setUserValue("vista.labels", 1);
     osg::StateSet* rs = root->getOrCreateStateSet();
     rs->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
     rs->setAttributeAndModes(new osg::CullFace(osg::CullFace::BACK), osg::StateAttribute::ON);
@@ -219,6 +232,7 @@ osg::ref_ptr<osg::Node> buildCityScene(const City& city) {
         protos[i].verts = toVec3Array(m.positions);
         protos[i].normals = normalsFor(m);
         protos[i].colors = toColorArray(m.colors);
+        protos[i].labels = labelArray(m);
         protos[i].bounds = boundsOf(m.positions);
     }
     osg::ref_ptr<osg::StateSet> instSS;  // shared by all instanced geometries
@@ -239,6 +253,7 @@ osg::ref_ptr<osg::Node> buildCityScene(const City& city) {
             checkMesh(m);
             auto g = makeGeometry(materialName(Material(mi)), toVec3Array(m.positions).get(), normalsFor(m).get(),
                                   toColorArray(m.colors).get(), m.indices);
+            g->setVertexAttribArray(kLabelAttrib, labelArray(m).get(), osg::Array::BIND_PER_VERTEX);
             g->setInitialBound(boundsOf(m.positions));
             geode->addDrawable(g.get());
         }
@@ -258,6 +273,9 @@ osg::ref_ptr<osg::Node> buildCityScene(const City& city) {
             g->getPrimitiveSet(0)->setNumInstances(int(list.size()));
             osg::ref_ptr<osg::Vec4Array> cols[4];
             for (auto& c : cols) c = new osg::Vec4Array(unsigned(list.size()));
+            osg::ref_ptr<osg::UIntArray> treeIds = new osg::UIntArray(unsigned(list.size()));
+            treeIds->setPreserveDataType(true);
+            for (size_t k = 0; k < list.size(); ++k) (*treeIds)[unsigned(k)] = makeInstanceId(InstanceKind::Tree, list[k]);
             osg::BoundingBox bb;
             const osg::BoundingBox& pb = protos[pi].bounds;
             for (size_t k = 0; k < list.size(); ++k) {
@@ -270,6 +288,8 @@ osg::ref_ptr<osg::Node> buildCityScene(const City& city) {
                 }
             }
             for (unsigned c = 0; c < 4; ++c) g->setVertexAttribArray(kInstanceAttrib0 + c, cols[c].get(), osg::Array::BIND_PER_VERTEX);
+            g->setVertexAttribArray(kLabelAttrib, protos[pi].labels.get(), osg::Array::BIND_PER_VERTEX);
+            g->setVertexAttribArray(kTreeIdAttrib, treeIds.get(), osg::Array::BIND_PER_VERTEX);
             g->setInitialBound(bb);
             g->setStateSet(instSS.get());
             geode->addDrawable(g.get());
@@ -338,6 +358,8 @@ Result<SceneModel> decodeCityScene(osg::Node* node, const std::string& path) {
         if (!g) return Status::error("city file '" + path + "': vista.streets: " + g.status().message());
         out.streets = std::move(*g);
     }
+    int labels = 0;
+    out.labelled = getUser(*root, "vista.labels", labels) && labels == 1;
     int protoCount = 0;
     getUser(*root, "vista.tree_prototypes", protoCount);
     if (protoCount < 0 || protoCount > 1000000) return bad("vista.tree_prototypes = " + std::to_string(protoCount) + " out of range");
@@ -372,6 +394,13 @@ Result<SceneModel> decodeCityScene(osg::Node* node, const std::string& path) {
             }
             if (mesh.indices.size() % 3 != 0) return bad("geometry '" + g->getName() + "': index count not a multiple of 3");
             const std::string& name = g->getName();
+            mesh.material = materialFromName(name.c_str());
+            if (out.labelled) {
+                auto* ids = dynamic_cast<osg::UIntArray*>(g->getVertexAttribArray(kLabelAttrib));
+                if (!ids || ids->size() != verts->size()) return bad("geometry '" + name + "': label count != vertex count");
+                ids->setPreserveDataType(true);
+                mesh.ids.assign(ids->begin(), ids->end());
+            }
             if (name.rfind(kTreeGeometryPrefix, 0) == 0) {
                 long pi = std::strtol(name.c_str() + std::strlen(kTreeGeometryPrefix), nullptr, 10);
                 if (pi < 0 || pi >= protoCount) return bad("tree geometry '" + name + "' names an unknown prototype");
@@ -382,6 +411,12 @@ Result<SceneModel> decodeCityScene(osg::Node* node, const std::string& path) {
                 }
                 size_t n = size_t(std::max(0, de->getNumInstances()));
                 for (auto* c : cols) if (c->size() != n) return bad("tree geometry '" + name + "': instance count mismatch");
+                osg::UIntArray* treeIds = nullptr;
+                if (out.labelled) {
+                    treeIds = dynamic_cast<osg::UIntArray*>(g->getVertexAttribArray(kTreeIdAttrib));
+                    if (!treeIds || treeIds->size() != n) return bad("tree geometry '" + name + "': tree id count != instance count");
+                    treeIds->setPreserveDataType(true);
+                }
                 for (size_t k = 0; k < n; ++k) {
                     glm::dmat4 m(1.0);
                     for (int c = 0; c < 4; ++c) {
@@ -389,7 +424,7 @@ Result<SceneModel> decodeCityScene(osg::Node* node, const std::string& path) {
                         m[c] = glm::dvec4(v.x(), v.y(), v.z(), v.w());
                     }
                     tile.instances.push_back(uint32_t(out.instances.size()));
-                    out.instances.push_back({uint32_t(pi), tileM * m});
+                    out.instances.push_back({uint32_t(pi), tileM * m, treeIds ? (*treeIds)[unsigned(k)] : 0u});
                 }
                 out.triangles += n * (mesh.indices.size() / 3);
                 tile.triangles += n * (mesh.indices.size() / 3);

@@ -37,6 +37,15 @@ osg::ref_ptr<osg::Node> buildCityScene(const City& city);
 
 constexpr const char* kTreeGeometryPrefix = "tree_prototype_";
 constexpr unsigned kInstanceAttrib0 = 12;
+// Ground-truth labels (citygen/labels.h; files with the root user value
+// vista.labels = 1): every tile geometry and tree prototype carries its
+// per-vertex label ids (osg::UIntArray, integer data type preserved) in
+// vertex attribute kLabelAttrib; every instanced tree geometry carries each
+// instance's id in kTreeIdAttrib (one value per instance, divisor 1).
+// Location 5 is reserved for the label pass's per-vertex class.
+constexpr unsigned kLabelAttrib = 6;
+constexpr unsigned kTreeIdAttrib = 7;
+constexpr unsigned kLabelClassAttrib = 5;
 // Haze uniforms read by every vista shader that draws city geometry (the
 // instanced trees' program as loaded, the haze program of nodes/render):
 // colour = mix(vista_haze_color, colour, exp(-vista_haze_density * eye-plane depth)).

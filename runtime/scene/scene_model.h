@@ -21,6 +21,7 @@
 
 #include <glm/glm.hpp>
 
+#include "citygen/mesh.h"
 #include "citygen/params.h"
 #include "citygen/street_graph.h"
 
@@ -31,11 +32,17 @@ struct SceneMesh {
     std::vector<glm::vec3> positions;    // metres, relative to origin
     std::vector<glm::u8vec4> colors;     // prelit RGBA, one per position
     std::vector<uint32_t> indices;       // triangles (3 per triangle)
+    // Ground truth (citygen/labels.h): the geometry's material (Count when
+    // its name is none) and the label id per vertex (tile meshes: instance
+    // id; prototypes: the part's Material), empty for files without labels.
+    Material material = Material::Count;
+    std::vector<uint32_t> ids;
 };
 
 struct SceneInstance {
     uint32_t prototype = 0;
     glm::dmat4 transform{1.0};  // prototype frame -> world
+    uint32_t id = 0;            // ground-truth instance id (labels.h: tree index), 0 when unlabelled
 };
 
 struct SceneTile {
@@ -56,6 +63,7 @@ struct SceneModel {
     std::vector<SceneInstance> instances;
     std::vector<SceneTile> tiles;         // empty for hand-built models
     size_t triangles = 0;                 // rendered triangles (instances expanded)
+    bool labelled = false;                // the file carries ground-truth labels (vista.labels)
     std::shared_ptr<SceneGraph> graph;    // the decoded OSG graph, or null
 };
 

@@ -3,7 +3,10 @@
 // Status (the trailer check), never crash. Set VISTA_FUZZ_TRUSTED_TRAILER=1 to
 // append a valid trailer to every input (a malformed payload another tool
 // could write): that fuzzes the OSG reader itself (see docs/reliability.md,
-// trust model).
+// trust model). Seeds: tiny_city.osgb (a file without ground-truth labels, as
+// older versions wrote) and tiny_labelled_city.osgb (vista.labels = 1: label
+// arrays on every geometry, tree ids per instance; a label array whose size
+// does not match is refused like any other malformed geometry).
 #include <cstdlib>
 #include <string>
 
