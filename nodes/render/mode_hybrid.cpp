@@ -67,6 +67,7 @@ public:
         FrameStats ns;
         VISTA_RETURN_IF_ERROR(_ctx.renderer->render(_root.get(), camera, zFar, &out, &_depth, ns));
         stats.stages.set(Stage::Near, ns.frameMs);
+        stats.stages.set(Stage::Readback, ns.stages.ms(Stage::Readback));  // part of Near
         stats.cullMs = ns.cullMs;
         stats.drawMs = ns.drawMs;
         stats.triangles = ns.triangles ? ns.triangles : tris;

@@ -3,6 +3,7 @@
 #include "nodes/render/offscreen.h"
 #include "nodes/render/effects_state.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -36,6 +37,7 @@ struct Readback : public osg::Camera::DrawCallback {
     mutable double finishedMs = 0;     // frame time at which the GL finished drawing
     mutable double readMs = 0;
     mutable std::string renderer;
+    mutable std::vector<uint32_t> depthBits;  // scratch of the depth read
     void operator()(osg::RenderInfo&) const override {
         glFinish();
         finishedMs = frame ? frame->ms() : 0.0;
@@ -52,8 +54,17 @@ struct Readback : public osg::Camera::DrawCallback {
             glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, color->data());
         }
         if (depth) {
-            depth->resize(size_t(width) * size_t(height));
-            glReadPixels(0, 0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, depth->data());
+            // As normalised 32-bit integers, converted here: on llvmpipe (24-bit depth)
+            // this read is about 5x faster than GL_FLOAT (1280x720: 0.23 against 1.2 ms),
+            // and u / (2^32 - 1) is the GL_FLOAT value within float rounding (1 stays 1).
+            const size_t n = size_t(width) * size_t(height);
+            depthBits.resize(n);
+            depth->resize(n);
+            glReadPixels(0, 0, width, height, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, depthBits.data());
+            constexpr float kScale = float(1.0 / 4294967295.0);
+            float* out = depth->data();
+            const uint32_t* in = depthBits.data();
+            for (size_t i = 0; i < n; ++i) out[i] = std::min(1.0f, float(in[i]) * kScale);
         }
         readMs = read.ms();
     }

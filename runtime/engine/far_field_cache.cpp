@@ -39,7 +39,9 @@ int64_t cacheBudget(const FarFrame& f, const FarFieldMemory& m, const FarFieldOp
 
 void cacheStage(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, FrameStats& stats) {
     double spentMs = 0;
-    stats.stages.forEach([&](Stage, double ms) { spentMs += ms; });
+    stats.stages.forEach([&](Stage s, double ms) {
+        if (s != Stage::Readback) spentMs += ms;  // readback is part of Near when both are set
+    });
     Stopwatch sw;
     const double key[4] = {f.camera.fovY, double(f.width), double(f.height), o.cacheOversample};
     if (!m.cache || !std::equal(key, key + 4, m.cacheKey)) {
