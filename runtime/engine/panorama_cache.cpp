@@ -3,6 +3,7 @@
 #include "foundation/units.h"
 
 #include <algorithm>
+#include <cstring>
 #include <cmath>
 #include <numeric>
 
@@ -66,14 +67,32 @@ int64_t PanoramaCache::index(const glm::dvec3& d, glm::u8vec2* sub) const {
     return row * _width + col;
 }
 
+uint32_t PanoramaCache::encodeNear(float d) {
+    uint32_t b, inf;
+    const float i = INFINITY;
+    std::memcpy(&b, &d, 4);
+    std::memcpy(&inf, &i, 4);
+    return b ^ inf;
+}
+
+float PanoramaCache::decodeNear(uint32_t v) {
+    const float i = INFINITY;
+    uint32_t inf;
+    std::memcpy(&inf, &i, 4);
+    v ^= inf;
+    float d;
+    std::memcpy(&d, &v, 4);
+    return d;
+}
+
 void PanoramaCache::clear() {
     size_t n = size_t(_width) * size_t(_height);
-    _color.assign(n, glm::u8vec4(0));
-    _near.assign(n, INFINITY);
-    _sub.assign(n, glm::u8vec2(128));
-    _stamped.assign(n, 0u);
+    _color.reset(n);
+    _near.reset(n);
+    _sub.reset(n);
+    _stamped.reset(n);
     _stamp = 0;
-    _record.assign(n, 0);
+    _record.reset(n);
     _records.assign(1, Record{});
     _baseline.assign(1, INFINITY);
     _current = 0;
@@ -133,7 +152,7 @@ double PanoramaCache::error(int64_t cell, glm::u8vec2 sub, const CachePolicy& p)
     // Resampling: the angle between the cell's traced ray and this one. On the
     // cylinder a column step is 2 pi / width of azimuth (times cos elevation
     // on the sphere), a row step 2 vMax / height of tan(elevation) (times cos^2).
-    const glm::u8vec2 s = _sub[size_t(cell)];
+    const glm::u8vec2 s = _sub[size_t(cell)] ^ glm::u8vec2(kSubBias);
     const double v = _vMax - (double(cell / _width) + 0.5) * 2.0 * _vMax / _height;
     const double c2 = 1.0 / (1.0 + v * v);
     const double du = (double(sub.x) - double(s.x)) / 256.0 * kTwoPi / _width * std::sqrt(c2);
@@ -141,7 +160,7 @@ double PanoramaCache::error(int64_t cell, glm::u8vec2 sub, const CachePolicy& p)
     const double offset = std::sqrt(du * du + dv * dv);
     const double b = _baseline[r];
     if (b == 0) return offset / p.radPerPixel;  // rotation only
-    const double own = b / double(_near[size_t(cell)]);  // 0 when the window was all sky
+    const double own = b / double(decodeNear(_near[size_t(cell)]));  // 0 when the window was all sky
     const double outside = p.lowerDepth > 0 ? b / p.lowerDepth - p.windowPx * p.radPerPixel : INFINITY;
     return (std::max(own, outside) + offset) / p.radPerPixel;
 }
@@ -196,8 +215,8 @@ void PanoramaCache::store(const std::vector<int64_t>& cells, const std::vector<g
         const bool twice = _stamped[k] == _stamp;
         _stamped[k] = _stamp;
         _color[k] = colors[i];
-        _sub[k] = subs[i];
-        _near[k] = nearDistance[i];
+        _sub[k] = subs[i] ^ glm::u8vec2(kSubBias);
+        _near[k] = encodeNear(nearDistance[i]);
         _record[k] = twice ? 0 : _current;
     }
 }

@@ -43,6 +43,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "foundation/zeroed_array.h"
+
 #include <glm/glm.hpp>
 
 #include "runtime/scene/camera.h"
@@ -95,7 +97,7 @@ public:
     void store(const std::vector<int64_t>& cells, const std::vector<glm::u8vec2>& subs,
                const std::vector<glm::u8vec4>& colors, const std::vector<float>& nearDistance);
     glm::u8vec4 color(int64_t cell) const { return _color[size_t(cell)]; }
-    float nearDistance(int64_t cell) const { return _near[size_t(cell)]; }
+    float nearDistance(int64_t cell) const { return decodeNear(_near[size_t(cell)]); }
     uint32_t record(int64_t cell) const { return _record[size_t(cell)]; }
     size_t recordCount() const { return _records.size(); }
     uint32_t currentRecord() const { return _current; }
@@ -109,14 +111,21 @@ private:
     void compact();
     int _width = 0, _height = 0;
     double _vMax = 1;
-    std::vector<glm::u8vec4> _color;
-    std::vector<float> _near;
-    std::vector<glm::u8vec2> _sub;
-    std::vector<uint32_t> _record;
+    // Per cell, zero-initialised so that a fresh panorama costs nothing until
+    // touched: colour (alpha 0 = never traced), nearest far surface (float
+    // bits XOR those of +inf: zero = +inf), sub-cell position (XOR 128:
+    // zero = the centre), record (0 = never traced).
+    static uint32_t encodeNear(float d);
+    static float decodeNear(uint32_t v);
+    static constexpr uint8_t kSubBias = 128;
+    ZeroedArray<glm::u8vec4> _color;
+    ZeroedArray<uint32_t> _near;
+    ZeroedArray<glm::u8vec2> _sub;
+    ZeroedArray<uint32_t> _record;
     std::vector<Record> _records;  // [0] = never traced
     uint32_t _current = 0;
     std::vector<double> _baseline;  // per record: distance to the current eye (beginFrame)
-    std::vector<uint32_t> _stamped;  // per cell: the store() call that last wrote it
+    ZeroedArray<uint32_t> _stamped;  // per cell: the store() call that last wrote it
     uint32_t _stamp = 0;
     std::vector<double> _error;      // scratch of selectForTracing
 };

@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include "foundation/zeroed_array.h"
 #include "foundation/atomic_file.h"
 #include "foundation/hash.h"
 #include "foundation/rng.h"
@@ -211,3 +212,17 @@ TEST(Statistics, PercentileInterpolatesBetweenRanksAndIgnoresNonFinite) {
 
 }  // namespace
 }  // namespace vista
+
+TEST(ZeroedArray, StartsZeroAndResetsToZero) {
+    vista::ZeroedArray<uint32_t> a(1000);
+    ASSERT_EQ(a.size(), 1000u);
+    for (uint32_t v : a) EXPECT_EQ(v, 0u);
+    a[7] = 42;
+    EXPECT_EQ(a[7], 42u);
+    a.reset(10);
+    EXPECT_EQ(a.size(), 10u);
+    for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i], 0u);
+    a.reset(0);
+    EXPECT_EQ(a.size(), 0u);
+    EXPECT_EQ(a.begin(), a.end());
+}
