@@ -252,6 +252,9 @@ Result<BenchResult> runBenchmark(const SceneModel* city, osg::Node* scene, const
         threads.reset(new tbb::global_control(tbb::global_control::max_allowed_parallelism, size_t(cfg.options.threads)));
     auto run = setUp(city, scene, cfg);
     if (!run) return run.status();
+    BenchResult result;
+    result.memory = cfg.memoryPhases;
+    result.memory.push_back(memoryPhase("setup"));
     if (!cfg.dumpRaysDir.empty()) {
         const auto& ms = (*run)->modes;
         if (std::none_of(ms.begin(), ms.end(), [](const auto& m) { return m->lastTracedPixels() != nullptr; }))
@@ -273,10 +276,10 @@ Result<BenchResult> runBenchmark(const SceneModel* city, osg::Node* scene, const
     const std::vector<size_t> idx = path.frames(size_t(cfg.frames), cfg.sampleRuns);
     if (cfg.warmup) VISTA_RETURN_IF_ERROR(warmUp(**run, path.camera(idx[0], base)));
 
-    BenchResult result;
     result.loadAvgStart = loadAverage();
     FrameImages images(cfg, (*run)->modes.size());
     VISTA_RETURN_IF_ERROR(renderFrames(**run, path, idx, base, cfg, result, images));
+    result.memory.push_back(memoryPhase("frames"));
     result.loadAvgEnd = loadAverage();
     result.glRenderer = (*run)->renderer->glRenderer();
     result.motion = pathMotion(path, idx);

@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "cmd/memory.h"
 #include "foundation/statistics.h"
 #include "foundation/status.h"
 #include "nodes/render/render_mode.h"
@@ -54,6 +55,8 @@ struct BenchConfig {
     ModeOptions options;
     std::string command;           // recorded in summary.json
     std::string cityLabel;         // recorded in summary.json
+    std::vector<MemoryPhase> memoryPhases;  // phases measured by the caller before the run (load)
+    double memoryBudgetGb = 0, memoryEstimateMb = 0;  // --memory-budget (0 = none) and the up-front estimate
     double loadMs = -1;            // city load time measured by the caller (set-up "load"); < 0 = not reported
     double runUpS = -1;            // the path's run-up (PathOptions::runUp) when the bench made it; < 0 = unknown
     std::string effectsDeclared = "{}";  // the scene's effects (JSON, effects.h), recorded in summary.json
@@ -107,6 +110,7 @@ struct BenchResult {
     std::string glRenderer;
     PathMotion motion;                     // of the rendered frames
     double loadAvgStart = -1, loadAvgEnd = -1;
+    std::vector<MemoryPhase> memory;       // load, setup (ray scene, modes), frames
 };
 
 // The config with `full` moved to the front of the modes (the reference of

@@ -147,6 +147,12 @@ json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneM
                     {"hardware_threads", std::thread::hardware_concurrency()},
                     {"load_avg_1min_start", result.loadAvgStart},
                     {"load_avg_1min_end", result.loadAvgEnd}};
+    json phases = json::array();
+    for (const MemoryPhase& p : result.memory) phases.push_back({{"phase", p.name}, {"peak_rss_mb", p.peakRssMb}, {"rss_mb", p.rssMb}});
+    j["memory"] = {{"peak_rss_mb", result.memory.empty() ? json(nullptr) : json(result.memory.back().peakRssMb)},
+                   {"estimate_mb", cfg.memoryEstimateMb > 0 ? json(cfg.memoryEstimateMb) : json(nullptr)},
+                   {"budget_gb", cfg.memoryBudgetGb > 0 ? json(cfg.memoryBudgetGb) : json(nullptr)},
+                   {"phases", phases}};
     json modes = json::object();
     std::vector<std::string> order;
     for (const auto& s : result.modes) {

@@ -2,6 +2,7 @@
 // summary.json, plots, difference images. Also the size sweep (--sweep).
 // Every mode comes from the registry (nodes/render/render_mode.h); the
 // options are parsed by cmd/options.h.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -32,6 +33,7 @@ struct BenchArgs {
     std::string sampling = samplingName(kDefaultSampleRuns);
     std::vector<fs::path> createdOut;  // directories of --out made by this run, deepest first
     bool quiet = false;
+    std::string memoryBudget;
     PathFlags path;
     ModeFlags mode;
     BenchConfig cfg;
@@ -60,6 +62,9 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
                    "write the far-field rays each hybrid frame traced as DIR/MODE_fNNNN.rays (ray sets for bench_raw_rays)");
     app.add_option("--dump-rays-every", a.cfg.dumpRaysEvery, "with --dump-rays: only every N-th frame, 1 .. 1000000 (default 1)");
     app.add_option("--out", a.out, "output directory (created if missing)")->required();
+    app.add_option("--memory-budget", a.memoryBudget,
+                   "GB: refuse up front a run whose estimated peak memory (from the city file's size) exceeds it; "
+                   "summary.json reports the estimate and the measured peak per phase (default: no budget)");
     app.add_option("--effects", a.effects,
                    "run-time effects for this run instead of the scene's: 'none', names (haze, glass, night) or a JSON "
                    "object as in the params file; baked effects (sun_shadows, ambient_occlusion, materials, night's "
@@ -101,6 +106,9 @@ Status configure(BenchArgs& a) {
             return Status::error("mode " + m + " needs --baked city.baked.osgb (from 'vista bake')");
     a.cfg.quiet = a.quiet;
     VISTA_RETURN_IF_ERROR(validateBenchConfig(a.cfg));
+    auto budget = parseMemoryBudgetGb("--memory-budget", a.memoryBudget);
+    if (!budget) return budget.status();
+    a.cfg.memoryBudgetGb = budget.value();
     auto po = parsePathFlags(a.path);
     if (!po) return po.status();
     a.pathOptions = po.value();
@@ -136,11 +144,24 @@ void printTable(const BenchResult& r) {
 // One bench of one city file into one directory: load, path, run, print.
 int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string& outDir, BenchResult* res,
               size_t* cityTriangles = nullptr) {
+    BenchConfig cfg = a.cfg;
+    {
+        // The estimate before anything is loaded: a run over the budget stops here.
+        std::error_code ec;
+        const uint64_t bytes = fs::file_size(cityFile, ec);
+        const bool rays = std::any_of(cfg.modes.begin(), cfg.modes.end(),
+                                      [](const std::string& m) { return findRenderMode(m)->needsRays; });
+        if (!ec) {
+            cfg.memoryEstimateMb = estimateCityRunMb(bytes, rays);
+            if (Status s = checkMemoryBudget("--memory-budget", cfg.memoryBudgetGb, cfg.memoryEstimateMb, bytes, rays); !s)
+                return reportBadInput(kCmd, s);
+        }
+    }
     Stopwatch sw;
     auto city = loadCityFile(cityFile);
     if (!city) return reportBadInput(kCmd, city.status());
-    BenchConfig cfg = a.cfg;
     cfg.loadMs = sw.ms();
+    cfg.memoryPhases.push_back(memoryPhase("load"));
     auto path = walkthroughPath(a.path, a.pathOptions, city.value());
     if (!path) return reportBadInput(kCmd, path.status());
     cfg.runUpS = a.path.file.empty() ? a.pathOptions.runUp : -1.0;

@@ -6,6 +6,7 @@
 // notes), screenshots (key p, or --screenshot with --frames for headless
 // use). --step shows exactly the bench's frames of the path (the camera of
 // `vista bench --frames N`), so view and bench can be compared image to image.
+#include <filesystem>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
@@ -29,6 +30,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "cmd/cli.h"
+#include "cmd/memory.h"
 #include "cmd/commands.h"
 #include "cmd/options.h"
 #include "foundation/timing.h"
@@ -48,7 +50,7 @@ const char* const kCmd = "vista view";
 osg::Matrixd toOsg(const glm::dmat4& m) { return osg::Matrixd(glm::value_ptr(m)); }
 
 struct ViewArgs {
-    std::string city, size = "1280x720", screenshot, mode = "full", fov = "60", effects;
+    std::string city, size = "1280x720", screenshot, mode = "full", fov = "60", effects, memoryBudget;
     int frames = 0;
     bool step = false, noHud = false;
     std::string sampling = samplingName(kDefaultSampleRuns);
@@ -76,6 +78,9 @@ void declareFlags(CLI::App& app, ViewArgs& a) {
                    "(default " + samplingName(kDefaultSampleRuns) + ")");
     app.add_flag("--no-hud", a.noHud, "no text overlay (for screenshots compared with `vista bench`)");
     app.add_option("--screenshot", a.screenshot, "write a PNG of the last frame (use with --frames)");
+    app.add_option("--memory-budget", a.memoryBudget,
+                   "GB: refuse up front when the estimated peak memory (from the city file's size, with the ray scene "
+                   "every mode may need) exceeds it (default: no budget)");
     app.add_option("--effects", a.effects,
                    "run-time effects instead of the scene's: 'none', names (haze, glass, night) or a JSON object; "
                    "keys y / g / n toggle haze, glass reflections and the night sky");
@@ -420,6 +425,15 @@ int runView(int argc, char** argv) {
     if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;
     ModeContext ctx;
     if (Status s = configure(a, ctx.options); !s) return reportBadInput(kCmd, s);
+    {
+        auto budget = parseMemoryBudgetGb("--memory-budget", a.memoryBudget);
+        if (!budget) return reportBadInput(kCmd, budget.status());
+        std::error_code ec;
+        const uint64_t bytes = std::filesystem::file_size(a.city, ec);
+        if (!ec)
+            if (Status s = checkMemoryBudget("--memory-budget", *budget, estimateCityRunMb(bytes, true), bytes, true); !s)
+                return reportBadInput(kCmd, s);
+    }
     auto city = loadCityFile(a.city);
     if (!city) return reportBadInput(kCmd, city.status());
     bool playback = false;

@@ -630,6 +630,30 @@ TEST(BenchCli, TinyGeneratedCity) {
     EXPECT_GT(j["path_motion"]["metres_per_frame_median"].get<double>(), 0.0);
     expectSpeedupsFromCsv(dir + "/bench");
     EXPECT_TRUE(fs::exists(dir + "/bench/frame_time.png"));
+    {  // Memory: the peak per phase (never falling), the up-front estimate beside it.
+        const auto& mem = j["memory"];
+        ASSERT_EQ(mem["phases"].size(), 3u);
+        double last = 0;
+        for (const auto& p : mem["phases"]) {
+            EXPECT_GE(p["peak_rss_mb"].get<double>(), last) << p["phase"];
+            EXPECT_GT(p["rss_mb"].get<double>(), 0.0);
+            EXPECT_LE(p["rss_mb"].get<double>(), p["peak_rss_mb"].get<double>() + 1.0);
+            last = p["peak_rss_mb"].get<double>();
+        }
+        EXPECT_EQ(mem["phases"][0]["phase"], "load");
+        EXPECT_EQ(mem["peak_rss_mb"].get<double>(), last);
+        EXPECT_GT(mem["estimate_mb"].get<double>(), 0.0);
+        EXPECT_TRUE(mem["budget_gb"].is_null());
+    }
+    // A budget below the estimate stops the run up front: exit 2, the estimate in the message, no output.
+    const double estimateGb = j["memory"]["estimate_mb"].get<double>() / 1024.0;
+    EXPECT_EQ(runVista("bench " + city + " --path " + dir + "/p.csv --frames 2 --size 160x120 -q --modes full,hybrid "
+                       "--memory-budget " + std::to_string(0.5 * estimateGb) + " --out " + dir + "/over",
+                       &out),
+              2)
+        << out;
+    EXPECT_NE(out.find("estimated to peak"), std::string::npos) << out;
+    EXPECT_FALSE(fs::exists(dir + "/over"));
     EXPECT_EQ(runVista("view " + dir + "/missing.osgb --frames 1", &out), 2) << out;
     fs::remove_all(dir);
 }
@@ -709,7 +733,8 @@ TEST(BenchCli, FarFieldFlagsRejectBadValues) {
     std::ofstream(dummy) << "x";
     const std::pair<const char*, const char*> bad[] = {
         {"--near -5", "--near"}, {"--near abc", "--near"}, {"--horizon-grid 0", "--horizon-grid"},
-        {"--budget -7", "--budget"}, {"--horizon-grid 9000", "--horizon-grid"}};
+        {"--budget -7", "--budget"}, {"--horizon-grid 9000", "--horizon-grid"}, {"--far-step 3", "--far-step"},
+        {"--memory-budget 0", "--memory-budget"}, {"--memory-budget lots", "--memory-budget"}};
     for (const auto& [args, flag] : bad) {
         EXPECT_EQ(runVista("bench " + dummy + " " + args + " --out " + dir + "/o", &out), 2) << args << ": " << out;
         EXPECT_NE(out.find(flag), std::string::npos) << args << ": " << out;

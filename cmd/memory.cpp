@@ -1,0 +1,58 @@
+// Memory phases, the city-run estimate and the budget check (memory.h).
+#include "cmd/memory.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+
+#include <unistd.h>
+
+#include "cmd/cli.h"
+
+namespace vista {
+
+namespace {
+
+constexpr double kSceneBytesPerFileByte = 4.1;  // measured: 4.03 (2 km city), 3.76 (8 km)
+constexpr double kRaysBytesPerFileByte = 1.7;   // measured: 1.63 (2 km), see docs/performance.md
+constexpr double kFixedMb = 200.0;
+constexpr double kMb = 1024.0 * 1024.0;
+
+double currentRssMb() {
+    std::ifstream f("/proc/self/statm");
+    long pages = 0, resident = 0;
+    if (!(f >> pages >> resident)) return 0.0;
+    return double(resident) * double(sysconf(_SC_PAGESIZE)) / kMb;
+}
+
+}  // namespace
+
+MemoryPhase memoryPhase(const std::string& name) { return {name, peakRssMb(), currentRssMb()}; }
+
+Result<double> parseMemoryBudgetGb(const std::string& option, const std::string& text) {
+    if (text.empty()) return 0.0;
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    if (end == text.c_str() || *end != '\0' || !std::isfinite(v) || !(v > 0) || v > 65536)
+        return Status::error("option " + option + " = '" + text + "': expected a number of GB in (0, 65536]");
+    return v;
+}
+
+double estimateCityRunMb(uint64_t fileBytes, bool rayScene) {
+    const double f = double(fileBytes) / kMb;
+    return kFixedMb + kSceneBytesPerFileByte * f + (rayScene ? kRaysBytesPerFileByte * f : 0.0);
+}
+
+Status checkMemoryBudget(const std::string& option, double budgetGb, double estimateMb, uint64_t fileBytes, bool rayScene) {
+    if (budgetGb <= 0 || estimateMb <= budgetGb * 1024.0) return Status::ok();
+    char buf[512];
+    std::snprintf(buf, sizeof(buf),
+                  "option %s = %g GB: this run is estimated to peak at %.1f GB (%.0f MB city file x %.1f for the scene%s, "
+                  "+ %.0f MB fixed; docs/performance.md \"Memory\"); give a larger budget or a smaller city",
+                  option.c_str(), budgetGb, estimateMb / 1024.0, double(fileBytes) / kMb, kSceneBytesPerFileByte,
+                  rayScene ? " + 1.7 for the ray scene" : "", kFixedMb);
+    return Status::error(buf);
+}
+
+}  // namespace vista

@@ -1,0 +1,35 @@
+// Memory as a measured budget: the process's resident memory per phase and
+// an up-front estimate checked against `--memory-budget GB`.
+//
+// The estimate of a run that loads a city file (bench, view, bake) is linear
+// in the file's size, from peaks measured on this machine (docs/performance.md
+// "Memory"): the loaded scene graph, the decoded model and the 40 m chunks
+// come to about 4 bytes per file byte, the Embree ray scene to about 1.7 more
+// (modes that cast rays), plus a fixed 200 MB (GL context, TBB, libraries).
+// It is an estimate, not a bound: summary.json reports it beside the measured
+// peak so that its error is on record for every run.
+#pragma once
+#include <cstdint>
+#include <string>
+
+#include "foundation/status.h"
+
+namespace vista {
+
+struct MemoryPhase {
+    std::string name;
+    double peakRssMb = 0;  // peak resident set size of the process so far (MiB)
+    double rssMb = 0;      // resident set size at the end of the phase (MiB)
+};
+// The phase just ended, measured now.
+MemoryPhase memoryPhase(const std::string& name);
+
+// "" = no budget (0); else a number of GB in (0, 65536]. Errors name `option`.
+Result<double> parseMemoryBudgetGb(const std::string& option, const std::string& text);
+// Estimated peak (MiB) of a run on a city file of `fileBytes` bytes.
+double estimateCityRunMb(uint64_t fileBytes, bool rayScene);
+// Ok when there is no budget or the estimate fits it; otherwise an error that
+// gives the estimate, what it is made of and the budget.
+Status checkMemoryBudget(const std::string& option, double budgetGb, double estimateMb, uint64_t fileBytes, bool rayScene);
+
+}  // namespace vista
