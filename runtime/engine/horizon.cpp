@@ -24,6 +24,36 @@ struct Box2 {
     bool valid() const { return lo.x <= hi.x; }
 };
 
+// A 2D DDA over square cells `unit` grid cells wide, starting in cell (x, y)
+// for the ray s0 + d * t (grid units); tMax = the ray parameter where it
+// leaves the current cell in x / y.
+struct GridWalk {
+    int x, y, stepX, stepY;
+    double tMaxX, tMaxY, tDeltaX, tDeltaY;
+    GridWalk(int x0, int y0, double sx0, double sy0, double dx, double dy, double unit)
+        : x(x0), y(y0), stepX(dx > 0 ? 1 : -1), stepY(dy > 0 ? 1 : -1),
+          tDeltaX(dx != 0 ? 1.0 / std::abs(dx) * unit : kInf), tDeltaY(dy != 0 ? 1.0 / std::abs(dy) * unit : kInf) {
+        tMaxX = std::max(0.0, dx > 0 ? ((x + 1) * unit - sx0) / dx : dx < 0 ? (sx0 - x * unit) / -dx : kInf);
+        tMaxY = std::max(0.0, dy > 0 ? ((y + 1) * unit - sy0) / dy : dy < 0 ? (sy0 - y * unit) / -dy : kInf);
+    }
+    double next() const { return std::min(tMaxX, tMaxY); }
+    bool corner() const { return std::abs(tMaxX - tMaxY) <= kTieEps * std::max(1.0, next()); }
+    void advance() {
+        if (corner()) {
+            x += stepX;
+            y += stepY;
+            tMaxX += tDeltaX;
+            tMaxY += tDeltaY;
+        } else if (tMaxX < tMaxY) {
+            x += stepX;
+            tMaxX += tDeltaX;
+        } else {
+            y += stepY;
+            tMaxY += tDeltaY;
+        }
+    }
+};
+
 }  // namespace
 
 HeightGrid HeightGrid::build(const SceneModel& city, const glm::dvec3& frameOrigin, int cells) {
@@ -183,136 +213,75 @@ double HeightGrid::trace(const glm::dvec3& eye, double azimuth, double nearDista
     const double zTop = _boundsMax.z + 1e-3;
     double best = -kInf;
 
-    auto run = [&](int ix, int iy) {
-        const int stepX = dx > 0 ? 1 : -1, stepY = dy > 0 ? 1 : -1;
-        const double sx0 = px + dx * t0, sy0 = py + dy * t0;
-        const double tDeltaX = dx != 0 ? 1.0 / std::abs(dx) : kInf, tDeltaY = dy != 0 ? 1.0 / std::abs(dy) : kInf;
-        double tMaxX = dx > 0 ? (ix + 1 - sx0) / dx : dx < 0 ? (sx0 - ix) / -dx : kInf;
-        double tMaxY = dy > 0 ? (iy + 1 - sy0) / dy : dy < 0 ? (sy0 - iy) / -dy : kInf;
-        tMaxX = std::max(tMaxX, 0.0);
-        tMaxY = std::max(tMaxY, 0.0);
-        const double tLen = t1 - t0;
-        auto inGrid = [&](int x, int y) { return x >= 0 && y >= 0 && x < n && y < n; };
-        while (inGrid(ix, iy)) {
-            best = std::max(best, cellBound(ix, iy, eye, nearDistance, maxDistance));
-            double tNext = std::min(tMaxX, tMaxY);
-            if (tNext > tLen + kTieEps) break;
-            // Early exit: nothing farther can beat `best` (only valid when best > 0: farther is lower).
-            double distM = (t0 + tNext - 1.5) * s - 2 * kCellMargin;  // nearest point of any later cell
-            if (best > 0 && distM > 0 && (zTop - eye.z) / distM < best) break;
-            if (distM > maxDistance) break;  // every later cell lies beyond the haze limit
-            if (std::abs(tMaxX - tMaxY) <= kTieEps * std::max(1.0, tNext)) {
-                // Through a grid corner: both side cells touch the ray.
-                if (inGrid(ix + stepX, iy)) best = std::max(best, cellBound(ix + stepX, iy, eye, nearDistance, maxDistance));
-                if (inGrid(ix, iy + stepY)) best = std::max(best, cellBound(ix, iy + stepY, eye, nearDistance, maxDistance));
-                ix += stepX;
-                iy += stepY;
-                tMaxX += tDeltaX;
-                tMaxY += tDeltaY;
-            } else if (tMaxX < tMaxY) {
-                ix += stepX;
-                tMaxX += tDeltaX;
-            } else {
-                iy += stepY;
-                tMaxY += tDeltaY;
+    const double sx0 = px + dx * t0, sy0 = py + dy * t0;
+    const double tLen = t1 - t0;
+    auto inGrid = [&](int x, int y) { return x >= 0 && y >= 0 && x < n && y < n; };
+    auto visit = [&](int x, int y) {
+        if (inGrid(x, y)) best = std::max(best, cellBound(x, y, eye, nearDistance, maxDistance));
+    };
+    // Nothing touched after ray parameter tNext can beat `best` (farther is
+    // lower when best > 0), or it all lies beyond the distance limit.
+    auto laterCellsLose = [&](double tNext) {
+        const double distM = (t0 + tNext - 1.5) * s - 2 * kCellMargin;  // nearest point of any later cell
+        return (best > 0 && distM > 0 && (zTop - eye.z) / distM < best) || distM > maxDistance;
+    };
+    // The cells from (w.x, w.y) up to ray parameter tStop; with a block
+    // (bx >= 0) only while inside it, without one also stopping early.
+    const int B = kBlock;
+    auto walkCells = [&](GridWalk w, double tStop, int bx, int by) {
+        const double eps = kTieEps * (bx < 0 ? 1.0 : std::max(1.0, tStop));
+        while (inGrid(w.x, w.y) && (bx < 0 || (w.x / B == bx && w.y / B == by))) {
+            visit(w.x, w.y);
+            const double tNext = w.next();
+            if (tNext > tStop + eps) break;
+            if (bx < 0 && laterCellsLose(tNext)) break;
+            if (w.corner()) {  // through a grid corner: both side cells touch the ray
+                visit(w.x + w.stepX, w.y);
+                visit(w.x, w.y + w.stepY);
             }
+            w.advance();
         }
     };
+    auto run = [&](int ix, int iy) { walkCells(GridWalk(ix, iy, sx0, sy0, dx, dy, 1.0), tLen, -1, -1); };
     // The same walk over blocks of kBlock x kBlock cells: a block whose bound
     // cannot beat `best` is passed over whole; otherwise its cells along the
     // ray's stretch [tIn, tOut] inside it are walked as in run(). A ray
-    // through a block corner touches the four cells around that corner.
+    // through a block corner, or entering a block through a cell corner,
+    // touches the four cells around that corner.
     auto runBlocks = [&](int ix, int iy) {
-        const int B = kBlock;
-        const int stepX = dx > 0 ? 1 : -1, stepY = dy > 0 ? 1 : -1;
-        const double sx0 = px + dx * t0, sy0 = py + dy * t0;
-        const double tDeltaX = dx != 0 ? 1.0 / std::abs(dx) : kInf, tDeltaY = dy != 0 ? 1.0 / std::abs(dy) : kInf;
-        const double tLen = t1 - t0;
-        auto inGrid = [&](int x, int y) { return x >= 0 && y >= 0 && x < n && y < n; };
-        auto visit = [&](int x, int y) {
-            if (inGrid(x, y)) best = std::max(best, cellBound(x, y, eye, nearDistance, maxDistance));
+        auto onGridLine = [](double p) { return std::abs(p - std::round(p)) <= kTieEps * std::max(1.0, std::abs(p)); };
+        auto cellAt = [](double p, double d, int lo, int hi) {
+            double c = std::floor(p);
+            if (d < 0 && c == p) c -= 1;
+            return std::clamp(int(c), lo, hi);
         };
-        int bx = ix / B, by = iy / B;
-        double bMaxX = dx > 0 ? ((bx + 1) * B - sx0) / dx : dx < 0 ? (sx0 - bx * B) / -dx : kInf;
-        double bMaxY = dy > 0 ? ((by + 1) * B - sy0) / dy : dy < 0 ? (sy0 - by * B) / -dy : kInf;
-        bMaxX = std::max(bMaxX, 0.0);
-        bMaxY = std::max(bMaxY, 0.0);
-        const double bDeltaX = tDeltaX * B, bDeltaY = tDeltaY * B;
+        auto visitAround = [&](int qx, int qy) {
+            visit(qx - 1, qy - 1);
+            visit(qx, qy - 1);
+            visit(qx - 1, qy);
+            visit(qx, qy);
+        };
+        GridWalk b(ix / B, iy / B, sx0, sy0, dx, dy, double(B));
         double tIn = 0;
         bool first = true;
-        while (bx >= 0 && by >= 0 && bx < _blocks && by < _blocks) {
-            const double tOut = std::min({bMaxX, bMaxY, tLen});
-            if (blockBound(bx, by, eye, nearDistance, maxDistance) > best) {
-                // Walk the block's cells from where the ray enters it.
+        while (b.x >= 0 && b.y >= 0 && b.x < _blocks && b.y < _blocks) {
+            const double tOut = std::min(b.next(), tLen);
+            if (blockBound(b.x, b.y, eye, nearDistance, maxDistance) > best) {
                 int cx = ix, cy = iy;
-                if (!first) {
-                    auto cellAt = [&](double p, double d, int lo, int hi) {
-                        double c = std::floor(p);
-                        if (d < 0 && c == p) c -= 1;
-                        return std::clamp(int(c), lo, hi);
-                    };
+                if (!first) {  // where the ray enters the block
                     const double qx = sx0 + dx * tIn, qy = sy0 + dy * tIn;
-                    cx = cellAt(qx, dx, bx * B, std::min(n, (bx + 1) * B) - 1);
-                    cy = cellAt(qy, dy, by * B, std::min(n, (by + 1) * B) - 1);
-                    // Entering through a cell corner: the cells around it touch the ray there.
-                    auto onGridLine = [](double p) { return std::abs(p - std::round(p)) <= kTieEps * std::max(1.0, std::abs(p)); };
-                    if (onGridLine(qx) && onGridLine(qy)) {
-                        const int rx = int(std::round(qx)), ry = int(std::round(qy));
-                        visit(rx - 1, ry - 1);
-                        visit(rx, ry - 1);
-                        visit(rx - 1, ry);
-                        visit(rx, ry);
-                    }
+                    cx = cellAt(qx, dx, b.x * B, std::min(n, (b.x + 1) * B) - 1);
+                    cy = cellAt(qy, dy, b.y * B, std::min(n, (b.y + 1) * B) - 1);
+                    if (onGridLine(qx) && onGridLine(qy)) visitAround(int(std::round(qx)), int(std::round(qy)));
                 }
-                double tMaxX = dx > 0 ? (cx + 1 - sx0) / dx : dx < 0 ? (sx0 - cx) / -dx : kInf;
-                double tMaxY = dy > 0 ? (cy + 1 - sy0) / dy : dy < 0 ? (sy0 - cy) / -dy : kInf;
-                tMaxX = std::max(tMaxX, 0.0);
-                tMaxY = std::max(tMaxY, 0.0);
-                while (inGrid(cx, cy) && cx / B == bx && cy / B == by) {
-                    best = std::max(best, cellBound(cx, cy, eye, nearDistance, maxDistance));
-                    const double tNext = std::min(tMaxX, tMaxY);
-                    if (tNext > tOut + kTieEps * std::max(1.0, tOut)) break;
-                    if (std::abs(tMaxX - tMaxY) <= kTieEps * std::max(1.0, tNext)) {
-                        visit(cx + stepX, cy);
-                        visit(cx, cy + stepY);
-                        cx += stepX;
-                        cy += stepY;
-                        tMaxX += tDeltaX;
-                        tMaxY += tDeltaY;
-                    } else if (tMaxX < tMaxY) {
-                        cx += stepX;
-                        tMaxX += tDeltaX;
-                    } else {
-                        cy += stepY;
-                        tMaxY += tDeltaY;
-                    }
-                }
+                walkCells(GridWalk(cx, cy, sx0, sy0, dx, dy, 1.0), tOut, b.x, b.y);
             }
             first = false;
-            const double tNext = std::min(bMaxX, bMaxY);
-            if (tNext > tLen + kTieEps) break;
-            const double distM = (t0 + tNext - 1.5) * s - 2 * kCellMargin;  // nearest point of any later cell
-            if (best > 0 && distM > 0 && (zTop - eye.z) / distM < best) break;
-            if (distM > maxDistance) break;
+            const double tNext = b.next();
+            if (tNext > tLen + kTieEps || laterCellsLose(tNext)) break;
             tIn = tNext;
-            if (std::abs(bMaxX - bMaxY) <= kTieEps * std::max(1.0, tNext)) {
-                // Through a block corner: the four cells around it touch the ray.
-                const int qx = dx > 0 ? (bx + 1) * B : bx * B, qy = dy > 0 ? (by + 1) * B : by * B;
-                visit(qx - 1, qy - 1);
-                visit(qx, qy - 1);
-                visit(qx - 1, qy);
-                visit(qx, qy);
-                bx += stepX;
-                by += stepY;
-                bMaxX += bDeltaX;
-                bMaxY += bDeltaY;
-            } else if (bMaxX < bMaxY) {
-                bx += stepX;
-                bMaxX += bDeltaX;
-            } else {
-                by += stepY;
-                bMaxY += bDeltaY;
-            }
+            if (b.corner()) visitAround(b.stepX > 0 ? (b.x + 1) * B : b.x * B, b.stepY > 0 ? (b.y + 1) * B : b.y * B);
+            b.advance();
         }
     };
     // Start cell: the cell the ray enters just after t0.
