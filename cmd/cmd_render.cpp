@@ -8,8 +8,13 @@
 // far plane; pixels the mode took from the far field (hybrid: uncovered, or
 // beyond its near distance) are labelled by Embree rays cast per frame
 // (runtime/engine/ground_truth.h). The colour cache of hybrid applies to rgb only.
-// Output goes into "<out>.tmp.<pid>" next to <out> and is renamed to <out>
-// when every frame is written: a failed run leaves nothing behind.
+// Output goes into the work directory "<out>.partial" (cmd/render_work_dir.h):
+// every frame's files are written atomically, then its record; a rerun of the
+// same command after an interruption keeps the finished frames and renders
+// the rest (hybrid first re-renders the finished frames before the last
+// missing one without writing them, so that its panoramic cache holds what
+// an uninterrupted run's held); "<out>.partial/out" is renamed to <out> when
+// every frame is written.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -17,6 +22,10 @@
 #include <memory>
 #include <string>
 #include <vector>
+
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
 
 #include <unistd.h>
 
@@ -26,7 +35,9 @@
 #include "cmd/cli.h"
 #include "cmd/commands.h"
 #include "cmd/options.h"
+#include "cmd/render_work_dir.h"
 #include "foundation/atomic_file.h"
+#include "foundation/hash.h"
 #include "foundation/progress.h"
 #include "foundation/statistics.h"
 #include "foundation/timing.h"
@@ -52,7 +63,7 @@ struct RenderArgs {
     std::string city, size = "640x480", mode = "full", out, channels = "rgb,depth,semantic,instance", fov = "60";
     std::string sampling = "spread";
     int frames = 60;
-    bool stats = false, quiet = false;
+    bool stats = false, quiet = false, restart = false;
     PathFlags path;
     ModeFlags modeFlags;
 };
@@ -78,51 +89,6 @@ std::string frameName(size_t f) {
     std::snprintf(b, sizeof b, "%06zu", f);
     return b;
 }
-
-// The output directory: "<out>.tmp.<pid>" beside it, renamed at the end.
-struct Staging {
-    fs::path out, tmp;
-    bool active = false;
-    ~Staging() {
-        if (!active) return;
-        std::error_code ec;
-        fs::remove_all(tmp, ec);
-    }
-    Status begin(const std::string& dir) {
-        out = fs::path(dir).lexically_normal();
-        if (!out.has_filename()) out = out.parent_path();
-        if (out.empty()) return Status::error("--out: empty directory name");
-        std::error_code ec;
-        if (fs::exists(out, ec)) {
-            if (!fs::is_directory(out, ec)) return Status::error("--out '" + dir + "' exists and is not a directory");
-            if (!fs::is_empty(out, ec)) return Status::error("--out '" + dir + "' exists and is not empty (choose a new directory)");
-        }
-        const fs::path parent = out.has_parent_path() ? out.parent_path() : fs::path(".");
-        if (!fs::is_directory(parent, ec)) return Status::error("--out '" + dir + "': parent directory '" + parent.string() + "' does not exist");
-        tmp = fs::path(out.string() + ".tmp." + std::to_string(getpid()));
-        fs::remove_all(tmp, ec);
-        if (!fs::create_directory(tmp, ec) || ec)
-            return Status::error("--out '" + dir + "': cannot create a directory in '" + parent.string() + "': " +
-                                 (ec ? ec.message() : std::string("unknown error")));
-        active = true;
-        if (access(tmp.c_str(), W_OK) != 0) return Status::error("--out '" + dir + "': directory is not writable");
-        return Status::ok();
-    }
-    Status subdir(const char* name) {
-        std::error_code ec;
-        fs::create_directories(tmp / name, ec);
-        return ec ? Status::error("--out: cannot create '" + (tmp / name).string() + "': " + ec.message()) : Status::ok();
-    }
-    std::string file(const std::string& rel) const { return (tmp / rel).string(); }
-    Status commit() {
-        std::error_code ec;
-        if (fs::exists(out, ec)) fs::remove(out, ec);  // an empty directory (checked at the start)
-        fs::rename(tmp, out, ec);
-        if (ec) return Status::error("--out '" + out.string() + "': cannot rename the finished output into place: " + ec.message());
-        active = false;
-        return Status::ok();
-    }
-};
 
 // A frame's eye may stand this far outside the city square (streets run up
 // to its border and a vehicle drives beside their centre line).
@@ -173,7 +139,91 @@ nlohmann::json cameraFromWorld(const Camera& c, const glm::dvec3& offset) {
 
 struct Timings {
     std::vector<double> rgb, labelRaster, labelRays, labels, writeRgb, writeDepth, writeSemantic, writeInstance, farPixels;
+    // The frame's record in the work directory (its costs, measured when it was rendered).
+    static nlohmann::json record(const Timings& t) {
+        nlohmann::json r = nlohmann::json::object();
+        auto put = [&](const char* k, const std::vector<double>& v) {
+            if (!v.empty()) r[k] = v.back();
+        };
+        put("rgb", t.rgb), put("labels_raster_pass", t.labelRaster), put("labels_far_rays", t.labelRays);
+        put("labels_total", t.labels), put("write_rgb", t.writeRgb), put("write_depth", t.writeDepth);
+        put("write_semantic", t.writeSemantic), put("write_instance", t.writeInstance), put("far_label_pixels", t.farPixels);
+        return r;
+    }
+    void add(const nlohmann::json& r) {
+        auto get = [&](const char* k, std::vector<double>& v) {
+            if (r.contains(k) && r[k].is_number()) v.push_back(r[k].get<double>());
+        };
+        get("rgb", rgb), get("labels_raster_pass", labelRaster), get("labels_far_rays", labelRays);
+        get("labels_total", labels), get("write_rgb", writeRgb), get("write_depth", writeDepth);
+        get("write_semantic", writeSemantic), get("write_instance", writeInstance), get("far_label_pixels", farPixels);
+    }
 };
+
+// Content hash of a file's bytes (hex), streamed.
+Result<std::string> fileHash(const std::string& path, uint64_t& bytes) {
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (!f) return Status::error("cannot read '" + path + "': " + errnoText());
+    Hasher64 h;
+    std::vector<unsigned char> buf(1 << 20);
+    bytes = 0;
+    size_t n;
+    while ((n = std::fread(buf.data(), 1, buf.size(), f)) > 0) {
+        h.update(buf.data(), n);
+        bytes += n;
+    }
+    const bool bad = std::ferror(f) != 0;
+    std::fclose(f);
+    if (bad) return Status::error("cannot read '" + path + "': read error");
+    char b[24];
+    std::snprintf(b, sizeof b, "%016llx", static_cast<unsigned long long>(h.finish()));
+    return std::string(b);
+}
+
+// Hash of the frames' camera poses (path index, time, eye, heading, pitch):
+// whatever chose them (--path file, --seed/--kind/--duration/--run-up,
+// --frames, --sampling), equal poses give equal frames.
+std::string posesHash(const Path& path, const std::vector<size_t>& idx) {
+    Hasher64 h;
+    auto put = [&](uint64_t v) {
+        unsigned char b[8];
+        storeLE64(b, v);
+        h.update(b, 8);
+    };
+    auto putD = [&](double d) {
+        uint64_t v;
+        std::memcpy(&v, &d, 8);
+        put(v);
+    };
+    for (size_t i : idx) {
+        const PathSample& s = path.samples[i];
+        put(i);
+        putD(s.t), putD(s.position.x), putD(s.position.y), putD(s.position.z), putD(s.heading), putD(s.pitch);
+    }
+    char b[24];
+    std::snprintf(b, sizeof b, "%016llx", static_cast<unsigned long long>(h.finish()));
+    return b;
+}
+
+std::string channelList(unsigned c) {
+    std::string s;
+    for (const auto& [bit, name] : {std::pair<unsigned, const char*>{kRgb, "rgb"}, {kDepth, "depth"}, {kSemantic, "semantic"}, {kInstance, "instance"}})
+        if (c & bit) s += (s.empty() ? "" : ",") + std::string(name);
+    return s;
+}
+
+std::string num(double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.17g", v);
+    return b;
+}
+
+// Test hook (docs/formats.md): VISTA_RENDER_KILL_AFTER_FRAMES=N makes the run
+// kill itself with SIGKILL after it finished N frames, as an interruption would.
+long killAfterFrames() {
+    const char* e = std::getenv("VISTA_RENDER_KILL_AFTER_FRAMES");
+    return e && *e ? std::atol(e) : 0;
+}
 
 nlohmann::json medianOf(const std::vector<double>& v) { return v.empty() ? nlohmann::json(nullptr) : nlohmann::json(median(v)); }
 
@@ -196,8 +246,8 @@ int run(RenderArgs& a, const std::string& command) {
     auto po = parsePathFlags(a.path);
     if (!po) return reportBadInput(kCmd, po.status());
     if (!fs::exists(a.city)) return reportBadInput(kCmd, Status::error("city file '" + a.city + "' does not exist"));
-    Staging out;
-    if (Status s = out.begin(a.out); !s) return reportBadInput(kCmd, s);
+    RenderWorkDir out;
+    if (Status s = out.checkOut(a.out); !s) return reportBadInput(kCmd, s);
 
     // ---- city, path ------------------------------------------------------------
     auto city = loadCityFile(a.city);
@@ -215,6 +265,20 @@ int run(RenderArgs& a, const std::string& command) {
     auto fx = runTimeEffects("", city->params.effects, true, kCmd);
     if (!fx) return reportBadInput(kCmd, fx.status());
     mo.effects = *fx;
+
+    // ---- work directory: new, or the one of an interrupted run with the same parameters ----
+    uint64_t cityBytes = 0;
+    auto cityHash = fileHash(a.city, cityBytes);
+    if (!cityHash) return reportBadInput(kCmd, cityHash.status());
+    const nlohmann::json manifest = {
+        {"city_hash", *cityHash}, {"city_bytes", cityBytes},
+        {"frames", idx.size()}, {"camera_poses_hash", posesHash(*path, idx)},
+        {"size", std::to_string(size->width) + "x" + std::to_string(size->height)}, {"fov_deg", num(*fov)},
+        {"mode", a.mode}, {"channels", channelList(*channels)},
+        {"near", num(mo.nearDistance)}, {"triangle_budget", mo.triangleBudget}, {"pixel_budget", mo.pixelBudget},
+        {"horizon_grid", mo.horizonGrid}, {"cache", mo.cache}, {"cache_error_px", num(mo.cacheErrorPx)},
+        {"frame_ms", num(mo.frameMsTarget)}, {"far_step", mo.farStep}};
+    if (Status s = out.open(manifest, a.restart); !s) return reportBadInput(kCmd, s);
     for (const char* d : {"rgb", "depth", "semantic", "instance"}) {
         const unsigned c = std::string(d) == "rgb" ? kRgb : std::string(d) == "depth" ? kDepth : std::string(d) == "semantic" ? kSemantic : kInstance;
         if (*channels & c)
@@ -254,10 +318,35 @@ int run(RenderArgs& a, const std::string& command) {
     const glm::dvec3 offset(city->params.origin_x, city->params.origin_y, 0.0);
     const double fy = 0.5 * base.height / std::tan(0.5 * base.fovY);
     nlohmann::json frames = nlohmann::json::array();
-    Timings tm;
     std::unique_ptr<Progress> progress;
     if (!a.quiet) progress = std::make_unique<StderrProgress>(isatty(2));
-    if (progress) progress->begin("render " + std::to_string(idx.size()) + " frames (" + a.mode + ")");
+    // Finished frames (record and every channel file present) are kept. The
+    // hybrid mode carries state from frame to frame (panoramic cache, adaptive
+    // split): it re-renders the finished frames before the last missing one
+    // (rgb only, nothing written) so that every frame it writes sees the state
+    // of an uninterrupted run.
+    std::vector<nlohmann::json> records(idx.size());
+    long lastMissing = -1;
+    size_t kept = 0;
+    for (size_t f = 0; f < idx.size(); ++f) {
+        if (out.resumed()) {
+            records[f] = out.frameRecord(f);
+            const std::string name = frameName(f);
+            for (const auto& [bit, file] : {std::pair<unsigned, std::string>{kRgb, "rgb/" + name + ".png"}, {kDepth, "depth/" + name + ".npy"},
+                                            {kSemantic, "semantic/" + name + ".png"}, {kInstance, "instance/" + name + ".npy"}})
+                if (!records[f].is_null() && (*channels & bit) && !fs::exists(out.file(file))) records[f] = nullptr;
+        }
+        if (records[f].is_null())
+            lastMissing = long(f);
+        else
+            ++kept;
+    }
+    const bool stateful = a.mode == "hybrid";
+    const long killAfter = killAfterFrames();
+    long finishedNow = 0;
+    if (progress)
+        progress->begin("render " + std::to_string(idx.size()) + " frames (" + a.mode + ")" +
+                        (kept ? ", resuming: " + std::to_string(kept) + " done" : std::string()));
 
     // ---- frames ------------------------------------------------------------------
     Image img;
@@ -266,8 +355,20 @@ int run(RenderArgs& a, const std::string& command) {
     std::vector<uint32_t> far;
     for (size_t f = 0; f < idx.size(); ++f) {
         const Camera cam = path->camera(idx[f], base);
+        const PathSample& ps = path->samples[idx[f]];
+        frames.push_back({{"frame", f}, {"name", frameName(f)}, {"path_index", idx[f]}, {"t_s", ps.t},
+                          {"eye_world", {ps.position.x, ps.position.y, ps.position.z}},
+                          {"heading_deg", radToDeg(ps.heading)}, {"pitch_deg", radToDeg(ps.pitch)},
+                          {"camera_from_world", cameraFromWorld(cam, offset)}});
+        const bool done = !records[f].is_null();
+        if (done && !(stateful && long(f) < lastMissing)) continue;
         FrameStats st;
         if (Status s = (*mode)->renderFrame(cam, img, st); !s) return fail(Status::error("frame " + std::to_string(f) + ": " + s.message()));
+        if (done) {  // hybrid warm-up: the state, not the image
+            if (progress) progress->update(double(f + 1) / double(idx.size()));
+            continue;
+        }
+        Timings tm;
         tm.rgb.push_back(st.frameMs);
         const std::string name = frameName(f);
         if (labels) {
@@ -321,14 +422,14 @@ int run(RenderArgs& a, const std::string& command) {
             if (Status s = writeFileAtomic(out.file("instance/" + name + ".npy"), npyBytes(gt.ids.data(), gt.width, gt.height)); !s) return fail(s);
             tm.writeInstance.push_back(w.lap());
         }
-        const PathSample& ps = path->samples[idx[f]];
-        frames.push_back({{"frame", f}, {"name", name}, {"path_index", idx[f]}, {"t_s", ps.t},
-                          {"eye_world", {ps.position.x, ps.position.y, ps.position.z}},
-                          {"heading_deg", radToDeg(ps.heading)}, {"pitch_deg", radToDeg(ps.pitch)},
-                          {"camera_from_world", cameraFromWorld(cam, offset)}});
+        records[f] = Timings::record(tm);
+        if (Status s = out.finishFrame(f, records[f]); !s) return fail(s);
+        if (killAfter > 0 && ++finishedNow == killAfter) std::raise(SIGKILL);
         if (progress) progress->update(double(f + 1) / double(idx.size()));
     }
     if (progress) progress->end();
+    Timings tm;  // every frame's, whichever run rendered it
+    for (const auto& r : records) tm.add(r);
 
     // ---- metadata, commit ----------------------------------------------------------
     const nlohmann::json cameras = {
@@ -355,8 +456,10 @@ int run(RenderArgs& a, const std::string& command) {
           {"write_semantic", medianOf(tm.writeSemantic)},
           {"write_instance", medianOf(tm.writeInstance)}}},
         {"median_far_label_pixels", medianOf(tm.farPixels)},
+        {"frames_resumed", kept},
         {"note", "depth, semantic and instance come from one label pass (+ far-field rays in hybrid): their cost is "
-                 "labels_total, shared; write_* is encoding and writing the files"}};
+                 "labels_total, shared; write_* is encoding and writing the files; medians over every frame, each timed "
+                 "by the run that rendered it (frames_resumed: frames an interrupted run had finished)"}};
     for (const auto& [file, j] : {std::pair<const char*, const nlohmann::json*>{"cameras.json", &cameras},
                                   {"summary.json", &summary}}) {
         if (Status s = writeFileAtomic(out.file(file), j->dump(2) + "\n"); !s) return fail(s);
@@ -364,7 +467,7 @@ int run(RenderArgs& a, const std::string& command) {
     if (Status s = writeFileAtomic(out.file("classes.json"), classesJson().dump(2) + "\n"); !s) return fail(s);
     if (Status s = out.commit(); !s) return fail(s);
     if (a.stats || !a.quiet) {
-        std::printf("%s: %zu frames, %s, %dx%d -> %s\n", kCmd, idx.size(), a.mode.c_str(), base.width, base.height, out.out.c_str());
+        std::printf("%s: %zu frames, %s, %dx%d -> %s\n", kCmd, idx.size(), a.mode.c_str(), base.width, base.height, out.outPath().c_str());
         if (a.stats) {
             auto p = [](const char* what, const std::vector<double>& v) {
                 if (!v.empty()) std::printf("  %-22s %8.2f ms (median)\n", what, median(v));
@@ -398,7 +501,9 @@ int runRender(int argc, char** argv) {
     app.add_option("--mode", a.mode, "render mode: full (every triangle rasterised) or hybrid (near field + ray-cast far field) (default full)");
     app.add_option("--channels", a.channels, "comma-separated channels: rgb, depth, semantic, instance (default all)");
     addModeFlags(app, a.modeFlags);
-    app.add_option("--out", a.out, "output directory (must not exist or be empty; written atomically)")->required();
+    app.add_option("--out", a.out, "output directory (must not exist or be empty; its parent must exist); work goes into "
+                                    "OUT.partial and a rerun of the same command resumes it")->required();
+    app.add_flag("--restart", a.restart, "discard the work directory (OUT.partial) of an interrupted run and start over");
     app.add_flag("--stats", a.stats, "print the median per-channel costs (also in OUT/summary.json)");
     app.add_flag("-q,--quiet", a.quiet, "no progress on stderr");
     if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates the counts table of docs/formats.md "OpenDRIVE": the default city
-# (data/default.json) and an OSM import (tests/data/osm/hard_cases.osm) are
+# (data/default.json) and two OSM imports (tests/data/osm/hard_cases.osm and the
+# synthetic town tests/data/osm/town.osm with its building footprints) are
 # written with --xodr, read by SUMO netconvert, and their roads, junctions and
 # lanes counted on both sides. Prints the Markdown table on stdout.
 # Usage: docs/tools/opendrive_table.sh [OUT_DIR] [VISTA_BINARY]
@@ -41,8 +42,12 @@ netconvert --opendrive-files "$OUT/default.xodr" -o "$OUT/default.net.xml" >"$OU
 log "OSM import"
 "$VISTA" gen --osm tests/data/osm/hard_cases.osm -q -o "$OUT/osm.osgb" --xodr "$OUT/osm.xodr"
 netconvert --opendrive-files "$OUT/osm.xodr" -o "$OUT/osm.net.xml" >"$OUT/osm.log" 2>&1
+log "OSM town"
+"$VISTA" gen --osm tests/data/osm/town.osm -q -o "$OUT/town.osgb" --xodr "$OUT/town.xodr"
+netconvert --opendrive-files "$OUT/town.xodr" -o "$OUT/town.net.xml" >"$OUT/town.log" 2>&1
 echo "| city | roads | junctions | connecting roads | driving lanes | sidewalk lanes | netconvert junctions | netconvert edges | netconvert lanes | netconvert errors | netconvert warnings |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|"
 row "default (\`data/default.json\`)" "$OUT/default.xodr" "$OUT/default.log" "$OUT/default.net.xml"
 row "OSM import (\`tests/data/osm/hard_cases.osm\`)" "$OUT/osm.xodr" "$OUT/osm.log" "$OUT/osm.net.xml"
+row "OSM town (\`tests/data/osm/town.osm\`, streets + buildings)" "$OUT/town.xodr" "$OUT/town.log" "$OUT/town.net.xml"
 log "done"

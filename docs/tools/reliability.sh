@@ -135,6 +135,12 @@ print("- kill -9 at four points of `vista bake` (loading, first cell result, 10 
       "write), each triggered by the event, not a delay: the older output stays byte-identical and the work directory "
       "holds only whole cell results; the next run reuses them all and writes the bytes of an uninterrupted bake "
       "(BakeFaults.KillNineLeavesTheOldOutputOrTheWholeNewOneAndTheNextRunResumes).")
+print("- kill -9 of `vista render` after N finished frames (test hook `VISTA_RENDER_KILL_AFTER_FRAMES`, and a real "
+      "SIGKILL from the test once two frame records exist): no `DIR` appears, `DIR.partial` holds whole frames; "
+      "rerunning the command writes the bytes of an uninterrupted run, full and hybrid with its cache rebuilt "
+      "(GroundTruth.FullResumesAfterKillByteIdentical, HybridResumesAfterKillByteIdentical, ExternalKillThenResume); "
+      "other parameters are refused naming the field, or discarded with `--restart` "
+      "(ResumeWithOtherParametersIsRefusedOrRestarted).")
 print("- Disk full (a 2 MB tmpfs; the tests run as root, else they skip and say why): `vista gen` (also with a .glb that "
       "does not fit after the city and GeoJSON did) and `vista bake` (output or work directory on the full disk) exit 2 "
       "with 'No space left on device'; the older output stays, no output or temporary file is left, and whole cell "

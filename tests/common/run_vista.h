@@ -1,9 +1,11 @@
 // Test helpers that run the built `vista` tool (VISTA_BINARY, a build
 // dependency of every test executable) as a child process.
 //
-// runVista(): one whole run through the shell (`args` is a shell word list);
-// returns the exit code (-1 when it did not exit normally, e.g. killed) and
-// what it wrote to stderr; stdout is discarded.
+// runVista(): one whole run through the shell (`args` is a shell word list;
+// `env`, if given, is "NAME=value ..." set for that run only); returns the
+// exit code (-1 when it did not exit normally, e.g. killed; a shell may
+// report a killed child as 128 + signal instead) and what it wrote to
+// stderr; stdout is discarded.
 // startVista(): starts a run without a shell and returns its pid at once (for
 // tests that kill it); stdout and stderr go to /dev/null. The caller waits for it.
 // expectRefusedBeforeTheInput(): for a run whose input is not a valid file
@@ -31,10 +33,10 @@ struct CliRun {
     std::string err;
 };
 
-inline CliRun runVista(const std::string& args) {
+inline CliRun runVista(const std::string& args, const std::string& env = "") {
     TempDir tmp("vista_cli_err");
     const std::string errFile = tmp.file("stderr.txt");
-    const int st = std::system((std::string(VISTA_BINARY) + " " + args + " 2>" + errFile + " >/dev/null").c_str());
+    const int st = std::system(((env.empty() ? std::string() : env + " ") + std::string(VISTA_BINARY) + " " + args + " 2>" + errFile + " >/dev/null").c_str());
     CliRun r;
     r.code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
     r.err = readBytes(errFile);

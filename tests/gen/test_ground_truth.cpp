@@ -3,18 +3,27 @@
 // full and hybrid, instance ids byte-identical across runs, every pixel
 // classified, cameras.json projecting a depth-hit point back to its pixel,
 // and bad input (path outside the city, unknown channel, unwritable --out)
-// refused with exit code 2 and nothing left behind. Rendering: needs DISPLAY
+// refused with exit code 2 and nothing left behind; interrupted runs (killed
+// with SIGKILL) resume to the bytes of an uninterrupted run (full; hybrid with
+// its cache rebuilt), a work directory of other parameters is refused (exit 2,
+// the field named) or discarded with --restart. Rendering: needs DISPLAY
 // (ctest runs under xvfb-run).
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+
+#include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -284,6 +293,126 @@ TEST_F(GroundTruth, OldFileWithoutLabelsAsksToRegenerate) {
     r = runVista("render " + old + " --path " + pathCsv + " --frames 1 --size 64x48 --channels rgb,depth -q --out " + dir->file("old_rgb"));
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(fs::exists(dir->file("old_rgb/depth/000000.npy")));
+}
+
+// Every file under `dir` (relative path -> bytes) but summary.json (timings, command).
+std::map<std::string, std::string> outputFiles(const std::string& dir) {
+    std::map<std::string, std::string> m;
+    for (const auto& e : fs::recursive_directory_iterator(dir))
+        if (e.is_regular_file() && e.path().filename() != "summary.json")
+            m[fs::relative(e.path(), dir).string()] = test::readBytes(e.path().string());
+    return m;
+}
+
+// A run killed (SIGKILL, through the documented test hook) after `killAfter`
+// frames, then rerun with the same arguments: the result equals an
+// uninterrupted run byte for byte (all but summary.json's timings).
+void expectResumeEqualsUninterrupted(const std::string& city, const std::string& args, const std::string& ref,
+                                     const std::string& out, int killAfter, int frames) {
+    auto r = runVista("render " + city + " " + args + " -q --out " + ref);
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = runVista("render " + city + " " + args + " -q --out " + out, "VISTA_RENDER_KILL_AFTER_FRAMES=" + std::to_string(killAfter));
+    ASSERT_TRUE(r.code == -1 || r.code == 128 + SIGKILL) << "the hook kills the run: " << r.code << " " << r.err;
+    EXPECT_FALSE(fs::exists(out)) << "no output before every frame is written";
+    int records = 0;
+    for (const auto& e : fs::directory_iterator(out + ".partial/done")) records += e.path().extension() == ".json";
+    EXPECT_EQ(records, killAfter);
+    r = runVista("render " + city + " " + args + " -q --out " + out);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_FALSE(fs::exists(out + ".partial")) << "the work directory is gone after the final rename";
+    const auto a = outputFiles(ref), b = outputFiles(out);
+    EXPECT_EQ(a.size(), b.size());
+    for (const auto& [name, bytes] : a) {
+        auto it = b.find(name);
+        ASSERT_NE(it, b.end()) << name;
+        EXPECT_TRUE(it->second == bytes) << name << " differs after resuming";
+    }
+    const auto summary = nlohmann::json::parse(test::readBytes(out + "/summary.json"));
+    EXPECT_EQ(summary["frames"].get<int>(), frames);
+    EXPECT_EQ(summary["frames_resumed"].get<int>(), killAfter);
+    EXPECT_FALSE(summary["median_ms"]["labels_total"].is_null()) << "timings cover the resumed frames too";
+}
+
+TEST_F(GroundTruth, FullResumesAfterKillByteIdentical) {
+    expectResumeEqualsUninterrupted(city, "--path " + pathCsv + " --frames 5 --size 160x120", dir->file("res_full_ref"),
+                                    dir->file("res_full"), 2, 5);
+}
+
+TEST_F(GroundTruth, HybridResumesAfterKillByteIdentical) {
+    // Consecutive frames and a small ray budget: most far pixels come from the
+    // panoramic cache, so frame k depends on frames before it (without the
+    // warm-up of the resumed run, frames 3 and 4 differ in rgb).
+    expectResumeEqualsUninterrupted(city,
+                                    "--path " + pathCsv + " --frames 5 --sampling consecutive --size 160x120 --mode hybrid --near 40 --budget 500",
+                                    dir->file("res_hyb_ref"), dir->file("res_hyb"), 3, 5);
+}
+
+TEST_F(GroundTruth, ExternalKillThenResume) {
+    // A real SIGKILL from outside once two frames are finished.
+    const std::string ref = dir->file("kill_ref"), out = dir->file("kill");
+    const std::vector<std::string> args = {"render", city, "--path", pathCsv, "--frames", "24", "--size", "96x72", "--channels", "rgb,depth", "-q", "--out", out};
+    const pid_t pid = test::startVista(args);
+    ASSERT_GT(pid, 0);
+    bool killed = false;
+    for (int i = 0; i < 60000 && !killed; ++i) {
+        std::error_code ec;
+        size_t n = 0;
+        for (fs::directory_iterator it(out + ".partial/done", ec), end; !ec && it != end; it.increment(ec)) ++n;
+        if (n >= 2) killed = ::kill(pid, SIGKILL) == 0;
+        else std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        int st = 0;
+        if (!killed && ::waitpid(pid, &st, WNOHANG) == pid) break;  // ended on its own (should not happen)
+    }
+    int st = 0;
+    if (killed) ::waitpid(pid, &st, 0);
+    ASSERT_TRUE(killed) << "the run ended before two frames were seen";
+    EXPECT_FALSE(fs::exists(out));
+    std::string rerun;
+    for (const auto& w : args) rerun += w + " ";
+    auto r = runVista(rerun);
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = runVista("render " + city + " --path " + pathCsv + " --frames 24 --size 96x72 --channels rgb,depth -q --out " + ref);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(outputFiles(ref) == outputFiles(out));
+    EXPECT_FALSE(fs::exists(out + ".partial"));
+    for (const auto& e : fs::recursive_directory_iterator(out))
+        EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path();
+}
+
+TEST_F(GroundTruth, ResumeWithOtherParametersIsRefusedOrRestarted) {
+    const std::string out = dir->file("res_other"), ref = dir->file("res_other_ref");
+    const std::string base = "render " + city + " --path " + pathCsv + " --frames 3 --channels semantic -q --out " + out;
+    auto r = runVista(base + " --size 64x48", "VISTA_RENDER_KILL_AFTER_FRAMES=1");
+    ASSERT_TRUE(r.code == -1 || r.code == 128 + SIGKILL) << r.code << " " << r.err;
+    const std::set<std::string> before = test::listTree(out + ".partial");
+    r = runVista(base + " --size 80x60");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("size: 64x48 in the work directory, 80x60 now"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("--restart"), std::string::npos) << r.err;
+    EXPECT_EQ(test::listTree(out + ".partial"), before) << "refused: the work directory is untouched";
+    EXPECT_FALSE(fs::exists(out));
+    // Another city file (other bytes) is refused too.
+    const std::string other = dir->file("other_city.osgb");
+    ASSERT_EQ(runVista("gen --size 300 --seed 12 -q -o " + other).code, 0);
+    r = runVista("render " + other + " --path " + pathCsv + " --frames 3 --channels semantic -q --out " + out + " --size 64x48");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("city_"), std::string::npos) << r.err;  // city_bytes or city_hash
+    // --restart discards it and renders the new parameters.
+    r = runVista(base + " --size 80x60 --restart");
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = runVista("render " + city + " --path " + pathCsv + " --frames 3 --channels semantic -q --size 80x60 --out " + ref);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(outputFiles(ref) == outputFiles(out));
+    EXPECT_FALSE(fs::exists(out + ".partial"));
+}
+
+TEST_F(GroundTruth, MissingOutParentIsNamed) {
+    TempDir t("vista_gt_parent");
+    const std::string out = t.file("no/such/dir");
+    auto r = runVista("render " + city + " --path " + pathCsv + " --frames 1 --size 32x24 -q --out " + out);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("parent directory '" + t.file("no/such") + "' does not exist"), std::string::npos) << r.err;
+    EXPECT_TRUE(fs::is_empty(t.path()));
 }
 
 TEST(GroundTruthLabels, InstanceIdEncodingRoundTrips) {

@@ -1,6 +1,6 @@
 // OpenDRIVE export (citygen/opendrive.h) and the lane model (citygen/lanes.h):
 // - SUMO netconvert (a real consumer) reads the .xodr of a generated city and
-//   of an OSM import with 0 errors; its junctions and per-edge lane counts
+//   of OSM imports (hard_cases.osm, town.osm) with 0 errors; its junctions and per-edge lane counts
 //   match the street graph (skipped when netconvert is not installed);
 // - points on the lane centres, evaluated here from the XML (reference line +
 //   lane widths + elevation + superelevation), lie on the road mesh of the
@@ -340,6 +340,10 @@ TEST(OpenDrive, NetconvertReadsOddLaneCounts) { checkNet(oddLanes(smallParams(5,
 
 TEST(OpenDrive, NetconvertReadsOsmImport) { checkNet(osmCity("hard_cases.osm"), "osm hard_cases.osm"); }
 
+// The synthetic town (tests/data/osm/town.osm: a 7 x 7 street grid with
+// building footprints): many junctions, blocks with sidewalks on both sides.
+TEST(OpenDrive, NetconvertReadsOsmTown) { checkNet(osmCity("town.osm"), "osm town.osm"); }
+
 static void checkLaneCentres(const City& city, const std::string& label) {
     {
         auto xodr = openDriveXml(city.streets, city.params, &city.blocks);
@@ -421,6 +425,7 @@ TEST(OpenDrive, LaneCentresLieOnTheRoadMesh) {
     checkLaneCentres(generated(smallParams(7, 500, 0)), "generated, flat");
     checkLaneCentres(generated(smallParams(7, 500, 25)), "generated, hills 25 m / 500 m");
     checkLaneCentres(osmCity("hard_cases.osm"), "osm hard_cases.osm");
+    checkLaneCentres(osmCity("town.osm"), "osm town.osm");
     checkLaneCentres(oddLanes(smallParams(5, 400, 10)), "generated, odd lane counts, hills 10 m");
 }
 
