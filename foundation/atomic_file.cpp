@@ -6,6 +6,9 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <vector>
+#include <unordered_map>
+#include <mutex>
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -17,6 +20,34 @@ std::string errnoText() { return std::strerror(errno); }
 
 std::string tempPathFor(const std::string& path) { return path + ".tmp." + std::to_string(::getpid()); }
 
+namespace {
+
+// Per directory listed by this process: its names that look like temporaries.
+std::mutex gTempsMutex;
+std::unordered_map<std::string, std::vector<std::string>> gTempNames;
+
+// The pid of `f` if it is a temporary of `name` ("<name>.tmp.<pid>",
+// "<name>.stage.<pid>" or "<name>.stage.<pid>.tmp.<pid>"), else 0.
+long tempOwner(const std::string& f, const std::string& name) {
+    for (const char* tag : {".tmp.", ".stage."}) {
+        const std::string prefix = name + tag;
+        if (f.size() <= prefix.size() || f.compare(0, prefix.size(), prefix) != 0) continue;
+        std::string digits = f.substr(prefix.size());
+        // A staged file's own temporary: "<path>.stage.<pid>.tmp.<pid>".
+        const size_t inner = digits.find(".tmp.");
+        if (std::string(tag) == ".stage." && inner != std::string::npos) {
+            const std::string rest = digits.substr(inner + 5);
+            if (rest.empty() || rest.find_first_not_of("0123456789") != std::string::npos) continue;
+            digits = digits.substr(0, inner);
+        }
+        if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+        return std::stol(digits);
+    }
+    return 0;
+}
+
+}  // namespace
+
 int removeStaleTemps(const std::string& path) {
     namespace fs = std::filesystem;
     std::error_code ec;
@@ -24,25 +55,27 @@ int removeStaleTemps(const std::string& path) {
     const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
     const std::string name = p.filename().string();
     if (name.empty()) return 0;
+    std::lock_guard<std::mutex> lock(gTempsMutex);
+    auto it = gTempNames.find(dir.string());
+    if (it == gTempNames.end()) {
+        std::vector<std::string> names;
+        for (fs::directory_iterator d(dir, ec), end; !ec && d != end; d.increment(ec)) {
+            std::string f = d->path().filename().string();
+            if (f.find(".tmp.") != std::string::npos || f.find(".stage.") != std::string::npos) names.push_back(std::move(f));
+        }
+        it = gTempNames.emplace(dir.string(), std::move(names)).first;
+    }
     int removed = 0;
-    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
-        const std::string f = it->path().filename().string();
-        for (const char* tag : {".tmp.", ".stage."}) {
-            const std::string prefix = name + tag;
-            if (f.size() <= prefix.size() || f.compare(0, prefix.size(), prefix) != 0) continue;
-            std::string digits = f.substr(prefix.size());
-            // A staged file's own temporary: "<path>.stage.<pid>.tmp.<pid>".
-            const size_t inner = digits.find(".tmp.");
-            if (std::string(tag) == ".stage." && inner != std::string::npos) {
-                const std::string rest = digits.substr(inner + 5);
-                if (rest.empty() || rest.find_first_not_of("0123456789") != std::string::npos) continue;
-                digits = digits.substr(0, inner);
-            }
-            if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
-            const long pid = std::stol(digits);
-            if (pid <= 0 || pid == long(::getpid())) continue;
-            if (::kill(pid_t(pid), 0) == 0 || errno != ESRCH) continue;  // alive (or not ours to judge)
-            if (fs::remove(it->path(), ec)) ++removed;
+    std::vector<std::string>& names = it->second;
+    for (size_t k = 0; k < names.size();) {
+        const long pid = tempOwner(names[k], name);
+        const bool dead = pid > 0 && pid != long(::getpid()) && ::kill(pid_t(pid), 0) != 0 && errno == ESRCH;
+        if (dead && fs::remove(dir / names[k], ec)) ++removed;
+        if (dead) {
+            names[k] = std::move(names.back());
+            names.pop_back();
+        } else {
+            ++k;
         }
     }
     return removed;

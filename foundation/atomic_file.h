@@ -34,6 +34,11 @@ std::string errnoText();
 // "<path>.stage.<pid>" and "<path>.stage.<pid>.tmp.<pid>" whose process no longer exists (kill(pid, 0) fails
 // with ESRCH). Files of live processes (a concurrent writer) are kept.
 // Returns how many were removed. Called by every writer before it writes.
+// A directory is listed once per process (its names that look like
+// temporaries are remembered), so that writing N files into one directory
+// costs N lookups, not N listings; a leftover that appears after that first
+// listing (a run killed while this one goes on) is left for the next run.
+// Thread-safe.
 int removeStaleTemps(const std::string& path);
 
 // Several outputs of one command committed together or not at all: write each
