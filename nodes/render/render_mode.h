@@ -1,5 +1,5 @@
 // RenderMode: one way of drawing a walkthrough frame (full, near, raycast,
-// osgimpostor, osglod, hybrid, impostor), written once, in nodes/render/
+// osgimpostor, osglod, hybrid, impostor, lodmesh), written once, in nodes/render/
 // mode_<name>.{h,cpp}, and used by both programs through this registry:
 //   `vista bench` times renderFrame() through the shared OffscreenRenderer;
 //   `vista view`  draws viewerScene() in its window, calling
@@ -176,7 +176,7 @@ struct ModeInfo {
     bool needsBaked;      // needs a baked scene or options.bakedFile
     ModeFactory make;
 };
-// Every mode, in display order: full, near, raycast, osgimpostor, osglod, hybrid, impostor.
+// Every mode, in display order: full, near, raycast, osgimpostor, osglod, hybrid, impostor, lodmesh.
 const std::vector<ModeInfo>& renderModes();
 const ModeInfo* findRenderMode(const std::string& name);
 // "full, near, raycast, ..." (for messages and help).
