@@ -34,14 +34,16 @@ Result<std::unique_ptr<RenderMode>> makeLodMeshMode(ModeContext& ctx) {
     osg::ref_ptr<ViewCellSwitch> root = isMeshBake(ctx.scene) ? dynamic_cast<ViewCellSwitch*>(ctx.scene) : nullptr;
     SetupTimes setup;
     if (!root) {
-        if (ctx.options.bakedFile.empty())
-            return Status::error("mode lodmesh: the city has no textured depth meshes; open or pass (--baked) a file from "
+        const std::string file = !ctx.options.bakedMeshFile.empty() ? ctx.options.bakedMeshFile : ctx.options.bakedFile;
+        if (file.empty())
+            return Status::error("mode lodmesh: the city has no textured depth meshes; open or pass (--baked-mesh) a file from "
                                  "'vista bake --representation mesh'");
         Stopwatch sw;
-        auto bf = loadBakedFile(ctx.options.bakedFile);
+        auto bf = loadBakedFile(file);
         if (!bf) return bf.status();
         if (!bf->meshes)
-            return Status::error("mode lodmesh: '" + ctx.options.bakedFile + "' holds point impostors; bake with --representation mesh");
+            return Status::error("mode lodmesh: '" + file + "' holds point impostors; pass --baked-mesh with a file from "
+                                 "'vista bake --representation mesh'");
         root = bf->root;
         setup.push_back({"baked_load", sw.ms()});
     }

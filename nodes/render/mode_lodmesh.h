@@ -5,9 +5,10 @@
 // fallback), so the far field is always a mesh.
 //
 // Contract: the mesh bake is ctx.scene when that is the root of a mesh bake
-// (isMeshBake), else ctx.options.bakedFile when that file is a mesh bake
-// (loaded and checked by loadBakedFile; set-up cost "baked_load"); neither ->
-// error naming --representation mesh. Notes per frame: "cell N (K meshes)".
+// (isMeshBake), else ctx.options.bakedMeshFile (--baked-mesh), else
+// ctx.options.bakedFile (--baked), which must then be a mesh bake (loaded and
+// checked by loadBakedFile; set-up cost "baked_load"); none or a point bake ->
+// error naming --baked-mesh and --representation mesh. Notes per frame: "cell N (K meshes)".
 // Viewer: the same ViewCellSwitch, infinite far plane. All meshes are
 // resident once the file is loaded (no per-cell streaming or prefetch).
 #pragma once

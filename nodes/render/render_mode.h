@@ -60,6 +60,7 @@ struct ModeOptions {
     int farStep = 1;              // hybrid: far-field ray spacing, 1 (a ray per pixel) or 2 (FarFieldOptions::rayStep)
     int threads = 0;              // ray-casting threads; 0 = all cores
     std::string bakedFile;        // impostor: the baked file (unless the scene itself is baked)
+    std::string bakedMeshFile;    // lodmesh: the mesh bake (unless the scene itself is one)
     FrameEffects effects;         // run-time effects of every mode (haze, glass reflections, night sky)
     // The near distance of modes without an adaptive split.
     double fixedNearDistance() const { return nearDistance > 0 ? nearDistance : kDefaultNearDistance; }
