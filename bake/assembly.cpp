@@ -7,12 +7,14 @@
 #include <osg/UserDataContainer>
 
 #include "nodes/point_impostor.h"
+#include "nodes/textured_depth_mesh.h"
 #include "runtime/scene/scene_graph.h"
 
 namespace vista {
 
 osg::ref_ptr<ViewCellSwitch> assembleBakedScene(const SceneModel& city, const std::vector<ViewCell>& cells,
-                                                const std::vector<CellResult>& results, const std::string& paramsText) {
+                                                const std::vector<CellResult>& results, const std::string& paramsText,
+                                                BakeRepresentation representation) {
     osg::ref_ptr<ViewCellSwitch> root = new ViewCellSwitch;
     root->setName("vista.city");
     osg::Group* cityRoot = sceneRoot(city) ? sceneRoot(city)->asGroup() : nullptr;
@@ -25,6 +27,7 @@ osg::ref_ptr<ViewCellSwitch> assembleBakedScene(const SceneModel& city, const st
     root->setTileCount(root->getNumChildren());
     root->setUserValue("vista.baked", 1);
     root->setUserValue("vista.bake_params", paramsText);
+    if (representation == BakeRepresentation::Mesh) root->setUserValue("vista.bake_representation", std::string("mesh"));
     // Cell ids are edge ids; the switch is indexed by edge id (absent edges get empty boxes).
     uint32_t maxId = 0;
     for (const auto& c : cells) maxId = std::max(maxId, c.id + 1);
@@ -50,6 +53,25 @@ osg::ref_ptr<ViewCellSwitch> assembleBakedScene(const SceneModel& city, const st
             imps[im.cell].push_back(root->getNumChildren());
             root->addChild(xf.get());
             hidden[im.cell].insert(hidden[im.cell].end(), im.hiddenTiles.begin(), im.hiddenTiles.end());
+        }
+        for (const MeshResult& mr : cr.meshes) {
+            if (mr.cell >= maxId) continue;
+            osg::ref_ptr<osg::MatrixTransform> xf = new osg::MatrixTransform;
+            xf->setName("lodmesh_" + std::to_string(mr.cell) + "_" + std::to_string(int(mr.end)));
+            xf->setDataVariance(osg::Object::DYNAMIC);
+            const ImpostorFrame& f = mr.frame;
+            xf->setMatrix(osg::Matrixd(f.x.x, f.x.y, 0, 0, -f.x.y, f.x.x, 0, 0, 0, 0, 1, 0, f.origin.x, f.origin.y, f.origin.z, 1));
+            osg::ref_ptr<osg::Geode> geode = new osg::Geode;
+            osg::ref_ptr<TexturedDepthMesh> tm = new TexturedDepthMesh;
+            tm->setName(xf->getName());
+            tm->setCellId(mr.cell);
+            tm->setEnd(int(mr.end));
+            tm->setData(mr.mesh);
+            geode->addDrawable(tm.get());
+            xf->addChild(geode.get());
+            imps[mr.cell].push_back(root->getNumChildren());
+            root->addChild(xf.get());
+            hidden[mr.cell].insert(hidden[mr.cell].end(), mr.hiddenTiles.begin(), mr.hiddenTiles.end());
         }
     }
     for (uint32_t c = 0; c < maxId; ++c) {

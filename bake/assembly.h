@@ -7,7 +7,11 @@
 // order (MatrixTransform "impostor_C_E" holding the impostor frame -> Geode ->
 // PointImpostor). The switch is indexed by cell id (= street edge id); ids
 // without a cell get an empty box. Results for cell ids beyond `cells` are
-// ignored. Contract: `results` sorted by cell id (output bytes then depend
+// ignored. Representation Mesh: the per-cell children are the textured
+// depth meshes instead (MatrixTransform "lodmesh_C_E" -> Geode ->
+// TexturedDepthMesh), registered in the same per-cell lists, and the root
+// carries vista.bake_representation = "mesh" (a point bake has no such value,
+// so its bytes are unchanged). Contract: `results` sorted by cell id (output bytes then depend
 // only on the results). A hand-built city (no scene graph) gives a switch
 // without tiles.
 #pragma once
@@ -16,6 +20,7 @@
 
 #include <osg/ref_ptr>
 
+#include "bake/bake_params.h"
 #include "bake/cell_result.h"
 #include "bake/view_cells.h"
 #include "nodes/view_cell_switch.h"
@@ -24,6 +29,7 @@
 namespace vista {
 
 osg::ref_ptr<ViewCellSwitch> assembleBakedScene(const SceneModel& city, const std::vector<ViewCell>& cells,
-                                                const std::vector<CellResult>& results, const std::string& paramsText);
+                                                const std::vector<CellResult>& results, const std::string& paramsText,
+                                                BakeRepresentation representation = BakeRepresentation::Points);
 
 }  // namespace vista

@@ -95,7 +95,70 @@ Status bakeImpostor(const TriangleSoup& soup, const Box3& cellBox, const BakePar
     return Status::ok();
 }
 
+Status bakeMeshEnd(const TriangleSoup& soup, const Box3& cellBox, const BakeParams& p, MeshResult& r) {
+    r.stats.farTriangles = soup.triangleCount();
+    SoupSceneOptions so;
+    so.cullBackFaces = true;  // as the rasteriser draws the far field
+    auto scene = RayScene::build(soup, so);
+    if (!scene) return scene.status();
+    const int endBudget = std::max(p.mesh.maxTriangles / 2, 2);
+    const DepthView view = chooseDepthView(soup, cellBox.center(), std::tan(outputPixelAngle(p.sampling)), p.mesh.imageSize, endBudget);
+    const FarImage img = renderFarImage(**scene, view);
+    const double cellRadius = 0.5 * glm::length(cellBox.hi - cellBox.lo);
+    DepthMeshStats ds;
+    r.mesh = buildDepthMesh(img, cellRadius, endBudget, p.mesh.errorPx, ds);
+    r.stats.imageW = uint64_t(view.width);
+    r.stats.imageH = uint64_t(view.height);
+    r.stats.samples = ds.samples;
+    r.stats.hits = ds.hits;
+    r.stats.leaves = ds.leaves;
+    r.stats.triangles = ds.triangles;
+    r.stats.droppedTriangles = ds.droppedTriangles;
+    r.stats.snapped = ds.snapped;
+    r.stats.maxLeafErrorPx = ds.maxLeafErrorPx;
+    return Status::ok();
+}
+
+namespace {
+
+CellResult bakeCellMeshes(const BakeInput& in, const ViewCell& cell, const BakeParams& p) {
+    const Stopwatch cellTime;
+    CellResult out;
+    out.cell = cell.id;
+    for (int end = 0; end < 2; ++end) {
+        const Stopwatch endTime;
+        FarSet fs = selectFarSet(*in.city, in.tiles, cell, end, p.far);
+        const std::string what = "end " + std::to_string(end) + ": ";
+        if (fs.soup.triangleCount() < std::max<size_t>(p.far.minTriangles, 1)) {
+            out.notes.push_back(what + "far field small (" + std::to_string(fs.soup.triangleCount()) + " triangles < " +
+                                std::to_string(p.far.minTriangles) + ")");
+            continue;
+        }
+        MeshResult r;
+        r.cell = cell.id;
+        r.end = uint8_t(end);
+        r.frame = fs.frame;
+        r.hiddenTiles = std::move(fs.tiles);
+        r.stats.tiles = r.hiddenTiles.size();
+        if (Status st = bakeMeshEnd(fs.soup, cellInFrame(cell, r.frame), p, r); !st) {
+            out.notes.push_back(what + st.message());
+            continue;
+        }
+        if (r.mesh.indices.empty()) {
+            out.notes.push_back(what + "no visible far geometry");
+            continue;
+        }
+        r.stats.bakeMs = endTime.ms();
+        out.meshes.push_back(std::move(r));
+    }
+    out.bakeMs = cellTime.ms();
+    return out;
+}
+
+}  // namespace
+
 CellResult bakeCell(const BakeInput& in, const ViewCell& cell, const BakeParams& p) {
+    if (p.representation == BakeRepresentation::Mesh) return bakeCellMeshes(in, cell, p);
     const Stopwatch cellTime;
     CellResult out;
     out.cell = cell.id;

@@ -27,7 +27,14 @@ struct BakeInput {
 };
 BakeInput prepareBake(const SceneModel& city, const BakeParams& p);
 
+// Dispatches on p.representation: point impostors (impostors) or textured
+// depth meshes (meshes; bakeMeshEnd per street end, same far sets).
 CellResult bakeCell(const BakeInput& in, const ViewCell& cell, const BakeParams& p);
+
+// The textured depth mesh of one far field (soup in the frame, cell box in
+// the frame): image from the cell box centre (bake/depth_mesh.h), fills
+// r.mesh and r.stats (not frame, tiles or ids). Error only for a bad soup.
+Status bakeMeshEnd(const TriangleSoup& soup, const Box3& cellBox, const BakeParams& p, MeshResult& r);
 
 // Steps 1-6 for one far field (soup and cell box in the impostor frame):
 // fills r.data and r.stats (not the frame, tiles or ids). `entity` keys the

@@ -15,7 +15,17 @@ std::string BakeParams::canonical() const {
       << appearance.varianceThreshold << "," << appearance.singleColorThreshold << "," << appearance.viewSigma << ","
       << appearance.pixelSigma << "," << appearance.significance << ";margin=" << far.margin << ";depth=" << far.farDepth
       << ";opening=" << far.openingExtra << ";minTri=" << far.minTriangles << ";seed=" << seed;
+    if (representation == BakeRepresentation::Mesh)
+        o << ";repr=mesh;meshTri=" << mesh.maxTriangles << ";meshImg=" << mesh.imageSize << ";meshErr=" << mesh.errorPx;
     return o.str();
+}
+
+const char* representationName(BakeRepresentation r) { return r == BakeRepresentation::Mesh ? "mesh" : "points"; }
+
+Result<BakeRepresentation> parseRepresentation(const std::string& name) {
+    if (name == "points") return BakeRepresentation::Points;
+    if (name == "mesh") return BakeRepresentation::Mesh;
+    return Status::error("--representation '" + name + "': unknown (allowed: points, mesh)");
 }
 
 }  // namespace vista

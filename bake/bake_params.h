@@ -8,18 +8,30 @@
 #include <cstdint>
 #include <string>
 
+#include "foundation/status.h"
+
 #include "bake/appearance.h"
+#include "bake/depth_mesh.h"
 #include "bake/far_set.h"
 #include "bake/ldi_sampling.h"
 #include "bake/view_cells.h"
 
 namespace vista {
 
+// What a bake attaches per view cell: point impostors (thesis ch. 5) or
+// textured depth meshes (Chen et al. 2003; bake/depth_mesh.h).
+enum class BakeRepresentation { Points, Mesh };
+// "points" / "mesh"; parse: an unknown name -> error naming the allowed values.
+const char* representationName(BakeRepresentation r);
+Result<BakeRepresentation> parseRepresentation(const std::string& name);
+
 struct BakeParams {
     ViewCellParams cells;
     FarSetParams far;
     SamplingParams sampling;
     AppearanceParams appearance;
+    BakeRepresentation representation = BakeRepresentation::Points;
+    DepthMeshParams mesh;  // representation Mesh only
     uint64_t seed = 1;  // the city's seed (set from the city file by the driver)
     std::string canonical() const;
 };

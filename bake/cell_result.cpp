@@ -2,6 +2,7 @@
 // Reader archive, so the two directions cannot drift apart.
 #include "bake/cell_result.h"
 
+#include <cmath>
 #include <cstring>
 #include <type_traits>
 
@@ -11,7 +12,10 @@ namespace vista {
 namespace {
 
 const char kMagic[8] = {'V', 'B', 'C', 'E', 'L', 'L', '0', '1'};
-constexpr size_t kMaxNotes = 16, kMaxImpostors = 2;
+const char kMeshMagic[8] = {'V', 'B', 'C', 'M', 'E', 'S', 'H', '1'};
+constexpr size_t kMaxNotes = 16, kMaxImpostors = 2, kMaxMeshes = 2;
+constexpr int kMaxImageSide = 16384;
+static_assert(sizeof(MeshStats) == 96, "MeshStats is stored as one block: no padding, fixed layout");
 static_assert(sizeof(ImpostorStats) == 152, "ImpostorStats is stored as one block: no padding, fixed layout");
 
 class Writer {
@@ -125,11 +129,48 @@ template <class Ar> void visit(Ar& ar, ImpostorResult& im) {
     ar.pod(im.stats);
 }
 
-template <class Ar> void visit(Ar& ar, CellResult& r) {
+template <class Ar> void visit(Ar& ar, MeshResult& m) {
+    ar.pod(m.cell);
+    ar.pod(m.end);
+    ar.pod(m.frame.origin);
+    ar.pod(m.frame.x);
+    ar.vec(m.hiddenTiles);
+    ar.pod(m.mesh.eye);
+    ar.pod(m.mesh.width);
+    ar.pod(m.mesh.height);
+    ar.vec(m.mesh.image);
+    ar.vec(m.mesh.positions);
+    ar.vec(m.mesh.texcoords);
+    ar.vec(m.mesh.indices);
+    ar.pod(m.stats);
+}
+
+// `meshes`: the VBCMESH1 layout (the mesh list follows the impostors).
+template <class Ar> void visit(Ar& ar, CellResult& r, bool meshes) {
     ar.pod(r.cell);
     ar.pod(r.bakeMs);
     ar.list(r.notes, kMaxNotes, "notes", [&](std::string& s) { ar.str(s); });
     ar.list(r.impostors, kMaxImpostors, "impostors", [&](ImpostorResult& im) { visit(ar, im); });
+    if (meshes) ar.list(r.meshes, kMaxMeshes, "meshes", [&](MeshResult& m) { visit(ar, m); });
+}
+
+std::string checkMesh(const MeshResult& m) {
+    const TexturedDepthMeshData& d = m.mesh;
+    if (m.end > 1) return "mesh street end " + std::to_string(int(m.end)) + " (must be 0 or 1)";
+    if (d.width < 1 || d.height < 1 || d.width > kMaxImageSide || d.height > kMaxImageSide)
+        return "mesh image " + std::to_string(d.width) + "x" + std::to_string(d.height) + " (sides must be 1.." + std::to_string(kMaxImageSide) + ")";
+    if (d.image.size() != size_t(d.width) * size_t(d.height)) return "mesh image size does not match its width and height";
+    if (d.texcoords.size() != d.positions.size() || d.indices.size() % 3 != 0) return "inconsistent mesh arrays";
+    for (uint32_t i : d.indices)
+        if (i >= d.positions.size()) return "mesh index out of range";
+    for (size_t k = 0; k < d.positions.size(); ++k) {
+        const glm::vec3& p = d.positions[k];
+        const glm::vec4& t = d.texcoords[k];
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(t.x) || !std::isfinite(t.y) ||
+            !std::isfinite(t.w) || !(t.w > 0))
+            return "mesh vertex " + std::to_string(k) + " not finite or behind the eye";
+    }
+    return "";
 }
 
 // Consistency the field list cannot express; "" when fine.
@@ -147,10 +188,11 @@ std::string checkImpostor(const ImpostorResult& im) {
 }  // namespace
 
 std::string encodeCellResult(const CellResult& r, uint64_t configHash) {
-    std::string b(kMagic, 8);
+    const bool meshes = !r.meshes.empty();
+    std::string b(meshes ? kMeshMagic : kMagic, 8);
     Writer w(b);
     w.pod(configHash);
-    visit(w, const_cast<CellResult&>(r));  // the Writer only reads
+    visit(w, const_cast<CellResult&>(r), meshes);  // the Writer only reads
     uint64_t h = hashBytes64(b.data(), b.size());
     w.pod(h);
     return b;
@@ -158,7 +200,9 @@ std::string encodeCellResult(const CellResult& r, uint64_t configHash) {
 
 Result<CellResult> decodeCellResult(const std::string& bytes, uint64_t configHash, const std::string& what) {
     auto bad = [&](const std::string& why) { return Status::error("cell result '" + what + "': " + why); };
-    if (bytes.size() < 8 + 8 + 8 || std::memcmp(bytes.data(), kMagic, 8) != 0) return bad("not a vista cell result (bad magic)");
+    if (bytes.size() < 8 + 8 + 8 || (std::memcmp(bytes.data(), kMagic, 8) != 0 && std::memcmp(bytes.data(), kMeshMagic, 8) != 0))
+        return bad("not a vista cell result (bad magic)");
+    const bool meshes = std::memcmp(bytes.data(), kMeshMagic, 8) == 0;
     const size_t body = bytes.size() - 8;
     uint64_t stored = 0;
     std::memcpy(&stored, bytes.data() + body, 8);
@@ -168,11 +212,13 @@ Result<CellResult> decodeCellResult(const std::string& bytes, uint64_t configHas
     rd.pod(cfg);
     if (cfg != configHash) return bad("baked with other input or parameters");
     CellResult r;
-    visit(rd, r);
+    visit(rd, r, meshes);
     if (rd.ok() && rd.at() != body) rd.fail(std::to_string(body - rd.at()) + " trailing bytes after the last field");
     if (!rd.ok()) return bad("malformed: " + rd.error());
     for (const ImpostorResult& im : r.impostors)
         if (std::string why = checkImpostor(im); !why.empty()) return bad(why);
+    for (const MeshResult& m : r.meshes)
+        if (std::string why = checkMesh(m); !why.empty()) return bad(why);
     return r;
 }
 

@@ -5,11 +5,14 @@
 // File layout ("VBCELL01", native little-endian): magic, config hash (u64),
 // the CellResult fields in the order of one field list used by both the
 // encoder and the decoder (vectors and strings as u64 count + elements),
-// then a 64-bit hash of everything before it (foundation/hash.h).
+// then a 64-bit hash of everything before it (foundation/hash.h). A result
+// with textured depth meshes (`--representation mesh`) has the magic
+// "VBCMESH1" and the mesh list after the impostor list; a point result's
+// bytes are those of VBCELL01 unchanged.
 // decodeCellResult() never trusts the bytes: a wrong magic, a config hash
 // other than `configHash`, a hash mismatch, any count beyond the bytes left
-// (or > 16 notes, > 2 impostors), trailing bytes and inconsistent impostor
-// arrays are a Status error naming `what` (the file) — never a crash or a
+// (or > 16 notes, > 2 impostors, > 2 meshes), trailing bytes and inconsistent
+// impostor or mesh arrays are a Status error naming `what` (the file) — never a crash or a
 // huge allocation. Pure; thread-safe.
 #pragma once
 #include <cstddef>
@@ -20,6 +23,7 @@
 #include "bake/impostor_frame.h"
 #include "foundation/status.h"
 #include "nodes/point_impostor.h"
+#include "nodes/textured_depth_mesh.h"
 
 namespace vista {
 
@@ -44,9 +48,28 @@ struct ImpostorResult {
     ImpostorStats stats;
 };
 
+// Measurements of one textured depth mesh bake; stored as one block of 96 bytes.
+struct MeshStats {
+    uint64_t farTriangles = 0, tiles = 0, imageW = 0, imageH = 0;
+    uint64_t samples = 0, hits = 0, leaves = 0, triangles = 0, droppedTriangles = 0, snapped = 0;
+    double maxLeafErrorPx = 0;
+    double bakeMs = 0;  // not part of the baked scene
+};
+
+// The textured depth mesh of one (cell, street end) (bake/depth_mesh.h).
+struct MeshResult {
+    uint32_t cell = 0;
+    uint8_t end = 0;
+    ImpostorFrame frame;
+    std::vector<uint32_t> hiddenTiles;  // root child indices, ascending (as ImpostorResult)
+    TexturedDepthMeshData mesh;         // in the frame
+    MeshStats stats;
+};
+
 struct CellResult {
     uint32_t cell = 0;
     std::vector<ImpostorResult> impostors;  // at most 2 (one per street end)
+    std::vector<MeshResult> meshes;         // --representation mesh: at most 2 (one per street end)
     std::vector<std::string> notes;         // why ends were skipped (at most 16)
     double bakeMs = 0;
 };

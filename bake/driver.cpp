@@ -46,6 +46,10 @@ Status validateBakeJob(const BakeJob& j) {
                      range("--fov", p.sampling.fovYDeg, 1, 170), range("--texels (A)", p.appearance.texelsX, 1, 32),
                      range("--texels (B)", p.appearance.texelsY, 1, 32)})
         if (!s) return s;
+    if (p.representation == BakeRepresentation::Mesh)
+        for (Status s : {range("--mesh-triangles", p.mesh.maxTriangles, 1024, 1e7), range("--mesh-image", p.mesh.imageSize, 64, 4096),
+                         range("--mesh-error", p.mesh.errorPx, 0, 100)})
+            if (!s) return s;
     if (j.shardN < 1 || j.shardK < 1 || j.shardK > j.shardN)
         return Status::error("--shard " + std::to_string(j.shardK) + "/" + std::to_string(j.shardN) + ": expected K/N with 1 <= K <= N");
     if (j.merge && j.shardN > 1) return Status::error("--merge and --shard exclude each other");
@@ -92,6 +96,26 @@ nlohmann::json statsJson(const ImpostorResult& r) {
     const size_t bytes = r.data.positions.size() * kPointBytes + r.data.texels.size() * 4;
     j["memory_mb"] = double(bytes) / (1024.0 * 1024.0);
     j["memory_mb_uncompressed"] = double(r.data.positions.size() * (kPointBytes + 4 * size_t(r.data.texelsX * r.data.texelsY))) / (1024.0 * 1024.0);
+    j["bake_s"] = s.bakeMs / 1000.0;
+    return j;
+}
+
+nlohmann::json meshStatsJson(const MeshResult& r) {
+    const MeshStats& s = r.stats;
+    nlohmann::json j;
+    j["cell"] = r.cell;
+    j["end"] = int(r.end);
+    j["tiles"] = s.tiles;
+    j["far_triangles"] = s.farTriangles;
+    j["image"] = {s.imageW, s.imageH};
+    j["hit_samples"] = s.hits;
+    j["leaves"] = s.leaves;
+    j["triangles"] = s.triangles;
+    j["vertices"] = r.mesh.positions.size();
+    j["dropped_triangles"] = s.droppedTriangles;
+    j["snapped_vertices"] = s.snapped;
+    j["max_leaf_error_px"] = s.maxLeafErrorPx;
+    j["memory_mb"] = double(depthMeshBytes(r.mesh)) / (1024.0 * 1024.0);
     j["bake_s"] = s.bakeMs / 1000.0;
     return j;
 }
@@ -207,6 +231,11 @@ nlohmann::json tallyResults(const std::vector<CellResult>& results, BakeReport& 
             rep.points += im.stats.points;
             js.push_back(statsJson(im));
         }
+        for (const auto& m : r.meshes) {
+            ++rep.meshes;
+            rep.meshTriangles += m.mesh.triangleCount();
+            js.push_back(meshStatsJson(m));
+        }
     }
     rep.cellBakeS = cellMs / 1000.0;
     return js;
@@ -218,6 +247,11 @@ Status writeStatsFile(const BakeJob& job, const BakeReport& rep, size_t cells, c
     top["cells"] = cells;
     top["impostors"] = rep.impostors;
     top["points"] = rep.points;
+    if (job.params.representation == BakeRepresentation::Mesh) {
+        top["representation"] = "mesh";
+        top["meshes"] = rep.meshes;
+        top["mesh_triangles"] = rep.meshTriangles;
+    }
     top["cell_bake_s_sum"] = rep.cellBakeS;
     top["wall_s"] = rep.wallS;
     top["output_bytes"] = rep.outputBytes;
@@ -269,7 +303,7 @@ Result<BakeReport> runBakeJob(const BakeJob& job, Progress* progress, const std:
 
     auto results = readCellResults(in, *selected, configHash, rep.workDir);
     if (!results) return results.status();
-    osg::ref_ptr<ViewCellSwitch> root = assembleBakedScene(*city, in.cells, *results, canon);
+    osg::ref_ptr<ViewCellSwitch> root = assembleBakedScene(*city, in.cells, *results, canon, p.representation);
     VISTA_RETURN_IF_ERROR(writeSceneFile(*root, job.output, false));
     rep.assembled = true;
     nlohmann::json impostorStats = tallyResults(*results, rep);

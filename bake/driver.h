@@ -9,7 +9,8 @@
 // directory (every selected cell must be there), writes it atomically,
 // writes the stats JSON and removes the cell files (and the work directory
 // when empty) unless keepWork. With merge it bakes nothing, only assembles.
-// Config hash = hash(input file bytes, params.canonical()).
+// Config hash = hash(input file bytes, params.canonical()); the canonical
+// text names the representation and the mesh parameters of a mesh bake.
 // Determinism: output bytes depend only on (input file, params, cells), not
 // on jobs, shards, interruptions or resumption. A kill at any moment leaves
 // only whole cell files.
@@ -54,6 +55,7 @@ struct BakeReport {
     size_t skippedEdges = 0;           // degenerate street edges (no cell)
     bool assembled = false;            // false after one shard of several
     size_t impostors = 0, points = 0;  // in the output
+    size_t meshes = 0, meshTriangles = 0;  // in the output (--representation mesh)
     uint64_t outputBytes = 0;
     double wallS = 0;                  // this call
     double cellBakeS = 0;              // sum of the assembled cells' bake times

@@ -16,7 +16,7 @@ int runBake(int argc, char** argv) {
                  cmd};
     BakeJob job;
     BakeParams& p = job.params;
-    std::string cellList, shard, texels = "8x2";
+    std::string cellList, shard, texels = "8x2", representation = "points";
     bool quiet = false, noRemoval = false;
     app.add_option("city", job.input, "input city file (.osgb from 'vista gen')")->required();
     app.add_option("-o,--output", job.output, "baked output file (.osgb)")->required();
@@ -52,12 +52,24 @@ int runBake(int argc, char** argv) {
         ->capture_default_str();
     app.add_option("--out-size", p.sampling.outHeight, "target output height in pixels (width = 4/3 height)")->capture_default_str();
     app.add_option("--fov", p.sampling.fovYDeg, "target output vertical field of view, degrees")->capture_default_str();
+    app.add_option("--representation", representation,
+                   "far-field representation per view cell: points (point impostors, thesis ch. 5) or mesh (textured depth meshes, "
+                   "Chen et al. 2003)")
+        ->capture_default_str();
+    app.add_option("--mesh-triangles", p.mesh.maxTriangles, "mesh: triangle budget per view cell (half per street end)")
+        ->capture_default_str();
+    app.add_option("--mesh-image", p.mesh.imageSize, "mesh: largest side of the far-field image in pixels")->capture_default_str();
+    app.add_option("--mesh-error", p.mesh.errorPx, "mesh: stop refining below this parallax error (pixels, for a viewer at the cell's corner)")
+        ->capture_default_str();
     const int rc = parseOrExit(app, argc, argv);
     if (rc >= 0) return rc;
     p.sampling.outWidth = p.sampling.outHeight * 4 / 3;
     p.sampling.removeRedundant = !noRemoval;
 
     if (Status s = parseTexels(texels, p.appearance.texelsX, p.appearance.texelsY); !s) return reportBadInput(cmd, s);
+    auto repr = parseRepresentation(representation);
+    if (!repr) return reportBadInput(cmd, repr.status());
+    p.representation = *repr;
     if (Status s = validateBakeJob(job); !s) return reportBadInput(cmd, s);
     if (!shard.empty())
         if (Status s = parseShard(shard, job.shardK, job.shardN); !s) return reportBadInput(cmd, s);
@@ -78,6 +90,9 @@ int runBake(int argc, char** argv) {
         std::fprintf(stderr, "vista bake: shard %d/%d done (%zu cells) in %s; assemble with 'vista bake %s -o %s --merge%s'\n", job.shardK,
                      job.shardN, r.shardCells, r.workDir.c_str(), job.input.c_str(), job.output.c_str(),
                      cellList.empty() ? "" : (" --cells " + cellList).c_str());
+    else if (p.representation == BakeRepresentation::Mesh)
+        std::fprintf(stderr, "vista bake: wrote %s: %zu cells, %zu textured depth meshes, %zu triangles, %.1f MB, %.1f s (cell bake time %.1f s)\n",
+                     job.output.c_str(), r.cells, r.meshes, r.meshTriangles, double(r.outputBytes) / 1048576.0, r.wallS, r.cellBakeS);
     else
         std::fprintf(stderr, "vista bake: wrote %s: %zu cells, %zu impostors, %zu points, %.1f MB, %.1f s (cell bake time %.1f s)\n",
                      job.output.c_str(), r.cells, r.impostors, r.points, double(r.outputBytes) / 1048576.0, r.wallS, r.cellBakeS);

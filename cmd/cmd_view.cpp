@@ -63,7 +63,7 @@ struct ViewArgs {
 
 void declareFlags(CLI::App& app, ViewArgs& a) {
     a.path.seed = 0;  // no playback unless asked
-    app.add_option("city", a.city, "city scene file (.osgb), or a baked file from 'vista bake' (adds the impostor mode)")->required();
+    app.add_option("city", a.city, "city scene file (.osgb), or a baked file from 'vista bake' (adds the impostor mode; lodmesh for --representation mesh)")->required();
     addPathFlags(app, a.path, true);
     app.get_option("--seed")->description("play back the path of this seed (key 5); default 0 = none, start where seed 1's path starts");
     app.add_option("--size", a.size, "window size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 1280x720)");

@@ -259,6 +259,8 @@ void addModeFlags(CLI::App& app, ModeFlags& f) {
                    "hybrid: far-field ray spacing, 1 or 2: 2 = rays on every other pixel and row first, pixels between "
                    "lattice pixels that showed one triangle (or sky) blended from them (lossy: PSNR in the bench) (default 1)");
     app.add_option("--baked", f.baked, "impostor: the baked file of this city (from `vista bake`)");
+    app.add_option("--baked-mesh", f.bakedMesh,
+                   "lodmesh: the mesh bake of this city (from `vista bake --representation mesh`), unless the city file is one");
     app.add_option("--threads", f.threads, "worker threads for ray casting, 0 .. 1024 (0 = all cores)");
 }
 
@@ -290,6 +292,8 @@ Status parseModeFlags(const ModeFlags& f, ModeOptions& o) {
     if (!pb) return pb.status();
     if (!f.baked.empty() && access(f.baked.c_str(), R_OK) != 0)
         return Status::error("--baked '" + f.baked + "': cannot read the file");
+    if (!f.bakedMesh.empty() && access(f.bakedMesh.c_str(), R_OK) != 0)
+        return Status::error("--baked-mesh '" + f.bakedMesh + "': cannot read the file");
     o.nearDistance = nd.value();
     o.triangleBudget = tb.value();
     o.pixelBudget = pb.value();
@@ -300,6 +304,7 @@ Status parseModeFlags(const ModeFlags& f, ModeOptions& o) {
     o.frameMsTarget = f.frameMs;
     o.farStep = f.farStep;
     o.bakedFile = f.baked;
+    o.bakedMeshFile = f.bakedMesh;
     o.threads = f.threads;
     return checkModeOptions(o);
 }

@@ -8,7 +8,7 @@
 // PathFlags: the walkthrough options (--path, --seed, --kind, --duration,
 // --run-up) of bench and view. ModeFlags: the render-mode options both `vista bench` and `vista view`
 // accept (--near, --triangle-budget, --budget, --horizon-grid, --no-cache,
-// --cache-error, --frame-ms, --no-overlap, --baked, --threads), declared once by addModeFlags() and turned into
+// --cache-error, --frame-ms, --no-overlap, --baked, --baked-mesh, --threads), declared once by addModeFlags() and turned into
 // ModeOptions by parseModeFlags().
 #pragma once
 #include <cstdint>
@@ -85,6 +85,7 @@ struct ModeFlags {
     double cacheError = 0.25, frameMs = 0.0;
     int farStep = 1;
     std::string baked;
+    std::string bakedMesh;
     int threads = 0;
 };
 // Declares the flags on `app`; the defaults shown are the values in `flags`.

@@ -5,10 +5,16 @@
 #include <osg/MatrixTransform>
 
 #include "nodes/point_impostor.h"
+#include "nodes/textured_depth_mesh.h"
 #include "runtime/scene/city_file.h"
 #include "runtime/scene/scene_graph.h"
 
 namespace vista {
+
+bool isMeshBake(const osg::Node* root) {
+    std::string repr;
+    return root && root->getUserValue("vista.bake_representation", repr) && repr == "mesh";
+}
 
 Result<BakedFile> loadBakedFile(const std::string& path) {
     auto city = loadCityFile(path);
@@ -22,9 +28,18 @@ Result<BakedFile> loadBakedFile(const std::string& path) {
     if (!root->getUserValue("vista.baked", baked) || baked != 1) return bad("missing or unsupported user value vista.baked");
     const std::string why = root->validate();
     if (!why.empty()) return bad(why);
+    bf.meshes = isMeshBake(root);
     for (unsigned i = root->getTileCount(); i < root->getNumChildren(); ++i) {
         auto* xf = dynamic_cast<osg::MatrixTransform*>(root->getChild(i));
         osg::Geode* g = xf && xf->getNumChildren() == 1 ? xf->getChild(0)->asGeode() : nullptr;
+        if (bf.meshes) {
+            auto* tm = g && g->getNumDrawables() == 1 ? dynamic_cast<TexturedDepthMesh*>(g->getDrawable(0)) : nullptr;
+            if (!tm) return bad("child " + std::to_string(i) + " is not a textured depth mesh node");
+            if (const std::string w = tm->validate(); !w.empty()) return bad("child " + std::to_string(i) + ": " + w);
+            ++bf.meshCount;
+            bf.meshTriangles += tm->triangleCount();
+            continue;
+        }
         auto* pi = g && g->getNumDrawables() == 1 ? dynamic_cast<PointImpostor*>(g->getDrawable(0)) : nullptr;
         if (!pi) return bad("child " + std::to_string(i) + " is not an impostor node");
         if (const std::string w = pi->validate(); !w.empty()) return bad("child " + std::to_string(i) + ": " + w);

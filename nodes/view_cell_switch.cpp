@@ -98,7 +98,7 @@ ViewCellSwitch::ViewCellSwitch()
 ViewCellSwitch::ViewCellSwitch(const ViewCellSwitch& o, const osg::CopyOp& op)
     : osg::Group(o, op), _cells(o._cells), _grid(o._grid), _cellData(o._cellData), _hiddenStart(o._hiddenStart),
       _hiddenItems(o._hiddenItems), _impStart(o._impStart), _impItems(o._impItems), _tileCount(o._tileCount),
-      _forced(o._forced), _impostorsOn(o._impostorsOn) {}
+      _forced(o._forced), _impostorsOn(o._impostorsOn), _nearestFallback(o._nearestFallback) {}
 
 void ViewCellSwitch::setCells(const std::vector<ViewCellBox>& cells) {
     osg::ref_ptr<osg::DoubleArray> a = new osg::DoubleArray;
@@ -196,6 +196,25 @@ std::string ViewCellSwitch::validate() const {
     return checkCsr(_impStart.get(), _impItems.get(), "impostors", false);
 }
 
+int ViewCellSwitch::nearestCell(const glm::dvec3& p) const {
+    int best = -1;
+    double bestD = 1e300;
+    for (size_t c = 0; c < _cells.size(); ++c) {
+        const ViewCellBox& b = _cells[c];
+        if (!(b.halfLength > 0) || !(b.halfWidth > 0)) continue;
+        const glm::dvec3 d = p - b.center;
+        const double a = std::max(std::abs(d.x * b.axis.x + d.y * b.axis.y) - b.halfLength, 0.0);
+        const double s = std::max(std::abs(-d.x * b.axis.y + d.y * b.axis.x) - b.halfWidth, 0.0);
+        const double z = std::max(std::abs(d.z) - b.halfHeight, 0.0);
+        const double dist = a * a + s * s + z * z;
+        if (dist < bestD) {
+            bestD = dist;
+            best = int(c);
+        }
+    }
+    return best;
+}
+
 void ViewCellSwitch::traverse(osg::NodeVisitor& nv) {
     const unsigned nChildren = getNumChildren();
     const unsigned tiles = std::min(_tileCount, nChildren);
@@ -207,6 +226,7 @@ void ViewCellSwitch::traverse(osg::NodeVisitor& nv) {
     if (cell == -2) {
         const osg::Vec3 e = nv.getEyePoint();
         cell = _grid.find(glm::dvec3(e.x(), e.y(), e.z()));
+        if (cell < 0 && _nearestFallback) cell = nearestCell(glm::dvec3(e.x(), e.y(), e.z()));
     }
     if (cell >= int(_cells.size())) cell = -1;
     _lastCell = cell;

@@ -78,6 +78,13 @@ public:
     int cellAt(const glm::dvec3& eye) const { return _grid.find(eye); }
     // -2 = automatic (default); -1 = no cell; >= 0 = this cell.
     void setForcedCell(int c) { _forced = c; }
+    // Automatic lookup outside every cell: false (default) = no cell (the
+    // plain city); true = the nearest cell (render mode lodmesh). Run time
+    // only, not serialized.
+    void setNearestFallback(bool on) { _nearestFallback = on; }
+    // The lowest id among the cells nearest to p (Euclidean distance to the
+    // box; cells with an empty box are skipped), -1 without cells. O(cells).
+    int nearestCell(const glm::dvec3& p) const;
     void setImpostorsEnabled(bool on) { _impostorsOn = on; }
     // Cell chosen by the last cull traversal (-1: none).
     int lastCell() const { return _lastCell; }
@@ -115,6 +122,7 @@ private:
     unsigned _tileCount = 0;
     int _forced = -2;
     bool _impostorsOn = true;
+    bool _nearestFallback = false;
     int _lastCell = -1;
 };
 

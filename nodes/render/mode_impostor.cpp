@@ -31,14 +31,20 @@ private:
 }  // namespace
 
 Result<std::unique_ptr<RenderMode>> makeImpostorMode(ModeContext& ctx) {
-    osg::ref_ptr<ViewCellSwitch> root = dynamic_cast<ViewCellSwitch*>(ctx.scene);
+    // A mesh bake (--representation mesh) has no point impostors: use --baked then.
+    osg::ref_ptr<ViewCellSwitch> root = isMeshBake(ctx.scene) ? nullptr : dynamic_cast<ViewCellSwitch*>(ctx.scene);
     SetupTimes setup;
     if (!root) {
         if (ctx.options.bakedFile.empty())
-            return Status::error("mode impostor: the city is not baked; pass --baked city.baked.osgb (from 'vista bake')");
+            return Status::error(isMeshBake(ctx.scene)
+                                     ? "mode impostor: the scene holds textured depth meshes (mode lodmesh); pass --baked city.baked.osgb "
+                                       "(from 'vista bake') for point impostors"
+                                     : "mode impostor: the city is not baked; pass --baked city.baked.osgb (from 'vista bake')");
         Stopwatch sw;
         auto bf = loadBakedFile(ctx.options.bakedFile);
         if (!bf) return bf.status();
+        if (bf->meshes)
+            return Status::error("mode impostor: '" + ctx.options.bakedFile + "' holds textured depth meshes; use mode lodmesh");
         root = bf->root;
         setup.push_back({"baked_load", sw.ms()});
     }

@@ -2,8 +2,9 @@
 // view cell: the city tiles the cell's impostors do not replace plus the
 // cell's point impostors; outside every cell: the plain city.
 //
-// Contract: the baked scene is ctx.scene when that is a baked root (a baked
-// file was loaded), else ctx.options.bakedFile (loaded and checked by
+// Contract: the baked scene is ctx.scene when that is a baked root of point
+// impostors (a baked file was loaded; a mesh bake is left to mode lodmesh),
+// else ctx.options.bakedFile (a point bake) (loaded and checked by
 // loadBakedFile; its cost is set-up "baked_load"); neither -> error naming
 // --baked. Notes per frame: "cell N (K impostors)" or "no cell".
 // Viewer: the same ViewCellSwitch, infinite far plane.

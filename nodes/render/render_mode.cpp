@@ -15,6 +15,7 @@
 #include "nodes/render/mode_full.h"
 #include "nodes/render/mode_hybrid.h"
 #include "nodes/render/mode_impostor.h"
+#include "nodes/render/mode_lodmesh.h"
 #include "nodes/render/mode_near.h"
 #include "nodes/render/mode_osgimpostor.h"
 #include "nodes/render/mode_osglod.h"
@@ -74,6 +75,8 @@ const std::vector<ModeInfo>& renderModes() {
          makeOsgLodMode},
         {"hybrid", "near field rasterised + ray-cast far field (horizon, cache, Embree)", true, false, makeHybridMode},
         {"impostor", "near field + baked point impostors (needs a baked file: --baked)", false, true, makeImpostorMode},
+        {"lodmesh", "near field + the cell's textured depth meshes (a file from 'vista bake --representation mesh')", false, false,
+         makeLodMeshMode},
     };
     return kModes;
 }

@@ -1,5 +1,5 @@
 // RenderMode: one way of drawing a walkthrough frame (full, near, raycast,
-// osgimpostor, osglod, hybrid, impostor), written once, in nodes/render/
+// osgimpostor, osglod, hybrid, impostor, lodmesh), written once, in nodes/render/
 // mode_<name>.{h,cpp}, and used by both programs through this registry:
 //   `vista bench` times renderFrame() through the shared OffscreenRenderer;
 //   `vista view`  draws viewerScene() in its window, calling
@@ -60,6 +60,7 @@ struct ModeOptions {
     int farStep = 1;              // hybrid: far-field ray spacing, 1 (a ray per pixel) or 2 (FarFieldOptions::rayStep)
     int threads = 0;              // ray-casting threads; 0 = all cores
     std::string bakedFile;        // impostor: the baked file (unless the scene itself is baked)
+    std::string bakedMeshFile;    // lodmesh: the mesh bake (unless the scene itself is one)
     FrameEffects effects;         // run-time effects of every mode (haze, glass reflections, night sky)
     // The near distance of modes without an adaptive split.
     double fixedNearDistance() const { return nearDistance > 0 ? nearDistance : kDefaultNearDistance; }
@@ -176,7 +177,7 @@ struct ModeInfo {
     bool needsBaked;      // needs a baked scene or options.bakedFile
     ModeFactory make;
 };
-// Every mode, in display order: full, near, raycast, osgimpostor, osglod, hybrid, impostor.
+// Every mode, in display order: full, near, raycast, osgimpostor, osglod, hybrid, impostor, lodmesh.
 const std::vector<ModeInfo>& renderModes();
 const ModeInfo* findRenderMode(const std::string& name);
 // "full, near, raycast, ..." (for messages and help).

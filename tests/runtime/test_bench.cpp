@@ -213,8 +213,8 @@ TEST(Offscreen, BadSizesAndMismatchedCameras) {
 TEST(RenderModes, RegistryListsEveryModeOnce) {
     std::vector<std::string> names;
     for (const auto& m : renderModes()) names.push_back(m.name);
-    EXPECT_EQ(names, (std::vector<std::string>{"full", "near", "raycast", "osgimpostor", "osglod", "hybrid", "impostor"}));
-    EXPECT_EQ(renderModeNames(), "full, near, raycast, osgimpostor, osglod, hybrid, impostor");
+    EXPECT_EQ(names, (std::vector<std::string>{"full", "near", "raycast", "osgimpostor", "osglod", "hybrid", "impostor", "lodmesh"}));
+    EXPECT_EQ(renderModeNames(), "full, near, raycast, osgimpostor, osglod, hybrid, impostor, lodmesh");
     EXPECT_TRUE(findRenderMode("raycast")->needsRays);
     EXPECT_TRUE(findRenderMode("hybrid")->needsRays);
     EXPECT_FALSE(findRenderMode("osglod")->needsRays);
@@ -666,11 +666,14 @@ TEST(ViewCli, EveryModeShowsTheBenchPicture) {
     ASSERT_TRUE(fs::exists(VISTA_BINARY)) << "the vista binary is a build dependency of this test";
     std::string dir = tmpDir("view"), out;
     const std::string city = dir + "/tiny.osgb", baked = dir + "/tiny.baked.osgb", path = dir + "/p.csv";
+    const std::string meshes = dir + "/tiny.mesh.osgb";
     ASSERT_EQ(runVista("gen --size 300 --seed 3 -q -o " + city, &out), 0) << out;
     ASSERT_EQ(runVista("bake " + city + " -o " + baked + " --out-size 120 --min-triangles 1 --max-rays 20000 -q", &out), 0)
         << out;
+    ASSERT_EQ(runVista("bake " + city + " -o " + meshes + " --representation mesh --out-size 120 --min-triangles 1 -q", &out), 0)
+        << out;
     ASSERT_EQ(runVista("path " + city + " --seed 4 --duration 10 -o " + path, &out), 0) << out;
-    const std::string common = " --path " + path + " --size 160x120 --near 30 --budget unlimited --baked " + baked;
+    const std::string common = " --path " + path + " --size 160x120 --near 30 --budget unlimited --baked " + baked + " --baked-mesh " + meshes;
     std::string all;
     for (const auto& info : renderModes()) all += (all.empty() ? "" : ",") + std::string(info.name);
     ASSERT_EQ(runVista("bench " + city + common + " --frames 1 -q --modes " + all + " --out " + dir + "/b", &out), 0) << out;
@@ -691,7 +694,7 @@ TEST(ViewCli, EveryModeShowsTheBenchPicture) {
     // Interactive playback (not --step) of every mode runs headless too, with the HUD.
     for (const auto& info : renderModes()) {
         const std::string png = dir + "/play.png";
-        EXPECT_EQ(runVista("view " + city + " --seed 2 --size 160x120 --frames 3 --baked " + baked + " --mode " + info.name +
+        EXPECT_EQ(runVista("view " + city + " --seed 2 --size 160x120 --frames 3 --baked " + baked + " --baked-mesh " + meshes + " --mode " + info.name +
                                " --screenshot " + png, &out),
                   0)
             << info.name << ": " << out;
