@@ -121,7 +121,11 @@ Status bakeMeshEnd(const TriangleSoup& soup, const Box3& cellBox, const BakePara
 
 namespace {
 
-CellResult bakeCellMeshes(const BakeInput& in, const ViewCell& cell, const BakeParams& p) {
+// The cell's two street ends, each with its far set: a far field with too few
+// triangles gets a note; otherwise bakeEnd(far set, end, note prefix, the end's
+// stopwatch, out) bakes it. Result header fields of both representations.
+template <class BakeEnd>
+CellResult forEachEnd(const BakeInput& in, const ViewCell& cell, const BakeParams& p, BakeEnd&& bakeEnd) {
     const Stopwatch cellTime;
     CellResult out;
     out.cell = cell.id;
@@ -134,63 +138,53 @@ CellResult bakeCellMeshes(const BakeInput& in, const ViewCell& cell, const BakeP
                                 std::to_string(p.far.minTriangles) + ")");
             continue;
         }
-        MeshResult r;
-        r.cell = cell.id;
-        r.end = uint8_t(end);
-        r.frame = fs.frame;
-        r.hiddenTiles = std::move(fs.tiles);
-        r.stats.tiles = r.hiddenTiles.size();
-        if (Status st = bakeMeshEnd(fs.soup, cellInFrame(cell, r.frame), p, r); !st) {
-            out.notes.push_back(what + st.message());
-            continue;
-        }
-        if (r.mesh.indices.empty()) {
-            out.notes.push_back(what + "no visible far geometry");
-            continue;
-        }
-        r.stats.bakeMs = endTime.ms();
-        out.meshes.push_back(std::move(r));
+        bakeEnd(fs, end, what, endTime, out);
     }
     out.bakeMs = cellTime.ms();
     return out;
 }
 
+template <class R>
+void startResult(R& r, const ViewCell& cell, int end, FarSet& fs) {
+    r.cell = cell.id;
+    r.end = uint8_t(end);
+    r.frame = fs.frame;
+    r.hiddenTiles = std::move(fs.tiles);
+    r.stats.tiles = r.hiddenTiles.size();
+}
+
 }  // namespace
 
 CellResult bakeCell(const BakeInput& in, const ViewCell& cell, const BakeParams& p) {
-    if (p.representation == BakeRepresentation::Mesh) return bakeCellMeshes(in, cell, p);
-    const Stopwatch cellTime;
-    CellResult out;
-    out.cell = cell.id;
-    for (int end = 0; end < 2; ++end) {
-        const Stopwatch endTime;
-        FarSet fs = selectFarSet(*in.city, in.tiles, cell, end, p.far);
-        const std::string what = "end " + std::to_string(end) + ": ";
-        if (fs.soup.triangleCount() < std::max<size_t>(p.far.minTriangles, 1)) {
-            out.notes.push_back(what + "far field small (" + std::to_string(fs.soup.triangleCount()) + " triangles < " +
-                                std::to_string(p.far.minTriangles) + ")");
-            continue;
-        }
+    if (p.representation == BakeRepresentation::Mesh)
+        return forEachEnd(in, cell, p, [&](FarSet& fs, int end, const std::string& what, const Stopwatch& endTime, CellResult& out) {
+            MeshResult r;
+            startResult(r, cell, end, fs);
+            if (Status st = bakeMeshEnd(fs.soup, cellInFrame(cell, r.frame), p, r); !st) {
+                out.notes.push_back(what + st.message());
+                return;
+            }
+            if (r.mesh.indices.empty()) {
+                out.notes.push_back(what + "no visible far geometry");
+                return;
+            }
+            r.stats.bakeMs = endTime.ms();
+            out.meshes.push_back(std::move(r));
+        });
+    return forEachEnd(in, cell, p, [&](FarSet& fs, int end, const std::string& what, const Stopwatch& endTime, CellResult& out) {
         ImpostorResult r;
-        r.cell = cell.id;
-        r.end = uint8_t(end);
-        r.frame = fs.frame;
-        r.hiddenTiles = std::move(fs.tiles);
-        r.stats.tiles = r.hiddenTiles.size();
-        Status st = bakeImpostor(fs.soup, cellInFrame(cell, r.frame), p, hashKeys(cell.id, uint64_t(end)), r);
-        if (!st) {
+        startResult(r, cell, end, fs);
+        if (Status st = bakeImpostor(fs.soup, cellInFrame(cell, r.frame), p, hashKeys(cell.id, uint64_t(end)), r); !st) {
             out.notes.push_back(what + st.message());
-            continue;
+            return;
         }
         if (r.data.positions.empty()) {
             out.notes.push_back(what + "no visible points");
-            continue;
+            return;
         }
         r.stats.bakeMs = endTime.ms();
         out.impostors.push_back(std::move(r));
-    }
-    out.bakeMs = cellTime.ms();
-    return out;
+    });
 }
 
 }  // namespace vista

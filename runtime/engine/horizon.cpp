@@ -243,13 +243,13 @@ double HeightGrid::trace(const glm::dvec3& eye, double azimuth, double nearDista
         }
     };
     auto run = [&](int ix, int iy) { walkCells(GridWalk(ix, iy, sx0, sy0, dx, dy, 1.0), tLen, -1, -1); };
+    auto onLine = [](double p) { return std::abs(p - std::round(p)) <= kTieEps * std::max(1.0, std::abs(p)); };
     // The same walk over blocks of kBlock x kBlock cells: a block whose bound
     // cannot beat `best` is passed over whole; otherwise its cells along the
     // ray's stretch [tIn, tOut] inside it are walked as in run(). A ray
     // through a block corner, or entering a block through a cell corner,
     // touches the four cells around that corner.
     auto runBlocks = [&](int ix, int iy) {
-        auto onGridLine = [](double p) { return std::abs(p - std::round(p)) <= kTieEps * std::max(1.0, std::abs(p)); };
         auto cellAt = [](double p, double d, int lo, int hi) {
             double c = std::floor(p);
             if (d < 0 && c == p) c -= 1;
@@ -272,7 +272,7 @@ double HeightGrid::trace(const glm::dvec3& eye, double azimuth, double nearDista
                     const double qx = sx0 + dx * tIn, qy = sy0 + dy * tIn;
                     cx = cellAt(qx, dx, b.x * B, std::min(n, (b.x + 1) * B) - 1);
                     cy = cellAt(qy, dy, b.y * B, std::min(n, (b.y + 1) * B) - 1);
-                    if (onGridLine(qx) && onGridLine(qy)) visitAround(int(std::round(qx)), int(std::round(qy)));
+                    if (onLine(qx) && onLine(qy)) visitAround(int(std::round(qx)), int(std::round(qy)));
                 }
                 walkCells(GridWalk(cx, cy, sx0, sy0, dx, dy, 1.0), tOut, b.x, b.y);
             }
@@ -297,7 +297,6 @@ double HeightGrid::trace(const glm::dvec3& eye, double azimuth, double nearDista
     else
         run(ix, iy);
     // A ray running along a grid line touches the cells on both sides.
-    auto onLine = [&](double p) { return std::abs(p - std::round(p)) <= kTieEps * std::max(1.0, std::abs(p)); };
     if (dx == 0 && onLine(ex)) {
         int l = int(std::round(ex));
         if (l - 1 >= 0 && l - 1 != ix) run(l - 1, iy);
