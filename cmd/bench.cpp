@@ -173,6 +173,7 @@ Status dumpRays(const RenderMode& m, int f, const Camera& cam, const BenchConfig
     set.frame = uint32_t(f);
     set.camera = cam;
     set.hazeFar = cfg.options.effects.haze ? cfg.options.effects.hazeFar() : 0.0;
+    set.tnear = m.lastRayStart();
     set.pixels = *traced;
     char name[64];
     std::snprintf(name, sizeof name, "_f%04d.rays", f);

@@ -83,6 +83,7 @@ public:
     void reset() override { _far->reset(); }
     bool hazesRasterPixels() const override { return true; }  // FarFieldOptions::hazeCovered
     const std::vector<uint32_t>* lastTracedPixels() const override { return &_far->lastTraced(); }
+    double lastRayStart() const override { return _far->lastRayStart(); }
     const RasterSelection* lastRaster() const override { return &_raster; }
 
     osg::Node* viewerScene() override {

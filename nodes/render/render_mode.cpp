@@ -169,6 +169,7 @@ public:
     }
     void reset() override { _inner->reset(); }
     const std::vector<uint32_t>* lastTracedPixels() const override { return _inner->lastTracedPixels(); }
+    double lastRayStart() const override { return _inner->lastRayStart(); }
     const RasterSelection* lastRaster() const override { return _inner->lastRaster(); }
     osg::Node* viewerScene() override {
         if (!_viewer) {

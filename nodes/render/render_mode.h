@@ -132,6 +132,8 @@ public:
     // (FarField::lastTraced(), ascending), or null for a mode without one
     // (all but hybrid). `vista bench --dump-rays` writes them as RaySet files.
     virtual const std::vector<uint32_t>* lastTracedPixels() const { return nullptr; }
+    // Where those rays started (metres from the eye; FarField::lastRayStart).
+    virtual double lastRayStart() const { return 0.0; }
     // The raster part of the last renderFrame() (full, hybrid), or null for
     // modes whose picture is not the chunked near field plus rays.
     virtual const RasterSelection* lastRaster() const { return nullptr; }

@@ -71,6 +71,7 @@ void FarField::render(const Camera& camera, const float* depth, Image& out, Fram
     f.moving = _mem->haveLast && !sameCamera(_mem->last, camera);
     _mem->last = camera;
     _mem->haveLast = true;
+    _rayStart = farRayStart(_options);
     renderStages(f, depth, stats);
     _traced = std::move(f.trace);
 }
@@ -80,8 +81,10 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
     // The horizon beginFrame started is this frame's, used or not: consumed here (its
     // destructor waits for the task if no stage took it).
     std::future<HorizonResult> early = std::move(_mem->earlyHorizon);
-    opacityStage(f, stats);
-    if (seamCheckApplies(f, _rays, _options)) seamStage(f, _rays, _options, stats);
+    // The seam check applies when something is covered: its candidates are listed by the opacity pass.
+    const bool seam = seamCheckApplies(f, _rays, _options);
+    opacityStage(f, stats, seam ? seamListDepth(f, _options) : 2.0f);
+    if (seam && f.covered > 0) seamStage(f, _rays, _options, stats);
     if (_options.hazeCovered && _options.effects.haze && depth && f.covered > 0) hazeCoveredStage(f, _options, stats);
     stats.pixels.covered += f.covered;
     if (f.covered == f.pixelCount) return;  // no sky, no far field visible: nothing else runs

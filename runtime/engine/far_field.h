@@ -58,7 +58,11 @@ enum FarPixelClass : uint8_t { kFarCovered = 0, kFarHorizon = 1, kFarCache = 2, 
 
 struct FarFieldOptions {
     double nearDistance = 100.0;  // metres (>= 0): horizon skips geometry the near field draws; 0 = skip nothing
-    bool nearIsDistance = true;   // false when the near field is a triangle budget (then no horizon skipping)
+    // true: the near field draws every object whose bounding box comes within nearDistance of
+    // the eye (selectNearField), so no surface nearer than nearDistance is missing from it: far
+    // and seam rays start at nearDistance. false when the near field is a triangle budget (then
+    // rays start at the eye and the horizon skips nothing).
+    bool nearIsDistance = true;
     // Panoramic cache (panorama_cache.h): a cached far pixel is reused while
     // its estimated reprojection error is below cacheErrorPx (0 = only
     // pixels traced by this very camera), else re-traced, the worst first, up
@@ -130,6 +134,8 @@ public:
     // y * width + x; empty when it did not run): rayHit/rayMiss pixels that
     // were not covered. Seam-check rays are not in it. RaySet files record it.
     const std::vector<uint32_t>& lastTraced() const { return _traced; }
+    // Where the last frame's far-field rays started (metres; FarFieldOptions::nearIsDistance).
+    float lastRayStart() const { return _rayStart; }
 
 private:
     void renderStages(FarFrame& f, const float* depth, FrameStats& stats);
@@ -139,6 +145,7 @@ private:
     std::unique_ptr<FarFieldMemory> _mem;  // cache, last frame, sky, early horizon (far_field_stages.h)
     std::vector<uint8_t> _class;
     std::vector<uint32_t> _traced;
+    float _rayStart = 0.0f;
 };
 
 }  // namespace vista

@@ -69,7 +69,7 @@ void cacheStage(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, FrameS
     policy.windowPx = kCacheWindowPx;
     policy.budget = cacheBudget(f, m, o, spentMs);
     if (o.frameMsTarget > 0) stats.notes.push_back("cache budget " + std::to_string(policy.budget) + " rays");
-    f.farDepth.assign(f.pixelCount, INFINITY);
+    f.farDepth.resize(f.pixelCount);  // only pending pixels are read: cache ones below, traced ones by the ray stage
     std::vector<uint8_t>& trace = m.traceMarks;
     inArena(o.threads, [&] { cache.selectForTracing(cand, policy, trace); });
     f.trace.clear();

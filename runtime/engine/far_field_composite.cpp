@@ -1,4 +1,4 @@
-// Composite stage (far_field_stages.h): sky behind the horizon, traced colours
+// Composite stage (far_field_stages.h): traced colours
 // into the panoramic cache, the frame kept for the next cache frame.
 #include <algorithm>
 #include <cmath>
@@ -24,25 +24,24 @@ const Image& skyImage(FarFieldMemory& m, const FarFrame& f) {
 
 void compositeStage(FarFrame& f, FarFieldMemory& m, bool cacheMode, FrameStats& stats, bool keepFrame) {
     Stopwatch sw;
-    for (size_t i = 0; i < f.pixelCount; ++i)
-        if (f.cls[i] == kFarHorizon) std::copy_n(&f.sky->rgba[i * 4], 4, &f.out.rgba[i * 4]);
     if (cacheMode) {
         if (m.cache && !f.trace.empty() && f.farDepth.size() == f.pixelCount) {
             // Nearest far surface around every traced pixel: minimum over the 3 x 3 blocks of
             // kCacheWindowPx pixels around its block (a window of radius >= kCacheWindowPx).
+            // Only pending pixels (cached or traced) have a far depth this frame; all others count
+            // as +inf, so the blocks are the minima over the pending list.
             const int B = int(kCacheWindowPx), bw = (f.width + B - 1) / B, bh = (f.height + B - 1) / B;
             std::vector<float> block(size_t(bw) * size_t(bh), INFINITY);
-            for (int y = 0; y < f.height; ++y) {
-                float* row = &block[size_t(y / B) * size_t(bw)];
-                const float* d = &f.farDepth[size_t(y) * size_t(f.width)];
-                for (int x = 0; x < f.width; ++x) row[x / B] = std::min(row[x / B], d[x]);
+            const uint32_t W = uint32_t(f.width);
+            for (const uint32_t i : f.pending) {
+                float& b = block[size_t(i / W) / size_t(B) * size_t(bw) + size_t(i % W) / size_t(B)];
+                b = std::min(b, f.farDepth[i]);
             }
             float lowest = INFINITY;
             for (float v : block) lowest = std::min(lowest, v);
             if (std::isfinite(lowest)) m.lastMinDepth = lowest;
             std::vector<glm::u8vec4> traced(f.trace.size());
             std::vector<float> nearest(f.trace.size());
-            const uint32_t W = uint32_t(f.width);
             for (size_t j = 0; j < f.trace.size(); ++j) {
                 const uint32_t i = f.trace[j];
                 std::copy_n(&f.out.rgba[size_t(i) * 4], 4, &traced[j][0]);

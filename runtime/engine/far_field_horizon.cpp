@@ -35,16 +35,26 @@ void horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o,
         stats.notes.push_back(hr.reason);
         return;
     }
+    // Row by row (contiguous in memory): pixel (x, y) is above the horizon when y < row[x]; it
+    // gets the sky colour here, so no later pass over the frame is needed.
+    const size_t W = size_t(f.width);
+    std::vector<int> rows(W);
+    int top = 0;
+    for (size_t x = 0; x < W; ++x) {
+        rows[x] = std::min(hr.row[x], f.height);
+        top = std::max(top, rows[x]);
+    }
     uint64_t culled = 0;
-    for (int x = 0; x < f.width; ++x) {
-        const int r = std::min(hr.row[size_t(x)], f.height);
-        for (int y = 0; y < r; ++y) {
-            uint8_t& c = f.cls[size_t(y) * size_t(f.width) + size_t(x)];
-            if (c == kFarPending) {
-                c = kFarHorizon;
+    for (int y = 0; y < top; ++y) {
+        uint8_t* c = &f.cls[size_t(y) * W];
+        uint8_t* px = &f.out.rgba[size_t(y) * W * 4];
+        const uint8_t* sky = &f.sky->rgba[size_t(y) * W * 4];
+        for (size_t x = 0; x < W; ++x)
+            if (y < rows[x] && c[x] == kFarPending) {
+                c[x] = kFarHorizon;
+                std::copy_n(sky + x * 4, 4, px + x * 4);
                 ++culled;
             }
-        }
     }
     stats.pixels.horizonCulled += culled;
     stats.stages.add(Stage::Horizon, sw.ms());
@@ -52,9 +62,10 @@ void horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o,
 
 void cullAllPending(FarFrame& f, FrameStats& stats) {
     uint64_t sky = 0;
-    for (uint8_t& c : f.cls)
-        if (c == kFarPending) {
-            c = kFarHorizon;
+    for (size_t i = 0; i < f.pixelCount; ++i)
+        if (f.cls[i] == kFarPending) {
+            f.cls[i] = kFarHorizon;
+            std::copy_n(&f.sky->rgba[i * 4], 4, &f.out.rgba[i * 4]);
             ++sky;
         }
     stats.pixels.horizonCulled += sky;

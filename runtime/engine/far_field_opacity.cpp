@@ -10,11 +10,12 @@ FarFrame::FarFrame(const Camera& c, const float* d, Image& o, std::vector<uint8_
     : camera(c), rays(c), width(c.width), height(c.height), pixelCount(size_t(c.width) * size_t(c.height)), depth(d),
       out(o), cls(classes) {}
 
-void opacityStage(FarFrame& f, FrameStats& stats) {
+void opacityStage(FarFrame& f, FrameStats& stats, float listAbove) {
     Stopwatch sw;
     const size_t W = size_t(f.width);
     f.cls.assign(f.pixelCount, kFarPending);
     f.columnNeeded.assign(W, 0);
+    f.seamCandidates.clear();
     f.covered = 0;
     if (f.depth) {
         for (size_t y = 0; y < size_t(f.height); ++y) {
@@ -24,6 +25,7 @@ void opacityStage(FarFrame& f, FrameStats& stats) {
                 if (d[x] < 1.0f) {
                     c[x] = kFarCovered;
                     ++f.covered;
+                    if (d[x] >= listAbove) f.seamCandidates.push_back(uint32_t(y * W + x));
                 } else {
                     f.columnNeeded[x] = 1;
                 }

@@ -85,7 +85,8 @@ void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, con
                     dirs[k] = glm::vec3(ddirs[k]);
                     if (fx.haze) tfars[k] = hazeTfar(ddirs[k], fwd, zMax);
                 }
-                scene.intersectMany(orgs.data(), dirs.data(), int(m), res.data(), 1e30f, fx.haze ? tfars.data() : nullptr);
+                scene.intersectMany(orgs.data(), dirs.data(), int(m), res.data(), 1e30f, fx.haze ? tfars.data() : nullptr,
+                                    shading.tnear);
                 for (size_t k = 0; k < m; ++k) {
                     const RayHit& h = res[k];
                     const double z = h.hit ? double(h.t) * glm::dot(ddirs[k], fwd) : 0.0;
@@ -127,12 +128,13 @@ std::vector<size_t> coherentRuns(const uint32_t* pixels, size_t n, int width) {
 }
 
 PrimaryRays primaryRays(const Camera& camera, const glm::dvec3& frameOrigin, const uint32_t* pixels, size_t n,
-                        double hazeFar) {
+                        double hazeFar, double tnear) {
     const PixelRays gen(camera);
     const glm::dvec3 fwd = camera.forward();
     const uint32_t W = uint32_t(camera.width);
     PrimaryRays r;
     r.org = glm::vec3(camera.eye - frameOrigin);
+    r.tnear = float(tnear);
     r.dirs.resize(n);
     r.tfars.assign(n, 1e30f);
     for (size_t k = 0; k < n; ++k) {
@@ -239,7 +241,7 @@ namespace {
 // direction when they all showed sky; every other entry casts its own ray.
 // Returns the number of interpolated entries; `hit`, `depth`, `keys` get one
 // value per entry of f.trace, colours go to f.out.
-uint64_t castOnLattice(FarFrame& f, FarFieldMemory& m, const RayScene& rays, int threads, RayCounts& counts,
+uint64_t castOnLattice(FarFrame& f, FarFieldMemory& m, const RayScene& rays, int threads, float tnear, RayCounts& counts,
                        uint8_t* hit, float* depth) {
     const size_t n = f.trace.size();
     const uint32_t W = uint32_t(f.width), H = uint32_t(f.height);
@@ -259,6 +261,7 @@ uint64_t castOnLattice(FarFrame& f, FarFieldMemory& m, const RayScene& rays, int
         RayShading sh;
         sh.effects = f.fx;
         sh.depth = d.data();
+        sh.tnear = tnear;
         if (keys) {
             keys->resize(sub.size());
             sh.keys = keys->data();
@@ -347,11 +350,12 @@ void raysStage(FarFrame& f, FarFieldMemory& m, const RayScene& rays, const FarFi
     RayCounts counts;
     uint64_t blended = 0;
     if (lattice) {
-        blended = castOnLattice(f, m, rays, o.threads, counts, hit.data(), depth.data());
+        blended = castOnLattice(f, m, rays, o.threads, farRayStart(o), counts, hit.data(), depth.data());
     } else {
         RayShading shading;
         shading.effects = f.fx;
         shading.depth = depth.empty() ? nullptr : depth.data();
+        shading.tnear = farRayStart(o);
         castPrimaryRays(rays, f.camera, f.trace.data(), n, f.out, counts, o.threads, hit.data(), shading);
     }
     for (size_t j = 0; j < n; ++j) f.cls[f.trace[j]] = hit[j] ? kFarRayHit : kFarRayMiss;

@@ -64,14 +64,16 @@ std::vector<size_t> coherentRuns(const uint32_t* pixels, size_t n, int width);
 // The rays castPrimaryRays casts for the listed pixels, bit for bit: the eye
 // in the scene-local frame around `frameOrigin`, unit float directions, and
 // far limits (hazeFar > 0: where the ray's eye-plane depth reaches hazeFar;
-// else 1e30). For timing the stage against raw Embree (bench_raw_rays).
+// else 1e30), and where they start (tnear, RayShading::tnear). For timing
+// the stage against raw Embree (bench_raw_rays).
 struct PrimaryRays {
     glm::vec3 org{0.0f};
+    float tnear = 0.0f;
     std::vector<glm::vec3> dirs;
     std::vector<float> tfars;
 };
 PrimaryRays primaryRays(const Camera& camera, const glm::dvec3& frameOrigin, const uint32_t* pixels, size_t n,
-                        double hazeFar);
+                        double hazeFar, double tnear = 0.0);
 
 struct RayCounts {
     uint64_t rays = 0;  // rays cast (hit or miss)
@@ -94,6 +96,9 @@ struct RayShading {
     const FrameEffects* effects = nullptr;  // null = none
     float* depth = nullptr;                 // n entries (castPrimaryRays) or width*height (castFrame)
     SurfaceKey* keys = nullptr;             // optional, like depth: the surface each entry showed
+    // Rays start at this distance (metres, >= 0): the far field sets the near distance, since a
+    // pixel the near field left uncovered has no surface nearer than it (nodes/near_far_split.h).
+    float tnear = 0.0f;
 };
 
 // Casts the rays of the n listed pixels (indices y * width + x) and writes

@@ -12,8 +12,24 @@
 namespace vista {
 
 bool seamCheckApplies(const FarFrame& f, const RayScene& rays, const FarFieldOptions& o) {
-    return f.depth && f.covered > 0 && o.verifySeam && o.nearIsDistance && o.nearDistance > 0 && std::isfinite(o.nearDistance) &&
+    return f.depth && o.verifySeam && o.nearIsDistance && o.nearDistance > 0 && std::isfinite(o.nearDistance) &&
            rays.triangleCount() > 0;
+}
+
+float seamListDepth(const FarFrame& f, const FarFieldOptions& o) {
+    // A pixel's distance is its eye depth times sqrt(1 + sx^2 + sy^2) <= kMax
+    // (the corner pixels'), so no surface with eye depth <= nearDistance / kMax
+    // reaches beyond the near distance. Its window depth (minus a margin for
+    // float rounding) is one compare per pixel.
+    const double n = f.camera.zNear, zf = o.depthZFar;
+    const double sx = std::max(std::abs(f.rays.screenX(0)), std::abs(f.rays.screenX(f.width - 1)));
+    const double sy = std::max(std::abs(f.rays.screenY(0)), std::abs(f.rays.screenY(f.height - 1)));
+    const double kMax = std::sqrt(1.0 + sx * sx + sy * sy);
+    const double zMin = o.nearDistance / kMax;
+    if (zMin <= n) return -1.0f;
+    // Window depth of eye depth z (inverse of eyeDepthOfWindowDepth).
+    const double dMin = zf > 0 ? (zf / (zf - n)) * (1.0 - n / zMin) : 1.0 - n / zMin;
+    return float(dMin - 1e-6);
 }
 
 void seamStage(FarFrame& f, const RayScene& rays, const FarFieldOptions& o, FrameStats& stats) {
@@ -22,41 +38,31 @@ void seamStage(FarFrame& f, const RayScene& rays, const FarFieldOptions& o, Fram
     const uint32_t W = uint32_t(f.width);
     // Covered pixels whose surface (window depth -> eye z -> distance along
     // the pixel's ray) lies beyond the near distance; tfar just before it.
+    // The opacity stage listed the candidates (window depth >= seamListDepth).
     std::vector<uint32_t> check;
     std::vector<float> dist;
-    // Quick rejection: a pixel's distance is its eye depth times
-    // sqrt(1 + sx^2 + sy^2) <= kMax (the corner pixels'), so no surface with
-    // eye depth <= nearDistance / kMax reaches beyond the near distance. Its
-    // window depth (minus a margin for float rounding) is one compare per pixel.
     std::vector<double> sx2(W), sy2(size_t(f.height));
     for (uint32_t x = 0; x < W; ++x) sx2[x] = f.rays.screenX(int(x)) * f.rays.screenX(int(x));
     for (int y = 0; y < f.height; ++y) sy2[size_t(y)] = f.rays.screenY(y) * f.rays.screenY(y);
-    const double kMax = std::sqrt(1.0 + std::max(sx2.front(), sx2.back()) + std::max(sy2.front(), sy2.back()));
-    const double zMin = o.nearDistance / kMax;
-    // Window depth of eye depth z (inverse of eyeDepthOfWindowDepth).
-    const double dMin = zf > 0 ? (zf / (zf - n)) * (1.0 - n / zMin) : 1.0 - n / zMin;
-    const float reject = zMin <= n ? -1.0f : float(dMin - 1e-6);
-    for (size_t y = 0; y < size_t(f.height); ++y) {
-        const float* d = f.depth + y * W;
-        const uint8_t* c = &f.cls[y * W];
-        for (uint32_t x = 0; x < W; ++x) {
-            if (c[x] != kFarCovered || d[x] < reject) continue;
-            const double ze = eyeDepthOfWindowDepth(double(d[x]), n, zf);
-            const double t = ze * std::sqrt(1.0 + sx2[x] + sy2[y]);
-            if (t > o.nearDistance) {
-                check.push_back(uint32_t(y * W + x));
-                dist.push_back(float(t * (1.0 - 1e-3)));
-            }
+    for (const uint32_t i : f.seamCandidates) {
+        const uint32_t x = i % W, y = i / W;
+        const double ze = eyeDepthOfWindowDepth(double(f.depth[i]), n, zf);
+        const double t = ze * std::sqrt(1.0 + sx2[x] + sy2[y]);
+        if (t > o.nearDistance) {
+            check.push_back(i);
+            dist.push_back(float(t * (1.0 - 1e-3)));
         }
     }
     if (!check.empty()) {
         const glm::vec3 org(f.camera.eye - rays.frameOrigin());
+        // Nothing the near field left out lies nearer than the near distance: start there.
+        const float tnear = farRayStart(o);
         std::vector<RayHit> res(check.size());
         inArena(o.threads, [&] {
             tbb::parallel_for(tbb::blocked_range<size_t>(0, check.size(), 256), [&](const tbb::blocked_range<size_t>& br) {
                 for (size_t k = br.begin(); k != br.end(); ++k) {
                     const uint32_t i = check[k];
-                    res[k] = rays.intersect(org, glm::vec3(f.rays.dir(int(i % W), int(i / W))), 0.0f, dist[k]);
+                    res[k] = rays.intersect(org, glm::vec3(f.rays.dir(int(i % W), int(i / W))), tnear, dist[k]);
                 }
             });
         });

@@ -6,6 +6,7 @@
 // its wall time to FrameStats::stages. Not thread-safe (one frame, one writer);
 // nothing throws.
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <future>
 #include <memory>
@@ -37,6 +38,12 @@ void inArena(int threads, const F& body) {
 inline double eyeDepthOfWindowDepth(double d, double n, double zf) {
     const double zn = 2.0 * d - 1.0;
     return zf > 0 ? 2.0 * zf * n / ((zf + n) - zn * (zf - n)) : 2.0 * n / (1.0 - zn);
+}
+
+// Where the far field's rays start (metres): just short of the near distance
+// when the near field is one (FarFieldOptions::nearIsDistance), else the eye.
+inline float farRayStart(const FarFieldOptions& o) {
+    return o.nearIsDistance && o.nearDistance > 0 && std::isfinite(o.nearDistance) ? float(o.nearDistance * 0.999) : 0.0f;
 }
 
 // What a FarField keeps from frame to frame.
@@ -78,22 +85,28 @@ struct FarFrame {
     const FrameEffects* fx = nullptr;  // run-time effects (haze, night sky); never null during render()
     std::vector<uint8_t> columnNeeded;  // per column: has a pending pixel (opacity)
     uint64_t covered = 0;          // pixels of class covered (opacity, seam)
+    std::vector<uint32_t> seamCandidates;  // covered pixels the seam check examines (opacity)
     std::vector<uint32_t> pending; // pending pixels after the horizon, ascending
     std::vector<uint32_t> trace;   // pixels to trace this frame, ascending (cache)
     std::vector<int64_t> traceCells;  // their panorama cells (cache stage only)
     std::vector<glm::u8vec2> traceSubs;  // where their rays fall in those cells (cache stage only)
-    std::vector<float> farDepth;   // cache mode: per pixel, eye-plane depth of its far colour (+inf = sky/none)
+    std::vector<float> farDepth;   // cache mode: per pending pixel, eye-plane depth of its far colour (+inf = sky/none); others unset
 };
 
 // Opacity (far_field_opacity.cpp). In: depth (null = nothing covered). Out:
-// cls (every pixel covered or pending), covered, columnNeeded. Records Opacity.
-void opacityStage(FarFrame& f, FrameStats& stats);
+// cls (every pixel covered or pending), covered, columnNeeded, and
+// seamCandidates: the covered pixels with window depth >= listAbove (> 1 =
+// none), ascending. Records Opacity.
+void opacityStage(FarFrame& f, FrameStats& stats, float listAbove = 2.0f);
 
+// The window depth below which no covered pixel can lie beyond the near
+// distance (the seam's candidates are the covered pixels at or above it).
+float seamListDepth(const FarFrame& f, const FarFieldOptions& o);
 // Seam check (far_field_seam.cpp) applies when o.verifySeam, the near field
-// is a distance > 0, depth exists, something is covered and the scene has
-// triangles.
+// is a distance > 0, depth exists and the scene has triangles (it runs when,
+// after the opacity stage, something is covered).
 bool seamCheckApplies(const FarFrame& f, const RayScene& rays, const FarFieldOptions& o);
-// In: cls, depth, o.nearDistance, o.depthZFar, camera.zNear. Every covered
+// In: seamCandidates, depth, o.nearDistance, o.depthZFar, camera.zNear. Every candidate
 // pixel whose surface lies beyond the near distance casts one ray with tfar =
 // that distance: a hit turns it rayHit (colour written, covered decremented,
 // pixels.rayHit counted), a miss leaves it covered. Every such ray, hit or
@@ -108,7 +121,8 @@ void hazeCoveredStage(FarFrame& f, const FarFieldOptions& o, FrameStats& stats);
 
 // Horizon (far_field_horizon.cpp), run when o.horizon. In: grid,
 // columnNeeded, moving, camera. When horizon tracing applies, pending pixels
-// above their column's row become horizonCulled and Horizon is recorded; when
+// above their column's row become horizonCulled with their sky colour (f.sky)
+// written to out, and Horizon is recorded; when
 // it does not (no grid, camera rolled, zenith/nadir in view) a note says why,
 // nothing is culled and no time is recorded.
 // early (optional): the horizon of this very camera traced ahead of the
@@ -118,7 +132,7 @@ void horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o,
                   std::future<HorizonResult>* early = nullptr);
 // The horizon options of a frame (near distance, haze depth, subsampling while moving).
 HorizonOptions horizonOptions(const FarFieldOptions& o, bool moving);
-// No far geometry: every pending pixel becomes horizonCulled (sky). No time.
+// No far geometry: every pending pixel becomes horizonCulled, sky colour written. No time.
 void cullAllPending(FarFrame& f, FrameStats& stats);
 
 // Lists the pending pixels in f.pending (ascending). No time.
@@ -129,8 +143,9 @@ void listPending(FarFrame& f);
 // (Re)creates the panorama for the camera, selects the pixels to trace under
 // the quality-bounded policy (f.trace, f.traceCells); the others become cache
 // and get their cell's colour (never traced: last frame's pixel, else sky).
-// Sets f.farDepth (every pixel, +inf except cache pixels: their cell's
-// nearest surface; the ray stage fills the traced ones). Records Cache; with
+// Sizes f.farDepth to the frame and sets it for the cache pixels (their cell's
+// nearest surface; the ray stage fills the traced ones; other pixels are left
+// as they were and never read). Records Cache; with
 // a frame-time target, a note gives the budget.
 void cacheStage(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, FrameStats& stats);
 // The pixel budget of this frame: o.pixelBudget, capped with a frame-time
@@ -151,8 +166,7 @@ void raysStage(FarFrame& f, FarFieldMemory& m, const RayScene& rays, const FarFi
 
 // Sky colours of the camera (far_field_composite.cpp), cached in m.sky.
 const Image& skyImage(FarFieldMemory& m, const FarFrame& f);
-// Composite (far_field_composite.cpp). Writes sky into every horizonCulled
-// pixel; in cache mode, stores the traced pixels' colours (now in out) into
+// Composite (far_field_composite.cpp). In cache mode, stores the traced pixels' colours (now in out) into
 // m.cache with the nearest far surface of their window (f.farDepth), sets
 // m.lastMinDepth and keeps the frame in m.prev (when keepFrame). Assigns no
 // class. Records Composite.

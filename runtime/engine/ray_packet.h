@@ -1,7 +1,7 @@
 // The lanes of an Embree 8-wide packet, set up one way for every caller:
 // RayScene::intersectMany and the raw timing of tests/bench/bench_raw_rays.cpp
 // (so "raw" differs from the wrapper only by what the wrapper adds).
-// Lane k < m takes ray base + k: org[i], dir[i], tnear 0, tfar tfars[i] (or
+// Lane k < m takes ray base + k: org[i], dir[i], tnear, tfar tfars[i] (or
 // `tfar` when tfars is null), no hit yet; lanes m..7 repeat ray `base` and
 // are invalid (valid[k] = 0). Contract: 1 <= m <= 8; rays base .. base+m-1
 // exist. Engine-internal (includes Embree); pure.
@@ -14,13 +14,13 @@
 namespace vista {
 
 inline void fillPacket8(RTCRayHit8& rh, int* valid, const glm::vec3* org, const glm::vec3* dir, const float* tfars,
-                        float tfar, size_t base, int m) {
+                        float tfar, size_t base, int m, float tnear = 0.0f) {
     for (int k = 0; k < 8; ++k) {
         const size_t i = base + size_t(k < m ? k : 0);
         valid[k] = k < m ? -1 : 0;
         rh.ray.org_x[k] = org[i].x; rh.ray.org_y[k] = org[i].y; rh.ray.org_z[k] = org[i].z;
         rh.ray.dir_x[k] = dir[i].x; rh.ray.dir_y[k] = dir[i].y; rh.ray.dir_z[k] = dir[i].z;
-        rh.ray.tnear[k] = 0.0f;
+        rh.ray.tnear[k] = tnear;
         rh.ray.tfar[k] = tfars ? tfars[i] : tfar;
         rh.ray.time[k] = 0.0f;
         rh.ray.mask[k] = 0xFFFFFFFFu;

@@ -392,7 +392,7 @@ RayHit RayScene::intersect(const glm::vec3& org, const glm::vec3& dir, float tne
 }
 
 void RayScene::intersectMany(const glm::vec3* org, const glm::vec3* dir, int n, RayHit* out, float tfar,
-                             const float* tfars) const {
+                             const float* tfars, float tnear) const {
     if (_impl->ftz) enableFtzDaz();
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
@@ -401,7 +401,7 @@ void RayScene::intersectMany(const glm::vec3* org, const glm::vec3* dir, int n, 
     alignas(32) int valid[8];
     for (int base = 0; base < n; base += 8) {
         int m = std::min(8, n - base);
-        fillPacket8(rh, valid, org, dir, tfars, tfar, size_t(base), m);
+        fillPacket8(rh, valid, org, dir, tfars, tfar, size_t(base), m, tnear);
         rtcIntersect8(valid, _impl->scene, &ctx, &rh);
         for (int k = 0; k < m; ++k) {
             RayHit& h = out[base + k];

@@ -75,9 +75,10 @@ public:
     // Single ray in scene-local coordinates. dir must be unit length.
     RayHit intersect(const glm::vec3& org, const glm::vec3& dir, float tnear = 0.0f, float tfar = 1e30f) const;
     // Coherent batch (packets of 8 internally): n rays sharing no constraints.
-    // tfars (optional, n values): a far limit per ray instead of `tfar`.
+    // tfars (optional, n values): a far limit per ray instead of `tfar`;
+    // tnear: every ray starts there (surfaces nearer are not seen; tnear > tfar = a miss).
     void intersectMany(const glm::vec3* org, const glm::vec3* dir, int n, RayHit* out, float tfar = 1e30f,
-                       const float* tfars = nullptr) const;
+                       const float* tfars = nullptr, float tnear = 0.0f) const;
     // Occlusion test: true if anything lies within (tnear, tfar).
     bool occluded(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar) const;
     // All surfaces along the ray in (tnear, tfar), nearest first, at most

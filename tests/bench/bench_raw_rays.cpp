@@ -107,7 +107,7 @@ World& world() {
             Frame f;
             f.set = std::move(*s);
             const size_t n = f.set.pixels.size();
-            f.rays = primaryRays(f.set.camera, x.scene->frameOrigin(), f.set.pixels.data(), n, f.set.hazeFar);
+            f.rays = primaryRays(f.set.camera, x.scene->frameOrigin(), f.set.pixels.data(), n, f.set.hazeFar, f.set.tnear);
             f.runs = coherentRuns(f.set.pixels.data(), n, f.set.camera.width);
             f.orgs.assign(n, f.rays.org);
             f.fx.haze = f.set.hazeFar > 0;
@@ -154,7 +154,7 @@ uint64_t raw1(RTCScene scene, const PrimaryRays& r, size_t b, size_t e) {
         RTCRayHit rh;
         rh.ray.org_x = r.org.x; rh.ray.org_y = r.org.y; rh.ray.org_z = r.org.z;
         rh.ray.dir_x = r.dirs[k].x; rh.ray.dir_y = r.dirs[k].y; rh.ray.dir_z = r.dirs[k].z;
-        rh.ray.tnear = 0.0f;
+        rh.ray.tnear = r.tnear;
         rh.ray.tfar = r.tfars[k];
         rh.ray.time = 0.0f;
         rh.ray.mask = 0xFFFFFFFFu;
@@ -179,7 +179,7 @@ uint64_t raw8(RTCScene scene, const Frame& f, size_t b, size_t e, const RayScene
     uint64_t hits = 0;
     for (size_t p = b; p < e; p += 8) {
         const int m = int(std::min<size_t>(8, e - p));
-        fillPacket8(rh, valid, f.orgs.data(), f.rays.dirs.data(), f.rays.tfars.data(), 0.0f, p, m);
+        fillPacket8(rh, valid, f.orgs.data(), f.rays.dirs.data(), f.rays.tfars.data(), 0.0f, p, m, f.rays.tnear);
         rtcIntersect8(valid, scene, &ctx, &rh);
         for (int k = 0; k < m; ++k) hits += rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
         if (!colours) continue;
@@ -255,14 +255,14 @@ uint64_t passFrame(Variant v, Frame& f, int threads) {
                         const size_t s = f.runs[r], m = f.runs[r + 1] - s;
                         res.resize(m);
                         w.scene->intersectMany(f.orgs.data() + s, f.rays.dirs.data() + s, int(m), res.data(), 1e30f,
-                                               f.rays.tfars.data() + s);
+                                               f.rays.tfars.data() + s, f.rays.tnear);
                         for (const RayHit& x : res) h += x.hit ? 1 : 0;
                     }
                     return h;
                 });
                 break;
             case Variant::Dirs: {
-                const PrimaryRays r = primaryRays(f.set.camera, w.scene->frameOrigin(), f.set.pixels.data(), n, f.set.hazeFar);
+                const PrimaryRays r = primaryRays(f.set.camera, w.scene->frameOrigin(), f.set.pixels.data(), n, f.set.hazeFar, f.set.tnear);
                 benchmark::DoNotOptimize(r.dirs.data());
                 break;
             }
@@ -271,6 +271,7 @@ uint64_t passFrame(Variant v, Frame& f, int threads) {
                 RayShading shading;
                 shading.effects = &f.fx;
                 shading.depth = f.depth.empty() ? nullptr : f.depth.data();
+                shading.tnear = float(f.set.tnear);
                 castPrimaryRays(*w.scene, f.set.camera, f.set.pixels.data(), n, f.out, counts, threads, f.hit.data(), shading);
                 hits += counts.hits;
                 break;

@@ -99,6 +99,9 @@ Reference reference(const RayScene& rs, const Camera& c, const float* depth, con
     r.covered.assign(N, 0);
     const glm::dmat4 inv = glm::inverse(c.projection(o.depthZFar));
     const glm::vec3 org(c.eye - rs.frameOrigin());
+    // A near field given as a distance holds every surface nearer than it
+    // (FarFieldOptions::nearIsDistance), so rays start just short of it.
+    const float tnear = o.nearIsDistance && o.nearDistance > 0 ? float(o.nearDistance * 0.999) : 0.0f;
     for (int y = 0; y < c.height; ++y)
         for (int x = 0; x < c.width; ++x) {
             const size_t i = size_t(y) * size_t(c.width) + size_t(x);
@@ -110,7 +113,7 @@ Reference reference(const RayScene& rs, const Camera& c, const float* depth, con
                 const double dist = glm::length(glm::dvec3(e) / e.w);
                 if (!o.verifySeam || o.nearDistance <= 0 || dist <= o.nearDistance) continue;
                 ++r.seamRays;
-                const RayHit h = rs.intersect(org, glm::vec3(d), 0.0f, float(dist * (1.0 - 1e-3)));
+                const RayHit h = rs.intersect(org, glm::vec3(d), tnear, float(dist * (1.0 - 1e-3)));
                 if (h.hit) {
                     ++r.seamHits;
                     r.covered[i] = 0;
@@ -119,7 +122,7 @@ Reference reference(const RayScene& rs, const Camera& c, const float* depth, con
                 }
                 continue;
             }
-            const RayHit h = rs.intersect(org, glm::vec3(d));
+            const RayHit h = rs.intersect(org, glm::vec3(d), tnear);
             r.hit[i] = h.hit ? 1 : 0;
             r.image.set(x, y, h.hit ? opaque(h) : skyOf(d));
         }

@@ -36,6 +36,7 @@ RaySet sampleSet() {
     s.camera = testCamera({1.0e6 + 0.25, -3.5, 1.7}, 0.3, -0.05, 64, 48, 0.9, 0.01);
     s.camera.zNear = 0.25;
     s.hazeFar = 1234.5;
+    s.tnear = 87.25;
     for (uint32_t i = 3; i < 64 * 48; i += 7) s.pixels.push_back(i);
     return s;
 }
@@ -51,6 +52,7 @@ void expectSame(const RaySet& a, const RaySet& b) {
     EXPECT_EQ(a.camera.width, b.camera.width);
     EXPECT_EQ(a.camera.height, b.camera.height);
     EXPECT_EQ(a.hazeFar, b.hazeFar);
+    EXPECT_EQ(a.tnear, b.tnear);
     EXPECT_EQ(a.pixels, b.pixels);
 }
 
@@ -64,7 +66,7 @@ std::string rehash(std::string b) {
 void putU32(std::string& b, size_t at, uint32_t v) { std::memcpy(&b[at], &v, 4); }  // little-endian host
 
 // Byte offsets of the layout (ray_set.h).
-constexpr size_t kWidthAt = 16, kCountAt = 8 + 16 + 9 * 8, kPixelsAt = kCountAt + 8;
+constexpr size_t kWidthAt = 16, kCountAt = 8 + 16 + 10 * 8, kPixelsAt = kCountAt + 8;
 
 void expectRefused(const std::string& bytes, const std::string& words, const std::string& label) {
     auto r = decodeRaySet(bytes, "set.rays");
@@ -129,8 +131,8 @@ TEST(RaySet, RefusesTruncatedCorruptAndInconsistentFiles) {
     putU32(b, kWidthAt + 4, 9000);
     expectRefused(rehash(b), "height = 9000", "height");
     b = good;
-    putU32(b, 8, 2);
-    expectRefused(rehash(b), "version = 2", "version");
+    putU32(b, 8, 1);
+    expectRefused(rehash(b), "version = 1", "version");
     b = good;
     putU32(b, kPixelsAt + 4, 1);  // pixel 1 = 1 < pixel 0 = 3
     expectRefused(rehash(b), "not above", "descending");
@@ -191,16 +193,19 @@ TEST(RaySet, LastTracedIsWhatTheRayStageCastAndReproducesItsPixels) {
     // castPrimaryRays and primaryRays + coherentRuns + intersectMany alike.
     Image again(c.width, c.height);
     RayCounts counts;
-    castPrimaryRays(**rs, c, traced.data(), traced.size(), again, counts, 1);
+    RayShading start;
+    start.tnear = ff.lastRayStart();
+    EXPECT_GT(start.tnear, 0.0f) << "a near field given as a distance: rays start there";
+    castPrimaryRays(**rs, c, traced.data(), traced.size(), again, counts, 1, nullptr, start);
     EXPECT_EQ(counts.rays, traced.size());
-    const PrimaryRays rays = primaryRays(c, (*rs)->frameOrigin(), traced.data(), traced.size(), 0.0);
+    const PrimaryRays rays = primaryRays(c, (*rs)->frameOrigin(), traced.data(), traced.size(), 0.0, ff.lastRayStart());
     const std::vector<size_t> runs = coherentRuns(traced.data(), traced.size(), c.width);
     ASSERT_EQ(runs.back(), traced.size());
     std::vector<RayHit> hits(traced.size());
     const std::vector<glm::vec3> orgs(traced.size(), rays.org);
     for (size_t r = 0; r + 1 < runs.size(); ++r)
         (*rs)->intersectMany(orgs.data() + runs[r], rays.dirs.data() + runs[r], int(runs[r + 1] - runs[r]),
-                             hits.data() + runs[r], 1e30f, rays.tfars.data() + runs[r]);
+                             hits.data() + runs[r], 1e30f, rays.tfars.data() + runs[r], rays.tnear);
     for (size_t k = 0; k < traced.size(); ++k) {
         const int x = int(traced[k] % uint32_t(c.width)), y = int(traced[k] / uint32_t(c.width));
         ASSERT_EQ(again.at(x, y), out.at(x, y)) << "pixel " << traced[k];
@@ -282,9 +287,12 @@ TEST(RaySet, BenchDumpsTheHybridFramesRays) {
         std::snprintf(name, sizeof name, "b/frames/f%04d_hybrid.png", f);
         auto png = readPng(dir.file(name));
         ASSERT_TRUE(png.isOk()) << png.status().message();
+        EXPECT_NEAR(set->tnear, 10.0, 0.05) << "--near 10: the far rays start at the near distance";
         Image again(160, 120);
         RayCounts counts;
-        castPrimaryRays(**rs, set->camera, set->pixels.data(), set->pixels.size(), again, counts, 1);
+        RayShading start;
+        start.tnear = float(set->tnear);
+        castPrimaryRays(**rs, set->camera, set->pixels.data(), set->pixels.size(), again, counts, 1, nullptr, start);
         size_t differ = 0;
         for (uint32_t i : set->pixels)
             differ += again.at(int(i % 160), int(i / 160)) != png->at(int(i % 160), int(i / 160)) ? 1 : 0;
