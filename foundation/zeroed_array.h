@@ -1,8 +1,11 @@
 // ZeroedArray<T>: a fixed-size array whose elements start as all-zero bytes,
-// allocated with calloc so that pages never touched cost neither time nor
-// memory (large allocations come from the OS as zero pages on first touch).
-// For big sparse tables such as the panoramic cache (millions of cells, a
-// few thousand touched per frame): a std::vector would write every byte.
+// taken from the OS as zero pages on first touch, so that pages never touched
+// cost neither time nor memory. For big sparse tables such as the panoramic
+// cache (millions of cells, a few thousand touched per frame): a std::vector
+// would write every byte. Arrays of kHugeBytes or more are mapped on 2 MiB
+// boundaries with transparent huge pages requested (Linux): a region is then
+// faulted in by one 2 MiB zero fill instead of 512 page faults, and random
+// lookups miss the TLB less; elsewhere, or when that fails, calloc.
 //
 // Contract: T is trivially copyable and all-zero bytes are a valid T (the
 // caller encodes its "empty" value as zero). Allocation failure is a
@@ -10,13 +13,19 @@
 // the same element; distinct elements may be written from distinct threads.
 #pragma once
 #include <cstddef>
-#include <cstdlib>
+#include <cstdint>
 #include <memory>
 #include <type_traits>
 
 #include "foundation/status.h"
 
 namespace vista {
+
+// Zero-filled memory of `bytes` (> 0) bytes, or null when out of memory; free
+// it with freeZeroed(p, bytes). Large blocks: huge pages where available.
+void* allocateZeroed(size_t bytes);
+void freeZeroed(void* p, size_t bytes);
+constexpr size_t kHugeBytes = size_t(4) << 20;
 
 template <class T>
 class ZeroedArray {
@@ -30,7 +39,8 @@ public:
         _data.reset();
         _size = 0;
         if (n == 0) return;
-        _data.reset(static_cast<T*>(std::calloc(n, sizeof(T))));
+        VISTA_CHECK(n <= SIZE_MAX / sizeof(T));
+        _data = std::unique_ptr<T, Free>(static_cast<T*>(allocateZeroed(n * sizeof(T))), Free{n * sizeof(T)});
         VISTA_CHECK(_data != nullptr);
         _size = n;
     }
@@ -44,7 +54,8 @@ public:
 
 private:
     struct Free {
-        void operator()(T* p) const { std::free(p); }
+        size_t bytes = 0;
+        void operator()(T* p) const { freeZeroed(p, bytes); }
     };
     std::unique_ptr<T, Free> _data;
     size_t _size = 0;

@@ -87,12 +87,8 @@ float PanoramaCache::decodeNear(uint32_t v) {
 
 void PanoramaCache::clear() {
     size_t n = size_t(_width) * size_t(_height);
-    _color.reset(n);
-    _near.reset(n);
-    _sub.reset(n);
-    _stamped.reset(n);
+    _cells.reset(n);
     _stamp = 0;
-    _record.reset(n);
     _records.assign(1, Record{});
     _baseline.assign(1, INFINITY);
     _current = 0;
@@ -126,7 +122,7 @@ void PanoramaCache::compact() {
     // Keep only records still referenced by a cell (and the current one).
     std::vector<uint32_t> remap(_records.size(), 0);
     std::vector<uint8_t> used(_records.size(), 0);
-    for (uint32_t r : _record) used[r] = 1;
+    for (const Cell& c : _cells) used[c.record] = 1;
     if (_current) used[_current] = 1;
     std::vector<Record> kept(1);
     for (size_t i = 1; i < _records.size(); ++i)
@@ -140,19 +136,20 @@ void PanoramaCache::compact() {
         for (auto& m : remap) m = m <= drop ? 0 : uint32_t(m - drop);
         kept.erase(kept.begin() + 1, kept.begin() + 1 + long(drop));
     }
-    for (auto& r : _record) r = remap[r];
+    for (Cell& c : _cells) c.record = remap[c.record];
     _current = remap[_current];
     _records = std::move(kept);
 }
 
 double PanoramaCache::error(int64_t cell, glm::u8vec2 sub, const CachePolicy& p) const {
-    const uint32_t r = _record[size_t(cell)];
+    const Cell& c = _cells[size_t(cell)];
+    const uint32_t r = c.record;
     if (r == 0) return INFINITY;
     if (r == _current) return -1.0;  // traced by this very camera
     // Resampling: the angle between the cell's traced ray and this one. On the
     // cylinder a column step is 2 pi / width of azimuth (times cos elevation
     // on the sphere), a row step 2 vMax / height of tan(elevation) (times cos^2).
-    const glm::u8vec2 s = _sub[size_t(cell)] ^ glm::u8vec2(kSubBias);
+    const glm::u8vec2 s = c.sub ^ glm::u8vec2(kSubBias);
     const double v = _vMax - (double(cell / _width) + 0.5) * 2.0 * _vMax / _height;
     const double c2 = 1.0 / (1.0 + v * v);
     const double du = (double(sub.x) - double(s.x)) / 256.0 * kTwoPi / _width * std::sqrt(c2);
@@ -160,7 +157,7 @@ double PanoramaCache::error(int64_t cell, glm::u8vec2 sub, const CachePolicy& p)
     const double offset = std::sqrt(du * du + dv * dv);
     const double b = _baseline[r];
     if (b == 0) return offset / p.radPerPixel;  // rotation only
-    const double own = b / double(decodeNear(_near[size_t(cell)]));  // 0 when the window was all sky
+    const double own = b / double(decodeNear(c.nearBits));  // 0 when the window was all sky
     const double outside = p.lowerDepth > 0 ? b / p.lowerDepth - p.windowPx * p.radPerPixel : INFINITY;
     return (std::max(own, outside) + offset) / p.radPerPixel;
 }
@@ -203,21 +200,18 @@ void PanoramaCache::store(const std::vector<int64_t>& cells, const std::vector<g
                           const std::vector<glm::u8vec4>& colors, const std::vector<float>& nearDistance) {
     VISTA_CHECK(cells.size() == colors.size() && cells.size() == nearDistance.size() && cells.size() == subs.size());
     // Cells hit by two pixels this frame hold only one of them: not exact (record 0).
-    ++_stamp;
-    if (_stamp == 0) {  // wrapped: forget old stamps
-        std::fill(_stamped.begin(), _stamped.end(), 0u);
-        _stamp = 1;
-    }
+    if (++_stamp == 0) _stamp = 1;  // 0 = never written
     for (size_t i = 0; i < cells.size(); ++i) {
         int64_t c = cells[i];
         if (c < 0) continue;
         const size_t k = size_t(c);
-        const bool twice = _stamped[k] == _stamp;
-        _stamped[k] = _stamp;
-        _color[k] = colors[i];
-        _sub[k] = subs[i] ^ glm::u8vec2(kSubBias);
-        _near[k] = encodeNear(nearDistance[i]);
-        _record[k] = twice ? 0 : _current;
+        Cell& cell = _cells[k];
+        const bool twice = cell.stamp == _stamp;
+        cell.stamp = _stamp;
+        cell.color = colors[i];
+        cell.sub = subs[i] ^ glm::u8vec2(kSubBias);
+        cell.nearBits = encodeNear(nearDistance[i]);
+        cell.record = twice ? 0 : _current;
     }
 }
 

@@ -96,9 +96,9 @@ public:
     // metres, +inf = none); duplicates are reset to record 0.
     void store(const std::vector<int64_t>& cells, const std::vector<glm::u8vec2>& subs,
                const std::vector<glm::u8vec4>& colors, const std::vector<float>& nearDistance);
-    glm::u8vec4 color(int64_t cell) const { return _color[size_t(cell)]; }
-    float nearDistance(int64_t cell) const { return decodeNear(_near[size_t(cell)]); }
-    uint32_t record(int64_t cell) const { return _record[size_t(cell)]; }
+    glm::u8vec4 color(int64_t cell) const { return _cells[size_t(cell)].color; }
+    float nearDistance(int64_t cell) const { return decodeNear(_cells[size_t(cell)].nearBits); }
+    uint32_t record(int64_t cell) const { return _cells[size_t(cell)].record; }
     size_t recordCount() const { return _records.size(); }
     uint32_t currentRecord() const { return _current; }
 
@@ -111,22 +111,29 @@ private:
     void compact();
     int _width = 0, _height = 0;
     double _vMax = 1;
-    // Per cell, zero-initialised so that a fresh panorama costs nothing until
-    // touched: colour (alpha 0 = never traced), nearest far surface (float
-    // bits XOR those of +inf: zero = +inf), sub-cell position (XOR 128:
-    // zero = the centre), record (0 = never traced).
+    // One cell, 16 bytes (one cache line holds four; a lookup or a store
+    // touches one), zero-initialised so that a fresh panorama costs nothing
+    // until touched: colour (alpha 0 = never traced), nearest far surface
+    // (float bits XOR those of +inf: zero = +inf), sub-cell position (XOR
+    // 128: zero = the centre), the store() call that last wrote it (16 bits,
+    // wrapping: a stale match only makes a cell re-traced), record (0 =
+    // never traced).
+    struct Cell {
+        glm::u8vec4 color;
+        uint32_t nearBits;
+        glm::u8vec2 sub;
+        uint16_t stamp;
+        uint32_t record;
+    };
+    static_assert(sizeof(Cell) == 16, "a panorama cell is 16 bytes");
     static uint32_t encodeNear(float d);
     static float decodeNear(uint32_t v);
     static constexpr uint8_t kSubBias = 128;
-    ZeroedArray<glm::u8vec4> _color;
-    ZeroedArray<uint32_t> _near;
-    ZeroedArray<glm::u8vec2> _sub;
-    ZeroedArray<uint32_t> _record;
+    ZeroedArray<Cell> _cells;
     std::vector<Record> _records;  // [0] = never traced
     uint32_t _current = 0;
     std::vector<double> _baseline;  // per record: distance to the current eye (beginFrame)
-    ZeroedArray<uint32_t> _stamped;  // per cell: the store() call that last wrote it
-    uint32_t _stamp = 0;
+    uint16_t _stamp = 0;
     std::vector<double> _error;      // scratch of selectForTracing
 };
 

@@ -226,3 +226,26 @@ TEST(ZeroedArray, StartsZeroAndResetsToZero) {
     EXPECT_EQ(a.size(), 0u);
     EXPECT_EQ(a.begin(), a.end());
 }
+
+// Large arrays (huge-page mappings on Linux): zero everywhere, aligned to
+// 2 MiB there, writable at both ends, and zero again after a reset to the same size.
+TEST(ZeroedArray, LargeArraysAreZeroAlignedAndReusable) {
+    const size_t n = (vista::kHugeBytes / sizeof(uint64_t)) * 3 + 123;  // not a multiple of the huge page
+    vista::ZeroedArray<uint64_t> a(n);
+    ASSERT_EQ(a.size(), n);
+#if defined(__linux__)
+    EXPECT_EQ(reinterpret_cast<uintptr_t>(a.begin()) % (uintptr_t(2) << 20), 0u);
+#endif
+    uint64_t sum = 0;
+    for (size_t i = 0; i < n; i += 511) sum += a[i];
+    sum += a[n - 1];
+    EXPECT_EQ(sum, 0u);
+    a[0] = 1;
+    a[n - 1] = 2;
+    a[n / 2] = 3;
+    EXPECT_EQ(a[0] + a[n - 1] + a[n / 2], 6u);
+    a.reset(n);
+    EXPECT_EQ(a[0] + a[n - 1] + a[n / 2], 0u);
+    a.reset(100);  // small again: an ordinary allocation
+    EXPECT_EQ(a[99], 0u);
+}
