@@ -14,7 +14,7 @@ namespace vista {
 
 osg::ref_ptr<ViewCellSwitch> assembleBakedScene(const SceneModel& city, const std::vector<ViewCell>& cells,
                                                 const std::vector<CellResult>& results, const std::string& paramsText,
-                                                BakeRepresentation representation) {
+                                                BakeRepresentation representation, const std::string& sourceCityHash) {
     osg::ref_ptr<ViewCellSwitch> root = new ViewCellSwitch;
     root->setName("vista.city");
     osg::Group* cityRoot = sceneRoot(city) ? sceneRoot(city)->asGroup() : nullptr;
@@ -28,6 +28,7 @@ osg::ref_ptr<ViewCellSwitch> assembleBakedScene(const SceneModel& city, const st
     root->setUserValue("vista.baked", 1);
     root->setUserValue("vista.bake_params", paramsText);
     if (representation == BakeRepresentation::Mesh) root->setUserValue("vista.bake_representation", std::string("mesh"));
+    if (!sourceCityHash.empty()) root->setUserValue("vista.source_city_hash", sourceCityHash);
     // Cell ids are edge ids; the switch is indexed by edge id (absent edges get empty boxes).
     uint32_t maxId = 0;
     for (const auto& c : cells) maxId = std::max(maxId, c.id + 1);

@@ -11,7 +11,9 @@
 // depth meshes instead (MatrixTransform "lodmesh_C_E" -> Geode ->
 // TexturedDepthMesh), registered in the same per-cell lists, and the root
 // carries vista.bake_representation = "mesh" (a point bake has no such value,
-// so its bytes are unchanged). Contract: `results` sorted by cell id (output bytes then depend
+// so its bytes are unchanged). sourceCityHash (sceneFileContentHash() of the
+// input city file) is stored as vista.source_city_hash, so readers can refuse
+// a baked file of another city; "" stores nothing. Contract: `results` sorted by cell id (output bytes then depend
 // only on the results). A hand-built city (no scene graph) gives a switch
 // without tiles.
 #pragma once
@@ -30,6 +32,7 @@ namespace vista {
 
 osg::ref_ptr<ViewCellSwitch> assembleBakedScene(const SceneModel& city, const std::vector<ViewCell>& cells,
                                                 const std::vector<CellResult>& results, const std::string& paramsText,
-                                                BakeRepresentation representation = BakeRepresentation::Points);
+                                                BakeRepresentation representation = BakeRepresentation::Points,
+                                                const std::string& sourceCityHash = "");
 
 }  // namespace vista

@@ -303,7 +303,9 @@ Result<BakeReport> runBakeJob(const BakeJob& job, Progress* progress, const std:
 
     auto results = readCellResults(in, *selected, configHash, rep.workDir);
     if (!results) return results.status();
-    osg::ref_ptr<ViewCellSwitch> root = assembleBakedScene(*city, in.cells, *results, canon, p.representation);
+    auto sourceHash = sceneFileContentHash(job.input);  // recorded so that readers can refuse a bake of another city
+    if (!sourceHash) return sourceHash.status();
+    osg::ref_ptr<ViewCellSwitch> root = assembleBakedScene(*city, in.cells, *results, canon, p.representation, *sourceHash);
     VISTA_RETURN_IF_ERROR(writeSceneFile(*root, job.output, false));
     rep.assembled = true;
     nlohmann::json impostorStats = tallyResults(*results, rep);

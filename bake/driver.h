@@ -6,7 +6,8 @@
 // whose result file WORK/cell_ID.vbc is missing, stale (other config hash) or
 // damaged — each written atomically when done, `jobs` threads — and then,
 // unless it is one shard of several, assembles the output from the work
-// directory (every selected cell must be there), writes it atomically,
+// directory (every selected cell must be there) with the input's content
+// hash as vista.source_city_hash (sceneFileContentHash), writes it atomically,
 // writes the stats JSON and removes the cell files (and the work directory
 // when empty) unless keepWork. With merge it bakes nothing, only assembles.
 // Config hash = hash(input file bytes, params.canonical()); the canonical

@@ -9,6 +9,8 @@
 // and prints luma PSNR of geom/imp/pts against ref (median over the views),
 // frame times (median over --frames renders from the centre), covered pixels
 // (pixels differing from an empty render) and the point count.
+// The baked files must come from one city (their vista.source_city_hash
+// values agree; exit 2 otherwise).
 // Usage: xvfb-run -a vista_bake_report --cell C --baked A.osgb [--baked B.osgb ...]
 //        [--label NAME ...] [--frames 20] [--ssaa 4] [--size 640x480] [--json out.json]
 #include <algorithm>
@@ -95,6 +97,13 @@ int main(int argc, char** argv) {
     for (size_t bi = 0; bi < baked.size(); ++bi) {
         auto bf = loadBakedFile(baked[bi]);
         if (!bf) return reportBadInput("vista_bake_report", bf.status());
+        // The rows compare bakes of one city: every recorded source city hash must agree.
+        static std::string firstHash, firstFile;
+        if (!bf->sourceCityHash.empty() && firstHash.empty()) firstHash = bf->sourceCityHash, firstFile = baked[bi];
+        if (!bf->sourceCityHash.empty() && bf->sourceCityHash != firstHash)
+            return reportBadInput("vista_bake_report", Status::error("baked from another city: '" + baked[bi] + "' was baked from a city with hash " +
+                                                                     bf->sourceCityHash + ", '" + firstFile + "' from one with hash " +
+                                                                     firstHash + "; compare bakes of one city"));
         ViewCellSwitch& root = *bf->root;
         if (cell < 0 || size_t(cell) >= root.cells().size() || root.impostorsOf(uint32_t(cell)).empty())
             return reportBadInput("vista_bake_report", Status::error("--cell " + std::to_string(cell) + ": no impostor in '" + baked[bi] + "'"));

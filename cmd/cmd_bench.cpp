@@ -162,6 +162,8 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
     if (!city) return reportBadInput(kCmd, city.status());
     cfg.loadMs = sw.ms();
     cfg.memoryPhases.push_back(memoryPhase("load"));
+    // A baked file of another city, or a truncated one, is refused before anything is drawn.
+    if (Status st = loadPairedBakes(kCmd, cityFile, sceneRoot(city.value()), cfg.modes, cfg.options); !st) return reportBadInput(kCmd, st);
     auto path = walkthroughPath(a.path, a.pathOptions, city.value());
     if (!path) return reportBadInput(kCmd, path.status());
     cfg.runUpS = a.path.file.empty() ? a.pathOptions.runUp : -1.0;

@@ -436,6 +436,8 @@ int runView(int argc, char** argv) {
     }
     auto city = loadCityFile(a.city);
     if (!city) return reportBadInput(kCmd, city.status());
+    // Every baked file given is checked against the city up front (modes are switched at run time).
+    if (Status st = loadPairedBakes(kCmd, a.city, sceneRoot(city.value()), {}, ctx.options); !st) return reportBadInput(kCmd, st);
     bool playback = false;
     auto path = viewPath(a, city.value(), playback);
     if (!path) return reportBadInput(kCmd, path.status());

@@ -9,6 +9,8 @@
 #include <sstream>
 #include <unistd.h>
 
+#include "foundation/timing.h"
+#include "nodes/baked_file.h"
 #include "runtime/scene/scene_model.h"
 
 namespace vista {
@@ -307,6 +309,27 @@ Status parseModeFlags(const ModeFlags& f, ModeOptions& o) {
     o.bakedMeshFile = f.bakedMesh;
     o.threads = f.threads;
     return checkModeOptions(o);
+}
+
+Status loadPairedBakes(const std::string& cmd, const std::string& cityPath, const osg::Node* cityRoot,
+                       const std::vector<std::string>& modes, ModeOptions& o) {
+    auto has = [&](const char* m) { return modes.empty() || std::find(modes.begin(), modes.end(), m) != modes.end(); };
+    std::vector<std::pair<const char*, std::string>> files;
+    if (!o.bakedFile.empty() && (has("impostor") || (has("lodmesh") && o.bakedMeshFile.empty())))
+        files.push_back({"--baked", o.bakedFile});
+    if (!o.bakedMeshFile.empty() && has("lodmesh")) files.push_back({"--baked-mesh", o.bakedMeshFile});
+    for (const auto& [flag, path] : files) {
+        if (o.loadedBakes.count(path)) continue;
+        Stopwatch sw;
+        auto bf = loadBakedFile(path);
+        if (!bf) return Status::error(std::string(flag) + ": " + bf.status().message());
+        const double ms = sw.ms();
+        std::string warning;
+        VISTA_RETURN_IF_ERROR(checkBakedFromCity(path, *bf, cityPath, cityRoot, &warning));
+        if (!warning.empty()) std::fprintf(stderr, "%s: warning: %s\n", cmd.c_str(), warning.c_str());
+        o.loadedBakes[path] = {bf->root, ms};
+    }
+    return Status::ok();
 }
 
 void addPathFlags(CLI::App& app, PathFlags& f, bool timing) {

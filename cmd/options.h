@@ -92,6 +92,17 @@ struct ModeFlags {
 void addModeFlags(CLI::App& app, ModeFlags& flags);
 // Parses and range-checks the flags into `out`.
 Status parseModeFlags(const ModeFlags& flags, ModeOptions& out);
+
+// Loads the baked files (--baked, --baked-mesh) that `modes` draw (every
+// given one when `modes` is empty: the viewer switches modes at run time),
+// checks each against the city opened as cityPath with root cityRoot
+// (checkBakedFromCity) and keeps them in out.loadedBakes, so the modes do not
+// load them again. Errors (unreadable, truncated, corrupt, not a baked file,
+// baked from another city) name the files: the command exits 2. A file
+// without a source city hash (an older bake) is a warning on stderr
+// ("CMD: warning: ..."), not an error.
+Status loadPairedBakes(const std::string& cmd, const std::string& cityPath, const osg::Node* cityRoot,
+                       const std::vector<std::string>& modes, ModeOptions& out);
 // Range checks of ModeOptions (for options set in code).
 Status checkModeOptions(const ModeOptions& o);
 

@@ -40,13 +40,12 @@ Result<std::unique_ptr<RenderMode>> makeImpostorMode(ModeContext& ctx) {
                                      ? "mode impostor: the scene holds textured depth meshes (mode lodmesh); pass --baked city.baked.osgb "
                                        "(from 'vista bake') for point impostors"
                                      : "mode impostor: the city is not baked; pass --baked city.baked.osgb (from 'vista bake')");
-        Stopwatch sw;
-        auto bf = loadBakedFile(ctx.options.bakedFile);
+        auto bf = loadBakeForMode(ctx, ctx.options.bakedFile);
         if (!bf) return bf.status();
         if (bf->meshes)
             return Status::error("mode impostor: '" + ctx.options.bakedFile + "' holds textured depth meshes; use mode lodmesh");
         root = bf->root;
-        setup.push_back({"baked_load", sw.ms()});
+        setup.push_back({"baked_load", bf->loadMs});
     }
     return std::unique_ptr<RenderMode>(new ImpostorMode(ctx, root, setup));
 }

@@ -38,14 +38,13 @@ Result<std::unique_ptr<RenderMode>> makeLodMeshMode(ModeContext& ctx) {
         if (file.empty())
             return Status::error("mode lodmesh: the city has no textured depth meshes; open or pass (--baked-mesh) a file from "
                                  "'vista bake --representation mesh'");
-        Stopwatch sw;
-        auto bf = loadBakedFile(file);
+        auto bf = loadBakeForMode(ctx, file);
         if (!bf) return bf.status();
         if (!bf->meshes)
             return Status::error("mode lodmesh: '" + file + "' holds point impostors; pass --baked-mesh with a file from "
                                  "'vista bake --representation mesh'");
         root = bf->root;
-        setup.push_back({"baked_load", sw.ms()});
+        setup.push_back({"baked_load", bf->loadMs});
     }
     return std::unique_ptr<RenderMode>(new LodMeshMode(ctx, root, setup));
 }

@@ -8,6 +8,7 @@
 #include <osg/RenderInfo>
 
 #include "foundation/timing.h"
+#include "nodes/baked_file.h"
 #include "nodes/far_field_node.h"
 #include "nodes/render/effects_state.h"
 #include "runtime/engine/reflections.h"
@@ -63,6 +64,22 @@ Status GraphMode::renderFrame(const Camera& camera, Image& out, FrameStats& stat
     VISTA_RETURN_IF_ERROR(_ctx.renderer->render(_graph.get(), camera, zFar, &out, nullptr, stats));
     describe(stats);
     return Status::ok();
+}
+
+Result<ModeBake> loadBakeForMode(const ModeContext& ctx, const std::string& file) {
+    ModeBake b;
+    if (auto it = ctx.options.loadedBakes.find(file); it != ctx.options.loadedBakes.end() && it->second.root) {
+        b.root = it->second.root;
+        b.loadMs = it->second.loadMs;
+    } else {
+        Stopwatch sw;
+        auto bf = loadBakedFile(file);
+        if (!bf) return bf.status();
+        b.root = bf->root;
+        b.loadMs = sw.ms();
+    }
+    b.meshes = isMeshBake(b.root.get());
+    return b;
 }
 
 const std::vector<ModeInfo>& renderModes() {

@@ -22,6 +22,7 @@
 // program adds the costs it paid for the mode ("load", "bvh").
 #pragma once
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <utility>
@@ -33,6 +34,7 @@
 
 #include "foundation/status.h"
 #include "nodes/near_field_chunks.h"
+#include "nodes/view_cell_switch.h"
 #include "runtime/engine/frame_effects.h"
 #include "runtime/engine/frame_stats.h"
 #include "runtime/engine/image.h"
@@ -62,6 +64,15 @@ struct ModeOptions {
     std::string bakedFile;        // impostor: the baked file (unless the scene itself is baked)
     std::string bakedMeshFile;    // lodmesh: the mesh bake (unless the scene itself is one)
     FrameEffects effects;         // run-time effects of every mode (haze, glass reflections, night sky)
+    // Baked files the program already loaded and checked against the city
+    // (checkBakedFromCity), by path as in bakedFile / bakedMeshFile: impostor
+    // and lodmesh take the root from here instead of loading the file again
+    // (set-up cost "baked_load" = loadMs).
+    struct LoadedBake {
+        osg::ref_ptr<ViewCellSwitch> root;
+        double loadMs = 0;
+    };
+    std::map<std::string, LoadedBake> loadedBakes;
     // The near distance of modes without an adaptive split.
     double fixedNearDistance() const { return nearDistance > 0 ? nearDistance : kDefaultNearDistance; }
 };
@@ -95,6 +106,16 @@ private:
     osg::ref_ptr<osg::Group> _chunked;
     double _chunkingMs = 0;
 };
+
+// A baked file for a mode: from ctx.options.loadedBakes when the program
+// loaded it already, else loaded and checked now (loadBakedFile; errors name
+// the file). loadMs = what loading cost (then or now).
+struct ModeBake {
+    osg::ref_ptr<ViewCellSwitch> root;
+    bool meshes = false;  // a mesh bake (isMeshBake)
+    double loadMs = 0;
+};
+Result<ModeBake> loadBakeForMode(const ModeContext& ctx, const std::string& file);
 
 // What a mode's last renderFrame() rasterised, for the ground-truth label
 // pass of `vista render`: the chunks of ModeContext::nearField() it drew (in

@@ -211,6 +211,20 @@ Result<osg::ref_ptr<osg::Node>> readSceneFile(const std::string& path) {
     return node;
 }
 
+Result<std::string> sceneFileContentHash(const std::string& path) {
+    std::ifstream in(path, std::ios::binary | std::ios::ate);
+    if (!in) return Status::error("cannot open scene file '" + path + "': " + errnoText());
+    const std::streamoff size = in.tellg();
+    unsigned char tr[kSceneTrailerSize];
+    if (size < std::streamoff(8 + kSceneTrailerSize) || !in.seekg(size - std::streamoff(kSceneTrailerSize)) ||
+        !in.read(reinterpret_cast<char*>(tr), kSceneTrailerSize) || std::memcmp(tr, kTrailerHead, 8) != 0 ||
+        std::memcmp(tr + 24, kTrailerTail, 8) != 0 || loadLE64(tr + 8) != uint64_t(size) - kSceneTrailerSize)
+        return Status::error("scene file '" + path + "' is truncated or was not written by vista (no integrity trailer)");
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(loadLE64(tr + 16)));
+    return std::string(hex);
+}
+
 std::string sceneFileTrailer(const std::string& payload) {
     unsigned char trailer[kSceneTrailerSize];
     std::memcpy(trailer, kTrailerHead, 8);

@@ -41,6 +41,14 @@ Status writeSceneFile(const osg::Node& node, const std::string& path, bool compr
 // model: docs/reliability.md).
 Result<osg::ref_ptr<osg::Node>> readSceneFile(const std::string& path);
 
+// The content hash of a scene file: its trailer's payload hash (bytes 16..23),
+// as 16 lowercase hex digits. Reads only the last 32 bytes (magic and payload
+// size are checked against the file size, the payload is not re-hashed:
+// readSceneFile() does that). The bake records it as the baked file's
+// vista.source_city_hash (docs/formats.md). Errors name the path: missing,
+// unreadable, or no trailer (truncated, not written by vista).
+Result<std::string> sceneFileContentHash(const std::string& path);
+
 // The trailer writeSceneFile() appends to `payload` (fuzzing, tests).
 std::string sceneFileTrailer(const std::string& payload);
 

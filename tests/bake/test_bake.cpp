@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <set>
@@ -15,6 +16,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <osg/UserDataContainer>
 #include <osgDB/ReaderWriter>
 #include <osgDB/Registry>
 #include <tbb/global_control.h>
@@ -1480,6 +1482,129 @@ TEST(LodMeshCli, BenchAndViewRunTheLodMeshMode) {
     EXPECT_TRUE(readPng(png).isOk());
     // A point bake has no lodmesh mode: a clear error, exit 2.
     EXPECT_EQ(tool("view " + dir.file("p.osgb") + " --mode lodmesh --size 160x120 --frames 3"), 2);
+}
+
+// Issue 11 item 6: a baked file records its source city's content hash
+// (vista.source_city_hash); bench and view refuse a baked file of another city
+// and a truncated one (exit 2, both representations), warn about a file without
+// the hash, and run with a matching pair.
+TEST(BakeCli, BakedFileOfAnotherCityOrTruncatedIsRefusedWithExit2) {
+    TempDir dir;
+    City other = makeBakeCity();
+    other.tiles[1].meshes[size_t(Material::Wall)].positions[0].z += 1.0f;  // one vertex moved: another city
+    ASSERT_TRUE(writeCityFile(makeBakeCity(), dir.file("city.osgb")).isOk());
+    ASSERT_TRUE(writeCityFile(other, dir.file("other.osgb")).isOk());
+    const std::string common = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q ";
+    ASSERT_EQ(run(common + "-o " + dir.file("p.osgb")), 0);
+    ASSERT_EQ(run(common + "-o " + dir.file("m.osgb") + " --representation mesh --mesh-image 256"), 0);
+
+    // The recorded hash is the hash64 of the city file's payload (everything but the 32-byte trailer), computed here independently.
+    const std::string cityBytes = readBytes(dir.file("city.osgb"));
+    ASSERT_GT(cityBytes.size(), kSceneTrailerSize);
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx",
+                  static_cast<unsigned long long>(hashBytes64(reinterpret_cast<const unsigned char*>(cityBytes.data()),
+                                                              cityBytes.size() - kSceneTrailerSize)));
+    auto cityHash = sceneFileContentHash(dir.file("city.osgb"));
+    ASSERT_TRUE(cityHash.isOk()) << cityHash.status().message();
+    EXPECT_EQ(*cityHash, std::string(hex));
+    auto otherHash = sceneFileContentHash(dir.file("other.osgb"));
+    ASSERT_TRUE(otherHash.isOk());
+    EXPECT_NE(*otherHash, *cityHash);
+    for (const char* f : {"p.osgb", "m.osgb"}) {
+        auto bf = loadBakedFile(dir.file(f));
+        ASSERT_TRUE(bf.isOk()) << bf.status().message();
+        EXPECT_EQ(bf->sourceCityHash, *cityHash) << f;
+        EXPECT_TRUE(checkBakedFromCity(dir.file(f), *bf, dir.file("city.osgb"), nullptr).isOk());
+        EXPECT_FALSE(checkBakedFromCity(dir.file(f), *bf, dir.file("other.osgb"), nullptr).isOk());
+    }
+
+    auto tool = [&](const std::string& args) {
+        const std::string cmd = std::string(VISTA_BINARY) + " " + args + " > " + dir.file("log.txt") + " 2>&1";
+        const int rc = std::system(cmd.c_str());
+        return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+    };
+    const std::string bench = " --frames 2 --size 80x60 --seed 1 --out " + dir.file("bench");
+    // Another city: exit 2, a message naming both files and both hashes (before any drawing: no display needed).
+    EXPECT_EQ(tool("bench " + dir.file("other.osgb") + " --baked " + dir.file("p.osgb") + " --modes impostor" + bench), 2);
+    std::string log = readBytes(dir.file("log.txt"));
+    EXPECT_NE(log.find("baked from another city"), std::string::npos) << log;
+    EXPECT_NE(log.find(dir.file("p.osgb")), std::string::npos) << log;
+    EXPECT_NE(log.find(dir.file("other.osgb")), std::string::npos) << log;
+    EXPECT_NE(log.find(*cityHash), std::string::npos) << log;
+    EXPECT_NE(log.find(*otherHash), std::string::npos) << log;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("bench/summary.json")));
+    EXPECT_EQ(tool("bench " + dir.file("other.osgb") + " --baked-mesh " + dir.file("m.osgb") + " --modes lodmesh" + bench), 2);
+    log = readBytes(dir.file("log.txt"));
+    EXPECT_NE(log.find("baked from another city"), std::string::npos) << log;
+    EXPECT_NE(log.find("--representation mesh"), std::string::npos) << log;
+    EXPECT_EQ(tool("view " + dir.file("other.osgb") + " --baked " + dir.file("p.osgb") + " --mode impostor --frames 1"), 2);
+    EXPECT_NE(readBytes(dir.file("log.txt")).find("baked from another city"), std::string::npos);
+    EXPECT_EQ(tool("view " + dir.file("other.osgb") + " --baked-mesh " + dir.file("m.osgb") + " --mode lodmesh --frames 1"), 2);
+    // A baked city file opened as the city stands for its source city: a mesh bake of `city` with a point bake of `city` pairs,
+    // with a point bake of `other` it does not.
+    ASSERT_EQ(run(dir.file("other.osgb") + " --out-size 120 --min-triangles 1 -q -o " + dir.file("po.osgb")), 0);
+    EXPECT_EQ(tool("bench " + dir.file("m.osgb") + " --baked " + dir.file("po.osgb") + " --modes impostor" + bench), 2);
+    EXPECT_NE(readBytes(dir.file("log.txt")).find("baked from another city"), std::string::npos);
+
+    // Truncated baked files, both representations: exit 2 naming the file.
+    for (const char* f : {"p.osgb", "m.osgb"}) {
+        const std::string bytes = readBytes(dir.file(f));
+        const std::string cut = dir.file(std::string("cut_") + f);
+        {
+            std::ofstream o(cut, std::ios::binary | std::ios::trunc);
+            o << bytes.substr(0, bytes.size() * 2 / 3);
+        }
+        const bool mesh = std::string(f) == "m.osgb";
+        EXPECT_EQ(tool("bench " + dir.file("city.osgb") + (mesh ? " --baked-mesh " : " --baked ") + cut +
+                       (mesh ? " --modes lodmesh" : " --modes impostor") + bench),
+                  2)
+            << f;
+        log = readBytes(dir.file("log.txt"));
+        EXPECT_NE(log.find("truncated"), std::string::npos) << log;
+        EXPECT_NE(log.find(cut), std::string::npos) << log;
+        EXPECT_EQ(tool("view " + dir.file("city.osgb") + (mesh ? " --baked-mesh " : " --baked ") + cut + " --frames 1"), 2) << f;
+    }
+    // Unknown representation: exit 2, the option and the value named.
+    EXPECT_EQ(tool("bake " + common + "-o " + dir.file("e.osgb") + " --representation voxels"), 2);
+    log = readBytes(dir.file("log.txt"));
+    EXPECT_NE(log.find("--representation"), std::string::npos) << log;
+    EXPECT_NE(log.find("voxels"), std::string::npos) << log;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("e.osgb")));
+
+    // A file baked before the hash existed: readable, a warning naming it (it cannot be checked).
+    {
+        auto node = readSceneFile(dir.file("p.osgb"));
+        ASSERT_TRUE(node.isOk());
+        osg::UserDataContainer* udc = (*node)->getUserDataContainer();
+        ASSERT_NE(udc, nullptr);
+        const unsigned i = udc->getUserObjectIndex("vista.source_city_hash");
+        ASSERT_LT(i, udc->getNumUserObjects());
+        udc->removeUserObject(i);
+        ASSERT_TRUE(writeSceneFile(**node, dir.file("old.osgb")).isOk());
+        auto bf = loadBakedFile(dir.file("old.osgb"));
+        ASSERT_TRUE(bf.isOk()) << bf.status().message();
+        EXPECT_TRUE(bf->sourceCityHash.empty());
+        std::string warning;
+        EXPECT_TRUE(checkBakedFromCity(dir.file("old.osgb"), *bf, dir.file("other.osgb"), nullptr, &warning).isOk());
+        EXPECT_NE(warning.find(dir.file("old.osgb")), std::string::npos) << warning;
+    }
+
+    const char* display = std::getenv("DISPLAY");
+    if (!display || !*display) GTEST_SKIP() << "no X display (run under xvfb-run -a): the runs that draw are skipped";
+    // Matching city: both representations run.
+    ASSERT_EQ(tool("bench " + dir.file("city.osgb") + " --baked " + dir.file("p.osgb") + " --baked-mesh " + dir.file("m.osgb") +
+                   " --modes full,impostor,lodmesh" + bench),
+              0)
+        << readBytes(dir.file("log.txt"));
+    EXPECT_TRUE(std::filesystem::exists(dir.file("bench/summary.json")));
+    EXPECT_EQ(readBytes(dir.file("log.txt")).find("warning"), std::string::npos) << readBytes(dir.file("log.txt"));
+    // The old file: runs, with the warning.
+    ASSERT_EQ(tool("bench " + dir.file("city.osgb") + " --baked " + dir.file("old.osgb") + " --modes impostor" + bench), 0)
+        << readBytes(dir.file("log.txt"));
+    log = readBytes(dir.file("log.txt"));
+    EXPECT_NE(log.find("warning"), std::string::npos) << log;
+    EXPECT_NE(log.find(dir.file("old.osgb")), std::string::npos) << log;
 }
 
 }  // namespace
