@@ -57,12 +57,21 @@ void seamStage(FarFrame& f, const RayScene& rays, const FarFieldOptions& o, Fram
         const glm::vec3 org(f.camera.eye - rays.frameOrigin());
         // Nothing the near field left out lies nearer than the near distance: start there.
         const float tnear = farRayStart(o);
+        // In fixed chunks of consecutive candidates (rows: coherent), cast in packets of 8 from
+        // each chunk's start, so the packets never depend on the thread count.
+        constexpr size_t kChunk = 256;
         std::vector<RayHit> res(check.size());
+        const size_t chunks = (check.size() + kChunk - 1) / kChunk;
         inArena(o.threads, [&] {
-            tbb::parallel_for(tbb::blocked_range<size_t>(0, check.size(), 256), [&](const tbb::blocked_range<size_t>& br) {
-                for (size_t k = br.begin(); k != br.end(); ++k) {
-                    const uint32_t i = check[k];
-                    res[k] = rays.intersect(org, glm::vec3(f.rays.dir(int(i % W), int(i / W))), tnear, dist[k]);
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks), [&](const tbb::blocked_range<size_t>& br) {
+                std::vector<glm::vec3> orgs(kChunk, org), dirs(kChunk);
+                for (size_t c = br.begin(); c != br.end(); ++c) {
+                    const size_t b = c * kChunk, m = std::min(kChunk, check.size() - b);
+                    for (size_t k = 0; k < m; ++k) {
+                        const uint32_t i = check[b + k];
+                        dirs[k] = glm::vec3(f.rays.dir(int(i % W), int(i / W)));
+                    }
+                    rays.intersectMany(orgs.data(), dirs.data(), int(m), &res[b], 1e30f, &dist[b], tnear);
                 }
             });
         });
