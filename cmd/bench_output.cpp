@@ -121,6 +121,7 @@ json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneM
                     {"horizon_grid", o.horizonGrid},
                     {"cache", o.cache},
                     {"cache_error_px", o.cacheErrorPx},
+                    {"cache_adaptive", o.cacheAdaptive},
                     {"far_step", o.farStep},
                     {"overlap", o.overlap},
                     {"frame_ms_target", o.frameMsTarget},

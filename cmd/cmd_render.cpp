@@ -243,6 +243,7 @@ int run(RenderArgs& a, const std::string& command) {
     if (!sampling) return reportBadInput(kCmd, sampling.status());
     ModeOptions mo;
     if (Status s = parseModeFlags(a.modeFlags, mo); !s) return reportBadInput(kCmd, s);
+    mo.cacheAdaptive = false;  // ground truth: the cache never pauses on timings (frames stay deterministic)
     auto po = parsePathFlags(a.path);
     if (!po) return reportBadInput(kCmd, po.status());
     if (!fs::exists(a.city)) return reportBadInput(kCmd, Status::error("city file '" + a.city + "' does not exist"));

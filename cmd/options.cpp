@@ -249,6 +249,9 @@ void addModeFlags(CLI::App& app, ModeFlags& f) {
                    "or 'unlimited' / -1 = no cap: every pixel over --cache-error is re-traced (default " + f.budget + ")");
     app.add_option("--horizon-grid", f.horizonGrid, "hybrid: horizon height-grid resolution, cells per side, 1 .. 8192 (default 512)");
     app.add_flag("--no-cache", f.noCache, "hybrid: panoramic image cache off (every far pixel traced)");
+    app.add_flag("--cache-always", f.cacheAlways,
+                 "hybrid: look up the cache in every frame, also while its measured reuse does not pay for its lookups "
+                 "(by default it then pauses for 8 moving frames and measures again)");
     app.add_flag("--no-overlap", f.noOverlap,
                  "hybrid: trace the horizon after the near field is drawn instead of on another thread during the draw");
     app.add_option("--cache-error", f.cacheError,
@@ -301,6 +304,7 @@ Status parseModeFlags(const ModeFlags& f, ModeOptions& o) {
     o.pixelBudget = pb.value();
     o.horizonGrid = f.horizonGrid;
     o.cache = !f.noCache;
+    o.cacheAdaptive = !f.cacheAlways;
     o.cacheErrorPx = f.cacheError;
     o.overlap = !f.noOverlap;
     o.frameMsTarget = f.frameMs;

@@ -142,6 +142,7 @@ private:
         o.pixelBudget = _ctx.options.pixelBudget;
         o.cache = _ctx.options.cache;
         o.cacheErrorPx = _ctx.options.cacheErrorPx;
+        o.cacheAdaptive = _ctx.options.cacheAdaptive;
         o.rayStep = _ctx.options.farStep;
         o.frameMsTarget = _ctx.options.frameMsTarget;
         o.threads = _ctx.options.threads;

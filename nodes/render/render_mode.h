@@ -56,6 +56,7 @@ struct ModeOptions {
     int64_t pixelBudget = -1;     // hybrid: far-field rays per frame through the cache; < 0 = unlimited
     int horizonGrid = 512;        // hybrid: horizon height-grid cells per side, 1 .. 8192
     bool cache = true;            // hybrid: panoramic image cache on/off
+    bool cacheAdaptive = true;    // hybrid: pause the cache while it does not pay (FarFieldOptions::cacheAdaptive)
     double cacheErrorPx = 0.25;   // hybrid: reuse a cached far pixel while its reprojection error is below this, 0 .. 100
     bool overlap = true;          // hybrid: trace the horizon on another thread while the near field is drawn
     double frameMsTarget = 0.0;   // hybrid: > 0 = the ray budget adapts so the frame takes about this long (ms), 0 .. 10000

@@ -61,6 +61,8 @@ void FarField::reset() {
     if (_mem->cache) _mem->cache->clear();
     _mem->prev = Image();
     _mem->haveLast = false;
+    _mem->cachePaused = 0;
+    _mem->lastFrameCached = false;
 }
 
 void FarField::render(const Camera& camera, const float* depth, Image& out, FrameStats& stats) {
@@ -99,13 +101,31 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
     const bool useEarly = early.valid() && sameCamera(_mem->earlyCamera, camera);
     if (_options.horizon) horizonStage(f, _grid, _options, stats, useEarly ? &early : nullptr);
     listPending(f);
-    const bool useCache = _options.cache;
+    const bool budgeted = _options.pixelBudget >= 0 || _options.frameMsTarget > 0;
+    const bool adaptive = _options.cacheAdaptive && !budgeted && f.moving;
+    bool useCache = _options.cache;
+    if (useCache && adaptive && _mem->cachePaused > 0) {
+        --_mem->cachePaused;
+        useCache = false;
+        stats.notes.push_back("cache paused: its reuse did not pay for its lookups");
+    }
     f.farDepth.swap(_mem->farDepth);  // reuse last frame's buffer (cacheStage refills it)
-    if (useCache && !f.pending.empty()) cacheStage(f, *_mem, _options, stats);
-    else {
+    const bool cacheRan = useCache && !f.pending.empty();
+    if (cacheRan) {
+        const double before = stats.stages.ms(Stage::Cache);
+        const uint64_t reusedBefore = stats.pixels.cache;
+        cacheStage(f, *_mem, _options, stats);
+        const double lookupMs = stats.stages.ms(Stage::Cache) - before;
+        const double reuse = double(stats.pixels.cache - reusedBefore) / double(f.pending.size());
+        // Judged only when last frame's stores are fresh (two cache frames in a row).
+        if (adaptive && _mem->lastFrameCached && _mem->msPerRay > 0 &&
+            reuse * _mem->msPerRay < lookupMs / double(f.pending.size()))
+            _mem->cachePaused = kCachePauseFrames;
+    } else {
         f.farDepth.clear();
         bypassCache(f);
     }
+    _mem->lastFrameCached = cacheRan;
     if (!f.trace.empty()) {
         const double before = stats.stages.ms(Stage::Rays);
         raysStage(f, *_mem, _rays, _options, stats);
@@ -114,8 +134,7 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
     }
     const double before = stats.stages.ms(Stage::Composite);
     // The last frame is the fallback of never-traced cells left out by a budget: kept only under one.
-    const bool budgeted = _options.pixelBudget >= 0 || _options.frameMsTarget > 0;
-    compositeStage(f, *_mem, useCache, stats, useCache && budgeted);
+    compositeStage(f, *_mem, cacheRan, stats, cacheRan && budgeted);
     const double composite = stats.stages.ms(Stage::Composite) - before;
     _mem->compositeMs = _mem->compositeMs > 0 ? 0.8 * _mem->compositeMs + 0.2 * composite : composite;
     f.farDepth.swap(_mem->farDepth);

@@ -56,6 +56,9 @@ struct FarFrame;
 // Pixel classes of classification() (see above).
 enum FarPixelClass : uint8_t { kFarCovered = 0, kFarHorizon = 1, kFarCache = 2, kFarRayHit = 3, kFarRayMiss = 4 };
 
+// Moving frames the cache pauses for when it did not pay (FarFieldOptions::cacheAdaptive).
+constexpr int kCachePauseFrames = 8;
+
 struct FarFieldOptions {
     double nearDistance = 100.0;  // metres (>= 0): horizon skips geometry the near field draws; 0 = skip nothing
     // true: the near field draws every object whose bounding box comes within nearDistance of
@@ -76,6 +79,15 @@ struct FarFieldOptions {
     bool horizon = true;
     int horizonSubsampleMoving = 1;  // >= 1: subsample factor of the horizon while the camera moves
     double cacheOversample = 1.5;
+    // Pause the cache while it does not pay: after two consecutive cache
+    // frames of a moving camera, if the share r of pending pixels the second
+    // reused, times the measured ms per ray, is below the measured ms per
+    // lookup (the cache stage per pending pixel), the next
+    // kCachePauseFrames moving frames trace every far pixel without lookups
+    // (a note says so); then two cache frames measure again. Never paused for
+    // a still camera or under a pixel budget or frame-time target. false =
+    // always look up (the Pareto front of docs/results.md measures that).
+    bool cacheAdaptive = true;
     int threads = 0;
     // Ray spacing of the far field: 1 = a ray per far pixel (exact); 2 = rays
     // on the even pixel lattice first, and a pixel between lattice pixels

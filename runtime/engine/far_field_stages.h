@@ -60,6 +60,9 @@ struct FarFieldMemory {
     double lastMinDepth = 0;   // nearest far surface of the last cache frame (m; 0 = none yet)
     double msPerRay = 0;       // ray stage ms per ray (moving average; 0 = not measured)
     double compositeMs = 0;    // composite stage ms (moving average)
+    // Cache duty cycle (FarFieldOptions::cacheAdaptive).
+    int cachePaused = 0;          // moving frames left to trace without the cache
+    bool lastFrameCached = false; // the last frame ran the cache stage (its stores are fresh)
     // Scratch of the cache stage, kept so that a frame does not fault in fresh pages.
     std::vector<CacheCandidate> cand;
     std::vector<uint8_t> traceMarks;

@@ -367,6 +367,7 @@ TEST(Panorama, MovingViewerStaysCloseToTheUncachedImage) {
         FarFieldOptions o = plain;
         o.cache = true;
         o.cacheErrorPx = bound;
+        o.cacheAdaptive = false;  // the policy itself, never paused on timings
         FarField cached(*rs.value(), &grid, o), direct(*rs.value(), &grid, plain);
         psnrMin = 1e9;
         psnrMean = 0;
@@ -401,4 +402,54 @@ TEST(Panorama, MovingViewerStaysCloseToTheUncachedImage) {
     // A looser bound: fewer rays, lower quality.
     EXPECT_LT(looseRays, tightRays);
     EXPECT_LT(looseMean, tightMean);
+}
+
+// The duty cycle (FarFieldOptions::cacheAdaptive): a moving camera whose
+// cache reuses nothing (bound 0: only this very camera's pixels) is judged
+// on its second cache frame, pauses for kCachePauseFrames moving frames
+// (no cache stage, a note), then looks up again; a still camera, a pixel
+// budget and cacheAdaptive = false never pause.
+TEST(FarField, CachePausesWhileItsReuseDoesNotPayAndResumes) {
+    SceneModel city = randomCity(8, 60);
+    auto rs = RayScene::build(city);
+    ASSERT_TRUE(rs.isOk());
+    HeightGrid grid = HeightGrid::build(city, glm::dvec3(0), 64);
+    auto paused = [](const FrameStats& st) {
+        for (const std::string& n : st.notes)
+            if (n.find("cache paused") != std::string::npos) return true;
+        return false;
+    };
+    auto runFrames = [&](FarFieldOptions o, bool move, int frames) {
+        FarField ff(*rs.value(), &grid, o);
+        std::vector<int> pattern;  // 1 = the cache stage ran, 0 = paused
+        for (int f = 0; f < frames; ++f) {
+            Camera c = cam(glm::dvec3(move ? 3.0 * f : 0.0, -190, 1.7), 0.1);
+            Image img;
+            FrameStats st;
+            ff.render(c, nullptr, img, st);
+            EXPECT_EQ(st.stages.ran(Stage::Cache), !paused(st)) << "frame " << f;
+            if (paused(st)) EXPECT_EQ(st.pixels.cache, 0u) << "frame " << f;
+            pattern.push_back(st.stages.ran(Stage::Cache) ? 1 : 0);
+        }
+        return pattern;
+    };
+    FarFieldOptions o;
+    o.nearDistance = 0;
+    o.cacheErrorPx = 0;  // reuse exactly nothing while moving: the verdict does not depend on timings
+    // Frames 0 and 1 look up, frame 1 finds no reuse, 2 .. 9 pause, 10 and 11 look up and judge again.
+    std::vector<int> expect = {1, 1};
+    for (int k = 0; k < kCachePauseFrames; ++k) expect.push_back(0);
+    expect.insert(expect.end(), {1, 1});
+    for (int k = 0; k < kCachePauseFrames; ++k) expect.push_back(0);
+    EXPECT_EQ(runFrames(o, true, int(expect.size())), expect);
+    // Still camera: every frame runs the cache stage.
+    EXPECT_EQ(runFrames(o, false, 6), std::vector<int>(6, 1));
+    // Always look up.
+    FarFieldOptions always = o;
+    always.cacheAdaptive = false;
+    EXPECT_EQ(runFrames(always, true, 12), std::vector<int>(12, 1));
+    // Under a pixel budget the cache is what spreads the rays: never paused.
+    FarFieldOptions budget = o;
+    budget.pixelBudget = 1000000;
+    EXPECT_EQ(runFrames(budget, true, 12), std::vector<int>(12, 1));
 }
