@@ -13,21 +13,33 @@
 namespace vista {
 namespace {
 
-// Least-squares slope of y = c + slope * x over the samples; nullopt unless
-// there are 5 or more and x varies by more than 10 % of its mean.
+// Slope of y = c + slope * x over the samples, robust to outliers (a frame
+// slowed down by another process on the machine): the Theil-Sen estimator,
+// the median of the slopes between pairs whose x differ by more than 5 % of
+// the mean x. nullopt unless there are 5 or more samples, x varies by more
+// than 10 % of its mean and 5 or more pairs qualify.
 std::optional<double> fitSlope(const std::vector<std::pair<double, double>>& samples) {
     const double n = double(samples.size());
     if (n < 5) return std::nullopt;
-    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    double sx = 0, sxx = 0;
     for (const auto& [x, y] : samples) {
         sx += x;
-        sy += y;
         sxx += x * x;
-        sxy += x * y;
     }
     const double var = sxx / n - (sx / n) * (sx / n), mean = sx / n;
     if (!(var > 0) || std::sqrt(var) <= 0.1 * std::max(mean, 1.0)) return std::nullopt;
-    return (sxy / n - (sx / n) * (sy / n)) / var;
+    const double minDx = 0.05 * std::max(mean, 1.0);
+    std::vector<double> slopes;
+    slopes.reserve(samples.size() * (samples.size() - 1) / 2);
+    for (size_t i = 0; i < samples.size(); ++i)
+        for (size_t j = i + 1; j < samples.size(); ++j) {
+            const double dx = samples[j].first - samples[i].first;
+            if (std::abs(dx) > minDx) slopes.push_back((samples[j].second - samples[i].second) / dx);
+        }
+    if (slopes.size() < 5) return std::nullopt;
+    const auto mid = slopes.begin() + long(slopes.size() / 2);
+    std::nth_element(slopes.begin(), mid, slopes.end());
+    return *mid;
 }
 
 void pushWindow(std::vector<std::pair<double, double>>& w, std::pair<double, double> s, int window) {

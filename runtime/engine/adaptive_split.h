@@ -9,7 +9,7 @@
 //
 // AdaptiveSplit: picks the near distance per frame from the measured cost of
 // this machine: raster ms = c + a * triangles and far ms = c' + b * far
-// pixels (least-squares fits over the last `window` frames, whose near
+// pixels (robust line fits, Theil-Sen, over the last `window` frames, whose near
 // distances differ as the walk goes on; priors until a fit is well
 // conditioned; b falls back to the mean ms per far pixel, and a fitted b is
 // kept within [1/5, 1] of that mean; b is capped by the probe's bulk ms per

@@ -122,3 +122,35 @@ TEST(Split, AdaptiveChoiceFollowsTheMeasuredCosts) {
     EXPECT_LE(cheapTris.predictedTriangles(c.eye, 50), cheapTris.predictedTriangles(c.eye, 400));
     EXPECT_GE(cheapTris.predictedRays(50), cheapTris.predictedRays(400));
 }
+
+// The raster-cost fit is robust: frames slowed down by another process (one
+// in four here, 3x to 8x their cost) do not move the fitted ms per triangle
+// off the line the other frames lie on (a least-squares fit would: it is
+// pulled towards the outliers' slope).
+TEST(Split, RasterCostFitIgnoresFramesSlowedByOtherWork) {
+    std::vector<SplitObject> objs = {box({0, 0, 0}, {10, 10, 10}, 1000)};
+    AdaptiveSplitOptions o;
+    o.timeProbe = false;
+    AdaptiveSplit clean(objs, nullptr, o), noisy(objs, nullptr, o);
+    const double c = 8.0, a = 2e-4;  // ms, ms per triangle
+    for (int i = 0; i < 40; ++i) {
+        const uint64_t tris = uint64_t(10000 + 2500 * (i % 9));
+        const double ms = c + a * double(tris);
+        clean.record(tris, ms, 0, 0);
+        // Every fourth frame slowed 3x .. 8x, more so for the larger draws.
+        noisy.record(tris, i % 4 == 3 ? ms * (3.0 + double(i % 9) * 5.0 / 8.0) : ms, 0, 0);
+    }
+    EXPECT_NEAR(clean.msPerTriangle(), a, 1e-9);
+    EXPECT_NEAR(noisy.msPerTriangle(), a, 0.15 * a) << "the outliers moved the fit";
+    // The same samples under least squares would be off by more than that tolerance:
+    // the test would fail with the previous estimator.
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    int n = 0;
+    for (int i = 0; i < 40; ++i) {
+        const double x = double(10000 + 2500 * (i % 9)), base = c + a * x;
+        const double y = i % 4 == 3 ? base * (3.0 + double(i % 9) * 5.0 / 8.0) : base;
+        sx += x, sy += y, sxx += x * x, sxy += x * y, ++n;
+    }
+    const double ls = (sxy / n - sx / n * sy / n) / (sxx / n - sx / n * sx / n);
+    EXPECT_GT(std::abs(ls - a), 0.15 * a);
+}
