@@ -148,6 +148,7 @@ Result<PagedCityOptions> resolvePaged(const GenArgs& a, const CityParams& params
     o.dir = a.out;
     while (o.dir.size() > 1 && o.dir.back() == '/') o.dir.pop_back();
     if (a.regionSize) o.regionSizeM = *a.regionSize;
+    o.merge = a.merge;
     if (Status s = validateRegionSize(params, o.regionSizeM); !s) return Status::error("option --region-size: " + s.message());
     if (!a.shard.empty()) {
         auto sh = parseShard("--shard", a.shard);

@@ -179,7 +179,7 @@ osg::ref_ptr<osg::Node> buildIndex(const CityParams& params, const RegionGrid& g
         const osg::Vec3d hi(b[3].get<double>(), b[4].get<double>(), b[5].get<double>());
         const double radius = 0.5 * (hi - lo).length();
         double fullRange = 0, coarseRange = 0;
-        pagedRanges(regionSize, radius, fullRange, coarseRange);
+        pagedRanges(regionSize, params.size_m, radius, fullRange, coarseRange);
         osg::ref_ptr<osg::PagedLOD> lod = new osg::PagedLOD;
         const int ix = rec.at("ix").get<int>(), iy = rec.at("iy").get<int>();
         lod->setName("region_" + std::to_string(ix) + "_" + std::to_string(iy));
@@ -222,7 +222,7 @@ Json manifestJson(const CityParams& params, const RegionGrid& grid, double regio
                                                   std::pow(b[4].get<double>() - b[1].get<double>(), 2) +
                                                   std::pow(b[5].get<double>() - b[2].get<double>(), 2));
             double fullRange = 0, coarseRange = 0;
-            pagedRanges(regionSize, double(float(radius)), fullRange, coarseRange);
+            pagedRanges(regionSize, params.size_m, double(float(radius)), fullRange, coarseRange);
             e["full_range_m"] = double(float(fullRange));
             e["coarse_range_m"] = double(float(coarseRange));
             e["files"] = rec.at("files");
@@ -243,9 +243,12 @@ std::string coarseFileName(int ix, int iy) {
     return "region_" + std::to_string(ix) + "_" + std::to_string(iy) + ".coarse.osgb";
 }
 
-void pagedRanges(double regionSizeM, double radius, double& fullRange, double& coarseRange) {
+void pagedRanges(double regionSizeM, double citySizeM, double radius, double& fullRange, double& coarseRange) {
     fullRange = radius + regionSizeM;
-    coarseRange = radius + 6.0 * regionSizeM;
+    // osgviewer's home view stands 3.5 bounding radii from the centre: small
+    // cities show their coarse level from there.
+    const double home = 4.0 * 0.5 * std::sqrt(2.0) * citySizeM;
+    coarseRange = radius + std::min(std::max(6.0 * regionSizeM, home), 16.0 * regionSizeM);
 }
 
 Result<Shard> parseShard(const std::string& option, const std::string& text) {
@@ -282,8 +285,10 @@ Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedC
         return Status::error("shard " + std::to_string(o.shard.index) + "/" + std::to_string(o.shard.count) + " out of range");
     VISTA_RETURN_IF_ERROR(checkPagedOutput("-o", o.dir));
     std::error_code ec;
-    fs::create_directories(fs::path(o.dir) / "records", ec);
-    if (ec) return Status::error("cannot create '" + (fs::path(o.dir) / "records").string() + "': " + ec.message());
+    if (!o.merge) {  // a merge only reads (and writes index and manifest once every region is there)
+        fs::create_directories(fs::path(o.dir) / "records", ec);
+        if (ec) return Status::error("cannot create '" + (fs::path(o.dir) / "records").string() + "': " + ec.message());
+    }
 
     const RegionGrid grid(params, o.regionSizeM);
     const std::string keyText = paramsToJson(params) + "\nregion_size_m=" + fmt(o.regionSizeM) +

@@ -78,9 +78,10 @@ constexpr const char* kPagedIndexFile = "index.osgb";
 constexpr const char* kPagedManifestFile = "manifest.json";
 
 // PagedLOD ranges (metres from the eye to the region's bounding-sphere centre)
-// for a region of `regionSizeM` and bounding radius `radius`: full detail
-// within radius + regionSizeM, the coarse level out to radius + 6 regionSizeM,
-// nothing beyond.
-void pagedRanges(double regionSizeM, double radius, double& fullRange, double& coarseRange);
+// for a region of `regionSizeM` and bounding radius `radius` in a city of side
+// `citySizeM`: full detail within radius + regionSizeM; the coarse level out
+// to radius + clamp(4 x the city's half-diagonal, 6, 16 region sizes) (so
+// osgviewer's home view of a small city shows it), nothing beyond.
+void pagedRanges(double regionSizeM, double citySizeM, double radius, double& fullRange, double& coarseRange);
 
 }  // namespace vista
