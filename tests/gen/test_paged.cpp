@@ -241,8 +241,13 @@ TEST_F(Paged, KillNineThenResumeGivesTheSameBytes) {
     std::vector<std::string> args{"gen", "--size", "1500", "--seed", "4", "--detail", "1", "--region-size", "500", "-q",
                                   "--threads", "1", "-o", dir};
     const pid_t pid = vista::test::startVista(args);
-    // Kill it once the first region is recorded (mid-run: 9 regions).
-    for (int i = 0; i < 6000 && listTree(dir + "/records").empty(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    // Kill it once the first region is recorded (a record renamed into place; mid-run: 9 regions).
+    auto recorded = [&] {
+        for (const auto& n : listTree(dir + "/records"))
+            if (n.size() > 5 && n.compare(n.size() - 5, 5, ".json") == 0) return true;
+        return false;
+    };
+    for (int i = 0; i < 6000 && !recorded(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
     ::kill(pid, SIGKILL);
     int st = 0;
     ::waitpid(pid, &st, 0);
