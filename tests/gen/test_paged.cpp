@@ -291,6 +291,12 @@ TEST_F(Paged, IndexHasOnePagedLodPerRegion) {
             auto city = vista::loadCityFile(dir + "/" + f);
             ASSERT_TRUE(city.isOk()) << city.status().message();
             EXPECT_FALSE(city->tiles.empty()) << f;
+            if (f == coarse) {  // plain prisms, no trees
+                EXPECT_EQ(city->params.detail, 0);
+                EXPECT_TRUE(city->instances.empty()) << f;
+            } else {
+                EXPECT_EQ(city->params.detail, 1);
+            }
             osg::ComputeBoundsVisitor cbv;
             vista::sceneRoot(*city)->accept(cbv);
             const osg::BoundingBox box = cbv.getBoundingBox();
