@@ -18,6 +18,7 @@
 #include <osg/Group>
 #include <osg/PagedLOD>
 #include <osgDB/ReadFile>
+#include <osgViewer/Viewer>
 
 #include "citygen/regions.h"
 #include "runtime/scene/city_file.h"
@@ -362,5 +363,49 @@ TEST_F(Paged, BadInputExitsTwoAndLeavesNothing) {
         EXPECT_EQ(r.code, 2) << c.args << ": " << r.err;
         EXPECT_NE(r.err.find(c.field), std::string::npos) << c.args << ": " << r.err;
         EXPECT_EQ(listTree(tmp.path()), before) << c.args;
+    }
+}
+
+// Stock OSG paging (what osgviewer does): a viewer over the index, the camera
+// 150 m above region 0_0 looking down, pages in that region's coarse and then
+// full file; the far corner region (beyond the full range) gets at most its
+// coarse level.
+TEST_F(Paged, StockViewerPagesTheNearRegionIn) {
+    const char* display = std::getenv("DISPLAY");
+    if (!display || !*display) GTEST_SKIP() << "no DISPLAY: run the tests under xvfb-run -a";
+    const std::string dir = ref->file("city.paged");
+    osg::ref_ptr<osg::Node> index = osgDB::readNodeFile(dir + "/index.osgb");
+    ASSERT_TRUE(index.valid());
+    osg::PagedLOD *near = nullptr, *far = nullptr;
+    for (unsigned i = 0; i < index->asGroup()->getNumChildren(); ++i) {
+        auto* lod = dynamic_cast<osg::PagedLOD*>(index->asGroup()->getChild(i));
+        ASSERT_NE(lod, nullptr);
+        if (lod->getName() == "region_0_0") near = lod;
+        if (lod->getName() == "region_2_2") far = lod;
+    }
+    ASSERT_NE(near, nullptr);
+    ASSERT_NE(far, nullptr);
+    const osg::Vec3 c = near->getCenter();
+    ASSERT_GT((far->getCenter() - c).length(), far->getMaxRange(1)) << "the far region must be beyond its full range";
+
+    osgViewer::Viewer viewer;
+    viewer.setThreadingModel(osgViewer::Viewer::SingleThreaded);
+    viewer.setUpViewInWindow(0, 0, 64, 64);
+    viewer.setSceneData(index.get());
+    viewer.realize();
+    ASSERT_TRUE(viewer.isRealized());
+    viewer.getCamera()->setViewMatrixAsLookAt(c + osg::Vec3(0, -1, 150), c, osg::Vec3(0, 1, 0));
+    for (int frame = 0; frame < 3000 && near->getNumChildren() < 2; ++frame) {
+        viewer.frame();
+        viewer.getCamera()->setViewMatrixAsLookAt(c + osg::Vec3(0, -1, 150), c, osg::Vec3(0, 1, 0));
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    EXPECT_EQ(near->getNumChildren(), 2u) << "the near region's full level was not paged in";
+    EXPECT_LE(far->getNumChildren(), 1u) << "the far region got its full level";
+    if (near->getNumChildren() == 2) {
+        osg::Group* full = near->getChild(1)->asGroup();
+        ASSERT_NE(full, nullptr);
+        EXPECT_EQ(full->getName(), "vista.city");
+        EXPECT_GT(full->getNumChildren(), 0u);
     }
 }
