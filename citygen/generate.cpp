@@ -40,7 +40,9 @@ private:
     std::chrono::steady_clock::time_point _t0;
 };
 
-void buildTiles(City& city, Progress* progress) {
+}  // namespace
+
+void meshTiles(City& city, const std::vector<int>& only, Progress* progress) {
     const CityParams& p = city.params;
     TileGrid grid(p);
     Lighting light(p);
@@ -55,11 +57,16 @@ void buildTiles(City& city, Progress* progress) {
         lightsOf[size_t(grid.tileOf(glm::dvec2(city.streetLights[i])))].push_back(i);
 
     const SurfaceIndex surfaceIndex = buildSurfaceIndex(city, grid);
-    std::vector<Tile> tiles(size_t(grid.count()));
+    std::vector<int> which = only;
+    if (which.empty())
+        for (int t = 0; t < grid.count(); ++t) which.push_back(t);
+    for (int t : which) VISTA_CHECK(t >= 0 && t < grid.count());
+    std::vector<Tile> tiles(which.size());
     std::mutex m;
     size_t done = 0;
-    tbb::parallel_for(0, grid.count(), [&](int t) {
-        Tile& tile = tiles[size_t(t)];
+    tbb::parallel_for(0, int(which.size()), [&](int k) {
+        const int t = which[size_t(k)];
+        Tile& tile = tiles[size_t(k)];
         tile.ix = grid.ix(t);
         tile.iy = grid.iy(t);
         tile.origin = grid.origin(t);
@@ -84,11 +91,10 @@ void buildTiles(City& city, Progress* progress) {
     }
 }
 
-}  // namespace
-
 Result<City> generateCity(const CityParams& params, const GenerateOptions& options) {
     Status s = validateParams(params);
     if (!s) return s;
+    VISTA_RETURN_IF_ERROR(checkSingleFileSize(params));
     int threads = params.threads > 0 ? params.threads : int(tbb::info::default_concurrency());
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
 
@@ -131,7 +137,7 @@ Result<City> generateCity(const CityParams& params, const GenerateOptions& optio
     }
     {
         StageTimer t(city, pr, "meshes");
-        buildTiles(city, pr);
+        meshTiles(city, {}, pr);
     }
     return city;
 }

@@ -2,7 +2,8 @@
 //
 // Stages: streets (grown, or `streets` given e.g. from OSM) -> blocks ->
 // lots -> buildings (imported ones from OSM first take their land) -> trees -> meshes per tile (parallel over tiles).
-// Contract: params must pass validateParams() (checked; error otherwise).
+// Contract: params must pass validateParams() and checkSingleFileSize()
+// (checked; error otherwise: larger cities go through citygen/regions.h).
 // Output is byte-for-byte identical for the same params whatever
 // params.threads is. Stage timings go to City::stageTimes.
 #pragma once
@@ -25,6 +26,15 @@ struct GenerateOptions {
 };
 
 Result<City> generateCity(const CityParams& params, const GenerateOptions& options = {});
+
+// The meshes-per-tile stage of generateCity on a city whose streets, blocks,
+// buildings, trees (and street lights) are set: replaces city.tiles with the
+// non-empty tiles among `tiles` (indices of TileGrid(city.params), row-major;
+// empty = every tile), in that order. Buildings, trees and lights go to the
+// tile of their anchor (footprint centroid, trunk base, pole base); those
+// anchored in other tiles are not meshed. Parallel over tiles; the bytes do
+// not depend on the thread count. Indices out of range: VISTA_CHECK.
+void meshTiles(City& city, const std::vector<int>& tiles, Progress* progress);
 
 // Summary numbers of a city (stats file fields).
 struct CityCounts {

@@ -435,12 +435,8 @@ std::string distance(double m) {
     return s.str();
 }
 
-double maxExtent_m() {
-    for (const auto& s : paramSpecs())
-        if (std::string(s.name) == "size_m") return s.max;
-    VISTA_CHECK(false);
-    return 0;
-}
+// OSM imports are single-file cities (paged output does not take --osm).
+double maxExtent_m() { return kMaxSingleFileSizeM; }
 
 // ---- buildings ------------------------------------------------------------------
 

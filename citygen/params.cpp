@@ -32,7 +32,8 @@ const std::vector<Field>& fields() {
         Field seed{{"seed", "", 0, 18446744073709551615.0, "random seed; every stream derives from (seed, entity id)"}, Kind::U64};
         seed.u = &CityParams::seed;
         v.push_back(seed);
-        v.push_back(D("size_m", &CityParams::size_m, "metres", 100, 16000, "side of the square city area"));
+        v.push_back(D("size_m", &CityParams::size_m, "metres", 100, 64000,
+                       "side of the square city area (above 16000 only as paged output)"));
         v.push_back(D("origin_x", &CityParams::origin_x, "metres", -2e7, 2e7, "world east position of the city centre"));
         v.push_back(D("origin_y", &CityParams::origin_y, "metres", -2e7, 2e7, "world north position of the city centre"));
         v.push_back(D("tile_size_m", &CityParams::tile_size_m, "metres", 50, 2000, "side of the square output tiles"));
@@ -186,6 +187,14 @@ Status validateParams(const CityParams& p) {
     if (p.local_spacing_m > p.arterial_spacing_m)
         return Status::error("parameter 'local_spacing_m' = " + fmt(p.local_spacing_m) +
                              " must not exceed 'arterial_spacing_m' = " + fmt(p.arterial_spacing_m));
+    return Status::ok();
+}
+
+Status checkSingleFileSize(const CityParams& p) {
+    if (p.size_m > kMaxSingleFileSizeM)
+        return Status::error("parameter 'size_m' = " + fmt(p.size_m) + " is out of range [100, " + fmt(kMaxSingleFileSizeM) +
+                             "] for a single-file city (metres); larger cities (up to " + fmt(kMaxPagedSizeM) +
+                             ") are written as a paged city: vista gen -o DIR.paged");
     return Status::ok();
 }
 

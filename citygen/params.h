@@ -87,8 +87,17 @@ struct ParamSpec {
 const std::vector<ParamSpec>& paramSpecs();
 
 // Checks every field against its range. Error message format:
-//   "parameter 'size_m' = 0 is out of range [100, 16000] (metres)"
+//   "parameter 'size_m' = 0 is out of range [100, 64000] (metres)"
 Status validateParams(const CityParams& p);
+
+// A city built whole in memory (generateCity, single-file output) is capped at
+// kMaxSingleFileSizeM; up to kMaxPagedSizeM (the size_m range) it is generated
+// region by region as a paged city (citygen/regions.h). checkSingleFileSize()
+// returns an error naming 'size_m', the value, the single-file range and the
+// paged alternative above the cap.
+constexpr double kMaxSingleFileSizeM = 16000.0;
+constexpr double kMaxPagedSizeM = 64000.0;
+Status checkSingleFileSize(const CityParams& p);
 
 // Parses a JSON object of parameters on top of `base` (keys absent keep base values).
 // `source` names the input in messages (a file name). Unknown keys are errors.

@@ -14,6 +14,8 @@
 #include "cmd/options.h"
 #include "runtime/engine/baked_lighting.h"
 #include "runtime/scene/city_file.h"
+#include "runtime/scene/paged_city.h"
+#include "citygen/regions.h"
 #include "cmd/cli.h"
 #include "cmd/commands.h"
 
@@ -30,12 +32,21 @@ struct GenArgs {
     std::optional<double> size;
     std::optional<int> detail, threads;
     bool quiet = false, listParams = false;
+    // Paged output (-o DIR.paged).
+    std::optional<double> regionSize;
+    std::string shard;
+    bool merge = false;
+    bool paged() const { return endsWith(out, ".paged") || endsWith(out, ".paged/"); }
+    static bool endsWith(const std::string& s, const std::string& t) {
+        return s.size() >= t.size() && s.compare(s.size() - t.size(), t.size(), t) == 0;
+    }
 };
 
 CLI::Option* declareFlags(CLI::App& app, GenArgs& a) {
     app.add_option("--params", a.paramsFile, "JSON parameter file (see docs/params.md; examples in data/)");
     app.add_option("--seed", a.seed, "random seed (overrides the params file)");
-    app.add_option("--size", a.size, "side of the square city area in metres, 100..16000 (default 2000)");
+    app.add_option("--size", a.size,
+                   "side of the square city area in metres, 100..16000 (default 2000); up to 64000 with paged output");
     app.add_option("--detail", a.detail, "facade detail 0..3 (0 = plain boxes, default 2)");
     app.add_option("--threads", a.threads, "worker threads (0 = all; output never depends on it)");
     app.add_option("--effects", a.effects,
@@ -49,7 +60,18 @@ CLI::Option* declareFlags(CLI::App& app, GenArgs& a) {
     app.add_option("--gltf", a.gltfFile, "also write the city as binary glTF 2.0 (.glb)");
     app.add_option("--xodr", a.xodrFile, "also write the road network as ASAM OpenDRIVE 1.6 (.xodr, see docs/formats.md)");
     app.add_option("--stats", a.statsFile, "write statistics (counts, timings, peak memory) as JSON");
-    auto* out = app.add_option("-o,--output", a.out, "output scene file (.osgb)");
+    auto* out = app.add_option("-o,--output", a.out,
+                               "output: a scene file (.osgb), or a paged city directory (DIR.paged: one city file per "
+                               "region, index.osgb with a PagedLOD per region for osgviewer, manifest.json; "
+                               "docs/formats.md 'Paged city')");
+    app.add_option("--region-size", a.regionSize,
+                   "paged output: side of a region in metres, a whole number of tiles (tile_size_m), 250..16000 (default 2000)");
+    app.add_option("--shard", a.shard,
+                   "paged output: generate only the regions whose index % N == I (I/N, 0 <= I < N), no index; "
+                   "then --merge (or an unsharded run) writes index and manifest");
+    app.add_flag("--merge", a.merge,
+                 "paged output: generate nothing; write index.osgb and manifest.json once every region is done "
+                 "(exit 2 naming the missing regions otherwise)");
     app.add_flag("--list-params", a.listParams, "print every parameter with unit, range and default (Markdown) and exit");
     app.add_flag("-q,--quiet", a.quiet, "no progress on stderr");
     return out;
@@ -105,14 +127,89 @@ Result<CityParams> resolveParams(GenArgs& a) {
     }
     if (a.osmBuildings != "on" && a.osmBuildings != "off")
         return Status::error("option --osm-buildings = '" + a.osmBuildings + "': must be 'on' or 'off'");
+    if (a.paged()) return params;  // checked by resolvePaged
+    if (a.regionSize || !a.shard.empty() || a.merge)
+        return Status::error(std::string("option ") + (a.regionSize ? "--region-size" : !a.shard.empty() ? "--shard" : "--merge") +
+                             ": only with paged output (-o DIR.paged)");
     if (a.out.size() < 5 || a.out.substr(a.out.size() - 5) != ".osgb")
-        return Status::error("option -o = '" + a.out + "': the output must end in .osgb");
+        return Status::error("option -o = '" + a.out + "': the output must end in .osgb (a scene file) or .paged (a paged city directory)");
+    if (Status s = checkSingleFileSize(params); !s) return Status::error((a.size ? "option --size: " : "") + s.message());
     if (!a.xodrFile.empty()) VISTA_RETURN_IF_ERROR(checkXodrPath("--xodr", a.xodrFile));
     for (auto [opt, path] : {std::pair<const char*, std::string*>{"-o", &a.out}, {"--stats", &a.statsFile},
                              {"--geojson", &a.geojsonFile}, {"--gltf", &a.gltfFile}, {"--xodr", &a.xodrFile}}) {
         if (!path->empty()) VISTA_RETURN_IF_ERROR(checkWritablePath(opt, *path));
     }
     return params;
+}
+
+// The paged output's options, checked before anything is written.
+Result<PagedCityOptions> resolvePaged(const GenArgs& a, const CityParams& params) {
+    PagedCityOptions o;
+    o.dir = a.out;
+    while (o.dir.size() > 1 && o.dir.back() == '/') o.dir.pop_back();
+    if (a.regionSize) o.regionSizeM = *a.regionSize;
+    o.merge = a.merge;
+    if (Status s = validateRegionSize(params, o.regionSizeM); !s) return Status::error("option --region-size: " + s.message());
+    if (!a.shard.empty()) {
+        auto sh = parseShard("--shard", a.shard);
+        if (!sh) return sh.status();
+        o.shard = *sh;
+    }
+    if (a.merge && !a.shard.empty()) return Status::error("option --merge: not with --shard (the merge covers every shard)");
+    for (auto [opt, path] : {std::pair<const char*, const std::string*>{"--geojson", &a.geojsonFile}, {"--gltf", &a.gltfFile},
+                             {"--xodr", &a.xodrFile}, {"--osm", &a.osmFile}})
+        if (!path->empty()) return Status::error(std::string("option ") + opt + ": not supported with paged output (-o DIR.paged)");
+    if (bakedLightingCalledFor(params))
+        return Status::error("parameter 'effects' = " + params.effects.list() +
+                             ": baked lighting (sun_shadows, ambient_occlusion, night street lights) is computed over the "
+                             "whole city and is not supported with paged output (-o DIR.paged)");
+    VISTA_RETURN_IF_ERROR(checkPagedOutput("-o", o.dir));
+    if (!a.statsFile.empty()) VISTA_RETURN_IF_ERROR(checkWritablePath("--stats", a.statsFile));
+    return o;
+}
+
+int runPaged(const GenArgs& a, const CityParams& params, const Stopwatch& total) {
+    auto o = resolvePaged(a, params);
+    if (!o) return reportBadInput(kCmd, o.status());
+    StderrProgress progress(isatty(2));
+    o->progress = a.quiet ? nullptr : &progress;
+    auto rep = generatePagedCity(params, *o);
+    if (!rep) return reportBadInput(kCmd, rep.status());
+    const double totalSeconds = total.ms() / 1000.0;
+    if (!a.statsFile.empty()) {
+        nlohmann::ordered_json j;
+        j["seed"] = params.seed;
+        j["size_m"] = params.size_m;
+        j["detail"] = params.detail;
+        j["region_size_m"] = o->regionSizeM;
+        j["shard"] = std::to_string(o->shard.index) + "/" + std::to_string(o->shard.count);
+        j["merge"] = o->merge;
+        j["regions"] = rep->regions;
+        j["regions_generated"] = rep->generated;
+        j["regions_reused"] = rep->reused;
+        j["regions_regenerated"] = rep->regenerated;
+        j["empty_regions"] = rep->emptyRegions;
+        j["index_written"] = rep->indexWritten;
+        j["street_edges"] = rep->streetEdges;
+        j["blocks"] = rep->blocks;
+        j["buildings"] = rep->buildings;
+        j["trees"] = rep->trees;
+        j["triangles"] = rep->triangles;
+        j["bytes"] = rep->bytes;
+        j["seconds"] = {{"total", totalSeconds},
+                        {"stages", {{"streets and blocks", rep->baseSeconds}, {"regions", rep->regionSeconds}, {"index", rep->indexSeconds}}}};
+        j["peak_rss_mb"] = peakRssMb();
+        j["threads"] = params.threads;
+        if (Status s = writeFileAtomic(a.statsFile, j.dump(2) + "\n"); !s) return reportBadInput(kCmd, s);
+    }
+    if (!a.quiet)
+        std::fprintf(stderr, "wrote %s: %d regions (%d generated, %d reused, %d empty), %zu buildings, %zu trees, %.2f M triangles, "
+                     "%.1f MB, %s, %.1fs, peak %.0f MiB\n",
+                     o->dir.c_str(), rep->regions, rep->generated, rep->reused, rep->emptyRegions, rep->buildings, rep->trees,
+                     rep->triangles / 1e6, rep->bytes / 1e6,
+                     rep->indexWritten ? "index written" : "no index (shard: run --merge when every shard is done)",
+                     totalSeconds, peakRssMb());
+    return 0;
 }
 
 // Every output of the command, or none: each is staged, then all renamed together.
@@ -179,7 +276,8 @@ nlohmann::ordered_json statsJson(const City& city, const CityParams& params, con
 }  // namespace
 
 int runGen(int argc, char** argv) {
-    CLI::App app("Generate a city (deterministic by seed) and write it as one .osgb scene file.", kCmd);
+    CLI::App app("Generate a city (deterministic by seed) and write it as one .osgb scene file, or region by region as a "
+                 "paged city directory (-o DIR.paged) that resumes after a kill and splits into shards.", kCmd);
     GenArgs a;
     CLI::Option* outOpt = declareFlags(app, a);
     if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;
@@ -191,6 +289,7 @@ int runGen(int argc, char** argv) {
     Stopwatch total;
     auto params = resolveParams(a);
     if (!params) return reportBadInput(kCmd, params.status());
+    if (a.paged()) return runPaged(a, *params, total);
     StderrProgress progress(isatty(2));
     GenerateOptions opts;
     opts.progress = a.quiet ? nullptr : &progress;

@@ -14,7 +14,7 @@ struct Command {
 };
 
 const Command kCommands[] = {
-    {"gen", vista::runGen, "generate a city: params -> city.osgb (+ GeoJSON, glTF, stats)"},
+    {"gen", vista::runGen, "generate a city: params -> city.osgb (+ GeoJSON, glTF, stats) or a paged city DIR.paged"},
     {"path", vista::runPath, "make a deterministic walkthrough path along the streets (CSV)"},
     {"bench", vista::runBench, "headless walkthrough: render modes side by side, write CSV/JSON/PNG"},
     {"view", vista::runView, "interactive viewer (window; works under Xvfb)"},

@@ -68,11 +68,8 @@ GeoPoint destination(const GeoPoint& p, double bearingDeg, double dist) {
     return {f2 / kD2R, std::remainder(l2 / kD2R, 360.0)};
 }
 
-double maxCitySize() {
-    for (const auto& s : paramSpecs())
-        if (std::string(s.name) == "size_m") return s.max;
-    return 0;
-}
+// The largest city an OSM import may span (a single-file city; paged output takes no --osm).
+double maxCitySize() { return kMaxSingleFileSizeM; }
 
 // A synthetic .osm file; coordinates are written with 7 decimals (OSM's resolution) and
 // remembered as written.

@@ -41,15 +41,29 @@ TEST(Params, SizeZeroRejectedWithRange) {
     Status s = validateParams(p);
     ASSERT_FALSE(s.isOk());
     EXPECT_NE(s.message().find("size_m"), std::string::npos);
-    EXPECT_NE(s.message().find("[100, 16000]"), std::string::npos);
+    EXPECT_NE(s.message().find("[100, 64000]"), std::string::npos);
 }
 
 TEST(Params, TinyAndHugeSizesRejected) {
-    for (double v : {1.0, 99.9, 16000.1, 1e9, -5.0}) {
+    for (double v : {1.0, 99.9, 64000.1, 1e9, -5.0}) {
         CityParams p;
         p.size_m = v;
         EXPECT_FALSE(validateParams(p).isOk()) << v;
     }
+}
+
+TEST(Params, SingleFileCapNamesThePagedAlternative) {
+    CityParams p;
+    p.size_m = 16000;
+    EXPECT_TRUE(validateParams(p).isOk());
+    EXPECT_TRUE(checkSingleFileSize(p).isOk());
+    p.size_m = 16000.5;
+    EXPECT_TRUE(validateParams(p).isOk());
+    const Status s = checkSingleFileSize(p);
+    ASSERT_FALSE(s.isOk());
+    EXPECT_NE(s.message().find("'size_m' = 16000.5"), std::string::npos) << s.message();
+    EXPECT_NE(s.message().find("[100, 16000]"), std::string::npos) << s.message();
+    EXPECT_NE(s.message().find(".paged"), std::string::npos) << s.message();
 }
 
 TEST(Params, NanRejected) {

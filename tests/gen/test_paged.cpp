@@ -1,0 +1,411 @@
+// Paged generation (vista gen -o DIR.paged): determinism across threads and
+// shards, resume after an interruption, the PagedLOD index, building counts
+// against the unpaged city, bad input, damaged region files.
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <string>
+#include <thread>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+#include <osg/ComputeBoundsVisitor>
+#include <osg/Group>
+#include <osg/PagedLOD>
+#include <osgDB/ReadFile>
+#include <osgViewer/Viewer>
+
+#include "citygen/regions.h"
+#include "runtime/scene/city_file.h"
+#include "runtime/scene/paged_city.h"
+#include "runtime/scene/scene_file.h"
+#include "runtime/scene/scene_graph.h"
+#include "tests/common/run_vista.h"
+#include "tests/common/temp_dir.h"
+
+namespace fs = std::filesystem;
+using vista::test::CliRun;
+using vista::test::listTree;
+using vista::test::readBytes;
+using vista::test::runVista;
+using vista::test::TempDir;
+
+namespace {
+
+// A 1.5 km city in 500 m regions (3 x 3), facade detail 1 to keep it quick.
+const std::string kCity = "gen --size 1500 --seed 4 --detail 1 --region-size 500 -q";
+
+// Every file under `dir` (relative name -> bytes), temporaries included.
+std::map<std::string, std::string> snapshot(const std::string& dir) {
+    std::map<std::string, std::string> out;
+    for (const auto& name : listTree(dir))
+        if (fs::is_regular_file(fs::path(dir) / name)) out[name] = readBytes((fs::path(dir) / name).string());
+    return out;
+}
+
+void expectSameFiles(const std::map<std::string, std::string>& a, const std::map<std::string, std::string>& b,
+                     const std::string& what) {
+    std::set<std::string> na, nb;
+    for (const auto& [k, v] : a) na.insert(k);
+    for (const auto& [k, v] : b) nb.insert(k);
+    ASSERT_EQ(na, nb) << what;
+    for (const auto& [k, v] : a) EXPECT_TRUE(v == b.at(k)) << what << ": " << k << " differs";
+}
+
+nlohmann::json readJson(const std::string& path) { return nlohmann::json::parse(readBytes(path)); }
+
+class Paged : public ::testing::Test {
+protected:
+    // One reference run shared by the tests (threads 1).
+    static void SetUpTestSuite() {
+        ref = new TempDir("vista_paged_ref");
+        const CliRun r = runVista(kCity + " --threads 1 -o " + ref->file("city.paged") + " --stats " + ref->file("stats.json"));
+        ASSERT_EQ(r.code, 0) << r.err;
+        files = new std::map<std::string, std::string>(snapshot(ref->file("city.paged")));
+    }
+    static void TearDownTestSuite() {
+        delete files;
+        delete ref;
+        files = nullptr;
+        ref = nullptr;
+    }
+    static TempDir* ref;
+    static std::map<std::string, std::string>* files;
+    TempDir tmp{"vista_paged"};
+};
+TempDir* Paged::ref = nullptr;
+std::map<std::string, std::string>* Paged::files = nullptr;
+
+}  // namespace
+
+TEST(RegionGrid, EveryTileInExactlyOneRegion) {
+    vista::CityParams p;
+    p.size_m = 1600;  // 7 tiles of 250 m (the last one cut), regions of 3 tiles: 3 x 3, the last row/column of 1 tile
+    const vista::RegionGrid g(p, 750);
+    EXPECT_EQ(g.countX(), 3);
+    EXPECT_EQ(g.tilesPerRegion(), 3);
+    std::vector<int> seen(49, 0);
+    for (int r = 0; r < g.count(); ++r) {
+        glm::dvec2 lo, hi;
+        g.bounds(r, lo, hi);
+        for (int t : g.tilesOf(r)) {
+            ASSERT_GE(t, 0);
+            ASSERT_LT(t, 49);
+            ++seen[size_t(t)];
+            EXPECT_EQ(g.regionOfTile(t), r);
+            const double x = -800 + (t % 7) * 250.0 + 1, y = -800 + (t / 7) * 250.0 + 1;  // inside tile t
+            EXPECT_TRUE(x >= lo.x && x <= hi.x && y >= lo.y && y <= hi.y) << "tile " << t << " region " << r;
+        }
+    }
+    for (int c : seen) EXPECT_EQ(c, 1);
+    glm::dvec2 lo, hi;
+    g.bounds(8, lo, hi);
+    EXPECT_DOUBLE_EQ(lo.x, 700.0);
+    EXPECT_DOUBLE_EQ(hi.x, 800.0);  // cut by the city border
+}
+
+TEST(RegionGrid, RegionSizeValidated) {
+    vista::CityParams p;
+    EXPECT_TRUE(vista::validateRegionSize(p, 2000).isOk());
+    EXPECT_TRUE(vista::validateRegionSize(p, 250).isOk());
+    for (double bad : {0.0, 100.0, 333.0, 16250.0, 1e9, -500.0}) {
+        const vista::Status s = vista::validateRegionSize(p, bad);
+        ASSERT_FALSE(s.isOk()) << bad;
+        EXPECT_NE(s.message().find("region_size_m"), std::string::npos) << s.message();
+        EXPECT_NE(s.message().find("250 .. 16000"), std::string::npos) << s.message();
+    }
+}
+
+TEST(Shard, Parsed) {
+    auto s = vista::parseShard("--shard", "2/5");
+    ASSERT_TRUE(s.isOk());
+    EXPECT_EQ(s->index, 2);
+    EXPECT_EQ(s->count, 5);
+    for (const char* bad : {"3/2", "2/2", "0/0", "-1/2", "1", "a/b", "1/", "/3", "1/2/3", ""}) {
+        auto r = vista::parseShard("--shard", bad);
+        ASSERT_FALSE(r.isOk()) << bad;
+        EXPECT_NE(r.status().message().find("--shard"), std::string::npos);
+        EXPECT_NE(r.status().message().find("0 <= I < N"), std::string::npos) << r.status().message();
+    }
+}
+
+TEST_F(Paged, LayoutAndManifest) {
+    const std::string dir = ref->file("city.paged");
+    const auto m = readJson(dir + "/manifest.json");
+    EXPECT_EQ(m["format"], "vista.paged_city");
+    EXPECT_EQ(m["regions_x"], 3);
+    EXPECT_EQ(m["region_size_m"], 500.0);
+    EXPECT_EQ(m["params"]["size_m"], 1500.0);
+    ASSERT_EQ(m["regions"].size(), 9u);
+    size_t buildings = 0;
+    for (const auto& r : m["regions"]) {
+        buildings += r["buildings"].get<size_t>();
+        if (r["empty"].get<bool>()) continue;
+        ASSERT_EQ(r["files"].size(), 2u);
+        for (const auto& f : r["files"]) {
+            const std::string bytes = readBytes(dir + "/" + f["name"].get<std::string>());
+            EXPECT_EQ(bytes.size(), f["bytes"].get<size_t>()) << f["name"];
+            char hex[17];
+            std::snprintf(hex, sizeof hex, "%016llx", (unsigned long long)vista::hashBytes64(bytes.data(), bytes.size()));
+            EXPECT_EQ(f["hash"].get<std::string>(), hex) << f["name"];
+        }
+    }
+    EXPECT_EQ(buildings, m["totals"]["buildings"].get<size_t>());
+    EXPECT_GT(buildings, 0u);
+}
+
+// Every building of the city lies in exactly one region (anchor: footprint
+// centroid) and is the one the unpaged generator places on that lot, so the
+// union of the regions' buildings is the unpaged city's building count.
+TEST_F(Paged, BuildingCountsEqualTheUnpagedCity) {
+    const CliRun r = runVista("gen --size 1500 --seed 4 --detail 1 -q -o " + tmp.file("one.osgb") + " --stats " + tmp.file("one.json"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto one = readJson(tmp.file("one.json"));
+    const auto m = readJson(ref->file("city.paged") + "/manifest.json");
+    EXPECT_EQ(m["totals"]["buildings"].get<size_t>(), one["buildings"].get<size_t>());
+    const auto stats = readJson(ref->file("stats.json"));
+    EXPECT_EQ(stats["buildings"].get<size_t>(), one["buildings"].get<size_t>());
+    EXPECT_EQ(stats["street_edges"].get<size_t>(), one["street_edges"].get<size_t>());
+    EXPECT_EQ(stats["blocks"].get<size_t>(), one["blocks"].get<size_t>());
+    // Trees: the spacing filter runs per region and halo; the counts agree closely.
+    const double trees = stats["trees"].get<double>(), oneTrees = one["trees"].get<double>();
+    EXPECT_NEAR(trees, oneTrees, 0.02 * oneTrees);
+}
+
+TEST_F(Paged, SameBytesForAnyThreadCountAndShards) {
+    const std::string two = tmp.file("two.paged");
+    CliRun r = runVista(kCity + " --threads 2 -o " + two);
+    ASSERT_EQ(r.code, 0) << r.err;
+    expectSameFiles(*files, snapshot(two), "threads 2 vs 1");
+
+    // Three shards as concurrent processes, then the merge.
+    const std::string sh = tmp.file("shards.paged");
+    std::vector<pid_t> pids;
+    for (int i = 0; i < 3; ++i) {
+        std::vector<std::string> args{"gen", "--size", "1500", "--seed", "4", "--detail", "1", "--region-size", "500", "-q",
+                                      "--threads", "1", "--shard", std::to_string(i) + "/3", "-o", sh};
+        pids.push_back(vista::test::startVista(args));
+    }
+    for (pid_t p : pids) {
+        int st = 0;
+        ASSERT_EQ(::waitpid(p, &st, 0), p);
+        ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0);
+    }
+    EXPECT_FALSE(fs::exists(sh + "/index.osgb")) << "a shard wrote the index";
+    EXPECT_FALSE(fs::exists(sh + "/manifest.json"));
+    r = runVista(kCity + " --merge -o " + sh + " --stats " + tmp.file("merge.json"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(readJson(tmp.file("merge.json"))["regions_generated"], 0);
+    expectSameFiles(*files, snapshot(sh), "3 shards + merge vs one run");
+}
+
+TEST_F(Paged, MergeRefusesMissingRegions) {
+    const std::string sh = tmp.file("half.paged");
+    ASSERT_EQ(runVista(kCity + " --shard 0/2 -o " + sh).code, 0);
+    const auto before = snapshot(sh);
+    const CliRun r = runVista(kCity + " --merge -o " + sh);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--merge"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("region_1_0.osgb"), std::string::npos) << r.err;  // region 1: shard 1/2
+    EXPECT_FALSE(fs::exists(sh + "/index.osgb"));
+    expectSameFiles(before, snapshot(sh), "a refused merge changes nothing");
+}
+
+TEST_F(Paged, ResumeRegeneratesOnlyDamagedRegions) {
+    const std::string dir = tmp.file("city.paged");
+    fs::copy(ref->file("city.paged"), dir, fs::copy_options::recursive);
+    fs::remove(dir + "/index.osgb");
+    fs::remove(dir + "/manifest.json");
+    fs::remove(dir + "/region_0_0.osgb");                         // missing
+    fs::resize_file(dir + "/region_1_1.osgb", 1000);               // truncated
+    {
+        std::fstream f(dir + "/region_2_2.coarse.osgb", std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(600);
+        f.put('\x5a');                                              // one byte changed
+    }
+    fs::remove(dir + "/records/region_2_0.json");                  // files but no record (killed before it)
+    const CliRun r = runVista(kCity + " -o " + dir + " --stats " + tmp.file("s.json"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto s = readJson(tmp.file("s.json"));
+    EXPECT_EQ(s["regions_generated"], 4);
+    EXPECT_EQ(s["regions_reused"], 5);
+    expectSameFiles(*files, snapshot(dir), "resumed vs uninterrupted");
+}
+
+TEST_F(Paged, KillNineThenResumeGivesTheSameBytes) {
+    const std::string dir = tmp.file("killed.paged");
+    std::vector<std::string> args{"gen", "--size", "1500", "--seed", "4", "--detail", "1", "--region-size", "500", "-q",
+                                  "--threads", "1", "-o", dir};
+    const pid_t pid = vista::test::startVista(args);
+    // Kill it once the first region is recorded (a record renamed into place; mid-run: 9 regions).
+    auto recorded = [&] {
+        for (const auto& n : listTree(dir + "/records"))
+            if (n.size() > 5 && n.compare(n.size() - 5, 5, ".json") == 0) return true;
+        return false;
+    };
+    for (int i = 0; i < 6000 && !recorded(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    ::kill(pid, SIGKILL);
+    int st = 0;
+    ::waitpid(pid, &st, 0);
+    ASSERT_TRUE(WIFSIGNALED(st)) << "the run finished before it was killed";
+    EXPECT_FALSE(fs::exists(dir + "/index.osgb"));
+    const CliRun r = runVista(kCity + " --threads 1 -o " + dir + " --stats " + tmp.file("s.json"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_GE(readJson(tmp.file("s.json"))["regions_reused"].get<int>(), 1);
+    expectSameFiles(*files, snapshot(dir), "killed + resumed vs uninterrupted");  // no temporaries left either
+}
+
+// The index loads with osgDB (vista's reader and the stock one); one PagedLOD
+// per non-empty region naming its coarse and full files, whose bounding
+// sphere contains the region's geometry; full detail nearer than the coarse level.
+TEST_F(Paged, IndexHasOnePagedLodPerRegion) {
+    const std::string dir = ref->file("city.paged");
+    const auto m = readJson(dir + "/manifest.json");
+    auto root = vista::readSceneFile(dir + "/index.osgb");
+    ASSERT_TRUE(root.isOk()) << root.status().message();
+    osg::Group* g = (*root)->asGroup();
+    ASSERT_NE(g, nullptr);
+    EXPECT_EQ(g->getName(), "vista.paged_city");
+    size_t nonEmpty = 0;
+    for (const auto& r : m["regions"]) nonEmpty += r["empty"].get<bool>() ? 0 : 1;
+    ASSERT_EQ(g->getNumChildren(), nonEmpty);
+    EXPECT_GT(nonEmpty, 0u);
+    std::set<std::string> named;
+    for (unsigned i = 0; i < g->getNumChildren(); ++i) {
+        auto* lod = dynamic_cast<osg::PagedLOD*>(g->getChild(i));
+        ASSERT_NE(lod, nullptr);
+        ASSERT_EQ(lod->getNumFileNames(), 2u);
+        const std::string coarse = lod->getFileName(0), full = lod->getFileName(1);
+        EXPECT_EQ(full, lod->getName() + ".osgb");
+        EXPECT_EQ(coarse, lod->getName() + ".coarse.osgb");
+        named.insert(full);
+        EXPECT_EQ(lod->getMinRange(1), 0.0f);
+        EXPECT_EQ(lod->getMaxRange(1), lod->getMinRange(0));
+        EXPECT_GT(lod->getMaxRange(0), lod->getMaxRange(1));
+        const osg::BoundingSphere bs = lod->getBound();
+        for (const std::string& f : {full, coarse}) {
+            auto city = vista::loadCityFile(dir + "/" + f);
+            ASSERT_TRUE(city.isOk()) << city.status().message();
+            EXPECT_FALSE(city->tiles.empty()) << f;
+            if (f == coarse) {  // plain prisms, no trees
+                EXPECT_EQ(city->params.detail, 0);
+                EXPECT_TRUE(city->instances.empty()) << f;
+            } else {
+                EXPECT_EQ(city->params.detail, 1);
+            }
+            osg::ComputeBoundsVisitor cbv;
+            vista::sceneRoot(*city)->accept(cbv);
+            const osg::BoundingBox box = cbv.getBoundingBox();
+            ASSERT_TRUE(box.valid()) << f;
+            for (unsigned c = 0; c < 8; ++c)
+                EXPECT_LE((box.corner(c) - bs.center()).length(), bs.radius() * 1.0001f + 0.01f) << f << " corner " << c;
+        }
+    }
+    for (const auto& r : m["regions"])
+        if (!r["empty"].get<bool>()) EXPECT_EQ(named.count(r["files"][0]["name"].get<std::string>()), 1u);
+    // The stock reader: the PagedLODs get the index's directory as database path.
+    osg::ref_ptr<osg::Node> stock = osgDB::readNodeFile(dir + "/index.osgb");
+    ASSERT_TRUE(stock.valid());
+    auto* lod = dynamic_cast<osg::PagedLOD*>(stock->asGroup()->getChild(0));
+    ASSERT_NE(lod, nullptr);
+    EXPECT_TRUE(fs::exists(lod->getDatabasePath() + lod->getFileName(1))) << lod->getDatabasePath() << lod->getFileName(1);
+}
+
+// A region file that is missing or damaged is an error for vista's reader and
+// no crash for the stock one (the pager of osgviewer reads with it).
+TEST_F(Paged, DamagedRegionFilesDoNotCrashReaders) {
+    const std::string dir = tmp.file("city.paged");
+    fs::copy(ref->file("city.paged"), dir, fs::copy_options::recursive);
+    fs::remove(dir + "/region_0_0.osgb");
+    fs::resize_file(dir + "/region_1_1.osgb", fs::file_size(dir + "/region_1_1.osgb") / 2);
+    auto missing = vista::loadCityFile(dir + "/region_0_0.osgb");
+    ASSERT_FALSE(missing.isOk());
+    EXPECT_NE(missing.status().message().find("region_0_0.osgb"), std::string::npos);
+    auto truncated = vista::loadCityFile(dir + "/region_1_1.osgb");
+    ASSERT_FALSE(truncated.isOk());
+    EXPECT_NE(truncated.status().message().find("region_1_1.osgb"), std::string::npos);
+    EXPECT_FALSE(osg::ref_ptr<osg::Node>(osgDB::readNodeFile(dir + "/region_0_0.osgb")).valid());
+    osg::ref_ptr<osg::Node> part = osgDB::readNodeFile(dir + "/region_1_1.osgb");  // may return a part; must not crash
+    // The index and the other regions still load.
+    EXPECT_TRUE(vista::readSceneFile(dir + "/index.osgb").isOk());
+    EXPECT_TRUE(vista::loadCityFile(dir + "/region_0_1.osgb").isOk());
+}
+
+TEST_F(Paged, BadInputExitsTwoAndLeavesNothing) {
+    std::ofstream(tmp.file("file.paged")) << "x";
+    struct Case {
+        std::string args, field;
+    };
+    const std::string out = " -o " + tmp.file("out.paged");
+    const std::vector<Case> cases{
+        {"gen --size 1500 -q --region-size 100" + out, "region_size_m"},
+        {"gen --size 1500 -q --region-size 333" + out, "region_size_m"},
+        {"gen --size 1500 -q --region-size 20000" + out, "16000"},
+        {"gen --size 1500 -q -o " + tmp.file("file.paged"), "not a directory"},
+        {"gen --size 1500 -q --shard 3/2" + out, "--shard"},
+        {"gen --size 1500 -q --shard x" + out, "0 <= I < N"},
+        {"gen --size 1500 -q --shard 0/2 --merge" + out, "--merge"},
+        {"gen --size 1500 -q --merge" + out, "missing"},
+        {"gen --size 64001 -q" + out, "size_m"},
+        {"gen --size 1500 -q --gltf " + tmp.file("c.glb") + out, "--gltf"},
+        {"gen --size 1500 -q --effects sun_shadows" + out, "effects"},
+        {"gen --size 16001 -q -o " + tmp.file("c.osgb"), ".paged"},
+        {"gen --size 1500 -q --region-size 500 -o " + tmp.file("c.osgb"), "--region-size"},
+    };
+    for (const auto& c : cases) {
+        const std::set<std::string> before = listTree(tmp.path());
+        const CliRun r = runVista(c.args);
+        EXPECT_EQ(r.code, 2) << c.args << ": " << r.err;
+        EXPECT_NE(r.err.find(c.field), std::string::npos) << c.args << ": " << r.err;
+        EXPECT_EQ(listTree(tmp.path()), before) << c.args;
+    }
+}
+
+// Stock OSG paging (what osgviewer does): a viewer over the index, the camera
+// 150 m above region 0_0 looking down, pages in that region's coarse and then
+// full file; the far corner region (beyond the full range) gets at most its
+// coarse level.
+TEST_F(Paged, StockViewerPagesTheNearRegionIn) {
+    const char* display = std::getenv("DISPLAY");
+    if (!display || !*display) GTEST_SKIP() << "no DISPLAY: run the tests under xvfb-run -a";
+    const std::string dir = ref->file("city.paged");
+    osg::ref_ptr<osg::Node> index = osgDB::readNodeFile(dir + "/index.osgb");
+    ASSERT_TRUE(index.valid());
+    osg::PagedLOD *near = nullptr, *far = nullptr;
+    for (unsigned i = 0; i < index->asGroup()->getNumChildren(); ++i) {
+        auto* lod = dynamic_cast<osg::PagedLOD*>(index->asGroup()->getChild(i));
+        ASSERT_NE(lod, nullptr);
+        if (lod->getName() == "region_0_0") near = lod;
+        if (lod->getName() == "region_2_2") far = lod;
+    }
+    ASSERT_NE(near, nullptr);
+    ASSERT_NE(far, nullptr);
+    const osg::Vec3 c = near->getCenter();
+    ASSERT_GT((far->getCenter() - c).length(), far->getMaxRange(1)) << "the far region must be beyond its full range";
+
+    osgViewer::Viewer viewer;
+    viewer.setThreadingModel(osgViewer::Viewer::SingleThreaded);
+    viewer.setUpViewInWindow(0, 0, 64, 64);
+    viewer.setSceneData(index.get());
+    viewer.realize();
+    ASSERT_TRUE(viewer.isRealized());
+    viewer.getCamera()->setViewMatrixAsLookAt(c + osg::Vec3(0, -1, 150), c, osg::Vec3(0, 1, 0));
+    for (int frame = 0; frame < 3000 && near->getNumChildren() < 2; ++frame) {
+        viewer.frame();
+        viewer.getCamera()->setViewMatrixAsLookAt(c + osg::Vec3(0, -1, 150), c, osg::Vec3(0, 1, 0));
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    EXPECT_EQ(near->getNumChildren(), 2u) << "the near region's full level was not paged in";
+    EXPECT_LE(far->getNumChildren(), 1u) << "the far region got its full level";
+    if (near->getNumChildren() == 2) {
+        osg::Group* full = near->getChild(1)->asGroup();
+        ASSERT_NE(full, nullptr);
+        EXPECT_EQ(full->getName(), "vista.city");
+        EXPECT_GT(full->getNumChildren(), 0u);
+    }
+}
