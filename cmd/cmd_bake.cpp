@@ -7,6 +7,7 @@
 #include "cmd/cli.h"
 #include "cmd/commands.h"
 #include "cmd/options.h"
+#include "foundation/shard.h"
 
 namespace vista {
 
@@ -72,7 +73,10 @@ int runBake(int argc, char** argv) {
     p.representation = *repr;
     if (Status s = validateBakeJob(job); !s) return reportBadInput(cmd, s);
     if (!shard.empty())
-        if (Status s = parseShard(shard, job.shardK, job.shardN); !s) return reportBadInput(cmd, s);
+        auto sh = parseShard("--shard", shard);
+        if (!sh) return reportBadInput(cmd, sh.status());
+        job.shardK = sh->k();
+        job.shardN = sh->count;
     if (job.merge && !shard.empty()) return reportBadInput(cmd, Status::error("--merge and --shard exclude each other"));
     if (!cellList.empty()) {
         auto ids = parseCellList(cellList);

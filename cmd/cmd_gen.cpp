@@ -67,8 +67,8 @@ CLI::Option* declareFlags(CLI::App& app, GenArgs& a) {
     app.add_option("--region-size", a.regionSize,
                    "paged output: side of a region in metres, a whole number of tiles (tile_size_m), 250..16000 (default 2000)");
     app.add_option("--shard", a.shard,
-                   "paged output: generate only the regions whose index % N == I (I/N, 0 <= I < N), no index; "
-                   "then --merge (or an unsharded run) writes index and manifest");
+                   "paged output: shard K of N (K/N, 1 <= K <= N): generate only the regions whose index % N == K - 1, "
+                   "no index; then --merge (or an unsharded run) writes index and manifest");
     app.add_flag("--merge", a.merge,
                  "paged output: generate nothing; write index.osgb and manifest.json once every region is done "
                  "(exit 2 naming the missing regions otherwise)");
@@ -182,7 +182,7 @@ int runPaged(const GenArgs& a, const CityParams& params, const Stopwatch& total)
         j["size_m"] = params.size_m;
         j["detail"] = params.detail;
         j["region_size_m"] = o->regionSizeM;
-        j["shard"] = std::to_string(o->shard.index) + "/" + std::to_string(o->shard.count);
+        j["shard"] = std::to_string(o->shard.k()) + "/" + std::to_string(o->shard.count);
         j["merge"] = o->merge;
         j["regions"] = rep->regions;
         j["regions_generated"] = rep->generated;

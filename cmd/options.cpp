@@ -81,15 +81,6 @@ Status parseTexels(const std::string& s, int& x, int& y) {
     return Status::ok();
 }
 
-Status parseShard(const std::string& s, int& k, int& n) {
-    long a = 0, b = 0;
-    if (!splitPair(s, "/", a, b) || b < 1 || a < 1 || a > b)
-        return Status::error("--shard '" + s + "': expected K/N with 1 <= K <= N (e.g. 2/4)");
-    k = int(a);
-    n = int(b);
-    return Status::ok();
-}
-
 Result<std::vector<uint32_t>> parseCellList(const std::string& s) {
     std::vector<uint32_t> out;
     std::stringstream ss(s);

@@ -62,7 +62,6 @@ Result<std::string> parseModeName(const std::string& s);
 // vista bake: --cells "3,7,10-20" -> sorted unique ids (0 .. 1e8); --shard K/N
 // with 1 <= K <= N; --texels 1 or AxB with A, B in 1 .. 32.
 Result<std::vector<uint32_t>> parseCellList(const std::string& s);
-Status parseShard(const std::string& s, int& k, int& n);
 Status parseTexels(const std::string& s, int& x, int& y);
 // --sweep sizes=S1,S2,...: city sizes in metres, each 100 .. 16000.
 Result<std::vector<int>> parseSweep(const std::string& s);

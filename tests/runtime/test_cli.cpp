@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "cmd/options.h"
+#include "foundation/shard.h"
 
 using namespace vista;
 
@@ -155,14 +156,18 @@ TEST(Options, BakeCellsShardAndTexels) {
     for (const char* bad : {"", ",", "a", "3-", "-3", "5-2", "1-2-3", "3x", "100000001"})
         expectBad(parseCellList(bad), bad, "--cells", "10-20");
 
-    int k = 0, n = 0;
-    ASSERT_TRUE(parseShard("2/4", k, n).isOk());
-    EXPECT_EQ(k, 2);
-    EXPECT_EQ(n, 4);
-    for (const char* bad : {"0/4", "5/4", "2/0", "2", "2/", "/4", "2/4x", " 2/4", "+2/4", "a/b", "2\\4"}) {
-        Status s = parseShard(bad, k, n);
+    // Shards (foundation/shard.h, gen and bake alike): K/N, 1-based K.
+    auto sh = parseShard("--shard", "2/4");
+    ASSERT_TRUE(sh.isOk());
+    EXPECT_EQ(sh->k(), 2);
+    EXPECT_EQ(sh->index, 1);
+    EXPECT_EQ(sh->count, 4);
+    ASSERT_TRUE(parseShard("--shard", "100000/100000").isOk());
+    for (const char* bad : {"0/4", "5/4", "2/0", "2", "2/", "/4", "2/4x", " 2/4", "+2/4", "a/b", "2\\4", "1/100001", "-1/2", "1/2/3", ""}) {
+        auto s = parseShard("--shard", bad);
         ASSERT_FALSE(s.isOk()) << bad;
-        EXPECT_NE(s.message().find("1 <= K <= N"), std::string::npos) << s.message();
+        EXPECT_NE(s.status().message().find("1 <= K <= N"), std::string::npos) << s.status().message();
+        EXPECT_NE(s.status().message().find("--shard"), std::string::npos) << s.status().message();
     }
 
     int x = 0, y = 0;
