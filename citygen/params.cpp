@@ -1,4 +1,5 @@
 #include "citygen/params.h"
+#include "foundation/format.h"
 
 #include <algorithm>
 #include <cmath>
@@ -71,16 +72,10 @@ const std::vector<Field>& fields() {
     return kFields;
 }
 
-std::string fmt(double v) {
-    std::ostringstream s;
-    s.precision(17);
-    s << v;
-    return s.str();
-}
 
 std::string rangeMessage(const ParamSpec& s, const std::string& value) {
-    std::string m = "parameter '" + std::string(s.name) + "' = " + value + " is out of range [" + fmt(s.min) +
-                    ", " + fmt(s.max) + "]";
+    std::string m = "parameter '" + std::string(s.name) + "' = " + value + " is out of range [" + exactDecimal(s.min) +
+                    ", " + exactDecimal(s.max) + "]";
     if (*s.unit) m += std::string(" (") + s.unit + ")";
     return m;
 }
@@ -122,7 +117,7 @@ const ParamSpec kGeoLon{"geo.lon0_deg", "degrees", -180, 180, "WGS84 longitude o
 
 Status validateGeo(const GeoReference& g) {
     for (auto [spec, v] : {std::pair<const ParamSpec*, double>{&kGeoLat, g.lat0_deg}, {&kGeoLon, g.lon0_deg}})
-        if (!std::isfinite(v) || v < spec->min || v > spec->max) return Status::error(rangeMessage(*spec, fmt(v)));
+        if (!std::isfinite(v) || v < spec->min || v > spec->max) return Status::error(rangeMessage(*spec, exactDecimal(v)));
     return Status::ok();
 }
 
@@ -175,7 +170,7 @@ Status validateParams(const CityParams& p) {
             case Kind::Int: v = p.*(f.i); break;
             case Kind::U64: continue;
         }
-        if (!std::isfinite(v) || v < f.spec.min || v > f.spec.max) return Status::error(rangeMessage(f.spec, fmt(v)));
+        if (!std::isfinite(v) || v < f.spec.min || v > f.spec.max) return Status::error(rangeMessage(f.spec, exactDecimal(v)));
     }
     if (p.min_floors > p.max_floors)
         return Status::error("parameter 'min_floors' = " + std::to_string(p.min_floors) +
@@ -185,15 +180,15 @@ Status validateParams(const CityParams& p) {
     if (Status e = validateEffects(p.effects); !e) return e;
     if (p.geo) VISTA_RETURN_IF_ERROR(validateGeo(*p.geo));
     if (p.local_spacing_m > p.arterial_spacing_m)
-        return Status::error("parameter 'local_spacing_m' = " + fmt(p.local_spacing_m) +
-                             " must not exceed 'arterial_spacing_m' = " + fmt(p.arterial_spacing_m));
+        return Status::error("parameter 'local_spacing_m' = " + exactDecimal(p.local_spacing_m) +
+                             " must not exceed 'arterial_spacing_m' = " + exactDecimal(p.arterial_spacing_m));
     return Status::ok();
 }
 
 Status checkSingleFileSize(const CityParams& p) {
     if (p.size_m > kMaxSingleFileSizeM)
-        return Status::error("parameter 'size_m' = " + fmt(p.size_m) + " is out of range [100, " + fmt(kMaxSingleFileSizeM) +
-                             "] for a single-file city (metres); larger cities (up to " + fmt(kMaxPagedSizeM) +
+        return Status::error("parameter 'size_m' = " + exactDecimal(p.size_m) + " is out of range [100, " + exactDecimal(kMaxSingleFileSizeM) +
+                             "] for a single-file city (metres); larger cities (up to " + exactDecimal(kMaxPagedSizeM) +
                              ") are written as a paged city: vista gen -o DIR.paged");
     return Status::ok();
 }

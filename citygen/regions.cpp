@@ -1,4 +1,5 @@
 #include "citygen/regions.h"
+#include "foundation/format.h"
 
 #include <algorithm>
 #include <cmath>
@@ -27,12 +28,6 @@ tbb::global_control threadLimit(const CityParams& p) {
     return tbb::global_control(tbb::global_control::max_allowed_parallelism, size_t(threads));
 }
 
-std::string fmt(double v) {
-    std::ostringstream s;
-    s.precision(17);
-    s << v;
-    return s.str();
-}
 
 // Regions whose rectangle, grown by the halo, meets the box [lo, hi].
 template <class F>
@@ -50,13 +45,13 @@ void forRegionsNear(const RegionGrid& grid, double half, double regionSize, glm:
 
 Status validateRegionSize(const CityParams& p, double r) {
     const double lo = std::max(kMinRegionSizeM, p.tile_size_m);
-    const std::string range = " (metres; allowed: " + fmt(lo) + " .. " + fmt(kMaxRegionSizeM) +
-                              ", a whole multiple of tile_size_m = " + fmt(p.tile_size_m) + ")";
+    const std::string range = " (metres; allowed: " + exactDecimal(lo) + " .. " + exactDecimal(kMaxRegionSizeM) +
+                              ", a whole multiple of tile_size_m = " + exactDecimal(p.tile_size_m) + ")";
     if (!std::isfinite(r) || r < lo || r > kMaxRegionSizeM)
-        return Status::error("parameter 'region_size_m' = " + fmt(r) + " is out of range" + range);
+        return Status::error("parameter 'region_size_m' = " + exactDecimal(r) + " is out of range" + range);
     const double k = r / p.tile_size_m;
     if (std::abs(k - std::round(k)) > 1e-9 * k)
-        return Status::error("parameter 'region_size_m' = " + fmt(r) + " is not a whole number of tiles" + range);
+        return Status::error("parameter 'region_size_m' = " + exactDecimal(r) + " is not a whole number of tiles" + range);
     return Status::ok();
 }
 

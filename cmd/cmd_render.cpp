@@ -32,6 +32,7 @@
 #include <nlohmann/json.hpp>
 
 #include "citygen/labels.h"
+#include "foundation/format.h"
 #include "cmd/cli.h"
 #include "cmd/commands.h"
 #include "cmd/options.h"
@@ -175,9 +176,7 @@ Result<std::string> fileHash(const std::string& path, uint64_t& bytes) {
     const bool bad = std::ferror(f) != 0;
     std::fclose(f);
     if (bad) return Status::error("cannot read '" + path + "': read error");
-    char b[24];
-    std::snprintf(b, sizeof b, "%016llx", static_cast<unsigned long long>(h.finish()));
-    return std::string(b);
+    return hex64(h.finish());
 }
 
 // Hash of the frames' camera poses (path index, time, eye, heading, pitch):
@@ -200,9 +199,7 @@ std::string posesHash(const Path& path, const std::vector<size_t>& idx) {
         put(i);
         putD(s.t), putD(s.position.x), putD(s.position.y), putD(s.position.z), putD(s.heading), putD(s.pitch);
     }
-    char b[24];
-    std::snprintf(b, sizeof b, "%016llx", static_cast<unsigned long long>(h.finish()));
-    return b;
+    return hex64(h.finish());
 }
 
 std::string channelList(unsigned c) {

@@ -1,6 +1,7 @@
 // The paged city writer: regions (citygen/regions.h) as city files, their
 // records (resume), the PagedLOD index and the manifest. See paged_city.h.
 #include "runtime/scene/paged_city.h"
+#include "foundation/format.h"
 
 #include <chrono>
 #include <cinttypes>
@@ -36,18 +37,6 @@ double seconds(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-std::string hex64(uint64_t v) {
-    char b[17];
-    std::snprintf(b, sizeof b, "%016" PRIx64, v);
-    return b;
-}
-
-std::string fmt(double v) {
-    std::ostringstream s;
-    s.precision(17);
-    s << v;
-    return s.str();
-}
 
 // Size and content hash (hashBytes64) of a file, streamed; false if unreadable.
 bool hashFile(const std::string& path, uint64_t& bytes, uint64_t& hash) {
@@ -271,7 +260,7 @@ Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedC
     }
 
     const RegionGrid grid(params, o.regionSizeM);
-    const std::string keyText = paramsToJson(params) + "\nregion_size_m=" + fmt(o.regionSizeM) +
+    const std::string keyText = paramsToJson(params) + "\nregion_size_m=" + exactDecimal(o.regionSizeM) +
                                 "\nformat=" + std::to_string(kPagedFormatVersion);
     const std::string key = hex64(hashBytes64(keyText.data(), keyText.size()));
     PagedCityReport rep;

@@ -1,5 +1,6 @@
 // Scene file I/O: atomic writes, osgb payload + integrity trailer (city_file_io.h).
 #include "runtime/scene/scene_file.h"
+#include "foundation/format.h"
 
 #include <cstdlib>
 #include <sys/wait.h>
@@ -220,9 +221,7 @@ Result<std::string> sceneFileContentHash(const std::string& path) {
         !in.read(reinterpret_cast<char*>(tr), kSceneTrailerSize) || std::memcmp(tr, kTrailerHead, 8) != 0 ||
         std::memcmp(tr + 24, kTrailerTail, 8) != 0 || loadLE64(tr + 8) != uint64_t(size) - kSceneTrailerSize)
         return Status::error("scene file '" + path + "' is truncated or was not written by vista (no integrity trailer)");
-    char hex[17];
-    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(loadLE64(tr + 16)));
-    return std::string(hex);
+    return hex64(loadLE64(tr + 16));
 }
 
 std::string sceneFileTrailer(const std::string& payload) {
