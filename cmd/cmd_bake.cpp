@@ -72,11 +72,12 @@ int runBake(int argc, char** argv) {
     if (!repr) return reportBadInput(cmd, repr.status());
     p.representation = *repr;
     if (Status s = validateBakeJob(job); !s) return reportBadInput(cmd, s);
-    if (!shard.empty())
+    if (!shard.empty()) {
         auto sh = parseShard("--shard", shard);
         if (!sh) return reportBadInput(cmd, sh.status());
         job.shardK = sh->k();
         job.shardN = sh->count;
+    }
     if (job.merge && !shard.empty()) return reportBadInput(cmd, Status::error("--merge and --shard exclude each other"));
     if (!cellList.empty()) {
         auto ids = parseCellList(cellList);
