@@ -19,8 +19,9 @@ int runPath(int argc, char** argv) {
     double yawDeg = 45.0, pitchDeg = o.flyPitch * 180.0 / kPi;
     // Option declarations (alike in shape to every command's: one CLI11 call per flag, kept).
     app.add_option("city", city,
-                   "city scene file (.osgb) written by `vista gen`, or a paged city directory (DIR.paged: the path runs "
-                   "on the streets of the region nearest the city centre, no region geometry is loaded)")
+                   "city scene file (.osgb) written by `vista gen`, or a paged city directory (DIR.paged: its street "
+                   "graph is grown again from the manifest's params, no region is read; the same path as the "
+                   "single-file city's)")
         ->required();
     app.add_option("--seed", o.seed, "random seed of the route (default 1)");
     app.add_option("--kind", kind, "walk (eye 1.7 m), car (eye 1.2 m) or fly (elevated fly-over); default car");

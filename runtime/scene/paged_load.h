@@ -25,11 +25,10 @@
 // selected (points far from the city, or none): an error naming the radius.
 //
 // pagedPathStreets(): the street graph that a path of a paged city made from
-// a seed runs on: the streets of the non-empty region whose bounds centre is
-// nearest the city centre (its region file's vista.streets: the region's edges
-// plus a 250 m halo). A generated path therefore stays within that region and
-// its halo; a longer walkthrough comes from `--path FILE.csv`.
-//
+// a seed runs on: the whole city's graph, grown again from the manifest's
+// params (growStreets, as `vista gen` made it: paged cities are never OSM
+// imports; about a second for the 64 km city), so `--seed N` gives the same
+// path as on the single-file city of the same params. No region is read.
 // Radius: kMinPagedRadiusM .. kMaxPagedRadiusM (validatePagedRadius names
 // the option, the value and the range).
 #pragma once

@@ -115,7 +115,7 @@ TEST_F(PagedLoad, WholeCityMergeMatchesTheRegions) {
         sum += t.triangles;
     }
     EXPECT_EQ(sum, city->triangles);
-    // A seeded path on the centre region's streets stays on the city's streets.
+    // A seeded path (on the regrown street graph) stays on the merged streets.
     auto g = vista::pagedPathStreets(*m);
     ASSERT_TRUE(g.isOk()) << g.status().message();
     vista::PathOptions po;
@@ -156,6 +156,12 @@ TEST_F(PagedLoad, BenchLoadsOnlyTheRegionsNearThePath) {
     auto p = vista::loadPathCsv(tmp.file("p.csv"));
     ASSERT_TRUE(p.isOk()) << p.status().message();
     EXPECT_FALSE(p->samples.empty());
+    // The same path as on the single-file city of the same params (the whole street graph, regrown).
+    r = runVista("gen --size 1500 --seed 4 --detail 1 -q -o " + tmp.file("one.osgb"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = runVista("path " + tmp.file("one.osgb") + " --seed 4 -o " + tmp.file("one.csv"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(readBytes(tmp.file("p.csv")) == readBytes(tmp.file("one.csv")));
     // ... and bench follows that CSV (the same path as its --seed 4: the same regions).
     r = runVista("bench " + dir() + " --path " + tmp.file("p.csv") + " --frames 2 --size 160x120 --modes full -q --paged-radius 0 --out " +
                  tmp.file("csv"));
