@@ -64,7 +64,8 @@ struct ViewArgs {
 
 void declareFlags(CLI::App& app, ViewArgs& a) {
     a.path.seed = 0;  // no playback unless asked
-    app.add_option("city", a.city, "city scene file (.osgb), or a baked file from 'vista bake' (adds the impostor mode; lodmesh for --representation mesh)")->required();
+    app.add_option("city", a.city, "city scene file (.osgb), a paged city directory (DIR.paged: the regions within --paged-radius of the path), "
+                   "or a baked file from 'vista bake' (adds the impostor mode; lodmesh for --representation mesh)")->required();
     addPathFlags(app, a.path, true);
     addPagedRadiusFlag(app, a.pagedRadius);
     app.get_option("--seed")->description("play back the path of this seed (key 5); default 0 = none, start where seed 1's path starts");
