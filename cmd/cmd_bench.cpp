@@ -170,7 +170,14 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
         if (!paged) return reportBadInput(kCmd, paged.status());
         path = walkthroughPath(a.path, a.pathOptions, paged->stub);
         if (!path) return reportBadInput(kCmd, path.status());
-        city = loadPagedNear(*paged, *path, a.pagedRadius, kCmd, a.quiet, &cfg.pagedJson);
+        // The budget check of a city file, on the selected regions' bytes.
+        auto budget = [&](uint64_t bytes) {
+            const bool rays = std::any_of(cfg.modes.begin(), cfg.modes.end(),
+                                          [](const std::string& m) { return findRenderMode(m)->needsRays; });
+            cfg.memoryEstimateMb = estimateCityRunMb(bytes, rays);
+            return checkMemoryBudget("--memory-budget", cfg.memoryBudgetGb, cfg.memoryEstimateMb, bytes, rays);
+        };
+        city = loadPagedNear(*paged, *path, a.pagedRadius, kCmd, a.quiet, &cfg.pagedJson, budget);
         if (!city) return reportBadInput(kCmd, city.status());
     } else {
         city = loadCityFile(cityFile);

@@ -429,9 +429,9 @@ int runView(int argc, char** argv) {
     if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;
     ModeContext ctx;
     if (Status s = configure(a, ctx.options); !s) return reportBadInput(kCmd, s);
+    auto budget = parseMemoryBudgetGb("--memory-budget", a.memoryBudget);
+    if (!budget) return reportBadInput(kCmd, budget.status());
     {
-        auto budget = parseMemoryBudgetGb("--memory-budget", a.memoryBudget);
-        if (!budget) return reportBadInput(kCmd, budget.status());
         std::error_code ec;
         const uint64_t bytes = std::filesystem::file_size(a.city, ec);
         if (!ec)
@@ -447,7 +447,9 @@ int runView(int argc, char** argv) {
         if (!paged) return reportBadInput(kCmd, paged.status());
         path = viewPath(a, paged->stub, playback);
         if (!path) return reportBadInput(kCmd, path.status());
-        city = loadPagedNear(*paged, *path, a.pagedRadius, kCmd, false);
+        city = loadPagedNear(*paged, *path, a.pagedRadius, kCmd, false, nullptr, [&](uint64_t bytes) {
+            return checkMemoryBudget("--memory-budget", *budget, estimateCityRunMb(bytes, true), bytes, true);
+        });
         if (!city) return reportBadInput(kCmd, city.status());
     } else {
         city = loadCityFile(a.city);

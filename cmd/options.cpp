@@ -430,11 +430,16 @@ Result<PagedOpen> openPagedCity(const std::string& dir, bool needStreets) {
 }
 
 Result<SceneModel> loadPagedNear(const PagedOpen& city, const Path& path, double radius, const char* cmd, bool quiet,
-                                 std::string* pagedJson) {
+                                 std::string* pagedJson, const std::function<Status(uint64_t bytes)>& beforeLoad) {
     std::vector<glm::dvec2> points;
     for (const PathSample& s : path.samples) points.emplace_back(s.position.x, s.position.y);
     if (points.empty()) points.emplace_back(city.manifest.params.origin_x, city.manifest.params.origin_y);
     const std::vector<int> regions = selectPagedRegions(city.manifest, points, radius);
+    if (beforeLoad) {
+        uint64_t bytes = 0;
+        for (int r : regions) bytes += city.manifest.regions[size_t(r)].bytes;
+        VISTA_RETURN_IF_ERROR(beforeLoad(bytes));
+    }
     PagedLoadReport rep;
     auto model = loadPagedCity(city.manifest, regions, radius, &rep);
     if (!model) return model.status();

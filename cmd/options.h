@@ -12,6 +12,7 @@
 // ModeOptions by parseModeFlags().
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -136,7 +137,10 @@ Result<PagedOpen> openPagedCity(const std::string& dir, bool needStreets);
 // sample only when `firstOnly`) and merges them; prints a note naming the
 // count on stderr unless quiet; `pagedJson` (if not null) receives the
 // summary.json block {regions_loaded, regions_total, radius_m, bytes_loaded}.
+// `beforeLoad` (if set) is called with the selected regions' file bytes before
+// any is read (the --memory-budget check); its error stops the load.
 Result<SceneModel> loadPagedNear(const PagedOpen& city, const Path& path, double radius, const char* cmd, bool quiet,
-                                 std::string* pagedJson = nullptr);
+                                 std::string* pagedJson = nullptr,
+                                 const std::function<Status(uint64_t bytes)>& beforeLoad = nullptr);
 
 }  // namespace vista

@@ -139,6 +139,8 @@ TEST_F(PagedLoad, BenchLoadsOnlyTheRegionsNearThePath) {
     EXPECT_LT(near, 9);
     EXPECT_EQ(s["paged"]["regions_total"].get<int>(), 9);
     EXPECT_EQ(s["paged"]["radius_m"].get<double>(), 0.0);
+    // The memory estimate is made from the selected regions' bytes.
+    EXPECT_GT(s["memory"]["estimate_mb"].get<double>(), 0.0) << s["memory"].dump();
 
     r = runVista("bench " + dir() + kBench + " --paged-radius 5000 --out " + tmp.file("all"));
     ASSERT_EQ(r.code, 0) << r.err;
@@ -198,6 +200,12 @@ TEST_F(PagedLoad, BadInputExitsTwoNamingIt) {
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_NE(r.err.find("manifest.json"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(tmp.file("p.csv")));
+    // A memory budget below the estimate of the selected regions: refused before loading them.
+    r = runVista("bench " + dir() + kBench + " --paged-radius 5000 --memory-budget 0.01 --out " + tmp.file("o5"));
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("--memory-budget"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("paged city: loaded"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(tmp.file("o5/summary.json")));
     // Radius out of range.
     EXPECT_FALSE(vista::validatePagedRadius("--paged-radius", std::nan("")).isOk());
     EXPECT_TRUE(vista::validatePagedRadius("--paged-radius", 0.0).isOk());
