@@ -60,6 +60,9 @@ struct BenchConfig {
     double loadMs = -1;            // city load time measured by the caller (set-up "load"); < 0 = not reported
     double runUpS = -1;            // the path's run-up (PathOptions::runUp) when the bench made it; < 0 = unknown
     std::string effectsDeclared = "{}";  // the scene's effects (JSON, effects.h), recorded in summary.json
+    // A paged city's load (summary.json "paged": regions_loaded, regions_total,
+    // radius_m, bytes_loaded): JSON object, empty = a city file.
+    std::string pagedJson;
 };
 // Checks sizes, frame count, fov, reference, modes and the mode options
 // (options.h ranges); messages name the command-line flag.

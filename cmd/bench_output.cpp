@@ -110,6 +110,7 @@ json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneM
     j["command"] = cfg.command;
     j["city"] = cfg.cityLabel;
     j["city_triangles"] = city ? city->triangles : 0;
+    if (!cfg.pagedJson.empty()) j["paged"] = json::parse(cfg.pagedJson);
     j["size"] = {cfg.width, cfg.height};
     j["frames"] = cfg.frames;
     j["sampling"] = samplingName(cfg.sampleRuns);

@@ -38,13 +38,15 @@ struct BenchArgs {
     ModeFlags mode;
     BenchConfig cfg;
     PathOptions pathOptions;
+    double pagedRadius = kDefaultPagedRadiusM;
 };
 
 void declareFlags(CLI::App& app, BenchArgs& a) {
     std::string modeHelp = "comma-separated modes (default full,near); available:";
     for (const auto& m : renderModes()) modeHelp += std::string("\n    ") + m.name + ": " + m.summary;
-    app.add_option("city", a.city, "city scene file (.osgb); not needed with --sweep");
+    app.add_option("city", a.city, "city scene file (.osgb), or a paged city directory (DIR.paged); not needed with --sweep");
     addPathFlags(app, a.path, true);
+    addPagedRadiusFlag(app, a.pagedRadius);
     app.add_option("--frames", a.cfg.frames, "frames rendered, sampled from the path as --sampling says (default 120)");
     app.add_option("--sampling", a.sampling,
                    "which path samples are the frames: 'spread' (evenly over the whole path), 'consecutive' (the first "
@@ -112,6 +114,7 @@ Status configure(BenchArgs& a) {
     auto po = parsePathFlags(a.path);
     if (!po) return po.status();
     a.pathOptions = po.value();
+    VISTA_RETURN_IF_ERROR(validatePagedRadius("--paged-radius", a.pagedRadius));
     if (a.sweep.empty()) {
         if (a.city.empty()) return Status::error("missing the city file argument (or use --sweep)");
         if (!fs::exists(a.city)) return Status::error("city file '" + a.city + "' does not exist");
@@ -158,13 +161,33 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
         }
     }
     Stopwatch sw;
-    auto city = loadCityFile(cityFile);
-    if (!city) return reportBadInput(kCmd, city.status());
+    Result<SceneModel> city = Status::error("no city");
+    Result<Path> path = Status::error("no path");
+    if (isPagedCityPath(cityFile)) {
+        // A paged city: the walkthrough first (a CSV, or a seeded path on the
+        // centre region's streets), then only the regions near it.
+        auto paged = openPagedCity(cityFile, a.path.file.empty());
+        if (!paged) return reportBadInput(kCmd, paged.status());
+        path = walkthroughPath(a.path, a.pathOptions, paged->stub);
+        if (!path) return reportBadInput(kCmd, path.status());
+        // The budget check of a city file, on the selected regions' bytes.
+        auto budget = [&](uint64_t bytes) {
+            const bool rays = std::any_of(cfg.modes.begin(), cfg.modes.end(),
+                                          [](const std::string& m) { return findRenderMode(m)->needsRays; });
+            cfg.memoryEstimateMb = estimateCityRunMb(bytes, rays);
+            return checkMemoryBudget("--memory-budget", cfg.memoryBudgetGb, cfg.memoryEstimateMb, bytes, rays);
+        };
+        city = loadPagedNear(*paged, *path, a.pagedRadius, kCmd, a.quiet, &cfg.pagedJson, budget);
+        if (!city) return reportBadInput(kCmd, city.status());
+    } else {
+        city = loadCityFile(cityFile);
+        if (!city) return reportBadInput(kCmd, city.status());
+    }
     cfg.loadMs = sw.ms();
     cfg.memoryPhases.push_back(memoryPhase("load"));
     // A baked file of another city, or a truncated one, is refused before anything is drawn.
     if (Status st = loadPairedBakes(kCmd, cityFile, sceneRoot(city.value()), cfg.modes, cfg.options); !st) return reportBadInput(kCmd, st);
-    auto path = walkthroughPath(a.path, a.pathOptions, city.value());
+    if (!path) path = walkthroughPath(a.path, a.pathOptions, city.value());
     if (!path) return reportBadInput(kCmd, path.status());
     cfg.runUpS = a.path.file.empty() ? a.pathOptions.runUp : -1.0;
     cfg.outDir = outDir;

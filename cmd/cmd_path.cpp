@@ -6,6 +6,7 @@
 #include "foundation/units.h"
 #include "cmd/cli.h"
 #include "cmd/commands.h"
+#include "cmd/options.h"
 #include "runtime/scene/paths.h"
 
 namespace vista {
@@ -17,7 +18,11 @@ int runPath(int argc, char** argv) {
     PathOptions o;
     double yawDeg = 45.0, pitchDeg = o.flyPitch * 180.0 / kPi;
     // Option declarations (alike in shape to every command's: one CLI11 call per flag, kept).
-    app.add_option("city", city, "city scene file (.osgb) written by `vista gen`")->required();
+    app.add_option("city", city,
+                   "city scene file (.osgb) written by `vista gen`, or a paged city directory (DIR.paged: its street "
+                   "graph is grown again from the manifest's params, no region is read; the same path as the "
+                   "single-file city's)")
+        ->required();
     app.add_option("--seed", o.seed, "random seed of the route (default 1)");
     app.add_option("--kind", kind, "walk (eye 1.7 m), car (eye 1.2 m) or fly (elevated fly-over); default car");
     app.add_option("--duration", o.duration, "path length in seconds (default 60)");
@@ -39,7 +44,14 @@ int runPath(int argc, char** argv) {
     o.flyPitch = pitchDeg * kPi / 180.0;
     if (Status s = validatePathOptions(o); !s) return reportBadInput("vista path", s);
     if (Status s = checkWritablePath("--output", out); !s) return reportBadInput("vista path", s);
-    auto c = loadCityFile(city);
+    Result<SceneModel> c = Status::error("no city");
+    if (isPagedCityPath(city)) {
+        auto paged = openPagedCity(city, true);
+        if (!paged) return reportBadInput("vista path", paged.status());
+        c = std::move(paged->stub);
+    } else {
+        c = loadCityFile(city);
+    }
     if (!c) return reportBadInput("vista path", c.status());
     auto p = generatePath(c->streets, c->params, o);
     if (!p) return reportBadInput("vista path", p.status());

@@ -59,12 +59,15 @@ struct ViewArgs {
     ModeFlags modeFlags;
     ImageSize window;
     double fovDeg = 60.0;
+    double pagedRadius = kDefaultPagedRadiusM;
 };
 
 void declareFlags(CLI::App& app, ViewArgs& a) {
     a.path.seed = 0;  // no playback unless asked
-    app.add_option("city", a.city, "city scene file (.osgb), or a baked file from 'vista bake' (adds the impostor mode; lodmesh for --representation mesh)")->required();
+    app.add_option("city", a.city, "city scene file (.osgb), a paged city directory (DIR.paged: the regions within --paged-radius of the path), "
+                   "or a baked file from 'vista bake' (adds the impostor mode; lodmesh for --representation mesh)")->required();
     addPathFlags(app, a.path, true);
+    addPagedRadiusFlag(app, a.pagedRadius);
     app.get_option("--seed")->description("play back the path of this seed (key 5); default 0 = none, start where seed 1's path starts");
     app.add_option("--size", a.size, "window size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 1280x720)");
     app.add_option("--fov", a.fov, "vertical field of view in degrees, (1, 179) (default 60)");
@@ -101,6 +104,7 @@ Status configure(ViewArgs& a, ModeOptions& options) {
     if (a.step && (a.frames < 1 || (a.path.file.empty() && a.path.seed == 0)))
         return Status::error("--step needs --frames N >= 1 and a path (--path or --seed)");
     if (!a.screenshot.empty()) VISTA_RETURN_IF_ERROR(checkWritablePath("--screenshot", a.screenshot));
+    VISTA_RETURN_IF_ERROR(validatePagedRadius("--paged-radius", a.pagedRadius));
     return parseModeFlags(a.modeFlags, options);
 }
 
@@ -425,21 +429,35 @@ int runView(int argc, char** argv) {
     if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;
     ModeContext ctx;
     if (Status s = configure(a, ctx.options); !s) return reportBadInput(kCmd, s);
+    auto budget = parseMemoryBudgetGb("--memory-budget", a.memoryBudget);
+    if (!budget) return reportBadInput(kCmd, budget.status());
     {
-        auto budget = parseMemoryBudgetGb("--memory-budget", a.memoryBudget);
-        if (!budget) return reportBadInput(kCmd, budget.status());
         std::error_code ec;
         const uint64_t bytes = std::filesystem::file_size(a.city, ec);
         if (!ec)
             if (Status s = checkMemoryBudget("--memory-budget", *budget, estimateCityRunMb(bytes, true), bytes, true); !s)
                 return reportBadInput(kCmd, s);
     }
-    auto city = loadCityFile(a.city);
-    if (!city) return reportBadInput(kCmd, city.status());
+    bool playback = false;
+    Result<SceneModel> city = Status::error("no city");
+    Result<Path> path = Status::error("no path");
+    if (isPagedCityPath(a.city)) {
+        // A paged city: the walkthrough (or its start) first, then the regions near it.
+        auto paged = openPagedCity(a.city, a.path.file.empty());
+        if (!paged) return reportBadInput(kCmd, paged.status());
+        path = viewPath(a, paged->stub, playback);
+        if (!path) return reportBadInput(kCmd, path.status());
+        city = loadPagedNear(*paged, *path, a.pagedRadius, kCmd, false, nullptr, [&](uint64_t bytes) {
+            return checkMemoryBudget("--memory-budget", *budget, estimateCityRunMb(bytes, true), bytes, true);
+        });
+        if (!city) return reportBadInput(kCmd, city.status());
+    } else {
+        city = loadCityFile(a.city);
+        if (!city) return reportBadInput(kCmd, city.status());
+    }
     // Every baked file given is checked against the city up front (modes are switched at run time).
     if (Status st = loadPairedBakes(kCmd, a.city, sceneRoot(city.value()), {}, ctx.options); !st) return reportBadInput(kCmd, st);
-    bool playback = false;
-    auto path = viewPath(a, city.value(), playback);
+    if (!path) path = viewPath(a, city.value(), playback);
     if (!path) return reportBadInput(kCmd, path.status());
     if (a.step && path->samples.empty()) return reportBadInput(kCmd, Status::error("--step: the path has no samples"));
     const char* display = std::getenv("DISPLAY");

@@ -407,4 +407,53 @@ Result<FrameEffects> runTimeEffects(const std::string& option, const Effects& de
 }
 
 
+void addPagedRadiusFlag(CLI::App& app, double& radius) {
+    std::ostringstream help;
+    help << "with a paged city (a DIR.paged directory from `vista gen`): load only the regions within this many metres "
+            "of the walkthrough, "
+         << kMinPagedRadiusM << " .. " << kMaxPagedRadiusM << " (default " << kDefaultPagedRadiusM << ")";
+    app.add_option("--paged-radius", radius, help.str());
+}
+
+Result<PagedOpen> openPagedCity(const std::string& dir, bool needStreets) {
+    auto m = readPagedManifest(dir);
+    if (!m) return m.status();
+    PagedOpen out;
+    out.stub.params = m->params;
+    if (needStreets) {
+        auto g = pagedPathStreets(*m);
+        if (!g) return g.status();
+        out.stub.streets = std::move(*g);
+    }
+    out.manifest = std::move(*m);
+    return out;
+}
+
+Result<SceneModel> loadPagedNear(const PagedOpen& city, const Path& path, double radius, const char* cmd, bool quiet,
+                                 std::string* pagedJson, const std::function<Status(uint64_t bytes)>& beforeLoad) {
+    std::vector<glm::dvec2> points;
+    for (const PathSample& s : path.samples) points.emplace_back(s.position.x, s.position.y);
+    if (points.empty()) points.emplace_back(city.manifest.params.origin_x, city.manifest.params.origin_y);
+    const std::vector<int> regions = selectPagedRegions(city.manifest, points, radius);
+    if (beforeLoad) {
+        uint64_t bytes = 0;
+        for (int r : regions) bytes += city.manifest.regions[size_t(r)].bytes;
+        VISTA_RETURN_IF_ERROR(beforeLoad(bytes));
+    }
+    PagedLoadReport rep;
+    auto model = loadPagedCity(city.manifest, regions, radius, &rep);
+    if (!model) return model.status();
+    if (!quiet)
+        std::fprintf(stderr, "%s: paged city: loaded %d of %d regions within %g m of the walkthrough (%.1f MB of region files, %zu triangles)\n",
+                     cmd, rep.regionsLoaded, rep.regionsTotal, radius, double(rep.bytesLoaded) / 1e6, model->triangles);
+    if (pagedJson) {
+        std::ostringstream j;
+        j.precision(17);
+        j << "{\"regions_loaded\": " << rep.regionsLoaded << ", \"regions_total\": " << rep.regionsTotal
+          << ", \"radius_m\": " << radius << ", \"bytes_loaded\": " << rep.bytesLoaded << "}";
+        *pagedJson = j.str();
+    }
+    return model;
+}
+
 }  // namespace vista

@@ -12,6 +12,7 @@
 // ModeOptions by parseModeFlags().
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@
 #include "citygen/effects.h"
 #include "foundation/status.h"
 #include "nodes/render/render_mode.h"
+#include "runtime/scene/paged_load.h"
 #include "runtime/scene/paths.h"
 
 namespace vista {
@@ -117,5 +119,28 @@ Result<PathOptions> parsePathFlags(const PathFlags& flags);
 // The walkthrough: the CSV of --path if given, else a path generated on the
 // city's streets with `options`.
 Result<Path> walkthroughPath(const PathFlags& flags, const PathOptions& options, const SceneModel& city);
+
+// --paged-radius M (bench, view): metres around the walkthrough within which
+// a paged city's regions are loaded (paged_load.h; default kDefaultPagedRadiusM).
+void addPagedRadiusFlag(CLI::App& app, double& radius);
+
+// A paged city opened for a walkthrough: `stub` has the params and, unless
+// the walkthrough comes from a CSV (`needStreets` false), the streets a
+// seeded path runs on (pagedPathStreets), so that walkthroughPath() can make
+// the path before any region is loaded.
+struct PagedOpen {
+    PagedManifest manifest;
+    SceneModel stub;
+};
+Result<PagedOpen> openPagedCity(const std::string& dir, bool needStreets);
+// Loads the regions within `radius` metres of the path's samples (its first
+// sample only when `firstOnly`) and merges them; prints a note naming the
+// count on stderr unless quiet; `pagedJson` (if not null) receives the
+// summary.json block {regions_loaded, regions_total, radius_m, bytes_loaded}.
+// `beforeLoad` (if set) is called with the selected regions' file bytes before
+// any is read (the --memory-budget check); its error stops the load.
+Result<SceneModel> loadPagedNear(const PagedOpen& city, const Path& path, double radius, const char* cmd, bool quiet,
+                                 std::string* pagedJson = nullptr,
+                                 const std::function<Status(uint64_t bytes)>& beforeLoad = nullptr);
 
 }  // namespace vista

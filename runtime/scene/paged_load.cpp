@@ -1,0 +1,249 @@
+// Reading a paged city: manifest, region selection, merge. See paged_load.h.
+#include "runtime/scene/paged_load.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <utility>
+
+#include <nlohmann/json.hpp>
+#include <osg/Group>
+
+#include "citygen/streets.h"
+#include "runtime/scene/city_file.h"
+#include "runtime/scene/paged_city.h"
+#include "runtime/scene/scene_graph.h"
+
+namespace vista {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+int PagedManifest::nonEmpty() const {
+    int n = 0;
+    for (const auto& r : regions) n += r.empty ? 0 : 1;
+    return n;
+}
+
+bool isPagedCityPath(const std::string& path) {
+    std::error_code ec;
+    return !path.empty() && fs::is_directory(path, ec);
+}
+
+Status validatePagedRadius(const std::string& option, double value) {
+    if (!std::isfinite(value) || value < kMinPagedRadiusM || value > kMaxPagedRadiusM) {
+        std::ostringstream s;
+        s << "option " << option << " = " << value << ": out of range (" << kMinPagedRadiusM << " .. " << kMaxPagedRadiusM
+          << " metres)";
+        return Status::error(s.str());
+    }
+    return Status::ok();
+}
+
+Result<PagedManifest> readPagedManifest(const std::string& dir) {
+    const std::string path = (fs::path(dir) / kPagedManifestFile).string();
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return Status::error("paged city '" + dir + "': cannot read '" + path + "' (not a paged city from `vista gen -o DIR.paged`, or its run did not finish)");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    Json j = Json::parse(ss.str(), nullptr, false);
+    auto bad = [&](const std::string& why) { return Status::error("'" + path + "': " + why); };
+    if (j.is_discarded() || !j.is_object()) return bad("not valid JSON (corrupt or truncated)");
+    PagedManifest m;
+    m.dir = dir;
+    try {
+        if (!j.contains("format") || j.at("format") != "vista.paged_city") return bad("field 'format' is not \"vista.paged_city\"");
+        if (j.at("version").get<int>() != 1)
+            return bad("field 'version' = " + j.at("version").dump() + " is not supported (expected 1)");
+        auto params = parseParamsJson(j.at("params").dump(), path + " (params)");
+        if (!params) return params.status();
+        m.params = *params;
+        m.regionSizeM = j.at("region_size_m").get<double>();
+        m.regionsX = j.at("regions_x").get<int>();
+        m.regionsY = j.at("regions_y").get<int>();
+        if (m.regionsX < 1 || m.regionsY < 1 || m.regionsX > 4096 || m.regionsY > 4096)
+            return bad("fields 'regions_x'/'regions_y' = " + std::to_string(m.regionsX) + "/" + std::to_string(m.regionsY) +
+                       " out of range (1 .. 4096)");
+        const Json& regions = j.at("regions");
+        if (!regions.is_array() || regions.size() != size_t(m.regionsX) * size_t(m.regionsY))
+            return bad("field 'regions' is not an array of regions_x * regions_y entries");
+        for (const Json& e : regions) {
+            PagedRegionEntry r;
+            r.region = e.at("region").get<int>();
+            r.ix = e.at("ix").get<int>();
+            r.iy = e.at("iy").get<int>();
+            r.empty = e.at("empty").get<bool>();
+            r.triangles = e.at("triangles").get<uint64_t>();
+            const std::string where = "region " + std::to_string(r.region);
+            if (!r.empty) {
+                const Json& b = e.at("bounds");
+                if (!b.is_array() || b.size() != 6) return bad(where + ": field 'bounds' is not 6 numbers");
+                double v[6];
+                for (int k = 0; k < 6; ++k) {
+                    v[k] = b[size_t(k)].get<double>();
+                    if (!std::isfinite(v[k])) return bad(where + ": field 'bounds' has a non-finite value");
+                }
+                r.lo = glm::dvec3(v[0], v[1], v[2]);
+                r.hi = glm::dvec3(v[3], v[4], v[5]);
+                for (const Json& f : e.at("files"))
+                    if (f.at("role") == "full") {
+                        r.file = f.at("name").get<std::string>();
+                        r.bytes = f.at("bytes").get<uint64_t>();
+                    }
+                if (r.file.empty()) return bad(where + ": no file with role 'full'");
+                if (r.file.find('/') != std::string::npos || r.file.find('\\') != std::string::npos || r.file == "..")
+                    return bad(where + ": file name '" + r.file + "' is not a plain name inside the directory");
+            }
+            m.regions.push_back(std::move(r));
+        }
+    } catch (const std::exception& ex) {
+        return bad(std::string("missing or mistyped field (") + ex.what() + ")");
+    }
+    return m;
+}
+
+std::vector<int> selectPagedRegions(const PagedManifest& m, const std::vector<glm::dvec2>& points, double radiusM) {
+    std::vector<int> out;
+    const double r2 = radiusM * radiusM;
+    for (size_t i = 0; i < m.regions.size(); ++i) {
+        const PagedRegionEntry& r = m.regions[i];
+        if (r.empty) continue;
+        for (const glm::dvec2& p : points) {
+            const double dx = std::max({r.lo.x - p.x, 0.0, p.x - r.hi.x});
+            const double dy = std::max({r.lo.y - p.y, 0.0, p.y - r.hi.y});
+            if (dx * dx + dy * dy <= r2) {
+                out.push_back(int(i));
+                break;
+            }
+        }
+    }
+    return out;
+}
+
+namespace {
+
+// Loads region `i`'s full file, checking its size against the manifest first.
+Result<SceneModel> loadRegion(const PagedManifest& m, int i) {
+    const PagedRegionEntry& r = m.regions[size_t(i)];
+    const std::string path = (fs::path(m.dir) / r.file).string();
+    std::error_code ec;
+    const uint64_t size = fs::file_size(path, ec);
+    if (ec) return Status::error("paged city '" + m.dir + "': region file '" + path + "' is missing or unreadable (" + ec.message() + ")");
+    if (size != r.bytes)
+        return Status::error("paged city '" + m.dir + "': region file '" + path + "' has " + std::to_string(size) +
+                             " bytes, the manifest says " + std::to_string(r.bytes) + " (damaged or from another run)");
+    return loadCityFile(path);
+}
+
+// Appends `b`'s streets to `a`, merging nodes by exact position and edges by end nodes.
+struct StreetUnion {
+    StreetGraph g;
+    std::map<std::pair<double, double>, uint32_t> nodeIndex;
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> edgeIndex;
+    void add(const StreetGraph& b) {
+        std::vector<uint32_t> remap(b.nodes.size());
+        for (size_t n = 0; n < b.nodes.size(); ++n) {
+            auto [it, fresh] = nodeIndex.emplace(std::make_pair(b.nodes[n].x, b.nodes[n].y), uint32_t(g.nodes.size()));
+            if (fresh) g.nodes.push_back(b.nodes[n]);
+            remap[n] = it->second;
+        }
+        for (const StreetEdge& e : b.edges) {
+            if (e.a >= remap.size() || e.b >= remap.size()) continue;
+            StreetEdge x = e;
+            x.a = remap[e.a];
+            x.b = remap[e.b];
+            const auto key = std::make_pair(std::min(x.a, x.b), std::max(x.a, x.b));
+            if (edgeIndex.emplace(key, uint32_t(g.edges.size())).second) g.edges.push_back(x);
+        }
+    }
+};
+
+}  // namespace
+
+Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>& regions, double radiusM,
+                                 PagedLoadReport* report) {
+    if (regions.empty())
+        return Status::error("paged city '" + m.dir + "': no region within --paged-radius " + std::to_string(radiusM) +
+                             " m of the walkthrough (" + std::to_string(m.nonEmpty()) + " non-empty regions)");
+    PagedLoadReport rep;
+    rep.regionsTotal = m.nonEmpty();
+    rep.radiusM = radiusM;
+    SceneModel out;
+    osg::ref_ptr<osg::Group> root = new osg::Group;
+    root->setName("vista.city");
+    StreetUnion streets;
+    bool first = true;
+    for (int i : regions) {
+        if (i < 0 || size_t(i) >= m.regions.size() || m.regions[size_t(i)].empty) continue;
+        auto rm = loadRegion(m, i);
+        if (!rm) return rm.status();
+        SceneModel& r = *rm;
+        osg::Group* rroot = sceneRoot(r) ? sceneRoot(r)->asGroup() : nullptr;
+        if (!rroot) return Status::error("region file '" + m.regions[size_t(i)].file + "' has no scene graph");
+        if (first) {
+            out.params = r.params;
+            out.prototypes = std::move(r.prototypes);
+            root->setStateSet(rroot->getStateSet());
+            for (const char* key : {"vista.format", "vista.tree_prototypes"}) {
+                int v = 0;
+                if (rroot->getUserValue(key, v)) root->setUserValue(key, v);
+            }
+            for (const char* key : {"vista.origin_x", "vista.origin_y", "vista.tile_size_m"}) {
+                double v = 0;
+                if (rroot->getUserValue(key, v)) root->setUserValue(key, v);
+            }
+            std::string params;
+            if (rroot->getUserValue("vista.params", params)) root->setUserValue("vista.params", params);
+            first = false;
+        } else {
+            if (r.prototypes.size() != out.prototypes.size())
+                return Status::error("region file '" + m.regions[size_t(i)].file + "': " + std::to_string(r.prototypes.size()) +
+                                     " tree prototypes, the first region has " + std::to_string(out.prototypes.size()) +
+                                     " (regions of different cities)");
+            for (size_t p = 0; p < out.prototypes.size(); ++p)
+                if (out.prototypes[p].indices.empty() && !r.prototypes[p].indices.empty()) out.prototypes[p] = std::move(r.prototypes[p]);
+        }
+        const uint32_t meshBase = uint32_t(out.meshes.size()), instBase = uint32_t(out.instances.size());
+        for (SceneMesh& mesh : r.meshes) {
+            mesh.ids.clear();
+            mesh.ids.shrink_to_fit();
+            out.meshes.push_back(std::move(mesh));
+        }
+        for (SceneInstance& in : r.instances) {
+            in.id = 0;
+            out.instances.push_back(in);
+        }
+        for (SceneTile& t : r.tiles) {
+            osg::Node* child = rroot->getChild(t.child);
+            t.child = root->getNumChildren();
+            root->addChild(child);
+            for (uint32_t& k : t.meshes) k += meshBase;
+            for (uint32_t& k : t.instances) k += instBase;
+            out.tiles.push_back(std::move(t));
+        }
+        out.triangles += r.triangles;
+        streets.add(r.streets);
+        ++rep.regionsLoaded;
+        rep.bytesLoaded += m.regions[size_t(i)].bytes;
+        rep.files.push_back(m.regions[size_t(i)].file);
+    }
+    for (SceneMesh& p : out.prototypes) p.ids.clear();
+    out.streets = std::move(streets.g);
+    root->setUserValue("vista.streets", streetGraphToJson(out.streets));
+    out.labelled = false;
+    setSceneRoot(out, root.get());
+    if (report) *report = std::move(rep);
+    return out;
+}
+
+Result<StreetGraph> pagedPathStreets(const PagedManifest& m) {
+    // The street graph of a city depends only on its params (paged cities are
+    // never imported from OSM); growing it is cheap (the 64 km city: 21,475
+    // edges, about a second), so the path is the single-file city's path.
+    return growStreets(m.params, nullptr);
+}
+
+}  // namespace vista

@@ -1,0 +1,89 @@
+// Reading a paged city (docs/formats.md "Paged city", written by
+// paged_city.h): the regions near a walkthrough, merged into one SceneModel,
+// so that `vista bench/view/path DIR.paged` fit a 32 or 64 km city in memory.
+//
+// readPagedManifest(): parses DIR/manifest.json (format "vista.paged_city",
+// version 1) into the region list. Errors name the file and the field:
+// missing or unreadable manifest, bad JSON, wrong format or version, a region
+// entry without ix/iy/bounds/files, bounds that are not 6 finite numbers, a
+// file name with a path separator.
+//
+// selectPagedRegions(): the non-empty regions whose world xy bounds
+// (manifest `bounds`) come within `radiusM` metres (2D distance to the
+// rectangle) of at least one of `points` (world metres), in region order.
+//
+// loadPagedCity(): loads each selected region's full file (loadCityFile:
+// missing, truncated or corrupt files are errors naming the file; a file
+// whose size differs from the manifest is an error naming it too) and merges
+// them: tiles, meshes and tree instances of every region in region order (the
+// merged graph is a new "vista.city" root over the regions' tile transforms,
+// SceneTile::child indexes it), the root state and user values of the first
+// region; streets = the union of the regions' street graphs (nodes merged by
+// exact position, edges by their end nodes, in first-seen order), which is a
+// subgraph of the city's graph. Ground-truth ids are numbered per region, so
+// the merged model is unlabelled (labelled = false, ids empty). No region
+// selected (points far from the city, or none): an error naming the radius.
+//
+// pagedPathStreets(): the street graph that a path of a paged city made from
+// a seed runs on: the whole city's graph, grown again from the manifest's
+// params (growStreets, as `vista gen` made it: paged cities are never OSM
+// imports; about a second for the 64 km city), so `--seed N` gives the same
+// path as on the single-file city of the same params. No region is read.
+// Radius: kMinPagedRadiusM .. kMaxPagedRadiusM (validatePagedRadius names
+// the option, the value and the range).
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "citygen/params.h"
+#include "citygen/street_graph.h"
+#include "foundation/status.h"
+#include "runtime/scene/scene_model.h"
+
+namespace vista {
+
+constexpr double kDefaultPagedRadiusM = 3000.0;
+constexpr double kMinPagedRadiusM = 0.0;
+constexpr double kMaxPagedRadiusM = 100000.0;
+
+struct PagedRegionEntry {
+    int region = 0, ix = 0, iy = 0;
+    bool empty = true;
+    glm::dvec3 lo{0.0}, hi{0.0};  // world bounds of the geometry (non-empty only)
+    std::string file;             // the full file, relative to the directory
+    uint64_t bytes = 0;           // its size per the manifest
+    uint64_t triangles = 0;       // rendered triangles per the manifest
+};
+
+struct PagedManifest {
+    std::string dir;
+    CityParams params;
+    double regionSizeM = 0;
+    int regionsX = 0, regionsY = 0;
+    std::vector<PagedRegionEntry> regions;  // every region of the grid, empty ones included
+    int nonEmpty() const;
+};
+
+struct PagedLoadReport {
+    int regionsLoaded = 0;
+    int regionsTotal = 0;  // non-empty regions of the city
+    double radiusM = 0;
+    uint64_t bytesLoaded = 0;           // file bytes of the loaded regions
+    std::vector<std::string> files;     // loaded region files (relative names)
+};
+
+// True when `path` is a directory (a paged city is a directory; a city file is not).
+bool isPagedCityPath(const std::string& path);
+// `option` = `value` within [kMinPagedRadiusM, kMaxPagedRadiusM] and finite.
+Status validatePagedRadius(const std::string& option, double value);
+
+Result<PagedManifest> readPagedManifest(const std::string& dir);
+std::vector<int> selectPagedRegions(const PagedManifest& m, const std::vector<glm::dvec2>& points, double radiusM);
+Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>& regions, double radiusM,
+                                 PagedLoadReport* report = nullptr);
+Result<StreetGraph> pagedPathStreets(const PagedManifest& m);
+
+}  // namespace vista

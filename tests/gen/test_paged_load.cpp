@@ -1,0 +1,221 @@
+// Reading a paged city (runtime/scene/paged_load.h; `vista bench/view/path
+// DIR.paged`): region selection by distance to the walkthrough, the merged
+// model against the manifest, the bench's paged block, bad input.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "runtime/scene/city_file.h"
+#include "runtime/scene/paged_load.h"
+#include "runtime/scene/paths.h"
+#include "tests/common/run_vista.h"
+#include "tests/common/temp_dir.h"
+
+namespace fs = std::filesystem;
+using vista::test::CliRun;
+using vista::test::readBytes;
+using vista::test::runVista;
+using vista::test::TempDir;
+
+namespace {
+
+// A 1.5 km city in 500 m regions (3 x 3), facade detail 1 to keep it quick.
+const std::string kCity = "gen --size 1500 --seed 4 --detail 1 --region-size 500 -q";
+const std::string kBench = " --seed 4 --frames 2 --size 160x120 --modes full -q";
+
+nlohmann::json readJson(const std::string& path) { return nlohmann::json::parse(readBytes(path)); }
+
+class PagedLoad : public ::testing::Test {
+protected:
+    static void SetUpTestSuite() {
+        ref = new TempDir("vista_pagedload_ref");
+        const CliRun r = runVista(kCity + " -o " + ref->file("city.paged"));
+        ASSERT_EQ(r.code, 0) << r.err;
+    }
+    static void TearDownTestSuite() {
+        delete ref;
+        ref = nullptr;
+    }
+    static std::string dir() { return ref->file("city.paged"); }
+    static TempDir* ref;
+    TempDir tmp{"vista_pagedload"};
+};
+TempDir* PagedLoad::ref = nullptr;
+
+}  // namespace
+
+TEST_F(PagedLoad, ManifestAndSelectionByDistance) {
+    auto m = vista::readPagedManifest(dir());
+    ASSERT_TRUE(m.isOk()) << m.status().message();
+    ASSERT_EQ(m->regions.size(), 9u);
+    ASSERT_EQ(m->nonEmpty(), 9);
+    // A point inside the south-west region, radius 0: that region only.
+    const auto& r0 = m->regions[0];
+    const glm::dvec2 inside = 0.5 * (glm::dvec2(r0.lo) + glm::dvec2(r0.hi));
+    EXPECT_EQ(vista::selectPagedRegions(*m, {inside}, 0.0), std::vector<int>{0});
+    // Independent check of the rule (2D distance to the bounds rectangle <= radius) for a few radii.
+    for (double radius : {0.0, 200.0, 600.0, 5000.0}) {
+        std::vector<int> expect;
+        for (size_t i = 0; i < m->regions.size(); ++i) {
+            const auto& r = m->regions[i];
+            const double cx = std::clamp(inside.x, r.lo.x, r.hi.x), cy = std::clamp(inside.y, r.lo.y, r.hi.y);
+            if (std::hypot(inside.x - cx, inside.y - cy) <= radius) expect.push_back(int(i));
+        }
+        EXPECT_EQ(vista::selectPagedRegions(*m, {inside}, radius), expect) << radius;
+    }
+    EXPECT_EQ(vista::selectPagedRegions(*m, {inside}, 5000.0).size(), 9u);
+    EXPECT_TRUE(vista::selectPagedRegions(*m, {glm::dvec2(1e6, 1e6)}, 1000.0).empty());
+}
+
+TEST_F(PagedLoad, WholeCityMergeMatchesTheRegions) {
+    auto m = vista::readPagedManifest(dir());
+    ASSERT_TRUE(m.isOk()) << m.status().message();
+    std::vector<int> all;
+    uint64_t manifestTriangles = 0;
+    size_t tiles = 0, meshes = 0, instances = 0;
+    std::set<std::pair<double, double>> nodes;
+    for (size_t i = 0; i < m->regions.size(); ++i) {
+        all.push_back(int(i));
+        manifestTriangles += m->regions[i].triangles;
+        auto one = vista::loadCityFile((fs::path(dir()) / m->regions[i].file).string());
+        ASSERT_TRUE(one.isOk()) << one.status().message();
+        tiles += one->tiles.size();
+        meshes += one->meshes.size();
+        instances += one->instances.size();
+        for (const auto& n : one->streets.nodes) nodes.insert({n.x, n.y});
+    }
+    vista::PagedLoadReport rep;
+    auto city = vista::loadPagedCity(*m, all, 1e5, &rep);
+    ASSERT_TRUE(city.isOk()) << city.status().message();
+    EXPECT_EQ(rep.regionsLoaded, 9);
+    EXPECT_EQ(rep.regionsTotal, 9);
+    EXPECT_EQ(city->triangles, manifestTriangles);
+    EXPECT_EQ(city->tiles.size(), tiles);
+    EXPECT_EQ(city->meshes.size(), meshes);
+    EXPECT_EQ(city->instances.size(), instances);
+    EXPECT_FALSE(city->labelled);
+    // Streets: the union of the regions' graphs, each node once.
+    EXPECT_EQ(city->streets.nodes.size(), nodes.size());
+    for (const auto& e : city->streets.edges) {
+        ASSERT_LT(e.a, city->streets.nodes.size());
+        ASSERT_LT(e.b, city->streets.nodes.size());
+    }
+    // Every tile's meshes and instances index the merged arrays; tile triangles add up.
+    size_t sum = 0;
+    for (const auto& t : city->tiles) {
+        for (uint32_t k : t.meshes) ASSERT_LT(k, city->meshes.size());
+        for (uint32_t k : t.instances) ASSERT_LT(k, city->instances.size());
+        sum += t.triangles;
+    }
+    EXPECT_EQ(sum, city->triangles);
+    // A seeded path (on the regrown street graph) stays on the merged streets.
+    auto g = vista::pagedPathStreets(*m);
+    ASSERT_TRUE(g.isOk()) << g.status().message();
+    vista::PathOptions po;
+    po.seed = 3;
+    po.duration = 20;
+    auto p = vista::generatePath(*g, m->params, po);
+    ASSERT_TRUE(p.isOk()) << p.status().message();
+    for (size_t i = 0; i < p->samples.size(); i += 30) {
+        const glm::dvec2 c(p->samples[i].position.x - m->params.origin_x, p->samples[i].position.y - m->params.origin_y);
+        EXPECT_LT(vista::distanceToStreets(city->streets, c), 15.0) << "sample " << i;
+    }
+}
+
+TEST_F(PagedLoad, BenchLoadsOnlyTheRegionsNearThePath) {
+    CliRun r = runVista("bench " + dir() + kBench + " --paged-radius 0 --out " + tmp.file("near"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    auto s = readJson(tmp.file("near/summary.json"));
+    ASSERT_TRUE(s.contains("paged")) << s.dump();
+    const int near = s["paged"]["regions_loaded"].get<int>();
+    EXPECT_GE(near, 1);
+    EXPECT_LT(near, 9);
+    EXPECT_EQ(s["paged"]["regions_total"].get<int>(), 9);
+    EXPECT_EQ(s["paged"]["radius_m"].get<double>(), 0.0);
+    // The memory estimate is made from the selected regions' bytes.
+    EXPECT_GT(s["memory"]["estimate_mb"].get<double>(), 0.0) << s["memory"].dump();
+
+    r = runVista("bench " + dir() + kBench + " --paged-radius 5000 --out " + tmp.file("all"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    s = readJson(tmp.file("all/summary.json"));
+    EXPECT_EQ(s["paged"]["regions_loaded"].get<int>(), 9);
+    const auto manifest = readJson((fs::path(dir()) / "manifest.json").string());
+    uint64_t sum = 0;
+    for (const auto& e : manifest["regions"]) sum += e["triangles"].get<uint64_t>();
+    EXPECT_EQ(s["city_triangles"].get<uint64_t>(), sum);
+    EXPECT_EQ(sum, manifest["totals"]["triangles"].get<uint64_t>());
+
+    // vista path on the directory: a CSV whose samples lie on the city's streets.
+    r = runVista("path " + dir() + " --seed 4 -o " + tmp.file("p.csv"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    auto p = vista::loadPathCsv(tmp.file("p.csv"));
+    ASSERT_TRUE(p.isOk()) << p.status().message();
+    EXPECT_FALSE(p->samples.empty());
+    // The same path as on the single-file city of the same params (the whole street graph, regrown).
+    r = runVista("gen --size 1500 --seed 4 --detail 1 -q -o " + tmp.file("one.osgb"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = runVista("path " + tmp.file("one.osgb") + " --seed 4 -o " + tmp.file("one.csv"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(readBytes(tmp.file("p.csv")) == readBytes(tmp.file("one.csv")));
+    // ... and bench follows that CSV (the same path as its --seed 4: the same regions).
+    r = runVista("bench " + dir() + " --path " + tmp.file("p.csv") + " --frames 2 --size 160x120 --modes full -q --paged-radius 0 --out " +
+                 tmp.file("csv"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(readJson(tmp.file("csv/summary.json"))["paged"]["regions_loaded"].get<int>(), near);
+}
+
+TEST_F(PagedLoad, BadInputExitsTwoNamingIt) {
+    // A missing region file.
+    const std::string copy = tmp.file("copy.paged");
+    fs::copy(dir(), copy, fs::copy_options::recursive);
+    fs::remove(fs::path(copy) / "region_1_1.osgb");
+    CliRun r = runVista("bench " + copy + kBench + " --paged-radius 5000 --out " + tmp.file("o1"));
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("region_1_1.osgb"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(tmp.file("o1/summary.json")));
+    // A truncated region file.
+    fs::copy_file(fs::path(dir()) / "region_1_1.osgb", fs::path(copy) / "region_1_1.osgb");
+    fs::resize_file(fs::path(copy) / "region_1_1.osgb", 1000);
+    r = runVista("bench " + copy + kBench + " --paged-radius 5000 --out " + tmp.file("o2"));
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("region_1_1.osgb"), std::string::npos) << r.err;
+    // A corrupt manifest, a missing one.
+    {
+        std::ofstream(fs::path(copy) / "manifest.json") << "{\"format\": \"vista.paged_city\", \"ver";
+    }
+    for (const std::string& cmd : {"bench " + copy + kBench + " --out " + tmp.file("o3"), "path " + copy + " -o " + tmp.file("p.csv")}) {
+        r = runVista(cmd);
+        EXPECT_EQ(r.code, 2) << cmd << ": " << r.err;
+        EXPECT_NE(r.err.find("manifest.json"), std::string::npos) << r.err;
+    }
+    fs::remove(fs::path(copy) / "manifest.json");
+    r = runVista("view " + copy + " --frames 1");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("manifest.json"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(tmp.file("p.csv")));
+    // A memory budget below the estimate of the selected regions: refused before loading them.
+    r = runVista("bench " + dir() + kBench + " --paged-radius 5000 --memory-budget 0.01 --out " + tmp.file("o5"));
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("--memory-budget"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("paged city: loaded"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(tmp.file("o5/summary.json")));
+    // Radius out of range.
+    EXPECT_FALSE(vista::validatePagedRadius("--paged-radius", std::nan("")).isOk());
+    EXPECT_TRUE(vista::validatePagedRadius("--paged-radius", 0.0).isOk());
+    EXPECT_TRUE(vista::validatePagedRadius("--paged-radius", 100000.0).isOk());
+    for (const char* v : {"-1", "1e9", "100000.5"}) {
+        for (const std::string& cmd : {"bench " + dir() + kBench + " --out " + tmp.file("o4"), "view " + dir() + " --frames 1"}) {
+            r = runVista(cmd + " --paged-radius " + v);
+            EXPECT_EQ(r.code, 2) << cmd << " " << v << ": " << r.err;
+            EXPECT_NE(r.err.find("--paged-radius"), std::string::npos) << r.err;
+            EXPECT_NE(r.err.find("0 .. 100000"), std::string::npos) << r.err;
+        }
+    }
+}
