@@ -110,13 +110,18 @@ private:
     std::string _error;
 };
 
+// The fields every result starts with: which street end of which cell, its frame, the tiles it hides.
+template <class Ar, class R> void visitEnd(Ar& ar, R& r) {
+    ar.pod(r.cell);
+    ar.pod(r.end);
+    ar.pod(r.frame.origin);
+    ar.pod(r.frame.x);
+    ar.vec(r.hiddenTiles);
+}
+
 // The one field list of the format.
 template <class Ar> void visit(Ar& ar, ImpostorResult& im) {
-    ar.pod(im.cell);
-    ar.pod(im.end);
-    ar.pod(im.frame.origin);
-    ar.pod(im.frame.x);
-    ar.vec(im.hiddenTiles);
+    visitEnd(ar, im);
     ar.pod(im.data.planeOrigin);
     ar.pod(im.data.planeU);
     ar.pod(im.data.planeV);
@@ -130,11 +135,7 @@ template <class Ar> void visit(Ar& ar, ImpostorResult& im) {
 }
 
 template <class Ar> void visit(Ar& ar, MeshResult& m) {
-    ar.pod(m.cell);
-    ar.pod(m.end);
-    ar.pod(m.frame.origin);
-    ar.pod(m.frame.x);
-    ar.vec(m.hiddenTiles);
+    visitEnd(ar, m);
     ar.pod(m.mesh.eye);
     ar.pod(m.mesh.width);
     ar.pod(m.mesh.height);

@@ -1,4 +1,5 @@
 #include "nodes/point_impostor.h"
+#include "nodes/texture_state.h"
 
 #include <algorithm>
 #include <cmath>
@@ -194,13 +195,7 @@ void PointImpostor::setData(const PointImpostorData& d) {
     prog->addShader(new osg::Shader(osg::Shader::VERTEX, kVertexShader));
     prog->addShader(new osg::Shader(osg::Shader::FRAGMENT, kFragmentShader));
     ss->setAttributeAndModes(prog.get(), osg::StateAttribute::ON);
-    osg::ref_ptr<osg::Texture2D> tex = new osg::Texture2D(atlas.get());
-    tex->setFilter(osg::Texture::MIN_FILTER, osg::Texture::LINEAR);
-    tex->setFilter(osg::Texture::MAG_FILTER, osg::Texture::LINEAR);
-    tex->setWrap(osg::Texture::WRAP_S, osg::Texture::CLAMP_TO_EDGE);
-    tex->setWrap(osg::Texture::WRAP_T, osg::Texture::CLAMP_TO_EDGE);
-    tex->setResizeNonPowerOfTwoHint(false);
-    tex->setUnRefImageDataAfterApply(false);
+    osg::ref_ptr<osg::Texture2D> tex = clampedLinearTexture(atlas.get());
     ss->setTextureAttributeAndModes(0, tex.get(), osg::StateAttribute::ON);
     ss->addUniform(new osg::Uniform("vista_atlas", 0));
     ss->addUniform(new osg::Uniform("vista_planeOrigin", _planeOrigin));

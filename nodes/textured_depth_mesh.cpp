@@ -1,4 +1,5 @@
 #include "nodes/textured_depth_mesh.h"
+#include "nodes/texture_state.h"
 
 #include <algorithm>
 #include <cmath>
@@ -98,13 +99,7 @@ void TexturedDepthMesh::setData(const TexturedDepthMeshData& d) {
         }
     img->setWriteHint(osg::Image::STORE_INLINE);
     osg::ref_ptr<osg::StateSet> ss = new osg::StateSet;
-    osg::ref_ptr<osg::Texture2D> tex = new osg::Texture2D(img.get());
-    tex->setFilter(osg::Texture::MIN_FILTER, osg::Texture::LINEAR);
-    tex->setFilter(osg::Texture::MAG_FILTER, osg::Texture::LINEAR);
-    tex->setWrap(osg::Texture::WRAP_S, osg::Texture::CLAMP_TO_EDGE);
-    tex->setWrap(osg::Texture::WRAP_T, osg::Texture::CLAMP_TO_EDGE);
-    tex->setResizeNonPowerOfTwoHint(false);
-    tex->setUnRefImageDataAfterApply(false);
+    osg::ref_ptr<osg::Texture2D> tex = clampedLinearTexture(img.get());
     ss->setTextureAttributeAndModes(0, tex.get(), osg::StateAttribute::ON);
     ss->setTextureAttribute(0, new osg::TexEnv(osg::TexEnv::REPLACE));
     ss->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
