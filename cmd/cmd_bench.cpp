@@ -38,7 +38,7 @@ struct BenchArgs {
     ModeFlags mode;
     BenchConfig cfg;
     PathOptions pathOptions;
-    double pagedRadius = kDefaultPagedRadiusM;
+    PagedReach paged;
 };
 
 void declareFlags(CLI::App& app, BenchArgs& a) {
@@ -46,7 +46,7 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
     for (const auto& m : renderModes()) modeHelp += std::string("\n    ") + m.name + ": " + m.summary;
     app.add_option("city", a.city, "city scene file (.osgb), or a paged city directory (DIR.paged); not needed with --sweep");
     addPathFlags(app, a.path, true);
-    addPagedRadiusFlag(app, a.pagedRadius);
+    addPagedFlags(app, a.paged);
     app.add_option("--frames", a.cfg.frames, "frames rendered, sampled from the path as --sampling says (default 120)");
     app.add_option("--sampling", a.sampling,
                    "which path samples are the frames: 'spread' (evenly over the whole path), 'consecutive' (the first "
@@ -114,7 +114,7 @@ Status configure(BenchArgs& a) {
     auto po = parsePathFlags(a.path);
     if (!po) return po.status();
     a.pathOptions = po.value();
-    VISTA_RETURN_IF_ERROR(validatePagedRadius("--paged-radius", a.pagedRadius));
+    VISTA_RETURN_IF_ERROR(validatePagedReach(a.paged));
     if (a.sweep.empty()) {
         if (a.city.empty()) return Status::error("missing the city file argument (or use --sweep)");
         if (!fs::exists(a.city)) return Status::error("city file '" + a.city + "' does not exist");
@@ -177,7 +177,7 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
             cfg.memoryEstimateMb = estimateCityRunMb(bytes, rays);
             return checkMemoryBudget("--memory-budget", cfg.memoryBudgetGb, cfg.memoryEstimateMb, bytes, rays);
         };
-        city = loadPagedNear(*paged, *path, a.pagedRadius, kCmd, a.quiet, &cfg.pagedJson, budget);
+        city = loadPagedNear(*paged, *path, a.paged, kCmd, a.quiet, &cfg.pagedJson, budget);
         if (!city) return reportBadInput(kCmd, city.status());
     } else {
         city = loadCityFile(cityFile);

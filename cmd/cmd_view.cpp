@@ -59,7 +59,7 @@ struct ViewArgs {
     ModeFlags modeFlags;
     ImageSize window;
     double fovDeg = 60.0;
-    double pagedRadius = kDefaultPagedRadiusM;
+    PagedReach paged;
 };
 
 void declareFlags(CLI::App& app, ViewArgs& a) {
@@ -67,7 +67,7 @@ void declareFlags(CLI::App& app, ViewArgs& a) {
     app.add_option("city", a.city, "city scene file (.osgb), a paged city directory (DIR.paged: the regions within --paged-radius of the path), "
                    "or a baked file from 'vista bake' (adds the impostor mode; lodmesh for --representation mesh)")->required();
     addPathFlags(app, a.path, true);
-    addPagedRadiusFlag(app, a.pagedRadius);
+    addPagedFlags(app, a.paged);
     app.get_option("--seed")->description("play back the path of this seed (key 5); default 0 = none, start where seed 1's path starts");
     app.add_option("--size", a.size, "window size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 1280x720)");
     app.add_option("--fov", a.fov, "vertical field of view in degrees, (1, 179) (default 60)");
@@ -104,7 +104,7 @@ Status configure(ViewArgs& a, ModeOptions& options) {
     if (a.step && (a.frames < 1 || (a.path.file.empty() && a.path.seed == 0)))
         return Status::error("--step needs --frames N >= 1 and a path (--path or --seed)");
     if (!a.screenshot.empty()) VISTA_RETURN_IF_ERROR(checkWritablePath("--screenshot", a.screenshot));
-    VISTA_RETURN_IF_ERROR(validatePagedRadius("--paged-radius", a.pagedRadius));
+    VISTA_RETURN_IF_ERROR(validatePagedReach(a.paged));
     return parseModeFlags(a.modeFlags, options);
 }
 
@@ -447,7 +447,7 @@ int runView(int argc, char** argv) {
         if (!paged) return reportBadInput(kCmd, paged.status());
         path = viewPath(a, paged->stub, playback);
         if (!path) return reportBadInput(kCmd, path.status());
-        city = loadPagedNear(*paged, *path, a.pagedRadius, kCmd, false, nullptr, [&](uint64_t bytes) {
+        city = loadPagedNear(*paged, *path, a.paged, kCmd, false, nullptr, [&](uint64_t bytes) {
             return checkMemoryBudget("--memory-budget", *budget, estimateCityRunMb(bytes, true), bytes, true);
         });
         if (!city) return reportBadInput(kCmd, city.status());

@@ -9,6 +9,8 @@
 #include <sstream>
 #include <unistd.h>
 
+#include <nlohmann/json.hpp>
+
 #include "foundation/timing.h"
 #include "nodes/baked_file.h"
 #include "runtime/scene/scene_model.h"
@@ -407,12 +409,23 @@ Result<FrameEffects> runTimeEffects(const std::string& option, const Effects& de
 }
 
 
-void addPagedRadiusFlag(CLI::App& app, double& radius) {
+void addPagedFlags(CLI::App& app, PagedReach& reach) {
     std::ostringstream help;
     help << "with a paged city (a DIR.paged directory from `vista gen`): load only the regions within this many metres "
-            "of the walkthrough, "
+            "of the walkthrough at full detail, "
          << kMinPagedRadiusM << " .. " << kMaxPagedRadiusM << " (default " << kDefaultPagedRadiusM << ")";
-    app.add_option("--paged-radius", radius, help.str());
+    app.add_option("--paged-radius", reach.radius, help.str());
+    std::ostringstream far;
+    far << "with a paged city: load the other regions within this many metres of the walkthrough at their coarse level "
+           "(detail 0, no trees) for the far field, "
+        << kMinPagedRadiusM << " .. " << kMaxPagedRadiusM << " (default " << kDefaultPagedFarM
+        << " = the whole city; 0 = none: the city ends at --paged-radius)";
+    app.add_option("--paged-far", reach.far, far.str());
+}
+
+Status validatePagedReach(const PagedReach& reach) {
+    VISTA_RETURN_IF_ERROR(validatePagedRadius("--paged-radius", reach.radius));
+    return validatePagedRadius("--paged-far", reach.far);
 }
 
 Result<PagedOpen> openPagedCity(const std::string& dir, bool needStreets) {
@@ -429,29 +442,37 @@ Result<PagedOpen> openPagedCity(const std::string& dir, bool needStreets) {
     return out;
 }
 
-Result<SceneModel> loadPagedNear(const PagedOpen& city, const Path& path, double radius, const char* cmd, bool quiet,
+Result<SceneModel> loadPagedNear(const PagedOpen& city, const Path& path, const PagedReach& reach, const char* cmd, bool quiet,
                                  std::string* pagedJson, const std::function<Status(uint64_t bytes)>& beforeLoad) {
     std::vector<glm::dvec2> points;
     for (const PathSample& s : path.samples) points.emplace_back(s.position.x, s.position.y);
     if (points.empty()) points.emplace_back(city.manifest.params.origin_x, city.manifest.params.origin_y);
+    const double radius = reach.radius;
     const std::vector<int> regions = selectPagedRegions(city.manifest, points, radius);
+    const std::vector<int> coarse = reach.far > radius ? selectCoarseRegions(city.manifest, points, reach.far, regions) : std::vector<int>{};
     if (beforeLoad) {
         uint64_t bytes = 0;
         for (int r : regions) bytes += city.manifest.regions[size_t(r)].bytes;
+        for (int r : coarse) bytes += city.manifest.regions[size_t(r)].coarseBytes;
         VISTA_RETURN_IF_ERROR(beforeLoad(bytes));
     }
     PagedLoadReport rep;
-    auto model = loadPagedCity(city.manifest, regions, radius, &rep);
+    auto model = loadPagedCity(city.manifest, regions, radius, &rep, coarse);
     if (!model) return model.status();
     if (!quiet)
-        std::fprintf(stderr, "%s: paged city: loaded %d of %d regions within %g m of the walkthrough (%.1f MB of region files, %zu triangles)\n",
-                     cmd, rep.regionsLoaded, rep.regionsTotal, radius, double(rep.bytesLoaded) / 1e6, model->triangles);
+        std::fprintf(stderr,
+                     "%s: paged city: loaded %d of %d regions within %g m of the walkthrough and %d more at their coarse level "
+                     "(%.1f MB of region files, %zu triangles)\n",
+                     cmd, rep.regionsLoaded, rep.regionsTotal, radius, rep.coarseLoaded, double(rep.bytesLoaded) / 1e6,
+                     model->triangles);
+    for (const std::string& d : rep.damaged)
+        std::fprintf(stderr, "%s: warning: %s; the rest of the city is loaded\n", cmd, d.c_str());
     if (pagedJson) {
-        std::ostringstream j;
-        j.precision(17);
-        j << "{\"regions_loaded\": " << rep.regionsLoaded << ", \"regions_total\": " << rep.regionsTotal
-          << ", \"radius_m\": " << radius << ", \"bytes_loaded\": " << rep.bytesLoaded << "}";
-        *pagedJson = j.str();
+        nlohmann::json j = {{"regions_loaded", rep.regionsLoaded}, {"regions_total", rep.regionsTotal},
+                            {"radius_m", radius}, {"bytes_loaded", rep.bytesLoaded},
+                            {"coarse_regions_loaded", rep.coarseLoaded}, {"far_m", reach.far},
+                            {"coarse_bytes_loaded", rep.coarseBytes}, {"damaged", rep.damaged}};
+        *pagedJson = j.dump();
     }
     return model;
 }

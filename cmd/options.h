@@ -120,9 +120,18 @@ Result<PathOptions> parsePathFlags(const PathFlags& flags);
 // city's streets with `options`.
 Result<Path> walkthroughPath(const PathFlags& flags, const PathOptions& options, const SceneModel& city);
 
-// --paged-radius M (bench, view): metres around the walkthrough within which
-// a paged city's regions are loaded (paged_load.h; default kDefaultPagedRadiusM).
-void addPagedRadiusFlag(CLI::App& app, double& radius);
+// How much of a paged city a walkthrough loads (bench, view): --paged-radius M
+// = metres around the walkthrough within which regions are loaded at full
+// detail (default kDefaultPagedRadiusM); --paged-far M = metres within which
+// the other regions are loaded at their coarse level, for the far field
+// (default kDefaultPagedFarM = the whole city; 0 or <= radius: none).
+struct PagedReach {
+    double radius = kDefaultPagedRadiusM;
+    double far = kDefaultPagedFarM;
+};
+void addPagedFlags(CLI::App& app, PagedReach& reach);
+// Both values within [kMinPagedRadiusM, kMaxPagedRadiusM]; errors name the option.
+Status validatePagedReach(const PagedReach& reach);
 
 // A paged city opened for a walkthrough: `stub` has the params and, unless
 // the walkthrough comes from a CSV (`needStreets` false), the streets a
@@ -133,13 +142,15 @@ struct PagedOpen {
     SceneModel stub;
 };
 Result<PagedOpen> openPagedCity(const std::string& dir, bool needStreets);
-// Loads the regions within `radius` metres of the path's samples (its first
-// sample only when `firstOnly`) and merges them; prints a note naming the
-// count on stderr unless quiet; `pagedJson` (if not null) receives the
-// summary.json block {regions_loaded, regions_total, radius_m, bytes_loaded}.
-// `beforeLoad` (if set) is called with the selected regions' file bytes before
-// any is read (the --memory-budget check); its error stops the load.
-Result<SceneModel> loadPagedNear(const PagedOpen& city, const Path& path, double radius, const char* cmd, bool quiet,
+// Loads the regions within `reach.radius` metres of the path's samples at
+// full detail and the others within `reach.far` at their coarse level, and
+// merges them; prints a note naming the counts on stderr unless quiet;
+// `pagedJson` (if not null) receives the summary.json block {regions_loaded,
+// regions_total, radius_m, bytes_loaded, coarse_regions_loaded, far_m,
+// coarse_bytes_loaded}. `beforeLoad` (if set) is called with the selected
+// files' bytes before any is read (the --memory-budget check); its error
+// stops the load.
+Result<SceneModel> loadPagedNear(const PagedOpen& city, const Path& path, const PagedReach& reach, const char* cmd, bool quiet,
                                  std::string* pagedJson = nullptr,
                                  const std::function<Status(uint64_t bytes)>& beforeLoad = nullptr);
 

@@ -88,14 +88,20 @@ Result<PagedManifest> readPagedManifest(const std::string& dir) {
                 }
                 r.lo = glm::dvec3(v[0], v[1], v[2]);
                 r.hi = glm::dvec3(v[3], v[4], v[5]);
-                for (const Json& f : e.at("files"))
+                for (const Json& f : e.at("files")) {
                     if (f.at("role") == "full") {
                         r.file = f.at("name").get<std::string>();
                         r.bytes = f.at("bytes").get<uint64_t>();
+                    } else if (f.at("role") == "coarse") {
+                        r.coarseFile = f.at("name").get<std::string>();
+                        r.coarseBytes = f.at("bytes").get<uint64_t>();
                     }
+                }
                 if (r.file.empty()) return bad(where + ": no file with role 'full'");
-                if (r.file.find('/') != std::string::npos || r.file.find('\\') != std::string::npos || r.file == "..")
-                    return bad(where + ": file name '" + r.file + "' is not a plain name inside the directory");
+                if (r.coarseFile.empty()) return bad(where + ": no file with role 'coarse'");
+                for (const std::string& name : {r.file, r.coarseFile})
+                    if (name.find('/') != std::string::npos || name.find('\\') != std::string::npos || name == "..")
+                        return bad(where + ": file name '" + name + "' is not a plain name inside the directory");
             }
             m.regions.push_back(std::move(r));
         }
@@ -123,18 +129,32 @@ std::vector<int> selectPagedRegions(const PagedManifest& m, const std::vector<gl
     return out;
 }
 
+std::vector<int> selectCoarseRegions(const PagedManifest& m, const std::vector<glm::dvec2>& points, double farM,
+                                     const std::vector<int>& full) {
+    std::vector<int> out;
+    if (!(farM > 0)) return out;
+    std::vector<char> isFull(m.regions.size(), 0);
+    for (int i : full)
+        if (i >= 0 && size_t(i) < isFull.size()) isFull[size_t(i)] = 1;
+    for (int i : selectPagedRegions(m, points, farM))
+        if (!isFull[size_t(i)]) out.push_back(i);
+    return out;
+}
+
 namespace {
 
-// Loads region `i`'s full file, checking its size against the manifest first.
-Result<SceneModel> loadRegion(const PagedManifest& m, int i) {
+// Loads region `i`'s full or coarse file, checking its size against the manifest first.
+Result<SceneModel> loadRegion(const PagedManifest& m, int i, bool coarse) {
     const PagedRegionEntry& r = m.regions[size_t(i)];
-    const std::string path = (fs::path(m.dir) / r.file).string();
+    const std::string& name = coarse ? r.coarseFile : r.file;
+    const uint64_t bytes = coarse ? r.coarseBytes : r.bytes;
+    const std::string path = (fs::path(m.dir) / name).string();
     std::error_code ec;
     const uint64_t size = fs::file_size(path, ec);
     if (ec) return Status::error("paged city '" + m.dir + "': region file '" + path + "' is missing or unreadable (" + ec.message() + ")");
-    if (size != r.bytes)
+    if (size != bytes)
         return Status::error("paged city '" + m.dir + "': region file '" + path + "' has " + std::to_string(size) +
-                             " bytes, the manifest says " + std::to_string(r.bytes) + " (damaged or from another run)");
+                             " bytes, the manifest says " + std::to_string(bytes) + " (damaged or from another run)");
     return loadCityFile(path);
 }
 
@@ -164,7 +184,7 @@ struct StreetUnion {
 }  // namespace
 
 Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>& regions, double radiusM,
-                                 PagedLoadReport* report) {
+                                 PagedLoadReport* report, const std::vector<int>& coarse) {
     if (regions.empty())
         return Status::error("paged city '" + m.dir + "': no region within --paged-radius " + std::to_string(radiusM) +
                              " m of the walkthrough (" + std::to_string(m.nonEmpty()) + " non-empty regions)");
@@ -176,10 +196,29 @@ Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>&
     root->setName("vista.city");
     StreetUnion streets;
     bool first = true;
-    for (int i : regions) {
+    std::vector<std::pair<int, bool>> order;  // (region, coarse): full regions first
+    for (int i : regions) order.emplace_back(i, false);
+    const size_t fullCount = order.size();
+    for (size_t k = 0;; ++k) {
+        if (k == fullCount) {
+            // Every full region has been tried (fallbacks of damaged ones queued
+            // after them): the far city follows, once at least one loaded.
+            if (first) break;
+            for (int i : coarse) order.emplace_back(i, true);
+        }
+        if (k >= order.size()) break;
+        const auto [i, isCoarse] = order[k];
         if (i < 0 || size_t(i) >= m.regions.size() || m.regions[size_t(i)].empty) continue;
-        auto rm = loadRegion(m, i);
-        if (!rm) return rm.status();
+        const std::string& name = isCoarse ? m.regions[size_t(i)].coarseFile : m.regions[size_t(i)].file;
+        auto rm = loadRegion(m, i, isCoarse);
+        if (!rm) {
+            // A damaged or missing region file: reported by name, the rest of the city loads;
+            // a full region falls back to its coarse level.
+            rep.damaged.push_back(rm.status().message());
+            if (!isCoarse) order.emplace_back(i, true);
+            continue;
+        }
+        if (isCoarse && first) continue;  // a fallback without any full region loaded (reported below)
         SceneModel& r = *rm;
         osg::Group* rroot = sceneRoot(r) ? sceneRoot(r)->asGroup() : nullptr;
         if (!rroot) return Status::error("region file '" + m.regions[size_t(i)].file + "' has no scene graph");
@@ -198,13 +237,18 @@ Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>&
             std::string params;
             if (rroot->getUserValue("vista.params", params)) root->setUserValue("vista.params", params);
             first = false;
-        } else {
-            if (r.prototypes.size() != out.prototypes.size())
-                return Status::error("region file '" + m.regions[size_t(i)].file + "': " + std::to_string(r.prototypes.size()) +
-                                     " tree prototypes, the first region has " + std::to_string(out.prototypes.size()) +
-                                     " (regions of different cities)");
+        } else if (r.prototypes.size() == out.prototypes.size()) {
             for (size_t p = 0; p < out.prototypes.size(); ++p)
                 if (out.prototypes[p].indices.empty() && !r.prototypes[p].indices.empty()) out.prototypes[p] = std::move(r.prototypes[p]);
+        } else if (!isCoarse) {
+            return Status::error("region file '" + name + "': " + std::to_string(r.prototypes.size()) +
+                                 " tree prototypes, the first region has " + std::to_string(out.prototypes.size()) +
+                                 " (regions of different cities)");
+        } else {
+            // A coarse level with its own (or no) tree shapes: appended, its instances renumbered.
+            const uint32_t base = uint32_t(out.prototypes.size());
+            for (SceneMesh& p : r.prototypes) out.prototypes.push_back(std::move(p));
+            for (SceneInstance& in : r.instances) in.prototype += base;
         }
         const uint32_t meshBase = uint32_t(out.meshes.size()), instBase = uint32_t(out.instances.size());
         for (SceneMesh& mesh : r.meshes) {
@@ -226,9 +270,20 @@ Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>&
         }
         out.triangles += r.triangles;
         streets.add(r.streets);
-        ++rep.regionsLoaded;
-        rep.bytesLoaded += m.regions[size_t(i)].bytes;
-        rep.files.push_back(m.regions[size_t(i)].file);
+        const uint64_t bytes = isCoarse ? m.regions[size_t(i)].coarseBytes : m.regions[size_t(i)].bytes;
+        if (isCoarse) {
+            ++rep.coarseLoaded;
+            rep.coarseBytes += bytes;
+        } else {
+            ++rep.regionsLoaded;
+        }
+        rep.bytesLoaded += bytes;
+        rep.files.push_back(name);
+    }
+    if (first) {
+        std::string why = "paged city '" + m.dir + "': no region near the walkthrough could be read";
+        for (const std::string& d : rep.damaged) why += "; " + d;
+        return Status::error(why);
     }
     for (SceneMesh& p : out.prototypes) p.ids.clear();
     out.streets = std::move(streets.g);

@@ -12,17 +12,27 @@
 // (manifest `bounds`) come within `radiusM` metres (2D distance to the
 // rectangle) of at least one of `points` (world metres), in region order.
 //
-// loadPagedCity(): loads each selected region's full file (loadCityFile:
-// missing, truncated or corrupt files are errors naming the file; a file
-// whose size differs from the manifest is an error naming it too) and merges
-// them: tiles, meshes and tree instances of every region in region order (the
-// merged graph is a new "vista.city" root over the regions' tile transforms,
-// SceneTile::child indexes it), the root state and user values of the first
-// region; streets = the union of the regions' street graphs (nodes merged by
-// exact position, edges by their end nodes, in first-seen order), which is a
-// subgraph of the city's graph. Ground-truth ids are numbered per region, so
-// the merged model is unlabelled (labelled = false, ids empty). No region
-// selected (points far from the city, or none): an error naming the radius.
+// selectCoarseRegions(): the non-empty regions within `farM` of the points
+// that are not in `full` (the regions loaded at full detail), in region
+// order: the far city, loaded at its coarse level (paged_city.h: detail 0, no
+// trees) so that the ray-cast far field still sees it. farM <= radius of
+// `full`, or 0: none.
+//
+// loadPagedCity(): loads each selected region's full file (loadCityFile;
+// its size must match the manifest's), then each `coarse` region's coarse
+// file (the same checks), and merges them: tiles, meshes and tree instances
+// of every region in that order (the merged graph is a new "vista.city" root
+// over the regions' tile transforms, SceneTile::child indexes it), the root
+// state and user values of the first full region; streets = the union of the
+// regions' street graphs (nodes merged by exact position, edges by their end
+// nodes, in first-seen order), a subgraph of the city's graph. Ground-truth
+// ids are numbered per region, so the merged model is unlabelled (labelled =
+// false, ids empty). A missing, truncated or corrupt region file (or one
+// whose size differs from the manifest) does not stop the load: its message
+// (naming the file) goes to report->damaged, a full region then falls back to
+// its coarse level, and the rest of the city loads. Errors: no region
+// selected (points far from the city, or none), or no full region readable
+// (the message names the radius or every damaged file).
 //
 // pagedPathStreets(): the street graph that a path of a paged city made from
 // a seed runs on: the whole city's graph, grown again from the manifest's
@@ -48,6 +58,8 @@ namespace vista {
 constexpr double kDefaultPagedRadiusM = 3000.0;
 constexpr double kMinPagedRadiusM = 0.0;
 constexpr double kMaxPagedRadiusM = 100000.0;
+// Default reach of the coarse far city (--paged-far): every region of the largest city.
+constexpr double kDefaultPagedFarM = kMaxPagedRadiusM;
 
 struct PagedRegionEntry {
     int region = 0, ix = 0, iy = 0;
@@ -55,6 +67,8 @@ struct PagedRegionEntry {
     glm::dvec3 lo{0.0}, hi{0.0};  // world bounds of the geometry (non-empty only)
     std::string file;             // the full file, relative to the directory
     uint64_t bytes = 0;           // its size per the manifest
+    std::string coarseFile;       // the coarse level, relative to the directory
+    uint64_t coarseBytes = 0;     // its size per the manifest
     uint64_t triangles = 0;       // rendered triangles per the manifest
 };
 
@@ -71,8 +85,11 @@ struct PagedLoadReport {
     int regionsLoaded = 0;
     int regionsTotal = 0;  // non-empty regions of the city
     double radiusM = 0;
-    uint64_t bytesLoaded = 0;           // file bytes of the loaded regions
-    std::vector<std::string> files;     // loaded region files (relative names)
+    uint64_t bytesLoaded = 0;           // file bytes of the loaded regions (full and coarse)
+    int coarseLoaded = 0;               // regions loaded at their coarse level
+    uint64_t coarseBytes = 0;           // file bytes of those coarse files
+    std::vector<std::string> files;     // loaded region files (relative names), full then coarse
+    std::vector<std::string> damaged;   // one message per missing or damaged file (it names the file)
 };
 
 // True when `path` is a directory (a paged city is a directory; a city file is not).
@@ -82,8 +99,10 @@ Status validatePagedRadius(const std::string& option, double value);
 
 Result<PagedManifest> readPagedManifest(const std::string& dir);
 std::vector<int> selectPagedRegions(const PagedManifest& m, const std::vector<glm::dvec2>& points, double radiusM);
+std::vector<int> selectCoarseRegions(const PagedManifest& m, const std::vector<glm::dvec2>& points, double farM,
+                                     const std::vector<int>& full);
 Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>& regions, double radiusM,
-                                 PagedLoadReport* report = nullptr);
+                                 PagedLoadReport* report = nullptr, const std::vector<int>& coarse = {});
 Result<StreetGraph> pagedPathStreets(const PagedManifest& m);
 
 }  // namespace vista

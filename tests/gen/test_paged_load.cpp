@@ -171,21 +171,98 @@ TEST_F(PagedLoad, BenchLoadsOnlyTheRegionsNearThePath) {
     EXPECT_EQ(readJson(tmp.file("csv/summary.json"))["paged"]["regions_loaded"].get<int>(), near);
 }
 
-TEST_F(PagedLoad, BadInputExitsTwoNamingIt) {
-    // A missing region file.
+TEST_F(PagedLoad, TheFarCityLoadsAtItsCoarseLevel) {
+    auto m = vista::readPagedManifest(dir());
+    ASSERT_TRUE(m.isOk()) << m.status().message();
+    const auto& r0 = m->regions[0];
+    const glm::dvec2 inside = 0.5 * (glm::dvec2(r0.lo) + glm::dvec2(r0.hi));
+    const std::vector<int> full = vista::selectPagedRegions(*m, {inside}, 0.0);
+    ASSERT_EQ(full, std::vector<int>{0});
+    // Coarse = the regions within the far reach that are not full; none when the reach is 0.
+    const std::vector<int> coarse = vista::selectCoarseRegions(*m, {inside}, 5000.0, full);
+    EXPECT_EQ(coarse, (std::vector<int>{1, 2, 3, 4, 5, 6, 7, 8}));
+    EXPECT_TRUE(vista::selectCoarseRegions(*m, {inside}, 0.0, full).empty());
+    // The merged model: region 0 whole plus every coarse file, counted independently.
+    auto one = vista::loadCityFile((fs::path(dir()) / r0.file).string());
+    ASSERT_TRUE(one.isOk()) << one.status().message();
+    size_t triangles = one->triangles, tiles = one->tiles.size(), coarseTriangles = 0;
+    uint64_t coarseBytes = 0;
+    for (int i : coarse) {
+        const auto& r = m->regions[size_t(i)];
+        ASSERT_FALSE(r.coarseFile.empty());
+        auto c = vista::loadCityFile((fs::path(dir()) / r.coarseFile).string());
+        ASSERT_TRUE(c.isOk()) << c.status().message();
+        EXPECT_EQ(fs::file_size(fs::path(dir()) / r.coarseFile), r.coarseBytes);
+        // The coarse level is lighter than the region: no trees, detail 0.
+        EXPECT_LT(c->triangles, r.triangles) << r.coarseFile;
+        EXPECT_TRUE(c->instances.empty()) << r.coarseFile;
+        coarseTriangles += c->triangles;
+        tiles += c->tiles.size();
+        coarseBytes += r.coarseBytes;
+    }
+    vista::PagedLoadReport rep;
+    auto city = vista::loadPagedCity(*m, full, 0.0, &rep, coarse);
+    ASSERT_TRUE(city.isOk()) << city.status().message();
+    EXPECT_EQ(rep.regionsLoaded, 1);
+    EXPECT_EQ(rep.coarseLoaded, 8);
+    EXPECT_EQ(rep.coarseBytes, coarseBytes);
+    EXPECT_EQ(rep.bytesLoaded, r0.bytes + coarseBytes);
+    EXPECT_TRUE(rep.damaged.empty());
+    EXPECT_EQ(city->triangles, triangles + coarseTriangles);
+    EXPECT_EQ(city->tiles.size(), tiles);
+    // The bench's default reach takes the whole far city; --paged-far 0 none.
+    CliRun r = runVista("bench " + dir() + kBench + " --paged-radius 0 --out " + tmp.file("far"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    auto s = readJson(tmp.file("far/summary.json"));
+    const int near = s["paged"]["regions_loaded"].get<int>();
+    EXPECT_EQ(near + s["paged"]["coarse_regions_loaded"].get<int>(), 9) << s["paged"].dump();
+    r = runVista("bench " + dir() + kBench + " --paged-radius 0 --paged-far 0 --out " + tmp.file("nofar"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    s = readJson(tmp.file("nofar/summary.json"));
+    EXPECT_EQ(s["paged"]["coarse_regions_loaded"].get<int>(), 0);
+    EXPECT_EQ(s["paged"]["regions_loaded"].get<int>(), near);
+}
+
+TEST_F(PagedLoad, DamagedRegionFilesAreNamedAndTheRestRenders) {
     const std::string copy = tmp.file("copy.paged");
     fs::copy(dir(), copy, fs::copy_options::recursive);
+    auto m = vista::readPagedManifest(copy);
+    ASSERT_TRUE(m.isOk()) << m.status().message();
+    // A missing full file falls back to the region's coarse level.
     fs::remove(fs::path(copy) / "region_1_1.osgb");
     CliRun r = runVista("bench " + copy + kBench + " --paged-radius 5000 --out " + tmp.file("o1"));
-    EXPECT_EQ(r.code, 2) << r.err;
+    ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.err.find("region_1_1.osgb"), std::string::npos) << r.err;
-    EXPECT_FALSE(fs::exists(tmp.file("o1/summary.json")));
-    // A truncated region file.
+    auto s = readJson(tmp.file("o1/summary.json"));
+    EXPECT_EQ(s["paged"]["regions_loaded"].get<int>(), 8) << s["paged"].dump();
+    EXPECT_EQ(s["paged"]["coarse_regions_loaded"].get<int>(), 1) << s["paged"].dump();
+    ASSERT_EQ(s["paged"]["damaged"].size(), 1u);
+    EXPECT_NE(s["paged"]["damaged"][0].get<std::string>().find("region_1_1.osgb"), std::string::npos);
+    // A truncated full file and its coarse file corrupt: named both, the region is left out.
     fs::copy_file(fs::path(dir()) / "region_1_1.osgb", fs::path(copy) / "region_1_1.osgb");
     fs::resize_file(fs::path(copy) / "region_1_1.osgb", 1000);
+    fs::resize_file(fs::path(copy) / "region_1_1.coarse.osgb", 500);
     r = runVista("bench " + copy + kBench + " --paged-radius 5000 --out " + tmp.file("o2"));
-    EXPECT_EQ(r.code, 2) << r.err;
+    ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.err.find("region_1_1.osgb"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("region_1_1.coarse.osgb"), std::string::npos) << r.err;
+    s = readJson(tmp.file("o2/summary.json"));
+    EXPECT_EQ(s["paged"]["regions_loaded"].get<int>(), 8);
+    EXPECT_EQ(s["paged"]["coarse_regions_loaded"].get<int>(), 0);
+    EXPECT_EQ(s["paged"]["damaged"].size(), 2u);
+    // Only damaged files near the walkthrough: an error naming them, exit 2, nothing written.
+    const std::vector<int> nearest = vista::selectPagedRegions(*m, {glm::dvec2(m->regions[4].lo + m->regions[4].hi) * 0.5}, 0.0);
+    ASSERT_EQ(nearest, std::vector<int>{4});
+    vista::PagedLoadReport rep;
+    auto city = vista::loadPagedCity(*m, {4}, 0.0, &rep, {});
+    EXPECT_FALSE(city.isOk());
+    EXPECT_NE(city.status().message().find("region_1_1.osgb"), std::string::npos) << city.status().message();
+}
+
+TEST_F(PagedLoad, BadInputExitsTwoNamingIt) {
+    const std::string copy = tmp.file("copy.paged");
+    fs::copy(dir(), copy, fs::copy_options::recursive);
+    CliRun r;
     // A corrupt manifest, a missing one.
     {
         std::ofstream(fs::path(copy) / "manifest.json") << "{\"format\": \"vista.paged_city\", \"ver";
@@ -216,6 +293,9 @@ TEST_F(PagedLoad, BadInputExitsTwoNamingIt) {
             EXPECT_EQ(r.code, 2) << cmd << " " << v << ": " << r.err;
             EXPECT_NE(r.err.find("--paged-radius"), std::string::npos) << r.err;
             EXPECT_NE(r.err.find("0 .. 100000"), std::string::npos) << r.err;
+            r = runVista(cmd + " --paged-far " + v);
+            EXPECT_EQ(r.code, 2) << cmd << " " << v << ": " << r.err;
+            EXPECT_NE(r.err.find("--paged-far"), std::string::npos) << r.err;
         }
     }
 }
