@@ -119,7 +119,7 @@ json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneM
     j["options"] = {{"near_m", o.nearDistance < 0 ? json("auto") : json(o.nearDistance)},
                     {"triangle_budget", o.triangleBudget},
                     {"pixel_budget", o.pixelBudget < 0 ? json("unlimited") : json(o.pixelBudget)},
-                    {"horizon_grid", o.horizonGrid},
+                    {"horizon_grid", o.horizonGrid > 0 ? json(o.horizonGrid) : json("auto")},
                     {"cache", o.cache},
                     {"cache_error_px", o.cacheErrorPx},
                     {"cache_adaptive", o.cacheAdaptive},

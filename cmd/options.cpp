@@ -240,7 +240,9 @@ void addModeFlags(CLI::App& app, ModeFlags& f) {
     app.add_option("--budget", f.budget,
                    "hybrid: most far-field rays per frame (the cache re-traces its worst pixels first), 0 .. 1000000000, "
                    "or 'unlimited' / -1 = no cap: every pixel over --cache-error is re-traced (default " + f.budget + ")");
-    app.add_option("--horizon-grid", f.horizonGrid, "hybrid: horizon height-grid resolution, cells per side, 1 .. 8192 (default 512)");
+    app.add_option("--horizon-grid", f.horizonGrid,
+                   "hybrid: horizon height-grid resolution, cells per side, 1 .. 8192, or 0 = auto: cells of about 4 m, "
+                   "512 .. 2048 a side (default 0)");
     app.add_flag("--no-cache", f.noCache, "hybrid: panoramic image cache off (every far pixel traced)");
     app.add_flag("--cache-always", f.cacheAlways,
                  "hybrid: look up the cache in every frame, also while its measured reuse does not pay for its lookups "
@@ -268,8 +270,8 @@ Status checkModeOptions(const ModeOptions& o) {
     if (o.triangleBudget > kMaxTriangleBudget)
         return Status::error("--triangle-budget " + std::to_string(o.triangleBudget) + " out of range 0 .. " +
                              std::to_string(kMaxTriangleBudget) + " triangles");
-    if (o.horizonGrid < 1 || o.horizonGrid > 8192)
-        return Status::error("--horizon-grid " + std::to_string(o.horizonGrid) + " out of range 1 .. 8192 cells per side");
+    if (o.horizonGrid < 0 || o.horizonGrid > 8192)
+        return Status::error("--horizon-grid " + std::to_string(o.horizonGrid) + " out of range 1 .. 8192 cells per side, or 0 = auto");
     if (!(o.cacheErrorPx >= 0 && o.cacheErrorPx <= 100))
         return Status::error("--cache-error " + std::to_string(o.cacheErrorPx) + " out of range 0 .. 100 pixels");
     if (!(o.frameMsTarget >= 0 && o.frameMsTarget <= 10000))

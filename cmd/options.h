@@ -81,7 +81,7 @@ Result<FrameEffects> runTimeEffects(const std::string& option, const Effects& de
 
 struct ModeFlags {
     std::string near = "auto", triangleBudget = "0", budget = "unlimited";
-    int horizonGrid = 512;
+    int horizonGrid = 0;   // 0 = auto (HeightGrid::autoCells)
     bool noCache = false, noOverlap = false, cacheAlways = false;
     double cacheError = 0.25, frameMs = 0.0;
     int farStep = 1;

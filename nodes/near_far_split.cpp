@@ -76,6 +76,7 @@ void NearFarSplit::refresh() {
         }
         o.triangles = countTriangles(_children[i].get());
     }
+    _index = std::make_unique<SplitIndex>(_objects);
     _dirty = false;
 }
 
@@ -94,7 +95,7 @@ void NearFarSplit::traverse(osg::NodeVisitor& nv) {
     osg::Vec3 e = cv->getEyePoint();
     glm::dvec3 eye(e.x(), e.y(), e.z());
     std::vector<uint32_t> sel =
-        _triangleBudget > 0 ? selectNearFieldByBudget(objs, eye, _triangleBudget) : selectNearField(objs, eye, _nearDistance);
+        _triangleBudget > 0 ? selectNearFieldByBudget(objs, eye, _triangleBudget) : selectNearField(*_index, eye, _nearDistance);
     uint64_t tris = 0;
     for (uint32_t i : sel) {
         _children[i]->accept(nv);

@@ -16,6 +16,7 @@
 // cull at a time); lastNearCount()/lastNearTriangles() report the last cull.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <osg/Group>
@@ -55,6 +56,7 @@ private:
     double _nearDistance = 100.0;
     uint64_t _triangleBudget = 0;
     std::vector<SplitObject> _objects;
+    std::unique_ptr<SplitIndex> _index;  // over _objects, rebuilt with them
     bool _dirty = true;
     unsigned _lastCount = 0;
     uint64_t _lastTriangles = 0;

@@ -44,7 +44,7 @@ public:
         // Cull: the near/far split.
         const double nearD = chooseNear(camera);
         std::vector<uint32_t> sel = byBudget() ? selectNearFieldByBudget(_near.objects, camera.eye, _ctx.options.triangleBudget)
-                                               : selectNearField(_near.objects, camera.eye, nearD);
+                                               : selectNearField(_adaptive->index(), camera.eye, nearD);
         _root->removeChildren(0, _root->getNumChildren());
         uint64_t tris = 0;
         for (uint32_t i : sel) {
@@ -175,9 +175,9 @@ Result<std::unique_ptr<RenderMode>> makeHybridMode(ModeContext& ctx) {
     if (!ctx.rays) return Status::error("mode hybrid needs the city's ray scene, which is not available");
     if (!ctx.city) return Status::error("mode hybrid needs the loaded city (height grid), which is not available");
     if (!ctx.scene) return Status::error("mode hybrid needs a scene graph, none was loaded");
-    if (ctx.options.horizonGrid < 1 || ctx.options.horizonGrid > 8192)
+    if (ctx.options.horizonGrid < 0 || ctx.options.horizonGrid > 8192)
         return Status::error("option horizon grid = " + std::to_string(ctx.options.horizonGrid) +
-                             " is out of range [1, 8192] (cells per side)");
+                             " is out of range [1, 8192] (cells per side), or 0 = auto");
     return std::unique_ptr<RenderMode>(new HybridMode(ctx));
 }
 

@@ -54,7 +54,7 @@ struct ModeOptions {
     double nearDistance = kDefaultNearDistance;  // metres, 1 .. 100000; < 0 = auto (hybrid: adaptive split)
     uint64_t triangleBudget = 0;  // hybrid: > 0 = near field = nearest chunks up to this many triangles
     int64_t pixelBudget = -1;     // hybrid: far-field rays per frame through the cache; < 0 = unlimited
-    int horizonGrid = 512;        // hybrid: horizon height-grid cells per side, 1 .. 8192
+    int horizonGrid = 0;          // hybrid: horizon height-grid cells per side, 1 .. 8192, 0 = auto (HeightGrid::autoCells)
     bool cache = true;            // hybrid: panoramic image cache on/off
     bool cacheAdaptive = true;    // hybrid: pause the cache while it does not pay (FarFieldOptions::cacheAdaptive)
     double cacheErrorPx = 0.25;   // hybrid: reuse a cached far pixel while its reprojection error is below this, 0 .. 100

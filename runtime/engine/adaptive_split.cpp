@@ -62,6 +62,87 @@ std::vector<uint32_t> selectNearField(const std::vector<SplitObject>& objects, c
     return out;
 }
 
+SplitIndex::SplitIndex(const std::vector<SplitObject>& objects, double cell) : _objects(objects), _cell(cell > 0 ? cell : 64.0) {
+    double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
+    for (const SplitObject& o : objects) {
+        _total += o.triangles;
+        x0 = std::min(x0, o.lo.x);
+        y0 = std::min(y0, o.lo.y);
+        x1 = std::max(x1, o.lo.x);
+        y1 = std::max(y1, o.lo.y);
+    }
+    if (objects.empty() || !std::isfinite(x0) || !std::isfinite(y0) || !std::isfinite(x1) || !std::isfinite(y1)) {
+        for (uint32_t i = 0; i < objects.size(); ++i) _wide.push_back(i);
+        return;
+    }
+    _x0 = x0;
+    _y0 = y0;
+    // At most 4096 cells a side (a 262 km city at 64 m); beyond, cells grow.
+    _cell = std::max(_cell, std::max(x1 - x0, y1 - y0) / 4095.0);
+    _nx = int((x1 - x0) / _cell) + 1;
+    _ny = int((y1 - y0) / _cell) + 1;
+    std::vector<int64_t> cellOf(objects.size(), -1);
+    _start.assign(size_t(_nx) * size_t(_ny) + 1, 0);
+    for (uint32_t i = 0; i < objects.size(); ++i) {
+        const SplitObject& o = objects[i];
+        if (!(o.hi.x - o.lo.x <= _cell) || !(o.hi.y - o.lo.y <= _cell)) {
+            _wide.push_back(i);
+            continue;
+        }
+        const int cx = std::clamp(int((o.lo.x - _x0) / _cell), 0, _nx - 1), cy = std::clamp(int((o.lo.y - _y0) / _cell), 0, _ny - 1);
+        cellOf[i] = int64_t(cy) * _nx + cx;
+        ++_start[size_t(cellOf[i]) + 1];
+    }
+    for (size_t c = 1; c < _start.size(); ++c) _start[c] += _start[c - 1];
+    _items.resize(_start.back());
+    std::vector<uint32_t> fill(_start.begin(), _start.end() - 1);
+    for (uint32_t i = 0; i < objects.size(); ++i)
+        if (cellOf[i] >= 0) _items[fill[size_t(cellOf[i])]++] = i;  // ascending within a cell
+}
+
+template <class F>
+void SplitIndex::visit(const glm::dvec3& p, double d, F&& f) const {
+    for (uint32_t i : _wide) f(i);
+    if (_nx == 0) return;
+    if (!(d < 1e15)) {  // +inf or huge: every cell
+        for (uint32_t i : _items) f(i);
+        return;
+    }
+    // A small object (extent <= cell) within d of p has its low corner in [p - d - cell, p + d].
+    auto cellOf = [&](double v, int n) { return int(std::clamp(std::floor(v / _cell), -1.0, double(n))); };
+    const int cx0 = std::max(0, cellOf(p.x - d - _cell - _x0, _nx)), cy0 = std::max(0, cellOf(p.y - d - _cell - _y0, _ny));
+    const int cx1 = std::min(_nx - 1, cellOf(p.x + d - _x0, _nx)), cy1 = std::min(_ny - 1, cellOf(p.y + d - _y0, _ny));
+    if (!std::isfinite(p.x) || !std::isfinite(p.y)) {  // a NaN eye: every object (boxDistance decides)
+        for (uint32_t i : _items) f(i);
+        return;
+    }
+    for (int cy = cy0; cy <= cy1; ++cy) {
+        const size_t row = size_t(cy) * size_t(_nx);
+        for (uint32_t k = _start[row + size_t(cx0)]; cx0 <= cx1 && k < _start[row + size_t(cx1) + 1]; ++k) f(_items[k]);
+    }
+}
+
+std::vector<uint32_t> SplitIndex::within(const glm::dvec3& p, double d) const {
+    std::vector<uint32_t> out;
+    visit(p, d, [&](uint32_t i) {
+        if (boxDistance(_objects[i], p) <= d) out.push_back(i);
+    });
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+void SplitIndex::distances(const glm::dvec3& p, double d, std::vector<std::pair<double, uint64_t>>& out) const {
+    out.clear();
+    visit(p, d, [&](uint32_t i) {
+        const double t = boxDistance(_objects[i], p);
+        if (t <= d) out.push_back({t, _objects[i].triangles});
+    });
+}
+
+std::vector<uint32_t> selectNearField(const SplitIndex& index, const glm::dvec3& eye, double nearDistance) {
+    return index.within(eye, nearDistance);
+}
+
 std::vector<uint32_t> selectNearFieldByBudget(const std::vector<SplitObject>& objects, const glm::dvec3& eye,
                                               uint64_t budget) {
     std::vector<std::pair<double, uint32_t>> byDist;
@@ -81,12 +162,14 @@ std::vector<uint32_t> selectNearFieldByBudget(const std::vector<SplitObject>& ob
 
 AdaptiveSplit::AdaptiveSplit(const std::vector<SplitObject>& objects, const RayScene* rays,
                              const AdaptiveSplitOptions& o)
-    : _objects(objects), _rays(rays), _o(o), _current(o.initialDistance) {}
+    : _objects(objects), _index(objects), _rays(rays), _o(o), _current(o.initialDistance) {}
 
 uint64_t AdaptiveSplit::predictedTriangles(const glm::dvec3& eye, double d) const {
+    if (std::isinf(d)) return _index.totalTriangles();
+    std::vector<std::pair<double, uint64_t>> near;
+    _index.distances(eye, d, near);
     uint64_t n = 0;
-    for (const auto& ob : _objects)
-        if (boxDistance(ob, eye) <= d) n += ob.triangles;
+    for (const auto& [t, tris] : near) n += tris;
     return n;
 }
 
@@ -136,10 +219,9 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
     const int frame = _frame++;
     if (_probeT.empty()) return _current;
     const int g = std::max(2, _o.candidates);
-    // Sort objects by distance once, then sweep the candidates.
+    // The objects within the largest finite candidate, sorted by distance once; then sweep the candidates.
     std::vector<std::pair<double, uint64_t>> byDist;
-    byDist.reserve(_objects.size());
-    for (const auto& ob : _objects) byDist.push_back({boxDistance(ob, camera.eye), ob.triangles});
+    _index.distances(camera.eye, _o.maxDistance, byDist);
     std::sort(byDist.begin(), byDist.end());
     std::vector<double> cand;
     // The ends only once both costs are measured: on the priors alone they are guesses (on a
@@ -156,7 +238,11 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
     int bestI = 0;
     for (int i = 0; i < n; ++i) {
         const double d = cand[size_t(i)];
-        while (k < byDist.size() && byDist[k].first <= d) tris += byDist[k++].second;
+        if (std::isinf(d)) {
+            tris = _index.totalTriangles();
+        } else {
+            while (k < byDist.size() && byDist[k].first <= d) tris += byDist[k++].second;
+        }
         cost[size_t(i)] = _a * double(tris) + b * predictedRays(d) + (std::isinf(d) ? 0.0 : _f);
         if (cost[size_t(i)] < cost[size_t(bestI)]) bestI = i;
     }

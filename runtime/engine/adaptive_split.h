@@ -48,9 +48,38 @@ struct SplitObject {
 
 double boxDistance(const SplitObject& o, const glm::dvec3& p);
 
+// SplitIndex: the objects bucketed on a uniform xy grid (cells of `cell`
+// metres, each object in the cell of its box's low corner; objects wider
+// than a cell in x or y in a list visited by every query), so that the
+// objects near a point are found by visiting the cells within reach, not
+// every object: a paged 32 km city has half a million 40 m chunks, and a
+// linear scan per frame cost 20 ms. Keeps a reference to `objects` (they must
+// outlive it and not change). within() returns exactly what the linear
+// selectNearField() returns (tested).
+class SplitIndex {
+public:
+    explicit SplitIndex(const std::vector<SplitObject>& objects, double cell = 64.0);
+    // Every object whose box comes within d of p (boxDistance <= d), ascending; all for d = +inf.
+    std::vector<uint32_t> within(const glm::dvec3& p, double d) const;
+    // (boxDistance, triangles) of every object within d of p, unsorted.
+    void distances(const glm::dvec3& p, double d, std::vector<std::pair<double, uint64_t>>& out) const;
+    uint64_t totalTriangles() const { return _total; }
+    const std::vector<SplitObject>& objects() const { return _objects; }
+
+private:
+    template <class F>
+    void visit(const glm::dvec3& p, double d, F&& f) const;
+    const std::vector<SplitObject>& _objects;
+    double _cell, _x0 = 0, _y0 = 0;
+    int _nx = 0, _ny = 0;
+    std::vector<uint32_t> _start, _items, _wide;  // CSR cells: _items[_start[c] .. _start[c+1])
+    uint64_t _total = 0;
+};
+
 // Returns the indices of the near-field objects (ascending).
 std::vector<uint32_t> selectNearField(const std::vector<SplitObject>& objects, const glm::dvec3& eye,
                                       double nearDistance);
+std::vector<uint32_t> selectNearField(const SplitIndex& index, const glm::dvec3& eye, double nearDistance);
 std::vector<uint32_t> selectNearFieldByBudget(const std::vector<SplitObject>& objects, const glm::dvec3& eye,
                                               uint64_t triangleBudget);
 
@@ -88,10 +117,12 @@ public:
     // Predictions (exposed for tests/docs).
     uint64_t predictedTriangles(const glm::dvec3& eye, double d) const;
     double predictedRays(double d) const;
+    const SplitIndex& index() const { return _index; }
 
 private:
     void probe(const Camera& camera);
     const std::vector<SplitObject>& _objects;
+    SplitIndex _index;
     const RayScene* _rays;
     AdaptiveSplitOptions _o;
     double _a = 2e-5, _b = 5e-4, _f = 0, _bProbe = 0;  // priors: ms per triangle, ms per far pixel, fixed far ms

@@ -56,7 +56,13 @@ struct GridWalk {
 
 }  // namespace
 
+int HeightGrid::autoCells(double extentM) {
+    if (!(extentM > 0)) return kAutoMinCells;
+    return int(std::clamp(std::ceil(extentM / kAutoCellM), double(kAutoMinCells), double(kAutoMaxCells)));
+}
+
 HeightGrid HeightGrid::build(const SceneModel& city, const glm::dvec3& frameOrigin, int cells) {
+    const bool automatic = cells <= 0;
     cells = std::clamp(cells, 1, 8192);
     HeightGrid g;
     g._origin = frameOrigin;
@@ -91,6 +97,7 @@ HeightGrid HeightGrid::build(const SceneModel& city, const glm::dvec3& frameOrig
     g._boundsMax = all.hi;
     double extent = std::max(all.hi.x - all.lo.x, all.hi.y - all.lo.y) + 4 * kCellMargin;
     extent = std::max(extent, 1e-3);
+    if (automatic) cells = autoCells(extent);
     g._cells = cells;
     g._cellSize = extent / cells;
     g._min = glm::dvec2(all.lo.x, all.lo.y) - glm::dvec2(2 * kCellMargin);

@@ -47,8 +47,18 @@ class HeightGrid {
 public:
     static constexpr double kCellMargin = 1e-3;  // metres added around every triangle's bounding box
 
+    // Automatic resolution: cells of about kAutoCellM metres, within
+    // kAutoMinCells .. kAutoMaxCells a side. A horizon over cells much coarser
+    // than the buildings (the 32 km city in 512 cells: 62 m) bounds every
+    // column by the tallest building in a wide cell near the eye: 5 to 10 times
+    // the far rays, nearly all of them missing.
+    static constexpr double kAutoCellM = 4.0;
+    static constexpr int kAutoMinCells = 512, kAutoMaxCells = 2048;
+    static int autoCells(double extentM);
+
     HeightGrid() = default;
-    // cells: 1..8192 (clamped). frameOrigin: world position of the scene-local origin.
+    // cells: 1..8192 (clamped), or <= 0: autoCells() of the geometry's xy extent.
+    // frameOrigin: world position of the scene-local origin.
     static HeightGrid build(const SceneModel& city, const glm::dvec3& frameOrigin, int cells);
 
     bool empty() const { return _cells == 0; }  // no geometry at all

@@ -335,3 +335,30 @@ TEST(Horizon, SubsamplingNeverCullsMoreThanOnItsOwnLattice) {
     for (size_t x = 0; x < exact.row.size(); ++x) culled += sub.row[x];
     EXPECT_GT(culled, 0);
 }
+
+TEST(Horizon, AutomaticGridResolutionFollowsTheCityExtent) {
+    // About 4 m cells, 512 .. 2048 a side: independent arithmetic on the extents.
+    EXPECT_EQ(HeightGrid::autoCells(100.0), 512);
+    EXPECT_EQ(HeightGrid::autoCells(2100.0), 525);
+    EXPECT_EQ(HeightGrid::autoCells(8000.0), 2000);
+    EXPECT_EQ(HeightGrid::autoCells(32000.0), 2048);
+    EXPECT_EQ(HeightGrid::autoCells(0.0), 512);
+    EXPECT_EQ(HeightGrid::autoCells(std::nan("")), 512);
+    // build(..., 0) picks autoCells of the geometry's extent; an explicit count is kept.
+    SceneModel city = randomCity(3, 40, 3000.0);
+    auto rs = RayScene::build(city);
+    ASSERT_TRUE(rs.isOk());
+    const HeightGrid a = HeightGrid::build(city, rs.value()->frameOrigin(), 0);
+    const double extent = std::max(a.boundsMax().x - a.boundsMin().x, a.boundsMax().y - a.boundsMin().y);
+    EXPECT_GT(extent, 1000.0);
+    EXPECT_EQ(a.cells(), HeightGrid::autoCells(extent + 4 * HeightGrid::kCellMargin));
+    EXPECT_NEAR(a.cellSize(), (extent + 4 * HeightGrid::kCellMargin) / a.cells(), 1e-9);
+    EXPECT_EQ(HeightGrid::build(city, rs.value()->frameOrigin(), 64).cells(), 64);
+    // The automatic grid is as conservative as any: never above the brute-force top hit.
+    const Camera cam = cameraAt(glm::dvec3(0, -200, 1.7), 0.3, 0.05);
+    const HorizonResult hr = traceHorizon(a, cam);
+    EXPECT_TRUE(hr.active) << hr.reason;
+    const Check c = compare(hr, bruteForceTopHit(*rs.value(), cam, 0.0));
+    EXPECT_EQ(c.violations, 0);
+    EXPECT_GT(c.culled, 0);  // not vacuous: the sky above the skyline is culled
+}

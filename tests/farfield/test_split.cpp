@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <random>
 
 #include "runtime/engine/adaptive_split.h"
 #include "runtime/engine/ray_scene.h"
@@ -153,4 +155,53 @@ TEST(Split, RasterCostFitIgnoresFramesSlowedByOtherWork) {
     }
     const double ls = (sxy / n - sx / n * sy / n) / (sxx / n - sx / n * sx / n);
     EXPECT_GT(std::abs(ls - a), 0.15 * a);
+}
+
+TEST(Split, GridIndexSelectsExactlyWhatTheLinearScanSelects) {
+    // Random boxes: mostly chunk-sized, some wider than a cell (per-tile large chunks), some flat
+    // points, spread over 3 km with a few far outliers; eyes inside, at the edge and far outside.
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> pos(-1500.0, 1500.0), ext(0.0, 45.0), big(60.0, 900.0), h(0.0, 80.0);
+    std::vector<SplitObject> objs;
+    for (int i = 0; i < 4000; ++i) {
+        const glm::dvec3 lo(pos(rng), pos(rng), 0.0);
+        const bool wide = i % 97 == 0, point = i % 89 == 0;
+        const glm::dvec3 size = point ? glm::dvec3(0.0) : glm::dvec3(wide ? big(rng) : ext(rng), ext(rng), h(rng));
+        objs.push_back(box(lo, lo + size, uint64_t(1 + i % 13)));
+    }
+    objs.push_back(box({40000, 40000, 0}, {40030, 40030, 10}, 5));
+    for (double cell : {16.0, 64.0, 500.0}) {
+        SplitIndex index(objs, cell);
+        uint64_t total = 0;
+        for (const auto& o : objs) total += o.triangles;
+        EXPECT_EQ(index.totalTriangles(), total);
+        std::uniform_real_distribution<double> eyeXY(-2500.0, 2500.0);
+        for (int e = 0; e < 40; ++e) {
+            const glm::dvec3 eye = e == 0 ? glm::dvec3(40010, 40010, 2) : glm::dvec3(eyeXY(rng), eyeXY(rng), e % 3 == 0 ? 300.0 : 1.7);
+            for (double d : {0.0, 15.0, 100.0, 333.3, 800.0, 5000.0, std::numeric_limits<double>::infinity()}) {
+                ASSERT_EQ(index.within(eye, d), selectNearField(objs, eye, d)) << "cell " << cell << " eye " << e << " d " << d;
+                std::vector<std::pair<double, uint64_t>> near;
+                index.distances(eye, d, near);
+                uint64_t sum = 0;
+                for (uint32_t i : selectNearField(objs, eye, d)) sum += objs[i].triangles;
+                uint64_t got = 0;
+                for (const auto& [t, n] : near) {
+                    EXPECT_LE(t, d);
+                    got += n;
+                }
+                EXPECT_EQ(got, sum);
+            }
+        }
+    }
+    // An empty object list, and an AdaptiveSplit's predicted triangles against the linear sum.
+    std::vector<SplitObject> none;
+    EXPECT_TRUE(SplitIndex(none).within(glm::dvec3(0.0), 100.0).empty());
+    AdaptiveSplitOptions o;
+    o.timeProbe = false;
+    AdaptiveSplit split(objs, nullptr, o);
+    for (double d : {15.0, 120.0, 800.0, std::numeric_limits<double>::infinity()}) {
+        uint64_t sum = 0;
+        for (uint32_t i : selectNearField(objs, glm::dvec3(10, 20, 1.7), d)) sum += objs[i].triangles;
+        EXPECT_EQ(split.predictedTriangles(glm::dvec3(10, 20, 1.7), d), sum) << d;
+    }
 }

@@ -244,7 +244,7 @@ TEST(RenderModes, RegistryListsEveryModeOnce) {
     c.width = 0;
     EXPECT_FALSE(validateBenchConfig(c).isOk());
     c.width = 64;
-    c.options.horizonGrid = 0;
+    c.options.horizonGrid = -1;
     auto s = validateBenchConfig(c);
     ASSERT_FALSE(s.isOk());
     EXPECT_NE(s.message().find("--horizon-grid"), std::string::npos) << s.message();
@@ -735,7 +735,7 @@ TEST(BenchCli, FarFieldFlagsRejectBadValues) {
     std::string dummy = dir + "/dummy.osgb";
     std::ofstream(dummy) << "x";
     const std::pair<const char*, const char*> bad[] = {
-        {"--near -5", "--near"}, {"--near abc", "--near"}, {"--horizon-grid 0", "--horizon-grid"},
+        {"--near -5", "--near"}, {"--near abc", "--near"}, {"--horizon-grid -1", "--horizon-grid"},
         {"--budget -7", "--budget"}, {"--horizon-grid 9000", "--horizon-grid"}, {"--far-step 3", "--far-step"},
         {"--memory-budget 0", "--memory-budget"}, {"--memory-budget lots", "--memory-budget"}};
     for (const auto& [args, flag] : bad) {

@@ -116,7 +116,7 @@ TEST(Options, ModeFlagsBecomeModeOptions) {
         const char* flag;
     };
     ModeFlags grid, threads, baked, near;
-    grid.horizonGrid = 0;
+    grid.horizonGrid = -1;
     threads.threads = 5000;
     baked.baked = "/nonexistent/city.baked.osgb";
     near.near = "-5";
