@@ -261,7 +261,7 @@ Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedC
 
     const RegionGrid grid(params, o.regionSizeM);
     const std::string keyText = paramsToJson(params) + "\nregion_size_m=" + exactDecimal(o.regionSizeM) +
-                                "\nformat=" + std::to_string(kPagedFormatVersion);
+                                "\nformat=" + std::to_string(kPagedFormatVersion) + "\ncoarse_trees=impostors";
     const std::string key = hex64(hashBytes64(keyText.data(), keyText.size()));
     PagedCityReport rep;
     rep.regions = grid.count();
