@@ -47,7 +47,8 @@ namespace vista {
 
 constexpr int kImpostorVerticalQuads = 3;
 constexpr int kImpostorCells = kImpostorVerticalQuads + 1;  // + the top quad
-constexpr int kImpostorCellPixels = 64;
+constexpr int kImpostorCellPixels = 64;            // osglod's far levels
+constexpr int kCoarseImpostorCellPixels = 32;      // paged coarse levels (trees beyond about 1 km): 16 KB per prototype
 constexpr int kMinImpostorCellPixels = 8, kMaxImpostorCellPixels = 1024;
 constexpr int kImpostorPadPixels = 2;
 constexpr int kImpostorSupersample = 4;            // samples per texel side

@@ -11,6 +11,7 @@
 //   level 0  the chunk itself, every triangle         d <  nearD + r
 //   level 1  Simplifier, sample ratio 0.25             nearD + r <= d < 4 nearD + r
 //   level 2  Simplifier, sample ratio 0.0625           d >= 4 nearD + r
+// (trees: impostors on levels 1 and 2, below)
 // so every chunk with a point within nearD of the eye is drawn exactly (as
 // in hybrid's near field) and only chunks wholly beyond it are simplified.
 // Before simplifying, vertices at the same position are welded (colours
@@ -42,7 +43,7 @@ namespace vista {
 constexpr double kOsgLodRatio1 = 0.25, kOsgLodRatio2 = 0.0625;  // Simplifier sample ratios of levels 1, 2
 constexpr double kOsgLodFarFactor = 4.0;                          // level 2 from kOsgLodFarFactor * nearD + r
 constexpr float kOsgLodSmallFeaturePixels = 2.0f;
-constexpr int kOsgLodTreeImpostorLevel = 2;  // trees are impostors on levels >= this (1 or 2)
+constexpr int kOsgLodTreeImpostorLevel = 1;  // trees are impostors on levels >= this (1 or 2; 1 measured better: docs/performance.md)
 
 Result<std::unique_ptr<RenderMode>> makeOsgLodMode(ModeContext& ctx);
 

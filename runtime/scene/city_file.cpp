@@ -232,7 +232,7 @@ osg::ref_ptr<osg::Node> buildCityScene(const City& city) {
     for (size_t i = 0; i < city.treePrototypes.size(); ++i) {
         const Mesh& m = city.treePrototypes[i].mesh;
         checkMesh(m);
-        if (city.treeImpostors) impostors[i] = makeTreeImpostorArrays(makeTreeImpostor(m.positions, m.colors, m.indices));
+        if (city.treeImpostors) impostors[i] = makeTreeImpostorArrays(makeTreeImpostor(m.positions, m.colors, m.indices, kCoarseImpostorCellPixels));
         protos[i].verts = toVec3Array(m.positions);
         protos[i].normals = normalsFor(m);
         protos[i].colors = toColorArray(m.colors);

@@ -412,7 +412,7 @@ struct FindImpostors : osg::NodeVisitor {
             instances += size_t(geo->getPrimitiveSet(0)->getNumInstances());
             const osg::StateSet* ss = geo->getStateSet();
             auto* tex = ss ? dynamic_cast<const osg::Texture2D*>(ss->getTextureAttribute(0, osg::StateAttribute::TEXTURE)) : nullptr;
-            if (tex && tex->getImage() && tex->getImage()->s() == 2 * vista::kImpostorCellPixels && tex->getImage()->data()) ++textured;
+            if (tex && tex->getImage() && tex->getImage()->s() == 2 * vista::kCoarseImpostorCellPixels && tex->getImage()->data()) ++textured;
         }
     }
 };
