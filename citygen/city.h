@@ -128,6 +128,10 @@ struct City {
     std::vector<Tile> tiles;        // row-major by (iy, ix); only non-empty tiles
     std::vector<StageTime> stageTimes;
     OsmBuildingStats osmBuildings;  // all zero unless buildings came from OSM
+    // The trees are written as impostors (citygen/tree_impostor.h: cross
+    // billboards with a baked atlas) instead of their prototype meshes: the
+    // coarse level of a paged city (RegionalCity::coarse).
+    bool treeImpostors = false;
 };
 
 }  // namespace vista

@@ -180,7 +180,9 @@ City RegionalCity::coarse(const City& region) {
     City k;
     k.params = region.params;
     k.params.detail = 0;
-    k.treePrototypes = region.treePrototypes;  // none is drawn; kept so prototype indices stay valid
+    k.treePrototypes = region.treePrototypes;
+    k.trees = region.trees;  // drawn as impostors (tree_impostor.h)
+    k.treeImpostors = true;
     const TileGrid grid(k.params);
     const Lighting light(k.params);
     std::map<std::pair<int, int>, std::vector<uint32_t>> buildingsOf;
@@ -193,13 +195,14 @@ City RegionalCity::coarse(const City& region) {
         out.ix = t.ix;
         out.iy = t.iy;
         out.origin = t.origin;
+        out.trees = t.trees;
         for (Material m : {Material::Ground, Material::Grass, Material::Road}) out.meshes[size_t(m)] = t.meshes[size_t(m)];
         BuildingMeshes bm{&out.meshes[size_t(Material::Wall)], &out.meshes[size_t(Material::Window)],
                           &out.meshes[size_t(Material::Roof)]};
         auto it = buildingsOf.find({t.ix, t.iy});
         if (it != buildingsOf.end())
             for (uint32_t b : it->second) meshBuilding(region.buildings[b], b, k.params, light, out.origin, bm);
-        bool any = false;
+        bool any = !out.trees.empty();
         for (const auto& m : out.meshes) any = any || !m.empty();
         if (any) k.tiles.push_back(std::move(out));
     }

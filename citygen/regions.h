@@ -27,8 +27,9 @@
 // and its halo, so near a region border a tree may differ from the unpaged
 // city's (the region's own trees are deterministic).
 // coarse(): the far level of a region: the same tiles with ground, grass and
-// roads, buildings as plain prisms (detail 0), no sidewalks, markings, lamps
-// or trees; the coarse City's params carry detail 0.
+// roads, buildings as plain prisms (detail 0), the region's trees as
+// impostors (City::treeImpostors: cross billboards, tree_impostor.h), no
+// sidewalks, markings or lamps; the coarse City's params carry detail 0.
 //
 // Contract: params must pass validateParams() (the single-file cap does not
 // apply); bad params or region size: error Status naming the field. region()

@@ -15,6 +15,7 @@
 #include "citygen/labels.h"
 #include "nodes/label_pass.h"
 #include "runtime/scene/scene_graph.h"
+#include "runtime/scene/tree_impostor_graph.h"
 
 namespace vista {
 
@@ -220,6 +221,7 @@ private:
         g->setVertexArray(src.getVertexArray());
         if (src.getNormalArray()) g->setNormalArray(src.getNormalArray(), osg::Array::BIND_PER_VERTEX);
         g->setColorArray(src.getColorArray(), osg::Array::BIND_PER_VERTEX);
+        if (src.getTexCoordArray(0)) g->setTexCoordArray(0, src.getTexCoordArray(0), osg::Array::BIND_PER_VERTEX);  // tree impostors
         osg::ref_ptr<osg::PrimitiveSet> ps = static_cast<osg::PrimitiveSet*>(src.getPrimitiveSet(0)->clone(osg::CopyOp::SHALLOW_COPY));
         ps->setNumInstances(int(tb.cols[0].size()));
         g->addPrimitiveSet(ps.get());
@@ -338,7 +340,7 @@ NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk, bool labe
             auto* verts = dynamic_cast<osg::Vec3Array*>(g->getVertexArray());
             auto* de = dynamic_cast<osg::DrawElements*>(g->getPrimitiveSet(0));
             if (!verts || !de || de->getMode() != GL_TRIANGLES) continue;
-            if (g->getName().rfind(kTreeGeometryPrefix, 0) == 0) chunker.addTrees(g, tileId, tileOrigin);
+            if (g->getName().rfind(kTreeGeometryPrefix, 0) == 0 || isTreeImpostorName(g->getName())) chunker.addTrees(g, tileId, tileOrigin);
             else chunker.addMesh(g, tileId, tileOrigin);
         }
     }

@@ -3,6 +3,8 @@
 
 #include <limits>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <map>
 #include <tuple>
 
@@ -15,6 +17,7 @@
 
 #include "foundation/timing.h"
 #include "runtime/scene/scene_graph.h"
+#include "runtime/scene/tree_impostor_graph.h"
 
 namespace vista {
 namespace {
@@ -137,18 +140,61 @@ private:
     std::map<const osg::Array*, osg::ref_ptr<osg::Geometry>> _protos;
 };
 
+// Tree prototypes as impostors (citygen/tree_impostor.h), baked once per
+// prototype (key: the prototype's vertex array), for the far levels.
+class ImpostorCache {
+public:
+    void add(const osg::Geometry& tree) {
+        const osg::Array* key = tree.getVertexArray();
+        if (_impostors.count(key) || tree.getNumPrimitiveSets() == 0) return;
+        const auto* v = dynamic_cast<const osg::Vec3Array*>(tree.getVertexArray());
+        const auto* c = dynamic_cast<const osg::Vec4ubArray*>(tree.getColorArray());
+        const auto* de = dynamic_cast<const osg::DrawElements*>(tree.getPrimitiveSet(0));
+        if (!v || !de || de->getMode() != GL_TRIANGLES) return;
+        std::vector<glm::vec3> positions(v->size());
+        std::vector<glm::u8vec4> colors(v->size(), glm::u8vec4(255));
+        for (size_t i = 0; i < v->size(); ++i) positions[i] = glm::vec3((*v)[i].x(), (*v)[i].y(), (*v)[i].z());
+        if (c)
+            for (size_t i = 0; i < c->size() && i < v->size(); ++i)
+                colors[i] = glm::u8vec4((*c)[i].r(), (*c)[i].g(), (*c)[i].b(), (*c)[i].a());
+        std::vector<uint32_t> indices;
+        for (unsigned i = 0; i + 2 < de->getNumIndices(); i += 3)
+            if (de->index(i) < v->size() && de->index(i + 1) < v->size() && de->index(i + 2) < v->size())
+                for (unsigned k = 0; k < 3; ++k) indices.push_back(de->index(i + k));
+        _impostors[key] = makeTreeImpostorArrays(makeTreeImpostor(positions, colors, indices));
+    }
+    // The chunk's instanced tree drawn as impostors (null: nothing to draw).
+    osg::ref_ptr<osg::Geometry> instance(const osg::Geometry& tree) const {
+        auto it = _impostors.find(tree.getVertexArray());
+        if (it == _impostors.end()) return nullptr;
+        osg::Array* cols[4];
+        for (unsigned c = 0; c < 4; ++c)
+            if (!(cols[c] = const_cast<osg::Array*>(tree.getVertexAttribArray(kInstanceAttrib0 + c)))) return nullptr;
+        long pi = std::strtol(tree.getName().c_str() + std::strlen(kTreeGeometryPrefix), nullptr, 10);
+        osg::ref_ptr<osg::Geometry> g = instancedTreeImpostor(it->second, unsigned(std::max(0L, pi)), cols,
+                                                              unsigned(std::max(0, tree.getPrimitiveSet(0)->getNumInstances())),
+                                                              tree.getInitialBound());
+        if (g) g->setComputeBoundingBoxCallback(const_cast<osg::Drawable::ComputeBoundingBoxCallback*>(tree.getComputeBoundingBoxCallback()));
+        return g;
+    }
+
+private:
+    std::map<const osg::Array*, TreeImpostorArrays> _impostors;
+};
+
 // The geode of a chunk (transform -> geode), or null for another layout.
 osg::Geode* chunkGeode(osg::Node* chunk) {
     auto* xf = dynamic_cast<osg::MatrixTransform*>(chunk);
     return xf && xf->getNumChildren() == 1 ? xf->getChild(0)->asGeode() : nullptr;
 }
 
-osg::ref_ptr<osg::Geode> simplifiedGeode(const osg::Geode& src, double ratio, const PrototypeCache& trees) {
+// Trees: simplified prototypes (`impostors` null) or impostors.
+osg::ref_ptr<osg::Geode> simplifiedGeode(const osg::Geode& src, double ratio, const PrototypeCache& trees, const ImpostorCache* impostors) {
     osg::ref_ptr<osg::Geode> out = new osg::Geode;
     for (unsigned i = 0; i < src.getNumDrawables(); ++i) {
         const osg::Geometry* g = src.getDrawable(i)->asGeometry();
         if (!g) continue;
-        osg::ref_ptr<osg::Geometry> s = isTree(g) ? trees.instance(*g) : simplifiedCopy(*g, ratio);
+        osg::ref_ptr<osg::Geometry> s = !isTree(g) ? simplifiedCopy(*g, ratio) : impostors ? impostors->instance(*g) : trees.instance(*g);
         if (s) out->addDrawable(s.get());
     }
     return out;
@@ -162,16 +208,21 @@ public:
         Stopwatch sw;
         const double ratios[2] = {kOsgLodRatio1, kOsgLodRatio2};
         PrototypeCache trees[2] = {PrototypeCache(ratios[0]), PrototypeCache(ratios[1])};
+        ImpostorCache impostors;
         for (const auto& c : nf.chunks)
             if (osg::Geode* geode = chunkGeode(c.get()))
                 for (unsigned i = 0; i < geode->getNumDrawables(); ++i)
-                    if (const osg::Geometry* g = geode->getDrawable(i)->asGeometry(); g && isTree(g))
-                        for (auto& t : trees) t.add(*g);
+                    if (const osg::Geometry* g = geode->getDrawable(i)->asGeometry(); g && isTree(g)) {
+                        for (int l = 0; l < 2; ++l)
+                            if (l + 1 < kOsgLodTreeImpostorLevel) trees[l].add(*g);
+                        impostors.add(*g);
+                    }
         std::vector<osg::ref_ptr<osg::Geode>> far[2];
         for (auto& f : far) f.resize(nf.chunks.size());
         tbb::parallel_for(size_t(0), nf.chunks.size(), [&](size_t i) {
             if (osg::Geode* geode = chunkGeode(nf.chunks[i].get()))
-                for (int l = 0; l < 2; ++l) far[l][i] = simplifiedGeode(*geode, ratios[l], trees[l]);
+                for (int l = 0; l < 2; ++l)
+                    far[l][i] = simplifiedGeode(*geode, ratios[l], trees[l], l + 1 >= kOsgLodTreeImpostorLevel ? &impostors : nullptr);
         });
         _setup.push_back({"simplify", sw.ms()});
         _root = smallFeatureCulling();

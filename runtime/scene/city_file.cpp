@@ -28,6 +28,7 @@
 
 #include "citygen/labels.h"
 #include "runtime/scene/scene_file.h"
+#include "runtime/scene/tree_impostor_graph.h"
 
 namespace vista {
 
@@ -220,15 +221,18 @@ osg::ref_ptr<osg::Node> buildCityScene(const City& city) {
     root->setUserValue("vista.tile_size_m", p.tile_size_m);
     root->setUserValue("vista.tree_prototypes", int(city.treePrototypes.size()));
     root->setUserValue("vista.labels", 1);
+    if (city.treeImpostors) root->setUserValue("vista.tree_impostors", 1);
     osg::StateSet* rs = root->getOrCreateStateSet();
     rs->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
     rs->setAttributeAndModes(new osg::CullFace(osg::CullFace::BACK), osg::StateAttribute::ON);
 
     // Tree prototypes: arrays shared by every tile that uses them (osgb stores them once).
     std::vector<ProtoArrays> protos(city.treePrototypes.size());
+    std::vector<TreeImpostorArrays> impostors(city.treeImpostors ? city.treePrototypes.size() : 0);
     for (size_t i = 0; i < city.treePrototypes.size(); ++i) {
         const Mesh& m = city.treePrototypes[i].mesh;
         checkMesh(m);
+        if (city.treeImpostors) impostors[i] = makeTreeImpostorArrays(makeTreeImpostor(m.positions, m.colors, m.indices, kCoarseImpostorCellPixels));
         protos[i].verts = toVec3Array(m.positions);
         protos[i].normals = normalsFor(m);
         protos[i].colors = toColorArray(m.colors);
@@ -267,6 +271,25 @@ osg::ref_ptr<osg::Node> buildCityScene(const City& city) {
         for (const auto& [pi, list] : byProto) {
             const Mesh& pm = city.treePrototypes[pi].mesh;
             if (pm.empty()) continue;
+            if (city.treeImpostors) {
+                if (impostors[pi].empty()) continue;
+                osg::ref_ptr<osg::Vec4Array> cols[4];
+                for (auto& c : cols) c = new osg::Vec4Array(unsigned(list.size()));
+                osg::BoundingBox bb;
+                const osg::BoundingBox& pb = impostors[pi].bounds;
+                for (size_t k = 0; k < list.size(); ++k) {
+                    glm::mat4 m = instanceMatrix(city.trees[list[k]], tile.origin);
+                    for (int c = 0; c < 4; ++c) (*cols[c])[unsigned(k)].set(m[c][0], m[c][1], m[c][2], m[c][3]);
+                    for (int corner = 0; corner < 8; ++corner) {
+                        osg::Vec3 v = pb.corner(unsigned(corner));
+                        glm::vec4 w = m * glm::vec4(v.x(), v.y(), v.z(), 1.0f);
+                        bb.expandBy(w.x, w.y, w.z);
+                    }
+                }
+                osg::Array* const arrays[4] = {cols[0].get(), cols[1].get(), cols[2].get(), cols[3].get()};
+                if (auto g = instancedTreeImpostor(impostors[pi], pi, arrays, unsigned(list.size()), bb)) geode->addDrawable(g.get());
+                continue;
+            }
             if (!instSS) instSS = instancedStateSet();
             auto g = makeGeometry(kTreeGeometryPrefix + std::to_string(pi), protos[pi].verts.get(), protos[pi].normals.get(),
                                   protos[pi].colors.get(), pm.indices);
@@ -394,6 +417,27 @@ Result<SceneModel> decodeCityScene(osg::Node* node, const std::string& path) {
             }
             if (mesh.indices.size() % 3 != 0) return bad("geometry '" + g->getName() + "': index count not a multiple of 3");
             const std::string& name = g->getName();
+            if (long pi = -1; isTreeImpostorName(name, &pi)) {  // coarse levels: drawn by the graph only
+                if (pi < 0 || pi >= protoCount) return bad("tree impostor geometry '" + name + "' names an unknown prototype");
+                osg::Vec4Array* cols[4];
+                for (unsigned c = 0; c < 4; ++c) {
+                    cols[c] = dynamic_cast<osg::Vec4Array*>(g->getVertexAttribArray(kInstanceAttrib0 + c));
+                    if (!cols[c]) return bad("tree impostor geometry '" + name + "' has no instance matrices");
+                }
+                const size_t n = size_t(std::max(0, de->getNumInstances()));
+                for (auto* c : cols) if (c->size() != n) return bad("tree impostor geometry '" + name + "': instance count mismatch");
+                for (size_t k = 0; k < n; ++k) {
+                    glm::dmat4 m(1.0);
+                    for (int c = 0; c < 4; ++c) {
+                        const osg::Vec4& v = (*cols[c])[unsigned(k)];
+                        m[c] = glm::dvec4(v.x(), v.y(), v.z(), v.w());
+                    }
+                    out.impostors.push_back({uint32_t(pi), tileM * m, 0u});
+                }
+                out.triangles += n * (mesh.indices.size() / 3);
+                tile.triangles += n * (mesh.indices.size() / 3);
+                continue;
+            }
             mesh.material = materialFromName(name.c_str());
             if (out.labelled) {
                 auto* ids = dynamic_cast<osg::UIntArray*>(g->getVertexAttribArray(kLabelAttrib));

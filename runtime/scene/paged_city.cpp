@@ -136,6 +136,9 @@ Result<Json> generateRegion(const RegionalCity& base, int r, const std::string& 
             City k = RegionalCity::coarse(c);
             c = City();
             osg::ref_ptr<osg::Node> scene = buildCityScene(k);
+            osg::ComputeBoundsVisitor cbv;  // the impostors' quads may reach beyond the trees' meshes
+            scene->accept(cbv);
+            box.expandBy(cbv.getBoundingBox());
             VISTA_RETURN_IF_ERROR(writeSceneFile(*scene, (fs::path(dir) / coarse).string(), false));
         }
         rec["bounds"] = {box.xMin(), box.yMin(), box.zMin(), box.xMax(), box.yMax(), box.zMax()};
@@ -261,7 +264,7 @@ Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedC
 
     const RegionGrid grid(params, o.regionSizeM);
     const std::string keyText = paramsToJson(params) + "\nregion_size_m=" + exactDecimal(o.regionSizeM) +
-                                "\nformat=" + std::to_string(kPagedFormatVersion);
+                                "\nformat=" + std::to_string(kPagedFormatVersion) + "\ncoarse_trees=impostors";
     const std::string key = hex64(hashBytes64(keyText.data(), keyText.size()));
     PagedCityReport rep;
     rep.regions = grid.count();

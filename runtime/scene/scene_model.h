@@ -61,6 +61,10 @@ struct SceneModel {
     std::vector<SceneMesh> meshes;        // tile meshes (world origin per mesh)
     std::vector<SceneMesh> prototypes;    // tree prototypes (origin 0)
     std::vector<SceneInstance> instances;
+    // Tree impostors (tree_impostor_graph.h; coarse levels of a paged city):
+    // drawn by the graph only, not ray-cast and in no tile's lists; their
+    // quads count in `triangles`.
+    std::vector<SceneInstance> impostors;
     std::vector<SceneTile> tiles;         // empty for hand-built models
     size_t triangles = 0;                 // rendered triangles (instances expanded)
     bool labelled = false;                // the file carries ground-truth labels (vista.labels)

@@ -10,6 +10,7 @@
 #include <set>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -17,6 +18,7 @@
 #include <osg/ComputeBoundsVisitor>
 #include <osg/Group>
 #include <osg/PagedLOD>
+#include <osg/Texture2D>
 #include <osgDB/ReadFile>
 #include <osgViewer/Viewer>
 
@@ -25,6 +27,7 @@
 #include "runtime/scene/paged_city.h"
 #include "runtime/scene/scene_file.h"
 #include "runtime/scene/scene_graph.h"
+#include "runtime/scene/tree_impostor_graph.h"
 #include "tests/common/run_vista.h"
 #include "tests/common/temp_dir.h"
 
@@ -395,4 +398,53 @@ TEST_F(Paged, StockViewerPagesTheNearRegionIn) {
         EXPECT_EQ(full->getName(), "vista.city");
         EXPECT_GT(full->getNumChildren(), 0u);
     }
+}
+
+namespace {
+struct FindImpostors : osg::NodeVisitor {
+    FindImpostors() : osg::NodeVisitor(TRAVERSE_ALL_CHILDREN) {}
+    size_t geometries = 0, instances = 0, textured = 0;
+    void apply(osg::Geode& g) override {
+        for (unsigned i = 0; i < g.getNumDrawables(); ++i) {
+            const osg::Geometry* geo = g.getDrawable(i)->asGeometry();
+            if (!geo || !vista::isTreeImpostorName(geo->getName())) continue;
+            ++geometries;
+            instances += size_t(geo->getPrimitiveSet(0)->getNumInstances());
+            const osg::StateSet* ss = geo->getStateSet();
+            auto* tex = ss ? dynamic_cast<const osg::Texture2D*>(ss->getTextureAttribute(0, osg::StateAttribute::TEXTURE)) : nullptr;
+            if (tex && tex->getImage() && tex->getImage()->s() == 2 * vista::kCoarseImpostorCellPixels && tex->getImage()->data()) ++textured;
+        }
+    }
+};
+}  // namespace
+
+// The coarse level keeps the region's trees as impostors: the coarse file
+// loads (loadCityFile) with one impostor per tree of the full file, no
+// prototype mesh, and the impostor geometries carry their atlas inline (the
+// stock reader sees it too).
+TEST_F(Paged, CoarseLevelDrawsTreesAsImpostors) {
+    const std::string dir = ref->file("city.paged");
+    size_t trees = 0;
+    const auto manifest = readJson(dir + "/manifest.json");
+    for (const auto& r : manifest["regions"]) {
+        if (r["empty"].get<bool>()) continue;
+        const std::string name = "region_" + std::to_string(r["ix"].get<int>()) + "_" + std::to_string(r["iy"].get<int>());
+        auto full = vista::loadCityFile(dir + "/" + name + ".osgb");
+        auto coarse = vista::loadCityFile(dir + "/" + name + ".coarse.osgb");
+        ASSERT_TRUE(full.isOk() && coarse.isOk()) << name;
+        EXPECT_TRUE(coarse->instances.empty()) << name;
+        ASSERT_EQ(coarse->impostors.size(), full->instances.size()) << name;
+        std::multiset<std::tuple<uint32_t, double, double>> a, b;
+        for (const auto& in : full->instances) a.insert({in.prototype, in.transform[3].x, in.transform[3].y});
+        for (const auto& in : coarse->impostors) b.insert({in.prototype, in.transform[3].x, in.transform[3].y});
+        EXPECT_TRUE(a == b) << name << ": impostors at other places than the trees";
+        trees += coarse->impostors.size();
+        osg::ref_ptr<osg::Node> stock = osgDB::readNodeFile(dir + "/" + name + ".coarse.osgb");
+        ASSERT_TRUE(stock.valid()) << name;
+        FindImpostors f;
+        stock->accept(f);
+        EXPECT_EQ(f.instances, coarse->impostors.size()) << name;
+        EXPECT_EQ(f.textured, f.geometries) << name << ": an impostor without its inline atlas";
+    }
+    EXPECT_GT(trees, 0u);
 }
