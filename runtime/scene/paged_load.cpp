@@ -249,6 +249,7 @@ Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>&
             const uint32_t base = uint32_t(out.prototypes.size());
             for (SceneMesh& p : r.prototypes) out.prototypes.push_back(std::move(p));
             for (SceneInstance& in : r.instances) in.prototype += base;
+            for (SceneInstance& im : r.impostors) im.prototype += base;
         }
         const uint32_t meshBase = uint32_t(out.meshes.size()), instBase = uint32_t(out.instances.size());
         for (SceneMesh& mesh : r.meshes) {
@@ -260,6 +261,7 @@ Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>&
             in.id = 0;
             out.instances.push_back(in);
         }
+        for (const SceneInstance& im : r.impostors) out.impostors.push_back(im);
         for (SceneTile& t : r.tiles) {
             osg::Node* child = rroot->getChild(t.child);
             t.child = root->getNumChildren();
