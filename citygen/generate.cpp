@@ -135,11 +135,37 @@ Result<City> generateCity(const CityParams& params, const GenerateOptions& optio
         StageTimer t(city, pr, "street lights");
         city.streetLights = placeStreetLights(city);
     }
+    if (options.beforeMeshing) VISTA_RETURN_IF_ERROR(options.beforeMeshing(city));
     {
         StageTimer t(city, pr, "meshes");
         meshTiles(city, {}, pr);
     }
     return city;
+}
+
+size_t estimateStoredTriangles(const City& layout) {
+    const TileGrid grid(layout.params);
+    const int n = grid.count();
+    if (n <= 0) return 0;
+    const int want = std::min(n, std::clamp(n / 8, 16, 64));
+    std::vector<int> sample;
+    for (int k = 0; k < want; ++k) sample.push_back(int((int64_t(k) * n + n / (2 * want)) / want));
+    City c;
+    c.params = layout.params;
+    c.streets = layout.streets;
+    c.blocks = layout.blocks;
+    c.lots = layout.lots;
+    c.buildings = layout.buildings;
+    c.trees = layout.trees;
+    c.treePrototypes = layout.treePrototypes;
+    c.streetLights = layout.streetLights;
+    meshTiles(c, sample, nullptr);
+    size_t tileTriangles = 0;
+    for (const Tile& t : c.tiles)
+        for (const Mesh& m : t.meshes) tileTriangles += m.indices.size() / 3;
+    size_t prototypes = 0;
+    for (const TreePrototype& p : layout.treePrototypes) prototypes += p.mesh.indices.size() / 3;
+    return size_t(std::llround(double(tileTriangles) * double(n) / double(sample.size()))) + prototypes;
 }
 
 CityCounts countCity(const City& c) {

@@ -7,6 +7,7 @@
 // Output is byte-for-byte identical for the same params whatever
 // params.threads is. Stage timings go to City::stageTimes.
 #pragma once
+#include <functional>
 #include <optional>
 
 #include "citygen/city.h"
@@ -23,6 +24,10 @@ struct GenerateOptions {
     // overlapping one of them is dropped before the procedural buildings are placed.
     std::optional<std::vector<OsmFootprint>> osmBuildings;
     OsmBuildingStats osmStats;  // the import's counts, carried into City::osmBuildings
+    // Called with the laid-out city (streets, blocks, lots, buildings, trees,
+    // street lights; no tiles yet) before the meshes stage, the bulk of the
+    // memory: an error stops generation and is returned (the --memory-budget check).
+    std::function<Status(const City& layout)> beforeMeshing;
 };
 
 Result<City> generateCity(const CityParams& params, const GenerateOptions& options = {});
@@ -45,5 +50,13 @@ struct CityCounts {
     size_t drawCalls = 0;        // non-empty tile meshes + one instanced draw per (tile, tree prototype)
 };
 CityCounts countCity(const City& city);
+
+// Stored triangles (countCity().storedTriangles) that the meshes stage will
+// make for a laid-out city, estimated by meshing a sample of its tiles
+// (every k-th tile of the grid: at least 16, at most 64, all of a small city)
+// and scaling by the tile count, plus the tree prototypes once. Exact when
+// every tile is sampled; deterministic; costs about one eighth of the
+// meshes stage on a large city.
+size_t estimateStoredTriangles(const City& layout);
 
 }  // namespace vista

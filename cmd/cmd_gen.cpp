@@ -18,6 +18,7 @@
 #include "citygen/regions.h"
 #include "cmd/cli.h"
 #include "cmd/commands.h"
+#include "cmd/memory.h"
 
 namespace vista {
 
@@ -36,6 +37,8 @@ struct GenArgs {
     std::optional<double> regionSize;
     std::string shard;
     bool merge = false;
+    std::string memoryBudget;
+    double budgetGb = 0;  // parsed --memory-budget (0 = none)
     bool paged() const { return endsWith(out, ".paged") || endsWith(out, ".paged/"); }
     static bool endsWith(const std::string& s, const std::string& t) {
         return s.size() >= t.size() && s.compare(s.size() - t.size(), t.size(), t) == 0;
@@ -72,6 +75,10 @@ CLI::Option* declareFlags(CLI::App& app, GenArgs& a) {
     app.add_flag("--merge", a.merge,
                  "paged output: generate nothing; write index.osgb and manifest.json once every region is done "
                  "(exit 2 naming the missing regions otherwise)");
+    app.add_option("--memory-budget", a.memoryBudget,
+                   "GB: refuse up front, before the meshes are made and with nothing written, a generation whose "
+                   "estimated peak memory exceeds it (one file: from the laid-out city's estimated triangles; paged: "
+                   "from --region-size); --stats reports the estimate beside the measured peak (default: no budget)");
     app.add_flag("--list-params", a.listParams, "print every parameter with unit, range and default (Markdown) and exit");
     app.add_flag("-q,--quiet", a.quiet, "no progress on stderr");
     return out;
@@ -171,6 +178,12 @@ Result<PagedCityOptions> resolvePaged(const GenArgs& a, const CityParams& params
 int runPaged(const GenArgs& a, const CityParams& params, const Stopwatch& total) {
     auto o = resolvePaged(a, params);
     if (!o) return reportBadInput(kCmd, o.status());
+    const double estimateMb = estimatePagedGenMb(o->regionSizeM, params.detail);
+    {
+        char how[160];
+        std::snprintf(how, sizeof(how), "paged: one %g m region at a time at detail %d", o->regionSizeM, params.detail);
+        if (Status s = checkGenBudget("--memory-budget", a.budgetGb, estimateMb, how, true); !s) return reportBadInput(kCmd, s);
+    }
     StderrProgress progress(isatty(2));
     o->progress = a.quiet ? nullptr : &progress;
     auto rep = generatePagedCity(params, *o);
@@ -199,6 +212,7 @@ int runPaged(const GenArgs& a, const CityParams& params, const Stopwatch& total)
         j["seconds"] = {{"total", totalSeconds},
                         {"stages", {{"streets and blocks", rep->baseSeconds}, {"regions", rep->regionSeconds}, {"index", rep->indexSeconds}}}};
         j["peak_rss_mb"] = peakRssMb();
+        j["memory"] = {{"estimate_mb", estimateMb}, {"budget_gb", a.budgetGb > 0 ? nlohmann::json(a.budgetGb) : nlohmann::json(nullptr)}};
         j["threads"] = params.threads;
         if (Status s = writeFileAtomic(a.statsFile, j.dump(2) + "\n"); !s) return reportBadInput(kCmd, s);
     }
@@ -289,10 +303,23 @@ int runGen(int argc, char** argv) {
     Stopwatch total;
     auto params = resolveParams(a);
     if (!params) return reportBadInput(kCmd, params.status());
+    auto budget = parseMemoryBudgetGb("--memory-budget", a.memoryBudget);
+    if (!budget) return reportBadInput(kCmd, budget.status());
+    a.budgetGb = *budget;
     if (a.paged()) return runPaged(a, *params, total);
     StderrProgress progress(isatty(2));
     GenerateOptions opts;
     opts.progress = a.quiet ? nullptr : &progress;
+    double estimateMb = -1;  // made only under a budget (the estimate meshes a sample of tiles)
+    if (a.budgetGb > 0)
+        opts.beforeMeshing = [&](const City& layout) {
+            const size_t tris = estimateStoredTriangles(layout);
+            estimateMb = estimateGenMb(tris);
+            char how[160];
+            std::snprintf(how, sizeof(how), "about %.2f M stored triangles x %.0f bytes + %.0f MB", double(tris) / 1e6,
+                          kGenBytesPerStoredTriangle, kGenFixedMb);
+            return checkGenBudget("--memory-budget", a.budgetGb, estimateMb, how, false);
+        };
     double osmSeconds = -1;
     if (!a.osmFile.empty()) {
         Stopwatch osmTime;
@@ -327,7 +354,8 @@ int runGen(int argc, char** argv) {
     const double writeSeconds = write.ms() / 1000.0, totalSeconds = total.ms() / 1000.0;
     const CityCounts n = countCity(*city);
     if (!a.statsFile.empty()) {
-        const auto j = statsJson(*city, *params, n, lighting, writeSeconds, totalSeconds);
+        auto j = statsJson(*city, *params, n, lighting, writeSeconds, totalSeconds);
+        if (a.budgetGb > 0) j["memory"] = {{"estimate_mb", estimateMb}, {"budget_gb", a.budgetGb}};
         if (Status s = writeFileAtomic(a.statsFile, j.dump(2) + "\n"); !s) return reportBadInput(kCmd, s);
     }
     if (!a.quiet)

@@ -1,6 +1,7 @@
 // Memory phases, the city-run estimate and the budget check (memory.h).
 #include "cmd/memory.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -52,6 +53,27 @@ Status checkMemoryBudget(const std::string& option, double budgetGb, double esti
                   "+ %.0f MB fixed; docs/performance.md \"Memory\"); give a larger budget or a smaller city",
                   option.c_str(), budgetGb, estimateMb / 1024.0, double(fileBytes) / kMb, kSceneBytesPerFileByte,
                   rayScene ? " + 1.7 for the ray scene" : "", kFixedMb);
+    return Status::error(buf);
+}
+
+double estimateGenMb(size_t storedTriangles) {
+    return kGenFixedMb + kGenBytesPerStoredTriangle * double(storedTriangles) / kMb;
+}
+
+double estimatePagedGenMb(double regionSizeM, int detail) {
+    static const double kDetail[] = {0.3, 0.35, 1.0, 1.8};
+    const double km2 = regionSizeM * regionSizeM / 1e6;
+    return kPagedGenFixedMb + kPagedGenMbPerKm2 * km2 * kDetail[std::clamp(detail, 0, 3)];
+}
+
+Status checkGenBudget(const std::string& option, double budgetGb, double estimateMb, const std::string& how, bool paged) {
+    if (budgetGb <= 0 || estimateMb <= budgetGb * 1024.0) return Status::ok();
+    char buf[640];
+    std::snprintf(buf, sizeof(buf),
+                  "option %s = %g GB: this generation is estimated to peak at %.2f GB (%s; docs/performance.md \"Memory\"); "
+                  "nothing was written. Give a larger budget%s",
+                  option.c_str(), budgetGb, estimateMb / 1024.0, how.c_str(),
+                  paged ? " or a smaller --region-size" : ", a smaller city, or paged output (-o DIR.paged, whose peak follows --region-size)");
     return Status::error(buf);
 }
 

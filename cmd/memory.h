@@ -32,4 +32,20 @@ double estimateCityRunMb(uint64_t fileBytes, bool rayScene);
 // gives the estimate, what it is made of and the budget.
 Status checkMemoryBudget(const std::string& option, double budgetGb, double estimateMb, uint64_t fileBytes, bool rayScene);
 
+// `vista gen` to one file: peak about kGenBytesPerStoredTriangle per stored
+// triangle (measured 152 to 177 on the 0.5 to 8 km cities of
+// docs/performance.md) + kGenFixedMb; the triangles come from
+// estimateStoredTriangles() on the laid-out city, before its meshes are made.
+constexpr double kGenBytesPerStoredTriangle = 180.0, kGenFixedMb = 100.0;
+double estimateGenMb(size_t storedTriangles);
+// `vista gen -o DIR.paged`: one region at a time, so the peak follows the
+// region, not the city (measured 401 to 431 MB for 2 km regions of 4 to 64 km
+// cities at detail 2): kPagedGenFixedMb + kPagedGenMbPerKm2 per km² of region,
+// scaled by the facade detail (0.3, 0.35, 1, 1.8 for detail 0..3).
+constexpr double kPagedGenFixedMb = 150.0, kPagedGenMbPerKm2 = 70.0;
+double estimatePagedGenMb(double regionSizeM, int detail);
+// The gen budget check: Ok without a budget or when the estimate fits; else
+// an error naming the option, the budget, the estimate and what it is made of (`how`).
+Status checkGenBudget(const std::string& option, double budgetGb, double estimateMb, const std::string& how, bool paged);
+
 }  // namespace vista

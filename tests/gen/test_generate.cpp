@@ -159,3 +159,35 @@ TEST(Generate, CountsAddUp) {
     ASSERT_FALSE(r->trees.empty());
     EXPECT_LT(n.storedTriangles, n.triangles) << "instancing stores fewer triangles than are drawn";
 }
+
+TEST(Generate, StoredTriangleEstimateFromTheLayout) {
+    // The estimate meshes a sample of the laid-out city's tiles before the meshes stage
+    // (beforeMeshing); compared with the counted triangles of the finished city.
+    for (double size : {500.0, 2000.0}) {
+        CityParams p = small(11, size);
+        p.detail = 1;
+        size_t estimate = 0;
+        GenerateOptions o;
+        o.beforeMeshing = [&](const City& layout) {
+            EXPECT_TRUE(layout.tiles.empty());
+            EXPECT_FALSE(layout.buildings.empty());
+            estimate = estimateStoredTriangles(layout);
+            return Status::ok();
+        };
+        auto c = generateCity(p, o);
+        ASSERT_TRUE(c.isOk()) << c.status().message();
+        const size_t counted = countCity(*c).storedTriangles;
+        ASSERT_GT(counted, 0u);
+        if (size == 500.0) {
+            EXPECT_EQ(estimate, counted);  // a small city: every tile sampled, exact
+        } else {
+            EXPECT_NEAR(double(estimate) / double(counted), 1.0, 0.35) << estimate << " vs " << counted;
+        }
+    }
+    // An error from the hook stops generation before the meshes and is returned.
+    GenerateOptions stop;
+    stop.beforeMeshing = [](const City&) { return Status::error("budget says no"); };
+    auto c = generateCity(small(3), stop);
+    ASSERT_FALSE(c.isOk());
+    EXPECT_EQ(c.status().message(), "budget says no");
+}
