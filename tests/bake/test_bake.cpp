@@ -21,6 +21,7 @@
 #include <osgDB/Registry>
 #include <tbb/global_control.h>
 
+#include "citygen/generate.h"
 #include "citygen/polygon.h"
 #include "bake/appearance.h"
 #include "bake/assembly.h"
@@ -41,6 +42,7 @@
 #include "runtime/scene/city_file.h"
 #include "runtime/scene/scene_file.h"
 #include "nodes/render/mode_impostor.h"
+#include "nodes/render/mode_full.h"
 #include "nodes/render/mode_lodmesh.h"
 #include "runtime/engine/image.h"
 #include "runtime/engine/metrics.h"
@@ -1334,6 +1336,103 @@ TEST(LodMesh, NoSkinAcrossADepthDiscontinuityAndTheBudgetHolds) {
             EXPECT_FALSE(lo < 170 && hi > 280) << "triangle " << t << " spans " << lo << " .. " << hi << " (budget " << budget << ")";
         }
     }
+}
+
+// Issue 11, item 1: the baked modes draw the near field in the 40 m chunks of
+// `full`/`hybrid` (view_cell_switch.h). On a small generated city, from inside
+// a baked cell looking down its street: the baked modes draw no more
+// triangles than `full` (a subset of its chunks, plus the few mesh triangles
+// or points), fewer than the whole 250 m tiles they drew before, and the
+// picture stays within a stated PSNR of `full`.
+TEST(BakedChunks, BakedModesDrawNoMoreTrianglesThanFullAndMatchIt) {
+    const char* display = std::getenv("DISPLAY");
+    if (!display || !*display) GTEST_SKIP() << "no X display (run under xvfb-run -a)";
+    const int W = 160, H = 120;
+    auto renderer = OffscreenRenderer::create(W, H);
+    ASSERT_TRUE(renderer.isOk()) << "DISPLAY is set but the renderer failed: " << renderer.status().message();
+    CityParams cp;
+    cp.size_m = 700;
+    cp.tile_size_m = 100;  // small tiles: far fields fit in a small city
+    cp.seed = 3;
+    auto gen = generateCity(cp);
+    ASSERT_TRUE(gen.isOk()) << gen.status().message();
+    TempDir dir;
+    ASSERT_TRUE(writeCityFile(*gen, dir.file("city.osgb")).isOk());
+    auto city = loadCityFile(dir.file("city.osgb"));
+    ASSERT_TRUE(city.isOk()) << city.status().message();
+    const BakeParams p = meshParams();
+    BakeInput in = prepareBake(*city, p);
+    ASSERT_FALSE(in.cells.empty());
+    // The longest cells first: the first with a mesh at both ends.
+    std::vector<size_t> order(in.cells.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](size_t a, size_t b) { return in.cells[a].box.halfLength > in.cells[b].box.halfLength; });
+    CellResult cr;
+    for (size_t k = 0; k < order.size() && k < 12; ++k) {
+        cr = bakeCell(in, in.cells[order[k]], p);
+        if (cr.meshes.size() == 2) break;
+    }
+    ASSERT_FALSE(cr.meshes.empty()) << "no cell of the test city has a far field";
+    const ViewCell& cell = in.cells[cr.cell];
+    auto root = assembleBakedScene(*city, in.cells, {cr}, p.canonical(), p.representation);
+    ModeContext ctx;
+    ctx.scene = root.get();
+    ctx.renderer = renderer->get();
+    auto lod = makeLodMeshMode(ctx);
+    auto full = makeFullMode(ctx);
+    ASSERT_TRUE(lod.isOk() && full.isOk());
+    ASSERT_TRUE(root->hasNearChunks());
+    EXPECT_EQ(root->nearChunkDistance(), kDefaultNearDistance) << "the near distance of hybrid";
+    const ViewCellBox& b = cell.box;
+    int views = 0;
+    double worstPsnr = 1e9;
+    for (int dir01 = 0; dir01 < 2; ++dir01) {
+        const double sgn = dir01 ? -1.0 : 1.0;
+        Camera cam;
+        cam.eye = b.center + glm::dvec3(-sgn * b.axis.x * b.halfLength * 0.5, -sgn * b.axis.y * b.halfLength * 0.5, 0.0);
+        cam.eye.z = cell.groundMax + 1.7;
+        if (!b.contains(cam.eye)) cam.eye.z = b.center.z;
+        cam.heading = std::atan2(sgn * b.axis.x, sgn * b.axis.y);
+        cam.fovY = 60 * kPi / 180;
+        cam.width = W;
+        cam.height = H;
+        Image baked, ref, whole;
+        FrameStats sb, sf, sw;
+        ASSERT_TRUE((*lod)->renderFrame(cam, baked, sb).isOk());
+        ASSERT_EQ(root->lastCell(), int(cr.cell));
+        ASSERT_TRUE((*full)->renderFrame(cam, ref, sf).isOk());
+        // The same frame with the whole tiles (as before the chunking).
+        root->setNearChunks(NearFieldScene(), 0.0);
+        ASSERT_TRUE((*renderer)->render(root.get(), cam, 0.0, &whole, nullptr, sw).isOk());
+        root->setNearChunks(ctx.nearField(), kDefaultNearDistance);
+        const double psnr = lumaPsnr(baked, ref);
+        std::printf("cell %u view %d: triangles lodmesh %llu, full %llu, whole tiles %llu; lodmesh vs full %.1f dB\n", cr.cell,
+                    dir01, (unsigned long long)sb.triangles, (unsigned long long)sf.triangles, (unsigned long long)sw.triangles, psnr);
+        EXPECT_GT(sf.triangles, 0u);
+        EXPECT_LE(sb.triangles, sf.triangles) << "the baked mode draws more than full";
+        EXPECT_LT(sb.triangles, sw.triangles) << "chunking saved nothing over the whole tiles";
+        EXPECT_GT(psnr, 30.0) << "the baked frame does not match full";
+        worstPsnr = std::min(worstPsnr, psnr);
+        ++views;
+    }
+    EXPECT_EQ(views, 2);
+    // Outside every cell the chunked baked root is exactly full's frame.
+    root->setForcedCell(-1);
+    Camera out;
+    out.eye = b.center + glm::dvec3(0, 0, 40.0);
+    out.heading = 0.3;
+    out.pitch = -0.3;
+    out.fovY = 60 * kPi / 180;
+    out.width = W;
+    out.height = H;
+    Image a, c;
+    FrameStats s1, s2;
+    ASSERT_TRUE((*lod)->renderFrame(out, a, s1).isOk());
+    ASSERT_TRUE((*full)->renderFrame(out, c, s2).isOk());
+    EXPECT_EQ(s1.triangles, s2.triangles);
+    EXPECT_EQ(lumaPsnr(a, c), kPsnrCapDb) << "without a cell the chunked baked root is full";
+    root->setForcedCell(-2);
 }
 
 // The lodmesh mode through OpenGL (run under xvfb-run -a): in the cell it draws
