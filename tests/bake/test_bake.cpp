@@ -32,6 +32,7 @@
 #include "bake/impostor_frame.h"
 #include "bake/driver.h"
 #include "bake/ldi_sampling.h"
+#include "bake/placement.h"
 #include "bake/point_removal.h"
 #include "bake/sampling_plane.h"
 #include "bake/view_cells.h"
@@ -997,6 +998,80 @@ TEST(ImpostorMode, DrawsImpostorsInTheCellAndResemblesTheGeometry) {
     EXPECT_NE(bad.status().message().find("--baked"), std::string::npos);
 }
 
+// Issue 11, item 2: from-region visibility of the baked points through the
+// whole city, and the cost estimate that decides where an impostor goes.
+TEST(Placement, PointsBehindAnOccluderAreDroppedAndTheCostRuleHolds) {
+    TempDir dir;
+    ASSERT_TRUE(writeCityFile(makeBakeCity(), dir.file("city.osgb")).isOk());
+    auto city = loadCityFile(dir.file("city.osgb"));
+    ASSERT_TRUE(city.isOk());
+    BakeParams p = smallParams();
+    p.placement.byCost = true;
+    BakeInput in = prepareBake(*city, p);
+    ASSERT_TRUE(in.cityRays) << "placement by cost builds the city's ray scene";
+    const ViewCell& cell = in.cells[0];
+    const FarSet fs = selectFarSet(*city, in.tiles, cell, 1, p.far);  // end 1: towards x = 100, far tile at x = 300
+    ASSERT_FALSE(fs.tiles.empty());
+    ASSERT_GT(fs.soup.triangleCount(), 0u);
+    // The far tile's first wall spans world x 285..315, y -30..-22, 12 m high.
+    const glm::vec3 front(fs.frame.toLocal(glm::dvec3(284.9, -26, 5)));  // on its face towards the cell
+    const glm::vec3 behind(fs.frame.toLocal(glm::dvec3(316.5, -26, 5)));  // behind it, seen from nowhere in the cell
+    const glm::vec3 above(fs.frame.toLocal(glm::dvec3(300, -26, 12.05)));  // on its roof: seen over it from eye height? no
+    const std::vector<uint8_t> vis = visibleFromCell(*in.cityRays, cell, fs.frame, {front, behind, above}, p.placement);
+    ASSERT_EQ(vis.size(), 3u);
+    EXPECT_EQ(vis[0], 1) << "a point on the face towards the cell is visible";
+    EXPECT_EQ(vis[1], 0) << "a point behind the wall is occluded from every viewpoint";
+    EXPECT_EQ(vis[2], 0) << "a roof 12 m up is not seen from eye height";
+    // The estimate: rays reach the far walls; saved/cost follow the stated formula.
+    PlacementEstimate e = estimatePlacement(*in.cityRays, in.tileLookup, cell, fs, p.sampling, p.placement);
+    EXPECT_GT(e.rays, 0);
+    EXPECT_GT(e.farHits, 0) << "the far walls are in plain view down the street";
+    EXPECT_GT(e.farPixels, 0.0);
+    EXPECT_LE(e.farPixels, e.maxFarPixels);
+    EXPECT_NEAR(e.savedMs, double(fs.soup.triangleCount()) * p.placement.triangleNs * 1e-6, 1e-9);
+    EXPECT_NEAR(e.costMs, p.placement.pointsPerFarPixel * e.farPixels * p.placement.pointNs * 1e-6, 1e-9);
+    EXPECT_EQ(e.place, e.savedMs > e.costMs);
+    // A few walls (120 triangles) seen over hundreds of pixels: points cost more than the triangles.
+    EXPECT_FALSE(e.place) << e.describe();
+    PlacementParams cheapPoints = p.placement;
+    cheapPoints.pointNs = 1e-6;
+    EXPECT_TRUE(estimatePlacement(*in.cityRays, in.tileLookup, cell, fs, p.sampling, cheapPoints).place);
+    // The whole cell: the ends are not placed, each with a note saying why.
+    CellResult cr = bakeCell(in, cell, p);
+    EXPECT_TRUE(cr.impostors.empty());
+    size_t notPlaced = 0;
+    for (const auto& n : cr.notes) notPlaced += n.find("not placed: saves") != std::string::npos;
+    EXPECT_EQ(notPlaced, 2u);
+    // With cheap points both ends are placed; a wall just beyond end 1 (world
+    // x 102..108, y -40..8, 40 m high) hides the far tile's walls at y < 0
+    // from the whole cell: their points are dropped, the open part stays.
+    City occ = makeBakeCity();
+    occ.tiles[0].meshes[size_t(Material::Wall)] = boxMesh({52, -40, 0}, {58, 8, 40}, {90, 90, 90, 255}, {100, 100, 100, 255});
+    ASSERT_TRUE(writeCityFile(occ, dir.file("occ.osgb")).isOk());
+    auto occCity = loadCityFile(dir.file("occ.osgb"));
+    ASSERT_TRUE(occCity.isOk());
+    p.placement = cheapPoints;
+    BakeParams all = smallParams();
+    BakeInput occIn = prepareBake(*occCity, p);
+    CellResult placed = bakeCell(occIn, occIn.cells[0], p), every = bakeCell(occIn, occIn.cells[0], all);
+    ASSERT_EQ(placed.impostors.size(), 2u);
+    ASSERT_EQ(every.impostors.size(), 2u);
+    for (size_t k = 0; k < 2; ++k) {
+        const ImpostorResult &a = placed.impostors[k], &b = every.impostors[k];
+        EXPECT_EQ(a.hiddenTiles, b.hiddenTiles);
+        EXPECT_GT(a.stats.points, 0u);
+        if (a.end == 1) {
+            EXPECT_LT(double(a.stats.points), 0.8 * double(b.stats.points)) << "the occluded points were kept";
+            size_t behindWall = 0;
+            for (const auto& q : a.data.positions) behindWall += a.frame.toWorld(glm::dvec3(q)).y < -3.0;
+            EXPECT_EQ(behindWall, 0u) << "points hidden by the wall from the whole cell survived";
+        } else {
+            EXPECT_EQ(a.stats.points, b.stats.points) << "nothing occludes end 0's far field";
+        }
+    }
+    EXPECT_NE(p.canonical(), all.canonical()) << "placement changes the config hash";
+}
+
 int run(const std::string& args) {
     const std::string cmd = std::string(VISTA_BINARY) + " bake " + args + " > /dev/null 2>&1";
     const int rc = std::system(cmd.c_str());
@@ -1006,7 +1081,7 @@ int run(const std::string& args) {
 TEST(BakeCli, ResumeShardsAndJobsGiveIdenticalBytes) {
     TempDir dir;
     ASSERT_TRUE(writeCityFile(makeBakeCity(), dir.file("city.osgb")).isOk());
-    const std::string common = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q ";
+    const std::string common = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q  --placement all ";
     ASSERT_EQ(run(common + "-o " + dir.file("a.osgb") + " --jobs 2"), 0);
     const std::string ref = readBytes(dir.file("a.osgb"));
     ASSERT_GT(ref.size(), 1000u);
@@ -1136,13 +1211,53 @@ TEST(BakeDriver, ResumeAfterInterruptionGivesTheBytesOfOneRun) {
     EXPECT_NE(noInput.status().message().find("missing.osgb"), std::string::npos);
 }
 
+// Placement by cost (the default of `vista bake`) stays byte-identical across
+// thread counts, shards + merge and a resume with a damaged cell result; bad
+// placement values are refused with exit 2.
+TEST(BakeCli, PlacementByCostIsDeterministicAcrossJobsShardsAndResume) {
+    TempDir dir;
+    City occ = makeBakeCity();
+    occ.tiles[0].meshes[size_t(Material::Wall)] = boxMesh({52, -40, 0}, {58, 8, 40}, {90, 90, 90, 255}, {100, 100, 100, 255});
+    ASSERT_TRUE(writeCityFile(occ, dir.file("city.osgb")).isOk());
+    // Cheap points: both ends are placed (and culled by the from-region visibility).
+    const std::string common = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q --point-ns 0.000001 ";
+    ASSERT_EQ(run(common + "-o " + dir.file("a.osgb") + " --jobs 2 --stats " + dir.file("a.json")), 0);
+    const std::string ref = readBytes(dir.file("a.osgb"));
+    ASSERT_GT(ref.size(), 1000u);
+    const std::string stats = readBytes(dir.file("a.json"));
+    EXPECT_NE(stats.find("place=cost"), std::string::npos) << "the default placement is by cost";
+    EXPECT_NE(stats.find("end 1: placed: saves"), std::string::npos) << stats.substr(0, 400);
+    ASSERT_EQ(run(common + "-o " + dir.file("b.osgb") + " --jobs 1"), 0);
+    EXPECT_EQ(readBytes(dir.file("b.osgb")), ref);
+    ASSERT_EQ(run(common + "-o " + dir.file("c.osgb") + " --shard 1/2"), 0);
+    ASSERT_EQ(run(common + "-o " + dir.file("c.osgb") + " --shard 2/2"), 0);
+    ASSERT_EQ(run(common + "-o " + dir.file("c.osgb") + " --merge --keep-work"), 0);
+    EXPECT_EQ(readBytes(dir.file("c.osgb")), ref);
+    std::remove(dir.file("c.osgb").c_str());
+    {
+        const std::string part = readBytes(dir.file("c.osgb.work/cell_0.vbc"));
+        ASSERT_FALSE(part.empty());
+        std::ofstream o(dir.file("c.osgb.work/cell_0.vbc"), std::ios::binary | std::ios::trunc);
+        o << part.substr(0, part.size() / 2);
+    }
+    ASSERT_EQ(run(common + "-o " + dir.file("c.osgb")), 0);
+    EXPECT_EQ(readBytes(dir.file("c.osgb")), ref) << "a damaged cell result was trusted";
+    // The default (real) costs: a few walls are cheaper as triangles, nothing is placed.
+    ASSERT_EQ(run(dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q -o " + dir.file("d.osgb") + " --stats " +
+                  dir.file("d.json")),
+              0);
+    EXPECT_NE(readBytes(dir.file("d.json")).find("not placed: saves"), std::string::npos);
+    EXPECT_EQ(run(common + "-o " + dir.file("e.osgb") + " --placement some"), 2);
+    EXPECT_EQ(run(common + "-o " + dir.file("e.osgb") + " --triangle-ns 0"), 2);
+}
+
 // `vista view` opens a baked file and offers the impostor mode (needs a display).
 TEST(BakeCli, ViewOpensTheBakedFileInImpostorMode) {
     const char* display = std::getenv("DISPLAY");
     if (!display || !*display) GTEST_SKIP() << "no X display (run under xvfb-run -a)";
     TempDir dir;
     ASSERT_TRUE(writeCityFile(makeBakeCity(), dir.file("city.osgb")).isOk());
-    ASSERT_EQ(run(dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q -o " + dir.file("a.osgb")), 0);
+    ASSERT_EQ(run(dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q  --placement all -o " + dir.file("a.osgb")), 0);
     auto view = [&](const std::string& args) {
         const std::string cmd = std::string(VISTA_BINARY) + " view " + args + " > /dev/null 2>&1";
         const int rc = std::system(cmd.c_str());
@@ -1501,7 +1616,7 @@ TEST(LodMeshMode, DrawsTheCellMeshesAndResemblesTheGeometry) {
 TEST(LodMeshCli, ResumeShardsCorruptCellAndBadValues) {
     TempDir dir;
     ASSERT_TRUE(writeCityFile(makeBakeCity(), dir.file("city.osgb")).isOk());
-    const std::string common = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q --representation mesh --mesh-image 256 ";
+    const std::string common = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q  --placement all --representation mesh --mesh-image 256 ";
     ASSERT_EQ(run(common + "-o " + dir.file("a.osgb") + " --jobs 2 --stats " + dir.file("a.json")), 0);
     const std::string ref = readBytes(dir.file("a.osgb"));
     ASSERT_GT(ref.size(), 1000u);
@@ -1540,7 +1655,7 @@ TEST(LodMeshCli, ResumeShardsCorruptCellAndBadValues) {
     EXPECT_EQ(readBytes(dir.file("d.osgb")), ref);
     // The representation is in the config hash: point results in the same work
     // directory are not reused for a mesh bake (and the other way round).
-    const std::string points = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q ";
+    const std::string points = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q  --placement all ";
     ASSERT_EQ(run(points + "-o " + dir.file("p.osgb") + " --keep-work --work " + dir.file("w")), 0);
     ASSERT_EQ(run(common + "-o " + dir.file("m.osgb") + " --work " + dir.file("w")), 0);
     EXPECT_EQ(readBytes(dir.file("m.osgb")), ref);
@@ -1560,7 +1675,7 @@ TEST(LodMeshCli, BenchAndViewRunTheLodMeshMode) {
     if (!display || !*display) GTEST_SKIP() << "no X display (run under xvfb-run -a)";
     TempDir dir;
     ASSERT_TRUE(writeCityFile(makeBakeCity(), dir.file("city.osgb")).isOk());
-    const std::string common = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q ";
+    const std::string common = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q  --placement all ";
     ASSERT_EQ(run(common + "-o " + dir.file("m.osgb") + " --representation mesh --mesh-image 256"), 0);
     ASSERT_EQ(run(common + "-o " + dir.file("p.osgb")), 0);
     auto tool = [&](const std::string& args) {
@@ -1593,7 +1708,7 @@ TEST(BakeCli, BakedFileOfAnotherCityOrTruncatedIsRefusedWithExit2) {
     other.tiles[1].meshes[size_t(Material::Wall)].positions[0].z += 1.0f;  // one vertex moved: another city
     ASSERT_TRUE(writeCityFile(makeBakeCity(), dir.file("city.osgb")).isOk());
     ASSERT_TRUE(writeCityFile(other, dir.file("other.osgb")).isOk());
-    const std::string common = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q ";
+    const std::string common = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q  --placement all ";
     ASSERT_EQ(run(common + "-o " + dir.file("p.osgb")), 0);
     ASSERT_EQ(run(common + "-o " + dir.file("m.osgb") + " --representation mesh --mesh-image 256"), 0);
 
@@ -1642,7 +1757,7 @@ TEST(BakeCli, BakedFileOfAnotherCityOrTruncatedIsRefusedWithExit2) {
     EXPECT_EQ(tool("view " + dir.file("other.osgb") + " --baked-mesh " + dir.file("m.osgb") + " --mode lodmesh --frames 1"), 2);
     // A baked city file opened as the city stands for its source city: a mesh bake of `city` with a point bake of `city` pairs,
     // with a point bake of `other` it does not.
-    ASSERT_EQ(run(dir.file("other.osgb") + " --out-size 120 --min-triangles 1 -q -o " + dir.file("po.osgb")), 0);
+    ASSERT_EQ(run(dir.file("other.osgb") + " --out-size 120 --min-triangles 1 -q  --placement all -o " + dir.file("po.osgb")), 0);
     EXPECT_EQ(tool("bench " + dir.file("m.osgb") + " --baked " + dir.file("po.osgb") + " --modes impostor" + bench), 2);
     EXPECT_NE(readBytes(dir.file("log.txt")).find("baked from another city"), std::string::npos);
 

@@ -41,7 +41,7 @@ size_t countCells(const std::string& workDir) {
 }
 
 // A small, quick bake of a 300 m city (36 cells, 8 impostors, about 1 s on one core).
-const char* const kParams = " --out-size 80 --min-triangles 1";
+const char* const kParams = " --out-size 80 --min-triangles 1 --placement all";
 
 std::string makeCity(const test::TempDir& dir) {
     const std::string city = dir.file("city.osgb");
