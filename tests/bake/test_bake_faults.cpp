@@ -97,7 +97,8 @@ TEST(BakeFaults, KillNineLeavesTheOldOutputOrTheWholeNewOneAndTheNextRunResumes)
     for (const KillPoint& k : points) {
         const size_t before = countCells(work);
         const auto start = std::chrono::steady_clock::now();
-        const pid_t pid = test::startVista({"bake", city, "--out-size", "80", "--min-triangles", "1", "-q", "--jobs", "2", "-o", out});
+        const pid_t pid = test::startVista(
+            {"bake", city, "--out-size", "80", "--min-triangles", "1", "--placement", "all", "-q", "--jobs", "2", "-o", out});
         ASSERT_GT(pid, 0);
         int st = 0;
         bool exited = false;
