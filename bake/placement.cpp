@@ -149,16 +149,16 @@ std::vector<uint8_t> visibleFromCell(const RayScene& cityRays, const ViewCell& c
             const size_t count = size_t(n);
             std::vector<glm::vec3> org(count, v), dir(count);
             std::vector<float> tfar(count);
-            std::vector<RayHit> hits(count);
+            std::vector<uint8_t> blocked(count);
             for (int k = 0; k < n; ++k) {
                 const glm::dvec3 d = glm::dvec3(local[todo[r.begin() + size_t(k)]]) - vd;
                 const double len = glm::length(d);
                 dir[size_t(k)] = len > 1e-6 ? glm::vec3(d / len) : glm::vec3(0, 0, 1);
                 tfar[size_t(k)] = float(len * (1.0 - 2e-3) - 0.1);  // < 0 for a point next to the viewpoint: a miss
             }
-            cityRays.intersectMany(org.data(), dir.data(), n, hits.data(), 1e30f, tfar.data(), 0.0f);
+            cityRays.occludedMany(org.data(), dir.data(), n, tfar.data(), blocked.data(), 0.0f);
             for (int k = 0; k < n; ++k)
-                if (!hits[size_t(k)].hit) vis[todo[r.begin() + size_t(k)]] = 1;
+                if (!blocked[size_t(k)]) vis[todo[r.begin() + size_t(k)]] = 1;
         });
         std::vector<uint32_t> next;
         for (uint32_t i : todo)

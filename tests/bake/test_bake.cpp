@@ -1022,6 +1022,30 @@ TEST(Placement, PointsBehindAnOccluderAreDroppedAndTheCostRuleHolds) {
     EXPECT_EQ(vis[0], 1) << "a point on the face towards the cell is visible";
     EXPECT_EQ(vis[1], 0) << "a point behind the wall is occluded from every viewpoint";
     EXPECT_EQ(vis[2], 0) << "a roof 12 m up is not seen from eye height";
+    // The packet occlusion test agrees with the single-ray one (rays from the
+    // cell centre to points on a grid through the far tile, some behind walls,
+    // some in the open, one with an empty interval).
+    {
+        const glm::vec3 o(glm::dvec3(cell.box.center) - in.cityRays->frameOrigin());
+        std::vector<glm::vec3> org, dirs;
+        std::vector<float> tfars;
+        for (int i = 0; i < 21; ++i) {
+            const glm::vec3 q(glm::dvec3(270 + 3 * i, -35 + 3.3 * i, 4) - in.cityRays->frameOrigin());
+            org.push_back(o);
+            dirs.push_back(glm::normalize(q - o));
+            tfars.push_back(i == 20 ? -1.0f : glm::length(q - o));
+        }
+        std::vector<uint8_t> many(org.size(), 7);
+        in.cityRays->occludedMany(org.data(), dirs.data(), int(org.size()), tfars.data(), many.data());
+        size_t blocked = 0;
+        for (size_t i = 0; i < org.size(); ++i) {
+            EXPECT_EQ(many[i] != 0, in.cityRays->occluded(org[i], dirs[i], 0.0f, tfars[i])) << "ray " << i;
+            blocked += many[i];
+        }
+        EXPECT_GT(blocked, 0u);
+        EXPECT_LT(blocked, org.size());
+        EXPECT_EQ(many.back(), 0) << "an empty interval is not occluded";
+    }
     // The estimate: rays reach the far walls; saved/cost follow the stated formula.
     PlacementEstimate e = estimatePlacement(*in.cityRays, in.tileLookup, cell, fs, p.sampling, p.placement);
     EXPECT_GT(e.rays, 0);
