@@ -18,6 +18,11 @@ BakeInput prepareBake(const SceneModel& city, const BakeParams& p) {
     const CityParams cp = city.params;
     auto ground = [&cp](const glm::dvec2& q) { return terrainHeight(cp, q); };
     in.cells = makeViewCells(city.streets, glm::dvec2(cp.origin_x, cp.origin_y), ground, p.cells, &in.skipped);
+    if (p.representation == BakeRepresentation::Points && p.placement.byCost) {
+        auto rays = RayScene::build(city);
+        if (rays) in.cityRays = std::shared_ptr<const RayScene>(std::move(*rays));
+        in.tileLookup = TileLookup::build(city, in.tiles);
+    }
     return in;
 }
 
@@ -47,7 +52,8 @@ void screenStats(const PointImpostorData& d, const Box3& cell, const SamplingSet
 
 }  // namespace
 
-Status bakeImpostor(const TriangleSoup& soup, const Box3& cellBox, const BakeParams& p, uint64_t entity, ImpostorResult& r) {
+Status bakeImpostor(const TriangleSoup& soup, const Box3& cellBox, const BakeParams& p, uint64_t entity, ImpostorResult& r,
+                    const std::function<std::vector<uint8_t>(const std::vector<glm::vec3>&)>& keepVisible) {
     Box3 far{glm::dvec3(1e300), glm::dvec3(-1e300)};
     for (uint32_t idx : soup.indices) {
         far.lo = glm::min(far.lo, glm::dvec3(soup.positions[idx]));
@@ -67,6 +73,15 @@ Status bakeImpostor(const TriangleSoup& soup, const Box3& cellBox, const BakePar
     r.stats.ldiRays = ldi.rays;
     r.stats.ldiSamples = ldi.samples.size();
     r.stats.afterRemoval = pts.size();
+    size_t occludedDropped = 0;
+    if (keepVisible) {
+        const std::vector<uint8_t> vis = keepVisible(pts);
+        std::vector<glm::vec3> kept;
+        for (size_t i = 0; i < pts.size(); ++i)
+            if (i < vis.size() && vis[i]) kept.push_back(pts[i]);
+        occludedDropped = pts.size() - kept.size();
+        pts.swap(kept);
+    }
     r.stats.requiredStep = ldi.requiredStep;
     r.stats.usedStep = std::max({ldi.cams[0].step, ldi.cams[1].step, ldi.cams[2].step});
     for (int k = 0; k < 3; ++k) {
@@ -89,7 +104,7 @@ Status bakeImpostor(const TriangleSoup& soup, const Box3& cellBox, const BakePar
     r.stats.mcSamples = as.samples;
     r.stats.points = r.data.positions.size();
     r.stats.textured = size_t(std::count_if(r.data.block.begin(), r.data.block.end(), [](int32_t b) { return b >= 0; }));
-    r.stats.dropped = as.dropped;
+    r.stats.dropped = as.dropped + occludedDropped;
     r.stats.noiseSingle = as.noiseOnly;
     screenStats(r.data, cellBox, s, p.sampling, r.stats);
     return Status::ok();
@@ -172,9 +187,22 @@ CellResult bakeCell(const BakeInput& in, const ViewCell& cell, const BakeParams&
             out.meshes.push_back(std::move(r));
         });
     return forEachEnd(in, cell, p, [&](FarSet& fs, int end, const std::string& what, const Stopwatch& endTime, CellResult& out) {
+        if (p.placement.byCost) {
+            if (!in.cityRays) {
+                out.notes.push_back(what + "placement by cost: no city ray scene, placed");
+            } else {
+                const PlacementEstimate est = estimatePlacement(*in.cityRays, in.tileLookup, cell, fs, p.sampling, p.placement);
+                out.notes.push_back(what + (est.place ? "placed: " : "not placed: ") + est.describe());
+                if (!est.place) return;
+            }
+        }
         ImpostorResult r;
+        const ImpostorFrame frame = fs.frame;
         startResult(r, cell, end, fs);
-        if (Status st = bakeImpostor(fs.soup, cellInFrame(cell, r.frame), p, hashKeys(cell.id, uint64_t(end)), r); !st) {
+        std::function<std::vector<uint8_t>(const std::vector<glm::vec3>&)> keep;
+        if (p.placement.byCost && in.cityRays)
+            keep = [&](const std::vector<glm::vec3>& pts) { return visibleFromCell(*in.cityRays, cell, frame, pts, p.placement); };
+        if (Status st = bakeImpostor(fs.soup, cellInFrame(cell, r.frame), p, hashKeys(cell.id, uint64_t(end)), r, keep); !st) {
             out.notes.push_back(what + st.message());
             return;
         }

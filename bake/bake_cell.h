@@ -11,6 +11,8 @@
 // Thread-safe on a const BakeInput; runs its own loops in parallel (TBB).
 #pragma once
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <vector>
 
 #include "bake/bake_params.h"
@@ -22,6 +24,11 @@ namespace vista {
 struct BakeInput {
     const SceneModel* city = nullptr;
     std::vector<SceneTile> tiles;      // bakeTiles(city)
+    // Placement by cost (points, p.placement.byCost): the whole city's ray
+    // scene and the hit -> tile lookup; null when not asked for or when the
+    // scene could not be built (then every end is baked, with a note).
+    std::shared_ptr<const RayScene> cityRays;
+    TileLookup tileLookup;
     std::vector<ViewCell> cells;       // one per street edge that is not degenerate
     std::vector<SkippedCell> skipped;  // the degenerate edges
 };
@@ -39,6 +46,9 @@ Status bakeMeshEnd(const TriangleSoup& soup, const Box3& cellBox, const BakePara
 // Steps 1-6 for one far field (soup and cell box in the impostor frame):
 // fills r.data and r.stats (not the frame, tiles or ids). `entity` keys the
 // random streams. Error only for an ill-defined set-up or a bad soup.
-Status bakeImpostor(const TriangleSoup& soup, const Box3& cellBox, const BakeParams& p, uint64_t entity, ImpostorResult& r);
+// `keepVisible` (optional): marks the points (after removal, before the
+// appearance step) to keep; the others count as dropped invisible points.
+Status bakeImpostor(const TriangleSoup& soup, const Box3& cellBox, const BakeParams& p, uint64_t entity, ImpostorResult& r,
+                    const std::function<std::vector<uint8_t>(const std::vector<glm::vec3>&)>& keepVisible = {});
 
 }  // namespace vista

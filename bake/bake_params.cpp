@@ -15,6 +15,10 @@ std::string BakeParams::canonical() const {
       << appearance.varianceThreshold << "," << appearance.singleColorThreshold << "," << appearance.viewSigma << ","
       << appearance.pixelSigma << "," << appearance.significance << ";margin=" << far.margin << ";depth=" << far.farDepth
       << ";opening=" << far.openingExtra << ";minTri=" << far.minTriangles << ";seed=" << seed;
+    if (representation == BakeRepresentation::Points && placement.byCost)
+        o << ";place=cost," << placement.triangleNs << "," << placement.pointNs << "," << placement.pointsPerFarPixel << ","
+          << placement.samplesAlong << "x" << placement.samplesAcross << "," << placement.rayStepPx << "," << placement.maxRaysPerSample
+          << ";vis=" << placement.visAlong << "x" << placement.visAcross << "x" << placement.visHeights;
     if (representation == BakeRepresentation::Mesh)
         o << ";repr=mesh;meshTri=" << mesh.maxTriangles << ";meshImg=" << mesh.imageSize << ";meshErr=" << mesh.errorPx;
     return o.str();

@@ -14,6 +14,7 @@
 #include "bake/depth_mesh.h"
 #include "bake/far_set.h"
 #include "bake/ldi_sampling.h"
+#include "bake/placement.h"
 #include "bake/view_cells.h"
 
 namespace vista {
@@ -32,6 +33,7 @@ struct BakeParams {
     AppearanceParams appearance;
     BakeRepresentation representation = BakeRepresentation::Points;
     DepthMeshParams mesh;  // representation Mesh only
+    PlacementParams placement;  // representation Points only (bake/placement.h); off by default here, on in `vista bake`
     uint64_t seed = 1;  // the city's seed (set from the city file by the driver)
     std::string canonical() const;
 };

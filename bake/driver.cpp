@@ -226,6 +226,7 @@ nlohmann::json tallyResults(const std::vector<CellResult>& results, BakeReport& 
     nlohmann::json js = nlohmann::json::array();
     for (const auto& r : results) {
         cellMs += r.bakeMs;
+        for (const auto& n : r.notes) rep.notes.push_back("cell " + std::to_string(r.cell) + ": " + n);
         for (const auto& im : r.impostors) {
             ++rep.impostors;
             rep.points += im.stats.points;
@@ -257,6 +258,7 @@ Status writeStatsFile(const BakeJob& job, const BakeReport& rep, size_t cells, c
     top["output_bytes"] = rep.outputBytes;
     top["params"] = canon;
     top["impostor_stats"] = std::move(impostorStats);
+    top["notes"] = rep.notes;
     return writeFileAtomic(job.statsFile, top.dump(1));
 }
 

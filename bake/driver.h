@@ -60,6 +60,7 @@ struct BakeReport {
     uint64_t outputBytes = 0;
     double wallS = 0;                  // this call
     double cellBakeS = 0;              // sum of the assembled cells' bake times
+    std::vector<std::string> notes;    // the assembled cells' notes, "cell C: end E: ..." (--stats "notes")
 };
 
 Status validateBakeJob(const BakeJob& job);

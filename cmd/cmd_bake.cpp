@@ -17,7 +17,7 @@ int runBake(int argc, char** argv) {
                  cmd};
     BakeJob job;
     BakeParams& p = job.params;
-    std::string cellList, shard, texels = "8x2", representation = "points";
+    std::string cellList, shard, texels = "8x2", representation = "points", placement = "cost";
     bool quiet = false, noRemoval = false;
     app.add_option("city", job.input, "input city file (.osgb from 'vista gen')")->required();
     app.add_option("-o,--output", job.output, "baked output file (.osgb)")->required();
@@ -57,6 +57,12 @@ int runBake(int argc, char** argv) {
                    "far-field representation per view cell: points (point impostors, thesis ch. 5) or mesh (textured depth meshes, "
                    "Chen et al. 2003)")
         ->capture_default_str();
+    app.add_option("--placement", placement,
+                   "points: cost = an impostor only where it saves more raster time than its points cost (bake/placement.h); "
+                   "all = at every street end with a far field")
+        ->capture_default_str();
+    app.add_option("--triangle-ns", p.placement.triangleNs, "placement: raster cost of a triangle, ns (measured here)")->capture_default_str();
+    app.add_option("--point-ns", p.placement.pointNs, "placement: raster cost of a point, ns (measured here)")->capture_default_str();
     app.add_option("--mesh-triangles", p.mesh.maxTriangles, "mesh: triangle budget per view cell (half per street end)")
         ->capture_default_str();
     app.add_option("--mesh-image", p.mesh.imageSize, "mesh: largest side of the far-field image in pixels")->capture_default_str();
@@ -71,6 +77,12 @@ int runBake(int argc, char** argv) {
     auto repr = parseRepresentation(representation);
     if (!repr) return reportBadInput(cmd, repr.status());
     p.representation = *repr;
+    if (placement != "cost" && placement != "all")
+        return reportBadInput(cmd, Status::error("--placement '" + placement + "': unknown (allowed: cost, all)"));
+    p.placement.byCost = placement == "cost";
+    if (!(p.placement.triangleNs > 0 && p.placement.triangleNs < 1e9) || !(p.placement.pointNs > 0 && p.placement.pointNs < 1e9))
+        return reportBadInput(cmd, Status::error("--triangle-ns / --point-ns: " + std::to_string(p.placement.triangleNs) + " / " +
+                                                 std::to_string(p.placement.pointNs) + " out of range (0, 1e9) ns"));
     if (Status s = validateBakeJob(job); !s) return reportBadInput(cmd, s);
     if (!shard.empty()) {
         auto sh = parseShard("--shard", shard);

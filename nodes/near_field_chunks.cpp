@@ -187,6 +187,8 @@ public:
             out.triangles += cb.triangles;
             out.objects.push_back(o);
             drawKeys.push_back({std::get<0>(key), std::get<1>(key) == 1 ? 0 : 1, uint32_t(out.chunks.size())});
+            const int64_t tid = std::get<0>(key);
+            out.chunkTile.push_back(tid >= 0 && size_t(tid) < _tileChild.size() ? _tileChild[size_t(tid)] : -1);
             out.chunks.push_back(xf);
         }
         std::stable_sort(drawKeys.begin(), drawKeys.end());
@@ -293,6 +295,16 @@ private:
         return g;
     }
 
+public:
+    // tileId (as passed to addMesh/addTrees) -> the tile's child index in the city root.
+    void setTileChild(int64_t tileId, int32_t child) {
+        if (tileId < 0) return;
+        if (_tileChild.size() <= size_t(tileId)) _tileChild.resize(size_t(tileId) + 1, -1);
+        _tileChild[size_t(tileId)] = child;
+    }
+
+private:
+    std::vector<int32_t> _tileChild;
     double _chunk;
     bool _labels = false;
     osg::ref_ptr<osg::StateSet> _treeLabelState;
@@ -301,7 +313,7 @@ private:
 };
 
 // An unknown layout: one chunk with OSG's bound.
-void keepWhole(osg::Node* n, NearFieldScene& out) {
+void keepWhole(osg::Node* n, NearFieldScene& out, int32_t child) {
     const osg::BoundingSphere& bs = n->getBound();
     if (!bs.valid()) return;
     SplitObject o;
@@ -309,6 +321,7 @@ void keepWhole(osg::Node* n, NearFieldScene& out) {
     o.hi = glm::dvec3(bs.center().x(), bs.center().y(), bs.center().z()) + glm::dvec3(bs.radius());
     out.objects.push_back(o);
     out.chunks.push_back(n);
+    out.chunkTile.push_back(child);
     if (out.labelRootState) out.labelChunks.push_back(new osg::Group);  // unknown layout: no labels
 }
 
@@ -321,7 +334,7 @@ NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk, bool labe
     if (labels) out.labelRootState = labelRootState();
     osg::Group* root = cityScene->asGroup();
     if (!root) {
-        keepWhole(cityScene, out);
+        keepWhole(cityScene, out, -1);
         out.drawOrder.assign(out.chunks.size(), 0);
         return out;
     }
@@ -330,10 +343,11 @@ NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk, bool labe
     for (unsigned ci = 0; ci < root->getNumChildren(); ++ci) {
         osg::MatrixTransform* xf = asCityTile(root->getChild(ci));
         if (!xf) {
-            keepWhole(root->getChild(ci), out);
+            keepWhole(root->getChild(ci), out, int32_t(ci));
             continue;
         }
         ++tileId;
+        chunker.setTileChild(tileId, int32_t(ci));
         const osg::Vec3d tt = xf->getMatrix().getTrans();
         const glm::dvec3 tileOrigin(tt.x(), tt.y(), tt.z());
         for (osg::Geometry* g : tileGeometries(*xf)) {

@@ -44,6 +44,11 @@ struct NearFieldScene {
     // indices themselves put a tile's squares first (distance ties of a
     // triangle budget then pick the squares around the eye).
     std::vector<uint32_t> drawOrder;
+    // Index-aligned with chunks: the child index, in the city root, of the
+    // tile (or unknown node) the chunk was cut from; -1 when the scene is not
+    // a group. The baked modes hide a view cell's replaced tiles chunk by
+    // chunk with it (ViewCellSwitch::setNearChunks).
+    std::vector<int32_t> chunkTile;
     uint64_t triangles = 0;
     // Built with labels only (else empty / null): labelChunks[i] is the label
     // twin of chunks[i] (nodes/label_pass.h: the same vertex arrays, primitive

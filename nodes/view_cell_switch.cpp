@@ -98,7 +98,23 @@ ViewCellSwitch::ViewCellSwitch()
 ViewCellSwitch::ViewCellSwitch(const ViewCellSwitch& o, const osg::CopyOp& op)
     : osg::Group(o, op), _cells(o._cells), _grid(o._grid), _cellData(o._cellData), _hiddenStart(o._hiddenStart),
       _hiddenItems(o._hiddenItems), _impStart(o._impStart), _impItems(o._impItems), _tileCount(o._tileCount),
-      _forced(o._forced), _impostorsOn(o._impostorsOn), _nearestFallback(o._nearestFallback) {}
+      _forced(o._forced), _impostorsOn(o._impostorsOn), _nearestFallback(o._nearestFallback), _chunkNodes(o._chunkNodes),
+      _chunkTile(o._chunkTile), _chunkBoxes(o._chunkBoxes), _chunkNear(o._chunkNear) {}
+
+void ViewCellSwitch::setNearChunks(const NearFieldScene& nf, double nearDistance) {
+    _chunkNodes.clear();
+    _chunkTile.clear();
+    _chunkBoxes.clear();
+    _chunkNear = std::max(0.0, nearDistance);
+    const size_t n = nf.chunks.size();
+    if (nf.objects.size() != n) return;  // not a chunking: keep the whole tiles
+    for (uint32_t i : nf.drawOrder) {
+        if (i >= n || !nf.chunks[i]) continue;
+        _chunkNodes.push_back(nf.chunks[i]);
+        _chunkTile.push_back(i < nf.chunkTile.size() ? nf.chunkTile[i] : -1);
+        _chunkBoxes.push_back(nf.objects[i]);
+    }
+}
 
 void ViewCellSwitch::setCells(const std::vector<ViewCellBox>& cells) {
     osg::ref_ptr<osg::DoubleArray> a = new osg::DoubleArray;
@@ -230,6 +246,33 @@ void ViewCellSwitch::traverse(osg::NodeVisitor& nv) {
     }
     if (cell >= int(_cells.size())) cell = -1;
     _lastCell = cell;
+    if (!_chunkNodes.empty()) {
+        const bool inCell = cell >= 0 && _impostorsOn;
+        _hiddenMask.assign(tiles, 0);
+        if (inCell) {
+            const uint32_t hs = (*_hiddenStart)[size_t(cell)], he = (*_hiddenStart)[size_t(cell) + 1];
+            for (uint32_t k = hs; k < he && k < _hiddenItems->size(); ++k)
+                if ((*_hiddenItems)[k] < tiles) _hiddenMask[(*_hiddenItems)[k]] = 1;
+        }
+        const osg::Vec3 e = nv.getEyePoint();
+        const glm::dvec3 eye(e.x(), e.y(), e.z());
+        unsigned drawn = 0;
+        for (size_t k = 0; k < _chunkNodes.size(); ++k) {
+            const int32_t t = _chunkTile[k];
+            if (inCell && t >= 0 && unsigned(t) < tiles && _hiddenMask[size_t(t)] && boxDistance(_chunkBoxes[k], eye) > _chunkNear)
+                continue;
+            _chunkNodes[k]->accept(nv);
+            ++drawn;
+        }
+        _lastChunks = drawn;
+        if (!inCell) return;
+        const uint32_t is = (*_impStart)[size_t(cell)], ie = (*_impStart)[size_t(cell) + 1];
+        for (uint32_t j = is; j < ie && j < _impItems->size(); ++j) {
+            const unsigned c = (*_impItems)[j];
+            if (c < nChildren) _children[c]->accept(nv);
+        }
+        return;
+    }
     if (cell < 0 || !_impostorsOn) {
         for (unsigned i = 0; i < tiles; ++i) _children[i]->accept(nv);
         return;

@@ -16,7 +16,19 @@
 // picks the cell from the eye point (node-local = world frame); every other
 // traversal (update, intersection, ...) sees the tiles only. The lookup can be
 // forced (setForcedCell) and impostors switched off (setImpostorsEnabled) for
-// measurements. Serialized by osgDB (wrapper "vista::ViewCellSwitch", in
+// measurements.
+//
+// Near-field chunks (run time, not serialized; the baked render modes set
+// them): with setNearChunks() the cull traversal draws the city as the 40 m
+// chunks of the shared near-field chunking (nodes/near_field_chunks.h, the
+// chunks `full` and `hybrid` draw) instead of the whole 250 m tiles, so OSG
+// culls them against the frustum chunk by chunk. In a cell a chunk of a
+// replaced (hidden) tile is skipped unless its box comes within the near
+// distance of the eye (the test and distance of hybrid's near field,
+// selectNearField): beyond it the cell's far representation stands in.
+// Chunks of tiles the cell does not replace are drawn (frustum culled), so the
+// drawn chunks are always a subset of what `full` draws. Outside every cell
+// (or impostors off): every chunk, as `full`. Serialized by osgDB (wrapper "vista::ViewCellSwitch", in
 // view_cell_switch.cpp); bad per-cell indices in a loaded file are reported
 // by validate(), never dereferenced.
 #pragma once
@@ -27,6 +39,8 @@
 #include <glm/glm.hpp>
 #include <osg/Array>
 #include <osg/Group>
+
+#include "nodes/near_field_chunks.h"
 
 namespace vista {
 
@@ -89,6 +103,16 @@ public:
     // Cell chosen by the last cull traversal (-1: none).
     int lastCell() const { return _lastCell; }
 
+    // Draw the tiles as these chunks (see above). nf.chunks/objects/chunkTile
+    // index-aligned, chunkTile = child index of the tile here (< tile count;
+    // other values are drawn always); drawn in nf.drawOrder. nearDistance in
+    // metres (>= 0). An empty scene switches back to whole tiles.
+    void setNearChunks(const NearFieldScene& nf, double nearDistance);
+    bool hasNearChunks() const { return !_chunkNodes.empty(); }
+    double nearChunkDistance() const { return _chunkNear; }
+    // Chunks the last cull traversal passed on (before OSG's frustum culling).
+    unsigned lastChunkCount() const { return _lastChunks; }
+
     // Consistency of the per-cell lists with the children; message names the
     // first problem, empty when fine.
     std::string validate() const;
@@ -124,6 +148,13 @@ private:
     bool _impostorsOn = true;
     bool _nearestFallback = false;
     int _lastCell = -1;
+    // Near-field chunks, in draw order (run time only).
+    std::vector<osg::ref_ptr<osg::Node>> _chunkNodes;
+    std::vector<int32_t> _chunkTile;
+    std::vector<SplitObject> _chunkBoxes;
+    double _chunkNear = 0;
+    unsigned _lastChunks = 0;
+    std::vector<uint8_t> _hiddenMask;  // scratch of the cull traversal, per tile
 };
 
 }  // namespace vista

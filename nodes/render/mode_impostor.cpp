@@ -12,6 +12,9 @@ public:
     ImpostorMode(ModeContext& ctx, osg::ref_ptr<ViewCellSwitch> root, const SetupTimes& setup)
         : GraphMode(ctx), _root(std::move(root)) {
         _setup = setup;
+        // The near field in hybrid's 40 m chunks and at its near distance (view_cell_switch.h).
+        _root->setNearChunks(ctx.nearField(), ctx.options.fixedNearDistance());
+        _setup.push_back({"chunking", ctx.chunkingMs()});
         _graph = _root;
     }
     std::string name() const override { return "impostor"; }
@@ -19,6 +22,7 @@ public:
 protected:
     void describe(FrameStats& stats) const override {
         const int cell = _root->lastCell();
+        stats.notes.push_back("near chunks " + std::to_string(_root->lastChunkCount()));
         stats.notes.push_back(cell >= 0 ? "cell " + std::to_string(cell) + " (" +
                                               std::to_string(_root->impostorsOf(uint32_t(cell)).size()) + " impostors)"
                                         : "no cell");

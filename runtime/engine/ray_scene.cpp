@@ -413,6 +413,23 @@ void RayScene::intersectMany(const glm::vec3* org, const glm::vec3* dir, int n, 
     }
 }
 
+void RayScene::occludedMany(const glm::vec3* org, const glm::vec3* dir, int n, const float* tfars, uint8_t* out, float tnear) const {
+    if (_impl->ftz) enableFtzDaz();
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    alignas(32) RTCRayHit8 rh;
+    alignas(32) int valid[8];
+    for (int base = 0; base < n; base += 8) {
+        const int m = std::min(8, n - base);
+        fillPacket8(rh, valid, org, dir, tfars, 0.0f, size_t(base), m, tnear);
+        for (int k = 0; k < m; ++k)
+            if (!(rh.ray.tnear[k] <= rh.ray.tfar[k])) valid[k] = 0;  // empty interval: not occluded
+        rtcOccluded8(valid, _impl->scene, &ctx, &rh.ray);
+        for (int k = 0; k < m; ++k) out[base + k] = valid[k] && rh.ray.tfar[k] < 0.0f ? 1 : 0;
+    }
+}
+
 bool RayScene::occluded(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar) const {
     if (_impl->ftz) enableFtzDaz();
     if (!(tnear <= tfar)) return false;

@@ -81,6 +81,9 @@ public:
                        const float* tfars = nullptr, float tnear = 0.0f) const;
     // Occlusion test: true if anything lies within (tnear, tfar).
     bool occluded(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar) const;
+    // Coherent batch of occlusion tests (packets of 8): out[i] = 1 if anything
+    // lies within (tnear, tfars[i]) along ray i, else 0 (also when tnear > tfars[i]).
+    void occludedMany(const glm::vec3* org, const glm::vec3* dir, int n, const float* tfars, uint8_t* out, float tnear = 0.0f) const;
     // All surfaces along the ray in (tnear, tfar), nearest first, at most
     // maxHits: each next cast starts max(minGap, 1e-5 t) beyond the last hit.
     int allHits(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar, int maxHits, float minGap,

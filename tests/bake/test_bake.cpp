@@ -21,6 +21,7 @@
 #include <osgDB/Registry>
 #include <tbb/global_control.h>
 
+#include "citygen/generate.h"
 #include "citygen/polygon.h"
 #include "bake/appearance.h"
 #include "bake/assembly.h"
@@ -31,6 +32,7 @@
 #include "bake/impostor_frame.h"
 #include "bake/driver.h"
 #include "bake/ldi_sampling.h"
+#include "bake/placement.h"
 #include "bake/point_removal.h"
 #include "bake/sampling_plane.h"
 #include "bake/view_cells.h"
@@ -41,6 +43,7 @@
 #include "runtime/scene/city_file.h"
 #include "runtime/scene/scene_file.h"
 #include "nodes/render/mode_impostor.h"
+#include "nodes/render/mode_full.h"
 #include "nodes/render/mode_lodmesh.h"
 #include "runtime/engine/image.h"
 #include "runtime/engine/metrics.h"
@@ -995,6 +998,104 @@ TEST(ImpostorMode, DrawsImpostorsInTheCellAndResemblesTheGeometry) {
     EXPECT_NE(bad.status().message().find("--baked"), std::string::npos);
 }
 
+// Issue 11, item 2: from-region visibility of the baked points through the
+// whole city, and the cost estimate that decides where an impostor goes.
+TEST(Placement, PointsBehindAnOccluderAreDroppedAndTheCostRuleHolds) {
+    TempDir dir;
+    ASSERT_TRUE(writeCityFile(makeBakeCity(), dir.file("city.osgb")).isOk());
+    auto city = loadCityFile(dir.file("city.osgb"));
+    ASSERT_TRUE(city.isOk());
+    BakeParams p = smallParams();
+    p.placement.byCost = true;
+    BakeInput in = prepareBake(*city, p);
+    ASSERT_TRUE(in.cityRays) << "placement by cost builds the city's ray scene";
+    const ViewCell& cell = in.cells[0];
+    const FarSet fs = selectFarSet(*city, in.tiles, cell, 1, p.far);  // end 1: towards x = 100, far tile at x = 300
+    ASSERT_FALSE(fs.tiles.empty());
+    ASSERT_GT(fs.soup.triangleCount(), 0u);
+    // The far tile's first wall spans world x 285..315, y -30..-22, 12 m high.
+    const glm::vec3 front(fs.frame.toLocal(glm::dvec3(284.9, -26, 5)));  // on its face towards the cell
+    const glm::vec3 behind(fs.frame.toLocal(glm::dvec3(316.5, -26, 5)));  // behind it, seen from nowhere in the cell
+    const glm::vec3 above(fs.frame.toLocal(glm::dvec3(300, -26, 12.05)));  // on its roof: seen over it from eye height? no
+    const std::vector<uint8_t> vis = visibleFromCell(*in.cityRays, cell, fs.frame, {front, behind, above}, p.placement);
+    ASSERT_EQ(vis.size(), 3u);
+    EXPECT_EQ(vis[0], 1) << "a point on the face towards the cell is visible";
+    EXPECT_EQ(vis[1], 0) << "a point behind the wall is occluded from every viewpoint";
+    EXPECT_EQ(vis[2], 0) << "a roof 12 m up is not seen from eye height";
+    // The packet occlusion test agrees with the single-ray one (rays from the
+    // cell centre to points on a grid through the far tile, some behind walls,
+    // some in the open, one with an empty interval).
+    {
+        const glm::vec3 o(glm::dvec3(cell.box.center) - in.cityRays->frameOrigin());
+        std::vector<glm::vec3> org, dirs;
+        std::vector<float> tfars;
+        for (int i = 0; i < 21; ++i) {
+            const glm::vec3 q(glm::dvec3(270 + 3 * i, -35 + 3.3 * i, 4) - in.cityRays->frameOrigin());
+            org.push_back(o);
+            dirs.push_back(glm::normalize(q - o));
+            tfars.push_back(i == 20 ? -1.0f : glm::length(q - o));
+        }
+        std::vector<uint8_t> many(org.size(), 7);
+        in.cityRays->occludedMany(org.data(), dirs.data(), int(org.size()), tfars.data(), many.data());
+        size_t blocked = 0;
+        for (size_t i = 0; i < org.size(); ++i) {
+            EXPECT_EQ(many[i] != 0, in.cityRays->occluded(org[i], dirs[i], 0.0f, tfars[i])) << "ray " << i;
+            blocked += many[i];
+        }
+        EXPECT_GT(blocked, 0u);
+        EXPECT_LT(blocked, org.size());
+        EXPECT_EQ(many.back(), 0) << "an empty interval is not occluded";
+    }
+    // The estimate: rays reach the far walls; saved/cost follow the stated formula.
+    PlacementEstimate e = estimatePlacement(*in.cityRays, in.tileLookup, cell, fs, p.sampling, p.placement);
+    EXPECT_GT(e.rays, 0);
+    EXPECT_GT(e.farHits, 0) << "the far walls are in plain view down the street";
+    EXPECT_GT(e.farPixels, 0.0);
+    EXPECT_LE(e.farPixels, e.maxFarPixels);
+    EXPECT_NEAR(e.savedMs, double(fs.soup.triangleCount()) * p.placement.triangleNs * 1e-6, 1e-9);
+    EXPECT_NEAR(e.costMs, p.placement.pointsPerFarPixel * e.farPixels * p.placement.pointNs * 1e-6, 1e-9);
+    EXPECT_EQ(e.place, e.savedMs > e.costMs);
+    // A few walls (120 triangles) seen over hundreds of pixels: points cost more than the triangles.
+    EXPECT_FALSE(e.place) << e.describe();
+    PlacementParams cheapPoints = p.placement;
+    cheapPoints.pointNs = 1e-6;
+    EXPECT_TRUE(estimatePlacement(*in.cityRays, in.tileLookup, cell, fs, p.sampling, cheapPoints).place);
+    // The whole cell: the ends are not placed, each with a note saying why.
+    CellResult cr = bakeCell(in, cell, p);
+    EXPECT_TRUE(cr.impostors.empty());
+    size_t notPlaced = 0;
+    for (const auto& n : cr.notes) notPlaced += n.find("not placed: saves") != std::string::npos;
+    EXPECT_EQ(notPlaced, 2u);
+    // With cheap points both ends are placed; a wall just beyond end 1 (world
+    // x 102..108, y -40..8, 40 m high) hides the far tile's walls at y < 0
+    // from the whole cell: their points are dropped, the open part stays.
+    City occ = makeBakeCity();
+    occ.tiles[0].meshes[size_t(Material::Wall)] = boxMesh({52, -40, 0}, {58, 8, 40}, {90, 90, 90, 255}, {100, 100, 100, 255});
+    ASSERT_TRUE(writeCityFile(occ, dir.file("occ.osgb")).isOk());
+    auto occCity = loadCityFile(dir.file("occ.osgb"));
+    ASSERT_TRUE(occCity.isOk());
+    p.placement = cheapPoints;
+    BakeParams all = smallParams();
+    BakeInput occIn = prepareBake(*occCity, p);
+    CellResult placed = bakeCell(occIn, occIn.cells[0], p), every = bakeCell(occIn, occIn.cells[0], all);
+    ASSERT_EQ(placed.impostors.size(), 2u);
+    ASSERT_EQ(every.impostors.size(), 2u);
+    for (size_t k = 0; k < 2; ++k) {
+        const ImpostorResult &a = placed.impostors[k], &b = every.impostors[k];
+        EXPECT_EQ(a.hiddenTiles, b.hiddenTiles);
+        EXPECT_GT(a.stats.points, 0u);
+        if (a.end == 1) {
+            EXPECT_LT(double(a.stats.points), 0.8 * double(b.stats.points)) << "the occluded points were kept";
+            size_t behindWall = 0;
+            for (const auto& q : a.data.positions) behindWall += a.frame.toWorld(glm::dvec3(q)).y < -3.0;
+            EXPECT_EQ(behindWall, 0u) << "points hidden by the wall from the whole cell survived";
+        } else {
+            EXPECT_EQ(a.stats.points, b.stats.points) << "nothing occludes end 0's far field";
+        }
+    }
+    EXPECT_NE(p.canonical(), all.canonical()) << "placement changes the config hash";
+}
+
 int run(const std::string& args) {
     const std::string cmd = std::string(VISTA_BINARY) + " bake " + args + " > /dev/null 2>&1";
     const int rc = std::system(cmd.c_str());
@@ -1004,7 +1105,7 @@ int run(const std::string& args) {
 TEST(BakeCli, ResumeShardsAndJobsGiveIdenticalBytes) {
     TempDir dir;
     ASSERT_TRUE(writeCityFile(makeBakeCity(), dir.file("city.osgb")).isOk());
-    const std::string common = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q ";
+    const std::string common = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q  --placement all ";
     ASSERT_EQ(run(common + "-o " + dir.file("a.osgb") + " --jobs 2"), 0);
     const std::string ref = readBytes(dir.file("a.osgb"));
     ASSERT_GT(ref.size(), 1000u);
@@ -1134,13 +1235,53 @@ TEST(BakeDriver, ResumeAfterInterruptionGivesTheBytesOfOneRun) {
     EXPECT_NE(noInput.status().message().find("missing.osgb"), std::string::npos);
 }
 
+// Placement by cost (the default of `vista bake`) stays byte-identical across
+// thread counts, shards + merge and a resume with a damaged cell result; bad
+// placement values are refused with exit 2.
+TEST(BakeCli, PlacementByCostIsDeterministicAcrossJobsShardsAndResume) {
+    TempDir dir;
+    City occ = makeBakeCity();
+    occ.tiles[0].meshes[size_t(Material::Wall)] = boxMesh({52, -40, 0}, {58, 8, 40}, {90, 90, 90, 255}, {100, 100, 100, 255});
+    ASSERT_TRUE(writeCityFile(occ, dir.file("city.osgb")).isOk());
+    // Cheap points: both ends are placed (and culled by the from-region visibility).
+    const std::string common = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q --point-ns 0.000001 ";
+    ASSERT_EQ(run(common + "-o " + dir.file("a.osgb") + " --jobs 2 --stats " + dir.file("a.json")), 0);
+    const std::string ref = readBytes(dir.file("a.osgb"));
+    ASSERT_GT(ref.size(), 1000u);
+    const std::string stats = readBytes(dir.file("a.json"));
+    EXPECT_NE(stats.find("place=cost"), std::string::npos) << "the default placement is by cost";
+    EXPECT_NE(stats.find("end 1: placed: saves"), std::string::npos) << stats.substr(0, 400);
+    ASSERT_EQ(run(common + "-o " + dir.file("b.osgb") + " --jobs 1"), 0);
+    EXPECT_EQ(readBytes(dir.file("b.osgb")), ref);
+    ASSERT_EQ(run(common + "-o " + dir.file("c.osgb") + " --shard 1/2"), 0);
+    ASSERT_EQ(run(common + "-o " + dir.file("c.osgb") + " --shard 2/2"), 0);
+    ASSERT_EQ(run(common + "-o " + dir.file("c.osgb") + " --merge --keep-work"), 0);
+    EXPECT_EQ(readBytes(dir.file("c.osgb")), ref);
+    std::remove(dir.file("c.osgb").c_str());
+    {
+        const std::string part = readBytes(dir.file("c.osgb.work/cell_0.vbc"));
+        ASSERT_FALSE(part.empty());
+        std::ofstream o(dir.file("c.osgb.work/cell_0.vbc"), std::ios::binary | std::ios::trunc);
+        o << part.substr(0, part.size() / 2);
+    }
+    ASSERT_EQ(run(common + "-o " + dir.file("c.osgb")), 0);
+    EXPECT_EQ(readBytes(dir.file("c.osgb")), ref) << "a damaged cell result was trusted";
+    // The default (real) costs: a few walls are cheaper as triangles, nothing is placed.
+    ASSERT_EQ(run(dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q -o " + dir.file("d.osgb") + " --stats " +
+                  dir.file("d.json")),
+              0);
+    EXPECT_NE(readBytes(dir.file("d.json")).find("not placed: saves"), std::string::npos);
+    EXPECT_EQ(run(common + "-o " + dir.file("e.osgb") + " --placement some"), 2);
+    EXPECT_EQ(run(common + "-o " + dir.file("e.osgb") + " --triangle-ns 0"), 2);
+}
+
 // `vista view` opens a baked file and offers the impostor mode (needs a display).
 TEST(BakeCli, ViewOpensTheBakedFileInImpostorMode) {
     const char* display = std::getenv("DISPLAY");
     if (!display || !*display) GTEST_SKIP() << "no X display (run under xvfb-run -a)";
     TempDir dir;
     ASSERT_TRUE(writeCityFile(makeBakeCity(), dir.file("city.osgb")).isOk());
-    ASSERT_EQ(run(dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q -o " + dir.file("a.osgb")), 0);
+    ASSERT_EQ(run(dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q  --placement all -o " + dir.file("a.osgb")), 0);
     auto view = [&](const std::string& args) {
         const std::string cmd = std::string(VISTA_BINARY) + " view " + args + " > /dev/null 2>&1";
         const int rc = std::system(cmd.c_str());
@@ -1336,6 +1477,103 @@ TEST(LodMesh, NoSkinAcrossADepthDiscontinuityAndTheBudgetHolds) {
     }
 }
 
+// Issue 11, item 1: the baked modes draw the near field in the 40 m chunks of
+// `full`/`hybrid` (view_cell_switch.h). On a small generated city, from inside
+// a baked cell looking down its street: the baked modes draw no more
+// triangles than `full` (a subset of its chunks, plus the few mesh triangles
+// or points), fewer than the whole 250 m tiles they drew before, and the
+// picture stays within a stated PSNR of `full`.
+TEST(BakedChunks, BakedModesDrawNoMoreTrianglesThanFullAndMatchIt) {
+    const char* display = std::getenv("DISPLAY");
+    if (!display || !*display) GTEST_SKIP() << "no X display (run under xvfb-run -a)";
+    const int W = 160, H = 120;
+    auto renderer = OffscreenRenderer::create(W, H);
+    ASSERT_TRUE(renderer.isOk()) << "DISPLAY is set but the renderer failed: " << renderer.status().message();
+    CityParams cp;
+    cp.size_m = 700;
+    cp.tile_size_m = 100;  // small tiles: far fields fit in a small city
+    cp.seed = 3;
+    auto gen = generateCity(cp);
+    ASSERT_TRUE(gen.isOk()) << gen.status().message();
+    TempDir dir;
+    ASSERT_TRUE(writeCityFile(*gen, dir.file("city.osgb")).isOk());
+    auto city = loadCityFile(dir.file("city.osgb"));
+    ASSERT_TRUE(city.isOk()) << city.status().message();
+    const BakeParams p = meshParams();
+    BakeInput in = prepareBake(*city, p);
+    ASSERT_FALSE(in.cells.empty());
+    // The longest cells first: the first with a mesh at both ends.
+    std::vector<size_t> order(in.cells.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](size_t a, size_t b) { return in.cells[a].box.halfLength > in.cells[b].box.halfLength; });
+    CellResult cr;
+    for (size_t k = 0; k < order.size() && k < 12; ++k) {
+        cr = bakeCell(in, in.cells[order[k]], p);
+        if (cr.meshes.size() == 2) break;
+    }
+    ASSERT_FALSE(cr.meshes.empty()) << "no cell of the test city has a far field";
+    const ViewCell& cell = in.cells[cr.cell];
+    auto root = assembleBakedScene(*city, in.cells, {cr}, p.canonical(), p.representation);
+    ModeContext ctx;
+    ctx.scene = root.get();
+    ctx.renderer = renderer->get();
+    auto lod = makeLodMeshMode(ctx);
+    auto full = makeFullMode(ctx);
+    ASSERT_TRUE(lod.isOk() && full.isOk());
+    ASSERT_TRUE(root->hasNearChunks());
+    EXPECT_EQ(root->nearChunkDistance(), kDefaultNearDistance) << "the near distance of hybrid";
+    const ViewCellBox& b = cell.box;
+    int views = 0;
+    double worstPsnr = 1e9;
+    for (int dir01 = 0; dir01 < 2; ++dir01) {
+        const double sgn = dir01 ? -1.0 : 1.0;
+        Camera cam;
+        cam.eye = b.center + glm::dvec3(-sgn * b.axis.x * b.halfLength * 0.5, -sgn * b.axis.y * b.halfLength * 0.5, 0.0);
+        cam.eye.z = cell.groundMax + 1.7;
+        if (!b.contains(cam.eye)) cam.eye.z = b.center.z;
+        cam.heading = std::atan2(sgn * b.axis.x, sgn * b.axis.y);
+        cam.fovY = 60 * kPi / 180;
+        cam.width = W;
+        cam.height = H;
+        Image baked, ref, whole;
+        FrameStats sb, sf, sw;
+        ASSERT_TRUE((*lod)->renderFrame(cam, baked, sb).isOk());
+        ASSERT_EQ(root->lastCell(), int(cr.cell));
+        ASSERT_TRUE((*full)->renderFrame(cam, ref, sf).isOk());
+        // The same frame with the whole tiles (as before the chunking).
+        root->setNearChunks(NearFieldScene(), 0.0);
+        ASSERT_TRUE((*renderer)->render(root.get(), cam, 0.0, &whole, nullptr, sw).isOk());
+        root->setNearChunks(ctx.nearField(), kDefaultNearDistance);
+        const double psnr = lumaPsnr(baked, ref);
+        std::printf("cell %u view %d: triangles lodmesh %llu, full %llu, whole tiles %llu; lodmesh vs full %.1f dB\n", cr.cell,
+                    dir01, (unsigned long long)sb.triangles, (unsigned long long)sf.triangles, (unsigned long long)sw.triangles, psnr);
+        EXPECT_GT(sf.triangles, 0u);
+        EXPECT_LE(sb.triangles, sf.triangles) << "the baked mode draws more than full";
+        EXPECT_LT(sb.triangles, sw.triangles) << "chunking saved nothing over the whole tiles";
+        EXPECT_GT(psnr, 30.0) << "the baked frame does not match full";
+        worstPsnr = std::min(worstPsnr, psnr);
+        ++views;
+    }
+    EXPECT_EQ(views, 2);
+    // Outside every cell the chunked baked root is exactly full's frame.
+    root->setForcedCell(-1);
+    Camera out;
+    out.eye = b.center + glm::dvec3(0, 0, 40.0);
+    out.heading = 0.3;
+    out.pitch = -0.3;
+    out.fovY = 60 * kPi / 180;
+    out.width = W;
+    out.height = H;
+    Image a, c;
+    FrameStats s1, s2;
+    ASSERT_TRUE((*lod)->renderFrame(out, a, s1).isOk());
+    ASSERT_TRUE((*full)->renderFrame(out, c, s2).isOk());
+    EXPECT_EQ(s1.triangles, s2.triangles);
+    EXPECT_EQ(lumaPsnr(a, c), kPsnrCapDb) << "without a cell the chunked baked root is full";
+    root->setForcedCell(-2);
+}
+
 // The lodmesh mode through OpenGL (run under xvfb-run -a): in the cell it draws
 // the meshes instead of the far tiles and looks like the geometry; outside every
 // cell it uses the nearest cell.
@@ -1402,7 +1640,7 @@ TEST(LodMeshMode, DrawsTheCellMeshesAndResemblesTheGeometry) {
 TEST(LodMeshCli, ResumeShardsCorruptCellAndBadValues) {
     TempDir dir;
     ASSERT_TRUE(writeCityFile(makeBakeCity(), dir.file("city.osgb")).isOk());
-    const std::string common = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q --representation mesh --mesh-image 256 ";
+    const std::string common = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q  --placement all --representation mesh --mesh-image 256 ";
     ASSERT_EQ(run(common + "-o " + dir.file("a.osgb") + " --jobs 2 --stats " + dir.file("a.json")), 0);
     const std::string ref = readBytes(dir.file("a.osgb"));
     ASSERT_GT(ref.size(), 1000u);
@@ -1441,7 +1679,7 @@ TEST(LodMeshCli, ResumeShardsCorruptCellAndBadValues) {
     EXPECT_EQ(readBytes(dir.file("d.osgb")), ref);
     // The representation is in the config hash: point results in the same work
     // directory are not reused for a mesh bake (and the other way round).
-    const std::string points = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q ";
+    const std::string points = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q  --placement all ";
     ASSERT_EQ(run(points + "-o " + dir.file("p.osgb") + " --keep-work --work " + dir.file("w")), 0);
     ASSERT_EQ(run(common + "-o " + dir.file("m.osgb") + " --work " + dir.file("w")), 0);
     EXPECT_EQ(readBytes(dir.file("m.osgb")), ref);
@@ -1461,7 +1699,7 @@ TEST(LodMeshCli, BenchAndViewRunTheLodMeshMode) {
     if (!display || !*display) GTEST_SKIP() << "no X display (run under xvfb-run -a)";
     TempDir dir;
     ASSERT_TRUE(writeCityFile(makeBakeCity(), dir.file("city.osgb")).isOk());
-    const std::string common = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q ";
+    const std::string common = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q  --placement all ";
     ASSERT_EQ(run(common + "-o " + dir.file("m.osgb") + " --representation mesh --mesh-image 256"), 0);
     ASSERT_EQ(run(common + "-o " + dir.file("p.osgb")), 0);
     auto tool = [&](const std::string& args) {
@@ -1494,7 +1732,7 @@ TEST(BakeCli, BakedFileOfAnotherCityOrTruncatedIsRefusedWithExit2) {
     other.tiles[1].meshes[size_t(Material::Wall)].positions[0].z += 1.0f;  // one vertex moved: another city
     ASSERT_TRUE(writeCityFile(makeBakeCity(), dir.file("city.osgb")).isOk());
     ASSERT_TRUE(writeCityFile(other, dir.file("other.osgb")).isOk());
-    const std::string common = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q ";
+    const std::string common = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q  --placement all ";
     ASSERT_EQ(run(common + "-o " + dir.file("p.osgb")), 0);
     ASSERT_EQ(run(common + "-o " + dir.file("m.osgb") + " --representation mesh --mesh-image 256"), 0);
 
@@ -1543,7 +1781,7 @@ TEST(BakeCli, BakedFileOfAnotherCityOrTruncatedIsRefusedWithExit2) {
     EXPECT_EQ(tool("view " + dir.file("other.osgb") + " --baked-mesh " + dir.file("m.osgb") + " --mode lodmesh --frames 1"), 2);
     // A baked city file opened as the city stands for its source city: a mesh bake of `city` with a point bake of `city` pairs,
     // with a point bake of `other` it does not.
-    ASSERT_EQ(run(dir.file("other.osgb") + " --out-size 120 --min-triangles 1 -q -o " + dir.file("po.osgb")), 0);
+    ASSERT_EQ(run(dir.file("other.osgb") + " --out-size 120 --min-triangles 1 -q  --placement all -o " + dir.file("po.osgb")), 0);
     EXPECT_EQ(tool("bench " + dir.file("m.osgb") + " --baked " + dir.file("po.osgb") + " --modes impostor" + bench), 2);
     EXPECT_NE(readBytes(dir.file("log.txt")).find("baked from another city"), std::string::npos);
 

@@ -41,7 +41,7 @@ size_t countCells(const std::string& workDir) {
 }
 
 // A small, quick bake of a 300 m city (36 cells, 8 impostors, about 1 s on one core).
-const char* const kParams = " --out-size 80 --min-triangles 1";
+const char* const kParams = " --out-size 80 --min-triangles 1 --placement all";
 
 std::string makeCity(const test::TempDir& dir) {
     const std::string city = dir.file("city.osgb");
@@ -97,7 +97,8 @@ TEST(BakeFaults, KillNineLeavesTheOldOutputOrTheWholeNewOneAndTheNextRunResumes)
     for (const KillPoint& k : points) {
         const size_t before = countCells(work);
         const auto start = std::chrono::steady_clock::now();
-        const pid_t pid = test::startVista({"bake", city, "--out-size", "80", "--min-triangles", "1", "-q", "--jobs", "2", "-o", out});
+        const pid_t pid = test::startVista(
+            {"bake", city, "--out-size", "80", "--min-triangles", "1", "--placement", "all", "-q", "--jobs", "2", "-o", out});
         ASSERT_GT(pid, 0);
         int st = 0;
         bool exited = false;

@@ -668,7 +668,7 @@ TEST(ViewCli, EveryModeShowsTheBenchPicture) {
     const std::string city = dir + "/tiny.osgb", baked = dir + "/tiny.baked.osgb", path = dir + "/p.csv";
     const std::string meshes = dir + "/tiny.mesh.osgb";
     ASSERT_EQ(runVista("gen --size 300 --seed 3 -q -o " + city, &out), 0) << out;
-    ASSERT_EQ(runVista("bake " + city + " -o " + baked + " --out-size 120 --min-triangles 1 --max-rays 20000 -q", &out), 0)
+    ASSERT_EQ(runVista("bake " + city + " -o " + baked + " --out-size 120 --min-triangles 1 --placement all --max-rays 20000 -q", &out), 0)
         << out;
     ASSERT_EQ(runVista("bake " + city + " -o " + meshes + " --representation mesh --out-size 120 --min-triangles 1 -q", &out), 0)
         << out;
