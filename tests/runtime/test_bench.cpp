@@ -755,15 +755,14 @@ TEST(BenchCli, HybridPixelClassesAndOptions) {
     ASSERT_EQ(runVista("gen --size 300 --seed 3 -q -o " + city, &out), 0) << out;
     struct Run {
         std::string flags;
-        nlohmann::json near, budget;
-        int grid;
+        nlohmann::json near, budget, grid;
         bool cache;
         uint64_t triangleBudget;
     };
     const Run runs[] = {
         {"--near auto --budget 1000 --no-cache --horizon-grid 64", "auto", 1000, 64, false, 0},
-        {"--near 60 --budget unlimited", 60.0, "unlimited", 512, true, 0},
-        {"--triangle-budget 5000", "auto", "unlimited", 512, true, 5000},  // the default --near (unused: a budget)
+        {"--near 60 --budget unlimited", 60.0, "unlimited", "auto", true, 0},
+        {"--triangle-budget 5000", "auto", "unlimited", "auto", true, 5000},  // the default --near (unused: a budget)
     };
     for (size_t i = 0; i < 3; ++i) {
         const Run& r = runs[i];
