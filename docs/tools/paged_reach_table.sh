@@ -80,16 +80,5 @@ for name, radius in [("reference", "all")] + [(f"r{r}", r) for r in radii]:
 EOF
 cat "$OUT/table.md"
 
-doc=docs/performance.md
-grep -q '<!-- paged-reach:begin -->' "$doc" || die "$doc has no <!-- paged-reach:begin --> marker"
-python3 - "$doc" "$OUT/table.md" "$(date -u +%Y-%m-%d)" "$(cut -d' ' -f1-3 /proc/loadavg)" > docs/.performance.md.tmp <<'EOF'
-import sys
-doc, table, day, load = sys.argv[1:5]
-text = open(doc).read()
-begin, end = "<!-- paged-reach:begin -->", "<!-- paged-reach:end -->"
-head, rest = text.split(begin, 1)
-_, tail = rest.split(end, 1)
-print(head + begin + "\n" + f"Run of {day} (load average at the end: {load}).\n\n" + open(table).read() + end + tail, end="")
-EOF
-mv docs/.performance.md.tmp "$doc"
-log "done: $doc updated"
+doc_replace_block docs/performance.md paged-reach "$OUT/table.md"
+log "done: docs/performance.md updated"

@@ -111,17 +111,5 @@ for s, g, b, p, gen_rss, bench_rss, setup, ms, psnr in rows:
 EOF
 cat "$OUT/table.md"
 
-doc=docs/performance.md
-grep -q '<!-- scale-table:begin -->' "$doc" || die "$doc has no <!-- scale-table:begin --> marker"
-python3 - "$doc" "$OUT/table.md" "$(date -u +%Y-%m-%d)" "$(cut -d' ' -f1-3 /proc/loadavg)" > docs/.performance.md.tmp <<'EOF'
-import sys
-doc, table, day, load = sys.argv[1:5]
-text = open(doc).read()
-begin, end = "<!-- scale-table:begin -->", "<!-- scale-table:end -->"
-head, rest = text.split(begin, 1)
-_, tail = rest.split(end, 1)
-body = f"Run of {day} (load average at the end: {load}).\n\n" + open(table).read()
-print(head + begin + "\n" + body + end + tail, end="")
-EOF
-mv docs/.performance.md.tmp "$doc"
-log "done: $doc updated"
+doc_replace_block docs/performance.md scale-table "$OUT/table.md"
+log "done: docs/performance.md updated"

@@ -181,6 +181,22 @@ glm::mat4 instanceMatrix(const TreeInstance& t, const glm::dvec3& tileOrigin) {
     return glm::mat4(m);
 }
 
+// The instance matrices of the trees `list` (tile-local) as four column arrays, and the
+// tile-local box of the prototype box `pb` under every matrix.
+void instanceColumns(const City& city, const std::vector<uint32_t>& list, const glm::dvec3& tileOrigin, const osg::BoundingBox& pb,
+                     osg::ref_ptr<osg::Vec4Array> (&cols)[4], osg::BoundingBox& bb) {
+    for (auto& c : cols) c = new osg::Vec4Array(unsigned(list.size()));
+    for (size_t k = 0; k < list.size(); ++k) {
+        const glm::mat4 m = instanceMatrix(city.trees[list[k]], tileOrigin);
+        for (int c = 0; c < 4; ++c) (*cols[c])[unsigned(k)].set(m[c][0], m[c][1], m[c][2], m[c][3]);
+        for (int corner = 0; corner < 8; ++corner) {
+            const osg::Vec3 v = pb.corner(unsigned(corner));
+            const glm::vec4 w = m * glm::vec4(v.x(), v.y(), v.z(), 1.0f);
+            bb.expandBy(w.x, w.y, w.z);
+        }
+    }
+}
+
 osg::ref_ptr<osg::StateSet> instancedStateSet() {
     osg::ref_ptr<osg::StateSet> ss = new osg::StateSet;
     osg::ref_ptr<osg::Program> prog = new osg::Program;
@@ -274,18 +290,8 @@ osg::ref_ptr<osg::Node> buildCityScene(const City& city) {
             if (city.treeImpostors) {
                 if (impostors[pi].empty()) continue;
                 osg::ref_ptr<osg::Vec4Array> cols[4];
-                for (auto& c : cols) c = new osg::Vec4Array(unsigned(list.size()));
                 osg::BoundingBox bb;
-                const osg::BoundingBox& pb = impostors[pi].bounds;
-                for (size_t k = 0; k < list.size(); ++k) {
-                    glm::mat4 m = instanceMatrix(city.trees[list[k]], tile.origin);
-                    for (int c = 0; c < 4; ++c) (*cols[c])[unsigned(k)].set(m[c][0], m[c][1], m[c][2], m[c][3]);
-                    for (int corner = 0; corner < 8; ++corner) {
-                        osg::Vec3 v = pb.corner(unsigned(corner));
-                        glm::vec4 w = m * glm::vec4(v.x(), v.y(), v.z(), 1.0f);
-                        bb.expandBy(w.x, w.y, w.z);
-                    }
-                }
+                instanceColumns(city, list, tile.origin, impostors[pi].bounds, cols, bb);
                 osg::Array* const arrays[4] = {cols[0].get(), cols[1].get(), cols[2].get(), cols[3].get()};
                 if (auto g = instancedTreeImpostor(impostors[pi], pi, arrays, unsigned(list.size()), bb)) geode->addDrawable(g.get());
                 continue;
@@ -295,21 +301,11 @@ osg::ref_ptr<osg::Node> buildCityScene(const City& city) {
                                   protos[pi].colors.get(), pm.indices);
             g->getPrimitiveSet(0)->setNumInstances(int(list.size()));
             osg::ref_ptr<osg::Vec4Array> cols[4];
-            for (auto& c : cols) c = new osg::Vec4Array(unsigned(list.size()));
             osg::ref_ptr<osg::UIntArray> treeIds = new osg::UIntArray(unsigned(list.size()));
             treeIds->setPreserveDataType(true);
             for (size_t k = 0; k < list.size(); ++k) (*treeIds)[unsigned(k)] = makeInstanceId(InstanceKind::Tree, list[k]);
             osg::BoundingBox bb;
-            const osg::BoundingBox& pb = protos[pi].bounds;
-            for (size_t k = 0; k < list.size(); ++k) {
-                glm::mat4 m = instanceMatrix(city.trees[list[k]], tile.origin);
-                for (int c = 0; c < 4; ++c) (*cols[c])[unsigned(k)].set(m[c][0], m[c][1], m[c][2], m[c][3]);
-                for (int corner = 0; corner < 8; ++corner) {
-                    osg::Vec3 v = pb.corner(unsigned(corner));
-                    glm::vec4 w = m * glm::vec4(v.x(), v.y(), v.z(), 1.0f);
-                    bb.expandBy(w.x, w.y, w.z);
-                }
-            }
+            instanceColumns(city, list, tile.origin, protos[pi].bounds, cols, bb);
             for (unsigned c = 0; c < 4; ++c) g->setVertexAttribArray(kInstanceAttrib0 + c, cols[c].get(), osg::Array::BIND_PER_VERTEX);
             g->setVertexAttribArray(kLabelAttrib, protos[pi].labels.get(), osg::Array::BIND_PER_VERTEX);
             g->setVertexAttribArray(kTreeIdAttrib, treeIds.get(), osg::Array::BIND_PER_VERTEX);
