@@ -150,15 +150,7 @@ size_t estimateStoredTriangles(const City& layout) {
     const int want = std::min(n, std::clamp(n / 8, 16, 64));
     std::vector<int> sample;
     for (int k = 0; k < want; ++k) sample.push_back(int((int64_t(k) * n + n / (2 * want)) / want));
-    City c;
-    c.params = layout.params;
-    c.streets = layout.streets;
-    c.blocks = layout.blocks;
-    c.lots = layout.lots;
-    c.buildings = layout.buildings;
-    c.trees = layout.trees;
-    c.treePrototypes = layout.treePrototypes;
-    c.streetLights = layout.streetLights;
+    City c = layout;  // meshTiles replaces the copy's tiles, not the layout's
     meshTiles(c, sample, nullptr);
     size_t tileTriangles = 0;
     for (const Tile& t : c.tiles)

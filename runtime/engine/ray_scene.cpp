@@ -391,16 +391,24 @@ RayHit RayScene::intersect(const glm::vec3& org, const glm::vec3& dir, float tne
     return out;
 }
 
-void RayScene::intersectMany(const glm::vec3* org, const glm::vec3* dir, int n, RayHit* out, float tfar,
-                             const float* tfars, float tnear) const {
-    if (_impl->ftz) enableFtzDaz();
+// Calls packet(ctx, rh, valid, base, m) for the n rays in packets of 8 (m valid lanes from base),
+// with a coherent intersect context and FTZ/DAZ as the scene asks.
+namespace {
+template <class F>
+void forPackets8(bool ftz, int n, F&& packet) {
+    if (ftz) enableFtzDaz();
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     alignas(32) RTCRayHit8 rh;
     alignas(32) int valid[8];
-    for (int base = 0; base < n; base += 8) {
-        int m = std::min(8, n - base);
+    for (int base = 0; base < n; base += 8) packet(ctx, rh, valid, base, std::min(8, n - base));
+}
+}  // namespace
+
+void RayScene::intersectMany(const glm::vec3* org, const glm::vec3* dir, int n, RayHit* out, float tfar,
+                             const float* tfars, float tnear) const {
+    forPackets8(_impl->ftz, n, [&](RTCIntersectContext& ctx, RTCRayHit8& rh, int* valid, int base, int m) {
         fillPacket8(rh, valid, org, dir, tfars, tfar, size_t(base), m, tnear);
         rtcIntersect8(valid, _impl->scene, &ctx, &rh);
         for (int k = 0; k < m; ++k) {
@@ -410,24 +418,17 @@ void RayScene::intersectMany(const glm::vec3* org, const glm::vec3* dir, int n, 
                 _impl->fill(h, rh.hit.geomID[k], rh.hit.primID[k], rh.hit.instID[0][k], rh.hit.u[k], rh.hit.v[k],
                             rh.ray.tfar[k], rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]);
         }
-    }
+    });
 }
 
 void RayScene::occludedMany(const glm::vec3* org, const glm::vec3* dir, int n, const float* tfars, uint8_t* out, float tnear) const {
-    if (_impl->ftz) enableFtzDaz();
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    alignas(32) RTCRayHit8 rh;
-    alignas(32) int valid[8];
-    for (int base = 0; base < n; base += 8) {
-        const int m = std::min(8, n - base);
+    forPackets8(_impl->ftz, n, [&](RTCIntersectContext& ctx, RTCRayHit8& rh, int* valid, int base, int m) {
         fillPacket8(rh, valid, org, dir, tfars, 0.0f, size_t(base), m, tnear);
         for (int k = 0; k < m; ++k)
             if (!(rh.ray.tnear[k] <= rh.ray.tfar[k])) valid[k] = 0;  // empty interval: not occluded
         rtcOccluded8(valid, _impl->scene, &ctx, &rh.ray);
         for (int k = 0; k < m; ++k) out[base + k] = valid[k] && rh.ray.tfar[k] < 0.0f ? 1 : 0;
-    }
+    });
 }
 
 bool RayScene::occluded(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar) const {

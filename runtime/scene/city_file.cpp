@@ -11,6 +11,8 @@
 #include <map>
 
 #include <glm/gtc/matrix_transform.hpp>
+#include <string>
+
 #include <osg/BlendFunc>
 #include <osg/CullFace>
 #include <osg/NodeVisitor>
@@ -40,6 +42,19 @@ vec4 vistaHaze(vec4 c, float eyeDepth) {
     return vec4(mix(vista_haze_color, c.rgb, t), c.a);
 }
 )";
+const char* const kInstancedHazeVertexHead = R"(#version 120
+attribute vec4 vista_instance0;
+attribute vec4 vista_instance1;
+attribute vec4 vista_instance2;
+attribute vec4 vista_instance3;
+varying float vista_eye_depth;
+void main() {
+    mat4 instance = mat4(vista_instance0, vista_instance1, vista_instance2, vista_instance3);
+    vec4 p = instance * gl_Vertex;
+    gl_Position = gl_ModelViewProjectionMatrix * p;
+    vista_eye_depth = -(gl_ModelViewMatrix * p).z;
+)";
+
 namespace {
 
 constexpr int kFormatVersion = 1;
@@ -67,18 +82,7 @@ void main() {
 )";
 
 // Loaded form of the trees' program: the same instancing, plus haze.
-const char* const kInstanceVertexShaderHaze = R"(#version 120
-attribute vec4 vista_instance0;
-attribute vec4 vista_instance1;
-attribute vec4 vista_instance2;
-attribute vec4 vista_instance3;
-varying float vista_eye_depth;
-void main() {
-    mat4 instance = mat4(vista_instance0, vista_instance1, vista_instance2, vista_instance3);
-    vec4 p = instance * gl_Vertex;
-    gl_Position = gl_ModelViewProjectionMatrix * p;
-    vista_eye_depth = -(gl_ModelViewMatrix * p).z;
-    gl_FrontColor = gl_Color;
+const std::string kInstanceVertexShaderHaze = std::string(kInstancedHazeVertexHead) + R"(    gl_FrontColor = gl_Color;
     gl_BackColor = gl_Color;
 }
 )";

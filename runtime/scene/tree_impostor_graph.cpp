@@ -18,20 +18,9 @@
 namespace vista {
 namespace {
 
-const char* const kImpostorVertexShader = R"(#version 120
-attribute vec4 vista_instance0;
-attribute vec4 vista_instance1;
-attribute vec4 vista_instance2;
-attribute vec4 vista_instance3;
-varying float vista_eye_depth;
-void main() {
-    mat4 instance = mat4(vista_instance0, vista_instance1, vista_instance2, vista_instance3);
-    vec4 p = instance * gl_Vertex;
-    gl_Position = gl_ModelViewProjectionMatrix * p;
-    vista_eye_depth = -(gl_ModelViewMatrix * p).z;
-    gl_TexCoord[0] = gl_MultiTexCoord0;
+std::string vertexShader() {
+    return std::string(kInstancedHazeVertexHead) + "    gl_TexCoord[0] = gl_MultiTexCoord0;\n}\n";
 }
-)";
 
 std::string fragmentShader() {
     return std::string(kHazeGlsl) +
@@ -49,7 +38,7 @@ osg::Program* impostorProgram() {
     static osg::ref_ptr<osg::Program> prog = [] {
         osg::ref_ptr<osg::Program> p = new osg::Program;
         p->setName(kTreeImpostorProgramName);
-        p->addShader(new osg::Shader(osg::Shader::VERTEX, kImpostorVertexShader));
+        p->addShader(new osg::Shader(osg::Shader::VERTEX, vertexShader()));
         p->addShader(new osg::Shader(osg::Shader::FRAGMENT, fragmentShader()));
         for (unsigned c = 0; c < 4; ++c) p->addBindAttribLocation("vista_instance" + std::to_string(c), kInstanceAttrib0 + c);
         return p;
