@@ -297,7 +297,9 @@ TEST_F(Paged, IndexHasOnePagedLodPerRegion) {
         }
     }
     for (const auto& r : m["regions"])
-        if (!r["empty"].get<bool>()) EXPECT_EQ(named.count(r["files"][0]["name"].get<std::string>()), 1u);
+        if (!r["empty"].get<bool>()) {
+            EXPECT_EQ(named.count(r["files"][0]["name"].get<std::string>()), 1u);
+        }
     // The stock reader: the PagedLODs get the index's directory as database path.
     osg::ref_ptr<osg::Node> stock = osgDB::readNodeFile(dir + "/index.osgb");
     ASSERT_TRUE(stock.valid());
