@@ -218,7 +218,6 @@ Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>&
             if (!isCoarse) order.emplace_back(i, true);
             continue;
         }
-        if (isCoarse && first) continue;  // a fallback without any full region loaded (reported below)
         SceneModel& r = *rm;
         osg::Group* rroot = sceneRoot(r) ? sceneRoot(r)->asGroup() : nullptr;
         if (!rroot) return Status::error("region file '" + m.regions[size_t(i)].file + "' has no scene graph");
