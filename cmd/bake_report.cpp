@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
     std::vector<std::string> baked, labels;
     int cell = -1, frames = 20, ssaa = 4, width = 640, height = 480;
     double fov = 60;
-    std::string jsonOut, size = "640x480";
+    std::string jsonOut, size = "640x480", splat = "";
     app.add_option("--baked", baked, "baked files (same city)")->required();
     app.add_option("--size", size, "image size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 640x480)");
     app.add_option("--label", labels, "a label per baked file");
@@ -81,10 +81,17 @@ int main(int argc, char** argv) {
     app.add_option("--ssaa", ssaa, "reference supersampling factor per axis");
     app.add_option("--fov", fov, "vertical field of view, degrees");
     app.add_option("--json", jsonOut, "also write the results as JSON");
+    app.add_option("--point-splat", splat, "impostor points as splats of SIGMA output pixels (0.05 .. 4), or off = 1-pixel points (default " +
+                                               formatSplatSigma(kDefaultSplatSigma) + ")");
     const int rc = parseOrExit(app, argc, argv);
     if (rc >= 0) return rc;
     auto wh = parseImageSize(size);
     if (!wh) return reportBadInput("vista_bake_report", wh.status());
+    if (!splat.empty()) {
+        auto sg = parseSplatSigma(splat);
+        if (!sg) return reportBadInput("vista_bake_report", sg.status());
+        setPointSplatSigma(float(*sg));
+    }
     width = wh->width;
     height = wh->height;
     auto r1 = OffscreenRenderer::create(width, height);

@@ -164,6 +164,21 @@ Result<double> parseFov(const std::string& s) {
     return v;
 }
 
+Result<double> parseSplatSigma(const std::string& s) {
+    if (s == "off" || s == "0") return 0.0;
+    double v = 0;
+    if (!toNumber(s, v) || !(v >= 0.05 && v <= 4.0))
+        return Status::error("--point-splat '" + s + "': expected a Gaussian sigma in output pixels, 0.05 .. 4, or 'off' (1-pixel points)");
+    return v;
+}
+
+std::string formatSplatSigma(double sigma) {
+    if (!(sigma > 0)) return "off";
+    char b[32];
+    std::snprintf(b, sizeof b, "%g", sigma);
+    return b;
+}
+
 Result<int> parseReference(const std::string& s) {
     if (s == "full") return 0;
     long long k = 0;
@@ -261,6 +276,9 @@ void addModeFlags(CLI::App& app, ModeFlags& f) {
     app.add_option("--baked", f.baked, "impostor: the baked file of this city (from `vista bake`)");
     app.add_option("--baked-mesh", f.bakedMesh,
                    "lodmesh: the mesh bake of this city (from `vista bake --representation mesh`), unless the city file is one");
+    app.add_option("--point-splat", f.pointSplat,
+                   "impostor: points drawn as Gaussian splats of SIGMA output pixels with normalised accumulation, 0.05 .. 4, "
+                   "or off = 1-pixel points (default " + formatSplatSigma(ModeOptions().splatSigma) + ")");
     app.add_option("--threads", f.threads, "worker threads for ray casting, 0 .. 1024 (0 = all cores)");
 }
 
@@ -280,6 +298,8 @@ Status checkModeOptions(const ModeOptions& o) {
         return Status::error("--far-step " + std::to_string(o.farStep) + " out of range 1 .. 2 pixels");
     if (o.threads < 0 || o.threads > 1024)
         return Status::error("--threads " + std::to_string(o.threads) + " out of range 0 .. 1024 (0 = all cores)");
+    if (o.splatSigma != 0 && !(o.splatSigma >= 0.05 && o.splatSigma <= 4))
+        return Status::error("--point-splat " + std::to_string(o.splatSigma) + " out of range 0.05 .. 4 pixels (or off)");
     return Status::ok();
 }
 
@@ -307,6 +327,11 @@ Status parseModeFlags(const ModeFlags& f, ModeOptions& o) {
     o.bakedFile = f.baked;
     o.bakedMeshFile = f.bakedMesh;
     o.threads = f.threads;
+    if (!f.pointSplat.empty()) {
+        auto sg = parseSplatSigma(f.pointSplat);
+        if (!sg) return sg.status();
+        o.splatSigma = *sg;
+    }
     return checkModeOptions(o);
 }
 

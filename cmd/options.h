@@ -65,6 +65,10 @@ Result<std::string> parseModeName(const std::string& s);
 // with 1 <= K <= N; --texels 1 or AxB with A, B in 1 .. 32.
 Result<std::vector<uint32_t>> parseCellList(const std::string& s);
 Status parseTexels(const std::string& s, int& x, int& y);
+// --point-splat SIGMA|off: Gaussian sigma of the impostor splats in output
+// pixels, 0.05 .. 4, or "off" / "0" -> 0 (1-pixel points).
+Result<double> parseSplatSigma(const std::string& s);
+std::string formatSplatSigma(double sigma);  // "off" or the number
 // --sweep sizes=S1,S2,...: city sizes in metres, each 100 .. 16000.
 Result<std::vector<int>> parseSweep(const std::string& s);
 
@@ -87,6 +91,7 @@ struct ModeFlags {
     int farStep = 1;
     std::string baked;
     std::string bakedMesh;
+    std::string pointSplat;  // "" = the default (ModeOptions::splatSigma)
     int threads = 0;
 };
 // Declares the flags on `app`; the defaults shown are the values in `flags`.

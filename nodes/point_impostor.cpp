@@ -1,8 +1,11 @@
 #include "nodes/point_impostor.h"
+#include "nodes/point_splat.h"
 #include "nodes/texture_state.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <string>
 
 #include <osg/Point>
 #include <osg/Program>
@@ -18,33 +21,9 @@
 namespace vista {
 namespace {
 
-const char* const kVertexShader = R"(#version 120
-uniform vec3 vista_planeOrigin;
-uniform vec3 vista_planeU;
-uniform vec3 vista_planeV;
-uniform vec2 vista_texels;
-uniform vec2 vista_atlasSize;
-uniform int vista_useTexture;
-uniform vec4 vista_dequant;
-varying vec2 vUv;
-varying float vTextured;
+const char* const kVertexMain = R"(
 void main() {
-    vec4 e4 = gl_ModelViewMatrixInverse * vec4(0.0, 0.0, 0.0, 1.0);
-    vec3 eye = e4.xyz / e4.w;
-    vec3 p = vista_dequant.xyz + vista_dequant.w * gl_Vertex.xyz;
-    vec3 n = cross(vista_planeU, vista_planeV);
-    float denom = dot(n, p - eye);
-    vec2 ab = vec2(0.5);
-    if (abs(denom) > 1e-9) {
-        float t = dot(n, vista_planeOrigin - eye) / denom;
-        vec3 d = eye + t * (p - eye) - vista_planeOrigin;
-        ab = vec2(dot(d, vista_planeU) / dot(vista_planeU, vista_planeU), dot(d, vista_planeV) / dot(vista_planeV, vista_planeV));
-    }
-    vec2 tc = clamp(ab * vista_texels, vec2(0.5), vista_texels - vec2(0.5));
-    vTextured = (vista_useTexture != 0 && gl_MultiTexCoord0.x >= 0.0) ? 1.0 : 0.0;
-    vUv = (gl_MultiTexCoord0.xy + tc) / vista_atlasSize;
-    gl_FrontColor = gl_Color;
-    gl_Position = gl_ModelViewProjectionMatrix * vec4(p, 1.0);
+    gl_Position = gl_ModelViewProjectionMatrix * vec4(vista_impostorVertex(), 1.0);
 }
 )";
 
@@ -57,7 +36,22 @@ void main() {
 }
 )";
 
+std::atomic<float> gSplatSigma{kDefaultSplatSigma};
+
 }  // namespace
+
+void setPointSplatSigma(float sigmaPx) { gSplatSigma.store(sigmaPx > 0 ? sigmaPx : 0.0f); }
+float pointSplatSigma() { return gSplatSigma.load(); }
+
+void PointImpostor::drawImplementation(osg::RenderInfo& ri) const {
+    const float sigma = gSplatSigma.load();
+    if (sigma > 0) {
+        SplatParams p;
+        p.sigmaPx = sigma;
+        if (drawSplats(*this, ri, p)) return;
+    }
+    osg::Geometry::drawImplementation(ri);
+}
 
 PointImpostor::PointImpostor() {
     setUseDisplayList(false);
@@ -192,7 +186,7 @@ void PointImpostor::setData(const PointImpostorData& d) {
     osg::ref_ptr<osg::StateSet> ss = new osg::StateSet;
     osg::ref_ptr<osg::Program> prog = new osg::Program;
     prog->setName("vista.point_impostor");
-    prog->addShader(new osg::Shader(osg::Shader::VERTEX, kVertexShader));
+    prog->addShader(new osg::Shader(osg::Shader::VERTEX, std::string("#version 120\n") + impostorVertexLibrary() + kVertexMain));
     prog->addShader(new osg::Shader(osg::Shader::FRAGMENT, kFragmentShader));
     ss->setAttributeAndModes(prog.get(), osg::StateAttribute::ON);
     osg::ref_ptr<osg::Texture2D> tex = clampedLinearTexture(atlas.get());

@@ -9,7 +9,10 @@
 // p = dequant.xyz + dequant.w * q (one scale for all axes, so the shader's
 // plane projection stays orthogonal; step = largest half-extent / 32767, e.g.
 // 1.2 cm for a 800 m far field), 8-bit RGBA colours, 16-bit atlas offsets.
-// Drawing: GL_POINTS (1 pixel by default). A GLSL 1.20 shader intersects the
+// Drawing: as Gaussian splats with normalised accumulation (point_splat.h)
+// while pointSplatSigma() > 0 (the default, kDefaultSplatSigma output
+// pixels), else as GL_POINTS of 1 pixel (the stored state: what stock
+// osgviewer draws without the plugin's class). A GLSL 1.20 shader intersects the
 // ray from the viewer to the point with the sampling plane, maps it to the
 // point's block in a packed atlas texture (offset per point in texcoord 0,
 // x < 0 = single colour) and samples it bilinearly, clamped to the block so
@@ -41,6 +44,13 @@ struct PointImpostorData {
     std::vector<glm::u8vec4> texels;   // blocks of texelsX * texelsY, row-major (j, then i)
 };
 
+// How every PointImpostor of the process draws: splats of this Gaussian sigma
+// in output pixels (at the bake's focal length), or 1-pixel points for 0.
+// Set before rendering (vista bench/view --point-splat); read on the draw thread.
+constexpr float kDefaultSplatSigma = 0.25f;
+void setPointSplatSigma(float sigmaPx);
+float pointSplatSigma();
+
 constexpr int kAtlasBlocksPerRow = 256;
 constexpr int kMaxAtlasHeight = 8192;
 constexpr size_t kPointBytes = 6 + 4 + 4;  // position, colour, atlas offset (texels: 4 bytes each, extra)
@@ -61,6 +71,8 @@ public:
     // (for files read from disk: a corrupt impostor is reported, never drawn).
     std::string validate() const;
     osg::BoundingBox computeBoundingBox() const override;
+    // Splats or points, as pointSplatSigma() says.
+    void drawImplementation(osg::RenderInfo& ri) const override;
 
     // The packed atlas of `d` (texel blocks laid out as the shader expects).
     static osg::ref_ptr<osg::Image> buildAtlas(const PointImpostorData& d, std::vector<glm::vec2>& offsets);

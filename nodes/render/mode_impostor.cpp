@@ -3,6 +3,7 @@
 
 #include "foundation/timing.h"
 #include "nodes/baked_file.h"
+#include "nodes/point_impostor.h"
 
 namespace vista {
 namespace {
@@ -12,6 +13,7 @@ public:
     ImpostorMode(ModeContext& ctx, osg::ref_ptr<ViewCellSwitch> root, const SetupTimes& setup)
         : GraphMode(ctx), _root(std::move(root)) {
         _setup = setup;
+        setPointSplatSigma(float(ctx.options.splatSigma));
         // The near field in hybrid's 40 m chunks and at its near distance (view_cell_switch.h).
         _root->setNearChunks(ctx.nearField(), ctx.options.fixedNearDistance());
         _setup.push_back({"chunking", ctx.chunkingMs()});

@@ -33,6 +33,7 @@
 #include <osg/ref_ptr>
 
 #include "foundation/status.h"
+#include "nodes/point_impostor.h"
 #include "nodes/near_field_chunks.h"
 #include "nodes/view_cell_switch.h"
 #include "runtime/engine/frame_effects.h"
@@ -62,6 +63,7 @@ struct ModeOptions {
     double frameMsTarget = 0.0;   // hybrid: > 0 = the ray budget adapts so the frame takes about this long (ms), 0 .. 10000
     int farStep = 1;              // hybrid: far-field ray spacing, 1 (a ray per pixel) or 2 (FarFieldOptions::rayStep)
     int threads = 0;              // ray-casting threads; 0 = all cores
+    double splatSigma = kDefaultSplatSigma;  // impostor: splat Gaussian sigma in output pixels (PointImpostor), 0 = 1-pixel points
     std::string bakedFile;        // impostor: the baked file (unless the scene itself is baked)
     std::string bakedMeshFile;    // lodmesh: the mesh bake (unless the scene itself is one)
     FrameEffects effects;         // run-time effects of every mode (haze, glass reflections, night sky)

@@ -737,6 +737,7 @@ TEST(BenchCli, FarFieldFlagsRejectBadValues) {
     const std::pair<const char*, const char*> bad[] = {
         {"--near -5", "--near"}, {"--near abc", "--near"}, {"--horizon-grid -1", "--horizon-grid"},
         {"--budget -7", "--budget"}, {"--horizon-grid 9000", "--horizon-grid"}, {"--far-step 3", "--far-step"},
+        {"--point-splat 5", "--point-splat"}, {"--point-splat wide", "0.05 .. 4"},
         {"--memory-budget 0", "--memory-budget"}, {"--memory-budget lots", "--memory-budget"}};
     for (const auto& [args, flag] : bad) {
         EXPECT_EQ(runVista("bench " + dummy + " " + args + " --out " + dir + "/o", &out), 2) << args << ": " << out;

@@ -77,6 +77,11 @@ TEST(Options, FovReferenceAndModes) {
     EXPECT_DOUBLE_EQ(parseFov("60").value(), 60.0);
     EXPECT_DOUBLE_EQ(parseFov("1.5").value(), 1.5);
     for (const char* bad : {"1", "179", "0", "-60", "200", "wide", ""}) expectBad(parseFov(bad), bad, "--fov", "179");
+    EXPECT_DOUBLE_EQ(parseSplatSigma("off").value(), 0.0);
+    EXPECT_DOUBLE_EQ(parseSplatSigma("0.25").value(), 0.25);
+    EXPECT_EQ(formatSplatSigma(0.25), "0.25");
+    EXPECT_EQ(formatSplatSigma(0), "off");
+    for (const char* bad : {"0.01", "4.5", "-1", "wide", ""}) expectBad(parseSplatSigma(bad), bad, "--point-splat", "0.05 .. 4");
     EXPECT_EQ(parseReference("full").value(), 0);
     EXPECT_EQ(parseReference("ssaa:2").value(), 2);
     EXPECT_EQ(parseReference("ssaa:8").value(), 8);
