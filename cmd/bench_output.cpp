@@ -124,6 +124,7 @@ json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneM
                     {"cache_error_px", o.cacheErrorPx},
                     {"cache_adaptive", o.cacheAdaptive},
                     {"far_step", o.farStep},
+                    {"point_splat_px", o.splatSigma > 0 ? json(o.splatSigma) : json("off")},
                     {"overlap", o.overlap},
                     {"frame_ms_target", o.frameMsTarget},
                     {"threads", o.threads}};
