@@ -17,7 +17,7 @@
 #
 # usage: docs/tools/splat_table.sh [OUT_DIR] [VISTA_BIN]
 #   env: SIZE_M (default 2000), CITY_SEED (default 1), CELLS (default "3 20 940 1180"),
-#        SIGMAS (default "0.25 0.4 0.7"), FRAMES (default 10)
+#        SIGMAS (default "0.25 0.4 0.7"), FRAMES (default 10), MARKER (the block, default splat-table)
 # vista_bake_report is taken from VISTA_BIN's directory. Needs python3.
 set -euo pipefail
 source "$(dirname "$0")/lib.sh"
@@ -30,7 +30,8 @@ CITY_SEED=${CITY_SEED:-1}
 CELLS=${CELLS:-"3 20 940 1180"}
 SIGMAS=${SIGMAS:-"0.25 0.4 0.7"}
 FRAMES=${FRAMES:-10}
-INVOCATION="SIZE_M=$SIZE_M CITY_SEED=$CITY_SEED CELLS='$CELLS' SIGMAS='$SIGMAS' FRAMES=$FRAMES docs/tools/splat_table.sh OUT $(basename "$VISTA")"
+MARKER=${MARKER:-splat-table}
+INVOCATION="SIZE_M=$SIZE_M CITY_SEED=$CITY_SEED CELLS='$CELLS' SIGMAS='$SIGMAS' FRAMES=$FRAMES MARKER=$MARKER docs/tools/splat_table.sh OUT $(basename "$VISTA")"
 mkdir -p "$OUT"
 touch "$OUT/commands.log"
 run() { echo "$*" >> "$OUT/commands.log"; "${XVFB[@]}" "$@"; }
@@ -75,5 +76,5 @@ for s in settings:
           + f" | {better} of {len(alli)} | {gain:+.2f} | " + " / ".join(f"{rep[(c, s)]['imp_ms']:.1f}" for c in cells) + " |")
 print()
 PYEOF
-doc_replace_block docs/results.md splat-table "$TABLE"
-log "docs/results.md splat-table block written"
+doc_replace_block docs/results.md "$MARKER" "$TABLE"
+log "docs/results.md $MARKER block written"
