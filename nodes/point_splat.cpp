@@ -313,8 +313,12 @@ bool drawSplats(const osg::Geometry& geometry, osg::RenderInfo& ri, const SplatP
     glScissor(scissorBox[0], scissorBox[1], scissorBox[2], scissorBox[3]);
     if (!scissorWas) glDisable(GL_SCISSOR_TEST);
     glClearColor(clear[0], clear[1], clear[2], clear[3]);
-    if (own) st.popStateSet();
-    st.apply(own);  // back to the state OSG applied for this drawable
+    if (own) {
+        st.popStateSet();
+        st.apply(own);  // back to the state OSG applied for this drawable (RenderLeaf)
+    } else {
+        st.apply();
+    }
     return true;
 }
 
