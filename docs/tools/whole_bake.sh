@@ -55,7 +55,7 @@ out, kinds, invocation = sys.argv[1], sys.argv[2].split(), sys.argv[3]
 w = json.load(open(f"{out}/whole.json"))
 t = open(f"{out}/bake.time").read()
 def field(name):
-    m = re.search(re.escape(name) + r"[^:]*:\s*(\S+)", t)
+    m = re.search(re.escape(name) + r".*:\s+(\S+)\s*$", t, re.M)
     return m.group(1) if m else "?"
 def secs(v):
     p = [float(x) for x in v.split(":")]
