@@ -104,7 +104,7 @@ TEST(TreeImpostor, CoverageMatchesProjectedTriangles) {
                     alpha += a;
                     const bool border = x < kImpostorPadPixels || y < kImpostorPadPixels || x >= cellPx - kImpostorPadPixels ||
                                         y >= cellPx - kImpostorPadPixels;
-                    if (border) EXPECT_EQ(a, 0) << "padding texel " << x << "," << y << " of cell " << cell << " is covered";
+                    if (border) { EXPECT_EQ(a, 0) << "padding texel " << x << "," << y << " of cell " << cell << " is covered"; }
                 }
             const double measured = alpha / 255.0 / (double(inner) * inner);
             EXPECT_NEAR(measured, expected, 0.015) << "prototype " << pi << " cell " << cell;

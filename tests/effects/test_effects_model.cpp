@@ -90,7 +90,7 @@ TEST(Haze, KoschmiederContrastAtTheVisibilityAndStableFrom20mTo1e6m) {
         int last = -1;
         for (double z = 0; z <= 2 * v; z += v / 16) {  // monotone towards the haze colour
             const int d = std::abs(int(fx.applyHaze(c, z).y) - int(h.y));
-            if (last >= 0) EXPECT_LE(d, last) << v << " " << z;
+            if (last >= 0) { EXPECT_LE(d, last) << v << " " << z; }
             last = d;
         }
         for (double z : {-1.0, std::numeric_limits<double>::infinity(), 1e300})
@@ -303,7 +303,7 @@ TEST(BakedLighting, HardCasesStayFinite) {
             const glm::u8vec4 lit = prelitColor(Material::Ground, {0, 0, 1}, light);
             for (size_t i = 0; i < g.positions.size(); ++i) {
                 const glm::dvec3 p = city.tiles[0].origin + glm::dvec3(g.positions[i]);
-                if (std::max(std::abs(p.x), std::abs(p.y)) > 5 + 6.5) EXPECT_GE(g.colors[i].x + 2, lit.x) << p.x << "," << p.y;
+                if (std::max(std::abs(p.x), std::abs(p.y)) > 5 + 6.5) { EXPECT_GE(g.colors[i].x + 2, lit.x) << p.x << "," << p.y; }
             }
         }
     }

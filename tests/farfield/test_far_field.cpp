@@ -539,8 +539,9 @@ TEST(FarFieldFrame, HazeOfCoveredPixelsMatchesTheFormulaAtTheirDepth) {
         FrameStats s2;
         ff.render(c, depth.data(), plain, s2);
         for (size_t i = 0; i < N; ++i)
-            if (ff.classification()[i] == kFarCovered)
+            if (ff.classification()[i] == kFarCovered) {
                 ASSERT_EQ(std::memcmp(&plain.rgba[i * 4], &in.rgba[i * 4], 4), 0);
+            }
     }
 }
 
@@ -614,8 +615,9 @@ TEST(FarFieldFrame, LatticeRaysBlendOnlyWithinOneSurface) {
         for (int y = 0; y < c.height; y += 2)
             for (int x = 0; x < c.width; x += 2) {
                 const size_t i = size_t(y) * size_t(c.width) + size_t(x);
-                if (lattice.classification()[i] == kFarRayHit || lattice.classification()[i] == kFarRayMiss)
+                if (lattice.classification()[i] == kFarRayHit || lattice.classification()[i] == kFarRayMiss) {
                     ASSERT_EQ(channelDiff(a, b, i), 0) << x << "," << y;
+                }
             }
     }
     // One flat-coloured wall filling the view, and sky above it: every blended

@@ -428,7 +428,7 @@ TEST(FarField, CachePausesWhileItsReuseDoesNotPayAndResumes) {
             FrameStats st;
             ff.render(c, nullptr, img, st);
             EXPECT_EQ(st.stages.ran(Stage::Cache), !paused(st)) << "frame " << f;
-            if (paused(st)) EXPECT_EQ(st.pixels.cache, 0u) << "frame " << f;
+            if (paused(st)) { EXPECT_EQ(st.pixels.cache, 0u) << "frame " << f; }
             pattern.push_back(st.stages.ran(Stage::Cache) ? 1 : 0);
         }
         return pattern;

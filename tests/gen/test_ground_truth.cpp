@@ -130,7 +130,7 @@ void checkAgainstRays(const std::string& cityFile, const std::string& out, const
         for (size_t p = 0; p < cls.size(); ++p) {  // every pixel: sky or a surface class, depth +inf iff sky
             ASSERT_LT(cls[p], kSemanticClassCount) << "pixel " << p << " without a class";
             ASSERT_EQ(cls[p] == 0, std::isinf(depth[p])) << "pixel " << p;
-            if (cls[p] == 0) ASSERT_EQ(ids[p], 0u);
+            if (cls[p] == 0) { ASSERT_EQ(ids[p], 0u); }
         }
         Camera cam;
         cam.width = kW;
