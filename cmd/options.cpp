@@ -164,10 +164,15 @@ Result<double> parseFov(const std::string& s) {
     return v;
 }
 
+Status checkSplatSigma(double sigma) {
+    if (sigma == 0 || (sigma >= kMinSplatSigma && sigma <= kMaxSplatSigma)) return Status::ok();
+    return Status::error("--point-splat " + num(sigma) + " out of range 0.05 .. 4 pixels (or off)");
+}
+
 Result<double> parseSplatSigma(const std::string& s) {
     if (s == "off" || s == "0") return 0.0;
     double v = 0;
-    if (!toNumber(s, v) || !(v >= 0.05 && v <= 4.0))
+    if (!toNumber(s, v) || !checkSplatSigma(v) || v == 0)
         return Status::error("--point-splat '" + s + "': expected a Gaussian sigma in output pixels, 0.05 .. 4, or 'off' (1-pixel points)");
     return v;
 }
@@ -298,9 +303,7 @@ Status checkModeOptions(const ModeOptions& o) {
         return Status::error("--far-step " + std::to_string(o.farStep) + " out of range 1 .. 2 pixels");
     if (o.threads < 0 || o.threads > 1024)
         return Status::error("--threads " + std::to_string(o.threads) + " out of range 0 .. 1024 (0 = all cores)");
-    if (o.splatSigma != 0 && !(o.splatSigma >= 0.05 && o.splatSigma <= 4))
-        return Status::error("--point-splat " + std::to_string(o.splatSigma) + " out of range 0.05 .. 4 pixels (or off)");
-    return Status::ok();
+    return checkSplatSigma(o.splatSigma);
 }
 
 Status parseModeFlags(const ModeFlags& f, ModeOptions& o) {

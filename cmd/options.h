@@ -67,7 +67,9 @@ Result<std::vector<uint32_t>> parseCellList(const std::string& s);
 Status parseTexels(const std::string& s, int& x, int& y);
 // --point-splat SIGMA|off: Gaussian sigma of the impostor splats in output
 // pixels, 0.05 .. 4, or "off" / "0" -> 0 (1-pixel points).
+constexpr double kMinSplatSigma = 0.05, kMaxSplatSigma = 4.0;
 Result<double> parseSplatSigma(const std::string& s);
+Status checkSplatSigma(double sigma);  // 0 (off) or within the range
 std::string formatSplatSigma(double sigma);  // "off" or the number
 // --sweep sizes=S1,S2,...: city sizes in metres, each 100 .. 16000.
 Result<std::vector<int>> parseSweep(const std::string& s);

@@ -71,6 +71,11 @@ TEST(Options, SamplingAndCacheKnobs) {
     EXPECT_TRUE(checkModeOptions(o).isOk());
     o.frameMsTarget = 10001;
     EXPECT_NE(checkModeOptions(o).message().find("--frame-ms"), std::string::npos);
+    o.frameMsTarget = 0;
+    o.splatSigma = 4.5;
+    EXPECT_NE(checkModeOptions(o).message().find("--point-splat"), std::string::npos);
+    o.splatSigma = 0;  // off: 1-pixel points
+    EXPECT_TRUE(checkModeOptions(o).isOk());
 }
 
 TEST(Options, FovReferenceAndModes) {
