@@ -1,5 +1,7 @@
 #include "nodes/point_splat.h"
 
+#include "foundation/units.h"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -102,7 +104,7 @@ void main() {
 )";
 
 // The focal length (pixels) of the bake's default target: 480 rows over 60 degrees.
-const double kBakeFocalPx = 240.0 / std::tan(30.0 * 3.14159265358979323846 / 180.0);
+const double kBakeFocalPx = 240.0 / std::tan(30.0 * kPi / 180.0);
 // Kernel cut-off in sigmas (weight exp(-2) = 0.14 at the rim; at the default
 // sigma of 0.25 px the rim is half a pixel: a point feeds only the pixels
 // whose centre is within half a pixel of it).
