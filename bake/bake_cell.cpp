@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <tbb/parallel_for.h>
+
 #include "bake/point_removal.h"
 #include "citygen/terrain.h"
 #include "foundation/hash.h"
@@ -66,22 +68,24 @@ Status bakeImpostor(const TriangleSoup& soup, const Box3& cellBox, const BakePar
     if (!scene) return scene.status();
     const SamplingSetup& s = *setup;
     LdiResult ldi = sampleLdi(**scene, s, far, p.sampling);
-    std::vector<uint8_t> keep = removeRedundant(ldi, s, cellBox, p.sampling);
+    // Visibility first (cheap per sample), then the removal only among the
+    // visible samples: both are decided per sample, so the order does not
+    // change the result, only the work.
+    std::vector<uint8_t> visible;
+    if (keepVisible) {
+        std::vector<glm::vec3> all(ldi.samples.size());
+        for (size_t i = 0; i < all.size(); ++i) all[i] = ldi.samples[i].pos;
+        visible = keepVisible(all);
+        visible.resize(all.size(), 0);
+    }
+    std::vector<uint8_t> keep = removeRedundant(ldi, s, cellBox, p.sampling, keepVisible ? &visible : nullptr);
     std::vector<glm::vec3> pts;
     for (size_t i = 0; i < ldi.samples.size(); ++i)
         if (keep[i]) pts.push_back(ldi.samples[i].pos);
     r.stats.ldiRays = ldi.rays;
     r.stats.ldiSamples = ldi.samples.size();
     r.stats.afterRemoval = pts.size();
-    size_t occludedDropped = 0;
-    if (keepVisible) {
-        const std::vector<uint8_t> vis = keepVisible(pts);
-        std::vector<glm::vec3> kept;
-        for (size_t i = 0; i < pts.size(); ++i)
-            if (i < vis.size() && vis[i]) kept.push_back(pts[i]);
-        occludedDropped = pts.size() - kept.size();
-        pts.swap(kept);
-    }
+    const size_t occludedDropped = keepVisible ? size_t(std::count(visible.begin(), visible.end(), uint8_t(0))) : 0;
     r.stats.requiredStep = ldi.requiredStep;
     r.stats.usedStep = std::max({ldi.cams[0].step, ldi.cams[1].step, ldi.cams[2].step});
     for (int k = 0; k < 3; ++k) {
@@ -170,6 +174,28 @@ void startResult(R& r, const ViewCell& cell, int end, FarSet& fs) {
 
 }  // namespace
 
+PlacementPlan planPlacement(const BakeInput& in, const BakeParams& p, std::atomic<size_t>* done) {
+    std::vector<std::vector<PlannedEnd>> perCell(in.cells.size());
+    if (in.cityRays)
+        tbb::parallel_for(size_t(0), in.cells.size(), size_t(1), [&](size_t ci) {
+            const ViewCell& cell = in.cells[ci];
+            for (int end = 0; end < 2; ++end) {
+                const FarSet fs = selectFarSet(*in.city, in.tiles, cell, end, p.far);
+                if (fs.soup.triangleCount() < std::max<size_t>(p.far.minTriangles, 1)) continue;
+                PlannedEnd e;
+                e.cell = cell.id;
+                e.end = uint8_t(end);
+                e.estimate = estimatePlacement(*in.cityRays, in.tileLookup, cell, fs, p.sampling, p.placement);
+                e.predictedMb = predictedMb(e.estimate, p.placement);
+                perCell[ci].push_back(e);
+            }
+            if (done) ++*done;
+        });
+    std::vector<PlannedEnd> ends;
+    for (auto& v : perCell) ends.insert(ends.end(), v.begin(), v.end());
+    return rankPlacement(std::move(ends), p.placement.budgetMb);
+}
+
 CellResult bakeCell(const BakeInput& in, const ViewCell& cell, const BakeParams& p) {
     if (p.representation == BakeRepresentation::Mesh)
         return forEachEnd(in, cell, p, [&](FarSet& fs, int end, const std::string& what, const Stopwatch& endTime, CellResult& out) {
@@ -188,8 +214,12 @@ CellResult bakeCell(const BakeInput& in, const ViewCell& cell, const BakeParams&
         });
     return forEachEnd(in, cell, p, [&](FarSet& fs, int end, const std::string& what, const Stopwatch& endTime, CellResult& out) {
         if (p.placement.byCost) {
+            const PlannedEnd* planned = in.plan ? in.plan->find(cell.id, end) : nullptr;
             if (!in.cityRays) {
                 out.notes.push_back(what + "placement by cost: no city ray scene, placed");
+            } else if (planned) {
+                out.notes.push_back(what + planned->describe());
+                if (!planned->inBudget) return;
             } else {
                 const PlacementEstimate est = estimatePlacement(*in.cityRays, in.tileLookup, cell, fs, p.sampling, p.placement);
                 out.notes.push_back(what + (est.place ? "placed: " : "not placed: ") + est.describe());
@@ -201,7 +231,7 @@ CellResult bakeCell(const BakeInput& in, const ViewCell& cell, const BakeParams&
         startResult(r, cell, end, fs);
         std::function<std::vector<uint8_t>(const std::vector<glm::vec3>&)> keep;
         if (p.placement.byCost && in.cityRays)
-            keep = [&](const std::vector<glm::vec3>& pts) { return visibleFromCell(*in.cityRays, cell, frame, pts, p.placement); };
+            keep = [&](const std::vector<glm::vec3>& pts) { return visibleFromCell(*in.cityRays, cell, frame, pts, outputPixelAngle(p.sampling), p.placement); };
         if (Status st = bakeImpostor(fs.soup, cellInFrame(cell, r.frame), p, hashKeys(cell.id, uint64_t(end)), r, keep); !st) {
             out.notes.push_back(what + st.message());
             return;

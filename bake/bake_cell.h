@@ -10,6 +10,7 @@
 // that yields no visible point gets no impostor and a note saying why.
 // Thread-safe on a const BakeInput; runs its own loops in parallel (TBB).
 #pragma once
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -29,10 +30,19 @@ struct BakeInput {
     // scene could not be built (then every end is baked, with a note).
     std::shared_ptr<const RayScene> cityRays;
     TileLookup tileLookup;
+    // The storage-budget plan (p.placement.budgetMb > 0; planPlacement, set
+    // by the caller): bakeCell then follows it instead of estimating the end.
+    std::shared_ptr<const PlacementPlan> plan;
     std::vector<ViewCell> cells;       // one per street edge that is not degenerate
     std::vector<SkippedCell> skipped;  // the degenerate edges
 };
 BakeInput prepareBake(const SceneModel& city, const BakeParams& p);
+
+// The whole city's placement under p.placement.budgetMb (bake/placement.h):
+// every cell's street ends with a large enough far field, estimated in
+// parallel (TBB; `done` counts finished cells), then ranked. Needs
+// in.cityRays (else an empty plan). Deterministic: depends on (city, params).
+PlacementPlan planPlacement(const BakeInput& in, const BakeParams& p, std::atomic<size_t>* done = nullptr);
 
 // Dispatches on p.representation: point impostors (impostors) or textured
 // depth meshes (meshes; bakeMeshEnd per street end, same far sets).

@@ -19,6 +19,10 @@ std::string BakeParams::canonical() const {
         o << ";place=cost," << placement.triangleNs << "," << placement.pointNs << "," << placement.pointsPerFarPixel << ","
           << placement.samplesAlong << "x" << placement.samplesAcross << "," << placement.rayStepPx << "," << placement.maxRaysPerSample
           << ";vis=" << placement.visAlong << "x" << placement.visAcross << "x" << placement.visHeights;
+    if (representation == BakeRepresentation::Points && placement.byCost && placement.visByImage)
+        o << ";visImage=" << placement.visStepPx << "," << placement.maxVisRaysPerView << "," << placement.visMaxTan;
+    if (representation == BakeRepresentation::Points && placement.byCost && placement.budgetMb > 0)
+        o << ";budget=" << placement.budgetMb << "," << placement.bytesPerPoint;
     if (representation == BakeRepresentation::Mesh)
         o << ";repr=mesh;meshTri=" << mesh.maxTriangles << ";meshImg=" << mesh.imageSize << ";meshErr=" << mesh.errorPx;
     return o.str();

@@ -120,6 +120,17 @@ nlohmann::json meshStatsJson(const MeshResult& r) {
     return j;
 }
 
+// Area (m^2) of the street graph's bounding box, at least 1 km^2 (the
+// automatic storage budget's measure of the city).
+double streetArea(const StreetGraph& g) {
+    glm::dvec2 lo(1e300), hi(-1e300);
+    for (const glm::dvec2& q : g.nodes) {
+        lo = glm::min(lo, q);
+        hi = glm::max(hi, q);
+    }
+    return lo.x <= hi.x ? std::max((hi.x - lo.x) * (hi.y - lo.y), 1e6) : 1e6;
+}
+
 // Bakes in.cells[todo[k]] on `arena`, each result written atomically as soon
 // as it is done; progress from this thread while a worker thread runs the loop.
 Status bakeCells(const BakeInput& in, const std::vector<size_t>& todo, const BakeParams& p, uint64_t configHash,
@@ -179,7 +190,7 @@ std::vector<size_t> shardOf(const BakeJob& job, const std::vector<size_t>& selec
 }
 
 // Bakes the cells of `mine` that have no valid result in the work directory yet.
-Status bakeMissingCells(const BakeJob& job, const BakeInput& in, const std::vector<size_t>& mine, const BakeParams& p,
+Status bakeMissingCells(const BakeJob& job, BakeInput& in, const std::vector<size_t>& mine, const BakeParams& p,
                         uint64_t configHash, BakeReport& rep, Progress* progress, const std::function<void(const std::string&)>& log) {
     std::vector<size_t> todo;
     for (size_t ci : mine) {
@@ -193,6 +204,32 @@ Status bakeMissingCells(const BakeJob& job, const BakeInput& in, const std::vect
         log(std::to_string(mine.size()) + " cells (" + std::to_string(todo.size()) + " in this run, " + std::to_string(rep.resumed) +
             " already done), " + std::to_string(in.skipped.size()) + " degenerate edges skipped");
     tbb::task_arena arena(job.jobs > 0 ? job.jobs : tbb::task_arena::automatic);
+    if (!todo.empty() && p.representation == BakeRepresentation::Points && p.placement.byCost && p.placement.budgetMb > 0 &&
+        in.cityRays) {
+        // The storage budget ranks every street end of the city, so every run
+        // (shard, resume) plans the whole city the same way.
+        std::atomic<size_t> done{0};
+        PlacementPlan plan;
+        if (progress) progress->begin("plan");
+        std::thread worker([&] { arena.execute([&] { plan = planPlacement(in, p, &done); }); });
+        while (done.load() < in.cells.size()) {
+            if (progress) progress->update(double(done.load()) / double(std::max<size_t>(in.cells.size(), 1)));
+            std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        }
+        worker.join();
+        if (progress) progress->end();
+        rep.planChosen = plan.chosen;
+        rep.planPaying = plan.paying;
+        rep.planChosenMb = plan.chosenMb;
+        rep.planPayingMb = plan.payingMb;
+        if (log) {
+            char buf[200];
+            std::snprintf(buf, sizeof buf, "storage budget %.1f MB: %zu of %zu street ends that pay (%.1f of %.1f MB predicted)",
+                          p.placement.budgetMb, plan.chosen, plan.paying, plan.chosenMb, plan.payingMb);
+            log(buf);
+        }
+        in.plan = std::make_shared<const PlacementPlan>(std::move(plan));
+    }
     return bakeCells(in, todo, p, configHash, rep.workDir, arena, progress);
 }
 
@@ -257,6 +294,8 @@ Status writeStatsFile(const BakeJob& job, const BakeReport& rep, size_t cells, c
     top["wall_s"] = rep.wallS;
     top["output_bytes"] = rep.outputBytes;
     top["params"] = canon;
+    if (job.params.representation == BakeRepresentation::Points && job.params.placement.byCost)
+        top["storage_budget_mb"] = rep.budgetMb;
     top["impostor_stats"] = std::move(impostorStats);
     top["notes"] = rep.notes;
     return writeFileAtomic(job.statsFile, top.dump(1));
@@ -275,6 +314,7 @@ Result<BakeReport> runBakeJob(const BakeJob& job, Progress* progress, const std:
         return Status::error("'" + job.input + "' is already baked; bake the plain city file");
     BakeParams p = job.params;
     p.seed = city->params.seed;
+    if (p.placement.budgetMbPerKm2 > 0) p.placement.budgetMb = p.placement.budgetMbPerKm2 * streetArea(city->streets) * 1e-6;
     const std::string canon = p.canonical();
     uint64_t configHash = 0;  // of the input's bytes and the parameters: a cell result is reused only under both
     {
@@ -282,8 +322,9 @@ Result<BakeReport> runBakeJob(const BakeJob& job, Progress* progress, const std:
         if (!bytes) return bytes.status();
         configHash = hashBytes64(bytes->data(), bytes->size(), hashBytes64(canon.data(), canon.size()));
     }
-    const BakeInput in = prepareBake(*city, p);
+    BakeInput in = prepareBake(*city, p);
     rep.skippedEdges = in.skipped.size();
+    rep.budgetMb = p.placement.budgetMb;
 
     auto selected = selectCells(job, in, city->streets.edges.size());
     if (!selected) return selected.status();

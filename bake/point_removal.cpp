@@ -63,8 +63,11 @@ bool sufficient(const LdiCamera& c, const SamplingSetup& s, const glm::dvec3& po
 
 }  // namespace
 
-std::vector<uint8_t> removeRedundant(const LdiResult& ldi, const SamplingSetup& s, const Box3& cell, const SamplingParams& p) {
+std::vector<uint8_t> removeRedundant(const LdiResult& ldi, const SamplingSetup& s, const Box3& cell, const SamplingParams& p,
+                                     const std::vector<uint8_t>* only) {
     std::vector<uint8_t> keep(ldi.samples.size(), 1);
+    if (only)
+        for (size_t i = 0; i < keep.size(); ++i) keep[i] = i < only->size() && (*only)[i] ? 1 : 0;
     if (!p.removeRedundant) return keep;
     // "Sufficient": every edge of camera m's sampling pattern around the point
     // (pixel edges, and the shorter pixel diagonal when the diagonal factor is on)
@@ -75,6 +78,7 @@ std::vector<uint8_t> removeRedundant(const LdiResult& ldi, const SamplingSetup& 
     std::array<glm::dvec3, 8> corners;
     for (int i = 0; i < 8; ++i) corners[size_t(i)] = cell.corner(i);
     tbb::parallel_for(size_t(0), ldi.samples.size(), [&](size_t idx) {
+        if (!keep[idx]) return;
         const LdiSample& a = ldi.samples[idx];
         const glm::dvec3 pos(a.pos), nrm(a.normal);
         const double dmin = cell.distance(pos);

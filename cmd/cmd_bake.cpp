@@ -17,7 +17,8 @@ int runBake(int argc, char** argv) {
                  cmd};
     BakeJob job;
     BakeParams& p = job.params;
-    std::string cellList, shard, texels = "8x2", representation = "points", placement = "cost";
+    std::string cellList, shard, texels = "8x2", representation = "points", placement = "cost", budget = "auto",
+                visibility = "image";
     bool quiet = false, noRemoval = false;
     app.add_option("city", job.input, "input city file (.osgb from 'vista gen')")->required();
     app.add_option("-o,--output", job.output, "baked output file (.osgb)")->required();
@@ -63,6 +64,15 @@ int runBake(int argc, char** argv) {
         ->capture_default_str();
     app.add_option("--triangle-ns", p.placement.triangleNs, "placement: raster cost of a triangle, ns (measured here)")->capture_default_str();
     app.add_option("--point-ns", p.placement.pointNs, "placement: raster cost of a point, ns (measured here)")->capture_default_str();
+    app.add_option("--storage-budget", budget,
+                   "points: auto (" + std::to_string(int(kAutoBudgetMbPerKm2)) +
+                       " MB per km2 of the street graph's bounding box), off, or MB: impostors only at the street ends that save the "
+                       "most raster time per predicted MB, until the budget is spent")
+        ->capture_default_str();
+    app.add_option("--visibility", visibility,
+                   "points: how the cell's viewpoints test the baked points: image (a depth image per viewpoint, then rays for the "
+                   "points it leaves) or rays (one occlusion ray per point and viewpoint)")
+        ->capture_default_str();
     app.add_option("--mesh-triangles", p.mesh.maxTriangles, "mesh: triangle budget per view cell (half per street end)")
         ->capture_default_str();
     app.add_option("--mesh-image", p.mesh.imageSize, "mesh: largest side of the far-field image in pixels")->capture_default_str();
@@ -83,6 +93,13 @@ int runBake(int argc, char** argv) {
     if (!(p.placement.triangleNs > 0 && p.placement.triangleNs < 1e9) || !(p.placement.pointNs > 0 && p.placement.pointNs < 1e9))
         return reportBadInput(cmd, Status::error("--triangle-ns / --point-ns: " + std::to_string(p.placement.triangleNs) + " / " +
                                                  std::to_string(p.placement.pointNs) + " out of range (0, 1e9) ns"));
+    if (visibility != "image" && visibility != "rays")
+        return reportBadInput(cmd, Status::error("--visibility '" + visibility + "': unknown (allowed: image, rays)"));
+    p.placement.visByImage = visibility == "image";
+    auto mb = parseStorageBudget(budget);
+    if (!mb) return reportBadInput(cmd, mb.status());
+    if (*mb < 0) p.placement.budgetMbPerKm2 = kAutoBudgetMbPerKm2;
+    else p.placement.budgetMb = *mb;
     if (Status s = validateBakeJob(job); !s) return reportBadInput(cmd, s);
     if (!shard.empty()) {
         auto sh = parseShard("--shard", shard);

@@ -164,6 +164,15 @@ Result<double> parseFov(const std::string& s) {
     return v;
 }
 
+Result<double> parseStorageBudget(const std::string& s) {
+    if (s == "auto") return -1.0;
+    if (s == "off") return 0.0;
+    double v = 0;
+    if (!toNumber(s, v) || !(v >= kMinStorageBudgetMb && v <= kMaxStorageBudgetMb))
+        return Status::error("--storage-budget '" + s + "': expected auto, off or megabytes in 0.01 .. 1000000");
+    return v;
+}
+
 Status checkSplatSigma(double sigma) {
     if (sigma == 0 || (sigma >= kMinSplatSigma && sigma <= kMaxSplatSigma)) return Status::ok();
     return Status::error("--point-splat " + num(sigma) + " out of range 0.05 .. 4 pixels (or off)");

@@ -71,6 +71,9 @@ constexpr double kMinSplatSigma = 0.05, kMaxSplatSigma = 4.0;
 Result<double> parseSplatSigma(const std::string& s);
 Status checkSplatSigma(double sigma);  // 0 (off) or within the range
 std::string formatSplatSigma(double sigma);  // "off" or the number
+// --storage-budget auto|off|MB: -1 for auto, 0 for off, else MB in 0.01 .. 1e6.
+constexpr double kMinStorageBudgetMb = 0.01, kMaxStorageBudgetMb = 1e6;
+Result<double> parseStorageBudget(const std::string& s);
 // --sweep sizes=S1,S2,...: city sizes in metres, each 100 .. 16000.
 Result<std::vector<int>> parseSweep(const std::string& s);
 

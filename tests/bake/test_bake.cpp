@@ -2,6 +2,7 @@
 // triangle, cameras, LDI, point removal), Monte Carlo appearance, cell
 // results and their codec, baked file, the driver as a library call, CLI.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -1017,7 +1018,7 @@ TEST(Placement, PointsBehindAnOccluderAreDroppedAndTheCostRuleHolds) {
     const glm::vec3 front(fs.frame.toLocal(glm::dvec3(284.9, -26, 5)));  // on its face towards the cell
     const glm::vec3 behind(fs.frame.toLocal(glm::dvec3(316.5, -26, 5)));  // behind it, seen from nowhere in the cell
     const glm::vec3 above(fs.frame.toLocal(glm::dvec3(300, -26, 12.05)));  // on its roof: seen over it from eye height? no
-    const std::vector<uint8_t> vis = visibleFromCell(*in.cityRays, cell, fs.frame, {front, behind, above}, p.placement);
+    const std::vector<uint8_t> vis = visibleFromCell(*in.cityRays, cell, fs.frame, {front, behind, above}, outputPixelAngle(p.sampling), p.placement);
     ASSERT_EQ(vis.size(), 3u);
     EXPECT_EQ(vis[0], 1) << "a point on the face towards the cell is visible";
     EXPECT_EQ(vis[1], 0) << "a point behind the wall is occluded from every viewpoint";
@@ -1045,6 +1046,33 @@ TEST(Placement, PointsBehindAnOccluderAreDroppedAndTheCostRuleHolds) {
         EXPECT_GT(blocked, 0u);
         EXPECT_LT(blocked, org.size());
         EXPECT_EQ(many.back(), 0) << "an empty interval is not occluded";
+    }
+    // The depth-image prefilter (the default) against one ray per point and
+    // viewpoint: a grid of points through the far tile (inside walls, on
+    // faces, in the open) — what the image keeps is confirmed by rays, so it
+    // is a subset; it may lose only points seen through sub-pixel gaps.
+    {
+        std::vector<glm::vec3> grid;
+        for (int i = 0; i < 40; ++i)
+            for (int j = 0; j < 30; ++j)
+                for (int k = 0; k < 8; ++k)
+                    grid.push_back(glm::vec3(fs.frame.toLocal(glm::dvec3(270 + 1.55 * i, -45 + 1.9 * j, 0.3 + 1.9 * k))));
+        PlacementParams byRays = p.placement;
+        byRays.visByImage = false;
+        ASSERT_TRUE(p.placement.visByImage) << "the image prefilter is the default";
+        const std::vector<uint8_t> img = visibleFromCell(*in.cityRays, cell, fs.frame, grid, outputPixelAngle(p.sampling), p.placement);
+        const std::vector<uint8_t> ray = visibleFromCell(*in.cityRays, cell, fs.frame, grid, outputPixelAngle(p.sampling), byRays);
+        ASSERT_EQ(img.size(), grid.size());
+        size_t seenByRays = 0, seenByImage = 0, onlyImage = 0;
+        for (size_t i = 0; i < grid.size(); ++i) {
+            seenByRays += ray[i];
+            seenByImage += img[i];
+            onlyImage += img[i] && !ray[i];
+        }
+        EXPECT_EQ(onlyImage, 0u) << "the image keeps a point that no viewpoint's ray sees";
+        EXPECT_GT(seenByRays, grid.size() / 20) << "some of the grid is in plain view";
+        EXPECT_LT(seenByRays, grid.size() - grid.size() / 20) << "some of the grid is behind or inside walls";
+        EXPECT_GE(double(seenByImage), 0.98 * double(seenByRays)) << seenByImage << " of " << seenByRays;
     }
     // The estimate: rays reach the far walls; saved/cost follow the stated formula.
     PlacementEstimate e = estimatePlacement(*in.cityRays, in.tileLookup, cell, fs, p.sampling, p.placement);
@@ -1235,6 +1263,61 @@ TEST(BakeDriver, ResumeAfterInterruptionGivesTheBytesOfOneRun) {
     EXPECT_NE(noInput.status().message().find("missing.osgb"), std::string::npos);
 }
 
+// The storage budget: paying ends ranked by (saved - cost) ms per predicted
+// MB, taken while they fit; an end that does not fit is passed over and a
+// smaller one after it may still fit; an end that does not pay never counts.
+TEST(Placement, StorageBudgetTakesTheMostMillisecondsPerMegabyteThatFit) {
+    auto end = [](uint32_t cell, int e, double saved, double cost, double mb) {
+        PlannedEnd p;
+        p.cell = cell;
+        p.end = uint8_t(e);
+        p.estimate.savedMs = saved;
+        p.estimate.costMs = cost;
+        p.estimate.place = saved > cost;
+        p.predictedMb = mb;
+        return p;
+    };
+    // Values (ms per MB): (1,0) 8, (1,1) does not pay, (2,0) 7.5, (3,0) 8
+    // (a tie with (1,0): the lower cell first), (4,1) 5 with 50 MB, (5,0) 4.
+    const std::vector<PlannedEnd> ends = {end(5, 0, 3, 1, 0.5), end(4, 1, 250, 0, 50), end(3, 0, 9, 1, 1),
+                                          end(2, 0, 30, 0, 4),  end(1, 1, 5, 6, 0.1),   end(1, 0, 10, 2, 1)};
+    const PlacementPlan plan = rankPlacement(ends, 6.6);
+    ASSERT_EQ(plan.ends.size(), ends.size());
+    for (size_t i = 1; i < plan.ends.size(); ++i)
+        EXPECT_LT(std::make_pair(plan.ends[i - 1].cell, plan.ends[i - 1].end), std::make_pair(plan.ends[i].cell, plan.ends[i].end));
+    auto at = [&](uint32_t c, int e) {
+        const PlannedEnd* p = plan.find(c, e);
+        EXPECT_NE(p, nullptr) << c << "," << e;
+        return p ? *p : PlannedEnd();
+    };
+    EXPECT_EQ(plan.find(9, 0), nullptr);
+    EXPECT_EQ(at(1, 0).rank, 0);
+    EXPECT_EQ(at(3, 0).rank, 1);
+    EXPECT_EQ(at(2, 0).rank, 2);
+    EXPECT_EQ(at(4, 1).rank, 3);
+    EXPECT_EQ(at(5, 0).rank, 4);
+    EXPECT_EQ(at(1, 1).rank, -1);
+    // 1 + 1 + 4 = 6 MB; 50 MB does not fit in what is left; 0.5 MB does.
+    EXPECT_TRUE(at(1, 0).inBudget && at(3, 0).inBudget && at(2, 0).inBudget && at(5, 0).inBudget);
+    EXPECT_FALSE(at(4, 1).inBudget);
+    EXPECT_FALSE(at(1, 1).inBudget) << "an end that does not pay is never chosen";
+    EXPECT_EQ(plan.chosen, 4u);
+    EXPECT_EQ(plan.paying, 5u);
+    EXPECT_NEAR(plan.chosenMb, 6.5, 1e-12);
+    EXPECT_NEAR(plan.payingMb, 56.5, 1e-12);
+    EXPECT_NE(at(4, 1).describe().find("over the storage budget"), std::string::npos) << at(4, 1).describe();
+    EXPECT_EQ(at(2, 0).describe().rfind("placed: ", 0), 0u) << at(2, 0).describe();
+    EXPECT_EQ(at(1, 1).describe().rfind("not placed: saves", 0), 0u) << at(1, 1).describe();
+    // A budget below the smallest paying end chooses nothing; a large one every paying end.
+    EXPECT_EQ(rankPlacement(ends, 0.4).chosen, 0u);
+    EXPECT_EQ(rankPlacement(ends, 1e9).chosen, 5u);
+    // The predicted size follows its stated formula.
+    PlacementEstimate e;
+    e.farPixels = 1000;
+    PlacementParams pp;
+    EXPECT_NEAR(predictedMb(e, pp), pp.pointsPerFarPixel * 1000 * pp.bytesPerPoint / 1048576.0, 1e-12);
+}
+
 // Placement by cost (the default of `vista bake`) stays byte-identical across
 // thread counts, shards + merge and a resume with a damaged cell result; bad
 // placement values are refused with exit 2.
@@ -1271,6 +1354,32 @@ TEST(BakeCli, PlacementByCostIsDeterministicAcrossJobsShardsAndResume) {
                   dir.file("d.json")),
               0);
     EXPECT_NE(readBytes(dir.file("d.json")).find("not placed: saves"), std::string::npos);
+    // A budget that holds at most one of the two ends: the other is passed
+    // over with a note, and the placed ends' predicted MB fit in the budget.
+    ASSERT_EQ(run(common + "-o " + dir.file("f.osgb") + " --storage-budget 0.01 --stats " + dir.file("f.json")), 0);
+    {
+        const nlohmann::json fj = nlohmann::json::parse(readBytes(dir.file("f.json")));
+        size_t placed = 0, over = 0;
+        double placedMb = 0;
+        for (const auto& n : fj["notes"]) {
+            const std::string t = n.get<std::string>();
+            if (t.find("over the storage budget") != std::string::npos) ++over;
+            if (t.find(": placed: ") != std::string::npos) {
+                ++placed;
+                placedMb += std::stod(t.substr(t.rfind("; ") + 2));
+            }
+        }
+        EXPECT_GE(over, 1u) << fj["notes"].dump();
+        EXPECT_EQ(fj["impostors"].get<size_t>(), placed);
+        EXPECT_LE(placedMb, 0.01 + 1e-3) << fj["notes"].dump();
+        EXPECT_DOUBLE_EQ(fj["storage_budget_mb"].get<double>(), 0.01);
+        EXPECT_NE(fj["params"].get<std::string>().find("budget=0.01"), std::string::npos);
+    }
+    ASSERT_EQ(run(common + "-o " + dir.file("g.osgb") + " --storage-budget off --visibility rays --stats " + dir.file("g.json")), 0);
+    EXPECT_EQ(readBytes(dir.file("g.json")).find("budget="), std::string::npos) << "off: no budget in the parameters";
+    EXPECT_EQ(run(common + "-o " + dir.file("e.osgb") + " --storage-budget 0"), 2);
+    EXPECT_EQ(run(common + "-o " + dir.file("e.osgb") + " --storage-budget lots"), 2);
+    EXPECT_EQ(run(common + "-o " + dir.file("e.osgb") + " --visibility maybe"), 2);
     EXPECT_EQ(run(common + "-o " + dir.file("e.osgb") + " --placement some"), 2);
     EXPECT_EQ(run(common + "-o " + dir.file("e.osgb") + " --triangle-ns 0"), 2);
 }
