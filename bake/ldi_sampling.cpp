@@ -92,23 +92,37 @@ LdiResult sampleLdi(const RayScene& scene, const SamplingSetup& s, const Box3& f
         std::vector<std::vector<LdiSample>> rows(size_t(c.height));
         std::vector<std::vector<uint32_t>> rowCounts(size_t(c.height));
         tbb::parallel_for(0, c.height, [&](int j) {
-            std::vector<RayHit> hits(static_cast<size_t>(layers));
-            auto& out = rows[size_t(j)];
-            auto& cnt = rowCounts[size_t(j)];
-            cnt.assign(size_t(c.width), 0);
+            // The row's rays, clipped to the far box, traced together (packets of 8).
+            const size_t w = size_t(c.width);
+            std::vector<glm::vec3> org(w, glm::vec3(c.pos)), dirs(w);
+            std::vector<glm::dvec3> ddirs(w);
+            std::vector<float> tn(w, 1.0f), tf(w, 0.0f);  // tn > tf: no ray
             for (int i = 0; i < c.width; ++i) {
                 const glm::dvec3 dd = s.n + (c.x0 + (i + 0.5) * c.step) * s.U + (c.y0 + (j + 0.5) * c.step) * s.V;
-                const glm::dvec3 dir = glm::normalize(dd);
+                ddirs[size_t(i)] = glm::normalize(dd);
+                dirs[size_t(i)] = glm::vec3(ddirs[size_t(i)]);
                 double t0, t1;
-                if (!clipRay(far, c.pos, dir, t0, t1)) continue;
-                const int n = scene.allHits(glm::vec3(c.pos), glm::vec3(dir), float(std::max(0.0, t0 - 1e-3)), float(t1 + 1e-3),
-                                            layers, gap, hits.data());
-                for (int h = 0; h < n; ++h) {
+                if (!clipRay(far, c.pos, ddirs[size_t(i)], t0, t1)) continue;
+                tn[size_t(i)] = float(std::max(0.0, t0 - 1e-3));
+                tf[size_t(i)] = float(t1 + 1e-3);
+            }
+            std::vector<RayHit> hits(w * size_t(layers));
+            std::vector<int> counts(w);
+            scene.allHitsMany(org.data(), dirs.data(), c.width, tn.data(), tf.data(), layers, gap, hits.data(), counts.data());
+            auto& out = rows[size_t(j)];
+            auto& cnt = rowCounts[size_t(j)];
+            cnt.assign(w, 0);
+            size_t rowHits = 0;
+            for (int n : counts) rowHits += size_t(n);
+            out.reserve(rowHits);
+            for (int i = 0; i < c.width; ++i) {
+                for (int h = 0; h < counts[size_t(i)]; ++h) {
+                    const RayHit& hit = hits[size_t(i) * size_t(layers) + size_t(h)];
                     LdiSample smp;
-                    const glm::dvec3 pos = c.pos + dir * double(hits[size_t(h)].t);
+                    const glm::dvec3 pos = c.pos + ddirs[size_t(i)] * double(hit.t);
                     smp.pos = glm::vec3(pos);
-                    smp.normal = hits[size_t(h)].normal;
-                    smp.color = scene.hitColor(hits[size_t(h)]);
+                    smp.normal = hit.normal;
+                    smp.color = scene.hitColor(hit);
                     smp.camera = uint8_t(k);
                     smp.pixel = uint32_t(j) * uint32_t(c.width) + uint32_t(i);
                     smp.spacing = float(footprint(c, s, pos, glm::dvec3(smp.normal)));
@@ -121,6 +135,9 @@ LdiResult sampleLdi(const RayScene& scene, const SamplingSetup& s, const Box3& f
         auto& st = r.start[size_t(k)];
         st.assign(size_t(c.width) * size_t(c.height) + 1, 0);
         uint32_t acc = uint32_t(r.samples.size());
+        size_t add = 0;
+        for (const auto& row : rows) add += row.size();
+        r.samples.reserve(r.samples.size() + add);
         for (int j = 0; j < c.height; ++j) {
             for (int i = 0; i < c.width; ++i) {
                 st[size_t(j) * size_t(c.width) + size_t(i)] = acc;

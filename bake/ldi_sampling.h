@@ -11,8 +11,8 @@
 //     street lies near the image centre), sqrt2 = pixel diagonal. The planar
 //     cameras' off-axis pixels already shrink by cos^2, so the thesis'
 //     D^2 / (R^2 + D^2) term is not applied (docs/bake.md).
-//  5. Multi-layer hits (RayScene::allHits) clipped to the far box, up to
-//     maxLayers per pixel; each sample records its footprint.
+//  5. Multi-layer hits (RayScene::allHitsMany: each LDI row in packets of 8)
+//     clipped to the far box, up to maxLayers per pixel; each sample records its footprint.
 // Positions in the impostor frame (metres). Deterministic: LDI rows are traced
 // in parallel into per-row buffers concatenated in order. Thread-safe.
 #pragma once

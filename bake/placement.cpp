@@ -9,6 +9,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
+#include <tbb/parallel_sort.h>
 
 namespace vista {
 
@@ -198,6 +199,8 @@ std::vector<glm::dvec3> cellViewpoints(const ViewCell& cell, const glm::dvec3& s
     return views;
 }
 
+constexpr double kVisClusterM = 4.0;  // grid of the point clusters of the image test (metres)
+
 // Where the occlusion test ends: 0.1 m + 0.2 % short of a point at distance
 // `len`, so that the point's own surface does not count (< 0: next to the viewpoint).
 float openUntil(double len) { return float(len * (1.0 - 2e-3) - 0.1); }
@@ -225,80 +228,188 @@ void visibleByRays(const RayScene& cityRays, const glm::dvec3& vd, const std::ve
     });
 }
 
-// Depth-image prefilter of the points `idx` from viewpoint v, looking at
-// `target`: a planar depth image (first hits of the city, one ray per image
-// node, `step` tangent units apart) over the points' projections. A point is
-// a candidate (appended to `cand`, in idx order) when the farthest of the 4
-// nodes around its projection reaches it (openUntil): a point that the image
-// says hidden is hidden at the image's pixel scale. Points more than maxTan
-// off the axis, or within reach of the viewpoint, are candidates too.
+// The points grouped by a grid of `size` metres (scene-local): cluster c
+// holds order[start[c] .. start[c + 1]) inside the box lo[c] .. hi[c].
+struct PointClusters {
+    std::vector<uint32_t> order, start;
+    std::vector<glm::dvec3> lo, hi;
+};
+
+PointClusters clusterPoints(const std::vector<glm::vec3>& local, double size) {
+    PointClusters pc;
+    if (local.empty()) {
+        pc.start.push_back(0);
+        return pc;
+    }
+    glm::dvec3 mn(1e300);
+    for (const glm::vec3& q : local) mn = glm::min(mn, glm::dvec3(q));
+    std::vector<std::pair<uint64_t, uint32_t>> keyed(local.size());
+    tbb::parallel_for(size_t(0), local.size(), [&](size_t i) {
+        const glm::dvec3 g = glm::floor((glm::dvec3(local[i]) - mn) / size);
+        const uint64_t x = uint64_t(std::min(g.x, 2097151.0)), y = uint64_t(std::min(g.y, 2097151.0)), z = uint64_t(std::min(g.z, 2097151.0));
+        keyed[i] = {(x << 42) | (y << 21) | z, uint32_t(i)};
+    });
+    tbb::parallel_sort(keyed.begin(), keyed.end());  // keys and indices unique together: one order
+    pc.order.resize(keyed.size());
+    for (size_t i = 0; i < keyed.size(); ++i) {
+        pc.order[i] = keyed[i].second;
+        if (i == 0 || keyed[i].first != keyed[i - 1].first) {
+            pc.start.push_back(uint32_t(i));
+            pc.lo.push_back(glm::dvec3(1e300));
+            pc.hi.push_back(glm::dvec3(-1e300));
+        }
+        pc.lo.back() = glm::min(pc.lo.back(), glm::dvec3(local[keyed[i].second]));
+        pc.hi.back() = glm::max(pc.hi.back(), glm::dvec3(local[keyed[i].second]));
+    }
+    pc.start.push_back(uint32_t(keyed.size()));
+    return pc;
+}
+
+// A depth image with a pyramid of 2x2 maxima, for "the farthest first hit
+// over a block of nodes" in a few lookups (conservative: a larger block).
+struct MaxPyramid {
+    std::vector<std::vector<float>> level;
+    std::vector<int> w, h;
+    explicit MaxPyramid(std::vector<float> base, int w0, int h0) {
+        level.push_back(std::move(base));
+        w.push_back(w0);
+        h.push_back(h0);
+        while (w.back() > 2 || h.back() > 2) {
+            const int pw = w.back(), ph = h.back(), nw = (pw + 1) / 2, nh = (ph + 1) / 2;
+            const std::vector<float>& src = level.back();
+            std::vector<float> dst(size_t(nw) * size_t(nh));
+            for (int j = 0; j < nh; ++j)
+                for (int i = 0; i < nw; ++i) {
+                    float m = -std::numeric_limits<float>::infinity();
+                    for (int dj = 0; dj < 2; ++dj)
+                        for (int di = 0; di < 2; ++di) {
+                            const int x = std::min(2 * i + di, pw - 1), y = std::min(2 * j + dj, ph - 1);
+                            m = std::max(m, src[size_t(y) * size_t(pw) + size_t(x)]);
+                        }
+                    dst[size_t(j) * size_t(nw) + size_t(i)] = m;
+                }
+            level.push_back(std::move(dst));
+            w.push_back(nw);
+            h.push_back(nh);
+        }
+    }
+    float at(int i, int j) const { return level[0][size_t(j) * size_t(w[0]) + size_t(i)]; }
+    // Max over nodes [i0, i1] x [j0, j1] of level 0 (or over a block containing them).
+    float maxOver(int i0, int i1, int j0, int j1) const {
+        size_t l = 0;
+        while (l + 1 < level.size() && ((i1 >> l) - (i0 >> l) > 1 || (j1 >> l) - (j0 >> l) > 1)) ++l;
+        float m = -std::numeric_limits<float>::infinity();
+        for (int j = j0 >> l; j <= (j1 >> l); ++j)
+            for (int i = i0 >> l; i <= (i1 >> l); ++i) m = std::max(m, level[l][size_t(j) * size_t(w[l]) + size_t(i)]);
+        return m;
+    }
+};
+
+// Depth-image prefilter from viewpoint v, looking at `target`: a planar
+// depth image (first hits of the city, one ray per image node, `step`
+// tangent units apart) over the clusters that still hold points not seen
+// (todoOf[c] > 0). A point is a candidate (isCand = 1) when the farthest of
+// the 4 nodes around its projection reaches it (openUntil): a point that the
+// image says hidden is hidden at the image's pixel scale. A cluster whose
+// nodes all end before its nearest point is skipped whole (the same verdict
+// for each of its points, found at once). Clusters next to the viewpoint or
+// more than maxTan off the axis make all their points candidates.
 void imageCandidates(const RayScene& cityRays, const glm::dvec3& vd, const glm::dvec3& target, const std::vector<glm::vec3>& local,
-                     const std::vector<uint32_t>& idx, double step, int64_t maxRays, double maxTan, std::vector<uint32_t>& cand) {
+                     const PointClusters& pc, const std::vector<uint32_t>& todoOf, const std::vector<uint8_t>& vis, double step,
+                     int64_t maxRays, double maxTan, std::vector<uint8_t>& isCand) {
     const glm::dvec3 axis = target - vd;
     const double al = glm::length(axis);
     const glm::dvec3 fwd = al > 1e-9 ? axis / al : glm::dvec3(1, 0, 0);
     const glm::dvec3 up0 = std::abs(fwd.z) < 0.9 ? glm::dvec3(0, 0, 1) : glm::dvec3(1, 0, 0);
     const glm::dvec3 right = glm::normalize(glm::cross(fwd, up0)), up = glm::cross(right, fwd);
-    const size_t n = idx.size();
-    std::vector<glm::vec2> tan(n);
-    std::vector<float> until(n);
-    std::vector<uint8_t> kind(n);  // 0: in the image, 1: candidate without the image
+    const size_t nc = pc.lo.size();
+    // Per cluster: 0 = nothing to do, 1 = in the image, 2 = all candidates.
+    std::vector<uint8_t> kind(nc, 0);
+    std::vector<glm::dvec4> rect(nc);  // tangent-space bounds x0, x1, y0, y1
+    std::vector<float> nearUntil(nc);
     struct Box {
         double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
-        void join(const Box& o) { x0 = std::min(x0, o.x0); x1 = std::max(x1, o.x1); y0 = std::min(y0, o.y0); y1 = std::max(y1, o.y1); }
     };
     const Box box = tbb::parallel_reduce(
-        tbb::blocked_range<size_t>(0, n, 4096), Box(),
+        tbb::blocked_range<size_t>(0, nc, 256), Box(),
         [&](const tbb::blocked_range<size_t>& r, Box b) {
-            for (size_t k = r.begin(); k < r.end(); ++k) {
-                const glm::dvec3 d = glm::dvec3(local[idx[k]]) - vd;
-                const double z = glm::dot(d, fwd);
-                until[k] = openUntil(glm::length(d));
-                const glm::dvec2 t = z > 0 ? glm::dvec2(glm::dot(d, right), glm::dot(d, up)) / z : glm::dvec2(1e300);
-                kind[k] = until[k] <= 0.0f || !(std::abs(t.x) <= maxTan && std::abs(t.y) <= maxTan) ? 1 : 0;
-                if (kind[k]) continue;
-                tan[k] = glm::vec2(t);
-                b.x0 = std::min(b.x0, double(tan[k].x)); b.x1 = std::max(b.x1, double(tan[k].x));
-                b.y0 = std::min(b.y0, double(tan[k].y)); b.y1 = std::max(b.y1, double(tan[k].y));
+            for (size_t c = r.begin(); c < r.end(); ++c) {
+                if (!todoOf[c]) continue;
+                nearUntil[c] = openUntil(glm::length(glm::clamp(vd, pc.lo[c], pc.hi[c]) - vd));
+                glm::dvec4 q(1e300, -1e300, 1e300, -1e300);
+                bool ok = nearUntil[c] > 0.0f;
+                for (int k = 0; k < 8 && ok; ++k) {
+                    const glm::dvec3 corner((k & 1) ? pc.hi[c].x : pc.lo[c].x, (k & 2) ? pc.hi[c].y : pc.lo[c].y,
+                                            (k & 4) ? pc.hi[c].z : pc.lo[c].z);
+                    const glm::dvec3 d = corner - vd;
+                    const double z = glm::dot(d, fwd);
+                    if (!(z > 1e-3)) {
+                        ok = false;
+                        break;
+                    }
+                    const double x = glm::dot(d, right) / z, y = glm::dot(d, up) / z;
+                    ok = std::abs(x) <= maxTan && std::abs(y) <= maxTan;
+                    q = glm::dvec4(std::min(q.x, x), std::max(q.y, x), std::min(q.z, y), std::max(q.w, y));
+                }
+                kind[c] = ok ? 1 : 2;
+                if (!ok) continue;
+                rect[c] = q;
+                b.x0 = std::min(b.x0, q.x); b.x1 = std::max(b.x1, q.y); b.y0 = std::min(b.y0, q.z); b.y1 = std::max(b.y1, q.w);
             }
             return b;
         },
-        [](Box a, const Box& b) { a.join(b); return a; });
-    std::vector<uint8_t> keep(kind);
-    if (box.x0 <= box.x1) {
-        double w = std::floor((box.x1 - box.x0) / step) + 2, h = std::floor((box.y1 - box.y0) / step) + 2;  // nodes per axis
-        const double cap = double(std::max<int64_t>(maxRays, 16));
-        if (w * h > cap) {
-            step *= std::sqrt(w * h / cap);
-            w = std::floor((box.x1 - box.x0) / step) + 2;
-            h = std::floor((box.y1 - box.y0) / step) + 2;
-        }
-        const int nw = int(w), nh = int(h);
-        std::vector<float> depth(size_t(nw) * size_t(nh));
-        const glm::vec3 v(vd);
-        tbb::parallel_for(0, nh, [&](int j) {
-            const size_t m = size_t(nw);
-            std::vector<glm::vec3> org(m, v), dir(m);
-            std::vector<RayHit> hits(m);
-            for (int i = 0; i < nw; ++i)
-                dir[size_t(i)] = glm::vec3(glm::normalize(fwd + (box.x0 + i * step) * right + (box.y0 + j * step) * up));
-            cityRays.intersectMany(org.data(), dir.data(), nw, hits.data());
-            for (int i = 0; i < nw; ++i)
-                depth[size_t(j) * m + size_t(i)] = hits[size_t(i)].hit ? hits[size_t(i)].t : std::numeric_limits<float>::infinity();
+        [](Box a, const Box& b) {
+            a.x0 = std::min(a.x0, b.x0); a.x1 = std::max(a.x1, b.x1); a.y0 = std::min(a.y0, b.y0); a.y1 = std::max(a.y1, b.y1);
+            return a;
         });
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
-            for (size_t k = r.begin(); k < r.end(); ++k) {
-                if (kind[k]) continue;
-                const int i = std::clamp(int((double(tan[k].x) - box.x0) / step), 0, nw - 2);
-                const int j = std::clamp(int((double(tan[k].y) - box.y0) / step), 0, nh - 2);
-                const size_t a = size_t(j) * size_t(nw) + size_t(i), b = a + size_t(nw);
-                const float reach = std::max(std::max(depth[a], depth[a + 1]), std::max(depth[b], depth[b + 1]));
-                keep[k] = reach >= until[k] ? 1 : 0;
-            }
-        });
+    if (!(box.x0 <= box.x1)) {  // no cluster in the image
+        for (size_t c = 0; c < nc; ++c)
+            if (kind[c] == 2)
+                for (uint32_t k = pc.start[c]; k < pc.start[c + 1]; ++k) isCand[pc.order[k]] = !vis[pc.order[k]];
+        return;
     }
-    for (size_t k = 0; k < n; ++k)
-        if (keep[k]) cand.push_back(idx[k]);
+    double w = std::floor((box.x1 - box.x0) / step) + 2, h = std::floor((box.y1 - box.y0) / step) + 2;  // nodes per axis
+    const double cap = double(std::max<int64_t>(maxRays, 16));
+    if (w * h > cap) {
+        step *= std::sqrt(w * h / cap);
+        w = std::floor((box.x1 - box.x0) / step) + 2;
+        h = std::floor((box.y1 - box.y0) / step) + 2;
+    }
+    const int nw = int(w), nh = int(h);
+    std::vector<float> depth(size_t(nw) * size_t(nh));
+    const glm::vec3 v(vd);
+    tbb::parallel_for(0, nh, [&](int j) {
+        const size_t m = size_t(nw);
+        std::vector<glm::vec3> org(m, v), dir(m);
+        std::vector<RayHit> hits(m);
+        for (int i = 0; i < nw; ++i)
+            dir[size_t(i)] = glm::vec3(glm::normalize(fwd + (box.x0 + i * step) * right + (box.y0 + j * step) * up));
+        cityRays.intersectMany(org.data(), dir.data(), nw, hits.data());
+        for (int i = 0; i < nw; ++i)
+            depth[size_t(j) * m + size_t(i)] = hits[size_t(i)].hit ? hits[size_t(i)].t : std::numeric_limits<float>::infinity();
+    });
+    const MaxPyramid img(std::move(depth), nw, nh);
+    auto node = [&](double t, double o, int n) { return std::clamp(int((t - o) / step), 0, n - 2); };
+    tbb::parallel_for(size_t(0), nc, [&](size_t c) {
+        if (!kind[c]) return;
+        const uint32_t b = pc.start[c], e = pc.start[c + 1];
+        if (kind[c] == 2) {
+            for (uint32_t k = b; k < e; ++k) isCand[pc.order[k]] = !vis[pc.order[k]];
+            return;
+        }
+        const int i0 = node(rect[c].x, box.x0, nw), i1 = node(rect[c].y, box.x0, nw) + 1;
+        const int j0 = node(rect[c].z, box.y0, nh), j1 = node(rect[c].w, box.y0, nh) + 1;
+        if (img.maxOver(i0, i1, j0, j1) < nearUntil[c]) return;  // every point of the cluster is hidden
+        for (uint32_t k = b; k < e; ++k) {
+            const uint32_t pi = pc.order[k];
+            if (vis[pi]) continue;
+            const glm::dvec3 d = glm::dvec3(local[pi]) - vd;
+            const double z = glm::dot(d, fwd);
+            const int i = node(glm::dot(d, right) / z, box.x0, nw), j = node(glm::dot(d, up) / z, box.y0, nh);
+            const float reach = std::max(std::max(img.at(i, j), img.at(i + 1, j)), std::max(img.at(i, j + 1), img.at(i + 1, j + 1)));
+            isCand[pi] = reach >= openUntil(glm::length(d)) ? 1 : 0;
+        }
+    });
 }
 
 }  // namespace
@@ -318,14 +429,31 @@ std::vector<uint8_t> visibleFromCell(const RayScene& cityRays, const ViewCell& c
     glm::dvec3 centroid(0.0);
     for (const glm::vec3& q : local) centroid += glm::dvec3(q);
     if (!local.empty()) centroid /= double(local.size());
+    PointClusters pc;
+    std::vector<uint32_t> todoOf, clusterOf;  // per cluster: points not seen yet; per point: its cluster
+    if (p.visByImage) {
+        pc = clusterPoints(local, kVisClusterM);
+        todoOf.resize(pc.lo.size());
+        clusterOf.resize(points.size());
+        for (size_t c = 0; c < todoOf.size(); ++c) {
+            todoOf[c] = pc.start[c + 1] - pc.start[c];
+            for (uint32_t k = pc.start[c]; k < pc.start[c + 1]; ++k) clusterOf[pc.order[k]] = uint32_t(c);
+        }
+    }
+    std::vector<uint8_t> isCand(p.visByImage ? points.size() : 0, 0);
     // Per viewpoint, the points not seen yet.
     for (const glm::dvec3& vd : views) {
         if (todo.empty()) break;
         if (p.visByImage) {
+            std::fill(isCand.begin(), isCand.end(), uint8_t(0));
+            imageCandidates(cityRays, vd, centroid, local, pc, todoOf, vis, std::max(p.visStepPx, 0.05) * pixelAngle,
+                            p.maxVisRaysPerView, p.visMaxTan, isCand);
             std::vector<uint32_t> cand;
-            imageCandidates(cityRays, vd, centroid, local, todo, std::max(p.visStepPx, 0.05) * pixelAngle, p.maxVisRaysPerView,
-                            p.visMaxTan, cand);
+            for (uint32_t i : todo)
+                if (isCand[i]) cand.push_back(i);
             visibleByRays(cityRays, vd, local, cand, vis);
+            for (uint32_t i : cand)
+                if (vis[i]) --todoOf[clusterOf[i]];
         } else {
             visibleByRays(cityRays, vd, local, todo, vis);
         }

@@ -40,7 +40,7 @@ struct PlacementParams {
     bool byCost = false;            // false: every end with a far field gets an impostor (the old rule)
     double triangleNs = 349.0;      // raster cost of a triangle, ns (> 0)
     double pointNs = 495.0;         // raster cost of a point, ns (> 0)
-    double pointsPerFarPixel = 23.0; // points the bake makes per visible far pixel (> 0; the default city baked whole: sum of points / sum of estimated far pixels)
+    double pointsPerFarPixel = 31.0; // points the bake makes per visible far pixel (> 0; the default city baked whole under its storage budget: sum of points / sum of estimated far pixels over its impostors)
     double bytesPerPoint = 15.0;     // stored bytes per point, texels included (> 0; the same bake)
     // Storage budget (planPlacement): 0 = none; else the street ends whose
     // impostors save the most milliseconds per predicted megabyte, until the

@@ -16,7 +16,8 @@
 #
 # usage: docs/tools/whole_bake.sh [OUT_DIR] [VISTA_BIN]
 #   env: SIZE_M (2000), CITY_SEED (1), JOBS (2), KINDS ("car walk"), SEED (path seed, 5),
-#        FRAMES (32), SAMPLING (runs:4)
+#        FRAMES (32), SAMPLING (runs:4), MARKER (the doc block, whole-bake; whole-bake-seed2 for
+#        the check on a second city)
 set -euo pipefail
 source "$(dirname "$0")/lib.sh"
 doc_setup whole_bake.sh wholebake 1280x1024x24 "${1:-whole-bake-out}" "${2:-build/vista}"
@@ -28,7 +29,8 @@ KINDS=${KINDS:-"car walk"}
 SEED=${SEED:-5}
 FRAMES=${FRAMES:-32}
 SAMPLING=${SAMPLING:-runs:4}
-INVOCATION="SIZE_M=$SIZE_M CITY_SEED=$CITY_SEED JOBS=$JOBS KINDS='$KINDS' SEED=$SEED FRAMES=$FRAMES SAMPLING=$SAMPLING docs/tools/whole_bake.sh OUT $(basename "$VISTA")"
+MARKER=${MARKER:-whole-bake}
+INVOCATION="SIZE_M=$SIZE_M CITY_SEED=$CITY_SEED JOBS=$JOBS KINDS='$KINDS' SEED=$SEED FRAMES=$FRAMES SAMPLING=$SAMPLING MARKER=$MARKER docs/tools/whole_bake.sh OUT $(basename "$VISTA")"
 [ -x /usr/bin/time ] || die "/usr/bin/time is needed (bake wall time, CPU time and peak memory)"
 mkdir -p "$OUT/bench"
 touch "$OUT/commands.log"
@@ -92,5 +94,5 @@ for k in kinds:
           f"{with_imp} of {frames} |")
 print()
 PYEOF
-doc_replace_block docs/farfield-compare.md whole-bake "$TABLE"
-log "docs/farfield-compare.md whole-bake block written"
+doc_replace_block docs/farfield-compare.md "$MARKER" "$TABLE"
+log "docs/farfield-compare.md $MARKER block written"

@@ -460,6 +460,46 @@ int RayScene::allHits(const glm::vec3& org, const glm::vec3& dir, float tnear, f
     return n;
 }
 
+void RayScene::allHitsMany(const glm::vec3* org, const glm::vec3* dir, int n, const float* tnears, const float* tfars, int maxHits,
+                           float minGap, RayHit* out, int* counts) const {
+    forPackets8(_impl->ftz, n, [&](RTCIntersectContext& ctx, RTCRayHit8& rh, int* valid, int base, int m) {
+        float t0[8];
+        int live[8];
+        for (int k = 0; k < m; ++k) {
+            counts[base + k] = 0;
+            t0[k] = tnears[base + k];
+            live[k] = maxHits > 0 && tnears[base + k] <= tfars[base + k];
+        }
+        for (int k = m; k < 8; ++k) live[k] = 0;
+        for (int layer = 0; layer < maxHits; ++layer) {
+            fillPacket8(rh, valid, org, dir, tfars, 0.0f, size_t(base), m);
+            bool any = false;
+            for (int k = 0; k < 8; ++k) {
+                valid[k] = live[k] ? -1 : 0;
+                any = any || live[k];
+                if (k < m) rh.ray.tnear[k] = t0[k];
+            }
+            if (!any) break;
+            rtcIntersect8(valid, _impl->scene, &ctx, &rh);
+            for (int k = 0; k < m; ++k) {
+                if (!live[k]) continue;
+                if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) {
+                    live[k] = 0;
+                    continue;
+                }
+                const size_t i = size_t(base + k);
+                RayHit& h = out[i * size_t(maxHits) + size_t(counts[i])];
+                h = RayHit();
+                _impl->fill(h, rh.hit.geomID[k], rh.hit.primID[k], rh.hit.instID[0][k], rh.hit.u[k], rh.hit.v[k], rh.ray.tfar[k],
+                            rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]);
+                ++counts[i];
+                t0[k] = h.t + std::max(minGap, h.t * 1e-5f);
+                if (counts[i] >= maxHits || !(t0[k] <= tfars[i])) live[k] = 0;
+            }
+        }
+    });
+}
+
 glm::vec3 RayScene::hitColor(const RayHit& h) const {
     if (!h.hit) return glm::vec3(0.0f);
     const bool inst = h.instId != 0xFFFFFFFFu;

@@ -88,6 +88,13 @@ public:
     // maxHits: each next cast starts max(minGap, 1e-5 t) beyond the last hit.
     int allHits(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar, int maxHits, float minGap,
                 RayHit* out) const;
+    // allHits for n rays at once, in packets of 8 (each layer one packet
+    // cast for the lanes still going): ray i's hits go to
+    // out[i * maxHits .. i * maxHits + counts[i]), nearest first, within
+    // (tnears[i], tfars[i]) (tnears[i] > tfars[i]: no hit). The same rule
+    // as allHits for the next cast.
+    void allHitsMany(const glm::vec3* org, const glm::vec3* dir, int n, const float* tnears, const float* tfars, int maxHits,
+                     float minGap, RayHit* out, int* counts) const;
     // The prelit colour at a hit, interpolated and not rounded: RGB 0..1.
     glm::vec3 hitColor(const RayHit& h) const;
     // The SceneModel entity a hit struck (ground-truth labels).

@@ -163,6 +163,40 @@ TEST(RaySceneSoup, AllHitsUnroundedColoursAndCullingOption) {
     }
     EXPECT_NEAR(glm::length((*scene)->hitColor(hits[2]) - glm::vec3(glm::u8vec3(100, 150, 200)) / 255.0f), 0.0f, 1e-6f);
     EXPECT_EQ((*scene)->allHits({0, 0.3f, 0.2f}, {1, 0, 0}, 0.0f, 15.0f, 8, 0.01f, hits), 2);  // tfar clips
+    // The packet version (as the LDI rows use it) gives each ray the hits of
+    // allHits: 19 rays fanning through both boxes (some miss, one with an
+    // empty interval, one clipped), 3 layers at most.
+    {
+        std::vector<glm::vec3> org, dir;
+        std::vector<float> tn, tf;
+        for (int i = 0; i < 19; ++i) {
+            org.push_back({0, 0.1f * i - 0.9f, 0.2f});
+            dir.push_back(glm::normalize(glm::vec3(1, 0.0123f * (i - 9), 0.0037f * i)));  // no ray through an edge
+            tn.push_back(i == 4 ? 30.0f : 0.5f * (i % 3));
+            tf.push_back(i == 7 ? 11.0f : i == 4 ? 5.0f : 1e30f);
+        }
+        const int layers = 3;
+        std::vector<RayHit> many(org.size() * layers);
+        std::vector<int> counts(org.size(), -1);
+        (*scene)->allHitsMany(org.data(), dir.data(), int(org.size()), tn.data(), tf.data(), layers, 0.01f, many.data(), counts.data());
+        int total = 0, missed = 0;
+        for (size_t i = 0; i < org.size(); ++i) {
+            RayHit one[3];
+            const int n1 = (*scene)->allHits(org[i], dir[i], tn[i], tf[i], layers, 0.01f, one);
+            ASSERT_EQ(counts[i], n1) << "ray " << i;
+            for (int k = 0; k < n1; ++k) {
+                EXPECT_NEAR(many[i * layers + size_t(k)].t, one[k].t, 1e-5f) << "ray " << i << " layer " << k;
+                EXPECT_EQ(many[i * layers + size_t(k)].primId, one[k].primId) << "ray " << i << " layer " << k;
+            }
+            total += n1;
+            missed += n1 == 0;
+        }
+        EXPECT_EQ(counts[4], 0) << "an empty interval has no hit";
+        EXPECT_EQ(counts[7], 1) << "tfar clips after the entry face";
+        EXPECT_GT(total, 19) << "rays cross several faces";
+        EXPECT_GT(missed, 1) << "some rays pass beside the boxes";
+    }
+
     EXPECT_TRUE((*scene)->occluded({0, 0.3f, 0.2f}, {1, 0, 0}, 0.0f, 10.5f));
     EXPECT_FALSE((*scene)->occluded({0, 0.3f, 0.2f}, {1, 0, 0}, 0.0f, 9.5f));
     // From inside the first box, looking out: the culled scene skips the exit (back) face.
