@@ -3,7 +3,8 @@
 // sampling (bake/ldi_sampling.h), redundant-point removal
 // (bake/point_removal.h), appearance (bake/appearance.h), in that order.
 //
-// Contract: bakeCell() depends only on (city, cell, params) — not on thread
+// Contract: bakeCell() depends only on (city, cell, params) and in.plan,
+// itself a function of (city, params) — not on thread
 // count, timing (apart from the *Ms fields) or the other cells — so cells can
 // be baked in any order, on any machine, and merged. An end whose far field
 // is too small, whose set-up is ill-defined (cell touching the far field) or
@@ -56,8 +57,9 @@ Status bakeMeshEnd(const TriangleSoup& soup, const Box3& cellBox, const BakePara
 // Steps 1-6 for one far field (soup and cell box in the impostor frame):
 // fills r.data and r.stats (not the frame, tiles or ids). `entity` keys the
 // random streams. Error only for an ill-defined set-up or a bad soup.
-// `keepVisible` (optional): marks the points (after removal, before the
-// appearance step) to keep; the others count as dropped invisible points.
+// `keepVisible` (optional): marks the LDI samples (all of them, before the
+// redundancy removal, which then examines only the marked ones) to keep;
+// the others count as dropped invisible points.
 Status bakeImpostor(const TriangleSoup& soup, const Box3& cellBox, const BakeParams& p, uint64_t entity, ImpostorResult& r,
                     const std::function<std::vector<uint8_t>(const std::vector<glm::vec3>&)>& keepVisible = {});
 

@@ -10,6 +10,10 @@
 // hash as vista.source_city_hash (sceneFileContentHash), writes it atomically,
 // writes the stats JSON and removes the cell files (and the work directory
 // when empty) unless keepWork. With merge it bakes nothing, only assembles.
+// Storage budget (points, placement by cost, params.placement.budgetMb > 0,
+// or budgetMbPerKm2 > 0: budgetMb = that x the street graph's bounding box
+// area, at least 1 km2): before baking, a run with cells to bake plans the
+// whole city (planPlacement, progress stage "plan"); every run plans alike.
 // Config hash = hash(input file bytes, params.canonical()); the canonical
 // text names the representation and the mesh parameters of a mesh bake.
 // Determinism: output bytes depend only on (input file, params, cells), not
