@@ -719,10 +719,23 @@ TEST(ViewCli, HybridHazeShowsTheBenchPicture) {
     ASSERT_EQ(runVista("bench " + city + " --path " + path + " --size 160x120 --near 40 --effects none --frames 1 -q --modes hybrid --out " +
                            dir + "/clear", &out), 0) << out;
     const std::string png = dir + "/view_hybrid.png";
-    ASSERT_EQ(runVista("view " + city + common + " --mode hybrid --step --frames 1 --no-hud --screenshot " + png, &out), 0) << out;
-    auto view = readPng(png), hybrid = readPng(dir + "/b/images/first_hybrid.png"), full = readPng(dir + "/b/images/first_full.png"),
+    auto hybrid = readPng(dir + "/b/images/first_hybrid.png"), full = readPng(dir + "/b/images/first_full.png"),
          clear = readPng(dir + "/clear/images/first_hybrid.png");
-    ASSERT_TRUE(view.isOk() && hybrid.isOk() && full.isOk() && clear.isOk());
+    ASSERT_TRUE(hybrid.isOk() && full.isOk() && clear.isOk());
+    // The viewer's window: under a loaded CI run (ctest -j2, no window
+    // manager) the X server has once mapped it at another size than asked
+    // before the frame was drawn (one failure in many runs, never reproduced
+    // alone). What this test checks is the haze, not window placement: the
+    // screenshot is retaken (at most 3 tries) until it has the asked size.
+    Result<Image> view = Status::error("no screenshot");
+    for (int attempt = 0; attempt < 3; ++attempt) {
+        ASSERT_EQ(runVista("view " + city + common + " --mode hybrid --step --frames 1 --no-hud --screenshot " + png, &out), 0) << out;
+        view = readPng(png);
+        ASSERT_TRUE(view.isOk()) << view.status().message();
+        if (view.value().width == hybrid.value().width && view.value().height == hybrid.value().height) break;
+    }
+    ASSERT_EQ(view.value().width, hybrid.value().width) << "the viewer's screenshot is not 160x120";
+    ASSERT_EQ(view.value().height, hybrid.value().height) << "the viewer's screenshot is not 160x120";
     EXPECT_GE(lumaPsnr(view.value(), hybrid.value()), kPsnrCapDb - 0.5) << "view and bench differ with haze";
     EXPECT_GE(lumaPsnr(hybrid.value(), full.value()), 40.0) << "hybrid's haze pass and the rasteriser's haze differ";
     EXPECT_LT(lumaPsnr(hybrid.value(), clear.value()), 28.0) << "80 m haze must change the picture";
