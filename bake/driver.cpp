@@ -218,10 +218,6 @@ Status bakeMissingCells(const BakeJob& job, BakeInput& in, const std::vector<siz
         }
         worker.join();
         if (progress) progress->end();
-        rep.planChosen = plan.chosen;
-        rep.planPaying = plan.paying;
-        rep.planChosenMb = plan.chosenMb;
-        rep.planPayingMb = plan.payingMb;
         if (log) {
             char buf[200];
             std::snprintf(buf, sizeof buf, "storage budget %.1f MB: %zu of %zu street ends that pay (%.1f of %.1f MB predicted)",

@@ -66,8 +66,6 @@ struct BakeReport {
     double cellBakeS = 0;              // sum of the assembled cells' bake times
     std::vector<std::string> notes;    // the assembled cells' notes, "cell C: end E: ..." (--stats "notes")
     double budgetMb = 0;               // the storage budget as resolved (0: none)
-    size_t planChosen = 0, planPaying = 0;      // street ends chosen / that pay, when this run planned (storage budget)
-    double planChosenMb = 0, planPayingMb = 0;  // their predicted MB
 };
 
 Status validateBakeJob(const BakeJob& job);
