@@ -405,7 +405,9 @@ int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path,
         }
         cam->setProjectionMatrix(toOsg(c.projection(v.current->beginViewerFrame(c))));
         if (v.keys->effects) v.sky->setNight(v.keys->effects->night);
-        v.sky->showSky(c);
+        const bool skyLayer = !v.current->drawsSky();  // hybrid: the far field writes every uncovered pixel
+        v.sky->node()->setNodeMask(skyLayer ? ~0u : 0u);
+        if (skyLayer) v.sky->showSky(c);
         v.hud.text->setText(hudText(v.mode, lastMs, v.current->lastViewerStats(), playback));
         const bool last = a.frames > 0 && n + 1 >= a.frames;
         if (last && !a.screenshot.empty()) v.keys->capture->pending = a.screenshot;

@@ -18,6 +18,7 @@
 #include <osg/Viewport>
 #include <GL/glext.h>
 
+#include "nodes/gl_readback.h"
 #include "nodes/near_far_split.h"
 #include "runtime/scene/city_file.h"
 #include "runtime/scene/scene_graph.h"
@@ -154,12 +155,8 @@ void FarFieldNode::drawImplementation(osg::RenderInfo& ri) const {
 
     // Opacity buffer: the near field's depth (GL rows bottom-up -> row 0 at top).
     const size_t N = size_t(W) * size_t(H);
-    _depth.resize(N);
-    _flipDepth.resize(N);
+    readDepthTopDown(GLint(vp->x()), GLint(vp->y()), W, H, _depthBits, _depth);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadPixels(GLint(vp->x()), GLint(vp->y()), W, H, GL_DEPTH_COMPONENT, GL_FLOAT, _flipDepth.data());
-    for (int y = 0; y < H; ++y)
-        std::copy_n(&_flipDepth[size_t(H - 1 - y) * size_t(W)], W, &_depth[size_t(y) * size_t(W)]);
 
     _stats = FrameStats();
     if (_image.width != W || _image.height != H) _image = Image(W, H);

@@ -65,7 +65,7 @@ public:
         _far->setOptions(farOptions(nearD, zFar));
         if (_ctx.options.overlap) _far->beginFrame(camera);
         FrameStats ns;
-        VISTA_RETURN_IF_ERROR(_ctx.renderer->render(_root.get(), camera, zFar, &out, &_depth, ns));
+        VISTA_RETURN_IF_ERROR(_ctx.renderer->render(_root.get(), camera, zFar, &out, &_depth, ns, /*skyLayer=*/false));
         stats.stages.set(Stage::Near, ns.frameMs);
         stats.stages.set(Stage::Readback, ns.stages.ms(Stage::Readback));  // part of Near
         stats.cullMs = ns.cullMs;
@@ -82,6 +82,7 @@ public:
     }
     void reset() override { _far->reset(); }
     bool hazesRasterPixels() const override { return true; }  // FarFieldOptions::hazeCovered
+    bool drawsSky() const override { return true; }  // the far field classifies and fills every uncovered pixel
     const std::vector<uint32_t>* lastTracedPixels() const override { return &_far->lastTraced(); }
     double lastRayStart() const override { return _far->lastRayStart(); }
     const RasterSelection* lastRaster() const override { return &_raster; }

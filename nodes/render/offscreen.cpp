@@ -23,6 +23,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "foundation/timing.h"
+#include "nodes/gl_readback.h"
 
 namespace vista {
 
@@ -53,19 +54,7 @@ struct Readback : public osg::Camera::DrawCallback {
             color->resize(size_t(width) * size_t(height) * 4);
             glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, color->data());
         }
-        if (depth) {
-            // As normalised 32-bit integers, converted here: on llvmpipe (24-bit depth)
-            // this read is about 5x faster than GL_FLOAT (1280x720: 0.23 against 1.2 ms),
-            // and u / (2^32 - 1) is the GL_FLOAT value within float rounding (1 stays 1).
-            const size_t n = size_t(width) * size_t(height);
-            depthBits.resize(n);
-            depth->resize(n);
-            glReadPixels(0, 0, width, height, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, depthBits.data());
-            constexpr float kScale = float(1.0 / 4294967295.0);
-            float* out = depth->data();
-            const uint32_t* in = depthBits.data();
-            for (size_t i = 0; i < n; ++i) out[i] = std::min(1.0f, float(in[i]) * kScale);
-        }
+        if (depth) readDepthTopDown(0, 0, width, height, depthBits, *depth);  // row 0 at top
         readMs = read.ms();
     }
 };
@@ -203,11 +192,6 @@ struct OffscreenRenderer::Impl {
             for (int y = 0; y < height; ++y)
                 std::memcpy(&color->rgba[size_t(y) * row], &colorBuf[size_t(height - 1 - y) * row], row);
         }
-        if (depth) {  // flip in place: row 0 at top
-            for (int y = 0; y < height / 2; ++y)
-                std::swap_ranges(depth->begin() + ptrdiff_t(y) * width, depth->begin() + ptrdiff_t(y + 1) * width,
-                                 depth->begin() + ptrdiff_t(height - 1 - y) * width);
-        }
         return Status::ok();
     }
 };
@@ -291,13 +275,14 @@ Result<std::unique_ptr<OffscreenRenderer>> OffscreenRenderer::create(int width, 
 }
 
 Status OffscreenRenderer::render(osg::Node* scene, const Camera& camera, double zFar, Image* color,
-                                 std::vector<float>* depth, FrameStats& stats) {
+                                 std::vector<float>* depth, FrameStats& stats, bool skyLayer) {
     Impl& m = *_impl;
     if (camera.width != m.width || camera.height != m.height)
         return Status::error("camera size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
                              " differs from the renderer's " + std::to_string(m.width) + "x" + std::to_string(m.height));
     Stopwatch sw;
-    m.sky->showSky(camera, m.jx, m.jy);
+    m.sky->node()->setNodeMask(skyLayer ? ~0u : 0u);
+    if (skyLayer) m.sky->showSky(camera, m.jx, m.jy);
     const double skyMs = sw.ms();
     Status s = m.draw(scene, camera, zFar, color, depth, stats);
     stats.frameMs += skyMs;

@@ -188,6 +188,8 @@ public:
     const std::vector<uint32_t>* lastTracedPixels() const override { return _inner->lastTracedPixels(); }
     double lastRayStart() const override { return _inner->lastRayStart(); }
     const RasterSelection* lastRaster() const override { return _inner->lastRaster(); }
+    bool hazesRasterPixels() const override { return _inner->hazesRasterPixels(); }
+    bool drawsSky() const override { return _inner->drawsSky(); }
     osg::Node* viewerScene() override {
         if (!_viewer) {
             _viewer = new osg::Group;

@@ -152,6 +152,10 @@ public:
     // True when the mode hazes its drawn pixels itself (both faces): the
     // effects wrapper then keeps the haze program out of the rasteriser.
     virtual bool hazesRasterPixels() const { return false; }
+    // True when the mode writes every pixel its GL pass leaves uncovered, sky
+    // included (hybrid: every such pixel is classified and filled by the far
+    // field): the sky layer under its GL pass is not drawn (both faces).
+    virtual bool drawsSky() const { return false; }
     // The pixels the far-field ray stage of the last renderFrame() cast
     // (FarField::lastTraced(), ascending), or null for a mode without one
     // (all but hybrid). `vista bench --dump-rays` writes them as RaySet files.

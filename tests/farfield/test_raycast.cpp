@@ -253,6 +253,26 @@ TEST(RayRaster, StillFrameOfHybridAndRaysMatchTheRasteriser) {
         const double psnrH = lumaPsnr(hyb, full), psnrR = lumaPsnr(rays, full);
         EXPECT_GE(psnrH, 40.0) << "hybrid vs full";
         EXPECT_GE(psnrR, 35.0) << "all rays vs full";
+        // The hybrid's GL pass draws no sky layer (RenderMode::drawsSky): the
+        // far field must write every pixel it leaves uncovered. Where `full`
+        // (drawn over the sky layer) shows bare sky, the hybrid shows the
+        // same sky, and no pixel keeps the black clear colour.
+        ASSERT_TRUE(hybrid.value()->drawsSky());
+        Image sky;
+        renderSky(c, sky);
+        size_t bareSky = 0, sameSky = 0, black = 0;
+        for (size_t i = 0; i < size_t(W) * H; ++i) {
+            const uint8_t* f = &full.rgba[4 * i];
+            const uint8_t* h = &hyb.rgba[4 * i];
+            const uint8_t* s = &sky.rgba[4 * i];
+            if (h[0] == 0 && h[1] == 0 && h[2] == 0) ++black;
+            if (f[0] != s[0] || f[1] != s[1] || f[2] != s[2]) continue;
+            ++bareSky;
+            if (h[0] == s[0] && h[1] == s[1] && h[2] == s[2]) ++sameSky;
+        }
+        EXPECT_EQ(black, 0u);
+        EXPECT_GT(bareSky, 0u);
+        EXPECT_GE(double(sameSky), 0.99 * double(bareSky)) << "sky pixels of full that the hybrid shows otherwise";
         // The far field was really traced, not only blended in: hybrid pixels
         // beyond the near field hit far geometry, every ray is counted.
         EXPECT_GT(hs.pixels.covered, 0u);
@@ -319,6 +339,11 @@ TEST(RayRaster, OsgNodesCompositeTheFarFieldInsideAnOsgFrame) {
     std::printf("OSG nodes: PSNR %.2f dB, near triangles %llu of %zu\n", psnr, (unsigned long long)split->lastNearTriangles(),
                 loaded->triangles);
     EXPECT_GE(psnr, 40.0);
+    // The viewer hides the sky layer under the hybrid (RenderMode::drawsSky):
+    // the far-field node writes every uncovered pixel, so the picture is the same.
+    Image noSky;
+    ASSERT_TRUE(renderer.value()->render(hybrid.get(), c, 0.0, &noSky, nullptr, hs, /*skyLayer=*/false).isOk());
+    EXPECT_EQ(noSky.rgba, hyb.rgba);
     // Budget split: nearest children up to the budget.
     split->setTriangleBudget(1);
     ASSERT_TRUE(renderer.value()->render(hybrid.get(), c, 0.0, &hyb, nullptr, hs).isOk());
