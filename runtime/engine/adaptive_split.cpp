@@ -174,16 +174,17 @@ uint64_t AdaptiveSplit::predictedTriangles(const glm::dvec3& eye, double d) cons
 }
 
 double AdaptiveSplit::predictedRays(double d) const {
-    double n = 0;
-    for (float t : _probeT)
-        if (t > d) n += 1;  // beyond the near field, or a miss (t = inf)
-    return n * _probeScale;
+    // Beyond the near field, or a miss (t = inf): _probeT is sorted ascending.
+    const auto first = std::upper_bound(_probeT.begin(), _probeT.end(), float(d));
+    return double(_probeT.end() - first) * _probeScale;
 }
 
 void AdaptiveSplit::probe(const Camera& camera) {
     _probeT.clear();
     if (!_rays) return;
-    const int s = std::max(1, _o.probeStride);
+    // Every probeStride-th pixel, or sparser on a large image: about probeRays rays.
+    const double fromCount = std::sqrt(double(camera.width) * camera.height / std::max(1, _o.probeRays));
+    const int s = std::max({1, _o.probeStride, int(std::lround(fromCount))});
     const glm::vec3 org(camera.eye - _rays->frameOrigin());
     std::vector<glm::vec3> orgs, dirs;
     for (int y = s / 2; y < camera.height; y += s)
@@ -210,6 +211,7 @@ void AdaptiveSplit::probe(const Camera& camera) {
             ++misses;
         }
     }
+    std::sort(_probeT.begin(), _probeT.end());  // predictedRays() counts by binary search
     _probeScale = dirs.empty() ? 0.0 : double(camera.width) * camera.height / double(dirs.size());
 }
 

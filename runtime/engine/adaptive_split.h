@@ -19,7 +19,8 @@
 // field's fixed cost F (opacity, seam, horizon, composite: exponential moving
 // average) paid by every candidate but "everything near", predicted triangles(d) from the objects'
 // boxes (exact) and predicted rays(d) from a sparse probe of the view (every
-// `probeStride`-th pixel cast once per `probeInterval` frames: a pixel whose
+// `probeStride`-th pixel, sparser so that a large image gets about
+// `probeRays` probe rays, cast once per `probeInterval` frames: a pixel whose
 // first hit lies beyond d, or that misses below the horizon, needs a ray). It
 // minimises a * triangles(d) + b * rays(d) (+ F unless d = infinity) over candidate distances
 // (geometric steps between minDistance and maxDistance, plus 0 = ray casting
@@ -86,7 +87,8 @@ std::vector<uint32_t> selectNearFieldByBudget(const std::vector<SplitObject>& ob
 struct AdaptiveSplitOptions {
     double minDistance = 15.0, maxDistance = 800.0;
     int candidates = 16;        // geometric steps between min and max
-    int probeStride = 8;        // probe every 8th pixel in x and y
+    int probeStride = 8;        // probe every 8th pixel in x and y, at least
+    int probeRays = 4800;       // ... and sparser on larger images: about this many rays (640x480 / 64)
     int probeInterval = 10;     // frames between probes
     double smoothing = 0.2;     // EMA weight of a new measurement
     double initialDistance = 100.0;
@@ -131,7 +133,7 @@ private:
     std::vector<std::pair<double, double>> _farSamples;     // (far pixels, ms), last `window` frames
     double _current;
     int _frame = 0;
-    std::vector<float> _probeT;  // per probe pixel: first hit distance (inf = miss)
+    std::vector<float> _probeT;  // per probe pixel: first hit distance (inf = miss), sorted ascending
     double _probeScale = 1;      // screen pixels per probe pixel
 };
 

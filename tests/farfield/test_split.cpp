@@ -125,6 +125,45 @@ TEST(Split, AdaptiveChoiceFollowsTheMeasuredCosts) {
     EXPECT_GE(cheapTris.predictedRays(50), cheapTris.predictedRays(400));
 }
 
+// predictedRays(d) against an independent count: every s-th pixel cast one
+// at a time (RayScene::intersect), where s follows from probeStride and
+// probeRays (a 1280x720 image: sqrt(921600 / 4800) = 13.9 -> every 14th
+// pixel); a probe pixel needs a ray when its hit lies beyond d or it misses
+// below the horizon.
+TEST(Split, ProbePredictsTheRaysOfAnIndependentCount) {
+    SceneModel city = randomCity(7, 150, 800.0);
+    auto rs = RayScene::build(city);
+    ASSERT_TRUE(rs.isOk());
+    std::vector<SplitObject> objs = {box({-400, -400, 0}, {400, 400, 60}, 1000)};
+    Camera c;
+    c.eye = glm::dvec3(10, -300, 12.0);
+    c.pitch = -0.05;
+    c.width = 1280;
+    c.height = 720;
+    AdaptiveSplitOptions o;
+    o.timeProbe = false;
+    AdaptiveSplit split(objs, rs.value().get(), o);
+    split.choose(c, -1);  // the first choice probes
+    const int s = 14;
+    const glm::vec3 org(c.eye - rs.value()->frameOrigin());
+    std::vector<double> need(5, 0.0);
+    const double ds[5] = {0.0, 30.0, 100.0, 300.0, std::numeric_limits<double>::infinity()};
+    double probes = 0;
+    for (int y = s / 2; y < c.height; y += s)
+        for (int x = s / 2; x < c.width; x += s) {
+            const glm::vec3 dir(c.rayDirection(x + 0.5, y + 0.5));
+            const RayHit h = rs.value()->intersect(org, dir);
+            probes += 1;
+            for (int k = 0; k < 5; ++k) need[size_t(k)] += h.hit ? (double(h.t) > ds[k]) : (dir.z < 0 && std::isinf(ds[k]) == false);
+        }
+    const double scale = double(c.width) * c.height / probes;
+    EXPECT_NEAR(probes, 4800.0, 300.0);
+    for (int k = 0; k < 5; ++k)
+        EXPECT_NEAR(split.predictedRays(ds[k]), need[size_t(k)] * scale, 0.002 * c.width * c.height) << "d = " << ds[k];
+    EXPECT_EQ(split.predictedRays(std::numeric_limits<double>::infinity()), 0.0);
+    EXPECT_GT(split.predictedRays(30.0), split.predictedRays(300.0));
+}
+
 // The raster-cost fit is robust: frames slowed down by another process (one
 // in four here, 3x to 8x their cost) do not move the fitted ms per triangle
 // off the line the other frames lie on (a least-squares fit would: it is
