@@ -4,7 +4,7 @@
 //
 // Contract: create() fails with a clear Status when no display is available
 // (message says to use `xvfb-run -a`). render() draws the sky (SkyBackground)
-// as background, then `scene` with the camera's view
+// as background (unless skyLayer = false), then `scene` with the camera's view
 // and projection (zFar <= 0: infinite far plane), waits for the GPU
 // (glFinish) and reads back colour (RGBA8, row 0 at top) and, if `depth` is
 // non-null, window-space depth in [0,1] (row 0 at top, 1 = nothing drawn).
