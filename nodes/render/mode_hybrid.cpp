@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "foundation/timing.h"
 #include "nodes/far_field_node.h"
@@ -52,7 +53,13 @@ public:
             tris += _near.objects[i].triangles;
         }
         stats.stages.set(Stage::Cull, sw.ms());
-        if (autoSplit()) stats.notes.push_back(nearAutoNote(nearD));
+        if (autoSplit()) {
+            stats.notes.push_back(nearAutoNote(nearD));
+            char model[160];
+            std::snprintf(model, sizeof model, "split model: %.3g ms/k triangles, %.3g ms/k far pixels, %.2f ms far fixed",
+                          1e3 * _adaptive->msPerTriangle(), 1e3 * _adaptive->msPerRay(), _adaptive->farFixedMs());
+            stats.notes.push_back(model);
+        }
         // Near field: GL draw + colour/depth readback (sky where uncovered).
         // Far plane at the near distance: straddling chunks are drawn up to
         // it, the far field fills the rest with the same shading; FarField's

@@ -13,14 +13,19 @@
 // distances differ as the walk goes on; priors until a fit is well
 // conditioned; b falls back to the mean ms per far pixel, and a fitted b is
 // kept within [1/5, 1] of that mean; b is capped by the probe's bulk ms per
-// ray (timed on one thread): a fixed cost per frame (thread start, packet
+// far ray (the probe rays that need the far field at the current near
+// distance, cast again from it and timed on one thread; timing all probe rays
+// priced far rays like the short ones into nearby facades, and the split then
+// shrank the near field into ever more rays): a fixed cost per frame (thread start, packet
 // set-up) divided by a few hundred rays would otherwise make rays look dearer
 // than they are, push the near field out, and so starve the fit), the far
 // field's fixed cost F (opacity, seam, horizon, composite: exponential moving
 // average) paid by every candidate but "everything near", predicted triangles(d) from the objects'
 // boxes (exact) and predicted rays(d) from a sparse probe of the view (every
 // `probeStride`-th pixel, sparser so that a large image gets about
-// `probeRays` probe rays, cast once per `probeInterval` frames: a pixel whose
+// `probeRays` probe rays, cast once per `probeInterval` frames and at once
+// when the view jumped (eye moved more than minDistance, heading or pitch
+// more than 0.1 rad since the probe): a pixel whose
 // first hit lies beyond d, or that misses below the horizon, needs a ray). It
 // minimises a * triangles(d) + b * rays(d) (+ F unless d = infinity) over candidate distances
 // (geometric steps between minDistance and maxDistance, plus 0 = ray casting
@@ -129,12 +134,15 @@ private:
     AdaptiveSplitOptions _o;
     double _a = 2e-5, _b = 5e-4, _f = 0, _bProbe = 0;  // priors: ms per triangle, ms per far pixel, fixed far ms
     bool _haveA = false, _haveB = false, _haveF = false;  // measured (not the priors)
+    bool _bFitted = false;  // _b is the frames' well-conditioned slope (not the mean)
     std::vector<std::pair<double, double>> _rasterSamples;  // (triangles, ms), last `window` frames
     std::vector<std::pair<double, double>> _farSamples;     // (far pixels, ms), last `window` frames
     double _current;
     int _frame = 0;
     std::vector<float> _probeT;  // per probe pixel: first hit distance (inf = miss), sorted ascending
     double _probeScale = 1;      // screen pixels per probe pixel
+    glm::dvec3 _probeEye{0.0};   // the camera of the last probe
+    double _probeHeading = 0, _probePitch = 0;
 };
 
 }  // namespace vista

@@ -143,25 +143,67 @@ TEST(Split, ProbePredictsTheRaysOfAnIndependentCount) {
     AdaptiveSplitOptions o;
     o.timeProbe = false;
     AdaptiveSplit split(objs, rs.value().get(), o);
-    split.choose(c, -1);  // the first choice probes
     const int s = 14;
-    const glm::vec3 org(c.eye - rs.value()->frameOrigin());
-    std::vector<double> need(5, 0.0);
     const double ds[5] = {0.0, 30.0, 100.0, 300.0, std::numeric_limits<double>::infinity()};
-    double probes = 0;
-    for (int y = s / 2; y < c.height; y += s)
-        for (int x = s / 2; x < c.width; x += s) {
-            const glm::vec3 dir(c.rayDirection(x + 0.5, y + 0.5));
-            const RayHit h = rs.value()->intersect(org, dir);
-            probes += 1;
-            for (int k = 0; k < 5; ++k) need[size_t(k)] += h.hit ? (double(h.t) > ds[k]) : (dir.z < 0 && std::isinf(ds[k]) == false);
-        }
-    const double scale = double(c.width) * c.height / probes;
-    EXPECT_NEAR(probes, 4800.0, 300.0);
-    for (int k = 0; k < 5; ++k)
-        EXPECT_NEAR(split.predictedRays(ds[k]), need[size_t(k)] * scale, 0.002 * c.width * c.height) << "d = " << ds[k];
+    auto check = [&](const Camera& cam, const char* what) {
+        const glm::vec3 org(cam.eye - rs.value()->frameOrigin());
+        std::vector<double> need(5, 0.0);
+        double probes = 0;
+        for (int y = s / 2; y < cam.height; y += s)
+            for (int x = s / 2; x < cam.width; x += s) {
+                const glm::vec3 dir(cam.rayDirection(x + 0.5, y + 0.5));
+                const RayHit h = rs.value()->intersect(org, dir);
+                probes += 1;
+                for (int k = 0; k < 5; ++k)
+                    need[size_t(k)] += h.hit ? (double(h.t) > ds[k]) : (dir.z < 0 && !std::isinf(ds[k]));
+            }
+        const double scale = double(cam.width) * cam.height / probes;
+        EXPECT_NEAR(probes, 4800.0, 300.0) << what;
+        for (int k = 0; k < 5; ++k)
+            EXPECT_NEAR(split.predictedRays(ds[k]), need[size_t(k)] * scale, 0.002 * cam.width * cam.height)
+                << what << ", d = " << ds[k];
+    };
+    split.choose(c, -1);  // the first choice probes
+    check(c, "first view");
+    // A jump (200 m away, turned half a turn) within the probe interval: probed again at once.
+    Camera c2 = c;
+    c2.eye = glm::dvec3(150, 100, 30.0);
+    c2.heading = c.heading + 3.0;
+    split.choose(c2, -1);
+    check(c2, "after a jump");
     EXPECT_EQ(split.predictedRays(std::numeric_limits<double>::infinity()), 0.0);
     EXPECT_GT(split.predictedRays(30.0), split.predictedRays(300.0));
+}
+
+// The probe's timed rate (one thread, between frames) caps b only while the
+// frames' far-cost fit is ill-conditioned (b is then the mean ms per pixel,
+// which counts each frame's fixed cost); a well-conditioned fit is the price
+// of a far pixel in the frame, even above the probe's rate.
+TEST(Split, ProbeRateCapsOnlyTheFallbackToTheMean) {
+    SceneModel city = randomCity(5, 150, 800.0);
+    auto rs = RayScene::build(city);
+    ASSERT_TRUE(rs.isOk());
+    std::vector<SplitObject> objs = {box({-400, -400, 0}, {400, 400, 60}, 1000)};
+    Camera c;
+    c.eye = glm::dvec3(0, -300, 1.7);
+    c.width = 320;
+    c.height = 240;
+    AdaptiveSplitOptions o;
+    o.timeProbe = true;
+    o.minDistance = 1.0;  // nearly every probe ray is a far ray, so the probe is timed
+    AdaptiveSplit fitted(objs, rs.value().get(), o), flat(objs, rs.value().get(), o);
+    fitted.choose(c, -1);
+    flat.choose(c, -1);
+    // 10 ms per 1000 far pixels plus 1 ms a frame: far dearer than any Embree ray.
+    for (int i = 0; i < 12; ++i) {
+        const double px = 2000 + 1000 * i;
+        fitted.record(uint64_t(10000 + 1000 * i), 2.0 + 1e-4 * (10000 + 1000 * i), uint64_t(px), 1.0 + 1e-2 * px);
+        flat.record(uint64_t(10000 + 1000 * i), 2.0 + 1e-4 * (10000 + 1000 * i), 5000, 1.0 + 1e-2 * 5000);
+    }
+    EXPECT_NEAR(fitted.msPerRay(), 1e-2, 1e-4);
+    // Same far pixels every frame: no slope, the mean (1.02e-2) capped by the probe's rate.
+    EXPECT_GT(flat.msPerRay(), 0.0);
+    EXPECT_LT(flat.msPerRay(), 1e-2);
 }
 
 // The raster-cost fit is robust: frames slowed down by another process (one
