@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "foundation/timing.h"
 #include "runtime/engine/far_field_stages.h"
 #include "runtime/engine/ray_scene.h"
 
@@ -50,11 +51,17 @@ void FarField::beginFrame(const Camera& camera) {
     // Dropping an std::async future waits for its task: never two at once.
     _mem->earlyHorizon = std::future<HorizonResult>();
     if (!_grid || !_options.horizon || !farGeometryExists(_rays, _grid, camera, _options) || !horizonApplies(camera)) return;
+    if (_mem->horizonPaused > 0 && _mem->haveLast && !sameCamera(_mem->last, camera)) return;  // paused (renderStages)
     const bool moving = _mem->haveLast && !sameCamera(_mem->last, camera);
     const HorizonOptions ho = horizonOptions(_options, moving);
     const HeightGrid* grid = _grid;
     _mem->earlyCamera = camera;
-    _mem->earlyHorizon = std::async(std::launch::async, [grid, camera, ho] { return traceHorizon(*grid, camera, ho); });
+    _mem->earlyHorizon = std::async(std::launch::async, [grid, camera, ho] {
+        Stopwatch sw;
+        HorizonResult r = traceHorizon(*grid, camera, ho);
+        r.traceMs = sw.ms();
+        return r;
+    });
 }
 
 void FarField::reset() {
@@ -62,6 +69,7 @@ void FarField::reset() {
     _mem->prev = Image();
     _mem->haveLast = false;
     _mem->cachePaused = 0;
+    _mem->horizonPaused = 0;
     _mem->lastFrameCached = false;
 }
 
@@ -99,9 +107,22 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
         return;
     }
     const bool useEarly = early.valid() && sameCamera(_mem->earlyCamera, camera);
-    if (_options.horizon) horizonStage(f, _grid, _options, stats, useEarly ? &early : nullptr);
-    listPending(f);
     const bool budgeted = _options.pixelBudget >= 0 || _options.frameMsTarget > 0;
+    // The horizon pauses while it does not pay (FarFieldOptions::horizonAdaptive).
+    const bool horizonAdaptive = _options.horizonAdaptive && !budgeted && f.moving;
+    bool useHorizon = _options.horizon;
+    if (useHorizon && horizonAdaptive && _mem->horizonPaused > 0) {
+        --_mem->horizonPaused;
+        useHorizon = false;
+        stats.notes.push_back("horizon paused: tracing it cost more than the rays it saved");
+    }
+    if (useHorizon) {
+        const uint64_t culledBefore = stats.pixels.horizonCulled;
+        const double traceMs = horizonStage(f, _grid, _options, stats, useEarly ? &early : nullptr);
+        const double savedMs = double(stats.pixels.horizonCulled - culledBefore) * _mem->msPerRay;
+        if (horizonAdaptive && _mem->msPerRay > 0 && traceMs > savedMs) _mem->horizonPaused = kHorizonPauseFrames;
+    }
+    listPending(f);
     const bool adaptive = _options.cacheAdaptive && !budgeted && f.moving;
     bool useCache = _options.cache;
     if (useCache && adaptive && _mem->cachePaused > 0) {

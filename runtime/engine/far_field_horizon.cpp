@@ -15,11 +15,11 @@ HorizonOptions horizonOptions(const FarFieldOptions& o, bool moving) {
     return ho;
 }
 
-void horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o, FrameStats& stats,
-                  std::future<HorizonResult>* early) {
+double horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o, FrameStats& stats,
+                    std::future<HorizonResult>* early) {
     if (!grid) {
         stats.notes.push_back("horizon off: no height grid");
-        return;
+        return 0.0;
     }
     Stopwatch sw;
     HorizonResult hr;
@@ -29,11 +29,13 @@ void horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o,
     } else {
         HorizonOptions ho = horizonOptions(o, f.moving);
         ho.columnNeeded = &f.columnNeeded;
+        Stopwatch trace;
         hr = traceHorizon(*grid, f.camera, ho);
+        hr.traceMs = trace.ms();
     }
     if (!hr.active) {
         stats.notes.push_back(hr.reason);
-        return;
+        return hr.traceMs;
     }
     // Row by row (contiguous in memory): pixel (x, y) is above the horizon when y < row[x]; it
     // gets the sky colour here, so no later pass over the frame is needed.
@@ -58,6 +60,7 @@ void horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o,
     }
     stats.pixels.horizonCulled += culled;
     stats.stages.add(Stage::Horizon, sw.ms());
+    return hr.traceMs;
 }
 
 void cullAllPending(FarFrame& f, FrameStats& stats) {

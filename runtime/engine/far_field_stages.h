@@ -62,6 +62,7 @@ struct FarFieldMemory {
     double compositeMs = 0;    // composite stage ms (moving average)
     // Cache duty cycle (FarFieldOptions::cacheAdaptive).
     int cachePaused = 0;          // moving frames left to trace without the cache
+    int horizonPaused = 0;        // moving frames left to trace without the horizon
     bool lastFrameCached = false; // the last frame ran the cache stage (its stores are fresh)
     // Scratch of the cache stage, kept so that a frame does not fault in fresh pages.
     std::vector<CacheCandidate> cand;
@@ -131,7 +132,8 @@ void hazeCoveredStage(FarFrame& f, const FarFieldOptions& o, FrameStats& stats);
 // early (optional): the horizon of this very camera traced ahead of the
 // frame (FarField::beginFrame, all columns); then the stage waits for it
 // (the wait is the recorded time) and notes "horizon overlapped".
-void horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o, FrameStats& stats,
+// Returns the wall time of the trace itself (on whichever thread traced it).
+double horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o, FrameStats& stats,
                   std::future<HorizonResult>* early = nullptr);
 // The horizon options of a frame (near distance, haze depth, subsampling while moving).
 HorizonOptions horizonOptions(const FarFieldOptions& o, bool moving);

@@ -3,8 +3,10 @@
 
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <random>
 
+#include "foundation/status.h"
 #include "runtime/engine/adaptive_split.h"
 #include "runtime/engine/ray_scene.h"
 #include "tests/farfield/fixtures.h"
@@ -19,6 +21,16 @@ SplitObject box(glm::dvec3 lo, glm::dvec3 hi, uint64_t tris) {
     o.hi = hi;
     o.triangles = tris;
     return o;
+}
+// A random 800 m city of 150 boxes as a ray scene, and one split object over it.
+struct ProbeScene {
+    std::unique_ptr<RayScene> rays;
+    std::vector<SplitObject> objs;
+};
+ProbeScene probeScene(uint32_t seed) {
+    auto rs = RayScene::build(randomCity(seed, 150, 800.0));
+    VISTA_CHECK(rs.isOk());
+    return ProbeScene{std::move(rs.value()), {box({-400, -400, 0}, {400, 400, 60}, 1000)}};
 }
 }  // namespace
 
@@ -131,10 +143,9 @@ TEST(Split, AdaptiveChoiceFollowsTheMeasuredCosts) {
 // pixel); a probe pixel needs a ray when its hit lies beyond d or it misses
 // below the horizon.
 TEST(Split, ProbePredictsTheRaysOfAnIndependentCount) {
-    SceneModel city = randomCity(7, 150, 800.0);
-    auto rs = RayScene::build(city);
-    ASSERT_TRUE(rs.isOk());
-    std::vector<SplitObject> objs = {box({-400, -400, 0}, {400, 400, 60}, 1000)};
+    ProbeScene ps = probeScene(7);
+    RayScene* rays = ps.rays.get();
+    const std::vector<SplitObject>& objs = ps.objs;
     Camera c;
     c.eye = glm::dvec3(10, -300, 12.0);
     c.pitch = -0.05;
@@ -142,17 +153,17 @@ TEST(Split, ProbePredictsTheRaysOfAnIndependentCount) {
     c.height = 720;
     AdaptiveSplitOptions o;
     o.timeProbe = false;
-    AdaptiveSplit split(objs, rs.value().get(), o);
+    AdaptiveSplit split(objs, rays, o);
     const int s = 14;
     const double ds[5] = {0.0, 30.0, 100.0, 300.0, std::numeric_limits<double>::infinity()};
     auto check = [&](const Camera& cam, const char* what) {
-        const glm::vec3 org(cam.eye - rs.value()->frameOrigin());
+        const glm::vec3 org(cam.eye - rays->frameOrigin());
         std::vector<double> need(5, 0.0);
         double probes = 0;
         for (int y = s / 2; y < cam.height; y += s)
             for (int x = s / 2; x < cam.width; x += s) {
                 const glm::vec3 dir(cam.rayDirection(x + 0.5, y + 0.5));
-                const RayHit h = rs.value()->intersect(org, dir);
+                const RayHit h = rays->intersect(org, dir);
                 probes += 1;
                 for (int k = 0; k < 5; ++k)
                     need[size_t(k)] += h.hit ? (double(h.t) > ds[k]) : (dir.z < 0 && !std::isinf(ds[k]));
@@ -180,10 +191,9 @@ TEST(Split, ProbePredictsTheRaysOfAnIndependentCount) {
 // which counts each frame's fixed cost); a well-conditioned fit is the price
 // of a far pixel in the frame, even above the probe's rate.
 TEST(Split, ProbeRateCapsOnlyTheFallbackToTheMean) {
-    SceneModel city = randomCity(5, 150, 800.0);
-    auto rs = RayScene::build(city);
-    ASSERT_TRUE(rs.isOk());
-    std::vector<SplitObject> objs = {box({-400, -400, 0}, {400, 400, 60}, 1000)};
+    ProbeScene ps = probeScene(5);
+    RayScene* rays = ps.rays.get();
+    const std::vector<SplitObject>& objs = ps.objs;
     Camera c;
     c.eye = glm::dvec3(0, -300, 1.7);
     c.width = 320;
@@ -191,7 +201,7 @@ TEST(Split, ProbeRateCapsOnlyTheFallbackToTheMean) {
     AdaptiveSplitOptions o;
     o.timeProbe = true;
     o.minDistance = 1.0;  // nearly every probe ray is a far ray, so the probe is timed
-    AdaptiveSplit fitted(objs, rs.value().get(), o), flat(objs, rs.value().get(), o);
+    AdaptiveSplit fitted(objs, rays, o), flat(objs, rays, o);
     fitted.choose(c, -1);
     flat.choose(c, -1);
     // 10 ms per 1000 far pixels plus 1 ms a frame: far dearer than any Embree ray.
