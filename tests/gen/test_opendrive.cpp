@@ -154,7 +154,8 @@ std::string shellOut(const std::string& cmd) {
 }
 
 // The netconvert on PATH, or "" (then the caller skips). netconvert needs
-// SUMO_HOME for its built-in type maps: set it from the install prefix.
+// SUMO_HOME for its built-in type maps: set it from the install prefix (the
+// data are in Debian's sumo-tools, which .ci/setup.sh installs).
 std::string findNetconvert() {
     std::string path = shellOut("command -v netconvert 2>/dev/null");
     if (path.empty()) return path;
