@@ -28,11 +28,16 @@
 // nothing after opacity; no far geometry (city bounds within the near
 // distance, or an empty city) -> no horizon/cache/ray stage (note "rays off:
 // no far geometry"); camera rolled / zenith or nadir in view -> no horizon
-// stage (note says why); cache off -> every remaining pixel traced. stats.stages records the time of
+// stage (note says why); horizon not paying -> paused (horizonAdaptive, a
+// note); cache off -> every remaining pixel traced. stats.stages records the time of
 // every stage that ran (Stage::Opacity, Seam, Horizon, Cache, Rays,
 // Composite); stats.notes explains skipped stages.
 //
 // Determinism: the image, classes and counts do not depend on thread count.
+// The pauses (cacheAdaptive, horizonAdaptive; default on) follow measured
+// times, so with them the classes and counts of a moving frame can differ
+// between runs; the horizon's pause leaves the image as it is, the cache's
+// within its error bound.
 // Ray casting runs in a tbb::task_arena with `threads` workers (0 = all cores);
 // FTZ/DAZ are set in every casting thread (RayScene). Not thread-safe itself;
 // nothing throws. Contract: depth (if not null) has width*height entries.
