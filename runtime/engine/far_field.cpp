@@ -33,6 +33,16 @@ bool farGeometryExists(const RayScene& rays, const HeightGrid* grid, const Camer
     return far2 >= o.nearDistance * o.nearDistance;
 }
 
+// A stage that pauses while it does not pay (the cache, the horizon): true,
+// with the note, while `framesLeft` paused frames remain (counted down here);
+// only frames where the pause applies (`applies`) count.
+bool pausedThisFrame(int& framesLeft, bool applies, FrameStats& stats, const char* note) {
+    if (!applies || framesLeft <= 0) return false;
+    --framesLeft;
+    stats.notes.push_back(note);
+    return true;
+}
+
 }  // namespace
 
 FarField::FarField(const RayScene& rays, const HeightGrid* grid, const FarFieldOptions& options)
@@ -51,8 +61,8 @@ void FarField::beginFrame(const Camera& camera) {
     // Dropping an std::async future waits for its task: never two at once.
     _mem->earlyHorizon = std::future<HorizonResult>();
     if (!_grid || !_options.horizon || !farGeometryExists(_rays, _grid, camera, _options) || !horizonApplies(camera)) return;
-    if (_mem->horizonPaused > 0 && _mem->haveLast && !sameCamera(_mem->last, camera)) return;  // paused (renderStages)
     const bool moving = _mem->haveLast && !sameCamera(_mem->last, camera);
+    if (moving && _mem->horizonPaused > 0) return;  // the horizon is paused (renderStages)
     const HorizonOptions ho = horizonOptions(_options, moving);
     const HeightGrid* grid = _grid;
     _mem->earlyCamera = camera;
@@ -110,12 +120,8 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
     const bool budgeted = _options.pixelBudget >= 0 || _options.frameMsTarget > 0;
     // The horizon pauses while it does not pay (FarFieldOptions::horizonAdaptive).
     const bool horizonAdaptive = _options.horizonAdaptive && !budgeted && f.moving;
-    bool useHorizon = _options.horizon;
-    if (useHorizon && horizonAdaptive && _mem->horizonPaused > 0) {
-        --_mem->horizonPaused;
-        useHorizon = false;
-        stats.notes.push_back("horizon paused: tracing it cost more than the rays it saved");
-    }
+    const bool useHorizon = _options.horizon && !pausedThisFrame(_mem->horizonPaused, horizonAdaptive, stats,
+                                                                 "horizon paused: tracing it cost more than the rays it saved");
     if (useHorizon) {
         const uint64_t culledBefore = stats.pixels.horizonCulled;
         const double traceMs = horizonStage(f, _grid, _options, stats, useEarly ? &early : nullptr);
@@ -124,12 +130,8 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
     }
     listPending(f);
     const bool adaptive = _options.cacheAdaptive && !budgeted && f.moving;
-    bool useCache = _options.cache;
-    if (useCache && adaptive && _mem->cachePaused > 0) {
-        --_mem->cachePaused;
-        useCache = false;
-        stats.notes.push_back("cache paused: its reuse did not pay for its lookups");
-    }
+    const bool useCache = _options.cache && !pausedThisFrame(_mem->cachePaused, adaptive, stats,
+                                                             "cache paused: its reuse did not pay for its lookups");
     f.farDepth.swap(_mem->farDepth);  // reuse last frame's buffer (cacheStage refills it)
     const bool cacheRan = useCache && !f.pending.empty();
     if (cacheRan) {
