@@ -342,6 +342,7 @@ Status setUpWindow(ViewState& v, const ViewArgs& a, osg::ref_ptr<osgGA::KeySwitc
     v.hud = makeHud(a.window.width, a.window.height);
     if (!a.noHud) root->addChild(v.hud.camera.get());
     v.viewer.setThreadingModel(osgViewer::ViewerBase::SingleThreaded);
+    v.viewer.setUseConfigureAffinity(false);  // no pinning of the main thread to core 0 (render/offscreen.cpp)
     v.viewer.setUpViewInWindow(0, 0, a.window.width, a.window.height);
     v.viewer.setSceneData(root.get());
     osg::Camera* cam = v.viewer.getCamera();

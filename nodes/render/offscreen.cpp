@@ -245,6 +245,10 @@ Result<std::unique_ptr<OffscreenRenderer>> OffscreenRenderer::create(int width, 
     m.height = height;
     m.viewer = new osgViewer::Viewer;
     m.viewer->setThreadingModel(osgViewer::ViewerBase::SingleThreaded);
+    // osgViewer pins a single-threaded viewer's main thread to core 0 by default
+    // (configureAffinity); every thread it starts afterwards (TBB's ray casting,
+    // the horizon's overlap thread) would then share that one core.
+    m.viewer->setUseConfigureAffinity(false);
     m.viewer->setKeyEventSetsDone(0);
     m.viewer->setQuitEventSetsDone(false);
     osg::Camera* cam = m.viewer->getCamera();
