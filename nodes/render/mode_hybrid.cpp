@@ -72,15 +72,23 @@ public:
         _far->setOptions(farOptions(nearD, zFar));
         if (_ctx.options.overlap) _far->beginFrame(camera);
         FrameStats ns;
-        VISTA_RETURN_IF_ERROR(_ctx.renderer->render(_root.get(), camera, zFar, &out, &_depth, ns, /*skyLayer=*/false));
-        stats.stages.set(Stage::Near, ns.frameMs);
-        stats.stages.set(Stage::Readback, ns.stages.ms(Stage::Readback));  // part of Near
+        if (sel.empty()) {
+            // Nothing near (ray casting, or an eye far from every chunk): no GL pass, no
+            // read-back; the far field fills every pixel.
+            if (out.width != camera.width || out.height != camera.height || !out.valid()) out = Image(camera.width, camera.height);
+            _depth.clear();
+            stats.notes.push_back("near field empty: no GL pass");
+        } else {
+            VISTA_RETURN_IF_ERROR(_ctx.renderer->render(_root.get(), camera, zFar, &out, &_depth, ns, /*skyLayer=*/false));
+            stats.stages.set(Stage::Near, ns.frameMs);
+            stats.stages.set(Stage::Readback, ns.stages.ms(Stage::Readback));  // part of Near
+        }
         stats.cullMs = ns.cullMs;
         stats.drawMs = ns.drawMs;
         stats.triangles = ns.triangles ? ns.triangles : tris;
         stats.drawCalls = ns.drawCalls;
-        // Far field on the CPU.
-        const bool haveDepth = _depth.size() == size_t(camera.width) * size_t(camera.height);
+        // Far field on the CPU (every pixel far without a depth buffer).
+        const bool haveDepth = !sel.empty() && _depth.size() == size_t(camera.width) * size_t(camera.height);
         _far->render(camera, haveDepth ? _depth.data() : nullptr, out, stats);
         stats.frameMs = sw.ms();
         if (autoSplit())

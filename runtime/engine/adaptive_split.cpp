@@ -266,7 +266,8 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
         } else {
             while (k < byDist.size() && byDist[k].first <= d) tris += byDist[k++].second;
         }
-        cost[size_t(i)] = _a * double(tris) + b * predictedRays(d) + (std::isinf(d) ? 0.0 : _f);
+        // Nothing to draw -> no GL pass: the raster's fixed cost only where triangles are drawn.
+        cost[size_t(i)] = (tris > 0 ? _c + _a * double(tris) : 0.0) + b * predictedRays(d) + (std::isinf(d) ? 0.0 : _f);
         if (cost[size_t(i)] < cost[size_t(bestI)]) bestI = i;
     }
     if (_o.exploreEvery > 0 && frame % _o.exploreEvery == _o.exploreEvery - 1)
@@ -291,6 +292,13 @@ void AdaptiveSplit::record(uint64_t triangles, double rasterMs, uint64_t farPixe
         if (auto a = fitSlope(_rasterSamples); a && *a > 0) {  // keep the prior until the counts vary enough
             _a = *a;
             _haveA = true;
+            // The raster's fixed cost (clear, read-back): the median residual of the slope.
+            std::vector<double> rest;
+            rest.reserve(_rasterSamples.size());
+            for (const auto& [x, y] : _rasterSamples) rest.push_back(y - _a * x);
+            const auto mid = rest.begin() + long(rest.size() / 2);
+            std::nth_element(rest.begin(), mid, rest.end());
+            _c = std::max(0.0, *mid);
         }
     }
     if (farPixels > 100 && farMs > 0) {

@@ -20,14 +20,16 @@
 // set-up) divided by a few hundred rays would otherwise make rays look dearer
 // than they are, push the near field out, and so starve the fit), the far
 // field's fixed cost F (opacity, seam, horizon, composite: exponential moving
-// average) paid by every candidate but "everything near", predicted triangles(d) from the objects'
+// average) paid by every candidate but "everything near", the raster's fixed cost c (the fit's
+// median residual: clear, read-back) paid only by candidates that draw a triangle (a near field
+// with nothing in it needs no GL pass: the hybrid then skips it), predicted triangles(d) from the objects'
 // boxes (exact) and predicted rays(d) from a sparse probe of the view (every
 // `probeStride`-th pixel, sparser so that a large image gets about
 // `probeRays` probe rays, cast once per `probeInterval` frames and at once
 // when the view jumped (eye moved more than minDistance, heading or pitch
 // more than 0.1 rad since the probe): a pixel whose
 // first hit lies beyond d, or that misses below the horizon, needs a ray). It
-// minimises a * triangles(d) + b * rays(d) (+ F unless d = infinity) over candidate distances
+// minimises [c + a * triangles(d) if triangles(d) > 0] + b * rays(d) (+ F unless d = infinity) over candidate distances
 // (geometric steps between minDistance and maxDistance, plus 0 = ray casting
 // and +infinity = everything rasterised when the options allow them). rays(d) is not capped
 // by the pixel budget: the aim is the lowest frame time at full accuracy (a
@@ -118,6 +120,7 @@ public:
     // stages' ms (fixedMs; 0 when the frame had no far field).
     void record(uint64_t triangles, double rasterMs, uint64_t farPixels, double farMs, double fixedMs = 0);
     double msPerTriangle() const { return _a; }
+    double rasterFixedMs() const { return _c; }  // the raster fit's intercept (0 until a is fitted)
     double msPerRay() const;  // per far pixel: the frames' model, capped by the probe's bulk rate
     double farFixedMs() const { return _f; }
     double current() const { return _current; }
@@ -133,6 +136,7 @@ private:
     const RayScene* _rays;
     AdaptiveSplitOptions _o;
     double _a = 2e-5, _b = 5e-4, _f = 0, _bProbe = 0;  // priors: ms per triangle, ms per far pixel, fixed far ms
+    double _c = 0;                                       // fixed raster ms (fitted with a)
     bool _haveA = false, _haveB = false, _haveF = false;  // measured (not the priors)
     bool _bFitted = false;  // _b is the frames' well-conditioned slope (not the mean)
     std::vector<std::pair<double, double>> _rasterSamples;  // (triangles, ms), last `window` frames

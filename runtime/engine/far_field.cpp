@@ -79,6 +79,7 @@ void FarField::reset() {
     _mem->prev = Image();
     _mem->haveLast = false;
     _mem->cachePaused = 0;
+    _mem->cachePauseLength = kCachePauseFrames;
     _mem->horizonPaused = 0;
     _mem->lastFrameCached = false;
 }
@@ -123,10 +124,15 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
     const bool useHorizon = _options.horizon && !pausedThisFrame(_mem->horizonPaused, horizonAdaptive, stats,
                                                                  "horizon paused: tracing it cost more than the rays it saved");
     if (useHorizon) {
-        const uint64_t culledBefore = stats.pixels.horizonCulled;
-        const double traceMs = horizonStage(f, _grid, _options, stats, useEarly ? &early : nullptr);
-        const double savedMs = double(stats.pixels.horizonCulled - culledBefore) * _mem->msPerRay;
-        if (horizonAdaptive && _mem->msPerRay > 0 && traceMs > savedMs) _mem->horizonPaused = kHorizonPauseFrames;
+        const double before = stats.stages.ms(Stage::Horizon);
+        horizonStage(f, _grid, _options, stats, useEarly ? &early : nullptr);
+        // What the horizon cost this frame: its stage time (the trace, or only the wait for a
+        // trace that overlapped the near-field draw). Judged once a ray stage has run (frame 1
+        // on), against a timed sample of the culled pixels' own rays (mostly sky misses: the
+        // mean traced ray prices them 5 to 10 times too high).
+        const double costMs = stats.stages.ms(Stage::Horizon) - before;
+        if (horizonAdaptive && _mem->msPerRay > 0 && costMs > culledRaysMs(f, _rays, _options))
+            _mem->horizonPaused = kHorizonPauseFrames;
     }
     listPending(f);
     const bool adaptive = _options.cacheAdaptive && !budgeted && f.moving;
@@ -141,9 +147,14 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
         const double lookupMs = stats.stages.ms(Stage::Cache) - before;
         const double reuse = double(stats.pixels.cache - reusedBefore) / double(f.pending.size());
         // Judged only when last frame's stores are fresh (two cache frames in a row).
-        if (adaptive && _mem->lastFrameCached && _mem->msPerRay > 0 &&
-            reuse * _mem->msPerRay < lookupMs / double(f.pending.size()))
-            _mem->cachePaused = kCachePauseFrames;
+        if (adaptive && _mem->lastFrameCached && _mem->msPerRay > 0) {
+            if (reuse * _mem->msPerRay < lookupMs / double(f.pending.size())) {
+                _mem->cachePaused = _mem->cachePauseLength;
+                _mem->cachePauseLength = std::min(2 * _mem->cachePauseLength, kCacheMaxPauseFrames);
+            } else {
+                _mem->cachePauseLength = kCachePauseFrames;
+            }
+        }
     } else {
         f.farDepth.clear();
         bypassCache(f);

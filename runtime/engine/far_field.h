@@ -61,8 +61,10 @@ struct FarFrame;
 // Pixel classes of classification() (see above).
 enum FarPixelClass : uint8_t { kFarCovered = 0, kFarHorizon = 1, kFarCache = 2, kFarRayHit = 3, kFarRayMiss = 4 };
 
-// Moving frames the cache pauses for when it did not pay (FarFieldOptions::cacheAdaptive).
+// Moving frames the cache pauses for when it did not pay (FarFieldOptions::cacheAdaptive);
+// each further verdict in a row that it does not pay doubles the pause, up to kCacheMaxPauseFrames.
 constexpr int kCachePauseFrames = 8;
+constexpr int kCacheMaxPauseFrames = 64;
 // Moving frames the horizon pauses for when it did not pay (FarFieldOptions::horizonAdaptive).
 constexpr int kHorizonPauseFrames = 8;
 
@@ -101,7 +103,10 @@ struct FarFieldOptions {
     // reused, times the measured ms per ray, is below the measured ms per
     // lookup (the cache stage per pending pixel), the next
     // kCachePauseFrames moving frames trace every far pixel without lookups
-    // (a note says so); then two cache frames measure again. Never paused for
+    // (a note says so); then two cache frames measure again, and a second
+    // verdict in a row doubles the pause (16, 32, at most kCacheMaxPauseFrames:
+    // on a fly-over the two measuring frames cost 12 to 17 ms of lookups
+    // each); a verdict that it pays resets it. Never paused for
     // a still camera or under a pixel budget or frame-time target. false =
     // always look up (the Pareto front of docs/results.md measures that).
     bool cacheAdaptive = true;

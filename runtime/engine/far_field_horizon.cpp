@@ -2,10 +2,35 @@
 // their column become sky without a ray.
 #include <algorithm>
 
+#include <tbb/task_arena.h>
+
 #include "foundation/timing.h"
 #include "runtime/engine/far_field_stages.h"
+#include "runtime/engine/ray_scene.h"
 
 namespace vista {
+
+double culledRaysMs(const FarFrame& f, const RayScene& rays, const FarFieldOptions& o, size_t sample) {
+    uint64_t culled = 0;
+    for (size_t i = 0; i < f.pixelCount; ++i) culled += f.cls[i] == kFarHorizon ? 1 : 0;
+    if (culled == 0 || sample == 0) return 0.0;
+    const uint64_t step = std::max<uint64_t>(1, culled / sample);
+    const uint32_t W = uint32_t(f.width);
+    const glm::vec3 org(f.camera.eye - rays.frameOrigin());
+    std::vector<glm::vec3> orgs, dirs;
+    uint64_t k = 0;
+    for (size_t i = 0; i < f.pixelCount && dirs.size() < sample; ++i)
+        if (f.cls[i] == kFarHorizon && k++ % step == 0) {
+            orgs.push_back(org);
+            dirs.push_back(glm::vec3(f.rays.dir(int(i % W), int(i / W))));
+        }
+    std::vector<RayHit> hits(dirs.size());
+    Stopwatch sw;
+    rays.intersectMany(orgs.data(), dirs.data(), int(dirs.size()), hits.data(), 1e30f, nullptr, farRayStart(o));
+    const double perRay = sw.ms() / double(dirs.size());
+    const int workers = o.threads > 0 ? o.threads : std::max(1, tbb::this_task_arena::max_concurrency());
+    return perRay * double(culled) / double(workers);
+}
 
 HorizonOptions horizonOptions(const FarFieldOptions& o, bool moving) {
     HorizonOptions ho;

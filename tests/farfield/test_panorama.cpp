@@ -408,8 +408,9 @@ TEST(Panorama, MovingViewerStaysCloseToTheUncachedImage) {
 // The duty cycle (FarFieldOptions::cacheAdaptive): a moving camera whose
 // cache reuses nothing (bound 0: only this very camera's pixels) is judged
 // on its second cache frame, pauses for kCachePauseFrames moving frames
-// (no cache stage, a note), then looks up again; a still camera, a pixel
-// budget and cacheAdaptive = false never pause.
+// (no cache stage, a note), then looks up again, and pauses twice as long
+// after each further verdict in a row; a still camera, a pixel budget and
+// cacheAdaptive = false never pause.
 TEST(FarField, CachePausesWhileItsReuseDoesNotPayAndResumes) {
     SceneModel city = randomCity(8, 60);
     auto rs = RayScene::build(city);
@@ -424,7 +425,7 @@ TEST(FarField, CachePausesWhileItsReuseDoesNotPayAndResumes) {
         FarField ff(*rs.value(), &grid, o);
         std::vector<int> pattern;  // 1 = the cache stage ran, 0 = paused
         for (int f = 0; f < frames; ++f) {
-            Camera c = cam(glm::dvec3(move ? 3.0 * f : 0.0, -190, 1.7), 0.1);
+            Camera c = cam(glm::dvec3(move ? 3.0 * (f % 50) : 0.0, -190, 1.7), 0.1);  // back and forth within the city
             Image img;
             FrameStats st;
             ff.render(c, nullptr, img, st);
@@ -437,11 +438,13 @@ TEST(FarField, CachePausesWhileItsReuseDoesNotPayAndResumes) {
     FarFieldOptions o;
     o.nearDistance = 0;
     o.cacheErrorPx = 0;  // reuse exactly nothing while moving: the verdict does not depend on timings
-    // Frames 0 and 1 look up, frame 1 finds no reuse, 2 .. 9 pause, 10 and 11 look up and judge again.
+    // Frames 0 and 1 look up, frame 1 finds no reuse, 2 .. 9 pause, 10 and 11 look up and judge
+    // again, then 16 pause, then 32, then 64, and 64 again (the longest pause).
     std::vector<int> expect = {1, 1};
-    for (int k = 0; k < kCachePauseFrames; ++k) expect.push_back(0);
-    expect.insert(expect.end(), {1, 1});
-    for (int k = 0; k < kCachePauseFrames; ++k) expect.push_back(0);
+    for (int len : {kCachePauseFrames, 2 * kCachePauseFrames, 4 * kCachePauseFrames, kCacheMaxPauseFrames, kCacheMaxPauseFrames}) {
+        for (int k = 0; k < len; ++k) expect.push_back(0);
+        expect.insert(expect.end(), {1, 1});
+    }
     EXPECT_EQ(runFrames(o, true, int(expect.size())), expect);
     // Still camera: every frame runs the cache stage.
     EXPECT_EQ(runFrames(o, false, 6), std::vector<int>(6, 1));

@@ -137,6 +137,39 @@ TEST(Split, AdaptiveChoiceFollowsTheMeasuredCosts) {
     EXPECT_GE(cheapTris.predictedRays(50), cheapTris.predictedRays(400));
 }
 
+// A candidate that draws no triangle needs no GL pass (the hybrid skips it), so
+// it saves the raster's fixed cost c (clear, read-back), fitted as the
+// intercept of raster ms = c + a * triangles. From outside the city (every
+// box 300 m or more away) with triangles cheap and rays dear, a small c keeps
+// the choice at rasterising the city; a large one (same a and b) makes the
+// split cast rays instead, with nothing drawn.
+TEST(Split, RayCastingSavesTheRasterFixedCost) {
+    ProbeScene ps = probeScene(12);
+    std::vector<SplitObject> objs;
+    for (int x = -8; x < 8; ++x)
+        for (int y = -8; y < 8; ++y) objs.push_back(box({x * 50.0, y * 50.0, 0}, {x * 50.0 + 50, y * 50.0 + 50, 60}, 1000));
+    Camera out;
+    out.eye = glm::dvec3(0, -700, 1.7);
+    out.width = 64;
+    out.height = 48;
+    AdaptiveSplitOptions o;
+    o.exploreEvery = 0;
+    o.timeProbe = false;
+    AdaptiveSplit smallC(objs, ps.rays.get(), o), largeC(objs, ps.rays.get(), o);
+    for (int i = 0; i < 10; ++i) {
+        const double tris = 20000 + 4000 * i;
+        smallC.record(uint64_t(tris), 0.01 + 1e-6 * tris, 2000, 2000 * 0.01);
+        largeC.record(uint64_t(tris), 1e4 + 1e-6 * tris, 2000, 2000 * 0.01);
+    }
+    EXPECT_NEAR(smallC.rasterFixedMs(), 0.01, 1e-6);
+    EXPECT_NEAR(largeC.rasterFixedMs(), 1e4, 1e-3);
+    EXPECT_NEAR(largeC.msPerTriangle(), 1e-6, 1e-9);
+    const double dSmall = smallC.choose(out, -1), dLarge = largeC.choose(out, -1);
+    EXPECT_GT(smallC.predictedTriangles(out.eye, dSmall), 0u) << dSmall;
+    EXPECT_EQ(largeC.predictedTriangles(out.eye, dLarge), 0u) << dLarge;
+    EXPECT_LT(dLarge, dSmall);
+}
+
 // predictedRays(d) against an independent count: every s-th pixel cast one
 // at a time (RayScene::intersect), where s follows from probeStride and
 // probeRays (a 1280x720 image: sqrt(921600 / 4800) = 13.9 -> every 14th

@@ -542,6 +542,50 @@ TEST(Bench, RaycastAgreesWithFull) {
     EXPECT_EQ(sb.raysCast, uint64_t(160 * 120));
 }
 
+// A near field with nothing in it needs no GL pass: the hybrid then skips the
+// draw and the read-back and casts every pixel, as `raycast` does (the split's
+// "0 m: ray casting" candidate). The tiny city is one chunk (its layout is not
+// a tiled city file: bounds from OSG); from 2 km away it is beyond the 1 m
+// near distance, and the hybrid's picture must be raycast's, with every pixel
+// written although the GL pass (which would clear them) is gone.
+TEST(Hybrid, AnEmptyNearFieldSkipsTheGlPassAndCastsEveryPixel) {
+    REQUIRE_DISPLAY();
+    SceneModel city = tinyCity();
+    auto rs = RayScene::build(city);
+    ASSERT_TRUE(rs.isOk()) << rs.status().message();
+    auto r = OffscreenRenderer::create(160, 120);
+    ASSERT_TRUE(r.isOk()) << r.status().message();
+    ModeContext ctx;
+    ctx.city = &city;
+    ctx.scene = sceneRoot(city);
+    ctx.renderer = r.value().get();
+    ctx.rays = rs.value().get();
+    ctx.options.nearDistance = 1.0;
+    ctx.options.cache = false;
+    auto hyb = createRenderMode("hybrid", ctx), ray = createRenderMode("raycast", ctx);
+    ASSERT_TRUE(hyb.isOk()) << hyb.status().message();
+    ASSERT_TRUE(ray.isOk()) << ray.status().message();
+    Camera cam = testCamera(160, 120);
+    cam.eye = kWorld + glm::dvec3(0, -2000, 300);
+    cam.pitch = -0.15;
+    Image h(160, 120), c;
+    for (size_t i = 0; i < h.rgba.size(); ++i) h.rgba[i] = uint8_t(i % 4 == 3 ? 255 : 7);  // stale content
+    FrameStats sh, sc;
+    ASSERT_TRUE(hyb.value()->renderFrame(cam, h, sh).isOk());
+    ASSERT_TRUE(ray.value()->renderFrame(cam, c, sc).isOk());
+    EXPECT_NE(std::find(sh.notes.begin(), sh.notes.end(), "near field empty: no GL pass"), sh.notes.end());
+    EXPECT_EQ(sh.stages.ms(Stage::Near), 0.0);
+    EXPECT_EQ(sh.pixels.covered, 0u);
+    EXPECT_GT(sh.pixels.rayHit, 0u);
+    EXPECT_EQ(fractionDiffering(h, c, 0), 0.0) << "hybrid without a near field vs raycast";
+    // A near field that holds something (the eye inside the chunk's bounds) is drawn as before.
+    cam.eye = kWorld + glm::dvec3(0, 0, 1.7);
+    FrameStats sn;
+    ASSERT_TRUE(hyb.value()->renderFrame(cam, h, sn).isOk());
+    EXPECT_EQ(std::find(sn.notes.begin(), sn.notes.end(), "near field empty: no GL pass"), sn.notes.end());
+    EXPECT_GT(sn.stages.ms(Stage::Near), 0.0);
+}
+
 TEST(BenchCli, BadInputExitsWithTwo) {
     ASSERT_TRUE(fs::exists(VISTA_BINARY)) << "the vista binary is a build dependency of this test";
     std::string dir = tmpDir("badcli"), out;
