@@ -32,6 +32,28 @@ ProbeScene probeScene(uint32_t seed) {
     VISTA_CHECK(rs.isOk());
     return ProbeScene{std::move(rs.value()), {box({-400, -400, 0}, {400, 400, 60}, 1000)}};
 }
+// One object per 50 m square of an 800 m city, 1000 triangles each.
+std::vector<SplitObject> squareObjects() {
+    std::vector<SplitObject> objs;
+    for (int x = -8; x < 8; ++x)
+        for (int y = -8; y < 8; ++y) objs.push_back(box({x * 50.0, y * 50.0, 0}, {x * 50.0 + 50, y * 50.0 + 50, 60}, 1000));
+    return objs;
+}
+// A 64x48 camera at `eye`, looking along +y.
+Camera smallCamera(const glm::dvec3& eye) {
+    Camera c;
+    c.eye = eye;
+    c.width = 64;
+    c.height = 48;
+    return c;
+}
+// No exploration and no probe timing: the costs a test records are the only measurements.
+AdaptiveSplitOptions measuredOnly() {
+    AdaptiveSplitOptions o;
+    o.exploreEvery = 0;
+    o.timeProbe = false;
+    return o;
+}
 }  // namespace
 
 TEST(Split, DistanceSelectionDrawsStraddlingObjectsWhole) {
@@ -58,17 +80,9 @@ TEST(Split, AdaptiveChoiceFollowsTheMeasuredCosts) {
     SceneModel city = randomCity(12, 150, 800.0);
     auto rs = RayScene::build(city);
     ASSERT_TRUE(rs.isOk());
-    // One object per 50 m square of boxes, with their triangles.
-    std::vector<SplitObject> objs;
-    for (int x = -8; x < 8; ++x)
-        for (int y = -8; y < 8; ++y) objs.push_back(box({x * 50.0, y * 50.0, 0}, {x * 50.0 + 50, y * 50.0 + 50, 60}, 1000));
-    Camera c;
-    c.eye = glm::dvec3(0, -350, 1.7);
-    c.width = 64;
-    c.height = 48;
-    AdaptiveSplitOptions o;
-    o.exploreEvery = 0;
-    o.timeProbe = false;  // the costs below are the only measurements
+    const std::vector<SplitObject> objs = squareObjects();
+    Camera c = smallCamera(glm::dvec3(0, -350, 1.7));
+    const AdaptiveSplitOptions o = measuredOnly();
     AdaptiveSplit cheapRays(objs, rs.value().get(), o), cheapTris(objs, rs.value().get(), o);
     {
         // Nothing measured yet: the ends (0, everything) are not offered on the priors.
@@ -145,16 +159,9 @@ TEST(Split, AdaptiveChoiceFollowsTheMeasuredCosts) {
 // split cast rays instead, with nothing drawn.
 TEST(Split, RayCastingSavesTheRasterFixedCost) {
     ProbeScene ps = probeScene(12);
-    std::vector<SplitObject> objs;
-    for (int x = -8; x < 8; ++x)
-        for (int y = -8; y < 8; ++y) objs.push_back(box({x * 50.0, y * 50.0, 0}, {x * 50.0 + 50, y * 50.0 + 50, 60}, 1000));
-    Camera out;
-    out.eye = glm::dvec3(0, -700, 1.7);
-    out.width = 64;
-    out.height = 48;
-    AdaptiveSplitOptions o;
-    o.exploreEvery = 0;
-    o.timeProbe = false;
+    const std::vector<SplitObject> objs = squareObjects();
+    const Camera out = smallCamera(glm::dvec3(0, -700, 1.7));
+    const AdaptiveSplitOptions o = measuredOnly();
     AdaptiveSplit smallC(objs, ps.rays.get(), o), largeC(objs, ps.rays.get(), o);
     for (int i = 0; i < 10; ++i) {
         const double tris = 20000 + 4000 * i;

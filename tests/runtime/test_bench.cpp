@@ -508,21 +508,38 @@ TEST(Bench, SupersampledReferenceIsCloserToItselfThanAliasedFrames) {
     EXPECT_GT(r->modes[0].psnrDbMin, 20.0);
 }
 
+// The tiny city with its ray scene and a 160x120 renderer, as a ModeContext.
+struct TinyModes {
+    SceneModel city = tinyCity();
+    std::unique_ptr<RayScene> rays;
+    std::unique_ptr<OffscreenRenderer> renderer;
+    ModeContext ctx;
+    std::string error;
+    TinyModes() {
+        auto rs = RayScene::build(city);
+        auto r = OffscreenRenderer::create(160, 120);
+        if (!rs.isOk() || !r.isOk()) {
+            error = (rs.isOk() ? r.status() : rs.status()).message();
+            return;
+        }
+        rays = std::move(rs.value());
+        renderer = std::move(r.value());
+        ctx.city = &city;
+        ctx.scene = sceneRoot(city);
+        ctx.renderer = renderer.get();
+        ctx.rays = rays.get();
+    }
+    bool ready() const { return error.empty(); }
+};
+
 // Ray casting and rasterising the same prelit scene agree: on a still frame
 // luma PSNR >= 30 dB (differences only along edges, where pixel centres fall
 // on different sides of a triangle edge).
 TEST(Bench, RaycastAgreesWithFull) {
     REQUIRE_DISPLAY();
-    SceneModel city = tinyCity();
-    auto rs = RayScene::build(city);
-    ASSERT_TRUE(rs.isOk()) << rs.status().message();
-    auto r = OffscreenRenderer::create(160, 120);
-    ASSERT_TRUE(r.isOk()) << r.status().message();
-    ModeContext ctx;
-    ctx.city = &city;
-    ctx.scene = sceneRoot(city);
-    ctx.renderer = r.value().get();
-    ctx.rays = rs.value().get();
+    TinyModes t;
+    ASSERT_TRUE(t.ready()) << t.error;
+    ModeContext& ctx = t.ctx;
     auto full = createRenderMode("full", ctx), ray = createRenderMode("raycast", ctx);
     ASSERT_TRUE(full.isOk());
     ASSERT_TRUE(ray.isOk()) << ray.status().message();
@@ -550,16 +567,9 @@ TEST(Bench, RaycastAgreesWithFull) {
 // written although the GL pass (which would clear them) is gone.
 TEST(Hybrid, AnEmptyNearFieldSkipsTheGlPassAndCastsEveryPixel) {
     REQUIRE_DISPLAY();
-    SceneModel city = tinyCity();
-    auto rs = RayScene::build(city);
-    ASSERT_TRUE(rs.isOk()) << rs.status().message();
-    auto r = OffscreenRenderer::create(160, 120);
-    ASSERT_TRUE(r.isOk()) << r.status().message();
-    ModeContext ctx;
-    ctx.city = &city;
-    ctx.scene = sceneRoot(city);
-    ctx.renderer = r.value().get();
-    ctx.rays = rs.value().get();
+    TinyModes t;
+    ASSERT_TRUE(t.ready()) << t.error;
+    ModeContext& ctx = t.ctx;
     ctx.options.nearDistance = 1.0;
     ctx.options.cache = false;
     auto hyb = createRenderMode("hybrid", ctx), ray = createRenderMode("raycast", ctx);
