@@ -125,13 +125,15 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
                                                                  "horizon paused: tracing it cost more than the rays it saved");
     if (useHorizon) {
         const double before = stats.stages.ms(Stage::Horizon);
+        const uint64_t culledBefore = stats.pixels.horizonCulled;
         horizonStage(f, _grid, _options, stats, useEarly ? &early : nullptr);
         // What the horizon cost this frame: its stage time (the trace, or only the wait for a
         // trace that overlapped the near-field draw). Judged once a ray stage has run (frame 1
         // on), against a timed sample of the culled pixels' own rays (mostly sky misses: the
         // mean traced ray prices them 5 to 10 times too high).
         const double costMs = stats.stages.ms(Stage::Horizon) - before;
-        if (horizonAdaptive && _mem->msPerRay > 0 && costMs > culledRaysMs(f, _rays, _options))
+        if (horizonAdaptive && _mem->msPerRay > 0 &&
+            costMs > culledRaysMs(f, _rays, _options, stats.pixels.horizonCulled - culledBefore))
             _mem->horizonPaused = kHorizonPauseFrames;
     }
     listPending(f);

@@ -10,9 +10,7 @@
 
 namespace vista {
 
-double culledRaysMs(const FarFrame& f, const RayScene& rays, const FarFieldOptions& o, size_t sample) {
-    uint64_t culled = 0;
-    for (size_t i = 0; i < f.pixelCount; ++i) culled += f.cls[i] == kFarHorizon ? 1 : 0;
+double culledRaysMs(const FarFrame& f, const RayScene& rays, const FarFieldOptions& o, uint64_t culled, size_t sample) {
     if (culled == 0 || sample == 0) return 0.0;
     const uint64_t step = std::max<uint64_t>(1, culled / sample);
     const uint32_t W = uint32_t(f.width);

@@ -136,13 +136,14 @@ void hazeCoveredStage(FarFrame& f, const FarFieldOptions& o, FrameStats& stats);
 // Returns the wall time of the trace itself (on whichever thread traced it).
 double horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o, FrameStats& stats,
                   std::future<HorizonResult>* early = nullptr);
-// What the rays of the pixels the horizon culled this frame (class kFarHorizon)
-// would have cost the ray stage, in wall ms: a sample of at most `sample` of
-// them, spread over the frame, cast from farRayStart(o) and timed on this
-// thread, scaled to all of them and divided among the stage's workers
+// What the rays of the `culled` pixels the horizon culled this frame (class
+// kFarHorizon) would have cost the ray stage, in wall ms: a sample of at most
+// `sample` of them, spread over the frame, cast from farRayStart(o) and timed
+// on this thread, scaled to all of them and divided among the stage's workers
 // (o.threads, or TBB's concurrency). Nearly all are sky misses, far cheaper
 // than the frame's mean traced ray. 0 when none was culled.
-double culledRaysMs(const FarFrame& f, const RayScene& rays, const FarFieldOptions& o, size_t sample = 512);
+double culledRaysMs(const FarFrame& f, const RayScene& rays, const FarFieldOptions& o, uint64_t culled,
+                    size_t sample = 512);
 // The horizon options of a frame (near distance, haze depth, subsampling while moving).
 HorizonOptions horizonOptions(const FarFieldOptions& o, bool moving);
 // No far geometry: every pending pixel becomes horizonCulled, sky colour written. No time.
