@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "foundation/timing.h"
 #include "runtime/engine/far_field_stages.h"
 #include "runtime/engine/ray_scene.h"
 
@@ -66,12 +65,7 @@ void FarField::beginFrame(const Camera& camera) {
     const HorizonOptions ho = horizonOptions(_options, moving);
     const HeightGrid* grid = _grid;
     _mem->earlyCamera = camera;
-    _mem->earlyHorizon = std::async(std::launch::async, [grid, camera, ho] {
-        Stopwatch sw;
-        HorizonResult r = traceHorizon(*grid, camera, ho);
-        r.traceMs = sw.ms();
-        return r;
-    });
+    _mem->earlyHorizon = std::async(std::launch::async, [grid, camera, ho] { return traceHorizon(*grid, camera, ho); });
 }
 
 void FarField::reset() {
@@ -125,15 +119,14 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
                                                                  "horizon paused: tracing it cost more than the rays it saved");
     if (useHorizon) {
         const double before = stats.stages.ms(Stage::Horizon);
-        const uint64_t culledBefore = stats.pixels.horizonCulled;
-        horizonStage(f, _grid, _options, stats, useEarly ? &early : nullptr);
+        const uint64_t culled = horizonStage(f, _grid, _options, stats, useEarly ? &early : nullptr);
         // What the horizon cost this frame: its stage time (the trace, or only the wait for a
         // trace that overlapped the near-field draw). Judged once a ray stage has run (frame 1
         // on), against a timed sample of the culled pixels' own rays (mostly sky misses: the
         // mean traced ray prices them 5 to 10 times too high).
         const double costMs = stats.stages.ms(Stage::Horizon) - before;
         if (horizonAdaptive && _mem->msPerRay > 0 &&
-            costMs > culledRaysMs(f, _rays, _options, stats.pixels.horizonCulled - culledBefore))
+            costMs > culledRaysMs(f, _rays, _options, culled))
             _mem->horizonPaused = kHorizonPauseFrames;
     }
     listPending(f);

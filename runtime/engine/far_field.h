@@ -86,9 +86,10 @@ struct FarFieldOptions {
     double frameMsTarget = 0.0;
     bool cache = true;
     bool horizon = true;
-    // Pause the horizon while it does not pay: when the trace of a moving
-    // frame's horizon took longer than the rays of the pixels it culled
-    // would have (culled pixels x the measured ms per ray), the next
+    // Pause the horizon while it does not pay: when a moving frame's horizon
+    // stage (the trace, or the wait for a trace that overlapped the near
+    // field) took longer than the rays of the pixels it culled would have
+    // (culledRaysMs: a timed sample of those rays, far_field_stages.h), the next
     // kHorizonPauseFrames moving frames trace those pixels instead (they miss
     // and show the same sky; a note says so); then it is traced and judged
     // again. On an elevated view over a 64 km² city the trace over the

@@ -38,11 +38,11 @@ HorizonOptions horizonOptions(const FarFieldOptions& o, bool moving) {
     return ho;
 }
 
-double horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o, FrameStats& stats,
-                    std::future<HorizonResult>* early) {
+uint64_t horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o, FrameStats& stats,
+                      std::future<HorizonResult>* early) {
     if (!grid) {
         stats.notes.push_back("horizon off: no height grid");
-        return 0.0;
+        return 0;
     }
     Stopwatch sw;
     HorizonResult hr;
@@ -52,13 +52,11 @@ double horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& 
     } else {
         HorizonOptions ho = horizonOptions(o, f.moving);
         ho.columnNeeded = &f.columnNeeded;
-        Stopwatch trace;
         hr = traceHorizon(*grid, f.camera, ho);
-        hr.traceMs = trace.ms();
     }
     if (!hr.active) {
         stats.notes.push_back(hr.reason);
-        return hr.traceMs;
+        return 0;
     }
     // Row by row (contiguous in memory): pixel (x, y) is above the horizon when y < row[x]; it
     // gets the sky colour here, so no later pass over the frame is needed.
@@ -83,7 +81,7 @@ double horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& 
     }
     stats.pixels.horizonCulled += culled;
     stats.stages.add(Stage::Horizon, sw.ms());
-    return hr.traceMs;
+    return culled;
 }
 
 void cullAllPending(FarFrame& f, FrameStats& stats) {

@@ -133,9 +133,9 @@ void hazeCoveredStage(FarFrame& f, const FarFieldOptions& o, FrameStats& stats);
 // early (optional): the horizon of this very camera traced ahead of the
 // frame (FarField::beginFrame, all columns); then the stage waits for it
 // (the wait is the recorded time) and notes "horizon overlapped".
-// Returns the wall time of the trace itself (on whichever thread traced it).
-double horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o, FrameStats& stats,
-                  std::future<HorizonResult>* early = nullptr);
+// Returns the number of pixels culled (0 when it does not apply).
+uint64_t horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions& o, FrameStats& stats,
+                      std::future<HorizonResult>* early = nullptr);
 // What the rays of the `culled` pixels the horizon culled this frame (class
 // kFarHorizon) would have cost the ray stage, in wall ms: a sample of at most
 // `sample` of them, spread over the frame, cast from farRayStart(o) and timed

@@ -121,7 +121,6 @@ struct HorizonResult {
     std::string reason;        // why inactive ("camera rolled", ...)
     std::vector<int> row;      // per column: rows y < row[x] are sky (0..height)
     int raysTraced = 0;        // 2D rays cast this frame
-    double traceMs = 0;        // wall time of the trace (set by the far field's horizon stage)
 };
 
 // True if horizon tracing applies to this camera (upright, no zenith/nadir in view).
