@@ -36,6 +36,7 @@
 #include "foundation/timing.h"
 #include "foundation/units.h"
 #include "nodes/far_field_node.h"
+#include "nodes/gl_readback.h"
 #include "nodes/render/offscreen.h"
 #include "runtime/engine/ray_scene.h"
 #include "runtime/scene/city_file.h"
@@ -166,12 +167,9 @@ struct Capture : public osg::Camera::DrawCallback {
         const osg::Viewport* vp = ri.getCurrentCamera()->getViewport();
         const int w = int(vp->width()), h = int(vp->height());
         Image img(w, h);
-        std::vector<uint8_t> buf(size_t(w) * size_t(h) * 4);
-        glPixelStorei(GL_PACK_ALIGNMENT, 1);
+        std::vector<uint32_t> buf;
         glReadBuffer(GL_BACK);
-        glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, buf.data());
-        for (int y = 0; y < h; ++y)
-            std::copy_n(&buf[size_t(h - 1 - y) * size_t(w) * 4], size_t(w) * 4, &img.rgba[size_t(y) * size_t(w) * 4]);
+        readColorTopDown(0, 0, w, h, buf, img.rgba.data());
         for (size_t i = 3; i < img.rgba.size(); i += 4) img.rgba[i] = 255;
         Status s = writePng(img, pending);
         if (s) std::fprintf(stderr, "%s: screenshot -> %s\n", kCmd, pending.c_str());

@@ -154,9 +154,7 @@ void FarFieldNode::drawImplementation(osg::RenderInfo& ri) const {
     _far->setOptions(o);
 
     // Opacity buffer: the near field's depth (GL rows bottom-up -> row 0 at top).
-    const size_t N = size_t(W) * size_t(H);
     readDepthTopDown(GLint(vp->x()), GLint(vp->y()), W, H, _depthBits, _depth);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
 
     _stats = FrameStats();
     if (_image.width != W || _image.height != H) _image = Image(W, H);
@@ -164,10 +162,7 @@ void FarFieldNode::drawImplementation(osg::RenderInfo& ri) const {
     // it needs the drawn colours, and then every pixel is drawn back.
     const bool hazeCovered = o.hazeCovered && o.effects.haze;
     if (hazeCovered) {
-        _upload.resize(N * 4);
-        glReadPixels(GLint(vp->x()), GLint(vp->y()), W, H, GL_RGBA, GL_UNSIGNED_BYTE, _upload.data());
-        for (int y = 0; y < H; ++y)
-            std::copy_n(&_upload[size_t(H - 1 - y) * size_t(W) * 4], size_t(W) * 4, &_image.rgba[size_t(y) * size_t(W) * 4]);
+        readColorTopDown(GLint(vp->x()), GLint(vp->y()), W, H, _colorBits, _image.rgba.data());
     }
     _far->render(c, _depth.data(), _image, _stats);
 

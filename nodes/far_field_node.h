@@ -90,7 +90,7 @@ private:
     osg::observer_ptr<NearFarSplit> _split;
     mutable std::unique_ptr<FarField> _far;
     mutable std::vector<float> _depth;
-    mutable std::vector<uint32_t> _depthBits;  // scratch of the depth read (gl_readback.h)
+    mutable std::vector<uint32_t> _depthBits, _colorBits;  // scratch of the reads (gl_readback.h)
     mutable Image _image;
     mutable std::vector<uint8_t> _upload;
     mutable FrameStats _stats;

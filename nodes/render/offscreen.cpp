@@ -38,7 +38,7 @@ struct Readback : public osg::Camera::DrawCallback {
     mutable double finishedMs = 0;     // frame time at which the GL finished drawing
     mutable double readMs = 0;
     mutable std::string renderer;
-    mutable std::vector<uint32_t> depthBits;  // scratch of the depth read
+    mutable std::vector<uint32_t> depthBits, colorBits;  // scratch of the reads
     void operator()(osg::RenderInfo&) const override {
         glFinish();
         finishedMs = frame ? frame->ms() : 0.0;
@@ -52,7 +52,7 @@ struct Readback : public osg::Camera::DrawCallback {
         glReadBuffer(GL_BACK);
         if (color) {
             color->resize(size_t(width) * size_t(height) * 4);
-            glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, color->data());
+            readColorTopDown(0, 0, width, height, colorBits, color->data());  // row 0 at top
         }
         if (depth) readDepthTopDown(0, 0, width, height, depthBits, *depth);  // row 0 at top
         readMs = read.ms();
@@ -188,9 +188,7 @@ struct OffscreenRenderer::Impl {
 
         if (color) {
             if (color->width != width || color->height != height) *color = Image(width, height);
-            size_t row = size_t(width) * 4;
-            for (int y = 0; y < height; ++y)
-                std::memcpy(&color->rgba[size_t(y) * row], &colorBuf[size_t(height - 1 - y) * row], row);
+            color->rgba.swap(colorBuf);  // read top-down already; the old buffer is the next frame's
         }
         return Status::ok();
     }

@@ -10,6 +10,7 @@
 #include "foundation/timing.h"
 #include "nodes/baked_file.h"
 #include "nodes/far_field_node.h"
+#include "nodes/gl_readback.h"
 #include "nodes/render/effects_state.h"
 #include "runtime/engine/reflections.h"
 #include "nodes/render/offscreen.h"
@@ -141,11 +142,7 @@ public:
         const osg::Viewport& vp = *vpp;
         const int W = int(vp.width()), H = int(vp.height());
         _image = Image(W, H);
-        _gl.resize(size_t(W) * size_t(H) * 4);
-        glPixelStorei(GL_PACK_ALIGNMENT, 1);
-        glReadPixels(GLint(vp.x()), GLint(vp.y()), W, H, GL_RGBA, GL_UNSIGNED_BYTE, _gl.data());
-        for (int y = 0; y < H; ++y)
-            std::copy_n(&_gl[size_t(H - 1 - y) * size_t(W) * 4], size_t(W) * 4, &_image.rgba[size_t(y) * size_t(W) * 4]);
+        readColorTopDown(GLint(vp.x()), GLint(vp.y()), W, H, _gl, _image.rgba.data());
         _stats = FrameStats();
         if (!hasGlassPixels(_image)) return;
         reflectionStage(_rays, c, *_fx, _image, _stats);
@@ -158,7 +155,8 @@ private:
     const RayScene* _rays = nullptr;
     const FrameEffects* _fx = nullptr;
     mutable Image _image;
-    mutable std::vector<uint8_t> _gl, _upload;
+    mutable std::vector<uint32_t> _gl;  // scratch of the colour read (gl_readback.h)
+    mutable std::vector<uint8_t> _upload;
     mutable FrameStats _stats;
     mutable std::mutex _mutex;
 };

@@ -59,6 +59,11 @@ void FarField::setOptions(const FarFieldOptions& o) {
 void FarField::beginFrame(const Camera& camera) {
     // Dropping an std::async future waits for its task: never two at once.
     _mem->earlyHorizon = std::future<HorizonResult>();
+    if (_options.speculate && !_traced.empty() && _traced.back() < uint32_t(camera.width * camera.height) &&
+        farGeometryExists(_rays, _grid, camera, _options))
+        startSpeculation(*_mem, _rays, camera, _options, _traced);
+    else
+        _mem->spec.stop();
     if (!_grid || !_options.horizon || !farGeometryExists(_rays, _grid, camera, _options) || !horizonApplies(camera)) return;
     const bool moving = _mem->haveLast && !sameCamera(_mem->last, camera);
     if (moving && _mem->horizonPaused > 0) return;  // the horizon is paused (renderStages)
@@ -68,7 +73,11 @@ void FarField::beginFrame(const Camera& camera) {
     _mem->earlyHorizon = std::async(std::launch::async, [grid, camera, ho] { return traceHorizon(*grid, camera, ho); });
 }
 
+void FarField::awaitSpeculation() { _mem->spec.finish(); }
+
 void FarField::reset() {
+    _mem->spec.stop();
+    _mem->spec.chunks = 0;
     if (_mem->cache) _mem->cache->clear();
     _mem->prev = Image();
     _mem->haveLast = false;
@@ -88,6 +97,12 @@ void FarField::render(const Camera& camera, const float* depth, Image& out, Fram
     _mem->haveLast = true;
     _rayStart = farRayStart(_options);
     renderStages(f, depth, stats);
+    if (_mem->spec.active()) {  // the ray stage did not run: its speculation is wasted
+        std::vector<uint32_t> none;
+        f.trace.swap(none);
+        takeSpeculation(f, *_mem, _options, nullptr, nullptr, stats);
+        f.trace.swap(none);
+    }
     _traced = std::move(f.trace);
 }
 

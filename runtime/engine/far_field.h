@@ -97,6 +97,14 @@ struct FarFieldOptions {
     // Never paused for a still camera or under a pixel budget or frame-time
     // target (the culled pixels would eat the budget).
     bool horizonAdaptive = true;
+    // Speculative rays: beginFrame also casts last frame's traced pixels for
+    // the new camera, on one other thread while the near field is drawn (on
+    // this machine the draw keeps 1.1 of 2 cores busy); the ray stage takes
+    // the results of the pixels it traces (the same rays, so the same
+    // image) and casts only the rest. Rays for pixels not traced this frame
+    // are wasted, and counted in raysCast (a note says how many were used).
+    // Only with rayStep 1 and only after beginFrame.
+    bool speculate = true;
     int horizonSubsampleMoving = 1;  // >= 1: subsample factor of the horizon while the camera moves
     double cacheOversample = 1.5;
     // Pause the cache while it does not pay: after two consecutive cache
@@ -158,9 +166,14 @@ public:
     // of `camera` on another thread (all columns), so that it overlaps the
     // draw; render() of the same camera then waits for it instead of tracing
     // (the Horizon stage time is the wait; a note says so). A render() of
-    // another camera discards it. No effect without a grid or with the
-    // horizon off or not applicable to the camera.
+    // another camera discards it. No horizon without a grid or with the
+    // horizon off or not applicable to the camera. With o.speculate, also
+    // starts the speculative rays of last frame's traced pixels
+    // (FarFieldOptions::speculate), which render() stops and takes.
     void beginFrame(const Camera& camera);
+    // Waits until the speculative rays beginFrame started are all cast (tests:
+    // makes what render() takes from them deterministic; a frame never waits).
+    void awaitSpeculation();
     // Drops the cache (walkthrough jump).
     void reset();
     // Per pixel of the last frame: a FarPixelClass (0 covered, 1 horizon, 2 cache, 3 hit, 4 miss).

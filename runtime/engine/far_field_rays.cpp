@@ -348,20 +348,42 @@ void raysStage(FarFrame& f, FarFieldMemory& m, const RayScene& rays, const FarFi
     const bool lattice = o.rayStep >= 2;
     std::vector<float> depth(lattice || f.fx->haze || !f.farDepth.empty() ? n : 0);
     RayCounts counts;
-    uint64_t blended = 0;
+    uint64_t blended = 0, hits = 0, misses = 0;
     if (lattice) {
         blended = castOnLattice(f, m, rays, o.threads, farRayStart(o), counts, hit.data(), depth.data());
+        hits = counts.hits;
+        misses = counts.rays - counts.hits;
     } else {
         RayShading shading;
         shading.effects = f.fx;
-        shading.depth = depth.empty() ? nullptr : depth.data();
         shading.tnear = farRayStart(o);
-        castPrimaryRays(rays, f.camera, f.trace.data(), n, f.out, counts, o.threads, hit.data(), shading);
+        // The entries the speculative rays did not cast (all of them without speculation).
+        const bool spec = m.spec.active();
+        std::vector<uint32_t> left;
+        if (spec) left = takeSpeculation(f, m, o, hit.data(), depth.empty() ? nullptr : depth.data(), stats);
+        if (!spec || left.size() == n) {
+            shading.depth = depth.empty() ? nullptr : depth.data();
+            castPrimaryRays(rays, f.camera, f.trace.data(), n, f.out, counts, o.threads, hit.data(), shading);
+        } else if (!left.empty()) {
+            std::vector<uint32_t> pix(left.size());
+            std::vector<uint8_t> h(left.size());
+            std::vector<float> d(depth.empty() ? 0 : left.size());
+            for (size_t k = 0; k < left.size(); ++k) pix[k] = f.trace[left[k]];
+            shading.depth = d.empty() ? nullptr : d.data();
+            castPrimaryRays(rays, f.camera, pix.data(), pix.size(), f.out, counts, o.threads, h.data(), shading);
+            for (size_t k = 0; k < left.size(); ++k) {
+                hit[left[k]] = h[k];
+                if (!d.empty()) depth[left[k]] = d[k];
+            }
+        }
+        // Every entry is cast now (here or ahead; speculative rays are in raysCast already).
+        hits = uint64_t(std::count(hit.begin(), hit.end(), uint8_t(1)));
+        misses = n - hits;
     }
     for (size_t j = 0; j < n; ++j) f.cls[f.trace[j]] = hit[j] ? kFarRayHit : kFarRayMiss;
     stats.raysCast += counts.rays;
-    stats.pixels.rayHit += counts.hits;
-    stats.pixels.rayMiss += counts.rays - counts.hits;
+    stats.pixels.rayHit += hits;
+    stats.pixels.rayMiss += misses;
     stats.pixels.interpolated += blended;
     stats.stages.add(Stage::Rays, sw.ms());
     if (!f.farDepth.empty())

@@ -6,10 +6,12 @@
 // its wall time to FrameStats::stages. Not thread-safe (one frame, one writer);
 // nothing throws.
 #pragma once
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <future>
 #include <memory>
+#include <thread>
 #include <vector>
 
 #include <tbb/task_arena.h>
@@ -46,6 +48,32 @@ inline float farRayStart(const FarFieldOptions& o) {
     return o.nearIsDistance && o.nearDistance > 0 && std::isfinite(o.nearDistance) ? float(o.nearDistance * 0.999) : 0.0f;
 }
 
+// Rays cast ahead of the ray stage, on another thread while the near field
+// is drawn (FarField::beginFrame; far_field_speculate.cpp): last frame's
+// traced pixels, cast for this frame's camera in chunks. stop() ends the work
+// after the chunk in hand and joins; the chunks done by then hold exact
+// results (the same rays the ray stage would cast).
+struct SpeculativeRays {
+    Camera camera;
+    float tnear = 0.0f;
+    FrameEffects effects;
+    std::vector<uint32_t> pixels;     // ascending
+    Image colors;                     // camera-sized: the colours of cast pixels
+    std::vector<float> depth;         // per entry of pixels (eye-plane depth, +inf = sky)
+    std::vector<uint8_t> hit;         // per entry: 1 = showed geometry
+    std::unique_ptr<std::atomic<uint8_t>[]> done;  // per chunk
+    size_t chunks = 0;
+    std::atomic<size_t> next{0};
+    std::atomic<bool> stopFlag{false};
+    std::atomic<uint64_t> rays{0};    // rays cast so far
+    std::thread worker;
+    bool active() const { return worker.joinable() || chunks > 0; }
+    void stop();                      // ends the work after the chunk in hand and joins (no-op when idle)
+    void finish();                    // joins once every chunk is cast (no-op when idle)
+    ~SpeculativeRays() { stop(); }
+};
+constexpr size_t kSpeculativeChunk = 512;  // rays per chunk of SpeculativeRays
+
 // What a FarField keeps from frame to frame.
 struct FarFieldMemory {
     std::unique_ptr<PanoramaCache> cache;
@@ -70,6 +98,7 @@ struct FarFieldMemory {
     std::vector<uint8_t> traceMarks;
     std::vector<float> farDepth;  // swapped into FarFrame::farDepth for the frame
     std::vector<uint32_t> raySlot;  // ray stage (rayStep 2): per pixel, ~0 between frames
+    SpeculativeRays spec;           // FarField::beginFrame (o.speculate)
 };
 
 // Radius (pixels) of the screen window whose nearest far surface a cached cell records.
@@ -177,6 +206,22 @@ void bypassCache(FarFrame& f);
 // pixels.rayHit / rayMiss count cast rays, pixels.interpolated the blended
 // ones. Records Rays.
 void raysStage(FarFrame& f, FarFieldMemory& m, const RayScene& rays, const FarFieldOptions& o, FrameStats& stats);
+
+// Speculative rays (far_field_speculate.cpp). Starts casting `pixels`
+// (ascending, e.g. last frame's traced pixels) for `camera` with the ray
+// stage's start distance and effects (o), on one other thread, chunk by
+// chunk, into m.spec; any earlier speculation is stopped first. Nothing
+// starts for an empty list or o.rayStep != 1.
+void startSpeculation(FarFieldMemory& m, const RayScene& rays, const Camera& camera, const FarFieldOptions& o,
+                      std::vector<uint32_t> pixels);
+// Stops m.spec and takes its results for the ray stage: when it was cast for
+// f.camera with farRayStart(o) and o's effects, every entry j of f.trace whose
+// pixel a finished chunk cast gets its colour in f.out, hit[j] and depth[j]
+// (depth may be null); the other entries' indices j are returned (ascending),
+// all of them when nothing applies. Adds the speculative rays cast to
+// raysCast and a note with how many were used. m.spec is idle afterwards.
+std::vector<uint32_t> takeSpeculation(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, uint8_t* hit,
+                                      float* depth, FrameStats& stats);
 
 // Sky colours of the camera (far_field_composite.cpp), cached in m.sky.
 const Image& skyImage(FarFieldMemory& m, const FarFrame& f);

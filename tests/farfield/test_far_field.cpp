@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <iterator>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -598,6 +599,7 @@ TEST(FarFieldFrame, EarlyHorizonGivesTheSameFrame) {
     o.nearDistance = 0;
     o.cache = false;
     o.horizonAdaptive = false;  // its pause follows measured times: the two could classify differently
+    o.speculate = false;  // speculative rays add rays to raysCast (tested below): the horizon alone here
     FarField early(*t.rays, &t.grid, o), plain(*t.rays, &t.grid, o);
     for (int f = 0; f < 3; ++f) {
         c.eye.x += 3.0;
@@ -623,6 +625,69 @@ TEST(FarFieldFrame, EarlyHorizonGivesTheSameFrame) {
     early.render(other, depth.data(), a, sa);
     plain.render(other, depth.data(), b, sb);
     EXPECT_FALSE(has(sa, "horizon overlapped"));
+    EXPECT_EQ(a.rgba, b.rgba);
+}
+
+// Speculative rays (FarFieldOptions::speculate): last frame's traced pixels,
+// cast ahead for the new camera, give the very frame the plain ray stage
+// gives; the ray stage takes exactly those of them it traces this frame and
+// casts only the rest, and every speculative ray counts in raysCast.
+TEST(FarFieldFrame, SpeculativeRaysGiveTheSameFrame) {
+    const TestCity t = testCity(9, 60);
+    ASSERT_TRUE(t.rays);
+    Camera c = cam(glm::dvec3(0, -190, 1.7), 0.2);
+    const size_t N = size_t(c.width) * size_t(c.height);
+    std::vector<float> depth(N, 1.0f);
+    for (size_t i = N * 2 / 3; i < N; ++i) depth[i] = 0.5f;  // bottom third covered
+    FarFieldOptions o;
+    o.nearDistance = 20;
+    o.cache = false;
+    o.horizonAdaptive = false;  // its pause follows measured times: the two could classify differently
+    FarFieldOptions po = o;
+    po.speculate = false;
+    FarField spec(*t.rays, &t.grid, o), plain(*t.rays, &t.grid, po);
+    std::vector<uint32_t> last;
+    for (int f = 0; f < 4; ++f) {
+        c.eye.x += 3.0;
+        c.heading += 0.02;
+        spec.beginFrame(c);
+        spec.awaitSpeculation();
+        plain.beginFrame(c);
+        Image a, b;
+        FrameStats sa, sb;
+        spec.render(c, depth.data(), a, sa);
+        plain.render(c, depth.data(), b, sb);
+        EXPECT_EQ(a.rgba, b.rgba) << "frame " << f;
+        EXPECT_EQ(spec.classification(), plain.classification());
+        EXPECT_EQ(sa.pixels.rayHit, sb.pixels.rayHit);
+        EXPECT_EQ(sa.pixels.rayMiss, sb.pixels.rayMiss);
+        EXPECT_EQ(spec.lastTraced(), plain.lastTraced());
+        EXPECT_FALSE(has(sb, "speculative rays"));
+        std::vector<uint32_t> both;
+        std::set_intersection(last.begin(), last.end(), spec.lastTraced().begin(), spec.lastTraced().end(),
+                              std::back_inserter(both));
+        if (f == 0) {
+            EXPECT_FALSE(has(sa, "speculative rays"));  // nothing was traced before
+            EXPECT_EQ(sa.raysCast, sb.raysCast);
+        } else {
+            EXPECT_GT(both.size(), last.size() / 2) << "frame " << f;
+            EXPECT_LT(both.size(), spec.lastTraced().size()) << "frame " << f;  // the view moved: some are new
+            EXPECT_TRUE(has(sa, "speculative rays: " + std::to_string(last.size()) + " cast during the draw, " +
+                                    std::to_string(both.size()) + " used"));
+            EXPECT_EQ(sa.raysCast, sb.raysCast - both.size() + last.size());
+        }
+        last = spec.lastTraced();
+    }
+    // Begun for one camera, rendered for another: none used, the same frame.
+    Camera other = c;
+    other.heading += 0.3;
+    spec.beginFrame(c);
+    spec.awaitSpeculation();
+    Image a, b;
+    FrameStats sa, sb;
+    spec.render(other, depth.data(), a, sa);
+    plain.render(other, depth.data(), b, sb);
+    EXPECT_TRUE(has(sa, "speculative rays: " + std::to_string(last.size()) + " cast during the draw, 0 used"));
     EXPECT_EQ(a.rgba, b.rgba);
 }
 
