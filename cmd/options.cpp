@@ -277,7 +277,8 @@ void addModeFlags(CLI::App& app, ModeFlags& f) {
                  "hybrid: look up the cache in every frame, also while its measured reuse does not pay for its lookups "
                  "(by default it then pauses for 8 moving frames and measures again)");
     app.add_flag("--no-overlap", f.noOverlap,
-                 "hybrid: trace the horizon after the near field is drawn instead of on another thread during the draw");
+                 "hybrid: trace the horizon and last frame's far pixels after the near field is drawn instead of on other threads "
+                 "during the draw");
     app.add_option("--cache-error", f.cacheError,
                    "hybrid: reuse a cached far pixel while its estimated reprojection error is below this many pixels, "
                    "0 .. 100 (0 = only pixels traced by this very camera) (default 0.25)");

@@ -4,6 +4,8 @@
 #endif
 #include "nodes/far_field_node.h"
 
+#include <osgUtil/CullVisitor>
+
 #include <osg/Program>
 #include "foundation/units.h"
 
@@ -27,8 +29,23 @@
 
 namespace vista {
 
+namespace {
+
+// At cull time, before the near field is drawn: starts the frame's horizon and speculative
+// rays (FarField::beginFrame) for the camera the draw will see.
+struct BeginFrameAtCull : public osg::DrawableCullCallback {
+    bool cull(osg::NodeVisitor* nv, osg::Drawable* d, osg::RenderInfo*) const override {
+        const osg::Camera* cam = nv && nv->asCullVisitor() ? nv->asCullVisitor()->getCurrentCamera() : nullptr;
+        if (cam) static_cast<FarFieldNode*>(d)->beginFrame(*cam);
+        return false;
+    }
+};
+
+}  // namespace
+
 FarFieldNode::FarFieldNode(const RayScene& rays, const HeightGrid* grid, const FarFieldOptions& options)
     : _rays(rays), _grid(grid), _options(options) {
+    setCullCallback(new BeginFrameAtCull);
     setUseDisplayList(false);
     setUseVertexBufferObjects(false);
     setCullingActive(false);
@@ -134,14 +151,7 @@ bool currentView(osg::RenderInfo& ri, Camera& camera, const osg::Viewport*& vp, 
     return cameraFromOsg(cam->getViewMatrix(), cam->getProjectionMatrix(), int(vp->width()), int(vp->height()), camera, zFar);
 }
 
-void FarFieldNode::drawImplementation(osg::RenderInfo& ri) const {
-    std::lock_guard<std::mutex> lock(_mutex);
-    Camera c;
-    const osg::Viewport* vp = nullptr;
-    double zFar = 0;
-    if (!currentView(ri, c, vp, zFar)) return;
-    const int W = int(vp->width()), H = int(vp->height());
-    if (!_far) _far = std::make_unique<FarField>(_rays, _grid, _options);
+FarFieldOptions FarFieldNode::frameOptions(double zFar) const {
     FarFieldOptions o = _options;
     if (_split.valid()) {
         osg::ref_ptr<NearFarSplit> s;
@@ -151,6 +161,32 @@ void FarFieldNode::drawImplementation(osg::RenderInfo& ri) const {
         }
     }
     o.depthZFar = zFar;
+    return o;
+}
+
+void FarFieldNode::beginFrame(const osg::Camera& cam) const {
+    const osg::Viewport* vp = cam.getViewport();
+    Camera c;
+    double zFar = 0;
+    if (!vp || vp->width() < 1 || vp->height() < 1 ||
+        !cameraFromOsg(cam.getViewMatrix(), cam.getProjectionMatrix(), int(vp->width()), int(vp->height()), c, zFar))
+        return;
+    std::lock_guard<std::mutex> lock(_mutex);
+    if (!_options.overlap) return;
+    if (!_far) _far = std::make_unique<FarField>(_rays, _grid, _options);
+    _far->setOptions(frameOptions(zFar));
+    _far->beginFrame(c);
+}
+
+void FarFieldNode::drawImplementation(osg::RenderInfo& ri) const {
+    std::lock_guard<std::mutex> lock(_mutex);
+    Camera c;
+    const osg::Viewport* vp = nullptr;
+    double zFar = 0;
+    if (!currentView(ri, c, vp, zFar)) return;
+    const int W = int(vp->width()), H = int(vp->height());
+    if (!_far) _far = std::make_unique<FarField>(_rays, _grid, _options);
+    const FarFieldOptions o = frameOptions(zFar);
     _far->setOptions(o);
 
     // Opacity buffer: the near field's depth (GL rows bottom-up -> row 0 at top).

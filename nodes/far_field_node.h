@@ -77,6 +77,11 @@ public:
     // Statistics of the last drawn frame (copy; thread-safe).
     FrameStats lastStats() const;
 
+    // Called at cull time (a cull callback set here): starts the far field's
+    // horizon and speculative rays for the camera the draw will see
+    // (FarField::beginFrame), so that they overlap the near field's draw. The
+    // draw takes them only when its camera is exactly that one.
+    void beginFrame(const osg::Camera& camera) const;
     void drawImplementation(osg::RenderInfo& renderInfo) const override;
     osg::BoundingBox computeBoundingBox() const override;
 
@@ -84,6 +89,7 @@ protected:
     ~FarFieldNode() override;
 
 private:
+    FarFieldOptions frameOptions(double zFar) const;  // _options with the split's near distance; _mutex held
     const RayScene& _rays;
     const HeightGrid* _grid;
     FarFieldOptions _options;

@@ -70,7 +70,7 @@ public:
         _raster.nearDistance = byBudget() ? 1e300 : std::max(0.0, nearD);
         // The horizon depends on the camera only: traced on another thread while the near field is drawn.
         _far->setOptions(farOptions(nearD, zFar));
-        if (_ctx.options.overlap) _far->beginFrame(camera);
+        if (_far->options().overlap) _far->beginFrame(camera);
         FrameStats ns;
         if (sel.empty()) {
             // Nothing near (ray casting, or an eye far from every chunk): no GL pass, no
@@ -162,6 +162,7 @@ private:
         o.rayStep = _ctx.options.farStep;
         o.frameMsTarget = _ctx.options.frameMsTarget;
         o.threads = _ctx.options.threads;
+        o.overlap = _ctx.options.overlap;
         o.effects = _ctx.options.effects;
         o.depthZFar = effectsFarPlane(zFar, o.effects);  // the projection the renderer used
         o.hazeCovered = true;

@@ -105,6 +105,10 @@ struct FarFieldOptions {
     // are wasted, and counted in raysCast (a note says how many were used).
     // Only with rayStep 1 and only after beginFrame.
     bool speculate = true;
+    // The caller begins each frame before drawing the near field (FarField::beginFrame):
+    // the bench's hybrid and the viewer's FarFieldNode (at cull time) do so while set
+    // (`--no-overlap` clears it). FarField itself does not read it.
+    bool overlap = true;
     int horizonSubsampleMoving = 1;  // >= 1: subsample factor of the horizon while the camera moves
     double cacheOversample = 1.5;
     // Pause the cache while it does not pay: after two consecutive cache

@@ -344,6 +344,15 @@ TEST(RayRaster, OsgNodesCompositeTheFarFieldInsideAnOsgFrame) {
     Image noSky;
     ASSERT_TRUE(renderer.value()->render(hybrid.get(), c, 0.0, &noSky, nullptr, hs, /*skyLayer=*/false).isOk());
     EXPECT_EQ(noSky.rgba, hyb.rgba);
+    // The node began that frame at cull time for the very camera its draw saw: the
+    // horizon was traced during the near field's draw, and last frame's traced pixels
+    // were cast ahead (FarField::beginFrame).
+    auto noted = [](const FrameStats& s, const std::string& what) {
+        return std::any_of(s.notes.begin(), s.notes.end(), [&](const std::string& n) { return n.find(what) != std::string::npos; });
+    };
+    st = far->lastStats();
+    EXPECT_TRUE(noted(st, "horizon overlapped"));
+    EXPECT_TRUE(noted(st, "speculative rays: "));
     // Budget split: nearest children up to the budget.
     split->setTriangleBudget(1);
     ASSERT_TRUE(renderer.value()->render(hybrid.get(), c, 0.0, &hyb, nullptr, hs).isOk());
