@@ -136,7 +136,13 @@ private:
     // The adaptive split's cost model: far pixels (cached or traced) against the stages that
     // scale with them; the far field's other stages as its fixed cost.
     void recordCosts(uint64_t tris, double rasterMs, const FrameStats& fs) {
-        const uint64_t farPixels = fs.pixels.cache + fs.pixels.rayHit + fs.pixels.rayMiss + fs.pixels.interpolated;
+        // The far pixels the frame paid for after the draw: pixels whose speculative ray was cast
+        // during the draw are left out, so b is the price of a pixel the frame waits for. The
+        // split then prices every far pixel of a candidate at it (the overlap's capacity is not
+        // modelled): measured, a b lowered by the overlap led the split to near distances whose
+        // far pixels the overlap could not cover (docs/far-field.md, speculative rays).
+        const uint64_t farPixels = fs.pixels.cache + fs.pixels.rayHit + fs.pixels.rayMiss + fs.pixels.interpolated -
+                                   std::min(fs.speculativeUsed, fs.pixels.rayHit + fs.pixels.rayMiss);
         const double farMs = fs.stages.ms(Stage::Rays) + fs.stages.ms(Stage::Cache);
         const double fixedMs = fs.stages.ms(Stage::Opacity) + fs.stages.ms(Stage::Seam) + fs.stages.ms(Stage::Horizon) +
                                fs.stages.ms(Stage::Composite);

@@ -115,7 +115,8 @@ public:
     // Near distance to use for this frame (0 and +infinity possible, see the options).
     double choose(const Camera& camera, int64_t pixelBudget);
     // Measurements of the frame just rendered: the near field's triangles and
-    // raster ms; the far pixels filled (cached or traced) and the ms of the
+    // raster ms; the far pixels filled (cached or traced; the hybrid leaves out
+    // those its speculative rays filled during the draw) and the ms of the
     // stages that scale with them (cache + rays); the far field's other
     // stages' ms (fixedMs; 0 when the frame had no far field).
     void record(uint64_t triangles, double rasterMs, uint64_t farPixels, double farMs, double fixedMs = 0);

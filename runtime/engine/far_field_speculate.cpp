@@ -110,6 +110,8 @@ std::vector<uint32_t> takeSpeculation(FarFrame& f, FarFieldMemory& m, const FarF
     }
     if (had) {
         stats.raysCast += cast;
+        stats.speculativeRays += cast;
+        stats.speculativeUsed += used;
         stats.notes.push_back("speculative rays: " + std::to_string(cast) + " cast during the draw, " +
                               std::to_string(used) + " used");
     }

@@ -97,6 +97,10 @@ struct FrameStats {
     double frameMs = 0, cullMs = 0, drawMs = 0;
     uint64_t triangles = 0, drawCalls = 0;
     uint64_t raysCast = 0;                    // every ray cast this frame (far field, seam check, probes)
+    // Speculative rays (FarFieldOptions::speculate): cast while the near field was drawn (in
+    // raysCast), and how many of them gave a traced pixel its colour (rayHit/rayMiss pixels
+    // the ray stage did not cast itself).
+    uint64_t speculativeRays = 0, speculativeUsed = 0;
     PixelCounts pixels;
     StageTimes stages;
     EffectTimes effects;

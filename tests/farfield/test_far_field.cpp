@@ -675,6 +675,8 @@ TEST(FarFieldFrame, SpeculativeRaysGiveTheSameFrame) {
             EXPECT_TRUE(has(sa, "speculative rays: " + std::to_string(last.size()) + " cast during the draw, " +
                                     std::to_string(both.size()) + " used"));
             EXPECT_EQ(sa.raysCast, sb.raysCast - both.size() + last.size());
+            EXPECT_EQ(sa.speculativeRays, last.size());
+            EXPECT_EQ(sa.speculativeUsed, both.size());
         }
         last = spec.lastTraced();
     }

@@ -8,6 +8,8 @@
 #include <thread>
 
 #include <gtest/gtest.h>
+#include <osg/Geode>
+#include <osg/Geometry>
 #include <osg/Group>
 #include <tbb/task_arena.h>
 
@@ -50,4 +52,57 @@ TEST(Offscreen, LeavesTheCallersThreadOnAllItsCores) {
     t.join();
     EXPECT_EQ(inherited, CPU_COUNT(&before));
     EXPECT_GE(tbb::this_task_arena::max_concurrency(), 2);
+}
+
+// The read-back (nodes/gl_readback.h, colour as BGRA swizzled to RGBA): a
+// quad of one colour over the upper half of the view comes back in RGBA order,
+// row 0 at the top, with depth below 1 there and exactly 1 (nothing drawn) and
+// the clear colour below it.
+TEST(Offscreen, ReadsColourAndDepthBackTopDownInRgba) {
+    const char* display = std::getenv("DISPLAY");
+    if (!display || !*display) GTEST_SKIP() << "no X display (run under xvfb-run -a)";
+    const int W = 64, H = 48;
+    auto renderer = OffscreenRenderer::create(W, H);
+    ASSERT_TRUE(renderer.isOk()) << renderer.status().message();
+    Camera cam;
+    cam.width = W;
+    cam.height = H;
+    cam.eye = glm::dvec3(0, 0, 2);  // heading 0: looking north (+y), level
+    osg::ref_ptr<osg::Geometry> quad = new osg::Geometry;
+    osg::ref_ptr<osg::Vec3Array> v = new osg::Vec3Array;
+    for (const auto& p : {osg::Vec3(-50, 10, 2), osg::Vec3(50, 10, 2), osg::Vec3(50, 10, 60), osg::Vec3(-50, 10, 60)})
+        v->push_back(p);
+    quad->setVertexArray(v.get());
+    osg::ref_ptr<osg::Vec4Array> c = new osg::Vec4Array;
+    c->push_back(osg::Vec4(200 / 255.0f, 30 / 255.0f, 10 / 255.0f, 1.0f));
+    quad->setColorArray(c.get(), osg::Array::BIND_OVERALL);
+    quad->addPrimitiveSet(new osg::DrawArrays(GL_QUADS, 0, 4));
+    quad->getOrCreateStateSet()->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
+    quad->getOrCreateStateSet()->setMode(GL_CULL_FACE, osg::StateAttribute::OFF);
+    osg::ref_ptr<osg::Geode> geode = new osg::Geode;
+    geode->addDrawable(quad.get());
+    Image color;
+    std::vector<float> depth;
+    FrameStats stats;
+    ASSERT_TRUE((*renderer)->render(geode.get(), cam, 0.0, &color, &depth, stats, /*skyLayer=*/false).isOk());
+    ASSERT_EQ(color.width, W);
+    ASSERT_EQ(color.height, H);
+    ASSERT_EQ(depth.size(), size_t(W) * size_t(H));
+    for (int y : {0, H / 2 - 2}) {
+        for (int x : {0, W / 2, W - 1}) {
+            const glm::u8vec4 p = color.at(x, y);
+            EXPECT_NEAR(p[0], 200, 1) << x << "," << y;
+            EXPECT_NEAR(p[1], 30, 1) << x << "," << y;
+            EXPECT_NEAR(p[2], 10, 1) << x << "," << y;
+            EXPECT_LT(depth[size_t(y) * W + size_t(x)], 1.0f);
+        }
+    }
+    for (int y : {H / 2 + 1, H - 1}) {
+        for (int x : {0, W / 2, W - 1}) {
+            const glm::u8vec4 p = color.at(x, y);
+            EXPECT_EQ(int(p[0]) + int(p[1]) + int(p[2]), 0) << x << "," << y;  // the clear colour: black
+            EXPECT_EQ(int(p[3]), 255);
+            EXPECT_EQ(depth[size_t(y) * W + size_t(x)], 1.0f);
+        }
+    }
 }
