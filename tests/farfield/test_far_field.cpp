@@ -585,6 +585,28 @@ TEST(FarFieldFrame, HorizonPausesWhileItSavesNoRays) {
     EXPECT_EQ(paused, kHorizonPauseFrames);  // frame 0 measures no ray cost yet; frame 1 pauses the next 8
 }
 
+namespace {
+
+// A fake near-field depth covering the bottom third of the camera's pixels.
+std::vector<float> bottomThirdCovered(const Camera& c) {
+    const size_t N = size_t(c.width) * size_t(c.height);
+    std::vector<float> depth(N, 1.0f);
+    for (size_t i = N * 2 / 3; i < N; ++i) depth[i] = 0.5f;
+    return depth;
+}
+
+// Options for two FarFields whose frames are compared: no cache, and no horizon pause (it
+// follows measured times, so the two could classify differently).
+FarFieldOptions twoFieldOptions(double nearDistance) {
+    FarFieldOptions o;
+    o.nearDistance = nearDistance;
+    o.cache = false;
+    o.horizonAdaptive = false;
+    return o;
+}
+
+}  // namespace
+
 // The horizon traced ahead of the frame (FarField::beginFrame, overlapping the
 // near-field draw) gives the very frame the in-frame horizon gives; a
 // beginFrame for another camera is not used.
@@ -592,13 +614,8 @@ TEST(FarFieldFrame, EarlyHorizonGivesTheSameFrame) {
     const TestCity t = testCity(9, 60);
     ASSERT_TRUE(t.rays);
     Camera c = cam(glm::dvec3(0, -190, 1.7), 0.2);
-    const size_t N = size_t(c.width) * size_t(c.height);
-    std::vector<float> depth(N, 1.0f);
-    for (size_t i = N * 2 / 3; i < N; ++i) depth[i] = 0.5f;  // bottom third covered
-    FarFieldOptions o;
-    o.nearDistance = 0;
-    o.cache = false;
-    o.horizonAdaptive = false;  // its pause follows measured times: the two could classify differently
+    const std::vector<float> depth = bottomThirdCovered(c);
+    FarFieldOptions o = twoFieldOptions(0);
     o.speculate = false;  // speculative rays add rays to raysCast (tested below): the horizon alone here
     FarField early(*t.rays, &t.grid, o), plain(*t.rays, &t.grid, o);
     for (int f = 0; f < 3; ++f) {
@@ -636,13 +653,8 @@ TEST(FarFieldFrame, SpeculativeRaysGiveTheSameFrame) {
     const TestCity t = testCity(9, 60);
     ASSERT_TRUE(t.rays);
     Camera c = cam(glm::dvec3(0, -190, 1.7), 0.2);
-    const size_t N = size_t(c.width) * size_t(c.height);
-    std::vector<float> depth(N, 1.0f);
-    for (size_t i = N * 2 / 3; i < N; ++i) depth[i] = 0.5f;  // bottom third covered
-    FarFieldOptions o;
-    o.nearDistance = 20;
-    o.cache = false;
-    o.horizonAdaptive = false;  // its pause follows measured times: the two could classify differently
+    const std::vector<float> depth = bottomThirdCovered(c);
+    const FarFieldOptions o = twoFieldOptions(20);
     FarFieldOptions po = o;
     po.speculate = false;
     FarField spec(*t.rays, &t.grid, o), plain(*t.rays, &t.grid, po);
