@@ -12,11 +12,6 @@ namespace vista {
 
 namespace {
 
-bool sameCamera(const Camera& a, const Camera& b) {
-    return a.eye == b.eye && a.heading == b.heading && a.pitch == b.pitch && a.roll == b.roll && a.fovY == b.fovY &&
-           a.width == b.width && a.height == b.height;
-}
-
 // False when no geometry lies beyond the near distance: an empty city, or the
 // eye's farthest corner of the city's bounding box within the near distance.
 bool farGeometryExists(const RayScene& rays, const HeightGrid* grid, const Camera& camera, const FarFieldOptions& o) {
@@ -44,14 +39,18 @@ bool pausedThisFrame(int& framesLeft, bool applies, FrameStats& stats, const cha
 
 }  // namespace
 
+bool sameCamera(const Camera& a, const Camera& b) {
+    return a.eye == b.eye && a.heading == b.heading && a.pitch == b.pitch && a.roll == b.roll && a.fovY == b.fovY &&
+           a.width == b.width && a.height == b.height;
+}
+
 FarField::FarField(const RayScene& rays, const HeightGrid* grid, const FarFieldOptions& options)
     : _rays(rays), _grid(grid), _options(options), _mem(std::make_unique<FarFieldMemory>()) {}
 FarField::~FarField() = default;
 
 void FarField::setOptions(const FarFieldOptions& o) {
     const bool cacheChanged = o.cache != _options.cache || o.cacheOversample != _options.cacheOversample ||
-                              o.effects.haze != _options.effects.haze || o.effects.visibility != _options.effects.visibility ||
-                              o.effects.night != _options.effects.night;
+                              !sameRayShading(o.effects, _options.effects);
     _options = o;
     if (cacheChanged) _mem->cache.reset();
 }
@@ -76,8 +75,7 @@ void FarField::beginFrame(const Camera& camera) {
 void FarField::awaitSpeculation() { _mem->spec.finish(); }
 
 void FarField::reset() {
-    _mem->spec.stop();
-    _mem->spec.chunks = 0;
+    _mem->spec.discard();
     if (_mem->cache) _mem->cache->clear();
     _mem->prev = Image();
     _mem->haveLast = false;
@@ -97,12 +95,7 @@ void FarField::render(const Camera& camera, const float* depth, Image& out, Fram
     _mem->haveLast = true;
     _rayStart = farRayStart(_options);
     renderStages(f, depth, stats);
-    if (_mem->spec.active()) {  // the ray stage did not run: its speculation is wasted
-        std::vector<uint32_t> none;
-        f.trace.swap(none);
-        takeSpeculation(f, *_mem, _options, nullptr, nullptr, stats);
-        f.trace.swap(none);
-    }
+    if (_mem->spec.active()) discardSpeculation(*_mem, stats);  // the ray stage did not run
     _traced = std::move(f.trace);
 }
 

@@ -70,12 +70,24 @@ void startSpeculation(FarFieldMemory& m, const RayScene& rays, const Camera& cam
 
 namespace {
 
-bool sameView(const Camera& a, const Camera& b) {
-    return a.eye == b.eye && a.heading == b.heading && a.pitch == b.pitch && a.roll == b.roll && a.fovY == b.fovY &&
-           a.width == b.width && a.height == b.height && a.zNear == b.zNear;
+// Stops the worker; counts its rays (cast, used) and notes them.
+void recordSpeculation(SpeculativeRays& s, uint64_t used, FrameStats& stats) {
+    const uint64_t cast = s.rays.load(std::memory_order_relaxed);
+    stats.raysCast += cast;
+    stats.speculativeRays += cast;
+    stats.speculativeUsed += used;
+    stats.notes.push_back("speculative rays: " + std::to_string(cast) + " cast during the draw, " +
+                          std::to_string(used) + " used");
+    s.chunks = 0;
 }
 
 }  // namespace
+
+void discardSpeculation(FarFieldMemory& m, FrameStats& stats) {
+    const bool had = m.spec.chunks > 0;
+    m.spec.stop();
+    if (had) recordSpeculation(m.spec, 0, stats);
+}
 
 std::vector<uint32_t> takeSpeculation(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, uint8_t* hit,
                                       float* depth, FrameStats& stats) {
@@ -85,10 +97,8 @@ std::vector<uint32_t> takeSpeculation(FarFrame& f, FarFieldMemory& m, const FarF
     left.reserve(n);
     const bool had = s.chunks > 0;
     s.stop();
-    const uint64_t cast = s.rays.load(std::memory_order_relaxed);
-    const bool applies = had && sameView(s.camera, f.camera) && s.tnear == farRayStart(o) && o.rayStep == 1 &&
-                         s.effects.haze == o.effects.haze && s.effects.visibility == o.effects.visibility &&
-                         s.effects.night == o.effects.night;
+    const bool applies = had && sameCamera(s.camera, f.camera) && s.tnear == farRayStart(o) && o.rayStep == 1 &&
+                         sameRayShading(s.effects, o.effects);
     uint64_t used = 0;
     if (applies) {
         // Both lists ascend: one merge walk.
@@ -108,13 +118,7 @@ std::vector<uint32_t> takeSpeculation(FarFrame& f, FarFieldMemory& m, const FarF
     } else {
         for (size_t j = 0; j < n; ++j) left.push_back(uint32_t(j));
     }
-    if (had) {
-        stats.raysCast += cast;
-        stats.speculativeRays += cast;
-        stats.speculativeUsed += used;
-        stats.notes.push_back("speculative rays: " + std::to_string(cast) + " cast during the draw, " +
-                              std::to_string(used) + " used");
-    }
+    if (had) recordSpeculation(s, used, stats);
     s.chunks = 0;
     return left;
 }

@@ -70,6 +70,7 @@ struct SpeculativeRays {
     bool active() const { return worker.joinable() || chunks > 0; }
     void stop();                      // ends the work after the chunk in hand and joins (no-op when idle)
     void finish();                    // joins once every chunk is cast (no-op when idle)
+    void discard() { stop(); chunks = 0; }  // stops and forgets (not counted anywhere)
     ~SpeculativeRays() { stop(); }
 };
 constexpr size_t kSpeculativeChunk = 512;  // rays per chunk of SpeculativeRays
@@ -207,6 +208,13 @@ void bypassCache(FarFrame& f);
 // ones. Records Rays.
 void raysStage(FarFrame& f, FarFieldMemory& m, const RayScene& rays, const FarFieldOptions& o, FrameStats& stats);
 
+// Same pixel rays: eye, orientation, field of view and size (far_field.cpp).
+bool sameCamera(const Camera& a, const Camera& b);
+// Same colours for the same ray: the effects that shade rays (haze, its visibility, night sky).
+inline bool sameRayShading(const FrameEffects& a, const FrameEffects& b) {
+    return a.haze == b.haze && a.visibility == b.visibility && a.night == b.night;
+}
+
 // Speculative rays (far_field_speculate.cpp). Starts casting `pixels`
 // (ascending, e.g. last frame's traced pixels) for `camera` with the ray
 // stage's start distance and effects (o), on one other thread, chunk by
@@ -222,6 +230,8 @@ void startSpeculation(FarFieldMemory& m, const RayScene& rays, const Camera& cam
 // raysCast and a note with how many were used. m.spec is idle afterwards.
 std::vector<uint32_t> takeSpeculation(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, uint8_t* hit,
                                       float* depth, FrameStats& stats);
+// A frame without a ray stage: stops m.spec and counts its rays as cast and none used.
+void discardSpeculation(FarFieldMemory& m, FrameStats& stats);
 
 // Sky colours of the camera (far_field_composite.cpp), cached in m.sky.
 const Image& skyImage(FarFieldMemory& m, const FarFrame& f);

@@ -703,6 +703,18 @@ TEST(FarFieldFrame, SpeculativeRaysGiveTheSameFrame) {
     plain.render(other, depth.data(), b, sb);
     EXPECT_TRUE(has(sa, "speculative rays: " + std::to_string(last.size()) + " cast during the draw, 0 used"));
     EXPECT_EQ(a.rgba, b.rgba);
+    // A frame the near field covers whole runs no ray stage: the rays are counted, none used.
+    const std::vector<uint32_t> before = spec.lastTraced();
+    ASSERT_FALSE(before.empty());
+    const std::vector<float> covered(size_t(c.width) * size_t(c.height), 0.5f);
+    spec.beginFrame(other);
+    spec.awaitSpeculation();
+    FrameStats sc;
+    spec.render(other, covered.data(), a, sc);
+    EXPECT_EQ(sc.speculativeRays, before.size());
+    EXPECT_EQ(sc.speculativeUsed, 0u);
+    EXPECT_EQ(sc.raysCast, before.size());
+    EXPECT_FALSE(sc.stages.ran(Stage::Rays));
 }
 
 // rayStep 2 (the lattice): fewer rays, the frame close to the exact one, and
