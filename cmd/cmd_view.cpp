@@ -345,6 +345,7 @@ Status setUpWindow(ViewState& v, const ViewArgs& a, osg::ref_ptr<osgGA::KeySwitc
     v.viewer.setSceneData(root.get());
     osg::Camera* cam = v.viewer.getCamera();
     setExactCulling(*cam);  // the bench renderer's culling: same pictures
+    flushDeletedGLObjectsEvery(*cam);  // as the bench renderer: no walk over every GL buffer set each frame
     cam->setClearColor(osg::Vec4(0, 0, 0, 1));
     v.keys = new Keys;
     v.keys->capture = new Capture;

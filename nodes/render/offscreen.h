@@ -8,6 +8,9 @@
 // and projection (zFar <= 0: infinite far plane), waits for the GPU
 // (glFinish) and reads back colour (RGBA8, row 0 at top) and, if `depth` is
 // non-null, window-space depth in [0,1] (row 0 at top, 1 = nothing drawn).
+// The window is never presented (no buffer swap: a frame is the read-back
+// image, as a ray-cast frame is), and deleted GL objects are released every
+// kGLObjectFlushFrames frames (flushDeletedGLObjectsEvery).
 // Fills stats.frameMs/cullMs/drawMs/triangles/drawCalls. Single-threaded:
 // call from the thread that created it.
 //
@@ -43,6 +46,18 @@ namespace vista {
 // small-feature culling (the ray caster has none). A mode that wants more
 // culling adds it inside its own graph (osglod).
 void setExactCulling(osg::Camera& camera);
+
+// Deleted GL objects (buffers, textures, programs of dropped nodes) are
+// released every `frames` frames instead of every frame. osgViewer's renderer
+// flushes them at the start of each draw (osg::flushDeletedGLObjects), which
+// walks every buffer-object set under a mutex whether anything was deleted or
+// not; OSG keeps one set per buffer size, thousands in a city, so the walk
+// cost 2.5 ms of CPU a frame on the 2 km city whatever was drawn (docs/results.md).
+// Installs a renderer on `camera` (before the viewer is realized; a viewer
+// with an incremental compile operation flushes through it and is left as
+// is). frames >= 1 (1 = OSG's every frame).
+constexpr unsigned kGLObjectFlushFrames = 16;
+void flushDeletedGLObjectsEvery(osg::Camera& camera, unsigned frames = kGLObjectFlushFrames);
 
 // One frame of ground-truth labels (renderLabels), row 0 at the top.
 struct LabelFrame {

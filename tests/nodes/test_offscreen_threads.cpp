@@ -4,13 +4,19 @@
 // field's overlap thread) then shares that one core (render/offscreen.cpp).
 #include <sched.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <thread>
 
 #include <gtest/gtest.h>
 #include <osg/Geode>
 #include <osg/Geometry>
+#include <osg/BufferObject>
+#include <osg/ContextData>
 #include <osg/Group>
+#include <osgUtil/SceneView>
+#include <osgViewer/Renderer>
+#include <osgViewer/Viewer>
 #include <tbb/task_arena.h>
 
 #include "nodes/render/offscreen.h"
@@ -105,4 +111,72 @@ TEST(Offscreen, ReadsColourAndDepthBackTopDownInRgba) {
             EXPECT_EQ(depth[size_t(y) * W + size_t(x)], 1.0f);
         }
     }
+}
+
+// flushDeletedGLObjectsEvery: the GL buffers of a dropped node stay with the
+// context until the next flush frame, and are released then; the scene view
+// flushes on every `frames`-th frame only (OSG's default is every frame,
+// which walks every buffer set: render/offscreen.h).
+TEST(Offscreen, ReleasesTheBuffersOfDroppedNodesEveryFlushPeriod) {
+    const char* display = std::getenv("DISPLAY");
+    if (!display || !*display) GTEST_SKIP() << "no X display (run under xvfb-run -a)";
+    osg::ref_ptr<osg::GraphicsContext::Traits> traits = new osg::GraphicsContext::Traits;
+    traits->readDISPLAY();
+    traits->setUndefinedScreenDetailsToDefaultScreen();
+    traits->width = 32;
+    traits->height = 24;
+    traits->windowDecoration = false;
+    traits->doubleBuffer = true;
+    osg::ref_ptr<osg::GraphicsContext> gc;
+    for (int attempt = 0; attempt < 20 && !(gc && gc->valid()); ++attempt) {  // a busy Xvfb refuses now and then
+        if (attempt) std::this_thread::sleep_for(std::chrono::milliseconds(50 + 50 * attempt));
+        gc = osg::GraphicsContext::createGraphicsContext(traits.get());
+    }
+    ASSERT_TRUE(gc && gc->valid()) << "no GL window on display " << display;
+    constexpr unsigned kFrames = 4;
+    osg::ref_ptr<osgViewer::Viewer> viewer = new osgViewer::Viewer;
+    viewer->setThreadingModel(osgViewer::ViewerBase::SingleThreaded);
+    viewer->setUseConfigureAffinity(false);
+    osg::Camera* cam = viewer->getCamera();
+    cam->setGraphicsContext(gc.get());
+    cam->setViewport(new osg::Viewport(0, 0, 32, 24));
+    flushDeletedGLObjectsEvery(*cam, kFrames);
+    osg::ref_ptr<osg::Group> root = new osg::Group;
+    {
+        osg::ref_ptr<osg::Geometry> tri = new osg::Geometry;
+        osg::ref_ptr<osg::Vec3Array> v = new osg::Vec3Array;
+        v->push_back({-1, 5, -1});
+        v->push_back({1, 5, -1});
+        v->push_back({0, 5, 1});
+        tri->setVertexArray(v.get());
+        tri->addPrimitiveSet(new osg::DrawArrays(GL_TRIANGLES, 0, 3));
+        tri->setUseDisplayList(false);
+        tri->setUseVertexBufferObjects(true);
+        osg::ref_ptr<osg::Geode> geode = new osg::Geode;
+        geode->addDrawable(tri.get());
+        root->addChild(geode.get());
+    }
+    viewer->setSceneData(root.get());
+    viewer->realize();
+    ASSERT_TRUE(viewer->isRealized());
+    auto* renderer = dynamic_cast<osgViewer::Renderer*>(cam->getRenderer());
+    ASSERT_NE(renderer, nullptr);
+    osgUtil::SceneView* sv = renderer->getSceneView(0);  // single-threaded: cull and draw use view 0
+    ASSERT_NE(sv, nullptr);
+    viewer->frame();  // frame 1: the triangle's buffer is created
+    osg::GLBufferObjectManager* bom = osg::get<osg::GLBufferObjectManager>(gc->getState()->getContextID());
+    ASSERT_NE(bom, nullptr);
+    const unsigned active = bom->getNumberActiveGLBufferObjects();
+    ASSERT_GE(active, 1u);
+    root->removeChildren(0, root->getNumChildren());  // the triangle is destroyed: its buffer is orphaned
+    // Frames 2 .. kFrames: no flush (the flag set in frame kFrames makes frame kFrames + 1 flush).
+    for (unsigned f = 2; f <= kFrames; ++f) {
+        viewer->frame();
+        EXPECT_EQ(sv->getAutomaticFlush(), f % kFrames == 0) << "frame " << f;
+        EXPECT_EQ(bom->getNumberActiveGLBufferObjects(), active) << "released before the flush frame, frame " << f;
+    }
+    viewer->frame();  // frame kFrames + 1 flushes
+    EXPECT_FALSE(sv->getAutomaticFlush());
+    EXPECT_LT(bom->getNumberActiveGLBufferObjects(), active) << "the dropped triangle's buffer was not released";
+    viewer->setSceneData(nullptr);
 }
