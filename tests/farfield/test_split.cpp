@@ -336,3 +336,43 @@ TEST(Split, GridIndexSelectsExactlyWhatTheLinearScanSelects) {
         EXPECT_EQ(split.predictedTriangles(glm::dvec3(10, 20, 1.7), d), sum) << d;
     }
 }
+
+// The overlap's capacity (recordOverlap): far rays cast on the side while a
+// candidate's own near field is drawn cost the frame nothing more. With the
+// same measured costs, a split that knows the draw casts many rays on the side
+// picks a smaller near field than one that does not; with a capacity that
+// covers every far pixel it draws the least near field. An exhausted
+// worker's rate only raises the estimate; a measured rate lowers it again.
+TEST(Split, OverlapCapacityMovesTheSplitIn) {
+    ProbeScene ps = probeScene(12);
+    const std::vector<SplitObject> objs = squareObjects();
+    const Camera c = smallCamera(glm::dvec3(0, -350, 1.7));
+    AdaptiveSplitOptions o = measuredOnly();
+    o.rayCastOnly = o.everythingNear = false;
+    AdaptiveSplit plain(objs, ps.rays.get(), o), overlapped(objs, ps.rays.get(), o);
+    for (int i = 0; i < 10; ++i) {
+        const double tris = 20000 + 4000 * i;
+        for (AdaptiveSplit* s : {&plain, &overlapped}) s->record(uint64_t(tris), 1.0 + 2e-4 * tris, 2000, 2000 * 0.01);
+    }
+    EXPECT_EQ(plain.overlapRaysPerMs(), 0.0);
+    overlapped.recordOverlap(uint64_t(1e9), 1.0, false);  // covers any far field
+    EXPECT_NEAR(overlapped.overlapRaysPerMs(), 1e9, 1.0);
+    const double dPlain = plain.choose(c, -1), dOver = overlapped.choose(c, -1);
+    EXPECT_LT(dOver, dPlain);
+    EXPECT_GT(plain.predictedRays(dOver), plain.predictedRays(dPlain));  // more far pixels, cast on the side
+    // The eye stands in a box, so every candidate draws triangles: the least is the smallest.
+    EXPECT_GT(overlapped.predictedTriangles(c.eye, o.minDistance), 0u);
+    EXPECT_NEAR(dOver, o.minDistance, 1e-9);
+    // Exhausted: a lower bound, never lowering the estimate; measured: a moving average.
+    AdaptiveSplit rate(objs, ps.rays.get(), o);
+    rate.recordOverlap(10000, 10.0, false);
+    EXPECT_NEAR(rate.overlapRaysPerMs(), 1000.0, 1e-9);
+    rate.recordOverlap(100, 10.0, true);
+    EXPECT_NEAR(rate.overlapRaysPerMs(), 1000.0, 1e-9);
+    rate.recordOverlap(30000, 10.0, true);
+    EXPECT_NEAR(rate.overlapRaysPerMs(), 3000.0, 1e-9);
+    rate.recordOverlap(0, 10.0, false);
+    EXPECT_NEAR(rate.overlapRaysPerMs(), (1 - o.smoothing) * 3000.0, 1e-9);
+    rate.recordOverlap(5000, 0.0, false);  // no draw: ignored
+    EXPECT_NEAR(rate.overlapRaysPerMs(), (1 - o.smoothing) * 3000.0, 1e-9);
+}
