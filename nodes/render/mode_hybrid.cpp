@@ -55,12 +55,9 @@ public:
         stats.stages.set(Stage::Cull, sw.ms());
         if (autoSplit()) {
             stats.notes.push_back(nearAutoNote(nearD));
-            char model[200];
-            std::snprintf(model, sizeof model,
-                          "split model: %.3g ms/k triangles, %.3g ms/k far pixels, %.2f ms far fixed, %.3g k far rays per ms "
-                          "of drawing overlapped",
-                          1e3 * _adaptive->msPerTriangle(), 1e3 * _adaptive->msPerRay(), _adaptive->farFixedMs(),
-                          1e-3 * _adaptive->overlapRaysPerMs());
+            char model[160];
+            std::snprintf(model, sizeof model, "split model: %.3g ms/k triangles, %.3g ms/k far pixels, %.2f ms far fixed",
+                          1e3 * _adaptive->msPerTriangle(), 1e3 * _adaptive->msPerRay(), _adaptive->farFixedMs());
             stats.notes.push_back(model);
         }
         // Near field: GL draw + colour/depth readback (sky where uncovered).
@@ -141,20 +138,15 @@ private:
     void recordCosts(uint64_t tris, double rasterMs, const FrameStats& fs) {
         // The far pixels the frame paid for after the draw: pixels whose speculative ray was cast
         // during the draw are left out, so b is the price of a pixel the frame waits for. The
-        // split prices a candidate's far pixels at it after taking off those the overlap can cast
-        // during the candidate's draw (its measured rays per ms of drawing): a b lowered by the
-        // overlap alone led the split to near distances whose far pixels the overlap could not
-        // cover (docs/far-field.md, speculative rays).
+        // split then prices every far pixel of a candidate at it (the overlap's capacity is not
+        // modelled): measured, a b lowered by the overlap led the split to near distances whose
+        // far pixels the overlap could not cover (docs/far-field.md, speculative rays).
         const uint64_t farPixels = fs.pixels.cache + fs.pixels.rayHit + fs.pixels.rayMiss + fs.pixels.interpolated -
                                    std::min(fs.speculativeUsed, fs.pixels.rayHit + fs.pixels.rayMiss);
         const double farMs = fs.stages.ms(Stage::Rays) + fs.stages.ms(Stage::Cache);
         const double fixedMs = fs.stages.ms(Stage::Opacity) + fs.stages.ms(Stage::Seam) + fs.stages.ms(Stage::Horizon) +
                                fs.stages.ms(Stage::Composite);
         _adaptive->record(tris, rasterMs, farPixels, farMs, fixedMs);
-        // The overlap's capacity: speculative rays the frame used per ms of drawing
-        // (AdaptiveSplit::recordOverlap). Used, not cast: a ray cast for a pixel that is no longer
-        // far saves nothing, and every far pixel still pays its cache lookup.
-        if (fs.speculated && tris > 0) _adaptive->recordOverlap(fs.speculativeUsed, rasterMs, fs.speculativeExhausted);
     }
     bool byBudget() const { return _ctx.options.triangleBudget > 0; }
     bool autoSplit() const { return !byBudget() && _ctx.options.nearDistance < 0; }

@@ -267,10 +267,7 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
             while (k < byDist.size() && byDist[k].first <= d) tris += byDist[k++].second;
         }
         // Nothing to draw -> no GL pass: the raster's fixed cost only where triangles are drawn.
-        const double raster = tris > 0 ? _c + _a * double(tris) : 0.0;
-        // Far pixels cast on the side during this candidate's own draw cost nothing more.
-        const double rays = std::max(0.0, predictedRays(d) - _overlap * raster);
-        cost[size_t(i)] = raster + b * rays + (std::isinf(d) ? 0.0 : _f);
+        cost[size_t(i)] = (tris > 0 ? _c + _a * double(tris) : 0.0) + b * predictedRays(d) + (std::isinf(d) ? 0.0 : _f);
         if (cost[size_t(i)] < cost[size_t(bestI)]) bestI = i;
     }
     if (_o.exploreEvery > 0 && frame % _o.exploreEvery == _o.exploreEvery - 1)
@@ -286,17 +283,6 @@ double AdaptiveSplit::msPerRay() const {
     if (_bFitted) return _b;
     if (_bProbe > 0) return _haveB ? std::min(_b, _bProbe) : _bProbe;
     return _b;
-}
-
-void AdaptiveSplit::recordOverlap(uint64_t rays, double rasterMs, bool exhausted) {
-    if (!(rasterMs > 0) || !std::isfinite(rasterMs)) return;
-    const double rate = double(rays) / rasterMs;
-    if (exhausted) {
-        if (rate > _overlap) _overlap = rate;  // a lower bound of what the draw allowed
-    } else {
-        _overlap = _haveOverlap ? (1 - _o.smoothing) * _overlap + _o.smoothing * rate : rate;
-    }
-    _haveOverlap = true;
 }
 
 void AdaptiveSplit::record(uint64_t triangles, double rasterMs, uint64_t farPixels, double farMs, double fixedMs) {

@@ -29,18 +29,12 @@
 // when the view jumped (eye moved more than minDistance, heading or pitch
 // more than 0.1 rad since the probe): a pixel whose
 // first hit lies beyond d, or that misses below the horizon, needs a ray). It
-// minimises [R(d) = c + a * triangles(d) if triangles(d) > 0] + b * max(0, rays(d) - s * R(d))
-// (+ F unless d = infinity) over candidate distances
+// minimises [c + a * triangles(d) if triangles(d) > 0] + b * rays(d) (+ F unless d = infinity) over candidate distances
 // (geometric steps between minDistance and maxDistance, plus 0 = ray casting
 // and +infinity = everything rasterised when the options allow them). rays(d) is not capped
 // by the pixel budget: the aim is the lowest frame time at full accuracy (a
 // budget-capped model would always pick the smallest near field and let the
-// cache's error grow). s (recordOverlap; 0 until measured) is how many far rays a
-// millisecond of drawing casts on the side (FarFieldOptions::speculate: last
-// frame's far pixels cast while the near field is drawn): a candidate's far
-// pixels that fit into its own draw cost the frame nothing more, so the split
-// may move in while they fit (measured, not assumed: where the draw keeps
-// every core busy, s stays near 0). Every `exploreEvery`-th choice steps one candidate up
+// cache's error grow). Every `exploreEvery`-th choice steps one candidate up
 // or down from the optimum so that the fit sees varied triangle counts.
 // Not thread-safe; deterministic for given measurements.
 #pragma once
@@ -126,12 +120,6 @@ public:
     // stages that scale with them (cache + rays); the far field's other
     // stages' ms (fixedMs; 0 when the frame had no far field).
     void record(uint64_t triangles, double rasterMs, uint64_t farPixels, double farMs, double fixedMs = 0);
-    // Speculative rays of a frame with a draw: `rays` cast during `rasterMs` of drawing and
-    // used by the frame;
-    // exhausted = the worker ran out of pixels (then rays / rasterMs is only a lower bound,
-    // which raises s but never lowers it); otherwise s follows rays / rasterMs (moving average).
-    void recordOverlap(uint64_t rays, double rasterMs, bool exhausted);
-    double overlapRaysPerMs() const { return _overlap; }
     double msPerTriangle() const { return _a; }
     double rasterFixedMs() const { return _c; }  // the raster fit's intercept (0 until a is fitted)
     double msPerRay() const;  // per far pixel: the frames' model, capped by the probe's bulk rate
@@ -150,8 +138,6 @@ private:
     AdaptiveSplitOptions _o;
     double _a = 2e-5, _b = 5e-4, _f = 0, _bProbe = 0;  // priors: ms per triangle, ms per far pixel, fixed far ms
     double _c = 0;                                       // fixed raster ms (fitted with a)
-    double _overlap = 0;                                 // s: far rays cast per ms of drawing (recordOverlap)
-    bool _haveOverlap = false;
     bool _haveA = false, _haveB = false, _haveF = false;  // measured (not the priors)
     bool _bFitted = false;  // _b is the frames' well-conditioned slope (not the mean)
     std::vector<std::pair<double, double>> _rasterSamples;  // (triangles, ms), last `window` frames

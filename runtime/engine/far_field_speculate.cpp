@@ -76,8 +76,6 @@ void recordSpeculation(SpeculativeRays& s, uint64_t used, FrameStats& stats) {
     stats.raysCast += cast;
     stats.speculativeRays += cast;
     stats.speculativeUsed += used;
-    stats.speculated = true;
-    stats.speculativeExhausted = s.next.load(std::memory_order_relaxed) >= s.chunks;
     stats.notes.push_back("speculative rays: " + std::to_string(cast) + " cast during the draw, " +
                           std::to_string(used) + " used");
     s.chunks = 0;

@@ -101,10 +101,6 @@ struct FrameStats {
     // raysCast), and how many of them gave a traced pixel its colour (rayHit/rayMiss pixels
     // the ray stage did not cast itself).
     uint64_t speculativeRays = 0, speculativeUsed = 0;
-    // speculated: a speculative worker ran during the draw (its rays may still be 0);
-    // exhausted: it cast every pixel it was given before it was stopped (so speculativeRays
-    // is a lower bound of what the draw's time would have allowed).
-    bool speculated = false, speculativeExhausted = false;
     PixelCounts pixels;
     StageTimes stages;
     EffectTimes effects;
