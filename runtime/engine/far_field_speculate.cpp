@@ -70,7 +70,7 @@ void startSpeculation(FarFieldMemory& m, const RayScene& rays, const Camera& cam
 
 namespace {
 
-// Stops the worker; counts its rays (cast, used) and notes them.
+// Counts a stopped worker's rays (cast, used), notes them and marks it idle.
 void recordSpeculation(SpeculativeRays& s, uint64_t used, FrameStats& stats) {
     const uint64_t cast = s.rays.load(std::memory_order_relaxed);
     stats.raysCast += cast;
