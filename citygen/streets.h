@@ -13,7 +13,7 @@
 //
 // importOsm(): ways tagged highway=* from an OpenStreetMap extract (.osm XML,
 // also .osm.gz / .osm.bz2, or .osm.pbf) as a planar street graph in a local
-// metric frame. Steps (docs/streets.md):
+// metric frame. Steps (docs/reference/streets.md):
 // 1. Nodes are dropped, and their ways split there, when their coordinates
 //    are invalid (unparsable, non-finite, lat outside [-90, 90], lon outside
 //    [-180, 180]; XML coordinates are checked as text before libosmium parses
@@ -74,7 +74,7 @@ struct OsmImport {
     std::vector<OsmFootprint> buildings;
     OsmBuildingStats buildingStats;  // the import counts (candidates, repaired, skipped by reason)
 };
-// `buildings`: also read the building footprints (docs/buildings.md "Buildings
+// `buildings`: also read the building footprints (docs/reference/buildings.md "Buildings
 // from OSM"): closed ways and multipolygon relations tagged building=*,
 // repaired or skipped per reason (never an error), those with a vertex outside
 // the city square [-size_m/2, size_m/2]^2 skipped.

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Checks the include order of vista's rooms (docs/architecture.md).
+"""Checks the include order of vista's rooms (docs/reference/architecture.md).
 
 Every source file belongs to one room (by its folder). A file may include
 project headers only from its own room and the rooms below it, and some rooms
