@@ -61,7 +61,7 @@ print("Regenerate with `docs/tools/reliability.sh [FUZZ_SECONDS] [SOAK_FRAMES]` 
 print()
 print("## Findings and their regression tests")
 print()
-print("| input | finding | now | regression test |")
+print("| input | fault found | behaviour | regression test |")
 print("|---|---|---|---|")
 rows = [
  ("params JSON", "`1e999` or a 400-digit number aborted (uncaught exception)", "exit 2: 'number overflow ... (numbers must fit a double)'", "Params.HostileJsonIsRefusedCleanlyAndTheFullSeedRangeAccepted"),
