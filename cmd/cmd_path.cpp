@@ -7,6 +7,7 @@
 #include "cmd/cli.h"
 #include "cmd/commands.h"
 #include "cmd/options.h"
+#include "runtime/scene/paged_walkthrough.h"
 #include "runtime/scene/paths.h"
 
 namespace vista {

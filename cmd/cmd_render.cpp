@@ -47,7 +47,7 @@
 #include "runtime/engine/far_field_rays.h"
 #include "runtime/engine/ground_truth.h"
 #include "runtime/engine/ray_scene.h"
-#include "runtime/scene/city_file.h"
+#include "nodes/render/walkthrough.h"
 #include "runtime/scene/scene_graph.h"
 
 namespace vista {
@@ -248,21 +248,35 @@ int run(RenderArgs& a, const std::string& command) {
     if (Status s = out.checkOut(a.out); !s) return reportBadInput(kCmd, s);
 
     // ---- city, path ------------------------------------------------------------
-    auto city = loadCityFile(a.city);
-    if (!city) return reportBadInput(kCmd, city.status());
     const bool labels = (*channels & kLabelChannels) != 0;
-    if ((*channels & (kSemantic | kInstance)) && !city->labelled)
-        return reportBadInput(kCmd, Status::error("city file '" + a.city +
-                                                  "' has no ground-truth labels (written by an older vista): regenerate the "
-                                                  "city with this version (`vista gen`) for the semantic and instance channels"));
-    auto path = walkthroughPath(a.path, *po, *city);
-    if (!path) return reportBadInput(kCmd, path.status());
-    if (path->samples.empty()) return reportBadInput(kCmd, Status::error("the walkthrough path has no samples"));
-    const std::vector<size_t> idx = path->frames(size_t(a.frames), *sampling);
-    if (Status s = checkPathInCity(*path, idx, *city); !s) return reportBadInput(kCmd, s);
-    auto fx = runTimeEffects("", city->params.effects, true, kCmd);
-    if (!fx) return reportBadInput(kCmd, fx.status());
-    mo.effects = *fx;
+    std::vector<size_t> idx;
+    WalkthroughRequest req;
+    req.city = a.city;
+    req.cmd = kCmd;
+    req.quiet = true;
+    req.allowPaged = false;
+    req.pathNeedsStreets = a.path.file.empty();
+    req.checkCity = [&](const SceneModel& city) {
+        if ((*channels & (kSemantic | kInstance)) && !city.labelled)
+            return Status::error("city file '" + a.city +
+                                 "' has no ground-truth labels (written by an older vista): regenerate the "
+                                 "city with this version (`vista gen`) for the semantic and instance channels");
+        return Status::ok();
+    };
+    req.makePath = [&](const SceneModel& city) -> Result<Path> {
+        auto path = walkthroughPath(a.path.file, *po, city);
+        if (!path) return path;
+        if (path->samples.empty()) return Status::error("the walkthrough path has no samples");
+        idx = path->frames(size_t(a.frames), *sampling);
+        VISTA_RETURN_IF_ERROR(checkPathInCity(*path, idx, city));
+        return path;
+    };
+    req.bakedModes = {a.mode};
+    req.effects = [](const Effects& declared) { return runTimeEffects("", declared, true, kCmd); };
+    auto walk = loadWalkthrough(req, mo);
+    if (!walk) return reportBadInput(kCmd, walk.status());
+    const SceneModel* city = &walk->city;
+    const Path* path = &walk->path;
 
     // ---- work directory: new, or the one of an interrupted run with the same parameters ----
     uint64_t cityBytes = 0;
@@ -292,7 +306,7 @@ int run(RenderArgs& a, const std::string& command) {
     if (!renderer) return fail(renderer.status());
     std::unique_ptr<RayScene> rays;
     ModeContext ctx;
-    ctx.city = &city.value();
+    ctx.city = city;
     ctx.scene = sceneRoot(*city);
     ctx.renderer = renderer->get();
     ctx.options = mo;
