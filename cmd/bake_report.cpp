@@ -1,5 +1,5 @@
-// vista_bake_report: measurements of baked point impostors (docs/results.md,
-// "Issue 5: bake"). For one view cell of one or more baked files (same city,
+// vista_bake_report: measurements of baked point impostors (the bake section
+// of docs/results.md). For one view cell of one or more baked files (same city,
 // different bake parameters) it renders, through OffscreenRenderer, from the
 // cell's 8 corners and the midpoints of its 4 vertical side edges (inset 2 %,
 // the edges at mid height) and its centre towards the cell's impostors:

@@ -1,5 +1,5 @@
-// far_field_sweep: the measurements of docs/results.md "Issue 4: ray-cast far
-// field" in one command. Runs the bench (runBenchmark, modes interleaved per
+// far_field_sweep: the measurements of the ray-cast far-field section of
+// docs/results.md in one command. Runs the bench (runBenchmark, modes interleaved per
 // frame in one process) on consecutive samples of one car walkthrough (30 fps
 // spacing, so the panoramic cache sees real frame-to-frame coherence) for:
 //   modes640 / modes320  full, near, raycast, osgimpostor, osglod, hybrid (Figs 4.8, 4.10)
