@@ -1,6 +1,6 @@
 // Baked lighting (baked_lighting.h): shadows, ambient occlusion and street
 // light pools into the prelit vertex colours, with refinement where light changes.
-#include "runtime/engine/baked_lighting.h"
+#include "bake/gen/baked_lighting.h"
 
 #include <algorithm>
 #include <atomic>

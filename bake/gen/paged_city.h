@@ -36,6 +36,7 @@
 #include "foundation/progress.h"
 #include "foundation/shard.h"
 #include "foundation/status.h"
+#include "runtime/scene/paged_load.h"
 
 namespace vista {
 
@@ -67,11 +68,9 @@ Status checkPagedOutput(const std::string& option, const std::string& dir);
 
 Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedCityOptions& options);
 
-// File names inside DIR (relative).
+// File names inside DIR (relative; the index and the manifest: paged_load.h).
 std::string regionFileName(int ix, int iy);
 std::string coarseFileName(int ix, int iy);
-constexpr const char* kPagedIndexFile = "index.osgb";
-constexpr const char* kPagedManifestFile = "manifest.json";
 
 // PagedLOD ranges (metres from the eye to the region's bounding-sphere centre)
 // for a region of `regionSizeM` and bounding radius `radius` in a city of side

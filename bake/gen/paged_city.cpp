@@ -1,6 +1,6 @@
 // The paged city writer: regions (citygen/regions.h) as city files, their
 // records (resume), the PagedLOD index and the manifest. See paged_city.h.
-#include "runtime/scene/paged_city.h"
+#include "bake/gen/paged_city.h"
 #include "foundation/format.h"
 
 #include <chrono>
