@@ -27,7 +27,7 @@ set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 if(VISTA_INSTALL_PACKAGE)
   set(CPACK_DEBIAN_PACKAGE_DEPENDS
     "libopenscenegraph-dev, libembree-dev, libtbb-dev, libcgal-dev, libgmp-dev, libmpfr-dev, libglm-dev, \
-nlohmann-json3-dev, libpng-dev, zlib1g-dev, libbz2-dev, libexpat1-dev, libgl-dev")
+nlohmann-json3-dev, libpng-dev, zlib1g-dev, libbz2-dev, libexpat1-dev, libgl-dev, libopengl-dev")
   set(CPACK_DEBIAN_PACKAGE_SUGGESTS "cmake (>= 3.20)")
 endif()
 include(CPack)
