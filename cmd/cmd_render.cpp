@@ -76,7 +76,7 @@ Result<unsigned> parseChannels(const std::string& s) {
     while (start <= s.size()) {
         const size_t end = s.find(',', start);
         const std::string name = s.substr(start, end == std::string::npos ? std::string::npos : end - start);
-        unsigned c = name == "rgb" ? kRgb : name == "depth" ? kDepth : name == "semantic" ? kSemantic : name == "instance" ? kInstance : 0;
+        unsigned c = name == "rgb" ? kRgb : name == "depth" ? kDepth : name == "semantic" ? kSemantic : name == "instance" ? kInstance : Channel{0};
         if (!c) return Status::error("--channels: unknown channel '" + name + "' (known: rgb, depth, semantic, instance)");
         if (out & c) return Status::error("--channels: channel '" + name + "' given twice");
         out |= c;
