@@ -496,20 +496,23 @@ class Check:
         self.worst_where = None
         self.offenders = []
         self.max_list = max_list
+        self.by_kind = {}
 
     def value(self, v, where, worse=lambda a, b: a > b):
         if self.worst is None or worse(v, self.worst):
             self.worst, self.worst_where = v, where
 
-    def fail(self, where):
+    def fail(self, where, kind=None):
         self.failures += 1
+        if kind:
+            self.by_kind[kind] = self.by_kind.get(kind, 0) + 1
         if len(self.offenders) < self.max_list:
             self.offenders.append(where)
 
     def as_json(self):
         return {"failures": self.failures, "checked": self.checked, "limit": self.limit, "unit": self.unit,
                 "worst": self.worst, "worst_at": self.worst_where, "offenders": self.offenders,
-                "pass": self.failures == 0}
+                "failures_by_kind": self.by_kind, "pass": self.failures == 0}
 
 
 class Network:
@@ -577,12 +580,12 @@ def check_network(net, opt):
                 gaps.checked += 1
                 gaps.value(d, f"road {r.id} geometry {i - 1}->{i}")
                 if d > opt.max_gap:
-                    gaps.fail(f"road {r.id} geometry {i - 1}->{i}: plan {d:.4f} m")
+                    gaps.fail(f"road {r.id} geometry {i - 1}->{i}: plan {d:.4f} m", "geometry")
                 jump = abs(math.degrees(wrap_angle(g.hdg - h0)))
                 kinks.checked += 1
                 kinks.value(jump, f"road {r.id} geometry {i - 1}->{i}")
                 if jump > opt.max_kink_deg:
-                    kinks.fail(f"road {r.id} geometry {i - 1}->{i}: {jump:.3f} deg")
+                    kinks.fail(f"road {r.id} geometry {i - 1}->{i}: {jump:.3f} deg", "geometry")
         planview.checked += 1
         err = abs(expect - r.length)
         planview.value(err, f"road {r.id} length")
@@ -591,6 +594,7 @@ def check_network(net, opt):
         for sec in r.sections:
             if not (-1e-9 <= sec.s <= r.length + 1e-9):
                 refs.fail(f"road {r.id}: laneSection s={sec.s} outside [0, {r.length}]")
+        refs.checked += 1
         if r.junction != "-1" and r.junction not in net.junctions:
             refs.fail(f"road {r.id}: junction=\"{r.junction}\" does not exist")
 
@@ -600,6 +604,9 @@ def check_network(net, opt):
     def add_contact(kind, a, ea, b, eb, pairs, label):
         key = frozenset([(a.id, ea), (b.id, eb)])
         c = contacts.get(key)
+        j = a.junction if a.junction != "-1" else b.junction
+        if j != "-1":  # a connecting road's end: reported under its junction
+            kind, label = "junction", f"junction {j}"
         if c is None:
             c = contacts[key] = {"kind": kind, "a": a, "ea": ea, "b": b, "eb": eb, "pairs": set(), "label": label}
         for la, lb in pairs:
@@ -614,6 +621,7 @@ def check_network(net, opt):
             if link is None:
                 continue
             where = f"road {r.id} {tag}"
+            refs.checked += 1
             if link["type"] == "junction":
                 if link["id"] not in net.junctions:
                     refs.fail(f"{where}: junction {link['id']} does not exist")
@@ -628,6 +636,7 @@ def check_network(net, opt):
             if link["cp"] not in ("start", "end"):
                 refs.fail(f"{where}: contactPoint=\"{link['cp']}\" is not start or end")
                 continue
+            refs.checked += 1
             # symmetry: the other road links back to this one (or to this road's junction)
             back = other.link_at(link["cp"])
             ok = back is not None and ((back["type"] == "road" and back["id"] == r.id and back["cp"] == end) or
@@ -639,12 +648,13 @@ def check_network(net, opt):
             pairs = []
             for lane in sec.lanes.values():
                 for target in (lane.pred if end == "start" else lane.succ):
+                    refs.checked += 1
                     if not lane_exists(other, link["cp"], target):
                         refs.fail(f"{where}: lane {lane.id} links to lane {target}, which road {other.id} "
                                   f"lacks at its {link['cp']}")
                     else:
                         pairs.append((lane.id, target))
-            add_contact("road", r, end, other, link["cp"], pairs, "road link")
+            add_contact("road link", r, end, other, link["cp"], pairs, "road link")
 
     # junction connections: incoming road end <-> connecting road contact point
     incoming_links = {}  # (road id, lane id) -> set of junction ids providing a laneLink
@@ -653,6 +663,7 @@ def check_network(net, opt):
             where = f"junction {jid} connection {con.get('id', ci)}"
             inc, conn_id, cp = con.get("incomingRoad"), con.get("connectingRoad"), con.get("contactPoint")
             I, C = roads.get(inc), roads.get(conn_id)
+            refs.checked += 3
             if I is None:
                 refs.fail(f"{where}: incomingRoad {inc} does not exist")
             if C is None:
@@ -677,6 +688,7 @@ def check_network(net, opt):
             ei = ends[0]
             pairs = []
             for ll in con.findall("laneLink"):
+                refs.checked += 1
                 try:
                     lf, lt = int(ll.get("from")), int(ll.get("to"))
                 except (TypeError, ValueError):
@@ -707,29 +719,36 @@ def check_network(net, opt):
             object_ids[oid] = r.id
     for r in roads.values():
         for sr in children(r.signals, "signalReference"):
+            refs.checked += 1
             if sr.get("id") not in signal_ids:
                 refs.fail(f"road {r.id}: signalReference to signal {sr.get('id')}, which does not exist")
         for sg in children(r.signals, "signal"):
             for dep in sg.findall("dependency"):
+                refs.checked += 1
                 if dep.get("id") not in signal_ids:
                     refs.fail(f"road {r.id} signal {sg.get('id')}: dependency on signal {dep.get('id')}, which does not exist")
             for ref in sg.findall("reference"):
+                refs.checked += 1
                 pool = signal_ids if ref.get("elementType") == "signal" else object_ids
                 if ref.get("elementId") not in pool:
                     refs.fail(f"road {r.id} signal {sg.get('id')}: reference to {ref.get('elementType')} "
                               f"{ref.get('elementId')}, which does not exist")
             for pr in sg.findall("positionRoad"):
+                refs.checked += 1
                 if pr.get("roadId") not in roads:
                     refs.fail(f"road {r.id} signal {sg.get('id')}: positionRoad on road {pr.get('roadId')}, which does not exist")
         for orf in children(r.objects, "objectReference"):
+            refs.checked += 1
             if orf.get("id") not in object_ids:
                 refs.fail(f"road {r.id}: objectReference to object {orf.get('id')}, which does not exist")
     for cid, cel in net.controllers.items():
         for ctl in cel.findall("control"):
+            refs.checked += 1
             if ctl.get("signalId") not in signal_ids:
                 refs.fail(f"controller {cid}: control of signal {ctl.get('signalId')}, which does not exist")
     for jid, jel in net.junctions.items():
         for jc in jel.findall("controller"):
+            refs.checked += 1
             if jc.get("id") not in net.controllers:
                 refs.fail(f"junction {jid}: controller {jc.get('id')} does not exist")
 
@@ -739,7 +758,7 @@ def check_network(net, opt):
         x, y, h, _ = road.ref(road.end_s(end))
         return (h if end == "end" else h + math.pi), x, y
 
-    def compare_lanes(label, ra, sa, seca, rb, sb, secb, pairs):
+    def compare_lanes(kind, label, ra, sa, seca, rb, sb, secb, pairs):
         pa, pb = ra.border_points(seca, sa), rb.border_points(secb, sb)
         for la, lb in sorted(pairs):
             if la not in pa or lb not in pb:
@@ -754,7 +773,7 @@ def check_network(net, opt):
             if gaps.worst_dz is None or worst_z > gaps.worst_dz[0]:
                 gaps.worst_dz = (worst_z, at)
             if worst_d > opt.max_gap or worst_z > opt.max_dz:
-                gaps.fail(f"{at}: plan {worst_d:.4f} m, height {worst_z:.4f} m")
+                gaps.fail(f"{at}: plan {worst_d:.4f} m, height {worst_z:.4f} m", kind)
 
     for c in contacts.values():
         a, ea, b, eb = c["a"], c["ea"], c["b"], c["eb"]
@@ -767,8 +786,8 @@ def check_network(net, opt):
         kinks.checked += 1
         kinks.value(jump, label)
         if jump > opt.max_kink_deg:
-            kinks.fail(f"{label}: {jump:.3f} deg")
-        compare_lanes(c["label"], a, a.end_s(ea), a.end_section(ea), b, b.end_s(eb), b.end_section(eb), c["pairs"])
+            kinks.fail(f"{label}: {jump:.3f} deg", c["kind"])
+        compare_lanes(c["kind"], c["label"], a, a.end_s(ea), a.end_section(ea), b, b.end_s(eb), b.end_section(eb), c["pairs"])
 
     # lane section boundaries inside a road
     for r in roads.values():
@@ -790,7 +809,7 @@ def check_network(net, opt):
                         refs.fail(f"road {r.id} laneSection {k + 1} lane {lane.id}: predecessor {t} is not in the previous laneSection")
                     elif (t, lane.id) not in pairs:
                         pairs.append((t, lane.id))
-            compare_lanes(f"road {r.id} laneSection {k}->{k + 1}", r, s1.s, s0, r, s1.s, s1, pairs)
+            compare_lanes("laneSection", f"road {r.id} laneSection {k}->{k + 1}", r, s1.s, s0, r, s1.s, s1, pairs)
 
     # -- folds
     for r in roads.values():
@@ -819,7 +838,8 @@ def check_network(net, opt):
                         bad[lid] = (v, s)
             folds.checked += len(samples)
             for lid, (v, s) in sorted(bad.items()):
-                folds.fail(f"road {r.id} laneSection {k} lane {lid}: 1-k*t={v:.3f} at s={s:.2f}")
+                folds.fail(f"road {r.id} laneSection {k} lane {lid}: 1-k*t={v:.3f} at s={s:.2f}",
+                           "road" if r.junction == "-1" else "connecting road")
 
     # -- unlinked driving lanes
     for r in roads.values():
@@ -844,10 +864,10 @@ def check_network(net, opt):
                     targets = lane.pred if lane_sec_end == "start" else lane.succ
                     if not targets:
                         unlinked.fail(f"{where}: no lane {'predecessor' if lane_sec_end == 'start' else 'successor'} "
-                                      f"on road {link['id']}")
+                                      f"on road {link['id']}", "road link")
                 elif link["type"] == "junction":
                     if link["id"] not in incoming_links.get((r.id, lane_sec_end, lane.id), set()):
-                        unlinked.fail(f"{where}: no laneLink from it in junction {link['id']}")
+                        unlinked.fail(f"{where}: no laneLink from it in junction {link['id']}", "junction")
         # lanes ending at a laneSection boundary inside the road
         for k in range(len(r.sections) - 1):
             s0, s1 = r.sections[k], r.sections[k + 1]
@@ -866,9 +886,8 @@ def check_network(net, opt):
                     if abs(bd[1] - bd[0]) < opt.taper_width:
                         continue
                     unlinked.fail(f"road {r.id} laneSection {k if toward_plus else k + 1} lane {lane.id}: "
-                                  f"no lane to continue into at s={s1.s:.2f}")
+                                  f"no lane to continue into at s={s1.s:.2f}", "laneSection")
 
-    refs.checked = refs.failures  # every reference is checked; failures are what counts
     return {c.name: c for c in (gaps, kinks, folds, unlinked, refs, planview)}
 
 
