@@ -55,7 +55,8 @@ def section(left=(), right=(), s=0.0):
 
 
 def road(rid, length, geoms, sections, pred=None, succ=None, junction="-1", elevation=None,
-         superelevation=None, offsets=None, rule="RHT"):
+         superelevation=None, offsets=None, rule="RHT", extra=""):
+    """extra: <objects>/<signals> XML after <lanes>."""
     """pred/succ: ("road", id, contactPoint) or ("junction", id)."""
     def link(tag, l):
         if l is None:
@@ -77,7 +78,7 @@ def road(rid, length, geoms, sections, pred=None, succ=None, junction="-1", elev
             for s, a, b, c, d in superelevation) + "</lateralProfile>"
     out += "<lanes>" + "".join(f'<laneOffset s="{s!r}" a="{a!r}" b="{b!r}" c="{c!r}" d="{d!r}"/>'
                                for s, a, b, c, d in (offsets or []))
-    out += "".join(sections) + "</lanes></road>\n"
+    out += "".join(sections) + "</lanes>" + extra + "</road>\n"
     return out
 
 
@@ -101,13 +102,22 @@ def arc_network(shift3=0.0, dz3=0.0, succ1=-1, succ2=-1, hdg3=0.0):
              pred=("road", 2, "end"), elevation=[(0.0, z2 + dz3, 0.02, 0.0, 0.0)]))
 
 
-def t_junction(incoming_a="1"):
+SIGNALS = ('<objects><object id="o1" s="45.0" t="-4.0" zOffset="0" type="pole" height="3"/></objects>'
+           '<signals><signal id="s1" s="49.0" t="-3.5" zOffset="2" dynamic="yes" orientation="+" country="DE" '
+           'type="1000001" subtype="-1"><validity fromLane="-1" toLane="-1"/></signal>'
+           '<signal id="s2" s="40.0" t="-3.5" zOffset="2" dynamic="no" orientation="+" country="DE" '
+           'type="205" subtype="-1"/></signals>')
+
+
+def t_junction(incoming_a="1", signals=SIGNALS):
     """Arms 1 (west, ends at the junction), 2 (east) and 3 (south), both starting
     at it; six connecting roads (100..105) of one right lane each, 3 m lanes,
-    turns of radius 10 m."""
+    turns of radius 10 m; arm 1 carries a traffic light (controlled by c1), a
+    sign and a pole."""
     w = 3.0
     arms = (
-        road(1, 50.0, [geom(-60.0, 0.0, 0.0, 50.0)], [section([lane(1, w)], [lane(-1, w)])], succ=("junction", 9)) +
+        road(1, 50.0, [geom(-60.0, 0.0, 0.0, 50.0)], [section([lane(1, w)], [lane(-1, w)])], succ=("junction", 9),
+             extra=signals) +
         road(2, 50.0, [geom(10.0, 0.0, 0.0, 50.0)], [section([lane(1, w)], [lane(-1, w)])], pred=("junction", 9)) +
         road(3, 50.0, [geom(0.0, -10.0, -0.5 * math.pi, 50.0)], [section([lane(1, w)], [lane(-1, w)])],
              pred=("junction", 9)))
@@ -121,7 +131,7 @@ def t_junction(incoming_a="1"):
         (104, 2, "start", 1, 10.0, 0.0, math.pi, quarter, 0.1, 3, "start", -1),
         (105, 3, "start", 1, 0.0, -10.0, 0.5 * math.pi, quarter, -0.1, 2, "start", -1),
     ]
-    body, junction = "", '<junction id="9" name="T">'
+    body, junction = "", '<controller id="c1"><control signalId="s1"/></controller>\n<junction id="9" name="T">'
     for i, (rid, fr, fe, fl, x, y, h, length, k, to, te, tl) in enumerate(conns):
         kind = "<line/>" if k == 0 else f'<arc curvature="{k!r}"/>'
         body += road(rid, length, [geom(x, y, h, length, kind)],
@@ -130,7 +140,7 @@ def t_junction(incoming_a="1"):
         inc = incoming_a if rid == 100 else str(fr)
         junction += (f'<connection id="{i}" incomingRoad="{inc}" connectingRoad="{rid}" contactPoint="start">'
                      f'<laneLink from="{fl}" to="-1"/></connection>')
-    return doc(arms + body + junction + "</junction>\n")
+    return doc(arms + body + junction + '<controller id="c1"/></junction>\n')
 
 
 def check(text, **kw):
@@ -266,6 +276,8 @@ class CorrectNetworksTest(unittest.TestCase):
         self.assertEqual((n["roads"], n["connecting_roads"], n["junctions"], n["driving_lanes"],
                           n["connecting_driving_lanes"]), (3, 6, 1, 6, 6))
         self.assertEqual(n["geometries"]["arc"], 4)
+        self.assertEqual((n["signals"], n["signals_dynamic"], n["signals_static"], n["controllers"]), (2, 1, 1, 1))
+        self.assertEqual(n["objects_by_type"], {"pole": 1})
 
     def test_correct_networks_are_schema_valid(self):
         xsd = xsd_path()
@@ -404,10 +416,67 @@ class BrokenFilesTest(unittest.TestCase):
         self.assertTrue(any("does not link back" in o for o in c["references"].offenders))
 
     def test_controller_of_a_missing_signal(self):
-        text = t_junction().replace("<junction ", '<controller id="c1"><control signalId="s9"/></controller>\n<junction ')
+        text = t_junction().replace('<control signalId="s1"/>', '<control signalId="s9"/>')
         c = check(text)
         self.assertEqual(failing(c), ["references"])
         self.assertIn("signal s9", c["references"].offenders[0])
+
+
+    def test_signal_off_its_road_and_validity_of_a_missing_lane(self):
+        for bad, words in (('s="49.0"', 's="51.0"'), ('toLane="-1"', 'toLane="-4"')):
+            c = check(t_junction().replace(*((bad, words))))
+            self.assertEqual(failing(c), ["references"], words)
+            self.assertIn("s1", c["references"].offenders[0])
+
+    def test_connecting_road_not_linked_to_its_incoming_road(self):
+        text = t_junction().replace('<predecessor elementType="road" elementId="2" contactPoint="start"/>'
+                                    '<successor elementType="road" elementId="1"',
+                                    '<predecessor elementType="road" elementId="3" contactPoint="start"/>'
+                                    '<successor elementType="road" elementId="1"')
+        c = check(text)
+        self.assertIn("references", failing(c))
+        self.assertTrue(any("does not link to incomingRoad 2" in o for o in c["references"].offenders))
+
+
+class GeometryJoinsTest(unittest.TestCase):
+    """A road of line + arc + line (a rounded corner) as one reference line."""
+    R, L1 = 20.0, 30.0
+
+    def corner(self, arc_hdg=0.0, arc_dx=0.0, line2_s=None, length=None):
+        R, L1 = self.R, self.L1
+        La = 0.5 * math.pi * R
+        g = [geom(0.0, 0.0, 0.0, L1),
+             geom(L1 + arc_dx, 0.0, arc_hdg, La, f'<arc curvature="{1 / R!r}"/>', s=L1),
+             geom(L1 + R, R, 0.5 * math.pi, 25.0, s=L1 + La if line2_s is None else line2_s)]
+        total = L1 + La + 25.0 if length is None else length
+        return doc(road(1, total, g, [section([lane(1)], [lane(-1)])]))
+
+    def test_rounded_corner_passes(self):
+        c = check(self.corner())
+        self.assertEqual(failing(c), [])
+        self.assertEqual(c["kinks"].checked, 2)
+        r = xc.load_text(self.corner()).roads["1"]
+        x, y, h, k = r.ref(self.L1 + 0.5 * math.pi * self.R + 10.0)
+        self.assertAlmostEqual(x, self.L1 + self.R, places=9)
+        self.assertAlmostEqual(y, self.R + 10.0, places=9)
+        self.assertAlmostEqual(h, 0.5 * math.pi, places=12)
+
+    def test_heading_jump_between_geometries(self):
+        # the arc turned by 1 degree: its start and its end meet the lines at 1 degree
+        c = check(self.corner(arc_hdg=math.radians(1.0)))
+        self.assertIn("kinks", failing(c))
+        self.assertEqual(c["kinks"].by_kind, {"geometry": 2})
+        self.assertAlmostEqual(c["kinks"].worst, 1.0, places=9)
+
+    def test_position_jump_between_geometries(self):
+        c = check(self.corner(arc_dx=0.05))
+        self.assertEqual(failing(c), ["gaps"])
+        self.assertEqual(c["gaps"].by_kind, {"geometry": 2})
+
+    def test_planview_lengths(self):
+        self.assertEqual(failing(check(self.corner(length=80.0))), ["planview"])
+        c = check(self.corner(line2_s=self.L1 + 0.5 * math.pi * self.R + 0.1))
+        self.assertIn("planview", failing(c))
 
 
 class CommandLineTest(unittest.TestCase):

@@ -674,6 +674,10 @@ def check_network(net, opt):
                 refs.fail(f"{where}: contactPoint=\"{cp}\" is not start or end")
             if I is None or C is None or cp not in ("start", "end"):
                 continue
+            back = C.link_at(cp)
+            refs.checked += 1
+            if back is None or back["type"] != "road" or back["id"] != I.id:
+                refs.fail(f"{where}: connectingRoad {C.id} does not link to incomingRoad {I.id} at its {cp}")
             ends = [e for e in ("start", "end")
                     if (I.link_at(e) or {}).get("type") == "junction" and I.link_at(e)["id"] == jid]
             if not ends:
@@ -718,6 +722,29 @@ def check_network(net, opt):
                 refs.fail(f"road {r.id}: object id {oid} appears twice")
             object_ids[oid] = r.id
     for r in roads.values():
+        for kind, parent, tags in (("signal", r.signals, ("signal", "signalReference")),
+                                   ("object", r.objects, ("object", "objectReference", "tunnel", "bridge"))):
+            for tag in tags:
+                for el in children(parent, tag):
+                    refs.checked += 1
+                    try:
+                        s_el = float(el.get("s", "nan"))
+                    except ValueError:
+                        s_el = float("nan")
+                    if not (-1e-6 <= s_el <= r.length + 1e-6):
+                        refs.fail(f"road {r.id} {tag} {el.get('id')}: s=\"{el.get('s')}\" is not in [0, {r.length:.3f}]")
+                        continue
+                    for v in el.findall("validity"):
+                        sec = r.sections[r.section_index(s_el)]
+                        for att in ("fromLane", "toLane"):
+                            refs.checked += 1
+                            try:
+                                ok = int(v.get(att)) in sec.lanes
+                            except (TypeError, ValueError):
+                                ok = False
+                            if not ok:
+                                refs.fail(f"road {r.id} {tag} {el.get('id')}: validity {att}=\"{v.get(att)}\" "
+                                          f"is not a lane at s={s_el:.2f}")
         for sr in children(r.signals, "signalReference"):
             refs.checked += 1
             if sr.get("id") not in signal_ids:
