@@ -387,6 +387,23 @@ class BrokenFilesTest(unittest.TestCase):
         self.assertEqual(failing(c), ["unlinked"])
         self.assertIn("road 1 lane -2", c["unlinked"].offenders[0])
 
+    def test_lane_ending_between_lane_sections(self):
+        # lane -2 ends where the second laneSection starts: a cubic taper to zero width is fine
+        def road_with(widths):
+            return doc(road(1, 40.0, [geom(0.0, 0.0, 0.0, 40.0)],
+                            [section(right=[lane(-1), lane(-2, widths=widths)]),
+                             section(right=[lane(-1)], s=20.0)]))
+        # 3.5 m to 0 over 20 m with zero slope at both ends: 3.5 - 3*3.5/400 ds^2 + 2*3.5/8000 ds^3
+        taper = [(0.0, 3.5, 0.0, -3 * 3.5 / 400, 2 * 3.5 / 8000)]
+        c = check(road_with(taper))
+        self.assertEqual(failing(c), [])
+        self.assertEqual(c["gaps"].checked, 1)  # lane -1 across the boundary
+        r = xc.load_text(road_with(taper)).roads["1"]
+        self.assertAlmostEqual(r.borders(r.sections[0], 10.0)[-2][1], -3.5 - 1.75, places=9)
+        c = check(road_with([(0.0, 3.5, 0.0, 0.0, 0.0)]))
+        self.assertEqual(failing(c), ["unlinked"])
+        self.assertEqual(c["unlinked"].by_kind, {"laneSection": 1})
+
     def test_left_hand_traffic_swaps_directions(self):
         # right lanes without successors: fine under LHT (they run toward -s), not under RHT
         def two(rule):

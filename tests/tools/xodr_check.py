@@ -300,7 +300,6 @@ class Lane:
         self.type = el.get("type", "none")
         self.level = el.get("level", "false") in ("true", "1")
         link = el.find("link")
-        self.has_link = link is not None
         self.pred = [where.attr(p, "id", kind=int) for p in children(link, "predecessor")]
         self.succ = [where.attr(p, "id", kind=int) for p in children(link, "successor")]
         self.widths = sorted(((where.attr(w, "sOffset"), where.attr(w, "a"), where.attr(w, "b"),
@@ -824,7 +823,7 @@ def check_network(net, opt):
             for lane in s0.lanes.values():
                 if lane.id == 0:
                     continue
-                targets = lane.succ if lane.succ else ([] if lane.has_link and lane.pred else [lane.id])
+                targets = lane.succ or [lane.id]  # an omitted successor continues the same id
                 for t in targets:
                     if t in s1.lanes:
                         pairs.append((lane.id, t))
@@ -905,8 +904,7 @@ def check_network(net, opt):
                     if ((lane.id < 0) == (r.rule == "RHT")) != toward_plus:
                         continue
                     unlinked.checked += 1
-                    targets = (lane.succ if toward_plus else lane.pred) or \
-                        ([] if lane.has_link and (lane.pred if toward_plus else lane.succ) else [lane.id])
+                    targets = (lane.succ if toward_plus else lane.pred) or [lane.id]
                     if any(t in b.lanes for t in targets):
                         continue
                     bd = r.borders(a, s1.s)[lane.id]
