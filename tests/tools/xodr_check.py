@@ -1020,7 +1020,11 @@ def summary(res):
             extra = f", smallest 1-k*t {ch['worst'] if ch['worst'] is not None else 1:.4f} (must stay > 0)"
         elif name == "planview":
             extra = f", worst {ch['worst'] or 0:.5f} m (limit {ch['limit']})"
+        if ch.get("failures_by_kind"):
+            extra += "; by kind: " + ", ".join(f"{k} {v}" for k, v in sorted(ch["failures_by_kind"].items()))
         out.append(f"  {state} {name}: {ch['failures']} failures of {ch['checked']} checked{extra}")
+        if ch.get("worst_at") and not ch["pass"]:
+            out.append(f"         worst at {ch['worst_at']}")
         for o in ch["offenders"]:
             out.append(f"         {o}")
     out.append("PASS" if res["pass"] else "FAIL")
