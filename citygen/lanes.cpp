@@ -279,7 +279,7 @@ LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const s
         w = std::max(w, t);
     };
     // Turn plans per junction: the straight exit takes every lane, right
-    // turns the outermost, left turns the innermost; lanes no exit takes
+    // turns the outermost lane, left turns the innermost; lanes no exit takes
     // join the nearest turn.
     std::vector<std::vector<TurnPlan>> plans(m.junctions.size());
     for (size_t j = 0; j < m.junctions.size(); ++j) {
@@ -302,10 +302,10 @@ LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const s
                 if (std::abs(t.angle) > kMaxTurn) continue;
                 if (t.angle < -kStraightTurn) {
                     t.turn = LinkRoad::Turn::Right;
-                    t.i0 = std::max(1, nIn - nOut + 1), t.i1 = nIn, t.shift = nIn - nOut;
+                    t.i0 = t.i1 = nIn, t.shift = nIn - nOut;
                 } else if (t.angle > kStraightTurn) {
                     t.turn = LinkRoad::Turn::Left;
-                    t.i0 = 1, t.i1 = std::min(nIn, nOut);
+                    t.i0 = t.i1 = 1;
                 } else {
                     t.i0 = 1, t.i1 = nIn, t.appear = std::max(0, nOut - nIn);
                 }
@@ -384,7 +384,8 @@ LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const s
         bool taper = std::abs(r.offset0 - r.offset1) > 1e-9;
         for (const auto* side : {&r.right, &r.left})
             for (const LinkRoad::Lane& l : *side) taper = taper || std::abs(l.w0 - l.w1) > 1e-9;
-        const double need = std::max(filletTrim(r.angle, turnSideExtent(r)), taper ? 0.5 * kTaperLength : 0.0);
+        const double need = std::max({filletTrim(r.angle, turnSideExtent(r)), taper ? 0.5 * kTaperLength : 0.0,
+                                      0.5 * kMinLinkLength});
         want(inE, v, need);
         want(outE, v, need);
         transitions.push_back(std::move(r));
@@ -450,6 +451,36 @@ LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const s
         (g.edges[r.out].a == r.node ? m.edges[r.out].linkA : m.edges[r.out].linkB) = idx;
         m.links.push_back(std::move(r));
     }
+    // Signals at junction ends (SignalPlacement).
+    for (size_t e = 0; e < g.edges.size(); ++e) {
+        const EdgeLanes& L = m.edges[e];
+        if (!L.valid) continue;
+        for (int atB = 0; atB < 2; ++atB) {
+            const int j = atB ? L.junctionB : L.junctionA;
+            const int lanes = atB ? L.right : L.left;
+            if (j < 0 || lanes < 1 || m.junctions[size_t(j)].links.empty()) continue;
+            const Junction& J = m.junctions[size_t(j)];
+            int major = 0;
+            for (uint32_t a : J.arms) major += g.edges[a].cls != RoadClass::Local;
+            SignalPlacement sp;
+            if (major >= 3) sp.kind = SignalPlacement::Kind::TrafficLight;
+            else if (major >= 1 && g.edges[e].cls == RoadClass::Local)
+                sp.kind = J.arms.size() >= 4 ? SignalPlacement::Kind::Stop : SignalPlacement::Kind::Yield;
+            else continue;
+            const int side = atB ? -1 : 1;
+            sp.edge = uint32_t(e);
+            sp.atB = atB != 0;
+            sp.junction = j;
+            sp.lanes = lanes;
+            sp.t = L.offset + side * lanes * L.laneWidth + side * (L.hasWalk(side) ? 0.5 * L.sidewalk : 0.5);
+            sp.s = atB ? std::max(0.0, L.length - kStopSetback) : std::min(L.length, kStopSetback);
+            sp.position = L.start + L.dir * sp.s + L.normal() * sp.t;
+            sp.facing = atB ? -L.dir : L.dir;
+            m.signals.push_back(sp);
+        }
+    }
+    m.nodeLinks.assign(N, {});
+    for (size_t k = 0; k < m.links.size(); ++k) m.nodeLinks[m.links[k].node].push_back(uint32_t(k));
     return m;
 }
 

@@ -43,10 +43,12 @@
 //   the values of the road it leaves to those of the road it enters along a
 //   smoothstep (zero slope at both ends), so linked lane borders meet. A lane
 //   that exists on one side only appears or ends with width 0 there.
-// - Turning lanes at junctions (right-hand traffic): a straight exit takes
-//   every incoming lane (extra lanes taper), a right turn the outermost
-//   min(in, out) lanes, a left turn the innermost; an incoming lane that no
-//   exit would take joins the nearest turn (and tapers out).
+// - Turning lanes at junctions (right-hand traffic): a straight exit (turn
+//   within 35 degrees) takes every incoming lane (extra lanes taper in or
+//   out), a right turn the outermost lane into the outermost lane, a left
+//   turn the innermost into the innermost; an incoming lane that no exit
+//   would take joins the nearest turn (and tapers out where the exit has
+//   fewer lanes).
 // Edges with invalid node indices, non-finite coordinates or zero length are
 // kept with `valid = false` (no lanes written or drawn). Deterministic; pure.
 #pragma once
@@ -63,6 +65,7 @@ constexpr double kMinRoadLength = 1.0;      // shortest trimmed reference line
 constexpr double kMaxTurn = 2.356194490192345;  // 135 degrees: sharper turns get no link road
 constexpr double kCurvatureMargin = 0.3;    // lane borders stay this far from a turn's centre of curvature
 constexpr double kTaperLength = 12.0;       // transition length where lane counts or widths change
+constexpr double kMinLinkLength = 1.0;      // shortest transition (straight on, same lanes)
 
 // Carriageway width the road mesh draws for an edge.
 double carriagewayWidth(const StreetEdge& e);
@@ -140,12 +143,33 @@ struct LinkRoad {
     double leftBorder(double s) const;
 };
 
+// A traffic light or sign at a junction end of a street road, facing the
+// traffic that arrives there. Junctions where three or more arms are
+// highways or arterials get traffic lights on every approach; junctions with
+// at least one such arm get stop signs (4+ arms) or yield signs (3 arms) on
+// their local approaches; junctions of local streets get none (priority to
+// the right). The pole stands on the sidewalk (or 0.5 m past the
+// carriageway without one) by the stop line, on the right of the traffic.
+struct SignalPlacement {
+    enum class Kind : uint8_t { TrafficLight, Stop, Yield };
+    Kind kind = Kind::TrafficLight;
+    uint32_t edge = 0;         // street road it stands on
+    bool atB = true;           // at the road's end b (faces traffic a -> b) or its start a
+    int junction = -1;         // index into LaneModel::junctions
+    int lanes = 0;             // incoming lanes it controls: ids -1..-lanes (atB) or 1..lanes
+    double s = 0, t = 0;       // road frame: s along the trimmed reference line from start, t left positive
+    glm::dvec2 position{0.0};  // city frame
+    glm::dvec2 facing{0.0};    // unit: toward the traffic it controls
+};
+
 struct LaneModel {
     std::vector<EdgeLanes> edges;      // one per street edge
     std::vector<Junction> junctions;   // nodes of degree >= 3, by node index
     std::vector<int> nodeJunction;     // per node: junction index or -1
     std::vector<int> degree;           // per node
     std::vector<LinkRoad> links;       // junctions' connecting roads, then transitions, by node index
+    std::vector<std::vector<uint32_t>> nodeLinks;  // per node: its link roads
+    std::vector<SignalPlacement> signals;          // by edge, start before end
     size_t sharpCorners = 0;           // degree-2 nodes left unlinked: too sharp for the lanes
     size_t droppedTurns = 0;           // junction turns within kMaxTurn whose trims did not fit the edges
     size_t unlinkedLanes = 0;          // incoming driving lanes at a junction that no turn takes

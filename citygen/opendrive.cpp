@@ -26,8 +26,10 @@ std::string num(double v) {
     return buf;
 }
 
-std::string str(size_t v) { return std::to_string(v); }
-std::string str(int v) { return std::to_string(v); }
+template <class T>
+std::string str(T v) {
+    return std::to_string(v);
+}
 
 // Height, slope (along the edge's a -> b direction) and superelevation of a
 // street road at one of its ends.
@@ -67,15 +69,13 @@ private:
     size_t junctionId(size_t j) const { return g.edges.size() + j; }
     // Lane of the transition at the edge's end (atB) or start that links lane `id` of edge e (0: none).
     int transitionLane(uint32_t e, bool atB, int id) const;
-    // Traffic control of a junction: 2 traffic lights, 1 stop/yield signs on minor approaches, 0 none.
-    int control(const Junction& J) const;
 
     const StreetGraph& g;
     const CityParams& P;
     LaneModel M;
     std::string o;
     OpenDriveCounts n;
-    size_t nextSignal = 0, nextObject = 0;
+    size_t nextSignal = 0, nextObject = 0, nextPlacement = 0;
     // Signals per junction and approach group (controllers of signalised junctions).
     struct Group {
         size_t junction;
@@ -206,65 +206,43 @@ void Writer::laneSide(uint32_t e, bool left) {
     (void)E;
 }
 
-int Writer::control(const Junction& J) const {
-    int major = 0;
-    for (uint32_t e : J.arms) major += g.edges[e].cls != RoadClass::Local;
-    return major >= 3 ? 2 : major >= 1 ? 1 : 0;
-}
 
-// Signals at the junction ends of a street road, facing the traffic that
-// arrives there: traffic lights at signalised junctions, stop (4+ arms) or
-// yield (3 arms) signs on the minor approaches of junctions with a major road.
+// The lane model's signals on a street road (SignalPlacement), with a
+// controller per approach group at signalised junctions.
 void Writer::signals(uint32_t e) {
-    const EdgeLanes& L = M.edges[e];
-    const StreetEdge& E = g.edges[e];
     std::string xml;
-    for (int atB = 0; atB < 2; ++atB) {
-        const int j = atB ? L.junctionB : L.junctionA;
-        if (j < 0) continue;
-        const Junction& J = M.junctions[size_t(j)];
-        const int lanes = atB ? L.right : L.left;
-        if (lanes < 1) continue;
-        const int ctl = control(J);
-        const bool minor = E.cls == RoadClass::Local;
-        if (ctl == 0 || (ctl == 1 && !minor)) continue;
-        const int side = atB ? -1 : 1;
-        const double border = L.offset + side * lanes * L.laneWidth;
-        const double t = border + side * (L.hasWalk(side) ? 0.5 * L.sidewalk : 0.5);
-        const double s = atB ? std::max(0.0, L.length - kStopSetback) : std::min(L.length, kStopSetback);
+    for (; nextPlacement < M.signals.size() && M.signals[nextPlacement].edge == e; ++nextPlacement) {
+        const SignalPlacement& sp = M.signals[nextPlacement];
         const size_t id = nextSignal++;
-        const bool light = ctl == 2;
-        const char* type = light ? "1000001" : J.arms.size() >= 4 ? "206" : "205";
-        const char* name = light ? "traffic light" : J.arms.size() >= 4 ? "stop" : "yield";
-        xml += "      <signal s=\"" + num(s) + "\" t=\"" + num(t) + "\" id=\"" + str(id) + "\" name=\"" + name +
-               "\" dynamic=\"" + (light ? "yes" : "no") + "\" orientation=\"" + (atB ? "+" : "-") + "\" zOffset=\"" +
+        const bool light = sp.kind == SignalPlacement::Kind::TrafficLight;
+        const char* type = light ? "1000001" : sp.kind == SignalPlacement::Kind::Stop ? "206" : "205";
+        const char* name = light ? "traffic light" : sp.kind == SignalPlacement::Kind::Stop ? "stop" : "yield";
+        xml += "      <signal s=\"" + num(sp.s) + "\" t=\"" + num(sp.t) + "\" id=\"" + str(id) + "\" name=\"" + name +
+               "\" dynamic=\"" + (light ? "yes" : "no") + "\" orientation=\"" + (sp.atB ? "+" : "-") + "\" zOffset=\"" +
                (light ? "2.5" : "1.8") + "\" country=\"DE\" type=\"" + type + "\" subtype=\"-1\" height=\"" +
                (light ? "0.9" : "0.75") + "\" width=\"" + (light ? "0.3" : "0.75") + "\">\n";
-        xml += "        <validity fromLane=\"" + str(atB ? -1 : 1) + "\" toLane=\"" + str(atB ? -lanes : lanes) + "\"/>\n";
-        xml += "      </signal>\n";
-        if (light) {
-            ++n.trafficLights;
-            // Approach groups: arms within 45 degrees of opposite share a phase.
-            const glm::dvec2 d = atB ? L.dir : -L.dir;
-            auto& gs = junctionGroups[size_t(j)];
-            const double a = std::atan2(d.y, d.x);
-            const double axis = std::fmod(a + 2 * kPi, kPi);  // direction modulo pi
-            size_t best = gs.size();
-            for (size_t x = 0; x < gs.size(); ++x) {
-                double da = std::abs(groupAxis[gs[x]] - axis);
-                da = std::min(da, kPi - da);
-                if (da < 0.25 * kPi) best = x;
-            }
-            if (best == gs.size()) {
-                gs.push_back(groups.size());
-                groups.push_back({size_t(j), {}});
-                groupAxis.push_back(axis);
-                best = gs.size() - 1;
-            }
-            groups[gs[best]].signals.push_back(id);
-        } else {
+        xml += "        <validity fromLane=\"" + str(sp.atB ? -1 : 1) + "\" toLane=\"" + str(sp.atB ? -sp.lanes : sp.lanes) +
+               "\"/>\n      </signal>\n";
+        if (!light) {
             ++n.signs;
+            continue;
         }
+        ++n.trafficLights;
+        // Approach groups: arms within 45 degrees of opposite share a phase.
+        auto& gs = junctionGroups[size_t(sp.junction)];
+        const glm::dvec2 d = -sp.facing;
+        const double axis = std::fmod(std::atan2(d.y, d.x) + 2 * kPi, kPi);  // direction modulo pi
+        size_t best = gs.size();
+        for (size_t x = 0; x < gs.size(); ++x) {
+            double da = std::abs(groupAxis[gs[x]] - axis);
+            if (std::min(da, kPi - da) < 0.25 * kPi) best = x;
+        }
+        if (best == gs.size()) {
+            gs.push_back(groups.size());
+            groups.push_back({size_t(sp.junction), {}});
+            groupAxis.push_back(axis);
+        }
+        groups[gs[best]].signals.push_back(id);
     }
     if (!xml.empty()) o += "    <signals>\n" + xml + "    </signals>\n";
 }
@@ -282,7 +260,7 @@ void Writer::objects(uint32_t e) {
         xml += "      <object type=\"crosswalk\" name=\"zebra crossing\" id=\"" + str(nextObject++) + "\" s=\"" + num(anchor) +
                "\" t=\"0\" zOffset=\"0\" hdg=\"0\" pitch=\"0\" roll=\"0\" orientation=\"none\" length=\"" + num(u1 - u0) +
                "\" width=\"" + num(2 * hw) + "\" height=\"0\">\n        <outlines>\n          <outline id=\"0\" "
-               "fillType=\"paint\" outer=\"true\" closed=\"true\" laneType=\"driving\">\n";
+               "outer=\"true\" closed=\"true\" laneType=\"driving\">\n";
         for (auto [u, v] : {std::pair{u0, -hw}, {u1, -hw}, {u1, hw}, {u0, hw}})
             xml += "            <cornerLocal u=\"" + num(u) + "\" v=\"" + num(v) + "\" z=\"0\" height=\"0\"/>\n";
         xml += "          </outline>\n        </outlines>\n      </object>\n";

@@ -347,6 +347,7 @@ void SurfaceContext::roads() {
     // the ground under rounded sidewalk corners). Dead ends get a round cap.
     const double sw = std::max(0.0, P.sidewalk_m);
     std::sort(nodeEdges.begin(), nodeEdges.end());
+
     struct Arm { double angle; glm::dvec2 d; double hw; };
     std::vector<Arm> arms;
     for (size_t i = 0; i < nodeEdges.size();) {
@@ -391,6 +392,24 @@ void SurfaceContext::roads() {
                 double t = (rhs.x * b.d.y - rhs.y * b.d.x) / den;
                 glm::dvec2 q = c + na * a.hw + a.d * t;
                 if (glm::length(q - c) <= r + sw + 1e-9) pts.push_back(q);
+            }
+        }
+        // The carriageway of the lane model's link roads at this node (junction
+        // turns, degree-2 transitions): samples of their outer driving-lane borders.
+        if (lanes && node < lanes->nodeLinks.size()) {
+            for (uint32_t k : lanes->nodeLinks[node]) {
+                const LinkRoad& r = lanes->links[k];
+                const double len = r.length();
+                const int steps = std::max(2, int(std::ceil(len / 1.0)));
+                for (int q = 0; q <= steps; ++q) {
+                    const double u = len * q / steps, h = r.heading(u);
+                    double tl = r.laneOffset(u), tr = tl;
+                    for (const LinkRoad::Lane& l : r.left) tl += l.sidewalk ? 0.0 : r.width(l, u);
+                    for (const LinkRoad::Lane& l : r.right) tr -= l.sidewalk ? 0.0 : r.width(l, u);
+                    const glm::dvec2 c0 = r.point(u), nl(-std::sin(h), std::cos(h));
+                    pts.push_back(c0 + nl * tl);
+                    pts.push_back(c0 + nl * tr);
+                }
             }
         }
         Polygon2 hull = convexHull(pts, 1e-12);
