@@ -53,6 +53,8 @@ constexpr size_t kSimplifyChunk = 1024;           // Douglas-Peucker works on ru
 constexpr size_t kMaxSelfConflicts = 16;          // a way crossing itself more often is dropped
 constexpr size_t kMaxConflicts = 100000;          // more crossings in all is refused
 constexpr size_t kMaxXmlBytes = size_t(4) << 30;  // decompressed XML read into memory
+constexpr double kAlongCos = 0.7;                 // a way within 45 degrees of an edge runs along it
+constexpr double kParallelCos = 0.95;             // opposite one-ways merged into an edge: within 18 degrees of it
 
 // ---- XML pre-scan ---------------------------------------------------------
 
@@ -444,9 +446,10 @@ StreetGraph segmentGraph(const std::vector<Way>& ways, size_t first, size_t last
 // and 3/4 of the edge (the largest of the three distances, at most `tol`: planarization moves
 // nodes by up to the snap radius and merges ends closer than the minimum segment). The way's
 // segment nearest to the edge's midpoint gives the direction: tags are swapped for an edge
-// running against the way. When that way is one-way and another way of the class within
-// `mergeTol` is one-way the other way round (a dual carriageway merged into one edge), each
-// gives its direction.
+// running against the way; ways whose segment there lies within 45 degrees of the edge come
+// before crossing ones. When that way is one-way and another way of the class within
+// `mergeTol` is one-way the other way round, both within 18 degrees of the edge (a dual
+// carriageway merged into one edge), each gives its direction.
 void assignRoadTags(StreetGraph& g, const std::vector<Way>& ways, const std::vector<OsmRoadTags>& tags, double tol,
                     double mergeTol, OsmRoadTagStats& st) {
     struct Seg { glm::dvec2 p, q; uint32_t way; };
@@ -498,7 +501,19 @@ void assignRoadTags(StreetGraph& g, const std::vector<Way>& ways, const std::vec
                 }
             }
         }
-        auto better = [](const Cand& x, const Cand& y) { return x.score() < y.score() || (x.score() == y.score() && x.way < y.way); };
+        // |cos| of the angle between the edge and the way's segment at the midpoint.
+        const glm::dvec2 dir = glm::normalize(b - a);
+        auto alignment = [&](const Cand& c) {
+            const glm::dvec2 sd = segs[c.midSeg].q - segs[c.midSeg].p;
+            const double len = glm::length(sd);
+            return len > 0 ? std::abs(glm::dot(dir, sd / len)) : 0.0;
+        };
+        // Ways along the edge before crossing ones (near a junction a short edge is close to both).
+        auto better = [&](const Cand& x, const Cand& y) {
+            const bool ax = alignment(x) >= kAlongCos, ay = alignment(y) >= kAlongCos;
+            if (ax != ay) return ax;
+            return x.score() < y.score() || (x.score() == y.score() && x.way < y.way);
+        };
         const Cand* best = nullptr;
         for (const auto& c : cands)
             if (c.score() <= tol && (!best || better(c, *best))) best = &c;
@@ -510,11 +525,11 @@ void assignRoadTags(StreetGraph& g, const std::vector<Way>& ways, const std::vec
             return glm::dot(b - a, s.q - s.p) >= 0 ? t : t.reversed();
         };
         OsmRoadTags t = oriented(*best);
-        if (t.onlyForward() || t.onlyBackward()) {
+        if ((t.onlyForward() || t.onlyBackward()) && alignment(*best) >= kParallelCos) {
             const Cand* other = nullptr;
             OsmRoadTags u;
             for (const auto& c : cands) {
-                if (&c == best || c.score() > mergeTol || (other && !better(c, *other))) continue;
+                if (&c == best || c.score() > mergeTol || alignment(c) < kParallelCos || (other && !better(c, *other))) continue;
                 OsmRoadTags o = oriented(c);
                 if (t.onlyForward() ? o.onlyBackward() : o.onlyForward()) { other = &c; u = std::move(o); }
             }

@@ -315,24 +315,42 @@ TEST(OsmRoadTags, StatsReportTagUseAndFallbacks) {
     EXPECT_FALSE(nlohmann::json::parse(test::readBytes(dir.file("g.json"))).contains("osm_roads"));
 }
 
+namespace {
+
+// An .osm text: nodes 1..n at `pts` (metres about 48.21 N, 16.36 E), then ways of node ids and
+// their tags as written XML ("<tag .../>...").
+std::string osmText(const std::vector<glm::dvec2>& pts, const std::vector<std::pair<std::vector<int>, std::string>>& ways) {
+    const double lat0 = 48.21, mLat = 1.0 / 111132.0, mLon = 1.0 / (111320.0 * std::cos(lat0 * 3.14159265358979 / 180));
+    std::string xml = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<osm version=\"0.6\" generator=\"vista-test\">\n";
+    for (size_t i = 0; i < pts.size(); ++i) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "  <node id=\"%zu\" lat=\"%.7f\" lon=\"%.7f\"/>\n", i + 1, lat0 + pts[i].y * mLat,
+                      16.36 + pts[i].x * mLon);
+        xml += buf;
+    }
+    for (size_t w = 0; w < ways.size(); ++w) {
+        xml += "  <way id=\"" + std::to_string(w + 1) + "\">";
+        for (int r : ways[w].first) xml += "<nd ref=\"" + std::to_string(r) + "\"/>";
+        xml += ways[w].second + "</way>\n";
+    }
+    return xml + "</osm>\n";
+}
+
+Result<OsmImport> importText(const std::string& xml) {
+    test::TempDir dir("vista_osm_road_tags");
+    std::ofstream(dir.file("t.osm"), std::ios::binary) << xml;
+    return importOsm(dir.file("t.osm"), CityParams());
+}
+
+}  // namespace
+
 TEST(OsmRoadTags, OppositeOneWaysMergedIntoOneEdgeGiveOneDirectionEach) {
     // A dual carriageway 8 m wide: two one-way ways sharing their end nodes, closer than the snap
     // radius, so planarization merges them into single edges.
-    const double lat0 = 48.21, mLat = 1.0 / 111132.0, mLon = 1.0 / (111320.0 * std::cos(lat0 * 3.14159265358979 / 180));
-    std::string xml = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<osm version=\"0.6\" generator=\"vista-test\">\n";
-    const double pts[][2] = {{-200, 0}, {-100, 4}, {100, 4}, {200, 0}, {100, -4}, {-100, -4}};
-    for (int i = 0; i < 6; ++i) {
-        char buf[160];
-        std::snprintf(buf, sizeof buf, "  <node id=\"%d\" lat=\"%.7f\" lon=\"%.7f\"/>\n", i + 1, lat0 + pts[i][1] * mLat, 16.36 + pts[i][0] * mLon);
-        xml += buf;
-    }
-    xml += "  <way id=\"1\"><nd ref=\"1\"/><nd ref=\"2\"/><nd ref=\"3\"/><nd ref=\"4\"/><tag k=\"highway\" v=\"primary\"/>"
-           "<tag k=\"oneway\" v=\"yes\"/><tag k=\"lanes\" v=\"2\"/><tag k=\"turn:lanes\" v=\"through|right\"/></way>\n";
-    xml += "  <way id=\"2\"><nd ref=\"4\"/><nd ref=\"5\"/><nd ref=\"6\"/><nd ref=\"1\"/><tag k=\"highway\" v=\"primary\"/>"
-           "<tag k=\"oneway\" v=\"yes\"/><tag k=\"lanes\" v=\"1\"/></way>\n</osm>\n";
-    test::TempDir dir("vista_osm_dual");
-    std::ofstream(dir.file("dual.osm"), std::ios::binary) << xml;
-    auto imp = importOsm(dir.file("dual.osm"), CityParams());
+    auto imp = importText(osmText({{-200, 0}, {-100, 4}, {100, 4}, {200, 0}, {100, -4}, {-100, -4}},
+                                  {{{1, 2, 3, 4}, R"(<tag k="highway" v="primary"/><tag k="oneway" v="yes"/><tag k="lanes" v="2"/>)"
+                                                  R"(<tag k="turn:lanes" v="through|right"/>)"},
+                                   {{4, 5, 6, 1}, R"(<tag k="highway" v="primary"/><tag k="oneway" v="yes"/><tag k="lanes" v="1"/>)"}}));
     ASSERT_TRUE(imp.isOk()) << imp.status().message();
     const StreetGraph& g = imp->streets;
     ASSERT_FALSE(g.edges.empty());
@@ -346,6 +364,29 @@ TEST(OsmRoadTags, OppositeOneWaysMergedIntoOneEdgeGiveOneDirectionEach) {
         EXPECT_EQ(int(e.lanes), 3);
     }
     EXPECT_EQ(imp->roadTagStats.edgesMergedOneWays, g.edges.size());
+}
+
+TEST(OsmRoadTags, ShortEdgeAtAJunctionKeepsItsOwnWayNotTheCrossingOne) {
+    // One-way A runs east through a junction, bending 15 m after it; one-way B crosses at the
+    // junction at 63 degrees, its part near that 15 m piece running the other way along x.
+    auto imp = importText(osmText({{-100, 0}, {0, 0}, {15, 0}, {100, 10}, {40, -80}, {-40, 80}},
+                                  {{{1, 2, 3, 4}, R"(<tag k="highway" v="residential"/><tag k="oneway" v="yes"/><tag k="maxspeed" v="30"/>)"},
+                                   {{5, 2, 6}, R"(<tag k="highway" v="residential"/><tag k="oneway" v="yes"/><tag k="lanes" v="2"/>)"}}));
+    ASSERT_TRUE(imp.isOk()) << imp.status().message();
+    const StreetGraph& g = imp->streets;
+    int found = 0;
+    for (const auto& e : g.edges) {
+        const glm::dvec2 a = g.nodes[e.a], b = g.nodes[e.b];
+        if (pointLineDistance(a, {40, -80}, {-40, 80}) < 1 && pointLineDistance(b, {40, -80}, {-40, 80}) < 1) continue;  // way B
+        ++found;
+        const bool eastward = b.x > a.x;
+        EXPECT_EQ(int(e.lanesForward), eastward ? 1 : 0);
+        EXPECT_EQ(int(e.lanesBackward), eastward ? 0 : 1);
+        EXPECT_EQ(int(e.lanes), 1);
+        EXPECT_FLOAT_EQ(e.maxspeedKmh, 30.0f);
+    }
+    EXPECT_EQ(found, 3);
+    EXPECT_EQ(imp->roadTagStats.edgesMergedOneWays, 0u);
 }
 
 // ---- the street graph JSON of the new fields ------------------------------------------
