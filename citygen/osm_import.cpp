@@ -481,9 +481,11 @@ void assignRoadTags(StreetGraph& g, const std::vector<Way>& ways, const std::vec
         double score() const { return std::max({d[0], d[1], d[2]}); }
     };
     std::vector<Cand> cands;
+    std::unordered_map<uint32_t, size_t> candOf;  // way -> index in cands
     for (auto& e : g.edges) {
         const glm::dvec2 a = g.nodes[e.a], b = g.nodes[e.b];
         cands.clear();
+        candOf.clear();
         for (int k = 0; k < 3; ++k) {
             const glm::dvec2 p = a + 0.25 * (k + 1) * (b - a);
             const auto [cx, cy] = cellOf(p);
@@ -493,11 +495,12 @@ void assignRoadTags(StreetGraph& g, const std::vector<Way>& ways, const std::vec
                 if (ways[segs[s].way].cls != e.cls) continue;
                 const double d = pointSegmentDistance(p, segs[s].p, segs[s].q);
                 if (d > tol) continue;
-                auto c = std::find_if(cands.begin(), cands.end(), [&](const Cand& x) { return x.way == segs[s].way; });
-                if (c == cands.end()) c = cands.insert(cands.end(), Cand{segs[s].way, {1e300, 1e300, 1e300}, s});
-                if (d < c->d[k]) {
-                    c->d[k] = d;
-                    if (k == 1) c->midSeg = s;
+                auto [slot, fresh] = candOf.emplace(segs[s].way, cands.size());
+                if (fresh) cands.push_back(Cand{segs[s].way, {1e300, 1e300, 1e300}, s});
+                Cand& c = cands[slot->second];
+                if (d < c.d[k]) {
+                    c.d[k] = d;
+                    if (k == 1) c.midSeg = s;
                 }
             }
         }
