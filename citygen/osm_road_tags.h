@@ -3,7 +3,7 @@
 // fields lanes, lanesForward, lanesBackward, turnForward, turnBackward,
 // maxspeedKmh and width (street_graph.h), with counts for `vista gen --stats`.
 //
-// Contract (docs/streets.md "Road tags from OSM"):
+// Contract (docs/reference/streets.md "Road tags from OSM"):
 // - oneway: yes / true / 1 -> one-way along the way, -1 / reverse -> one-way
 //   against it, no / false / 0 -> two-way; without a valid value,
 //   highway=motorway and junction=roundabout / circular are one-way along the
