@@ -640,3 +640,42 @@ TEST(OpenDrive, LinkRoadLanesLieOnTheRoadMesh) {
         EXPECT_EQ(missing, 0u);
     }
 }
+
+// OSM road tags reach the simulator: every street road of lanes.osm carries
+// its edge's lanes per direction and speed limit (maxspeed where tagged, the
+// class default otherwise) on its <type> and on each driving lane.
+TEST(OpenDrive, OsmLaneAndSpeedTagsReachTheFile) {
+    const City city = osmCity("lanes.osm");
+    auto xodr = openDriveXml(city.streets, city.params, &city.blocks);
+    ASSERT_TRUE(xodr.isOk());
+    std::string err;
+    auto doc = parseXml(*xodr, &err);
+    ASSERT_TRUE(doc) << err;
+    size_t tagged = 0, oneWay = 0, checked = 0;
+    for (const Element* road : doc->all("road")) {
+        if (road->str("junction") != "-1" || road->str("name").rfind("transition", 0) == 0) continue;
+        const size_t e = std::stoul(road->str("id"));
+        ASSERT_LT(e, city.streets.edges.size());
+        const StreetEdge& E = city.streets.edges[e];
+        const double speed = E.maxspeedKmh > 0 ? double(E.maxspeedKmh) : classSpeedKmh(E.cls);
+        tagged += E.maxspeedKmh > 0;
+        EXPECT_NEAR(road->first("type")->first("speed")->num("max"), speed, 1e-6) << "road " << e;
+        int right = 0, left = 0;
+        const Element* section = road->first("lanes")->first("laneSection");
+        for (const char* side : {"left", "right"}) {
+            if (!section->first(side)) continue;
+            for (const Element* lane : section->first(side)->all("lane")) {
+                if (lane->str("type") != "driving") continue;
+                (std::string(side) == "left" ? left : right)++;
+                EXPECT_NEAR(lane->first("speed")->num("max"), speed, 1e-6) << "road " << e;
+            }
+        }
+        if (E.lanesForward >= 0) EXPECT_EQ(right, E.lanesForward) << "road " << e;
+        if (E.lanesBackward >= 0) EXPECT_EQ(left, E.lanesBackward) << "road " << e;
+        oneWay += right == 0 || left == 0;
+        ++checked;
+    }
+    EXPECT_GT(checked, 10u);
+    EXPECT_GT(tagged, 5u);
+    EXPECT_GT(oneWay, 3u);
+}
