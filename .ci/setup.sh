@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 PKGS="build-essential cmake ninja-build pkg-config libopenscenegraph-dev openscenegraph libembree-dev
   libcgal-dev libgmp-dev libmpfr-dev libboost-dev libglm-dev libtbb-dev nlohmann-json3-dev libcli11-dev
   libosmium2-dev libprotozero-dev libbz2-dev libexpat1-dev zlib1g-dev libpng-dev libgtest-dev
-  libbenchmark-dev xvfb xauth libgl1-mesa-dri jq python3 sumo sumo-tools file dpkg-dev"
+  libbenchmark-dev xvfb xauth libgl1-mesa-dri jq python3 sumo sumo-tools file dpkg-dev libxml2-utils"
 missing=""
 for p in $PKGS; do dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"; done
 if [ -n "$missing" ]; then

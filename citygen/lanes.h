@@ -1,30 +1,54 @@
-// LaneModel: the lanes of every street edge and the junctions of the street
-// graph, the one description that both the OpenDRIVE writer (opendrive.h) and
-// the lane markings of the road meshes (surfaces.cpp) read, so the lanes a
-// simulator loads and the lines drawn on the road agree.
+// LaneModel: the lanes of every street edge, the junctions of the street
+// graph and the roads that join street roads (link roads), the one
+// description that the OpenDRIVE writer (opendrive.h), the road meshes and
+// their lane markings (surfaces.cpp) read, so the lanes a simulator loads and
+// the road drawn agree.
 //
-// Contract (all lengths metres, positions city frame, right-hand traffic):
+// Contract (all lengths metres, positions city frame; lane ids and sides as
+// in OpenDRIVE: right lanes -1..-n drive along the reference line in
+// right-hand traffic):
 // - Per edge e (index = edge index): the reference line runs from node a to
 //   node b along the straight centre line, trimmed at each end that is a
-//   junction (node of degree >= 3) by that junction's radius (clamped so that
-//   at least kMinRoadLength of the edge remains, both trims shrunk in
-//   proportion). Untrimmed ends (degree 1 or 2) start/end exactly at the node.
+//   junction (node of degree >= 3) by that junction's radius and at each
+//   degree-2 node by the length its transition needs (see below); both trims
+//   are shrunk in proportion when less than kMinRoadLength of the edge would
+//   remain. Dead ends (degree 1) start/end exactly at the node.
 // - Driving lanes: `right` lanes drive a -> b (right of the reference line),
-//   `left` lanes drive b -> a. right = ceil(n/2), left = floor(n/2) with
-//   n = max(edge.lanes, 2) (the graph has no one-way flag, so a 1-lane edge
-//   gets one lane per direction). All driving lanes have the same width
-//   laneWidth = carriageway / n, so they sum to the carriageway width the
-//   road mesh uses (edge.width, or the class default for a non-finite or
-//   < 0.5 m width, as surfaces.cpp does).
+//   `left` lanes drive b -> a: the edge's lanesForward/lanesBackward when set
+//   (OSM lanes:forward/backward, oneway), else right = ceil(n/2),
+//   left = floor(n/2) with n = max(edge.lanes, 2). All driving lanes of an
+//   edge have the same width laneWidth = carriageway / (right + left), so they
+//   sum to the carriageway width the road mesh uses (edge.width, or the class
+//   default for a non-finite or < 0.5 m width).
+// - Speed limit: the edge's maxspeedKmh when set, else the class default
+//   (classSpeedKmh).
 // - Sidewalk: width params.sidewalk_m (0 when <= 0.01, as the sidewalk mesh),
 //   directly outside the carriageway, on each side that borders a block
 //   (the sidewalk mesh runs along block outlines): with `blocks` given, a side
 //   has a sidewalk when the point a metre past the sidewalk at the edge's
 //   midpoint lies inside a block outline; without blocks, both sides.
-// - Junction: one per node of degree >= 3, radius = max over its edges of
-//   (half carriageway + sidewalk): the corner points of the sidewalks of
-//   neighbouring streets lie inside it; its arms are the incident edges in
-//   counter-clockwise angle order (angles in (-pi, pi]).
+// - Junction: one per node of degree >= 3; its arms are the incident edges in
+//   counter-clockwise angle order (angles in (-pi, pi]); radius = the largest
+//   of (half carriageway + sidewalk) over its arms and of the trims its turns
+//   need so that no lane border of a turn passes the turn's centre of
+//   curvature (turns sharper than kMaxTurn are not built).
+// - Link roads (LinkRoad): every junction has one per allowed turn (ordered
+//   pair of distinct arms with lanes to give and take, |turn| <= kMaxTurn);
+//   every degree-2 node has one transition road joining its two edges, unless
+//   the corner is too sharp for the lanes to turn inside the edges (counted
+//   in sharpCorners; both ends are then dead ends). A link road's reference
+//   line is a line, a circular arc and a line, tangent to both street roads
+//   (G1), starting at the incoming road's trimmed end and ending at the
+//   outgoing road's trimmed start; its lane widths and lane offset run from
+//   the values of the road it leaves to those of the road it enters along a
+//   smoothstep (zero slope at both ends), so linked lane borders meet. A lane
+//   that exists on one side only appears or ends with width 0 there.
+// - Turning lanes at junctions (right-hand traffic): a straight exit (turn
+//   within 35 degrees) takes every incoming lane (extra lanes taper in or
+//   out), a right turn the outermost lane into the outermost lane, a left
+//   turn the innermost into the innermost; an incoming lane that no exit
+//   would take joins the nearest turn (and tapers out where the exit has
+//   fewer lanes).
 // Edges with invalid node indices, non-finite coordinates or zero length are
 // kept with `valid = false` (no lanes written or drawn). Deterministic; pure.
 #pragma once
@@ -37,10 +61,16 @@
 
 namespace vista {
 
-constexpr double kMinRoadLength = 1.0;  // shortest trimmed reference line
+constexpr double kMinRoadLength = 1.0;      // shortest trimmed reference line
+constexpr double kMaxTurn = 2.356194490192345;  // 135 degrees: sharper turns get no link road
+constexpr double kCurvatureMargin = 0.3;    // lane borders stay this far from a turn's centre of curvature
+constexpr double kTaperLength = 12.0;       // transition length where lane counts or widths change
+constexpr double kMinLinkLength = 1.0;      // shortest transition (straight on, same lanes)
 
 // Carriageway width the road mesh draws for an edge.
 double carriagewayWidth(const StreetEdge& e);
+// Default speed limit (km/h) of a road class.
+double classSpeedKmh(RoadClass c);
 
 struct EdgeLanes {
     bool valid = false;
@@ -48,16 +78,18 @@ struct EdgeLanes {
     glm::dvec2 dir{1.0, 0.0};         // unit a -> b
     double trimA = 0, trimB = 0;      // distance cut off at node a / node b
     double length = 0;                // |end - start|
-    int right = 1, left = 1;          // driving lanes a->b / b->a
+    int right = 1, left = 1;          // driving lanes a->b / b->a (either may be 0 on a one-way edge)
     double laneWidth = 3.5;
     double sidewalk = 0;              // sidewalk width, 0 = none
     bool walkLeft = true, walkRight = true;  // sidewalk present on that side (when sidewalk > 0)
+    double speedKmh = 50;             // speed limit of the driving lanes
     // Lateral position of the centre lane (lane 0) relative to the street's
     // centre line (left positive): (right - left) / 2 x laneWidth, so the
     // lanes span exactly the carriageway [-w/2, w/2] for odd lane counts too
     // (OpenDRIVE <laneOffset>).
     double offset = 0;
     int junctionA = -1, junctionB = -1;  // index into LaneModel::junctions, -1 = none
+    int linkA = -1, linkB = -1;          // transition at a degree-2 node a / b: index into LaneModel::links
     glm::dvec2 normal() const { return {-dir.y, dir.x}; }  // left of a -> b
     bool hasWalk(int side) const { return sidewalk > 0 && (side > 0 ? walkLeft : walkRight); }
     double halfWidth() const { return 0.5 * laneWidth * (right + left); }
@@ -70,6 +102,64 @@ struct Junction {
     uint32_t node = 0;
     double radius = 0;
     std::vector<uint32_t> arms;  // incident edge indices, counter-clockwise by angle
+    std::vector<uint32_t> links; // its link roads (indices into LaneModel::links)
+};
+
+// A road between two street roads: a junction's connecting road (junction
+// >= 0) or the transition at a degree-2 node (junction = -1, linked road to
+// road). Its s runs from `in` to `out`.
+struct LinkRoad {
+    enum class Turn : uint8_t { Straight, Right, Left };
+    struct Lane {
+        double w0 = 0, w1 = 0;  // width at s = 0 and s = length (0: the lane appears / ends there)
+        int from = 0, to = 0;   // lane id in `in` / `out` it links to (0: none)
+        bool sidewalk = false;
+    };
+    int junction = -1;
+    uint32_t node = 0;
+    uint32_t in = 0, out = 0;  // street edges
+    bool inEnd = true;         // `in` meets the node with its end (b == node), else with its start
+    bool outStart = true;      // `out` leaves the node with its start (a == node), else with its end
+    Turn turn = Turn::Straight;
+    double angle = 0;          // signed heading change in -> out (left positive), radians
+    // Reference line: a line of length line0, an arc of length arcLength and
+    // curvature `curvature` (1/m, left positive), a line of length line1,
+    // starting at `start` with heading `hdg` (radians, city frame).
+    glm::dvec2 start{0.0};
+    double hdg = 0;
+    double line0 = 0, arcLength = 0, curvature = 0, line1 = 0;
+    double offset0 = 0, offset1 = 0;  // lane offset (centre lane) at s = 0 / length
+    std::vector<Lane> right;          // right[k - 1] is lane -k (drives in -> out)
+    std::vector<Lane> left;           // left[k - 1] is lane +k (drives out -> in; transitions only)
+    double length() const { return line0 + arcLength + line1; }
+    glm::dvec2 point(double s) const;   // reference line at s (clamped to [0, length])
+    double heading(double s) const;
+    // Smoothstep weight of the end values at s: 0 at s = 0, 1 at s = length.
+    double blend(double s) const;
+    double laneOffset(double s) const { return offset0 + (offset1 - offset0) * blend(s); }
+    double width(const Lane& l, double s) const { return l.w0 + (l.w1 - l.w0) * blend(s); }
+    // Lateral offsets (left positive) of the outermost right and left borders at s.
+    double rightBorder(double s) const;
+    double leftBorder(double s) const;
+};
+
+// A traffic light or sign at a junction end of a street road, facing the
+// traffic that arrives there. Junctions where three or more arms are
+// highways or arterials get traffic lights on every approach; junctions with
+// at least one such arm get stop signs (4+ arms) or yield signs (3 arms) on
+// their local approaches; junctions of local streets get none (priority to
+// the right). The pole stands on the sidewalk (or 0.5 m past the
+// carriageway without one) by the stop line, on the right of the traffic.
+struct SignalPlacement {
+    enum class Kind : uint8_t { TrafficLight, Stop, Yield };
+    Kind kind = Kind::TrafficLight;
+    uint32_t edge = 0;         // street road it stands on
+    bool atB = true;           // at the road's end b (faces traffic a -> b) or its start a
+    int junction = -1;         // index into LaneModel::junctions
+    int lanes = 0;             // incoming lanes it controls: ids -1..-lanes (atB) or 1..lanes
+    double s = 0, t = 0;       // road frame: s along the trimmed reference line from start, t left positive
+    glm::dvec2 position{0.0};  // city frame
+    glm::dvec2 facing{0.0};    // unit: toward the traffic it controls
 };
 
 struct LaneModel {
@@ -77,8 +167,30 @@ struct LaneModel {
     std::vector<Junction> junctions;   // nodes of degree >= 3, by node index
     std::vector<int> nodeJunction;     // per node: junction index or -1
     std::vector<int> degree;           // per node
+    std::vector<LinkRoad> links;       // junctions' connecting roads, then transitions, by node index
+    std::vector<std::vector<uint32_t>> nodeLinks;  // per node: its link roads
+    std::vector<SignalPlacement> signals;          // by edge, start before end
+    size_t sharpCorners = 0;           // degree-2 nodes left unlinked: too sharp for the lanes
+    size_t droppedTurns = 0;           // junction turns within kMaxTurn whose trims did not fit the edges
+    size_t unlinkedLanes = 0;          // incoming driving lanes at a junction that no turn takes
 };
 
 LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks = nullptr);
+
+// Stop lines and zebra crossings at junction ends (metres): the stop line
+// lies kStopSetback before the road's trimmed end, kStopDepth deep; the
+// crossing lies in the junction, between kCrossingGap past the road end and
+// the sidewalk width (or kCrossingDepth without sidewalks) into it, where the
+// corner sidewalks of the neighbouring streets meet.
+constexpr double kStopSetback = 0.5, kStopDepth = 0.4;
+constexpr double kCrossingDepth = 3.0;
+constexpr double kCrossingGap = 0.3;
+
+// The s range [s0, s1] (along the edge's trimmed reference line, from
+// L.start; negative before it, beyond L.length after it) of the zebra
+// crossing at the junction end of edge L at node b (atB) or a; false when
+// that end has no crossing (no junction, or too short a road or band).
+// The road meshes draw it and the OpenDRIVE writer declares it.
+bool crossingBand(const EdgeLanes& L, bool atB, double& s0, double& s1);
 
 }  // namespace vista

@@ -9,6 +9,7 @@
 
 #include "citygen/lanes.h"
 #include "citygen/terrain.h"
+#include "foundation/units.h"
 
 namespace vista {
 
@@ -16,12 +17,31 @@ namespace {
 
 constexpr double kRoadSurfaceLift = 0.02;  // road mesh above ground (surfaces.cpp kRoadLift)
 constexpr double kElevationStep = 10.0;    // longest elevation piece
+constexpr double kFiniteStep = 0.25;       // finite-difference step of slopes (metres)
 
 std::string num(double v) {
     if (std::abs(v) < 1e-12) v = 0.0;  // no "-0"
     char buf[40];
     std::snprintf(buf, sizeof buf, "%.12g", v);
     return buf;
+}
+
+template <class T>
+std::string str(T v) {
+    return std::to_string(v);
+}
+
+// Height, slope (along the edge's a -> b direction) and superelevation of a
+// street road at one of its ends.
+struct EndProfile {
+    double z = kRoadSurfaceLift, slope = 0, superelevation = 0;
+};
+
+// Cubic a + b ds + c ds^2 + d ds^3 with the smoothstep from v0 to v1 over L
+// (zero slope at both ends).
+std::string smoothstepAttrs(double v0, double v1, double L) {
+    const double dv = v1 - v0;
+    return "a=\"" + num(v0) + "\" b=\"0\" c=\"" + num(3 * dv / (L * L)) + "\" d=\"" + num(-2 * dv / (L * L * L)) + "\"";
 }
 
 class Writer {
@@ -31,25 +51,39 @@ public:
     Result<std::string> run(OpenDriveCounts* counts);
 
 private:
+    bool flat() const { return !(P.hills_amplitude_m > 0); }
     double surface(const glm::dvec2& p) const { return terrainHeight(P, p) + kRoadSurfaceLift; }
+    double crossSlope(const glm::dvec2& p, const glm::dvec2& dir) const;
     glm::dvec2 world(const glm::dvec2& p) const { return p + glm::dvec2(P.origin_x, P.origin_y); }
+    EndProfile endProfile(uint32_t e, bool atB) const;
     void elevation(const glm::dvec2& a, const glm::dvec2& dir, double len);
-    void laneSide(const EdgeLanes& L, const StreetEdge& E, bool left, uint32_t e);
+    void laneSide(uint32_t e, bool left);
     void road(uint32_t e);
+    void linkRoad(size_t k);
     void junction(size_t j);
+    void signals(uint32_t e);
+    void objects(uint32_t e);
     std::string roadMarkCentre(RoadClass c) const;
-    // Lane link at node v for lane `id` of edge e (0: none).
-    int linkedLane(uint32_t e, uint32_t v, int id) const;
-    uint32_t otherEdge(uint32_t e, uint32_t v) const;
+    std::string roadType(double speedKmh) const;
+    size_t linkRoadId(size_t k) const { return g.edges.size() + M.junctions.size() + k; }
+    size_t junctionId(size_t j) const { return g.edges.size() + j; }
+    // Lane of the transition at the edge's end (atB) or start that links lane `id` of edge e (0: none).
+    int transitionLane(uint32_t e, bool atB, int id) const;
 
     const StreetGraph& g;
     const CityParams& P;
     LaneModel M;
     std::string o;
-    std::vector<std::vector<uint32_t>> incident;
-    size_t nextRoadId = 0;
     OpenDriveCounts n;
-    std::string junctionXml;  // <junction> elements, written after the roads
+    size_t nextSignal = 0, nextObject = 0, nextPlacement = 0;
+    // Signals per junction and approach group (controllers of signalised junctions).
+    struct Group {
+        size_t junction;
+        std::vector<size_t> signals;
+    };
+    std::vector<Group> groups;
+    std::vector<double> groupAxis;                     // per group: its approaches' direction modulo pi
+    std::vector<std::vector<size_t>> junctionGroups;  // per junction: indices into groups
 };
 
 std::string Writer::roadMarkCentre(RoadClass c) const {
@@ -58,114 +92,181 @@ std::string Writer::roadMarkCentre(RoadClass c) const {
            "\" weight=\"standard\" color=\"standard\" width=\"0.15\" laneChange=\"none\"/>";
 }
 
-// Cubic Hermite pieces through the road surface height, and the terrain's
-// cross slope as superelevation (linear pieces).
-void Writer::elevation(const glm::dvec2& a, const glm::dvec2& dir, double len) {
+std::string Writer::roadType(double speedKmh) const {
+    return "    <type s=\"0\" type=\"town\">\n      <speed max=\"" + num(speedKmh) + "\" unit=\"km/h\"/>\n    </type>\n";
+}
+
+double Writer::crossSlope(const glm::dvec2& p, const glm::dvec2& dir) const {
     const glm::dvec2 nrm(-dir.y, dir.x);
+    const double h = kFiniteStep;
+    // Left side higher by tan(angle) per metre; OpenDRIVE: positive falls to the right.
+    return std::atan((terrainHeight(P, p + nrm * h) - terrainHeight(P, p - nrm * h)) / (2 * h));
+}
+
+EndProfile Writer::endProfile(uint32_t e, bool atB) const {
+    EndProfile r;
+    if (flat()) return r;
+    const EdgeLanes& L = M.edges[e];
+    const glm::dvec2 p = atB ? L.end : L.start;
+    const double h = kFiniteStep;
+    r.z = surface(p);
+    r.slope = (surface(p + L.dir * h) - surface(p - L.dir * h)) / (2 * h);
+    r.superelevation = crossSlope(p, L.dir);
+    return r;
+}
+
+// Cubic Hermite pieces through the road surface height, and the terrain's
+// cross slope as superelevation (linear pieces). The end values are those of
+// endProfile, which the link roads continue.
+void Writer::elevation(const glm::dvec2& a, const glm::dvec2& dir, double len) {
     const int pieces = std::max(1, int(std::ceil(len / kElevationStep)));
-    const double h = 0.25;  // finite-difference step
+    const double h = kFiniteStep;
     auto zAt = [&](double s) { return surface(a + dir * s); };
     auto slope = [&](double s) { return (zAt(s + h) - zAt(s - h)) / (2 * h); };
-    auto cross = [&](double s) {
-        glm::dvec2 p = a + dir * s;
-        return std::atan((terrainHeight(P, p + nrm * h) - terrainHeight(P, p - nrm * h)) / (2 * h));
-    };
-    const bool flat = !(P.hills_amplitude_m > 0);
-    o += "      <elevationProfile>\n";
-    if (flat) {
-        o += "        <elevation s=\"0\" a=\"" + num(kRoadSurfaceLift) + "\" b=\"0\" c=\"0\" d=\"0\"/>\n";
+    o += "    <elevationProfile>\n";
+    if (flat()) {
+        o += "      <elevation s=\"0\" a=\"" + num(kRoadSurfaceLift) + "\" b=\"0\" c=\"0\" d=\"0\"/>\n";
     } else {
         for (int k = 0; k < pieces; ++k) {
             double s0 = len * k / pieces, s1 = len * (k + 1) / pieces, ds = s1 - s0;
             double z0 = zAt(s0), z1 = zAt(s1), m0 = slope(s0), m1 = slope(s1);
             double c = (3 * (z1 - z0) / ds - 2 * m0 - m1) / ds;
             double d = (m0 + m1 - 2 * (z1 - z0) / ds) / (ds * ds);
-            o += "        <elevation s=\"" + num(s0) + "\" a=\"" + num(z0) + "\" b=\"" + num(m0) + "\" c=\"" + num(c) +
+            o += "      <elevation s=\"" + num(s0) + "\" a=\"" + num(z0) + "\" b=\"" + num(m0) + "\" c=\"" + num(c) +
                  "\" d=\"" + num(d) + "\"/>\n";
         }
     }
-    o += "      </elevationProfile>\n      <lateralProfile>\n";
-    if (flat) {
-        o += "        <superelevation s=\"0\" a=\"0\" b=\"0\" c=\"0\" d=\"0\"/>\n";
+    o += "    </elevationProfile>\n    <lateralProfile>\n";
+    if (flat()) {
+        o += "      <superelevation s=\"0\" a=\"0\" b=\"0\" c=\"0\" d=\"0\"/>\n";
     } else {
         for (int k = 0; k < pieces; ++k) {
             double s0 = len * k / pieces, s1 = len * (k + 1) / pieces;
-            // Left side higher by tan(angle) per metre; OpenDRIVE: positive falls to the right.
-            double r0 = cross(s0), r1 = cross(s1);
-            o += "        <superelevation s=\"" + num(s0) + "\" a=\"" + num(r0) + "\" b=\"" + num((r1 - r0) / (s1 - s0)) +
+            double r0 = crossSlope(a + dir * s0, dir), r1 = crossSlope(a + dir * s1, dir);
+            o += "      <superelevation s=\"" + num(s0) + "\" a=\"" + num(r0) + "\" b=\"" + num((r1 - r0) / (s1 - s0)) +
                  "\" c=\"0\" d=\"0\"/>\n";
         }
     }
-    o += "      </lateralProfile>\n";
+    o += "    </lateralProfile>\n";
 }
 
-uint32_t Writer::otherEdge(uint32_t e, uint32_t v) const {
-    for (uint32_t f : incident[v])
-        if (f != e) return f;
-    return e;
-}
-
-// Lanes across a degree-2 node: driving lane k links to driving lane k of the
-// same travel direction when it exists, sidewalk to sidewalk.
-int Writer::linkedLane(uint32_t e, uint32_t v, int id) const {
-    const uint32_t f = otherEdge(e, v);
-    if (f == e) return 0;
-    const EdgeLanes &Le = M.edges[e], &Lf = M.edges[f];
-    const bool eEndsHere = g.edges[e].b == v, fStartsHere = g.edges[f].a == v;
-    // Same s direction through the node: ids keep their sign; else flip.
-    const int sign = (eEndsHere == fStartsHere) ? 1 : -1;
-    const int side = id > 0 ? 1 : -1;
-    const int k = std::abs(id);
-    const int ne = side > 0 ? Le.left : Le.right;
-    const int nf = (side * sign) > 0 ? Lf.left : Lf.right;
-    if (k <= ne) return k <= nf ? side * sign * k : 0;
-    if (k == ne + 1 && Le.hasWalk(side) && Lf.hasWalk(side * sign)) return side * sign * (nf + 1);
+int Writer::transitionLane(uint32_t e, bool atB, int id) const {
+    const int k = atB ? M.edges[e].linkB : M.edges[e].linkA;
+    if (k < 0) return 0;
+    const LinkRoad& r = M.links[size_t(k)];
+    const bool isIn = r.in == e && (g.edges[e].b == r.node) == r.inEnd;
+    for (int side = 0; side < 2; ++side) {
+        const auto& lanes = side ? r.left : r.right;
+        for (size_t i = 0; i < lanes.size(); ++i)
+            if ((isIn ? lanes[i].from : lanes[i].to) == id) return side ? int(i) + 1 : -int(i) - 1;
+    }
     return 0;
 }
 
-void Writer::laneSide(const EdgeLanes& L, const StreetEdge& E, bool left, uint32_t e) {
+void Writer::laneSide(uint32_t e, bool left) {
+    const EdgeLanes& L = M.edges[e];
+    const StreetEdge& E = g.edges[e];
     const int count = left ? L.left : L.right;
     const int sgn = left ? 1 : -1;
-    const StreetEdge& SE = g.edges[e];
-    const bool linkA = M.degree[SE.a] == 2, linkB = M.degree[SE.b] == 2;
     auto laneXml = [&](int k, bool sidewalk) {
         const int id = sgn * k;
-        o += "            <lane id=\"" + std::to_string(id) + "\" type=\"" + (sidewalk ? "sidewalk" : "driving") +
-             "\" level=\"false\">\n";
-        int pre = linkA ? linkedLane(e, SE.a, id) : 0, suc = linkB ? linkedLane(e, SE.b, id) : 0;
+        o += "          <lane id=\"" + str(id) + "\" type=\"" + (sidewalk ? "sidewalk" : "driving") + "\" level=\"false\">\n";
+        const int pre = transitionLane(e, false, id), suc = transitionLane(e, true, id);
         if (pre || suc) {
-            o += "              <link>";
-            if (pre) o += "<predecessor id=\"" + std::to_string(pre) + "\"/>";
-            if (suc) o += "<successor id=\"" + std::to_string(suc) + "\"/>";
+            o += "            <link>";
+            if (pre) o += "<predecessor id=\"" + str(pre) + "\"/>";
+            if (suc) o += "<successor id=\"" + str(suc) + "\"/>";
             o += "</link>\n";
         }
-        o += "              <width sOffset=\"0\" a=\"" + num(sidewalk ? L.sidewalk : L.laneWidth) +
-             "\" b=\"0\" c=\"0\" d=\"0\"/>\n";
-        const bool divider = !sidewalk && k < count;
-        if (divider)
-            o += "              <roadMark sOffset=\"0\" type=\"broken\" weight=\"standard\" color=\"standard\" "
+        o += "            <width sOffset=\"0\" a=\"" + num(sidewalk ? L.sidewalk : L.laneWidth) + "\" b=\"0\" c=\"0\" d=\"0\"/>\n";
+        if (!sidewalk && k < count)
+            o += "            <roadMark sOffset=\"0\" type=\"broken\" weight=\"standard\" color=\"standard\" "
                  "width=\"0.15\" laneChange=\"both\"/>\n";
         else
-            o += "              <roadMark sOffset=\"0\" type=\"none\"/>\n";
+            o += "            <roadMark sOffset=\"0\" type=\"none\" color=\"standard\"/>\n";
         if (!sidewalk) {
-            o += "              <speed sOffset=\"0\" max=\"" +
-                 std::string(E.cls == RoadClass::Highway ? "80" : E.cls == RoadClass::Arterial ? "50" : "30") +
-                 "\" unit=\"km/h\"/>\n";
+            o += "            <speed sOffset=\"0\" max=\"" + num(L.speedKmh) + "\" unit=\"km/h\"/>\n";
             ++n.drivingLanes;
         } else {
             ++n.sidewalks;
         }
-        o += "            </lane>\n";
+        o += "          </lane>\n";
     };
-    o += left ? "          <left>\n" : "          <right>\n";
+    const bool walk = L.hasWalk(sgn);
+    if (count == 0 && !walk) return;
+    o += left ? "        <left>\n" : "        <right>\n";
     if (left) {
-        if (L.hasWalk(1)) laneXml(count + 1, true);
+        if (walk) laneXml(count + 1, true);
         for (int k = count; k >= 1; --k) laneXml(k, false);
     } else {
         for (int k = 1; k <= count; ++k) laneXml(k, false);
-        if (L.hasWalk(-1)) laneXml(count + 1, true);
+        if (walk) laneXml(count + 1, true);
     }
-    o += left ? "          </left>\n" : "          </right>\n";
+    o += left ? "        </left>\n" : "        </right>\n";
+    (void)E;
+}
+
+
+// The lane model's signals on a street road (SignalPlacement), with a
+// controller per approach group at signalised junctions.
+void Writer::signals(uint32_t e) {
+    std::string xml;
+    for (; nextPlacement < M.signals.size() && M.signals[nextPlacement].edge == e; ++nextPlacement) {
+        const SignalPlacement& sp = M.signals[nextPlacement];
+        const size_t id = nextSignal++;
+        const bool light = sp.kind == SignalPlacement::Kind::TrafficLight;
+        const char* type = light ? "1000001" : sp.kind == SignalPlacement::Kind::Stop ? "206" : "205";
+        const char* name = light ? "traffic light" : sp.kind == SignalPlacement::Kind::Stop ? "stop" : "yield";
+        xml += "      <signal s=\"" + num(sp.s) + "\" t=\"" + num(sp.t) + "\" id=\"" + str(id) + "\" name=\"" + name +
+               "\" dynamic=\"" + (light ? "yes" : "no") + "\" orientation=\"" + (sp.atB ? "+" : "-") + "\" zOffset=\"" +
+               (light ? "2.5" : "1.8") + "\" country=\"DE\" type=\"" + type + "\" subtype=\"-1\" height=\"" +
+               (light ? "0.9" : "0.75") + "\" width=\"" + (light ? "0.3" : "0.75") + "\">\n";
+        xml += "        <validity fromLane=\"" + str(sp.atB ? -1 : 1) + "\" toLane=\"" + str(sp.atB ? -sp.lanes : sp.lanes) +
+               "\"/>\n      </signal>\n";
+        if (!light) {
+            ++n.signs;
+            continue;
+        }
+        ++n.trafficLights;
+        // Approach groups: arms within 45 degrees of opposite share a phase.
+        auto& gs = junctionGroups[size_t(sp.junction)];
+        const glm::dvec2 d = -sp.facing;
+        const double axis = std::fmod(std::atan2(d.y, d.x) + 2 * kPi, kPi);  // direction modulo pi
+        size_t best = gs.size();
+        for (size_t x = 0; x < gs.size(); ++x) {
+            double da = std::abs(groupAxis[gs[x]] - axis);
+            if (std::min(da, kPi - da) < 0.25 * kPi) best = x;
+        }
+        if (best == gs.size()) {
+            gs.push_back(groups.size());
+            groups.push_back({size_t(sp.junction), {}});
+            groupAxis.push_back(axis);
+        }
+        groups[gs[best]].signals.push_back(id);
+    }
+    if (!xml.empty()) o += "    <signals>\n" + xml + "    </signals>\n";
+}
+
+// Zebra crossings where the road meshes draw them (crossingBand), as
+// crosswalk objects outlined in the road's local frame.
+void Writer::objects(uint32_t e) {
+    const EdgeLanes& L = M.edges[e];
+    std::string xml;
+    for (int atB = 0; atB < 2; ++atB) {
+        double s0 = 0, s1 = 0;
+        if (!crossingBand(L, atB != 0, s0, s1)) continue;
+        const double anchor = atB ? L.length : 0.0;
+        const double u0 = s0 - anchor, u1 = s1 - anchor, hw = L.halfWidth();
+        xml += "      <object type=\"crosswalk\" name=\"zebra crossing\" id=\"" + str(nextObject++) + "\" s=\"" + num(anchor) +
+               "\" t=\"0\" zOffset=\"0\" hdg=\"0\" pitch=\"0\" roll=\"0\" orientation=\"none\" length=\"" + num(u1 - u0) +
+               "\" width=\"" + num(2 * hw) + "\" height=\"0\">\n        <outlines>\n          <outline id=\"0\" "
+               "outer=\"true\" closed=\"true\" laneType=\"driving\">\n";
+        for (auto [u, v] : {std::pair{u0, -hw}, {u1, -hw}, {u1, hw}, {u0, hw}})
+            xml += "            <cornerLocal u=\"" + num(u) + "\" v=\"" + num(v) + "\" z=\"0\" height=\"0\"/>\n";
+        xml += "          </outline>\n        </outlines>\n      </object>\n";
+        ++n.crosswalks;
+    }
+    if (!xml.empty()) o += "    <objects>\n" + xml + "    </objects>\n";
 }
 
 void Writer::road(uint32_t e) {
@@ -173,135 +274,156 @@ void Writer::road(uint32_t e) {
     const StreetEdge& E = g.edges[e];
     const glm::dvec2 w = world(L.start);
     const double hdg = std::atan2(L.dir.y, L.dir.x);
-    o += "  <road name=\"" + std::string(roadClassName(E.cls)) + " " + std::to_string(e) + "\" length=\"" +
-         num(L.length) + "\" id=\"" + std::to_string(e) + "\" junction=\"-1\" rule=\"RHT\">\n";
+    o += "  <road name=\"" + std::string(roadClassName(E.cls)) + " " + str(e) + "\" length=\"" + num(L.length) +
+         "\" id=\"" + str(e) + "\" junction=\"-1\" rule=\"RHT\">\n";
     o += "    <link>\n";
-    auto endLink = [&](uint32_t v, bool isSuccessor) {
-        const char* tag = isSuccessor ? "successor" : "predecessor";
-        if (M.nodeJunction[v] >= 0) {
-            o += std::string("      <") + tag + " elementType=\"junction\" elementId=\"" +
-                 std::to_string(g.edges.size() + size_t(M.nodeJunction[v])) + "\"/>\n";
-        } else if (M.degree[v] == 2) {
-            uint32_t f = otherEdge(e, v);
-            if (f == e) return;
-            o += std::string("      <") + tag + " elementType=\"road\" elementId=\"" + std::to_string(f) +
-                 "\" contactPoint=\"" + (g.edges[f].a == v ? "start" : "end") + "\"/>\n";
+    auto endLink = [&](bool atB) {
+        const char* tag = atB ? "successor" : "predecessor";
+        const int j = atB ? L.junctionB : L.junctionA;
+        const int k = atB ? L.linkB : L.linkA;
+        if (j >= 0 && !M.junctions[size_t(j)].links.empty()) {
+            o += std::string("      <") + tag + " elementType=\"junction\" elementId=\"" + str(junctionId(size_t(j))) +
+                 "\"/>\n";
+        } else if (k >= 0) {
+            const LinkRoad& r = M.links[size_t(k)];
+            const bool isIn = r.in == e && (E.b == r.node) == r.inEnd;
+            o += std::string("      <") + tag + " elementType=\"road\" elementId=\"" + str(linkRoadId(size_t(k))) +
+                 "\" contactPoint=\"" + (isIn ? "start" : "end") + "\"/>\n";
         }
     };
-    endLink(E.a, false);
-    endLink(E.b, true);
+    endLink(false);
+    endLink(true);
     o += "    </link>\n";
-    o += "    <type s=\"0\" type=\"town\"/>\n";
+    o += roadType(L.speedKmh);
     o += "    <planView>\n      <geometry s=\"0\" x=\"" + num(w.x) + "\" y=\"" + num(w.y) + "\" hdg=\"" + num(hdg) +
          "\" length=\"" + num(L.length) + "\">\n        <line/>\n      </geometry>\n    </planView>\n";
     elevation(L.start, L.dir, L.length);
     o += "    <lanes>\n      <laneOffset s=\"0\" a=\"" + num(L.offset) + "\" b=\"0\" c=\"0\" d=\"0\"/>\n";
     o += "      <laneSection s=\"0\">\n";
-    laneSide(L, E, true, e);
+    laneSide(e, true);
     o += "        <center>\n          <lane id=\"0\" type=\"none\" level=\"false\">\n            " + roadMarkCentre(E.cls) +
          "\n          </lane>\n        </center>\n";
-    laneSide(L, E, false, e);
-    o += "      </laneSection>\n    </lanes>\n  </road>\n";
+    laneSide(e, false);
+    o += "      </laneSection>\n    </lanes>\n";
+    objects(e);
+    signals(e);
+    o += "  </road>\n";
+    (void)E;
     ++n.roads;
 }
 
-// Connecting roads of one junction and its <junction> element.
+// A junction's connecting road or a degree-2 transition (lanes.h LinkRoad).
+void Writer::linkRoad(size_t k) {
+    const LinkRoad& r = M.links[k];
+    const double len = r.length();
+    const bool inJunction = r.junction >= 0;
+    const EdgeLanes &Li = M.edges[r.in], &Lo = M.edges[r.out];
+    o += "  <road name=\"" + std::string(inJunction ? "junction " + str(junctionId(size_t(r.junction))) : "transition") + " " +
+         str(size_t(r.in)) + " to " + str(size_t(r.out)) + "\" length=\"" + num(len) + "\" id=\"" + str(linkRoadId(k)) +
+         "\" junction=\"" + (inJunction ? str(junctionId(size_t(r.junction))) : std::string("-1")) + "\" rule=\"RHT\">\n";
+    o += "    <link>\n      <predecessor elementType=\"road\" elementId=\"" + str(size_t(r.in)) + "\" contactPoint=\"" +
+         (r.inEnd ? "end" : "start") + "\"/>\n      <successor elementType=\"road\" elementId=\"" + str(size_t(r.out)) +
+         "\" contactPoint=\"" + (r.outStart ? "start" : "end") + "\"/>\n    </link>\n";
+    o += roadType(std::min(Li.speedKmh, Lo.speedKmh));
+    // Line, arc, line.
+    o += "    <planView>\n";
+    double s = 0;
+    auto piece = [&](double length, const std::string& shape) {
+        if (!(length > 1e-9)) return;
+        const glm::dvec2 w = world(r.point(s));
+        o += "      <geometry s=\"" + num(s) + "\" x=\"" + num(w.x) + "\" y=\"" + num(w.y) + "\" hdg=\"" +
+             num(r.heading(s)) + "\" length=\"" + num(length) + "\">\n        " + shape + "\n      </geometry>\n";
+        s += length;
+    };
+    piece(r.line0, "<line/>");
+    piece(r.arcLength, "<arc curvature=\"" + num(r.curvature) + "\"/>");
+    piece(r.line1, "<line/>");
+    o += "    </planView>\n";
+    // Height: a cubic Hermite from the incoming road's end to the outgoing
+    // road's start (values and slopes), superelevation linear between theirs
+    // (both flip sign where a road runs against this road's s).
+    const EndProfile a = endProfile(r.in, r.inEnd), b = endProfile(r.out, !r.outStart);
+    const double z0 = a.z, z1 = b.z, m0 = r.inEnd ? a.slope : -a.slope, m1 = r.outStart ? b.slope : -b.slope;
+    const double c = (3 * (z1 - z0) / len - 2 * m0 - m1) / len, d = (m0 + m1 - 2 * (z1 - z0) / len) / (len * len);
+    o += "    <elevationProfile>\n      <elevation s=\"0\" a=\"" + num(z0) + "\" b=\"" + num(m0) + "\" c=\"" + num(c) +
+         "\" d=\"" + num(d) + "\"/>\n    </elevationProfile>\n";
+    const double r0 = r.inEnd ? a.superelevation : -a.superelevation;
+    const double r1 = r.outStart ? b.superelevation : -b.superelevation;
+    o += "    <lateralProfile>\n      <superelevation s=\"0\" a=\"" + num(r0) + "\" b=\"" + num((r1 - r0) / len) +
+         "\" c=\"0\" d=\"0\"/>\n    </lateralProfile>\n";
+    o += "    <lanes>\n      <laneOffset s=\"0\" " + smoothstepAttrs(r.offset0, r.offset1, len) + "/>\n";
+    o += "      <laneSection s=\"0\">\n";
+    const double speed = std::min(Li.speedKmh, Lo.speedKmh);
+    auto lanesXml = [&](const std::vector<LinkRoad::Lane>& lanes, int sgn) {
+        for (size_t i = 0; i < lanes.size(); ++i) {
+            const size_t idx = sgn > 0 ? lanes.size() - 1 - i : i;  // left lanes outermost first
+            const LinkRoad::Lane& l = lanes[idx];
+            const int id = sgn * int(idx + 1);
+            o += "          <lane id=\"" + str(id) + "\" type=\"" + (l.sidewalk ? "sidewalk" : "driving") +
+                 "\" level=\"false\">\n";
+            if (l.from || l.to) {
+                o += "            <link>";
+                if (l.from) o += "<predecessor id=\"" + str(l.from) + "\"/>";
+                if (l.to) o += "<successor id=\"" + str(l.to) + "\"/>";
+                o += "</link>\n";
+            }
+            o += "            <width sOffset=\"0\" " + smoothstepAttrs(l.w0, l.w1, len) + "/>\n";
+            o += "            <roadMark sOffset=\"0\" type=\"none\" color=\"standard\"/>\n";
+            if (!l.sidewalk) o += "            <speed sOffset=\"0\" max=\"" + num(speed) + "\" unit=\"km/h\"/>\n";
+            o += "          </lane>\n";
+        }
+    };
+    if (!r.left.empty()) {
+        o += "        <left>\n";
+        lanesXml(r.left, 1);
+        o += "        </left>\n";
+    }
+    o += "        <center>\n          <lane id=\"0\" type=\"none\" level=\"false\">\n            <roadMark sOffset=\"0\" "
+         "type=\"none\" color=\"standard\"/>\n          </lane>\n        </center>\n";
+    if (!r.right.empty()) {
+        o += "        <right>\n";
+        lanesXml(r.right, -1);
+        o += "        </right>\n";
+    }
+    o += "      </laneSection>\n    </lanes>\n  </road>\n";
+    if (inJunction) ++n.connectingRoads;
+    else ++n.transitions;
+}
+
 void Writer::junction(size_t j) {
     const Junction& J = M.junctions[j];
-    const uint32_t v = J.node;
-    const size_t jid = g.edges.size() + j;
-    std::string jx = "  <junction id=\"" + std::to_string(jid) + "\" name=\"node " + std::to_string(v) + "\">\n";
+    if (J.links.empty()) return;
+    o += "  <junction id=\"" + str(junctionId(j)) + "\" name=\"node " + str(size_t(J.node)) + "\">\n";
     int connection = 0;
-    for (uint32_t in : J.arms) {
-        const EdgeLanes& Li = M.edges[in];
-        const bool inEnd = g.edges[in].b == v;  // incoming road meets the junction with its end
-        const int inLanes = inEnd ? Li.right : Li.left;
-        const glm::dvec2 p0 = inEnd ? Li.end : Li.start;
-        const glm::dvec2 d0 = inEnd ? Li.dir : -Li.dir;  // travel direction into the junction
-        for (uint32_t out : J.arms) {
-            if (out == in) continue;
-            const EdgeLanes& Lo = M.edges[out];
-            const bool outStart = g.edges[out].a == v;
-            const int outLanes = outStart ? Lo.right : Lo.left;
-            const int lanes = std::min(inLanes, outLanes);
-            if (lanes < 1) continue;
-            const glm::dvec2 p1 = outStart ? Lo.start : Lo.end;
-            const glm::dvec2 d1 = outStart ? Lo.dir : -Lo.dir;
-            // Cubic Hermite in the local frame of (p0, d0), tangents of length |p1 - p0|.
-            const double chord = glm::length(p1 - p0);
-            if (!(chord > 1e-6)) continue;
-            const glm::dvec2 side(-d0.y, d0.x);
-            auto local = [&](const glm::dvec2& q) { return glm::dvec2(glm::dot(q, d0), glm::dot(q, side)); };
-            const glm::dvec2 P1 = local(p1 - p0), T0(chord, 0.0), T1 = local(d1) * chord;
-            const glm::dvec2 c = 3.0 * P1 - 2.0 * T0 - T1, d = -2.0 * P1 + T0 + T1;
-            // Arc length by Simpson's rule on the derivative.
-            auto speed = [&](double t) { return glm::length(T0 + 2.0 * c * t + 3.0 * d * t * t); };
-            const int K = 64;
-            double len = 0;
-            for (int k = 0; k < K; ++k) {
-                double t0 = double(k) / K, t1 = double(k + 1) / K;
-                len += (t1 - t0) / 6 * (speed(t0) + 4 * speed(0.5 * (t0 + t1)) + speed(t1));
-            }
-            const size_t rid = nextRoadId++;
-            const glm::dvec2 w = world(p0);
-            const double z0 = surface(p0), z1 = surface(p1);
-            const double w0 = Li.laneWidth, w1 = Lo.laneWidth;
-            o += "  <road name=\"junction " + std::to_string(jid) + " " + std::to_string(in) + " to " +
-                 std::to_string(out) + "\" length=\"" + num(len) + "\" id=\"" + std::to_string(rid) + "\" junction=\"" +
-                 std::to_string(jid) + "\" rule=\"RHT\">\n";
-            o += "    <link>\n      <predecessor elementType=\"road\" elementId=\"" + std::to_string(in) +
-                 "\" contactPoint=\"" + (inEnd ? "end" : "start") + "\"/>\n      <successor elementType=\"road\" elementId=\"" +
-                 std::to_string(out) + "\" contactPoint=\"" + (outStart ? "start" : "end") + "\"/>\n    </link>\n";
-            o += "    <type s=\"0\" type=\"town\"/>\n";
-            o += "    <planView>\n      <geometry s=\"0\" x=\"" + num(w.x) + "\" y=\"" + num(w.y) + "\" hdg=\"" +
-                 num(std::atan2(d0.y, d0.x)) + "\" length=\"" + num(len) + "\">\n        <paramPoly3 aU=\"0\" bU=\"" +
-                 num(T0.x) + "\" cU=\"" + num(c.x) + "\" dU=\"" + num(d.x) + "\" aV=\"0\" bV=\"" + num(T0.y) + "\" cV=\"" +
-                 num(c.y) + "\" dV=\"" + num(d.y) + "\" pRange=\"normalized\"/>\n      </geometry>\n    </planView>\n";
-            o += "    <elevationProfile>\n      <elevation s=\"0\" a=\"" + num(z0) + "\" b=\"" + num((z1 - z0) / len) +
-                 "\" c=\"0\" d=\"0\"/>\n    </elevationProfile>\n";
-            // Centre lane position in this road's frame (reversed roads flip its sign).
-            const double off0 = inEnd ? Li.offset : -Li.offset, off1 = outStart ? Lo.offset : -Lo.offset;
-            o += "    <lanes>\n      <laneOffset s=\"0\" a=\"" + num(off0) + "\" b=\"" + num((off1 - off0) / len) +
-                 "\" c=\"0\" d=\"0\"/>\n      <laneSection s=\"0\">\n        <center>\n          <lane id=\"0\" type=\"none\" "
-                 "level=\"false\">\n            <roadMark sOffset=\"0\" type=\"none\"/>\n          </lane>\n        </center>\n"
-                 "        <right>\n";
-            jx += "    <connection id=\"" + std::to_string(connection++) + "\" incomingRoad=\"" + std::to_string(in) +
-                  "\" connectingRoad=\"" + std::to_string(rid) + "\" contactPoint=\"start\">\n";
-            for (int k = 1; k <= lanes; ++k) {
-                const int fromId = inEnd ? -k : k, toId = outStart ? -k : k;
-                o += "          <lane id=\"" + std::to_string(-k) + "\" type=\"driving\" level=\"false\">\n"
-                     "            <link><predecessor id=\"" + std::to_string(fromId) + "\"/><successor id=\"" +
-                     std::to_string(toId) + "\"/></link>\n            <width sOffset=\"0\" a=\"" + num(w0) + "\" b=\"" +
-                     num((w1 - w0) / len) + "\" c=\"0\" d=\"0\"/>\n            <roadMark sOffset=\"0\" type=\"none\"/>\n"
-                     "          </lane>\n";
-                jx += "      <laneLink from=\"" + std::to_string(fromId) + "\" to=\"" + std::to_string(-k) + "\"/>\n";
-            }
-            jx += "    </connection>\n";
-            o += "        </right>\n      </laneSection>\n    </lanes>\n  </road>\n";
-            ++n.connectingRoads;
-        }
+    for (uint32_t k : J.links) {
+        const LinkRoad& r = M.links[k];
+        o += "    <connection id=\"" + str(connection++) + "\" incomingRoad=\"" + str(size_t(r.in)) +
+             "\" connectingRoad=\"" + str(linkRoadId(k)) + "\" contactPoint=\"start\">\n";
+        for (size_t i = 0; i < r.right.size(); ++i)
+            if (r.right[i].from)
+                o += "      <laneLink from=\"" + str(r.right[i].from) + "\" to=\"" + str(-int(i) - 1) + "\"/>\n";
+        o += "    </connection>\n";
     }
-    jx += "  </junction>\n";
-    junctionXml += jx;
+    for (size_t x = 0; x < junctionGroups[j].size(); ++x)
+        o += "    <controller id=\"" + str(junctionGroups[j][x]) + "\" type=\"0\" sequence=\"" + str(x + 1) + "\"/>\n";
+    o += "  </junction>\n";
     ++n.junctions;
 }
 
 Result<std::string> Writer::run(OpenDriveCounts* counts) {
-    incident.assign(g.nodes.size(), {});
     glm::dvec2 lo(1e300), hi(-1e300);
     size_t valid = 0;
     for (uint32_t e = 0; e < g.edges.size(); ++e) {
         if (!M.edges[e].valid) continue;
         ++valid;
-        incident[g.edges[e].a].push_back(e);
-        incident[g.edges[e].b].push_back(e);
         for (const glm::dvec2& q : {g.nodes[g.edges[e].a], g.nodes[g.edges[e].b]}) {
             lo = glm::min(lo, world(q));
             hi = glm::max(hi, world(q));
         }
     }
     if (valid == 0) return Status::error("OpenDRIVE export: the street graph has no streets (no valid edge)");
-    o.reserve(valid * 4096);
+    junctionGroups.assign(M.junctions.size(), {});
+    o.reserve(valid * 6144);
     o += "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<OpenDRIVE>\n";
     o += "  <header revMajor=\"1\" revMinor=\"6\" name=\"vista city seed " + std::to_string(P.seed) +
          "\" version=\"1\" north=\"" + num(hi.y) + "\" south=\"" + num(lo.y) + "\" east=\"" + num(hi.x) + "\" west=\"" +
@@ -309,10 +431,18 @@ Result<std::string> Writer::run(OpenDriveCounts* counts) {
     o += "    <geoReference><![CDATA[" + openDriveGeoReference(P) + "]]></geoReference>\n  </header>\n";
     for (uint32_t e = 0; e < g.edges.size(); ++e)
         if (M.edges[e].valid) road(e);
-    nextRoadId = g.edges.size() + M.junctions.size();
+    for (size_t k = 0; k < M.links.size(); ++k) linkRoad(k);
+    for (size_t x = 0; x < groups.size(); ++x) {
+        o += "  <controller id=\"" + str(x) + "\" name=\"junction " + str(junctionId(groups[x].junction)) + " phase " +
+             str(x) + "\">\n";
+        for (size_t s : groups[x].signals) o += "    <control signalId=\"" + str(s) + "\" type=\"0\"/>\n";
+        o += "  </controller>\n";
+    }
     for (size_t j = 0; j < M.junctions.size(); ++j) junction(j);
-    o += junctionXml;
     o += "</OpenDRIVE>\n";
+    n.sharpCorners = M.sharpCorners;
+    n.droppedTurns = M.droppedTurns;
+    n.unlinkedLanes = M.unlinkedLanes;
     if (counts) *counts = n;
     return std::move(o);
 }

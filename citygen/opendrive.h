@@ -10,19 +10,26 @@
 //   2 cm, as the road mesh) and a <lateralProfile> superelevation for the
 //   cross slope of the terrain (positive = road falls to the right); one
 //   laneSection: left/right driving lanes and type="sidewalk" lanes (on the
-//   sides that have a sidewalk mesh) with
-//   constant <width>, road marks on the centre lane and lane dividers.
-// - One <junction> per node of degree >= 3 (id = road count + junction
-//   index) with one connecting road (junction attribute set) per ordered pair
-//   of distinct arms: a paramPoly3 (cubic Hermite) from the incoming road's
-//   reference end to the outgoing road's reference start, min(in, out)
-//   driving lanes, <connection> + <laneLink> entries. Degree-2 nodes link the
-//   two roads directly (road and lane predecessor/successor); dead ends have
-//   no link.
+//   sides that have a sidewalk mesh) with constant <width>, road marks on the
+//   centre lane and lane dividers, the speed limit on the road <type> and on
+//   every driving lane; crosswalk <object>s where the meshes draw zebra
+//   crossings; <signal>s at junction ends (traffic lights where three or more
+//   arms are highways or arterials, else stop signs at 4+ arms and yield signs
+//   at 3 arms on the local approaches of junctions with a major arm).
+// - One road per link road of the lane model (lanes.h LinkRoad; ids follow
+//   the street roads and junctions): line, arc and line geometry, G1 with both
+//   roads; lane widths and laneOffset as smoothstep cubics; elevation a cubic
+//   Hermite continuing both roads' heights and slopes, superelevation linear
+//   between theirs. Transitions at degree-2 nodes are linked road to road
+//   (both directions' lanes); connecting roads belong to one <junction> per
+//   node of degree >= 3 (id = road count + junction index) with a
+//   <connection> and <laneLink>s per turn, and a <controller> per approach
+//   group (arms within 45 degrees of opposite) at signalised junctions.
 // - <header> with <geoReference>: the OSM import's transverse Mercator when
 //   params.geo is set, else a transverse Mercator at (0, 0); both with
 //   +x_0/+y_0 = the world offset, so PROJ maps the written coordinates.
-// - Deterministic: the bytes depend only on (graph, params).
+// - Valid against the ASAM OpenDRIVE 1.6 schema; deterministic: the bytes
+//   depend only on (graph, params, blocks).
 // Returns an error when the graph has no valid edge. Pure, thread-safe.
 #pragma once
 #include <cstddef>
@@ -41,6 +48,13 @@ struct OpenDriveCounts {
     size_t junctions = 0;
     size_t drivingLanes = 0;     // over the street-edge roads (both directions)
     size_t sidewalks = 0;        // sidewalk lanes over the street-edge roads
+    size_t transitions = 0;      // link roads at degree-2 nodes
+    size_t trafficLights = 0;    // signals of type traffic light
+    size_t signs = 0;            // stop and yield signs
+    size_t crosswalks = 0;       // crosswalk objects
+    size_t sharpCorners = 0;     // degree-2 nodes left unlinked (LaneModel::sharpCorners)
+    size_t droppedTurns = 0;     // LaneModel::droppedTurns
+    size_t unlinkedLanes = 0;    // LaneModel::unlinkedLanes
 };
 
 // `blocks` (the city's, or extractBlocks() of the same graph and params)

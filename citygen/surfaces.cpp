@@ -33,9 +33,6 @@ constexpr double kMinArea = 1e-6;       // smallest triangle emitted (m^2)
 // Markings (metres): line width, dashes, stop lines, zebra crossings.
 constexpr double kLineWidth = 0.15;     // as the OpenDRIVE road marks
 constexpr double kDashPeriod = 9.0, kDash = 3.0;
-constexpr double kStopSetback = 0.5, kStopDepth = 0.4;  // stop line before the junction boundary
-constexpr double kCrossingDepth = 3.0;  // crossing length without sidewalks
-constexpr double kCrossingGap = 0.3;    // junction boundary to the crossing
 constexpr double kZebraStripe = 0.5, kZebraGap = 0.6;
 
 bool finitePolygon(const Polygon2& p) {
@@ -288,12 +285,9 @@ void SurfaceContext::edgeMarkings(MeshBuilder& mark, size_t e, const glm::dvec2&
         for (int k = 1; k < ln.right; ++k) dashed(s0, s1, off - k * lw, lineHw);
         for (int k = 1; k < ln.left; ++k) dashed(s0, s1, off + k * lw, lineHw);
     }
-    // Stop lines and crossings at junction ends. trim = the junction radius
-    // (or less on a short edge); the crossing spans the last `depth` metres
-    // of it, where the corner sidewalks are.
-    const double depth = ln.sidewalk > 0 ? ln.sidewalk : kCrossingDepth;
+    // Stop lines at junction ends and the crossings the lane model places
+    // there (crossingBand).
     auto zebra = [&](double sNear, double sFar) {  // s range of the crossing band
-        if (!(sFar - sNear > 1.0)) return;
         const int stripes = std::max(1, int(std::floor((2 * hw - kZebraGap) / (kZebraStripe + kZebraGap) + 1e-9)));
         const double total = stripes * kZebraStripe + (stripes - 1) * kZebraGap, first = -0.5 * total;
         for (int k = 0; k < stripes; ++k) {
@@ -301,14 +295,12 @@ void SurfaceContext::edgeMarkings(MeshBuilder& mark, size_t e, const glm::dvec2&
             rect(sNear, sFar, t0, t0 + kZebraStripe);
         }
     };
-    if (jA && Lr > 2 * (kStopSetback + kStopDepth)) {
-        rect(kStopSetback, kStopSetback + kStopDepth, off, off + ln.left * lw);
-        zebra(-ln.trimA + std::max(0.5, ln.trimA - depth), -kCrossingGap);
-    }
-    if (jB && Lr > 2 * (kStopSetback + kStopDepth)) {
+    double c0 = 0, c1 = 0;
+    if (jA && Lr > 2 * (kStopSetback + kStopDepth)) rect(kStopSetback, kStopSetback + kStopDepth, off, off + ln.left * lw);
+    if (jB && Lr > 2 * (kStopSetback + kStopDepth))
         rect(Lr - kStopSetback - kStopDepth, Lr - kStopSetback, off - ln.right * lw, off);
-        zebra(Lr + kCrossingGap, Lr + std::min(ln.trimB - 0.5, depth));
-    }
+    if (crossingBand(ln, false, c0, c1)) zebra(c0, c1);
+    if (crossingBand(ln, true, c0, c1)) zebra(c0, c1);
 }
 
 void SurfaceContext::roads() {
@@ -355,6 +347,7 @@ void SurfaceContext::roads() {
     // the ground under rounded sidewalk corners). Dead ends get a round cap.
     const double sw = std::max(0.0, P.sidewalk_m);
     std::sort(nodeEdges.begin(), nodeEdges.end());
+
     struct Arm { double angle; glm::dvec2 d; double hw; };
     std::vector<Arm> arms;
     for (size_t i = 0; i < nodeEdges.size();) {
@@ -399,6 +392,24 @@ void SurfaceContext::roads() {
                 double t = (rhs.x * b.d.y - rhs.y * b.d.x) / den;
                 glm::dvec2 q = c + na * a.hw + a.d * t;
                 if (glm::length(q - c) <= r + sw + 1e-9) pts.push_back(q);
+            }
+        }
+        // The carriageway of the lane model's link roads at this node (junction
+        // turns, degree-2 transitions): samples of their outer driving-lane borders.
+        if (lanes && node < lanes->nodeLinks.size()) {
+            for (uint32_t k : lanes->nodeLinks[node]) {
+                const LinkRoad& r = lanes->links[k];
+                const double len = r.length();
+                const int steps = std::max(2, int(std::ceil(len / 1.0)));
+                for (int q = 0; q <= steps; ++q) {
+                    const double u = len * q / steps, h = r.heading(u);
+                    double tl = r.laneOffset(u), tr = tl;
+                    for (const LinkRoad::Lane& l : r.left) tl += l.sidewalk ? 0.0 : r.width(l, u);
+                    for (const LinkRoad::Lane& l : r.right) tr -= l.sidewalk ? 0.0 : r.width(l, u);
+                    const glm::dvec2 c0 = r.point(u), nl(-std::sin(h), std::cos(h));
+                    pts.push_back(c0 + nl * tl);
+                    pts.push_back(c0 + nl * tr);
+                }
             }
         }
         Polygon2 hull = convexHull(pts, 1e-12);
