@@ -52,8 +52,12 @@ int runExport(int argc, char** argv) {
     if (!text) return reportBadInput(cmd, Status::error("scene file '" + input + "': " + text.status().message()));
     if (Status s = writeFileAtomic(xodr, *text); !s) return reportBadInput(cmd, s);
     if (!quiet)
-        std::fprintf(stderr, "wrote %s: %zu roads, %zu junctions (%zu connecting roads), %zu driving lanes, %zu sidewalks\n",
-                     xodr.c_str(), n.roads, n.junctions, n.connectingRoads, n.drivingLanes, n.sidewalks);
+        std::fprintf(stderr,
+                     "wrote %s: %zu roads, %zu transitions, %zu junctions (%zu connecting roads), %zu driving lanes, "
+                     "%zu sidewalks, %zu traffic lights, %zu signs, %zu crosswalks; %zu corners too sharp to link, "
+                     "%zu turns dropped, %zu incoming lanes without a turn\n",
+                     xodr.c_str(), n.roads, n.transitions, n.junctions, n.connectingRoads, n.drivingLanes, n.sidewalks,
+                     n.trafficLights, n.signs, n.crosswalks, n.sharpCorners, n.droppedTurns, n.unlinkedLanes);
     return 0;
 }
 
