@@ -13,6 +13,10 @@ namespace {
 constexpr double kStreetStep = 1.0;  // centre-line vertex spacing on street roads (straight)
 constexpr double kCurveStep = 0.25;  // on link roads and U-turns
 constexpr double kTaperWidth = 0.01; // a lane narrower than this where it ends is a taper
+// Vertices closer than this to the previous one are dropped: where two
+// pieces meet, their end points agree only to rounding, and the heading of
+// so short a segment would be noise (a curvature spike).
+constexpr double kMinVertexGap = 0.02;
 
 double compassHeading(const glm::dvec2& d) { return std::atan2(d.x, d.y); }
 glm::dvec2 leftNormal(double hdg) { return {-std::sin(hdg), std::cos(hdg)}; }  // of a math heading
@@ -200,7 +204,9 @@ void LaneRoute::buildGraph(bool lht) {
         }
         n.next.clear();
         const int64_t back = streetNode(n.index, n.lane < 0 ? 1 : -1);
-        if (back >= 0) {
+        const EdgeLanes& L = m.edges[n.index];
+        const double R = back >= 0 ? 0.5 * std::abs(L.laneCentre(n.lane) - L.laneCentre(_nodes[size_t(back)].lane)) : 0.0;
+        if (back >= 0 && L.length >= 2.0 * R + kUTurnMargin) {
             n.next.push_back(uint32_t(back));
             _uturn[u] = uint32_t(back) + 1;
         }
@@ -372,7 +378,7 @@ void LaneRoute::emitPiece(const Piece& p) {
 }
 
 void LaneRoute::addVertex(const glm::dvec2& q, size_t piece) {
-    if (!_pts.empty() && glm::length(q - _pts.back()) < 1e-6) return;
+    if (!_pts.empty() && glm::length(q - _pts.back()) < kMinVertexGap) return;
     if (_pts.empty()) {
         _pts.push_back(q);
         _cum.push_back(0.0);

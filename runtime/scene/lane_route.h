@@ -21,9 +21,11 @@
 // - Successors whose lane narrows to width 0 where the car would leave it
 //   (a taper) are dropped when another successor exists. A street lane left
 //   without successors is a dead end: the route U-turns there into the
-//   innermost lane of the opposite direction (a semicircle between the two
-//   lane centres whose apex lies kUTurnMargin before the road end; a road
-//   shorter than the semicircle needs is overrun). Only the largest strongly
+//   innermost lane of the opposite direction: a semicircle of radius R
+//   between the two lane centres whose apex lies kUTurnMargin before the
+//   road end, on roads at least 2 R + kUTurnMargin long (a straight run-in as
+//   long as the turn's radius); on a shorter road the lane is left without a
+//   successor. Only the largest strongly
 //   connected part of the lane graph is driven, so the walk never enters a
 //   lane it cannot leave (a lane that ends in a taper, a one-way dead end).
 // - Walk: Rng(seed, 0, Stream::Paths). The route starts at the beginning of a
