@@ -13,20 +13,25 @@ t_offset across it) and checks, per sample:
   in lane    |t_offset| < half the lane's width at s;
   driving    the lane is of a driving type.
 
-With --vista, --city and --xodr-out-of-band files it can also run the path
-command first: see --help.
+With --vista BIN --city CITY.osgb it first makes the paths itself: one car
+path per --seeds entry and --rules entry (rht, lht: `vista path --lht`),
+written with --xodr-positions into a temporary folder, and checks each.
 
 Exit status: 0 all samples pass, 1 a sample fails (the first offenders are
 listed), 2 the input cannot be read.
 
 Usage: xodr_positions.py FILE.xodr PATH.csv POSITIONS.csv [--tolerance 0.05]
        [--min-connecting N]
+       xodr_positions.py FILE.xodr --vista BIN --city CITY.osgb [--seeds 1,2,3]
+       [--rules rht,lht] [--duration 60] [--tolerance 0.05] [--min-connecting N]
 """
 import argparse
 import csv
 import math
 import os
+import subprocess
 import sys
+import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import xodr_check  # noqa: E402  (the independent evaluator; its checks are not used here)
@@ -90,31 +95,66 @@ def replay(net, path_rows, pos_rows, tolerance):
     return failures, worst, connecting
 
 
-def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("xodr")
-    ap.add_argument("path_csv")
-    ap.add_argument("positions_csv")
-    ap.add_argument("--tolerance", type=float, default=0.05, help="metres (default 0.05)")
-    ap.add_argument("--min-connecting", type=int, default=0,
-                    help="fail unless at least this many samples lie on junction connecting roads")
-    a = ap.parse_args(argv)
+def check_files(net, path_csv, positions_csv, tolerance, min_connecting):
+    """Replays one path; prints its summary and failures; True when it passes."""
     try:
-        net = xodr_check.load(a.xodr)
-        path_rows = read_rows(a.path_csv, ["t_s", "x_m", "y_m", "z_m", "heading_deg", "pitch_deg"])
-        pos_rows = read_rows(a.positions_csv, ["t_s", "road_id", "lane_id", "s_m", "t_offset_m"])
+        path_rows = read_rows(path_csv, ["t_s", "x_m", "y_m", "z_m", "heading_deg", "pitch_deg"])
+        pos_rows = read_rows(positions_csv, ["t_s", "road_id", "lane_id", "s_m", "t_offset_m"])
     except xodr_check.InputError as e:
         print(f"xodr_positions: {e}", file=sys.stderr)
-        return 2
-    failures, worst, connecting = replay(net, path_rows, pos_rows, a.tolerance)
-    if connecting < a.min_connecting:
-        failures.append(f"only {connecting} samples on junction connecting roads (at least {a.min_connecting} asked)")
-    print(f"{os.path.basename(a.positions_csv)}: {len(pos_rows)} samples, worst distance "
-          f"{'-' if worst is None else f'{worst:.5f}'} m (tolerance {a.tolerance} m), {connecting} on connecting roads, "
+        raise
+    failures, worst, connecting = replay(net, path_rows, pos_rows, tolerance)
+    if connecting < min_connecting:
+        failures.append(f"only {connecting} samples on junction connecting roads (at least {min_connecting} asked)")
+    print(f"{os.path.basename(positions_csv)}: {len(pos_rows)} samples, worst distance "
+          f"{'-' if worst is None else f'{worst:.5f}'} m (tolerance {tolerance} m), {connecting} on connecting roads, "
           f"{len(failures)} failures")
     for f in failures[:20]:
         print("  " + f)
-    return 1 if failures else 0
+    return not failures
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("xodr")
+    ap.add_argument("files", nargs="*", help="PATH.csv POSITIONS.csv (without --vista)")
+    ap.add_argument("--tolerance", type=float, default=0.05, help="metres (default 0.05)")
+    ap.add_argument("--min-connecting", type=int, default=0,
+                    help="fail unless at least this many samples of each path lie on junction connecting roads")
+    ap.add_argument("--vista", help="the vista executable: make the paths with `vista path`")
+    ap.add_argument("--city", help="with --vista: the city scene file the .xodr was written with")
+    ap.add_argument("--seeds", default="1,2,3", help="with --vista: path seeds (default 1,2,3)")
+    ap.add_argument("--rules", default="rht", help="with --vista: traffic rules, rht and/or lht (default rht)")
+    ap.add_argument("--duration", type=float, default=60.0, help="with --vista: path seconds (default 60)")
+    a = ap.parse_args(argv)
+    if bool(a.vista) != bool(a.city) or (not a.vista and len(a.files) != 2) or (a.vista and a.files):
+        ap.error("give PATH.csv POSITIONS.csv, or --vista BIN --city CITY.osgb")
+    try:
+        net = xodr_check.load(a.xodr)
+        if not a.vista:
+            return 0 if check_files(net, a.files[0], a.files[1], a.tolerance, a.min_connecting) else 1
+        ok = True
+        with tempfile.TemporaryDirectory(prefix="xodr_positions_") as tmp:
+            for rule in a.rules.split(","):
+                if rule not in ("rht", "lht"):
+                    ap.error(f"--rules: {rule} is not rht or lht")
+                for seed in a.seeds.split(","):
+                    base = os.path.join(tmp, f"{rule}_seed{seed}")
+                    cmd = [a.vista, "path", a.city, "--seed", seed, "--duration", str(a.duration),
+                           "-o", base + ".path.csv", "--xodr-positions", base + ".lanes.csv"]
+                    if rule == "lht":
+                        cmd.append("--lht")
+                    p = subprocess.run(cmd, capture_output=True, text=True)
+                    if p.returncode != 0:
+                        print(f"{' '.join(cmd)} failed ({p.returncode}): {p.stderr.strip()}")
+                        ok = False
+                        continue
+                    print(f"{rule} seed {seed}: ", end="")
+                    ok = check_files(net, base + ".path.csv", base + ".lanes.csv", a.tolerance, a.min_connecting) and ok
+        return 0 if ok else 1
+    except xodr_check.InputError as e:
+        print(f"xodr_positions: {e}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":
