@@ -25,17 +25,18 @@
 //   between the two lane centres whose apex lies kUTurnMargin before the
 //   road end, on roads at least 2 R + kUTurnMargin long (a straight run-in as
 //   long as the turn's radius); on a shorter road the lane is left without a
-//   successor. Only the largest strongly
-//   connected part of the lane graph is driven, so the walk never enters a
-//   lane it cannot leave (a lane that ends in a taper, a one-way dead end).
+//   successor. Only the largest strongly connected part of the lane graph
+//   is driven, so the walk never enters a lane it cannot leave (a lane that
+//   ends in a taper, a one-way dead end, a dead end too short to turn in).
 // - Walk: Rng(seed, 0, Stream::Paths). The route starts at the beginning of a
 //   random street lane of that part. At the end of each lane a successor is
 //   drawn with weight 3 when its link road turns less than 0.5 rad, else 1,
 //   times 0.05 when the street lane after it is a dead end.
 // - Centre line: a polyline through the centres of the route's lanes
 //   (laneOffset + the inner lanes' widths + half the lane's width), vertices
-//   at most 1 m apart on street roads and 0.25 m on link roads and U-turns,
-//   extended on demand, with arc length, heading (radians clockwise from
+//   at most 1 m apart on street roads and 0.25 m on link roads and U-turns
+//   (and at least 2 cm, so that the rounding where pieces meet makes no
+//   curvature spike), extended on demand, with arc length, heading (radians clockwise from
 //   north, as Camera) and curvature (dheading/ds) per vertex.
 // - Road ids follow the OpenDRIVE writer (opendrive.h): street road e has id
 //   e, link road k has id edges + junctions + k.

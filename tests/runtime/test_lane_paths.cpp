@@ -21,6 +21,8 @@
 #include "foundation/units.h"
 #include "runtime/scene/lane_route.h"
 #include "runtime/scene/paths.h"
+#include "tests/common/run_vista.h"
+#include "tests/common/temp_dir.h"
 
 using namespace vista;
 
@@ -252,4 +254,29 @@ TEST(LanePaths, SameSeedSameBytes) {
     EXPECT_TRUE(walk->lanes.empty());
     EXPECT_FALSE(saveLanePositionsCsv(*walk, files[3]).isOk());
     for (const auto& f : files) std::filesystem::remove(f);
+}
+
+TEST(LanePaths, CommandWritesPositionsForCarsOnly) {
+    test::TempDir tmp("vista_lane_paths_cli");
+    const std::string city = tmp.file("c.osgb");
+    auto r = test::runVista("gen --seed 3 --size 400 --detail 0 -q -o " + city);
+    ASSERT_EQ(r.code, 0) << r.err;
+    // Walk paths do not drive in lanes: refused before anything is written.
+    r = test::runVista("path " + city + " --kind walk -o " + tmp.file("w.csv") + " --xodr-positions " + tmp.file("w.lanes.csv"));
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("--xodr-positions"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(tmp.file("w.csv")));
+    EXPECT_FALSE(std::filesystem::exists(tmp.file("w.lanes.csv")));
+    // A car path, right- and left-hand traffic: one position per sample, other drives.
+    for (const char* rule : {"", " --lht"}) {
+        const std::string tag = *rule ? "lht" : "rht";
+        r = test::runVista("path " + city + " --seed 2 --duration 5" + rule + " -o " + tmp.file(tag + ".csv") +
+                           " --xodr-positions " + tmp.file(tag + ".lanes.csv"));
+        ASSERT_EQ(r.code, 0) << r.err;
+        auto p = loadPathCsv(tmp.file(tag + ".csv"));
+        ASSERT_TRUE(p.isOk()) << p.status().message();
+        const std::string lanes = readBytes(tmp.file(tag + ".lanes.csv"));
+        EXPECT_EQ(size_t(std::count(lanes.begin(), lanes.end(), '\n')), p->samples.size() + 1);
+    }
+    EXPECT_NE(readBytes(tmp.file("rht.lanes.csv")), readBytes(tmp.file("lht.lanes.csv")));
 }
