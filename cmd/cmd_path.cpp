@@ -15,7 +15,7 @@ namespace vista {
 int runPath(int argc, char** argv) {
     CLI::App app{"Make a deterministic walkthrough path along the city's street graph (CSV: t_s,x_m,y_m,z_m,heading_deg,pitch_deg).",
                  "vista path"};
-    std::string city, out, kind = "car";
+    std::string city, out, kind = "car", positions;
     PathOptions o;
     double yawDeg = 45.0, pitchDeg = o.flyPitch * 180.0 / kPi;
     // Options: one CLI11 call per flag.
@@ -33,7 +33,13 @@ int runPath(int argc, char** argv) {
     app.add_option("--yaw-rate", yawDeg, "maximum yaw rate in degrees/s (default 45)");
     app.add_option("--fly-height", o.flyHeight, "fly-over height above the terrain in metres (default 80)");
     app.add_option("--fly-pitch", pitchDeg, "fly-over pitch in degrees (default -11.5)");
+    app.add_flag("--lht", o.leftHandTraffic,
+                 "car: left-hand traffic, every lane driven against its right-hand direction (the lane model is "
+                 "right-hand traffic; one-way streets are then driven the wrong way)");
     app.add_option("-o,--output", out, "output CSV file")->required();
+    app.add_option("--xodr-positions", positions,
+                   "car: also write the OpenDRIVE position of every sample (CSV: t_s,road_id,lane_id,s_m,t_offset_m) "
+                   "on the roads `vista gen --xodr` writes for this city");
     int rc = parseOrExit(app, argc, argv);
     if (rc >= 0) return rc;
 
@@ -45,6 +51,11 @@ int runPath(int argc, char** argv) {
     o.flyPitch = pitchDeg * kPi / 180.0;
     if (Status s = validatePathOptions(o); !s) return reportBadInput("vista path", s);
     if (Status s = checkWritablePath("--output", out); !s) return reportBadInput("vista path", s);
+    if (!positions.empty() && o.kind != PathKind::Car)
+        return reportBadInput("vista path", Status::error("--xodr-positions: only with --kind car (walk and fly "
+                                                          "paths do not drive in lanes)"));
+    if (!positions.empty())
+        if (Status s = checkWritablePath("--xodr-positions", positions); !s) return reportBadInput("vista path", s);
     Result<SceneModel> c = Status::error("no city");
     if (isPagedCityPath(city)) {
         auto paged = openPagedCity(city, true);
@@ -56,6 +67,8 @@ int runPath(int argc, char** argv) {
     if (!c) return reportBadInput("vista path", c.status());
     auto p = generatePath(c->streets, c->params, o);
     if (!p) return reportBadInput("vista path", p.status());
+    if (!positions.empty())
+        if (Status s = saveLanePositionsCsv(p.value(), positions); !s) return reportBadInput("vista path", s);
     if (Status s = savePathCsv(p.value(), out); !s) return reportBadInput("vista path", s);
     std::fprintf(stderr, "vista path: %zu samples (%.1f s, %s) -> %s\n", p->samples.size(), o.duration, pathKindName(o.kind),
                  out.c_str());

@@ -347,6 +347,7 @@ void addPathFlags(CLI::App& app, PathFlags& f, bool timing) {
     app.add_option("--seed", f.seed, "make the path from this seed instead of --path (default " + std::to_string(f.seed) + ")")
         ->excludes(path);
     app.add_option("--kind", f.kind, "path kind when made from --seed: walk, car, fly (default " + f.kind + ")");
+    app.add_flag("--lht", f.lht, "car path made from --seed: left-hand traffic (lanes driven mirrored)");
     if (!timing) return;
     app.add_option("--duration", f.duration, "path duration in seconds when made from --seed (default 60)");
     app.add_option("--run-up", f.runUp,
@@ -362,6 +363,7 @@ Result<PathOptions> parsePathFlags(const PathFlags& f) {
     po.maxSpeed = defaultSpeed(po.kind);
     po.duration = f.duration;
     po.runUp = f.runUp;
+    po.leftHandTraffic = f.lht;
     VISTA_RETURN_IF_ERROR(validatePathOptions(po));
     return po;
 }

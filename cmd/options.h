@@ -110,8 +110,9 @@ struct PathFlags {
     std::string file, kind = "car";
     uint64_t seed = 1;
     double duration = 60.0, runUp = PathOptions().runUp;
+    bool lht = false;
 };
-// Declares --path, --seed, --kind and, with `timing`, --duration and --run-up.
+// Declares --path, --seed, --kind, --lht and, with `timing`, --duration and --run-up.
 void addPathFlags(CLI::App& app, PathFlags& flags, bool timing);
 // The path options of the flags (kind and ranges checked; messages name the flag).
 Result<PathOptions> parsePathFlags(const PathFlags& flags);

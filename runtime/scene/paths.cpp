@@ -14,6 +14,8 @@
 #include <unistd.h>
 
 #include "foundation/rng.h"
+#include "citygen/blocks.h"
+#include "citygen/lanes.h"
 #include "citygen/terrain.h"
 
 namespace vista {
@@ -22,6 +24,13 @@ namespace {
 
 constexpr double kMinSpeed = 2.0;       // m/s while turning sharply
 constexpr double kTurnRadius = 6.0;     // metres of corner cut we allow at full yaw rate
+// Car lane keeping: heading rate = speed x (curvature - kLateralGain x
+// lateral error - kHeadingGain x heading error), critically damped over
+// about 5 m of travel.
+constexpr double kLateralGain = 0.3;    // 1/m^2
+constexpr double kHeadingGain = 1.1;    // 1/m (2 sqrt(kLateralGain))
+constexpr double kBrakeShare = 0.8;     // share of the braking limit the speed profile plans with
+constexpr double kProgressWindow = 3.0; // metres ahead of the progress where the closest route point is searched
 
 double headingOf(const glm::dvec2& d) { return std::atan2(d.x, d.y); }  // clockwise from north
 
@@ -223,12 +232,88 @@ double distanceToStreets(const StreetGraph& g, const glm::dvec2& p, int* edge) {
     return best;
 }
 
+namespace {
+
+// The car: a LaneRoute through the lane model, steered along the lane centre.
+Result<Path> driveCar(const StreetGraph& g, const CityParams& params, const PathOptions& o) {
+    std::vector<Block> blocks;
+    if (params.sidewalk_m > 0.01) blocks = extractBlocks(g, params, nullptr);
+    const LaneModel lanes = buildLaneModel(g, params, params.sidewalk_m > 0.01 ? &blocks : nullptr);
+    auto made = LaneRoute::create(lanes, o.seed, o.leftHandTraffic);
+    if (!made) return made.status();
+    LaneRoute& route = made.value();
+    glm::dvec2 pos = route.point(0);
+    double h = route.segHeading(0);
+    double v = 0.0;
+    double sp = 0.0;  // progress along the route (arc length of the closest point)
+    size_t seg = 0;
+    const double w = o.maxYawRate, dt = o.dt;
+    const size_t n = size_t(std::floor(o.duration / dt + 1e-9)) + 1;
+    const size_t skip = size_t(std::floor(o.runUp / dt + 1e-9));
+    const glm::dvec2 origin(params.origin_x, params.origin_y);
+    const double brake = kBrakeShare * o.decel;
+
+    Path path;
+    path.samples.reserve(n);
+    path.lanes.reserve(n);
+    for (size_t i = 0; i < n + skip; ++i) {
+        // Progress: the closest route point a few metres ahead.
+        const double horizon = v * v / (2.0 * brake) + 2.0 * v * dt + 3.0;
+        route.ensure(sp + horizon + kProgressWindow + 1.0);
+        double bestD = 1e300, bestT = 0.0;
+        size_t bestSeg = seg;
+        for (size_t k = seg; k < route.segments() && (k == seg || route.cum(k) <= sp + kProgressWindow); ++k) {
+            double t;
+            const double d = segDistance(pos, route.point(k), route.point(k + 1), &t);
+            if (d < bestD - 1e-9) bestD = d, bestSeg = k, bestT = t;
+        }
+        seg = bestSeg;
+        sp = std::max(sp, route.cum(seg) + bestT * (route.cum(seg + 1) - route.cum(seg)));
+
+        if (i >= skip) {
+            PathSample s;
+            s.t = double(i - skip) * dt;
+            s.position = glm::dvec3(pos + origin, terrainHeight(params, pos) + o.eyeHeight());
+            s.heading = wrapAngle(h);
+            path.samples.push_back(s);
+            path.lanes.push_back(route.position(pos, seg));
+        }
+
+        // Steering: the centre line's curvature ahead plus the lateral and
+        // heading errors (positive right of the centre line / clockwise of it).
+        const glm::dvec2 a = route.point(seg), b = route.point(seg + 1);
+        const double ref = route.segHeading(seg);
+        const glm::dvec2 foot = a + bestT * (b - a), right(std::cos(ref), -std::sin(ref));
+        const double lateral = glm::dot(pos - foot, right), psi = wrapAngle(h - ref);
+        const double kappa = route.curvature(bestT < 0.5 ? seg : seg + 1);
+        const double rate = v * (kappa - kLateralGain * lateral - kHeadingGain * psi);
+        h = wrapAngle(h + std::clamp(rate * dt, -w * dt, w * dt));
+
+        // Speed: below kCarYawShare x yaw limit / curvature at every vertex
+        // within braking distance, braking at kBrakeShare of the limit.
+        double vt = o.maxSpeed;
+        for (size_t k = seg; k < route.vertices() && route.cum(k) <= sp + horizon; ++k) {
+            const double c = std::abs(route.curvature(k));
+            if (c < 1e-9) continue;
+            const double vl = std::min(o.maxSpeed, kCarYawShare * w / c);
+            vt = std::min(vt, std::sqrt(vl * vl + 2.0 * brake * std::max(0.0, route.cum(k) - sp)));
+        }
+        v += std::clamp(vt - v, -o.decel * dt, o.accel * dt);
+        v = std::clamp(v, 0.0, o.maxSpeed);
+        pos += v * dt * glm::dvec2(std::sin(h), std::cos(h));
+    }
+    return path;
+}
+
+}  // namespace
+
 Result<Path> generatePath(const StreetGraph& g, const CityParams& params, const PathOptions& o) {
     VISTA_RETURN_IF_ERROR(validatePathOptions(o));
     if (g.edges.empty()) return Status::error("cannot make a path: the city has no streets (street graph has 0 edges)");
     for (const auto& e : g.edges)
         if (e.a >= g.nodes.size() || e.b >= g.nodes.size())
             return Status::error("cannot make a path: street graph edge refers to a missing node");
+    if (o.kind == PathKind::Car) return driveCar(g, params, o);
 
     Route route(g, o.seed);
     glm::dvec2 pos = route.point(0);
@@ -305,6 +390,21 @@ Status savePathCsv(const Path& path, const std::string& file) {
     for (const auto& s : path.samples) {
         std::snprintf(buf, sizeof(buf), "%.6f,%.4f,%.4f,%.4f,%.6f,%.6f\n", s.t, s.position.x, s.position.y,
                       s.position.z, s.heading * 180.0 / kPi, s.pitch * 180.0 / kPi);
+        out += buf;
+    }
+    return writeFileAtomic(file, out);
+}
+
+Status saveLanePositionsCsv(const Path& path, const std::string& file) {
+    if (path.lanes.size() != path.samples.size() || path.lanes.empty())
+        return Status::error("lane positions for '" + file + "': the path has none (only car paths made from a city's "
+                             "streets carry them, not paths read from a CSV or walk and fly paths)");
+    std::string out = "t_s,road_id,lane_id,s_m,t_offset_m\n";
+    char buf[160];
+    for (size_t i = 0; i < path.samples.size(); ++i) {
+        const LanePosition& l = path.lanes[i];
+        std::snprintf(buf, sizeof(buf), "%.6f,%llu,%d,%.4f,%.4f\n", path.samples[i].t, (unsigned long long)l.road, l.lane,
+                      l.s, l.tOffset);
         out += buf;
     }
     return writeFileAtomic(file, out);

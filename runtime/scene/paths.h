@@ -3,17 +3,30 @@
 //
 // A path is a list of samples at a fixed time step (PathOptions::dt): time
 // (s), eye position (world metres: city frame + params.origin), heading
-// (radians clockwise from north, as Camera) and pitch (radians). The vehicle
-// follows a route of street-graph edges chosen by a seeded random walk
-// (vista::Rng(seed, 0, Stream::Paths); U-turns only at dead ends, straight
-// continuations preferred), steering with pure pursuit of a point ahead on
-// the route centre line. Limits hold at every step by construction:
-// |speed| <= maxSpeed, |heading change| <= maxYawRate * dt, |dv| <= accel * dt;
-// the vehicle slows before turns so that it stays on the carriageway.
-// The vehicle starts at rest at the route's first node; the first
-// PathOptions::runUp seconds are simulated and dropped, so that the returned
-// path starts at cruising speed (measurements must not be flattered by a
-// slow start, where frame-to-frame coherence is highest).
+// (radians clockwise from north, as Camera) and pitch (radians).
+// Walk and fly: the vehicle follows a route of street-graph edges chosen by a
+// seeded random walk (vista::Rng(seed, 0, Stream::Paths); U-turns only at
+// dead ends, straight continuations preferred), steering with pure pursuit of
+// a point ahead on the route centre line.
+// Car: the vehicle drives in lanes of the lane model (citygen/lanes.h, built
+// with the blocks of the street graph, extractBlocks, as `vista gen --xodr`
+// builds it): its route is a LaneRoute (lane_route.h: street lanes, the
+// junctions' connecting roads and the transitions between them, U-turns at
+// dead ends into the opposite lane; right-hand traffic, or the lanes driven
+// mirrored with PathOptions::leftHandTraffic), and it steers along the lane
+// centre (the centre line's curvature as feed-forward, the lateral and
+// heading error as feedback). Its speed stays below kCarYawShare of the yaw
+// rate limit divided by the curvature ahead, braking in time; each sample
+// carries the OpenDRIVE position of the eye (Path::lanes).
+// Limits hold at every step by construction:
+// |speed| <= maxSpeed, |heading change| <= maxYawRate * dt, |dv| <= accel * dt
+// (speeding up) and decel * dt (braking); the vehicle slows before turns so
+// that it stays on the carriageway (the car: in its lane).
+// The vehicle starts at rest at the route's first node (the car: at the
+// start of its first lane); the first PathOptions::runUp seconds are
+// simulated and dropped, so that the returned path starts at cruising speed
+// (measurements must not be flattered by a slow start, where frame-to-frame
+// coherence is highest).
 // Eye height above the terrain: walk 1.7 m, car 1.2 m, fly flyHeight (the
 // elevated fly-over where occlusion is weak; pitched down by flyPitch).
 // Output depends only on (graph, params, options): no threads, no clocks.
@@ -22,6 +35,12 @@
 // (degrees at this user interface). loadPathCsv rejects missing files,
 // malformed lines, non-finite values and non-increasing time with a message
 // naming the line. savePathCsv writes atomically.
+// Lane positions CSV (car paths): header `t_s,road_id,lane_id,s_m,t_offset_m`,
+// one line per sample: the OpenDRIVE road and lane the car drives in, s along
+// that road's reference line and the lateral offset of the eye's xy from the
+// lane centre (left of the road's reference line positive, whatever the
+// direction of travel), so that evaluating the .xodr at (road, lane, s,
+// t_offset) gives the sample's x, y. saveLanePositionsCsv writes atomically.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -33,6 +52,7 @@
 #include "foundation/status.h"
 #include "citygen/street_graph.h"
 #include "runtime/scene/camera.h"
+#include "runtime/scene/lane_route.h"
 
 namespace vista {
 
@@ -57,6 +77,9 @@ struct PathOptions {
     // Seconds driven before t = 0 and dropped, so that a measured path starts
     // at cruising speed instead of at rest (0 = start at rest), 0 .. 600.
     double runUp = 8.0;
+    // Car: left-hand traffic, every lane driven against its right-hand
+    // direction (lane_route.h; the lane model itself is right-hand traffic).
+    bool leftHandTraffic = false;
     double eyeHeight() const { return kind == PathKind::Walk ? 1.7 : kind == PathKind::Car ? 1.2 : flyHeight; }
 };
 // Checks ranges; message names the option.
@@ -69,8 +92,15 @@ struct PathSample {
     double pitch = 0;          // radians
 };
 
+// Share of the yaw-rate limit a car's speed leaves to the lane's curvature
+// (the rest corrects lateral and heading errors).
+constexpr double kCarYawShare = 0.7;
+
 struct Path {
     std::vector<PathSample> samples;
+    // Car paths from generatePath: the OpenDRIVE position of each sample's eye
+    // (lane_route.h); empty for other kinds and for paths read from a CSV.
+    std::vector<LanePosition> lanes;
     // Camera at sample i: eye/heading/pitch from the sample, the rest (fov,
     // size, zNear) from `base`.
     Camera camera(size_t i, const Camera& base) const;
@@ -106,6 +136,8 @@ PathMotion pathMotion(const Path& path, const std::vector<size_t>& frames);
 Result<Path> generatePath(const StreetGraph& streets, const CityParams& params, const PathOptions& options);
 
 Status savePathCsv(const Path& path, const std::string& file);
+// Errors: the path has no lane positions (not a generated car path); I/O.
+Status saveLanePositionsCsv(const Path& path, const std::string& file);
 Result<Path> loadPathCsv(const std::string& file);
 
 // Distance (metres, 2D) from city-frame point p to the nearest street centre
