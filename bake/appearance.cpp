@@ -83,155 +83,198 @@ struct PointResult {
     int64_t rays = 0, samples = 0;
 };
 
-}  // namespace
+// The sampling plane's texel grid: its corner, extent, texel size and texel count.
+struct TexelGrid {
+    glm::dvec2 lo, size, texel;
+    int nt;
+};
 
-void computeAppearance(const RayScene& scene, const SamplingSetup& s, const std::vector<glm::vec3>& points,
-                       const AppearanceParams& p, uint64_t seed, uint64_t entity, PointImpostorData& out,
-                       AppearanceStats& stats, std::vector<uint32_t>* kept, const Box3* cell) {
-    VISTA_CHECK(p.texelsX >= 1 && p.texelsY >= 1 && p.minSamples >= 1 && p.maxSamples >= p.minSamples);
-    const int nt = p.texelsX * p.texelsY;
-    const glm::dvec2 lo = s.rectLo, size = glm::max(s.rectHi - s.rectLo, glm::dvec2(1e-6));
-    const glm::dvec2 texel(size.x / p.texelsX, size.y / p.texelsY);
-    std::vector<PointResult> res(points.size());
-    const FTable fTable(p.significance, std::max(1, nt - 1), std::max(1, nt * p.maxSamples));
+// Samples the appearance of one point from the sampling plane into a
+// PointResult. Every draw comes from the point's own stream in a fixed order,
+// so the result does not depend on threads.
+class PointSampler {
+public:
+    PointSampler(const RayScene& scene, const SamplingSetup& s, const AppearanceParams& p, const TexelGrid& grid,
+                 const FTable& fTable, const glm::dvec3& pt, Rng& rng, PointResult& r)
+        : _scene(scene), _s(s), _p(p), _grid(grid), _fTable(fTable), _pt(pt), _rng(rng), _r(r),
+          _acc(static_cast<size_t>(grid.nt)) {}
 
-    tbb::parallel_for(size_t(0), points.size(), [&](size_t k) {
-        Rng rng(seed, hashKeys(entity, k), Stream::Bake);
-        PointResult& r = res[k];
-        const glm::dvec3 pt(points[k]);
+    // Runs the steps: visibility from the cell, a first pass of samples per
+    // texel, a colour from the cell when no plane sample saw the point, else
+    // adaptive refinement and the summary of the texels.
+    void run(const Box3* cell) {
+        const int nt = _grid.nt;
         bool seen = false;
         glm::dvec3 seenFrom(0.0);
-        if (cell && p.cellVisibilityRays > 0) {
-            for (int v = 0; v < p.cellVisibilityRays && !seen; ++v) {
-                glm::dvec3 e;
-                if (v < 8) e = cell->corner(v);
-                else if (v == 8) e = cell->center();
-                else
-                    for (int a = 0; a < 3; ++a) e[a] = rng.uniform(cell->lo[a], cell->hi[a]);
-                glm::dvec3 d = pt - e;
-                const double dist = glm::length(d);
-                if (dist < 1e-6) { seen = true; break; }
-                d /= dist;
-                ++r.rays;
-                seen = !scene.occluded(glm::vec3(e), glm::vec3(d), 0.0f, float(dist - std::max(0.1, 2e-3 * dist)));
-                if (seen) seenFrom = e;
-            }
-            if (!seen) { r.visible = false; return; }
+        if (cell && _p.cellVisibilityRays > 0) {
+            seen = seenFromCell(*cell, seenFrom);
+            if (!seen) { _r.visible = false; return; }
         }
-        std::vector<TexelAcc> acc(static_cast<size_t>(nt));
-        // One sample for texel t; returns false if the point was hidden.
-        auto sample = [&](int t) {
-            const int ti = t % p.texelsX, tj = t / p.texelsX;
-            glm::dvec2 q = lo + glm::dvec2((ti + 0.5) * texel.x, (tj + 0.5) * texel.y);
-            q.x += rng.normal() * p.viewSigma * texel.x;
-            q.y += rng.normal() * p.viewSigma * texel.y;
-            q = glm::clamp(q, lo, lo + size);
-            const glm::dvec3 sp = s.toFrame(q);
-            glm::dvec3 d = pt - sp;
-            const double dist = glm::length(d);
-            TexelAcc& a = acc[size_t(t)];
-            ++a.attempts;
-            if (dist < 1e-6) return;
-            d /= dist;
-            ++r.rays;
-            const double gap = std::max(0.05, 2e-4 * dist);
-            if (scene.occluded(glm::vec3(sp), glm::vec3(d), 0.0f, float(dist - gap))) return;
-            glm::dvec3 e1 = glm::cross(d, glm::dvec3(0, 0, 1));
-            if (glm::length(e1) < 1e-9) e1 = glm::dvec3(1, 0, 0);
-            e1 = glm::normalize(e1);
-            const glm::dvec3 e2 = glm::cross(e1, d);
-            const double ox = rng.uniform(-0.5, 0.5) + rng.normal() * p.pixelSigma;
-            const double oy = rng.uniform(-0.5, 0.5) + rng.normal() * p.pixelSigma;
-            const glm::dvec3 dir = glm::normalize(d + p.pixelAngle * (ox * e1 + oy * e2));
-            ++r.rays;
-            const RayHit h = scene.intersect(glm::vec3(sp), glm::vec3(dir), 0.0f, 1e30f);
-            glm::dvec3 c;
-            if (h.hit) c = glm::dvec3(scene.hitColor(h));
-            else c = glm::dvec3(glm::vec3(skyColor(std::asin(std::clamp(dir.z, -1.0, 1.0))))) / 255.0;
-            a.sum += c;
-            const double l = luma(c);
-            a.l += l;
-            a.l2 += l * l;
-            ++a.n;
-        };
-        const int maxAttempts = 4 * p.maxSamples;
         // Pass 1: minSamples visible samples per texel.
         for (int t = 0; t < nt; ++t)
-            while (acc[size_t(t)].n < p.minSamples && acc[size_t(t)].attempts < 4 * p.minSamples) sample(t);
+            while (_acc[size_t(t)].n < _p.minSamples && _acc[size_t(t)].attempts < 4 * _p.minSamples) sample(t);
         int64_t n = 0;
         double l = 0, l2 = 0;
-        for (const auto& a : acc) { n += a.n; l += a.l; l2 += a.l2; }
-        if (n == 0 && !seen) { r.visible = false; return; }
+        for (const auto& a : _acc) { n += a.n; l += a.l; l2 += a.l2; }
+        if (n == 0 && !seen) { _r.visible = false; return; }
         if (n == 0) {
-            // Seen from the cell but from no sampled viewpoint on the plane: one
-            // colour from pixel rays at the cell position that sees it (never a hole).
-            glm::dvec3 d = glm::normalize(pt - seenFrom);
-            glm::dvec3 e1 = glm::cross(d, glm::dvec3(0, 0, 1));
-            if (glm::length(e1) < 1e-9) e1 = glm::dvec3(1, 0, 0);
-            e1 = glm::normalize(e1);
-            const glm::dvec3 e2 = glm::cross(e1, d);
-            glm::dvec3 sum(0.0);
-            const int k = std::max(4, p.minSamples);
-            for (int i = 0; i < k; ++i) {
-                const double ox = rng.uniform(-0.5, 0.5) + rng.normal() * p.pixelSigma;
-                const double oy = rng.uniform(-0.5, 0.5) + rng.normal() * p.pixelSigma;
-                const glm::dvec3 dir = glm::normalize(d + p.pixelAngle * (ox * e1 + oy * e2));
-                ++r.rays;
-                const RayHit h = scene.intersect(glm::vec3(seenFrom), glm::vec3(dir), 0.0f, 1e30f);
-                sum += h.hit ? glm::dvec3(scene.hitColor(h)) : glm::dvec3(glm::vec3(skyColor(std::asin(std::clamp(dir.z, -1.0, 1.0))))) / 255.0;
-            }
-            r.visible = true;
-            r.single = true;
-            r.samples = k;
-            r.mean = sum / double(k);
-            r.texels.assign(size_t(nt), r.mean);
+            colourFromCell(seenFrom);
             return;
         }
-        r.visible = true;
+        _r.visible = true;
         const double pooledStd = n > 1 ? std::sqrt(std::max(0.0, (l2 - l * l / double(n)) / double(n - 1))) : 0.0;
-        const bool noiseOnly = nt > 1 && fTable.enabled() && !(pooledStd < p.singleColorThreshold) && !viewDependent(acc, fTable);
-        if (!(pooledStd < p.singleColorThreshold) && nt > 1 && !noiseOnly) {
+        const bool noiseOnly = nt > 1 && _fTable.enabled() && !(pooledStd < _p.singleColorThreshold) && !viewDependent(_acc, _fTable);
+        refine(pooledStd, noiseOnly);
+        summarize(noiseOnly);
+    }
+
+private:
+    // Casts visibility rays from the cell's corners, centre and random points
+    // inside it; returns whether one sees the point (seenFrom: where from).
+    bool seenFromCell(const Box3& cell, glm::dvec3& seenFrom) {
+        bool seen = false;
+        for (int v = 0; v < _p.cellVisibilityRays && !seen; ++v) {
+            glm::dvec3 e;
+            if (v < 8) e = cell.corner(v);
+            else if (v == 8) e = cell.center();
+            else
+                for (int a = 0; a < 3; ++a) e[a] = _rng.uniform(cell.lo[a], cell.hi[a]);
+            glm::dvec3 d = _pt - e;
+            const double dist = glm::length(d);
+            if (dist < 1e-6) { seen = true; break; }
+            d /= dist;
+            ++_r.rays;
+            seen = !_scene.occluded(glm::vec3(e), glm::vec3(d), 0.0f, float(dist - std::max(0.1, 2e-3 * dist)));
+            if (seen) seenFrom = e;
+        }
+        return seen;
+    }
+
+    // Takes one sample for texel t: a jittered viewpoint in the texel, a
+    // visibility ray to the point and, if it is seen, one pixel ray's colour.
+    void sample(int t) {
+        const glm::dvec2 lo = _grid.lo, texel = _grid.texel;
+        const int ti = t % _p.texelsX, tj = t / _p.texelsX;
+        glm::dvec2 q = lo + glm::dvec2((ti + 0.5) * texel.x, (tj + 0.5) * texel.y);
+        q.x += _rng.normal() * _p.viewSigma * texel.x;
+        q.y += _rng.normal() * _p.viewSigma * texel.y;
+        q = glm::clamp(q, lo, lo + _grid.size);
+        const glm::dvec3 sp = _s.toFrame(q);
+        glm::dvec3 d = _pt - sp;
+        const double dist = glm::length(d);
+        TexelAcc& a = _acc[size_t(t)];
+        ++a.attempts;
+        if (dist < 1e-6) return;
+        d /= dist;
+        ++_r.rays;
+        const double gap = std::max(0.05, 2e-4 * dist);
+        if (_scene.occluded(glm::vec3(sp), glm::vec3(d), 0.0f, float(dist - gap))) return;
+        glm::dvec3 e1 = glm::cross(d, glm::dvec3(0, 0, 1));
+        if (glm::length(e1) < 1e-9) e1 = glm::dvec3(1, 0, 0);
+        e1 = glm::normalize(e1);
+        const glm::dvec3 e2 = glm::cross(e1, d);
+        const double ox = _rng.uniform(-0.5, 0.5) + _rng.normal() * _p.pixelSigma;
+        const double oy = _rng.uniform(-0.5, 0.5) + _rng.normal() * _p.pixelSigma;
+        const glm::dvec3 dir = glm::normalize(d + _p.pixelAngle * (ox * e1 + oy * e2));
+        ++_r.rays;
+        const RayHit h = _scene.intersect(glm::vec3(sp), glm::vec3(dir), 0.0f, 1e30f);
+        glm::dvec3 c;
+        if (h.hit) c = glm::dvec3(_scene.hitColor(h));
+        else c = glm::dvec3(glm::vec3(skyColor(std::asin(std::clamp(dir.z, -1.0, 1.0))))) / 255.0;
+        a.sum += c;
+        const double l = luma(c);
+        a.l += l;
+        a.l2 += l * l;
+        ++a.n;
+    }
+
+    // Seen from the cell but from no sampled viewpoint on the plane: gives one
+    // colour from pixel rays at the cell position that sees it (never a hole).
+    void colourFromCell(const glm::dvec3& seenFrom) {
+        glm::dvec3 d = glm::normalize(_pt - seenFrom);
+        glm::dvec3 e1 = glm::cross(d, glm::dvec3(0, 0, 1));
+        if (glm::length(e1) < 1e-9) e1 = glm::dvec3(1, 0, 0);
+        e1 = glm::normalize(e1);
+        const glm::dvec3 e2 = glm::cross(e1, d);
+        glm::dvec3 sum(0.0);
+        const int k = std::max(4, _p.minSamples);
+        for (int i = 0; i < k; ++i) {
+            const double ox = _rng.uniform(-0.5, 0.5) + _rng.normal() * _p.pixelSigma;
+            const double oy = _rng.uniform(-0.5, 0.5) + _rng.normal() * _p.pixelSigma;
+            const glm::dvec3 dir = glm::normalize(d + _p.pixelAngle * (ox * e1 + oy * e2));
+            ++_r.rays;
+            const RayHit h = _scene.intersect(glm::vec3(seenFrom), glm::vec3(dir), 0.0f, 1e30f);
+            sum += h.hit ? glm::dvec3(_scene.hitColor(h)) : glm::dvec3(glm::vec3(skyColor(std::asin(std::clamp(dir.z, -1.0, 1.0))))) / 255.0;
+        }
+        _r.visible = true;
+        _r.single = true;
+        _r.samples = k;
+        _r.mean = sum / double(k);
+        _r.texels.assign(size_t(_grid.nt), _r.mean);
+    }
+
+    // Samples each texel further until its luma is known well enough, when
+    // the point looks different from different viewpoints (or has one texel).
+    void refine(double pooledStd, bool noiseOnly) {
+        const int nt = _grid.nt;
+        const int maxAttempts = 4 * _p.maxSamples;
+        if (!(pooledStd < _p.singleColorThreshold) && nt > 1 && !noiseOnly) {
             for (int t = 0; t < nt; ++t) {
-                TexelAcc& a = acc[size_t(t)];
-                while (a.n < p.maxSamples && a.attempts < maxAttempts && !(a.n >= p.minSamples && a.stdErr() < p.varianceThreshold))
+                TexelAcc& a = _acc[size_t(t)];
+                while (a.n < _p.maxSamples && a.attempts < maxAttempts && !(a.n >= _p.minSamples && a.stdErr() < _p.varianceThreshold))
                     sample(t);
             }
         } else if (nt == 1) {
-            TexelAcc& a = acc[0];
-            while (a.n < p.maxSamples && a.attempts < maxAttempts && !(a.n >= p.minSamples && a.stdErr() < p.varianceThreshold))
+            TexelAcc& a = _acc[0];
+            while (a.n < _p.maxSamples && a.attempts < maxAttempts && !(a.n >= _p.minSamples && a.stdErr() < _p.varianceThreshold))
                 sample(0);
         }
+    }
+
+    // Sets the point's mean, texel colours and whether one colour (or noise) stands for it.
+    void summarize(bool noiseOnly) {
+        const int nt = _grid.nt;
         glm::dvec3 sum(0.0);
         int64_t cnt = 0;
         int seenTexels = 0;
-        for (const auto& a : acc) {
+        for (const auto& a : _acc) {
             sum += a.sum;
             cnt += a.n;
             seenTexels += a.n > 0 ? 1 : 0;
         }
-        r.samples = cnt;
-        r.mean = sum / double(cnt);
+        _r.samples = cnt;
+        _r.mean = sum / double(cnt);
         // Texel means; unseen texels take the mean of the seen ones.
         glm::dvec3 tm(0.0);
-        for (const auto& a : acc) if (a.n > 0) tm += a.mean();
+        for (const auto& a : _acc) if (a.n > 0) tm += a.mean();
         tm /= double(seenTexels);
-        r.texels.resize(size_t(nt));
-        for (int t = 0; t < nt; ++t) r.texels[size_t(t)] = acc[size_t(t)].n > 0 ? acc[size_t(t)].mean() : tm;
+        _r.texels.resize(size_t(nt));
+        for (int t = 0; t < nt; ++t) _r.texels[size_t(t)] = _acc[size_t(t)].n > 0 ? _acc[size_t(t)].mean() : tm;
         glm::dvec3 var(0.0);
-        for (const auto& c : r.texels) var += (c - tm) * (c - tm);
+        for (const auto& c : _r.texels) var += (c - tm) * (c - tm);
         var /= double(nt);
         const double maxStd = std::sqrt(std::max(var.x, std::max(var.y, var.z)));
-        r.noise = noiseOnly || (nt > 1 && fTable.enabled() && !(maxStd < p.singleColorThreshold) && !viewDependent(acc, fTable));
-        r.single = nt == 1 || maxStd < p.singleColorThreshold || r.noise;
+        _r.noise = noiseOnly || (nt > 1 && _fTable.enabled() && !(maxStd < _p.singleColorThreshold) && !viewDependent(_acc, _fTable));
+        _r.single = nt == 1 || maxStd < _p.singleColorThreshold || _r.noise;
         // One colour: the mean of every sample (noise) or of the texel means.
-        if (r.single && !r.noise) r.mean = tm;
-    });
+        if (_r.single && !_r.noise) _r.mean = tm;
+    }
 
-    out.texelsX = p.texelsX;
-    out.texelsY = p.texelsY;
-    out.planeOrigin = glm::vec3(s.toFrame(lo));
-    out.planeU = glm::vec3(s.U * size.x);
-    out.planeV = glm::vec3(s.V * size.y);
+    const RayScene& _scene;
+    const SamplingSetup& _s;
+    const AppearanceParams& _p;
+    const TexelGrid& _grid;
+    const FTable& _fTable;
+    const glm::dvec3 _pt;
+    Rng& _rng;
+    PointResult& _r;
+    std::vector<TexelAcc> _acc;
+};
+
+// Writes the visible points' colours and texel blocks to out (in point order)
+// and adds every point's rays, samples and kind to stats.
+void writeResults(const std::vector<PointResult>& res, const std::vector<glm::vec3>& points, int nt,
+                  PointImpostorData& out, AppearanceStats& stats, std::vector<uint32_t>* kept) {
     out.positions.clear(); out.colors.clear(); out.block.clear(); out.texels.clear();
     if (kept) kept->clear();
     for (size_t k = 0; k < points.size(); ++k) {
@@ -252,6 +295,32 @@ void computeAppearance(const RayScene& scene, const SamplingSetup& s, const std:
             for (const auto& c : r.texels) out.texels.push_back(toU8(c));
         }
     }
+}
+
+}  // namespace
+
+void computeAppearance(const RayScene& scene, const SamplingSetup& s, const std::vector<glm::vec3>& points,
+                       const AppearanceParams& p, uint64_t seed, uint64_t entity, PointImpostorData& out,
+                       AppearanceStats& stats, std::vector<uint32_t>* kept, const Box3* cell) {
+    VISTA_CHECK(p.texelsX >= 1 && p.texelsY >= 1 && p.minSamples >= 1 && p.maxSamples >= p.minSamples);
+    const int nt = p.texelsX * p.texelsY;
+    const glm::dvec2 lo = s.rectLo, size = glm::max(s.rectHi - s.rectLo, glm::dvec2(1e-6));
+    const glm::dvec2 texel(size.x / p.texelsX, size.y / p.texelsY);
+    const TexelGrid grid{lo, size, texel, nt};
+    std::vector<PointResult> res(points.size());
+    const FTable fTable(p.significance, std::max(1, nt - 1), std::max(1, nt * p.maxSamples));
+
+    tbb::parallel_for(size_t(0), points.size(), [&](size_t k) {
+        Rng rng(seed, hashKeys(entity, k), Stream::Bake);
+        PointSampler(scene, s, p, grid, fTable, glm::dvec3(points[k]), rng, res[k]).run(cell);
+    });
+
+    out.texelsX = p.texelsX;
+    out.texelsY = p.texelsY;
+    out.planeOrigin = glm::vec3(s.toFrame(lo));
+    out.planeU = glm::vec3(s.U * size.x);
+    out.planeV = glm::vec3(s.V * size.y);
+    writeResults(res, points, nt, out, stats, kept);
 }
 
 }  // namespace vista

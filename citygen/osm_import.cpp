@@ -768,17 +768,14 @@ std::string OsmImport::dropSummary() const {
     return out;
 }
 
-Result<OsmImport> importOsm(const std::string& path, const CityParams& params, bool buildings) {
-    {
-        std::ifstream probe(path, std::ios::binary);
-        if (!probe) return Status::error("OSM file '" + path + "' cannot be opened");
-    }
-    OsmImport out;
-    const double limit = maxExtent_m();
-    out.outlierRadius_m = limit * std::sqrt(2.0);
-    WayCollector collector;
-    RelationCollector relationCollector;
-    std::vector<NodeId> blanked;
+namespace {
+
+// Reads the node locations and highway ways of an OSM file, and with
+// buildings its building ways and relations (relations first, so the second
+// pass keeps their member ways). XML is read as text and scanned first: the
+// ids of nodes whose coordinates it blanks go to `blanked`.
+Status readOsm(const std::string& path, bool buildings, WayCollector& collector, RelationCollector& relationCollector,
+               std::vector<NodeId>& blanked) {
     try {
         osmium::io::File file(path);
         const auto format = file.format();
@@ -812,42 +809,48 @@ Result<OsmImport> importOsm(const std::string& path, const CityParams& params, b
     } catch (const std::exception& e) {
         return Status::error("OSM file '" + path + "' could not be read: " + e.what());
     }
-    const std::string noRoads = "OSM file '" + path + "' contains no usable highway=* ways (roads with node locations)";
-    if (collector.ways.empty()) return Status::error(noRoads);
+    return Status::ok();
+}
 
-    // Nodes without a valid location: invalid coordinates (blanked by the scan, or out of range in PBF) or missing.
-    std::set<NodeId> invalid, missing, outliers;
-    std::vector<Way> ways = splitWays(std::move(collector.ways), [&](const WayNode& n) {
+// Splits the ways at nodes without a valid location: invalid coordinates
+// (blanked by the scan, or out of range in PBF) or missing; counts both.
+std::vector<Way> dropUnlocatedNodes(std::vector<Way>&& collected, const std::vector<NodeId>& blanked, OsmImport& out) {
+    std::set<NodeId> invalid, missing;
+    std::vector<Way> ways = splitWays(std::move(collected), [&](const WayNode& n) {
         if (n.loc.valid()) return true;
         const bool bad = n.loc.is_defined() || std::binary_search(blanked.begin(), blanked.end(), n.id);
         (bad ? invalid : missing).insert(n.id);
         return false;
     });
-    if (ways.empty()) return Status::error(noRoads);
-    for (auto& w : ways)
-        for (auto& n : w.nodes) n.geo = {n.loc.lat(), n.loc.lon()};
+    out.invalidNodes = invalid.size();
+    out.missingNodes = missing.size();
+    return ways;
+}
 
-    // Outliers: farther than limit * sqrt(2) (a city of the largest size never loses a node) from the median.
-    const glm::dvec3 median = medianDirection(ways);
-    ways = splitWays(std::move(ways), [&](const WayNode& n) {
+// Splits the ways at outliers: nodes farther than the outlier radius (limit *
+// sqrt(2): a city of the largest size never loses a node) from the median; counts them.
+std::vector<Way> dropOutliers(std::vector<Way>&& located, const glm::dvec3& median, OsmImport& out) {
+    std::set<NodeId> outliers;
+    std::vector<Way> ways = splitWays(std::move(located), [&](const WayNode& n) {
         const glm::dvec3 v = unitVector(n.geo);
         if (std::atan2(glm::length(glm::cross(v, median)), glm::dot(v, median)) * kEarthRadius_m <= out.outlierRadius_m) return true;
         outliers.insert(n.id);
         return false;
     });
-    out.invalidNodes = invalid.size();
-    out.missingNodes = missing.size();
     out.outlierNodes = outliers.size();
-    if (ways.empty()) return Status::error(noRoads);
+    return ways;
+}
 
-    // Frame: transverse Mercator about the centroid, moved to the centre of the bounding box (repeated:
-    // near a pole moving the reference turns the frame), rounded to 1e-7 deg.
+// Places the frame: transverse Mercator about the centroid, moved to the
+// centre of the bounding box (repeated: near a pole moving the reference
+// turns the frame), rounded to 1e-7 deg. Projects every node into it (n.xy)
+// and returns the reference; lo, hi: the nodes' bounding box.
+GeoReference placeFrame(std::vector<Way>& ways, glm::dvec2& lo, glm::dvec2& hi) {
     glm::dvec3 sum(0.0);
     for (const auto& w : ways)
         for (const auto& n : w.nodes) sum += unitVector(n.geo);
     const GeoPoint centroid = fromUnitVector(glm::normalize(sum));
     GeoReference ref{centroid.lat_deg, centroid.lon_deg};
-    glm::dvec2 lo(0.0), hi(0.0);
     auto bounds = [&] {
         lo = glm::dvec2(1e300);
         hi = glm::dvec2(-1e300);
@@ -867,9 +870,11 @@ Result<OsmImport> importOsm(const std::string& path, const CityParams& params, b
     }
     ref = {roundTo1e7(ref.lat0_deg), roundTo1e7(ref.lon0_deg)};
     bounds();
-    out.geo = ref;
-    out.extentX_m = hi.x - lo.x;
-    out.extentY_m = hi.y - lo.y;
+    return ref;
+}
+
+// Refuses roads that span more than the largest city vista gen builds (`limit` metres).
+Status checkExtent(const std::string& path, double limit, const OsmImport& out) {
     if (std::max(out.extentX_m, out.extentY_m) > limit) {
         std::string dropped = out.outlierNodes ? " after dropping " + std::to_string(out.outlierNodes) + " outlier nodes farther than " +
                                                      distance(out.outlierRadius_m) + " from the median position" : "";
@@ -877,12 +882,13 @@ Result<OsmImport> importOsm(const std::string& path, const CityParams& params, b
                              " north-south" + dropped + ", more than the largest city vista gen builds (size_m up to " +
                              std::to_string(int(limit)) + " m = " + distance(limit) + "); crop the extract");
     }
+    return Status::ok();
+}
 
-    if (buildings)
-        importBuildings(collector.buildingWays, relationCollector.relations,
-                        {ref, median, out.outlierRadius_m, 0.5 * params.size_m}, out);
-
-    // Bounded planarization: simplify, drop ways tangled with themselves, refuse a tangle of many ways.
+// Bounded planarization: simplifies the ways, drops ways tangled with
+// themselves, refuses a tangle of many ways; returns the kept ways.
+Result<std::vector<Way>> untangleWays(std::vector<Way>& ways, const CityParams& params, const std::string& path,
+                                      const std::string& noRoads, OsmImport& out) {
     out.simplifiedNodes = simplify(ways, params.min_segment_m);
     std::set<NodeId> tangled;
     std::vector<Way> kept;
@@ -897,7 +903,13 @@ Result<OsmImport> importOsm(const std::string& path, const CityParams& params, b
     if (findConflictingEdges(segmentGraph(kept, 0, kept.size()), kMaxConflicts + 1).size() > kMaxConflicts)
         return Status::error("OSM file '" + path + "': the roads cross or touch each other away from shared nodes more than " +
                              std::to_string(kMaxConflicts) + " times; planarizing that many crossings is refused");
+    return kept;
+}
 
+// Planarizes the kept ways' segments into the street graph and gives its
+// edges the road tags of the ways they come from.
+Status buildStreets(const std::vector<Way>& kept, const WayCollector& collector, const CityParams& params,
+                    const std::string& path, OsmImport& out) {
     std::vector<RawSegment> segs;
     for (const auto& w : kept)
         for (size_t k = 1; k < w.nodes.size(); ++k) segs.push_back({w.nodes[k - 1].xy, w.nodes[k].xy, w.cls});
@@ -909,6 +921,48 @@ Result<OsmImport> importOsm(const std::string& path, const CityParams& params, b
     const double snap = std::isfinite(params.snap_radius_m) ? std::max(params.snap_radius_m, 0.0) : 0.0;
     const double minSeg = std::isfinite(params.min_segment_m) ? std::max(params.min_segment_m, 0.0) : 0.0;
     assignRoadTags(out.streets, kept, collector.roadTags, snap + minSeg + 1.0, snap + 1.0, out.roadTagStats);
+    return Status::ok();
+}
+
+}  // namespace
+
+Result<OsmImport> importOsm(const std::string& path, const CityParams& params, bool buildings) {
+    {
+        std::ifstream probe(path, std::ios::binary);
+        if (!probe) return Status::error("OSM file '" + path + "' cannot be opened");
+    }
+    OsmImport out;
+    const double limit = maxExtent_m();
+    out.outlierRadius_m = limit * std::sqrt(2.0);
+    WayCollector collector;
+    RelationCollector relationCollector;
+    std::vector<NodeId> blanked;
+    if (Status read = readOsm(path, buildings, collector, relationCollector, blanked); !read) return read;
+    const std::string noRoads = "OSM file '" + path + "' contains no usable highway=* ways (roads with node locations)";
+    if (collector.ways.empty()) return Status::error(noRoads);
+
+    std::vector<Way> ways = dropUnlocatedNodes(std::move(collector.ways), blanked, out);
+    if (ways.empty()) return Status::error(noRoads);
+    for (auto& w : ways)
+        for (auto& n : w.nodes) n.geo = {n.loc.lat(), n.loc.lon()};
+    const glm::dvec3 median = medianDirection(ways);
+    ways = dropOutliers(std::move(ways), median, out);
+    if (ways.empty()) return Status::error(noRoads);
+
+    glm::dvec2 lo(0.0), hi(0.0);
+    const GeoReference ref = placeFrame(ways, lo, hi);
+    out.geo = ref;
+    out.extentX_m = hi.x - lo.x;
+    out.extentY_m = hi.y - lo.y;
+    if (Status extent = checkExtent(path, limit, out); !extent) return extent;
+
+    if (buildings)
+        importBuildings(collector.buildingWays, relationCollector.relations,
+                        {ref, median, out.outlierRadius_m, 0.5 * params.size_m}, out);
+
+    auto kept = untangleWays(ways, params, path, noRoads, out);
+    if (!kept) return kept.status();
+    if (Status streets = buildStreets(*kept, collector, params, path, out); !streets) return streets;
     return out;
 }
 

@@ -99,6 +99,16 @@ public:
     void edgeMarkings(MeshBuilder& mark, size_t e, const glm::dvec2& A, const glm::dvec2& d, double L, int pieces);
     void parks();
     void roads();
+    // Draws the carriageway and markings of every edge this tile claims;
+    // collects (node of this tile, incident edge) pairs for the junctions.
+    void carriageways(MeshBuilder& road, MeshBuilder& mark, std::vector<std::pair<uint32_t, uint32_t>>& nodeEdges);
+    // The points whose convex hull is the junction polygon of `node`, from its
+    // incident edges nodeEdges[i, j): carriageway corners, a dead end's round
+    // cap, and where consecutive edges' carriageway borders meet.
+    Polygon2 junctionPoints(uint32_t node, const std::vector<std::pair<uint32_t, uint32_t>>& nodeEdges, size_t i, size_t j) const;
+    // Adds the carriageway of the lane model's link roads at `node` (junction
+    // turns, degree-2 transitions): samples of their outer driving-lane borders.
+    void linkRoadBorders(uint32_t node, Polygon2& pts) const;
     void sidewalks();
 
     const CityParams& P;
@@ -304,10 +314,38 @@ void SurfaceContext::edgeMarkings(MeshBuilder& mark, size_t e, const glm::dvec2&
 }
 
 void SurfaceContext::roads() {
-    const StreetGraph& g = city.streets;
     MeshBuilder road(mesh(Material::Road), out.origin, Material::Road, light);
     MeshBuilder mark(mesh(Material::Marking), out.origin, Material::Marking, light);
     std::vector<std::pair<uint32_t, uint32_t>> nodeEdges;  // (node of this tile, incident edge)
+    carriageways(road, mark, nodeEdges);
+    // Junction polygons, drawn by the node's tile: the convex hull of the
+    // carriageway corners at the node and a sidewalk width further along every
+    // incident edge, plus, between angularly consecutive edges, the point where
+    // their facing carriageway borders meet (fills the outer side of bends and
+    // the ground under rounded sidewalk corners). Dead ends get a round cap.
+    std::sort(nodeEdges.begin(), nodeEdges.end());
+    for (size_t i = 0; i < nodeEdges.size();) {
+        size_t j = i;
+        while (j < nodeEdges.size() && nodeEdges[j].first == nodeEdges[i].first) ++j;
+        const uint32_t node = nodeEdges[i].first;
+        Polygon2 pts = junctionPoints(node, nodeEdges, i, j);
+        linkRoadBorders(node, pts);
+        Polygon2 hull = convexHull(pts, 1e-12);
+        if (hull.size() < 3) hull.clear();
+        if (hull.size() >= 3) {
+            road.setId(makeInstanceId(InstanceKind::Junction, node));
+            glm::dvec2 m(0.0);
+            for (const auto& q : hull) m += q;
+            glm::dvec3 centre = at(m / double(hull.size()), kRoadLift);
+            for (size_t k = 0; k < hull.size(); ++k)
+                tri(road, centre, at(hull[k], kRoadLift), at(hull[(k + 1) % hull.size()], kRoadLift));
+        }
+        i = j;
+    }
+}
+
+void SurfaceContext::carriageways(MeshBuilder& road, MeshBuilder& mark, std::vector<std::pair<uint32_t, uint32_t>>& nodeEdges) {
+    const StreetGraph& g = city.streets;
     const size_t nodeCount = g.nodes.size();
     const size_t edgeCount = edgeList ? edgeList->size() : g.edges.size();
     for (size_t ei = 0; ei < edgeCount; ++ei) {
@@ -340,89 +378,72 @@ void SurfaceContext::roads() {
         }
         edgeMarkings(mark, e, A, d, L, pieces);
     }
-    // Junction polygons, drawn by the node's tile: the convex hull of the
-    // carriageway corners at the node and a sidewalk width further along every
-    // incident edge, plus, between angularly consecutive edges, the point where
-    // their facing carriageway borders meet (fills the outer side of bends and
-    // the ground under rounded sidewalk corners). Dead ends get a round cap.
-    const double sw = std::max(0.0, P.sidewalk_m);
-    std::sort(nodeEdges.begin(), nodeEdges.end());
+}
 
+Polygon2 SurfaceContext::junctionPoints(uint32_t node, const std::vector<std::pair<uint32_t, uint32_t>>& nodeEdges, size_t i,
+                                        size_t j) const {
+    const StreetGraph& g = city.streets;
+    const double sw = std::max(0.0, P.sidewalk_m);
     struct Arm { double angle; glm::dvec2 d; double hw; };
     std::vector<Arm> arms;
-    for (size_t i = 0; i < nodeEdges.size();) {
-        size_t j = i;
-        while (j < nodeEdges.size() && nodeEdges[j].first == nodeEdges[i].first) ++j;
-        const uint32_t node = nodeEdges[i].first;
-        const glm::dvec2 c = g.nodes[node];
-        arms.clear();
-        Polygon2 pts;
-        double r = 0;
-        for (size_t k = i; k < j; ++k) {
-            const StreetEdge& E = g.edges[nodeEdges[k].second];
-            glm::dvec2 o = g.nodes[E.a == node ? E.b : E.a];
-            double L = glm::length(o - c);
-            if (!(L > 1e-6)) continue;
-            glm::dvec2 d = (o - c) / L, n(-d.y, d.x);
-            double hw = 0.5 * safeWidth(E), s = std::min(hw + sw, 0.5 * L);
-            r = std::max(r, hw);
-            pts.push_back(c + n * hw);
-            pts.push_back(c - n * hw);
-            pts.push_back(c + d * s + n * hw);
-            pts.push_back(c + d * s - n * hw);
-            arms.push_back({std::atan2(d.y, d.x), d, hw});
+    const glm::dvec2 c = g.nodes[node];
+    Polygon2 pts;
+    double r = 0;
+    for (size_t k = i; k < j; ++k) {
+        const StreetEdge& E = g.edges[nodeEdges[k].second];
+        glm::dvec2 o = g.nodes[E.a == node ? E.b : E.a];
+        double L = glm::length(o - c);
+        if (!(L > 1e-6)) continue;
+        glm::dvec2 d = (o - c) / L, n(-d.y, d.x);
+        double hw = 0.5 * safeWidth(E), s = std::min(hw + sw, 0.5 * L);
+        r = std::max(r, hw);
+        pts.push_back(c + n * hw);
+        pts.push_back(c - n * hw);
+        pts.push_back(c + d * s + n * hw);
+        pts.push_back(c + d * s - n * hw);
+        arms.push_back({std::atan2(d.y, d.x), d, hw});
+    }
+    if (arms.size() == 1) {
+        // Dead end: round cap of the carriageway's half width.
+        const int capN = 12;
+        for (int k = 0; k < capN; ++k) {
+            double a = 2 * kPi * k / capN;
+            pts.push_back(c + arms[0].hw * glm::dvec2(std::cos(a), std::sin(a)));
         }
-        if (arms.size() == 1) {
-            // Dead end: round cap of the carriageway's half width.
-            const int capN = 12;
-            for (int k = 0; k < capN; ++k) {
-                double a = 2 * kPi * k / capN;
-                pts.push_back(c + arms[0].hw * glm::dvec2(std::cos(a), std::sin(a)));
-            }
-        } else if (arms.size() > 1) {
-            std::sort(arms.begin(), arms.end(), [](const Arm& a, const Arm& b) { return a.angle < b.angle; });
-            for (size_t k = 0; k < arms.size(); ++k) {
-                const Arm& a = arms[k];
-                const Arm& b = arms[(k + 1) % arms.size()];
-                // Left border of a: c + n_a hw_a + t d_a; right border of b: c - n_b hw_b + u d_b.
-                glm::dvec2 na(-a.d.y, a.d.x), nb(-b.d.y, b.d.x);
-                double den = a.d.x * b.d.y - a.d.y * b.d.x;
-                if (std::abs(den) < 1e-6) continue;
-                glm::dvec2 rhs = -nb * b.hw - na * a.hw;
-                double t = (rhs.x * b.d.y - rhs.y * b.d.x) / den;
-                glm::dvec2 q = c + na * a.hw + a.d * t;
-                if (glm::length(q - c) <= r + sw + 1e-9) pts.push_back(q);
-            }
+    } else if (arms.size() > 1) {
+        std::sort(arms.begin(), arms.end(), [](const Arm& a, const Arm& b) { return a.angle < b.angle; });
+        for (size_t k = 0; k < arms.size(); ++k) {
+            const Arm& a = arms[k];
+            const Arm& b = arms[(k + 1) % arms.size()];
+            // Left border of a: c + n_a hw_a + t d_a; right border of b: c - n_b hw_b + u d_b.
+            glm::dvec2 na(-a.d.y, a.d.x), nb(-b.d.y, b.d.x);
+            double den = a.d.x * b.d.y - a.d.y * b.d.x;
+            if (std::abs(den) < 1e-6) continue;
+            glm::dvec2 rhs = -nb * b.hw - na * a.hw;
+            double t = (rhs.x * b.d.y - rhs.y * b.d.x) / den;
+            glm::dvec2 q = c + na * a.hw + a.d * t;
+            if (glm::length(q - c) <= r + sw + 1e-9) pts.push_back(q);
         }
-        // The carriageway of the lane model's link roads at this node (junction
-        // turns, degree-2 transitions): samples of their outer driving-lane borders.
-        if (lanes && node < lanes->nodeLinks.size()) {
-            for (uint32_t k : lanes->nodeLinks[node]) {
-                const LinkRoad& r = lanes->links[k];
-                const double len = r.length();
-                const int steps = std::max(2, int(std::ceil(len / 1.0)));
-                for (int q = 0; q <= steps; ++q) {
-                    const double u = len * q / steps, h = r.heading(u);
-                    double tl = r.laneOffset(u), tr = tl;
-                    for (const LinkRoad::Lane& l : r.left) tl += l.sidewalk ? 0.0 : r.width(l, u);
-                    for (const LinkRoad::Lane& l : r.right) tr -= l.sidewalk ? 0.0 : r.width(l, u);
-                    const glm::dvec2 c0 = r.point(u), nl(-std::sin(h), std::cos(h));
-                    pts.push_back(c0 + nl * tl);
-                    pts.push_back(c0 + nl * tr);
-                }
+    }
+    return pts;
+}
+
+void SurfaceContext::linkRoadBorders(uint32_t node, Polygon2& pts) const {
+    if (lanes && node < lanes->nodeLinks.size()) {
+        for (uint32_t k : lanes->nodeLinks[node]) {
+            const LinkRoad& r = lanes->links[k];
+            const double len = r.length();
+            const int steps = std::max(2, int(std::ceil(len / 1.0)));
+            for (int q = 0; q <= steps; ++q) {
+                const double u = len * q / steps, h = r.heading(u);
+                double tl = r.laneOffset(u), tr = tl;
+                for (const LinkRoad::Lane& l : r.left) tl += l.sidewalk ? 0.0 : r.width(l, u);
+                for (const LinkRoad::Lane& l : r.right) tr -= l.sidewalk ? 0.0 : r.width(l, u);
+                const glm::dvec2 c0 = r.point(u), nl(-std::sin(h), std::cos(h));
+                pts.push_back(c0 + nl * tl);
+                pts.push_back(c0 + nl * tr);
             }
         }
-        Polygon2 hull = convexHull(pts, 1e-12);
-        if (hull.size() < 3) hull.clear();
-        if (hull.size() >= 3) {
-            road.setId(makeInstanceId(InstanceKind::Junction, node));
-            glm::dvec2 m(0.0);
-            for (const auto& q : hull) m += q;
-            glm::dvec3 centre = at(m / double(hull.size()), kRoadLift);
-            for (size_t k = 0; k < hull.size(); ++k)
-                tri(road, centre, at(hull[k], kRoadLift), at(hull[(k + 1) % hull.size()], kRoadLift));
-        }
-        i = j;
     }
 }
 

@@ -387,161 +387,194 @@ struct Candidate {
     int species;  // -1: choose per tree
 };
 
-}  // namespace
-
-std::vector<TreeInstance> placeTrees(const City& city, Progress* progress) {
-    const CityParams& P = city.params;
-    const StreetGraph& g = city.streets;
-    const double half = P.size_m * 0.5;
-    const int protoCount = city.treePrototypes.empty() ? kSpecies * kVariants : int(city.treePrototypes.size());
-    std::vector<TreeInstance> out;
-    if (progress) progress->update(0.0);
-
-    // Spatial indices over buildings and carriageways (cell 32 m).
-    const double cell = 32.0;
-    CellIndex bIdx(half, cell), eIdx(half, cell);
-    std::vector<std::pair<glm::dvec2, glm::dvec2>> bBox(city.buildings.size());
-    for (size_t i = 0; i < city.buildings.size(); ++i) {
-        glm::dvec2 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
-        for (const auto& q : city.buildings[i].footprint) lo = glm::min(lo, q), hi = glm::max(hi, q);
-        bBox[i] = {lo - kBuildingClearance, hi + kBuildingClearance};
-        if (!std::isfinite(lo.x + lo.y + hi.x + hi.y)) bBox[i] = {glm::dvec2(1.0), glm::dvec2(0.0)};  // skipped
+// Where trees may not stand and how much room their crowns have: buildings
+// and carriageways in cell indices (cell 32 m), and the crown radius of every
+// prototype.
+class SiteIndex {
+public:
+    SiteIndex(const City& city, double half) : _city(city), _bIdx(half, kCell), _eIdx(half, kCell) {
+        indexBuildings();
+        indexEdges();
+        measureCrowns();
     }
-    for (const auto& b : bBox) if (b.first.x <= b.second.x) bIdx.count(b.first, b.second);
-    bIdx.finishCounts();
-    for (size_t i = 0; i < bBox.size(); ++i) if (bBox[i].first.x <= bBox[i].second.x) bIdx.fill(bBox[i].first, bBox[i].second, uint32_t(i));
-    // Edges with valid, finite end points (the graph contract guarantees this; be safe anyway).
-    std::vector<uint8_t> edgeOk(g.edges.size(), 0);
-    for (size_t e = 0; e < g.edges.size(); ++e) {
-        const auto& E = g.edges[e];
-        edgeOk[e] = E.a < g.nodes.size() && E.b < g.nodes.size() &&
-                    std::isfinite(g.nodes[E.a].x + g.nodes[E.a].y + g.nodes[E.b].x + g.nodes[E.b].y);
-    }
-    auto edgeBox = [&](size_t e) {
-        const auto& a = g.nodes[g.edges[e].a];
-        const auto& b = g.nodes[g.edges[e].b];
-        double m = 0.5 * edgeWidth(g.edges[e]) + kRoadClearance;
-        return std::make_pair(glm::min(a, b) - m, glm::max(a, b) + m);
-    };
-    for (size_t e = 0; e < g.edges.size(); ++e) if (edgeOk[e]) { auto bb = edgeBox(e); eIdx.count(bb.first, bb.second); }
-    eIdx.finishCounts();
-    for (size_t e = 0; e < g.edges.size(); ++e) if (edgeOk[e]) { auto bb = edgeBox(e); eIdx.fill(bb.first, bb.second, uint32_t(e)); }
 
-    auto onRoad = [&](const glm::dvec2& p) {
-        return eIdx.any(p, [&](uint32_t e) {
+    // Whether each street edge has valid, finite end points.
+    const std::vector<uint8_t>& edgeOk() const { return _edgeOk; }
+
+    // Whether a trunk at p stands within the clearance of a carriageway.
+    bool onRoad(const glm::dvec2& p) const {
+        const StreetGraph& g = _city.streets;
+        return _eIdx.any(p, [&](uint32_t e) {
             const auto& E = g.edges[e];
             return pointSegmentDistance(p, g.nodes[E.a], g.nodes[E.b]) < 0.5 * edgeWidth(E) + kRoadClearance;
         });
-    };
-    auto inBuilding = [&](const glm::dvec2& p) {
-        return bIdx.any(p, [&](uint32_t i) {
-            const auto& fp = city.buildings[i].footprint;
-            if (p.x < bBox[i].first.x || p.y < bBox[i].first.y || p.x > bBox[i].second.x || p.y > bBox[i].second.y) return false;
+    }
+
+    // Whether a trunk at p stands inside a building footprint or within its clearance.
+    bool inBuilding(const glm::dvec2& p) const {
+        return _bIdx.any(p, [&](uint32_t i) {
+            const auto& fp = _city.buildings[i].footprint;
+            if (p.x < _bBox[i].first.x || p.y < _bBox[i].first.y || p.x > _bBox[i].second.x || p.y > _bBox[i].second.y) return false;
             if (fp.size() >= 3 && pointInPolygon(fp, p)) return true;
             for (size_t k = 0; k < fp.size(); ++k)
                 if (pointSegmentDistance(p, fp[k], fp[(k + 1) % fp.size()]) < kBuildingClearance) return true;
             return false;
         });
-    };
-    // Crown radius (max horizontal extent) of every prototype.
-    std::vector<double> crown(size_t(kSpecies * kVariants), 0.0);
-    for (int i = 0; i < kSpecies * kVariants; ++i) {
-        if (size_t(i) < city.treePrototypes.size()) {
-            for (const auto& q : city.treePrototypes[size_t(i)].mesh.positions)
-                crown[size_t(i)] = std::max(crown[size_t(i)], std::hypot(double(q.x), double(q.y)));
-        } else {
-            crown[size_t(i)] = 0.3 * kHeights[i / kVariants][i % kVariants];  // nominal
-        }
     }
-    auto crownRadius = [&](int species, int variant) { return crown[size_t(species * kVariants + variant)]; };
+
     // Distance from p to the nearest building footprint, capped at kCrownSearch.
-    auto clearance = [&](const glm::dvec2& p) {
+    double clearance(const glm::dvec2& p) const {
         double best = kCrownSearch;
         const glm::dvec2 lo = p - kCrownSearch, hi = p + kCrownSearch;
-        bIdx.forCells(lo, hi, [&](size_t cellId) {
-            bIdx.forItems(cellId, [&](uint32_t i) {
-                const auto& fp = city.buildings[i].footprint;
-                if (bBox[i].second.x < lo.x || bBox[i].second.y < lo.y || bBox[i].first.x > hi.x || bBox[i].first.y > hi.y) return;
+        _bIdx.forCells(lo, hi, [&](size_t cellId) {
+            _bIdx.forItems(cellId, [&](uint32_t i) {
+                const auto& fp = _city.buildings[i].footprint;
+                if (_bBox[i].second.x < lo.x || _bBox[i].second.y < lo.y || _bBox[i].first.x > hi.x || _bBox[i].first.y > hi.y) return;
                 for (size_t k = 0; k < fp.size(); ++k)
                     best = std::min(best, pointSegmentDistance(p, fp[k], fp[(k + 1) % fp.size()]));
             });
         });
         return best;
-    };
-    auto inCity = [&](const glm::dvec2& p) { return std::abs(p.x) <= half - 1.0 && std::abs(p.y) <= half - 1.0; };
-
-    std::vector<Candidate> cand;
-    // Street trees.
-    if (P.street_tree_spacing_m > 0 && !g.edges.empty()) {
-        std::vector<int> deg(g.nodes.size(), 0);
-        for (size_t e = 0; e < g.edges.size(); ++e)
-            if (edgeOk[e]) ++deg[g.edges[e].a], ++deg[g.edges[e].b];
-        const double spacing = P.street_tree_spacing_m;
-        for (size_t e = 0; e < g.edges.size(); ++e) {
-            if (!edgeOk[e]) continue;
-            const auto& E = g.edges[e];
-            glm::dvec2 A = g.nodes[E.a], B = g.nodes[E.b];
-            double L = glm::length(B - A);
-            if (!(L > 1e-6)) continue;
-            glm::dvec2 d = (B - A) / L, n(-d.y, d.x);
-            auto clearance = [&](uint32_t node) {
-                int k = deg[node];
-                return k >= 3 ? kIntersectionClearance : (k == 2 ? 4.0 : 3.0);
-            };
-            double ca = clearance(E.a), cb = clearance(E.b);
-            double usable = L - ca - cb;
-            if (usable < 0) continue;
-            // Evenly spaced, centred in the usable stretch.
-            int count = int(std::floor(usable / spacing)) + 1;
-            double first = ca + 0.5 * (usable - (count - 1) * spacing);
-            // Species per street (stable key: quantised end points, order-independent).
-            uint64_t ka = quantKey(A), kb = quantKey(B);
-            Rng srng(P.seed, hashKeys(std::min(ka, kb), std::max(ka, kb), 0x57EE7ull), Stream::Trees);
-            int streetSpecies = int(srng.range(0, kSpecies - 1));
-            double off = 0.5 * edgeWidth(E) + 0.5 * P.sidewalk_m;
-            for (int side = -1; side <= 1; side += 2) {
-                for (int i = 0; i < count; ++i) {
-                    glm::dvec2 p = A + d * (first + i * spacing) + n * (side * off);
-                    if (!inCity(p)) continue;
-                    cand.push_back({p, 0, quantKey(p), true, streetSpecies});
-                }
-            }
-        }
     }
-    if (progress) progress->update(0.3);
-    // Park trees: a jittered grid anchored to the city frame (cells seeded by
-    // their lattice index, so a park's trees do not depend on other blocks).
-    if (P.park_tree_density > 0) {
-        const double c = 1.0 / std::sqrt(P.park_tree_density);
-        for (const auto& blk : city.blocks) {
-            if (!blk.park || blk.outline.size() < 3) continue;
+
+    double crownRadius(int species, int variant) const { return _crown[size_t(species * kVariants + variant)]; }
+
+private:
+    static constexpr double kCell = 32.0;
+
+    // Indexes every building's footprint box, grown by the building clearance.
+    void indexBuildings() {
+        _bBox.resize(_city.buildings.size());
+        for (size_t i = 0; i < _city.buildings.size(); ++i) {
             glm::dvec2 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
-            for (const auto& q : blk.outline) lo = glm::min(lo, q), hi = glm::max(hi, q);
-            if (!std::isfinite(lo.x + lo.y + hi.x + hi.y)) continue;
-            // Clamp to the city square (park blocks lie inside it; guards huge loops on bad input).
-            lo = glm::max(lo, glm::dvec2(-half)), hi = glm::min(hi, glm::dvec2(half));
-            if (!(hi.x > lo.x && hi.y > lo.y)) continue;
-            int64_t i0 = int64_t(std::floor(lo.x / c)), i1 = int64_t(std::floor(hi.x / c));
-            int64_t j0 = int64_t(std::floor(lo.y / c)), j1 = int64_t(std::floor(hi.y / c));
-            for (int64_t j = j0; j <= j1; ++j) {
-                for (int64_t i = i0; i <= i1; ++i) {
-                    Rng r(P.seed, hashKeys(uint64_t(i), uint64_t(j), 0x9A2Cull), Stream::Trees);
-                    glm::dvec2 p((double(i) + r.uniform(0.1, 0.9)) * c, (double(j) + r.uniform(0.1, 0.9)) * c);
-                    if (!pointInPolygon(blk.outline, p) || !inCity(p)) continue;
-                    bool nearEdge = false;
-                    for (size_t k = 0; k < blk.outline.size() && !nearEdge; ++k)
-                        nearEdge = pointSegmentDistance(p, blk.outline[k], blk.outline[(k + 1) % blk.outline.size()]) <
-                                   kParkEdgeClearance;
-                    if (nearEdge) continue;
-                    cand.push_back({p, 0, quantKey(p), false, -1});
-                }
+            for (const auto& q : _city.buildings[i].footprint) lo = glm::min(lo, q), hi = glm::max(hi, q);
+            _bBox[i] = {lo - kBuildingClearance, hi + kBuildingClearance};
+            if (!std::isfinite(lo.x + lo.y + hi.x + hi.y)) _bBox[i] = {glm::dvec2(1.0), glm::dvec2(0.0)};  // skipped
+        }
+        for (const auto& b : _bBox) if (b.first.x <= b.second.x) _bIdx.count(b.first, b.second);
+        _bIdx.finishCounts();
+        for (size_t i = 0; i < _bBox.size(); ++i) if (_bBox[i].first.x <= _bBox[i].second.x) _bIdx.fill(_bBox[i].first, _bBox[i].second, uint32_t(i));
+    }
+
+    // Indexes every carriageway with valid, finite end points (the graph
+    // contract guarantees them; the check keeps bad input safe anyway).
+    void indexEdges() {
+        const StreetGraph& g = _city.streets;
+        _edgeOk.assign(g.edges.size(), 0);
+        for (size_t e = 0; e < g.edges.size(); ++e) {
+            const auto& E = g.edges[e];
+            _edgeOk[e] = E.a < g.nodes.size() && E.b < g.nodes.size() &&
+                         std::isfinite(g.nodes[E.a].x + g.nodes[E.a].y + g.nodes[E.b].x + g.nodes[E.b].y);
+        }
+        auto edgeBox = [&](size_t e) {
+            const auto& a = g.nodes[g.edges[e].a];
+            const auto& b = g.nodes[g.edges[e].b];
+            double m = 0.5 * edgeWidth(g.edges[e]) + kRoadClearance;
+            return std::make_pair(glm::min(a, b) - m, glm::max(a, b) + m);
+        };
+        for (size_t e = 0; e < g.edges.size(); ++e) if (_edgeOk[e]) { auto bb = edgeBox(e); _eIdx.count(bb.first, bb.second); }
+        _eIdx.finishCounts();
+        for (size_t e = 0; e < g.edges.size(); ++e) if (_edgeOk[e]) { auto bb = edgeBox(e); _eIdx.fill(bb.first, bb.second, uint32_t(e)); }
+    }
+
+    // Measures the crown radius (max horizontal extent) of every prototype.
+    void measureCrowns() {
+        _crown.assign(size_t(kSpecies * kVariants), 0.0);
+        for (int i = 0; i < kSpecies * kVariants; ++i) {
+            if (size_t(i) < _city.treePrototypes.size()) {
+                for (const auto& q : _city.treePrototypes[size_t(i)].mesh.positions)
+                    _crown[size_t(i)] = std::max(_crown[size_t(i)], std::hypot(double(q.x), double(q.y)));
+            } else {
+                _crown[size_t(i)] = 0.3 * kHeights[i / kVariants][i % kVariants];  // nominal
             }
         }
     }
-    if (progress) progress->update(0.5);
 
-    // Canonical order (by position), then reject conflicts; the greedy
-    // spacing filter runs in this order so it does not depend on edge order.
+    const City& _city;
+    CellIndex _bIdx, _eIdx;
+    std::vector<std::pair<glm::dvec2, glm::dvec2>> _bBox;
+    std::vector<uint8_t> _edgeOk;
+    std::vector<double> _crown;
+};
+
+bool inCity(const glm::dvec2& p, double half) { return std::abs(p.x) <= half - 1.0 && std::abs(p.y) <= half - 1.0; }
+
+// Adds street tree candidates: evenly spaced along both sides of every
+// street, clear of its intersections, one species per street.
+void addStreetCandidates(const City& city, const std::vector<uint8_t>& edgeOk, double half, std::vector<Candidate>& cand) {
+    const CityParams& P = city.params;
+    const StreetGraph& g = city.streets;
+    std::vector<int> deg(g.nodes.size(), 0);
+    for (size_t e = 0; e < g.edges.size(); ++e)
+        if (edgeOk[e]) ++deg[g.edges[e].a], ++deg[g.edges[e].b];
+    const double spacing = P.street_tree_spacing_m;
+    for (size_t e = 0; e < g.edges.size(); ++e) {
+        if (!edgeOk[e]) continue;
+        const auto& E = g.edges[e];
+        glm::dvec2 A = g.nodes[E.a], B = g.nodes[E.b];
+        double L = glm::length(B - A);
+        if (!(L > 1e-6)) continue;
+        glm::dvec2 d = (B - A) / L, n(-d.y, d.x);
+        auto clearance = [&](uint32_t node) {
+            int k = deg[node];
+            return k >= 3 ? kIntersectionClearance : (k == 2 ? 4.0 : 3.0);
+        };
+        double ca = clearance(E.a), cb = clearance(E.b);
+        double usable = L - ca - cb;
+        if (usable < 0) continue;
+        // Evenly spaced, centred in the usable stretch.
+        int count = int(std::floor(usable / spacing)) + 1;
+        double first = ca + 0.5 * (usable - (count - 1) * spacing);
+        // Species per street (stable key: quantised end points, order-independent).
+        uint64_t ka = quantKey(A), kb = quantKey(B);
+        Rng srng(P.seed, hashKeys(std::min(ka, kb), std::max(ka, kb), 0x57EE7ull), Stream::Trees);
+        int streetSpecies = int(srng.range(0, kSpecies - 1));
+        double off = 0.5 * edgeWidth(E) + 0.5 * P.sidewalk_m;
+        for (int side = -1; side <= 1; side += 2) {
+            for (int i = 0; i < count; ++i) {
+                glm::dvec2 p = A + d * (first + i * spacing) + n * (side * off);
+                if (!inCity(p, half)) continue;
+                cand.push_back({p, 0, quantKey(p), true, streetSpecies});
+            }
+        }
+    }
+}
+
+// Adds park tree candidates: a jittered grid anchored to the city frame (cells
+// seeded by their lattice index, so a park's trees do not depend on other
+// blocks), kept off the park outline.
+void addParkCandidates(const City& city, double half, std::vector<Candidate>& cand) {
+    const CityParams& P = city.params;
+    const double c = 1.0 / std::sqrt(P.park_tree_density);
+    for (const auto& blk : city.blocks) {
+        if (!blk.park || blk.outline.size() < 3) continue;
+        glm::dvec2 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+        for (const auto& q : blk.outline) lo = glm::min(lo, q), hi = glm::max(hi, q);
+        if (!std::isfinite(lo.x + lo.y + hi.x + hi.y)) continue;
+        // Clamp to the city square (park blocks lie inside it; guards huge loops on bad input).
+        lo = glm::max(lo, glm::dvec2(-half)), hi = glm::min(hi, glm::dvec2(half));
+        if (!(hi.x > lo.x && hi.y > lo.y)) continue;
+        int64_t i0 = int64_t(std::floor(lo.x / c)), i1 = int64_t(std::floor(hi.x / c));
+        int64_t j0 = int64_t(std::floor(lo.y / c)), j1 = int64_t(std::floor(hi.y / c));
+        for (int64_t j = j0; j <= j1; ++j) {
+            for (int64_t i = i0; i <= i1; ++i) {
+                Rng r(P.seed, hashKeys(uint64_t(i), uint64_t(j), 0x9A2Cull), Stream::Trees);
+                glm::dvec2 p((double(i) + r.uniform(0.1, 0.9)) * c, (double(j) + r.uniform(0.1, 0.9)) * c);
+                if (!pointInPolygon(blk.outline, p) || !inCity(p, half)) continue;
+                bool nearEdge = false;
+                for (size_t k = 0; k < blk.outline.size() && !nearEdge; ++k)
+                    nearEdge = pointSegmentDistance(p, blk.outline[k], blk.outline[(k + 1) % blk.outline.size()]) <
+                               kParkEdgeClearance;
+                if (nearEdge) continue;
+                cand.push_back({p, 0, quantKey(p), false, -1});
+            }
+        }
+    }
+}
+
+// Puts the candidates in canonical order (tile, then position, street trees
+// first), so the greedy spacing filter does not depend on edge order.
+void sortCandidates(const CityParams& P, std::vector<Candidate>& cand) {
     TileGrid grid(P);
     for (auto& c : cand) c.tile = grid.tileOf(c.p);
     std::sort(cand.begin(), cand.end(), [&](const Candidate& a, const Candidate& b) {
@@ -550,53 +583,97 @@ std::vector<TreeInstance> placeTrees(const City& city, Progress* progress) {
         if (a.p.x != b.p.x) return a.p.x < b.p.x;
         return a.street > b.street;
     });
-    // Accepted trunks in a hash grid (cell = kMinTreeDistance): head per cell + linked list.
-    std::unordered_map<uint64_t, uint32_t> head;
-    head.reserve(cand.size());
-    std::vector<glm::dvec2> keptPos;
-    std::vector<uint32_t> keptNext;
-    constexpr uint32_t kNone = 0xFFFFFFFFu;
-    auto cellKey = [](int64_t x, int64_t y) { return (uint64_t(x) << 32) ^ (uint64_t(y) & 0xFFFFFFFFull); };
-    out.reserve(cand.size());
-    for (const auto& c : cand) {
-        int64_t gx = int64_t(std::floor(c.p.x / kMinTreeDistance)), gy = int64_t(std::floor(c.p.y / kMinTreeDistance));
+}
+
+// Accepted trunks in a hash grid (cell = kMinTreeDistance): head per cell + linked list.
+class TrunkGrid {
+public:
+    explicit TrunkGrid(size_t capacity) { _head.reserve(capacity); }
+
+    // Whether an accepted trunk stands closer than kMinTreeDistance to p.
+    bool close(const glm::dvec2& p) const {
+        int64_t gx = cellOf(p.x), gy = cellOf(p.y);
         bool close = false;
         for (int64_t y = gy - 1; y <= gy + 1 && !close; ++y)
             for (int64_t x = gx - 1; x <= gx + 1 && !close; ++x) {
-                auto it = head.find(cellKey(x, y));
-                if (it == head.end()) continue;
-                for (uint32_t k = it->second; k != kNone && !close; k = keptNext[k])
-                    close = glm::length(keptPos[k] - c.p) < kMinTreeDistance;
+                auto it = _head.find(cellKey(x, y));
+                if (it == _head.end()) continue;
+                for (uint32_t k = it->second; k != kNone && !close; k = _next[k])
+                    close = glm::length(_pos[k] - p) < kMinTreeDistance;
             }
-        if (close || onRoad(c.p) || inBuilding(c.p)) continue;
-        auto ins = head.emplace(cellKey(gx, gy), kNone);
-        keptNext.push_back(ins.first->second);
-        keptPos.push_back(c.p);
-        ins.first->second = uint32_t(keptPos.size() - 1);
+        return close;
+    }
 
-        Rng r(P.seed, c.key, Stream::Trees);
-        int species;
-        if (c.species >= 0) {
-            species = r.chance(0.85) ? c.species : int(r.range(0, kSpecies - 1));
-        } else {
-            double u = r.uniform();  // parks: mostly broadleaf
-            species = u < 0.55 ? 0 : (u < 0.85 ? 1 : 2);
-        }
-        int variant = c.street ? (r.chance(0.6) ? 1 : int(r.range(0, 1)) * 2) : int(r.range(0, kVariants - 1));
-        TreeInstance t;
-        t.position = glm::dvec3(c.p, terrainHeight(P, c.p));
-        t.yaw = float(r.uniform(0.0, 2 * kPi));
-        double scale = r.uniform(0.85, 1.15);
-        // Crowns should not grow into facades: near buildings take a smaller
-        // variant (then a smaller scale) so the crown radius fits the clearance.
-        double room = clearance(c.p) + kCrownOverlap;
-        while (variant > 0 && crownRadius(species, variant) * scale > room) --variant;
-        if (crownRadius(species, variant) * scale > room)
-            scale = std::max(0.85, room / std::max(crownRadius(species, variant), 1e-6));
-        t.scale = float(scale);
-        t.prototype = uint16_t(std::min(species * kVariants + variant, protoCount - 1));
-        t.street = c.street;
-        out.push_back(t);
+    void add(const glm::dvec2& p) {
+        auto ins = _head.emplace(cellKey(cellOf(p.x), cellOf(p.y)), kNone);
+        _next.push_back(ins.first->second);
+        _pos.push_back(p);
+        ins.first->second = uint32_t(_pos.size() - 1);
+    }
+
+private:
+    static constexpr uint32_t kNone = 0xFFFFFFFFu;
+    static int64_t cellOf(double v) { return int64_t(std::floor(v / kMinTreeDistance)); }
+    static uint64_t cellKey(int64_t x, int64_t y) { return (uint64_t(x) << 32) ^ (uint64_t(y) & 0xFFFFFFFFull); }
+
+    std::unordered_map<uint64_t, uint32_t> _head;
+    std::vector<glm::dvec2> _pos;
+    std::vector<uint32_t> _next;
+};
+
+// Grows the tree of an accepted candidate: species, variant, yaw and scale
+// drawn from the candidate's own stream, the crown shrunk to fit between facades.
+TreeInstance growTree(const CityParams& P, const Candidate& c, const SiteIndex& sites, int protoCount) {
+    Rng r(P.seed, c.key, Stream::Trees);
+    int species;
+    if (c.species >= 0) {
+        species = r.chance(0.85) ? c.species : int(r.range(0, kSpecies - 1));
+    } else {
+        double u = r.uniform();  // parks: mostly broadleaf
+        species = u < 0.55 ? 0 : (u < 0.85 ? 1 : 2);
+    }
+    int variant = c.street ? (r.chance(0.6) ? 1 : int(r.range(0, 1)) * 2) : int(r.range(0, kVariants - 1));
+    TreeInstance t;
+    t.position = glm::dvec3(c.p, terrainHeight(P, c.p));
+    t.yaw = float(r.uniform(0.0, 2 * kPi));
+    double scale = r.uniform(0.85, 1.15);
+    // Crowns should not grow into facades: near buildings take a smaller
+    // variant (then a smaller scale) so the crown radius fits the clearance.
+    double room = sites.clearance(c.p) + kCrownOverlap;
+    while (variant > 0 && sites.crownRadius(species, variant) * scale > room) --variant;
+    if (sites.crownRadius(species, variant) * scale > room)
+        scale = std::max(0.85, room / std::max(sites.crownRadius(species, variant), 1e-6));
+    t.scale = float(scale);
+    t.prototype = uint16_t(std::min(species * kVariants + variant, protoCount - 1));
+    t.street = c.street;
+    return t;
+}
+
+}  // namespace
+
+std::vector<TreeInstance> placeTrees(const City& city, Progress* progress) {
+    const CityParams& P = city.params;
+    const double half = P.size_m * 0.5;
+    const int protoCount = city.treePrototypes.empty() ? kSpecies * kVariants : int(city.treePrototypes.size());
+    std::vector<TreeInstance> out;
+    if (progress) progress->update(0.0);
+
+    const SiteIndex sites(city, half);
+    std::vector<Candidate> cand;
+    if (P.street_tree_spacing_m > 0 && !city.streets.edges.empty()) addStreetCandidates(city, sites.edgeOk(), half, cand);
+    if (progress) progress->update(0.3);
+    if (P.park_tree_density > 0) addParkCandidates(city, half, cand);
+    if (progress) progress->update(0.5);
+
+    // Rejects conflicts in canonical order: too close to a kept tree, on a
+    // carriageway or in a building.
+    sortCandidates(P, cand);
+    TrunkGrid kept(cand.size());
+    out.reserve(cand.size());
+    for (const auto& c : cand) {
+        if (kept.close(c.p) || sites.onRoad(c.p) || sites.inBuilding(c.p)) continue;
+        kept.add(c.p);
+        out.push_back(growTree(P, c, sites, protoCount));
     }
     if (progress) progress->update(1.0);
     return out;

@@ -196,48 +196,108 @@ double HeightGrid::traceRayFlat(const glm::dvec3& eye, double azimuth, double ne
     return trace(eye, azimuth, nearDistance, maxDistance, false);
 }
 
-double HeightGrid::trace(const glm::dvec3& eye, double azimuth, double nearDistance, double maxDistance, bool blocks) const {
-    if (_cells == 0) return -kInf;
-    const int n = _cells;
-    const double s = _cellSize;
-    // Cell units.
-    const double px = (eye.x - _min.x) / s, py = (eye.y - _min.y) / s;
-    double dx = std::sin(azimuth), dy = std::cos(azimuth);
-    if (std::abs(dx) < 1e-15) dx = 0;
-    if (std::abs(dy) < 1e-15) dy = 0;
-    // Clip the ray (t >= 0) against the grid square [0, n]^2.
-    double t0 = 0, t1 = kInf;
-    auto clip = [&](double p, double d) {
-        if (d == 0) return p >= 0 && p <= n;
-        double a = (0 - p) / d, b = (n - p) / d;
-        if (a > b) std::swap(a, b);
-        t0 = std::max(t0, a);
-        t1 = std::min(t1, b);
-        return t0 <= t1;
-    };
-    if (!clip(px, dx) || !clip(py, dy)) return -kInf;
-    // Highest geometry anywhere: bounds the remaining cells for early exit.
-    const double zTop = _boundsMax.z + 1e-3;
-    double best = -kInf;
+// One ray's walk over the grid in cell units: the bound `best` of every cell
+// the ray touches, walked cell by cell or block by block, stopping once no
+// later cell can beat it.
+class HeightGrid::RayTrace {
+public:
+    RayTrace(const HeightGrid& g, const glm::dvec3& eye, double azimuth, double nearDistance, double maxDistance)
+        : _g(g), _eye(eye), _nearDistance(nearDistance), _maxDistance(maxDistance), _n(g._cells), _s(g._cellSize),
+          _px((eye.x - g._min.x) / g._cellSize), _py((eye.y - g._min.y) / g._cellSize),
+          _dx(std::sin(azimuth)), _dy(std::cos(azimuth)) {
+        if (std::abs(_dx) < 1e-15) _dx = 0;
+        if (std::abs(_dy) < 1e-15) _dy = 0;
+    }
 
-    const double sx0 = px + dx * t0, sy0 = py + dy * t0;
-    const double tLen = t1 - t0;
-    auto inGrid = [&](int x, int y) { return x >= 0 && y >= 0 && x < n && y < n; };
-    auto visit = [&](int x, int y) {
-        if (inGrid(x, y)) best = std::max(best, cellBound(x, y, eye, nearDistance, maxDistance));
-    };
+    // Clips the ray (t >= 0) against the grid square [0, n]^2; false when it misses.
+    bool clipToGrid() {
+        if (!clip(_px, _dx) || !clip(_py, _dy)) return false;
+        _sx0 = _px + _dx * _t0;
+        _sy0 = _py + _dy * _t0;
+        _tLen = _t1 - _t0;
+        return true;
+    }
+
+    // Walks from the start cell (over blocks or every cell), then visits the
+    // cells a ray along a grid line or starting on one touches; returns the bound.
+    double walk(bool blocks) {
+        const int n = _n;
+        // Start cell: the cell the ray enters just after t0.
+        const double ex = _px + _dx * _t0, ey = _py + _dy * _t0;
+        int ix = cellAt(ex, _dx, 0, n - 1), iy = cellAt(ey, _dy, 0, n - 1);
+        if (blocks)
+            runBlocks(ix, iy);
+        else
+            run(ix, iy);
+        // A ray running along a grid line touches the cells on both sides.
+        if (_dx == 0 && onLine(ex)) {
+            int l = int(std::round(ex));
+            if (l - 1 >= 0 && l - 1 != ix) run(l - 1, iy);
+            if (l < n && l != ix) run(l, iy);
+        }
+        if (_dy == 0 && onLine(ey)) {
+            int l = int(std::round(ey));
+            if (l - 1 >= 0 && l - 1 != iy) run(ix, l - 1);
+            if (l < n && l != iy) run(ix, l);
+        }
+        // Starting on a corner/line (eye on a grid line): the neighbour cells the
+        // start point touches may hold geometry arbitrarily close to the ray start.
+        if (onLine(ex) || onLine(ey)) {
+            int cx = int(std::round(ex)), cy = int(std::round(ey));
+            for (int yy = (onLine(ey) ? cy - 1 : iy); yy <= (onLine(ey) ? cy : iy); ++yy)
+                for (int xx = (onLine(ex) ? cx - 1 : ix); xx <= (onLine(ex) ? cx : ix); ++xx)
+                    if (xx >= 0 && yy >= 0 && xx < n && yy < n)
+                        _best = std::max(_best, _g.cellBound(xx, yy, _eye, _nearDistance, _maxDistance));
+        }
+        return _best;
+    }
+
+private:
+    // Narrows [t0, t1] to where the ray's coordinate p + d * t lies in [0, n].
+    bool clip(double p, double d) {
+        if (d == 0) return p >= 0 && p <= _n;
+        double a = (0 - p) / d, b = (_n - p) / d;
+        if (a > b) std::swap(a, b);
+        _t0 = std::max(_t0, a);
+        _t1 = std::min(_t1, b);
+        return _t0 <= _t1;
+    }
+
+    // The cell (clamped to [lo, hi]) of coordinate p; on a line heading down, the lower cell.
+    static int cellAt(double p, double d, int lo, int hi) {
+        double c = std::floor(p);
+        if (d < 0 && c == p) c -= 1;
+        return std::clamp(int(c), lo, hi);
+    }
+
+    static bool onLine(double p) { return std::abs(p - std::round(p)) <= kTieEps * std::max(1.0, std::abs(p)); }
+
+    bool inGrid(int x, int y) const { return x >= 0 && y >= 0 && x < _n && y < _n; }
+
+    void visit(int x, int y) {
+        if (inGrid(x, y)) _best = std::max(_best, _g.cellBound(x, y, _eye, _nearDistance, _maxDistance));
+    }
+
+    // Visits the four cells around grid corner (qx, qy).
+    void visitAround(int qx, int qy) {
+        visit(qx - 1, qy - 1);
+        visit(qx, qy - 1);
+        visit(qx - 1, qy);
+        visit(qx, qy);
+    }
+
     // Nothing touched after ray parameter tNext can beat `best` (farther is
     // lower when best > 0), or it all lies beyond the distance limit.
-    auto laterCellsLose = [&](double tNext) {
-        const double distM = (t0 + tNext - 1.5) * s - 2 * kCellMargin;  // nearest point of any later cell
-        return (best > 0 && distM > 0 && (zTop - eye.z) / distM < best) || distM > maxDistance;
-    };
+    bool laterCellsLose(double tNext) const {
+        const double distM = (_t0 + tNext - 1.5) * _s - 2 * kCellMargin;  // nearest point of any later cell
+        return (_best > 0 && distM > 0 && (_zTop - _eye.z) / distM < _best) || distM > _maxDistance;
+    }
+
     // The cells from (w.x, w.y) up to ray parameter tStop; with a block
     // (bx >= 0) only while inside it, without one also stopping early.
-    const int B = kBlock;
-    auto walkCells = [&](GridWalk w, double tStop, int bx, int by) {
+    void walkCells(GridWalk w, double tStop, int bx, int by) {
         const double eps = kTieEps * (bx < 0 ? 1.0 : std::max(1.0, tStop));
-        while (inGrid(w.x, w.y) && (bx < 0 || (w.x / B == bx && w.y / B == by))) {
+        while (inGrid(w.x, w.y) && (bx < 0 || (w.x / kBlock == bx && w.y / kBlock == by))) {
             visit(w.x, w.y);
             const double tNext = w.next();
             if (tNext > tStop + eps) break;
@@ -248,81 +308,60 @@ double HeightGrid::trace(const glm::dvec3& eye, double azimuth, double nearDista
             }
             w.advance();
         }
-    };
-    auto run = [&](int ix, int iy) { walkCells(GridWalk(ix, iy, sx0, sy0, dx, dy, 1.0), tLen, -1, -1); };
-    auto onLine = [](double p) { return std::abs(p - std::round(p)) <= kTieEps * std::max(1.0, std::abs(p)); };
+    }
+
+    void run(int ix, int iy) { walkCells(GridWalk(ix, iy, _sx0, _sy0, _dx, _dy, 1.0), _tLen, -1, -1); }
+
     // The same walk over blocks of kBlock x kBlock cells: a block whose bound
     // cannot beat `best` is passed over whole; otherwise its cells along the
     // ray's stretch [tIn, tOut] inside it are walked as in run(). A ray
     // through a block corner, or entering a block through a cell corner,
     // touches the four cells around that corner.
-    auto runBlocks = [&](int ix, int iy) {
-        auto cellAt = [](double p, double d, int lo, int hi) {
-            double c = std::floor(p);
-            if (d < 0 && c == p) c -= 1;
-            return std::clamp(int(c), lo, hi);
-        };
-        auto visitAround = [&](int qx, int qy) {
-            visit(qx - 1, qy - 1);
-            visit(qx, qy - 1);
-            visit(qx - 1, qy);
-            visit(qx, qy);
-        };
-        GridWalk b(ix / B, iy / B, sx0, sy0, dx, dy, double(B));
+    void runBlocks(int ix, int iy) {
+        const int n = _n;
+        GridWalk b(ix / kBlock, iy / kBlock, _sx0, _sy0, _dx, _dy, double(kBlock));
         double tIn = 0;
         bool first = true;
-        while (b.x >= 0 && b.y >= 0 && b.x < _blocks && b.y < _blocks) {
-            const double tOut = std::min(b.next(), tLen);
-            if (blockBound(b.x, b.y, eye, nearDistance, maxDistance) > best) {
+        while (b.x >= 0 && b.y >= 0 && b.x < _g._blocks && b.y < _g._blocks) {
+            const double tOut = std::min(b.next(), _tLen);
+            if (_g.blockBound(b.x, b.y, _eye, _nearDistance, _maxDistance) > _best) {
                 int cx = ix, cy = iy;
                 if (!first) {  // where the ray enters the block
-                    const double qx = sx0 + dx * tIn, qy = sy0 + dy * tIn;
-                    cx = cellAt(qx, dx, b.x * B, std::min(n, (b.x + 1) * B) - 1);
-                    cy = cellAt(qy, dy, b.y * B, std::min(n, (b.y + 1) * B) - 1);
+                    const double qx = _sx0 + _dx * tIn, qy = _sy0 + _dy * tIn;
+                    cx = cellAt(qx, _dx, b.x * kBlock, std::min(n, (b.x + 1) * kBlock) - 1);
+                    cy = cellAt(qy, _dy, b.y * kBlock, std::min(n, (b.y + 1) * kBlock) - 1);
                     if (onLine(qx) && onLine(qy)) visitAround(int(std::round(qx)), int(std::round(qy)));
                 }
-                walkCells(GridWalk(cx, cy, sx0, sy0, dx, dy, 1.0), tOut, b.x, b.y);
+                walkCells(GridWalk(cx, cy, _sx0, _sy0, _dx, _dy, 1.0), tOut, b.x, b.y);
             }
             first = false;
             const double tNext = b.next();
-            if (tNext > tLen + kTieEps || laterCellsLose(tNext)) break;
+            if (tNext > _tLen + kTieEps || laterCellsLose(tNext)) break;
             tIn = tNext;
-            if (b.corner()) visitAround(b.stepX > 0 ? (b.x + 1) * B : b.x * B, b.stepY > 0 ? (b.y + 1) * B : b.y * B);
+            if (b.corner()) visitAround(b.stepX > 0 ? (b.x + 1) * kBlock : b.x * kBlock, b.stepY > 0 ? (b.y + 1) * kBlock : b.y * kBlock);
             b.advance();
         }
-    };
-    // Start cell: the cell the ray enters just after t0.
-    const double ex = px + dx * t0, ey = py + dy * t0;
-    auto startCell = [&](double p, double d) {
-        double c = std::floor(p);
-        if (d < 0 && c == p) c -= 1;  // on a line heading down: the lower cell
-        return std::clamp(int(c), 0, n - 1);
-    };
-    int ix = startCell(ex, dx), iy = startCell(ey, dy);
-    if (blocks)
-        runBlocks(ix, iy);
-    else
-        run(ix, iy);
-    // A ray running along a grid line touches the cells on both sides.
-    if (dx == 0 && onLine(ex)) {
-        int l = int(std::round(ex));
-        if (l - 1 >= 0 && l - 1 != ix) run(l - 1, iy);
-        if (l < n && l != ix) run(l, iy);
     }
-    if (dy == 0 && onLine(ey)) {
-        int l = int(std::round(ey));
-        if (l - 1 >= 0 && l - 1 != iy) run(ix, l - 1);
-        if (l < n && l != iy) run(ix, l);
-    }
-    // Starting on a corner/line (eye on a grid line): the neighbour cells the
-    // start point touches may hold geometry arbitrarily close to the ray start.
-    if (onLine(ex) || onLine(ey)) {
-        int cx = int(std::round(ex)), cy = int(std::round(ey));
-        for (int yy = (onLine(ey) ? cy - 1 : iy); yy <= (onLine(ey) ? cy : iy); ++yy)
-            for (int xx = (onLine(ex) ? cx - 1 : ix); xx <= (onLine(ex) ? cx : ix); ++xx)
-                if (xx >= 0 && yy >= 0 && xx < n && yy < n) best = std::max(best, cellBound(xx, yy, eye, nearDistance, maxDistance));
-    }
-    return best;
+
+    const HeightGrid& _g;
+    const glm::dvec3 _eye;
+    const double _nearDistance, _maxDistance;
+    const int _n;
+    const double _s;
+    const double _px, _py;  // the eye in cell units
+    double _dx, _dy;
+    double _t0 = 0, _t1 = kInf;
+    // Highest geometry anywhere: bounds the remaining cells for early exit.
+    const double _zTop = _g._boundsMax.z + 1e-3;
+    double _best = -kInf;
+    double _sx0 = 0, _sy0 = 0, _tLen = 0;
+};
+
+double HeightGrid::trace(const glm::dvec3& eye, double azimuth, double nearDistance, double maxDistance, bool blocks) const {
+    if (_cells == 0) return -kInf;
+    RayTrace ray(*this, eye, azimuth, nearDistance, maxDistance);
+    if (!ray.clipToGrid()) return -kInf;
+    return ray.walk(blocks);
 }
 
 bool horizonApplies(const Camera& camera, std::string* reason) {

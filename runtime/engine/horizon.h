@@ -91,6 +91,7 @@ public:
 
 private:
     double trace(const glm::dvec3& eye, double azimuth, double nearDistance, double maxDistance, bool blocks) const;
+    class RayTrace;  // one ray's walk over the cells and blocks
     double cellBound(int ix, int iy, const glm::dvec3& eye, double nearDistance, double maxDistance) const;
     // The bound of any geometry in the xy rectangle [x0, x1] x [y0, y1] (scene-local metres) with heights in [zLo, zHi].
     static double rectBound(double x0, double x1, double y0, double y1, double zLo, double zHi, const glm::dvec3& eye,

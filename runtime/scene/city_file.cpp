@@ -359,133 +359,190 @@ void expandBounds(const SceneModel& city, const SceneInstance& in, glm::dvec2& l
     }
 }
 
+namespace {
+
+Status notCityFile(const std::string& path, const std::string& why) {
+    return Status::error("'" + path + "' is not a vista city file: " + why);
+}
+
+// Reads the city's parameters, street graph, label flag and tree prototype
+// count from the root's user values.
+Status decodeCityValues(const osg::Group& root, const std::string& path, SceneModel& out, int& protoCount) {
+    std::string paramsJson, streetsJson;
+    if (!getUser(root, "vista.params", paramsJson)) return notCityFile(path, "missing user value vista.params");
+    auto params = parseParamsJson(paramsJson, path + " (vista.params)");
+    if (!params) return params.status();
+    out.params = *params;
+    if (getUser(root, "vista.streets", streetsJson) && !streetsJson.empty() && streetsJson != "{}") {
+        auto g = streetGraphFromJson(streetsJson);
+        if (!g) return Status::error("city file '" + path + "': vista.streets: " + g.status().message());
+        out.streets = std::move(*g);
+    }
+    int labels = 0;
+    out.labelled = getUser(root, "vista.labels", labels) && labels == 1;
+    getUser(root, "vista.tree_prototypes", protoCount);
+    if (protoCount < 0 || protoCount > 1000000)
+        return notCityFile(path, "vista.tree_prototypes = " + std::to_string(protoCount) + " out of range");
+    return Status::ok();
+}
+
+// Copies one geometry's triangles (positions, colours, indices) into mesh,
+// checking that its arrays agree.
+Status decodeMesh(osg::Geometry& g, const osg::MatrixTransform& xf, const std::string& path, SceneMesh& mesh) {
+    auto* verts = dynamic_cast<osg::Vec3Array*>(g.getVertexArray());
+    auto* colors = dynamic_cast<osg::Vec4ubArray*>(g.getColorArray());
+    auto* de = dynamic_cast<osg::DrawElements*>(g.getPrimitiveSet(0));
+    if (!verts || !de || de->getMode() != GL_TRIANGLES) return notCityFile(path, "geometry '" + g.getName() + "' in " + xf.getName() + " is malformed");
+    if (colors && colors->size() != verts->size()) return notCityFile(path, "geometry '" + g.getName() + "': colour count != vertex count");
+    mesh.positions.resize(verts->size());
+    for (size_t i = 0; i < verts->size(); ++i) mesh.positions[i] = glm::vec3((*verts)[i].x(), (*verts)[i].y(), (*verts)[i].z());
+    mesh.colors.assign(verts->size(), glm::u8vec4(255));
+    if (colors)
+        for (size_t i = 0; i < colors->size(); ++i) mesh.colors[i] = glm::u8vec4((*colors)[i].r(), (*colors)[i].g(), (*colors)[i].b(), (*colors)[i].a());
+    mesh.indices.resize(de->getNumIndices());
+    for (unsigned i = 0; i < de->getNumIndices(); ++i) {
+        mesh.indices[i] = de->getElement(i);
+        if (mesh.indices[i] >= verts->size()) return notCityFile(path, "geometry '" + g.getName() + "': index out of range");
+    }
+    if (mesh.indices.size() % 3 != 0) return notCityFile(path, "geometry '" + g.getName() + "': index count not a multiple of 3");
+    return Status::ok();
+}
+
+// Reads the instance matrices of an instanced geometry (`what`: "tree
+// geometry" or "tree impostor geometry"): one column per vec4 attribute array.
+Status decodeInstanceMatrices(osg::Geometry& g, const std::string& what, const std::string& path,
+                              std::vector<glm::dmat4>& matrices) {
+    const std::string& name = g.getName();
+    osg::Vec4Array* cols[4];
+    for (unsigned c = 0; c < 4; ++c) {
+        cols[c] = dynamic_cast<osg::Vec4Array*>(g.getVertexAttribArray(kInstanceAttrib0 + c));
+        if (!cols[c]) return notCityFile(path, what + " '" + name + "' has no instance matrices");
+    }
+    const size_t n = size_t(std::max(0, g.getPrimitiveSet(0)->getNumInstances()));
+    for (auto* c : cols) if (c->size() != n) return notCityFile(path, what + " '" + name + "': instance count mismatch");
+    matrices.resize(n);
+    for (size_t k = 0; k < n; ++k) {
+        glm::dmat4 m(1.0);
+        for (int c = 0; c < 4; ++c) {
+            const osg::Vec4& v = (*cols[c])[unsigned(k)];
+            m[c] = glm::dvec4(v.x(), v.y(), v.z(), v.w());
+        }
+        matrices[k] = m;
+    }
+    return Status::ok();
+}
+
+// Decodes the tiles of a city file's root into out: meshes, tree instances
+// and prototypes, tree impostors, and each tile's triangles and mesh bounds.
+class TileDecoder {
+public:
+    TileDecoder(const std::string& path, int protoCount, SceneModel& out)
+        : _path(path), _protoCount(protoCount), _out(out), _protoSeen(size_t(protoCount), false) {}
+
+    // Decodes the tile xf (child ci of the root).
+    Status decodeTile(osg::MatrixTransform& xf, unsigned ci) {
+        const osg::Vec3d t = xf.getMatrix().getTrans();
+        const glm::dvec3 tileOrigin(t.x(), t.y(), t.z());
+        SceneTile tile;
+        tile.child = ci;
+        tile.origin = tileOrigin;
+        for (osg::Geometry* g : tileGeometries(xf))
+            if (Status s = decodeGeometry(*g, xf, tile); !s) return s;
+        for (uint32_t mi : tile.meshes) expandBounds(_out.meshes[mi], tile.lo, tile.hi);
+        _out.tiles.push_back(std::move(tile));
+        return Status::ok();
+    }
+
+private:
+    // Decodes one geometry of a tile: a tree impostor, a tree prototype with
+    // its instances, or a mesh of the tile.
+    Status decodeGeometry(osg::Geometry& g, osg::MatrixTransform& xf, SceneTile& tile) {
+        SceneMesh mesh;
+        if (Status s = decodeMesh(g, xf, _path, mesh); !s) return s;
+        const glm::dmat4 tileM = glm::translate(glm::dmat4(1.0), tile.origin);
+        const std::string& name = g.getName();
+        if (long pi = -1; isTreeImpostorName(name, &pi)) {  // coarse levels: drawn by the graph only
+            if (pi < 0 || pi >= _protoCount) return notCityFile(_path, "tree impostor geometry '" + name + "' names an unknown prototype");
+            std::vector<glm::dmat4> matrices;
+            if (Status s = decodeInstanceMatrices(g, "tree impostor geometry", _path, matrices); !s) return s;
+            for (const glm::dmat4& m : matrices) _out.impostors.push_back({uint32_t(pi), tileM * m, 0u});
+            const size_t n = matrices.size();
+            _out.triangles += n * (mesh.indices.size() / 3);
+            tile.triangles += n * (mesh.indices.size() / 3);
+            return Status::ok();
+        }
+        mesh.material = materialFromName(name.c_str());
+        if (_out.labelled) {
+            auto* ids = dynamic_cast<osg::UIntArray*>(g.getVertexAttribArray(kLabelAttrib));
+            if (!ids || ids->size() != mesh.positions.size()) return notCityFile(_path, "geometry '" + name + "': label count != vertex count");
+            ids->setPreserveDataType(true);
+            mesh.ids.assign(ids->begin(), ids->end());
+        }
+        if (name.rfind(kTreeGeometryPrefix, 0) == 0) return decodeTrees(g, tileM, std::move(mesh), tile);
+        mesh.origin = tile.origin;
+        _out.triangles += mesh.indices.size() / 3;
+        tile.triangles += mesh.indices.size() / 3;
+        tile.meshes.push_back(uint32_t(_out.meshes.size()));
+        _out.meshes.push_back(std::move(mesh));
+        return Status::ok();
+    }
+
+    // Decodes a tree geometry: its instances (with their tree ids when
+    // labelled) and, the first time its prototype appears, the prototype mesh.
+    Status decodeTrees(osg::Geometry& g, const glm::dmat4& tileM, SceneMesh&& mesh, SceneTile& tile) {
+        const std::string& name = g.getName();
+        long pi = std::strtol(name.c_str() + std::strlen(kTreeGeometryPrefix), nullptr, 10);
+        if (pi < 0 || pi >= _protoCount) return notCityFile(_path, "tree geometry '" + name + "' names an unknown prototype");
+        std::vector<glm::dmat4> matrices;
+        if (Status s = decodeInstanceMatrices(g, "tree geometry", _path, matrices); !s) return s;
+        const size_t n = matrices.size();
+        osg::UIntArray* treeIds = nullptr;
+        if (_out.labelled) {
+            treeIds = dynamic_cast<osg::UIntArray*>(g.getVertexAttribArray(kTreeIdAttrib));
+            if (!treeIds || treeIds->size() != n) return notCityFile(_path, "tree geometry '" + name + "': tree id count != instance count");
+            treeIds->setPreserveDataType(true);
+        }
+        for (size_t k = 0; k < n; ++k) {
+            tile.instances.push_back(uint32_t(_out.instances.size()));
+            _out.instances.push_back({uint32_t(pi), tileM * matrices[k], treeIds ? (*treeIds)[unsigned(k)] : 0u});
+        }
+        _out.triangles += n * (mesh.indices.size() / 3);
+        tile.triangles += n * (mesh.indices.size() / 3);
+        if (!_protoSeen[size_t(pi)]) {
+            _protoSeen[size_t(pi)] = true;
+            _out.prototypes[size_t(pi)] = std::move(mesh);
+        }
+        return Status::ok();
+    }
+
+    const std::string& _path;
+    const int _protoCount;
+    SceneModel& _out;
+    std::vector<bool> _protoSeen;
+};
+
+}  // namespace
+
 Result<SceneModel> decodeCityScene(osg::Node* node, const std::string& path) {
-    auto bad = [&](const std::string& why) { return Status::error("'" + path + "' is not a vista city file: " + why); };
     osg::Group* root = node ? node->asGroup() : nullptr;
-    if (!root || root->getName() != "vista.city") return bad("root node is not the group 'vista.city'");
+    if (!root || root->getName() != "vista.city") return notCityFile(path, "root node is not the group 'vista.city'");
     int format = 0;
-    if (!getUser(*root, "vista.format", format)) return bad("missing user value vista.format");
+    if (!getUser(*root, "vista.format", format)) return notCityFile(path, "missing user value vista.format");
     if (format != kFormatVersion)
         return Status::error("city file '" + path + "': vista.format = " + std::to_string(format) + " is not supported (expected " +
                              std::to_string(kFormatVersion) + ")");
     SceneModel out;
     addHazeToTreePrograms(node);
     setSceneRoot(out, node);
-    std::string paramsJson, streetsJson;
-    if (!getUser(*root, "vista.params", paramsJson)) return bad("missing user value vista.params");
-    auto params = parseParamsJson(paramsJson, path + " (vista.params)");
-    if (!params) return params.status();
-    out.params = *params;
-    if (getUser(*root, "vista.streets", streetsJson) && !streetsJson.empty() && streetsJson != "{}") {
-        auto g = streetGraphFromJson(streetsJson);
-        if (!g) return Status::error("city file '" + path + "': vista.streets: " + g.status().message());
-        out.streets = std::move(*g);
-    }
-    int labels = 0;
-    out.labelled = getUser(*root, "vista.labels", labels) && labels == 1;
     int protoCount = 0;
-    getUser(*root, "vista.tree_prototypes", protoCount);
-    if (protoCount < 0 || protoCount > 1000000) return bad("vista.tree_prototypes = " + std::to_string(protoCount) + " out of range");
+    if (Status s = decodeCityValues(*root, path, out, protoCount); !s) return s;
     out.prototypes.resize(size_t(protoCount));
-    std::vector<bool> protoSeen(size_t(protoCount), false);
 
+    TileDecoder tiles(path, protoCount, out);
     for (unsigned ci = 0; ci < root->getNumChildren(); ++ci) {
         osg::MatrixTransform* xf = asCityTile(root->getChild(ci));
         if (!xf) continue;
-        const osg::Vec3d t = xf->getMatrix().getTrans();
-        const glm::dvec3 tileOrigin(t.x(), t.y(), t.z());
-        const glm::dmat4 tileM = glm::translate(glm::dmat4(1.0), tileOrigin);
-        SceneTile tile;
-        tile.child = ci;
-        tile.origin = tileOrigin;
-        for (osg::Geometry* g : tileGeometries(*xf)) {
-            auto* verts = dynamic_cast<osg::Vec3Array*>(g->getVertexArray());
-            auto* colors = dynamic_cast<osg::Vec4ubArray*>(g->getColorArray());
-            auto* de = dynamic_cast<osg::DrawElements*>(g->getPrimitiveSet(0));
-            if (!verts || !de || de->getMode() != GL_TRIANGLES) return bad("geometry '" + g->getName() + "' in " + xf->getName() + " is malformed");
-            if (colors && colors->size() != verts->size()) return bad("geometry '" + g->getName() + "': colour count != vertex count");
-            SceneMesh mesh;
-            mesh.positions.resize(verts->size());
-            for (size_t i = 0; i < verts->size(); ++i) mesh.positions[i] = glm::vec3((*verts)[i].x(), (*verts)[i].y(), (*verts)[i].z());
-            mesh.colors.assign(verts->size(), glm::u8vec4(255));
-            if (colors)
-                for (size_t i = 0; i < colors->size(); ++i) mesh.colors[i] = glm::u8vec4((*colors)[i].r(), (*colors)[i].g(), (*colors)[i].b(), (*colors)[i].a());
-            mesh.indices.resize(de->getNumIndices());
-            for (unsigned i = 0; i < de->getNumIndices(); ++i) {
-                mesh.indices[i] = de->getElement(i);
-                if (mesh.indices[i] >= verts->size()) return bad("geometry '" + g->getName() + "': index out of range");
-            }
-            if (mesh.indices.size() % 3 != 0) return bad("geometry '" + g->getName() + "': index count not a multiple of 3");
-            const std::string& name = g->getName();
-            if (long pi = -1; isTreeImpostorName(name, &pi)) {  // coarse levels: drawn by the graph only
-                if (pi < 0 || pi >= protoCount) return bad("tree impostor geometry '" + name + "' names an unknown prototype");
-                osg::Vec4Array* cols[4];
-                for (unsigned c = 0; c < 4; ++c) {
-                    cols[c] = dynamic_cast<osg::Vec4Array*>(g->getVertexAttribArray(kInstanceAttrib0 + c));
-                    if (!cols[c]) return bad("tree impostor geometry '" + name + "' has no instance matrices");
-                }
-                const size_t n = size_t(std::max(0, de->getNumInstances()));
-                for (auto* c : cols) if (c->size() != n) return bad("tree impostor geometry '" + name + "': instance count mismatch");
-                for (size_t k = 0; k < n; ++k) {
-                    glm::dmat4 m(1.0);
-                    for (int c = 0; c < 4; ++c) {
-                        const osg::Vec4& v = (*cols[c])[unsigned(k)];
-                        m[c] = glm::dvec4(v.x(), v.y(), v.z(), v.w());
-                    }
-                    out.impostors.push_back({uint32_t(pi), tileM * m, 0u});
-                }
-                out.triangles += n * (mesh.indices.size() / 3);
-                tile.triangles += n * (mesh.indices.size() / 3);
-                continue;
-            }
-            mesh.material = materialFromName(name.c_str());
-            if (out.labelled) {
-                auto* ids = dynamic_cast<osg::UIntArray*>(g->getVertexAttribArray(kLabelAttrib));
-                if (!ids || ids->size() != verts->size()) return bad("geometry '" + name + "': label count != vertex count");
-                ids->setPreserveDataType(true);
-                mesh.ids.assign(ids->begin(), ids->end());
-            }
-            if (name.rfind(kTreeGeometryPrefix, 0) == 0) {
-                long pi = std::strtol(name.c_str() + std::strlen(kTreeGeometryPrefix), nullptr, 10);
-                if (pi < 0 || pi >= protoCount) return bad("tree geometry '" + name + "' names an unknown prototype");
-                osg::Vec4Array* cols[4];
-                for (unsigned c = 0; c < 4; ++c) {
-                    cols[c] = dynamic_cast<osg::Vec4Array*>(g->getVertexAttribArray(kInstanceAttrib0 + c));
-                    if (!cols[c]) return bad("tree geometry '" + name + "' has no instance matrices");
-                }
-                size_t n = size_t(std::max(0, de->getNumInstances()));
-                for (auto* c : cols) if (c->size() != n) return bad("tree geometry '" + name + "': instance count mismatch");
-                osg::UIntArray* treeIds = nullptr;
-                if (out.labelled) {
-                    treeIds = dynamic_cast<osg::UIntArray*>(g->getVertexAttribArray(kTreeIdAttrib));
-                    if (!treeIds || treeIds->size() != n) return bad("tree geometry '" + name + "': tree id count != instance count");
-                    treeIds->setPreserveDataType(true);
-                }
-                for (size_t k = 0; k < n; ++k) {
-                    glm::dmat4 m(1.0);
-                    for (int c = 0; c < 4; ++c) {
-                        const osg::Vec4& v = (*cols[c])[unsigned(k)];
-                        m[c] = glm::dvec4(v.x(), v.y(), v.z(), v.w());
-                    }
-                    tile.instances.push_back(uint32_t(out.instances.size()));
-                    out.instances.push_back({uint32_t(pi), tileM * m, treeIds ? (*treeIds)[unsigned(k)] : 0u});
-                }
-                out.triangles += n * (mesh.indices.size() / 3);
-                tile.triangles += n * (mesh.indices.size() / 3);
-                if (!protoSeen[size_t(pi)]) {
-                    protoSeen[size_t(pi)] = true;
-                    out.prototypes[size_t(pi)] = std::move(mesh);
-                }
-            } else {
-                mesh.origin = tileOrigin;
-                out.triangles += mesh.indices.size() / 3;
-                tile.triangles += mesh.indices.size() / 3;
-                tile.meshes.push_back(uint32_t(out.meshes.size()));
-                out.meshes.push_back(std::move(mesh));
-            }
-        }
-        for (uint32_t mi : tile.meshes) expandBounds(out.meshes[mi], tile.lo, tile.hi);
-        out.tiles.push_back(std::move(tile));
+        if (Status s = tiles.decodeTile(*xf, ci); !s) return s;
     }
     // Instance bounds need the prototypes, which a later tile may define first.
     for (SceneTile& t : out.tiles)
