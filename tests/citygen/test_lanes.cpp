@@ -168,8 +168,11 @@ TEST(Lanes, LinkRoadsAreTangentToBothRoads) {
             if (r.arcLength > 0) {
                 const double R = 1.0 / std::abs(r.curvature);
                 for (double s = 0; s <= r.length(); s += 0.25) {
-                    if (r.curvature > 0) EXPECT_LT(r.leftBorder(s), R) << s;
-                    else EXPECT_GT(r.rightBorder(s), -R) << s;
+                    if (r.curvature > 0) {
+                        EXPECT_LT(r.leftBorder(s), R) << s;
+                    } else {
+                        EXPECT_GT(r.rightBorder(s), -R) << s;
+                    }
                 }
             }
         }

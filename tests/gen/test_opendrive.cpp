@@ -280,7 +280,9 @@ void checkNet(const City& city, const std::string& label) {
         if (!L.valid) continue;
         ++roads;
         const StreetEdge& E = city.streets.edges[e];
-        if (E.lanesForward < 0 && E.lanesBackward < 0) EXPECT_EQ(L.right + L.left, std::max<int>(E.lanes, 2)) << "edge " << e;
+        if (E.lanesForward < 0 && E.lanesBackward < 0) {
+            EXPECT_EQ(L.right + L.left, std::max<int>(E.lanes, 2)) << "edge " << e;
+        }
         EXPECT_NEAR(L.laneWidth * (L.right + L.left), carriagewayWidth(city.streets.edges[e]), 1e-9);
         const std::string rid = std::to_string(e);
         if (L.right > 0) {
@@ -670,8 +672,12 @@ TEST(OpenDrive, OsmLaneAndSpeedTagsReachTheFile) {
                 EXPECT_NEAR(lane->first("speed")->num("max"), speed, 1e-6) << "road " << e;
             }
         }
-        if (E.lanesForward >= 0) EXPECT_EQ(right, E.lanesForward) << "road " << e;
-        if (E.lanesBackward >= 0) EXPECT_EQ(left, E.lanesBackward) << "road " << e;
+        if (E.lanesForward >= 0) {
+            EXPECT_EQ(right, E.lanesForward) << "road " << e;
+        }
+        if (E.lanesBackward >= 0) {
+            EXPECT_EQ(left, E.lanesBackward) << "road " << e;
+        }
         oneWay += right == 0 || left == 0;
         ++checked;
     }
