@@ -87,7 +87,7 @@ Result<unsigned> parseChannels(const std::string& s) {
 }
 
 std::string frameName(size_t f) {
-    char b[16];
+    char b[24];  // up to 20 digits of a size_t
     std::snprintf(b, sizeof b, "%06zu", f);
     return b;
 }
