@@ -12,7 +12,7 @@
 #include "runtime/engine/metrics.h"
 #include "runtime/engine/panorama_cache.h"
 #include "runtime/engine/ray_scene.h"
-#include "tests/farfield/fixtures.h"
+#include "tests/runtime/engine/fixtures.h"
 
 using namespace vista;
 using namespace vista::test;

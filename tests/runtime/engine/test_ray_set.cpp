@@ -23,7 +23,7 @@
 #include "runtime/scene/city_file.h"
 #include "tests/common/run_vista.h"
 #include "tests/common/temp_dir.h"
-#include "tests/farfield/fixtures.h"
+#include "tests/runtime/engine/fixtures.h"
 
 using namespace vista;
 using namespace vista::test;

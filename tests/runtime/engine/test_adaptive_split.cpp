@@ -9,7 +9,7 @@
 #include "foundation/status.h"
 #include "runtime/engine/adaptive_split.h"
 #include "runtime/engine/ray_scene.h"
-#include "tests/farfield/fixtures.h"
+#include "tests/runtime/engine/fixtures.h"
 
 using namespace vista;
 using namespace vista::test;

@@ -28,100 +28,11 @@
 #include "nodes/render/offscreen.h"
 #include "runtime/scene/paths.h"
 #include "runtime/engine/ray_scene.h"
+#include "tests/nodes/render/render_fixtures.h"
 
 using namespace vista;
 namespace fs = std::filesystem;
-
 namespace {
-
-
-#define REQUIRE_DISPLAY()                                                                        \
-    do {                                                                                         \
-        const char* d = std::getenv("DISPLAY");                                                  \
-        if (!d || !*d) GTEST_SKIP() << "no X display: run the rendering tests under xvfb-run -a"; \
-    } while (0)
-
-// Axis-aligned box (5 faces, no bottom) as a SceneMesh in a local frame.
-void addBox(SceneMesh& m, glm::vec3 lo, glm::vec3 hi, glm::u8vec4 c) {
-    glm::vec3 p[8];
-    for (int i = 0; i < 8; ++i) p[i] = {i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z};
-    const int faces[5][4] = {{0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}, {4, 5, 7, 6}};
-    for (const auto& f : faces) {
-        uint32_t base = uint32_t(m.positions.size());
-        for (int k = 0; k < 4; ++k) {
-            m.positions.push_back(p[f[k]]);
-            m.colors.push_back(c);
-        }
-        for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) m.indices.push_back(base + i);
-    }
-}
-void addQuad(SceneMesh& m, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, glm::u8vec4 col) {
-    uint32_t base = uint32_t(m.positions.size());
-    for (auto v : {a, b, c, d}) {
-        m.positions.push_back(v);
-        m.colors.push_back(col);
-    }
-    for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) m.indices.push_back(base + i);
-}
-
-// The OSG scene of a set of meshes, structured like a city file (tiles as
-// double MatrixTransforms, prelit colours, lighting off).
-osg::ref_ptr<osg::Group> sceneOf(const std::vector<SceneMesh>& meshes) {
-    osg::ref_ptr<osg::Group> root = new osg::Group;
-    root->getOrCreateStateSet()->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
-    for (const auto& m : meshes) {
-        osg::ref_ptr<osg::Geometry> g = new osg::Geometry;
-        osg::ref_ptr<osg::Vec3Array> v = new osg::Vec3Array;
-        osg::ref_ptr<osg::Vec4ubArray> c = new osg::Vec4ubArray;
-        for (size_t i = 0; i < m.positions.size(); ++i) {
-            v->push_back({m.positions[i].x, m.positions[i].y, m.positions[i].z});
-            c->push_back({m.colors[i].x, m.colors[i].y, m.colors[i].z, m.colors[i].w});
-        }
-        c->setNormalize(true);
-        g->setVertexArray(v.get());
-        g->setColorArray(c.get(), osg::Array::BIND_PER_VERTEX);
-        osg::ref_ptr<osg::DrawElementsUInt> de = new osg::DrawElementsUInt(GL_TRIANGLES);
-        for (uint32_t i : m.indices) de->push_back(i);
-        g->addPrimitiveSet(de.get());
-        g->setUseDisplayList(false);
-        g->setUseVertexBufferObjects(true);
-        osg::ref_ptr<osg::Geode> geode = new osg::Geode;
-        geode->addDrawable(g.get());
-        osg::ref_ptr<osg::MatrixTransform> mt = new osg::MatrixTransform(osg::Matrixd::translate(m.origin.x, m.origin.y, m.origin.z));
-        mt->addChild(geode.get());
-        root->addChild(mt.get());
-    }
-    return root;
-}
-
-// A little "city": ground and a few coloured blocks, far from the world origin.
-const glm::dvec3 kWorld(1.0e6, 2.0e6, 0.0);
-SceneModel tinyCity() {
-    SceneModel c;
-    SceneMesh ground;
-    ground.origin = kWorld;
-    addQuad(ground, {-400, -400, 0}, {400, -400, 0}, {400, 400, 0}, {-400, 400, 0}, {90, 110, 80, 255});
-    c.meshes.push_back(ground);
-    SceneMesh blocks;
-    blocks.origin = kWorld + glm::dvec3(0, 100, 0);
-    addBox(blocks, {-60, -20, 0}, {-20, 20, 30}, {200, 80, 60, 255});
-    addBox(blocks, {10, -10, 0}, {40, 30, 55}, {60, 90, 200, 255});
-    addBox(blocks, {-15, 80, 0}, {25, 120, 90}, {220, 210, 170, 255});
-    c.meshes.push_back(blocks);
-    for (const auto& m : c.meshes) c.triangles += m.indices.size() / 3;
-    setSceneRoot(c, sceneOf(c.meshes));
-    return c;
-}
-
-Camera testCamera(int w = 96, int h = 72) {
-    Camera c;
-    c.width = w;
-    c.height = h;
-    c.fovY = 60.0 * kPi / 180.0;
-    c.eye = kWorld + glm::dvec3(0, 0, 1.7);
-    return c;
-}
-
 std::string tmpDir(const std::string& name) {
     fs::path p = fs::temp_directory_path() / ("vista_test_bench_" + std::to_string(::getpid()) + "_" + name);
     fs::create_directories(p);
@@ -141,74 +52,6 @@ int runVista(const std::string& args, std::string* output = nullptr) {
 }
 
 }  // namespace
-
-TEST(Offscreen, SkyBackgroundMatchesTheCpuSkyExactly) {
-    REQUIRE_DISPLAY();
-    auto r = OffscreenRenderer::create(96, 72);
-    ASSERT_TRUE(r.isOk()) << r.status().message();
-    osg::ref_ptr<osg::Group> empty = new osg::Group;
-    Camera cam = testCamera();
-    cam.pitch = 0.15;  // horizon below the centre: rows differ top to bottom
-    Image img, sky;
-    FrameStats st;
-    ASSERT_TRUE(r.value()->render(empty.get(), cam, 0.0, &img, nullptr, st).isOk());
-    renderSky(cam, sky);
-    EXPECT_EQ(lumaPsnr(img, sky), kPsnrCapDb);
-    EXPECT_NE(img.at(0, 0), img.at(0, 71));  // the gradient is there, row 0 at the top
-    EXPECT_EQ(st.triangles, 0u);              // the background is not counted
-}
-
-TEST(Offscreen, ColourDepthOrientationAndCounts) {
-    REQUIRE_DISPLAY();
-    auto r = OffscreenRenderer::create(96, 72);
-    ASSERT_TRUE(r.isOk()) << r.status().message();
-    // A red wall 50 m ahead (north) covering the upper half of a level view
-    // (from eye height up), in a tile far from the world origin.
-    SceneMesh wall;
-    wall.origin = kWorld + glm::dvec3(0, 50, 0);
-    addQuad(wall, {-500, 0, 1.7f}, {500, 0, 1.7f}, {500, 0, 900}, {-500, 0, 900}, {255, 0, 0, 255});
-    auto scene = sceneOf({wall});
-    Camera cam = testCamera();
-    Image img;
-    std::vector<float> depth;
-    FrameStats st;
-    ASSERT_TRUE(r.value()->render(scene.get(), cam, 0.0, &img, &depth, st).isOk());
-    EXPECT_EQ(img.at(48, 0), glm::u8vec4(255, 0, 0, 255));   // top: wall
-    EXPECT_EQ(img.at(48, 71), skyColor(std::asin(cam.rayDirection(48.5, 71.5).z)));  // bottom: sky
-    ASSERT_EQ(depth.size(), size_t(96 * 72));
-    // Infinite far plane: window depth = 1 - zNear / distance.
-    double d0 = depth[size_t(0 * 96 + 48)];
-    double dist = 50.0 / glm::dot(cam.rayDirection(48.5, 0.5), cam.forward()) * glm::dot(cam.rayDirection(48.5, 0.5), cam.forward());
-    EXPECT_NEAR(d0, 1.0 - cam.zNear / dist, 1e-5);
-    EXPECT_EQ(depth[size_t(71 * 96 + 48)], 1.0f);
-    EXPECT_EQ(st.triangles, 2u);
-    EXPECT_EQ(st.drawCalls, 1u);
-    EXPECT_GT(st.frameMs, 0.0);
-
-    // Near plane at 40 m: the wall at 50 m is gone.
-    ASSERT_TRUE(r.value()->render(scene.get(), cam, 40.0, &img, nullptr, st).isOk());
-    EXPECT_EQ(img.at(48, 0), skyColor(std::asin(cam.rayDirection(48.5, 0.5).z)));
-    // A small object wholly beyond the near plane is culled, not just clipped.
-    SceneMesh far;
-    far.origin = kWorld + glm::dvec3(0, 200, 0);
-    addQuad(far, {-5, 0, 0}, {5, 0, 0}, {5, 0, 10}, {-5, 0, 10}, {0, 255, 0, 255});
-    auto farScene = sceneOf({far});
-    ASSERT_TRUE(r.value()->render(farScene.get(), cam, 40.0, &img, nullptr, st).isOk());
-    EXPECT_EQ(st.triangles, 0u);
-    ASSERT_TRUE(r.value()->render(farScene.get(), cam, 0.0, &img, nullptr, st).isOk());
-    EXPECT_EQ(st.triangles, 2u);
-}
-
-TEST(Offscreen, BadSizesAndMismatchedCameras) {
-    EXPECT_FALSE(OffscreenRenderer::create(0, 0).isOk());
-    REQUIRE_DISPLAY();
-    auto r = OffscreenRenderer::create(32, 24);
-    ASSERT_TRUE(r.isOk()) << r.status().message();
-    Image img;
-    FrameStats st;
-    osg::ref_ptr<osg::Group> empty = new osg::Group;
-    EXPECT_FALSE(r.value()->render(empty.get(), testCamera(64, 48), 0.0, &img, nullptr, st).isOk());
-}
 
 TEST(RenderModes, RegistryListsEveryModeOnce) {
     std::vector<std::string> names;
@@ -281,9 +124,7 @@ TEST(BenchSummary, SpeedupIsTheMedianOfSameFrameRatios) {
     EXPECT_TRUE(std::isnan(medianOfSameFrameRatios({}, {})));
     EXPECT_EQ(modeFrameTimes(r, "x"), (std::vector<double>{5, 40, 10, 20, 100}));
 }
-
 namespace {
-
 std::vector<std::vector<std::string>> readCsv(const std::string& file) {
     std::ifstream f(file);
     std::vector<std::vector<std::string>> rows;
@@ -399,93 +240,6 @@ TEST(Bench, SyntheticSceneSmokeRun) {
     fs::remove_all(cfg.outDir);
 }
 
-namespace {
-
-// A tile (double MatrixTransform) holding one coloured box, as a city file's tiles are.
-osg::ref_ptr<osg::Node> boxTile(const glm::dvec3& origin, glm::vec3 lo, glm::vec3 hi, glm::u8vec4 colour) {
-    SceneMesh m;
-    m.origin = origin;
-    addBox(m, lo, hi, colour);
-    osg::ref_ptr<osg::Group> g = sceneOf({m});
-    return g->getChild(0);
-}
-
-struct ImpostorFrame {
-    std::string note;
-    uint64_t triangles = 0, fullTriangles = 0;
-    double psnrVsFull = 0;
-};
-
-// osgimpostor at `first` (sprites made there), then at `cam`, against full at `cam`.
-ImpostorFrame renderOsgImpostor(osg::Group* scene, OffscreenRenderer& renderer, const Camera& first, const Camera& cam) {
-    ModeContext ctx;
-    ctx.scene = scene;
-    ctx.renderer = &renderer;
-    ctx.options.nearDistance = 100;
-    auto imp = createRenderMode("osgimpostor", ctx), full = createRenderMode("full", ctx);
-    EXPECT_TRUE(imp.isOk() && full.isOk());
-    if (!imp.isOk() || !full.isOk()) return {};
-    Image a, b;
-    FrameStats sa, sb;
-    EXPECT_TRUE(imp.value()->renderFrame(first, a, sa).isOk());
-    sa = FrameStats();
-    EXPECT_TRUE(imp.value()->renderFrame(cam, a, sa).isOk());
-    EXPECT_TRUE(full.value()->renderFrame(cam, b, sb).isOk());
-    return {sa.notes.empty() ? "" : sa.notes.back(), sa.triangles, sb.triangles, lumaPsnr(a, b)};
-}
-
-}  // namespace
-
-// Why osgimpostor scored 99 dB on small cities: osgSim::Impostor draws the
-// real geometry while the eye is within nearD + r (or sqrt(2) r) of a tile's
-// centre; when every tile is that close no sprite is ever drawn and the
-// image is exactly `full`'s. A tile beyond the threshold is drawn as a sprite.
-TEST(OsgImpostor, SpritesOnlyBeyondTheThreshold) {
-    REQUIRE_DISPLAY();
-    auto r = OffscreenRenderer::create(160, 120);
-    ASSERT_TRUE(r.isOk()) << r.status().message();
-    Camera first = testCamera(160, 120), cam = first;
-    cam.eye.x += 6.0;  // the sprite made at `first` is reused (its pixel error stays small)
-    osg::ref_ptr<osg::Group> scene = new osg::Group;
-    scene->getOrCreateStateSet()->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
-    scene->addChild(boxTile(kWorld + glm::dvec3(0, 60, 0), {-10, -5, 0}, {10, 5, 12}, {200, 80, 60, 255}));
-    const ImpostorFrame within = renderOsgImpostor(scene.get(), *r.value(), first, cam);
-    EXPECT_EQ(within.note, "impostors: 0 sprites, 1 geometry");
-    EXPECT_EQ(within.triangles, within.fullTriangles);
-    EXPECT_EQ(within.psnrVsFull, kPsnrCapDb) << "within the threshold osgimpostor is full";
-    // A tall block 700 m ahead, right of the near one: beyond 100 m + its radius.
-    scene->addChild(boxTile(kWorld + glm::dvec3(250, 700, 0), {-40, -20, 0}, {40, 20, 120}, {60, 90, 200, 255}));
-    const ImpostorFrame beyond = renderOsgImpostor(scene.get(), *r.value(), first, cam);
-    EXPECT_EQ(beyond.note, "impostors: 1 sprites, 1 geometry");
-    EXPECT_EQ(beyond.triangles, within.triangles + 2) << "the far tile is one sprite quad, not its 10 triangles";
-    EXPECT_EQ(beyond.fullTriangles, within.fullTriangles + 10);
-    EXPECT_LT(beyond.psnrVsFull, kPsnrCapDb) << "the sprite made from the first viewpoint is not the geometry";
-    EXPECT_GT(beyond.psnrVsFull, 20.0) << "the sprite shows the far tile";
-    std::printf("osgimpostor with one sprite vs full: %.2f dB\n", beyond.psnrVsFull);
-}
-
-// The viewer derives the camera of its modes' frame hook from OSG's matrices.
-TEST(ViewCamera, PoseFromOsgMatricesRoundTrips) {
-    Camera c = testCamera(320, 240);
-    c.eye = kWorld + glm::dvec3(12.5, -40.25, 31.0);
-    c.heading = 2.1;
-    c.pitch = -0.3;
-    c.roll = 0.05;
-    for (double zFar : {0.0, 1.0e5}) {
-        Camera back;
-        double zf = -1;
-        ASSERT_TRUE(cameraFromOsg(osg::Matrixd(glm::value_ptr(c.view())), osg::Matrixd(glm::value_ptr(c.projection(zFar))),
-                                  c.width, c.height, back, zf))
-            << zFar;
-        EXPECT_NEAR(glm::length(back.eye - c.eye), 0.0, 1e-6) << zFar;
-        EXPECT_NEAR(back.heading, c.heading, 1e-9) << zFar;
-        EXPECT_NEAR(back.pitch, c.pitch, 1e-9) << zFar;
-        EXPECT_NEAR(back.roll, c.roll, 1e-9) << zFar;
-        EXPECT_NEAR(back.fovY, c.fovY, 1e-9) << zFar;
-        EXPECT_NEAR(zf, zFar, 1e-3 * zFar) << zFar;
-    }
-}
-
 TEST(Bench, SupersampledReferenceIsCloserToItselfThanAliasedFrames) {
     REQUIRE_DISPLAY();
     SceneModel city = tinyCity();
@@ -506,94 +260,6 @@ TEST(Bench, SupersampledReferenceIsCloserToItselfThanAliasedFrames) {
     // (edges), but stays close to it.
     EXPECT_LT(r->modes[0].psnrDbMin, kPsnrCapDb);
     EXPECT_GT(r->modes[0].psnrDbMin, 20.0);
-}
-
-// The tiny city with its ray scene and a 160x120 renderer, as a ModeContext.
-struct TinyModes {
-    SceneModel city = tinyCity();
-    std::unique_ptr<RayScene> rays;
-    std::unique_ptr<OffscreenRenderer> renderer;
-    ModeContext ctx;
-    std::string error;
-    TinyModes() {
-        auto rs = RayScene::build(city);
-        auto r = OffscreenRenderer::create(160, 120);
-        if (!rs.isOk() || !r.isOk()) {
-            error = (rs.isOk() ? r.status() : rs.status()).message();
-            return;
-        }
-        rays = std::move(rs.value());
-        renderer = std::move(r.value());
-        ctx.city = &city;
-        ctx.scene = sceneRoot(city);
-        ctx.renderer = renderer.get();
-        ctx.rays = rays.get();
-    }
-    bool ready() const { return error.empty(); }
-};
-
-// Ray casting and rasterising the same prelit scene agree: on a still frame
-// luma PSNR >= 30 dB (differences only along edges, where pixel centres fall
-// on different sides of a triangle edge).
-TEST(Bench, RaycastAgreesWithFull) {
-    REQUIRE_DISPLAY();
-    TinyModes t;
-    ASSERT_TRUE(t.ready()) << t.error;
-    ModeContext& ctx = t.ctx;
-    auto full = createRenderMode("full", ctx), ray = createRenderMode("raycast", ctx);
-    ASSERT_TRUE(full.isOk());
-    ASSERT_TRUE(ray.isOk()) << ray.status().message();
-    Camera cam = testCamera(160, 120);
-    cam.eye = kWorld + glm::dvec3(-10, -40, 1.7);
-    cam.heading = 0.15;
-    Image a, b;
-    FrameStats sa, sb;
-    ASSERT_TRUE(full.value()->renderFrame(cam, a, sa).isOk());
-    ASSERT_TRUE(ray.value()->renderFrame(cam, b, sb).isOk());
-    double psnr = lumaPsnr(a, b);
-    EXPECT_GE(psnr, 30.0) << "raycast vs full";
-    std::printf("raycast vs full on a still frame: %.2f dB, %.4f of pixels differ by > 8\n", psnr, fractionDiffering(a, b, 8));
-    EXPECT_GT(sb.pixels.rayHit, 0u);
-    EXPECT_GT(sb.pixels.rayMiss, 0u);
-    EXPECT_EQ(sb.pixels.rayHit + sb.pixels.rayMiss, uint64_t(160 * 120));
-    EXPECT_EQ(sb.raysCast, uint64_t(160 * 120));
-}
-
-// A near field with nothing in it needs no GL pass: the hybrid then skips the
-// draw and the read-back and casts every pixel, as `raycast` does (the split's
-// "0 m: ray casting" candidate). The tiny city is one chunk (its layout is not
-// a tiled city file: bounds from OSG); from 2 km away it is beyond the 1 m
-// near distance, and the hybrid's picture must be raycast's, with every pixel
-// written although the GL pass (which would clear them) is gone.
-TEST(Hybrid, AnEmptyNearFieldSkipsTheGlPassAndCastsEveryPixel) {
-    REQUIRE_DISPLAY();
-    TinyModes t;
-    ASSERT_TRUE(t.ready()) << t.error;
-    ModeContext& ctx = t.ctx;
-    ctx.options.nearDistance = 1.0;
-    ctx.options.cache = false;
-    auto hyb = createRenderMode("hybrid", ctx), ray = createRenderMode("raycast", ctx);
-    ASSERT_TRUE(hyb.isOk()) << hyb.status().message();
-    ASSERT_TRUE(ray.isOk()) << ray.status().message();
-    Camera cam = testCamera(160, 120);
-    cam.eye = kWorld + glm::dvec3(0, -2000, 300);
-    cam.pitch = -0.15;
-    Image h(160, 120), c;
-    for (size_t i = 0; i < h.rgba.size(); ++i) h.rgba[i] = uint8_t(i % 4 == 3 ? 255 : 7);  // stale content
-    FrameStats sh, sc;
-    ASSERT_TRUE(hyb.value()->renderFrame(cam, h, sh).isOk());
-    ASSERT_TRUE(ray.value()->renderFrame(cam, c, sc).isOk());
-    EXPECT_NE(std::find(sh.notes.begin(), sh.notes.end(), "near field empty: no GL pass"), sh.notes.end());
-    EXPECT_EQ(sh.stages.ms(Stage::Near), 0.0);
-    EXPECT_EQ(sh.pixels.covered, 0u);
-    EXPECT_GT(sh.pixels.rayHit, 0u);
-    EXPECT_EQ(fractionDiffering(h, c, 0), 0.0) << "hybrid without a near field vs raycast";
-    // A near field that holds something (the eye inside the chunk's bounds) is drawn as before.
-    cam.eye = kWorld + glm::dvec3(0, 0, 1.7);
-    FrameStats sn;
-    ASSERT_TRUE(hyb.value()->renderFrame(cam, h, sn).isOk());
-    EXPECT_EQ(std::find(sn.notes.begin(), sn.notes.end(), "near field empty: no GL pass"), sn.notes.end());
-    EXPECT_GT(sn.stages.ms(Stage::Near), 0.0);
 }
 
 TEST(BenchCli, BadInputExitsWithTwo) {

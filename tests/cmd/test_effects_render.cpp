@@ -12,7 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "../common/temp_dir.h"
+#include "tests/common/temp_dir.h"
 
 namespace fs = std::filesystem;
 

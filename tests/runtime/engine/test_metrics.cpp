@@ -1,4 +1,4 @@
-// Image metrics against hand-built images, PNG I/O, the plotter.
+// Image metrics against hand-built images, PNG I/O.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,9 +12,7 @@
 #include "cmd/plot.h"
 
 using namespace vista;
-
 namespace {
-
 Image solid(int w, int h, glm::u8vec4 c) {
     Image img(w, h);
     for (int y = 0; y < h; ++y)
@@ -126,30 +124,4 @@ TEST(Png, RoundTripAndBadFiles) {
     EXPECT_FALSE(writePng(a, "/nonexistent-dir-vista/x.png").isOk());
     EXPECT_FALSE(writePng(Image(), tmpFile("empty.png")).isOk());
     for (const auto& p : {f, t, junk}) std::filesystem::remove(p);
-}
-
-TEST(Plot, DrawsSeriesAndSurvivesBadValues) {
-    PlotSpec s;
-    s.title = "Frame time";
-    s.xLabel = "frame";
-    s.yLabel = "ms";
-    PlotSeries a;
-    a.label = "full";
-    a.color = {200, 0, 0};
-    for (int i = 0; i < 50; ++i) {
-        a.x.push_back(i);
-        a.y.push_back(10 + (i % 7));
-    }
-    a.y[10] = std::nan("");
-    s.series.push_back(a);
-    Image img = renderPlot(s);
-    ASSERT_TRUE(img.valid());
-    size_t red = 0;
-    for (int y = 0; y < img.height; ++y)
-        for (int x = 0; x < img.width; ++x)
-            if (img.at(x, y) == glm::u8vec4(200, 0, 0, 255)) ++red;
-    EXPECT_GT(red, 200u);
-    PlotSpec empty;
-    empty.logX = empty.logY = true;
-    EXPECT_TRUE(renderPlot(empty).valid());
 }

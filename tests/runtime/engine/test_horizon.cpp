@@ -10,7 +10,7 @@
 #include "foundation/units.h"
 #include "runtime/engine/horizon.h"
 #include "runtime/engine/ray_scene.h"
-#include "tests/farfield/fixtures.h"
+#include "tests/runtime/engine/fixtures.h"
 
 using namespace vista;
 using namespace vista::test;

@@ -1,0 +1,206 @@
+// OpenDRIVE files read by SUMO netconvert (a reader vista did not write): generated, hilly,
+// odd-lane and OSM cities convert without errors and keep their roads and lanes.
+#include <gtest/gtest.h>
+
+#include <expat.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "citygen/generate.h"
+#include "citygen/lanes.h"
+#include "citygen/opendrive.h"
+#include "citygen/streets.h"
+#include "tests/common/run_vista.h"
+#include "tests/common/temp_dir.h"
+#include "tests/citygen/opendrive_fixtures.h"
+
+namespace fs = std::filesystem;
+using namespace vista;
+using vista::test::readBytes;
+using vista::test::runVista;
+using vista::test::TempDir;
+namespace {
+// ---- netconvert --------------------------------------------------------------
+std::string shellOut(const std::string& cmd) {
+    std::string out;
+    FILE* f = ::popen(cmd.c_str(), "r");
+    if (!f) return out;
+    char buf[512];
+    while (std::fgets(buf, sizeof buf, f)) out += buf;
+    ::pclose(f);
+    while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
+    return out;
+}
+
+// The netconvert on PATH, or "" (then the caller skips). netconvert needs
+// SUMO_HOME for its built-in type maps: set it from the install prefix (the
+// data are in Debian's sumo-tools, which .ci/setup.sh installs).
+std::string findNetconvert() {
+    std::string path = shellOut("command -v netconvert 2>/dev/null");
+    if (path.empty()) return path;
+    if (!std::getenv("SUMO_HOME")) {
+        std::error_code ec;
+        fs::path real = fs::canonical(path, ec);
+        fs::path home = (ec ? fs::path(path) : real).parent_path().parent_path() / "share" / "sumo";
+        if (fs::exists(home / "data")) ::setenv("SUMO_HOME", home.c_str(), 1);
+    }
+    return path;
+}
+
+struct NetCheck {
+    int exitCode = -1;
+    int errors = 0;
+    std::string log;
+    std::unique_ptr<Element> net;
+};
+
+NetCheck runNetconvert(const std::string& netconvert, const std::string& xodr, const std::string& dir) {
+    NetCheck r;
+    const std::string net = dir + "/city.net.xml", log = dir + "/netconvert.log";
+    const int st = std::system((netconvert + " --opendrive-files " + xodr + " -o " + net + " >" + log + " 2>&1").c_str());
+    r.exitCode = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    r.log = readBytes(log);
+    for (size_t pos = 0; (pos = r.log.find("Error", pos)) != std::string::npos; ++pos)
+        if (pos == 0 || r.log[pos - 1] == '\n') ++r.errors;
+    std::string err;
+    r.net = parseXml(readBytes(net), &err);
+    EXPECT_TRUE(r.net) << "net.xml does not parse: " << err;
+    return r;
+}
+
+bool allDigits(const std::string& s) {
+    if (s.empty()) return false;
+    for (char c : s)
+        if (c < '0' || c > '9') return false;
+    return true;
+}
+
+// netconvert's net against the graph: one junction (id = the OpenDRIVE
+// junction id, digits only) per node of degree >= 3; road ends without a
+// link become "<road>.begin"/"<road>.end" nodes, each transition road two
+// "<road>.<road>" nodes; one traffic-light program per signalised junction;
+// "internal" junctions are netconvert's own (inside junctions). Every road
+// becomes edge "-<id>" (right lanes) and "<id>" (left lanes) with the
+// lane model's driving lane counts (sidewalks are not imported by default).
+void checkNet(const City& city, const std::string& label) {
+    const std::string netconvert = findNetconvert();
+    if (netconvert.empty()) GTEST_SKIP() << "netconvert (SUMO) is not on PATH: install the Debian package 'sumo'";
+    TempDir dir("vista_xodr");
+    OpenDriveCounts n;
+    auto xodr = openDriveXml(city.streets, city.params, &city.blocks, &n);
+    ASSERT_TRUE(xodr.isOk()) << xodr.status().message();
+    {
+        std::ofstream f(dir.file("city.xodr"), std::ios::binary);
+        f << *xodr;
+    }
+    NetCheck r = runNetconvert(netconvert, dir.file("city.xodr"), dir.path());
+    EXPECT_EQ(r.exitCode, 0) << label << "\n" << r.log;
+    EXPECT_EQ(r.errors, 0) << label << "\n" << r.log;
+    ASSERT_TRUE(r.net);
+
+    const LaneModel M = buildLaneModel(city.streets, city.params, &city.blocks);
+    size_t graphJunctions = 0;
+    for (int d : M.degree) graphJunctions += d >= 3;
+    // Road ends without a link: dead ends, and both roads at a corner too
+    // sharp for a transition (LaneModel::sharpCorners).
+    size_t openEnds = 0;
+    for (size_t e = 0; e < M.edges.size(); ++e) {
+        const EdgeLanes& L = M.edges[e];
+        if (!L.valid) continue;
+        for (uint32_t v : {city.streets.edges[e].a, city.streets.edges[e].b}) {
+            const int link = v == city.streets.edges[e].a ? L.linkA : L.linkB;
+            openEnds += M.degree[size_t(v)] == 1 || (M.degree[size_t(v)] == 2 && link < 0);
+        }
+    }
+    EXPECT_EQ(graphJunctions, M.junctions.size());
+    EXPECT_EQ(n.junctions, M.junctions.size());
+    size_t transitions = 0;
+    for (const LinkRoad& r : M.links) transitions += r.junction < 0;
+    EXPECT_EQ(n.transitions, transitions);
+    size_t netJunctions = 0, netEnds = 0, netLinks = 0;
+    for (const Element* j : r.net->all("junction")) {
+        const std::string id = j->str("id"), type = j->str("type");
+        if (type == "internal" || id.empty() || id[0] == ':') continue;
+        // "<road>#<k>": netconvert splits a road where its lane count
+        // changes (a lane tapering in or out inside a transition).
+        if (id.find('#') != std::string::npos) continue;
+        if (allDigits(id)) {
+            const size_t jid = std::stoul(id);
+            EXPECT_GE(jid, city.streets.edges.size()) << id;
+            EXPECT_LT(jid, city.streets.edges.size() + M.junctions.size()) << id;
+            ++netJunctions;
+        } else if ((id.size() > 6 && id.compare(id.size() - 6, 6, ".begin") == 0) ||
+                   (id.size() > 4 && id.compare(id.size() - 4, 4, ".end") == 0)) {
+            ++netEnds;
+        } else {
+            ++netLinks;
+        }
+    }
+    // Traffic lights: netconvert builds one traffic-light program per
+    // junction whose approaches carry dynamic signals.
+    std::set<int> lit;
+    for (const SignalPlacement& sp : M.signals)
+        if (sp.kind == SignalPlacement::Kind::TrafficLight) lit.insert(sp.junction);
+    EXPECT_EQ(r.net->all("tlLogic").size(), lit.size()) << label;
+    EXPECT_EQ(netJunctions, graphJunctions) << label;
+    EXPECT_EQ(netEnds, openEnds) << label;
+    // A transition road between two street roads: two road-to-road nodes.
+    EXPECT_EQ(netLinks, 2 * transitions) << label;
+
+    std::map<std::string, int> netLanes;
+    for (const Element* e : r.net->all("edge")) {
+        if (e->str("function") == "internal") continue;
+        netLanes[e->str("id")] = int(e->all("lane").size());
+    }
+    size_t roads = 0, lanes = 0;
+    for (size_t e = 0; e < M.edges.size(); ++e) {
+        const EdgeLanes& L = M.edges[e];
+        if (!L.valid) continue;
+        ++roads;
+        const StreetEdge& E = city.streets.edges[e];
+        if (E.lanesForward < 0 && E.lanesBackward < 0) {
+            EXPECT_EQ(L.right + L.left, std::max<int>(E.lanes, 2)) << "edge " << e;
+        }
+        EXPECT_NEAR(L.laneWidth * (L.right + L.left), carriagewayWidth(city.streets.edges[e]), 1e-9);
+        const std::string rid = std::to_string(e);
+        if (L.right > 0) {
+            ASSERT_TRUE(netLanes.count("-" + rid)) << label << ": no net edge for road " << rid;
+            EXPECT_EQ(netLanes["-" + rid], L.right) << label << " road " << rid;
+        }
+        if (L.left > 0) {
+            ASSERT_TRUE(netLanes.count(rid)) << label << ": no net edge for road " << rid;
+            EXPECT_EQ(netLanes[rid], L.left) << label << " road " << rid;
+        }
+        lanes += size_t(L.right + L.left);
+    }
+    EXPECT_EQ(n.roads, roads);
+    EXPECT_EQ(n.drivingLanes, lanes);
+    std::printf("[ %s ] roads %zu, transitions %zu, junctions %zu (netconvert %zu), connecting roads %zu, driving lanes %zu, "
+                "traffic lights %zu at %zu junctions (netconvert programs %zu), signs %zu, crosswalks %zu, "
+                "netconvert errors %d\n",
+                label.c_str(), n.roads, n.transitions, n.junctions, netJunctions, n.connectingRoads, n.drivingLanes,
+                n.trafficLights, lit.size(), r.net->all("tlLogic").size(), n.signs, n.crosswalks, r.errors);
+}
+
+}  // namespace
+
+TEST(OpenDrive, NetconvertReadsGeneratedCity) { checkNet(generated(smallParams(3, 600, 0)), "generated 600 m seed 3"); }
+
+TEST(OpenDrive, NetconvertReadsHillyCity) { checkNet(generated(smallParams(7, 500, 25)), "generated 500 m seed 7, hills 25 m"); }
+
+TEST(OpenDrive, NetconvertReadsOddLaneCounts) { checkNet(oddLanes(smallParams(5, 400, 0)), "generated 400 m seed 5, odd lane counts"); }
+
+TEST(OpenDrive, NetconvertReadsOsmImport) { checkNet(osmCity("hard_cases.osm"), "osm hard_cases.osm"); }
+
+// The synthetic town (tests/data/osm/town.osm: a 7 x 7 street grid with
+// building footprints): many junctions, blocks with sidewalks on both sides.
+TEST(OpenDrive, NetconvertReadsOsmTown) { checkNet(osmCity("town.osm"), "osm town.osm"); }

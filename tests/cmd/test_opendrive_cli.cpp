@@ -1,0 +1,62 @@
+// OpenDRIVE through the tool: `vista gen --xodr` and `vista export` write the same bytes;
+// bad input is exit 2 without a file.
+#include <gtest/gtest.h>
+
+#include <expat.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "citygen/generate.h"
+#include "citygen/lanes.h"
+#include "citygen/opendrive.h"
+#include "citygen/streets.h"
+#include "tests/common/run_vista.h"
+#include "tests/common/temp_dir.h"
+#include "tests/citygen/opendrive_fixtures.h"
+
+namespace fs = std::filesystem;
+using namespace vista;
+using vista::test::readBytes;
+using vista::test::runVista;
+using vista::test::TempDir;
+
+TEST(OpenDrive, GenAndExportWriteTheSameBytes) {
+    TempDir dir("vista_xodr_cli");
+    const std::string city = dir.file("c.osgb"), a = dir.file("a.xodr"), b = dir.file("b.xodr");
+    auto r = runVista("gen --size 300 --seed 4 --detail 0 -q -o " + city + " --xodr " + a);
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = runVista("export " + city + " --xodr " + b + " -q");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const std::string x = readBytes(a);
+    EXPECT_GT(x.size(), 1000u);
+    EXPECT_EQ(x, readBytes(b));
+}
+
+TEST(OpenDrive, ExportBadInputIsExit2WithoutFile) {
+    TempDir dir("vista_xodr_bad");
+    const std::string out = dir.file("x.xodr");
+    auto r = runVista("export " + dir.file("missing.osgb") + " --xodr " + out);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("missing.osgb"), std::string::npos) << r.err;
+    r = runVista("export " + dir.file("missing.osgb") + " --xodr " + dir.file("x.txt"));
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find(".xodr"), std::string::npos) << r.err;
+    r = runVista("export " + dir.file("missing.osgb") + " --xodr " + dir.file("no/such/dir/x.xodr"));
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--xodr"), std::string::npos) << r.err;
+    r = runVista("export " + dir.file("missing.osgb"));
+    EXPECT_EQ(r.code, 2);
+    r = runVista("gen --size 300 -q -o " + dir.file("c.osgb") + " --xodr " + dir.file("c.txt"));
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--xodr"), std::string::npos) << r.err;
+    EXPECT_TRUE(vista::test::listTree(dir.path()).empty());
+}

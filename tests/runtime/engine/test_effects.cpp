@@ -1,0 +1,166 @@
+// Effects without GL in the engine: haze maths and the reflection stage.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "citygen/effects.h"
+#include "citygen/lighting.h"
+#include "citygen/mesh_builder.h"
+#include "citygen/params.h"
+#include "bake/gen/baked_lighting.h"
+#include "runtime/engine/far_field_rays.h"
+#include "runtime/engine/frame_raycast.h"
+#include "runtime/engine/frame_effects.h"
+#include "runtime/engine/ray_scene.h"
+#include "runtime/engine/reflections.h"
+
+namespace vista {
+namespace {
+// ---- haze ----------------------------------------------------------------------
+
+TEST(Haze, KoschmiederContrastAtTheVisibilityAndStableFrom20mTo1e6m) {
+    for (double v : {20.0, 150.0, 1500.0, 1e4, 1e6}) {
+        FrameEffects fx;
+        fx.haze = true;
+        fx.visibility = v;
+        // Independent: 2 % contrast at the visibility distance (Koschmieder, ln 50 = 3.912).
+        EXPECT_NEAR(fx.transmittance(v), 0.02, 1e-4) << v;
+        EXPECT_FLOAT_EQ(fx.transmittance(0), 1.0f);
+        EXPECT_DOUBLE_EQ(fx.hazeFar(), v);
+        const glm::u8vec4 c(10, 200, 30, 128), h = fx.hazeColor();
+        EXPECT_EQ(fx.applyHaze(c, 0.0), c);
+        const glm::u8vec4 far = fx.applyHaze(c, 1e9);
+        for (int k = 0; k < 3; ++k) EXPECT_EQ(far[k], h[k]) << v;
+        EXPECT_EQ(far.w, 128) << "glass marks survive haze";
+        int last = -1;
+        for (double z = 0; z <= 2 * v; z += v / 16) {  // monotone towards the haze colour
+            const int d = std::abs(int(fx.applyHaze(c, z).y) - int(h.y));
+            if (last >= 0) { EXPECT_LE(d, last) << v << " " << z; }
+            last = d;
+        }
+        for (double z : {-1.0, std::numeric_limits<double>::infinity(), 1e300})
+            EXPECT_TRUE(std::isfinite(fx.transmittance(z))) << z;
+    }
+}
+
+// A hand-built scene: a wall of glass (alpha kGlassAlpha) facing -y at y = 20
+// and a red wall behind the camera at y = -30 (so the glass reflects red).
+SceneModel glassScene() {
+    SceneModel m;
+    SceneMesh glass, red;
+    auto quad = [](SceneMesh& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, glm::u8vec4 col) {
+        const uint32_t base = uint32_t(s.positions.size());
+        for (auto p : {a, b, c, d}) {
+            s.positions.push_back(p);
+            s.colors.push_back(col);
+        }
+        for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) s.indices.push_back(base + i);
+    };
+    // Counter-clockwise seen from -y (the camera side).
+    quad(glass, {-50, 20, -10}, {50, 20, -10}, {50, 20, 40}, {-50, 20, 40}, {40, 60, 90, kGlassAlpha});
+    quad(red, {50, -30, -10}, {-50, -30, -10}, {-50, -30, 40}, {50, -30, 40}, {230, 10, 10, 255});
+    m.meshes = {glass, red};
+    m.triangles = 4;
+    return m;
+}
+
+Camera lookNorth(int w = 64, int h = 48) {
+    Camera c;
+    c.eye = {0, 0, 2};
+    c.heading = 0;
+    c.width = w;
+    c.height = h;
+    c.fovY = 0.8;
+    return c;
+}
+
+TEST(Reflections, GlassReflectsTheCityAndNoGlassCastsNoRay) {
+    auto rays = RayScene::build(glassScene());
+    ASSERT_TRUE(rays) << rays.status().message();
+    const Camera cam = lookNorth();
+    FrameEffects fx;
+    fx.glass = fx.glassMarked = true;
+    fx.reflectance = 0.5;
+    fx.rayBudget = 100000;
+    Image img(cam.width, cam.height);
+    RayCounts counts;
+    castFrame(**rays, cam, img, counts, 1);
+    const glm::u8vec4 before = img.at(cam.width / 2, cam.height / 2);
+    ASSERT_EQ(before.w, kGlassAlpha) << "the ray caster keeps the glass mark";
+    FrameStats st;
+    reflectionStage(rays->get(), cam, fx, img, st);
+    const glm::u8vec4 after = img.at(cam.width / 2, cam.height / 2);
+    EXPECT_GT(int(after.x), int(before.x) + 40) << "red reflected into the glass";
+    EXPECT_EQ(after.w, 255);
+    EXPECT_TRUE(st.stages.ran(Stage::Reflect));
+    EXPECT_TRUE(st.effects.ran(EffectId::Glass));
+    EXPECT_GT(st.reflectionRays, 0u);
+    EXPECT_FALSE(hasGlassPixels(img));
+    // Independent Fresnel check at normal incidence-ish (centre pixel, cos ~ 1):
+    // after = before (1 - F) + red F with F ~ F0 = 0.5.
+    const double F = (double(after.x) - before.x) / (230.0 - before.x);
+    EXPECT_NEAR(F, 0.5, 0.06);
+
+    // Looking away from the glass: nothing marked, no stage, no ray.
+    Camera away = cam;
+    away.heading = 3.14159;
+    Image img2(cam.width, cam.height);
+    castFrame(**rays, away, img2, counts, 1);
+    FrameStats st2;
+    reflectionStage(rays->get(), away, fx, img2, st2);
+    EXPECT_FALSE(st2.stages.ran(Stage::Reflect));
+    EXPECT_EQ(st2.reflectionRays, 0u);
+    EXPECT_EQ(st2.raysCast, 0u);
+}
+
+TEST(Reflections, BudgetBoundsTheRaysAndZeroBudgetOnlyClearsMarks) {
+    auto rays = RayScene::build(glassScene());
+    ASSERT_TRUE(rays);
+    const Camera cam = lookNorth(320, 240);
+    Image base(cam.width, cam.height);
+    RayCounts counts;
+    castFrame(**rays, cam, base, counts, 1);
+    for (int64_t budget : {int64_t(0), int64_t(50), int64_t(1000), int64_t(1) << 40}) {
+        FrameEffects fx;
+        fx.glass = fx.glassMarked = true;
+        fx.rayBudget = budget;
+        Image img = base;
+        FrameStats st;
+        reflectionStage(rays->get(), cam, fx, img, st);
+        EXPECT_FALSE(hasGlassPixels(img)) << budget;
+        // Two rays (find the pane, reflect) per sampled block, at most `budget` blocks
+        // (the stride stops at 64 pixels: at most ceil(320/64) * ceil(240/64) blocks).
+        EXPECT_LE(st.reflectionRays, uint64_t(2 * std::max<int64_t>(budget == 0 ? 0 : 20, std::min<int64_t>(budget, 320 * 240))))
+            << budget;
+        if (budget == 0) EXPECT_EQ(st.reflectionRays, 0u);
+        else EXPECT_GT(st.reflectionRays, 0u);
+    }
+}
+
+TEST(Reflections, GrazingAndParallelRaysStayFinite) {
+    auto rays = RayScene::build(glassScene());
+    ASSERT_TRUE(rays);
+    FrameEffects fx;
+    fx.glass = fx.glassMarked = true;
+    fx.rayBudget = 1 << 20;
+    fx.haze = true;
+    fx.visibility = 20;  // the shortest haze too
+    for (double heading : {1.55, 1.5707963, 1.58, -1.5707963}) {  // along the pane (x axis)
+        for (double z : {20.0 - 1e-4, 20.0 - 0.01}) {              // eye on / next to the glass plane's side
+            Camera c = lookNorth(96, 64);
+            c.eye = {0, z, 2};
+            c.heading = heading;
+            Image img(c.width, c.height);
+            RayCounts counts;
+            castFrame(**rays, c, img, counts, 1);
+            FrameStats st;
+            reflectionStage(rays->get(), c, fx, img, st);
+            EXPECT_FALSE(hasGlassPixels(img));
+            for (size_t i = 3; i < img.rgba.size(); i += 4) ASSERT_EQ(img.rgba[i], 255);
+        }
+    }
+}
+
+}  // namespace
+}  // namespace vista
