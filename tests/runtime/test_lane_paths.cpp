@@ -222,10 +222,16 @@ TEST(LanePaths, DeadEndsTurnIntoTheOppositeLane) {
     ASSERT_TRUE(q.isOk()) << q.status().message();
     EXPECT_FALSE(q->samples.empty());
     EXPECT_TRUE(q->lanes.empty());
-    // Along the centre line (y = 0) but for the turns at the dead ends.
-    size_t onCentre = 0;
-    for (const PathSample& smp : q->samples) onCentre += std::abs(smp.position.y - params.origin_y) < 0.5;
-    EXPECT_GT(onCentre, q->samples.size() / 2);
+    // The centre-line drive of a walk path with the same options, at car eye height.
+    PathOptions walkOptions = o;
+    walkOptions.kind = PathKind::Walk;
+    auto w = generatePath(g, params, walkOptions);
+    ASSERT_TRUE(w.isOk());
+    ASSERT_EQ(w->samples.size(), q->samples.size());
+    for (size_t i = 0; i < q->samples.size(); ++i) {
+        EXPECT_EQ(glm::dvec2(q->samples[i].position), glm::dvec2(w->samples[i].position)) << i;
+        EXPECT_NEAR(q->samples[i].position.z - w->samples[i].position.z, 1.2 - 1.7, 1e-9) << i;
+    }
 }
 
 TEST(LanePaths, SameSeedSameBytes) {
