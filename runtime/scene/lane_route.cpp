@@ -211,7 +211,11 @@ void LaneRoute::buildGraph(bool lht) {
             _uturn[u] = uint32_t(back) + 1;
         }
     }
-    // The largest strongly connected part (Tarjan, iterative); arcs leaving it are dropped.
+    keepLargestStronglyConnected();
+}
+
+// The largest strongly connected part (Tarjan, iterative); arcs leaving it are dropped.
+void LaneRoute::keepLargestStronglyConnected() {
     const size_t N = _nodes.size();
     std::vector<int64_t> index(N, -1), low(N, 0), comp(N, -1);
     std::vector<uint8_t> onStack(N, 0);

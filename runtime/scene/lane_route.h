@@ -118,6 +118,7 @@ private:
     };
     LaneRoute(const LaneModel& m, uint64_t seed) : _m(m), _rng(seed, 0, Stream::Paths) {}
     void buildGraph(bool lht);
+    void keepLargestStronglyConnected();
     uint32_t pick(uint32_t node);
     bool deadEnd(uint32_t node) const;
     double laneStart(const Node& n) const;

@@ -313,7 +313,13 @@ Result<Path> generatePath(const StreetGraph& g, const CityParams& params, const 
     for (const auto& e : g.edges)
         if (e.a >= g.nodes.size() || e.b >= g.nodes.size())
             return Status::error("cannot make a path: street graph edge refers to a missing node");
-    if (o.kind == PathKind::Car) return driveCar(g, params, o);
+    if (o.kind == PathKind::Car) {
+        // A city whose lanes form no network a car can keep driving (a few
+        // dead-end streets too short to turn in, one-way dead ends) still gets
+        // a car path: along the street centre lines, as walk paths go, and
+        // without lane positions (saveLanePositionsCsv then refuses).
+        if (auto car = driveCar(g, params, o)) return car;
+    }
 
     Route route(g, o.seed);
     glm::dvec2 pos = route.point(0);

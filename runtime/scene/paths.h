@@ -17,7 +17,9 @@
 // centre (the centre line's curvature as feed-forward, the lateral and
 // heading error as feedback). Its speed stays below kCarYawShare of the yaw
 // rate limit divided by the curvature ahead, braking in time; each sample
-// carries the OpenDRIVE position of the eye (Path::lanes).
+// carries the OpenDRIVE position of the eye (Path::lanes). Where the lanes
+// form no network a car can keep driving (LaneRoute::create fails), the car
+// follows the street centre lines as walk does and carries no positions.
 // Limits hold at every step by construction:
 // |speed| <= maxSpeed, |heading change| <= maxYawRate * dt, |dv| <= accel * dt
 // (speeding up) and decel * dt (braking); the vehicle slows before turns so
