@@ -1,4 +1,4 @@
-// Assembly of the baked scene from the cell results (docs/bake.md "Files").
+// Assembly of the baked scene from the cell results (docs/reference/bake.md "Files").
 //
 // The baked scene: a ViewCellSwitch named "vista.city" carrying the city
 // root's user values and state (so loadCityFile() reads it as a city) plus

@@ -1,5 +1,5 @@
 // BakeParams: every parameter that changes a bake's result, grouped by step
-// (docs/bake.md; `vista bake --help` for ranges and defaults).
+// (docs/reference/bake.md; `vista bake --help` for ranges and defaults).
 //
 // canonical() is the text stored in the baked file (vista.bake_params) and
 // hashed into each cell result's config hash: two bakes with equal text give

@@ -1,5 +1,5 @@
 // Cell result: what bakeCell() (bake/bake_cell.h) produces for one view cell,
-// and its file codec (the driver writes one file per cell; docs/bake.md
+// and its file codec (the driver writes one file per cell; docs/reference/bake.md
 // "Work directory, resume, shards").
 //
 // File layout ("VBCELL01", native little-endian): magic, config hash (u64),

@@ -1,5 +1,5 @@
 // Textured depth meshes of a far field (Chen et al. 2003, single-view
-// meshes; docs/bake.md "Textured LOD meshes"): a perspective colour + depth
+// meshes; docs/reference/bake.md "Textured LOD meshes"): a perspective colour + depth
 // image of the far-field soup taken with Embree from the view cell's centre,
 // triangulated on its sample grid and simplified to a triangle budget.
 //

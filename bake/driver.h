@@ -1,5 +1,5 @@
 // The bake driver: a whole bake (`vista bake`) as one library call
-// (docs/bake.md "Work directory, resume, shards").
+// (docs/reference/bake.md "Work directory, resume, shards").
 //
 // runBakeJob() loads the city file, selects the cells (job.cells, or all;
 // then every shardN-th from offset shardK - 1), bakes those of this shard

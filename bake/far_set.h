@@ -1,6 +1,6 @@
 // Far-field selection: which city tiles an impostor of (view cell, street
 // end) replaces, and their triangles in the impostor frame (thesis 5.5;
-// docs/bake.md "Pipeline", far field).
+// docs/reference/bake.md "Pipeline", far field).
 //
 // The far field of (cell, end) = the tiles with triangles that lie entirely
 // between `margin` and `margin + farDepth` metres beyond the street end

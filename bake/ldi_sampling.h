@@ -1,5 +1,5 @@
 // LDI cameras and multi-layer sampling of one far field (thesis 5.3.2,
-// 5.4.1; steps 4-5 of docs/bake.md "Pipeline").
+// 5.4.1; steps 4-5 of docs/reference/bake.md "Pipeline").
 //
 //  4. Three perspective LDI cameras at the bounding-triangle corners
 //     (bake/sampling_plane.h), looking along n with an off-axis frustum around
@@ -10,7 +10,7 @@
 //     1.33 at the image corner for 60 deg, but a far field seen along the
 //     street lies near the image centre), sqrt2 = pixel diagonal. The planar
 //     cameras' off-axis pixels already shrink by cos^2, so the thesis'
-//     D^2 / (R^2 + D^2) term is not applied (docs/bake.md).
+//     D^2 / (R^2 + D^2) term is not applied (docs/reference/bake.md).
 //  5. Multi-layer hits (RayScene::allHitsMany: each LDI row in packets of 8)
 //     clipped to the far box, up to maxLayers per pixel; each sample records its footprint.
 // Positions in the impostor frame (metres). Deterministic: LDI rows are traced

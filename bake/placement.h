@@ -1,4 +1,4 @@
-// Impostor placement by cost (issue 11, item 1; thesis 5.5 "placement
+// Impostor placement by cost (thesis 5.5 "placement
 // strategies"): before a street end's far field is baked, estimate from the
 // view cell what drawing it costs and what its point impostor would cost,
 // and bake an impostor only where it saves more than it costs.
@@ -14,9 +14,9 @@
 //   saved  = far-set triangles x triangleNs      (drawn as geometry otherwise)
 //   cost   = pointsPerFarPixel x far pixels x pointNs (the points drawn instead)
 // place iff saved > cost. triangleNs / pointNs: the raster costs measured on
-// this machine (docs/farfield-compare.md: llvmpipe, 349 ns per triangle, 495
-// ns per point); pointsPerFarPixel: points a bake makes per visible far pixel
-// (measured on the town's path cells; docs/farfield-compare.md).
+// this machine (llvmpipe: 349 ns per triangle, 495 ns per point);
+// pointsPerFarPixel: points a bake makes per visible far pixel (measured on a
+// whole bake; docs/measurements/bake.md).
 //
 // Deterministic: depends on (city, cell, far set, params) only; rays are cast
 // in a fixed order (rows of coherent packets) on the calling thread. Thread-safe on a const scene.
@@ -33,11 +33,11 @@
 namespace vista {
 
 // `vista bake --storage-budget auto`: MB of impostor data per km2 of the
-// street graph's bounding box (the thesis: 165 MB for 4 km2, the issue aims at 80; docs/bake.md).
+// street graph's bounding box (the thesis stored 165 MB for 4 km2; docs/reference/bake.md).
 constexpr double kAutoBudgetMbPerKm2 = 25.0;
 
 struct PlacementParams {
-    bool byCost = false;            // false: every end with a far field gets an impostor (the old rule)
+    bool byCost = false;            // false: every end with a far field gets an impostor (--placement all)
     double triangleNs = 349.0;      // raster cost of a triangle, ns (> 0)
     double pointNs = 495.0;         // raster cost of a point, ns (> 0)
     double pointsPerFarPixel = 31.0; // points the bake makes per visible far pixel (> 0; the default city baked whole under its storage budget: sum of points / sum of estimated far pixels over its impostors)

@@ -1,4 +1,4 @@
-// Removal of redundant LDI samples (thesis 5.3.2; step 6 of docs/bake.md
+// Removal of redundant LDI samples (thesis 5.3.2; step 6 of docs/reference/bake.md
 // "Pipeline").
 //
 // A sample of camera k is removed when another camera m samples the same

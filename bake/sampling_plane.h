@@ -1,5 +1,5 @@
 // Sampling plane, shaft and bounding triangle of one far field seen from one
-// view cell (thesis 5.3.2, 5.4.1; steps 1-3 of docs/bake.md "Pipeline").
+// view cell (thesis 5.3.2, 5.4.1; steps 1-3 of docs/reference/bake.md "Pipeline").
 //
 // All positions are in the impostor frame (metres), where the view cell box
 // `cell` and the far-field box `far` are axis-aligned.

@@ -1,5 +1,5 @@
 // placeBuildings() and meshBuilding(); see buildings.h for the contract and
-// docs/buildings.md for the algorithms and the triangle budget.
+// docs/reference/buildings.md for the algorithms and the triangle budget.
 #include "citygen/buildings.h"
 #include "citygen/labels.h"
 #include "foundation/units.h"

@@ -88,7 +88,7 @@ struct StageTime {
 };
 
 // Buildings from OSM (vista gen --osm): what was read, repaired, skipped and how the
-// buildings were completed (osm_buildings.h, docs/buildings.md "Buildings from OSM").
+// buildings were completed (osm_buildings.h, docs/reference/buildings.md "Buildings from OSM").
 // Counts are per footprint candidate: a building way is one, a multipolygon relation one
 // per outer ring it assembles to (or one, skipped as no_outer_ring, when it has none).
 struct OsmBuildingStats {

@@ -3,7 +3,7 @@
 //
 // Contract: an effect is on when it is present (its std::optional holds a
 // value); its fields are its parameters, each with a unit and a range listed
-// by effectSpecs() (what docs/params.md shows). parseEffectsJson() rejects
+// by effectSpecs() (what docs/reference/params.md shows). parseEffectsJson() rejects
 // unknown effect names, unknown fields, non-objects, non-numbers and values
 // out of range with a message naming the effect, the field, the value and the
 // range (and listing the known names). effectsToJson() is canonical (every

@@ -45,7 +45,7 @@ void semanticClassColor(SemanticClass c, uint8_t rgb[3]) {
         {70, 130, 180}, {152, 251, 152}, {128, 64, 128}, {255, 255, 255}, {244, 35, 232}, {107, 142, 35},
         {70, 70, 70},   {0, 130, 200},   {180, 60, 50},  {120, 80, 40},   {0, 160, 0},    {250, 170, 30},
         {255, 100, 0},  {220, 220, 0}};
-    const int i = int(c) >= 0 && int(c) < kSemanticClassCount ? int(c) : 0;
+    const int i = int(c) < kSemanticClassCount ? int(c) : 0;  // unsigned underlying type: never negative
     for (int k = 0; k < 3; ++k) rgb[k] = int(c) == i ? kColors[i][k] : 0;
 }
 

@@ -176,16 +176,64 @@ double filletTrim(double angle, double extent) {
     return (extent + kCurvatureMargin) * std::tan(0.5 * std::abs(angle));
 }
 
-}  // namespace
+// The steps of buildLaneModel, in order: lanes per edge, sidewalk sides,
+// junctions, turn plans (growing junction radii), transitions at degree-2
+// nodes, trims, link-road geometry (dropping what would fold), signals.
+class LaneModelBuilder {
+public:
+    LaneModelBuilder(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks)
+        : g(g), blocks(blocks), N(g.nodes.size()), sw(params.sidewalk_m > 0.01 ? params.sidewalk_m : 0.0),
+          incident(g.nodes.size()), wantA(g.edges.size(), 0.0), wantB(g.edges.size(), 0.0) {
+        m.degree.assign(N, 0);
+        m.nodeJunction.assign(N, -1);
+        m.edges.resize(g.edges.size());
+    }
+    LaneModel build() {
+        edgeLanes();
+        sidewalkSides();
+        junctions();
+        planTurns();
+        planTransitions();
+        applyTrims();
+        placeLinks();
+        placeSignals();
+        m.nodeLinks.assign(N, {});
+        for (size_t k = 0; k < m.links.size(); ++k) m.nodeLinks[m.links[k].node].push_back(uint32_t(k));
+        return std::move(m);
+    }
 
-LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks) {
+private:
+    NodeEnd end(uint32_t e, uint32_t v) const { return NodeEnd{&m.edges[e], g.edges[e].b == v}; }
+    // Desired trim of edge e at node v: at least t.
+    void want(uint32_t e, uint32_t v, double t) {
+        double& w = g.edges[e].a == v ? wantA[e] : wantB[e];
+        w = std::max(w, t);
+    }
+    double trimAt(uint32_t e, uint32_t v) const { return g.edges[e].a == v ? m.edges[e].trimA : m.edges[e].trimB; }
+    LinkRoad junctionRoad(int j, const TurnPlan& t) const;
+    bool place(LinkRoad& r) const;
+    void edgeLanes();
+    void sidewalkSides();
+    void junctions();
+    void planTurns();
+    void planTransitions();
+    void applyTrims();
+    void placeLinks();
+    void placeSignals();
+
+    const StreetGraph& g;
+    const std::vector<Block>* blocks;
+    const size_t N;
+    const double sw;  // sidewalk width, 0 = none
     LaneModel m;
-    const size_t N = g.nodes.size();
-    m.degree.assign(N, 0);
-    m.nodeJunction.assign(N, -1);
-    m.edges.resize(g.edges.size());
-    const double sw = params.sidewalk_m > 0.01 ? params.sidewalk_m : 0.0;
-    std::vector<std::vector<uint32_t>> incident(N);
+    std::vector<std::vector<uint32_t>> incident;  // per node: its valid edges
+    std::vector<double> wantA, wantB;             // desired trims per edge at node a / b
+    std::vector<std::vector<TurnPlan>> plans;     // per junction
+    std::vector<LinkRoad> transitions;            // degree-2 nodes, before placing
+};
+
+// Lanes, widths, speed and direction of every valid edge; node degrees.
+void LaneModelBuilder::edgeLanes() {
     for (size_t e = 0; e < g.edges.size(); ++e) {
         const StreetEdge& E = g.edges[e];
         EdgeLanes& L = m.edges[e];
@@ -216,6 +264,10 @@ LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const s
         incident[E.a].push_back(uint32_t(e));
         incident[E.b].push_back(uint32_t(e));
     }
+}
+
+// Sidewalk sides from the blocks (lanes.h).
+void LaneModelBuilder::sidewalkSides() {
     if (blocks && sw > 0) {
         const BlockLookup lookup(*blocks);
         for (size_t e = 0; e < g.edges.size(); ++e) {
@@ -227,7 +279,10 @@ LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const s
             L.walkRight = lookup.inside(mid - L.normal() * reach);
         }
     }
-    auto end = [&](uint32_t e, uint32_t v) { return NodeEnd{&m.edges[e], g.edges[e].b == v}; };
+}
+
+// One junction per node of degree >= 3, arms counter-clockwise.
+void LaneModelBuilder::junctions() {
     for (uint32_t v = 0; v < N; ++v) {
         if (m.degree[v] < 3) continue;
         Junction J;
@@ -242,46 +297,43 @@ LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const s
         m.nodeJunction[v] = int(m.junctions.size());
         m.junctions.push_back(std::move(J));
     }
+}
 
-    // Lanes of a junction turn as a link road (geometry still unset).
-    auto junctionRoad = [&](int j, const TurnPlan& t) {
-        const uint32_t v = m.junctions[size_t(j)].node;
-        const NodeEnd in = end(t.in, v), out = end(t.out, v);
-        LinkRoad r;
-        r.junction = j;
-        r.node = v;
-        r.in = t.in;
-        r.out = t.out;
-        r.inEnd = in.atB;
-        r.outStart = !out.atB;
-        r.turn = t.turn;
-        r.angle = t.angle;
-        const int nOut = out.away();
-        int firstOut = 0;
-        for (int i = t.i0; i <= t.i1 + t.appear; ++i) {
-            LinkRoad::Lane l;
-            if (i <= t.i1) l.from = in.towardId(i), l.w0 = in.L->laneWidth;
-            const int o = i - t.shift;
-            if (o >= 1 && o <= nOut) {
-                l.to = out.awayId(o), l.w1 = out.L->laneWidth;
-                if (!firstOut) firstOut = o;
-            }
-            r.right.push_back(l);
+// Lanes of a junction turn as a link road (geometry still unset).
+LinkRoad LaneModelBuilder::junctionRoad(int j, const TurnPlan& t) const {
+    const uint32_t v = m.junctions[size_t(j)].node;
+    const NodeEnd in = end(t.in, v), out = end(t.out, v);
+    LinkRoad r;
+    r.junction = j;
+    r.node = v;
+    r.in = t.in;
+    r.out = t.out;
+    r.inEnd = in.atB;
+    r.outStart = !out.atB;
+    r.turn = t.turn;
+    r.angle = t.angle;
+    const int nOut = out.away();
+    int firstOut = 0;
+    for (int i = t.i0; i <= t.i1 + t.appear; ++i) {
+        LinkRoad::Lane l;
+        if (i <= t.i1) l.from = in.towardId(i), l.w0 = in.L->laneWidth;
+        const int o = i - t.shift;
+        if (o >= 1 && o <= nOut) {
+            l.to = out.awayId(o), l.w1 = out.L->laneWidth;
+            if (!firstOut) firstOut = o;
         }
-        r.offset0 = in.centreIn() - (t.i0 - 1) * in.L->laneWidth;
-        r.offset1 = -out.centreIn() - (std::max(firstOut, 1) - 1) * out.L->laneWidth;
-        return r;
-    };
-    // Desired trims per (edge, end a / b).
-    std::vector<double> wantA(g.edges.size(), 0.0), wantB(g.edges.size(), 0.0);
-    auto want = [&](uint32_t e, uint32_t v, double t) {
-        double& w = g.edges[e].a == v ? wantA[e] : wantB[e];
-        w = std::max(w, t);
-    };
-    // Turn plans per junction: the straight exit takes every lane, right
-    // turns the outermost lane, left turns the innermost; lanes no exit takes
-    // join the nearest turn.
-    std::vector<std::vector<TurnPlan>> plans(m.junctions.size());
+        r.right.push_back(l);
+    }
+    r.offset0 = in.centreIn() - (t.i0 - 1) * in.L->laneWidth;
+    r.offset1 = -out.centreIn() - (std::max(firstOut, 1) - 1) * out.L->laneWidth;
+    return r;
+}
+
+// Turn plans per junction: the straight exit takes every lane, right turns
+// the outermost lane, left turns the innermost; lanes no exit takes join the
+// nearest turn. Junction radii grow to the trims the turns need.
+void LaneModelBuilder::planTurns() {
+    plans.assign(m.junctions.size(), {});
     for (size_t j = 0; j < m.junctions.size(); ++j) {
         Junction& J = m.junctions[j];
         const uint32_t v = J.node;
@@ -333,8 +385,10 @@ LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const s
         }
         for (uint32_t e : J.arms) want(e, v, J.radius);
     }
+}
+
+void LaneModelBuilder::planTransitions() {
     // Transitions at degree-2 nodes.
-    std::vector<LinkRoad> transitions;
     for (uint32_t v = 0; v < N; ++v) {
         if (m.degree[v] != 2) continue;
         const uint32_t inE = incident[v][0], outE = incident[v][1];
@@ -390,6 +444,9 @@ LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const s
         want(outE, v, need);
         transitions.push_back(std::move(r));
     }
+}
+
+void LaneModelBuilder::applyTrims() {
     // Trims, shrunk in proportion where the edge is too short for both.
     for (size_t e = 0; e < g.edges.size(); ++e) {
         EdgeLanes& L = m.edges[e];
@@ -411,15 +468,19 @@ LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const s
         L.end = A + L.dir * (len - tb);
         L.length = len - ta - tb;
     }
-    auto trimAt = [&](uint32_t e, uint32_t v) { return g.edges[e].a == v ? m.edges[e].trimA : m.edges[e].trimB; };
-    // The fillet of a link road with the trims the edges got; false when its
-    // lanes would reach the centre of curvature.
-    auto place = [&](LinkRoad& r) {
-        const NodeEnd in = end(r.in, r.node), out = end(r.out, r.node);
-        filletGeometry(r, g.nodes[r.node], in.dirIn(), -out.dirIn(), trimAt(r.in, r.node), trimAt(r.out, r.node));
-        if (r.arcLength <= 0) return r.length() > 1e-9;
-        return 1.0 / std::abs(r.curvature) > turnSideExtent(r) + 1e-6;
-    };
+}
+
+// The fillet of a link road with the trims the edges got; false when its
+// lanes would reach the centre of curvature.
+bool LaneModelBuilder::place(LinkRoad& r) const {
+    const NodeEnd in = end(r.in, r.node), out = end(r.out, r.node);
+    filletGeometry(r, g.nodes[r.node], in.dirIn(), -out.dirIn(), trimAt(r.in, r.node), trimAt(r.out, r.node));
+    if (r.arcLength <= 0) return r.length() > 1e-9;
+    return 1.0 / std::abs(r.curvature) > turnSideExtent(r) + 1e-6;
+}
+
+// Junction turns and transitions with their geometry; counts what is dropped.
+void LaneModelBuilder::placeLinks() {
     for (size_t j = 0; j < m.junctions.size(); ++j) {
         Junction& J = m.junctions[j];
         std::map<uint32_t, std::vector<bool>> taken;  // per incoming arm: lanes with a link
@@ -451,6 +512,9 @@ LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const s
         (g.edges[r.out].a == r.node ? m.edges[r.out].linkA : m.edges[r.out].linkB) = idx;
         m.links.push_back(std::move(r));
     }
+}
+
+void LaneModelBuilder::placeSignals() {
     // Signals at junction ends (SignalPlacement).
     for (size_t e = 0; e < g.edges.size(); ++e) {
         const EdgeLanes& L = m.edges[e];
@@ -479,9 +543,13 @@ LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const s
             m.signals.push_back(sp);
         }
     }
-    m.nodeLinks.assign(N, {});
-    for (size_t k = 0; k < m.links.size(); ++k) m.nodeLinks[m.links[k].node].push_back(uint32_t(k));
-    return m;
 }
+
+}  // namespace
+
+LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks) {
+    return LaneModelBuilder(g, params, blocks).build();
+}
+
 
 }  // namespace vista

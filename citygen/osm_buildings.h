@@ -1,5 +1,5 @@
 // Buildings from OpenStreetMap: the footprints importOsm() reads and their
-// completion into City::buildings (docs/buildings.md "Buildings from OSM").
+// completion into City::buildings (docs/reference/buildings.md "Buildings from OSM").
 //
 // importOsm() (streets.h) reads closed ways tagged building=* (not "no") and
 // multipolygon relations (type=multipolygon + building=*) with their outer

@@ -33,6 +33,7 @@
 #include <osmium/visitor.hpp>
 
 #include "citygen/footprint_repair.h"
+#include "citygen/osm_road_tags.h"
 #include "citygen/polygon.h"
 #include "citygen/street_geometry.h"
 #include "citygen/streets.h"
@@ -52,6 +53,8 @@ constexpr size_t kSimplifyChunk = 1024;           // Douglas-Peucker works on ru
 constexpr size_t kMaxSelfConflicts = 16;          // a way crossing itself more often is dropped
 constexpr size_t kMaxConflicts = 100000;          // more crossings in all is refused
 constexpr size_t kMaxXmlBytes = size_t(4) << 30;  // decompressed XML read into memory
+constexpr double kAlongCos = 0.7;                 // a way within 45 degrees of an edge runs along it
+constexpr double kParallelCos = 0.95;             // opposite one-ways merged into an edge: within 18 degrees of it
 
 // ---- XML pre-scan ---------------------------------------------------------
 
@@ -222,6 +225,7 @@ struct Way {
     NodeId id = 0;
     RoadClass cls = RoadClass::Local;
     std::vector<WayNode> nodes;
+    uint32_t tags = 0;  // index into WayCollector::roadTags
 };
 
 bool isBuilding(const osmium::TagList& tags) {
@@ -280,6 +284,8 @@ struct RelationCollector : public osmium::handler::Handler {
 
 struct WayCollector : public osmium::handler::Handler {
     std::vector<Way> ways;
+    std::vector<OsmRoadTags> roadTags;  // of every way in `ways` (by Way::tags)
+    OsmRoadTagStats roadStats;
     bool buildings = false;
     std::unordered_set<NodeId> memberWays;  // ways of building relations
     std::vector<BuildingWay> buildingWays;
@@ -302,6 +308,8 @@ struct WayCollector : public osmium::handler::Handler {
         out.id = w.id();
         out.cls = cls;
         for (const auto& nr : w.nodes()) out.nodes.push_back({nr.ref(), nr.location(), {}, {}});
+        out.tags = uint32_t(roadTags.size());
+        roadTags.push_back(readOsmRoadTags([&](const char* key) { return w.tags()[key]; }, cls, roadStats));
         ways.push_back(std::move(out));
     }
 };
@@ -311,7 +319,7 @@ template <class Keep>
 std::vector<Way> splitWays(std::vector<Way>&& ways, Keep keep) {
     std::vector<Way> out;
     for (auto& w : ways) {
-        Way piece{w.id, w.cls, {}};
+        Way piece{w.id, w.cls, {}, w.tags};
         auto flush = [&] {
             if (piece.nodes.size() >= 2) out.push_back(piece);
             piece.nodes.clear();
@@ -421,9 +429,130 @@ StreetGraph segmentGraph(const std::vector<Way>& ways, size_t first, size_t last
     for (size_t w = first; w < last; ++w)
         for (size_t k = 1; k < ways[w].nodes.size(); ++k) {
             const uint32_t a = node(ways[w].nodes[k - 1]), b = node(ways[w].nodes[k]);
-            if (a != b && g.nodes[a] != g.nodes[b]) g.edges.push_back({a, b, ways[w].cls});
+            if (a == b || g.nodes[a] == g.nodes[b]) continue;
+            StreetEdge e;
+            e.a = a;
+            e.b = b;
+            e.cls = ways[w].cls;
+            g.edges.push_back(e);
         }
     return g;
+}
+
+// ---- road tags onto the planar edges ---------------------------------------------
+
+// Gives every street edge the road tags (osm_road_tags.h) of the way it lies on: among the
+// ways of the edge's class, the one whose segments come closest to the points at 1/4, 1/2
+// and 3/4 of the edge (the largest of the three distances, at most `tol`: planarization moves
+// nodes by up to the snap radius and merges ends closer than the minimum segment). The way's
+// segment nearest to the edge's midpoint gives the direction: tags are swapped for an edge
+// running against the way; ways whose segment there lies within 45 degrees of the edge come
+// before crossing ones. When that way is one-way and another way of the class within
+// `mergeTol` is one-way the other way round, both within 18 degrees of the edge (a dual
+// carriageway merged into one edge), each gives its direction.
+void assignRoadTags(StreetGraph& g, const std::vector<Way>& ways, const std::vector<OsmRoadTags>& tags, double tol,
+                    double mergeTol, OsmRoadTagStats& st) {
+    struct Seg { glm::dvec2 p, q; uint32_t way; };
+    std::vector<Seg> segs;
+    for (size_t w = 0; w < ways.size(); ++w)
+        for (size_t k = 1; k < ways[w].nodes.size(); ++k) segs.push_back({ways[w].nodes[k - 1].xy, ways[w].nodes[k].xy, uint32_t(w)});
+    // Uniform grid: a segment is listed in the 3 x 3 cells around points every `cell` along it, so
+    // every point within tol (= cell / 2) of it finds it in its own cell.
+    const double cell = std::max(2.0 * tol, 1.0);
+    auto cellOf = [&](const glm::dvec2& p) { return std::make_pair(int64_t(std::floor(p.x / cell)), int64_t(std::floor(p.y / cell))); };
+    auto key = [](int64_t x, int64_t y) { return (uint64_t(x) << 32) ^ (uint64_t(y) & 0xffffffffull); };
+    std::unordered_map<uint64_t, std::vector<uint32_t>> grid;
+    for (uint32_t s = 0; s < segs.size(); ++s) {
+        const double len = glm::length(segs[s].q - segs[s].p);
+        const int steps = int(std::min(std::ceil(len / cell), 1e6));
+        for (int i = 0; i <= steps; ++i) {
+            const auto [cx, cy] = cellOf(segs[s].p + (steps ? double(i) / steps : 0.0) * (segs[s].q - segs[s].p));
+            for (int64_t dy = -1; dy <= 1; ++dy)
+                for (int64_t dx = -1; dx <= 1; ++dx) {
+                    auto& list = grid[key(cx + dx, cy + dy)];
+                    if (list.empty() || list.back() != s) list.push_back(s);
+                }
+        }
+    }
+    struct Cand {
+        uint32_t way;
+        double d[3];
+        uint32_t midSeg;  // the way's segment nearest to the edge's midpoint
+        double score() const { return std::max({d[0], d[1], d[2]}); }
+    };
+    std::vector<Cand> cands;
+    std::unordered_map<uint32_t, size_t> candOf;  // way -> index in cands
+    for (auto& e : g.edges) {
+        const glm::dvec2 a = g.nodes[e.a], b = g.nodes[e.b];
+        cands.clear();
+        candOf.clear();
+        for (int k = 0; k < 3; ++k) {
+            const glm::dvec2 p = a + 0.25 * (k + 1) * (b - a);
+            const auto [cx, cy] = cellOf(p);
+            auto it = grid.find(key(cx, cy));
+            if (it == grid.end()) continue;
+            for (uint32_t s : it->second) {
+                if (ways[segs[s].way].cls != e.cls) continue;
+                const double d = pointSegmentDistance(p, segs[s].p, segs[s].q);
+                if (d > tol) continue;
+                auto [slot, fresh] = candOf.emplace(segs[s].way, cands.size());
+                if (fresh) cands.push_back(Cand{segs[s].way, {1e300, 1e300, 1e300}, s});
+                Cand& c = cands[slot->second];
+                if (d < c.d[k]) {
+                    c.d[k] = d;
+                    if (k == 1) c.midSeg = s;
+                }
+            }
+        }
+        // |cos| of the angle between the edge and the way's segment at the midpoint.
+        const glm::dvec2 dir = glm::normalize(b - a);
+        auto alignment = [&](const Cand& c) {
+            const glm::dvec2 sd = segs[c.midSeg].q - segs[c.midSeg].p;
+            const double len = glm::length(sd);
+            return len > 0 ? std::abs(glm::dot(dir, sd / len)) : 0.0;
+        };
+        // Ways along the edge before crossing ones (near a junction a short edge is close to both).
+        auto better = [&](const Cand& x, const Cand& y) {
+            const bool ax = alignment(x) >= kAlongCos, ay = alignment(y) >= kAlongCos;
+            if (ax != ay) return ax;
+            return x.score() < y.score() || (x.score() == y.score() && x.way < y.way);
+        };
+        const Cand* best = nullptr;
+        for (const auto& c : cands)
+            if (c.score() <= tol && (!best || better(c, *best))) best = &c;
+        if (!best) { ++st.edgesUnmatched; continue; }
+        ++st.edgesMatched;
+        auto oriented = [&](const Cand& c) {
+            const Seg& s = segs[c.midSeg];
+            const OsmRoadTags& t = tags[ways[c.way].tags];
+            return glm::dot(b - a, s.q - s.p) >= 0 ? t : t.reversed();
+        };
+        OsmRoadTags t = oriented(*best);
+        if ((t.onlyForward() || t.onlyBackward()) && alignment(*best) >= kParallelCos) {
+            const Cand* other = nullptr;
+            OsmRoadTags u;
+            for (const auto& c : cands) {
+                if (&c == best || c.score() > mergeTol || alignment(c) < kParallelCos || (other && !better(c, *other))) continue;
+                OsmRoadTags o = oriented(c);
+                if (t.onlyForward() ? o.onlyBackward() : o.onlyForward()) { other = &c; u = std::move(o); }
+            }
+            if (other) {
+                ++st.edgesMergedOneWays;
+                const OsmRoadTags& f = t.onlyForward() ? t : u;
+                const OsmRoadTags& r = t.onlyForward() ? u : t;
+                OsmRoadTags m;
+                m.lanesForward = f.lanesForward;
+                m.lanesBackward = r.lanesBackward;
+                m.turnForward = f.turnForward;
+                m.turnBackward = r.turnBackward;
+                m.lanes = f.lanes + r.lanes;
+                m.maxspeedKmh = t.maxspeedKmh > 0 ? t.maxspeedKmh : u.maxspeedKmh;
+                m.width = f.width > 0 && r.width > 0 ? f.width + r.width : 0.0f;
+                t = std::move(m);
+            }
+        }
+        applyOsmRoadTags(t, e);
+    }
 }
 
 // "74.3 m", "22.6 km".
@@ -776,6 +905,10 @@ Result<OsmImport> importOsm(const std::string& path, const CityParams& params, b
     if (out.streets.edges.empty())
         return Status::error("OSM file '" + path + "' has highway ways but none longer than min_segment_m = " +
                              std::to_string(params.min_segment_m) + " m");
+    out.roadTagStats = collector.roadStats;
+    const double snap = std::isfinite(params.snap_radius_m) ? std::max(params.snap_radius_m, 0.0) : 0.0;
+    const double minSeg = std::isfinite(params.min_segment_m) ? std::max(params.min_segment_m, 0.0) : 0.0;
+    assignRoadTags(out.streets, kept, collector.roadTags, snap + minSeg + 1.0, snap + 1.0, out.roadTagStats);
     return out;
 }
 

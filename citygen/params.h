@@ -1,7 +1,7 @@
 // City generation parameters: the single input of the generator.
 //
 // Contract: every field has a documented unit, default and allowed range
-// (see kParamSpecs in params.cpp, which is also what docs/params.md lists).
+// (see kParamSpecs in params.cpp, which is also what docs/reference/params.md lists).
 // parseParamsJson() rejects unknown keys, wrong types, out-of-range values and
 // malformed JSON (reporting line and column) with a Status naming the field.
 // validateParams() checks a struct filled by hand or by command-line flags.

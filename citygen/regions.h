@@ -1,5 +1,5 @@
 // Regions: a city generated region by region (the generation side of a paged
-// city, runtime/scene/paged_city.h), so that memory is bounded by the street
+// city, bake/gen/paged_city.h), so that memory is bounded by the street
 // graph, the blocks and one region, not by the city.
 //
 // RegionGrid: square regions of `region_size_m` (a whole number of tiles,

@@ -9,6 +9,7 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <nlohmann/json.hpp>
 
+#include "citygen/osm_road_tags.h"
 #include "citygen/street_geometry.h"
 
 namespace vista {
@@ -195,12 +196,80 @@ std::string streetGraphToJson(const StreetGraph& g) {
     nlohmann::json nodes = nlohmann::json::array();
     for (const auto& p : g.nodes) nodes.push_back({p.x, p.y});
     nlohmann::json edges = nlohmann::json::array();
-    for (const auto& e : g.edges) edges.push_back({e.a, e.b, int(e.cls), double(e.width), int(e.lanes)});
+    for (const auto& e : g.edges) {
+        nlohmann::json row = {e.a, e.b, int(e.cls), double(e.width), int(e.lanes)};
+        // The lane directions, speed limit and turn lanes only when they differ from the defaults.
+        nlohmann::json extra = nlohmann::json::object();
+        if (e.lanesForward != -1) extra["forward"] = int(e.lanesForward);
+        if (e.lanesBackward != -1) extra["backward"] = int(e.lanesBackward);
+        if (e.maxspeedKmh != 0.0f) extra["maxspeed"] = double(e.maxspeedKmh);
+        if (!e.turnForward.empty()) extra["turn_forward"] = e.turnForward;
+        if (!e.turnBackward.empty()) extra["turn_backward"] = e.turnBackward;
+        if (!extra.empty()) row.push_back(std::move(extra));
+        edges.push_back(std::move(row));
+    }
     nlohmann::json j;
     j["nodes"] = std::move(nodes);
     j["edges"] = std::move(edges);
     return j.dump();
 }
+
+namespace {
+
+// Lanes of one direction: the explicit count, else the split derived from `lanes`.
+int directionLanes(const StreetEdge& e, bool forward) {
+    const int explicitCount = forward ? e.lanesForward : e.lanesBackward;
+    if (explicitCount >= 0) return explicitCount;
+    const int n = std::max(int(e.lanes), 2);
+    return forward ? (n + 1) / 2 : n / 2;
+}
+
+// The sixth element of an edge row: the fields that differ from the defaults.
+Status readEdgeExtras(const nlohmann::json& x, const std::string& where, StreetEdge& se) {
+    if (!x.is_object())
+        return Status::error(where + " must be an object with forward, backward, maxspeed, turn_forward, turn_backward");
+    for (const auto& [key, value] : x.items()) {
+        const std::string at = where + "." + key;
+        if (key == "forward" || key == "backward") {
+            if (!value.is_number_integer()) return Status::error(at + " must be an integer");
+            const int64_t n = value.get<int64_t>();
+            if (n < 0 || n > kMaxLanesPerDirection)
+                return Status::error(at + " = " + std::to_string(n) + " is out of range [0, " + std::to_string(kMaxLanesPerDirection) + "]");
+            (key == "forward" ? se.lanesForward : se.lanesBackward) = int8_t(n);
+        } else if (key == "maxspeed") {
+            if (!value.is_number()) return Status::error(at + " is not a number");
+            const double v = value.get<double>();
+            if (!(v >= kMinMaxspeedKmh && v <= kMaxMaxspeedKmh))
+                return Status::error(at + " = " + std::to_string(v) + " is out of range [" + std::to_string(int(kMinMaxspeedKmh)) +
+                                     ", " + std::to_string(int(kMaxMaxspeedKmh)) + "] km/h");
+            se.maxspeedKmh = float(v);
+        } else if (key == "turn_forward" || key == "turn_backward") {
+            if (!value.is_string()) return Status::error(at + " must be a string");
+            const std::string v = value.get<std::string>();
+            const auto turns = parseOsmTurnLanes(v);
+            if (v.empty() || !turns || turns->value != v)
+                return Status::error(at + " = '" + v.substr(0, 64) + "' is not a turn:lanes value (lanes separated by '|', each "
+                                     "empty or ';'-separated turn values, at most " + std::to_string(kMaxLanesPerDirection) + " lanes)");
+            (key == "turn_forward" ? se.turnForward : se.turnBackward) = v;
+        } else {
+            return Status::error(where + " has unknown key '" + key.substr(0, 64) +
+                                 "' (allowed: forward, backward, maxspeed, turn_forward, turn_backward)");
+        }
+    }
+    if (se.lanesForward == 0 && se.lanesBackward == 0) return Status::error(where + " has no driving lane (forward = backward = 0)");
+    for (bool forward : {true, false}) {
+        const std::string& turn = forward ? se.turnForward : se.turnBackward;
+        if (turn.empty()) continue;
+        const int lanes = directionLanes(se, forward);
+        const int listed = parseOsmTurnLanes(turn)->lanes;
+        if (listed != lanes)
+            return Status::error(where + (forward ? ".turn_forward" : ".turn_backward") + " lists " + std::to_string(listed) +
+                                 " lanes, the direction has " + std::to_string(lanes));
+    }
+    return Status::ok();
+}
+
+}  // namespace
 
 Result<StreetGraph> streetGraphFromJson(const std::string& text) {
     try {
@@ -233,8 +302,8 @@ Result<StreetGraph> streetGraphFromJson(const std::string& text) {
         for (size_t i = 0; i < edges.size(); ++i) {
             const auto& e = edges[i];
             std::string where = "street graph JSON: edges[" + std::to_string(i) + "]";
-            if (!e.is_array() || e.size() != 5)
-                return Status::error(where + " must be [a, b, class, width, lanes]");
+            if (!e.is_array() || (e.size() != 5 && e.size() != 6))
+                return Status::error(where + " must be [a, b, class, width, lanes] or [a, b, class, width, lanes, {...}]");
             for (int k = 0; k < 5; ++k)
                 if (!e[k].is_number()) return Status::error(where + "[" + std::to_string(k) + "] is not a number");
             for (int k : {0, 1, 2, 4})
@@ -259,7 +328,8 @@ Result<StreetGraph> streetGraphFromJson(const std::string& text) {
             se.cls = RoadClass(uint8_t(cls));
             se.width = float(width);
             se.lanes = uint8_t(lanes);
-            g.edges.push_back(se);
+            if (e.size() == 6) VISTA_RETURN_IF_ERROR(readEdgeExtras(e[5], where + "[5]", se));
+            g.edges.push_back(std::move(se));
         }
         return g;
     } catch (const std::exception& ex) {

@@ -33,7 +33,7 @@ struct StreetEdge {
     // `lanes` (forward ceil(n/2), backward floor(n/2), n = max(lanes, 2)). A one-way edge has 0 backward (or 0 forward).
     int8_t lanesForward = -1, lanesBackward = -1;
     float maxspeedKmh = 0.0f;          // 0 = the class default
-    std::string turnForward, turnBackward;  // OSM turn:lanes value for that direction ("" = none), lanes listed left to right as OSM does
+    std::string turnForward{}, turnBackward{};  // OSM turn:lanes value for that direction ("" = none), lanes listed left to right as OSM does
 };
 
 struct StreetGraph {
@@ -50,7 +50,14 @@ struct StreetGraph {
 Status checkPlanarGraph(const StreetGraph& g, double minSegment);
 
 // Serialisation used inside the city file and by tools (compact JSON:
-// {"nodes":[[x,y],...],"edges":[[a,b,cls,width,lanes],...]}).
+// {"nodes":[[x,y],...],"edges":[[a,b,cls,width,lanes],...]}). An edge whose
+// lane directions, speed limit or turn lanes differ from the defaults (an OSM
+// import) has a sixth element, an object holding only those that differ:
+// "forward" / "backward" (lanesForward / lanesBackward, 0..8), "maxspeed"
+// (km/h, [5, 250]), "turn_forward" / "turn_backward" (turn:lanes values as
+// osm_road_tags.h accepts them, listing exactly that direction's lanes). A
+// generated city has none, so its JSON is the five-element form. The reader
+// refuses other keys, values out of range, and an edge without driving lanes.
 std::string streetGraphToJson(const StreetGraph& g);
 Result<StreetGraph> streetGraphFromJson(const std::string& text);
 

@@ -13,7 +13,7 @@
 //
 // importOsm(): ways tagged highway=* from an OpenStreetMap extract (.osm XML,
 // also .osm.gz / .osm.bz2, or .osm.pbf) as a planar street graph in a local
-// metric frame. Steps (docs/streets.md):
+// metric frame. Steps (docs/reference/streets.md):
 // 1. Nodes are dropped, and their ways split there, when their coordinates
 //    are invalid (unparsable, non-finite, lat outside [-90, 90], lon outside
 //    [-180, 180]; XML coordinates are checked as text before libosmium parses
@@ -32,6 +32,10 @@
 //    16 times is dropped (counted); more than 100,000 conflicts among all
 //    segments (crossings away from shared nodes) are refused; then
 //    planarize(segments, snap_radius_m, min_segment_m).
+// 6. Road tags (osm_road_tags.h): every edge takes the lanes, oneway,
+//    turn:lanes, maxspeed and width tags of the way of its class it lies on
+//    (within snap_radius_m + min_segment_m + 1 m), in the edge's direction
+//    (swapped where the edge runs against the way); counts in roadTagStats.
 // Unreadable, corrupt, unsupported (DOCTYPE, UTF-16, other formats) or
 // road-less files return an error naming the file. Every drop is counted in
 // the result; dropSummary() words them ("" when nothing was dropped).
@@ -41,6 +45,7 @@
 #include <vector>
 
 #include "citygen/osm_buildings.h"
+#include "citygen/osm_road_tags.h"
 #include "citygen/params.h"
 #include "foundation/progress.h"
 #include "foundation/status.h"
@@ -73,8 +78,9 @@ struct OsmImport {
     // Building footprints (osm_buildings.h), in the streets' frame; empty unless asked for.
     std::vector<OsmFootprint> buildings;
     OsmBuildingStats buildingStats;  // the import counts (candidates, repaired, skipped by reason)
+    OsmRoadTagStats roadTagStats;    // ways that used each road tag or fell back (osm_road_tags.h)
 };
-// `buildings`: also read the building footprints (docs/buildings.md "Buildings
+// `buildings`: also read the building footprints (docs/reference/buildings.md "Buildings
 // from OSM"): closed ways and multipolygon relations tagged building=*,
 // repaired or skipped per reason (never an error), those with a vertex outside
 // the city square [-size_m/2, size_m/2]^2 skipped.

@@ -1,5 +1,5 @@
 // Ground, roads, markings and sidewalks of one tile. See surfaces.h for the
-// contract and docs/trees-and-surfaces.md for the assignment rules.
+// contract and docs/reference/trees-and-surfaces.md for the assignment rules.
 //
 // Exactly-once assignment: a road piece (<= 50 m) belongs to the tile of its
 // midpoint, a junction polygon to the tile of its node, a sidewalk segment to

@@ -1,6 +1,6 @@
 // Trees: procedural prototypes (recursive branching + low-poly leaf clusters)
 // and their placement along streets and in parks. See trees.h for the
-// contract and docs/trees-and-surfaces.md for budgets and rules.
+// contract and docs/reference/trees-and-surfaces.md for budgets and rules.
 #include "citygen/trees.h"
 #include "foundation/units.h"
 

@@ -1,5 +1,5 @@
-// vista_bake_report: measurements of baked point impostors (docs/results.md,
-// "Issue 5: bake"). For one view cell of one or more baked files (same city,
+// vista_bake_report: measurements of baked point impostors (the bake section
+// of docs/results.md). For one view cell of one or more baked files (same city,
 // different bake parameters) it renders, through OffscreenRenderer, from the
 // cell's 8 corners and the midpoints of its 4 vertical side edges (inset 2 %,
 // the edges at mid height) and its centre towards the cell's impostors:
@@ -65,159 +65,233 @@ size_t coveredPixels(const Image& a, const Image& empty) {
     return n;
 }
 
-}  // namespace
+const char* const kTool = "vista_bake_report";
 
-int main(int argc, char** argv) {
-    CLI::App app{"Measure baked point impostors of one view cell against plain and supersampled geometry.", "vista_bake_report"};
+struct ReportArgs {
     std::vector<std::string> baked, labels;
     int cell = -1, frames = 20, ssaa = 4, width = 640, height = 480;
     double fov = 60;
     std::string jsonOut, size = "640x480", splat = "";
-    app.add_option("--baked", baked, "baked files (same city)")->required();
-    app.add_option("--size", size, "image size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 640x480)");
-    app.add_option("--label", labels, "a label per baked file");
-    app.add_option("--cell", cell, "view cell id")->required();
-    app.add_option("--frames", frames, "timed renders per mode");
-    app.add_option("--ssaa", ssaa, "reference supersampling factor per axis");
-    app.add_option("--fov", fov, "vertical field of view, degrees");
-    app.add_option("--json", jsonOut, "also write the results as JSON");
-    app.add_option("--point-splat", splat, "impostor points as splats of SIGMA output pixels (0.05 .. 4), or off = 1-pixel points (default " +
-                                               formatSplatSigma(kDefaultSplatSigma) + ")");
-    const int rc = parseOrExit(app, argc, argv);
-    if (rc >= 0) return rc;
-    auto wh = parseImageSize(size);
-    if (!wh) return reportBadInput("vista_bake_report", wh.status());
-    if (!splat.empty()) {
-        auto sg = parseSplatSigma(splat);
-        if (!sg) return reportBadInput("vista_bake_report", sg.status());
+};
+
+void declareFlags(CLI::App& app, ReportArgs& a) {
+    app.add_option("--baked", a.baked, "baked files (same city)")->required();
+    app.add_option("--size", a.size, "image size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 640x480)");
+    app.add_option("--label", a.labels, "a label per baked file");
+    app.add_option("--cell", a.cell, "view cell id")->required();
+    app.add_option("--frames", a.frames, "timed renders per mode");
+    app.add_option("--ssaa", a.ssaa, "reference supersampling factor per axis");
+    app.add_option("--fov", a.fov, "vertical field of view, degrees");
+    app.add_option("--json", a.jsonOut, "also write the results as JSON");
+    app.add_option("--point-splat", a.splat, "impostor points as splats of SIGMA output pixels (0.05 .. 4), or off = 1-pixel points (default " +
+                                                 formatSplatSigma(kDefaultSplatSigma) + ")");
+}
+
+// --size and --point-splat (the splat sigma is set for every impostor drawn).
+Status configure(ReportArgs& a) {
+    auto wh = parseImageSize(a.size);
+    if (!wh) return wh.status();
+    if (!a.splat.empty()) {
+        auto sg = parseSplatSigma(a.splat);
+        if (!sg) return sg.status();
         setPointSplatSigma(float(*sg));
     }
-    width = wh->width;
-    height = wh->height;
-    auto r1 = OffscreenRenderer::create(width, height);
-    if (!r1) return reportBadInput("vista_bake_report", r1.status());
-    auto rs = OffscreenRenderer::create(width * ssaa, height * ssaa);
-    if (!rs) return reportBadInput("vista_bake_report", rs.status());
+    a.width = wh->width;
+    a.height = wh->height;
+    return Status::ok();
+}
+
+// The rows compare bakes of one city: every recorded source city hash must
+// agree with the first one recorded (`firstHash` of `firstFile`).
+Status checkSameCity(const BakedFile& bf, const std::string& file, std::string& firstHash, std::string& firstFile) {
+    if (!bf.sourceCityHash.empty() && firstHash.empty()) firstHash = bf.sourceCityHash, firstFile = file;
+    if (!bf.sourceCityHash.empty() && bf.sourceCityHash != firstHash)
+        return Status::error("baked from another city: '" + file + "' was baked from a city with hash " + bf.sourceCityHash +
+                             ", '" + firstFile + "' from one with hash " + firstHash + "; compare bakes of one city");
+    return Status::ok();
+}
+
+// The scenes compared for one cell: geom = the tiles its impostors replace,
+// imp = its impostors (textured), pts = the same as single-colour points,
+// empty = nothing (for the covered pixels); the impostors' point counts.
+struct CellScenes {
+    osg::ref_ptr<osg::Group> geom = new osg::Group, imp = new osg::Group, pts = new osg::Group, empty = new osg::Group;
+    size_t points = 0, textured = 0;
+};
+
+CellScenes cellScenes(ViewCellSwitch& root, uint32_t cell) {
+    CellScenes c;
+    c.geom->setStateSet(root.getStateSet());
+    c.imp->setStateSet(root.getStateSet());
+    for (uint32_t h : root.hiddenOf(cell)) c.geom->addChild(root.getChild(h));
+    for (uint32_t k : root.impostorsOf(cell)) {
+        c.imp->addChild(root.getChild(k));
+        auto* xf = root.getChild(k)->asGroup();
+        auto* pi = dynamic_cast<PointImpostor*>(xf->getChild(0)->asGeode()->getDrawable(0));
+        c.points += pi->pointCount();
+        c.textured += pi->texturedCount();
+    }
+    c.pts->addChild(c.imp.get());
+    if (std::getenv("VISTA_REPORT_FF"))  // diagnostic: fixed-function points (no shader)
+        c.pts->getOrCreateStateSet()->setAttributeAndModes(new osg::Program, osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE);
+    c.pts->getOrCreateStateSet()->addUniform(new osg::Uniform("vista_useTexture", 0),
+                                             osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE);
+    return c;
+}
+
+// The eyes of the quality measurement: the cell's 8 corners (inset 2 %), the
+// midpoints of its 4 vertical side edges (at mid height) and its centre.
+struct CellViews {
+    std::vector<glm::dvec3> eyes;
+    std::vector<std::string> names;
+};
+
+CellViews cellViews(const ViewCellBox& cb) {
+    glm::dvec3 corners[8];
+    ViewCellBox inset = cb;
+    inset.halfLength *= 0.98; inset.halfWidth *= 0.98; inset.halfHeight *= 0.98;
+    inset.corners(corners);
+    CellViews v;
+    v.eyes.assign(corners, corners + 8);
+    for (int k = 0; k < 8; ++k) v.names.push_back("corner" + std::to_string(k));
+    const glm::dvec3 ax(cb.axis, 0.0), sd(cb.side(), 0.0);
+    for (int k = 0; k < 4; ++k) {
+        const double a = (k == 0 ? 1 : k == 1 ? -1 : 0) * inset.halfLength, b = (k == 2 ? 1 : k == 3 ? -1 : 0) * inset.halfWidth;
+        v.eyes.push_back(cb.center + a * ax + b * sd);
+        v.names.push_back(k < 2 ? (k == 0 ? "edge+axis" : "edge-axis") : (k == 2 ? "edge+side" : "edge-side"));
+    }
+    v.eyes.push_back(cb.center);
+    v.names.push_back("centre");
+    return v;
+}
+
+// Luma PSNR of geom / imp / pts against the supersampled reference per view,
+// and the impostors' covered pixels from the last view (the centre). With
+// --json, the last view's reference, geom and imp images go beside it.
+struct Quality {
+    std::vector<double> geom, imp, pts;
+    size_t covered = 0;
+};
+
+Result<Quality> measureQuality(const ReportArgs& a, size_t bi, const CellScenes& sc, const CellViews& views,
+                               const glm::dvec3& target, OffscreenRenderer& r1, OffscreenRenderer& rs) {
+    Quality q;
+    FrameStats fs;
+    for (size_t e = 0; e < views.eyes.size(); ++e) {
+        Camera c = lookAt(views.eyes[e], target, a.width, a.height, a.fov);
+        Camera cs = c;
+        cs.width = a.width * a.ssaa;
+        cs.height = a.height * a.ssaa;
+        Image big, ref, g, im, pt;
+        VISTA_RETURN_IF_ERROR(rs.render(sc.geom.get(), cs, 0.0, &big, nullptr, fs));
+        ref = downsampleBox(big, a.ssaa);
+        r1.render(sc.geom.get(), c, 0.0, &g, nullptr, fs);
+        r1.render(sc.imp.get(), c, 0.0, &im, nullptr, fs);
+        r1.render(sc.pts.get(), c, 0.0, &pt, nullptr, fs);
+        q.geom.push_back(lumaPsnr(g, ref));
+        q.imp.push_back(lumaPsnr(im, ref));
+        q.pts.push_back(lumaPsnr(pt, ref));
+        if (e == views.eyes.size() - 1) {
+            Image em;
+            r1.render(sc.empty.get(), c, 0.0, &em, nullptr, fs);
+            q.covered = coveredPixels(im, em);
+            if (!a.jsonOut.empty()) {
+                writePng(ref, a.jsonOut + "." + std::to_string(bi) + ".ref.png");
+                writePng(g, a.jsonOut + "." + std::to_string(bi) + ".geom.png");
+                writePng(im, a.jsonOut + "." + std::to_string(bi) + ".imp.png");
+            }
+        }
+    }
+    return q;
+}
+
+// Frame times of geom, imp and pts from camera `c`: blocks of --frames per
+// scene after one warm-up frame each (swapping the scene every frame would
+// time the scene switch, not the drawing).
+struct Times {
+    std::vector<double> geom, imp, pts;
+};
+
+Times timeScenes(const ReportArgs& a, const CellScenes& sc, const Camera& c, OffscreenRenderer& r1) {
+    Times t;
+    osg::Node* scenes[3] = {sc.geom.get(), sc.imp.get(), sc.pts.get()};
+    std::vector<double>* times[3] = {&t.geom, &t.imp, &t.pts};
+    for (int m = 0; m < 3; ++m)
+        for (int f = 0; f < a.frames + 1; ++f) {
+            Image img;
+            FrameStats fs;
+            r1.render(scenes[m], c, 0.0, &img, nullptr, fs);
+            if (f > 0) times[m]->push_back(fs.frameMs);
+            if (f > 0 && std::getenv("VISTA_REPORT_VERBOSE"))
+                std::fprintf(stderr, "mode %d frame %d: %.1f ms (cull %.1f, draw %.1f)\n", m, f, fs.frameMs, fs.cullMs, fs.drawMs);
+        }
+    return t;
+}
+
+// One bake's row: the table line on stdout and its JSON object.
+nlohmann::json reportRow(const std::string& label, const std::string& file, int cell, const CellScenes& sc,
+                         const CellViews& views, const Quality& q, const Times& t) {
+    std::printf("| %s | %zu | %zu | %zu | %.2f | %.1f | %.1f | %.1f | %.2f | %.2f | %.2f |\n", label.c_str(), sc.points, sc.textured,
+                q.covered, q.covered ? double(sc.points) / double(q.covered) : 0.0, median(t.geom), median(t.imp), median(t.pts),
+                median(q.geom), median(q.imp), median(q.pts));
+    std::fflush(stdout);
+    nlohmann::json j;
+    j["label"] = label;
+    j["file"] = file;
+    j["cell"] = cell;
+    j["points"] = sc.points;
+    j["textured"] = sc.textured;
+    j["covered_pixels"] = q.covered;
+    j["geom_ms"] = median(t.geom);
+    j["imp_ms"] = median(t.imp);
+    j["pts_ms"] = median(t.pts);
+    j["views"] = views.names;
+    j["psnr_geom_db"] = q.geom;
+    j["psnr_imp_db"] = q.imp;
+    j["psnr_pts_db"] = q.pts;
+    return j;
+}
+
+}  // namespace
+
+// The steps: options, renderers, then per baked file: load, check, scenes,
+// views, quality, timings, row; the JSON last.
+int main(int argc, char** argv) {
+    CLI::App app{"Measure baked point impostors of one view cell against plain and supersampled geometry.", kTool};
+    ReportArgs a;
+    declareFlags(app, a);
+    const int rc = parseOrExit(app, argc, argv);
+    if (rc >= 0) return rc;
+    if (Status s = configure(a); !s) return reportBadInput(kTool, s);
+    auto r1 = OffscreenRenderer::create(a.width, a.height);
+    if (!r1) return reportBadInput(kTool, r1.status());
+    auto rs = OffscreenRenderer::create(a.width * a.ssaa, a.height * a.ssaa);
+    if (!rs) return reportBadInput(kTool, rs.status());
     nlohmann::json out = nlohmann::json::array();
     std::printf("| bake | points | textured | covered px | pts/px | geom ms | imp ms (textured) | imp ms (points) | PSNR geom dB | PSNR imp dB | PSNR pts dB |\n");
     std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
-    for (size_t bi = 0; bi < baked.size(); ++bi) {
-        auto bf = loadBakedFile(baked[bi]);
-        if (!bf) return reportBadInput("vista_bake_report", bf.status());
-        // The rows compare bakes of one city: every recorded source city hash must agree.
-        static std::string firstHash, firstFile;
-        if (!bf->sourceCityHash.empty() && firstHash.empty()) firstHash = bf->sourceCityHash, firstFile = baked[bi];
-        if (!bf->sourceCityHash.empty() && bf->sourceCityHash != firstHash)
-            return reportBadInput("vista_bake_report", Status::error("baked from another city: '" + baked[bi] + "' was baked from a city with hash " +
-                                                                     bf->sourceCityHash + ", '" + firstFile + "' from one with hash " +
-                                                                     firstHash + "; compare bakes of one city"));
+    std::string firstHash, firstFile;
+    for (size_t bi = 0; bi < a.baked.size(); ++bi) {
+        auto bf = loadBakedFile(a.baked[bi]);
+        if (!bf) return reportBadInput(kTool, bf.status());
+        if (Status s = checkSameCity(*bf, a.baked[bi], firstHash, firstFile); !s) return reportBadInput(kTool, s);
         ViewCellSwitch& root = *bf->root;
-        if (cell < 0 || size_t(cell) >= root.cells().size() || root.impostorsOf(uint32_t(cell)).empty())
-            return reportBadInput("vista_bake_report", Status::error("--cell " + std::to_string(cell) + ": no impostor in '" + baked[bi] + "'"));
-        osg::ref_ptr<osg::Group> geom = new osg::Group, imp = new osg::Group, pts = new osg::Group, empty = new osg::Group;
-        geom->setStateSet(root.getStateSet());
-        imp->setStateSet(root.getStateSet());
-        for (uint32_t h : root.hiddenOf(uint32_t(cell))) geom->addChild(root.getChild(h));
-        size_t points = 0, textured = 0;
-        osg::BoundingSphere bs;
-        for (uint32_t k : root.impostorsOf(uint32_t(cell))) {
-            imp->addChild(root.getChild(k));
-            bs.expandBy(root.getChild(k)->getBound());
-            auto* xf = root.getChild(k)->asGroup();
-            auto* pi = dynamic_cast<PointImpostor*>(xf->getChild(0)->asGeode()->getDrawable(0));
-            points += pi->pointCount();
-            textured += pi->texturedCount();
-        }
-        pts->addChild(imp.get());
-        if (std::getenv("VISTA_REPORT_FF"))  // diagnostic: fixed-function points (no shader)
-            pts->getOrCreateStateSet()->setAttributeAndModes(new osg::Program, osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE);
-        pts->getOrCreateStateSet()->addUniform(new osg::Uniform("vista_useTexture", 0),
-                                               osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE);
-        const ViewCellBox& cb = root.cells()[size_t(cell)];
+        if (a.cell < 0 || size_t(a.cell) >= root.cells().size() || root.impostorsOf(uint32_t(a.cell)).empty())
+            return reportBadInput(kTool, Status::error("--cell " + std::to_string(a.cell) + ": no impostor in '" + a.baked[bi] + "'"));
+        const CellScenes scenes = cellScenes(root, uint32_t(a.cell));
+        const ViewCellBox& cb = root.cells()[size_t(a.cell)];
         // Target: the first impostor's bound centre.
-        const osg::Vec3d tc = root.getChild(root.impostorsOf(uint32_t(cell))[0])->getBound().center();
+        const osg::Vec3d tc = root.getChild(root.impostorsOf(uint32_t(a.cell))[0])->getBound().center();
         const glm::dvec3 target(tc.x(), tc.y(), tc.z());
-        glm::dvec3 corners[8];
-        ViewCellBox inset = cb;
-        inset.halfLength *= 0.98; inset.halfWidth *= 0.98; inset.halfHeight *= 0.98;
-        inset.corners(corners);
-        std::vector<glm::dvec3> eyes(corners, corners + 8);
-        std::vector<std::string> views;
-        for (int k = 0; k < 8; ++k) views.push_back("corner" + std::to_string(k));
-        const glm::dvec3 ax(cb.axis, 0.0), sd(cb.side(), 0.0);
-        for (int k = 0; k < 4; ++k) {
-            const double a = (k == 0 ? 1 : k == 1 ? -1 : 0) * inset.halfLength, b = (k == 2 ? 1 : k == 3 ? -1 : 0) * inset.halfWidth;
-            eyes.push_back(cb.center + a * ax + b * sd);
-            views.push_back(k < 2 ? (k == 0 ? "edge+axis" : "edge-axis") : (k == 2 ? "edge+side" : "edge-side"));
-        }
-        eyes.push_back(cb.center);
-        views.push_back("centre");
-        std::vector<double> pg, pi, pp;
-        FrameStats fs;
-        size_t covered = 0;
-        for (size_t e = 0; e < eyes.size(); ++e) {
-            Camera c = lookAt(eyes[e], target, width, height, fov);
-            Camera cs = c;
-            cs.width = width * ssaa;
-            cs.height = height * ssaa;
-            Image big, ref, g, im, pt;
-            if (Status s = (*rs)->render(geom.get(), cs, 0.0, &big, nullptr, fs); !s) return reportBadInput("vista_bake_report", s);
-            ref = downsampleBox(big, ssaa);
-            (*r1)->render(geom.get(), c, 0.0, &g, nullptr, fs);
-            (*r1)->render(imp.get(), c, 0.0, &im, nullptr, fs);
-            (*r1)->render(pts.get(), c, 0.0, &pt, nullptr, fs);
-            pg.push_back(lumaPsnr(g, ref));
-            pi.push_back(lumaPsnr(im, ref));
-            pp.push_back(lumaPsnr(pt, ref));
-            if (e == eyes.size() - 1) {
-                Image em;
-                (*r1)->render(empty.get(), c, 0.0, &em, nullptr, fs);
-                covered = coveredPixels(im, em);
-                if (!jsonOut.empty()) {
-                    writePng(ref, jsonOut + "." + std::to_string(bi) + ".ref.png");
-                    writePng(g, jsonOut + "." + std::to_string(bi) + ".geom.png");
-                    writePng(im, jsonOut + "." + std::to_string(bi) + ".imp.png");
-                }
-            }
-        }
-        // Timing from the centre.
-        const Camera c = lookAt(cb.center, target, width, height, fov);
-        std::vector<double> tg, ti, tp;
-        // Blocks of frames per mode (one warm-up frame each): swapping the scene
-        // every frame would time the scene switch, not the drawing.
-        osg::Node* scenes[3] = {geom.get(), imp.get(), pts.get()};
-        std::vector<double>* times[3] = {&tg, &ti, &tp};
-        for (int m = 0; m < 3; ++m)
-            for (int f = 0; f < frames + 1; ++f) {
-                Image img;
-                FrameStats a;
-                (*r1)->render(scenes[m], c, 0.0, &img, nullptr, a);
-                if (f > 0) times[m]->push_back(a.frameMs);
-                if (f > 0 && std::getenv("VISTA_REPORT_VERBOSE"))
-                    std::fprintf(stderr, "mode %d frame %d: %.1f ms (cull %.1f, draw %.1f)\n", m, f, a.frameMs, a.cullMs, a.drawMs);
-            }
-        const std::string label = bi < labels.size() ? labels[bi] : baked[bi];
-        std::printf("| %s | %zu | %zu | %zu | %.2f | %.1f | %.1f | %.1f | %.2f | %.2f | %.2f |\n", label.c_str(), points, textured, covered,
-                    covered ? double(points) / double(covered) : 0.0, median(tg), median(ti), median(tp), median(pg), median(pi), median(pp));
-        std::fflush(stdout);
-        nlohmann::json j;
-        j["label"] = label;
-        j["file"] = baked[bi];
-        j["cell"] = cell;
-        j["points"] = points;
-        j["textured"] = textured;
-        j["covered_pixels"] = covered;
-        j["geom_ms"] = median(tg);
-        j["imp_ms"] = median(ti);
-        j["pts_ms"] = median(tp);
-        j["views"] = views;
-        j["psnr_geom_db"] = pg;
-        j["psnr_imp_db"] = pi;
-        j["psnr_pts_db"] = pp;
-        out.push_back(j);
+        const CellViews views = cellViews(cb);
+        auto q = measureQuality(a, bi, scenes, views, target, **r1, **rs);
+        if (!q) return reportBadInput(kTool, q.status());
+        const Times t = timeScenes(a, scenes, lookAt(cb.center, target, a.width, a.height, a.fov), **r1);
+        const std::string label = bi < a.labels.size() ? a.labels[bi] : a.baked[bi];
+        out.push_back(reportRow(label, a.baked[bi], a.cell, scenes, views, *q, t));
     }
-    if (!jsonOut.empty()) {
-        if (Status s = writeFileAtomic(jsonOut, out.dump(1)); !s) return reportBadInput("vista_bake_report", s);
+    if (!a.jsonOut.empty()) {
+        if (Status s = writeFileAtomic(a.jsonOut, out.dump(1)); !s) return reportBadInput(kTool, s);
     }
     return 0;
 }

@@ -115,7 +115,7 @@ json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneM
     j["frames"] = cfg.frames;
     j["sampling"] = samplingName(cfg.sampleRuns);
     j["fov_y_deg"] = cfg.fovYDeg;
-    j["near_m"] = o.nearDistance;  // < 0 = auto (kept for older readers; see "options")
+    j["near_m"] = o.nearDistance;  // < 0 = auto; "options" holds every mode option, "auto" spelled out
     j["options"] = {{"near_m", o.nearDistance < 0 ? json("auto") : json(o.nearDistance)},
                     {"triangle_budget", o.triangleBudget},
                     {"pixel_budget", o.pixelBudget < 0 ? json("unlimited") : json(o.pixelBudget)},

@@ -18,7 +18,7 @@
 #include "cmd/plot.h"
 #include "foundation/atomic_file.h"
 #include "foundation/timing.h"
-#include "runtime/scene/city_file.h"
+#include "nodes/render/walkthrough.h"
 #include "runtime/scene/scene_graph.h"
 
 namespace vista {
@@ -148,62 +148,53 @@ void printTable(const BenchResult& r) {
 int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string& outDir, BenchResult* res,
               size_t* cityTriangles = nullptr) {
     BenchConfig cfg = a.cfg;
+    const bool rays = std::any_of(cfg.modes.begin(), cfg.modes.end(),
+                                  [](const std::string& m) { return findRenderMode(m)->needsRays; });
     {
         // The estimate before anything is loaded: a run over the budget stops here.
         std::error_code ec;
         const uint64_t bytes = fs::file_size(cityFile, ec);
-        const bool rays = std::any_of(cfg.modes.begin(), cfg.modes.end(),
-                                      [](const std::string& m) { return findRenderMode(m)->needsRays; });
         if (!ec) {
             cfg.memoryEstimateMb = estimateCityRunMb(bytes, rays);
             if (Status s = checkMemoryBudget("--memory-budget", cfg.memoryBudgetGb, cfg.memoryEstimateMb, bytes, rays); !s)
                 return reportBadInput(kCmd, s);
         }
     }
-    Stopwatch sw;
-    Result<SceneModel> city = Status::error("no city");
-    Result<Path> path = Status::error("no path");
-    if (isPagedCityPath(cityFile)) {
-        // A paged city: the walkthrough first (a CSV, or a seeded path on the
-        // centre region's streets), then only the regions near it.
-        auto paged = openPagedCity(cityFile, a.path.file.empty());
-        if (!paged) return reportBadInput(kCmd, paged.status());
-        path = walkthroughPath(a.path, a.pathOptions, paged->stub);
-        if (!path) return reportBadInput(kCmd, path.status());
-        // The budget check of a city file, on the selected regions' bytes.
-        auto budget = [&](uint64_t bytes) {
-            const bool rays = std::any_of(cfg.modes.begin(), cfg.modes.end(),
-                                          [](const std::string& m) { return findRenderMode(m)->needsRays; });
-            cfg.memoryEstimateMb = estimateCityRunMb(bytes, rays);
-            return checkMemoryBudget("--memory-budget", cfg.memoryBudgetGb, cfg.memoryEstimateMb, bytes, rays);
-        };
-        city = loadPagedNear(*paged, *path, a.paged, kCmd, a.quiet, &cfg.pagedJson, budget);
-        if (!city) return reportBadInput(kCmd, city.status());
-    } else {
-        city = loadCityFile(cityFile);
-        if (!city) return reportBadInput(kCmd, city.status());
-    }
-    cfg.loadMs = sw.ms();
-    cfg.memoryPhases.push_back(memoryPhase("load"));
+    WalkthroughRequest req;
+    req.city = cityFile;
+    req.cmd = kCmd;
+    req.quiet = a.quiet;
+    req.paged = a.paged;
+    // A paged city: the walkthrough first (a CSV, or a seeded path on the
+    // city's streets), then only the regions near it.
+    req.pathNeedsStreets = a.path.file.empty();
+    req.makePath = [&](const SceneModel& city) { return walkthroughPath(a.path.file, a.pathOptions, city); };
+    // The budget check of a city file, on the selected regions' bytes.
+    req.beforePagedLoad = [&](uint64_t bytes) {
+        cfg.memoryEstimateMb = estimateCityRunMb(bytes, rays);
+        return checkMemoryBudget("--memory-budget", cfg.memoryBudgetGb, cfg.memoryEstimateMb, bytes, rays);
+    };
+    req.cityLoaded = [&] { cfg.memoryPhases.push_back(memoryPhase("load")); };
     // A baked file of another city, or a truncated one, is refused before anything is drawn.
-    if (Status st = loadPairedBakes(kCmd, cityFile, sceneRoot(city.value()), cfg.modes, cfg.options); !st) return reportBadInput(kCmd, st);
-    if (!path) path = walkthroughPath(a.path, a.pathOptions, city.value());
-    if (!path) return reportBadInput(kCmd, path.status());
+    req.bakedModes = cfg.modes;
+    req.effects = [&](const Effects& declared) { return runTimeEffects(a.effects, declared, a.quiet, kCmd); };
+    auto walk = loadWalkthrough(req, cfg.options);
+    if (!walk) return reportBadInput(kCmd, walk.status());
+    const SceneModel& city = walk->city;
+    cfg.loadMs = walk->cityLoadMs;
+    cfg.pagedJson = walk->pagedJson;
     cfg.runUpS = a.path.file.empty() ? a.pathOptions.runUp : -1.0;
     cfg.outDir = outDir;
     cfg.cityLabel = fs::path(cityFile).filename().string();
-    auto fx = runTimeEffects(a.effects, city->params.effects, a.quiet, kCmd);
-    if (!fx) return reportBadInput(kCmd, fx.status());
-    cfg.options.effects = *fx;
-    cfg.effectsDeclared = effectsToJson(city->params.effects);
-    auto r = runBenchmark(&city.value(), sceneRoot(city.value()), path.value(), cfg);
+    cfg.effectsDeclared = effectsToJson(city.params.effects);
+    auto r = runBenchmark(&city, sceneRoot(city), walk->path, cfg);
     if (!r) {
         std::fprintf(stderr, "%s: %s\n", kCmd, r.status().message().c_str());
         return 1;
     }
     if (!a.quiet) printTable(r.value());
     if (res) *res = std::move(r.value());
-    if (cityTriangles) *cityTriangles = city->triangles;
+    if (cityTriangles) *cityTriangles = city.triangles;
     return 0;
 }
 

@@ -12,9 +12,9 @@
 #include "foundation/timing.h"
 #include "citygen/streets.h"
 #include "cmd/options.h"
-#include "runtime/engine/baked_lighting.h"
+#include "bake/gen/baked_lighting.h"
 #include "runtime/scene/city_file.h"
-#include "runtime/scene/paged_city.h"
+#include "bake/gen/paged_city.h"
 #include "citygen/regions.h"
 #include "cmd/cli.h"
 #include "cmd/commands.h"
@@ -321,6 +321,7 @@ int runGen(int argc, char** argv) {
             return checkGenBudget("--memory-budget", a.budgetGb, estimateMb, how, false);
         };
     double osmSeconds = -1;
+    std::optional<OsmRoadTagStats> osmRoads;
     if (!a.osmFile.empty()) {
         Stopwatch osmTime;
         auto g = importOsm(a.osmFile, *params, a.osmBuildings == "on");
@@ -328,6 +329,7 @@ int runGen(int argc, char** argv) {
         if (const std::string dropped = g->dropSummary(); !dropped.empty()) std::fprintf(stderr, "osm: %s\n", dropped.c_str());
         params->geo = g->geo;
         opts.streets = std::move(g->streets);
+        osmRoads = g->roadTagStats;
         if (a.osmBuildings == "on") {
             const OsmBuildingStats& b = g->buildingStats;
             const size_t skipped = b.candidates - b.imported;
@@ -356,6 +358,7 @@ int runGen(int argc, char** argv) {
     if (!a.statsFile.empty()) {
         auto j = statsJson(*city, *params, n, lighting, writeSeconds, totalSeconds);
         if (a.budgetGb > 0) j["memory"] = {{"estimate_mb", estimateMb}, {"budget_gb", a.budgetGb}};
+        if (osmRoads) j["osm_roads"] = nlohmann::ordered_json::parse(osmRoadTagStatsJson(*osmRoads));
         if (Status s = writeFileAtomic(a.statsFile, j.dump(2) + "\n"); !s) return reportBadInput(kCmd, s);
     }
     if (!a.quiet)

@@ -7,6 +7,7 @@
 #include "cmd/cli.h"
 #include "cmd/commands.h"
 #include "cmd/options.h"
+#include "runtime/scene/paged_walkthrough.h"
 #include "runtime/scene/paths.h"
 
 namespace vista {
@@ -17,7 +18,7 @@ int runPath(int argc, char** argv) {
     std::string city, out, kind = "car";
     PathOptions o;
     double yawDeg = 45.0, pitchDeg = o.flyPitch * 180.0 / kPi;
-    // Option declarations (alike in shape to every command's: one CLI11 call per flag, kept).
+    // Options: one CLI11 call per flag.
     app.add_option("city", city,
                    "city scene file (.osgb) written by `vista gen`, or a paged city directory (DIR.paged: its street "
                    "graph is grown again from the manifest's params, no region is read; the same path as the "

@@ -44,10 +44,9 @@
 #include "foundation/timing.h"
 #include "foundation/units.h"
 #include "nodes/render/offscreen.h"
-#include "runtime/engine/far_field_rays.h"
 #include "runtime/engine/ground_truth.h"
 #include "runtime/engine/ray_scene.h"
-#include "runtime/scene/city_file.h"
+#include "nodes/render/walkthrough.h"
 #include "runtime/scene/scene_graph.h"
 
 namespace vista {
@@ -59,6 +58,8 @@ const char* const kCmd = "vista render";
 
 enum Channel : unsigned { kRgb = 1, kDepth = 2, kSemantic = 4, kInstance = 8 };
 constexpr unsigned kLabelChannels = kDepth | kSemantic | kInstance;
+// The output folder of each channel, in output order.
+const std::pair<unsigned, const char*> kChannelDirs[] = {{kRgb, "rgb"}, {kDepth, "depth"}, {kSemantic, "semantic"}, {kInstance, "instance"}};
 
 struct RenderArgs {
     std::string city, size = "640x480", mode = "full", out, channels = "rgb,depth,semantic,instance", fov = "60";
@@ -75,7 +76,7 @@ Result<unsigned> parseChannels(const std::string& s) {
     while (start <= s.size()) {
         const size_t end = s.find(',', start);
         const std::string name = s.substr(start, end == std::string::npos ? std::string::npos : end - start);
-        unsigned c = name == "rgb" ? kRgb : name == "depth" ? kDepth : name == "semantic" ? kSemantic : name == "instance" ? kInstance : 0;
+        unsigned c = name == "rgb" ? kRgb : name == "depth" ? kDepth : name == "semantic" ? kSemantic : name == "instance" ? kInstance : Channel{0};
         if (!c) return Status::error("--channels: unknown channel '" + name + "' (known: rgb, depth, semantic, instance)");
         if (out & c) return Status::error("--channels: channel '" + name + "' given twice");
         out |= c;
@@ -224,212 +225,276 @@ long killAfterFrames() {
 
 nlohmann::json medianOf(const std::vector<double>& v) { return v.empty() ? nlohmann::json(nullptr) : nlohmann::json(median(v)); }
 
-int run(RenderArgs& a, const std::string& command) {
-    // ---- options -------------------------------------------------------------
+// The parsed options of a run.
+struct RenderPlan {
+    ImageSize size;
+    double fovDeg = 0;
+    unsigned channels = 0;
+    int sampleRuns = 0;
+    ModeOptions options;
+    PathOptions path;
+    bool labels() const { return (channels & kLabelChannels) != 0; }
+};
+
+// Every option checked before anything is loaded; errors name the flag.
+Status configure(const RenderArgs& a, RenderPlan& p) {
     auto size = parseImageSize(a.size);
-    if (!size) return reportBadInput(kCmd, size.status());
+    if (!size) return size.status();
+    p.size = *size;
     auto fov = parseFov(a.fov);
-    if (!fov) return reportBadInput(kCmd, fov.status());
+    if (!fov) return fov.status();
+    p.fovDeg = *fov;
     if (a.mode != "full" && a.mode != "hybrid")
-        return reportBadInput(kCmd, Status::error("--mode '" + a.mode + "': ground truth is rendered in full or hybrid"));
+        return Status::error("--mode '" + a.mode + "': ground truth is rendered in full or hybrid");
     auto channels = parseChannels(a.channels);
-    if (!channels) return reportBadInput(kCmd, channels.status());
+    if (!channels) return channels.status();
+    p.channels = *channels;
     if (a.frames < 1 || a.frames > 1000000)
-        return reportBadInput(kCmd, Status::error("--frames " + std::to_string(a.frames) + " out of range 1 .. 1000000"));
+        return Status::error("--frames " + std::to_string(a.frames) + " out of range 1 .. 1000000");
     auto sampling = parseSampling(a.sampling);
-    if (!sampling) return reportBadInput(kCmd, sampling.status());
-    ModeOptions mo;
-    if (Status s = parseModeFlags(a.modeFlags, mo); !s) return reportBadInput(kCmd, s);
-    mo.cacheAdaptive = false;  // ground truth: the cache never pauses on timings (frames stay deterministic)
+    if (!sampling) return sampling.status();
+    p.sampleRuns = *sampling;
+    VISTA_RETURN_IF_ERROR(parseModeFlags(a.modeFlags, p.options));
+    p.options.cacheAdaptive = false;  // ground truth: the cache never pauses on timings (frames stay deterministic)
     auto po = parsePathFlags(a.path);
-    if (!po) return reportBadInput(kCmd, po.status());
-    if (!fs::exists(a.city)) return reportBadInput(kCmd, Status::error("city file '" + a.city + "' does not exist"));
-    RenderWorkDir out;
-    if (Status s = out.checkOut(a.out); !s) return reportBadInput(kCmd, s);
+    if (!po) return po.status();
+    p.path = *po;
+    if (!fs::exists(a.city)) return Status::error("city file '" + a.city + "' does not exist");
+    return Status::ok();
+}
 
-    // ---- city, path ------------------------------------------------------------
-    auto city = loadCityFile(a.city);
-    if (!city) return reportBadInput(kCmd, city.status());
-    const bool labels = (*channels & kLabelChannels) != 0;
-    if ((*channels & (kSemantic | kInstance)) && !city->labelled)
-        return reportBadInput(kCmd, Status::error("city file '" + a.city +
-                                                  "' has no ground-truth labels (written by an older vista): regenerate the "
-                                                  "city with this version (`vista gen`) for the semantic and instance channels"));
-    auto path = walkthroughPath(a.path, *po, *city);
-    if (!path) return reportBadInput(kCmd, path.status());
-    if (path->samples.empty()) return reportBadInput(kCmd, Status::error("the walkthrough path has no samples"));
-    const std::vector<size_t> idx = path->frames(size_t(a.frames), *sampling);
-    if (Status s = checkPathInCity(*path, idx, *city); !s) return reportBadInput(kCmd, s);
-    auto fx = runTimeEffects("", city->params.effects, true, kCmd);
-    if (!fx) return reportBadInput(kCmd, fx.status());
-    mo.effects = *fx;
+// The city (labelled when a label channel needs it), the walkthrough and the
+// path indices of the frames (`idx`), each frame inside the city.
+Result<Walkthrough> loadCityAndFrames(const RenderArgs& a, RenderPlan& p, std::vector<size_t>& idx) {
+    WalkthroughRequest req;
+    req.city = a.city;
+    req.cmd = kCmd;
+    req.quiet = true;
+    req.allowPaged = false;
+    req.pathNeedsStreets = a.path.file.empty();
+    req.checkCity = [&](const SceneModel& city) {
+        if ((p.channels & (kSemantic | kInstance)) && !city.labelled)
+            return Status::error("city file '" + a.city +
+                                 "' has no ground-truth labels (written by an older vista): regenerate the "
+                                 "city with this version (`vista gen`) for the semantic and instance channels");
+        return Status::ok();
+    };
+    req.makePath = [&](const SceneModel& city) -> Result<Path> {
+        auto path = walkthroughPath(a.path.file, p.path, city);
+        if (!path) return path;
+        if (path->samples.empty()) return Status::error("the walkthrough path has no samples");
+        idx = path->frames(size_t(a.frames), p.sampleRuns);
+        VISTA_RETURN_IF_ERROR(checkPathInCity(*path, idx, city));
+        return path;
+    };
+    req.bakedModes = {a.mode};
+    req.effects = [](const Effects& declared) { return runTimeEffects("", declared, true, kCmd); };
+    return loadWalkthrough(req, p.options);
+}
 
-    // ---- work directory: new, or the one of an interrupted run with the same parameters ----
+// The work directory: new, or the one of an interrupted run with the same
+// parameters (the manifest: city bytes, camera poses, every option that
+// changes a pixel), with a folder per channel.
+Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, const std::vector<size_t>& idx,
+                   RenderWorkDir& out) {
     uint64_t cityBytes = 0;
     auto cityHash = fileHash(a.city, cityBytes);
-    if (!cityHash) return reportBadInput(kCmd, cityHash.status());
+    if (!cityHash) return cityHash.status();
+    const ModeOptions& mo = p.options;
     const nlohmann::json manifest = {
         {"city_hash", *cityHash}, {"city_bytes", cityBytes},
-        {"frames", idx.size()}, {"camera_poses_hash", posesHash(*path, idx)},
-        {"size", std::to_string(size->width) + "x" + std::to_string(size->height)}, {"fov_deg", num(*fov)},
-        {"mode", a.mode}, {"channels", channelList(*channels)},
+        {"frames", idx.size()}, {"camera_poses_hash", posesHash(path, idx)},
+        {"size", std::to_string(p.size.width) + "x" + std::to_string(p.size.height)}, {"fov_deg", num(p.fovDeg)},
+        {"mode", a.mode}, {"channels", channelList(p.channels)},
         {"near", num(mo.nearDistance)}, {"triangle_budget", mo.triangleBudget}, {"pixel_budget", mo.pixelBudget},
         {"horizon_grid", mo.horizonGrid}, {"cache", mo.cache}, {"cache_error_px", num(mo.cacheErrorPx)},
         {"frame_ms", num(mo.frameMsTarget)}, {"far_step", mo.farStep}};
-    if (Status s = out.open(manifest, a.restart); !s) return reportBadInput(kCmd, s);
-    for (const char* d : {"rgb", "depth", "semantic", "instance"}) {
-        const unsigned c = std::string(d) == "rgb" ? kRgb : std::string(d) == "depth" ? kDepth : std::string(d) == "semantic" ? kSemantic : kInstance;
-        if (*channels & c)
-            if (Status s = out.subdir(d); !s) return reportBadInput(kCmd, s);
-    }
+    VISTA_RETURN_IF_ERROR(out.open(manifest, a.restart));
+    for (const auto& [bit, dir] : kChannelDirs)
+        if (p.channels & bit) VISTA_RETURN_IF_ERROR(out.subdir(dir));
+    return Status::ok();
+}
 
-    // ---- set up ------------------------------------------------------------------
-    auto fail = [&](const Status& s) {
-        std::fprintf(stderr, "%s: %s\n", kCmd, s.message().c_str());
-        return 1;
-    };
-    auto renderer = OffscreenRenderer::create(size->width, size->height);
-    if (!renderer) return fail(renderer.status());
+// What the frames are drawn with: the renderer, the ray scene (when the
+// mode or the effects cast rays), the mode, and the root of the label pass.
+// Members are destroyed in reverse order: the mode before its context.
+struct RenderSession {
+    std::unique_ptr<OffscreenRenderer> renderer;
     std::unique_ptr<RayScene> rays;
     ModeContext ctx;
-    ctx.city = &city.value();
-    ctx.scene = sceneRoot(*city);
-    ctx.renderer = renderer->get();
-    ctx.options = mo;
-    ctx.labels = labels;
-    if (findRenderMode(a.mode)->needsRays || effectsNeedRays(mo.effects)) {
-        auto r = RayScene::build(*city);
-        if (!r) return fail(Status::error("building the Embree ray scene failed: " + r.status().message()));
-        rays = std::move(r.value());
-        ctx.rays = rays.get();
-    }
-    auto mode = createRenderMode(a.mode, ctx);
-    if (!mode) return fail(mode.status());
-    const NearFieldScene& nf = ctx.nearField();
+    std::unique_ptr<RenderMode> mode;
     osg::ref_ptr<osg::Group> labelRoot = new osg::Group;
-    if (labels) labelRoot->setStateSet(nf.labelRootState.get());
+};
 
-    Camera base;
-    base.width = size->width;
-    base.height = size->height;
-    base.fovY = degToRad(*fov);
-    const glm::dvec3 offset(city->params.origin_x, city->params.origin_y, 0.0);
-    const double fy = 0.5 * base.height / std::tan(0.5 * base.fovY);
-    nlohmann::json frames = nlohmann::json::array();
-    std::unique_ptr<Progress> progress;
-    if (!a.quiet) progress = std::make_unique<StderrProgress>(isatty(2));
-    // Finished frames (record and every channel file present) are kept. The
-    // hybrid mode carries state from frame to frame (panoramic cache, adaptive
-    // split): it re-renders the finished frames before the last missing one
-    // (rgb only, nothing written) so that every frame it writes sees the state
-    // of an uninterrupted run.
-    std::vector<nlohmann::json> records(idx.size());
+Status setUp(const std::string& modeName, const RenderPlan& p, const SceneModel& city, RenderSession& s) {
+    auto renderer = OffscreenRenderer::create(p.size.width, p.size.height);
+    if (!renderer) return renderer.status();
+    s.renderer = std::move(*renderer);
+    s.ctx.city = &city;
+    s.ctx.scene = sceneRoot(city);
+    s.ctx.renderer = s.renderer.get();
+    s.ctx.options = p.options;
+    s.ctx.labels = p.labels();
+    if (findRenderMode(modeName)->needsRays || effectsNeedRays(p.options.effects)) {
+        auto r = RayScene::build(city);
+        if (!r) return Status::error("building the Embree ray scene failed: " + r.status().message());
+        s.rays = std::move(r.value());
+        s.ctx.rays = s.rays.get();
+    }
+    auto mode = createRenderMode(modeName, s.ctx);
+    if (!mode) return mode.status();
+    s.mode = std::move(*mode);
+    const NearFieldScene& nf = s.ctx.nearField();
+    if (p.labels()) s.labelRoot->setStateSet(nf.labelRootState.get());
+    return Status::ok();
+}
+
+// Frames an interrupted run finished (their record and every channel file
+// present) are kept. The hybrid mode carries state from frame to frame
+// (panoramic cache, adaptive split): it re-renders the finished frames before
+// the last missing one (rgb only, nothing written) so that every frame it
+// writes sees the state of an uninterrupted run.
+struct Progressed {
+    std::vector<nlohmann::json> records;  // per frame; null = still to render
     long lastMissing = -1;
     size_t kept = 0;
-    for (size_t f = 0; f < idx.size(); ++f) {
+};
+
+Progressed finishedFrames(const RenderWorkDir& out, unsigned channels, size_t frames) {
+    Progressed r;
+    r.records.resize(frames);
+    for (size_t f = 0; f < frames; ++f) {
         if (out.resumed()) {
-            records[f] = out.frameRecord(f);
+            r.records[f] = out.frameRecord(f);
             const std::string name = frameName(f);
             for (const auto& [bit, file] : {std::pair<unsigned, std::string>{kRgb, "rgb/" + name + ".png"}, {kDepth, "depth/" + name + ".npy"},
                                             {kSemantic, "semantic/" + name + ".png"}, {kInstance, "instance/" + name + ".npy"}})
-                if (!records[f].is_null() && (*channels & bit) && !fs::exists(out.file(file))) records[f] = nullptr;
+                if (!r.records[f].is_null() && (channels & bit) && !fs::exists(out.file(file))) r.records[f] = nullptr;
         }
-        if (records[f].is_null())
-            lastMissing = long(f);
+        if (r.records[f].is_null())
+            r.lastMissing = long(f);
         else
-            ++kept;
+            ++r.kept;
     }
+    return r;
+}
+
+// The camera of every frame: the path's pose at the plan's size and field of view.
+Camera baseCamera(const RenderPlan& p) {
+    Camera base;
+    base.width = p.size.width;
+    base.height = p.size.height;
+    base.fovY = degToRad(p.fovDeg);
+    return base;
+}
+
+// Scratch buffers reused from frame to frame.
+struct FrameBuffers {
+    Image img;
+    LabelImage gt;
+    LabelFrame raster;
+};
+
+// The labels of the frame the mode just rendered: the label pass over the
+// chunks it rasterised, then rays for the pixels its far field filled
+// (mergeLabels). Costs into `tm`.
+Status frameLabels(const std::string& modeName, const Camera& cam, int threads, RenderSession& s, FrameBuffers& b,
+                   Timings& tm) {
+    const RasterSelection* sel = s.mode->lastRaster();
+    if (!sel) return Status::error("mode " + modeName + " reports no raster selection");
+    const NearFieldScene& nf = s.ctx.nearField();
+    s.labelRoot->removeChildren(0, s.labelRoot->getNumChildren());
+    for (uint32_t i : sel->chunks)
+        if (i < nf.labelChunks.size()) s.labelRoot->addChild(nf.labelChunks[i].get());
+    FrameStats ls;
+    VISTA_RETURN_IF_ERROR(s.renderer->renderLabels(s.labelRoot.get(), cam, sel->zFar, b.raster, ls));
+    tm.labelRaster.push_back(ls.frameMs);
+    Stopwatch sw;
+    const RasterLabels raster{b.raster.ids.data(), b.raster.classes.data(), b.raster.depth.data()};
+    const size_t cast = mergeLabels(*s.ctx.city, s.ctx.rays, cam, raster, sel->nearDistance, modeName == "hybrid", b.gt, threads);
+    tm.labelRays.push_back(sw.ms());
+    tm.farPixels.push_back(double(cast));
+    tm.labels.push_back(tm.labelRaster.back() + tm.labelRays.back());
+    return Status::ok();
+}
+
+// The frame's channel files, each written atomically (costs into `tm`,
+// apart from the channel costs).
+Status writeFrameFiles(unsigned channels, const std::string& name, const FrameBuffers& b, const RenderWorkDir& out,
+                       Timings& tm) {
+    Stopwatch w;
+    if (channels & kRgb) {
+        VISTA_RETURN_IF_ERROR(writePngRgb(b.img, out.file("rgb/" + name + ".png")));
+        tm.writeRgb.push_back(w.lap());
+    }
+    const LabelImage& gt = b.gt;
+    if (channels & kDepth) {
+        VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file("depth/" + name + ".npy"), npyBytes(gt.depth.data(), gt.width, gt.height)));
+        tm.writeDepth.push_back(w.lap());
+    }
+    if (channels & kSemantic) {
+        VISTA_RETURN_IF_ERROR(writePngGray8(gt.classes, gt.width, gt.height, out.file("semantic/" + name + ".png")));
+        tm.writeSemantic.push_back(w.lap());
+    }
+    if (channels & kInstance) {
+        VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file("instance/" + name + ".npy"), npyBytes(gt.ids.data(), gt.width, gt.height)));
+        tm.writeInstance.push_back(w.lap());
+    }
+    return Status::ok();
+}
+
+// Renders every frame still missing (and hybrid's warm-up frames), writes
+// its files and record; `frames` receives every frame's camera entry of
+// cameras.json.
+Status renderFrames(const RenderArgs& a, const RenderPlan& p, const Walkthrough& w, const std::vector<size_t>& idx,
+                    RenderSession& s, RenderWorkDir& out, Progressed& done, nlohmann::json& frames) {
+    std::unique_ptr<Progress> progress;
+    if (!a.quiet) progress = std::make_unique<StderrProgress>(isatty(2));
     const bool stateful = a.mode == "hybrid";
     const long killAfter = killAfterFrames();
     long finishedNow = 0;
     if (progress)
         progress->begin("render " + std::to_string(idx.size()) + " frames (" + a.mode + ")" +
-                        (kept ? ", resuming: " + std::to_string(kept) + " done" : std::string()));
-
-    // ---- frames ------------------------------------------------------------------
-    Image img;
-    LabelImage gt;
-    LabelFrame raster;
-    std::vector<uint32_t> far;
+                        (done.kept ? ", resuming: " + std::to_string(done.kept) + " done" : std::string()));
+    const Camera base = baseCamera(p);
+    const glm::dvec3 offset(w.city.params.origin_x, w.city.params.origin_y, 0.0);
+    FrameBuffers b;
     for (size_t f = 0; f < idx.size(); ++f) {
-        const Camera cam = path->camera(idx[f], base);
-        const PathSample& ps = path->samples[idx[f]];
+        const Camera cam = w.path.camera(idx[f], base);
+        const PathSample& ps = w.path.samples[idx[f]];
         frames.push_back({{"frame", f}, {"name", frameName(f)}, {"path_index", idx[f]}, {"t_s", ps.t},
                           {"eye_world", {ps.position.x, ps.position.y, ps.position.z}},
                           {"heading_deg", radToDeg(ps.heading)}, {"pitch_deg", radToDeg(ps.pitch)},
                           {"camera_from_world", cameraFromWorld(cam, offset)}});
-        const bool done = !records[f].is_null();
-        if (done && !(stateful && long(f) < lastMissing)) continue;
+        const bool finished = !done.records[f].is_null();
+        if (finished && !(stateful && long(f) < done.lastMissing)) continue;
         FrameStats st;
-        if (Status s = (*mode)->renderFrame(cam, img, st); !s) return fail(Status::error("frame " + std::to_string(f) + ": " + s.message()));
-        if (done) {  // hybrid warm-up: the state, not the image
+        if (Status e = s.mode->renderFrame(cam, b.img, st); !e) return Status::error("frame " + std::to_string(f) + ": " + e.message());
+        if (finished) {  // hybrid warm-up: the state, not the image
             if (progress) progress->update(double(f + 1) / double(idx.size()));
             continue;
         }
         Timings tm;
         tm.rgb.push_back(st.frameMs);
-        const std::string name = frameName(f);
-        if (labels) {
-            const RasterSelection* sel = (*mode)->lastRaster();
-            if (!sel) return fail(Status::error("mode " + a.mode + " reports no raster selection"));
-            labelRoot->removeChildren(0, labelRoot->getNumChildren());
-            for (uint32_t i : sel->chunks)
-                if (i < nf.labelChunks.size()) labelRoot->addChild(nf.labelChunks[i].get());
-            FrameStats ls;
-            if (Status s = (*renderer)->renderLabels(labelRoot.get(), cam, sel->zFar, raster, ls); !s) return fail(s);
-            tm.labelRaster.push_back(ls.frameMs);
-            Stopwatch sw;
-            gt.resize(cam.width, cam.height);
-            far.clear();
-            const PixelRays gen(cam);
-            const glm::dvec3 fwd = cam.forward();
-            for (int y = 0; y < cam.height; ++y)
-                for (int x = 0; x < cam.width; ++x) {
-                    const size_t p = size_t(y) * size_t(cam.width) + size_t(x);
-                    const float z = raster.depth[p];
-                    bool keep = z > 0.0f;
-                    if (keep && sel->nearDistance < 1e299) keep = double(z) / glm::dot(gen.dir(x, y), fwd) <= sel->nearDistance;
-                    if (keep) {
-                        gt.ids[p] = raster.ids[p];
-                        gt.classes[p] = raster.classes[p];
-                        gt.depth[p] = z;
-                    } else if (ctx.rays && (sel->nearDistance < 1e299 || a.mode == "hybrid")) {
-                        far.push_back(uint32_t(p));
-                    }
-                }
-            if (!far.empty()) castLabels(*city, *ctx.rays, cam, far, gt, mo.threads);
-            tm.labelRays.push_back(sw.ms());
-            tm.farPixels.push_back(double(far.size()));
-            tm.labels.push_back(tm.labelRaster.back() + tm.labelRays.back());
-        }
-        // Writes (not part of the channel costs; timed apart).
-        Stopwatch w;
-        if (*channels & kRgb) {
-            if (Status s = writePngRgb(img, out.file("rgb/" + name + ".png")); !s) return fail(s);
-            tm.writeRgb.push_back(w.lap());
-        }
-        if (*channels & kDepth) {
-            if (Status s = writeFileAtomic(out.file("depth/" + name + ".npy"), npyBytes(gt.depth.data(), gt.width, gt.height)); !s) return fail(s);
-            tm.writeDepth.push_back(w.lap());
-        }
-        if (*channels & kSemantic) {
-            if (Status s = writePngGray8(gt.classes, gt.width, gt.height, out.file("semantic/" + name + ".png")); !s) return fail(s);
-            tm.writeSemantic.push_back(w.lap());
-        }
-        if (*channels & kInstance) {
-            if (Status s = writeFileAtomic(out.file("instance/" + name + ".npy"), npyBytes(gt.ids.data(), gt.width, gt.height)); !s) return fail(s);
-            tm.writeInstance.push_back(w.lap());
-        }
-        records[f] = Timings::record(tm);
-        if (Status s = out.finishFrame(f, records[f]); !s) return fail(s);
+        if (p.labels()) VISTA_RETURN_IF_ERROR(frameLabels(a.mode, cam, p.options.threads, s, b, tm));
+        VISTA_RETURN_IF_ERROR(writeFrameFiles(p.channels, frameName(f), b, out, tm));
+        done.records[f] = Timings::record(tm);
+        VISTA_RETURN_IF_ERROR(out.finishFrame(f, done.records[f]));
         if (killAfter > 0 && ++finishedNow == killAfter) std::raise(SIGKILL);
         if (progress) progress->update(double(f + 1) / double(idx.size()));
     }
     if (progress) progress->end();
-    Timings tm;  // every frame's, whichever run rendered it
-    for (const auto& r : records) tm.add(r);
+    return Status::ok();
+}
 
-    // ---- metadata, commit ----------------------------------------------------------
+// cameras.json, summary.json and classes.json, then the work directory
+// renamed to the output.
+Status writeMetadata(const RenderArgs& a, const RenderPlan& p, const std::string& command, const SceneModel& city,
+                     const std::vector<size_t>& idx, const nlohmann::json& frames, const Timings& tm, size_t kept,
+                     const OffscreenRenderer& renderer, RenderWorkDir& out) {
+    const Camera base = baseCamera(p);
+    const glm::dvec3 offset(city.params.origin_x, city.params.origin_y, 0.0);
+    const double fy = 0.5 * base.height / std::tan(0.5 * base.fovY);
     const nlohmann::json cameras = {
         {"convention",
          "OpenCV pinhole: camera x right, y down, z forward (optical axis); camera_from_world maps world points minus "
@@ -437,13 +502,13 @@ int run(RenderArgs& a, const std::string& command) {
          "coordinates (u = column, v = row from the top), so cx = (width - 1) / 2"},
         {"width", base.width}, {"height", base.height},
         {"fx", fy}, {"fy", fy}, {"cx", 0.5 * (base.width - 1)}, {"cy", 0.5 * (base.height - 1)},
-        {"fov_y_deg", *fov}, {"z_near_m", base.zNear},
+        {"fov_y_deg", p.fovDeg}, {"z_near_m", base.zNear},
         {"world_offset", {offset.x, offset.y, offset.z}},
         {"depth", "float32 metres along the optical axis (camera z), +inf = sky"},
         {"frames", frames}};
     const nlohmann::json summary = {
         {"command", command}, {"mode", a.mode}, {"frames", idx.size()}, {"width", base.width}, {"height", base.height},
-        {"channels", a.channels}, {"gl_renderer", (*renderer)->glRenderer()},
+        {"channels", a.channels}, {"gl_renderer", renderer.glRenderer()},
         {"median_ms",
          {{"rgb", medianOf(tm.rgb)},
           {"labels_raster_pass", medianOf(tm.labelRaster)},
@@ -460,26 +525,56 @@ int run(RenderArgs& a, const std::string& command) {
                  "by the run that rendered it (frames_resumed: frames an interrupted run had finished)"}};
     for (const auto& [file, j] : {std::pair<const char*, const nlohmann::json*>{"cameras.json", &cameras},
                                   {"summary.json", &summary}}) {
-        if (Status s = writeFileAtomic(out.file(file), j->dump(2) + "\n"); !s) return fail(s);
+        VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(file), j->dump(2) + "\n"));
     }
-    if (Status s = writeFileAtomic(out.file("classes.json"), classesJson().dump(2) + "\n"); !s) return fail(s);
-    if (Status s = out.commit(); !s) return fail(s);
-    if (a.stats || !a.quiet) {
-        std::printf("%s: %zu frames, %s, %dx%d -> %s\n", kCmd, idx.size(), a.mode.c_str(), base.width, base.height, out.outPath().c_str());
-        if (a.stats) {
-            auto p = [](const char* what, const std::vector<double>& v) {
-                if (!v.empty()) std::printf("  %-22s %8.2f ms (median)\n", what, median(v));
-            };
-            p("rgb (mode frame)", tm.rgb);
-            p("labels: raster pass", tm.labelRaster);
-            p("labels: far rays", tm.labelRays);
-            p("labels: total", tm.labels);
-            p("write rgb", tm.writeRgb);
-            p("write depth", tm.writeDepth);
-            p("write semantic", tm.writeSemantic);
-            p("write instance", tm.writeInstance);
-        }
-    }
+    VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file("classes.json"), classesJson().dump(2) + "\n"));
+    return out.commit();
+}
+
+void printResult(const RenderArgs& a, const RenderPlan& p, size_t frames, const Timings& tm, const RenderWorkDir& out) {
+    if (!a.stats && a.quiet) return;
+    std::printf("%s: %zu frames, %s, %dx%d -> %s\n", kCmd, frames, a.mode.c_str(), p.size.width, p.size.height, out.outPath().c_str());
+    if (!a.stats) return;
+    auto line = [](const char* what, const std::vector<double>& v) {
+        if (!v.empty()) std::printf("  %-22s %8.2f ms (median)\n", what, median(v));
+    };
+    line("rgb (mode frame)", tm.rgb);
+    line("labels: raster pass", tm.labelRaster);
+    line("labels: far rays", tm.labelRays);
+    line("labels: total", tm.labels);
+    line("write rgb", tm.writeRgb);
+    line("write depth", tm.writeDepth);
+    line("write semantic", tm.writeSemantic);
+    line("write instance", tm.writeInstance);
+}
+
+int fail(const Status& s) {
+    std::fprintf(stderr, "%s: %s\n", kCmd, s.message().c_str());
+    return 1;
+}
+
+// The command's steps: options, city and path, work directory (bad input
+// so far: exit 2), set-up, frames, metadata and commit (failures: exit 1).
+int run(const RenderArgs& a, const std::string& command) {
+    RenderPlan plan;
+    if (Status s = configure(a, plan); !s) return reportBadInput(kCmd, s);
+    RenderWorkDir out;
+    if (Status s = out.checkOut(a.out); !s) return reportBadInput(kCmd, s);
+    std::vector<size_t> idx;
+    auto walk = loadCityAndFrames(a, plan, idx);
+    if (!walk) return reportBadInput(kCmd, walk.status());
+    if (Status s = openWorkDir(a, plan, walk->path, idx, out); !s) return reportBadInput(kCmd, s);
+
+    RenderSession session;
+    if (Status s = setUp(a.mode, plan, walk->city, session); !s) return fail(s);
+    Progressed done = finishedFrames(out, plan.channels, idx.size());
+    nlohmann::json frames = nlohmann::json::array();
+    if (Status s = renderFrames(a, plan, *walk, idx, session, out, done, frames); !s) return fail(s);
+    Timings tm;  // every frame's, whichever run rendered it
+    for (const auto& r : done.records) tm.add(r);
+    if (Status s = writeMetadata(a, plan, command, walk->city, idx, frames, tm, done.kept, *session.renderer, out); !s)
+        return fail(s);
+    printResult(a, plan, idx.size(), tm, out);
     return 0;
 }
 

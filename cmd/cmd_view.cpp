@@ -38,8 +38,8 @@
 #include "nodes/far_field_node.h"
 #include "nodes/gl_readback.h"
 #include "nodes/render/offscreen.h"
+#include "nodes/render/walkthrough.h"
 #include "runtime/engine/ray_scene.h"
-#include "runtime/scene/city_file.h"
 #include "runtime/scene/scene_graph.h"
 
 namespace vista {
@@ -315,7 +315,7 @@ Result<Path> viewPath(const ViewArgs& a, const SceneModel& city, bool& playback)
     auto po = parsePathFlags(f);
     if (!po) return po.status();
     if (f.file.empty() && city.streets.edges.empty()) return Path();
-    auto p = walkthroughPath(f, po.value(), city);
+    auto p = walkthroughPath(f.file, po.value(), city);
     if (!p) return p;
     if (!playback && !p->samples.empty()) p->samples.resize(1);
     return p;
@@ -421,7 +421,8 @@ int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path,
 
 }  // namespace
 
-// The command's entry: parse, then the named steps (alike in shape to runBench's; kept).
+// The command's entry: parse, check the memory budget, load the walkthrough,
+// then open the window and run the frame loop.
 int runView(int argc, char** argv) {
     CLI::App app{"Interactive viewer: drive (1), walk (2), fly (3), orbit (4), path playback (5); s = stats, "
                  "m = render mode, p = screenshot, h = help.",
@@ -441,49 +442,45 @@ int runView(int argc, char** argv) {
                 return reportBadInput(kCmd, s);
     }
     bool playback = false;
-    Result<SceneModel> city = Status::error("no city");
-    Result<Path> path = Status::error("no path");
-    if (isPagedCityPath(a.city)) {
-        // A paged city: the walkthrough (or its start) first, then the regions near it.
-        auto paged = openPagedCity(a.city, a.path.file.empty());
-        if (!paged) return reportBadInput(kCmd, paged.status());
-        path = viewPath(a, paged->stub, playback);
-        if (!path) return reportBadInput(kCmd, path.status());
-        city = loadPagedNear(*paged, *path, a.paged, kCmd, false, nullptr, [&](uint64_t bytes) {
-            return checkMemoryBudget("--memory-budget", *budget, estimateCityRunMb(bytes, true), bytes, true);
-        });
-        if (!city) return reportBadInput(kCmd, city.status());
-    } else {
-        city = loadCityFile(a.city);
-        if (!city) return reportBadInput(kCmd, city.status());
-    }
+    WalkthroughRequest req;
+    req.city = a.city;
+    req.cmd = kCmd;
+    req.paged = a.paged;
+    req.pathNeedsStreets = a.path.file.empty();
+    req.makePath = [&](const SceneModel& city) -> Result<Path> {
+        auto p = viewPath(a, city, playback);
+        if (p && a.step && p->samples.empty()) return Status::error("--step: the path has no samples");
+        return p;
+    };
+    req.beforePagedLoad = [&](uint64_t bytes) {
+        return checkMemoryBudget("--memory-budget", *budget, estimateCityRunMb(bytes, true), bytes, true);
+    };
     // Every baked file given is checked against the city up front (modes are switched at run time).
-    if (Status st = loadPairedBakes(kCmd, a.city, sceneRoot(city.value()), {}, ctx.options); !st) return reportBadInput(kCmd, st);
-    if (!path) path = viewPath(a, city.value(), playback);
-    if (!path) return reportBadInput(kCmd, path.status());
-    if (a.step && path->samples.empty()) return reportBadInput(kCmd, Status::error("--step: the path has no samples"));
+    req.bakedModes = {};
+    req.effects = [&](const Effects& declared) { return runTimeEffects(a.effects, declared, false, kCmd); };
+    auto walk = loadWalkthrough(req, ctx.options);
+    if (!walk) return reportBadInput(kCmd, walk.status());
     const char* display = std::getenv("DISPLAY");
     if (!display || !*display) {
         std::fprintf(stderr, "%s: no X display (DISPLAY is not set); run under `xvfb-run -a` without a screen\n", kCmd);
         return 1;
     }
-    ctx.city = &city.value();
-    ctx.scene = sceneRoot(city.value());
-    auto fx = runTimeEffects(a.effects, city->params.effects, false, kCmd);
-    if (!fx) return reportBadInput(kCmd, fx.status());
-    ctx.options.effects = *fx;
+    const SceneModel& city = walk->city;
+    const Path& path = walk->path;
+    ctx.city = &city;
+    ctx.scene = sceneRoot(city);
     ViewModes modes(ctx);
     auto start = modes.get(a.mode);
     if (!start) return reportBadInput(kCmd, Status::error("--mode " + a.mode + ": " + start.status().message()));
     ViewState v;
-    if (Status s = setUpWindow(v, a, makeManipulators(path.value(), playback && !a.step, city.value())); !s) {
+    if (Status s = setUpWindow(v, a, makeManipulators(path, playback && !a.step, city)); !s) {
         std::fprintf(stderr, "%s: %s\n", kCmd, s.message().c_str());
         return 1;
     }
     v.keys->effects = &ctx.options.effects;
-    v.keys->declared = FrameEffects::fromScene(city->params.effects);
+    v.keys->declared = FrameEffects::fromScene(city.params.effects);
     showMode(v, modes, a.mode);
-    return runLoop(v, modes, a, path.value(), playback);
+    return runLoop(v, modes, a, path, playback);
 }
 
 }  // namespace vista

@@ -9,12 +9,6 @@
 #include <sstream>
 #include <unistd.h>
 
-#include <nlohmann/json.hpp>
-
-#include "foundation/timing.h"
-#include "nodes/baked_file.h"
-#include "runtime/scene/scene_model.h"
-
 namespace vista {
 
 namespace {
@@ -348,27 +342,6 @@ Status parseModeFlags(const ModeFlags& f, ModeOptions& o) {
     return checkModeOptions(o);
 }
 
-Status loadPairedBakes(const std::string& cmd, const std::string& cityPath, const osg::Node* cityRoot,
-                       const std::vector<std::string>& modes, ModeOptions& o) {
-    auto has = [&](const char* m) { return modes.empty() || std::find(modes.begin(), modes.end(), m) != modes.end(); };
-    std::vector<std::pair<const char*, std::string>> files;
-    if (!o.bakedFile.empty() && (has("impostor") || (has("lodmesh") && o.bakedMeshFile.empty())))
-        files.push_back({"--baked", o.bakedFile});
-    if (!o.bakedMeshFile.empty() && has("lodmesh")) files.push_back({"--baked-mesh", o.bakedMeshFile});
-    for (const auto& [flag, path] : files) {
-        if (o.loadedBakes.count(path)) continue;
-        Stopwatch sw;
-        auto bf = loadBakedFile(path);
-        if (!bf) return Status::error(std::string(flag) + ": " + bf.status().message());
-        const double ms = sw.ms();
-        std::string warning;
-        VISTA_RETURN_IF_ERROR(checkBakedFromCity(path, *bf, cityPath, cityRoot, &warning));
-        if (!warning.empty()) std::fprintf(stderr, "%s: warning: %s\n", cmd.c_str(), warning.c_str());
-        o.loadedBakes[path] = {bf->root, ms};
-    }
-    return Status::ok();
-}
-
 void addPathFlags(CLI::App& app, PathFlags& f, bool timing) {
     auto* path = app.add_option("--path", f.file, "walkthrough path CSV (from `vista path`)");
     app.add_option("--seed", f.seed, "make the path from this seed instead of --path (default " + std::to_string(f.seed) + ")")
@@ -391,11 +364,6 @@ Result<PathOptions> parsePathFlags(const PathFlags& f) {
     po.runUp = f.runUp;
     VISTA_RETURN_IF_ERROR(validatePathOptions(po));
     return po;
-}
-
-Result<Path> walkthroughPath(const PathFlags& f, const PathOptions& po, const SceneModel& city) {
-    if (!f.file.empty()) return loadPathCsv(f.file);
-    return generatePath(city.streets, city.params, po);
 }
 
 Result<Effects> parseEffectsOption(const std::string& s, const Effects& base) {
@@ -466,55 +434,6 @@ void addPagedFlags(CLI::App& app, PagedReach& reach) {
 Status validatePagedReach(const PagedReach& reach) {
     VISTA_RETURN_IF_ERROR(validatePagedRadius("--paged-radius", reach.radius));
     return validatePagedRadius("--paged-far", reach.far);
-}
-
-Result<PagedOpen> openPagedCity(const std::string& dir, bool needStreets) {
-    auto m = readPagedManifest(dir);
-    if (!m) return m.status();
-    PagedOpen out;
-    out.stub.params = m->params;
-    if (needStreets) {
-        auto g = pagedPathStreets(*m);
-        if (!g) return g.status();
-        out.stub.streets = std::move(*g);
-    }
-    out.manifest = std::move(*m);
-    return out;
-}
-
-Result<SceneModel> loadPagedNear(const PagedOpen& city, const Path& path, const PagedReach& reach, const char* cmd, bool quiet,
-                                 std::string* pagedJson, const std::function<Status(uint64_t bytes)>& beforeLoad) {
-    std::vector<glm::dvec2> points;
-    for (const PathSample& s : path.samples) points.emplace_back(s.position.x, s.position.y);
-    if (points.empty()) points.emplace_back(city.manifest.params.origin_x, city.manifest.params.origin_y);
-    const double radius = reach.radius;
-    const std::vector<int> regions = selectPagedRegions(city.manifest, points, radius);
-    const std::vector<int> coarse = reach.far > radius ? selectCoarseRegions(city.manifest, points, reach.far, regions) : std::vector<int>{};
-    if (beforeLoad) {
-        uint64_t bytes = 0;
-        for (int r : regions) bytes += city.manifest.regions[size_t(r)].bytes;
-        for (int r : coarse) bytes += city.manifest.regions[size_t(r)].coarseBytes;
-        VISTA_RETURN_IF_ERROR(beforeLoad(bytes));
-    }
-    PagedLoadReport rep;
-    auto model = loadPagedCity(city.manifest, regions, radius, &rep, coarse);
-    if (!model) return model.status();
-    if (!quiet)
-        std::fprintf(stderr,
-                     "%s: paged city: loaded %d of %d regions within %g m of the walkthrough and %d more at their coarse level "
-                     "(%.1f MB of region files, %zu triangles)\n",
-                     cmd, rep.regionsLoaded, rep.regionsTotal, radius, rep.coarseLoaded, double(rep.bytesLoaded) / 1e6,
-                     model->triangles);
-    for (const std::string& d : rep.damaged)
-        std::fprintf(stderr, "%s: warning: %s; the rest of the city is loaded\n", cmd, d.c_str());
-    if (pagedJson) {
-        nlohmann::json j = {{"regions_loaded", rep.regionsLoaded}, {"regions_total", rep.regionsTotal},
-                            {"radius_m", radius}, {"bytes_loaded", rep.bytesLoaded},
-                            {"coarse_regions_loaded", rep.coarseLoaded}, {"far_m", reach.far},
-                            {"coarse_bytes_loaded", rep.coarseBytes}, {"damaged", rep.damaged}};
-        *pagedJson = j.dump();
-    }
-    return model;
 }
 
 }  // namespace vista

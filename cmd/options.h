@@ -12,7 +12,6 @@
 // ModeOptions by parseModeFlags().
 #pragma once
 #include <cstdint>
-#include <functional>
 #include <string>
 #include <vector>
 
@@ -21,7 +20,7 @@
 #include "citygen/effects.h"
 #include "foundation/status.h"
 #include "nodes/render/render_mode.h"
-#include "runtime/scene/paged_load.h"
+#include "runtime/scene/paged_walkthrough.h"
 #include "runtime/scene/paths.h"
 
 namespace vista {
@@ -104,16 +103,6 @@ void addModeFlags(CLI::App& app, ModeFlags& flags);
 // Parses and range-checks the flags into `out`.
 Status parseModeFlags(const ModeFlags& flags, ModeOptions& out);
 
-// Loads the baked files (--baked, --baked-mesh) that `modes` draw (every
-// given one when `modes` is empty: the viewer switches modes at run time),
-// checks each against the city opened as cityPath with root cityRoot
-// (checkBakedFromCity) and keeps them in out.loadedBakes, so the modes do not
-// load them again. Errors (unreadable, truncated, corrupt, not a baked file,
-// baked from another city) name the files: the command exits 2. A file
-// without a source city hash (an older bake) is a warning on stderr
-// ("CMD: warning: ..."), not an error.
-Status loadPairedBakes(const std::string& cmd, const std::string& cityPath, const osg::Node* cityRoot,
-                       const std::vector<std::string>& modes, ModeOptions& out);
 // Range checks of ModeOptions (for options set in code).
 Status checkModeOptions(const ModeOptions& o);
 
@@ -126,42 +115,15 @@ struct PathFlags {
 void addPathFlags(CLI::App& app, PathFlags& flags, bool timing);
 // The path options of the flags (kind and ranges checked; messages name the flag).
 Result<PathOptions> parsePathFlags(const PathFlags& flags);
-// The walkthrough: the CSV of --path if given, else a path generated on the
-// city's streets with `options`.
-Result<Path> walkthroughPath(const PathFlags& flags, const PathOptions& options, const SceneModel& city);
 
-// How much of a paged city a walkthrough loads (bench, view): --paged-radius M
-// = metres around the walkthrough within which regions are loaded at full
-// detail (default kDefaultPagedRadiusM); --paged-far M = metres within which
-// the other regions are loaded at their coarse level, for the far field
-// (default kDefaultPagedFarM = the whole city; 0 or <= radius: none).
-struct PagedReach {
-    double radius = kDefaultPagedRadiusM;
-    double far = kDefaultPagedFarM;
-};
+// The paged-city reach (PagedReach, paged_walkthrough.h) of bench and view:
+// --paged-radius M = metres around the walkthrough within which regions are
+// loaded at full detail (default kDefaultPagedRadiusM); --paged-far M =
+// metres within which the other regions are loaded at their coarse level,
+// for the far field (default kDefaultPagedFarM = the whole city; 0 or <=
+// radius: none).
 void addPagedFlags(CLI::App& app, PagedReach& reach);
 // Both values within [kMinPagedRadiusM, kMaxPagedRadiusM]; errors name the option.
 Status validatePagedReach(const PagedReach& reach);
-
-// A paged city opened for a walkthrough: `stub` has the params and, unless
-// the walkthrough comes from a CSV (`needStreets` false), the streets a
-// seeded path runs on (pagedPathStreets), so that walkthroughPath() can make
-// the path before any region is loaded.
-struct PagedOpen {
-    PagedManifest manifest;
-    SceneModel stub;
-};
-Result<PagedOpen> openPagedCity(const std::string& dir, bool needStreets);
-// Loads the regions within `reach.radius` metres of the path's samples at
-// full detail and the others within `reach.far` at their coarse level, and
-// merges them; prints a note naming the counts on stderr unless quiet;
-// `pagedJson` (if not null) receives the summary.json block {regions_loaded,
-// regions_total, radius_m, bytes_loaded, coarse_regions_loaded, far_m,
-// coarse_bytes_loaded}. `beforeLoad` (if set) is called with the selected
-// files' bytes before any is read (the --memory-budget check); its error
-// stops the load.
-Result<SceneModel> loadPagedNear(const PagedOpen& city, const Path& path, const PagedReach& reach, const char* cmd, bool quiet,
-                                 std::string* pagedJson = nullptr,
-                                 const std::function<Status(uint64_t bytes)>& beforeLoad = nullptr);
 
 }  // namespace vista

@@ -31,35 +31,16 @@
 #include "runtime/engine/horizon.h"
 #include "nodes/near_far_split.h"
 #include "nodes/near_field_chunks.h"
+#include "nodes/readback_drawable.h"
 
 namespace vista {
 
 class RayScene;
 struct SceneModel;
 
-// Makes drawables under `ss` draw with the fixed-function pipeline whatever
-// program the graph above sets (images drawn with glDrawPixels are final).
-void useFixedFunction(osg::StateSet& ss);
-// The vista::Camera of an OSG camera's view and projection matrices (world
-// frame, x east, y north, z up) for a width x height viewport. zFar = the
-// projection's far plane (0 = infinite). False for a non-perspective
-// projection or a non-finite eye.
-bool cameraFromOsg(const osg::Matrixd& view, const osg::Matrixd& proj, int width, int height, Camera& camera,
-                   double& zFar);
-// The vista::Camera and the viewport of the camera being drawn (for a
-// drawable's drawImplementation). False without a camera, a viewport of at
-// least 1x1 or a perspective projection.
-bool currentView(osg::RenderInfo& ri, Camera& camera, const osg::Viewport*& viewport, double& zFar);
-// Draws `image` (row 0 at top, the viewport's size) into the current frame
-// buffer over `vp`, leaving pixels with mask[i] == 0 untouched (mask null:
-// every pixel drawn). Fixed-function GL (glDrawPixels, alpha test), state
-// saved and restored; `scratch` is reused between calls. GL thread only.
-void drawImageOverViewport(const osg::Viewport& vp, const Image& image, const std::vector<uint8_t>* mask,
-                           std::vector<uint8_t>& scratch);
-
 constexpr int kFarFieldRenderBin = 10000;
 
-class FarFieldNode : public osg::Drawable {
+class FarFieldNode : public ReadbackDrawable {
 public:
     FarFieldNode(const RayScene& rays, const HeightGrid* grid, const FarFieldOptions& options);
     // Not copyable through CopyOp (owns per-context state); clone returns a fresh node.
@@ -74,19 +55,19 @@ public:
     void setSplit(NearFarSplit* split) { _split = split; }
     void setOptions(const FarFieldOptions& o);
     FarFieldOptions options() const;
-    // Statistics of the last drawn frame (copy; thread-safe).
-    FrameStats lastStats() const;
 
     // Called at cull time (a cull callback set here): starts the far field's
     // horizon and speculative rays for the camera the draw will see
     // (FarField::beginFrame), so that they overlap the near field's draw. The
     // draw takes them only when its camera is exactly that one.
     void beginFrame(const osg::Camera& camera) const;
-    void drawImplementation(osg::RenderInfo& renderInfo) const override;
-    osg::BoundingBox computeBoundingBox() const override;
 
 protected:
     ~FarFieldNode() override;
+    // Reads the depth (and, for hazeCovered, the colours), runs FarField and
+    // draws the far-field pixels.
+    void drawFrame(osg::RenderInfo& renderInfo, const Camera& camera, const osg::Viewport& viewport,
+                   double zFar) const override;
 
 private:
     FarFieldOptions frameOptions(double zFar) const;  // _options with the split's near distance; _mutex held
@@ -97,10 +78,6 @@ private:
     mutable std::unique_ptr<FarField> _far;
     mutable std::vector<float> _depth;
     mutable std::vector<uint32_t> _depthBits, _colorBits;  // scratch of the reads (gl_readback.h)
-    mutable Image _image;
-    mutable std::vector<uint8_t> _upload;
-    mutable FrameStats _stats;
-    mutable std::mutex _mutex;
 };
 
 // The hybrid renderer as one graph (the viewer face of the `hybrid` mode and

@@ -1,4 +1,4 @@
-// Version string of the node library (the node types arrive with issues 4 and 5).
+// Version string of the node library (the far-field and bake node types).
 namespace vista {
 const char* nodesVersion() { return "1"; }
 }  // namespace vista

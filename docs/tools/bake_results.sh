@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates the measurements of docs/results.md, "Issue 5: bake": Table 5.1
+# Regenerates the measurements of docs/measurements/bake.md "Table 5.1": Table 5.1
 # for three impostors, accuracy against cost for the bake options, the
 # antialiasing comparison and (with --whole) the whole-city bake, its
 # placement trade-off and a `vista bench --modes full,impostor` run on it.
@@ -7,13 +7,13 @@
 # are reused when the script is run again (delete them to re-measure).
 #
 # usage: docs/tools/bake_results.sh [BUILD_DIR] [OUT_DIR] [--whole]
-#   BUILD_DIR defaults to build, OUT_DIR to ./results-issue5.
+#   BUILD_DIR defaults to build, OUT_DIR to ./results-bake.
 # Needs jq and an X display; without one it re-runs itself under `xvfb-run -a`.
 # About 15 minutes on 2 cores with llvmpipe; --whole adds about an hour and
 # about 6 GB of disk.
 set -euo pipefail
 BUILD=$(realpath "${1:-build}")
-OUT=${2:-results-issue5}
+OUT=${2:-results-bake}
 WHOLE=${3:-}
 VISTA=$BUILD/vista
 REPORT=$BUILD/vista_bake_report

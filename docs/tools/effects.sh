@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates docs/effects.md: what each declared effect (sun_shadows, ambient_occlusion,
+# Regenerates docs/measurements/effects.md: what each declared effect (sun_shadows, ambient_occlusion,
 # haze, glass, night, materials) costs at generation and per frame, how its quality knobs
 # trade time for PSNR (with one Pareto plot per effect in docs/img/effects_pareto_*.svg),
 # the haze payoff on a 2 km, a 4 km and an 8 km city, reflection rays vs glass in view, and raster
@@ -11,13 +11,13 @@
 #   VISTA_BIN the vista binary (default build/vista); image_psnr is taken from
 #             <dir of VISTA_BIN>/tests/bench/image_psnr (override with IMAGE_PSNR=...).
 # Needs python3 and, without a display, xvfb-run. About 20 minutes on 2 cores with llvmpipe.
-# docs/effects.md is replaced only when every step succeeded (written to a temp file, then moved).
+# docs/measurements/effects.md is replaced only when every step succeeded (written to a temp file, then moved).
 set -euo pipefail
 
 INVOCATION="docs/tools/effects.sh${1:+ $1}${2:+ $2}"
 source "$(dirname "$0")/lib.sh"
 doc_setup effects.sh effects 1280x1024x24 "$@"
-DOC_TMP_FILES=(docs/.effects.md.tmp)
+DOC_TMP_FILES=(docs/measurements/.effects.md.tmp)
 IMAGE_PSNR=${IMAGE_PSNR:-$(dirname "$VISTA")/tests/bench/image_psnr}
 
 [ -x "$IMAGE_PSNR" ] || die "image_psnr not found: $IMAGE_PSNR"
@@ -146,6 +146,6 @@ cp "$OUT/bench/night/images/first_full.png" "$OUT/img/effect_night.png"
 for f in "$OUT"/img/*; do [ -s "$f" ] || die "empty output $f"; done
 mkdir -p docs/img
 cp "$OUT"/img/* docs/img/
-cp "$OUT/effects.md" docs/.effects.md.tmp
-mv docs/.effects.md.tmp docs/effects.md
-log "wrote docs/effects.md and docs/img/effect*.{png,svg} in $(( (SECONDS - START) / 60 )) min $(( (SECONDS - START) % 60 )) s"
+cp "$OUT/effects.md" docs/measurements/.effects.md.tmp
+mv docs/measurements/.effects.md.tmp docs/measurements/effects.md
+log "wrote docs/measurements/effects.md and docs/img/effect*.{png,svg} in $(( (SECONDS - START) / 60 )) min $(( (SECONDS - START) % 60 )) s"

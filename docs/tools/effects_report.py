@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes docs/effects.md (Markdown) and the Pareto SVGs from the measurements of
+"""Writes docs/measurements/effects.md (Markdown) and the Pareto SVGs from the measurements of
 docs/tools/effects.sh. Standard library only; PSNR of saved frames via image_psnr.
 
 usage: effects_report.py --out OUT_DIR --psnr IMAGE_PSNR --md FILE.md --img IMG_DIR
@@ -325,9 +325,9 @@ w("**Timing noise.** " + ("The machine was busy with other work during this run 
 w("")
 w("| | |")
 w("|---|---|")
-w("| ![sun shadows](img/effect_shadows.png) | ![haze](img/effect_haze.png) |")
+w("| ![sun shadows](../img/effect_shadows.png) | ![haze](../img/effect_haze.png) |")
 w("| `sun_shadows`, fly-over | `haze` 1500 m, fly-over |")
-w("| ![glass](img/effect_glass.png) | ![night](img/effect_night.png) |")
+w("| ![glass](../img/effect_glass.png) | ![night](../img/effect_night.png) |")
 w("| `glass`, car | `night`, car |")
 w("")
 w("The first `full` frame of the seed 3 path, 640x480, 2 km city.")
@@ -470,7 +470,7 @@ for e, k in KNOBS.items():
               f"| {db(pf)} ({db(pfmin)}) | {db(ph)} | {load_of(run):.1f} |")
     front = pareto_svg(os.path.join(A.img, svg), k["title"], pts)
     w("")
-    w(f"![{e}: PSNR vs frame time](img/{svg})")
+    w(f"![{e}: PSNR vs frame time](../img/{svg})")
     w("")
     w("Pareto front: " + ", ".join(f"{p['series']} {p['label']}" for p in front) +
       ". Frame-time gaps smaller than the noise band above do not order the points.")

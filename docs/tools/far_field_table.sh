@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates the far-field table of docs/results.md (issue 15): path kinds
+# Regenerates the far-field table of docs/measurements/far-field.md: path kinds
 # (car, walk, fly) x image sizes x city sizes, hybrid against full, raycast
 # and near (same chunking), PSNR against full, rays per frame, stage times;
 # and the cache's Pareto front (PSNR against full vs rays per frame as
@@ -7,9 +7,9 @@
 # plotted to docs/img/cache_pareto.svg, with a lattice-ray point (--far-step 2
 # at the default cache bound) beside it. The block between the markers
 # <!-- far-field-table:begin --> and <!-- far-field-table:end --> of
-# docs/results.md is replaced only when every step succeeded. MARKER=name
+# docs/measurements/far-field.md is replaced only when every step succeeded. MARKER=name
 # writes the block <!-- name:begin/end --> and docs/img/name_pareto.svg
-# instead (a second, smaller table beside the first, e.g. after a change).
+# instead (a second, smaller table beside the first).
 #
 # usage: docs/tools/far_field_table.sh [OUT_DIR] [VISTA_BIN]
 #   env: CITY_SIZES (metres, default "2000 8000" = 4 and 64 km2), KINDS (default "car walk fly"),
@@ -23,7 +23,7 @@ source "$(dirname "$0")/lib.sh"
 doc_setup far_field_table.sh fftable 1920x1080x24 "$@"
 MARKER=${MARKER:-far-field-table}
 SVG=$([ "$MARKER" = far-field-table ] && echo cache_pareto.svg || echo "${MARKER}_pareto.svg")
-DOC_TMP_FILES=(docs/.results.md.tmp "docs/img/.$SVG.tmp")
+DOC_TMP_FILES=(docs/measurements/.far-field.md.tmp "docs/img/.$SVG.tmp")
 CITY_SIZES=${CITY_SIZES:-"2000 8000"}
 KINDS=${KINDS:-"car walk fly"}
 IMAGES=${IMAGES:-"320x240 640x480 1280x720"}
@@ -73,7 +73,7 @@ for c in $CITY_SIZES; do
 done
 
 log "report"
-python3 - "$OUT" "$REPO/docs/results.md" "$REPO/docs/.results.md.tmp" "$REPO/docs/img/.$SVG.tmp" \
+python3 - "$OUT" "$REPO/docs/measurements/far-field.md" "$REPO/docs/measurements/.far-field.md.tmp" "$REPO/docs/img/.$SVG.tmp" \
   "$INVOCATION" "$CITY_SIZES" "$KINDS" "$IMAGES" "$BOUNDS" "$PARETO_CITY" "$PARETO_IMAGE" "$MARKER" "$SVG" <<'PY'
 import json, os, sys
 out, results, tmp, svgtmp, invocation, cities, kinds, images, bounds, pcity, pimage, marker, svgname = sys.argv[1:]
@@ -117,7 +117,7 @@ lines.append(f"Cache Pareto front ({pimage}, {int(pcity)/1000:g} km city, `--nea
              "against `full` vs far-field rays per frame as `--cache-error` varies (with `--cache-always`: the policy itself, "
              "looked up in every frame); `off` = `--no-cache` (every far pixel traced); `default` = the default cache, "
              "paused while its measured reuse does not pay for its lookups; "
-             f"`--far-step 2` = lattice rays (docs/far-field.md) at the default cache bound. Plot: docs/img/{svgname}.")
+             f"`--far-step 2` = lattice rays ([far-field reference](../reference/far-field.md)) at the default cache bound. Plot: [{svgname}](../img/{svgname}).")
 lines.append("")
 lines.append("| path | setting | rays/frame | PSNR med / min (dB) | hybrid ms | vs raycast | cache % | interpolated % |")
 lines.append("|---|---|---:|---:|---:|---:|---:|---:|")
@@ -149,7 +149,7 @@ block = "\n".join(lines)
 text = open(results).read()
 b0, b1 = text.find(f"<!-- {marker}:begin -->"), text.find(f"<!-- {marker}:end -->")
 if b0 < 0 or b1 < 0:
-    sys.exit(f"docs/results.md has no {marker} markers")
+    sys.exit(f"docs/measurements/far-field.md has no {marker} markers")
 text = text[:b0] + block + text[b1 + len(f"<!-- {marker}:end -->"):]
 open(tmp, "w").write(text)
 # SVG: one polyline per path kind.
@@ -186,5 +186,5 @@ svg.append("</svg>")
 open(svgtmp, "w").write("\n".join(svg))
 PY
 mv "$REPO/docs/img/.$SVG.tmp" "$REPO/docs/img/$SVG"
-mv "$REPO/docs/.results.md.tmp" "$REPO/docs/results.md"
-log "docs/results.md ($MARKER) and docs/img/$SVG written ($OUT/commands.log has every command)"
+mv "$REPO/docs/measurements/.far-field.md.tmp" "$REPO/docs/measurements/far-field.md"
+log "docs/measurements/far-field.md ($MARKER) and docs/img/$SVG written ($OUT/commands.log has every command)"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates the measured block of docs/farfield-compare.md (issue 11, item 4):
+# Regenerates the measured block of docs/measurements/farfield-compare.md:
 # the far-field representations side by side on one city, the same view
 # cells and the same walkthrough paths — full (all geometry, frustum-culled
 # 40 m chunks), osglod (stock osg::LOD + osgUtil::Simplifier, the best
@@ -40,7 +40,7 @@
 set -euo pipefail
 source "$(dirname "$0")/lib.sh"
 doc_setup farfield_compare.sh fcompare 1280x1024x24 "${1:-farfield-compare-out}" "${2:-build/vista}"
-DOC_TMP_FILES=(docs/.farfield-compare.md.tmp)
+DOC_TMP_FILES=(docs/measurements/.farfield-compare.md.tmp)
 PARAMS=${PARAMS:-data/town.json}
 KINDS=${KINDS:-"car walk"}
 SEED=${SEED:-1}
@@ -125,7 +125,7 @@ first=${KINDS%% *}
 for m in ${MODES//,/ }; do bench "mem_$m" "$first" "$m" 4; done
 
 log "report"
-python3 - "$OUT" "$REPO/docs/farfield-compare.md" "$REPO/docs/.farfield-compare.md.tmp" "$INVOCATION" "$KINDS" "$MODES" "$SSAA" \
+python3 - "$OUT" "$REPO/docs/measurements/farfield-compare.md" "$REPO/docs/measurements/.farfield-compare.md.tmp" "$INVOCATION" "$KINDS" "$MODES" "$SSAA" \
   "$PARAMS" <<'PY'
 import json, os, re, statistics, sys
 out, doc, tmp, invocation, kinds, modes, ssaa, params = sys.argv[1:]
@@ -299,9 +299,9 @@ L.append("<!-- farfield-compare:end -->")
 block = "\n".join(L)
 text = open(doc).read() if os.path.exists(doc) else "# Far-field representations side by side\n\n<!-- farfield-compare:begin -->\n<!-- farfield-compare:end -->\n"
 b0, b1 = text.find("<!-- farfield-compare:begin -->"), text.find("<!-- farfield-compare:end -->")
-if b0 < 0 or b1 < 0: sys.exit("docs/farfield-compare.md has no farfield-compare markers")
+if b0 < 0 or b1 < 0: sys.exit("docs/measurements/farfield-compare.md has no farfield-compare markers")
 text = text[:b0] + block + text[b1 + len("<!-- farfield-compare:end -->"):]
 open(tmp, "w").write(text)
 PY
-mv "$REPO/docs/.farfield-compare.md.tmp" "$REPO/docs/farfield-compare.md"
-log "docs/farfield-compare.md written ($OUT/commands.log has every command)"
+mv "$REPO/docs/measurements/.farfield-compare.md.tmp" "$REPO/docs/measurements/farfield-compare.md"
+log "docs/measurements/farfield-compare.md written ($OUT/commands.log has every command)"

@@ -43,22 +43,22 @@ doc_setup() {
 
 # doc_replace_block DOC MARKER TABLE: replaces the block between
 # <!-- MARKER:begin --> and <!-- MARKER:end --> of DOC (a path relative to the
-# repository) with "Run of DATE (load average ...)" and TABLE's text, through
-# docs/.NAME.tmp (list it in DOC_TMP_FILES) and a rename, so a failure leaves
+# repository) with "Load average at the end of the run: ..." and TABLE's text,
+# through DOC's directory/.NAME.tmp (list it in DOC_TMP_FILES) and a rename, so a failure leaves
 # DOC as it was.
 doc_replace_block() {
   local doc=$1 marker=$2 table=$3
   local tmp
   tmp="$(dirname "$doc")/.$(basename "$doc").tmp"
   grep -q "<!-- $marker:begin -->" "$doc" || die "$doc has no <!-- $marker:begin --> marker"
-  python3 - "$doc" "$marker" "$table" "$(date -u +%Y-%m-%d)" "$(cut -d' ' -f1-3 /proc/loadavg)" > "$tmp" <<'PYEOF'
+  python3 - "$doc" "$marker" "$table" "$(cut -d' ' -f1-3 /proc/loadavg)" > "$tmp" <<'PYEOF'
 import sys
-doc, marker, table, day, load = sys.argv[1:6]
+doc, marker, table, load = sys.argv[1:5]
 text = open(doc).read()
 begin, end = f"<!-- {marker}:begin -->", f"<!-- {marker}:end -->"
 head, rest = text.split(begin, 1)
 _, tail = rest.split(end, 1)
-body = f"Run of {day} (load average at the end: {load}).\n\n" + open(table).read()
+body = f"Load average at the end of the run: {load}.\n\n" + open(table).read()
 print(head + begin + "\n" + body + end + tail, end="")
 PYEOF
   mv "$tmp" "$doc"

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# Regenerates the counts table of docs/formats.md "OpenDRIVE": the default city
-# (data/default.json) and two OSM imports (tests/data/osm/hard_cases.osm and the
-# synthetic town tests/data/osm/town.osm with its building footprints) are
-# written with --xodr, read by SUMO netconvert, and their roads, junctions and
-# lanes counted on both sides; the independent checker tests/tools/xodr_check.py
+# Regenerates the two tables of docs/formats.md "OpenDRIVE": the default city
+# (data/default.json), a hilly city (tests/data/xodr_hilly.json) and three OSM
+# imports (tests/data/osm/town.osm with its building footprints, hard_cases.osm
+# and lanes.osm with lane, one-way and speed tags) are written with --xodr,
+# read by SUMO netconvert, and their roads, junctions, lanes and traffic lights
+# counted on both sides; the independent checker tests/tools/xodr_check.py
 # adds its continuity columns (linked lane borders more than 1 cm apart in plan
 # or 2 cm in height, the worst plan gap, heading kinks over 0.5 degrees, lane
 # borders folding over their centre of curvature, driving lanes without a
@@ -41,48 +42,64 @@ check() {  # NAME: runs the checker (exit 1 = some check fails, which the table 
   fi
 }
 
-row() {  # NAME XODR NETLOG NET CHECK_JSON SCHEMA_COUNT
-  python3 - "$@" <<'PY'
+row() {  # NAME KEY: one row of each table (written to KEY.counts / KEY.checks)
+  python3 - "$1" "$OUT/$2" <<'PY2'
 import json, re, sys, xml.etree.ElementTree as ET
-name, xodr, log, net, check, schema = sys.argv[1:7]
-x = ET.parse(xodr).getroot()
-roads = [r for r in x.findall("road") if r.get("junction") == "-1"]
+name, base = sys.argv[1:3]
+x = ET.parse(base + ".xodr").getroot()
+street = [r for r in x.findall("road") if r.get("junction") == "-1" and not r.get("name", "").startswith("transition")]
+trans = [r for r in x.findall("road") if r.get("junction") == "-1" and r.get("name", "").startswith("transition")]
 conn = [r for r in x.findall("road") if r.get("junction") != "-1"]
 junctions = x.findall("junction")
-lanes = sum(len([l for l in r.iter("lane") if l.get("type") == "driving"]) for r in roads)
-walks = sum(len([l for l in r.iter("lane") if l.get("type") == "sidewalk"]) for r in roads)
-n = ET.parse(net).getroot()
+lanes = sum(len([l for l in r.iter("lane") if l.get("type") == "driving"]) for r in street)
+walks = sum(len([l for l in r.iter("lane") if l.get("type") == "sidewalk"]) for r in street)
+signals = [s for r in x.findall("road") for s in r.iter("signal")]
+lights = [s for s in signals if s.get("dynamic") == "yes"]
+lit = {j.get("id") for j in junctions if j.find("controller") is not None}
+n = ET.parse(base + ".net.xml").getroot()
 nj = [j for j in n.findall("junction") if j.get("type") != "internal" and re.fullmatch(r"\d+", j.get("id"))]
 ne = [e for e in n.findall("edge") if e.get("function") != "internal"]
 nl = sum(len(e.findall("lane")) for e in ne)
-text = open(log).read()
+text = open(base + ".log").read()
 errors = len(re.findall(r"^Error", text, re.M))
 warnings = len(re.findall(r"^Warning", text, re.M))
-c = json.load(open(check))
+c = json.load(open(base + ".check.json"))
 k = c["checks"]
+schema = open(base + ".schema.count").read().strip()
+with open(base + ".counts", "w") as f:
+    f.write(f"| {name} | {len(street)} | {len(trans)} | {len(junctions)} | {len(conn)} | {lanes} | {walks} "
+            f"| {len(lights)} at {len(lit)} | {len(signals) - len(lights)} | {c['counts']['objects']} "
+            f"| {len(nj)} | {len(ne)} | {nl} | {len(n.findall('tlLogic'))} | {errors} | {warnings} |\n")
 worst = k["gaps"]["worst"] or 0.0
-print(f"| {name} | {len(roads)} | {len(junctions)} | {len(conn)} | {lanes} | {walks} | {len(nj)} | {len(ne)} | {nl} "
-      f"| {errors} | {warnings} | {open(schema).read().strip()} | {k['gaps']['failures']} | {worst:.3f} m "
-      f"| {k['kinks']['failures']} | {k['folds']['failures']} | {k['unlinked']['failures']} "
-      f"| {c['counts']['signals']} | {c['counts']['objects']} |")
-PY
+with open(base + ".checks", "w") as f:
+    f.write(f"| {name} | {schema} | {k['gaps']['failures']} of {k['gaps']['checked']} | {worst * 1000:.1f} mm "
+            f"| {k['kinks']['failures']} of {k['kinks']['checked']} | {k['folds']['failures']} "
+            f"| {k['unlinked']['failures']} of {k['unlinked']['checked']} | {k['references']['failures']} |\n")
+PY2
 }
 
-log "default city"
-"$VISTA" gen --params data/default.json -q -o "$OUT/default.osgb" --xodr "$OUT/default.xodr"
-netconvert --opendrive-files "$OUT/default.xodr" -o "$OUT/default.net.xml" >"$OUT/default.log" 2>&1
-check default
-log "OSM import"
-"$VISTA" gen --osm tests/data/osm/hard_cases.osm -q -o "$OUT/osm.osgb" --xodr "$OUT/osm.xodr"
-netconvert --opendrive-files "$OUT/osm.xodr" -o "$OUT/osm.net.xml" >"$OUT/osm.log" 2>&1
-check osm
-log "OSM town"
-"$VISTA" gen --osm tests/data/osm/town.osm -q -o "$OUT/town.osgb" --xodr "$OUT/town.xodr"
-netconvert --opendrive-files "$OUT/town.xodr" -o "$OUT/town.net.xml" >"$OUT/town.log" 2>&1
-check town
-echo "| city | roads | junctions | connecting roads | driving lanes | sidewalk lanes | netconvert junctions | netconvert edges | netconvert lanes | netconvert errors | netconvert warnings | schema errors | gaps > 1 cm | worst gap | kinks | folds | unlinked lanes | signals | objects |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
-row "default (\`data/default.json\`)" "$OUT/default.xodr" "$OUT/default.log" "$OUT/default.net.xml" "$OUT/default.check.json" "$OUT/default.schema.count"
-row "OSM import (\`tests/data/osm/hard_cases.osm\`)" "$OUT/osm.xodr" "$OUT/osm.log" "$OUT/osm.net.xml" "$OUT/osm.check.json" "$OUT/osm.schema.count"
-row "OSM town (\`tests/data/osm/town.osm\`, streets + buildings)" "$OUT/town.xodr" "$OUT/town.log" "$OUT/town.net.xml" "$OUT/town.check.json" "$OUT/town.schema.count"
+city() {  # KEY LABEL GEN_ARGS...
+  local key=$1 label=$2
+  shift 2
+  log "$label"
+  rm -f "$OUT/$key.osgb" "$OUT/$key.xodr"
+  "$VISTA" gen "$@" -q -o "$OUT/$key.osgb" --xodr "$OUT/$key.xodr"
+  netconvert --opendrive-files "$OUT/$key.xodr" -o "$OUT/$key.net.xml" >"$OUT/$key.log" 2>&1
+  check "$key"
+  row "$label" "$key"
+}
+
+city default "default (\`data/default.json\`)" --params data/default.json
+city hilly "hilly (\`tests/data/xodr_hilly.json\`, 25 m hills)" --params tests/data/xodr_hilly.json
+city town "OSM town (\`tests/data/osm/town.osm\`)" --osm tests/data/osm/town.osm
+city osm "OSM hard cases (\`tests/data/osm/hard_cases.osm\`)" --osm tests/data/osm/hard_cases.osm
+city lanes "OSM lane tags (\`tests/data/osm/lanes.osm\`)" --osm tests/data/osm/lanes.osm
+KEYS="default hilly town osm lanes"
+echo "| city | roads | transitions | junctions | connecting roads | driving lanes | sidewalk lanes | traffic lights (at junctions) | signs | crosswalks | netconvert junctions | netconvert edges | netconvert lanes | netconvert traffic lights | netconvert errors | netconvert warnings |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+for k in $KEYS; do cat "$OUT/$k.counts"; done
+echo
+echo "| city | schema errors | linked lane borders > 1 cm apart | worst gap | heading kinks > 0.5 deg | folding borders | driving lanes without successor | broken references |"
+echo "|---|---|---|---|---|---|---|---|"
+for k in $KEYS; do cat "$OUT/$k.checks"; done
 log "done"

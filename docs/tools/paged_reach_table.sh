@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Regenerates docs/performance.md "What the coarse far city costs in accuracy"
-# (issue 14 item 3): the same walkthrough of one paged city with the full
+# Regenerates docs/measurements/paging.md "What the coarse far city costs in
+# accuracy": the same walkthrough of one paged city with the full
 # detail loaded out to a growing --paged-radius and the coarse level beyond
 # (detail 0, trees as impostors; the ray-cast far field sees it), against a
 # reference run with every region at full detail. PSNR: each run's `hybrid`
@@ -8,7 +8,7 @@
 # (image_psnr, luma), so it holds both the far field's own error and what the
 # coarse city costs; ms: the run's own hybrid median; memory: GNU time's peak
 # of the bench. The block between <!-- paged-reach:begin --> and
-# <!-- paged-reach:end --> of docs/performance.md is replaced only when every
+# <!-- paged-reach:end --> of docs/measurements/paging.md is replaced only when every
 # step succeeded.
 #
 # usage: docs/tools/paged_reach_table.sh CITY.paged [OUT_DIR] [BUILD_DIR]
@@ -24,7 +24,7 @@ shift
 BUILD=$(realpath -m "${2:-build}")
 source "$(dirname "$0")/lib.sh"
 doc_setup paged_reach_table.sh reach 1280x1024x24 "${1:-}" "$BUILD/vista"
-DOC_TMP_FILES=(docs/.performance.md.tmp)
+DOC_TMP_FILES=(docs/measurements/.paging.md.tmp)
 IMAGE_PSNR=$BUILD/tests/bench/image_psnr
 [ -x "$IMAGE_PSNR" ] || die "image_psnr not found: $IMAGE_PSNR (ninja -C $BUILD image_psnr)"
 [ -s "$CITY/manifest.json" ] || die "$CITY is not a paged city (no manifest.json)"
@@ -80,5 +80,5 @@ for name, radius in [("reference", "all")] + [(f"r{r}", r) for r in radii]:
 EOF
 cat "$OUT/table.md"
 
-doc_replace_block docs/performance.md paged-reach "$OUT/table.md"
-log "done: docs/performance.md updated"
+doc_replace_block docs/measurements/paging.md paged-reach "$OUT/table.md"
+log "done: docs/measurements/paging.md updated"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates docs/performance.md "Paged generation": peak RSS, time and output
+# Regenerates docs/measurements/paging.md "Generation": peak RSS, time and output
 # size of `vista gen -o DIR.paged` for growing city sizes, beside the
 # single-file gen where it exists (up to 16 km). Prints a Markdown table on
 # stdout. Each city is deleted after it is measured (a 16 km paged city takes

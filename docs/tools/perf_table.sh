@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates the generation-throughput table of docs/performance.md:
+# Regenerates the table "Cities by size" of docs/measurements/generation.md:
 # generates cities of 0.5, 1, 2, 4, 8 km side (default params otherwise) and
 # prints a Markdown table of triangles, seconds and peak memory from --stats.
 # Usage: docs/tools/perf_table.sh [sizes...]   (default: 500 1000 2000 4000 8000)

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Regenerates docs/raw-rays.md: the far field's ray stage against raw Embree on
-# exactly the rays real hybrid frames cast (issue 15, item 4).
+# Regenerates docs/measurements/raw-rays.md: the far field's ray stage against
+# raw Embree on exactly the rays real hybrid frames cast.
 #   1. a city from data/default.json (2 km);
 #   2. `vista bench` hybrid on a car, a walk and a fly path (--seed 11, 640x480,
 #      FRAMES frames each) with --dump-rays: one ray set per frame;
@@ -8,7 +8,7 @@
 #      rtcIntersect8 (the stage's packets and dense packets), intersectMany,
 #      direction generation and the in-frame path castPrimaryRays, one core and
 #      all cores, repetitions interleaved at random in one process (medians);
-#   4. docs/raw-rays.md written from those numbers (python below).
+#   4. docs/measurements/raw-rays.md written from those numbers (python below).
 #
 # usage: docs/tools/raw_rays.sh [OUT_DIR] [VISTA_BIN]   (run from anywhere)
 #   OUT_DIR   working directory (default: a new temp dir, removed at the end)
@@ -18,14 +18,14 @@
 # MIN_TIME (seconds per repetition, default 0.5), REUSE_RAYS=1 (keep the ray
 # sets and bench output of an earlier run in OUT_DIR; only step 3 and 4 run,
 # e.g. after a change to the ray stage). Needs python3 and, without a
-# display, xvfb-run. About 10 minutes on 2 cores. docs/raw-rays.md is replaced
+# display, xvfb-run. About 10 minutes on 2 cores. docs/measurements/raw-rays.md is replaced
 # only when every step succeeded.
 set -euo pipefail
 
 INVOCATION="docs/tools/raw_rays.sh${1:+ $1}${2:+ $2}"
 source "$(dirname "$0")/lib.sh"
 doc_setup raw_rays.sh rawrays 1280x1024x24 "$@"
-DOC_TMP_FILES=(docs/.raw-rays.md.tmp)
+DOC_TMP_FILES=(docs/measurements/.raw-rays.md.tmp)
 RAW=${BENCH_RAW_RAYS:-$(dirname "$VISTA")/tests/bench/bench_raw_rays}
 FRAMES=${FRAMES:-6}
 REPS=${REPS:-10}
@@ -66,8 +66,8 @@ for kind in car walk fly; do
 done
 cat /proc/loadavg > "$OUT/load_end.txt"
 
-log "writing docs/raw-rays.md"
-python3 - "$OUT" "$INVOCATION" "$REPS" "$MIN_TIME" "$FRAMES" "$VISTA" "$RAW" > "$REPO/docs/.raw-rays.md.tmp" <<'PY'
+log "writing docs/measurements/raw-rays.md"
+python3 - "$OUT" "$INVOCATION" "$REPS" "$MIN_TIME" "$FRAMES" "$VISTA" "$RAW" > "$REPO/docs/measurements/.raw-rays.md.tmp" <<'PY'
 import csv, json, os, sys
 out, invocation, reps, min_time, frames, vista, raw = sys.argv[1:8]
 kinds = ["car", "walk", "fly"]
@@ -113,7 +113,7 @@ P()
 P(f"Regenerate: `{invocation}` (about 10 minutes on 2 cores). Every number below is written by that")
 P("script from the measurements of one run; the commands it ran are listed at the end.")
 P()
-P("The question (issue 15, item 4): how close does the far field's ray stage come to what Embree alone")
+P("How close does the far field's ray stage come to what Embree alone")
 P("can do on the same rays? `vista bench --dump-rays` writes the pixel list each hybrid frame traced")
 P("(`FarField::lastTraced()`, one `RaySet` file per frame: camera + pixels, runtime/engine/ray_set.h);")
 P("`bench_raw_rays` (tests/bench/bench_raw_rays.cpp) rebuilds the city's `RayScene`, turns every set into")
@@ -258,5 +258,5 @@ for line in open(f"{out}/commands.log"):
     P(line.replace(out, "OUT"))
 P("```")
 PY
-mv "$REPO/docs/.raw-rays.md.tmp" "$REPO/docs/raw-rays.md"
-log "done: docs/raw-rays.md"
+mv "$REPO/docs/measurements/.raw-rays.md.tmp" "$REPO/docs/measurements/raw-rays.md"
+log "done: docs/measurements/raw-rays.md"

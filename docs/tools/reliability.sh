@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates docs/reliability.md: the regression tests of every finding, the
+# Regenerates docs/measurements/reliability.md: the regression tests of every finding, the
 # fuzz targets' executions and findings (.ci/fuzz.sh), the sanitizer run of the
 # test suite (.ci/sanitize.sh), fault injection and the soak memory curve.
 #   usage: docs/tools/reliability.sh [FUZZ_SECONDS=600] [SOAK_FRAMES=100000]
@@ -44,7 +44,7 @@ else
   "${XVFB[@]}" build/tests/bench/soak "$OUT/soak.osgb" "$SOAK_FRAMES" 64x48 > "$OUT/soak.csv"
 fi
 
-python3 - "$OUT" "$FUZZ_SECONDS" "$SOAK_FRAMES" "${FUZZ_TSV:+fuzz }${SANITIZE_LOG:+sanitizer }${SOAK_CSV:+soak}" > docs/reliability.md.tmp <<'PY'
+python3 - "$OUT" "$FUZZ_SECONDS" "$SOAK_FRAMES" "${FUZZ_TSV:+fuzz }${SANITIZE_LOG:+sanitizer }${SOAK_CSV:+soak}" > docs/measurements/reliability.md.tmp <<'PY'
 import csv, os, re, sys, datetime, subprocess
 out, fuzz_s, soak_n, reused = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4].split()
 def read(n):
@@ -56,12 +56,12 @@ def tests_summary(text):
 print("# Reliability: fuzzing, sanitizers, faults, soak")
 print()
 print("Regenerate with `docs/tools/reliability.sh [FUZZ_SECONDS] [SOAK_FRAMES]` (this run: "
-      f"up to {fuzz_s} s per fuzz target (FUZZ_RUNS stops a target earlier), {soak_n} soak frames; {datetime.date.today()}; 2 cores, no GPU, Mesa llvmpipe)."
+      f"up to {fuzz_s} s per fuzz target (FUZZ_RUNS stops a target earlier), {soak_n} soak frames; 2 cores, no GPU, Mesa llvmpipe)."
       + (f" Results of the {', '.join(reused)} step(s) were run separately and passed in (FUZZ_TSV / SANITIZE_LOG / SOAK_CSV)." if reused else ""))
 print()
 print("## Findings and their regression tests")
 print()
-print("| input | finding (issue 12) | now | regression test |")
+print("| input | fault found | behaviour | regression test |")
 print("|---|---|---|---|")
 rows = [
  ("params JSON", "`1e999` or a 400-digit number aborted (uncaught exception)", "exit 2: 'number overflow ... (numbers must fit a double)'", "Params.HostileJsonIsRefusedCleanlyAndTheFullSeedRangeAccepted"),
@@ -79,7 +79,7 @@ rows = [
  ("faults", "`vista path` exited 1 on a write failure", "exit 2 like every user-facing failure", "(code path shared with reportBadInput)"),
  ("faults", "`vista bench` left an empty output folder for a bad scene file", "every `--out` directory this run created is removed when it wrote nothing", "GenCli.BenchOfABadSceneLeavesNoOutputFolder"),
  ("faults", "`vista bake --work` and `vista bench --out` (read-only, or a file) were refused only after the scene was loaded (bench: exit 1)", "refused before the input is read, exit 2, naming the option", "BakeFaults.UnwritableOutputWorkOrStatsIsRefusedBeforeTheInputIsRead, BakeFaults.ReadOnlyDirectoryIsRefusedBeforeTheInputIsRead, BenchFaults.*"),
- ("scene file", "fuzz_scene_file (this session): libFuzzer's comparison tracing forged the 64-bit trailer hash, and a 3.8 KB payload kept OSG's osgb reader busy for 9 s (45 s under ASan)", "untrusted mode (`VISTA_UNTRUSTED_FILES=1`) gives the child decode a time limit (5 s + 1 s per 10 MB, `VISTA_UNTRUSTED_DECODE_SECONDS`); the default target leaves forged trailers to the trusted-trailer mode", "CityFile.PayloadThatKeepsTheReaderBusyIsRefusedInUntrustedMode (the input is tests/data/fuzz_findings/scene_slow_reader.osgb)"),
+ ("scene file", "fuzz_scene_file: libFuzzer's comparison tracing forged the 64-bit trailer hash, and a 3.8 KB payload kept OSG's osgb reader busy for 9 s (45 s under ASan)", "untrusted mode (`VISTA_UNTRUSTED_FILES=1`) gives the child decode a time limit (5 s + 1 s per 10 MB, `VISTA_UNTRUSTED_DECODE_SECONDS`); the default target leaves forged trailers to the trusted-trailer mode", "CityFile.PayloadThatKeepsTheReaderBusyIsRefusedInUntrustedMode (the input is tests/data/fuzz_findings/scene_slow_reader.osgb)"),
  ("faults", "horizon stage: a column with nothing in view gave a NaN limit and culled nothing (every sky pixel at a city's edge was traced)", "all sky", "Horizon.LookingOutOfTheCityIsAllSky"),
 ]
 for r in rows: print("| " + " | ".join(r) + " |")
@@ -164,5 +164,5 @@ for l in rows[::step] + ([rows[-1]] if rows and (len(rows) - 1) % step else []):
     print(f"| {int(f):,} | {r} | {ms} |")
 if last: print("\n" + last[0].lstrip("# "))
 PY
-mv docs/reliability.md.tmp docs/reliability.md
-echo "wrote docs/reliability.md" >&2
+mv docs/measurements/reliability.md.tmp docs/measurements/reliability.md
+echo "wrote docs/measurements/reliability.md" >&2

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates the per-size table of docs/performance.md (issue 14 item 5):
+# Regenerates the per-size table of docs/measurements/paging.md:
 # for each city size, a paged city from `vista gen -o cS.paged` (generation
 # time and peak RSS), then one walkthrough of it with `full`, `osglod` and
 # `hybrid` interleaved frame by frame (`vista bench cS.paged`: the regions
@@ -7,7 +7,7 @@
 # its coarse level for the far field), its frame times, PSNR against `full`,
 # load and set-up times and the bench's peak RSS (GNU time). The block
 # between <!-- scale-table:begin --> and <!-- scale-table:end --> of
-# docs/performance.md is replaced only when every step succeeded.
+# docs/measurements/paging.md is replaced only when every step succeeded.
 # Cities and bench outputs already in OUT_DIR are kept (resumable; delete
 # them to re-measure).
 #
@@ -24,7 +24,7 @@
 set -euo pipefail
 source "$(dirname "$0")/lib.sh"
 doc_setup scale_table.sh scale 1280x1024x24 "$@"
-DOC_TMP_FILES=(docs/.performance.md.tmp)
+DOC_TMP_FILES=(docs/measurements/.paging.md.tmp)
 SIZES=${SIZES:-"1000 2000 4000 8000 16000 32000"}
 CITY_SEED=${CITY_SEED:-1}
 SEED=${SEED:-5}
@@ -111,5 +111,5 @@ for s, g, b, p, gen_rss, bench_rss, setup, ms, psnr in rows:
 EOF
 cat "$OUT/table.md"
 
-doc_replace_block docs/performance.md scale-table "$OUT/table.md"
-log "done: docs/performance.md updated"
+doc_replace_block docs/measurements/paging.md scale-table "$OUT/table.md"
+log "done: docs/measurements/paging.md updated"

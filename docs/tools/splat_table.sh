@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates the splat block of docs/results.md (issue 11, item 2): point
+# Regenerates the splat block of docs/measurements/bake.md: point
 # impostors drawn as 1-pixel points and as splats (several kernel widths)
 # against plain geometry, all against the 4x4 supersampled geometry, from the
 # 13 views of each of four view cells (52 views), with the render time of
@@ -22,7 +22,7 @@
 set -euo pipefail
 source "$(dirname "$0")/lib.sh"
 doc_setup splat_table.sh splat 1280x1024x24 "${1:-splat-table-out}" "${2:-build/vista}"
-DOC_TMP_FILES=(docs/.results.md.tmp)
+DOC_TMP_FILES=(docs/measurements/.bake.md.tmp)
 REPORT=$(dirname "$VISTA")/vista_bake_report
 [ -x "$REPORT" ] || die "vista_bake_report not found next to $VISTA"
 SIZE_M=${SIZE_M:-2000}
@@ -76,5 +76,5 @@ for s in settings:
           + f" | {better} of {len(alli)} | {gain:+.2f} | " + " / ".join(f"{rep[(c, s)]['imp_ms']:.1f}" for c in cells) + " |")
 print()
 PYEOF
-doc_replace_block docs/results.md "$MARKER" "$TABLE"
-log "docs/results.md $MARKER block written"
+doc_replace_block docs/measurements/bake.md "$MARKER" "$TABLE"
+log "docs/measurements/bake.md $MARKER block written"

@@ -1,15 +1,15 @@
 #!/usr/bin/env bash
-# Regenerates the measurements of docs/results.md, "Issue 3: measuring instrument":
+# Regenerates the measurements of docs/measurements/modes.md (render modes side by side):
 # the 2 km city's six modes side by side at 640x480 and 320x240 (car path), the
 # fly-over, and the size sweep. Prints the Markdown tables on stdout.
 #
 # usage: docs/tools/sweep.sh [VISTA_BINARY] [OUT_DIR]
-#   VISTA_BINARY defaults to build/vista, OUT_DIR to ./results-issue3.
+#   VISTA_BINARY defaults to build/vista, OUT_DIR to ./results-modes.
 # Needs an X display; without one it re-runs itself under `xvfb-run -a`.
 # Needs jq. Takes about 20 minutes on 2 cores with llvmpipe.
 set -euo pipefail
 VISTA=$(realpath "${1:-build/vista}")
-OUT=${2:-results-issue3}
+OUT=${2:-results-modes}
 MODES=full,near,raycast,osgimpostor,osglod,hybrid
 if [ -z "${DISPLAY:-}" ]; then exec xvfb-run -a "$0" "$VISTA" "$OUT"; fi
 mkdir -p "$OUT" && cd "$OUT"

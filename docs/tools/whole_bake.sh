@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Regenerates the whole-city bake block of docs/farfield-compare.md (issue 11,
-# done-when 1): the default city baked whole with point impostors (placement
+# Regenerates the whole-city bake block of docs/measurements/bake.md
+# (and MARKER=whole-bake-seed2): the default city baked whole with point impostors (placement
 # by cost, splats), its storage and bake time, and walkthroughs on it.
 #
 # What it runs (commands go to OUT/commands.log):
@@ -21,7 +21,7 @@
 set -euo pipefail
 source "$(dirname "$0")/lib.sh"
 doc_setup whole_bake.sh wholebake 1280x1024x24 "${1:-whole-bake-out}" "${2:-build/vista}"
-DOC_TMP_FILES=(docs/.farfield-compare.md.tmp)
+DOC_TMP_FILES=(docs/measurements/.bake.md.tmp)
 SIZE_M=${SIZE_M:-2000}
 CITY_SEED=${CITY_SEED:-1}
 JOBS=${JOBS:-2}
@@ -94,5 +94,5 @@ for k in kinds:
           f"{with_imp} of {frames} |")
 print()
 PYEOF
-doc_replace_block docs/farfield-compare.md "$MARKER" "$TABLE"
-log "docs/farfield-compare.md $MARKER block written"
+doc_replace_block docs/measurements/bake.md "$MARKER" "$TABLE"
+log "docs/measurements/bake.md $MARKER block written"

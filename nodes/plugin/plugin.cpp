@@ -6,7 +6,7 @@
 // ("vista::PointImpostor") and nodes/view_cell_switch.cpp ("vista::ViewCellSwitch")
 // run when osgDB loads the module and add their wrappers to
 // osgDB::ObjectWrapperManager. osgDB loads it on its own the first time an input or
-// output stream meets an unknown class "vista::..." (see docs/plugin.md for the
+// output stream meets an unknown class "vista::..." (see docs/reference/plugin.md for the
 // search order and paths). There is no ReaderWriter: the files stay ordinary
 // .osgb/.osgt/.osgx, read by OSG's own osgdb_osg plugin.
 //

@@ -140,7 +140,7 @@ private:
         // during the draw are left out, so b is the price of a pixel the frame waits for. The
         // split then prices every far pixel of a candidate at it (the overlap's capacity is not
         // modelled): measured, a b lowered by the overlap led the split to near distances whose
-        // far pixels the overlap could not cover (docs/far-field.md, speculative rays).
+        // far pixels the overlap could not cover (docs/reference/far-field.md, speculative rays).
         const uint64_t farPixels = fs.pixels.cache + fs.pixels.rayHit + fs.pixels.rayMiss + fs.pixels.interpolated -
                                    std::min(fs.speculativeUsed, fs.pixels.rayHit + fs.pixels.rayMiss);
         const double farMs = fs.stages.ms(Stage::Rays) + fs.stages.ms(Stage::Cache);

@@ -9,8 +9,9 @@
 #include <osg/RenderInfo>
 
 #include "foundation/timing.h"
-#include "nodes/far_field_node.h"
-#include "runtime/engine/far_field_rays.h"
+#include "nodes/readback_drawable.h"
+#include "runtime/engine/frame_raycast.h"
+#include "runtime/engine/far_field_haze.h"
 #include "runtime/engine/ray_scene.h"
 
 namespace vista {
@@ -37,46 +38,26 @@ void castEveryPixel(const RayScene& rays, const Camera& camera, Image& out, Fram
 }
 
 // Viewer face: casts the OSG camera's frame and draws it over the viewport.
-class RaycastDrawable : public osg::Drawable {
+class RaycastDrawable : public ReadbackDrawable {
 public:
-    RaycastDrawable(const RayScene& rays, const FrameEffects* fx) : _rays(rays), _fx(fx) {
-        useFixedFunction(*getOrCreateStateSet());
-        setUseDisplayList(false);
-        setUseVertexBufferObjects(false);
-        setCullingActive(false);
-        setDataVariance(osg::Object::DYNAMIC);
-    }
-    RaycastDrawable(const RaycastDrawable& o, const osg::CopyOp& op) : osg::Drawable(o, op), _rays(o._rays), _fx(o._fx) {}
+    RaycastDrawable(const RayScene& rays, const FrameEffects* fx) : _rays(rays), _fx(fx) {}
+    RaycastDrawable(const RaycastDrawable& o, const osg::CopyOp& op) : ReadbackDrawable(o, op), _rays(o._rays), _fx(o._fx) {}
     osg::Object* cloneType() const override { return new RaycastDrawable(_rays, _fx); }
     osg::Object* clone(const osg::CopyOp& op) const override { return new RaycastDrawable(*this, op); }
     bool isSameKindAs(const osg::Object* o) const override { return dynamic_cast<const RaycastDrawable*>(o) != nullptr; }
     const char* libraryName() const override { return "vista"; }
     const char* className() const override { return "RaycastDrawable"; }
-    FrameStats lastStats() const {
-        std::lock_guard<std::mutex> lock(_mutex);
-        return _stats;
-    }
-    void drawImplementation(osg::RenderInfo& ri) const override {
-        std::lock_guard<std::mutex> lock(_mutex);
-        Camera c;
-        const osg::Viewport* vpp = nullptr;
-        double zFar = 0;
-        if (!currentView(ri, c, vpp, zFar)) return;
-        const osg::Viewport& vp = *vpp;
-        _stats = FrameStats();
+
+protected:
+    void drawFrame(osg::RenderInfo&, const Camera& c, const osg::Viewport& vp, double) const override {
         static const FrameEffects kNone;
         castEveryPixel(_rays, c, _image, _stats, 0, _fx ? *_fx : kNone);
-        drawImageOverViewport(vp, _image, nullptr, _upload);
+        drawImage(vp);
     }
-    osg::BoundingBox computeBoundingBox() const override { return osg::BoundingBox(); }
 
 private:
     const RayScene& _rays;
     const FrameEffects* _fx;
-    mutable Image _image;
-    mutable std::vector<uint8_t> _upload;
-    mutable FrameStats _stats;
-    mutable std::mutex _mutex;
 };
 
 class RaycastMode : public RenderMode {

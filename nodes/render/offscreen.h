@@ -52,7 +52,7 @@ void setExactCulling(osg::Camera& camera);
 // flushes them at the start of each draw (osg::flushDeletedGLObjects), which
 // walks every buffer-object set under a mutex whether anything was deleted or
 // not; OSG keeps one set per buffer size, thousands in a city, so the walk
-// cost 2.2 ms of CPU a frame on the 2 km city whatever was drawn (docs/results.md).
+// costs 2.2 ms of CPU a frame on the 2 km city whatever was drawn (perf, llvmpipe).
 // Installs a renderer on `camera` (before the viewer is realized; a viewer
 // with an incremental compile operation flushes through it and is left as
 // is). frames >= 1 (1 = OSG's every frame).

@@ -23,7 +23,7 @@
 // as the OffscreenRenderer's background, so sky pixels agree across modes.
 //
 // The frame runs as named stages, one file each (far_field_<stage>.cpp, see
-// far_field_stages.h and docs/far-field.md): opacity, seam, horizon, cache,
+// far_field_stages.h and docs/reference/far-field.md): opacity, seam, horizon, cache,
 // rays, composite. Stages run only when called for: no uncovered pixel ->
 // nothing after opacity; no far geometry (city bounds within the near
 // distance, or an empty city) -> no horizon/cache/ray stage (note "rays off:
@@ -121,7 +121,7 @@ struct FarFieldOptions {
     // on a fly-over the two measuring frames cost 12 to 17 ms of lookups
     // each); a verdict that it pays resets it. Never paused for
     // a still camera or under a pixel budget or frame-time target. false =
-    // always look up (the Pareto front of docs/results.md measures that).
+    // always look up (the cache Pareto front of docs/measurements/far-field.md measures that).
     bool cacheAdaptive = true;
     int threads = 0;
     // Ray spacing of the far field: 1 = a ray per far pixel (exact); 2 = rays

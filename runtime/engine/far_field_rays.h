@@ -1,6 +1,8 @@
 // Primary rays: the camera's pixel-centre rays cast into a RayScene, written
 // as colours (prelit colour on a hit, sky colour on a miss). One loop serves
-// the far field's ray stage and the `raycast` render mode.
+// the far field's ray stage (far_field_rays.cpp) and the whole-frame raycast
+// of the `raycast` render mode (frame_raycast.h); the haze of their pixels is
+// far_field_haze.h.
 //
 // Directions: PixelRays::dir(x, y) == Camera::rayDirection(x + 0.5, y + 0.5)
 // bit for bit (the same operations in the same order, basis hoisted). Origin:
@@ -107,14 +109,12 @@ struct RayShading {
 void castPrimaryRays(const RayScene& scene, const Camera& camera, const uint32_t* pixels, size_t n, Image& out,
                      RayCounts& counts, int threads, uint8_t* hit = nullptr, const RayShading& shading = {});
 
-// Every pixel of the camera, row by row (out is resized to the camera).
-void castFrame(const RayScene& scene, const Camera& camera, Image& out, RayCounts& counts, int threads,
-               const RayShading& shading = {});
-
-// Haze stage: fx.applyHaze to the n listed pixels (null list = every pixel)
-// at their eye-plane depth (one entry per listed pixel; +inf = sky, left
-// alone). Records Stage::Haze and the haze effect when fx.haze and n > 0.
-void hazeStage(const FrameEffects& fx, const uint32_t* pixels, size_t n, const float* depth, Image& out,
-               FrameStats& stats);
+// The listed pixels (null = every pixel of the frame, in order) grouped into
+// the given runs: the entries runs[r] .. runs[r + 1] - 1 of every run r
+// (runs.back() = the entry count), each run cast in packets of 8, runs in
+// parallel. castPrimaryRays groups its list with coherentRuns();
+// castFrame (frame_raycast.h) casts one run per image row.
+void castPixelRuns(const RayScene& scene, const Camera& camera, const uint32_t* pixels, const std::vector<size_t>& runs,
+                   Image& out, RayCounts& counts, int threads, uint8_t* hit, const RayShading& shading);
 
 }  // namespace vista

@@ -148,7 +148,7 @@ bool seamCheckApplies(const FarFrame& f, const RayScene& rays, const FarFieldOpt
 // miss, is added to raysCast. Records Seam.
 void seamStage(FarFrame& f, const RayScene& rays, const FarFieldOptions& o, FrameStats& stats);
 
-// Haze of the covered pixels (far_field_rays.cpp), run when o.hazeCovered,
+// Haze of the covered pixels (far_field_haze.cpp), run when o.hazeCovered,
 // haze is on and depth exists: every pixel still covered gets the haze of its
 // eye-plane depth (from depth, camera.zNear, o.depthZFar), the blend of
 // FrameEffects::applyHaze. Records Haze (stage and effect).

@@ -109,6 +109,32 @@ void castLabels(const SceneModel& city, const RayScene& rays, const Camera& came
     });
 }
 
+size_t mergeLabels(const SceneModel& city, const RayScene* rays, const Camera& camera, const RasterLabels& raster,
+                   double nearDistance, bool castUncovered, LabelImage& out, int threads) {
+    out.resize(camera.width, camera.height);
+    const bool limited = nearDistance < 1e299;
+    const bool castOthers = rays && (limited || castUncovered);
+    const PixelRays gen(camera);
+    const glm::dvec3 fwd = camera.forward();
+    std::vector<uint32_t> far;
+    for (int y = 0; y < camera.height; ++y)
+        for (int x = 0; x < camera.width; ++x) {
+            const size_t p = size_t(y) * size_t(camera.width) + size_t(x);
+            const float z = raster.depth[p];
+            bool keep = z > 0.0f;
+            if (keep && limited) keep = double(z) / glm::dot(gen.dir(x, y), fwd) <= nearDistance;
+            if (keep) {
+                out.ids[p] = raster.ids[p];
+                out.classes[p] = raster.classes[p];
+                out.depth[p] = z;
+            } else if (castOthers) {
+                far.push_back(uint32_t(p));
+            }
+        }
+    if (!far.empty()) castLabels(city, *rays, camera, far, out, threads);
+    return far.size();
+}
+
 namespace {
 
 std::string npyHeader(const char* descr, int width, int height) {

@@ -16,8 +16,19 @@
 // + x) from the eye, starting at the near plane (tnear = zNear / cos), and
 // writes their labels into `out` (which has the camera's size). Parallel over
 // `threads` workers (0 = all); deterministic. Thread-safe for distinct outputs.
+// mergeLabels(): the labels of a frame whose near field was rasterised by the
+// label pass (`raster`: the camera's size, row 0 at the top, depth 0 =
+// nothing drawn) and whose other pixels come from rays. A drawn pixel keeps
+// its raster label when `nearDistance` is unlimited (>= 1e299) or its hit
+// lies within nearDistance metres of the eye along its pixel ray (PixelRays);
+// every other pixel is cast (castLabels) when `rays` is not null and either a
+// near distance applies or `castUncovered` (the far field fills uncovered
+// pixels, as hybrid's does), else it stays sky. `out` is resized to the
+// camera. Returns the number of pixels cast. Deterministic.
 #pragma once
+#include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -46,6 +57,14 @@ PixelLabel rayLabel(const SceneModel& city, const RayScene& rays, const RayHit& 
 
 void castLabels(const SceneModel& city, const RayScene& rays, const Camera& camera, const std::vector<uint32_t>& pixels,
                 LabelImage& out, int threads = 0);
+
+struct RasterLabels {
+    const uint32_t* ids = nullptr;
+    const uint8_t* classes = nullptr;
+    const float* depth = nullptr;
+};
+size_t mergeLabels(const SceneModel& city, const RayScene* rays, const Camera& camera, const RasterLabels& raster,
+                   double nearDistance, bool castUncovered, LabelImage& out, int threads = 0);
 
 // .npy (format 1.0) bytes of a row-major height x width array of little-endian
 // float32 ("<f4") or uint32 ("<u4") values.

@@ -6,7 +6,7 @@
 // Hit colours: barycentric interpolation of the prelit vertex colours, rounded
 // to 8 bits exactly as the fixed-function rasteriser does; the colours are kept
 // per triangle (primID -> its three corners), so a hit costs one memory fetch
-// (docs/raw-rays.md: the colour fetch was the wrapper's largest cost).
+// (docs/measurements/raw-rays.md: the colour fetch was the wrapper's largest cost).
 // A soup scene: one triangle geometry on a device shared by all soup scenes
 // (so the bake does not create a device per impostor); no robust flag.
 #include "runtime/engine/ray_scene.h"

@@ -1,6 +1,6 @@
 // RaySet: the primary rays one far-field frame cast, as a file, so that the
 // ray stage can be timed against raw Embree on exactly those rays
-// (tests/bench/bench_raw_rays.cpp, docs/raw-rays.md).
+// (tests/bench/bench_raw_rays.cpp, docs/measurements/raw-rays.md).
 //
 // A set is the camera, the haze ray limit, where the rays start and the traced pixel list
 // (FarField::lastTraced(): ascending indices y * width + x); the rays follow

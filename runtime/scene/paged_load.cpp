@@ -14,7 +14,6 @@
 
 #include "citygen/streets.h"
 #include "runtime/scene/city_file.h"
-#include "runtime/scene/paged_city.h"
 #include "runtime/scene/scene_graph.h"
 
 namespace vista {

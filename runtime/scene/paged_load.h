@@ -1,5 +1,5 @@
 // Reading a paged city (docs/formats.md "Paged city", written by
-// paged_city.h): the regions near a walkthrough, merged into one SceneModel,
+// bake/gen/paged_city.h): the regions near a walkthrough, merged into one SceneModel,
 // so that `vista bench/view/path DIR.paged` fit a 32 or 64 km city in memory.
 //
 // readPagedManifest(): parses DIR/manifest.json (format "vista.paged_city",
@@ -14,7 +14,7 @@
 //
 // selectCoarseRegions(): the non-empty regions within `farM` of the points
 // that are not in `full` (the regions loaded at full detail), in region
-// order: the far city, loaded at its coarse level (paged_city.h: detail 0, no
+// order: the far city, loaded at its coarse level (bake/gen/paged_city.h: detail 0, no
 // trees) so that the ray-cast far field still sees it. farM <= radius of
 // `full`, or 0: none.
 //
@@ -54,6 +54,11 @@
 #include "runtime/scene/scene_model.h"
 
 namespace vista {
+
+// The index and the manifest inside a paged city's directory (written by
+// `vista gen -o DIR.paged`, bake/gen/paged_city.h).
+constexpr const char* kPagedIndexFile = "index.osgb";
+constexpr const char* kPagedManifestFile = "manifest.json";
 
 constexpr double kDefaultPagedRadiusM = 3000.0;
 constexpr double kMinPagedRadiusM = 0.0;

@@ -160,7 +160,7 @@ Result<osg::ref_ptr<osg::Node>> readSceneFile(const std::string& path) {
         return Status::error("scene file '" + path + "' is corrupted: checksum mismatch");
     osgDB::ReaderWriter* rw = osgbReaderWriter();
     if (!rw) return Status::error("cannot read '" + path + "': OpenSceneGraph osgb plugin not found");
-    // Trust model (docs/reliability.md): a matching trailer proves the file is
+    // Trust model (docs/measurements/reliability.md): a matching trailer proves the file is
     // whole, not that its payload is well formed. With VISTA_UNTRUSTED_FILES=1
     // the payload is first decoded in a child process, so a payload that
     // crashes OSG's reader is refused instead of taking vista down.

@@ -38,7 +38,7 @@ Status writeSceneFile(const osg::Node& node, const std::string& path, bool compr
 // Reads a file written by writeSceneFile(); verifies magic, size and hash.
 // VISTA_UNTRUSTED_FILES=1 (environment): the payload is decoded once in a
 // child process first; one that crashes OSG's reader is an error (trust
-// model: docs/reliability.md).
+// model: docs/measurements/reliability.md).
 Result<osg::ref_ptr<osg::Node>> readSceneFile(const std::string& path);
 
 // The content hash of a scene file: its trailer's payload hash (bytes 16..23),

@@ -1033,7 +1033,7 @@ TEST(ImpostorMode, DrawsImpostorsInTheCellAndResemblesTheGeometry) {
     EXPECT_NE(bad.status().message().find("--baked"), std::string::npos);
 }
 
-// Issue 11, item 2: from-region visibility of the baked points through the
+// From-region visibility of the baked points through the
 // whole city, and the cost estimate that decides where an impostor goes.
 TEST(Placement, PointsBehindAnOccluderAreDroppedAndTheCostRuleHolds) {
     TempDir dir;
@@ -1620,7 +1620,7 @@ TEST(LodMesh, NoSkinAcrossADepthDiscontinuityAndTheBudgetHolds) {
     }
 }
 
-// Issue 11, item 1: the baked modes draw the near field in the 40 m chunks of
+// The baked modes draw the near field in the 40 m chunks of
 // `full`/`hybrid` (view_cell_switch.h). On a small generated city, from inside
 // a baked cell looking down its street: the baked modes draw no more
 // triangles than `full` (a subset of its chunks, plus the few mesh triangles
@@ -1865,7 +1865,7 @@ TEST(LodMeshCli, BenchAndViewRunTheLodMeshMode) {
     EXPECT_EQ(tool("view " + dir.file("p.osgb") + " --mode lodmesh --size 160x120 --frames 3"), 2);
 }
 
-// Issue 11 item 6: a baked file records its source city's content hash
+// A baked file records its source city's content hash
 // (vista.source_city_hash); bench and view refuse a baked file of another city
 // and a truncated one (exit 2, both representations), warn about a file without
 // the hash, and run with a matching pair.

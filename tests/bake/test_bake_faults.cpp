@@ -1,4 +1,4 @@
-// Faults of `vista bake` (issue 12): a kill -9 at several points of a bake
+// Faults of `vista bake`: a kill -9 at several points of a bake
 // leaves the old output or the whole new one, never a partial file, and the
 // next run resumes to the bytes of an uninterrupted bake; a full disk gives
 // the cause and no partial output; an unwritable --output, --work or --stats

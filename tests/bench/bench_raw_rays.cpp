@@ -1,5 +1,5 @@
 // Google Benchmark: the far field's ray stage against raw Embree on exactly
-// the rays real frames cast (docs/raw-rays.md, made by docs/tools/raw_rays.sh).
+// the rays real frames cast (docs/measurements/raw-rays.md, made by docs/tools/raw_rays.sh).
 // Usage:
 //   bench_raw_rays --city CITY.osgb --rays DIR [--benchmark_...]
 // (or VISTA_CITY / VISTA_RAYS in the environment). DIR holds RaySet files

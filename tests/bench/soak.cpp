@@ -1,6 +1,6 @@
 // Soak: a long `hybrid` walkthrough (default 100,000 frames at 64x48) with the
 // resident set size sampled every 1,000 frames, to show that memory does not
-// grow with the number of frames (docs/reliability.md). A measurement driver,
+// grow with the number of frames (docs/measurements/reliability.md). A measurement driver,
 // not a test: it asserts nothing; it prints CSV (frame, rss_mb, ms_per_frame
 // over the last interval) and a last line with the growth.
 //   usage: soak CITY.osgb [FRAMES] [WIDTHxHEIGHT]   (needs an X display: xvfb-run -a)

@@ -392,7 +392,7 @@ TEST(Buildings, PipelineMeshesAreFinite) {
     EXPECT_GT(m.windows.triangleCount(), 0u);
 }
 
-// Triangle budget of the default city per detail level (docs/buildings.md).
+// Triangle budget of the default city per detail level (docs/reference/buildings.md).
 // Disabled in CI (it generates the default 2000 m city four times); run with
 //   test_citygen --gtest_filter='*BuildingBudget*' --gtest_also_run_disabled_tests
 TEST(BuildingBudget, DISABLED_DefaultCityPerDetail) {

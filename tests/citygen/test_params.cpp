@@ -8,8 +8,8 @@ using namespace vista;
 
 TEST(Params, DefaultsAreValid) { EXPECT_TRUE(validateParams(CityParams()).isOk()); }
 
-// Found by trying malformed files as a new user would (issue 12): each was a
-// crash, an uncaught exception, a silent acceptance or a wrong rejection.
+// Malformed files a new user might write: each must be refused cleanly (no
+// crash, no uncaught exception, no silent acceptance) or accepted when valid.
 TEST(Params, HostileJsonIsRefusedCleanlyAndTheFullSeedRangeAccepted) {
     const std::pair<std::string, std::string> bad[] = {
         {R"({"seed": 1e999})", "number overflow"},

@@ -138,7 +138,7 @@ TEST(TreePrototypes, NineSpeciesVariantsWithinBudget) {
     for (const auto& t : protos) {
         SCOPED_TRACE(testing::Message() << "species " << t.species << " variant " << t.variant);
         seen[{t.species, t.variant}]++;
-        // Reported in docs/trees-and-surfaces.md (figures come from this line).
+        // Reported in docs/reference/trees-and-surfaces.md (figures come from this line).
         std::printf("prototype species %d variant %d: %zu triangles, %zu vertices, height %.2f m\n", t.species, t.variant,
                     t.mesh.triangleCount(), t.mesh.positions.size(), t.height);
         expectWellFormed(t.mesh, "tree");

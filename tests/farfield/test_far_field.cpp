@@ -18,6 +18,7 @@
 #include "citygen/lighting.h"
 #include "runtime/engine/far_field.h"
 #include "runtime/engine/far_field_rays.h"
+#include "runtime/engine/frame_raycast.h"
 #include "runtime/engine/horizon.h"
 #include "runtime/engine/metrics.h"
 #include "runtime/engine/ray_scene.h"

@@ -2,7 +2,7 @@
 // `view`, `bake` and `path` read it. Damaged files must be refused with a
 // Status (the trailer check), never crash. Set VISTA_FUZZ_TRUSTED_TRAILER=1 to
 // append a valid trailer to every input (a malformed payload another tool
-// could write): that fuzzes the OSG reader itself (see docs/reliability.md,
+// could write): that fuzzes the OSG reader itself (see docs/measurements/reliability.md,
 // trust model). Seeds: tiny_city.osgb (a file without ground-truth labels, as
 // older versions wrote) and tiny_labelled_city.osgb (vista.labels = 1: label
 // arrays on every geometry, tree ids per instance; a label array whose size
@@ -26,7 +26,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         // libFuzzer's comparison tracing forges the 64-bit trailer hash (an
         // integrity check, not an authentication): such an input is a
         // "malformed payload with a valid trailer", the trusted-trailer
-        // mode's subject (trust model, docs/reliability.md), not this target's.
+        // mode's subject (trust model, docs/measurements/reliability.md), not this target's.
         return 0;
     }
     const std::string path =

@@ -515,7 +515,7 @@ TEST(Gltf, UnwritablePathIsAnError) {
     EXPECT_NE(s.message().find("city.glb"), std::string::npos);
 }
 
-// Trust model (docs/reliability.md): a payload with a matching trailer (as
+// Trust model (docs/measurements/reliability.md): a payload with a matching trailer (as
 // another tool could write) that is not a valid osgb graph is refused; with
 // VISTA_UNTRUSTED_FILES=1 it is decoded in a child process first, and a good
 // file still loads.

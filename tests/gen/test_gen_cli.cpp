@@ -128,7 +128,7 @@ TEST_F(GenCli, SameSeedSameBytesWhateverThreads) {
     EXPECT_TRUE(sa == sb) << "outputs differ between 1 and 2 threads";
 }
 
-// kill -9 at several points of `vista gen` (issue 12): the older output stays
+// kill -9 at several points of `vista gen`: the older output stays
 // intact and whole, no partial output appears, and the next run removes the
 // killed run's temporary files. Also with --geojson and --gltf: the outputs of
 // one command appear together or not at all.

@@ -1,4 +1,4 @@
-// Faults of `vista gen` and `vista bench` (issue 12): a full disk gives the
+// Faults of `vista gen` and `vista bench`: a full disk gives the
 // cause, leaves the old output intact and no partial output or temporary;
 // an --out that bench cannot write is refused before the scene is loaded.
 // (kill -9 of `vista gen`: test_gen_cli.cpp.)

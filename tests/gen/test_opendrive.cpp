@@ -18,6 +18,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -197,8 +198,9 @@ bool allDigits(const std::string& s) {
 }
 
 // netconvert's net against the graph: one junction (id = the OpenDRIVE
-// junction id, digits only) per node of degree >= 3; dead ends become
-// "<road>.begin"/"<road>.end" nodes, degree-2 links "<road>.<road>" nodes;
+// junction id, digits only) per node of degree >= 3; road ends without a
+// link become "<road>.begin"/"<road>.end" nodes, each transition road two
+// "<road>.<road>" nodes; one traffic-light program per signalised junction;
 // "internal" junctions are netconvert's own (inside junctions). Every road
 // becomes edge "-<id>" (right lanes) and "<id>" (left lanes) with the
 // lane model's driving lane counts (sidewalks are not imported by default).
@@ -219,18 +221,31 @@ void checkNet(const City& city, const std::string& label) {
     ASSERT_TRUE(r.net);
 
     const LaneModel M = buildLaneModel(city.streets, city.params, &city.blocks);
-    size_t graphJunctions = 0, deadEnds = 0, links = 0;
-    for (int d : M.degree) {
-        graphJunctions += d >= 3;
-        deadEnds += d == 1;
-        links += d == 2;
+    size_t graphJunctions = 0;
+    for (int d : M.degree) graphJunctions += d >= 3;
+    // Road ends without a link: dead ends, and both roads at a corner too
+    // sharp for a transition (LaneModel::sharpCorners).
+    size_t openEnds = 0;
+    for (size_t e = 0; e < M.edges.size(); ++e) {
+        const EdgeLanes& L = M.edges[e];
+        if (!L.valid) continue;
+        for (uint32_t v : {city.streets.edges[e].a, city.streets.edges[e].b}) {
+            const int link = v == city.streets.edges[e].a ? L.linkA : L.linkB;
+            openEnds += M.degree[size_t(v)] == 1 || (M.degree[size_t(v)] == 2 && link < 0);
+        }
     }
     EXPECT_EQ(graphJunctions, M.junctions.size());
     EXPECT_EQ(n.junctions, M.junctions.size());
+    size_t transitions = 0;
+    for (const LinkRoad& r : M.links) transitions += r.junction < 0;
+    EXPECT_EQ(n.transitions, transitions);
     size_t netJunctions = 0, netEnds = 0, netLinks = 0;
     for (const Element* j : r.net->all("junction")) {
         const std::string id = j->str("id"), type = j->str("type");
         if (type == "internal" || id.empty() || id[0] == ':') continue;
+        // "<road>#<k>": netconvert splits a road where its lane count
+        // changes (a lane tapering in or out inside a transition).
+        if (id.find('#') != std::string::npos) continue;
         if (allDigits(id)) {
             const size_t jid = std::stoul(id);
             EXPECT_GE(jid, city.streets.edges.size()) << id;
@@ -243,9 +258,16 @@ void checkNet(const City& city, const std::string& label) {
             ++netLinks;
         }
     }
+    // Traffic lights: netconvert builds one traffic-light program per
+    // junction whose approaches carry dynamic signals.
+    std::set<int> lit;
+    for (const SignalPlacement& sp : M.signals)
+        if (sp.kind == SignalPlacement::Kind::TrafficLight) lit.insert(sp.junction);
+    EXPECT_EQ(r.net->all("tlLogic").size(), lit.size()) << label;
     EXPECT_EQ(netJunctions, graphJunctions) << label;
-    EXPECT_EQ(netEnds, deadEnds) << label;
-    EXPECT_EQ(netLinks, links) << label;
+    EXPECT_EQ(netEnds, openEnds) << label;
+    // A transition road between two street roads: two road-to-road nodes.
+    EXPECT_EQ(netLinks, 2 * transitions) << label;
 
     std::map<std::string, int> netLanes;
     for (const Element* e : r.net->all("edge")) {
@@ -257,20 +279,27 @@ void checkNet(const City& city, const std::string& label) {
         const EdgeLanes& L = M.edges[e];
         if (!L.valid) continue;
         ++roads;
-        const int want = std::max<int>(city.streets.edges[e].lanes, 2);
-        EXPECT_EQ(L.right + L.left, want) << "edge " << e;
+        const StreetEdge& E = city.streets.edges[e];
+        if (E.lanesForward < 0 && E.lanesBackward < 0) EXPECT_EQ(L.right + L.left, std::max<int>(E.lanes, 2)) << "edge " << e;
         EXPECT_NEAR(L.laneWidth * (L.right + L.left), carriagewayWidth(city.streets.edges[e]), 1e-9);
         const std::string rid = std::to_string(e);
-        ASSERT_TRUE(netLanes.count("-" + rid)) << label << ": no net edge for road " << rid;
-        ASSERT_TRUE(netLanes.count(rid)) << label << ": no net edge for road " << rid;
-        EXPECT_EQ(netLanes["-" + rid], L.right) << label << " road " << rid;
-        EXPECT_EQ(netLanes[rid], L.left) << label << " road " << rid;
+        if (L.right > 0) {
+            ASSERT_TRUE(netLanes.count("-" + rid)) << label << ": no net edge for road " << rid;
+            EXPECT_EQ(netLanes["-" + rid], L.right) << label << " road " << rid;
+        }
+        if (L.left > 0) {
+            ASSERT_TRUE(netLanes.count(rid)) << label << ": no net edge for road " << rid;
+            EXPECT_EQ(netLanes[rid], L.left) << label << " road " << rid;
+        }
         lanes += size_t(L.right + L.left);
     }
     EXPECT_EQ(n.roads, roads);
     EXPECT_EQ(n.drivingLanes, lanes);
-    std::printf("[ %s ] roads %zu, junctions %zu (netconvert %zu), connecting roads %zu, driving lanes %zu, netconvert errors %d\n",
-                label.c_str(), n.roads, n.junctions, netJunctions, n.connectingRoads, n.drivingLanes, r.errors);
+    std::printf("[ %s ] roads %zu, transitions %zu, junctions %zu (netconvert %zu), connecting roads %zu, driving lanes %zu, "
+                "traffic lights %zu at %zu junctions (netconvert programs %zu), signs %zu, crosswalks %zu, "
+                "netconvert errors %d\n",
+                label.c_str(), n.roads, n.transitions, n.junctions, netJunctions, n.connectingRoads, n.drivingLanes,
+                n.trafficLights, lit.size(), r.net->all("tlLogic").size(), n.signs, n.crosswalks, r.errors);
 }
 
 // ---- lane centres on the road mesh ------------------------------------------
@@ -357,7 +386,8 @@ static void checkLaneCentres(const City& city, const std::string& label) {
         size_t samples = 0, missing = 0, walkSamples = 0, walkCovered = 0;
         double worst = 0;
         for (const Element* road : doc->all("road")) {
-            if (road->str("junction") != "-1") continue;
+            // Street roads (straight lines); transitions are checked by xodr_check.py.
+            if (road->str("junction") != "-1" || road->str("name").rfind("transition", 0) == 0) continue;
             const Element* g = road->first("planView")->first("geometry");
             ASSERT_TRUE(g->first("line"));
             const double len = g->num("length"), hdg = g->num("hdg");
@@ -575,4 +605,77 @@ TEST(OpenDrive, MarkingsFollowTheLaneModel) {
     EXPECT_LT(markingTriangles, 20 * roadTriangles);
     std::printf("[ markings ] %zu stop lines, %zu crossings, %zu centre lines, %zu dividers checked, %zu clear lane centres; "
                 "%zu marking triangles (road: %zu)\n", stops, crossings, centres, dividers, clear, markingTriangles, roadTriangles);
+}
+
+// The road meshes follow the lane model through junctions and bends too:
+// the centres of the driving lanes of every link road (junction turns,
+// degree-2 transitions) lie on the road surface.
+TEST(OpenDrive, LinkRoadLanesLieOnTheRoadMesh) {
+    for (const City& city : {generated(smallParams(7, 500, 0)), osmCity("town.osm"), osmCity("hard_cases.osm")}) {
+        const LaneModel M = buildLaneModel(city.streets, city.params, &city.blocks);
+        const RoadTriangles mesh(city);
+        size_t samples = 0, missing = 0;
+        for (const LinkRoad& r : M.links) {
+            for (double f : {0.1, 0.5, 0.9}) {
+                const double s = f * r.length(), h = r.heading(s);
+                const glm::dvec2 n(-std::sin(h), std::cos(h));
+                for (int side : {-1, 1}) {
+                    double t = r.laneOffset(s);
+                    for (const LinkRoad::Lane& l : side < 0 ? r.right : r.left) {
+                        const double w = r.width(l, s);
+                        if (!l.sidewalk && w > 0.5) {
+                            ++samples;
+                            const glm::dvec2 q = r.point(s) + n * (t + side * 0.5 * w);
+                            if (!mesh.covers(q)) {
+                                ++missing;
+                                ADD_FAILURE() << "no road under link road " << r.in << "->" << r.out << " at s " << s;
+                            }
+                        }
+                        t += side * w;
+                    }
+                }
+            }
+        }
+        EXPECT_GT(samples, 100u);
+        EXPECT_EQ(missing, 0u);
+    }
+}
+
+// OSM road tags reach the simulator: every street road of lanes.osm carries
+// its edge's lanes per direction and speed limit (maxspeed where tagged, the
+// class default otherwise) on its <type> and on each driving lane.
+TEST(OpenDrive, OsmLaneAndSpeedTagsReachTheFile) {
+    const City city = osmCity("lanes.osm");
+    auto xodr = openDriveXml(city.streets, city.params, &city.blocks);
+    ASSERT_TRUE(xodr.isOk());
+    std::string err;
+    auto doc = parseXml(*xodr, &err);
+    ASSERT_TRUE(doc) << err;
+    size_t tagged = 0, oneWay = 0, checked = 0;
+    for (const Element* road : doc->all("road")) {
+        if (road->str("junction") != "-1" || road->str("name").rfind("transition", 0) == 0) continue;
+        const size_t e = std::stoul(road->str("id"));
+        ASSERT_LT(e, city.streets.edges.size());
+        const StreetEdge& E = city.streets.edges[e];
+        const double speed = E.maxspeedKmh > 0 ? double(E.maxspeedKmh) : classSpeedKmh(E.cls);
+        tagged += E.maxspeedKmh > 0;
+        EXPECT_NEAR(road->first("type")->first("speed")->num("max"), speed, 1e-6) << "road " << e;
+        int right = 0, left = 0;
+        const Element* section = road->first("lanes")->first("laneSection");
+        for (const char* side : {"left", "right"}) {
+            if (!section->first(side)) continue;
+            for (const Element* lane : section->first(side)->all("lane")) {
+                if (lane->str("type") != "driving") continue;
+                (std::string(side) == "left" ? left : right)++;
+                EXPECT_NEAR(lane->first("speed")->num("max"), speed, 1e-6) << "road " << e;
+            }
+        }
+        if (E.lanesForward >= 0) EXPECT_EQ(right, E.lanesForward) << "road " << e;
+        if (E.lanesBackward >= 0) EXPECT_EQ(left, E.lanesBackward) << "road " << e;
+        oneWay += right == 0 || left == 0;
+        ++checked;
+    }
+    EXPECT_GT(checked, 10u);
+    EXPECT_GT(tagged, 5u);
+    EXPECT_GT(oneWay, 3u);
 }

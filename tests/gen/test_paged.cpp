@@ -24,7 +24,7 @@
 
 #include "citygen/regions.h"
 #include "runtime/scene/city_file.h"
-#include "runtime/scene/paged_city.h"
+#include "bake/gen/paged_city.h"
 #include "runtime/scene/scene_file.h"
 #include "runtime/scene/scene_graph.h"
 #include "runtime/scene/tree_impostor_graph.h"

@@ -1,4 +1,4 @@
-// Issue 11, item 2: point impostors drawn as splats with normalised
+// Point impostors drawn as splats with normalised
 // accumulation (nodes/point_splat.h). Needs a display (xvfb-run -a); skips
 // without one.
 #include <cmath>

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes town.osm: a synthetic, partly mapped OSM extract for measuring the building import
-(docs/buildings.md "Buildings from OSM"). A 7 x 7 grid of streets 120 m apart; 30 of the 36
+(docs/reference/buildings.md "Buildings from OSM"). A 7 x 7 grid of streets 120 m apart; 30 of the 36
 blocks carry buildings (rows of rectangles along the block sides, a courtyard multipolygon in
 every sixth mapped block), the other 6 are unmapped (procedural lots stay there). Tags mix
 height, building:levels, none, roof:shape; a few footprints are broken on purpose (bow-ties,

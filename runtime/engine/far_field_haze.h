@@ -1,0 +1,25 @@
+// Haze stage: FrameEffects::applyHaze over pixels whose eye-plane depth is
+// known (the far field's traced pixels, the `raycast` mode's frame), through
+// a transmittance table built once per frame (linear interpolation per
+// 1/1024 of the haze range: error < 1e-6, far below an 8-bit step).
+//
+// hazeStage(): hazes the n listed pixels (indices y * width + x; a null list
+// = the first n pixels of the image in order) at their eye-plane depth
+// (depth[k] for entry k, metres; +inf = sky, left alone). Records
+// Stage::Haze and the haze effect when fx.haze and n > 0; else does nothing.
+// Contract: every listed index < out's pixel count. Single-threaded;
+// thread-safe for distinct outputs.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+
+#include "runtime/engine/frame_effects.h"
+#include "runtime/engine/frame_stats.h"
+#include "runtime/engine/image.h"
+
+namespace vista {
+
+void hazeStage(const FrameEffects& fx, const uint32_t* pixels, size_t n, const float* depth, Image& out,
+               FrameStats& stats);
+
+}  // namespace vista
