@@ -15,6 +15,7 @@
 #include "citygen/street_lights.h"
 #include "citygen/streets.h"
 #include "citygen/surfaces.h"
+#include "citygen/traffic_signals.h"
 #include "citygen/trees.h"
 
 namespace vista {
@@ -57,6 +58,10 @@ void meshTiles(City& city, const std::vector<int>& only, Progress* progress) {
         lightsOf[size_t(grid.tileOf(glm::dvec2(city.streetLights[i])))].push_back(i);
 
     const SurfaceIndex surfaceIndex = buildSurfaceIndex(city, grid);
+    // Signals (traffic lights, stop and yield signs): the lane model's, each in the tile of its pole.
+    const std::vector<SignalPlacement>& signals = surfaceIndex.lanes.signals;
+    std::vector<std::vector<uint32_t>> signalsOf(size_t(grid.count()));
+    for (uint32_t i = 0; i < signals.size(); ++i) signalsOf[size_t(grid.tileOf(signals[i].position))].push_back(i);
     std::vector<int> which = only;
     if (which.empty())
         for (int t = 0; t < grid.count(); ++t) which.push_back(t);
@@ -79,6 +84,11 @@ void meshTiles(City& city, const std::vector<int>& only, Progress* progress) {
         for (uint32_t l : tile.streetLights)
             meshStreetLight(city.streetLights[l], tile.origin, light, tile.meshes[size_t(Material::Lamp)],
                             makeInstanceId(InstanceKind::StreetLight, l));
+        for (uint32_t i : signalsOf[size_t(t)]) {
+            const SignalPlacement& sp = signals[i];
+            meshSignal(sp, p, tile.origin, light, tile.meshes[size_t(signalMaterial(sp.kind))],
+                       makeInstanceId(signalInstanceKind(sp.kind), i));
+        }
         std::lock_guard<std::mutex> lock(m);
         ++done;
     });

@@ -35,9 +35,10 @@ Result<City> generateCity(const CityParams& params, const GenerateOptions& optio
 // The meshes-per-tile stage of generateCity on a city whose streets, blocks,
 // buildings, trees (and street lights) are set: replaces city.tiles with the
 // non-empty tiles among `tiles` (indices of TileGrid(city.params), row-major;
-// empty = every tile), in that order. Buildings, trees and lights go to the
-// tile of their anchor (footprint centroid, trunk base, pole base); those
-// anchored in other tiles are not meshed. Parallel over tiles; the bytes do
+// empty = every tile), in that order. Buildings, trees, lights and signals
+// (the lane model's traffic lights, stop and yield signs: traffic_signals.h)
+// go to the tile of their anchor (footprint centroid, trunk base, pole base);
+// those anchored in other tiles are not meshed. Parallel over tiles; the bytes do
 // not depend on the thread count. Indices out of range: VISTA_CHECK.
 void meshTiles(City& city, const std::vector<int>& tiles, Progress* progress);
 

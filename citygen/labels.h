@@ -7,14 +7,17 @@
 // (City::trees), street edge index (carriageway pieces and lane markings of
 // the edge), street node index (the junction polygon at the node), block
 // index (sidewalk ring of the block; park lawn of a park block), street
-// light index (City::streetLights). Ground (terrain) and sky are 0.
+// light index (City::streetLights), signal index (LaneModel::signals of
+// lanes.h, for traffic lights and for stop and yield signs alike). Ground
+// (terrain) and sky are 0.
 // Tree prototype meshes are shared by all trees: their vertices carry the
 // Material of the part (Trunk, Leaves) instead; the tree's id comes from the
 // instance. makeInstanceId() checks index < 2^28 (VISTA_CHECK).
 //
 // Semantic class (uint8): one per Material (semanticClass) plus sky = 0;
 // classes whose effect a city does not declare (street_light: night) simply
-// never occur. Pure functions; thread-safe.
+// never occur; traffic_light and traffic_sign cover the whole signal, pole
+// included (as street_light covers its pole). Pure functions; thread-safe.
 #pragma once
 #include <cstdint>
 
@@ -23,7 +26,11 @@
 
 namespace vista {
 
-enum class InstanceKind : uint32_t { None = 0, Building = 1, Tree = 2, Road = 3, Junction = 4, Sidewalk = 5, Park = 6, StreetLight = 7 };
+enum class InstanceKind : uint32_t {
+    None = 0, Building = 1, Tree = 2, Road = 3, Junction = 4, Sidewalk = 5, Park = 6, StreetLight = 7,
+    TrafficLight = 8, TrafficSign = 9,
+    Count = 10  // number of kinds (not a kind)
+};
 constexpr uint32_t kInstanceIndexBits = 28;
 constexpr uint32_t kInstanceIndexMask = (1u << kInstanceIndexBits) - 1u;
 
@@ -33,7 +40,7 @@ inline uint32_t makeInstanceId(InstanceKind kind, uint64_t index) {
 }
 inline InstanceKind instanceKind(uint32_t id) { return InstanceKind(id >> kInstanceIndexBits); }
 inline uint32_t instanceIndex(uint32_t id) { return id & kInstanceIndexMask; }
-const char* instanceKindName(InstanceKind k);  // "none", "building", ...; "unknown" out of range
+const char* instanceKindName(InstanceKind k);  // "none", "building", ...; "unknown" out of range (Count included)
 
 // Semantic classes (values are stable: datasets depend on them).
 enum class SemanticClass : uint8_t {
@@ -49,7 +56,9 @@ enum class SemanticClass : uint8_t {
     TreeTrunk = 9,
     TreeLeaves = 10,
     StreetLight = 11,
-    Count = 12
+    TrafficLight = 12,
+    TrafficSign = 13,
+    Count = 14
 };
 constexpr int kSemanticClassCount = int(SemanticClass::Count);
 SemanticClass semanticClass(Material m);          // Count (invalid) for Material::Count

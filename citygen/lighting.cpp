@@ -34,6 +34,8 @@ glm::dvec3 materialAlbedo(Material m) {
         case Material::Trunk: return {0.33, 0.24, 0.17};
         case Material::Leaves: return {0.15, 0.33, 0.11};
         case Material::Lamp: return {0.30, 0.31, 0.32};
+        case Material::TrafficLight: return {0.06, 0.07, 0.06};
+        case Material::TrafficSign: return {0.45, 0.46, 0.47};
         case Material::Count: break;
     }
     return {1, 0, 1};

@@ -19,7 +19,11 @@ namespace vista {
 
 // Surface materials; one output Geometry per tile and material.
 // Lamp: street lights of the `night` effect (pole and emissive head); absent otherwise.
-enum class Material : uint8_t { Ground, Road, Marking, Sidewalk, Grass, Wall, Window, Roof, Trunk, Leaves, Lamp, Count };
+// TrafficLight, TrafficSign: the lane model's signals (traffic_signals.h), pole and head.
+// Values are stable (tree prototypes store Trunk and Leaves by value): new ones go last.
+enum class Material : uint8_t {
+    Ground, Road, Marking, Sidewalk, Grass, Wall, Window, Roof, Trunk, Leaves, Lamp, TrafficLight, TrafficSign, Count
+};
 constexpr int kMaterialCount = int(Material::Count);
 const char* materialName(Material m);
 // The Material named `name` (materialName's inverse); Material::Count if none.

@@ -121,7 +121,7 @@ nlohmann::json classesJson() {
         classes.push_back({{"id", c}, {"name", semanticClassName(SemanticClass(c))}, {"color", {rgb[0], rgb[1], rgb[2]}}});
     }
     nlohmann::json kinds = nlohmann::json::array();
-    for (uint32_t k = 0; k <= uint32_t(InstanceKind::StreetLight); ++k)
+    for (uint32_t k = 0; k < uint32_t(InstanceKind::Count); ++k)
         kinds.push_back({{"kind", k}, {"name", instanceKindName(InstanceKind(k))}});
     return {{"semantic_classes", classes},
             {"semantic_unknown", 255},

@@ -264,7 +264,8 @@ Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedC
 
     const RegionGrid grid(params, o.regionSizeM);
     const std::string keyText = paramsToJson(params) + "\nregion_size_m=" + exactDecimal(o.regionSizeM) +
-                                "\nformat=" + std::to_string(kPagedFormatVersion) + "\ncoarse_trees=impostors";
+                                "\nformat=" + std::to_string(kPagedFormatVersion) + "\ncoarse_trees=impostors" +
+                                "\nsignals=lane_model";  // regions of runs whose tiles had no signals are remade
     const std::string key = hex64(hashBytes64(keyText.data(), keyText.size()));
     PagedCityReport rep;
     rep.regions = grid.count();
