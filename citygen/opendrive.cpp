@@ -9,6 +9,7 @@
 
 #include "citygen/lanes.h"
 #include "citygen/terrain.h"
+#include "citygen/traffic_signals.h"
 #include "foundation/units.h"
 
 namespace vista {
@@ -219,8 +220,9 @@ void Writer::signals(uint32_t e) {
         const char* name = light ? "traffic light" : sp.kind == SignalPlacement::Kind::Stop ? "stop" : "yield";
         xml += "      <signal s=\"" + num(sp.s) + "\" t=\"" + num(sp.t) + "\" id=\"" + str(id) + "\" name=\"" + name +
                "\" dynamic=\"" + (light ? "yes" : "no") + "\" orientation=\"" + (sp.atB ? "+" : "-") + "\" zOffset=\"" +
-               (light ? "2.5" : "1.8") + "\" country=\"DE\" type=\"" + type + "\" subtype=\"-1\" height=\"" +
-               (light ? "0.9" : "0.75") + "\" width=\"" + (light ? "0.3" : "0.75") + "\">\n";
+               num(light ? kTrafficLightBottom : kSignBottom) + "\" country=\"DE\" type=\"" + type +
+               "\" subtype=\"-1\" height=\"" + num(light ? kTrafficLightHeight : kSignSize) + "\" width=\"" +
+               num(light ? kTrafficLightWidth : kSignSize) + "\">\n";
         xml += "        <validity fromLane=\"" + str(sp.atB ? -1 : 1) + "\" toLane=\"" + str(sp.atB ? -sp.lanes : sp.lanes) +
                "\"/>\n      </signal>\n";
         if (!light) {
