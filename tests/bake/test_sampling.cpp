@@ -285,7 +285,7 @@ TEST(Sampling, RemovalOnGrazingGroundKeepsOneCameraWithoutHoles) {
     // records the top face from behind, through the box). Those cameras sample
     // the ground sufficiently for every viewpoint of the cell, so after removal
     // about one camera's worth of samples is left: at most 10 % more than the
-    // larger of their counts (before the fix: all of them, about twice that).
+    // larger of their counts (keeping every camera's samples would give about twice that).
     std::array<size_t, 3> top{0, 0, 0}, kept{0, 0, 0};
     for (size_t i = 0; i < ldi.samples.size(); ++i) {
         const auto& smp = ldi.samples[i];
