@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Installs the Debian packages vista needs (skips apt when all are present) and builds it
-# (file and dpkg-dev: cpack's Debian generator, .ci/package.sh).
+# (file and dpkg-dev: cpack's Debian generator, .ci/package.sh; clang-format: the Style test).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 PKGS="build-essential cmake ninja-build pkg-config libopenscenegraph-dev openscenegraph libembree-dev
   libcgal-dev libgmp-dev libmpfr-dev libboost-dev libglm-dev libtbb-dev nlohmann-json3-dev libcli11-dev
   libosmium2-dev libprotozero-dev libbz2-dev libexpat1-dev zlib1g-dev libpng-dev libgtest-dev
-  libbenchmark-dev xvfb xauth libgl1-mesa-dri jq python3 sumo sumo-tools file dpkg-dev libxml2-utils"
+  libbenchmark-dev xvfb xauth libgl1-mesa-dri jq python3 sumo sumo-tools file dpkg-dev libxml2-utils
+  clang-format"
 missing=""
 for p in $PKGS; do dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"; done
 if [ -n "$missing" ]; then

@@ -96,7 +96,14 @@ class PointSampler {
 public:
     PointSampler(const RayScene& scene, const SamplingSetup& s, const AppearanceParams& p, const TexelGrid& grid,
                  const FTable& fTable, const glm::dvec3& pt, Rng& rng, PointResult& r)
-        : _scene(scene), _s(s), _p(p), _grid(grid), _fTable(fTable), _pt(pt), _rng(rng), _r(r),
+        : _scene(scene),
+          _s(s),
+          _p(p),
+          _grid(grid),
+          _fTable(fTable),
+          _pt(pt),
+          _rng(rng),
+          _r(r),
           _acc(static_cast<size_t>(grid.nt)) {}
 
     // Runs the steps: visibility from the cell, a first pass of samples per
@@ -108,22 +115,33 @@ public:
         glm::dvec3 seenFrom(0.0);
         if (cell && _p.cellVisibilityRays > 0) {
             seen = seenFromCell(*cell, seenFrom);
-            if (!seen) { _r.visible = false; return; }
+            if (!seen) {
+                _r.visible = false;
+                return;
+            }
         }
         // Pass 1: minSamples visible samples per texel.
         for (int t = 0; t < nt; ++t)
             while (_acc[size_t(t)].n < _p.minSamples && _acc[size_t(t)].attempts < 4 * _p.minSamples) sample(t);
         int64_t n = 0;
         double l = 0, l2 = 0;
-        for (const auto& a : _acc) { n += a.n; l += a.l; l2 += a.l2; }
-        if (n == 0 && !seen) { _r.visible = false; return; }
+        for (const auto& a : _acc) {
+            n += a.n;
+            l += a.l;
+            l2 += a.l2;
+        }
+        if (n == 0 && !seen) {
+            _r.visible = false;
+            return;
+        }
         if (n == 0) {
             colourFromCell(seenFrom);
             return;
         }
         _r.visible = true;
         const double pooledStd = n > 1 ? std::sqrt(std::max(0.0, (l2 - l * l / double(n)) / double(n - 1))) : 0.0;
-        const bool noiseOnly = nt > 1 && _fTable.enabled() && !(pooledStd < _p.singleColorThreshold) && !viewDependent(_acc, _fTable);
+        const bool noiseOnly =
+            nt > 1 && _fTable.enabled() && !(pooledStd < _p.singleColorThreshold) && !viewDependent(_acc, _fTable);
         refine(pooledStd, noiseOnly);
         summarize(noiseOnly);
     }
@@ -141,7 +159,10 @@ private:
                 for (int a = 0; a < 3; ++a) e[a] = _rng.uniform(cell.lo[a], cell.hi[a]);
             glm::dvec3 d = _pt - e;
             const double dist = glm::length(d);
-            if (dist < 1e-6) { seen = true; break; }
+            if (dist < 1e-6) {
+                seen = true;
+                break;
+            }
             d /= dist;
             ++_r.rays;
             seen = !_scene.occluded(glm::vec3(e), glm::vec3(d), 0.0f, float(dist - std::max(0.1, 2e-3 * dist)));
@@ -204,7 +225,8 @@ private:
             const glm::dvec3 dir = glm::normalize(d + _p.pixelAngle * (ox * e1 + oy * e2));
             ++_r.rays;
             const RayHit h = _scene.intersect(glm::vec3(seenFrom), glm::vec3(dir), 0.0f, 1e30f);
-            sum += h.hit ? glm::dvec3(_scene.hitColor(h)) : glm::dvec3(glm::vec3(skyColor(std::asin(std::clamp(dir.z, -1.0, 1.0))))) / 255.0;
+            sum += h.hit ? glm::dvec3(_scene.hitColor(h))
+                         : glm::dvec3(glm::vec3(skyColor(std::asin(std::clamp(dir.z, -1.0, 1.0))))) / 255.0;
         }
         _r.visible = true;
         _r.single = true;
@@ -221,12 +243,14 @@ private:
         if (!(pooledStd < _p.singleColorThreshold) && nt > 1 && !noiseOnly) {
             for (int t = 0; t < nt; ++t) {
                 TexelAcc& a = _acc[size_t(t)];
-                while (a.n < _p.maxSamples && a.attempts < maxAttempts && !(a.n >= _p.minSamples && a.stdErr() < _p.varianceThreshold))
+                while (a.n < _p.maxSamples && a.attempts < maxAttempts &&
+                       !(a.n >= _p.minSamples && a.stdErr() < _p.varianceThreshold))
                     sample(t);
             }
         } else if (nt == 1) {
             TexelAcc& a = _acc[0];
-            while (a.n < _p.maxSamples && a.attempts < maxAttempts && !(a.n >= _p.minSamples && a.stdErr() < _p.varianceThreshold))
+            while (a.n < _p.maxSamples && a.attempts < maxAttempts &&
+                   !(a.n >= _p.minSamples && a.stdErr() < _p.varianceThreshold))
                 sample(0);
         }
     }
@@ -246,7 +270,8 @@ private:
         _r.mean = sum / double(cnt);
         // Texel means; unseen texels take the mean of the seen ones.
         glm::dvec3 tm(0.0);
-        for (const auto& a : _acc) if (a.n > 0) tm += a.mean();
+        for (const auto& a : _acc)
+            if (a.n > 0) tm += a.mean();
         tm /= double(seenTexels);
         _r.texels.resize(size_t(nt));
         for (int t = 0; t < nt; ++t) _r.texels[size_t(t)] = _acc[size_t(t)].n > 0 ? _acc[size_t(t)].mean() : tm;
@@ -254,7 +279,8 @@ private:
         for (const auto& c : _r.texels) var += (c - tm) * (c - tm);
         var /= double(nt);
         const double maxStd = std::sqrt(std::max(var.x, std::max(var.y, var.z)));
-        _r.noise = noiseOnly || (nt > 1 && _fTable.enabled() && !(maxStd < _p.singleColorThreshold) && !viewDependent(_acc, _fTable));
+        _r.noise = noiseOnly || (nt > 1 && _fTable.enabled() && !(maxStd < _p.singleColorThreshold) &&
+                                 !viewDependent(_acc, _fTable));
         _r.single = nt == 1 || maxStd < _p.singleColorThreshold || _r.noise;
         // One colour: the mean of every sample (noise) or of the texel means.
         if (_r.single && !_r.noise) _r.mean = tm;
@@ -275,13 +301,19 @@ private:
 // and adds every point's rays, samples and kind to stats.
 void writeResults(const std::vector<PointResult>& res, const std::vector<glm::vec3>& points, int nt,
                   PointImpostorData& out, AppearanceStats& stats, std::vector<uint32_t>* kept) {
-    out.positions.clear(); out.colors.clear(); out.block.clear(); out.texels.clear();
+    out.positions.clear();
+    out.colors.clear();
+    out.block.clear();
+    out.texels.clear();
     if (kept) kept->clear();
     for (size_t k = 0; k < points.size(); ++k) {
         const PointResult& r = res[k];
         stats.rays += r.rays;
         stats.samples += r.samples;
-        if (!r.visible) { ++stats.dropped; continue; }
+        if (!r.visible) {
+            ++stats.dropped;
+            continue;
+        }
         if (kept) kept->push_back(uint32_t(k));
         out.positions.push_back(points[k]);
         out.colors.push_back(toU8(r.mean));

@@ -44,24 +44,24 @@ namespace vista {
 
 struct AppearanceParams {
     int texelsX = 8, texelsY = 2;
-    int minSamples = 2;                     // visible samples per texel in pass 1
-    int maxSamples = 8;                     // per texel
-    double varianceThreshold = 2.0 / 255;   // std error of the texel luma mean (0..1)
-    double singleColorThreshold = 3.0 / 255;// std dev (0..1) below which one colour suffices
-    double significance = 0.01;             // F-test level for view dependence (0 = off)
-    double viewSigma = 0.5;                 // texel widths
-    double pixelSigma = 0.5;                // output pixels
-    double pixelAngle = 0.0024;             // radians per output pixel (from SamplingParams)
-    int cellVisibilityRays = 17;            // visibility pre-pass from the view cell (0 = off)
+    int minSamples = 2;                       // visible samples per texel in pass 1
+    int maxSamples = 8;                       // per texel
+    double varianceThreshold = 2.0 / 255;     // std error of the texel luma mean (0..1)
+    double singleColorThreshold = 3.0 / 255;  // std dev (0..1) below which one colour suffices
+    double significance = 0.01;               // F-test level for view dependence (0 = off)
+    double viewSigma = 0.5;                   // texel widths
+    double pixelSigma = 0.5;                  // output pixels
+    double pixelAngle = 0.0024;               // radians per output pixel (from SamplingParams)
+    int cellVisibilityRays = 17;              // visibility pre-pass from the view cell (0 = off)
 };
 
 struct AppearanceStats {
-    int64_t rays = 0;          // occlusion + pixel rays
-    int64_t samples = 0;       // visible samples
-    size_t dropped = 0;        // points never visible
+    int64_t rays = 0;     // occlusion + pixel rays
+    int64_t samples = 0;  // visible samples
+    size_t dropped = 0;   // points never visible
     size_t singleColor = 0;
     size_t textured = 0;
-    size_t noiseOnly = 0;      // points made single-coloured by the F test
+    size_t noiseOnly = 0;  // points made single-coloured by the F test
 };
 
 // Fills `out` (positions, colours, blocks, texels, plane) from `points` (frame

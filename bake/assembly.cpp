@@ -27,7 +27,8 @@ osg::ref_ptr<ViewCellSwitch> assembleBakedScene(const SceneModel& city, const st
     root->setTileCount(root->getNumChildren());
     root->setUserValue("vista.baked", 1);
     root->setUserValue("vista.bake_params", paramsText);
-    if (representation == BakeRepresentation::Mesh) root->setUserValue("vista.bake_representation", std::string("mesh"));
+    if (representation == BakeRepresentation::Mesh)
+        root->setUserValue("vista.bake_representation", std::string("mesh"));
     if (!sourceCityHash.empty()) root->setUserValue("vista.source_city_hash", sourceCityHash);
     // Cell ids are edge ids; the switch is indexed by edge id (absent edges get empty boxes).
     uint32_t maxId = 0;
@@ -43,7 +44,8 @@ osg::ref_ptr<ViewCellSwitch> assembleBakedScene(const SceneModel& city, const st
             xf->setName("impostor_" + std::to_string(im.cell) + "_" + std::to_string(int(im.end)));
             xf->setDataVariance(osg::Object::DYNAMIC);
             const ImpostorFrame& f = im.frame;
-            const osg::Matrixd m(f.x.x, f.x.y, 0, 0, -f.x.y, f.x.x, 0, 0, 0, 0, 1, 0, f.origin.x, f.origin.y, f.origin.z, 1);
+            const osg::Matrixd m(f.x.x, f.x.y, 0, 0, -f.x.y, f.x.x, 0, 0, 0, 0, 1, 0, f.origin.x, f.origin.y,
+                                 f.origin.z, 1);
             xf->setMatrix(m);
             osg::ref_ptr<osg::Geode> geode = new osg::Geode;
             osg::ref_ptr<PointImpostor> pi = new PointImpostor;
@@ -61,7 +63,8 @@ osg::ref_ptr<ViewCellSwitch> assembleBakedScene(const SceneModel& city, const st
             xf->setName("lodmesh_" + std::to_string(mr.cell) + "_" + std::to_string(int(mr.end)));
             xf->setDataVariance(osg::Object::DYNAMIC);
             const ImpostorFrame& f = mr.frame;
-            xf->setMatrix(osg::Matrixd(f.x.x, f.x.y, 0, 0, -f.x.y, f.x.x, 0, 0, 0, 0, 1, 0, f.origin.x, f.origin.y, f.origin.z, 1));
+            xf->setMatrix(osg::Matrixd(f.x.x, f.x.y, 0, 0, -f.x.y, f.x.x, 0, 0, 0, 0, 1, 0, f.origin.x, f.origin.y,
+                                       f.origin.z, 1));
             osg::ref_ptr<osg::Geode> geode = new osg::Geode;
             osg::ref_ptr<TexturedDepthMesh> tm = new TexturedDepthMesh;
             tm->setName(xf->getName());
@@ -80,7 +83,8 @@ osg::ref_ptr<ViewCellSwitch> assembleBakedScene(const SceneModel& city, const st
         hidden[c].erase(std::unique(hidden[c].begin(), hidden[c].end()), hidden[c].end());
     }
     // Build the CSR lists in one go (setCellChildren per cell would be quadratic).
-    osg::ref_ptr<osg::UIntArray> hs = new osg::UIntArray, hi = new osg::UIntArray, is = new osg::UIntArray, ii = new osg::UIntArray;
+    osg::ref_ptr<osg::UIntArray> hs = new osg::UIntArray, hi = new osg::UIntArray, is = new osg::UIntArray,
+                                 ii = new osg::UIntArray;
     hs->push_back(0);
     is->push_back(0);
     for (uint32_t c = 0; c < maxId; ++c) {

@@ -32,7 +32,8 @@ namespace {
 
 // Software projection of the points from the cell centre (target view looking
 // along the sampling-plane normal): covered pixels and screen bounding box.
-void screenStats(const PointImpostorData& d, const Box3& cell, const SamplingSetup& s, const SamplingParams& sp, ImpostorStats& st) {
+void screenStats(const PointImpostorData& d, const Box3& cell, const SamplingSetup& s, const SamplingParams& sp,
+                 ImpostorStats& st) {
     const glm::dvec3 eye = cell.center();
     const double f = 1.0 / std::tan(0.5 * sp.fovYDeg * kPi / 180.0);
     const double aspect = double(sp.outWidth) / sp.outHeight;
@@ -43,10 +44,14 @@ void screenStats(const PointImpostorData& d, const Box3& cell, const SamplingSet
         const double z = glm::dot(v, s.n);
         if (z <= 0) continue;
         const double x = glm::dot(v, s.U) / z * f / aspect, y = glm::dot(v, s.V) / z * f;
-        const int px = int(std::floor((x * 0.5 + 0.5) * sp.outWidth)), py = int(std::floor((0.5 - y * 0.5) * sp.outHeight));
+        const int px = int(std::floor((x * 0.5 + 0.5) * sp.outWidth)),
+                  py = int(std::floor((0.5 - y * 0.5) * sp.outHeight));
         if (px < 0 || py < 0 || px >= sp.outWidth || py >= sp.outHeight) continue;
         hit[size_t(py) * size_t(sp.outWidth) + size_t(px)] = 1;
-        bx0 = std::min(bx0, px); bx1 = std::max(bx1, px); by0 = std::min(by0, py); by1 = std::max(by1, py);
+        bx0 = std::min(bx0, px);
+        bx1 = std::max(bx1, px);
+        by0 = std::min(by0, py);
+        by1 = std::max(by1, py);
     }
     st.screenPixels = size_t(std::count(hit.begin(), hit.end(), uint8_t(1)));
     st.screenBBoxPixels = bx1 >= bx0 ? size_t(bx1 - bx0 + 1) * size_t(by1 - by0 + 1) : 0;
@@ -54,7 +59,8 @@ void screenStats(const PointImpostorData& d, const Box3& cell, const SamplingSet
 
 }  // namespace
 
-Status bakeImpostor(const TriangleSoup& soup, const Box3& cellBox, const BakeParams& p, uint64_t entity, ImpostorResult& r,
+Status bakeImpostor(const TriangleSoup& soup, const Box3& cellBox, const BakeParams& p, uint64_t entity,
+                    ImpostorResult& r,
                     const std::function<std::vector<uint8_t>(const std::vector<glm::vec3>&)>& keepVisible) {
     Box3 far{glm::dvec3(1e300), glm::dvec3(-1e300)};
     for (uint32_t idx : soup.indices) {
@@ -107,7 +113,8 @@ Status bakeImpostor(const TriangleSoup& soup, const Box3& cellBox, const BakePar
     r.stats.mcRays = as.rays;
     r.stats.mcSamples = as.samples;
     r.stats.points = r.data.positions.size();
-    r.stats.textured = size_t(std::count_if(r.data.block.begin(), r.data.block.end(), [](int32_t b) { return b >= 0; }));
+    r.stats.textured =
+        size_t(std::count_if(r.data.block.begin(), r.data.block.end(), [](int32_t b) { return b >= 0; }));
     r.stats.dropped = as.dropped + occludedDropped;
     r.stats.noiseSingle = as.noiseOnly;
     screenStats(r.data, cellBox, s, p.sampling, r.stats);
@@ -121,7 +128,8 @@ Status bakeMeshEnd(const TriangleSoup& soup, const Box3& cellBox, const BakePara
     auto scene = RayScene::build(soup, so);
     if (!scene) return scene.status();
     const int endBudget = std::max(p.mesh.maxTriangles / 2, 2);
-    const DepthView view = chooseDepthView(soup, cellBox.center(), std::tan(outputPixelAngle(p.sampling)), p.mesh.imageSize, endBudget);
+    const DepthView view =
+        chooseDepthView(soup, cellBox.center(), std::tan(outputPixelAngle(p.sampling)), p.mesh.imageSize, endBudget);
     const FarImage img = renderFarImage(**scene, view);
     const double cellRadius = 0.5 * glm::length(cellBox.hi - cellBox.lo);
     DepthMeshStats ds;
@@ -198,51 +206,58 @@ PlacementPlan planPlacement(const BakeInput& in, const BakeParams& p, std::atomi
 
 CellResult bakeCell(const BakeInput& in, const ViewCell& cell, const BakeParams& p) {
     if (p.representation == BakeRepresentation::Mesh)
-        return forEachEnd(in, cell, p, [&](FarSet& fs, int end, const std::string& what, const Stopwatch& endTime, CellResult& out) {
-            MeshResult r;
+        return forEachEnd(in, cell, p,
+                          [&](FarSet& fs, int end, const std::string& what, const Stopwatch& endTime, CellResult& out) {
+                              MeshResult r;
+                              startResult(r, cell, end, fs);
+                              if (Status st = bakeMeshEnd(fs.soup, cellInFrame(cell, r.frame), p, r); !st) {
+                                  out.notes.push_back(what + st.message());
+                                  return;
+                              }
+                              if (r.mesh.indices.empty()) {
+                                  out.notes.push_back(what + "no visible far geometry");
+                                  return;
+                              }
+                              r.stats.bakeMs = endTime.ms();
+                              out.meshes.push_back(std::move(r));
+                          });
+    return forEachEnd(
+        in, cell, p, [&](FarSet& fs, int end, const std::string& what, const Stopwatch& endTime, CellResult& out) {
+            if (p.placement.byCost) {
+                const PlannedEnd* planned = in.plan ? in.plan->find(cell.id, end) : nullptr;
+                if (!in.cityRays) {
+                    out.notes.push_back(what + "placement by cost: no city ray scene, placed");
+                } else if (planned) {
+                    out.notes.push_back(what + planned->describe());
+                    if (!planned->inBudget) return;
+                } else {
+                    const PlacementEstimate est =
+                        estimatePlacement(*in.cityRays, in.tileLookup, cell, fs, p.sampling, p.placement);
+                    out.notes.push_back(what + (est.place ? "placed: " : "not placed: ") + est.describe());
+                    if (!est.place) return;
+                }
+            }
+            ImpostorResult r;
+            const ImpostorFrame frame = fs.frame;
             startResult(r, cell, end, fs);
-            if (Status st = bakeMeshEnd(fs.soup, cellInFrame(cell, r.frame), p, r); !st) {
+            std::function<std::vector<uint8_t>(const std::vector<glm::vec3>&)> keep;
+            if (p.placement.byCost && in.cityRays)
+                keep = [&](const std::vector<glm::vec3>& pts) {
+                    return visibleFromCell(*in.cityRays, cell, frame, pts, outputPixelAngle(p.sampling), p.placement);
+                };
+            if (Status st =
+                    bakeImpostor(fs.soup, cellInFrame(cell, r.frame), p, hashKeys(cell.id, uint64_t(end)), r, keep);
+                !st) {
                 out.notes.push_back(what + st.message());
                 return;
             }
-            if (r.mesh.indices.empty()) {
-                out.notes.push_back(what + "no visible far geometry");
+            if (r.data.positions.empty()) {
+                out.notes.push_back(what + "no visible points");
                 return;
             }
             r.stats.bakeMs = endTime.ms();
-            out.meshes.push_back(std::move(r));
+            out.impostors.push_back(std::move(r));
         });
-    return forEachEnd(in, cell, p, [&](FarSet& fs, int end, const std::string& what, const Stopwatch& endTime, CellResult& out) {
-        if (p.placement.byCost) {
-            const PlannedEnd* planned = in.plan ? in.plan->find(cell.id, end) : nullptr;
-            if (!in.cityRays) {
-                out.notes.push_back(what + "placement by cost: no city ray scene, placed");
-            } else if (planned) {
-                out.notes.push_back(what + planned->describe());
-                if (!planned->inBudget) return;
-            } else {
-                const PlacementEstimate est = estimatePlacement(*in.cityRays, in.tileLookup, cell, fs, p.sampling, p.placement);
-                out.notes.push_back(what + (est.place ? "placed: " : "not placed: ") + est.describe());
-                if (!est.place) return;
-            }
-        }
-        ImpostorResult r;
-        const ImpostorFrame frame = fs.frame;
-        startResult(r, cell, end, fs);
-        std::function<std::vector<uint8_t>(const std::vector<glm::vec3>&)> keep;
-        if (p.placement.byCost && in.cityRays)
-            keep = [&](const std::vector<glm::vec3>& pts) { return visibleFromCell(*in.cityRays, cell, frame, pts, outputPixelAngle(p.sampling), p.placement); };
-        if (Status st = bakeImpostor(fs.soup, cellInFrame(cell, r.frame), p, hashKeys(cell.id, uint64_t(end)), r, keep); !st) {
-            out.notes.push_back(what + st.message());
-            return;
-        }
-        if (r.data.positions.empty()) {
-            out.notes.push_back(what + "no visible points");
-            return;
-        }
-        r.stats.bakeMs = endTime.ms();
-        out.impostors.push_back(std::move(r));
-    });
 }
 
 }  // namespace vista

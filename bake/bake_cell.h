@@ -25,7 +25,7 @@ namespace vista {
 
 struct BakeInput {
     const SceneModel* city = nullptr;
-    std::vector<SceneTile> tiles;      // bakeTiles(city)
+    std::vector<SceneTile> tiles;  // bakeTiles(city)
     // Placement by cost (points, p.placement.byCost): the whole city's ray
     // scene and the hit -> tile lookup; null when not asked for or when the
     // scene could not be built (then every end is baked, with a note).
@@ -60,7 +60,8 @@ Status bakeMeshEnd(const TriangleSoup& soup, const Box3& cellBox, const BakePara
 // `keepVisible` (optional): marks the LDI samples (all of them, before the
 // redundancy removal, which then examines only the marked ones) to keep;
 // the others count as dropped invisible points.
-Status bakeImpostor(const TriangleSoup& soup, const Box3& cellBox, const BakeParams& p, uint64_t entity, ImpostorResult& r,
+Status bakeImpostor(const TriangleSoup& soup, const Box3& cellBox, const BakeParams& p, uint64_t entity,
+                    ImpostorResult& r,
                     const std::function<std::vector<uint8_t>(const std::vector<glm::vec3>&)>& keepVisible = {});
 
 }  // namespace vista

@@ -8,17 +8,19 @@ std::string BakeParams::canonical() const {
     std::ostringstream o;
     o.precision(17);
     o << "eye=" << cells.eyeMin << "," << cells.eyeMax << ";minLen=" << cells.minLength << ";minW=" << cells.minWidth
-      << ";out=" << sampling.outWidth << "x" << sampling.outHeight << ";fov=" << sampling.fovYDeg << ";os=" << sampling.oversample
-      << ";fp=" << sampling.perspective << ";diag=" << sampling.diagonalFactor << ";layers=" << sampling.maxLayers
-      << ";maxRays=" << sampling.maxRaysPerCamera << ";removal=" << sampling.removeRedundant << ";texels=" << appearance.texelsX
-      << "x" << appearance.texelsY << ";mc=" << appearance.minSamples << "," << appearance.maxSamples << ","
-      << appearance.varianceThreshold << "," << appearance.singleColorThreshold << "," << appearance.viewSigma << ","
-      << appearance.pixelSigma << "," << appearance.significance << ";margin=" << far.margin << ";depth=" << far.farDepth
+      << ";out=" << sampling.outWidth << "x" << sampling.outHeight << ";fov=" << sampling.fovYDeg
+      << ";os=" << sampling.oversample << ";fp=" << sampling.perspective << ";diag=" << sampling.diagonalFactor
+      << ";layers=" << sampling.maxLayers << ";maxRays=" << sampling.maxRaysPerCamera
+      << ";removal=" << sampling.removeRedundant << ";texels=" << appearance.texelsX << "x" << appearance.texelsY
+      << ";mc=" << appearance.minSamples << "," << appearance.maxSamples << "," << appearance.varianceThreshold << ","
+      << appearance.singleColorThreshold << "," << appearance.viewSigma << "," << appearance.pixelSigma << ","
+      << appearance.significance << ";margin=" << far.margin << ";depth=" << far.farDepth
       << ";opening=" << far.openingExtra << ";minTri=" << far.minTriangles << ";seed=" << seed;
     if (representation == BakeRepresentation::Points && placement.byCost)
-        o << ";place=cost," << placement.triangleNs << "," << placement.pointNs << "," << placement.pointsPerFarPixel << ","
-          << placement.samplesAlong << "x" << placement.samplesAcross << "," << placement.rayStepPx << "," << placement.maxRaysPerSample
-          << ";vis=" << placement.visAlong << "x" << placement.visAcross << "x" << placement.visHeights;
+        o << ";place=cost," << placement.triangleNs << "," << placement.pointNs << "," << placement.pointsPerFarPixel
+          << "," << placement.samplesAlong << "x" << placement.samplesAcross << "," << placement.rayStepPx << ","
+          << placement.maxRaysPerSample << ";vis=" << placement.visAlong << "x" << placement.visAcross << "x"
+          << placement.visHeights;
     if (representation == BakeRepresentation::Points && placement.byCost && placement.visByImage)
         o << ";visImage=" << placement.visStepPx << "," << placement.maxVisRaysPerView << "," << placement.visMaxTan;
     if (representation == BakeRepresentation::Points && placement.byCost && placement.budgetMb > 0)

@@ -33,7 +33,8 @@ struct BakeParams {
     AppearanceParams appearance;
     BakeRepresentation representation = BakeRepresentation::Points;
     DepthMeshParams mesh;  // representation Mesh only
-    PlacementParams placement;  // representation Points only (bake/placement.h); off by default here, on in `vista bake`
+    PlacementParams
+        placement;      // representation Points only (bake/placement.h); off by default here, on in `vista bake`
     uint64_t seed = 1;  // the city's seed (set from the city file by the driver)
     std::string canonical() const;
 };

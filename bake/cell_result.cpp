@@ -21,11 +21,13 @@ static_assert(sizeof(ImpostorStats) == 152, "ImpostorStats is stored as one bloc
 class Writer {
 public:
     explicit Writer(std::string& out) : _b(out) {}
-    template <class T> void pod(T& v) {
+    template <class T>
+    void pod(T& v) {
         static_assert(std::is_trivially_copyable<T>::value, "pod() needs a trivially copyable type");
         _b.append(reinterpret_cast<const char*>(&v), sizeof(T));
     }
-    template <class T> void vec(std::vector<T>& v) {
+    template <class T>
+    void vec(std::vector<T>& v) {
         pod64(v.size());
         if (!v.empty()) _b.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
     }
@@ -33,7 +35,8 @@ public:
         pod64(s.size());
         _b.append(s);
     }
-    template <class T, class F> void list(std::vector<T>& v, size_t /*max*/, const char* /*what*/, F&& each) {
+    template <class T, class F>
+    void list(std::vector<T>& v, size_t /*max*/, const char* /*what*/, F&& each) {
         pod64(v.size());
         for (T& x : v) each(x);
     }
@@ -54,23 +57,27 @@ public:
     bool ok() const { return _error.empty(); }
     const std::string& error() const { return _error; }
     size_t at() const { return _at; }
-    template <class T> void pod(T& v) {
+    template <class T>
+    void pod(T& v) {
         static_assert(std::is_trivially_copyable<T>::value, "pod() needs a trivially copyable type");
         if (!take(sizeof(T), "a field")) return;
         std::memcpy(&v, _d + _at - sizeof(T), sizeof(T));
     }
-    template <class T> void vec(std::vector<T>& v) {
+    template <class T>
+    void vec(std::vector<T>& v) {
         uint64_t n = 0;
         if (!count(n, (_n - std::min(_n, _at + 8)) / sizeof(T), "an array")) return;
         v.resize(size_t(n));
-        if (n && take(size_t(n) * sizeof(T), "an array")) std::memcpy(v.data(), _d + _at - size_t(n) * sizeof(T), size_t(n) * sizeof(T));
+        if (n && take(size_t(n) * sizeof(T), "an array"))
+            std::memcpy(v.data(), _d + _at - size_t(n) * sizeof(T), size_t(n) * sizeof(T));
     }
     void str(std::string& s) {
         uint64_t n = 0;
         if (!count(n, _n - std::min(_n, _at + 8), "a string")) return;
         if (take(size_t(n), "a string")) s.assign(_d + _at - size_t(n), size_t(n));
     }
-    template <class T, class F> void list(std::vector<T>& v, size_t max, const char* what, F&& each) {
+    template <class T, class F>
+    void list(std::vector<T>& v, size_t max, const char* what, F&& each) {
         uint64_t n = 0;
         if (!count(n, max, what)) return;
         v.resize(size_t(n));
@@ -87,8 +94,8 @@ private:
     bool take(size_t n, const char* what) {
         if (!ok()) return false;
         if (n > _n - _at) {
-            fail("truncated: " + std::string(what) + " of " + std::to_string(n) + " bytes at byte " + std::to_string(_at) + " runs past the end (" +
-                 std::to_string(_n) + " bytes)");
+            fail("truncated: " + std::string(what) + " of " + std::to_string(n) + " bytes at byte " +
+                 std::to_string(_at) + " runs past the end (" + std::to_string(_n) + " bytes)");
             return false;
         }
         _at += n;
@@ -100,7 +107,8 @@ private:
         pod(n);
         if (!ok()) return false;
         if (n > max) {
-            fail(std::string(what) + " count " + std::to_string(n) + " at byte " + std::to_string(at) + " exceeds " + std::to_string(max));
+            fail(std::string(what) + " count " + std::to_string(n) + " at byte " + std::to_string(at) + " exceeds " +
+                 std::to_string(max));
             return false;
         }
         return true;
@@ -111,7 +119,8 @@ private:
 };
 
 // The fields every result starts with: which street end of which cell, its frame, the tiles it hides.
-template <class Ar, class R> void visitEnd(Ar& ar, R& r) {
+template <class Ar, class R>
+void visitEnd(Ar& ar, R& r) {
     ar.pod(r.cell);
     ar.pod(r.end);
     ar.pod(r.frame.origin);
@@ -120,7 +129,8 @@ template <class Ar, class R> void visitEnd(Ar& ar, R& r) {
 }
 
 // The one field list of the format.
-template <class Ar> void visit(Ar& ar, ImpostorResult& im) {
+template <class Ar>
+void visit(Ar& ar, ImpostorResult& im) {
     visitEnd(ar, im);
     ar.pod(im.data.planeOrigin);
     ar.pod(im.data.planeU);
@@ -134,7 +144,8 @@ template <class Ar> void visit(Ar& ar, ImpostorResult& im) {
     ar.pod(im.stats);
 }
 
-template <class Ar> void visit(Ar& ar, MeshResult& m) {
+template <class Ar>
+void visit(Ar& ar, MeshResult& m) {
     visitEnd(ar, m);
     ar.pod(m.mesh.eye);
     ar.pod(m.mesh.width);
@@ -147,7 +158,8 @@ template <class Ar> void visit(Ar& ar, MeshResult& m) {
 }
 
 // `meshes`: the VBCMESH1 layout (the mesh list follows the impostors).
-template <class Ar> void visit(Ar& ar, CellResult& r, bool meshes) {
+template <class Ar>
+void visit(Ar& ar, CellResult& r, bool meshes) {
     ar.pod(r.cell);
     ar.pod(r.bakeMs);
     ar.list(r.notes, kMaxNotes, "notes", [&](std::string& s) { ar.str(s); });
@@ -159,16 +171,18 @@ std::string checkMesh(const MeshResult& m) {
     const TexturedDepthMeshData& d = m.mesh;
     if (m.end > 1) return "mesh street end " + std::to_string(int(m.end)) + " (must be 0 or 1)";
     if (d.width < 1 || d.height < 1 || d.width > kMaxImageSide || d.height > kMaxImageSide)
-        return "mesh image " + std::to_string(d.width) + "x" + std::to_string(d.height) + " (sides must be 1.." + std::to_string(kMaxImageSide) + ")";
-    if (d.image.size() != size_t(d.width) * size_t(d.height)) return "mesh image size does not match its width and height";
+        return "mesh image " + std::to_string(d.width) + "x" + std::to_string(d.height) + " (sides must be 1.." +
+               std::to_string(kMaxImageSide) + ")";
+    if (d.image.size() != size_t(d.width) * size_t(d.height))
+        return "mesh image size does not match its width and height";
     if (d.texcoords.size() != d.positions.size() || d.indices.size() % 3 != 0) return "inconsistent mesh arrays";
     for (uint32_t i : d.indices)
         if (i >= d.positions.size()) return "mesh index out of range";
     for (size_t k = 0; k < d.positions.size(); ++k) {
         const glm::vec3& p = d.positions[k];
         const glm::vec4& t = d.texcoords[k];
-        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(t.x) || !std::isfinite(t.y) ||
-            !std::isfinite(t.w) || !(t.w > 0))
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(t.x) ||
+            !std::isfinite(t.y) || !std::isfinite(t.w) || !(t.w > 0))
             return "mesh vertex " + std::to_string(k) + " not finite or behind the eye";
     }
     return "";
@@ -177,7 +191,8 @@ std::string checkMesh(const MeshResult& m) {
 // Consistency the field list cannot express; "" when fine.
 std::string checkImpostor(const ImpostorResult& im) {
     const PointImpostorData& d = im.data;
-    if (d.texelsX < 1 || d.texelsY < 1) return "texel layout " + std::to_string(d.texelsX) + "x" + std::to_string(d.texelsY) + " (must be >= 1x1)";
+    if (d.texelsX < 1 || d.texelsY < 1)
+        return "texel layout " + std::to_string(d.texelsX) + "x" + std::to_string(d.texelsY) + " (must be >= 1x1)";
     const size_t bs = size_t(d.texelsX) * size_t(d.texelsY);
     if (d.colors.size() != d.positions.size() || d.block.size() != d.positions.size() || d.texels.size() % bs != 0)
         return "inconsistent impostor arrays";
@@ -201,7 +216,8 @@ std::string encodeCellResult(const CellResult& r, uint64_t configHash) {
 
 Result<CellResult> decodeCellResult(const std::string& bytes, uint64_t configHash, const std::string& what) {
     auto bad = [&](const std::string& why) { return Status::error("cell result '" + what + "': " + why); };
-    if (bytes.size() < 8 + 8 + 8 || (std::memcmp(bytes.data(), kMagic, 8) != 0 && std::memcmp(bytes.data(), kMeshMagic, 8) != 0))
+    if (bytes.size() < 8 + 8 + 8 ||
+        (std::memcmp(bytes.data(), kMagic, 8) != 0 && std::memcmp(bytes.data(), kMeshMagic, 8) != 0))
         return bad("not a vista cell result (bad magic)");
     const bool meshes = std::memcmp(bytes.data(), kMeshMagic, 8) == 0;
     const size_t body = bytes.size() - 8;

@@ -31,17 +31,17 @@ namespace vista {
 struct ImpostorStats {
     size_t farTriangles = 0, tiles = 0;
     int camW[3] = {0, 0, 0}, camH[3] = {0, 0, 0};
-    double requiredStep = 0, usedStep = 0;    // LDI angular step (tangent units)
+    double requiredStep = 0, usedStep = 0;  // LDI angular step (tangent units)
     int64_t ldiRays = 0, mcRays = 0, mcSamples = 0;
     size_t ldiSamples = 0, afterRemoval = 0, points = 0, textured = 0, dropped = 0;
-    size_t noiseSingle = 0;                          // single-coloured by the F test (appearance.h)
+    size_t noiseSingle = 0;                         // single-coloured by the F test (appearance.h)
     size_t screenPixels = 0, screenBBoxPixels = 0;  // from the cell centre, target view
-    double bakeMs = 0;                               // not part of the baked scene
+    double bakeMs = 0;                              // not part of the baked scene
 };
 
 struct ImpostorResult {
     uint32_t cell = 0;
-    uint8_t end = 0;                    // 0: towards node a, 1: towards node b
+    uint8_t end = 0;  // 0: towards node a, 1: towards node b
     ImpostorFrame frame;
     std::vector<uint32_t> hiddenTiles;  // root child indices, ascending
     PointImpostorData data;             // in the frame

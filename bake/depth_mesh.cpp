@@ -10,19 +10,24 @@
 
 namespace vista {
 
-DepthView chooseDepthView(const TriangleSoup& soup, const glm::dvec3& eye, double minStep, int imageSize, int maxEndTriangles) {
+DepthView chooseDepthView(const TriangleSoup& soup, const glm::dvec3& eye, double minStep, int imageSize,
+                          int maxEndTriangles) {
     const double kMaxX = std::tan(60.0 * 3.14159265358979323846 / 180.0), kMinY = -1.0, kMaxY = kMaxX;
     double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
     for (const glm::vec3& p : soup.positions) {
         const glm::dvec3 r = glm::dvec3(p) - eye;
         if (r.x <= 1.0) continue;
         const double u = -r.y / r.x, v = r.z / r.x;
-        u0 = std::min(u0, u); u1 = std::max(u1, u);
-        v0 = std::min(v0, v); v1 = std::max(v1, v);
+        u0 = std::min(u0, u);
+        u1 = std::max(u1, u);
+        v0 = std::min(v0, v);
+        v1 = std::max(v1, v);
     }
     if (u0 > u1) u0 = u1 = v0 = v1 = 0;
-    u0 = std::clamp(u0, -kMaxX, kMaxX); u1 = std::clamp(u1, -kMaxX, kMaxX);
-    v0 = std::clamp(v0, kMinY, kMaxY); v1 = std::clamp(v1, kMinY, kMaxY);
+    u0 = std::clamp(u0, -kMaxX, kMaxX);
+    u1 = std::clamp(u1, -kMaxX, kMaxX);
+    v0 = std::clamp(v0, kMinY, kMaxY);
+    v1 = std::clamp(v1, kMinY, kMaxY);
     DepthView view;
     view.eye = eye;
     const double ext = std::max(u1 - u0, v1 - v0);
@@ -34,7 +39,8 @@ DepthView chooseDepthView(const TriangleSoup& soup, const glm::dvec3& eye, doubl
     int nx = 0, ny = 0;
     view.rootBlock = 32;
     fit(view.rootBlock, nx, ny);
-    while (view.rootBlock < 4096 && 2 * (nx / view.rootBlock) * (ny / view.rootBlock) > std::max(maxEndTriangles / 4, 2)) {
+    while (view.rootBlock < 4096 &&
+           2 * (nx / view.rootBlock) * (ny / view.rootBlock) > std::max(maxEndTriangles / 4, 2)) {
         view.rootBlock *= 2;
         fit(view.rootBlock, nx, ny);
     }
@@ -96,8 +102,10 @@ public:
         _hits.assign(size_t(_W + 1) * size_t(_H + 1), 0);
         for (int j = 0; j < _H; ++j)
             for (int i = 0; i < _W; ++i)
-                _hits[size_t(j + 1) * size_t(_W + 1) + size_t(i + 1)] = _hits[size_t(j) * size_t(_W + 1) + size_t(i + 1)] +
-                    _hits[size_t(j + 1) * size_t(_W + 1) + size_t(i)] - _hits[size_t(j) * size_t(_W + 1) + size_t(i)] + (valid(i, j) ? 1 : 0);
+                _hits[size_t(j + 1) * size_t(_W + 1) + size_t(i + 1)] =
+                    _hits[size_t(j) * size_t(_W + 1) + size_t(i + 1)] +
+                    _hits[size_t(j + 1) * size_t(_W + 1) + size_t(i)] - _hits[size_t(j) * size_t(_W + 1) + size_t(i)] +
+                    (valid(i, j) ? 1 : 0);
     }
 
     bool valid(int i, int j) const { return _img.depth[idx(i, j)] > 0; }
@@ -119,7 +127,8 @@ public:
             for (int i = x; i <= x + s; ++i) {
                 if (!valid(i, j)) continue;
                 const double a = double(i - x) / s, b = double(j - y) / s;
-                const double approx = a >= b ? w00 + a * (w10 - w00) + b * (w11 - w10) : w00 + b * (w01 - w00) + a * (w11 - w01);
+                const double approx =
+                    a >= b ? w00 + a * (w10 - w00) + b * (w11 - w10) : w00 + b * (w01 - w00) + a * (w11 - w01);
                 e = std::max(e, std::abs(_w[idx(i, j)] - approx));
             }
         return e * _scale;
@@ -214,9 +223,11 @@ private:
 
 }  // namespace
 
-TexturedDepthMeshData buildDepthMesh(const FarImage& img, double cellRadius, int maxTriangles, double errorPx, DepthMeshStats& stats) {
+TexturedDepthMeshData buildDepthMesh(const FarImage& img, double cellRadius, int maxTriangles, double errorPx,
+                                     DepthMeshStats& stats) {
     const DepthView& v = img.view;
-    VISTA_CHECK(v.width >= 2 && v.height >= 2 && v.rootBlock >= 1 && (v.width - 1) % v.rootBlock == 0 && (v.height - 1) % v.rootBlock == 0);
+    VISTA_CHECK(v.width >= 2 && v.height >= 2 && v.rootBlock >= 1 && (v.width - 1) % v.rootBlock == 0 &&
+                (v.height - 1) % v.rootBlock == 0);
     VISTA_CHECK(img.depth.size() == size_t(v.width) * size_t(v.height) && img.color.size() == img.depth.size());
     const int W = v.width, H = v.height, B = v.rootBlock;
     Builder b(img, cellRadius);
@@ -313,8 +324,10 @@ TexturedDepthMeshData buildDepthMesh(const FarImage& img, double cellRadius, int
         if (l.err > stats.maxLeafErrorPx && !(drop1 && drop2)) stats.maxLeafErrorPx = l.err;
         stats.droppedTriangles += uint64_t(drop1) + uint64_t(drop2);
         // Counter-clockwise in the image (x right, y up) = front-facing from the eye.
-        if (!drop1) for (uint32_t q : {vertex(x0, y0), vertex(x1, y0), vertex(x1, y1)}) out.indices.push_back(q);
-        if (!drop2) for (uint32_t q : {vertex(x0, y0), vertex(x1, y1), vertex(x0, y1)}) out.indices.push_back(q);
+        if (!drop1)
+            for (uint32_t q : {vertex(x0, y0), vertex(x1, y0), vertex(x1, y1)}) out.indices.push_back(q);
+        if (!drop2)
+            for (uint32_t q : {vertex(x0, y0), vertex(x1, y1), vertex(x0, y1)}) out.indices.push_back(q);
     }
     stats.triangles = out.triangleCount();
     return out;

@@ -51,7 +51,7 @@ struct DepthMeshParams {
 };
 
 struct DepthView {
-    glm::dvec3 eye{0.0};      // frame coordinates
+    glm::dvec3 eye{0.0};                    // frame coordinates
     double tanX0 = 0, tanY0 = 0, step = 1;  // tangent of sample (0, 0) and the step per sample
     int width = 0, height = 0;              // samples (width - 1, height - 1 multiples of rootBlock)
     int rootBlock = 32;
@@ -63,7 +63,8 @@ struct DepthView {
 // minStep (the target's pixel angle) and the extent / (imageSize - 1); the
 // root block grows (32, 64, ...) until the root blocks take at most a quarter
 // of maxEndTriangles. Vertices with x <= eye.x + 1 m are ignored.
-DepthView chooseDepthView(const TriangleSoup& soup, const glm::dvec3& eye, double minStep, int imageSize, int maxEndTriangles);
+DepthView chooseDepthView(const TriangleSoup& soup, const glm::dvec3& eye, double minStep, int imageSize,
+                          int maxEndTriangles);
 
 struct FarImage {
     DepthView view;
@@ -79,6 +80,7 @@ struct DepthMeshStats {
 };
 
 // The simplified textured depth mesh of `img` (at most maxTriangles triangles).
-TexturedDepthMeshData buildDepthMesh(const FarImage& img, double cellRadius, int maxTriangles, double errorPx, DepthMeshStats& stats);
+TexturedDepthMeshData buildDepthMesh(const FarImage& img, double cellRadius, int maxTriangles, double errorPx,
+                                     DepthMeshStats& stats);
 
 }  // namespace vista

@@ -31,27 +31,33 @@ Status validateBakeJob(const BakeJob& j) {
     const BakeParams& p = j.params;
     auto range = [](const char* opt, double v, double lo, double hi) -> Status {
         if (v >= lo && v <= hi) return Status::ok();
-        return Status::error(std::string(opt) + " " + std::to_string(v) + " out of range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+        return Status::error(std::string(opt) + " " + std::to_string(v) + " out of range [" + std::to_string(lo) +
+                             ", " + std::to_string(hi) + "]");
     };
     if (j.input.empty()) return Status::error("input city file: no path given");
     if (j.output.empty()) return Status::error("--output: no path given");
-    for (Status s : {range("--jobs", j.jobs, 0, 1024), range("--margin", p.far.margin, 0, 1e5), range("--far-depth", p.far.farDepth, 1, 1e6),
-                     range("--oversample", p.sampling.oversample, 0.05, 16), range("--perspective", p.sampling.perspective, 1, 4),
-                     range("--texel-significance", p.appearance.significance, 0, 0.5),
-                     range("--pixel-sigma", p.appearance.pixelSigma, 0, 4), range("--layers", p.sampling.maxLayers, 1, 64),
-                     range("--max-rays", double(p.sampling.maxRaysPerCamera), 1, 1e9),
-                     range("--mc-threshold", p.appearance.varianceThreshold, 0, 1), range("--mc-min", p.appearance.minSamples, 1, 4096),
-                     range("--mc-max", p.appearance.maxSamples, p.appearance.minSamples, 65536),
-                     range("--single-threshold", p.appearance.singleColorThreshold, 0, 1), range("--out-size", p.sampling.outHeight, 16, 8192),
-                     range("--fov", p.sampling.fovYDeg, 1, 170), range("--texels (A)", p.appearance.texelsX, 1, 32),
-                     range("--texels (B)", p.appearance.texelsY, 1, 32)})
+    for (Status s :
+         {range("--jobs", j.jobs, 0, 1024), range("--margin", p.far.margin, 0, 1e5),
+          range("--far-depth", p.far.farDepth, 1, 1e6), range("--oversample", p.sampling.oversample, 0.05, 16),
+          range("--perspective", p.sampling.perspective, 1, 4),
+          range("--texel-significance", p.appearance.significance, 0, 0.5),
+          range("--pixel-sigma", p.appearance.pixelSigma, 0, 4), range("--layers", p.sampling.maxLayers, 1, 64),
+          range("--max-rays", double(p.sampling.maxRaysPerCamera), 1, 1e9),
+          range("--mc-threshold", p.appearance.varianceThreshold, 0, 1),
+          range("--mc-min", p.appearance.minSamples, 1, 4096),
+          range("--mc-max", p.appearance.maxSamples, p.appearance.minSamples, 65536),
+          range("--single-threshold", p.appearance.singleColorThreshold, 0, 1),
+          range("--out-size", p.sampling.outHeight, 16, 8192), range("--fov", p.sampling.fovYDeg, 1, 170),
+          range("--texels (A)", p.appearance.texelsX, 1, 32), range("--texels (B)", p.appearance.texelsY, 1, 32)})
         if (!s) return s;
     if (p.representation == BakeRepresentation::Mesh)
-        for (Status s : {range("--mesh-triangles", p.mesh.maxTriangles, 1024, 1e7), range("--mesh-image", p.mesh.imageSize, 64, 4096),
-                         range("--mesh-error", p.mesh.errorPx, 0, 100)})
+        for (Status s :
+             {range("--mesh-triangles", p.mesh.maxTriangles, 1024, 1e7),
+              range("--mesh-image", p.mesh.imageSize, 64, 4096), range("--mesh-error", p.mesh.errorPx, 0, 100)})
             if (!s) return s;
     if (j.shardN < 1 || j.shardK < 1 || j.shardK > j.shardN)
-        return Status::error("--shard " + std::to_string(j.shardK) + "/" + std::to_string(j.shardN) + ": expected K/N with 1 <= K <= N");
+        return Status::error("--shard " + std::to_string(j.shardK) + "/" + std::to_string(j.shardN) +
+                             ": expected K/N with 1 <= K <= N");
     if (j.merge && j.shardN > 1) return Status::error("--merge and --shard exclude each other");
     VISTA_RETURN_IF_ERROR(checkWritablePath("--output", j.output));
     if (!j.statsFile.empty()) VISTA_RETURN_IF_ERROR(checkWritablePath("--stats", j.statsFile));
@@ -95,7 +101,9 @@ nlohmann::json statsJson(const ImpostorResult& r) {
     j["points_per_screen_pixel"] = s.screenPixels ? double(s.points) / double(s.screenPixels) : 0.0;
     const size_t bytes = r.data.positions.size() * kPointBytes + r.data.texels.size() * 4;
     j["memory_mb"] = double(bytes) / (1024.0 * 1024.0);
-    j["memory_mb_uncompressed"] = double(r.data.positions.size() * (kPointBytes + 4 * size_t(r.data.texelsX * r.data.texelsY))) / (1024.0 * 1024.0);
+    j["memory_mb_uncompressed"] =
+        double(r.data.positions.size() * (kPointBytes + 4 * size_t(r.data.texelsX * r.data.texelsY))) /
+        (1024.0 * 1024.0);
     j["bake_s"] = s.bakeMs / 1000.0;
     return j;
 }
@@ -191,7 +199,8 @@ std::vector<size_t> shardOf(const BakeJob& job, const std::vector<size_t>& selec
 
 // Bakes the cells of `mine` that have no valid result in the work directory yet.
 Status bakeMissingCells(const BakeJob& job, BakeInput& in, const std::vector<size_t>& mine, const BakeParams& p,
-                        uint64_t configHash, BakeReport& rep, Progress* progress, const std::function<void(const std::string&)>& log) {
+                        uint64_t configHash, BakeReport& rep, Progress* progress,
+                        const std::function<void(const std::string&)>& log) {
     std::vector<size_t> todo;
     for (size_t ci : mine) {
         auto b = readAll(cellPath(rep.workDir, in.cells[ci].id));
@@ -201,11 +210,12 @@ Status bakeMissingCells(const BakeJob& job, BakeInput& in, const std::vector<siz
     rep.baked = todo.size();
     rep.resumed = mine.size() - todo.size();
     if (log)
-        log(std::to_string(mine.size()) + " cells (" + std::to_string(todo.size()) + " in this run, " + std::to_string(rep.resumed) +
-            " already done), " + std::to_string(in.skipped.size()) + " degenerate edges skipped");
+        log(std::to_string(mine.size()) + " cells (" + std::to_string(todo.size()) + " in this run, " +
+            std::to_string(rep.resumed) + " already done), " + std::to_string(in.skipped.size()) +
+            " degenerate edges skipped");
     tbb::task_arena arena(job.jobs > 0 ? job.jobs : tbb::task_arena::automatic);
-    if (!todo.empty() && p.representation == BakeRepresentation::Points && p.placement.byCost && p.placement.budgetMb > 0 &&
-        in.cityRays) {
+    if (!todo.empty() && p.representation == BakeRepresentation::Points && p.placement.byCost &&
+        p.placement.budgetMb > 0 && in.cityRays) {
         // The storage budget ranks every street end of the city, so every run
         // (shard, resume) plans the whole city the same way.
         std::atomic<size_t> done{0};
@@ -220,7 +230,8 @@ Status bakeMissingCells(const BakeJob& job, BakeInput& in, const std::vector<siz
         if (progress) progress->end();
         if (log) {
             char buf[200];
-            std::snprintf(buf, sizeof buf, "storage budget %.1f MB: %zu of %zu street ends that pay (%.1f of %.1f MB predicted)",
+            std::snprintf(buf, sizeof buf,
+                          "storage budget %.1f MB: %zu of %zu street ends that pay (%.1f of %.1f MB predicted)",
                           p.placement.budgetMb, plan.chosen, plan.paying, plan.chosenMb, plan.payingMb);
             log(buf);
         }
@@ -231,8 +242,8 @@ Status bakeMissingCells(const BakeJob& job, BakeInput& in, const std::vector<siz
 
 // Every selected cell's result from the work directory, sorted by cell id;
 // an error listing the missing or stale ones.
-Result<std::vector<CellResult>> readCellResults(const BakeInput& in, const std::vector<size_t>& selected, uint64_t configHash,
-                                                const std::string& workDir) {
+Result<std::vector<CellResult>> readCellResults(const BakeInput& in, const std::vector<size_t>& selected,
+                                                uint64_t configHash, const std::string& workDir) {
     std::vector<CellResult> results;
     std::vector<uint32_t> missing;
     for (size_t ci : selected) {
@@ -246,8 +257,8 @@ Result<std::vector<CellResult>> readCellResults(const BakeInput& in, const std::
         std::string list;
         for (size_t i = 0; i < missing.size() && i < 20; ++i) list += (i ? "," : "") + std::to_string(missing[i]);
         if (missing.size() > 20) list += ",...";
-        return Status::error(std::to_string(missing.size()) + " cell results missing or stale in '" + workDir + "' (cells " + list +
-                             "); bake them first (all shards with the same parameters)");
+        return Status::error(std::to_string(missing.size()) + " cell results missing or stale in '" + workDir +
+                             "' (cells " + list + "); bake them first (all shards with the same parameters)");
     }
     std::sort(results.begin(), results.end(), [](const CellResult& a, const CellResult& b) { return a.cell < b.cell; });
     return results;
@@ -275,7 +286,8 @@ nlohmann::json tallyResults(const std::vector<CellResult>& results, BakeReport& 
     return js;
 }
 
-Status writeStatsFile(const BakeJob& job, const BakeReport& rep, size_t cells, const std::string& canon, nlohmann::json impostorStats) {
+Status writeStatsFile(const BakeJob& job, const BakeReport& rep, size_t cells, const std::string& canon,
+                      nlohmann::json impostorStats) {
     nlohmann::json top;
     top["input"] = job.input;
     top["cells"] = cells;
@@ -299,7 +311,8 @@ Status writeStatsFile(const BakeJob& job, const BakeReport& rep, size_t cells, c
 
 }  // namespace
 
-Result<BakeReport> runBakeJob(const BakeJob& job, Progress* progress, const std::function<void(const std::string&)>& log) {
+Result<BakeReport> runBakeJob(const BakeJob& job, Progress* progress,
+                              const std::function<void(const std::string&)>& log) {
     VISTA_RETURN_IF_ERROR(validateBakeJob(job));
     const Stopwatch wall;
     BakeReport rep;
@@ -310,7 +323,8 @@ Result<BakeReport> runBakeJob(const BakeJob& job, Progress* progress, const std:
         return Status::error("'" + job.input + "' is already baked; bake the plain city file");
     BakeParams p = job.params;
     p.seed = city->params.seed;
-    if (p.placement.budgetMbPerKm2 > 0) p.placement.budgetMb = p.placement.budgetMbPerKm2 * streetArea(city->streets) * 1e-6;
+    if (p.placement.budgetMbPerKm2 > 0)
+        p.placement.budgetMb = p.placement.budgetMbPerKm2 * streetArea(city->streets) * 1e-6;
     const std::string canon = p.canonical();
     uint64_t configHash = 0;  // of the input's bytes and the parameters: a cell result is reused only under both
     {
@@ -344,14 +358,16 @@ Result<BakeReport> runBakeJob(const BakeJob& job, Progress* progress, const std:
     if (!results) return results.status();
     auto sourceHash = sceneFileContentHash(job.input);  // recorded so that readers can refuse a bake of another city
     if (!sourceHash) return sourceHash.status();
-    osg::ref_ptr<ViewCellSwitch> root = assembleBakedScene(*city, in.cells, *results, canon, p.representation, *sourceHash);
+    osg::ref_ptr<ViewCellSwitch> root =
+        assembleBakedScene(*city, in.cells, *results, canon, p.representation, *sourceHash);
     VISTA_RETURN_IF_ERROR(writeSceneFile(*root, job.output, false));
     rep.assembled = true;
     nlohmann::json impostorStats = tallyResults(*results, rep);
     const auto size = std::filesystem::file_size(job.output, ec);
     rep.outputBytes = ec ? 0 : uint64_t(size);
     rep.wallS = wall.ms() / 1000.0;
-    if (!job.statsFile.empty()) VISTA_RETURN_IF_ERROR(writeStatsFile(job, rep, results->size(), canon, std::move(impostorStats)));
+    if (!job.statsFile.empty())
+        VISTA_RETURN_IF_ERROR(writeStatsFile(job, rep, results->size(), canon, std::move(impostorStats)));
     if (!job.keepWork) {
         for (size_t ci : *selected) std::filesystem::remove(cellPath(rep.workDir, in.cells[ci].id), ec);
         std::filesystem::remove(rep.workDir, ec);  // only if empty

@@ -53,19 +53,19 @@ struct BakeJob {
 };
 
 struct BakeReport {
-    std::string workDir;               // as resolved
-    size_t cells = 0;                  // selected cells
-    size_t shardCells = 0;             // cells of this shard
-    size_t baked = 0, resumed = 0;     // of this shard: baked now / found done in the work directory
-    size_t skippedEdges = 0;           // degenerate street edges (no cell)
-    bool assembled = false;            // false after one shard of several
-    size_t impostors = 0, points = 0;  // in the output
+    std::string workDir;                   // as resolved
+    size_t cells = 0;                      // selected cells
+    size_t shardCells = 0;                 // cells of this shard
+    size_t baked = 0, resumed = 0;         // of this shard: baked now / found done in the work directory
+    size_t skippedEdges = 0;               // degenerate street edges (no cell)
+    bool assembled = false;                // false after one shard of several
+    size_t impostors = 0, points = 0;      // in the output
     size_t meshes = 0, meshTriangles = 0;  // in the output (--representation mesh)
     uint64_t outputBytes = 0;
-    double wallS = 0;                  // this call
-    double cellBakeS = 0;              // sum of the assembled cells' bake times
-    std::vector<std::string> notes;    // the assembled cells' notes, "cell C: end E: ..." (--stats "notes")
-    double budgetMb = 0;               // the storage budget as resolved (0: none)
+    double wallS = 0;                // this call
+    double cellBakeS = 0;            // sum of the assembled cells' bake times
+    std::vector<std::string> notes;  // the assembled cells' notes, "cell C: end E: ..." (--stats "notes")
+    double budgetMb = 0;             // the storage budget as resolved (0: none)
 };
 
 Status validateBakeJob(const BakeJob& job);

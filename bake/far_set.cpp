@@ -36,7 +36,8 @@ namespace {
 void appendMesh(TriangleSoup& soup, const ImpostorFrame& f, const SceneMesh& m, const glm::dmat4* xf) {
     const uint32_t base = uint32_t(soup.positions.size());
     for (size_t i = 0; i < m.positions.size(); ++i) {
-        const glm::dvec3 w = xf ? glm::dvec3(*xf * glm::dvec4(glm::dvec3(m.positions[i]), 1.0)) : m.origin + glm::dvec3(m.positions[i]);
+        const glm::dvec3 w =
+            xf ? glm::dvec3(*xf * glm::dvec4(glm::dvec3(m.positions[i]), 1.0)) : m.origin + glm::dvec3(m.positions[i]);
         soup.positions.push_back(glm::vec3(f.toLocal(w)));
         soup.colors.push_back(i < m.colors.size() ? m.colors[i] : glm::u8vec4(255));
     }
@@ -53,15 +54,18 @@ FarSet selectFarSet(const SceneModel& city, const std::vector<SceneTile>& tiles,
     const double slope = hw0 / (cell.box.halfLength + p.margin);
     // Haze: nothing beyond the visibility is drawn, so the far field ends there too.
     double farDepth = p.farDepth;
-    if (city.params.effects.haze) farDepth = std::min(farDepth, std::max(0.0, city.params.effects.haze->visibility_m - p.margin));
+    if (city.params.effects.haze)
+        farDepth = std::min(farDepth, std::max(0.0, city.params.effects.haze->visibility_m - p.margin));
     for (const SceneTile& t : tiles) {
         if (t.triangles == 0 || t.lo.x > t.hi.x) continue;
         double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
         bool inWedge = false;
         for (int c = 0; c < 4; ++c) {
             const glm::dvec3 l = out.frame.toLocal({(c & 1) ? t.hi.x : t.lo.x, (c & 2) ? t.hi.y : t.lo.y, 0.0});
-            x0 = std::min(x0, l.x); x1 = std::max(x1, l.x);
-            y0 = std::min(y0, l.y); y1 = std::max(y1, l.y);
+            x0 = std::min(x0, l.x);
+            x1 = std::max(x1, l.x);
+            y0 = std::min(y0, l.y);
+            y1 = std::max(y1, l.y);
             if (std::abs(l.y) <= hw0 + slope * (l.x - p.margin)) inWedge = true;
         }
         if (x0 < p.margin || x1 > p.margin + farDepth) continue;
@@ -70,7 +74,8 @@ FarSet selectFarSet(const SceneModel& city, const std::vector<SceneTile>& tiles,
         for (uint32_t mi : t.meshes) appendMesh(out.soup, out.frame, city.meshes[mi], nullptr);
         for (uint32_t ii : t.instances) {
             const SceneInstance& inst = city.instances[ii];
-            if (inst.prototype < city.prototypes.size()) appendMesh(out.soup, out.frame, city.prototypes[inst.prototype], &inst.transform);
+            if (inst.prototype < city.prototypes.size())
+                appendMesh(out.soup, out.frame, city.prototypes[inst.prototype], &inst.transform);
         }
     }
     std::sort(out.tiles.begin(), out.tiles.end());

@@ -72,7 +72,10 @@ LdiResult sampleLdi(const RayScene& scene, const SamplingSetup& s, const Box3& f
             const double z = glm::dot(s.n, d);
             VISTA_CHECK(z > 0);
             const double x = glm::dot(s.U, d) / z, y = glm::dot(s.V, d) / z;
-            x0 = std::min(x0, x); x1 = std::max(x1, x); y0 = std::min(y0, y); y1 = std::max(y1, y);
+            x0 = std::min(x0, x);
+            x1 = std::max(x1, x);
+            y0 = std::min(y0, y);
+            y1 = std::max(y1, y);
         }
         double step = step0;
         double w = std::ceil((x1 - x0) / step), h = std::ceil((y1 - y0) / step);
@@ -81,7 +84,9 @@ LdiResult sampleLdi(const RayScene& scene, const SamplingSetup& s, const Box3& f
             w = std::ceil((x1 - x0) / step);
             h = std::ceil((y1 - y0) / step);
         }
-        c.x0 = x0; c.y0 = y0; c.step = step;
+        c.x0 = x0;
+        c.y0 = y0;
+        c.step = step;
         c.width = std::max(1, int(w));
         c.height = std::max(1, int(h));
     }
@@ -108,7 +113,8 @@ LdiResult sampleLdi(const RayScene& scene, const SamplingSetup& s, const Box3& f
             }
             std::vector<RayHit> hits(w * size_t(layers));
             std::vector<int> counts(w);
-            scene.allHitsMany(org.data(), dirs.data(), c.width, tn.data(), tf.data(), layers, gap, hits.data(), counts.data());
+            scene.allHitsMany(org.data(), dirs.data(), c.width, tn.data(), tf.data(), layers, gap, hits.data(),
+                              counts.data());
             auto& out = rows[size_t(j)];
             auto& cnt = rowCounts[size_t(j)];
             cnt.assign(w, 0);

@@ -45,14 +45,14 @@ double ldiStep(const SamplingSetup& s, const SamplingParams& p);
 
 struct LdiCamera {
     glm::dvec3 pos{0.0};
-    double x0 = 0, y0 = 0;   // tangent-plane coordinates of the lower-left image corner
-    double step = 0;         // tangent units per pixel
+    double x0 = 0, y0 = 0;  // tangent-plane coordinates of the lower-left image corner
+    double step = 0;        // tangent units per pixel
     int width = 0, height = 0;
 };
 
 struct LdiSample {
     glm::vec3 pos{0.0f}, normal{0.0f}, color{0.0f};  // colour: RayScene::hitColor, 0..1
-    float spacing = 0;   // footprint of the camera pixel on the surface (metres)
+    float spacing = 0;                               // footprint of the camera pixel on the surface (metres)
     uint8_t camera = 0;
     uint32_t pixel = 0;  // j * width + i in its camera
 };

@@ -34,8 +34,8 @@ int32_t TileLookup::tileOf(const HitSource& s) const {
 
 std::string PlacementEstimate::describe() const {
     char buf[160];
-    std::snprintf(buf, sizeof buf, "saves %.1f ms, costs %.1f ms (%.0f far pixels, %lld of %lld rays)", savedMs, costMs, farPixels,
-                  (long long)farHits, (long long)rays);
+    std::snprintf(buf, sizeof buf, "saves %.1f ms, costs %.1f ms (%.0f far pixels, %lld of %lld rays)", savedMs, costMs,
+                  farPixels, (long long)farHits, (long long)rays);
     return buf;
 }
 
@@ -51,10 +51,9 @@ std::string PlannedEnd::describe() const {
 }
 
 const PlannedEnd* PlacementPlan::find(uint32_t cell, int end) const {
-    auto it = std::lower_bound(ends.begin(), ends.end(), std::make_pair(cell, end),
-                               [](const PlannedEnd& e, const std::pair<uint32_t, int>& k) {
-                                   return std::make_pair(e.cell, int(e.end)) < k;
-                               });
+    auto it = std::lower_bound(
+        ends.begin(), ends.end(), std::make_pair(cell, end),
+        [](const PlannedEnd& e, const std::pair<uint32_t, int>& k) { return std::make_pair(e.cell, int(e.end)) < k; });
     return it != ends.end() && it->cell == cell && int(it->end) == end ? &*it : nullptr;
 }
 
@@ -93,8 +92,8 @@ PlacementPlan rankPlacement(std::vector<PlannedEnd> ends, double budgetMb) {
     return plan;
 }
 
-PlacementEstimate estimatePlacement(const RayScene& cityRays, const TileLookup& tiles, const ViewCell& cell, const FarSet& fs,
-                                    const SamplingParams& sampling, const PlacementParams& p) {
+PlacementEstimate estimatePlacement(const RayScene& cityRays, const TileLookup& tiles, const ViewCell& cell,
+                                    const FarSet& fs, const SamplingParams& sampling, const PlacementParams& p) {
     PlacementEstimate e;
     const ImpostorFrame& f = fs.frame;
     glm::dvec3 lo(1e300), hi(-1e300);
@@ -152,7 +151,8 @@ PlacementEstimate estimatePlacement(const RayScene& cityRays, const TileLookup& 
                 const double pitch = p0 + (j + 0.5) * sp;
                 for (int i = 0; i < iy; ++i) {
                     const double yaw = y0 + (i + 0.5) * sy;
-                    const glm::dvec3 dl(std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw), std::sin(pitch));
+                    const glm::dvec3 dl(std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw),
+                                        std::sin(pitch));
                     dirs[size_t(i)] = glm::vec3(f.toWorld(dl) - f.origin);
                 }
                 cityRays.intersectMany(orgs.data(), dirs.data(), iy, hits.data());
@@ -246,7 +246,8 @@ PointClusters clusterPoints(const std::vector<glm::vec3>& local, double size) {
     std::vector<std::pair<uint64_t, uint32_t>> keyed(local.size());
     tbb::parallel_for(size_t(0), local.size(), [&](size_t i) {
         const glm::dvec3 g = glm::floor((glm::dvec3(local[i]) - mn) / size);
-        const uint64_t x = uint64_t(std::min(g.x, 2097151.0)), y = uint64_t(std::min(g.y, 2097151.0)), z = uint64_t(std::min(g.z, 2097151.0));
+        const uint64_t x = uint64_t(std::min(g.x, 2097151.0)), y = uint64_t(std::min(g.y, 2097151.0)),
+                       z = uint64_t(std::min(g.z, 2097151.0));
         keyed[i] = {(x << 42) | (y << 21) | z, uint32_t(i)};
     });
     tbb::parallel_sort(keyed.begin(), keyed.end());  // keys and indices unique together: one order
@@ -314,9 +315,10 @@ struct MaxPyramid {
 // nodes all end before its nearest point is skipped whole (the same verdict
 // for each of its points, found at once). Clusters next to the viewpoint or
 // more than maxTan off the axis make all their points candidates.
-void imageCandidates(const RayScene& cityRays, const glm::dvec3& vd, const glm::dvec3& target, const std::vector<glm::vec3>& local,
-                     const PointClusters& pc, const std::vector<uint32_t>& todoOf, const std::vector<uint8_t>& vis, double step,
-                     int64_t maxRays, double maxTan, std::vector<uint8_t>& isCand) {
+void imageCandidates(const RayScene& cityRays, const glm::dvec3& vd, const glm::dvec3& target,
+                     const std::vector<glm::vec3>& local, const PointClusters& pc, const std::vector<uint32_t>& todoOf,
+                     const std::vector<uint8_t>& vis, double step, int64_t maxRays, double maxTan,
+                     std::vector<uint8_t>& isCand) {
     const glm::dvec3 axis = target - vd;
     const double al = glm::length(axis);
     const glm::dvec3 fwd = al > 1e-9 ? axis / al : glm::dvec3(1, 0, 0);
@@ -354,12 +356,18 @@ void imageCandidates(const RayScene& cityRays, const glm::dvec3& vd, const glm::
                 kind[c] = ok ? 1 : 2;
                 if (!ok) continue;
                 rect[c] = q;
-                b.x0 = std::min(b.x0, q.x); b.x1 = std::max(b.x1, q.y); b.y0 = std::min(b.y0, q.z); b.y1 = std::max(b.y1, q.w);
+                b.x0 = std::min(b.x0, q.x);
+                b.x1 = std::max(b.x1, q.y);
+                b.y0 = std::min(b.y0, q.z);
+                b.y1 = std::max(b.y1, q.w);
             }
             return b;
         },
         [](Box a, const Box& b) {
-            a.x0 = std::min(a.x0, b.x0); a.x1 = std::max(a.x1, b.x1); a.y0 = std::min(a.y0, b.y0); a.y1 = std::max(a.y1, b.y1);
+            a.x0 = std::min(a.x0, b.x0);
+            a.x1 = std::max(a.x1, b.x1);
+            a.y0 = std::min(a.y0, b.y0);
+            a.y1 = std::max(a.y1, b.y1);
             return a;
         });
     if (!(box.x0 <= box.x1)) {  // no cluster in the image
@@ -368,7 +376,8 @@ void imageCandidates(const RayScene& cityRays, const glm::dvec3& vd, const glm::
                 for (uint32_t k = pc.start[c]; k < pc.start[c + 1]; ++k) isCand[pc.order[k]] = !vis[pc.order[k]];
         return;
     }
-    double w = std::floor((box.x1 - box.x0) / step) + 2, h = std::floor((box.y1 - box.y0) / step) + 2;  // nodes per axis
+    double w = std::floor((box.x1 - box.x0) / step) + 2,
+           h = std::floor((box.y1 - box.y0) / step) + 2;  // nodes per axis
     const double cap = double(std::max<int64_t>(maxRays, 16));
     if (w * h > cap) {
         step *= std::sqrt(w * h / cap);
@@ -386,7 +395,8 @@ void imageCandidates(const RayScene& cityRays, const glm::dvec3& vd, const glm::
             dir[size_t(i)] = glm::vec3(glm::normalize(fwd + (box.x0 + i * step) * right + (box.y0 + j * step) * up));
         cityRays.intersectMany(org.data(), dir.data(), nw, hits.data());
         for (int i = 0; i < nw; ++i)
-            depth[size_t(j) * m + size_t(i)] = hits[size_t(i)].hit ? hits[size_t(i)].t : std::numeric_limits<float>::infinity();
+            depth[size_t(j) * m + size_t(i)] =
+                hits[size_t(i)].hit ? hits[size_t(i)].t : std::numeric_limits<float>::infinity();
     });
     const MaxPyramid img(std::move(depth), nw, nh);
     auto node = [&](double t, double o, int n) { return std::clamp(int((t - o) / step), 0, n - 2); };
@@ -406,7 +416,8 @@ void imageCandidates(const RayScene& cityRays, const glm::dvec3& vd, const glm::
             const glm::dvec3 d = glm::dvec3(local[pi]) - vd;
             const double z = glm::dot(d, fwd);
             const int i = node(glm::dot(d, right) / z, box.x0, nw), j = node(glm::dot(d, up) / z, box.y0, nh);
-            const float reach = std::max(std::max(img.at(i, j), img.at(i + 1, j)), std::max(img.at(i, j + 1), img.at(i + 1, j + 1)));
+            const float reach =
+                std::max(std::max(img.at(i, j), img.at(i + 1, j)), std::max(img.at(i, j + 1), img.at(i + 1, j + 1)));
             isCand[pi] = reach >= openUntil(glm::length(d)) ? 1 : 0;
         }
     });
@@ -415,7 +426,8 @@ void imageCandidates(const RayScene& cityRays, const glm::dvec3& vd, const glm::
 }  // namespace
 
 std::vector<uint8_t> visibleFromCell(const RayScene& cityRays, const ViewCell& cell, const ImpostorFrame& f,
-                                     const std::vector<glm::vec3>& points, double pixelAngle, const PlacementParams& p) {
+                                     const std::vector<glm::vec3>& points, double pixelAngle,
+                                     const PlacementParams& p) {
     std::vector<uint8_t> vis(points.size(), 0);
     const glm::dvec3 sceneOrigin = cityRays.frameOrigin();
     const std::vector<glm::dvec3> views = cellViewpoints(cell, sceneOrigin, p);

@@ -37,24 +37,26 @@ namespace vista {
 constexpr double kAutoBudgetMbPerKm2 = 25.0;
 
 struct PlacementParams {
-    bool byCost = false;            // false: every end with a far field gets an impostor (--placement all)
-    double triangleNs = 349.0;      // raster cost of a triangle, ns (> 0)
-    double pointNs = 495.0;         // raster cost of a point, ns (> 0)
-    double pointsPerFarPixel = 31.0; // points the bake makes per visible far pixel (> 0; the default city baked whole under its storage budget: sum of points / sum of estimated far pixels over its impostors)
-    double bytesPerPoint = 15.0;     // stored bytes per point, texels included (> 0; the same bake)
+    bool byCost = false;        // false: every end with a far field gets an impostor (--placement all)
+    double triangleNs = 349.0;  // raster cost of a triangle, ns (> 0)
+    double pointNs = 495.0;     // raster cost of a point, ns (> 0)
+    double pointsPerFarPixel =
+        31.0;  // points the bake makes per visible far pixel (> 0; the default city baked whole under its storage
+               // budget: sum of points / sum of estimated far pixels over its impostors)
+    double bytesPerPoint = 15.0;  // stored bytes per point, texels included (> 0; the same bake)
     // Storage budget (planPlacement): 0 = none; else the street ends whose
     // impostors save the most milliseconds per predicted megabyte, until the
     // predicted megabytes reach budgetMb. `vista bake` sets it from
     // --storage-budget (default: budgetMbPerKm2 x the street graph's area).
     double budgetMb = 0;
-    double budgetMbPerKm2 = 0;       // > 0: the driver sets budgetMb from the street graph's bounding box
+    double budgetMbPerKm2 = 0;  // > 0: the driver sets budgetMb from the street graph's bounding box
     // How a viewpoint tests the points (visibleFromCell): true = a depth image
     // of the city from the viewpoint first (one ray per visStepPx output
     // pixels, at most maxVisRaysPerView; points more than visMaxTan off its
     // axis skip it), then an occlusion ray for the points it leaves;
     // false = an occlusion ray for every point (--visibility rays).
     int samplesAlong = 5, samplesAcross = 3;
-    double rayStepPx = 2.0;         // output pixels per estimation ray (per axis)
+    double rayStepPx = 2.0;  // output pixels per estimation ray (per axis)
     int maxRaysPerSample = 40000;
     // From-region visibility of the baked points (visibleFromCell): viewpoints
     // per axis along x across x heights.
@@ -74,8 +76,8 @@ struct TileLookup {
 };
 
 struct PlacementEstimate {
-    double farPixels = 0;        // mean over the sample points
-    double maxFarPixels = 0;     // largest over the sample points
+    double farPixels = 0;     // mean over the sample points
+    double maxFarPixels = 0;  // largest over the sample points
     int64_t rays = 0, farHits = 0;
     double savedMs = 0, costMs = 0;
     bool place = true;
@@ -87,8 +89,8 @@ struct PlacementEstimate {
 double predictedMb(const PlacementEstimate& e, const PlacementParams& p);
 
 // `cityRays` = RayScene::build(city) (scene-local frame around its frameOrigin()).
-PlacementEstimate estimatePlacement(const RayScene& cityRays, const TileLookup& tiles, const ViewCell& cell, const FarSet& fs,
-                                    const SamplingParams& sampling, const PlacementParams& p);
+PlacementEstimate estimatePlacement(const RayScene& cityRays, const TileLookup& tiles, const ViewCell& cell,
+                                    const FarSet& fs, const SamplingParams& sampling, const PlacementParams& p);
 
 // The placement of a whole city under a storage budget: every street end
 // whose far field is large enough is estimated (estimatePlacement); the ends
@@ -101,12 +103,12 @@ struct PlannedEnd {
     uint8_t end = 0;
     PlacementEstimate estimate;
     double predictedMb = 0;
-    int rank = -1;            // 0-based among the ends that pay; -1 if it does not pay
-    bool inBudget = false;    // chosen: bake its impostor
+    int rank = -1;                 // 0-based among the ends that pay; -1 if it does not pay
+    bool inBudget = false;         // chosen: bake its impostor
     std::string describe() const;  // the note of the end: placed / not placed and why
 };
 struct PlacementPlan {
-    std::vector<PlannedEnd> ends;  // sorted by (cell, end)
+    std::vector<PlannedEnd> ends;                     // sorted by (cell, end)
     double budgetMb = 0, chosenMb = 0, payingMb = 0;  // predicted MB of the chosen / of all paying ends
     size_t chosen = 0, paying = 0;
     const PlannedEnd* find(uint32_t cell, int end) const;  // null if the end was not estimated

@@ -63,8 +63,8 @@ bool sufficient(const LdiCamera& c, const SamplingSetup& s, const glm::dvec3& po
 
 }  // namespace
 
-std::vector<uint8_t> removeRedundant(const LdiResult& ldi, const SamplingSetup& s, const Box3& cell, const SamplingParams& p,
-                                     const std::vector<uint8_t>* only) {
+std::vector<uint8_t> removeRedundant(const LdiResult& ldi, const SamplingSetup& s, const Box3& cell,
+                                     const SamplingParams& p, const std::vector<uint8_t>* only) {
     std::vector<uint8_t> keep(ldi.samples.size(), 1);
     if (only)
         for (size_t i = 0; i < keep.size(); ++i) keep[i] = i < only->size() && (*only)[i] ? 1 : 0;
@@ -97,7 +97,8 @@ std::vector<uint8_t> removeRedundant(const LdiResult& ldi, const SamplingSetup& 
             const glm::dvec3 d = pos - c.pos;
             const double z = glm::dot(s.n, d);
             if (z <= 0) continue;
-            if (!sufficient(c, s, pos, nrm, corners, glm::clamp(pos, cell.lo, cell.hi), limit, p.diagonalFactor)) continue;
+            if (!sufficient(c, s, pos, nrm, corners, glm::clamp(pos, cell.lo, cell.hi), limit, p.diagonalFactor))
+                continue;
             const double x = glm::dot(s.U, d) / z, y = glm::dot(s.V, d) / z;
             const double fi = (x - c.x0) / c.step, fj = (y - c.y0) / c.step;
             if (fi < 0 || fj < 0 || fi >= c.width || fj >= c.height) continue;
@@ -106,7 +107,8 @@ std::vector<uint8_t> removeRedundant(const LdiResult& ldi, const SamplingSetup& 
             const double tol = 2.0 * sm + 1e-3;
             for (uint32_t q = st[pix]; q < st[pix + 1]; ++q) {
                 const LdiSample& b = ldi.samples[q];
-                if (glm::length(glm::dvec3(b.pos) - pos) <= tol && std::abs(glm::dot(glm::dvec3(b.normal), nrm)) > 0.7) {
+                if (glm::length(glm::dvec3(b.pos) - pos) <= tol &&
+                    std::abs(glm::dot(glm::dvec3(b.normal), nrm)) > 0.7) {
                     keep[idx] = 0;
                     return;
                 }

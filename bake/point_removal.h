@@ -23,7 +23,7 @@ namespace vista {
 // all 1 when p.removeRedundant is off. `only` (optional, one per sample):
 // samples with only[i] == 0 get keep 0 without being examined (the others
 // are decided as without it: every sample of the LDI can still be the better one).
-std::vector<uint8_t> removeRedundant(const LdiResult& ldi, const SamplingSetup& s, const Box3& cell, const SamplingParams& p,
-                                     const std::vector<uint8_t>* only = nullptr);
+std::vector<uint8_t> removeRedundant(const LdiResult& ldi, const SamplingSetup& s, const Box3& cell,
+                                     const SamplingParams& p, const std::vector<uint8_t>* only = nullptr);
 
 }  // namespace vista

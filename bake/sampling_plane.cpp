@@ -61,7 +61,12 @@ std::array<glm::dvec2, 3> boundingTriangle(const std::vector<glm::dvec2>& poly) 
         std::array<glm::dvec2, 3> t;
         if (!triangleFor(q, top, a, b, t)) return;
         const double per = trianglePerimeter(t);
-        if (per < best) { best = per; bestA = a; bestB = b; bestT = t; }
+        if (per < best) {
+            best = per;
+            bestA = a;
+            bestB = b;
+            bestT = t;
+        }
     };
     const int n0 = 48;
     for (int i = 0; i <= n0; ++i)

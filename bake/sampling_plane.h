@@ -32,15 +32,15 @@ namespace vista {
 
 struct SamplingSetup {
     glm::dvec3 n{1, 0, 0}, U{0, -1, 0}, V{0, 0, 1};  // plane normal, right, up (orthonormal)
-    double planeD = 0;                                // plane: dot(n, x) = planeD
-    std::vector<glm::dvec2> polygon;                  // shaft cut, plane coords (U, V), counter-clockwise
-    glm::dvec2 rectLo{0.0}, rectHi{0.0};              // bounding rectangle of the polygon
-    std::array<glm::dvec2, 3> tri{};                  // bounding triangle: top-left, top-right, bottom
-    std::array<glm::dvec3, 3> cameras{};              // triangle corners in the frame
+    double planeD = 0;                               // plane: dot(n, x) = planeD
+    std::vector<glm::dvec2> polygon;                 // shaft cut, plane coords (U, V), counter-clockwise
+    glm::dvec2 rectLo{0.0}, rectHi{0.0};             // bounding rectangle of the polygon
+    std::array<glm::dvec2, 3> tri{};                 // bounding triangle: top-left, top-right, bottom
+    std::array<glm::dvec3, 3> cameras{};             // triangle corners in the frame
     glm::dvec2 circumcentre{0.0};
     double circumradius = 0;
-    double dNear = 0;   // nearest far-box depth in front of the plane
-    double dFar = 0;    // farthest
+    double dNear = 0;  // nearest far-box depth in front of the plane
+    double dFar = 0;   // farthest
 
     glm::dvec3 toFrame(const glm::dvec2& q) const { return n * planeD + U * q.x + V * q.y; }
 };

@@ -14,7 +14,10 @@ std::vector<ViewCell> makeViewCells(const StreetGraph& g, const glm::dvec2& orig
         auto skip = [&](const std::string& why) {
             if (skipped) skipped->push_back({uint32_t(e), why});
         };
-        if (ed.a >= g.nodes.size() || ed.b >= g.nodes.size()) { skip("node index out of range"); continue; }
+        if (ed.a >= g.nodes.size() || ed.b >= g.nodes.size()) {
+            skip("node index out of range");
+            continue;
+        }
         const glm::dvec2 a = g.nodes[ed.a], b = g.nodes[ed.b];
         if (!std::isfinite(a.x) || !std::isfinite(a.y) || !std::isfinite(b.x) || !std::isfinite(b.y)) {
             skip("non-finite node position");

@@ -22,15 +22,15 @@
 namespace vista {
 
 struct ViewCellParams {
-    double eyeMin = 1.2;      // metres above ground
+    double eyeMin = 1.2;  // metres above ground
     double eyeMax = 2.0;
-    double minLength = 0.5;   // metres; shorter edges get no cell
-    double minWidth = 2.0;    // metres; narrower streets are widened to this
+    double minLength = 0.5;  // metres; shorter edges get no cell
+    double minWidth = 2.0;   // metres; narrower streets are widened to this
 };
 
 struct ViewCell {
-    uint32_t id = 0;          // = street edge id
-    ViewCellBox box;          // world frame
+    uint32_t id = 0;                      // = street edge id
+    ViewCellBox box;                      // world frame
     double groundMin = 0, groundMax = 0;  // ground height range under the cell
 };
 

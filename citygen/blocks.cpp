@@ -53,7 +53,10 @@ public:
             double r = 0.5 * g.edges[e].width + 1.0;
             int x0 = cell(std::min(a.x, b.x) - r), x1 = cell(std::max(a.x, b.x) + r);
             int y0 = cell(std::min(a.y, b.y) - r), y1 = cell(std::max(a.y, b.y) + r);
-            if (x1 - x0 > 4096 || y1 - y0 > 4096) { _huge.push_back(e); continue; }
+            if (x1 - x0 > 4096 || y1 - y0 > 4096) {
+                _huge.push_back(e);
+                continue;
+            }
             for (int y = y0; y <= y1; ++y)
                 for (int x = x0; x <= x1; ++x) _cells[key(x, y)].push_back(e);
         }
@@ -103,7 +106,7 @@ double polygonSegmentDistance(const Polygon2& poly, const glm::dvec2& a, const g
 }
 
 struct FaceLoop {
-    Polygon2 pts;                 // outer boundary incl. antennas (both sides)
+    Polygon2 pts;                  // outer boundary incl. antennas (both sides)
     std::vector<uint8_t> antenna;  // per edge: both sides belong to this face
 };
 
@@ -123,7 +126,8 @@ double edgeOffset(const glm::dvec2& p, const glm::dvec2& q, const StreetGraph& g
     return best < 0 ? 0.0 : best;
 }
 
-std::vector<Polygon2> insetFace(const FaceLoop& f, const StreetGraph& g, const EdgeGrid& grid, const CityParams& params) {
+std::vector<Polygon2> insetFace(const FaceLoop& f, const StreetGraph& g, const EdgeGrid& grid,
+                                const CityParams& params) {
     std::vector<Polygon2> out;
     size_t n = f.pts.size();
     if (n < 3) return out;
@@ -182,9 +186,7 @@ std::vector<Polygon2> insetFace(const FaceLoop& f, const StreetGraph& g, const E
             q = cleanPolygon(makeCounterClockwise(std::move(q)), 1e-7);
             if (q.size() >= 3 && signedArea(q) > 0 && isSimplePolygon(q)) out.push_back(std::move(q));
         }
-    } catch (const std::exception&) {
-        out.clear();
-    }
+    } catch (const std::exception&) { out.clear(); }
     return out;
 }
 
@@ -199,7 +201,10 @@ bool keepBlock(const Polygon2& poly, const StreetGraph& g, const EdgeGrid& grid)
     if (2.0 * area / perim < 0.4 * kMinBlockWidth) return false;
     // Road clearance safety net.
     glm::dvec2 lo(1e300), hi(-1e300);
-    for (const auto& p : poly) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
+    for (const auto& p : poly) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
     bool ok = true;
     grid.query(lo - glm::dvec2(20.0), hi + glm::dvec2(20.0), [&](uint32_t e) {
         if (!ok) return;
@@ -249,14 +254,13 @@ std::vector<Block> extractBlocks(const StreetGraph& g, const CityParams& params,
             for (size_t i = 0; i < loop.pts.size(); ++i)
                 if (!loop.antenna[i]) noAnt.push_back(loop.pts[i]);
             auto tris = triangulate(noAnt);
-            glm::dvec2 inner = tris.size() >= 3 ? (noAnt[tris[0]] + noAnt[tris[1]] + noAnt[tris[2]]) / 3.0 : centroid(noAnt);
+            glm::dvec2 inner =
+                tris.size() >= 3 ? (noAnt[tris[0]] + noAnt[tris[1]] + noAnt[tris[2]]) / 3.0 : centroid(noAnt);
             if (std::abs(inner.x) > half || std::abs(inner.y) > half) continue;
             if (!(signedArea(loop.pts) > 0)) continue;  // outer CCBs of bounded faces are CCW
             loops.push_back(std::move(loop));
         }
-    } catch (const std::exception&) {
-        return blocks;
-    }
+    } catch (const std::exception&) { return blocks; }
     if (progress) progress->update(0.6);
 
     EdgeGrid grid(g);
@@ -275,7 +279,10 @@ std::vector<Block> extractBlocks(const StreetGraph& g, const CityParams& params,
     // Deterministic order: by centroid (y, then x).
     std::vector<glm::dvec2> cent(blocks.size());
     std::vector<size_t> order(blocks.size());
-    for (size_t i = 0; i < blocks.size(); ++i) { cent[i] = centroid(blocks[i].outline); order[i] = i; }
+    for (size_t i = 0; i < blocks.size(); ++i) {
+        cent[i] = centroid(blocks[i].outline);
+        order[i] = i;
+    }
     std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
         if (cent[a].y != cent[b].y) return cent[a].y < cent[b].y;
         return cent[a].x < cent[b].x;

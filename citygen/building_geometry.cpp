@@ -56,15 +56,19 @@ OrientedBox orientedBox(const Polygon2& poly) {
         double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
         for (const auto& q : hull) {
             double a = glm::dot(q, u), b = glm::dot(q, v);
-            u0 = std::min(u0, a); u1 = std::max(u1, a);
-            v0 = std::min(v0, b); v1 = std::max(v1, b);
+            u0 = std::min(u0, a);
+            u1 = std::max(u1, a);
+            v0 = std::min(v0, b);
+            v1 = std::max(v1, b);
         }
         double area = (u1 - u0) * (v1 - v0);
         if (area < bestArea - 1e-9) {
             bestArea = area;
             best.centre = u * (0.5 * (u0 + u1)) + v * (0.5 * (v0 + v1));
-            best.u = u; best.v = v;
-            best.halfU = 0.5 * (u1 - u0); best.halfV = 0.5 * (v1 - v0);
+            best.u = u;
+            best.v = v;
+            best.halfU = 0.5 * (u1 - u0);
+            best.halfV = 0.5 * (v1 - v0);
         }
     }
     if (best.halfV > best.halfU) {
@@ -162,7 +166,10 @@ std::vector<Polygon2> insetPolygon(const Polygon2& poly, double d) {
     if (poly.size() < 3 || !finitePoly(poly) || !(d >= 0)) return out;
     Polygon2 p = cleanPolygon(makeCounterClockwise(poly), 1e-7);
     if (p.size() < 3) return out;
-    if (d == 0) { out.push_back(p); return out; }
+    if (d == 0) {
+        out.push_back(p);
+        return out;
+    }
     Polygon2 r;
     if (insetPolygonMiter(p, std::vector<double>(p.size(), d), r)) {
         out.push_back(std::move(r));
@@ -176,13 +183,17 @@ std::vector<Polygon2> insetPolygon(const Polygon2& poly, double d) {
     return out;
 }
 
-std::vector<FlaggedPolygon> splitPolygonByLine(const FlaggedPolygon& poly, const glm::dvec2& origin, const glm::dvec2& dirIn) {
+std::vector<FlaggedPolygon> splitPolygonByLine(const FlaggedPolygon& poly, const glm::dvec2& origin,
+                                               const glm::dvec2& dirIn) {
     const auto& P = poly.pts;
     size_t n = P.size();
     std::vector<FlaggedPolygon> out;
     if (n < 3) return out;
     double dl = glm::length(dirIn);
-    if (!(dl > 0) || !finitePoly(P)) { out.push_back(poly); return out; }
+    if (!(dl > 0) || !finitePoly(P)) {
+        out.push_back(poly);
+        return out;
+    }
     glm::dvec2 dir = dirIn / dl, nrm = leftOf(dir);
     std::vector<double> s(n);
     bool pos = false, neg = false;
@@ -191,8 +202,15 @@ std::vector<FlaggedPolygon> splitPolygonByLine(const FlaggedPolygon& poly, const
         if (std::abs(s[i]) < 1e-7) s[i] = 1e-7;  // treat as positive side
         (s[i] > 0 ? pos : neg) = true;
     }
-    if (!pos || !neg) { out.push_back(poly); return out; }
-    struct Node { glm::dvec2 p; uint8_t flag; int cross; };  // cross: -1 or index into crossings
+    if (!pos || !neg) {
+        out.push_back(poly);
+        return out;
+    }
+    struct Node {
+        glm::dvec2 p;
+        uint8_t flag;
+        int cross;
+    };  // cross: -1 or index into crossings
     std::vector<Node> A;
     std::vector<std::pair<double, size_t>> crossings;  // (t along line, node index)
     for (size_t i = 0; i < n; ++i) {
@@ -206,7 +224,10 @@ std::vector<FlaggedPolygon> splitPolygonByLine(const FlaggedPolygon& poly, const
             A.push_back({q, f, 0});
         }
     }
-    if (crossings.size() < 2 || crossings.size() % 2) { out.push_back(poly); return out; }
+    if (crossings.size() < 2 || crossings.size() % 2) {
+        out.push_back(poly);
+        return out;
+    }
     std::sort(crossings.begin(), crossings.end());
     std::vector<size_t> partner(A.size(), SIZE_MAX);
     for (size_t k = 0; k + 1 < crossings.size(); k += 2) {

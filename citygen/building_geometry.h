@@ -60,7 +60,8 @@ struct FlaggedPolygon {
 // theirs. Concave polygons may yield more than two pieces. Returns the input
 // unchanged (one piece) when the line does not cross it. Vertices closer than
 // 1e-7 m to the line are treated as lying slightly on its positive side.
-std::vector<FlaggedPolygon> splitPolygonByLine(const FlaggedPolygon& poly, const glm::dvec2& origin, const glm::dvec2& dir);
+std::vector<FlaggedPolygon> splitPolygonByLine(const FlaggedPolygon& poly, const glm::dvec2& origin,
+                                               const glm::dvec2& dir);
 
 // Hipped roof faces of a counter-clockwise simple footprint through CGAL's
 // straight skeleton: every face is a planar polygon (counter-clockwise seen

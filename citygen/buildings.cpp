@@ -27,7 +27,8 @@ constexpr double kSuburb = 0.35;    // density below which buildings are houses
 
 // Keeps the part of `fp` inside the box centred at c with axes (u, v) and
 // half sizes (hu, hv): exact line cuts, so the result stays inside fp.
-Polygon2 clipToBox(const Polygon2& fp, const glm::dvec2& c, const glm::dvec2& u, const glm::dvec2& v, double hu, double hv) {
+Polygon2 clipToBox(const Polygon2& fp, const glm::dvec2& c, const glm::dvec2& u, const glm::dvec2& v, double hu,
+                   double hv) {
     FlaggedPolygon cur{fp, std::vector<uint8_t>(fp.size(), 1)};
     const glm::dvec2 origins[4] = {c - u * hu, c + u * hu, c - v * hv, c + v * hv};
     const glm::dvec2 dirs[4] = {-v, v, u, -u};  // the kept side is to the left of each line
@@ -39,7 +40,10 @@ Polygon2 clipToBox(const Polygon2& fp, const glm::dvec2& c, const glm::dvec2& u,
         for (auto& pc : pieces) {
             glm::dvec2 m = centroid(pc.pts);
             double a = std::abs(signedArea(pc.pts));
-            if (glm::dot(m - origins[k], nrm) > 0 && a > bestArea) { bestArea = a; best = pc; }
+            if (glm::dot(m - origins[k], nrm) > 0 && a > bestArea) {
+                bestArea = a;
+                best = pc;
+            }
         }
         if (best.pts.size() < 3) return {};
         cur = std::move(best);
@@ -76,7 +80,8 @@ int chooseFloors(Rng& rng, double density, double width, const CityParams& param
         // Downtown: mostly 6-20 floors (skewed low), a heavy tail of towers up to max_floors.
         floors = 6 + int(15.0 * std::pow(rng.uniform(), 2.2));
         double towerChance = 0.02 + 0.14 * std::clamp((density - kDowntown) / (1.0 - kDowntown), 0.0, 1.0);
-        if (rng.chance(towerChance)) floors = 20 + int(double(std::max(0, params.max_floors - 20)) * std::pow(rng.uniform(), 1.5) + 0.5);
+        if (rng.chance(towerChance))
+            floors = 20 + int(double(std::max(0, params.max_floors - 20)) * std::pow(rng.uniform(), 1.5) + 0.5);
     } else if (density >= kSuburb) {
         floors = 2 + int(4.0 * std::pow(rng.uniform(), 1.5));  // 2-5
     } else {
@@ -86,7 +91,8 @@ int chooseFloors(Rng& rng, double density, double width, const CityParams& param
     // Slenderness: height at most ~7 times the narrow footprint side.
     int slender = std::max(3, int(7.0 * width / params.floor_height_m));
     floors = std::min(floors, slender);
-    return std::clamp(floors, std::max(1, params.min_floors), std::max(std::max(1, params.min_floors), params.max_floors));
+    return std::clamp(floors, std::max(1, params.min_floors),
+                      std::max(std::max(1, params.min_floors), params.max_floors));
 }
 
 }  // namespace
@@ -98,8 +104,9 @@ std::vector<Building> placeBuildings(const std::vector<Lot>& lots, const std::ve
     tbb::parallel_for(size_t(0), lots.size(), [&](size_t li) {
         const Lot& lot = lots[li];
         if (lot.outline.size() < 3) return;
-        double density = lot.block < blocks.size() ? std::clamp(blocks[lot.block].density, 0.0, 1.0)
-                                                   : std::clamp(populationDensity(params, centroid(lot.outline)), 0.0, 1.0);
+        double density = lot.block < blocks.size()
+                             ? std::clamp(blocks[lot.block].density, 0.0, 1.0)
+                             : std::clamp(populationDensity(params, centroid(lot.outline)), 0.0, 1.0);
         double setback = std::max(0.3, params.setback_m * (1.5 - density));
         auto insets = insetPolygon(lot.outline, setback);
         if (insets.empty()) return;
@@ -113,8 +120,12 @@ std::vector<Building> placeBuildings(const std::vector<Lot>& lots, const std::ve
         if (!(area >= kMinFootprintArea) || 2.0 * box.halfV < kMinFootprintWidth) return;
         Rng rng(params.seed, stableIdOf(centroid(lot.outline)), Stream::Buildings);
         // Houses and small apartment blocks do not fill big lots: clip to a seeded box.
-        double maxU = density < kSuburb ? rng.uniform(9.0, 16.0) : density < kDowntown ? rng.uniform(18.0, 34.0) : rng.uniform(30.0, 55.0);
-        double maxV = density < kSuburb ? rng.uniform(8.0, 12.0) : density < kDowntown ? rng.uniform(12.0, 20.0) : rng.uniform(24.0, 45.0);
+        double maxU = density < kSuburb     ? rng.uniform(9.0, 16.0)
+                      : density < kDowntown ? rng.uniform(18.0, 34.0)
+                                            : rng.uniform(30.0, 55.0);
+        double maxV = density < kSuburb     ? rng.uniform(8.0, 12.0)
+                      : density < kDowntown ? rng.uniform(12.0, 20.0)
+                                            : rng.uniform(24.0, 45.0);
         if (box.halfU > 0.5 * maxU || box.halfV > 0.5 * maxV) {
             // The box stands on the lot's longest street edge (front yard = setback), else at the OBB centre.
             glm::dvec2 c = box.centre, u = box.u, v = box.v;
@@ -257,15 +268,16 @@ void meshFacade(MeshBuilder& wall, MeshBuilder& win, const glm::dvec2& a, const 
                 quadFacing(wall, o00, o10, i10, i00, {0, 0, 1});   // bottom faces up
                 quadFacing(wall, o01, o11, i11, i01, {0, 0, -1});  // top faces down
                 win.quad(i00, i10, i11, i01);                      // glass at the back
-                if (s.detail >= 3 && !shop) {  // protruding sill ledge under the window
+                if (s.detail >= 3 && !shop) {                      // protruding sill ledge under the window
                     const double out = 0.14, th = 0.08, ext = 0.12;
                     glm::dvec3 o = n3 * out;
-                    glm::dvec3 l0 = P(xl - ext, zw0 - th), r0 = P(xr + ext, zw0 - th), l1 = P(xl - ext, zw0), r1 = P(xr + ext, zw0);
-                    quadFacing(wall, l1, r1, r1 + o, l1 + o, {0, 0, 1});     // top
-                    quadFacing(wall, l0 + o, r0 + o, r1 + o, l1 + o, n3);    // front
-                    quadFacing(wall, l0, r0, r0 + o, l0 + o, {0, 0, -1});    // bottom
-                    quadFacing(wall, l0, l0 + o, l1 + o, l1, -t3);           // left end
-                    quadFacing(wall, r0, r0 + o, r1 + o, r1, t3);            // right end
+                    glm::dvec3 l0 = P(xl - ext, zw0 - th), r0 = P(xr + ext, zw0 - th), l1 = P(xl - ext, zw0),
+                               r1 = P(xr + ext, zw0);
+                    quadFacing(wall, l1, r1, r1 + o, l1 + o, {0, 0, 1});   // top
+                    quadFacing(wall, l0 + o, r0 + o, r1 + o, l1 + o, n3);  // front
+                    quadFacing(wall, l0, r0, r0 + o, l0 + o, {0, 0, -1});  // bottom
+                    quadFacing(wall, l0, l0 + o, l1 + o, l1, -t3);         // left end
+                    quadFacing(wall, r0, r0 + o, r1 + o, r1, t3);          // right end
                 }
             }
             wall.quad(P(prev, zw0), P(len, zw0), P(len, zw1), P(prev, zw1));  // last pier
@@ -302,9 +314,9 @@ void parapetRoof(MeshBuilder& wall, MeshBuilder& roof, const Polygon2& fp, doubl
         const auto& b = fp[(i + 1) % n];
         const auto& ia = inner[i];
         const auto& ib = inner[(i + 1) % n];
-        wall.quad(at(a, z), at(b, z), at(b, z + h), at(a, z + h));           // outer face
-        wall.quad(at(a, z + h), at(b, z + h), at(ib, z + h), at(ia, z + h)); // cap
-        wall.quad(at(ib, z), at(ia, z), at(ia, z + h), at(ib, z + h));       // inner face
+        wall.quad(at(a, z), at(b, z), at(b, z + h), at(a, z + h));            // outer face
+        wall.quad(at(a, z + h), at(b, z + h), at(ib, z + h), at(ia, z + h));  // cap
+        wall.quad(at(ib, z), at(ia, z), at(ia, z + h), at(ib, z + h));        // inner face
     }
     flatRoof(roof, inner, z);
 }
@@ -312,7 +324,9 @@ void parapetRoof(MeshBuilder& wall, MeshBuilder& roof, const Polygon2& fp, doubl
 bool gabledRoof(MeshBuilder& wall, MeshBuilder& roof, const Polygon2& fp, double z, double rh) {
     OrientedBox box = orientedBox(fp);
     if (!(box.halfV > 1e-3) || !(rh > 0)) return false;
-    auto h = [&](const glm::dvec2& p) { return rh * std::max(0.0, 1.0 - std::abs(glm::dot(p - box.centre, box.v)) / box.halfV); };
+    auto h = [&](const glm::dvec2& p) {
+        return rh * std::max(0.0, 1.0 - std::abs(glm::dot(p - box.centre, box.v)) / box.halfV);
+    };
     FlaggedPolygon whole{fp, std::vector<uint8_t>(fp.size(), 1)};
     auto pieces = splitPolygonByLine(whole, box.centre, box.u);
     if (pieces.size() < 2) return false;
@@ -370,14 +384,16 @@ struct BuildingPalette {
 };
 
 BuildingPalette buildingPalette(const Building& b, uint32_t buildingId, const CityParams& params) {
-    static const glm::dvec3 kTower[] = {{0.55, 0.55, 0.56}, {0.36, 0.42, 0.50}, {0.70, 0.64, 0.52}, {0.31, 0.33, 0.36},
-                                        {0.80, 0.80, 0.78}, {0.47, 0.50, 0.47}};
-    static const glm::dvec3 kMid[] = {{0.55, 0.28, 0.20}, {0.45, 0.30, 0.22}, {0.72, 0.58, 0.35}, {0.82, 0.76, 0.62},
-                                      {0.62, 0.62, 0.60}, {0.66, 0.45, 0.33}};
-    static const glm::dvec3 kHouse[] = {{0.85, 0.78, 0.55}, {0.60, 0.70, 0.78}, {0.86, 0.85, 0.82}, {0.62, 0.68, 0.55},
-                                        {0.82, 0.62, 0.52}, {0.78, 0.70, 0.60}};
-    static const glm::dvec3 kFlatRoof[] = {{0.45, 0.45, 0.43}, {0.20, 0.20, 0.22}, {0.55, 0.54, 0.50}, {0.30, 0.42, 0.22}};
-    static const glm::dvec3 kPitchedRoof[] = {{0.60, 0.30, 0.22}, {0.28, 0.30, 0.34}, {0.42, 0.28, 0.20}, {0.50, 0.22, 0.18}};
+    static const glm::dvec3 kTower[] = {{0.55, 0.55, 0.56}, {0.36, 0.42, 0.50}, {0.70, 0.64, 0.52},
+                                        {0.31, 0.33, 0.36}, {0.80, 0.80, 0.78}, {0.47, 0.50, 0.47}};
+    static const glm::dvec3 kMid[] = {{0.55, 0.28, 0.20}, {0.45, 0.30, 0.22}, {0.72, 0.58, 0.35},
+                                      {0.82, 0.76, 0.62}, {0.62, 0.62, 0.60}, {0.66, 0.45, 0.33}};
+    static const glm::dvec3 kHouse[] = {{0.85, 0.78, 0.55}, {0.60, 0.70, 0.78}, {0.86, 0.85, 0.82},
+                                        {0.62, 0.68, 0.55}, {0.82, 0.62, 0.52}, {0.78, 0.70, 0.60}};
+    static const glm::dvec3 kFlatRoof[] = {
+        {0.45, 0.45, 0.43}, {0.20, 0.20, 0.22}, {0.55, 0.54, 0.50}, {0.30, 0.42, 0.22}};
+    static const glm::dvec3 kPitchedRoof[] = {
+        {0.60, 0.30, 0.22}, {0.28, 0.30, 0.34}, {0.42, 0.28, 0.20}, {0.50, 0.22, 0.18}};
     Rng rng(params.seed, buildingId, uint64_t(0x4D415445ull));  // "MATE"
     const double density = populationDensity(params, centroid(b.footprint));
     // Districts: downtown towers in dense areas; the type follows the floors.
@@ -390,8 +406,10 @@ BuildingPalette buildingPalette(const Building& b, uint32_t buildingId, const Ci
     roof *= rng.uniform(0.92, 1.08);
     const double v = params.effects.materials->variety;
     const double var = rng.uniform(-0.6, 0.6) * 0.18;
-    const glm::dvec3 baseWall = materialAlbedo(Material::Wall) * (1.0 + var), baseRoof = materialAlbedo(Material::Roof) * (1.0 + var);
-    return {glm::clamp(baseWall + (wall - baseWall) * v, 0.0, 1.0), glm::clamp(baseRoof + (roof - baseRoof) * v, 0.0, 1.0)};
+    const glm::dvec3 baseWall = materialAlbedo(Material::Wall) * (1.0 + var),
+                     baseRoof = materialAlbedo(Material::Roof) * (1.0 + var);
+    return {glm::clamp(baseWall + (wall - baseWall) * v, 0.0, 1.0),
+            glm::clamp(baseRoof + (roof - baseRoof) * v, 0.0, 1.0)};
 }
 
 }  // namespace
@@ -433,7 +451,8 @@ void meshBuilding(const Building& b, uint32_t buildingId, const CityParams& para
     s.detail = params.detail;
     const double z0 = b.base_z + b.min_height, zTop = b.base_z + b.height;
     for (size_t i = 0; i < fp.size(); ++i) meshFacade(wall, win, fp[i], fp[(i + 1) % fp.size()], z0, floors, s);
-    // Courtyards: the inner rings run clockwise, so their outside (the courtyard) is on the right as for the outer ring.
+    // Courtyards: the inner rings run clockwise, so their outside (the courtyard) is on the right as for the outer
+    // ring.
     for (const auto& h : holes)
         for (size_t i = 0; i < h.size(); ++i) meshFacade(wall, win, h[i], h[(i + 1) % h.size()], z0, floors, s);
     if (b.min_height > 0) {  // a lifted building (OSM min_height): its underside
@@ -442,11 +461,13 @@ void meshBuilding(const Building& b, uint32_t buildingId, const CityParams& para
             for (auto it = fp.rbegin(); it != fp.rend(); ++it) under.push_back(at(*it, z0));
             wall.polygon(under, {0, 0, -1});
         } else {
-            for (const auto& t : triangulateWithHoles(fp, holes)) wall.triangle(at(t[0], z0), at(t[2], z0), at(t[1], z0));
+            for (const auto& t : triangulateWithHoles(fp, holes))
+                wall.triangle(at(t[0], z0), at(t[2], z0), at(t[1], z0));
         }
     }
     if (!holes.empty()) {  // flat roof over the polygon with holes (pitched shapes were resolved to flat)
-        for (const auto& t : triangulateWithHoles(fp, holes)) roof.triangle(at(t[0], zTop), at(t[1], zTop), at(t[2], zTop));
+        for (const auto& t : triangulateWithHoles(fp, holes))
+            roof.triangle(at(t[0], zTop), at(t[1], zTop), at(t[2], zTop));
         return;
     }
     bool done = false;

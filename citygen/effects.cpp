@@ -13,11 +13,11 @@ struct Field {
     void (*set)(Effects&, double);
 };
 
-#define VISTA_EFFECT_FIELD(E, member, field, unit, lo, hi, def, integer, help)                                      \
-    Field {                                                                                                         \
-        {EffectId::E, #field, unit, lo, hi, def, integer, help},                                                    \
-            [](const Effects& e) { return double(e.member->field); },                                               \
-            [](Effects& e, double v) { e.member->field = static_cast<decltype(e.member->field)>(v); }               \
+#define VISTA_EFFECT_FIELD(E, member, field, unit, lo, hi, def, integer, help)                        \
+    Field {                                                                                           \
+        {EffectId::E, #field, unit, lo, hi, def, integer, help},                                      \
+            [](const Effects& e) { return double(e.member->field); },                                 \
+            [](Effects& e, double v) { e.member->field = static_cast<decltype(e.member->field)>(v); } \
     }
 
 const std::vector<Field>& fields() {
@@ -78,7 +78,8 @@ std::string rangeMessage(const EffectFieldSpec& s, const std::string& value) {
 
 Status checkField(const Field& f, double v) {
     if (!std::isfinite(v) || v < f.spec.min || v > f.spec.max) return Status::error(rangeMessage(f.spec, fmt(v)));
-    if (f.spec.integer && v != std::floor(v)) return Status::error(rangeMessage(f.spec, fmt(v)) + "; must be an integer");
+    if (f.spec.integer && v != std::floor(v))
+        return Status::error(rangeMessage(f.spec, fmt(v)) + "; must be an integer");
     return Status::ok();
 }
 
@@ -133,12 +134,24 @@ void Effects::clear(EffectId e) {
 
 void Effects::enable(EffectId e) {
     switch (e) {
-        case EffectId::SunShadows: if (!sun_shadows) sun_shadows.emplace(); break;
-        case EffectId::AmbientOcclusion: if (!ambient_occlusion) ambient_occlusion.emplace(); break;
-        case EffectId::Haze: if (!haze) haze.emplace(); break;
-        case EffectId::Glass: if (!glass) glass.emplace(); break;
-        case EffectId::Night: if (!night) night.emplace(); break;
-        case EffectId::Materials: if (!materials) materials.emplace(); break;
+        case EffectId::SunShadows:
+            if (!sun_shadows) sun_shadows.emplace();
+            break;
+        case EffectId::AmbientOcclusion:
+            if (!ambient_occlusion) ambient_occlusion.emplace();
+            break;
+        case EffectId::Haze:
+            if (!haze) haze.emplace();
+            break;
+        case EffectId::Glass:
+            if (!glass) glass.emplace();
+            break;
+        case EffectId::Night:
+            if (!night) night.emplace();
+            break;
+        case EffectId::Materials:
+            if (!materials) materials.emplace();
+            break;
         case EffectId::Count: break;
     }
 }
@@ -183,9 +196,7 @@ Result<Effects> parseEffectsJson(const std::string& text, const std::string& sou
     nlohmann::json j;
     try {
         j = nlohmann::json::parse(text);
-    } catch (const std::exception& ex) {
-        return Status::error(source + ": 'effects' is not valid JSON: " + ex.what());
-    }
+    } catch (const std::exception& ex) { return Status::error(source + ": 'effects' is not valid JSON: " + ex.what()); }
     if (!j.is_object())
         return Status::error(source + ": 'effects' must be an object of effects (known: " + effectNames() + ")");
     Effects out;

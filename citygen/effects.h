@@ -29,22 +29,22 @@ struct SunShadowsEffect {
     double resolution_m = 2.0;   // surfaces are refined down to this edge length where shadows change
 };
 struct AmbientOcclusionEffect {
-    int samples = 16;            // hemisphere rays per shaded point
-    double radius_m = 6.0;       // occluders farther than this do not darken
-    double strength = 0.8;       // 0 = no darkening, 1 = ambient fully scaled by the open share
-    double resolution_m = 2.0;   // refinement edge length where occlusion changes
+    int samples = 16;           // hemisphere rays per shaded point
+    double radius_m = 6.0;      // occluders farther than this do not darken
+    double strength = 0.8;      // 0 = no darkening, 1 = ambient fully scaled by the open share
+    double resolution_m = 2.0;  // refinement edge length where occlusion changes
 };
 struct HazeEffect {
     double visibility_m = 1500.0;  // meteorological visibility: contrast falls to 2 % at this distance
 };
 struct GlassEffect {
-    double reflectance = 0.2;   // reflectance at normal incidence (Schlick F0); 1 at grazing angles
-    int ray_budget = 50000;     // reflection rays per frame at most (0 = base colour only)
+    double reflectance = 0.2;  // reflectance at normal incidence (Schlick F0); 1 at grazing angles
+    int ray_budget = 50000;    // reflection rays per frame at most (0 = base colour only)
 };
 struct NightEffect {
-    double lit_share = 0.35;              // share of windows lit from inside
-    double street_light_spacing_m = 30.0; // distance between street lights along streets (0 = none)
-    double light_radius_m = 14.0;         // radius of a street light's pool of light
+    double lit_share = 0.35;               // share of windows lit from inside
+    double street_light_spacing_m = 30.0;  // distance between street lights along streets (0 = none)
+    double light_radius_m = 14.0;          // radius of a street light's pool of light
 };
 struct MaterialsEffect {
     double variety = 1.0;  // 0 = the one default palette, 1 = full palettes by district and building type
@@ -52,9 +52,9 @@ struct MaterialsEffect {
 
 enum class EffectId { SunShadows, AmbientOcclusion, Haze, Glass, Night, Materials, Count };
 constexpr int kEffectCount = int(EffectId::Count);
-const char* effectName(EffectId e);     // "sun_shadows", ...
-bool effectIsBaked(EffectId e);         // true: computed at generation (prelit colours)
-std::string effectNames();              // "sun_shadows, ambient_occlusion, ..."
+const char* effectName(EffectId e);  // "sun_shadows", ...
+bool effectIsBaked(EffectId e);      // true: computed at generation (prelit colours)
+std::string effectNames();           // "sun_shadows, ambient_occlusion, ..."
 bool findEffect(const std::string& name, EffectId& out);
 
 struct Effects {

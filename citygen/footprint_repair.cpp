@@ -117,9 +117,7 @@ bool isSimpleRingExact(const Polygon2& ring) {
     if (!finite(ring)) return false;
     try {
         return simple(ring);
-    } catch (...) {
-        return false;
-    }
+    } catch (...) { return false; }
 }
 
 Polygon2 makeSimpleRing(const Polygon2& ring, bool& split) {
@@ -145,7 +143,8 @@ Polygon2 makeSimpleRing(const Polygon2& ring, bool& split) {
             const auto hit = CGAL::intersection(si, sj);
             if (!hit) continue;
             if (const Point* p = boost::get<Point>(&*hit)) x = {CGAL::to_double(p->x()), CGAL::to_double(p->y())};
-            else if (const Segment* s = boost::get<Segment>(&*hit)) x = {CGAL::to_double(s->source().x()), CGAL::to_double(s->source().y())};
+            else if (const Segment* s = boost::get<Segment>(&*hit))
+                x = {CGAL::to_double(s->source().x()), CGAL::to_double(s->source().y())};
             else continue;
             if (!std::isfinite(x.x) || !std::isfinite(x.y)) continue;
             // Loop A: x, r[i+1] .. r[j]; loop B: x, r[j+1] .. r[i] (cyclic).
@@ -161,33 +160,30 @@ Polygon2 makeSimpleRing(const Polygon2& ring, bool& split) {
         double bestArea = 0;
         for (size_t k = 0; k < done.size(); ++k) {
             const double a = std::abs(signedArea(done[k]));
-            if (a > bestArea) { bestArea = a; best = k; }
+            if (a > bestArea) {
+                bestArea = a;
+                best = k;
+            }
         }
         if (best == done.size()) return {};
         Polygon2 out = std::move(done[best]);
         if (signedArea(out) < 0) std::reverse(out.begin(), out.end());
         return out;
-    } catch (...) {
-        return {};
-    }
+    } catch (...) { return {}; }
 }
 
 bool ringStrictlyInside(const Polygon2& inner, const Polygon2& outer) {
     if (inner.size() < 3 || outer.size() < 3 || !finite(inner) || !finite(outer)) return false;
     try {
         return !segmentsConflict(inner, outer) && strictlyInsidePoint(inner[0], outer);
-    } catch (...) {
-        return false;
-    }
+    } catch (...) { return false; }
 }
 
 bool ringsDisjoint(const Polygon2& a, const Polygon2& b) {
     if (a.size() < 3 || b.size() < 3 || !finite(a) || !finite(b)) return false;
     try {
         return !segmentsConflict(a, b) && !strictlyInsidePoint(a[0], b) && !strictlyInsidePoint(b[0], a);
-    } catch (...) {
-        return false;
-    }
+    } catch (...) { return false; }
 }
 
 std::vector<std::array<glm::dvec2, 3>> triangulateWithHoles(const Polygon2& outer, const std::vector<Polygon2>& holes) {
@@ -239,12 +235,11 @@ std::vector<std::array<glm::dvec2, 3>> triangulateWithHoles(const Polygon2& oute
         for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
             if (f->info() % 2 != 1) continue;
             std::array<glm::dvec2, 3> t;
-            for (int k = 0; k < 3; ++k) t[size_t(k)] = {CGAL::to_double(f->vertex(k)->point().x()), CGAL::to_double(f->vertex(k)->point().y())};
+            for (int k = 0; k < 3; ++k)
+                t[size_t(k)] = {CGAL::to_double(f->vertex(k)->point().x()), CGAL::to_double(f->vertex(k)->point().y())};
             out.push_back(t);
         }
-    } catch (...) {
-        out.clear();
-    }
+    } catch (...) { out.clear(); }
     return out;
 }
 

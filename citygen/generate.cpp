@@ -190,7 +190,10 @@ CityCounts countCity(const City& c) {
     for (const auto& t : c.tiles) {
         std::vector<bool> u(c.treePrototypes.size(), false);
         for (uint32_t i : t.trees)
-            if (c.trees[i].prototype < u.size() && !u[c.trees[i].prototype]) { u[c.trees[i].prototype] = true; ++n.drawCalls; }
+            if (c.trees[i].prototype < u.size() && !u[c.trees[i].prototype]) {
+                u[c.trees[i].prototype] = true;
+                ++n.drawCalls;
+            }
     }
     for (const auto& tr : c.trees) {
         if (tr.prototype < c.treePrototypes.size()) {

@@ -18,8 +18,8 @@ constexpr double kA = 6378137.0;
 constexpr double kF = 1.0 / 298.257223563;
 
 struct TmConstants {
-    double e = 0, e2m = 0;      // eccentricity, 1 - e^2
-    double a1 = 0;              // rectifying radius A (scale 1 on the central meridian)
+    double e = 0, e2m = 0;            // eccentricity, 1 - e^2
+    double a1 = 0;                    // rectifying radius A (scale 1 on the central meridian)
     double alp[7] = {}, bet[7] = {};  // Krueger series, index 1..6
 
     TmConstants() {
@@ -65,7 +65,8 @@ double tauf(double taup) {
     const double stol = tol * std::max(1.0, std::abs(taup));
     for (int i = 0; i < 5; ++i) {
         const double taupa = taupf(tau);
-        const double dtau = (taup - taupa) * (1 + e2m * tau * tau) / (e2m * std::hypot(1.0, tau) * std::hypot(1.0, taupa));
+        const double dtau =
+            (taup - taupa) * (1 + e2m * tau * tau) / (e2m * std::hypot(1.0, tau) * std::hypot(1.0, taupa));
         tau += dtau;
         if (!(std::abs(dtau) >= stol)) break;
     }
@@ -95,9 +96,7 @@ double xiOfLatitude(double latDeg) {
     return xi;
 }
 
-bool validReference(const GeoReference& r) {
-    return std::abs(r.lat0_deg) <= 90 && std::abs(r.lon0_deg) <= 180;
-}
+bool validReference(const GeoReference& r) { return std::abs(r.lat0_deg) <= 90 && std::abs(r.lon0_deg) <= 180; }
 
 }  // namespace
 

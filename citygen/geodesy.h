@@ -27,7 +27,7 @@
 namespace vista {
 
 constexpr const char* kGeoProjection = "tmerc";  // the one projection (name stored with the city)
-constexpr double kGeoMaxLocal_m = 4.0e6;          // localToGeo() domain: |x|, |y| up to this
+constexpr double kGeoMaxLocal_m = 4.0e6;         // localToGeo() domain: |x|, |y| up to this
 
 struct GeoPoint {
     double lat_deg = 0.0;  // -90 .. 90, north positive

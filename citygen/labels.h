@@ -27,8 +27,16 @@
 namespace vista {
 
 enum class InstanceKind : uint32_t {
-    None = 0, Building = 1, Tree = 2, Road = 3, Junction = 4, Sidewalk = 5, Park = 6, StreetLight = 7,
-    TrafficLight = 8, TrafficSign = 9,
+    None = 0,
+    Building = 1,
+    Tree = 2,
+    Road = 3,
+    Junction = 4,
+    Sidewalk = 5,
+    Park = 6,
+    StreetLight = 7,
+    TrafficLight = 8,
+    TrafficSign = 9,
     Count = 10  // number of kinds (not a kind)
 };
 constexpr uint32_t kInstanceIndexBits = 28;
@@ -61,8 +69,8 @@ enum class SemanticClass : uint8_t {
     Count = 14
 };
 constexpr int kSemanticClassCount = int(SemanticClass::Count);
-SemanticClass semanticClass(Material m);          // Count (invalid) for Material::Count
-const char* semanticClassName(SemanticClass c);   // "sky", "terrain", ...; "unknown" out of range
+SemanticClass semanticClass(Material m);         // Count (invalid) for Material::Count
+const char* semanticClassName(SemanticClass c);  // "sky", "terrain", ...; "unknown" out of range
 // A colour per class for previews (RGB).
 void semanticClassColor(SemanticClass c, uint8_t rgb[3]);
 

@@ -90,7 +90,8 @@ private:
 }  // namespace
 
 bool crossingBand(const EdgeLanes& L, bool atB, double& s0, double& s1) {
-    if (!L.valid || (atB ? L.junctionB : L.junctionA) < 0 || !(L.length > 2 * (kStopSetback + kStopDepth))) return false;
+    if (!L.valid || (atB ? L.junctionB : L.junctionA) < 0 || !(L.length > 2 * (kStopSetback + kStopDepth)))
+        return false;
     const double depth = L.sidewalk > 0 ? L.sidewalk : kCrossingDepth;
     if (atB) {
         s0 = L.length + kCrossingGap;
@@ -182,8 +183,13 @@ double filletTrim(double angle, double extent) {
 class LaneModelBuilder {
 public:
     LaneModelBuilder(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks)
-        : g(g), blocks(blocks), N(g.nodes.size()), sw(params.sidewalk_m > 0.01 ? params.sidewalk_m : 0.0),
-          incident(g.nodes.size()), wantA(g.edges.size(), 0.0), wantB(g.edges.size(), 0.0) {
+        : g(g),
+          blocks(blocks),
+          N(g.nodes.size()),
+          sw(params.sidewalk_m > 0.01 ? params.sidewalk_m : 0.0),
+          incident(g.nodes.size()),
+          wantA(g.edges.size(), 0.0),
+          wantB(g.edges.size(), 0.0) {
         m.degree.assign(N, 0);
         m.nodeJunction.assign(N, -1);
         m.edges.resize(g.edges.size());
@@ -363,7 +369,8 @@ void LaneModelBuilder::planTurns() {
                 }
                 exits.push_back(t);
             }
-            std::stable_sort(exits.begin(), exits.end(), [](const TurnPlan& a, const TurnPlan& b) { return a.angle < b.angle; });
+            std::stable_sort(exits.begin(), exits.end(),
+                             [](const TurnPlan& a, const TurnPlan& b) { return a.angle < b.angle; });
             for (int k = 1; k <= nIn && !exits.empty(); ++k) {
                 size_t best = 0;
                 int bestDist = 1 << 30;
@@ -400,8 +407,9 @@ void LaneModelBuilder::planTransitions() {
         r.inEnd = in.atB;
         r.outStart = !out.atB;
         r.angle = turnAngle(in.dirIn(), -out.dirIn());
-        r.turn = r.angle < -kStraightTurn ? LinkRoad::Turn::Right : r.angle > kStraightTurn ? LinkRoad::Turn::Left
-                                                                                              : LinkRoad::Turn::Straight;
+        r.turn = r.angle < -kStraightTurn  ? LinkRoad::Turn::Right
+                 : r.angle > kStraightTurn ? LinkRoad::Turn::Left
+                                           : LinkRoad::Turn::Straight;
         const double wIn = in.L->laneWidth, wOut = out.L->laneWidth;
         // Right: in's lanes toward v continue as out's lanes away from v.
         for (int k = 1, n = std::max(in.toward(), out.away()); k <= n; ++k) {
@@ -438,8 +446,8 @@ void LaneModelBuilder::planTransitions() {
         bool taper = std::abs(r.offset0 - r.offset1) > 1e-9;
         for (const auto* side : {&r.right, &r.left})
             for (const LinkRoad::Lane& l : *side) taper = taper || std::abs(l.w0 - l.w1) > 1e-9;
-        const double need = std::max({filletTrim(r.angle, turnSideExtent(r)), taper ? 0.5 * kTaperLength : 0.0,
-                                      0.5 * kMinLinkLength});
+        const double need =
+            std::max({filletTrim(r.angle, turnSideExtent(r)), taper ? 0.5 * kTaperLength : 0.0, 0.5 * kMinLinkLength});
         want(inE, v, need);
         want(outE, v, need);
         transitions.push_back(std::move(r));
@@ -550,6 +558,5 @@ void LaneModelBuilder::placeSignals() {
 LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks) {
     return LaneModelBuilder(g, params, blocks).build();
 }
-
 
 }  // namespace vista

@@ -61,11 +61,11 @@
 
 namespace vista {
 
-constexpr double kMinRoadLength = 1.0;      // shortest trimmed reference line
+constexpr double kMinRoadLength = 1.0;          // shortest trimmed reference line
 constexpr double kMaxTurn = 2.356194490192345;  // 135 degrees: sharper turns get no link road
-constexpr double kCurvatureMargin = 0.3;    // lane borders stay this far from a turn's centre of curvature
-constexpr double kTaperLength = 12.0;       // transition length where lane counts or widths change
-constexpr double kMinLinkLength = 1.0;      // shortest transition (straight on, same lanes)
+constexpr double kCurvatureMargin = 0.3;        // lane borders stay this far from a turn's centre of curvature
+constexpr double kTaperLength = 12.0;           // transition length where lane counts or widths change
+constexpr double kMinLinkLength = 1.0;          // shortest transition (straight on, same lanes)
 
 // Carriageway width the road mesh draws for an edge.
 double carriagewayWidth(const StreetEdge& e);
@@ -80,9 +80,9 @@ struct EdgeLanes {
     double length = 0;                // |end - start|
     int right = 1, left = 1;          // driving lanes a->b / b->a (either may be 0 on a one-way edge)
     double laneWidth = 3.5;
-    double sidewalk = 0;              // sidewalk width, 0 = none
+    double sidewalk = 0;                     // sidewalk width, 0 = none
     bool walkLeft = true, walkRight = true;  // sidewalk present on that side (when sidewalk > 0)
-    double speedKmh = 50;             // speed limit of the driving lanes
+    double speedKmh = 50;                    // speed limit of the driving lanes
     // Lateral position of the centre lane (lane 0) relative to the street's
     // centre line (left positive): (right - left) / 2 x laneWidth, so the
     // lanes span exactly the carriageway [-w/2, w/2] for odd lane counts too
@@ -101,8 +101,8 @@ struct EdgeLanes {
 struct Junction {
     uint32_t node = 0;
     double radius = 0;
-    std::vector<uint32_t> arms;  // incident edge indices, counter-clockwise by angle
-    std::vector<uint32_t> links; // its link roads (indices into LaneModel::links)
+    std::vector<uint32_t> arms;   // incident edge indices, counter-clockwise by angle
+    std::vector<uint32_t> links;  // its link roads (indices into LaneModel::links)
 };
 
 // A road between two street roads: a junction's connecting road (junction
@@ -121,7 +121,7 @@ struct LinkRoad {
     bool inEnd = true;         // `in` meets the node with its end (b == node), else with its start
     bool outStart = true;      // `out` leaves the node with its start (a == node), else with its end
     Turn turn = Turn::Straight;
-    double angle = 0;          // signed heading change in -> out (left positive), radians
+    double angle = 0;  // signed heading change in -> out (left positive), radians
     // Reference line: a line of length line0, an arc of length arcLength and
     // curvature `curvature` (1/m, left positive), a line of length line1,
     // starting at `start` with heading `hdg` (radians, city frame).
@@ -132,7 +132,7 @@ struct LinkRoad {
     std::vector<Lane> right;          // right[k - 1] is lane -k (drives in -> out)
     std::vector<Lane> left;           // left[k - 1] is lane +k (drives out -> in; transitions only)
     double length() const { return line0 + arcLength + line1; }
-    glm::dvec2 point(double s) const;   // reference line at s (clamped to [0, length])
+    glm::dvec2 point(double s) const;  // reference line at s (clamped to [0, length])
     double heading(double s) const;
     // Smoothstep weight of the end values at s: 0 at s = 0, 1 at s = length.
     double blend(double s) const;
@@ -163,16 +163,16 @@ struct SignalPlacement {
 };
 
 struct LaneModel {
-    std::vector<EdgeLanes> edges;      // one per street edge
-    std::vector<Junction> junctions;   // nodes of degree >= 3, by node index
-    std::vector<int> nodeJunction;     // per node: junction index or -1
-    std::vector<int> degree;           // per node
-    std::vector<LinkRoad> links;       // junctions' connecting roads, then transitions, by node index
+    std::vector<EdgeLanes> edges;                  // one per street edge
+    std::vector<Junction> junctions;               // nodes of degree >= 3, by node index
+    std::vector<int> nodeJunction;                 // per node: junction index or -1
+    std::vector<int> degree;                       // per node
+    std::vector<LinkRoad> links;                   // junctions' connecting roads, then transitions, by node index
     std::vector<std::vector<uint32_t>> nodeLinks;  // per node: its link roads
     std::vector<SignalPlacement> signals;          // by edge, start before end
-    size_t sharpCorners = 0;           // degree-2 nodes left unlinked: too sharp for the lanes
-    size_t droppedTurns = 0;           // junction turns within kMaxTurn whose trims did not fit the edges
-    size_t unlinkedLanes = 0;          // incoming driving lanes at a junction that no turn takes
+    size_t sharpCorners = 0;                       // degree-2 nodes left unlinked: too sharp for the lanes
+    size_t droppedTurns = 0;                       // junction turns within kMaxTurn whose trims did not fit the edges
+    size_t unlinkedLanes = 0;                      // incoming driving lanes at a junction that no turn takes
 };
 
 LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks = nullptr);

@@ -28,11 +28,11 @@ constexpr double kNightAmbient = 0.14;
 struct Lighting {
     glm::dvec3 sunDir{0, 0, 1};  // unit vector towards the sun, city frame (x east, y north, z up)
     double ambient = 0.45;
-    double sun = 1.0;            // direct sun strength: 1 by day, 0 at night
-    bool glass = false;          // windows are glass (alpha kGlassAlpha)
+    double sun = 1.0;    // direct sun strength: 1 by day, 0 at night
+    bool glass = false;  // windows are glass (alpha kGlassAlpha)
     bool night = false;
-    double litShare = 0.0;       // night: share of windows lit from inside
-    uint64_t seed = 0;           // night: picks the lit windows
+    double litShare = 0.0;  // night: share of windows lit from inside
+    uint64_t seed = 0;      // night: picks the lit windows
     explicit Lighting(const CityParams& p);
     Lighting() = default;
 };
@@ -42,7 +42,8 @@ glm::dvec3 materialAlbedo(Material m);  // linear 0..1 RGB
 double lightLevel(const glm::dvec3& normal, const Lighting& light);
 glm::u8vec4 prelitColor(Material m, const glm::dvec3& normal, const Lighting& light, double variation = 0.0);
 // The same with an explicit linear albedo (materials effect palettes).
-glm::u8vec4 prelitAlbedo(const glm::dvec3& albedo, const glm::dvec3& normal, const Lighting& light, uint8_t alpha = 255);
+glm::u8vec4 prelitAlbedo(const glm::dvec3& albedo, const glm::dvec3& normal, const Lighting& light,
+                         uint8_t alpha = 255);
 // Linear 0..1 -> sRGB byte (the encoding of every prelit colour) and back.
 uint8_t encodeSrgb(double linear);
 double decodeSrgb(uint8_t v);

@@ -62,8 +62,14 @@ struct LotSplitter {
         OrientedBox box = orientedBox(p.pts);
         double len = 2.0 * box.halfU, wid = 2.0 * box.halfV;
         double front = frontageLength(p);
-        if (depth >= kMaxDepth || len <= target) { emit(p); return; }
-        if (front >= kMinFrontage && front <= 1.25 * target && len <= 2.5 * target) { emit(p); return; }
+        if (depth >= kMaxDepth || len <= target) {
+            emit(p);
+            return;
+        }
+        if (front >= kMinFrontage && front <= 1.25 * target && len <= 2.5 * target) {
+            emit(p);
+            return;
+        }
         Rng rng(params.seed, key, Stream::Lots);
         double j1 = rng.uniform(-0.12, 0.12), j2 = rng.uniform(-0.12, 0.12);
         auto pieces = splitPolygonByLine(p, box.centre + box.u * (len * j1), box.v);
@@ -71,7 +77,10 @@ struct LotSplitter {
             auto alt = splitPolygonByLine(p, box.centre + box.v * (wid * j2), box.u);
             if (alt.size() > 1 && allFront(alt)) pieces = std::move(alt);
         }
-        if (pieces.size() <= 1) { emit(p); return; }
+        if (pieces.size() <= 1) {
+            emit(p);
+            return;
+        }
         for (size_t k = 0; k < pieces.size(); ++k) split(pieces[k], hashKeys(key, k + 1), depth + 1);
     }
 };
@@ -89,7 +98,9 @@ std::vector<Lot> subdivideLots(const std::vector<Block>& blocks, const CityParam
         if (fp.pts.size() < 3) return;
         for (size_t i = 0; i < fp.pts.size(); ++i) {
             glm::dvec2 a = fp.pts[i], c = fp.pts[(i + 1) % fp.pts.size()];
-            auto onBorder = [&](double u, double v) { return std::abs(u) >= half - 1e-6 && std::abs(v) >= half - 1e-6 && u * v > 0; };
+            auto onBorder = [&](double u, double v) {
+                return std::abs(u) >= half - 1e-6 && std::abs(v) >= half - 1e-6 && u * v > 0;
+            };
             bool border = onBorder(a.x, c.x) || onBorder(a.y, c.y);
             fp.flags.push_back(border ? 0 : 1);
         }

@@ -22,7 +22,20 @@ namespace vista {
 // TrafficLight, TrafficSign: the lane model's signals (traffic_signals.h), pole and head.
 // Values are stable (tree prototypes store Trunk and Leaves by value): new ones go last.
 enum class Material : uint8_t {
-    Ground, Road, Marking, Sidewalk, Grass, Wall, Window, Roof, Trunk, Leaves, Lamp, TrafficLight, TrafficSign, Count
+    Ground,
+    Road,
+    Marking,
+    Sidewalk,
+    Grass,
+    Wall,
+    Window,
+    Roof,
+    Trunk,
+    Leaves,
+    Lamp,
+    TrafficLight,
+    TrafficSign,
+    Count
 };
 constexpr int kMaterialCount = int(Material::Count);
 const char* materialName(Material m);
@@ -34,7 +47,7 @@ struct Mesh {
     std::vector<glm::vec3> normals;   // per vertex, unit length (used for prelighting and export)
     std::vector<glm::u8vec4> colors;  // prelit
     std::vector<uint32_t> indices;
-    std::vector<uint32_t> ids;        // per vertex label id (labels.h), or empty
+    std::vector<uint32_t> ids;  // per vertex label id (labels.h), or empty
 
     size_t triangleCount() const { return indices.size() / 3; }
     bool empty() const { return indices.empty(); }

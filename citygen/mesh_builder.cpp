@@ -17,11 +17,10 @@ int TileGrid::tileOf(const glm::dvec2& p) const {
     return y * _n + x;
 }
 
-glm::dvec3 TileGrid::origin(int tile) const {
-    return {-_half + ix(tile) * _size, -_half + iy(tile) * _size, 0.0};
-}
+glm::dvec3 TileGrid::origin(int tile) const { return {-_half + ix(tile) * _size, -_half + iy(tile) * _size, 0.0}; }
 
-MeshBuilder::MeshBuilder(Mesh& target, const glm::dvec3& origin, Material material, const Lighting& light, double variation)
+MeshBuilder::MeshBuilder(Mesh& target, const glm::dvec3& origin, Material material, const Lighting& light,
+                         double variation)
     : _mesh(target), _origin(origin), _material(material), _light(light), _variation(variation) {}
 
 uint32_t MeshBuilder::vertex(const glm::dvec3& p, const glm::vec3& n, const glm::u8vec4& c) {

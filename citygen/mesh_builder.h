@@ -36,13 +36,17 @@ private:
 
 class MeshBuilder {
 public:
-    MeshBuilder(Mesh& target, const glm::dvec3& origin, Material material, const Lighting& light, double variation = 0.0);
+    MeshBuilder(Mesh& target, const glm::dvec3& origin, Material material, const Lighting& light,
+                double variation = 0.0);
     void setMaterial(Material m) { _material = m; }
     void setVariation(double v) { _variation = v; }
     // Ground-truth label of the following vertices (labels.h); 0 until set.
     void setId(uint32_t id) { _id = id; }
     // Materials effect: this albedo (linear RGB) instead of the material's palette x variation.
-    void setAlbedo(const glm::dvec3& albedo) { _albedo = albedo; _hasAlbedo = true; }
+    void setAlbedo(const glm::dvec3& albedo) {
+        _albedo = albedo;
+        _hasAlbedo = true;
+    }
     // Flat triangle/quad, counter-clockwise seen from the side the normal points to.
     void triangle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c);
     void quad(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& d);

@@ -83,7 +83,7 @@ private:
         std::vector<size_t> signals;
     };
     std::vector<Group> groups;
-    std::vector<double> groupAxis;                     // per group: its approaches' direction modulo pi
+    std::vector<double> groupAxis;                    // per group: its approaches' direction modulo pi
     std::vector<std::vector<size_t>> junctionGroups;  // per junction: indices into groups
 };
 
@@ -94,7 +94,8 @@ std::string Writer::roadMarkCentre(RoadClass c) const {
 }
 
 std::string Writer::roadType(double speedKmh) const {
-    return "    <type s=\"0\" type=\"town\">\n      <speed max=\"" + num(speedKmh) + "\" unit=\"km/h\"/>\n    </type>\n";
+    return "    <type s=\"0\" type=\"town\">\n      <speed max=\"" + num(speedKmh) +
+           "\" unit=\"km/h\"/>\n    </type>\n";
 }
 
 double Writer::crossSlope(const glm::dvec2& p, const glm::dvec2& dir) const {
@@ -171,7 +172,8 @@ void Writer::laneSide(uint32_t e, bool left) {
     const int sgn = left ? 1 : -1;
     auto laneXml = [&](int k, bool sidewalk) {
         const int id = sgn * k;
-        o += "          <lane id=\"" + str(id) + "\" type=\"" + (sidewalk ? "sidewalk" : "driving") + "\" level=\"false\">\n";
+        o += "          <lane id=\"" + str(id) + "\" type=\"" + (sidewalk ? "sidewalk" : "driving") +
+             "\" level=\"false\">\n";
         const int pre = transitionLane(e, false, id), suc = transitionLane(e, true, id);
         if (pre || suc) {
             o += "            <link>";
@@ -179,12 +181,12 @@ void Writer::laneSide(uint32_t e, bool left) {
             if (suc) o += "<successor id=\"" + str(suc) + "\"/>";
             o += "</link>\n";
         }
-        o += "            <width sOffset=\"0\" a=\"" + num(sidewalk ? L.sidewalk : L.laneWidth) + "\" b=\"0\" c=\"0\" d=\"0\"/>\n";
+        o += "            <width sOffset=\"0\" a=\"" + num(sidewalk ? L.sidewalk : L.laneWidth) +
+             "\" b=\"0\" c=\"0\" d=\"0\"/>\n";
         if (!sidewalk && k < count)
             o += "            <roadMark sOffset=\"0\" type=\"broken\" weight=\"standard\" color=\"standard\" "
                  "width=\"0.15\" laneChange=\"both\"/>\n";
-        else
-            o += "            <roadMark sOffset=\"0\" type=\"none\" color=\"standard\"/>\n";
+        else o += "            <roadMark sOffset=\"0\" type=\"none\" color=\"standard\"/>\n";
         if (!sidewalk) {
             o += "            <speed sOffset=\"0\" max=\"" + num(L.speedKmh) + "\" unit=\"km/h\"/>\n";
             ++n.drivingLanes;
@@ -207,7 +209,6 @@ void Writer::laneSide(uint32_t e, bool left) {
     (void)E;
 }
 
-
 // The lane model's signals on a street road (SignalPlacement), with a
 // controller per approach group at signalised junctions.
 void Writer::signals(uint32_t e) {
@@ -223,8 +224,8 @@ void Writer::signals(uint32_t e) {
                num(light ? kTrafficLightBottom : kSignBottom) + "\" country=\"DE\" type=\"" + type +
                "\" subtype=\"-1\" height=\"" + num(light ? kTrafficLightHeight : kSignSize) + "\" width=\"" +
                num(light ? kTrafficLightWidth : kSignSize) + "\">\n";
-        xml += "        <validity fromLane=\"" + str(sp.atB ? -1 : 1) + "\" toLane=\"" + str(sp.atB ? -sp.lanes : sp.lanes) +
-               "\"/>\n      </signal>\n";
+        xml += "        <validity fromLane=\"" + str(sp.atB ? -1 : 1) + "\" toLane=\"" +
+               str(sp.atB ? -sp.lanes : sp.lanes) + "\"/>\n      </signal>\n";
         if (!light) {
             ++n.signs;
             continue;
@@ -259,9 +260,11 @@ void Writer::objects(uint32_t e) {
         if (!crossingBand(L, atB != 0, s0, s1)) continue;
         const double anchor = atB ? L.length : 0.0;
         const double u0 = s0 - anchor, u1 = s1 - anchor, hw = L.halfWidth();
-        xml += "      <object type=\"crosswalk\" name=\"zebra crossing\" id=\"" + str(nextObject++) + "\" s=\"" + num(anchor) +
-               "\" t=\"0\" zOffset=\"0\" hdg=\"0\" pitch=\"0\" roll=\"0\" orientation=\"none\" length=\"" + num(u1 - u0) +
-               "\" width=\"" + num(2 * hw) + "\" height=\"0\">\n        <outlines>\n          <outline id=\"0\" "
+        xml += "      <object type=\"crosswalk\" name=\"zebra crossing\" id=\"" + str(nextObject++) + "\" s=\"" +
+               num(anchor) +
+               "\" t=\"0\" zOffset=\"0\" hdg=\"0\" pitch=\"0\" roll=\"0\" orientation=\"none\" length=\"" +
+               num(u1 - u0) + "\" width=\"" + num(2 * hw) +
+               "\" height=\"0\">\n        <outlines>\n          <outline id=\"0\" "
                "outer=\"true\" closed=\"true\" laneType=\"driving\">\n";
         for (auto [u, v] : {std::pair{u0, -hw}, {u1, -hw}, {u1, hw}, {u0, hw}})
             xml += "            <cornerLocal u=\"" + num(u) + "\" v=\"" + num(v) + "\" z=\"0\" height=\"0\"/>\n";
@@ -303,8 +306,8 @@ void Writer::road(uint32_t e) {
     o += "    <lanes>\n      <laneOffset s=\"0\" a=\"" + num(L.offset) + "\" b=\"0\" c=\"0\" d=\"0\"/>\n";
     o += "      <laneSection s=\"0\">\n";
     laneSide(e, true);
-    o += "        <center>\n          <lane id=\"0\" type=\"none\" level=\"false\">\n            " + roadMarkCentre(E.cls) +
-         "\n          </lane>\n        </center>\n";
+    o += "        <center>\n          <lane id=\"0\" type=\"none\" level=\"false\">\n            " +
+         roadMarkCentre(E.cls) + "\n          </lane>\n        </center>\n";
     laneSide(e, false);
     o += "      </laneSection>\n    </lanes>\n";
     objects(e);
@@ -320,9 +323,11 @@ void Writer::linkRoad(size_t k) {
     const double len = r.length();
     const bool inJunction = r.junction >= 0;
     const EdgeLanes &Li = M.edges[r.in], &Lo = M.edges[r.out];
-    o += "  <road name=\"" + std::string(inJunction ? "junction " + str(junctionId(size_t(r.junction))) : "transition") + " " +
+    o += "  <road name=\"" +
+         std::string(inJunction ? "junction " + str(junctionId(size_t(r.junction))) : "transition") + " " +
          str(size_t(r.in)) + " to " + str(size_t(r.out)) + "\" length=\"" + num(len) + "\" id=\"" + str(linkRoadId(k)) +
-         "\" junction=\"" + (inJunction ? str(junctionId(size_t(r.junction))) : std::string("-1")) + "\" rule=\"RHT\">\n";
+         "\" junction=\"" + (inJunction ? str(junctionId(size_t(r.junction))) : std::string("-1")) +
+         "\" rule=\"RHT\">\n";
     o += "    <link>\n      <predecessor elementType=\"road\" elementId=\"" + str(size_t(r.in)) + "\" contactPoint=\"" +
          (r.inEnd ? "end" : "start") + "\"/>\n      <successor elementType=\"road\" elementId=\"" + str(size_t(r.out)) +
          "\" contactPoint=\"" + (r.outStart ? "start" : "end") + "\"/>\n    </link>\n";
@@ -380,7 +385,8 @@ void Writer::linkRoad(size_t k) {
         lanesXml(r.left, 1);
         o += "        </left>\n";
     }
-    o += "        <center>\n          <lane id=\"0\" type=\"none\" level=\"false\">\n            <roadMark sOffset=\"0\" "
+    o += "        <center>\n          <lane id=\"0\" type=\"none\" level=\"false\">\n            <roadMark "
+         "sOffset=\"0\" "
          "type=\"none\" color=\"standard\"/>\n          </lane>\n        </center>\n";
     if (!r.right.empty()) {
         o += "        <right>\n";

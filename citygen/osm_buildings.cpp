@@ -38,9 +38,13 @@ bool leadingNumber(std::string_view& s, double& v) {
     bool any = false, dot = false;
     while (p < s.size()) {
         const char c = s[p];
-        if (c >= '0' && c <= '9') { digits += c; any = true; }
-        else if ((c == '.' || c == ',') && !dot) { digits += '.'; dot = true; }
-        else break;
+        if (c >= '0' && c <= '9') {
+            digits += c;
+            any = true;
+        } else if ((c == '.' || c == ',') && !dot) {
+            digits += '.';
+            dot = true;
+        } else break;
         ++p;
     }
     if (!any || digits.size() > 24) return false;
@@ -123,8 +127,9 @@ Building resolveOne(const OsmFootprint& f, const CityParams& params, OsmBuilding
     } else {
         const double fill = area / std::max(1e-9, 4.0 * box.halfU * box.halfV);
         const bool house = floors <= 3 && area <= 350.0 && density < kDowntown && f.holes.empty();
-        b.roof = !house ? RoofType::Flat
-                        : (fill > 0.85 && f.outer.size() <= 6 && !rng.chance(0.3)) ? RoofType::Gabled : RoofType::Hipped;
+        b.roof = !house                                                     ? RoofType::Flat
+                 : (fill > 0.85 && f.outer.size() <= 6 && !rng.chance(0.3)) ? RoofType::Gabled
+                                                                            : RoofType::Hipped;
         ++st.roofProcedural;
     }
     // 3. Roof height of pitched roofs: roof:height, else roof:levels storeys, else a seeded pitch.
@@ -176,7 +181,10 @@ Building resolveOne(const OsmFootprint& f, const CityParams& params, OsmBuilding
 
 struct Bounds {
     glm::dvec2 lo{1e300}, hi{-1e300};
-    void add(const glm::dvec2& p) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
+    void add(const glm::dvec2& p) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
     bool overlaps(const Bounds& o, double m = 0) const {
         return lo.x <= o.hi.x + m && o.lo.x <= hi.x + m && lo.y <= o.hi.y + m && o.lo.y <= hi.y + m;
     }
@@ -192,7 +200,10 @@ class BoxGrid {
 public:
     BoxGrid(const std::vector<Bounds>& boxes, double cell) : _cell(cell) {
         for (const auto& b : boxes)
-            if (b.lo.x <= b.hi.x) { _lo = glm::min(_lo, b.lo); _hi = glm::max(_hi, b.hi); }
+            if (b.lo.x <= b.hi.x) {
+                _lo = glm::min(_lo, b.lo);
+                _hi = glm::max(_hi, b.hi);
+            }
         if (!(_lo.x <= _hi.x)) return;
         _nx = std::clamp(int((_hi.x - _lo.x) / cell) + 1, 1, 4096);
         _ny = std::clamp(int((_hi.y - _lo.y) / cell) + 1, 1, 4096);
@@ -206,7 +217,9 @@ public:
     template <class F>
     void query(const Bounds& b, F f) const {
         if (_cells.empty()) return;
-        forCells(b, [&](size_t c) { for (uint32_t i : _cells[c]) f(i); });
+        forCells(b, [&](size_t c) {
+            for (uint32_t i : _cells[c]) f(i);
+        });
     }
 
 private:
@@ -267,10 +280,12 @@ OsmRoofShape parseOsmRoofShape(std::string_view text) {
     const std::string_view s = trim(text);
     if (s.empty()) return OsmRoofShape::Absent;
     static const char* gabled[] = {"gabled", "gambrel", "saltbox", "round", "double_saltbox", "quadruple_saltbox"};
-    static const char* hipped[] = {"hipped", "half-hipped", "side_hipped", "mansard", "pyramidal", "dome", "onion", "cone",
-                                   "side_half-hipped", "half_hipped"};
-    for (const char* g : gabled) if (s == g) return OsmRoofShape::Gabled;
-    for (const char* h : hipped) if (s == h) return OsmRoofShape::Hipped;
+    static const char* hipped[] = {"hipped", "half-hipped", "side_hipped", "mansard",          "pyramidal",
+                                   "dome",   "onion",       "cone",        "side_half-hipped", "half_hipped"};
+    for (const char* g : gabled)
+        if (s == g) return OsmRoofShape::Gabled;
+    for (const char* h : hipped)
+        if (s == h) return OsmRoofShape::Hipped;
     return OsmRoofShape::Flat;
 }
 
@@ -279,7 +294,8 @@ std::vector<Building> resolveOsmBuildings(const std::vector<OsmFootprint>& footp
     // In parallel (the roof checks run the straight skeleton); counts per footprint, summed in order.
     std::vector<Building> out(footprints.size());
     std::vector<OsmBuildingStats> counts(footprints.size());
-    tbb::parallel_for(size_t(0), footprints.size(), [&](size_t i) { out[i] = resolveOne(footprints[i], params, counts[i]); });
+    tbb::parallel_for(size_t(0), footprints.size(),
+                      [&](size_t i) { out[i] = resolveOne(footprints[i], params, counts[i]); });
     for (const auto& c : counts) {
         stats.heightFromTag += c.heightFromTag;
         stats.heightFromLevels += c.heightFromLevels;
@@ -304,7 +320,8 @@ size_t dropCoveredLots(std::vector<Lot>& lots, const std::vector<Building>& impo
         const Bounds lb = boundsOf(lot.outline);
         bool covered = false;
         grid.query(lb, [&](uint32_t i) {
-            if (!covered && lb.overlaps(boxes[i]) && polygonsOverlap(lot.outline, imported[i].footprint, 1e-6)) covered = true;
+            if (!covered && lb.overlaps(boxes[i]) && polygonsOverlap(lot.outline, imported[i].footprint, 1e-6))
+                covered = true;
         });
         if (covered) ++dropped;
         else kept.push_back(std::move(lot));
@@ -337,7 +354,10 @@ size_t countOnCarriageway(const std::vector<Building>& imported, const StreetGra
         grid.query(fb, [&](uint32_t e) {
             if (on || !fb.overlaps(boxes[e])) return;
             const glm::dvec2 &p = g.nodes[g.edges[e].a], &q = g.nodes[g.edges[e].b];
-            if (pointInPolygon(fp, p) || pointInPolygon(fp, q)) { on = true; return; }
+            if (pointInPolygon(fp, p) || pointInPolygon(fp, q)) {
+                on = true;
+                return;
+            }
             for (size_t k = 0; k < fp.size() && !on; ++k)
                 on = segmentDistance(fp[k], fp[(k + 1) % fp.size()], p, q) < halfWidth[e];
         });

@@ -35,8 +35,8 @@ struct OsmFootprint {
     Polygon2 outer;               // counter-clockwise, simple, city frame (metres)
     std::vector<Polygon2> holes;  // clockwise, simple, strictly inside outer, pairwise disjoint
     BuildingSource source = BuildingSource::OsmWay;
-    int64_t osm_id = 0;           // way or relation id
-    uint32_t ring = 0;            // index of the outer ring within its relation (0 for ways)
+    int64_t osm_id = 0;  // way or relation id
+    uint32_t ring = 0;   // index of the outer ring within its relation (0 for ways)
     // Parsed tags; NaN = absent or unparsable.
     double height_m = std::numeric_limits<double>::quiet_NaN();       // height
     double min_height_m = std::numeric_limits<double>::quiet_NaN();   // min_height

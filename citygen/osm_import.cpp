@@ -64,8 +64,10 @@ bool xmlSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; 
 int coordinateKind(std::string_view name) {
     static const char* lat[] = {"lat", "minlat", "maxlat", "min_lat", "max_lat"};
     static const char* lon[] = {"lon", "minlon", "maxlon", "min_lon", "max_lon"};
-    for (const char* s : lat) if (name == s) return 1;
-    for (const char* s : lon) if (name == s) return 2;
+    for (const char* s : lat)
+        if (name == s) return 1;
+    for (const char* s : lon)
+        if (name == s) return 2;
     return 0;
 }
 
@@ -74,10 +76,20 @@ int coordinateKind(std::string_view name) {
 bool saneCoordinate(std::string_view s, double limit) {
     if (s.empty() || s.size() > 32) return false;
     size_t p = 0, digits = 0;
-    auto run = [&] { size_t k = 0; while (p < s.size() && s[p] >= '0' && s[p] <= '9') { ++p; ++k; } return k; };
+    auto run = [&] {
+        size_t k = 0;
+        while (p < s.size() && s[p] >= '0' && s[p] <= '9') {
+            ++p;
+            ++k;
+        }
+        return k;
+    };
     if (s[p] == '-') ++p;
     digits += run();
-    if (p < s.size() && s[p] == '.') { ++p; digits += run(); }
+    if (p < s.size() && s[p] == '.') {
+        ++p;
+        digits += run();
+    }
     if (digits == 0) return false;
     if (p < s.size() && (s[p] == 'e' || s[p] == 'E')) {
         ++p;
@@ -91,7 +103,7 @@ bool saneCoordinate(std::string_view s, double limit) {
 }
 
 struct CoordinateAttribute {
-    size_t begin, end;       // the whole name="value" text
+    size_t begin, end;  // the whole name="value" text
     size_t valueBegin, valueEnd;
     int kind;
 };
@@ -117,11 +129,23 @@ Result<std::vector<NodeId>> sanitizeXml(std::string& xml, const std::string& pat
             size_t e = xml.find(close, lt + 1);
             return e == std::string::npos ? n : e + std::strlen(close);
         };
-        if (xml.compare(lt, 4, "<!--") == 0) { i = skipTo("-->"); continue; }
-        if (xml.compare(lt, 9, "<![CDATA[") == 0) { i = skipTo("]]>"); continue; }
+        if (xml.compare(lt, 4, "<!--") == 0) {
+            i = skipTo("-->");
+            continue;
+        }
+        if (xml.compare(lt, 9, "<![CDATA[") == 0) {
+            i = skipTo("]]>");
+            continue;
+        }
         if (xml.compare(lt, 2, "<!") == 0) return fail(lt, "DOCTYPE and other declarations are not supported");
-        if (xml.compare(lt, 2, "<?") == 0) { i = skipTo("?>"); continue; }
-        if (xml.compare(lt, 2, "</") == 0) { i = skipTo(">"); continue; }
+        if (xml.compare(lt, 2, "<?") == 0) {
+            i = skipTo("?>");
+            continue;
+        }
+        if (xml.compare(lt, 2, "</") == 0) {
+            i = skipTo(">");
+            continue;
+        }
         // A start tag: name, then name="value" / name='value' pairs, then > or />.
         size_t p = lt + 1;
         while (p < n && !xmlSpace(xml[p]) && xml[p] != '>' && xml[p] != '/') ++p;
@@ -132,9 +156,17 @@ Result<std::vector<NodeId>> sanitizeXml(std::string& xml, const std::string& pat
         while (p < n) {
             while (p < n && xmlSpace(xml[p])) ++p;
             if (p >= n) break;
-            if (xml[p] == '>') { ++p; closed = true; break; }
+            if (xml[p] == '>') {
+                ++p;
+                closed = true;
+                break;
+            }
             if (xml[p] == '/') {
-                if (p + 1 < n && xml[p + 1] == '>') { p += 2; closed = true; break; }
+                if (p + 1 < n && xml[p + 1] == '>') {
+                    p += 2;
+                    closed = true;
+                    break;
+                }
                 return fail(p, "malformed XML tag");
             }
             const size_t nameBegin = p;
@@ -148,7 +180,10 @@ Result<std::vector<NodeId>> sanitizeXml(std::string& xml, const std::string& pat
             if (p >= n) break;
             if (xml[p] != '"' && xml[p] != '\'') return fail(p, "malformed XML attribute");
             const size_t valueBegin = p + 1, valueEnd = xml.find(xml[p], valueBegin);
-            if (valueEnd == std::string::npos) { p = n; break; }
+            if (valueEnd == std::string::npos) {
+                p = n;
+                break;
+            }
             p = valueEnd + 1;
             if (int kind = coordinateKind(name)) coords.push_back({nameBegin, p, valueBegin, valueEnd, kind});
             else if (isNode && name == "id")
@@ -158,7 +193,8 @@ Result<std::vector<NodeId>> sanitizeXml(std::string& xml, const std::string& pat
         if (!closed) break;
         bool bad = false;
         for (const auto& c : coords)
-            bad = bad || !saneCoordinate(std::string_view(xml).substr(c.valueBegin, c.valueEnd - c.valueBegin), c.kind == 1 ? 90.0 : 180.0);
+            bad = bad || !saneCoordinate(std::string_view(xml).substr(c.valueBegin, c.valueEnd - c.valueBegin),
+                                         c.kind == 1 ? 90.0 : 180.0);
         if (bad) {
             for (const auto& c : coords) std::fill(xml.begin() + long(c.begin), xml.begin() + long(c.end), ' ');
             if (isNode && hasId) blanked.push_back(id);
@@ -205,11 +241,21 @@ Result<std::string> readXml(const osmium::io::File& file, const std::string& pat
 bool classify(const char* hw, RoadClass& cls) {
     static const char* highway[] = {"motorway", "motorway_link", "trunk", "trunk_link", "primary", "primary_link"};
     static const char* arterial[] = {"secondary", "secondary_link", "tertiary", "tertiary_link"};
-    static const char* skip[] = {"footway", "path", "cycleway", "steps", "bridleway", "pedestrian", "corridor",
-                                 "proposed", "construction", "platform", "elevator", "abandoned", "raceway"};
-    for (const char* s : skip) if (!std::strcmp(hw, s)) return false;
-    for (const char* s : highway) if (!std::strcmp(hw, s)) { cls = RoadClass::Highway; return true; }
-    for (const char* s : arterial) if (!std::strcmp(hw, s)) { cls = RoadClass::Arterial; return true; }
+    static const char* skip[] = {"footway",    "path",      "cycleway", "steps",        "bridleway",
+                                 "pedestrian", "corridor",  "proposed", "construction", "platform",
+                                 "elevator",   "abandoned", "raceway"};
+    for (const char* s : skip)
+        if (!std::strcmp(hw, s)) return false;
+    for (const char* s : highway)
+        if (!std::strcmp(hw, s)) {
+            cls = RoadClass::Highway;
+            return true;
+        }
+    for (const char* s : arterial)
+        if (!std::strcmp(hw, s)) {
+            cls = RoadClass::Arterial;
+            return true;
+        }
     cls = RoadClass::Local;
     return true;
 }
@@ -236,8 +282,14 @@ bool isBuilding(const osmium::TagList& tags) {
 // The height and roof tags of a building way or relation (absent / unparsable -> NaN).
 void readBuildingTags(const osmium::TagList& tags, OsmFootprint& f) {
     constexpr double kAbsent = std::numeric_limits<double>::quiet_NaN();
-    auto length = [&](const char* key) { const char* v = tags[key]; return v ? parseOsmLength(v) : kAbsent; };
-    auto levels = [&](const char* key) { const char* v = tags[key]; return v ? parseOsmLevels(v) : kAbsent; };
+    auto length = [&](const char* key) {
+        const char* v = tags[key];
+        return v ? parseOsmLength(v) : kAbsent;
+    };
+    auto levels = [&](const char* key) {
+        const char* v = tags[key];
+        return v ? parseOsmLevels(v) : kAbsent;
+    };
     f.height_m = length("height");
     f.min_height_m = length("min_height");
     f.roof_height_m = length("roof:height");
@@ -381,7 +433,10 @@ void douglasPeucker(const std::vector<WayNode>& nodes, size_t first, size_t last
         size_t at = s;
         for (size_t k = s + 1; k < e; ++k) {
             const double d = pointSegmentDistance(nodes[k].xy, nodes[s].xy, nodes[e].xy);
-            if (d > worst) { worst = d; at = k; }
+            if (d > worst) {
+                worst = d;
+                at = k;
+            }
         }
         if (worst > kSimplifyTolerance_m) {
             keep[at] = 1;
@@ -406,9 +461,15 @@ size_t simplify(std::vector<Way>& ways, double minSegment) {
             if (fixed(k) || glm::length(w.nodes[k].xy - spaced.back().xy) >= minSegment) spaced.push_back(w.nodes[k]);
         std::vector<char> keep(spaced.size(), 0);
         for (size_t k = 0, run = 0; k < spaced.size(); ++k, ++run)
-            if (k == 0 || k + 1 == spaced.size() || uses[spaced[k].id] > 1 || run == kSimplifyChunk) { keep[k] = 1; run = 0; }
+            if (k == 0 || k + 1 == spaced.size() || uses[spaced[k].id] > 1 || run == kSimplifyChunk) {
+                keep[k] = 1;
+                run = 0;
+            }
         for (size_t s = 0, e = 1; e < spaced.size(); ++e)
-            if (keep[e]) { douglasPeucker(spaced, s, e, keep); s = e; }
+            if (keep[e]) {
+                douglasPeucker(spaced, s, e, keep);
+                s = e;
+            }
         w.nodes.clear();
         for (size_t k = 0; k < spaced.size(); ++k)
             if (keep[k]) w.nodes.push_back(spaced[k]);
@@ -452,14 +513,20 @@ StreetGraph segmentGraph(const std::vector<Way>& ways, size_t first, size_t last
 // carriageway merged into one edge), each gives its direction.
 void assignRoadTags(StreetGraph& g, const std::vector<Way>& ways, const std::vector<OsmRoadTags>& tags, double tol,
                     double mergeTol, OsmRoadTagStats& st) {
-    struct Seg { glm::dvec2 p, q; uint32_t way; };
+    struct Seg {
+        glm::dvec2 p, q;
+        uint32_t way;
+    };
     std::vector<Seg> segs;
     for (size_t w = 0; w < ways.size(); ++w)
-        for (size_t k = 1; k < ways[w].nodes.size(); ++k) segs.push_back({ways[w].nodes[k - 1].xy, ways[w].nodes[k].xy, uint32_t(w)});
+        for (size_t k = 1; k < ways[w].nodes.size(); ++k)
+            segs.push_back({ways[w].nodes[k - 1].xy, ways[w].nodes[k].xy, uint32_t(w)});
     // Uniform grid: a segment is listed in the 3 x 3 cells around points every `cell` along it, so
     // every point within tol (= cell / 2) of it finds it in its own cell.
     const double cell = std::max(2.0 * tol, 1.0);
-    auto cellOf = [&](const glm::dvec2& p) { return std::make_pair(int64_t(std::floor(p.x / cell)), int64_t(std::floor(p.y / cell))); };
+    auto cellOf = [&](const glm::dvec2& p) {
+        return std::make_pair(int64_t(std::floor(p.x / cell)), int64_t(std::floor(p.y / cell)));
+    };
     auto key = [](int64_t x, int64_t y) { return (uint64_t(x) << 32) ^ (uint64_t(y) & 0xffffffffull); };
     std::unordered_map<uint64_t, std::vector<uint32_t>> grid;
     for (uint32_t s = 0; s < segs.size(); ++s) {
@@ -520,7 +587,10 @@ void assignRoadTags(StreetGraph& g, const std::vector<Way>& ways, const std::vec
         const Cand* best = nullptr;
         for (const auto& c : cands)
             if (c.score() <= tol && (!best || better(c, *best))) best = &c;
-        if (!best) { ++st.edgesUnmatched; continue; }
+        if (!best) {
+            ++st.edgesUnmatched;
+            continue;
+        }
         ++st.edgesMatched;
         auto oriented = [&](const Cand& c) {
             const Seg& s = segs[c.midSeg];
@@ -532,9 +602,13 @@ void assignRoadTags(StreetGraph& g, const std::vector<Way>& ways, const std::vec
             const Cand* other = nullptr;
             OsmRoadTags u;
             for (const auto& c : cands) {
-                if (&c == best || c.score() > mergeTol || alignment(c) < kParallelCos || (other && !better(c, *other))) continue;
+                if (&c == best || c.score() > mergeTol || alignment(c) < kParallelCos || (other && !better(c, *other)))
+                    continue;
                 OsmRoadTags o = oriented(c);
-                if (t.onlyForward() ? o.onlyBackward() : o.onlyForward()) { other = &c; u = std::move(o); }
+                if (t.onlyForward() ? o.onlyBackward() : o.onlyForward()) {
+                    other = &c;
+                    u = std::move(o);
+                }
             }
             if (other) {
                 ++st.edgesMergedOneWays;
@@ -574,7 +648,9 @@ enum class RingFail { None, Missing, Outside, TooFew, TooSmall, SelfIntersecting
 struct RingRepairs {
     bool duplicates = false, unclosed = false, split = false;
     RingRepairs& operator|=(const RingRepairs& o) {
-        duplicates |= o.duplicates; unclosed |= o.unclosed; split |= o.split;
+        duplicates |= o.duplicates;
+        unclosed |= o.unclosed;
+        split |= o.split;
         return *this;
     }
 };
@@ -592,7 +668,10 @@ RingFail makeRing(const std::vector<WayNode>& nodes, const BuildingContext& ctx,
         if (!n.loc.valid()) return RingFail::Missing;
     std::vector<WayNode> d;
     for (const auto& n : nodes) {
-        if (!d.empty() && (n.id == d.back().id || n.loc == d.back().loc)) { rep.duplicates = true; continue; }
+        if (!d.empty() && (n.id == d.back().id || n.loc == d.back().loc)) {
+            rep.duplicates = true;
+            continue;
+        }
         d.push_back(n);
     }
     if (d.size() >= 2 && (d.front().id == d.back().id || d.front().loc == d.back().loc)) d.pop_back();
@@ -601,15 +680,18 @@ RingFail makeRing(const std::vector<WayNode>& nodes, const BuildingContext& ctx,
     for (auto& n : d) {
         const GeoPoint g{n.loc.lat(), n.loc.lon()};
         const glm::dvec3 v = unitVector(g);
-        if (std::atan2(glm::length(glm::cross(v, ctx.median)), glm::dot(v, ctx.median)) * kEarthRadius_m > ctx.outlierRadius_m)
+        if (std::atan2(glm::length(glm::cross(v, ctx.median)), glm::dot(v, ctx.median)) * kEarthRadius_m >
+            ctx.outlierRadius_m)
             return RingFail::Outside;
         poly.push_back(projectToLocal(ctx.ref, g));
     }
     if (poly.size() < 3) return RingFail::TooFew;
     bool split = false;
     Polygon2 r = makeSimpleRing(poly, split);
-    if (r.empty()) return poly.size() <= kMaxRepairRingNodes && std::abs(signedArea(poly)) < kOsmMinFootprintArea_m2
-                              ? RingFail::TooSmall : RingFail::SelfIntersecting;
+    if (r.empty())
+        return poly.size() <= kMaxRepairRingNodes && std::abs(signedArea(poly)) < kOsmMinFootprintArea_m2
+                   ? RingFail::TooSmall
+                   : RingFail::SelfIntersecting;
     if (std::abs(signedArea(r)) < kOsmMinFootprintArea_m2) return RingFail::TooSmall;
     rep.split = split;
     out = std::move(r);
@@ -678,7 +760,10 @@ void importBuildings(const std::vector<BuildingWay>& ways, const std::vector<Bui
         for (const auto& [id, inner] : r.members)
             if (!inner) outerOfRelation.insert(id);
     auto accept = [&](OsmFootprint f, const RingRepairs& rep) {
-        if (!insideCity(f.outer, ctx.half_m)) { ++st.outsideCity; return; }
+        if (!insideCity(f.outer, ctx.half_m)) {
+            ++st.outsideCity;
+            return;
+        }
         addRepairs(rep, st);
         ++st.imported;
         out.buildings.push_back(std::move(f));
@@ -692,7 +777,10 @@ void importBuildings(const std::vector<BuildingWay>& ways, const std::vector<Bui
         f.osm_id = w.id;
         RingRepairs rep;
         const RingFail fail = makeRing(w.nodes, ctx, f.outer, rep);
-        if (fail != RingFail::None) { countSkip(fail, st); continue; }
+        if (fail != RingFail::None) {
+            countSkip(fail, st);
+            continue;
+        }
         accept(std::move(f), rep);
     }
     for (const auto& r : relations) {
@@ -708,9 +796,17 @@ void importBuildings(const std::vector<BuildingWay>& ways, const std::vector<Bui
             }
             (inner ? innerParts : outerParts).push_back(&ways[it->second].nodes);
         }
-        if (outerMissing) { ++st.candidates; ++st.missingNodes; continue; }
+        if (outerMissing) {
+            ++st.candidates;
+            ++st.missingNodes;
+            continue;
+        }
         const auto outerRings = assembleRings(outerParts);
-        if (outerRings.empty()) { ++st.candidates; ++st.noOuterRing; continue; }
+        if (outerRings.empty()) {
+            ++st.candidates;
+            ++st.noOuterRing;
+            continue;
+        }
         std::vector<OsmFootprint> made;
         std::vector<RingRepairs> reps;
         for (size_t k = 0; k < outerRings.size(); ++k) {
@@ -721,7 +817,10 @@ void importBuildings(const std::vector<BuildingWay>& ways, const std::vector<Bui
             f.ring = uint32_t(k);
             RingRepairs rep;
             const RingFail fail = makeRing(outerRings[k], ctx, f.outer, rep);
-            if (fail != RingFail::None) { countSkip(fail, st); continue; }
+            if (fail != RingFail::None) {
+                countSkip(fail, st);
+                continue;
+            }
             made.push_back(std::move(f));
             reps.push_back(rep);
         }
@@ -757,14 +856,16 @@ std::string OsmImport::dropSummary() const {
     };
     add(nodes, invalidNodes, "with invalid coordinates");
     add(nodes, missingNodes, "missing from the file");
-    add(nodes, outlierNodes, std::string(outlierNodes == 1 ? "outlier" : "outliers") + " farther than " + distance(outlierRadius_m) +
-                                 " from the median position");
+    add(nodes, outlierNodes,
+        std::string(outlierNodes == 1 ? "outlier" : "outliers") + " farther than " + distance(outlierRadius_m) +
+            " from the median position");
     std::string out;
     const size_t total = invalidNodes + missingNodes + outlierNodes;
     if (total) out = "dropped " + std::to_string(total) + (total == 1 ? " node (" : " nodes (") + nodes + ")";
     if (tangledWays)
         out += (out.empty() ? "dropped " : "; dropped ") + std::to_string(tangledWays) +
-               (tangledWays == 1 ? " way" : " ways") + " crossing itself more than " + std::to_string(kMaxSelfConflicts) + " times";
+               (tangledWays == 1 ? " way" : " ways") + " crossing itself more than " +
+               std::to_string(kMaxSelfConflicts) + " times";
     return out;
 }
 
@@ -833,7 +934,8 @@ std::vector<Way> dropOutliers(std::vector<Way>&& located, const glm::dvec3& medi
     std::set<NodeId> outliers;
     std::vector<Way> ways = splitWays(std::move(located), [&](const WayNode& n) {
         const glm::dvec3 v = unitVector(n.geo);
-        if (std::atan2(glm::length(glm::cross(v, median)), glm::dot(v, median)) * kEarthRadius_m <= out.outlierRadius_m) return true;
+        if (std::atan2(glm::length(glm::cross(v, median)), glm::dot(v, median)) * kEarthRadius_m <= out.outlierRadius_m)
+            return true;
         outliers.insert(n.id);
         return false;
     });
@@ -876,10 +978,13 @@ GeoReference placeFrame(std::vector<Way>& ways, glm::dvec2& lo, glm::dvec2& hi) 
 // Refuses roads that span more than the largest city vista gen builds (`limit` metres).
 Status checkExtent(const std::string& path, double limit, const OsmImport& out) {
     if (std::max(out.extentX_m, out.extentY_m) > limit) {
-        std::string dropped = out.outlierNodes ? " after dropping " + std::to_string(out.outlierNodes) + " outlier nodes farther than " +
-                                                     distance(out.outlierRadius_m) + " from the median position" : "";
-        return Status::error("OSM file '" + path + "': the roads span " + distance(out.extentX_m) + " east-west by " + distance(out.extentY_m) +
-                             " north-south" + dropped + ", more than the largest city vista gen builds (size_m up to " +
+        std::string dropped = out.outlierNodes ? " after dropping " + std::to_string(out.outlierNodes) +
+                                                     " outlier nodes farther than " + distance(out.outlierRadius_m) +
+                                                     " from the median position"
+                                               : "";
+        return Status::error("OSM file '" + path + "': the roads span " + distance(out.extentX_m) + " east-west by " +
+                             distance(out.extentY_m) + " north-south" + dropped +
+                             ", more than the largest city vista gen builds (size_m up to " +
                              std::to_string(int(limit)) + " m = " + distance(limit) + "); crop the extract");
     }
     return Status::ok();
@@ -895,13 +1000,13 @@ Result<std::vector<Way>> untangleWays(std::vector<Way>& ways, const CityParams& 
     for (size_t w = 0; w < ways.size(); ++w) {
         if (findConflictingEdges(segmentGraph(ways, w, w + 1), kMaxSelfConflicts + 1).size() > kMaxSelfConflicts)
             tangled.insert(ways[w].id);
-        else
-            kept.push_back(std::move(ways[w]));
+        else kept.push_back(std::move(ways[w]));
     }
     out.tangledWays = tangled.size();
     if (kept.empty()) return Status::error(noRoads + "; " + out.dropSummary());
     if (findConflictingEdges(segmentGraph(kept, 0, kept.size()), kMaxConflicts + 1).size() > kMaxConflicts)
-        return Status::error("OSM file '" + path + "': the roads cross or touch each other away from shared nodes more than " +
+        return Status::error("OSM file '" + path +
+                             "': the roads cross or touch each other away from shared nodes more than " +
                              std::to_string(kMaxConflicts) + " times; planarizing that many crossings is refused");
     return kept;
 }

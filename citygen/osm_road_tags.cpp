@@ -52,17 +52,35 @@ struct CountrySpeeds {
 };
 // Default limits of the countries with a common national rule (OSM wiki "Default speed limits").
 constexpr CountrySpeeds kCountries[] = {
-    {"AT", 50, 100, 100, 130}, {"BE", 50, 90, 120, 120}, {"CH", 50, 80, 100, 120}, {"CZ", 50, 90, 110, 130},
-    {"DE", 50, 100, 0, kMaxspeedNoneKmh}, {"DK", 50, 80, 0, 130}, {"ES", 50, 90, 0, 120}, {"FI", 50, 80, 0, 120},
-    {"FR", 50, 80, 110, 130}, {"GB", 30 * kMph, 60 * kMph, 70 * kMph, 70 * kMph}, {"HU", 50, 90, 110, 130},
-    {"IE", 50, 80, 100, 120}, {"IT", 50, 90, 110, 130}, {"NL", 50, 80, 100, 130}, {"NO", 50, 80, 0, 90},
-    {"PL", 50, 90, 0, 140}, {"PT", 50, 90, 100, 120}, {"RO", 50, 90, 0, 130}, {"RU", 60, 90, 0, 110},
-    {"SE", 50, 70, 0, 110}, {"SI", 50, 90, 110, 130}, {"SK", 50, 90, 0, 130}, {"UA", 50, 90, 0, 130},
+    {"AT", 50, 100, 100, 130},
+    {"BE", 50, 90, 120, 120},
+    {"CH", 50, 80, 100, 120},
+    {"CZ", 50, 90, 110, 130},
+    {"DE", 50, 100, 0, kMaxspeedNoneKmh},
+    {"DK", 50, 80, 0, 130},
+    {"ES", 50, 90, 0, 120},
+    {"FI", 50, 80, 0, 120},
+    {"FR", 50, 80, 110, 130},
+    {"GB", 30 * kMph, 60 * kMph, 70 * kMph, 70 * kMph},
+    {"HU", 50, 90, 110, 130},
+    {"IE", 50, 80, 100, 120},
+    {"IT", 50, 90, 110, 130},
+    {"NL", 50, 80, 100, 130},
+    {"NO", 50, 80, 0, 90},
+    {"PL", 50, 90, 0, 140},
+    {"PT", 50, 90, 100, 120},
+    {"RO", 50, 90, 0, 130},
+    {"RU", 60, 90, 0, 110},
+    {"SE", 50, 70, 0, 110},
+    {"SI", 50, 90, 110, 130},
+    {"SK", 50, 90, 0, 130},
+    {"UA", 50, 90, 0, 130},
 };
 
 bool isTurnValue(std::string_view v) {
-    static const char* kValues[] = {"none", "through", "left", "slight_left", "sharp_left", "right", "slight_right",
-                                    "sharp_right", "reverse", "merge_to_left", "merge_to_right", "slide_left", "slide_right"};
+    static const char* kValues[] = {"none",           "through",      "left",        "slight_left", "sharp_left",
+                                    "right",          "slight_right", "sharp_right", "reverse",     "merge_to_left",
+                                    "merge_to_right", "slide_left",   "slide_right"};
     for (const char* k : kValues)
         if (v == k) return true;
     return false;
@@ -117,7 +135,8 @@ std::optional<float> parseOsmMaxspeed(std::string_view text) {
     if (s == "walk") return kMaxspeedWalkKmh;
     if (const size_t colon = s.find(':'); colon != std::string_view::npos) {
         const std::string_view cc = s.substr(0, colon), zone = s.substr(colon + 1);
-        if (cc.size() != 2 || !std::all_of(cc.begin(), cc.end(), [](char c) { return c >= 'A' && c <= 'Z'; })) return std::nullopt;
+        if (cc.size() != 2 || !std::all_of(cc.begin(), cc.end(), [](char c) { return c >= 'A' && c <= 'Z'; }))
+            return std::nullopt;
         if (zone == "living_street" || zone == "walk") return kMaxspeedWalkKmh;
         if (zone == "bicycle_road") return 30.0f;
         if (cc == "GB") {
@@ -149,14 +168,16 @@ std::optional<OsmTurnLanes> parseOsmTurnLanes(std::string_view text) {
     size_t start = 0;
     while (true) {
         const size_t bar = text.find('|', start);
-        const std::string_view lane = text.substr(start, bar == std::string_view::npos ? std::string_view::npos : bar - start);
+        const std::string_view lane =
+            text.substr(start, bar == std::string_view::npos ? std::string_view::npos : bar - start);
         if (++out.lanes > kMaxLanesPerDirection) return std::nullopt;
         if (out.lanes > 1) out.value += '|';
         if (!trim(lane).empty()) {
             size_t vs = 0;
             while (true) {
                 const size_t semi = lane.find(';', vs);
-                const std::string_view v = trim(lane.substr(vs, semi == std::string_view::npos ? std::string_view::npos : semi - vs));
+                const std::string_view v =
+                    trim(lane.substr(vs, semi == std::string_view::npos ? std::string_view::npos : semi - vs));
                 if (!isTurnValue(v)) return std::nullopt;
                 if (vs > 0) out.value += ';';
                 out.value += v;
@@ -193,7 +214,8 @@ OsmRoadTags readOsmRoadTags(const OsmTagLookup& tag, RoadClass cls, OsmRoadTagSt
 
     // Direction.
     OsmOneway oneway = OsmOneway::No;
-    if (auto o = readTag<OsmOneway>(tag, "oneway", [](std::string_view v) { return parseOsmOneway(v); }, st.oneway)) {
+    if (auto o = readTag<OsmOneway>(
+            tag, "oneway", [](std::string_view v) { return parseOsmOneway(v); }, st.oneway)) {
         oneway = *o;
         ++st.oneway.used;
     } else {
@@ -209,12 +231,18 @@ OsmRoadTags readOsmRoadTags(const OsmTagLookup& tag, RoadClass cls, OsmRoadTagSt
     // Lane counts, in the way's direction.
     bool fromTags = false;
     auto use = [&](const std::optional<int>& v, OsmTagUse& u) {
-        if (v) { ++u.used; fromTags = true; }
+        if (v) {
+            ++u.used;
+            fromTags = true;
+        }
     };
     auto unused = [&](const std::optional<int>& v, OsmTagUse& u) {
         if (v) ++u.fallback;
     };
-    if (total) { ++st.lanes.used; fromTags = true; }
+    if (total) {
+        ++st.lanes.used;
+        fromTags = true;
+    }
     if (oneway != OsmOneway::No) {
         const bool fwd = oneway == OsmOneway::Forward;
         const auto& dirTag = fwd ? fwdTag : bwdTag;
@@ -231,11 +259,17 @@ OsmRoadTags readOsmRoadTags(const OsmTagLookup& tag, RoadClass cls, OsmRoadTagSt
         for (auto [cand, u] : {std::pair{&dirTurn, &dirTurnUse}, std::pair{&turnTag, &st.turnLanes}}) {
             if (!*cand) continue;
             const bool fits = turn ? (*cand)->value == turn->value : (n == 0 || (*cand)->lanes == n);
-            if (!fits) { ++u->fallback; continue; }
+            if (!fits) {
+                ++u->fallback;
+                continue;
+            }
             ++u->used;
             if (!turn) turn = &**cand;
         }
-        if (turn && n == 0) { n = turn->lanes; fromTags = true; }
+        if (turn && n == 0) {
+            n = turn->lanes;
+            fromTags = true;
+        }
         if (n == 0) n = std::max(1, (roadLanes(cls) + 1) / 2);
         t.lanesForward = fwd ? n : 0;
         t.lanesBackward = fwd ? 0 : n;
@@ -246,8 +280,14 @@ OsmRoadTags readOsmRoadTags(const OsmTagLookup& tag, RoadClass cls, OsmRoadTagSt
         use(fwdTag, st.lanesForward);
         use(bwdTag, st.lanesBackward);
         int f = fwdTag ? perDirection(*fwdTag) : 0, b = bwdTag ? perDirection(*bwdTag) : 0;
-        if (!f && turnFwd) { f = turnFwd->lanes; fromTags = true; }
-        if (!b && turnBwd) { b = turnBwd->lanes; fromTags = true; }
+        if (!f && turnFwd) {
+            f = turnFwd->lanes;
+            fromTags = true;
+        }
+        if (!b && turnBwd) {
+            b = turnBwd->lanes;
+            fromTags = true;
+        }
         if (f || b) {
             // One direction known: the other from the total, else the derived split.
             const int n = std::max(total ? std::min(*total, kMaxTotal) : roadLanes(cls), 2);
@@ -256,10 +296,12 @@ OsmRoadTags readOsmRoadTags(const OsmTagLookup& tag, RoadClass cls, OsmRoadTagSt
             t.lanesForward = f;
             t.lanesBackward = b;
             for (auto [turn, count, out, u] : {std::tuple{&turnFwd, f, &t.turnForward, &st.turnLanesForward},
-                                                std::tuple{&turnBwd, b, &t.turnBackward, &st.turnLanesBackward}}) {
+                                               std::tuple{&turnBwd, b, &t.turnBackward, &st.turnLanesBackward}}) {
                 if (!*turn) continue;
-                if ((*turn)->lanes == count) { *out = (*turn)->value; ++u->used; }
-                else ++u->fallback;
+                if ((*turn)->lanes == count) {
+                    *out = (*turn)->value;
+                    ++u->used;
+                } else ++u->fallback;
             }
             t.lanes = total ? std::min(*total, kMaxTotal) : std::min(f + b, kMaxTotal);
         } else {
@@ -269,7 +311,8 @@ OsmRoadTags readOsmRoadTags(const OsmTagLookup& tag, RoadClass cls, OsmRoadTagSt
     if (!fromTags) ++st.defaultLanes;
 
     // Speed limit and width.
-    if (auto v = readTag<float>(tag, "maxspeed", [](std::string_view s) { return parseOsmMaxspeed(s); }, st.maxspeed)) {
+    if (auto v = readTag<float>(
+            tag, "maxspeed", [](std::string_view s) { return parseOsmMaxspeed(s); }, st.maxspeed)) {
         t.maxspeedKmh = *v;
         ++st.maxspeed.used;
     } else {
@@ -316,7 +359,8 @@ std::string osmRoadTagStatsJson(const OsmRoadTagStats& s) {
     j["ways"] = s.ways;
     j["tags"] = std::move(tags);
     j["class_default"] = {{"lanes", s.defaultLanes}, {"maxspeed", s.defaultMaxspeed}, {"width", s.defaultWidth}};
-    j["edges"] = {{"matched", s.edgesMatched}, {"unmatched", s.edgesUnmatched}, {"merged_one_ways", s.edgesMergedOneWays}};
+    j["edges"] = {
+        {"matched", s.edgesMatched}, {"unmatched", s.edgesUnmatched}, {"merged_one_ways", s.edgesMergedOneWays}};
     return j.dump();
 }
 

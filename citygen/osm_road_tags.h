@@ -78,10 +78,10 @@ std::optional<OsmTurnLanes> parseOsmTurnLanes(std::string_view text);
 
 // The road tags of one way, in the way's direction (fields as StreetEdge's).
 struct OsmRoadTags {
-    int lanes = 0;                        // total; 0 = class default
+    int lanes = 0;  // total; 0 = class default
     int lanesForward = -1, lanesBackward = -1;
-    float maxspeedKmh = 0.0f;             // 0 = class default
-    float width = 0.0f;                   // carriageway metres; 0 = class default
+    float maxspeedKmh = 0.0f;  // 0 = class default
+    float width = 0.0f;        // carriageway metres; 0 = class default
     std::string turnForward, turnBackward;
     // The same tags for the opposite direction (forward and backward swapped).
     OsmRoadTags reversed() const;
@@ -96,7 +96,8 @@ struct OsmTagUse {
 };
 struct OsmRoadTagStats {
     size_t ways = 0;  // highway=* road ways read
-    OsmTagUse lanes, lanesForward, lanesBackward, oneway, turnLanes, turnLanesForward, turnLanesBackward, maxspeed, width;
+    OsmTagUse lanes, lanesForward, lanesBackward, oneway, turnLanes, turnLanesForward, turnLanesBackward, maxspeed,
+        width;
     size_t onewayImplied = 0;  // one-way from highway=motorway / junction=roundabout without a valid oneway tag
     // Ways whose lane counts / speed limit / width are the class defaults.
     size_t defaultLanes = 0, defaultMaxspeed = 0, defaultWidth = 0;

@@ -21,36 +21,36 @@ namespace vista {
 struct CityParams {
     // Identity and extent.
     uint64_t seed = 1;
-    double size_m = 2000.0;        // side of the square city area, centred on the origin
-    double origin_x = 0.0;         // world position of the city centre (metres, east)
-    double origin_y = 0.0;         // world position of the city centre (metres, north)
-    double tile_size_m = 250.0;    // side of the square spatial tiles of the output
-    int threads = 0;               // 0 = all hardware threads; output never depends on it
+    double size_m = 2000.0;      // side of the square city area, centred on the origin
+    double origin_x = 0.0;       // world position of the city centre (metres, east)
+    double origin_y = 0.0;       // world position of the city centre (metres, north)
+    double tile_size_m = 250.0;  // side of the square spatial tiles of the output
+    int threads = 0;             // 0 = all hardware threads; output never depends on it
 
     // Population density map: peak at the centre, falling off with distance.
-    double centre_density = 1.0;   // 0..1 density at the centre
+    double centre_density = 1.0;       // 0..1 density at the centre
     double density_radius_m = 1400.0;  // e-folding radius of the density falloff
-    double park_fraction = 0.08;   // share of blocks that become parks (weighted by low density)
+    double park_fraction = 0.08;       // share of blocks that become parks (weighted by low density)
 
     // Street network.
     double highway_spacing_m = 1600.0;  // mean distance between highways
     double arterial_spacing_m = 420.0;  // mean distance between arterials
     double local_spacing_m = 110.0;     // mean block side length of local streets
-    double pattern_grid = 0.5;     // mixing weights of street patterns by region (normalised)
+    double pattern_grid = 0.5;          // mixing weights of street patterns by region (normalised)
     double pattern_radial = 0.2;
     double pattern_organic = 0.3;
-    double min_segment_m = 12.0;   // no street edge shorter than this
-    double min_angle_deg = 25.0;   // minimum angle between edges at an intersection
-    double snap_radius_m = 14.0;   // new ends snap to intersections within this radius
-    double sidewalk_m = 3.0;       // sidewalk width on each side of a street
+    double min_segment_m = 12.0;  // no street edge shorter than this
+    double min_angle_deg = 25.0;  // minimum angle between edges at an intersection
+    double snap_radius_m = 14.0;  // new ends snap to intersections within this radius
+    double sidewalk_m = 3.0;      // sidewalk width on each side of a street
 
     // Buildings.
-    int detail = 2;                // 0 = plain boxes, 1 = window bands, 2 = window recesses, 3 = + sills
+    int detail = 2;  // 0 = plain boxes, 1 = window bands, 2 = window recesses, 3 = + sills
     double floor_height_m = 3.2;
-    int max_floors = 45;           // tallest towers (downtown)
+    int max_floors = 45;  // tallest towers (downtown)
     int min_floors = 1;
-    double setback_m = 2.0;        // footprint setback from the lot boundary (suburbs get more)
-    double lot_width_m = 22.0;     // typical lot frontage
+    double setback_m = 2.0;     // footprint setback from the lot boundary (suburbs get more)
+    double lot_width_m = 22.0;  // typical lot frontage
     double window_width_m = 1.4;
     double window_recess_m = 0.25;
 
@@ -59,13 +59,13 @@ struct CityParams {
     double park_tree_density = 0.002;     // trees per square metre of park
 
     // Terrain.
-    double hills_amplitude_m = 0.0;       // 0 = flat ground
+    double hills_amplitude_m = 0.0;  // 0 = flat ground
     double hills_wavelength_m = 1500.0;
 
     // Lighting (prelit vertex colours).
-    double sun_azimuth_deg = 135.0;       // clockwise from north
+    double sun_azimuth_deg = 135.0;  // clockwise from north
     double sun_elevation_deg = 40.0;
-    double ambient = 0.45;                // 0..1 share of ambient light
+    double ambient = 0.45;  // 0..1 share of ambient light
 
     // Effects the scene declares (citygen/effects.h); none by default.
     Effects effects;

@@ -70,7 +70,10 @@ struct UnionFind {
     std::vector<uint32_t> p;
     explicit UnionFind(size_t n) : p(n) { std::iota(p.begin(), p.end(), 0u); }
     uint32_t find(uint32_t x) {
-        while (p[x] != x) { p[x] = p[p[x]]; x = p[x]; }
+        while (p[x] != x) {
+            p[x] = p[p[x]];
+            x = p[x];
+        }
         return x;
     }
 };
@@ -91,7 +94,10 @@ void rebuild(WorkGraph& g, const std::vector<uint32_t>& rep) {
     WorkGraph out;
     for (const auto& [key, cls] : best) {
         for (uint32_t v : {key.first, key.second})
-            if (newIndex[v] == UINT32_MAX) { newIndex[v] = uint32_t(out.nodes.size()); out.nodes.push_back(g.nodes[v]); }
+            if (newIndex[v] == UINT32_MAX) {
+                newIndex[v] = uint32_t(out.nodes.size());
+                out.nodes.push_back(g.nodes[v]);
+            }
         out.edges.push_back({newIndex[key.first], newIndex[key.second], cls});
     }
     g = std::move(out);
@@ -101,7 +107,10 @@ void rebuild(WorkGraph& g, const std::vector<uint32_t>& rep) {
 std::vector<std::pair<int, int>> nodeRank(const WorkGraph& g) {
     std::vector<std::pair<int, int>> r(g.nodes.size(), {3, 0});  // (best class, -degree)
     for (const auto& e : g.edges)
-        for (uint32_t v : {e.a, e.b}) { r[v].first = std::min(r[v].first, e.cls); r[v].second--; }
+        for (uint32_t v : {e.a, e.b}) {
+            r[v].first = std::min(r[v].first, e.cls);
+            r[v].second--;
+        }
     return r;
 }
 
@@ -141,8 +150,10 @@ bool snapNodes(WorkGraph& g, double snap) {
                     }
                 }
             }
-        if (found != UINT32_MAX) { rep[v] = found; changed = true; }
-        else grid[key(cx, cy)].push_back(v);
+        if (found != UINT32_MAX) {
+            rep[v] = found;
+            changed = true;
+        } else grid[key(cx, cy)].push_back(v);
     }
     if (changed) rebuild(g, rep);
     return changed;
@@ -189,7 +200,10 @@ bool snapNodesToEdges(WorkGraph& g, double snap, double minSegment) {
     const size_t nn = g.nodes.size(), ne = g.edges.size();
     if (ne == 0) return false;
     std::vector<int> deg(nn, 0);
-    for (const auto& e : g.edges) { deg[e.a]++; deg[e.b]++; }
+    for (const auto& e : g.edges) {
+        deg[e.a]++;
+        deg[e.b]++;
+    }
     const double tolDead = std::max(snap, 1e-6), tolOther = std::max(std::min(snap, 0.5 * minSegment), 1e-6);
     double sumLen = 0;
     for (const auto& e : g.edges) sumLen += glm::length(g.nodes[e.b] - g.nodes[e.a]);
@@ -223,18 +237,31 @@ bool snapNodesToEdges(WorkGraph& g, double snap, double minSegment) {
             double t = glm::dot(p - a, d) / dd;
             if (t <= 0 || t >= 1) continue;
             double dist = glm::length(p - (a + t * d));
-            if (dist < bestD || (dist == bestD && best != UINT32_MAX && ei < best)) { bestD = dist; best = ei; bestT = t; }
+            if (dist < bestD || (dist == bestD && best != UINT32_MAX && ei < best)) {
+                bestD = dist;
+                best = ei;
+                bestT = t;
+            }
         }
-        if (best != UINT32_MAX) { splits[best].emplace_back(bestT, v); any = true; }
+        if (best != UINT32_MAX) {
+            splits[best].emplace_back(bestT, v);
+            any = true;
+        }
     }
     if (!any) return false;
     std::vector<WorkEdge> edges;
     for (uint32_t i = 0; i < ne; ++i) {
         const auto& e = g.edges[i];
-        if (splits[i].empty()) { edges.push_back(e); continue; }
+        if (splits[i].empty()) {
+            edges.push_back(e);
+            continue;
+        }
         std::sort(splits[i].begin(), splits[i].end());
         uint32_t prev = e.a;
-        for (auto [t, v] : splits[i]) { if (v != prev) edges.push_back({prev, v, e.cls}); prev = v; }
+        for (auto [t, v] : splits[i]) {
+            if (v != prev) edges.push_back({prev, v, e.cls});
+            prev = v;
+        }
         edges.push_back({prev, e.b, e.cls});
     }
     g.edges = std::move(edges);
@@ -252,7 +279,10 @@ StreetGraph toStreetGraph(const WorkGraph& w) {
     std::vector<uint32_t> newIndex(w.nodes.size());
     StreetGraph g;
     g.nodes.reserve(w.nodes.size());
-    for (uint32_t i = 0; i < order.size(); ++i) { newIndex[order[i]] = i; g.nodes.push_back(w.nodes[order[i]]); }
+    for (uint32_t i = 0; i < order.size(); ++i) {
+        newIndex[order[i]] = i;
+        g.nodes.push_back(w.nodes[order[i]]);
+    }
     g.edges.reserve(w.edges.size());
     for (const auto& e : w.edges) {
         StreetEdge se;
@@ -290,7 +320,9 @@ StreetGraph planarize(const std::vector<RawSegment>& segments, double snap, doub
             return it->second;
         };
         for (const auto& s : segments) {
-            auto ok = [](const glm::dvec2& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::abs(p.x) < 1e9 && std::abs(p.y) < 1e9; };
+            auto ok = [](const glm::dvec2& p) {
+                return std::isfinite(p.x) && std::isfinite(p.y) && std::abs(p.x) < 1e9 && std::abs(p.y) < 1e9;
+            };
             if (!ok(s.a) || !ok(s.b) || s.a == s.b) continue;
             // +0.0 canonicalises -0.0 so the map key matches.
             glm::dvec2 a(s.a.x + 0.0, s.a.y + 0.0), b(s.b.x + 0.0, s.b.y + 0.0);

@@ -159,20 +159,25 @@ std::vector<uint32_t> triangulate(const std::vector<glm::dvec2>& poly) {
         if (!found) {  // numerically degenerate remainder: fan it (keeps output valid, never loops)
             for (size_t i = 1; i + 1 < idx.size(); ++i) {
                 if (std::abs(orient(poly[idx[0]], poly[idx[i]], poly[idx[i + 1]])) < 1e-12) continue;
-                out.push_back(idx[0]); out.push_back(idx[i]); out.push_back(idx[i + 1]);
+                out.push_back(idx[0]);
+                out.push_back(idx[i]);
+                out.push_back(idx[i + 1]);
             }
             return out;
         }
         ++guard;
     }
     if (idx.size() == 3 && std::abs(orient(poly[idx[0]], poly[idx[1]], poly[idx[2]])) > 0) {
-        out.push_back(idx[0]); out.push_back(idx[1]); out.push_back(idx[2]);
+        out.push_back(idx[0]);
+        out.push_back(idx[1]);
+        out.push_back(idx[2]);
     }
     return out;
 }
 
 std::vector<glm::dvec2> convexHull(std::vector<glm::dvec2> pts, double collinearEps) {
-    std::sort(pts.begin(), pts.end(), [](const glm::dvec2& a, const glm::dvec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+    std::sort(pts.begin(), pts.end(),
+              [](const glm::dvec2& a, const glm::dvec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
     pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
     if (pts.size() < 3) return pts;
     auto turn = [](const glm::dvec2& o, const glm::dvec2& a, const glm::dvec2& b) {

@@ -12,8 +12,8 @@
 
 namespace vista {
 
-double signedArea(const std::vector<glm::dvec2>& poly);  // > 0 for counter-clockwise
-glm::dvec2 centroid(const std::vector<glm::dvec2>& poly); // area centroid (vertex mean if degenerate)
+double signedArea(const std::vector<glm::dvec2>& poly);    // > 0 for counter-clockwise
+glm::dvec2 centroid(const std::vector<glm::dvec2>& poly);  // area centroid (vertex mean if degenerate)
 bool pointInPolygon(const std::vector<glm::dvec2>& poly, const glm::dvec2& p);
 // True if every vertex of `inner` is inside or within `eps` of `outer`, and no
 // edges properly cross.

@@ -28,7 +28,6 @@ tbb::global_control threadLimit(const CityParams& p) {
     return tbb::global_control(tbb::global_control::max_allowed_parallelism, size_t(threads));
 }
 
-
 // Regions whose rectangle, grown by the halo, meets the box [lo, hi].
 template <class F>
 void forRegionsNear(const RegionGrid& grid, double half, double regionSize, glm::dvec2 lo, glm::dvec2 hi, F&& f) {
@@ -51,7 +50,8 @@ Status validateRegionSize(const CityParams& p, double r) {
         return Status::error("parameter 'region_size_m' = " + exactDecimal(r) + " is out of range" + range);
     const double k = r / p.tile_size_m;
     if (std::abs(k - std::round(k)) > 1e-9 * k)
-        return Status::error("parameter 'region_size_m' = " + exactDecimal(r) + " is not a whole number of tiles" + range);
+        return Status::error("parameter 'region_size_m' = " + exactDecimal(r) + " is not a whole number of tiles" +
+                             range);
     return Status::ok();
 }
 
@@ -61,9 +61,7 @@ RegionGrid::RegionGrid(const CityParams& p, double regionSizeM)
     _n = (_tileCount + _k - 1) / _k;
 }
 
-int RegionGrid::regionOfTile(int tile) const {
-    return (_tiles.iy(tile) / _k) * _n + _tiles.ix(tile) / _k;
-}
+int RegionGrid::regionOfTile(int tile) const { return (_tiles.iy(tile) / _k) * _n + _tiles.ix(tile) / _k; }
 
 std::vector<int> RegionGrid::tilesOf(int region) const {
     VISTA_CHECK(region >= 0 && region < count());
@@ -101,7 +99,8 @@ Result<RegionalCity> RegionalCity::create(const CityParams& params, double regio
     const StreetGraph& g = rc._streets;
     for (uint32_t e = 0; e < g.edges.size(); ++e) {
         const glm::dvec2 a = g.nodes[g.edges[e].a], b = g.nodes[g.edges[e].b];
-        forRegionsNear(grid, half, side, glm::min(a, b), glm::max(a, b), [&](int r) { rc._edgesNear[size_t(r)].push_back(e); });
+        forRegionsNear(grid, half, side, glm::min(a, b), glm::max(a, b),
+                       [&](int r) { rc._edgesNear[size_t(r)].push_back(e); });
     }
     for (uint32_t i = 0; i < rc._blocks.size(); ++i) {
         const Polygon2& o = rc._blocks[i].outline;
@@ -141,7 +140,9 @@ City RegionalCity::region(int r) const {
     for (uint32_t e : edges) nodes.push_back(_streets.edges[e].a), nodes.push_back(_streets.edges[e].b);
     std::sort(nodes.begin(), nodes.end());
     nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
-    auto newIndex = [&](uint32_t n) { return uint32_t(std::lower_bound(nodes.begin(), nodes.end(), n) - nodes.begin()); };
+    auto newIndex = [&](uint32_t n) {
+        return uint32_t(std::lower_bound(nodes.begin(), nodes.end(), n) - nodes.begin());
+    };
     for (uint32_t n : nodes) c.streets.nodes.push_back(_streets.nodes[n]);
     for (uint32_t e : edges) {
         StreetEdge se = _streets.edges[e];
@@ -196,7 +197,8 @@ City RegionalCity::coarse(const City& region) {
         out.iy = t.iy;
         out.origin = t.origin;
         out.trees = t.trees;
-        for (Material m : {Material::Ground, Material::Grass, Material::Road}) out.meshes[size_t(m)] = t.meshes[size_t(m)];
+        for (Material m : {Material::Ground, Material::Grass, Material::Road})
+            out.meshes[size_t(m)] = t.meshes[size_t(m)];
         BuildingMeshes bm{&out.meshes[size_t(Material::Wall)], &out.meshes[size_t(Material::Window)],
                           &out.meshes[size_t(Material::Roof)]};
         auto it = buildingsOf.find({t.ix, t.iy});

@@ -99,7 +99,7 @@ private:
     std::vector<Block> _blocks;
     std::vector<TreePrototype> _prototypes;
     std::vector<std::vector<uint32_t>> _edgesNear, _blocksNear;  // per region: within the halo
-    std::vector<uint32_t> _nodeEdgeStart, _nodeEdges;             // node -> incident edges (CSR)
+    std::vector<uint32_t> _nodeEdgeStart, _nodeEdges;            // node -> incident edges (CSR)
 };
 
 }  // namespace vista

@@ -44,9 +44,7 @@ std::vector<Polygon2> insetPolygonSkeleton(const Polygon2& ccw, double d) {
             for (const auto& v : q) ok = ok && std::isfinite(v.x) && std::isfinite(v.y);
             if (ok) out.push_back(makeCounterClockwise(std::move(q)));
         }
-    } catch (const std::exception&) {
-        out.clear();
-    } catch (...) {
+    } catch (const std::exception&) { out.clear(); } catch (...) {
         out.clear();
     }
     return out;
@@ -67,7 +65,8 @@ bool hippedRoofFaces(const Polygon2& ccw, std::vector<std::vector<glm::dvec3>>& 
             size_t guard = 0;
             do {
                 const auto& v = h->vertex();
-                glm::dvec3 q(CGAL::to_double(v->point().x()), CGAL::to_double(v->point().y()), CGAL::to_double(v->time()));
+                glm::dvec3 q(CGAL::to_double(v->point().x()), CGAL::to_double(v->point().y()),
+                             CGAL::to_double(v->time()));
                 if (!std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z)) return false;
                 face.push_back(q);
                 maxTime = std::max(maxTime, q.z);
@@ -84,11 +83,13 @@ bool hippedRoofFaces(const Polygon2& ccw, std::vector<std::vector<glm::dvec3>>& 
             if (nz < 0) std::reverse(face.begin(), face.end());
             faces.push_back(std::move(face));
         }
-        if (faces.size() < ccw.size() || !(maxTime > 0)) { faces.clear(); return false; }
+        if (faces.size() < ccw.size() || !(maxTime > 0)) {
+            faces.clear();
+            return false;
+        }
         return true;
     } catch (const std::exception&) {
-    } catch (...) {
-    }
+    } catch (...) {}
     faces.clear();
     return false;
 }

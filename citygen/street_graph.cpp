@@ -71,10 +71,23 @@ bool conflicts(const StreetGraph& g, const StreetEdge& e, const StreetEdge& f) {
     if (shared >= 2) return true;  // duplicate edge
     if (shared == 1) {
         KPoint s, a, b;
-        if (ea == fa) { s = p0; a = p1; b = q1; }
-        else if (ea == fb) { s = p0; a = p1; b = q0; }
-        else if (eb == fa) { s = p1; a = p0; b = q1; }
-        else { s = p1; a = p0; b = q0; }
+        if (ea == fa) {
+            s = p0;
+            a = p1;
+            b = q1;
+        } else if (ea == fb) {
+            s = p0;
+            a = p1;
+            b = q0;
+        } else if (eb == fa) {
+            s = p1;
+            a = p0;
+            b = q1;
+        } else {
+            s = p1;
+            a = p0;
+            b = q0;
+        }
         if (!CGAL::collinear(s, a, b)) return false;
         // Collinear: fine only when s lies strictly between a and b (opposite rays).
         return !CGAL::collinear_are_strictly_ordered_along_line(a, s, b);
@@ -88,15 +101,19 @@ std::vector<std::pair<uint32_t, uint32_t>> findConflictingEdges(const StreetGrap
     std::vector<std::pair<uint32_t, uint32_t>> out;
     const size_t n = g.edges.size();
     if (n < 2 || maxPairs == 0) return out;
-    struct Box { double x0, y0, x1, y1; };
+    struct Box {
+        double x0, y0, x1, y1;
+    };
     std::vector<Box> boxes(n);
     double minX = 1e300, minY = 1e300, maxX = -1e300, maxY = -1e300, sumLen = 0;
     for (size_t i = 0; i < n; ++i) {
         const auto& a = g.nodes[g.edges[i].a];
         const auto& b = g.nodes[g.edges[i].b];
         boxes[i] = {std::min(a.x, b.x), std::min(a.y, b.y), std::max(a.x, b.x), std::max(a.y, b.y)};
-        minX = std::min(minX, boxes[i].x0); minY = std::min(minY, boxes[i].y0);
-        maxX = std::max(maxX, boxes[i].x1); maxY = std::max(maxY, boxes[i].y1);
+        minX = std::min(minX, boxes[i].x0);
+        minY = std::min(minY, boxes[i].y0);
+        maxX = std::max(maxX, boxes[i].x1);
+        maxY = std::max(maxY, boxes[i].y1);
         sumLen += glm::length(b - a);
     }
     double w = std::max(maxX - minX, 1e-9), h = std::max(maxY - minY, 1e-9);
@@ -155,12 +172,17 @@ Status checkPlanarGraph(const StreetGraph& g, double minSegment) {
         const auto& ed = g.edges[e];
         if (ed.a >= nn || ed.b >= nn)
             return Status::error("street graph: edge " + std::to_string(e) + " references node " +
-                                 std::to_string(std::max(ed.a, ed.b)) + ", allowed range [0, " +
-                                 std::to_string(nn) + ")");
-        if (ed.a == ed.b) return Status::error("street graph: edge " + std::to_string(e) + " is a self loop at node " + std::to_string(ed.a));
-        if (uint8_t(ed.cls) > 2) return Status::error("street graph: edge " + std::to_string(e) + " has road class " + std::to_string(int(ed.cls)) + ", allowed range [0, 2]");
+                                 std::to_string(std::max(ed.a, ed.b)) + ", allowed range [0, " + std::to_string(nn) +
+                                 ")");
+        if (ed.a == ed.b)
+            return Status::error("street graph: edge " + std::to_string(e) + " is a self loop at node " +
+                                 std::to_string(ed.a));
+        if (uint8_t(ed.cls) > 2)
+            return Status::error("street graph: edge " + std::to_string(e) + " has road class " +
+                                 std::to_string(int(ed.cls)) + ", allowed range [0, 2]");
         if (!std::isfinite(ed.width) || ed.width <= 0)
-            return Status::error("street graph: edge " + std::to_string(e) + " has invalid width " + std::to_string(ed.width));
+            return Status::error("street graph: edge " + std::to_string(e) + " has invalid width " +
+                                 std::to_string(ed.width));
         uint64_t key = (uint64_t(std::min(ed.a, ed.b)) << 32) | std::max(ed.a, ed.b);
         if (!seen.insert(key).second)
             return Status::error("street graph: edge " + std::to_string(e) + " duplicates another edge between nodes " +
@@ -179,8 +201,8 @@ Status checkPlanarGraph(const StreetGraph& g, double minSegment) {
     });
     for (size_t i = 1; i < nn; ++i)
         if (g.nodes[order[i]] == g.nodes[order[i - 1]])
-            return Status::error("street graph: nodes " + std::to_string(order[i - 1]) + " and " + std::to_string(order[i]) +
-                                 " coincide at " + fmtPoint(g.nodes[order[i]]));
+            return Status::error("street graph: nodes " + std::to_string(order[i - 1]) + " and " +
+                                 std::to_string(order[i]) + " coincide at " + fmtPoint(g.nodes[order[i]]));
     auto bad = findConflictingEdges(g, 1);
     if (!bad.empty()) {
         auto [e, f] = bad.front();
@@ -227,44 +249,50 @@ int directionLanes(const StreetEdge& e, bool forward) {
 // The sixth element of an edge row: the fields that differ from the defaults.
 Status readEdgeExtras(const nlohmann::json& x, const std::string& where, StreetEdge& se) {
     if (!x.is_object())
-        return Status::error(where + " must be an object with forward, backward, maxspeed, turn_forward, turn_backward");
+        return Status::error(where +
+                             " must be an object with forward, backward, maxspeed, turn_forward, turn_backward");
     for (const auto& [key, value] : x.items()) {
         const std::string at = where + "." + key;
         if (key == "forward" || key == "backward") {
             if (!value.is_number_integer()) return Status::error(at + " must be an integer");
             const int64_t n = value.get<int64_t>();
             if (n < 0 || n > kMaxLanesPerDirection)
-                return Status::error(at + " = " + std::to_string(n) + " is out of range [0, " + std::to_string(kMaxLanesPerDirection) + "]");
+                return Status::error(at + " = " + std::to_string(n) + " is out of range [0, " +
+                                     std::to_string(kMaxLanesPerDirection) + "]");
             (key == "forward" ? se.lanesForward : se.lanesBackward) = int8_t(n);
         } else if (key == "maxspeed") {
             if (!value.is_number()) return Status::error(at + " is not a number");
             const double v = value.get<double>();
             if (!(v >= kMinMaxspeedKmh && v <= kMaxMaxspeedKmh))
-                return Status::error(at + " = " + std::to_string(v) + " is out of range [" + std::to_string(int(kMinMaxspeedKmh)) +
-                                     ", " + std::to_string(int(kMaxMaxspeedKmh)) + "] km/h");
+                return Status::error(at + " = " + std::to_string(v) + " is out of range [" +
+                                     std::to_string(int(kMinMaxspeedKmh)) + ", " +
+                                     std::to_string(int(kMaxMaxspeedKmh)) + "] km/h");
             se.maxspeedKmh = float(v);
         } else if (key == "turn_forward" || key == "turn_backward") {
             if (!value.is_string()) return Status::error(at + " must be a string");
             const std::string v = value.get<std::string>();
             const auto turns = parseOsmTurnLanes(v);
             if (v.empty() || !turns || turns->value != v)
-                return Status::error(at + " = '" + v.substr(0, 64) + "' is not a turn:lanes value (lanes separated by '|', each "
-                                     "empty or ';'-separated turn values, at most " + std::to_string(kMaxLanesPerDirection) + " lanes)");
+                return Status::error(at + " = '" + v.substr(0, 64) +
+                                     "' is not a turn:lanes value (lanes separated by '|', each "
+                                     "empty or ';'-separated turn values, at most " +
+                                     std::to_string(kMaxLanesPerDirection) + " lanes)");
             (key == "turn_forward" ? se.turnForward : se.turnBackward) = v;
         } else {
             return Status::error(where + " has unknown key '" + key.substr(0, 64) +
                                  "' (allowed: forward, backward, maxspeed, turn_forward, turn_backward)");
         }
     }
-    if (se.lanesForward == 0 && se.lanesBackward == 0) return Status::error(where + " has no driving lane (forward = backward = 0)");
+    if (se.lanesForward == 0 && se.lanesBackward == 0)
+        return Status::error(where + " has no driving lane (forward = backward = 0)");
     for (bool forward : {true, false}) {
         const std::string& turn = forward ? se.turnForward : se.turnBackward;
         if (turn.empty()) continue;
         const int lanes = directionLanes(se, forward);
         const int listed = parseOsmTurnLanes(turn)->lanes;
         if (listed != lanes)
-            return Status::error(where + (forward ? ".turn_forward" : ".turn_backward") + " lists " + std::to_string(listed) +
-                                 " lanes, the direction has " + std::to_string(lanes));
+            return Status::error(where + (forward ? ".turn_forward" : ".turn_backward") + " lists " +
+                                 std::to_string(listed) + " lanes, the direction has " + std::to_string(lanes));
     }
     return Status::ok();
 }
@@ -279,7 +307,8 @@ Result<StreetGraph> streetGraphFromJson(const std::string& text) {
         } catch (const nlohmann::json::parse_error& e) {
             return Status::error(std::string("street graph JSON is malformed: ") + e.what());
         }
-        if (!j.is_object()) return Status::error("street graph JSON: top level must be an object with 'nodes' and 'edges'");
+        if (!j.is_object())
+            return Status::error("street graph JSON: top level must be an object with 'nodes' and 'edges'");
         if (!j.contains("nodes") || !j["nodes"].is_array())
             return Status::error("street graph JSON: field 'nodes' is missing or not an array");
         if (!j.contains("edges") || !j["edges"].is_array())
@@ -293,8 +322,8 @@ Result<StreetGraph> streetGraphFromJson(const std::string& text) {
                 return Status::error("street graph JSON: nodes[" + std::to_string(i) + "] must be [x, y] numbers");
             double x = n[0].get<double>(), y = n[1].get<double>();
             if (!std::isfinite(x) || !std::isfinite(y) || std::abs(x) > 1e9 || std::abs(y) > 1e9)
-                return Status::error("street graph JSON: nodes[" + std::to_string(i) + "] = [" + std::to_string(x) + ", " +
-                                     std::to_string(y) + "] is out of range [-1e9, 1e9] metres");
+                return Status::error("street graph JSON: nodes[" + std::to_string(i) + "] = [" + std::to_string(x) +
+                                     ", " + std::to_string(y) + "] is out of range [-1e9, 1e9] metres");
             g.nodes.emplace_back(x, y);
         }
         const auto& edges = j["edges"];
@@ -303,13 +332,15 @@ Result<StreetGraph> streetGraphFromJson(const std::string& text) {
             const auto& e = edges[i];
             std::string where = "street graph JSON: edges[" + std::to_string(i) + "]";
             if (!e.is_array() || (e.size() != 5 && e.size() != 6))
-                return Status::error(where + " must be [a, b, class, width, lanes] or [a, b, class, width, lanes, {...}]");
+                return Status::error(where +
+                                     " must be [a, b, class, width, lanes] or [a, b, class, width, lanes, {...}]");
             for (int k = 0; k < 5; ++k)
                 if (!e[k].is_number()) return Status::error(where + "[" + std::to_string(k) + "] is not a number");
             for (int k : {0, 1, 2, 4})
                 if (!e[k].is_number_integer())
                     return Status::error(where + "[" + std::to_string(k) + "] must be an integer");
-            int64_t a = e[0].get<int64_t>(), b = e[1].get<int64_t>(), cls = e[2].get<int64_t>(), lanes = e[4].get<int64_t>();
+            int64_t a = e[0].get<int64_t>(), b = e[1].get<int64_t>(), cls = e[2].get<int64_t>(),
+                    lanes = e[4].get<int64_t>();
             double width = e[3].get<double>();
             int64_t nn = int64_t(g.nodes.size());
             if (a < 0 || a >= nn || b < 0 || b >= nn)
@@ -371,12 +402,12 @@ std::string streetGraphToGeoJson(const StreetGraph& g, double originX, double or
         const auto& b = g.nodes[e.b];
         nlohmann::json f;
         f["type"] = "Feature";
-        if (geo)
-            f["geometry"] = geoEdge(*geo, a, b);
+        if (geo) f["geometry"] = geoEdge(*geo, a, b);
         else
             f["geometry"] = {{"type", "LineString"},
                              {"coordinates", {{a.x + originX, a.y + originY}, {b.x + originX, b.y + originY}}}};
-        f["properties"] = {{"id", i}, {"class", roadClassName(e.cls)}, {"width", double(e.width)}, {"lanes", int(e.lanes)}};
+        f["properties"] = {
+            {"id", i}, {"class", roadClassName(e.cls)}, {"width", double(e.width)}, {"lanes", int(e.lanes)}};
         features.push_back(std::move(f));
     }
     nlohmann::json j;

@@ -25,15 +25,17 @@ double roadWidth(RoadClass c);
 int roadLanes(RoadClass c);
 
 struct StreetEdge {
-    uint32_t a = 0, b = 0;   // node indices
+    uint32_t a = 0, b = 0;  // node indices
     RoadClass cls = RoadClass::Local;
-    float width = 8.0f;      // carriageway width, metres (without sidewalks)
+    float width = 8.0f;  // carriageway width, metres (without sidewalks)
     uint8_t lanes = 2;
     // Driving lanes per travel direction: forward = a -> b, backward = b -> a; -1 = derived from
-    // `lanes` (forward ceil(n/2), backward floor(n/2), n = max(lanes, 2)). A one-way edge has 0 backward (or 0 forward).
+    // `lanes` (forward ceil(n/2), backward floor(n/2), n = max(lanes, 2)). A one-way edge has 0 backward (or 0
+    // forward).
     int8_t lanesForward = -1, lanesBackward = -1;
-    float maxspeedKmh = 0.0f;          // 0 = the class default
-    std::string turnForward{}, turnBackward{};  // OSM turn:lanes value for that direction ("" = none), lanes listed left to right as OSM does
+    float maxspeedKmh = 0.0f;  // 0 = the class default
+    std::string turnForward{},
+        turnBackward{};  // OSM turn:lanes value for that direction ("" = none), lanes listed left to right as OSM does
 };
 
 struct StreetGraph {

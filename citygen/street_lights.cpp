@@ -17,7 +17,10 @@ void box(Mesh& m, const glm::dvec3& origin, const glm::dvec3& lo, const glm::dve
     m.ids.resize(m.positions.size(), 0u);
     const glm::dvec3 c[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {lo.x, hi.y, lo.z},
                              {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}};
-    struct Face { int v[4]; glm::vec3 n; };
+    struct Face {
+        int v[4];
+        glm::vec3 n;
+    };
     const Face faces[6] = {{{0, 1, 5, 4}, {0, -1, 0}}, {{1, 2, 6, 5}, {1, 0, 0}}, {{2, 3, 7, 6}, {0, 1, 0}},
                            {{3, 0, 4, 7}, {-1, 0, 0}}, {{4, 5, 6, 7}, {0, 0, 1}}, {{3, 2, 1, 0}, {0, 0, -1}}};
     for (int f = 0; f < 6; ++f) {
@@ -66,7 +69,8 @@ std::vector<glm::dvec3> placeStreetLights(const City& city) {
 
 void meshStreetLight(const glm::dvec3& base, const glm::dvec3& origin, const Lighting& light, Mesh& mesh, uint32_t id) {
     const double r = 0.09, h = kStreetLightHeight;
-    const glm::u8vec4 side = prelitColor(Material::Lamp, {1, 0, 0}, light), top = prelitColor(Material::Lamp, {0, 0, 1}, light);
+    const glm::u8vec4 side = prelitColor(Material::Lamp, {1, 0, 0}, light),
+                      top = prelitColor(Material::Lamp, {0, 0, 1}, light);
     box(mesh, origin, base + glm::dvec3(-r, -r, 0), base + glm::dvec3(r, r, h - 0.15), side, top, side, false, id);
     const glm::u8vec4 glow = lampHeadColor();
     box(mesh, origin, base + glm::dvec3(-0.35, -0.35, h - 0.15), base + glm::dvec3(0.35, 0.35, h + 0.1), glow,

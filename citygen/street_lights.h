@@ -23,6 +23,7 @@ namespace vista {
 constexpr double kStreetLightHeight = 6.5;  // lamp head centre above the ground, metres
 
 std::vector<glm::dvec3> placeStreetLights(const City& city);
-void meshStreetLight(const glm::dvec3& base, const glm::dvec3& origin, const Lighting& light, Mesh& mesh, uint32_t id = 0);
+void meshStreetLight(const glm::dvec3& base, const glm::dvec3& origin, const Lighting& light, Mesh& mesh,
+                     uint32_t id = 0);
 
 }  // namespace vista

@@ -27,7 +27,6 @@ namespace vista {
 
 namespace {
 
-
 uint64_t cellId(uint64_t tag, int64_t i, int64_t j) { return hashKeys(tag, uint64_t(i), uint64_t(j)); }
 
 double smoothstep(double e0, double e1, double x) {
@@ -162,7 +161,10 @@ private:
                     if (outside(a, b)) continue;
                     bool hw = dir == 0 ? highwayJ(j) : highwayI(i);
                     bool ring = cheb(i, j) == _ringK && cheb(i2, j2) == _ringK && _h > 0.6 * _ringK * _s;
-                    if (hw || ring) { add(a, b, RoadClass::Highway); continue; }
+                    if (hw || ring) {
+                        add(a, b, RoadClass::Highway);
+                        continue;
+                    }
                     double d = density(0.5 * (a + b));
                     if (d < 0.03) continue;
                     if (d < 0.08) {  // sparse arterials in the outskirts
@@ -234,7 +236,10 @@ private:
         double best = -1;
         for (size_t k = 0; k < poly.size(); ++k) {
             double l = glm::length(poly[(k + 1) % poly.size()] - poly[k]);
-            if (l > best) { best = l; longest = k; }
+            if (l > best) {
+                best = l;
+                longest = k;
+            }
         }
         const glm::dvec2 a = poly[longest], b = poly[(longest + 1) % poly.size()];
         glm::dvec2 start = glm::mix(a, b, rng.uniform(0.38, 0.62));
@@ -262,7 +267,10 @@ private:
             glm::dvec2 w0 = p0 - start;
             double s = (w0.x * e.y - w0.y * e.x) / den;
             double r = (w0.x * dir.y - w0.y * dir.x) / den;
-            if (s > 1e-6 && r >= 0 && r <= 1 && s < bestS) { bestS = s; exitEdge = k; }
+            if (s > 1e-6 && r >= 0 && r <= 1 && s < bestS) {
+                bestS = s;
+                exitEdge = k;
+            }
         }
         if (exitEdge == SIZE_MAX) return;
         glm::dvec2 end = start + dir * bestS;
@@ -302,7 +310,10 @@ private:
         for (int pass = 0; pass < 8; ++pass) {
             std::vector<std::vector<uint32_t>> inc(g.nodes.size());
             for (uint32_t e = 0; e < g.edges.size(); ++e)
-                if (!removed[e]) { inc[g.edges[e].a].push_back(e); inc[g.edges[e].b].push_back(e); }
+                if (!removed[e]) {
+                    inc[g.edges[e].a].push_back(e);
+                    inc[g.edges[e].b].push_back(e);
+                }
             bool changed = false;
             for (uint32_t v = 0; v < g.nodes.size(); ++v) {
                 auto& list = inc[v];
@@ -342,8 +353,14 @@ private:
         // Keep canonical node order (planarize sorted by coordinates).
         uint32_t next = 0;
         for (uint32_t v = 0; v < g.nodes.size(); ++v)
-            if (newIndex[v] != UINT32_MAX) { newIndex[v] = next++; out.nodes.push_back(g.nodes[v]); }
-        for (auto& e : out.edges) { e.a = newIndex[e.a]; e.b = newIndex[e.b]; }
+            if (newIndex[v] != UINT32_MAX) {
+                newIndex[v] = next++;
+                out.nodes.push_back(g.nodes[v]);
+            }
+        for (auto& e : out.edges) {
+            e.a = newIndex[e.a];
+            e.b = newIndex[e.b];
+        }
         g = std::move(out);
     }
 

@@ -67,13 +67,13 @@ struct RawSegment {
 StreetGraph planarize(const std::vector<RawSegment>& segments, double snap, double minSegment);
 
 struct OsmImport {
-    StreetGraph streets;         // city frame: metres, x east, y north, (0,0) at `geo`
-    GeoReference geo;            // the projection's reference (store it as CityParams::geo)
+    StreetGraph streets;                  // city frame: metres, x east, y north, (0,0) at `geo`
+    GeoReference geo;                     // the projection's reference (store it as CityParams::geo)
     double extentX_m = 0, extentY_m = 0;  // bounding box of the kept road nodes
-    double outlierRadius_m = 0;  // nodes farther than this from the median position were dropped
+    double outlierRadius_m = 0;           // nodes farther than this from the median position were dropped
     // Distinct OSM nodes / ways of highway=* ways that were dropped, by reason.
     size_t invalidNodes = 0, missingNodes = 0, outlierNodes = 0, tangledWays = 0;
-    size_t simplifiedNodes = 0;  // removed by simplification (shape kept within its tolerances)
+    size_t simplifiedNodes = 0;       // removed by simplification (shape kept within its tolerances)
     std::string dropSummary() const;  // "dropped 2 nodes (1 with invalid coordinates, ...)"
     // Building footprints (osm_buildings.h), in the streets' frame; empty unless asked for.
     std::vector<OsmFootprint> buildings;

@@ -31,7 +31,7 @@ constexpr double kSidewalkLift = 0.12;  // sidewalk top above ground
 constexpr double kMaxPiece = 50.0;      // longest road piece
 constexpr double kMinArea = 1e-6;       // smallest triangle emitted (m^2)
 // Markings (metres): line width, dashes, stop lines, zebra crossings.
-constexpr double kLineWidth = 0.15;     // as the OpenDRIVE road marks
+constexpr double kLineWidth = 0.15;  // as the OpenDRIVE road marks
 constexpr double kDashPeriod = 9.0, kDash = 3.0;
 constexpr double kZebraStripe = 0.5, kZebraGap = 0.6;
 
@@ -68,7 +68,8 @@ public:
         const double inf = std::numeric_limits<double>::infinity();
         // Region whose points tileOf() maps to this tile (border tiles extend outwards).
         claim = {grid.ix(tile) == 0 ? -inf : o.x, grid.iy(tile) == 0 ? -inf : o.y,
-                 grid.ix(tile) == grid.countX() - 1 ? inf : o.x + T, grid.iy(tile) == grid.countY() - 1 ? inf : o.y + T};
+                 grid.ix(tile) == grid.countX() - 1 ? inf : o.x + T,
+                 grid.iy(tile) == grid.countY() - 1 ? inf : o.y + T};
         flat = !(P.hills_amplitude_m > 0);
         // Chord error of a piecewise-linear surface over a cell of side s is
         // about k s^2 / 4 with curvature k <= 25 A / lambda^2 (value noise with
@@ -90,7 +91,8 @@ public:
         if (!(glm::length(glm::cross(c1 - a, c2 - a)) > 2 * kMinArea)) return;
         b.triangle(a, c1, c2);
     }
-    static void quad(MeshBuilder& b, const glm::dvec3& a, const glm::dvec3& c1, const glm::dvec3& c2, const glm::dvec3& c3) {
+    static void quad(MeshBuilder& b, const glm::dvec3& a, const glm::dvec3& c1, const glm::dvec3& c2,
+                     const glm::dvec3& c3) {
         tri(b, a, c1, c2);
         tri(b, a, c2, c3);
     }
@@ -105,7 +107,8 @@ public:
     // The points whose convex hull is the junction polygon of `node`, from its
     // incident edges nodeEdges[i, j): carriageway corners, a dead end's round
     // cap, and where consecutive edges' carriageway borders meet.
-    Polygon2 junctionPoints(uint32_t node, const std::vector<std::pair<uint32_t, uint32_t>>& nodeEdges, size_t i, size_t j) const;
+    Polygon2 junctionPoints(uint32_t node, const std::vector<std::pair<uint32_t, uint32_t>>& nodeEdges, size_t i,
+                            size_t j) const;
     // Adds the carriageway of the lane model's link roads at `node` (junction
     // turns, degree-2 transitions): samples of their outer driving-lane borders.
     void linkRoadBorders(uint32_t node, Polygon2& pts) const;
@@ -127,7 +130,8 @@ public:
     template <class F>
     void forEach(const std::vector<uint32_t>* list, size_t n, F f) const {
         if (list) {
-            for (uint32_t i : *list) if (i < n) f(size_t(i));
+            for (uint32_t i : *list)
+                if (i < n) f(size_t(i));
         } else {
             for (size_t i = 0; i < n; ++i) f(i);
         }
@@ -143,7 +147,8 @@ void SurfaceContext::groundMesh() {
     int nx = flat ? 1 : std::max(1, int(std::ceil(w / step))), ny = flat ? 1 : std::max(1, int(std::ceil(h / step)));
     for (int j = 0; j < ny; ++j) {
         for (int i = 0; i < nx; ++i) {
-            glm::dvec2 a(rect.x0 + w * i / nx, rect.y0 + h * j / ny), c(rect.x0 + w * (i + 1) / nx, rect.y0 + h * (j + 1) / ny);
+            glm::dvec2 a(rect.x0 + w * i / nx, rect.y0 + h * j / ny),
+                c(rect.x0 + w * (i + 1) / nx, rect.y0 + h * (j + 1) / ny);
             quad(b, at(a, 0), at({c.x, a.y}, 0), at(c, 0), at({a.x, c.y}, 0));
         }
     }
@@ -171,7 +176,10 @@ Polygon2 clipToRect(const Polygon2& poly, const Rect& r) {
             }
             glm::dvec2 p = a + (b - a) * std::clamp(t, 0.0, 1.0);
             // Snap exactly onto the clip line.
-            if (edge == 0) p.x = r.x0; else if (edge == 1) p.x = r.x1; else if (edge == 2) p.y = r.y0; else p.y = r.y1;
+            if (edge == 0) p.x = r.x0;
+            else if (edge == 1) p.x = r.x1;
+            else if (edge == 2) p.y = r.y0;
+            else p.y = r.y1;
             return p;
         };
         Polygon2 next;
@@ -201,7 +209,8 @@ void SurfaceContext::parks() {
         int nx = std::max(1, int(std::ceil(w / step))), ny = std::max(1, int(std::ceil(h / step)));
         for (int j = 0; j < ny; ++j)
             for (int i = 0; i < nx; ++i)
-                cells.push_back({rect.x0 + w * i / nx, rect.y0 + h * j / ny, rect.x0 + w * (i + 1) / nx, rect.y0 + h * (j + 1) / ny});
+                cells.push_back({rect.x0 + w * i / nx, rect.y0 + h * j / ny, rect.x0 + w * (i + 1) / nx,
+                                 rect.y0 + h * (j + 1) / ny});
     }
     forEach(parkList, city.blocks.size(), [&](size_t bi) {
         const Block& blk = city.blocks[bi];
@@ -259,8 +268,8 @@ void SurfaceContext::edgeMarkings(MeshBuilder& mark, size_t e, const glm::dvec2&
         int sub = flat ? 1 : std::max(1, int(std::ceil((s1 - s0) / step)));
         for (int k = 0; k < sub; ++k) {
             double a0 = s0 + (s1 - s0) * k / sub, a1 = s0 + (s1 - s0) * (k + 1) / sub;
-            quad(mark, at(point(a0, t0), kMarkingLift), at(point(a1, t0), kMarkingLift), at(point(a1, t1), kMarkingLift),
-                 at(point(a0, t1), kMarkingLift));
+            quad(mark, at(point(a0, t0), kMarkingLift), at(point(a1, t0), kMarkingLift),
+                 at(point(a1, t1), kMarkingLift), at(point(a0, t1), kMarkingLift));
         }
     };
     // A line of half width hw at lateral t from s0 to s1, cut at the road pieces.
@@ -306,7 +315,8 @@ void SurfaceContext::edgeMarkings(MeshBuilder& mark, size_t e, const glm::dvec2&
         }
     };
     double c0 = 0, c1 = 0;
-    if (jA && Lr > 2 * (kStopSetback + kStopDepth)) rect(kStopSetback, kStopSetback + kStopDepth, off, off + ln.left * lw);
+    if (jA && Lr > 2 * (kStopSetback + kStopDepth))
+        rect(kStopSetback, kStopSetback + kStopDepth, off, off + ln.left * lw);
     if (jB && Lr > 2 * (kStopSetback + kStopDepth))
         rect(Lr - kStopSetback - kStopDepth, Lr - kStopSetback, off - ln.right * lw, off);
     if (crossingBand(ln, false, c0, c1)) zebra(c0, c1);
@@ -344,7 +354,8 @@ void SurfaceContext::roads() {
     }
 }
 
-void SurfaceContext::carriageways(MeshBuilder& road, MeshBuilder& mark, std::vector<std::pair<uint32_t, uint32_t>>& nodeEdges) {
+void SurfaceContext::carriageways(MeshBuilder& road, MeshBuilder& mark,
+                                  std::vector<std::pair<uint32_t, uint32_t>>& nodeEdges) {
     const StreetGraph& g = city.streets;
     const size_t nodeCount = g.nodes.size();
     const size_t edgeCount = edgeList ? edgeList->size() : g.edges.size();
@@ -380,11 +391,15 @@ void SurfaceContext::carriageways(MeshBuilder& road, MeshBuilder& mark, std::vec
     }
 }
 
-Polygon2 SurfaceContext::junctionPoints(uint32_t node, const std::vector<std::pair<uint32_t, uint32_t>>& nodeEdges, size_t i,
-                                        size_t j) const {
+Polygon2 SurfaceContext::junctionPoints(uint32_t node, const std::vector<std::pair<uint32_t, uint32_t>>& nodeEdges,
+                                        size_t i, size_t j) const {
     const StreetGraph& g = city.streets;
     const double sw = std::max(0.0, P.sidewalk_m);
-    struct Arm { double angle; glm::dvec2 d; double hw; };
+    struct Arm {
+        double angle;
+        glm::dvec2 d;
+        double hw;
+    };
     std::vector<Arm> arms;
     const glm::dvec2 c = g.nodes[node];
     Polygon2 pts;
@@ -551,7 +566,9 @@ SurfaceIndex buildSurfaceIndex(const City& city, const TileGrid& grid) {
     idx.parks.resize(size_t(idx.tiles));
     idx.lanes = buildLaneModel(city.streets, city.params, &city.blocks);
     const StreetGraph& g = city.streets;
-    auto addUnique = [](std::vector<uint32_t>& v, uint32_t i) { if (v.empty() || v.back() != i) v.push_back(i); };
+    auto addUnique = [](std::vector<uint32_t>& v, uint32_t i) {
+        if (v.empty() || v.back() != i) v.push_back(i);
+    };
     std::vector<int> touched;
     for (size_t e = 0; e < g.edges.size(); ++e) {
         const StreetEdge& E = g.edges[e];
@@ -587,7 +604,8 @@ SurfaceIndex buildSurfaceIndex(const City& city, const TileGrid& grid) {
         if (!city.blocks[b].park) continue;
         int t0 = grid.tileOf(lo), t1 = grid.tileOf(hi);
         for (int y = grid.iy(t0); y <= grid.iy(t1); ++y)
-            for (int x = grid.ix(t0); x <= grid.ix(t1); ++x) idx.parks[size_t(y * grid.countX() + x)].push_back(uint32_t(b));
+            for (int x = grid.ix(t0); x <= grid.ix(t1); ++x)
+                idx.parks[size_t(y * grid.countX() + x)].push_back(uint32_t(b));
     }
     return idx;
 }

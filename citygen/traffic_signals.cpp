@@ -56,7 +56,9 @@ void slab(MeshBuilder& b, const Frame& f, const std::vector<glm::dvec2>& outline
     }
 }
 
-std::vector<glm::dvec2> rect(double u0, double v0, double u1, double v1) { return {{u0, v0}, {u1, v0}, {u1, v1}, {u0, v1}}; }
+std::vector<glm::dvec2> rect(double u0, double v0, double u1, double v1) {
+    return {{u0, v0}, {u1, v0}, {u1, v1}, {u0, v1}};
+}
 
 // Regular polygon of `n` sides with inradius r around (0, cv), counter-clockwise, its
 // first vertex at angle `phase` (octagon: pi/8 puts a flat side at the bottom; triangle:
@@ -94,8 +96,10 @@ void meshSignal(const SignalPlacement& s, const CityParams& params, const glm::d
     b.setId(id);
     const double r = 0.5 * kSignalPoleWidth;
     const bool lightHead = s.kind == SignalPlacement::Kind::TrafficLight;
-    const double top = lightHead ? kTrafficLightBottom + kTrafficLightHeight
-                                 : kSignBottom + (s.kind == SignalPlacement::Kind::Stop ? kSignSize : 0.5 * std::sqrt(3.0) * kSignSize);
+    const double top =
+        lightHead
+            ? kTrafficLightBottom + kTrafficLightHeight
+            : kSignBottom + (s.kind == SignalPlacement::Kind::Stop ? kSignSize : 0.5 * std::sqrt(3.0) * kSignSize);
     b.setAlbedo(kPoleGrey);
     std::vector<glm::dvec2> pole;
     for (const glm::dvec2 q : {glm::dvec2(-r, -r), glm::dvec2(r, -r), glm::dvec2(r, r), glm::dvec2(-r, r)})
@@ -129,7 +133,8 @@ void meshSignal(const SignalPlacement& s, const CityParams& params, const glm::d
         face(b, rear, -f.w);
         b.setAlbedo(kSignRed);
         std::vector<glm::dvec3> red;
-        for (const auto& q : regular(8, half - kStopBorder, cv, kPi / 8)) red.push_back(f.at(q.x, q.y, plate + kFaceProud));
+        for (const auto& q : regular(8, half - kStopBorder, cv, kPi / 8))
+            red.push_back(f.at(q.x, q.y, plate + kFaceProud));
         face(b, red, f.w);
         return;
     }

@@ -37,16 +37,16 @@
 
 namespace vista {
 
-constexpr double kSignalPoleWidth = 0.1;      // metres
-constexpr double kTrafficLightBottom = 2.5;   // housing bottom above the ground
+constexpr double kSignalPoleWidth = 0.1;     // metres
+constexpr double kTrafficLightBottom = 2.5;  // housing bottom above the ground
 constexpr double kTrafficLightHeight = 0.9, kTrafficLightWidth = 0.3, kTrafficLightDepth = 0.25;
-constexpr double kSignBottom = 1.8;           // plate's lower edge above the ground
-constexpr double kSignSize = 0.75;            // octagon across the flats; triangle side
+constexpr double kSignBottom = 1.8;  // plate's lower edge above the ground
+constexpr double kSignSize = 0.75;   // octagon across the flats; triangle side
 constexpr double kSignThickness = 0.02;
 
 Material signalMaterial(SignalPlacement::Kind kind);
 InstanceKind signalInstanceKind(SignalPlacement::Kind kind);
-void meshSignal(const SignalPlacement& signal, const CityParams& params, const glm::dvec3& origin, const Lighting& light,
-                Mesh& mesh, uint32_t id);
+void meshSignal(const SignalPlacement& signal, const CityParams& params, const glm::dvec3& origin,
+                const Lighting& light, Mesh& mesh, uint32_t id);
 
 }  // namespace vista

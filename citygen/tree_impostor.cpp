@@ -31,8 +31,9 @@ int64_t edge(int64_t ax, int64_t ay, int64_t bx, int64_t by, int64_t px, int64_t
 }
 
 // Bakes one cell into `atlas` (its own texels only).
-void bakeCell(int cell, const TreeImpostor& imp, const std::vector<glm::vec3>& positions, const std::vector<glm::u8vec4>& colors,
-              const std::vector<uint32_t>& indices, std::vector<uint8_t>& atlas) {
+void bakeCell(int cell, const TreeImpostor& imp, const std::vector<glm::vec3>& positions,
+              const std::vector<glm::u8vec4>& colors, const std::vector<uint32_t>& indices,
+              std::vector<uint8_t>& atlas) {
     const int px = imp.cellPixels, ss = kImpostorSupersample, n = px * ss;
     const int inner = px - 2 * kImpostorPadPixels;
     const ImpostorView view = impostorView(cell, imp.radius, imp.zMin, imp.zMax);
@@ -184,10 +185,12 @@ TreeImpostor makeTreeImpostor(const std::vector<glm::vec3>& positions, const std
     const int inner = cellPixels - 2 * kImpostorPadPixels;
     for (int cell = 0; cell < kImpostorCells; ++cell) {
         const ImpostorView v = impostorView(cell, imp.radius, imp.zMin, imp.zMax);
-        const double plane = cell < kImpostorVerticalQuads ? 0.0 : imp.zMin + kImpostorTopQuadHeight * (imp.zMax - imp.zMin);
+        const double plane =
+            cell < kImpostorVerticalQuads ? 0.0 : imp.zMin + kImpostorTopQuadHeight * (imp.zMax - imp.zMin);
         const uint32_t base = uint32_t(imp.positions.size());
         for (auto [u, w] : {std::pair{0, 0}, {1, 0}, {1, 1}, {0, 1}}) {
-            const glm::dvec3 p = v.uAxis * (v.uMin + u * v.uSpan) + v.vAxis * (v.vMin + w * v.vSpan) + v.depthAxis * plane;
+            const glm::dvec3 p =
+                v.uAxis * (v.uMin + u * v.uSpan) + v.vAxis * (v.vMin + w * v.vSpan) + v.depthAxis * plane;
             imp.positions.push_back(glm::vec3(p));
             imp.normals.push_back(glm::vec3(v.depthAxis));
             const double s = (cell % 2) * cellPixels + kImpostorPadPixels + u * inner;

@@ -47,17 +47,17 @@ namespace vista {
 
 constexpr int kImpostorVerticalQuads = 3;
 constexpr int kImpostorCells = kImpostorVerticalQuads + 1;  // + the top quad
-constexpr int kImpostorCellPixels = 64;            // osglod's far levels
-constexpr int kCoarseImpostorCellPixels = 32;      // paged coarse levels (trees beyond about 1 km): 16 KB per prototype
+constexpr int kImpostorCellPixels = 64;                     // osglod's far levels
+constexpr int kCoarseImpostorCellPixels = 32;  // paged coarse levels (trees beyond about 1 km): 16 KB per prototype
 constexpr int kMinImpostorCellPixels = 8, kMaxImpostorCellPixels = 1024;
 constexpr int kImpostorPadPixels = 2;
-constexpr int kImpostorSupersample = 4;            // samples per texel side
-constexpr int kImpostorAlphaRef = 128;             // alpha test: drawn when alpha >= 128/255
-constexpr double kImpostorTopQuadHeight = 0.5;      // top quad height, fraction of the z range
+constexpr int kImpostorSupersample = 4;         // samples per texel side
+constexpr int kImpostorAlphaRef = 128;          // alpha test: drawn when alpha >= 128/255
+constexpr double kImpostorTopQuadHeight = 0.5;  // top quad height, fraction of the z range
 
 struct TreeImpostor {
-    float radius = 0;                // R, metres
-    float zMin = 0, zMax = 0;        // z range of the prototype, metres
+    float radius = 0;          // R, metres
+    float zMin = 0, zMax = 0;  // z range of the prototype, metres
     int cellPixels = 0;
     int atlasWidth = 0, atlasHeight = 0;  // 2 * cellPixels each
     std::vector<uint8_t> atlas;           // RGBA8, atlasWidth * atlasHeight * 4, row 0 = bottom

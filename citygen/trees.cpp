@@ -18,9 +18,9 @@ namespace vista {
 
 namespace {
 
-constexpr int kSpecies = 3;   // 0 broadleaf, 1 conifer, 2 columnar
-constexpr int kVariants = 3;  // small, medium, large
-constexpr double kMinBranchRadius = 0.035;  // thinnest twig, metres
+constexpr int kSpecies = 3;                                  // 0 broadleaf, 1 conifer, 2 columnar
+constexpr int kVariants = 3;                                 // small, medium, large
+constexpr double kMinBranchRadius = 0.035;                   // thinnest twig, metres
 constexpr size_t kMinTriangles = 400, kMaxTriangles = 1500;  // per prototype
 
 // Nominal prototype heights (metres) per species and size variant; instances
@@ -67,7 +67,8 @@ public:
             double r = rh * _rng.uniform(0.8, 1.15);
             rim[size_t(i)] = c + glm::dvec3(r * std::cos(a), r * std::sin(a), rz * _rng.uniform(-0.2, 0.2));
         }
-        glm::dvec3 top = c + glm::dvec3(_rng.uniform(-0.15, 0.15) * rh, _rng.uniform(-0.15, 0.15) * rh, rz * _rng.uniform(0.85, 1.15));
+        glm::dvec3 top = c + glm::dvec3(_rng.uniform(-0.15, 0.15) * rh, _rng.uniform(-0.15, 0.15) * rh,
+                                        rz * _rng.uniform(0.85, 1.15));
         glm::dvec3 bot = c - glm::dvec3(0, 0, rz * _rng.uniform(0.6, 0.9));
         for (int i = 0; i < ring; ++i) {
             const glm::dvec3& a = rim[size_t(i)];
@@ -121,13 +122,13 @@ struct BranchStyle {
     int maxDepth = 3;
     int minChildren = 2, maxChildren = 3;
     double tiltMin = 0.45, tiltMax = 0.85;  // child angle from parent (radians)
-    double lenRatio = 0.72;                  // child length / parent length
-    double leafRadius = 1.0;                 // horizontal half-extent of a tip cluster
-    double leafFlatten = 0.7;                // vertical / horizontal extent
-    double upBias = 0.15;                    // pull of children towards +z
+    double lenRatio = 0.72;                 // child length / parent length
+    double leafRadius = 1.0;                // horizontal half-extent of a tip cluster
+    double leafFlatten = 0.7;               // vertical / horizontal extent
+    double upBias = 0.15;                   // pull of children towards +z
     int leafRing = 4;
-    int deepMaxChildren = 3;                 // cap on children from depth 2 on
-    double midLeafChance = 0.0;              // cluster at the middle of outer branches
+    int deepMaxChildren = 3;     // cap on children from depth 2 on
+    double midLeafChance = 0.0;  // cluster at the middle of outer branches
 };
 
 // Recursive branch: two slightly bent tapered segments, then children; leaf
@@ -247,9 +248,9 @@ void makeColumnar(TreeShaper& t, int variant, double h) {
     for (int i = 0; i < n; ++i) {
         double f = (i + rng.uniform(0.0, 1.0)) / n;
         double z = z0 + (z1 - z0) * f;
-        double az = i * 2.39996 + rng.uniform(-0.3, 0.3);  // golden angle spiral
+        double az = i * 2.39996 + rng.uniform(-0.3, 0.3);   // golden angle spiral
         double profile = std::sin(kPi * (0.15 + 0.8 * f));  // spindle-shaped crown
-        double elev = rng.uniform(1.0, 1.25);                // steep, upward branches
+        double elev = rng.uniform(1.0, 1.25);               // steep, upward branches
         glm::dvec3 dir(std::cos(az) * std::cos(elev), std::sin(az) * std::cos(elev), std::sin(elev));
         double len = (crownR * profile + 0.4) / std::cos(elev);
         glm::dvec3 a(0, 0, z), b = a + dir * len;
@@ -414,7 +415,8 @@ public:
     bool inBuilding(const glm::dvec2& p) const {
         return _bIdx.any(p, [&](uint32_t i) {
             const auto& fp = _city.buildings[i].footprint;
-            if (p.x < _bBox[i].first.x || p.y < _bBox[i].first.y || p.x > _bBox[i].second.x || p.y > _bBox[i].second.y) return false;
+            if (p.x < _bBox[i].first.x || p.y < _bBox[i].first.y || p.x > _bBox[i].second.x || p.y > _bBox[i].second.y)
+                return false;
             if (fp.size() >= 3 && pointInPolygon(fp, p)) return true;
             for (size_t k = 0; k < fp.size(); ++k)
                 if (pointSegmentDistance(p, fp[k], fp[(k + 1) % fp.size()]) < kBuildingClearance) return true;
@@ -429,7 +431,9 @@ public:
         _bIdx.forCells(lo, hi, [&](size_t cellId) {
             _bIdx.forItems(cellId, [&](uint32_t i) {
                 const auto& fp = _city.buildings[i].footprint;
-                if (_bBox[i].second.x < lo.x || _bBox[i].second.y < lo.y || _bBox[i].first.x > hi.x || _bBox[i].first.y > hi.y) return;
+                if (_bBox[i].second.x < lo.x || _bBox[i].second.y < lo.y || _bBox[i].first.x > hi.x ||
+                    _bBox[i].first.y > hi.y)
+                    return;
                 for (size_t k = 0; k < fp.size(); ++k)
                     best = std::min(best, pointSegmentDistance(p, fp[k], fp[(k + 1) % fp.size()]));
             });
@@ -451,9 +455,11 @@ private:
             _bBox[i] = {lo - kBuildingClearance, hi + kBuildingClearance};
             if (!std::isfinite(lo.x + lo.y + hi.x + hi.y)) _bBox[i] = {glm::dvec2(1.0), glm::dvec2(0.0)};  // skipped
         }
-        for (const auto& b : _bBox) if (b.first.x <= b.second.x) _bIdx.count(b.first, b.second);
+        for (const auto& b : _bBox)
+            if (b.first.x <= b.second.x) _bIdx.count(b.first, b.second);
         _bIdx.finishCounts();
-        for (size_t i = 0; i < _bBox.size(); ++i) if (_bBox[i].first.x <= _bBox[i].second.x) _bIdx.fill(_bBox[i].first, _bBox[i].second, uint32_t(i));
+        for (size_t i = 0; i < _bBox.size(); ++i)
+            if (_bBox[i].first.x <= _bBox[i].second.x) _bIdx.fill(_bBox[i].first, _bBox[i].second, uint32_t(i));
     }
 
     // Indexes every carriageway with valid, finite end points (the graph
@@ -472,9 +478,17 @@ private:
             double m = 0.5 * edgeWidth(g.edges[e]) + kRoadClearance;
             return std::make_pair(glm::min(a, b) - m, glm::max(a, b) + m);
         };
-        for (size_t e = 0; e < g.edges.size(); ++e) if (_edgeOk[e]) { auto bb = edgeBox(e); _eIdx.count(bb.first, bb.second); }
+        for (size_t e = 0; e < g.edges.size(); ++e)
+            if (_edgeOk[e]) {
+                auto bb = edgeBox(e);
+                _eIdx.count(bb.first, bb.second);
+            }
         _eIdx.finishCounts();
-        for (size_t e = 0; e < g.edges.size(); ++e) if (_edgeOk[e]) { auto bb = edgeBox(e); _eIdx.fill(bb.first, bb.second, uint32_t(e)); }
+        for (size_t e = 0; e < g.edges.size(); ++e)
+            if (_edgeOk[e]) {
+                auto bb = edgeBox(e);
+                _eIdx.fill(bb.first, bb.second, uint32_t(e));
+            }
     }
 
     // Measures the crown radius (max horizontal extent) of every prototype.
@@ -501,7 +515,8 @@ bool inCity(const glm::dvec2& p, double half) { return std::abs(p.x) <= half - 1
 
 // Adds street tree candidates: evenly spaced along both sides of every
 // street, clear of its intersections, one species per street.
-void addStreetCandidates(const City& city, const std::vector<uint8_t>& edgeOk, double half, std::vector<Candidate>& cand) {
+void addStreetCandidates(const City& city, const std::vector<uint8_t>& edgeOk, double half,
+                         std::vector<Candidate>& cand) {
     const CityParams& P = city.params;
     const StreetGraph& g = city.streets;
     std::vector<int> deg(g.nodes.size(), 0);
@@ -660,7 +675,8 @@ std::vector<TreeInstance> placeTrees(const City& city, Progress* progress) {
 
     const SiteIndex sites(city, half);
     std::vector<Candidate> cand;
-    if (P.street_tree_spacing_m > 0 && !city.streets.edges.empty()) addStreetCandidates(city, sites.edgeOk(), half, cand);
+    if (P.street_tree_spacing_m > 0 && !city.streets.edges.empty())
+        addStreetCandidates(city, sites.edgeOk(), half, cand);
     if (progress) progress->update(0.3);
     if (P.park_tree_density > 0) addParkCandidates(city, half, cand);
     if (progress) progress->update(0.5);

@@ -83,8 +83,9 @@ void declareFlags(CLI::App& app, ReportArgs& a) {
     app.add_option("--ssaa", a.ssaa, "reference supersampling factor per axis");
     app.add_option("--fov", a.fov, "vertical field of view, degrees");
     app.add_option("--json", a.jsonOut, "also write the results as JSON");
-    app.add_option("--point-splat", a.splat, "impostor points as splats of SIGMA output pixels (0.05 .. 4), or off = 1-pixel points (default " +
-                                                 formatSplatSigma(kDefaultSplatSigma) + ")");
+    app.add_option("--point-splat", a.splat,
+                   "impostor points as splats of SIGMA output pixels (0.05 .. 4), or off = 1-pixel points (default " +
+                       formatSplatSigma(kDefaultSplatSigma) + ")");
 }
 
 // --size and --point-splat (the splat sigma is set for every impostor drawn).
@@ -106,8 +107,9 @@ Status configure(ReportArgs& a) {
 Status checkSameCity(const BakedFile& bf, const std::string& file, std::string& firstHash, std::string& firstFile) {
     if (!bf.sourceCityHash.empty() && firstHash.empty()) firstHash = bf.sourceCityHash, firstFile = file;
     if (!bf.sourceCityHash.empty() && bf.sourceCityHash != firstHash)
-        return Status::error("baked from another city: '" + file + "' was baked from a city with hash " + bf.sourceCityHash +
-                             ", '" + firstFile + "' from one with hash " + firstHash + "; compare bakes of one city");
+        return Status::error("baked from another city: '" + file + "' was baked from a city with hash " +
+                             bf.sourceCityHash + ", '" + firstFile + "' from one with hash " + firstHash +
+                             "; compare bakes of one city");
     return Status::ok();
 }
 
@@ -133,7 +135,8 @@ CellScenes cellScenes(ViewCellSwitch& root, uint32_t cell) {
     }
     c.pts->addChild(c.imp.get());
     if (std::getenv("VISTA_REPORT_FF"))  // diagnostic: fixed-function points (no shader)
-        c.pts->getOrCreateStateSet()->setAttributeAndModes(new osg::Program, osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE);
+        c.pts->getOrCreateStateSet()->setAttributeAndModes(new osg::Program,
+                                                           osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE);
     c.pts->getOrCreateStateSet()->addUniform(new osg::Uniform("vista_useTexture", 0),
                                              osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE);
     return c;
@@ -149,14 +152,23 @@ struct CellViews {
 CellViews cellViews(const ViewCellBox& cb) {
     glm::dvec3 corners[8];
     ViewCellBox inset = cb;
-    inset.halfLength *= 0.98; inset.halfWidth *= 0.98; inset.halfHeight *= 0.98;
+    inset.halfLength *= 0.98;
+    inset.halfWidth *= 0.98;
+    inset.halfHeight *= 0.98;
     inset.corners(corners);
     CellViews v;
     v.eyes.assign(corners, corners + 8);
     for (int k = 0; k < 8; ++k) v.names.push_back("corner" + std::to_string(k));
     const glm::dvec3 ax(cb.axis, 0.0), sd(cb.side(), 0.0);
     for (int k = 0; k < 4; ++k) {
-        const double a = (k == 0 ? 1 : k == 1 ? -1 : 0) * inset.halfLength, b = (k == 2 ? 1 : k == 3 ? -1 : 0) * inset.halfWidth;
+        const double a = (k == 0   ? 1
+                          : k == 1 ? -1
+                                   : 0) *
+                         inset.halfLength,
+                     b = (k == 2   ? 1
+                          : k == 3 ? -1
+                                   : 0) *
+                         inset.halfWidth;
         v.eyes.push_back(cb.center + a * ax + b * sd);
         v.names.push_back(k < 2 ? (k == 0 ? "edge+axis" : "edge-axis") : (k == 2 ? "edge+side" : "edge-side"));
     }
@@ -223,7 +235,8 @@ Times timeScenes(const ReportArgs& a, const CellScenes& sc, const Camera& c, Off
             r1.render(scenes[m], c, 0.0, &img, nullptr, fs);
             if (f > 0) times[m]->push_back(fs.frameMs);
             if (f > 0 && std::getenv("VISTA_REPORT_VERBOSE"))
-                std::fprintf(stderr, "mode %d frame %d: %.1f ms (cull %.1f, draw %.1f)\n", m, f, fs.frameMs, fs.cullMs, fs.drawMs);
+                std::fprintf(stderr, "mode %d frame %d: %.1f ms (cull %.1f, draw %.1f)\n", m, f, fs.frameMs, fs.cullMs,
+                             fs.drawMs);
         }
     return t;
 }
@@ -231,9 +244,9 @@ Times timeScenes(const ReportArgs& a, const CellScenes& sc, const Camera& c, Off
 // One bake's row: the table line on stdout and its JSON object.
 nlohmann::json reportRow(const std::string& label, const std::string& file, int cell, const CellScenes& sc,
                          const CellViews& views, const Quality& q, const Times& t) {
-    std::printf("| %s | %zu | %zu | %zu | %.2f | %.1f | %.1f | %.1f | %.2f | %.2f | %.2f |\n", label.c_str(), sc.points, sc.textured,
-                q.covered, q.covered ? double(sc.points) / double(q.covered) : 0.0, median(t.geom), median(t.imp), median(t.pts),
-                median(q.geom), median(q.imp), median(q.pts));
+    std::printf("| %s | %zu | %zu | %zu | %.2f | %.1f | %.1f | %.1f | %.2f | %.2f | %.2f |\n", label.c_str(), sc.points,
+                sc.textured, q.covered, q.covered ? double(sc.points) / double(q.covered) : 0.0, median(t.geom),
+                median(t.imp), median(t.pts), median(q.geom), median(q.imp), median(q.pts));
     std::fflush(stdout);
     nlohmann::json j;
     j["label"] = label;
@@ -268,7 +281,9 @@ int main(int argc, char** argv) {
     auto rs = OffscreenRenderer::create(a.width * a.ssaa, a.height * a.ssaa);
     if (!rs) return reportBadInput(kTool, rs.status());
     nlohmann::json out = nlohmann::json::array();
-    std::printf("| bake | points | textured | covered px | pts/px | geom ms | imp ms (textured) | imp ms (points) | PSNR geom dB | PSNR imp dB | PSNR pts dB |\n");
+    std::printf(
+        "| bake | points | textured | covered px | pts/px | geom ms | imp ms (textured) | imp ms (points) | PSNR geom "
+        "dB | PSNR imp dB | PSNR pts dB |\n");
     std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
     std::string firstHash, firstFile;
     for (size_t bi = 0; bi < a.baked.size(); ++bi) {
@@ -277,7 +292,8 @@ int main(int argc, char** argv) {
         if (Status s = checkSameCity(*bf, a.baked[bi], firstHash, firstFile); !s) return reportBadInput(kTool, s);
         ViewCellSwitch& root = *bf->root;
         if (a.cell < 0 || size_t(a.cell) >= root.cells().size() || root.impostorsOf(uint32_t(a.cell)).empty())
-            return reportBadInput(kTool, Status::error("--cell " + std::to_string(a.cell) + ": no impostor in '" + a.baked[bi] + "'"));
+            return reportBadInput(
+                kTool, Status::error("--cell " + std::to_string(a.cell) + ": no impostor in '" + a.baked[bi] + "'"));
         const CellScenes scenes = cellScenes(root, uint32_t(a.cell));
         const ViewCellBox& cb = root.cells()[size_t(a.cell)];
         // Target: the first impostor's bound centre.

@@ -53,9 +53,8 @@ Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene
     run->ctx.options = cfg.options;
     double bvhMs = -1;
     const bool fxRays = effectsNeedRays(cfg.options.effects);
-    const bool needRays = fxRays || std::any_of(cfg.modes.begin(), cfg.modes.end(), [](const std::string& m) {
-                              return findRenderMode(m)->needsRays;
-                          });
+    const bool needRays = fxRays || std::any_of(cfg.modes.begin(), cfg.modes.end(),
+                                                [](const std::string& m) { return findRenderMode(m)->needsRays; });
     if (needRays) {
         if (!city) return Status::error("modes that cast rays need a loaded city file (no city given)");
         Stopwatch sw;
@@ -122,7 +121,8 @@ public:
             std::snprintf(name, sizeof name, "f%04d_", rec.frame);
             std::error_code ec;
             std::filesystem::create_directories(std::filesystem::path(_cfg.outDir) / "frames", ec);
-            VISTA_RETURN_IF_ERROR(writePng(img, (std::filesystem::path(_cfg.outDir) / "frames" / (name + rec.mode + ".png")).string()));
+            VISTA_RETURN_IF_ERROR(
+                writePng(img, (std::filesystem::path(_cfg.outDir) / "frames" / (name + rec.mode + ".png")).string()));
         }
         if (_cfg.worstFrames <= 0 || (mi == 0 && _cfg.referenceSsaa < 2)) return Status::ok();
         auto& w = _worst[mi];
@@ -137,7 +137,8 @@ public:
         for (const auto& list : _worst)
             for (size_t k = 0; k < list.size(); ++k) {
                 const Worst& w = list[k];
-                const std::string stem = path("worst" + std::to_string(k + 1) + "_" + w.mode + "_f" + std::to_string(w.frame));
+                const std::string stem =
+                    path("worst" + std::to_string(k + 1) + "_" + w.mode + "_f" + std::to_string(w.frame));
                 VISTA_RETURN_IF_ERROR(writePng(w.image, stem + ".png"));
                 VISTA_RETURN_IF_ERROR(writePng(w.reference, stem + "_ref.png"));
                 VISTA_RETURN_IF_ERROR(writePng(differenceImage(w.image, w.reference), stem + "_diff.png"));
@@ -161,7 +162,8 @@ void reportProgress(const BenchConfig& cfg, size_t done, size_t total, const Sto
     if (cfg.quiet || (done % 10 != 0 && done != total)) return;
     const double el = sw.ms() / 1000.0, eta = el * double(total - done) / double(done);
     const bool tty = isatty(2);
-    std::fprintf(stderr, tty ? "\rframe %zu/%zu (%.0f s, eta %.0f s)   " : "frame %zu/%zu (%.0f s, eta %.0f s)\n", done, total, el, eta);
+    std::fprintf(stderr, tty ? "\rframe %zu/%zu (%.0f s, eta %.0f s)   " : "frame %zu/%zu (%.0f s, eta %.0f s)\n", done,
+                 total, el, eta);
     if (tty && done == total) std::fprintf(stderr, "\n");
 }
 
@@ -240,7 +242,8 @@ Status validateBenchConfig(const BenchConfig& c) {
         return Status::error("--dump-rays-every " + std::to_string(c.dumpRaysEvery) + " out of range 1 .. 1000000");
     if (c.modes.empty()) return Status::error("--modes: no mode given; available modes: " + renderModeNames());
     for (const auto& m : c.modes)
-        if (!findRenderMode(m)) return Status::error("--modes: unknown mode '" + m + "'; available modes: " + renderModeNames());
+        if (!findRenderMode(m))
+            return Status::error("--modes: unknown mode '" + m + "'; available modes: " + renderModeNames());
     return checkModeOptions(c.options);
 }
 
@@ -250,7 +253,8 @@ Result<BenchResult> runBenchmark(const SceneModel* city, osg::Node* scene, const
     if (path.samples.empty()) return Status::error("the walkthrough path has no samples");
     std::unique_ptr<tbb::global_control> threads;
     if (cfg.options.threads > 0)
-        threads.reset(new tbb::global_control(tbb::global_control::max_allowed_parallelism, size_t(cfg.options.threads)));
+        threads.reset(
+            new tbb::global_control(tbb::global_control::max_allowed_parallelism, size_t(cfg.options.threads)));
     auto run = setUp(city, scene, cfg);
     if (!run) return run.status();
     BenchResult result;
@@ -285,7 +289,8 @@ Result<BenchResult> runBenchmark(const SceneModel* city, osg::Node* scene, const
     result.glRenderer = (*run)->renderer->glRenderer();
     result.motion = pathMotion(path, idx);
     for (size_t mi = 0; mi < cfg.modes.size(); ++mi) {
-        result.modes.push_back(summariseMode(result, cfg.modes[mi], speedupBases(), double(cfg.width) * double(cfg.height)));
+        result.modes.push_back(
+            summariseMode(result, cfg.modes[mi], speedupBases(), double(cfg.width) * double(cfg.height)));
         result.modes.back().setupMs = (*run)->setup[mi];
     }
     if (cfg.outDir.empty()) return result;

@@ -39,26 +39,26 @@ struct BenchConfig {
     double fovYDeg = 60.0;
     double zNear = 0.3;
     std::vector<std::string> modes{"full", "near"};
-    std::string outDir;            // created if missing; empty = write nothing
-    int referenceSsaa = 0;         // 0/1 = `full` image; k >= 2 = k x k supersampled full
-    int diffThreshold = 8;         // for the differing-pixel fraction (0..255)
-    int worstFrames = 2;           // difference images for the N worst frames per mode
-    bool saveFrames = false;       // every frame of every mode as frames/f<NNNN>_<mode>.png
+    std::string outDir;       // created if missing; empty = write nothing
+    int referenceSsaa = 0;    // 0/1 = `full` image; k >= 2 = k x k supersampled full
+    int diffThreshold = 8;    // for the differing-pixel fraction (0..255)
+    int worstFrames = 2;      // difference images for the N worst frames per mode
+    bool saveFrames = false;  // every frame of every mode as frames/f<NNNN>_<mode>.png
     // Non-empty: every dumpRaysEvery-th frame (0, N, 2N, ...) of every mode
     // with a far-field ray stage (RenderMode::lastTracedPixels: hybrid) is
     // written as <dir>/<mode>_f<NNNN>.rays (RaySet, runtime/engine/ray_set.h),
     // outside the timed frame. No such mode among `modes` is an error.
     std::string dumpRaysDir;
-    int dumpRaysEvery = 1;         // 1 .. 1000000
+    int dumpRaysEvery = 1;  // 1 .. 1000000
     bool warmup = true;
-    bool quiet = false;            // no progress on stderr
+    bool quiet = false;  // no progress on stderr
     ModeOptions options;
-    std::string command;           // recorded in summary.json
-    std::string cityLabel;         // recorded in summary.json
-    std::vector<MemoryPhase> memoryPhases;  // phases measured by the caller before the run (load)
+    std::string command;                              // recorded in summary.json
+    std::string cityLabel;                            // recorded in summary.json
+    std::vector<MemoryPhase> memoryPhases;            // phases measured by the caller before the run (load)
     double memoryBudgetGb = 0, memoryEstimateMb = 0;  // --memory-budget (0 = none) and the up-front estimate
-    double loadMs = -1;            // city load time measured by the caller (set-up "load"); < 0 = not reported
-    double runUpS = -1;            // the path's run-up (PathOptions::runUp) when the bench made it; < 0 = unknown
+    double loadMs = -1;                  // city load time measured by the caller (set-up "load"); < 0 = not reported
+    double runUpS = -1;                  // the path's run-up (PathOptions::runUp) when the bench made it; < 0 = unknown
     std::string effectsDeclared = "{}";  // the scene's effects (JSON, effects.h), recorded in summary.json
     // A paged city's load (summary.json "paged": regions_loaded, regions_total,
     // radius_m, bytes_loaded): JSON object, empty = a city file.
@@ -111,9 +111,9 @@ struct BenchResult {
     std::vector<BenchFrameRecord> frames;  // frame-major: all modes of frame 0, then frame 1, ...
     std::vector<ModeSummary> modes;        // `full` first
     std::string glRenderer;
-    PathMotion motion;                     // of the rendered frames
+    PathMotion motion;  // of the rendered frames
     double loadAvgStart = -1, loadAvgEnd = -1;
-    std::vector<MemoryPhase> memory;       // load, setup (ray scene, modes), frames
+    std::vector<MemoryPhase> memory;  // load, setup (ray scene, modes), frames
 };
 
 // The config with `full` moved to the front of the modes (the reference of
@@ -138,6 +138,5 @@ const std::vector<std::string>& speedupBases();
 
 // frames.csv, summary.json, frame_time.png, quality.png (bench_output.cpp).
 Status writeBenchOutputs(const BenchResult& r, const BenchConfig& cfg, const SceneModel* city, const Path& path);
-
 
 }  // namespace vista

@@ -44,7 +44,8 @@ std::string framesCsv(const BenchResult& result) {
     char buf[512];
     for (const auto& r : result.frames) {
         const FrameStats& s = r.stats;
-        std::snprintf(buf, sizeof(buf), "%d,%zu,%.4f,%s,%.4f,%.4f,%.4f,%llu,%llu,%llu,%.3f,%.6f,%llu,%llu,%llu,%llu,%llu,%llu,", r.frame,
+        std::snprintf(buf, sizeof(buf),
+                      "%d,%zu,%.4f,%s,%.4f,%.4f,%.4f,%llu,%llu,%llu,%.3f,%.6f,%llu,%llu,%llu,%llu,%llu,%llu,", r.frame,
                       r.pathIndex, r.t, r.mode.c_str(), s.frameMs, s.cullMs, s.drawMs, (unsigned long long)s.triangles,
                       (unsigned long long)s.drawCalls, (unsigned long long)s.raysCast, r.psnrDb, r.diffFraction,
                       (unsigned long long)s.pixels.covered, (unsigned long long)s.pixels.horizonCulled,
@@ -66,11 +67,14 @@ std::string framesCsv(const BenchResult& result) {
 
 json pixelClasses(const ModeSummary& s) {
     auto cls = [](const PixelClassSummary& c) {
-        return json{{"min_pct", num(c.minPct)}, {"mean_pct", num(c.meanPct)}, {"max_pct", num(c.maxPct)},
+        return json{{"min_pct", num(c.minPct)},
+                    {"mean_pct", num(c.meanPct)},
+                    {"max_pct", num(c.maxPct)},
                     {"mean_count", num(c.meanCount)}};
     };
-    return {{"covered", cls(s.covered)}, {"horizon_culled", cls(s.horizonCulled)}, {"cache", cls(s.cache)},
-            {"ray_hit", cls(s.rayHit)}, {"ray_miss", cls(s.rayMiss)}, {"interpolated", cls(s.interpolated)}};
+    return {{"covered", cls(s.covered)},  {"horizon_culled", cls(s.horizonCulled)},
+            {"cache", cls(s.cache)},      {"ray_hit", cls(s.rayHit)},
+            {"ray_miss", cls(s.rayMiss)}, {"interpolated", cls(s.interpolated)}};
 }
 
 json modeJson(const ModeSummary& s) {
@@ -151,7 +155,8 @@ json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneM
                     {"load_avg_1min_start", result.loadAvgStart},
                     {"load_avg_1min_end", result.loadAvgEnd}};
     json phases = json::array();
-    for (const MemoryPhase& p : result.memory) phases.push_back({{"phase", p.name}, {"peak_rss_mb", p.peakRssMb}, {"rss_mb", p.rssMb}});
+    for (const MemoryPhase& p : result.memory)
+        phases.push_back({{"phase", p.name}, {"peak_rss_mb", p.peakRssMb}, {"rss_mb", p.rssMb}});
     j["memory"] = {{"peak_rss_mb", result.memory.empty() ? json(nullptr) : json(result.memory.back().peakRssMb)},
                    {"estimate_mb", cfg.memoryEstimateMb > 0 ? json(cfg.memoryEstimateMb) : json(nullptr)},
                    {"budget_gb", cfg.memoryBudgetGb > 0 ? json(cfg.memoryBudgetGb) : json(nullptr)},

@@ -29,7 +29,6 @@ int reportBadInput(const std::string& cmd, const Status& s) {
     return 2;
 }
 
-
 double peakRssMb() {
     struct rusage ru {};
     getrusage(RUSAGE_SELF, &ru);

@@ -44,25 +44,32 @@ struct BenchArgs {
 void declareFlags(CLI::App& app, BenchArgs& a) {
     std::string modeHelp = "comma-separated modes (default full,near); available:";
     for (const auto& m : renderModes()) modeHelp += std::string("\n    ") + m.name + ": " + m.summary;
-    app.add_option("city", a.city, "city scene file (.osgb), or a paged city directory (DIR.paged); not needed with --sweep");
+    app.add_option("city", a.city,
+                   "city scene file (.osgb), or a paged city directory (DIR.paged); not needed with --sweep");
     addPathFlags(app, a.path, true);
     addPagedFlags(app, a.paged);
     app.add_option("--frames", a.cfg.frames, "frames rendered, sampled from the path as --sampling says (default 120)");
     app.add_option("--sampling", a.sampling,
                    "which path samples are the frames: 'spread' (evenly over the whole path), 'consecutive' (the first "
                    "N samples, as a simulator renders them) or 'runs:K' (K runs of consecutive samples, their starts "
-                   "spread over the path) (default " + samplingName(kDefaultSampleRuns) + ")");
+                   "spread over the path) (default " +
+                       samplingName(kDefaultSampleRuns) + ")");
     app.add_option("--size", a.size, "image size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 640x480)");
     app.add_option("--modes", a.modes, modeHelp);
     addModeFlags(app, a.mode);
     app.add_option("--fov", a.fov, "vertical field of view in degrees, (1, 179) (default 60)");
-    app.add_option("--reference", a.reference, "reference for the quality metrics: full (default) or ssaa:K (K x K supersampled full)");
-    app.add_option("--diff-threshold", a.cfg.diffThreshold, "per-channel difference counted as a differing pixel (default 8)");
+    app.add_option("--reference", a.reference,
+                   "reference for the quality metrics: full (default) or ssaa:K (K x K supersampled full)");
+    app.add_option("--diff-threshold", a.cfg.diffThreshold,
+                   "per-channel difference counted as a differing pixel (default 8)");
     app.add_option("--worst", a.cfg.worstFrames, "difference images for the N worst frames per mode (default 2)");
-    app.add_flag("--save-frames", a.cfg.saveFrames, "also write every frame of every mode as OUT/frames/fNNNN_MODE.png");
-    app.add_option("--dump-rays", a.cfg.dumpRaysDir,
-                   "write the far-field rays each hybrid frame traced as DIR/MODE_fNNNN.rays (ray sets for bench_raw_rays)");
-    app.add_option("--dump-rays-every", a.cfg.dumpRaysEvery, "with --dump-rays: only every N-th frame, 1 .. 1000000 (default 1)");
+    app.add_flag("--save-frames", a.cfg.saveFrames,
+                 "also write every frame of every mode as OUT/frames/fNNNN_MODE.png");
+    app.add_option(
+        "--dump-rays", a.cfg.dumpRaysDir,
+        "write the far-field rays each hybrid frame traced as DIR/MODE_fNNNN.rays (ray sets for bench_raw_rays)");
+    app.add_option("--dump-rays-every", a.cfg.dumpRaysEvery,
+                   "with --dump-rays: only every N-th frame, 1 .. 1000000 (default 1)");
     app.add_option("--out", a.out, "output directory (created if missing)")->required();
     app.add_option("--memory-budget", a.memoryBudget,
                    "GB: refuse up front a run whose estimated peak memory (from the city file's size) exceeds it; "
@@ -71,7 +78,8 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
                    "run-time effects for this run instead of the scene's: 'none', names (haze, glass, night) or a JSON "
                    "object as in the params file; baked effects (sun_shadows, ambient_occlusion, materials, night's "
                    "lights) follow the scene file");
-    app.add_option("--sweep", a.sweep, "scaling sweep: sizes=500,1000,2000 generates a city per size (seed --seed) and benches each");
+    app.add_option("--sweep", a.sweep,
+                   "scaling sweep: sizes=500,1000,2000 generates a city per size (seed --seed) and benches each");
     app.add_flag("-q,--quiet", a.quiet, "no progress on stderr");
 }
 
@@ -137,8 +145,8 @@ Status configure(BenchArgs& a) {
 }
 
 void printTable(const BenchResult& r) {
-    std::printf("%-12s %10s %10s %9s %10s %10s %12s\n", "mode", "median_ms", "p95_ms", "speedup", "psnr_med", "psnr_min",
-                "triangles");
+    std::printf("%-12s %10s %10s %9s %10s %10s %12s\n", "mode", "median_ms", "p95_ms", "speedup", "psnr_med",
+                "psnr_min", "triangles");
     for (const auto& m : r.modes)
         std::printf("%-12s %10.2f %10.2f %9.2f %10.2f %10.2f %12.0f\n", m.mode.c_str(), m.frameMsMedian, m.frameMsP95,
                     m.speedupMedianOfRatios.at("full"), m.psnrDbMedian, m.psnrDbMin, m.trianglesMedian);
@@ -156,7 +164,8 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
         const uint64_t bytes = fs::file_size(cityFile, ec);
         if (!ec) {
             cfg.memoryEstimateMb = estimateCityRunMb(bytes, rays);
-            if (Status s = checkMemoryBudget("--memory-budget", cfg.memoryBudgetGb, cfg.memoryEstimateMb, bytes, rays); !s)
+            if (Status s = checkMemoryBudget("--memory-budget", cfg.memoryBudgetGb, cfg.memoryEstimateMb, bytes, rays);
+                !s)
                 return reportBadInput(kCmd, s);
         }
     }
@@ -219,12 +228,17 @@ struct SweepTable {
         "PSNR median (dB) | triangles drawn (median) |\n|---|---|---|---|---|---|---|---|\n";
     void add(int size, double tris, const ModeSummary& m) {
         const double speedup = m.speedupMedianOfRatios.at("full");
-        rows.push_back({{"size_m", size}, {"city_triangles", tris}, {"mode", m.mode}, {"frame_ms_median", m.frameMsMedian},
-                        {"frame_ms_p95", m.frameMsP95}, {"speedup_vs_full_median_of_ratios", speedup},
-                        {"psnr_db_median", m.psnrDbMedian}, {"triangles_median", m.trianglesMedian}});
+        rows.push_back({{"size_m", size},
+                        {"city_triangles", tris},
+                        {"mode", m.mode},
+                        {"frame_ms_median", m.frameMsMedian},
+                        {"frame_ms_p95", m.frameMsP95},
+                        {"speedup_vs_full_median_of_ratios", speedup},
+                        {"psnr_db_median", m.psnrDbMedian},
+                        {"triangles_median", m.trianglesMedian}});
         char buf[256];
-        std::snprintf(buf, sizeof(buf), "| %d | %.0f | %s | %.1f | %.1f | %.2f | %.1f | %.0f |\n", size, tris, m.mode.c_str(),
-                      m.frameMsMedian, m.frameMsP95, speedup, m.psnrDbMedian, m.trianglesMedian);
+        std::snprintf(buf, sizeof(buf), "| %d | %.0f | %s | %.1f | %.1f | %.2f | %.1f | %.0f |\n", size, tris,
+                      m.mode.c_str(), m.frameMsMedian, m.frameMsP95, speedup, m.psnrDbMedian, m.trianglesMedian);
         markdown += buf;
         PlotSeries& s = series[m.mode];
         s.label = m.mode;
@@ -255,14 +269,17 @@ struct SweepTable {
 int runSweep(const BenchArgs& a) {
     auto sizes = parseSweep(a.sweep);
     if (!sizes) return reportBadInput(kCmd, sizes.status());
-    if (!a.path.file.empty()) return reportBadInput(kCmd, Status::error("--sweep makes its own paths: do not give --path"));
+    if (!a.path.file.empty())
+        return reportBadInput(kCmd, Status::error("--sweep makes its own paths: do not give --path"));
     SweepTable table;
     for (int size : sizes.value()) {
         const std::string cityFile = (fs::path(a.out) / ("city_" + std::to_string(size) + ".osgb")).string();
         if (int rc = generateSweepCity(a, size, cityFile); rc != 0) return rc;
         BenchResult r;
         size_t triangles = 0;
-        if (int rc = benchCity(a, cityFile, (fs::path(a.out) / ("size_" + std::to_string(size))).string(), &r, &triangles); rc != 0)
+        if (int rc =
+                benchCity(a, cityFile, (fs::path(a.out) / ("size_" + std::to_string(size))).string(), &r, &triangles);
+            rc != 0)
             return rc;
         for (const auto& m : r.modes) table.add(size, double(triangles), m);
         std::error_code ec;
@@ -279,9 +296,10 @@ int runSweep(const BenchArgs& a) {
 }  // namespace
 
 int runBench(int argc, char** argv) {
-    CLI::App app{"Headless walkthrough: render modes side by side (interleaved per frame), write frames.csv, "
-                 "summary.json, plots and difference images.",
-                 kCmd};
+    CLI::App app{
+        "Headless walkthrough: render modes side by side (interleaved per frame), write frames.csv, "
+        "summary.json, plots and difference images.",
+        kCmd};
     BenchArgs a;
     declareFlags(app, a);
     if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;

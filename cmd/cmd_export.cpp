@@ -44,7 +44,8 @@ int runExport(int argc, char** argv) {
     auto model = loadCityFile(input);
     if (!model) return reportBadInput(cmd, model.status());
     if (model->streets.edges.empty())
-        return reportBadInput(cmd, Status::error("scene file '" + input + "' has no street graph (no streets to export)"));
+        return reportBadInput(cmd,
+                              Status::error("scene file '" + input + "' has no street graph (no streets to export)"));
     // The blocks decide the sidewalk sides; they are a function of (streets, params).
     const std::vector<Block> blocks = extractBlocks(model->streets, model->params, nullptr);
     OpenDriveCounts n;

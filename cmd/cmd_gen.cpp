@@ -55,20 +55,24 @@ CLI::Option* declareFlags(CLI::App& app, GenArgs& a) {
     app.add_option("--effects", a.effects,
                    "effects the scene declares, over the params file's: 'none', names (" + effectNames() +
                        ") or a JSON object as in the params file (see docs/params.md)");
-    app.add_option("--osm", a.osmFile, "take the streets (highway=* ways) and buildings (building=*, see --osm-buildings) from an OpenStreetMap extract (.osm/.osm.pbf)");
+    app.add_option("--osm", a.osmFile,
+                   "take the streets (highway=* ways) and buildings (building=*, see --osm-buildings) from an "
+                   "OpenStreetMap extract (.osm/.osm.pbf)");
     app.add_option("--osm-buildings", a.osmBuildings,
                    "with --osm: 'on' (default) imports building=* footprints and keeps procedural lots only where the "
                    "data has no building; 'off' fills every block procedurally (docs/buildings.md)");
     app.add_option("--geojson", a.geojsonFile, "also write the street graph as GeoJSON");
     app.add_option("--gltf", a.gltfFile, "also write the city as binary glTF 2.0 (.glb)");
-    app.add_option("--xodr", a.xodrFile, "also write the road network as ASAM OpenDRIVE 1.6 (.xodr, see docs/formats.md)");
+    app.add_option("--xodr", a.xodrFile,
+                   "also write the road network as ASAM OpenDRIVE 1.6 (.xodr, see docs/formats.md)");
     app.add_option("--stats", a.statsFile, "write statistics (counts, timings, peak memory) as JSON");
     auto* out = app.add_option("-o,--output", a.out,
                                "output: a scene file (.osgb), or a paged city directory (DIR.paged: one city file per "
                                "region, index.osgb with a PagedLOD per region for osgviewer, manifest.json; "
                                "docs/formats.md 'Paged city')");
-    app.add_option("--region-size", a.regionSize,
-                   "paged output: side of a region in metres, a whole number of tiles (tile_size_m), 250..16000 (default 2000)");
+    app.add_option(
+        "--region-size", a.regionSize,
+        "paged output: side of a region in metres, a whole number of tiles (tile_size_m), 250..16000 (default 2000)");
     app.add_option("--shard", a.shard,
                    "paged output: shard K of N (K/N, 1 <= K <= N): generate only the regions whose index % N == K - 1, "
                    "no index; then --merge (or an unsharded run) writes index and manifest");
@@ -79,7 +83,8 @@ CLI::Option* declareFlags(CLI::App& app, GenArgs& a) {
                    "GB: refuse up front, before the meshes are made and with nothing written, a generation whose "
                    "estimated peak memory exceeds it (one file: from the laid-out city's estimated triangles; paged: "
                    "from --region-size); --stats reports the estimate beside the measured peak (default: no budget)");
-    app.add_flag("--list-params", a.listParams, "print every parameter with unit, range and default (Markdown) and exit");
+    app.add_flag("--list-params", a.listParams,
+                 "print every parameter with unit, range and default (Markdown) and exit");
     app.add_flag("-q,--quiet", a.quiet, "no progress on stderr");
     return out;
 }
@@ -95,11 +100,12 @@ void printParamTable() {
         else std::snprintf(range, sizeof range, "%g .. %g", s.min, s.max);
         std::printf("| `%s` | %s | %s | %s | %s |\n", s.name, s.unit, range, def.c_str(), s.help);
     }
-    std::printf("\n### Effects\n\nThe `effects` object: an effect is on when its key is present; its object holds "
-                "its parameters (absent ones keep these defaults), e.g. `\"effects\": {\"haze\": "
-                "{\"visibility_m\": 1500}, \"glass\": {}}`. Baked effects change the prelit colours at "
-                "generation and cost nothing per frame beyond the triangles their refinement adds; run-time effects "
-                "are applied per frame, only where on screen (docs/effects.md measures both).\n\n");
+    std::printf(
+        "\n### Effects\n\nThe `effects` object: an effect is on when its key is present; its object holds "
+        "its parameters (absent ones keep these defaults), e.g. `\"effects\": {\"haze\": "
+        "{\"visibility_m\": 1500}, \"glass\": {}}`. Baked effects change the prelit colours at "
+        "generation and cost nothing per frame beyond the triangles their refinement adds; run-time effects "
+        "are applied per frame, only where on screen (docs/effects.md measures both).\n\n");
     std::printf("| effect | kind | field | unit | range | default | meaning |\n|---|---|---|---|---|---|---|\n");
     for (const auto& f : effectSpecs()) {
         char range[64], def[32];
@@ -136,14 +142,22 @@ Result<CityParams> resolveParams(GenArgs& a) {
         return Status::error("option --osm-buildings = '" + a.osmBuildings + "': must be 'on' or 'off'");
     if (a.paged()) return params;  // checked by resolvePaged
     if (a.regionSize || !a.shard.empty() || a.merge)
-        return Status::error(std::string("option ") + (a.regionSize ? "--region-size" : !a.shard.empty() ? "--shard" : "--merge") +
+        return Status::error(std::string("option ") +
+                             (a.regionSize       ? "--region-size"
+                              : !a.shard.empty() ? "--shard"
+                                                 : "--merge") +
                              ": only with paged output (-o DIR.paged)");
     if (a.out.size() < 5 || a.out.substr(a.out.size() - 5) != ".osgb")
-        return Status::error("option -o = '" + a.out + "': the output must end in .osgb (a scene file) or .paged (a paged city directory)");
-    if (Status s = checkSingleFileSize(params); !s) return Status::error((a.size ? "option --size: " : "") + s.message());
+        return Status::error("option -o = '" + a.out +
+                             "': the output must end in .osgb (a scene file) or .paged (a paged city directory)");
+    if (Status s = checkSingleFileSize(params); !s)
+        return Status::error((a.size ? "option --size: " : "") + s.message());
     if (!a.xodrFile.empty()) VISTA_RETURN_IF_ERROR(checkXodrPath("--xodr", a.xodrFile));
-    for (auto [opt, path] : {std::pair<const char*, std::string*>{"-o", &a.out}, {"--stats", &a.statsFile},
-                             {"--geojson", &a.geojsonFile}, {"--gltf", &a.gltfFile}, {"--xodr", &a.xodrFile}}) {
+    for (auto [opt, path] : {std::pair<const char*, std::string*>{"-o", &a.out},
+                             {"--stats", &a.statsFile},
+                             {"--geojson", &a.geojsonFile},
+                             {"--gltf", &a.gltfFile},
+                             {"--xodr", &a.xodrFile}}) {
         if (!path->empty()) VISTA_RETURN_IF_ERROR(checkWritablePath(opt, *path));
     }
     return params;
@@ -156,20 +170,26 @@ Result<PagedCityOptions> resolvePaged(const GenArgs& a, const CityParams& params
     while (o.dir.size() > 1 && o.dir.back() == '/') o.dir.pop_back();
     if (a.regionSize) o.regionSizeM = *a.regionSize;
     o.merge = a.merge;
-    if (Status s = validateRegionSize(params, o.regionSizeM); !s) return Status::error("option --region-size: " + s.message());
+    if (Status s = validateRegionSize(params, o.regionSizeM); !s)
+        return Status::error("option --region-size: " + s.message());
     if (!a.shard.empty()) {
         auto sh = parseShard("--shard", a.shard);
         if (!sh) return sh.status();
         o.shard = *sh;
     }
-    if (a.merge && !a.shard.empty()) return Status::error("option --merge: not with --shard (the merge covers every shard)");
-    for (auto [opt, path] : {std::pair<const char*, const std::string*>{"--geojson", &a.geojsonFile}, {"--gltf", &a.gltfFile},
-                             {"--xodr", &a.xodrFile}, {"--osm", &a.osmFile}})
-        if (!path->empty()) return Status::error(std::string("option ") + opt + ": not supported with paged output (-o DIR.paged)");
+    if (a.merge && !a.shard.empty())
+        return Status::error("option --merge: not with --shard (the merge covers every shard)");
+    for (auto [opt, path] : {std::pair<const char*, const std::string*>{"--geojson", &a.geojsonFile},
+                             {"--gltf", &a.gltfFile},
+                             {"--xodr", &a.xodrFile},
+                             {"--osm", &a.osmFile}})
+        if (!path->empty())
+            return Status::error(std::string("option ") + opt + ": not supported with paged output (-o DIR.paged)");
     if (bakedLightingCalledFor(params))
-        return Status::error("parameter 'effects' = " + params.effects.list() +
-                             ": baked lighting (sun_shadows, ambient_occlusion, night street lights) is computed over the "
-                             "whole city and is not supported with paged output (-o DIR.paged)");
+        return Status::error(
+            "parameter 'effects' = " + params.effects.list() +
+            ": baked lighting (sun_shadows, ambient_occlusion, night street lights) is computed over the "
+            "whole city and is not supported with paged output (-o DIR.paged)");
     VISTA_RETURN_IF_ERROR(checkPagedOutput("-o", o.dir));
     if (!a.statsFile.empty()) VISTA_RETURN_IF_ERROR(checkWritablePath("--stats", a.statsFile));
     return o;
@@ -182,7 +202,8 @@ int runPaged(const GenArgs& a, const CityParams& params, const Stopwatch& total)
     {
         char how[160];
         std::snprintf(how, sizeof(how), "paged: one %g m region at a time at detail %d", o->regionSizeM, params.detail);
-        if (Status s = checkGenBudget("--memory-budget", a.budgetGb, estimateMb, how, true); !s) return reportBadInput(kCmd, s);
+        if (Status s = checkGenBudget("--memory-budget", a.budgetGb, estimateMb, how, true); !s)
+            return reportBadInput(kCmd, s);
     }
     StderrProgress progress(isatty(2));
     o->progress = a.quiet ? nullptr : &progress;
@@ -210,19 +231,25 @@ int runPaged(const GenArgs& a, const CityParams& params, const Stopwatch& total)
         j["triangles"] = rep->triangles;
         j["bytes"] = rep->bytes;
         j["seconds"] = {{"total", totalSeconds},
-                        {"stages", {{"streets and blocks", rep->baseSeconds}, {"regions", rep->regionSeconds}, {"index", rep->indexSeconds}}}};
+                        {"stages",
+                         {{"streets and blocks", rep->baseSeconds},
+                          {"regions", rep->regionSeconds},
+                          {"index", rep->indexSeconds}}}};
         j["peak_rss_mb"] = peakRssMb();
-        j["memory"] = {{"estimate_mb", estimateMb}, {"budget_gb", a.budgetGb > 0 ? nlohmann::json(a.budgetGb) : nlohmann::json(nullptr)}};
+        j["memory"] = {{"estimate_mb", estimateMb},
+                       {"budget_gb", a.budgetGb > 0 ? nlohmann::json(a.budgetGb) : nlohmann::json(nullptr)}};
         j["threads"] = params.threads;
         if (Status s = writeFileAtomic(a.statsFile, j.dump(2) + "\n"); !s) return reportBadInput(kCmd, s);
     }
     if (!a.quiet)
-        std::fprintf(stderr, "wrote %s: %d regions (%d generated, %d reused, %d empty), %zu buildings, %zu trees, %.2f M triangles, "
-                     "%.1f MB, %s, %.1fs, peak %.0f MiB\n",
-                     o->dir.c_str(), rep->regions, rep->generated, rep->reused, rep->emptyRegions, rep->buildings, rep->trees,
-                     rep->triangles / 1e6, rep->bytes / 1e6,
-                     rep->indexWritten ? "index written" : "no index (shard: run --merge when every shard is done)",
-                     totalSeconds, peakRssMb());
+        std::fprintf(
+            stderr,
+            "wrote %s: %d regions (%d generated, %d reused, %d empty), %zu buildings, %zu trees, %.2f M triangles, "
+            "%.1f MB, %s, %.1fs, peak %.0f MiB\n",
+            o->dir.c_str(), rep->regions, rep->generated, rep->reused, rep->emptyRegions, rep->buildings, rep->trees,
+            rep->triangles / 1e6, rep->bytes / 1e6,
+            rep->indexWritten ? "index written" : "no index (shard: run --merge when every shard is done)",
+            totalSeconds, peakRssMb());
     return 0;
 }
 
@@ -231,8 +258,9 @@ Status writeOutputs(const GenArgs& a, const City& city, const CityParams& params
     OutputBatch batch;
     VISTA_RETURN_IF_ERROR(writeCityFile(city, batch.stage(a.out)));
     if (!a.geojsonFile.empty())
-        VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage(a.geojsonFile),
-                                              streetGraphToGeoJson(city.streets, params.origin_x, params.origin_y, params.geo)));
+        VISTA_RETURN_IF_ERROR(
+            writeFileAtomic(batch.stage(a.geojsonFile),
+                            streetGraphToGeoJson(city.streets, params.origin_x, params.origin_y, params.geo)));
     if (!a.gltfFile.empty()) VISTA_RETURN_IF_ERROR(writeGltf(city, batch.stage(a.gltfFile)));
     if (!a.xodrFile.empty()) {
         auto xodr = openDriveXml(city.streets, params, &city.blocks);
@@ -272,12 +300,22 @@ nlohmann::ordered_json statsJson(const City& city, const CityParams& params, con
                                {"rays", lighting.rays}};
     if (const OsmBuildingStats& o = city.osmBuildings; o.enabled)
         j["osm_buildings"] = {
-            {"ways", o.ways}, {"relations", o.relations}, {"candidates", o.candidates}, {"imported", o.imported},
-            {"repaired", {{"duplicate_nodes", o.duplicateNodes}, {"unclosed_rings", o.unclosedRings},
-                          {"self_intersections", o.selfIntersections}, {"inner_rings_dropped", o.innerRingsDropped}}},
-            {"skipped", {{"missing_nodes", o.missingNodes}, {"too_few_nodes", o.tooFewNodes}, {"too_small", o.tooSmall},
-                         {"self_intersecting", o.selfIntersecting}, {"outside_city", o.outsideCity},
-                         {"no_outer_ring", o.noOuterRing}}},
+            {"ways", o.ways},
+            {"relations", o.relations},
+            {"candidates", o.candidates},
+            {"imported", o.imported},
+            {"repaired",
+             {{"duplicate_nodes", o.duplicateNodes},
+              {"unclosed_rings", o.unclosedRings},
+              {"self_intersections", o.selfIntersections},
+              {"inner_rings_dropped", o.innerRingsDropped}}},
+            {"skipped",
+             {{"missing_nodes", o.missingNodes},
+              {"too_few_nodes", o.tooFewNodes},
+              {"too_small", o.tooSmall},
+              {"self_intersecting", o.selfIntersecting},
+              {"outside_city", o.outsideCity},
+              {"no_outer_ring", o.noOuterRing}}},
             {"height", {{"tag", o.heightFromTag}, {"levels", o.heightFromLevels}, {"procedural", o.heightProcedural}}},
             {"roof", {{"tag", o.roofFromTag}, {"procedural", o.roofProcedural}, {"fallback_flat", o.roofFallbackFlat}}},
             {"lots_dropped", o.lotsDropped},
@@ -290,8 +328,10 @@ nlohmann::ordered_json statsJson(const City& city, const CityParams& params, con
 }  // namespace
 
 int runGen(int argc, char** argv) {
-    CLI::App app("Generate a city (deterministic by seed) and write it as one .osgb scene file, or region by region as a "
-                 "paged city directory (-o DIR.paged) that resumes after a kill and splits into shards.", kCmd);
+    CLI::App app(
+        "Generate a city (deterministic by seed) and write it as one .osgb scene file, or region by region as a "
+        "paged city directory (-o DIR.paged) that resumes after a kill and splits into shards.",
+        kCmd);
     GenArgs a;
     CLI::Option* outOpt = declareFlags(app, a);
     if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;
@@ -299,7 +339,8 @@ int runGen(int argc, char** argv) {
         printParamTable();
         return 0;
     }
-    if (outOpt->count() == 0) return reportBadInput(kCmd, Status::error("option -o/--output is required (the .osgb to write)"));
+    if (outOpt->count() == 0)
+        return reportBadInput(kCmd, Status::error("option -o/--output is required (the .osgb to write)"));
     Stopwatch total;
     auto params = resolveParams(a);
     if (!params) return reportBadInput(kCmd, params.status());
@@ -326,15 +367,18 @@ int runGen(int argc, char** argv) {
         Stopwatch osmTime;
         auto g = importOsm(a.osmFile, *params, a.osmBuildings == "on");
         if (!g) return reportBadInput(kCmd, g.status());
-        if (const std::string dropped = g->dropSummary(); !dropped.empty()) std::fprintf(stderr, "osm: %s\n", dropped.c_str());
+        if (const std::string dropped = g->dropSummary(); !dropped.empty())
+            std::fprintf(stderr, "osm: %s\n", dropped.c_str());
         params->geo = g->geo;
         opts.streets = std::move(g->streets);
         osmRoads = g->roadTagStats;
         if (a.osmBuildings == "on") {
             const OsmBuildingStats& b = g->buildingStats;
             const size_t skipped = b.candidates - b.imported;
-            if (skipped) std::fprintf(stderr, "osm: skipped %zu of %zu building footprints (see --stats osm_buildings.skipped)\n",
-                                      skipped, b.candidates);
+            if (skipped)
+                std::fprintf(stderr,
+                             "osm: skipped %zu of %zu building footprints (see --stats osm_buildings.skipped)\n",
+                             skipped, b.candidates);
             opts.osmBuildings = std::move(g->buildings);
             opts.osmStats = b;
         }
@@ -362,9 +406,11 @@ int runGen(int argc, char** argv) {
         if (Status s = writeFileAtomic(a.statsFile, j.dump(2) + "\n"); !s) return reportBadInput(kCmd, s);
     }
     if (!a.quiet)
-        std::fprintf(stderr, "wrote %s: %zu street edges, %zu blocks, %zu buildings, %zu trees, %.2f M triangles, %zu draw calls, %.1fs, peak %.0f MiB%s%s\n",
-                     a.out.c_str(), n.streetEdges, n.blocks, n.buildings, n.trees, n.triangles / 1e6, n.drawCalls, totalSeconds,
-                     peakRssMb(), params->effects.any() ? ", effects: " : "",
+        std::fprintf(stderr,
+                     "wrote %s: %zu street edges, %zu blocks, %zu buildings, %zu trees, %.2f M triangles, %zu draw "
+                     "calls, %.1fs, peak %.0f MiB%s%s\n",
+                     a.out.c_str(), n.streetEdges, n.blocks, n.buildings, n.trees, n.triangles / 1e6, n.drawCalls,
+                     totalSeconds, peakRssMb(), params->effects.any() ? ", effects: " : "",
                      params->effects.any() ? params->effects.list().c_str() : "");
     return 0;
 }

@@ -13,8 +13,10 @@
 namespace vista {
 
 int runPath(int argc, char** argv) {
-    CLI::App app{"Make a deterministic walkthrough path along the city's street graph (CSV: t_s,x_m,y_m,z_m,heading_deg,pitch_deg).",
-                 "vista path"};
+    CLI::App app{
+        "Make a deterministic walkthrough path along the city's street graph (CSV: "
+        "t_s,x_m,y_m,z_m,heading_deg,pitch_deg).",
+        "vista path"};
     std::string city, out, kind = "car", positions;
     PathOptions o;
     double yawDeg = 45.0, pitchDeg = o.flyPitch * 180.0 / kPi;
@@ -27,7 +29,9 @@ int runPath(int argc, char** argv) {
     app.add_option("--seed", o.seed, "random seed of the route (default 1)");
     app.add_option("--kind", kind, "walk (eye 1.7 m), car (eye 1.2 m) or fly (elevated fly-over); default car");
     app.add_option("--duration", o.duration, "path length in seconds (default 60)");
-    app.add_option("--run-up", o.runUp, "seconds driven before the path starts and dropped, so it starts at cruising speed, 0 .. 600 (default 8)");
+    app.add_option(
+        "--run-up", o.runUp,
+        "seconds driven before the path starts and dropped, so it starts at cruising speed, 0 .. 600 (default 8)");
     app.add_option("--dt", o.dt, "seconds between samples (default 1/30)");
     auto* speed = app.add_option("--speed", o.maxSpeed, "maximum speed in m/s (default: walk 1.4, car and fly 14)");
     app.add_option("--yaw-rate", yawDeg, "maximum yaw rate in degrees/s (default 45)");
@@ -70,8 +74,8 @@ int runPath(int argc, char** argv) {
     if (!positions.empty())
         if (Status s = saveLanePositionsCsv(p.value(), positions); !s) return reportBadInput("vista path", s);
     if (Status s = savePathCsv(p.value(), out); !s) return reportBadInput("vista path", s);
-    std::fprintf(stderr, "vista path: %zu samples (%.1f s, %s) -> %s\n", p->samples.size(), o.duration, pathKindName(o.kind),
-                 out.c_str());
+    std::fprintf(stderr, "vista path: %zu samples (%.1f s, %s) -> %s\n", p->samples.size(), o.duration,
+                 pathKindName(o.kind), out.c_str());
     return 0;
 }
 

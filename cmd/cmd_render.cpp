@@ -59,7 +59,8 @@ const char* const kCmd = "vista render";
 enum Channel : unsigned { kRgb = 1, kDepth = 2, kSemantic = 4, kInstance = 8 };
 constexpr unsigned kLabelChannels = kDepth | kSemantic | kInstance;
 // The output folder of each channel, in output order.
-const std::pair<unsigned, const char*> kChannelDirs[] = {{kRgb, "rgb"}, {kDepth, "depth"}, {kSemantic, "semantic"}, {kInstance, "instance"}};
+const std::pair<unsigned, const char*> kChannelDirs[] = {
+    {kRgb, "rgb"}, {kDepth, "depth"}, {kSemantic, "semantic"}, {kInstance, "instance"}};
 
 struct RenderArgs {
     std::string city, size = "640x480", mode = "full", out, channels = "rgb,depth,semantic,instance", fov = "60";
@@ -76,8 +77,13 @@ Result<unsigned> parseChannels(const std::string& s) {
     while (start <= s.size()) {
         const size_t end = s.find(',', start);
         const std::string name = s.substr(start, end == std::string::npos ? std::string::npos : end - start);
-        unsigned c = name == "rgb" ? kRgb : name == "depth" ? kDepth : name == "semantic" ? kSemantic : name == "instance" ? kInstance : Channel{0};
-        if (!c) return Status::error("--channels: unknown channel '" + name + "' (known: rgb, depth, semantic, instance)");
+        unsigned c = name == "rgb"        ? kRgb
+                     : name == "depth"    ? kDepth
+                     : name == "semantic" ? kSemantic
+                     : name == "instance" ? kInstance
+                                          : Channel{0};
+        if (!c)
+            return Status::error("--channels: unknown channel '" + name + "' (known: rgb, depth, semantic, instance)");
         if (out & c) return Status::error("--channels: channel '" + name + "' given twice");
         out |= c;
         if (end == std::string::npos) break;
@@ -105,7 +111,8 @@ Status checkPathInCity(const Path& path, const std::vector<size_t>& idx, const S
         if (!(std::abs(x) <= half && std::abs(y) <= half)) {
             char b[256];
             std::snprintf(b, sizeof b,
-                          "path sample %zu (frame %zu) at city-frame (%.1f, %.1f) m lies outside the city square (+ 50 m) [-%.0f, %.0f] m",
+                          "path sample %zu (frame %zu) at city-frame (%.1f, %.1f) m lies outside the city square (+ 50 "
+                          "m) [-%.0f, %.0f] m",
                           idx[f], f, x, y, half, half);
             return Status::error(b);
         }
@@ -118,7 +125,8 @@ nlohmann::json classesJson() {
     for (int c = 0; c < kSemanticClassCount; ++c) {
         uint8_t rgb[3];
         semanticClassColor(SemanticClass(c), rgb);
-        classes.push_back({{"id", c}, {"name", semanticClassName(SemanticClass(c))}, {"color", {rgb[0], rgb[1], rgb[2]}}});
+        classes.push_back(
+            {{"id", c}, {"name", semanticClassName(SemanticClass(c))}, {"color", {rgb[0], rgb[1], rgb[2]}}});
     }
     nlohmann::json kinds = nlohmann::json::array();
     for (uint32_t k = 0; k < uint32_t(InstanceKind::Count); ++k)
@@ -140,7 +148,8 @@ nlohmann::json cameraFromWorld(const Camera& c, const glm::dvec3& offset) {
 }
 
 struct Timings {
-    std::vector<double> rgb, labelRaster, labelRays, labels, writeRgb, writeDepth, writeSemantic, writeInstance, farPixels;
+    std::vector<double> rgb, labelRaster, labelRays, labels, writeRgb, writeDepth, writeSemantic, writeInstance,
+        farPixels;
     // The frame's record in the work directory (its costs, measured when it was rendered).
     static nlohmann::json record(const Timings& t) {
         nlohmann::json r = nlohmann::json::object();
@@ -149,7 +158,8 @@ struct Timings {
         };
         put("rgb", t.rgb), put("labels_raster_pass", t.labelRaster), put("labels_far_rays", t.labelRays);
         put("labels_total", t.labels), put("write_rgb", t.writeRgb), put("write_depth", t.writeDepth);
-        put("write_semantic", t.writeSemantic), put("write_instance", t.writeInstance), put("far_label_pixels", t.farPixels);
+        put("write_semantic", t.writeSemantic), put("write_instance", t.writeInstance),
+            put("far_label_pixels", t.farPixels);
         return r;
     }
     void add(const nlohmann::json& r) {
@@ -205,7 +215,10 @@ std::string posesHash(const Path& path, const std::vector<size_t>& idx) {
 
 std::string channelList(unsigned c) {
     std::string s;
-    for (const auto& [bit, name] : {std::pair<unsigned, const char*>{kRgb, "rgb"}, {kDepth, "depth"}, {kSemantic, "semantic"}, {kInstance, "instance"}})
+    for (const auto& [bit, name] : {std::pair<unsigned, const char*>{kRgb, "rgb"},
+                                    {kDepth, "depth"},
+                                    {kSemantic, "semantic"},
+                                    {kInstance, "instance"}})
         if (c & bit) s += (s.empty() ? "" : ",") + std::string(name);
     return s;
 }
@@ -223,7 +236,9 @@ long killAfterFrames() {
     return e && *e ? std::atol(e) : 0;
 }
 
-nlohmann::json medianOf(const std::vector<double>& v) { return v.empty() ? nlohmann::json(nullptr) : nlohmann::json(median(v)); }
+nlohmann::json medianOf(const std::vector<double>& v) {
+    return v.empty() ? nlohmann::json(nullptr) : nlohmann::json(median(v));
+}
 
 // The parsed options of a run.
 struct RenderPlan {
@@ -301,14 +316,22 @@ Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, c
     auto cityHash = fileHash(a.city, cityBytes);
     if (!cityHash) return cityHash.status();
     const ModeOptions& mo = p.options;
-    const nlohmann::json manifest = {
-        {"city_hash", *cityHash}, {"city_bytes", cityBytes},
-        {"frames", idx.size()}, {"camera_poses_hash", posesHash(path, idx)},
-        {"size", std::to_string(p.size.width) + "x" + std::to_string(p.size.height)}, {"fov_deg", num(p.fovDeg)},
-        {"mode", a.mode}, {"channels", channelList(p.channels)},
-        {"near", num(mo.nearDistance)}, {"triangle_budget", mo.triangleBudget}, {"pixel_budget", mo.pixelBudget},
-        {"horizon_grid", mo.horizonGrid}, {"cache", mo.cache}, {"cache_error_px", num(mo.cacheErrorPx)},
-        {"frame_ms", num(mo.frameMsTarget)}, {"far_step", mo.farStep}};
+    const nlohmann::json manifest = {{"city_hash", *cityHash},
+                                     {"city_bytes", cityBytes},
+                                     {"frames", idx.size()},
+                                     {"camera_poses_hash", posesHash(path, idx)},
+                                     {"size", std::to_string(p.size.width) + "x" + std::to_string(p.size.height)},
+                                     {"fov_deg", num(p.fovDeg)},
+                                     {"mode", a.mode},
+                                     {"channels", channelList(p.channels)},
+                                     {"near", num(mo.nearDistance)},
+                                     {"triangle_budget", mo.triangleBudget},
+                                     {"pixel_budget", mo.pixelBudget},
+                                     {"horizon_grid", mo.horizonGrid},
+                                     {"cache", mo.cache},
+                                     {"cache_error_px", num(mo.cacheErrorPx)},
+                                     {"frame_ms", num(mo.frameMsTarget)},
+                                     {"far_step", mo.farStep}};
     VISTA_RETURN_IF_ERROR(out.open(manifest, a.restart));
     for (const auto& [bit, dir] : kChannelDirs)
         if (p.channels & bit) VISTA_RETURN_IF_ERROR(out.subdir(dir));
@@ -367,14 +390,14 @@ Progressed finishedFrames(const RenderWorkDir& out, unsigned channels, size_t fr
         if (out.resumed()) {
             r.records[f] = out.frameRecord(f);
             const std::string name = frameName(f);
-            for (const auto& [bit, file] : {std::pair<unsigned, std::string>{kRgb, "rgb/" + name + ".png"}, {kDepth, "depth/" + name + ".npy"},
-                                            {kSemantic, "semantic/" + name + ".png"}, {kInstance, "instance/" + name + ".npy"}})
+            for (const auto& [bit, file] : {std::pair<unsigned, std::string>{kRgb, "rgb/" + name + ".png"},
+                                            {kDepth, "depth/" + name + ".npy"},
+                                            {kSemantic, "semantic/" + name + ".png"},
+                                            {kInstance, "instance/" + name + ".npy"}})
                 if (!r.records[f].is_null() && (channels & bit) && !fs::exists(out.file(file))) r.records[f] = nullptr;
         }
-        if (r.records[f].is_null())
-            r.lastMissing = long(f);
-        else
-            ++r.kept;
+        if (r.records[f].is_null()) r.lastMissing = long(f);
+        else ++r.kept;
     }
     return r;
 }
@@ -411,7 +434,8 @@ Status frameLabels(const std::string& modeName, const Camera& cam, int threads, 
     tm.labelRaster.push_back(ls.frameMs);
     Stopwatch sw;
     const RasterLabels raster{b.raster.ids.data(), b.raster.classes.data(), b.raster.depth.data()};
-    const size_t cast = mergeLabels(*s.ctx.city, s.ctx.rays, cam, raster, sel->nearDistance, modeName == "hybrid", b.gt, threads);
+    const size_t cast =
+        mergeLabels(*s.ctx.city, s.ctx.rays, cam, raster, sel->nearDistance, modeName == "hybrid", b.gt, threads);
     tm.labelRays.push_back(sw.ms());
     tm.farPixels.push_back(double(cast));
     tm.labels.push_back(tm.labelRaster.back() + tm.labelRays.back());
@@ -429,7 +453,8 @@ Status writeFrameFiles(unsigned channels, const std::string& name, const FrameBu
     }
     const LabelImage& gt = b.gt;
     if (channels & kDepth) {
-        VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file("depth/" + name + ".npy"), npyBytes(gt.depth.data(), gt.width, gt.height)));
+        VISTA_RETURN_IF_ERROR(
+            writeFileAtomic(out.file("depth/" + name + ".npy"), npyBytes(gt.depth.data(), gt.width, gt.height)));
         tm.writeDepth.push_back(w.lap());
     }
     if (channels & kSemantic) {
@@ -437,7 +462,8 @@ Status writeFrameFiles(unsigned channels, const std::string& name, const FrameBu
         tm.writeSemantic.push_back(w.lap());
     }
     if (channels & kInstance) {
-        VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file("instance/" + name + ".npy"), npyBytes(gt.ids.data(), gt.width, gt.height)));
+        VISTA_RETURN_IF_ERROR(
+            writeFileAtomic(out.file("instance/" + name + ".npy"), npyBytes(gt.ids.data(), gt.width, gt.height)));
         tm.writeInstance.push_back(w.lap());
     }
     return Status::ok();
@@ -462,14 +488,19 @@ Status renderFrames(const RenderArgs& a, const RenderPlan& p, const Walkthrough&
     for (size_t f = 0; f < idx.size(); ++f) {
         const Camera cam = w.path.camera(idx[f], base);
         const PathSample& ps = w.path.samples[idx[f]];
-        frames.push_back({{"frame", f}, {"name", frameName(f)}, {"path_index", idx[f]}, {"t_s", ps.t},
+        frames.push_back({{"frame", f},
+                          {"name", frameName(f)},
+                          {"path_index", idx[f]},
+                          {"t_s", ps.t},
                           {"eye_world", {ps.position.x, ps.position.y, ps.position.z}},
-                          {"heading_deg", radToDeg(ps.heading)}, {"pitch_deg", radToDeg(ps.pitch)},
+                          {"heading_deg", radToDeg(ps.heading)},
+                          {"pitch_deg", radToDeg(ps.pitch)},
                           {"camera_from_world", cameraFromWorld(cam, offset)}});
         const bool finished = !done.records[f].is_null();
         if (finished && !(stateful && long(f) < done.lastMissing)) continue;
         FrameStats st;
-        if (Status e = s.mode->renderFrame(cam, b.img, st); !e) return Status::error("frame " + std::to_string(f) + ": " + e.message());
+        if (Status e = s.mode->renderFrame(cam, b.img, st); !e)
+            return Status::error("frame " + std::to_string(f) + ": " + e.message());
         if (finished) {  // hybrid warm-up: the state, not the image
             if (progress) progress->update(double(f + 1) / double(idx.size()));
             continue;
@@ -500,15 +531,25 @@ Status writeMetadata(const RenderArgs& a, const RenderPlan& p, const std::string
          "OpenCV pinhole: camera x right, y down, z forward (optical axis); camera_from_world maps world points minus "
          "world_offset (metres, x east, y north, z up) to camera coordinates; pixel (u, v) has its centre at integer "
          "coordinates (u = column, v = row from the top), so cx = (width - 1) / 2"},
-        {"width", base.width}, {"height", base.height},
-        {"fx", fy}, {"fy", fy}, {"cx", 0.5 * (base.width - 1)}, {"cy", 0.5 * (base.height - 1)},
-        {"fov_y_deg", p.fovDeg}, {"z_near_m", base.zNear},
+        {"width", base.width},
+        {"height", base.height},
+        {"fx", fy},
+        {"fy", fy},
+        {"cx", 0.5 * (base.width - 1)},
+        {"cy", 0.5 * (base.height - 1)},
+        {"fov_y_deg", p.fovDeg},
+        {"z_near_m", base.zNear},
         {"world_offset", {offset.x, offset.y, offset.z}},
         {"depth", "float32 metres along the optical axis (camera z), +inf = sky"},
         {"frames", frames}};
     const nlohmann::json summary = {
-        {"command", command}, {"mode", a.mode}, {"frames", idx.size()}, {"width", base.width}, {"height", base.height},
-        {"channels", a.channels}, {"gl_renderer", renderer.glRenderer()},
+        {"command", command},
+        {"mode", a.mode},
+        {"frames", idx.size()},
+        {"width", base.width},
+        {"height", base.height},
+        {"channels", a.channels},
+        {"gl_renderer", renderer.glRenderer()},
         {"median_ms",
          {{"rgb", medianOf(tm.rgb)},
           {"labels_raster_pass", medianOf(tm.labelRaster)},
@@ -520,11 +561,12 @@ Status writeMetadata(const RenderArgs& a, const RenderPlan& p, const std::string
           {"write_instance", medianOf(tm.writeInstance)}}},
         {"median_far_label_pixels", medianOf(tm.farPixels)},
         {"frames_resumed", kept},
-        {"note", "depth, semantic and instance come from one label pass (+ far-field rays in hybrid): their cost is "
-                 "labels_total, shared; write_* is encoding and writing the files; medians over every frame, each timed "
-                 "by the run that rendered it (frames_resumed: frames an interrupted run had finished)"}};
-    for (const auto& [file, j] : {std::pair<const char*, const nlohmann::json*>{"cameras.json", &cameras},
-                                  {"summary.json", &summary}}) {
+        {"note",
+         "depth, semantic and instance come from one label pass (+ far-field rays in hybrid): their cost is "
+         "labels_total, shared; write_* is encoding and writing the files; medians over every frame, each timed "
+         "by the run that rendered it (frames_resumed: frames an interrupted run had finished)"}};
+    for (const auto& [file, j] :
+         {std::pair<const char*, const nlohmann::json*>{"cameras.json", &cameras}, {"summary.json", &summary}}) {
         VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(file), j->dump(2) + "\n"));
     }
     VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file("classes.json"), classesJson().dump(2) + "\n"));
@@ -533,7 +575,8 @@ Status writeMetadata(const RenderArgs& a, const RenderPlan& p, const std::string
 
 void printResult(const RenderArgs& a, const RenderPlan& p, size_t frames, const Timings& tm, const RenderWorkDir& out) {
     if (!a.stats && a.quiet) return;
-    std::printf("%s: %zu frames, %s, %dx%d -> %s\n", kCmd, frames, a.mode.c_str(), p.size.width, p.size.height, out.outPath().c_str());
+    std::printf("%s: %zu frames, %s, %dx%d -> %s\n", kCmd, frames, a.mode.c_str(), p.size.width, p.size.height,
+                out.outPath().c_str());
     if (!a.stats) return;
     auto line = [](const char* what, const std::vector<double>& v) {
         if (!v.empty()) std::printf("  %-22s %8.2f ms (median)\n", what, median(v));
@@ -581,22 +624,29 @@ int run(const RenderArgs& a, const std::string& command) {
 }  // namespace
 
 int runRender(int argc, char** argv) {
-    CLI::App app{"Ground truth per frame of a walkthrough: rgb, metric depth, semantic classes, instance ids, "
-                 "cameras.json and classes.json (docs/formats.md).",
-                 kCmd};
+    CLI::App app{
+        "Ground truth per frame of a walkthrough: rgb, metric depth, semantic classes, instance ids, "
+        "cameras.json and classes.json (docs/formats.md).",
+        kCmd};
     RenderArgs a;
     app.add_option("city", a.city, "city scene file (.osgb) from `vista gen`")->required();
     addPathFlags(app, a.path, true);
     app.add_option("--frames", a.frames, "frames rendered, 1 .. 1000000 (default 60)");
-    app.add_option("--sampling", a.sampling, "which path samples are the frames: spread (default), consecutive or runs:K");
+    app.add_option("--sampling", a.sampling,
+                   "which path samples are the frames: spread (default), consecutive or runs:K");
     app.add_option("--size", a.size, "image size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 640x480)");
     app.add_option("--fov", a.fov, "vertical field of view in degrees, (1, 179) (default 60)");
-    app.add_option("--mode", a.mode, "render mode: full (every triangle rasterised) or hybrid (near field + ray-cast far field) (default full)");
+    app.add_option(
+        "--mode", a.mode,
+        "render mode: full (every triangle rasterised) or hybrid (near field + ray-cast far field) (default full)");
     app.add_option("--channels", a.channels, "comma-separated channels: rgb, depth, semantic, instance (default all)");
     addModeFlags(app, a.modeFlags);
-    app.add_option("--out", a.out, "output directory (must not exist or be empty; its parent must exist); work goes into "
-                                    "OUT.partial and a rerun of the same command resumes it")->required();
-    app.add_flag("--restart", a.restart, "discard the work directory (OUT.partial) of an interrupted run and start over");
+    app.add_option("--out", a.out,
+                   "output directory (must not exist or be empty; its parent must exist); work goes into "
+                   "OUT.partial and a rerun of the same command resumes it")
+        ->required();
+    app.add_flag("--restart", a.restart,
+                 "discard the work directory (OUT.partial) of an interrupted run and start over");
     app.add_flag("--stats", a.stats, "print the median per-channel costs (also in OUT/summary.json)");
     app.add_flag("-q,--quiet", a.quiet, "no progress on stderr");
     if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;

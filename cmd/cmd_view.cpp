@@ -65,21 +65,27 @@ struct ViewArgs {
 
 void declareFlags(CLI::App& app, ViewArgs& a) {
     a.path.seed = 0;  // no playback unless asked
-    app.add_option("city", a.city, "city scene file (.osgb), a paged city directory (DIR.paged: the regions within --paged-radius of the path), "
-                   "or a baked file from 'vista bake' (adds the impostor mode; lodmesh for --representation mesh)")->required();
+    app.add_option("city", a.city,
+                   "city scene file (.osgb), a paged city directory (DIR.paged: the regions within --paged-radius of "
+                   "the path), "
+                   "or a baked file from 'vista bake' (adds the impostor mode; lodmesh for --representation mesh)")
+        ->required();
     addPathFlags(app, a.path, true);
     addPagedFlags(app, a.paged);
-    app.get_option("--seed")->description("play back the path of this seed (key 5); default 0 = none, start where seed 1's path starts");
+    app.get_option("--seed")->description(
+        "play back the path of this seed (key 5); default 0 = none, start where seed 1's path starts");
     app.add_option("--size", a.size, "window size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 1280x720)");
     app.add_option("--fov", a.fov, "vertical field of view in degrees, (1, 179) (default 60)");
     app.add_option("--mode", a.mode, "start in this render mode: " + renderModeNames() + " (default full)");
     addModeFlags(app, a.modeFlags);
     app.add_option("--frames", a.frames, "quit after N frames (0 = run until Esc)");
-    app.add_flag("--step", a.step,
-                 "with --frames N and a path: show the N frames `vista bench --frames N` renders (one path sample per frame)");
+    app.add_flag(
+        "--step", a.step,
+        "with --frames N and a path: show the N frames `vista bench --frames N` renders (one path sample per frame)");
     app.add_option("--sampling", a.sampling,
                    "with --step: the path samples shown, as vista bench's --sampling: spread, consecutive or runs:K "
-                   "(default " + samplingName(kDefaultSampleRuns) + ")");
+                   "(default " +
+                       samplingName(kDefaultSampleRuns) + ")");
     app.add_flag("--no-hud", a.noHud, "no text overlay (for screenshots compared with `vista bench`)");
     app.add_option("--screenshot", a.screenshot, "write a PNG of the last frame (use with --frames)");
     app.add_option("--memory-budget", a.memoryBudget,
@@ -98,7 +104,8 @@ Status configure(ViewArgs& a, ModeOptions& options) {
     if (!fov) return fov.status();
     a.fovDeg = fov.value();
     if (auto m = parseModeName(a.mode); !m) return m.status();
-    if (a.frames < 0) return Status::error("--frames " + std::to_string(a.frames) + " out of range 0 .. (0 = until Esc)");
+    if (a.frames < 0)
+        return Status::error("--frames " + std::to_string(a.frames) + " out of range 0 .. (0 = until Esc)");
     auto sampling = parseSampling(a.sampling);
     if (!sampling) return sampling.status();
     a.sampleRuns = sampling.value();
@@ -134,7 +141,8 @@ public:
         for (size_t k = 1; k <= all.size(); ++k) {
             const std::string name = all[(i + k) % all.size()].name;
             if (auto m = get(name)) return name;
-            else std::fprintf(stderr, "%s: mode %s unavailable: %s\n", kCmd, name.c_str(), m.status().message().c_str());
+            else
+                std::fprintf(stderr, "%s: mode %s unavailable: %s\n", kCmd, name.c_str(), m.status().message().c_str());
         }
         return current;
     }
@@ -214,10 +222,11 @@ std::string hudText(const std::string& mode, double lastMs, const FrameStats& fs
     const PixelCounts& p = fs.pixels;
     if (p.total() > 0) {
         const double n = double(p.total());
-        std::snprintf(buf, sizeof(buf),
-                      "\npixels %%: covered %.1f horizon %.1f cache %.1f\n          ray hit %.1f ray miss %.1f interpolated %.1f",
-                      100.0 * double(p.covered) / n, 100.0 * double(p.horizonCulled) / n, 100.0 * double(p.cache) / n,
-                      100.0 * double(p.rayHit) / n, 100.0 * double(p.rayMiss) / n, 100.0 * double(p.interpolated) / n);
+        std::snprintf(
+            buf, sizeof(buf),
+            "\npixels %%: covered %.1f horizon %.1f cache %.1f\n          ray hit %.1f ray miss %.1f interpolated %.1f",
+            100.0 * double(p.covered) / n, 100.0 * double(p.horizonCulled) / n, 100.0 * double(p.cache) / n,
+            100.0 * double(p.rayHit) / n, 100.0 * double(p.rayMiss) / n, 100.0 * double(p.interpolated) / n);
         text += buf;
     }
     for (const auto& note : fs.notes) text += "\n" + note;
@@ -248,10 +257,12 @@ struct Keys : public osgGA::GUIEventHandler {
         else if (ea.getKey() == 'p') capture->pending = "vista_screenshot_" + std::to_string(shots++) + ".png";
         else if (ea.getKey() == 'y' && effects) {
             effects->haze = !effects->haze;
-            if (effects->haze && !(effects->visibility < 1e29)) effects->visibility = declared.haze ? declared.visibility : 1500.0;
+            if (effects->haze && !(effects->visibility < 1e29))
+                effects->visibility = declared.haze ? declared.visibility : 1500.0;
         } else if (ea.getKey() == 'g' && effects) {
             effects->glass = !effects->glass && effects->glassMarked;
-            if (effects->glass && effects->rayBudget <= 0) effects->rayBudget = declared.rayBudget > 0 ? declared.rayBudget : 50000;
+            if (effects->glass && effects->rayBudget <= 0)
+                effects->rayBudget = declared.rayBudget > 0 ? declared.rayBudget : 50000;
         } else if (ea.getKey() == 'n' && effects) {
             effects->night = !effects->night;
         } else {
@@ -269,7 +280,8 @@ struct Keys : public osgGA::GUIEventHandler {
 };
 
 // Drive / walk / fly from `start` looking along `dir`, orbit, and path playback.
-osg::ref_ptr<osgGA::KeySwitchMatrixManipulator> makeManipulators(const Path& path, bool playback, const SceneModel& city) {
+osg::ref_ptr<osgGA::KeySwitchMatrixManipulator> makeManipulators(const Path& path, bool playback,
+                                                                 const SceneModel& city) {
     osg::ref_ptr<osgGA::KeySwitchMatrixManipulator> ks = new osgGA::KeySwitchMatrixManipulator;
     osg::Vec3d start(city.params.origin_x, city.params.origin_y, 1.7), dir(0, 1, 0);
     if (!path.samples.empty()) {
@@ -344,7 +356,7 @@ Status setUpWindow(ViewState& v, const ViewArgs& a, osg::ref_ptr<osgGA::KeySwitc
     v.viewer.setUpViewInWindow(0, 0, a.window.width, a.window.height);
     v.viewer.setSceneData(root.get());
     osg::Camera* cam = v.viewer.getCamera();
-    setExactCulling(*cam);  // the bench renderer's culling: same pictures
+    setExactCulling(*cam);             // the bench renderer's culling: same pictures
     flushDeletedGLObjectsEvery(*cam);  // as the bench renderer: no walk over every GL buffer set each frame
     cam->setClearColor(osg::Vec4(0, 0, 0, 1));
     v.keys = new Keys;
@@ -357,7 +369,8 @@ Status setUpWindow(ViewState& v, const ViewArgs& a, osg::ref_ptr<osgGA::KeySwitc
     v.viewer.addEventHandler(new osgGA::StateSetManipulator(cam->getOrCreateStateSet()));
     v.viewer.addEventHandler(v.keys.get());
     v.viewer.realize();
-    if (!v.viewer.isRealized()) return Status::error("cannot open a window on display '" + std::string(std::getenv("DISPLAY")) + "'");
+    if (!v.viewer.isRealized())
+        return Status::error("cannot open a window on display '" + std::string(std::getenv("DISPLAY")) + "'");
     return Status::ok();
 }
 
@@ -396,7 +409,8 @@ int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path,
         } else {
             Camera fromOsg;
             double zf = 0;
-            if (cameraFromOsg(cam->getViewMatrix(), toOsg(c.projection(0.0)), c.width, c.height, fromOsg, zf)) {  // the pose
+            if (cameraFromOsg(cam->getViewMatrix(), toOsg(c.projection(0.0)), c.width, c.height, fromOsg,
+                              zf)) {  // the pose
                 c.eye = fromOsg.eye;
                 c.heading = fromOsg.heading;
                 c.pitch = fromOsg.pitch;
@@ -424,9 +438,10 @@ int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path,
 // The command's entry: parse, check the memory budget, load the walkthrough,
 // then open the window and run the frame loop.
 int runView(int argc, char** argv) {
-    CLI::App app{"Interactive viewer: drive (1), walk (2), fly (3), orbit (4), path playback (5); s = stats, "
-                 "m = render mode, p = screenshot, h = help.",
-                 kCmd};
+    CLI::App app{
+        "Interactive viewer: drive (1), walk (2), fly (3), orbit (4), path playback (5); s = stats, "
+        "m = render mode, p = screenshot, h = help.",
+        kCmd};
     ViewArgs a;
     declareFlags(app, a);
     if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;
@@ -438,7 +453,8 @@ int runView(int argc, char** argv) {
         std::error_code ec;
         const uint64_t bytes = std::filesystem::file_size(a.city, ec);
         if (!ec)
-            if (Status s = checkMemoryBudget("--memory-budget", *budget, estimateCityRunMb(bytes, true), bytes, true); !s)
+            if (Status s = checkMemoryBudget("--memory-budget", *budget, estimateCityRunMb(bytes, true), bytes, true);
+                !s)
                 return reportBadInput(kCmd, s);
     }
     bool playback = false;

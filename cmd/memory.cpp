@@ -45,14 +45,16 @@ double estimateCityRunMb(uint64_t fileBytes, bool rayScene) {
     return kFixedMb + kSceneBytesPerFileByte * f + (rayScene ? kRaysBytesPerFileByte * f : 0.0);
 }
 
-Status checkMemoryBudget(const std::string& option, double budgetGb, double estimateMb, uint64_t fileBytes, bool rayScene) {
+Status checkMemoryBudget(const std::string& option, double budgetGb, double estimateMb, uint64_t fileBytes,
+                         bool rayScene) {
     if (budgetGb <= 0 || estimateMb <= budgetGb * 1024.0) return Status::ok();
     char buf[512];
-    std::snprintf(buf, sizeof(buf),
-                  "option %s = %g GB: this run is estimated to peak at %.1f GB (%.0f MB city file x %.1f for the scene%s, "
-                  "+ %.0f MB fixed; docs/performance.md \"Memory\"); give a larger budget or a smaller city",
-                  option.c_str(), budgetGb, estimateMb / 1024.0, double(fileBytes) / kMb, kSceneBytesPerFileByte,
-                  rayScene ? " + 1.7 for the ray scene" : "", kFixedMb);
+    std::snprintf(
+        buf, sizeof(buf),
+        "option %s = %g GB: this run is estimated to peak at %.1f GB (%.0f MB city file x %.1f for the scene%s, "
+        "+ %.0f MB fixed; docs/performance.md \"Memory\"); give a larger budget or a smaller city",
+        option.c_str(), budgetGb, estimateMb / 1024.0, double(fileBytes) / kMb, kSceneBytesPerFileByte,
+        rayScene ? " + 1.7 for the ray scene" : "", kFixedMb);
     return Status::error(buf);
 }
 
@@ -66,14 +68,17 @@ double estimatePagedGenMb(double regionSizeM, int detail) {
     return kPagedGenFixedMb + kPagedGenMbPerKm2 * km2 * kDetail[std::clamp(detail, 0, 3)];
 }
 
-Status checkGenBudget(const std::string& option, double budgetGb, double estimateMb, const std::string& how, bool paged) {
+Status checkGenBudget(const std::string& option, double budgetGb, double estimateMb, const std::string& how,
+                      bool paged) {
     if (budgetGb <= 0 || estimateMb <= budgetGb * 1024.0) return Status::ok();
     char buf[640];
-    std::snprintf(buf, sizeof(buf),
-                  "option %s = %g GB: this generation is estimated to peak at %.2f GB (%s; docs/performance.md \"Memory\"); "
-                  "nothing was written. Give a larger budget%s",
-                  option.c_str(), budgetGb, estimateMb / 1024.0, how.c_str(),
-                  paged ? " or a smaller --region-size" : ", a smaller city, or paged output (-o DIR.paged, whose peak follows --region-size)");
+    std::snprintf(
+        buf, sizeof(buf),
+        "option %s = %g GB: this generation is estimated to peak at %.2f GB (%s; docs/performance.md \"Memory\"); "
+        "nothing was written. Give a larger budget%s",
+        option.c_str(), budgetGb, estimateMb / 1024.0, how.c_str(),
+        paged ? " or a smaller --region-size"
+              : ", a smaller city, or paged output (-o DIR.paged, whose peak follows --region-size)");
     return Status::error(buf);
 }
 

@@ -30,7 +30,8 @@ Result<double> parseMemoryBudgetGb(const std::string& option, const std::string&
 double estimateCityRunMb(uint64_t fileBytes, bool rayScene);
 // Ok when there is no budget or the estimate fits it; otherwise an error that
 // gives the estimate, what it is made of and the budget.
-Status checkMemoryBudget(const std::string& option, double budgetGb, double estimateMb, uint64_t fileBytes, bool rayScene);
+Status checkMemoryBudget(const std::string& option, double budgetGb, double estimateMb, uint64_t fileBytes,
+                         bool rayScene);
 
 // `vista gen` to one file: peak about kGenBytesPerStoredTriangle per stored
 // triangle (measured 152 to 177 on the 0.5 to 8 km cities of
@@ -46,6 +47,7 @@ constexpr double kPagedGenFixedMb = 150.0, kPagedGenMbPerKm2 = 70.0;
 double estimatePagedGenMb(double regionSizeM, int detail);
 // The gen budget check: Ok without a budget or when the estimate fits; else
 // an error naming the option, the budget, the estimate and what it is made of (`how`).
-Status checkGenBudget(const std::string& option, double budgetGb, double estimateMb, const std::string& how, bool paged);
+Status checkGenBudget(const std::string& option, double budgetGb, double estimateMb, const std::string& how,
+                      bool paged);
 
 }  // namespace vista

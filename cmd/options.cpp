@@ -33,7 +33,8 @@ bool toNumber(const std::string& s, double& v) {
 bool splitPair(const std::string& s, const char* seps, long& a, long& b) {
     const size_t k = s.find_first_of(seps);
     auto digits = [](const std::string& t) {
-        return !t.empty() && t.size() <= 9 && std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
+        return !t.empty() && t.size() <= 9 &&
+               std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
     };
     if (k == std::string::npos || !digits(s.substr(0, k)) || !digits(s.substr(k + 1))) return false;
     a = std::stol(s.substr(0, k));
@@ -51,7 +52,8 @@ std::string num(double v) {
 
 Status checkImageSize(int w, int h) {
     if (w < 1 || h < 1 || w > kMaxImageSide || h > kMaxImageSide)
-        return Status::error("--size " + std::to_string(w) + "x" + std::to_string(h) + " out of range 1x1 .. 8192x8192 pixels");
+        return Status::error("--size " + std::to_string(w) + "x" + std::to_string(h) +
+                             " out of range 1x1 .. 8192x8192 pixels");
     return Status::ok();
 }
 
@@ -97,15 +99,16 @@ Result<std::vector<uint32_t>> parseCellList(const std::string& s) {
             ok = ok && *end == 0;
         }
         if (!ok || a < 0 || b < a || b > 100000000)
-            return Status::error("--cells '" + s + "': bad item '" + item + "' (expected ids or ranges like 3,7,10-20)");
+            return Status::error("--cells '" + s + "': bad item '" + item +
+                                 "' (expected ids or ranges like 3,7,10-20)");
         for (long v = a; v <= b; ++v) out.push_back(uint32_t(v));
     }
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
-    if (out.empty()) return Status::error("--cells '" + s + "': no cell id given (expected ids or ranges like 3,7,10-20)");
+    if (out.empty())
+        return Status::error("--cells '" + s + "': no cell id given (expected ids or ranges like 3,7,10-20)");
     return out;
 }
-
 
 Status checkNearDistance(double v) {
     if (v < 0 || (v >= kMinNearDistance && v <= kMaxNearDistance)) return Status::ok();
@@ -115,7 +118,8 @@ Status checkNearDistance(double v) {
 Result<double> parseNearDistance(const std::string& s) {
     if (s == "auto") return -1.0;
     double v = 0;
-    if (!toNumber(s, v)) return Status::error("--near '" + s + "': expected a distance in metres (1 .. 100000) or 'auto'");
+    if (!toNumber(s, v))
+        return Status::error("--near '" + s + "': expected a distance in metres (1 .. 100000) or 'auto'");
     if (v < kMinNearDistance || v > kMaxNearDistance)
         return Status::error("--near " + s + " out of range 1 .. 100000 metres (or 'auto')");
     return v;
@@ -132,7 +136,8 @@ Result<int64_t> parsePixelBudget(const std::string& s) {
     if (s == "unlimited" || s == "-1") return int64_t(-1);
     long long v = 0;
     if (!toInteger(s, v))
-        return Status::error("--budget '" + s + "': expected an integer 0 .. " + std::to_string(kMaxPixelBudget) + range);
+        return Status::error("--budget '" + s + "': expected an integer 0 .. " + std::to_string(kMaxPixelBudget) +
+                             range);
     if (v < 0 || v > kMaxPixelBudget)
         return Status::error("--budget " + s + " out of range 0 .. " + std::to_string(kMaxPixelBudget) + range);
     return int64_t(v);
@@ -176,7 +181,8 @@ Result<double> parseSplatSigma(const std::string& s) {
     if (s == "off" || s == "0") return 0.0;
     double v = 0;
     if (!toNumber(s, v) || !checkSplatSigma(v) || v == 0)
-        return Status::error("--point-splat '" + s + "': expected a Gaussian sigma in output pixels, 0.05 .. 4, or 'off' (1-pixel points)");
+        return Status::error("--point-splat '" + s +
+                             "': expected a Gaussian sigma in output pixels, 0.05 .. 4, or 'off' (1-pixel points)");
     return v;
 }
 
@@ -195,7 +201,8 @@ Result<int> parseReference(const std::string& s) {
 }
 
 Result<std::string> parseModeName(const std::string& s) {
-    if (!findRenderMode(s)) return Status::error("--mode '" + s + "': unknown mode; available modes: " + renderModeNames());
+    if (!findRenderMode(s))
+        return Status::error("--mode '" + s + "': unknown mode; available modes: " + renderModeNames());
     return s;
 }
 
@@ -213,7 +220,8 @@ Result<std::vector<std::string>> parseModeList(const std::string& list) {
             return Status::error("--modes: mode '" + item + "' listed twice");
         out.push_back(item);
     }
-    if (out.empty()) return Status::error("--modes '" + list + "': no mode given; available modes: " + renderModeNames());
+    if (out.empty())
+        return Status::error("--modes '" + list + "': no mode given; available modes: " + renderModeNames());
     return out;
 }
 
@@ -255,39 +263,51 @@ Result<std::vector<int>> parseSweep(const std::string& s) {
 
 void addModeFlags(CLI::App& app, ModeFlags& f) {
     app.add_option("--near", f.near,
-                   "near-field distance in metres, 1 .. 100000, or 'auto' (hybrid: adaptive split per frame among 0 = ray casting, 15 .. 800 m and everything; the other "
-                   "modes then use 100) (default " + f.near + ")");
+                   "near-field distance in metres, 1 .. 100000, or 'auto' (hybrid: adaptive split per frame among 0 = "
+                   "ray casting, 15 .. 800 m and everything; the other "
+                   "modes then use 100) (default " +
+                       f.near + ")");
     app.add_option("--triangle-budget", f.triangleBudget,
                    "hybrid: near field = the nearest 40 m chunks up to N triangles instead of --near, 0 .. 10000000000 "
-                   "(default " + f.triangleBudget + " = off)");
-    app.add_option("--budget", f.budget,
-                   "hybrid: most far-field rays per frame (the cache re-traces its worst pixels first), 0 .. 1000000000, "
-                   "or 'unlimited' / -1 = no cap: every pixel over --cache-error is re-traced (default " + f.budget + ")");
-    app.add_option("--horizon-grid", f.horizonGrid,
-                   "hybrid: horizon height-grid resolution, cells per side, 1 .. 8192, or 0 = auto: cells of about 4 m, "
-                   "512 .. 2048 a side (default 0)");
+                   "(default " +
+                       f.triangleBudget + " = off)");
+    app.add_option(
+        "--budget", f.budget,
+        "hybrid: most far-field rays per frame (the cache re-traces its worst pixels first), 0 .. 1000000000, "
+        "or 'unlimited' / -1 = no cap: every pixel over --cache-error is re-traced (default " +
+            f.budget + ")");
+    app.add_option(
+        "--horizon-grid", f.horizonGrid,
+        "hybrid: horizon height-grid resolution, cells per side, 1 .. 8192, or 0 = auto: cells of about 4 m, "
+        "512 .. 2048 a side (default 0)");
     app.add_flag("--no-cache", f.noCache, "hybrid: panoramic image cache off (every far pixel traced)");
     app.add_flag("--cache-always", f.cacheAlways,
                  "hybrid: look up the cache in every frame, also while its measured reuse does not pay for its lookups "
                  "(by default it then pauses for 8 moving frames and measures again)");
     app.add_flag("--no-overlap", f.noOverlap,
-                 "hybrid: trace the horizon and last frame's far pixels after the near field is drawn instead of on other threads "
+                 "hybrid: trace the horizon and last frame's far pixels after the near field is drawn instead of on "
+                 "other threads "
                  "during the draw");
     app.add_option("--cache-error", f.cacheError,
                    "hybrid: reuse a cached far pixel while its estimated reprojection error is below this many pixels, "
                    "0 .. 100 (0 = only pixels traced by this very camera) (default 0.25)");
-    app.add_option("--frame-ms", f.frameMs,
-                   "hybrid: frame-time target in ms, 0 .. 10000: the far-field ray budget adapts to what the target leaves "
-                   "after the near field (0 = no target) (default 0)");
-    app.add_option("--far-step", f.farStep,
-                   "hybrid: far-field ray spacing, 1 or 2: 2 = rays on every other pixel and row first, pixels between "
-                   "lattice pixels that showed one triangle (or sky) blended from them (lossy: PSNR in the bench) (default 1)");
+    app.add_option(
+        "--frame-ms", f.frameMs,
+        "hybrid: frame-time target in ms, 0 .. 10000: the far-field ray budget adapts to what the target leaves "
+        "after the near field (0 = no target) (default 0)");
+    app.add_option(
+        "--far-step", f.farStep,
+        "hybrid: far-field ray spacing, 1 or 2: 2 = rays on every other pixel and row first, pixels between "
+        "lattice pixels that showed one triangle (or sky) blended from them (lossy: PSNR in the bench) (default 1)");
     app.add_option("--baked", f.baked, "impostor: the baked file of this city (from `vista bake`)");
-    app.add_option("--baked-mesh", f.bakedMesh,
-                   "lodmesh: the mesh bake of this city (from `vista bake --representation mesh`), unless the city file is one");
-    app.add_option("--point-splat", f.pointSplat,
-                   "impostor: points drawn as Gaussian splats of SIGMA output pixels with normalised accumulation, 0.05 .. 4, "
-                   "or off = 1-pixel points (default " + formatSplatSigma(ModeOptions().splatSigma) + ")");
+    app.add_option(
+        "--baked-mesh", f.bakedMesh,
+        "lodmesh: the mesh bake of this city (from `vista bake --representation mesh`), unless the city file is one");
+    app.add_option(
+        "--point-splat", f.pointSplat,
+        "impostor: points drawn as Gaussian splats of SIGMA output pixels with normalised accumulation, 0.05 .. 4, "
+        "or off = 1-pixel points (default " +
+            formatSplatSigma(ModeOptions().splatSigma) + ")");
     app.add_option("--threads", f.threads, "worker threads for ray casting, 0 .. 1024 (0 = all cores)");
 }
 
@@ -298,11 +318,13 @@ Status checkModeOptions(const ModeOptions& o) {
         return Status::error("--triangle-budget " + std::to_string(o.triangleBudget) + " out of range 0 .. " +
                              std::to_string(kMaxTriangleBudget) + " triangles");
     if (o.horizonGrid < 0 || o.horizonGrid > 8192)
-        return Status::error("--horizon-grid " + std::to_string(o.horizonGrid) + " out of range 1 .. 8192 cells per side, or 0 = auto");
+        return Status::error("--horizon-grid " + std::to_string(o.horizonGrid) +
+                             " out of range 1 .. 8192 cells per side, or 0 = auto");
     if (!(o.cacheErrorPx >= 0 && o.cacheErrorPx <= 100))
         return Status::error("--cache-error " + std::to_string(o.cacheErrorPx) + " out of range 0 .. 100 pixels");
     if (!(o.frameMsTarget >= 0 && o.frameMsTarget <= 10000))
-        return Status::error("--frame-ms " + std::to_string(o.frameMsTarget) + " out of range 0 .. 10000 ms (0 = no target)");
+        return Status::error("--frame-ms " + std::to_string(o.frameMsTarget) +
+                             " out of range 0 .. 10000 ms (0 = no target)");
     if (o.farStep < 1 || o.farStep > 2)
         return Status::error("--far-step " + std::to_string(o.farStep) + " out of range 1 .. 2 pixels");
     if (o.threads < 0 || o.threads > 1024)
@@ -344,14 +366,16 @@ Status parseModeFlags(const ModeFlags& f, ModeOptions& o) {
 
 void addPathFlags(CLI::App& app, PathFlags& f, bool timing) {
     auto* path = app.add_option("--path", f.file, "walkthrough path CSV (from `vista path`)");
-    app.add_option("--seed", f.seed, "make the path from this seed instead of --path (default " + std::to_string(f.seed) + ")")
+    app.add_option("--seed", f.seed,
+                   "make the path from this seed instead of --path (default " + std::to_string(f.seed) + ")")
         ->excludes(path);
     app.add_option("--kind", f.kind, "path kind when made from --seed: walk, car, fly (default " + f.kind + ")");
     app.add_flag("--lht", f.lht, "car path made from --seed: left-hand traffic (lanes driven mirrored)");
     if (!timing) return;
     app.add_option("--duration", f.duration, "path duration in seconds when made from --seed (default 60)");
-    app.add_option("--run-up", f.runUp,
-                   "seconds driven before the path starts and dropped, so it starts at cruising speed, 0 .. 600 (default 8)");
+    app.add_option(
+        "--run-up", f.runUp,
+        "seconds driven before the path starts and dropped, so it starts at cruising speed, 0 .. 600 (default 8)");
 }
 
 Result<PathOptions> parsePathFlags(const PathFlags& f) {
@@ -408,16 +432,17 @@ Result<FrameEffects> runTimeEffects(const std::string& option, const Effects& de
         for (int i = 0; i < kEffectCount; ++i) {
             const EffectId id = EffectId(i);
             if (id == EffectId::Night || !effectIsBaked(id) || e->has(id) == declared.has(id)) continue;
-            std::fprintf(stderr, "%s: note: %s is baked into the scene's colours at generation; it stays %s (regenerate with "
-                                 "`vista gen --effects` to change it)\n",
+            std::fprintf(stderr,
+                         "%s: note: %s is baked into the scene's colours at generation; it stays %s (regenerate with "
+                         "`vista gen --effects` to change it)\n",
                          cmd, effectName(id), declared.has(id) ? "on" : "off");
         }
         if (e->glass && !declared.glass)
-            std::fprintf(stderr, "%s: note: the scene declares no glass, so no window is marked: no reflections\n", cmd);
+            std::fprintf(stderr, "%s: note: the scene declares no glass, so no window is marked: no reflections\n",
+                         cmd);
     }
     return fx;
 }
-
 
 void addPagedFlags(CLI::App& app, PagedReach& reach) {
     std::ostringstream help;

@@ -8,8 +8,8 @@
 // PathFlags: the walkthrough options (--path, --seed, --kind, --duration,
 // --run-up) of bench and view. ModeFlags: the render-mode options both `vista bench` and `vista view`
 // accept (--near, --triangle-budget, --budget, --horizon-grid, --no-cache,
-// --cache-error, --frame-ms, --no-overlap, --baked, --baked-mesh, --threads), declared once by addModeFlags() and turned into
-// ModeOptions by parseModeFlags().
+// --cache-error, --frame-ms, --no-overlap, --baked, --baked-mesh, --threads), declared once by addModeFlags() and
+// turned into ModeOptions by parseModeFlags().
 #pragma once
 #include <cstdint>
 #include <string>
@@ -68,7 +68,7 @@ Status parseTexels(const std::string& s, int& x, int& y);
 // pixels, 0.05 .. 4, or "off" / "0" -> 0 (1-pixel points).
 constexpr double kMinSplatSigma = 0.05, kMaxSplatSigma = 4.0;
 Result<double> parseSplatSigma(const std::string& s);
-Status checkSplatSigma(double sigma);  // 0 (off) or within the range
+Status checkSplatSigma(double sigma);        // 0 (off) or within the range
 std::string formatSplatSigma(double sigma);  // "off" or the number
 // --storage-budget auto|off|MB: -1 for auto, 0 for off, else MB in 0.01 .. 1e6.
 constexpr double kMinStorageBudgetMb = 0.01, kMaxStorageBudgetMb = 1e6;
@@ -89,7 +89,7 @@ Result<FrameEffects> runTimeEffects(const std::string& option, const Effects& de
 
 struct ModeFlags {
     std::string near = "auto", triangleBudget = "0", budget = "unlimited";
-    int horizonGrid = 0;   // 0 = auto (HeightGrid::autoCells)
+    int horizonGrid = 0;  // 0 = auto (HeightGrid::autoCells)
     bool noCache = false, noOverlap = false, cacheAlways = false;
     double cacheError = 0.25, frameMs = 0.0;
     int farStep = 1;

@@ -69,8 +69,14 @@ void line(Image& img, int x0, int y0, int x1, int y1, glm::u8vec3 c, int thick =
         else fillRect(img, x0 - thick / 2, y0 - thick / 2, x0 + (thick - 1) / 2, y0 + (thick - 1) / 2, c);
         if (x0 == x1 && y0 == y1) break;
         int e2 = 2 * err;
-        if (e2 >= dy) { err += dy; x0 += sx; }
-        if (e2 <= dx) { err += dx; y0 += sy; }
+        if (e2 >= dy) {
+            err += dy;
+            x0 += sx;
+        }
+        if (e2 <= dx) {
+            err += dx;
+            y0 += sy;
+        }
     }
 }
 
@@ -87,7 +93,10 @@ std::vector<double> niceTicks(double lo, double hi, int target = 6) {
     double raw = span / target, mag = std::pow(10.0, std::floor(std::log10(raw)));
     double step = mag;
     for (double m : {1.0, 2.0, 5.0, 10.0})
-        if (m * mag >= raw) { step = m * mag; break; }
+        if (m * mag >= raw) {
+            step = m * mag;
+            break;
+        }
     std::vector<double> t;
     for (double v = std::ceil(lo / step - 1e-9) * step; v <= hi + step * 1e-9 && t.size() < 50; v += step)
         t.push_back(std::abs(v) < step * 1e-9 ? 0.0 : v);
@@ -121,12 +130,24 @@ Axis makeAxis(const std::vector<const std::vector<double>*>& data, bool log, boo
     double lo = 1e300, hi = -1e300;
     for (const auto* v : data)
         for (double x : *v)
-            if (a.ok(x)) { lo = std::min(lo, x); hi = std::max(hi, x); }
-    if (lo > hi) { lo = log ? 1 : 0; hi = log ? 10 : 1; }
+            if (a.ok(x)) {
+                lo = std::min(lo, x);
+                hi = std::max(hi, x);
+            }
+    if (lo > hi) {
+        lo = log ? 1 : 0;
+        hi = log ? 10 : 1;
+    }
     if (!log && fromZero && lo >= 0) lo = 0;
     if (hi - lo <= 0) {
-        if (log) { lo /= 2; hi *= 2; }
-        else { double d = std::max(1.0, std::abs(hi) * 0.1); lo -= d; hi += d; }
+        if (log) {
+            lo /= 2;
+            hi *= 2;
+        } else {
+            double d = std::max(1.0, std::abs(hi) * 0.1);
+            lo -= d;
+            hi += d;
+        }
     }
     if (log) {  // widen to decades' 1-2-5 marks
         lo = std::pow(10.0, std::floor(std::log10(lo) * 4) / 4);
@@ -154,15 +175,17 @@ void drawText(Image& img, int x, int y, const std::string& text, glm::u8vec3 col
         for (int r = 0; r < 7; ++r)
             for (int col = 0; col < 5; ++col) {
                 bool on = g ? (g[r] >> (4 - col)) & 1 : (r == 0 || r == 6 || col == 0 || col == 4);
-                if (on) fillRect(img, ox + col * scale, y + r * scale, ox + col * scale + scale - 1, y + r * scale + scale - 1, color);
+                if (on)
+                    fillRect(img, ox + col * scale, y + r * scale, ox + col * scale + scale - 1,
+                             y + r * scale + scale - 1, color);
             }
     }
 }
 
 glm::u8vec3 plotColor(size_t i) {
-    static const glm::u8vec3 kPalette[] = {{31, 119, 180}, {214, 39, 40},  {44, 160, 44},  {255, 127, 14},
-                                          {148, 103, 189}, {140, 86, 75}, {227, 119, 194}, {127, 127, 127},
-                                          {188, 189, 34},  {23, 190, 207}};
+    static const glm::u8vec3 kPalette[] = {{31, 119, 180},  {214, 39, 40}, {44, 160, 44},   {255, 127, 14},
+                                           {148, 103, 189}, {140, 86, 75}, {227, 119, 194}, {127, 127, 127},
+                                           {188, 189, 34},  {23, 190, 207}};
     return kPalette[i % (sizeof(kPalette) / sizeof(kPalette[0]))];
 }
 
@@ -175,7 +198,10 @@ Image renderPlot(const PlotSpec& spec) {
     const int left = 78, top = 34, bottom = 48, right = 24 + std::min<int>(240, int(maxLabel) * 6 + 30);
     const int px0 = left, px1 = W - right, py0 = top, py1 = H - bottom;
     std::vector<const std::vector<double>*> xs, ys;
-    for (const auto& s : spec.series) { xs.push_back(&s.x); ys.push_back(&s.y); }
+    for (const auto& s : spec.series) {
+        xs.push_back(&s.x);
+        ys.push_back(&s.y);
+    }
     Axis ax = makeAxis(xs, spec.logX, false), ay = makeAxis(ys, spec.logY, spec.yFromZero);
     auto sx = [&](double v) { return px0 + int(std::lround(ax.map(v) * (px1 - px0))); };
     auto sy = [&](double v) { return py1 - int(std::lround(ay.map(v) * (py1 - py0))); };
@@ -208,11 +234,16 @@ Image renderPlot(const PlotSpec& spec) {
         int lx = 0, lyy = 0;
         size_t n = std::min(s.x.size(), s.y.size());
         for (size_t i = 0; i < n; ++i) {
-            if (!ax.ok(s.x[i]) || !ay.ok(s.y[i])) { have = false; continue; }
+            if (!ax.ok(s.x[i]) || !ay.ok(s.y[i])) {
+                have = false;
+                continue;
+            }
             int x = std::clamp(sx(s.x[i]), px0, px1), y = std::clamp(sy(s.y[i]), py0, py1);
             if (s.line && have) line(img, lx, lyy, x, y, s.color, 2);
             if (s.points) fillRect(img, x - 2, y - 2, x + 2, y + 2, s.color);
-            lx = x; lyy = y; have = true;
+            lx = x;
+            lyy = y;
+            have = true;
         }
     }
     return img;

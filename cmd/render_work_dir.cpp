@@ -66,11 +66,13 @@ Status RenderWorkDir::checkOut(const std::string& dir) {
     std::error_code ec;
     if (fs::exists(out, ec)) {
         if (!fs::is_directory(out, ec)) return Status::error("--out '" + dir + "' exists and is not a directory");
-        if (!fs::is_empty(out, ec)) return Status::error("--out '" + dir + "' exists and is not empty (choose a new directory)");
+        if (!fs::is_empty(out, ec))
+            return Status::error("--out '" + dir + "' exists and is not empty (choose a new directory)");
     }
     const fs::path parent = out.has_parent_path() ? out.parent_path() : fs::path(".");
     if (!fs::exists(parent, ec))
-        return Status::error("--out '" + dir + "': parent directory '" + parent.string() + "' does not exist (create it first)");
+        return Status::error("--out '" + dir + "': parent directory '" + parent.string() +
+                             "' does not exist (create it first)");
     if (!fs::is_directory(parent, ec))
         return Status::error("--out '" + dir + "': parent '" + parent.string() + "' is not a directory");
     if (::access(parent.c_str(), W_OK) != 0)
@@ -115,11 +117,13 @@ Status RenderWorkDir::open(const nlohmann::json& manifestIn, bool restart) {
         _resumed = true;
         // Temporaries of writes a kill interrupted (we hold the lock: no live writer).
         for (fs::recursive_directory_iterator it(partial / "out", ec), end; !ec && it != end; it.increment(ec))
-            if (it->is_regular_file(ec) && it->path().filename().string().find(".tmp.") != std::string::npos) fs::remove(it->path(), ec);
+            if (it->is_regular_file(ec) && it->path().filename().string().find(".tmp.") != std::string::npos)
+                fs::remove(it->path(), ec);
     } else {
         for (const auto& e : fs::directory_iterator(partial, ec))
             if (e.path().filename() != "lock")
-                return Status::error(where + " exists without a manifest.json (not a vista render work directory); "
+                return Status::error(where +
+                                     " exists without a manifest.json (not a vista render work directory); "
                                      "remove it or add --restart");
         if (Status s = writeFileAtomic(mf.string(), manifest.dump(2) + "\n"); !s) return s;
     }
@@ -147,7 +151,8 @@ nlohmann::json RenderWorkDir::frameRecord(size_t frame) const {
 }
 
 Status RenderWorkDir::finishFrame(size_t frame, const nlohmann::json& record) {
-    if (Status s = writeFileAtomic((fs::path(_partialStr) / recordName(frame)).string(), record.dump() + "\n"); !s) return s;
+    if (Status s = writeFileAtomic((fs::path(_partialStr) / recordName(frame)).string(), record.dump() + "\n"); !s)
+        return s;
     ++_finished;
     return Status::ok();
 }
@@ -157,7 +162,8 @@ Status RenderWorkDir::commit() {
     const fs::path out(_outStr);
     if (fs::exists(out, ec)) fs::remove(out, ec);  // an empty directory (checkOut)
     fs::rename(fs::path(_partialStr) / "out", out, ec);
-    if (ec) return Status::error("--out '" + _outStr + "': cannot rename the finished output into place: " + ec.message());
+    if (ec)
+        return Status::error("--out '" + _outStr + "': cannot rename the finished output into place: " + ec.message());
     _committed = true;
     fs::remove_all(_partialStr, ec);  // bookkeeping only; the output is complete
     return Status::ok();

@@ -40,7 +40,8 @@ long tempOwner(const std::string& f, const std::string& name) {
             if (rest.empty() || rest.find_first_not_of("0123456789") != std::string::npos) continue;
             digits = digits.substr(0, inner);
         }
-        if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+        if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos)
+            continue;
         return std::stol(digits);
     }
     return 0;
@@ -61,7 +62,8 @@ int removeStaleTemps(const std::string& path) {
         std::vector<std::string> names;
         for (fs::directory_iterator d(dir, ec), end; !ec && d != end; d.increment(ec)) {
             std::string f = d->path().filename().string();
-            if (f.find(".tmp.") != std::string::npos || f.find(".stage.") != std::string::npos) names.push_back(std::move(f));
+            if (f.find(".tmp.") != std::string::npos || f.find(".stage.") != std::string::npos)
+                names.push_back(std::move(f));
         }
         it = gTempNames.emplace(dir.string(), std::move(names)).first;
     }
@@ -95,7 +97,8 @@ std::string OutputBatch::stage(const std::string& path) {
 
 Status OutputBatch::commit() {
     for (const auto& f : _files)
-        if (::access(f.first.c_str(), F_OK) != 0) return Status::error("cannot write '" + f.second + "': its staged file is missing");
+        if (::access(f.first.c_str(), F_OK) != 0)
+            return Status::error("cannot write '" + f.second + "': its staged file is missing");
     for (const auto& f : _files)
         if (::rename(f.first.c_str(), f.second.c_str()) != 0)
             return Status::error("cannot write '" + f.second + "': rename failed: " + errnoText());
@@ -120,7 +123,8 @@ Status writeFileAtomic(const std::string& path, const std::string& bytes) {
             ::unlink(tmp.c_str());
             return Status::error("cannot write '" + path + "': " + e);
         }
-        p += w; n -= size_t(w);
+        p += w;
+        n -= size_t(w);
     }
     if (::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) {
         std::string e = errnoText();
@@ -146,12 +150,14 @@ Status checkWritablePath(const std::string& option, const std::string& path) {
     if (path.empty()) return Status::error("option " + option + ": empty path");
     std::error_code ec;
     fs::path p(path);
-    if (fs::is_directory(p, ec)) return Status::error("option " + option + " = '" + path + "' is a directory, expected a file path");
+    if (fs::is_directory(p, ec))
+        return Status::error("option " + option + " = '" + path + "' is a directory, expected a file path");
     fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
     if (!fs::is_directory(dir, ec))
         return Status::error("option " + option + " = '" + path + "': directory '" + dir.string() + "' does not exist");
     if (access(dir.c_str(), W_OK) != 0)
-        return Status::error("option " + option + " = '" + path + "': directory '" + dir.string() + "' is not writable");
+        return Status::error("option " + option + " = '" + path + "': directory '" + dir.string() +
+                             "' is not writable");
     return Status::ok();
 }
 
@@ -160,12 +166,15 @@ Status checkWritableDirectory(const std::string& option, const std::string& path
     if (path.empty()) return Status::error("option " + option + ": empty path");
     std::error_code ec;
     fs::path dir = fs::path(path).lexically_normal();  // up to the nearest existing ancestor
-    while (!fs::exists(fs::symlink_status(dir, ec)) && dir.has_parent_path() && dir.parent_path() != dir) dir = dir.parent_path();
+    while (!fs::exists(fs::symlink_status(dir, ec)) && dir.has_parent_path() && dir.parent_path() != dir)
+        dir = dir.parent_path();
     if (!fs::exists(fs::symlink_status(dir, ec))) dir = ".";
     if (!fs::is_directory(dir, ec))
-        return Status::error("option " + option + " = '" + path + "': '" + dir.string() + "' exists and is not a directory");
+        return Status::error("option " + option + " = '" + path + "': '" + dir.string() +
+                             "' exists and is not a directory");
     if (access(dir.c_str(), W_OK) != 0)
-        return Status::error("option " + option + " = '" + path + "': directory '" + dir.string() + "' is not writable");
+        return Status::error("option " + option + " = '" + path + "': directory '" + dir.string() +
+                             "' is not writable");
     return Status::ok();
 }
 

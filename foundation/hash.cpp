@@ -28,10 +28,23 @@ Hasher64::Hasher64(uint64_t seed) : _h(seed ^ kK2) {}
 
 void Hasher64::update(const unsigned char* p, size_t n) {
     _size += n;
-    while (n > 0 && _pending > 0 && _pending < 8) { _tail[_pending++] = *p++; --n; }
-    if (_pending == 8) { _h = mixWord(_h, loadLE64(_tail)); _pending = 0; }
-    while (n >= 8) { _h = mixWord(_h, loadLE64(p)); p += 8; n -= 8; }
-    while (n > 0) { _tail[_pending++] = *p++; --n; }
+    while (n > 0 && _pending > 0 && _pending < 8) {
+        _tail[_pending++] = *p++;
+        --n;
+    }
+    if (_pending == 8) {
+        _h = mixWord(_h, loadLE64(_tail));
+        _pending = 0;
+    }
+    while (n >= 8) {
+        _h = mixWord(_h, loadLE64(p));
+        p += 8;
+        n -= 8;
+    }
+    while (n > 0) {
+        _tail[_pending++] = *p++;
+        --n;
+    }
 }
 
 uint64_t Hasher64::finish() const {
@@ -42,7 +55,11 @@ uint64_t Hasher64::finish() const {
         h = mixWord(h, loadLE64(t));
     }
     h ^= _size;
-    h ^= h >> 33; h *= 0xFF51AFD7ED558CCDull; h ^= h >> 33; h *= 0xC4CEB9FE1A85EC53ull; h ^= h >> 33;
+    h ^= h >> 33;
+    h *= 0xFF51AFD7ED558CCDull;
+    h ^= h >> 33;
+    h *= 0xC4CEB9FE1A85EC53ull;
+    h ^= h >> 33;
     return h;
 }
 

@@ -19,7 +19,8 @@ void StderrProgress::update(double f) {
     _last = now;
     double el = std::chrono::duration<double>(now - _start).count();
     double eta = f > 0.01 ? el * (1 - f) / f : 0;
-    std::fprintf(stderr, _tty ? "  %-12s %5.1f%%  eta %.0fs   \r" : "  %-12s %5.1f%%  eta %.0fs\n", _stage.c_str(), 100 * f, eta);
+    std::fprintf(stderr, _tty ? "  %-12s %5.1f%%  eta %.0fs   \r" : "  %-12s %5.1f%%  eta %.0fs\n", _stage.c_str(),
+                 100 * f, eta);
     std::fflush(stderr);
 }
 

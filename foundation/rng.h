@@ -15,7 +15,15 @@ namespace vista {
 
 // Well-known stream ids, so different subsystems never share a stream.
 enum class Stream : uint64_t {
-    Streets = 1, Blocks = 2, Lots = 3, Buildings = 4, Trees = 5, Terrain = 6, Facades = 7, Paths = 8, Bake = 9,
+    Streets = 1,
+    Blocks = 2,
+    Lots = 3,
+    Buildings = 4,
+    Trees = 5,
+    Terrain = 6,
+    Facades = 7,
+    Paths = 8,
+    Bake = 9,
 };
 
 class Rng {
@@ -24,7 +32,9 @@ public:
     Rng(uint64_t seed, uint64_t entity, uint64_t stream) : _state(hashKeys(seed, entity, stream) | 1ull) {}
 
     uint64_t next() {  // xorshift64* on a splitmix-seeded state
-        _state ^= _state >> 12; _state ^= _state << 25; _state ^= _state >> 27;
+        _state ^= _state >> 12;
+        _state ^= _state << 25;
+        _state ^= _state >> 27;
         return _state * 0x2545F4914F6CDD1Dull;
     }
     // Uniform in [0, 1).

@@ -5,8 +5,8 @@ namespace vista {
 
 Result<Shard> parseShard(const std::string& option, const std::string& text) {
     auto bad = [&](const std::string& why) {
-        return Status::error("option " + option + " = '" + text + "': " + why + " (expected K/N with 1 <= K <= N <= " +
-                             std::to_string(kMaxShards) + ")");
+        return Status::error("option " + option + " = '" + text + "': " + why +
+                             " (expected K/N with 1 <= K <= N <= " + std::to_string(kMaxShards) + ")");
     };
     const size_t slash = text.find('/');
     if (slash == std::string::npos) return bad("no '/'");

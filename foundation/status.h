@@ -18,7 +18,12 @@ class Status {
 public:
     Status() = default;
     static Status ok() { return Status(); }
-    static Status error(std::string message) { Status s; s._failed = true; s._message = std::move(message); return s; }
+    static Status error(std::string message) {
+        Status s;
+        s._failed = true;
+        s._message = std::move(message);
+        return s;
+    }
     bool isOk() const { return !_failed; }
     explicit operator bool() const { return !_failed; }
     const std::string& message() const { return _message; }
@@ -35,12 +40,21 @@ class Result {
 public:
     Result(T value) : _value(std::move(value)) {}
     Result(Status status) : _status(std::move(status)) {
-        if (_status.isOk()) { std::fprintf(stderr, "Result constructed from ok Status\n"); std::abort(); }
+        if (_status.isOk()) {
+            std::fprintf(stderr, "Result constructed from ok Status\n");
+            std::abort();
+        }
     }
     bool isOk() const { return _value.has_value(); }
     explicit operator bool() const { return isOk(); }
     const Status& status() const { return _status; }
-    T& value() { if (!_value) { std::fprintf(stderr, "Result::value on error: %s\n", _status.message().c_str()); std::abort(); } return *_value; }
+    T& value() {
+        if (!_value) {
+            std::fprintf(stderr, "Result::value on error: %s\n", _status.message().c_str());
+            std::abort();
+        }
+        return *_value;
+    }
     const T& value() const { return const_cast<Result*>(this)->value(); }
     T* operator->() { return &value(); }
     T& operator*() { return value(); }
@@ -57,9 +71,14 @@ private:
 
 }  // namespace vista
 
-#define VISTA_CHECK(cond) \
-    do { if (!(cond)) ::vista::checkFailed(#cond, __FILE__, __LINE__); } while (0)
+#define VISTA_CHECK(cond)                                             \
+    do {                                                              \
+        if (!(cond)) ::vista::checkFailed(#cond, __FILE__, __LINE__); \
+    } while (0)
 
 // Propagates an error Status from an expression returning Status.
-#define VISTA_RETURN_IF_ERROR(expr) \
-    do { ::vista::Status _vista_s = (expr); if (!_vista_s.isOk()) return _vista_s; } while (0)
+#define VISTA_RETURN_IF_ERROR(expr)            \
+    do {                                       \
+        ::vista::Status _vista_s = (expr);     \
+        if (!_vista_s.isOk()) return _vista_s; \
+    } while (0)

@@ -11,7 +11,9 @@ public:
     Stopwatch() : _start(std::chrono::steady_clock::now()) {}
     void restart() { _start = std::chrono::steady_clock::now(); }
     // Milliseconds since construction or the last restart().
-    double ms() const { return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - _start).count(); }
+    double ms() const {
+        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - _start).count();
+    }
     // ms(), then restart(): the time of one stage in a sequence.
     double lap() {
         const auto now = std::chrono::steady_clock::now();

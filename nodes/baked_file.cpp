@@ -22,11 +22,14 @@ Result<BakedFile> loadBakedFile(const std::string& path) {
     if (!city) return city.status();
     BakedFile bf;
     bf.city = std::move(*city);
-    auto bad = [&](const std::string& why) { return Status::error("'" + path + "' is not a vista baked file: " + why); };
+    auto bad = [&](const std::string& why) {
+        return Status::error("'" + path + "' is not a vista baked file: " + why);
+    };
     auto* root = dynamic_cast<ViewCellSwitch*>(sceneRoot(bf.city));
     if (!root) return bad("the root is a plain city (run 'vista bake' first)");
     int baked = 0;
-    if (!root->getUserValue("vista.baked", baked) || baked != 1) return bad("missing or unsupported user value vista.baked");
+    if (!root->getUserValue("vista.baked", baked) || baked != 1)
+        return bad("missing or unsupported user value vista.baked");
     const std::string why = root->validate();
     if (!why.empty()) return bad(why);
     bf.meshes = isMeshBake(root);
@@ -62,22 +65,26 @@ Result<std::string> cityIdentity(const std::string& path, const osg::Node* root)
     return sceneFileContentHash(path);
 }
 
-Status checkBakedFromCity(const std::string& bakedPath, const BakedFile& baked, const std::string& cityPath, const osg::Node* cityRoot,
-                          std::string* warning) {
+Status checkBakedFromCity(const std::string& bakedPath, const BakedFile& baked, const std::string& cityPath,
+                          const osg::Node* cityRoot, std::string* warning) {
     if (warning) warning->clear();
     auto city = cityIdentity(cityPath, cityRoot);
     if (!city) return city.status();
     const std::string unchecked = baked.sourceCityHash.empty() ? bakedPath : city->empty() ? cityPath : "";
     if (!unchecked.empty()) {
         if (warning)
-            *warning = "'" + unchecked + "' records no source city hash (baked before vista.source_city_hash existed): cannot check that '" +
-                       bakedPath + "' was baked from '" + cityPath + "'; rebake to add it";
+            *warning =
+                "'" + unchecked +
+                "' records no source city hash (baked before vista.source_city_hash existed): cannot check that '" +
+                bakedPath + "' was baked from '" + cityPath + "'; rebake to add it";
         return Status::ok();
     }
     if (*city == baked.sourceCityHash) return Status::ok();
-    return Status::error("baked from another city: '" + bakedPath + "' was baked from a city with hash " + baked.sourceCityHash + ", '" +
-                         cityPath + "' has hash " + *city + "; rebake with 'vista bake " + cityPath + " -o " + bakedPath +
-                         (baked.meshes ? " --representation mesh" : "") + "' (from the plain city file) or pass the city it was baked from");
+    return Status::error("baked from another city: '" + bakedPath + "' was baked from a city with hash " +
+                         baked.sourceCityHash + ", '" + cityPath + "' has hash " + *city +
+                         "; rebake with 'vista bake " + cityPath + " -o " + bakedPath +
+                         (baked.meshes ? " --representation mesh" : "") +
+                         "' (from the plain city file) or pass the city it was baked from");
 }
 
 }  // namespace vista

@@ -32,12 +32,12 @@
 namespace vista {
 
 struct BakedFile {
-    SceneModel city;                   // the city part (tiles) as loadCityFile reads it
+    SceneModel city;  // the city part (tiles) as loadCityFile reads it
     osg::ref_ptr<ViewCellSwitch> root;
     size_t impostors = 0, points = 0;
-    bool meshes = false;                  // the representation: textured depth meshes
+    bool meshes = false;  // the representation: textured depth meshes
     size_t meshCount = 0, meshTriangles = 0;
-    std::string sourceCityHash;           // vista.source_city_hash; "" = baked before the field existed
+    std::string sourceCityHash;  // vista.source_city_hash; "" = baked before the field existed
 };
 // True for the root of a mesh bake (user value vista.bake_representation = "mesh").
 bool isMeshBake(const osg::Node* root);

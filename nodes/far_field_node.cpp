@@ -102,9 +102,7 @@ void FarFieldNode::drawFrame(osg::RenderInfo& ri, const Camera& c, const osg::Vi
     // Near-field haze done by the far field (FarFieldOptions::hazeCovered):
     // it needs the drawn colours, and then every pixel is drawn back.
     const bool hazeCovered = o.hazeCovered && o.effects.haze;
-    if (hazeCovered) {
-        readColorTopDown(GLint(vp.x()), GLint(vp.y()), W, H, _colorBits, _image.rgba.data());
-    }
+    if (hazeCovered) { readColorTopDown(GLint(vp.x()), GLint(vp.y()), W, H, _colorBits, _image.rgba.data()); }
     _far->render(c, _depth.data(), _image, _stats);
 
     // Far-field pixels drawn, covered pixels (class 0) kept unless hazed here.

@@ -47,7 +47,9 @@ public:
     FarFieldNode(const FarFieldNode& o, const osg::CopyOp& copyop = osg::CopyOp::SHALLOW_COPY);
     osg::Object* cloneType() const override { return new FarFieldNode(_rays, _grid, _options); }
     osg::Object* clone(const osg::CopyOp& copyop) const override { return new FarFieldNode(*this, copyop); }
-    bool isSameKindAs(const osg::Object* obj) const override { return dynamic_cast<const FarFieldNode*>(obj) != nullptr; }
+    bool isSameKindAs(const osg::Object* obj) const override {
+        return dynamic_cast<const FarFieldNode*>(obj) != nullptr;
+    }
     const char* libraryName() const override { return "vista"; }
     const char* className() const override { return "FarFieldNode"; }
 

@@ -86,7 +86,8 @@ osg::ref_ptr<osg::StateSet> labelTreeState() {
     osg::ref_ptr<osg::StateSet> ss = new osg::StateSet;
     {
         osg::ref_ptr<osg::Program> p = program("vista.label_trees", kTreeVertex);
-        for (unsigned c = 0; c < 4; ++c) p->addBindAttribLocation("vista_instance" + std::to_string(c), kInstanceAttrib0 + c);
+        for (unsigned c = 0; c < 4; ++c)
+            p->addBindAttribLocation("vista_instance" + std::to_string(c), kInstanceAttrib0 + c);
         p->addBindAttribLocation("vista_tree_id", kTreeIdAttrib);
         ss->setAttributeAndModes(p.get(), osg::StateAttribute::ON);
         for (unsigned c = 0; c < 4; ++c) ss->setAttribute(new osg::VertexAttribDivisor(kInstanceAttrib0 + c, 1));

@@ -94,8 +94,8 @@ void NearFarSplit::traverse(osg::NodeVisitor& nv) {
     const std::vector<SplitObject>& objs = objects();
     osg::Vec3 e = cv->getEyePoint();
     glm::dvec3 eye(e.x(), e.y(), e.z());
-    std::vector<uint32_t> sel =
-        _triangleBudget > 0 ? selectNearFieldByBudget(objs, eye, _triangleBudget) : selectNearField(*_index, eye, _nearDistance);
+    std::vector<uint32_t> sel = _triangleBudget > 0 ? selectNearFieldByBudget(objs, eye, _triangleBudget)
+                                                    : selectNearField(*_index, eye, _nearDistance);
     uint64_t tris = 0;
     for (uint32_t i : sel) {
         _children[i]->accept(nv);

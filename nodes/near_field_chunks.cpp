@@ -112,7 +112,8 @@ public:
             bb.expandBy(a);
             bb.expandBy(b);
             bb.expandBy(c);
-            const glm::dvec3 cen = tileOrigin + glm::dvec3((a.x() + b.x() + c.x()) / 3.0, (a.y() + b.y() + c.y()) / 3.0, 0.0);
+            const glm::dvec3 cen =
+                tileOrigin + glm::dvec3((a.x() + b.x() + c.x()) / 3.0, (a.y() + b.y() + c.y()) / 3.0, 0.0);
             const bool large = std::max(bb.xMax() - bb.xMin(), bb.yMax() - bb.yMin()) > _chunk;
             tris.push_back({large ? ChunkKey{tileId, 1, 0, 0} : ChunkKey{tileId, 0, cell(cen.x), cell(cen.y)}, t});
         }
@@ -130,7 +131,8 @@ public:
                         touched.push_back(vi);
                         const osg::Vec3& p = (*verts)[vi];
                         cb.verts->push_back(p);
-                        cb.colors->push_back(colors && vi < colors->size() ? (*colors)[vi] : osg::Vec4ub(255, 255, 255, 255));
+                        cb.colors->push_back(colors && vi < colors->size() ? (*colors)[vi]
+                                                                           : osg::Vec4ub(255, 255, 255, 255));
                         if (_labels) {
                             if (!cb.labelIds) {
                                 cb.labelIds = new osg::UIntArray;
@@ -223,8 +225,10 @@ private:
         g->setVertexArray(src.getVertexArray());
         if (src.getNormalArray()) g->setNormalArray(src.getNormalArray(), osg::Array::BIND_PER_VERTEX);
         g->setColorArray(src.getColorArray(), osg::Array::BIND_PER_VERTEX);
-        if (src.getTexCoordArray(0)) g->setTexCoordArray(0, src.getTexCoordArray(0), osg::Array::BIND_PER_VERTEX);  // tree impostors
-        osg::ref_ptr<osg::PrimitiveSet> ps = static_cast<osg::PrimitiveSet*>(src.getPrimitiveSet(0)->clone(osg::CopyOp::SHALLOW_COPY));
+        if (src.getTexCoordArray(0))
+            g->setTexCoordArray(0, src.getTexCoordArray(0), osg::Array::BIND_PER_VERTEX);  // tree impostors
+        osg::ref_ptr<osg::PrimitiveSet> ps =
+            static_cast<osg::PrimitiveSet*>(src.getPrimitiveSet(0)->clone(osg::CopyOp::SHALLOW_COPY));
         ps->setNumInstances(int(tb.cols[0].size()));
         g->addPrimitiveSet(ps.get());
         osg::BoundingBox bb, pb;
@@ -268,7 +272,8 @@ private:
     // The label twin of an instanced tree geometry: the same vertices and
     // instance matrices, per-vertex classes from the prototype's parts and
     // the per-instance tree ids.
-    osg::ref_ptr<osg::Geometry> labelTreeGeometry(osg::Geometry& colour, osg::Geometry& src, const TreeBatch& tb) const {
+    osg::ref_ptr<osg::Geometry> labelTreeGeometry(osg::Geometry& colour, osg::Geometry& src,
+                                                  const TreeBatch& tb) const {
         osg::ref_ptr<osg::Geometry> g = new osg::Geometry;
         g->setName(colour.getName());
         g->setUseDisplayList(false);
@@ -276,13 +281,15 @@ private:
         g->setVertexArray(colour.getVertexArray());
         g->addPrimitiveSet(colour.getPrimitiveSet(0));
         for (unsigned c = 0; c < 4; ++c)
-            g->setVertexAttribArray(kInstanceAttrib0 + c, colour.getVertexAttribArray(kInstanceAttrib0 + c), osg::Array::BIND_PER_VERTEX);
+            g->setVertexAttribArray(kInstanceAttrib0 + c, colour.getVertexAttribArray(kInstanceAttrib0 + c),
+                                    osg::Array::BIND_PER_VERTEX);
         const unsigned nv = colour.getVertexArray()->getNumElements();
         osg::ref_ptr<osg::UIntArray> classes = new osg::UIntArray(nv);
         auto* parts = dynamic_cast<osg::UIntArray*>(src.getVertexAttribArray(kLabelAttrib));
         for (unsigned i = 0; i < nv; ++i) {
             const uint32_t part = parts && i < parts->size() ? (*parts)[i] : uint32_t(Material::Leaves);
-            const SemanticClass c = part < uint32_t(kMaterialCount) ? semanticClass(Material(part)) : SemanticClass::TreeLeaves;
+            const SemanticClass c =
+                part < uint32_t(kMaterialCount) ? semanticClass(Material(part)) : SemanticClass::TreeLeaves;
             (*classes)[i] = GLuint(c);
         }
         osg::ref_ptr<osg::UIntArray> ids = new osg::UIntArray(tb.ids.begin(), tb.ids.end());
@@ -354,7 +361,8 @@ NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk, bool labe
             auto* verts = dynamic_cast<osg::Vec3Array*>(g->getVertexArray());
             auto* de = dynamic_cast<osg::DrawElements*>(g->getPrimitiveSet(0));
             if (!verts || !de || de->getMode() != GL_TRIANGLES) continue;
-            if (g->getName().rfind(kTreeGeometryPrefix, 0) == 0 || isTreeImpostorName(g->getName())) chunker.addTrees(g, tileId, tileOrigin);
+            if (g->getName().rfind(kTreeGeometryPrefix, 0) == 0 || isTreeImpostorName(g->getName()))
+                chunker.addTrees(g, tileId, tileOrigin);
             else chunker.addMesh(g, tileId, tileOrigin);
         }
     }

@@ -59,8 +59,14 @@ PointImpostor::PointImpostor() {
 }
 
 PointImpostor::PointImpostor(const PointImpostor& o, const osg::CopyOp& op)
-    : osg::Geometry(o, op), _planeOrigin(o._planeOrigin), _planeU(o._planeU), _planeV(o._planeV), _dequant(o._dequant), _texelsX(o._texelsX),
-      _texelsY(o._texelsY), _textured(o._textured) {}
+    : osg::Geometry(o, op),
+      _planeOrigin(o._planeOrigin),
+      _planeU(o._planeU),
+      _planeV(o._planeV),
+      _dequant(o._dequant),
+      _texelsX(o._texelsX),
+      _texelsY(o._texelsY),
+      _textured(o._textured) {}
 
 size_t PointImpostor::pointCount() const {
     const osg::Array* v = getVertexArray();
@@ -98,17 +104,20 @@ std::string PointImpostor::validate() const {
     const auto* da = dynamic_cast<const osg::DrawArrays*>(getPrimitiveSet(0));
     if (!da || da->getMode() != GL_POINTS || da->getFirst() != 0 || size_t(da->getCount()) != n)
         return "impostor point set does not cover its points";
-    if (!(_dequant.w() > 0) || !std::isfinite(_dequant.w()) || _dequant.isNaN()) return "impostor dequantization invalid";
+    if (!(_dequant.w() > 0) || !std::isfinite(_dequant.w()) || _dequant.isNaN())
+        return "impostor dequantization invalid";
     if (_texelsX < 1 || _texelsY < 1 || _texelsX > 32 || _texelsY > 32) return "impostor texel layout out of range";
     const osg::StateSet* ss = getStateSet();
-    const auto* tex = ss ? dynamic_cast<const osg::Texture2D*>(ss->getTextureAttribute(0, osg::StateAttribute::TEXTURE)) : nullptr;
+    const auto* tex =
+        ss ? dynamic_cast<const osg::Texture2D*>(ss->getTextureAttribute(0, osg::StateAttribute::TEXTURE)) : nullptr;
     const osg::Image* img = tex ? tex->getImage() : nullptr;
     if (!img || img->s() < _texelsX || img->t() < _texelsY) return "impostor atlas missing";
     size_t textured = 0;
     for (const auto& o : *t) {
         if (o.x() < 0) continue;
         ++textured;
-        if (o.x() + _texelsX > img->s() || o.y() < 0 || o.y() + _texelsY > img->t()) return "impostor atlas offset outside the atlas";
+        if (o.x() + _texelsX > img->s() || o.y() < 0 || o.y() + _texelsY > img->t())
+            return "impostor atlas offset outside the atlas";
     }
     if (textured != _textured) return "impostor textured count does not match its offsets";
     return "";
@@ -132,7 +141,10 @@ osg::ref_ptr<osg::Image> PointImpostor::buildAtlas(const PointImpostorData& d, s
             for (int i = 0; i < d.texelsX; ++i) {
                 const glm::u8vec4 c = d.texels[b * blockSize + size_t(j) * size_t(d.texelsX) + size_t(i)];
                 unsigned char* p = img->data(bx + i, by + j);
-                p[0] = c.x; p[1] = c.y; p[2] = c.z; p[3] = 255;
+                p[0] = c.x;
+                p[1] = c.y;
+                p[2] = c.z;
+                p[3] = 255;
             }
     }
     img->setWriteHint(osg::Image::STORE_INLINE);
@@ -141,7 +153,8 @@ osg::ref_ptr<osg::Image> PointImpostor::buildAtlas(const PointImpostorData& d, s
         if (k >= d.block.size() || d.block[k] < 0) continue;
         const size_t b = size_t(d.block[k]);
         VISTA_CHECK(b < blocks);
-        offsets[k] = glm::vec2(float(int(b % kAtlasBlocksPerRow) * d.texelsX), float(int(b / kAtlasBlocksPerRow) * d.texelsY));
+        offsets[k] =
+            glm::vec2(float(int(b % kAtlasBlocksPerRow) * d.texelsX), float(int(b / kAtlasBlocksPerRow) * d.texelsY));
     }
     return img;
 }
@@ -161,7 +174,10 @@ void PointImpostor::setData(const PointImpostorData& d) {
     glm::vec3 lo(0.0f), hi(0.0f);
     if (!d.positions.empty()) {
         lo = hi = d.positions[0];
-        for (const auto& q : d.positions) { lo = glm::min(lo, q); hi = glm::max(hi, q); }
+        for (const auto& q : d.positions) {
+            lo = glm::min(lo, q);
+            hi = glm::max(hi, q);
+        }
     }
     const glm::vec3 mid = 0.5f * (lo + hi), half = 0.5f * (hi - lo);
     const float step = std::max(std::max(half.x, std::max(half.y, half.z)) / 32767.0f, 1e-6f);
@@ -172,7 +188,8 @@ void PointImpostor::setData(const PointImpostorData& d) {
     osg::ref_ptr<osg::Vec2sArray> t = new osg::Vec2sArray(unsigned(d.positions.size()));
     auto quant = [&](float x, float m) { return short(std::clamp(std::lround((x - m) / step), -32767L, 32767L)); };
     for (size_t k = 0; k < d.positions.size(); ++k) {
-        (*v)[unsigned(k)].set(quant(d.positions[k].x, mid.x), quant(d.positions[k].y, mid.y), quant(d.positions[k].z, mid.z));
+        (*v)[unsigned(k)].set(quant(d.positions[k].x, mid.x), quant(d.positions[k].y, mid.y),
+                              quant(d.positions[k].z, mid.z));
         (*c)[unsigned(k)].set(d.colors[k].x, d.colors[k].y, d.colors[k].z, 255);
         (*t)[unsigned(k)].set(short(offsets[k].x), short(offsets[k].y));
     }
@@ -186,7 +203,8 @@ void PointImpostor::setData(const PointImpostorData& d) {
     osg::ref_ptr<osg::StateSet> ss = new osg::StateSet;
     osg::ref_ptr<osg::Program> prog = new osg::Program;
     prog->setName("vista.point_impostor");
-    prog->addShader(new osg::Shader(osg::Shader::VERTEX, std::string("#version 120\n") + impostorVertexLibrary() + kVertexMain));
+    prog->addShader(
+        new osg::Shader(osg::Shader::VERTEX, std::string("#version 120\n") + impostorVertexLibrary() + kVertexMain));
     prog->addShader(new osg::Shader(osg::Shader::FRAGMENT, kFragmentShader));
     ss->setAttributeAndModes(prog.get(), osg::StateAttribute::ON);
     osg::ref_ptr<osg::Texture2D> tex = clampedLinearTexture(atlas.get());

@@ -39,9 +39,9 @@ struct PointImpostorData {
     glm::vec3 planeOrigin{0.0f}, planeU{0.0f}, planeV{0.0f};
     int texelsX = 8, texelsY = 2;
     std::vector<glm::vec3> positions;
-    std::vector<glm::u8vec4> colors;   // per point (mean over the texels)
-    std::vector<int32_t> block;        // per point: -1 = single colour, else block index
-    std::vector<glm::u8vec4> texels;   // blocks of texelsX * texelsY, row-major (j, then i)
+    std::vector<glm::u8vec4> colors;  // per point (mean over the texels)
+    std::vector<int32_t> block;       // per point: -1 = single colour, else block index
+    std::vector<glm::u8vec4> texels;  // blocks of texelsX * texelsY, row-major (j, then i)
 };
 
 // How every PointImpostor of the process draws: splats of this Gaussian sigma
@@ -61,8 +61,8 @@ public:
     PointImpostor(const PointImpostor& o, const osg::CopyOp& op = osg::CopyOp::SHALLOW_COPY);
     META_Object(vista, PointImpostor)
 
-    // Builds vertex arrays, atlas and state from `d` (replaces any previous content).
-    void setData(const PointImpostorData& d);
+        // Builds vertex arrays, atlas and state from `d` (replaces any previous content).
+        void setData(const PointImpostorData& d);
     size_t pointCount() const;
     size_t texturedCount() const { return _textured; }
     // Dequantized position of point k (model coordinates).

@@ -137,7 +137,8 @@ struct SplatTarget {
     SplatTarget() {
         osg::ref_ptr<osg::Program> prog = new osg::Program;
         prog->setName("vista.point_splat");
-        prog->addShader(new osg::Shader(osg::Shader::VERTEX, std::string("#version 120\n") + kImpostorVertexLib + kSplatVertexMain));
+        prog->addShader(new osg::Shader(osg::Shader::VERTEX,
+                                        std::string("#version 120\n") + kImpostorVertexLib + kSplatVertexMain));
         prog->addShader(new osg::Shader(osg::Shader::FRAGMENT, kSplatFragment));
         size = new osg::Uniform("vista_splatSize", 1.0f);
         sigma = new osg::Uniform("vista_splatSigma", 0.25f);
@@ -200,8 +201,10 @@ struct SplatTarget {
         fbo = new osg::FrameBufferObject;
         fbo->setAttachment(osg::Camera::COLOR_BUFFER0, osg::FrameBufferAttachment(color.get()));
         fbo->setAttachment(osg::Camera::DEPTH_BUFFER, osg::FrameBufferAttachment(depth.get()));
-        normalise->setTextureAttributeAndModes(1, color.get(), osg::StateAttribute::ON | osg::StateAttribute::PROTECTED);
-        normalise->setTextureAttributeAndModes(2, depth.get(), osg::StateAttribute::ON | osg::StateAttribute::PROTECTED);
+        normalise->setTextureAttributeAndModes(1, color.get(),
+                                               osg::StateAttribute::ON | osg::StateAttribute::PROTECTED);
+        normalise->setTextureAttributeAndModes(2, depth.get(),
+                                               osg::StateAttribute::ON | osg::StateAttribute::PROTECTED);
     }
 };
 
@@ -259,7 +262,8 @@ bool drawSplats(const osg::Geometry& geometry, osg::RenderInfo& ri, const SplatP
     const double focalPx = std::abs(proj(1, 1)) * 0.5 * H;
     const float sigma = params.sigmaPx * float(std::max(1.0, focalPx / kBakeFocalPx));
     const float radius = kRadiusSigmas * sigma;
-    const Rect r = screenRect(geometry.getBoundingBox(), st.getModelViewMatrix() * proj, W, H, int(std::ceil(radius)) + 1);
+    const Rect r =
+        screenRect(geometry.getBoundingBox(), st.getModelViewMatrix() * proj, W, H, int(std::ceil(radius)) + 1);
     if (r.w <= 0 || r.h <= 0) return true;
     t.size->set(2.0f * radius);
     t.sigma->set(sigma);

@@ -19,7 +19,8 @@ namespace vista {
 
 void useFixedFunction(osg::StateSet& ss) {
     // An osg::Program without shaders applies as glUseProgram(0).
-    ss.setAttributeAndModes(new osg::Program, osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE | osg::StateAttribute::PROTECTED);
+    ss.setAttributeAndModes(new osg::Program,
+                            osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE | osg::StateAttribute::PROTECTED);
 }
 
 // vista::Camera from OSG matrices (world frame, x east, y north, z up).
@@ -88,7 +89,8 @@ bool currentView(osg::RenderInfo& ri, Camera& camera, const osg::Viewport*& vp, 
     const osg::Camera* cam = ri.getCurrentCamera();
     vp = cam ? cam->getViewport() : nullptr;
     if (!vp || vp->width() < 1 || vp->height() < 1) return false;
-    return cameraFromOsg(cam->getViewMatrix(), cam->getProjectionMatrix(), int(vp->width()), int(vp->height()), camera, zFar);
+    return cameraFromOsg(cam->getViewMatrix(), cam->getProjectionMatrix(), int(vp->width()), int(vp->height()), camera,
+                         zFar);
 }
 
 ReadbackDrawable::ReadbackDrawable() {

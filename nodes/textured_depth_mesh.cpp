@@ -52,13 +52,17 @@ std::string TexturedDepthMesh::validate() const {
     }
     if (getNumPrimitiveSets() != 1) return "depth mesh without exactly one triangle set";
     const auto* de = dynamic_cast<const osg::DrawElementsUInt*>(getPrimitiveSet(0));
-    if (!de || de->getMode() != GL_TRIANGLES || de->size() % 3 != 0) return "depth mesh primitive set is not an indexed triangle list";
+    if (!de || de->getMode() != GL_TRIANGLES || de->size() % 3 != 0)
+        return "depth mesh primitive set is not an indexed triangle list";
     for (unsigned i : *de)
-        if (i >= n) return "depth mesh index " + std::to_string(i) + " out of range (" + std::to_string(n) + " vertices)";
-    if (!std::isfinite(_eye.x()) || !std::isfinite(_eye.y()) || !std::isfinite(_eye.z())) return "depth mesh eye not finite";
+        if (i >= n)
+            return "depth mesh index " + std::to_string(i) + " out of range (" + std::to_string(n) + " vertices)";
+    if (!std::isfinite(_eye.x()) || !std::isfinite(_eye.y()) || !std::isfinite(_eye.z()))
+        return "depth mesh eye not finite";
     if (_end < 0 || _end > 1) return "depth mesh street end " + std::to_string(_end) + " (must be 0 or 1)";
     const osg::StateSet* ss = getStateSet();
-    const auto* tex = ss ? dynamic_cast<const osg::Texture2D*>(ss->getTextureAttribute(0, osg::StateAttribute::TEXTURE)) : nullptr;
+    const auto* tex =
+        ss ? dynamic_cast<const osg::Texture2D*>(ss->getTextureAttribute(0, osg::StateAttribute::TEXTURE)) : nullptr;
     const osg::Image* img = tex ? tex->getImage() : nullptr;
     if (!img || img->s() < 1 || img->t() < 1 || !img->data()) return "depth mesh texture image missing";
     return "";
@@ -95,7 +99,10 @@ void TexturedDepthMesh::setData(const TexturedDepthMeshData& d) {
         for (int i = 0; i < d.width; ++i) {
             const glm::u8vec4 c = d.image[size_t(j) * size_t(d.width) + size_t(i)];
             unsigned char* p = img->data(i, j);
-            p[0] = c.x; p[1] = c.y; p[2] = c.z; p[3] = c.w;
+            p[0] = c.x;
+            p[1] = c.y;
+            p[2] = c.z;
+            p[3] = c.w;
         }
     img->setWriteHint(osg::Image::STORE_INLINE);
     osg::ref_ptr<osg::StateSet> ss = new osg::StateSet;

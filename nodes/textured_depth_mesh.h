@@ -49,8 +49,8 @@ public:
     TexturedDepthMesh(const TexturedDepthMesh& o, const osg::CopyOp& op = osg::CopyOp::SHALLOW_COPY);
     META_Object(vista, TexturedDepthMesh)
 
-    // Builds arrays, primitive set, texture and state from `d` (replaces any previous content).
-    void setData(const TexturedDepthMeshData& d);
+        // Builds arrays, primitive set, texture and state from `d` (replaces any previous content).
+        void setData(const TexturedDepthMeshData& d);
     size_t vertexCount() const;
     size_t triangleCount() const;
     // "" if arrays, primitive set, texture and properties are consistent, else the reason.

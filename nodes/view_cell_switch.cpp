@@ -65,8 +65,10 @@ void ViewCellGrid::build(const std::vector<ViewCellBox>& cells, double binSize) 
         if (!(cells[i].halfHeight > 0)) continue;
         glm::dvec2 a, b;
         cells[i].boundsXY(a, b);
-        const int x0 = std::clamp(int((a.x - lo.x) / _bin), 0, _nx - 1), x1 = std::clamp(int((b.x - lo.x) / _bin), 0, _nx - 1);
-        const int y0 = std::clamp(int((a.y - lo.y) / _bin), 0, _ny - 1), y1 = std::clamp(int((b.y - lo.y) / _bin), 0, _ny - 1);
+        const int x0 = std::clamp(int((a.x - lo.x) / _bin), 0, _nx - 1),
+                  x1 = std::clamp(int((b.x - lo.x) / _bin), 0, _nx - 1);
+        const int y0 = std::clamp(int((a.y - lo.y) / _bin), 0, _ny - 1),
+                  y1 = std::clamp(int((b.y - lo.y) / _bin), 0, _ny - 1);
         for (int y = y0; y <= y1; ++y)
             for (int x = x0; x <= x1; ++x) bins[size_t(y) * size_t(_nx) + size_t(x)].push_back(uint32_t(i));
     }
@@ -89,17 +91,32 @@ int ViewCellGrid::find(const glm::dvec3& p) const {
 }
 
 ViewCellSwitch::ViewCellSwitch()
-    : _cellData(new osg::DoubleArray), _hiddenStart(new osg::UIntArray), _hiddenItems(new osg::UIntArray),
-      _impStart(new osg::UIntArray), _impItems(new osg::UIntArray) {
+    : _cellData(new osg::DoubleArray),
+      _hiddenStart(new osg::UIntArray),
+      _hiddenItems(new osg::UIntArray),
+      _impStart(new osg::UIntArray),
+      _impItems(new osg::UIntArray) {
     _hiddenStart->push_back(0);
     _impStart->push_back(0);
 }
 
 ViewCellSwitch::ViewCellSwitch(const ViewCellSwitch& o, const osg::CopyOp& op)
-    : osg::Group(o, op), _cells(o._cells), _grid(o._grid), _cellData(o._cellData), _hiddenStart(o._hiddenStart),
-      _hiddenItems(o._hiddenItems), _impStart(o._impStart), _impItems(o._impItems), _tileCount(o._tileCount),
-      _forced(o._forced), _impostorsOn(o._impostorsOn), _nearestFallback(o._nearestFallback), _chunkNodes(o._chunkNodes),
-      _chunkTile(o._chunkTile), _chunkBoxes(o._chunkBoxes), _chunkNear(o._chunkNear) {}
+    : osg::Group(o, op),
+      _cells(o._cells),
+      _grid(o._grid),
+      _cellData(o._cellData),
+      _hiddenStart(o._hiddenStart),
+      _hiddenItems(o._hiddenItems),
+      _impStart(o._impStart),
+      _impItems(o._impItems),
+      _tileCount(o._tileCount),
+      _forced(o._forced),
+      _impostorsOn(o._impostorsOn),
+      _nearestFallback(o._nearestFallback),
+      _chunkNodes(o._chunkNodes),
+      _chunkTile(o._chunkTile),
+      _chunkBoxes(o._chunkBoxes),
+      _chunkNear(o._chunkNear) {}
 
 void ViewCellSwitch::setNearChunks(const NearFieldScene& nf, double nearDistance) {
     _chunkNodes.clear();
@@ -119,7 +136,8 @@ void ViewCellSwitch::setNearChunks(const NearFieldScene& nf, double nearDistance
 void ViewCellSwitch::setCells(const std::vector<ViewCellBox>& cells) {
     osg::ref_ptr<osg::DoubleArray> a = new osg::DoubleArray;
     for (const auto& c : cells) {
-        const double v[9] = {c.center.x, c.center.y, c.center.z, c.axis.x, c.axis.y, c.halfLength, c.halfWidth, c.halfHeight, 0.0};
+        const double v[9] = {c.center.x,   c.center.y,  c.center.z,   c.axis.x, c.axis.y,
+                             c.halfLength, c.halfWidth, c.halfHeight, 0.0};
         a->insert(a->end(), v, v + 9);
     }
     setCellData(a.get());
@@ -163,11 +181,13 @@ static void csrSet(osg::ref_ptr<osg::UIntArray>& start, osg::ref_ptr<osg::UIntAr
     items = it;
 }
 
-void ViewCellSwitch::setCellChildren(uint32_t cell, const std::vector<uint32_t>& hidden, const std::vector<uint32_t>& impostors) {
+void ViewCellSwitch::setCellChildren(uint32_t cell, const std::vector<uint32_t>& hidden,
+                                     const std::vector<uint32_t>& impostors) {
     rebuildLists(cell, hidden, impostors);
 }
 
-void ViewCellSwitch::rebuildLists(uint32_t cell, const std::vector<uint32_t>& hidden, const std::vector<uint32_t>& impostors) {
+void ViewCellSwitch::rebuildLists(uint32_t cell, const std::vector<uint32_t>& hidden,
+                                  const std::vector<uint32_t>& impostors) {
     if (cell >= _cells.size()) return;
     csrSet(_hiddenStart, _hiddenItems, cell, hidden);
     csrSet(_impStart, _impItems, cell, impostors);
@@ -181,12 +201,17 @@ static std::vector<uint32_t> csrGet(const osg::UIntArray* start, const osg::UInt
     return out;
 }
 
-std::vector<uint32_t> ViewCellSwitch::hiddenOf(uint32_t cell) const { return csrGet(_hiddenStart.get(), _hiddenItems.get(), cell); }
-std::vector<uint32_t> ViewCellSwitch::impostorsOf(uint32_t cell) const { return csrGet(_impStart.get(), _impItems.get(), cell); }
+std::vector<uint32_t> ViewCellSwitch::hiddenOf(uint32_t cell) const {
+    return csrGet(_hiddenStart.get(), _hiddenItems.get(), cell);
+}
+std::vector<uint32_t> ViewCellSwitch::impostorsOf(uint32_t cell) const {
+    return csrGet(_impStart.get(), _impItems.get(), cell);
+}
 
 std::string ViewCellSwitch::validate() const {
     const size_t n = _cells.size();
-    if (_cellData->size() % 9 != 0) return "cell data size " + std::to_string(_cellData->size()) + " is not a multiple of 9";
+    if (_cellData->size() % 9 != 0)
+        return "cell data size " + std::to_string(_cellData->size()) + " is not a multiple of 9";
     for (size_t i = 0; i < n; ++i) {
         const auto& c = _cells[i];
         const double len = glm::length(c.axis);
@@ -196,11 +221,13 @@ std::string ViewCellSwitch::validate() const {
             return "cell " + std::to_string(i) + " is not a valid box";
     }
     if (_tileCount > getNumChildren()) return "tile count " + std::to_string(_tileCount) + " exceeds the child count";
-    auto checkCsr = [&](const osg::UIntArray* s, const osg::UIntArray* it, const char* what, bool tiles) -> std::string {
+    auto checkCsr = [&](const osg::UIntArray* s, const osg::UIntArray* it, const char* what,
+                        bool tiles) -> std::string {
         if (!s || !it || s->size() != n + 1) return std::string(what) + ": list count does not match the cell count";
         if ((*s)[0] != 0 || (*s)[n] != it->size()) return std::string(what) + ": list offsets are inconsistent";
         for (size_t c = 0; c < n; ++c)
-            if ((*s)[c] > (*s)[c + 1]) return std::string(what) + ": list offsets decrease at cell " + std::to_string(c);
+            if ((*s)[c] > (*s)[c + 1])
+                return std::string(what) + ": list offsets decrease at cell " + std::to_string(c);
         for (unsigned v : *it) {
             if (tiles ? v >= _tileCount : (v < _tileCount || v >= getNumChildren()))
                 return std::string(what) + ": child index " + std::to_string(v) + " out of range";
@@ -259,7 +286,8 @@ void ViewCellSwitch::traverse(osg::NodeVisitor& nv) {
         unsigned drawn = 0;
         for (size_t k = 0; k < _chunkNodes.size(); ++k) {
             const int32_t t = _chunkTile[k];
-            if (inCell && t >= 0 && unsigned(t) < tiles && _hiddenMask[size_t(t)] && boxDistance(_chunkBoxes[k], eye) > _chunkNear)
+            if (inCell && t >= 0 && unsigned(t) < tiles && _hiddenMask[size_t(t)] &&
+                boxDistance(_chunkBoxes[k], eye) > _chunkNear)
                 continue;
             _chunkNodes[k]->accept(nv);
             ++drawn;

@@ -45,11 +45,11 @@
 namespace vista {
 
 struct ViewCellBox {
-    glm::dvec3 center{0.0};   // world position of the box centre
-    glm::dvec2 axis{1.0, 0.0};// unit vector along the street (node a -> node b)
-    double halfLength = 0;    // along axis
-    double halfWidth = 0;     // across the street
-    double halfHeight = 0;    // vertical
+    glm::dvec3 center{0.0};     // world position of the box centre
+    glm::dvec2 axis{1.0, 0.0};  // unit vector along the street (node a -> node b)
+    double halfLength = 0;      // along axis
+    double halfWidth = 0;       // across the street
+    double halfHeight = 0;      // vertical
 
     glm::dvec2 side() const { return {-axis.y, axis.x}; }  // left of axis
     bool contains(const glm::dvec3& p, double eps = 0.0) const;
@@ -80,7 +80,7 @@ public:
     ViewCellSwitch(const ViewCellSwitch& o, const osg::CopyOp& op = osg::CopyOp::SHALLOW_COPY);
     META_Node(vista, ViewCellSwitch)
 
-    void setCells(const std::vector<ViewCellBox>& cells);
+        void setCells(const std::vector<ViewCellBox>& cells);
     const std::vector<ViewCellBox>& cells() const { return _cells; }
     // Children to hide / impostor children to draw when the viewer is in `cell`.
     void setCellChildren(uint32_t cell, const std::vector<uint32_t>& hidden, const std::vector<uint32_t>& impostors);

@@ -27,9 +27,9 @@ constexpr double kLampIntensity = 1.2;
 constexpr double kDirectTolerance = 0.12;  // light units (0..1) between neighbouring vertices
 constexpr double kAoTolerance = 0.10;      // open-sky share
 constexpr double kLampTolerance = 0.10;
-constexpr double kLampResolution = 2.0;    // metres
-constexpr double kProbeFactor = 4.0;       // edges longer than 4x the resolution probe their midpoint
-constexpr size_t kMaxGrowth = 64;          // a mesh never grows past 64x its triangles (+ 4096)
+constexpr double kLampResolution = 2.0;  // metres
+constexpr double kProbeFactor = 4.0;     // edges longer than 4x the resolution probe their midpoint
+constexpr size_t kMaxGrowth = 64;        // a mesh never grows past 64x its triangles (+ 4096)
 const glm::dvec3 kLampColour(1.0, 0.84, 0.62);
 
 struct Sample {
@@ -47,7 +47,8 @@ uint64_t pointHash(const glm::dvec3& p) {
 double unit01(uint64_t h) { return double(h >> 11) * (1.0 / 9007199254740992.0); }
 
 void basis(const glm::dvec3& n, glm::dvec3& t, glm::dvec3& b) {
-    t = std::abs(n.z) < 0.9 ? glm::normalize(glm::cross(glm::dvec3(0, 0, 1), n)) : glm::normalize(glm::cross(glm::dvec3(1, 0, 0), n));
+    t = std::abs(n.z) < 0.9 ? glm::normalize(glm::cross(glm::dvec3(0, 0, 1), n))
+                            : glm::normalize(glm::cross(glm::dvec3(1, 0, 0), n));
     b = glm::cross(n, t);
 }
 
@@ -66,8 +67,13 @@ struct Context {
     std::atomic<uint64_t> rayCount{0};
 
     Context(const RayScene& r, const CityParams& p, const std::vector<glm::dvec3>& lampList)
-        : rays(r), frame(0.0), light(p), shadows(p.effects.sun_shadows), ao(p.effects.ambient_occlusion),
-          night(p.effects.night), lamps(&lampList) {
+        : rays(r),
+          frame(0.0),
+          light(p),
+          shadows(p.effects.sun_shadows),
+          ao(p.effects.ambient_occlusion),
+          night(p.effects.night),
+          lamps(&lampList) {
         basis(light.sunDir, su, sv);
         if (shadows) tanR = std::tan(0.5 * degToRad(shadows->softness_deg));
         if (night && !lampList.empty()) {
@@ -77,7 +83,8 @@ struct Context {
         if (light.sun <= 0) shadows.reset();  // night: no sun, nothing to shadow
     }
     uint64_t cellKey(const glm::dvec3& p) const {
-        return hashKeys(uint64_t(int64_t(std::floor(p.x / lampCell))), uint64_t(int64_t(std::floor(p.y / lampCell))), 0x1A3Bull);
+        return hashKeys(uint64_t(int64_t(std::floor(p.x / lampCell))), uint64_t(int64_t(std::floor(p.y / lampCell))),
+                        0x1A3Bull);
     }
     uint64_t cellKey(int64_t x, int64_t y) const { return hashKeys(uint64_t(x), uint64_t(y), 0x1A3Bull); }
 
@@ -102,7 +109,8 @@ struct Context {
                     }
                     ++tried;
                     const double r = N == 1 ? 0.0 : std::sqrt((i + 0.5) / N), th = i * kGoldenAngle + rot;
-                    const glm::dvec3 d = glm::normalize(light.sunDir + tanR * r * (std::cos(th) * su + std::sin(th) * sv));
+                    const glm::dvec3 d =
+                        glm::normalize(light.sunDir + tanR * r * (std::cos(th) * su + std::sin(th) * sv));
                     if (glm::dot(d, n) <= 0) continue;  // below the surface: self-shadowed
                     ++cast;
                     if (!rays.occluded(org, glm::vec3(d), 0.0f, 1e30f)) ++lit;

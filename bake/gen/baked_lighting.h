@@ -36,10 +36,10 @@ namespace vista {
 
 struct BakedLightingStats {
     bool ran = false;
-    double seconds = 0;               // whole pass
-    double sceneSeconds = 0;          // of which: building the occluder ray scene
+    double seconds = 0;                              // whole pass
+    double sceneSeconds = 0;                         // of which: building the occluder ray scene
     size_t trianglesBefore = 0, trianglesAfter = 0;  // tile meshes (refinement growth)
-    uint64_t rays = 0;                // shadow + occlusion rays cast
+    uint64_t rays = 0;                               // shadow + occlusion rays cast
 };
 
 bool bakedLightingCalledFor(const CityParams& params);

@@ -37,7 +37,6 @@ double seconds(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-
 // Size and content hash (hashBytes64) of a file, streamed; false if unreadable.
 bool hashFile(const std::string& path, uint64_t& bytes, uint64_t& hash) {
     std::ifstream in(path, std::ios::binary);
@@ -81,12 +80,11 @@ std::optional<Json> validRecord(const std::string& dir, const RegionGrid& grid, 
             if (name.find('/') != std::string::npos) return std::nullopt;
             uint64_t bytes = 0, hash = 0;
             if (!hashFile((fs::path(dir) / name).string(), bytes, hash)) return std::nullopt;
-            if (bytes != f.at("bytes").get<uint64_t>() || hex64(hash) != f.at("hash").get<std::string>()) return std::nullopt;
+            if (bytes != f.at("bytes").get<uint64_t>() || hex64(hash) != f.at("hash").get<std::string>())
+                return std::nullopt;
         }
         if (!empty && (!j.at("bounds").is_array() || j.at("bounds").size() != 6)) return std::nullopt;
-    } catch (const std::exception&) {
-        return std::nullopt;
-    }
+    } catch (const std::exception&) { return std::nullopt; }
     return j;
 }
 
@@ -187,7 +185,8 @@ osg::ref_ptr<osg::Node> buildIndex(const CityParams& params, const RegionGrid& g
     return root;
 }
 
-Json manifestJson(const CityParams& params, const RegionGrid& grid, double regionSize, const std::vector<Json>& records) {
+Json manifestJson(const CityParams& params, const RegionGrid& grid, double regionSize,
+                  const std::vector<Json>& records) {
     Json m;
     m["format"] = "vista.paged_city";
     m["version"] = kPagedFormatVersion;
@@ -221,15 +220,18 @@ Json manifestJson(const CityParams& params, const RegionGrid& grid, double regio
         }
         regions.push_back(std::move(e));
     }
-    m["totals"] = {{"regions", records.size()}, {"non_empty_regions", nonEmpty}, {"buildings", buildings},
-                   {"trees", trees}, {"triangles", triangles}, {"bytes", bytes}};
+    m["totals"] = {{"regions", records.size()}, {"non_empty_regions", nonEmpty},
+                   {"buildings", buildings},    {"trees", trees},
+                   {"triangles", triangles},    {"bytes", bytes}};
     m["regions"] = std::move(regions);
     return m;
 }
 
 }  // namespace
 
-std::string regionFileName(int ix, int iy) { return "region_" + std::to_string(ix) + "_" + std::to_string(iy) + ".osgb"; }
+std::string regionFileName(int ix, int iy) {
+    return "region_" + std::to_string(ix) + "_" + std::to_string(iy) + ".osgb";
+}
 std::string coarseFileName(int ix, int iy) {
     return "region_" + std::to_string(ix) + "_" + std::to_string(iy) + ".coarse.osgb";
 }
@@ -246,7 +248,8 @@ Status checkPagedOutput(const std::string& option, const std::string& dir) {
     std::error_code ec;
     const auto st = fs::status(dir, ec);
     if (fs::exists(st) && !fs::is_directory(st))
-        return Status::error("option " + option + " = '" + dir + "': exists and is not a directory (a paged city is a directory)");
+        return Status::error("option " + option + " = '" + dir +
+                             "': exists and is not a directory (a paged city is a directory)");
     return checkWritableDirectory(option, dir);
 }
 
@@ -254,7 +257,8 @@ Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedC
     VISTA_RETURN_IF_ERROR(validateParams(params));
     VISTA_RETURN_IF_ERROR(validateRegionSize(params, o.regionSizeM));
     if (o.shard.count < 1 || o.shard.index < 0 || o.shard.index >= o.shard.count)
-        return Status::error("shard " + std::to_string(o.shard.index) + "/" + std::to_string(o.shard.count) + " out of range");
+        return Status::error("shard " + std::to_string(o.shard.index) + "/" + std::to_string(o.shard.count) +
+                             " out of range");
     VISTA_RETURN_IF_ERROR(checkPagedOutput("-o", o.dir));
     std::error_code ec;
     if (!o.merge) {  // a merge only reads (and writes index and manifest once every region is there)

@@ -40,7 +40,6 @@
 
 namespace vista {
 
-
 struct PagedCityOptions {
     std::string dir;
     double regionSizeM = 2000.0;
@@ -50,11 +49,11 @@ struct PagedCityOptions {
 };
 
 struct PagedCityReport {
-    int regions = 0;           // in the grid
-    int generated = 0;         // this run
-    int reused = 0;            // valid records found (this shard's regions)
-    int regenerated = 0;       // of `generated`: had a record or files that did not check out
-    int emptyRegions = 0;      // of those this run generated or reused
+    int regions = 0;       // in the grid
+    int generated = 0;     // this run
+    int reused = 0;        // valid records found (this shard's regions)
+    int regenerated = 0;   // of `generated`: had a record or files that did not check out
+    int emptyRegions = 0;  // of those this run generated or reused
     bool indexWritten = false;
     size_t streetEdges = 0, blocks = 0;  // of the whole city (0 if nothing was generated)
     // Totals over the regions this run generated or reused.

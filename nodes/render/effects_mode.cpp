@@ -57,7 +57,9 @@ public:
         return _viewer.get();
     }
     double beginViewerFrame(const Camera& camera) override {
-        if (_viewer) applyEffectsState(*_viewer->getOrCreateStateSet(), _ctx.options.effects, !_inner->hazesRasterPixels());  // live toggles
+        if (_viewer)
+            applyEffectsState(*_viewer->getOrCreateStateSet(), _ctx.options.effects,
+                              !_inner->hazesRasterPixels());  // live toggles
         return effectsFarPlane(_inner->beginViewerFrame(camera), _ctx.options.effects);
     }
     FrameStats lastViewerStats() const override {

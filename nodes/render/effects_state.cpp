@@ -28,8 +28,9 @@ osg::Program* hazeProgram() {
         p->setName("vista.haze");
         p->addShader(new osg::Shader(osg::Shader::VERTEX, kHazeVertexShader));
         p->addShader(new osg::Shader(osg::Shader::FRAGMENT,
-                                     std::string(kHazeGlsl) + "varying float vista_eye_depth;\n"
-                                                              "void main() { gl_FragColor = vistaHaze(gl_Color, vista_eye_depth); }\n"));
+                                     std::string(kHazeGlsl) +
+                                         "varying float vista_eye_depth;\n"
+                                         "void main() { gl_FragColor = vistaHaze(gl_Color, vista_eye_depth); }\n"));
         return p;
     }();
     return prog.get();
@@ -43,7 +44,8 @@ void applyEffectsState(osg::StateSet& ss, const FrameEffects& fx, bool hazeInRas
     // older value (GL keeps uniform values per program) are reset too.
     const glm::u8vec4 c = fx.hazeColor();
     ss.getOrCreateUniform(kHazeDensityUniform, osg::Uniform::FLOAT)->set(haze ? float(fx.extinction()) : 0.0f);
-    ss.getOrCreateUniform(kHazeColorUniform, osg::Uniform::FLOAT_VEC3)->set(osg::Vec3(c.x / 255.0f, c.y / 255.0f, c.z / 255.0f));
+    ss.getOrCreateUniform(kHazeColorUniform, osg::Uniform::FLOAT_VEC3)
+        ->set(osg::Vec3(c.x / 255.0f, c.y / 255.0f, c.z / 255.0f));
     if (haze) ss.setAttributeAndModes(hazeProgram(), osg::StateAttribute::ON);
     else ss.removeAttribute(osg::StateAttribute::PROGRAM);
 }

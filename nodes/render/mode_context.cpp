@@ -14,7 +14,8 @@ osg::Node* ModeContext::plainScene() {
     if (auto* baked = dynamic_cast<ViewCellSwitch*>(scene)) {
         osg::ref_ptr<osg::Group> tiles = new osg::Group;
         tiles->setStateSet(baked->getStateSet());
-        for (unsigned i = 0; i < baked->getTileCount() && i < baked->getNumChildren(); ++i) tiles->addChild(baked->getChild(i));
+        for (unsigned i = 0; i < baked->getTileCount() && i < baked->getNumChildren(); ++i)
+            tiles->addChild(baked->getChild(i));
         _plain = tiles;
     } else {
         _plain = scene;

@@ -20,6 +20,8 @@ private:
 
 }  // namespace
 
-Result<std::unique_ptr<RenderMode>> makeFullMode(ModeContext& ctx) { return std::unique_ptr<RenderMode>(new FullMode(ctx)); }
+Result<std::unique_ptr<RenderMode>> makeFullMode(ModeContext& ctx) {
+    return std::unique_ptr<RenderMode>(new FullMode(ctx));
+}
 
 }  // namespace vista

@@ -44,8 +44,9 @@ public:
         Stopwatch sw;
         // Cull: the near/far split.
         const double nearD = chooseNear(camera);
-        std::vector<uint32_t> sel = byBudget() ? selectNearFieldByBudget(_near.objects, camera.eye, _ctx.options.triangleBudget)
-                                               : selectNearField(_adaptive->index(), camera.eye, nearD);
+        std::vector<uint32_t> sel =
+            byBudget() ? selectNearFieldByBudget(_near.objects, camera.eye, _ctx.options.triangleBudget)
+                       : selectNearField(_adaptive->index(), camera.eye, nearD);
         _root->removeChildren(0, _root->getNumChildren());
         uint64_t tris = 0;
         for (uint32_t i : sel) {
@@ -56,7 +57,8 @@ public:
         if (autoSplit()) {
             stats.notes.push_back(nearAutoNote(nearD));
             char model[160];
-            std::snprintf(model, sizeof model, "split model: %.3g ms/k triangles, %.3g ms/k far pixels, %.2f ms far fixed",
+            std::snprintf(model, sizeof model,
+                          "split model: %.3g ms/k triangles, %.3g ms/k far pixels, %.2f ms far fixed",
                           1e3 * _adaptive->msPerTriangle(), 1e3 * _adaptive->msPerRay(), _adaptive->farFixedMs());
             stats.notes.push_back(model);
         }
@@ -75,11 +77,13 @@ public:
         if (sel.empty()) {
             // Nothing near (ray casting, or an eye far from every chunk): no GL pass, no
             // read-back; the far field fills every pixel.
-            if (out.width != camera.width || out.height != camera.height || !out.valid()) out = Image(camera.width, camera.height);
+            if (out.width != camera.width || out.height != camera.height || !out.valid())
+                out = Image(camera.width, camera.height);
             _depth.clear();
             stats.notes.push_back("near field empty: no GL pass");
         } else {
-            VISTA_RETURN_IF_ERROR(_ctx.renderer->render(_root.get(), camera, zFar, &out, &_depth, ns, /*skyLayer=*/false));
+            VISTA_RETURN_IF_ERROR(
+                _ctx.renderer->render(_root.get(), camera, zFar, &out, &_depth, ns, /*skyLayer=*/false));
             stats.stages.set(Stage::Near, ns.frameMs);
             stats.stages.set(Stage::Readback, ns.stages.ms(Stage::Readback));  // part of Near
         }
@@ -91,8 +95,7 @@ public:
         const bool haveDepth = !sel.empty() && _depth.size() == size_t(camera.width) * size_t(camera.height);
         _far->render(camera, haveDepth ? _depth.data() : nullptr, out, stats);
         stats.frameMs = sw.ms();
-        if (autoSplit())
-            recordCosts(tris, ns.frameMs, stats);
+        if (autoSplit()) recordCosts(tris, ns.frameMs, stats);
         return Status::ok();
     }
     void reset() override { _far->reset(); }
@@ -185,8 +188,8 @@ private:
     RasterSelection _raster;
     // Viewer face.
     osg::ref_ptr<osg::Node> _viewer;
-    NearFarSplit* _split = nullptr;     // owned by _viewer
-    FarFieldNode* _farNode = nullptr;   // owned by _viewer
+    NearFarSplit* _split = nullptr;    // owned by _viewer
+    FarFieldNode* _farNode = nullptr;  // owned by _viewer
     Stopwatch _viewerClock;
     int _viewerFrames = 0;
     double _viewerNear = 0;

@@ -42,14 +42,17 @@ Result<std::unique_ptr<RenderMode>> makeImpostorMode(ModeContext& ctx) {
     SetupTimes setup;
     if (!root) {
         if (ctx.options.bakedFile.empty())
-            return Status::error(isMeshBake(ctx.scene)
-                                     ? "mode impostor: the scene holds textured depth meshes (mode lodmesh); pass --baked city.baked.osgb "
-                                       "(from 'vista bake') for point impostors"
-                                     : "mode impostor: the city is not baked; pass --baked city.baked.osgb (from 'vista bake')");
+            return Status::error(
+                isMeshBake(ctx.scene)
+                    ? "mode impostor: the scene holds textured depth meshes (mode lodmesh); pass --baked "
+                      "city.baked.osgb "
+                      "(from 'vista bake') for point impostors"
+                    : "mode impostor: the city is not baked; pass --baked city.baked.osgb (from 'vista bake')");
         auto bf = loadBakeForMode(ctx, ctx.options.bakedFile);
         if (!bf) return bf.status();
         if (bf->meshes)
-            return Status::error("mode impostor: '" + ctx.options.bakedFile + "' holds textured depth meshes; use mode lodmesh");
+            return Status::error("mode impostor: '" + ctx.options.bakedFile +
+                                 "' holds textured depth meshes; use mode lodmesh");
         root = bf->root;
         setup.push_back({"baked_load", bf->loadMs});
     }

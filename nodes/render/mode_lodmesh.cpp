@@ -9,7 +9,8 @@ namespace {
 
 class LodMeshMode : public GraphMode {
 public:
-    LodMeshMode(ModeContext& ctx, osg::ref_ptr<ViewCellSwitch> root, const SetupTimes& setup) : GraphMode(ctx), _root(std::move(root)) {
+    LodMeshMode(ModeContext& ctx, osg::ref_ptr<ViewCellSwitch> root, const SetupTimes& setup)
+        : GraphMode(ctx), _root(std::move(root)) {
         _setup = setup;
         // The near field in hybrid's 40 m chunks and at its near distance (view_cell_switch.h).
         _root->setNearChunks(ctx.nearField(), ctx.options.fixedNearDistance());
@@ -23,8 +24,8 @@ protected:
     void describe(FrameStats& stats) const override {
         const int cell = _root->lastCell();
         stats.notes.push_back("near chunks " + std::to_string(_root->lastChunkCount()));
-        stats.notes.push_back(cell >= 0 ? "cell " + std::to_string(cell) + " (" + std::to_string(_root->impostorsOf(uint32_t(cell)).size()) +
-                                              " meshes)"
+        stats.notes.push_back(cell >= 0 ? "cell " + std::to_string(cell) + " (" +
+                                              std::to_string(_root->impostorsOf(uint32_t(cell)).size()) + " meshes)"
                                         : "no cell");
     }
 
@@ -40,12 +41,14 @@ Result<std::unique_ptr<RenderMode>> makeLodMeshMode(ModeContext& ctx) {
     if (!root) {
         const std::string file = !ctx.options.bakedMeshFile.empty() ? ctx.options.bakedMeshFile : ctx.options.bakedFile;
         if (file.empty())
-            return Status::error("mode lodmesh: the city has no textured depth meshes; open or pass (--baked-mesh) a file from "
-                                 "'vista bake --representation mesh'");
+            return Status::error(
+                "mode lodmesh: the city has no textured depth meshes; open or pass (--baked-mesh) a file from "
+                "'vista bake --representation mesh'");
         auto bf = loadBakeForMode(ctx, file);
         if (!bf) return bf.status();
         if (!bf->meshes)
-            return Status::error("mode lodmesh: '" + file + "' holds point impostors; pass --baked-mesh with a file from "
+            return Status::error("mode lodmesh: '" + file +
+                                 "' holds point impostors; pass --baked-mesh with a file from "
                                  "'vista bake --representation mesh'");
         root = bf->root;
         setup.push_back({"baked_load", bf->loadMs});

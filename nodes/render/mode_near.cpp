@@ -15,7 +15,9 @@ public:
     std::string name() const override { return "near"; }
 
 protected:
-    double prepare(const Camera& camera) override { return std::max(_ctx.options.fixedNearDistance(), camera.zNear * 2.0); }
+    double prepare(const Camera& camera) override {
+        return std::max(_ctx.options.fixedNearDistance(), camera.zNear * 2.0);
+    }
     void describe(FrameStats& stats) const override {
         if (_ctx.options.nearDistance <= 0) stats.notes.push_back("near distance auto -> 100 m");
     }
@@ -23,6 +25,8 @@ protected:
 
 }  // namespace
 
-Result<std::unique_ptr<RenderMode>> makeNearMode(ModeContext& ctx) { return std::unique_ptr<RenderMode>(new NearMode(ctx)); }
+Result<std::unique_ptr<RenderMode>> makeNearMode(ModeContext& ctx) {
+    return std::unique_ptr<RenderMode>(new NearMode(ctx));
+}
 
 }  // namespace vista

@@ -29,8 +29,10 @@ namespace {
 // Other layouts (not a Vec3Array with indexed triangles) are returned as is.
 osg::ref_ptr<osg::Geometry> welded(const osg::Geometry& g) {
     const auto* v = dynamic_cast<const osg::Vec3Array*>(g.getVertexArray());
-    const auto* de = g.getNumPrimitiveSets() == 1 ? dynamic_cast<const osg::DrawElements*>(g.getPrimitiveSet(0)) : nullptr;
-    if (!v || !de || de->getMode() != GL_TRIANGLES) return new osg::Geometry(g, osg::CopyOp::DEEP_COPY_ARRAYS | osg::CopyOp::DEEP_COPY_PRIMITIVES);
+    const auto* de =
+        g.getNumPrimitiveSets() == 1 ? dynamic_cast<const osg::DrawElements*>(g.getPrimitiveSet(0)) : nullptr;
+    if (!v || !de || de->getMode() != GL_TRIANGLES)
+        return new osg::Geometry(g, osg::CopyOp::DEEP_COPY_ARRAYS | osg::CopyOp::DEEP_COPY_PRIMITIVES);
     const auto* c = dynamic_cast<const osg::Vec4ubArray*>(g.getColorArray());
     const auto* n = dynamic_cast<const osg::Vec3Array*>(g.getNormalArray());
     std::map<std::tuple<int64_t, int64_t, int64_t>, GLuint> index;
@@ -40,7 +42,8 @@ osg::ref_ptr<osg::Geometry> welded(const osg::Geometry& g) {
     osg::ref_ptr<osg::Vec3Array> nn = new osg::Vec3Array;
     for (size_t i = 0; i < v->size(); ++i) {
         const osg::Vec3& p = (*v)[i];
-        auto key = std::make_tuple(std::llround(p.x() * 1000.0), std::llround(p.y() * 1000.0), std::llround(p.z() * 1000.0));
+        auto key =
+            std::make_tuple(std::llround(p.x() * 1000.0), std::llround(p.y() * 1000.0), std::llround(p.z() * 1000.0));
         auto [it, fresh] = index.emplace(key, GLuint(nv->size()));
         if (fresh) {
             nv->push_back(p);
@@ -64,8 +67,8 @@ osg::ref_ptr<osg::Geometry> welded(const osg::Geometry& g) {
         osg::ref_ptr<osg::Vec4ubArray> nc = new osg::Vec4ubArray;
         for (size_t k = 0; k < nv->size(); ++k) {
             const osg::Vec4d a = colour[k] / double(std::max(1, count[k]));
-            nc->push_back(osg::Vec4ub(uint8_t(std::lround(a.x())), uint8_t(std::lround(a.y())), uint8_t(std::lround(a.z())),
-                                      uint8_t(std::lround(a.w()))));
+            nc->push_back(osg::Vec4ub(uint8_t(std::lround(a.x())), uint8_t(std::lround(a.y())),
+                                      uint8_t(std::lround(a.z())), uint8_t(std::lround(a.w()))));
         }
         nc->setNormalize(c->getNormalize());
         w->setColorArray(nc.get(), osg::Array::BIND_PER_VERTEX);
@@ -103,8 +106,10 @@ public:
         if (_protos.count(key) || tree.getNumPrimitiveSets() == 0) return;
         osg::ref_ptr<osg::Geometry> plain = new osg::Geometry;
         plain->setVertexArray(const_cast<osg::Array*>(tree.getVertexArray()));
-        if (tree.getNormalArray()) plain->setNormalArray(const_cast<osg::Array*>(tree.getNormalArray()), osg::Array::BIND_PER_VERTEX);
-        if (tree.getColorArray()) plain->setColorArray(const_cast<osg::Array*>(tree.getColorArray()), osg::Array::BIND_PER_VERTEX);
+        if (tree.getNormalArray())
+            plain->setNormalArray(const_cast<osg::Array*>(tree.getNormalArray()), osg::Array::BIND_PER_VERTEX);
+        if (tree.getColorArray())
+            plain->setColorArray(const_cast<osg::Array*>(tree.getColorArray()), osg::Array::BIND_PER_VERTEX);
         osg::ref_ptr<osg::PrimitiveSet> ps =
             static_cast<osg::PrimitiveSet*>(tree.getPrimitiveSet(0)->clone(osg::CopyOp::DEEP_COPY_ALL));
         ps->setNumInstances(0);
@@ -121,16 +126,21 @@ public:
         g->setUseDisplayList(false);
         g->setUseVertexBufferObjects(true);
         g->setVertexArray(const_cast<osg::Array*>(p.getVertexArray()));
-        if (p.getNormalArray()) g->setNormalArray(const_cast<osg::Array*>(p.getNormalArray()), osg::Array::BIND_PER_VERTEX);
-        if (p.getColorArray()) g->setColorArray(const_cast<osg::Array*>(p.getColorArray()), osg::Array::BIND_PER_VERTEX);
-        osg::ref_ptr<osg::PrimitiveSet> ps = static_cast<osg::PrimitiveSet*>(p.getPrimitiveSet(0)->clone(osg::CopyOp::SHALLOW_COPY));
+        if (p.getNormalArray())
+            g->setNormalArray(const_cast<osg::Array*>(p.getNormalArray()), osg::Array::BIND_PER_VERTEX);
+        if (p.getColorArray())
+            g->setColorArray(const_cast<osg::Array*>(p.getColorArray()), osg::Array::BIND_PER_VERTEX);
+        osg::ref_ptr<osg::PrimitiveSet> ps =
+            static_cast<osg::PrimitiveSet*>(p.getPrimitiveSet(0)->clone(osg::CopyOp::SHALLOW_COPY));
         ps->setNumInstances(tree.getPrimitiveSet(0)->getNumInstances());
         g->addPrimitiveSet(ps.get());
         for (unsigned c = 0; c < 4; ++c)
-            g->setVertexAttribArray(kInstanceAttrib0 + c, const_cast<osg::Array*>(tree.getVertexAttribArray(kInstanceAttrib0 + c)),
+            g->setVertexAttribArray(kInstanceAttrib0 + c,
+                                    const_cast<osg::Array*>(tree.getVertexAttribArray(kInstanceAttrib0 + c)),
                                     osg::Array::BIND_PER_VERTEX);
         g->setInitialBound(tree.getInitialBound());
-        g->setComputeBoundingBoxCallback(const_cast<osg::Drawable::ComputeBoundingBoxCallback*>(tree.getComputeBoundingBoxCallback()));
+        g->setComputeBoundingBoxCallback(
+            const_cast<osg::Drawable::ComputeBoundingBoxCallback*>(tree.getComputeBoundingBoxCallback()));
         g->setStateSet(const_cast<osg::StateSet*>(tree.getStateSet()));
         return g;
     }
@@ -171,10 +181,12 @@ public:
         for (unsigned c = 0; c < 4; ++c)
             if (!(cols[c] = const_cast<osg::Array*>(tree.getVertexAttribArray(kInstanceAttrib0 + c)))) return nullptr;
         long pi = std::strtol(tree.getName().c_str() + std::strlen(kTreeGeometryPrefix), nullptr, 10);
-        osg::ref_ptr<osg::Geometry> g = instancedTreeImpostor(it->second, unsigned(std::max(0L, pi)), cols,
-                                                              unsigned(std::max(0, tree.getPrimitiveSet(0)->getNumInstances())),
-                                                              tree.getInitialBound());
-        if (g) g->setComputeBoundingBoxCallback(const_cast<osg::Drawable::ComputeBoundingBoxCallback*>(tree.getComputeBoundingBoxCallback()));
+        osg::ref_ptr<osg::Geometry> g = instancedTreeImpostor(
+            it->second, unsigned(std::max(0L, pi)), cols,
+            unsigned(std::max(0, tree.getPrimitiveSet(0)->getNumInstances())), tree.getInitialBound());
+        if (g)
+            g->setComputeBoundingBoxCallback(
+                const_cast<osg::Drawable::ComputeBoundingBoxCallback*>(tree.getComputeBoundingBoxCallback()));
         return g;
     }
 
@@ -189,12 +201,15 @@ osg::Geode* chunkGeode(osg::Node* chunk) {
 }
 
 // Trees: simplified prototypes (`impostors` null) or impostors.
-osg::ref_ptr<osg::Geode> simplifiedGeode(const osg::Geode& src, double ratio, const PrototypeCache& trees, const ImpostorCache* impostors) {
+osg::ref_ptr<osg::Geode> simplifiedGeode(const osg::Geode& src, double ratio, const PrototypeCache& trees,
+                                         const ImpostorCache* impostors) {
     osg::ref_ptr<osg::Geode> out = new osg::Geode;
     for (unsigned i = 0; i < src.getNumDrawables(); ++i) {
         const osg::Geometry* g = src.getDrawable(i)->asGeometry();
         if (!g) continue;
-        osg::ref_ptr<osg::Geometry> s = !isTree(g) ? simplifiedCopy(*g, ratio) : impostors ? impostors->instance(*g) : trees.instance(*g);
+        osg::ref_ptr<osg::Geometry> s = !isTree(g)  ? simplifiedCopy(*g, ratio)
+                                        : impostors ? impostors->instance(*g)
+                                                    : trees.instance(*g);
         if (s) out->addDrawable(s.get());
     }
     return out;
@@ -222,7 +237,8 @@ public:
         tbb::parallel_for(size_t(0), nf.chunks.size(), [&](size_t i) {
             if (osg::Geode* geode = chunkGeode(nf.chunks[i].get()))
                 for (int l = 0; l < 2; ++l)
-                    far[l][i] = simplifiedGeode(*geode, ratios[l], trees[l], l + 1 >= kOsgLodTreeImpostorLevel ? &impostors : nullptr);
+                    far[l][i] = simplifiedGeode(*geode, ratios[l], trees[l],
+                                                l + 1 >= kOsgLodTreeImpostorLevel ? &impostors : nullptr);
         });
         _setup.push_back({"simplify", sw.ms()});
         _root = smallFeatureCulling();
@@ -273,6 +289,8 @@ private:
 
 }  // namespace
 
-Result<std::unique_ptr<RenderMode>> makeOsgLodMode(ModeContext& ctx) { return std::unique_ptr<RenderMode>(new OsgLodMode(ctx)); }
+Result<std::unique_ptr<RenderMode>> makeOsgLodMode(ModeContext& ctx) {
+    return std::unique_ptr<RenderMode>(new OsgLodMode(ctx));
+}
 
 }  // namespace vista

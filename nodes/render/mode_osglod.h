@@ -41,9 +41,10 @@
 namespace vista {
 
 constexpr double kOsgLodRatio1 = 0.25, kOsgLodRatio2 = 0.0625;  // Simplifier sample ratios of levels 1, 2
-constexpr double kOsgLodFarFactor = 4.0;                          // level 2 from kOsgLodFarFactor * nearD + r
+constexpr double kOsgLodFarFactor = 4.0;                        // level 2 from kOsgLodFarFactor * nearD + r
 constexpr float kOsgLodSmallFeaturePixels = 2.0f;
-constexpr int kOsgLodTreeImpostorLevel = 1;  // trees are impostors on levels >= this (1 or 2; 1 measured better: fewer triangles, closer to full)
+constexpr int kOsgLodTreeImpostorLevel =
+    1;  // trees are impostors on levels >= this (1 or 2; 1 measured better: fewer triangles, closer to full)
 
 Result<std::unique_ptr<RenderMode>> makeOsgLodMode(ModeContext& ctx);
 

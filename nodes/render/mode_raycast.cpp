@@ -41,10 +41,13 @@ void castEveryPixel(const RayScene& rays, const Camera& camera, Image& out, Fram
 class RaycastDrawable : public ReadbackDrawable {
 public:
     RaycastDrawable(const RayScene& rays, const FrameEffects* fx) : _rays(rays), _fx(fx) {}
-    RaycastDrawable(const RaycastDrawable& o, const osg::CopyOp& op) : ReadbackDrawable(o, op), _rays(o._rays), _fx(o._fx) {}
+    RaycastDrawable(const RaycastDrawable& o, const osg::CopyOp& op)
+        : ReadbackDrawable(o, op), _rays(o._rays), _fx(o._fx) {}
     osg::Object* cloneType() const override { return new RaycastDrawable(_rays, _fx); }
     osg::Object* clone(const osg::CopyOp& op) const override { return new RaycastDrawable(*this, op); }
-    bool isSameKindAs(const osg::Object* o) const override { return dynamic_cast<const RaycastDrawable*>(o) != nullptr; }
+    bool isSameKindAs(const osg::Object* o) const override {
+        return dynamic_cast<const RaycastDrawable*>(o) != nullptr;
+    }
     const char* libraryName() const override { return "vista"; }
     const char* className() const override { return "RaycastDrawable"; }
 

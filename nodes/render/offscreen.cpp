@@ -108,8 +108,9 @@ osg::Matrixd toOsg(const glm::dmat4& m) { return osg::Matrixd(glm::value_ptr(m))
 
 void setExactCulling(osg::Camera& cam) {
     cam.setComputeNearFarMode(osg::CullSettings::DO_NOT_COMPUTE_NEAR_FAR);
-    cam.setCullingMode((cam.getCullingMode() | osg::CullSettings::NEAR_PLANE_CULLING | osg::CullSettings::FAR_PLANE_CULLING) &
-                       ~osg::CullSettings::SMALL_FEATURE_CULLING);
+    cam.setCullingMode(
+        (cam.getCullingMode() | osg::CullSettings::NEAR_PLANE_CULLING | osg::CullSettings::FAR_PLANE_CULLING) &
+        ~osg::CullSettings::SMALL_FEATURE_CULLING);
 }
 
 namespace {
@@ -119,7 +120,8 @@ namespace {
 // every frame; SceneView::draw flushes when the frame before had it on).
 class PeriodicFlushRenderer : public osgViewer::Renderer {
 public:
-    PeriodicFlushRenderer(osg::Camera* camera, unsigned frames) : osgViewer::Renderer(camera), _frames(std::max(1u, frames)) {}
+    PeriodicFlushRenderer(osg::Camera* camera, unsigned frames)
+        : osgViewer::Renderer(camera), _frames(std::max(1u, frames)) {}
 
 protected:
     void updateSceneView(osgUtil::SceneView* sceneView) override {
@@ -243,7 +245,8 @@ Result<std::unique_ptr<OffscreenRenderer>> OffscreenRenderer::create(int width, 
                              " out of range 1x1 .. 8192x8192");
     const char* display = std::getenv("DISPLAY");
     if (!display || !*display)
-        return Status::error("no X display (DISPLAY is not set): run under `xvfb-run -a` on a machine without a screen");
+        return Status::error(
+            "no X display (DISPLAY is not set): run under `xvfb-run -a` on a machine without a screen");
     osg::ref_ptr<osg::GraphicsContext::Traits> traits = new osg::GraphicsContext::Traits;
     traits->readDISPLAY();
     traits->setUndefinedScreenDetailsToDefaultScreen();
@@ -269,8 +272,9 @@ Result<std::unique_ptr<OffscreenRenderer>> OffscreenRenderer::create(int width, 
         std::this_thread::sleep_for(std::chrono::milliseconds(50 + 50 * attempt));
     }
     if (!gc || !gc->valid())
-        return Status::error(std::string("cannot create an OpenGL window on display '") + display +
-                             "' (no GLX visual with RGBA8 + depth24?); try `xvfb-run -a -s \"-screen 0 1920x1080x24\"`");
+        return Status::error(
+            std::string("cannot create an OpenGL window on display '") + display +
+            "' (no GLX visual with RGBA8 + depth24?); try `xvfb-run -a -s \"-screen 0 1920x1080x24\"`");
 
     std::unique_ptr<OffscreenRenderer> r(new OffscreenRenderer);
     Impl& m = *r->_impl;
@@ -318,7 +322,8 @@ Status OffscreenRenderer::render(osg::Node* scene, const Camera& camera, double 
     Impl& m = *_impl;
     if (camera.width != m.width || camera.height != m.height)
         return Status::error("camera size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
-                             " differs from the renderer's " + std::to_string(m.width) + "x" + std::to_string(m.height));
+                             " differs from the renderer's " + std::to_string(m.width) + "x" +
+                             std::to_string(m.height));
     Stopwatch sw;
     m.sky->node()->setNodeMask(skyLayer ? ~0u : 0u);
     if (skyLayer) m.sky->showSky(camera, m.jx, m.jy);
@@ -340,7 +345,8 @@ Status OffscreenRenderer::renderLabels(osg::Node* labelScene, const Camera& came
     Impl& m = *_impl;
     if (camera.width != m.width || camera.height != m.height)
         return Status::error("camera size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
-                             " differs from the renderer's " + std::to_string(m.width) + "x" + std::to_string(m.height));
+                             " differs from the renderer's " + std::to_string(m.width) + "x" +
+                             std::to_string(m.height));
     if (!m.labelCam) m.makeLabelCamera();
     Stopwatch sw;
     m.labelCam->setViewMatrix(toOsg(camera.view()));
@@ -374,7 +380,8 @@ Status OffscreenRenderer::renderLabels(osg::Node* labelScene, const Camera& came
         const size_t src = size_t(H - 1 - y) * size_t(W), dst = size_t(y) * size_t(W);
         for (int x = 0; x < W; ++x) {
             const uint8_t* p = ib + 4 * (src + size_t(x));
-            out.ids[dst + size_t(x)] = uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+            out.ids[dst + size_t(x)] =
+                uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
             const float* d = db + 4 * (src + size_t(x));
             out.depth[dst + size_t(x)] = d[0];
             const float c = d[1];
@@ -391,6 +398,8 @@ void OffscreenRenderer::setSubpixelOffset(double dx, double dy) {
     _impl->jx = dx;
     _impl->jy = dy;
 }
-std::string OffscreenRenderer::glRenderer() const { return _impl->readback ? _impl->readback->renderer : std::string(); }
+std::string OffscreenRenderer::glRenderer() const {
+    return _impl->readback ? _impl->readback->renderer : std::string();
+}
 
 }  // namespace vista

@@ -19,7 +19,8 @@ class RayScene;
 class ReflectionDrawable : public ReadbackDrawable {
 public:
     ReflectionDrawable(const RayScene* rays, const FrameEffects* fx) : _rays(rays), _fx(fx) {}
-    ReflectionDrawable(const ReflectionDrawable& o, const osg::CopyOp& op) : ReadbackDrawable(o, op), _rays(o._rays), _fx(o._fx) {}
+    ReflectionDrawable(const ReflectionDrawable& o, const osg::CopyOp& op)
+        : ReadbackDrawable(o, op), _rays(o._rays), _fx(o._fx) {}
     META_Object(vista, ReflectionDrawable);
 
 protected:

@@ -16,16 +16,18 @@ namespace vista {
 
 const std::vector<ModeInfo>& renderModes() {
     static const std::vector<ModeInfo> kModes = {
-        {"full", "all geometry in 40 m chunks, far plane at infinity (the exact reference)", false, false, makeFullMode},
+        {"full", "all geometry in 40 m chunks, far plane at infinity (the exact reference)", false, false,
+         makeFullMode},
         {"near", "only the near field: the chunked city clipped at --near metres", false, false, makeNearMode},
         {"raycast", "every pixel ray cast with Embree, prelit colours", true, false, makeRaycastMode},
-        {"osgimpostor", "stock osgSim::Impostor on every tile beyond --near + tile radius", false, false, makeOsgImpostorMode},
-        {"osglod", "stock osg::LOD per chunk with osgUtil::Simplifier far versions + small-feature culling", false, false,
-         makeOsgLodMode},
+        {"osgimpostor", "stock osgSim::Impostor on every tile beyond --near + tile radius", false, false,
+         makeOsgImpostorMode},
+        {"osglod", "stock osg::LOD per chunk with osgUtil::Simplifier far versions + small-feature culling", false,
+         false, makeOsgLodMode},
         {"hybrid", "near field rasterised + ray-cast far field (horizon, cache, Embree)", true, false, makeHybridMode},
         {"impostor", "near field + baked point impostors (needs a baked file: --baked)", false, true, makeImpostorMode},
-        {"lodmesh", "near field + the cell's textured depth meshes (a file from 'vista bake --representation mesh')", false, false,
-         makeLodMeshMode},
+        {"lodmesh", "near field + the cell's textured depth meshes (a file from 'vista bake --representation mesh')",
+         false, false, makeLodMeshMode},
     };
     return kModes;
 }
@@ -48,7 +50,8 @@ Result<std::unique_ptr<RenderMode>> createRenderMode(const std::string& name, Mo
     const ModeInfo* m = findRenderMode(name);
     if (!m) return Status::error("unknown mode '" + name + "'; available modes: " + renderModeNames());
     if (!ctx.scene) return Status::error("mode " + name + " needs a scene graph, none was loaded");
-    if (m->needsRays && !ctx.rays) return Status::error("mode " + name + " needs the city's ray scene, which is not available");
+    if (m->needsRays && !ctx.rays)
+        return Status::error("mode " + name + " needs the city's ray scene, which is not available");
     if (effectsNeedRays(ctx.options.effects) && !ctx.rays)
         return Status::error("mode " + name + ": glass reflections need the city's ray scene, which is not available");
     auto inner = m->make(ctx);

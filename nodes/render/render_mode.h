@@ -53,20 +53,23 @@ constexpr double kDefaultNearDistance = 100.0;
 
 struct ModeOptions {
     double nearDistance = kDefaultNearDistance;  // metres, 1 .. 100000; < 0 = auto (hybrid: adaptive split)
-    uint64_t triangleBudget = 0;  // hybrid: > 0 = near field = nearest chunks up to this many triangles
-    int64_t pixelBudget = -1;     // hybrid: far-field rays per frame through the cache; < 0 = unlimited
-    int horizonGrid = 0;          // hybrid: horizon height-grid cells per side, 1 .. 8192, 0 = auto (HeightGrid::autoCells)
-    bool cache = true;            // hybrid: panoramic image cache on/off
-    bool cacheAdaptive = true;    // hybrid: pause the cache while it does not pay (FarFieldOptions::cacheAdaptive)
-    double cacheErrorPx = 0.25;   // hybrid: reuse a cached far pixel while its reprojection error is below this, 0 .. 100
-    bool overlap = true;          // hybrid: trace the horizon on another thread while the near field is drawn
-    double frameMsTarget = 0.0;   // hybrid: > 0 = the ray budget adapts so the frame takes about this long (ms), 0 .. 10000
-    int farStep = 1;              // hybrid: far-field ray spacing, 1 (a ray per pixel) or 2 (FarFieldOptions::rayStep)
-    int threads = 0;              // ray-casting threads; 0 = all cores
-    double splatSigma = kDefaultSplatSigma;  // impostor: splat Gaussian sigma in output pixels (PointImpostor), 0 = 1-pixel points
-    std::string bakedFile;        // impostor: the baked file (unless the scene itself is baked)
-    std::string bakedMeshFile;    // lodmesh: the mesh bake (unless the scene itself is one)
-    FrameEffects effects;         // run-time effects of every mode (haze, glass reflections, night sky)
+    uint64_t triangleBudget = 0;                 // hybrid: > 0 = near field = nearest chunks up to this many triangles
+    int64_t pixelBudget = -1;                    // hybrid: far-field rays per frame through the cache; < 0 = unlimited
+    int horizonGrid = 0;  // hybrid: horizon height-grid cells per side, 1 .. 8192, 0 = auto (HeightGrid::autoCells)
+    bool cache = true;    // hybrid: panoramic image cache on/off
+    bool cacheAdaptive = true;  // hybrid: pause the cache while it does not pay (FarFieldOptions::cacheAdaptive)
+    double cacheErrorPx =
+        0.25;             // hybrid: reuse a cached far pixel while its reprojection error is below this, 0 .. 100
+    bool overlap = true;  // hybrid: trace the horizon on another thread while the near field is drawn
+    double frameMsTarget =
+        0.0;          // hybrid: > 0 = the ray budget adapts so the frame takes about this long (ms), 0 .. 10000
+    int farStep = 1;  // hybrid: far-field ray spacing, 1 (a ray per pixel) or 2 (FarFieldOptions::rayStep)
+    int threads = 0;  // ray-casting threads; 0 = all cores
+    double splatSigma =
+        kDefaultSplatSigma;     // impostor: splat Gaussian sigma in output pixels (PointImpostor), 0 = 1-pixel points
+    std::string bakedFile;      // impostor: the baked file (unless the scene itself is baked)
+    std::string bakedMeshFile;  // lodmesh: the mesh bake (unless the scene itself is one)
+    FrameEffects effects;       // run-time effects of every mode (haze, glass reflections, night sky)
     // Baked files the program already loaded and checked against the city
     // (checkBakedFromCity), by path as in bakedFile / bakedMeshFile: impostor
     // and lodmesh take the root from here instead of loading the file again

@@ -25,10 +25,16 @@ void renderSky(const Camera& camera, Image& out, double jx, double jy, bool nigh
 SkyBackground::SkyBackground(int width, int height) {
     _quad = new osg::Geometry;
     osg::ref_ptr<osg::Vec3Array> v = new osg::Vec3Array;
-    v->push_back({0, 0, 0}); v->push_back({1, 0, 0}); v->push_back({1, 1, 0}); v->push_back({0, 1, 0});
+    v->push_back({0, 0, 0});
+    v->push_back({1, 0, 0});
+    v->push_back({1, 1, 0});
+    v->push_back({0, 1, 0});
     // Image row 0 (top) is texture row 0: the quad maps t = 0 to the top.
     osg::ref_ptr<osg::Vec2Array> tc = new osg::Vec2Array;
-    tc->push_back({0, 1}); tc->push_back({1, 1}); tc->push_back({1, 0}); tc->push_back({0, 0});
+    tc->push_back({0, 1});
+    tc->push_back({1, 1});
+    tc->push_back({1, 0});
+    tc->push_back({0, 0});
     osg::ref_ptr<osg::Vec4Array> c = new osg::Vec4Array;
     c->push_back({1, 1, 1, 1});
     _quad->setVertexArray(v.get());
@@ -99,7 +105,8 @@ void SkyBackground::showSky(const Camera& camera, double jx, double jy) {
 Status SkyBackground::showImage(const Image& image) {
     if (!image.valid() || image.width != _image->s() || image.height != _image->t())
         return Status::error("background image " + std::to_string(image.width) + "x" + std::to_string(image.height) +
-                             " differs from the layer's " + std::to_string(_image->s()) + "x" + std::to_string(_image->t()));
+                             " differs from the layer's " + std::to_string(_image->s()) + "x" +
+                             std::to_string(_image->t()));
     upload(image);
     _skyShown = false;
     return Status::ok();

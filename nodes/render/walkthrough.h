@@ -45,15 +45,15 @@
 namespace vista {
 
 struct WalkthroughRequest {
-    std::string city;          // a city file or a paged city directory
-    const char* cmd = "vista"; // prefix of notes and warnings
-    bool quiet = false;        // no notes on stderr (warnings stay)
-    bool allowPaged = true;    // false: a directory is loaded as a city file (and refused by it)
-    PagedReach paged;          // what a paged city loads around the path
+    std::string city;              // a city file or a paged city directory
+    const char* cmd = "vista";     // prefix of notes and warnings
+    bool quiet = false;            // no notes on stderr (warnings stay)
+    bool allowPaged = true;        // false: a directory is loaded as a city file (and refused by it)
+    PagedReach paged;              // what a paged city loads around the path
     bool pathNeedsStreets = true;  // the path is generated on the streets (not read from a CSV)
     std::function<Result<Path>(const SceneModel& city)> makePath;  // required
     std::function<Status(uint64_t bytes)> beforePagedLoad;  // paged: the selected files' bytes, before any is read
-    std::function<void()> cityLoaded;                        // after step 1 (e.g. a memory reading)
+    std::function<void()> cityLoaded;                       // after step 1 (e.g. a memory reading)
     std::function<Status(const SceneModel& city)> checkCity;
     std::vector<std::string> bakedModes;  // the modes whose baked files are loaded; empty = every given file
     std::function<Result<FrameEffects>(const Effects& declared)> effects;  // required

@@ -62,7 +62,8 @@ std::vector<uint32_t> selectNearField(const std::vector<SplitObject>& objects, c
     return out;
 }
 
-SplitIndex::SplitIndex(const std::vector<SplitObject>& objects, double cell) : _objects(objects), _cell(cell > 0 ? cell : 64.0) {
+SplitIndex::SplitIndex(const std::vector<SplitObject>& objects, double cell)
+    : _objects(objects), _cell(cell > 0 ? cell : 64.0) {
     double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
     for (const SplitObject& o : objects) {
         _total += o.triangles;
@@ -89,7 +90,8 @@ SplitIndex::SplitIndex(const std::vector<SplitObject>& objects, double cell) : _
             _wide.push_back(i);
             continue;
         }
-        const int cx = std::clamp(int((o.lo.x - _x0) / _cell), 0, _nx - 1), cy = std::clamp(int((o.lo.y - _y0) / _cell), 0, _ny - 1);
+        const int cx = std::clamp(int((o.lo.x - _x0) / _cell), 0, _nx - 1),
+                  cy = std::clamp(int((o.lo.y - _y0) / _cell), 0, _ny - 1);
         cellOf[i] = int64_t(cy) * _nx + cx;
         ++_start[size_t(cellOf[i]) + 1];
     }
@@ -110,7 +112,8 @@ void SplitIndex::visit(const glm::dvec3& p, double d, F&& f) const {
     }
     // A small object (extent <= cell) within d of p has its low corner in [p - d - cell, p + d].
     auto cellOf = [&](double v, int n) { return int(std::clamp(std::floor(v / _cell), -1.0, double(n))); };
-    const int cx0 = std::max(0, cellOf(p.x - d - _cell - _x0, _nx)), cy0 = std::max(0, cellOf(p.y - d - _cell - _y0, _ny));
+    const int cx0 = std::max(0, cellOf(p.x - d - _cell - _x0, _nx)),
+              cy0 = std::max(0, cellOf(p.y - d - _cell - _y0, _ny));
     const int cx1 = std::min(_nx - 1, cellOf(p.x + d - _x0, _nx)), cy1 = std::min(_ny - 1, cellOf(p.y + d - _y0, _ny));
     if (!std::isfinite(p.x) || !std::isfinite(p.y)) {  // a NaN eye: every object (boxDistance decides)
         for (uint32_t i : _items) f(i);
@@ -210,7 +213,8 @@ void AdaptiveSplit::probe(const Camera& camera) {
         if (farDirs.size() >= 100) {
             std::vector<RayHit> farHits(farDirs.size());
             Stopwatch sw;
-            _rays->intersectMany(orgs.data(), farDirs.data(), int(farDirs.size()), farHits.data(), 1e30f, nullptr, start);
+            _rays->intersectMany(orgs.data(), farDirs.data(), int(farDirs.size()), farHits.data(), 1e30f, nullptr,
+                                 start);
             const double b = sw.ms() / double(farDirs.size());
             _bProbe = _bProbe > 0 ? (1 - _o.smoothing) * _bProbe + _o.smoothing * b : b;
         }
@@ -251,7 +255,8 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
     // 3 M-triangle city the prior once chose "everything" for the first frames at 250 ms each).
     const bool measured = _haveA && _haveB;
     if (_o.rayCastOnly && measured) cand.push_back(0.0);
-    for (int i = 0; i < g; ++i) cand.push_back(_o.minDistance * std::pow(_o.maxDistance / _o.minDistance, double(i) / (g - 1)));
+    for (int i = 0; i < g; ++i)
+        cand.push_back(_o.minDistance * std::pow(_o.maxDistance / _o.minDistance, double(i) / (g - 1)));
     if (_o.everythingNear && measured) cand.push_back(std::numeric_limits<double>::infinity());
     const int n = int(cand.size());
     const double b = msPerRay();

@@ -93,14 +93,14 @@ std::vector<uint32_t> selectNearFieldByBudget(const std::vector<SplitObject>& ob
 
 struct AdaptiveSplitOptions {
     double minDistance = 15.0, maxDistance = 800.0;
-    int candidates = 16;        // geometric steps between min and max
-    int probeStride = 8;        // probe every 8th pixel in x and y, at least
-    int probeRays = 4800;       // ... and sparser on larger images: about this many rays (640x480 / 64)
-    int probeInterval = 10;     // frames between probes
-    double smoothing = 0.2;     // EMA weight of a new measurement
+    int candidates = 16;     // geometric steps between min and max
+    int probeStride = 8;     // probe every 8th pixel in x and y, at least
+    int probeRays = 4800;    // ... and sparser on larger images: about this many rays (640x480 / 64)
+    int probeInterval = 10;  // frames between probes
+    double smoothing = 0.2;  // EMA weight of a new measurement
     double initialDistance = 100.0;
-    int window = 60;            // frames in the raster-cost fit
-    int exploreEvery = 7;       // every n-th choice explores a neighbouring candidate (0 = never)
+    int window = 60;       // frames in the raster-cost fit
+    int exploreEvery = 7;  // every n-th choice explores a neighbouring candidate (0 = never)
     // Two more candidates at the ends: 0 (nothing rasterised beyond the eye's
     // own chunk: ray casting) and +infinity (everything rasterised, no far
     // field), offered once both costs have been measured (not on the priors).
@@ -122,7 +122,7 @@ public:
     void record(uint64_t triangles, double rasterMs, uint64_t farPixels, double farMs, double fixedMs = 0);
     double msPerTriangle() const { return _a; }
     double rasterFixedMs() const { return _c; }  // the raster fit's intercept (0 until a is fitted)
-    double msPerRay() const;  // per far pixel: the frames' model, capped by the probe's bulk rate
+    double msPerRay() const;                     // per far pixel: the frames' model, capped by the probe's bulk rate
     double farFixedMs() const { return _f; }
     double current() const { return _current; }
     // Predictions (exposed for tests/docs).
@@ -136,10 +136,10 @@ private:
     SplitIndex _index;
     const RayScene* _rays;
     AdaptiveSplitOptions _o;
-    double _a = 2e-5, _b = 5e-4, _f = 0, _bProbe = 0;  // priors: ms per triangle, ms per far pixel, fixed far ms
-    double _c = 0;                                       // fixed raster ms (fitted with a)
-    bool _haveA = false, _haveB = false, _haveF = false;  // measured (not the priors)
-    bool _bFitted = false;  // _b is the frames' well-conditioned slope (not the mean)
+    double _a = 2e-5, _b = 5e-4, _f = 0, _bProbe = 0;       // priors: ms per triangle, ms per far pixel, fixed far ms
+    double _c = 0;                                          // fixed raster ms (fitted with a)
+    bool _haveA = false, _haveB = false, _haveF = false;    // measured (not the priors)
+    bool _bFitted = false;                                  // _b is the frames' well-conditioned slope (not the mean)
     std::vector<std::pair<double, double>> _rasterSamples;  // (triangles, ms), last `window` frames
     std::vector<std::pair<double, double>> _farSamples;     // (far pixels, ms), last `window` frames
     double _current;

@@ -61,9 +61,9 @@ void FarField::beginFrame(const Camera& camera) {
     if (_options.speculate && !_traced.empty() && _traced.back() < uint32_t(camera.width * camera.height) &&
         farGeometryExists(_rays, _grid, camera, _options))
         startSpeculation(*_mem, _rays, camera, _options, _traced);
-    else
-        _mem->spec.stop();
-    if (!_grid || !_options.horizon || !farGeometryExists(_rays, _grid, camera, _options) || !horizonApplies(camera)) return;
+    else _mem->spec.stop();
+    if (!_grid || !_options.horizon || !farGeometryExists(_rays, _grid, camera, _options) || !horizonApplies(camera))
+        return;
     const bool moving = _mem->haveLast && !sameCamera(_mem->last, camera);
     if (moving && _mem->horizonPaused > 0) return;  // the horizon is paused (renderStages)
     const HorizonOptions ho = horizonOptions(_options, moving);
@@ -87,7 +87,8 @@ void FarField::reset() {
 
 void FarField::render(const Camera& camera, const float* depth, Image& out, FrameStats& stats) {
     VISTA_CHECK(camera.width >= 1 && camera.height >= 1);
-    if (out.width != camera.width || out.height != camera.height || !out.valid()) out = Image(camera.width, camera.height);
+    if (out.width != camera.width || out.height != camera.height || !out.valid())
+        out = Image(camera.width, camera.height);
     FarFrame f(camera, depth, out, _class);
     f.fx = &_options.effects;
     f.moving = _mem->haveLast && !sameCamera(_mem->last, camera);
@@ -123,8 +124,9 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
     const bool budgeted = _options.pixelBudget >= 0 || _options.frameMsTarget > 0;
     // The horizon pauses while it does not pay (FarFieldOptions::horizonAdaptive).
     const bool horizonAdaptive = _options.horizonAdaptive && !budgeted && f.moving;
-    const bool useHorizon = _options.horizon && !pausedThisFrame(_mem->horizonPaused, horizonAdaptive, stats,
-                                                                 "horizon paused: tracing it cost more than the rays it saved");
+    const bool useHorizon =
+        _options.horizon && !pausedThisFrame(_mem->horizonPaused, horizonAdaptive, stats,
+                                             "horizon paused: tracing it cost more than the rays it saved");
     if (useHorizon) {
         const double before = stats.stages.ms(Stage::Horizon);
         const uint64_t culled = horizonStage(f, _grid, _options, stats, useEarly ? &early : nullptr);
@@ -133,8 +135,7 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
         // on), against a timed sample of the culled pixels' own rays (mostly sky misses: the
         // mean traced ray prices them 5 to 10 times too high).
         const double costMs = stats.stages.ms(Stage::Horizon) - before;
-        if (horizonAdaptive && _mem->msPerRay > 0 &&
-            costMs > culledRaysMs(f, _rays, _options, culled))
+        if (horizonAdaptive && _mem->msPerRay > 0 && costMs > culledRaysMs(f, _rays, _options, culled))
             _mem->horizonPaused = kHorizonPauseFrames;
     }
     listPending(f);

@@ -78,11 +78,13 @@ void hazeCoveredStage(FarFrame& f, const FarFieldOptions& o, FrameStats& stats) 
     const float a = float(zf > 0 ? n * zf / (zf - n) : n), b = float(zf > 0 ? zf / (zf - n) : 1.0);
     const size_t W = size_t(f.width);
     inArena(o.threads, [&] {
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, size_t(f.height), 16), [&](const tbb::blocked_range<size_t>& r) {
-            for (size_t y = r.begin(); y != r.end(); ++y)
-                for (size_t i = y * W, e = i + W; i < e; ++i)
-                    if (f.cls[i] == kFarCovered) table.apply(&f.out.rgba[i * 4], a / std::max(b - f.depth[i], 1e-30f));
-        });
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, size_t(f.height), 16),
+                          [&](const tbb::blocked_range<size_t>& r) {
+                              for (size_t y = r.begin(); y != r.end(); ++y)
+                                  for (size_t i = y * W, e = i + W; i < e; ++i)
+                                      if (f.cls[i] == kFarCovered)
+                                          table.apply(&f.out.rgba[i * 4], a / std::max(b - f.depth[i], 1e-30f));
+                          });
     });
     recordHaze(sw.ms(), stats);
 }

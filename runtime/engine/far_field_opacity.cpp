@@ -7,8 +7,14 @@
 namespace vista {
 
 FarFrame::FarFrame(const Camera& c, const float* d, Image& o, std::vector<uint8_t>& classes)
-    : camera(c), rays(c), width(c.width), height(c.height), pixelCount(size_t(c.width) * size_t(c.height)), depth(d),
-      out(o), cls(classes) {}
+    : camera(c),
+      rays(c),
+      width(c.width),
+      height(c.height),
+      pixelCount(size_t(c.width) * size_t(c.height)),
+      depth(d),
+      out(o),
+      cls(classes) {}
 
 static_assert(kFarCovered == 0, "the opacity loop writes open * kFarPending");
 

@@ -19,8 +19,13 @@
 namespace vista {
 
 PixelRays::PixelRays(const Camera& c)
-    : _f(c.forward()), _r(c.right()), _u(c.up()), _tanHalf(std::tan(0.5 * c.fovY)),
-      _aspect(double(c.width) / double(c.height)), _width(c.width), _height(c.height) {}
+    : _f(c.forward()),
+      _r(c.right()),
+      _u(c.up()),
+      _tanHalf(std::tan(0.5 * c.fovY)),
+      _aspect(double(c.width) / double(c.height)),
+      _width(c.width),
+      _height(c.height) {}
 
 glm::u8vec4 primarySkyColor(const glm::dvec3& dir) { return skyColor(std::asin(std::clamp(dir.z, -1.0, 1.0))); }
 
@@ -51,8 +56,8 @@ float hazeTfar(const glm::dvec3& d, const glm::dvec3& fwd, double zMax) {
 }
 
 // Casts the entries runs[r] .. runs[r + 1] - 1 of every run r in packets of 8.
-void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, const std::vector<size_t>& runs, Image& out,
-              RayCounts& counts, int threads, uint8_t* hit, const RayShading& shading) {
+void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, const std::vector<size_t>& runs,
+              Image& out, RayCounts& counts, int threads, uint8_t* hit, const RayShading& shading) {
     const size_t nRuns = runs.size() - 1, n = runs.back();
     if (n == 0) return;
     const PixelRays gen(camera);
@@ -86,8 +91,8 @@ void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, con
                     dirs[k] = glm::vec3(ddirs[k]);
                     if (fx.haze) tfars[k] = hazeTfar(ddirs[k], fwd, zMax);
                 }
-                scene.intersectMany(orgs.data(), dirs.data(), int(m), res.data(), 1e30f, fx.haze ? tfars.data() : nullptr,
-                                    shading.tnear);
+                scene.intersectMany(orgs.data(), dirs.data(), int(m), res.data(), 1e30f,
+                                    fx.haze ? tfars.data() : nullptr, shading.tnear);
                 for (size_t k = 0; k < m; ++k) {
                     const RayHit& h = res[k];
                     const double z = h.hit ? double(h.t) * glm::dot(ddirs[k], fwd) : 0.0;
@@ -95,7 +100,8 @@ void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, con
                     const glm::u8vec4 c = shown ? h.color : fx.sky(ddirs[k]);
                     std::copy_n(&c[0], 4, &out.rgba[size_t(pixels[b + k]) * 4]);
                     if (shading.depth) shading.depth[b + k] = shown ? float(z) : INFINITY;
-                    if (shading.keys) shading.keys[b + k] = shown ? SurfaceKey{h.geomId, h.primId, h.instId} : SurfaceKey{};
+                    if (shading.keys)
+                        shading.keys[b + k] = shown ? SurfaceKey{h.geomId, h.primId, h.instId} : SurfaceKey{};
                     if (hit) hit[b + k] = shown ? 1 : 0;
                     nh += shown ? 1 : 0;
                 }
@@ -114,7 +120,8 @@ void castPrimaryRays(const RayScene& scene, const Camera& camera, const uint32_t
     VISTA_CHECK(out.width == camera.width && out.height == camera.height && out.valid());
     const uint32_t N = uint32_t(size_t(camera.width) * size_t(camera.height));
     for (size_t k = 0; k < n; ++k) VISTA_CHECK(pixels[k] < N);
-    castRuns(scene, camera, PixelList{pixels}, coherentRuns(pixels, n, camera.width), out, counts, threads, hit, shading);
+    castRuns(scene, camera, PixelList{pixels}, coherentRuns(pixels, n, camera.width), out, counts, threads, hit,
+             shading);
 }
 
 void castPixelRuns(const RayScene& scene, const Camera& camera, const uint32_t* pixels, const std::vector<size_t>& runs,
@@ -163,8 +170,8 @@ namespace {
 // direction when they all showed sky; every other entry casts its own ray.
 // Returns the number of interpolated entries; `hit`, `depth`, `keys` get one
 // value per entry of f.trace, colours go to f.out.
-uint64_t castOnLattice(FarFrame& f, FarFieldMemory& m, const RayScene& rays, int threads, float tnear, RayCounts& counts,
-                       uint8_t* hit, float* depth) {
+uint64_t castOnLattice(FarFrame& f, FarFieldMemory& m, const RayScene& rays, int threads, float tnear,
+                       RayCounts& counts, uint8_t* hit, float* depth) {
     const size_t n = f.trace.size();
     const uint32_t W = uint32_t(f.width), H = uint32_t(f.height);
     std::vector<uint32_t> lattice, rest;  // indices into f.trace
@@ -221,10 +228,8 @@ uint64_t castOnLattice(FarFrame& f, FarFieldMemory& m, const RayScene& rays, int
                             break;
                         }
                         const uint32_t s = slot[ys[a] * W + xs[b]];
-                        if (s == ~0u || (cnt > 0 && !(latticeKeys[s] == latticeKeys[nbr[0]])))
-                            ok = false;
-                        else
-                            nbr[cnt++] = s;
+                        if (s == ~0u || (cnt > 0 && !(latticeKeys[s] == latticeKeys[nbr[0]]))) ok = false;
+                        else nbr[cnt++] = s;
                     }
                 if (!ok || cnt == 0) continue;
                 uint8_t* px = &f.out.rgba[size_t(i) * 4];

@@ -82,7 +82,8 @@ void seamStage(FarFrame& f, const RayScene& rays, const FarFieldOptions& o, Fram
             f.cls[i] = kFarRayHit;
             // Eye-plane depth of the hit for haze (the seam lies within the near distance).
             const glm::dvec3 d = f.rays.dir(int(i % W), int(i / W));
-            f.out.set(int(i % W), int(i / W), f.fx->applyHaze(res[k].color, double(res[k].t) * glm::dot(d, f.camera.forward())));
+            f.out.set(int(i % W), int(i / W),
+                      f.fx->applyHaze(res[k].color, double(res[k].t) * glm::dot(d, f.camera.forward())));
             ++replaced;
         }
         f.covered -= replaced;

@@ -106,7 +106,8 @@ std::vector<uint32_t> takeSpeculation(FarFrame& f, FarFieldMemory& m, const FarF
         for (size_t j = 0; j < n; ++j) {
             const uint32_t p = f.trace[j];
             while (k < s.pixels.size() && s.pixels[k] < p) ++k;
-            if (k < s.pixels.size() && s.pixels[k] == p && s.done[k / kSpeculativeChunk].load(std::memory_order_acquire)) {
+            if (k < s.pixels.size() && s.pixels[k] == p &&
+                s.done[k / kSpeculativeChunk].load(std::memory_order_acquire)) {
                 std::copy_n(&s.colors.rgba[size_t(p) * 4], 4, &f.out.rgba[size_t(p) * 4]);
                 hit[j] = s.hit[k];
                 if (depth) depth[j] = s.depth[k];

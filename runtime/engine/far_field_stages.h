@@ -45,7 +45,8 @@ inline double eyeDepthOfWindowDepth(double d, double n, double zf) {
 // Where the far field's rays start (metres): just short of the near distance
 // when the near field is one (FarFieldOptions::nearIsDistance), else the eye.
 inline float farRayStart(const FarFieldOptions& o) {
-    return o.nearIsDistance && o.nearDistance > 0 && std::isfinite(o.nearDistance) ? float(o.nearDistance * 0.999) : 0.0f;
+    return o.nearIsDistance && o.nearDistance > 0 && std::isfinite(o.nearDistance) ? float(o.nearDistance * 0.999)
+                                                                                   : 0.0f;
 }
 
 // Rays cast ahead of the ray stage, on another thread while the near field
@@ -57,20 +58,23 @@ struct SpeculativeRays {
     Camera camera;
     float tnear = 0.0f;
     FrameEffects effects;
-    std::vector<uint32_t> pixels;     // ascending
-    Image colors;                     // camera-sized: the colours of cast pixels
-    std::vector<float> depth;         // per entry of pixels (eye-plane depth, +inf = sky)
-    std::vector<uint8_t> hit;         // per entry: 1 = showed geometry
+    std::vector<uint32_t> pixels;                  // ascending
+    Image colors;                                  // camera-sized: the colours of cast pixels
+    std::vector<float> depth;                      // per entry of pixels (eye-plane depth, +inf = sky)
+    std::vector<uint8_t> hit;                      // per entry: 1 = showed geometry
     std::unique_ptr<std::atomic<uint8_t>[]> done;  // per chunk
     size_t chunks = 0;
     std::atomic<size_t> next{0};
     std::atomic<bool> stopFlag{false};
-    std::atomic<uint64_t> rays{0};    // rays cast so far
+    std::atomic<uint64_t> rays{0};  // rays cast so far
     std::thread worker;
     bool active() const { return worker.joinable() || chunks > 0; }
-    void stop();                      // ends the work after the chunk in hand and joins (no-op when idle)
-    void finish();                    // joins once every chunk is cast (no-op when idle)
-    void discard() { stop(); chunks = 0; }  // stops and forgets (not counted anywhere)
+    void stop();    // ends the work after the chunk in hand and joins (no-op when idle)
+    void finish();  // joins once every chunk is cast (no-op when idle)
+    void discard() {
+        stop();
+        chunks = 0;
+    }  // stops and forgets (not counted anywhere)
     ~SpeculativeRays() { stop(); }
 };
 constexpr size_t kSpeculativeChunk = 512;  // rays per chunk of SpeculativeRays
@@ -79,25 +83,25 @@ constexpr size_t kSpeculativeChunk = 512;  // rays per chunk of SpeculativeRays
 struct FarFieldMemory {
     std::unique_ptr<PanoramaCache> cache;
     double cacheKey[4] = {0, 0, 0, 0};  // fovY, width, height, oversample of the cache
-    Image prev;                          // last composited frame (cache mode)
-    Image sky;                           // sky colours (depend on pitch, roll, fov, size only)
+    Image prev;                         // last composited frame (cache mode)
+    Image sky;                          // sky colours (depend on pitch, roll, fov, size only)
     double skyKey[5] = {1e300, 0, 0, 0, 0};
     Camera last;
     bool haveLast = false;
     std::future<HorizonResult> earlyHorizon;  // FarField::beginFrame
     Camera earlyCamera;
-    double lastMinDepth = 0;   // nearest far surface of the last cache frame (m; 0 = none yet)
-    double msPerRay = 0;       // ray stage ms per ray (moving average; 0 = not measured)
-    double compositeMs = 0;    // composite stage ms (moving average)
+    double lastMinDepth = 0;  // nearest far surface of the last cache frame (m; 0 = none yet)
+    double msPerRay = 0;      // ray stage ms per ray (moving average; 0 = not measured)
+    double compositeMs = 0;   // composite stage ms (moving average)
     // Cache duty cycle (FarFieldOptions::cacheAdaptive).
-    int cachePaused = 0;          // moving frames left to trace without the cache
+    int cachePaused = 0;                       // moving frames left to trace without the cache
     int cachePauseLength = kCachePauseFrames;  // the next pause (doubles while verdicts say it does not pay)
-    int horizonPaused = 0;        // moving frames left to trace without the horizon
-    bool lastFrameCached = false; // the last frame ran the cache stage (its stores are fresh)
+    int horizonPaused = 0;                     // moving frames left to trace without the horizon
+    bool lastFrameCached = false;              // the last frame ran the cache stage (its stores are fresh)
     // Scratch of the cache stage, kept so that a frame does not fault in fresh pages.
     std::vector<CacheCandidate> cand;
     std::vector<uint8_t> traceMarks;
-    std::vector<float> farDepth;  // swapped into FarFrame::farDepth for the frame
+    std::vector<float> farDepth;    // swapped into FarFrame::farDepth for the frame
     std::vector<uint32_t> raySlot;  // ray stage (rayStep 2): per pixel, ~0 between frames
     SpeculativeRays spec;           // FarField::beginFrame (o.speculate)
 };
@@ -109,23 +113,24 @@ constexpr double kCacheWindowPx = 8.0;
 struct FarFrame {
     FarFrame(const Camera& camera, const float* depth, Image& out, std::vector<uint8_t>& cls);
     const Camera& camera;
-    const PixelRays rays;          // pixel-centre directions
+    const PixelRays rays;  // pixel-centre directions
     const int width, height;
     const size_t pixelCount;
-    const float* depth;            // near-field window depth (1 = nothing drawn), or null
-    Image& out;                    // the frame (camera size)
-    std::vector<uint8_t>& cls;     // per pixel: a FarPixelClass or kFarPending
-    bool moving = false;           // camera differs from the last frame's
-    const Image* sky = nullptr;    // sky colour per pixel (set before the horizon stage)
-    const FrameEffects* fx = nullptr;  // run-time effects (haze, night sky); never null during render()
-    std::vector<uint8_t> columnNeeded;  // per column: has a pending pixel (opacity)
-    uint64_t covered = 0;          // pixels of class covered (opacity, seam)
+    const float* depth;                    // near-field window depth (1 = nothing drawn), or null
+    Image& out;                            // the frame (camera size)
+    std::vector<uint8_t>& cls;             // per pixel: a FarPixelClass or kFarPending
+    bool moving = false;                   // camera differs from the last frame's
+    const Image* sky = nullptr;            // sky colour per pixel (set before the horizon stage)
+    const FrameEffects* fx = nullptr;      // run-time effects (haze, night sky); never null during render()
+    std::vector<uint8_t> columnNeeded;     // per column: has a pending pixel (opacity)
+    uint64_t covered = 0;                  // pixels of class covered (opacity, seam)
     std::vector<uint32_t> seamCandidates;  // covered pixels the seam check examines (opacity)
-    std::vector<uint32_t> pending; // pending pixels after the horizon, ascending
-    std::vector<uint32_t> trace;   // pixels to trace this frame, ascending (cache)
-    std::vector<int64_t> traceCells;  // their panorama cells (cache stage only)
-    std::vector<glm::u8vec2> traceSubs;  // where their rays fall in those cells (cache stage only)
-    std::vector<float> farDepth;   // cache mode: per pending pixel, eye-plane depth of its far colour (+inf = sky/none); others unset
+    std::vector<uint32_t> pending;         // pending pixels after the horizon, ascending
+    std::vector<uint32_t> trace;           // pixels to trace this frame, ascending (cache)
+    std::vector<int64_t> traceCells;       // their panorama cells (cache stage only)
+    std::vector<glm::u8vec2> traceSubs;    // where their rays fall in those cells (cache stage only)
+    std::vector<float>
+        farDepth;  // cache mode: per pending pixel, eye-plane depth of its far colour (+inf = sky/none); others unset
 };
 
 // Opacity (far_field_opacity.cpp). In: depth (null = nothing covered). Out:

@@ -31,7 +31,7 @@ struct FrameEffects {
     bool glass = false;        // reflections on (the scene must declare glass for marks to exist)
     bool glassMarked = false;  // the scene's colours carry glass marks (declared glass)
     double reflectance = 0.2;
-    int64_t rayBudget = 0;     // reflection rays per frame
+    int64_t rayBudget = 0;  // reflection rays per frame
     bool night = false;
 
     // The run-time part of a scene's effects (baked ones are in the colours).

@@ -53,8 +53,14 @@ const char* stageName(Stage s);
 
 class StageTimes {
 public:
-    void add(Stage s, double ms) { _ms[size_t(s)] += ms; _ran[size_t(s)] = true; }
-    void set(Stage s, double ms) { _ms[size_t(s)] = ms; _ran[size_t(s)] = true; }
+    void add(Stage s, double ms) {
+        _ms[size_t(s)] += ms;
+        _ran[size_t(s)] = true;
+    }
+    void set(Stage s, double ms) {
+        _ms[size_t(s)] = ms;
+        _ran[size_t(s)] = true;
+    }
     bool ran(Stage s) const { return _ran[size_t(s)]; }
     double ms(Stage s) const { return _ms[size_t(s)]; }
     size_t count() const {
@@ -79,7 +85,10 @@ private:
 // screen) is absent. Baked effects never run per frame.
 class EffectTimes {
 public:
-    void add(EffectId e, double ms) { _ms[size_t(e)] += ms; _ran[size_t(e)] = true; }
+    void add(EffectId e, double ms) {
+        _ms[size_t(e)] += ms;
+        _ran[size_t(e)] = true;
+    }
     bool ran(EffectId e) const { return _ran[size_t(e)]; }
     double ms(EffectId e) const { return _ms[size_t(e)]; }
     template <class F>
@@ -96,7 +105,7 @@ private:
 struct FrameStats {
     double frameMs = 0, cullMs = 0, drawMs = 0;
     uint64_t triangles = 0, drawCalls = 0;
-    uint64_t raysCast = 0;                    // every ray cast this frame (far field, seam check, probes)
+    uint64_t raysCast = 0;  // every ray cast this frame (far field, seam check, probes)
     // Speculative rays (FarFieldOptions::speculate): cast while the near field was drawn (in
     // raysCast), and how many of them gave a traced pixel its colour (rayHit/rayMiss pixels
     // the ray stage did not cast itself).
@@ -104,9 +113,9 @@ struct FrameStats {
     PixelCounts pixels;
     StageTimes stages;
     EffectTimes effects;
-    uint64_t glassPixels = 0;                 // pixels marked as glass on screen
-    uint64_t reflectionRays = 0;              // reflection rays (also counted in raysCast)
-    std::vector<std::string> notes;           // e.g. "horizon off: camera rolled"
+    uint64_t glassPixels = 0;        // pixels marked as glass on screen
+    uint64_t reflectionRays = 0;     // reflection rays (also counted in raysCast)
+    std::vector<std::string> notes;  // e.g. "horizon off: camera rolled"
 };
 
 }  // namespace vista

@@ -54,7 +54,8 @@ PixelLabel rayLabel(const SceneModel& city, const RayScene& rays, const RayHit& 
         out.cls = uint8_t(SemanticClass::TreeLeaves);
         if (in.prototype < city.prototypes.size()) {
             const uint32_t part = triangleId(city.prototypes[in.prototype], hit.primId);
-            if (part < uint32_t(kMaterialCount) && city.prototypes[in.prototype].ids.size() > 0) out.cls = classOf(Material(part));
+            if (part < uint32_t(kMaterialCount) && city.prototypes[in.prototype].ids.size() > 0)
+                out.cls = classOf(Material(part));
         }
     } else if (hit.hit) {
         out.cls = 255;
@@ -138,8 +139,8 @@ size_t mergeLabels(const SceneModel& city, const RayScene* rays, const Camera& c
 namespace {
 
 std::string npyHeader(const char* descr, int width, int height) {
-    std::string dict = std::string("{'descr': '") + descr + "', 'fortran_order': False, 'shape': (" + std::to_string(height) +
-                       ", " + std::to_string(width) + "), }";
+    std::string dict = std::string("{'descr': '") + descr + "', 'fortran_order': False, 'shape': (" +
+                       std::to_string(height) + ", " + std::to_string(width) + "), }";
     // magic(6) + version(2) + header length(2) + dict + padding + '\n' is a multiple of 64.
     size_t total = 10 + dict.size() + 1;
     dict.append((64 - total % 64) % 64, ' ');

@@ -31,8 +31,12 @@ struct GridWalk {
     int x, y, stepX, stepY;
     double tMaxX, tMaxY, tDeltaX, tDeltaY;
     GridWalk(int x0, int y0, double sx0, double sy0, double dx, double dy, double unit)
-        : x(x0), y(y0), stepX(dx > 0 ? 1 : -1), stepY(dy > 0 ? 1 : -1),
-          tDeltaX(dx != 0 ? 1.0 / std::abs(dx) * unit : kInf), tDeltaY(dy != 0 ? 1.0 / std::abs(dy) * unit : kInf) {
+        : x(x0),
+          y(y0),
+          stepX(dx > 0 ? 1 : -1),
+          stepY(dy > 0 ? 1 : -1),
+          tDeltaX(dx != 0 ? 1.0 / std::abs(dx) * unit : kInf),
+          tDeltaY(dy != 0 ? 1.0 / std::abs(dy) * unit : kInf) {
         tMaxX = std::max(0.0, dx > 0 ? ((x + 1) * unit - sx0) / dx : dx < 0 ? (sx0 - x * unit) / -dx : kInf);
         tMaxY = std::max(0.0, dy > 0 ? ((y + 1) * unit - sy0) / dy : dy < 0 ? (sy0 - y * unit) / -dy : kInf);
     }
@@ -156,7 +160,8 @@ double HeightGrid::rectBound(double x0, double x1, double y0, double y1, double 
                              double nearDistance, double maxDistance) {
     if (zHi == -kInf) return -kInf;
     double nx = std::max({x0 - eye.x, 0.0, eye.x - x1}), ny = std::max({y0 - eye.y, 0.0, eye.y - y1});
-    double fx = std::max(std::abs(eye.x - x0), std::abs(eye.x - x1)), fy = std::max(std::abs(eye.y - y0), std::abs(eye.y - y1));
+    double fx = std::max(std::abs(eye.x - x0), std::abs(eye.x - x1)),
+           fy = std::max(std::abs(eye.y - y0), std::abs(eye.y - y1));
     double dmin2 = nx * nx + ny * ny, dmax2 = fx * fx + fy * fy;
     if (dmin2 > maxDistance * maxDistance) return -kInf;
     double dz = zHi - eye.z;
@@ -202,9 +207,16 @@ double HeightGrid::traceRayFlat(const glm::dvec3& eye, double azimuth, double ne
 class HeightGrid::RayTrace {
 public:
     RayTrace(const HeightGrid& g, const glm::dvec3& eye, double azimuth, double nearDistance, double maxDistance)
-        : _g(g), _eye(eye), _nearDistance(nearDistance), _maxDistance(maxDistance), _n(g._cells), _s(g._cellSize),
-          _px((eye.x - g._min.x) / g._cellSize), _py((eye.y - g._min.y) / g._cellSize),
-          _dx(std::sin(azimuth)), _dy(std::cos(azimuth)) {
+        : _g(g),
+          _eye(eye),
+          _nearDistance(nearDistance),
+          _maxDistance(maxDistance),
+          _n(g._cells),
+          _s(g._cellSize),
+          _px((eye.x - g._min.x) / g._cellSize),
+          _py((eye.y - g._min.y) / g._cellSize),
+          _dx(std::sin(azimuth)),
+          _dy(std::cos(azimuth)) {
         if (std::abs(_dx) < 1e-15) _dx = 0;
         if (std::abs(_dy) < 1e-15) _dy = 0;
     }
@@ -225,10 +237,8 @@ public:
         // Start cell: the cell the ray enters just after t0.
         const double ex = _px + _dx * _t0, ey = _py + _dy * _t0;
         int ix = cellAt(ex, _dx, 0, n - 1), iy = cellAt(ey, _dy, 0, n - 1);
-        if (blocks)
-            runBlocks(ix, iy);
-        else
-            run(ix, iy);
+        if (blocks) runBlocks(ix, iy);
+        else run(ix, iy);
         // A ray running along a grid line touches the cells on both sides.
         if (_dx == 0 && onLine(ex)) {
             int l = int(std::round(ex));
@@ -338,7 +348,9 @@ private:
             const double tNext = b.next();
             if (tNext > _tLen + kTieEps || laterCellsLose(tNext)) break;
             tIn = tNext;
-            if (b.corner()) visitAround(b.stepX > 0 ? (b.x + 1) * kBlock : b.x * kBlock, b.stepY > 0 ? (b.y + 1) * kBlock : b.y * kBlock);
+            if (b.corner())
+                visitAround(b.stepX > 0 ? (b.x + 1) * kBlock : b.x * kBlock,
+                            b.stepY > 0 ? (b.y + 1) * kBlock : b.y * kBlock);
             b.advance();
         }
     }
@@ -357,7 +369,8 @@ private:
     double _sx0 = 0, _sy0 = 0, _tLen = 0;
 };
 
-double HeightGrid::trace(const glm::dvec3& eye, double azimuth, double nearDistance, double maxDistance, bool blocks) const {
+double HeightGrid::trace(const glm::dvec3& eye, double azimuth, double nearDistance, double maxDistance,
+                         bool blocks) const {
     if (_cells == 0) return -kInf;
     RayTrace ray(*this, eye, azimuth, nearDistance, maxDistance);
     if (!ray.clipToGrid()) return -kInf;
@@ -382,8 +395,12 @@ struct ColumnGeometry {
     double cp, sp, t, aspect;
     int W, H;
     ColumnGeometry(const Camera& c)
-        : cp(std::cos(c.pitch)), sp(std::sin(c.pitch)), t(std::tan(0.5 * c.fovY)),
-          aspect(double(c.width) / double(c.height)), W(c.width), H(c.height) {}
+        : cp(std::cos(c.pitch)),
+          sp(std::sin(c.pitch)),
+          t(std::tan(0.5 * c.fovY)),
+          aspect(double(c.width) / double(c.height)),
+          W(c.width),
+          H(c.height) {}
     double sx(double px) const { return (2.0 * px / W - 1.0) * t * aspect; }
     double sy(double py) const { return (1.0 - 2.0 * py / H) * t; }
     // Azimuth relative to the heading, and tan(elevation), of the ray through (px, py).
@@ -476,7 +493,8 @@ HorizonResult traceHorizon(const HeightGrid& grid, const Camera& camera, const H
         for (int x = 0; x < W; ++x) {
             if (!needed(x)) continue;
             const double rx = std::max(horizontalReach(x + 0.5, 0.5), horizontalReach(x + 0.5, H - 0.5)) * (1.0 + 1e-6);
-            for (int k = kLo[size_t(x)]; k <= kHi[size_t(x)]; k += sub) reach[size_t(k)] = std::max(reach[size_t(k)], rx);
+            for (int k = kLo[size_t(x)]; k <= kHi[size_t(x)]; k += sub)
+                reach[size_t(k)] = std::max(reach[size_t(k)], rx);
         }
         for (double& v : reach) v = std::min(v, options.maxDistance);
     }
@@ -484,7 +502,8 @@ HorizonResult traceHorizon(const HeightGrid& grid, const Camera& camera, const H
     tbb::parallel_for(tbb::blocked_range<size_t>(0, list.size(), 16), [&](const tbb::blocked_range<size_t>& br) {
         for (size_t i = br.begin(); i != br.end(); ++i) {
             int k = list[i];
-            value[size_t(k)] = grid.traceRay(eye, camera.heading + a0 + k * delta, options.nearDistance, reach[size_t(k)]);
+            value[size_t(k)] =
+                grid.traceRay(eye, camera.heading + a0 + k * delta, options.nearDistance, reach[size_t(k)]);
         }
     });
     r.raysTraced = int(list.size());
@@ -506,10 +525,8 @@ HorizonResult traceHorizon(const HeightGrid& grid, const Camera& camera, const H
         int a = 0, b = H;
         while (a < b) {
             int m = (a + b) / 2;
-            if (cg.tanElev(x + 0.5, m + 0.5) > limit)
-                a = m + 1;
-            else
-                b = m;
+            if (cg.tanElev(x + 0.5, m + 0.5) > limit) a = m + 1;
+            else b = m;
         }
         r.row[size_t(x)] = a;
     }

@@ -64,8 +64,8 @@ public:
     bool empty() const { return _cells == 0; }  // no geometry at all
     int cells() const { return _cells; }
     double cellSize() const { return _cellSize; }
-    glm::dvec2 gridMin() const { return _min; }           // scene-local xy of cell (0,0)'s corner
-    glm::dvec3 boundsMin() const { return _boundsMin; }   // scene-local bounding box of all geometry
+    glm::dvec2 gridMin() const { return _min; }          // scene-local xy of cell (0,0)'s corner
+    glm::dvec3 boundsMin() const { return _boundsMin; }  // scene-local bounding box of all geometry
     glm::dvec3 boundsMax() const { return _boundsMax; }
     glm::dvec3 frameOrigin() const { return _origin; }
     // -inf / +inf for a cell without geometry. ix, iy in [0, cells).
@@ -93,7 +93,8 @@ private:
     double trace(const glm::dvec3& eye, double azimuth, double nearDistance, double maxDistance, bool blocks) const;
     class RayTrace;  // one ray's walk over the cells and blocks
     double cellBound(int ix, int iy, const glm::dvec3& eye, double nearDistance, double maxDistance) const;
-    // The bound of any geometry in the xy rectangle [x0, x1] x [y0, y1] (scene-local metres) with heights in [zLo, zHi].
+    // The bound of any geometry in the xy rectangle [x0, x1] x [y0, y1] (scene-local metres) with heights in [zLo,
+    // zHi].
     static double rectBound(double x0, double x1, double y0, double y1, double zLo, double zHi, const glm::dvec3& eye,
                             double nearDistance, double maxDistance);
     double blockBound(int bx, int by, const glm::dvec3& eye, double nearDistance, double maxDistance) const;
@@ -102,26 +103,26 @@ private:
     glm::dvec2 _min{0.0};
     glm::dvec3 _boundsMin{0.0}, _boundsMax{0.0}, _origin{0.0};
     std::vector<float> _maxZ, _minZ;
-    int _blocks = 0;                           // blocks per side: ceil(cells / kBlock)
+    int _blocks = 0;                            // blocks per side: ceil(cells / kBlock)
     std::vector<float> _blockMaxZ, _blockMinZ;  // over each block's cells
 };
 
 struct HorizonOptions {
-    double nearDistance = 0;                    // metres; 0 = consider all geometry
+    double nearDistance = 0;                                       // metres; 0 = consider all geometry
     double maxDistance = std::numeric_limits<double>::infinity();  // metres: ignore geometry beyond (haze)
     // Eye-plane depth beyond which nothing is traced (haze; metres): each
     // column ignores geometry horizontally farther than its pixels reach
     // before that depth (tighter than one maxDistance for the whole view).
     double maxEyeDepth = std::numeric_limits<double>::infinity();
-    int subsample = 1;                          // >= 1
+    int subsample = 1;                                   // >= 1
     const std::vector<uint8_t>* columnNeeded = nullptr;  // size camera.width, or null = all
 };
 
 struct HorizonResult {
     bool active = false;
-    std::string reason;        // why inactive ("camera rolled", ...)
-    std::vector<int> row;      // per column: rows y < row[x] are sky (0..height)
-    int raysTraced = 0;        // 2D rays cast this frame
+    std::string reason;    // why inactive ("camera rolled", ...)
+    std::vector<int> row;  // per column: rows y < row[x] are sky (0..height)
+    int raysTraced = 0;    // 2D rays cast this frame
 };
 
 // True if horizon tracing applies to this camera (upright, no zenith/nadir in view).

@@ -18,7 +18,9 @@ namespace vista {
 namespace {
 
 struct FileCloser {
-    void operator()(FILE* f) const { if (f) std::fclose(f); }
+    void operator()(FILE* f) const {
+        if (f) std::fclose(f);
+    }
 };
 
 // libpng reports errors through longjmp; we keep the message for the Status.
@@ -60,8 +62,10 @@ Status writePngRows(const uint8_t* data, int width, int height, int channels, co
         png_set_write_fn(png, &bytes, pngWriteToString, pngFlushNothing);
         png_set_compression_level(png, 3);
         png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8,
-                     channels == 1 ? PNG_COLOR_TYPE_GRAY : channels == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGBA, PNG_INTERLACE_NONE,
-                     PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+                     channels == 1   ? PNG_COLOR_TYPE_GRAY
+                     : channels == 3 ? PNG_COLOR_TYPE_RGB
+                                     : PNG_COLOR_TYPE_RGBA,
+                     PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
         png_write_info(png, info);
         png_write_image(png, rows.data());
         png_write_end(png, nullptr);

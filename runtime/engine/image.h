@@ -27,7 +27,10 @@ struct Image {
     }
     void set(int x, int y, const glm::u8vec4& c) {
         uint8_t* p = &rgba[(size_t(y) * size_t(width) + size_t(x)) * 4];
-        p[0] = c.x; p[1] = c.y; p[2] = c.z; p[3] = c.w;
+        p[0] = c.x;
+        p[1] = c.y;
+        p[2] = c.z;
+        p[3] = c.w;
     }
 };
 

@@ -63,7 +63,8 @@ int64_t PanoramaCache::index(const glm::dvec3& d, glm::u8vec2* sub) const {
     col %= _width;  // az == 2 pi after rounding wraps to 0
     if (col < 0) col += _width;
     int64_t row = std::min<int64_t>(_height - 1, int64_t(fy));
-    if (sub) *sub = glm::u8vec2(uint8_t(std::min(255.0, (c.x - fx) * 256.0)), uint8_t(std::min(255.0, (c.y - fy) * 256.0)));
+    if (sub)
+        *sub = glm::u8vec2(uint8_t(std::min(255.0, (c.x - fx) * 256.0)), uint8_t(std::min(255.0, (c.y - fy) * 256.0)));
     return row * _width + col;
 }
 
@@ -156,7 +157,7 @@ double PanoramaCache::error(int64_t cell, glm::u8vec2 sub, const CachePolicy& p)
     const double dv = (double(sub.y) - double(s.y)) / 256.0 * 2.0 * _vMax / _height * c2;
     const double offset = std::sqrt(du * du + dv * dv);
     const double b = _baseline[r];
-    if (b == 0) return offset / p.radPerPixel;  // rotation only
+    if (b == 0) return offset / p.radPerPixel;              // rotation only
     const double own = b / double(decodeNear(c.nearBits));  // 0 when the window was all sky
     const double outside = p.lowerDepth > 0 ? b / p.lowerDepth - p.windowPx * p.radPerPixel : INFINITY;
     return (std::max(own, outside) + offset) / p.radPerPixel;

@@ -52,17 +52,18 @@
 namespace vista {
 
 struct CacheCandidate {
-    int64_t cell;    // panorama cell index, or -1 (not cacheable: always traced)
-    uint32_t pixel;  // screen pixel index (y * width + x)
+    int64_t cell;               // panorama cell index, or -1 (not cacheable: always traced)
+    uint32_t pixel;             // screen pixel index (y * width + x)
     glm::u8vec2 sub{128, 128};  // where the pixel's ray falls in the cell (1/256 of a cell; index())
 };
 
 struct CachePolicy {
-    double maxErrorPx = 0.25;    // reuse while the error is below this (pixels, >= 0)
-    double radPerPixel = 1e-3;   // angular size of a pixel at the image centre (> 0)
-    double lowerDepth = 0.0;     // no far surface is nearer (metres); 0 = unknown (then the window term is +inf when moving)
-    double windowPx = 8.0;       // radius of the screen window that `near` of a cell covers (pixels)
-    int64_t budget = -1;         // most cells re-traced per frame; < 0 = no cap
+    double maxErrorPx = 0.25;   // reuse while the error is below this (pixels, >= 0)
+    double radPerPixel = 1e-3;  // angular size of a pixel at the image centre (> 0)
+    double lowerDepth =
+        0.0;                // no far surface is nearer (metres); 0 = unknown (then the window term is +inf when moving)
+    double windowPx = 8.0;  // radius of the screen window that `near` of a cell covers (pixels)
+    int64_t budget = -1;    // most cells re-traced per frame; < 0 = no cap
 };
 
 class PanoramaCache {
@@ -134,7 +135,7 @@ private:
     uint32_t _current = 0;
     std::vector<double> _baseline;  // per record: distance to the current eye (beginFrame)
     uint16_t _stamp = 0;
-    std::vector<double> _error;      // scratch of selectForTracing
+    std::vector<double> _error;  // scratch of selectForTracing
 };
 
 }  // namespace vista

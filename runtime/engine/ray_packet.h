@@ -18,8 +18,12 @@ inline void fillPacket8(RTCRayHit8& rh, int* valid, const glm::vec3* org, const 
     for (int k = 0; k < 8; ++k) {
         const size_t i = base + size_t(k < m ? k : 0);
         valid[k] = k < m ? -1 : 0;
-        rh.ray.org_x[k] = org[i].x; rh.ray.org_y[k] = org[i].y; rh.ray.org_z[k] = org[i].z;
-        rh.ray.dir_x[k] = dir[i].x; rh.ray.dir_y[k] = dir[i].y; rh.ray.dir_z[k] = dir[i].z;
+        rh.ray.org_x[k] = org[i].x;
+        rh.ray.org_y[k] = org[i].y;
+        rh.ray.org_z[k] = org[i].z;
+        rh.ray.dir_x[k] = dir[i].x;
+        rh.ray.dir_y[k] = dir[i].y;
+        rh.ray.dir_z[k] = dir[i].z;
         rh.ray.tnear[k] = tnear;
         rh.ray.tfar[k] = tfars ? tfars[i] : tfar;
         rh.ray.time[k] = 0.0f;

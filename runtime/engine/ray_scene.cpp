@@ -138,7 +138,8 @@ struct RayScene::Impl {
         RTCError e = rtcGetDeviceError(device);
         std::lock_guard<std::mutex> lock(errors.mutex);
         if (!errors.first.empty()) return Status::error(std::string("ray scene: ") + what + ": " + errors.first);
-        if (e != RTC_ERROR_NONE) return Status::error(std::string("ray scene: ") + what + ": Embree error " + embreeErrorName(e));
+        if (e != RTC_ERROR_NONE)
+            return Status::error(std::string("ray scene: ") + what + ": Embree error " + embreeErrorName(e));
         return Status::ok();
     }
 
@@ -179,10 +180,10 @@ bool addTriangles(RTCDevice device, RTCScene scene, const std::vector<glm::vec3>
     if (nv == 0 || nt == 0) return false;
     RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
     if (!g) return false;
-    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                           3 * sizeof(float), nv));
-    auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                              3 * sizeof(uint32_t), nt));
+    auto* vb = static_cast<float*>(
+        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv));
+    auto* ib = static_cast<uint32_t*>(
+        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), nt));
     if (!vb || !ib) {
         rtcReleaseGeometry(g);
         return false;
@@ -247,7 +248,8 @@ Result<std::unique_ptr<RayScene>> RayScene::build(const SceneModel& city) {
     for (size_t mi = 0; mi < city.meshes.size(); ++mi) {
         const SceneMesh& m = city.meshes[mi];
         if (!validMesh(m))
-            return Status::error("ray scene: mesh " + std::to_string(mi) + " is malformed (index out of range, "
+            return Status::error("ray scene: mesh " + std::to_string(mi) +
+                                 " is malformed (index out of range, "
                                  "index count not a multiple of 3 or colour count != vertex count)");
         unsigned id = 0;
         if (!addTriangles(im.device, im.scene, m.positions, m.indices, m.origin - im.origin, true, &id)) {
@@ -287,8 +289,8 @@ Result<std::unique_ptr<RayScene>> RayScene::build(const SceneModel& city) {
         const SceneInstance& inst = city.instances[ii];
         if (inst.prototype >= city.prototypes.size())
             return Status::error("ray scene: instance " + std::to_string(ii) + " refers to prototype " +
-                                 std::to_string(inst.prototype) + " (have " +
-                                 std::to_string(city.prototypes.size()) + ")");
+                                 std::to_string(inst.prototype) + " (have " + std::to_string(city.prototypes.size()) +
+                                 ")");
         RTCScene child = im.protoScenes[inst.prototype];
         if (!child) continue;
         glm::dmat4 xf = inst.transform;
@@ -317,10 +319,11 @@ Result<std::unique_ptr<RayScene>> RayScene::build(const SceneModel& city) {
 
 Result<std::unique_ptr<RayScene>> RayScene::build(const TriangleSoup& soup, const SoupSceneOptions& options) {
     if (soup.colors.size() != soup.positions.size())
-        return Status::error("ray scene: soup colour count " + std::to_string(soup.colors.size()) + " != vertex count " +
-                             std::to_string(soup.positions.size()));
+        return Status::error("ray scene: soup colour count " + std::to_string(soup.colors.size()) +
+                             " != vertex count " + std::to_string(soup.positions.size()));
     if (soup.indices.size() % 3 != 0)
-        return Status::error("ray scene: soup index count " + std::to_string(soup.indices.size()) + " is not a multiple of 3");
+        return Status::error("ray scene: soup index count " + std::to_string(soup.indices.size()) +
+                             " is not a multiple of 3");
     for (uint32_t i : soup.indices)
         if (i >= soup.positions.size())
             return Status::error("ray scene: soup index " + std::to_string(i) + " out of range (" +
@@ -350,7 +353,8 @@ Result<std::unique_ptr<RayScene>> RayScene::build(const TriangleSoup& soup, cons
     }
     rtcCommitScene(im.scene);
     const RTCError e = rtcGetDeviceError(device);  // per thread: this build's error
-    if (e != RTC_ERROR_NONE) return Status::error(std::string("ray scene: Embree error while building a soup: ") + embreeErrorName(e));
+    if (e != RTC_ERROR_NONE)
+        return Status::error(std::string("ray scene: Embree error while building a soup: ") + embreeErrorName(e));
     return rs;
 }
 
@@ -374,8 +378,12 @@ RayHit RayScene::intersect(const glm::vec3& org, const glm::vec3& dir, float tne
     rtcInitIntersectContext(&ctx);
     RTCRayHit rh;
     std::memset(&rh, 0, sizeof(rh));
-    rh.ray.org_x = org.x; rh.ray.org_y = org.y; rh.ray.org_z = org.z;
-    rh.ray.dir_x = dir.x; rh.ray.dir_y = dir.y; rh.ray.dir_z = dir.z;
+    rh.ray.org_x = org.x;
+    rh.ray.org_y = org.y;
+    rh.ray.org_z = org.z;
+    rh.ray.dir_x = dir.x;
+    rh.ray.dir_y = dir.y;
+    rh.ray.dir_z = dir.z;
     rh.ray.tnear = tnear;
     rh.ray.tfar = tfar;
     rh.ray.mask = 0xFFFFFFFFu;
@@ -421,7 +429,8 @@ void RayScene::intersectMany(const glm::vec3* org, const glm::vec3* dir, int n, 
     });
 }
 
-void RayScene::occludedMany(const glm::vec3* org, const glm::vec3* dir, int n, const float* tfars, uint8_t* out, float tnear) const {
+void RayScene::occludedMany(const glm::vec3* org, const glm::vec3* dir, int n, const float* tfars, uint8_t* out,
+                            float tnear) const {
     forPackets8(_impl->ftz, n, [&](RTCIntersectContext& ctx, RTCRayHit8& rh, int* valid, int base, int m) {
         fillPacket8(rh, valid, org, dir, tfars, 0.0f, size_t(base), m, tnear);
         for (int k = 0; k < m; ++k)
@@ -438,8 +447,12 @@ bool RayScene::occluded(const glm::vec3& org, const glm::vec3& dir, float tnear,
     rtcInitIntersectContext(&ctx);
     RTCRay r;
     std::memset(&r, 0, sizeof(r));
-    r.org_x = org.x; r.org_y = org.y; r.org_z = org.z;
-    r.dir_x = dir.x; r.dir_y = dir.y; r.dir_z = dir.z;
+    r.org_x = org.x;
+    r.org_y = org.y;
+    r.org_z = org.z;
+    r.dir_x = dir.x;
+    r.dir_y = dir.y;
+    r.dir_z = dir.z;
     r.tnear = tnear;
     r.tfar = tfar;
     r.mask = 0xFFFFFFFFu;
@@ -460,8 +473,8 @@ int RayScene::allHits(const glm::vec3& org, const glm::vec3& dir, float tnear, f
     return n;
 }
 
-void RayScene::allHitsMany(const glm::vec3* org, const glm::vec3* dir, int n, const float* tnears, const float* tfars, int maxHits,
-                           float minGap, RayHit* out, int* counts) const {
+void RayScene::allHitsMany(const glm::vec3* org, const glm::vec3* dir, int n, const float* tnears, const float* tfars,
+                           int maxHits, float minGap, RayHit* out, int* counts) const {
     forPackets8(_impl->ftz, n, [&](RTCIntersectContext& ctx, RTCRayHit8& rh, int* valid, int base, int m) {
         float t0[8];
         int live[8];
@@ -490,8 +503,8 @@ void RayScene::allHitsMany(const glm::vec3* org, const glm::vec3* dir, int n, co
                 const size_t i = size_t(base + k);
                 RayHit& h = out[i * size_t(maxHits) + size_t(counts[i])];
                 h = RayHit();
-                _impl->fill(h, rh.hit.geomID[k], rh.hit.primID[k], rh.hit.instID[0][k], rh.hit.u[k], rh.hit.v[k], rh.ray.tfar[k],
-                            rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]);
+                _impl->fill(h, rh.hit.geomID[k], rh.hit.primID[k], rh.hit.instID[0][k], rh.hit.u[k], rh.hit.v[k],
+                            rh.ray.tfar[k], rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]);
                 ++counts[i];
                 t0[k] = h.t + std::max(minGap, h.t * 1e-5f);
                 if (counts[i] >= maxHits || !(t0[k] <= tfars[i])) live[k] = 0;

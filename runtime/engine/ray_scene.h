@@ -35,11 +35,11 @@ namespace vista {
 
 struct RayHit {
     bool hit = false;
-    float t = 0;                // distance along the (unit) ray direction, metres
-    glm::u8vec4 color{0};       // prelit colour at the hit
-    glm::vec3 normal{0.0f};     // geometric normal, scene-local frame
+    float t = 0;             // distance along the (unit) ray direction, metres
+    glm::u8vec4 color{0};    // prelit colour at the hit
+    glm::vec3 normal{0.0f};  // geometric normal, scene-local frame
     uint32_t geomId = 0, primId = 0, instId = 0xFFFFFFFFu;
-    float u = 0, v = 0;         // barycentric coordinates of the hit in its triangle
+    float u = 0, v = 0;  // barycentric coordinates of the hit in its triangle
 };
 
 // Triangles in one float frame, a prelit colour per vertex.
@@ -62,8 +62,8 @@ enum class RayBuildQuality { Low, Medium, High };
 
 struct SoupSceneOptions {
     RayBuildQuality quality = RayBuildQuality::Medium;
-    bool cullBackFaces = false;    // true: as the rasteriser and the city build
-    glm::dvec3 frameOrigin{0.0};   // reported by frameOrigin(); not applied to the positions
+    bool cullBackFaces = false;   // true: as the rasteriser and the city build
+    glm::dvec3 frameOrigin{0.0};  // reported by frameOrigin(); not applied to the positions
 };
 
 class RayScene {
@@ -83,7 +83,8 @@ public:
     bool occluded(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar) const;
     // Coherent batch of occlusion tests (packets of 8): out[i] = 1 if anything
     // lies within (tnear, tfars[i]) along ray i, else 0 (also when tnear > tfars[i]).
-    void occludedMany(const glm::vec3* org, const glm::vec3* dir, int n, const float* tfars, uint8_t* out, float tnear = 0.0f) const;
+    void occludedMany(const glm::vec3* org, const glm::vec3* dir, int n, const float* tfars, uint8_t* out,
+                      float tnear = 0.0f) const;
     // All surfaces along the ray in (tnear, tfar), nearest first, at most
     // maxHits: each next cast starts max(minGap, 1e-5 t) beyond the last hit.
     int allHits(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar, int maxHits, float minGap,
@@ -93,8 +94,8 @@ public:
     // out[i * maxHits .. i * maxHits + counts[i]), nearest first, within
     // (tnears[i], tfars[i]) (tnears[i] > tfars[i]: no hit). The same rule
     // as allHits for the next cast.
-    void allHitsMany(const glm::vec3* org, const glm::vec3* dir, int n, const float* tnears, const float* tfars, int maxHits,
-                     float minGap, RayHit* out, int* counts) const;
+    void allHitsMany(const glm::vec3* org, const glm::vec3* dir, int n, const float* tnears, const float* tfars,
+                     int maxHits, float minGap, RayHit* out, int* counts) const;
     // The prelit colour at a hit, interpolated and not rounded: RGB 0..1.
     glm::vec3 hitColor(const RayHit& h) const;
     // The SceneModel entity a hit struck (ground-truth labels).

@@ -76,7 +76,8 @@ Status checkHeader(const RaySet& s, const std::string& what) {
         if (!std::isfinite(finite[k])) return bad(names[k], std::to_string(finite[k]), "(finite)");
     if (!(c.fovY > 0 && c.fovY < kPi)) return bad("fovY", std::to_string(c.fovY), "(0, pi) radians");
     if (!(c.zNear > 0 && std::isfinite(c.zNear))) return bad("zNear", std::to_string(c.zNear), "(0, inf) metres");
-    if (!(s.hazeFar >= 0 && std::isfinite(s.hazeFar))) return bad("hazeFar", std::to_string(s.hazeFar), "[0, inf) metres");
+    if (!(s.hazeFar >= 0 && std::isfinite(s.hazeFar)))
+        return bad("hazeFar", std::to_string(s.hazeFar), "[0, inf) metres");
     if (!(s.tnear >= 0 && std::isfinite(s.tnear))) return bad("tnear", std::to_string(s.tnear), "[0, inf) metres");
     return Status::ok();
 }
@@ -107,7 +108,8 @@ std::string encodeRaySet(const RaySet& s) {
     putU32(b, uint32_t(s.camera.width));
     putU32(b, uint32_t(s.camera.height));
     const Camera& c = s.camera;
-    for (double v : {c.eye.x, c.eye.y, c.eye.z, c.heading, c.pitch, c.roll, c.fovY, c.zNear, s.hazeFar, s.tnear}) putF64(b, v);
+    for (double v : {c.eye.x, c.eye.y, c.eye.z, c.heading, c.pitch, c.roll, c.fovY, c.zNear, s.hazeFar, s.tnear})
+        putF64(b, v);
     putU64(b, s.pixels.size());
     for (uint32_t p : s.pixels) putU32(b, p);
     putU64(b, hashBytes64(b.data(), b.size()));
@@ -118,12 +120,14 @@ Result<RaySet> decodeRaySet(const std::string& bytes, const std::string& what) {
     if (bytes.size() < kHeaderBytes + 8)
         return Status::error(what + ": ray set truncated: " + std::to_string(bytes.size()) + " bytes, a header needs " +
                              std::to_string(kHeaderBytes + 8));
-    if (std::memcmp(bytes.data(), kMagic, 8) != 0) return Status::error(what + ": not a ray set (magic is not VRAYSET1)");
+    if (std::memcmp(bytes.data(), kMagic, 8) != 0)
+        return Status::error(what + ": not a ray set (magic is not VRAYSET1)");
     Cursor in(bytes, 8);
     RaySet s;
     const uint32_t version = in.u32();
     if (version != kVersion)
-        return Status::error(what + ": ray set version = " + std::to_string(version) + " unsupported (this build reads 2; dump the rays again with `vista bench --dump-rays`)");
+        return Status::error(what + ": ray set version = " + std::to_string(version) +
+                             " unsupported (this build reads 2; dump the rays again with `vista bench --dump-rays`)");
     s.frame = in.u32();
     const uint32_t w = in.u32(), h = in.u32();
     for (auto [name, v] : {std::pair<const char*, uint32_t>{"width", w}, {"height", h}})
@@ -132,7 +136,9 @@ Result<RaySet> decodeRaySet(const std::string& bytes, const std::string& what) {
     s.camera.width = int(w);
     s.camera.height = int(h);
     Camera& c = s.camera;
-    for (double* v : {&c.eye.x, &c.eye.y, &c.eye.z, &c.heading, &c.pitch, &c.roll, &c.fovY, &c.zNear, &s.hazeFar, &s.tnear}) *v = in.f64();
+    for (double* v :
+         {&c.eye.x, &c.eye.y, &c.eye.z, &c.heading, &c.pitch, &c.roll, &c.fovY, &c.zNear, &s.hazeFar, &s.tnear})
+        *v = in.f64();
     VISTA_RETURN_IF_ERROR(checkHeader(s, what));
     const uint64_t count = in.u64();
     const uint64_t room = (bytes.size() - kHeaderBytes - 8) / 4;

@@ -29,7 +29,8 @@ size_t blocksAt(const std::vector<uint32_t>& glass, int W, int s) {
     const int bw = (W + s - 1) / s;
     std::vector<uint32_t> keys;
     keys.reserve(glass.size());
-    for (uint32_t i : glass) keys.push_back(uint32_t((i / uint32_t(W)) / uint32_t(s)) * uint32_t(bw) + (i % uint32_t(W)) / uint32_t(s));
+    for (uint32_t i : glass)
+        keys.push_back(uint32_t((i / uint32_t(W)) / uint32_t(s)) * uint32_t(bw) + (i % uint32_t(W)) / uint32_t(s));
     std::sort(keys.begin(), keys.end());
     return size_t(std::unique(keys.begin(), keys.end()) - keys.begin());
 }
@@ -42,7 +43,8 @@ bool hasGlassPixels(const Image& img) {
     return false;
 }
 
-void reflectionStage(const RayScene* rays, const Camera& camera, const FrameEffects& fx, Image& img, FrameStats& stats) {
+void reflectionStage(const RayScene* rays, const Camera& camera, const FrameEffects& fx, Image& img,
+                     FrameStats& stats) {
     const int W = img.width, H = img.height;
     std::vector<uint32_t> glass;
     for (size_t i = 0, n = size_t(W) * size_t(H); i < n; ++i)
@@ -64,7 +66,8 @@ void reflectionStage(const RayScene* rays, const Camera& camera, const FrameEffe
     std::vector<std::pair<uint32_t, uint32_t>> byBlock;  // (block, pixel)
     byBlock.reserve(glass.size());
     for (uint32_t i : glass)
-        byBlock.emplace_back(uint32_t((i / uint32_t(W)) / uint32_t(s)) * uint32_t(bw) + (i % uint32_t(W)) / uint32_t(s), i);
+        byBlock.emplace_back(uint32_t((i / uint32_t(W)) / uint32_t(s)) * uint32_t(bw) + (i % uint32_t(W)) / uint32_t(s),
+                             i);
     std::stable_sort(byBlock.begin(), byBlock.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     std::vector<size_t> starts;
     for (size_t k = 0; k < byBlock.size(); ++k)
@@ -84,7 +87,8 @@ void reflectionStage(const RayScene* rays, const Camera& camera, const FrameEffe
         double best = 1e300;
         for (size_t k = k0; k < k1; ++k) {
             const uint32_t i = byBlock[k].second;
-            const double dx = double(i % uint32_t(W)) + 0.5 - cx, dy = double(i / uint32_t(W)) + 0.5 - cy, d2 = dx * dx + dy * dy;
+            const double dx = double(i % uint32_t(W)) + 0.5 - cx, dy = double(i / uint32_t(W)) + 0.5 - cy,
+                         d2 = dx * dx + dy * dy;
             if (d2 < best) best = d2, sample = i;
         }
         const glm::dvec3 d = gen.dir(int(sample % uint32_t(W)), int(sample / uint32_t(W)));
@@ -113,7 +117,8 @@ void reflectionStage(const RayScene* rays, const Camera& camera, const FrameEffe
         for (size_t k = k0; k < k1; ++k) {
             uint8_t* px = &img.rgba[size_t(byBlock[k].second) * 4];
             const double w = F * coverage(px[3]);
-            for (int c = 0; c < 3; ++c) px[c] = uint8_t(std::lround(std::clamp(px[c] * (1.0 - w) + refl[c] * w, 0.0, 255.0)));
+            for (int c = 0; c < 3; ++c)
+                px[c] = uint8_t(std::lround(std::clamp(px[c] * (1.0 - w) + refl[c] * w, 0.0, 255.0)));
         }
         cast += n;
     });

@@ -27,9 +27,15 @@ glm::dvec3 Camera::rayDirection(double px, double py) const {
 glm::dmat4 Camera::view(const glm::dvec3& o) const {
     glm::dvec3 f = forward(), r = right(), u = up(), e = eye - o;
     glm::dmat4 m(1.0);
-    m[0][0] = r.x; m[1][0] = r.y; m[2][0] = r.z;
-    m[0][1] = u.x; m[1][1] = u.y; m[2][1] = u.z;
-    m[0][2] = -f.x; m[1][2] = -f.y; m[2][2] = -f.z;
+    m[0][0] = r.x;
+    m[1][0] = r.y;
+    m[2][0] = r.z;
+    m[0][1] = u.x;
+    m[1][1] = u.y;
+    m[2][1] = u.z;
+    m[0][2] = -f.x;
+    m[1][2] = -f.y;
+    m[2][2] = -f.z;
     m[3][0] = -glm::dot(r, e);
     m[3][1] = -glm::dot(u, e);
     m[3][2] = glm::dot(f, e);

@@ -13,13 +13,13 @@
 namespace vista {
 
 struct Camera {
-    glm::dvec3 eye{0.0};       // world position
-    double heading = 0;        // radians
-    double pitch = 0;          // radians
-    double roll = 0;           // radians
+    glm::dvec3 eye{0.0};               // world position
+    double heading = 0;                // radians
+    double pitch = 0;                  // radians
+    double roll = 0;                   // radians
     double fovY = 0.7853981633974483;  // 45 degrees
     int width = 640, height = 480;
-    double zNear = 0.3;        // metres
+    double zNear = 0.3;  // metres
 
     // Unit vectors of the view frame in world coordinates.
     glm::dvec3 forward() const;
@@ -32,7 +32,7 @@ struct Camera {
     // relative to `frameOrigin` (pass the same origin to the model matrices,
     // so float precision holds far from the world origin).
     glm::dmat4 view(const glm::dvec3& frameOrigin = glm::dvec3(0.0)) const;
-    glm::dmat4 projection(double zFar) const;   // zFar <= 0 means infinity
+    glm::dmat4 projection(double zFar) const;  // zFar <= 0 means infinity
     bool upright(double tolerance = 1e-6) const { return roll < tolerance && roll > -tolerance; }
 };
 

@@ -98,9 +98,10 @@ void addHazeToTreePrograms(osg::Node* root) {
             if (!prog || prog->getName() != "vista.instanced_trees" || !seen.insert(prog).second) return;
             while (prog->getNumShaders() > 0) prog->removeShader(prog->getShader(0));
             prog->addShader(new osg::Shader(osg::Shader::VERTEX, kInstanceVertexShaderHaze));
-            prog->addShader(new osg::Shader(osg::Shader::FRAGMENT, std::string(kHazeGlsl) +
-                                                                      "varying float vista_eye_depth;\n"
-                                                                      "void main() { gl_FragColor = vistaHaze(gl_Color, vista_eye_depth); }\n"));
+            prog->addShader(new osg::Shader(
+                osg::Shader::FRAGMENT, std::string(kHazeGlsl) +
+                                           "varying float vista_eye_depth;\n"
+                                           "void main() { gl_FragColor = vistaHaze(gl_Color, vista_eye_depth); }\n"));
         }
         void apply(osg::Node& n) override {
             fix(n.getStateSet());
@@ -187,8 +188,8 @@ glm::mat4 instanceMatrix(const TreeInstance& t, const glm::dvec3& tileOrigin) {
 
 // The instance matrices of the trees `list` (tile-local) as four column arrays, and the
 // tile-local box of the prototype box `pb` under every matrix.
-void instanceColumns(const City& city, const std::vector<uint32_t>& list, const glm::dvec3& tileOrigin, const osg::BoundingBox& pb,
-                     osg::ref_ptr<osg::Vec4Array> (&cols)[4], osg::BoundingBox& bb) {
+void instanceColumns(const City& city, const std::vector<uint32_t>& list, const glm::dvec3& tileOrigin,
+                     const osg::BoundingBox& pb, osg::ref_ptr<osg::Vec4Array> (&cols)[4], osg::BoundingBox& bb) {
     for (auto& c : cols) c = new osg::Vec4Array(unsigned(list.size()));
     for (size_t k = 0; k < list.size(); ++k) {
         const glm::mat4 m = instanceMatrix(city.trees[list[k]], tileOrigin);
@@ -207,7 +208,8 @@ osg::ref_ptr<osg::StateSet> instancedStateSet() {
     prog->setName("vista.instanced_trees");
     prog->addShader(new osg::Shader(osg::Shader::VERTEX, kInstanceVertexShader));
     prog->addShader(new osg::Shader(osg::Shader::FRAGMENT, kInstanceFragmentShader));
-    for (unsigned c = 0; c < 4; ++c) prog->addBindAttribLocation("vista_instance" + std::to_string(c), kInstanceAttrib0 + c);
+    for (unsigned c = 0; c < 4; ++c)
+        prog->addBindAttribLocation("vista_instance" + std::to_string(c), kInstanceAttrib0 + c);
     ss->setAttributeAndModes(prog.get(), osg::StateAttribute::ON);
     for (unsigned c = 0; c < 4; ++c) ss->setAttribute(new osg::VertexAttribDivisor(kInstanceAttrib0 + c, 1));
     ss->setAttribute(new osg::VertexAttribDivisor(kTreeIdAttrib, 1));
@@ -218,7 +220,8 @@ std::string tileName(const Tile& t) { return "tile_" + std::to_string(t.ix) + "_
 
 bool tileEmpty(const Tile& t) {
     if (!t.trees.empty()) return false;
-    for (const Mesh& m : t.meshes) if (!m.empty()) return false;
+    for (const Mesh& m : t.meshes)
+        if (!m.empty()) return false;
     return true;
 }
 
@@ -252,7 +255,9 @@ osg::ref_ptr<osg::Node> buildCityScene(const City& city) {
     for (size_t i = 0; i < city.treePrototypes.size(); ++i) {
         const Mesh& m = city.treePrototypes[i].mesh;
         checkMesh(m);
-        if (city.treeImpostors) impostors[i] = makeTreeImpostorArrays(makeTreeImpostor(m.positions, m.colors, m.indices, kCoarseImpostorCellPixels));
+        if (city.treeImpostors)
+            impostors[i] =
+                makeTreeImpostorArrays(makeTreeImpostor(m.positions, m.colors, m.indices, kCoarseImpostorCellPixels));
         protos[i].verts = toVec3Array(m.positions);
         protos[i].normals = normalsFor(m);
         protos[i].colors = toColorArray(m.colors);
@@ -297,20 +302,23 @@ osg::ref_ptr<osg::Node> buildCityScene(const City& city) {
                 osg::BoundingBox bb;
                 instanceColumns(city, list, tile.origin, impostors[pi].bounds, cols, bb);
                 osg::Array* const arrays[4] = {cols[0].get(), cols[1].get(), cols[2].get(), cols[3].get()};
-                if (auto g = instancedTreeImpostor(impostors[pi], pi, arrays, unsigned(list.size()), bb)) geode->addDrawable(g.get());
+                if (auto g = instancedTreeImpostor(impostors[pi], pi, arrays, unsigned(list.size()), bb))
+                    geode->addDrawable(g.get());
                 continue;
             }
             if (!instSS) instSS = instancedStateSet();
-            auto g = makeGeometry(kTreeGeometryPrefix + std::to_string(pi), protos[pi].verts.get(), protos[pi].normals.get(),
-                                  protos[pi].colors.get(), pm.indices);
+            auto g = makeGeometry(kTreeGeometryPrefix + std::to_string(pi), protos[pi].verts.get(),
+                                  protos[pi].normals.get(), protos[pi].colors.get(), pm.indices);
             g->getPrimitiveSet(0)->setNumInstances(int(list.size()));
             osg::ref_ptr<osg::Vec4Array> cols[4];
             osg::ref_ptr<osg::UIntArray> treeIds = new osg::UIntArray(unsigned(list.size()));
             treeIds->setPreserveDataType(true);
-            for (size_t k = 0; k < list.size(); ++k) (*treeIds)[unsigned(k)] = makeInstanceId(InstanceKind::Tree, list[k]);
+            for (size_t k = 0; k < list.size(); ++k)
+                (*treeIds)[unsigned(k)] = makeInstanceId(InstanceKind::Tree, list[k]);
             osg::BoundingBox bb;
             instanceColumns(city, list, tile.origin, protos[pi].bounds, cols, bb);
-            for (unsigned c = 0; c < 4; ++c) g->setVertexAttribArray(kInstanceAttrib0 + c, cols[c].get(), osg::Array::BIND_PER_VERTEX);
+            for (unsigned c = 0; c < 4; ++c)
+                g->setVertexAttribArray(kInstanceAttrib0 + c, cols[c].get(), osg::Array::BIND_PER_VERTEX);
             g->setVertexAttribArray(kLabelAttrib, protos[pi].labels.get(), osg::Array::BIND_PER_VERTEX);
             g->setVertexAttribArray(kTreeIdAttrib, treeIds.get(), osg::Array::BIND_PER_VERTEX);
             g->setInitialBound(bb);
@@ -392,19 +400,25 @@ Status decodeMesh(osg::Geometry& g, const osg::MatrixTransform& xf, const std::s
     auto* verts = dynamic_cast<osg::Vec3Array*>(g.getVertexArray());
     auto* colors = dynamic_cast<osg::Vec4ubArray*>(g.getColorArray());
     auto* de = dynamic_cast<osg::DrawElements*>(g.getPrimitiveSet(0));
-    if (!verts || !de || de->getMode() != GL_TRIANGLES) return notCityFile(path, "geometry '" + g.getName() + "' in " + xf.getName() + " is malformed");
-    if (colors && colors->size() != verts->size()) return notCityFile(path, "geometry '" + g.getName() + "': colour count != vertex count");
+    if (!verts || !de || de->getMode() != GL_TRIANGLES)
+        return notCityFile(path, "geometry '" + g.getName() + "' in " + xf.getName() + " is malformed");
+    if (colors && colors->size() != verts->size())
+        return notCityFile(path, "geometry '" + g.getName() + "': colour count != vertex count");
     mesh.positions.resize(verts->size());
-    for (size_t i = 0; i < verts->size(); ++i) mesh.positions[i] = glm::vec3((*verts)[i].x(), (*verts)[i].y(), (*verts)[i].z());
+    for (size_t i = 0; i < verts->size(); ++i)
+        mesh.positions[i] = glm::vec3((*verts)[i].x(), (*verts)[i].y(), (*verts)[i].z());
     mesh.colors.assign(verts->size(), glm::u8vec4(255));
     if (colors)
-        for (size_t i = 0; i < colors->size(); ++i) mesh.colors[i] = glm::u8vec4((*colors)[i].r(), (*colors)[i].g(), (*colors)[i].b(), (*colors)[i].a());
+        for (size_t i = 0; i < colors->size(); ++i)
+            mesh.colors[i] = glm::u8vec4((*colors)[i].r(), (*colors)[i].g(), (*colors)[i].b(), (*colors)[i].a());
     mesh.indices.resize(de->getNumIndices());
     for (unsigned i = 0; i < de->getNumIndices(); ++i) {
         mesh.indices[i] = de->getElement(i);
-        if (mesh.indices[i] >= verts->size()) return notCityFile(path, "geometry '" + g.getName() + "': index out of range");
+        if (mesh.indices[i] >= verts->size())
+            return notCityFile(path, "geometry '" + g.getName() + "': index out of range");
     }
-    if (mesh.indices.size() % 3 != 0) return notCityFile(path, "geometry '" + g.getName() + "': index count not a multiple of 3");
+    if (mesh.indices.size() % 3 != 0)
+        return notCityFile(path, "geometry '" + g.getName() + "': index count not a multiple of 3");
     return Status::ok();
 }
 
@@ -419,7 +433,8 @@ Status decodeInstanceMatrices(osg::Geometry& g, const std::string& what, const s
         if (!cols[c]) return notCityFile(path, what + " '" + name + "' has no instance matrices");
     }
     const size_t n = size_t(std::max(0, g.getPrimitiveSet(0)->getNumInstances()));
-    for (auto* c : cols) if (c->size() != n) return notCityFile(path, what + " '" + name + "': instance count mismatch");
+    for (auto* c : cols)
+        if (c->size() != n) return notCityFile(path, what + " '" + name + "': instance count mismatch");
     matrices.resize(n);
     for (size_t k = 0; k < n; ++k) {
         glm::dmat4 m(1.0);
@@ -462,7 +477,8 @@ private:
         const glm::dmat4 tileM = glm::translate(glm::dmat4(1.0), tile.origin);
         const std::string& name = g.getName();
         if (long pi = -1; isTreeImpostorName(name, &pi)) {  // coarse levels: drawn by the graph only
-            if (pi < 0 || pi >= _protoCount) return notCityFile(_path, "tree impostor geometry '" + name + "' names an unknown prototype");
+            if (pi < 0 || pi >= _protoCount)
+                return notCityFile(_path, "tree impostor geometry '" + name + "' names an unknown prototype");
             std::vector<glm::dmat4> matrices;
             if (Status s = decodeInstanceMatrices(g, "tree impostor geometry", _path, matrices); !s) return s;
             for (const glm::dmat4& m : matrices) _out.impostors.push_back({uint32_t(pi), tileM * m, 0u});
@@ -474,7 +490,8 @@ private:
         mesh.material = materialFromName(name.c_str());
         if (_out.labelled) {
             auto* ids = dynamic_cast<osg::UIntArray*>(g.getVertexAttribArray(kLabelAttrib));
-            if (!ids || ids->size() != mesh.positions.size()) return notCityFile(_path, "geometry '" + name + "': label count != vertex count");
+            if (!ids || ids->size() != mesh.positions.size())
+                return notCityFile(_path, "geometry '" + name + "': label count != vertex count");
             ids->setPreserveDataType(true);
             mesh.ids.assign(ids->begin(), ids->end());
         }
@@ -492,14 +509,16 @@ private:
     Status decodeTrees(osg::Geometry& g, const glm::dmat4& tileM, SceneMesh&& mesh, SceneTile& tile) {
         const std::string& name = g.getName();
         long pi = std::strtol(name.c_str() + std::strlen(kTreeGeometryPrefix), nullptr, 10);
-        if (pi < 0 || pi >= _protoCount) return notCityFile(_path, "tree geometry '" + name + "' names an unknown prototype");
+        if (pi < 0 || pi >= _protoCount)
+            return notCityFile(_path, "tree geometry '" + name + "' names an unknown prototype");
         std::vector<glm::dmat4> matrices;
         if (Status s = decodeInstanceMatrices(g, "tree geometry", _path, matrices); !s) return s;
         const size_t n = matrices.size();
         osg::UIntArray* treeIds = nullptr;
         if (_out.labelled) {
             treeIds = dynamic_cast<osg::UIntArray*>(g.getVertexAttribArray(kTreeIdAttrib));
-            if (!treeIds || treeIds->size() != n) return notCityFile(_path, "tree geometry '" + name + "': tree id count != instance count");
+            if (!treeIds || treeIds->size() != n)
+                return notCityFile(_path, "tree geometry '" + name + "': tree id count != instance count");
             treeIds->setPreserveDataType(true);
         }
         for (size_t k = 0; k < n; ++k) {
@@ -529,8 +548,8 @@ Result<SceneModel> decodeCityScene(osg::Node* node, const std::string& path) {
     int format = 0;
     if (!getUser(*root, "vista.format", format)) return notCityFile(path, "missing user value vista.format");
     if (format != kFormatVersion)
-        return Status::error("city file '" + path + "': vista.format = " + std::to_string(format) + " is not supported (expected " +
-                             std::to_string(kFormatVersion) + ")");
+        return Status::error("city file '" + path + "': vista.format = " + std::to_string(format) +
+                             " is not supported (expected " + std::to_string(kFormatVersion) + ")");
     SceneModel out;
     addHazeToTreePrograms(node);
     setSceneRoot(out, node);

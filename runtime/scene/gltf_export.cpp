@@ -58,7 +58,10 @@ public:
         nlohmann::ordered_json prim;
         // POSITION with min/max.
         glm::vec3 lo(INFINITY), hi(-INFINITY);
-        for (const auto& p : m.positions) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
+        for (const auto& p : m.positions) {
+            lo = glm::min(lo, p);
+            hi = glm::max(hi, p);
+        }
         size_t pa = addAccessor(addView(m.positions.data(), n * sizeof(glm::vec3), kArrayBuffer), kFloat, n, "VEC3");
         accessors[pa]["min"] = {lo.x, lo.y, lo.z};
         accessors[pa]["max"] = {hi.x, hi.y, hi.z};
@@ -69,11 +72,13 @@ public:
             float l = glm::length(v);
             v = l > 0 && std::isfinite(l) ? v / l : glm::vec3(0, 0, 1);
         }
-        prim["attributes"]["NORMAL"] = addAccessor(addView(normals.data(), n * sizeof(glm::vec3), kArrayBuffer), kFloat, n, "VEC3");
-        prim["attributes"]["COLOR_0"] =
-            addAccessor(addView(m.colors.data(), n * sizeof(glm::u8vec4), kArrayBuffer), kUnsignedByte, n, "VEC4", true);
-        prim["indices"] = addAccessor(addView(m.indices.data(), m.indices.size() * sizeof(uint32_t), kElementArrayBuffer),
-                                      kUnsignedInt, m.indices.size(), "SCALAR");
+        prim["attributes"]["NORMAL"] =
+            addAccessor(addView(normals.data(), n * sizeof(glm::vec3), kArrayBuffer), kFloat, n, "VEC3");
+        prim["attributes"]["COLOR_0"] = addAccessor(addView(m.colors.data(), n * sizeof(glm::u8vec4), kArrayBuffer),
+                                                    kUnsignedByte, n, "VEC4", true);
+        prim["indices"] =
+            addAccessor(addView(m.indices.data(), m.indices.size() * sizeof(uint32_t), kElementArrayBuffer),
+                        kUnsignedInt, m.indices.size(), "SCALAR");
         prim["mode"] = 4;
         return prim;
     }
@@ -98,7 +103,9 @@ Status writeGltf(const City& city, const std::string& path) {
     nlohmann::ordered_json nodes = nlohmann::ordered_json::array();
 
     // Node 0: root, turning the z-up city frame into glTF's y-up frame.
-    nodes.push_back({{"name", "vista.city"}, {"rotation", {-std::sqrt(0.5), 0.0, 0.0, std::sqrt(0.5)}}, {"children", nlohmann::ordered_json::array()}});
+    nodes.push_back({{"name", "vista.city"},
+                     {"rotation", {-std::sqrt(0.5), 0.0, 0.0, std::sqrt(0.5)}},
+                     {"children", nlohmann::ordered_json::array()}});
 
     // Tree prototypes: one mesh each (empty prototypes get no mesh).
     std::vector<long> protoMesh(city.treePrototypes.size(), -1);
@@ -120,10 +127,10 @@ Status writeGltf(const City& city, const std::string& path) {
     nlohmann::ordered_json materials = nlohmann::ordered_json::array();
     long glassMaterial = -1, lampMaterial = -1;
     if (city.params.effects.glass) {
-        materials.push_back({{"name", "vista.glass"},
-                             {"pbrMetallicRoughness", {{"baseColorFactor", {1.0, 1.0, 1.0, 1.0}},
-                                                       {"metallicFactor", 0.0},
-                                                       {"roughnessFactor", 0.05}}}});
+        materials.push_back(
+            {{"name", "vista.glass"},
+             {"pbrMetallicRoughness",
+              {{"baseColorFactor", {1.0, 1.0, 1.0, 1.0}}, {"metallicFactor", 0.0}, {"roughnessFactor", 0.05}}}});
         glassMaterial = long(materials.size() - 1);
     }
     if (city.params.effects.night) {
@@ -174,11 +181,12 @@ Status writeGltf(const City& city, const std::string& path) {
     nlohmann::ordered_json j;
     j["asset"]["version"] = "2.0";
     j["asset"]["generator"] = "vista";
-    j["asset"]["extras"]["vista"] = {{"origin_x", city.params.origin_x},
-                                     {"origin_y", city.params.origin_y},
-                                     {"tile_size_m", city.params.tile_size_m},
-                                     {"up", "z (root node rotates to glTF y-up)"},
-                                     {"params", nlohmann::ordered_json::parse(paramsToJson(city.params), nullptr, false)}};
+    j["asset"]["extras"]["vista"] = {
+        {"origin_x", city.params.origin_x},
+        {"origin_y", city.params.origin_y},
+        {"tile_size_m", city.params.tile_size_m},
+        {"up", "z (root node rotates to glTF y-up)"},
+        {"params", nlohmann::ordered_json::parse(paramsToJson(city.params), nullptr, false)}};
     j["scene"] = 0;
     j["scenes"] = nlohmann::ordered_json::array({{{"name", "vista.city"}, {"nodes", {0}}}});
     j["nodes"] = nodes;

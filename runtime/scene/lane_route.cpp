@@ -10,9 +10,9 @@ namespace vista {
 
 namespace {
 
-constexpr double kStreetStep = 1.0;  // centre-line vertex spacing on street roads (straight)
-constexpr double kCurveStep = 0.25;  // on link roads and U-turns
-constexpr double kTaperWidth = 0.01; // a lane narrower than this where it ends is a taper
+constexpr double kStreetStep = 1.0;   // centre-line vertex spacing on street roads (straight)
+constexpr double kCurveStep = 0.25;   // on link roads and U-turns
+constexpr double kTaperWidth = 0.01;  // a lane narrower than this where it ends is a taper
 // Vertices closer than this to the previous one are dropped: where two
 // pieces meet, their end points agree only to rounding, and the heading of
 // so short a segment would be noise (a curvature spike).
@@ -102,8 +102,9 @@ Result<LaneRoute> LaneRoute::create(const LaneModel& model, uint64_t seed, bool 
     for (size_t i = 0; i < route._nodes.size(); ++i)
         if (!route._nodes[i].link && !route._nodes[i].next.empty()) starts.push_back(uint32_t(i));
     if (starts.empty())
-        return Status::error("cannot make a car path: no lane of the city's roads can be driven without reaching a lane "
-                             "it cannot leave (no valid street, or only one-way dead ends)");
+        return Status::error(
+            "cannot make a car path: no lane of the city's roads can be driven without reaching a lane "
+            "it cannot leave (no valid street, or only one-way dead ends)");
     route._seq.push_back(starts[size_t(route._rng.range(0, int64_t(starts.size()) - 1))]);
     route.ensure(1.0);
     return route;
@@ -205,7 +206,8 @@ void LaneRoute::buildGraph(bool lht) {
         n.next.clear();
         const int64_t back = streetNode(n.index, n.lane < 0 ? 1 : -1);
         const EdgeLanes& L = m.edges[n.index];
-        const double R = back >= 0 ? 0.5 * std::abs(L.laneCentre(n.lane) - L.laneCentre(_nodes[size_t(back)].lane)) : 0.0;
+        const double R =
+            back >= 0 ? 0.5 * std::abs(L.laneCentre(n.lane) - L.laneCentre(_nodes[size_t(back)].lane)) : 0.0;
         if (back >= 0 && L.length >= 2.0 * R + kUTurnMargin) {
             n.next.push_back(uint32_t(back));
             _uturn[u] = uint32_t(back) + 1;

@@ -113,7 +113,7 @@ private:
     struct Piece {
         uint32_t node = 0;
         bool uturn = false;
-        int laneTo = 0;      // U-turn: the lane it enters
+        int laneTo = 0;         // U-turn: the lane it enters
         double s0 = 0, s1 = 0;  // s range driven (s0 where the car enters)
     };
     LaneRoute(const LaneModel& m, uint64_t seed) : _m(m), _rng(seed, 0, Stream::Paths) {}

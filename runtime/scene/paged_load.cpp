@@ -35,8 +35,8 @@ bool isPagedCityPath(const std::string& path) {
 Status validatePagedRadius(const std::string& option, double value) {
     if (!std::isfinite(value) || value < kMinPagedRadiusM || value > kMaxPagedRadiusM) {
         std::ostringstream s;
-        s << "option " << option << " = " << value << ": out of range (" << kMinPagedRadiusM << " .. " << kMaxPagedRadiusM
-          << " metres)";
+        s << "option " << option << " = " << value << ": out of range (" << kMinPagedRadiusM << " .. "
+          << kMaxPagedRadiusM << " metres)";
         return Status::error(s.str());
     }
     return Status::ok();
@@ -45,7 +45,9 @@ Status validatePagedRadius(const std::string& option, double value) {
 Result<PagedManifest> readPagedManifest(const std::string& dir) {
     const std::string path = (fs::path(dir) / kPagedManifestFile).string();
     std::ifstream in(path, std::ios::binary);
-    if (!in) return Status::error("paged city '" + dir + "': cannot read '" + path + "' (not a paged city from `vista gen -o DIR.paged`, or its run did not finish)");
+    if (!in)
+        return Status::error("paged city '" + dir + "': cannot read '" + path +
+                             "' (not a paged city from `vista gen -o DIR.paged`, or its run did not finish)");
     std::stringstream ss;
     ss << in.rdbuf();
     Json j = Json::parse(ss.str(), nullptr, false);
@@ -54,7 +56,8 @@ Result<PagedManifest> readPagedManifest(const std::string& dir) {
     PagedManifest m;
     m.dir = dir;
     try {
-        if (!j.contains("format") || j.at("format") != "vista.paged_city") return bad("field 'format' is not \"vista.paged_city\"");
+        if (!j.contains("format") || j.at("format") != "vista.paged_city")
+            return bad("field 'format' is not \"vista.paged_city\"");
         if (j.at("version").get<int>() != 1)
             return bad("field 'version' = " + j.at("version").dump() + " is not supported (expected 1)");
         auto params = parseParamsJson(j.at("params").dump(), path + " (params)");
@@ -64,8 +67,8 @@ Result<PagedManifest> readPagedManifest(const std::string& dir) {
         m.regionsX = j.at("regions_x").get<int>();
         m.regionsY = j.at("regions_y").get<int>();
         if (m.regionsX < 1 || m.regionsY < 1 || m.regionsX > 4096 || m.regionsY > 4096)
-            return bad("fields 'regions_x'/'regions_y' = " + std::to_string(m.regionsX) + "/" + std::to_string(m.regionsY) +
-                       " out of range (1 .. 4096)");
+            return bad("fields 'regions_x'/'regions_y' = " + std::to_string(m.regionsX) + "/" +
+                       std::to_string(m.regionsY) + " out of range (1 .. 4096)");
         const Json& regions = j.at("regions");
         if (!regions.is_array() || regions.size() != size_t(m.regionsX) * size_t(m.regionsY))
             return bad("field 'regions' is not an array of regions_x * regions_y entries");
@@ -104,9 +107,7 @@ Result<PagedManifest> readPagedManifest(const std::string& dir) {
             }
             m.regions.push_back(std::move(r));
         }
-    } catch (const std::exception& ex) {
-        return bad(std::string("missing or mistyped field (") + ex.what() + ")");
-    }
+    } catch (const std::exception& ex) { return bad(std::string("missing or mistyped field (") + ex.what() + ")"); }
     return m;
 }
 
@@ -150,7 +151,9 @@ Result<SceneModel> loadRegion(const PagedManifest& m, int i, bool coarse) {
     const std::string path = (fs::path(m.dir) / name).string();
     std::error_code ec;
     const uint64_t size = fs::file_size(path, ec);
-    if (ec) return Status::error("paged city '" + m.dir + "': region file '" + path + "' is missing or unreadable (" + ec.message() + ")");
+    if (ec)
+        return Status::error("paged city '" + m.dir + "': region file '" + path + "' is missing or unreadable (" +
+                             ec.message() + ")");
     if (size != bytes)
         return Status::error("paged city '" + m.dir + "': region file '" + path + "' has " + std::to_string(size) +
                              " bytes, the manifest says " + std::to_string(bytes) + " (damaged or from another run)");
@@ -237,7 +240,8 @@ Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>&
             first = false;
         } else if (r.prototypes.size() == out.prototypes.size()) {
             for (size_t p = 0; p < out.prototypes.size(); ++p)
-                if (out.prototypes[p].indices.empty() && !r.prototypes[p].indices.empty()) out.prototypes[p] = std::move(r.prototypes[p]);
+                if (out.prototypes[p].indices.empty() && !r.prototypes[p].indices.empty())
+                    out.prototypes[p] = std::move(r.prototypes[p]);
         } else if (!isCoarse) {
             return Status::error("region file '" + name + "': " + std::to_string(r.prototypes.size()) +
                                  " tree prototypes, the first region has " + std::to_string(out.prototypes.size()) +

@@ -90,11 +90,11 @@ struct PagedLoadReport {
     int regionsLoaded = 0;
     int regionsTotal = 0;  // non-empty regions of the city
     double radiusM = 0;
-    uint64_t bytesLoaded = 0;           // file bytes of the loaded regions (full and coarse)
-    int coarseLoaded = 0;               // regions loaded at their coarse level
-    uint64_t coarseBytes = 0;           // file bytes of those coarse files
-    std::vector<std::string> files;     // loaded region files (relative names), full then coarse
-    std::vector<std::string> damaged;   // one message per missing or damaged file (it names the file)
+    uint64_t bytesLoaded = 0;          // file bytes of the loaded regions (full and coarse)
+    int coarseLoaded = 0;              // regions loaded at their coarse level
+    uint64_t coarseBytes = 0;          // file bytes of those coarse files
+    std::vector<std::string> files;    // loaded region files (relative names), full then coarse
+    std::vector<std::string> damaged;  // one message per missing or damaged file (it names the file)
 };
 
 // True when `path` is a directory (a paged city is a directory; a city file is not).

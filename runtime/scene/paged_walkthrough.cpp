@@ -24,14 +24,16 @@ Result<PagedOpen> openPagedCity(const std::string& dir, bool needStreets) {
     return out;
 }
 
-Result<SceneModel> loadPagedNear(const PagedOpen& city, const Path& path, const PagedReach& reach, const char* cmd, bool quiet,
-                                 std::string* pagedJson, const std::function<Status(uint64_t bytes)>& beforeLoad) {
+Result<SceneModel> loadPagedNear(const PagedOpen& city, const Path& path, const PagedReach& reach, const char* cmd,
+                                 bool quiet, std::string* pagedJson,
+                                 const std::function<Status(uint64_t bytes)>& beforeLoad) {
     std::vector<glm::dvec2> points;
     for (const PathSample& s : path.samples) points.emplace_back(s.position.x, s.position.y);
     if (points.empty()) points.emplace_back(city.manifest.params.origin_x, city.manifest.params.origin_y);
     const double radius = reach.radius;
     const std::vector<int> regions = selectPagedRegions(city.manifest, points, radius);
-    const std::vector<int> coarse = reach.far > radius ? selectCoarseRegions(city.manifest, points, reach.far, regions) : std::vector<int>{};
+    const std::vector<int> coarse =
+        reach.far > radius ? selectCoarseRegions(city.manifest, points, reach.far, regions) : std::vector<int>{};
     if (beforeLoad) {
         uint64_t bytes = 0;
         for (int r : regions) bytes += city.manifest.regions[size_t(r)].bytes;
@@ -42,18 +44,23 @@ Result<SceneModel> loadPagedNear(const PagedOpen& city, const Path& path, const 
     auto model = loadPagedCity(city.manifest, regions, radius, &rep, coarse);
     if (!model) return model.status();
     if (!quiet)
-        std::fprintf(stderr,
-                     "%s: paged city: loaded %d of %d regions within %g m of the walkthrough and %d more at their coarse level "
-                     "(%.1f MB of region files, %zu triangles)\n",
-                     cmd, rep.regionsLoaded, rep.regionsTotal, radius, rep.coarseLoaded, double(rep.bytesLoaded) / 1e6,
-                     model->triangles);
+        std::fprintf(
+            stderr,
+            "%s: paged city: loaded %d of %d regions within %g m of the walkthrough and %d more at their coarse level "
+            "(%.1f MB of region files, %zu triangles)\n",
+            cmd, rep.regionsLoaded, rep.regionsTotal, radius, rep.coarseLoaded, double(rep.bytesLoaded) / 1e6,
+            model->triangles);
     for (const std::string& d : rep.damaged)
         std::fprintf(stderr, "%s: warning: %s; the rest of the city is loaded\n", cmd, d.c_str());
     if (pagedJson) {
-        nlohmann::json j = {{"regions_loaded", rep.regionsLoaded}, {"regions_total", rep.regionsTotal},
-                            {"radius_m", radius}, {"bytes_loaded", rep.bytesLoaded},
-                            {"coarse_regions_loaded", rep.coarseLoaded}, {"far_m", reach.far},
-                            {"coarse_bytes_loaded", rep.coarseBytes}, {"damaged", rep.damaged}};
+        nlohmann::json j = {{"regions_loaded", rep.regionsLoaded},
+                            {"regions_total", rep.regionsTotal},
+                            {"radius_m", radius},
+                            {"bytes_loaded", rep.bytesLoaded},
+                            {"coarse_regions_loaded", rep.coarseLoaded},
+                            {"far_m", reach.far},
+                            {"coarse_bytes_loaded", rep.coarseBytes},
+                            {"damaged", rep.damaged}};
         *pagedJson = j.dump();
     }
     return model;

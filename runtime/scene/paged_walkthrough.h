@@ -45,8 +45,8 @@ struct PagedOpen {
 };
 
 Result<PagedOpen> openPagedCity(const std::string& dir, bool needStreets);
-Result<SceneModel> loadPagedNear(const PagedOpen& city, const Path& path, const PagedReach& reach, const char* cmd, bool quiet,
-                                 std::string* pagedJson = nullptr,
+Result<SceneModel> loadPagedNear(const PagedOpen& city, const Path& path, const PagedReach& reach, const char* cmd,
+                                 bool quiet, std::string* pagedJson = nullptr,
                                  const std::function<Status(uint64_t bytes)>& beforeLoad = nullptr);
 
 }  // namespace vista

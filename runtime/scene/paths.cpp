@@ -22,15 +22,15 @@ namespace vista {
 
 namespace {
 
-constexpr double kMinSpeed = 2.0;       // m/s while turning sharply
-constexpr double kTurnRadius = 6.0;     // metres of corner cut we allow at full yaw rate
+constexpr double kMinSpeed = 2.0;    // m/s while turning sharply
+constexpr double kTurnRadius = 6.0;  // metres of corner cut we allow at full yaw rate
 // Car lane keeping: heading rate = speed x (curvature - kLateralGain x
 // lateral error - kHeadingGain x heading error), critically damped over
 // about 5 m of travel.
-constexpr double kLateralGain = 0.3;    // 1/m^2
-constexpr double kHeadingGain = 1.1;    // 1/m (2 sqrt(kLateralGain))
-constexpr double kBrakeShare = 0.8;     // share of the braking limit the speed profile plans with
-constexpr double kProgressWindow = 3.0; // metres ahead of the progress where the closest route point is searched
+constexpr double kLateralGain = 0.3;     // 1/m^2
+constexpr double kHeadingGain = 1.1;     // 1/m (2 sqrt(kLateralGain))
+constexpr double kBrakeShare = 0.8;      // share of the braking limit the speed profile plans with
+constexpr double kProgressWindow = 3.0;  // metres ahead of the progress where the closest route point is searched
 
 double headingOf(const glm::dvec2& d) { return std::atan2(d.x, d.y); }  // clockwise from north
 
@@ -102,7 +102,10 @@ private:
         double r = _rng.uniform() * total;
         size_t pick = cand.size() - 1;
         for (size_t i = 0; i < cand.size(); ++i) {
-            if (r < weight[i]) { pick = i; break; }
+            if (r < weight[i]) {
+                pick = i;
+                break;
+            }
             r -= weight[i];
         }
         uint32_t e = cand[pick];
@@ -159,12 +162,14 @@ Status validatePathOptions(const PathOptions& o) {
     if (!(o.duration > 0 && o.duration <= 86400)) return bad("duration", o.duration, "(0, 86400] s");
     if (!(o.dt > 0 && o.dt <= 10)) return bad("dt", o.dt, "(0, 10] s");
     if (!(o.maxSpeed > 0 && o.maxSpeed <= 1000)) return bad("speed", o.maxSpeed, "(0, 1000] m/s");
-    if (!(o.maxYawRate > 0 && o.maxYawRate <= 4 * kPi)) return bad("yaw rate", o.maxYawRate, "(0, 720] deg/s (in rad/s)");
+    if (!(o.maxYawRate > 0 && o.maxYawRate <= 4 * kPi))
+        return bad("yaw rate", o.maxYawRate, "(0, 720] deg/s (in rad/s)");
     if (!(o.accel > 0) || !(o.decel > 0)) return bad("accel/decel", std::min(o.accel, o.decel), "> 0 m/s^2");
     if (!(o.flyHeight > 0 && o.flyHeight < 10000)) return bad("fly height", o.flyHeight, "(0, 10000) m");
     if (!(o.flyPitch > -kPi / 2 && o.flyPitch < kPi / 2)) return bad("fly pitch", o.flyPitch, "(-90, 90) deg");
     if (!(o.runUp >= 0 && o.runUp <= 600)) return bad("run-up", o.runUp, "[0, 600] s");
-    if ((o.duration + o.runUp) / o.dt > 1e7) return bad("(duration + run-up)/dt", (o.duration + o.runUp) / o.dt, "<= 1e7 samples");
+    if ((o.duration + o.runUp) / o.dt > 1e7)
+        return bad("(duration + run-up)/dt", (o.duration + o.runUp) / o.dt, "<= 1e7 samples");
     return Status::ok();
 }
 
@@ -325,7 +330,7 @@ Result<Path> generatePath(const StreetGraph& g, const CityParams& params, const 
     glm::dvec2 pos = route.point(0);
     double h = route.segHeading(0);
     double v = 0.0;
-    double sp = 0.0;      // progress along the route (arc length of the closest point)
+    double sp = 0.0;  // progress along the route (arc length of the closest point)
     size_t seg = 0;
     const double w = o.maxYawRate, dt = o.dt;
     const size_t n = size_t(std::floor(o.duration / dt + 1e-9)) + 1;
@@ -380,7 +385,8 @@ Result<Path> generatePath(const StreetGraph& g, const CityParams& params, const 
             turn = std::max(turn, std::abs(wrapAngle(route.segHeading(k) - h)));
         }
         double vt = o.maxSpeed;
-        if (turn > 0.26) vt = std::clamp(w * kTurnRadius * (kPi / 2) / turn, std::min(kMinSpeed, o.maxSpeed), o.maxSpeed);
+        if (turn > 0.26)
+            vt = std::clamp(w * kTurnRadius * (kPi / 2) / turn, std::min(kMinSpeed, o.maxSpeed), o.maxSpeed);
         vt = std::min(vt, o.maxSpeed * std::max(0.15, std::cos(std::min(std::abs(err), kPi / 2))));
         vt = std::min(vt, o.maxSpeed);
         v += std::clamp(vt - v, -o.decel * dt, o.accel * dt);
@@ -403,14 +409,15 @@ Status savePathCsv(const Path& path, const std::string& file) {
 
 Status saveLanePositionsCsv(const Path& path, const std::string& file) {
     if (path.lanes.size() != path.samples.size() || path.lanes.empty())
-        return Status::error("lane positions for '" + file + "': the path has none (only car paths made from a city's "
+        return Status::error("lane positions for '" + file +
+                             "': the path has none (only car paths made from a city's "
                              "streets carry them, not paths read from a CSV or walk and fly paths)");
     std::string out = "t_s,road_id,lane_id,s_m,t_offset_m\n";
     char buf[160];
     for (size_t i = 0; i < path.samples.size(); ++i) {
         const LanePosition& l = path.lanes[i];
-        std::snprintf(buf, sizeof(buf), "%.6f,%llu,%d,%.4f,%.4f\n", path.samples[i].t, (unsigned long long)l.road, l.lane,
-                      l.s, l.tOffset);
+        std::snprintf(buf, sizeof(buf), "%.6f,%llu,%d,%.4f,%.4f\n", path.samples[i].t, (unsigned long long)l.road,
+                      l.lane, l.s, l.tOffset);
         out += buf;
     }
     return writeFileAtomic(file, out);
@@ -435,7 +442,8 @@ Result<Path> loadPathCsv(const std::string& file) {
             v[k] = std::strtod(p, &end);
             if (end == p || errno == ERANGE || !std::isfinite(v[k]))
                 return Status::error("path file '" + file + "' line " + std::to_string(lineNo) + ": field " +
-                                     std::to_string(k + 1) + " is not a finite number (expected t_s,x_m,y_m,z_m,heading_deg,pitch_deg)");
+                                     std::to_string(k + 1) +
+                                     " is not a finite number (expected t_s,x_m,y_m,z_m,heading_deg,pitch_deg)");
             p = end;
             while (*p == ' ' || *p == '\t') ++p;
             if (k < 5) {
@@ -458,7 +466,8 @@ Result<Path> loadPathCsv(const std::string& file) {
         for (int k = 0; k < 5; ++k)
             if (std::abs(v[k]) > limits[k])
                 return Status::error("path file '" + file + "' line " + std::to_string(lineNo) + ": " + names[k] + " " +
-                                     fmtNum(v[k]) + " out of range [-" + fmtNum(limits[k]) + ", " + fmtNum(limits[k]) + "]");
+                                     fmtNum(v[k]) + " out of range [-" + fmtNum(limits[k]) + ", " + fmtNum(limits[k]) +
+                                     "]");
         if (std::abs(v[5]) >= 90.0)
             return Status::error("path file '" + file + "' line " + std::to_string(lineNo) + ": pitch " + fmtNum(v[5]) +
                                  " deg out of range (-90, 90)");

@@ -68,14 +68,14 @@ double defaultSpeed(PathKind k);
 struct PathOptions {
     uint64_t seed = 1;
     PathKind kind = PathKind::Car;
-    double duration = 60.0;                       // seconds, > 0
-    double dt = 1.0 / 30.0;                       // seconds between samples, > 0
-    double maxSpeed = 14.0;                       // m/s, > 0 (programs set defaultSpeed(kind))
-    double maxYawRate = 0.7853981633974483;       // rad/s (45 deg/s), > 0
-    double accel = 2.5;                           // m/s^2 speeding up
-    double decel = 4.0;                           // m/s^2 braking
-    double flyHeight = 80.0;                      // metres above the terrain (Fly)
-    double flyPitch = -0.2;                       // radians (Fly)
+    double duration = 60.0;                  // seconds, > 0
+    double dt = 1.0 / 30.0;                  // seconds between samples, > 0
+    double maxSpeed = 14.0;                  // m/s, > 0 (programs set defaultSpeed(kind))
+    double maxYawRate = 0.7853981633974483;  // rad/s (45 deg/s), > 0
+    double accel = 2.5;                      // m/s^2 speeding up
+    double decel = 4.0;                      // m/s^2 braking
+    double flyHeight = 80.0;                 // metres above the terrain (Fly)
+    double flyPitch = -0.2;                  // radians (Fly)
     // Seconds driven before t = 0 and dropped, so that a measured path starts
     // at cruising speed instead of at rest (0 = start at rest), 0 .. 600.
     double runUp = 8.0;

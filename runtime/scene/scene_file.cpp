@@ -44,7 +44,9 @@ public:
 protected:
     pos_type seekoff(off_type off, std::ios_base::seekdir dir, std::ios_base::openmode which) override {
         if (!(which & std::ios_base::in)) return pos_type(off_type(-1));
-        off_type base = dir == std::ios_base::beg ? 0 : dir == std::ios_base::cur ? off_type(gptr() - eback()) : off_type(egptr() - eback());
+        off_type base = dir == std::ios_base::beg   ? 0
+                        : dir == std::ios_base::cur ? off_type(gptr() - eback())
+                                                    : off_type(egptr() - eback());
         off_type np = base + off;
         if (np < 0 || np > off_type(egptr() - eback())) return pos_type(off_type(-1));
         setg(eback(), eback() + np, egptr());
@@ -55,9 +57,7 @@ protected:
     }
 };
 
-osgDB::ReaderWriter* osgbReaderWriter() {
-    return osgDB::Registry::instance()->getReaderWriterForExtension("osgb");
-}
+osgDB::ReaderWriter* osgbReaderWriter() { return osgDB::Registry::instance()->getReaderWriterForExtension("osgb"); }
 
 }  // namespace
 
@@ -92,9 +92,7 @@ Status writeSceneFile(const osg::Node& node, const std::string& path, bool compr
             } else if (!written) {
                 why = "osgb writer failed" + (wr.message().empty() ? std::string() : ": " + wr.message());
             }
-        } catch (const std::exception& e) {
-            why = std::string("osgb writer failed: ") + e.what();
-        }
+        } catch (const std::exception& e) { why = std::string("osgb writer failed: ") + e.what(); }
         out.close();
         if (!written || out.fail()) return fail(why.empty() ? "write error" : why);
     }
@@ -106,7 +104,12 @@ Status writeSceneFile(const osg::Node& node, const std::string& path, bool compr
     std::vector<char> chunk(1 << 20);
     for (;;) {
         ssize_t r = ::read(fd, chunk.data(), chunk.size());
-        if (r < 0) { if (errno == EINTR) continue; std::string e = errnoText(); ::close(fd); return fail(e); }
+        if (r < 0) {
+            if (errno == EINTR) continue;
+            std::string e = errnoText();
+            ::close(fd);
+            return fail(e);
+        }
         if (r == 0) break;
         hasher.update(reinterpret_cast<unsigned char*>(chunk.data()), size_t(r));
         size += uint64_t(r);
@@ -119,10 +122,19 @@ Status writeSceneFile(const osg::Node& node, const std::string& path, bool compr
     size_t done = 0;
     while (done < sizeof trailer) {
         ssize_t w = ::pwrite(fd, trailer + done, sizeof trailer - done, off_t(size + done));
-        if (w < 0) { if (errno == EINTR) continue; std::string e = errnoText(); ::close(fd); return fail(e); }
+        if (w < 0) {
+            if (errno == EINTR) continue;
+            std::string e = errnoText();
+            ::close(fd);
+            return fail(e);
+        }
         done += size_t(w);
     }
-    if (::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) { std::string e = errnoText(); ::close(fd); return fail("fsync failed: " + e); }
+    if (::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) {
+        std::string e = errnoText();
+        ::close(fd);
+        return fail("fsync failed: " + e);
+    }
     if (::close(fd) != 0) return fail(errnoText());
     if (::rename(tmp.c_str(), path.c_str()) != 0) return fail("rename failed: " + errnoText());
     return Status::ok();
@@ -137,9 +149,7 @@ Result<osg::ref_ptr<osg::Node>> readSceneFile(const std::string& path) {
     std::vector<char> data;
     try {
         data.resize(size_t(st.st_size));
-    } catch (const std::exception&) {
-        return Status::error("cannot read scene file '" + path + "': out of memory");
-    }
+    } catch (const std::exception&) { return Status::error("cannot read scene file '" + path + "': out of memory"); }
     if (!data.empty() && !in.read(data.data(), std::streamsize(data.size())))
         return Status::error("cannot read scene file '" + path + "': read error");
     const auto* bytes = reinterpret_cast<const unsigned char*>(data.data());
@@ -150,12 +160,14 @@ Result<osg::ref_ptr<osg::Node>> readSceneFile(const std::string& path) {
     if (data.size() < 8 + kSceneTrailerSize ||
         std::memcmp(bytes + data.size() - kSceneTrailerSize, kTrailerHead, 8) != 0 ||
         std::memcmp(bytes + data.size() - 8, kTrailerTail, 8) != 0)
-        return Status::error("scene file '" + path + "' is truncated or was not written by vista (no integrity trailer)");
+        return Status::error("scene file '" + path +
+                             "' is truncated or was not written by vista (no integrity trailer)");
     const unsigned char* tr = bytes + data.size() - kSceneTrailerSize;
     uint64_t payload = loadLE64(tr + 8), hash = loadLE64(tr + 16);
     if (payload != data.size() - kSceneTrailerSize)
-        return Status::error("scene file '" + path + "' is truncated or corrupted: payload size " + std::to_string(data.size() - kSceneTrailerSize) +
-                             " bytes, trailer says " + std::to_string(payload));
+        return Status::error("scene file '" + path + "' is truncated or corrupted: payload size " +
+                             std::to_string(data.size() - kSceneTrailerSize) + " bytes, trailer says " +
+                             std::to_string(payload));
     if (hashBytes64(bytes, size_t(payload)) != hash)
         return Status::error("scene file '" + path + "' is corrupted: checksum mismatch");
     osgDB::ReaderWriter* rw = osgbReaderWriter();
@@ -177,7 +189,8 @@ Result<osg::ref_ptr<osg::Node>> readSceneFile(const std::string& path) {
             // found by fuzzing: 9 s): the child gets a time limit (5 s plus
             // 1 s per 10 MB, VISTA_UNTRUSTED_DECODE_SECONDS overrides).
             double limitS = 5.0 + double(payload) / 1e7;
-            if (const char* l = std::getenv("VISTA_UNTRUSTED_DECODE_SECONDS"); l && std::atof(l) > 0) limitS = std::atof(l);
+            if (const char* l = std::getenv("VISTA_UNTRUSTED_DECODE_SECONDS"); l && std::atof(l) > 0)
+                limitS = std::atof(l);
             const auto start = std::chrono::steady_clock::now();
             int st = 0;
             for (;;) {
@@ -188,13 +201,15 @@ Result<osg::ref_ptr<osg::Node>> readSceneFile(const std::string& path) {
                     while (::waitpid(pid, &st, 0) < 0 && errno == EINTR) {}
                     char buf[32];
                     std::snprintf(buf, sizeof buf, "%.0f", limitS);
-                    return Status::error("scene file '" + path + "' is malformed: its payload keeps the osgb reader busy beyond " +
-                                         buf + " s (checked in a child process; VISTA_UNTRUSTED_DECODE_SECONDS sets the limit)");
+                    return Status::error(
+                        "scene file '" + path + "' is malformed: its payload keeps the osgb reader busy beyond " + buf +
+                        " s (checked in a child process; VISTA_UNTRUSTED_DECODE_SECONDS sets the limit)");
                 }
                 std::this_thread::sleep_for(std::chrono::milliseconds(5));
             }
             if (WIFSIGNALED(st))
-                return Status::error("scene file '" + path + "' is malformed: its payload crashes the osgb reader (signal " +
+                return Status::error("scene file '" + path +
+                                     "' is malformed: its payload crashes the osgb reader (signal " +
                                      std::to_string(WTERMSIG(st)) + "; checked in a child process)");
         }
     }
@@ -204,11 +219,10 @@ Result<osg::ref_ptr<osg::Node>> readSceneFile(const std::string& path) {
         std::istream is(&mb);
         osgDB::ReaderWriter::ReadResult rr = rw->readNode(is, nullptr);
         if (!rr.validNode())
-            return Status::error("cannot read scene file '" + path + "': " + (rr.message().empty() ? std::string("osgb reader returned no node") : rr.message()));
+            return Status::error("cannot read scene file '" + path + "': " +
+                                 (rr.message().empty() ? std::string("osgb reader returned no node") : rr.message()));
         node = rr.getNode();
-    } catch (const std::exception& e) {
-        return Status::error("cannot read scene file '" + path + "': " + e.what());
-    }
+    } catch (const std::exception& e) { return Status::error("cannot read scene file '" + path + "': " + e.what()); }
     return node;
 }
 
@@ -220,7 +234,8 @@ Result<std::string> sceneFileContentHash(const std::string& path) {
     if (size < std::streamoff(8 + kSceneTrailerSize) || !in.seekg(size - std::streamoff(kSceneTrailerSize)) ||
         !in.read(reinterpret_cast<char*>(tr), kSceneTrailerSize) || std::memcmp(tr, kTrailerHead, 8) != 0 ||
         std::memcmp(tr + 24, kTrailerTail, 8) != 0 || loadLE64(tr + 8) != uint64_t(size) - kSceneTrailerSize)
-        return Status::error("scene file '" + path + "' is truncated or was not written by vista (no integrity trailer)");
+        return Status::error("scene file '" + path +
+                             "' is truncated or was not written by vista (no integrity trailer)");
     return hex64(loadLE64(tr + 16));
 }
 

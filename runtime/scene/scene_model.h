@@ -28,10 +28,10 @@
 namespace vista {
 
 struct SceneMesh {
-    glm::dvec3 origin{0.0};              // world position of the mesh frame
-    std::vector<glm::vec3> positions;    // metres, relative to origin
-    std::vector<glm::u8vec4> colors;     // prelit RGBA, one per position
-    std::vector<uint32_t> indices;       // triangles (3 per triangle)
+    glm::dvec3 origin{0.0};            // world position of the mesh frame
+    std::vector<glm::vec3> positions;  // metres, relative to origin
+    std::vector<glm::u8vec4> colors;   // prelit RGBA, one per position
+    std::vector<uint32_t> indices;     // triangles (3 per triangle)
     // Ground truth (citygen/labels.h): the geometry's material (Count when
     // its name is none) and the label id per vertex (tile meshes: instance
     // id; prototypes: the part's Material), empty for files without labels.
@@ -46,29 +46,29 @@ struct SceneInstance {
 };
 
 struct SceneTile {
-    uint32_t child = 0;                  // index of the tile among the scene root's children
-    glm::dvec3 origin{0.0};              // world origin of the tile
-    glm::dvec2 lo{1e300}, hi{-1e300};    // world xy bounds of its geometry (lo > hi: empty)
+    uint32_t child = 0;                // index of the tile among the scene root's children
+    glm::dvec3 origin{0.0};            // world origin of the tile
+    glm::dvec2 lo{1e300}, hi{-1e300};  // world xy bounds of its geometry (lo > hi: empty)
     std::vector<uint32_t> meshes, instances;
-    size_t triangles = 0;                // rendered triangles (instances expanded)
+    size_t triangles = 0;  // rendered triangles (instances expanded)
 };
 
 struct SceneGraph;  // defined in runtime/scene/scene_graph.h (OSG side)
 
 struct SceneModel {
     CityParams params;
-    StreetGraph streets;                  // city frame (add params.origin for world)
-    std::vector<SceneMesh> meshes;        // tile meshes (world origin per mesh)
-    std::vector<SceneMesh> prototypes;    // tree prototypes (origin 0)
+    StreetGraph streets;                // city frame (add params.origin for world)
+    std::vector<SceneMesh> meshes;      // tile meshes (world origin per mesh)
+    std::vector<SceneMesh> prototypes;  // tree prototypes (origin 0)
     std::vector<SceneInstance> instances;
     // Tree impostors (tree_impostor_graph.h; coarse levels of a paged city):
     // drawn by the graph only, not ray-cast and in no tile's lists; their
     // quads count in `triangles`.
     std::vector<SceneInstance> impostors;
-    std::vector<SceneTile> tiles;         // empty for hand-built models
-    size_t triangles = 0;                 // rendered triangles (instances expanded)
-    bool labelled = false;                // the file carries ground-truth labels (vista.labels)
-    std::shared_ptr<SceneGraph> graph;    // the decoded OSG graph, or null
+    std::vector<SceneTile> tiles;       // empty for hand-built models
+    size_t triangles = 0;               // rendered triangles (instances expanded)
+    bool labelled = false;              // the file carries ground-truth labels (vista.labels)
+    std::shared_ptr<SceneGraph> graph;  // the decoded OSG graph, or null
 };
 
 // World xy bounds of a mesh / an instance (expanding lo/hi).

@@ -28,7 +28,9 @@ std::string fragmentShader() {
            "varying float vista_eye_depth;\n"
            "void main() {\n"
            "    vec4 c = texture2D(vista_impostor_atlas, gl_TexCoord[0].st);\n"
-           "    if (c.a < " + std::to_string(kImpostorAlphaRef) + ".0 / 255.0) discard;\n"
+           "    if (c.a < " +
+           std::to_string(kImpostorAlphaRef) +
+           ".0 / 255.0) discard;\n"
            "    gl_FragColor = vistaHaze(vec4(c.rgb, 1.0), vista_eye_depth);\n"
            "}\n";
 }
@@ -40,7 +42,8 @@ osg::Program* impostorProgram() {
         p->setName(kTreeImpostorProgramName);
         p->addShader(new osg::Shader(osg::Shader::VERTEX, vertexShader()));
         p->addShader(new osg::Shader(osg::Shader::FRAGMENT, fragmentShader()));
-        for (unsigned c = 0; c < 4; ++c) p->addBindAttribLocation("vista_instance" + std::to_string(c), kInstanceAttrib0 + c);
+        for (unsigned c = 0; c < 4; ++c)
+            p->addBindAttribLocation("vista_instance" + std::to_string(c), kInstanceAttrib0 + c);
         return p;
     }();
     return prog.get();
@@ -85,8 +88,9 @@ TreeImpostorArrays makeTreeImpostorArrays(const TreeImpostor& imp) {
     return a;
 }
 
-osg::ref_ptr<osg::Geometry> instancedTreeImpostor(const TreeImpostorArrays& a, unsigned prototype, osg::Array* const cols[4],
-                                                  unsigned instances, const osg::BoundingBox& bound) {
+osg::ref_ptr<osg::Geometry> instancedTreeImpostor(const TreeImpostorArrays& a, unsigned prototype,
+                                                  osg::Array* const cols[4], unsigned instances,
+                                                  const osg::BoundingBox& bound) {
     if (a.empty() || instances == 0) return nullptr;
     osg::ref_ptr<osg::Geometry> g = new osg::Geometry;
     g->setName(kTreeImpostorGeometryPrefix + std::to_string(prototype));
@@ -99,7 +103,8 @@ osg::ref_ptr<osg::Geometry> instancedTreeImpostor(const TreeImpostorArrays& a, u
     osg::ref_ptr<osg::DrawElementsUInt> tris = new osg::DrawElementsUInt(*a.triangles, osg::CopyOp::SHALLOW_COPY);
     tris->setNumInstances(int(instances));
     g->addPrimitiveSet(tris.get());
-    for (unsigned c = 0; c < 4; ++c) g->setVertexAttribArray(kInstanceAttrib0 + c, cols[c], osg::Array::BIND_PER_VERTEX);
+    for (unsigned c = 0; c < 4; ++c)
+        g->setVertexAttribArray(kInstanceAttrib0 + c, cols[c], osg::Array::BIND_PER_VERTEX);
     g->setInitialBound(bound);
     g->setStateSet(a.state.get());
     return g;

@@ -44,8 +44,9 @@ TreeImpostorArrays makeTreeImpostorArrays(const TreeImpostor& impostor);
 // `prototype`, with `instances` instances whose matrix columns are cols[0..3]
 // (Vec4Arrays of at least `instances` entries, shared, not copied) and the
 // given initial bound (tile frame). Null when the impostor is empty.
-osg::ref_ptr<osg::Geometry> instancedTreeImpostor(const TreeImpostorArrays& arrays, unsigned prototype, osg::Array* const cols[4],
-                                                  unsigned instances, const osg::BoundingBox& bound);
+osg::ref_ptr<osg::Geometry> instancedTreeImpostor(const TreeImpostorArrays& arrays, unsigned prototype,
+                                                  osg::Array* const cols[4], unsigned instances,
+                                                  const osg::BoundingBox& bound);
 
 // True when `name` is an impostor geometry's name; `prototype` gets its index.
 bool isTreeImpostorName(const std::string& name, long* prototype = nullptr);

@@ -62,7 +62,8 @@ inline void addBox(TriangleSoup& s, glm::vec3 lo, glm::vec3 hi, const std::funct
         s.positions.push_back(p);
         s.colors.push_back(color(p));
     }
-    const uint32_t f[] = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
+    const uint32_t f[] = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
+                          2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
     for (uint32_t i : f) s.indices.push_back(base + i);
 }
 
@@ -76,7 +77,9 @@ inline TriangleSoup testFarField(bool constant) {
         const int w = (int(std::floor(p.y / 3.0)) + int(std::floor(p.z / 3.0))) & 1;
         return w ? glm::u8vec4(60, 70, 90, 255) : glm::u8vec4(200, 180, 150, 255);
     };
-    addBox(s, {150, -40, -1}, {210, 40, 0}, constant ? constantColor : [](glm::vec3) { return glm::u8vec4(90, 120, 80, 255); });
+    addBox(
+        s, {150, -40, -1}, {210, 40, 0},
+        constant ? constantColor : [](glm::vec3) { return glm::u8vec4(90, 120, 80, 255); });
     // Side walls seen at a slant (left- and right-facing): sampled better by one camera.
     addBox(s, {172, -39, 0}, {208, -37, 18}, [](glm::vec3) { return glm::u8vec4(150, 90, 60, 255); });
     addBox(s, {172, 37, 0}, {208, 39, 18}, [](glm::vec3) { return glm::u8vec4(60, 90, 150, 255); });
@@ -116,7 +119,8 @@ inline Mesh boxMesh(glm::vec3 lo, glm::vec3 hi, glm::u8vec4 c0, glm::u8vec4 c1) 
         m.normals.push_back(glm::normalize(glm::vec3((i & 1) ? 1 : -1, (i & 2) ? 1 : -1, (i & 4) ? 1 : -1)));
         m.colors.push_back((i & 4) ? c1 : c0);
     }
-    const uint32_t f[] = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
+    const uint32_t f[] = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
+                          2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
     m.indices.assign(std::begin(f), std::end(f));
     return m;
 }
@@ -130,10 +134,12 @@ inline City makeBakeCity() {
     c.params.seed = 5;
     c.params.hills_amplitude_m = 0;
     c.streets.nodes = {{0, 0}, {100, 0}, {100, 0}, {0, 0.8}};
-    c.streets.edges = {{0, 1, RoadClass::Local, 10.0f, 2}, {1, 2, RoadClass::Local, 8.0f, 2}, {0, 3, RoadClass::Local, 8.0f, 2}};
+    c.streets.edges = {
+        {0, 1, RoadClass::Local, 10.0f, 2}, {1, 2, RoadClass::Local, 8.0f, 2}, {0, 3, RoadClass::Local, 8.0f, 2}};
     Tile near;
     near.origin = {50, 0, 0};
-    near.meshes[size_t(Material::Ground)] = boxMesh({-60, -40, -1}, {60, 40, 0}, {90, 90, 90, 255}, {100, 100, 100, 255});
+    near.meshes[size_t(Material::Ground)] =
+        boxMesh({-60, -40, -1}, {60, 40, 0}, {90, 90, 90, 255}, {100, 100, 100, 255});
     c.tiles.push_back(near);
     for (int side = 0; side < 2; ++side) {
         Tile t;
@@ -141,10 +147,11 @@ inline City makeBakeCity() {
         t.origin = {side ? 300.0 : -200.0, 0, 0};
         Mesh walls;
         for (int i = 0; i < 6; ++i)
-            walls.append(boxMesh({-15, -30.0f + 10 * i, 0}, {15, -22.0f + 10 * i, 12.0f + 4 * i}, {uint8_t(60 + 30 * i), 80, 120, 255},
-                                 {200, uint8_t(40 * i), 90, 255}));
+            walls.append(boxMesh({-15, -30.0f + 10 * i, 0}, {15, -22.0f + 10 * i, 12.0f + 4 * i},
+                                 {uint8_t(60 + 30 * i), 80, 120, 255}, {200, uint8_t(40 * i), 90, 255}));
         t.meshes[size_t(Material::Wall)] = walls;
-        t.meshes[size_t(Material::Ground)] = boxMesh({-30, -40, -1}, {30, 40, 0}, {70, 110, 60, 255}, {80, 120, 70, 255});
+        t.meshes[size_t(Material::Ground)] =
+            boxMesh({-30, -40, -1}, {30, 40, 0}, {70, 110, 60, 255}, {80, 120, 70, 255});
         c.tiles.push_back(t);
     }
     return c;

@@ -62,7 +62,10 @@ TEST(Appearance, ConstantColourSceneIsExactAndCompressesToOneColour) {
     ASSERT_TRUE(scene.isOk());
     const Box3 cell{{-100, -5, 1.2}, {0, 5, 2.0}};
     Box3 far{glm::dvec3(1e300), glm::dvec3(-1e300)};
-    for (auto& p : soup.positions) { far.lo = glm::min(far.lo, glm::dvec3(p)); far.hi = glm::max(far.hi, glm::dvec3(p)); }
+    for (auto& p : soup.positions) {
+        far.lo = glm::min(far.lo, glm::dvec3(p));
+        far.hi = glm::max(far.hi, glm::dvec3(p));
+    }
     auto s = setupSampling(cell, far);
     ASSERT_TRUE(s.isOk());
     // Points on the facade's front, away from its edges (no sky in the pixel filter).
@@ -133,7 +136,7 @@ TEST(Appearance, ViewDependentPointsTexturedNoiseOnlyPointsOneColour) {
     auto s = setupSampling(ps.cell, ps.far);
     ASSERT_TRUE(s.isOk());
     std::vector<glm::vec3> pts;
-    for (int k = 0; k < 5; ++k) pts.emplace_back(200.0f, 0.0f, 1.0f + float(k));      // post
+    for (int k = 0; k < 5; ++k) pts.emplace_back(200.0f, 0.0f, 1.0f + float(k));          // post
     for (int k = 0; k < 10; ++k) pts.emplace_back(300.0f, 0.0f, 7.0f + 0.4f * float(k));  // boundary
     AppearanceParams ap;
     ASSERT_GT(ap.significance, 0.0);
@@ -145,7 +148,8 @@ TEST(Appearance, ViewDependentPointsTexturedNoiseOnlyPointsOneColour) {
     const int nt = ap.texelsX * ap.texelsY;
     auto texelY = [&](int t) {  // frame y of the texel centre on the sampling plane
         const glm::dvec2 size = s->rectHi - s->rectLo;
-        const glm::dvec2 q = s->rectLo + glm::dvec2((t % ap.texelsX + 0.5) * size.x / ap.texelsX, (t / ap.texelsX + 0.5) * size.y / ap.texelsY);
+        const glm::dvec2 q = s->rectLo + glm::dvec2((t % ap.texelsX + 0.5) * size.x / ap.texelsX,
+                                                    (t / ap.texelsX + 0.5) * size.y / ap.texelsY);
         return s->toFrame(q).y;
     };
     auto luma = [](glm::u8vec4 c) { return (0.299 * c.x + 0.587 * c.y + 0.114 * c.z) / 255.0; };
@@ -155,8 +159,14 @@ TEST(Appearance, ViewDependentPointsTexturedNoiseOnlyPointsOneColour) {
         int nl = 0, nr = 0;
         for (int t = 0; t < nt; ++t) {
             const double l = luma(d.texels[size_t(d.block[size_t(k)]) * size_t(nt) + size_t(t)]);
-            if (texelY(t) < -2) { left += l; ++nl; }
-            if (texelY(t) > 2) { right += l; ++nr; }
+            if (texelY(t) < -2) {
+                left += l;
+                ++nl;
+            }
+            if (texelY(t) > 2) {
+                right += l;
+                ++nr;
+            }
         }
         ASSERT_GT(nl, 0);
         ASSERT_GT(nr, 0);

@@ -76,7 +76,8 @@ TEST(Bake, CellBakesBothEndsAndAssemblesAValidFile) {
         EXPECT_GT(im.stats.screenPixels, 0u);
     }
     EXPECT_NE(cr.impostors[0].hiddenTiles, cr.impostors[1].hiddenTiles);
-    CellResult cr1 = bakeCell(in, in.cells[1], p);  // the 0.8 m street: far fields too close/small are skipped, not errors
+    CellResult cr1 =
+        bakeCell(in, in.cells[1], p);  // the 0.8 m street: far fields too close/small are skipped, not errors
     auto root = assembleBakedScene(*city, in.cells, {cr, cr1}, p.canonical());
     ASSERT_TRUE(writeSceneFile(*root, dir.file("city.baked.osgb")).isOk());
     auto bf = loadBakedFile(dir.file("city.baked.osgb"));
@@ -206,7 +207,8 @@ TEST(BakedChunks, BakedModesDrawNoMoreTrianglesThanFullAndMatchIt) {
     for (int dir01 = 0; dir01 < 2; ++dir01) {
         const double sgn = dir01 ? -1.0 : 1.0;
         Camera cam;
-        cam.eye = b.center + glm::dvec3(-sgn * b.axis.x * b.halfLength * 0.5, -sgn * b.axis.y * b.halfLength * 0.5, 0.0);
+        cam.eye =
+            b.center + glm::dvec3(-sgn * b.axis.x * b.halfLength * 0.5, -sgn * b.axis.y * b.halfLength * 0.5, 0.0);
         cam.eye.z = cell.groundMax + 1.7;
         if (!b.contains(cam.eye)) cam.eye.z = b.center.z;
         cam.heading = std::atan2(sgn * b.axis.x, sgn * b.axis.y);
@@ -223,8 +225,9 @@ TEST(BakedChunks, BakedModesDrawNoMoreTrianglesThanFullAndMatchIt) {
         ASSERT_TRUE((*renderer)->render(root.get(), cam, 0.0, &whole, nullptr, sw).isOk());
         root->setNearChunks(ctx.nearField(), kDefaultNearDistance);
         const double psnr = lumaPsnr(baked, ref);
-        std::printf("cell %u view %d: triangles lodmesh %llu, full %llu, whole tiles %llu; lodmesh vs full %.1f dB\n", cr.cell,
-                    dir01, (unsigned long long)sb.triangles, (unsigned long long)sf.triangles, (unsigned long long)sw.triangles, psnr);
+        std::printf("cell %u view %d: triangles lodmesh %llu, full %llu, whole tiles %llu; lodmesh vs full %.1f dB\n",
+                    cr.cell, dir01, (unsigned long long)sb.triangles, (unsigned long long)sf.triangles,
+                    (unsigned long long)sw.triangles, psnr);
         EXPECT_GT(sf.triangles, 0u);
         EXPECT_LE(sb.triangles, sf.triangles) << "the baked mode draws more than full";
         EXPECT_LT(sb.triangles, sw.triangles) << "chunking saved nothing over the whole tiles";

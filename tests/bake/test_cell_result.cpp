@@ -80,7 +80,7 @@ TEST(Bake, CellResultRoundTripAndCorruption) {
     EXPECT_EQ(back->notes, cr.notes);
     EXPECT_EQ(back->impostors[0].data.positions, cr.impostors[0].data.positions);
     EXPECT_EQ(back->impostors[0].data.texels, cr.impostors[0].data.texels);
-    EXPECT_FALSE(decodeCellResult(bytes, 78, "x").isOk());                          // other config
+    EXPECT_FALSE(decodeCellResult(bytes, 78, "x").isOk());                              // other config
     EXPECT_FALSE(decodeCellResult(bytes.substr(0, bytes.size() / 2), 77, "x").isOk());  // truncated
     std::string bad = bytes;
     bad[bad.size() / 2] ^= 0x5a;

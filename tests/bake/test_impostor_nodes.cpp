@@ -81,7 +81,9 @@ TEST(Nodes, SerializersRoundTrip) {
     sw->addChild(g.get());
     ViewCellBox b;
     b.center = {1, 2, 1.6};
-    b.halfLength = 10; b.halfWidth = 4; b.halfHeight = 0.4;
+    b.halfLength = 10;
+    b.halfWidth = 4;
+    b.halfHeight = 0.4;
     sw->setCells({b, ViewCellBox{}});
     sw->setCellChildren(0, {0}, {1});
     ASSERT_EQ(sw->validate(), "");
@@ -113,7 +115,8 @@ TEST(Nodes, PointImpostorQuantizesWithinHalfAStepAndValidates) {
     PointImpostorData d;
     Rng rng(5, 0, Stream::Bake);
     for (int k = 0; k < 2000; ++k)
-        d.positions.emplace_back(float(rng.uniform(100, 700)), float(rng.uniform(-300, 300)), float(rng.uniform(0, 80)));
+        d.positions.emplace_back(float(rng.uniform(100, 700)), float(rng.uniform(-300, 300)),
+                                 float(rng.uniform(0, 80)));
     d.positions.emplace_back(100.0f, -300.0f, 0.0f);  // the extremes are representable exactly up to rounding
     d.positions.emplace_back(700.0f, 300.0f, 80.0f);
     d.colors.assign(d.positions.size(), glm::u8vec4(10, 20, 30, 255));
@@ -130,7 +133,8 @@ TEST(Nodes, PointImpostorQuantizesWithinHalfAStepAndValidates) {
     for (size_t k = 0; k < d.positions.size(); ++k) {
         const osg::Vec3f q = pi->position(k);
         const glm::vec3& p = d.positions[k];
-        worst = std::max({worst, std::abs(double(q.x()) - p.x), std::abs(double(q.y()) - p.y), std::abs(double(q.z()) - p.z)});
+        worst = std::max(
+            {worst, std::abs(double(q.x()) - p.x), std::abs(double(q.y()) - p.y), std::abs(double(q.z()) - p.z)});
         EXPECT_TRUE(bb.contains(q)) << k;
     }
     EXPECT_LE(worst, 0.5 * step * 1.001 + 1e-4);  // float rounding of the dequantized value
@@ -142,12 +146,16 @@ TEST(Nodes, PointImpostorQuantizesWithinHalfAStepAndValidates) {
         f(*b);
         return b->validate();
     };
-    EXPECT_NE(broken([](PointImpostor& b) { b.setColorArray(new osg::Vec4ubArray(3), osg::Array::BIND_PER_VERTEX); }), "");
-    EXPECT_NE(broken([](PointImpostor& b) { (*static_cast<osg::Vec2sArray*>(b.getTexCoordArray(0)))[0].set(30000, 0); }), "");
+    EXPECT_NE(broken([](PointImpostor& b) { b.setColorArray(new osg::Vec4ubArray(3), osg::Array::BIND_PER_VERTEX); }),
+              "");
+    EXPECT_NE(
+        broken([](PointImpostor& b) { (*static_cast<osg::Vec2sArray*>(b.getTexCoordArray(0)))[0].set(30000, 0); }), "");
     EXPECT_NE(broken([](PointImpostor& b) { b.setDequant(osg::Vec4f(0, 0, 0, 0)); }), "");
     EXPECT_NE(broken([](PointImpostor& b) { b.setTexturedCount(5); }), "");
-    EXPECT_NE(broken([&](PointImpostor& b) { b.setVertexArray(new osg::Vec3Array(unsigned(d.positions.size()))); }), "");
-    EXPECT_NE(broken([](PointImpostor& b) { static_cast<osg::DrawArrays*>(b.getPrimitiveSet(0))->setCount(5000); }), "");
+    EXPECT_NE(broken([&](PointImpostor& b) { b.setVertexArray(new osg::Vec3Array(unsigned(d.positions.size()))); }),
+              "");
+    EXPECT_NE(broken([](PointImpostor& b) { static_cast<osg::DrawArrays*>(b.getPrimitiveSet(0))->setCount(5000); }),
+              "");
 }
 
 }  // namespace

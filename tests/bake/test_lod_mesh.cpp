@@ -58,7 +58,8 @@ using test::readBytes;
 // A perspective image (width x height, vertical field of view fovY, row 0 at
 // the top) from `eye` looking along +x of the impostor frame; `shade` gives
 // the colour of a pixel's ray (unit direction) or nothing (black).
-Image frameImage(int width, int height, double fovY, const glm::vec3& eye, const std::function<glm::u8vec4(const glm::vec3&)>& shade) {
+Image frameImage(int width, int height, double fovY, const glm::vec3& eye,
+                 const std::function<glm::u8vec4(const glm::vec3&)>& shade) {
     Image img(width, height);
     const double f = std::tan(0.5 * fovY), aspect = double(width) / height;
     for (int y = 0; y < height; ++y)
@@ -88,13 +89,16 @@ struct MeshCaster {
         const RayHit h = scene->intersect(eye, dir);
         if (!h.hit) return glm::u8vec4(0, 0, 0, 255);
         const uint32_t* t = &mesh.indices[size_t(h.primId) * 3];
-        const glm::vec4 tc = (1 - h.u - h.v) * mesh.texcoords[t[0]] + h.u * mesh.texcoords[t[1]] + h.v * mesh.texcoords[t[2]];
+        const glm::vec4 tc =
+            (1 - h.u - h.v) * mesh.texcoords[t[0]] + h.u * mesh.texcoords[t[1]] + h.v * mesh.texcoords[t[2]];
         const double s = tc.x / tc.w * mesh.width - 0.5, r = tc.y / tc.w * mesh.height - 0.5;
-        const int i0 = std::clamp(int(std::floor(s)), 0, mesh.width - 1), j0 = std::clamp(int(std::floor(r)), 0, mesh.height - 1);
+        const int i0 = std::clamp(int(std::floor(s)), 0, mesh.width - 1),
+                  j0 = std::clamp(int(std::floor(r)), 0, mesh.height - 1);
         const int i1 = std::min(i0 + 1, mesh.width - 1), j1 = std::min(j0 + 1, mesh.height - 1);
         const double a = std::clamp(s - i0, 0.0, 1.0), b = std::clamp(r - j0, 0.0, 1.0);
         auto at = [&](int i, int j) { return glm::dvec4(mesh.image[size_t(j) * size_t(mesh.width) + size_t(i)]); };
-        const glm::dvec4 c = (1 - b) * ((1 - a) * at(i0, j0) + a * at(i1, j0)) + b * ((1 - a) * at(i0, j1) + a * at(i1, j1));
+        const glm::dvec4 c =
+            (1 - b) * ((1 - a) * at(i0, j0) + a * at(i1, j0)) + b * ((1 - a) * at(i0, j1) + a * at(i1, j1));
         if (c.w <= 127.5) return glm::u8vec4(0, 0, 0, 255);
         return glm::u8vec4(uint8_t(c.x + 0.5), uint8_t(c.y + 0.5), uint8_t(c.z + 0.5), 255);
     }
@@ -192,7 +196,7 @@ TEST(LodMesh, OneMeshPerStreetEndWithinTheBudgetReproducingTheRayCastFarField) {
 // the budget holds.
 TEST(LodMesh, NoSkinAcrossADepthDiscontinuityAndTheBudgetHolds) {
     TriangleSoup soup;
-    addBox(soup, {300, -100, -2}, {301, 100, 60}, constantColor);  // far wall
+    addBox(soup, {300, -100, -2}, {301, 100, 60}, constantColor);                                          // far wall
     addBox(soup, {150, -10, -2}, {160, 10, 20}, [](glm::vec3) { return glm::u8vec4(200, 40, 40, 255); });  // near box
     SoupSceneOptions so;
     so.cullBackFaces = true;
@@ -210,7 +214,8 @@ TEST(LodMesh, NoSkinAcrossADepthDiscontinuityAndTheBudgetHolds) {
         // transparent part of the texture.
         auto opaque = [&](uint32_t v) {
             const glm::vec4 tc = m.texcoords[v];
-            const int i = int(std::lround(tc.x / tc.w * m.width - 0.5)), j = int(std::lround(tc.y / tc.w * m.height - 0.5));
+            const int i = int(std::lround(tc.x / tc.w * m.width - 0.5)),
+                      j = int(std::lround(tc.y / tc.w * m.height - 0.5));
             return m.image[size_t(j) * size_t(m.width) + size_t(i)].w == 255;
         };
         for (size_t t = 0; t < m.triangleCount(); ++t) {
@@ -224,7 +229,8 @@ TEST(LodMesh, NoSkinAcrossADepthDiscontinuityAndTheBudgetHolds) {
                 hi = std::max(hi, x);
             }
             // Every vertex lies on the box front (x = 150) or on the wall (x = 300) or the ground; none bridges both.
-            EXPECT_FALSE(lo < 170 && hi > 280) << "triangle " << t << " spans " << lo << " .. " << hi << " (budget " << budget << ")";
+            EXPECT_FALSE(lo < 170 && hi > 280)
+                << "triangle " << t << " spans " << lo << " .. " << hi << " (budget " << budget << ")";
         }
     }
 }

@@ -71,10 +71,12 @@ TEST(Placement, PointsBehindAnOccluderAreDroppedAndTheCostRuleHolds) {
     ASSERT_FALSE(fs.tiles.empty());
     ASSERT_GT(fs.soup.triangleCount(), 0u);
     // The far tile's first wall spans world x 285..315, y -30..-22, 12 m high.
-    const glm::vec3 front(fs.frame.toLocal(glm::dvec3(284.9, -26, 5)));  // on its face towards the cell
+    const glm::vec3 front(fs.frame.toLocal(glm::dvec3(284.9, -26, 5)));   // on its face towards the cell
     const glm::vec3 behind(fs.frame.toLocal(glm::dvec3(316.5, -26, 5)));  // behind it, seen from nowhere in the cell
-    const glm::vec3 above(fs.frame.toLocal(glm::dvec3(300, -26, 12.05)));  // on its roof: seen over it from eye height? no
-    const std::vector<uint8_t> vis = visibleFromCell(*in.cityRays, cell, fs.frame, {front, behind, above}, outputPixelAngle(p.sampling), p.placement);
+    const glm::vec3 above(
+        fs.frame.toLocal(glm::dvec3(300, -26, 12.05)));  // on its roof: seen over it from eye height? no
+    const std::vector<uint8_t> vis = visibleFromCell(*in.cityRays, cell, fs.frame, {front, behind, above},
+                                                     outputPixelAngle(p.sampling), p.placement);
     ASSERT_EQ(vis.size(), 3u);
     EXPECT_EQ(vis[0], 1) << "a point on the face towards the cell is visible";
     EXPECT_EQ(vis[1], 0) << "a point behind the wall is occluded from every viewpoint";
@@ -112,12 +114,15 @@ TEST(Placement, PointsBehindAnOccluderAreDroppedAndTheCostRuleHolds) {
         for (int i = 0; i < 40; ++i)
             for (int j = 0; j < 30; ++j)
                 for (int k = 0; k < 8; ++k)
-                    grid.push_back(glm::vec3(fs.frame.toLocal(glm::dvec3(270 + 1.55 * i, -45 + 1.9 * j, 0.3 + 1.9 * k))));
+                    grid.push_back(
+                        glm::vec3(fs.frame.toLocal(glm::dvec3(270 + 1.55 * i, -45 + 1.9 * j, 0.3 + 1.9 * k))));
         PlacementParams byRays = p.placement;
         byRays.visByImage = false;
         ASSERT_TRUE(p.placement.visByImage) << "the image prefilter is the default";
-        const std::vector<uint8_t> img = visibleFromCell(*in.cityRays, cell, fs.frame, grid, outputPixelAngle(p.sampling), p.placement);
-        const std::vector<uint8_t> ray = visibleFromCell(*in.cityRays, cell, fs.frame, grid, outputPixelAngle(p.sampling), byRays);
+        const std::vector<uint8_t> img =
+            visibleFromCell(*in.cityRays, cell, fs.frame, grid, outputPixelAngle(p.sampling), p.placement);
+        const std::vector<uint8_t> ray =
+            visibleFromCell(*in.cityRays, cell, fs.frame, grid, outputPixelAngle(p.sampling), byRays);
         ASSERT_EQ(img.size(), grid.size());
         size_t seenByRays = 0, seenByImage = 0, onlyImage = 0;
         for (size_t i = 0; i < grid.size(); ++i) {
@@ -154,7 +159,8 @@ TEST(Placement, PointsBehindAnOccluderAreDroppedAndTheCostRuleHolds) {
     // x 102..108, y -40..8, 40 m high) hides the far tile's walls at y < 0
     // from the whole cell: their points are dropped, the open part stays.
     City occ = makeBakeCity();
-    occ.tiles[0].meshes[size_t(Material::Wall)] = boxMesh({52, -40, 0}, {58, 8, 40}, {90, 90, 90, 255}, {100, 100, 100, 255});
+    occ.tiles[0].meshes[size_t(Material::Wall)] =
+        boxMesh({52, -40, 0}, {58, 8, 40}, {90, 90, 90, 255}, {100, 100, 100, 255});
     ASSERT_TRUE(writeCityFile(occ, dir.file("occ.osgb")).isOk());
     auto occCity = loadCityFile(dir.file("occ.osgb"));
     ASSERT_TRUE(occCity.isOk());
@@ -197,11 +203,12 @@ TEST(Placement, StorageBudgetTakesTheMostMillisecondsPerMegabyteThatFit) {
     // Values (ms per MB): (1,0) 8, (1,1) does not pay, (2,0) 7.5, (3,0) 8
     // (a tie with (1,0): the lower cell first), (4,1) 5 with 50 MB, (5,0) 4.
     const std::vector<PlannedEnd> ends = {end(5, 0, 3, 1, 0.5), end(4, 1, 250, 0, 50), end(3, 0, 9, 1, 1),
-                                          end(2, 0, 30, 0, 4),  end(1, 1, 5, 6, 0.1),   end(1, 0, 10, 2, 1)};
+                                          end(2, 0, 30, 0, 4),  end(1, 1, 5, 6, 0.1),  end(1, 0, 10, 2, 1)};
     const PlacementPlan plan = rankPlacement(ends, 6.6);
     ASSERT_EQ(plan.ends.size(), ends.size());
     for (size_t i = 1; i < plan.ends.size(); ++i)
-        EXPECT_LT(std::make_pair(plan.ends[i - 1].cell, plan.ends[i - 1].end), std::make_pair(plan.ends[i].cell, plan.ends[i].end));
+        EXPECT_LT(std::make_pair(plan.ends[i - 1].cell, plan.ends[i - 1].end),
+                  std::make_pair(plan.ends[i].cell, plan.ends[i].end));
     auto at = [&](uint32_t c, int e) {
         const PlannedEnd* p = plan.find(c, e);
         EXPECT_NE(p, nullptr) << c << "," << e;

@@ -80,7 +80,10 @@ TEST(Sampling, BoundingTriangleContainsPolygonWithMinimalCircumference) {
             const double a = 3.14159265358979 + rng.uniform(0.01, 1.56), b = 4.71238898038469 + rng.uniform(0.01, 1.56);
             const glm::dvec2 nl(std::cos(a), std::sin(a)), nr(std::cos(b), std::sin(b));
             double hl = -1e300, hr = -1e300;
-            for (auto& q : poly) { hl = std::max(hl, glm::dot(nl, q)); hr = std::max(hr, glm::dot(nr, q)); }
+            for (auto& q : poly) {
+                hl = std::max(hl, glm::dot(nl, q));
+                hr = std::max(hr, glm::dot(nr, q));
+            }
             const glm::dvec2 tl((hl - nl.y * top) / nl.x, top), tr((hr - nr.y * top) / nr.x, top);
             const double det = nl.x * nr.y - nl.y * nr.x;
             const glm::dvec2 bot((hl * nr.y - nl.y * hr) / det, (nl.x * hr - hl * nr.x) / det);
@@ -123,7 +126,7 @@ void expectCamerasWellDefined(const Box3& cell, const Box3& far) {
 TEST(Sampling, CameraPlacementIsWellDefined) {
     const Box3 cell{{-100, -5, 1.2}, {0, 5, 2.0}};
     expectCamerasWellDefined(cell, Box3{{150, -40, 0}, {210, 40, 30}});
-    expectCamerasWellDefined(cell, Box3{{100, 30, -2}, {400, 300, 60}});   // off to the side
+    expectCamerasWellDefined(cell, Box3{{100, 30, -2}, {400, 300, 60}});  // off to the side
     // Hard case: the far-field box nearly touches the view cell.
     expectCamerasWellDefined(cell, Box3{{1e-3, -40, 0}, {60, 40, 30}});
     expectCamerasWellDefined(cell, Box3{{1e-3, -4, 1.5}, {0.5, 4, 1.7}});
@@ -142,7 +145,7 @@ TEST(Sampling, ResolutionFactors) {
     EXPECT_NEAR(exactPerspectiveFactor(p), 1.17, 0.005);  // the thesis' value for 45 degrees
     p.fovYDeg = 60;
     EXPECT_NEAR(exactPerspectiveFactor(p), 4.0 / 3.0, 1e-12);  // 1 / cos^2(30 deg)
-    EXPECT_DOUBLE_EQ(p.perspective, 1.17);                      // the default is the thesis' factor
+    EXPECT_DOUBLE_EQ(p.perspective, 1.17);                     // the default is the thesis' factor
     const double delta = outputPixelAngle(p);
     EXPECT_NEAR(delta, 2 * std::tan(M_PI / 6) / 480, 1e-15);
     EXPECT_NEAR(ldiStep(s, p), delta / 1.17 / std::sqrt(2.0), 1e-12);
@@ -191,7 +194,10 @@ TEST(Sampling, NoHolesFromCellCornersAndCentre) {
     ASSERT_TRUE(scene.isOk()) << scene.status().message();
     const Box3 cell{{-100, -5, 1.2}, {0, 5, 2.0}};
     Box3 far{glm::dvec3(1e300), glm::dvec3(-1e300)};
-    for (auto& p : soup.positions) { far.lo = glm::min(far.lo, glm::dvec3(p)); far.hi = glm::max(far.hi, glm::dvec3(p)); }
+    for (auto& p : soup.positions) {
+        far.lo = glm::min(far.lo, glm::dvec3(p));
+        far.hi = glm::max(far.hi, glm::dvec3(p));
+    }
     auto s = setupSampling(cell, far);
     ASSERT_TRUE(s.isOk());
     SamplingParams sp;  // 640x480, 60 degrees
@@ -226,7 +232,8 @@ TEST(Sampling, NoHolesFromCellCornersAndCentre) {
         std::vector<uint8_t> geo(size_t(v.w) * size_t(v.h), 0), cov(geo.size(), 0);
         for (int y = 160; y < 320; ++y)
             for (int x = 200; x < 440; ++x)
-                geo[size_t(y) * size_t(v.w) + size_t(x)] = (*scene)->intersect(glm::vec3(eye), glm::vec3(v.ray(x + 0.5, y + 0.5)), 0, 1e30f).hit;
+                geo[size_t(y) * size_t(v.w) + size_t(x)] =
+                    (*scene)->intersect(glm::vec3(eye), glm::vec3(v.ray(x + 0.5, y + 0.5)), 0, 1e30f).hit;
         for (const auto& p : pts) {
             int x, y;
             if (v.project(p, x, y)) cov[size_t(y) * size_t(v.w) + size_t(x)] = 1;
@@ -235,29 +242,34 @@ TEST(Sampling, NoHolesFromCellCornersAndCentre) {
             for (int x = 201; x < 439; ++x) {
                 bool all = true;
                 for (int dy = -1; dy <= 1 && all; ++dy)
-                    for (int dx = -1; dx <= 1 && all; ++dx) all = geo[size_t(y + dy) * size_t(v.w) + size_t(x + dx)] != 0;
+                    for (int dx = -1; dx <= 1 && all; ++dx)
+                        all = geo[size_t(y + dy) * size_t(v.w) + size_t(x + dx)] != 0;
                 if (!all) continue;
                 ++interior;
                 if (!cov[size_t(y) * size_t(v.w) + size_t(x)] && std::getenv("VISTA_DEBUG_HOLE")) {
                     RayHit hh = (*scene)->intersect(glm::vec3(eye), glm::vec3(v.ray(x + 0.5, y + 0.5)), 0, 1e30f);
                     glm::dvec3 hp = eye + v.ray(x + 0.5, y + 0.5) * double(hh.t);
-                    std::fprintf(stderr, "hit %f %f %f n %f %f %f\n", hp.x, hp.y, hp.z, hh.normal.x, hh.normal.y, hh.normal.z);
+                    std::fprintf(stderr, "hit %f %f %f n %f %f %f\n", hp.x, hp.y, hp.z, hh.normal.x, hh.normal.y,
+                                 hh.normal.z);
                     for (size_t i = 0; i < ldi.samples.size(); ++i) {
                         int px, py;
-                        if (v.project(glm::dvec3(ldi.samples[i].pos), px, py) && std::abs(px - x) <= 1 && std::abs(py - y) <= 1)
-                        {
+                        if (v.project(glm::dvec3(ldi.samples[i].pos), px, py) && std::abs(px - x) <= 1 &&
+                            std::abs(py - y) <= 1) {
                             const glm::dvec3 q(ldi.samples[i].pos);
                             const double dd = glm::length(q - eye);
-                            const bool occ = (*scene)->occluded(glm::vec3(eye), glm::vec3((q - eye) / dd), 0, float(dd - 0.1));
+                            const bool occ =
+                                (*scene)->occluded(glm::vec3(eye), glm::vec3((q - eye) / dd), 0, float(dd - 0.1));
                             bool inPts = false;
-                            for (auto& z : pts) if (glm::length(z - q) < 1e-4) inPts = true;
-                            std::fprintf(stderr, " ldi %zu cam %d px %d %d pos %f %f %f keep %d occ %d final %d\n", i, ldi.samples[i].camera, px, py,
-                                         q.x, q.y, q.z, int(keep[i]), int(occ), int(inPts));
+                            for (auto& z : pts)
+                                if (glm::length(z - q) < 1e-4) inPts = true;
+                            std::fprintf(stderr, " ldi %zu cam %d px %d %d pos %f %f %f keep %d occ %d final %d\n", i,
+                                         ldi.samples[i].camera, px, py, q.x, q.y, q.z, int(keep[i]), int(occ),
+                                         int(inPts));
                         }
                     }
                 }
-                ASSERT_TRUE(cov[size_t(y) * size_t(v.w) + size_t(x)]) << "hole at " << x << "," << y << " from eye " << eye.x << ","
-                                                                       << eye.y << "," << eye.z;
+                ASSERT_TRUE(cov[size_t(y) * size_t(v.w) + size_t(x)])
+                    << "hole at " << x << "," << y << " from eye " << eye.x << "," << eye.y << "," << eye.z;
             }
     }
     EXPECT_GT(interior, 5000u);
@@ -316,7 +328,8 @@ TEST(Sampling, RemovalOnGrazingGroundKeepsOneCameraWithoutHoles) {
         std::vector<uint8_t> geo(size_t(v.w) * size_t(v.h), 0), cov(geo.size(), 0);
         for (int y = 0; y < v.h; ++y)
             for (int x = 0; x < v.w; ++x)
-                geo[size_t(y) * size_t(v.w) + size_t(x)] = (*scene)->intersect(glm::vec3(eye), glm::vec3(v.ray(x + 0.5, y + 0.5)), 0, 1e30f).hit;
+                geo[size_t(y) * size_t(v.w) + size_t(x)] =
+                    (*scene)->intersect(glm::vec3(eye), glm::vec3(v.ray(x + 0.5, y + 0.5)), 0, 1e30f).hit;
         for (const auto& q : pts) {
             int x, y;
             if (v.project(q, x, y)) cov[size_t(y) * size_t(v.w) + size_t(x)] = 1;
@@ -325,11 +338,12 @@ TEST(Sampling, RemovalOnGrazingGroundKeepsOneCameraWithoutHoles) {
             for (int x = 1; x + 1 < v.w; ++x) {
                 bool all = true;
                 for (int dy = -1; dy <= 1 && all; ++dy)
-                    for (int dx = -1; dx <= 1 && all; ++dx) all = geo[size_t(y + dy) * size_t(v.w) + size_t(x + dx)] != 0;
+                    for (int dx = -1; dx <= 1 && all; ++dx)
+                        all = geo[size_t(y + dy) * size_t(v.w) + size_t(x + dx)] != 0;
                 if (!all) continue;
                 ++interior;
-                ASSERT_TRUE(cov[size_t(y) * size_t(v.w) + size_t(x)]) << "hole at " << x << "," << y << " from eye " << eye.x << ","
-                                                                       << eye.y << "," << eye.z;
+                ASSERT_TRUE(cov[size_t(y) * size_t(v.w) + size_t(x)])
+                    << "hole at " << x << "," << y << " from eye " << eye.x << "," << eye.y << "," << eye.z;
             }
     }
     EXPECT_GT(interior, 2000u);

@@ -59,14 +59,15 @@ using test::readBytes;
 TEST(ViewCells, BoxesFromStreetSegments) {
     StreetGraph g;
     g.nodes = {{0, 0}, {100, 0}, {100, 0}, {100.3, 0}, {101, 0}, {100, 50}};
-    g.edges = {{0, 1, RoadClass::Local, 10.0f, 2},   // normal
-               {1, 2, RoadClass::Local, 8.0f, 2},    // zero length
-               {1, 3, RoadClass::Local, 8.0f, 2},    // 0.3 m: below the minimum
-               {1, 4, RoadClass::Local, 8.0f, 2},    // 1 m: very short but valid
+    g.edges = {{0, 1, RoadClass::Local, 10.0f, 2},  // normal
+               {1, 2, RoadClass::Local, 8.0f, 2},   // zero length
+               {1, 3, RoadClass::Local, 8.0f, 2},   // 0.3 m: below the minimum
+               {1, 4, RoadClass::Local, 8.0f, 2},   // 1 m: very short but valid
                {1, 5, RoadClass::Local, 8.0f, 2}};
     std::vector<SkippedCell> skipped;
     ViewCellParams p;
-    auto cells = makeViewCells(g, {1000.0, 2000.0}, [](const glm::dvec2& q) { return 0.01 * q.x; }, p, &skipped);
+    auto cells = makeViewCells(
+        g, {1000.0, 2000.0}, [](const glm::dvec2& q) { return 0.01 * q.x; }, p, &skipped);
     ASSERT_EQ(cells.size(), 3u);
     ASSERT_EQ(skipped.size(), 2u);
     EXPECT_EQ(skipped[0].edge, 1u);
@@ -108,7 +109,10 @@ TEST(ViewCells, GridLookupMatchesBruteForce) {
         const glm::dvec3 p(rng.uniform(-600, 600), rng.uniform(-600, 600), rng.uniform(1.0, 2.2));
         int brute = -1;
         for (size_t i = 0; i < boxes.size(); ++i)
-            if (boxes[i].halfHeight > 0 && boxes[i].contains(p)) { brute = int(i); break; }
+            if (boxes[i].halfHeight > 0 && boxes[i].contains(p)) {
+                brute = int(i);
+                break;
+            }
         ASSERT_EQ(grid.find(p), brute) << p.x << "," << p.y << "," << p.z;
         found += brute >= 0;
     }
@@ -123,7 +127,8 @@ TEST(ViewCells, GridLookupMatchesBruteForce) {
 TEST(RaySceneSoup, AllHitsUnroundedColoursAndCullingOption) {
     TriangleSoup soup;
     // First box: black at y = -1, white at y = 1 (linear across each face).
-    addBox(soup, {10, -1, -1}, {12, 1, 1}, [](glm::vec3 p) { return p.y < 0 ? glm::u8vec4(0, 0, 0, 255) : glm::u8vec4(255, 255, 255, 255); });
+    addBox(soup, {10, -1, -1}, {12, 1, 1},
+           [](glm::vec3 p) { return p.y < 0 ? glm::u8vec4(0, 0, 0, 255) : glm::u8vec4(255, 255, 255, 255); });
     addBox(soup, {20, -1, -1}, {21, 1, 1}, constantColor);
     auto scene = RayScene::build(soup);
     ASSERT_TRUE(scene.isOk()) << scene.status().message();
@@ -157,7 +162,8 @@ TEST(RaySceneSoup, AllHitsUnroundedColoursAndCullingOption) {
         const int layers = 3;
         std::vector<RayHit> many(org.size() * layers);
         std::vector<int> counts(org.size(), -1);
-        (*scene)->allHitsMany(org.data(), dir.data(), int(org.size()), tn.data(), tf.data(), layers, 0.01f, many.data(), counts.data());
+        (*scene)->allHitsMany(org.data(), dir.data(), int(org.size()), tn.data(), tf.data(), layers, 0.01f, many.data(),
+                              counts.data());
         int total = 0, missed = 0;
         for (size_t i = 0; i < org.size(); ++i) {
             RayHit one[3];

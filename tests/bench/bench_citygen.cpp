@@ -47,7 +47,8 @@ void BM_BuildingMeshes(benchmark::State& s) {
     size_t tris = 0;
     for (auto _ : s) {
         Mesh w, win, r;
-        for (uint32_t i = 0; i < buildings.size(); ++i) meshBuilding(buildings[i], i, p, light, glm::dvec3(0.0), {&w, &win, &r});
+        for (uint32_t i = 0; i < buildings.size(); ++i)
+            meshBuilding(buildings[i], i, p, light, glm::dvec3(0.0), {&w, &win, &r});
         tris = w.triangleCount() + win.triangleCount() + r.triangleCount();
         benchmark::DoNotOptimize(tris);
     }
@@ -70,6 +71,11 @@ void BM_GenerateCity(benchmark::State& s) {
 
 BENCHMARK(BM_Streets)->Arg(1000)->Arg(2000)->Arg(4000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_BlocksAndLots)->Arg(1000)->Arg(2000)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_BuildingMeshes)->Args({1000, 0})->Args({1000, 1})->Args({1000, 2})->Args({1000, 3})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_BuildingMeshes)
+    ->Args({1000, 0})
+    ->Args({1000, 1})
+    ->Args({1000, 2})
+    ->Args({1000, 3})
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GenerateCity)->Arg(500)->Arg(1000)->Arg(2000)->Unit(benchmark::kMillisecond)->Iterations(2);
 BENCHMARK_MAIN();

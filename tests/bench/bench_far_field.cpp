@@ -141,7 +141,12 @@ void BM_HorizonRayWalk(benchmark::State& st) {
     }
     st.SetItemsProcessed(int64_t(st.iterations()) * n);
 }
-BENCHMARK(BM_HorizonRayWalk)->Args({512, 0})->Args({512, 1})->Args({1024, 0})->Args({1024, 1})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_HorizonRayWalk)
+    ->Args({512, 0})
+    ->Args({512, 1})
+    ->Args({1024, 0})
+    ->Args({1024, 1})
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -69,7 +69,7 @@ struct Frame {
     FrameEffects fx;              // the haze limit of the set (nothing else changes the rays)
     Image out;
     std::vector<uint8_t> hit;
-    std::vector<float> depth;     // eye-plane depth per ray when hazed (raysStage passes it)
+    std::vector<float> depth;  // eye-plane depth per ray when hazed (raysStage passes it)
 };
 
 struct World {
@@ -87,7 +87,8 @@ struct World {
 World& world() {
     static World w = [] {
         World x;
-        if (gCityPath.empty() || gRaysDir.empty()) fail("give --city CITY.osgb and --rays DIR (or VISTA_CITY / VISTA_RAYS)");
+        if (gCityPath.empty() || gRaysDir.empty())
+            fail("give --city CITY.osgb and --rays DIR (or VISTA_CITY / VISTA_RAYS)");
         auto c = loadCityFile(gCityPath);
         if (!c) fail(c.status().message());
         x.city = std::move(*c);
@@ -107,7 +108,8 @@ World& world() {
             Frame f;
             f.set = std::move(*s);
             const size_t n = f.set.pixels.size();
-            f.rays = primaryRays(f.set.camera, x.scene->frameOrigin(), f.set.pixels.data(), n, f.set.hazeFar, f.set.tnear);
+            f.rays =
+                primaryRays(f.set.camera, x.scene->frameOrigin(), f.set.pixels.data(), n, f.set.hazeFar, f.set.tnear);
             f.runs = coherentRuns(f.set.pixels.data(), n, f.set.camera.width);
             f.orgs.assign(n, f.rays.org);
             f.fx.haze = f.set.hazeFar > 0;
@@ -137,10 +139,11 @@ template <class F>
 uint64_t parallelHits(int threads, size_t n, size_t grain, const F& f) {
     std::atomic<uint64_t> hits{0};
     inArena(threads, [&] {
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, std::max<size_t>(1, grain)), [&](const tbb::blocked_range<size_t>& br) {
-            enableFtzDaz();
-            hits += f(br.begin(), br.end());
-        });
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, std::max<size_t>(1, grain)),
+                          [&](const tbb::blocked_range<size_t>& br) {
+                              enableFtzDaz();
+                              hits += f(br.begin(), br.end());
+                          });
     });
     return hits.load();
 }
@@ -152,8 +155,12 @@ uint64_t raw1(RTCScene scene, const PrimaryRays& r, size_t b, size_t e) {
     uint64_t hits = 0;
     for (size_t k = b; k < e; ++k) {
         RTCRayHit rh;
-        rh.ray.org_x = r.org.x; rh.ray.org_y = r.org.y; rh.ray.org_z = r.org.z;
-        rh.ray.dir_x = r.dirs[k].x; rh.ray.dir_y = r.dirs[k].y; rh.ray.dir_z = r.dirs[k].z;
+        rh.ray.org_x = r.org.x;
+        rh.ray.org_y = r.org.y;
+        rh.ray.org_z = r.org.z;
+        rh.ray.dir_x = r.dirs[k].x;
+        rh.ray.dir_y = r.dirs[k].y;
+        rh.ray.dir_z = r.dirs[k].z;
         rh.ray.tnear = r.tnear;
         rh.ray.tfar = r.tfars[k];
         rh.ray.time = 0.0f;
@@ -209,9 +216,10 @@ size_t runGrain(const Frame& f) {
 // One pass of a variant over every frame; returns the hit count.
 enum class Variant { Raw1, Raw8, Raw8Dense, Raw8Serial, Raw8Color, Many, Dirs, Stage };
 
-constexpr Variant kVariants[] = {Variant::Raw1, Variant::Raw8, Variant::Raw8Dense, Variant::Raw8Serial,
-                                 Variant::Raw8Color, Variant::Many, Variant::Dirs, Variant::Stage};
-constexpr const char* kVariantNames[] = {"Raw1", "Raw8", "Raw8Dense", "Raw8Serial", "Raw8Color", "Many", "Dirs", "Stage"};
+constexpr Variant kVariants[] = {Variant::Raw1,      Variant::Raw8, Variant::Raw8Dense, Variant::Raw8Serial,
+                                 Variant::Raw8Color, Variant::Many, Variant::Dirs,      Variant::Stage};
+constexpr const char* kVariantNames[] = {"Raw1",      "Raw8", "Raw8Dense", "Raw8Serial",
+                                         "Raw8Color", "Many", "Dirs",      "Stage"};
 
 // One variant on one frame; returns the hit count.
 uint64_t passFrame(Variant v, Frame& f, int threads) {
@@ -222,7 +230,8 @@ uint64_t passFrame(Variant v, Frame& f, int threads) {
         const size_t n = f.runs.back(), nRuns = f.runs.size() - 1;
         switch (v) {
             case Variant::Raw1:
-                hits += parallelHits(threads, n, kRaysPerTask, [&](size_t b, size_t e) { return raw1(scene, f.rays, b, e); });
+                hits += parallelHits(threads, n, kRaysPerTask,
+                                     [&](size_t b, size_t e) { return raw1(scene, f.rays, b, e); });
                 break;
             case Variant::Raw8:
                 hits += parallelHits(threads, nRuns, runGrain(f), [&](size_t b, size_t e) {
@@ -243,9 +252,8 @@ uint64_t passFrame(Variant v, Frame& f, int threads) {
                 });
                 break;
             case Variant::Raw8Dense:
-                hits += parallelHits(threads, (n + 7) / 8, kRaysPerTask / 8, [&](size_t b, size_t e) {
-                    return raw8(scene, f, 8 * b, std::min(n, 8 * e));
-                });
+                hits += parallelHits(threads, (n + 7) / 8, kRaysPerTask / 8,
+                                     [&](size_t b, size_t e) { return raw8(scene, f, 8 * b, std::min(n, 8 * e)); });
                 break;
             case Variant::Many:
                 hits += parallelHits(threads, nRuns, runGrain(f), [&](size_t b, size_t e) {
@@ -262,7 +270,8 @@ uint64_t passFrame(Variant v, Frame& f, int threads) {
                 });
                 break;
             case Variant::Dirs: {
-                const PrimaryRays r = primaryRays(f.set.camera, w.scene->frameOrigin(), f.set.pixels.data(), n, f.set.hazeFar, f.set.tnear);
+                const PrimaryRays r = primaryRays(f.set.camera, w.scene->frameOrigin(), f.set.pixels.data(), n,
+                                                  f.set.hazeFar, f.set.tnear);
                 benchmark::DoNotOptimize(r.dirs.data());
                 break;
             }
@@ -272,7 +281,8 @@ uint64_t passFrame(Variant v, Frame& f, int threads) {
                 shading.effects = &f.fx;
                 shading.depth = f.depth.empty() ? nullptr : f.depth.data();
                 shading.tnear = float(f.set.tnear);
-                castPrimaryRays(*w.scene, f.set.camera, f.set.pixels.data(), n, f.out, counts, threads, f.hit.data(), shading);
+                castPrimaryRays(*w.scene, f.set.camera, f.set.pixels.data(), n, f.out, counts, threads, f.hit.data(),
+                                shading);
                 hits += counts.hits;
                 break;
             }
@@ -315,7 +325,8 @@ void BM_Interleaved(benchmark::State& st) {
             ++rot;
         }
     st.SetItemsProcessed(int64_t(st.iterations()) * int64_t(w.rays));
-    for (size_t i = 0; i < kN; ++i) st.counters[std::string(kVariantNames[i]) + "_ns"] = ns[i] / (double(st.iterations()) * double(w.rays));
+    for (size_t i = 0; i < kN; ++i)
+        st.counters[std::string(kVariantNames[i]) + "_ns"] = ns[i] / (double(st.iterations()) * double(w.rays));
     st.counters["rays"] = double(w.rays);
     st.counters["frames"] = double(w.frames.size());
     st.counters["packet_fill"] = double(w.rays) / (8.0 * double(w.packets));
@@ -361,7 +372,8 @@ BENCHMARK(BM_Interleaved)->Unit(benchmark::kMillisecond);
 void compareHits() {
     const uint64_t h1 = pass(Variant::Raw1, 0), h8 = pass(Variant::Raw8, 0), hd = pass(Variant::Raw8Dense, 0),
                    hm = pass(Variant::Many, 0), hs = pass(Variant::Stage, 0);
-    std::fprintf(stderr, "bench_raw_rays: hits raw1 %llu, raw8 %llu, raw8 dense %llu, intersectMany %llu, stage %llu%s\n",
+    std::fprintf(stderr,
+                 "bench_raw_rays: hits raw1 %llu, raw8 %llu, raw8 dense %llu, intersectMany %llu, stage %llu%s\n",
                  (unsigned long long)h1, (unsigned long long)h8, (unsigned long long)hd, (unsigned long long)hm,
                  (unsigned long long)hs, (h1 == h8 && h8 == hd && hd == hm) ? "" : "  (DIFFER)");
 }

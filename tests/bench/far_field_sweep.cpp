@@ -78,7 +78,9 @@ struct SweepArgs {
 // The command line; false (after the usage line) when CITY and OUT are missing.
 bool parseArgs(int argc, char** argv, SweepArgs& a) {
     if (argc < 3) {
-        std::fprintf(stderr, "usage: far_field_sweep CITY.osgb OUT [--frames N] [--only a,b] [--budget B] [--seed N] [--run-up S]\n");
+        std::fprintf(
+            stderr,
+            "usage: far_field_sweep CITY.osgb OUT [--frames N] [--only a,b] [--budget B] [--seed N] [--run-up S]\n");
         return false;
     }
     a.cityPath = argv[1];
@@ -193,9 +195,12 @@ nlohmann::json runJson(const RunSpec& rs, const BenchResult& r, SweepResults& re
     jr["size"] = {rs.width, rs.height};
     for (const auto& m : rs.modes) {
         const ModeSummary& a = res.all[rs.name][m];
-        jr["modes"][m] = {{"frame_ms_median", a.frameMsMedian}, {"frame_ms_mean", a.frameMsMean},
-                          {"frame_ms_p95", a.frameMsP95},       {"psnr_db_median", a.psnrDbMedian},
-                          {"psnr_db_min", a.psnrDbMin},         {"frame_ms", res.frameMs[rs.name][m]},
+        jr["modes"][m] = {{"frame_ms_median", a.frameMsMedian},
+                          {"frame_ms_mean", a.frameMsMean},
+                          {"frame_ms_p95", a.frameMsP95},
+                          {"psnr_db_median", a.psnrDbMedian},
+                          {"psnr_db_min", a.psnrDbMin},
+                          {"frame_ms", res.frameMs[rs.name][m]},
                           {"speedup_vs_full_median_of_ratios", speedup(a)}};
     }
     jr["hybrid_speedup_vs_full_median_of_ratios"] = speedup(h);
@@ -204,7 +209,8 @@ nlohmann::json runJson(const RunSpec& rs, const BenchResult& r, SweepResults& re
     const char* names[5] = {"ray_hit", "ray_miss", "cache", "horizon_culled", "covered"};
     for (int k = 0; k < 5; ++k) {
         const PixelClassSummary& c = *pixelRows(h, k);
-        jr["pixels"][names[k]] = {{"min_pct", c.minPct}, {"mean_pct", c.meanPct}, {"max_pct", c.maxPct}, {"mean_count", c.meanCount}};
+        jr["pixels"][names[k]] = {
+            {"min_pct", c.minPct}, {"mean_pct", c.meanPct}, {"max_pct", c.maxPct}, {"mean_count", c.meanCount}};
     }
     jr["stages_ms_mean"] = h.stagesMsMean;
     std::vector<std::string> notes;
@@ -215,7 +221,8 @@ nlohmann::json runJson(const RunSpec& rs, const BenchResult& r, SweepResults& re
 
 // Benches every run (modes interleaved per frame) into OUT/<run>/ and
 // collects the results; false when a run fails (the message is printed).
-bool runAll(const SweepArgs& a, const std::vector<RunSpec>& runs, const SceneModel& city, const Path& path, SweepResults& res) {
+bool runAll(const SweepArgs& a, const std::vector<RunSpec>& runs, const SceneModel& city, const Path& path,
+            SweepResults& res) {
     for (const RunSpec& rs : runs) {
         BenchConfig cfg;
         cfg.width = rs.width;
@@ -260,32 +267,39 @@ void writeModeTables(std::ostringstream& md, const std::vector<RunSpec>& runs, S
         for (const auto& x : runs)
             if (x.name == run) rs = &x;
         md << "**Table 4.1 (" << rs->label << ")** — of " << rs->width * rs->height << " pixels:\n\n";
-        md << "| Of " << rs->width * rs->height << " pixels ... | Min [%] | Avg. [%] | Max [%] | Avg. [#] |\n|---|---:|---:|---:|---:|\n";
+        md << "| Of " << rs->width * rs->height
+           << " pixels ... | Min [%] | Avg. [%] | Max [%] | Avg. [#] |\n|---|---:|---:|---:|---:|\n";
         for (int k = 0; k < 5; ++k) {
             const PixelClassSummary& c = *pixelRows(h, k);
-            md << "| " << rowNames[k] << " | " << fmt(c.minPct, 2) << " | " << fmt(c.meanPct, 2) << " | " << fmt(c.maxPct, 2)
-               << " | " << fmt(c.meanCount, 0) << " |\n";
+            md << "| " << rowNames[k] << " | " << fmt(c.minPct, 2) << " | " << fmt(c.meanPct, 2) << " | "
+               << fmt(c.maxPct, 2) << " | " << fmt(c.meanCount, 0) << " |\n";
         }
         md << "\nHybrid stage times (mean ms over the frames each ran in):";
         for (const auto& [st, ms] : h.stagesMsMean) md << " " << st << " " << fmt(ms, 2) << ";";
         md << "\n\n";
-        md << "**Frame times (" << rs->label << ")**\n\n| mode | median ms | mean ms | p95 ms | speedup vs full (median of same-frame ratios) | PSNR median dB | PSNR min dB |\n|---|---:|---:|---:|---:|---:|---:|\n";
+        md << "**Frame times (" << rs->label
+           << ")**\n\n| mode | median ms | mean ms | p95 ms | speedup vs full (median of same-frame ratios) | PSNR "
+              "median dB | PSNR min dB |\n|---|---:|---:|---:|---:|---:|---:|\n";
         for (const auto& m : rs->modes) {
             const ModeSummary& a = res.all[run][m];
-            md << "| " << m << " | " << fmt(a.frameMsMedian) << " | " << fmt(a.frameMsMean) << " | " << fmt(a.frameMsP95)
-               << " | " << fmt(speedup(a), 2) << " | " << fmt(a.psnrDbMedian) << " | " << fmt(a.psnrDbMin) << " |\n";
+            md << "| " << m << " | " << fmt(a.frameMsMedian) << " | " << fmt(a.frameMsMean) << " | "
+               << fmt(a.frameMsP95) << " | " << fmt(speedup(a), 2) << " | " << fmt(a.psnrDbMedian) << " | "
+               << fmt(a.psnrDbMin) << " |\n";
         }
         md << "\nFrame time per frame: `" << run << "/frame_time.png`.\n\n";
     }
 }
 
 // One parameter sweep's table (the runs of `group`), if any ran.
-void writeSweepTable(std::ostringstream& md, const std::vector<RunSpec>& runs, SweepResults& res, const std::string& group,
-                     const std::string& title) {
+void writeSweepTable(std::ostringstream& md, const std::vector<RunSpec>& runs, SweepResults& res,
+                     const std::string& group, const std::string& title) {
     bool any = false;
     for (const auto& rs : runs) any = any || rs.group == group;
     if (!any) return;
-    md << "**" << title << "**\n\n| run | hybrid median ms | hybrid p95 ms | full median ms | speedup (median of same-frame ratios) | PSNR median dB | PSNR min dB | traced px/frame (mean) | cache px (mean) |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    md << "**" << title
+       << "**\n\n| run | hybrid median ms | hybrid p95 ms | full median ms | speedup (median of same-frame ratios) | "
+          "PSNR median dB | PSNR min dB | traced px/frame (mean) | cache px (mean) "
+          "|\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     for (const auto& rs : runs) {
         if (rs.group != group) continue;
         const ModeSummary& h = res.all[rs.name]["hybrid"];
@@ -299,7 +313,8 @@ void writeSweepTable(std::ostringstream& md, const std::vector<RunSpec>& runs, S
 }
 
 // Fig 4.9 plot: frame time per frame per near distance.
-void plotNearDistances(std::ostringstream& md, const std::vector<RunSpec>& runs, SweepResults& res, const std::string& out) {
+void plotNearDistances(std::ostringstream& md, const std::vector<RunSpec>& runs, SweepResults& res,
+                       const std::string& out) {
     PlotSpec ps;
     ps.title = "hybrid frame time vs near distance (640x480)";
     ps.xLabel = "frame";
@@ -357,7 +372,8 @@ void plotAccuracy(std::ostringstream& md, const std::vector<Point>& accuracy, co
     ps.series = {pts, fr};
     writePng(renderPlot(ps), (fs::path(out) / "accuracy_vs_time.png").string());
     md << "**What accuracy costs** (`accuracy_vs_time.png`; * = on the Pareto front: no other configuration is both "
-          "faster and more accurate)\n\n| configuration | speedup vs full | hybrid median ms | median PSNR dB | Pareto |\n"
+          "faster and more accurate)\n\n| configuration | speedup vs full | hybrid median ms | median PSNR dB | Pareto "
+          "|\n"
           "|---|---:|---:|---:|:---:|\n";
     for (const auto& p : sorted) {
         bool onFront = false;
@@ -371,8 +387,9 @@ void plotAccuracy(std::ostringstream& md, const std::vector<Point>& accuracy, co
 // far_field.md: the city and defaults, the mode tables, the sweeps, the plots.
 std::string markdown(const SweepArgs& a, const std::vector<RunSpec>& runs, const SceneModel& city, SweepResults& res) {
     std::ostringstream md;
-    md << "City: `" << res.J["city"].get<std::string>() << "` (" << city.triangles << " triangles), car walkthrough seed " << a.po.seed << " (run-up " << a.po.runUp << " s), "
-       << a.frames << " consecutive frames at 30 fps spacing; hybrid defaults: near 100 m, pixel budget " << a.budget
+    md << "City: `" << res.J["city"].get<std::string>() << "` (" << city.triangles
+       << " triangles), car walkthrough seed " << a.po.seed << " (run-up " << a.po.runUp << " s), " << a.frames
+       << " consecutive frames at 30 fps spacing; hybrid defaults: near 100 m, pixel budget " << a.budget
        << ", horizon grid 512, cache on.\n\n";
     writeModeTables(md, runs, res);
     writeSweepTable(md, runs, res, "near", "Fig. 4.9: frame time vs near distance (640x480)");

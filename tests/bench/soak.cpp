@@ -90,6 +90,7 @@ int main(int argc, char** argv) {
             std::fflush(stdout);
         }
     }
-    std::printf("# rss first %.1f MB, last %.1f MB, growth %.1f MB over %ld frames\n", first, last, last - first, frames);
+    std::printf("# rss first %.1f MB, last %.1f MB, growth %.1f MB over %ld frames\n", first, last, last - first,
+                frames);
     return 0;
 }

@@ -28,7 +28,8 @@ constexpr double kD2R = 3.14159265358979323846 / 180.0;
 inline double vincenty(const GeoPoint& p, const GeoPoint& q) {
     const double a = 6378137.0, f = 1 / 298.257223563, b = a * (1 - f);
     const double L = std::remainder(q.lon_deg - p.lon_deg, 360.0) * kD2R;
-    const double U1 = std::atan((1 - f) * std::tan(p.lat_deg * kD2R)), U2 = std::atan((1 - f) * std::tan(q.lat_deg * kD2R));
+    const double U1 = std::atan((1 - f) * std::tan(p.lat_deg * kD2R)),
+                 U2 = std::atan((1 - f) * std::tan(q.lat_deg * kD2R));
     const double sU1 = std::sin(U1), cU1 = std::cos(U1), sU2 = std::sin(U2), cU2 = std::cos(U2);
     double lam = L, sinS = 0, cosS = 0, sig = 0, cos2A = 0, cos2Sm = 0;
     for (int i = 0; i < 200; ++i) {
@@ -48,8 +49,10 @@ inline double vincenty(const GeoPoint& p, const GeoPoint& q) {
     const double u2 = cos2A * (a * a - b * b) / (b * b);
     const double A = 1 + u2 / 16384 * (4096 + u2 * (-768 + u2 * (320 - 175 * u2)));
     const double B = u2 / 1024 * (256 + u2 * (-128 + u2 * (74 - 47 * u2)));
-    const double dS = B * sinS * (cos2Sm + B / 4 * (cosS * (-1 + 2 * cos2Sm * cos2Sm) -
-                                                    B / 6 * cos2Sm * (-3 + 4 * sinS * sinS) * (-3 + 4 * cos2Sm * cos2Sm)));
+    const double dS = B * sinS *
+                      (cos2Sm + B / 4 *
+                                    (cosS * (-1 + 2 * cos2Sm * cos2Sm) -
+                                     B / 6 * cos2Sm * (-3 + 4 * sinS * sinS) * (-3 + 4 * cos2Sm * cos2Sm)));
     return b * A * (sig - dS);
 }
 
@@ -57,7 +60,8 @@ inline double vincenty(const GeoPoint& p, const GeoPoint& q) {
 inline GeoPoint destination(const GeoPoint& p, double bearingDeg, double dist) {
     const double d = dist / 6371000.0, t = bearingDeg * kD2R, f1 = p.lat_deg * kD2R;
     const double f2 = std::asin(std::sin(f1) * std::cos(d) + std::cos(f1) * std::sin(d) * std::cos(t));
-    const double l2 = p.lon_deg * kD2R + std::atan2(std::sin(t) * std::sin(d) * std::cos(f1), std::cos(d) - std::sin(f1) * std::sin(f2));
+    const double l2 = p.lon_deg * kD2R +
+                      std::atan2(std::sin(t) * std::sin(d) * std::cos(f1), std::cos(d) - std::sin(f1) * std::sin(f2));
     return {f2 / kD2R, std::remainder(l2 / kD2R, 360.0)};
 }
 

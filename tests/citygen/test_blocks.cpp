@@ -169,10 +169,10 @@ TEST(Blocks, LongDeadEndsAndTreesDoNotCrash) {
     gb.edge(60, -60, 60, 60);
     gb.edge(60, 60, -60, 60);
     gb.edge(-60, 60, -60, -60);
-    gb.edge(-60, 0, 50, 0);    // almost crosses the block: notch meets the far side
-    gb.edge(20, 0, 20, 30);    // branch on the dead end
+    gb.edge(-60, 0, 50, 0);  // almost crosses the block: notch meets the far side
+    gb.edge(20, 0, 20, 30);  // branch on the dead end
     gb.edge(20, 30, 35, 45);
-    gb.edge(0, 60, 0, 40);     // dead end from the north
+    gb.edge(0, 60, 0, 40);  // dead end from the north
     auto blocks = extractBlocks(gb.g, smallCity(400.0), nullptr);
     expectValidBlocks(blocks, gb.g);
     double total = 0;
@@ -271,7 +271,10 @@ TEST(Blocks, DeterministicAndIndependentOfEdgeOrder) {
     EXPECT_EQ(parks, 16u);
     // Parks favour low density: mean park density below the mean block density.
     double dp = 0, da = 0;
-    for (const auto& x : a) { da += x.density; if (x.park) dp += x.density; }
+    for (const auto& x : a) {
+        da += x.density;
+        if (x.park) dp += x.density;
+    }
     EXPECT_LT(dp / double(parks), da / double(a.size()));
 }
 
@@ -304,11 +307,15 @@ TEST(Lots, InsideBlocksNoOverlapAndFrontage) {
     CityParams p = smallCity(600.0);
     // Grid plus an L-shaped concave block (one missing street) and a diagonal.
     StreetGraph g = grid(6, 100.0);
-    g.edges.erase(std::remove_if(g.edges.begin(), g.edges.end(), [&](const StreetEdge& e) {
-        glm::dvec2 a = g.nodes[e.a], b = g.nodes[e.b];
-        // removes the streets x=0, y in [0,100] and y=100, x in [0,100]: three cells form an L
-        return (a.x == 0 && b.x == 0 && std::min(a.y, b.y) == 0) || (a.y == 100 && b.y == 100 && std::min(a.x, b.x) == 0);
-    }), g.edges.end());
+    g.edges.erase(std::remove_if(g.edges.begin(), g.edges.end(),
+                                 [&](const StreetEdge& e) {
+                                     glm::dvec2 a = g.nodes[e.a], b = g.nodes[e.b];
+                                     // removes the streets x=0, y in [0,100] and y=100, x in [0,100]: three cells form
+                                     // an L
+                                     return (a.x == 0 && b.x == 0 && std::min(a.y, b.y) == 0) ||
+                                            (a.y == 100 && b.y == 100 && std::min(a.x, b.x) == 0);
+                                 }),
+                  g.edges.end());
     auto blocks = extractBlocks(g, p, nullptr);
     ASSERT_GE(blocks.size(), 30u);
     bool concave = false;
@@ -329,7 +336,8 @@ TEST(Lots, InsideBlocksNoOverlapAndFrontage) {
         bool touches = false;
         const auto& bo = blocks[l.block].outline;
         for (const auto& q : l.outline)
-            for (size_t k = 0; k < bo.size() && !touches; ++k) touches = pointSegmentDistance(q, bo[k], bo[(k + 1) % bo.size()]) < 1e-6;
+            for (size_t k = 0; k < bo.size() && !touches; ++k)
+                touches = pointSegmentDistance(q, bo[k], bo[(k + 1) % bo.size()]) < 1e-6;
         EXPECT_TRUE(touches);
         for (size_t j = i + 1; j < lots.size() && lots[j].block == l.block; ++j)
             EXPECT_FALSE(polygonsOverlap(l.outline, lots[j].outline, 1e-6)) << i << " vs " << j;

@@ -23,7 +23,8 @@ StreetGraph gridGraph(int n, double s, double jitter) {
     for (int j = 0; j <= n; ++j)
         for (int i = 0; i <= n; ++i) {
             bool border = i == 0 || j == 0 || i == n || j == n;
-            double dx = border ? 0 : jitter * std::sin(1.7 * i + 3.1 * j), dy = border ? 0 : jitter * std::cos(2.3 * i - 1.3 * j);
+            double dx = border ? 0 : jitter * std::sin(1.7 * i + 3.1 * j),
+                   dy = border ? 0 : jitter * std::cos(2.3 * i - 1.3 * j);
             g.nodes.emplace_back(-h + i * s + dx, -h + j * s + dy);
         }
     auto id = [&](int i, int j) { return uint32_t(j * (n + 1) + i); };
@@ -31,8 +32,16 @@ StreetGraph gridGraph(int n, double s, double jitter) {
         for (int i = 0; i <= n; ++i) {
             StreetEdge e;
             e.width = (i == n / 2 || j == n / 2) ? 16.0f : 8.0f;
-            if (i < n) { e.a = id(i, j); e.b = id(i + 1, j); g.edges.push_back(e); }
-            if (j < n) { e.a = id(i, j); e.b = id(i, j + 1); g.edges.push_back(e); }
+            if (i < n) {
+                e.a = id(i, j);
+                e.b = id(i + 1, j);
+                g.edges.push_back(e);
+            }
+            if (j < n) {
+                e.a = id(i, j);
+                e.b = id(i, j + 1);
+                g.edges.push_back(e);
+            }
         }
     return g;
 }
@@ -154,8 +163,17 @@ TEST(Buildings, IrregularGraphWithDeadEnds) {
     // Radial star with a ring, dead ends into the sectors, a T junction and a dense centre.
     Pipeline pl(StreetGraph{});
     StreetGraph& g = pl.g;
-    auto node = [&](double x, double y) { g.nodes.emplace_back(x, y); return uint32_t(g.nodes.size() - 1); };
-    auto edge = [&](uint32_t a, uint32_t b, float w) { StreetEdge e; e.a = a; e.b = b; e.width = w; g.edges.push_back(e); };
+    auto node = [&](double x, double y) {
+        g.nodes.emplace_back(x, y);
+        return uint32_t(g.nodes.size() - 1);
+    };
+    auto edge = [&](uint32_t a, uint32_t b, float w) {
+        StreetEdge e;
+        e.a = a;
+        e.b = b;
+        e.width = w;
+        g.edges.push_back(e);
+    };
     uint32_t c = node(0, 0);
     const int k = 7;
     std::vector<uint32_t> ring, mid;
@@ -197,7 +215,10 @@ TEST(Buildings, FloorsHeightsAndBase) {
         EXPECT_GE(b.roof_height, 0.0);
         if (b.roof == RoofType::Flat) { EXPECT_EQ(b.roof_height, 0.0); }
         double dens = pl.blocks[pl.lots[b.lot].block].density;
-        if (dens < 0.3) { EXPECT_LE(b.floors, 3); ++houses; }
+        if (dens < 0.3) {
+            EXPECT_LE(b.floors, 3);
+            ++houses;
+        }
         if (b.floors > 20) ++towers;
     }
     EXPECT_GT(houses, 0);
@@ -218,8 +239,14 @@ TEST(Buildings, DenseCentreIsTaller) {
     int nhi = 0, nlo = 0;
     for (const auto& b : pl.buildings) {
         double d = pl.blocks[pl.lots[b.lot].block].density;
-        if (d > 0.6) { hi += b.floors; ++nhi; }
-        if (d < 0.3) { lo += b.floors; ++nlo; }
+        if (d > 0.6) {
+            hi += b.floors;
+            ++nhi;
+        }
+        if (d < 0.3) {
+            lo += b.floors;
+            ++nlo;
+        }
     }
     ASSERT_GT(nhi, 0);
     ASSERT_GT(nlo, 0);
@@ -348,7 +375,10 @@ TEST(Buildings, GabledRoofHeightsAndGableWalls) {
     EXPECT_EQ(m.roofs.triangleCount(), 4u);
     double ridge0 = 1e300, ridge1 = -1e300;
     for (const auto& p : m.roofs.positions)
-        if (std::abs(p.z - zmax) < 1e-4) { ridge0 = std::min(ridge0, double(p.x)); ridge1 = std::max(ridge1, double(p.x)); }
+        if (std::abs(p.z - zmax) < 1e-4) {
+            ridge0 = std::min(ridge0, double(p.x));
+            ridge1 = std::max(ridge1, double(p.x));
+        }
     EXPECT_NEAR(ridge1 - ridge0, L, 1e-4);  // ridge along the longer axis
 }
 
@@ -385,7 +415,8 @@ TEST(Buildings, PipelineMeshesAreFinite) {
     Meshes m;
     size_t n = std::min<size_t>(pl.buildings.size(), 400);
     for (size_t i = 0; i < n; ++i)
-        meshBuilding(pl.buildings[i], uint32_t(i), p, light, glm::dvec3(0.0), BuildingMeshes{&m.walls, &m.windows, &m.roofs});
+        meshBuilding(pl.buildings[i], uint32_t(i), p, light, glm::dvec3(0.0),
+                     BuildingMeshes{&m.walls, &m.windows, &m.roofs});
     expectWellFormed(m.walls);
     expectWellFormed(m.windows);
     expectWellFormed(m.roofs);
@@ -412,10 +443,11 @@ TEST(BuildingBudget, DISABLED_DefaultCityPerDetail) {
             if (s.name == "meshes") meshSeconds = s.seconds;
         size_t tallest = 0;
         for (const auto& bd : c.buildings) tallest = std::max(tallest, size_t(bd.floors));
-        std::printf("detail %d: %zu blocks, %zu lots, %zu buildings (tallest %zu floors); building triangles %zu "
-                    "(walls %zu, windows %zu, roofs %zu); city total %zu; meshes stage %.2f s\n",
-                    detail, c.blocks.size(), c.lots.size(), c.buildings.size(), tallest, b, per[int(Material::Wall)],
-                    per[int(Material::Window)], per[int(Material::Roof)], countCity(c).triangles, meshSeconds);
+        std::printf(
+            "detail %d: %zu blocks, %zu lots, %zu buildings (tallest %zu floors); building triangles %zu "
+            "(walls %zu, windows %zu, roofs %zu); city total %zu; meshes stage %.2f s\n",
+            detail, c.blocks.size(), c.lots.size(), c.buildings.size(), tallest, b, per[int(Material::Wall)],
+            per[int(Material::Window)], per[int(Material::Roof)], countCity(c).triangles, meshSeconds);
         EXPECT_GT(b, prev);
         prev = b;
     }
@@ -486,7 +518,8 @@ TEST(BuildingMesh, CourtyardAndLiftedBuildingAreClosed) {
             if (n.z < -0.999 && std::abs(t.centre().z - (b.base_z + 3.0)) < 1e-4) under += t.area();
             // Courtyard walls (on the inner ring) face into the courtyard.
             const glm::dvec2 c(t.centre());
-            if (std::abs(n.z) < 1e-3 && std::max(std::abs(c.x), std::abs(c.y)) > 5 - 1e-4 && std::max(std::abs(c.x), std::abs(c.y)) < 5 + 1e-4) {
+            if (std::abs(n.z) < 1e-3 && std::max(std::abs(c.x), std::abs(c.y)) > 5 - 1e-4 &&
+                std::max(std::abs(c.x), std::abs(c.y)) < 5 + 1e-4) {
                 EXPECT_LT(glm::dot(glm::dvec2(n), c), 0.0);
                 courtyardWall += t.area();
             }

@@ -66,7 +66,8 @@ TEST(EffectsParams, BadDeclarationsNameTheEffectTheFieldAndTheRange) {
     for (const auto& c : cases) {
         auto r = parseParamsJson(c.json, "bad.json");
         ASSERT_FALSE(r) << c.json;
-        for (const auto& s : c.mustSay) EXPECT_NE(r.status().message().find(s), std::string::npos) << c.json << " -> " << r.status().message();
+        for (const auto& s : c.mustSay)
+            EXPECT_NE(r.status().message().find(s), std::string::npos) << c.json << " -> " << r.status().message();
     }
 }
 

@@ -96,10 +96,12 @@ TEST(Generate, CityInvariants) {
         for (const auto& tile : c.tiles)
             for (const auto& m : tile.meshes) {
                 ASSERT_EQ(m.colors.size(), m.positions.size());
-                for (const auto& p : m.positions) ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
+                for (const auto& p : m.positions)
+                    ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
                 for (uint32_t i : m.indices) ASSERT_LT(i, m.positions.size());
                 // Tile-local floats stay small: within two tile sizes of the tile origin.
-                for (const auto& p : m.positions) ASSERT_LT(std::abs(p.x) + std::abs(p.y), 4 * c.params.tile_size_m + 200);
+                for (const auto& p : m.positions)
+                    ASSERT_LT(std::abs(p.x) + std::abs(p.y), 4 * c.params.tile_size_m + 200);
             }
     }
 }

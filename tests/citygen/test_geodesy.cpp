@@ -30,7 +30,8 @@ TEST(Geodesy, ProjectedDistancesMatchVincentyAnywhere) {
     const double reach = 0.5 * std::sqrt(2.0) * maxCitySize();
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> bearing(0, 360), dist(0, reach);
-    const GeoReference refs[] = {{0, 0}, {48.2, 16.37}, {60, 10}, {-60, -70}, {89.5, 30}, {-89.5, -150}, {89.95, 0}, {20, 180}, {-33.9, -179.99}};
+    const GeoReference refs[] = {{0, 0},        {48.2, 16.37}, {60, 10},  {-60, -70},      {89.5, 30},
+                                 {-89.5, -150}, {89.95, 0},    {20, 180}, {-33.9, -179.99}};
     for (const auto& ref : refs) {
         std::vector<GeoPoint> pts;
         for (int i = 0; i < 40; ++i) pts.push_back(destination({ref.lat0_deg, ref.lon0_deg}, bearing(rng), dist(rng)));
@@ -51,7 +52,8 @@ TEST(Geodesy, ProjectedDistancesMatchVincentyAnywhere) {
 TEST(Geodesy, RoundTripWithinOneCentimetre) {
     std::mt19937 rng(3);
     std::uniform_real_distribution<double> local(-20000, 20000), bearing(0, 360), dist(0, 20000);
-    const GeoReference refs[] = {{0, 0}, {60, 10}, {89.5, 0}, {-89.5, 120}, {90, 0}, {-90, 45}, {10, 180}, {-5, -180}, {0, 179.999}};
+    const GeoReference refs[] = {{0, 0},    {60, 10},  {89.5, 0},  {-89.5, 120}, {90, 0},
+                                 {-90, 45}, {10, 180}, {-5, -180}, {0, 179.999}};
     for (const auto& ref : refs) {
         for (int i = 0; i < 200; ++i) {
             const glm::dvec2 xy(local(rng), local(rng));
@@ -97,11 +99,17 @@ TEST(OsmGeoReference, ParamsJsonRoundTripAndOmittedWhenAbsent) {
 }
 
 TEST(OsmGeoReference, BadGeoObjectsAreRefusedNamingTheField) {
-    struct Case { const char* json; const char* expect; };
+    struct Case {
+        const char* json;
+        const char* expect;
+    };
     const Case cases[] = {
-        {R"({"geo": {"projection": "tmerc", "lat0_deg": 95, "lon0_deg": 0}})", "'geo.lat0_deg' = 95 is out of range [-90, 90]"},
-        {R"({"geo": {"projection": "tmerc", "lat0_deg": 0, "lon0_deg": -181}})", "'geo.lon0_deg' = -181 is out of range [-180, 180]"},
-        {R"({"geo": {"projection": "utm", "lat0_deg": 0, "lon0_deg": 0}})", "'geo.projection' = \"utm\" is not supported"},
+        {R"({"geo": {"projection": "tmerc", "lat0_deg": 95, "lon0_deg": 0}})",
+         "'geo.lat0_deg' = 95 is out of range [-90, 90]"},
+        {R"({"geo": {"projection": "tmerc", "lat0_deg": 0, "lon0_deg": -181}})",
+         "'geo.lon0_deg' = -181 is out of range [-180, 180]"},
+        {R"({"geo": {"projection": "utm", "lat0_deg": 0, "lon0_deg": 0}})",
+         "'geo.projection' = \"utm\" is not supported"},
         {R"({"geo": {"projection": "tmerc", "lat0_deg": 0}})", "lacks 'lon0_deg'"},
         {R"({"geo": {"projection": "tmerc", "lat0_deg": 0, "lon0_deg": 0, "k0": 1}})", "unknown parameter 'geo.k0'"},
         {R"({"geo": {"projection": "tmerc", "lat0_deg": "0", "lon0_deg": 0}})", "'geo.lat0_deg' must be a number"},

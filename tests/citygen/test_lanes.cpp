@@ -18,8 +18,10 @@ namespace {
 StreetGraph tee() {
     StreetGraph g;
     g.nodes = {{0, 0}, {100, 0}, {-100, 0}, {0, 6}, {30, 36}};
-    g.edges = {{0, 1, RoadClass::Arterial, 13.0f, 4}, {2, 0, RoadClass::Local, 7.5f, 2},
-               {0, 3, RoadClass::Local, 9.0f, 3}, {3, 4, RoadClass::Local, 7.5f, 1}};
+    g.edges = {{0, 1, RoadClass::Arterial, 13.0f, 4},
+               {2, 0, RoadClass::Local, 7.5f, 2},
+               {0, 3, RoadClass::Local, 9.0f, 3},
+               {3, 4, RoadClass::Local, 7.5f, 1}};
     return g;
 }
 
@@ -95,7 +97,7 @@ TEST(Lanes, SidewalkSidesFromBlocks) {
     b.outline = {{20, 9.5}, {90, 9.5}, {90, 60}, {20, 60}};
     const std::vector<Block> blocks{b};
     const LaneModel m = buildLaneModel(tee(), p, &blocks);
-    EXPECT_TRUE(m.edges[0].hasWalk(1));    // left of a -> b (east) is north
+    EXPECT_TRUE(m.edges[0].hasWalk(1));  // left of a -> b (east) is north
     EXPECT_FALSE(m.edges[0].hasWalk(-1));
     EXPECT_FALSE(m.edges[1].hasWalk(1));
     const LaneModel all = buildLaneModel(tee(), p);
@@ -237,7 +239,8 @@ TEST(Lanes, TurningLanesGoWhereADriverExpects) {
     for (const LinkRoad& r : m.links) {
         if (r.junction < 0 || r.in != 2) continue;  // edge 2 = arm 1 (north), starts at the junction
         const int idx = r.turn == LinkRoad::Turn::Right ? 0 : r.turn == LinkRoad::Turn::Straight ? 1 : 2;
-        for (const LinkRoad::Lane& l : r.right) if (l.from) fromEast[idx].insert(l.from);
+        for (const LinkRoad::Lane& l : r.right)
+            if (l.from) fromEast[idx].insert(l.from);
     }
     // The north arm starts at the junction: its lanes toward it are its left lanes (+1 inner, +2 outer).
     EXPECT_EQ(fromEast[0], (std::set<int>{2}));

@@ -113,7 +113,8 @@ static void checkLaneCentres(const City& city, const std::string& label) {
             const Element* g = road->first("planView")->first("geometry");
             ASSERT_TRUE(g->first("line"));
             const double len = g->num("length"), hdg = g->num("hdg");
-            const glm::dvec2 p0 = glm::dvec2(g->num("x"), g->num("y")) - origin, d(std::cos(hdg), std::sin(hdg)), nrm(-d.y, d.x);
+            const glm::dvec2 p0 = glm::dvec2(g->num("x"), g->num("y")) - origin, d(std::cos(hdg), std::sin(hdg)),
+                             nrm(-d.y, d.x);
             const Element* section = road->first("lanes")->first("laneSection");
             for (const char* sideName : {"left", "right"}) {
                 const Element* side = section->first(sideName);
@@ -153,8 +154,9 @@ static void checkLaneCentres(const City& city, const std::string& label) {
                         ++samples;
                         if (std::isnan(e)) {
                             ++missing;
-                            ADD_FAILURE() << label << ": no road triangle under lane " << k << " of road " << road->str("id") << " at s " << s
-                                          << " (city frame " << q.x << ", " << q.y << ")";
+                            ADD_FAILURE()
+                                << label << ": no road triangle under lane " << k << " of road " << road->str("id")
+                                << " at s " << s << " (city frame " << q.x << ", " << q.y << ")";
                             continue;
                         }
                         worst = std::max(worst, e);
@@ -169,8 +171,10 @@ static void checkLaneCentres(const City& city, const std::string& label) {
         }
         EXPECT_GE(double(walkCovered), 0.95 * double(walkSamples)) << label;
         EXPECT_EQ(missing, 0u);
-        std::printf("[ %s ] %zu lane-centre samples, worst vertical distance to the road mesh %.4f m; sidewalk lanes on "
-                    "the sidewalk mesh %zu of %zu\n", label.c_str(), samples, worst, walkCovered, walkSamples);
+        std::printf(
+            "[ %s ] %zu lane-centre samples, worst vertical distance to the road mesh %.4f m; sidewalk lanes on "
+            "the sidewalk mesh %zu of %zu\n",
+            label.c_str(), samples, worst, walkCovered, walkSamples);
     }
 }
 
@@ -184,7 +188,8 @@ TEST(OpenDrive, LaneCentresLieOnTheRoadMesh) {
 
 TEST(OpenDrive, DeterministicAndWellFormed) {
     const City city = generated(smallParams(3, 400, 10));
-    auto a = openDriveXml(city.streets, city.params, &city.blocks), b = openDriveXml(city.streets, city.params, &city.blocks);
+    auto a = openDriveXml(city.streets, city.params, &city.blocks),
+         b = openDriveXml(city.streets, city.params, &city.blocks);
     ASSERT_TRUE(a.isOk());
     EXPECT_EQ(*a, *b);
     std::string err;
@@ -266,7 +271,8 @@ TEST(OpenDrive, MarkingsFollowTheLaneModel) {
         const double s = 2.0;  // inside the first dash (dashes [0, 3] of every 9 m)
         if (L.length > 6 && M.degree[city.streets.edges[e].a] != 1) {
             if (cls == RoadClass::Highway) {
-                EXPECT_TRUE(marks.covers(at(s, off + 0.15)) && marks.covers(at(s, off - 0.15))) << "double centre line " << e;
+                EXPECT_TRUE(marks.covers(at(s, off + 0.15)) && marks.covers(at(s, off - 0.15)))
+                    << "double centre line " << e;
                 EXPECT_FALSE(marks.covers(at(s, off))) << "gap of the double line " << e;
             } else {
                 EXPECT_TRUE(marks.covers(at(s, off))) << "centre line, edge " << e;
@@ -293,8 +299,10 @@ TEST(OpenDrive, MarkingsFollowTheLaneModel) {
     EXPECT_GT(dividers, 5u);
     // Modest: markings stay a small share of the road surface triangles' order of magnitude.
     EXPECT_LT(markingTriangles, 20 * roadTriangles);
-    std::printf("[ markings ] %zu stop lines, %zu crossings, %zu centre lines, %zu dividers checked, %zu clear lane centres; "
-                "%zu marking triangles (road: %zu)\n", stops, crossings, centres, dividers, clear, markingTriangles, roadTriangles);
+    std::printf(
+        "[ markings ] %zu stop lines, %zu crossings, %zu centre lines, %zu dividers checked, %zu clear lane centres; "
+        "%zu marking triangles (road: %zu)\n",
+        stops, crossings, centres, dividers, clear, markingTriangles, roadTriangles);
 }
 
 // The road meshes follow the lane model through junctions and bends too:
@@ -360,12 +368,8 @@ TEST(OpenDrive, OsmLaneAndSpeedTagsReachTheFile) {
                 EXPECT_NEAR(lane->first("speed")->num("max"), speed, 1e-6) << "road " << e;
             }
         }
-        if (E.lanesForward >= 0) {
-            EXPECT_EQ(right, E.lanesForward) << "road " << e;
-        }
-        if (E.lanesBackward >= 0) {
-            EXPECT_EQ(left, E.lanesBackward) << "road " << e;
-        }
+        if (E.lanesForward >= 0) { EXPECT_EQ(right, E.lanesForward) << "road " << e; }
+        if (E.lanesBackward >= 0) { EXPECT_EQ(left, E.lanesBackward) << "road " << e; }
         oneWay += right == 0 || left == 0;
         ++checked;
     }

@@ -66,7 +66,8 @@ struct NetCheck {
 NetCheck runNetconvert(const std::string& netconvert, const std::string& xodr, const std::string& dir) {
     NetCheck r;
     const std::string net = dir + "/city.net.xml", log = dir + "/netconvert.log";
-    const int st = std::system((netconvert + " --opendrive-files " + xodr + " -o " + net + " >" + log + " 2>&1").c_str());
+    const int st =
+        std::system((netconvert + " --opendrive-files " + xodr + " -o " + net + " >" + log + " 2>&1").c_str());
     r.exitCode = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
     r.log = readBytes(log);
     for (size_t pos = 0; (pos = r.log.find("Error", pos)) != std::string::npos; ++pos)
@@ -184,20 +185,25 @@ void checkNet(const City& city, const std::string& label) {
     }
     EXPECT_EQ(n.roads, roads);
     EXPECT_EQ(n.drivingLanes, lanes);
-    std::printf("[ %s ] roads %zu, transitions %zu, junctions %zu (netconvert %zu), connecting roads %zu, driving lanes %zu, "
-                "traffic lights %zu at %zu junctions (netconvert programs %zu), signs %zu, crosswalks %zu, "
-                "netconvert errors %d\n",
-                label.c_str(), n.roads, n.transitions, n.junctions, netJunctions, n.connectingRoads, n.drivingLanes,
-                n.trafficLights, lit.size(), r.net->all("tlLogic").size(), n.signs, n.crosswalks, r.errors);
+    std::printf(
+        "[ %s ] roads %zu, transitions %zu, junctions %zu (netconvert %zu), connecting roads %zu, driving lanes %zu, "
+        "traffic lights %zu at %zu junctions (netconvert programs %zu), signs %zu, crosswalks %zu, "
+        "netconvert errors %d\n",
+        label.c_str(), n.roads, n.transitions, n.junctions, netJunctions, n.connectingRoads, n.drivingLanes,
+        n.trafficLights, lit.size(), r.net->all("tlLogic").size(), n.signs, n.crosswalks, r.errors);
 }
 
 }  // namespace
 
 TEST(OpenDrive, NetconvertReadsGeneratedCity) { checkNet(generated(smallParams(3, 600, 0)), "generated 600 m seed 3"); }
 
-TEST(OpenDrive, NetconvertReadsHillyCity) { checkNet(generated(smallParams(7, 500, 25)), "generated 500 m seed 7, hills 25 m"); }
+TEST(OpenDrive, NetconvertReadsHillyCity) {
+    checkNet(generated(smallParams(7, 500, 25)), "generated 500 m seed 7, hills 25 m");
+}
 
-TEST(OpenDrive, NetconvertReadsOddLaneCounts) { checkNet(oddLanes(smallParams(5, 400, 0)), "generated 400 m seed 5, odd lane counts"); }
+TEST(OpenDrive, NetconvertReadsOddLaneCounts) {
+    checkNet(oddLanes(smallParams(5, 400, 0)), "generated 400 m seed 5, odd lane counts");
+}
 
 TEST(OpenDrive, NetconvertReadsOsmImport) { checkNet(osmCity("hard_cases.osm"), "osm hard_cases.osm"); }
 

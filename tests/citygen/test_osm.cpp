@@ -88,18 +88,23 @@ TEST(OsmImport, DistancesMatchGeodesicsAtAnyLatitude) {
                     std::abs(vincenty(w.at(spokes[k].first), w.at(spokes[k].second)) - len))
                     k = s;
             const double expected = vincenty(w.at(spokes[k].first), w.at(spokes[k].second));
-            EXPECT_NEAR(len, expected, 1e-4 * expected) << "centre " << c.lat_deg << ", " << c.lon_deg << " spoke " << k;
+            EXPECT_NEAR(len, expected, 1e-4 * expected)
+                << "centre " << c.lat_deg << ", " << c.lon_deg << " spoke " << k;
             const glm::dvec2 a = g.nodes[g.edges[e].a], bb = g.nodes[g.edges[e].b];
             tips[size_t(k)] = glm::length(a) > glm::length(bb) ? a : bb;
         }
         for (int i = 0; i < 12; ++i)
             for (int j = i + 1; j < 12; ++j) {
                 const double expected = vincenty(w.at(spokes[i].second), w.at(spokes[j].second));
-                EXPECT_NEAR(glm::length(tips[i] - tips[j]), expected, 1e-4 * expected) << c.lat_deg << " tips " << i << " " << j;
+                EXPECT_NEAR(glm::length(tips[i] - tips[j]), expected, 1e-4 * expected)
+                    << c.lat_deg << " tips " << i << " " << j;
             }
         // The frame is centred on the bounding box.
         glm::dvec2 lo(1e300), hi(-1e300);
-        for (const auto& n : g.nodes) { lo = glm::min(lo, n); hi = glm::max(hi, n); }
+        for (const auto& n : g.nodes) {
+            lo = glm::min(lo, n);
+            hi = glm::max(hi, n);
+        }
         EXPECT_NEAR(lo.x + hi.x, 0.0, 0.05);
         EXPECT_NEAR(lo.y + hi.y, 0.0, 0.05);
         EXPECT_NEAR(hi.x - lo.x, r->extentX_m, 1e-6);
@@ -141,16 +146,18 @@ TEST(OsmImport, InvalidMissingAndOutlierNodesAreDroppedAndCounted) {
     // Exponent notation within range is fine.
     const GeoPoint expoAt{48.201, 16.371};
     w.way({w.rawNode(R"(lat="4.8201e1" lon="16371e-3")"), w.node(destination(expoAt, 45, 60))});
-    w.way({valid(120, 100), 999999});  // node missing from the file
+    w.way({valid(120, 100), 999999});                               // node missing from the file
     w.way({valid(130, 100), w.node(destination(c, 130, 500000))});  // 500 km away
-    const std::string bounds = R"(  <bounds minlat="-1e300" minlon="16" maxlat="49" maxlon="1e300"/>)" "\n";
+    const std::string bounds = R"(  <bounds minlat="-1e300" minlon="16" maxlat="49" maxlon="1e300"/>)"
+                               "\n";
     auto r = importOsm(w.write(dir, "dirty.osm", bounds), CityParams());
     ASSERT_TRUE(r.isOk()) << r.status().message();
     EXPECT_EQ(r->invalidNodes, 6u);
     EXPECT_EQ(r->missingNodes, 1u);
     EXPECT_EQ(r->outlierNodes, 1u);
-    EXPECT_EQ(r->dropSummary(), "dropped 8 nodes (6 with invalid coordinates, 1 missing from the file, 1 outlier farther than 22.6 km "
-                                "from the median position)");
+    EXPECT_EQ(r->dropSummary(),
+              "dropped 8 nodes (6 with invalid coordinates, 1 missing from the file, 1 outlier farther than 22.6 km "
+              "from the median position)");
     EXPECT_LT(std::max(r->extentX_m, r->extentY_m), 1100);  // the city, not 500 km
     EXPECT_TRUE(checkPlanarGraph(r->streets, CityParams().min_segment_m).isOk());
     // The exponent-notation node is kept: its position is on the graph.
@@ -163,7 +170,7 @@ TEST(OsmImport, InvalidMissingAndOutlierNodesAreDroppedAndCounted) {
 TEST(OsmImport, ExtentBeyondTheLargestCityIsRefused) {
     const double limit = maxCitySize();
     const GeoPoint c{60.17, 24.94};
-    {   // A road leaving the city for a place 1.2 x the limit away: too big, not an outlier.
+    {  // A road leaving the city for a place 1.2 x the limit away: too big, not an outlier.
         test::TempDir dir("vista_osm");
         OsmWriter w;
         w.grid(c, 2000, 3);
@@ -179,7 +186,7 @@ TEST(OsmImport, ExtentBeyondTheLargestCityIsRefused) {
         EXPECT_NE(m.find(" km east-west by 2.01 km north-south"), std::string::npos) << m;
         EXPECT_NE(m.find("size_m up to " + std::to_string(int(limit)) + " m"), std::string::npos) << m;
     }
-    {   // The same place 2 x the limit away is an outlier (> sqrt(2) x limit): dropped, the city stays.
+    {  // The same place 2 x the limit away is an outlier (> sqrt(2) x limit): dropped, the city stays.
         test::TempDir dir("vista_osm");
         OsmWriter w;
         w.grid(c, 2000, 3);
@@ -189,7 +196,7 @@ TEST(OsmImport, ExtentBeyondTheLargestCityIsRefused) {
         EXPECT_EQ(r->outlierNodes, 1u);
         EXPECT_NEAR(r->extentX_m, 2000 * 1.0036, 3);
     }
-    {   // Evenly spread roads wider than the limit: refused (nothing is an outlier).
+    {  // Evenly spread roads wider than the limit: refused (nothing is an outlier).
         test::TempDir dir("vista_osm");
         OsmWriter w;
         w.grid(c, 1.1 * limit, 3);
@@ -249,7 +256,8 @@ TEST(OsmImport, LongZigzagWaysAreBounded) {
     auto r = importOsm(w.write(dir, "zigzag.osm"), CityParams());
     ASSERT_TRUE(r.isOk()) << r.status().message();
     EXPECT_EQ(r->tangledWays, 1u);
-    EXPECT_NE(r->dropSummary().find("dropped 1 way crossing itself more than 16 times"), std::string::npos) << r->dropSummary();
+    EXPECT_NE(r->dropSummary().find("dropped 1 way crossing itself more than 16 times"), std::string::npos)
+        << r->dropSummary();
     ASSERT_EQ(r->streets.edges.size(), gridEdges);
     for (size_t i = 0; i < r->streets.nodes.size(); ++i)  // same graph (the frame may differ by < 2 cm of rounding)
         EXPECT_LT(glm::length(r->streets.nodes[i] - plain->streets.nodes[i]), 0.02);
@@ -258,7 +266,8 @@ TEST(OsmImport, LongZigzagWaysAreBounded) {
     // wide) is simplified and snapped to a bounded graph.
     OsmWriter dense = base;
     std::vector<int64_t> saw;
-    for (int i = 0; i < 5000; ++i) saw.push_back(dense.node(destination(destination(c, 0, -250 + 0.1 * i), 90, (i % 2) ? 40 : -40)));
+    for (int i = 0; i < 5000; ++i)
+        saw.push_back(dense.node(destination(destination(c, 0, -250 + 0.1 * i), 90, (i % 2) ? 40 : -40)));
     dense.way(saw);
     r = importOsm(dense.write(dir, "saw.osm"), CityParams());
     ASSERT_TRUE(r.isOk()) << r.status().message();
@@ -300,16 +309,13 @@ TEST(OsmImport, SimplificationKeepsJunctionsAndShape) {
     for (size_t i = 0; i < r->streets.nodes.size(); ++i) {
         const glm::dvec2 n = r->streets.nodes[i];
         if (glm::length(n - junction) < 0.01) junctionFound = deg[i] == 3;
-        if (glm::length(n - centre) > 200) {
-            EXPECT_NEAR(glm::length(n - centre), 300.0, 0.05);
-        }
+        if (glm::length(n - centre) > 200) { EXPECT_NEAR(glm::length(n - centre), 300.0, 0.05); }
     }
     EXPECT_TRUE(junctionFound);
     for (size_t e = 0; e < r->streets.edges.size(); ++e) {
-        const glm::dvec2 mid = 0.5 * (r->streets.nodes[r->streets.edges[e].a] + r->streets.nodes[r->streets.edges[e].b]);
-        if (glm::length(mid - centre) > 200) {
-            EXPECT_GT(glm::length(mid - centre), 300.0 - 0.6);
-        }
+        const glm::dvec2 mid =
+            0.5 * (r->streets.nodes[r->streets.edges[e].a] + r->streets.nodes[r->streets.edges[e].b]);
+        if (glm::length(mid - centre) > 200) { EXPECT_GT(glm::length(mid - centre), 300.0 - 0.6); }
     }
 }
 

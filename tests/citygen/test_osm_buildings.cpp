@@ -33,11 +33,13 @@ TEST(OsmGen, GeoReferenceReachesSceneAndGeoJsonAndDropsAreReported) {
     w.way({w.node(destination(c, 0, 150)), w.rawNode(R"(lat="-16.8" lon="1e300")"), w.node(destination(c, 10, 180))});
     const std::string osm = w.write(dir, "fiji.osm");
     auto run = [&](const std::string& args) {
-        const std::string cmd = std::string(VISTA_BINARY) + " gen " + args + " 2>" + dir.file("err.txt") + " >/dev/null";
+        const std::string cmd =
+            std::string(VISTA_BINARY) + " gen " + args + " 2>" + dir.file("err.txt") + " >/dev/null";
         const int st = std::system(cmd.c_str());
         return std::make_pair(WIFEXITED(st) ? WEXITSTATUS(st) : -1, test::readBytes(dir.file("err.txt")));
     };
-    auto [code, err] = run("--osm " + osm + " --size 500 --detail 0 -q -o " + dir.file("c.osgb") + " --geojson " + dir.file("s.geojson"));
+    auto [code, err] = run("--osm " + osm + " --size 500 --detail 0 -q -o " + dir.file("c.osgb") + " --geojson " +
+                           dir.file("s.geojson"));
     ASSERT_EQ(code, 0) << err;
     EXPECT_NE(err.find("osm: dropped 1 node (1 with invalid coordinates)"), std::string::npos) << err;
     // The scene stores the geo reference with the parameters.
@@ -50,7 +52,8 @@ TEST(OsmGen, GeoReferenceReachesSceneAndGeoJsonAndDropsAreReported) {
     for (const auto& f : j["features"]) {
         const bool multi = f["geometry"]["type"] == "MultiLineString";
         cut += multi;
-        for (const auto& line : multi ? f["geometry"]["coordinates"] : nlohmann::json::array({f["geometry"]["coordinates"]}))
+        for (const auto& line :
+             multi ? f["geometry"]["coordinates"] : nlohmann::json::array({f["geometry"]["coordinates"]}))
             for (const auto& p : line) {
                 EXPECT_NEAR(p[1].get<double>(), -16.8, 0.01);
                 EXPECT_GT(std::abs(p[0].get<double>()), 179.99);
@@ -187,7 +190,8 @@ TEST(OsmBuildings, FixtureImportsRepairsAndSkipsPerReason) {
     EXPECT_EQ(s.selfIntersecting, 0u);
     EXPECT_EQ(s.outsideCity, 0u);
     EXPECT_EQ(s.noOuterRing, 0u);
-    EXPECT_EQ(s.candidates, s.imported + s.missingNodes + s.tooSmall + s.tooFewNodes + s.selfIntersecting + s.outsideCity + s.noOuterRing);
+    EXPECT_EQ(s.candidates, s.imported + s.missingNodes + s.tooSmall + s.tooFewNodes + s.selfIntersecting +
+                                s.outsideCity + s.noOuterRing);
     // Every footprint simple and counter-clockwise; holes clockwise, strictly inside.
     size_t withHoles = 0;
     for (const auto& f : r->buildings) {
@@ -223,9 +227,13 @@ TEST(OsmBuildings, HeightsAndRoofsFollowTheTags) {
     const City& c = oc.city;
     const double storey = c.params.floor_height_m;
     auto top = [](const Building& b) { return b.height + b.roof_height; };
-    struct Want { int64_t id; double top; };
+    struct Want {
+        int64_t id;
+        double top;
+    };
     // Total heights from `height` (metres, "m" suffix, feet): independent of the parser.
-    for (const Want& w : {Want{200, 12.0}, Want{203, 12.5}, Want{205, 40 * 0.3048}, Want{214, 6.0}, Want{300, 15.0}, Want{202, 9.0}}) {
+    for (const Want& w :
+         {Want{200, 12.0}, Want{203, 12.5}, Want{205, 40 * 0.3048}, Want{214, 6.0}, Want{300, 15.0}, Want{202, 9.0}}) {
         const Building* b = byOsmId(c, w.id);
         ASSERT_NE(b, nullptr) << w.id;
         EXPECT_NEAR(top(*b), w.top, 1e-9) << w.id;
@@ -278,7 +286,8 @@ TEST(OsmBuildings, CourtyardStaysOpen) {
         const Mesh& m = t.meshes[size_t(Material::Roof)];
         for (size_t k = 0; k + 2 < m.indices.size(); k += 3) {
             Polygon2 tri;
-            for (int v = 0; v < 3; ++v) tri.push_back(glm::dvec2(t.origin) + glm::dvec2(m.positions[m.indices[k + size_t(v)]]));
+            for (int v = 0; v < 3; ++v)
+                tri.push_back(glm::dvec2(t.origin) + glm::dvec2(m.positions[m.indices[k + size_t(v)]]));
             ++roofTris;
             if (std::abs(signedArea(tri)) < 1e-9) continue;
             EXPECT_FALSE(pointInPolygon(tri, yard));
@@ -333,8 +342,8 @@ TEST(OsmBuildings, NoProceduralBuildingOverlapsAnImportedOne) {
 TEST(OsmGen, BuildingsAreDeterministicCountedAndCanBeTurnedOff) {
     test::TempDir dir("vista_osm_buildings");
     auto run = [&](const std::string& args) {
-        const std::string cmd = std::string(VISTA_BINARY) + " gen --osm " + fixture("buildings.osm") + " --size 800 " + args +
-                                " 2>" + dir.file("err.txt") + " >/dev/null";
+        const std::string cmd = std::string(VISTA_BINARY) + " gen --osm " + fixture("buildings.osm") + " --size 800 " +
+                                args + " 2>" + dir.file("err.txt") + " >/dev/null";
         const int st = std::system(cmd.c_str());
         return std::make_pair(WIFEXITED(st) ? WEXITSTATUS(st) : -1, test::readBytes(dir.file("err.txt")));
     };
@@ -395,7 +404,8 @@ TEST(FootprintRepair, RandomRingsGiveSimpleCounterClockwiseRingsOrNothing) {
         // Every vertex of the result is an input vertex or lies on an input edge (a split point).
         for (const auto& q : r) {
             double best = 1e300;
-            for (size_t i = 0; i < ring.size(); ++i) best = std::min(best, pointSegmentDistance(q, ring[i], ring[(i + 1) % ring.size()]));
+            for (size_t i = 0; i < ring.size(); ++i)
+                best = std::min(best, pointSegmentDistance(q, ring[i], ring[(i + 1) % ring.size()]));
             EXPECT_LT(best, 1e-9) << k;
         }
     }

@@ -60,7 +60,8 @@ TEST(OsmRoadTags, LaneCountsOnewayAndTurnLanesParse) {
     EXPECT_EQ(parseOsmOneway("reverse"), OsmOneway::Backward);
     EXPECT_EQ(parseOsmOneway("no"), OsmOneway::No);
     EXPECT_EQ(parseOsmOneway("false"), OsmOneway::No);
-    for (const char* bad : {"", "maybe", "reversible", "alternating", "YES"}) EXPECT_FALSE(parseOsmOneway(bad).has_value()) << bad;
+    for (const char* bad : {"", "maybe", "reversible", "alternating", "YES"})
+        EXPECT_FALSE(parseOsmOneway(bad).has_value()) << bad;
 
     auto t = parseOsmTurnLanes("left|through;right");
     ASSERT_TRUE(t.has_value());
@@ -73,7 +74,8 @@ TEST(OsmRoadTags, LaneCountsOnewayAndTurnLanesParse) {
     t = parseOsmTurnLanes("|");  // two lanes without markings
     ASSERT_TRUE(t.has_value());
     EXPECT_EQ(t->lanes, 2);
-    for (const char* bad : {"", " ", "left|up", "left;;right", "Left", "l|l|l|l|l|l|l|l|l", "left|through|through|through|through|through|through|through|right"})
+    for (const char* bad : {"", " ", "left|up", "left;;right", "Left", "l|l|l|l|l|l|l|l|l",
+                            "left|through|through|through|through|through|through|through|right"})
         EXPECT_FALSE(parseOsmTurnLanes(bad).has_value()) << bad;
 }
 
@@ -100,8 +102,8 @@ TEST(OsmRoadTags, MaxspeedUnitsWordsAndCountryCodes) {
     // Clamped to [5, 250].
     EXPECT_TRUE(near(parseOsmMaxspeed("2"), kMinMaxspeedKmh));
     EXPECT_TRUE(near(parseOsmMaxspeed("1000"), kMaxMaxspeedKmh));
-    for (const char* bad : {"", "0", "signals", "variable", "fast", "50;30", "50 km", "-30", "XX:urban", "de:urban", "DE:school",
-                            "DE:trunk", "DE:zone", "1e3", "50..5"})
+    for (const char* bad : {"", "0", "signals", "variable", "fast", "50;30", "50 km", "-30", "XX:urban", "de:urban",
+                            "DE:school", "DE:trunk", "DE:zone", "1e3", "50..5"})
         EXPECT_FALSE(parseOsmMaxspeed(bad).has_value()) << bad;
 }
 
@@ -121,7 +123,7 @@ TEST(OsmRoadTags, DirectionsAndLaneCountsResolve) {
     t = read({{"lanes", "2"}, {"lanes:forward", "3"}});
     EXPECT_EQ(t.lanesForward, 3);
     EXPECT_EQ(t.lanesBackward, 1);
-    EXPECT_EQ(t.lanes, 2);  // the tagged total stays the total
+    EXPECT_EQ(t.lanes, 2);                                     // the tagged total stays the total
     t = read({{"lanes:backward", "2"}}, RoadClass::Arterial);  // forward: the derived split of the class total 4
     EXPECT_EQ(t.lanesForward, 2);
     EXPECT_EQ(t.lanesBackward, 2);
@@ -168,7 +170,8 @@ TEST(OsmRoadTags, DirectionsAndLaneCountsResolve) {
 TEST(OsmRoadTags, UnusableValuesFallBackAndAreCounted) {
     OsmRoadTagStats st;
     // Turn lanes whose count contradicts the lane count, turn:lanes on a two-way road.
-    OsmRoadTags t = read({{"oneway", "yes"}, {"lanes", "2"}, {"turn:lanes", "left|through|right"}}, RoadClass::Local, st);
+    OsmRoadTags t =
+        read({{"oneway", "yes"}, {"lanes", "2"}, {"turn:lanes", "left|through|right"}}, RoadClass::Local, st);
     EXPECT_EQ(t.lanesForward, 2);
     EXPECT_EQ(t.turnForward, "");
     t = read({{"turn:lanes", "left|through"}, {"lanes", "2"}}, RoadClass::Local, st);
@@ -185,8 +188,9 @@ TEST(OsmRoadTags, UnusableValuesFallBackAndAreCounted) {
     EXPECT_EQ(st.turnLanesBackward.fallback, 1u);
     // Invalid values: class defaults, each counted.
     OsmRoadTagStats bad;
-    t = read({{"oneway", "reversible"}, {"lanes", "0"}, {"maxspeed", "signals"}, {"width", "0.2"}, {"lanes:forward", "x"}},
-             RoadClass::Local, bad);
+    t = read(
+        {{"oneway", "reversible"}, {"lanes", "0"}, {"maxspeed", "signals"}, {"width", "0.2"}, {"lanes:forward", "x"}},
+        RoadClass::Local, bad);
     EXPECT_EQ(t.lanes, 0);
     EXPECT_EQ(t.lanesForward, -1);
     EXPECT_EQ(t.lanesBackward, -1);
@@ -249,7 +253,8 @@ TEST(OsmRoadTags, FixtureEdgesCarryTheirWaysTagsInTheirDirection) {
         const glm::dvec2 a = g.nodes[e.a], b = g.nodes[e.b], mid = 0.5 * (a + b);
         const WayExpect* w = nullptr;
         for (const auto& x : kLanesWays)
-            if (pointLineDistance(mid, x.p, x.q) < 1.0 && pointLineDistance(a, x.p, x.q) < 1.0 && pointLineDistance(b, x.p, x.q) < 1.0)
+            if (pointLineDistance(mid, x.p, x.q) < 1.0 && pointLineDistance(a, x.p, x.q) < 1.0 &&
+                pointLineDistance(b, x.p, x.q) < 1.0)
                 w = &x;
         ASSERT_NE(w, nullptr) << "edge at (" << mid.x << ", " << mid.y << ") lies on no way of the fixture";
         ++pieces[w->name];
@@ -280,8 +285,9 @@ TEST(OsmRoadTags, FixtureEdgesCarryTheirWaysTagsInTheirDirection) {
 
 TEST(OsmRoadTags, StatsReportTagUseAndFallbacks) {
     test::TempDir dir("vista_osm_lanes");
-    const std::string cmd = std::string(VISTA_BINARY) + " gen --osm " + fixture("lanes.osm") + " --size 600 --detail 0 -q -o " +
-                            dir.file("c.osgb") + " --stats " + dir.file("s.json") + " 2>" + dir.file("err.txt");
+    const std::string cmd = std::string(VISTA_BINARY) + " gen --osm " + fixture("lanes.osm") +
+                            " --size 600 --detail 0 -q -o " + dir.file("c.osgb") + " --stats " + dir.file("s.json") +
+                            " 2>" + dir.file("err.txt");
     const int status = std::system(cmd.c_str());
     ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << test::readBytes(dir.file("err.txt"));
     const auto j = nlohmann::json::parse(test::readBytes(dir.file("s.json")));
@@ -293,24 +299,24 @@ TEST(OsmRoadTags, StatsReportTagUseAndFallbacks) {
         EXPECT_EQ(t[tag]["used"], used) << tag;
         EXPECT_EQ(t[tag]["fallback"], fallback) << tag;
     };
-    use("lanes", 4, 1);                // 100, 103, 105, 108; "two"
-    use("lanes:forward", 2, 0);        // 100, 102
-    use("lanes:backward", 2, 1);       // 100, 102; on the one-way 108
-    use("oneway", 3, 1);               // 103, 104, 108; "maybe"
+    use("lanes", 4, 1);                    // 100, 103, 105, 108; "two"
+    use("lanes:forward", 2, 0);            // 100, 102
+    use("lanes:backward", 2, 1);           // 100, 102; on the one-way 108
+    use("oneway", 3, 1);                   // 103, 104, 108; "maybe"
     EXPECT_EQ(t["oneway"]["implied"], 1);  // the motorway
-    use("turn:lanes", 1, 0);           // 104
-    use("turn:lanes:forward", 2, 1);   // 100, 102; "left|up"
-    use("turn:lanes:backward", 1, 0);  // 102
-    use("maxspeed", 6, 1);             // all but 107 ("signals")
-    use("width", 2, 1);                // 100, 104; "wide"
+    use("turn:lanes", 1, 0);               // 104
+    use("turn:lanes:forward", 2, 1);       // 100, 102; "left|up"
+    use("turn:lanes:backward", 1, 0);      // 102
+    use("maxspeed", 6, 1);                 // all but 107 ("signals")
+    use("width", 2, 1);                    // 100, 104; "wide"
     EXPECT_EQ(o["class_default"]["lanes"], 1);
     EXPECT_EQ(o["class_default"]["maxspeed"], 1);
     EXPECT_EQ(o["class_default"]["width"], 5);
     EXPECT_EQ(o["edges"]["matched"], j["street_edges"]);
     EXPECT_EQ(o["edges"]["unmatched"], 0);
     // A generated city reports no osm_roads.
-    const std::string gen = std::string(VISTA_BINARY) + " gen --size 400 --detail 0 -q -o " + dir.file("g.osgb") + " --stats " +
-                            dir.file("g.json") + " 2>" + dir.file("err.txt");
+    const std::string gen = std::string(VISTA_BINARY) + " gen --size 400 --detail 0 -q -o " + dir.file("g.osgb") +
+                            " --stats " + dir.file("g.json") + " 2>" + dir.file("err.txt");
     ASSERT_EQ(std::system(gen.c_str()), 0) << test::readBytes(dir.file("err.txt"));
     EXPECT_FALSE(nlohmann::json::parse(test::readBytes(dir.file("g.json"))).contains("osm_roads"));
 }
@@ -319,13 +325,14 @@ namespace {
 
 // An .osm text: nodes 1..n at `pts` (metres about 48.21 N, 16.36 E), then ways of node ids and
 // their tags as written XML ("<tag .../>...").
-std::string osmText(const std::vector<glm::dvec2>& pts, const std::vector<std::pair<std::vector<int>, std::string>>& ways) {
+std::string osmText(const std::vector<glm::dvec2>& pts,
+                    const std::vector<std::pair<std::vector<int>, std::string>>& ways) {
     const double lat0 = 48.21, mLat = 1.0 / 111132.0, mLon = 1.0 / (111320.0 * std::cos(lat0 * 3.14159265358979 / 180));
     std::string xml = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<osm version=\"0.6\" generator=\"vista-test\">\n";
     for (size_t i = 0; i < pts.size(); ++i) {
         char buf[160];
-        std::snprintf(buf, sizeof buf, "  <node id=\"%zu\" lat=\"%.7f\" lon=\"%.7f\"/>\n", i + 1, lat0 + pts[i].y * mLat,
-                      16.36 + pts[i].x * mLon);
+        std::snprintf(buf, sizeof buf, "  <node id=\"%zu\" lat=\"%.7f\" lon=\"%.7f\"/>\n", i + 1,
+                      lat0 + pts[i].y * mLat, 16.36 + pts[i].x * mLon);
         xml += buf;
     }
     for (size_t w = 0; w < ways.size(); ++w) {
@@ -347,10 +354,12 @@ Result<OsmImport> importText(const std::string& xml) {
 TEST(OsmRoadTags, OppositeOneWaysMergedIntoOneEdgeGiveOneDirectionEach) {
     // A dual carriageway 8 m wide: two one-way ways sharing their end nodes, closer than the snap
     // radius, so planarization merges them into single edges.
-    auto imp = importText(osmText({{-200, 0}, {-100, 4}, {100, 4}, {200, 0}, {100, -4}, {-100, -4}},
-                                  {{{1, 2, 3, 4}, R"(<tag k="highway" v="primary"/><tag k="oneway" v="yes"/><tag k="lanes" v="2"/>)"
-                                                  R"(<tag k="turn:lanes" v="through|right"/>)"},
-                                   {{4, 5, 6, 1}, R"(<tag k="highway" v="primary"/><tag k="oneway" v="yes"/><tag k="lanes" v="1"/>)"}}));
+    auto imp = importText(
+        osmText({{-200, 0}, {-100, 4}, {100, 4}, {200, 0}, {100, -4}, {-100, -4}},
+                {{{1, 2, 3, 4},
+                  R"(<tag k="highway" v="primary"/><tag k="oneway" v="yes"/><tag k="lanes" v="2"/>)"
+                  R"(<tag k="turn:lanes" v="through|right"/>)"},
+                 {{4, 5, 6, 1}, R"(<tag k="highway" v="primary"/><tag k="oneway" v="yes"/><tag k="lanes" v="1"/>)"}}));
     ASSERT_TRUE(imp.isOk()) << imp.status().message();
     const StreetGraph& g = imp->streets;
     ASSERT_FALSE(g.edges.empty());
@@ -369,15 +378,17 @@ TEST(OsmRoadTags, OppositeOneWaysMergedIntoOneEdgeGiveOneDirectionEach) {
 TEST(OsmRoadTags, ShortEdgeAtAJunctionKeepsItsOwnWayNotTheCrossingOne) {
     // One-way A runs east through a junction, bending 15 m after it; one-way B crosses at the
     // junction at 63 degrees, its part near that 15 m piece running the other way along x.
-    auto imp = importText(osmText({{-100, 0}, {0, 0}, {15, 0}, {100, 10}, {40, -80}, {-40, 80}},
-                                  {{{1, 2, 3, 4}, R"(<tag k="highway" v="residential"/><tag k="oneway" v="yes"/><tag k="maxspeed" v="30"/>)"},
-                                   {{5, 2, 6}, R"(<tag k="highway" v="residential"/><tag k="oneway" v="yes"/><tag k="lanes" v="2"/>)"}}));
+    auto imp = importText(osmText(
+        {{-100, 0}, {0, 0}, {15, 0}, {100, 10}, {40, -80}, {-40, 80}},
+        {{{1, 2, 3, 4}, R"(<tag k="highway" v="residential"/><tag k="oneway" v="yes"/><tag k="maxspeed" v="30"/>)"},
+         {{5, 2, 6}, R"(<tag k="highway" v="residential"/><tag k="oneway" v="yes"/><tag k="lanes" v="2"/>)"}}));
     ASSERT_TRUE(imp.isOk()) << imp.status().message();
     const StreetGraph& g = imp->streets;
     int found = 0;
     for (const auto& e : g.edges) {
         const glm::dvec2 a = g.nodes[e.a], b = g.nodes[e.b];
-        if (pointLineDistance(a, {40, -80}, {-40, 80}) < 1 && pointLineDistance(b, {40, -80}, {-40, 80}) < 1) continue;  // way B
+        if (pointLineDistance(a, {40, -80}, {-40, 80}) < 1 && pointLineDistance(b, {40, -80}, {-40, 80}) < 1)
+            continue;  // way B
         ++found;
         const bool eastward = b.x > a.x;
         EXPECT_EQ(int(e.lanesForward), eastward ? 1 : 0);
@@ -420,7 +431,8 @@ TEST(OsmRoadTags, GraphJsonRoundTripsTheFieldsAndRefusesBadValues) {
     EXPECT_EQ(six, g.edges.size() - 2);
 
     const std::string head = R"({"nodes":[[0,0],[100,0]],"edges":[[0,1,2,7.5,3,)";
-    auto ok = streetGraphFromJson(head + R"({"forward":2,"backward":1,"maxspeed":50,"turn_forward":"left|through"}]]})");
+    auto ok =
+        streetGraphFromJson(head + R"({"forward":2,"backward":1,"maxspeed":50,"turn_forward":"left|through"}]]})");
     ASSERT_TRUE(ok.isOk()) << ok.status().message();
     EXPECT_EQ(ok->edges[0].lanesForward, 2);
     EXPECT_EQ(ok->edges[0].turnForward, "left|through");

@@ -145,7 +145,8 @@ TEST(GrowStreets, CentreStableWhenSizeGrows) {
                 for (int dy = -1; dy <= 1; ++dy) {
                     auto it = bigNodes.find({std::llround(p.x) + dx, std::llround(p.y) + dy});
                     if (it == bigNodes.end()) continue;
-                    for (auto q : it->second) if (glm::length(q - p) < 1.0) return q;
+                    for (auto q : it->second)
+                        if (glm::length(q - p) < 1.0) return q;
                 }
             return glm::dvec2(1e18);
         };
@@ -178,15 +179,17 @@ TEST(Planarize, RandomSoupsMatchBruteForce) {
             glm::dvec2 b(rng.uniform(-200, 200), rng.uniform(-200, 200));
             segs.push_back({a, b, RoadClass(uint8_t(rng.range(0, 2)))});
             int kind = int(rng.range(0, 5));
-            if (kind == 0) segs.push_back({a + 0.3 * (b - a), b + 0.4 * (b - a), RoadClass::Local});  // collinear overlap
-            if (kind == 1) segs.push_back({a + glm::dvec2(1e-3, -1e-3), b + glm::dvec2(rng.uniform(-5, 5), 3), RoadClass::Local});
+            if (kind == 0)
+                segs.push_back({a + 0.3 * (b - a), b + 0.4 * (b - a), RoadClass::Local});  // collinear overlap
+            if (kind == 1)
+                segs.push_back({a + glm::dvec2(1e-3, -1e-3), b + glm::dvec2(rng.uniform(-5, 5), 3), RoadClass::Local});
             if (kind == 2) {  // tiny-angle crossing (~0.5 degrees) through the midpoint
                 glm::dvec2 m = 0.5 * (a + b), d = b - a;
                 double ang = 0.5 * 3.14159265358979 / 180.0;
                 glm::dvec2 r(d.x * std::cos(ang) - d.y * std::sin(ang), d.x * std::sin(ang) + d.y * std::cos(ang));
                 segs.push_back({m - 0.5 * r, m + 0.5 * r, RoadClass::Arterial});
             }
-            if (kind == 3) segs.push_back({a, a, RoadClass::Local});  // zero length
+            if (kind == 3) segs.push_back({a, a, RoadClass::Local});    // zero length
             if (kind == 4) segs.push_back({b, a, RoadClass::Highway});  // exact duplicate reversed
         }
         const double snap = trial % 3 == 0 ? 0.0 : 2.0, minSeg = trial % 2 ? 1.0 : 5.0;
@@ -250,16 +253,14 @@ TEST(StreetGraphJson, RoundTripAndCorruptRejected) {
     ASSERT_EQ(r.value().nodes.size(), g.nodes.size());
     for (size_t i = 0; i < g.nodes.size(); ++i) EXPECT_EQ(r.value().nodes[i], g.nodes[i]);
 
-    for (const char* bad : {"", "{", "[]", "{\"nodes\":[]}", "{\"nodes\":[[0,0]],\"edges\":[[0,0,2,7.5,2]]}",
-                            "{\"nodes\":[[0,0],[1,1]],\"edges\":[[0,5,2,7.5,2]]}",
-                            "{\"nodes\":[[0,0],[1,1]],\"edges\":[[0,1,9,7.5,2]]}",
-                            "{\"nodes\":[[0,\"x\"]],\"edges\":[]}", "{\"nodes\":[[0,0],[1,1]],\"edges\":[[0,1,2,-1,2]]}",
-                            "{\"nodes\":[[0,0],[1,1]],\"edges\":[[0,1,2,7.5]]}"}) {
+    for (const char* bad :
+         {"", "{", "[]", "{\"nodes\":[]}", "{\"nodes\":[[0,0]],\"edges\":[[0,0,2,7.5,2]]}",
+          "{\"nodes\":[[0,0],[1,1]],\"edges\":[[0,5,2,7.5,2]]}", "{\"nodes\":[[0,0],[1,1]],\"edges\":[[0,1,9,7.5,2]]}",
+          "{\"nodes\":[[0,\"x\"]],\"edges\":[]}", "{\"nodes\":[[0,0],[1,1]],\"edges\":[[0,1,2,-1,2]]}",
+          "{\"nodes\":[[0,0],[1,1]],\"edges\":[[0,1,2,7.5]]}"}) {
         auto rb = streetGraphFromJson(bad);
         EXPECT_FALSE(rb.isOk()) << bad;
-        if (!rb.isOk()) {
-            EXPECT_FALSE(rb.status().message().empty());
-        }
+        if (!rb.isOk()) { EXPECT_FALSE(rb.status().message().empty()); }
     }
     // Truncations of a real graph never crash and are rejected.
     for (size_t cut : {size_t(1), text.size() / 3, text.size() / 2, text.size() - 1}) {

@@ -96,7 +96,8 @@ TEST(TrafficSignals, EverySignalStandsInOneTileFacingItsTraffic) {
         const auto [t, m] = seen[id][0];
         EXPECT_EQ(m, mat) << i;
         const Tile& tile = city.tiles[t];
-        EXPECT_EQ(tile.iy * grid.countX() + tile.ix, grid.tileOf(s.position)) << "signal " << i << ": the tile of its pole";
+        EXPECT_EQ(tile.iy * grid.countX() + tile.ix, grid.tileOf(s.position))
+            << "signal " << i << ": the tile of its pole";
         const std::vector<Tri> tris = trianglesOf(tile.meshes[size_t(mat)], tile.origin, id);
         ASSERT_FALSE(tris.empty()) << i;
 
@@ -112,7 +113,8 @@ TEST(TrafficSignals, EverySignalStandsInOneTileFacingItsTraffic) {
                 highest = std::max(highest, p.z);
                 if (p.z < ground + headBottom - 0.01) {
                     ++below;
-                    EXPECT_LT(glm::length(glm::dvec2(p) - s.position), 0.5 * kSignalPoleWidth * std::sqrt(2.0) + 1e-3) << i;
+                    EXPECT_LT(glm::length(glm::dvec2(p) - s.position), 0.5 * kSignalPoleWidth * std::sqrt(2.0) + 1e-3)
+                        << i;
                 }
             }
         EXPECT_GT(below, 4) << "signal " << i << " has a pole";
@@ -136,7 +138,8 @@ TEST(TrafficSignals, EverySignalStandsInOneTileFacingItsTraffic) {
         }
         ASSERT_GT(headArea, 0) << i;
         headCentre /= headArea;
-        EXPECT_GT(glm::dot(headCentre - base, f), 0.5 * kSignalPoleWidth) << "signal " << i << ": head in front of the pole";
+        EXPECT_GT(glm::dot(headCentre - base, f), 0.5 * kSignalPoleWidth)
+            << "signal " << i << ": head in front of the pole";
         double frontArea = 0;
         for (const Tri& tr : tris) {
             const glm::dvec3 c = tr.centroid();
@@ -155,9 +158,9 @@ TEST(TrafficSignals, EverySignalStandsInOneTileFacingItsTraffic) {
         for (const Tri& tr : tris)
             if (tr.centroid().z >= ground + headBottom - 0.01 && glm::dot(glm::normalize(tr.cross()), f) > 0.9)
                 facingArea += 0.5 * glm::length(tr.cross());
-        const double plate = light ? kTrafficLightWidth * kTrafficLightHeight
-                                   : s.kind == SignalPlacement::Kind::Stop ? 2 * kSignSize * kSignSize * std::tan(kPi / 8)
-                                                                          : std::sqrt(3.0) / 4 * kSignSize * kSignSize;
+        const double plate = light                                   ? kTrafficLightWidth * kTrafficLightHeight
+                             : s.kind == SignalPlacement::Kind::Stop ? 2 * kSignSize * kSignSize * std::tan(kPi / 8)
+                                                                     : std::sqrt(3.0) / 4 * kSignSize * kSignSize;
         EXPECT_GT(facingArea, 0.99 * plate) << "signal " << i;
     }
 }

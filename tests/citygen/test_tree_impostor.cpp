@@ -49,7 +49,7 @@ TEST(TreeImpostor, AtlasIsDeterministicAndIndependentOfThreadCount) {
 bool inTriangle(const glm::dvec2& p, const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c) {
     auto cross = [](const glm::dvec2& u, const glm::dvec2& v) { return u.x * v.y - u.y * v.x; };
     const double d1 = cross(b - a, p - a), d2 = cross(c - b, p - b), d3 = cross(a - c, p - c);
-    const bool neg = d1 < 0 || d2 < 0 || d3 < 0, pos = d1 > 0 || d2 > 0 || d3 > 0;
+    const bool neg = d1 < 0 || d2 < 0 || d3<0, pos = d1> 0 || d2 > 0 || d3 > 0;
     return !(neg && pos);
 }
 
@@ -102,9 +102,11 @@ TEST(TreeImpostor, CoverageMatchesProjectedTriangles) {
                 for (int x = 0; x < cellPx; ++x) {
                     const uint8_t a = imp.atlas[(size_t(cy + y) * W + size_t(cx + x)) * 4 + 3];
                     alpha += a;
-                    const bool border = x < kImpostorPadPixels || y < kImpostorPadPixels || x >= cellPx - kImpostorPadPixels ||
-                                        y >= cellPx - kImpostorPadPixels;
-                    if (border) { EXPECT_EQ(a, 0) << "padding texel " << x << "," << y << " of cell " << cell << " is covered"; }
+                    const bool border = x < kImpostorPadPixels || y < kImpostorPadPixels ||
+                                        x >= cellPx - kImpostorPadPixels || y >= cellPx - kImpostorPadPixels;
+                    if (border) {
+                        EXPECT_EQ(a, 0) << "padding texel " << x << "," << y << " of cell " << cell << " is covered";
+                    }
                 }
             const double measured = alpha / 255.0 / (double(inner) * inner);
             EXPECT_NEAR(measured, expected, 0.015) << "prototype " << pi << " cell " << cell;
@@ -130,7 +132,7 @@ TEST(TreeImpostor, QuadsHaveThePrototypesHeightAndWidth) {
         ASSERT_EQ(imp.positions.size(), size_t(4 * kImpostorCells));
         double qz0 = 1e30, qz1 = -1e30;
         for (int q = 0; q < kImpostorVerticalQuads; ++q) {
-            const glm::vec3 *c = &imp.positions[size_t(4 * q)];
+            const glm::vec3* c = &imp.positions[size_t(4 * q)];
             EXPECT_NEAR(glm::distance(glm::dvec2(c[0]), glm::dvec2(c[1])), 2 * R, 1e-4) << "quad " << q << " width";
             EXPECT_NEAR(std::abs(double(c[2].z) - c[1].z), z1 - z0, 1e-4) << "quad " << q << " height";
             for (int k = 0; k < 4; ++k) {
@@ -160,8 +162,8 @@ TEST(TreeImpostor, EmptyMeshGivesNoQuads) {
     EXPECT_TRUE(imp.empty());
     EXPECT_TRUE(std::all_of(imp.atlas.begin(), imp.atlas.end(), [](uint8_t b) { return b == 0; }));
     // A flat (zero-height) mesh: no quads either.
-    const TreeImpostor flat = makeTreeImpostor({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {glm::u8vec4(255), glm::u8vec4(255), glm::u8vec4(255)},
-                                               {0, 1, 2});
+    const TreeImpostor flat = makeTreeImpostor({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}},
+                                               {glm::u8vec4(255), glm::u8vec4(255), glm::u8vec4(255)}, {0, 1, 2});
     EXPECT_TRUE(flat.empty());
 }
 

@@ -91,12 +91,14 @@ bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y
 
 // Area of triangle t of a mesh.
 double triArea(const Mesh& m, size_t t) {
-    glm::dvec3 a(m.positions[m.indices[3 * t]]), b(m.positions[m.indices[3 * t + 1]]), c(m.positions[m.indices[3 * t + 2]]);
+    glm::dvec3 a(m.positions[m.indices[3 * t]]), b(m.positions[m.indices[3 * t + 1]]),
+        c(m.positions[m.indices[3 * t + 2]]);
     return 0.5 * glm::length(glm::cross(b - a, c - a));
 }
 // Area projected on the ground plane.
 double triAreaXY(const Mesh& m, size_t t) {
-    glm::dvec2 a(m.positions[m.indices[3 * t]]), b(m.positions[m.indices[3 * t + 1]]), c(m.positions[m.indices[3 * t + 2]]);
+    glm::dvec2 a(m.positions[m.indices[3 * t]]), b(m.positions[m.indices[3 * t + 1]]),
+        c(m.positions[m.indices[3 * t + 2]]);
     return 0.5 * std::abs((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x));
 }
 
@@ -139,8 +141,8 @@ TEST(TreePrototypes, NineSpeciesVariantsWithinBudget) {
         SCOPED_TRACE(testing::Message() << "species " << t.species << " variant " << t.variant);
         seen[{t.species, t.variant}]++;
         // Reported in docs/reference/trees-and-surfaces.md (figures come from this line).
-        std::printf("prototype species %d variant %d: %zu triangles, %zu vertices, height %.2f m\n", t.species, t.variant,
-                    t.mesh.triangleCount(), t.mesh.positions.size(), t.height);
+        std::printf("prototype species %d variant %d: %zu triangles, %zu vertices, height %.2f m\n", t.species,
+                    t.variant, t.mesh.triangleCount(), t.mesh.positions.size(), t.height);
         expectWellFormed(t.mesh, "tree");
         EXPECT_GE(t.mesh.triangleCount(), 400u);
         EXPECT_LE(t.mesh.triangleCount(), 1500u);
@@ -205,7 +207,8 @@ TEST(TreePlacement, StreetAndParkTreesRespectRoadsBuildingsParks) {
     auto trees = placeTrees(c, nullptr);
     size_t street = 0, park = 0;
     const Block* parkBlock = nullptr;
-    for (const auto& b : c.blocks) if (b.park) parkBlock = &b;
+    for (const auto& b : c.blocks)
+        if (b.park) parkBlock = &b;
     ASSERT_NE(parkBlock, nullptr);
     for (const auto& t : trees) {
         glm::dvec2 p(t.position);
@@ -236,9 +239,7 @@ TEST(TreePlacement, StreetAndParkTreesRespectRoadsBuildingsParks) {
     auto deg = c.streets.degrees();
     for (const auto& t : trees)
         for (size_t n = 0; n < c.streets.nodes.size(); ++n)
-            if (t.street && deg[n] >= 3) {
-                EXPECT_GE(glm::length(glm::dvec2(t.position) - c.streets.nodes[n]), 10.0);
-            }
+            if (t.street && deg[n] >= 3) { EXPECT_GE(glm::length(glm::dvec2(t.position) - c.streets.nodes[n]), 10.0); }
     // Crowns do not grow more than 1 m into facades, unless the tree is already
     // the smallest variant at the smallest scale.
     size_t shrunk = 0;
@@ -249,7 +250,8 @@ TEST(TreePlacement, StreetAndParkTreesRespectRoadsBuildingsParks) {
         double room = 1e9;
         for (const auto& b : c.buildings)
             for (size_t k = 0; k < b.footprint.size(); ++k)
-                room = std::min(room, pointSegmentDistance(glm::dvec2(t.position), b.footprint[k], b.footprint[(k + 1) % b.footprint.size()]));
+                room = std::min(room, pointSegmentDistance(glm::dvec2(t.position), b.footprint[k],
+                                                           b.footprint[(k + 1) % b.footprint.size()]));
         if (room > 12.0) continue;  // beyond the search radius
         bool smallest = proto.variant == 0 && t.scale <= 0.85f + 1e-6f;
         EXPECT_TRUE(crown * t.scale <= room + 1.0 + 1e-4 || smallest)
@@ -281,7 +283,8 @@ TEST(TreePlacement, DeterministicAndLocal) {
     std::reverse(d.streets.edges.begin(), d.streets.edges.end());
     Building extra;
     glm::dvec2 at(200.0, 200.0);
-    extra.footprint = {at + glm::dvec2(-46, -46), at + glm::dvec2(46, -46), at + glm::dvec2(46, 46), at + glm::dvec2(-46, 46)};
+    extra.footprint = {at + glm::dvec2(-46, -46), at + glm::dvec2(46, -46), at + glm::dvec2(46, 46),
+                       at + glm::dvec2(-46, 46)};
     d.buildings.push_back(extra);
     auto e = placeTrees(d, nullptr);
     auto key = [](const TreeInstance& t) { return std::make_pair(t.position.x, t.position.y); };
@@ -328,7 +331,8 @@ TEST(Surfaces, RoadPiecesDrawnExactlyOnceAcrossTiles) {
     // r + sidewalk along the arm, both sides: >= 2 r^2) and lies within the
     // disc through the corners a sidewalk further along: pi ((r + sw)^2 + r^2).
     double pieces = 0;
-    for (size_t e = 0; e < many.streets.edges.size(); ++e) pieces += many.streets.edgeLength(e) * many.streets.edges[e].width;
+    for (size_t e = 0; e < many.streets.edges.size(); ++e)
+        pieces += many.streets.edgeLength(e) * many.streets.edges[e].width;
     std::vector<double> r(many.streets.nodes.size(), 0.0);
     for (const auto& e : many.streets.edges) {
         r[e.a] = std::max(r[e.a], 0.5 * e.width);
@@ -343,7 +347,8 @@ TEST(Surfaces, RoadPiecesDrawnExactlyOnceAcrossTiles) {
     EXPECT_NEAR(materialArea(tilesMany, Material::Ground), many.params.size_m * many.params.size_m, 1.0);
     // Parks: the lawn covers the park block exactly once.
     double parkArea = 0;
-    for (const auto& b : many.blocks) if (b.park) parkArea += std::abs(signedArea(b.outline));
+    for (const auto& b : many.blocks)
+        if (b.park) parkArea += std::abs(signedArea(b.outline));
     EXPECT_NEAR(materialArea(tilesMany, Material::Grass), parkArea, 1e-3 * parkArea);
     EXPECT_NEAR(materialArea(tilesMany, Material::Sidewalk), materialArea(tilesOne, Material::Sidewalk),
                 1e-4 * materialArea(tilesOne, Material::Sidewalk));
@@ -357,7 +362,8 @@ TEST(Surfaces, RoadPiecesDrawnExactlyOnceAcrossTiles) {
             glm::dvec2 w = glm::dvec2(q) + glm::dvec2(t.origin);
             bool onRoad = false;
             for (const auto& e : many.streets.edges)
-                onRoad = onRoad || pointSegmentDistance(w, many.streets.nodes[e.a], many.streets.nodes[e.b]) <= 0.5 * e.width + 1e-3;
+                onRoad = onRoad || pointSegmentDistance(w, many.streets.nodes[e.a], many.streets.nodes[e.b]) <=
+                                       0.5 * e.width + 1e-3;
             EXPECT_TRUE(onRoad) << "marking at " << w.x << "," << w.y;
         }
     // Sidewalk tops (projected; kerb faces are vertical): perimeter x width per
@@ -365,7 +371,8 @@ TEST(Surfaces, RoadPiecesDrawnExactlyOnceAcrossTiles) {
     const double sw = many.params.sidewalk_m;
     double walk = 0;
     for (const auto& b : many.blocks) {
-        for (size_t i = 0; i < b.outline.size(); ++i) walk += glm::length(b.outline[(i + 1) % b.outline.size()] - b.outline[i]) * sw;
+        for (size_t i = 0; i < b.outline.size(); ++i)
+            walk += glm::length(b.outline[(i + 1) % b.outline.size()] - b.outline[i]) * sw;
         walk += 4 * 3 * 0.5 * sw * sw * std::sin(M_PI / 6);
     }
     EXPECT_NEAR(materialArea(tilesMany, Material::Sidewalk), walk, 1e-6 * walk);
@@ -409,7 +416,8 @@ TEST(Surfaces, ConcaveParkCoveredOnce) {
         for (auto& b : c.blocks) b.park = false;
         Block u;
         u.park = true;
-        u.outline = {{-180, -170}, {170, -170}, {170, 160}, {90, 160}, {90, -60}, {-110, -60}, {-110, 160}, {-180, 160}};
+        u.outline = {{-180, -170}, {170, -170}, {170, 160},  {90, 160},
+                     {90, -60},    {-110, -60}, {-110, 160}, {-180, 160}};
         c.blocks.push_back(u);
         auto tiles = meshAllTiles(c);
         for (const auto& t : tiles) expectWellFormed(t.meshes[size_t(Material::Grass)], "grass");

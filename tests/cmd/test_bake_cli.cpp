@@ -83,8 +83,9 @@ TEST(BakeCli, ResumeShardsAndJobsGiveIdenticalBytes) {
     // A real kill -9 at an arbitrary moment (before, during or after the cell
     // writes): the rerun must produce the same bytes whenever the kill landed.
     {
-        const std::string bg = "(" + std::string(VISTA_BINARY) + " bake " + common + "-o " + dir.file("k.osgb") +
-                               " > /dev/null 2>&1 & p=$!; sleep 0.6; kill -9 $p 2>/dev/null; wait $p 2>/dev/null) ; true";
+        const std::string bg =
+            "(" + std::string(VISTA_BINARY) + " bake " + common + "-o " + dir.file("k.osgb") +
+            " > /dev/null 2>&1 & p=$!; sleep 0.6; kill -9 $p 2>/dev/null; wait $p 2>/dev/null) ; true";
         ASSERT_EQ(std::system(bg.c_str()), 0);
         ASSERT_EQ(run(common + "-o " + dir.file("k.osgb")), 0);
         EXPECT_EQ(readBytes(dir.file("k.osgb")), ref);
@@ -110,7 +111,8 @@ TEST(BakeCli, ResumeShardsAndJobsGiveIdenticalBytes) {
 TEST(BakeCli, PlacementByCostIsDeterministicAcrossJobsShardsAndResume) {
     TempDir dir;
     City occ = makeBakeCity();
-    occ.tiles[0].meshes[size_t(Material::Wall)] = boxMesh({52, -40, 0}, {58, 8, 40}, {90, 90, 90, 255}, {100, 100, 100, 255});
+    occ.tiles[0].meshes[size_t(Material::Wall)] =
+        boxMesh({52, -40, 0}, {58, 8, 40}, {90, 90, 90, 255}, {100, 100, 100, 255});
     ASSERT_TRUE(writeCityFile(occ, dir.file("city.osgb")).isOk());
     // Cheap points: both ends are placed (and culled by the from-region visibility).
     const std::string common = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q --point-ns 0.000001 ";
@@ -136,8 +138,8 @@ TEST(BakeCli, PlacementByCostIsDeterministicAcrossJobsShardsAndResume) {
     ASSERT_EQ(run(common + "-o " + dir.file("c.osgb")), 0);
     EXPECT_EQ(readBytes(dir.file("c.osgb")), ref) << "a damaged cell result was trusted";
     // The default (real) costs: a few walls are cheaper as triangles, nothing is placed.
-    ASSERT_EQ(run(dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q -o " + dir.file("d.osgb") + " --stats " +
-                  dir.file("d.json")),
+    ASSERT_EQ(run(dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q -o " + dir.file("d.osgb") +
+                  " --stats " + dir.file("d.json")),
               0);
     EXPECT_NE(readBytes(dir.file("d.json")).find("not placed: saves"), std::string::npos);
     // A budget that holds at most one of the two ends: the other is passed
@@ -161,7 +163,9 @@ TEST(BakeCli, PlacementByCostIsDeterministicAcrossJobsShardsAndResume) {
         EXPECT_DOUBLE_EQ(fj["storage_budget_mb"].get<double>(), 0.01);
         EXPECT_NE(fj["params"].get<std::string>().find("budget=0.01"), std::string::npos);
     }
-    ASSERT_EQ(run(common + "-o " + dir.file("g.osgb") + " --storage-budget off --visibility rays --stats " + dir.file("g.json")), 0);
+    ASSERT_EQ(run(common + "-o " + dir.file("g.osgb") + " --storage-budget off --visibility rays --stats " +
+                  dir.file("g.json")),
+              0);
     EXPECT_EQ(readBytes(dir.file("g.json")).find("budget="), std::string::npos) << "off: no budget in the parameters";
     EXPECT_EQ(run(common + "-o " + dir.file("e.osgb") + " --storage-budget 0"), 2);
     EXPECT_EQ(run(common + "-o " + dir.file("e.osgb") + " --storage-budget lots"), 2);
@@ -176,7 +180,9 @@ TEST(BakeCli, ViewOpensTheBakedFileInImpostorMode) {
     if (!display || !*display) GTEST_SKIP() << "no X display (run under xvfb-run -a)";
     TempDir dir;
     ASSERT_TRUE(writeCityFile(makeBakeCity(), dir.file("city.osgb")).isOk());
-    ASSERT_EQ(run(dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q  --placement all -o " + dir.file("a.osgb")), 0);
+    ASSERT_EQ(
+        run(dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q  --placement all -o " + dir.file("a.osgb")),
+        0);
     auto view = [&](const std::string& args) {
         const std::string cmd = std::string(VISTA_BINARY) + " view " + args + " > /dev/null 2>&1";
         const int rc = std::system(cmd.c_str());
@@ -192,7 +198,9 @@ TEST(BakeCli, ViewOpensTheBakedFileInImpostorMode) {
 TEST(LodMeshCli, ResumeShardsCorruptCellAndBadValues) {
     TempDir dir;
     ASSERT_TRUE(writeCityFile(makeBakeCity(), dir.file("city.osgb")).isOk());
-    const std::string common = dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q  --placement all --representation mesh --mesh-image 256 ";
+    const std::string common =
+        dir.file("city.osgb") +
+        " --out-size 120 --min-triangles 1 -q  --placement all --representation mesh --mesh-image 256 ";
     ASSERT_EQ(run(common + "-o " + dir.file("a.osgb") + " --jobs 2 --stats " + dir.file("a.json")), 0);
     const std::string ref = readBytes(dir.file("a.osgb"));
     ASSERT_GT(ref.size(), 1000u);
@@ -218,8 +226,9 @@ TEST(LodMeshCli, ResumeShardsCorruptCellAndBadValues) {
     EXPECT_EQ(readBytes(dir.file("c.osgb")), ref);
     // kill -9 at an arbitrary moment, then a rerun: the bytes of one run.
     {
-        const std::string bg = "(" + std::string(VISTA_BINARY) + " bake " + common + "-o " + dir.file("k.osgb") +
-                               " > /dev/null 2>&1 & p=$!; sleep 0.3; kill -9 $p 2>/dev/null; wait $p 2>/dev/null) ; true";
+        const std::string bg =
+            "(" + std::string(VISTA_BINARY) + " bake " + common + "-o " + dir.file("k.osgb") +
+            " > /dev/null 2>&1 & p=$!; sleep 0.3; kill -9 $p 2>/dev/null; wait $p 2>/dev/null) ; true";
         ASSERT_EQ(std::system(bg.c_str()), 0);
         ASSERT_EQ(run(common + "-o " + dir.file("k.osgb")), 0);
         EXPECT_EQ(readBytes(dir.file("k.osgb")), ref);
@@ -288,7 +297,8 @@ TEST(BakeCli, BakedFileOfAnotherCityOrTruncatedIsRefusedWithExit2) {
     ASSERT_EQ(run(common + "-o " + dir.file("p.osgb")), 0);
     ASSERT_EQ(run(common + "-o " + dir.file("m.osgb") + " --representation mesh --mesh-image 256"), 0);
 
-    // The recorded hash is the hash64 of the city file's payload (everything but the 32-byte trailer), computed here independently.
+    // The recorded hash is the hash64 of the city file's payload (everything but the 32-byte trailer), computed here
+    // independently.
     const std::string cityBytes = readBytes(dir.file("city.osgb"));
     ASSERT_GT(cityBytes.size(), kSceneTrailerSize);
     char hex[17];
@@ -316,7 +326,8 @@ TEST(BakeCli, BakedFileOfAnotherCityOrTruncatedIsRefusedWithExit2) {
     };
     const std::string bench = " --frames 2 --size 80x60 --seed 1 --out " + dir.file("bench");
     // Another city: exit 2, a message naming both files and both hashes (before any drawing: no display needed).
-    EXPECT_EQ(tool("bench " + dir.file("other.osgb") + " --baked " + dir.file("p.osgb") + " --modes impostor" + bench), 2);
+    EXPECT_EQ(tool("bench " + dir.file("other.osgb") + " --baked " + dir.file("p.osgb") + " --modes impostor" + bench),
+              2);
     std::string log = readBytes(dir.file("log.txt"));
     EXPECT_NE(log.find("baked from another city"), std::string::npos) << log;
     EXPECT_NE(log.find(dir.file("p.osgb")), std::string::npos) << log;
@@ -324,16 +335,23 @@ TEST(BakeCli, BakedFileOfAnotherCityOrTruncatedIsRefusedWithExit2) {
     EXPECT_NE(log.find(*cityHash), std::string::npos) << log;
     EXPECT_NE(log.find(*otherHash), std::string::npos) << log;
     EXPECT_FALSE(std::filesystem::exists(dir.file("bench/summary.json")));
-    EXPECT_EQ(tool("bench " + dir.file("other.osgb") + " --baked-mesh " + dir.file("m.osgb") + " --modes lodmesh" + bench), 2);
+    EXPECT_EQ(
+        tool("bench " + dir.file("other.osgb") + " --baked-mesh " + dir.file("m.osgb") + " --modes lodmesh" + bench),
+        2);
     log = readBytes(dir.file("log.txt"));
     EXPECT_NE(log.find("baked from another city"), std::string::npos) << log;
     EXPECT_NE(log.find("--representation mesh"), std::string::npos) << log;
-    EXPECT_EQ(tool("view " + dir.file("other.osgb") + " --baked " + dir.file("p.osgb") + " --mode impostor --frames 1"), 2);
+    EXPECT_EQ(tool("view " + dir.file("other.osgb") + " --baked " + dir.file("p.osgb") + " --mode impostor --frames 1"),
+              2);
     EXPECT_NE(readBytes(dir.file("log.txt")).find("baked from another city"), std::string::npos);
-    EXPECT_EQ(tool("view " + dir.file("other.osgb") + " --baked-mesh " + dir.file("m.osgb") + " --mode lodmesh --frames 1"), 2);
-    // A baked city file opened as the city stands for its source city: a mesh bake of `city` with a point bake of `city` pairs,
-    // with a point bake of `other` it does not.
-    ASSERT_EQ(run(dir.file("other.osgb") + " --out-size 120 --min-triangles 1 -q  --placement all -o " + dir.file("po.osgb")), 0);
+    EXPECT_EQ(
+        tool("view " + dir.file("other.osgb") + " --baked-mesh " + dir.file("m.osgb") + " --mode lodmesh --frames 1"),
+        2);
+    // A baked city file opened as the city stands for its source city: a mesh bake of `city` with a point bake of
+    // `city` pairs, with a point bake of `other` it does not.
+    ASSERT_EQ(
+        run(dir.file("other.osgb") + " --out-size 120 --min-triangles 1 -q  --placement all -o " + dir.file("po.osgb")),
+        0);
     EXPECT_EQ(tool("bench " + dir.file("m.osgb") + " --baked " + dir.file("po.osgb") + " --modes impostor" + bench), 2);
     EXPECT_NE(readBytes(dir.file("log.txt")).find("baked from another city"), std::string::npos);
 
@@ -353,7 +371,9 @@ TEST(BakeCli, BakedFileOfAnotherCityOrTruncatedIsRefusedWithExit2) {
         log = readBytes(dir.file("log.txt"));
         EXPECT_NE(log.find("truncated"), std::string::npos) << log;
         EXPECT_NE(log.find(cut), std::string::npos) << log;
-        EXPECT_EQ(tool("view " + dir.file("city.osgb") + (mesh ? " --baked-mesh " : " --baked ") + cut + " --frames 1"), 2) << f;
+        EXPECT_EQ(tool("view " + dir.file("city.osgb") + (mesh ? " --baked-mesh " : " --baked ") + cut + " --frames 1"),
+                  2)
+            << f;
     }
     // Unknown representation: exit 2, the option and the value named.
     EXPECT_EQ(tool("bake " + common + "-o " + dir.file("e.osgb") + " --representation voxels"), 2);
@@ -383,14 +403,15 @@ TEST(BakeCli, BakedFileOfAnotherCityOrTruncatedIsRefusedWithExit2) {
     const char* display = std::getenv("DISPLAY");
     if (!display || !*display) GTEST_SKIP() << "no X display (run under xvfb-run -a): the runs that draw are skipped";
     // Matching city: both representations run.
-    ASSERT_EQ(tool("bench " + dir.file("city.osgb") + " --baked " + dir.file("p.osgb") + " --baked-mesh " + dir.file("m.osgb") +
-                   " --modes full,impostor,lodmesh" + bench),
+    ASSERT_EQ(tool("bench " + dir.file("city.osgb") + " --baked " + dir.file("p.osgb") + " --baked-mesh " +
+                   dir.file("m.osgb") + " --modes full,impostor,lodmesh" + bench),
               0)
         << readBytes(dir.file("log.txt"));
     EXPECT_TRUE(std::filesystem::exists(dir.file("bench/summary.json")));
     EXPECT_EQ(readBytes(dir.file("log.txt")).find("warning"), std::string::npos) << readBytes(dir.file("log.txt"));
     // The old file: runs, with the warning.
-    ASSERT_EQ(tool("bench " + dir.file("city.osgb") + " --baked " + dir.file("old.osgb") + " --modes impostor" + bench), 0)
+    ASSERT_EQ(tool("bench " + dir.file("city.osgb") + " --baked " + dir.file("old.osgb") + " --modes impostor" + bench),
+              0)
         << readBytes(dir.file("log.txt"));
     log = readBytes(dir.file("log.txt"));
     EXPECT_NE(log.find("warning"), std::string::npos) << log;

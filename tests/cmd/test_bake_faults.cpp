@@ -97,32 +97,33 @@ TEST(BakeFaults, KillNineLeavesTheOldOutputOrTheWholeNewOneAndTheNextRunResumes)
     for (const KillPoint& k : points) {
         const size_t before = countCells(work);
         const auto start = std::chrono::steady_clock::now();
-        const pid_t pid = test::startVista(
-            {"bake", city, "--out-size", "80", "--min-triangles", "1", "--placement", "all", "-q", "--jobs", "2", "-o", out});
+        const pid_t pid = test::startVista({"bake", city, "--out-size", "80", "--min-triangles", "1", "--placement",
+                                            "all", "-q", "--jobs", "2", "-o", out});
         ASSERT_GT(pid, 0);
         int st = 0;
         bool exited = false;
         while (!(exited = ::waitpid(pid, &st, WNOHANG) == pid)) {
-            const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+            const double ms =
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
             if (k.due(pid, before, ms)) {
                 ::kill(pid, SIGKILL);
                 break;
             }
             std::this_thread::sleep_for(std::chrono::microseconds(300));
         }
-        if (!exited) {
-            ASSERT_EQ(::waitpid(pid, &st, 0), pid);
-        }
+        if (!exited) { ASSERT_EQ(::waitpid(pid, &st, 0), pid); }
         const std::string now = readBytes(out);
         lastKilled = WIFSIGNALED(st) && WTERMSIG(st) == SIGKILL;
-        std::printf("kill point '%s': %s, %zu cell results\n", k.what, lastKilled ? "killed" : "finished first", countCells(work));
+        std::printf("kill point '%s': %s, %zu cell results\n", k.what, lastKilled ? "killed" : "finished first",
+                    countCells(work));
         if (lastKilled) {
             ++killed;
-            EXPECT_TRUE(now == old) << "killed " << k.what << ": the old output changed (" << now.size() << " bytes, old " << old.size()
-                                    << ")";
+            EXPECT_TRUE(now == old) << "killed " << k.what << ": the old output changed (" << now.size()
+                                    << " bytes, old " << old.size() << ")";
             // The work directory holds cell results and temporaries of the killed run only.
             const std::regex cellFile("cell_[0-9]+\\.vbc(\\.tmp\\." + std::to_string(pid) + ")?");
-            for (const std::string& n : listTree(work)) EXPECT_TRUE(std::regex_match(n, cellFile)) << k.what << ": " << n;
+            for (const std::string& n : listTree(work))
+                EXPECT_TRUE(std::regex_match(n, cellFile)) << k.what << ": " << n;
         } else {
             ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << k.what << ": status " << st;
             EXPECT_TRUE(now == ref) << "a run that was not killed (" << k.what << ") must leave the whole new output";
@@ -131,8 +132,8 @@ TEST(BakeFaults, KillNineLeavesTheOldOutputOrTheWholeNewOneAndTheNextRunResumes)
         // Next to the output: only its work directory and the killed run's temporary.
         for (const auto& e : fs::directory_iterator(dir.path())) {
             const std::string n = e.path().filename().string();
-            const bool expected = n == "city.osgb" || n == "ref.osgb" || n == "ref1.osgb" || n == "out.osgb" || n == "out.osgb.work" ||
-                                  (lastKilled && n == "out.osgb.tmp." + std::to_string(pid));
+            const bool expected = n == "city.osgb" || n == "ref.osgb" || n == "ref1.osgb" || n == "out.osgb" ||
+                                  n == "out.osgb.work" || (lastKilled && n == "out.osgb.tmp." + std::to_string(pid));
             EXPECT_TRUE(expected) << k.what << ": " << n;
         }
     }
@@ -142,9 +143,7 @@ TEST(BakeFaults, KillNineLeavesTheOldOutputOrTheWholeNewOneAndTheNextRunResumes)
     // runs left (all of them whole), writes the bytes of an uninterrupted
     // bake, and removes the temporaries and the work directory.
     const size_t done = countCells(work);
-    if (lastKilled) {
-        EXPECT_GT(done, 0u) << "the last kill came after cell results were written";
-    }
+    if (lastKilled) { EXPECT_GT(done, 0u) << "the last kill came after cell results were written"; }
     r = runVista("bake " + city + kParams + " --jobs 2 -o " + out);
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.err.find(std::to_string(done) + " already done"), std::string::npos) << r.err;
@@ -190,8 +189,8 @@ TEST(BakeFaults, DiskFullGivesTheCauseAndLeavesNoPartialOutput) {
 }
 
 // The input is a file that is not a scene; the output, work or stats path cannot be written.
-void expectRefusedBeforeTheInput(const test::TempDir& dir, const std::string& junk, const std::string& args, const std::string& option,
-                                 const std::string& reason) {
+void expectRefusedBeforeTheInput(const test::TempDir& dir, const std::string& junk, const std::string& args,
+                                 const std::string& option, const std::string& reason) {
     test::expectRefusedBeforeTheInput(dir.path(), "bake " + junk + " -q " + args, junk, option, reason);
 }
 
@@ -210,10 +209,13 @@ TEST(BakeFaults, UnwritableOutputWorkOrStatsIsRefusedBeforeTheInputIsRead) {
     expectRefusedBeforeTheInput(dir, junk, "-o " + dir.file("no/such/b.osgb"), "--output", "does not exist");
     expectRefusedBeforeTheInput(dir, junk, "-o " + aFile + "/b.osgb", "--output", "does not exist");
     expectRefusedBeforeTheInput(dir, junk, "-o " + dir.path(), "--output", "is a directory");
-    expectRefusedBeforeTheInput(dir, junk, "-o " + dir.file("b.osgb") + " --work " + aFile, "--work", "not a directory");
-    expectRefusedBeforeTheInput(dir, junk, "-o " + dir.file("b.osgb") + " --work " + aFile + "/w", "--work", "not a directory");
+    expectRefusedBeforeTheInput(dir, junk, "-o " + dir.file("b.osgb") + " --work " + aFile, "--work",
+                                "not a directory");
+    expectRefusedBeforeTheInput(dir, junk, "-o " + dir.file("b.osgb") + " --work " + aFile + "/w", "--work",
+                                "not a directory");
     expectRefusedBeforeTheInput(dir, junk, "-o " + dir.file("d.osgb"), "--work", "not a directory");
-    expectRefusedBeforeTheInput(dir, junk, "-o " + dir.file("b.osgb") + " --stats " + dir.file("no/s.json"), "--stats", "does not exist");
+    expectRefusedBeforeTheInput(dir, junk, "-o " + dir.file("b.osgb") + " --stats " + dir.file("no/s.json"), "--stats",
+                                "does not exist");
 }
 
 TEST(BakeFaults, ReadOnlyDirectoryIsRefusedBeforeTheInputIsRead) {
@@ -225,7 +227,8 @@ TEST(BakeFaults, ReadOnlyDirectoryIsRefusedBeforeTheInputIsRead) {
     if (!readOnly.ready()) GTEST_SKIP() << "no read-only directory: " << readOnly.why();
     expectRefusedBeforeTheInput(dir, junk, "-o " + ro + "/b.osgb", "--output", "not writable");
     expectRefusedBeforeTheInput(dir, junk, "-o " + dir.file("b.osgb") + " --work " + ro, "--work", "not writable");
-    expectRefusedBeforeTheInput(dir, junk, "-o " + dir.file("b.osgb") + " --work " + ro + "/w", "--work", "not writable");
+    expectRefusedBeforeTheInput(dir, junk, "-o " + dir.file("b.osgb") + " --work " + ro + "/w", "--work",
+                                "not writable");
 }
 
 }  // namespace

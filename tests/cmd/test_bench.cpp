@@ -56,7 +56,8 @@ int runVista(const std::string& args, std::string* output = nullptr) {
 TEST(RenderModes, RegistryListsEveryModeOnce) {
     std::vector<std::string> names;
     for (const auto& m : renderModes()) names.push_back(m.name);
-    EXPECT_EQ(names, (std::vector<std::string>{"full", "near", "raycast", "osgimpostor", "osglod", "hybrid", "impostor", "lodmesh"}));
+    EXPECT_EQ(names, (std::vector<std::string>{"full", "near", "raycast", "osgimpostor", "osglod", "hybrid", "impostor",
+                                               "lodmesh"}));
     EXPECT_EQ(renderModeNames(), "full, near, raycast, osgimpostor, osglod, hybrid, impostor, lodmesh");
     EXPECT_TRUE(findRenderMode("raycast")->needsRays);
     EXPECT_TRUE(findRenderMode("hybrid")->needsRays);
@@ -115,7 +116,7 @@ TEST(BenchSummary, SpeedupIsTheMedianOfSameFrameRatios) {
         }
     const ModeSummary s = summariseMode(r, "x", speedupBases(), 100.0);
     ASSERT_EQ(s.speedupMedianOfRatios.count("full"), 1u);
-    EXPECT_DOUBLE_EQ(s.speedupMedianOfRatios.at("full"), 2.0);  // ratios 2, 0.5, 3, 2, 0.5
+    EXPECT_DOUBLE_EQ(s.speedupMedianOfRatios.at("full"), 2.0);   // ratios 2, 0.5, 3, 2, 0.5
     EXPECT_NE(s.speedupMedianOfRatios.at("full"), 30.0 / 20.0);  // the ratio of the medians
     EXPECT_EQ(s.speedupMedianOfRatios.count("near"), 0u);        // near did not run
     EXPECT_DOUBLE_EQ(s.frameMsMedian, 20.0);
@@ -171,7 +172,8 @@ void expectSpeedupsFromCsv(const std::string& dir) {
             std::vector<double> ratios;
             for (size_t k = 0; k < ms.size(); ++k) ratios.push_back(times.at(base)[k] / ms[k]);
             ASSERT_TRUE(j["modes"][mode][key].is_number()) << mode << "." << key;
-            EXPECT_NEAR(j["modes"][mode][key].get<double>(), medianOf(ratios), 1e-3 * medianOf(ratios)) << mode << "." << key;
+            EXPECT_NEAR(j["modes"][mode][key].get<double>(), medianOf(ratios), 1e-3 * medianOf(ratios))
+                << mode << "." << key;
         }
 }
 
@@ -193,7 +195,7 @@ TEST(Bench, SyntheticSceneSmokeRun) {
     cfg.height = 72;
     cfg.frames = 3;
     cfg.modes = {"near", "osgimpostor", "osglod"};  // full is added as the reference
-    cfg.options.nearDistance = 40;                   // the blocks (100 m ahead) lie beyond it
+    cfg.options.nearDistance = 40;                  // the blocks (100 m ahead) lie beyond it
     cfg.outDir = tmpDir("smoke");
     cfg.quiet = true;
     cfg.loadMs = 12.5;
@@ -216,9 +218,9 @@ TEST(Bench, SyntheticSceneSmokeRun) {
     for (const char* mode : {"full", "near", "osgimpostor", "osglod"}) {
         ASSERT_TRUE(j["modes"].contains(mode)) << mode;
         const auto& m = j["modes"][mode];
-        for (const char* key : {"frame_ms_median", "frame_ms_p95", "speedup_vs_full_median_of_ratios",
-                                "speedup_vs_near_median_of_ratios", "psnr_db_median", "psnr_db_min", "triangles_median",
-                                "rays_per_frame_median"})
+        for (const char* key :
+             {"frame_ms_median", "frame_ms_p95", "speedup_vs_full_median_of_ratios", "speedup_vs_near_median_of_ratios",
+              "psnr_db_median", "psnr_db_min", "triangles_median", "rays_per_frame_median"})
             EXPECT_TRUE(m[key].is_number()) << mode << "." << key;
         EXPECT_FALSE(m.contains("speedup_vs_full_median")) << "the old name would hide what the number is";
         EXPECT_FALSE(m.contains("speedup_vs_raycast_median_of_ratios")) << "raycast did not run";
@@ -282,9 +284,12 @@ TEST(BenchCli, BadInputExitsWithTwo) {
     EXPECT_EQ(runVista("bench " + dummy + " --modes full,impostor --out " + dir + "/o", &out), 2) << out;
     EXPECT_NE(out.find("--baked"), std::string::npos) << out;
     // The viewer parses the same options with the same parsers.
-    const std::pair<const char*, const char*> view[] = {{"--size 0x0", "--size"},          {"--size 640", "--size"},
-                                                        {"--mode warp", "available modes"}, {"--near 0", "--near"},
-                                                        {"--budget x", "--budget"},         {"--fov 200", "--fov"},
+    const std::pair<const char*, const char*> view[] = {{"--size 0x0", "--size"},
+                                                        {"--size 640", "--size"},
+                                                        {"--mode warp", "available modes"},
+                                                        {"--near 0", "--near"},
+                                                        {"--budget x", "--budget"},
+                                                        {"--fov 200", "--fov"},
                                                         {"--triangle-budget -1", "--triangle-budget"},
                                                         {"--step --frames 2", "--step"}};
     for (const auto& [args, what] : view) {
@@ -319,8 +324,10 @@ TEST(BenchCli, TinyGeneratedCity) {
     }
     // A short near distance: most of the city is far field (traced by hybrid,
     // simplified by osglod).
-    ASSERT_EQ(runVista("bench " + city + " --path " + dir + "/p.csv --frames 4 --size 160x120 -q --near 10 "
-                       "--modes full,near,raycast,osgimpostor,osglod,hybrid --out " + dir + "/bench",
+    ASSERT_EQ(runVista("bench " + city + " --path " + dir +
+                           "/p.csv --frames 4 --size 160x120 -q --near 10 "
+                           "--modes full,near,raycast,osgimpostor,osglod,hybrid --out " +
+                           dir + "/bench",
                        &out),
               0)
         << out;
@@ -367,8 +374,10 @@ TEST(BenchCli, TinyGeneratedCity) {
     }
     // A budget below the estimate stops the run up front: exit 2, the estimate in the message, no output.
     const double estimateGb = j["memory"]["estimate_mb"].get<double>() / 1024.0;
-    EXPECT_EQ(runVista("bench " + city + " --path " + dir + "/p.csv --frames 2 --size 160x120 -q --modes full,hybrid "
-                       "--memory-budget " + std::to_string(0.5 * estimateGb) + " --out " + dir + "/over",
+    EXPECT_EQ(runVista("bench " + city + " --path " + dir +
+                           "/p.csv --frames 2 --size 160x120 -q --modes full,hybrid "
+                           "--memory-budget " +
+                           std::to_string(0.5 * estimateGb) + " --out " + dir + "/over",
                        &out),
               2)
         << out;
@@ -388,18 +397,28 @@ TEST(ViewCli, EveryModeShowsTheBenchPicture) {
     const std::string city = dir + "/tiny.osgb", baked = dir + "/tiny.baked.osgb", path = dir + "/p.csv";
     const std::string meshes = dir + "/tiny.mesh.osgb";
     ASSERT_EQ(runVista("gen --size 300 --seed 3 -q -o " + city, &out), 0) << out;
-    ASSERT_EQ(runVista("bake " + city + " -o " + baked + " --out-size 120 --min-triangles 1 --placement all --max-rays 20000 -q", &out), 0)
+    ASSERT_EQ(runVista("bake " + city + " -o " + baked +
+                           " --out-size 120 --min-triangles 1 --placement all --max-rays 20000 -q",
+                       &out),
+              0)
         << out;
-    ASSERT_EQ(runVista("bake " + city + " -o " + meshes + " --representation mesh --out-size 120 --min-triangles 1 -q", &out), 0)
+    ASSERT_EQ(
+        runVista("bake " + city + " -o " + meshes + " --representation mesh --out-size 120 --min-triangles 1 -q", &out),
+        0)
         << out;
     ASSERT_EQ(runVista("path " + city + " --seed 4 --duration 10 -o " + path, &out), 0) << out;
-    const std::string common = " --path " + path + " --size 160x120 --near 30 --budget unlimited --baked " + baked + " --baked-mesh " + meshes;
+    const std::string common =
+        " --path " + path + " --size 160x120 --near 30 --budget unlimited --baked " + baked + " --baked-mesh " + meshes;
     std::string all;
     for (const auto& info : renderModes()) all += (all.empty() ? "" : ",") + std::string(info.name);
-    ASSERT_EQ(runVista("bench " + city + common + " --frames 1 -q --modes " + all + " --out " + dir + "/b", &out), 0) << out;
+    ASSERT_EQ(runVista("bench " + city + common + " --frames 1 -q --modes " + all + " --out " + dir + "/b", &out), 0)
+        << out;
     for (const auto& info : renderModes()) {
         const std::string mode = info.name, png = dir + "/view_" + mode + ".png";
-        ASSERT_EQ(runVista("view " + city + common + " --mode " + mode + " --step --frames 1 --no-hud --screenshot " + png, &out), 0)
+        ASSERT_EQ(
+            runVista("view " + city + common + " --mode " + mode + " --step --frames 1 --no-hud --screenshot " + png,
+                     &out),
+            0)
             << mode << ": " << out;
         auto view = readPng(png);
         ASSERT_TRUE(view.isOk()) << mode << ": " << view.status().message();
@@ -414,8 +433,9 @@ TEST(ViewCli, EveryModeShowsTheBenchPicture) {
     // Interactive playback (not --step) of every mode runs headless too, with the HUD.
     for (const auto& info : renderModes()) {
         const std::string png = dir + "/play.png";
-        EXPECT_EQ(runVista("view " + city + " --seed 2 --size 160x120 --frames 3 --baked " + baked + " --baked-mesh " + meshes + " --mode " + info.name +
-                               " --screenshot " + png, &out),
+        EXPECT_EQ(runVista("view " + city + " --seed 2 --size 160x120 --frames 3 --baked " + baked + " --baked-mesh " +
+                               meshes + " --mode " + info.name + " --screenshot " + png,
+                           &out),
                   0)
             << info.name << ": " << out;
         EXPECT_TRUE(readPng(png).isOk()) << info.name;
@@ -434,10 +454,16 @@ TEST(ViewCli, HybridHazeShowsTheBenchPicture) {
     const std::string city = dir + "/tiny.osgb", path = dir + "/p.csv";
     ASSERT_EQ(runVista("gen --size 300 --seed 5 -q -o " + city, &out), 0) << out;
     ASSERT_EQ(runVista("path " + city + " --seed 2 --duration 10 -o " + path, &out), 0) << out;
-    const std::string common = " --path " + path + " --size 160x120 --near 40 --effects '{\"haze\":{\"visibility_m\":80}}'";
-    ASSERT_EQ(runVista("bench " + city + common + " --frames 1 -q --modes full,hybrid --out " + dir + "/b", &out), 0) << out;
-    ASSERT_EQ(runVista("bench " + city + " --path " + path + " --size 160x120 --near 40 --effects none --frames 1 -q --modes hybrid --out " +
-                           dir + "/clear", &out), 0) << out;
+    const std::string common =
+        " --path " + path + " --size 160x120 --near 40 --effects '{\"haze\":{\"visibility_m\":80}}'";
+    ASSERT_EQ(runVista("bench " + city + common + " --frames 1 -q --modes full,hybrid --out " + dir + "/b", &out), 0)
+        << out;
+    ASSERT_EQ(
+        runVista("bench " + city + " --path " + path +
+                     " --size 160x120 --near 40 --effects none --frames 1 -q --modes hybrid --out " + dir + "/clear",
+                 &out),
+        0)
+        << out;
     const std::string png = dir + "/view_hybrid.png";
     auto hybrid = readPng(dir + "/b/images/first_hybrid.png"), full = readPng(dir + "/b/images/first_full.png"),
          clear = readPng(dir + "/clear/images/first_hybrid.png");
@@ -449,7 +475,10 @@ TEST(ViewCli, HybridHazeShowsTheBenchPicture) {
     // screenshot is retaken (at most 3 tries) until it has the asked size.
     Result<Image> view = Status::error("no screenshot");
     for (int attempt = 0; attempt < 3; ++attempt) {
-        ASSERT_EQ(runVista("view " + city + common + " --mode hybrid --step --frames 1 --no-hud --screenshot " + png, &out), 0) << out;
+        ASSERT_EQ(
+            runVista("view " + city + common + " --mode hybrid --step --frames 1 --no-hud --screenshot " + png, &out),
+            0)
+            << out;
         view = readPng(png);
         ASSERT_TRUE(view.isOk()) << view.status().message();
         if (view.value().width == hybrid.value().width && view.value().height == hybrid.value().height) break;
@@ -467,11 +496,16 @@ TEST(BenchCli, FarFieldFlagsRejectBadValues) {
     std::string dir = tmpDir("badff"), out;
     std::string dummy = dir + "/dummy.osgb";
     std::ofstream(dummy) << "x";
-    const std::pair<const char*, const char*> bad[] = {
-        {"--near -5", "--near"}, {"--near abc", "--near"}, {"--horizon-grid -1", "--horizon-grid"},
-        {"--budget -7", "--budget"}, {"--horizon-grid 9000", "--horizon-grid"}, {"--far-step 3", "--far-step"},
-        {"--point-splat 5", "--point-splat"}, {"--point-splat wide", "0.05 .. 4"},
-        {"--memory-budget 0", "--memory-budget"}, {"--memory-budget lots", "--memory-budget"}};
+    const std::pair<const char*, const char*> bad[] = {{"--near -5", "--near"},
+                                                       {"--near abc", "--near"},
+                                                       {"--horizon-grid -1", "--horizon-grid"},
+                                                       {"--budget -7", "--budget"},
+                                                       {"--horizon-grid 9000", "--horizon-grid"},
+                                                       {"--far-step 3", "--far-step"},
+                                                       {"--point-splat 5", "--point-splat"},
+                                                       {"--point-splat wide", "0.05 .. 4"},
+                                                       {"--memory-budget 0", "--memory-budget"},
+                                                       {"--memory-budget lots", "--memory-budget"}};
     for (const auto& [args, flag] : bad) {
         EXPECT_EQ(runVista("bench " + dummy + " " + args + " --out " + dir + "/o", &out), 2) << args << ": " << out;
         EXPECT_NE(out.find(flag), std::string::npos) << args << ": " << out;
@@ -501,10 +535,11 @@ TEST(BenchCli, HybridPixelClassesAndOptions) {
     for (size_t i = 0; i < 3; ++i) {
         const Run& r = runs[i];
         std::string o = dir + "/b" + std::to_string(i);
-        ASSERT_EQ(runVista("bench " + city + " --seed 4 --duration 10 --frames 3 --size 160x120 -q --modes full,hybrid " +
-                               r.flags + " --out " + o,
-                           &out),
-                  0)
+        ASSERT_EQ(
+            runVista("bench " + city + " --seed 4 --duration 10 --frames 3 --size 160x120 -q --modes full,hybrid " +
+                         r.flags + " --out " + o,
+                     &out),
+            0)
             << r.flags << ": " << out;
         std::ifstream f(o + "/summary.json");
         ASSERT_TRUE(f.good()) << r.flags;
@@ -516,7 +551,8 @@ TEST(BenchCli, HybridPixelClassesAndOptions) {
         EXPECT_EQ(opt["cache"], r.cache) << r.flags;
         EXPECT_EQ(opt["triangle_budget"], r.triangleBudget) << r.flags;
         if (r.triangleBudget > 0) {  // the nearest chunks up to the budget
-            EXPECT_LT(j["modes"]["hybrid"]["triangles_median"].get<double>(), j["modes"]["full"]["triangles_median"].get<double>());
+            EXPECT_LT(j["modes"]["hybrid"]["triangles_median"].get<double>(),
+                      j["modes"]["full"]["triangles_median"].get<double>());
         }
         ASSERT_TRUE(j["modes"]["hybrid"].contains("pixels")) << j["modes"]["hybrid"].dump();
         const auto& px = j["modes"]["hybrid"]["pixels"];
@@ -527,13 +563,12 @@ TEST(BenchCli, HybridPixelClassesAndOptions) {
                 ASSERT_TRUE(px[cls][k].is_number()) << cls << "." << k;
             EXPECT_LE(px[cls]["min_pct"].get<double>(), px[cls]["mean_pct"].get<double>() + 1e-9) << cls;
             EXPECT_LE(px[cls]["mean_pct"].get<double>(), px[cls]["max_pct"].get<double>() + 1e-9) << cls;
-            EXPECT_NEAR(px[cls]["mean_count"].get<double>(), px[cls]["mean_pct"].get<double>() / 100.0 * 160 * 120, 1e-6);
+            EXPECT_NEAR(px[cls]["mean_count"].get<double>(), px[cls]["mean_pct"].get<double>() / 100.0 * 160 * 120,
+                        1e-6);
             sum += px[cls]["mean_pct"].get<double>();
         }
         EXPECT_NEAR(sum, 100.0, 0.1) << px.dump();
-        if (!r.cache) {
-            EXPECT_EQ(px["cache"]["max_pct"].get<double>(), 0.0);
-        }
+        if (!r.cache) { EXPECT_EQ(px["cache"]["max_pct"].get<double>(), 0.0); }
         // Stage times: every stage that ran has a mean and a run count within the frame count.
         const auto& stages = j["modes"]["hybrid"]["stages_ms"];
         ASSERT_TRUE(stages.contains("opacity")) << stages.dump();
@@ -552,7 +587,8 @@ TEST(BenchCli, HybridPixelClassesAndOptions) {
 TEST(BenchCli, SweepTableListsEveryCityWithItsTrianglesAndFullFirst) {
     REQUIRE_DISPLAY();
     std::string dir = tmpDir("sweep"), out;
-    ASSERT_EQ(runVista("bench --sweep sizes=300,400 --seed 2 --frames 2 --size 160x120 --modes near,full --out " + dir + "/s -q",
+    ASSERT_EQ(runVista("bench --sweep sizes=300,400 --seed 2 --frames 2 --size 160x120 --modes near,full --out " + dir +
+                           "/s -q",
                        &out),
               0)
         << out;
@@ -566,7 +602,8 @@ TEST(BenchCli, SweepTableListsEveryCityWithItsTrianglesAndFullFirst) {
         const double tris = j[i]["city_triangles"].get<double>();
         EXPECT_GT(tris, 1000.0) << "city " << size << ": its triangle count comes from the benched city";
         trianglesOf[size] = tris;
-        EXPECT_EQ(j[i]["mode"].get<std::string>(), i % 2 == 0 ? "full" : "near") << "full is listed first for every city";
+        EXPECT_EQ(j[i]["mode"].get<std::string>(), i % 2 == 0 ? "full" : "near")
+            << "full is listed first for every city";
     }
     ASSERT_EQ(trianglesOf.size(), 2u);
     EXPECT_GT(trianglesOf[400], trianglesOf[300]) << "a larger city has more triangles";

@@ -47,7 +47,7 @@ bool haveDisplay() {
 
 struct EffectCase {
     const char* name;
-    const char* spec;      // --effects of vista gen
+    const char* spec;  // --effects of vista gen
     double originX;
 };
 
@@ -68,7 +68,8 @@ TEST_P(EffectRender, RasterAndRayCasterAgreeWithTheEffectOn) {
     const auto s = readJson(stats);
     ASSERT_TRUE(s["effects"].is_object());
     EXPECT_FALSE(s["effects"].empty()) << "the stats name the declared effects";
-    CliResult b = vista("bench " + city + " --seed 2 --frames 4 --modes full,hybrid,raycast --out " + out + " -q", dir.path());
+    CliResult b =
+        vista("bench " + city + " --seed 2 --frames 4 --modes full,hybrid,raycast --out " + out + " -q", dir.path());
     ASSERT_EQ(b.code, 0) << b.err;
     const auto j = readJson(out + "/summary.json");
     EXPECT_EQ(j["effects"], s["effects"]) << "the bench reads the effects from the scene file";
@@ -94,13 +95,13 @@ INSTANTIATE_TEST_SUITE_P(
     EachEffect, EffectRender,
     ::testing::Values(EffectCase{"sun_shadows", R"({"sun_shadows":{"resolution_m":4}})", 0},
                       EffectCase{"ambient_occlusion", R"({"ambient_occlusion":{"samples":4,"resolution_m":4}})", 0},
-                      EffectCase{"haze", R"({"haze":{"visibility_m":300}})", 0},
-                      EffectCase{"glass", "glass", 0}, EffectCase{"night", "night", 0},
-                      EffectCase{"materials", "materials", 0},
-                      EffectCase{"all_far_away",
-                                 R"({"sun_shadows":{"resolution_m":4},"ambient_occlusion":{"samples":4,"resolution_m":4},)"
-                                 R"("haze":{"visibility_m":400},"glass":{},"night":{},"materials":{}})",
-                                 1e6}),
+                      EffectCase{"haze", R"({"haze":{"visibility_m":300}})", 0}, EffectCase{"glass", "glass", 0},
+                      EffectCase{"night", "night", 0}, EffectCase{"materials", "materials", 0},
+                      EffectCase{
+                          "all_far_away",
+                          R"({"sun_shadows":{"resolution_m":4},"ambient_occlusion":{"samples":4,"resolution_m":4},)"
+                          R"("haze":{"visibility_m":400},"glass":{},"night":{},"materials":{}})",
+                          1e6}),
     [](const ::testing::TestParamInfo<EffectCase>& i) { return std::string(i.param.name); });
 
 TEST(EffectsCli, BadEffectsExitTwoNameTheFieldAndLeaveNoFile) {
@@ -135,7 +136,8 @@ TEST(EffectsCli, NoEffectsIsByteIdenticalAndBenchRejectsUnknownEffects) {
     ASSERT_EQ(vista("gen --size 300 -q -o " + dir.file("a.osgb"), dir.path()).code, 0);
     ASSERT_EQ(vista("gen --size 300 -q --effects none -o " + dir.file("b.osgb"), dir.path()).code, 0);
     EXPECT_EQ(vista::test::readBytes(dir.file("a.osgb")), vista::test::readBytes(dir.file("b.osgb")));
-    CliResult r = vista("bench " + dir.file("a.osgb") + " --effects smoke --frames 1 --out " + dir.file("o"), dir.path());
+    CliResult r =
+        vista("bench " + dir.file("a.osgb") + " --effects smoke --frames 1 --out " + dir.file("o"), dir.path());
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_NE(r.err.find("unknown effect 'smoke'"), std::string::npos) << r.err;
 }

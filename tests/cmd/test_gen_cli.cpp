@@ -115,7 +115,8 @@ TEST_F(GenCli, WritesSceneAndStats) {
     auto gj = nlohmann::json::parse(g);
     EXPECT_EQ(gj["type"], "FeatureCollection");
     // No temp files left behind.
-    for (const auto& e : fs::directory_iterator(dir)) EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << e.path();
+    for (const auto& e : fs::directory_iterator(dir))
+        EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << e.path();
 }
 
 TEST_F(GenCli, SameSeedSameBytesWhateverThreads) {
@@ -142,7 +143,8 @@ TEST_F(GenCli, KillNineKeepsTheOldOutputAndTheNextRunCleansUp) {
     ASSERT_FALSE(old.empty());
     int killedWhileRunning = 0;
     for (int delayMs : {150, 700, 1500, 2500, 3500}) {
-        const pid_t pid = vista::test::startVista({"gen", "--size", "2000", "-q", "-o", out, "--geojson", geo, "--gltf", glb});
+        const pid_t pid =
+            vista::test::startVista({"gen", "--size", "2000", "-q", "-o", out, "--geojson", geo, "--gltf", glb});
         ASSERT_GT(pid, 0);
         ::usleep(useconds_t(delayMs) * 1000);
         ::kill(pid, SIGKILL);
@@ -184,7 +186,8 @@ TEST_F(GenCli, BenchOfABadSceneLeavesNoOutputFolder) {
 
 TEST_F(GenCli, MemoryBudgetRefusesUpFrontWithNothingWritten) {
     // Too small for one file: exit 2 naming the option and the estimate; no file, no stats.
-    CliRun r = runVista("gen --size 1000 --detail 1 --seed 2 -q --memory-budget 0.05 -o " + file("c.osgb") + " --stats " + file("s.json"));
+    CliRun r = runVista("gen --size 1000 --detail 1 --seed 2 -q --memory-budget 0.05 -o " + file("c.osgb") +
+                        " --stats " + file("s.json"));
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_NE(r.err.find("--memory-budget"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("estimated to peak"), std::string::npos) << r.err;
@@ -203,7 +206,8 @@ TEST_F(GenCli, MemoryBudgetRefusesUpFrontWithNothingWritten) {
     }
     // A budget that fits: written, and the stats give the estimate beside the measured peak,
     // within a factor of two of it (the estimate's stated accuracy on these cities is 20 to 35 %).
-    r = runVista("gen --size 1000 --detail 2 --seed 2 -q --memory-budget 8 -o " + file("c.osgb") + " --stats " + file("s.json"));
+    r = runVista("gen --size 1000 --detail 2 --seed 2 -q --memory-budget 8 -o " + file("c.osgb") + " --stats " +
+                 file("s.json"));
     ASSERT_EQ(r.code, 0) << r.err;
     std::ifstream in(file("s.json"));
     const auto j = nlohmann::json::parse(in);

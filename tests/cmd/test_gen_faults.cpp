@@ -40,7 +40,8 @@ TEST(GenFaults, DiskFullGivesTheCauseAndLeavesTheOldOutputAndNoTemporary) {
 
     // Several outputs: the city and the GeoJSON fit elsewhere, the glTF does
     // not; none of them appears (they are committed together).
-    r = runVista("gen --size 300 -q -o " + dir.file("d.osgb") + " --geojson " + dir.file("d.geojson") + " --gltf " + small + "/d.glb");
+    r = runVista("gen --size 300 -q -o " + dir.file("d.osgb") + " --geojson " + dir.file("d.geojson") + " --gltf " +
+                 small + "/d.glb");
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_NE(r.err.find("No space left on device"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("d.glb"), std::string::npos) << r.err;
@@ -49,8 +50,10 @@ TEST(GenFaults, DiskFullGivesTheCauseAndLeavesTheOldOutputAndNoTemporary) {
 }
 
 // The scene is a file that is not a scene; --out cannot be written.
-void expectOutRefused(const test::TempDir& dir, const std::string& junk, const std::string& out, const std::string& reason) {
-    test::expectRefusedBeforeTheInput(dir.path(), "bench " + junk + " --frames 1 -q --out " + out, junk, "--out", reason);
+void expectOutRefused(const test::TempDir& dir, const std::string& junk, const std::string& out,
+                      const std::string& reason) {
+    test::expectRefusedBeforeTheInput(dir.path(), "bench " + junk + " --frames 1 -q --out " + out, junk, "--out",
+                                      reason);
 }
 
 TEST(BenchFaults, UnwritableOutIsRefusedBeforeTheSceneIsLoaded) {

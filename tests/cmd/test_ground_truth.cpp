@@ -95,8 +95,8 @@ protected:
         if (!display || !*display) GTEST_SKIP() << "no DISPLAY: run the tests under xvfb-run -a";
     }
     static std::string render(const std::string& mode, const std::string& out, const std::string& extra = "") {
-        const auto r = runVista("render " + city + " --path " + pathCsv + " --frames 3 --size " + std::to_string(kW) + "x" +
-                                std::to_string(kH) + " --mode " + mode + " -q --out " + out + " " + extra);
+        const auto r = runVista("render " + city + " --path " + pathCsv + " --frames 3 --size " + std::to_string(kW) +
+                                "x" + std::to_string(kH) + " --mode " + mode + " -q --out " + out + " " + extra);
         EXPECT_EQ(r.code, 0) << r.err;
         return out;
     }
@@ -136,7 +136,8 @@ void checkAgainstRays(const std::string& cityFile, const std::string& out, const
         cam.width = kW;
         cam.height = kH;
         cam.fovY = fovY;
-        cam.eye = {fr["eye_world"][0].get<double>(), fr["eye_world"][1].get<double>(), fr["eye_world"][2].get<double>()};
+        cam.eye = {fr["eye_world"][0].get<double>(), fr["eye_world"][1].get<double>(),
+                   fr["eye_world"][2].get<double>()};
         cam.heading = fr["heading_deg"].get<double>() * M_PI / 180.0;
         cam.pitch = fr["pitch_deg"].get<double>() * M_PI / 180.0;
         const PixelRays gen(cam);
@@ -222,7 +223,8 @@ TEST_F(GroundTruth, CamerasProjectDepthPointsBack) {
         cam.width = kW;
         cam.height = kH;
         cam.fovY = 2.0 * std::atan(0.5 * kH / fy);
-        cam.eye = {fr["eye_world"][0].get<double>(), fr["eye_world"][1].get<double>(), fr["eye_world"][2].get<double>()};
+        cam.eye = {fr["eye_world"][0].get<double>(), fr["eye_world"][1].get<double>(),
+                   fr["eye_world"][2].get<double>()};
         cam.heading = fr["heading_deg"].get<double>() * M_PI / 180.0;
         cam.pitch = fr["pitch_deg"].get<double>() * M_PI / 180.0;
         const auto& M = fr["camera_from_world"];
@@ -236,7 +238,8 @@ TEST_F(GroundTruth, CamerasProjectDepthPointsBack) {
                 const glm::dvec3 P = cam.eye + d * (double(z) / glm::dot(d, cam.forward())) - off;
                 double c[3];
                 for (int r = 0; r < 3; ++r)
-                    c[r] = M[r][0].get<double>() * P.x + M[r][1].get<double>() * P.y + M[r][2].get<double>() * P.z + M[r][3].get<double>();
+                    c[r] = M[r][0].get<double>() * P.x + M[r][1].get<double>() * P.y + M[r][2].get<double>() * P.z +
+                           M[r][3].get<double>();
                 EXPECT_NEAR(c[2], z, 1e-3 * std::max(1.0, double(z)));
                 EXPECT_NEAR(fx * c[0] / c[2] + cx, x, 1e-3);
                 EXPECT_NEAR(fy * c[1] / c[2] + cy, y, 1e-3);
@@ -285,12 +288,14 @@ TEST_F(GroundTruth, OldFileWithoutLabelsAsksToRegenerate) {
     udc->removeUserObject(i);
     const std::string old = dir->file("old.osgb");
     ASSERT_TRUE(bool(writeSceneFile(*root, old)));
-    auto r = runVista("render " + old + " --path " + pathCsv + " --frames 1 --size 64x48 -q --out " + dir->file("old_sem"));
+    auto r =
+        runVista("render " + old + " --path " + pathCsv + " --frames 1 --size 64x48 -q --out " + dir->file("old_sem"));
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_NE(r.err.find("regenerate the city"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir->file("old_sem")));
     // rgb and depth need no labels.
-    r = runVista("render " + old + " --path " + pathCsv + " --frames 1 --size 64x48 --channels rgb,depth -q --out " + dir->file("old_rgb"));
+    r = runVista("render " + old + " --path " + pathCsv + " --frames 1 --size 64x48 --channels rgb,depth -q --out " +
+                 dir->file("old_rgb"));
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(fs::exists(dir->file("old_rgb/depth/000000.npy")));
 }
@@ -311,7 +316,8 @@ void expectResumeEqualsUninterrupted(const std::string& city, const std::string&
                                      const std::string& out, int killAfter, int frames) {
     auto r = runVista("render " + city + " " + args + " -q --out " + ref);
     ASSERT_EQ(r.code, 0) << r.err;
-    r = runVista("render " + city + " " + args + " -q --out " + out, "VISTA_RENDER_KILL_AFTER_FRAMES=" + std::to_string(killAfter));
+    r = runVista("render " + city + " " + args + " -q --out " + out,
+                 "VISTA_RENDER_KILL_AFTER_FRAMES=" + std::to_string(killAfter));
     ASSERT_TRUE(r.code == -1 || r.code == 128 + SIGKILL) << "the hook kills the run: " << r.code << " " << r.err;
     EXPECT_FALSE(fs::exists(out)) << "no output before every frame is written";
     int records = 0;
@@ -342,15 +348,17 @@ TEST_F(GroundTruth, HybridResumesAfterKillByteIdentical) {
     // Consecutive frames and a small ray budget: most far pixels come from the
     // panoramic cache, so frame k depends on frames before it (without the
     // warm-up of the resumed run, frames 3 and 4 differ in rgb).
-    expectResumeEqualsUninterrupted(city,
-                                    "--path " + pathCsv + " --frames 5 --sampling consecutive --size 160x120 --mode hybrid --near 40 --budget 500",
-                                    dir->file("res_hyb_ref"), dir->file("res_hyb"), 3, 5);
+    expectResumeEqualsUninterrupted(
+        city,
+        "--path " + pathCsv + " --frames 5 --sampling consecutive --size 160x120 --mode hybrid --near 40 --budget 500",
+        dir->file("res_hyb_ref"), dir->file("res_hyb"), 3, 5);
 }
 
 TEST_F(GroundTruth, ExternalKillThenResume) {
     // A real SIGKILL from outside once two frames are finished.
     const std::string ref = dir->file("kill_ref"), out = dir->file("kill");
-    const std::vector<std::string> args = {"render", city, "--path", pathCsv, "--frames", "24", "--size", "96x72", "--channels", "rgb,depth", "-q", "--out", out};
+    const std::vector<std::string> args = {"render", city,         "--path",    pathCsv, "--frames", "24", "--size",
+                                           "96x72",  "--channels", "rgb,depth", "-q",    "--out",    out};
     const pid_t pid = test::startVista(args);
     ASSERT_GT(pid, 0);
     bool killed = false;
@@ -371,7 +379,8 @@ TEST_F(GroundTruth, ExternalKillThenResume) {
     for (const auto& w : args) rerun += w + " ";
     auto r = runVista(rerun);
     ASSERT_EQ(r.code, 0) << r.err;
-    r = runVista("render " + city + " --path " + pathCsv + " --frames 24 --size 96x72 --channels rgb,depth -q --out " + ref);
+    r = runVista("render " + city + " --path " + pathCsv + " --frames 24 --size 96x72 --channels rgb,depth -q --out " +
+                 ref);
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(outputFiles(ref) == outputFiles(out));
     EXPECT_FALSE(fs::exists(out + ".partial"));
@@ -381,7 +390,8 @@ TEST_F(GroundTruth, ExternalKillThenResume) {
 
 TEST_F(GroundTruth, ResumeWithOtherParametersIsRefusedOrRestarted) {
     const std::string out = dir->file("res_other"), ref = dir->file("res_other_ref");
-    const std::string base = "render " + city + " --path " + pathCsv + " --frames 3 --channels semantic -q --out " + out;
+    const std::string base =
+        "render " + city + " --path " + pathCsv + " --frames 3 --channels semantic -q --out " + out;
     auto r = runVista(base + " --size 64x48", "VISTA_RENDER_KILL_AFTER_FRAMES=1");
     ASSERT_TRUE(r.code == -1 || r.code == 128 + SIGKILL) << r.code << " " << r.err;
     const std::set<std::string> before = test::listTree(out + ".partial");
@@ -394,13 +404,15 @@ TEST_F(GroundTruth, ResumeWithOtherParametersIsRefusedOrRestarted) {
     // Another city file (other bytes) is refused too.
     const std::string other = dir->file("other_city.osgb");
     ASSERT_EQ(runVista("gen --size 300 --seed 12 -q -o " + other).code, 0);
-    r = runVista("render " + other + " --path " + pathCsv + " --frames 3 --channels semantic -q --out " + out + " --size 64x48");
+    r = runVista("render " + other + " --path " + pathCsv + " --frames 3 --channels semantic -q --out " + out +
+                 " --size 64x48");
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_NE(r.err.find("city_"), std::string::npos) << r.err;  // city_bytes or city_hash
     // --restart discards it and renders the new parameters.
     r = runVista(base + " --size 80x60 --restart");
     ASSERT_EQ(r.code, 0) << r.err;
-    r = runVista("render " + city + " --path " + pathCsv + " --frames 3 --channels semantic -q --size 80x60 --out " + ref);
+    r = runVista("render " + city + " --path " + pathCsv + " --frames 3 --channels semantic -q --size 80x60 --out " +
+                 ref);
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(outputFiles(ref) == outputFiles(out));
     EXPECT_FALSE(fs::exists(out + ".partial"));

@@ -28,8 +28,8 @@ TEST(Options, ImageSize) {
     EXPECT_EQ(s->height, 480);
     EXPECT_EQ(parseImageSize("1X1")->height, 1);
     EXPECT_EQ(parseImageSize("8192x8192")->width, 8192);
-    for (const char* bad : {"0x0", "8193x10", "10x8193", "640", "640x", "x480", "-5x4", "640x480x3", "64 0x480", "ax b", "",
-                            "99999999999x1"})
+    for (const char* bad : {"0x0", "8193x10", "10x8193", "640", "640x", "x480", "-5x4", "640x480x3", "64 0x480", "ax b",
+                            "", "99999999999x1"})
         expectBad(parseImageSize(bad), bad, "--size", "8192");
     EXPECT_TRUE(checkImageSize(1, 1).isOk());
     EXPECT_FALSE(checkImageSize(0, 5).isOk());
@@ -58,7 +58,8 @@ TEST(Options, SamplingAndCacheKnobs) {
     EXPECT_EQ(parseSampling("consecutive").value(), 1);
     EXPECT_EQ(parseSampling("runs:8").value(), 8);
     EXPECT_EQ(parseSampling("runs:100000").value(), 100000);
-    for (const char* text : {"spread", "consecutive", "runs:8"}) EXPECT_EQ(samplingName(parseSampling(text).value()), text);
+    for (const char* text : {"spread", "consecutive", "runs:8"})
+        EXPECT_EQ(samplingName(parseSampling(text).value()), text);
     for (const char* bad : {"runs:0", "runs:", "runs:x", "runs:100001", "runs:-3", "every", ""})
         expectBad(parseSampling(bad), bad, "--sampling", "100000");
     ModeOptions o;
@@ -86,7 +87,8 @@ TEST(Options, FovReferenceAndModes) {
     EXPECT_DOUBLE_EQ(parseSplatSigma("0.25").value(), 0.25);
     EXPECT_EQ(formatSplatSigma(0.25), "0.25");
     EXPECT_EQ(formatSplatSigma(0), "off");
-    for (const char* bad : {"0.01", "4.5", "-1", "wide", ""}) expectBad(parseSplatSigma(bad), bad, "--point-splat", "0.05 .. 4");
+    for (const char* bad : {"0.01", "4.5", "-1", "wide", ""})
+        expectBad(parseSplatSigma(bad), bad, "--point-splat", "0.05 .. 4");
     EXPECT_EQ(parseReference("full").value(), 0);
     EXPECT_EQ(parseReference("ssaa:2").value(), 2);
     EXPECT_EQ(parseReference("ssaa:8").value(), 8);
@@ -95,13 +97,15 @@ TEST(Options, FovReferenceAndModes) {
     auto m = parseModeList("full, near,osglod ,hybrid");
     ASSERT_TRUE(m.isOk()) << m.status().message();
     EXPECT_EQ(m.value(), (std::vector<std::string>{"full", "near", "osglod", "hybrid"}));
-    expectBad(parseModeList("full,warp"), "full,warp", "--modes", "available modes: full, near, raycast, osgimpostor, osglod, hybrid, impostor");
+    expectBad(parseModeList("full,warp"), "full,warp", "--modes",
+              "available modes: full, near, raycast, osgimpostor, osglod, hybrid, impostor");
     expectBad(parseModeList("full,full"), "full,full", "--modes", "twice");
     expectBad(parseModeList(","), ",", "--modes", "available modes");
     EXPECT_EQ(parseModeName("raycast").value(), "raycast");
     expectBad(parseModeName("fast"), "fast", "--mode", "available modes");
     EXPECT_EQ(parseSweep("sizes=500,1000").value(), (std::vector<int>{500, 1000}));
-    for (const char* bad : {"sizes=50", "sizes=", "500,1000", "sizes=1000,x"}) EXPECT_FALSE(parseSweep(bad).isOk()) << bad;
+    for (const char* bad : {"sizes=50", "sizes=", "500,1000", "sizes=1000,x"})
+        EXPECT_FALSE(parseSweep(bad).isOk()) << bad;
 }
 
 TEST(Options, ModeFlagsBecomeModeOptions) {
@@ -130,7 +134,8 @@ TEST(Options, ModeFlagsBecomeModeOptions) {
     threads.threads = 5000;
     baked.baked = "/nonexistent/city.baked.osgb";
     near.near = "-5";
-    for (const Bad& b : {Bad{grid, "--horizon-grid"}, Bad{threads, "--threads"}, Bad{baked, "--baked"}, Bad{near, "--near"}}) {
+    for (const Bad& b :
+         {Bad{grid, "--horizon-grid"}, Bad{threads, "--threads"}, Bad{baked, "--baked"}, Bad{near, "--near"}}) {
         Status s = parseModeFlags(b.flags, o);
         ASSERT_FALSE(s.isOk()) << b.flag;
         EXPECT_NE(s.message().find(b.flag), std::string::npos) << s.message();
@@ -173,7 +178,8 @@ TEST(Options, BakeCellsShardAndTexels) {
     EXPECT_EQ(sh->index, 1);
     EXPECT_EQ(sh->count, 4);
     ASSERT_TRUE(parseShard("--shard", "100000/100000").isOk());
-    for (const char* bad : {"0/4", "5/4", "2/0", "2", "2/", "/4", "2/4x", " 2/4", "+2/4", "a/b", "2\\4", "1/100001", "-1/2", "1/2/3", ""}) {
+    for (const char* bad : {"0/4", "5/4", "2/0", "2", "2/", "/4", "2/4x", " 2/4", "+2/4", "a/b", "2\\4", "1/100001",
+                            "-1/2", "1/2/3", ""}) {
         auto s = parseShard("--shard", bad);
         ASSERT_FALSE(s.isOk()) << bad;
         EXPECT_NE(s.status().message().find("1 <= K <= N"), std::string::npos) << s.status().message();

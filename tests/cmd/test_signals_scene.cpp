@@ -117,9 +117,10 @@ TEST_F(SignalsScene, RenderShowsTrafficLightPixelsWithTheirInstances) {
     for (const std::string mode : {"full", "hybrid"}) {
         const std::string out = dir->file("render_" + mode);
         // hybrid: a 5 m near distance leaves the light (10 m away) to the far-field rays.
-        const auto r = runVista("render " + cityFile + " --path " + pathCsv + " --frames 1 --size " + std::to_string(kW) + "x" +
-                                std::to_string(kH) + " --mode " + mode + (mode == "hybrid" ? " --near 5" : "") +
-                                " --channels semantic,instance -q --out " + out);
+        const auto r =
+            runVista("render " + cityFile + " --path " + pathCsv + " --frames 1 --size " + std::to_string(kW) + "x" +
+                     std::to_string(kH) + " --mode " + mode + (mode == "hybrid" ? " --near 5" : "") +
+                     " --channels semantic,instance -q --out " + out);
         ASSERT_EQ(r.code, 0) << r.err;
         const auto ids = loadIds(out + "/instance/000000.npy");
         auto sem = readPng(out + "/semantic/000000.png");
@@ -135,7 +136,8 @@ TEST_F(SignalsScene, RenderShowsTrafficLightPixelsWithTheirInstances) {
             ++lightPixels;
             ofWanted += ids[p] == want;
             EXPECT_LT(instanceIndex(ids[p]), lanes->signals.size()) << mode;
-            EXPECT_EQ(lanes->signals[instanceIndex(ids[p]) % lanes->signals.size()].kind, SignalPlacement::Kind::TrafficLight);
+            EXPECT_EQ(lanes->signals[instanceIndex(ids[p]) % lanes->signals.size()].kind,
+                      SignalPlacement::Kind::TrafficLight);
         }
         // The housing (0.3 x 0.9 m at about 10.4 m) covers about 8 x 24 pixels at 60 degrees over 120 rows.
         EXPECT_GT(ofWanted, 60u) << mode << ": the light looked at";
@@ -184,13 +186,15 @@ TEST_F(SignalsScene, OpenDriveSignalsAreTheSceneSignalInstances) {
     std::set<uint32_t> instances;
     for (const auto& m : model->meshes)
         for (uint32_t id : m.ids)
-            if (instanceKind(id) == InstanceKind::TrafficLight || instanceKind(id) == InstanceKind::TrafficSign) instances.insert(id);
+            if (instanceKind(id) == InstanceKind::TrafficLight || instanceKind(id) == InstanceKind::TrafficSign)
+                instances.insert(id);
     ASSERT_FALSE(declared.empty());
     EXPECT_EQ(declared.size(), instances.size());
     EXPECT_EQ(declared.size(), lanes->signals.size());
     for (const auto& [id, type] : declared) {
         const InstanceKind k = type == "1000001" ? InstanceKind::TrafficLight : InstanceKind::TrafficSign;
-        EXPECT_TRUE(instances.count(makeInstanceId(k, id))) << "signal " << id << " (type " << type << ") stands in the scene";
+        EXPECT_TRUE(instances.count(makeInstanceId(k, id)))
+            << "signal " << id << " (type " << type << ") stands in the scene";
     }
 }
 

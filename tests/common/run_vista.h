@@ -36,7 +36,9 @@ struct CliRun {
 inline CliRun runVista(const std::string& args, const std::string& env = "") {
     TempDir tmp("vista_cli_err");
     const std::string errFile = tmp.file("stderr.txt");
-    const int st = std::system(((env.empty() ? std::string() : env + " ") + std::string(VISTA_BINARY) + " " + args + " 2>" + errFile + " >/dev/null").c_str());
+    const int st = std::system(((env.empty() ? std::string() : env + " ") + std::string(VISTA_BINARY) + " " + args +
+                                " 2>" + errFile + " >/dev/null")
+                                   .c_str());
     CliRun r;
     r.code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
     r.err = readBytes(errFile);

@@ -12,12 +12,12 @@ namespace vista::test {
 
 inline StreetGraph signalStreets() {
     StreetGraph g;
-    g.nodes = {{0, 0},      {-150, 0},  {0, 110},  {0, -150},  {110, 0},   {190, 0},
-               {110, 120},  {110, -150}, {-120, 110}, {60, 110}};
+    g.nodes = {{0, 0},   {-150, 0},  {0, 110},    {0, -150},   {110, 0},
+               {190, 0}, {110, 120}, {110, -150}, {-120, 110}, {60, 110}};
     g.edges = {{0, 1, RoadClass::Arterial, 13.0f, 4}, {0, 2, RoadClass::Arterial, 13.0f, 4},
                {0, 3, RoadClass::Arterial, 13.0f, 4}, {0, 4, RoadClass::Arterial, 13.0f, 4},
                {4, 5, RoadClass::Arterial, 13.0f, 4}, {4, 6, RoadClass::Local, 7.5f, 2},
-               {4, 7, RoadClass::Local, 7.5f, 2},    {2, 8, RoadClass::Local, 7.5f, 2},
+               {4, 7, RoadClass::Local, 7.5f, 2},     {2, 8, RoadClass::Local, 7.5f, 2},
                {2, 9, RoadClass::Local, 7.5f, 2}};
     return g;
 }

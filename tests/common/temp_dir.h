@@ -26,7 +26,8 @@ inline std::set<std::string> listTree(const std::string& dir) {
     namespace fs = std::filesystem;
     std::set<std::string> names;
     std::error_code ec;
-    for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::recursive_directory_iterator(); it.increment(ec))
+    for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::recursive_directory_iterator();
+         it.increment(ec))
         names.insert(fs::relative(it->path(), dir).string());
     return names;
 }
@@ -43,7 +44,8 @@ public:
         namespace fs = std::filesystem;
         std::error_code ec;
         // Tests make entries read-only to provoke write errors: restore write access first.
-        for (auto it = fs::recursive_directory_iterator(_path, ec); !ec && it != fs::recursive_directory_iterator(); it.increment(ec))
+        for (auto it = fs::recursive_directory_iterator(_path, ec); !ec && it != fs::recursive_directory_iterator();
+             it.increment(ec))
             fs::permissions(it->path(), fs::perms::owner_write, fs::perm_options::add, ec);
         fs::permissions(_path, fs::perms::owner_all, fs::perm_options::add, ec);
         fs::remove_all(_path, ec);

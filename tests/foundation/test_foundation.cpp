@@ -75,7 +75,10 @@ TEST(AtomicFile, WritesWholeFileAndLeavesNoTemporary) {
     ASSERT_TRUE(writeFileAtomic(f, "short").isOk());  // replaces
     EXPECT_EQ(test::readBytes(f), "short");
     size_t entries = 0;
-    for (const auto& e : std::filesystem::directory_iterator(dir.path())) { (void)e; ++entries; }
+    for (const auto& e : std::filesystem::directory_iterator(dir.path())) {
+        (void)e;
+        ++entries;
+    }
     EXPECT_EQ(entries, 1u);
 }
 
@@ -94,7 +97,7 @@ TEST(AtomicFile, StaleTemporariesOfKilledRunsAreRemovedAndLiveOnesKept) {
     const std::string dead = target + ".tmp." + std::to_string(deadPid());
     const std::string deadStage = target + ".stage." + std::to_string(deadPid());
     const std::string live = target + ".tmp." + std::to_string(::getppid());  // the parent runs
-    const std::string other = dir.file("other.osgb.tmp.1");                    // another file's
+    const std::string other = dir.file("other.osgb.tmp.1");                   // another file's
     for (const auto& f : {dead, deadStage, live, other}) std::ofstream(f) << "partial";
     ASSERT_TRUE(writeFileAtomic(target, "whole"));
     EXPECT_FALSE(std::filesystem::exists(dead));

@@ -23,7 +23,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             for (const auto& p : f.outer)
                 if (!(std::abs(p.x) <= half && std::abs(p.y) <= half)) std::abort();
             for (const auto& h : f.holes)
-                if (!vista::isSimpleRingExact(h) || !(vista::signedArea(h) < 0) || !vista::ringStrictlyInside(h, f.outer)) std::abort();
+                if (!vista::isSimpleRingExact(h) || !(vista::signedArea(h) < 0) ||
+                    !vista::ringStrictlyInside(h, f.outer))
+                    std::abort();
         }
     }
     return 0;

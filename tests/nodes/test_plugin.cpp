@@ -70,8 +70,8 @@ bool onPath(const std::string& tool) {
 int runOsgconv(const std::string& libPath, const std::string& in, const std::string& out, const std::string& log) {
     const char* preload = std::getenv("VISTA_TEST_PRELOAD");
     const std::string pre = preload && *preload ? " LD_PRELOAD='" + std::string(preload) + "'" : std::string();
-    const std::string cmd = "env OSG_LIBRARY_PATH='" + libPath + "'" + pre + " OSG_OPTIMIZER=OFF osgconv '" + in + "' '" + out +
-                            "' > '" + log + "' 2>&1";
+    const std::string cmd = "env OSG_LIBRARY_PATH='" + libPath + "'" + pre + " OSG_OPTIMIZER=OFF osgconv '" + in +
+                            "' '" + out + "' > '" + log + "' 2>&1";
     const int rc = std::system(cmd.c_str());
     return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
 }
@@ -220,4 +220,3 @@ TEST(Plugin, StockOsgconvRoundTripsTexturedDepthMesh) {
 }
 
 }  // namespace
-

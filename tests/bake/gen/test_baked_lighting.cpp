@@ -105,7 +105,9 @@ TEST(BakedLighting, HardCasesStayFinite) {
             const glm::u8vec4 lit = prelitColor(Material::Ground, {0, 0, 1}, light);
             for (size_t i = 0; i < g.positions.size(); ++i) {
                 const glm::dvec3 p = city.tiles[0].origin + glm::dvec3(g.positions[i]);
-                if (std::max(std::abs(p.x), std::abs(p.y)) > 5 + 6.5) { EXPECT_GE(g.colors[i].x + 2, lit.x) << p.x << "," << p.y; }
+                if (std::max(std::abs(p.x), std::abs(p.y)) > 5 + 6.5) {
+                    EXPECT_GE(g.colors[i].x + 2, lit.x) << p.x << "," << p.y;
+                }
             }
         }
     }
@@ -136,7 +138,8 @@ TEST(BakedLighting, NotCalledForMeansNothingChanges) {
     BakedLightingStats st;
     ASSERT_TRUE(bakeLighting(city, nullptr, st));
     EXPECT_FALSE(st.ran);
-    EXPECT_EQ(city.tiles[0].meshes[size_t(Material::Ground)].colors, copy.tiles[0].meshes[size_t(Material::Ground)].colors);
+    EXPECT_EQ(city.tiles[0].meshes[size_t(Material::Ground)].colors,
+              copy.tiles[0].meshes[size_t(Material::Ground)].colors);
 }
 
 }  // namespace

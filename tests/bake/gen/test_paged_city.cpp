@@ -67,7 +67,8 @@ protected:
     // One reference run shared by the tests (threads 1).
     static void SetUpTestSuite() {
         ref = new TempDir("vista_paged_ref");
-        const CliRun r = runVista(kCity + " --threads 1 -o " + ref->file("city.paged") + " --stats " + ref->file("stats.json"));
+        const CliRun r =
+            runVista(kCity + " --threads 1 -o " + ref->file("city.paged") + " --stats " + ref->file("stats.json"));
         ASSERT_EQ(r.code, 0) << r.err;
         files = new std::map<std::string, std::string>(snapshot(ref->file("city.paged")));
     }
@@ -141,7 +142,8 @@ TEST_F(Paged, LayoutAndManifest) {
             const std::string bytes = readBytes(dir + "/" + f["name"].get<std::string>());
             EXPECT_EQ(bytes.size(), f["bytes"].get<size_t>()) << f["name"];
             char hex[17];
-            std::snprintf(hex, sizeof hex, "%016llx", (unsigned long long)vista::hashBytes64(bytes.data(), bytes.size()));
+            std::snprintf(hex, sizeof hex, "%016llx",
+                          (unsigned long long)vista::hashBytes64(bytes.data(), bytes.size()));
             EXPECT_EQ(f["hash"].get<std::string>(), hex) << f["name"];
         }
     }
@@ -153,7 +155,8 @@ TEST_F(Paged, LayoutAndManifest) {
 // centroid) and is the one the unpaged generator places on that lot, so the
 // union of the regions' buildings is the unpaged city's building count.
 TEST_F(Paged, BuildingCountsEqualTheUnpagedCity) {
-    const CliRun r = runVista("gen --size 1500 --seed 4 --detail 1 -q -o " + tmp.file("one.osgb") + " --stats " + tmp.file("one.json"));
+    const CliRun r = runVista("gen --size 1500 --seed 4 --detail 1 -q -o " + tmp.file("one.osgb") + " --stats " +
+                              tmp.file("one.json"));
     ASSERT_EQ(r.code, 0) << r.err;
     const auto one = readJson(tmp.file("one.json"));
     const auto m = readJson(ref->file("city.paged") + "/manifest.json");
@@ -177,8 +180,14 @@ TEST_F(Paged, SameBytesForAnyThreadCountAndShards) {
     const std::string sh = tmp.file("shards.paged");
     std::vector<pid_t> pids;
     for (int i = 0; i < 3; ++i) {
-        std::vector<std::string> args{"gen", "--size", "1500", "--seed", "4", "--detail", "1", "--region-size", "500", "-q",
-                                      "--threads", "1", "--shard", std::to_string(i + 1) + "/3", "-o", sh};
+        std::vector<std::string> args{"gen",       "--size",
+                                      "1500",      "--seed",
+                                      "4",         "--detail",
+                                      "1",         "--region-size",
+                                      "500",       "-q",
+                                      "--threads", "1",
+                                      "--shard",   std::to_string(i + 1) + "/3",
+                                      "-o",        sh};
         pids.push_back(vista::test::startVista(args));
     }
     for (pid_t p : pids) {
@@ -211,14 +220,14 @@ TEST_F(Paged, ResumeRegeneratesOnlyDamagedRegions) {
     fs::copy(ref->file("city.paged"), dir, fs::copy_options::recursive);
     fs::remove(dir + "/index.osgb");
     fs::remove(dir + "/manifest.json");
-    fs::remove(dir + "/region_0_0.osgb");                         // missing
-    fs::resize_file(dir + "/region_1_1.osgb", 1000);               // truncated
+    fs::remove(dir + "/region_0_0.osgb");             // missing
+    fs::resize_file(dir + "/region_1_1.osgb", 1000);  // truncated
     {
         std::fstream f(dir + "/region_2_2.coarse.osgb", std::ios::in | std::ios::out | std::ios::binary);
         f.seekp(600);
-        f.put('\x5a');                                              // one byte changed
+        f.put('\x5a');  // one byte changed
     }
-    fs::remove(dir + "/records/region_2_0.json");                  // files but no record (killed before it)
+    fs::remove(dir + "/records/region_2_0.json");  // files but no record (killed before it)
     const CliRun r = runVista(kCity + " -o " + dir + " --stats " + tmp.file("s.json"));
     ASSERT_EQ(r.code, 0) << r.err;
     const auto s = readJson(tmp.file("s.json"));
@@ -229,8 +238,8 @@ TEST_F(Paged, ResumeRegeneratesOnlyDamagedRegions) {
 
 TEST_F(Paged, KillNineThenResumeGivesTheSameBytes) {
     const std::string dir = tmp.file("killed.paged");
-    std::vector<std::string> args{"gen", "--size", "1500", "--seed", "4", "--detail", "1", "--region-size", "500", "-q",
-                                  "--threads", "1", "-o", dir};
+    std::vector<std::string> args{"gen",           "--size", "1500", "--seed",    "4", "--detail", "1",
+                                  "--region-size", "500",    "-q",   "--threads", "1", "-o",       dir};
     const pid_t pid = vista::test::startVista(args);
     // Kill it once the first region is recorded (a record renamed into place; mid-run: 9 regions).
     auto recorded = [&] {
@@ -293,19 +302,19 @@ TEST_F(Paged, IndexHasOnePagedLodPerRegion) {
             const osg::BoundingBox box = cbv.getBoundingBox();
             ASSERT_TRUE(box.valid()) << f;
             for (unsigned c = 0; c < 8; ++c)
-                EXPECT_LE((box.corner(c) - bs.center()).length(), bs.radius() * 1.0001f + 0.01f) << f << " corner " << c;
+                EXPECT_LE((box.corner(c) - bs.center()).length(), bs.radius() * 1.0001f + 0.01f)
+                    << f << " corner " << c;
         }
     }
     for (const auto& r : m["regions"])
-        if (!r["empty"].get<bool>()) {
-            EXPECT_EQ(named.count(r["files"][0]["name"].get<std::string>()), 1u);
-        }
+        if (!r["empty"].get<bool>()) { EXPECT_EQ(named.count(r["files"][0]["name"].get<std::string>()), 1u); }
     // The stock reader: the PagedLODs get the index's directory as database path.
     osg::ref_ptr<osg::Node> stock = osgDB::readNodeFile(dir + "/index.osgb");
     ASSERT_TRUE(stock.valid());
     auto* lod = dynamic_cast<osg::PagedLOD*>(stock->asGroup()->getChild(0));
     ASSERT_NE(lod, nullptr);
-    EXPECT_TRUE(fs::exists(lod->getDatabasePath() + lod->getFileName(1))) << lod->getDatabasePath() << lod->getFileName(1);
+    EXPECT_TRUE(fs::exists(lod->getDatabasePath() + lod->getFileName(1)))
+        << lod->getDatabasePath() << lod->getFileName(1);
 }
 
 // A region file that is missing or damaged is an error for vista's reader and
@@ -413,8 +422,12 @@ struct FindImpostors : osg::NodeVisitor {
             ++geometries;
             instances += size_t(geo->getPrimitiveSet(0)->getNumInstances());
             const osg::StateSet* ss = geo->getStateSet();
-            auto* tex = ss ? dynamic_cast<const osg::Texture2D*>(ss->getTextureAttribute(0, osg::StateAttribute::TEXTURE)) : nullptr;
-            if (tex && tex->getImage() && tex->getImage()->s() == 2 * vista::kCoarseImpostorCellPixels && tex->getImage()->data()) ++textured;
+            auto* tex =
+                ss ? dynamic_cast<const osg::Texture2D*>(ss->getTextureAttribute(0, osg::StateAttribute::TEXTURE))
+                   : nullptr;
+            if (tex && tex->getImage() && tex->getImage()->s() == 2 * vista::kCoarseImpostorCellPixels &&
+                tex->getImage()->data())
+                ++textured;
         }
     }
 };
@@ -430,7 +443,8 @@ TEST_F(Paged, CoarseLevelDrawsTreesAsImpostors) {
     const auto manifest = readJson(dir + "/manifest.json");
     for (const auto& r : manifest["regions"]) {
         if (r["empty"].get<bool>()) continue;
-        const std::string name = "region_" + std::to_string(r["ix"].get<int>()) + "_" + std::to_string(r["iy"].get<int>());
+        const std::string name =
+            "region_" + std::to_string(r["ix"].get<int>()) + "_" + std::to_string(r["iy"].get<int>());
         auto full = vista::loadCityFile(dir + "/" + name + ".osgb");
         auto coarse = vista::loadCityFile(dir + "/" + name + ".coarse.osgb");
         ASSERT_TRUE(full.isOk() && coarse.isOk()) << name;

@@ -30,9 +30,9 @@
 using namespace vista;
 namespace fs = std::filesystem;
 
-#define REQUIRE_DISPLAY()                                                                        \
-    do {                                                                                         \
-        const char* d = std::getenv("DISPLAY");                                                  \
+#define REQUIRE_DISPLAY()                                                                         \
+    do {                                                                                          \
+        const char* d = std::getenv("DISPLAY");                                                   \
         if (!d || !*d) GTEST_SKIP() << "no X display: run the rendering tests under xvfb-run -a"; \
     } while (0)
 
@@ -82,7 +82,8 @@ inline osg::ref_ptr<osg::Group> sceneOf(const std::vector<SceneMesh>& meshes) {
         g->setUseVertexBufferObjects(true);
         osg::ref_ptr<osg::Geode> geode = new osg::Geode;
         geode->addDrawable(g.get());
-        osg::ref_ptr<osg::MatrixTransform> mt = new osg::MatrixTransform(osg::Matrixd::translate(m.origin.x, m.origin.y, m.origin.z));
+        osg::ref_ptr<osg::MatrixTransform> mt =
+            new osg::MatrixTransform(osg::Matrixd::translate(m.origin.x, m.origin.y, m.origin.z));
         mt->addChild(geode.get());
         root->addChild(mt.get());
     }

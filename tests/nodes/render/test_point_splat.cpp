@@ -105,7 +105,8 @@ TEST(Splats, AverageThePointsOfEachPixelAndKeepTheDepthOrder) {
         const double px = (c.x / c.w * 0.5 + 0.5) * W, py = (1.0 - (c.y / c.w * 0.5 + 0.5)) * H;
         const double v = d.colors[k].x / 255.0;
         const int x0 = int(std::floor(px)), y0 = int(std::floor(py));
-        if (x0 >= 0 && y0 >= 0 && x0 < W && y0 < H) bsum[size_t(y0) * W + size_t(x0)] += v, ++bcount[size_t(y0) * W + size_t(x0)];
+        if (x0 >= 0 && y0 >= 0 && x0 < W && y0 < H)
+            bsum[size_t(y0) * W + size_t(x0)] += v, ++bcount[size_t(y0) * W + size_t(x0)];
         for (int y = y0 - 1; y <= y0 + 1; ++y)
             for (int x = x0 - 1; x <= x0 + 1; ++x) {
                 if (x < 0 || y < 0 || x >= W || y >= H) continue;
@@ -157,7 +158,8 @@ TEST(Splats, AverageThePointsOfEachPixelAndKeepTheDepthOrder) {
     EXPECT_LT(eDef, 0.03) << "splats against their CPU definition";
     // Plain points show one point per pixel (about 0.5 off the grey box mean);
     // the splats average the pixel's points.
-    EXPECT_LT(eSplatBox, 0.5 * ePointBox) << "splats " << eSplatBox << " vs plain points " << ePointBox << " from the box mean";
+    EXPECT_LT(eSplatBox, 0.5 * ePointBox)
+        << "splats " << eSplatBox << " vs plain points " << ePointBox << " from the box mean";
 
     // Depth order: the red quad in front hides the splats whether it is drawn
     // before (bin 0) or after (bin 2) them; outside it the facade is unchanged.

@@ -34,7 +34,8 @@ TEST(RayRaster, StillFrameOfHybridAndRaysMatchTheRasteriser) {
     p.origin_x = 250000.0;  // far from the world origin: frames must still line up
     auto city = generateCity(p);
     ASSERT_TRUE(city.isOk()) << city.status().message();
-    std::string path = std::filesystem::temp_directory_path() / ("vista_farfield_" + std::to_string(getpid()) + ".osgb");
+    std::string path =
+        std::filesystem::temp_directory_path() / ("vista_farfield_" + std::to_string(getpid()) + ".osgb");
     ASSERT_TRUE(writeCityFile(*city, path).isOk());
     auto loaded = loadCityFile(path);
     std::filesystem::remove(path);
@@ -43,8 +44,8 @@ TEST(RayRaster, StillFrameOfHybridAndRaysMatchTheRasteriser) {
     ASSERT_TRUE(rs.isOk());
     const int W = 160, H = 120;
     auto renderer = OffscreenRenderer::create(W, H);
-    ASSERT_TRUE(renderer.isOk()) << "DISPLAY=" << d << " is set, but the renderer did not start: "
-                                 << renderer.status().message();
+    ASSERT_TRUE(renderer.isOk()) << "DISPLAY=" << d
+                                 << " is set, but the renderer did not start: " << renderer.status().message();
     ModeContext ctx;
     ctx.city = &*loaded;
     ctx.scene = sceneRoot(*loaded);
@@ -111,11 +112,12 @@ TEST(RayRaster, StillFrameOfHybridAndRaysMatchTheRasteriser) {
         EXPECT_EQ(hs.pixels.total(), uint64_t(W) * H);
         EXPECT_GT(rsStats.pixels.rayHit, 0u);
         EXPECT_EQ(rsStats.raysCast, rsStats.pixels.rayHit + rsStats.pixels.rayMiss);  // no near field: no seam rays
-        std::printf("camera z=%.1f: PSNR hybrid %.2f dB, rays-only %.2f dB; covered %llu horizon %llu hit %llu miss %llu, "
-                    "rays cast %llu\n",
-                    c.eye.z, psnrH, psnrR, (unsigned long long)hs.pixels.covered,
-                    (unsigned long long)hs.pixels.horizonCulled, (unsigned long long)hs.pixels.rayHit,
-                    (unsigned long long)hs.pixels.rayMiss, (unsigned long long)hs.raysCast);
+        std::printf(
+            "camera z=%.1f: PSNR hybrid %.2f dB, rays-only %.2f dB; covered %llu horizon %llu hit %llu miss %llu, "
+            "rays cast %llu\n",
+            c.eye.z, psnrH, psnrR, (unsigned long long)hs.pixels.covered, (unsigned long long)hs.pixels.horizonCulled,
+            (unsigned long long)hs.pixels.rayHit, (unsigned long long)hs.pixels.rayMiss,
+            (unsigned long long)hs.raysCast);
     }
 }
 
@@ -143,8 +145,8 @@ TEST(RayRaster, OsgNodesCompositeTheFarFieldInsideAnOsgFrame) {
     ASSERT_TRUE(split && far);
     EXPECT_GT(split->getNumChildren(), 4u);
     auto renderer = OffscreenRenderer::create(160, 120);
-    ASSERT_TRUE(renderer.isOk()) << "DISPLAY=" << d << " is set, but the renderer did not start: "
-                                 << renderer.status().message();
+    ASSERT_TRUE(renderer.isOk()) << "DISPLAY=" << d
+                                 << " is set, but the renderer did not start: " << renderer.status().message();
     Camera c;
     const auto& n = loaded->streets.nodes[3 % loaded->streets.nodes.size()];
     c.eye = glm::dvec3(n.x, n.y, 1.7);
@@ -165,8 +167,8 @@ TEST(RayRaster, OsgNodesCompositeTheFarFieldInsideAnOsgFrame) {
     EXPECT_GT(st.pixels.rayHit, 0u);  // far geometry was traced, not only the near field drawn
     EXPECT_GE(st.raysCast, st.pixels.rayHit + st.pixels.rayMiss);
     const double psnr = lumaPsnr(hyb, full);
-    std::printf("OSG nodes: PSNR %.2f dB, near triangles %llu of %zu\n", psnr, (unsigned long long)split->lastNearTriangles(),
-                loaded->triangles);
+    std::printf("OSG nodes: PSNR %.2f dB, near triangles %llu of %zu\n", psnr,
+                (unsigned long long)split->lastNearTriangles(), loaded->triangles);
     EXPECT_GE(psnr, 40.0);
     // The viewer hides the sky layer under the hybrid (RenderMode::drawsSky):
     // the far-field node writes every uncovered pixel, so the picture is the same.
@@ -177,7 +179,8 @@ TEST(RayRaster, OsgNodesCompositeTheFarFieldInsideAnOsgFrame) {
     // horizon was traced during the near field's draw, and last frame's traced pixels
     // were cast ahead (FarField::beginFrame).
     auto noted = [](const FrameStats& s, const std::string& what) {
-        return std::any_of(s.notes.begin(), s.notes.end(), [&](const std::string& n) { return n.find(what) != std::string::npos; });
+        return std::any_of(s.notes.begin(), s.notes.end(),
+                           [&](const std::string& n) { return n.find(what) != std::string::npos; });
     };
     st = far->lastStats();
     EXPECT_TRUE(noted(st, "horizon overlapped"));

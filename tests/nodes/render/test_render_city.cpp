@@ -43,8 +43,14 @@ Fractions analyse(const Image& img, const Camera& cam) {
         for (int x = 0; x < img.width; ++x) {
             auto c = img.at(x, y);
             bool sky = isSky(c, skyImg.at(x, y));
-            if (y < img.height / 2) { ++nTop; top += sky; }
-            if (y >= img.height * 3 / 4) { ++nBottom; bottom += sky; }
+            if (y < img.height / 2) {
+                ++nTop;
+                top += sky;
+            }
+            if (y >= img.height * 3 / 4) {
+                ++nBottom;
+                bottom += sky;
+            }
             uint32_t key = (uint32_t(c.x) >> 3) << 10 | (uint32_t(c.y) >> 3) << 5 | (uint32_t(c.z) >> 3);
             seen.push_back(key);
         }

@@ -57,7 +57,7 @@ TEST(Offscreen, SkyBackgroundMatchesTheCpuSkyExactly) {
     renderSky(cam, sky);
     EXPECT_EQ(lumaPsnr(img, sky), kPsnrCapDb);
     EXPECT_NE(img.at(0, 0), img.at(0, 71));  // the gradient is there, row 0 at the top
-    EXPECT_EQ(st.triangles, 0u);              // the background is not counted
+    EXPECT_EQ(st.triangles, 0u);             // the background is not counted
 }
 
 TEST(Offscreen, ColourDepthOrientationAndCounts) {
@@ -75,12 +75,13 @@ TEST(Offscreen, ColourDepthOrientationAndCounts) {
     std::vector<float> depth;
     FrameStats st;
     ASSERT_TRUE(r.value()->render(scene.get(), cam, 0.0, &img, &depth, st).isOk());
-    EXPECT_EQ(img.at(48, 0), glm::u8vec4(255, 0, 0, 255));   // top: wall
+    EXPECT_EQ(img.at(48, 0), glm::u8vec4(255, 0, 0, 255));                           // top: wall
     EXPECT_EQ(img.at(48, 71), skyColor(std::asin(cam.rayDirection(48.5, 71.5).z)));  // bottom: sky
     ASSERT_EQ(depth.size(), size_t(96 * 72));
     // Infinite far plane: window depth = 1 - zNear / distance.
     double d0 = depth[size_t(0 * 96 + 48)];
-    double dist = 50.0 / glm::dot(cam.rayDirection(48.5, 0.5), cam.forward()) * glm::dot(cam.rayDirection(48.5, 0.5), cam.forward());
+    double dist = 50.0 / glm::dot(cam.rayDirection(48.5, 0.5), cam.forward()) *
+                  glm::dot(cam.rayDirection(48.5, 0.5), cam.forward());
     EXPECT_NEAR(d0, 1.0 - cam.zNear / dist, 1e-5);
     EXPECT_EQ(depth[size_t(71 * 96 + 48)], 1.0f);
     EXPECT_EQ(st.triangles, 2u);
@@ -128,7 +129,8 @@ struct ImpostorFrame {
 };
 
 // osgimpostor at `first` (sprites made there), then at `cam`, against full at `cam`.
-ImpostorFrame renderOsgImpostor(osg::Group* scene, OffscreenRenderer& renderer, const Camera& first, const Camera& cam) {
+ImpostorFrame renderOsgImpostor(osg::Group* scene, OffscreenRenderer& renderer, const Camera& first,
+                                const Camera& cam) {
     ModeContext ctx;
     ctx.scene = scene;
     ctx.renderer = &renderer;
@@ -185,8 +187,8 @@ TEST(ViewCamera, PoseFromOsgMatricesRoundTrips) {
     for (double zFar : {0.0, 1.0e5}) {
         Camera back;
         double zf = -1;
-        ASSERT_TRUE(cameraFromOsg(osg::Matrixd(glm::value_ptr(c.view())), osg::Matrixd(glm::value_ptr(c.projection(zFar))),
-                                  c.width, c.height, back, zf))
+        ASSERT_TRUE(cameraFromOsg(osg::Matrixd(glm::value_ptr(c.view())),
+                                  osg::Matrixd(glm::value_ptr(c.projection(zFar))), c.width, c.height, back, zf))
             << zFar;
         EXPECT_NEAR(glm::length(back.eye - c.eye), 0.0, 1e-6) << zFar;
         EXPECT_NEAR(back.heading, c.heading, 1e-9) << zFar;
@@ -241,7 +243,8 @@ TEST(Bench, RaycastAgreesWithFull) {
     ASSERT_TRUE(ray.value()->renderFrame(cam, b, sb).isOk());
     double psnr = lumaPsnr(a, b);
     EXPECT_GE(psnr, 30.0) << "raycast vs full";
-    std::printf("raycast vs full on a still frame: %.2f dB, %.4f of pixels differ by > 8\n", psnr, fractionDiffering(a, b, 8));
+    std::printf("raycast vs full on a still frame: %.2f dB, %.4f of pixels differ by > 8\n", psnr,
+                fractionDiffering(a, b, 8));
     EXPECT_GT(sb.pixels.rayHit, 0u);
     EXPECT_GT(sb.pixels.rayMiss, 0u);
     EXPECT_EQ(sb.pixels.rayHit + sb.pixels.rayMiss, uint64_t(160 * 120));

@@ -87,9 +87,7 @@ TEST(OsgLodTreeImpostors, FarLevelDrawsTreesAsImpostors) {
     // least that fraction of the triangles (it stops there or earlier).
     EXPECT_LT(double(n.impostor[2]), kOsgLodRatio2 * double(n.prototype[0]))
         << "impostors: " << n.impostor[2] << ", level 0 trees: " << n.prototype[0];
-    if (kOsgLodTreeImpostorLevel == 1) {
-        EXPECT_LT(double(n.impostor[1]), kOsgLodRatio1 * double(n.prototype[0]));
-    }
+    if (kOsgLodTreeImpostorLevel == 1) { EXPECT_LT(double(n.impostor[1]), kOsgLodRatio1 * double(n.prototype[0])); }
 }
 
 }  // namespace

@@ -47,7 +47,8 @@ inline TestCity testCity(uint32_t seed, int boxes, double ox = 0.0) {
     return t;
 }
 
-inline Camera cam(const glm::dvec3& eye, double heading, double pitch = 0.0, int w = 120, int h = 80, double roll = 0.0) {
+inline Camera cam(const glm::dvec3& eye, double heading, double pitch = 0.0, int w = 120, int h = 80,
+                  double roll = 0.0) {
     return testCamera(eye, heading, pitch, w, h, 0.8, roll);
 }
 

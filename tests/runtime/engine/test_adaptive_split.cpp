@@ -36,7 +36,8 @@ ProbeScene probeScene(uint32_t seed) {
 std::vector<SplitObject> squareObjects() {
     std::vector<SplitObject> objs;
     for (int x = -8; x < 8; ++x)
-        for (int y = -8; y < 8; ++y) objs.push_back(box({x * 50.0, y * 50.0, 0}, {x * 50.0 + 50, y * 50.0 + 50, 60}, 1000));
+        for (int y = -8; y < 8; ++y)
+            objs.push_back(box({x * 50.0, y * 50.0, 0}, {x * 50.0 + 50, y * 50.0 + 50, 60}, 1000));
     return objs;
 }
 // A 64x48 camera at `eye`, looking along +y.
@@ -58,10 +59,10 @@ AdaptiveSplitOptions measuredOnly() {
 
 TEST(Split, DistanceSelectionDrawsStraddlingObjectsWhole) {
     std::vector<SplitObject> objs = {
-        box({10, -1, 0}, {20, 1, 5}, 10),     // 10 m away
-        box({95, -1, 0}, {120, 1, 5}, 20),    // straddles 100 m
-        box({101, -1, 0}, {130, 1, 5}, 30),   // just beyond
-        box({-5, -5, 0}, {5, 5, 50}, 40),     // contains the eye
+        box({10, -1, 0}, {20, 1, 5}, 10),    // 10 m away
+        box({95, -1, 0}, {120, 1, 5}, 20),   // straddles 100 m
+        box({101, -1, 0}, {130, 1, 5}, 30),  // just beyond
+        box({-5, -5, 0}, {5, 5, 50}, 40),    // contains the eye
     };
     auto sel = selectNearField(objs, glm::dvec3(0, 0, 2), 100.0);
     EXPECT_EQ(sel, (std::vector<uint32_t>{0, 1, 3}));
@@ -308,9 +309,11 @@ TEST(Split, GridIndexSelectsExactlyWhatTheLinearScanSelects) {
         EXPECT_EQ(index.totalTriangles(), total);
         std::uniform_real_distribution<double> eyeXY(-2500.0, 2500.0);
         for (int e = 0; e < 40; ++e) {
-            const glm::dvec3 eye = e == 0 ? glm::dvec3(40010, 40010, 2) : glm::dvec3(eyeXY(rng), eyeXY(rng), e % 3 == 0 ? 300.0 : 1.7);
+            const glm::dvec3 eye =
+                e == 0 ? glm::dvec3(40010, 40010, 2) : glm::dvec3(eyeXY(rng), eyeXY(rng), e % 3 == 0 ? 300.0 : 1.7);
             for (double d : {0.0, 15.0, 100.0, 333.3, 800.0, 5000.0, std::numeric_limits<double>::infinity()}) {
-                ASSERT_EQ(index.within(eye, d), selectNearField(objs, eye, d)) << "cell " << cell << " eye " << e << " d " << d;
+                ASSERT_EQ(index.within(eye, d), selectNearField(objs, eye, d))
+                    << "cell " << cell << " eye " << e << " d " << d;
                 std::vector<std::pair<double, uint64_t>> near;
                 index.distances(eye, d, near);
                 uint64_t sum = 0;

@@ -131,7 +131,8 @@ TEST(Reflections, BudgetBoundsTheRaysAndZeroBudgetOnlyClearsMarks) {
         EXPECT_FALSE(hasGlassPixels(img)) << budget;
         // Two rays (find the pane, reflect) per sampled block, at most `budget` blocks
         // (the stride stops at 64 pixels: at most ceil(320/64) * ceil(240/64) blocks).
-        EXPECT_LE(st.reflectionRays, uint64_t(2 * std::max<int64_t>(budget == 0 ? 0 : 20, std::min<int64_t>(budget, 320 * 240))))
+        EXPECT_LE(st.reflectionRays,
+                  uint64_t(2 * std::max<int64_t>(budget == 0 ? 0 : 20, std::min<int64_t>(budget, 320 * 240))))
             << budget;
         if (budget == 0) EXPECT_EQ(st.reflectionRays, 0u);
         else EXPECT_GT(st.reflectionRays, 0u);
@@ -145,9 +146,9 @@ TEST(Reflections, GrazingAndParallelRaysStayFinite) {
     fx.glass = fx.glassMarked = true;
     fx.rayBudget = 1 << 20;
     fx.haze = true;
-    fx.visibility = 20;  // the shortest haze too
+    fx.visibility = 20;                                           // the shortest haze too
     for (double heading : {1.55, 1.5707963, 1.58, -1.5707963}) {  // along the pane (x axis)
-        for (double z : {20.0 - 1e-4, 20.0 - 0.01}) {              // eye on / next to the glass plane's side
+        for (double z : {20.0 - 1e-4, 20.0 - 0.01}) {             // eye on / next to the glass plane's side
             Camera c = lookNorth(96, 64);
             c.eye = {0, z, 2};
             c.heading = heading;

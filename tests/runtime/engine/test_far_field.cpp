@@ -56,12 +56,13 @@ std::vector<float> fakeNearField(const RayScene& rs, const Camera& c, double cut
 // colour or the sky.
 struct Reference {
     Image image;
-    std::vector<uint8_t> hit;     // per pixel: 1 = shows a ray's hit (uncovered or seam)
-    std::vector<uint8_t> covered; // per pixel: covered and kept
+    std::vector<uint8_t> hit;      // per pixel: 1 = shows a ray's hit (uncovered or seam)
+    std::vector<uint8_t> covered;  // per pixel: covered and kept
     uint64_t seamRays = 0, seamHits = 0;
 };
 
-Reference reference(const RayScene& rs, const Camera& c, const float* depth, const Image& start, const FarFieldOptions& o) {
+Reference reference(const RayScene& rs, const Camera& c, const float* depth, const Image& start,
+                    const FarFieldOptions& o) {
     Reference r;
     r.image = start;
     const size_t N = size_t(c.width) * size_t(c.height);
@@ -78,7 +79,8 @@ Reference reference(const RayScene& rs, const Camera& c, const float* depth, con
             const glm::dvec3 d = c.rayDirection(x + 0.5, y + 0.5);
             if (depth && depth[i] < 1.0f) {
                 r.covered[i] = 1;
-                const glm::dvec4 ndc(2.0 * (x + 0.5) / c.width - 1.0, 1.0 - 2.0 * (y + 0.5) / c.height, 2.0 * depth[i] - 1.0, 1.0);
+                const glm::dvec4 ndc(2.0 * (x + 0.5) / c.width - 1.0, 1.0 - 2.0 * (y + 0.5) / c.height,
+                                     2.0 * depth[i] - 1.0, 1.0);
                 const glm::dvec4 e = inv * ndc;
                 const double dist = glm::length(glm::dvec3(e) / e.w);
                 if (!o.verifySeam || o.nearDistance <= 0 || dist <= o.nearDistance) continue;
@@ -118,8 +120,8 @@ TEST(FarFieldFrame, MatchesAPerPixelReferenceWithTruthfulCounts) {
             bool nearField;
         };
         const std::vector<Case> cases = {
-            {cam(o + glm::dvec3(0, -150, 1.7), 0.2), 30, 60, true},           // street, finite far plane
-            {cam(o + glm::dvec3(20, -170, 25), 0.4, -0.2), 35, 0, true},       // elevated, infinite far plane
+            {cam(o + glm::dvec3(0, -150, 1.7), 0.2), 30, 60, true},                    // street, finite far plane
+            {cam(o + glm::dvec3(20, -170, 25), 0.4, -0.2), 35, 0, true},               // elevated, infinite far plane
             {cam(o + glm::dvec3(0, -190, 1.7), 0.1, 0.0, 120, 80, 0.2), 0, 0, false},  // rolled: no horizon
             {cam(o + glm::dvec3(-30, -120, 3.0), -0.3, 0.05), 25, 45, true},
         };

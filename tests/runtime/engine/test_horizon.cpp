@@ -139,8 +139,8 @@ TEST(Horizon, ConservativeWithCameraOnGridLinesAndAxisParallelRays) {
     SceneMesh m;
     addGround(m, {-100, -100}, {100, 100}, 0, {80, 80, 80, 255});
     addBox(m, {-100, -100, 0}, {100, -99.999f, 2}, {200, 0, 0, 255});  // marks the grid extent
-    addBox(m, {0, 20, 0}, {0.0005f, 60, 30}, {0, 200, 0, 255});         // wall on x = 0
-    addBox(m, {20, 0, 0}, {60, 0.0005f, 25}, {0, 0, 200, 255});         // wall on y = 0
+    addBox(m, {0, 20, 0}, {0.0005f, 60, 30}, {0, 200, 0, 255});        // wall on x = 0
+    addBox(m, {20, 0, 0}, {60, 0.0005f, 25}, {0, 0, 200, 255});        // wall on y = 0
     city.meshes.push_back(m);
     auto rs = RayScene::build(city);
     ASSERT_TRUE(rs.isOk());
@@ -192,14 +192,16 @@ TEST(Horizon, BlockWalkEqualsTheFlatWalk) {
             eyes.push_back({g0.x + (B + 3) * s, g0.y + 5 * s, 20.0});       // on a cell corner
             eyes.push_back({g0.x + (grid / 2) * s, g0.y + 0.37 * s, 3.0});  // on a grid line
             for (const glm::dvec3& e : eyes) {
-                std::vector<double> azimuths = {0.0, 0.5 * M_PI, M_PI, -0.5 * M_PI, 0.25 * M_PI, 0.75 * M_PI, -0.25 * M_PI};
+                std::vector<double> azimuths = {0.0,         0.5 * M_PI,  M_PI,        -0.5 * M_PI,
+                                                0.25 * M_PI, 0.75 * M_PI, -0.25 * M_PI};
                 for (int k = 0; k < 40; ++k) azimuths.push_back(az(rng));
                 for (double a : azimuths)
                     for (double nearD : {0.0, 45.0})
                         for (double maxD : {std::numeric_limits<double>::infinity(), 150.0}) {
-                            const double flat = hg.traceRayFlat(e, a, nearD, maxD), block = hg.traceRay(e, a, nearD, maxD);
-                            EXPECT_EQ(block, flat) << "seed " << seed << " grid " << grid << " eye " << e.x << "," << e.y
-                                                   << " azimuth " << a << " near " << nearD << " max " << maxD;
+                            const double flat = hg.traceRayFlat(e, a, nearD, maxD),
+                                         block = hg.traceRay(e, a, nearD, maxD);
+                            EXPECT_EQ(block, flat) << "seed " << seed << " grid " << grid << " eye " << e.x << ","
+                                                   << e.y << " azimuth " << a << " near " << nearD << " max " << maxD;
                             ++compared;
                             if (std::isfinite(flat)) ++nonTrivial;
                         }
@@ -317,7 +319,8 @@ TEST(Horizon, ViewportExtremes) {
     glm::vec3 org(big.eye);
     for (int x = 0; x < 4096; x += 64)
         for (int y = 0; y < r.row[size_t(x)]; y += 7)
-            ASSERT_FALSE(rs.value()->intersect(org, glm::vec3(big.rayDirection(x + 0.5, y + 0.5))).hit) << x << "," << y;
+            ASSERT_FALSE(rs.value()->intersect(org, glm::vec3(big.rayDirection(x + 0.5, y + 0.5))).hit)
+                << x << "," << y;
 }
 
 TEST(Horizon, SubsamplingNeverCullsMoreThanOnItsOwnLattice) {

@@ -21,7 +21,8 @@ Image solid(int w, int h, glm::u8vec4 c) {
 }
 
 std::string tmpFile(const std::string& name) {
-    return (std::filesystem::temp_directory_path() / ("vista_test_metrics_" + std::to_string(::getpid()) + "_" + name)).string();
+    return (std::filesystem::temp_directory_path() / ("vista_test_metrics_" + std::to_string(::getpid()) + "_" + name))
+        .string();
 }
 
 }  // namespace
@@ -58,9 +59,9 @@ TEST(Metrics, KnownNoiseGivesKnownPsnr) {
 
 TEST(Metrics, LumaWeights) {
     Image a = solid(8, 8, {100, 100, 100, 255});
-    Image r = solid(8, 8, {110, 100, 100, 255});  // +10 red only -> luma +2.99
-    Image g = solid(8, 8, {100, 110, 100, 255});  // +10 green -> +5.87
-    Image bl = solid(8, 8, {100, 100, 110, 255}); // +10 blue -> +1.14
+    Image r = solid(8, 8, {110, 100, 100, 255});   // +10 red only -> luma +2.99
+    Image g = solid(8, 8, {100, 110, 100, 255});   // +10 green -> +5.87
+    Image bl = solid(8, 8, {100, 100, 110, 255});  // +10 blue -> +1.14
     EXPECT_NEAR(lumaPsnr(a, r), 20.0 * std::log10(255.0 / 2.99), 1e-9);
     EXPECT_NEAR(lumaPsnr(a, g), 20.0 * std::log10(255.0 / 5.87), 1e-9);
     EXPECT_NEAR(lumaPsnr(a, bl), 20.0 * std::log10(255.0 / 1.14), 1e-9);
@@ -100,7 +101,8 @@ TEST(Metrics, DownsampleAndAverage) {
 TEST(Png, RoundTripAndBadFiles) {
     Image a(37, 11);
     for (int y = 0; y < a.height; ++y)
-        for (int x = 0; x < a.width; ++x) a.set(x, y, {uint8_t(x * 7), uint8_t(y * 20), uint8_t(x + y), uint8_t(255 - x)});
+        for (int x = 0; x < a.width; ++x)
+            a.set(x, y, {uint8_t(x * 7), uint8_t(y * 20), uint8_t(x + y), uint8_t(255 - x)});
     std::string f = tmpFile("rt.png");
     ASSERT_TRUE(writePng(a, f).isOk());
     auto b = readPng(f);

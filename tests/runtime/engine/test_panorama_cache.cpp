@@ -130,9 +130,9 @@ TEST(Panorama, ErrorBoundAndBudgetRetraceTheWorstCells) {
     // outside-the-window term b / lowerDepth - 8 px.
     const glm::u8vec2 mid(128, 128);
     auto expected = [&](double b, double near) { return std::max(b / near, b / 40.0 - 8e-3) / 1e-3; };
-    EXPECT_NEAR(pc.error(5, mid, p), expected(10, 1000), 1e-9);   // 242 px: the window term dominates
-    EXPECT_NEAR(pc.error(45, mid, p), expected(10, 50), 1e-9);    // 242 px as well
-    EXPECT_NEAR(pc.error(70, mid, p), expected(1, 1000), 1e-9);   // max(1, 17) px
+    EXPECT_NEAR(pc.error(5, mid, p), expected(10, 1000), 1e-9);  // 242 px: the window term dominates
+    EXPECT_NEAR(pc.error(45, mid, p), expected(10, 50), 1e-9);   // 242 px as well
+    EXPECT_NEAR(pc.error(70, mid, p), expected(1, 1000), 1e-9);  // max(1, 17) px
     EXPECT_TRUE(std::isinf(pc.error(95, mid, p)));
     // Far lower bound (nothing nearer than 2 km): the own term decides.
     p.lowerDepth = 2000.0;
@@ -211,7 +211,8 @@ TEST(Panorama, StillViewerConvergesToTheExactImage) {
     while (traced > 0 && frames < 100) {
         FrameStats st;
         ff.render(still, nullptr, img, st);
-        EXPECT_EQ(st.pixels.covered + st.pixels.horizonCulled + st.pixels.cache + st.pixels.rayHit + st.pixels.rayMiss, N);
+        EXPECT_EQ(st.pixels.covered + st.pixels.horizonCulled + st.pixels.cache + st.pixels.rayHit + st.pixels.rayMiss,
+                  N);
         traced = st.pixels.rayHit + st.pixels.rayMiss;
         EXPECT_LE(traced, 700u);
         ++frames;
@@ -292,8 +293,8 @@ TEST(FarField, HardCasesStayFinite) {
     std::vector<Camera> cams = {
         cam(glm::dvec3(grid.gridMin().x + 10 * s, grid.gridMin().y + 7 * s, 1.7), 0.0),  // on grid lines, axis rays
         cam(glm::dvec3(0, 0, 1.7), 0.5 * M_PI),
-        cam(glm::dvec3(0, 0, 1.7), 0.0, 0.5 * M_PI),   // straight up
-        cam(glm::dvec3(0, 0, 30.0), 0.0, -0.5 * M_PI), // straight down
+        cam(glm::dvec3(0, 0, 1.7), 0.0, 0.5 * M_PI),    // straight up
+        cam(glm::dvec3(0, 0, 30.0), 0.0, -0.5 * M_PI),  // straight down
         cam(glm::dvec3(0, -100, 1.7), 0.0, 0.0, 1, 1),
     };
     for (const Camera& c : cams) {
@@ -301,7 +302,8 @@ TEST(FarField, HardCasesStayFinite) {
         FrameStats st;
         ff.render(c, nullptr, img, st);
         const uint64_t N = uint64_t(c.width) * c.height;
-        EXPECT_EQ(st.pixels.covered + st.pixels.horizonCulled + st.pixels.cache + st.pixels.rayHit + st.pixels.rayMiss, N);
+        EXPECT_EQ(st.pixels.covered + st.pixels.horizonCulled + st.pixels.cache + st.pixels.rayHit + st.pixels.rayMiss,
+                  N);
         for (size_t i = 3; i < img.rgba.size(); i += 4) ASSERT_EQ(img.rgba[i], 255);  // every pixel written
     }
     // Empty city: nothing to trace, all sky.
@@ -381,7 +383,9 @@ TEST(Panorama, MovingViewerStaysCloseToTheUncachedImage) {
             cached.render(c, nullptr, a, sa);
             direct.render(c, nullptr, b, sb);
             const uint64_t N = uint64_t(c.width) * c.height;
-            EXPECT_EQ(sa.pixels.covered + sa.pixels.horizonCulled + sa.pixels.cache + sa.pixels.rayHit + sa.pixels.rayMiss, N);
+            EXPECT_EQ(
+                sa.pixels.covered + sa.pixels.horizonCulled + sa.pixels.cache + sa.pixels.rayHit + sa.pixels.rayMiss,
+                N);
             const double p = std::min(99.0, lumaPsnr(a, b));
             psnrMin = std::min(psnrMin, p);
             psnrMean += p / frames;
@@ -441,7 +445,8 @@ TEST(FarField, CachePausesWhileItsReuseDoesNotPayAndResumes) {
     // Frames 0 and 1 look up, frame 1 finds no reuse, 2 .. 9 pause, 10 and 11 look up and judge
     // again, then 16 pause, then 32, then 64, and 64 again (the longest pause).
     std::vector<int> expect = {1, 1};
-    for (int len : {kCachePauseFrames, 2 * kCachePauseFrames, 4 * kCachePauseFrames, kCacheMaxPauseFrames, kCacheMaxPauseFrames}) {
+    for (int len : {kCachePauseFrames, 2 * kCachePauseFrames, 4 * kCachePauseFrames, kCacheMaxPauseFrames,
+                    kCacheMaxPauseFrames}) {
         for (int k = 0; k < len; ++k) expect.push_back(0);
         expect.insert(expect.end(), {1, 1});
     }

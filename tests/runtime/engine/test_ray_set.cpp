@@ -210,9 +210,7 @@ TEST(RaySet, LastTracedIsWhatTheRayStageCastAndReproducesItsPixels) {
         const int x = int(traced[k] % uint32_t(c.width)), y = int(traced[k] / uint32_t(c.width));
         ASSERT_EQ(again.at(x, y), out.at(x, y)) << "pixel " << traced[k];
         ASSERT_EQ(hits[k].hit, ff.classification()[traced[k]] == kFarRayHit) << "pixel " << traced[k];
-        if (hits[k].hit) {
-            ASSERT_EQ(hits[k].color, out.at(x, y)) << "pixel " << traced[k];
-        }
+        if (hits[k].hit) { ASSERT_EQ(hits[k].color, out.at(x, y)) << "pixel " << traced[k]; }
     }
 
     // A frame whose ray stage does not run leaves an empty list.

@@ -51,7 +51,8 @@ Mesh boxMesh(glm::vec3 lo, glm::vec3 hi, uint8_t tag) {
         m.normals.push_back(glm::normalize(glm::vec3((i & 1) ? 1 : -1, (i & 2) ? 1 : -1, (i & 4) ? 1 : -1)));
         m.colors.push_back({uint8_t(tag + i), uint8_t(100 + tag), uint8_t(200 - i), 255});
     }
-    const uint32_t f[] = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
+    const uint32_t f[] = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
+                          2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
     m.indices.assign(std::begin(f), std::end(f));
     return m;
 }
@@ -68,8 +69,12 @@ City makeCity(double originX = 0, double originY = 0) {
     c.streets.nodes = {{-100, 0}, {100, 0}, {0, 120}};
     c.streets.edges = {{0, 1, RoadClass::Arterial, 12.0f, 3}, {1, 2, RoadClass::Local, 7.0f, 2}};
     TreePrototype p0, p1;
-    p0.species = 0; p0.height = 8; p0.mesh = boxMesh({-0.3f, -0.3f, 0}, {0.3f, 0.3f, 8}, 30);
-    p1.species = 1; p1.height = 12; p1.mesh = boxMesh({-2, -2, 2}, {2, 2, 12}, 60);
+    p0.species = 0;
+    p0.height = 8;
+    p0.mesh = boxMesh({-0.3f, -0.3f, 0}, {0.3f, 0.3f, 8}, 30);
+    p1.species = 1;
+    p1.height = 12;
+    p1.mesh = boxMesh({-2, -2, 2}, {2, 2, 12}, 60);
     p1.mesh.append(boxMesh({-0.2f, -0.2f, 0}, {0.2f, 0.2f, 2}, 90));
     c.treePrototypes = {p0, p1};
     const double half = 125;
@@ -77,7 +82,8 @@ City makeCity(double originX = 0, double originY = 0) {
         for (int ix = 0; ix < 2; ++ix) {
             if (ix == 1 && iy == 1) continue;  // a missing tile
             Tile t;
-            t.ix = ix; t.iy = iy;
+            t.ix = ix;
+            t.iy = iy;
             t.origin = {-250 + half + 250 * ix, -250 + half + 250 * iy, 1.5 * ix};
             t.meshes[size_t(Material::Ground)] = boxMesh({-125, -125, -1}, {125, 125, 0}, uint8_t(10 * ix + iy));
             if (ix == 0) t.meshes[size_t(Material::Wall)] = boxMesh({-20, -10, 0}, {20, 10, 30}, 5);
@@ -87,7 +93,9 @@ City makeCity(double originX = 0, double originY = 0) {
     auto addTree = [&](size_t tile, glm::dvec2 local, float yaw, float scale, uint16_t proto) {
         TreeInstance ti;
         ti.position = c.tiles[tile].origin + glm::dvec3(local, 0.0);
-        ti.yaw = yaw; ti.scale = scale; ti.prototype = proto;
+        ti.yaw = yaw;
+        ti.scale = scale;
+        ti.prototype = proto;
         c.tiles[tile].trees.push_back(uint32_t(c.trees.size()));
         c.trees.push_back(ti);
     };
@@ -106,7 +114,9 @@ TEST(CityFile, SceneLayout) {
     osg::Group* root = n->asGroup();
     ASSERT_NE(root, nullptr);
     EXPECT_EQ(root->getName(), "vista.city");
-    int fmt = 0; double ox = 0, ts = 0; std::string pj;
+    int fmt = 0;
+    double ox = 0, ts = 0;
+    std::string pj;
     EXPECT_TRUE(root->getUserValue("vista.format", fmt));
     EXPECT_EQ(fmt, 1);
     EXPECT_TRUE(root->getUserValue("vista.origin_x", ox));
@@ -164,7 +174,8 @@ TEST(CityFile, RoundTrip) {
     for (size_t i = 0; i < expected.size(); ++i) {
         const Mesh& m = *expected[i].second;
         const SceneMesh& l = lc.meshes[i];
-        EXPECT_EQ(l.origin, glm::dvec3(5000 + expected[i].first->origin.x, -3000 + expected[i].first->origin.y, expected[i].first->origin.z));
+        EXPECT_EQ(l.origin, glm::dvec3(5000 + expected[i].first->origin.x, -3000 + expected[i].first->origin.y,
+                                       expected[i].first->origin.z));
         EXPECT_EQ(l.positions, m.positions);
         EXPECT_EQ(l.colors, m.colors);
         EXPECT_EQ(l.indices, m.indices);
@@ -202,9 +213,7 @@ TEST(CityFile, RoundTrip) {
     for (const auto& [t, m] : expected) tris += m->triangleCount();
     for (const TreeInstance& t : c.trees) tris += c.treePrototypes[t.prototype].mesh.triangleCount();
     EXPECT_EQ(lc.triangles, tris);
-    if (counts.triangles != 0) {
-        EXPECT_EQ(lc.triangles, counts.triangles);
-    }
+    if (counts.triangles != 0) { EXPECT_EQ(lc.triangles, counts.triangles); }
     // Street graph: compared only once the serialiser is implemented.
     if (streetGraphToJson(c.streets) != "{}") {
         EXPECT_EQ(lc.streets.nodes.size(), c.streets.nodes.size());
@@ -252,7 +261,8 @@ TEST(CityFile, FarFromOriginKeepsMillimetres) {
     for (const SceneInstance& li : r->instances) {
         glm::dvec3 base = glm::dvec3(li.transform * glm::dvec4(0, 0, 0, 1));
         double best = 1e30;
-        for (const TreeInstance& t : c.trees) best = std::min(best, glm::length(base - (t.position + glm::dvec3(ox, oy, 0))));
+        for (const TreeInstance& t : c.trees)
+            best = std::min(best, glm::length(base - (t.position + glm::dvec3(ox, oy, 0))));
         EXPECT_LT(best, 1e-3);
     }
 }
@@ -460,10 +470,13 @@ TEST(Gltf, StructureIsValid) {
         EXPECT_LE(o + l, g.bin.size());
     }
     auto compSize = [](int ct) { return ct == 5126 || ct == 5125 ? 4 : ct == 5123 ? 2 : 1; };
-    auto ncomp = [](const std::string& t) { return t == "SCALAR" ? 1 : t == "VEC3" ? 3 : t == "VEC4" ? 4 : t == "MAT4" ? 16 : 0; };
+    auto ncomp = [](const std::string& t) {
+        return t == "SCALAR" ? 1 : t == "VEC3" ? 3 : t == "VEC4" ? 4 : t == "MAT4" ? 16 : 0;
+    };
     for (const auto& a : j["accessors"]) {
         const auto& bv = j["bufferViews"][a["bufferView"].get<size_t>()];
-        size_t need = a.value("byteOffset", size_t(0)) + a["count"].get<size_t>() * compSize(a["componentType"]) * ncomp(a["type"]);
+        size_t need = a.value("byteOffset", size_t(0)) +
+                      a["count"].get<size_t>() * compSize(a["componentType"]) * ncomp(a["type"]);
         EXPECT_LE(need, bv["byteLength"].get<size_t>());
         EXPECT_GT(a["count"].get<size_t>(), 0u);
     }
@@ -484,7 +497,8 @@ TEST(Gltf, StructureIsValid) {
             for (size_t i = 0; i < n; ++i) {
                 glm::vec3 v;
                 std::memcpy(&v, g.bin.data() + off + 12 * i, 12);
-                lo = glm::min(lo, v); hi = glm::max(hi, v);
+                lo = glm::min(lo, v);
+                hi = glm::max(hi, v);
             }
             for (int k = 0; k < 3; ++k) {
                 EXPECT_FLOAT_EQ(pa["min"][k].get<float>(), lo[k]);

@@ -74,7 +74,7 @@ struct Evaluated {
     bool driving = false;
     bool connecting = false;  // a junction's connecting road
     bool street = false;
-    glm::dvec2 dir{0.0};      // street roads: the reference line's direction
+    glm::dvec2 dir{0.0};  // street roads: the reference line's direction
 };
 
 Evaluated evaluate(const LaneModel& m, const LanePosition& l) {
@@ -84,8 +84,8 @@ Evaluated evaluate(const LaneModel& m, const LanePosition& l) {
         const EdgeLanes& L = m.edges[size_t(l.road)];
         r.street = true;
         r.dir = L.dir;
-        r.driving = L.valid && l.lane != 0 && l.lane >= -L.right && l.lane <= L.left && l.s >= -1e-6 &&
-                    l.s <= L.length + 1e-6;
+        r.driving =
+            L.valid && l.lane != 0 && l.lane >= -L.right && l.lane <= L.left && l.s >= -1e-6 && l.s <= L.length + 1e-6;
         const double centre = L.offset + (l.lane < 0 ? (l.lane + 0.5) : (l.lane - 0.5)) * L.laneWidth;
         r.point = L.start + L.dir * l.s + L.normal() * (centre + l.tOffset);
         r.halfWidth = 0.5 * L.laneWidth;
@@ -143,7 +143,8 @@ size_t checkInLane(const TestCity& c, const LaneModel& m, const Path& p, bool lh
 }
 
 std::string tmpFile(const std::string& name) {
-    return (std::filesystem::temp_directory_path() / ("vista_test_lane_paths_" + std::to_string(::getpid()) + "_" + name))
+    return (std::filesystem::temp_directory_path() /
+            ("vista_test_lane_paths_" + std::to_string(::getpid()) + "_" + name))
         .string();
 }
 
@@ -274,7 +275,8 @@ TEST(LanePaths, CommandWritesPositionsForCarsOnly) {
     auto r = test::runVista("gen --seed 3 --size 400 --detail 0 -q -o " + city);
     ASSERT_EQ(r.code, 0) << r.err;
     // Walk paths do not drive in lanes: refused before anything is written.
-    r = test::runVista("path " + city + " --kind walk -o " + tmp.file("w.csv") + " --xodr-positions " + tmp.file("w.lanes.csv"));
+    r = test::runVista("path " + city + " --kind walk -o " + tmp.file("w.csv") + " --xodr-positions " +
+                       tmp.file("w.lanes.csv"));
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_NE(r.err.find("--xodr-positions"), std::string::npos) << r.err;
     EXPECT_FALSE(std::filesystem::exists(tmp.file("w.csv")));

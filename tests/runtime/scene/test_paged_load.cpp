@@ -124,7 +124,8 @@ TEST_F(PagedLoad, WholeCityMergeMatchesTheRegions) {
     auto p = vista::generatePath(*g, m->params, po);
     ASSERT_TRUE(p.isOk()) << p.status().message();
     for (size_t i = 0; i < p->samples.size(); i += 30) {
-        const glm::dvec2 c(p->samples[i].position.x - m->params.origin_x, p->samples[i].position.y - m->params.origin_y);
+        const glm::dvec2 c(p->samples[i].position.x - m->params.origin_x,
+                           p->samples[i].position.y - m->params.origin_y);
         EXPECT_LT(vista::distanceToStreets(city->streets, c), 15.0) << "sample " << i;
     }
 }
@@ -165,8 +166,8 @@ TEST_F(PagedLoad, BenchLoadsOnlyTheRegionsNearThePath) {
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(readBytes(tmp.file("p.csv")) == readBytes(tmp.file("one.csv")));
     // ... and bench follows that CSV (the same path as its --seed 4: the same regions).
-    r = runVista("bench " + dir() + " --path " + tmp.file("p.csv") + " --frames 2 --size 160x120 --modes full -q --paged-radius 0 --out " +
-                 tmp.file("csv"));
+    r = runVista("bench " + dir() + " --path " + tmp.file("p.csv") +
+                 " --frames 2 --size 160x120 --modes full -q --paged-radius 0 --out " + tmp.file("csv"));
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_EQ(readJson(tmp.file("csv/summary.json"))["paged"]["regions_loaded"].get<int>(), near);
 }
@@ -251,7 +252,8 @@ TEST_F(PagedLoad, DamagedRegionFilesAreNamedAndTheRestRenders) {
     EXPECT_EQ(s["paged"]["coarse_regions_loaded"].get<int>(), 0);
     EXPECT_EQ(s["paged"]["damaged"].size(), 2u);
     // Only damaged files near the walkthrough: an error naming them, exit 2, nothing written.
-    const std::vector<int> nearest = vista::selectPagedRegions(*m, {glm::dvec2(m->regions[4].lo + m->regions[4].hi) * 0.5}, 0.0);
+    const std::vector<int> nearest =
+        vista::selectPagedRegions(*m, {glm::dvec2(m->regions[4].lo + m->regions[4].hi) * 0.5}, 0.0);
     ASSERT_EQ(nearest, std::vector<int>{4});
     vista::PagedLoadReport rep;
     auto city = vista::loadPagedCity(*m, {4}, 0.0, &rep, {});
@@ -264,10 +266,9 @@ TEST_F(PagedLoad, BadInputExitsTwoNamingIt) {
     fs::copy(dir(), copy, fs::copy_options::recursive);
     CliRun r;
     // A corrupt manifest, a missing one.
-    {
-        std::ofstream(fs::path(copy) / "manifest.json") << "{\"format\": \"vista.paged_city\", \"ver";
-    }
-    for (const std::string& cmd : {"bench " + copy + kBench + " --out " + tmp.file("o3"), "path " + copy + " -o " + tmp.file("p.csv")}) {
+    { std::ofstream(fs::path(copy) / "manifest.json") << "{\"format\": \"vista.paged_city\", \"ver"; }
+    for (const std::string& cmd :
+         {"bench " + copy + kBench + " --out " + tmp.file("o3"), "path " + copy + " -o " + tmp.file("p.csv")}) {
         r = runVista(cmd);
         EXPECT_EQ(r.code, 2) << cmd << ": " << r.err;
         EXPECT_NE(r.err.find("manifest.json"), std::string::npos) << r.err;
@@ -288,7 +289,8 @@ TEST_F(PagedLoad, BadInputExitsTwoNamingIt) {
     EXPECT_TRUE(vista::validatePagedRadius("--paged-radius", 0.0).isOk());
     EXPECT_TRUE(vista::validatePagedRadius("--paged-radius", 100000.0).isOk());
     for (const char* v : {"-1", "1e9", "100000.5"}) {
-        for (const std::string& cmd : {"bench " + dir() + kBench + " --out " + tmp.file("o4"), "view " + dir() + " --frames 1"}) {
+        for (const std::string& cmd :
+             {"bench " + dir() + kBench + " --out " + tmp.file("o4"), "view " + dir() + " --frames 1"}) {
             r = runVista(cmd + " --paged-radius " + v);
             EXPECT_EQ(r.code, 2) << cmd << " " << v << ": " << r.err;
             EXPECT_NE(r.err.find("--paged-radius"), std::string::npos) << r.err;

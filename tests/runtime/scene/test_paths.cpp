@@ -15,7 +15,6 @@ using namespace vista;
 
 namespace {
 
-
 // A 6 x 6 grid of streets, 120 m apart, plus one dead-end spur.
 StreetGraph gridGraph() {
     StreetGraph g;
@@ -52,7 +51,8 @@ double wrap(double a) {
 }
 
 std::string tmpFile(const std::string& name) {
-    return (std::filesystem::temp_directory_path() / ("vista_test_paths_" + std::to_string(::getpid()) + "_" + name)).string();
+    return (std::filesystem::temp_directory_path() / ("vista_test_paths_" + std::to_string(::getpid()) + "_" + name))
+        .string();
 }
 
 }  // namespace
@@ -73,7 +73,8 @@ TEST(Paths, DeterministicPerSeed) {
     auto c = generatePath(g, flatParams(), o);
     ASSERT_TRUE(c.isOk());
     bool differs = false;
-    for (size_t i = 0; i < c->samples.size(); ++i) differs = differs || c->samples[i].position != a->samples[i].position;
+    for (size_t i = 0; i < c->samples.size(); ++i)
+        differs = differs || c->samples[i].position != a->samples[i].position;
     EXPECT_TRUE(differs);
 }
 
@@ -91,7 +92,8 @@ TEST(Paths, RespectsSpeedAndYawLimitsAndStaysOnStreets) {
             const auto& s = p->samples[i];
             EXPECT_NEAR(s.position.z, 1.2, 1e-9);  // car eye height on flat ground
             double d = distanceToStreets(g, glm::dvec2(s.position));
-            EXPECT_LE(d, 4.0) << "seed " << seed << " sample " << i << " is " << d << " m off the centre line (half width 4 m)";
+            EXPECT_LE(d, 4.0) << "seed " << seed << " sample " << i << " is " << d
+                              << " m off the centre line (half width 4 m)";
             if (i == 0) continue;
             const auto& q = p->samples[i - 1];
             double v = glm::length(glm::dvec2(s.position - q.position)) / o.dt;
@@ -177,10 +179,10 @@ TEST(Paths, BadInput) {
     // Finite but huge coordinates (the renderer and the ray caster could not
     // represent them) are refused with the field and its range; Earth-sized ones load.
     const std::pair<std::string, std::string> huge[] = {{"0,1e20,0,1.7,0,0\n", "x 1e+20 out of range"},
-                                                         {"0,0,-3e7,1.7,0,0\n", "y -3e+07 out of range"},
-                                                         {"0,0,0,1e6,0,0\n", "z 1e+06 out of range"},
-                                                         {"0,0,0,1.7,1e300,0\n", "heading 1e+300 out of range"},
-                                                         {"1e300,0,0,1.7,0,0\n", "time 1e+300 out of range"}};
+                                                        {"0,0,-3e7,1.7,0,0\n", "y -3e+07 out of range"},
+                                                        {"0,0,0,1e6,0,0\n", "z 1e+06 out of range"},
+                                                        {"0,0,0,1.7,1e300,0\n", "heading 1e+300 out of range"},
+                                                        {"1e300,0,0,1.7,0,0\n", "time 1e+300 out of range"}};
     for (const auto& [text, says] : huge) {
         const std::string f = write("huge.csv", text);
         auto r = loadPathCsv(f);
