@@ -17,7 +17,7 @@ int runPath(int argc, char** argv) {
         "Make a deterministic walkthrough path along the city's street graph (CSV: "
         "t_s,x_m,y_m,z_m,heading_deg,pitch_deg).",
         "vista path"};
-    std::string city, out, kind = "car", positions;
+    std::string city, out, kind = "car", positions, route = "tour";
     PathOptions o;
     double yawDeg = 45.0, pitchDeg = o.flyPitch * 180.0 / kPi;
     // Options: one CLI11 call per flag.
@@ -32,6 +32,9 @@ int runPath(int argc, char** argv) {
     app.add_option(
         "--run-up", o.runUp,
         "seconds driven before the path starts and dropped, so it starts at cruising speed, 0 .. 600 (default 8)");
+    app.add_option("--route", route,
+                   "tour (default): head for far goals along shortest paths, so a long drive keeps going across "
+                   "the city; wander: a seeded random walk that prefers going straight on");
     app.add_option("--dt", o.dt, "seconds between samples (default 1/30)");
     auto* speed = app.add_option("--speed", o.maxSpeed, "maximum speed in m/s (default: walk 1.4, car and fly 14)");
     app.add_option("--yaw-rate", yawDeg, "maximum yaw rate in degrees/s (default 45)");
@@ -51,6 +54,9 @@ int runPath(int argc, char** argv) {
     if (!k) return reportBadInput("vista path", Status::error("--kind: " + k.status().message()));
     o.kind = k.value();
     if (speed->count() == 0) o.maxSpeed = defaultSpeed(o.kind);
+    auto r = parseRouteStyle(route);
+    if (!r) return reportBadInput("vista path", Status::error("--route: " + r.status().message()));
+    o.route = r.value();
     o.maxYawRate = yawDeg * kPi / 180.0;
     o.flyPitch = pitchDeg * kPi / 180.0;
     if (Status s = validatePathOptions(o); !s) return reportBadInput("vista path", s);

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <memory>
 #include <sstream>
 
 #include <unistd.h>
@@ -17,6 +18,7 @@
 #include "citygen/blocks.h"
 #include "citygen/lanes.h"
 #include "citygen/terrain.h"
+#include "runtime/scene/tour.h"
 
 namespace vista {
 
@@ -32,16 +34,30 @@ constexpr double kHeadingGain = 1.1;     // 1/m (2 sqrt(kLateralGain))
 constexpr double kBrakeShare = 0.8;      // share of the braking limit the speed profile plans with
 constexpr double kProgressWindow = 3.0;  // metres ahead of the progress where the closest route point is searched
 
+// The vehicle is simulated in steps of at most kMaxSimStep seconds whatever
+// the sample spacing: steering at a coarser step overshoots and can circle.
+constexpr double kMaxSimStep = 1.0 / 30.0;
+size_t simulationSubsteps(double dt) { return std::max<size_t>(1, size_t(std::ceil(dt / kMaxSimStep - 1e-9))); }
+
 double headingOf(const glm::dvec2& d) { return std::atan2(d.x, d.y); }  // clockwise from north
 
 // The route: node sequence chosen by a seeded walk, extended on demand.
 class Route {
 public:
-    Route(const StreetGraph& g, uint64_t seed) : _g(g), _rng(seed, 0, Stream::Paths) {
+    Route(const StreetGraph& g, uint64_t seed, RouteStyle style) : _g(g), _rng(seed, 0, Stream::Paths) {
         _adj.resize(g.nodes.size());
         for (size_t e = 0; e < g.edges.size(); ++e) {
             _adj[g.edges[e].a].push_back(uint32_t(e));
             _adj[g.edges[e].b].push_back(uint32_t(e));
+        }
+        if (style == RouteStyle::Tour) {
+            std::vector<std::vector<Tour::Arc>> arcs(g.nodes.size());
+            for (size_t n = 0; n < g.nodes.size(); ++n)
+                for (uint32_t e : _adj[n]) {
+                    const uint32_t m = other(e, uint32_t(n));
+                    arcs[n].push_back({m, glm::length(g.nodes[m] - g.nodes[n])});
+                }
+            _tour = std::make_unique<Tour>(g.nodes, std::move(arcs));
         }
         // Start on a random edge whose ends both continue (avoid dead ends).
         std::vector<uint32_t> good;
@@ -97,6 +113,14 @@ private:
             push(prev, inEdge);
             return;
         }
+        if (_tour) {
+            std::vector<size_t> allowed;
+            for (size_t i = 0; i < _adj[n].size(); ++i)
+                if (_adj[n][i] != inEdge) allowed.push_back(i);
+            const uint32_t e = _adj[n][_tour->step(n, allowed, _rng)];
+            push(other(e, n), e);
+            return;
+        }
         double total = 0;
         for (double w : weight) total += w;
         double r = _rng.uniform() * total;
@@ -112,8 +136,11 @@ private:
         push(_g.edges[e].a == n ? _g.edges[e].b : _g.edges[e].a, e);
     }
 
+    uint32_t other(uint32_t e, uint32_t n) const { return _g.edges[e].a == n ? _g.edges[e].b : _g.edges[e].a; }
+
     const StreetGraph& _g;
     Rng _rng;
+    std::unique_ptr<Tour> _tour;  // RouteStyle::Tour
     std::vector<std::vector<uint32_t>> _adj;
     std::vector<glm::dvec2> _pts;
     std::vector<double> _cum;
@@ -153,6 +180,14 @@ Result<PathKind> parsePathKind(const std::string& s) {
     if (s == "car") return PathKind::Car;
     if (s == "fly") return PathKind::Fly;
     return Status::error("path kind '" + s + "' unknown; expected one of: walk, car, fly");
+}
+
+const char* routeStyleName(RouteStyle s) { return s == RouteStyle::Tour ? "tour" : "wander"; }
+
+Result<RouteStyle> parseRouteStyle(const std::string& s) {
+    if (s == "tour") return RouteStyle::Tour;
+    if (s == "wander") return RouteStyle::Wander;
+    return Status::error("route '" + s + "' unknown; expected one of: tour, wander");
 }
 
 Status validatePathOptions(const PathOptions& o) {
@@ -244,7 +279,7 @@ Result<Path> driveCar(const StreetGraph& g, const CityParams& params, const Path
     std::vector<Block> blocks;
     if (params.sidewalk_m > 0.01) blocks = extractBlocks(g, params, nullptr);
     const LaneModel lanes = buildLaneModel(g, params, params.sidewalk_m > 0.01 ? &blocks : nullptr);
-    auto made = LaneRoute::create(lanes, o.seed, o.leftHandTraffic);
+    auto made = LaneRoute::create(lanes, o.seed, o.leftHandTraffic, o.route);
     if (!made) return made.status();
     LaneRoute& route = made.value();
     glm::dvec2 pos = route.point(0);
@@ -252,16 +287,19 @@ Result<Path> driveCar(const StreetGraph& g, const CityParams& params, const Path
     double v = 0.0;
     double sp = 0.0;  // progress along the route (arc length of the closest point)
     size_t seg = 0;
-    const double w = o.maxYawRate, dt = o.dt;
-    const size_t n = size_t(std::floor(o.duration / dt + 1e-9)) + 1;
-    const size_t skip = size_t(std::floor(o.runUp / dt + 1e-9));
+    const double w = o.maxYawRate;
+    const size_t n = size_t(std::floor(o.duration / o.dt + 1e-9)) + 1;
+    const size_t skip = size_t(std::floor(o.runUp / o.dt + 1e-9));
+    const size_t sub = simulationSubsteps(o.dt);
+    const double dt = o.dt / double(sub);
     const glm::dvec2 origin(params.origin_x, params.origin_y);
     const double brake = kBrakeShare * o.decel;
 
     Path path;
     path.samples.reserve(n);
     path.lanes.reserve(n);
-    for (size_t i = 0; i < n + skip; ++i) {
+    for (size_t j = 0; j < (n + skip) * sub; ++j) {
+        const size_t i = j / sub;
         // Progress: the closest route point a few metres ahead.
         const double horizon = v * v / (2.0 * brake) + 2.0 * v * dt + 3.0;
         route.ensure(sp + horizon + kProgressWindow + 1.0);
@@ -275,9 +313,9 @@ Result<Path> driveCar(const StreetGraph& g, const CityParams& params, const Path
         seg = bestSeg;
         sp = std::max(sp, route.cum(seg) + bestT * (route.cum(seg + 1) - route.cum(seg)));
 
-        if (i >= skip) {
+        if (j % sub == 0 && i >= skip) {
             PathSample s;
-            s.t = double(i - skip) * dt;
+            s.t = double(i - skip) * o.dt;
             s.position = glm::dvec3(pos + origin, terrainHeight(params, pos) + o.eyeHeight());
             s.heading = wrapAngle(h);
             path.samples.push_back(s);
@@ -326,25 +364,28 @@ Result<Path> generatePath(const StreetGraph& g, const CityParams& params, const 
         if (auto car = driveCar(g, params, o)) return car;
     }
 
-    Route route(g, o.seed);
+    Route route(g, o.seed, o.route);
     glm::dvec2 pos = route.point(0);
     double h = route.segHeading(0);
     double v = 0.0;
     double sp = 0.0;  // progress along the route (arc length of the closest point)
     size_t seg = 0;
-    const double w = o.maxYawRate, dt = o.dt;
-    const size_t n = size_t(std::floor(o.duration / dt + 1e-9)) + 1;
+    const double w = o.maxYawRate;
+    const size_t n = size_t(std::floor(o.duration / o.dt + 1e-9)) + 1;
     // The run-up is simulated exactly like the path and then dropped, so the
     // first kept sample is where the vehicle is after runUp seconds, at speed.
-    const size_t skip = size_t(std::floor(o.runUp / dt + 1e-9));
+    const size_t skip = size_t(std::floor(o.runUp / o.dt + 1e-9));
+    const size_t sub = simulationSubsteps(o.dt);
+    const double dt = o.dt / double(sub);
     const glm::dvec2 origin(params.origin_x, params.origin_y);
 
     Path path;
     path.samples.reserve(n);
-    for (size_t i = 0; i < n + skip; ++i) {
-        if (i >= skip) {
+    for (size_t j = 0; j < (n + skip) * sub; ++j) {
+        const size_t i = j / sub;
+        if (j % sub == 0 && i >= skip) {
             PathSample s;
-            s.t = double(i - skip) * dt;
+            s.t = double(i - skip) * o.dt;
             double ground = terrainHeight(params, pos);
             s.position = glm::dvec3(pos + origin, ground + o.eyeHeight());
             s.heading = wrapAngle(h);

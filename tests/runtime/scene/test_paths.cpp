@@ -290,3 +290,26 @@ TEST(Paths, MotionPerFrameMatchesAnIndependentSum) {
     EXPECT_NEAR(pathMotion(p, {1, 2}).degreesMax, 2.0, 1e-9);
     EXPECT_EQ(pathMotion(p, {3}).frames, 0u);
 }
+
+TEST(Paths, CoarseSamplesAreTheFineDriveSampledLess) {
+    // The vehicle is simulated in steps of at most 1/30 s whatever --dt: a
+    // path sampled every 0.5 s is every 15th sample of the 1/30 s path (up to
+    // the rounding of 0.5 / 15), for each kind, and the car still drives.
+    StreetGraph g = gridGraph();
+    for (PathKind kind : {PathKind::Car, PathKind::Walk, PathKind::Fly}) {
+        PathOptions fine;
+        fine.kind = kind;
+        fine.maxSpeed = defaultSpeed(kind);
+        fine.duration = 40;
+        PathOptions coarse = fine;
+        coarse.dt = 0.5;
+        auto a = generatePath(g, flatParams(), fine), b = generatePath(g, flatParams(), coarse);
+        ASSERT_TRUE(a.isOk() && b.isOk());
+        ASSERT_EQ(b->samples.size(), 81u);
+        for (size_t i = 0; i < b->samples.size(); ++i) {
+            const PathSample& p = a->samples[i * 15];
+            EXPECT_NEAR(b->samples[i].t, p.t, 1e-9);
+            EXPECT_LT(glm::length(b->samples[i].position - p.position), 1e-3) << pathKindName(kind) << " " << i;
+        }
+    }
+}
