@@ -4,7 +4,8 @@
 # for; a small scheduler here then runs each batch script as slurmd would:
 # a fresh environment (the submitter's, --export=ALL) plus the SLURM_*
 # variables, the submit directory as working directory, stdout and stderr
-# into the --output file (%A, %a, %j, %x expanded, appended on a requeue),
+# into the --output file (%A, %a, %j, %x expanded; a rerun truncates it
+# unless --open-mode=append),
 # SIGUSR1 to the batch shell before the time limit (--signal=B:USR1@...),
 # SIGTERM to the job's processes on scancel, requeued tasks run again with
 # SLURM_RESTART_COUNT, the merge after its afterany dependency.
@@ -119,6 +120,7 @@ start() {
   out="${out//%x/$(opt "$id" job-name)}"
   case "$out" in /*) ;; *) out="$(cat "$d/cwd")/$out" ;; esac
   echo "$out" >"$d/log.$jid"
+  [ "$(opt "$id" open-mode)" = append ] || : >"$out"  # Slurm truncates the log of a rerun by default
   (cd "$(cat "$d/cwd")" && exec setsid env -i bash --noprofile --norc -c \
     'while IFS= read -r -d "" kv; do export "$kv" 2>/dev/null || true; done <"$1"; shift; exec env "$@"' \
     _ "$d/env" "${vars[@]}" bash "$d/script" >>"$out" 2>&1) &
@@ -150,6 +152,19 @@ gen -q -o /x/c.paged --merge --shards 4
 bake /x/c.osgb -q -o /x/c.baked.osgb --shard 4/4"
 [ "$(cat "$W/argv")" = "$expected" ] || fail "with VISTA_ARGS unset the scripts ran: $(cat "$W/argv")"
 ok "the scripts run with VISTA_ARGS unset (set -u)"
+
+# Bad input (exit 2) is not retried; nor is a failure once VISTA_MAX_RESTARTS is reached.
+printf '#!/usr/bin/env bash\nexit "$EXIT"\n' >"$W/bin/vista-exit"
+chmod +x "$W/bin/vista-exit"
+for c in "2 0" "1 3"; do
+  set -- $c
+  rc=0
+  VISTA="$W/bin/vista-exit" EXIT=$1 SLURM_RESTART_COUNT=$2 SLURM_JOB_ID=99 SLURM_ARRAY_TASK_ID=1 VISTA_JOB=gen \
+    VISTA_SHARDS=2 VISTA_OUT=/x/c.paged bash "$JOBS/slurm-array.sbatch" 2>>"$W/retry.err" || rc=$?
+  [ "$rc" = "$1" ] || fail "vista exiting $1 made the task exit $rc"
+done
+[ ! -s "$S/requeued" ] || fail "requeued after bad input or past VISTA_MAX_RESTARTS: $(cat "$W/retry.err")"
+ok "bad input and a task past VISTA_MAX_RESTARTS are not requeued"
 
 # --- the single-machine run -------------------------------------------------
 ARGS=(--size 1500 --seed 3 --detail 1 --region-size 500)
