@@ -86,6 +86,16 @@ chmod +x "$W/bin/"*
 export FAKE_SLURM="$S"
 export PATH="$W/bin:$PATH"
 
+# started N: waits until shard N's first vista run has begun (the batch shell is past its setup).
+started() {
+  local i
+  for i in $(seq 1 600); do
+    [ -e "$W/first.$1" ] && return 0
+    sleep 0.1
+  done
+  fail "shard $1 did not start vista"
+}
+
 opt() { sed -n "s/^--$2=//p" "$S/jobs/$1/options" | tail -1; }  # opt JOBID NAME: the value that applies
 
 # The array tasks of a job: "1-3", "2,5" or "3-4" expanded.
@@ -213,7 +223,7 @@ ok "VISTA_SBATCH_OPTS reach sbatch"
 
 # Shard 1: the time limit is near (SIGUSR1 to the batch shell).
 start $array 1
-sleep 2
+started 1
 kill -USR1 "$PID"
 rc=0
 wait "$PID" || rc=$?
@@ -225,7 +235,7 @@ rc=$RC
 grep -qx "$((array + 2))" "$S/requeued" || fail "shard 2 did not requeue itself after vista failed"
 # Shard 3: scancel (SIGTERM to every process of the job).
 start $array 3
-sleep 2
+started 3
 kill -TERM -- "-$PID"
 wait "$PID" || true
 grep -qx "$((array + 3))" "$S/requeued" && fail "a cancelled shard requeued itself"
