@@ -35,7 +35,7 @@ struct GenArgs {
     bool quiet = false, listParams = false;
     // Paged output (-o DIR.paged).
     std::optional<double> regionSize;
-    std::string shard;
+    std::string shard, shards;
     bool merge = false;
     std::string memoryBudget;
     double budgetGb = 0;  // parsed --memory-budget (0 = none)
@@ -79,6 +79,9 @@ CLI::Option* declareFlags(CLI::App& app, GenArgs& a) {
     app.add_flag("--merge", a.merge,
                  "paged output: generate nothing; write index.osgb and manifest.json once every region is done "
                  "(exit 2 naming the missing regions otherwise)");
+    app.add_option("--shards", a.shards,
+                   "with --merge: N, the shard count of the shards' --shard K/N; a merge that finds regions missing "
+                   "then names the shards K/N to run again");
     app.add_option("--memory-budget", a.memoryBudget,
                    "GB: refuse up front, before the meshes are made and with nothing written, a generation whose "
                    "estimated peak memory exceeds it (one file: from the laid-out city's estimated triangles; paged: "
@@ -141,11 +144,12 @@ Result<CityParams> resolveParams(GenArgs& a) {
     if (a.osmBuildings != "on" && a.osmBuildings != "off")
         return Status::error("option --osm-buildings = '" + a.osmBuildings + "': must be 'on' or 'off'");
     if (a.paged()) return params;  // checked by resolvePaged
-    if (a.regionSize || !a.shard.empty() || a.merge)
+    if (a.regionSize || !a.shard.empty() || a.merge || !a.shards.empty())
         return Status::error(std::string("option ") +
-                             (a.regionSize       ? "--region-size"
-                              : !a.shard.empty() ? "--shard"
-                                                 : "--merge") +
+                             (a.regionSize        ? "--region-size"
+                              : !a.shard.empty()  ? "--shard"
+                              : !a.shards.empty() ? "--shards"
+                                                  : "--merge") +
                              ": only with paged output (-o DIR.paged)");
     if (a.out.size() < 5 || a.out.substr(a.out.size() - 5) != ".osgb")
         return Status::error("option -o = '" + a.out +
@@ -179,6 +183,12 @@ Result<PagedCityOptions> resolvePaged(const GenArgs& a, const CityParams& params
     }
     if (a.merge && !a.shard.empty())
         return Status::error("option --merge: not with --shard (the merge covers every shard)");
+    if (!a.shards.empty()) {
+        if (!a.merge) return Status::error("option --shards: only with --merge (shards take --shard K/N)");
+        auto n = parseShardCount("--shards", a.shards);
+        if (!n) return n.status();
+        o.mergeShards = *n;
+    }
     for (auto [opt, path] : {std::pair<const char*, const std::string*>{"--geojson", &a.geojsonFile},
                              {"--gltf", &a.gltfFile},
                              {"--xodr", &a.xodrFile},
