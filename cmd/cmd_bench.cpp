@@ -79,7 +79,7 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
     app.add_option("--effects", a.effects,
                    "run-time effects for this run instead of the scene's: 'none', names (haze, glass, night) or a JSON "
                    "object as in the params file; baked effects (sun_shadows, ambient_occlusion, materials, night's "
-                   "lights) follow the scene file");
+                   "lights) follow the scene file, and naming one here is an error (give it to `vista gen --effects`)");
     app.add_option("--sweep", a.sweep,
                    "scaling sweep: sizes=500,1000,2000 generates a city per size (seed --seed) and benches each");
     app.add_flag("-q,--quiet", a.quiet, "no progress on stderr");

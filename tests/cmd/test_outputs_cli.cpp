@@ -159,3 +159,20 @@ TEST(EffectsOption, EmptyDuplicateAndDeepValuesAreRefused) {
     std::string deep = "{\"haze\":" + std::string(40, '[') + std::string(40, ']') + "}";
     expectRefusedUnchanged(dir, gen + "'" + deep + "'", {"nested deeper than"});
 }
+
+// Each baked-file flag takes one representation: the wrong one is bad input (exit 2), refused before drawing.
+TEST(BakedFlags, APointsBakeAsBakedMeshAndAMeshBakeAsBakedAreRefused) {
+    TempDir dir;
+    ASSERT_TRUE(vista::writeCityFile(vista::makeBakeCity(), dir.file("city.osgb")).isOk());
+    const std::string bake = "bake " + dir.file("city.osgb") + " --out-size 120 --min-triangles 1 -q --placement all ";
+    ASSERT_EQ(runVista(bake + "-o " + dir.file("p.osgb")).code, 0);
+    ASSERT_EQ(runVista(bake + "-o " + dir.file("m.osgb") + " --representation mesh --mesh-image 256").code, 0);
+    const std::string bench = "bench " + dir.file("city.osgb") + " -q --frames 1 --size 80x60 --out " + dir.file("o");
+    CliRun r = runVista(bench + " --baked-mesh " + dir.file("p.osgb") + " --modes lodmesh");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_TRUE(has(r.err, "--baked-mesh") && has(r.err, "point impostors")) << r.err;
+    r = runVista(bench + " --baked " + dir.file("m.osgb") + " --modes impostor");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_TRUE(has(r.err, "--baked") && has(r.err, "textured depth meshes")) << r.err;
+    EXPECT_FALSE(fs::exists(dir.file("o")));
+}
