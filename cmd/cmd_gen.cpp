@@ -10,6 +10,7 @@
 #include "citygen/generate.h"
 #include "citygen/opendrive.h"
 #include "foundation/atomic_file.h"
+#include "foundation/input_file.h"
 #include "foundation/number_text.h"
 #include "foundation/output_paths.h"
 #include "foundation/timing.h"
@@ -124,6 +125,8 @@ void printParamTable() {
 Result<CityParams> resolveParams(GenArgs& a) {
     CityParams params;
     if (!a.paramsFile.empty()) {
+        if (Status s = checkInputFile("parameter file", a.paramsFile, kMaxParamsFileBytes); !s)
+            return Status::error("option --params: " + s.message());
         auto r = loadParamsFile(a.paramsFile);
         if (!r) return r.status();
         params = *r;

@@ -407,7 +407,9 @@ Status checkRunFiles(CommandFiles files, const std::string& city, const PathFlag
                               .input("--baked", mode.baked)
                               .input("--baked-mesh", mode.bakedMesh)
                               .check());
-    if (!path.file.empty()) VISTA_RETURN_IF_ERROR(checkInputFile("path file", path.file, kMaxPathCsvBytes));
+    if (!path.file.empty())
+        if (Status s = checkInputFile("path file", path.file, kMaxPathCsvBytes); !s)
+            return Status::error("option --path: " + s.message());
     return Status::ok();
 }
 

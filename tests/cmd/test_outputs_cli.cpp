@@ -13,7 +13,7 @@
 #include <map>
 #include <string>
 
-#include "bake/bake_fixtures.h"
+#include "tests/bake/bake_fixtures.h"
 #include "runtime/scene/city_file.h"
 #include "tests/common/run_vista.h"
 #include "tests/common/temp_dir.h"
@@ -123,7 +123,7 @@ TEST(BoundedReads, DevicesDirectoriesAndOversizedFilesAreRefused) {
     // bench --path /dev/zero: refused before the output folder is made.
     write(dir.file("c.osgb"), "junk city");
     expectRefusedUnchanged(dir, "bench " + dir.file("c.osgb") + " --path /dev/zero --out " + dir.file("o/deep"),
-                           {"path file", "not a regular file"});
+                           {"--path", "path file", "not a regular file"});
     EXPECT_FALSE(fs::exists(dir.file("o")));
 }
 
