@@ -52,7 +52,7 @@ struct GenArgs {
 
 CLI::Option* declareFlags(CLI::App& app, GenArgs& a) {
     app.add_option("--params", a.paramsFile, "JSON parameter file (see docs/params.md; examples in data/)");
-    app.add_option("--seed", a.seed, "random seed (overrides the params file)");
+    app.add_option("--seed", a.seed, "random seed (overrides the params file)")->type_name("UINT");
     app.add_option("--size", a.size,
                    "side of the square city area in metres, 100..16000 (default 2000); up to 64000 with paged output");
     app.add_option("--detail", a.detail, "facade detail 0..3 (0 = plain boxes, default 2)");

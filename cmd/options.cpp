@@ -363,14 +363,16 @@ Status parseModeFlags(const ModeFlags& f, ModeOptions& o) {
 }
 
 CLI::Option* addSeedOption(CLI::App& app, const std::string& name, uint64_t& seed, const std::string& help) {
-    return app.add_option_function<std::string>(
-        name,
-        [&seed, name](const std::string& text) {
-            auto v = parseUnsignedText("option " + name, text, 0, UINT64_MAX);
-            if (!v) throw CLI::ValidationError(v.status().message());
-            seed = *v;
-        },
-        help);
+    return app
+        .add_option_function<std::string>(
+            name,
+            [&seed, name](const std::string& text) {
+                auto v = parseUnsignedText("option " + name, text, 0, UINT64_MAX);
+                if (!v) throw CLI::ValidationError(v.status().message());
+                seed = *v;
+            },
+            help)
+        ->type_name("UINT");
 }
 
 void addPathFlags(CLI::App& app, PathFlags& f, bool timing) {

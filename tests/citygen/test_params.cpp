@@ -27,8 +27,6 @@ TEST(Params, HostileJsonIsRefusedCleanlyAndTheFullSeedRangeAccepted) {
          "'seed' = 18446744073709551616 is out of range [0, 18446744073709551615]"},
         {R"({"detail": 2.5})", "'detail' must be an integer, got 2.5"},
         {R"({"detail": 99999999999999999999})", "'detail' = 99999999999999999999 is out of range [0, 3]"},
-        // A megabyte key is named, cut short.
-        {"{\"" + std::string(1 << 20, 'k') + "\": 1}", "unknown parameter 'kkkk"},
     };
     for (const auto& [text, says] : bad) {
         auto r = parseParamsJson(text, "p.json");
@@ -36,6 +34,11 @@ TEST(Params, HostileJsonIsRefusedCleanlyAndTheFullSeedRangeAccepted) {
         EXPECT_NE(r.status().message().find(says), std::string::npos) << r.status().message();
         EXPECT_LT(r.status().message().size(), 300u) << "messages stay short";
     }
+    // A megabyte key is named, cut short (the message lists the known parameters besides).
+    auto key = parseParamsJson("{\"" + std::string(1 << 20, 'k') + "\": 1}", "p.json");
+    ASSERT_FALSE(key.isOk());
+    EXPECT_NE(key.status().message().find("unknown parameter 'kkkk"), std::string::npos);
+    EXPECT_LT(key.status().message().size(), 1000u);
     auto top = parseParamsJson(R"({"seed": 18446744073709551615})", "p.json");
     ASSERT_TRUE(top.isOk()) << top.status().message();
     EXPECT_EQ(top->seed, 18446744073709551615ull);
