@@ -10,7 +10,10 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <cmath>
+#include <cstdio>
 #include <map>
+#include <sstream>
 #include <string>
 
 #include "tests/bake/bake_fixtures.h"
@@ -175,4 +178,29 @@ TEST(BakedFlags, APointsBakeAsBakedMeshAndAMeshBakeAsBakedAreRefused) {
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_TRUE(has(r.err, "--baked") && has(r.err, "textured depth meshes")) << r.err;
     EXPECT_FALSE(fs::exists(dir.file("o")));
+}
+
+// An OSM extract larger than --size: the city's own seeded path stays in the city square (render's check).
+TEST(OsmLargerThanTheCity, SeededPathsStayInsideTheCitySquare) {
+    TempDir dir;
+    const std::string city = dir.file("c.osgb");
+    CliRun r = runVista("gen -q --osm " + std::string(VISTA_SOURCE_DIR) +
+                        "/tests/data/osm/town.osm --osm-buildings off --size 300 -o " + city);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(has(r.err, "clipped")) << r.err;
+    for (const char* seed : {"1", "3", "7"}) {
+        r = runVista("path " + city + " --seed " + seed + " -o " + dir.file("p.csv"));
+        ASSERT_EQ(r.code, 0) << r.err;
+        std::istringstream csv(readBytes(dir.file("p.csv")));
+        std::string line;
+        std::getline(csv, line);  // header
+        size_t samples = 0;
+        while (std::getline(csv, line)) {
+            double t = 0, x = 0, y = 0;
+            ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf", &t, &x, &y), 3) << line;
+            EXPECT_LE(std::max(std::abs(x), std::abs(y)), 150.0 + 50.0) << "seed " << seed << ": " << line;
+            ++samples;
+        }
+        EXPECT_GT(samples, 100u);
+    }
 }
