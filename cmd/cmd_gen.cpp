@@ -1,5 +1,6 @@
 // vista gen: params -> city.osgb (+ optional GeoJSON streets, glTF, stats).
 #include <cstdio>
+#include <functional>
 #include <fstream>
 #include <optional>
 #include <unistd.h>
@@ -9,6 +10,9 @@
 #include "citygen/generate.h"
 #include "citygen/opendrive.h"
 #include "foundation/atomic_file.h"
+#include "foundation/input_file.h"
+#include "foundation/number_text.h"
+#include "foundation/output_paths.h"
 #include "foundation/timing.h"
 #include "citygen/streets.h"
 #include "cmd/options.h"
@@ -27,9 +31,10 @@ namespace {
 const char* const kCmd = "vista gen";
 
 struct GenArgs {
-    std::string paramsFile, out, statsFile, osmFile, geojsonFile, gltfFile, xodrFile, effects;
+    std::string paramsFile, out, statsFile, osmFile, geojsonFile, gltfFile, xodrFile;
+    std::optional<std::string> effects;  // unset: the params file's
     std::string osmBuildings = "on";
-    std::optional<uint64_t> seed;
+    std::string seed;  // as written: parsed by parseUnsignedText (no wrap-around of "-1")
     std::optional<double> size;
     std::optional<int> detail, threads;
     bool quiet = false, listParams = false;
@@ -47,7 +52,7 @@ struct GenArgs {
 
 CLI::Option* declareFlags(CLI::App& app, GenArgs& a) {
     app.add_option("--params", a.paramsFile, "JSON parameter file (see docs/params.md; examples in data/)");
-    app.add_option("--seed", a.seed, "random seed (overrides the params file)");
+    app.add_option("--seed", a.seed, "random seed (overrides the params file)")->type_name("UINT");
     app.add_option("--size", a.size,
                    "side of the square city area in metres, 100..16000 (default 2000); up to 64000 with paged output");
     app.add_option("--detail", a.detail, "facade detail 0..3 (0 = plain boxes, default 2)");
@@ -123,16 +128,22 @@ void printParamTable() {
 Result<CityParams> resolveParams(GenArgs& a) {
     CityParams params;
     if (!a.paramsFile.empty()) {
+        if (Status s = checkInputFile("parameter file", a.paramsFile, kMaxParamsFileBytes); !s)
+            return Status::error("option --params: " + s.message());
         auto r = loadParamsFile(a.paramsFile);
         if (!r) return r.status();
         params = *r;
     }
-    if (a.seed) params.seed = *a.seed;
+    if (!a.seed.empty()) {
+        auto seed = parseUnsignedText("option --seed", a.seed, 0, UINT64_MAX);
+        if (!seed) return seed.status();
+        params.seed = *seed;
+    }
     if (a.size) params.size_m = *a.size;
     if (a.detail) params.detail = *a.detail;
     if (a.threads) params.threads = *a.threads;
-    if (!a.effects.empty()) {
-        auto e = parseEffectsOption(a.effects, params.effects);
+    if (a.effects) {
+        auto e = parseEffectsOption(*a.effects, params.effects);
         if (!e) return e.status();
         params.effects = *e;
     }
@@ -263,8 +274,10 @@ int runPaged(const GenArgs& a, const CityParams& params, const Stopwatch& total)
     return 0;
 }
 
-// Every output of the command, or none: each is staged, then all renamed together.
-Status writeOutputs(const GenArgs& a, const City& city, const CityParams& params) {
+// Every output of the command, or none: each is staged, then all renamed
+// together; `stats` (called once the others are staged) gives the stats JSON.
+Status writeOutputs(const GenArgs& a, const City& city, const CityParams& params,
+                    const std::function<std::string()>& stats) {
     OutputBatch batch;
     VISTA_RETURN_IF_ERROR(writeCityFile(city, batch.stage(a.out)));
     if (!a.geojsonFile.empty())
@@ -277,6 +290,7 @@ Status writeOutputs(const GenArgs& a, const City& city, const CityParams& params
         if (!xodr) return Status::error("option --xodr = '" + a.xodrFile + "': " + xodr.status().message());
         VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage(a.xodrFile), *xodr));
     }
+    if (!a.statsFile.empty()) VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage(a.statsFile), stats()));
     return batch.commit();
 }
 
@@ -351,6 +365,17 @@ int runGen(int argc, char** argv) {
     }
     if (outOpt->count() == 0)
         return reportBadInput(kCmd, Status::error("option -o/--output is required (the .osgb to write)"));
+    if (Status s = CommandFiles()
+                       .input("--params", a.paramsFile)
+                       .input("--osm", a.osmFile)
+                       .output("-o", a.out)
+                       .output("--stats", a.statsFile)
+                       .output("--geojson", a.geojsonFile)
+                       .output("--gltf", a.gltfFile)
+                       .output("--xodr", a.xodrFile)
+                       .check();
+        !s)
+        return reportBadInput(kCmd, s);
     Stopwatch total;
     auto params = resolveParams(a);
     if (!params) return reportBadInput(kCmd, params.status());
@@ -406,15 +431,17 @@ int runGen(int argc, char** argv) {
         city->stageTimes.push_back({"lighting", lighting.seconds});
     }
     Stopwatch write;
-    if (Status s = writeOutputs(a, *city, *params); !s) return reportBadInput(kCmd, s);
-    const double writeSeconds = write.ms() / 1000.0, totalSeconds = total.ms() / 1000.0;
     const CityCounts n = countCity(*city);
-    if (!a.statsFile.empty()) {
-        auto j = statsJson(*city, *params, n, lighting, writeSeconds, totalSeconds);
+    double totalSeconds = 0;
+    auto stats = [&] {
+        totalSeconds = total.ms() / 1000.0;
+        auto j = statsJson(*city, *params, n, lighting, write.ms() / 1000.0, totalSeconds);
         if (a.budgetGb > 0) j["memory"] = {{"estimate_mb", estimateMb}, {"budget_gb", a.budgetGb}};
         if (osmRoads) j["osm_roads"] = nlohmann::ordered_json::parse(osmRoadTagStatsJson(*osmRoads));
-        if (Status s = writeFileAtomic(a.statsFile, j.dump(2) + "\n"); !s) return reportBadInput(kCmd, s);
-    }
+        return j.dump(2) + "\n";
+    };
+    if (Status s = writeOutputs(a, *city, *params, stats); !s) return reportBadInput(kCmd, s);
+    totalSeconds = total.ms() / 1000.0;
     if (!a.quiet)
         std::fprintf(stderr,
                      "wrote %s: %zu street edges, %zu blocks, %zu buildings, %zu trees, %.2f M triangles, %zu draw "

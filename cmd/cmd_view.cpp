@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <osg/Camera>
@@ -51,7 +52,8 @@ const char* const kCmd = "vista view";
 osg::Matrixd toOsg(const glm::dmat4& m) { return osg::Matrixd(glm::value_ptr(m)); }
 
 struct ViewArgs {
-    std::string city, size = "1280x720", screenshot, mode = "full", fov = "60", effects, memoryBudget;
+    std::string city, size = "1280x720", screenshot, mode = "full", fov = "60", memoryBudget;
+    std::optional<std::string> effects;  // unset: the scene's
     int frames = 0;
     bool step = false, noHud = false;
     std::string sampling = samplingName(kDefaultSampleRuns);
@@ -111,6 +113,8 @@ Status configure(ViewArgs& a, ModeOptions& options) {
     a.sampleRuns = sampling.value();
     if (a.step && (a.frames < 1 || (a.path.file.empty() && a.path.seed == 0)))
         return Status::error("--step needs --frames N >= 1 and a path (--path or --seed)");
+    VISTA_RETURN_IF_ERROR(
+        checkRunFiles(CommandFiles().output("--screenshot", a.screenshot), a.city, a.path, a.modeFlags));
     if (!a.screenshot.empty()) VISTA_RETURN_IF_ERROR(checkWritablePath("--screenshot", a.screenshot));
     VISTA_RETURN_IF_ERROR(validatePagedReach(a.paged));
     return parseModeFlags(a.modeFlags, options);

@@ -1,5 +1,7 @@
 #include "runtime/scene/paths.h"
 #include "foundation/atomic_file.h"
+#include "foundation/input_file.h"
+#include "foundation/number_text.h"
 #include "foundation/statistics.h"
 #include "foundation/units.h"
 
@@ -465,52 +467,51 @@ Status saveLanePositionsCsv(const Path& path, const std::string& file) {
 }
 
 Result<Path> loadPathCsv(const std::string& file) {
-    std::ifstream f(file);
-    if (!f) return Status::error("path file '" + file + "' cannot be opened (missing or unreadable)");
-    std::string line;
+    auto text = readInputFile("path file", file, kMaxPathCsvBytes);
+    if (!text) return text.status();
+    // A UTF-8 byte order mark (spreadsheet exports) is not part of the header.
+    size_t pos = text->compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
+    const std::string where = "path file '" + echoText(file) + "' line ";
+    const char* const fieldNames[6] = {"t_s", "x_m", "y_m", "z_m", "heading_deg", "pitch_deg"};
+    // Coordinates a renderer and a ray caster can represent: on Earth
+    // (|x|, |y| <= 2e7 m, as the city origin), |z| <= 1e5 m, bounded time and heading.
+    const double limits[6] = {1e9, 2e7, 2e7, 1e5, 36000.0, 90.0};
     Path path;
     int lineNo = 0;
-    while (std::getline(f, line)) {
+    while (pos < text->size()) {
+        size_t eol = text->find('\n', pos);
+        if (eol == std::string::npos) eol = text->size();
+        std::string line = text->substr(pos, eol - pos);
+        pos = eol + 1;
         ++lineNo;
         if (!line.empty() && line.back() == '\r') line.pop_back();
         if (line.empty() || line[0] == '#') continue;
         if (lineNo == 1 && line.rfind("t_s", 0) == 0) continue;  // header
-        double v[6];
-        const char* p = line.c_str();
-        for (int k = 0; k < 6; ++k) {
-            char* end = nullptr;
-            errno = 0;
-            v[k] = std::strtod(p, &end);
-            if (end == p || errno == ERANGE || !std::isfinite(v[k]))
-                return Status::error("path file '" + file + "' line " + std::to_string(lineNo) + ": field " +
-                                     std::to_string(k + 1) +
-                                     " is not a finite number (expected t_s,x_m,y_m,z_m,heading_deg,pitch_deg)");
-            p = end;
-            while (*p == ' ' || *p == '\t') ++p;
-            if (k < 5) {
-                if (*p != ',')
-                    return Status::error("path file '" + file + "' line " + std::to_string(lineNo) +
-                                         ": expected 6 comma-separated fields");
-                ++p;
-            }
+        std::vector<std::string> fields;
+        for (size_t a = 0;;) {
+            const size_t comma = line.find(',', a);
+            std::string f = line.substr(a, comma == std::string::npos ? std::string::npos : comma - a);
+            const size_t b = f.find_first_not_of(" \t"), e = f.find_last_not_of(" \t");
+            fields.push_back(b == std::string::npos ? std::string() : f.substr(b, e - b + 1));
+            if (comma == std::string::npos || fields.size() > 6) break;
+            a = comma + 1;
         }
-        while (*p == ' ' || *p == '\t') ++p;
-        if (*p != '\0')
-            return Status::error("path file '" + file + "' line " + std::to_string(lineNo) + ": more than 6 fields");
+        if (fields.size() != 6)
+            return Status::error(where + std::to_string(lineNo) + ": expected 6 comma-separated fields " +
+                                 "(t_s,x_m,y_m,z_m,heading_deg,pitch_deg), found " +
+                                 (fields.size() > 6 ? std::string("more") : std::to_string(fields.size())));
+        double v[6];
+        for (int k = 0; k < 6; ++k) {
+            auto r = parseRealText(
+                where + std::to_string(lineNo) + ": field " + std::to_string(k + 1) + " (" + fieldNames[k] + ")",
+                fields[size_t(k)], -limits[k], limits[k]);
+            if (!r) return r.status();
+            v[k] = *r;
+        }
         if (!path.samples.empty() && !(v[0] > path.samples.back().t))
-            return Status::error("path file '" + file + "' line " + std::to_string(lineNo) + ": time " + fmtNum(v[0]) +
-                                 " s does not increase");
-        // Coordinates a renderer and a ray caster can represent: on Earth
-        // (|x|, |y| <= 2e7 m, as the city origin), |z| <= 1e5 m, bounded time and heading.
-        const char* const names[6] = {"time", "x", "y", "z", "heading", "pitch"};
-        const double limits[6] = {1e9, 2e7, 2e7, 1e5, 36000.0, 90.0};
-        for (int k = 0; k < 5; ++k)
-            if (std::abs(v[k]) > limits[k])
-                return Status::error("path file '" + file + "' line " + std::to_string(lineNo) + ": " + names[k] + " " +
-                                     fmtNum(v[k]) + " out of range [-" + fmtNum(limits[k]) + ", " + fmtNum(limits[k]) +
-                                     "]");
+            return Status::error(where + std::to_string(lineNo) + ": time " + fmtNum(v[0]) + " s does not increase");
         if (std::abs(v[5]) >= 90.0)
-            return Status::error("path file '" + file + "' line " + std::to_string(lineNo) + ": pitch " + fmtNum(v[5]) +
+            return Status::error(where + std::to_string(lineNo) + ": pitch " + fmtNum(v[5]) +
                                  " deg out of range (-90, 90)");
         PathSample s;
         s.t = v[0];
