@@ -12,9 +12,9 @@
 //    float), instanced into a top-level scene by a translation. Trees are
 //    instances of prototype scenes in the top-level scene. Vertex precision is
 //    then that of a region's extent (0.1 mm for 2 km), wherever the region
-//    lies; what remains of the distance from frameOrigin is the float ray
-//    origin (half a float step of |eye - frameOrigin|: 1 mm at 16 km, 2 mm
-//    at 32 km).
+//    lies; ray origins are floats around frameOrigin (half a float step of
+//    |eye - frameOrigin|: 1 mm at 16 km), so callers that move far keep the
+//    frame near the camera with placeFrameNear().
 //  - flat (`regionSizeM` = 0): every tile mesh is one triangle geometry of one
 //    scene, its vertices relative to frameOrigin.
 // Regions can be added and removed after the build (addRegion, removeRegion,
