@@ -499,6 +499,8 @@ Status renderFrames(const RenderArgs& a, const RenderPlan& p, const Walkthrough&
         const bool finished = !done.records[f].is_null();
         if (finished && !(stateful && long(f) < done.lastMissing)) continue;
         FrameStats st;
+        // Ray origins near the scene's frame origin: float precision anywhere in the city.
+        if (s.rays) VISTA_RETURN_IF_ERROR(s.rays->placeFrameNear(cam.eye));
         if (Status e = s.mode->renderFrame(cam, b.img, st); !e)
             return Status::error("frame " + std::to_string(f) + ": " + e.message());
         if (finished) {  // hybrid warm-up: the state, not the image

@@ -137,6 +137,12 @@ public:
         std::fprintf(stderr, "%s: mode %s set up in %.0f ms\n", kCmd, name.c_str(), sw.ms());
         return (_modes[name] = std::move(m.value())).get();
     }
+    // Moves the ray scene's frame next to the eye (RayScene::placeFrameNear),
+    // between frames, when no ray is in flight.
+    void placeFrameNear(const glm::dvec3& eye) {
+        if (!_rays) return;
+        if (Status st = _rays->placeFrameNear(eye); !st) std::fprintf(stderr, "%s: %s\n", kCmd, st.message().c_str());
+    }
     // The mode after `current` that can be created (stays on `current` if none).
     std::string next(const std::string& current) {
         const auto& all = renderModes();
@@ -421,6 +427,7 @@ int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path,
                 c.roll = fromOsg.roll;
             }
         }
+        modes.placeFrameNear(c.eye);  // ray origins near the frame origin: float precision anywhere
         cam->setProjectionMatrix(toOsg(c.projection(v.current->beginViewerFrame(c))));
         if (v.keys->effects) v.sky->setNight(v.keys->effects->night);
         const bool skyLayer = !v.current->drawsSky();  // hybrid: the far field writes every uncovered pixel
