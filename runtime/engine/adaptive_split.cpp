@@ -6,8 +6,10 @@
 #include <limits>
 #include <numeric>
 #include <optional>
+#include <thread>
 
 #include "foundation/timing.h"
+#include "runtime/engine/far_field_rays.h"
 #include "runtime/engine/ray_scene.h"
 
 namespace vista {
@@ -41,6 +43,12 @@ std::optional<double> fitSlope(const std::vector<std::pair<double, double>>& sam
     std::nth_element(slopes.begin(), mid, slopes.end());
     return *mid;
 }
+
+// The kind of a candidate distance: 0 = ray casting, 1 = a middle distance, 2 = everything.
+int kindOf(double d) { return d <= 0 ? 0 : std::isinf(d) ? 2 : 1; }
+
+// Weight of a new frame in a kind's price correction.
+constexpr double kCorrectionWeight = 0.25;
 
 void pushWindow(std::vector<std::pair<double, double>>& w, std::pair<double, double> s, int window) {
     w.push_back(s);
@@ -199,7 +207,21 @@ void AdaptiveSplit::probe(const Camera& camera) {
             dirs.push_back(glm::vec3(camera.rayDirection(x + 0.5, y + 0.5)));
         }
     std::vector<RayHit> hits(dirs.size());
-    if (!dirs.empty()) _rays->intersectMany(orgs.data(), dirs.data(), int(dirs.size()), hits.data());
+    // With haze nothing beyond its depth is traced: the probe stops there too.
+    const glm::dvec3 fwd = camera.forward();
+    const float tfar = _hazeFar > 0 ? float(_hazeFar / minForwardCosine(camera)) : 1e30f;
+    if (!dirs.empty()) {
+        Stopwatch sw;
+        _rays->intersectMany(orgs.data(), dirs.data(), int(dirs.size()), hits.data(), tfar);
+        if (_o.timeProbe) {
+            // The ray-casting end point's price: every pixel's ray from the eye, one thread.
+            const double all = sw.ms() / double(dirs.size());
+            _probeAllMs = _probeAllMs > 0 ? (1 - _o.smoothing) * _probeAllMs + _o.smoothing * all : all;
+        }
+    }
+    if (_hazeFar > 0)
+        for (size_t i = 0; i < hits.size(); ++i)
+            if (hits[i].hit && double(hits[i].t) * glm::dot(glm::dvec3(dirs[i]), fwd) > _hazeFar) hits[i].hit = false;
     if (_o.timeProbe) {
         // Bulk ms per far ray on one thread, independent of how many rays the split let
         // through: the probe rays that need the far field at the current near distance
@@ -213,7 +235,7 @@ void AdaptiveSplit::probe(const Camera& camera) {
         if (farDirs.size() >= 100) {
             std::vector<RayHit> farHits(farDirs.size());
             Stopwatch sw;
-            _rays->intersectMany(orgs.data(), farDirs.data(), int(farDirs.size()), farHits.data(), 1e30f, nullptr,
+            _rays->intersectMany(orgs.data(), farDirs.data(), int(farDirs.size()), farHits.data(), tfar, nullptr,
                                  start);
             const double b = sw.ms() / double(farDirs.size());
             _bProbe = _bProbe > 0 ? (1 - _o.smoothing) * _bProbe + _o.smoothing * b : b;
@@ -260,7 +282,10 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
     if (_o.everythingNear && measured) cand.push_back(std::numeric_limits<double>::infinity());
     const int n = int(cand.size());
     const double b = msPerRay();
-    std::vector<double> cost(cand.size());
+    _pixels = int64_t(camera.width) * int64_t(camera.height);
+    const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+    // The model's price of each candidate (see the header), then the learned correction of its kind.
+    std::vector<double> price(cand.size()), cost(cand.size());
     size_t k = 0;
     uint64_t tris = 0;
     int bestI = 0;
@@ -271,14 +296,46 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
         } else {
             while (k < byDist.size() && byDist[k].first <= d) tris += byDist[k++].second;
         }
-        // Nothing to draw -> no GL pass: the raster's fixed cost only where triangles are drawn.
-        cost[size_t(i)] = (tris > 0 ? _c + _a * double(tris) : 0.0) + b * predictedRays(d) + (std::isinf(d) ? 0.0 : _f);
+        const int kind = kindOf(d);
+        if (kind == 0) {
+            price[size_t(i)] = _probeAllMs > 0 ? _probeAllMs * double(_pixels) / double(cores) : b * predictedRays(0.0);
+        } else {
+            // Nothing to draw -> no GL pass: the raster's fixed cost only where triangles are drawn.
+            price[size_t(i)] =
+                (tris > 0 ? _c + _a * double(tris) : 0.0) + (kind == 1 ? b * predictedRays(d) + _f : 0.0);
+        }
+        cost[size_t(i)] = std::max(0.0, price[size_t(i)] + _corr[kind]);
         if (cost[size_t(i)] < cost[size_t(bestI)]) bestI = i;
     }
-    if (_o.exploreEvery > 0 && frame % _o.exploreEvery == _o.exploreEvery - 1)
-        bestI = std::clamp(bestI + ((frame / _o.exploreEvery) % 2 ? 1 : -1), 0, n - 1);
+    const double best = cost[size_t(bestI)];
+    if (_o.exploreEvery > 0 && frame % _o.exploreEvery == _o.exploreEvery - 1) {
+        const int slot = frame / _o.exploreEvery;
+        const int j = std::clamp(bestI + (slot % 2 ? 1 : -1), 0, n - 1);
+        if (cost[size_t(j)] <= _o.exploreRatio * best || slot % 4 == 3) bestI = j;
+    }
+    // An end not run for a while is tried when its price is near the best: its correction is
+    // then measured, not assumed.
+    if (_o.endTryEvery > 0 && _o.endTryRatio > 0)
+        for (int e = 0; e < 2; ++e) {
+            const int i = e == 0 ? 0 : n - 1;
+            if (kindOf(cand[size_t(i)]) != (e == 0 ? 0 : 2) || i == bestI) continue;
+            if (frame - _lastEndFrame[e] >= _o.endTryEvery && cost[size_t(i)] <= _o.endTryRatio * best) {
+                bestI = i;
+                break;
+            }
+        }
     _current = cand[size_t(bestI)];
+    _chosenPrice = price[size_t(bestI)];
+    if (kindOf(_current) != 1) _lastEndFrame[kindOf(_current) == 0 ? 0 : 1] = frame;
     return _current;
+}
+
+void AdaptiveSplit::recordFrame(double nearD, double frameMs) {
+    if (!(nearD == _current) || !(frameMs >= 0)) return;
+    const int kind = kindOf(nearD);
+    const double r = frameMs - _chosenPrice;
+    _corr[kind] = _haveCorr[kind] ? (1 - kCorrectionWeight) * _corr[kind] + kCorrectionWeight * r : r;
+    _haveCorr[kind] = true;
 }
 
 double AdaptiveSplit::msPerRay() const {
