@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <vector>
 
 #include <tbb/parallel_for.h>
 
@@ -26,7 +27,8 @@ typedef uint32_t __attribute__((may_alias)) PixelWord;
 // polynomial to r^7 on |r| < ln2 (relative error < 2e-6, far below an 8-bit
 // step). x below -87 gives about 1e-38, x above 0 gives 1.
 inline float expNonPositive(float x) {
-    x = std::clamp(x, -87.0f, 0.0f);
+    x = x < -87.0f ? -87.0f : x;  // branch-free forms, so loops over pixels vectorise
+    x = x > 0.0f ? 0.0f : x;
     const float t = x * 1.44269504f;  // x / ln2, in (-126, 0]
     const int n = int(t);             // truncation: n = ceil(t) for t <= 0
     const float r = x - float(n) * 0.693147181f;
@@ -62,6 +64,18 @@ struct HazeBlend {
     float colour[3];
 };
 
+// The covered pixels of a span hazed for window depths d (eye depth a / (b - d), na = -beta a);
+// every pixel is computed and the covered ones kept: a select, so the loop vectorises.
+void hazeCoveredSpan(PixelWord* px, const uint8_t* cls, const float* depth, size_t n, float na, float b,
+                     const HazeBlend& blend) {
+    for (size_t i = 0; i < n; ++i) {
+        const uint32_t p = px[i];
+        const float w = b - depth[i];
+        const uint32_t q = blend.apply(p, expNonPositive(na / (w > 1e-30f ? w : 1e-30f)));
+        px[i] = cls[i] == kFarCovered ? q : p;
+    }
+}
+
 void recordHaze(double ms, FrameStats& stats) {
     stats.stages.add(Stage::Haze, ms);
     stats.effects.add(EffectId::Haze, ms);
@@ -85,11 +99,13 @@ void hazeStage(const FrameEffects& fx, const uint32_t* pixels, size_t n, const f
             px[k] = z < kInf ? q : p;
         }
     } else {
+        // A pixel list: the transmittances in one vectorised pass, then the blend per pixel.
+        std::vector<float> t(n);
+        for (size_t k = 0; k < n; ++k) t[k] = expNonPositive(-blend.beta * depth[k]);
         for (size_t k = 0; k < n; ++k) {
-            const float z = depth[k];
-            if (!(z < kInf)) continue;
+            if (!(depth[k] < kInf)) continue;
             PixelWord& p = px[pixels[k]];
-            p = blend.apply(p, expNonPositive(-blend.beta * z));
+            p = blend.apply(p, t[k]);
         }
     }
     recordHaze(sw.ms(), stats);
@@ -101,8 +117,7 @@ void hazeCoveredStage(FarFrame& f, const FarFieldOptions& o, FrameStats& stats) 
     const HazeBlend blend(o.effects);
     // Eye depth of window depth d: z = a / (b - d) (eyeDepthOfWindowDepth
     // rearranged; infinite far plane: a = n, b = 1), in float: its relative
-    // error (1e-7) is far below an 8-bit step. Every pixel is computed and the
-    // covered ones kept (a select, so the row loop vectorises).
+    // error (1e-7) is far below an 8-bit step.
     const double zn = f.camera.zNear, zf = o.depthZFar;
     const float a = float(zf > 0 ? zn * zf / (zf - zn) : zn), b = float(zf > 0 ? zf / (zf - zn) : 1.0);
     const float na = -blend.beta * a;
@@ -113,12 +128,8 @@ void hazeCoveredStage(FarFrame& f, const FarFieldOptions& o, FrameStats& stats) 
     inArena(o.threads, [&] {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, size_t(f.height), 32),
                           [&](const tbb::blocked_range<size_t>& r) {
-                              for (size_t i = r.begin() * W, e = r.end() * W; i < e; ++i) {
-                                  const uint32_t p = px[i];
-                                  const float t = expNonPositive(na / std::max(b - depth[i], 1e-30f));
-                                  const uint32_t q = blend.apply(p, t);
-                                  px[i] = cls[i] == kFarCovered ? q : p;
-                              }
+                              hazeCoveredSpan(px + r.begin() * W, cls + r.begin() * W, depth + r.begin() * W,
+                                              (r.end() - r.begin()) * W, na, b, blend);
                           });
     });
     recordHaze(sw.ms(), stats);
