@@ -276,7 +276,8 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
     // The ends only once both costs are measured: on the priors alone they are guesses (on a
     // 3 M-triangle city the prior once chose "everything" for the first frames at 250 ms each).
     const bool measured = _haveA && _haveB;
-    if (_o.rayCastOnly && measured) cand.push_back(0.0);
+    // Ray casting's price needs only the probe's timed rate: offered once the probe is timed.
+    if (_o.rayCastOnly && (measured || _probeAllMs > 0)) cand.push_back(0.0);
     for (int i = 0; i < g; ++i)
         cand.push_back(_o.minDistance * std::pow(_o.maxDistance / _o.minDistance, double(i) / (g - 1)));
     if (_o.everythingNear && measured) cand.push_back(std::numeric_limits<double>::infinity());
@@ -313,20 +314,26 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
         const int j = std::clamp(bestI + (slot % 2 ? 1 : -1), 0, n - 1);
         if (cost[size_t(j)] <= _o.exploreRatio * best || slot % 4 == 3) bestI = j;
     }
-    // An end not run for a while is tried when its price is near the best: its correction is
-    // then measured, not assumed.
-    if (_o.endTryEvery > 0 && _o.endTryRatio > 0)
-        for (int e = 0; e < 2; ++e) {
-            const int i = e == 0 ? 0 : n - 1;
-            if (kindOf(cand[size_t(i)]) != (e == 0 ? 0 : 2) || i == bestI) continue;
-            if (frame - _lastEndFrame[e] >= _o.endTryEvery && cost[size_t(i)] <= _o.endTryRatio * best) {
-                bestI = i;
+    // A kind of choice (ray casting, the middle, everything) not run for a while is tried, its
+    // cheapest candidate, when its price is near the best: its correction is then measured, not
+    // assumed (a price resting on one frame's one-time costs would otherwise keep the split away).
+    if (_o.endTryEvery > 0 && _o.endTryRatio > 0) {
+        const int bestKind = kindOf(cand[size_t(bestI)]);
+        for (int kind = 0; kind < 3; ++kind) {
+            if (kind == bestKind || frame - _lastKindFrame[kind] < _o.endTryEvery) continue;
+            int cheapest = -1;
+            for (int i = 0; i < n; ++i)
+                if (kindOf(cand[size_t(i)]) == kind && (cheapest < 0 || cost[size_t(i)] < cost[size_t(cheapest)]))
+                    cheapest = i;
+            if (cheapest >= 0 && cost[size_t(cheapest)] <= _o.endTryRatio * best) {
+                bestI = cheapest;
                 break;
             }
         }
+    }
     _current = cand[size_t(bestI)];
     _chosenPrice = price[size_t(bestI)];
-    if (kindOf(_current) != 1) _lastEndFrame[kindOf(_current) == 0 ? 0 : 1] = frame;
+    _lastKindFrame[kindOf(_current)] = frame;
     return _current;
 }
 
@@ -376,7 +383,9 @@ void AdaptiveSplit::record(uint64_t triangles, double rasterMs, uint64_t farPixe
         _bFitted = b.has_value();
         _haveB = true;
     }
-    if (farPixels > 0 || fixedMs > 0) {
+    // The far field's first frame pays one-time costs (the panorama's pages, the first horizon
+    // trace): not counted, or the price of every middle candidate rests on them.
+    if ((farPixels > 0 || fixedMs > 0) && _farFrames++ > 0) {
         _f = _haveF ? (1 - w) * _f + w * fixedMs : fixedMs;
         _haveF = true;
     }

@@ -22,9 +22,10 @@
 // recordFrame(). So costs the model does not see (the probe, the cull, the
 // sky layer, haze in the rasteriser, the ray stage's task start-up) are
 // learned online for each alternative instead of tuned. Until a kind has run
-// its correction is 0; the ends are tried now and then (every `endTryEvery`
-// frames, an end not run for that long whose price is within `endTryRatio`
-// of the best) so that a wrong prior does not keep the split from them.
+// its correction is 0; each kind is tried now and then (its cheapest
+// candidate, when the kind has not run for `endTryEvery` frames and its price
+// is within `endTryRatio` of the best) so that a wrong price does not keep
+// the split from it. F skips the far field's first frame (one-time costs).
 // raster ms = c + a * triangles and far ms = c' + b * far pixels are robust
 // line fits (Theil-Sen) over the last `window` frames, whose near distances
 // differ as the walk goes on; priors until a fit is well conditioned; b falls
@@ -118,11 +119,12 @@ struct AdaptiveSplitOptions {
     int window = 60;            // frames in the raster-cost fit
     int exploreEvery = 7;       // every n-th choice explores a neighbouring candidate (0 = never)
     double exploreRatio = 1.2;  // ... when its price is within this factor of the best (else every 4th time)
-    int endTryEvery = 40;       // an end (0, everything) not chosen for this many frames is tried ...
+    int endTryEvery = 40;       // a kind (0, middle, everything) not chosen for this many frames is tried ...
     double endTryRatio = 1.3;   // ... when its price is within this factor of the best (0 = never)
-    // Two more candidates at the ends: 0 (nothing rasterised beyond the eye's
-    // own chunk: ray casting) and +infinity (everything rasterised, no far
-    // field), offered once both costs have been measured (not on the priors).
+    // Two more candidates at the ends: 0 (ray casting: the `raycast` frame) and
+    // +infinity (everything rasterised: the `full` frame), offered once both
+    // costs have been measured (not on the priors); 0 also once the probe is
+    // timed (its price is the probe's rate).
     bool rayCastOnly = true, everythingNear = true;
     // Time the probe: its bulk ms per ray caps b (off: b from the frames alone, deterministic).
     bool timeProbe = true;
@@ -176,10 +178,11 @@ private:
     double _hazeFar = 0;          // setHazeFar
     double _corr[3] = {0, 0, 0};  // per kind: EMA of frame ms - the model's price
     bool _haveCorr[3] = {false, false, false};
-    double _chosenPrice = 0;        // the model's price (no correction) of the last choice
-    int _lastEndFrame[2] = {0, 0};  // the frame an end (0, everything) was last chosen or tried
-    int64_t _pixels = 0;            // the camera's pixel count at the last choice
-    glm::dvec3 _probeEye{0.0};      // the camera of the last probe
+    double _chosenPrice = 0;            // the model's price (no correction) of the last choice
+    int _lastKindFrame[3] = {0, 0, 0};  // per kind: the frame it was last chosen or tried
+    int _farFrames = 0;                 // frames recorded with a far field
+    int64_t _pixels = 0;                // the camera's pixel count at the last choice
+    glm::dvec3 _probeEye{0.0};          // the camera of the last probe
     double _probeHeading = 0, _probePitch = 0;
 };
 
