@@ -34,7 +34,9 @@ public:
         _grid = HeightGrid::build(*ctx.city, ctx.rays->frameOrigin(), ctx.options.horizonGrid);
         _setup.push_back({"height_grid", sw.ms()});
         _far = std::make_unique<FarField>(*ctx.rays, &_grid, farOptions(ctx.options.fixedNearDistance(), 0.0));
-        _adaptive = std::make_unique<AdaptiveSplit>(_near.objects, ctx.rays);
+        AdaptiveSplitOptions so;
+        so.endTryEvery = 12;  // each kind of choice re-measured about every 12 frames of a walkthrough
+        _adaptive = std::make_unique<AdaptiveSplit>(_near.objects, ctx.rays, so);
         _root = new osg::Group;
         if (_near.rootState) _root->setStateSet(_near.rootState.get());
     }

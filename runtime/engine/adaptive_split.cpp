@@ -47,6 +47,11 @@ std::optional<double> fitSlope(const std::vector<std::pair<double, double>>& sam
 // The kind of a candidate distance: 0 = ray casting, 1 = a middle distance, 2 = everything.
 int kindOf(double d) { return d <= 0 ? 0 : std::isinf(d) ? 2 : 1; }
 
+// A kind of choice never run is tried from this frame on, when its price is within this factor of
+// the best (AdaptiveSplit::choose).
+constexpr int kFirstTryFrame = 3;
+constexpr double kFirstTryRatio = 3.0;
+
 // Weight of a new frame in a kind's price correction.
 constexpr double kCorrectionWeight = 0.25;
 
@@ -320,12 +325,18 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
     if (_o.endTryEvery > 0 && _o.endTryRatio > 0) {
         const int bestKind = kindOf(cand[size_t(bestI)]);
         for (int kind = 0; kind < 3; ++kind) {
-            if (kind == bestKind || frame - _lastKindFrame[kind] < _o.endTryEvery) continue;
+            // A kind never run is tried early (from frame kFirstTryFrame, within kFirstTryRatio of
+            // the best): its price then stops resting on the model alone.
+            const bool never = !_haveCorr[kind] && _lastKindFrame[kind] == 0;
+            if (kind == bestKind ||
+                !(frame - _lastKindFrame[kind] >= _o.endTryEvery || (never && frame >= kFirstTryFrame)))
+                continue;
             int cheapest = -1;
             for (int i = 0; i < n; ++i)
                 if (kindOf(cand[size_t(i)]) == kind && (cheapest < 0 || cost[size_t(i)] < cost[size_t(cheapest)]))
                     cheapest = i;
-            if (cheapest >= 0 && cost[size_t(cheapest)] <= _o.endTryRatio * best) {
+            if (cheapest >= 0 &&
+                cost[size_t(cheapest)] <= (never ? std::max(kFirstTryRatio, _o.endTryRatio) : _o.endTryRatio) * best) {
                 bestI = cheapest;
                 break;
             }
