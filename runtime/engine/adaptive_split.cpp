@@ -310,7 +310,7 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
             price[size_t(i)] =
                 (tris > 0 ? _c + _a * double(tris) : 0.0) + (kind == 1 ? b * predictedRays(d) + _f : 0.0);
         }
-        cost[size_t(i)] = std::max(0.0, price[size_t(i)] + _corr[kind]);
+        cost[size_t(i)] = std::max(0.0, price[size_t(i)] + (_haveCorr[kind] ? _corr[kind] : 0.0));
         if (cost[size_t(i)] < cost[size_t(bestI)]) bestI = i;
     }
     const double best = cost[size_t(bestI)];
@@ -327,9 +327,8 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
         for (int kind = 0; kind < 3; ++kind) {
             // A kind never run is tried early (from frame kFirstTryFrame, within kFirstTryRatio of
             // the best): its price then stops resting on the model alone.
-            const bool never = !_haveCorr[kind] && _lastKindFrame[kind] == 0;
-            if (kind == bestKind ||
-                !(frame - _lastKindFrame[kind] >= _o.endTryEvery || (never && frame >= kFirstTryFrame)))
+            const bool never = !_haveCorr[kind];
+            if (kind == bestKind || !(frame - _lastKindFrame[kind] >= (never ? kFirstTryFrame : _o.endTryEvery)))
                 continue;
             int cheapest = -1;
             for (int i = 0; i < n; ++i)
@@ -351,6 +350,12 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
 void AdaptiveSplit::recordFrame(double nearD, double frameMs) {
     if (!(nearD == _current) || !(frameMs >= 0)) return;
     const int kind = kindOf(nearD);
+    // A kind's first frame pays one-time costs (the first draw of the chunks, the far field's
+    // first frame, the ray casters' threads): not counted; NaN marks it seen.
+    if (!_haveCorr[kind] && !std::isnan(_corr[kind])) {
+        _corr[kind] = std::numeric_limits<double>::quiet_NaN();
+        return;
+    }
     const double r = frameMs - _chosenPrice;
     _corr[kind] = _haveCorr[kind] ? (1 - kCorrectionWeight) * _corr[kind] + kCorrectionWeight * r : r;
     _haveCorr[kind] = true;

@@ -360,7 +360,8 @@ TEST(Split, EachChoiceLearnsItsOwnFixedCost) {
         s.record(uint64_t(tris), 1.0 + 1e-2 * tris, 5000, 5000 * 1e-6);  // rays nearly free
     }
     ASSERT_EQ(s.choose(out, -1), 0.0);
-    EXPECT_EQ(s.correctionMs(0), 0.0);
+    s.recordFrame(0.0, 5000.0);  // a kind's first frame (one-time costs) is not counted
+    ASSERT_EQ(s.choose(out, -1), 0.0);
     s.recordFrame(0.0, 1000.0);
     EXPECT_GT(s.correctionMs(0), 900.0);
     const double d = s.choose(out, -1);
@@ -369,8 +370,8 @@ TEST(Split, EachChoiceLearnsItsOwnFixedCost) {
     EXPECT_EQ(s.correctionMs(1), 0.0);
     EXPECT_EQ(s.correctionMs(2), 0.0);
 
-    // End tries: the model's price of ray casting is dear here (rays dear), but every 5th frame
-    // it is tried when within a factor 1e9 of the best; never with endTryRatio 0.
+    // End tries: the model's price of ray casting is dear here (rays dear), but it is tried when
+    // within a factor 1e9 of the best; never with endTryRatio 0.
     for (const double ratio : {1e9, 0.0}) {
         AdaptiveSplitOptions t = measuredOnly();
         t.endTryEvery = 5;
@@ -384,8 +385,9 @@ TEST(Split, EachChoiceLearnsItsOwnFixedCost) {
         int zeros = 0;
         for (int f = 0; f < 20; ++f) zeros += tr.choose(out, -1) == 0.0;
         if (ratio > 0) {
-            EXPECT_GE(zeros, 3) << "tried every 5th frame";
-            EXPECT_LE(zeros, 4);
+            // Never measured (no frame recorded): tried every third frame from frame 3.
+            EXPECT_GE(zeros, 3) << "tried";
+            EXPECT_LE(zeros, 6);
         } else {
             EXPECT_EQ(zeros, 0);
         }
