@@ -357,8 +357,15 @@ void AdaptiveSplit::recordFrame(double nearD, double frameMs) {
         return;
     }
     const double r = frameMs - _chosenPrice;
-    _corr[kind] = _haveCorr[kind] ? (1 - kCorrectionWeight) * _corr[kind] + kCorrectionWeight * r : r;
-    _haveCorr[kind] = true;
+    if (!_haveCorr[kind]) {
+        _corr[kind] = r;
+        _haveCorr[kind] = true;
+        return;
+    }
+    // A frame slowed by other work on the machine moves the correction by a bounded step (a
+    // fifth of the kind's corrected price), so one such frame does not push the split away.
+    const double k = std::max(1.0, 0.2 * std::max(_chosenPrice + _corr[kind], 1.0));
+    _corr[kind] += kCorrectionWeight * std::clamp(r - _corr[kind], -k, k);
 }
 
 double AdaptiveSplit::msPerRay() const {
