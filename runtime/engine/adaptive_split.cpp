@@ -50,7 +50,7 @@ int kindOf(double d) { return d <= 0 ? 0 : std::isinf(d) ? 2 : 1; }
 // A kind of choice never run is tried from this frame on, when its price is within this factor of
 // the best (AdaptiveSplit::choose).
 constexpr int kFirstTryFrame = 3;
-constexpr double kFirstTryRatio = 3.0;
+constexpr double kFirstTryRatio = 1.5;
 
 // Weight of a new frame in a kind's price correction.
 constexpr double kCorrectionWeight = 0.25;
