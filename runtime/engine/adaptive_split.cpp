@@ -393,7 +393,11 @@ void AdaptiveSplit::record(uint64_t triangles, double rasterMs, uint64_t farPixe
             _c = std::max(0.0, *mid);
         }
     }
-    if (farPixels > 100 && farMs > 0) {
+    // The far field's first frame pays one-time costs (the panorama's pages, the first horizon
+    // trace): counted neither in b nor in F, or the price of every middle candidate rests on them.
+    const bool farFrame = farPixels > 0 || fixedMs > 0;
+    const bool firstFar = farFrame && _farFrames++ == 0;
+    if (farPixels > 100 && farMs > 0 && !firstFar) {
         pushWindow(_farSamples, {double(farPixels), farMs}, _o.window);
         double sx = 0, sy = 0;
         for (const auto& [x, y] : _farSamples) {
@@ -406,9 +410,7 @@ void AdaptiveSplit::record(uint64_t triangles, double rasterMs, uint64_t farPixe
         _bFitted = b.has_value();
         _haveB = true;
     }
-    // The far field's first frame pays one-time costs (the panorama's pages, the first horizon
-    // trace): not counted, or the price of every middle candidate rests on them.
-    if ((farPixels > 0 || fixedMs > 0) && _farFrames++ > 0) {
+    if (farFrame && !firstFar) {
         _f = _haveF ? (1 - w) * _f + w * fixedMs : fixedMs;
         _haveF = true;
     }
