@@ -2,8 +2,8 @@
 # Regenerates docs/measurements/effects.md: what each declared effect (sun_shadows, ambient_occlusion,
 # haze, glass, night, materials) costs at generation and per frame, how its quality knobs
 # trade time for PSNR (with one Pareto plot per effect in docs/img/effects_pareto_*.svg),
-# the haze payoff on a 2 km, a 4 km and an 8 km city, reflection rays vs glass in view, and raster
-# vs ray-caster agreement; plus the README pictures docs/img/effect_{shadows,haze,glass,night}.png.
+# the haze payoff on a 2 km, a 4 km and an 8 km city, reflection rays vs glass in view, raster
+# vs ray-caster agreement, and the hybrid with haze vs clear per path kind (effects_haze.sh); plus the README pictures docs/img/effect_{shadows,haze,glass,night}.png.
 #
 # usage: docs/tools/effects.sh [OUT_DIR] [VISTA_BIN]     (run from anywhere; works in the repo root)
 #   OUT_DIR   working directory for cities, benches and frames (default: a new temp dir, removed at
@@ -137,6 +137,9 @@ log "measurements done; writing the report"
 ELAPSED=$((SECONDS - START))
 python3 docs/tools/effects_report.py --out "$OUT" --psnr "$IMAGE_PSNR" \
   --invocation "$INVOCATION" --elapsed "$ELAPSED" --md "$OUT/effects.md" --img "$OUT/img"
+
+# 6. Haze per path kind (hybrid, 600 / 1500 / 3000 m vs clear), into the report's own block.
+DOC="$OUT/effects.md" "$(dirname "$0")/effects_haze.sh" "$OUT/haze_kinds" "$VISTA" >/dev/null
 
 # Pictures (first full frame of the chosen bench) and plots, then the doc, all or nothing.
 cp "$OUT/bench/pic_shadows/images/first_full.png" "$OUT/img/effect_shadows.png"

@@ -653,6 +653,15 @@ w(("Every hybrid median reaches the 40 dB target" if not low else
    "**Below the 40 dB target:** " + ", ".join(low)) +
   ("; single frames fall below 40 dB with " + ", ".join(lowmin) + "." if lowmin else "; so does every frame."))
 w("")
+w("## 6. Haze only saves: the hybrid per path kind")
+w("")
+w("The hybrid (`--near auto`) with haze against the same frames in clear air, on car, walk and fly paths of the "
+  "2 km city, at three visibilities; the `haze` stage is the haze of the drawn near field and of the traced far "
+  "pixels. Regenerated with the rest of this page, or alone by `docs/tools/effects_haze.sh [OUT_DIR] [VISTA_BIN]`.")
+w("")
+w("<!-- effects-haze:begin -->")
+w("<!-- effects-haze:end -->")
+w("")
 w("Raw data of a run: OUT_DIR/bench/NAME/{summary.json,frames.csv,frames/}, OUT_DIR/gen/NAME.json (--stats), "
   "every command in OUT_DIR/commands.log.")
 

@@ -12,6 +12,7 @@
 #include "nodes/render/offscreen.h"
 #include "runtime/engine/adaptive_split.h"
 #include "runtime/engine/far_field.h"
+#include "runtime/engine/frame_raycast.h"
 #include "runtime/engine/horizon.h"
 #include "runtime/engine/ray_scene.h"
 
@@ -27,23 +28,26 @@ std::string nearAutoNote(double nearD) {
 
 class HybridMode : public RenderMode {
 public:
-    explicit HybridMode(ModeContext& ctx) : _ctx(ctx), _near(ctx.nearField()) {
+    HybridMode(ModeContext& ctx, bool fixedSplit) : _ctx(ctx), _near(ctx.nearField()), _fixedSplit(fixedSplit) {
         _setup.push_back({"chunking", ctx.chunkingMs()});
         Stopwatch sw;
         _grid = HeightGrid::build(*ctx.city, ctx.rays->frameOrigin(), ctx.options.horizonGrid);
         _setup.push_back({"height_grid", sw.ms()});
         _far = std::make_unique<FarField>(*ctx.rays, &_grid, farOptions(ctx.options.fixedNearDistance(), 0.0));
-        _adaptive = std::make_unique<AdaptiveSplit>(_near.objects, ctx.rays);
+        AdaptiveSplitOptions so;
+        so.endTryEvery = 12;  // each kind of choice re-measured about every 12 frames of a walkthrough
+        _adaptive = std::make_unique<AdaptiveSplit>(_near.objects, ctx.rays, so);
         _root = new osg::Group;
         if (_near.rootState) _root->setStateSet(_near.rootState.get());
     }
-    std::string name() const override { return "hybrid"; }
+    std::string name() const override { return _fixedSplit ? "hybrid-fixed" : "hybrid"; }
 
     Status renderFrame(const Camera& camera, Image& out, FrameStats& stats) override {
         if (!_ctx.renderer) return Status::error("mode hybrid needs an OpenGL renderer (run under `xvfb-run -a`)");
         Stopwatch sw;
         // Cull: the near/far split.
         const double nearD = chooseNear(camera);
+        if (!byBudget() && (nearD <= 0 || std::isinf(nearD))) return endPointFrame(camera, nearD, sw, out, stats);
         std::vector<uint32_t> sel =
             byBudget() ? selectNearFieldByBudget(_near.objects, camera.eye, _ctx.options.triangleBudget)
                        : selectNearField(_adaptive->index(), camera.eye, nearD);
@@ -95,7 +99,10 @@ public:
         const bool haveDepth = !sel.empty() && _depth.size() == size_t(camera.width) * size_t(camera.height);
         _far->render(camera, haveDepth ? _depth.data() : nullptr, out, stats);
         stats.frameMs = sw.ms();
-        if (autoSplit()) recordCosts(tris, ns.frameMs, stats);
+        if (autoSplit()) {
+            recordCosts(tris, ns.frameMs, stats);
+            _adaptive->recordFrame(nearD, stats.frameMs);
+        }
         return Status::ok();
     }
     void reset() override { _far->reset(); }
@@ -136,6 +143,48 @@ public:
     }
 
 private:
+    // The split's end points are the modes they stand for, at their cost: ray casting (0 m) is
+    // the `raycast` frame (no GL pass, no read-back, no far-field stage: raycastFrame), and
+    // everything near is the `full` frame (the chunked city in its draw order, infinite far
+    // plane but for haze, sky layer, haze in the rasteriser; no read-back, no far field).
+    Status endPointFrame(const Camera& camera, double nearD, Stopwatch& sw, Image& out, FrameStats& stats) {
+        stats.stages.set(Stage::Cull, sw.ms());  // the split's decision
+        const FrameEffects& fx = _ctx.options.effects;
+        uint64_t tris = 0;
+        double rasterMs = 0;
+        if (nearD <= 0) {
+            raycastFrame(*_ctx.rays, camera, out, stats, _ctx.options.threads, fx);
+            _raster.chunks.clear();
+            _raster.zFar = 0.0;
+            _raster.nearDistance = 0.0;
+        } else {
+            if (fx.haze) _ctx.renderer->setEffects(fx, /*hazeInRaster=*/true);
+            FrameStats ns;
+            const Status s = _ctx.renderer->render(_ctx.chunkedCity(), camera, 0.0, &out, nullptr, ns);
+            if (fx.haze) _ctx.renderer->setEffects(fx, false);
+            VISTA_RETURN_IF_ERROR(s);
+            ns.stages.forEach([&](Stage st, double ms) { stats.stages.set(st, ms); });
+            stats.stages.set(Stage::Near, ns.frameMs);
+            stats.cullMs = ns.cullMs;
+            stats.drawMs = ns.drawMs;
+            stats.drawCalls = ns.drawCalls;
+            tris = _adaptive->index().totalTriangles();
+            stats.triangles = ns.triangles ? ns.triangles : tris;
+            stats.pixels.covered = uint64_t(camera.width) * uint64_t(camera.height);
+            rasterMs = ns.frameMs;
+            _raster.chunks = _near.drawOrder;
+            _raster.zFar = 0.0;
+            _raster.nearDistance = 1e300;
+        }
+        stats.frameMs = sw.ms();
+        if (autoSplit()) {
+            stats.notes.push_back(nearAutoNote(nearD));
+            if (rasterMs > 0) _adaptive->record(tris, rasterMs, 0, 0.0, 0.0);
+            _adaptive->recordFrame(nearD, stats.frameMs);
+        }
+        return Status::ok();
+    }
+
     // The adaptive split's cost model: far pixels (cached or traced) against the stages that
     // scale with them; the far field's other stages as its fixed cost.
     void recordCosts(uint64_t tris, double rasterMs, const FrameStats& fs) {
@@ -152,10 +201,14 @@ private:
         _adaptive->record(tris, rasterMs, farPixels, farMs, fixedMs);
     }
     bool byBudget() const { return _ctx.options.triangleBudget > 0; }
-    bool autoSplit() const { return !byBudget() && _ctx.options.nearDistance < 0; }
+    bool autoSplit() const { return !_fixedSplit && !byBudget() && _ctx.options.nearDistance < 0; }
     double chooseNear(const Camera& camera) {
         if (byBudget()) return 0.0;
-        return autoSplit() ? _adaptive->choose(camera, _ctx.options.pixelBudget) : _ctx.options.nearDistance;
+        if (autoSplit()) {
+            _adaptive->setHazeFar(_ctx.options.effects.hazeFar());
+            return _adaptive->choose(camera, _ctx.options.pixelBudget);
+        }
+        return _fixedSplit ? _ctx.options.fixedNearDistance() : _ctx.options.nearDistance;
     }
     double farPlane(double nearD, const Camera& camera) const {
         return byBudget() || !std::isfinite(nearD) ? 0.0 : std::max(nearD, camera.zNear * 4.0);  // 0 = infinite
@@ -180,6 +233,7 @@ private:
 
     ModeContext& _ctx;
     const NearFieldScene& _near;
+    const bool _fixedSplit;  // `hybrid-fixed`: always the fixed near distance, never the adaptive split
     HeightGrid _grid;
     std::unique_ptr<FarField> _far;
     std::unique_ptr<AdaptiveSplit> _adaptive;
@@ -204,7 +258,13 @@ Result<std::unique_ptr<RenderMode>> makeHybridMode(ModeContext& ctx) {
     if (ctx.options.horizonGrid < 0 || ctx.options.horizonGrid > 8192)
         return Status::error("option horizon grid = " + std::to_string(ctx.options.horizonGrid) +
                              " is out of range [1, 8192] (cells per side), or 0 = auto");
-    return std::unique_ptr<RenderMode>(new HybridMode(ctx));
+    return std::unique_ptr<RenderMode>(new HybridMode(ctx, false));
+}
+
+Result<std::unique_ptr<RenderMode>> makeHybridFixedMode(ModeContext& ctx) {
+    auto m = makeHybridMode(ctx);
+    if (!m) return m.status();
+    return std::unique_ptr<RenderMode>(new HybridMode(ctx, true));
 }
 
 }  // namespace vista

@@ -16,6 +16,14 @@
 // (buildHybridScene); beginViewerFrame() applies the same split and far
 // plane (auto: records the previous viewer frame's costs — near ms taken as
 // the frame's wall time minus its far-field stages — and chooses again).
+// End points of the split (--near auto picks 0 m or everything; never under a
+// triangle budget): 0 m draws the `raycast` frame (raycastFrame: no GL pass,
+// no read-back, no far-field stage), everything draws the `full` frame (the
+// chunked city with sky layer and haze in the rasteriser, no read-back, no
+// far field): the same images as those modes, at their cost.
+// `hybrid-fixed`: the same mode at the fixed near distance (--near, 100 m
+// under --near auto), never the adaptive split: the split's middle fixed
+// choice, for side-by-side runs against `hybrid --near auto`.
 // Errors: missing ray scene / city, horizon grid out of 1 .. 8192.
 #pragma once
 #include <memory>
@@ -25,5 +33,6 @@
 namespace vista {
 
 Result<std::unique_ptr<RenderMode>> makeHybridMode(ModeContext& ctx);
+Result<std::unique_ptr<RenderMode>> makeHybridFixedMode(ModeContext& ctx);
 
 }  // namespace vista

@@ -11,30 +11,17 @@
 #include "foundation/timing.h"
 #include "nodes/readback_drawable.h"
 #include "runtime/engine/frame_raycast.h"
-#include "runtime/engine/far_field_haze.h"
 #include "runtime/engine/ray_scene.h"
 
 namespace vista {
 namespace {
 
-// One primary ray per pixel centre into `rays` (the engine's castFrame: the
-// same packets and colours as the far field's ray stage); fills `out` and the
-// pixel classes, rays and the "rays" stage of `stats`.
+// One primary ray per pixel centre into `rays`: the engine's raycastFrame
+// (the same packets and colours as the far field's ray stage, and the frame
+// the hybrid draws when its split picks ray casting).
 void castEveryPixel(const RayScene& rays, const Camera& camera, Image& out, FrameStats& stats, int threads,
                     const FrameEffects& fx) {
-    Stopwatch sw;
-    if (out.width != camera.width || out.height != camera.height) out = Image(camera.width, camera.height);
-    RayCounts counts;
-    std::vector<float> depth(fx.haze ? size_t(camera.width) * size_t(camera.height) : 0);
-    RayShading shading;
-    shading.effects = &fx;
-    shading.depth = depth.empty() ? nullptr : depth.data();
-    castFrame(rays, camera, out, counts, threads, shading);
-    stats.pixels.rayHit = counts.hits;
-    stats.pixels.rayMiss = counts.rays - counts.hits;
-    stats.raysCast += counts.rays;
-    stats.stages.set(Stage::Rays, sw.ms());
-    if (!depth.empty()) hazeStage(fx, nullptr, depth.size(), depth.data(), out, stats);
+    raycastFrame(rays, camera, out, stats, threads, fx);
 }
 
 // Viewer face: casts the OSG camera's frame and draws it over the viewport.

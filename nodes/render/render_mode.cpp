@@ -25,6 +25,8 @@ const std::vector<ModeInfo>& renderModes() {
         {"osglod", "stock osg::LOD per chunk with osgUtil::Simplifier far versions + small-feature culling", false,
          false, makeOsgLodMode},
         {"hybrid", "near field rasterised + ray-cast far field (horizon, cache, Embree)", true, false, makeHybridMode},
+        {"hybrid-fixed", "hybrid at the fixed --near distance (100 m under --near auto), never the adaptive split",
+         true, false, makeHybridFixedMode},
         {"impostor", "near field + baked point impostors (needs a baked file: --baked)", false, true, makeImpostorMode},
         {"lodmesh", "near field + the cell's textured depth meshes (a file from 'vista bake --representation mesh')",
          false, false, makeLodMeshMode},

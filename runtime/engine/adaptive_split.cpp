@@ -6,8 +6,10 @@
 #include <limits>
 #include <numeric>
 #include <optional>
+#include <thread>
 
 #include "foundation/timing.h"
+#include "runtime/engine/far_field_rays.h"
 #include "runtime/engine/ray_scene.h"
 
 namespace vista {
@@ -41,6 +43,17 @@ std::optional<double> fitSlope(const std::vector<std::pair<double, double>>& sam
     std::nth_element(slopes.begin(), mid, slopes.end());
     return *mid;
 }
+
+// The kind of a candidate distance: 0 = ray casting, 1 = a middle distance, 2 = everything.
+int kindOf(double d) { return d <= 0 ? 0 : std::isinf(d) ? 2 : 1; }
+
+// A kind of choice never run is tried from this frame on, when its price is within this factor of
+// the best (AdaptiveSplit::choose).
+constexpr int kFirstTryFrame = 3;
+constexpr double kFirstTryRatio = 1.5;
+
+// Weight of a new frame in a kind's price correction.
+constexpr double kCorrectionWeight = 0.25;
 
 void pushWindow(std::vector<std::pair<double, double>>& w, std::pair<double, double> s, int window) {
     w.push_back(s);
@@ -199,7 +212,21 @@ void AdaptiveSplit::probe(const Camera& camera) {
             dirs.push_back(glm::vec3(camera.rayDirection(x + 0.5, y + 0.5)));
         }
     std::vector<RayHit> hits(dirs.size());
-    if (!dirs.empty()) _rays->intersectMany(orgs.data(), dirs.data(), int(dirs.size()), hits.data());
+    // With haze nothing beyond its depth is traced: the probe stops there too.
+    const glm::dvec3 fwd = camera.forward();
+    const float tfar = _hazeFar > 0 ? float(_hazeFar / minForwardCosine(camera)) : 1e30f;
+    if (!dirs.empty()) {
+        Stopwatch sw;
+        _rays->intersectMany(orgs.data(), dirs.data(), int(dirs.size()), hits.data(), tfar);
+        if (_o.timeProbe) {
+            // The ray-casting end point's price: every pixel's ray from the eye, one thread.
+            const double all = sw.ms() / double(dirs.size());
+            _probeAllMs = _probeAllMs > 0 ? (1 - _o.smoothing) * _probeAllMs + _o.smoothing * all : all;
+        }
+    }
+    if (_hazeFar > 0)
+        for (size_t i = 0; i < hits.size(); ++i)
+            if (hits[i].hit && double(hits[i].t) * glm::dot(glm::dvec3(dirs[i]), fwd) > _hazeFar) hits[i].hit = false;
     if (_o.timeProbe) {
         // Bulk ms per far ray on one thread, independent of how many rays the split let
         // through: the probe rays that need the far field at the current near distance
@@ -213,7 +240,7 @@ void AdaptiveSplit::probe(const Camera& camera) {
         if (farDirs.size() >= 100) {
             std::vector<RayHit> farHits(farDirs.size());
             Stopwatch sw;
-            _rays->intersectMany(orgs.data(), farDirs.data(), int(farDirs.size()), farHits.data(), 1e30f, nullptr,
+            _rays->intersectMany(orgs.data(), farDirs.data(), int(farDirs.size()), farHits.data(), tfar, nullptr,
                                  start);
             const double b = sw.ms() / double(farDirs.size());
             _bProbe = _bProbe > 0 ? (1 - _o.smoothing) * _bProbe + _o.smoothing * b : b;
@@ -254,13 +281,17 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
     // The ends only once both costs are measured: on the priors alone they are guesses (on a
     // 3 M-triangle city the prior once chose "everything" for the first frames at 250 ms each).
     const bool measured = _haveA && _haveB;
-    if (_o.rayCastOnly && measured) cand.push_back(0.0);
+    // Ray casting's price needs only the probe's timed rate: offered once the probe is timed.
+    if (_o.rayCastOnly && (measured || _probeAllMs > 0)) cand.push_back(0.0);
     for (int i = 0; i < g; ++i)
         cand.push_back(_o.minDistance * std::pow(_o.maxDistance / _o.minDistance, double(i) / (g - 1)));
     if (_o.everythingNear && measured) cand.push_back(std::numeric_limits<double>::infinity());
     const int n = int(cand.size());
     const double b = msPerRay();
-    std::vector<double> cost(cand.size());
+    _pixels = int64_t(camera.width) * int64_t(camera.height);
+    const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+    // The model's price of each candidate (see the header), then the learned correction of its kind.
+    std::vector<double> price(cand.size()), cost(cand.size());
     size_t k = 0;
     uint64_t tris = 0;
     int bestI = 0;
@@ -271,14 +302,70 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
         } else {
             while (k < byDist.size() && byDist[k].first <= d) tris += byDist[k++].second;
         }
-        // Nothing to draw -> no GL pass: the raster's fixed cost only where triangles are drawn.
-        cost[size_t(i)] = (tris > 0 ? _c + _a * double(tris) : 0.0) + b * predictedRays(d) + (std::isinf(d) ? 0.0 : _f);
+        const int kind = kindOf(d);
+        if (kind == 0) {
+            price[size_t(i)] = _probeAllMs > 0 ? _probeAllMs * double(_pixels) / double(cores) : b * predictedRays(0.0);
+        } else {
+            // Nothing to draw -> no GL pass: the raster's fixed cost only where triangles are drawn.
+            price[size_t(i)] =
+                (tris > 0 ? _c + _a * double(tris) : 0.0) + (kind == 1 ? b * predictedRays(d) + _f : 0.0);
+        }
+        cost[size_t(i)] = std::max(0.0, price[size_t(i)] + (_haveCorr[kind] ? _corr[kind] : 0.0));
         if (cost[size_t(i)] < cost[size_t(bestI)]) bestI = i;
     }
-    if (_o.exploreEvery > 0 && frame % _o.exploreEvery == _o.exploreEvery - 1)
-        bestI = std::clamp(bestI + ((frame / _o.exploreEvery) % 2 ? 1 : -1), 0, n - 1);
+    const double best = cost[size_t(bestI)];
+    if (_o.exploreEvery > 0 && frame % _o.exploreEvery == _o.exploreEvery - 1) {
+        const int slot = frame / _o.exploreEvery;
+        const int j = std::clamp(bestI + (slot % 2 ? 1 : -1), 0, n - 1);
+        if (cost[size_t(j)] <= _o.exploreRatio * best || slot % 4 == 3) bestI = j;
+    }
+    // A kind of choice (ray casting, the middle, everything) not run for a while is tried, its
+    // cheapest candidate, when its price is near the best: its correction is then measured, not
+    // assumed (a price resting on one frame's one-time costs would otherwise keep the split away).
+    if (_o.endTryEvery > 0 && _o.endTryRatio > 0) {
+        const int bestKind = kindOf(cand[size_t(bestI)]);
+        for (int kind = 0; kind < 3; ++kind) {
+            // A kind never run is tried early (from frame kFirstTryFrame, within kFirstTryRatio of
+            // the best): its price then stops resting on the model alone.
+            const bool never = !_haveCorr[kind];
+            if (kind == bestKind || !(frame - _lastKindFrame[kind] >= (never ? kFirstTryFrame : _o.endTryEvery)))
+                continue;
+            int cheapest = -1;
+            for (int i = 0; i < n; ++i)
+                if (kindOf(cand[size_t(i)]) == kind && (cheapest < 0 || cost[size_t(i)] < cost[size_t(cheapest)]))
+                    cheapest = i;
+            if (cheapest >= 0 &&
+                cost[size_t(cheapest)] <= (never ? std::max(kFirstTryRatio, _o.endTryRatio) : _o.endTryRatio) * best) {
+                bestI = cheapest;
+                break;
+            }
+        }
+    }
     _current = cand[size_t(bestI)];
+    _chosenPrice = price[size_t(bestI)];
+    _lastKindFrame[kindOf(_current)] = frame;
     return _current;
+}
+
+void AdaptiveSplit::recordFrame(double nearD, double frameMs) {
+    if (!(nearD == _current) || !(frameMs >= 0)) return;
+    const int kind = kindOf(nearD);
+    // A kind's first frame pays one-time costs (the first draw of the chunks, the far field's
+    // first frame, the ray casters' threads): not counted; NaN marks it seen.
+    if (!_haveCorr[kind] && !std::isnan(_corr[kind])) {
+        _corr[kind] = std::numeric_limits<double>::quiet_NaN();
+        return;
+    }
+    const double r = frameMs - _chosenPrice;
+    if (!_haveCorr[kind]) {
+        _corr[kind] = r;
+        _haveCorr[kind] = true;
+        return;
+    }
+    // A frame slowed by other work on the machine moves the correction by a bounded step (a
+    // fifth of the kind's corrected price), so one such frame does not push the split away.
+    const double k = std::max(1.0, 0.2 * std::max(_chosenPrice + _corr[kind], 1.0));
+    _corr[kind] += kCorrectionWeight * std::clamp(r - _corr[kind], -k, k);
 }
 
 double AdaptiveSplit::msPerRay() const {
@@ -306,7 +393,11 @@ void AdaptiveSplit::record(uint64_t triangles, double rasterMs, uint64_t farPixe
             _c = std::max(0.0, *mid);
         }
     }
-    if (farPixels > 100 && farMs > 0) {
+    // The far field's first frame pays one-time costs (the panorama's pages, the first horizon
+    // trace): counted neither in b nor in F, or the price of every middle candidate rests on them.
+    const bool farFrame = farPixels > 0 || fixedMs > 0;
+    const bool firstFar = farFrame && _farFrames++ == 0;
+    if (farPixels > 100 && farMs > 0 && !firstFar) {
         pushWindow(_farSamples, {double(farPixels), farMs}, _o.window);
         double sx = 0, sy = 0;
         for (const auto& [x, y] : _farSamples) {
@@ -319,7 +410,7 @@ void AdaptiveSplit::record(uint64_t triangles, double rasterMs, uint64_t farPixe
         _bFitted = b.has_value();
         _haveB = true;
     }
-    if (farPixels > 0 || fixedMs > 0) {
+    if (farFrame && !firstFar) {
         _f = _haveF ? (1 - w) * _f + w * fixedMs : fixedMs;
         _haveF = true;
     }

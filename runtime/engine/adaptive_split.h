@@ -8,35 +8,52 @@
 // first object is always drawn). Pure; thread-safe.
 //
 // AdaptiveSplit: picks the near distance per frame from the measured cost of
-// this machine: raster ms = c + a * triangles and far ms = c' + b * far
-// pixels (robust line fits, Theil-Sen, over the last `window` frames, whose near
-// distances differ as the walk goes on; priors until a fit is well
-// conditioned; b falls back to the mean ms per far pixel, and a fitted b is
-// kept within [1/5, 1] of that mean; b is capped by the probe's bulk ms per
-// far ray (the probe rays that need the far field at the current near
-// distance, cast again from it and timed on one thread; timing all probe rays
-// priced far rays like the short ones into nearby facades, and the split then
-// shrank the near field into ever more rays): a fixed cost per frame (thread start, packet
-// set-up) divided by a few hundred rays would otherwise make rays look dearer
-// than they are, push the near field out, and so starve the fit), the far
-// field's fixed cost F (opacity, seam, horizon, composite: exponential moving
-// average) paid by every candidate but "everything near", the raster's fixed cost c (the fit's
-// median residual: clear, read-back) paid only by candidates that draw a triangle (a near field
-// with nothing in it needs no GL pass: the hybrid then skips it), predicted triangles(d) from the objects'
-// boxes (exact) and predicted rays(d) from a sparse probe of the view (every
-// `probeStride`-th pixel, sparser so that a large image gets about
-// `probeRays` probe rays, cast once per `probeInterval` frames and at once
-// when the view jumped (eye moved more than minDistance, heading or pitch
-// more than 0.1 rad since the probe): a pixel whose
-// first hit lies beyond d, or that misses below the horizon, needs a ray). It
-// minimises [c + a * triangles(d) if triangles(d) > 0] + b * rays(d) (+ F unless d = infinity) over candidate distances
-// (geometric steps between minDistance and maxDistance, plus 0 = ray casting
-// and +infinity = everything rasterised when the options allow them). rays(d) is not capped
-// by the pixel budget: the aim is the lowest frame time at full accuracy (a
-// budget-capped model would always pick the smallest near field and let the
-// cache's error grow). Every `exploreEvery`-th choice steps one candidate up
-// or down from the optimum so that the fit sees varied triangle counts.
-// Not thread-safe; deterministic for given measurements.
+// this machine. Three kinds of choice, each priced with its own fixed costs:
+//   0 (ray casting): the hybrid draws the `raycast` frame (no GL pass, no
+//     read-back, no far-field stage): every pixel cast. Priced by the probe's
+//     timed ms per ray over the whole view (one thread, divided among the
+//     cores) times the pixels, or, without probe timing, b * rays(0).
+//   a middle distance d: c + a * triangles(d) (c only if triangles(d) > 0:
+//     an empty near field needs no GL pass) + b * rays(d) + F.
+//   +infinity (everything): the `full` frame, c + a * all triangles.
+// Each kind's price is corrected by what its own frames measured: an
+// exponential moving average of (whole frame ms, the decision included) minus
+// (the model's price for the choice made), per kind, recorded by
+// recordFrame(). So costs the model does not see (the probe, the cull, the
+// sky layer, haze in the rasteriser, the ray stage's task start-up) are
+// learned online for each alternative instead of tuned. Until a kind has run
+// its correction is 0; each kind is tried now and then (its cheapest
+// candidate, when the kind has not run for `endTryEvery` frames and its price
+// is within `endTryRatio` of the best) so that a wrong price does not keep
+// the split from it. F skips the far field's first frame (one-time costs).
+// raster ms = c + a * triangles and far ms = c' + b * far pixels are robust
+// line fits (Theil-Sen) over the last `window` frames, whose near distances
+// differ as the walk goes on; priors until a fit is well conditioned; b falls
+// back to the mean ms per far pixel, and a fitted b is kept within [1/5, 1] of
+// that mean; b is capped by the probe's bulk ms per far ray (the probe rays
+// that need the far field at the current near distance, cast again from it
+// and timed on one thread; timing all probe rays priced far rays like the
+// short ones into nearby facades, and the split then shrank the near field
+// into ever more rays): a fixed cost per frame (thread start, packet set-up)
+// divided by a few hundred rays would otherwise make rays look dearer than
+// they are, push the near field out, and so starve the fit), the far field's
+// fixed cost F (opacity, seam, horizon, composite: exponential moving
+// average), the raster's fixed cost c (the fit's median residual: clear,
+// read-back), predicted triangles(d) from the objects' boxes (exact) and
+// predicted rays(d) from a sparse probe of the view (every `probeStride`-th
+// pixel, sparser so that a large image gets about `probeRays` probe rays,
+// cast once per `probeInterval` frames and at once when the view jumped (eye
+// moved more than minDistance, heading or pitch more than 0.1 rad since the
+// probe): a pixel whose first hit lies beyond d, or that misses below the
+// horizon, needs a ray; with haze (setHazeFar) the probe stops at the haze
+// and a surface beyond it counts as a miss: sky above the horizon costs no
+// ray). rays(d) is not capped by the pixel budget: the aim is the lowest
+// frame time at full accuracy (a budget-capped model would always pick the
+// smallest near field and let the cache's error grow). Every
+// `exploreEvery`-th choice steps one candidate up or down from the optimum so
+// that the fit sees varied triangle counts, when that neighbour's price is
+// within `exploreRatio` of the best (else only every fourth time).
+// Not thread-safe; deterministic for given measurements (timeProbe off).
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -99,11 +116,15 @@ struct AdaptiveSplitOptions {
     int probeInterval = 10;  // frames between probes
     double smoothing = 0.2;  // EMA weight of a new measurement
     double initialDistance = 100.0;
-    int window = 60;       // frames in the raster-cost fit
-    int exploreEvery = 7;  // every n-th choice explores a neighbouring candidate (0 = never)
-    // Two more candidates at the ends: 0 (nothing rasterised beyond the eye's
-    // own chunk: ray casting) and +infinity (everything rasterised, no far
-    // field), offered once both costs have been measured (not on the priors).
+    int window = 60;            // frames in the raster-cost fit
+    int exploreEvery = 7;       // every n-th choice explores a neighbouring candidate (0 = never)
+    double exploreRatio = 1.2;  // ... when its price is within this factor of the best (else every 4th time)
+    int endTryEvery = 40;       // a kind (0, middle, everything) not chosen for this many frames is tried ...
+    double endTryRatio = 1.3;   // ... when its price is within this factor of the best (0 = never)
+    // Two more candidates at the ends: 0 (ray casting: the `raycast` frame) and
+    // +infinity (everything rasterised: the `full` frame), offered once both
+    // costs have been measured (not on the priors); 0 also once the probe is
+    // timed (its price is the probe's rate).
     bool rayCastOnly = true, everythingNear = true;
     // Time the probe: its bulk ms per ray caps b (off: b from the frames alone, deterministic).
     bool timeProbe = true;
@@ -120,6 +141,13 @@ public:
     // stages that scale with them (cache + rays); the far field's other
     // stages' ms (fixedMs; 0 when the frame had no far field).
     void record(uint64_t triangles, double rasterMs, uint64_t farPixels, double farMs, double fixedMs = 0);
+    // The whole frame's ms (decision included) of a frame rendered at nearD, the distance
+    // choose() returned last (other values are ignored): corrects that kind's price.
+    void recordFrame(double nearD, double frameMs);
+    // Haze: nothing beyond this eye-plane depth (metres) is traced; 0 = no haze.
+    void setHazeFar(double zMax) { _hazeFar = zMax; }
+    // The learned correction of a kind's price (0 = ray casting, 1 = middle, 2 = everything), ms.
+    double correctionMs(int kind) const { return _corr[kind]; }
     double msPerTriangle() const { return _a; }
     double rasterFixedMs() const { return _c; }  // the raster fit's intercept (0 until a is fitted)
     double msPerRay() const;                     // per far pixel: the frames' model, capped by the probe's bulk rate
@@ -144,9 +172,17 @@ private:
     std::vector<std::pair<double, double>> _farSamples;     // (far pixels, ms), last `window` frames
     double _current;
     int _frame = 0;
-    std::vector<float> _probeT;  // per probe pixel: first hit distance (inf = miss), sorted ascending
-    double _probeScale = 1;      // screen pixels per probe pixel
-    glm::dvec3 _probeEye{0.0};   // the camera of the last probe
+    std::vector<float> _probeT;   // per probe pixel: first hit distance (inf = miss), sorted ascending
+    double _probeScale = 1;       // screen pixels per probe pixel
+    double _probeAllMs = 0;       // one-thread ms per probe ray over the whole view (EMA; 0 = not timed)
+    double _hazeFar = 0;          // setHazeFar
+    double _corr[3] = {0, 0, 0};  // per kind: EMA of frame ms - the model's price
+    bool _haveCorr[3] = {false, false, false};
+    double _chosenPrice = 0;            // the model's price (no correction) of the last choice
+    int _lastKindFrame[3] = {0, 0, 0};  // per kind: the frame it was last chosen or tried
+    int _farFrames = 0;                 // frames recorded with a far field
+    int64_t _pixels = 0;                // the camera's pixel count at the last choice
+    glm::dvec3 _probeEye{0.0};          // the camera of the last probe
     double _probeHeading = 0, _probePitch = 0;
 };
 

@@ -1,7 +1,8 @@
 // Haze stage: FrameEffects::applyHaze over pixels whose eye-plane depth is
-// known (the far field's traced pixels, the `raycast` mode's frame), through
-// a transmittance table built once per frame (linear interpolation per
-// 1/1024 of the haze range: error < 1e-6, far below an 8-bit step).
+// known (the far field's traced pixels, the `raycast` mode's frame), with the
+// transmittance evaluated per pixel by a polynomial exp (relative error
+// < 2e-6, far below an 8-bit step; within one level of applyHaze). The whole
+// frame (a null list) is one vectorised pass: about 0.2 ms at 640x480.
 //
 // hazeStage(): hazes the n listed pixels (indices y * width + x; a null list
 // = the first n pixels of the image in order) at their eye-plane depth

@@ -4,6 +4,8 @@
 #include <vector>
 
 #include "foundation/status.h"
+#include "foundation/timing.h"
+#include "runtime/engine/far_field_haze.h"
 
 namespace vista {
 
@@ -15,6 +17,22 @@ void castFrame(const RayScene& scene, const Camera& camera, Image& out, RayCount
     std::vector<size_t> runs(size_t(camera.height) + 1);
     for (size_t y = 0; y < runs.size(); ++y) runs[y] = y * size_t(camera.width);
     castPixelRuns(scene, camera, nullptr, runs, out, counts, threads, nullptr, shading);
+}
+
+void raycastFrame(const RayScene& scene, const Camera& camera, Image& out, FrameStats& stats, int threads,
+                  const FrameEffects& fx) {
+    Stopwatch sw;
+    RayCounts counts;
+    std::vector<float> depth(fx.haze ? size_t(camera.width) * size_t(camera.height) : 0);
+    RayShading shading;
+    shading.effects = &fx;
+    shading.depth = depth.empty() ? nullptr : depth.data();
+    castFrame(scene, camera, out, counts, threads, shading);
+    stats.pixels.rayHit += counts.hits;
+    stats.pixels.rayMiss += counts.rays - counts.hits;
+    stats.raysCast += counts.rays;
+    stats.stages.set(Stage::Rays, sw.ms());
+    if (!depth.empty()) hazeStage(fx, nullptr, depth.size(), depth.data(), out, stats);
 }
 
 }  // namespace vista

@@ -8,6 +8,13 @@
 // the rays and hits to `counts`; shading.depth / shading.keys, when set,
 // hold width * height entries. Deterministic for any `threads` (0 = all
 // cores). Contract (VISTA_CHECK): the camera has at least one pixel.
+//
+// raycastFrame(): the `raycast` render mode's frame, also the hybrid's frame
+// when its split picks ray casting: castFrame with the run-time effects of
+// `fx` (haze clips the rays and hazes every pixel by its eye-plane depth:
+// the haze stage), into `out` (resized to the camera), and the pixel
+// classes (rayHit, rayMiss), raysCast and the stages rays (and haze) in
+// `stats`. One implementation, so the two frames are the same bytes.
 #pragma once
 #include "runtime/engine/far_field_rays.h"
 
@@ -15,5 +22,8 @@ namespace vista {
 
 void castFrame(const RayScene& scene, const Camera& camera, Image& out, RayCounts& counts, int threads,
                const RayShading& shading = {});
+
+void raycastFrame(const RayScene& scene, const Camera& camera, Image& out, FrameStats& stats, int threads,
+                  const FrameEffects& fx);
 
 }  // namespace vista

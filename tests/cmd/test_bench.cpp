@@ -56,11 +56,12 @@ int runVista(const std::string& args, std::string* output = nullptr) {
 TEST(RenderModes, RegistryListsEveryModeOnce) {
     std::vector<std::string> names;
     for (const auto& m : renderModes()) names.push_back(m.name);
-    EXPECT_EQ(names, (std::vector<std::string>{"full", "near", "raycast", "osgimpostor", "osglod", "hybrid", "impostor",
-                                               "lodmesh"}));
-    EXPECT_EQ(renderModeNames(), "full, near, raycast, osgimpostor, osglod, hybrid, impostor, lodmesh");
+    EXPECT_EQ(names, (std::vector<std::string>{"full", "near", "raycast", "osgimpostor", "osglod", "hybrid",
+                                               "hybrid-fixed", "impostor", "lodmesh"}));
+    EXPECT_EQ(renderModeNames(), "full, near, raycast, osgimpostor, osglod, hybrid, hybrid-fixed, impostor, lodmesh");
     EXPECT_TRUE(findRenderMode("raycast")->needsRays);
     EXPECT_TRUE(findRenderMode("hybrid")->needsRays);
+    EXPECT_TRUE(findRenderMode("hybrid-fixed")->needsRays);
     EXPECT_FALSE(findRenderMode("osglod")->needsRays);
     EXPECT_TRUE(findRenderMode("impostor")->needsBaked);
     EXPECT_FALSE(findRenderMode("full")->needsBaked);

@@ -287,3 +287,111 @@ TEST(Hybrid, AnEmptyNearFieldSkipsTheGlPassAndCastsEveryPixel) {
     EXPECT_EQ(std::find(sn.notes.begin(), sn.notes.end(), "near field empty: no GL pass"), sn.notes.end());
     EXPECT_GT(sn.stages.ms(Stage::Near), 0.0);
 }
+
+namespace {
+// True when a far-field stage (anything the hybrid adds to a plain GL or ray-cast frame) ran.
+bool anyFarFieldStage(const FrameStats& s) {
+    for (Stage st : {Stage::Opacity, Stage::Seam, Stage::Horizon, Stage::Cache, Stage::Composite})
+        if (s.stages.ran(st)) return true;
+    return false;
+}
+// Exactly equal images (sizes and every byte).
+bool sameBytes(const Image& a, const Image& b) {
+    return a.width == b.width && a.height == b.height && a.rgba == b.rgba;
+}
+}  // namespace
+
+// The split's ends are the modes they stand for: at 0 m the hybrid's frame is
+// the `raycast` frame (no GL pass, no read-back, no far-field stage) and at
+// "everything" the `full` frame (no read-back, no far-field stage), byte for
+// byte, in clear air and in haze (raycast hazes by the ray's depth, full in
+// the rasteriser). Checked independently: ray casting vs rasterising the same
+// frame agree to >= 30 dB (both ends are pictures of the city, not copies of
+// each other), and the two end frames differ from the middle choice's
+// classification (the hybrid at 20 m draws and casts).
+TEST(Hybrid, EndPointsAreTheFramesOfTheirModes) {
+    REQUIRE_DISPLAY();
+    for (const bool haze : {false, true}) {
+        TinyModes t;
+        ASSERT_TRUE(t.ready()) << t.error;
+        ModeContext& ctx = t.ctx;
+        ctx.options.effects.haze = haze;
+        ctx.options.effects.visibility = 120.0;
+        auto full = createRenderMode("full", ctx), ray = createRenderMode("raycast", ctx);
+        ASSERT_TRUE(full.isOk() && ray.isOk());
+        Camera cam = testCamera(160, 120);
+        cam.eye = kWorld + glm::dvec3(-10, -40, 1.7);
+        cam.heading = 0.15;
+        Image fa, ra;
+        FrameStats fs, rs;
+        ASSERT_TRUE(full.value()->renderFrame(cam, fa, fs).isOk());
+        ASSERT_TRUE(ray.value()->renderFrame(cam, ra, rs).isOk());
+        EXPECT_GE(lumaPsnr(fa, ra), 30.0) << "haze " << haze;
+
+        // 0 m: ray casting.
+        ctx.options.nearDistance = 0.0;
+        auto h0 = createRenderMode("hybrid", ctx);
+        ASSERT_TRUE(h0.isOk()) << h0.status().message();
+        Image a(160, 120);
+        for (size_t i = 0; i < a.rgba.size(); ++i) a.rgba[i] = 7;  // stale content
+        FrameStats s0;
+        ASSERT_TRUE(h0.value()->renderFrame(cam, a, s0).isOk());
+        EXPECT_TRUE(sameBytes(a, ra)) << "hybrid at 0 m vs raycast, haze " << haze << ": "
+                                      << fractionDiffering(a, ra, 0) << " of pixels differ";
+        EXPECT_FALSE(s0.stages.ran(Stage::Near));
+        EXPECT_FALSE(s0.stages.ran(Stage::Readback));
+        EXPECT_FALSE(anyFarFieldStage(s0));
+        EXPECT_EQ(s0.pixels.covered, 0u);
+        EXPECT_EQ(s0.raysCast, rs.raysCast);
+        EXPECT_EQ(s0.pixels.rayHit, rs.pixels.rayHit);
+        EXPECT_EQ(s0.stages.ran(Stage::Haze), haze);
+
+        // Everything near: the full frame.
+        ctx.options.nearDistance = std::numeric_limits<double>::infinity();
+        auto hInf = createRenderMode("hybrid", ctx);
+        ASSERT_TRUE(hInf.isOk()) << hInf.status().message();
+        Image b;
+        FrameStats si;
+        ASSERT_TRUE(hInf.value()->renderFrame(cam, b, si).isOk());
+        EXPECT_TRUE(sameBytes(b, fa)) << "hybrid with everything near vs full, haze " << haze << ": "
+                                      << fractionDiffering(b, fa, 0) << " of pixels differ";
+        EXPECT_FALSE(anyFarFieldStage(si));
+        EXPECT_FALSE(si.stages.ran(Stage::Rays));
+        EXPECT_EQ(si.raysCast, 0u);
+        EXPECT_EQ(si.triangles, fs.triangles);
+        // The picture stays the same after another mode drew in between (the end frame restores
+        // the renderer's effects, and the hybrid's haze of covered pixels is its own).
+        ASSERT_TRUE(ray.value()->renderFrame(cam, ra, rs).isOk());
+        ASSERT_TRUE(hInf.value()->renderFrame(cam, b, si).isOk());
+        EXPECT_TRUE(sameBytes(b, fa)) << "haze " << haze;
+
+        // A middle distance runs the far field (so the checks above can fail).
+        ctx.options.nearDistance = 20.0;
+        auto hMid = createRenderMode("hybrid", ctx);
+        ASSERT_TRUE(hMid.isOk());
+        Image m;
+        FrameStats sm;
+        ASSERT_TRUE(hMid.value()->renderFrame(cam, m, sm).isOk());
+        EXPECT_TRUE(anyFarFieldStage(sm));
+        EXPECT_TRUE(sm.stages.ran(Stage::Near));
+    }
+}
+
+// `hybrid-fixed` is the hybrid at the fixed near distance even when --near is auto: the
+// split's middle choice, for side-by-side runs.
+TEST(Hybrid, FixedModeKeepsTheDefaultNearDistanceUnderAuto) {
+    REQUIRE_DISPLAY();
+    TinyModes t;
+    ASSERT_TRUE(t.ready()) << t.error;
+    t.ctx.options.nearDistance = -1.0;  // auto
+    auto fixed = createRenderMode("hybrid-fixed", t.ctx);
+    ASSERT_TRUE(fixed.isOk()) << fixed.status().message();
+    EXPECT_EQ(fixed.value()->name(), "hybrid-fixed");
+    Camera cam = testCamera(160, 120);
+    Image img;
+    FrameStats s;
+    ASSERT_TRUE(fixed.value()->renderFrame(cam, img, s).isOk());
+    for (const std::string& n : s.notes) EXPECT_EQ(n.rfind("near auto", 0), std::string::npos) << n;
+    ASSERT_NE(fixed.value()->lastRaster(), nullptr);
+    EXPECT_EQ(fixed.value()->lastRaster()->nearDistance, kDefaultNearDistance);
+}

@@ -137,9 +137,12 @@ TEST(Split, AdaptiveChoiceFollowsTheMeasuredCosts) {
     }
     EXPECT_NEAR(fitted.msPerRay(), 1e-5, 1e-7);
     EXPECT_LT(fitted.msPerRay(), 0.5 * sumMs / sumPx);
-    // The far field's fixed cost is paid by every candidate but "everything near": a large one
-    // (same per-triangle and per-ray costs) tips the choice to rasterising everything.
-    AdaptiveSplit noFixed(objs, rs.value().get(), o), bigFixed(objs, rs.value().get(), o);
+    // The far field's fixed cost is paid by every middle candidate, not by the ends: a large one
+    // (same per-triangle and per-ray costs) tips the choice to rasterising everything (ray
+    // casting left out here: it pays neither F nor c).
+    AdaptiveSplitOptions noRayCasting = o;
+    noRayCasting.rayCastOnly = false;
+    AdaptiveSplit noFixed(objs, rs.value().get(), noRayCasting), bigFixed(objs, rs.value().get(), noRayCasting);
     for (int i = 0; i < 10; ++i) {
         noFixed.record(uint64_t(20000 + 4000 * i), 1.0 + 1e-5 * (20000 + 4000 * i), 5000, 5000 * 1e-4, 0.0);
         bigFixed.record(uint64_t(20000 + 4000 * i), 1.0 + 1e-5 * (20000 + 4000 * i), 5000, 5000 * 1e-4, 1e4);
@@ -337,5 +340,56 @@ TEST(Split, GridIndexSelectsExactlyWhatTheLinearScanSelects) {
         uint64_t sum = 0;
         for (uint32_t i : selectNearField(objs, glm::dvec3(10, 20, 1.7), d)) sum += objs[i].triangles;
         EXPECT_EQ(split.predictedTriangles(glm::dvec3(10, 20, 1.7), d), sum) << d;
+    }
+}
+
+// Each kind of choice (ray casting, a middle distance, everything) is corrected
+// by what its own frames cost: the model prices ray casting cheapest, its frames
+// measure 1000 ms, and the split leaves it; frames at the middle that cost what
+// the model says change nothing there. An end not chosen for endTryEvery frames
+// is tried again when its price is within endTryRatio of the best.
+TEST(Split, EachChoiceLearnsItsOwnFixedCost) {
+    ProbeScene ps = probeScene(12);
+    const std::vector<SplitObject> objs = squareObjects();
+    const Camera out = smallCamera(glm::dvec3(0, -700, 1.7));
+    AdaptiveSplitOptions o = measuredOnly();
+    o.endTryEvery = 0;
+    AdaptiveSplit s(objs, ps.rays.get(), o);
+    for (int i = 0; i < 10; ++i) {
+        const double tris = 20000 + 4000 * i;
+        s.record(uint64_t(tris), 1.0 + 1e-2 * tris, 5000, 5000 * 1e-6);  // rays nearly free
+    }
+    ASSERT_EQ(s.choose(out, -1), 0.0);
+    s.recordFrame(0.0, 5000.0);  // a kind's first frame (one-time costs) is not counted
+    ASSERT_EQ(s.choose(out, -1), 0.0);
+    s.recordFrame(0.0, 1000.0);
+    EXPECT_GT(s.correctionMs(0), 900.0);
+    const double d = s.choose(out, -1);
+    EXPECT_GT(d, 0.0) << "a measured 1000 ms ray-casting frame must move the split";
+    s.recordFrame(d + 1.0, 5000.0);  // not the distance chosen: ignored
+    EXPECT_EQ(s.correctionMs(1), 0.0);
+    EXPECT_EQ(s.correctionMs(2), 0.0);
+
+    // End tries: the model's price of ray casting is dear here (rays dear), but it is tried when
+    // within a factor 1e9 of the best; never with endTryRatio 0.
+    for (const double ratio : {1e9, 0.0}) {
+        AdaptiveSplitOptions t = measuredOnly();
+        t.endTryEvery = 5;
+        t.endTryRatio = ratio;
+        t.everythingNear = false;
+        AdaptiveSplit tr(objs, ps.rays.get(), t);
+        for (int i = 0; i < 10; ++i) {
+            const double tris = 20000 + 4000 * i;
+            tr.record(uint64_t(tris), 1.0 + 1e-7 * tris, 5000, 5000 * 10.0);  // rays dear
+        }
+        int zeros = 0;
+        for (int f = 0; f < 20; ++f) zeros += tr.choose(out, -1) == 0.0;
+        if (ratio > 0) {
+            // Never measured (no frame recorded): tried every third frame from frame 3.
+            EXPECT_GE(zeros, 3) << "tried";
+            EXPECT_LE(zeros, 6);
+        } else {
+            EXPECT_EQ(zeros, 0);
+        }
     }
 }

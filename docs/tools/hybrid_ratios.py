@@ -1,0 +1,176 @@
+#!/usr/bin/env python3
+"""Same-frame ratios of `vista bench` runs (frames.csv), for the hybrid's tables and its guard.
+
+  hybrid_ratios.py split LABEL=DIR ...           Markdown table: the hybrid (--near auto) against its
+                                                 fixed choices (raycast = 0 m, hybrid-fixed = the near
+                                                 default, full = everything) in each bench DIR;
+                                                 LABEL is "city|path".
+  hybrid_ratios.py effect LABEL=ON:OFF[:ON:OFF...] ...
+                                                 Markdown table: the hybrid's frame with an effect (ON
+                                                 bench dirs) against the same frames without it (OFF);
+                                                 repeated runs are alternated, a frame's time is its
+                                                 median over them.
+  hybrid_ratios.py guard --limit 1.05 split LABEL=DIR ... effect LABEL=ON:OFF ...
+                                                 prints only the rows where the hybrid loses by more
+                                                 than the limit; exit status 1 when any row prints.
+
+A ratio is the median over frames f of (time of the hybrid on f) / (time of the other on f): the two
+measured on the same frame of the same path. Above 1 = the hybrid is slower.
+"""
+import csv
+import statistics
+import sys
+
+
+def load(d):
+    """{mode: {frame: (frame_ms, psnr_db, notes, {stage: ms})}} of DIR/frames.csv."""
+    out = {}
+    with open(f"{d}/frames.csv") as f:
+        for r in csv.DictReader(f):
+            stages = {}
+            for item in filter(None, r["stages_ms"].split(";")):
+                k, v = item.split("=")
+                stages[k] = float(v)
+            out.setdefault(r["mode"], {})[int(r["frame"])] = (float(r["frame_ms"]), float(r["psnr_db"]), r["notes"],
+                                                              stages)
+    return out
+
+
+def ratio(a, b):
+    """Median over the frames both have of a[f] / b[f] (dicts frame -> ms)."""
+    fs = sorted(set(a) & set(b))
+    if not fs:
+        raise SystemExit("no common frames")
+    return statistics.median(a[f] / b[f] for f in fs)
+
+
+def ms(frames):
+    return {f: v[0] for f, v in frames.items()}
+
+
+def choices(frames):
+    """How many frames the split chose ray casting, a middle distance, everything."""
+    c = [0, 0, 0]
+    for _, _, notes, _ in frames.values():
+        if "near auto: 0 m" in notes:
+            c[0] += 1
+        elif "near auto: everything" in notes:
+            c[2] += 1
+        elif "near auto:" in notes:
+            c[1] += 1
+    return c
+
+
+SPLIT_OTHERS = [("raycast", "0 m (raycast)"), ("hybrid-fixed", "near default (hybrid-fixed)"),
+                ("full", "everything (full)")]
+
+
+def split_rows(specs):
+    rows = []
+    for spec in specs:
+        label, d = spec.split("=", 1)
+        city, path = label.split("|")
+        m = load(d)
+        h = m["hybrid"]
+        r = {o: ratio(ms(h), ms(m[o])) for o, _ in SPLIT_OTHERS if o in m}
+        best_ms = {o: statistics.median(ms(m[o]).values()) for o in r}
+        best = min(best_ms, key=best_ms.get)
+        psnr = statistics.median(v[1] for v in h.values())
+        if path == "fly":
+            target, goal = r["raycast"], 1 / 0.97
+            goal_text = "≥ 0.97× raycast"
+        else:
+            # The better of everything near and ray casting on this path (by median frame time).
+            better = min(("full", "raycast"), key=lambda o: best_ms[o])
+            target, goal = r[better], 1 / 0.95
+            goal_text = f"≥ 0.95× {better}"
+        rows.append(dict(city=city, path=path, h=statistics.median(ms(h).values()), others=best_ms, r=r, best=best,
+                         psnr=psnr, choices=choices(h), ok=target <= goal and psnr >= 40.0, goal=goal_text,
+                         target=target))
+    return rows
+
+
+def split_table(rows):
+    lines = ["| city | path | hybrid ms | raycast ms | hybrid-fixed ms | full ms | hybrid / raycast | "
+             "hybrid / hybrid-fixed | hybrid / full | hybrid / best fixed | hybrid PSNR vs full, median | "
+             "split: 0 m / middle / everything frames | goal | met |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for x in rows:
+        o = x["others"]
+        lines.append(
+            f"| {x['city']} | {x['path']} | {x['h']:.1f} | {o.get('raycast', float('nan')):.1f} | "
+            f"{o.get('hybrid-fixed', float('nan')):.1f} | {o.get('full', float('nan')):.1f} | "
+            f"{x['r'].get('raycast', float('nan')):.2f} | {x['r'].get('hybrid-fixed', float('nan')):.2f} | "
+            f"{x['r'].get('full', float('nan')):.2f} | {x['r'][x['best']]:.2f} ({x['best']}) | {x['psnr']:.1f} dB | "
+            f"{' / '.join(map(str, x['choices']))} | {x['goal']} | {'yes' if x['ok'] else 'no'} |")
+    return "\n".join(lines) + "\n"
+
+
+def effect_rows(specs, mode="hybrid"):
+    rows = []
+    for spec in specs:
+        label, dirs = spec.split("=", 1)
+        parts = dirs.split(":")
+        on_frames = [load(d)[mode] for d in parts[0::2]]
+        on_runs = [ms(x) for x in on_frames]
+        haze = [v[3]["haze"] for x in on_frames for v in x.values() if "haze" in v[3]]
+        off_runs = [ms(load(d)[mode]) for d in parts[1::2]]
+
+        def med(runs):
+            fs = set.intersection(*(set(r) for r in runs))
+            return {f: statistics.median(r[f] for r in runs) for f in fs}
+
+        on, off = med(on_runs), med(off_runs)
+        rows.append(dict(label=label, on=statistics.median(on.values()), off=statistics.median(off.values()),
+                         r=ratio(on, off), runs=len(on_runs), stage=statistics.mean(haze) if haze else 0.0))
+    return rows
+
+
+def effect_table(rows, header):
+    cols = header.count("|") + 1
+    lines = [f"| {header} | hybrid ms with, median | hybrid ms without, median | same-frame ratio with / without | "
+             "haze stage ms, mean | runs each |",
+             "|" + "---|" * (cols + 5)]
+    for x in rows:
+        lines.append(f"| {x['label']} | {x['on']:.2f} | {x['off']:.2f} | {x['r']:.3f} | {x['stage']:.2f} | "
+                     f"{x['runs']} |")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv):
+    if not argv:
+        raise SystemExit(__doc__)
+    if argv[0] == "split":
+        sys.stdout.write(split_table(split_rows(argv[1:])))
+    elif argv[0] == "effect":
+        header = "effect | path"
+        sys.stdout.write(effect_table(effect_rows(argv[1:]), header))
+    elif argv[0] == "guard":
+        limit = 1.05
+        args = argv[1:]
+        if args[:1] == ["--limit"]:
+            limit, args = float(args[1]), args[2:]
+        split, effect, cur = [], [], None
+        for a in args:
+            if a in ("split", "effect"):
+                cur = split if a == "split" else effect
+            else:
+                cur.append(a)
+        bad = 0
+        for x in split_rows(split):
+            for o, name in SPLIT_OTHERS:
+                if o in x["r"] and x["r"][o] > limit:
+                    print(f"{x['city']} {x['path']}: hybrid is {x['r'][o]:.3f}x the frame time of {name}")
+                    bad += 1
+        for x in effect_rows(effect):
+            if x["r"] > limit:
+                print(f"{x['label']}: hybrid with the effect is {x['r']:.3f}x its frame time without it")
+                bad += 1
+        return 1 if bad else 0
+    else:
+        raise SystemExit(__doc__)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

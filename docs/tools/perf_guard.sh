@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# The hybrid's performance guard, run before stopping work on the renderer (it
+# measures, so it is not a test): on three small cities no test uses (seeds 101,
+# 202, 303, 800 m, with glass declared) and their car, walk and fly paths, the
+# hybrid (--near auto) side by side with its end points (`raycast` = 0 m, `full`
+# = everything) and its near default (`hybrid-fixed`), and the hybrid with and
+# without each run-time effect (haze at 600 m, night sky, glass) on the car
+# path. Prints every row where the hybrid's median same-frame ratio exceeds
+# LIMIT (default 1.05: 5 % slower); prints nothing and exits 0 when none does,
+# exits 1 when a row prints.
+#
+# usage: docs/tools/perf_guard.sh [OUT_DIR] [VISTA_BIN]     (LIMIT=1.05 FRAMES=24 in the environment)
+# Needs python3 and, without a display, xvfb-run. About 10 minutes on 2 cores with llvmpipe.
+set -euo pipefail
+source "$(dirname "$0")/lib.sh"
+doc_setup perf_guard.sh perf-guard 1280x1024x24 "$@"
+LIMIT=${LIMIT:-1.05}
+FRAMES=${FRAMES:-24}
+mkdir -p "$OUT"
+bench() {  # bench DIR CITY KIND MODES [flags...]
+  local d=$1 city=$2 kind=$3 modes=$4
+  shift 4
+  rm -rf "$d"
+  "${XVFB[@]}" "$VISTA" bench "$city" --seed 7 --kind "$kind" --frames "$FRAMES" --size 640x480 --near auto \
+    --modes "$modes" --out "$d" -q "$@" >/dev/null
+}
+SPLIT=() EFFECT=()
+for seed in 101 202 303; do
+  city="$OUT/city$seed.osgb"
+  [ -s "$city" ] || "$VISTA" gen --params data/default.json --seed "$seed" --size 800 --effects glass -o "$city" -q
+  for kind in car walk fly; do
+    log "seed $seed $kind: hybrid against its fixed choices"
+    bench "$OUT/s${seed}_$kind" "$city" "$kind" full,raycast,hybrid-fixed,hybrid --effects none
+    SPLIT+=("seed $seed|$kind=$OUT/s${seed}_$kind")
+  done
+  # Each run-time effect on and off, alternated twice (the machine's drift falls on both).
+  for fx in haze night glass; do
+    case $fx in
+      haze) spec='{"haze":{"visibility_m":600}}' ;;
+      night) spec=night ;;
+      glass) spec=glass ;;
+    esac
+    dirs=""
+    for rep in 1 2; do
+      log "seed $seed car: $fx on/off ($rep)"
+      bench "$OUT/s${seed}_${fx}_on$rep" "$city" car hybrid --effects "$spec"
+      bench "$OUT/s${seed}_${fx}_off$rep" "$city" car hybrid --effects none
+      dirs+="${dirs:+:}$OUT/s${seed}_${fx}_on$rep:$OUT/s${seed}_${fx}_off$rep"
+    done
+    EFFECT+=("$fx, seed $seed, car=$dirs")
+  done
+done
+python3 docs/tools/hybrid_ratios.py guard --limit "$LIMIT" split "${SPLIT[@]}" effect "${EFFECT[@]}"
