@@ -343,8 +343,9 @@ Result<BakeReport> runBakeJob(const BakeJob& job, Progress* progress,
     rep.shardCells = mine.size();
     std::error_code ec;
     std::filesystem::create_directories(rep.workDir, ec);
-    if (ec || access(rep.workDir.c_str(), W_OK) != 0)
-        return Status::error("--work '" + rep.workDir + "': cannot create or write the directory");
+    if (ec) return Status::error("--work '" + rep.workDir + "': cannot create the directory: " + ec.message());
+    if (access(rep.workDir.c_str(), W_OK) != 0)
+        return Status::error("--work '" + rep.workDir + "': cannot write the directory: " + errnoText());
 
     if (!job.merge) {
         VISTA_RETURN_IF_ERROR(bakeMissingCells(job, in, mine, p, configHash, rep, progress, log));

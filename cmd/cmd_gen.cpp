@@ -207,6 +207,8 @@ int runPaged(const GenArgs& a, const CityParams& params, const Stopwatch& total)
     }
     StderrProgress progress(isatty(2));
     o->progress = a.quiet ? nullptr : &progress;
+    OutputBatch batch;  // index and manifest, committed with --stats
+    o->batch = &batch;
     auto rep = generatePagedCity(params, *o);
     if (!rep) return reportBadInput(kCmd, rep.status());
     const double totalSeconds = total.ms() / 1000.0;
@@ -239,8 +241,9 @@ int runPaged(const GenArgs& a, const CityParams& params, const Stopwatch& total)
         j["memory"] = {{"estimate_mb", estimateMb},
                        {"budget_gb", a.budgetGb > 0 ? nlohmann::json(a.budgetGb) : nlohmann::json(nullptr)}};
         j["threads"] = params.threads;
-        if (Status s = writeFileAtomic(a.statsFile, j.dump(2) + "\n"); !s) return reportBadInput(kCmd, s);
+        if (Status s = writeFileAtomic(batch.stage(a.statsFile), j.dump(2) + "\n"); !s) return reportBadInput(kCmd, s);
     }
+    if (Status s = batch.commit(); !s) return reportBadInput(kCmd, s);
     if (!a.quiet)
         std::fprintf(
             stderr,
@@ -253,9 +256,9 @@ int runPaged(const GenArgs& a, const CityParams& params, const Stopwatch& total)
     return 0;
 }
 
-// Every output of the command, or none: each is staged, then all renamed together.
-Status writeOutputs(const GenArgs& a, const City& city, const CityParams& params) {
-    OutputBatch batch;
+// Every output of the command, or none: each is staged into `batch` (the
+// caller stages --stats too, then commits them all together).
+Status writeOutputs(const GenArgs& a, const City& city, const CityParams& params, OutputBatch& batch) {
     VISTA_RETURN_IF_ERROR(writeCityFile(city, batch.stage(a.out)));
     if (!a.geojsonFile.empty())
         VISTA_RETURN_IF_ERROR(
@@ -267,7 +270,7 @@ Status writeOutputs(const GenArgs& a, const City& city, const CityParams& params
         if (!xodr) return Status::error("option --xodr = '" + a.xodrFile + "': " + xodr.status().message());
         VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage(a.xodrFile), *xodr));
     }
-    return batch.commit();
+    return Status::ok();
 }
 
 nlohmann::ordered_json statsJson(const City& city, const CityParams& params, const CityCounts& n,
@@ -396,15 +399,17 @@ int runGen(int argc, char** argv) {
         city->stageTimes.push_back({"lighting", lighting.seconds});
     }
     Stopwatch write;
-    if (Status s = writeOutputs(a, *city, *params); !s) return reportBadInput(kCmd, s);
+    OutputBatch batch;
+    if (Status s = writeOutputs(a, *city, *params, batch); !s) return reportBadInput(kCmd, s);
     const double writeSeconds = write.ms() / 1000.0, totalSeconds = total.ms() / 1000.0;
     const CityCounts n = countCity(*city);
     if (!a.statsFile.empty()) {
         auto j = statsJson(*city, *params, n, lighting, writeSeconds, totalSeconds);
         if (a.budgetGb > 0) j["memory"] = {{"estimate_mb", estimateMb}, {"budget_gb", a.budgetGb}};
         if (osmRoads) j["osm_roads"] = nlohmann::ordered_json::parse(osmRoadTagStatsJson(*osmRoads));
-        if (Status s = writeFileAtomic(a.statsFile, j.dump(2) + "\n"); !s) return reportBadInput(kCmd, s);
+        if (Status s = writeFileAtomic(batch.stage(a.statsFile), j.dump(2) + "\n"); !s) return reportBadInput(kCmd, s);
     }
+    if (Status s = batch.commit(); !s) return reportBadInput(kCmd, s);
     if (!a.quiet)
         std::fprintf(stderr,
                      "wrote %s: %zu street edges, %zu blocks, %zu buildings, %zu trees, %.2f M triangles, %zu draw "
