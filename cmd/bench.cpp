@@ -117,7 +117,7 @@ public:
     FrameImages(const BenchConfig& cfg, size_t modes, OutputBatch& batch) : _cfg(cfg), _worst(modes), _batch(batch) {}
     Status add(size_t mi, const BenchFrameRecord& rec, const Image& img, const Image& ref) {
         if (_cfg.outDir.empty()) return Status::ok();
-        if (rec.frame == 0) VISTA_RETURN_IF_ERROR(writePng(img, path("first_" + rec.mode + ".png")));
+        if (rec.frame == 0) VISTA_RETURN_IF_ERROR(writePng(img, stage("first_" + rec.mode + ".png")));
         if (_cfg.saveFrames) {
             char name[64];
             std::snprintf(name, sizeof name, "f%04d_", rec.frame);
@@ -139,10 +139,10 @@ public:
             for (size_t k = 0; k < list.size(); ++k) {
                 const Worst& w = list[k];
                 const std::string stem =
-                    path("worst" + std::to_string(k + 1) + "_" + w.mode + "_f" + std::to_string(w.frame));
-                VISTA_RETURN_IF_ERROR(writePng(w.image, stem + ".png"));
-                VISTA_RETURN_IF_ERROR(writePng(w.reference, stem + "_ref.png"));
-                VISTA_RETURN_IF_ERROR(writePng(differenceImage(w.image, w.reference), stem + "_diff.png"));
+                    "worst" + std::to_string(k + 1) + "_" + w.mode + "_f" + std::to_string(w.frame);
+                VISTA_RETURN_IF_ERROR(writePng(w.image, stage(stem + ".png")));
+                VISTA_RETURN_IF_ERROR(writePng(w.reference, stage(stem + "_ref.png")));
+                VISTA_RETURN_IF_ERROR(writePng(differenceImage(w.image, w.reference), stage(stem + "_diff.png")));
             }
         return Status::ok();
     }
@@ -154,7 +154,8 @@ private:
         std::string mode;
         Image image, reference;
     };
-    std::string path(const std::string& name) const {
+    // The staged file of images/NAME.
+    std::string stage(const std::string& name) const {
         return _batch.stage((fs::path(_cfg.outDir) / "images" / name).string());
     }
     const BenchConfig& _cfg;

@@ -111,8 +111,10 @@ Status OutputBatch::commit() {
             if (!kept[j].empty()) ::rename(kept[j].c_str(), _files[j].second.c_str());
             else if (!existed[j]) ::unlink(_files[j].second.c_str());
         }
-        for (size_t j = renamed; j < _files.size(); ++j)
+        for (size_t j = renamed; j < _files.size(); ++j) {
             if (!kept[j].empty()) ::unlink(kept[j].c_str());
+            ::unlink(_files[j].first.c_str());  // the staged files not renamed
+        }
     };
     for (size_t k = 0; k < _files.size(); ++k) {
         const std::string& target = _files[k].second;

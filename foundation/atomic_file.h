@@ -47,11 +47,11 @@ int removeStaleTemps(const std::string& path);
 // staged file over its path. If commit() is never reached (an error, an
 // exception) the destructor removes the staged files, so no output of a
 // failed command appears. A rename failure in commit() is reported and the
-// renames before it are undone: each output that existed is kept under a
-// second name ("<path>.prev.<pid>", a hard link, removed after the last
-// rename) and put back, each that did not is removed. (Where hard links are
-// not possible, a previous file renamed over before the failure stays
-// replaced.)
+// renames before it are undone and the staged files removed: each output
+// that existed is kept under a second name ("<path>.prev.<pid>", a hard
+// link, removed after the last rename) and put back, each that did not is
+// removed. (Where hard links are not possible, a previous file renamed over
+// before the failure stays replaced.)
 class OutputBatch {
 public:
     OutputBatch() = default;
