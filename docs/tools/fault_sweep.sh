@@ -47,7 +47,8 @@ if [ -z "${DISPLAY:-}" ] && [ -z "${VISTA_FAULT_SWEEP_XVFB:-}" ] && command -v x
   VISTA_FAULT_SWEEP_XVFB=1 exec xvfb-run -a -s "-screen 0 640x480x24" "$0" "$@"
 fi
 exec python3 - "$@" <<'PY'
-import argparse, hashlib, os, re, shutil, subprocess, sys, tempfile
+import argparse, hashlib, os, re, shutil, signal, subprocess, sys, tempfile
+signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # a stopped sweep removes its scratch directory too
 
 ap = argparse.ArgumentParser(prog="fault_sweep.sh")
 ap.add_argument("--sample", type=int, default=0)
