@@ -181,8 +181,15 @@ print("`docs/tools/fault_sweep.sh` (the full sweep; `Reliability.FaultSweepSampl
 print()
 print("| command | fault points | exercised | crashes | partial outputs | failures (any kind) |")
 print("|---|---|---|---|---|---|")
-for row in csv.DictReader(read("faults.tsv").splitlines(), delimiter="\t"):
+fault_rows = list(csv.DictReader(read("faults.tsv").splitlines(), delimiter="\t"))
+for row in fault_rows:
     print(f"| {row['command']} | {int(row['fault_points']):,} | {int(row['exercised']):,} | {row['crash']} | {row['partial']} | {row['failures']} |")
+total = lambda k: sum(int(r[k]) for r in fault_rows)
+if fault_rows:
+    print()
+    print(f"The full sweep, `docs/tools/fault_sweep.sh --tsv faults.tsv`: {total('exercised'):,} fault points, each one "
+          f"failed run and one rerun; {total('crash')} crashes, {total('partial')} partial outputs, "
+          f"{total('failures')} failures of any kind.")
 print()
 print("- An unwritable output (missing directory, a file, a directory, read-only) is refused before the input is read, "
       "exit 2 naming the option: `vista gen`, `path`, `view --screenshot`, `bake -o/--work/--stats`, `bench --out` "
