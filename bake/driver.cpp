@@ -20,6 +20,8 @@
 #include "bake/bake_cell.h"
 #include "foundation/atomic_file.h"
 #include "foundation/hash.h"
+#include "foundation/number_text.h"
+#include "foundation/output_paths.h"
 #include "foundation/timing.h"
 #include "runtime/scene/city_file.h"
 #include "runtime/scene/scene_file.h"
@@ -31,8 +33,8 @@ Status validateBakeJob(const BakeJob& j) {
     const BakeParams& p = j.params;
     auto range = [](const char* opt, double v, double lo, double hi) -> Status {
         if (v >= lo && v <= hi) return Status::ok();
-        return Status::error(std::string(opt) + " " + std::to_string(v) + " out of range [" + std::to_string(lo) +
-                             ", " + std::to_string(hi) + "]");
+        return Status::error(std::string(opt) + " " + shortNumber(v) + " out of range [" + shortNumber(lo) + ", " +
+                             shortNumber(hi) + "]");
     };
     if (j.input.empty()) return Status::error("input city file: no path given");
     if (j.output.empty()) return Status::error("--output: no path given");
@@ -59,6 +61,12 @@ Status validateBakeJob(const BakeJob& j) {
         return Status::error("--shard " + std::to_string(j.shardK) + "/" + std::to_string(j.shardN) +
                              ": expected K/N with 1 <= K <= N");
     if (j.merge && j.shardN > 1) return Status::error("--merge and --shard exclude each other");
+    VISTA_RETURN_IF_ERROR(CommandFiles()
+                              .input("city", j.input)
+                              .output("--output", j.output)
+                              .output("--stats", j.statsFile)
+                              .output("--work", j.workDir.empty() ? j.output + ".work" : j.workDir)
+                              .check());
     VISTA_RETURN_IF_ERROR(checkWritablePath("--output", j.output));
     if (!j.statsFile.empty()) VISTA_RETURN_IF_ERROR(checkWritablePath("--stats", j.statsFile));
     VISTA_RETURN_IF_ERROR(checkWritableDirectory("--work", j.workDir.empty() ? j.output + ".work" : j.workDir));
@@ -182,8 +190,11 @@ Result<std::vector<size_t>> selectCells(const BakeJob& job, const BakeInput& in,
     for (uint32_t id : job.cells) {
         auto it = std::find_if(in.cells.begin(), in.cells.end(), [&](const ViewCell& c) { return c.id == id; });
         if (it == in.cells.end())
-            return Status::error("--cells: cell " + std::to_string(id) + " does not exist (cells are street edges 0.." +
-                                 std::to_string(edges) + ", minus degenerate ones)");
+            return Status::error(
+                "--cells: cell " + std::to_string(id) + " does not exist (" +
+                (edges == 0 ? std::string("the city has no street edges")
+                            : "cells are street edges 0.." + std::to_string(edges - 1) + ", minus degenerate ones") +
+                ")");
         selected.push_back(size_t(it - in.cells.begin()));
     }
     return selected;
@@ -286,8 +297,8 @@ nlohmann::json tallyResults(const std::vector<CellResult>& results, BakeReport& 
     return js;
 }
 
-Status writeStatsFile(const BakeJob& job, const BakeReport& rep, size_t cells, const std::string& canon,
-                      nlohmann::json impostorStats) {
+Status writeStatsFile(const BakeJob& job, const std::string& path, const BakeReport& rep, size_t cells,
+                      const std::string& canon, nlohmann::json impostorStats) {
     nlohmann::json top;
     top["input"] = job.input;
     top["cells"] = cells;
@@ -306,7 +317,7 @@ Status writeStatsFile(const BakeJob& job, const BakeReport& rep, size_t cells, c
         top["storage_budget_mb"] = rep.budgetMb;
     top["impostor_stats"] = std::move(impostorStats);
     top["notes"] = rep.notes;
-    return writeFileAtomic(job.statsFile, top.dump(1));
+    return writeFileAtomic(path, top.dump(1));
 }
 
 }  // namespace
@@ -362,14 +373,19 @@ Result<BakeReport> runBakeJob(const BakeJob& job, Progress* progress,
     if (!sourceHash) return sourceHash.status();
     osg::ref_ptr<ViewCellSwitch> root =
         assembleBakedScene(*city, in.cells, *results, canon, p.representation, *sourceHash);
-    VISTA_RETURN_IF_ERROR(writeSceneFile(*root, job.output, false));
-    rep.assembled = true;
+    // The baked file and the stats: both or neither.
+    OutputBatch batch;
+    const std::string staged = batch.stage(job.output);
+    VISTA_RETURN_IF_ERROR(writeSceneFile(*root, staged, false));
     nlohmann::json impostorStats = tallyResults(*results, rep);
-    const auto size = std::filesystem::file_size(job.output, ec);
+    const auto size = std::filesystem::file_size(staged, ec);
     rep.outputBytes = ec ? 0 : uint64_t(size);
     rep.wallS = wall.ms() / 1000.0;
     if (!job.statsFile.empty())
-        VISTA_RETURN_IF_ERROR(writeStatsFile(job, rep, results->size(), canon, std::move(impostorStats)));
+        VISTA_RETURN_IF_ERROR(
+            writeStatsFile(job, batch.stage(job.statsFile), rep, results->size(), canon, std::move(impostorStats)));
+    VISTA_RETURN_IF_ERROR(batch.commit());
+    rep.assembled = true;
     if (!job.keepWork) {
         for (size_t ci : *selected) std::filesystem::remove(cellPath(rep.workDir, in.cells[ci].id), ec);
         std::filesystem::remove(rep.workDir, ec);  // only if empty

@@ -4,6 +4,9 @@
 #include <sstream>
 #include <nlohmann/json.hpp>
 
+#include "citygen/json_input.h"
+#include "foundation/number_text.h"
+
 namespace vista {
 namespace {
 
@@ -193,17 +196,18 @@ Status validateEffects(const Effects& e) {
 }
 
 Result<Effects> parseEffectsJson(const std::string& text, const std::string& source) {
-    nlohmann::json j;
-    try {
-        j = nlohmann::json::parse(text);
-    } catch (const std::exception& ex) { return Status::error(source + ": 'effects' is not valid JSON: " + ex.what()); }
+    // The same rules as a parameter file: nesting bounded, duplicate keys refused.
+    auto input = parseJsonInput(text, source);
+    if (!input) return input.status();
+    const nlohmann::json& j = input->doc;
     if (!j.is_object())
         return Status::error(source + ": 'effects' must be an object of effects (known: " + effectNames() + ")");
     Effects out;
     for (auto it = j.begin(); it != j.end(); ++it) {
         EffectId id;
         if (!findEffect(it.key(), id))
-            return Status::error(source + ": unknown effect '" + it.key() + "' (known: " + effectNames() + ")");
+            return Status::error(source + ": unknown effect '" + echoText(it.key()) + "' (known: " + effectNames() +
+                                 ")");
         const auto& obj = it.value();
         if (!obj.is_object())
             return Status::error(source + ": effect '" + it.key() + "' must be an object of its parameters (" +
@@ -214,11 +218,11 @@ Result<Effects> parseEffectsJson(const std::string& text, const std::string& sou
             for (const auto& cand : fields())
                 if (cand.spec.effect == id && f.key() == cand.spec.name) field = &cand;
             if (!field)
-                return Status::error(source + ": unknown field '" + f.key() + "' of effect '" + it.key() +
+                return Status::error(source + ": unknown field '" + echoText(f.key()) + "' of effect '" + it.key() +
                                      "' (known: " + fieldNames(id) + ")");
             if (!f.value().is_number())
                 return Status::error(source + ": effect '" + it.key() + "' field '" + f.key() +
-                                     "' must be a number, got " + f.value().dump());
+                                     "' must be a number, got " + echoText(f.value().dump()));
             double v = f.value().get<double>();
             Status s = checkField(*field, v);
             if (!s) return Status::error(source + ": " + s.message());

@@ -37,6 +37,7 @@
 #include "citygen/polygon.h"
 #include "citygen/street_geometry.h"
 #include "citygen/streets.h"
+#include "foundation/input_file.h"
 #include "foundation/units.h"
 
 namespace vista {
@@ -203,6 +204,19 @@ Result<std::vector<NodeId>> sanitizeXml(std::string& xml, const std::string& pat
     }
     std::sort(blanked.begin(), blanked.end());
     return blanked;
+}
+
+// A bzip2 error in words (libbz2 reports a number).
+std::string bzip2Problem(const osmium::bzip2_error& e) {
+    switch (e.bzip2_error_code) {
+        case BZ_UNEXPECTED_EOF: return "the bzip2 data ends early (the file is truncated or incomplete)";
+        case BZ_DATA_ERROR:
+        case BZ_DATA_ERROR_MAGIC: return "the file is not valid bzip2 data (damaged or not compressed with bzip2)";
+        case BZ_MEM_ERROR: return "out of memory while decompressing bzip2 data";
+        case BZ_IO_ERROR:
+            return std::string("read error: ") + (e.system_errno ? std::strerror(e.system_errno) : "I/O error");
+        default: return e.what();
+    }
 }
 
 // The whole (decompressed) XML text.
@@ -862,6 +876,10 @@ std::string OsmImport::dropSummary() const {
     std::string out;
     const size_t total = invalidNodes + missingNodes + outlierNodes;
     if (total) out = "dropped " + std::to_string(total) + (total == 1 ? " node (" : " nodes (") + nodes + ")";
+    if (clippedSegments)
+        out += (out.empty() ? "" : "; ") + std::string("clipped ") + std::to_string(clippedSegments) +
+               (clippedSegments == 1 ? " road segment" : " road segments") +
+               " at the city square's border (the extract is larger than size_m = " + distance(2.0 * clipHalf_m) + ")";
     if (tangledWays)
         out += (out.empty() ? "dropped " : "; dropped ") + std::to_string(tangledWays) +
                (tangledWays == 1 ? " way" : " ways") + " crossing itself more than " +
@@ -907,6 +925,8 @@ Status readOsm(const std::string& path, bool buildings, WayCollector& collector,
         locations.ignore_errors();
         osmium::apply(reader, locations, collector);
         reader.close();
+    } catch (const osmium::bzip2_error& e) {
+        return Status::error("OSM file '" + path + "' could not be read: " + bzip2Problem(e));
     } catch (const std::exception& e) {
         return Status::error("OSM file '" + path + "' could not be read: " + e.what());
     }
@@ -1011,13 +1031,47 @@ Result<std::vector<Way>> untangleWays(std::vector<Way>& ways, const CityParams& 
     return kept;
 }
 
+// Clips segment a-b to the square [-half, half]^2 (Liang-Barsky): 1 = whole
+// inside, 2 = cut (a, b moved onto the border), 0 = outside.
+int clipToSquare(glm::dvec2& a, glm::dvec2& b, double half) {
+    const glm::dvec2 d = b - a;
+    double t0 = 0.0, t1 = 1.0;
+    const double p[4] = {-d.x, d.x, -d.y, d.y};
+    const double q[4] = {a.x + half, half - a.x, a.y + half, half - a.y};
+    for (int i = 0; i < 4; ++i) {
+        if (p[i] == 0.0) {
+            if (q[i] < 0.0) return 0;
+            continue;
+        }
+        const double t = q[i] / p[i];
+        if (p[i] < 0.0) t0 = std::max(t0, t);
+        else t1 = std::min(t1, t);
+    }
+    if (t0 > t1) return 0;
+    if (t0 == 0.0 && t1 == 1.0) return 1;
+    const glm::dvec2 a0 = a;
+    a = a0 + t0 * d;
+    b = a0 + t1 * d;
+    return 2;
+}
+
 // Planarizes the kept ways' segments into the street graph and gives its
 // edges the road tags of the ways they come from.
 Status buildStreets(const std::vector<Way>& kept, const WayCollector& collector, const CityParams& params,
                     const std::string& path, OsmImport& out) {
     std::vector<RawSegment> segs;
+    const double half = 0.5 * params.size_m;
+    out.clipHalf_m = half;
     for (const auto& w : kept)
-        for (size_t k = 1; k < w.nodes.size(); ++k) segs.push_back({w.nodes[k - 1].xy, w.nodes[k].xy, w.cls});
+        for (size_t k = 1; k < w.nodes.size(); ++k) {
+            glm::dvec2 a = w.nodes[k - 1].xy, b = w.nodes[k].xy;
+            const int clip = clipToSquare(a, b, half);
+            if (clip != 1) ++out.clippedSegments;
+            if (clip) segs.push_back({a, b, w.cls});
+        }
+    if (segs.empty())
+        return Status::error("OSM file '" + path + "': no road lies inside the city square of size_m = " +
+                             distance(params.size_m) + " about the data's centre");
     out.streets = planarize(segs, params.snap_radius_m, params.min_segment_m);
     if (out.streets.edges.empty())
         return Status::error("OSM file '" + path + "' has highway ways but none longer than min_segment_m = " +
@@ -1032,10 +1086,7 @@ Status buildStreets(const std::vector<Way>& kept, const WayCollector& collector,
 }  // namespace
 
 Result<OsmImport> importOsm(const std::string& path, const CityParams& params, bool buildings) {
-    {
-        std::ifstream probe(path, std::ios::binary);
-        if (!probe) return Status::error("OSM file '" + path + "' cannot be opened");
-    }
+    VISTA_RETURN_IF_ERROR(checkInputFile("OSM file", path, kMaxOsmFileBytes));
     OsmImport out;
     const double limit = maxExtent_m();
     out.outlierRadius_m = limit * std::sqrt(2.0);

@@ -198,6 +198,49 @@ OsmRoadTags OsmRoadTags::reversed() const {
     return r;
 }
 
+namespace {
+
+// The way's direction: the oneway tag, else implied by motorways and roundabouts.
+OsmOneway readOneway(const OsmTagLookup& tag, OsmRoadTagStats& st) {
+    if (auto o = readTag<OsmOneway>(
+            tag, "oneway", [](std::string_view v) { return parseOsmOneway(v); }, st.oneway)) {
+        ++st.oneway.used;
+        return *o;
+    }
+    const char* hw = tag("highway");
+    const char* junction = tag("junction");
+    if ((hw && std::string_view(hw) == "motorway") ||
+        (junction && (std::string_view(junction) == "roundabout" || std::string_view(junction) == "circular"))) {
+        ++st.onewayImplied;
+        return OsmOneway::Forward;
+    }
+    return OsmOneway::No;
+}
+
+// The speed limit and the carriageway width, each counted as used or defaulted.
+void readSpeedAndWidth(const OsmTagLookup& tag, OsmRoadTagStats& st, OsmRoadTags& t) {
+    if (auto v = readTag<float>(
+            tag, "maxspeed", [](std::string_view s) { return parseOsmMaxspeed(s); }, st.maxspeed)) {
+        t.maxspeedKmh = *v;
+        ++st.maxspeed.used;
+    } else {
+        ++st.defaultMaxspeed;
+    }
+    auto width = [](std::string_view s) -> std::optional<float> {
+        const double w = parseOsmLength(s);
+        if (!(w >= kMinOsmRoadWidth_m && w <= kMaxOsmRoadWidth_m)) return std::nullopt;
+        return float(w);
+    };
+    if (auto w = readTag<float>(tag, "width", width, st.width)) {
+        t.width = *w;
+        ++st.width.used;
+    } else {
+        ++st.defaultWidth;
+    }
+}
+
+}  // namespace
+
 OsmRoadTags readOsmRoadTags(const OsmTagLookup& tag, RoadClass cls, OsmRoadTagStats& st) {
     ++st.ways;
     OsmRoadTags t;
@@ -212,21 +255,7 @@ OsmRoadTags readOsmRoadTags(const OsmTagLookup& tag, RoadClass cls, OsmRoadTagSt
     const int kMaxTotal = 2 * kMaxLanesPerDirection;
     auto perDirection = [](int n) { return std::clamp(n, 1, kMaxLanesPerDirection); };
 
-    // Direction.
-    OsmOneway oneway = OsmOneway::No;
-    if (auto o = readTag<OsmOneway>(
-            tag, "oneway", [](std::string_view v) { return parseOsmOneway(v); }, st.oneway)) {
-        oneway = *o;
-        ++st.oneway.used;
-    } else {
-        const char* hw = tag("highway");
-        const char* junction = tag("junction");
-        if ((hw && std::string_view(hw) == "motorway") ||
-            (junction && (std::string_view(junction) == "roundabout" || std::string_view(junction) == "circular"))) {
-            oneway = OsmOneway::Forward;
-            ++st.onewayImplied;
-        }
-    }
+    const OsmOneway oneway = readOneway(tag, st);
 
     // Lane counts, in the way's direction.
     bool fromTags = false;
@@ -309,26 +338,7 @@ OsmRoadTags readOsmRoadTags(const OsmTagLookup& tag, RoadClass cls, OsmRoadTagSt
         }
     }
     if (!fromTags) ++st.defaultLanes;
-
-    // Speed limit and width.
-    if (auto v = readTag<float>(
-            tag, "maxspeed", [](std::string_view s) { return parseOsmMaxspeed(s); }, st.maxspeed)) {
-        t.maxspeedKmh = *v;
-        ++st.maxspeed.used;
-    } else {
-        ++st.defaultMaxspeed;
-    }
-    auto width = [](std::string_view s) -> std::optional<float> {
-        const double w = parseOsmLength(s);
-        if (!(w >= kMinOsmRoadWidth_m && w <= kMaxOsmRoadWidth_m)) return std::nullopt;
-        return float(w);
-    };
-    if (auto w = readTag<float>(tag, "width", width, st.width)) {
-        t.width = *w;
-        ++st.width.used;
-    } else {
-        ++st.defaultWidth;
-    }
+    readSpeedAndWidth(tag, st, t);
     return t;
 }
 

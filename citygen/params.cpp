@@ -1,5 +1,8 @@
 #include "citygen/params.h"
+#include "citygen/json_input.h"
 #include "foundation/format.h"
+#include "foundation/input_file.h"
+#include "foundation/number_text.h"
 
 #include <algorithm>
 #include <cmath>
@@ -94,48 +97,12 @@ const std::vector<Field>& fields() {
 }
 
 std::string rangeMessage(const ParamSpec& s, const std::string& value) {
+    // The seed's range is every uint64_t: printed exactly, not as the double 1.8446744073709552e+19.
+    const std::string hi = s.max >= 18446744073709551615.0 ? "18446744073709551615" : exactDecimal(s.max);
     std::string m = "parameter '" + std::string(s.name) + "' = " + value + " is out of range [" + exactDecimal(s.min) +
-                    ", " + exactDecimal(s.max) + "]";
+                    ", " + hi + "]";
     if (*s.unit) m += std::string(" (") + s.unit + ")";
     return m;
-}
-
-void lineCol(const std::string& text, size_t byte, size_t& line, size_t& col) {
-    line = 1;
-    col = 1;
-    for (size_t i = 0; i < byte && i < text.size(); ++i) {
-        if (text[i] == '\n') {
-            ++line;
-            col = 1;
-        } else {
-            ++col;
-        }
-    }
-}
-
-// Deepest nesting of arrays/objects in `text` (outside strings), stopping at `limit` + 1.
-int nestingDepth(const std::string& text, int limit, size_t& where) {
-    int depth = 0, worst = 0;
-    bool inString = false;
-    for (size_t i = 0; i < text.size(); ++i) {
-        const char c = text[i];
-        if (inString) {
-            if (c == '\\') ++i;
-            else if (c == '"') inString = false;
-            continue;
-        }
-        if (c == '"') inString = true;
-        else if (c == '[' || c == '{') {
-            if (++depth > worst) worst = depth;
-            if (worst > limit) {
-                where = i;
-                return worst;
-            }
-        } else if (c == ']' || c == '}') {
-            --depth;
-        }
-    }
-    return worst;
 }
 
 const ParamSpec kGeoLat{"geo.lat0_deg", "degrees", -90, 90, "WGS84 latitude of the city frame's origin"};
@@ -229,49 +196,9 @@ Status checkSingleFileSize(const CityParams& p) {
 }
 
 Result<CityParams> parseParamsJson(const std::string& text, const std::string& source, const CityParams& base) {
-    // Bounded nesting (a parameter file is 3 levels deep): deeper input would
-    // only cost stack in the parser and in messages.
-    constexpr int kMaxDepth = 16;
-    size_t deepAt = 0;
-    if (nestingDepth(text, kMaxDepth, deepAt) > kMaxDepth) {
-        size_t line = 0, col = 0;
-        lineCol(text, deepAt, line, col);
-        return Status::error(source + ":" + std::to_string(line) + ":" + std::to_string(col) +
-                             ": JSON nested deeper than " + std::to_string(kMaxDepth) + " levels");
-    }
-    nlohmann::json j;
-    std::string duplicate;
-    std::vector<std::vector<std::string>> keys;  // per open object: its keys so far
-    auto callback = [&](int, nlohmann::json::parse_event_t ev, nlohmann::json& parsed) {
-        using E = nlohmann::json::parse_event_t;
-        if (ev == E::object_start) keys.emplace_back();
-        else if (ev == E::object_end && !keys.empty()) keys.pop_back();
-        else if (ev == E::key && !keys.empty() && parsed.is_string()) {
-            const std::string k = parsed.get<std::string>();
-            if (std::find(keys.back().begin(), keys.back().end(), k) != keys.back().end() && duplicate.empty())
-                duplicate = k;
-            keys.back().push_back(k);
-        }
-        return true;
-    };
-    try {
-        j = nlohmann::json::parse(text, callback);
-    } catch (const nlohmann::json::parse_error& e) {
-        size_t line = 0, col = 0;
-        lineCol(text, e.byte == 0 ? 0 : e.byte - 1, line, col);
-        std::string what = e.what();
-        auto pos = what.find("syntax error");
-        return Status::error(source + ":" + std::to_string(line) + ":" + std::to_string(col) +
-                             ": malformed JSON: " + (pos == std::string::npos ? what : what.substr(pos)));
-    } catch (const nlohmann::json::exception& e) {
-        // out_of_range 406: a number beyond the range of a double (1e999, 400 digits).
-        std::string what = e.what();
-        auto pos = what.find("number overflow");
-        what = pos == std::string::npos ? what : what.substr(pos);
-        if (what.size() > 80) what = what.substr(0, 77) + "...";
-        return Status::error(source + ": malformed JSON: " + what + " (numbers must fit a double)");
-    }
-    if (!duplicate.empty()) return Status::error(source + ": key '" + duplicate + "' appears twice in one object");
+    auto input = parseJsonInput(text, source);
+    if (!input) return input.status();
+    const nlohmann::json& j = input->doc;
     if (!j.is_object()) return Status::error(source + ": parameters must be a JSON object");
     CityParams p = base;
     for (auto it = j.begin(); it != j.end(); ++it) {
@@ -295,26 +222,27 @@ Result<CityParams> parseParamsJson(const std::string& text, const std::string& s
         if (!f) {
             std::string known;
             for (const auto& cand : fields()) known += std::string(known.empty() ? "" : ", ") + cand.spec.name;
-            return Status::error(source + ": unknown parameter '" + key + "' (known: " + known + ", effects, geo)");
+            return Status::error(source + ": unknown parameter '" + echoText(key) + "' (known: " + known +
+                                 ", effects, geo)");
         }
         const auto& val = it.value();
         if (!val.is_number())
-            return Status::error(source + ": parameter '" + key + "' must be a number, got " + val.dump());
+            return Status::error(source + ": parameter '" + key + "' must be a number, got " + echoText(val.dump()));
+        const std::string written = input->textOf("/" + key, val);
         if (f->kind == Kind::Double) {
             p.*(f->d) = val.get<double>();
         } else {
-            if (!val.is_number_integer() && !val.is_number_unsigned())
-                return Status::error(source + ": parameter '" + key + "' must be an integer, got " + val.dump());
+            // From the text as written: 2^64 is out of range, not a double that rounds; 2.5 is not an integer.
+            if (written.find_first_of(".eE") != std::string::npos)
+                return Status::error(source + ": parameter '" + key + "' must be an integer, got " + written);
             if (f->kind == Kind::U64) {
-                // Unsigned first: 2^63 .. 2^64-1 are in range (is_number_integer() is true for them too).
-                if (!val.is_number_unsigned() && val.get<int64_t>() < 0)
-                    return Status::error(source + ": " + rangeMessage(f->spec, val.dump()));
-                p.*(f->u) = val.get<uint64_t>();
+                auto v = parseUnsignedText(key, written, 0, UINT64_MAX);
+                if (!v) return Status::error(source + ": " + rangeMessage(f->spec, written));
+                p.*(f->u) = *v;
             } else {
-                int64_t v = val.get<int64_t>();
-                if (v < f->spec.min || v > f->spec.max)
-                    return Status::error(source + ": " + rangeMessage(f->spec, val.dump()));
-                p.*(f->i) = int(v);
+                auto v = parseSignedText(key, written, int64_t(f->spec.min), int64_t(f->spec.max));
+                if (!v) return Status::error(source + ": " + rangeMessage(f->spec, written));
+                p.*(f->i) = int(*v);
             }
         }
     }
@@ -324,11 +252,9 @@ Result<CityParams> parseParamsJson(const std::string& text, const std::string& s
 }
 
 Result<CityParams> loadParamsFile(const std::string& path, const CityParams& base) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return Status::error("cannot read parameter file '" + path + "'");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return parseParamsJson(ss.str(), path, base);
+    auto text = readInputFile("parameter file", path, kMaxParamsFileBytes);
+    if (!text) return text.status();
+    return parseParamsJson(*text, path, base);
 }
 
 std::string paramsToJson(const CityParams& p) {

@@ -11,6 +11,7 @@
 
 #include "citygen/osm_road_tags.h"
 #include "citygen/street_geometry.h"
+#include "foundation/number_text.h"
 
 namespace vista {
 
@@ -182,7 +183,7 @@ Status checkPlanarGraph(const StreetGraph& g, double minSegment) {
                                  std::to_string(int(ed.cls)) + ", allowed range [0, 2]");
         if (!std::isfinite(ed.width) || ed.width <= 0)
             return Status::error("street graph: edge " + std::to_string(e) + " has invalid width " +
-                                 std::to_string(ed.width));
+                                 shortNumber(ed.width));
         uint64_t key = (uint64_t(std::min(ed.a, ed.b)) << 32) | std::max(ed.a, ed.b);
         if (!seen.insert(key).second)
             return Status::error("street graph: edge " + std::to_string(e) + " duplicates another edge between nodes " +
@@ -264,7 +265,7 @@ Status readEdgeExtras(const nlohmann::json& x, const std::string& where, StreetE
             if (!value.is_number()) return Status::error(at + " is not a number");
             const double v = value.get<double>();
             if (!(v >= kMinMaxspeedKmh && v <= kMaxMaxspeedKmh))
-                return Status::error(at + " = " + std::to_string(v) + " is out of range [" +
+                return Status::error(at + " = " + shortNumber(v) + " is out of range [" +
                                      std::to_string(int(kMinMaxspeedKmh)) + ", " +
                                      std::to_string(int(kMaxMaxspeedKmh)) + "] km/h");
             se.maxspeedKmh = float(v);
@@ -322,8 +323,8 @@ Result<StreetGraph> streetGraphFromJson(const std::string& text) {
                 return Status::error("street graph JSON: nodes[" + std::to_string(i) + "] must be [x, y] numbers");
             double x = n[0].get<double>(), y = n[1].get<double>();
             if (!std::isfinite(x) || !std::isfinite(y) || std::abs(x) > 1e9 || std::abs(y) > 1e9)
-                return Status::error("street graph JSON: nodes[" + std::to_string(i) + "] = [" + std::to_string(x) +
-                                     ", " + std::to_string(y) + "] is out of range [-1e9, 1e9] metres");
+                return Status::error("street graph JSON: nodes[" + std::to_string(i) + "] = [" + shortNumber(x) + ", " +
+                                     shortNumber(y) + "] is out of range [-1e9, 1e9] metres");
             g.nodes.emplace_back(x, y);
         }
         const auto& edges = j["edges"];

@@ -74,6 +74,8 @@ struct OsmImport {
     // Distinct OSM nodes / ways of highway=* ways that were dropped, by reason.
     size_t invalidNodes = 0, missingNodes = 0, outlierNodes = 0, tangledWays = 0;
     size_t simplifiedNodes = 0;       // removed by simplification (shape kept within its tolerances)
+    size_t clippedSegments = 0;       // road segments cut at the city square's border or beyond it
+    double clipHalf_m = 0;            // half the city side they were clipped to
     std::string dropSummary() const;  // "dropped 2 nodes (1 with invalid coordinates, ...)"
     // Building footprints (osm_buildings.h), in the streets' frame; empty unless asked for.
     std::vector<OsmFootprint> buildings;
@@ -83,7 +85,10 @@ struct OsmImport {
 // `buildings`: also read the building footprints (docs/reference/buildings.md "Buildings
 // from OSM"): closed ways and multipolygon relations tagged building=*,
 // repaired or skipped per reason (never an error), those with a vertex outside
-// the city square [-size_m/2, size_m/2]^2 skipped.
+// the city square [-size_m/2, size_m/2]^2 skipped. Roads are clipped to the
+// city square: a segment that leaves it ends at its border, one beyond it is
+// dropped (counted in clippedSegments and dropSummary()), so every street
+// lies inside the city the scene file describes.
 Result<OsmImport> importOsm(const std::string& path, const CityParams& params, bool buildings = false);
 
 }  // namespace vista

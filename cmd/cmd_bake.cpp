@@ -1,6 +1,7 @@
 // vista bake: view cells + point impostors at street ends (docs/bake.md).
 // Parses the options into a BakeJob and runs it (bake/driver.h).
 #include <cstdio>
+#include <optional>
 #include <unistd.h>
 
 #include "bake/driver.h"
@@ -17,8 +18,9 @@ const char* const kCmd = "vista bake";
 
 struct BakeArgs {
     BakeJob job;
-    std::string cellList, shard, texels = "8x2", representation = "points", placement = "cost", budget = "auto",
-                                 visibility = "image";
+    std::optional<std::string> cellList;  // unset: every cell
+    std::string shard, texels = "8x2", representation = "points", placement = "cost", budget = "auto",
+                       visibility = "image";
     bool quiet = false, noRemoval = false;
 };
 
@@ -137,8 +139,8 @@ Status configure(BakeArgs& a) {
         job.shardN = sh->count;
     }
     if (job.merge && !a.shard.empty()) return Status::error("--merge and --shard exclude each other");
-    if (!a.cellList.empty()) {
-        auto ids = parseCellList(a.cellList);
+    if (a.cellList) {
+        auto ids = parseCellList(*a.cellList);
         if (!ids) return ids.status();
         job.cells = std::move(*ids);
     }
@@ -148,7 +150,7 @@ Status configure(BakeArgs& a) {
 // The closing line on stderr: a shard's cells and how to assemble, or the output's counts.
 void printReport(const BakeArgs& a, const BakeReport& r) {
     const BakeJob& job = a.job;
-    const std::string& cellList = a.cellList;
+    const std::string cellList = a.cellList.value_or("");
     if (!r.assembled)
         std::fprintf(stderr,
                      "vista bake: shard %d/%d done (%zu cells) in %s; assemble with 'vista bake %s -o %s --merge%s'\n",

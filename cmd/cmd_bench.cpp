@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,7 +30,8 @@ namespace fs = std::filesystem;
 const char* const kCmd = "vista bench";
 
 struct BenchArgs {
-    std::string city, size = "640x480", modes = "full,near", out, reference = "full", fov = "60", sweep, effects;
+    std::string city, size = "640x480", modes = "full,near", out, reference = "full", fov = "60", sweep;
+    std::optional<std::string> effects;  // unset: the scene's
     std::string sampling = samplingName(kDefaultSampleRuns);
     std::vector<fs::path> createdOut;  // directories of --out made by this run, deepest first
     bool quiet = false;
@@ -77,7 +79,7 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
     app.add_option("--effects", a.effects,
                    "run-time effects for this run instead of the scene's: 'none', names (haze, glass, night) or a JSON "
                    "object as in the params file; baked effects (sun_shadows, ambient_occlusion, materials, night's "
-                   "lights) follow the scene file");
+                   "lights) follow the scene file, and naming one here is an error (give it to `vista gen --effects`)");
     app.add_option("--sweep", a.sweep,
                    "scaling sweep: sizes=500,1000,2000 generates a city per size (seed --seed) and benches each");
     app.add_flag("-q,--quiet", a.quiet, "no progress on stderr");
@@ -127,6 +129,8 @@ Status configure(BenchArgs& a) {
         if (a.city.empty()) return Status::error("missing the city file argument (or use --sweep)");
         if (!fs::exists(a.city)) return Status::error("city file '" + a.city + "' does not exist");
     }
+    VISTA_RETURN_IF_ERROR(checkRunFiles(CommandFiles().output("--out", a.out).output("--dump-rays", a.cfg.dumpRaysDir),
+                                        a.city, a.path, a.mode));
     VISTA_RETURN_IF_ERROR(checkWritableDirectory("--out", a.out));  // before any work, so a run never fails at its end
     if (!a.cfg.dumpRaysDir.empty()) {
         if (!a.sweep.empty()) return Status::error("--dump-rays is not supported with --sweep (one city per run)");

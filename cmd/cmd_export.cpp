@@ -11,6 +11,7 @@
 #include "cmd/cli.h"
 #include "cmd/commands.h"
 #include "foundation/atomic_file.h"
+#include "foundation/output_paths.h"
 #include "runtime/scene/city_file.h"
 
 namespace vista {
@@ -40,6 +41,8 @@ int runExport(int argc, char** argv) {
     app.add_flag("-q,--quiet", quiet, "no summary on stderr");
     if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;
     if (xodr.empty()) return reportBadInput(cmd, Status::error("nothing to export: give --xodr FILE.xodr"));
+    if (Status s = CommandFiles().input("city", input).output("--xodr", xodr).check(); !s)
+        return reportBadInput(cmd, s);
     if (Status s = checkXodrPath("--xodr", xodr); !s) return reportBadInput(cmd, s);
     auto model = loadCityFile(input);
     if (!model) return reportBadInput(cmd, model.status());

@@ -1,5 +1,6 @@
 // vista gen: params -> city.osgb (+ optional GeoJSON streets, glTF, stats).
 #include <cstdio>
+#include <functional>
 #include <fstream>
 #include <optional>
 #include <unistd.h>
@@ -9,6 +10,9 @@
 #include "citygen/generate.h"
 #include "citygen/opendrive.h"
 #include "foundation/atomic_file.h"
+#include "foundation/input_file.h"
+#include "foundation/number_text.h"
+#include "foundation/output_paths.h"
 #include "foundation/timing.h"
 #include "citygen/streets.h"
 #include "cmd/options.h"
@@ -27,15 +31,16 @@ namespace {
 const char* const kCmd = "vista gen";
 
 struct GenArgs {
-    std::string paramsFile, out, statsFile, osmFile, geojsonFile, gltfFile, xodrFile, effects;
+    std::string paramsFile, out, statsFile, osmFile, geojsonFile, gltfFile, xodrFile;
+    std::optional<std::string> effects;  // unset: the params file's
     std::string osmBuildings = "on";
-    std::optional<uint64_t> seed;
+    std::string seed;  // as written: parsed by parseUnsignedText (no wrap-around of "-1")
     std::optional<double> size;
     std::optional<int> detail, threads;
     bool quiet = false, listParams = false;
     // Paged output (-o DIR.paged).
     std::optional<double> regionSize;
-    std::string shard;
+    std::string shard, shards;
     bool merge = false;
     std::string memoryBudget;
     double budgetGb = 0;  // parsed --memory-budget (0 = none)
@@ -47,7 +52,7 @@ struct GenArgs {
 
 CLI::Option* declareFlags(CLI::App& app, GenArgs& a) {
     app.add_option("--params", a.paramsFile, "JSON parameter file (see docs/params.md; examples in data/)");
-    app.add_option("--seed", a.seed, "random seed (overrides the params file)");
+    app.add_option("--seed", a.seed, "random seed (overrides the params file)")->type_name("UINT");
     app.add_option("--size", a.size,
                    "side of the square city area in metres, 100..16000 (default 2000); up to 64000 with paged output");
     app.add_option("--detail", a.detail, "facade detail 0..3 (0 = plain boxes, default 2)");
@@ -79,6 +84,9 @@ CLI::Option* declareFlags(CLI::App& app, GenArgs& a) {
     app.add_flag("--merge", a.merge,
                  "paged output: generate nothing; write index.osgb and manifest.json once every region is done "
                  "(exit 2 naming the missing regions otherwise)");
+    app.add_option("--shards", a.shards,
+                   "with --merge: N, the shard count of the shards' --shard K/N; a merge that finds regions missing "
+                   "then names the shards K/N to run again");
     app.add_option("--memory-budget", a.memoryBudget,
                    "GB: refuse up front, before the meshes are made and with nothing written, a generation whose "
                    "estimated peak memory exceeds it (one file: from the laid-out city's estimated triangles; paged: "
@@ -120,16 +128,22 @@ void printParamTable() {
 Result<CityParams> resolveParams(GenArgs& a) {
     CityParams params;
     if (!a.paramsFile.empty()) {
+        if (Status s = checkInputFile("parameter file", a.paramsFile, kMaxParamsFileBytes); !s)
+            return Status::error("option --params: " + s.message());
         auto r = loadParamsFile(a.paramsFile);
         if (!r) return r.status();
         params = *r;
     }
-    if (a.seed) params.seed = *a.seed;
+    if (!a.seed.empty()) {
+        auto seed = parseUnsignedText("option --seed", a.seed, 0, UINT64_MAX);
+        if (!seed) return seed.status();
+        params.seed = *seed;
+    }
     if (a.size) params.size_m = *a.size;
     if (a.detail) params.detail = *a.detail;
     if (a.threads) params.threads = *a.threads;
-    if (!a.effects.empty()) {
-        auto e = parseEffectsOption(a.effects, params.effects);
+    if (a.effects) {
+        auto e = parseEffectsOption(*a.effects, params.effects);
         if (!e) return e.status();
         params.effects = *e;
     }
@@ -141,11 +155,12 @@ Result<CityParams> resolveParams(GenArgs& a) {
     if (a.osmBuildings != "on" && a.osmBuildings != "off")
         return Status::error("option --osm-buildings = '" + a.osmBuildings + "': must be 'on' or 'off'");
     if (a.paged()) return params;  // checked by resolvePaged
-    if (a.regionSize || !a.shard.empty() || a.merge)
+    if (a.regionSize || !a.shard.empty() || a.merge || !a.shards.empty())
         return Status::error(std::string("option ") +
-                             (a.regionSize       ? "--region-size"
-                              : !a.shard.empty() ? "--shard"
-                                                 : "--merge") +
+                             (a.regionSize        ? "--region-size"
+                              : !a.shard.empty()  ? "--shard"
+                              : !a.shards.empty() ? "--shards"
+                                                  : "--merge") +
                              ": only with paged output (-o DIR.paged)");
     if (a.out.size() < 5 || a.out.substr(a.out.size() - 5) != ".osgb")
         return Status::error("option -o = '" + a.out +
@@ -179,6 +194,12 @@ Result<PagedCityOptions> resolvePaged(const GenArgs& a, const CityParams& params
     }
     if (a.merge && !a.shard.empty())
         return Status::error("option --merge: not with --shard (the merge covers every shard)");
+    if (!a.shards.empty()) {
+        if (!a.merge) return Status::error("option --shards: only with --merge (shards take --shard K/N)");
+        auto n = parseShardCount("--shards", a.shards);
+        if (!n) return n.status();
+        o.mergeShards = *n;
+    }
     for (auto [opt, path] : {std::pair<const char*, const std::string*>{"--geojson", &a.geojsonFile},
                              {"--gltf", &a.gltfFile},
                              {"--xodr", &a.xodrFile},
@@ -256,9 +277,11 @@ int runPaged(const GenArgs& a, const CityParams& params, const Stopwatch& total)
     return 0;
 }
 
-// Every output of the command, or none: each is staged into `batch` (the
-// caller stages --stats too, then commits them all together).
-Status writeOutputs(const GenArgs& a, const City& city, const CityParams& params, OutputBatch& batch) {
+// Every output of the command, or none: each is staged, then all renamed
+// together; `stats` (called once the others are staged) gives the stats JSON.
+Status writeOutputs(const GenArgs& a, const City& city, const CityParams& params,
+                    const std::function<std::string()>& stats) {
+    OutputBatch batch;
     VISTA_RETURN_IF_ERROR(writeCityFile(city, batch.stage(a.out)));
     if (!a.geojsonFile.empty())
         VISTA_RETURN_IF_ERROR(
@@ -270,7 +293,8 @@ Status writeOutputs(const GenArgs& a, const City& city, const CityParams& params
         if (!xodr) return Status::error("option --xodr = '" + a.xodrFile + "': " + xodr.status().message());
         VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage(a.xodrFile), *xodr));
     }
-    return Status::ok();
+    if (!a.statsFile.empty()) VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage(a.statsFile), stats()));
+    return batch.commit();
 }
 
 nlohmann::ordered_json statsJson(const City& city, const CityParams& params, const CityCounts& n,
@@ -344,6 +368,17 @@ int runGen(int argc, char** argv) {
     }
     if (outOpt->count() == 0)
         return reportBadInput(kCmd, Status::error("option -o/--output is required (the .osgb to write)"));
+    if (Status s = CommandFiles()
+                       .input("--params", a.paramsFile)
+                       .input("--osm", a.osmFile)
+                       .output("-o", a.out)
+                       .output("--stats", a.statsFile)
+                       .output("--geojson", a.geojsonFile)
+                       .output("--gltf", a.gltfFile)
+                       .output("--xodr", a.xodrFile)
+                       .check();
+        !s)
+        return reportBadInput(kCmd, s);
     Stopwatch total;
     auto params = resolveParams(a);
     if (!params) return reportBadInput(kCmd, params.status());
@@ -399,17 +434,17 @@ int runGen(int argc, char** argv) {
         city->stageTimes.push_back({"lighting", lighting.seconds});
     }
     Stopwatch write;
-    OutputBatch batch;
-    if (Status s = writeOutputs(a, *city, *params, batch); !s) return reportBadInput(kCmd, s);
-    const double writeSeconds = write.ms() / 1000.0, totalSeconds = total.ms() / 1000.0;
     const CityCounts n = countCity(*city);
-    if (!a.statsFile.empty()) {
-        auto j = statsJson(*city, *params, n, lighting, writeSeconds, totalSeconds);
+    double totalSeconds = 0;
+    auto stats = [&] {
+        totalSeconds = total.ms() / 1000.0;
+        auto j = statsJson(*city, *params, n, lighting, write.ms() / 1000.0, totalSeconds);
         if (a.budgetGb > 0) j["memory"] = {{"estimate_mb", estimateMb}, {"budget_gb", a.budgetGb}};
         if (osmRoads) j["osm_roads"] = nlohmann::ordered_json::parse(osmRoadTagStatsJson(*osmRoads));
-        if (Status s = writeFileAtomic(batch.stage(a.statsFile), j.dump(2) + "\n"); !s) return reportBadInput(kCmd, s);
-    }
-    if (Status s = batch.commit(); !s) return reportBadInput(kCmd, s);
+        return j.dump(2) + "\n";
+    };
+    if (Status s = writeOutputs(a, *city, *params, stats); !s) return reportBadInput(kCmd, s);
+    totalSeconds = total.ms() / 1000.0;
     if (!a.quiet)
         std::fprintf(stderr,
                      "wrote %s: %zu street edges, %zu blocks, %zu buildings, %zu trees, %.2f M triangles, %zu draw "

@@ -3,6 +3,8 @@
 #include <string>
 
 #include "runtime/scene/city_file.h"
+#include "foundation/atomic_file.h"
+#include "foundation/output_paths.h"
 #include "foundation/units.h"
 #include "cmd/cli.h"
 #include "cmd/commands.h"
@@ -17,7 +19,7 @@ int runPath(int argc, char** argv) {
         "Make a deterministic walkthrough path along the city's street graph (CSV: "
         "t_s,x_m,y_m,z_m,heading_deg,pitch_deg).",
         "vista path"};
-    std::string city, out, kind = "car", positions;
+    std::string city, out, kind = "car", positions, route = "tour";
     PathOptions o;
     double yawDeg = 45.0, pitchDeg = o.flyPitch * 180.0 / kPi;
     // Options: one CLI11 call per flag.
@@ -26,12 +28,15 @@ int runPath(int argc, char** argv) {
                    "graph is grown again from the manifest's params, no region is read; the same path as the "
                    "single-file city's)")
         ->required();
-    app.add_option("--seed", o.seed, "random seed of the route (default 1)");
+    addSeedOption(app, "--seed", o.seed, "random seed of the route (default 1)");
     app.add_option("--kind", kind, "walk (eye 1.7 m), car (eye 1.2 m) or fly (elevated fly-over); default car");
     app.add_option("--duration", o.duration, "path length in seconds (default 60)");
     app.add_option(
         "--run-up", o.runUp,
         "seconds driven before the path starts and dropped, so it starts at cruising speed, 0 .. 600 (default 8)");
+    app.add_option("--route", route,
+                   "tour (default): head for far goals along shortest paths, so a long drive keeps going across "
+                   "the city; wander: a seeded random walk that prefers going straight on");
     app.add_option("--dt", o.dt, "seconds between samples (default 1/30)");
     auto* speed = app.add_option("--speed", o.maxSpeed, "maximum speed in m/s (default: walk 1.4, car and fly 14)");
     app.add_option("--yaw-rate", yawDeg, "maximum yaw rate in degrees/s (default 45)");
@@ -51,9 +56,15 @@ int runPath(int argc, char** argv) {
     if (!k) return reportBadInput("vista path", Status::error("--kind: " + k.status().message()));
     o.kind = k.value();
     if (speed->count() == 0) o.maxSpeed = defaultSpeed(o.kind);
+    auto r = parseRouteStyle(route);
+    if (!r) return reportBadInput("vista path", Status::error("--route: " + r.status().message()));
+    o.route = r.value();
     o.maxYawRate = yawDeg * kPi / 180.0;
     o.flyPitch = pitchDeg * kPi / 180.0;
     if (Status s = validatePathOptions(o); !s) return reportBadInput("vista path", s);
+    if (Status s = CommandFiles().input("city", city).output("-o", out).output("--xodr-positions", positions).check();
+        !s)
+        return reportBadInput("vista path", s);
     if (Status s = checkWritablePath("--output", out); !s) return reportBadInput("vista path", s);
     if (!positions.empty() && o.kind != PathKind::Car)
         return reportBadInput("vista path", Status::error("--xodr-positions: only with --kind car (walk and fly "
@@ -71,9 +82,13 @@ int runPath(int argc, char** argv) {
     if (!c) return reportBadInput("vista path", c.status());
     auto p = generatePath(c->streets, c->params, o);
     if (!p) return reportBadInput("vista path", p.status());
+    // Both outputs or neither.
+    OutputBatch batch;
     if (!positions.empty())
-        if (Status s = saveLanePositionsCsv(p.value(), positions); !s) return reportBadInput("vista path", s);
-    if (Status s = savePathCsv(p.value(), out); !s) return reportBadInput("vista path", s);
+        if (Status s = saveLanePositionsCsv(p.value(), batch.stage(positions)); !s)
+            return reportBadInput("vista path", s);
+    if (Status s = savePathCsv(p.value(), batch.stage(out)); !s) return reportBadInput("vista path", s);
+    if (Status s = batch.commit(); !s) return reportBadInput("vista path", s);
     std::fprintf(stderr, "vista path: %zu samples (%.1f s, %s) -> %s\n", p->samples.size(), o.duration,
                  pathKindName(o.kind), out.c_str());
     return 0;

@@ -275,7 +275,7 @@ Status configure(const RenderArgs& a, RenderPlan& p) {
     if (!po) return po.status();
     p.path = *po;
     if (!fs::exists(a.city)) return Status::error("city file '" + a.city + "' does not exist");
-    return Status::ok();
+    return checkRunFiles(CommandFiles().output("--out", a.out), a.city, a.path, a.modeFlags);
 }
 
 // The city (labelled when a label channel needs it), the walkthrough and the
@@ -303,7 +303,7 @@ Result<Walkthrough> loadCityAndFrames(const RenderArgs& a, RenderPlan& p, std::v
         return path;
     };
     req.bakedModes = {a.mode};
-    req.effects = [](const Effects& declared) { return runTimeEffects("", declared, true, kCmd); };
+    req.effects = [](const Effects& declared) { return runTimeEffects(std::nullopt, declared, true, kCmd); };
     return loadWalkthrough(req, p.options);
 }
 
@@ -499,6 +499,8 @@ Status renderFrames(const RenderArgs& a, const RenderPlan& p, const Walkthrough&
         const bool finished = !done.records[f].is_null();
         if (finished && !(stateful && long(f) < done.lastMissing)) continue;
         FrameStats st;
+        // Ray origins near the scene's frame origin: float precision anywhere in the city.
+        if (s.rays) VISTA_RETURN_IF_ERROR(s.rays->placeFrameNear(cam.eye));
         if (Status e = s.mode->renderFrame(cam, b.img, st); !e)
             return Status::error("frame " + std::to_string(f) + ": " + e.message());
         if (finished) {  // hybrid warm-up: the state, not the image

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <osg/Camera>
@@ -51,7 +52,8 @@ const char* const kCmd = "vista view";
 osg::Matrixd toOsg(const glm::dmat4& m) { return osg::Matrixd(glm::value_ptr(m)); }
 
 struct ViewArgs {
-    std::string city, size = "1280x720", screenshot, mode = "full", fov = "60", effects, memoryBudget;
+    std::string city, size = "1280x720", screenshot, mode = "full", fov = "60", memoryBudget;
+    std::optional<std::string> effects;  // unset: the scene's
     int frames = 0;
     bool step = false, noHud = false;
     std::string sampling = samplingName(kDefaultSampleRuns);
@@ -111,6 +113,8 @@ Status configure(ViewArgs& a, ModeOptions& options) {
     a.sampleRuns = sampling.value();
     if (a.step && (a.frames < 1 || (a.path.file.empty() && a.path.seed == 0)))
         return Status::error("--step needs --frames N >= 1 and a path (--path or --seed)");
+    VISTA_RETURN_IF_ERROR(
+        checkRunFiles(CommandFiles().output("--screenshot", a.screenshot), a.city, a.path, a.modeFlags));
     if (!a.screenshot.empty()) VISTA_RETURN_IF_ERROR(checkWritablePath("--screenshot", a.screenshot));
     VISTA_RETURN_IF_ERROR(validatePagedReach(a.paged));
     return parseModeFlags(a.modeFlags, options);
@@ -132,6 +136,12 @@ public:
         if (!m) return m.status();
         std::fprintf(stderr, "%s: mode %s set up in %.0f ms\n", kCmd, name.c_str(), sw.ms());
         return (_modes[name] = std::move(m.value())).get();
+    }
+    // Moves the ray scene's frame next to the eye (RayScene::placeFrameNear),
+    // between frames, when no ray is in flight.
+    void placeFrameNear(const glm::dvec3& eye) {
+        if (!_rays) return;
+        if (Status st = _rays->placeFrameNear(eye); !st) std::fprintf(stderr, "%s: %s\n", kCmd, st.message().c_str());
     }
     // The mode after `current` that can be created (stays on `current` if none).
     std::string next(const std::string& current) {
@@ -417,6 +427,7 @@ int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path,
                 c.roll = fromOsg.roll;
             }
         }
+        modes.placeFrameNear(c.eye);  // ray origins near the frame origin: float precision anywhere
         cam->setProjectionMatrix(toOsg(c.projection(v.current->beginViewerFrame(c))));
         if (v.keys->effects) v.sky->setNight(v.keys->effects->night);
         const bool skyLayer = !v.current->drawsSky();  // hybrid: the far field writes every uncovered pixel

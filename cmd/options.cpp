@@ -1,6 +1,9 @@
 // Command-line value parsers (options.h).
 #include "cmd/options.h"
 
+#include "foundation/input_file.h"
+#include "foundation/number_text.h"
+
 #include <algorithm>
 #include <cstdio>
 #include <cerrno>
@@ -80,33 +83,28 @@ Status parseTexels(const std::string& s, int& x, int& y) {
 }
 
 Result<std::vector<uint32_t>> parseCellList(const std::string& s) {
+    const std::string shape = " (expected ids or ranges like 3,7,10-20)";
+    if (s.empty()) return Status::error("--cells '': no cell id given" + shape);
     std::vector<uint32_t> out;
     std::stringstream ss(s);
     std::string item;
     while (std::getline(ss, item, ',')) {
         if (item.empty()) continue;
-        char* end = nullptr;
-        const size_t dash = item.find('-');
-        long a = std::strtol(item.c_str(), &end, 10);
-        long b = a;
-        bool ok = end && end != item.c_str();
-        if (dash != std::string::npos && dash > 0) {
-            ok = ok && size_t(end - item.c_str()) == dash;
-            char* e2 = nullptr;
-            b = std::strtol(item.c_str() + dash + 1, &e2, 10);
-            ok = ok && e2 && *e2 == 0 && e2 != item.c_str() + dash + 1;
-        } else {
-            ok = ok && *end == 0;
+        const size_t dash = item.find('-', 1);
+        const std::string what = "--cells item '" + echoText(item) + "'";
+        auto a = parseUnsignedText(what, item.substr(0, dash), 0, 100000000);
+        if (!a) return Status::error(a.status().message() + shape);
+        uint64_t b = *a;
+        if (dash != std::string::npos) {
+            auto r = parseUnsignedText(what, item.substr(dash + 1), *a, 100000000);
+            if (!r) return Status::error(r.status().message() + shape);
+            b = *r;
         }
-        if (!ok || a < 0 || b < a || b > 100000000)
-            return Status::error("--cells '" + s + "': bad item '" + item +
-                                 "' (expected ids or ranges like 3,7,10-20)");
-        for (long v = a; v <= b; ++v) out.push_back(uint32_t(v));
+        for (uint64_t v = *a; v <= b; ++v) out.push_back(uint32_t(v));
     }
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
-    if (out.empty())
-        return Status::error("--cells '" + s + "': no cell id given (expected ids or ranges like 3,7,10-20)");
+    if (out.empty()) return Status::error("--cells '" + echoText(s) + "': no cell id given" + shape);
     return out;
 }
 
@@ -364,10 +362,23 @@ Status parseModeFlags(const ModeFlags& f, ModeOptions& o) {
     return checkModeOptions(o);
 }
 
+CLI::Option* addSeedOption(CLI::App& app, const std::string& name, uint64_t& seed, const std::string& help) {
+    return app
+        .add_option_function<std::string>(
+            name,
+            [&seed, name](const std::string& text) {
+                auto v = parseUnsignedText("option " + name, text, 0, UINT64_MAX);
+                if (!v) throw CLI::ValidationError(v.status().message());
+                seed = *v;
+            },
+            help)
+        ->type_name("UINT");
+}
+
 void addPathFlags(CLI::App& app, PathFlags& f, bool timing) {
     auto* path = app.add_option("--path", f.file, "walkthrough path CSV (from `vista path`)");
-    app.add_option("--seed", f.seed,
-                   "make the path from this seed instead of --path (default " + std::to_string(f.seed) + ")")
+    addSeedOption(app, "--seed", f.seed,
+                  "make the path from this seed instead of --path (default " + std::to_string(f.seed) + ")")
         ->excludes(path);
     app.add_option("--kind", f.kind, "path kind when made from --seed: walk, car, fly (default " + f.kind + ")");
     app.add_flag("--lht", f.lht, "car path made from --seed: left-hand traffic (lanes driven mirrored)");
@@ -392,17 +403,39 @@ Result<PathOptions> parsePathFlags(const PathFlags& f) {
     return po;
 }
 
+Status checkRunFiles(CommandFiles files, const std::string& city, const PathFlags& path, const ModeFlags& mode) {
+    VISTA_RETURN_IF_ERROR(files.input("city", city)
+                              .input("--path", path.file)
+                              .input("--baked", mode.baked)
+                              .input("--baked-mesh", mode.bakedMesh)
+                              .check());
+    if (!path.file.empty())
+        if (Status s = checkInputFile("path file", path.file, kMaxPathCsvBytes); !s)
+            return Status::error("option --path: " + s.message());
+    return Status::ok();
+}
+
 Result<Effects> parseEffectsOption(const std::string& s, const Effects& base) {
+    if (s.empty())
+        return Status::error(
+            "option --effects = '': empty (give 'none', effect names such as haze,glass, or a JSON "
+            "object)");
+    if (s.size() > kMaxEffectsTextBytes)
+        return Status::error("option --effects: " + std::to_string(s.size()) + " bytes, more than the limit of " +
+                             byteLimitText(kMaxEffectsTextBytes));
     if (s == "none") return Effects();
-    if (!s.empty() && s[0] == '{') return parseEffectsJson(s, "option --effects");
+    if (s[0] == '{') return parseEffectsJson(s, "option --effects");
+    if (s.back() == ',') return Status::error("option --effects = '" + echoText(s) + "': empty effect name");
     Effects out;
     std::stringstream ss(s);
     std::string name;
     while (std::getline(ss, name, ',')) {
         EffectId id;
+        if (name.empty()) return Status::error("option --effects = '" + echoText(s) + "': empty effect name");
         if (!findEffect(name, id))
-            return Status::error("option --effects: unknown effect '" + name + "' (known: " + effectNames() +
+            return Status::error("option --effects: unknown effect '" + echoText(name) + "' (known: " + effectNames() +
                                  "; or 'none', or a JSON object)");
+        if (out.has(id)) return Status::error("option --effects: effect '" + name + "' is named twice");
         if (base.has(id)) {
             switch (id) {
                 case EffectId::SunShadows: out.sun_shadows = base.sun_shadows; break;
@@ -417,14 +450,22 @@ Result<Effects> parseEffectsOption(const std::string& s, const Effects& base) {
             out.enable(id);
         }
     }
-    if (s.empty() || s.back() == ',') return Status::error("option --effects = '" + s + "': empty effect name");
     return out;
 }
 
-Result<FrameEffects> runTimeEffects(const std::string& option, const Effects& declared, bool quiet, const char* cmd) {
-    if (option.empty()) return FrameEffects::fromScene(declared);
-    auto e = parseEffectsOption(option, declared);
+Result<FrameEffects> runTimeEffects(const std::optional<std::string>& option, const Effects& declared, bool quiet,
+                                    const char* cmd) {
+    if (!option) return FrameEffects::fromScene(declared);
+    auto e = parseEffectsOption(*option, declared);
     if (!e) return e.status();
+    // A baked effect cannot change per run: asking for it is an error, not a silent no-op.
+    for (int i = 0; i < kEffectCount; ++i) {
+        const EffectId id = EffectId(i);
+        if (id != EffectId::Night && effectIsBaked(id) && e->has(id))
+            return Status::error(std::string("option --effects: '") + effectName(id) +
+                                 "' is baked into the scene's colours at generation and cannot change per run "
+                                 "(give it to `vista gen --effects`); run-time effects: haze, glass, night");
+    }
     FrameEffects fx = FrameEffects::fromScene(*e);
     fx.glassMarked = declared.glass.has_value();
     if (!fx.glassMarked) fx.glass = false;

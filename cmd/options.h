@@ -12,12 +12,14 @@
 // turned into ModeOptions by parseModeFlags().
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "citygen/effects.h"
+#include "foundation/output_paths.h"
 #include "foundation/status.h"
 #include "nodes/render/render_mode.h"
 #include "runtime/scene/paged_walkthrough.h"
@@ -85,7 +87,10 @@ Result<Effects> parseEffectsOption(const std::string& s, const Effects& base);
 // ones, or --effects over them. Glass marks exist only where the scene
 // declared glass at generation; baked effects follow the scene file (a note
 // on stderr says so unless quiet; `cmd` prefixes it).
-Result<FrameEffects> runTimeEffects(const std::string& option, const Effects& declared, bool quiet, const char* cmd);
+// `option` unset = the scene's; set = parsed (an empty value is an error; a
+// baked effect other than night is refused: it cannot change per run).
+Result<FrameEffects> runTimeEffects(const std::optional<std::string>& option, const Effects& declared, bool quiet,
+                                    const char* cmd);
 
 struct ModeFlags {
     std::string near = "auto", triangleBudget = "0", budget = "unlimited";
@@ -106,6 +111,10 @@ Status parseModeFlags(const ModeFlags& flags, ModeOptions& out);
 // Range checks of ModeOptions (for options set in code).
 Status checkModeOptions(const ModeOptions& o);
 
+// A seed option (0 .. 2^64-1, decimal; parseUnsignedText): "-1" or 2^64 is a
+// parse error naming the option and the range, never a wrapped value.
+CLI::Option* addSeedOption(CLI::App& app, const std::string& name, uint64_t& seed, const std::string& help);
+
 struct PathFlags {
     std::string file, kind = "car";
     uint64_t seed = 1;
@@ -116,6 +125,12 @@ struct PathFlags {
 void addPathFlags(CLI::App& app, PathFlags& flags, bool timing);
 // The path options of the flags (kind and ranges checked; messages name the flag).
 Result<PathOptions> parsePathFlags(const PathFlags& flags);
+
+// The file rule of a walkthrough run (bench, render, view): `files` holds the
+// command's outputs; adds its inputs (the city, --path, --baked, --baked-mesh)
+// and checks the rule (output_paths.h), and that a --path file is a regular
+// file within kMaxPathCsvBytes, before anything is read or created.
+Status checkRunFiles(CommandFiles files, const std::string& city, const PathFlags& path, const ModeFlags& mode);
 
 // The paged-city reach (PagedReach, paged_walkthrough.h) of bench and view:
 // --paged-radius M = metres around the walkthrough within which regions are

@@ -91,7 +91,7 @@ OutputBatch::~OutputBatch() {
 
 std::string OutputBatch::stage(const std::string& path) {
     removeStaleTemps(path);
-    const std::string staged = path + ".stage." + std::to_string(::getpid());
+    std::string staged = path + ".stage." + std::to_string(::getpid());  // not const: returned by move
     _files.emplace_back(staged, path);
     return staged;
 }

@@ -22,4 +22,12 @@ Result<Shard> parseShard(const std::string& option, const std::string& text) {
     return Shard{int(k - 1), int(n)};
 }
 
+Result<int> parseShardCount(const std::string& option, const std::string& text) {
+    if (text.empty() || text.size() > 9 || text.find_first_not_of("0123456789") != std::string::npos ||
+        std::stol(text) < 1 || std::stol(text) > kMaxShards)
+        return Status::error("option " + option + " = '" + text +
+                             "': expected a whole number N with 1 <= N <= " + std::to_string(kMaxShards));
+    return int(std::stol(text));
+}
+
 }  // namespace vista

@@ -20,4 +20,8 @@ struct Shard {
 // allowed range ("expected K/N with 1 <= K <= N <= 100000").
 Result<Shard> parseShard(const std::string& option, const std::string& text);
 
+// Parses a shard count "N" (1 <= N <= kMaxShards); a bad value is an error
+// naming `option`, the value and the allowed range.
+Result<int> parseShardCount(const std::string& option, const std::string& text);
+
 }  // namespace vista

@@ -227,6 +227,34 @@ Json manifestJson(const CityParams& params, const RegionGrid& grid, double regio
     return m;
 }
 
+// The merge's refusal: how many regions are missing (the first few by
+// name) and which shards to run again: K/N for each, when the merge knows the
+// N the shards ran with, otherwise how regions map to shards.
+Status missingRegionsError(const PagedCityOptions& o, const RegionGrid& grid, const std::vector<int>& missing) {
+    std::string names;
+    for (size_t i = 0; i < missing.size() && i < 8; ++i)
+        names += (i ? ", " : "") + regionFileName(grid.ix(missing[i]), grid.iy(missing[i]));
+    if (missing.size() > 8) names += ", ...";
+    std::string msg = "--merge: " + std::to_string(missing.size()) + " of " + std::to_string(grid.count()) +
+                      " regions of '" + o.dir + "' are missing, corrupt or from other parameters (" + names + "); ";
+    if (o.mergeShards < 1)
+        return Status::error(msg + "run the shards that own them again (--shard K/N owns the regions whose index " +
+                             "IY * " + std::to_string(grid.countX()) + " + IX satisfies index % N == K - 1; " +
+                             "--merge --shards N names them)");
+    std::vector<bool> rerun(size_t(o.mergeShards), false);
+    for (int r : missing) rerun[size_t(r % o.mergeShards)] = true;
+    std::string shards;
+    int count = 0;
+    for (int k = 0; k < o.mergeShards; ++k) {
+        if (!rerun[size_t(k)]) continue;
+        if (++count <= 20)
+            shards += (count > 1 ? ", " : "") + std::to_string(k + 1) + "/" + std::to_string(o.mergeShards);
+    }
+    if (count > 20) shards += ", ...";
+    return Status::error(msg + "run " + (count == 1 ? "shard " : std::to_string(count) + " shards ") + shards +
+                         " again (--shard K/N with the same parameters), then the merge");
+}
+
 }  // namespace
 
 std::string regionFileName(int ix, int iy) {
@@ -328,20 +356,16 @@ Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedC
 
     const auto ti = std::chrono::steady_clock::now();
     std::vector<Json> all;
-    std::string missing;
-    int nMissing = 0;
+    std::vector<int> missingRegions;
     for (int r = 0; r < grid.count(); ++r) {
         if (!records[size_t(r)]) records[size_t(r)] = validRecord(o.dir, grid, r, key);
         if (!records[size_t(r)]) {
-            if (++nMissing <= 8) missing += (missing.empty() ? "" : ", ") + regionFileName(grid.ix(r), grid.iy(r));
+            missingRegions.push_back(r);
             continue;
         }
         all.push_back(*records[size_t(r)]);
     }
-    if (nMissing > 0)
-        return Status::error("--merge: " + std::to_string(nMissing) + " of " + std::to_string(grid.count()) +
-                             " regions of '" + o.dir + "' are missing, corrupt or from other parameters (" + missing +
-                             (nMissing > 8 ? ", ..." : "") + "); run their shards (region index % N) first");
+    if (!missingRegions.empty()) return missingRegionsError(o, grid, missingRegions);
     osg::ref_ptr<osg::Node> index = buildIndex(params, grid, o.regionSizeM, all);
     OutputBatch own;
     OutputBatch& batch = o.batch ? *o.batch : own;

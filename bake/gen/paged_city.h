@@ -18,7 +18,8 @@
 // params) is generated again, never trusted. Unsharded (count 1) or with
 // `merge`, it then writes index.osgb and manifest.json (atomically, together)
 // once every region has a valid record; `merge` generates nothing and is an
-// error naming the missing regions when some are not done. The bytes of every
+// error naming the missing regions when some are not done, and the shards
+// K/N to run again when `mergeShards` gives the N the shards ran with. The bytes of every
 // file depend only on params and the region size: the same for any thread
 // count, any split into shards and any number of interruptions. Shards of one
 // city may run concurrently in separate processes on the same directory.
@@ -48,6 +49,7 @@ struct PagedCityOptions {
     double regionSizeM = 2000.0;
     Shard shard;
     bool merge = false;
+    int mergeShards = 0;  // with merge: the N of the shards' K/N (0: unknown)
     Progress* progress = nullptr;
     // Non-null: index.osgb and manifest.json are staged into this batch and
     // the caller commits them with its own outputs (--stats); null: they are

@@ -14,15 +14,15 @@ N="${3:-3}"
 export VISTA
 mkdir -p "$OUT"
 OUT="$(realpath "$OUT")"
-rm -rf "$OUT"/one.paged "$OUT"/arr.paged "$OUT"/one.baked.osgb* "$OUT"/arr.baked.osgb* "$OUT"/c.osgb
+rm -rf "$OUT"/one.paged "$OUT"/arr.paged "$OUT"/one.baked.osgb* "$OUT"/arr.baked.osgb* "$OUT"/c.osgb "$OUT"/jobs.log
 
-array() {  # array JOB: the N shards at once, then the merge
+array() {  # array JOB: the N shards at once, then the merge; their logs in OUT/jobs.log
   local pids=() k
   for k in $(seq 1 "$N"); do
-    SLURM_ARRAY_TASK_ID=$k bash "$REPO/docs/jobs/slurm-array.sbatch" & pids+=($!)
+    SLURM_ARRAY_TASK_ID=$k bash "$REPO/docs/jobs/slurm-array.sbatch" 2>>"$OUT/jobs.log" & pids+=($!)
   done
-  for p in "${pids[@]}"; do wait "$p"; done
-  bash "$REPO/docs/jobs/slurm-merge.sbatch"
+  for p in "${pids[@]}"; do wait "$p" || { cat "$OUT/jobs.log" >&2; exit 1; }; done
+  bash "$REPO/docs/jobs/slurm-merge.sbatch" 2>>"$OUT/jobs.log" || { cat "$OUT/jobs.log" >&2; exit 1; }
 }
 
 # Generation: a 1.5 km city in 500 m regions.

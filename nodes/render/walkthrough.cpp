@@ -58,6 +58,16 @@ Status loadPairedBakes(const std::string& cmd, const std::string& cityPath, cons
         Stopwatch sw;
         auto bf = loadBakedFile(path);
         if (!bf) return Status::error(std::string(flag) + ": " + bf.status().message());
+        // Each flag takes one representation (a user error, refused before anything is drawn).
+        const std::string f = flag;
+        if (f == "--baked-mesh" && !bf->meshes)
+            return Status::error("--baked-mesh: '" + path +
+                                 "' holds point impostors; --baked-mesh takes a file from 'vista bake "
+                                 "--representation mesh' (pass a points bake as --baked)");
+        if (f == "--baked" && bf->meshes && !modes.empty() && has("impostor"))
+            return Status::error("--baked: '" + path +
+                                 "' holds textured depth meshes, and mode impostor needs point impostors; pass it as "
+                                 "--baked-mesh (for mode lodmesh) and a points bake as --baked");
         const double ms = sw.ms();
         std::string warning;
         VISTA_RETURN_IF_ERROR(checkBakedFromCity(path, *bf, cityPath, cityRoot, &warning));

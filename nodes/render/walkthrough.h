@@ -21,7 +21,8 @@
 // cityPath with root cityRoot (checkBakedFromCity) and keeps them in
 // options.loadedBakes, so the modes do not load them again. Errors
 // (unreadable, truncated, corrupt, not a baked file, baked from another
-// city) name the flag and the file. A file without a source city hash (an
+// city, a points bake as --baked-mesh, a mesh bake as --baked when mode
+// impostor is asked) name the flag and the file. A file without a source city hash (an
 // older bake) is a warning on stderr, not an error.
 //
 // walkthroughPath(): the CSV `csvFile` if not empty (loadPathCsv), else a

@@ -151,7 +151,8 @@ double PanoramaCache::error(int64_t cell, glm::u8vec2 sub, const CachePolicy& p)
     // cylinder a column step is 2 pi / width of azimuth (times cos elevation
     // on the sphere), a row step 2 vMax / height of tan(elevation) (times cos^2).
     const glm::u8vec2 s = c.sub ^ glm::u8vec2(kSubBias);
-    const double v = _vMax - (double(cell / _width) + 0.5) * 2.0 * _vMax / _height;
+    const int64_t row = cell / _width;  // the cell's row (integer division on purpose)
+    const double v = _vMax - (double(row) + 0.5) * 2.0 * _vMax / _height;
     const double c2 = 1.0 / (1.0 + v * v);
     const double du = (double(sub.x) - double(s.x)) / 256.0 * kTwoPi / _width * std::sqrt(c2);
     const double dv = (double(sub.y) - double(s.y)) / 256.0 * 2.0 * _vMax / _height * c2;

@@ -1,8 +1,12 @@
 // RayScene: Embree 3 scene of a loaded city (see ray_scene.h for the contract).
 //
-// Layout: one RTCScene; one triangle geometry per tile mesh (vertices in a
-// scene-local float frame around frameOrigin); one child scene per tree
-// prototype, instanced with RTC_GEOMETRY_TYPE_INSTANCE per SceneInstance.
+// Layout (regions): a top-level RTCScene holding one instance per region
+// (a translation onto the region's own scene of tile meshes, vertices relative
+// to the region origin) and one instance per tree (onto its prototype's
+// scene). Embree here traverses one instance level, so trees cannot sit
+// inside a region scene: a region's trees are its instances in the top level.
+// Layout (flat): one triangle geometry per tile mesh in the top-level scene
+// (vertices around frameOrigin), trees as above.
 // Hit colours: barycentric interpolation of the prelit vertex colours, rounded
 // to 8 bits exactly as the fixed-function rasteriser does; the colours are kept
 // per triangle (primID -> its three corners), so a hit costs one memory fetch
@@ -14,12 +18,14 @@
 #include "runtime/engine/ray_packet.h"
 
 #include <embree3/rtcore.h>
+#include <glm/gtc/matrix_transform.hpp>
 #include <pmmintrin.h>
 #include <xmmintrin.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -105,32 +111,72 @@ void cullBackFaces(const RTCFilterFunctionNArguments* args) {
     }
 }
 
+// The tree prototypes of one SceneModel: one child scene each (null when empty).
+struct PrototypeSet {
+    std::vector<RTCScene> scenes;
+    std::vector<std::vector<TriColors>> colors;  // per prototype, per triangle
+    std::vector<size_t> triangles;
+    PrototypeSet() = default;
+    PrototypeSet(const PrototypeSet&) = delete;
+    PrototypeSet& operator=(const PrototypeSet&) = delete;
+    ~PrototypeSet() {
+        for (RTCScene s : scenes)
+            if (s) rtcReleaseScene(s);
+    }
+};
+
 }  // namespace
 
 struct RayScene::Impl {
     RTCDevice device = nullptr;
-    bool ftz = true;  // set FTZ/DAZ on casting threads (city scenes)
+    bool ftz = true;    // set FTZ/DAZ on casting threads (city scenes)
+    bool city = false;  // a city scene (regions may be added)
+    bool flat = false;  // flat layout (no regions)
     RTCScene scene = nullptr;
-    std::vector<RTCScene> protoScenes;
     ErrorSink errors;
     glm::dvec3 origin{0.0};
+    glm::dvec3 buildOrigin{0.0};  // the origin the scene was built around
     size_t triangles = 0;
 
-    // Per top-level geometry id: what it is.
-    struct GeomInfo {
-        int mesh = -1;       // index into meshColors, or -1 for an instance
-        int prototype = -1;  // prototype index for an instance
-        int sceneMesh = -1;  // SceneModel::meshes index (city scenes)
-        int instance = -1;   // SceneModel::instances index (city scenes)
-        glm::mat3 normalMatrix{1.0f};
+    // A triangle geometry of the flat layout or of a region scene.
+    struct MeshInfo {
+        int sceneMesh = -1;  // index into the model's meshes (-1: soup)
+        std::vector<TriColors> colors;
     };
-    std::vector<GeomInfo> geoms;
-    std::vector<std::vector<TriColors>> meshColors, protoColors;  // per triangle (primID)
+    // One region: its scene and what it put into the top level.
+    struct Region {
+        bool live = false;
+        RTCScene scene = nullptr;  // null when the region has no tile mesh
+        unsigned topId = RTC_INVALID_GEOMETRY_ID;
+        std::vector<unsigned> treeIds;  // its tree instances in the top level
+        std::vector<MeshInfo> meshes;   // per geomID of `scene`
+        std::shared_ptr<PrototypeSet> protos;
+        glm::dvec3 origin{0.0};
+        size_t triangles = 0;
+    };
+    // Per top-level geometry id: what it is.
+    struct TopGeom {
+        enum class Kind { None, Mesh, Region, Tree } kind = Kind::None;
+        int index = -1;  // Mesh: flatMeshes; Region / Tree: regions (Tree: -1 in the flat layout)
+        int prototype = -1;
+        int instance = -1;  // Tree: index into the model's instances, or
+        int impostor = -1;  // into its impostors
+        const PrototypeSet* protos = nullptr;
+        glm::mat3 normalMatrix{1.0f};
+        glm::dmat4 transform{1.0};  // Tree: prototype frame -> world; Region: translation to its origin
+    };
+    std::vector<TopGeom> geoms;
+    std::vector<MeshInfo> flatMeshes;
+    std::shared_ptr<PrototypeSet> flatProtos;  // trees of the flat layout
+    std::vector<unsigned> flatTreeIds;
+    std::vector<Region> regions;
 
     ~Impl() {
+        for (Region& r : regions)
+            if (r.scene) rtcReleaseScene(r.scene);
         if (scene) rtcReleaseScene(scene);
-        for (RTCScene s : protoScenes)
-            if (s) rtcReleaseScene(s);
+        regions.clear();
+        flatProtos.reset();
         if (device) rtcReleaseDevice(device);
     }
 
@@ -143,6 +189,33 @@ struct RayScene::Impl {
         return Status::ok();
     }
 
+    TopGeom& top(unsigned id) {
+        if (geoms.size() <= id) geoms.resize(size_t(id) + 1);
+        return geoms[id];
+    }
+
+    // The mesh a hit of (geomID, instID) struck, or null for a tree.
+    const MeshInfo* meshOf(unsigned geomID, unsigned instID) const {
+        const unsigned t = instID != RTC_INVALID_GEOMETRY_ID ? instID : geomID;
+        if (t >= geoms.size()) return nullptr;
+        const TopGeom& g = geoms[t];
+        if (g.kind == TopGeom::Kind::Mesh) return &flatMeshes[size_t(g.index)];
+        if (g.kind == TopGeom::Kind::Region) {
+            const Region& r = regions[size_t(g.index)];
+            return geomID < r.meshes.size() ? &r.meshes[geomID] : nullptr;
+        }
+        return nullptr;
+    }
+    const std::vector<TriColors>* colorsOf(unsigned geomID, unsigned instID, const TopGeom** tree) const {
+        *tree = nullptr;
+        if (const MeshInfo* m = meshOf(geomID, instID)) return &m->colors;
+        if (instID == RTC_INVALID_GEOMETRY_ID || instID >= geoms.size()) return nullptr;
+        const TopGeom& g = geoms[instID];
+        if (g.kind != TopGeom::Kind::Tree) return nullptr;
+        *tree = &g;
+        return &g.protos->colors[size_t(g.prototype)];
+    }
+
     void fill(RayHit& h, unsigned geomID, unsigned primID, unsigned instID, float u, float v, float t, float nx,
               float ny, float nz) const {
         h.hit = true;
@@ -150,22 +223,26 @@ struct RayScene::Impl {
         h.u = u;
         h.v = v;
         h.primId = primID;
+        h.geomId = geomID;
+        h.instId = instID != RTC_INVALID_GEOMETRY_ID ? instID : 0xFFFFFFFFu;
         glm::vec3 n(nx, ny, nz);
-        if (instID != RTC_INVALID_GEOMETRY_ID) {
-            h.instId = instID;
-            h.geomId = geomID;
-            const GeomInfo& gi = geoms[instID];
-            h.color = interpolateColor(protoColors[size_t(gi.prototype)], primID, u, v);
-            n = gi.normalMatrix * n;
-        } else {
-            h.instId = 0xFFFFFFFFu;
-            h.geomId = geomID;
-            const GeomInfo& gi = geoms[geomID];
-            h.color = interpolateColor(meshColors[size_t(gi.mesh)], primID, u, v);
-        }
+        const TopGeom* tree = nullptr;
+        const std::vector<TriColors>* tris = colorsOf(geomID, instID, &tree);
+        h.color = tris ? interpolateColor(*tris, primID, u, v) : glm::u8vec4(255, 0, 255, 255);
+        if (tree) n = tree->normalMatrix * n;  // regions are translations: their normals are world normals
         float len = glm::length(n);
         h.normal = len > 0 ? n / len : glm::vec3(0, 0, 1);
     }
+
+    Status initCity(const glm::dvec3& cityOrigin);
+    Result<std::shared_ptr<PrototypeSet>> buildPrototypes(const SceneModel& model);
+    Status attachTrees(const SceneModel& model, const std::vector<uint32_t>& instances,
+                       const std::vector<uint32_t>& impostors, const std::shared_ptr<PrototypeSet>& protos, int region,
+                       std::vector<unsigned>* ids, size_t* tris);
+    Result<int> addRegionItems(const SceneModel& model, const std::vector<uint32_t>& meshes,
+                               const std::vector<uint32_t>& instances, const std::vector<uint32_t>& impostors,
+                               const std::shared_ptr<PrototypeSet>& protos);
+    void dropRegion(Region& r);
 };
 
 RayScene::RayScene() : _impl(new Impl) {}
@@ -230,91 +307,352 @@ RTCBuildQuality embreeQuality(RayBuildQuality q) {
 
 }  // namespace
 
-Result<std::unique_ptr<RayScene>> RayScene::build(const SceneModel& city) {
+namespace {
+
+Status malformedMesh(size_t mi) {
+    return Status::error("ray scene: mesh " + std::to_string(mi) +
+                         " is malformed (index out of range, "
+                         "index count not a multiple of 3 or colour count != vertex count)");
+}
+
+// Column-major 3x4 float matrix of `xf` with `shift` subtracted from its translation.
+void embreeTransform(const glm::dmat4& xf, const glm::dvec3& shift, float m[12]) {
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 3; ++r) m[c * 3 + r] = float(c == 3 ? xf[c][r] - shift[r] : xf[c][r]);
+}
+
+// World position of a region anchored at `anchor`: a whole number of metres
+// from the frame origin, so that the region's translation in the float top
+// level is exact (below 2^24 m).
+glm::dvec3 regionOrigin(const glm::dvec3& frame, const glm::dvec3& anchor) {
+    const glm::dvec3 d = anchor - frame;
+    return frame + glm::dvec3(std::round(d.x), std::round(d.y), std::round(d.z));
+}
+
+}  // namespace
+
+// A city scene's device and empty top-level scene, around `origin`.
+Status RayScene::Impl::initCity(const glm::dvec3& cityOrigin) {
     enableFtzDaz();
-    std::unique_ptr<RayScene> rs(new RayScene());
-    Impl& im = *rs->_impl;
-    im.origin = glm::dvec3(city.params.origin_x, city.params.origin_y, 0.0);
-    im.device = rtcNewDevice("");
-    if (!im.device) {
+    city = true;
+    origin = buildOrigin = cityOrigin;
+    device = rtcNewDevice("");
+    if (!device) {
         return Status::error(std::string("ray scene: cannot create Embree device (") +
                              embreeErrorName(rtcGetDeviceError(nullptr)) + ")");
     }
-    rtcSetDeviceErrorFunction(im.device, errorCallback, &im.errors);
-    im.scene = rtcNewScene(im.device);
-    rtcSetSceneFlags(im.scene, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(im.scene, RTC_BUILD_QUALITY_HIGH);
+    rtcSetDeviceErrorFunction(device, errorCallback, &errors);
+    scene = rtcNewScene(device);
+    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
+    return Status::ok();
+}
 
-    for (size_t mi = 0; mi < city.meshes.size(); ++mi) {
-        const SceneMesh& m = city.meshes[mi];
-        if (!validMesh(m))
-            return Status::error("ray scene: mesh " + std::to_string(mi) +
-                                 " is malformed (index out of range, "
-                                 "index count not a multiple of 3 or colour count != vertex count)");
-        unsigned id = 0;
-        if (!addTriangles(im.device, im.scene, m.positions, m.indices, m.origin - im.origin, true, &id)) {
-            VISTA_RETURN_IF_ERROR(im.checkDevice("building tile geometry"));
-            continue;
-        }
-        if (im.geoms.size() <= id) im.geoms.resize(id + 1);
-        im.geoms[id].mesh = int(im.meshColors.size());
-        im.geoms[id].sceneMesh = int(mi);
-        im.meshColors.push_back(triangleColors(m.colors, m.indices));
-        im.triangles += m.indices.size() / 3;
-    }
-
-    // Prototypes: one child scene each.
-    std::vector<size_t> protoTris(city.prototypes.size(), 0);
-    im.protoScenes.assign(city.prototypes.size(), nullptr);
-    for (size_t pi = 0; pi < city.prototypes.size(); ++pi) {
-        const SceneMesh& p = city.prototypes[pi];
+Result<std::shared_ptr<PrototypeSet>> RayScene::Impl::buildPrototypes(const SceneModel& model) {
+    auto set = std::make_shared<PrototypeSet>();
+    set->scenes.assign(model.prototypes.size(), nullptr);
+    set->triangles.assign(model.prototypes.size(), 0);
+    for (size_t pi = 0; pi < model.prototypes.size(); ++pi) {
+        const SceneMesh& p = model.prototypes[pi];
         if (!validMesh(p)) return Status::error("ray scene: tree prototype " + std::to_string(pi) + " is malformed");
-        im.protoColors.push_back(triangleColors(p.colors, p.indices));
+        set->colors.push_back(triangleColors(p.colors, p.indices));
         if (p.indices.empty()) continue;
-        RTCScene s = rtcNewScene(im.device);
+        RTCScene s = rtcNewScene(device);
         rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
         unsigned id = 0;
-        if (!addTriangles(im.device, s, p.positions, p.indices, p.origin, true, &id)) {
+        if (!addTriangles(device, s, p.positions, p.indices, p.origin, true, &id)) {
             rtcReleaseScene(s);
-            VISTA_RETURN_IF_ERROR(im.checkDevice("building prototype geometry"));
+            VISTA_RETURN_IF_ERROR(checkDevice("building prototype geometry"));
             continue;
         }
         rtcCommitScene(s);
-        im.protoScenes[pi] = s;
-        protoTris[pi] = p.indices.size() / 3;
+        set->scenes[pi] = s;
+        set->triangles[pi] = p.indices.size() / 3;
     }
-    VISTA_RETURN_IF_ERROR(im.checkDevice("building tree prototypes"));
+    VISTA_RETURN_IF_ERROR(checkDevice("building tree prototypes"));
+    return set;
+}
 
-    for (size_t ii = 0; ii < city.instances.size(); ++ii) {
-        const SceneInstance& inst = city.instances[ii];
-        if (inst.prototype >= city.prototypes.size())
-            return Status::error("ray scene: instance " + std::to_string(ii) + " refers to prototype " +
-                                 std::to_string(inst.prototype) + " (have " + std::to_string(city.prototypes.size()) +
-                                 ")");
-        RTCScene child = im.protoScenes[inst.prototype];
-        if (!child) continue;
-        glm::dmat4 xf = inst.transform;
-        xf[3] -= glm::dvec4(im.origin, 0.0);  // scene-local translation
-        float m[12];
-        for (int c = 0; c < 4; ++c)
-            for (int r = 0; r < 3; ++r) m[c * 3 + r] = float(xf[c][r]);
-        RTCGeometry g = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_INSTANCE);
-        rtcSetGeometryInstancedScene(g, child);
+// Attaches the trees (model.instances[instances], model.impostors[impostors])
+// to the top level; their ids go to `ids`.
+Status RayScene::Impl::attachTrees(const SceneModel& model, const std::vector<uint32_t>& instances,
+                                   const std::vector<uint32_t>& impostors, const std::shared_ptr<PrototypeSet>& protos,
+                                   int region, std::vector<unsigned>* ids, size_t* tris) {
+    for (int pass = 0; pass < 2; ++pass) {
+        const std::vector<uint32_t>& list = pass == 0 ? instances : impostors;
+        const std::vector<SceneInstance>& all = pass == 0 ? model.instances : model.impostors;
+        for (uint32_t ii : list) {
+            const SceneInstance& inst = all[ii];
+            if (inst.prototype >= model.prototypes.size())
+                return Status::error(std::string("ray scene: ") + (pass == 0 ? "instance " : "impostor ") +
+                                     std::to_string(ii) + " refers to prototype " + std::to_string(inst.prototype) +
+                                     " (have " + std::to_string(model.prototypes.size()) + ")");
+            RTCScene child = protos->scenes[inst.prototype];
+            if (!child) continue;
+            float m[12];
+            embreeTransform(inst.transform, origin, m);
+            RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+            rtcSetGeometryInstancedScene(g, child);
+            rtcSetGeometryTimeStepCount(g, 1);
+            rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, m);
+            rtcCommitGeometry(g);
+            const unsigned id = rtcAttachGeometry(scene, g);
+            rtcReleaseGeometry(g);
+            TopGeom& tg = top(id);
+            tg = TopGeom();
+            tg.kind = TopGeom::Kind::Tree;
+            tg.index = region;
+            tg.prototype = int(inst.prototype);
+            (pass == 0 ? tg.instance : tg.impostor) = int(ii);
+            tg.protos = protos.get();
+            tg.transform = inst.transform;
+            const glm::mat3 lin(glm::dmat3(inst.transform));
+            tg.normalMatrix = glm::transpose(glm::inverse(lin));
+            ids->push_back(id);
+            *tris += protos->triangles[inst.prototype];
+        }
+    }
+    return Status::ok();
+}
+
+void RayScene::Impl::dropRegion(Region& r) {
+    if (r.topId != RTC_INVALID_GEOMETRY_ID) {
+        rtcDetachGeometry(scene, r.topId);
+        geoms[r.topId] = TopGeom();
+    }
+    for (unsigned id : r.treeIds) {
+        rtcDetachGeometry(scene, id);
+        geoms[id] = TopGeom();
+    }
+    if (r.scene) rtcReleaseScene(r.scene);
+    triangles -= r.triangles;
+    r = Region();
+}
+
+Result<int> RayScene::Impl::addRegionItems(const SceneModel& model, const std::vector<uint32_t>& meshes,
+                                           const std::vector<uint32_t>& instances,
+                                           const std::vector<uint32_t>& impostors,
+                                           const std::shared_ptr<PrototypeSet>& protos) {
+    const int id = int(regions.size());
+    regions.emplace_back();
+    Region r;
+    r.live = true;
+    r.protos = protos;
+    // Anchor: the first mesh's origin (else the first tree's position).
+    glm::dvec3 anchor = origin;
+    if (!meshes.empty()) anchor = model.meshes[meshes[0]].origin;
+    else if (!instances.empty()) anchor = glm::dvec3(model.instances[instances[0]].transform[3]);
+    else if (!impostors.empty()) anchor = glm::dvec3(model.impostors[impostors[0]].transform[3]);
+    r.origin = regionOrigin(origin, anchor);
+    auto fail = [&](Status st) -> Result<int> {
+        r.triangles = 0;  // not yet counted in the scene's total
+        regions[size_t(id)] = std::move(r);
+        dropRegion(regions[size_t(id)]);
+        return st;
+    };
+    for (uint32_t mi : meshes) {
+        const SceneMesh& m = model.meshes[mi];
+        if (!validMesh(m)) return fail(malformedMesh(mi));
+        if (!r.scene) {
+            r.scene = rtcNewScene(device);
+            rtcSetSceneFlags(r.scene, RTC_SCENE_FLAG_ROBUST);
+            rtcSetSceneBuildQuality(r.scene, RTC_BUILD_QUALITY_HIGH);
+        }
+        unsigned gid = 0;
+        if (!addTriangles(device, r.scene, m.positions, m.indices, m.origin - r.origin, true, &gid)) {
+            Status st = checkDevice("building tile geometry");
+            if (!st.isOk()) return fail(st);
+            continue;
+        }
+        if (r.meshes.size() <= gid) r.meshes.resize(size_t(gid) + 1);
+        r.meshes[gid].sceneMesh = int(mi);
+        r.meshes[gid].colors = triangleColors(m.colors, m.indices);
+        r.triangles += m.indices.size() / 3;
+    }
+    if (r.scene) {
+        rtcCommitScene(r.scene);
+        Status st = checkDevice("committing a region");
+        if (!st.isOk()) return fail(st);
+        const glm::dvec3 t = r.origin - origin;  // whole metres: exact in float
+        const float m[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, float(t.x), float(t.y), float(t.z)};
+        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+        rtcSetGeometryInstancedScene(g, r.scene);
         rtcSetGeometryTimeStepCount(g, 1);
         rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, m);
         rtcCommitGeometry(g);
-        unsigned id = rtcAttachGeometry(im.scene, g);
+        r.topId = rtcAttachGeometry(scene, g);
         rtcReleaseGeometry(g);
-        if (im.geoms.size() <= id) im.geoms.resize(id + 1);
-        im.geoms[id].prototype = int(inst.prototype);
-        im.geoms[id].instance = int(ii);
-        glm::mat3 lin(glm::dmat3(inst.transform));
-        im.geoms[id].normalMatrix = glm::transpose(glm::inverse(lin));
-        im.triangles += protoTris[inst.prototype];
+        TopGeom& tg = top(r.topId);
+        tg = TopGeom();
+        tg.kind = TopGeom::Kind::Region;
+        tg.index = id;
+        tg.transform = glm::translate(glm::dmat4(1.0), r.origin);
+    }
+    size_t treeTris = 0;
+    Status st = attachTrees(model, instances, impostors, protos, id, &r.treeIds, &treeTris);
+    r.triangles += treeTris;
+    if (!st.isOk()) return fail(st);
+    st = checkDevice("adding a region");
+    if (!st.isOk()) return fail(st);
+    triangles += r.triangles;
+    regions[size_t(id)] = std::move(r);
+    return id;
+}
+
+Result<std::unique_ptr<RayScene>> RayScene::build(const SceneModel& city, const RaySceneOptions& options) {
+    std::unique_ptr<RayScene> rs(new RayScene());
+    Impl& im = *rs->_impl;
+    VISTA_RETURN_IF_ERROR(im.initCity(glm::dvec3(city.params.origin_x, city.params.origin_y, 0.0)));
+    for (size_t mi = 0; mi < city.meshes.size(); ++mi)
+        if (!validMesh(city.meshes[mi])) return malformedMesh(mi);
+    auto protos = im.buildPrototypes(city);
+    if (!protos) return protos.status();
+    // Impostors (coarse levels) are traced as their prototype's mesh where the model has it.
+    std::vector<uint32_t> impostors;
+    for (size_t k = 0; k < city.impostors.size(); ++k)
+        if (city.impostors[k].prototype < city.prototypes.size()) impostors.push_back(uint32_t(k));
+
+    if (!(options.regionSizeM > 0)) {
+        im.flat = true;
+        for (size_t mi = 0; mi < city.meshes.size(); ++mi) {
+            const SceneMesh& m = city.meshes[mi];
+            unsigned id = 0;
+            if (!addTriangles(im.device, im.scene, m.positions, m.indices, m.origin - im.origin, true, &id)) {
+                VISTA_RETURN_IF_ERROR(im.checkDevice("building tile geometry"));
+                continue;
+            }
+            Impl::TopGeom& tg = im.top(id);
+            tg.kind = Impl::TopGeom::Kind::Mesh;
+            tg.index = int(im.flatMeshes.size());
+            im.flatMeshes.push_back({int(mi), triangleColors(m.colors, m.indices)});
+            im.triangles += m.indices.size() / 3;
+        }
+        std::vector<uint32_t> all(city.instances.size());
+        for (size_t k = 0; k < all.size(); ++k) all[k] = uint32_t(k);
+        im.flatProtos = *protos;
+        VISTA_RETURN_IF_ERROR(im.attachTrees(city, all, impostors, im.flatProtos, -1, &im.flatTreeIds, &im.triangles));
+    } else {
+        // Regions: meshes by their origin, trees by their position, on a grid of
+        // regionSizeM around the frame origin.
+        struct Items {
+            std::vector<uint32_t> meshes, instances, impostors;
+        };
+        std::map<std::pair<int64_t, int64_t>, Items> cells;
+        auto cellOf = [&](const glm::dvec3& p) {
+            const double s = options.regionSizeM;
+            return std::make_pair(int64_t(std::floor((p.x - im.origin.x) / s)),
+                                  int64_t(std::floor((p.y - im.origin.y) / s)));
+        };
+        for (size_t mi = 0; mi < city.meshes.size(); ++mi) {
+            const SceneMesh& m = city.meshes[mi];
+            cells[cellOf(m.origin)].meshes.push_back(uint32_t(mi));  // a tile's meshes share its origin
+        }
+        for (size_t k = 0; k < city.instances.size(); ++k)
+            cells[cellOf(glm::dvec3(city.instances[k].transform[3]))].instances.push_back(uint32_t(k));
+        for (uint32_t k : impostors) cells[cellOf(glm::dvec3(city.impostors[k].transform[3]))].impostors.push_back(k);
+        for (const auto& [key, items] : cells) {
+            auto id = im.addRegionItems(city, items.meshes, items.instances, items.impostors, *protos);
+            if (!id) return id.status();
+        }
     }
     rtcCommitScene(im.scene);
     VISTA_RETURN_IF_ERROR(im.checkDevice("committing the scene"));
     return rs;
+}
+
+Result<std::unique_ptr<RayScene>> RayScene::empty(const glm::dvec3& frameOrigin) {
+    std::unique_ptr<RayScene> rs(new RayScene());
+    VISTA_RETURN_IF_ERROR(rs->_impl->initCity(frameOrigin));
+    rtcCommitScene(rs->_impl->scene);
+    VISTA_RETURN_IF_ERROR(rs->_impl->checkDevice("committing the scene"));
+    return rs;
+}
+
+Result<int> RayScene::addRegion(const SceneModel& model, const std::vector<uint32_t>& tiles) {
+    Impl& im = *_impl;
+    if (!im.city || im.flat) return Status::error("ray scene: regions can be added to a city scene of regions only");
+    std::vector<uint32_t> meshes, instances, impostors;
+    for (uint32_t t : tiles) {
+        if (t >= model.tiles.size())
+            return Status::error("ray scene: tile " + std::to_string(t) + " out of range (the model has " +
+                                 std::to_string(model.tiles.size()) + " tiles)");
+        const SceneTile& tile = model.tiles[t];
+        for (uint32_t m : tile.meshes) {
+            if (m >= model.meshes.size())
+                return Status::error("ray scene: tile " + std::to_string(t) + " lists mesh " + std::to_string(m) +
+                                     " (the model has " + std::to_string(model.meshes.size()) + ")");
+            meshes.push_back(m);
+        }
+        for (uint32_t i : tile.instances) {
+            if (i >= model.instances.size())
+                return Status::error("ray scene: tile " + std::to_string(t) + " lists instance " + std::to_string(i) +
+                                     " (the model has " + std::to_string(model.instances.size()) + ")");
+            instances.push_back(i);
+        }
+    }
+    // Impostors belong to no tile: those within the tiles' xy bounds come with them.
+    for (size_t k = 0; k < model.impostors.size(); ++k) {
+        const glm::dvec3 p(model.impostors[k].transform[3]);
+        if (model.impostors[k].prototype >= model.prototypes.size()) continue;
+        for (uint32_t t : tiles) {
+            const SceneTile& tile = model.tiles[t];
+            if (p.x >= tile.lo.x && p.x <= tile.hi.x && p.y >= tile.lo.y && p.y <= tile.hi.y) {
+                impostors.push_back(uint32_t(k));
+                break;
+            }
+        }
+    }
+    auto protos = im.buildPrototypes(model);
+    if (!protos) return protos.status();
+    return im.addRegionItems(model, meshes, instances, impostors, *protos);
+}
+
+Status RayScene::removeRegion(int region) {
+    Impl& im = *_impl;
+    if (region < 0 || size_t(region) >= im.regions.size() || !im.regions[size_t(region)].live)
+        return Status::error("ray scene: no region " + std::to_string(region) + " to remove");
+    im.dropRegion(im.regions[size_t(region)]);
+    return Status::ok();
+}
+
+Status RayScene::commit() {
+    rtcCommitScene(_impl->scene);
+    return _impl->checkDevice("committing the scene");
+}
+
+Status RayScene::setFrameOrigin(const glm::dvec3& frameOrigin) {
+    Impl& im = *_impl;
+    if (!im.city || im.flat) return Status::error("ray scene: only a city scene of regions can move its frame");
+    // Whole metres from the current frame, as every region origin: translations stay exact.
+    const glm::dvec3 d = frameOrigin - im.origin;
+    const glm::dvec3 next = im.origin + glm::dvec3(std::round(d.x), std::round(d.y), std::round(d.z));
+    if (next == im.origin) return Status::ok();
+    im.origin = next;
+    for (size_t id = 0; id < im.geoms.size(); ++id) {
+        const Impl::TopGeom& g = im.geoms[id];
+        if (g.kind != Impl::TopGeom::Kind::Region && g.kind != Impl::TopGeom::Kind::Tree) continue;
+        RTCGeometry geom = rtcGetGeometry(im.scene, unsigned(id));
+        float m[12];
+        embreeTransform(g.transform, im.origin, m);
+        rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, m);
+        rtcCommitGeometry(geom);
+    }
+    rtcCommitScene(im.scene);
+    return im.checkDevice("moving the frame origin");
+}
+
+Status RayScene::placeFrameNear(const glm::dvec3& eye) {
+    Impl& im = *_impl;
+    if (!im.city || im.flat) return Status::ok();
+    const glm::dvec3 d = (eye - im.buildOrigin) / kFrameCellM;
+    const glm::dvec3 cell = im.buildOrigin + kFrameCellM * glm::dvec3(std::round(d.x), std::round(d.y), 0.0);
+    return setFrameOrigin(glm::dvec3(cell.x, cell.y, im.buildOrigin.z));
+}
+
+int RayScene::regionCount() const {
+    int n = 0;
+    for (const auto& r : _impl->regions) n += r.live ? 1 : 0;
+    return n;
 }
 
 Result<std::unique_ptr<RayScene>> RayScene::build(const TriangleSoup& soup, const SoupSceneOptions& options) {
@@ -334,6 +672,7 @@ Result<std::unique_ptr<RayScene>> RayScene::build(const TriangleSoup& soup, cons
     std::unique_ptr<RayScene> rs(new RayScene());
     Impl& im = *rs->_impl;
     im.ftz = false;
+    im.flat = true;
     im.origin = options.frameOrigin;
     RTCDevice device = sharedSoupDevice();
     if (!device) return Status::error("ray scene: cannot create the Embree device for soups");
@@ -346,9 +685,10 @@ Result<std::unique_ptr<RayScene>> RayScene::build(const TriangleSoup& soup, cons
         if (!addTriangles(device, im.scene, soup.positions, soup.indices, glm::dvec3(0.0), options.cullBackFaces, &id))
             return Status::error("ray scene: Embree buffer allocation failed for a soup of " +
                                  std::to_string(soup.triangleCount()) + " triangles");
-        if (im.geoms.size() <= id) im.geoms.resize(id + 1);
-        im.geoms[id].mesh = 0;
-        im.meshColors.push_back(triangleColors(soup.colors, soup.indices));
+        Impl::TopGeom& tg = im.top(id);
+        tg.kind = Impl::TopGeom::Kind::Mesh;
+        tg.index = 0;
+        im.flatMeshes.push_back({-1, triangleColors(soup.colors, soup.indices)});
         im.triangles = soup.triangleCount();
     }
     rtcCommitScene(im.scene);
@@ -363,12 +703,19 @@ glm::dvec3 RayScene::frameOrigin() const { return _impl->origin; }
 HitSource RayScene::source(const RayHit& h) const {
     HitSource s;
     if (!h.hit) return s;
-    const bool inst = h.instId != 0xFFFFFFFFu;
-    const uint32_t g = inst ? h.instId : h.geomId;
-    if (g >= _impl->geoms.size()) return s;
-    const Impl::GeomInfo& gi = _impl->geoms[g];
-    if (inst) s.instance = gi.instance;
-    else s.mesh = gi.sceneMesh;
+    const Impl& im = *_impl;
+    const unsigned instId = h.instId != 0xFFFFFFFFu ? h.instId : RTC_INVALID_GEOMETRY_ID;
+    if (const Impl::MeshInfo* m = im.meshOf(h.geomId, instId)) {
+        s.mesh = m->sceneMesh;
+        if (instId != RTC_INVALID_GEOMETRY_ID) s.region = im.geoms[instId].index;
+        return s;
+    }
+    if (instId == RTC_INVALID_GEOMETRY_ID || instId >= im.geoms.size()) return s;
+    const Impl::TopGeom& g = im.geoms[instId];
+    if (g.kind != Impl::TopGeom::Kind::Tree) return s;
+    s.instance = g.instance;
+    s.impostor = g.impostor;
+    s.region = g.index;
     return s;
 }
 
@@ -515,11 +862,10 @@ void RayScene::allHitsMany(const glm::vec3* org, const glm::vec3* dir, int n, co
 
 glm::vec3 RayScene::hitColor(const RayHit& h) const {
     if (!h.hit) return glm::vec3(0.0f);
-    const bool inst = h.instId != 0xFFFFFFFFu;
-    const Impl::GeomInfo& gi = _impl->geoms[inst ? h.instId : h.geomId];
-    const auto& tris = inst ? _impl->protoColors[size_t(gi.prototype)] : _impl->meshColors[size_t(gi.mesh)];
-    if (h.primId >= tris.size()) return {1.0f, 0.0f, 1.0f};  // cannot happen for a hit of this scene
-    const TriColors& t = tris[h.primId];
+    const Impl::TopGeom* tree = nullptr;
+    const auto* tris = _impl->colorsOf(h.geomId, h.instId != 0xFFFFFFFFu ? h.instId : RTC_INVALID_GEOMETRY_ID, &tree);
+    if (!tris || h.primId >= tris->size()) return {1.0f, 0.0f, 1.0f};  // cannot happen for a hit of this scene
+    const TriColors& t = (*tris)[h.primId];
     const glm::vec3 c0 = glm::vec3(t.c[0]) / 255.0f, c1 = glm::vec3(t.c[1]) / 255.0f, c2 = glm::vec3(t.c[2]) / 255.0f;
     return (1.0f - h.u - h.v) * c0 + h.u * c1 + h.v * c2;
 }

@@ -2,14 +2,29 @@
 // hybrid far field) or of a triangle soup (the bake's far field of one
 // impostor, in the impostor's float frame).
 //
-// Contract: a city scene is built once from a SceneModel (tile meshes as triangle geometry,
-// tree prototypes as instanced geometry); immutable afterwards, so every
-// method is thread-safe. Coordinates: world double positions are converted
-// to a scene-local float frame around `frameOrigin()` (the city centre), so
-// precision holds 1,000 km from the world origin. Hits return the
-// interpolated prelit vertex colour: the same colour the rasteriser shows.
-// Back faces (triangles clockwise as seen along the ray) are culled, as the
-// rasteriser culls them (CullFace BACK on the city root).
+// Contract: a city scene is built from a SceneModel. Coordinates: world
+// double positions are given to the queries in a scene-local float frame
+// around `frameOrigin()` (the city centre). Layout (RaySceneOptions):
+//  - regions (default): the city's tile meshes are grouped into square
+//    regions of `regionSizeM` (by mesh origin); each region is its own Embree
+//    scene with its vertices relative to the region's origin (a whole number
+//    of metres from frameOrigin, so the instance's translation is exact in
+//    float), instanced into a top-level scene by a translation. Trees are
+//    instances of prototype scenes in the top-level scene. Vertex precision is
+//    then that of a region's extent (0.1 mm for 2 km), wherever the region
+//    lies; ray origins are floats around frameOrigin (half a float step of
+//    |eye - frameOrigin|: 1 mm at 16 km), so callers that move far keep the
+//    frame near the camera with placeFrameNear().
+//  - flat (`regionSizeM` = 0): every tile mesh is one triangle geometry of one
+//    scene, its vertices relative to frameOrigin.
+// Regions can be added and removed after the build (addRegion, removeRegion,
+// then commit: a commit of the top-level scene, the other regions' BVHs are
+// kept). Queries are const and thread-safe among themselves; addRegion,
+// removeRegion and commit must not run while another thread queries or
+// changes the scene (a pager swaps regions between frames).
+// Hits return the interpolated prelit vertex colour: the same colour the
+// rasteriser shows. Back faces (triangles clockwise as seen along the ray)
+// are culled, as the rasteriser culls them (CullFace BACK on the city root).
 // Embree errors are mapped to Status at construction; nothing throws from a
 // ray-casting loop. FTZ/DAZ are set on every thread that casts.
 // Soup scenes (build(TriangleSoup, SoupSceneOptions)): the soup's positions
@@ -53,9 +68,16 @@ struct TriangleSoup {
 // What a hit of a city scene struck: the SceneModel mesh index (tile
 // meshes) or the instance index (trees), the other -1; both -1 for a miss or
 // a soup scene. primId of the hit indexes the mesh's / prototype's triangles.
+// impostor: a tree of a coarse level (SceneModel::impostors), traced as its
+// prototype's mesh; then mesh and instance are -1. region: the region the hit
+// lies in (the index build() gave it or the id addRegion() returned; -1 for
+// flat and soup scenes); mesh, instance and impostor index the SceneModel that
+// region was made from (build(): the city).
 struct HitSource {
     int mesh = -1;
     int instance = -1;
+    int impostor = -1;
+    int region = -1;
 };
 
 enum class RayBuildQuality { Low, Medium, High };
@@ -66,9 +88,19 @@ struct SoupSceneOptions {
     glm::dvec3 frameOrigin{0.0};  // reported by frameOrigin(); not applied to the positions
 };
 
+// Grid of the frame origins placeFrameNear() chooses, metres.
+constexpr double kFrameCellM = 1000.0;
+
+// How a city scene is laid out (see the contract above).
+struct RaySceneOptions {
+    double regionSizeM = 2000.0;  // side of a region, metres; 0: one flat scene
+};
+
 class RayScene {
 public:
-    static Result<std::unique_ptr<RayScene>> build(const SceneModel& city);
+    static Result<std::unique_ptr<RayScene>> build(const SceneModel& city, const RaySceneOptions& options = {});
+    // A city scene without geometry (frame origin given), for regions added later.
+    static Result<std::unique_ptr<RayScene>> empty(const glm::dvec3& frameOrigin);
     static Result<std::unique_ptr<RayScene>> build(const TriangleSoup& soup, const SoupSceneOptions& options = {});
     ~RayScene();
     glm::dvec3 frameOrigin() const;  // world position of the scene-local origin
@@ -101,6 +133,37 @@ public:
     // The SceneModel entity a hit struck (ground-truth labels).
     HitSource source(const RayHit& h) const;
     size_t triangleCount() const;  // rendered triangles (instances expanded)
+
+    // Adds the tiles `tiles` (indices into model.tiles) of `model` as one
+    // region: their meshes in a new Embree scene (region-local vertices,
+    // origin: the first mesh's origin rounded to whole metres from
+    // frameOrigin) instanced into the top-level scene, and their trees
+    // (model.instances, and model.impostors drawn as their prototype meshes
+    // when the model has them) as instances of the model's prototypes. The
+    // model is not kept. Returns the region's id (>= 0, never reused). Seen
+    // by queries after commit(). Errors: a tile index out of range, a
+    // malformed mesh, an instance of a missing prototype, an Embree error;
+    // the scene is then unchanged. Not for flat or soup scenes.
+    Result<int> addRegion(const SceneModel& model, const std::vector<uint32_t>& tiles);
+    // Detaches a region (its instance and its trees): seen after commit().
+    // Errors: no live region with that id.
+    Status removeRegion(int region);
+    // Commits the top-level scene (only its instance BVH is rebuilt).
+    Status commit();
+    int regionCount() const;  // live regions
+    // Moves the scene-local frame (regions layout): frameOrigin() becomes
+    // `frameOrigin` rounded to whole metres from the current one, every
+    // top-level instance is re-placed and the top level committed (no region
+    // BVH is rebuilt). Keeping it near the camera keeps float ray origins
+    // exact to a few micrometres. Not while another thread queries.
+    // Errors: a flat or soup scene.
+    Status setFrameOrigin(const glm::dvec3& frameOrigin);
+    // setFrameOrigin() to the point of a kFrameCellM grid (around the origin
+    // the scene was built with, in x and y) nearest `eye`: a function of the
+    // eye alone, so a frame's rays do not depend on the frames before it.
+    // Within 710 m of the eye the float step of a ray origin is 61 um at
+    // most. No-op for flat and soup scenes. Not while another thread queries.
+    Status placeFrameNear(const glm::dvec3& eye);
     // The committed Embree scene (RTCScene), for timing raw Embree on the same
     // BVH (tests/bench/bench_raw_rays.cpp). Read-only queries only; owned
     // here (never release or modify it); the caller sets FTZ/DAZ itself.

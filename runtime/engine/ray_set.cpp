@@ -9,6 +9,7 @@
 
 #include "foundation/atomic_file.h"
 #include "foundation/hash.h"
+#include "foundation/input_file.h"
 #include "foundation/units.h"
 
 namespace vista {
@@ -167,11 +168,9 @@ Result<RaySet> decodeRaySet(const std::string& bytes, const std::string& what) {
 Status writeRaySet(const std::string& path, const RaySet& s) { return writeFileAtomic(path, encodeRaySet(s)); }
 
 Result<RaySet> readRaySet(const std::string& path) {
-    std::ifstream f(path, std::ios::binary);
-    if (!f) return Status::error("cannot read ray set '" + path + "': " + errnoText());
-    const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-    if (f.bad()) return Status::error("cannot read ray set '" + path + "': " + errnoText());
-    return decodeRaySet(bytes, "'" + path + "'");
+    auto bytes = readInputFile("ray set", path, kMaxRaySetBytes);
+    if (!bytes) return bytes.status();
+    return decodeRaySet(*bytes, "'" + path + "'");
 }
 
 }  // namespace vista

@@ -94,6 +94,25 @@ void appendLE32(std::string& s, uint32_t v) {
     for (int i = 0; i < 4; ++i) s.push_back(char((v >> (8 * i)) & 0xFF));
 }
 
+// Effects glTF can say: glass windows as a smooth dielectric material (a
+// viewer with environment lighting reflects in them), street-light lamps as
+// emissive. Haze, shadows and occlusion are in the colours or in
+// asset.extras.vista.params.effects. No material without those effects; -1
+// for a material not made.
+void effectMaterials(const Effects& effects, nlohmann::ordered_json& materials, long& glass, long& lamp) {
+    if (effects.glass) {
+        materials.push_back(
+            {{"name", "vista.glass"},
+             {"pbrMetallicRoughness",
+              {{"baseColorFactor", {1.0, 1.0, 1.0, 1.0}}, {"metallicFactor", 0.0}, {"roughnessFactor", 0.05}}}});
+        glass = long(materials.size() - 1);
+    }
+    if (effects.night) {
+        materials.push_back({{"name", "vista.lamp"}, {"emissiveFactor", {1.0, 0.95, 0.85}}});
+        lamp = long(materials.size() - 1);
+    }
+}
+
 }  // namespace
 
 Status writeGltf(const City& city, const std::string& path) {
@@ -120,23 +139,9 @@ Status writeGltf(const City& city, const std::string& path) {
         protoMesh[i] = long(meshes.size() - 1);
     }
 
-    // Effects glTF can say: glass windows as a smooth dielectric material (a
-    // viewer with environment lighting reflects in them), street-light lamps
-    // as emissive. Haze, shadows and occlusion are in the colours or in
-    // asset.extras.vista.params.effects. No material without those effects.
     nlohmann::ordered_json materials = nlohmann::ordered_json::array();
     long glassMaterial = -1, lampMaterial = -1;
-    if (city.params.effects.glass) {
-        materials.push_back(
-            {{"name", "vista.glass"},
-             {"pbrMetallicRoughness",
-              {{"baseColorFactor", {1.0, 1.0, 1.0, 1.0}}, {"metallicFactor", 0.0}, {"roughnessFactor", 0.05}}}});
-        glassMaterial = long(materials.size() - 1);
-    }
-    if (city.params.effects.night) {
-        materials.push_back({{"name", "vista.lamp"}, {"emissiveFactor", {1.0, 0.95, 0.85}}});
-        lampMaterial = long(materials.size() - 1);
-    }
+    effectMaterials(city.params.effects, materials, glassMaterial, lampMaterial);
 
     for (const Tile& tile : city.tiles) {
         const std::string tname = "tile_" + std::to_string(tile.ix) + "_" + std::to_string(tile.iy);

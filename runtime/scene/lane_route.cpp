@@ -95,9 +95,10 @@ bool projectOnLinkRoad(const LinkRoad& r, const glm::dvec2& p, double& s, double
     return found;
 }
 
-Result<LaneRoute> LaneRoute::create(const LaneModel& model, uint64_t seed, bool leftHandTraffic) {
+Result<LaneRoute> LaneRoute::create(const LaneModel& model, uint64_t seed, bool leftHandTraffic, RouteStyle style) {
     LaneRoute route(model, seed);
     route.buildGraph(leftHandTraffic);
+    if (style == RouteStyle::Tour) route.makeTour();
     std::vector<uint32_t> starts;
     for (size_t i = 0; i < route._nodes.size(); ++i)
         if (!route._nodes[i].link && !route._nodes[i].next.empty()) starts.push_back(uint32_t(i));
@@ -274,9 +275,26 @@ void LaneRoute::keepLargestStronglyConnected() {
 
 bool LaneRoute::deadEnd(uint32_t node) const { return _uturn[node] != 0; }
 
+void LaneRoute::makeTour() {
+    std::vector<glm::dvec2> pos(_nodes.size());
+    std::vector<std::vector<Tour::Arc>> arcs(_nodes.size());
+    for (size_t u = 0; u < _nodes.size(); ++u) {
+        const Node& n = _nodes[u];
+        const double len = n.link ? _m.links[n.index].length() : _m.edges[n.index].length;
+        pos[u] = n.link ? _m.links[n.index].point(0.5 * len) : 0.5 * (_m.edges[n.index].start + _m.edges[n.index].end);
+        for (uint32_t v : n.next) arcs[u].push_back({v, len});
+    }
+    _tour = std::make_shared<Tour>(std::move(pos), std::move(arcs));
+}
+
 uint32_t LaneRoute::pick(uint32_t u) {
     const std::vector<uint32_t>& cand = _nodes[u].next;
     VISTA_CHECK(!cand.empty());
+    if (_tour) {  // every lane, so that the tour sees each goal it reaches
+        std::vector<size_t> all(cand.size());
+        for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+        return cand[_tour->step(u, all, _rng)];
+    }
     if (cand.size() == 1) return cand[0];
     std::vector<double> weight;
     double total = 0;

@@ -28,10 +28,14 @@
 //   successor. Only the largest strongly connected part of the lane graph
 //   is driven, so the walk never enters a lane it cannot leave (a lane that
 //   ends in a taper, a one-way dead end, a dead end too short to turn in).
-// - Walk: Rng(seed, 0, Stream::Paths). The route starts at the beginning of a
-//   random street lane of that part. At the end of each lane a successor is
-//   drawn with weight 3 when its link road turns less than 0.5 rad, else 1,
-//   times 0.05 when the street lane after it is a dead end.
+// - Choice of lanes: Rng(seed, 0, Stream::Paths). The route starts at the
+//   beginning of a random street lane of that part. Tour (the default): at
+//   the end of each lane it takes the successor on the shortest path to a
+//   goal lane, goals drawn far from where the route has been (tour.h; a
+//   lane's position is its road's midpoint, an arc's cost the lane's length).
+//   Wander: a successor is drawn with weight 3 when its link road turns less
+//   than 0.5 rad, else 1, times 0.05 when the street lane after it is a dead
+//   end.
 // - Centre line: a polyline through the centres of the route's lanes
 //   (laneOffset + the inner lanes' widths + half the lane's width), vertices
 //   at most 1 m apart on street roads and 0.25 m on link roads and U-turns
@@ -43,6 +47,7 @@
 // Deterministic; not thread-safe (extends itself); the LaneModel must outlive it.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -51,8 +56,13 @@
 #include "citygen/lanes.h"
 #include "foundation/rng.h"
 #include "foundation/status.h"
+#include "runtime/scene/tour.h"
 
 namespace vista {
+
+// How a route chooses its turns: toward far goals (a drive that keeps going)
+// or by a seeded random walk that prefers going straight on.
+enum class RouteStyle { Tour, Wander };
 
 constexpr double kUTurnMargin = 0.5;  // metres between a U-turn's apex and the road end
 
@@ -85,7 +95,8 @@ class LaneRoute {
 public:
     // Errors: no lane of the model can be driven in a loop (no valid edge,
     // only one-way dead ends).
-    static Result<LaneRoute> create(const LaneModel& model, uint64_t seed, bool leftHandTraffic);
+    static Result<LaneRoute> create(const LaneModel& model, uint64_t seed, bool leftHandTraffic,
+                                    RouteStyle style = RouteStyle::Tour);
 
     // Extends the centre line to at least arc length s.
     void ensure(double s);
@@ -101,6 +112,8 @@ public:
     // the neighbouring piece's when p lies beyond the road's end; on a
     // U-turn, the lane of the street road that holds p.
     LanePosition position(const glm::dvec2& p, size_t seg) const;
+    // Goals the tour has drawn so far (0 for a wander).
+    size_t legs() const { return _tour ? _tour->legs() : 0; }
 
 private:
     struct Node {
@@ -119,6 +132,7 @@ private:
     LaneRoute(const LaneModel& m, uint64_t seed) : _m(m), _rng(seed, 0, Stream::Paths) {}
     void buildGraph(bool lht);
     void keepLargestStronglyConnected();
+    void makeTour();
     uint32_t pick(uint32_t node);
     bool deadEnd(uint32_t node) const;
     double laneStart(const Node& n) const;
@@ -139,6 +153,7 @@ private:
     std::vector<glm::dvec2> _pts;
     std::vector<double> _cum, _segHeading, _curv;
     std::vector<uint32_t> _segPiece;  // per segment: the piece it belongs to
+    std::shared_ptr<Tour> _tour;      // RouteStyle::Tour (shared: a LaneRoute is returned by value)
 };
 
 }  // namespace vista

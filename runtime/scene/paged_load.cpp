@@ -9,10 +9,13 @@
 #include <sstream>
 #include <utility>
 
+#include <unistd.h>
+
 #include <nlohmann/json.hpp>
 #include <osg/Group>
 
 #include "citygen/streets.h"
+#include "foundation/input_file.h"
 #include "runtime/scene/city_file.h"
 #include "runtime/scene/scene_graph.h"
 
@@ -44,13 +47,12 @@ Status validatePagedRadius(const std::string& option, double value) {
 
 Result<PagedManifest> readPagedManifest(const std::string& dir) {
     const std::string path = (fs::path(dir) / kPagedManifestFile).string();
-    std::ifstream in(path, std::ios::binary);
-    if (!in)
+    if (::access(path.c_str(), F_OK) != 0)
         return Status::error("paged city '" + dir + "': cannot read '" + path +
                              "' (not a paged city from `vista gen -o DIR.paged`, or its run did not finish)");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    Json j = Json::parse(ss.str(), nullptr, false);
+    auto text = readInputFile("paged city manifest", path, kMaxManifestBytes);
+    if (!text) return Status::error("paged city '" + dir + "': " + text.status().message());
+    Json j = Json::parse(*text, nullptr, false);
     auto bad = [&](const std::string& why) { return Status::error("'" + path + "': " + why); };
     if (j.is_discarded() || !j.is_object()) return bad("not valid JSON (corrupt or truncated)");
     PagedManifest m;

@@ -1,5 +1,7 @@
 #include "runtime/scene/paths.h"
 #include "foundation/atomic_file.h"
+#include "foundation/input_file.h"
+#include "foundation/number_text.h"
 #include "foundation/statistics.h"
 #include "foundation/units.h"
 
@@ -9,6 +11,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <memory>
 #include <sstream>
 
 #include <unistd.h>
@@ -17,6 +20,7 @@
 #include "citygen/blocks.h"
 #include "citygen/lanes.h"
 #include "citygen/terrain.h"
+#include "runtime/scene/tour.h"
 
 namespace vista {
 
@@ -32,16 +36,30 @@ constexpr double kHeadingGain = 1.1;     // 1/m (2 sqrt(kLateralGain))
 constexpr double kBrakeShare = 0.8;      // share of the braking limit the speed profile plans with
 constexpr double kProgressWindow = 3.0;  // metres ahead of the progress where the closest route point is searched
 
+// The vehicle is simulated in steps of at most kMaxSimStep seconds whatever
+// the sample spacing: steering at a coarser step overshoots and can circle.
+constexpr double kMaxSimStep = 1.0 / 30.0;
+size_t simulationSubsteps(double dt) { return std::max<size_t>(1, size_t(std::ceil(dt / kMaxSimStep - 1e-9))); }
+
 double headingOf(const glm::dvec2& d) { return std::atan2(d.x, d.y); }  // clockwise from north
 
 // The route: node sequence chosen by a seeded walk, extended on demand.
 class Route {
 public:
-    Route(const StreetGraph& g, uint64_t seed) : _g(g), _rng(seed, 0, Stream::Paths) {
+    Route(const StreetGraph& g, uint64_t seed, RouteStyle style) : _g(g), _rng(seed, 0, Stream::Paths) {
         _adj.resize(g.nodes.size());
         for (size_t e = 0; e < g.edges.size(); ++e) {
             _adj[g.edges[e].a].push_back(uint32_t(e));
             _adj[g.edges[e].b].push_back(uint32_t(e));
+        }
+        if (style == RouteStyle::Tour) {
+            std::vector<std::vector<Tour::Arc>> arcs(g.nodes.size());
+            for (size_t n = 0; n < g.nodes.size(); ++n)
+                for (uint32_t e : _adj[n]) {
+                    const uint32_t m = other(e, uint32_t(n));
+                    arcs[n].push_back({m, glm::length(g.nodes[m] - g.nodes[n])});
+                }
+            _tour = std::make_unique<Tour>(g.nodes, std::move(arcs));
         }
         // Start on a random edge whose ends both continue (avoid dead ends).
         std::vector<uint32_t> good;
@@ -97,6 +115,14 @@ private:
             push(prev, inEdge);
             return;
         }
+        if (_tour) {
+            std::vector<size_t> allowed;
+            for (size_t i = 0; i < _adj[n].size(); ++i)
+                if (_adj[n][i] != inEdge) allowed.push_back(i);
+            const uint32_t e = _adj[n][_tour->step(n, allowed, _rng)];
+            push(other(e, n), e);
+            return;
+        }
         double total = 0;
         for (double w : weight) total += w;
         double r = _rng.uniform() * total;
@@ -112,8 +138,11 @@ private:
         push(_g.edges[e].a == n ? _g.edges[e].b : _g.edges[e].a, e);
     }
 
+    uint32_t other(uint32_t e, uint32_t n) const { return _g.edges[e].a == n ? _g.edges[e].b : _g.edges[e].a; }
+
     const StreetGraph& _g;
     Rng _rng;
+    std::unique_ptr<Tour> _tour;  // RouteStyle::Tour
     std::vector<std::vector<uint32_t>> _adj;
     std::vector<glm::dvec2> _pts;
     std::vector<double> _cum;
@@ -153,6 +182,14 @@ Result<PathKind> parsePathKind(const std::string& s) {
     if (s == "car") return PathKind::Car;
     if (s == "fly") return PathKind::Fly;
     return Status::error("path kind '" + s + "' unknown; expected one of: walk, car, fly");
+}
+
+const char* routeStyleName(RouteStyle s) { return s == RouteStyle::Tour ? "tour" : "wander"; }
+
+Result<RouteStyle> parseRouteStyle(const std::string& s) {
+    if (s == "tour") return RouteStyle::Tour;
+    if (s == "wander") return RouteStyle::Wander;
+    return Status::error("route '" + s + "' unknown; expected one of: tour, wander");
 }
 
 Status validatePathOptions(const PathOptions& o) {
@@ -244,7 +281,7 @@ Result<Path> driveCar(const StreetGraph& g, const CityParams& params, const Path
     std::vector<Block> blocks;
     if (params.sidewalk_m > 0.01) blocks = extractBlocks(g, params, nullptr);
     const LaneModel lanes = buildLaneModel(g, params, params.sidewalk_m > 0.01 ? &blocks : nullptr);
-    auto made = LaneRoute::create(lanes, o.seed, o.leftHandTraffic);
+    auto made = LaneRoute::create(lanes, o.seed, o.leftHandTraffic, o.route);
     if (!made) return made.status();
     LaneRoute& route = made.value();
     glm::dvec2 pos = route.point(0);
@@ -252,16 +289,19 @@ Result<Path> driveCar(const StreetGraph& g, const CityParams& params, const Path
     double v = 0.0;
     double sp = 0.0;  // progress along the route (arc length of the closest point)
     size_t seg = 0;
-    const double w = o.maxYawRate, dt = o.dt;
-    const size_t n = size_t(std::floor(o.duration / dt + 1e-9)) + 1;
-    const size_t skip = size_t(std::floor(o.runUp / dt + 1e-9));
+    const double w = o.maxYawRate;
+    const size_t n = size_t(std::floor(o.duration / o.dt + 1e-9)) + 1;
+    const size_t skip = size_t(std::floor(o.runUp / o.dt + 1e-9));
+    const size_t sub = simulationSubsteps(o.dt);
+    const double dt = o.dt / double(sub);
     const glm::dvec2 origin(params.origin_x, params.origin_y);
     const double brake = kBrakeShare * o.decel;
 
     Path path;
     path.samples.reserve(n);
     path.lanes.reserve(n);
-    for (size_t i = 0; i < n + skip; ++i) {
+    for (size_t j = 0; j < (n + skip) * sub; ++j) {
+        const size_t i = j / sub;
         // Progress: the closest route point a few metres ahead.
         const double horizon = v * v / (2.0 * brake) + 2.0 * v * dt + 3.0;
         route.ensure(sp + horizon + kProgressWindow + 1.0);
@@ -275,9 +315,9 @@ Result<Path> driveCar(const StreetGraph& g, const CityParams& params, const Path
         seg = bestSeg;
         sp = std::max(sp, route.cum(seg) + bestT * (route.cum(seg + 1) - route.cum(seg)));
 
-        if (i >= skip) {
+        if (j % sub == 0 && i >= skip) {
             PathSample s;
-            s.t = double(i - skip) * dt;
+            s.t = double(i - skip) * o.dt;
             s.position = glm::dvec3(pos + origin, terrainHeight(params, pos) + o.eyeHeight());
             s.heading = wrapAngle(h);
             path.samples.push_back(s);
@@ -326,25 +366,28 @@ Result<Path> generatePath(const StreetGraph& g, const CityParams& params, const 
         if (auto car = driveCar(g, params, o)) return car;
     }
 
-    Route route(g, o.seed);
+    Route route(g, o.seed, o.route);
     glm::dvec2 pos = route.point(0);
     double h = route.segHeading(0);
     double v = 0.0;
     double sp = 0.0;  // progress along the route (arc length of the closest point)
     size_t seg = 0;
-    const double w = o.maxYawRate, dt = o.dt;
-    const size_t n = size_t(std::floor(o.duration / dt + 1e-9)) + 1;
+    const double w = o.maxYawRate;
+    const size_t n = size_t(std::floor(o.duration / o.dt + 1e-9)) + 1;
     // The run-up is simulated exactly like the path and then dropped, so the
     // first kept sample is where the vehicle is after runUp seconds, at speed.
-    const size_t skip = size_t(std::floor(o.runUp / dt + 1e-9));
+    const size_t skip = size_t(std::floor(o.runUp / o.dt + 1e-9));
+    const size_t sub = simulationSubsteps(o.dt);
+    const double dt = o.dt / double(sub);
     const glm::dvec2 origin(params.origin_x, params.origin_y);
 
     Path path;
     path.samples.reserve(n);
-    for (size_t i = 0; i < n + skip; ++i) {
-        if (i >= skip) {
+    for (size_t j = 0; j < (n + skip) * sub; ++j) {
+        const size_t i = j / sub;
+        if (j % sub == 0 && i >= skip) {
             PathSample s;
-            s.t = double(i - skip) * dt;
+            s.t = double(i - skip) * o.dt;
             double ground = terrainHeight(params, pos);
             s.position = glm::dvec3(pos + origin, ground + o.eyeHeight());
             s.heading = wrapAngle(h);
@@ -424,52 +467,51 @@ Status saveLanePositionsCsv(const Path& path, const std::string& file) {
 }
 
 Result<Path> loadPathCsv(const std::string& file) {
-    std::ifstream f(file);
-    if (!f) return Status::error("path file '" + file + "' cannot be opened (missing or unreadable)");
-    std::string line;
+    auto text = readInputFile("path file", file, kMaxPathCsvBytes);
+    if (!text) return text.status();
+    // A UTF-8 byte order mark (spreadsheet exports) is not part of the header.
+    size_t pos = text->compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
+    const std::string where = "path file '" + echoText(file) + "' line ";
+    const char* const fieldNames[6] = {"t_s", "x_m", "y_m", "z_m", "heading_deg", "pitch_deg"};
+    // Coordinates a renderer and a ray caster can represent: on Earth
+    // (|x|, |y| <= 2e7 m, as the city origin), |z| <= 1e5 m, bounded time and heading.
+    const double limits[6] = {1e9, 2e7, 2e7, 1e5, 36000.0, 90.0};
     Path path;
     int lineNo = 0;
-    while (std::getline(f, line)) {
+    while (pos < text->size()) {
+        size_t eol = text->find('\n', pos);
+        if (eol == std::string::npos) eol = text->size();
+        std::string line = text->substr(pos, eol - pos);
+        pos = eol + 1;
         ++lineNo;
         if (!line.empty() && line.back() == '\r') line.pop_back();
         if (line.empty() || line[0] == '#') continue;
         if (lineNo == 1 && line.rfind("t_s", 0) == 0) continue;  // header
-        double v[6];
-        const char* p = line.c_str();
-        for (int k = 0; k < 6; ++k) {
-            char* end = nullptr;
-            errno = 0;
-            v[k] = std::strtod(p, &end);
-            if (end == p || errno == ERANGE || !std::isfinite(v[k]))
-                return Status::error("path file '" + file + "' line " + std::to_string(lineNo) + ": field " +
-                                     std::to_string(k + 1) +
-                                     " is not a finite number (expected t_s,x_m,y_m,z_m,heading_deg,pitch_deg)");
-            p = end;
-            while (*p == ' ' || *p == '\t') ++p;
-            if (k < 5) {
-                if (*p != ',')
-                    return Status::error("path file '" + file + "' line " + std::to_string(lineNo) +
-                                         ": expected 6 comma-separated fields");
-                ++p;
-            }
+        std::vector<std::string> fields;
+        for (size_t a = 0;;) {
+            const size_t comma = line.find(',', a);
+            std::string f = line.substr(a, comma == std::string::npos ? std::string::npos : comma - a);
+            const size_t b = f.find_first_not_of(" \t"), e = f.find_last_not_of(" \t");
+            fields.push_back(b == std::string::npos ? std::string() : f.substr(b, e - b + 1));
+            if (comma == std::string::npos || fields.size() > 6) break;
+            a = comma + 1;
         }
-        while (*p == ' ' || *p == '\t') ++p;
-        if (*p != '\0')
-            return Status::error("path file '" + file + "' line " + std::to_string(lineNo) + ": more than 6 fields");
+        if (fields.size() != 6)
+            return Status::error(where + std::to_string(lineNo) + ": expected 6 comma-separated fields " +
+                                 "(t_s,x_m,y_m,z_m,heading_deg,pitch_deg), found " +
+                                 (fields.size() > 6 ? std::string("more") : std::to_string(fields.size())));
+        double v[6];
+        for (int k = 0; k < 6; ++k) {
+            auto r = parseRealText(
+                where + std::to_string(lineNo) + ": field " + std::to_string(k + 1) + " (" + fieldNames[k] + ")",
+                fields[size_t(k)], -limits[k], limits[k]);
+            if (!r) return r.status();
+            v[k] = *r;
+        }
         if (!path.samples.empty() && !(v[0] > path.samples.back().t))
-            return Status::error("path file '" + file + "' line " + std::to_string(lineNo) + ": time " + fmtNum(v[0]) +
-                                 " s does not increase");
-        // Coordinates a renderer and a ray caster can represent: on Earth
-        // (|x|, |y| <= 2e7 m, as the city origin), |z| <= 1e5 m, bounded time and heading.
-        const char* const names[6] = {"time", "x", "y", "z", "heading", "pitch"};
-        const double limits[6] = {1e9, 2e7, 2e7, 1e5, 36000.0, 90.0};
-        for (int k = 0; k < 5; ++k)
-            if (std::abs(v[k]) > limits[k])
-                return Status::error("path file '" + file + "' line " + std::to_string(lineNo) + ": " + names[k] + " " +
-                                     fmtNum(v[k]) + " out of range [-" + fmtNum(limits[k]) + ", " + fmtNum(limits[k]) +
-                                     "]");
+            return Status::error(where + std::to_string(lineNo) + ": time " + fmtNum(v[0]) + " s does not increase");
         if (std::abs(v[5]) >= 90.0)
-            return Status::error("path file '" + file + "' line " + std::to_string(lineNo) + ": pitch " + fmtNum(v[5]) +
+            return Status::error(where + std::to_string(lineNo) + ": pitch " + fmtNum(v[5]) +
                                  " deg out of range (-90, 90)");
         PathSample s;
         s.t = v[0];

@@ -61,6 +61,8 @@ namespace vista {
 enum class PathKind { Walk, Car, Fly };
 const char* pathKindName(PathKind k);
 Result<PathKind> parsePathKind(const std::string& s);  // "walk" | "car" | "fly"
+const char* routeStyleName(RouteStyle s);
+Result<RouteStyle> parseRouteStyle(const std::string& s);  // "tour" | "wander"
 // The kind's pace when the user gives none: walk 1.4 m/s (a walker), car and
 // fly 14 m/s (about 50 km/h).
 double defaultSpeed(PathKind k);
@@ -82,6 +84,10 @@ struct PathOptions {
     // Car: left-hand traffic, every lane driven against its right-hand
     // direction (lane_route.h; the lane model itself is right-hand traffic).
     bool leftHandTraffic = false;
+    // How the route chooses its turns (lane_route.h, tour.h): Tour heads for
+    // far goals along shortest paths, so a long drive keeps going across the
+    // city; Wander is a seeded random walk that prefers going straight on.
+    RouteStyle route = RouteStyle::Tour;
     double eyeHeight() const { return kind == PathKind::Walk ? 1.7 : kind == PathKind::Car ? 1.2 : flyHeight; }
 };
 // Checks ranges; message names the option.

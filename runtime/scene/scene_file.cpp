@@ -144,6 +144,9 @@ Result<osg::ref_ptr<osg::Node>> readSceneFile(const std::string& path) {
     struct stat st;
     if (::stat(path.c_str(), &st) != 0) return Status::error("cannot open scene file '" + path + "': " + errnoText());
     if (S_ISDIR(st.st_mode)) return Status::error("cannot open scene file '" + path + "': is a directory");
+    if (!S_ISREG(st.st_mode))
+        return Status::error("cannot open scene file '" + path +
+                             "': not a regular file (a device, pipe or socket), expected a file");
     std::ifstream in(path, std::ios::binary);
     if (!in) return Status::error("cannot open scene file '" + path + "': " + errnoText());
     std::vector<char> data;

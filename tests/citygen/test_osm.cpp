@@ -17,6 +17,8 @@
 
 #include "citygen/footprint_repair.h"
 #include "citygen/generate.h"
+#include <bzlib.h>
+
 #include "citygen/geodesy.h"
 #include "citygen/osm_buildings.h"
 #include "citygen/polygon.h"
@@ -75,7 +77,9 @@ TEST(OsmImport, DistancesMatchGeodesicsAtAnyLatitude) {
             spokes.emplace_back(w.node(destination(c, b, 300 + 10 * k)), w.node(destination(c, b, 2000 + 500 * k)));
             w.way({spokes.back().first, spokes.back().second});
         }
-        auto r = importOsm(w.write(dir, "spokes.osm"), CityParams());
+        CityParams big;
+        big.size_m = 16000;  // the city holds every spoke (roads are clipped to the city square)
+        auto r = importOsm(w.write(dir, "spokes.osm"), big);
         ASSERT_TRUE(r.isOk()) << r.status().message();
         const StreetGraph& g = r->streets;
         ASSERT_EQ(g.edges.size(), 12u) << c.lat_deg << ", " << c.lon_deg;
@@ -116,7 +120,9 @@ TEST(OsmImport, ExtractAcrossTheAntimeridianHasItsRealExtent) {
     OsmWriter w;
     const GeoPoint centre{-16.8, 180.0};  // Fiji
     w.grid(centre, 3000, 4);              // 3 km square of roads across 180 degrees
-    auto r = importOsm(w.write(dir, "fiji.osm"), CityParams());
+    CityParams big;
+    big.size_m = 4000;  // the city holds the whole extract (roads are clipped to the city square)
+    auto r = importOsm(w.write(dir, "fiji.osm"), big);
     ASSERT_TRUE(r.isOk()) << r.status().message();
     const double expectedX = vincenty(destination(centre, 270, 1500), destination(centre, 90, 1500));
     const double expectedY = vincenty(destination(centre, 180, 1500), destination(centre, 0, 1500));
@@ -323,6 +329,59 @@ TEST(OsmImport, TruncatedFileIsAnErrorNamingTheFile) {
     auto r = importOsm(fixture("truncated.osm"), CityParams());
     ASSERT_FALSE(r.isOk());
     EXPECT_NE(r.status().message().find("truncated.osm"), std::string::npos) << r.status().message();
+}
+
+// A .osm.bz2 cut short says so in words (libbz2 reports only a number).
+TEST(OsmImport, TruncatedBzip2IsNamedInWords) {
+    test::TempDir dir("vista_osm");
+    const std::string xml = vista::test::readBytes(fixture("hard_cases.osm"));
+    std::vector<char> packed(xml.size() + 1024);
+    unsigned int size = unsigned(packed.size());
+    ASSERT_EQ(
+        BZ2_bzBuffToBuffCompress(packed.data(), &size, const_cast<char*>(xml.data()), unsigned(xml.size()), 9, 0, 0),
+        BZ_OK);
+    const std::string path = dir.file("cut.osm.bz2");
+    std::ofstream(path, std::ios::binary).write(packed.data(), std::streamsize(size / 2));
+    auto r = importOsm(path, CityParams());
+    ASSERT_FALSE(r.isOk());
+    const std::string& m = r.status().message();
+    EXPECT_NE(m.find("cut.osm.bz2"), std::string::npos) << m;
+    EXPECT_NE(m.find("truncated"), std::string::npos) << m;
+    EXPECT_EQ(m.find("-7"), std::string::npos) << m;
+}
+
+// An extract larger than the city: its roads are clipped to the city square,
+// so every street (and every seeded path on them) lies inside the city.
+TEST(OsmImport, RoadsBeyondTheCitySquareAreClipped) {
+    test::TempDir dir("vista_osm");
+    OsmWriter w;
+    w.grid({48.2, 16.37}, 3000, 4);  // roads 3 km long, 750 m apart
+    CityParams p;
+    p.size_m = 1000;
+    auto r = importOsm(w.write(dir, "big.osm"), p);
+    ASSERT_TRUE(r.isOk()) << r.status().message();
+    ASSERT_FALSE(r->streets.edges.empty());
+    for (const auto& n : r->streets.nodes) {
+        EXPECT_LE(std::abs(n.x), 500.0 + 1e-6);
+        EXPECT_LE(std::abs(n.y), 500.0 + 1e-6);
+    }
+    EXPECT_GT(r->clippedSegments, 0u);
+    EXPECT_NE(r->dropSummary().find("clipped"), std::string::npos) << r->dropSummary();
+    EXPECT_TRUE(checkPlanarGraph(r->streets, p.min_segment_m).isOk());
+    // The roads at +-375 m cross the square: 2 x 2 crossings inside it.
+    size_t inner = 0;
+    for (const auto& n : r->streets.nodes) inner += std::abs(n.x) < 499 && std::abs(n.y) < 499;
+    EXPECT_EQ(inner, 4u);
+    // A city smaller than any gap between the roads: refused, naming the square.
+    p.size_m = 100;
+    OsmWriter off;  // two roads 800 m apart: the data's centre, where the city lies, has none
+    for (double north : {-400.0, 400.0}) {
+        const GeoPoint a = destination({48.2, 16.37}, 0, north);
+        off.way({off.node(a), off.node(destination(a, 90, 100))});
+    }
+    auto none = importOsm(off.write(dir, "off.osm"), p);
+    ASSERT_FALSE(none.isOk());
+    EXPECT_NE(none.status().message().find("city square"), std::string::npos) << none.status().message();
 }
 
 TEST(OsmImport, MissingFileIsAnError) {

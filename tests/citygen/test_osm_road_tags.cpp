@@ -462,6 +462,11 @@ TEST(OsmRoadTags, GraphJsonRoundTripsTheFieldsAndRefusesBadValues) {
         EXPECT_NE(r.status().message().find("edges[0][5]"), std::string::npos) << r.status().message();
     }
     EXPECT_FALSE(streetGraphFromJson(R"({"nodes":[[0,0],[100,0]],"edges":[[0,1,2,7.5,3,{},{}]]})").isOk());
+    // A coordinate of 1e308 is printed short, not as 309 digits.
+    auto far = streetGraphFromJson(R"({"nodes":[[1e308,0],[100,0]],"edges":[]})");
+    ASSERT_FALSE(far.isOk());
+    EXPECT_NE(far.status().message().find("[1e+308, 0]"), std::string::npos) << far.status().message();
+    EXPECT_LT(far.status().message().size(), 200u);
 }
 
 TEST(OsmRoadTags, GeneratedCitiesKeepTheDefaultsAndTheFiveElementJson) {

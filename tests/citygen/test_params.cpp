@@ -1,7 +1,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
 
+#include "citygen/effects.h"
 #include "citygen/params.h"
 
 using namespace vista;
@@ -18,6 +22,11 @@ TEST(Params, HostileJsonIsRefusedCleanlyAndTheFullSeedRangeAccepted) {
         {R"({"effects": {"haze": {}, "haze": {"visibility_m": 30}}})", "key 'haze' appears twice"},
         {"{\"_c\": " + std::string(100000, '[') + std::string(100000, ']') + "}", "nested deeper than 16"},
         {R"({"seed": -1})", "out of range"},
+        // Integers from the text as written: 2^64 is out of range (not a double near 1.8e19), 2.5 is no integer.
+        {R"({"seed": 18446744073709551616})",
+         "'seed' = 18446744073709551616 is out of range [0, 18446744073709551615]"},
+        {R"({"detail": 2.5})", "'detail' must be an integer, got 2.5"},
+        {R"({"detail": 99999999999999999999})", "'detail' = 99999999999999999999 is out of range [0, 3]"},
     };
     for (const auto& [text, says] : bad) {
         auto r = parseParamsJson(text, "p.json");
@@ -25,12 +34,28 @@ TEST(Params, HostileJsonIsRefusedCleanlyAndTheFullSeedRangeAccepted) {
         EXPECT_NE(r.status().message().find(says), std::string::npos) << r.status().message();
         EXPECT_LT(r.status().message().size(), 300u) << "messages stay short";
     }
+    // A megabyte key is named, cut short (the message lists the known parameters besides).
+    auto key = parseParamsJson("{\"" + std::string(1 << 20, 'k') + "\": 1}", "p.json");
+    ASSERT_FALSE(key.isOk());
+    EXPECT_NE(key.status().message().find("unknown parameter 'kkkk"), std::string::npos);
+    EXPECT_LT(key.status().message().size(), 1000u);
     auto top = parseParamsJson(R"({"seed": 18446744073709551615})", "p.json");
     ASSERT_TRUE(top.isOk()) << top.status().message();
     EXPECT_EQ(top->seed, 18446744073709551615ull);
     auto mid = parseParamsJson(R"({"seed": 9223372036854775808})", "p.json");
     ASSERT_TRUE(mid.isOk()) << mid.status().message();
     EXPECT_EQ(mid->seed, 9223372036854775808ull);
+    // The --effects JSON follows the same rules as a parameter file.
+    for (const auto& [text, says] : std::vector<std::pair<std::string, std::string>>{
+             {R"({"haze": {}, "haze": {}})", "key 'haze' appears twice"},
+             {R"({"haze": {"visibility_m": 100, "visibility_m": 200}})", "key 'visibility_m' appears twice"},
+             {"{\"haze\": " + std::string(40, '[') + std::string(40, ']') + "}", "nested deeper than 16"},
+             {"{\"" + std::string(1 << 20, 'e') + "\": {}}", "unknown effect 'eeee"}}) {
+        auto r = parseEffectsJson(text, "option --effects");
+        ASSERT_FALSE(r.isOk()) << text.substr(0, 60);
+        EXPECT_NE(r.status().message().find(says), std::string::npos) << r.status().message().substr(0, 300);
+        EXPECT_LT(r.status().message().size(), 300u) << "messages stay short";
+    }
     // Strings may hold brackets: they do not count as nesting.
     EXPECT_TRUE(parseParamsJson("{\"_c\": \"" + std::string(100, '[') + "\"}", "p.json").isOk());
 }

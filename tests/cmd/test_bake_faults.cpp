@@ -85,11 +85,14 @@ TEST(BakeFaults, KillNineLeavesTheOldOutputOrTheWholeNewOneAndTheNextRunResumes)
         {"while loading (100 ms)", [](pid_t, size_t, double ms) { return ms >= 100; }},
         {"at the first cell result", [&](pid_t, size_t before, double) { return countCells(work) > before; }},
         {"ten cell results later", [&](pid_t, size_t before, double) { return countCells(work) >= before + 10; }},
-        // (the temporary exists, or the output itself changes, as it would under a writer that is not atomic)
+        // (a temporary or the staged output exists, or the output itself changes, as it would under a
+        // writer that is not atomic)
         {"while writing the output",
          [&](pid_t pid, size_t, double) {
              std::error_code ec;
-             return fs::exists(out + ".tmp." + std::to_string(pid)) || fs::file_size(out, ec) != old.size();
+             const std::string p = std::to_string(pid);
+             return fs::exists(out + ".tmp." + p) || fs::exists(out + ".stage." + p + ".tmp." + p) ||
+                    fs::exists(out + ".stage." + p) || fs::file_size(out, ec) != old.size();
          }},
     };
     int killed = 0;
@@ -129,11 +132,14 @@ TEST(BakeFaults, KillNineLeavesTheOldOutputOrTheWholeNewOneAndTheNextRunResumes)
             EXPECT_TRUE(now == ref) << "a run that was not killed (" << k.what << ") must leave the whole new output";
             std::ofstream(out, std::ios::binary | std::ios::trunc) << old;  // the old output again, for the next kill
         }
-        // Next to the output: only its work directory and the killed run's temporary.
+        // Next to the output: only its work directory and the killed run's temporary or staged output.
+        const std::string p = std::to_string(pid);
         for (const auto& e : fs::directory_iterator(dir.path())) {
             const std::string n = e.path().filename().string();
+            const bool killedRunsFile =
+                n == "out.osgb.tmp." + p || n == "out.osgb.stage." + p || n == "out.osgb.stage." + p + ".tmp." + p;
             const bool expected = n == "city.osgb" || n == "ref.osgb" || n == "ref1.osgb" || n == "out.osgb" ||
-                                  n == "out.osgb.work" || (lastKilled && n == "out.osgb.tmp." + std::to_string(pid));
+                                  n == "out.osgb.work" || (lastKilled && killedRunsFile);
             EXPECT_TRUE(expected) << k.what << ": " << n;
         }
     }

@@ -200,3 +200,45 @@ TEST(Options, BakeCellsShardAndTexels) {
         EXPECT_NE(s.message().find("32"), std::string::npos) << s.message();
     }
 }
+
+// --effects: empty, repeated and oversized values are refused; a baked effect
+// cannot be asked for at run time (it is in the scene's colours).
+TEST(Options, EffectsOptionRules) {
+    const Effects none;
+    EXPECT_TRUE(parseEffectsOption("haze,glass", none).isOk());
+    for (const char* bad : {"", ",", "haze,", ",haze", "haze,,glass"})
+        expectBad(parseEffectsOption(bad, none), bad, "--effects", "empty");
+    expectBad(parseEffectsOption("haze,haze", none), "haze,haze", "--effects", "twice");
+    expectBad(parseEffectsOption(std::string(100000, 'h'), none), "100000 x h", "--effects", "64 KiB");
+    auto longName = parseEffectsOption(std::string(5000, 'h'), none);
+    ASSERT_FALSE(longName.isOk());
+    EXPECT_LT(longName.status().message().size(), 300u);
+    for (const char* baked :
+         {"sun_shadows", "ambient_occlusion", "materials", "haze,sun_shadows", "{\"ambient_occlusion\": {}}"}) {
+        auto fx = runTimeEffects(std::string(baked), none, true, "vista bench");
+        ASSERT_FALSE(fx.isOk()) << baked;
+        EXPECT_NE(fx.status().message().find("baked"), std::string::npos) << fx.status().message();
+    }
+    EXPECT_TRUE(runTimeEffects(std::string("haze,night"), none, true, "vista bench").isOk());
+    EXPECT_TRUE(runTimeEffects(std::string("none"), none, true, "vista bench").isOk());
+    EXPECT_TRUE(runTimeEffects(std::nullopt, none, true, "vista bench").isOk());
+    EXPECT_FALSE(runTimeEffects(std::string(""), none, true, "vista bench").isOk());
+}
+
+// The one seed rule on the command line: 0 .. 2^64-1 in decimal, nothing wraps.
+TEST(Options, SeedOptionNeverWraps) {
+    for (const char* bad : {"-1", "18446744073709551616", "0x10", "1e3"}) {
+        CLI::App app;
+        uint64_t seed = 7;
+        addSeedOption(app, "--seed", seed, "");
+        std::vector<std::string> args = {bad, "--seed"};  // CLI11 parses the reversed vector
+        EXPECT_THROW(app.parse(args), CLI::ValidationError) << bad;
+        EXPECT_EQ(seed, 7u);
+    }
+    CLI::App app;
+    uint64_t seed = 7;
+    addSeedOption(app, "--seed", seed, "");
+    std::vector<std::string> args = {"18446744073709551615", "--seed"};
+    app.parse(args);
+    EXPECT_EQ(seed, UINT64_MAX);
+}

@@ -1,6 +1,7 @@
 // libFuzzer target: an OpenStreetMap XML extract (vista gen --osm), streets and buildings.
 // Accepted extracts give a planar street graph of bounded extent and building footprints
-// that are simple, counter-clockwise, inside the city, with clockwise holes strictly inside.
+// that are simple, counter-clockwise, inside the city, with clockwise holes strictly inside;
+// every street node lies inside the city square.
 #include <cmath>
 #include <cstdlib>
 
@@ -18,6 +19,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (g && !vista::checkPlanarGraph(g->streets, 0.0)) std::abort();
     if (g) {
         const double half = 0.5 * params.size_m;
+        for (const auto& n : g->streets.nodes)  // roads are clipped to the city square
+            if (!(std::abs(n.x) <= half + 1e-6 && std::abs(n.y) <= half + 1e-6)) std::abort();
         for (const auto& f : g->buildings) {
             if (!vista::isSimpleRingExact(f.outer) || !(vista::signedArea(f.outer) > 0)) std::abort();
             for (const auto& p : f.outer)

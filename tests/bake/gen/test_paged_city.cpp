@@ -211,7 +211,20 @@ TEST_F(Paged, MergeRefusesMissingRegions) {
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("--merge"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("region_1_0.osgb"), std::string::npos) << r.err;  // region 1: shard 2/2, never run
+    EXPECT_NE(r.err.find("--shards N"), std::string::npos) << "tells how to name the shards: " << r.err;
     EXPECT_FALSE(fs::exists(sh + "/index.osgb"));
+    expectSameFiles(before, snapshot(sh), "a refused merge changes nothing");
+
+    // Told the shard count, the merge names the shard to run again, and only that one.
+    const CliRun named = runVista(kCity + " --merge --shards 2 -o " + sh);
+    EXPECT_EQ(named.code, 2);
+    EXPECT_NE(named.err.find("run shard 2/2 again"), std::string::npos) << named.err;
+    EXPECT_EQ(named.err.find("1/2"), std::string::npos) << "shard 1/2 is done: " << named.err;
+    // Split in 4, regions 0..8 of the 3 x 3 grid: shard 1/2 wrote 0, 2, 4, 6, 8;
+    // 1, 5 are shard 2/4's and 3, 7 shard 4/4's.
+    const CliRun four = runVista(kCity + " --merge --shards 4 -o " + sh);
+    EXPECT_EQ(four.code, 2);
+    EXPECT_NE(four.err.find("run 2 shards 2/4, 4/4 again"), std::string::npos) << four.err;
     expectSameFiles(before, snapshot(sh), "a refused merge changes nothing");
 }
 
@@ -352,6 +365,9 @@ TEST_F(Paged, BadInputExitsTwoAndLeavesNothing) {
         {"gen --size 1500 -q --shard x" + out, "1 <= K <= N"},
         {"gen --size 1500 -q --shard 1/2 --merge" + out, "--merge"},
         {"gen --size 1500 -q --merge" + out, "missing"},
+        {"gen --size 1500 -q --merge --shards 0" + out, "1 <= N <= 100000"},
+        {"gen --size 1500 -q --merge --shards x2" + out, "--shards"},
+        {"gen --size 1500 -q --shards 2" + out, "only with --merge"},
         {"gen --size 64001 -q" + out, "size_m"},
         {"gen --size 1500 -q --gltf " + tmp.file("c.glb") + out, "--gltf"},
         {"gen --size 1500 -q --effects sun_shadows" + out, "effects"},

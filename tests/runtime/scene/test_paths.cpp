@@ -178,11 +178,14 @@ TEST(Paths, BadInput) {
     for (const auto& f : {f1, f2, f3, f4, f5}) std::filesystem::remove(f);
     // Finite but huge coordinates (the renderer and the ray caster could not
     // represent them) are refused with the field and its range; Earth-sized ones load.
-    const std::pair<std::string, std::string> huge[] = {{"0,1e20,0,1.7,0,0\n", "x 1e+20 out of range"},
-                                                        {"0,0,-3e7,1.7,0,0\n", "y -3e+07 out of range"},
-                                                        {"0,0,0,1e6,0,0\n", "z 1e+06 out of range"},
-                                                        {"0,0,0,1.7,1e300,0\n", "heading 1e+300 out of range"},
-                                                        {"1e300,0,0,1.7,0,0\n", "time 1e+300 out of range"}};
+    // The message prints the field as written, never as 309 digits.
+    const std::pair<std::string, std::string> huge[] = {
+        {"0,1e20,0,1.7,0,0\n", "field 2 (x_m) = '1e20' is out of range [-20000000, 20000000]"},
+        {"0,0,-3e7,1.7,0,0\n", "field 3 (y_m) = '-3e7' is out of range"},
+        {"0,0,0,1e6,0,0\n", "field 4 (z_m) = '1e6' is out of range [-100000, 100000]"},
+        {"0,0,0,1.7,1e300,0\n", "field 5 (heading_deg) = '1e300' is out of range"},
+        {"1e300,0,0,1.7,0,0\n", "field 1 (t_s) = '1e300' is out of range"},
+        {"0,1e308,0,1.7,0,0\n", "field 2 (x_m) = '1e308' is out of range"}};
     for (const auto& [text, says] : huge) {
         const std::string f = write("huge.csv", text);
         auto r = loadPathCsv(f);
@@ -190,6 +193,24 @@ TEST(Paths, BadInput) {
         EXPECT_NE(r.status().message().find(says), std::string::npos) << r.status().message();
         std::filesystem::remove(f);
     }
+    // A field that is not a number is named, with its line and text.
+    const std::string fAbc = write("abc.csv", "t_s,x_m,y_m,z_m,heading_deg,pitch_deg\n1.5abc,0,0,1.7,0,0\n");
+    auto abc = loadPathCsv(fAbc);
+    ASSERT_FALSE(abc.isOk());
+    EXPECT_NE(abc.status().message().find("line 2: field 1 (t_s) = '1.5abc' is not a number"), std::string::npos)
+        << abc.status().message();
+    std::filesystem::remove(fAbc);
+    // A UTF-8 byte order mark before the header (spreadsheet exports) is skipped.
+    const std::string fBom =
+        write("bom.csv", "\xEF\xBB\xBFt_s,x_m,y_m,z_m,heading_deg,pitch_deg\n0,1,2,1.7,0,0\n0.5,2,2,1.7,0,0\n");
+    auto bom = loadPathCsv(fBom);
+    ASSERT_TRUE(bom.isOk()) << bom.status().message();
+    EXPECT_EQ(bom->samples.size(), 2u);
+    std::filesystem::remove(fBom);
+    // Not a regular file: refused at once (a device would be read without end).
+    auto dev = loadPathCsv("/dev/zero");
+    ASSERT_FALSE(dev.isOk());
+    EXPECT_NE(dev.status().message().find("not a regular file"), std::string::npos) << dev.status().message();
     const std::string fOk = write("earth.csv", "0,-2e7,2e7,1e5,-36000,89\n");
     EXPECT_TRUE(loadPathCsv(fOk).isOk());
     std::filesystem::remove(fOk);
@@ -289,4 +310,27 @@ TEST(Paths, MotionPerFrameMatchesAnIndependentSum) {
     p.samples[2].heading = degToRad(-179.0);
     EXPECT_NEAR(pathMotion(p, {1, 2}).degreesMax, 2.0, 1e-9);
     EXPECT_EQ(pathMotion(p, {3}).frames, 0u);
+}
+
+TEST(Paths, CoarseSamplesAreTheFineDriveSampledLess) {
+    // The vehicle is simulated in steps of at most 1/30 s whatever --dt: a
+    // path sampled every 0.5 s is every 15th sample of the 1/30 s path (up to
+    // the rounding of 0.5 / 15), for each kind, and the car still drives.
+    StreetGraph g = gridGraph();
+    for (PathKind kind : {PathKind::Car, PathKind::Walk, PathKind::Fly}) {
+        PathOptions fine;
+        fine.kind = kind;
+        fine.maxSpeed = defaultSpeed(kind);
+        fine.duration = 40;
+        PathOptions coarse = fine;
+        coarse.dt = 0.5;
+        auto a = generatePath(g, flatParams(), fine), b = generatePath(g, flatParams(), coarse);
+        ASSERT_TRUE(a.isOk() && b.isOk());
+        ASSERT_EQ(b->samples.size(), 81u);
+        for (size_t i = 0; i < b->samples.size(); ++i) {
+            const PathSample& p = a->samples[i * 15];
+            EXPECT_NEAR(b->samples[i].t, p.t, 1e-9);
+            EXPECT_LT(glm::length(b->samples[i].position - p.position), 1e-3) << pathKindName(kind) << " " << i;
+        }
+    }
 }

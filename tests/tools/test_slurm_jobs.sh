@@ -1,0 +1,295 @@
+#!/usr/bin/env bash
+# Runs the Slurm recipe of docs/jobs/ the way Slurm runs it, without Slurm:
+# fake `sbatch`, `scontrol` and `srun` on PATH record what the scripts ask
+# for; a small scheduler here then runs each batch script as slurmd would:
+# a fresh environment (the submitter's, --export=ALL) plus the SLURM_*
+# variables, the submit directory as working directory, stdout and stderr
+# into the --output file (%A, %a, %j, %x expanded; a rerun truncates it
+# unless --open-mode=append),
+# SIGUSR1 to the batch shell before the time limit (--signal=B:USR1@...),
+# SIGTERM to the job's processes on scancel, requeued tasks run again with
+# SLURM_RESTART_COUNT, the merge after its afterany dependency.
+#
+# The city: 1.5 km in 500 m regions (9 regions), 3 shards. Shard 1 reaches
+# its time limit, shard 2 fails after damaging a region file, shard 3 is
+# cancelled. The merge must name shard 3/3 and the command that runs it
+# again; that command, run as printed, finishes the city, and the result
+# must be byte for byte the single-machine run. Also checked: the scripts run
+# with VISTA_ARGS unset (set -u), logs land in OUT.logs (not the submit
+# directory), VISTA_SBATCH_OPTS reach sbatch, the merge asks for a sized
+# amount of memory that covers its measured peak.
+#   tests/tools/test_slurm_jobs.sh VISTA SOURCE_DIR WORK_DIR
+set -euo pipefail
+for tool in /usr/bin/time setsid truncate; do
+  [ -x "$tool" ] || command -v "$tool" >/dev/null || { echo "SKIP: $tool not found"; exit 77; }
+done
+VISTA_BIN="$(realpath "${1:?usage: $0 VISTA SOURCE_DIR WORK_DIR}")"
+SRC="$(realpath "${2:?}")"
+W="${3:?}"
+rm -rf "$W"
+mkdir -p "$W"
+W="$(realpath "$W")"
+JOBS="$SRC/docs/jobs"
+S="$W/slurm"  # the fake controller's state
+mkdir -p "$S/jobs" "$W/bin" "$W/submit"
+echo 1000 >"$S/next_id"
+: >"$S/requeued"
+
+fail() { echo "FAIL: $*" >&2; exit 1; }
+ok() { echo "ok: $*"; }
+
+# --- the fake Slurm commands -------------------------------------------------
+cat >"$W/bin/sbatch" <<'EOF'
+#!/usr/bin/env bash
+# Fake sbatch: records the submission (options, a copy of the script, the
+# environment, the submit directory) under $FAKE_SLURM/jobs/ID; runs nothing.
+set -euo pipefail
+S="$FAKE_SLURM"
+parsable=0 opts=()
+while [ $# -gt 0 ] && [ "${1#-}" != "$1" ]; do
+  [ "$1" = --parsable ] && parsable=1 || opts+=("$1")
+  shift
+done
+script="${1:?sbatch: no script}"
+[ -f "$script" ] || { echo "sbatch: error: Unable to open file $script" >&2; exit 1; }
+id=$(cat "$S/next_id")
+echo $((id + 100)) >"$S/next_id"
+d="$S/jobs/$id"
+mkdir -p "$d"
+# #SBATCH lines first, then the command line (later options win, as in sbatch).
+sed -n 's/^#SBATCH \([^ ]*\).*/\1/p' "$script" >"$d/options"
+printf '%s\n' ${opts[@]+"${opts[@]}"} >>"$d/options"
+printf '%s\n' ${opts[@]+"${opts[@]}"} >"$d/argv"
+cp "$script" "$d/script"  # Slurm keeps a copy: the job runs what was submitted
+env -0 >"$d/env"
+pwd >"$d/cwd"
+out="$(sed -n 's/^--output=//p' "$d/options" | tail -1)"
+case "$out" in /*) ;; *) out="$(pwd)/$out" ;; esac
+[ -d "$(dirname "$out")" ] || echo "the directory of --output=$out does not exist" >>"$S/errors"
+if [ "$parsable" = 1 ]; then echo "$id"; else echo "Submitted batch job $id"; fi
+EOF
+cat >"$W/bin/scontrol" <<'EOF'
+#!/usr/bin/env bash
+# Fake scontrol: `scontrol requeue JOBID...` asks the fake controller to run
+# these jobs again; nothing else is supported.
+set -euo pipefail
+[ "${1:-}" = requeue ] || { echo "fake scontrol: only 'requeue' is supported, not '$*'" >&2; exit 1; }
+shift
+for j in "$@"; do echo "$j" >>"$FAKE_SLURM/requeued"; done
+EOF
+cat >"$W/bin/srun" <<'EOF'
+#!/usr/bin/env bash
+# Fake srun: a job step is the command itself.
+exec "$@"
+EOF
+chmod +x "$W/bin/"*
+export FAKE_SLURM="$S"
+export PATH="$W/bin:$PATH"
+
+# started N: waits until shard N's first vista run has begun (the batch shell is past its setup).
+started() {
+  local i
+  for i in $(seq 1 600); do
+    [ -e "$W/first.$1" ] && return 0
+    sleep 0.1
+  done
+  fail "shard $1 did not start vista"
+}
+
+opt() { sed -n "s/^--$2=//p" "$S/jobs/$1/options" | tail -1; }  # opt JOBID NAME: the value that applies
+
+# The array tasks of a job: "1-3", "2,5" or "3-4" expanded.
+tasks() {
+  local spec k
+  spec="$(opt "$1" array)"
+  for k in ${spec//,/ }; do
+    case "$k" in *-*) seq "${k%-*}" "${k#*-}" ;; *) echo "$k" ;; esac
+  done
+}
+
+# start JOBID [TASK]: starts the batch script as slurmd does; PID is its pid
+# (a process group of its own, so that a cancel reaches vista too). The
+# task's own job id is JOBID + TASK, its array job id JOBID.
+start() {
+  local id=$1 k=${2:-} d="$S/jobs/$1" jid out restarts
+  jid=$id
+  local -a vars=(SLURM_JOB_ID="$id" SLURM_SUBMIT_DIR="$(cat "$d/cwd")" SLURM_JOB_NAME="$(opt "$id" job-name)")
+  out="$(opt "$id" output)"
+  if [ -n "$k" ]; then
+    jid=$((id + k))
+    local -a ks
+    mapfile -t ks < <(tasks "$id")
+    vars=(SLURM_JOB_ID="$jid" SLURM_ARRAY_JOB_ID="$id" SLURM_ARRAY_TASK_ID="$k" SLURM_ARRAY_TASK_COUNT="${#ks[@]}"
+      SLURM_ARRAY_TASK_MIN="${ks[0]}" SLURM_ARRAY_TASK_MAX="${ks[-1]}" "${vars[@]:1}")
+    out="${out//%a/$k}"
+  fi
+  restarts=$(grep -c "^$jid\$" "$S/requeued" || true)
+  [ "$restarts" -gt 0 ] && vars+=(SLURM_RESTART_COUNT="$restarts")
+  out="${out//%A/$id}"
+  out="${out//%j/$jid}"
+  out="${out//%x/$(opt "$id" job-name)}"
+  case "$out" in /*) ;; *) out="$(cat "$d/cwd")/$out" ;; esac
+  echo "$out" >"$d/log.$jid"
+  [ "$(opt "$id" open-mode)" = append ] || : >"$out"  # Slurm truncates the log of a rerun by default
+  (cd "$(cat "$d/cwd")" && exec setsid env -i bash --noprofile --norc -c \
+    'while IFS= read -r -d "" kv; do export "$kv" 2>/dev/null || true; done <"$1"; shift; exec env "$@"' \
+    _ "$d/env" "${vars[@]}" bash "$d/script" >>"$out" 2>&1) &
+  PID=$!
+}
+
+# run JOBID [TASK]: runs it to the end; RC is its exit code.
+run() {
+  start "$@"
+  RC=0
+  wait "$PID" || RC=$?
+}
+
+# --- set -u: the scripts with VISTA_ARGS unset, vista a recorder ------------
+cat >"$W/bin/vista-argv" <<'EOF'
+#!/usr/bin/env bash
+printf '%s\n' "$*" >>"$ARGV_LOG"
+EOF
+chmod +x "$W/bin/vista-argv"
+(
+  unset VISTA_ARGS
+  export ARGV_LOG="$W/argv" VISTA="$W/bin/vista-argv" VISTA_JOB=gen VISTA_SHARDS=4 VISTA_OUT=/x/c.paged
+  SLURM_ARRAY_TASK_ID=2 bash "$JOBS/slurm-array.sbatch"
+  bash "$JOBS/slurm-merge.sbatch"
+  VISTA_JOB=bake VISTA_CITY=/x/c.osgb VISTA_OUT=/x/c.baked.osgb SLURM_ARRAY_TASK_ID=4 bash "$JOBS/slurm-array.sbatch"
+) 2>"$W/unset.err" || { cat "$W/unset.err"; fail "a script fails with VISTA_ARGS unset"; }
+expected="gen -q -o /x/c.paged --shard 2/4
+gen -q -o /x/c.paged --merge --shards 4
+bake /x/c.osgb -q -o /x/c.baked.osgb --shard 4/4"
+[ "$(cat "$W/argv")" = "$expected" ] || fail "with VISTA_ARGS unset the scripts ran: $(cat "$W/argv")"
+ok "the scripts run with VISTA_ARGS unset (set -u)"
+
+# Bad input (exit 2) is not retried; nor is a failure once VISTA_MAX_RESTARTS is reached.
+printf '#!/usr/bin/env bash\nexit "$EXIT"\n' >"$W/bin/vista-exit"
+chmod +x "$W/bin/vista-exit"
+for c in "2 0" "1 3"; do
+  set -- $c
+  rc=0
+  VISTA="$W/bin/vista-exit" EXIT=$1 SLURM_RESTART_COUNT=$2 SLURM_JOB_ID=99 SLURM_ARRAY_TASK_ID=1 VISTA_JOB=gen \
+    VISTA_SHARDS=2 VISTA_OUT=/x/c.paged bash "$JOBS/slurm-array.sbatch" 2>>"$W/retry.err" || rc=$?
+  [ "$rc" = "$1" ] || fail "vista exiting $1 made the task exit $rc"
+done
+[ ! -s "$S/requeued" ] || fail "requeued after bad input or past VISTA_MAX_RESTARTS: $(cat "$W/retry.err")"
+ok "bad input and a task past VISTA_MAX_RESTARTS are not requeued"
+
+# --- the single-machine run -------------------------------------------------
+ARGS=(--size 1500 --seed 3 --detail 1 --region-size 500)
+"$VISTA_BIN" gen "${ARGS[@]}" -q -o "$W/one.paged"
+
+# --- vista as the cluster sees it: shard 1 runs into its time limit, shard 2
+# --- fails after damaging a region file, shard 3 is cancelled; each only once.
+cat >"$W/bin/vista-cluster" <<EOF
+#!/usr/bin/env bash
+# Every run's peak RSS (KiB) and arguments go to $W/rss.
+shard=""
+for a in "\$@"; do case "\$a" in */3) shard="\$a" ;; esac; done
+first="$W/first.\${shard%/*}"
+if [ -n "\$shard" ] && [ ! -e "\$first" ]; then
+  : >"\$first"
+  case "\$shard" in
+    1/3 | 3/3) exec sleep 600 ;;  # long: stopped by the time limit / cancelled
+    2/3)
+      "$VISTA_BIN" "\$@" || exit
+      out="\$(printf '%s\n' "\$@" | grep '\.paged\$')"
+      region="\$(ls "\$out"/region_*.osgb | grep -v coarse | head -1)"
+      truncate -s 100 "\$region"  # killed while writing it
+      exit 137 ;;
+  esac
+fi
+exec /usr/bin/time -a -o "$W/rss" -f "%M \$*" "$VISTA_BIN" "\$@"
+EOF
+chmod +x "$W/bin/vista-cluster"
+
+cd "$W/submit"
+export VISTA="$W/bin/vista-cluster"
+VISTA_SBATCH_OPTS="--partition=debug --account=maps" \
+  "$JOBS/slurm-submit.sh" gen 3 "$W/arr.paged" "${ARGS[@]}" >"$W/submit1.out"
+array=1000 merge=1100
+grep -q "array job $array .*merge job $merge" "$W/submit1.out" || fail "submit printed: $(cat "$W/submit1.out")"
+[ ! -e "$S/errors" ] || fail "$(cat "$S/errors")"
+for j in $array $merge; do
+  grep -qx -- "--partition=debug" "$S/jobs/$j/argv" && grep -qx -- "--account=maps" "$S/jobs/$j/argv" \
+    || fail "VISTA_SBATCH_OPTS did not reach sbatch for job $j: $(tr '\n' ' ' <"$S/jobs/$j/argv")"
+done
+ok "VISTA_SBATCH_OPTS reach sbatch"
+[ "$(opt $array array)" = 1-3 ] || fail "array $(opt $array array)"
+[ "$(opt $merge dependency)" = "afterany:$array" ] || fail "merge dependency '$(opt $merge dependency)'"
+[ "$(opt $array signal)" = "B:USR1@180" ] && grep -qx -- --requeue "$S/jobs/$array/options" \
+  || fail "the array asks for no time-limit warning or no requeue"
+
+# Shard 1: the time limit is near (SIGUSR1 to the batch shell).
+start $array 1
+started 1
+kill -USR1 "$PID"
+rc=0
+wait "$PID" || rc=$?
+grep -qx "$((array + 1))" "$S/requeued" || fail "shard 1 did not requeue itself before the time limit (exit $rc)"
+# Shard 2: vista fails.
+run $array 2
+rc=$RC
+[ "$rc" = 137 ] || fail "shard 2's first run exited $rc"
+grep -qx "$((array + 2))" "$S/requeued" || fail "shard 2 did not requeue itself after vista failed"
+# Shard 3: scancel (SIGTERM to every process of the job).
+start $array 3
+started 3
+kill -TERM -- "-$PID"
+wait "$PID" || true
+grep -qx "$((array + 3))" "$S/requeued" && fail "a cancelled shard requeued itself"
+ok "time limit and failure requeue the shard, a cancel does not"
+
+# The controller runs the requeued tasks again.
+for k in 1 2; do
+  run $array $k
+  rc=$RC
+  [ "$rc" = 0 ] || fail "shard $k/3 failed again (exit $rc): $(cat "$(cat "$S/jobs/$array/log.$((array + k))")")"
+done
+grep -q "attempt 2" "$(cat "$S/jobs/$array/log.$((array + 2))")" || fail "shard 2's log lost a run (open-mode=append)"
+grep -q "requeueing" "$(cat "$S/jobs/$array/log.$((array + 2))")" || fail "shard 2's log does not say it requeued"
+
+# afterany: every task has ended, the merge runs and names shard 3/3.
+run $merge
+rc=$RC
+mlog="$(cat "$S/jobs/$merge/log.$merge")"
+[ "$rc" = 2 ] || fail "the merge with shard 3 missing exited $rc: $(cat "$mlog")"
+grep -q "run shard 3/3 again" "$mlog" || fail "the merge does not name shard 3/3: $(cat "$mlog")"
+[ ! -e "$W/arr.paged/index.osgb" ] || fail "a refused merge wrote the index"
+fix="$(grep -o 'VISTA_SHARD_LIST=3 .*slurm-submit.sh .*' "$mlog")" || fail "no command to run shard 3 again: $(cat "$mlog")"
+ok "the merge names shard 3/3 and prints: $fix"
+
+# Recovery, as printed: shard 3 alone, then a new merge.
+eval "$fix" >"$W/submit2.out"
+array2=1200 merge2=1300
+[ "$(opt $array2 array)" = 3 ] || fail "the rerun's array is '$(opt $array2 array)', not 3"
+[ "$(opt $merge2 dependency)" = "afterany:$array2" ] || fail "the new merge waits for '$(opt $merge2 dependency)'"
+run $array2 3
+rc=$RC
+[ "$rc" = 0 ] || fail "shard 3 rerun exited $rc"
+run $merge2
+rc=$RC
+[ "$rc" = 0 ] || fail "the second merge exited $rc: $(cat "$(cat "$S/jobs/$merge2/log.$merge2")")"
+diff -r "$W/one.paged" "$W/arr.paged" >/dev/null || fail "shards + requeues + merge differ from one run"
+ok "shards, requeues, a rerun and the merge = one run, byte for byte ($(find "$W/arr.paged" -type f | wc -l) files)"
+
+# Logs: in arr.paged.logs, one per task (appended over its runs) and merge; none in the submit directory.
+ls "$W/arr.paged.logs/shard-${array}_1.log" "$W/arr.paged.logs/shard-${array}_2.log" \
+  "$W/arr.paged.logs/shard-${array2}_3.log" "$W/arr.paged.logs/merge-$merge.log" >/dev/null \
+  || fail "logs missing from arr.paged.logs: $(ls "$W/arr.paged.logs")"
+[ -z "$(ls -A "$W/submit")" ] || fail "files in the submit directory: $(ls -A "$W/submit")"
+ok "logs in OUT.logs, nothing in the submit directory"
+
+# The merge's memory: what it asks for covers its measured peak, and is not the shard's.
+mem="$(opt $merge2 mem)"
+[ "$mem" = 1G ] || fail "the gen merge asks for --mem=$mem"
+peak="$(grep -- '--merge' "$W/rss" | tail -1 | cut -d' ' -f1)"
+[ -n "$peak" ] && [ "$peak" -lt $((1024 * 1024)) ] || fail "the merge's peak ${peak:-?} KiB is over its 1G"
+ok "gen merge asks for 1G, peaks at $((peak / 1024)) MiB"
+truncate -s 50M "$W/c.osgb"
+VISTA="$W/bin/vista-argv" VISTA_SHARD_LIST=2-3 "$JOBS/slurm-submit.sh" bake 4 "$W/c.baked.osgb" "$W/c.osgb" >/dev/null
+[ "$(opt 1500 mem)" = 2248M ] || fail "the bake merge of a 50 MB city asks for --mem=$(opt 1500 mem), not 2048 + 4 x 50 MB"
+[ "$(opt 1400 array)" = 2-3 ] || fail "VISTA_SHARD_LIST=2-3 gave --array=$(opt 1400 array)"
+ok "bake merge sized from the city file (2248M for 50 MB)"
+echo "PASS"
