@@ -353,12 +353,14 @@ Result<BakeReport> runBakeJob(const BakeJob& job, Progress* progress,
     rep.cells = selected->size();
     rep.shardCells = mine.size();
     std::error_code ec;
-    std::filesystem::create_directories(rep.workDir, ec);
-    if (ec || access(rep.workDir.c_str(), W_OK) != 0)
-        return Status::error("--work '" + rep.workDir + "': cannot create or write the directory");
+    CreatedDirectories made;  // a run that leaves the work directory it made empty removes it
+    VISTA_RETURN_IF_ERROR(made.create("--work", rep.workDir));
+    if (access(rep.workDir.c_str(), W_OK) != 0)
+        return Status::error("--work '" + rep.workDir + "': cannot write the directory: " + errnoText());
 
     if (!job.merge) {
         VISTA_RETURN_IF_ERROR(bakeMissingCells(job, in, mine, p, configHash, rep, progress, log));
+        made.keep();
         if (job.shardN > 1) {  // a shard bakes; --merge assembles
             rep.wallS = wall.ms() / 1000.0;
             return rep;

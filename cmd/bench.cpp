@@ -109,21 +109,22 @@ Result<Image> supersampledReference(BenchRun& run, const Camera& cam, int k) {
     return averageImages(subs);
 }
 
-// The first image of every mode and the N lowest-PSNR frames per mode (with
-// their references), written as PNGs at the end.
+// The first image of every mode, every frame with --save-frames, and the N
+// lowest-PSNR frames per mode (with their references, written at the end),
+// each staged into `batch`: the run's outputs appear together when it
+// succeeds, none of them when it fails.
 class FrameImages {
 public:
-    FrameImages(const BenchConfig& cfg, size_t modes) : _cfg(cfg), _worst(modes) {}
+    FrameImages(const BenchConfig& cfg, size_t modes, OutputBatch& batch) : _cfg(cfg), _worst(modes), _batch(batch) {}
     Status add(size_t mi, const BenchFrameRecord& rec, const Image& img, const Image& ref) {
         if (_cfg.outDir.empty()) return Status::ok();
-        if (rec.frame == 0) VISTA_RETURN_IF_ERROR(writePng(img, path("first_" + rec.mode + ".png")));
+        if (rec.frame == 0) VISTA_RETURN_IF_ERROR(writePng(img, stage("first_" + rec.mode + ".png")));
         if (_cfg.saveFrames) {
             char name[64];
             std::snprintf(name, sizeof name, "f%04d_", rec.frame);
-            std::error_code ec;
-            std::filesystem::create_directories(std::filesystem::path(_cfg.outDir) / "frames", ec);
-            VISTA_RETURN_IF_ERROR(
-                writePng(img, (std::filesystem::path(_cfg.outDir) / "frames" / (name + rec.mode + ".png")).string()));
+            VISTA_RETURN_IF_ERROR(writePng(
+                img,
+                _batch.stage((std::filesystem::path(_cfg.outDir) / "frames" / (name + rec.mode + ".png")).string())));
         }
         if (_cfg.worstFrames <= 0 || (mi == 0 && _cfg.referenceSsaa < 2)) return Status::ok();
         auto& w = _worst[mi];
@@ -139,10 +140,10 @@ public:
             for (size_t k = 0; k < list.size(); ++k) {
                 const Worst& w = list[k];
                 const std::string stem =
-                    path("worst" + std::to_string(k + 1) + "_" + w.mode + "_f" + std::to_string(w.frame));
-                VISTA_RETURN_IF_ERROR(writePng(w.image, stem + ".png"));
-                VISTA_RETURN_IF_ERROR(writePng(w.reference, stem + "_ref.png"));
-                VISTA_RETURN_IF_ERROR(writePng(differenceImage(w.image, w.reference), stem + "_diff.png"));
+                    "worst" + std::to_string(k + 1) + "_" + w.mode + "_f" + std::to_string(w.frame);
+                VISTA_RETURN_IF_ERROR(writePng(w.image, stage(stem + ".png")));
+                VISTA_RETURN_IF_ERROR(writePng(w.reference, stage(stem + "_ref.png")));
+                VISTA_RETURN_IF_ERROR(writePng(differenceImage(w.image, w.reference), stage(stem + "_diff.png")));
             }
         return Status::ok();
     }
@@ -154,9 +155,13 @@ private:
         std::string mode;
         Image image, reference;
     };
-    std::string path(const std::string& name) const { return (fs::path(_cfg.outDir) / "images" / name).string(); }
+    // The staged file of images/NAME.
+    std::string stage(const std::string& name) const {
+        return _batch.stage((fs::path(_cfg.outDir) / "images" / name).string());
+    }
     const BenchConfig& _cfg;
     std::vector<std::vector<Worst>> _worst;
+    OutputBatch& _batch;
 };
 
 void reportProgress(const BenchConfig& cfg, size_t done, size_t total, const Stopwatch& sw) {
@@ -169,7 +174,7 @@ void reportProgress(const BenchConfig& cfg, size_t done, size_t total, const Sto
 }
 
 // --dump-rays: the pixels mode `m` traced in frame f as a RaySet file.
-Status dumpRays(const RenderMode& m, int f, const Camera& cam, const BenchConfig& cfg) {
+Status dumpRays(const RenderMode& m, int f, const Camera& cam, const BenchConfig& cfg, OutputBatch& batch) {
     const std::vector<uint32_t>* traced = m.lastTracedPixels();
     if (cfg.dumpRaysDir.empty() || !traced || f % cfg.dumpRaysEvery != 0) return Status::ok();
     RaySet set;
@@ -180,12 +185,12 @@ Status dumpRays(const RenderMode& m, int f, const Camera& cam, const BenchConfig
     set.pixels = *traced;
     char name[64];
     std::snprintf(name, sizeof name, "_f%04d.rays", f);
-    return writeRaySet((fs::path(cfg.dumpRaysDir) / (m.name() + name)).string(), set);
+    return writeRaySet(batch.stage((fs::path(cfg.dumpRaysDir) / (m.name() + name)).string()), set);
 }
 
 // Renders every frame in every mode (interleaved) and scores it.
 Status renderFrames(BenchRun& run, const Path& path, const std::vector<size_t>& idx, const Camera& base,
-                    const BenchConfig& cfg, BenchResult& result, FrameImages& images) {
+                    const BenchConfig& cfg, BenchResult& result, FrameImages& images, OutputBatch& batch) {
     Image img, ref;
     Stopwatch sw;
     for (size_t f = 0; f < idx.size(); ++f) {
@@ -205,7 +210,7 @@ Status renderFrames(BenchRun& run, const Path& path, const std::vector<size_t>& 
             rec.mode = run.modes[mi]->name();
             Status st = run.modes[mi]->renderFrame(cam, img, rec.stats);
             if (!st) return Status::error("mode " + rec.mode + ", frame " + std::to_string(f) + ": " + st.message());
-            VISTA_RETURN_IF_ERROR(dumpRays(*run.modes[mi], int(f), cam, cfg));
+            VISTA_RETURN_IF_ERROR(dumpRays(*run.modes[mi], int(f), cam, cfg, batch));
             if (!img.valid() || img.width != cfg.width || img.height != cfg.height)
                 return Status::error("mode " + rec.mode + " returned an image of the wrong size");
             if (mi == 0 && cfg.referenceSsaa < 2) ref = img;
@@ -267,14 +272,15 @@ Result<BenchResult> runBenchmark(const SceneModel* city, osg::Node* scene, const
         const auto& ms = (*run)->modes;
         if (std::none_of(ms.begin(), ms.end(), [](const auto& m) { return m->lastTracedPixels() != nullptr; }))
             return Status::error("--dump-rays: no mode among --modes has a far-field ray stage (hybrid has)");
-        std::error_code ec;
-        fs::create_directories(cfg.dumpRaysDir, ec);
-        if (ec) return Status::error("--dump-rays '" + cfg.dumpRaysDir + "': cannot create directory: " + ec.message());
     }
+    // Every output file is staged and committed at the end; directories made
+    // here that stay empty (a failed run) are removed again.
+    OutputBatch batch;
+    CreatedDirectories made;
+    if (!cfg.dumpRaysDir.empty()) VISTA_RETURN_IF_ERROR(made.create("--dump-rays", cfg.dumpRaysDir));
     if (!cfg.outDir.empty()) {
-        std::error_code ec;
-        fs::create_directories(fs::path(cfg.outDir) / "images", ec);
-        if (ec) return Status::error("--out '" + cfg.outDir + "': cannot create directory: " + ec.message());
+        VISTA_RETURN_IF_ERROR(made.create("--out", (fs::path(cfg.outDir) / "images").string()));
+        if (cfg.saveFrames) VISTA_RETURN_IF_ERROR(made.create("--out", (fs::path(cfg.outDir) / "frames").string()));
     }
     Camera base;
     base.width = cfg.width;
@@ -285,8 +291,8 @@ Result<BenchResult> runBenchmark(const SceneModel* city, osg::Node* scene, const
     if (cfg.warmup) VISTA_RETURN_IF_ERROR(warmUp(**run, path.camera(idx[0], base)));
 
     result.loadAvgStart = loadAverage();
-    FrameImages images(cfg, (*run)->modes.size());
-    VISTA_RETURN_IF_ERROR(renderFrames(**run, path, idx, base, cfg, result, images));
+    FrameImages images(cfg, (*run)->modes.size(), batch);
+    VISTA_RETURN_IF_ERROR(renderFrames(**run, path, idx, base, cfg, result, images, batch));
     result.memory.push_back(memoryPhase("frames"));
     result.loadAvgEnd = loadAverage();
     result.glRenderer = (*run)->renderer->glRenderer();
@@ -296,9 +302,12 @@ Result<BenchResult> runBenchmark(const SceneModel* city, osg::Node* scene, const
             summariseMode(result, cfg.modes[mi], speedupBases(), double(cfg.width) * double(cfg.height)));
         result.modes.back().setupMs = (*run)->setup[mi];
     }
-    if (cfg.outDir.empty()) return result;
-    VISTA_RETURN_IF_ERROR(writeBenchOutputs(result, cfg, city, path));
-    VISTA_RETURN_IF_ERROR(images.writeWorst());
+    if (!cfg.outDir.empty()) {
+        VISTA_RETURN_IF_ERROR(writeBenchOutputs(result, cfg, city, path, batch));
+        VISTA_RETURN_IF_ERROR(images.writeWorst());
+    }
+    VISTA_RETURN_IF_ERROR(batch.commit());
+    made.keep();
     return result;
 }
 

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "cmd/memory.h"
+#include "foundation/atomic_file.h"
 #include "foundation/statistics.h"
 #include "foundation/status.h"
 #include "nodes/render/render_mode.h"
@@ -136,7 +137,9 @@ ModeSummary summariseMode(const BenchResult& r, const std::string& mode, const s
 // The bases of speedups in summaries: full, near, raycast.
 const std::vector<std::string>& speedupBases();
 
-// frames.csv, summary.json, frame_time.png, quality.png (bench_output.cpp).
-Status writeBenchOutputs(const BenchResult& r, const BenchConfig& cfg, const SceneModel* city, const Path& path);
+// frames.csv, summary.json, frame_time.png, quality.png (bench_output.cpp),
+// each staged into `batch` (the caller commits).
+Status writeBenchOutputs(const BenchResult& r, const BenchConfig& cfg, const SceneModel* city, const Path& path,
+                         OutputBatch& batch);
 
 }  // namespace vista

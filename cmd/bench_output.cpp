@@ -173,7 +173,7 @@ json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneM
 }
 
 // Frame time per frame (thesis Fig. 4.8) and quality per frame.
-Status writePlots(const BenchResult& result, const BenchConfig& cfg) {
+Status writePlots(const BenchResult& result, const BenchConfig& cfg, OutputBatch& batch) {
     PlotSpec pt, pq;
     pt.title = "Frame time per frame";
     pt.xLabel = "frame";
@@ -196,18 +196,19 @@ Status writePlots(const BenchResult& result, const BenchConfig& cfg) {
         pt.series.push_back(st);
         if (mi > 0 || cfg.referenceSsaa >= 2) pq.series.push_back(sq);
     }
-    VISTA_RETURN_IF_ERROR(writePng(renderPlot(pt), (fs::path(cfg.outDir) / "frame_time.png").string()));
-    return writePng(renderPlot(pq), (fs::path(cfg.outDir) / "quality.png").string());
+    VISTA_RETURN_IF_ERROR(writePng(renderPlot(pt), batch.stage((fs::path(cfg.outDir) / "frame_time.png").string())));
+    return writePng(renderPlot(pq), batch.stage((fs::path(cfg.outDir) / "quality.png").string()));
 }
 
 }  // namespace
 
-Status writeBenchOutputs(const BenchResult& result, const BenchConfig& cfg, const SceneModel* city, const Path& path) {
+Status writeBenchOutputs(const BenchResult& result, const BenchConfig& cfg, const SceneModel* city, const Path& path,
+                         OutputBatch& batch) {
     const fs::path dir(cfg.outDir);
-    VISTA_RETURN_IF_ERROR(writeFileAtomic((dir / "frames.csv").string(), framesCsv(result)));
-    VISTA_RETURN_IF_ERROR(
-        writeFileAtomic((dir / "summary.json").string(), summaryJson(result, cfg, city, path).dump(2) + "\n"));
-    return writePlots(result, cfg);
+    VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage((dir / "frames.csv").string()), framesCsv(result)));
+    VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage((dir / "summary.json").string()),
+                                          summaryJson(result, cfg, city, path).dump(2) + "\n"));
+    return writePlots(result, cfg, batch);
 }
 
 }  // namespace vista

@@ -201,10 +201,7 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
     cfg.cityLabel = fs::path(cityFile).filename().string();
     cfg.effectsDeclared = effectsToJson(city.params.effects);
     auto r = runBenchmark(&city, sceneRoot(city), walk->path, cfg);
-    if (!r) {
-        std::fprintf(stderr, "%s: %s\n", kCmd, r.status().message().c_str());
-        return 1;
-    }
+    if (!r) return reportBadInput(kCmd, r.status());
     if (!a.quiet) printTable(r.value());
     if (res) *res = std::move(r.value());
     if (cityTriangles) *cityTriangles = city.triangles;
@@ -289,10 +286,7 @@ int runSweep(const BenchArgs& a) {
         std::error_code ec;
         fs::remove(cityFile, ec);  // cities are large; regenerate from the command if needed
     }
-    if (Status s = table.write(a, withFullFirst(a.cfg).modes); !s) {
-        std::fprintf(stderr, "%s: %s\n", kCmd, s.message().c_str());
-        return 1;
-    }
+    if (Status s = table.write(a, withFullFirst(a.cfg).modes); !s) return reportBadInput(kCmd, s);
     std::printf("%s", table.markdown.c_str());
     return 0;
 }

@@ -228,6 +228,8 @@ int runPaged(const GenArgs& a, const CityParams& params, const Stopwatch& total)
     }
     StderrProgress progress(isatty(2));
     o->progress = a.quiet ? nullptr : &progress;
+    OutputBatch batch;  // index and manifest, committed with --stats
+    o->batch = &batch;
     auto rep = generatePagedCity(params, *o);
     if (!rep) return reportBadInput(kCmd, rep.status());
     const double totalSeconds = total.ms() / 1000.0;
@@ -260,8 +262,9 @@ int runPaged(const GenArgs& a, const CityParams& params, const Stopwatch& total)
         j["memory"] = {{"estimate_mb", estimateMb},
                        {"budget_gb", a.budgetGb > 0 ? nlohmann::json(a.budgetGb) : nlohmann::json(nullptr)}};
         j["threads"] = params.threads;
-        if (Status s = writeFileAtomic(a.statsFile, j.dump(2) + "\n"); !s) return reportBadInput(kCmd, s);
+        if (Status s = writeFileAtomic(batch.stage(a.statsFile), j.dump(2) + "\n"); !s) return reportBadInput(kCmd, s);
     }
+    if (Status s = batch.commit(); !s) return reportBadInput(kCmd, s);
     if (!a.quiet)
         std::fprintf(
             stderr,

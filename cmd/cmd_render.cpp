@@ -593,13 +593,10 @@ void printResult(const RenderArgs& a, const RenderPlan& p, size_t frames, const 
     line("write instance", tm.writeInstance);
 }
 
-int fail(const Status& s) {
-    std::fprintf(stderr, "%s: %s\n", kCmd, s.message().c_str());
-    return 1;
-}
-
-// The command's steps: options, city and path, work directory (bad input
-// so far: exit 2), set-up, frames, metadata and commit (failures: exit 1).
+// The command's steps: options, city and path, work directory, set-up,
+// frames, metadata and commit; any failure (bad input, a write that fails,
+// no display) is a message and exit 2. Finished frames stay in OUT.partial
+// for the rerun.
 int run(const RenderArgs& a, const std::string& command) {
     RenderPlan plan;
     if (Status s = configure(a, plan); !s) return reportBadInput(kCmd, s);
@@ -611,14 +608,14 @@ int run(const RenderArgs& a, const std::string& command) {
     if (Status s = openWorkDir(a, plan, walk->path, idx, out); !s) return reportBadInput(kCmd, s);
 
     RenderSession session;
-    if (Status s = setUp(a.mode, plan, walk->city, session); !s) return fail(s);
+    if (Status s = setUp(a.mode, plan, walk->city, session); !s) return reportBadInput(kCmd, s);
     Progressed done = finishedFrames(out, plan.channels, idx.size());
     nlohmann::json frames = nlohmann::json::array();
-    if (Status s = renderFrames(a, plan, *walk, idx, session, out, done, frames); !s) return fail(s);
+    if (Status s = renderFrames(a, plan, *walk, idx, session, out, done, frames); !s) return reportBadInput(kCmd, s);
     Timings tm;  // every frame's, whichever run rendered it
     for (const auto& r : done.records) tm.add(r);
     if (Status s = writeMetadata(a, plan, command, walk->city, idx, frames, tm, done.kept, *session.renderer, out); !s)
-        return fail(s);
+        return reportBadInput(kCmd, s);
     printResult(a, plan, idx.size(), tm, out);
     return 0;
 }

@@ -27,9 +27,9 @@ std::mutex gTempsMutex;
 std::unordered_map<std::string, std::vector<std::string>> gTempNames;
 
 // The pid of `f` if it is a temporary of `name` ("<name>.tmp.<pid>",
-// "<name>.stage.<pid>" or "<name>.stage.<pid>.tmp.<pid>"), else 0.
+// "<name>.stage.<pid>", "<name>.stage.<pid>.tmp.<pid>" or "<name>.prev.<pid>"), else 0.
 long tempOwner(const std::string& f, const std::string& name) {
-    for (const char* tag : {".tmp.", ".stage."}) {
+    for (const char* tag : {".tmp.", ".stage.", ".prev."}) {
         const std::string prefix = name + tag;
         if (f.size() <= prefix.size() || f.compare(0, prefix.size(), prefix) != 0) continue;
         std::string digits = f.substr(prefix.size());
@@ -62,7 +62,8 @@ int removeStaleTemps(const std::string& path) {
         std::vector<std::string> names;
         for (fs::directory_iterator d(dir, ec), end; !ec && d != end; d.increment(ec)) {
             std::string f = d->path().filename().string();
-            if (f.find(".tmp.") != std::string::npos || f.find(".stage.") != std::string::npos)
+            if (f.find(".tmp.") != std::string::npos || f.find(".stage.") != std::string::npos ||
+                f.find(".prev.") != std::string::npos)
                 names.push_back(std::move(f));
         }
         it = gTempNames.emplace(dir.string(), std::move(names)).first;
@@ -99,10 +100,65 @@ Status OutputBatch::commit() {
     for (const auto& f : _files)
         if (::access(f.first.c_str(), F_OK) != 0)
             return Status::error("cannot write '" + f.second + "': its staged file is missing");
-    for (const auto& f : _files)
-        if (::rename(f.first.c_str(), f.second.c_str()) != 0)
-            return Status::error("cannot write '" + f.second + "': rename failed: " + errnoText());
+    // Each output that exists keeps a second name ("<path>.prev.<pid>", a hard
+    // link) until every rename is done, so that a failed rename can put the
+    // previous outputs back: all new outputs appear, or none.
+    const std::string pid = std::to_string(::getpid());
+    std::vector<std::string> kept(_files.size());  // "" = no previous file (or no hard link possible)
+    std::vector<bool> existed(_files.size(), false);
+    auto undo = [&](size_t renamed) {
+        for (size_t j = 0; j < renamed; ++j) {
+            if (!kept[j].empty()) ::rename(kept[j].c_str(), _files[j].second.c_str());
+            else if (!existed[j]) ::unlink(_files[j].second.c_str());
+        }
+        for (size_t j = renamed; j < _files.size(); ++j) {
+            if (!kept[j].empty()) ::unlink(kept[j].c_str());
+            ::unlink(_files[j].first.c_str());  // the staged files not renamed
+        }
+    };
+    for (size_t k = 0; k < _files.size(); ++k) {
+        const std::string& target = _files[k].second;
+        const std::string prev = target + ".prev." + pid;
+        ::unlink(prev.c_str());
+        if (::link(target.c_str(), prev.c_str()) == 0) {
+            kept[k] = prev;
+            existed[k] = true;
+        } else {
+            existed[k] = errno != ENOENT;
+        }
+        if (::rename(_files[k].first.c_str(), target.c_str()) != 0) {
+            const std::string e = errnoText();
+            undo(k);
+            return Status::error("cannot write '" + target + "': rename failed: " + e);
+        }
+    }
+    for (const std::string& k : kept)
+        if (!k.empty()) ::unlink(k.c_str());
     _committed = true;
+    return Status::ok();
+}
+
+CreatedDirectories::~CreatedDirectories() {
+    for (auto it = _made.rbegin(); it != _made.rend(); ++it) ::rmdir(it->c_str());  // fails unless empty
+}
+
+Status CreatedDirectories::create(const std::string& option, const std::string& path) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    std::vector<std::string> missing;
+    fs::path d = fs::path(path).lexically_normal();
+    if (!d.has_filename()) d = d.parent_path();  // "out/" -> "out"
+    for (; !d.empty() && !fs::exists(fs::symlink_status(d, ec)); d = d.parent_path()) {
+        missing.push_back(d.string());
+        if (!d.has_parent_path() || d.parent_path() == d) break;
+    }
+    for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
+        if (::mkdir(it->c_str(), 0777) == 0) _made.push_back(*it);
+        else if (errno != EEXIST)
+            return Status::error("option " + option + " = '" + path + "': cannot create directory '" + *it +
+                                 "': " + errnoText());
+    }
+    if (!fs::is_directory(path, ec)) return Status::error("option " + option + " = '" + path + "': not a directory");
     return Status::ok();
 }
 

@@ -31,7 +31,8 @@ Status checkWritableDirectory(const std::string& option, const std::string& path
 std::string errnoText();
 
 // Removes the leftovers of killed runs next to `path`: "<path>.tmp.<pid>",
-// "<path>.stage.<pid>" and "<path>.stage.<pid>.tmp.<pid>" whose process no longer exists (kill(pid, 0) fails
+// "<path>.stage.<pid>", "<path>.stage.<pid>.tmp.<pid>" and "<path>.prev.<pid>"
+// whose process no longer exists (kill(pid, 0) fails
 // with ESRCH). Files of live processes (a concurrent writer) are kept.
 // Returns how many were removed. Called by every writer before it writes.
 // A directory is listed once per process (its names that look like
@@ -45,9 +46,12 @@ int removeStaleTemps(const std::string& path);
 // output to stage(path) (with any atomic writer), then commit() renames every
 // staged file over its path. If commit() is never reached (an error, an
 // exception) the destructor removes the staged files, so no output of a
-// failed command appears. A rename failure in commit() is reported; files
-// renamed before it stay (rename is the only step that can still fail and
-// it does not fail for lack of space).
+// failed command appears. A rename failure in commit() is reported and the
+// renames before it are undone and the staged files removed: each output
+// that existed is kept under a second name ("<path>.prev.<pid>", a hard
+// link, removed after the last rename) and put back, each that did not is
+// removed. (Where hard links are not possible, a previous file renamed over
+// before the failure stays replaced.)
 class OutputBatch {
 public:
     OutputBatch() = default;
@@ -60,6 +64,27 @@ public:
 private:
     std::vector<std::pair<std::string, std::string>> _files;  // (staged, final)
     bool _committed = false;
+};
+
+// The directories a command creates for its outputs, removed again when a
+// failed command leaves them empty: create() is std::filesystem::create_directories
+// that remembers each directory it made; unless keep() was called, the
+// destructor removes those that are empty, deepest first (one that holds something, such as the whole
+// results a rerun resumes from, stays, and so do its ancestors). So a run
+// that fails before it writes into a directory leaves no directory behind.
+// Errors name `option`, the path and the reason. Not thread-safe.
+class CreatedDirectories {
+public:
+    CreatedDirectories() = default;
+    CreatedDirectories(const CreatedDirectories&) = delete;
+    CreatedDirectories& operator=(const CreatedDirectories&) = delete;
+    ~CreatedDirectories();
+    Status create(const std::string& option, const std::string& path);
+    // The command succeeded: every directory stays, empty or not.
+    void keep() { _made.clear(); }
+
+private:
+    std::vector<std::string> _made;  // in the order made (parents first)
 };
 
 }  // namespace vista

@@ -289,10 +289,9 @@ Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedC
                              " out of range");
     VISTA_RETURN_IF_ERROR(checkPagedOutput("-o", o.dir));
     std::error_code ec;
-    if (!o.merge) {  // a merge only reads (and writes index and manifest once every region is there)
-        fs::create_directories(fs::path(o.dir) / "records", ec);
-        if (ec) return Status::error("cannot create '" + (fs::path(o.dir) / "records").string() + "': " + ec.message());
-    }
+    CreatedDirectories made;  // removed again if the run leaves them empty
+    if (!o.merge)             // a merge only reads (and writes index and manifest once every region is there)
+        VISTA_RETURN_IF_ERROR(made.create("-o", (fs::path(o.dir) / "records").string()));
 
     const RegionGrid grid(params, o.regionSizeM);
     const std::string keyText = paramsToJson(params) + "\nregion_size_m=" + exactDecimal(o.regionSizeM) +
@@ -352,6 +351,7 @@ Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedC
         rep.triangles += (*rec).at("triangles").get<size_t>();
         for (const Json& f : (*rec).at("files")) rep.bytes += f.at("bytes").get<size_t>();
     }
+    made.keep();
     if (o.shard.count > 1 && !o.merge) return rep;
 
     const auto ti = std::chrono::steady_clock::now();
@@ -367,11 +367,12 @@ Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedC
     }
     if (!missingRegions.empty()) return missingRegionsError(o, grid, missingRegions);
     osg::ref_ptr<osg::Node> index = buildIndex(params, grid, o.regionSizeM, all);
-    OutputBatch batch;
+    OutputBatch own;
+    OutputBatch& batch = o.batch ? *o.batch : own;
     VISTA_RETURN_IF_ERROR(writeSceneFile(*index, batch.stage((fs::path(o.dir) / kPagedIndexFile).string()), false));
     VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage((fs::path(o.dir) / kPagedManifestFile).string()),
                                           manifestJson(params, grid, o.regionSizeM, all).dump(2) + "\n"));
-    VISTA_RETURN_IF_ERROR(batch.commit());
+    if (!o.batch) VISTA_RETURN_IF_ERROR(own.commit());
     rep.indexWritten = true;
     rep.indexSeconds = seconds(ti);
     if (o.merge) {  // totals over the whole city

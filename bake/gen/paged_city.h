@@ -28,12 +28,15 @@
 // Contract: params valid (validateParams; size_m up to kMaxPagedSizeM),
 // region size validateRegionSize, shard 0 <= index < count; otherwise an error
 // Status naming the field, before anything is written. `dir` must be a
-// directory or not exist (checkPagedOutput). I/O errors name the path.
+// directory or not exist (checkPagedOutput). I/O errors name the path. A run
+// that fails before it finished a region leaves no directory it created
+// (no empty DIR or records/); finished regions stay for the next run.
 #pragma once
 #include <cstdint>
 #include <string>
 
 #include "citygen/params.h"
+#include "foundation/atomic_file.h"
 #include "foundation/progress.h"
 #include "foundation/shard.h"
 #include "foundation/status.h"
@@ -48,6 +51,10 @@ struct PagedCityOptions {
     bool merge = false;
     int mergeShards = 0;  // with merge: the N of the shards' K/N (0: unknown)
     Progress* progress = nullptr;
+    // Non-null: index.osgb and manifest.json are staged into this batch and
+    // the caller commits them with its own outputs (--stats); null: they are
+    // committed here.
+    OutputBatch* batch = nullptr;
 };
 
 struct PagedCityReport {

@@ -2,7 +2,8 @@
 // resident set size sampled every 1,000 frames, to show that memory does not
 // grow with the number of frames (docs/measurements/reliability.md). A measurement driver,
 // not a test: it asserts nothing; it prints CSV (frame, rss_mb, ms_per_frame
-// over the last interval) and a last line with the growth.
+// over the last interval) and a last line with the growth (MB and percent of
+// the first sample, taken after frame 1).
 //   usage: soak CITY.osgb [FRAMES] [WIDTHxHEIGHT]   (needs an X display: xvfb-run -a)
 #include <cstdio>
 #include <cstdlib>
@@ -90,7 +91,7 @@ int main(int argc, char** argv) {
             std::fflush(stdout);
         }
     }
-    std::printf("# rss first %.1f MB, last %.1f MB, growth %.1f MB over %ld frames\n", first, last, last - first,
-                frames);
+    std::printf("# rss first %.1f MB, last %.1f MB, growth %.1f MB (%.2f %%) over %ld frames\n", first, last,
+                last - first, 100.0 * (last - first) / first, frames);
     return 0;
 }

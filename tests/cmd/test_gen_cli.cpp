@@ -184,6 +184,24 @@ TEST_F(GenCli, BenchOfABadSceneLeavesNoOutputFolder) {
     EXPECT_FALSE(fs::exists(out));
 }
 
+// AddressSanitizer (.ci/sanitize.sh builds vista and the tests alike) adds
+// shadow memory, redzones and a quarantine of freed blocks to every
+// allocation: a sanitized `vista gen` peaks at about twice the memory of a
+// normal build (a 343 MB estimate against a 702 MB peak). The estimate is of
+// a normal build; under the sanitizer the measured peak may be up to four
+// times it.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr double kPeakOverEstimateMax = 4.0;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr double kPeakOverEstimateMax = 4.0;
+#else
+constexpr double kPeakOverEstimateMax = 2.0;
+#endif
+#else
+constexpr double kPeakOverEstimateMax = 2.0;
+#endif
+
 TEST_F(GenCli, MemoryBudgetRefusesUpFrontWithNothingWritten) {
     // Too small for one file: exit 2 naming the option and the estimate; no file, no stats.
     CliRun r = runVista("gen --size 1000 --detail 1 --seed 2 -q --memory-budget 0.05 -o " + file("c.osgb") +
@@ -205,7 +223,8 @@ TEST_F(GenCli, MemoryBudgetRefusesUpFrontWithNothingWritten) {
         EXPECT_NE(r.err.find("--memory-budget"), std::string::npos) << r.err;
     }
     // A budget that fits: written, and the stats give the estimate beside the measured peak,
-    // within a factor of two of it (the estimate's stated accuracy on these cities is 20 to 35 %).
+    // within a factor of two of it (the estimate's stated accuracy on these cities is 20 to 35 %;
+    // under AddressSanitizer the peak may be up to kPeakOverEstimateMax times the estimate).
     r = runVista("gen --size 1000 --detail 2 --seed 2 -q --memory-budget 8 -o " + file("c.osgb") + " --stats " +
                  file("s.json"));
     ASSERT_EQ(r.code, 0) << r.err;
@@ -213,6 +232,6 @@ TEST_F(GenCli, MemoryBudgetRefusesUpFrontWithNothingWritten) {
     const auto j = nlohmann::json::parse(in);
     const double estimate = j.at("memory").at("estimate_mb").get<double>(), peak = j.at("peak_rss_mb").get<double>();
     EXPECT_EQ(j.at("memory").at("budget_gb").get<double>(), 8.0);
-    EXPECT_GT(estimate, peak / 2) << estimate << " vs " << peak;
+    EXPECT_GT(estimate, peak / kPeakOverEstimateMax) << estimate << " vs " << peak;
     EXPECT_LT(estimate, peak * 2) << estimate << " vs " << peak;
 }

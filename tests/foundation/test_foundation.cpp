@@ -96,12 +96,14 @@ TEST(AtomicFile, StaleTemporariesOfKilledRunsAreRemovedAndLiveOnesKept) {
     const std::string target = dir.file("city.osgb");
     const std::string dead = target + ".tmp." + std::to_string(deadPid());
     const std::string deadStage = target + ".stage." + std::to_string(deadPid());
-    const std::string live = target + ".tmp." + std::to_string(::getppid());  // the parent runs
-    const std::string other = dir.file("other.osgb.tmp.1");                   // another file's
-    for (const auto& f : {dead, deadStage, live, other}) std::ofstream(f) << "partial";
+    const std::string deadPrev = target + ".prev." + std::to_string(deadPid());  // OutputBatch's kept previous file
+    const std::string live = target + ".tmp." + std::to_string(::getppid());     // the parent runs
+    const std::string other = dir.file("other.osgb.tmp.1");                      // another file's
+    for (const auto& f : {dead, deadStage, deadPrev, live, other}) std::ofstream(f) << "partial";
     ASSERT_TRUE(writeFileAtomic(target, "whole"));
     EXPECT_FALSE(std::filesystem::exists(dead));
     EXPECT_FALSE(std::filesystem::exists(deadStage));
+    EXPECT_FALSE(std::filesystem::exists(deadPrev));
     EXPECT_TRUE(std::filesystem::exists(live)) << "a concurrent writer's file is not touched";
     EXPECT_TRUE(std::filesystem::exists(other));
     EXPECT_EQ(vista::test::readBytes(target), "whole");
@@ -129,6 +131,60 @@ TEST(AtomicFile, OutputBatchCommitsAllOrNothing) {
     OutputBatch missing;
     missing.stage(dir.file("never_written"));
     EXPECT_FALSE(missing.commit());
+}
+
+// A rename that fails in commit() (here: a directory where the second output
+// goes) undoes the renames before it: the first output's previous bytes come
+// back, an output that did not exist is removed, and no staged file or kept
+// previous file is left.
+TEST(AtomicFile, OutputBatchUndoesItsRenamesWhenOneFails) {
+    vista::test::TempDir dir("vista_batch");
+    const std::string a = dir.file("a.osgb"), b = dir.file("b.glb"), c = dir.file("c.json");
+    std::ofstream(a) << "old a";
+    OutputBatch batch;
+    ASSERT_TRUE(writeFileAtomic(batch.stage(a), "new a"));
+    ASSERT_TRUE(writeFileAtomic(batch.stage(c), "new c"));
+    ASSERT_TRUE(writeFileAtomic(batch.stage(b), "new b"));
+    ASSERT_TRUE(std::filesystem::create_directory(b));
+    std::ofstream(b + "/in_the_way") << "x";
+    const Status s = batch.commit();
+    ASSERT_FALSE(s);
+    EXPECT_NE(s.message().find("b.glb"), std::string::npos) << s.message();
+    EXPECT_EQ(vista::test::readBytes(a), "old a");
+    EXPECT_FALSE(std::filesystem::exists(c));
+    const std::set<std::string> left = vista::test::listTree(dir.path());
+    EXPECT_EQ(left, (std::set<std::string>{"a.osgb", "b.glb", "b.glb/in_the_way"}));
+}
+
+// Directories made for outputs go again when a failed run leaves them empty;
+// one that holds something stays with its ancestors; keep() keeps them all.
+TEST(AtomicFile, CreatedDirectoriesThatStayEmptyAreRemoved) {
+    namespace fs = std::filesystem;
+    vista::test::TempDir dir("vista_dirs");
+    {
+        CreatedDirectories made;
+        ASSERT_TRUE(made.create("--out", dir.file("x/y/z")));
+        ASSERT_TRUE(fs::is_directory(dir.file("x/y/z")));
+    }
+    EXPECT_FALSE(fs::exists(dir.file("x")));
+    {
+        CreatedDirectories made;
+        ASSERT_TRUE(made.create("--out", dir.file("x/y/z")));
+        std::ofstream(dir.file("x/y/whole_result")) << "x";
+    }
+    EXPECT_EQ(vista::test::listTree(dir.path()), (std::set<std::string>{"x", "x/y", "x/y/whole_result"}));
+    {
+        CreatedDirectories made;
+        ASSERT_TRUE(made.create("--out", dir.file("k/l/")));
+        made.keep();
+    }
+    EXPECT_TRUE(fs::is_directory(dir.file("k/l")));
+    std::ofstream(dir.file("afile")) << "x";
+    CreatedDirectories made;
+    const Status s = made.create("--out", dir.file("afile/sub"));
+    ASSERT_FALSE(s);
+    EXPECT_NE(s.message().find("--out"), std::string::npos) << s.message();
+    EXPECT_NE(s.message().find("afile/sub"), std::string::npos) << s.message();
 }
 
 TEST(AtomicFile, FailureNamesThePathAndKeepsTheOldFile) {
