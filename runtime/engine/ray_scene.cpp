@@ -847,7 +847,7 @@ void RayScene::allHitsMany(const glm::vec3* org, const glm::vec3* dir, int n, co
                     live[k] = 0;
                     continue;
                 }
-                const size_t i = size_t(base + k);
+                const size_t i = size_t(base) + size_t(k);
                 RayHit& h = out[i * size_t(maxHits) + size_t(counts[i])];
                 h = RayHit();
                 _impl->fill(h, rh.hit.geomID[k], rh.hit.primID[k], rh.hit.instID[0][k], rh.hit.u[k], rh.hit.v[k],
