@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "foundation/statistics.h"
 #include "foundation/timing.h"
 #include "runtime/engine/frame_raycast.h"
 #include "runtime/engine/ray_scene.h"
@@ -24,13 +25,6 @@
 using namespace vista;
 
 namespace {
-
-double median(std::vector<double> v) {
-    if (v.empty()) return 0;
-    std::sort(v.begin(), v.end());
-    const size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 int fail(const std::string& m) {
     std::fprintf(stderr, "bench_ray_regions: %s\n", m.c_str());

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "foundation/statistics.h"
 #include "runtime/engine/metrics.h"
 #include "runtime/engine/ray_scene.h"
 #include "runtime/scene/city_file.h"
@@ -32,13 +33,6 @@
 using namespace vista;
 
 namespace {
-
-double median(std::vector<double> v) {
-    if (v.empty()) return 0;
-    std::sort(v.begin(), v.end());
-    const size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 int fail(const std::string& m) {
     std::fprintf(stderr, "far_precision: %s\n", m.c_str());

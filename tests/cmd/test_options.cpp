@@ -98,7 +98,7 @@ TEST(Options, FovReferenceAndModes) {
     ASSERT_TRUE(m.isOk()) << m.status().message();
     EXPECT_EQ(m.value(), (std::vector<std::string>{"full", "near", "osglod", "hybrid"}));
     expectBad(parseModeList("full,warp"), "full,warp", "--modes",
-              "available modes: full, near, raycast, osgimpostor, osglod, hybrid, impostor");
+              "available modes: full, near, raycast, osgimpostor, osglod, hybrid, hybrid-fixed, impostor");
     expectBad(parseModeList("full,full"), "full,full", "--modes", "twice");
     expectBad(parseModeList(","), ",", "--modes", "available modes");
     EXPECT_EQ(parseModeName("raycast").value(), "raycast");
