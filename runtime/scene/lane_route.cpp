@@ -290,11 +290,7 @@ void LaneRoute::makeTour() {
 uint32_t LaneRoute::pick(uint32_t u) {
     const std::vector<uint32_t>& cand = _nodes[u].next;
     VISTA_CHECK(!cand.empty());
-    if (_tour) {  // every lane, so that the tour sees each goal it reaches
-        std::vector<size_t> all(cand.size());
-        for (size_t i = 0; i < all.size(); ++i) all[i] = i;
-        return cand[_tour->step(u, all, _rng)];
-    }
+    if (_tour) return cand[_tour->step(u, _rng)];  // every lane, so that the tour sees each goal it reaches
     if (cand.size() == 1) return cand[0];
     std::vector<double> weight;
     double total = 0;

@@ -39,7 +39,25 @@ constexpr double kProgressWindow = 3.0;  // metres ahead of the progress where t
 // The vehicle is simulated in steps of at most kMaxSimStep seconds whatever
 // the sample spacing: steering at a coarser step overshoots and can circle.
 constexpr double kMaxSimStep = 1.0 / 30.0;
-size_t simulationSubsteps(double dt) { return std::max<size_t>(1, size_t(std::ceil(dt / kMaxSimStep - 1e-9))); }
+
+// The clock of a drive: `samples` kept samples `o.dt` apart after `skip`
+// dropped run-up samples, each sample interval simulated in `sub` steps of
+// `dt` seconds. The run-up is simulated exactly like the path and then
+// dropped, so the first kept sample is where the vehicle is after runUp
+// seconds, at speed.
+struct DriveClock {
+    size_t samples, skip, sub;
+    double dt;
+    explicit DriveClock(const PathOptions& o)
+        : samples(size_t(std::floor(o.duration / o.dt + 1e-9)) + 1),
+          skip(size_t(std::floor(o.runUp / o.dt + 1e-9))),
+          sub(std::max<size_t>(1, size_t(std::ceil(o.dt / kMaxSimStep - 1e-9)))),
+          dt(o.dt / double(sub)) {}
+    size_t steps() const { return (samples + skip) * sub; }
+    // Step j begins kept sample index() when kept(j).
+    bool kept(size_t j) const { return j % sub == 0 && j / sub >= skip; }
+    size_t index(size_t j) const { return j / sub - skip; }
+};
 
 double headingOf(const glm::dvec2& d) { return std::atan2(d.x, d.y); }  // clockwise from north
 
@@ -290,18 +308,15 @@ Result<Path> driveCar(const StreetGraph& g, const CityParams& params, const Path
     double sp = 0.0;  // progress along the route (arc length of the closest point)
     size_t seg = 0;
     const double w = o.maxYawRate;
-    const size_t n = size_t(std::floor(o.duration / o.dt + 1e-9)) + 1;
-    const size_t skip = size_t(std::floor(o.runUp / o.dt + 1e-9));
-    const size_t sub = simulationSubsteps(o.dt);
-    const double dt = o.dt / double(sub);
+    const DriveClock clock(o);
+    const double dt = clock.dt;
     const glm::dvec2 origin(params.origin_x, params.origin_y);
     const double brake = kBrakeShare * o.decel;
 
     Path path;
-    path.samples.reserve(n);
-    path.lanes.reserve(n);
-    for (size_t j = 0; j < (n + skip) * sub; ++j) {
-        const size_t i = j / sub;
+    path.samples.reserve(clock.samples);
+    path.lanes.reserve(clock.samples);
+    for (size_t j = 0; j < clock.steps(); ++j) {
         // Progress: the closest route point a few metres ahead.
         const double horizon = v * v / (2.0 * brake) + 2.0 * v * dt + 3.0;
         route.ensure(sp + horizon + kProgressWindow + 1.0);
@@ -315,9 +330,9 @@ Result<Path> driveCar(const StreetGraph& g, const CityParams& params, const Path
         seg = bestSeg;
         sp = std::max(sp, route.cum(seg) + bestT * (route.cum(seg + 1) - route.cum(seg)));
 
-        if (j % sub == 0 && i >= skip) {
+        if (clock.kept(j)) {
             PathSample s;
-            s.t = double(i - skip) * o.dt;
+            s.t = double(clock.index(j)) * o.dt;
             s.position = glm::dvec3(pos + origin, terrainHeight(params, pos) + o.eyeHeight());
             s.heading = wrapAngle(h);
             path.samples.push_back(s);
@@ -373,21 +388,16 @@ Result<Path> generatePath(const StreetGraph& g, const CityParams& params, const 
     double sp = 0.0;  // progress along the route (arc length of the closest point)
     size_t seg = 0;
     const double w = o.maxYawRate;
-    const size_t n = size_t(std::floor(o.duration / o.dt + 1e-9)) + 1;
-    // The run-up is simulated exactly like the path and then dropped, so the
-    // first kept sample is where the vehicle is after runUp seconds, at speed.
-    const size_t skip = size_t(std::floor(o.runUp / o.dt + 1e-9));
-    const size_t sub = simulationSubsteps(o.dt);
-    const double dt = o.dt / double(sub);
+    const DriveClock clock(o);
+    const double dt = clock.dt;
     const glm::dvec2 origin(params.origin_x, params.origin_y);
 
     Path path;
-    path.samples.reserve(n);
-    for (size_t j = 0; j < (n + skip) * sub; ++j) {
-        const size_t i = j / sub;
-        if (j % sub == 0 && i >= skip) {
+    path.samples.reserve(clock.samples);
+    for (size_t j = 0; j < clock.steps(); ++j) {
+        if (clock.kept(j)) {
             PathSample s;
-            s.t = double(i - skip) * o.dt;
+            s.t = double(clock.index(j)) * o.dt;
             double ground = terrainHeight(params, pos);
             s.position = glm::dvec3(pos + origin, ground + o.eyeHeight());
             s.heading = wrapAngle(h);

@@ -83,4 +83,10 @@ size_t Tour::step(uint32_t u, const std::vector<size_t>& allowed, Rng& rng) {
     return best;
 }
 
+size_t Tour::step(uint32_t u, Rng& rng) {
+    _every.resize(_arcs[u].size());
+    for (size_t i = 0; i < _every.size(); ++i) _every[i] = i;
+    return step(u, _every, rng);
+}
+
 }  // namespace vista

@@ -45,6 +45,8 @@ public:
     // Index into arcs(u) of the arc to take among `allowed` (indices into
     // arcs(u), not empty).
     size_t step(uint32_t u, const std::vector<size_t>& allowed, Rng& rng);
+    // The same with every arc of u allowed (u has arcs).
+    size_t step(uint32_t u, Rng& rng);
     // The arc list of u, as given.
     const std::vector<Arc>& arcs(uint32_t u) const { return _arcs[u]; }
     // The current goal (valid after the first step).
@@ -62,6 +64,7 @@ private:
     std::vector<uint32_t> _withArcs;
     std::vector<double> _dist;  // to the goal; +inf where unreachable
     std::vector<uint32_t> _recent;
+    std::vector<size_t> _every;  // scratch: every arc index of a node
     uint32_t _goal = 0;
     bool _haveGoal = false;
     size_t _legs = 0;
