@@ -2,14 +2,15 @@
 // known (the far field's traced pixels, the `raycast` mode's frame), with the
 // transmittance evaluated per pixel by a polynomial exp (relative error
 // < 2e-6, far below an 8-bit step; within one level of applyHaze). The whole
-// frame (a null list) is one vectorised pass: about 0.2 ms at 640x480.
+// frame (a null list) is hazed in vectorised spans on `threads` workers (0 =
+// the caller's arena; bench_far_field's BM_HazeWholeFrame times it).
 //
 // hazeStage(): hazes the n listed pixels (indices y * width + x; a null list
 // = the first n pixels of the image in order) at their eye-plane depth
 // (depth[k] for entry k, metres; +inf = sky, left alone). Records
 // Stage::Haze and the haze effect when fx.haze and n > 0; else does nothing.
-// Contract: every listed index < out's pixel count. Single-threaded;
-// thread-safe for distinct outputs.
+// Contract: every listed index < out's pixel count. A list is hazed on the
+// calling thread; thread-safe for distinct outputs.
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -21,6 +22,6 @@
 namespace vista {
 
 void hazeStage(const FrameEffects& fx, const uint32_t* pixels, size_t n, const float* depth, Image& out,
-               FrameStats& stats);
+               FrameStats& stats, int threads = 0);
 
 }  // namespace vista

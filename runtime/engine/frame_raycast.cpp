@@ -32,7 +32,7 @@ void raycastFrame(const RayScene& scene, const Camera& camera, Image& out, Frame
     stats.pixels.rayMiss += counts.rays - counts.hits;
     stats.raysCast += counts.rays;
     stats.stages.set(Stage::Rays, sw.ms());
-    if (!depth.empty()) hazeStage(fx, nullptr, depth.size(), depth.data(), out, stats);
+    if (!depth.empty()) hazeStage(fx, nullptr, depth.size(), depth.data(), out, stats, threads);
 }
 
 }  // namespace vista
