@@ -100,7 +100,7 @@ public:
         _far->render(camera, haveDepth ? _depth.data() : nullptr, out, stats);
         stats.frameMs = sw.ms();
         if (autoSplit()) {
-            recordCosts(tris, ns.frameMs, stats);
+            recordCosts(_adaptive->chosenTriangles(), ns.frameMs, stats);
             _adaptive->recordFrame(nearD, stats.frameMs);
         }
         return Status::ok();
@@ -128,7 +128,7 @@ public:
             const FrameStats fs = _farNode->lastStats();
             double farMs = 0;
             fs.stages.forEach([&](Stage, double ms) { farMs += ms; });
-            recordCosts(_split->lastNearTriangles(), std::max(0.0, wallMs - farMs), fs);
+            recordCosts(_adaptive->chosenTriangles(), std::max(0.0, wallMs - farMs), fs);
         }
         _viewerNear = chooseNear(camera);
         if (_split) _split->setNearDistance(_viewerNear);
@@ -168,8 +168,8 @@ private:
             stats.cullMs = ns.cullMs;
             stats.drawMs = ns.drawMs;
             stats.drawCalls = ns.drawCalls;
-            tris = _adaptive->index().totalTriangles();
-            stats.triangles = ns.triangles ? ns.triangles : tris;
+            tris = autoSplit() ? _adaptive->chosenTriangles() : _adaptive->index().totalTriangles();
+            stats.triangles = ns.triangles ? ns.triangles : _adaptive->index().totalTriangles();
             stats.pixels.covered = uint64_t(camera.width) * uint64_t(camera.height);
             rasterMs = ns.frameMs;
             _raster.chunks = _near.drawOrder;

@@ -44,6 +44,33 @@ std::optional<double> fitSlope(const std::vector<std::pair<double, double>>& sam
     return *mid;
 }
 
+// The four side planes of a camera's view (through the eye, normals inward): a box
+// wholly outside one of them is culled by the renderer and costs no raster time.
+struct ViewSides {
+    explicit ViewSides(const Camera& c) : eye(c.eye) {
+        const double ty = std::tan(0.5 * c.fovY), tx = ty * double(c.width) / double(std::max(1, c.height));
+        const glm::dvec3 f = c.forward(), r = c.right(), u = c.up();
+        n[0] = tx * f - r;
+        n[1] = tx * f + r;
+        n[2] = ty * f - u;
+        n[3] = ty * f + u;
+    }
+    bool sees(const SplitObject& o) const {
+        for (const glm::dvec3& m : n) {
+            // The box corner farthest along m.
+            const glm::dvec3 c(m.x > 0 ? o.hi.x : o.lo.x, m.y > 0 ? o.hi.y : o.lo.y, m.z > 0 ? o.hi.z : o.lo.z);
+            if (glm::dot(m, c - eye) < 0) return false;
+        }
+        return true;
+    }
+    glm::dvec3 eye;
+    glm::dvec3 n[4];
+};
+
+// Objects up to this count are tested against the view for the price of
+// rasterising everything (at each probe); beyond it, every triangle counts.
+constexpr size_t kEverythingViewTestObjects = 200000;
+
 // The kind of a candidate distance: 0 = ray casting, 1 = a middle distance, 2 = everything.
 int kindOf(double d) { return d <= 0 ? 0 : std::isinf(d) ? 2 : 1; }
 
@@ -51,6 +78,9 @@ int kindOf(double d) { return d <= 0 ? 0 : std::isinf(d) ? 2 : 1; }
 // the best (AdaptiveSplit::choose).
 constexpr int kFirstTryFrame = 3;
 constexpr double kFirstTryRatio = 1.5;
+
+// The probe's far-ray timing casts at most this many of its rays again.
+constexpr size_t kProbeFarTimed = 1000;
 
 // Weight of a new frame in a kind's price correction.
 constexpr double kCorrectionWeight = 0.25;
@@ -196,6 +226,16 @@ double AdaptiveSplit::predictedRays(double d) const {
 }
 
 void AdaptiveSplit::probe(const Camera& camera) {
+    // Everything's triangles in view (within the haze, where nothing beyond is drawn).
+    if (_objects.size() <= kEverythingViewTestObjects) {
+        const ViewSides view(camera);
+        const double reach = _hazeFar > 0 ? _hazeFar / minForwardCosine(camera) : 0.0;
+        _everythingTris = 0;
+        for (const SplitObject& o : _objects)
+            if (view.sees(o) && (reach <= 0 || boxDistance(o, camera.eye) <= reach)) _everythingTris += o.triangles;
+    } else {
+        _everythingTris = _index.totalTriangles();
+    }
     _probeT.clear();
     _probeEye = camera.eye;
     _probeHeading = camera.heading;
@@ -237,6 +277,13 @@ void AdaptiveSplit::probe(const Camera& camera) {
         std::vector<glm::vec3> farDirs;
         for (size_t i = 0; i < hits.size(); ++i)
             if (hits[i].hit ? hits[i].t > start : dirs[i].z < 0) farDirs.push_back(dirs[i]);
+        // A spread sample is timed: the rate, not the count, is what the split needs.
+        if (farDirs.size() > kProbeFarTimed) {
+            const size_t step = (farDirs.size() + kProbeFarTimed - 1) / kProbeFarTimed;
+            size_t m = 0;
+            for (size_t i = 0; i < farDirs.size(); i += step) farDirs[m++] = farDirs[i];
+            farDirs.resize(m);
+        }
         if (farDirs.size() >= 100) {
             std::vector<RayHit> farHits(farDirs.size());
             Stopwatch sw;
@@ -273,35 +320,47 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
     const int frame = _frame++;
     if (_probeT.empty()) return _current;
     const int g = std::max(2, _o.candidates);
-    // The objects within the largest finite candidate, sorted by distance once; then sweep the candidates.
+    // The objects within the largest finite candidate that the view sees, sorted by distance
+    // once; then sweep the candidates. Triangles outside the view are culled by the renderer
+    // and cost no raster time, so prices (and the raster fit, chosenTriangles()) count only
+    // the triangles in view.
+    const ViewSides view(camera);
     std::vector<std::pair<double, uint64_t>> byDist;
-    _index.distances(camera.eye, _o.maxDistance, byDist);
+    _index.visitWithin(camera.eye, _o.maxDistance, [&](uint32_t i, double t) {
+        if (view.sees(_objects[i])) byDist.push_back({t, _objects[i].triangles});
+    });
     std::sort(byDist.begin(), byDist.end());
     std::vector<double> cand;
-    // The ends only once both costs are measured: on the priors alone they are guesses (on a
-    // 3 M-triangle city the prior once chose "everything" for the first frames at 250 ms each).
+    // The ends are priced on measurements: ray casting once the probe is timed (its rate) or
+    // the far cost measured; everything once the raster cost is measured. Before that
+    // everything is offered only to be tried (kFirstTryFrame, kFirstTryRatio), never chosen
+    // as the best on the priors alone (on a 3 M-triangle city the prior once chose it for
+    // the first frames at 250 ms each): one tried frame measures it.
     const bool measured = _haveA && _haveB;
-    // Ray casting's price needs only the probe's timed rate: offered once the probe is timed.
-    if (_o.rayCastOnly && (measured || _probeAllMs > 0)) cand.push_back(0.0);
+    const bool rayPriced = measured || _probeAllMs > 0;
+    if (_o.rayCastOnly && rayPriced) cand.push_back(0.0);
     for (int i = 0; i < g; ++i)
         cand.push_back(_o.minDistance * std::pow(_o.maxDistance / _o.minDistance, double(i) / (g - 1)));
-    if (_o.everythingNear && measured) cand.push_back(std::numeric_limits<double>::infinity());
+    const bool everythingPriced = measured || _haveCorr[2];
+    if (_o.everythingNear && (everythingPriced || rayPriced)) cand.push_back(std::numeric_limits<double>::infinity());
     const int n = int(cand.size());
     const double b = msPerRay();
     _pixels = int64_t(camera.width) * int64_t(camera.height);
     const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
     // The model's price of each candidate (see the header), then the learned correction of its kind.
     std::vector<double> price(cand.size()), cost(cand.size());
+    std::vector<uint64_t> candTris(cand.size());
     size_t k = 0;
     uint64_t tris = 0;
-    int bestI = 0;
+    int bestI = -1;
     for (int i = 0; i < n; ++i) {
         const double d = cand[size_t(i)];
         if (std::isinf(d)) {
-            tris = _index.totalTriangles();
+            tris = _everythingTris;
         } else {
             while (k < byDist.size() && byDist[k].first <= d) tris += byDist[k++].second;
         }
+        candTris[size_t(i)] = kindOf(d) == 0 ? 0 : tris;
         const int kind = kindOf(d);
         if (kind == 0) {
             price[size_t(i)] = _probeAllMs > 0 ? _probeAllMs * double(_pixels) / double(cores) : b * predictedRays(0.0);
@@ -311,7 +370,8 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
                 (tris > 0 ? _c + _a * double(tris) : 0.0) + (kind == 1 ? b * predictedRays(d) + _f : 0.0);
         }
         cost[size_t(i)] = std::max(0.0, price[size_t(i)] + (_haveCorr[kind] ? _corr[kind] : 0.0));
-        if (cost[size_t(i)] < cost[size_t(bestI)]) bestI = i;
+        const bool tryOnly = kind == 2 && !everythingPriced;
+        if (!tryOnly && (bestI < 0 || cost[size_t(i)] < cost[size_t(bestI)])) bestI = i;
     }
     const double best = cost[size_t(bestI)];
     if (_o.exploreEvery > 0 && frame % _o.exploreEvery == _o.exploreEvery - 1) {
@@ -343,6 +403,7 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
     }
     _current = cand[size_t(bestI)];
     _chosenPrice = price[size_t(bestI)];
+    _chosenTris = candTris[size_t(bestI)];
     _lastKindFrame[kindOf(_current)] = frame;
     return _current;
 }

@@ -16,6 +16,10 @@
 //   a middle distance d: c + a * triangles(d) (c only if triangles(d) > 0:
 //     an empty near field needs no GL pass) + b * rays(d) + F.
 //   +infinity (everything): the `full` frame, c + a * all triangles.
+// Triangles are counted in view: an object whose box lies wholly outside one
+// of the view's four side planes is culled by the renderer and costs no
+// raster time (for everything, counted at each probe, and every triangle on
+// a city of more than 200,000 objects; with haze, only objects within it).
 // Each kind's price is corrected by what its own frames measured: an
 // exponential moving average of (whole frame ms, the decision included) minus
 // (the model's price for the choice made), per kind, recorded by
@@ -25,7 +29,10 @@
 // its correction is 0; each kind is tried now and then (its cheapest
 // candidate, when the kind has not run for `endTryEvery` frames and its price
 // is within `endTryRatio` of the best) so that a wrong price does not keep
-// the split from it. F skips the far field's first frame (one-time costs).
+// the split from it. Everything is offered before the raster cost is
+// measured only to be tried, never as the best on the priors alone (a frame
+// of a large city drawn whole can cost a quarter second). F skips the far
+// field's first frame (one-time costs).
 // raster ms = c + a * triangles and far ms = c' + b * far pixels are robust
 // line fits (Theil-Sen) over the last `window` frames, whose near distances
 // differ as the walk goes on; priors until a fit is well conditioned; b falls
@@ -88,6 +95,14 @@ public:
     std::vector<uint32_t> within(const glm::dvec3& p, double d) const;
     // (boxDistance, triangles) of every object within d of p, unsorted.
     void distances(const glm::dvec3& p, double d, std::vector<std::pair<double, uint64_t>>& out) const;
+    // f(index, boxDistance) for every object within d of p, unordered.
+    template <class F>
+    void visitWithin(const glm::dvec3& p, double d, F&& f) const {
+        visit(p, d, [&](uint32_t i) {
+            const double t = boxDistance(_objects[i], p);
+            if (t <= d) f(i, t);
+        });
+    }
     uint64_t totalTriangles() const { return _total; }
     const std::vector<SplitObject>& objects() const { return _objects; }
 
@@ -112,7 +127,7 @@ struct AdaptiveSplitOptions {
     double minDistance = 15.0, maxDistance = 800.0;
     int candidates = 16;     // geometric steps between min and max
     int probeStride = 8;     // probe every 8th pixel in x and y, at least
-    int probeRays = 4800;    // ... and sparser on larger images: about this many rays (640x480 / 64)
+    int probeRays = 2400;    // ... and sparser on larger images: about this many rays (640x480 / 128)
     int probeInterval = 10;  // frames between probes
     double smoothing = 0.2;  // EMA weight of a new measurement
     double initialDistance = 100.0;
@@ -122,9 +137,10 @@ struct AdaptiveSplitOptions {
     int endTryEvery = 40;       // a kind (0, middle, everything) not chosen for this many frames is tried ...
     double endTryRatio = 1.3;   // ... when its price is within this factor of the best (0 = never)
     // Two more candidates at the ends: 0 (ray casting: the `raycast` frame) and
-    // +infinity (everything rasterised: the `full` frame), offered once both
-    // costs have been measured (not on the priors); 0 also once the probe is
-    // timed (its price is the probe's rate).
+    // +infinity (everything rasterised: the `full` frame). Ray casting is
+    // offered once both costs have been measured or the probe is timed (its
+    // price is the probe's rate); everything once both are measured, and
+    // before that, from the same point as ray casting, only to be tried.
     bool rayCastOnly = true, everythingNear = true;
     // Time the probe: its bulk ms per ray caps b (off: b from the frames alone, deterministic).
     bool timeProbe = true;
@@ -153,6 +169,9 @@ public:
     double msPerRay() const;                     // per far pixel: the frames' model, capped by the probe's bulk rate
     double farFixedMs() const { return _f; }
     double current() const { return _current; }
+    // The triangles in view of the last choice (0 for ray casting): what the raster fit is
+    // fed (record()'s triangles) by a caller that drew that choice.
+    uint64_t chosenTriangles() const { return _chosenTris; }
     // Predictions (exposed for tests/docs).
     uint64_t predictedTriangles(const glm::dvec3& eye, double d) const;
     double predictedRays(double d) const;
@@ -179,6 +198,8 @@ private:
     double _corr[3] = {0, 0, 0};  // per kind: EMA of frame ms - the model's price
     bool _haveCorr[3] = {false, false, false};
     double _chosenPrice = 0;            // the model's price (no correction) of the last choice
+    uint64_t _chosenTris = 0;           // its triangles in view
+    uint64_t _everythingTris = 0;       // every object's triangles in view at the last probe
     int _lastKindFrame[3] = {0, 0, 0};  // per kind: the frame it was last chosen or tried
     int _farFrames = 0;                 // frames recorded with a far field
     int64_t _pixels = 0;                // the camera's pixel count at the last choice

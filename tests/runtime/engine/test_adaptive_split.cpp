@@ -183,7 +183,7 @@ TEST(Split, RayCastingSavesTheRasterFixedCost) {
 
 // predictedRays(d) against an independent count: every s-th pixel cast one
 // at a time (RayScene::intersect), where s follows from probeStride and
-// probeRays (a 1280x720 image: sqrt(921600 / 4800) = 13.9 -> every 14th
+// probeRays (a 1280x720 image: sqrt(921600 / 2400) = 19.6 -> every 20th
 // pixel); a probe pixel needs a ray when its hit lies beyond d or it misses
 // below the horizon.
 TEST(Split, ProbePredictsTheRaysOfAnIndependentCount) {
@@ -198,7 +198,7 @@ TEST(Split, ProbePredictsTheRaysOfAnIndependentCount) {
     AdaptiveSplitOptions o;
     o.timeProbe = false;
     AdaptiveSplit split(objs, rays, o);
-    const int s = 14;
+    const int s = 20;
     const double ds[5] = {0.0, 30.0, 100.0, 300.0, std::numeric_limits<double>::infinity()};
     auto check = [&](const Camera& cam, const char* what) {
         const glm::vec3 org(cam.eye - rays->frameOrigin());
@@ -213,7 +213,7 @@ TEST(Split, ProbePredictsTheRaysOfAnIndependentCount) {
                     need[size_t(k)] += h.hit ? (double(h.t) > ds[k]) : (dir.z < 0 && !std::isinf(ds[k]));
             }
         const double scale = double(cam.width) * cam.height / probes;
-        EXPECT_NEAR(probes, 4800.0, 300.0) << what;
+        EXPECT_NEAR(probes, 2400.0, 200.0) << what;
         for (int k = 0; k < 5; ++k)
             EXPECT_NEAR(split.predictedRays(ds[k]), need[size_t(k)] * scale, 0.002 * cam.width * cam.height)
                 << what << ", d = " << ds[k];
