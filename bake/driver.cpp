@@ -31,31 +31,39 @@ namespace vista {
 
 Status validateBakeJob(const BakeJob& j) {
     const BakeParams& p = j.params;
-    auto range = [](const char* opt, double v, double lo, double hi) -> Status {
-        if (v >= lo && v <= hi) return Status::ok();
-        return Status::error(std::string(opt) + " " + shortNumber(v) + " out of range [" + shortNumber(lo) + ", " +
-                             shortNumber(hi) + "]");
+    auto range = [](const char* opt, double v, const RealRange& r) -> Status {
+        if (r.contains(v)) return Status::ok();
+        return Status::error(std::string(opt) + " " + shortNumber(v) + " out of range " + r.text());
     };
+    namespace R = bake_range;
     if (j.input.empty()) return Status::error("input city file: no path given");
     if (j.output.empty()) return Status::error("--output: no path given");
     for (Status s :
-         {range("--jobs", j.jobs, 0, 1024), range("--margin", p.far.margin, 0, 1e5),
-          range("--far-depth", p.far.farDepth, 1, 1e6), range("--oversample", p.sampling.oversample, 0.05, 16),
-          range("--perspective", p.sampling.perspective, 1, 4),
-          range("--texel-significance", p.appearance.significance, 0, 0.5),
-          range("--pixel-sigma", p.appearance.pixelSigma, 0, 4), range("--layers", p.sampling.maxLayers, 1, 64),
-          range("--max-rays", double(p.sampling.maxRaysPerCamera), 1, 1e9),
-          range("--mc-threshold", p.appearance.varianceThreshold, 0, 1),
-          range("--mc-min", p.appearance.minSamples, 1, 4096),
-          range("--mc-max", p.appearance.maxSamples, p.appearance.minSamples, 65536),
-          range("--single-threshold", p.appearance.singleColorThreshold, 0, 1),
-          range("--out-size", p.sampling.outHeight, 16, 8192), range("--fov", p.sampling.fovYDeg, 1, 170),
-          range("--texels (A)", p.appearance.texelsX, 1, 32), range("--texels (B)", p.appearance.texelsY, 1, 32)})
+         {range("--jobs", j.jobs, R::jobs),
+          range("--margin", p.far.margin, R::margin),
+          range("--far-depth", p.far.farDepth, R::farDepth),
+          range("--min-triangles", double(p.far.minTriangles), R::minTriangles),
+          range("--oversample", p.sampling.oversample, R::oversample),
+          range("--perspective", p.sampling.perspective, R::perspective),
+          range("--texel-significance", p.appearance.significance, R::significance),
+          range("--pixel-sigma", p.appearance.pixelSigma, R::pixelSigma),
+          range("--layers", p.sampling.maxLayers, R::layers),
+          range("--max-rays", double(p.sampling.maxRaysPerCamera), R::maxRays),
+          range("--mc-threshold", p.appearance.varianceThreshold, R::mcThreshold),
+          range("--mc-min", p.appearance.minSamples, R::mcMin),
+          range("--mc-max", p.appearance.maxSamples, RealRange::closed(p.appearance.minSamples, R::mcMax.max)),
+          range("--single-threshold", p.appearance.singleColorThreshold, R::singleThreshold),
+          range("--out-size", p.sampling.outHeight, R::outSize),
+          range("--fov", p.sampling.fovYDeg, R::fov),
+          range("--texels (A)", p.appearance.texelsX, R::texels),
+          range("--texels (B)", p.appearance.texelsY, R::texels),
+          range("--triangle-ns", p.placement.triangleNs, R::rasterNs),
+          range("--point-ns", p.placement.pointNs, R::rasterNs)})
         if (!s) return s;
     if (p.representation == BakeRepresentation::Mesh)
-        for (Status s :
-             {range("--mesh-triangles", p.mesh.maxTriangles, 1024, 1e7),
-              range("--mesh-image", p.mesh.imageSize, 64, 4096), range("--mesh-error", p.mesh.errorPx, 0, 100)})
+        for (Status s : {range("--mesh-triangles", p.mesh.maxTriangles, R::meshTriangles),
+                         range("--mesh-image", p.mesh.imageSize, R::meshImage),
+                         range("--mesh-error", p.mesh.errorPx, R::meshError)})
             if (!s) return s;
     if (j.shardN < 1 || j.shardK < 1 || j.shardK > j.shardN)
         return Status::error("--shard " + std::to_string(j.shardK) + "/" + std::to_string(j.shardN) +

@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "bake/bake_params.h"
+#include "foundation/number_text.h"
 #include "foundation/progress.h"
 #include "foundation/status.h"
 
@@ -67,6 +68,24 @@ struct BakeReport {
     std::vector<std::string> notes;  // the assembled cells' notes, "cell C: end E: ..." (--stats "notes")
     double budgetMb = 0;             // the storage budget as resolved (0: none)
 };
+
+// The range of each number of a job, named by its `vista bake` flag:
+// validateBakeJob checks them and the command reads its flags within them
+// (integers have whole bounds). --mc-max is also at least --mc-min; the mesh
+// ranges are checked for a mesh bake.
+namespace bake_range {
+constexpr RealRange jobs = RealRange::closed(0, 1024), margin = RealRange::closed(0, 1e5),
+                    farDepth = RealRange::closed(1, 1e6), minTriangles = RealRange::closed(0, 1e9),
+                    oversample = RealRange::closed(0.05, 16), perspective = RealRange::closed(1, 4),
+                    significance = RealRange::closed(0, 0.5), pixelSigma = RealRange::closed(0, 4),
+                    layers = RealRange::closed(1, 64), maxRays = RealRange::closed(1, 1e9),
+                    mcThreshold = RealRange::closed(0, 1), mcMin = RealRange::closed(1, 4096),
+                    mcMax = RealRange::closed(1, 65536), singleThreshold = RealRange::closed(0, 1),
+                    outSize = RealRange::closed(16, 8192), fov = RealRange::closed(1, 170),
+                    texels = RealRange::closed(1, 32), rasterNs = RealRange::open(0, 1e9),
+                    meshTriangles = RealRange::closed(1024, 1e7), meshImage = RealRange::closed(64, 4096),
+                    meshError = RealRange::closed(0, 100);
+}  // namespace bake_range
 
 Status validateBakeJob(const BakeJob& job);
 Result<BakeReport> runBakeJob(const BakeJob& job, Progress* progress = nullptr,

@@ -78,10 +78,11 @@ void declareFlags(CLI::App& app, ReportArgs& a) {
     app.add_option("--baked", a.baked, "baked files (same city)")->required();
     app.add_option("--size", a.size, "image size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 640x480)");
     app.add_option("--label", a.labels, "a label per baked file");
-    app.add_option("--cell", a.cell, "view cell id")->required();
-    app.add_option("--frames", a.frames, "timed renders per mode");
-    app.add_option("--ssaa", a.ssaa, "reference supersampling factor per axis");
-    app.add_option("--fov", a.fov, "vertical field of view, degrees");
+    addNumberOption(app, "--cell", a.cell, 0, 100000000, "view cell id, 0 .. 100000000")->required();
+    addNumberOption(app, "--frames", a.frames, 1, 1000000, "timed renders per mode, 1 .. 1000000 (default 20)");
+    addNumberOption(app, "--ssaa", a.ssaa, 1, kMaxReferenceSsaa,
+                    "reference supersampling factor per axis, 1 .. 8 (default 4)");
+    addNumberOption(app, "--fov", a.fov, kFovRange, "vertical field of view in degrees, (1, 179) (default 60)");
     app.add_option("--json", a.jsonOut, "also write the results as JSON");
     app.add_option("--point-splat", a.splat,
                    "impostor points as splats of SIGMA output pixels (0.05 .. 4), or off = 1-pixel points (default " +

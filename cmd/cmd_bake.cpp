@@ -24,12 +24,19 @@ struct BakeArgs {
     bool quiet = false, noRemoval = false;
 };
 
+// A whole-number flag within its bake_range (bake/driver.h).
+template <class T>
+CLI::Option* addWhole(CLI::App& app, const std::string& name, T& value, const RealRange& r, const std::string& help) {
+    return addNumberOption(app, name, value, T(r.min), T(r.max), help);
+}
+
 void declareFlags(CLI::App& app, BakeArgs& a) {
     BakeJob& job = a.job;
     BakeParams& p = job.params;
+    namespace R = bake_range;
     app.add_option("city", job.input, "input city file (.osgb from 'vista gen')")->required();
     app.add_option("-o,--output", job.output, "baked output file (.osgb)")->required();
-    app.add_option("--jobs", job.jobs, "worker threads (0 = all cores)");
+    addWhole(app, "--jobs", job.jobs, R::jobs, "worker threads, 0 .. 1024 (0 = all cores)");
     app.add_option("--cells", a.cellList, "bake only these cell ids (= street edge ids), e.g. 3,7,10-20");
     app.add_option("--shard", a.shard,
                    "bake shard K of N (K = 1..N) of the cells into the work directory; assemble with --merge");
@@ -38,40 +45,49 @@ void declareFlags(CLI::App& app, BakeArgs& a) {
     app.add_flag("--keep-work", job.keepWork, "keep the work directory after a successful assembly");
     app.add_option("--stats", job.statsFile, "write per-impostor statistics (JSON)");
     app.add_flag("-q,--quiet", a.quiet, "no progress output");
-    app.add_option("--margin", p.far.margin, "far field starts this many metres beyond the street end")
+    addNumberOption(app, "--margin", p.far.margin, R::margin,
+                    "far field starts this many metres beyond the street end, 0 .. 100000")
         ->capture_default_str();
-    app.add_option("--far-depth", p.far.farDepth, "metres of far field beyond the margin")->capture_default_str();
-    app.add_option("--min-triangles", p.far.minTriangles, "skip street ends whose far field has fewer triangles")
+    addNumberOption(app, "--far-depth", p.far.farDepth, R::farDepth,
+                    "metres of far field beyond the margin, 1 .. 1000000")
         ->capture_default_str();
-    app.add_option("--oversample", p.sampling.oversample, "LDI resolution factor over the criterion")
+    addWhole(app, "--min-triangles", p.far.minTriangles, R::minTriangles,
+             "skip street ends whose far field has fewer triangles, 0 .. 1000000000")
         ->capture_default_str();
-    app.add_option("--perspective", p.sampling.perspective,
-                   "perspective factor fp of the sampling criterion (thesis: 1.17)")
+    addNumberOption(app, "--oversample", p.sampling.oversample, R::oversample,
+                    "LDI resolution factor over the criterion, 0.05 .. 16")
         ->capture_default_str();
-    app.add_option("--texel-significance", p.appearance.significance,
-                   "F-test level for view-dependent texels (0 = off: the colour spread alone decides)")
+    addNumberOption(app, "--perspective", p.sampling.perspective, R::perspective,
+                    "perspective factor fp of the sampling criterion, 1 .. 4 (thesis: 1.17)")
         ->capture_default_str();
-    app.add_option("--pixel-sigma", p.appearance.pixelSigma,
-                   "Monte Carlo pixel filter: Gaussian sigma in output pixels added to the box (the monitor filter; 0 "
-                   "= box only)")
+    addNumberOption(app, "--texel-significance", p.appearance.significance, R::significance,
+                    "F-test level for view-dependent texels, 0 .. 0.5 (0 = off: the colour spread alone decides)")
         ->capture_default_str();
-    app.add_option("--layers", p.sampling.maxLayers, "LDI layers per pixel")->capture_default_str();
-    app.add_option("--max-rays", p.sampling.maxRaysPerCamera, "cap on LDI rays per camera")->capture_default_str();
+    addNumberOption(app, "--pixel-sigma", p.appearance.pixelSigma, R::pixelSigma,
+                    "Monte Carlo pixel filter: Gaussian sigma in output pixels added to the box, 0 .. 4 (the monitor "
+                    "filter; 0 = box only)")
+        ->capture_default_str();
+    addWhole(app, "--layers", p.sampling.maxLayers, R::layers, "LDI layers per pixel, 1 .. 64")->capture_default_str();
+    addWhole(app, "--max-rays", p.sampling.maxRaysPerCamera, R::maxRays, "cap on LDI rays per camera, 1 .. 1000000000")
+        ->capture_default_str();
     app.add_flag("--no-removal", a.noRemoval, "keep points sampled better by another camera");
     app.add_option("--texels", a.texels, "texels per point: 1, 4x1, 8x2 (default 8x2)");
-    app.add_option("--mc-threshold", p.appearance.varianceThreshold,
-                   "Monte Carlo stop: std error of a texel's luma (0..1)")
+    addNumberOption(app, "--mc-threshold", p.appearance.varianceThreshold, R::mcThreshold,
+                    "Monte Carlo stop: std error of a texel's luma (0..1)")
         ->capture_default_str();
-    app.add_option("--mc-min", p.appearance.minSamples, "Monte Carlo samples per texel, first pass")
+    addWhole(app, "--mc-min", p.appearance.minSamples, R::mcMin, "Monte Carlo samples per texel, first pass, 1 .. 4096")
         ->capture_default_str();
-    app.add_option("--mc-max", p.appearance.maxSamples, "Monte Carlo samples per texel, maximum")
+    addWhole(app, "--mc-max", p.appearance.maxSamples, R::mcMax,
+             "Monte Carlo samples per texel, maximum, --mc-min .. 65536")
         ->capture_default_str();
-    app.add_option("--single-threshold", p.appearance.singleColorThreshold,
-                   "colour std dev (0..1) for single-colour points")
+    addNumberOption(app, "--single-threshold", p.appearance.singleColorThreshold, R::singleThreshold,
+                    "colour std dev (0..1) for single-colour points")
         ->capture_default_str();
-    app.add_option("--out-size", p.sampling.outHeight, "target output height in pixels (width = 4/3 height)")
+    addWhole(app, "--out-size", p.sampling.outHeight, R::outSize,
+             "target output height in pixels, 16 .. 8192 (width = 4/3 height)")
         ->capture_default_str();
-    app.add_option("--fov", p.sampling.fovYDeg, "target output vertical field of view, degrees")->capture_default_str();
+    addNumberOption(app, "--fov", p.sampling.fovYDeg, R::fov, "target output vertical field of view, degrees, 1 .. 170")
+        ->capture_default_str();
     app.add_option("--representation", a.representation,
                    "far-field representation per view cell: points (point impostors, thesis ch. 5) or mesh (textured "
                    "depth meshes, "
@@ -82,9 +98,11 @@ void declareFlags(CLI::App& app, BakeArgs& a) {
            "points: cost = an impostor only where it saves more raster time than its points cost (bake/placement.h); "
            "all = at every street end with a far field")
         ->capture_default_str();
-    app.add_option("--triangle-ns", p.placement.triangleNs, "placement: raster cost of a triangle, ns (measured here)")
+    addNumberOption(app, "--triangle-ns", p.placement.triangleNs, R::rasterNs,
+                    "placement: raster cost of a triangle, ns, (0, 1e9) (measured here)")
         ->capture_default_str();
-    app.add_option("--point-ns", p.placement.pointNs, "placement: raster cost of a point, ns (measured here)")
+    addNumberOption(app, "--point-ns", p.placement.pointNs, R::rasterNs,
+                    "placement: raster cost of a point, ns, (0, 1e9) (measured here)")
         ->capture_default_str();
     app.add_option("--storage-budget", a.budget,
                    "points: auto (" + std::to_string(int(kAutoBudgetMbPerKm2)) +
@@ -97,12 +115,15 @@ void declareFlags(CLI::App& app, BakeArgs& a) {
                    "rays for the "
                    "points it leaves) or rays (one occlusion ray per point and viewpoint)")
         ->capture_default_str();
-    app.add_option("--mesh-triangles", p.mesh.maxTriangles, "mesh: triangle budget per view cell (half per street end)")
+    addWhole(app, "--mesh-triangles", p.mesh.maxTriangles, R::meshTriangles,
+             "mesh: triangle budget per view cell (half per street end), 1024 .. 10000000")
         ->capture_default_str();
-    app.add_option("--mesh-image", p.mesh.imageSize, "mesh: largest side of the far-field image in pixels")
+    addWhole(app, "--mesh-image", p.mesh.imageSize, R::meshImage,
+             "mesh: largest side of the far-field image in pixels, 64 .. 4096")
         ->capture_default_str();
-    app.add_option("--mesh-error", p.mesh.errorPx,
-                   "mesh: stop refining below this parallax error (pixels, for a viewer at the cell's corner)")
+    addNumberOption(app, "--mesh-error", p.mesh.errorPx, R::meshError,
+                    "mesh: stop refining below this parallax error, 0 .. 100 (pixels, for a viewer at the cell's "
+                    "corner)")
         ->capture_default_str();
 }
 
@@ -120,10 +141,6 @@ Status configure(BakeArgs& a) {
     if (a.placement != "cost" && a.placement != "all")
         return Status::error("--placement '" + a.placement + "': unknown (allowed: cost, all)");
     p.placement.byCost = a.placement == "cost";
-    if (!(p.placement.triangleNs > 0 && p.placement.triangleNs < 1e9) ||
-        !(p.placement.pointNs > 0 && p.placement.pointNs < 1e9))
-        return Status::error("--triangle-ns / --point-ns: " + std::to_string(p.placement.triangleNs) + " / " +
-                             std::to_string(p.placement.pointNs) + " out of range (0, 1e9) ns");
     if (a.visibility != "image" && a.visibility != "rays")
         return Status::error("--visibility '" + a.visibility + "': unknown (allowed: image, rays)");
     p.placement.visByImage = a.visibility == "image";

@@ -30,12 +30,11 @@ namespace fs = std::filesystem;
 const char* const kCmd = "vista bench";
 
 struct BenchArgs {
-    std::string city, size = "640x480", modes = "full,near", out, reference = "full", fov = "60", sweep;
+    std::string city, size = "640x480", modes = "full,near", out, reference = "full", sweep;
     std::optional<std::string> effects;  // unset: the scene's
     std::string sampling = samplingName(kDefaultSampleRuns);
     std::vector<fs::path> createdOut;  // directories of --out made by this run, deepest first
     bool quiet = false;
-    std::string memoryBudget;
     PathFlags path;
     ModeFlags mode;
     BenchConfig cfg;
@@ -50,7 +49,8 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
                    "city scene file (.osgb), or a paged city directory (DIR.paged); not needed with --sweep");
     addPathFlags(app, a.path, true);
     addPagedFlags(app, a.paged);
-    app.add_option("--frames", a.cfg.frames, "frames rendered, sampled from the path as --sampling says (default 120)");
+    addNumberOption(app, "--frames", a.cfg.frames, 1, 1000000,
+                    "frames rendered, sampled from the path as --sampling says, 1 .. 1000000 (default 120)");
     app.add_option("--sampling", a.sampling,
                    "which path samples are the frames: 'spread' (evenly over the whole path), 'consecutive' (the first "
                    "N samples, as a simulator renders them) or 'runs:K' (K runs of consecutive samples, their starts "
@@ -59,23 +59,25 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
     app.add_option("--size", a.size, "image size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 640x480)");
     app.add_option("--modes", a.modes, modeHelp);
     addModeFlags(app, a.mode);
-    app.add_option("--fov", a.fov, "vertical field of view in degrees, (1, 179) (default 60)");
+    addNumberOption(app, "--fov", a.cfg.fovYDeg, kFovRange, "vertical field of view in degrees, (1, 179) (default 60)");
     app.add_option("--reference", a.reference,
                    "reference for the quality metrics: full (default) or ssaa:K (K x K supersampled full)");
-    app.add_option("--diff-threshold", a.cfg.diffThreshold,
-                   "per-channel difference counted as a differing pixel (default 8)");
-    app.add_option("--worst", a.cfg.worstFrames, "difference images for the N worst frames per mode (default 2)");
+    addNumberOption(app, "--diff-threshold", a.cfg.diffThreshold, 0, 255,
+                    "per-channel difference counted as a differing pixel, 0 .. 255 (default 8)");
+    addNumberOption(app, "--worst", a.cfg.worstFrames, 0, 100,
+                    "difference images for the N worst frames per mode, 0 .. 100 (default 2)");
     app.add_flag("--save-frames", a.cfg.saveFrames,
                  "also write every frame of every mode as OUT/frames/fNNNN_MODE.png");
     app.add_option(
         "--dump-rays", a.cfg.dumpRaysDir,
         "write the far-field rays each hybrid frame traced as DIR/MODE_fNNNN.rays (ray sets for bench_raw_rays)");
-    app.add_option("--dump-rays-every", a.cfg.dumpRaysEvery,
-                   "with --dump-rays: only every N-th frame, 1 .. 1000000 (default 1)");
+    addNumberOption(app, "--dump-rays-every", a.cfg.dumpRaysEvery, 1, 1000000,
+                    "with --dump-rays: only every N-th frame, 1 .. 1000000 (default 1)");
     app.add_option("--out", a.out, "output directory (created if missing)")->required();
-    app.add_option("--memory-budget", a.memoryBudget,
-                   "GB: refuse up front a run whose estimated peak memory (from the city file's size) exceeds it; "
-                   "summary.json reports the estimate and the measured peak per phase (default: no budget)");
+    addNumberOption(
+        app, "--memory-budget", a.cfg.memoryBudgetGb, kMemoryBudgetGbRange,
+        "GB, (0, 65536]: refuse up front a run whose estimated peak memory (from the city file's size) exceeds it; "
+        "summary.json reports the estimate and the measured peak per phase (default: no budget)");
     app.add_option("--effects", a.effects,
                    "run-time effects for this run instead of the scene's: 'none', names (haze, glass, night) or a JSON "
                    "object as in the params file; baked effects (sun_shadows, ambient_occlusion, materials, night's "
@@ -100,9 +102,6 @@ Status configure(BenchArgs& a) {
     if (!size) return size.status();
     a.cfg.width = size->width;
     a.cfg.height = size->height;
-    auto fov = parseFov(a.fov);
-    if (!fov) return fov.status();
-    a.cfg.fovYDeg = fov.value();
     auto sampling = parseSampling(a.sampling);
     if (!sampling) return sampling.status();
     a.cfg.sampleRuns = sampling.value();
@@ -118,9 +117,6 @@ Status configure(BenchArgs& a) {
             return Status::error("mode " + m + " needs --baked city.baked.osgb (from 'vista bake')");
     a.cfg.quiet = a.quiet;
     VISTA_RETURN_IF_ERROR(validateBenchConfig(a.cfg));
-    auto budget = parseMemoryBudgetGb("--memory-budget", a.memoryBudget);
-    if (!budget) return budget.status();
-    a.cfg.memoryBudgetGb = budget.value();
     auto po = parsePathFlags(a.path);
     if (!po) return po.status();
     a.pathOptions = po.value();

@@ -13,6 +13,7 @@
 #include "foundation/input_file.h"
 #include "foundation/number_text.h"
 #include "foundation/output_paths.h"
+#include "foundation/shard.h"
 #include "foundation/timing.h"
 #include "citygen/streets.h"
 #include "cmd/options.h"
@@ -34,29 +35,40 @@ struct GenArgs {
     std::string paramsFile, out, statsFile, osmFile, geojsonFile, gltfFile, xodrFile;
     std::optional<std::string> effects;  // unset: the params file's
     std::string osmBuildings = "on";
-    std::string seed;  // as written: parsed by parseUnsignedText (no wrap-around of "-1")
+    std::optional<uint64_t> seed;
     std::optional<double> size;
     std::optional<int> detail, threads;
     bool quiet = false, listParams = false;
     // Paged output (-o DIR.paged).
     std::optional<double> regionSize;
-    std::string shard, shards;
+    std::string shard;
+    std::optional<int> shards;
     bool merge = false;
-    std::string memoryBudget;
-    double budgetGb = 0;  // parsed --memory-budget (0 = none)
+    double budgetGb = 0;  // --memory-budget (0 = none)
     bool paged() const { return endsWith(out, ".paged") || endsWith(out, ".paged/"); }
     static bool endsWith(const std::string& s, const std::string& t) {
         return s.size() >= t.size() && s.compare(s.size() - t.size(), t.size(), t) == 0;
     }
 };
 
+// The range of the parameter `name` (citygen/params.h), for the flag that sets it.
+const ParamSpec& paramSpec(const char* name) {
+    for (const auto& s : paramSpecs())
+        if (std::string(s.name) == name) return s;
+    VISTA_CHECK(false);
+    return paramSpecs().front();
+}
+
 CLI::Option* declareFlags(CLI::App& app, GenArgs& a) {
     app.add_option("--params", a.paramsFile, "JSON parameter file (see docs/params.md; examples in data/)");
-    app.add_option("--seed", a.seed, "random seed (overrides the params file)")->type_name("UINT");
-    app.add_option("--size", a.size,
-                   "side of the square city area in metres, 100..16000 (default 2000); up to 64000 with paged output");
-    app.add_option("--detail", a.detail, "facade detail 0..3 (0 = plain boxes, default 2)");
-    app.add_option("--threads", a.threads, "worker threads (0 = all; output never depends on it)");
+    addNumberOption(app, "--seed", a.seed, 0, UINT64_MAX, "random seed (overrides the params file)");
+    const ParamSpec &size = paramSpec("size_m"), &detail = paramSpec("detail"), &threads = paramSpec("threads");
+    addNumberOption(app, "--size", a.size, RealRange::closed(size.min, size.max),
+                    "side of the square city area in metres, 100..16000 (default 2000); up to 64000 with paged output");
+    addNumberOption(app, "--detail", a.detail, int(detail.min), int(detail.max),
+                    "facade detail 0..3 (0 = plain boxes, default 2)");
+    addNumberOption(app, "--threads", a.threads, int(threads.min), int(threads.max),
+                    "worker threads, 0 .. 256 (0 = all; output never depends on it)");
     app.add_option("--effects", a.effects,
                    "effects the scene declares, over the params file's: 'none', names (" + effectNames() +
                        ") or a JSON object as in the params file (see docs/params.md)");
@@ -75,8 +87,8 @@ CLI::Option* declareFlags(CLI::App& app, GenArgs& a) {
                                "output: a scene file (.osgb), or a paged city directory (DIR.paged: one city file per "
                                "region, index.osgb with a PagedLOD per region for osgviewer, manifest.json; "
                                "docs/formats.md 'Paged city')");
-    app.add_option(
-        "--region-size", a.regionSize,
+    addNumberOption(
+        app, "--region-size", a.regionSize, RealRange::closed(kMinRegionSizeM, kMaxRegionSizeM),
         "paged output: side of a region in metres, a whole number of tiles (tile_size_m), 250..16000 (default 2000)");
     app.add_option("--shard", a.shard,
                    "paged output: shard K of N (K/N, 1 <= K <= N): generate only the regions whose index % N == K - 1, "
@@ -84,13 +96,15 @@ CLI::Option* declareFlags(CLI::App& app, GenArgs& a) {
     app.add_flag("--merge", a.merge,
                  "paged output: generate nothing; write index.osgb and manifest.json once every region is done "
                  "(exit 2 naming the missing regions otherwise)");
-    app.add_option("--shards", a.shards,
-                   "with --merge: N, the shard count of the shards' --shard K/N; a merge that finds regions missing "
-                   "then names the shards K/N to run again");
-    app.add_option("--memory-budget", a.memoryBudget,
-                   "GB: refuse up front, before the meshes are made and with nothing written, a generation whose "
-                   "estimated peak memory exceeds it (one file: from the laid-out city's estimated triangles; paged: "
-                   "from --region-size); --stats reports the estimate beside the measured peak (default: no budget)");
+    addNumberOption(
+        app, "--shards", a.shards, 1, kMaxShards,
+        "with --merge: N, 1 .. 100000, the shard count of the shards' --shard K/N; a merge that finds regions missing "
+        "then names the shards K/N to run again");
+    addNumberOption(
+        app, "--memory-budget", a.budgetGb, kMemoryBudgetGbRange,
+        "GB, (0, 65536]: refuse up front, before the meshes are made and with nothing written, a generation whose "
+        "estimated peak memory exceeds it (one file: from the laid-out city's estimated triangles; paged: "
+        "from --region-size); --stats reports the estimate beside the measured peak (default: no budget)");
     app.add_flag("--list-params", a.listParams,
                  "print every parameter with unit, range and default (Markdown) and exit");
     app.add_flag("-q,--quiet", a.quiet, "no progress on stderr");
@@ -134,11 +148,7 @@ Result<CityParams> resolveParams(GenArgs& a) {
         if (!r) return r.status();
         params = *r;
     }
-    if (!a.seed.empty()) {
-        auto seed = parseUnsignedText("option --seed", a.seed, 0, UINT64_MAX);
-        if (!seed) return seed.status();
-        params.seed = *seed;
-    }
+    if (a.seed) params.seed = *a.seed;
     if (a.size) params.size_m = *a.size;
     if (a.detail) params.detail = *a.detail;
     if (a.threads) params.threads = *a.threads;
@@ -155,12 +165,12 @@ Result<CityParams> resolveParams(GenArgs& a) {
     if (a.osmBuildings != "on" && a.osmBuildings != "off")
         return Status::error("option --osm-buildings = '" + a.osmBuildings + "': must be 'on' or 'off'");
     if (a.paged()) return params;  // checked by resolvePaged
-    if (a.regionSize || !a.shard.empty() || a.merge || !a.shards.empty())
+    if (a.regionSize || !a.shard.empty() || a.merge || a.shards)
         return Status::error(std::string("option ") +
-                             (a.regionSize        ? "--region-size"
-                              : !a.shard.empty()  ? "--shard"
-                              : !a.shards.empty() ? "--shards"
-                                                  : "--merge") +
+                             (a.regionSize       ? "--region-size"
+                              : !a.shard.empty() ? "--shard"
+                              : a.shards         ? "--shards"
+                                                 : "--merge") +
                              ": only with paged output (-o DIR.paged)");
     if (a.out.size() < 5 || a.out.substr(a.out.size() - 5) != ".osgb")
         return Status::error("option -o = '" + a.out +
@@ -194,11 +204,9 @@ Result<PagedCityOptions> resolvePaged(const GenArgs& a, const CityParams& params
     }
     if (a.merge && !a.shard.empty())
         return Status::error("option --merge: not with --shard (the merge covers every shard)");
-    if (!a.shards.empty()) {
+    if (a.shards) {
         if (!a.merge) return Status::error("option --shards: only with --merge (shards take --shard K/N)");
-        auto n = parseShardCount("--shards", a.shards);
-        if (!n) return n.status();
-        o.mergeShards = *n;
+        o.mergeShards = *a.shards;
     }
     for (auto [opt, path] : {std::pair<const char*, const std::string*>{"--geojson", &a.geojsonFile},
                              {"--gltf", &a.gltfFile},
@@ -382,9 +390,6 @@ int runGen(int argc, char** argv) {
     Stopwatch total;
     auto params = resolveParams(a);
     if (!params) return reportBadInput(kCmd, params.status());
-    auto budget = parseMemoryBudgetGb("--memory-budget", a.memoryBudget);
-    if (!budget) return reportBadInput(kCmd, budget.status());
-    a.budgetGb = *budget;
     if (a.paged()) return runPaged(a, *params, total);
     StderrProgress progress(isatty(2));
     GenerateOptions opts;

@@ -30,18 +30,23 @@ int runPath(int argc, char** argv) {
         ->required();
     addSeedOption(app, "--seed", o.seed, "random seed of the route (default 1)");
     app.add_option("--kind", kind, "walk (eye 1.7 m), car (eye 1.2 m) or fly (elevated fly-over); default car");
-    app.add_option("--duration", o.duration, "path length in seconds (default 60)");
-    app.add_option(
-        "--run-up", o.runUp,
+    addNumberOption(app, "--duration", o.duration, path_range::duration,
+                    "path length in seconds, (0, 86400] (default 60)");
+    addNumberOption(
+        app, "--run-up", o.runUp, path_range::runUp,
         "seconds driven before the path starts and dropped, so it starts at cruising speed, 0 .. 600 (default 8)");
     app.add_option("--route", route,
                    "tour (default): head for far goals along shortest paths, so a long drive keeps going across "
                    "the city; wander: a seeded random walk that prefers going straight on");
-    app.add_option("--dt", o.dt, "seconds between samples (default 1/30)");
-    auto* speed = app.add_option("--speed", o.maxSpeed, "maximum speed in m/s (default: walk 1.4, car and fly 14)");
-    app.add_option("--yaw-rate", yawDeg, "maximum yaw rate in degrees/s (default 45)");
-    app.add_option("--fly-height", o.flyHeight, "fly-over height above the terrain in metres (default 80)");
-    app.add_option("--fly-pitch", pitchDeg, "fly-over pitch in degrees (default -11.5)");
+    addNumberOption(app, "--dt", o.dt, path_range::dt, "seconds between samples, (0, 10] (default 1/30)");
+    auto* speed = addNumberOption(app, "--speed", o.maxSpeed, path_range::speed,
+                                  "maximum speed in m/s, (0, 1000] (default: walk 1.4, car and fly 14)");
+    addNumberOption(app, "--yaw-rate", yawDeg, path_range::yawRateDeg,
+                    "maximum yaw rate in degrees/s, (0, 720] (default 45)");
+    addNumberOption(app, "--fly-height", o.flyHeight, path_range::flyHeight,
+                    "fly-over height above the terrain in metres, (0, 10000) (default 80)");
+    addNumberOption(app, "--fly-pitch", pitchDeg, path_range::flyPitchDeg,
+                    "fly-over pitch in degrees, (-90, 90) (default -11.5)");
     app.add_flag("--lht", o.leftHandTraffic,
                  "car: left-hand traffic, every lane driven against its right-hand direction (the lane model is "
                  "right-hand traffic; one-way streets are then driven the wrong way)");

@@ -63,9 +63,10 @@ const std::pair<unsigned, const char*> kChannelDirs[] = {
     {kRgb, "rgb"}, {kDepth, "depth"}, {kSemantic, "semantic"}, {kInstance, "instance"}};
 
 struct RenderArgs {
-    std::string city, size = "640x480", mode = "full", out, channels = "rgb,depth,semantic,instance", fov = "60";
+    std::string city, size = "640x480", mode = "full", out, channels = "rgb,depth,semantic,instance";
     std::string sampling = "spread";
     int frames = 60;
+    double fov = 60;
     bool stats = false, quiet = false, restart = false;
     PathFlags path;
     ModeFlags modeFlags;
@@ -256,9 +257,8 @@ Status configure(const RenderArgs& a, RenderPlan& p) {
     auto size = parseImageSize(a.size);
     if (!size) return size.status();
     p.size = *size;
-    auto fov = parseFov(a.fov);
-    if (!fov) return fov.status();
-    p.fovDeg = *fov;
+    VISTA_RETURN_IF_ERROR(checkFov(a.fov));
+    p.fovDeg = a.fov;
     if (a.mode != "full" && a.mode != "hybrid")
         return Status::error("--mode '" + a.mode + "': ground truth is rendered in full or hybrid");
     auto channels = parseChannels(a.channels);
@@ -630,11 +630,11 @@ int runRender(int argc, char** argv) {
     RenderArgs a;
     app.add_option("city", a.city, "city scene file (.osgb) from `vista gen`")->required();
     addPathFlags(app, a.path, true);
-    app.add_option("--frames", a.frames, "frames rendered, 1 .. 1000000 (default 60)");
+    addNumberOption(app, "--frames", a.frames, 1, 1000000, "frames rendered, 1 .. 1000000 (default 60)");
     app.add_option("--sampling", a.sampling,
                    "which path samples are the frames: spread (default), consecutive or runs:K");
     app.add_option("--size", a.size, "image size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 640x480)");
-    app.add_option("--fov", a.fov, "vertical field of view in degrees, (1, 179) (default 60)");
+    addNumberOption(app, "--fov", a.fov, kFovRange, "vertical field of view in degrees, (1, 179) (default 60)");
     app.add_option(
         "--mode", a.mode,
         "render mode: full (every triangle rasterised) or hybrid (near field + ray-cast far field) (default full)");

@@ -52,7 +52,7 @@ const char* const kCmd = "vista view";
 osg::Matrixd toOsg(const glm::dmat4& m) { return osg::Matrixd(glm::value_ptr(m)); }
 
 struct ViewArgs {
-    std::string city, size = "1280x720", screenshot, mode = "full", fov = "60", memoryBudget;
+    std::string city, size = "1280x720", screenshot, mode = "full";
     std::optional<std::string> effects;  // unset: the scene's
     int frames = 0;
     bool step = false, noHud = false;
@@ -61,7 +61,7 @@ struct ViewArgs {
     PathFlags path;
     ModeFlags modeFlags;
     ImageSize window;
-    double fovDeg = 60.0;
+    double fovDeg = 60.0, memoryBudgetGb = 0;
     PagedReach paged;
 };
 
@@ -77,10 +77,10 @@ void declareFlags(CLI::App& app, ViewArgs& a) {
     app.get_option("--seed")->description(
         "play back the path of this seed (key 5); default 0 = none, start where seed 1's path starts");
     app.add_option("--size", a.size, "window size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 1280x720)");
-    app.add_option("--fov", a.fov, "vertical field of view in degrees, (1, 179) (default 60)");
+    addNumberOption(app, "--fov", a.fovDeg, kFovRange, "vertical field of view in degrees, (1, 179) (default 60)");
     app.add_option("--mode", a.mode, "start in this render mode: " + renderModeNames() + " (default full)");
     addModeFlags(app, a.modeFlags);
-    app.add_option("--frames", a.frames, "quit after N frames (0 = run until Esc)");
+    addNumberOption(app, "--frames", a.frames, 0, 100000000, "quit after N frames, 0 .. 100000000 (0 = run until Esc)");
     app.add_flag(
         "--step", a.step,
         "with --frames N and a path: show the N frames `vista bench --frames N` renders (one path sample per frame)");
@@ -90,9 +90,10 @@ void declareFlags(CLI::App& app, ViewArgs& a) {
                        samplingName(kDefaultSampleRuns) + ")");
     app.add_flag("--no-hud", a.noHud, "no text overlay (for screenshots compared with `vista bench`)");
     app.add_option("--screenshot", a.screenshot, "write a PNG of the last frame (use with --frames)");
-    app.add_option("--memory-budget", a.memoryBudget,
-                   "GB: refuse up front when the estimated peak memory (from the city file's size, with the ray scene "
-                   "every mode may need) exceeds it (default: no budget)");
+    addNumberOption(
+        app, "--memory-budget", a.memoryBudgetGb, kMemoryBudgetGbRange,
+        "GB, (0, 65536]: refuse up front when the estimated peak memory (from the city file's size, with the ray scene "
+        "every mode may need) exceeds it (default: no budget)");
     app.add_option("--effects", a.effects,
                    "run-time effects instead of the scene's: 'none', names (haze, glass, night) or a JSON object; "
                    "keys y / g / n toggle haze, glass reflections and the night sky");
@@ -102,17 +103,13 @@ Status configure(ViewArgs& a, ModeOptions& options) {
     auto size = parseImageSize(a.size);
     if (!size) return size.status();
     a.window = size.value();
-    auto fov = parseFov(a.fov);
-    if (!fov) return fov.status();
-    a.fovDeg = fov.value();
+    VISTA_RETURN_IF_ERROR(checkFov(a.fovDeg));
     if (auto m = parseModeName(a.mode); !m) return m.status();
-    if (a.frames < 0)
-        return Status::error("--frames " + std::to_string(a.frames) + " out of range 0 .. (0 = until Esc)");
     auto sampling = parseSampling(a.sampling);
     if (!sampling) return sampling.status();
     a.sampleRuns = sampling.value();
-    if (a.step && (a.frames < 1 || (a.path.file.empty() && a.path.seed == 0)))
-        return Status::error("--step needs --frames N >= 1 and a path (--path or --seed)");
+    if (a.step && (a.frames < 1 || a.frames > 1000000 || (a.path.file.empty() && a.path.seed == 0)))
+        return Status::error("--step needs --frames N in 1 .. 1000000 (as vista bench) and a path (--path or --seed)");
     VISTA_RETURN_IF_ERROR(
         checkRunFiles(CommandFiles().output("--screenshot", a.screenshot), a.city, a.path, a.modeFlags));
     if (!a.screenshot.empty()) VISTA_RETURN_IF_ERROR(checkWritablePath("--screenshot", a.screenshot));
@@ -458,13 +455,12 @@ int runView(int argc, char** argv) {
     if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;
     ModeContext ctx;
     if (Status s = configure(a, ctx.options); !s) return reportBadInput(kCmd, s);
-    auto budget = parseMemoryBudgetGb("--memory-budget", a.memoryBudget);
-    if (!budget) return reportBadInput(kCmd, budget.status());
     {
         std::error_code ec;
         const uint64_t bytes = std::filesystem::file_size(a.city, ec);
         if (!ec)
-            if (Status s = checkMemoryBudget("--memory-budget", *budget, estimateCityRunMb(bytes, true), bytes, true);
+            if (Status s =
+                    checkMemoryBudget("--memory-budget", a.memoryBudgetGb, estimateCityRunMb(bytes, true), bytes, true);
                 !s)
                 return reportBadInput(kCmd, s);
     }
@@ -480,7 +476,7 @@ int runView(int argc, char** argv) {
         return p;
     };
     req.beforePagedLoad = [&](uint64_t bytes) {
-        return checkMemoryBudget("--memory-budget", *budget, estimateCityRunMb(bytes, true), bytes, true);
+        return checkMemoryBudget("--memory-budget", a.memoryBudgetGb, estimateCityRunMb(bytes, true), bytes, true);
     };
     // Every baked file given is checked against the city up front (modes are switched at run time).
     req.bakedModes = {};

@@ -31,15 +31,6 @@ double currentRssMb() {
 
 MemoryPhase memoryPhase(const std::string& name) { return {name, peakRssMb(), currentRssMb()}; }
 
-Result<double> parseMemoryBudgetGb(const std::string& option, const std::string& text) {
-    if (text.empty()) return 0.0;
-    char* end = nullptr;
-    const double v = std::strtod(text.c_str(), &end);
-    if (end == text.c_str() || *end != '\0' || !std::isfinite(v) || !(v > 0) || v > 65536)
-        return Status::error("option " + option + " = '" + text + "': expected a number of GB in (0, 65536]");
-    return v;
-}
-
 double estimateCityRunMb(uint64_t fileBytes, bool rayScene) {
     const double f = double(fileBytes) / kMb;
     return kFixedMb + kSceneBytesPerFileByte * f + (rayScene ? kRaysBytesPerFileByte * f : 0.0);

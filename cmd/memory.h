@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <string>
 
+#include "foundation/number_text.h"
 #include "foundation/status.h"
 
 namespace vista {
@@ -24,8 +25,9 @@ struct MemoryPhase {
 // The phase just ended, measured now.
 MemoryPhase memoryPhase(const std::string& name);
 
-// "" = no budget (0); else a number of GB in (0, 65536]. Errors name `option`.
-Result<double> parseMemoryBudgetGb(const std::string& option, const std::string& text);
+// --memory-budget GB of bench, view and gen (addNumberOption): a number of GB
+// in (0, 65536]; not given = no budget (0).
+constexpr RealRange kMemoryBudgetGbRange = RealRange::openMin(0, 65536);
 // Estimated peak (MiB) of a run on a city file of `fileBytes` bytes.
 double estimateCityRunMb(uint64_t fileBytes, bool rayScene);
 // Ok when there is no budget or the estimate fits it; otherwise an error that

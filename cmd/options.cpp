@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
@@ -16,34 +15,25 @@ namespace vista {
 
 namespace {
 
-// A whole string as a signed integer; false on anything else (sign, spaces, overflow).
-bool toInteger(const std::string& s, long long& v) {
-    if (s.empty()) return false;
-    char* end = nullptr;
-    errno = 0;
-    v = std::strtoll(s.c_str(), &end, 10);
-    return end && *end == 0 && errno != ERANGE;
-}
-
-bool toNumber(const std::string& s, double& v) {
-    if (s.empty()) return false;
-    char* end = nullptr;
-    v = std::strtod(s.c_str(), &end);
-    return end && *end == 0 && std::isfinite(v);
-}
-
-// "AsepB" with decimal digits only on both sides (at most 9 each); false otherwise.
-bool splitPair(const std::string& s, const char* seps, long& a, long& b) {
+// "AsepB" (sep one of `seps`): A and B decimal integers in [lo, hi]
+// (number_text.h). An error names "option WHAT", the whole text and the part
+// (`nameA`, `nameB`), and ends in `shape`.
+Status parsePair(const std::string& s, const char* seps, const std::string& what, const char* nameA, const char* nameB,
+                 uint64_t lo, uint64_t hi, const std::string& shape, uint64_t& a, uint64_t& b) {
+    const std::string head = "option " + what + " = '" + echoText(s) + "': ";
     const size_t k = s.find_first_of(seps);
-    auto digits = [](const std::string& t) {
-        return !t.empty() && t.size() <= 9 &&
-               std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
-    };
-    if (k == std::string::npos || !digits(s.substr(0, k)) || !digits(s.substr(k + 1))) return false;
-    a = std::stol(s.substr(0, k));
-    b = std::stol(s.substr(k + 1));
-    return true;
+    if (k == std::string::npos) return Status::error(head + "no '" + seps[0] + "'" + shape);
+    auto first = parseUnsignedText(nameA, s.substr(0, k), lo, hi);
+    if (!first) return Status::error(head + first.status().message() + shape);
+    auto second = parseUnsignedText(nameB, s.substr(k + 1), lo, hi);
+    if (!second) return Status::error(head + second.status().message() + shape);
+    a = *first;
+    b = *second;
+    return Status::ok();
 }
+
+// number_text's error for an option that also takes words ("auto", "off").
+Status orWords(const Status& s, const std::string& words) { return Status::error(s.message() + " (or " + words + ")"); }
 
 std::string num(double v) {
     std::ostringstream o;
@@ -61,11 +51,9 @@ Status checkImageSize(int w, int h) {
 }
 
 Result<ImageSize> parseImageSize(const std::string& s) {
-    long w = 0, h = 0;
-    if (!splitPair(s, "xX", w, h))
-        return Status::error("--size '" + s + "': expected WIDTHxHEIGHT, e.g. 640x480 (each 1 .. 8192 pixels)");
-    if (w < 1 || h < 1 || w > kMaxImageSide || h > kMaxImageSide)
-        return Status::error("--size " + s + " out of range 1x1 .. 8192x8192 pixels");
+    uint64_t w = 0, h = 0;
+    VISTA_RETURN_IF_ERROR(parsePair(s, "xX", "--size", "width", "height", 1, kMaxImageSide,
+                                    " (expected WIDTHxHEIGHT, e.g. 640x480, each 1 .. 8192 pixels)", w, h));
     return ImageSize{int(w), int(h)};
 }
 
@@ -74,9 +62,9 @@ Status parseTexels(const std::string& s, int& x, int& y) {
         x = y = 1;
         return Status::ok();
     }
-    long a = 0, b = 0;
-    if (!splitPair(s, "xX", a, b) || a < 1 || b < 1 || a > 32 || b > 32)
-        return Status::error("--texels '" + s + "': expected 1 or AxB with 1 <= A, B <= 32 (e.g. 8x2, 4x1)");
+    uint64_t a = 0, b = 0;
+    VISTA_RETURN_IF_ERROR(parsePair(s, "xX", "--texels", "A", "B", 1, 32,
+                                    " (expected 1 or AxB with A, B in [1, 32], e.g. 8x2, 4x1)", a, b));
     x = int(a);
     y = int(b);
     return Status::ok();
@@ -115,11 +103,8 @@ Status checkNearDistance(double v) {
 
 Result<double> parseNearDistance(const std::string& s) {
     if (s == "auto") return -1.0;
-    double v = 0;
-    if (!toNumber(s, v))
-        return Status::error("--near '" + s + "': expected a distance in metres (1 .. 100000) or 'auto'");
-    if (v < kMinNearDistance || v > kMaxNearDistance)
-        return Status::error("--near " + s + " out of range 1 .. 100000 metres (or 'auto')");
+    auto v = parseRealText("option --near", s, kMinNearDistance, kMaxNearDistance);
+    if (!v) return orWords(v.status(), "'auto'");
     return v;
 }
 
@@ -130,23 +115,10 @@ Status checkPixelBudget(int64_t v) {
 }
 
 Result<int64_t> parsePixelBudget(const std::string& s) {
-    const std::string range = " rays per frame, or 'unlimited' / -1";
-    if (s == "unlimited" || s == "-1") return int64_t(-1);
-    long long v = 0;
-    if (!toInteger(s, v))
-        return Status::error("--budget '" + s + "': expected an integer 0 .. " + std::to_string(kMaxPixelBudget) +
-                             range);
-    if (v < 0 || v > kMaxPixelBudget)
-        return Status::error("--budget " + s + " out of range 0 .. " + std::to_string(kMaxPixelBudget) + range);
-    return int64_t(v);
-}
-
-Result<uint64_t> parseTriangleBudget(const std::string& s) {
-    long long v = 0;
-    if (!toInteger(s, v) || v < 0 || uint64_t(v) > kMaxTriangleBudget)
-        return Status::error("--triangle-budget '" + s + "' out of range 0 .. " + std::to_string(kMaxTriangleBudget) +
-                             " triangles (0 = near field by distance)");
-    return uint64_t(v);
+    if (s == "unlimited") return int64_t(-1);
+    auto v = parseSignedText("option --budget", s, -1, kMaxPixelBudget);  // -1 = unlimited
+    if (!v) return orWords(v.status(), "'unlimited'");
+    return v;
 }
 
 Status checkFov(double deg) {
@@ -154,19 +126,11 @@ Status checkFov(double deg) {
     return Status::error("--fov " + num(deg) + " out of range (1, 179) degrees");
 }
 
-Result<double> parseFov(const std::string& s) {
-    double v = 0;
-    if (!toNumber(s, v)) return Status::error("--fov '" + s + "': expected degrees in (1, 179)");
-    VISTA_RETURN_IF_ERROR(checkFov(v));
-    return v;
-}
-
 Result<double> parseStorageBudget(const std::string& s) {
     if (s == "auto") return -1.0;
     if (s == "off") return 0.0;
-    double v = 0;
-    if (!toNumber(s, v) || !(v >= kMinStorageBudgetMb && v <= kMaxStorageBudgetMb))
-        return Status::error("--storage-budget '" + s + "': expected auto, off or megabytes in 0.01 .. 1000000");
+    auto v = parseRealText("option --storage-budget", s, kMinStorageBudgetMb, kMaxStorageBudgetMb);
+    if (!v) return orWords(v.status(), "'auto', 'off'");
     return v;
 }
 
@@ -177,10 +141,8 @@ Status checkSplatSigma(double sigma) {
 
 Result<double> parseSplatSigma(const std::string& s) {
     if (s == "off" || s == "0") return 0.0;
-    double v = 0;
-    if (!toNumber(s, v) || !checkSplatSigma(v) || v == 0)
-        return Status::error("--point-splat '" + s +
-                             "': expected a Gaussian sigma in output pixels, 0.05 .. 4, or 'off' (1-pixel points)");
+    auto v = parseRealText("option --point-splat", s, kMinSplatSigma, kMaxSplatSigma);
+    if (!v) return orWords(v.status(), "'off' = 1-pixel points");
     return v;
 }
 
@@ -192,10 +154,14 @@ std::string formatSplatSigma(double sigma) {
 }
 
 Result<int> parseReference(const std::string& s) {
+    const std::string shape = " (expected 'full' or 'ssaa:K')";
     if (s == "full") return 0;
-    long long k = 0;
-    if (s.rfind("ssaa:", 0) == 0 && toInteger(s.substr(5), k) && k >= 2 && k <= kMaxReferenceSsaa) return int(k);
-    return Status::error("--reference '" + s + "': expected 'full' or 'ssaa:K' with K in 2 .. 8");
+    if (s.rfind("ssaa:", 0) != 0)
+        return Status::error("option --reference = '" + echoText(s) + "': expected 'full' or 'ssaa:K' with K in [2, " +
+                             std::to_string(kMaxReferenceSsaa) + "]");
+    auto k = parseUnsignedText("K", s.substr(5), 2, kMaxReferenceSsaa);
+    if (!k) return Status::error("option --reference = '" + echoText(s) + "': " + k.status().message() + shape);
+    return int(*k);
 }
 
 Result<std::string> parseModeName(const std::string& s) {
@@ -228,14 +194,14 @@ Result<int> parseSampling(const std::string& s) {
     if (s == "consecutive") return 1;
     const std::string prefix = "runs:";
     if (s.rfind(prefix, 0) == 0) {
-        const std::string k = s.substr(prefix.size());
-        char* end = nullptr;
-        errno = 0;
-        const long v = std::strtol(k.c_str(), &end, 10);
-        if (!k.empty() && *end == 0 && errno == 0 && v >= 1 && v <= 100000) return int(v);
-        return Status::error("--sampling '" + s + "': K out of range 1 .. 100000 (runs:K)");
+        auto k = parseUnsignedText("K", s.substr(prefix.size()), 1, 100000);
+        if (!k)
+            return Status::error("option --sampling = '" + echoText(s) + "': " + k.status().message() +
+                                 " (expected spread, consecutive or runs:K)");
+        return int(*k);
     }
-    return Status::error("--sampling '" + s + "': expected spread, consecutive or runs:K (K in 1 .. 100000)");
+    return Status::error("option --sampling = '" + echoText(s) +
+                         "': expected spread, consecutive or runs:K (K in [1, 100000])");
 }
 
 std::string samplingName(int runs) {
@@ -244,18 +210,17 @@ std::string samplingName(int runs) {
 
 Result<std::vector<int>> parseSweep(const std::string& s) {
     const std::string prefix = "sizes=";
-    if (s.rfind(prefix, 0) != 0) return Status::error("--sweep '" + s + "': expected sizes=S1,S2,... (metres)");
+    if (s.rfind(prefix, 0) != 0)
+        return Status::error("option --sweep = '" + echoText(s) + "': expected sizes=S1,S2,... (metres)");
     std::vector<int> out;
     std::stringstream ss(s.substr(prefix.size()));
     std::string item;
     while (std::getline(ss, item, ',')) {
-        char* end = nullptr;
-        long v = std::strtol(item.c_str(), &end, 10);
-        if (item.empty() || *end || v < 100 || v > 16000)
-            return Status::error("--sweep: size '" + item + "' out of range 100 .. 16000 metres");
-        out.push_back(int(v));
+        auto v = parseUnsignedText("size", item, 100, 16000);  // metres
+        if (!v) return Status::error("option --sweep = '" + echoText(s) + "': " + v.status().message());
+        out.push_back(int(*v));
     }
-    if (out.empty()) return Status::error("--sweep '" + s + "': no sizes");
+    if (out.empty()) return Status::error("option --sweep = '" + echoText(s) + "': no sizes");
     return out;
 }
 
@@ -265,17 +230,17 @@ void addModeFlags(CLI::App& app, ModeFlags& f) {
                    "ray casting, 15 .. 800 m and everything; the other "
                    "modes then use 100) (default " +
                        f.near + ")");
-    app.add_option("--triangle-budget", f.triangleBudget,
-                   "hybrid: near field = the nearest 40 m chunks up to N triangles instead of --near, 0 .. 10000000000 "
-                   "(default " +
-                       f.triangleBudget + " = off)");
+    addNumberOption(app, "--triangle-budget", f.triangleBudget, 0, kMaxTriangleBudget,
+                    "hybrid: near field = the nearest 40 m chunks up to N triangles instead of --near, 0 .. "
+                    "10000000000 (default " +
+                        std::to_string(f.triangleBudget) + " = off)");
     app.add_option(
         "--budget", f.budget,
         "hybrid: most far-field rays per frame (the cache re-traces its worst pixels first), 0 .. 1000000000, "
         "or 'unlimited' / -1 = no cap: every pixel over --cache-error is re-traced (default " +
             f.budget + ")");
-    app.add_option(
-        "--horizon-grid", f.horizonGrid,
+    addNumberOption(
+        app, "--horizon-grid", f.horizonGrid, 0, 8192,
         "hybrid: horizon height-grid resolution, cells per side, 1 .. 8192, or 0 = auto: cells of about 4 m, "
         "512 .. 2048 a side (default 0)");
     app.add_flag("--no-cache", f.noCache, "hybrid: panoramic image cache off (every far pixel traced)");
@@ -286,15 +251,16 @@ void addModeFlags(CLI::App& app, ModeFlags& f) {
                  "hybrid: trace the horizon and last frame's far pixels after the near field is drawn instead of on "
                  "other threads "
                  "during the draw");
-    app.add_option("--cache-error", f.cacheError,
-                   "hybrid: reuse a cached far pixel while its estimated reprojection error is below this many pixels, "
-                   "0 .. 100 (0 = only pixels traced by this very camera) (default 0.25)");
-    app.add_option(
-        "--frame-ms", f.frameMs,
+    addNumberOption(
+        app, "--cache-error", f.cacheError, RealRange::closed(0, 100),
+        "hybrid: reuse a cached far pixel while its estimated reprojection error is below this many pixels, "
+        "0 .. 100 (0 = only pixels traced by this very camera) (default 0.25)");
+    addNumberOption(
+        app, "--frame-ms", f.frameMs, RealRange::closed(0, 10000),
         "hybrid: frame-time target in ms, 0 .. 10000: the far-field ray budget adapts to what the target leaves "
         "after the near field (0 = no target) (default 0)");
-    app.add_option(
-        "--far-step", f.farStep,
+    addNumberOption(
+        app, "--far-step", f.farStep, 1, 2,
         "hybrid: far-field ray spacing, 1 or 2: 2 = rays on every other pixel and row first, pixels between "
         "lattice pixels that showed one triangle (or sky) blended from them (lossy: PSNR in the bench) (default 1)");
     app.add_option("--baked", f.baked, "impostor: the baked file of this city (from `vista bake`)");
@@ -306,7 +272,7 @@ void addModeFlags(CLI::App& app, ModeFlags& f) {
         "impostor: points drawn as Gaussian splats of SIGMA output pixels with normalised accumulation, 0.05 .. 4, "
         "or off = 1-pixel points (default " +
             formatSplatSigma(ModeOptions().splatSigma) + ")");
-    app.add_option("--threads", f.threads, "worker threads for ray casting, 0 .. 1024 (0 = all cores)");
+    addNumberOption(app, "--threads", f.threads, 0, 1024, "worker threads for ray casting, 0 .. 1024 (0 = all cores)");
 }
 
 Status checkModeOptions(const ModeOptions& o) {
@@ -333,8 +299,6 @@ Status checkModeOptions(const ModeOptions& o) {
 Status parseModeFlags(const ModeFlags& f, ModeOptions& o) {
     auto nd = parseNearDistance(f.near);
     if (!nd) return nd.status();
-    auto tb = parseTriangleBudget(f.triangleBudget);
-    if (!tb) return tb.status();
     auto pb = parsePixelBudget(f.budget);
     if (!pb) return pb.status();
     if (!f.baked.empty() && access(f.baked.c_str(), R_OK) != 0)
@@ -342,7 +306,7 @@ Status parseModeFlags(const ModeFlags& f, ModeOptions& o) {
     if (!f.bakedMesh.empty() && access(f.bakedMesh.c_str(), R_OK) != 0)
         return Status::error("--baked-mesh '" + f.bakedMesh + "': cannot read the file");
     o.nearDistance = nd.value();
-    o.triangleBudget = tb.value();
+    o.triangleBudget = f.triangleBudget;
     o.pixelBudget = pb.value();
     o.horizonGrid = f.horizonGrid;
     o.cache = !f.noCache;
@@ -362,17 +326,57 @@ Status parseModeFlags(const ModeFlags& f, ModeOptions& o) {
     return checkModeOptions(o);
 }
 
+namespace option_detail {
+
+CLI::Option* addConvertedOption(CLI::App& app, const std::string& name, const std::string& help,
+                                const std::string& typeName, std::function<Status(const std::string&)> set,
+                                std::function<std::string()> shown) {
+    auto convert = [set](const CLI::results_t& res) {
+        if (res.empty()) return false;
+        if (Status s = set(res.back()); !s) throw CLI::ValidationError(s.message());
+        return true;
+    };
+    CLI::Option* opt = app.add_option(name, convert, help, false, std::move(shown));
+    opt->type_name(typeName);
+    opt->type_size(1, 1);
+    opt->expected(1);
+    return opt;
+}
+
+}  // namespace option_detail
+
+namespace {
+
+CLI::Option* addReal(CLI::App& app, const std::string& name, const RealRange& range, const std::string& help,
+                     std::function<void(double)> store, std::function<std::string()> shown) {
+    return option_detail::addConvertedOption(
+        app, name, help, CLI::detail::type_name<double>(),
+        [name, range, store](const std::string& text) -> Status {
+            auto v = parseRealText("option " + name, text, range);
+            if (!v) return v.status();
+            store(*v);
+            return Status::ok();
+        },
+        std::move(shown));
+}
+
+}  // namespace
+
+CLI::Option* addNumberOption(CLI::App& app, const std::string& name, double& value, const RealRange& range,
+                             const std::string& help) {
+    return addReal(
+        app, name, range, help, [&value](double v) { value = v; },
+        [&value] { return CLI::detail::checked_to_string<double, double>(value); });
+}
+
+CLI::Option* addNumberOption(CLI::App& app, const std::string& name, std::optional<double>& value,
+                             const RealRange& range, const std::string& help) {
+    return addReal(
+        app, name, range, help, [&value](double v) { value = v; }, [] { return std::string(); });
+}
+
 CLI::Option* addSeedOption(CLI::App& app, const std::string& name, uint64_t& seed, const std::string& help) {
-    return app
-        .add_option_function<std::string>(
-            name,
-            [&seed, name](const std::string& text) {
-                auto v = parseUnsignedText("option " + name, text, 0, UINT64_MAX);
-                if (!v) throw CLI::ValidationError(v.status().message());
-                seed = *v;
-            },
-            help)
-        ->type_name("UINT");
+    return addNumberOption(app, name, seed, 0, UINT64_MAX, help);
 }
 
 void addPathFlags(CLI::App& app, PathFlags& f, bool timing) {
@@ -383,9 +387,10 @@ void addPathFlags(CLI::App& app, PathFlags& f, bool timing) {
     app.add_option("--kind", f.kind, "path kind when made from --seed: walk, car, fly (default " + f.kind + ")");
     app.add_flag("--lht", f.lht, "car path made from --seed: left-hand traffic (lanes driven mirrored)");
     if (!timing) return;
-    app.add_option("--duration", f.duration, "path duration in seconds when made from --seed (default 60)");
-    app.add_option(
-        "--run-up", f.runUp,
+    addNumberOption(app, "--duration", f.duration, path_range::duration,
+                    "path duration in seconds when made from --seed, (0, 86400] (default 60)");
+    addNumberOption(
+        app, "--run-up", f.runUp, path_range::runUp,
         "seconds driven before the path starts and dropped, so it starts at cruising speed, 0 .. 600 (default 8)");
 }
 
@@ -490,13 +495,14 @@ void addPagedFlags(CLI::App& app, PagedReach& reach) {
     help << "with a paged city (a DIR.paged directory from `vista gen`): load only the regions within this many metres "
             "of the walkthrough at full detail, "
          << kMinPagedRadiusM << " .. " << kMaxPagedRadiusM << " (default " << kDefaultPagedRadiusM << ")";
-    app.add_option("--paged-radius", reach.radius, help.str());
+    const RealRange range = RealRange::closed(kMinPagedRadiusM, kMaxPagedRadiusM);
+    addNumberOption(app, "--paged-radius", reach.radius, range, help.str());
     std::ostringstream far;
     far << "with a paged city: load the other regions within this many metres of the walkthrough at their coarse level "
            "(detail 0, no trees) for the far field, "
         << kMinPagedRadiusM << " .. " << kMaxPagedRadiusM << " (default " << kDefaultPagedFarM
         << " = the whole city; 0 = none: the city ends at --paged-radius)";
-    app.add_option("--paged-far", reach.far, far.str());
+    addNumberOption(app, "--paged-far", reach.far, range, far.str());
 }
 
 Status validatePagedReach(const PagedReach& reach) {

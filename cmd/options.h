@@ -1,9 +1,13 @@
 // Command-line values of the `vista` commands: one parser per option kind,
 // used by every command that takes the option (bench, view, bake_report).
-// Each parser returns the value or an error whose message names the flag,
-// the value and the allowed range; the command prints it and exits with
-// code 2 (reportBadInput). The check* functions apply the same ranges to
-// values set in code (BenchConfig), so a range is written once.
+// Every number in an option's value is read by foundation/number_text.h:
+// plain numeric options through addNumberOption (at parse time), and the
+// numbers inside the other kinds (WxH, K/N, runs:K, lists, "auto" or a
+// number) by their parsers below. Each parser returns the value or an error
+// whose message names the flag, the value and the allowed range; the
+// command prints it and exits with code 2 (reportBadInput, parseOrExit).
+// The check* functions apply the same ranges to values set in code
+// (BenchConfig), so a range is written once.
 //
 // PathFlags: the walkthrough options (--path, --seed, --kind, --duration,
 // --run-up) of bench and view. ModeFlags: the render-mode options both `vista bench` and `vista view`
@@ -12,13 +16,16 @@
 // turned into ModeOptions by parseModeFlags().
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "citygen/effects.h"
+#include "foundation/number_text.h"
 #include "foundation/output_paths.h"
 #include "foundation/status.h"
 #include "nodes/render/render_mode.h"
@@ -46,10 +53,9 @@ Status checkNearDistance(double metres);  // < 0 = auto
 // --budget N|unlimited: rays per frame 0 .. 1e9, or "unlimited" / "-1" -> -1.
 Result<int64_t> parsePixelBudget(const std::string& s);
 Status checkPixelBudget(int64_t rays);
-// --triangle-budget N: 0 (off: the near field by distance) .. 1e10 triangles.
-Result<uint64_t> parseTriangleBudget(const std::string& s);
-// --fov D: vertical field of view in degrees, strictly between 1 and 179.
-Result<double> parseFov(const std::string& s);
+// --fov D: vertical field of view in degrees, strictly between 1 and 179
+// (bench, render, view: addNumberOption with kFovRange).
+constexpr RealRange kFovRange = RealRange::open(kMinFovDeg, kMaxFovDeg);
 Status checkFov(double degrees);
 // --reference full|ssaa:K: 0 for `full`, else K in 2 .. 8.
 Result<int> parseReference(const std::string& s);
@@ -93,8 +99,9 @@ Result<FrameEffects> runTimeEffects(const std::optional<std::string>& option, co
                                     const char* cmd);
 
 struct ModeFlags {
-    std::string near = "auto", triangleBudget = "0", budget = "unlimited";
-    int horizonGrid = 0;  // 0 = auto (HeightGrid::autoCells)
+    std::string near = "auto", budget = "unlimited";
+    uint64_t triangleBudget = 0;  // 0 = off (the near field by distance) .. kMaxTriangleBudget
+    int horizonGrid = 0;          // 0 = auto (HeightGrid::autoCells)
     bool noCache = false, noOverlap = false, cacheAlways = false;
     double cacheError = 0.25, frameMs = 0.0;
     int farStep = 1;
@@ -111,7 +118,78 @@ Status parseModeFlags(const ModeFlags& flags, ModeOptions& out);
 // Range checks of ModeOptions (for options set in code).
 Status checkModeOptions(const ModeOptions& o);
 
-// A seed option (0 .. 2^64-1, decimal; parseUnsignedText): "-1" or 2^64 is a
+// Numeric options: one value, read by number_text.h when CLI11 parses the
+// command line (decimal only: no hex, octal or binary prefix, no fraction for
+// an integer, no '-' where the range has no negatives, never wrapped or
+// truncated). A value outside the range or malformed throws
+// CLI::ValidationError with number_text's message, which names the option,
+// the text as written and the range ("option --frames = '0x10' is not a whole
+// number (expected a decimal integer in [1, 1000000])"); parseOrExit prints it
+// and returns exit code 2. The help shows CLI11's own type name (INT, UINT,
+// FLOAT); capture_default_str() shows the variable's value as CLI11 would.
+// A std::optional variable stays unset unless the option is given.
+template <class T>
+struct NumberOptionType {
+    using type = T;
+};
+template <class T>
+using NumberOptionBound = typename NumberOptionType<T>::type;  // a bound never deduces T
+
+namespace option_detail {
+// Registers `name` as a one-value option whose text goes to `set`; a failed
+// Status becomes CLI::ValidationError. `shown` gives the default for the help.
+CLI::Option* addConvertedOption(CLI::App& app, const std::string& name, const std::string& help,
+                                const std::string& typeName, std::function<Status(const std::string&)> set,
+                                std::function<std::string()> shown);
+template <class T>
+Result<T> parseInteger(const std::string& name, const std::string& text, T min, T max) {
+    static_assert(std::is_integral_v<T> && !std::is_same_v<T, bool>, "an integer option");
+    if constexpr (std::is_signed_v<T>) {
+        auto v = parseSignedText("option " + name, text, int64_t(min), int64_t(max));
+        if (!v) return v.status();
+        return T(*v);
+    } else {
+        auto v = parseUnsignedText("option " + name, text, uint64_t(min), uint64_t(max));
+        if (!v) return v.status();
+        return T(*v);
+    }
+}
+template <class T, class Store>
+CLI::Option* addInteger(CLI::App& app, const std::string& name, T min, T max, const std::string& help, Store store,
+                        std::function<std::string()> shown) {
+    return addConvertedOption(
+        app, name, help, CLI::detail::type_name<T>(),
+        [name, min, max, store](const std::string& text) -> Status {
+            auto v = parseInteger<T>(name, text, min, max);
+            if (!v) return v.status();
+            store(*v);
+            return Status::ok();
+        },
+        std::move(shown));
+}
+}  // namespace option_detail
+
+// Integers: [min, max], both included.
+template <class T>
+CLI::Option* addNumberOption(CLI::App& app, const std::string& name, T& value, NumberOptionBound<T> min,
+                             NumberOptionBound<T> max, const std::string& help) {
+    return option_detail::addInteger<T>(
+        app, name, min, max, help, [&value](T v) { value = v; },
+        [&value] { return CLI::detail::checked_to_string<T, T>(value); });
+}
+template <class T>
+CLI::Option* addNumberOption(CLI::App& app, const std::string& name, std::optional<T>& value, NumberOptionBound<T> min,
+                             NumberOptionBound<T> max, const std::string& help) {
+    return option_detail::addInteger<T>(
+        app, name, min, max, help, [&value](T v) { value = v; }, [] { return std::string(); });
+}
+// Reals: within `range` (RealRange: closed, open or half-open).
+CLI::Option* addNumberOption(CLI::App& app, const std::string& name, double& value, const RealRange& range,
+                             const std::string& help);
+CLI::Option* addNumberOption(CLI::App& app, const std::string& name, std::optional<double>& value,
+                             const RealRange& range, const std::string& help);
+
+// A seed option (0 .. 2^64-1, decimal; addNumberOption): "-1" or 2^64 is a
 // parse error naming the option and the range, never a wrapped value.
 CLI::Option* addSeedOption(CLI::App& app, const std::string& name, uint64_t& seed, const std::string& help);
 

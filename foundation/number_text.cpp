@@ -86,8 +86,16 @@ Result<int64_t> parseSignedText(const std::string& what, const std::string& text
     return v;
 }
 
+std::string RealRange::text() const {
+    return std::string(minOpen ? "(" : "[") + shortNumber(min) + ", " + shortNumber(max) + (maxOpen ? ")" : "]");
+}
+
 Result<double> parseRealText(const std::string& what, const std::string& text, double min, double max) {
-    const std::string range = rangeText(shortNumber(min), shortNumber(max));
+    return parseRealText(what, text, RealRange::closed(min, max));
+}
+
+Result<double> parseRealText(const std::string& what, const std::string& text, const RealRange& r) {
+    const std::string range = r.text();
     bool plain = !text.empty();
     for (char c : text)
         if (!((c >= '0' && c <= '9') || c == '.' || c == '-' || c == '+' || c == 'e' || c == 'E')) plain = false;
@@ -100,7 +108,7 @@ Result<double> parseRealText(const std::string& what, const std::string& text, d
     if (end != text.c_str() + text.size())
         return Status::error(what + " = " + quoted(text) + " is not a number (expected a decimal number in " + range +
                              ")");
-    if (!std::isfinite(v) || errno == ERANGE || v < min || v > max)
+    if (!std::isfinite(v) || errno == ERANGE || !r.contains(v))
         return Status::error(what + " = " + quoted(text) + " is out of range " + range);
     return v;
 }

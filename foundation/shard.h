@@ -16,12 +16,9 @@ struct Shard {
     int k() const { return index + 1; }
 };
 
-// Parses "K/N"; a bad value is an error naming `option`, the value and the
-// allowed range ("expected K/N with 1 <= K <= N <= 100000").
+// Parses "K/N", K and N by number_text.h (decimal, never wrapped); a bad
+// value is an error naming `option`, the value and the allowed range
+// ("expected K/N with 1 <= K <= N <= 100000").
 Result<Shard> parseShard(const std::string& option, const std::string& text);
-
-// Parses a shard count "N" (1 <= N <= kMaxShards); a bad value is an error
-// naming `option`, the value and the allowed range.
-Result<int> parseShardCount(const std::string& option, const std::string& text);
 
 }  // namespace vista

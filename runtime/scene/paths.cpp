@@ -211,18 +211,19 @@ Result<RouteStyle> parseRouteStyle(const std::string& s) {
 }
 
 Status validatePathOptions(const PathOptions& o) {
-    auto bad = [](const char* name, double v, const char* range) {
+    auto bad = [](const char* name, double v, const std::string& range) {
         return Status::error(std::string("path option ") + name + " = " + fmtNum(v) + " out of range " + range);
     };
-    if (!(o.duration > 0 && o.duration <= 86400)) return bad("duration", o.duration, "(0, 86400] s");
-    if (!(o.dt > 0 && o.dt <= 10)) return bad("dt", o.dt, "(0, 10] s");
-    if (!(o.maxSpeed > 0 && o.maxSpeed <= 1000)) return bad("speed", o.maxSpeed, "(0, 1000] m/s");
+    namespace R = path_range;
+    if (!R::duration.contains(o.duration)) return bad("duration", o.duration, R::duration.text() + " s");
+    if (!R::dt.contains(o.dt)) return bad("dt", o.dt, R::dt.text() + " s");
+    if (!R::speed.contains(o.maxSpeed)) return bad("speed", o.maxSpeed, R::speed.text() + " m/s");
     if (!(o.maxYawRate > 0 && o.maxYawRate <= 4 * kPi))
         return bad("yaw rate", o.maxYawRate, "(0, 720] deg/s (in rad/s)");
     if (!(o.accel > 0) || !(o.decel > 0)) return bad("accel/decel", std::min(o.accel, o.decel), "> 0 m/s^2");
-    if (!(o.flyHeight > 0 && o.flyHeight < 10000)) return bad("fly height", o.flyHeight, "(0, 10000) m");
+    if (!R::flyHeight.contains(o.flyHeight)) return bad("fly height", o.flyHeight, R::flyHeight.text() + " m");
     if (!(o.flyPitch > -kPi / 2 && o.flyPitch < kPi / 2)) return bad("fly pitch", o.flyPitch, "(-90, 90) deg");
-    if (!(o.runUp >= 0 && o.runUp <= 600)) return bad("run-up", o.runUp, "[0, 600] s");
+    if (!R::runUp.contains(o.runUp)) return bad("run-up", o.runUp, R::runUp.text() + " s");
     if ((o.duration + o.runUp) / o.dt > 1e7)
         return bad("(duration + run-up)/dt", (o.duration + o.runUp) / o.dt, "<= 1e7 samples");
     return Status::ok();

@@ -51,6 +51,7 @@
 #include <glm/glm.hpp>
 
 #include "citygen/params.h"
+#include "foundation/number_text.h"
 #include "foundation/status.h"
 #include "citygen/street_graph.h"
 #include "runtime/scene/camera.h"
@@ -90,6 +91,15 @@ struct PathOptions {
     RouteStyle route = RouteStyle::Tour;
     double eyeHeight() const { return kind == PathKind::Walk ? 1.7 : kind == PathKind::Car ? 1.2 : flyHeight; }
 };
+// The ranges of the path options (validatePathOptions; `vista path`, bench,
+// render and view read their flags within them): seconds, m/s, metres, and
+// the yaw rate and fly pitch in degrees (their flags' unit).
+namespace path_range {
+constexpr RealRange duration = RealRange::openMin(0, 86400), dt = RealRange::openMin(0, 10),
+                    speed = RealRange::openMin(0, 1000), yawRateDeg = RealRange::openMin(0, 720),
+                    flyHeight = RealRange::open(0, 10000), flyPitchDeg = RealRange::open(-90, 90),
+                    runUp = RealRange::closed(0, 600);
+}  // namespace path_range
 // Checks ranges; message names the option.
 Status validatePathOptions(const PathOptions& o);
 

@@ -504,7 +504,7 @@ TEST(BenchCli, FarFieldFlagsRejectBadValues) {
                                                        {"--horizon-grid 9000", "--horizon-grid"},
                                                        {"--far-step 3", "--far-step"},
                                                        {"--point-splat 5", "--point-splat"},
-                                                       {"--point-splat wide", "0.05 .. 4"},
+                                                       {"--point-splat wide", "[0.05, 4]"},
                                                        {"--memory-budget 0", "--memory-budget"},
                                                        {"--memory-budget lots", "--memory-budget"}};
     for (const auto& [args, flag] : bad) {

@@ -2,7 +2,9 @@
 // ones are errors naming the flag and the allowed range.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "cmd/options.h"
 #include "foundation/shard.h"
@@ -19,6 +21,20 @@ void expectBad(const R& r, const std::string& input, const std::string& flag, co
     EXPECT_NE(r.status().message().find(range), std::string::npos) << input << ": " << r.status().message();
 }
 
+// Parses `args` as typed (the program name left out) with the options
+// `declare` adds; returns the parse error's message, or "" when it parsed.
+std::string parseArgs(const std::function<void(CLI::App&)>& declare, std::vector<std::string> args) {
+    CLI::App app;
+    declare(app);
+    std::reverse(args.begin(), args.end());  // CLI11 parses the reversed vector
+    try {
+        app.parse(args);
+    } catch (const CLI::ParseError& e) { return e.what(); }
+    return "";
+}
+
+bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
 }  // namespace
 
 TEST(Options, ImageSize) {
@@ -29,7 +45,7 @@ TEST(Options, ImageSize) {
     EXPECT_EQ(parseImageSize("1X1")->height, 1);
     EXPECT_EQ(parseImageSize("8192x8192")->width, 8192);
     for (const char* bad : {"0x0", "8193x10", "10x8193", "640", "640x", "x480", "-5x4", "640x480x3", "64 0x480", "ax b",
-                            "", "99999999999x1"})
+                            "", "99999999999x1", "640x0x1e0", "+640x480", "640x4.8e2"})
         expectBad(parseImageSize(bad), bad, "--size", "8192");
     EXPECT_TRUE(checkImageSize(1, 1).isOk());
     EXPECT_FALSE(checkImageSize(0, 5).isOk());
@@ -47,10 +63,98 @@ TEST(Options, NearDistanceAndBudgets) {
     EXPECT_EQ(parsePixelBudget("1000000000").value(), 1000000000);
     for (const char* bad : {"-7", "1e3", "x", "", "1000000001", "99999999999999999999"})
         expectBad(parsePixelBudget(bad), bad, "--budget", "1000000000");
-    EXPECT_EQ(parseTriangleBudget("0").value(), 0u);
-    EXPECT_EQ(parseTriangleBudget("200000").value(), 200000u);
-    for (const char* bad : {"-1", "1.5", "many", "", "10000000001"})
-        expectBad(parseTriangleBudget(bad), bad, "--triangle-budget", "10000000000");
+    for (const char* bad : {"0x10", "+5", " 5", "1e3"})
+        expectBad(parsePixelBudget(bad), bad, "--budget", "[-1, 1000000000]");
+    for (const char* bad : {"0x10", "1e999", "+5"}) expectBad(parseNearDistance(bad), bad, "--near", "[1, 100000]");
+    ModeFlags f;
+    const auto modeFlags = [&f](CLI::App& app) { addModeFlags(app, f); };
+    EXPECT_EQ(parseArgs(modeFlags, {"--triangle-budget", "10000000000"}), "");
+    EXPECT_EQ(f.triangleBudget, 10000000000u);
+    for (const char* bad : {"-1", "1.5", "many", "", "10000000001", "0x10", "1e3"}) {
+        const std::string e = parseArgs(modeFlags, {"--triangle-budget", bad});
+        EXPECT_TRUE(has(e, "--triangle-budget") && has(e, "[0, 10000000000]")) << bad << ": " << e;
+        EXPECT_TRUE(has(e, std::string("'") + bad + "'")) << bad << ": " << e;
+    }
+}
+
+// Numeric options read by number_text: decimal only, nothing wraps or is
+// cut, the error names the option, the text and the range; a value in range
+// (also at the bounds) is taken as written.
+TEST(Options, NumberOptionsFollowTheNumberTextRules) {
+    int frames = 7;
+    uint64_t budget = 3;
+    size_t count = 5;
+    double fov = 60, dt = 1;
+    std::optional<int> detail;
+    std::optional<double> size;
+    const auto declare = [&](CLI::App& app) {
+        addNumberOption(app, "--frames", frames, 1, 1000000, "frames");
+        addNumberOption(app, "--budget", budget, 0, 100, "budget")->capture_default_str();
+        addNumberOption(app, "--count", count, 0, 1000000000, "count");
+        addNumberOption(app, "--fov", fov, kFovRange, "fov")->capture_default_str();
+        addNumberOption(app, "--dt", dt, RealRange::openMin(0, 10), "dt");
+        addNumberOption(app, "--detail", detail, 0, 3, "detail");
+        addNumberOption(app, "--size", size, RealRange::closed(100, 64000), "size");
+    };
+    struct Bad {
+        std::vector<std::string> args;
+        const char* range;
+    };
+    const Bad bad[] = {{{"--frames", "0x10"}, "[1, 1000000]"},
+                       {{"--frames", "1.5"}, "[1, 1000000]"},
+                       {{"--frames", "0b11"}, "[1, 1000000]"},
+                       {{"--frames", "1e3"}, "[1, 1000000]"},
+                       {{"--frames", "0"}, "[1, 1000000]"},
+                       {{"--frames", "1000001"}, "[1, 1000000]"},
+                       {{"--frames", "4294967297"}, "[1, 1000000]"},  // 2^32 + 1: would wrap to 1 in an int
+                       {{"--frames", "+5"}, "[1, 1000000]"},
+                       {{"--frames", ""}, "[1, 1000000]"},
+                       {{"--budget", "-1"}, "[0, 100]"},
+                       {{"--budget", "101"}, "[0, 100]"},
+                       {{"--budget", "18446744073709551617"}, "[0, 100]"},
+                       {{"--count", "-1"}, "[0, 1000000000]"},
+                       {{"--count", "1000000001"}, "[0, 1000000000]"},
+                       {{"--fov", "1"}, "(1, 179)"},
+                       {{"--fov", "179"}, "(1, 179)"},
+                       {{"--fov", "0x3c"}, "(1, 179)"},
+                       {{"--fov", "inf"}, "(1, 179)"},
+                       {{"--fov", "nan"}, "(1, 179)"},
+                       {{"--fov", "60deg"}, "(1, 179)"},
+                       {{"--dt", "0"}, "(0, 10]"},
+                       {{"--dt", "10.001"}, "(0, 10]"},
+                       {{"--detail", "4"}, "[0, 3]"},
+                       {{"--detail", "-1"}, "[0, 3]"},
+                       {{"--size", "1e5"}, "[100, 64000]"},
+                       {{"--size", "0x100"}, "[100, 64000]"}};
+    for (const Bad& b : bad) {
+        const std::string e = parseArgs(declare, b.args);
+        EXPECT_TRUE(has(e, "option " + b.args[0])) << b.args[0] << " " << b.args[1] << ": " << e;
+        EXPECT_TRUE(has(e, b.range)) << b.args[0] << " " << b.args[1] << ": " << e;
+        EXPECT_TRUE(has(e, "'" + b.args[1] + "'")) << b.args[0] << " " << b.args[1] << ": " << e;
+    }
+    EXPECT_EQ(frames, 7) << "a refused value leaves the variable alone";
+    EXPECT_EQ(budget, 3u);
+    EXPECT_FALSE(detail.has_value());
+    ASSERT_EQ(parseArgs(declare, {"--frames", "010", "--budget", "100", "--count", "1000000000", "--fov", "1.5", "--dt",
+                                  "10", "--detail", "0", "--size", "1e2"}),
+              "");
+    EXPECT_EQ(frames, 10) << "leading zeros are decimal, not octal";
+    EXPECT_EQ(budget, 100u);
+    EXPECT_EQ(count, 1000000000u);
+    EXPECT_DOUBLE_EQ(fov, 1.5);
+    EXPECT_DOUBLE_EQ(dt, 10.0);
+    EXPECT_EQ(detail, 0);
+    EXPECT_EQ(size, 100.0);
+    // The help keeps CLI11's type names, and the defaults where asked for.
+    CLI::App app;
+    frames = 120;
+    budget = 3;
+    fov = 60;
+    declare(app);
+    const std::string help = app.help();
+    for (const char* part :
+         {"--frames INT", "--budget UINT=3", "--count UINT", "--fov FLOAT=60", "--detail INT", "--size FLOAT"})
+        EXPECT_TRUE(has(help, part)) << part << " not in:\n" << help;
 }
 
 TEST(Options, SamplingAndCacheKnobs) {
@@ -60,7 +164,8 @@ TEST(Options, SamplingAndCacheKnobs) {
     EXPECT_EQ(parseSampling("runs:100000").value(), 100000);
     for (const char* text : {"spread", "consecutive", "runs:8"})
         EXPECT_EQ(samplingName(parseSampling(text).value()), text);
-    for (const char* bad : {"runs:0", "runs:", "runs:x", "runs:100001", "runs:-3", "every", ""})
+    for (const char* bad :
+         {"runs:0", "runs:", "runs:x", "runs:100001", "runs:-3", "every", "", "runs:0x10", "runs:1e3"})
         expectBad(parseSampling(bad), bad, "--sampling", "100000");
     ModeOptions o;
     EXPECT_TRUE(checkModeOptions(o).isOk());
@@ -80,20 +185,19 @@ TEST(Options, SamplingAndCacheKnobs) {
 }
 
 TEST(Options, FovReferenceAndModes) {
-    EXPECT_DOUBLE_EQ(parseFov("60").value(), 60.0);
-    EXPECT_DOUBLE_EQ(parseFov("1.5").value(), 1.5);
-    for (const char* bad : {"1", "179", "0", "-60", "200", "wide", ""}) expectBad(parseFov(bad), bad, "--fov", "179");
+    EXPECT_TRUE(kFovRange.contains(1.5));
+    for (double bad : {1.0, 179.0, 0.0, -60.0, 200.0, double(NAN)}) EXPECT_FALSE(checkFov(bad).isOk()) << bad;
     EXPECT_DOUBLE_EQ(parseSplatSigma("off").value(), 0.0);
     EXPECT_DOUBLE_EQ(parseSplatSigma("0.25").value(), 0.25);
     EXPECT_EQ(formatSplatSigma(0.25), "0.25");
     EXPECT_EQ(formatSplatSigma(0), "off");
-    for (const char* bad : {"0.01", "4.5", "-1", "wide", ""})
-        expectBad(parseSplatSigma(bad), bad, "--point-splat", "0.05 .. 4");
+    for (const char* bad : {"0.01", "4.5", "-1", "wide", "", "0x1"})
+        expectBad(parseSplatSigma(bad), bad, "--point-splat", "[0.05, 4]");
     EXPECT_EQ(parseReference("full").value(), 0);
     EXPECT_EQ(parseReference("ssaa:2").value(), 2);
     EXPECT_EQ(parseReference("ssaa:8").value(), 8);
-    for (const char* bad : {"ssaa:1", "ssaa:9", "ssaa:", "ssaa:x", "ssaa:4x", "half", ""})
-        expectBad(parseReference(bad), bad, "--reference", "2 .. 8");
+    for (const char* bad : {"ssaa:1", "ssaa:9", "ssaa:", "ssaa:x", "ssaa:4x", "half", "", "ssaa:0x2", "ssaa:+2"})
+        expectBad(parseReference(bad), bad, "--reference", "[2, 8]");
     auto m = parseModeList("full, near,osglod ,hybrid");
     ASSERT_TRUE(m.isOk()) << m.status().message();
     EXPECT_EQ(m.value(), (std::vector<std::string>{"full", "near", "osglod", "hybrid"}));
@@ -104,14 +208,15 @@ TEST(Options, FovReferenceAndModes) {
     EXPECT_EQ(parseModeName("raycast").value(), "raycast");
     expectBad(parseModeName("fast"), "fast", "--mode", "available modes");
     EXPECT_EQ(parseSweep("sizes=500,1000").value(), (std::vector<int>{500, 1000}));
-    for (const char* bad : {"sizes=50", "sizes=", "500,1000", "sizes=1000,x"})
+    for (const char* bad : {"sizes=50", "sizes=", "500,1000", "sizes=1000,x", "sizes=0x200", "sizes=500.5"})
         EXPECT_FALSE(parseSweep(bad).isOk()) << bad;
+    expectBad(parseSweep("sizes=500,16001"), "sizes=500,16001", "--sweep", "[100, 16000]");
 }
 
 TEST(Options, ModeFlagsBecomeModeOptions) {
     ModeFlags f;
     f.near = "auto";
-    f.triangleBudget = "50000";
+    f.triangleBudget = 50000;
     f.budget = "2000";
     f.horizonGrid = 64;
     f.noCache = true;
@@ -179,7 +284,7 @@ TEST(Options, BakeCellsShardAndTexels) {
     EXPECT_EQ(sh->count, 4);
     ASSERT_TRUE(parseShard("--shard", "100000/100000").isOk());
     for (const char* bad : {"0/4", "5/4", "2/0", "2", "2/", "/4", "2/4x", " 2/4", "+2/4", "a/b", "2\\4", "1/100001",
-                            "-1/2", "1/2/3", ""}) {
+                            "-1/2", "1/2/3", "", "0x1/2", "1/0x2", "1.0/2"}) {
         auto s = parseShard("--shard", bad);
         ASSERT_FALSE(s.isOk()) << bad;
         EXPECT_NE(s.status().message().find("1 <= K <= N"), std::string::npos) << s.status().message();

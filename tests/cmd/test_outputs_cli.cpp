@@ -153,6 +153,81 @@ TEST(NumbersAsWritten, SeedsOutsideTheRangeAreRefusedWithTheTextAsWritten) {
     EXPECT_LT(k.err.size(), 2000u) << k.err.substr(0, 300);
 }
 
+// Every numeric option of every command reads its value by the one rule
+// (cmd/options.h addNumberOption, foundation/number_text.h): hex, a fraction
+// for an integer, '-' where the range has no negatives and a value past the
+// range are refused with exit code 2 before anything is read or written,
+// naming the option, the text as written and the range.
+TEST(NumbersAsWritten, NumericOptionsOfEveryCommandFollowOneRule) {
+    TempDir dir;
+    write(dir.file("c.osgb"), "junk city");
+    const std::string c = dir.file("c.osgb");
+    const std::string bench = "bench " + c + " -q --out " + dir.file("o") + " ",
+                      render = "render " + c + " -q --out " + dir.file("r") + " ", view = "view " + c + " ",
+                      gen = "gen -q -o " + dir.file("n.osgb") + " ",
+                      path = "path " + c + " -o " + dir.file("p.csv") + " ",
+                      bake = "bake " + c + " -q -o " + dir.file("b.osgb") + " ";
+    struct Case {
+        std::string command, option, text, range;
+    };
+    const Case cases[] = {{bench, "--frames", "0x10", "[1, 1000000]"},
+                          {bench, "--frames", "1.5", "[1, 1000000]"},
+                          {bench, "--frames", "1000001", "[1, 1000000]"},
+                          {bench, "--triangle-budget", "-1", "[0, 10000000000]"},
+                          {bench, "--fov", "179", "(1, 179)"},
+                          {bench, "--fov", "0x3c", "(1, 179)"},
+                          {bench, "--diff-threshold", "0x8", "[0, 255]"},
+                          {bench, "--threads", "1025", "[0, 1024]"},
+                          {bench, "--memory-budget", "0", "(0, 65536]"},
+                          {bench, "--paged-radius", "1e6", "[0, 100000]"},
+                          {bench, "--budget", "1.5", "[-1, 1000000000]"},
+                          {bench, "--near", "0x10", "[1, 100000]"},
+                          {bench, "--sampling", "runs:0x10", "[1, 100000]"},
+                          {bench, "--size", "640x0x1e0", "[1, 8192]"},
+                          {render, "--frames", "-1", "[1, 1000000]"},
+                          {render, "--run-up", "0x10", "[0, 600]"},
+                          {render, "--far-step", "3", "[1, 2]"},
+                          {view, "--frames", "-1", "[0, 100000000]"},
+                          {view, "--horizon-grid", "1.5", "[0, 8192]"},
+                          {view, "--cache-error", "101", "[0, 100]"},
+                          {gen, "--detail", "4", "[0, 3]"},
+                          {gen, "--threads", "0x2", "[0, 256]"},
+                          {gen, "--size", "0x100", "[100, 64000]"},
+                          {gen, "--region-size", "-1", "[250, 16000]"},
+                          {path, "--dt", "0", "(0, 10]"},
+                          {path, "--fly-pitch", "-90", "(-90, 90)"},
+                          {path, "--duration", "0x3c", "(0, 86400]"},
+                          {path, "--yaw-rate", "721", "(0, 720]"},
+                          {bake, "--jobs", "0x10", "[0, 1024]"},
+                          {bake, "--min-triangles", "-1", "[0, 1000000000]"},
+                          {bake, "--max-rays", "1e6", "[1, 1000000000]"},
+                          {bake, "--mc-max", "1.5", "[1, 65536]"},
+                          {bake, "--layers", "65", "[1, 64]"},
+                          {bake, "--triangle-ns", "0", "(0, 1000000000)"},
+                          {bake, "--texels", "8x0x2", "[1, 32]"},
+                          {bake, "--shard", "0x1/2", "1 <= K <= N"}};
+    for (const Case& k : cases)
+        expectRefusedUnchanged(dir, k.command + k.option + " " + k.text,
+                               {"option " + k.option, "'" + k.text + "'", k.range});
+    // In range (at the bounds, leading zeros decimal): the generation and the
+    // path run; the other commands get past their options to the junk city.
+    CliRun r = runVista("gen -q --size 300 --detail 0 --threads 256 --seed 010 -o " + dir.file("g.osgb"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = runVista("path " + dir.file("g.osgb") + " --duration 5 --dt 10 --speed 1000 --yaw-rate 720 --run-up 0 -o " +
+                 dir.file("p.csv"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (const std::string& args :
+         {bench + "--frames 1000000 --fov 1.5 --threads 1024 --triangle-budget 10000000000 --memory-budget 65536 "
+                  "--budget -1 --near 100000 --size 8192x1",
+          render + "--frames 1 --far-step 2 --run-up 600", view + "--frames 0 --horizon-grid 8192 --cache-error 0",
+          bake + "--jobs 1024 --min-triangles 0 --mc-max 65536 --layers 64 --max-rays 1000000000"}) {
+        r = runVista(args);
+        EXPECT_EQ(r.code, 2) << args << ": " << r.err;
+        EXPECT_FALSE(has(r.err, "option --")) << args << ": " << r.err;
+        EXPECT_TRUE(has(r.err, "c.osgb")) << args << ": the city is refused, not an option: " << r.err;
+    }
+}
+
 TEST(EffectsOption, EmptyDuplicateAndDeepValuesAreRefused) {
     TempDir dir;
     const std::string gen = "gen -q --size 300 -o " + dir.file("c.osgb") + " --effects ";

@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdint>
 #include <fstream>
 #include <string>
@@ -59,6 +60,25 @@ TEST(NumberText, RealsAreDecimalFiniteAndWhole) {
     EXPECT_TRUE(has(big.status().message(), "'1e308'")) << big.status().message();
     EXPECT_TRUE(has(big.status().message(), "[-20000000, 20000000]")) << big.status().message();
     EXPECT_FALSE(parseRealText("x", "1e999", -1e300, 1e300).isOk());
+}
+
+// An open end excludes its bound, and the message writes the range as it is.
+TEST(NumberText, OpenEndsExcludeTheirBound) {
+    const RealRange fov = RealRange::open(1, 179), dt = RealRange::openMin(0, 10);
+    EXPECT_DOUBLE_EQ(*parseRealText("option --fov", "1.5", fov), 1.5);
+    EXPECT_DOUBLE_EQ(*parseRealText("option --dt", "10", dt), 10.0);
+    for (const char* bad : {"1", "179", "0.999", "200"}) {
+        auto r = parseRealText("option --fov", bad, fov);
+        ASSERT_FALSE(r.isOk()) << bad;
+        EXPECT_TRUE(has(r.status().message(), "option --fov = '" + std::string(bad) + "' is out of range (1, 179)"))
+            << r.status().message();
+    }
+    auto zero = parseRealText("option --dt", "0", dt);
+    ASSERT_FALSE(zero.isOk());
+    EXPECT_TRUE(has(zero.status().message(), "(0, 10]")) << zero.status().message();
+    EXPECT_EQ(RealRange::openMax(0, 1).text(), "[0, 1)");
+    EXPECT_EQ(RealRange::closed(0.05, 4).text(), "[0.05, 4]");
+    EXPECT_FALSE(RealRange::closed(0, 1).contains(std::nan("")));
 }
 
 TEST(NumberText, EchoedTextAndNumbersStayShort) {

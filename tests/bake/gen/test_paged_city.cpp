@@ -357,7 +357,7 @@ TEST_F(Paged, BadInputExitsTwoAndLeavesNothing) {
     };
     const std::string out = " -o " + tmp.file("out.paged");
     const std::vector<Case> cases{
-        {"gen --size 1500 -q --region-size 100" + out, "region_size_m"},
+        {"gen --size 1500 -q --region-size 100" + out, "--region-size = '100' is out of range [250, 16000]"},
         {"gen --size 1500 -q --region-size 333" + out, "region_size_m"},
         {"gen --size 1500 -q --region-size 20000" + out, "16000"},
         {"gen --size 1500 -q -o " + tmp.file("file.paged"), "not a directory"},
@@ -365,10 +365,10 @@ TEST_F(Paged, BadInputExitsTwoAndLeavesNothing) {
         {"gen --size 1500 -q --shard x" + out, "1 <= K <= N"},
         {"gen --size 1500 -q --shard 1/2 --merge" + out, "--merge"},
         {"gen --size 1500 -q --merge" + out, "missing"},
-        {"gen --size 1500 -q --merge --shards 0" + out, "1 <= N <= 100000"},
+        {"gen --size 1500 -q --merge --shards 0" + out, "--shards = '0' is out of range [1, 100000]"},
         {"gen --size 1500 -q --merge --shards x2" + out, "--shards"},
         {"gen --size 1500 -q --shards 2" + out, "only with --merge"},
-        {"gen --size 64001 -q" + out, "size_m"},
+        {"gen --size 64001 -q" + out, "--size = '64001' is out of range [100, 64000]"},
         {"gen --size 1500 -q --gltf " + tmp.file("c.glb") + out, "--gltf"},
         {"gen --size 1500 -q --effects sun_shadows" + out, "effects"},
         {"gen --size 16001 -q -o " + tmp.file("c.osgb"), ".paged"},

@@ -294,7 +294,7 @@ TEST_F(PagedLoad, BadInputExitsTwoNamingIt) {
             r = runVista(cmd + " --paged-radius " + v);
             EXPECT_EQ(r.code, 2) << cmd << " " << v << ": " << r.err;
             EXPECT_NE(r.err.find("--paged-radius"), std::string::npos) << r.err;
-            EXPECT_NE(r.err.find("0 .. 100000"), std::string::npos) << r.err;
+            EXPECT_NE(r.err.find("[0, 100000]"), std::string::npos) << r.err;
             r = runVista(cmd + " --paged-far " + v);
             EXPECT_EQ(r.code, 2) << cmd << " " << v << ": " << r.err;
             EXPECT_NE(r.err.find("--paged-far"), std::string::npos) << r.err;
