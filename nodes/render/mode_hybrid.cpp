@@ -35,7 +35,8 @@ public:
         _setup.push_back({"height_grid", sw.ms()});
         _far = std::make_unique<FarField>(*ctx.rays, &_grid, farOptions(ctx.options.fixedNearDistance(), 0.0));
         AdaptiveSplitOptions so;
-        so.endTryEvery = 12;  // each kind of choice re-measured about every 12 frames of a walkthrough
+        so.endTryEvery = 24;  // each kind of choice re-measured about every 24 frames of a walkthrough
+        so.fixedDistance = ctx.options.fixedNearDistance();  // `hybrid-fixed`'s choice, a kind of its own
         _adaptive = std::make_unique<AdaptiveSplit>(_near.objects, ctx.rays, so);
         _root = new osg::Group;
         if (_near.rootState) _root->setStateSet(_near.rootState.get());

@@ -71,9 +71,6 @@ struct ViewSides {
 // rasterising everything (at each probe); beyond it, every triangle counts.
 constexpr size_t kEverythingViewTestObjects = 200000;
 
-// The kind of a candidate distance: 0 = ray casting, 1 = a middle distance, 2 = everything.
-int kindOf(double d) { return d <= 0 ? 0 : std::isinf(d) ? 2 : 1; }
-
 // A kind of choice never run is tried from this frame on, when its price is within this factor of
 // the best (AdaptiveSplit::choose).
 constexpr int kFirstTryFrame = 3;
@@ -81,6 +78,9 @@ constexpr double kFirstTryRatio = 1.5;
 
 // The probe's far-ray timing casts at most this many of its rays again.
 constexpr size_t kProbeFarTimed = 1000;
+// The probe's share of a frame's time (its rays fewer on cheap frames), and its fewest rays.
+constexpr double kProbeFrameShare = 0.05;
+constexpr double kProbeMinRays = 300;
 
 // Weight of a new frame in a kind's price correction.
 constexpr double kCorrectionWeight = 0.25;
@@ -95,6 +95,12 @@ void pushWindow(std::vector<std::pair<double, double>>& w, std::pair<double, dou
 double boxDistance(const SplitObject& o, const glm::dvec3& p) {
     glm::dvec3 d = glm::max(glm::max(o.lo - p, p - o.hi), glm::dvec3(0.0));
     return glm::length(d);
+}
+
+int AdaptiveSplit::kindOf(double d) const {
+    if (d <= 0) return 0;
+    if (std::isinf(d)) return 2;
+    return _o.fixedDistance > 0 && d == _o.fixedDistance ? 3 : 1;
 }
 
 std::vector<uint32_t> selectNearField(const std::vector<SplitObject>& objects, const glm::dvec3& eye,
@@ -226,6 +232,7 @@ double AdaptiveSplit::predictedRays(double d) const {
 }
 
 void AdaptiveSplit::probe(const Camera& camera) {
+    Stopwatch whole;
     // Everything's triangles in view (within the haze, where nothing beyond is drawn).
     if (_objects.size() <= kEverythingViewTestObjects) {
         const ViewSides view(camera);
@@ -242,7 +249,12 @@ void AdaptiveSplit::probe(const Camera& camera) {
     _probePitch = camera.pitch;
     if (!_rays) return;
     // Every probeStride-th pixel, or sparser on a large image: about probeRays rays.
-    const double fromCount = std::sqrt(double(camera.width) * camera.height / std::max(1, _o.probeRays));
+    // The probe's own cost stays a small share of the frames it prices: on frames of a few ms
+    // (a small city drawn whole) it casts fewer rays, down to kProbeMinRays.
+    double rays = double(std::max(1, _o.probeRays));
+    if (_o.timeProbe && _probeMsPerRay > 0 && _frameMs > 0)
+        rays = std::clamp(kProbeFrameShare * _frameMs / _probeMsPerRay, std::min(rays, kProbeMinRays), rays);
+    const double fromCount = std::sqrt(double(camera.width) * camera.height / rays);
     const int s = std::max({1, _o.probeStride, int(std::lround(fromCount))});
     const glm::vec3 org(camera.eye - _rays->frameOrigin());
     std::vector<glm::vec3> orgs, dirs;
@@ -305,6 +317,7 @@ void AdaptiveSplit::probe(const Camera& camera) {
         }
     }
     std::sort(_probeT.begin(), _probeT.end());  // predictedRays() counts by binary search
+    if (!dirs.empty()) _probeMsPerRay = whole.ms() / double(dirs.size());
     _probeScale = dirs.empty() ? 0.0 : double(camera.width) * camera.height / double(dirs.size());
 }
 
@@ -341,6 +354,10 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
     if (_o.rayCastOnly && rayPriced) cand.push_back(0.0);
     for (int i = 0; i < g; ++i)
         cand.push_back(_o.minDistance * std::pow(_o.maxDistance / _o.minDistance, double(i) / (g - 1)));
+    // The fixed mode's near distance, a kind of its own: its frames measure its correction, so
+    // the split can always fall back to the fixed choice when the model's middle does not pay.
+    if (_o.fixedDistance > 0 && std::isfinite(_o.fixedDistance))
+        cand.insert(std::upper_bound(cand.begin(), cand.end(), _o.fixedDistance), _o.fixedDistance);
     const bool everythingPriced = measured || _haveCorr[2];
     if (_o.everythingNear && (everythingPriced || rayPriced)) cand.push_back(std::numeric_limits<double>::infinity());
     const int n = int(cand.size());
@@ -367,7 +384,7 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
         } else {
             // Nothing to draw -> no GL pass: the raster's fixed cost only where triangles are drawn.
             price[size_t(i)] =
-                (tris > 0 ? _c + _a * double(tris) : 0.0) + (kind == 1 ? b * predictedRays(d) + _f : 0.0);
+                (tris > 0 ? _c + _a * double(tris) : 0.0) + (kind != 2 ? b * predictedRays(d) + _f : 0.0);
         }
         cost[size_t(i)] = std::max(0.0, price[size_t(i)] + (_haveCorr[kind] ? _corr[kind] : 0.0));
         const bool tryOnly = kind == 2 && !everythingPriced;
@@ -384,7 +401,7 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
     // assumed (a price resting on one frame's one-time costs would otherwise keep the split away).
     if (_o.endTryEvery > 0 && _o.endTryRatio > 0) {
         const int bestKind = kindOf(cand[size_t(bestI)]);
-        for (int kind = 0; kind < 3; ++kind) {
+        for (int kind = 0; kind < kSplitKinds; ++kind) {
             // A kind never run is tried early (from frame kFirstTryFrame, within kFirstTryRatio of
             // the best): its price then stops resting on the model alone.
             const bool never = !_haveCorr[kind];
@@ -410,6 +427,7 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
 
 void AdaptiveSplit::recordFrame(double nearD, double frameMs) {
     if (!(nearD == _current) || !(frameMs >= 0)) return;
+    _frameMs = _frameMs > 0 ? (1 - _o.smoothing) * _frameMs + _o.smoothing * frameMs : frameMs;
     const int kind = kindOf(nearD);
     // A kind's first frame pays one-time costs (the first draw of the chunks, the far field's
     // first frame, the ray casters' threads): not counted; NaN marks it seen.

@@ -8,7 +8,7 @@
 // first object is always drawn). Pure; thread-safe.
 //
 // AdaptiveSplit: picks the near distance per frame from the measured cost of
-// this machine. Three kinds of choice, each priced with its own fixed costs:
+// this machine. Four kinds of choice, each priced with its own fixed costs:
 //   0 (ray casting): the hybrid draws the `raycast` frame (no GL pass, no
 //     read-back, no far-field stage): every pixel cast. Priced by the probe's
 //     timed ms per ray over the whole view (one thread, divided among the
@@ -16,6 +16,9 @@
 //   a middle distance d: c + a * triangles(d) (c only if triangles(d) > 0:
 //     an empty near field needs no GL pass) + b * rays(d) + F.
 //   +infinity (everything): the `full` frame, c + a * all triangles.
+//   the fixed distance (AdaptiveSplitOptions::fixedDistance, `hybrid-fixed`'s
+//     choice): priced as a middle distance, corrected by its own frames, so
+//     that the split falls back to it where the model's middle does not pay.
 // Triangles are counted in view: an object whose box lies wholly outside one
 // of the view's four side planes is culled by the renderer and costs no
 // raster time (for everything, counted at each probe, and every triangle on
@@ -49,6 +52,7 @@
 // read-back), predicted triangles(d) from the objects' boxes (exact) and
 // predicted rays(d) from a sparse probe of the view (every `probeStride`-th
 // pixel, sparser so that a large image gets about `probeRays` probe rays,
+// fewer on frames so cheap that the probe would cost more than 5 % of one,
 // cast once per `probeInterval` frames and at once when the view jumped (eye
 // moved more than minDistance, heading or pitch more than 0.1 rad since the
 // probe): a pixel whose first hit lies beyond d, or that misses below the
@@ -142,6 +146,9 @@ struct AdaptiveSplitOptions {
     // price is the probe's rate); everything once both are measured, and
     // before that, from the same point as ray casting, only to be tried.
     bool rayCastOnly = true, everythingNear = true;
+    // The fixed near distance (`hybrid-fixed`) as a candidate of its own kind (0 = none): priced
+    // like a middle distance, corrected by its own frames.
+    double fixedDistance = 0;
     // Time the probe: its bulk ms per ray caps b (off: b from the frames alone, deterministic).
     bool timeProbe = true;
 };
@@ -162,7 +169,8 @@ public:
     void recordFrame(double nearD, double frameMs);
     // Haze: nothing beyond this eye-plane depth (metres) is traced; 0 = no haze.
     void setHazeFar(double zMax) { _hazeFar = zMax; }
-    // The learned correction of a kind's price (0 = ray casting, 1 = middle, 2 = everything), ms.
+    // The learned correction of a kind's price (0 = ray casting, 1 = middle, 2 = everything,
+    // 3 = the fixed distance), ms.
     double correctionMs(int kind) const { return _corr[kind]; }
     double msPerTriangle() const { return _a; }
     double rasterFixedMs() const { return _c; }  // the raster fit's intercept (0 until a is fitted)
@@ -191,19 +199,23 @@ private:
     std::vector<std::pair<double, double>> _farSamples;     // (far pixels, ms), last `window` frames
     double _current;
     int _frame = 0;
-    std::vector<float> _probeT;   // per probe pixel: first hit distance (inf = miss), sorted ascending
-    double _probeScale = 1;       // screen pixels per probe pixel
-    double _probeAllMs = 0;       // one-thread ms per probe ray over the whole view (EMA; 0 = not timed)
-    double _hazeFar = 0;          // setHazeFar
-    double _corr[3] = {0, 0, 0};  // per kind: EMA of frame ms - the model's price
-    bool _haveCorr[3] = {false, false, false};
-    double _chosenPrice = 0;            // the model's price (no correction) of the last choice
-    uint64_t _chosenTris = 0;           // its triangles in view
-    uint64_t _everythingTris = 0;       // every object's triangles in view at the last probe
-    int _lastKindFrame[3] = {0, 0, 0};  // per kind: the frame it was last chosen or tried
-    int _farFrames = 0;                 // frames recorded with a far field
-    int64_t _pixels = 0;                // the camera's pixel count at the last choice
-    glm::dvec3 _probeEye{0.0};          // the camera of the last probe
+    std::vector<float> _probeT;            // per probe pixel: first hit distance (inf = miss), sorted ascending
+    double _probeScale = 1;                // screen pixels per probe pixel
+    double _probeAllMs = 0;                // one-thread ms per probe ray over the whole view (EMA; 0 = not timed)
+    double _hazeFar = 0;                   // setHazeFar
+    double _frameMs = 0;                   // EMA of the recorded frames' ms
+    double _probeMsPerRay = 0;             // the last probe's whole ms per probe ray
+    static constexpr int kSplitKinds = 4;  // ray casting, middle, everything, the fixed distance
+    int kindOf(double d) const;
+    double _corr[kSplitKinds] = {0, 0, 0, 0};  // per kind: EMA of frame ms - the model's price
+    bool _haveCorr[kSplitKinds] = {false, false, false, false};
+    double _chosenPrice = 0;                         // the model's price (no correction) of the last choice
+    uint64_t _chosenTris = 0;                        // its triangles in view
+    uint64_t _everythingTris = 0;                    // every object's triangles in view at the last probe
+    int _lastKindFrame[kSplitKinds] = {0, 0, 0, 0};  // per kind: the frame it was last chosen or tried
+    int _farFrames = 0;                              // frames recorded with a far field
+    int64_t _pixels = 0;                             // the camera's pixel count at the last choice
+    glm::dvec3 _probeEye{0.0};                       // the camera of the last probe
     double _probeHeading = 0, _probePitch = 0;
 };
 

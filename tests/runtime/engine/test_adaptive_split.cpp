@@ -393,3 +393,49 @@ TEST(Split, EachChoiceLearnsItsOwnFixedCost) {
         }
     }
 }
+
+namespace vista {
+namespace {
+
+// The fixed near distance is a kind of its own: when the frames at the
+// model's middle distances cost far more than the model says (here 1000 ms
+// against a price of a few ms) and the fixed distance's frames cost what the
+// model says, the split settles on the fixed distance; without that kind the
+// choice stays in the middle.
+TEST(Split, FixedDistanceIsAFallbackWhenTheMiddleDoesNotPay) {
+    ProbeScene ps = probeScene(12);
+    const std::vector<SplitObject> objs = squareObjects();
+    const Camera c = smallCamera(glm::dvec3(0, -350, 1.7));
+    AdaptiveSplitOptions o = measuredOnly();
+    o.rayCastOnly = o.everythingNear = false;
+    o.endTryEvery = 4;
+    o.endTryRatio = 1e9;  // every kind is re-measured every fourth frame
+    o.fixedDistance = 123.0;
+    AdaptiveSplit s(objs, ps.rays.get(), o);
+    for (int i = 0; i < 10; ++i) {
+        const double tris = 20000 + 4000 * i;
+        s.record(uint64_t(tris), 1.0 + 1e-4 * tris, 5000, 5000 * 1e-4);
+    }
+    int fixedChoices = 0;
+    for (int f = 0; f < 60; ++f) {
+        const double d = s.choose(c, -1);
+        ASSERT_TRUE(std::isfinite(d) && d > 0) << d;
+        // Frames at the fixed distance cost about the model's price; any other distance 1000 ms.
+        s.recordFrame(d, d == o.fixedDistance ? 5.0 : 1000.0);
+        if (f >= 40) fixedChoices += d == o.fixedDistance;
+    }
+    EXPECT_GT(s.correctionMs(1), 500.0) << "the middle's frames were measured dear";
+    EXPECT_GE(fixedChoices, 15) << "the last 20 choices settle on the fixed distance (tries aside)";
+
+    AdaptiveSplitOptions none = o;
+    none.fixedDistance = 0;
+    AdaptiveSplit t(objs, ps.rays.get(), none);
+    for (int i = 0; i < 10; ++i) {
+        const double tris = 20000 + 4000 * i;
+        t.record(uint64_t(tris), 1.0 + 1e-4 * tris, 5000, 5000 * 1e-4);
+    }
+    for (int f = 0; f < 20; ++f) EXPECT_NE(t.choose(c, -1), 123.0);
+}
+
+}  // namespace
+}  // namespace vista
