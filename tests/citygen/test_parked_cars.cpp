@@ -262,6 +262,33 @@ TEST(ParkedCars, NoCarOverlapsABuildingATreeOrAnotherCar) {
     EXPECT_EQ(bad, 0u);
 }
 
+TEST(ParkedCars, ClearOfStreetLightsAndSignalPoles) {
+    CityParams p = carParams();
+    p.effects.night = NightEffect{};
+    p.effects.night->street_light_spacing_m = 12.0;
+    const City city = generate(p);
+    ASSERT_GT(city.streetLights.size(), 50u);
+    ASSERT_GT(city.cars.size(), 20u);
+    const LaneModel lm = buildLaneModel(city.streets, city.params, &city.blocks);
+    std::vector<glm::dvec2> poles;
+    for (const auto& l : city.streetLights) poles.emplace_back(l);
+    for (const auto& s : lm.signals) poles.push_back(s.position);
+    ASSERT_GT(poles.size(), city.streetLights.size());
+    size_t bad = 0, curb = 0;
+    for (size_t i = 0; i < city.cars.size(); ++i) {
+        const Box b = boxOf(city.cars[i]);
+        curb += city.cars[i].curb;
+        for (const auto& q : poles) {
+            const glm::dvec2 d = q - b.c;
+            const double du = std::max(0.0, std::abs(glm::dot(d, b.f)) - b.hl);
+            const double dv = std::max(0.0, std::abs(glm::dot(d, b.l)) - b.hw);
+            if (std::hypot(du, dv) < 0.35 && ++bad < 5) ADD_FAILURE() << "car " << i << " at a pole";
+        }
+    }
+    EXPECT_EQ(bad, 0u);
+    EXPECT_GT(curb, 0u);
+}
+
 TEST(ParkedCars, InTheCityOnTheGround) {
     const City& city = carCity();
     const double half = 0.5 * city.params.size_m;
