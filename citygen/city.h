@@ -73,6 +73,16 @@ struct TreeInstance {
     bool street = true;  // street tree (true) or park tree (false)
 };
 
+// A parked car (parked_cars.h): one of the procedural car models, standing
+// on the ground (or on the sidewalk) along a curb or in a lot.
+struct ParkedCar {
+    glm::dvec3 position{0.0};  // centre of the car's footprint at ground level (wheel contact), city frame
+    double yaw = 0;            // heading of the car's front, radians counter-clockwise from east
+    uint8_t model = 0;         // index into carModels()
+    uint8_t colour = 0;        // index into the body colour palette (kCarColourCount)
+    bool curb = true;          // along a curb (true) or in a lot (false)
+};
+
 // A square spatial tile of the output. Geometry is float relative to `origin`
 // (city frame, double); the world origin of the tile is params.origin + origin.
 struct Tile {
@@ -126,6 +136,7 @@ struct City {
     std::vector<TreePrototype> treePrototypes;
     std::vector<TreeInstance> trees;
     std::vector<glm::dvec3> streetLights;  // night effect: lamp pole bases, city frame (empty otherwise)
+    std::vector<ParkedCar> cars;           // parked cars (params.parked_car_share; parked_cars.h)
     std::vector<Tile> tiles;               // row-major by (iy, ix); only non-empty tiles
     std::vector<StageTime> stageTimes;
     OsmBuildingStats osmBuildings;  // all zero unless buildings came from OSM

@@ -11,6 +11,7 @@
 #include "citygen/buildings.h"
 #include "citygen/labels.h"
 #include "citygen/mesh_builder.h"
+#include "citygen/parked_cars.h"
 #include "citygen/polygon.h"
 #include "citygen/street_lights.h"
 #include "citygen/streets.h"
@@ -60,6 +61,9 @@ void meshTiles(City& city, const std::vector<int>& only, Progress* progress) {
     const SurfaceIndex surfaceIndex = buildSurfaceIndex(city, grid);
     // Signals (traffic lights, stop and yield signs): the lane model's, each in the tile of its pole.
     const std::vector<SignalPlacement>& signals = surfaceIndex.lanes.signals;
+    std::vector<std::vector<uint32_t>> carsOf(size_t(grid.count()));
+    for (uint32_t i = 0; i < city.cars.size(); ++i)
+        carsOf[size_t(grid.tileOf(glm::dvec2(city.cars[i].position)))].push_back(i);
     std::vector<std::vector<uint32_t>> signalsOf(size_t(grid.count()));
     for (uint32_t i = 0; i < signals.size(); ++i) signalsOf[size_t(grid.tileOf(signals[i].position))].push_back(i);
     std::vector<int> which = only;
@@ -89,6 +93,9 @@ void meshTiles(City& city, const std::vector<int>& only, Progress* progress) {
             meshSignal(sp, p, tile.origin, light, tile.meshes[size_t(signalMaterial(sp.kind))],
                        makeInstanceId(signalInstanceKind(sp.kind), i));
         }
+        for (uint32_t c : carsOf[size_t(t)])
+            meshParkedCar(city.cars[c], tile.origin, light, tile.meshes[size_t(Material::Car)],
+                          makeInstanceId(InstanceKind::Car, c));
         std::lock_guard<std::mutex> lock(m);
         ++done;
     });
@@ -144,6 +151,10 @@ Result<City> generateCity(const CityParams& params, const GenerateOptions& optio
     if (params.effects.night) {
         StageTimer t(city, pr, "street lights");
         city.streetLights = placeStreetLights(city);
+    }
+    if (params.parked_car_share > 0) {
+        StageTimer t(city, pr, "parked cars");
+        city.cars = placeParkedCars(city, buildLaneModel(city.streets, params, &city.blocks));
     }
     if (options.beforeMeshing) VISTA_RETURN_IF_ERROR(options.beforeMeshing(city));
     {

@@ -1,7 +1,8 @@
 // generateCity(): the whole pipeline params -> City.
 //
 // Stages: streets (grown, or `streets` given e.g. from OSM) -> blocks ->
-// lots -> buildings (imported ones from OSM first take their land) -> trees -> meshes per tile (parallel over tiles).
+// lots -> buildings (imported ones from OSM first take their land) -> trees -> (street lights) -> parked cars
+// -> meshes per tile (parallel over tiles).
 // Contract: params must pass validateParams() and checkSingleFileSize()
 // (checked; error otherwise: larger cities go through citygen/regions.h).
 // Output is byte-for-byte identical for the same params whatever
@@ -33,11 +34,12 @@ struct GenerateOptions {
 Result<City> generateCity(const CityParams& params, const GenerateOptions& options = {});
 
 // The meshes-per-tile stage of generateCity on a city whose streets, blocks,
-// buildings, trees (and street lights) are set: replaces city.tiles with the
+// buildings, trees (and street lights, parked cars) are set: replaces city.tiles with the
 // non-empty tiles among `tiles` (indices of TileGrid(city.params), row-major;
-// empty = every tile), in that order. Buildings, trees, lights and signals
+// empty = every tile), in that order. Buildings, trees, lights, signals
 // (the lane model's traffic lights, stop and yield signs: traffic_signals.h)
-// go to the tile of their anchor (footprint centroid, trunk base, pole base);
+// and parked cars (parked_cars.h) go to the tile of their anchor (footprint
+// centroid, trunk base, pole base, car centre);
 // those anchored in other tiles are not meshed. Parallel over tiles; the bytes do
 // not depend on the thread count. Indices out of range: VISTA_CHECK.
 void meshTiles(City& city, const std::vector<int>& tiles, Progress* progress);

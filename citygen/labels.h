@@ -8,7 +8,8 @@
 // the edge), street node index (the junction polygon at the node), block
 // index (sidewalk ring of the block; park lawn of a park block), street
 // light index (City::streetLights), signal index (LaneModel::signals of
-// lanes.h, for traffic lights and for stop and yield signs alike). Ground
+// lanes.h, for traffic lights and for stop and yield signs alike), parked car
+// index (City::cars). Ground
 // (terrain) and sky are 0.
 // Tree prototype meshes are shared by all trees: their vertices carry the
 // Material of the part (Trunk, Leaves) instead; the tree's id comes from the
@@ -37,7 +38,8 @@ enum class InstanceKind : uint32_t {
     StreetLight = 7,
     TrafficLight = 8,
     TrafficSign = 9,
-    Count = 10  // number of kinds (not a kind)
+    Car = 10,
+    Count = 11  // number of kinds (not a kind)
 };
 constexpr uint32_t kInstanceIndexBits = 28;
 constexpr uint32_t kInstanceIndexMask = (1u << kInstanceIndexBits) - 1u;
@@ -66,7 +68,8 @@ enum class SemanticClass : uint8_t {
     StreetLight = 11,
     TrafficLight = 12,
     TrafficSign = 13,
-    Count = 14
+    Car = 14,
+    Count = 15
 };
 constexpr int kSemanticClassCount = int(SemanticClass::Count);
 SemanticClass semanticClass(Material m);         // Count (invalid) for Material::Count

@@ -36,6 +36,7 @@ glm::dvec3 materialAlbedo(Material m) {
         case Material::Lamp: return {0.30, 0.31, 0.32};
         case Material::TrafficLight: return {0.06, 0.07, 0.06};
         case Material::TrafficSign: return {0.45, 0.46, 0.47};
+        case Material::Car: return {0.45, 0.46, 0.47};
         case Material::Count: break;
     }
     return {1, 0, 1};

@@ -20,6 +20,7 @@ namespace vista {
 // Surface materials; one output Geometry per tile and material.
 // Lamp: street lights of the `night` effect (pole and emissive head); absent otherwise.
 // TrafficLight, TrafficSign: the lane model's signals (traffic_signals.h), pole and head.
+// Car: parked cars (parked_cars.h), every part of the car.
 // Values are stable (tree prototypes store Trunk and Leaves by value): new ones go last.
 enum class Material : uint8_t {
     Ground,
@@ -35,6 +36,7 @@ enum class Material : uint8_t {
     Lamp,
     TrafficLight,
     TrafficSign,
+    Car,
     Count
 };
 constexpr int kMaterialCount = int(Material::Count);

@@ -82,6 +82,8 @@ const std::vector<Field>& fields() {
                       "street tree spacing (0 = none)"));
         v.push_back(
             D("park_tree_density", &CityParams::park_tree_density, "1/m^2", 0, 0.05, "park trees per square metre"));
+        v.push_back(D("parked_car_share", &CityParams::parked_car_share, "", 0, 1,
+                      "share of the free parking slots (curbs, lots) holding a parked car (0 = none)"));
         v.push_back(D("hills_amplitude_m", &CityParams::hills_amplitude_m, "metres", 0, 200,
                       "terrain height amplitude (0 = flat)"));
         v.push_back(

@@ -58,6 +58,9 @@ struct CityParams {
     double street_tree_spacing_m = 30.0;  // 0 = no street trees
     double park_tree_density = 0.002;     // trees per square metre of park
 
+    // Parked cars (parked_cars.h).
+    double parked_car_share = 0.3;  // share of the free parking slots (curbs, lots) that hold a car; 0 = none
+
     // Terrain.
     double hills_amplitude_m = 0.0;  // 0 = flat ground
     double hills_wavelength_m = 1500.0;

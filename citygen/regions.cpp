@@ -12,7 +12,9 @@
 #include "citygen/blocks.h"
 #include "citygen/buildings.h"
 #include "citygen/generate.h"
+#include "citygen/lanes.h"
 #include "citygen/lighting.h"
+#include "citygen/parked_cars.h"
 #include "citygen/polygon.h"
 #include "citygen/street_lights.h"
 #include "citygen/streets.h"
@@ -156,6 +158,7 @@ City RegionalCity::region(int r) const {
     c.buildings = placeBuildings(c.lots, c.blocks, _params, nullptr);
     c.trees = placeTrees(c, nullptr);
     if (_params.effects.night) c.streetLights = placeStreetLights(c);
+    if (_params.parked_car_share > 0) c.cars = placeParkedCars(c, buildLaneModel(c.streets, _params, &c.blocks));
 
     // Keep what is anchored in the region.
     const TileGrid tiles(_params);
@@ -172,6 +175,10 @@ City RegionalCity::region(int r) const {
     for (const auto& l : c.streetLights)
         if (inRegion(glm::dvec2(l))) lights.push_back(l);
     c.streetLights = std::move(lights);
+    std::vector<ParkedCar> cars;
+    for (const auto& car : c.cars)
+        if (inRegion(glm::dvec2(car.position))) cars.push_back(car);
+    c.cars = std::move(cars);
 
     meshTiles(c, _grid.tilesOf(r), nullptr);
     return c;

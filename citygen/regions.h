@@ -16,20 +16,20 @@
 //   - the blocks within kRegionHaloM of the region (global order, parks kept);
 //     their lots and buildings (both seeded by position, so each is the
 //     building generateCity places on that lot), the trees (placed among the
-//     halo's buildings and streets) and street lights;
-//   - it keeps the buildings, trees and lights anchored in the region (tile of
-//     the footprint centroid / trunk base / pole base, the anchor of
+//     halo's buildings and streets), street lights and parked cars;
+//   - it keeps the buildings, trees, lights and cars anchored in the region (tile
+//     of the footprint centroid / trunk base / pole base / car centre, the anchor of
 //     generateCity's tiles), and meshes the region's tiles (meshTiles).
 // So every building of the city is in exactly one region, the same building
 // as in generateCity (its count is the unpaged count); its facade colours and
 // every ground-truth id (labels.h) are numbered within the region (index in
 // the region's City). Trees: the greedy spacing filter runs over the region
 // and its halo, so near a region border a tree may differ from the unpaged
-// city's (the region's own trees are deterministic).
+// city's (the region's own trees are deterministic); so may a parked car.
 // coarse(): the far level of a region: the same tiles with ground, grass and
 // roads, buildings as plain prisms (detail 0), the region's trees as
 // impostors (City::treeImpostors: cross billboards, tree_impostor.h), no
-// sidewalks, markings or lamps; the coarse City's params carry detail 0.
+// sidewalks, markings, lamps or cars; the coarse City's params carry detail 0.
 //
 // Contract: params must pass validateParams() (the single-file cap does not
 // apply); bad params or region size: error Status naming the field. region()

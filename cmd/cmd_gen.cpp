@@ -317,6 +317,7 @@ nlohmann::ordered_json statsJson(const City& city, const CityParams& params, con
     j["lots"] = n.lots;
     j["buildings"] = n.buildings;
     j["trees"] = n.trees;
+    j["cars"] = city.cars.size();
     j["tiles"] = city.tiles.size();
     j["triangles"] = n.triangles;
     j["stored_triangles"] = n.storedTriangles;

@@ -24,6 +24,7 @@ enum class Stream : uint64_t {
     Facades = 7,
     Paths = 8,
     Bake = 9,
+    Cars = 10,
 };
 
 class Rng {

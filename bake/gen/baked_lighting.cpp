@@ -356,8 +356,10 @@ Status bakeLighting(City& city, Progress* progress, BakedLightingStats& stats) {
     for (size_t t = 0; t < city.tiles.size(); ++t)
         for (int m = 0; m < kMaterialCount; ++m) {
             const Material mat = Material(m);
-            // Small fixtures keep their prelit colours (they still cast shadows: occluders()).
-            if (mat == Material::Lamp || mat == Material::TrafficLight || mat == Material::TrafficSign) continue;
+            // Small fixtures and parked cars keep their prelit colours (they still cast shadows: occluders()).
+            if (mat == Material::Lamp || mat == Material::TrafficLight || mat == Material::TrafficSign ||
+                mat == Material::Car)
+                continue;
             if (mat == Material::Trunk || mat == Material::Leaves) continue;
             if (mat == Material::Window && ctx.night) continue;
             if (!city.tiles[t].meshes[size_t(m)].empty()) tasks.emplace_back(t, m);

@@ -64,6 +64,7 @@ float lidarReflectivity(uint8_t semanticClass) {
         case SemanticClass::Roof: return 0.2f;
         case SemanticClass::TreeTrunk: return 0.3f;
         case SemanticClass::TreeLeaves: return 0.45f;
+        case SemanticClass::Car: return 0.5f;  // painted metal and glass
         default: return 0.2f;
     }
 }

@@ -150,6 +150,8 @@ TEST_F(SignalsScene, RenderShowsTrafficLightPixelsWithTheirInstances) {
         EXPECT_EQ(names[13], "traffic_sign");
         EXPECT_EQ(kinds[8], "traffic_light");
         EXPECT_EQ(kinds[9], "traffic_sign");
+        EXPECT_EQ(names[14], "car");
+        EXPECT_EQ(kinds[10], "car");
     }
 }
 
