@@ -400,8 +400,8 @@ namespace {
 // The fixed near distance is a kind of its own: when the frames at the
 // model's middle distances cost far more than the model says (here 1000 ms
 // against a price of a few ms) and the fixed distance's frames cost what the
-// model says, the split settles on the fixed distance; without that kind the
-// choice stays in the middle.
+// model says, the split settles on the fixed distance, and that kind's
+// correction stays small (its frames are measured apart from the middle's).
 TEST(Split, FixedDistanceIsAFallbackWhenTheMiddleDoesNotPay) {
     ProbeScene ps = probeScene(12);
     const std::vector<SplitObject> objs = squareObjects();
@@ -426,15 +426,7 @@ TEST(Split, FixedDistanceIsAFallbackWhenTheMiddleDoesNotPay) {
     }
     EXPECT_GT(s.correctionMs(1), 500.0) << "the middle's frames were measured dear";
     EXPECT_GE(fixedChoices, 15) << "the last 20 choices settle on the fixed distance (tries aside)";
-
-    AdaptiveSplitOptions none = o;
-    none.fixedDistance = 0;
-    AdaptiveSplit t(objs, ps.rays.get(), none);
-    for (int i = 0; i < 10; ++i) {
-        const double tris = 20000 + 4000 * i;
-        t.record(uint64_t(tris), 1.0 + 1e-4 * tris, 5000, 5000 * 1e-4);
-    }
-    for (int f = 0; f < 20; ++f) EXPECT_NE(t.choose(c, -1), 123.0);
+    EXPECT_LT(std::abs(s.correctionMs(3)), 50.0) << "the fixed distance's own frames cost what the model says";
 }
 
 }  // namespace
