@@ -38,8 +38,11 @@ struct BenchRun {
     std::unique_ptr<OffscreenRenderer> renderer;
     std::unique_ptr<RayScene> rays;
     ModeContext ctx;
+    ModeContext clearCtx;  // ctx without run-time effects (BenchConfig::alsoClear)
     std::vector<std::unique_ptr<RenderMode>> modes;
-    std::vector<SetupTimes> setup;  // per mode: load, bvh, the mode's own
+    std::vector<std::string> labels;  // per mode: its name, "+clear" for the twins
+    std::vector<SetupTimes> setup;    // per mode: load, bvh, the mode's own
+    size_t plainCount = 0;            // modes[0, plainCount) run with the effects, the rest are their twins
 };
 
 Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene, const BenchConfig& cfg) {
@@ -65,8 +68,8 @@ Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene
         bvhMs = sw.ms();
         if (!cfg.quiet) std::fprintf(stderr, "ray scene built in %.0f ms\n", bvhMs);
     }
-    for (const auto& name : cfg.modes) {
-        auto m = createRenderMode(name, run->ctx);
+    auto add = [&](const std::string& name, ModeContext& ctx, const std::string& label) -> Status {
+        auto m = createRenderMode(name, ctx);
         if (!m) return m.status();
         SetupTimes s;
         if (cfg.loadMs >= 0) s.push_back({"load", cfg.loadMs});
@@ -74,6 +77,15 @@ Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene
         for (const auto& kv : m.value()->setupMs()) s.push_back(kv);
         run->setup.push_back(s);
         run->modes.push_back(std::move(m.value()));
+        run->labels.push_back(label);
+        return Status::ok();
+    };
+    for (const auto& name : cfg.modes) VISTA_RETURN_IF_ERROR(add(name, run->ctx, name));
+    run->plainCount = run->modes.size();
+    if (cfg.alsoClear) {
+        run->clearCtx = run->ctx;  // shares the near field and the bakes the modes above built
+        run->clearCtx.options.effects = FrameEffects{};
+        for (const auto& name : cfg.modes) VISTA_RETURN_IF_ERROR(add(name, run->clearCtx, clearTwinName(name)));
     }
     return run;
 }
@@ -90,15 +102,16 @@ Status warmUp(BenchRun& run, const Camera& camera) {
     return Status::ok();
 }
 
-// The k x k supersampled `full` image of the camera (the mode's own draw, jittered).
-Result<Image> supersampledReference(BenchRun& run, const Camera& cam, int k) {
+// The k x k supersampled image of mode `mi` (`full`, with or without the
+// effects) of the camera: the mode's own draw, jittered.
+Result<Image> supersampledReference(BenchRun& run, size_t mi, const Camera& cam, int k) {
     std::vector<Image> subs;
     for (int j = 0; j < k; ++j)
         for (int i = 0; i < k; ++i) {
             run.renderer->setSubpixelOffset((i + 0.5) / k - 0.5, (j + 0.5) / k - 0.5);
             FrameStats s;
             Image sub;
-            Status st = run.modes[0]->renderFrame(cam, sub, s);
+            Status st = run.modes[mi]->renderFrame(cam, sub, s);
             if (!st) {
                 run.renderer->setSubpixelOffset(0, 0);
                 return st;
@@ -116,7 +129,8 @@ Result<Image> supersampledReference(BenchRun& run, const Camera& cam, int k) {
 class FrameImages {
 public:
     FrameImages(const BenchConfig& cfg, size_t modes, OutputBatch& batch) : _cfg(cfg), _worst(modes), _batch(batch) {}
-    Status add(size_t mi, const BenchFrameRecord& rec, const Image& img, const Image& ref) {
+    // isReference: the mode whose image is `ref` (no difference image of its own).
+    Status add(size_t mi, const BenchFrameRecord& rec, const Image& img, const Image& ref, bool isReference) {
         if (_cfg.outDir.empty()) return Status::ok();
         if (rec.frame == 0) VISTA_RETURN_IF_ERROR(writePng(img, stage("first_" + rec.mode + ".png")));
         if (_cfg.saveFrames) {
@@ -126,7 +140,7 @@ public:
                 img,
                 _batch.stage((std::filesystem::path(_cfg.outDir) / "frames" / (name + rec.mode + ".png")).string())));
         }
-        if (_cfg.worstFrames <= 0 || (mi == 0 && _cfg.referenceSsaa < 2)) return Status::ok();
+        if (_cfg.worstFrames <= 0 || isReference) return Status::ok();
         auto& w = _worst[mi];
         if (int(w.size()) < _cfg.worstFrames || rec.psnrDb < w.back().psnr) {
             w.push_back({rec.psnrDb, rec.frame, rec.mode, img, ref});
@@ -173,52 +187,74 @@ void reportProgress(const BenchConfig& cfg, size_t done, size_t total, const Sto
     if (tty && done == total) std::fprintf(stderr, "\n");
 }
 
-// --dump-rays: the pixels mode `m` traced in frame f as a RaySet file.
-Status dumpRays(const RenderMode& m, int f, const Camera& cam, const BenchConfig& cfg, OutputBatch& batch) {
+// --dump-rays: the pixels mode `m` (named `label`) traced in frame f as a RaySet file.
+Status dumpRays(const RenderMode& m, const std::string& label, int f, const Camera& cam, const BenchConfig& cfg,
+                OutputBatch& batch) {
     const std::vector<uint32_t>* traced = m.lastTracedPixels();
     if (cfg.dumpRaysDir.empty() || !traced || f % cfg.dumpRaysEvery != 0) return Status::ok();
     RaySet set;
     set.frame = uint32_t(f);
     set.camera = cam;
-    set.hazeFar = cfg.options.effects.haze ? cfg.options.effects.hazeFar() : 0.0;
+    const bool twin = label != m.name();
+    set.hazeFar = cfg.options.effects.haze && !twin ? cfg.options.effects.hazeFar() : 0.0;
     set.tnear = m.lastRayStart();
     set.pixels = *traced;
     char name[64];
     std::snprintf(name, sizeof name, "_f%04d.rays", f);
-    return writeRaySet(batch.stage((fs::path(cfg.dumpRaysDir) / (m.name() + name)).string()), set);
+    return writeRaySet(batch.stage((fs::path(cfg.dumpRaysDir) / (label + name)).string()), set);
 }
 
-// Renders every frame in every mode (interleaved) and scores it.
+// Renders one frame in modes [begin, end) of the run (the first is `full`,
+// the reference of the others) and scores each; records go to recs[mi].
+Status renderGroup(BenchRun& run, size_t begin, size_t end, size_t f, size_t pathIndex, double t, const Camera& cam,
+                   const BenchConfig& cfg, std::vector<BenchFrameRecord>& recs, FrameImages& images,
+                   OutputBatch& batch) {
+    Image img, ref;
+    if (cfg.referenceSsaa >= 2) {
+        auto r = supersampledReference(run, begin, cam, cfg.referenceSsaa);
+        if (!r) return Status::error("reference, frame " + std::to_string(f) + ": " + r.status().message());
+        ref = std::move(r.value());
+    }
+    for (size_t mi = begin; mi < end; ++mi) {
+        BenchFrameRecord& rec = recs[mi];
+        rec.frame = int(f);
+        rec.pathIndex = pathIndex;
+        rec.t = t;
+        rec.mode = run.labels[mi];
+        Status st = run.modes[mi]->renderFrame(cam, img, rec.stats);
+        if (!st) return Status::error("mode " + rec.mode + ", frame " + std::to_string(f) + ": " + st.message());
+        VISTA_RETURN_IF_ERROR(dumpRays(*run.modes[mi], rec.mode, int(f), cam, cfg, batch));
+        if (!img.valid() || img.width != cfg.width || img.height != cfg.height)
+            return Status::error("mode " + rec.mode + " returned an image of the wrong size");
+        const bool isReference = mi == begin && cfg.referenceSsaa < 2;
+        if (isReference) ref = img;
+        rec.psnrDb = lumaPsnr(img, ref);
+        rec.diffFraction = fractionDiffering(img, ref, cfg.diffThreshold);
+        VISTA_RETURN_IF_ERROR(images.add(mi, rec, img, ref, isReference));
+    }
+    return Status::ok();
+}
+
+// Renders every frame in every mode (interleaved) and scores it. With the
+// clear twins, the modes with effects go first on even frames and the twins
+// on odd ones, so neither side is always the one that runs on warm caches.
 Status renderFrames(BenchRun& run, const Path& path, const std::vector<size_t>& idx, const Camera& base,
                     const BenchConfig& cfg, BenchResult& result, FrameImages& images, OutputBatch& batch) {
-    Image img, ref;
     Stopwatch sw;
+    const size_t n = run.modes.size(), plain = run.plainCount;
+    std::vector<BenchFrameRecord> recs(n);
     for (size_t f = 0; f < idx.size(); ++f) {
         const Camera cam = path.camera(idx[f], base);
         // Ray origins near the scene's frame origin: float precision anywhere in the city.
         if (run.rays) VISTA_RETURN_IF_ERROR(run.rays->placeFrameNear(cam.eye));
-        if (cfg.referenceSsaa >= 2) {
-            auto r = supersampledReference(run, cam, cfg.referenceSsaa);
-            if (!r) return Status::error("reference, frame " + std::to_string(f) + ": " + r.status().message());
-            ref = std::move(r.value());
-        }
-        for (size_t mi = 0; mi < run.modes.size(); ++mi) {
-            BenchFrameRecord rec;
-            rec.frame = int(f);
-            rec.pathIndex = idx[f];
-            rec.t = path.samples[idx[f]].t;
-            rec.mode = run.modes[mi]->name();
-            Status st = run.modes[mi]->renderFrame(cam, img, rec.stats);
-            if (!st) return Status::error("mode " + rec.mode + ", frame " + std::to_string(f) + ": " + st.message());
-            VISTA_RETURN_IF_ERROR(dumpRays(*run.modes[mi], int(f), cam, cfg, batch));
-            if (!img.valid() || img.width != cfg.width || img.height != cfg.height)
-                return Status::error("mode " + rec.mode + " returned an image of the wrong size");
-            if (mi == 0 && cfg.referenceSsaa < 2) ref = img;
-            rec.psnrDb = lumaPsnr(img, ref);
-            rec.diffFraction = fractionDiffering(img, ref, cfg.diffThreshold);
-            VISTA_RETURN_IF_ERROR(images.add(mi, rec, img, ref));
-            result.frames.push_back(std::move(rec));
-        }
+        const double t = path.samples[idx[f]].t;
+        const bool twinsFirst = plain < n && f % 2 == 1;
+        if (twinsFirst) VISTA_RETURN_IF_ERROR(renderGroup(run, plain, n, f, idx[f], t, cam, cfg, recs, images, batch));
+        VISTA_RETURN_IF_ERROR(renderGroup(run, 0, plain, f, idx[f], t, cam, cfg, recs, images, batch));
+        if (!twinsFirst && plain < n)
+            VISTA_RETURN_IF_ERROR(renderGroup(run, plain, n, f, idx[f], t, cam, cfg, recs, images, batch));
+        for (auto& rec : recs) result.frames.push_back(std::move(rec));
+        recs.assign(n, BenchFrameRecord{});
         reportProgress(cfg, f + 1, idx.size(), sw);
     }
     return Status::ok();
@@ -297,10 +333,12 @@ Result<BenchResult> runBenchmark(const SceneModel* city, osg::Node* scene, const
     result.loadAvgEnd = loadAverage();
     result.glRenderer = (*run)->renderer->glRenderer();
     result.motion = pathMotion(path, idx);
-    for (size_t mi = 0; mi < cfg.modes.size(); ++mi) {
-        result.modes.push_back(
-            summariseMode(result, cfg.modes[mi], speedupBases(), double(cfg.width) * double(cfg.height)));
-        result.modes.back().setupMs = (*run)->setup[mi];
+    const BenchRun& r = **run;
+    for (size_t mi = 0; mi < r.modes.size(); ++mi) {
+        std::vector<std::string> bases = speedupBases();
+        if (mi >= r.plainCount) bases.push_back(r.labels[mi - r.plainCount]);  // the effects' cost ratio
+        result.modes.push_back(summariseMode(result, r.labels[mi], bases, double(cfg.width) * double(cfg.height)));
+        result.modes.back().setupMs = r.setup[mi];
     }
     if (!cfg.outDir.empty()) {
         VISTA_RETURN_IF_ERROR(writeBenchOutputs(result, cfg, city, path, batch));

@@ -53,6 +53,10 @@ struct BenchConfig {
     int dumpRaysEvery = 1;  // 1 .. 1000000
     bool warmup = true;
     bool quiet = false;  // no progress on stderr
+    // Every mode also runs without the run-time effects, on the same frames,
+    // as "MODE+clear" (the two alternate which goes first from frame to
+    // frame); its speedup against MODE is the effects' same-frame cost ratio.
+    bool alsoClear = false;
     ModeOptions options;
     std::string command;                              // recorded in summary.json
     std::string cityLabel;                            // recorded in summary.json
@@ -136,6 +140,8 @@ ModeSummary summariseMode(const BenchResult& r, const std::string& mode, const s
                           double pixels);
 // The bases of speedups in summaries: full, near, raycast.
 const std::vector<std::string>& speedupBases();
+// The name of a mode's twin without run-time effects (BenchConfig::alsoClear).
+std::string clearTwinName(const std::string& mode);
 
 // frames.csv, summary.json, frame_time.png, quality.png (bench_output.cpp),
 // each staged into `batch` (the caller commits).

@@ -29,6 +29,8 @@ const std::vector<std::string>& speedupBases() {
     return kBases;
 }
 
+std::string clearTwinName(const std::string& mode) { return mode + "+clear"; }
+
 namespace {
 
 // Pixel classes (min / mean / max percent, mean count) over the frames of a mode.

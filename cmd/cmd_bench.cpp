@@ -82,6 +82,10 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
                    "run-time effects for this run instead of the scene's: 'none', names (haze, glass, night) or a JSON "
                    "object as in the params file; baked effects (sun_shadows, ambient_occlusion, materials, night's "
                    "lights) follow the scene file, and naming one here is an error (give it to `vista gen --effects`)");
+    app.add_flag("--also-clear", a.cfg.alsoClear,
+                 "also run every mode without the run-time effects on the same frames, as MODE+clear (alternating "
+                 "which goes first); its speedup_vs_MODE in summary.json is the effects' same-frame cost ratio; "
+                 "without effects it is an A/A run that shows the machine's noise");
     app.add_option("--sweep", a.sweep,
                    "scaling sweep: sizes=500,1000,2000 generates a city per size (seed --seed) and benches each");
     app.add_flag("-q,--quiet", a.quiet, "no progress on stderr");

@@ -5,12 +5,13 @@
                                                  fixed choices (raycast = 0 m, hybrid-fixed = the near
                                                  default, full = everything) in each bench DIR;
                                                  LABEL is "city|path".
-  hybrid_ratios.py effect LABEL=ON:OFF[:ON:OFF...] ...
-                                                 Markdown table: the hybrid's frame with an effect (ON
-                                                 bench dirs) against the same frames without it (OFF);
-                                                 repeated runs are alternated, a frame's time is its
-                                                 median over them.
-  hybrid_ratios.py guard --limit 1.05 split LABEL=DIR ... effect LABEL=ON:OFF ...
+  hybrid_ratios.py effect LABEL=DIR[:DIR...] ...
+                                                 Markdown table: the hybrid's frame with an effect
+                                                 against the same frames without it, both from one
+                                                 bench run with --also-clear (modes hybrid and
+                                                 hybrid+clear, interleaved frame by frame); with
+                                                 several runs a frame's ratio is its median over them.
+  hybrid_ratios.py guard --limit 1.05 split LABEL=DIR ... effect LABEL=DIR ...
                                                  prints only the rows where the hybrid loses by more
                                                  than the limit; exit status 1 when any row prints.
 
@@ -110,34 +111,27 @@ def effect_rows(specs, mode="hybrid"):
     rows = []
     for spec in specs:
         label, dirs = spec.split("=", 1)
-        parts = dirs.split(":")
-        on_frames = [load(d)[mode] for d in parts[0::2]]
+        runs = [load(d) for d in dirs.split(":")]
         # Glass is judged where it is off-screen: frames on which no run's reflection pass ran
         # (on-screen, the pass is the effect's own work, shown in docs/measurements/effects.md).
-        keep = None
+        frames = set.intersection(*(set(r[mode]) & set(r[mode + "+clear"]) for r in runs))
         if label.startswith("glass"):
-            keep = {f for f in on_frames[0] if all("reflect" not in x[f][3] for x in on_frames if f in x)}
-        on_runs = [{f: v for f, v in ms(x).items() if keep is None or f in keep} for x in on_frames]
-        haze = [v[3]["haze"] for x in on_frames for v in x.values() if "haze" in v[3]]
-        off_runs = [ms(load(d)[mode]) for d in parts[1::2]]
-        if not all(on_runs):
+            frames = {f for f in frames if all("reflect" not in r[mode][f][3] for r in runs)}
+        if not frames:
             continue
-
-        def med(runs):
-            fs = set.intersection(*(set(r) for r in runs))
-            return {f: statistics.median(r[f] for r in runs) for f in fs}
-
-        on, off = med(on_runs), med(off_runs)
-        rows.append(dict(label=label, on=statistics.median(on.values()), off=statistics.median(off.values()),
-                         r=ratio(on, off), runs=len(on_runs), stage=statistics.mean(haze) if haze else 0.0,
-                         frames=len(set(on) & set(off))))
+        per_frame = {f: statistics.median(r[mode][f][0] / r[mode + "+clear"][f][0] for r in runs) for f in frames}
+        haze = [v[3]["haze"] for r in runs for v in r[mode].values() if "haze" in v[3]]
+        rows.append(dict(label=label, on=statistics.median(r[mode][f][0] for r in runs for f in frames),
+                         off=statistics.median(r[mode + "+clear"][f][0] for r in runs for f in frames),
+                         r=statistics.median(per_frame.values()), runs=len(runs),
+                         stage=statistics.mean(haze) if haze else 0.0, frames=len(frames)))
     return rows
 
 
 def effect_table(rows, header):
     cols = header.count("|") + 1
     lines = [f"| {header} | hybrid ms with, median | hybrid ms without, median | same-frame ratio with / without | "
-             "haze stage ms, mean | frames compared | runs each |",
+             "haze stage ms, mean | frames compared | runs |",
              "|" + "---|" * (cols + 6)]
     for x in rows:
         lines.append(f"| {x['label']} | {x['on']:.2f} | {x['off']:.2f} | {x['r']:.3f} | {x['stage']:.2f} | "

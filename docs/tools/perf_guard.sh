@@ -35,8 +35,9 @@ for seed in 101 202 303; do
     bench "$OUT/s${seed}_$kind" "$city" "$kind" full,raycast,hybrid-fixed,hybrid --effects none
     SPLIT+=("seed $seed|$kind=$OUT/s${seed}_$kind")
   done
-  # Each run-time effect on and off, alternated twice (the machine's drift falls on both): every
-  # effect on the car path, haze at 600 m on the walk and fly paths too.
+  # Each run-time effect on and off as two modes of one run (--also-clear: hybrid and hybrid+clear
+  # on the same frames, alternating which goes first): every effect on the car path, haze at 600 m
+  # on the walk and fly paths too.
   for kind in car walk fly; do
     fxs="haze600"
     [ "$kind" = car ] && fxs="haze600 haze1500 haze3000 night glass"
@@ -46,14 +47,9 @@ for seed in 101 202 303; do
         night) spec=night ;;
         glass) spec=glass ;;
       esac
-      dirs=""
-      for rep in 1 2; do
-        log "seed $seed $kind: $fx on/off ($rep)"
-        bench "$OUT/s${seed}_${kind}_${fx}_on$rep" "$city" "$kind" hybrid --effects "$spec"
-        bench "$OUT/s${seed}_${kind}_${fx}_off$rep" "$city" "$kind" hybrid --effects none
-        dirs+="${dirs:+:}$OUT/s${seed}_${kind}_${fx}_on$rep:$OUT/s${seed}_${kind}_${fx}_off$rep"
-      done
-      EFFECT+=("$fx, seed $seed, $kind=$dirs")
+      log "seed $seed $kind: $fx on/off"
+      bench "$OUT/s${seed}_${kind}_$fx" "$city" "$kind" hybrid --effects "$spec" --also-clear
+      EFFECT+=("$fx, seed $seed, $kind=$OUT/s${seed}_${kind}_$fx")
     done
   done
 done

@@ -82,8 +82,11 @@ constexpr size_t kProbeFarTimed = 1000;
 constexpr double kProbeFrameShare = 0.05;
 constexpr double kProbeMinRays = 300;
 
-// Weight of a new frame in a kind's price correction.
-constexpr double kCorrectionWeight = 0.25;
+// Frames of a kind its correction is the median over: enough that one frame slowed by other work
+// on the machine does not move it, few enough that it follows the path.
+constexpr size_t kKindWindow = 8;
+
+double coreCount() { return double(std::max(1u, std::thread::hardware_concurrency())); }
 
 void pushWindow(std::vector<std::pair<double, double>>& w, std::pair<double, double> s, int window) {
     w.push_back(s);
@@ -358,14 +361,14 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
     // the split can always fall back to the fixed choice when the model's middle does not pay.
     if (_o.fixedDistance > 0 && std::isfinite(_o.fixedDistance))
         cand.insert(std::upper_bound(cand.begin(), cand.end(), _o.fixedDistance), _o.fixedDistance);
-    const bool everythingPriced = measured || _haveCorr[2];
+    const bool everythingPriced = measured || !_kindFrames[2].empty();
     if (_o.everythingNear && (everythingPriced || rayPriced)) cand.push_back(std::numeric_limits<double>::infinity());
     const int n = int(cand.size());
-    const double b = msPerRay();
     _pixels = int64_t(camera.width) * int64_t(camera.height);
-    const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
     // The model's price of each candidate (see the header), then the learned correction of its kind.
-    std::vector<double> price(cand.size()), cost(cand.size());
+    double corr[kSplitKinds];
+    for (int kind = 0; kind < kSplitKinds; ++kind) corr[kind] = correctionMs(kind);
+    std::vector<double> price(cand.size()), cost(cand.size()), candRays(cand.size());
     std::vector<uint64_t> candTris(cand.size());
     size_t k = 0;
     uint64_t tris = 0;
@@ -377,16 +380,11 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
         } else {
             while (k < byDist.size() && byDist[k].first <= d) tris += byDist[k++].second;
         }
-        candTris[size_t(i)] = kindOf(d) == 0 ? 0 : tris;
         const int kind = kindOf(d);
-        if (kind == 0) {
-            price[size_t(i)] = _probeAllMs > 0 ? _probeAllMs * double(_pixels) / double(cores) : b * predictedRays(0.0);
-        } else {
-            // Nothing to draw -> no GL pass: the raster's fixed cost only where triangles are drawn.
-            price[size_t(i)] =
-                (tris > 0 ? _c + _a * double(tris) : 0.0) + (kind != 2 ? b * predictedRays(d) + _f : 0.0);
-        }
-        cost[size_t(i)] = std::max(0.0, price[size_t(i)] + (_haveCorr[kind] ? _corr[kind] : 0.0));
+        candTris[size_t(i)] = kind == 0 ? 0 : tris;
+        candRays[size_t(i)] = kind == 2 ? 0.0 : predictedRays(kind == 0 ? 0.0 : d);
+        price[size_t(i)] = priceOf(kind, double(candTris[size_t(i)]), candRays[size_t(i)], double(_pixels));
+        cost[size_t(i)] = std::max(0.0, price[size_t(i)] + corr[kind]);
         const bool tryOnly = kind == 2 && !everythingPriced;
         if (!tryOnly && (bestI < 0 || cost[size_t(i)] < cost[size_t(bestI)])) bestI = i;
     }
@@ -404,7 +402,7 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
         for (int kind = 0; kind < kSplitKinds; ++kind) {
             // A kind never run is tried early (from frame kFirstTryFrame, within kFirstTryRatio of
             // the best): its price then stops resting on the model alone.
-            const bool never = !_haveCorr[kind];
+            const bool never = _kindFrames[kind].empty();
             if (kind == bestKind || !(frame - _lastKindFrame[kind] >= (never ? kFirstTryFrame : _o.endTryEvery)))
                 continue;
             int cheapest = -1;
@@ -419,8 +417,8 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
         }
     }
     _current = cand[size_t(bestI)];
-    _chosenPrice = price[size_t(bestI)];
     _chosenTris = candTris[size_t(bestI)];
+    _chosenRays = candRays[size_t(bestI)];
     _lastKindFrame[kindOf(_current)] = frame;
     return _current;
 }
@@ -430,21 +428,34 @@ void AdaptiveSplit::recordFrame(double nearD, double frameMs) {
     _frameMs = _frameMs > 0 ? (1 - _o.smoothing) * _frameMs + _o.smoothing * frameMs : frameMs;
     const int kind = kindOf(nearD);
     // A kind's first frame pays one-time costs (the first draw of the chunks, the far field's
-    // first frame, the ray casters' threads): not counted; NaN marks it seen.
-    if (!_haveCorr[kind] && !std::isnan(_corr[kind])) {
-        _corr[kind] = std::numeric_limits<double>::quiet_NaN();
+    // first frame, the ray casters' threads): not counted.
+    if (!_kindSeen[kind]) {
+        _kindSeen[kind] = true;
         return;
     }
-    const double r = frameMs - _chosenPrice;
-    if (!_haveCorr[kind]) {
-        _corr[kind] = r;
-        _haveCorr[kind] = true;
-        return;
-    }
-    // A frame slowed by other work on the machine moves the correction by a bounded step (a
-    // fifth of the kind's corrected price), so one such frame does not push the split away.
-    const double k = std::max(1.0, 0.2 * std::max(_chosenPrice + _corr[kind], 1.0));
-    _corr[kind] += kCorrectionWeight * std::clamp(r - _corr[kind], -k, k);
+    std::vector<KindFrame>& w = _kindFrames[kind];
+    w.push_back({double(_chosenTris), _chosenRays, double(_pixels), frameMs});
+    if (w.size() > kKindWindow) w.erase(w.begin());
+}
+
+double AdaptiveSplit::priceOf(int kind, double tris, double rays, double pixels) const {
+    if (kind == 0) return _probeAllMs > 0 ? _probeAllMs * pixels / coreCount() : msPerRay() * rays;
+    // Nothing to draw -> no GL pass: the raster's fixed cost only where triangles are drawn.
+    const double raster = tris > 0 ? _c + _a * tris : 0.0;
+    return kind == 2 ? raster : raster + msPerRay() * rays + _f;
+}
+
+double AdaptiveSplit::correctionMs(int kind) const {
+    // Re-priced with the current model at every call: a residual taken against the first
+    // frames' priors would otherwise outlive them (measured: a correction of -22 ms, set when
+    // the prior priced far pixels 20 times too high, held a kind's price down for 60 frames).
+    const std::vector<KindFrame>& w = _kindFrames[kind];
+    if (w.empty()) return 0.0;
+    std::vector<double> r;
+    r.reserve(w.size());
+    for (const KindFrame& k : w) r.push_back(k.frameMs - priceOf(kind, k.tris, k.rays, k.pixels));
+    std::nth_element(r.begin(), r.begin() + long(r.size() / 2), r.end());
+    return r[r.size() / 2];
 }
 
 double AdaptiveSplit::msPerRay() const {

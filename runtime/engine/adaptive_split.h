@@ -23,10 +23,11 @@
 // of the view's four side planes is culled by the renderer and costs no
 // raster time (for everything, counted at each probe, and every triangle on
 // a city of more than 200,000 objects; with haze, only objects within it).
-// Each kind's price is corrected by what its own frames measured: an
-// exponential moving average of (whole frame ms, the decision included) minus
-// (the model's price for the choice made), per kind, recorded by
-// recordFrame(). So costs the model does not see (the probe, the cull, the
+// Each kind's price is corrected by what its own frames measured: the median
+// over its last 8 frames (recordFrame()) of (whole frame ms, the decision
+// included) minus (the current model's price of what that frame drew and
+// traced), re-priced as the model learns, so a residual taken against the
+// first frames' priors does not outlive them. So costs the model does not see (the probe, the cull, the
 // sky layer, haze in the rasteriser, the ray stage's task start-up) are
 // learned online for each alternative instead of tuned. Until a kind has run
 // its correction is 0; each kind is tried now and then (its cheapest
@@ -171,7 +172,9 @@ public:
     void setHazeFar(double zMax) { _hazeFar = zMax; }
     // The learned correction of a kind's price (0 = ray casting, 1 = middle, 2 = everything,
     // 3 = the fixed distance), ms.
-    double correctionMs(int kind) const { return _corr[kind]; }
+    // The median over the kind's last kKindWindow counted frames of (frame ms - the current
+    // model's price of what that frame drew and traced); 0 before its first counted frame.
+    double correctionMs(int kind) const;
     double msPerTriangle() const { return _a; }
     double rasterFixedMs() const { return _c; }  // the raster fit's intercept (0 until a is fitted)
     double msPerRay() const;                     // per far pixel: the frames' model, capped by the probe's bulk rate
@@ -207,15 +210,22 @@ private:
     double _probeMsPerRay = 0;             // the last probe's whole ms per probe ray
     static constexpr int kSplitKinds = 4;  // ray casting, middle, everything, the fixed distance
     int kindOf(double d) const;
-    double _corr[kSplitKinds] = {0, 0, 0, 0};  // per kind: EMA of frame ms - the model's price
-    bool _haveCorr[kSplitKinds] = {false, false, false, false};
-    double _chosenPrice = 0;                         // the model's price (no correction) of the last choice
-    uint64_t _chosenTris = 0;                        // its triangles in view
-    uint64_t _everythingTris = 0;                    // every object's triangles in view at the last probe
-    int _lastKindFrame[kSplitKinds] = {0, 0, 0, 0};  // per kind: the frame it was last chosen or tried
-    int _farFrames = 0;                              // frames recorded with a far field
-    int64_t _pixels = 0;                             // the camera's pixel count at the last choice
-    glm::dvec3 _probeEye{0.0};                       // the camera of the last probe
+    // The model's price of a choice of `kind` that draws `tris` triangles in view and traces
+    // `rays` far pixels in a frame of `pixels` pixels.
+    double priceOf(int kind, double tris, double rays, double pixels) const;
+    // A frame the split chose, as its kind's correction needs it.
+    struct KindFrame {
+        double tris = 0, rays = 0, pixels = 0, frameMs = 0;
+    };
+    std::vector<KindFrame> _kindFrames[kSplitKinds];             // per kind: its last counted frames
+    bool _kindSeen[kSplitKinds] = {false, false, false, false};  // per kind: its first (uncounted) frame ran
+    uint64_t _chosenTris = 0;                                    // the last choice's triangles in view
+    double _chosenRays = 0;                                      // ... and its predicted far rays
+    uint64_t _everythingTris = 0;                                // every object's triangles in view at the last probe
+    int _lastKindFrame[kSplitKinds] = {0, 0, 0, 0};              // per kind: the frame it was last chosen or tried
+    int _farFrames = 0;                                          // frames recorded with a far field
+    int64_t _pixels = 0;                                         // the camera's pixel count at the last choice
+    glm::dvec3 _probeEye{0.0};                                   // the camera of the last probe
     double _probeHeading = 0, _probePitch = 0;
 };
 

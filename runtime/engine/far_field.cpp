@@ -82,6 +82,7 @@ void FarField::reset() {
     _mem->cachePaused = 0;
     _mem->cachePauseLength = kCachePauseFrames;
     _mem->horizonPaused = 0;
+    _mem->horizonStrikes = 0;
     _mem->lastFrameCached = false;
 }
 
@@ -135,8 +136,15 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
         // on), against a timed sample of the culled pixels' own rays (mostly sky misses: the
         // mean traced ray prices them 5 to 10 times too high).
         const double costMs = stats.stages.ms(Stage::Horizon) - before;
-        if (horizonAdaptive && _mem->msPerRay > 0 && costMs > culledRaysMs(f, _rays, _options, culled))
-            _mem->horizonPaused = kHorizonPauseFrames;
+        if (horizonAdaptive && _mem->msPerRay > 0) {
+            // One slow frame (the trace's thread descheduled) is not a verdict: it takes kHorizonStrikes in a row.
+            const bool pays = costMs <= culledRaysMs(f, _rays, _options, culled);
+            _mem->horizonStrikes = pays ? 0 : _mem->horizonStrikes + 1;
+            if (_mem->horizonStrikes >= kHorizonStrikes) {
+                _mem->horizonPaused = kHorizonPauseFrames;
+                _mem->horizonStrikes = 0;
+            }
+        }
     }
     listPending(f);
     const bool adaptive = _options.cacheAdaptive && !budgeted && f.moving;

@@ -67,6 +67,8 @@ constexpr int kCachePauseFrames = 8;
 constexpr int kCacheMaxPauseFrames = 64;
 // Moving frames the horizon pauses for when it did not pay (FarFieldOptions::horizonAdaptive).
 constexpr int kHorizonPauseFrames = 8;
+// Judged frames in a row in which the horizon must not pay before it pauses.
+constexpr int kHorizonStrikes = 2;
 
 struct FarFieldOptions {
     double nearDistance = 100.0;  // metres (>= 0): horizon skips geometry the near field draws; 0 = skip nothing
@@ -89,13 +91,12 @@ struct FarFieldOptions {
     // Pause the horizon while it does not pay: when a moving frame's horizon
     // stage (the trace, or the wait for a trace that overlapped the near
     // field) took longer than the rays of the pixels it culled would have
-    // (culledRaysMs: a timed sample of those rays, far_field_stages.h), the next
-    // kHorizonPauseFrames moving frames trace those pixels instead (they miss
-    // and show the same sky; a note says so); then it is traced and judged
-    // again. On an elevated view over a 64 km² city the trace over the
-    // 2048-cell grid cost 80 to 120 ms a frame for a few ms of sky rays.
-    // Never paused for a still camera or under a pixel budget or frame-time
-    // target (the culled pixels would eat the budget).
+    // (culledRaysMs: a timed sample of those rays, far_field_stages.h) on
+    // kHorizonStrikes judged frames in a row, the next kHorizonPauseFrames
+    // moving frames trace those pixels instead (they miss and show the same
+    // sky; a note says so); then it is traced and judged again. On an elevated view over a 64 km² city the trace over
+    // the 2048-cell grid cost 80 to 120 ms a frame for a few ms of sky rays. Never paused for a still camera or under a
+    // pixel budget or frame-time target (the culled pixels would eat the budget).
     bool horizonAdaptive = true;
     // Speculative rays: beginFrame also casts last frame's traced pixels for
     // the new camera, on one other thread while the near field is drawn (on

@@ -15,16 +15,21 @@ double culledRaysMs(const FarFrame& f, const RayScene& rays, const FarFieldOptio
     const uint64_t step = std::max<uint64_t>(1, culled / sample);
     const uint32_t W = uint32_t(f.width);
     const glm::vec3 org(f.camera.eye - rays.frameOrigin());
+    const glm::dvec3 fwd = f.camera.forward();
+    const double zMax = o.effects.haze ? o.effects.hazeFar() : 0.0;
     std::vector<glm::vec3> orgs, dirs;
+    std::vector<float> tfars;
     uint64_t k = 0;
     for (size_t i = 0; i < f.pixelCount && dirs.size() < sample; ++i)
         if (f.cls[i] == kFarHorizon && k++ % step == 0) {
+            const glm::dvec3 d = f.rays.dir(int(i % W), int(i / W));
             orgs.push_back(org);
-            dirs.push_back(glm::vec3(f.rays.dir(int(i % W), int(i / W))));
+            dirs.push_back(glm::vec3(d));
+            tfars.push_back(zMax > 0 ? hazeTfar(d, fwd, zMax) : 1e30f);
         }
     std::vector<RayHit> hits(dirs.size());
     Stopwatch sw;
-    rays.intersectMany(orgs.data(), dirs.data(), int(dirs.size()), hits.data(), 1e30f, nullptr, farRayStart(o));
+    rays.intersectMany(orgs.data(), dirs.data(), int(dirs.size()), hits.data(), 1e30f, tfars.data(), farRayStart(o));
     const double perRay = sw.ms() / double(dirs.size());
     const int workers = o.threads > 0 ? o.threads : std::max(1, tbb::this_task_arena::max_concurrency());
     return perRay * double(culled) / double(workers);

@@ -50,11 +50,6 @@ struct PixelList {
     uint32_t operator[](size_t k) const { return idx ? idx[k] : uint32_t(k); }
 };
 
-// Far limit of a ray (unit direction d) that stops at eye-plane depth zMax.
-float hazeTfar(const glm::dvec3& d, const glm::dvec3& fwd, double zMax) {
-    return float(zMax / std::max(glm::dot(d, fwd), 1e-6)) * (1.0f + 1e-6f);
-}
-
 // Casts the entries runs[r] .. runs[r + 1] - 1 of every run r in packets of 8.
 void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, const std::vector<size_t>& runs,
               Image& out, RayCounts& counts, int threads, uint8_t* hit, const RayShading& shading) {

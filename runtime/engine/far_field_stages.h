@@ -6,6 +6,7 @@
 // its wall time to FrameStats::stages. Not thread-safe (one frame, one writer);
 // nothing throws.
 #pragma once
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -14,6 +15,7 @@
 #include <thread>
 #include <vector>
 
+#include <glm/glm.hpp>
 #include <tbb/task_arena.h>
 
 #include "runtime/engine/far_field.h"
@@ -97,6 +99,7 @@ struct FarFieldMemory {
     int cachePaused = 0;                       // moving frames left to trace without the cache
     int cachePauseLength = kCachePauseFrames;  // the next pause (doubles while verdicts say it does not pay)
     int horizonPaused = 0;                     // moving frames left to trace without the horizon
+    int horizonStrikes = 0;                    // judged frames in a row in which the horizon did not pay
     bool lastFrameCached = false;              // the last frame ran the cache stage (its stores are fresh)
     // Scratch of the cache stage, kept so that a frame does not fault in fresh pages.
     std::vector<CacheCandidate> cand;
@@ -174,11 +177,17 @@ uint64_t horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions
 // What the rays of the `culled` pixels the horizon culled this frame (class
 // kFarHorizon) would have cost the ray stage, in wall ms: a sample of at most
 // `sample` of them, spread over the frame, cast from farRayStart(o) and timed
-// on this thread, scaled to all of them and divided among the stage's workers
-// (o.threads, or TBB's concurrency). Nearly all are sky misses, far cheaper
-// than the frame's mean traced ray. 0 when none was culled.
+// on this thread with the far limit the ray stage would give them (haze),
+// scaled to all of them and divided among the stage's workers (o.threads, or
+// TBB's concurrency). Nearly all are sky misses, far cheaper than the frame's
+// mean traced ray. 0 when none was culled.
 double culledRaysMs(const FarFrame& f, const RayScene& rays, const FarFieldOptions& o, uint64_t culled,
                     size_t sample = 512);
+// Far limit of a ray (unit direction d) that stops at eye-plane depth zMax
+// (haze: nothing beyond the visibility is traced).
+inline float hazeTfar(const glm::dvec3& d, const glm::dvec3& fwd, double zMax) {
+    return float(zMax / std::max(glm::dot(d, fwd), 1e-6)) * (1.0f + 1e-6f);
+}
 // The horizon options of a frame (near distance, haze depth, subsampling while moving).
 HorizonOptions horizonOptions(const FarFieldOptions& o, bool moving);
 // No far geometry: every pending pixel becomes horizonCulled, sky colour written. No time.

@@ -389,10 +389,11 @@ TEST(FarFieldFrame, HazeOfCoveredPixelsMatchesTheFormulaAtTheirDepth) {
 }
 
 // The horizon pauses while it does not pay: here the near field covers every
-// pixel above the horizon, so the horizon culls nothing and saves no ray, and
-// the next kHorizonPauseFrames moving frames run without it. The picture is
-// the same as with the horizon always traced (the pixels it would cull are
-// covered), and the pause ends after kHorizonPauseFrames frames.
+// pixel above the horizon, so the horizon culls nothing and saves no ray;
+// after kHorizonStrikes judged frames in a row say so, the next
+// kHorizonPauseFrames moving frames run without it. The picture is the same
+// as with the horizon always traced (the pixels it would cull are covered),
+// and the pause ends after kHorizonPauseFrames frames.
 TEST(FarFieldFrame, HorizonPausesWhileItSavesNoRays) {
     const TestCity t = testCity(9, 60);
     ASSERT_TRUE(t.rays);
@@ -406,8 +407,8 @@ TEST(FarFieldFrame, HorizonPausesWhileItSavesNoRays) {
     FarFieldOptions always = o;
     always.horizonAdaptive = false;
     FarField adaptive(*t.rays, &t.grid, o), traced(*t.rays, &t.grid, always);
-    int paused = 0;
-    for (int f = 0; f < 2 + kHorizonPauseFrames + 1; ++f) {
+    int paused = 0, firstPaused = -1;
+    for (int f = 0; f < 1 + kHorizonStrikes + kHorizonPauseFrames + 1; ++f) {
         c.eye.x += 3.0;  // moving
         Image a, b;
         FrameStats sa, sb;
@@ -418,11 +419,14 @@ TEST(FarFieldFrame, HorizonPausesWhileItSavesNoRays) {
         EXPECT_EQ(a.rgba, b.rgba) << "frame " << f;
         EXPECT_EQ(sa.raysCast, sb.raysCast) << "frame " << f;
         if (has(sa, "horizon paused")) {
+            if (firstPaused < 0) firstPaused = f;
             ++paused;
             EXPECT_FALSE(sa.stages.ran(Stage::Horizon));
         } else {
             EXPECT_TRUE(sa.stages.ran(Stage::Horizon)) << "frame " << f;
         }
     }
-    EXPECT_EQ(paused, kHorizonPauseFrames);  // frame 0 measures no ray cost yet; frame 1 pauses the next 8
+    // Frame 0 measures no ray cost yet; frames 1 .. kHorizonStrikes are judged, then the pause.
+    EXPECT_EQ(firstPaused, 1 + kHorizonStrikes);
+    EXPECT_EQ(paused, kHorizonPauseFrames);
 }
