@@ -82,8 +82,8 @@ constexpr size_t kProbeFarTimed = 1000;
 constexpr double kProbeFrameShare = 0.05;
 constexpr double kProbeMinRays = 300;
 
-// Frames of a kind its correction is the median over: enough that one frame slowed by other work
-// on the machine does not move it, few enough that it follows the path.
+// Frames of a kind its correction is the lower quartile over: enough that frames slowed by other
+// work on the machine do not move it, few enough that it follows the path.
 constexpr size_t kKindWindow = 8;
 
 double coreCount() { return double(std::max(1u, std::thread::hardware_concurrency())); }
@@ -454,8 +454,11 @@ double AdaptiveSplit::correctionMs(int kind) const {
     std::vector<double> r;
     r.reserve(w.size());
     for (const KindFrame& k : w) r.push_back(k.frameMs - priceOf(kind, k.tris, k.rays, k.pixels));
-    std::nth_element(r.begin(), r.begin() + long(r.size() / 2), r.end());
-    return r[r.size() / 2];
+    // The lower quartile: other work on the machine only ever slows a frame, so a kind whose
+    // frames were hit by it is not priced out of reach (it is tried again only when near the best).
+    const size_t q = (r.size() - 1) / 4;
+    std::nth_element(r.begin(), r.begin() + long(q), r.end());
+    return r[q];
 }
 
 double AdaptiveSplit::msPerRay() const {

@@ -429,5 +429,59 @@ TEST(Split, FixedDistanceIsAFallbackWhenTheMiddleDoesNotPay) {
     EXPECT_LT(std::abs(s.correctionMs(3)), 50.0) << "the fixed distance's own frames cost what the model says";
 }
 
+// A kind's correction is taken from its own frames, re-priced by the model
+// as it stands: frames slowed by other work on the machine (here half of
+// them, at 50 times the others) do not move it, and once the model has
+// learned a new price the corrected price of the same choice is still what
+// its frames measured.
+TEST(Split, CorrectionIgnoresFramesSlowedByOtherWork) {
+    ProbeScene ps = probeScene(12);
+    const std::vector<SplitObject> objs = squareObjects();
+    const Camera c = smallCamera(glm::dvec3(0, -350, 1.7));
+    AdaptiveSplitOptions o = measuredOnly();
+    o.rayCastOnly = o.everythingNear = false;
+    o.endTryEvery = 0;
+    o.exploreEvery = 0;
+    AdaptiveSplit s(objs, ps.rays.get(), o);
+    for (int i = 0; i < 10; ++i) {
+        const double tris = 20000 + 4000 * i;
+        s.record(uint64_t(tris), 1.0 + 1e-4 * tris, 5000, 5000 * 1e-4);
+    }
+    double d = s.choose(c, -1);
+    s.recordFrame(d, 1000.0);  // the kind's first frame: one-time costs, not counted
+    for (int f = 0; f < 8; ++f) {
+        d = s.choose(c, -1);
+        s.recordFrame(d, f % 2 == 1 ? 500.0 : 10.0);
+    }
+    EXPECT_LT(s.correctionMs(1), 10.0) << "the slowed frames priced the middle out of reach";
+
+    // Its frames measured 20 ms; then the raster fit learns a steeper slope.
+    AdaptiveSplit t(objs, ps.rays.get(), o);
+    auto fit = [&](double perTri) {
+        for (int i = 0; i < 60; ++i) {
+            const double tris = 20000 + 4000 * (i % 10);
+            t.record(uint64_t(tris), 1.0 + perTri * tris, 5000, 0.5);
+        }
+    };
+    fit(1e-4);
+    d = t.choose(c, -1);
+    t.recordFrame(d, 1000.0);
+    uint64_t tris = 0;
+    for (int f = 0; f < 8; ++f) {
+        d = t.choose(c, -1);
+        tris = t.chosenTriangles();
+        t.recordFrame(d, 20.0);
+    }
+    auto price = [&] {
+        return t.rasterFixedMs() + t.msPerTriangle() * double(tris) + t.msPerRay() * t.predictedRays(d) +
+               t.farFixedMs();
+    };
+    EXPECT_NEAR(price() + t.correctionMs(1), 20.0, 1e-6);
+    const double before = price();
+    fit(4e-4);
+    ASSERT_GT(price(), before + 1.0) << "the model learned a new price";
+    EXPECT_NEAR(price() + t.correctionMs(1), 20.0, 1e-6) << "the measured frames still price the choice";
+}
+
 }  // namespace
 }  // namespace vista
