@@ -18,6 +18,7 @@
 #include <set>
 #include <sstream>
 
+#include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
 #include "citygen/generate.h"
@@ -314,6 +315,35 @@ TEST(Boxes, AnObjectPartlyBehindTheCameraIsClippedNotInverted) {
     OrientedBox behind = boxes.boxes[0].box;
     behind.center.y = -20.0;
     EXPECT_FALSE(projectedBox(cam, behind).valid());
+}
+
+TEST(Boxes, TreesComeFromTheirInstanceAndImpostorsOnlyFillIn) {
+    // A 2 m cube prototype; tree 0 as a full instance at x = 10 and as an impostor at x = 50 (a coarse
+    // level of the same tree), tree 1 only as an impostor at x = -20, scaled by 2.
+    SceneModel city;
+    SceneMesh proto;
+    test::addBox(proto, {-1.0f, -1.0f, 0.0f}, {1.0f, 1.0f, 2.0f}, {40, 120, 40, 255});
+    city.prototypes.push_back(proto);
+    auto at = [](double x, double scale) {
+        return glm::scale(glm::translate(glm::dmat4(1.0), glm::dvec3(x, 0.0, 0.0)), glm::dvec3(scale));
+    };
+    const uint32_t t0 = makeInstanceId(InstanceKind::Tree, 0), t1 = makeInstanceId(InstanceKind::Tree, 1);
+    city.instances.push_back({0, at(10.0, 1.0), t0});
+    city.impostors.push_back({0, at(50.0, 1.0), t0});
+    city.impostors.push_back({0, at(-20.0, 2.0), t1});
+    const CityBoxes boxes = buildCityBoxes(city);
+    ASSERT_EQ(boxes.boxes.size(), 2u);
+    const InstanceBox* a = boxes.find(t0);
+    const InstanceBox* b = boxes.find(t1);
+    ASSERT_TRUE(a && b);
+    EXPECT_NEAR(a->box.center.x, 10.0, 1e-9);
+    EXPECT_NEAR(a->box.size.x, 2.0, 1e-9);
+    EXPECT_NEAR(a->box.size.z, 2.0, 1e-9);
+    EXPECT_TRUE(a->impostors.empty());
+    EXPECT_NEAR(b->box.center.x, -20.0, 1e-9);
+    EXPECT_NEAR(b->box.size.y, 4.0, 1e-9);
+    EXPECT_NEAR(b->box.center.z, 2.0, 1e-9);
+    EXPECT_EQ(boxes.find(makeInstanceId(InstanceKind::Tree, 2)), nullptr);
 }
 
 TEST(Boxes, VehicleFrameKittiLabelsAndCalibrationMatchHandComputations) {
