@@ -1,0 +1,607 @@
+// Bounding boxes for dataset ground truth (boxes.h): 3D boxes per object
+// instance, 2D boxes per frame, and their writers.
+#include "runtime/engine/boxes.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <unordered_map>
+
+#include <nlohmann/json.hpp>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include "foundation/status.h"
+#include "foundation/units.h"
+#include "runtime/engine/far_field_stages.h"
+
+namespace vista {
+
+bool isObjectKind(InstanceKind k) {
+    switch (k) {
+        case InstanceKind::Building:
+        case InstanceKind::Tree:
+        case InstanceKind::StreetLight:
+        case InstanceKind::TrafficLight:
+        case InstanceKind::TrafficSign:
+        case InstanceKind::Car: return true;
+        default: return false;
+    }
+}
+
+glm::dvec3 OrientedBox::lengthAxis() const { return {std::cos(yaw), std::sin(yaw), 0.0}; }
+glm::dvec3 OrientedBox::widthAxis() const { return {-std::sin(yaw), std::cos(yaw), 0.0}; }
+
+std::array<glm::dvec3, 8> OrientedBox::corners() const {
+    const glm::dvec3 a = 0.5 * size.x * lengthAxis(), b = 0.5 * size.y * widthAxis(), h(0.0, 0.0, 0.5 * size.z);
+    const glm::dvec3 ring[4] = {-a - b, a - b, a + b, -a + b};
+    std::array<glm::dvec3, 8> out;
+    for (int k = 0; k < 4; ++k) {
+        out[size_t(k)] = center + ring[k] - h;
+        out[size_t(k) + 4] = center + ring[k] + h;
+    }
+    return out;
+}
+
+bool OrientedBox::contains(const glm::dvec3& p, double margin) const {
+    const glm::dvec3 d = p - center;
+    return std::abs(glm::dot(d, lengthAxis())) <= 0.5 * size.x + margin &&
+           std::abs(glm::dot(d, widthAxis())) <= 0.5 * size.y + margin && std::abs(d.z) <= 0.5 * size.z + margin;
+}
+
+namespace {
+
+double cross2(const glm::dvec2& o, const glm::dvec2& a, const glm::dvec2& b) {
+    return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+}
+
+// Counter-clockwise convex hull without collinear points (Andrew's monotone chain).
+std::vector<glm::dvec2> convexHull(std::vector<glm::dvec2> p) {
+    std::sort(p.begin(), p.end(),
+              [](const glm::dvec2& a, const glm::dvec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+    p.erase(std::unique(p.begin(), p.end()), p.end());
+    if (p.size() < 3) return p;
+    std::vector<glm::dvec2> h(2 * p.size());
+    size_t k = 0;
+    for (size_t i = 0; i < p.size(); ++i) {
+        while (k >= 2 && cross2(h[k - 2], h[k - 1], p[i]) <= 0) --k;
+        h[k++] = p[i];
+    }
+    for (size_t i = p.size() - 1, t = k + 1; i-- > 0;) {
+        while (k >= t && cross2(h[k - 2], h[k - 1], p[i]) <= 0) --k;
+        h[k++] = p[i];
+    }
+    h.resize(k - 1);
+    return h;
+}
+
+double wrapHalfTurn(double yaw) {  // into (-pi/2, pi/2]
+    while (yaw > kHalfPi) yaw -= kPi;
+    while (yaw <= -kHalfPi) yaw += kPi;
+    return yaw;
+}
+
+}  // namespace
+
+OrientedBox fitUprightBox(const std::vector<glm::dvec3>& points) {
+    OrientedBox box;
+    if (points.empty()) return box;
+    const glm::dvec2 ref(points[0]);
+    double zLo = points[0].z, zHi = points[0].z;
+    std::vector<glm::dvec2> xy(points.size());
+    for (size_t i = 0; i < points.size(); ++i) {
+        xy[i] = glm::dvec2(points[i]) - ref;
+        zLo = std::min(zLo, points[i].z);
+        zHi = std::max(zHi, points[i].z);
+    }
+    const std::vector<glm::dvec2> hull = convexHull(std::move(xy));
+    box.center = glm::dvec3(ref + hull[0], 0.5 * (zLo + zHi));
+    box.size = glm::dvec3(0.0, 0.0, zHi - zLo);
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < hull.size() && hull.size() > 1; ++i) {
+        const glm::dvec2 edge = hull[(i + 1) % hull.size()] - hull[i];
+        if (glm::length(edge) <= 0) continue;
+        const glm::dvec2 e = glm::normalize(edge), n(-e.y, e.x);
+        double eLo = 1e300, eHi = -1e300, nLo = 1e300, nHi = -1e300;
+        for (const glm::dvec2& q : hull) {
+            const double a = glm::dot(q, e), b = glm::dot(q, n);
+            eLo = std::min(eLo, a), eHi = std::max(eHi, a), nLo = std::min(nLo, b), nHi = std::max(nHi, b);
+        }
+        const double area = (eHi - eLo) * (nHi - nLo);
+        if (!(area < best)) continue;
+        best = area;
+        const glm::dvec2 c = ref + e * (0.5 * (eLo + eHi)) + n * (0.5 * (nLo + nHi));
+        box.center = glm::dvec3(c, 0.5 * (zLo + zHi));
+        const bool swap = nHi - nLo > eHi - eLo;
+        const glm::dvec2 axis = swap ? n : e;
+        box.size = glm::dvec3(swap ? nHi - nLo : eHi - eLo, swap ? eHi - eLo : nHi - nLo, zHi - zLo);
+        box.yaw = wrapHalfTurn(std::atan2(axis.y, axis.x));
+    }
+    return box;
+}
+
+const InstanceBox* CityBoxes::find(uint32_t id) const {
+    auto it =
+        std::lower_bound(boxes.begin(), boxes.end(), id, [](const InstanceBox& b, uint32_t v) { return b.id < v; });
+    return it != boxes.end() && it->id == id ? &*it : nullptr;
+}
+
+namespace {
+
+// The label id of triangle `prim` of a tile mesh (its first vertex's; 0 without labels).
+uint32_t triangleLabel(const SceneMesh& m, size_t prim) {
+    const uint32_t v = m.indices[prim * 3];
+    return v < m.ids.size() ? m.ids[v] : 0u;
+}
+
+bool labelledMesh(const SceneMesh& m) { return !m.ids.empty() && m.ids.size() == m.positions.size(); }
+
+// Calls f(world a, world b, world c) for every triangle of the instance.
+template <class F>
+void forEachTriangle(const SceneModel& city, const CityBoxes& boxes, const InstanceBox& box, const F& f) {
+    for (uint32_t k = 0; k < box.triangleCount; ++k) {
+        const MeshTriangle& t = boxes.triangles[box.firstTriangle + k];
+        const SceneMesh& m = city.meshes[t.mesh];
+        const uint32_t* idx = &m.indices[size_t(t.prim) * 3];
+        f(m.origin + glm::dvec3(m.positions[idx[0]]), m.origin + glm::dvec3(m.positions[idx[1]]),
+          m.origin + glm::dvec3(m.positions[idx[2]]));
+    }
+    auto trees = [&](const std::vector<SceneInstance>& list, const std::vector<uint32_t>& which) {
+        std::vector<glm::dvec3> world;
+        for (uint32_t i : which) {
+            const SceneInstance& in = list[i];
+            if (in.prototype >= city.prototypes.size()) continue;
+            const SceneMesh& p = city.prototypes[in.prototype];
+            world.resize(p.positions.size());
+            for (size_t v = 0; v < p.positions.size(); ++v)
+                world[v] = glm::dvec3(in.transform * glm::dvec4(glm::dvec3(p.positions[v]), 1.0));
+            for (size_t t = 0; t + 2 < p.indices.size(); t += 3)
+                f(world[p.indices[t]], world[p.indices[t + 1]], world[p.indices[t + 2]]);
+        }
+    };
+    trees(city.instances, box.trees);
+    trees(city.impostors, box.impostors);
+}
+
+}  // namespace
+
+std::vector<glm::dvec3> instancePoints(const SceneModel& city, const CityBoxes& boxes, const InstanceBox& box) {
+    std::vector<glm::dvec3> out;
+    forEachTriangle(city, boxes, box, [&](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+        out.push_back(a), out.push_back(b), out.push_back(c);
+    });
+    return out;
+}
+
+namespace {
+
+// The tile-mesh triangles of object instances, sorted by (id, mesh, prim).
+struct TriangleRef {
+    uint32_t id, mesh, prim;
+};
+
+std::vector<TriangleRef> objectTriangles(const SceneModel& city) {
+    std::vector<TriangleRef> refs;
+    for (size_t mi = 0; mi < city.meshes.size(); ++mi) {
+        const SceneMesh& m = city.meshes[mi];
+        if (!labelledMesh(m)) continue;
+        for (size_t t = 0; t < m.indices.size() / 3; ++t) {
+            const uint32_t id = triangleLabel(m, t);
+            if (id != 0 && isObjectKind(instanceKind(id))) refs.push_back({id, uint32_t(mi), uint32_t(t)});
+        }
+    }
+    std::sort(refs.begin(), refs.end(), [](const TriangleRef& a, const TriangleRef& b) {
+        return a.id != b.id ? a.id < b.id : a.mesh != b.mesh ? a.mesh < b.mesh : a.prim < b.prim;
+    });
+    return refs;
+}
+
+}  // namespace
+
+CityBoxes buildCityBoxes(const SceneModel& city, int threads) {
+    CityBoxes out;
+    std::map<uint32_t, size_t> at;  // id -> index in out.boxes
+    auto boxOf = [&](uint32_t id) -> InstanceBox& {
+        auto [it, fresh] = at.emplace(id, out.boxes.size());
+        if (fresh) {
+            out.boxes.emplace_back();
+            out.boxes.back().id = id;
+        }
+        return out.boxes[it->second];
+    };
+    const std::vector<TriangleRef> refs = objectTriangles(city);
+    out.triangles.reserve(refs.size());
+    for (size_t i = 0; i < refs.size(); ++i) {
+        InstanceBox& b = boxOf(refs[i].id);
+        if (b.triangleCount == 0) b.firstTriangle = uint32_t(i);
+        ++b.triangleCount;
+        out.triangles.push_back({refs[i].mesh, refs[i].prim});
+    }
+    std::vector<uint32_t> treeIds;
+    for (size_t i = 0; i < city.instances.size(); ++i) {
+        const uint32_t id = city.instances[i].id;
+        if (id == 0 || !isObjectKind(instanceKind(id))) continue;
+        boxOf(id).trees.push_back(uint32_t(i));
+        treeIds.push_back(id);
+    }
+    std::sort(treeIds.begin(), treeIds.end());
+    for (size_t i = 0; i < city.impostors.size(); ++i) {
+        const uint32_t id = city.impostors[i].id;
+        if (id == 0 || !isObjectKind(instanceKind(id)) || std::binary_search(treeIds.begin(), treeIds.end(), id))
+            continue;
+        boxOf(id).impostors.push_back(uint32_t(i));
+    }
+    std::sort(out.boxes.begin(), out.boxes.end(),
+              [](const InstanceBox& a, const InstanceBox& b) { return a.id < b.id; });
+    inArena(threads, [&] {
+        tbb::parallel_for(size_t(0), out.boxes.size(),
+                          [&](size_t i) { out.boxes[i].box = fitUprightBox(instancePoints(city, out, out.boxes[i])); });
+    });
+    return out;
+}
+
+OrientedBox boxInVehicleFrame(const OrientedBox& world, const LidarPose& pose) {
+    Camera c;
+    c.heading = pose.heading;
+    c.pitch = pose.pitch;
+    c.roll = pose.roll;
+    const glm::dvec3 fwd = c.forward(), left = -c.right(), up = c.up();
+    const glm::dvec3 d = world.center - pose.position, axis = world.lengthAxis();
+    OrientedBox v = world;
+    v.center = glm::dvec3(glm::dot(d, fwd), glm::dot(d, left), glm::dot(d, up));
+    v.yaw = wrapHalfTurn(std::atan2(glm::dot(axis, left), glm::dot(axis, fwd)));
+    return v;
+}
+
+PinholeIntrinsics pinholeIntrinsics(const Camera& camera) {
+    PinholeIntrinsics k;
+    k.fy = 0.5 * camera.height / std::tan(0.5 * camera.fovY);
+    k.fx = k.fy;
+    k.cx = 0.5 * (camera.width - 1);
+    k.cy = 0.5 * (camera.height - 1);
+    return k;
+}
+
+glm::dvec3 cameraPoint(const Camera& camera, const glm::dvec3& world) {
+    const glm::dvec3 d = world - camera.eye;
+    return {glm::dot(d, camera.right()), -glm::dot(d, camera.up()), glm::dot(d, camera.forward())};
+}
+
+namespace {
+
+// The camera's axes and intrinsics, evaluated once.
+struct Projector {
+    glm::dvec3 eye, right, down, fwd;
+    PinholeIntrinsics k;
+    double zNear;
+    explicit Projector(const Camera& c)
+        : eye(c.eye), right(c.right()), down(-c.up()), fwd(c.forward()), k(pinholeIntrinsics(c)), zNear(c.zNear) {}
+    glm::dvec3 toCamera(const glm::dvec3& w) const {
+        const glm::dvec3 d = w - eye;
+        return {glm::dot(d, right), glm::dot(d, down), glm::dot(d, fwd)};
+    }
+    // Pixel coordinates of a camera point with z > 0.
+    glm::dvec2 pixel(const glm::dvec3& p) const { return {k.fx * p.x / p.z + k.cx, k.fy * p.y / p.z + k.cy}; }
+    // The point where segment a-b crosses the near plane (a and b on either side).
+    glm::dvec3 nearCrossing(const glm::dvec3& a, const glm::dvec3& b) const {
+        const double t = (zNear - a.z) / (b.z - a.z);
+        glm::dvec3 p = a + t * (b - a);
+        p.z = zNear;
+        return p;
+    }
+};
+
+void extend(PixelBox& b, const glm::dvec2& p) {
+    if (!b.valid()) {
+        b = {p.x, p.y, p.x, p.y};
+        return;
+    }
+    b.u0 = std::min(b.u0, p.x), b.v0 = std::min(b.v0, p.y);
+    b.u1 = std::max(b.u1, p.x), b.v1 = std::max(b.v1, p.y);
+}
+
+}  // namespace
+
+PixelBox projectedExtent(const Camera& camera, const std::vector<glm::dvec3>& vertices,
+                         const std::vector<std::array<int, 2>>& edges) {
+    const Projector pr(camera);
+    std::vector<glm::dvec3> c(vertices.size());
+    PixelBox out;
+    for (size_t i = 0; i < vertices.size(); ++i) {
+        c[i] = pr.toCamera(vertices[i]);
+        if (c[i].z >= pr.zNear) extend(out, pr.pixel(c[i]));
+    }
+    for (const auto& e : edges) {
+        const glm::dvec3 &a = c[size_t(e[0])], &b = c[size_t(e[1])];
+        if ((a.z < pr.zNear) != (b.z < pr.zNear)) extend(out, pr.pixel(pr.nearCrossing(a, b)));
+    }
+    return out;
+}
+
+PixelBox projectedBox(const Camera& camera, const OrientedBox& box) {
+    const std::array<glm::dvec3, 8> c = box.corners();
+    static const std::vector<std::array<int, 2>> kEdges = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6},
+                                                           {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+    return projectedExtent(camera, std::vector<glm::dvec3>(c.begin(), c.end()), kEdges);
+}
+
+PixelBox clipToImage(const PixelBox& b, const Camera& camera) {
+    if (!b.valid()) return b;
+    PixelBox c{std::max(b.u0, -0.5), std::max(b.v0, -0.5), std::min(b.u1, camera.width - 0.5),
+               std::min(b.v1, camera.height - 0.5)};
+    return c.valid() ? c : PixelBox{};
+}
+
+namespace {
+
+// The extent and pixel count of every id in an instance image, sorted by id.
+struct VisibleStats {
+    uint32_t id;
+    int u0, v0, u1, v1;
+    uint32_t count;
+};
+
+std::vector<VisibleStats> visibleStats(const std::vector<uint32_t>& ids, int width, int height) {
+    std::unordered_map<uint32_t, size_t> at;
+    std::vector<VisibleStats> s;
+    uint32_t lastId = 0;
+    size_t last = 0;
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            const uint32_t id = ids[size_t(y) * size_t(width) + size_t(x)];
+            if (id == 0) continue;
+            if (id != lastId) {
+                auto [it, fresh] = at.emplace(id, s.size());
+                if (fresh) s.push_back({id, x, y, x, y, 0});
+                last = it->second;
+                lastId = id;
+            }
+            VisibleStats& v = s[last];
+            v.u0 = std::min(v.u0, x), v.v0 = std::min(v.v0, y), v.u1 = std::max(v.u1, x), v.v1 = std::max(v.v1, y);
+            ++v.count;
+        }
+    std::sort(s.begin(), s.end(), [](const VisibleStats& a, const VisibleStats& b) { return a.id < b.id; });
+    return s;
+}
+
+// One instance's triangles through the camera: `full` = the extent of every
+// triangle clipped against the near plane; `covered` = the pixels whose
+// centres its front faces cover (marked with `mark` in `stamp`, so each
+// pixel counts once).
+class MaskRaster {
+public:
+    MaskRaster(const Projector& pr, int width, int height, std::vector<uint32_t>& stamp, uint32_t mark)
+        : _pr(pr), _w(width), _h(height), _stamp(stamp), _mark(mark) {}
+    PixelBox full;
+    uint32_t covered = 0;
+
+    void triangle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+        const glm::dvec3 p[3] = {_pr.toCamera(a), _pr.toCamera(b), _pr.toCamera(c)};
+        glm::dvec3 poly[4];
+        int n = 0;
+        for (int i = 0; i < 3; ++i) {
+            const glm::dvec3 &cur = p[i], &nxt = p[(i + 1) % 3];
+            const bool curIn = cur.z >= _pr.zNear, nxtIn = nxt.z >= _pr.zNear;
+            if (curIn) poly[n++] = cur;
+            if (curIn != nxtIn) poly[n++] = _pr.nearCrossing(cur, nxt);
+        }
+        if (n < 3) return;
+        glm::dvec2 q[4];
+        for (int i = 0; i < n; ++i) extend(full, q[i] = _pr.pixel(poly[i]));
+        // Camera coordinates are a rotation of the world's: counter-clockwise
+        // seen from the eye (the origin) is a front face.
+        if (glm::dot(glm::cross(p[1] - p[0], p[2] - p[0]), p[0]) < 0) fill(q, n);
+    }
+
+private:
+    // Marks the pixels whose centres lie in the convex polygon q (edges included).
+    void fill(const glm::dvec2* q, int n) {
+        double vLo = q[0].y, vHi = q[0].y;
+        for (int i = 1; i < n; ++i) vLo = std::min(vLo, q[i].y), vHi = std::max(vHi, q[i].y);
+        const int y0 = int(std::max(0.0, std::ceil(vLo))), y1 = int(std::min(double(_h - 1), std::floor(vHi)));
+        for (int y = y0; y <= y1; ++y) {
+            double uL = 1e300, uR = -1e300;
+            for (int i = 0; i < n; ++i) {
+                const glm::dvec2 &s = q[i], &e = q[(i + 1) % n];
+                if (std::min(s.y, e.y) > y || std::max(s.y, e.y) < y) continue;
+                if (s.y == e.y) {
+                    uL = std::min(uL, std::min(s.x, e.x)), uR = std::max(uR, std::max(s.x, e.x));
+                    continue;
+                }
+                const double u = s.x + (double(y) - s.y) * (e.x - s.x) / (e.y - s.y);
+                uL = std::min(uL, u), uR = std::max(uR, u);
+            }
+            const int x0 = int(std::max(0.0, std::ceil(uL))), x1 = int(std::min(double(_w - 1), std::floor(uR)));
+            uint32_t* row = &_stamp[size_t(y) * size_t(_w)];
+            for (int x = x0; x <= x1; ++x)
+                if (row[x] != _mark) row[x] = _mark, ++covered;
+        }
+    }
+    const Projector& _pr;
+    int _w, _h;
+    std::vector<uint32_t>& _stamp;
+    uint32_t _mark;
+};
+
+// The share of `whole` outside `inside` (per axis, so a zero-width extent counts too).
+double truncation(const PixelBox& whole, const PixelBox& inside) {
+    if (!whole.valid()) return 0.0;
+    if (!inside.valid()) return 1.0;
+    auto share = [](double lo, double hi, double inLo, double inHi) {
+        return hi > lo ? (inHi - inLo) / (hi - lo) : 1.0;
+    };
+    const double f = share(whole.u0, whole.u1, inside.u0, inside.u1) * share(whole.v0, whole.v1, inside.v0, inside.v1);
+    return std::clamp(1.0 - f, 0.0, 1.0);
+}
+
+}  // namespace
+
+std::vector<FrameBox> frameBoxes(const SceneModel& city, const CityBoxes& boxes, const Camera& camera,
+                                 const std::vector<uint32_t>& ids, const FrameBoxOptions& options) {
+    const int W = camera.width, H = camera.height;
+    VISTA_CHECK(W > 0 && H > 0 && ids.size() == size_t(W) * size_t(H));
+    std::vector<FrameBox> out;
+    std::vector<const InstanceBox*> src;
+    for (const VisibleStats& s : visibleStats(ids, W, H)) {
+        const InstanceBox* ib = s.count >= options.minPixels ? boxes.find(s.id) : nullptr;
+        if (!ib) continue;
+        FrameBox f;
+        f.id = s.id;
+        f.box = ib->box;
+        f.visibleU0 = s.u0, f.visibleV0 = s.v0, f.visibleU1 = s.u1, f.visibleV1 = s.v1;
+        f.pixels = s.count;
+        out.push_back(f);
+        src.push_back(ib);
+    }
+    const Projector pr(camera);
+    tbb::enumerable_thread_specific<std::vector<uint32_t>> stamps(size_t(W) * size_t(H), 0xFFFFFFFFu);
+    inArena(options.threads, [&] {
+        tbb::parallel_for(size_t(0), out.size(), [&](size_t i) {
+            FrameBox& f = out[i];
+            MaskRaster r(pr, W, H, stamps.local(), uint32_t(i));
+            forEachTriangle(city, boxes, *src[i], [&](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+                r.triangle(a, b, c);
+            });
+            f.full = clipToImage(r.full, camera);
+            f.truncated = truncation(r.full, f.full);
+            f.boxExtent = clipToImage(projectedBox(camera, f.box), camera);
+            f.unoccludedPixels = r.covered;
+            f.visibleFraction = r.covered > 0 ? std::min(1.0, double(f.pixels) / double(r.covered)) : 1.0;
+        });
+    });
+    return out;
+}
+
+namespace {
+
+double round3(double v) { return std::round(v * 1000.0) / 1000.0; }
+
+nlohmann::json vec3Json(const glm::dvec3& v) { return {round3(v.x), round3(v.y), round3(v.z)}; }
+
+nlohmann::json pixelBoxJson(const PixelBox& b) {
+    if (!b.valid()) return nullptr;
+    return {round3(b.u0), round3(b.v0), round3(b.u1), round3(b.v1)};
+}
+
+double wrapTurn(double a) {  // into [-pi, pi]
+    while (a > kPi) a -= kTwoPi;
+    while (a < -kPi) a += kTwoPi;
+    return a;
+}
+
+// KITTI's rotation_y (about the camera's y axis, 0 = length axis along camera x) and alpha.
+struct CameraYaw {
+    double rotationY, alpha;
+};
+CameraYaw cameraYaw(const Camera& camera, const OrientedBox& box, const glm::dvec3& location) {
+    const glm::dvec3 h = box.lengthAxis();
+    const double ry = wrapTurn(std::atan2(-glm::dot(h, camera.forward()), glm::dot(h, camera.right())));
+    return {ry, wrapTurn(ry - std::atan2(location.x, location.z))};
+}
+
+glm::dvec3 bottomCenter(const OrientedBox& b) { return b.center - glm::dvec3(0.0, 0.0, 0.5 * b.size.z); }
+
+}  // namespace
+
+std::string frameBoxesJson(const std::vector<FrameBox>& boxes, const Camera& camera, const glm::dvec3& worldOffset) {
+    const PinholeIntrinsics k = pinholeIntrinsics(camera);
+    nlohmann::json list = nlohmann::json::array();
+    for (const FrameBox& f : boxes) {
+        const glm::dvec3 bottom = cameraPoint(camera, bottomCenter(f.box));
+        const CameraYaw cy = cameraYaw(camera, f.box, bottom);
+        list.push_back({{"id", f.id},
+                        {"kind", instanceKindName(instanceKind(f.id))},
+                        {"index", instanceIndex(f.id)},
+                        {"visible", {f.visibleU0, f.visibleV0, f.visibleU1, f.visibleV1}},
+                        {"pixels", f.pixels},
+                        {"full", pixelBoxJson(f.full)},
+                        {"box_extent", pixelBoxJson(f.boxExtent)},
+                        {"unoccluded_pixels", f.unoccludedPixels},
+                        {"visible_fraction", round3(f.visibleFraction)},
+                        {"truncated", round3(f.truncated)},
+                        {"box",
+                         {{"center", vec3Json(f.box.center - worldOffset)},
+                          {"size", vec3Json(f.box.size)},
+                          {"yaw", round3(f.box.yaw)}}},
+                        {"camera",
+                         {{"center", vec3Json(cameraPoint(camera, f.box.center))},
+                          {"bottom_center", vec3Json(bottom)},
+                          {"rotation_y", round3(cy.rotationY)},
+                          {"alpha", round3(cy.alpha)}}}});
+    }
+    const nlohmann::json doc = {{"format", "vista.boxes"},
+                                {"version", 1},
+                                {"width", camera.width},
+                                {"height", camera.height},
+                                {"fx", k.fx},
+                                {"fy", k.fy},
+                                {"cx", k.cx},
+                                {"cy", k.cy},
+                                {"z_near_m", camera.zNear},
+                                {"world_offset", {worldOffset.x, worldOffset.y, worldOffset.z}},
+                                {"boxes", list}};
+    return doc.dump(1) + "\n";
+}
+
+const char* kittiType(InstanceKind k) {
+    switch (k) {
+        case InstanceKind::Car: return "Car";
+        case InstanceKind::Building: return "Building";
+        case InstanceKind::Tree: return "Tree";
+        case InstanceKind::StreetLight: return "StreetLight";
+        case InstanceKind::TrafficLight: return "TrafficLight";
+        case InstanceKind::TrafficSign: return "TrafficSign";
+        default: return "DontCare";
+    }
+}
+
+std::string kittiLabels(const std::vector<FrameBox>& boxes, const Camera& camera) {
+    std::string out;
+    char line[512];
+    for (const FrameBox& f : boxes) {
+        const glm::dvec3 loc = cameraPoint(camera, bottomCenter(f.box));
+        const CameraYaw cy = cameraYaw(camera, f.box, loc);
+        const int occluded = f.visibleFraction >= 0.8 ? 0 : f.visibleFraction >= 0.4 ? 1 : 2;
+        std::snprintf(line, sizeof line, "%s %.2f %d %.2f %.2f %.2f %.2f %.2f %.2f %.2f %.2f %.2f %.2f %.2f %.2f\n",
+                      kittiType(instanceKind(f.id)), f.truncated, occluded, cy.alpha, double(f.visibleU0),
+                      double(f.visibleV0), double(f.visibleU1), double(f.visibleV1), f.box.size.z, f.box.size.y,
+                      f.box.size.x, loc.x, loc.y, loc.z, cy.rotationY);
+        out += line;
+    }
+    return out;
+}
+
+std::string kittiCalib(const Camera& camera, const LidarPose& lidar) {
+    const PinholeIntrinsics k = pinholeIntrinsics(camera);
+    Camera l;
+    l.heading = lidar.heading, l.pitch = lidar.pitch, l.roll = lidar.roll;
+    const glm::dvec3 camAxes[3] = {camera.right(), -camera.up(), camera.forward()};
+    const glm::dvec3 lidarAxes[3] = {l.forward(), -l.right(), l.up()};
+    const double P[12] = {k.fx, 0, k.cx, 0, 0, k.fy, k.cy, 0, 0, 0, 1, 0};
+    double tr[12];
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) tr[i * 4 + j] = glm::dot(camAxes[i], lidarAxes[j]);
+        tr[i * 4 + 3] = glm::dot(camAxes[i], lidar.position - camera.eye);
+    }
+    const double id3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, id34[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    std::string out;
+    auto row = [&](const char* name, const double* v, int n) {
+        out += name;
+        out += ':';
+        char buf[32];
+        for (int i = 0; i < n; ++i) {
+            std::snprintf(buf, sizeof buf, " %.12e", v[i]);
+            out += buf;
+        }
+        out += '\n';
+    };
+    for (const char* p : {"P0", "P1", "P2", "P3"}) row(p, P, 12);
+    row("R0_rect", id3, 9);
+    row("Tr_velo_to_cam", tr, 12);
+    row("Tr_imu_to_velo", id34, 12);
+    return out;
+}
+
+}  // namespace vista
