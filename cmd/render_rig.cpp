@@ -192,14 +192,10 @@ std::vector<nlohmann::json> finishedFrames(const RenderWorkDir& out, const RigPl
     return records;
 }
 
-// The time of camera k's next image after frame f, for its flow: its next
-// firing, else one period later (every-frame cameras: the next path sample).
+// The time camera k's flow at frame f looks ahead to (rig.h nextFiringTime).
 double nextShotTime(const RigPlan& p, const Path& path, size_t k, size_t f) {
-    for (size_t g = f + 1; g < p.idx.size(); ++g)
-        if (p.camFire[k][g] && p.times[g] > p.times[f]) return p.times[g];
-    const double rate = p.rig.cameras[k].rateHz;
-    if (rate > 0) return p.times[f] + 1.0 / rate;
-    return path.samples[std::min(p.idx[f] + 1, path.samples.size() - 1)].t;
+    const double sampleAfter = path.samples[std::min(p.idx[f] + 1, path.samples.size() - 1)].t;
+    return nextFiringTime(p.rig.cameras[k].rateHz, p.camFire[k], p.times, f, sampleAfter);
 }
 
 Status writeCamera(const RigCamera& c, size_t k, const std::string& name, const CameraImages& im,

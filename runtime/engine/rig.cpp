@@ -395,4 +395,11 @@ std::vector<uint8_t> firingFrames(double rateHz, const std::vector<double>& time
     return fire;
 }
 
+double nextFiringTime(double rateHz, const std::vector<uint8_t>& fires, const std::vector<double>& times, size_t f,
+                      double sampleAfter) {
+    for (size_t g = f + 1; g < times.size(); ++g)
+        if (fires[g] && times[g] > times[f]) return times[g];
+    return rateHz > 0 ? times[f] + 1.0 / rateHz : sampleAfter;
+}
+
 }  // namespace vista

@@ -122,5 +122,11 @@ LidarPose lidarPoseOf(const RigPose& pose);
 // Per frame: 1 where a sensor of rate `rateHz` (0 = every frame) fires, given
 // the frames' times (non-decreasing); see Firing above.
 std::vector<uint8_t> firingFrames(double rateHz, const std::vector<double>& frameTimes);
+// The time a camera's flow at frame f looks ahead to: its next firing at a
+// later time (`fires` = firingFrames()), else, after its last firing, one
+// period after frame f (rate 0: `sampleAfter`, the time of the path sample
+// after frame f's).
+double nextFiringTime(double rateHz, const std::vector<uint8_t>& fires, const std::vector<double>& frameTimes, size_t f,
+                      double sampleAfter);
 
 }  // namespace vista

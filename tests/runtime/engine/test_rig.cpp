@@ -149,6 +149,11 @@ TEST(Rig, SensorsFireAtTheirRates) {
     EXPECT_EQ(fast, std::vector<uint8_t>(10, 1));
     EXPECT_EQ(tenHz, (std::vector<uint8_t>{1, 0, 0, 1, 0, 0, 1, 0, 0, 1}));
     EXPECT_EQ(firingFrames(7, t), (std::vector<uint8_t>{1, 0, 0, 0, 0, 1, 0, 0, 0, 0}));
+    // Flow looks ahead to the next firing, after the last one to a period later.
+    EXPECT_EQ(nextFiringTime(10, tenHz, t, 0, 99), t[3]);
+    EXPECT_EQ(nextFiringTime(10, tenHz, t, 4, 99), t[6]);
+    EXPECT_NEAR(nextFiringTime(10, tenHz, t, 9, 99), t[9] + 0.1, 1e-12);
+    EXPECT_EQ(nextFiringTime(0, every, t, 9, 99), 99.0) << "every frame: the next path sample";
 }
 
 TEST(Rig, KittiCalibMapsLidarPointsToThePixelsOfThePoses) {
