@@ -36,6 +36,8 @@
 #include "cmd/cli.h"
 #include "cmd/commands.h"
 #include "cmd/options.h"
+#include "cmd/render_rig.h"
+#include "cmd/render_shared.h"
 #include "cmd/render_work_dir.h"
 #include "foundation/atomic_file.h"
 #include "foundation/hash.h"
@@ -64,7 +66,7 @@ const std::pair<unsigned, const char*> kChannelDirs[] = {
 
 struct RenderArgs {
     std::string city, size = "640x480", mode = "full", out, channels = "rgb,depth,semantic,instance";
-    std::string sampling = "spread";
+    std::string sampling = "spread", rig;
     int frames = 60;
     double fov = 60;
     bool stats = false, quiet = false, restart = false;
@@ -91,51 +93,6 @@ Result<unsigned> parseChannels(const std::string& s) {
         start = end + 1;
     }
     return out;
-}
-
-std::string frameName(size_t f) {
-    char b[24];  // up to 20 digits of a size_t
-    std::snprintf(b, sizeof b, "%06zu", f);
-    return b;
-}
-
-// A frame's eye may stand this far outside the city square (streets run up
-// to its border and a vehicle drives beside their centre line).
-constexpr double kPathMargin = 50.0;
-
-// World xy of every frame inside the city square (params.origin +- size/2) grown by kPathMargin.
-Status checkPathInCity(const Path& path, const std::vector<size_t>& idx, const SceneModel& city) {
-    const double half = 0.5 * city.params.size_m + kPathMargin;
-    for (size_t f = 0; f < idx.size(); ++f) {
-        const glm::dvec3& p = path.samples[idx[f]].position;
-        const double x = p.x - city.params.origin_x, y = p.y - city.params.origin_y;
-        if (!(std::abs(x) <= half && std::abs(y) <= half)) {
-            char b[256];
-            std::snprintf(b, sizeof b,
-                          "path sample %zu (frame %zu) at city-frame (%.1f, %.1f) m lies outside the city square (+ 50 "
-                          "m) [-%.0f, %.0f] m",
-                          idx[f], f, x, y, half, half);
-            return Status::error(b);
-        }
-    }
-    return Status::ok();
-}
-
-nlohmann::json classesJson() {
-    nlohmann::json classes = nlohmann::json::array();
-    for (int c = 0; c < kSemanticClassCount; ++c) {
-        uint8_t rgb[3];
-        semanticClassColor(SemanticClass(c), rgb);
-        classes.push_back(
-            {{"id", c}, {"name", semanticClassName(SemanticClass(c))}, {"color", {rgb[0], rgb[1], rgb[2]}}});
-    }
-    nlohmann::json kinds = nlohmann::json::array();
-    for (uint32_t k = 0; k < uint32_t(InstanceKind::Count); ++k)
-        kinds.push_back({{"kind", k}, {"name", instanceKindName(InstanceKind(k))}});
-    return {{"semantic_classes", classes},
-            {"semantic_unknown", 255},
-            {"instance_encoding", "id = kind << 28 | index (uint32); 0 = sky or terrain"},
-            {"instance_kinds", kinds}};
 }
 
 // OpenCV camera-from-world (x right, y down, z forward) relative to `offset`.
@@ -173,47 +130,6 @@ struct Timings {
     }
 };
 
-// Content hash of a file's bytes (hex), streamed.
-Result<std::string> fileHash(const std::string& path, uint64_t& bytes) {
-    std::FILE* f = std::fopen(path.c_str(), "rb");
-    if (!f) return Status::error("cannot read '" + path + "': " + errnoText());
-    Hasher64 h;
-    std::vector<unsigned char> buf(1 << 20);
-    bytes = 0;
-    size_t n;
-    while ((n = std::fread(buf.data(), 1, buf.size(), f)) > 0) {
-        h.update(buf.data(), n);
-        bytes += n;
-    }
-    const bool bad = std::ferror(f) != 0;
-    std::fclose(f);
-    if (bad) return Status::error("cannot read '" + path + "': read error");
-    return hex64(h.finish());
-}
-
-// Hash of the frames' camera poses (path index, time, eye, heading, pitch):
-// whatever chose them (--path file, --seed/--kind/--duration/--run-up,
-// --frames, --sampling), equal poses give equal frames.
-std::string posesHash(const Path& path, const std::vector<size_t>& idx) {
-    Hasher64 h;
-    auto put = [&](uint64_t v) {
-        unsigned char b[8];
-        storeLE64(b, v);
-        h.update(b, 8);
-    };
-    auto putD = [&](double d) {
-        uint64_t v;
-        std::memcpy(&v, &d, 8);
-        put(v);
-    };
-    for (size_t i : idx) {
-        const PathSample& s = path.samples[i];
-        put(i);
-        putD(s.t), putD(s.position.x), putD(s.position.y), putD(s.position.z), putD(s.heading), putD(s.pitch);
-    }
-    return hex64(h.finish());
-}
-
 std::string channelList(unsigned c) {
     std::string s;
     for (const auto& [bit, name] : {std::pair<unsigned, const char*>{kRgb, "rgb"},
@@ -222,23 +138,6 @@ std::string channelList(unsigned c) {
                                     {kInstance, "instance"}})
         if (c & bit) s += (s.empty() ? "" : ",") + std::string(name);
     return s;
-}
-
-std::string num(double v) {
-    char b[32];
-    std::snprintf(b, sizeof b, "%.17g", v);
-    return b;
-}
-
-// Test hook (docs/formats.md): VISTA_RENDER_KILL_AFTER_FRAMES=N makes the run
-// kill itself with SIGKILL after it finished N frames, as an interruption would.
-long killAfterFrames() {
-    const char* e = std::getenv("VISTA_RENDER_KILL_AFTER_FRAMES");
-    return e && *e ? std::atol(e) : 0;
-}
-
-nlohmann::json medianOf(const std::vector<double>& v) {
-    return v.empty() ? nlohmann::json(nullptr) : nlohmann::json(median(v));
 }
 
 // The parsed options of a run.
@@ -321,16 +220,16 @@ Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, c
                                      {"frames", idx.size()},
                                      {"camera_poses_hash", posesHash(path, idx)},
                                      {"size", std::to_string(p.size.width) + "x" + std::to_string(p.size.height)},
-                                     {"fov_deg", num(p.fovDeg)},
+                                     {"fov_deg", manifestNumber(p.fovDeg)},
                                      {"mode", a.mode},
                                      {"channels", channelList(p.channels)},
-                                     {"near", num(mo.nearDistance)},
+                                     {"near", manifestNumber(mo.nearDistance)},
                                      {"triangle_budget", mo.triangleBudget},
                                      {"pixel_budget", mo.pixelBudget},
                                      {"horizon_grid", mo.horizonGrid},
                                      {"cache", mo.cache},
-                                     {"cache_error_px", num(mo.cacheErrorPx)},
-                                     {"frame_ms", num(mo.frameMsTarget)},
+                                     {"cache_error_px", manifestNumber(mo.cacheErrorPx)},
+                                     {"frame_ms", manifestNumber(mo.frameMsTarget)},
                                      {"far_step", mo.farStep}};
     VISTA_RETURN_IF_ERROR(out.open(manifest, a.restart));
     for (const auto& [bit, dir] : kChannelDirs)
@@ -639,6 +538,10 @@ int runRender(int argc, char** argv) {
         "--mode", a.mode,
         "render mode: full (every triangle rasterised) or hybrid (near field + ray-cast far field) (default full)");
     app.add_option("--channels", a.channels, "comma-separated channels: rgb, depth, semantic, instance (default all)");
+    app.add_option("--rig", a.rig,
+                   "sensor rig file (JSON: cameras, fisheyes, LiDARs, each with its pose, rate and channels; "
+                   "docs/formats.md): every sensor is ray cast and written KITTI-style; replaces --size, --fov, "
+                   "--mode and --channels");
     addModeFlags(app, a.modeFlags);
     app.add_option("--out", a.out,
                    "output directory (must not exist or be empty; its parent must exist); work goes into "
@@ -646,11 +549,25 @@ int runRender(int argc, char** argv) {
         ->required();
     app.add_flag("--restart", a.restart,
                  "discard the work directory (OUT.partial) of an interrupted run and start over");
-    app.add_flag("--stats", a.stats, "print the median per-channel costs (also in OUT/summary.json)");
+    app.add_flag("--stats", a.stats,
+                 "print the median per-channel costs (with --rig: per-sensor ms and rig frames per second, on "
+                 "stderr; also in OUT/summary.json)");
     app.add_flag("-q,--quiet", a.quiet, "no progress on stderr");
     if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;
     std::string command = kCmd;
     for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
+    if (!a.rig.empty()) {
+        for (const char* flag : {"--size", "--fov", "--mode", "--channels"})
+            if (app.count(flag))
+                return reportBadInput(
+                    kCmd, Status::error(std::string(flag) + " does not apply with --rig: the rig file gives each "
+                                                            "sensor's model, size and channels"));
+        RigRunRequest r;
+        r.city = a.city, r.rig = a.rig, r.out = a.out, r.command = command, r.sampling = a.sampling;
+        r.frames = a.frames, r.stats = a.stats, r.quiet = a.quiet, r.restart = a.restart;
+        r.path = a.path, r.modeFlags = a.modeFlags;
+        return runRigRender(r);
+    }
     return run(a, command);
 }
 

@@ -5,7 +5,7 @@
 // and bad input (path outside the city, unknown channel, unwritable --out)
 // refused with exit code 2 and nothing left behind; interrupted runs (killed
 // with SIGKILL) resume to the bytes of an uninterrupted run (full; hybrid with
-// its cache rebuilt), a work directory of other parameters is refused (exit 2,
+// its cache rebuilt; a sensor rig), a work directory of other parameters is refused (exit 2,
 // the field named) or discarded with --restart. Rendering: needs DISPLAY
 // (ctest runs under xvfb-run).
 #include <gtest/gtest.h>
@@ -336,7 +336,12 @@ void expectResumeEqualsUninterrupted(const std::string& city, const std::string&
     const auto summary = nlohmann::json::parse(test::readBytes(out + "/summary.json"));
     EXPECT_EQ(summary["frames"].get<int>(), frames);
     EXPECT_EQ(summary["frames_resumed"].get<int>(), killAfter);
-    EXPECT_FALSE(summary["median_ms"]["labels_total"].is_null()) << "timings cover the resumed frames too";
+    if (summary.contains("median_ms")) {
+        EXPECT_FALSE(summary["median_ms"]["labels_total"].is_null()) << "timings cover the resumed frames too";
+    } else {  // a rig run: every sensor's timings
+        for (const auto& [name, sensor] : summary["sensors"].items())
+            EXPECT_FALSE(sensor["median_ms"].is_null()) << name << ": timings cover the resumed frames too";
+    }
 }
 
 TEST_F(GroundTruth, FullResumesAfterKillByteIdentical) {
@@ -352,6 +357,21 @@ TEST_F(GroundTruth, HybridResumesAfterKillByteIdentical) {
         city,
         "--path " + pathCsv + " --frames 5 --sampling consecutive --size 160x120 --mode hybrid --near 40 --budget 500",
         dir->file("res_hyb_ref"), dir->file("res_hyb"), 3, 5);
+}
+
+TEST_F(GroundTruth, RigResumesAfterKillByteIdentical) {
+    // A rig (pinhole with flow, fisheye, LiDAR at its own rate): the sensors
+    // that fired in the killed run's frames are kept, the rest cast again.
+    const std::string rig = dir->file("resume_rig.json");
+    std::ofstream(rig) << R"({"sensors": [
+        {"name": "front", "type": "pinhole", "rate_hz": 15, "intrinsics": {"width": 64, "height": 48, "fx": 50,
+         "fy": 50, "cx": 31.5, "cy": 23.5}, "channels": ["rgb", "depth", "semantic", "instance", "flow"]},
+        {"name": "side", "type": "fisheye", "pose": {"yaw_deg": 90}, "intrinsics": {"width": 48, "height": 48,
+         "fx": 15, "fy": 15, "cx": 23.5, "cy": 23.5, "max_fov_deg": 180}, "channels": ["rgb", "depth", "flow"]},
+        {"name": "top", "type": "lidar", "pose": {"z": 0.5}, "beams": {"count": 8, "min_deg": -15, "max_deg": 5},
+         "columns": 180}]})";
+    expectResumeEqualsUninterrupted(city, "--path " + pathCsv + " --frames 6 --sampling consecutive --rig " + rig,
+                                    dir->file("res_rig_ref"), dir->file("res_rig"), 4, 6);
 }
 
 TEST_F(GroundTruth, ExternalKillThenResume) {

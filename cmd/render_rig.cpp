@@ -1,0 +1,453 @@
+// `vista render --rig` (render_rig.h): options and rig file, city and path,
+// work directory, the frames (every sensor that fires, cast and written),
+// then rig.json, calib.txt, times.txt, classes.json and summary.json.
+#include "cmd/render_rig.h"
+
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <numeric>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cmd/cli.h"
+#include "cmd/render_shared.h"
+#include "cmd/render_work_dir.h"
+#include "foundation/atomic_file.h"
+#include "foundation/format.h"
+#include "foundation/hash.h"
+#include "foundation/progress.h"
+#include "foundation/statistics.h"
+#include "foundation/timing.h"
+#include "nodes/render/walkthrough.h"
+#include "runtime/engine/ground_truth.h"
+#include "runtime/engine/lidar.h"
+#include "runtime/engine/ray_scene.h"
+#include "runtime/engine/rig.h"
+#include "runtime/engine/rig_camera.h"
+#include "runtime/engine/rig_dataset.h"
+
+namespace vista {
+
+namespace {
+
+namespace fs = std::filesystem;
+const char* const kCmd = "vista render";
+
+// The output folders of camera k's channels and LiDAR j's files.
+std::string twoDigits(size_t k) {
+    char b[24];
+    std::snprintf(b, sizeof b, "%02zu", k);
+    return b;
+}
+struct CameraDirs {
+    std::string rgb, depth, semantic, instance, flow;
+};
+CameraDirs cameraDirs(size_t k) {
+    const std::string n = twoDigits(k);
+    return {"image_" + n, "depth_" + n, "semantic_" + n, "instance_" + n, "flow_" + n};
+}
+struct LidarDirs {
+    std::string points, labels, instances;
+};
+LidarDirs lidarDirs(size_t j) {
+    const std::string s = j == 0 ? std::string() : "_" + std::to_string(j);
+    return {"velodyne" + s, "labels" + s, "lidar_instance" + s};
+}
+
+// The files a sensor writes when it fires at frame `name` (paths under out/).
+std::vector<std::string> cameraFiles(const RigCamera& c, size_t k, const std::string& name) {
+    const CameraDirs d = cameraDirs(k);
+    std::vector<std::string> f;
+    if (c.channels & kRigRgb) f.push_back(d.rgb + "/" + name + ".png");
+    if (c.channels & kRigDepth) f.push_back(d.depth + "/" + name + ".npy");
+    if (c.channels & kRigSemantic) f.push_back(d.semantic + "/" + name + ".png");
+    if (c.channels & kRigInstance) f.push_back(d.instance + "/" + name + ".npy");
+    if (c.channels & kRigFlow) f.push_back(d.flow + "/" + name + ".flo");
+    return f;
+}
+std::vector<std::string> lidarFiles(size_t j, const std::string& name) {
+    const LidarDirs d = lidarDirs(j);
+    return {d.points + "/" + name + ".bin", d.labels + "/" + name + ".label", d.instances + "/" + name + ".bin"};
+}
+
+// The parsed run: rig, path options, frames and who fires when.
+struct RigPlan {
+    Rig rig;
+    PathOptions path;
+    ModeOptions options;
+    int sampleRuns = 0;
+    std::vector<size_t> idx;                               // path sample of every frame
+    std::vector<double> times;                             // its time
+    std::vector<std::vector<uint8_t>> camFire, lidarFire;  // per sensor, per frame
+    bool needsLabels() const {
+        if (!rig.lidars.empty()) return true;
+        for (const RigCamera& c : rig.cameras)
+            if (c.channels & (kRigSemantic | kRigInstance)) return true;
+        return false;
+    }
+};
+
+Status configure(const RigRunRequest& a, RigPlan& p) {
+    if (a.frames < 1 || a.frames > 1000000)
+        return Status::error("--frames " + std::to_string(a.frames) + " out of range 1 .. 1000000");
+    auto sampling = parseSampling(a.sampling);
+    if (!sampling) return sampling.status();
+    p.sampleRuns = *sampling;
+    VISTA_RETURN_IF_ERROR(parseModeFlags(a.modeFlags, p.options));
+    auto po = parsePathFlags(a.path);
+    if (!po) return po.status();
+    p.path = *po;
+    auto rig = loadRigFile(a.rig);
+    if (!rig) return Status::error("--rig: " + rig.status().message());
+    p.rig = std::move(*rig);
+    if (!fs::exists(a.city)) return Status::error("city file '" + a.city + "' does not exist");
+    return checkRunFiles(CommandFiles().output("--out", a.out).input("--rig", a.rig), a.city, a.path, a.modeFlags);
+}
+
+Result<Walkthrough> loadCityAndFrames(const RigRunRequest& a, RigPlan& p) {
+    WalkthroughRequest req;
+    req.city = a.city;
+    req.cmd = kCmd;
+    req.quiet = true;
+    req.allowPaged = false;
+    req.pathNeedsStreets = a.path.file.empty();
+    req.checkCity = [&](const SceneModel& city) {
+        if (p.needsLabels() && !city.labelled)
+            return Status::error("city file '" + a.city +
+                                 "' has no ground-truth labels (written by an older vista): regenerate the city "
+                                 "with this version (`vista gen`) for LiDAR labels and the semantic and instance "
+                                 "channels");
+        return Status::ok();
+    };
+    req.makePath = [&](const SceneModel& city) -> Result<Path> {
+        auto path = walkthroughPath(a.path.file, p.path, city);
+        if (!path) return path;
+        if (path->samples.empty()) return Status::error("the walkthrough path has no samples");
+        p.idx = path->frames(size_t(a.frames), p.sampleRuns);
+        VISTA_RETURN_IF_ERROR(checkPathInCity(*path, p.idx, city));
+        return path;
+    };
+    req.effects = [](const Effects& declared) { return runTimeEffects(std::nullopt, declared, true, kCmd); };
+    auto w = loadWalkthrough(req, p.options);
+    if (!w) return w;
+    for (size_t i : p.idx) p.times.push_back(w->path.samples[i].t);
+    for (const RigCamera& c : p.rig.cameras) p.camFire.push_back(firingFrames(c.rateHz, p.times));
+    for (const RigLidar& l : p.rig.lidars) p.lidarFire.push_back(firingFrames(l.rateHz, p.times));
+    return w;
+}
+
+// Hash of the rig's canonical form (every field that changes an output byte).
+std::string rigHash(const Rig& rig) {
+    const std::string text = rigToJson(rig);
+    Hasher64 h;
+    h.update(reinterpret_cast<const unsigned char*>(text.data()), text.size());
+    return hex64(h.finish());
+}
+
+Status openWorkDir(const RigRunRequest& a, const RigPlan& p, const Path& path, RenderWorkDir& out) {
+    uint64_t cityBytes = 0;
+    auto cityHash = fileHash(a.city, cityBytes);
+    if (!cityHash) return cityHash.status();
+    const nlohmann::json manifest = {{"kind", "rig"},
+                                     {"city_hash", *cityHash},
+                                     {"city_bytes", cityBytes},
+                                     {"frames", p.idx.size()},
+                                     {"camera_poses_hash", posesHash(path, p.idx)},
+                                     {"rig_hash", rigHash(p.rig)}};
+    VISTA_RETURN_IF_ERROR(out.open(manifest, a.restart));
+    for (size_t k = 0; k < p.rig.cameras.size(); ++k)
+        for (const std::string& f : cameraFiles(p.rig.cameras[k], k, "x"))
+            VISTA_RETURN_IF_ERROR(out.subdir(fs::path(f).parent_path().string()));
+    for (size_t j = 0; j < p.rig.lidars.size(); ++j)
+        for (const std::string& f : lidarFiles(j, "x"))
+            VISTA_RETURN_IF_ERROR(out.subdir(fs::path(f).parent_path().string()));
+    return Status::ok();
+}
+
+// Frames an interrupted run finished: their record and every file of the sensors that fired.
+std::vector<nlohmann::json> finishedFrames(const RenderWorkDir& out, const RigPlan& p, size_t& kept) {
+    std::vector<nlohmann::json> records(p.idx.size());
+    kept = 0;
+    if (!out.resumed()) return records;
+    for (size_t f = 0; f < records.size(); ++f) {
+        records[f] = out.frameRecord(f);
+        if (records[f].is_null()) continue;
+        std::vector<std::string> files;
+        const std::string name = frameName(f);
+        for (size_t k = 0; k < p.rig.cameras.size(); ++k)
+            if (p.camFire[k][f])
+                for (auto& s : cameraFiles(p.rig.cameras[k], k, name)) files.push_back(s);
+        for (size_t j = 0; j < p.rig.lidars.size(); ++j)
+            if (p.lidarFire[j][f])
+                for (auto& s : lidarFiles(j, name)) files.push_back(s);
+        for (const std::string& s : files)
+            if (!fs::exists(out.file(s))) records[f] = nullptr;
+        kept += records[f].is_null() ? 0 : 1;
+    }
+    return records;
+}
+
+// The time camera k's flow at frame f looks ahead to (rig.h nextFiringTime).
+double nextShotTime(const RigPlan& p, const Path& path, size_t k, size_t f) {
+    const double sampleAfter = path.samples[std::min(p.idx[f] + 1, path.samples.size() - 1)].t;
+    return nextFiringTime(p.rig.cameras[k].rateHz, p.camFire[k], p.times, f, sampleAfter);
+}
+
+Status writeCamera(const RigCamera& c, size_t k, const std::string& name, const CameraImages& im,
+                   const RenderWorkDir& out) {
+    const std::vector<std::string> files = cameraFiles(c, k, name);
+    size_t i = 0;
+    if (c.channels & kRigRgb) VISTA_RETURN_IF_ERROR(writePngRgb(im.rgb, out.file(files[i++])));
+    if (c.channels & kRigDepth)
+        VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(files[i++]), npyBytes(im.depth.data(), im.width, im.height)));
+    if (c.channels & kRigSemantic)
+        VISTA_RETURN_IF_ERROR(writePngGray8(im.classes, im.width, im.height, out.file(files[i++])));
+    if (c.channels & kRigInstance)
+        VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(files[i++]), npyBytes(im.ids.data(), im.width, im.height)));
+    if (c.channels & kRigFlow)
+        VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(files[i++]), floBytes(im.flow.data(), im.width, im.height)));
+    return Status::ok();
+}
+
+Status writeLidar(const LidarSweep& s, size_t j, const std::string& name, const RenderWorkDir& out) {
+    const std::vector<std::string> files = lidarFiles(j, name);
+    VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(files[0]), velodyneBytes(s)));
+    VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(files[1]), lidarLabelBytes(s)));
+    return writeFileAtomic(out.file(files[2]), lidarInstanceBytes(s));
+}
+
+// One rig frame: every sensor that fires, cast and written (each timed,
+// cast and write together, into the record).
+Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_t f, const RenderWorkDir& out,
+                   CameraImages& im, nlohmann::json& record) {
+    const Path& path = w.path;
+    const RigPose vehicle = vehiclePose(path.samples[p.idx[f]]);
+    // Ray origins near the scene's frame origin: float precision anywhere in the city.
+    VISTA_RETURN_IF_ERROR(rays.placeFrameNear(vehicle.position));
+    const std::string name = frameName(f);
+    const int threads = p.options.threads;
+    nlohmann::json ms = nlohmann::json::object(), lidar = nlohmann::json::object();
+    Stopwatch frame;
+    for (size_t k = 0; k < p.rig.cameras.size(); ++k) {
+        if (!p.camFire[k][f]) continue;
+        Stopwatch sw;
+        const RigCamera& c = p.rig.cameras[k];
+        CameraShot shot;
+        shot.model = c.model;
+        shot.pose = sensorPose(vehicle, c.mount);
+        shot.channels = c.channels;
+        shot.fx = &p.options.effects;
+        if (c.channels & kRigFlow) shot.next = sensorPose(vehiclePoseAt(path, nextShotTime(p, path, k, f)), c.mount);
+        castRigCamera(w.city, rays, shot, im, threads);
+        VISTA_RETURN_IF_ERROR(writeCamera(c, k, name, im, out));
+        ms[c.name] = sw.ms();
+    }
+    for (size_t j = 0; j < p.rig.lidars.size(); ++j) {
+        if (!p.lidarFire[j][f]) continue;
+        Stopwatch sw;
+        const RigLidar& l = p.rig.lidars[j];
+        const LidarPoseAt poseAt = [&](double t) { return lidarPoseOf(sensorPose(vehiclePoseAt(path, t), l.mount)); };
+        const LidarSweep sweep = castLidarSweep(w.city, rays, l.spec, poseAt, p.times[f], threads);
+        VISTA_RETURN_IF_ERROR(writeLidar(sweep, j, name, out));
+        ms[l.name] = sw.ms();
+        lidar[l.name] = {{"points", sweep.points.size()}, {"misses", sweep.misses}};
+    }
+    record = {{"frame_ms", frame.ms()}, {"sensor_ms", ms}, {"lidar", lidar}};
+    return Status::ok();
+}
+
+Status renderFrames(const RigRunRequest& a, const RigPlan& p, const Walkthrough& w, RayScene& rays, RenderWorkDir& out,
+                    std::vector<nlohmann::json>& records, size_t kept) {
+    std::unique_ptr<Progress> progress;
+    if (!a.quiet) progress = std::make_unique<StderrProgress>(isatty(2));
+    const long killAfter = killAfterFrames();
+    long finishedNow = 0;
+    const size_t n = p.idx.size();
+    if (progress)
+        progress->begin("render " + std::to_string(n) + " rig frames (" +
+                        std::to_string(p.rig.cameras.size() + p.rig.lidars.size()) + " sensors)" +
+                        (kept ? ", resuming: " + std::to_string(kept) + " done" : std::string()));
+    CameraImages im;
+    for (size_t f = 0; f < n; ++f) {
+        if (!records[f].is_null()) continue;
+        if (Status s = renderFrame(p, w, rays, f, out, im, records[f]); !s)
+            return Status::error("frame " + std::to_string(f) + ": " + s.message());
+        VISTA_RETURN_IF_ERROR(out.finishFrame(f, records[f]));
+        if (killAfter > 0 && ++finishedNow == killAfter) std::raise(SIGKILL);
+        if (progress) progress->update(double(f + 1) / double(n));
+    }
+    if (progress) progress->end();
+    return Status::ok();
+}
+
+nlohmann::json matrixJson(const RowMajor4& m) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const auto& row : m) j.push_back({row[0], row[1], row[2], row[3]});
+    return j;
+}
+
+// rig.json: the rig, the conventions, and per frame the vehicle's pose and
+// the pose of every sensor that fired (a LiDAR: at its sweep's start).
+nlohmann::json rigManifest(const RigPlan& p, const Walkthrough& w) {
+    const glm::dvec3 offset(w.city.params.origin_x, w.city.params.origin_y, 0.0);
+    nlohmann::json sensors = nlohmann::json::array();
+    const nlohmann::json rig = nlohmann::json::parse(rigToJson(p.rig));
+    for (size_t k = 0; k < p.rig.cameras.size(); ++k) {
+        const CameraDirs d = cameraDirs(k);
+        const RigCamera& c = p.rig.cameras[k];
+        sensors.push_back({{"name", c.name},
+                           {"index", k},
+                           {"dirs",
+                            {{"rgb", d.rgb},
+                             {"depth", d.depth},
+                             {"semantic", d.semantic},
+                             {"instance", d.instance},
+                             {"flow", d.flow}}},
+                           {"channels", rigChannelList(c.channels)},
+                           {"sensor_to_vehicle",
+                            matrixJson(poseToWorld({c.mount.position, mountRotation(c.mount)}, glm::dvec3(0.0)))}});
+    }
+    for (size_t j = 0; j < p.rig.lidars.size(); ++j) {
+        const LidarDirs d = lidarDirs(j);
+        const RigLidar& l = p.rig.lidars[j];
+        sensors.push_back({{"name", l.name},
+                           {"index", j},
+                           {"dirs", {{"points", d.points}, {"labels", d.labels}, {"instances", d.instances}}},
+                           {"sensor_to_vehicle",
+                            matrixJson(poseToWorld({l.mount.position, mountRotation(l.mount)}, glm::dvec3(0.0)))}});
+    }
+    nlohmann::json frames = nlohmann::json::array();
+    for (size_t f = 0; f < p.idx.size(); ++f) {
+        const RigPose v = vehiclePose(w.path.samples[p.idx[f]]);
+        nlohmann::json fired = nlohmann::json::object();
+        for (size_t k = 0; k < p.rig.cameras.size(); ++k)
+            if (p.camFire[k][f])
+                fired[p.rig.cameras[k].name] = {
+                    {"camera_to_world", matrixJson(cameraToWorld(sensorPose(v, p.rig.cameras[k].mount), offset))}};
+        for (size_t j = 0; j < p.rig.lidars.size(); ++j)
+            if (p.lidarFire[j][f])
+                fired[p.rig.lidars[j].name] = {{"sensor_to_world_at_start",
+                                                matrixJson(poseToWorld(sensorPose(v, p.rig.lidars[j].mount), offset))}};
+        frames.push_back({{"frame", f},
+                          {"name", frameName(f)},
+                          {"path_index", p.idx[f]},
+                          {"t_s", p.times[f]},
+                          {"vehicle_to_world", matrixJson(poseToWorld(v, offset))},
+                          {"sensors", fired}});
+    }
+    return {{"format", "vista rig run 1"},
+            {"conventions",
+             "world: metres, x east, y north, z up, minus world_offset; vehicle and sensor frames: x forward, y left, "
+             "z up; camera_to_world maps the OpenCV camera frame (x right, y down, z forward); matrices 4x4 "
+             "row-major"},
+            {"world_offset", {offset.x, offset.y, offset.z}},
+            {"rig", rig},
+            {"sensors", sensors},
+            {"frames", frames}};
+}
+
+// summary.json: per sensor its firings, median and mean ms (cast and write),
+// LiDAR points and misses; rig frames per second over every frame's wall time.
+nlohmann::json rigSummary(const RigRunRequest& a, const RigPlan& p, const std::vector<nlohmann::json>& records,
+                          size_t kept) {
+    nlohmann::json sensors = nlohmann::json::object();
+    double totalMs = 0;
+    for (const auto& r : records)
+        if (r.contains("frame_ms") && r["frame_ms"].is_number()) totalMs += r["frame_ms"].get<double>();
+    for (const std::string& name : p.rig.order) {
+        std::vector<double> ms;
+        uint64_t points = 0, misses = 0;
+        for (const auto& r : records) {
+            if (r.contains("sensor_ms") && r["sensor_ms"].contains(name))
+                ms.push_back(r["sensor_ms"][name].get<double>());
+            if (r.contains("lidar") && r["lidar"].contains(name)) {
+                points += r["lidar"][name]["points"].get<uint64_t>();
+                misses += r["lidar"][name]["misses"].get<uint64_t>();
+            }
+        }
+        nlohmann::json s = {
+            {"firings", ms.size()},
+            {"median_ms", medianOf(ms)},
+            {"mean_ms", ms.empty() ? nlohmann::json(nullptr)
+                                   : nlohmann::json(std::accumulate(ms.begin(), ms.end(), 0.0) / double(ms.size()))}};
+        bool isLidar = false;
+        for (const RigLidar& l : p.rig.lidars) isLidar = isLidar || l.name == name;
+        if (isLidar) s["points"] = points, s["misses"] = misses;
+        sensors[name] = s;
+    }
+    return {{"command", a.command},
+            {"kind", "rig"},
+            {"frames", p.idx.size()},
+            {"frames_resumed", kept},
+            {"rig_frames_per_second",
+             totalMs > 0 ? nlohmann::json(double(records.size()) * 1000.0 / totalMs) : nlohmann::json(nullptr)},
+            {"sensors", sensors},
+            {"note",
+             "per sensor: ray casting and writing its files, in ms per firing; rig_frames_per_second: frames divided "
+             "by the sum of every frame's wall time, each timed by the run that rendered it (frames_resumed: frames "
+             "an interrupted run had finished)"}};
+}
+
+Status writeMetadata(const RigRunRequest& a, const RigPlan& p, const Walkthrough& w,
+                     const std::vector<nlohmann::json>& records, size_t kept, RenderWorkDir& out,
+                     nlohmann::json& summary) {
+    VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file("rig.json"), rigManifest(p, w).dump(2) + "\n"));
+    const std::string calib = kittiCalib(p.rig);
+    if (!calib.empty()) VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file("calib.txt"), calib));
+    std::string times;
+    for (double t : p.times) {
+        char b[40];
+        std::snprintf(b, sizeof b, "%.6e\n", t - p.times.front());
+        times += b;
+    }
+    VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file("times.txt"), times));
+    VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file("classes.json"), classesJson().dump(2) + "\n"));
+    summary = rigSummary(a, p, records, kept);
+    VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file("summary.json"), summary.dump(2) + "\n"));
+    return out.commit();
+}
+
+void printStats(const RigRunRequest& a, const RigPlan& p, const nlohmann::json& summary, const RenderWorkDir& out) {
+    if (!a.quiet || a.stats)
+        std::printf("%s: %zu rig frames, %zu sensors -> %s\n", kCmd, p.idx.size(), p.rig.order.size(),
+                    out.outPath().c_str());
+    if (!a.stats) return;
+    for (const std::string& name : p.rig.order) {
+        const auto& s = summary["sensors"][name];
+        if (s["median_ms"].is_null()) continue;
+        std::fprintf(stderr, "  %-24s %8.2f ms median, %8.2f ms mean over %d firings\n", name.c_str(),
+                     s["median_ms"].get<double>(), s["mean_ms"].get<double>(), s["firings"].get<int>());
+    }
+    if (!summary["rig_frames_per_second"].is_null())
+        std::fprintf(stderr, "  %-24s %8.3f\n", "rig frames per second",
+                     summary["rig_frames_per_second"].get<double>());
+}
+
+}  // namespace
+
+int runRigRender(const RigRunRequest& a) {
+    RigPlan plan;
+    if (Status s = configure(a, plan); !s) return reportBadInput(kCmd, s);
+    RenderWorkDir out;
+    if (Status s = out.checkOut(a.out); !s) return reportBadInput(kCmd, s);
+    auto walk = loadCityAndFrames(a, plan);
+    if (!walk) return reportBadInput(kCmd, walk.status());
+    auto rays = RayScene::build(walk->city);
+    if (!rays)
+        return reportBadInput(kCmd, Status::error("building the Embree ray scene failed: " + rays.status().message()));
+    if (Status s = openWorkDir(a, plan, walk->path, out); !s) return reportBadInput(kCmd, s);
+    size_t kept = 0;
+    std::vector<nlohmann::json> records = finishedFrames(out, plan, kept);
+    if (Status s = renderFrames(a, plan, *walk, **rays, out, records, kept); !s) return reportBadInput(kCmd, s);
+    nlohmann::json summary;
+    if (Status s = writeMetadata(a, plan, *walk, records, kept, out, summary); !s) return reportBadInput(kCmd, s);
+    printStats(a, plan, summary, out);
+    return 0;
+}
+
+}  // namespace vista

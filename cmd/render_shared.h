@@ -1,0 +1,40 @@
+// Pieces both kinds of `vista render` run share (one camera: cmd_render.cpp;
+// a sensor rig: render_rig.cpp): the frames' names, the path check, the
+// hashes of the work directory's manifest, classes.json, the kill hook.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "foundation/status.h"
+#include "runtime/scene/paths.h"
+#include "runtime/scene/scene_model.h"
+
+namespace vista {
+
+// "000042": the name of frame 42's files.
+std::string frameName(size_t f);
+// A frame's eye may stand this far outside the city square (streets run up
+// to its border and a vehicle drives beside their centre line).
+constexpr double kPathMargin = 50.0;
+// World xy of every frame inside the city square (params.origin +- size/2) grown by kPathMargin.
+Status checkPathInCity(const Path& path, const std::vector<size_t>& idx, const SceneModel& city);
+// The class table and the instance encoding (classes.json).
+nlohmann::json classesJson();
+// Content hash of a file's bytes (hex), streamed; `bytes` receives its size.
+Result<std::string> fileHash(const std::string& path, uint64_t& bytes);
+// Hash of the frames' poses (path index, time, eye, heading, pitch):
+// whatever chose them, equal poses give equal frames.
+std::string posesHash(const Path& path, const std::vector<size_t>& idx);
+// A double as the manifest writes it (17 significant digits).
+std::string manifestNumber(double v);
+// Test hook (docs/formats.md): VISTA_RENDER_KILL_AFTER_FRAMES=N makes the run
+// kill itself with SIGKILL after it finished N frames, as an interruption would.
+long killAfterFrames();
+// The median of `v`, null when empty.
+nlohmann::json medianOf(const std::vector<double>& v);
+
+}  // namespace vista
