@@ -445,9 +445,9 @@ nlohmann::json rigSummary(const RigRunRequest& a, const RigPlan& p, const std::v
              totalMs > 0 ? nlohmann::json(double(records.size()) * 1000.0 / totalMs) : nlohmann::json(nullptr)},
             {"sensors", sensors},
             {"note",
-             "per sensor: ray casting and writing its files, in ms per firing; rig_frames_per_second: frames divided "
-             "by the sum of every frame's wall time, each timed by the run that rendered it (frames_resumed: frames "
-             "an interrupted run had finished)"}};
+             "per sensor: ray casting, its boxes and writing its files, in ms per firing; rig_frames_per_second: "
+             "frames divided by the sum of every frame's wall time, each timed by the run that rendered it "
+             "(frames_resumed: frames an interrupted run had finished)"}};
 }
 
 Status writeMetadata(const RigRunRequest& a, const RigPlan& p, const Walkthrough& w,
