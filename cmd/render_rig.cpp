@@ -5,6 +5,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -24,10 +25,12 @@
 #include "foundation/statistics.h"
 #include "foundation/timing.h"
 #include "nodes/render/walkthrough.h"
+#include "runtime/engine/boxes.h"
 #include "runtime/engine/ground_truth.h"
 #include "runtime/engine/lidar.h"
 #include "runtime/engine/ray_scene.h"
 #include "runtime/engine/rig.h"
+#include "runtime/engine/rig_boxes.h"
 #include "runtime/engine/rig_camera.h"
 #include "runtime/engine/rig_dataset.h"
 
@@ -45,12 +48,13 @@ std::string twoDigits(size_t k) {
     return b;
 }
 struct CameraDirs {
-    std::string rgb, depth, semantic, instance, flow;
+    std::string rgb, depth, semantic, instance, flow, boxes, labels;
 };
 CameraDirs cameraDirs(size_t k) {
     const std::string n = twoDigits(k);
-    return {"image_" + n, "depth_" + n, "semantic_" + n, "instance_" + n, "flow_" + n};
+    return {"image_" + n, "depth_" + n, "semantic_" + n, "instance_" + n, "flow_" + n, "boxes_" + n, "label_" + n};
 }
+const char* const kBoxes3dDir = "boxes_3d";
 struct LidarDirs {
     std::string points, labels, instances;
 };
@@ -68,6 +72,8 @@ std::vector<std::string> cameraFiles(const RigCamera& c, size_t k, const std::st
     if (c.channels & kRigSemantic) f.push_back(d.semantic + "/" + name + ".png");
     if (c.channels & kRigInstance) f.push_back(d.instance + "/" + name + ".npy");
     if (c.channels & kRigFlow) f.push_back(d.flow + "/" + name + ".flo");
+    if (c.channels & kRigBoxes) f.push_back(d.boxes + "/" + name + ".json");
+    if ((c.channels & kRigBoxes) && !c.model.fisheye()) f.push_back(d.labels + "/" + name + ".txt");
     return f;
 }
 std::vector<std::string> lidarFiles(size_t j, const std::string& name) {
@@ -87,7 +93,13 @@ struct RigPlan {
     bool needsLabels() const {
         if (!rig.lidars.empty()) return true;
         for (const RigCamera& c : rig.cameras)
-            if (c.channels & (kRigSemantic | kRigInstance)) return true;
+            if (c.channels & (kRigSemantic | kRigInstance | kRigBoxes)) return true;
+        return false;
+    }
+    // A camera asks for boxes: the run writes boxes_3d/ for every frame.
+    bool hasBoxes() const {
+        for (const RigCamera& c : rig.cameras)
+            if (c.channels & kRigBoxes) return true;
         return false;
     }
 };
@@ -120,8 +132,8 @@ Result<Walkthrough> loadCityAndFrames(const RigRunRequest& a, RigPlan& p) {
         if (p.needsLabels() && !city.labelled)
             return Status::error("city file '" + a.city +
                                  "' has no ground-truth labels (written by an older vista): regenerate the city "
-                                 "with this version (`vista gen`) for LiDAR labels and the semantic and instance "
-                                 "channels");
+                                 "with this version (`vista gen`) for LiDAR labels and the semantic, instance and "
+                                 "boxes channels");
         return Status::ok();
     };
     req.makePath = [&](const SceneModel& city) -> Result<Path> {
@@ -166,6 +178,7 @@ Status openWorkDir(const RigRunRequest& a, const RigPlan& p, const Path& path, R
     for (size_t j = 0; j < p.rig.lidars.size(); ++j)
         for (const std::string& f : lidarFiles(j, "x"))
             VISTA_RETURN_IF_ERROR(out.subdir(fs::path(f).parent_path().string()));
+    if (p.hasBoxes()) VISTA_RETURN_IF_ERROR(out.subdir(kBoxes3dDir));
     return Status::ok();
 }
 
@@ -185,6 +198,7 @@ std::vector<nlohmann::json> finishedFrames(const RenderWorkDir& out, const RigPl
         for (size_t j = 0; j < p.rig.lidars.size(); ++j)
             if (p.lidarFire[j][f])
                 for (auto& s : lidarFiles(j, name)) files.push_back(s);
+        if (p.hasBoxes()) files.push_back(std::string(kBoxes3dDir) + "/" + name + ".json");
         for (const std::string& s : files)
             if (!fs::exists(out.file(s))) records[f] = nullptr;
         kept += records[f].is_null() ? 0 : 1;
@@ -196,6 +210,29 @@ std::vector<nlohmann::json> finishedFrames(const RenderWorkDir& out, const RigPl
 double nextShotTime(const RigPlan& p, const Path& path, size_t k, size_t f) {
     const double sampleAfter = path.samples[std::min(p.idx[f] + 1, path.samples.size() - 1)].t;
     return nextFiringTime(p.rig.cameras[k].rateHz, p.camFire[k], p.times, f, sampleAfter);
+}
+
+// A frame's boxes: the city's 3D boxes and the sightings of the sensors that fired.
+struct FrameBoxState {
+    const CityBoxes* city = nullptr;  // null: no camera asks for boxes
+    FrameSightings seen;
+};
+
+// Camera k's 2D boxes from its instance image: boxes_NN/ and, for a pinhole, KITTI lines in label_NN/.
+Status writeCameraBoxes(const RigPlan& p, const Walkthrough& w, size_t k, const RigPose& pose, const std::string& name,
+                        const CameraImages& im, const RenderWorkDir& out, FrameBoxState& boxes) {
+    const RigCamera& c = p.rig.cameras[k];
+    const BoxCamera cam = rigBoxCamera(c.model, pose);
+    FrameBoxOptions o;
+    o.threads = p.options.threads;
+    const std::vector<FrameBox> fb = frameBoxes(w.city, *boxes.city, cam, im.ids, o);
+    addCameraSightings(boxes.seen, c.name, fb);
+    const CameraDirs d = cameraDirs(k);
+    const glm::dvec3 offset(w.city.params.origin_x, w.city.params.origin_y, 0.0);
+    VISTA_RETURN_IF_ERROR(
+        writeFileAtomic(out.file(d.boxes + "/" + name + ".json"), frameBoxesJson(fb, cam, offset, c.name)));
+    if (c.model.fisheye()) return Status::ok();
+    return writeFileAtomic(out.file(d.labels + "/" + name + ".txt"), kittiLabels(fb, cam));
 }
 
 Status writeCamera(const RigCamera& c, size_t k, const std::string& name, const CameraImages& im,
@@ -222,9 +259,9 @@ Status writeLidar(const LidarSweep& s, size_t j, const std::string& name, const 
 }
 
 // One rig frame: every sensor that fires, cast and written (each timed,
-// cast and write together, into the record).
+// cast, boxes and write together, into the record), then the frame's 3D boxes.
 Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_t f, const RenderWorkDir& out,
-                   CameraImages& im, nlohmann::json& record) {
+                   const CityBoxes* cityBoxes, CameraImages& im, nlohmann::json& record) {
     const Path& path = w.path;
     const RigPose vehicle = vehiclePose(path.samples[p.idx[f]]);
     // Ray origins near the scene's frame origin: float precision anywhere in the city.
@@ -232,6 +269,8 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
     const std::string name = frameName(f);
     const int threads = p.options.threads;
     nlohmann::json ms = nlohmann::json::object(), lidar = nlohmann::json::object();
+    FrameBoxState boxes;
+    boxes.city = cityBoxes;
     Stopwatch frame;
     for (size_t k = 0; k < p.rig.cameras.size(); ++k) {
         if (!p.camFire[k][f]) continue;
@@ -245,6 +284,7 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
         if (c.channels & kRigFlow) shot.next = sensorPose(vehiclePoseAt(path, nextShotTime(p, path, k, f)), c.mount);
         castRigCamera(w.city, rays, shot, im, threads);
         VISTA_RETURN_IF_ERROR(writeCamera(c, k, name, im, out));
+        if (c.channels & kRigBoxes) VISTA_RETURN_IF_ERROR(writeCameraBoxes(p, w, k, shot.pose, name, im, out, boxes));
         ms[c.name] = sw.ms();
     }
     for (size_t j = 0; j < p.rig.lidars.size(); ++j) {
@@ -254,8 +294,15 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
         const LidarPoseAt poseAt = [&](double t) { return lidarPoseOf(sensorPose(vehiclePoseAt(path, t), l.mount)); };
         const LidarSweep sweep = castLidarSweep(w.city, rays, l.spec, poseAt, p.times[f], threads);
         VISTA_RETURN_IF_ERROR(writeLidar(sweep, j, name, out));
+        if (boxes.city) addLidarSightings(boxes.seen, l.name, sweep, *boxes.city);
         ms[l.name] = sw.ms();
         lidar[l.name] = {{"points", sweep.points.size()}, {"misses", sweep.misses}};
+    }
+    if (boxes.city) {
+        const glm::dvec3 offset(w.city.params.origin_x, w.city.params.origin_y, 0.0);
+        VISTA_RETURN_IF_ERROR(
+            writeFileAtomic(out.file(std::string(kBoxes3dDir) + "/" + name + ".json"),
+                            frameBoxes3dJson(*boxes.city, boxes.seen, vehicle, offset, name, p.times[f])));
     }
     record = {{"frame_ms", frame.ms()}, {"sensor_ms", ms}, {"lidar", lidar}};
     return Status::ok();
@@ -263,6 +310,11 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
 
 Status renderFrames(const RigRunRequest& a, const RigPlan& p, const Walkthrough& w, RayScene& rays, RenderWorkDir& out,
                     std::vector<nlohmann::json>& records, size_t kept) {
+    // City boxes once per run, and only when a camera asks for boxes and a frame is left to render.
+    CityBoxes cityBoxes;
+    const bool anyLeft =
+        std::any_of(records.begin(), records.end(), [](const nlohmann::json& r) { return r.is_null(); });
+    if (p.hasBoxes() && anyLeft) cityBoxes = buildCityBoxes(w.city, p.options.threads);
     std::unique_ptr<Progress> progress;
     if (!a.quiet) progress = std::make_unique<StderrProgress>(isatty(2));
     const long killAfter = killAfterFrames();
@@ -275,7 +327,7 @@ Status renderFrames(const RigRunRequest& a, const RigPlan& p, const Walkthrough&
     CameraImages im;
     for (size_t f = 0; f < n; ++f) {
         if (!records[f].is_null()) continue;
-        if (Status s = renderFrame(p, w, rays, f, out, im, records[f]); !s)
+        if (Status s = renderFrame(p, w, rays, f, out, p.hasBoxes() ? &cityBoxes : nullptr, im, records[f]); !s)
             return Status::error("frame " + std::to_string(f) + ": " + s.message());
         VISTA_RETURN_IF_ERROR(out.finishFrame(f, records[f]));
         if (killAfter > 0 && ++finishedNow == killAfter) std::raise(SIGKILL);
@@ -307,7 +359,9 @@ nlohmann::json rigManifest(const RigPlan& p, const Walkthrough& w) {
                              {"depth", d.depth},
                              {"semantic", d.semantic},
                              {"instance", d.instance},
-                             {"flow", d.flow}}},
+                             {"flow", d.flow},
+                             {"boxes", d.boxes},
+                             {"kitti_labels", c.model.fisheye() ? nlohmann::json(nullptr) : nlohmann::json(d.labels)}}},
                            {"channels", rigChannelList(c.channels)},
                            {"sensor_to_vehicle",
                             matrixJson(poseToWorld({c.mount.position, mountRotation(c.mount)}, glm::dvec3(0.0)))}});
@@ -340,15 +394,18 @@ nlohmann::json rigManifest(const RigPlan& p, const Walkthrough& w) {
                           {"vehicle_to_world", matrixJson(poseToWorld(v, offset))},
                           {"sensors", fired}});
     }
-    return {{"format", "vista rig run 1"},
-            {"conventions",
-             "world: metres, x east, y north, z up, minus world_offset; vehicle and sensor frames: x forward, y left, "
-             "z up; camera_to_world maps the OpenCV camera frame (x right, y down, z forward); matrices 4x4 "
-             "row-major"},
-            {"world_offset", {offset.x, offset.y, offset.z}},
-            {"rig", rig},
-            {"sensors", sensors},
-            {"frames", frames}};
+    nlohmann::json doc = {
+        {"format", "vista rig run 1"},
+        {"conventions",
+         "world: metres, x east, y north, z up, minus world_offset; vehicle and sensor frames: x forward, y left, "
+         "z up; camera_to_world maps the OpenCV camera frame (x right, y down, z forward); matrices 4x4 "
+         "row-major"},
+        {"world_offset", {offset.x, offset.y, offset.z}},
+        {"rig", rig},
+        {"sensors", sensors},
+        {"frames", frames}};
+    if (p.hasBoxes()) doc["boxes_3d"] = kBoxes3dDir;
+    return doc;
 }
 
 // summary.json: per sensor its firings, median and mean ms (cast and write),
@@ -388,9 +445,9 @@ nlohmann::json rigSummary(const RigRunRequest& a, const RigPlan& p, const std::v
              totalMs > 0 ? nlohmann::json(double(records.size()) * 1000.0 / totalMs) : nlohmann::json(nullptr)},
             {"sensors", sensors},
             {"note",
-             "per sensor: ray casting and writing its files, in ms per firing; rig_frames_per_second: frames divided "
-             "by the sum of every frame's wall time, each timed by the run that rendered it (frames_resumed: frames "
-             "an interrupted run had finished)"}};
+             "per sensor: ray casting, its boxes and writing its files, in ms per firing; rig_frames_per_second: "
+             "frames divided by the sum of every frame's wall time, each timed by the run that rendered it "
+             "(frames_resumed: frames an interrupted run had finished)"}};
 }
 
 Status writeMetadata(const RigRunRequest& a, const RigPlan& p, const Walkthrough& w,

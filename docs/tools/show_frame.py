@@ -8,15 +8,23 @@ wherever python3 does.
 
   show_frame.py --image rgb/000000.png --boxes boxes/000000.json -o shown.png
   show_frame.py --image rgb.png --boxes boxes.json --lidar lidar.bin --calib calib.txt -o shown.png
+  show_frame.py --run rig_run --frame 000003 --camera 0 -o shown.png
+
+--run reads one frame of a `vista render --rig` run for camera NN:
+image_NN/FRAME.png, boxes_NN/FRAME.json and, when the first LiDAR fired at
+that frame, velodyne/FRAME.bin projected with calib.txt's PNN and
+Tr_velo_to_cam (a pinhole camera; a fisheye has no PNN line, so its boxes
+are drawn without points).
 
 Boxes: the visible extent (solid, the colour of the instance kind) and the
 full projected extent (dashed, same colour); --min-pixels hides boxes with
 fewer visible pixels, --no-full hides the dashed extents.
 LiDAR (--lidar, --calib): float32 little-endian records x, y, z, intensity
 (KITTI's velodyne .bin: x forward, y left, z up, metres), projected as
-P2 * R0_rect * Tr_velo_to_cam * (x, y, z, 1) and drawn as 2x2 dots coloured by
-range (near red, far blue); points less than 0.5 m in front of the camera are
-dropped.
+P * R0_rect * Tr_velo_to_cam * (x, y, z, 1) (P = P2, or PNN with --run;
+R0_rect = identity when the file has none) and drawn as 2x2 dots coloured by
+range (near red, far blue); points less than 0.5 m in front of the camera
+(the third coordinate of that product) are dropped.
 --self-test draws a synthetic frame and checks the pixels it sets.
 """
 import argparse
@@ -161,17 +169,18 @@ def draw_boxes(pic, doc, min_pixels=1, full=True):
     return drawn
 
 
-def read_calib(path):
-    """KITTI calibration: name -> list of floats ("P2: v v ...")."""
+def read_calib(path, p_name="P2"):
+    """KITTI calibration: name -> list of floats ("P2: v v ..."); "P" = the rows of p_name."""
     rows = {}
     with open(path) as f:
         for line in f:
             if ":" in line:
                 name, values = line.split(":", 1)
                 rows[name.strip()] = [float(v) for v in values.split()]
-    for need, count in (("P2", 12), ("Tr_velo_to_cam", 12)):
+    for need, count in ((p_name, 12), ("Tr_velo_to_cam", 12)):
         if len(rows.get(need, [])) != count:
             raise ValueError(f"{path}: {need} needs {count} numbers")
+    rows["P"] = rows[p_name]
     return rows
 
 
@@ -180,17 +189,17 @@ def _mat34(v):
 
 
 def project_lidar(points, calib):
-    """(u, v, range) of each point in front of the camera: P2 * R0_rect * Tr_velo_to_cam."""
-    P, T = _mat34(calib["P2"]), _mat34(calib["Tr_velo_to_cam"])
+    """(u, v, range) of each point in front of the camera: P * R0_rect * Tr_velo_to_cam."""
+    P, T = _mat34(calib.get("P", calib.get("P2"))), _mat34(calib["Tr_velo_to_cam"])
     R = calib.get("R0_rect", [1, 0, 0, 0, 1, 0, 0, 0, 1])
     R = [R[0:3], R[3:6], R[6:9]]
     out = []
     for x, y, z, _ in points:
         c = [T[i][0] * x + T[i][1] * y + T[i][2] * z + T[i][3] for i in range(3)]
         c = [R[i][0] * c[0] + R[i][1] * c[1] + R[i][2] * c[2] for i in range(3)]
-        if c[2] < 0.5:
-            continue
         h = [P[i][0] * c[0] + P[i][1] * c[1] + P[i][2] * c[2] + P[i][3] for i in range(3)]
+        if h[2] < 0.5:
+            continue
         out.append((h[0] / h[2], h[1] / h[2], math.sqrt(x * x + y * y + z * z)))
     return out
 
@@ -220,7 +229,7 @@ def draw_points(pic, projected):
     return drawn
 
 
-def show(image, boxes, out, lidar=None, calib=None, min_pixels=1, full=True):
+def show(image, boxes, out, lidar=None, calib=None, min_pixels=1, full=True, p_name="P2"):
     pic = read_png(image)
     with open(boxes) as f:
         doc = json.load(f)
@@ -232,10 +241,34 @@ def show(image, boxes, out, lidar=None, calib=None, min_pixels=1, full=True):
     if lidar:
         if not calib:
             raise ValueError("--lidar needs --calib")
-        points = draw_points(pic, project_lidar(read_lidar(lidar), read_calib(calib)))
+        points = draw_points(pic, project_lidar(read_lidar(lidar), read_calib(calib, p_name)))
     n = draw_boxes(pic, doc, min_pixels, full)
     write_png(pic, out)
     return n, points
+
+
+def rig_frame_files(run, frame, camera):
+    """The files of one rig frame for camera `camera` (an index): image, boxes,
+    LiDAR (None when the first LiDAR did not fire or the camera is a fisheye),
+    calib and the P line's name."""
+    nn = f"{int(camera):02d}"
+    frame = f"{int(frame):06d}"
+    image = os.path.join(run, f"image_{nn}", frame + ".png")
+    boxes = os.path.join(run, f"boxes_{nn}", frame + ".json")
+    for path, channel in ((image, "rgb"), (boxes, "boxes")):
+        if not os.path.exists(path):
+            raise ValueError(f"{path} does not exist: camera {nn} has no {channel} at frame {frame} "
+                             "(not in its channels, or it did not fire at that frame)")
+    lidar = os.path.join(run, "velodyne", frame + ".bin")
+    calib = os.path.join(run, "calib.txt")
+    p_name = "P" + str(int(camera))
+    has_p = False
+    if os.path.exists(calib):
+        with open(calib) as f:
+            has_p = any(line.split(":", 1)[0].strip() == p_name for line in f if ":" in line)
+    if not (has_p and os.path.exists(lidar)):
+        lidar = None
+    return image, boxes, lidar, calib, p_name
 
 
 def self_test():
@@ -268,6 +301,31 @@ def self_test():
             (pic.get(22, 24) == range_color(math.sqrt(10.0 ** 2 + 2.5 ** 2)), "LiDAR point at (22, 24)"),
             (pic.get(40, 40) == (90, 90, 90), "background untouched"),
         ]
+        # A rig run: camera 01 is the reference camera turned 90 degrees to the left (its z = the LiDAR's y).
+        run = os.path.join(d, "run")
+        for sub in ("image_01", "boxes_01", "velodyne"):
+            os.makedirs(os.path.join(run, sub))
+        write_png(grey, os.path.join(run, "image_01", "000002.png"))
+        with open(os.path.join(run, "boxes_01", "000002.json"), "w") as f:
+            json.dump(doc, f)
+        # P1 = K [R | 0], R mapping the reference camera (x right, y down, z forward) to one looking left:
+        # its x = the reference's z, its y = the reference's y, its z = -(the reference's x).
+        p1 = [-cx, 0, f_px, 0, -cy, f_px, 0, 0, -1, 0, 0, 0]
+        with open(os.path.join(run, "calib.txt"), "w") as f:
+            f.write(f"P0: {f_px} 0 {cx} 0 0 {f_px} {cy} 0 0 0 1 0\n")
+            f.write("P1: " + " ".join(str(v) for v in p1) + "\n")
+            f.write("Tr_velo_to_cam: 0 -1 0 0 0 0 -1 0 1 0 0 0\n")
+        # 10 m to the left and 2.5 m ahead: u = cx + 40 * 2.5 / 10 = 41.5 in camera 01; 10 m ahead is beside it.
+        with open(os.path.join(run, "velodyne", "000002.bin"), "wb") as f:
+            f.write(struct.pack("<8f", 2.5, 10.0, 0.0, 0.5, 10.0, 0.0, 0.0, 0.5))
+        files = rig_frame_files(run, "2", "1")
+        n2, pts2 = show(*files[:2], os.path.join(d, "rig.png"), files[2], files[3], p_name=files[4])
+        rig = read_png(os.path.join(d, "rig.png"))
+        checks += [
+            (files[4] == "P1" and files[2] is not None, f"rig files of camera 01: {files}"),
+            (n2 == 1 and pts2 == 1, f"rig frame: 1 box and 1 point drawn, got {n2} and {pts2}"),
+            (rig.get(42, 24) == range_color(math.sqrt(10.0 ** 2 + 2.5 ** 2)), "rig LiDAR point at (42, 24)"),
+        ]
         failed = [m for ok, m in checks if not ok]
         for m in failed:
             print("FAILED:", m)
@@ -282,6 +340,9 @@ def main():
     ap.add_argument("--boxes", help="the frame's boxes JSON (format vista.boxes)")
     ap.add_argument("--lidar", help="LiDAR points: float32 x, y, z, intensity records")
     ap.add_argument("--calib", help="KITTI calibration file (P2, R0_rect, Tr_velo_to_cam)")
+    ap.add_argument("--run", help="a `vista render --rig` output directory (with --frame and --camera)")
+    ap.add_argument("--frame", default="0", help="--run: the rig frame (number, e.g. 3 or 000003)")
+    ap.add_argument("--camera", default="0", help="--run: the camera's index NN (image_NN/)")
     ap.add_argument("-o", "--out", help="the picture to write (PNG)")
     ap.add_argument("--min-pixels", type=int, default=1, help="hide boxes with fewer visible pixels")
     ap.add_argument("--no-full", action="store_true", help="draw the visible extents only")
@@ -289,10 +350,15 @@ def main():
     a = ap.parse_args()
     if a.self_test:
         return self_test()
-    if not (a.image and a.boxes and a.out):
-        ap.error("--image, --boxes and -o are required")
+    if not a.out or not (a.run or (a.image and a.boxes)):
+        ap.error("-o and either --run or --image and --boxes are required")
     try:
-        n, pts = show(a.image, a.boxes, a.out, a.lidar, a.calib, a.min_pixels, not a.no_full)
+        p_name = "P2"
+        if a.run:
+            if not (a.frame.isdigit() and a.camera.isdigit()):
+                raise ValueError(f"--frame {a.frame!r} and --camera {a.camera!r} must be whole numbers")
+            a.image, a.boxes, a.lidar, a.calib, p_name = rig_frame_files(a.run, a.frame, a.camera)
+        n, pts = show(a.image, a.boxes, a.out, a.lidar, a.calib, a.min_pixels, not a.no_full, p_name)
     except (OSError, ValueError, KeyError) as e:
         print(f"show_frame: {e}", file=sys.stderr)
         return 2

@@ -264,34 +264,24 @@ PinholeIntrinsics pinholeIntrinsics(const Camera& camera) {
     return k;
 }
 
+BoxCamera boxCamera(const Camera& camera) {
+    BoxCamera b;
+    b.eye = camera.eye;
+    b.axes = glm::dmat3(camera.right(), -camera.up(), camera.forward());
+    const PinholeIntrinsics k = pinholeIntrinsics(camera);
+    b.model.kind = CameraModel::Kind::Pinhole;
+    b.model.width = camera.width, b.model.height = camera.height;
+    b.model.fx = k.fx, b.model.fy = k.fy, b.model.cx = k.cx, b.model.cy = k.cy;
+    b.zNear = camera.zNear;
+    return b;
+}
+
 glm::dvec3 cameraPoint(const Camera& camera, const glm::dvec3& world) {
     const glm::dvec3 d = world - camera.eye;
     return {glm::dot(d, camera.right()), -glm::dot(d, camera.up()), glm::dot(d, camera.forward())};
 }
 
 namespace {
-
-// The camera's axes and intrinsics, evaluated once.
-struct Projector {
-    glm::dvec3 eye, right, down, fwd;
-    PinholeIntrinsics k;
-    double zNear;
-    explicit Projector(const Camera& c)
-        : eye(c.eye), right(c.right()), down(-c.up()), fwd(c.forward()), k(pinholeIntrinsics(c)), zNear(c.zNear) {}
-    glm::dvec3 toCamera(const glm::dvec3& w) const {
-        const glm::dvec3 d = w - eye;
-        return {glm::dot(d, right), glm::dot(d, down), glm::dot(d, fwd)};
-    }
-    // Pixel coordinates of a camera point with z > 0.
-    glm::dvec2 pixel(const glm::dvec3& p) const { return {k.fx * p.x / p.z + k.cx, k.fy * p.y / p.z + k.cy}; }
-    // The point where segment a-b crosses the near plane (a and b on either side).
-    glm::dvec3 nearCrossing(const glm::dvec3& a, const glm::dvec3& b) const {
-        const double t = (zNear - a.z) / (b.z - a.z);
-        glm::dvec3 p = a + t * (b - a);
-        p.z = zNear;
-        return p;
-    }
-};
 
 void extend(PixelBox& b, const glm::dvec2& p) {
     if (!b.valid()) {
@@ -302,11 +292,102 @@ void extend(PixelBox& b, const glm::dvec2& p) {
     b.u1 = std::max(b.u1, p.x), b.v1 = std::max(b.v1, p.y);
 }
 
+void extend(PixelBox& b, const PixelBox& o) {
+    if (o.valid()) extend(b, glm::dvec2(o.u0, o.v0)), extend(b, glm::dvec2(o.u1, o.v1));
+}
+
+// The camera's axes and model, evaluated once.
+struct Projector {
+    glm::dvec3 eye;
+    glm::dmat3 toCam;  // world offsets -> camera coordinates
+    CameraModel m;
+    double zNear;
+    double thetaMax;  // fisheye: the image circle's half angle
+    explicit Projector(const BoxCamera& c)
+        : eye(c.eye),
+          toCam(glm::transpose(c.axes)),
+          m(c.model),
+          zNear(c.zNear),
+          thetaMax(std::min(kPi, 0.5 * c.model.maxFovDeg * kPi / 180.0)) {
+        VISTA_CHECK(m.fisheye() || zNear > 0.0);
+    }
+    glm::dvec3 toCamera(const glm::dvec3& w) const { return toCam * (w - eye); }
+    // Pinhole pixel coordinates of a camera point with z > 0.
+    glm::dvec2 pixel(const glm::dvec3& p) const { return {m.fx * p.x / p.z + m.cx, m.fy * p.y / p.z + m.cy}; }
+    // The point where segment a-b crosses the near plane (a and b on either side).
+    glm::dvec3 nearCrossing(const glm::dvec3& a, const glm::dvec3& b) const {
+        const double t = (zNear - a.z) / (b.z - a.z);
+        glm::dvec3 p = a + t * (b - a);
+        p.z = zNear;
+        return p;
+    }
+    // Fisheye: true when the direction of p lies within the image circle's cone.
+    bool inCone(const glm::dvec3& p) const {
+        const double rho = std::hypot(p.x, p.y);
+        return (rho > 0.0 || p.z > 0.0) && std::atan2(rho, p.z) <= thetaMax;
+    }
+    // Fisheye: the pixel of a camera point (not the origin).
+    glm::dvec2 fisheyePixel(const glm::dvec3& p) const {
+        glm::dvec2 uv(m.cx, m.cy);
+        m.project(p, uv);
+        return uv;
+    }
+};
+
+// The point where p moves into or out of the cone between a (inside == aIn) and b.
+glm::dvec3 coneCrossing(const Projector& pr, glm::dvec3 a, glm::dvec3 b, bool aIn) {
+    for (int i = 0; i < 40; ++i) {
+        const glm::dvec3 mid = 0.5 * (a + b);
+        (pr.inCone(mid) == aIn ? a : b) = mid;
+    }
+    return aIn ? a : b;
+}
+
+// The fisheye image of segment a-b within the cone, sampled at most about 1 px apart.
+void fisheyeEdge(const Projector& pr, const glm::dvec3& a, const glm::dvec3& b, PixelBox& out) {
+    const double la = glm::length(a), lb = glm::length(b);
+    const double angle = la > 0 && lb > 0 ? std::acos(std::clamp(glm::dot(a, b) / (la * lb), -1.0, 1.0)) : kPi;
+    const int n = int(std::clamp(std::ceil(angle * std::max(pr.m.fx, pr.m.fy)), 1.0, 4096.0));
+    glm::dvec3 prev = a;
+    bool prevIn = pr.inCone(a);
+    if (prevIn) extend(out, pr.fisheyePixel(a));
+    for (int k = 1; k <= n; ++k) {
+        const glm::dvec3 p = a + (double(k) / n) * (b - a);
+        const bool in = pr.inCone(p);
+        if (in != prevIn) extend(out, pr.fisheyePixel(coneCrossing(pr, prev, p, prevIn)));
+        if (in) extend(out, pr.fisheyePixel(p));
+        prev = p, prevIn = in;
+    }
+}
+
+// True when the ray from the origin along d passes through triangle p0 p1 p2 (edges included).
+bool rayThroughTriangle(const glm::dvec3& d, const glm::dvec3* p) {
+    const double det = glm::dot(p[0], glm::cross(p[1], p[2]));
+    if (det == 0.0) return false;
+    const double a = glm::dot(d, glm::cross(p[1], p[2])), b = glm::dot(d, glm::cross(p[2], p[0])),
+                 c = glm::dot(d, glm::cross(p[0], p[1]));
+    return det > 0 ? a >= 0 && b >= 0 && c >= 0 : a <= 0 && b <= 0 && c <= 0;
+}
+
+// The fisheye image of a triangle (camera coordinates) within the cone: its
+// edges and the image circle's extreme points its area covers.
+PixelBox fisheyeTriangleExtent(const Projector& pr, const glm::dvec3* p) {
+    PixelBox out;
+    for (int i = 0; i < 3; ++i) fisheyeEdge(pr, p[i], p[(i + 1) % 3], out);
+    const double st = std::sin(pr.thetaMax), ct = std::cos(pr.thetaMax);
+    const double r[4][2] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}};  // azimuth 0, 90, 180, 270 degrees
+    for (const auto& q : r)
+        if (rayThroughTriangle({st * q[0], st * q[1], ct}, p))
+            extend(out, glm::dvec2(pr.m.cx + pr.m.fx * pr.thetaMax * q[0], pr.m.cy + pr.m.fy * pr.thetaMax * q[1]));
+    return out;
+}
+
 }  // namespace
 
-PixelBox projectedExtent(const Camera& camera, const std::vector<glm::dvec3>& vertices,
+PixelBox projectedExtent(const BoxCamera& camera, const std::vector<glm::dvec3>& vertices,
                          const std::vector<std::array<int, 2>>& edges) {
     const Projector pr(camera);
+    VISTA_CHECK(!pr.m.fisheye());
     std::vector<glm::dvec3> c(vertices.size());
     PixelBox out;
     for (size_t i = 0; i < vertices.size(); ++i) {
@@ -320,19 +401,39 @@ PixelBox projectedExtent(const Camera& camera, const std::vector<glm::dvec3>& ve
     return out;
 }
 
-PixelBox projectedBox(const Camera& camera, const OrientedBox& box) {
+PixelBox projectedExtent(const Camera& camera, const std::vector<glm::dvec3>& vertices,
+                         const std::vector<std::array<int, 2>>& edges) {
+    return projectedExtent(boxCamera(camera), vertices, edges);
+}
+
+PixelBox projectedBox(const BoxCamera& camera, const OrientedBox& box) {
     const std::array<glm::dvec3, 8> c = box.corners();
+    if (camera.model.fisheye()) {
+        static const int kFaces[12][3] = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                                          {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+        const Projector pr(camera);
+        PixelBox out;
+        for (const auto& f : kFaces) {
+            const glm::dvec3 p[3] = {pr.toCamera(c[size_t(f[0])]), pr.toCamera(c[size_t(f[1])]),
+                                     pr.toCamera(c[size_t(f[2])])};
+            extend(out, fisheyeTriangleExtent(pr, p));
+        }
+        return out;
+    }
     static const std::vector<std::array<int, 2>> kEdges = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6},
                                                            {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
     return projectedExtent(camera, std::vector<glm::dvec3>(c.begin(), c.end()), kEdges);
 }
 
-PixelBox clipToImage(const PixelBox& b, const Camera& camera) {
+PixelBox projectedBox(const Camera& camera, const OrientedBox& box) { return projectedBox(boxCamera(camera), box); }
+
+PixelBox clipToImage(const PixelBox& b, int width, int height) {
     if (!b.valid()) return b;
-    PixelBox c{std::max(b.u0, -0.5), std::max(b.v0, -0.5), std::min(b.u1, camera.width - 0.5),
-               std::min(b.v1, camera.height - 0.5)};
+    PixelBox c{std::max(b.u0, -0.5), std::max(b.v0, -0.5), std::min(b.u1, width - 0.5), std::min(b.v1, height - 0.5)};
     return c.valid() ? c : PixelBox{};
 }
+
+PixelBox clipToImage(const PixelBox& b, const Camera& camera) { return clipToImage(b, camera.width, camera.height); }
 
 namespace {
 
@@ -367,9 +468,9 @@ std::vector<VisibleStats> visibleStats(const std::vector<uint32_t>& ids, int wid
 }
 
 // One instance's triangles through the camera: `full` = the extent of every
-// triangle clipped against the near plane; `covered` = the pixels whose
-// centres its front faces cover (marked with `mark` in `stamp`, so each
-// pixel counts once).
+// triangle clipped against the near plane (pinhole) or the image circle's
+// cone (fisheye); `covered` = the pixels whose centres its front faces
+// cover (marked with `mark` in `stamp`, so each pixel counts once).
 class MaskRaster {
 public:
     MaskRaster(const Projector& pr, int width, int height, std::vector<uint32_t>& stamp, uint32_t mark)
@@ -379,6 +480,15 @@ public:
 
     void triangle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
         const glm::dvec3 p[3] = {_pr.toCamera(a), _pr.toCamera(b), _pr.toCamera(c)};
+        // Camera coordinates are a rotation of the world's: counter-clockwise
+        // seen from the eye (the origin) is a front face.
+        const bool front = glm::dot(glm::cross(p[1] - p[0], p[2] - p[0]), p[0]) < 0;
+        if (_pr.m.fisheye()) {
+            const PixelBox e = fisheyeTriangleExtent(_pr, p);
+            extend(full, e);
+            if (front && e.valid()) fillSphere(p, e);
+            return;
+        }
         glm::dvec3 poly[4];
         int n = 0;
         for (int i = 0; i < 3; ++i) {
@@ -390,9 +500,7 @@ public:
         if (n < 3) return;
         glm::dvec2 q[4];
         for (int i = 0; i < n; ++i) extend(full, q[i] = _pr.pixel(poly[i]));
-        // Camera coordinates are a rotation of the world's: counter-clockwise
-        // seen from the eye (the origin) is a front face.
-        if (glm::dot(glm::cross(p[1] - p[0], p[2] - p[0]), p[0]) < 0) fill(q, n);
+        if (front) fill(q, n);
     }
 
 private:
@@ -419,6 +527,21 @@ private:
                 if (row[x] != _mark) row[x] = _mark, ++covered;
         }
     }
+    // Marks the pixels of extent e (grown by a pixel for the sampling of
+    // curved edges) whose ray passes through the triangle p.
+    void fillSphere(const glm::dvec3* p, const PixelBox& e) {
+        const int x0 = int(std::max(0.0, std::floor(e.u0) - 1)),
+                  x1 = int(std::min(double(_w - 1), std::ceil(e.u1) + 1));
+        const int y0 = int(std::max(0.0, std::floor(e.v0) - 1)),
+                  y1 = int(std::min(double(_h - 1), std::ceil(e.v1) + 1));
+        for (int y = y0; y <= y1; ++y) {
+            uint32_t* row = &_stamp[size_t(y) * size_t(_w)];
+            for (int x = x0; x <= x1; ++x) {
+                glm::dvec3 d;
+                if (row[x] != _mark && _pr.m.pixelRay(x, y, d) && rayThroughTriangle(d, p)) row[x] = _mark, ++covered;
+            }
+        }
+    }
     const Projector& _pr;
     int _w, _h;
     std::vector<uint32_t>& _stamp;
@@ -438,9 +561,9 @@ double truncation(const PixelBox& whole, const PixelBox& inside) {
 
 }  // namespace
 
-std::vector<FrameBox> frameBoxes(const SceneModel& city, const CityBoxes& boxes, const Camera& camera,
+std::vector<FrameBox> frameBoxes(const SceneModel& city, const CityBoxes& boxes, const BoxCamera& camera,
                                  const std::vector<uint32_t>& ids, const FrameBoxOptions& options) {
-    const int W = camera.width, H = camera.height;
+    const int W = camera.model.width, H = camera.model.height;
     VISTA_CHECK(W > 0 && H > 0 && ids.size() == size_t(W) * size_t(H));
     std::vector<FrameBox> out;
     std::vector<const InstanceBox*> src;
@@ -464,14 +587,19 @@ std::vector<FrameBox> frameBoxes(const SceneModel& city, const CityBoxes& boxes,
             forEachTriangle(city, boxes, *src[i], [&](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
                 r.triangle(a, b, c);
             });
-            f.full = clipToImage(r.full, camera);
+            f.full = clipToImage(r.full, W, H);
             f.truncated = truncation(r.full, f.full);
-            f.boxExtent = clipToImage(projectedBox(camera, f.box), camera);
+            f.boxExtent = clipToImage(projectedBox(camera, f.box), W, H);
             f.unoccludedPixels = r.covered;
             f.visibleFraction = r.covered > 0 ? std::min(1.0, double(f.pixels) / double(r.covered)) : 1.0;
         });
     });
     return out;
+}
+
+std::vector<FrameBox> frameBoxes(const SceneModel& city, const CityBoxes& boxes, const Camera& camera,
+                                 const std::vector<uint32_t>& ids, const FrameBoxOptions& options) {
+    return frameBoxes(city, boxes, boxCamera(camera), ids, options);
 }
 
 namespace {
@@ -495,9 +623,9 @@ double wrapTurn(double a) {  // into [-pi, pi]
 struct CameraYaw {
     double rotationY, alpha;
 };
-CameraYaw cameraYaw(const Camera& camera, const OrientedBox& box, const glm::dvec3& location) {
+CameraYaw cameraYaw(const BoxCamera& camera, const OrientedBox& box, const glm::dvec3& location) {
     const glm::dvec3 h = box.lengthAxis();
-    const double ry = wrapTurn(std::atan2(-glm::dot(h, camera.forward()), glm::dot(h, camera.right())));
+    const double ry = wrapTurn(std::atan2(-glm::dot(h, camera.axes[2]), glm::dot(h, camera.axes[0])));
     return {ry, wrapTurn(ry - std::atan2(location.x, location.z))};
 }
 
@@ -505,11 +633,12 @@ glm::dvec3 bottomCenter(const OrientedBox& b) { return b.center - glm::dvec3(0.0
 
 }  // namespace
 
-std::string frameBoxesJson(const std::vector<FrameBox>& boxes, const Camera& camera, const glm::dvec3& worldOffset) {
-    const PinholeIntrinsics k = pinholeIntrinsics(camera);
+std::string frameBoxesJson(const std::vector<FrameBox>& boxes, const BoxCamera& camera, const glm::dvec3& worldOffset,
+                           const std::string& cameraName) {
+    const CameraModel& k = camera.model;
     nlohmann::json list = nlohmann::json::array();
     for (const FrameBox& f : boxes) {
-        const glm::dvec3 bottom = cameraPoint(camera, bottomCenter(f.box));
+        const glm::dvec3 bottom = camera.toCamera(bottomCenter(f.box));
         const CameraYaw cy = cameraYaw(camera, f.box, bottom);
         list.push_back({{"id", f.id},
                         {"kind", instanceKindName(instanceKind(f.id))},
@@ -526,23 +655,30 @@ std::string frameBoxesJson(const std::vector<FrameBox>& boxes, const Camera& cam
                           {"size", vec3Json(f.box.size)},
                           {"yaw", round3(f.box.yaw)}}},
                         {"camera",
-                         {{"center", vec3Json(cameraPoint(camera, f.box.center))},
+                         {{"center", vec3Json(camera.toCamera(f.box.center))},
                           {"bottom_center", vec3Json(bottom)},
                           {"rotation_y", round3(cy.rotationY)},
                           {"alpha", round3(cy.alpha)}}}});
     }
-    const nlohmann::json doc = {{"format", "vista.boxes"},
-                                {"version", 1},
-                                {"width", camera.width},
-                                {"height", camera.height},
-                                {"fx", k.fx},
-                                {"fy", k.fy},
-                                {"cx", k.cx},
-                                {"cy", k.cy},
-                                {"z_near_m", camera.zNear},
-                                {"world_offset", {worldOffset.x, worldOffset.y, worldOffset.z}},
-                                {"boxes", list}};
+    nlohmann::json doc = {{"format", "vista.boxes"},
+                          {"version", 1},
+                          {"model", k.fisheye() ? "fisheye" : "pinhole"},
+                          {"width", k.width},
+                          {"height", k.height},
+                          {"fx", k.fx},
+                          {"fy", k.fy},
+                          {"cx", k.cx},
+                          {"cy", k.cy},
+                          {"world_offset", {worldOffset.x, worldOffset.y, worldOffset.z}},
+                          {"boxes", list}};
+    if (k.fisheye()) doc["max_fov_deg"] = k.maxFovDeg;
+    else doc["z_near_m"] = camera.zNear;
+    if (!cameraName.empty()) doc["camera_name"] = cameraName;
     return doc.dump(1) + "\n";
+}
+
+std::string frameBoxesJson(const std::vector<FrameBox>& boxes, const Camera& camera, const glm::dvec3& worldOffset) {
+    return frameBoxesJson(boxes, boxCamera(camera), worldOffset);
 }
 
 const char* kittiType(InstanceKind k) {
@@ -557,11 +693,11 @@ const char* kittiType(InstanceKind k) {
     }
 }
 
-std::string kittiLabels(const std::vector<FrameBox>& boxes, const Camera& camera) {
+std::string kittiLabels(const std::vector<FrameBox>& boxes, const BoxCamera& camera) {
     std::string out;
     char line[512];
     for (const FrameBox& f : boxes) {
-        const glm::dvec3 loc = cameraPoint(camera, bottomCenter(f.box));
+        const glm::dvec3 loc = camera.toCamera(bottomCenter(f.box));
         const CameraYaw cy = cameraYaw(camera, f.box, loc);
         const int occluded = f.visibleFraction >= 0.8 ? 0 : f.visibleFraction >= 0.4 ? 1 : 2;
         std::snprintf(line, sizeof line, "%s %.2f %d %.2f %.2f %.2f %.2f %.2f %.2f %.2f %.2f %.2f %.2f %.2f %.2f\n",
@@ -571,6 +707,10 @@ std::string kittiLabels(const std::vector<FrameBox>& boxes, const Camera& camera
         out += line;
     }
     return out;
+}
+
+std::string kittiLabels(const std::vector<FrameBox>& boxes, const Camera& camera) {
+    return kittiLabels(boxes, boxCamera(camera));
 }
 
 std::string kittiCalib(const Camera& camera, const LidarPose& lidar) {

@@ -21,28 +21,50 @@
 // (-pi/2, pi/2] (a box has no front). The box contains every vertex of its
 // instance.
 //
-// 2D boxes (frameBoxes): pixel coordinates of the OpenCV pinhole convention
-// that cameras.json uses: u = column, v = row from the top, pixel centres at
-// integers, fx = fy = height / (2 tan(fovY / 2)), cx = (width - 1) / 2,
-// cy = (height - 1) / 2; the image spans [-0.5, width - 0.5] x [-0.5,
+// Cameras (BoxCamera): a position, the axes of the camera's OpenCV frame
+// (x right, y down, z forward) in the world, a camera model
+// (runtime/scene/camera_model.h: a pinhole with any fx, fy, cx, cy, or an
+// equidistant fisheye) and, for a pinhole, a near plane zNear. A vista
+// `Camera` converts to one (boxCamera): fx = fy = height / (2 tan(fovY /
+// 2)), cx = (width - 1) / 2, cy = (height - 1) / 2, its zNear; every
+// function taking a `Camera` is that conversion and the BoxCamera function.
+//
+// 2D boxes (frameBoxes): pixel coordinates of the OpenCV convention that
+// cameras.json and the rig files use: u = column, v = row from the top,
+// pixel centres at integers; the image spans [-0.5, width - 0.5] x [-0.5,
 // height - 0.5]. `visible` = the first and last column and row (inclusive
 // pixel indices) of the instance's pixels in the instance image, `pixels`
 // their count. `full` = the extent of the instance's whole geometry as
-// projected by the camera (every triangle clipped against the near plane
-// zNear, so geometry behind the camera never inverts a box), clipped to the
-// image: the box an unoccluded instance would have. `boxExtent` = the same
-// for the 8 corners of its 3D box (its 12 edges clipped against the near
-// plane). `unoccludedPixels` = the pixels whose centre the instance's own
+// projected by the camera, clipped to the image: the box an unoccluded
+// instance would have. `boxExtent` = the same for its 3D box.
+// `unoccludedPixels` = the pixels whose centre the instance's own
 // front-facing triangles cover, with nothing else in the scene: its
 // triangles rasterised into a mask on the CPU (pixel-centre sampling, back
-// faces culled and the near plane clipped as the label pass and the label
-// rays do). Rasterising rather than ray casting the instance alone costs
-// its triangles plus the pixels it covers, needs no per-instance
-// acceleration structure and no GL context, and samples the same points as
-// the instance image. visibleFraction = pixels / unoccludedPixels, clamped
-// to [0, 1] (edge pixels may differ by the fill rule); `truncated` = 1 - the
-// share of the near-clipped projected geometry's extent (area) inside the
-// image.
+// faces culled as the label pass and the label rays do). Rasterising rather
+// than ray casting the instance alone costs its triangles plus the pixels
+// it covers, needs no per-instance acceleration structure and no GL
+// context, and samples the same points as the instance image.
+// visibleFraction = pixels / unoccludedPixels, clamped to [0, 1] (edge
+// pixels may differ by the fill rule); `truncated` = 1 - the share of the
+// projected geometry's extent (area) inside the image.
+// Pinhole: every triangle is clipped against the near plane z = zNear
+// before it is projected (u = cx + fx x / z, v = cy + fy y / z), so
+// geometry behind the camera never inverts a box; the projected box is that
+// of its 8 corners and 12 edges, clipped the same way. Fisheye (r = f
+// theta): the model projects every direction but the one straight behind,
+// and a pixel sees only directions within the image circle (theta <=
+// maxFovDeg / 2), so geometry is clipped against that cone instead: a
+// triangle's projected extent is that of its edges' images inside the cone
+// (each edge sampled at most 1 px apart in the image, plus the points where
+// it crosses the cone) and of the image circle's four extreme points
+// (theta = maxFov / 2, azimuth 0, 90, 180, 270 degrees) whose ray passes
+// through the triangle: the image of a triangle within the cone is bounded
+// by those edge pieces and arcs of the circle, and an arc's extent is its
+// end points' or the circle's extreme points'. The sampling of an edge's
+// curved image errs by well under 0.1 px (inside). The fisheye mask tests
+// each pixel centre of a front-facing triangle's extent: its ray
+// (pixelRay) passes through the triangle. The projected 3D box is the
+// extent of its 12 triangles.
 //
 // Vehicle frame (boxInVehicleFrame): x forward, y left, z up (LidarPose's
 // convention, KITTI's velodyne frame). The centre is exact for any pose;
@@ -52,7 +74,8 @@
 // Thread safety: pure functions on const inputs; CityBoxes is immutable
 // after build and may be shared. Parallel over `threads` workers (0 = all);
 // the results do not depend on the thread count. Contract violations
-// (an instance image whose size differs from the camera's) are VISTA_CHECKs.
+// (an instance image whose size differs from the camera's, a pinhole
+// zNear <= 0) are VISTA_CHECKs.
 #pragma once
 #include <array>
 #include <cstddef>
@@ -65,6 +88,7 @@
 #include "citygen/labels.h"
 #include "runtime/engine/lidar.h"
 #include "runtime/scene/camera.h"
+#include "runtime/scene/camera_model.h"
 #include "runtime/scene/scene_model.h"
 
 namespace vista {
@@ -123,6 +147,18 @@ struct PinholeIntrinsics {
     double fx = 0, fy = 0, cx = 0, cy = 0;
 };
 PinholeIntrinsics pinholeIntrinsics(const Camera& camera);
+
+// A camera as the boxes see it (see above).
+struct BoxCamera {
+    glm::dvec3 eye{0.0};   // world, metres
+    glm::dmat3 axes{1.0};  // columns: the camera's x (right), y (down), z (forward) in the world; a rotation
+    CameraModel model;
+    double zNear = 0.3;  // pinhole near plane, metres (> 0); the fisheye has none
+    // A world point in camera coordinates: x right, y down, z forward (metres).
+    glm::dvec3 toCamera(const glm::dvec3& world) const { return glm::transpose(axes) * (world - eye); }
+};
+BoxCamera boxCamera(const Camera& camera);
+
 // A world point in camera coordinates: x right, y down, z forward (metres).
 glm::dvec3 cameraPoint(const Camera& camera, const glm::dvec3& world);
 
@@ -133,14 +169,21 @@ struct PixelBox {
     double area() const { return valid() ? (u1 - u0) * (v1 - v0) : 0.0; }
 };
 // The projected extent of a convex polyhedron given by its vertices and
-// edges (pairs of vertex indices), its edges clipped against the near
-// plane z = zNear: not clipped to the image; invalid when nothing lies in
-// front of the near plane.
+// edges (pairs of vertex indices) in a pinhole camera, its edges clipped
+// against the near plane z = zNear: not clipped to the image; invalid when
+// nothing lies in front of the near plane. A fisheye camera is a contract
+// violation (projectedBox handles both).
+PixelBox projectedExtent(const BoxCamera& camera, const std::vector<glm::dvec3>& vertices,
+                         const std::vector<std::array<int, 2>>& edges);
 PixelBox projectedExtent(const Camera& camera, const std::vector<glm::dvec3>& vertices,
                          const std::vector<std::array<int, 2>>& edges);
-// projectedExtent of the box's 8 corners and 12 edges.
+// The projected extent of the box (see above), not clipped to the image;
+// invalid when none of it can be seen (behind a pinhole's near plane,
+// outside a fisheye's cone).
+PixelBox projectedBox(const BoxCamera& camera, const OrientedBox& box);
 PixelBox projectedBox(const Camera& camera, const OrientedBox& box);
 // The extent clipped to the image [-0.5, width - 0.5] x [-0.5, height - 0.5] (invalid when outside).
+PixelBox clipToImage(const PixelBox& b, int width, int height);
 PixelBox clipToImage(const PixelBox& b, const Camera& camera);
 
 struct FrameBox {
@@ -161,22 +204,27 @@ struct FrameBoxOptions {
 };
 
 // The 2D boxes of one frame: every object instance with at least minPixels
-// pixels in `ids` (the instance image: camera.width * camera.height ids,
-// row 0 at the top), sorted by id.
+// pixels in `ids` (the instance image: width * height ids of the camera's
+// model, row 0 at the top), sorted by id.
+std::vector<FrameBox> frameBoxes(const SceneModel& city, const CityBoxes& boxes, const BoxCamera& camera,
+                                 const std::vector<uint32_t>& ids, const FrameBoxOptions& options = {});
 std::vector<FrameBox> frameBoxes(const SceneModel& city, const CityBoxes& boxes, const Camera& camera,
                                  const std::vector<uint32_t>& ids, const FrameBoxOptions& options = {});
 
 // One frame's boxes as JSON text (docs/formats.md "Boxes"): world
 // positions minus `worldOffset` (cameras.json's world_offset), the camera's
-// intrinsics, and per box its 2D extents and its 3D box in the world and
-// camera frames.
+// model and intrinsics (and its name when `cameraName` is not empty), and
+// per box its 2D extents and its 3D box in the world and camera frames.
+std::string frameBoxesJson(const std::vector<FrameBox>& boxes, const BoxCamera& camera, const glm::dvec3& worldOffset,
+                           const std::string& cameraName = "");
 std::string frameBoxesJson(const std::vector<FrameBox>& boxes, const Camera& camera, const glm::dvec3& worldOffset);
 
 // KITTI object label lines (one per box, '\n'-terminated): type, truncated,
 // occluded (0: visibleFraction >= 0.8, 1: >= 0.4, 2: less), alpha, bbox
 // (the visible extent, inclusive pixel indices), dimensions (height, width,
 // length), location (bottom centre in camera coordinates), rotation_y.
-// For a level camera (pitch and roll 0) as KITTI assumes.
+// For a level pinhole camera (pitch and roll 0) as KITTI assumes.
+std::string kittiLabels(const std::vector<FrameBox>& boxes, const BoxCamera& camera);
 std::string kittiLabels(const std::vector<FrameBox>& boxes, const Camera& camera);
 const char* kittiType(InstanceKind k);  // "Car", "Building", "Tree", ...
 

@@ -20,8 +20,9 @@ namespace {
 
 using Json = nlohmann::json;
 
-const std::pair<unsigned, const char*> kChannelNames[] = {
-    {kRigRgb, "rgb"}, {kRigDepth, "depth"}, {kRigSemantic, "semantic"}, {kRigInstance, "instance"}, {kRigFlow, "flow"}};
+const std::pair<unsigned, const char*> kChannelNames[] = {{kRigRgb, "rgb"},           {kRigDepth, "depth"},
+                                                          {kRigSemantic, "semantic"}, {kRigInstance, "instance"},
+                                                          {kRigFlow, "flow"},         {kRigBoxes, "boxes"}};
 
 // A place in the rig file: its JSON pointer (number texts) and its path for messages.
 struct Where {
@@ -128,18 +129,19 @@ Status readCamera(const FieldReader& r, const Json& s, const Where& w, bool fish
     if (fisheye)
         VISTA_RETURN_IF_ERROR(r.real(in, iw, "max_fov_deg", RealRange::openMin(0, 360), "degrees", m.maxFovDeg, true));
     const Where cw = w.key("channels");
-    if (!s.contains("channels")) return r.error(cw, "is missing (a list of rgb, depth, semantic, instance, flow)");
+    if (!s.contains("channels"))
+        return r.error(cw, "is missing (a list of rgb, depth, semantic, instance, flow, boxes)");
     const Json& ch = s["channels"];
     if (!ch.is_array() || ch.empty())
-        return r.error(cw,
-                       "must be a non-empty list of rgb, depth, semantic, instance, flow, got " + echoText(ch.dump()));
+        return r.error(
+            cw, "must be a non-empty list of rgb, depth, semantic, instance, flow, boxes, got " + echoText(ch.dump()));
     for (size_t i = 0; i < ch.size(); ++i) {
         unsigned bit = 0;
         for (const auto& [b, name] : kChannelNames)
             if (ch[i].is_string() && ch[i].get<std::string>() == name) bit = b;
         if (!bit)
-            return r.error(cw.index(i),
-                           "= " + echoText(ch[i].dump()) + " is not a channel (rgb, depth, semantic, instance, flow)");
+            return r.error(cw.index(i), "= " + echoText(ch[i].dump()) +
+                                            " is not a channel (rgb, depth, semantic, instance, flow, boxes)");
         if (c.channels & bit) return r.error(cw.index(i), "= " + ch[i].dump() + " is given twice");
         c.channels |= bit;
     }

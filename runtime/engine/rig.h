@@ -34,7 +34,7 @@
 // cameras: "intrinsics": {"width", "height": 1 .. 8192, "fx", "fy": (0, 1e6]
 //   pixels, "cx": [0, width], "cy": [0, height], fisheye also "max_fov_deg":
 //   (0, 360]} and "channels": a non-empty list of "rgb", "depth", "semantic",
-//   "instance", "flow" (no repeats);
+//   "instance", "flow", "boxes" (no repeats; boxes: runtime/engine/rig_boxes.h);
 // LiDARs (LidarSpec): "beams": a list of 1 .. 256 elevations in [-90, 90]
 //   degrees, or {"count": 1 .. 256, "min_deg", "max_deg": [-90, 90], min <=
 //   max} (evenBeamTable); "columns": 1 .. 65536 (beams x columns at most
@@ -64,7 +64,14 @@ constexpr int kMaxRigSensors = 64;
 constexpr size_t kMaxLidarRays = size_t(1) << 22;  // beams x columns of one sweep
 
 // Channels a rig camera writes (bit set).
-enum RigChannel : unsigned { kRigRgb = 1, kRigDepth = 2, kRigSemantic = 4, kRigInstance = 8, kRigFlow = 16 };
+enum RigChannel : unsigned {
+    kRigRgb = 1,
+    kRigDepth = 2,
+    kRigSemantic = 4,
+    kRigInstance = 8,
+    kRigFlow = 16,
+    kRigBoxes = 32
+};
 // "rgb,depth,..." in the order above.
 std::string rigChannelList(unsigned channels);
 

@@ -39,7 +39,7 @@ void resizeChannels(const CameraShot& s, CameraImages& out) {
     };
     fit(out.depth, (s.channels & kRigDepth) != 0, 1);
     fit(out.classes, (s.channels & kRigSemantic) != 0, 1);
-    fit(out.ids, (s.channels & kRigInstance) != 0, 1);
+    fit(out.ids, (s.channels & (kRigInstance | kRigBoxes)) != 0, 1);
     fit(out.flow, (s.channels & kRigFlow) != 0, 2);
 }
 
@@ -62,7 +62,7 @@ void castRigCamera(const SceneModel& city, const RayScene& rays, const CameraSho
     const int W = s.model.width, H = s.model.height;
     const glm::vec3 org(s.pose.position - rays.frameOrigin());
     const bool wantRgb = (s.channels & kRigRgb) != 0, wantDepth = (s.channels & kRigDepth) != 0;
-    const bool wantCls = (s.channels & kRigSemantic) != 0, wantIds = (s.channels & kRigInstance) != 0;
+    const bool wantCls = (s.channels & kRigSemantic) != 0, wantIds = (s.channels & (kRigInstance | kRigBoxes)) != 0;
     const bool wantFlow = (s.channels & kRigFlow) != 0;
     const glm::dmat3 nextInv = glm::transpose(s.next.rotation);
     inArena(threads, [&] {

@@ -14,7 +14,9 @@
 // - depth (float32 metres): pinhole: z-depth along the optical axis;
 //   fisheye: the distance along the ray (a fisheye sees behind its image
 //   plane); +inf for sky;
-// - semantic / instance: ground_truth.h rayLabel (0 and 0 for sky);
+// - semantic / instance: ground_truth.h rayLabel (0 and 0 for sky); `ids`
+//   is also filled for boxes (the instance image that the boxes are
+//   computed from, runtime/engine/rig_boxes.h);
 // - flow (float32 pairs du, dv, pixels): where the surface point (or, for
 //   sky, the point at infinity in the ray's direction) seen at pixel (u, v)
 //   projects in the camera at pose `next`, minus (u, v): exact forward flow

@@ -312,8 +312,11 @@ std::map<std::string, std::string> outputFiles(const std::string& dir) {
 // A run killed (SIGKILL, through the documented test hook) after `killAfter`
 // frames, then rerun with the same arguments: the result equals an
 // uninterrupted run byte for byte (all but summary.json's timings).
+// `removeAfterKill`: a file of the killed run's output (under DIR.partial/out) removed before
+// the resume; its frame is rendered again.
 void expectResumeEqualsUninterrupted(const std::string& city, const std::string& args, const std::string& ref,
-                                     const std::string& out, int killAfter, int frames) {
+                                     const std::string& out, int killAfter, int frames,
+                                     const std::string& removeAfterKill = "") {
     auto r = runVista("render " + city + " " + args + " -q --out " + ref);
     ASSERT_EQ(r.code, 0) << r.err;
     r = runVista("render " + city + " " + args + " -q --out " + out,
@@ -323,6 +326,9 @@ void expectResumeEqualsUninterrupted(const std::string& city, const std::string&
     int records = 0;
     for (const auto& e : fs::directory_iterator(out + ".partial/done")) records += e.path().extension() == ".json";
     EXPECT_EQ(records, killAfter);
+    if (!removeAfterKill.empty()) {
+        EXPECT_TRUE(fs::remove(out + ".partial/out/" + removeAfterKill)) << removeAfterKill;
+    }
     r = runVista("render " + city + " " + args + " -q --out " + out);
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_FALSE(fs::exists(out + ".partial")) << "the work directory is gone after the final rename";
@@ -335,7 +341,7 @@ void expectResumeEqualsUninterrupted(const std::string& city, const std::string&
     }
     const auto summary = nlohmann::json::parse(test::readBytes(out + "/summary.json"));
     EXPECT_EQ(summary["frames"].get<int>(), frames);
-    EXPECT_EQ(summary["frames_resumed"].get<int>(), killAfter);
+    EXPECT_EQ(summary["frames_resumed"].get<int>(), killAfter - (removeAfterKill.empty() ? 0 : 1));
     if (summary.contains("median_ms")) {
         EXPECT_FALSE(summary["median_ms"]["labels_total"].is_null()) << "timings cover the resumed frames too";
     } else {  // a rig run: every sensor's timings
@@ -360,18 +366,19 @@ TEST_F(GroundTruth, HybridResumesAfterKillByteIdentical) {
 }
 
 TEST_F(GroundTruth, RigResumesAfterKillByteIdentical) {
-    // A rig (pinhole with flow, fisheye, LiDAR at its own rate): the sensors
-    // that fired in the killed run's frames are kept, the rest cast again.
+    // A rig (pinhole with flow and boxes, fisheye with boxes, LiDAR at its own
+    // rate): the sensors that fired in the killed run's frames and the frames'
+    // 3D boxes are kept, the rest cast again.
     const std::string rig = dir->file("resume_rig.json");
     std::ofstream(rig) << R"({"sensors": [
         {"name": "front", "type": "pinhole", "rate_hz": 15, "intrinsics": {"width": 64, "height": 48, "fx": 50,
-         "fy": 50, "cx": 31.5, "cy": 23.5}, "channels": ["rgb", "depth", "semantic", "instance", "flow"]},
+         "fy": 50, "cx": 31.5, "cy": 23.5}, "channels": ["rgb", "depth", "semantic", "instance", "flow", "boxes"]},
         {"name": "side", "type": "fisheye", "pose": {"yaw_deg": 90}, "intrinsics": {"width": 48, "height": 48,
-         "fx": 15, "fy": 15, "cx": 23.5, "cy": 23.5, "max_fov_deg": 180}, "channels": ["rgb", "depth", "flow"]},
+         "fx": 15, "fy": 15, "cx": 23.5, "cy": 23.5, "max_fov_deg": 180}, "channels": ["rgb", "depth", "flow", "boxes"]},
         {"name": "top", "type": "lidar", "pose": {"z": 0.5}, "beams": {"count": 8, "min_deg": -15, "max_deg": 5},
          "columns": 180}]})";
     expectResumeEqualsUninterrupted(city, "--path " + pathCsv + " --frames 6 --sampling consecutive --rig " + rig,
-                                    dir->file("res_rig_ref"), dir->file("res_rig"), 4, 6);
+                                    dir->file("res_rig_ref"), dir->file("res_rig"), 4, 6, "boxes_3d/000001.json");
 }
 
 TEST_F(GroundTruth, ExternalKillThenResume) {

@@ -39,7 +39,8 @@ TEST(Rig, ExampleRigParses) {
     ASSERT_EQ(rig->cameras.size(), 4u);
     ASSERT_EQ(rig->lidars.size(), 1u);
     EXPECT_EQ(rig->cameras[2].model.kind, CameraModel::Kind::Fisheye);
-    EXPECT_EQ(rig->cameras[0].channels, unsigned(kRigRgb | kRigDepth | kRigSemantic | kRigInstance | kRigFlow));
+    EXPECT_EQ(rig->cameras[0].channels,
+              unsigned(kRigRgb | kRigDepth | kRigSemantic | kRigInstance | kRigFlow | kRigBoxes));
     EXPECT_EQ(rig->lidars[0].spec.elevationDeg.size(), 64u);
     EXPECT_EQ(rig->lidars[0].spec.columns, 2048);
     EXPECT_TRUE(validateLidarSpec(rig->lidars[0].spec).isOk());

@@ -1,0 +1,328 @@
+// Boxes of rig cameras (rig_boxes.h, boxes.h BoxCamera) against independent
+// computations on a generated city with parked cars: for a pinhole with an
+// off-centre principal point and fx != fy the visible boxes equal the
+// instance mask's extents counted here, the full extents hold every visible
+// pixel centre, and an instance wholly in front of the camera has the
+// extent of its vertices projected here within 0.5 px; for a fisheye the
+// visible boxes equal the mask's extents, the full extents hold every
+// visible pixel centre and every vertex inside the image circle projected
+// here, and the unoccluded pixel counts agree with rays cast here at the
+// instance alone; a box in the vehicle frame is the world box through the inverse of
+// the pose's 4x4 matrix, in the file too; sightings merge cameras and LiDARs.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "citygen/generate.h"
+#include "citygen/labels.h"
+#include "foundation/units.h"
+#include "runtime/engine/boxes.h"
+#include "runtime/engine/ray_scene.h"
+#include "runtime/engine/rig_boxes.h"
+#include "runtime/engine/rig_camera.h"
+#include "runtime/scene/city_file.h"
+#include "tests/common/temp_dir.h"
+
+using namespace vista;
+
+namespace {
+
+struct TestCity {
+    SceneModel model;
+    std::unique_ptr<RayScene> rays;
+    CityBoxes boxes;
+};
+
+const TestCity& testCity() {
+    static TestCity* city = [] {
+        CityParams p;
+        p.seed = 5;
+        p.size_m = 400.0;
+        p.tile_size_m = 100.0;
+        p.origin_x = -3000.0;
+        p.origin_y = 1500.0;
+        p.parked_car_share = 0.6;
+        auto generated = generateCity(p);
+        VISTA_CHECK(generated.isOk());
+        test::TempDir dir("vista_rig_boxes");
+        VISTA_CHECK(writeCityFile(*generated, dir.file("city.osgb")).isOk());
+        auto model = loadCityFile(dir.file("city.osgb"));
+        VISTA_CHECK(model.isOk());
+        auto* c = new TestCity{std::move(*model), nullptr, {}};
+        auto rays = RayScene::build(c->model);
+        VISTA_CHECK(rays.isOk());
+        c->rays = std::move(*rays);
+        c->boxes = buildCityBoxes(c->model);
+        return c;
+    }();
+    return *city;
+}
+
+// A vehicle on street edge e (at `at` of its length), 1.2 m above the ground, driving along it;
+// the camera mounted 0.4 m up, turned `yawDeg` to the left and pitched down 3 degrees.
+RigPose cameraPose(const TestCity& c, size_t e, double at, double yawDeg) {
+    const StreetGraph& g = c.model.streets;
+    const glm::dvec2 a = g.nodes[g.edges[e].a], b = g.nodes[g.edges[e].b];
+    const glm::dvec2 xy = a + at * (b - a) + glm::dvec2(c.model.params.origin_x, c.model.params.origin_y);
+    const glm::dvec3 top(xy, 300.0);
+    const RayHit down = c.rays->intersect(glm::vec3(top - c.rays->frameOrigin()), glm::vec3(0, 0, -1));
+    PathSample s;
+    s.position = glm::dvec3(xy, (down.hit ? 300.0 - double(down.t) : 0.0) + 1.2);
+    const glm::dvec2 d = b - a;
+    s.heading = std::atan2(d.x, d.y);
+    SensorMount m;
+    m.position = {0.2, 0.0, 0.4};
+    m.yawDeg = yawDeg;
+    m.pitchDeg = -3.0;
+    return sensorPose(vehiclePose(s), m);
+}
+
+// The OpenCV camera coordinates of a world point, written out here: x = -left, y = -up, z = forward.
+glm::dvec3 cvPoint(const RigPose& p, const glm::dvec3& w) {
+    const glm::dvec3 d = w - p.position;
+    return {-glm::dot(d, p.rotation[1]), -glm::dot(d, p.rotation[2]), glm::dot(d, p.rotation[0])};
+}
+
+struct Mask {
+    int u0 = 1 << 30, v0 = 1 << 30, u1 = -1, v1 = -1;
+    uint32_t n = 0;
+    std::vector<glm::ivec2> pixels;
+};
+
+std::map<uint32_t, Mask> masks(const CityBoxes& boxes, const std::vector<uint32_t>& ids, int W, int H) {
+    std::map<uint32_t, Mask> out;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const uint32_t id = ids[size_t(y) * size_t(W) + size_t(x)];
+            if (!boxes.find(id)) continue;
+            Mask& m = out[id];
+            m.u0 = std::min(m.u0, x), m.v0 = std::min(m.v0, y), m.u1 = std::max(m.u1, x), m.v1 = std::max(m.v1, y);
+            ++m.n;
+            m.pixels.push_back({x, y});
+        }
+    return out;
+}
+
+CameraImages castBoxes(const TestCity& c, const CameraModel& model, const RigPose& pose) {
+    CameraShot shot;
+    shot.model = model;
+    shot.pose = pose;
+    shot.channels = kRigBoxes;
+    CameraImages im;
+    VISTA_CHECK(c.rays->placeFrameNear(pose.position).isOk());
+    castRigCamera(c.model, *c.rays, shot, im);
+    return im;
+}
+
+void expectVisibleEqualsMask(const FrameBox& f, const Mask& m) {
+    EXPECT_EQ(f.visibleU0, m.u0);
+    EXPECT_EQ(f.visibleV0, m.v0);
+    EXPECT_EQ(f.visibleU1, m.u1);
+    EXPECT_EQ(f.visibleV1, m.v1);
+    EXPECT_EQ(f.pixels, m.n);
+}
+
+void expectHolds(const PixelBox& b, double u, double v, double tol, uint32_t id) {
+    ASSERT_TRUE(b.valid()) << id;
+    EXPECT_LE(b.u0, u + tol) << instanceKindName(instanceKind(id));
+    EXPECT_GE(b.u1, u - tol) << instanceKindName(instanceKind(id));
+    EXPECT_LE(b.v0, v + tol) << instanceKindName(instanceKind(id));
+    EXPECT_GE(b.v1, v - tol) << instanceKindName(instanceKind(id));
+}
+
+// Fisheye pixels whose ray, written out here, hits the instance's triangles alone (back faces culled).
+uint32_t fisheyeRaysAtInstanceAlone(const CameraModel& m, const RigPose& pose, const std::vector<glm::dvec3>& tris) {
+    TriangleSoup soup;
+    for (const glm::dvec3& p : tris) {
+        soup.indices.push_back(uint32_t(soup.positions.size()));
+        soup.positions.push_back(glm::vec3(p - pose.position));
+        soup.colors.push_back({255, 255, 255, 255});
+    }
+    SoupSceneOptions o;
+    o.cullBackFaces = true;
+    auto scene = RayScene::build(soup, o);
+    VISTA_CHECK(scene.isOk());
+    const double thetaMax = 0.5 * degToRad(m.maxFovDeg);
+    uint32_t n = 0;
+    for (int v = 0; v < m.height; ++v)
+        for (int u = 0; u < m.width; ++u) {
+            const double x = (u - m.cx) / m.fx, y = (v - m.cy) / m.fy, th = std::hypot(x, y);
+            if (th > thetaMax) continue;
+            const double s = th > 0 ? std::sin(th) / th : 1.0;
+            // OpenCV (x right, y down, z forward) = (-left, -up, forward).
+            const glm::dvec3 d = -x * s * pose.rotation[1] - y * s * pose.rotation[2] + std::cos(th) * pose.rotation[0];
+            n += (*scene)->intersect(glm::vec3(0.0f), glm::vec3(d)).hit ? 1u : 0u;
+        }
+    return n;
+}
+
+}  // namespace
+
+TEST(RigBoxes, PinholeWithOffCentreIntrinsicsMatchesTheMaskAndProjectedVertices) {
+    const TestCity& c = testCity();
+    CameraModel model;
+    model.width = 200, model.height = 150;
+    model.fx = 170.0, model.fy = 130.0, model.cx = 83.25, model.cy = 88.75;
+    size_t compared = 0, projected = 0, cars = 0;
+    for (size_t e = 0; e < c.model.streets.edges.size() && compared < 80; e += 4) {
+        const RigPose pose = cameraPose(c, e, 0.35, e % 8 == 0 ? 20.0 : -15.0);
+        const CameraImages im = castBoxes(c, model, pose);
+        ASSERT_EQ(im.ids.size(), size_t(model.width) * size_t(model.height)) << "boxes compute the instance image";
+        EXPECT_TRUE(im.depth.empty() && im.classes.empty() && im.rgb.width == 0);
+        const auto mask = masks(c.boxes, im.ids, model.width, model.height);
+        const std::vector<FrameBox> fb = frameBoxes(c.model, c.boxes, rigBoxCamera(model, pose), im.ids);
+        ASSERT_EQ(fb.size(), mask.size());
+        for (const FrameBox& f : fb) {
+            const Mask& m = mask.at(f.id);
+            expectVisibleEqualsMask(f, m);
+            for (const glm::ivec2& px : m.pixels) expectHolds(f.full, px.x, px.y, 1e-6, f.id);
+            EXPECT_GE(f.unoccludedPixels + 2 + f.pixels / 50, f.pixels) << instanceKindName(instanceKind(f.id));
+            ++compared;
+            // Wholly in front of the camera: the extent of its vertices projected here, clipped to the image.
+            const std::vector<glm::dvec3> pts = instancePoints(c.model, c.boxes, *c.boxes.find(f.id));
+            double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
+            bool front = true;
+            for (const glm::dvec3& w : pts) {
+                const glm::dvec3 q = cvPoint(pose, w);
+                if (q.z < 0.05) front = false;
+                const double u = model.cx + model.fx * q.x / q.z, v = model.cy + model.fy * q.y / q.z;
+                u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, v), v1 = std::max(v1, v);
+            }
+            if (!front) continue;
+            u0 = std::max(u0, -0.5), v0 = std::max(v0, -0.5);
+            u1 = std::min(u1, model.width - 0.5), v1 = std::min(v1, model.height - 0.5);
+            EXPECT_NEAR(f.full.u0, u0, 0.5) << f.id;
+            EXPECT_NEAR(f.full.v0, v0, 0.5) << f.id;
+            EXPECT_NEAR(f.full.u1, u1, 0.5) << f.id;
+            EXPECT_NEAR(f.full.v1, v1, 0.5) << f.id;
+            ++projected;
+            cars += instanceKind(f.id) == InstanceKind::Car ? 1 : 0;
+        }
+    }
+    EXPECT_GT(compared, 30u);
+    EXPECT_GT(projected, 10u);
+    EXPECT_GT(cars, 2u);
+}
+
+TEST(RigBoxes, FisheyeBoxesHoldTheVisiblePixelsAndTheVerticesInsideTheImageCircle) {
+    const TestCity& c = testCity();
+    CameraModel model;
+    model.kind = CameraModel::Kind::Fisheye;
+    model.width = 160, model.height = 120;
+    model.fx = 38.0, model.fy = 42.0, model.cx = 78.5, model.cy = 61.0;
+    model.maxFovDeg = 190.0;
+    const double thetaMax = degToRad(95.0);
+    size_t compared = 0, vertices = 0, aloneChecked = 0;
+    for (size_t e = 1; e < c.model.streets.edges.size() && compared < 60; e += 6) {
+        const RigPose pose = cameraPose(c, e, 0.5, 90.0);
+        const CameraImages im = castBoxes(c, model, pose);
+        const auto mask = masks(c.boxes, im.ids, model.width, model.height);
+        const std::vector<FrameBox> fb = frameBoxes(c.model, c.boxes, rigBoxCamera(model, pose), im.ids);
+        ASSERT_EQ(fb.size(), mask.size());
+        for (const FrameBox& f : fb) {
+            const Mask& m = mask.at(f.id);
+            expectVisibleEqualsMask(f, m);
+            for (const glm::ivec2& px : m.pixels) expectHolds(f.full, px.x, px.y, 0.1, f.id);
+            EXPECT_GE(f.unoccludedPixels + 2 + f.pixels / 50, f.pixels) << instanceKindName(instanceKind(f.id));
+            EXPECT_GE(f.visibleFraction, 0.0);
+            EXPECT_LE(f.visibleFraction, 1.0);
+            ++compared;
+            const std::vector<glm::dvec3> pts = instancePoints(c.model, c.boxes, *c.boxes.find(f.id));
+            if (aloneChecked < 10 && f.pixels > 100) {
+                const uint32_t alone = fisheyeRaysAtInstanceAlone(model, pose, pts);
+                EXPECT_NEAR(double(f.unoccludedPixels), double(alone), 3.0 + 0.02 * alone)
+                    << instanceKindName(instanceKind(f.id));
+                ++aloneChecked;
+            }
+            for (const glm::dvec3& w : pts) {
+                const glm::dvec3 q = cvPoint(pose, w);
+                const double rho = std::hypot(q.x, q.y), th = std::atan2(rho, q.z);
+                if (rho == 0 || th > thetaMax) continue;
+                const double u = model.cx + model.fx * th * q.x / rho, v = model.cy + model.fy * th * q.y / rho;
+                if (u < -0.5 || v < -0.5 || u > model.width - 0.5 || v > model.height - 0.5) continue;
+                expectHolds(f.full, u, v, 1e-6, f.id);
+                expectHolds(f.boxExtent, u, v, 0.01, f.id);  // sampled curved edges err inside
+                ++vertices;
+            }
+        }
+    }
+    EXPECT_GT(compared, 30u);
+    EXPECT_GT(vertices, 1000u);
+    EXPECT_GT(aloneChecked, 4u);
+}
+
+TEST(RigBoxes, VehicleFrameBoxesAreTheWorldBoxesThroughThePose) {
+    PathSample s;
+    s.position = {-2950.0, 1520.0, 31.5};
+    s.heading = 1.1;
+    s.pitch = 0.04;
+    const RigPose vehicle = vehiclePose(s);
+    OrientedBox b;
+    b.center = {-2940.0, 1531.0, 31.0};
+    b.size = {4.4, 1.8, 1.5};
+    b.yaw = -0.7;
+    // The pose's 4x4 matrix (columns: the body axes, then the position), inverted by glm.
+    glm::dmat4 T(1.0);
+    for (int i = 0; i < 3; ++i) T[i] = glm::dvec4(vehicle.rotation[i], 0.0);
+    T[3] = glm::dvec4(vehicle.position, 1.0);
+    const glm::dmat4 inv = glm::inverse(T);
+    const glm::dvec3 c = glm::dvec3(inv * glm::dvec4(b.center, 1.0));
+    const glm::dvec3 tip = glm::dvec3(inv * glm::dvec4(b.center + b.lengthAxis(), 1.0)) - c;
+    double yaw = std::atan2(tip.y, tip.x);
+    if (yaw > kHalfPi) yaw -= kPi;
+    if (yaw <= -kHalfPi) yaw += kPi;
+    const OrientedBox v = boxInPoseFrame(b, vehicle);
+    EXPECT_NEAR(v.center.x, c.x, 1e-9);
+    EXPECT_NEAR(v.center.y, c.y, 1e-9);
+    EXPECT_NEAR(v.center.z, c.z, 1e-9);
+    EXPECT_NEAR(v.yaw, yaw, 1e-9);
+    EXPECT_EQ(v.size, b.size);
+    // Heading 1.1 rad east of north, the box 10 m east and 11 m north: ahead and to the left.
+    EXPECT_GT(v.center.x, 10.0);
+    EXPECT_GT(v.center.y, 0.0);
+
+    // The file: world minus the offset, vehicle frame as above, vehicle_to_world its inverse.
+    CityBoxes boxes;
+    InstanceBox ib;
+    ib.id = makeInstanceId(InstanceKind::Car, 7);
+    ib.box = b;
+    boxes.boxes.push_back(ib);
+    FrameSightings seen;
+    addCameraSightings(seen, "front", {FrameBox{ib.id, b}});
+    LidarSweep sweep;
+    for (uint32_t id : {ib.id, ib.id, 0u, makeInstanceId(InstanceKind::Road, 1), ib.id}) {
+        LidarPoint p;
+        p.instance = id;
+        sweep.points.push_back(p);
+    }
+    addLidarSightings(seen, "top", sweep, boxes);
+    ASSERT_EQ(seen.size(), 1u) << "a road has no box";
+    const glm::dvec3 offset(-3000.0, 1500.0, 0.0);
+    const auto j = nlohmann::json::parse(frameBoxes3dJson(boxes, seen, vehicle, offset, "000004", 0.4));
+    EXPECT_EQ(j["format"], "vista.boxes_3d");
+    EXPECT_EQ(j["frame"], "000004");
+    ASSERT_EQ(j["boxes"].size(), 1u);
+    const auto& jb = j["boxes"][0];
+    EXPECT_EQ(jb["kind"], "car");
+    EXPECT_EQ(jb["index"], 7);
+    EXPECT_EQ(jb["seen_by"], nlohmann::json({"front", "top"}));
+    EXPECT_EQ(jb["lidar_points"], 3);
+    const auto& M = j["vehicle_to_world"];
+    glm::dmat4 F(1.0);  // from the file's rows
+    for (int r = 0; r < 4; ++r)
+        for (int k = 0; k < 4; ++k) F[k][r] = M[r][k].get<double>();
+    glm::dvec3 w;
+    for (int i = 0; i < 3; ++i) w[i] = jb["world"]["center"][size_t(i)].get<double>();
+    EXPECT_NEAR(w.x, 60.0, 1e-9);
+    const glm::dvec3 fromFile = glm::dvec3(glm::inverse(F) * glm::dvec4(w, 1.0));
+    for (int i = 0; i < 3; ++i) {
+        EXPECT_NEAR(jb["vehicle"]["center"][size_t(i)].get<double>(), c[i], 1e-3);
+        EXPECT_NEAR(fromFile[i], c[i], 2e-3);
+    }
+    EXPECT_NEAR(jb["vehicle"]["yaw"].get<double>(), yaw, 1e-3);
+}
