@@ -428,11 +428,15 @@ void AdaptiveSplit::recordFrame(double nearD, double frameMs) {
     _frameMs = _frameMs > 0 ? (1 - _o.smoothing) * _frameMs + _o.smoothing * frameMs : frameMs;
     const int kind = kindOf(nearD);
     // A kind's first frame pays one-time costs (the first draw of the chunks, the far field's
-    // first frame, the ray casters' threads): not counted.
-    if (!_kindSeen[kind]) {
+    // first frame): not counted. Ray casting draws nothing, and once a frame has run its casters'
+    // threads are warm: its first frame counts, so that a price resting on the probe's one-thread
+    // rate (which overprices the coherent rows of a ray-cast frame) is corrected by one try.
+    const bool oneTimeCosts = kind != 0 || _frame <= 1;
+    if (!_kindSeen[kind] && oneTimeCosts) {
         _kindSeen[kind] = true;
         return;
     }
+    _kindSeen[kind] = true;
     std::vector<KindFrame>& w = _kindFrames[kind];
     w.push_back({double(_chosenTris), _chosenRays, double(_pixels), frameMs});
     if (w.size() > kKindWindow) w.erase(w.begin());

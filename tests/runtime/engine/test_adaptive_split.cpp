@@ -360,7 +360,7 @@ TEST(Split, EachChoiceLearnsItsOwnFixedCost) {
         s.record(uint64_t(tris), 1.0 + 1e-2 * tris, 5000, 5000 * 1e-6);  // rays nearly free
     }
     ASSERT_EQ(s.choose(out, -1), 0.0);
-    s.recordFrame(0.0, 5000.0);  // a kind's first frame (one-time costs) is not counted
+    s.recordFrame(0.0, 5000.0);  // one slow frame: the lower quartile of the kind's frames is its correction
     ASSERT_EQ(s.choose(out, -1), 0.0);
     s.recordFrame(0.0, 1000.0);
     EXPECT_GT(s.correctionMs(0), 900.0);
