@@ -34,6 +34,12 @@
 // selected (points far from the city, or none), or no full region readable
 // (the message names the radius or every damaged file).
 //
+// loadPagedRegion(): region `region`'s full file (or its coarse level),
+// after checking that the file exists and has the manifest's size; the
+// region's own SceneModel (loadCityFile). Errors name the file: missing,
+// another size than the manifest's, unreadable or corrupt; an empty region
+// or an index out of range. Thread-safe (reads the manifest only).
+//
 // pagedPathStreets(): the street graph that a path of a paged city made from
 // a seed runs on: the whole city's graph, grown again from the manifest's
 // params (growStreets, as `vista gen` made it: paged cities are never OSM
@@ -108,6 +114,7 @@ std::vector<int> selectCoarseRegions(const PagedManifest& m, const std::vector<g
                                      const std::vector<int>& full);
 Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>& regions, double radiusM,
                                  PagedLoadReport* report = nullptr, const std::vector<int>& coarse = {});
+Result<SceneModel> loadPagedRegion(const PagedManifest& m, int region, bool coarse);
 Result<StreetGraph> pagedPathStreets(const PagedManifest& m);
 
 }  // namespace vista
