@@ -18,6 +18,7 @@
 #include "runtime/engine/metrics.h"
 #include "runtime/engine/ray_scene.h"
 #include "runtime/engine/ray_set.h"
+#include "runtime/engine/ray_streaming.h"
 
 namespace vista {
 
@@ -37,6 +38,7 @@ double loadAverage() {
 struct BenchRun {
     std::unique_ptr<OffscreenRenderer> renderer;
     std::unique_ptr<RayScene> rays;
+    std::unique_ptr<StreamedRayScene> stream;  // instead of `rays` when the city is streamed
     ModeContext ctx;
     std::vector<std::unique_ptr<RenderMode>> modes;
     std::vector<SetupTimes> setup;  // per mode: load, bvh, the mode's own
@@ -58,10 +60,17 @@ Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene
     if (needRays) {
         if (!city) return Status::error("modes that cast rays need a loaded city file (no city given)");
         Stopwatch sw;
-        auto r = RayScene::build(*city);
-        if (!r) return Status::error("building the Embree ray scene failed: " + r.status().message());
-        run->rays = std::move(r.value());
-        run->ctx.rays = run->rays.get();
+        if (cfg.streamManifest) {
+            auto s = StreamedRayScene::create(*cfg.streamManifest, cfg.stream, city->prototypes);
+            if (!s) return Status::error("setting up the streamed ray scene failed: " + s.status().message());
+            run->stream = std::move(s.value());
+            run->ctx.rays = &run->stream->rays();
+        } else {
+            auto r = RayScene::build(*city);
+            if (!r) return Status::error("building the Embree ray scene failed: " + r.status().message());
+            run->rays = std::move(r.value());
+            run->ctx.rays = run->rays.get();
+        }
         bvhMs = sw.ms();
         if (!cfg.quiet) std::fprintf(stderr, "ray scene built in %.0f ms\n", bvhMs);
     }
@@ -78,8 +87,34 @@ Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene
     return run;
 }
 
+// The camera's velocity at path sample i (metres per second; from the next
+// sample, or the previous one at the end; zero for a path of one sample).
+glm::dvec3 pathVelocity(const Path& path, size_t i) {
+    const auto& s = path.samples;
+    if (s.size() < 2) return glm::dvec3(0.0);
+    const size_t a = i + 1 < s.size() ? i : i - 1;
+    const double dt = s[a + 1].t - s[a].t;
+    return dt > 0 ? (s[a + 1].position - s[a].position) / dt : glm::dvec3(0.0);
+}
+
+// A streamed city: the ray scene follows the camera of path sample i
+// (arrivals and drops between frames); damaged files are warned about once.
+Status advanceStream(BenchRun& run, const Path& path, size_t i, const Camera& cam, BenchResult& result, int* arrived) {
+    *arrived = 0;
+    if (!run.stream) return Status::ok();
+    auto f = run.stream->advance(cam.eye, pathVelocity(path, i));
+    if (!f) return f.status();
+    for (const std::string& d : f->damaged) {
+        std::fprintf(stderr, "vista bench: warning: %s; the rest of the city streams\n", d.c_str());
+        result.streamDamaged.push_back(d);
+    }
+    *arrived = f->arrived;
+    return Status::ok();
+}
+
 Status warmUp(BenchRun& run, const Camera& camera) {
-    if (run.rays) VISTA_RETURN_IF_ERROR(run.rays->placeFrameNear(camera.eye));
+    RayScene* rays = run.stream ? &run.stream->rays() : run.rays.get();
+    if (rays) VISTA_RETURN_IF_ERROR(rays->placeFrameNear(camera.eye));
     Image img;
     for (auto& m : run.modes) {
         FrameStats s;
@@ -195,8 +230,12 @@ Status renderFrames(BenchRun& run, const Path& path, const std::vector<size_t>& 
     Stopwatch sw;
     for (size_t f = 0; f < idx.size(); ++f) {
         const Camera cam = path.camera(idx[f], base);
+        int arrived = 0;
+        VISTA_RETURN_IF_ERROR(advanceStream(run, path, idx[f], cam, result, &arrived));
+        result.framesWithArrivals += arrived > 0 ? 1 : 0;
         // Ray origins near the scene's frame origin: float precision anywhere in the city.
-        if (run.rays) VISTA_RETURN_IF_ERROR(run.rays->placeFrameNear(cam.eye));
+        RayScene* rays = run.stream ? &run.stream->rays() : run.rays.get();
+        if (rays) VISTA_RETURN_IF_ERROR(rays->placeFrameNear(cam.eye));
         if (cfg.referenceSsaa >= 2) {
             auto r = supersampledReference(run, cam, cfg.referenceSsaa);
             if (!r) return Status::error("reference, frame " + std::to_string(f) + ": " + r.status().message());
@@ -208,6 +247,7 @@ Status renderFrames(BenchRun& run, const Path& path, const std::vector<size_t>& 
             rec.pathIndex = idx[f];
             rec.t = path.samples[idx[f]].t;
             rec.mode = run.modes[mi]->name();
+            rec.regionsArrived = arrived;
             Status st = run.modes[mi]->renderFrame(cam, img, rec.stats);
             if (!st) return Status::error("mode " + rec.mode + ", frame " + std::to_string(f) + ": " + st.message());
             VISTA_RETURN_IF_ERROR(dumpRays(*run.modes[mi], int(f), cam, cfg, batch));
@@ -288,12 +328,19 @@ Result<BenchResult> runBenchmark(const SceneModel* city, osg::Node* scene, const
     base.fovY = degToRad(cfg.fovYDeg);
     base.zNear = cfg.zNear;
     const std::vector<size_t> idx = path.frames(size_t(cfg.frames), cfg.sampleRuns);
+    result.streamed = (*run)->stream != nullptr;
+    if (result.streamed) {
+        // The first frame's regions before anything is timed (in wait mode as in every frame).
+        int arrived = 0;
+        VISTA_RETURN_IF_ERROR(advanceStream(**run, path, idx[0], path.camera(idx[0], base), result, &arrived));
+    }
     if (cfg.warmup) VISTA_RETURN_IF_ERROR(warmUp(**run, path.camera(idx[0], base)));
 
     result.loadAvgStart = loadAverage();
     FrameImages images(cfg, (*run)->modes.size(), batch);
     VISTA_RETURN_IF_ERROR(renderFrames(**run, path, idx, base, cfg, result, images, batch));
     result.memory.push_back(memoryPhase("frames"));
+    if (result.streamed) result.stream = (*run)->stream->stats();
     result.loadAvgEnd = loadAverage();
     result.glRenderer = (*run)->renderer->glRenderer();
     result.motion = pathMotion(path, idx);

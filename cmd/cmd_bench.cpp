@@ -40,6 +40,7 @@ struct BenchArgs {
     BenchConfig cfg;
     PathOptions pathOptions;
     PagedReach paged;
+    PagedStreamFlags stream;
 };
 
 void declareFlags(CLI::App& app, BenchArgs& a) {
@@ -49,6 +50,7 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
                    "city scene file (.osgb), or a paged city directory (DIR.paged); not needed with --sweep");
     addPathFlags(app, a.path, true);
     addPagedFlags(app, a.paged);
+    addPagedStreamFlags(app, a.stream);
     addNumberOption(app, "--frames", a.cfg.frames, 1, 1000000,
                     "frames rendered, sampled from the path as --sampling says, 1 .. 1000000 (default 120)");
     app.add_option("--sampling", a.sampling,
@@ -121,6 +123,9 @@ Status configure(BenchArgs& a) {
     if (!po) return po.status();
     a.pathOptions = po.value();
     VISTA_RETURN_IF_ERROR(validatePagedReach(a.paged));
+    VISTA_RETURN_IF_ERROR(validatePagedStream(a.stream));
+    if (a.stream.stream && !a.sweep.empty())
+        return Status::error("--paged-stream: not with --sweep (the sweep benches city files, not paged cities)");
     if (a.sweep.empty()) {
         if (a.city.empty()) return Status::error("missing the city file argument (or use --sweep)");
         if (!fs::exists(a.city)) return Status::error("city file '" + a.city + "' does not exist");
@@ -156,8 +161,10 @@ void printTable(const BenchResult& r) {
 int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string& outDir, BenchResult* res,
               size_t* cityTriangles = nullptr) {
     BenchConfig cfg = a.cfg;
-    const bool rays = std::any_of(cfg.modes.begin(), cfg.modes.end(),
-                                  [](const std::string& m) { return findRenderMode(m)->needsRays; });
+    // Streamed, the ray scene is not built from what is loaded before the first frame.
+    const bool rays = !a.stream.stream && std::any_of(cfg.modes.begin(), cfg.modes.end(), [](const std::string& m) {
+        return findRenderMode(m)->needsRays;
+    });
     {
         // The estimate before anything is loaded: a run over the budget stops here.
         std::error_code ec;
@@ -192,6 +199,19 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
     const SceneModel& city = walk->city;
     cfg.loadMs = walk->cityLoadMs;
     cfg.pagedJson = walk->pagedJson;
+    if (a.stream.stream) {
+        if (!walk->manifest)
+            return reportBadInput(kCmd, Status::error("--paged-stream: '" + cityFile +
+                                                      "' is a city file; streaming needs a paged city (DIR.paged)"));
+        auto budget = streamBudgetFileBytes("--memory-budget", cfg.memoryBudgetGb, cfg.memoryEstimateMb);
+        if (!budget) return reportBadInput(kCmd, budget.status());
+        cfg.streamManifest = walk->manifest.get();
+        cfg.stream.radius = a.paged.radius;
+        cfg.stream.far = a.paged.far;
+        cfg.stream.prefetchS = a.stream.prefetchS.value_or(kDefaultPagedPrefetchS);
+        cfg.stream.wait = a.stream.wait;
+        cfg.stream.budgetBytes = *budget;
+    }
     cfg.runUpS = a.path.file.empty() ? a.pathOptions.runUp : -1.0;
     cfg.outDir = outDir;
     cfg.cityLabel = fs::path(cityFile).filename().string();

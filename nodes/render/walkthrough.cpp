@@ -26,6 +26,7 @@ Result<Walkthrough> loadWalkthrough(const WalkthroughRequest& req, ModeOptions& 
         auto city = loadPagedNear(*paged, w.path, req.paged, req.cmd, req.quiet, &w.pagedJson, req.beforePagedLoad);
         if (!city) return city.status();
         w.city = std::move(*city);
+        w.manifest = std::make_shared<const PagedManifest>(std::move(paged->manifest));
     } else {
         auto city = loadCityFile(req.city);
         if (!city) return city.status();

@@ -30,6 +30,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -63,8 +64,9 @@ struct WalkthroughRequest {
 struct Walkthrough {
     SceneModel city;
     Path path;
-    double cityLoadMs = 0;  // step 1's wall time (with the path of a paged city)
-    std::string pagedJson;  // paged: the summary.json block of loadPagedNear(); else empty
+    double cityLoadMs = 0;                          // step 1's wall time (with the path of a paged city)
+    std::string pagedJson;                          // paged: the summary.json block of loadPagedNear(); else empty
+    std::shared_ptr<const PagedManifest> manifest;  // paged: the city's manifest (for a pager); else null
 };
 
 Result<Walkthrough> loadWalkthrough(const WalkthroughRequest& request, ModeOptions& options);

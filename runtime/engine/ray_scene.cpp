@@ -499,6 +499,49 @@ Result<int> RayScene::Impl::addRegionItems(const SceneModel& model, const std::v
     return id;
 }
 
+namespace {
+
+// The meshes and instances of `tiles` of `model`, in tile order.
+Status tileItems(const SceneModel& model, const std::vector<uint32_t>& tiles, std::vector<uint32_t>& meshes,
+                 std::vector<uint32_t>& instances) {
+    for (uint32_t t : tiles) {
+        if (t >= model.tiles.size())
+            return Status::error("ray scene: tile " + std::to_string(t) + " out of range (the model has " +
+                                 std::to_string(model.tiles.size()) + " tiles)");
+        const SceneTile& tile = model.tiles[t];
+        for (uint32_t m : tile.meshes) {
+            if (m >= model.meshes.size())
+                return Status::error("ray scene: tile " + std::to_string(t) + " lists mesh " + std::to_string(m) +
+                                     " (the model has " + std::to_string(model.meshes.size()) + ")");
+            meshes.push_back(m);
+        }
+        for (uint32_t i : tile.instances) {
+            if (i >= model.instances.size())
+                return Status::error("ray scene: tile " + std::to_string(t) + " lists instance " + std::to_string(i) +
+                                     " (the model has " + std::to_string(model.instances.size()) + ")");
+            instances.push_back(i);
+        }
+    }
+    return Status::ok();
+}
+
+// The items of one paged region span (SceneModel::regions) of `model`.
+Status spanItems(const SceneModel& model, const SceneRegionSpan& span, std::vector<uint32_t>& meshes,
+                 std::vector<uint32_t>& instances, std::vector<uint32_t>& impostors) {
+    if (uint64_t(span.firstTile) + span.tileCount > model.tiles.size() ||
+        uint64_t(span.firstImpostor) + span.impostorCount > model.impostors.size())
+        return Status::error("ray scene: region span of region " + std::to_string(span.region) +
+                             " lies outside the model's tiles or impostors");
+    std::vector<uint32_t> tiles(span.tileCount);
+    for (uint32_t k = 0; k < span.tileCount; ++k) tiles[k] = span.firstTile + k;
+    VISTA_RETURN_IF_ERROR(tileItems(model, tiles, meshes, instances));
+    for (uint32_t k = span.firstImpostor; k < span.firstImpostor + span.impostorCount; ++k)
+        if (model.impostors[k].prototype < model.prototypes.size()) impostors.push_back(k);
+    return Status::ok();
+}
+
+}  // namespace
+
 Result<std::unique_ptr<RayScene>> RayScene::build(const SceneModel& city, const RaySceneOptions& options) {
     std::unique_ptr<RayScene> rs(new RayScene());
     Impl& im = *rs->_impl;
@@ -531,6 +574,14 @@ Result<std::unique_ptr<RayScene>> RayScene::build(const SceneModel& city, const 
         for (size_t k = 0; k < all.size(); ++k) all[k] = uint32_t(k);
         im.flatProtos = *protos;
         VISTA_RETURN_IF_ERROR(im.attachTrees(city, all, impostors, im.flatProtos, -1, &im.flatTreeIds, &im.triangles));
+    } else if (!city.regions.empty()) {
+        // A merged paged city: one region per span, as the streamed scene adds them.
+        for (const SceneRegionSpan& span : city.regions) {
+            std::vector<uint32_t> meshes, instances, spanImpostors;
+            VISTA_RETURN_IF_ERROR(spanItems(city, span, meshes, instances, spanImpostors));
+            auto id = im.addRegionItems(city, meshes, instances, spanImpostors, *protos);
+            if (!id) return id.status();
+        }
     } else {
         // Regions: meshes by their origin, trees by their position, on a grid of
         // regionSizeM around the frame origin.
@@ -572,24 +623,7 @@ Result<int> RayScene::addRegion(const SceneModel& model, const std::vector<uint3
     Impl& im = *_impl;
     if (!im.city || im.flat) return Status::error("ray scene: regions can be added to a city scene of regions only");
     std::vector<uint32_t> meshes, instances, impostors;
-    for (uint32_t t : tiles) {
-        if (t >= model.tiles.size())
-            return Status::error("ray scene: tile " + std::to_string(t) + " out of range (the model has " +
-                                 std::to_string(model.tiles.size()) + " tiles)");
-        const SceneTile& tile = model.tiles[t];
-        for (uint32_t m : tile.meshes) {
-            if (m >= model.meshes.size())
-                return Status::error("ray scene: tile " + std::to_string(t) + " lists mesh " + std::to_string(m) +
-                                     " (the model has " + std::to_string(model.meshes.size()) + ")");
-            meshes.push_back(m);
-        }
-        for (uint32_t i : tile.instances) {
-            if (i >= model.instances.size())
-                return Status::error("ray scene: tile " + std::to_string(t) + " lists instance " + std::to_string(i) +
-                                     " (the model has " + std::to_string(model.instances.size()) + ")");
-            instances.push_back(i);
-        }
-    }
+    VISTA_RETURN_IF_ERROR(tileItems(model, tiles, meshes, instances));
     // Impostors belong to no tile: those within the tiles' xy bounds come with them.
     for (size_t k = 0; k < model.impostors.size(); ++k) {
         const glm::dvec3 p(model.impostors[k].transform[3]);
@@ -602,6 +636,20 @@ Result<int> RayScene::addRegion(const SceneModel& model, const std::vector<uint3
             }
         }
     }
+    auto protos = im.buildPrototypes(model);
+    if (!protos) return protos.status();
+    return im.addRegionItems(model, meshes, instances, impostors, *protos);
+}
+
+Result<int> RayScene::addRegion(const SceneModel& model) {
+    Impl& im = *_impl;
+    if (!im.city || im.flat) return Status::error("ray scene: regions can be added to a city scene of regions only");
+    if (model.tiles.empty()) return Status::error("ray scene: a region model without tiles");
+    SceneRegionSpan whole;
+    whole.tileCount = uint32_t(model.tiles.size());
+    whole.impostorCount = uint32_t(model.impostors.size());
+    std::vector<uint32_t> meshes, instances, impostors;
+    VISTA_RETURN_IF_ERROR(spanItems(model, whole, meshes, instances, impostors));
     auto protos = im.buildPrototypes(model);
     if (!protos) return protos.status();
     return im.addRegionItems(model, meshes, instances, impostors, *protos);

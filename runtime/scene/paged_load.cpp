@@ -256,6 +256,14 @@ Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>&
             for (SceneInstance& in : r.instances) in.prototype += base;
             for (SceneInstance& im : r.impostors) im.prototype += base;
         }
+        SceneRegionSpan span;
+        span.region = i;
+        span.coarse = isCoarse;
+        span.firstTile = uint32_t(out.tiles.size());
+        span.tileCount = uint32_t(r.tiles.size());
+        span.firstImpostor = uint32_t(out.impostors.size());
+        span.impostorCount = uint32_t(r.impostors.size());
+        out.regions.push_back(span);
         const uint32_t meshBase = uint32_t(out.meshes.size()), instBase = uint32_t(out.instances.size());
         for (SceneMesh& mesh : r.meshes) {
             mesh.ids.clear();

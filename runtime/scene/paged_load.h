@@ -22,7 +22,8 @@
 // its size must match the manifest's), then each `coarse` region's coarse
 // file (the same checks), and merges them: tiles, meshes and tree instances
 // of every region in that order (the merged graph is a new "vista.city" root
-// over the regions' tile transforms, SceneTile::child indexes it), the root
+// over the regions' tile transforms, SceneTile::child indexes it; one
+// SceneModel::regions span per region read, in that order), the root
 // state and user values of the first full region; streets = the union of the
 // regions' street graphs (nodes merged by exact position, edges by their end
 // nodes, in first-seen order), a subgraph of the city's graph. Ground-truth
