@@ -14,11 +14,11 @@
 #include "cmd/options.h"
 #include "foundation/timing.h"
 #include "foundation/units.h"
+#include "nodes/render/city_stream.h"
 #include "nodes/render/offscreen.h"
 #include "runtime/engine/metrics.h"
 #include "runtime/engine/ray_scene.h"
 #include "runtime/engine/ray_set.h"
-#include "runtime/engine/ray_streaming.h"
 
 namespace vista {
 
@@ -38,7 +38,7 @@ double loadAverage() {
 struct BenchRun {
     std::unique_ptr<OffscreenRenderer> renderer;
     std::unique_ptr<RayScene> rays;
-    std::unique_ptr<StreamedRayScene> stream;  // instead of `rays` when the city is streamed
+    std::unique_ptr<CityStream> stream;  // a streamed paged city: its graph and ray scene
     ModeContext ctx;
     std::vector<std::unique_ptr<RenderMode>> modes;
     std::vector<SetupTimes> setup;  // per mode: load, bvh, the mode's own
@@ -57,14 +57,19 @@ Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene
     const bool fxRays = effectsNeedRays(cfg.options.effects);
     const bool needRays = fxRays || std::any_of(cfg.modes.begin(), cfg.modes.end(),
                                                 [](const std::string& m) { return findRenderMode(m)->needsRays; });
+    if (cfg.streamManifest) {
+        // A streamed paged city: the graph and the ray scene follow the camera (advanceStream).
+        auto s = CityStream::create(*cfg.streamManifest, cfg.stream, needRays);
+        if (!s) return Status::error("setting up the streamed city failed: " + s.status().message());
+        run->stream = std::move(s.value());
+        run->ctx.streamedCity = run->stream->graph();
+        run->ctx.scene = run->stream->graph();
+    }
     if (needRays) {
         if (!city) return Status::error("modes that cast rays need a loaded city file (no city given)");
         Stopwatch sw;
         if (cfg.streamManifest) {
-            auto s = StreamedRayScene::create(*cfg.streamManifest, cfg.stream, city->prototypes);
-            if (!s) return Status::error("setting up the streamed ray scene failed: " + s.status().message());
-            run->stream = std::move(s.value());
-            run->ctx.rays = &run->stream->rays();
+            run->ctx.rays = run->stream->rays();
         } else {
             auto r = RayScene::build(*city);
             if (!r) return Status::error("building the Embree ray scene failed: " + r.status().message());
@@ -113,7 +118,7 @@ Status advanceStream(BenchRun& run, const Path& path, size_t i, const Camera& ca
 }
 
 Status warmUp(BenchRun& run, const Camera& camera) {
-    RayScene* rays = run.stream ? &run.stream->rays() : run.rays.get();
+    RayScene* rays = run.stream ? run.stream->rays() : run.rays.get();
     if (rays) VISTA_RETURN_IF_ERROR(rays->placeFrameNear(camera.eye));
     Image img;
     for (auto& m : run.modes) {
@@ -234,7 +239,7 @@ Status renderFrames(BenchRun& run, const Path& path, const std::vector<size_t>& 
         VISTA_RETURN_IF_ERROR(advanceStream(run, path, idx[f], cam, result, &arrived));
         result.framesWithArrivals += arrived > 0 ? 1 : 0;
         // Ray origins near the scene's frame origin: float precision anywhere in the city.
-        RayScene* rays = run.stream ? &run.stream->rays() : run.rays.get();
+        RayScene* rays = run.stream ? run.stream->rays() : run.rays.get();
         if (rays) VISTA_RETURN_IF_ERROR(rays->placeFrameNear(cam.eye));
         if (cfg.referenceSsaa >= 2) {
             auto r = supersampledReference(run, cam, cfg.referenceSsaa);

@@ -66,10 +66,11 @@ struct BenchConfig {
     // radius_m, bytes_loaded): JSON object, empty = a city file.
     std::string pagedJson;
     // A paged city streamed (--paged-stream): its manifest (outlives the run)
-    // and the pager's options; the ray scene of the modes that cast rays is
-    // then a StreamedRayScene (runtime/engine/ray_streaming.h) advanced to
-    // every frame's camera (and its velocity along the path) before the frame.
-    // Null: the ray scene is built from `city`.
+    // and the pager's options; the chunked city graph and the ray scene of
+    // the modes are then a CityStream (nodes/render/city_stream.h) advanced
+    // to every frame's camera (and its velocity along the path) before the
+    // frame, and `city` / `scene` are not drawn (only the modes of
+    // modeStreams()). Null: the modes draw `scene` and cast into `city`.
     const PagedManifest* streamManifest = nullptr;
     RegionPagerOptions stream;
 };

@@ -126,6 +126,11 @@ Status configure(BenchArgs& a) {
     VISTA_RETURN_IF_ERROR(validatePagedStream(a.stream));
     if (a.stream.stream && !a.sweep.empty())
         return Status::error("--paged-stream: not with --sweep (the sweep benches city files, not paged cities)");
+    if (a.stream.stream)
+        for (const auto& m : a.cfg.modes)
+            if (!modeStreams(m))
+                return Status::error("--paged-stream: mode " + m +
+                                     " does not stream a paged city (modes that do: " + streamingModeNames() + ")");
     if (a.sweep.empty()) {
         if (a.city.empty()) return Status::error("missing the city file argument (or use --sweep)");
         if (!fs::exists(a.city)) return Status::error("city file '" + a.city + "' does not exist");
@@ -161,10 +166,8 @@ void printTable(const BenchResult& r) {
 int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string& outDir, BenchResult* res,
               size_t* cityTriangles = nullptr) {
     BenchConfig cfg = a.cfg;
-    // Streamed, the ray scene is not built from what is loaded before the first frame.
-    const bool rays = !a.stream.stream && std::any_of(cfg.modes.begin(), cfg.modes.end(), [](const std::string& m) {
-        return findRenderMode(m)->needsRays;
-    });
+    const bool rays = std::any_of(cfg.modes.begin(), cfg.modes.end(),
+                                  [](const std::string& m) { return findRenderMode(m)->needsRays; });
     {
         // The estimate before anything is loaded: a run over the budget stops here.
         std::error_code ec;
@@ -181,6 +184,7 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
     req.cmd = kCmd;
     req.quiet = a.quiet;
     req.paged = a.paged;
+    req.streamPaged = a.stream.stream;  // no region before the first frame: the stream brings them
     // A paged city: the walkthrough first (a CSV, or a seeded path on the
     // city's streets), then only the regions near it.
     req.pathNeedsStreets = a.path.file.empty();
@@ -203,7 +207,7 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
         if (!walk->manifest)
             return reportBadInput(kCmd, Status::error("--paged-stream: '" + cityFile +
                                                       "' is a city file; streaming needs a paged city (DIR.paged)"));
-        auto budget = streamBudgetFileBytes("--memory-budget", cfg.memoryBudgetGb, cfg.memoryEstimateMb);
+        auto budget = streamBudgetFileBytes("--memory-budget", cfg.memoryBudgetGb, cfg.memoryEstimateMb, rays);
         if (!budget) return reportBadInput(kCmd, budget.status());
         cfg.streamManifest = walk->manifest.get();
         cfg.stream.radius = a.paged.radius;

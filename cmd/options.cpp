@@ -512,10 +512,10 @@ Status validatePagedReach(const PagedReach& reach) {
 
 void addPagedStreamFlags(CLI::App& app, PagedStreamFlags& f) {
     app.add_flag("--paged-stream", f.stream,
-                 "with a paged city: stream the ray scene of the modes that cast rays (raycast): regions load on a "
-                 "worker thread as the camera approaches and unload when it leaves (--paged-radius, --paged-far around "
-                 "the camera; --memory-budget bounds the streamed regions' file bytes); the modes that rasterise still "
-                 "draw the regions loaded around the whole walkthrough");
+                 "with a paged city: stream it instead of loading the regions near the walkthrough before the first "
+                 "frame: regions load on a worker thread as the camera approaches and unload when it leaves "
+                 "(--paged-radius at full detail and --paged-far at the coarse level, around the camera); "
+                 "--memory-budget bounds what is resident; modes full, near and raycast");
     app.add_flag("--paged-wait", f.wait,
                  "with --paged-stream (implied): every frame waits until the regions within reach of its camera are "
                  "resident, so frames do not depend on load timing");

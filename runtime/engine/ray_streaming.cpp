@@ -3,9 +3,8 @@
 
 namespace vista {
 
-Result<std::unique_ptr<StreamedRayScene>> StreamedRayScene::create(const PagedManifest& manifest,
-                                                                   const RegionPagerOptions& options,
-                                                                   std::vector<SceneMesh> prototypes) {
+Result<std::unique_ptr<StreamedRayScene>> StreamedRayScene::follower(const PagedManifest& manifest,
+                                                                     std::vector<SceneMesh> prototypes) {
     std::unique_ptr<StreamedRayScene> s(new StreamedRayScene());
     if (prototypes.empty()) {
         // The first full region file that loads (set-up: before the first frame).
@@ -19,16 +18,29 @@ Result<std::unique_ptr<StreamedRayScene>> StreamedRayScene::create(const PagedMa
     auto rays = RayScene::empty(glm::dvec3(manifest.params.origin_x, manifest.params.origin_y, 0.0));
     if (!rays) return rays.status();
     s->_rays = std::move(*rays);
-    s->_pager = std::make_unique<RegionPager>(manifest, options);
+    return s;
+}
+
+Result<std::unique_ptr<StreamedRayScene>> StreamedRayScene::create(const PagedManifest& manifest,
+                                                                   const RegionPagerOptions& options,
+                                                                   std::vector<SceneMesh> prototypes) {
+    auto s = follower(manifest, std::move(prototypes));
+    if (!s) return s.status();
+    (*s)->_pager = std::make_unique<RegionPager>(manifest, options);
     return s;
 }
 
 Result<RayStreamFrame> StreamedRayScene::advance(const glm::dvec3& eye, const glm::dvec3& velocity) {
+    VISTA_CHECK(_pager != nullptr);
     _pager->update(eye, velocity);
     RegionPagerDelta d = _pager->collect();
+    return apply(d);
+}
+
+Result<RayStreamFrame> StreamedRayScene::apply(RegionPagerDelta& d) {
     RayStreamFrame f;
     f.waited = d.waited;
-    f.damaged = std::move(d.damaged);
+    f.damaged = d.damaged;
     for (const RegionDrop& x : d.dropped) {
         auto it = _ids.find({x.region, x.coarse});
         if (it == _ids.end()) continue;  // never added (it failed to add)
@@ -46,7 +58,6 @@ Result<RayStreamFrame> StreamedRayScene::advance(const glm::dvec3& eye, const gl
             return Status::error("paged region " + std::to_string(a.region) + (a.coarse ? " (coarse)" : "") + ": " +
                                  id.status().message());
         _ids[{a.region, a.coarse}] = *id;
-        a.model = SceneModel();  // the Embree scene holds what the rays need
         ++f.arrived;
     }
     if (f.arrived > 0 || f.dropped > 0) VISTA_RETURN_IF_ERROR(_rays->commit());

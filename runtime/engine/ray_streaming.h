@@ -50,14 +50,22 @@ struct RayStreamFrame {
 
 class StreamedRayScene {
 public:
-    // `manifest` must outlive the scene.
+    // `manifest` must outlive the scene. With its own pager (advance()).
     static Result<std::unique_ptr<StreamedRayScene>> create(const PagedManifest& manifest,
                                                             const RegionPagerOptions& options,
                                                             std::vector<SceneMesh> prototypes = {});
+    // Without a pager: the caller's pager feeds it through apply() (a
+    // program that mirrors the same regions into other structures too).
+    static Result<std::unique_ptr<StreamedRayScene>> follower(const PagedManifest& manifest,
+                                                              std::vector<SceneMesh> prototypes = {});
+    // Own pager: update, collect, apply. Contract: made by create().
     Result<RayStreamFrame> advance(const glm::dvec3& eye, const glm::dvec3& velocity);
+    // Mirrors one pager delta: drops, then arrivals (their models' tree
+    // prototypes completed in place), then a commit if anything changed.
+    Result<RayStreamFrame> apply(RegionPagerDelta& delta);
     const RayScene& rays() const { return *_rays; }
     RayScene& rays() { return *_rays; }
-    RegionPagerStats stats() const { return _pager->stats(); }
+    RegionPagerStats stats() const { return _pager ? _pager->stats() : RegionPagerStats(); }
 
 private:
     StreamedRayScene() = default;

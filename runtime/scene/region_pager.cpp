@@ -94,6 +94,7 @@ void RegionPager::workerLoop() {
         Done done;
         done.job = job;
         done.model = loadPagedRegion(_m, job.region, job.coarse);
+        if (done.model && _o.prepare) done.prepared = _o.prepare(*done.model, job.region, job.coarse);
         done.loader = std::this_thread::get_id();
         lock.lock();
         --_busy;
@@ -128,23 +129,54 @@ void RegionPager::computeDesired() {
         if (level != kNone) total += levelBytes(int(i), level == kCoarse);
     }
     if (_o.budgetBytes == 0 || total <= _o.budgetBytes) return;
-    // Over the budget: coarse levels go first, then full regions (the radius
-    // shrinks), farthest first.
+    // Over the budget: coarse levels go first, farthest first; then full
+    // regions, farthest first (the radius shrinks), each keeping its coarse
+    // level when that fits; then regions left out get their coarse level
+    // back, nearest first, while it fits.
     ++_stats.budgetLimited;
-    for (uint8_t level : {kCoarse, kFull}) {
+    auto byKey = [&](uint8_t level) {
         std::vector<int> list;
         for (size_t i = 0; i < _desired.size(); ++i)
             if (_desired[i] == level) list.push_back(int(i));
-        std::sort(list.begin(), list.end(), [&](int a, int b) {
-            return _key[size_t(a)] != _key[size_t(b)] ? _key[size_t(a)] > _key[size_t(b)] : a > b;
+        std::sort(list.begin(), list.end(), [&](int x, int y) {
+            return _key[size_t(x)] != _key[size_t(y)] ? _key[size_t(x)] < _key[size_t(y)] : x < y;
         });
-        for (int i : list) {
-            if (total <= _o.budgetBytes) return;
-            total -= levelBytes(i, level == kCoarse);
+        return list;  // nearest first
+    };
+    std::vector<int> coarse = byKey(kCoarse), full = byKey(kFull), out;
+    while (total > _o.budgetBytes) {
+        if (!coarse.empty()) {
+            const int i = coarse.back();
+            coarse.pop_back();
+            total -= levelBytes(i, true);
             _desired[size_t(i)] = kNone;
-            _nearEye[size_t(i)] = 0;
+            out.push_back(i);
+        } else if (!full.empty()) {
+            const int i = full.back();
+            full.pop_back();
+            total -= levelBytes(i, false);
+            _desired[size_t(i)] = kNone;
+            if (!_failedCoarse[size_t(i)]) {
+                _desired[size_t(i)] = kCoarse;
+                total += levelBytes(i, true);
+                coarse.push_back(i);
+            } else {
+                out.push_back(i);
+            }
+        } else {
+            break;
         }
     }
+    std::sort(out.begin(), out.end(), [&](int x, int y) {
+        return _key[size_t(x)] != _key[size_t(y)] ? _key[size_t(x)] < _key[size_t(y)] : x < y;
+    });
+    for (int i : out)
+        if (!_failedCoarse[size_t(i)] && total + levelBytes(i, true) <= _o.budgetBytes) {
+            _desired[size_t(i)] = kCoarse;
+            total += levelBytes(i, true);
+        }
+    for (size_t i = 0; i < _desired.size(); ++i)
+        if (_desired[i] == kNone) _nearEye[i] = 0;
 }
 
 void RegionPager::drop(int region, bool coarse, RegionPagerDelta* delta) {
@@ -269,6 +301,7 @@ void RegionPager::takeArrivals(std::deque<Done>& done, RegionPagerDelta* delta) 
         a.bytes = levelBytes(i, coarse);
         a.loader = d.loader;
         a.sequence = d.sequence;
+        a.prepared = std::move(d.prepared);
         delta->arrived.push_back(std::move(a));
     }
     done.clear();

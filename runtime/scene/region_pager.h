@@ -16,11 +16,14 @@
 //
 // Budget (budgetBytes > 0): the desired set's file bytes (manifest sizes of
 // the wanted level) are held at or under it: coarse regions go first, farthest
-// first, then full regions farthest first (the radius shrinks). The resident
+// first, then full regions farthest first (the radius shrinks), each keeping
+// its coarse level if that fits; then regions left out get their coarse level
+// back, nearest first, while it fits (a budget below every full region keeps
+// the coarse levels near the eye). The resident
 // bytes (levels held by the caller plus loads in flight or not yet collected)
 // never exceed the budget either: a region changing level keeps its old level
 // until the new one arrives only when both fit, else the old level is dropped
-// first. A budget below a region's size keeps that region out.
+// first.
 //
 // Load order: by urgency, then by the mean of the region's distance to the
 // eye and to the end of the lookahead (so regions ahead of the heading come
@@ -51,6 +54,8 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <functional>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -74,6 +79,10 @@ struct RegionPagerOptions {
     uint64_t budgetBytes = 0;  // file bytes of the resident levels; 0 = no budget
     bool wait = false;         // collect() blocks until the desired set is resident
     int workers = 1;
+    // Optional: run on the worker thread right after a level loads (e.g. the
+    // near-field chunks of its graph); its result travels in
+    // RegionArrival::prepared. Must be thread-safe and must not throw.
+    std::function<std::shared_ptr<void>(const SceneModel& model, int region, bool coarse)> prepare;
 };
 
 // One region level loaded on a worker thread.
@@ -81,9 +90,10 @@ struct RegionArrival {
     int region = 0;  // index into the manifest's regions
     bool coarse = false;
     SceneModel model;
-    uint64_t bytes = 0;      // its file bytes (manifest)
-    std::thread::id loader;  // the worker thread that read it
-    uint64_t sequence = 0;   // 1, 2, ...: the order in which the pager's loads finished
+    uint64_t bytes = 0;              // its file bytes (manifest)
+    std::thread::id loader;          // the worker thread that read it
+    uint64_t sequence = 0;           // 1, 2, ...: the order in which the pager's loads finished
+    std::shared_ptr<void> prepared;  // what options.prepare made of it (null without one)
 };
 
 struct RegionDrop {
@@ -142,6 +152,7 @@ private:
         Result<SceneModel> model = Status::error("not loaded");
         std::thread::id loader;
         uint64_t sequence = 0;
+        std::shared_ptr<void> prepared;
     };
     enum Level : uint8_t { kNone = 0, kCoarse = 1, kFull = 2 };
 
