@@ -12,9 +12,12 @@ namespace {
 struct RegionChunks {
     osg::ref_ptr<osg::Group> group;
     osg::ref_ptr<osg::StateSet> rootState;
+    std::shared_ptr<RayScene::PreparedRegion> rays;  // its Embree scene (null without rays)
 };
 
 }  // namespace
+
+CityStream::~CityStream() { _pager.reset(); }
 
 Result<std::unique_ptr<CityStream>> CityStream::create(const PagedManifest& manifest, RegionPagerOptions options,
                                                        bool rays, std::vector<SceneMesh> prototypes) {
@@ -26,8 +29,10 @@ Result<std::unique_ptr<CityStream>> CityStream::create(const PagedManifest& mani
     }
     s->_root = new osg::Group;
     s->_root->setName("vista.streamed_city");
-    options.prepare = [](const SceneModel& model, int, bool) -> std::shared_ptr<void> {
+    const StreamedRayScene* rayScene = s->_rays.get();
+    options.prepare = [rayScene](SceneModel& model, int, bool) -> std::shared_ptr<void> {
         auto out = std::make_shared<RegionChunks>();
+        if (rayScene) out->rays = rayScene->prepare(model);
         out->group = new osg::Group;
         NearFieldScene nf = buildNearFieldScene(sceneRoot(model), kNearChunkSize, false);
         out->rootState = nf.rootState;
@@ -44,7 +49,14 @@ Result<CityStreamFrame> CityStream::advance(const glm::dvec3& eye, const glm::dv
     CityStreamFrame f;
     f.waited = d.waited;
     f.damaged = d.damaged;
-    if (_rays) VISTA_RETURN_IF_ERROR(_rays->apply(d).status());
+    if (_rays) {
+        std::vector<std::shared_ptr<RayScene::PreparedRegion>> prepared;
+        for (const RegionArrival& a : d.arrived) {
+            auto* chunks = static_cast<RegionChunks*>(a.prepared.get());
+            prepared.push_back(chunks ? chunks->rays : nullptr);
+        }
+        VISTA_RETURN_IF_ERROR(_rays->apply(d, prepared).status());
+    }
     for (const RegionDrop& x : d.dropped) {
         auto it = _groups.find({x.coarse, x.region});
         if (it == _groups.end()) continue;

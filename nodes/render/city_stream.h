@@ -8,7 +8,9 @@
 //    merges (full levels by region, then coarse levels by region), so the
 //    graph draws what ModeContext::chunkedCity() draws for a preloaded city
 //    of the same regions, in the same order;
-//  - the ray scene (rays(), when made with rays): a StreamedRayScene follower.
+//  - the ray scene (rays(), when made with rays): a StreamedRayScene follower,
+//    each region's Embree scene built on the worker thread too (the frame
+//    thread instances it and commits the top level).
 // Modes that draw the chunked city (full, near) or cast rays (raycast) use
 // them through ModeContext (streamedCity, rays); the others need the whole
 // loaded city and do not stream (modeStreams()).
@@ -43,6 +45,7 @@ class CityStream {
 public:
     // prototypes: the city's tree prototypes for the ray scene (see
     // StreamedRayScene; empty = read at set-up). rays = false: no ray scene.
+    ~CityStream();  // stops the pager first: its workers use the ray scene
     static Result<std::unique_ptr<CityStream>> create(const PagedManifest& manifest, RegionPagerOptions options,
                                                       bool rays, std::vector<SceneMesh> prototypes = {});
     Result<CityStreamFrame> advance(const glm::dvec3& eye, const glm::dvec3& velocity);

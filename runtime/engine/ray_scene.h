@@ -154,6 +154,19 @@ public:
     // impostor of a prototype the model has (a paged city's region file, full
     // or coarse). The same errors; a model without tiles is an error.
     Result<int> addRegion(const SceneModel& model);
+    // A region built off the frame thread: prepareRegion() makes it (on any
+    // thread), addPrepared() instances it (between frames).
+    struct PreparedRegion;
+    // Builds what addRegion(model) adds (the region's Embree scene and its
+    // tree prototypes) without changing this scene: it uses only the scene's
+    // Embree device, so it may run on another thread while the scene is
+    // queried or changed. The model is not kept (the trees' transforms are
+    // copied). Errors: those of addRegion(model).
+    Result<std::shared_ptr<PreparedRegion>> prepareRegion(const SceneModel& model) const;
+    // Instances a prepared region into the top level (seen after commit()),
+    // with the hits, ids and errors of addRegion(model). A prepared region is
+    // added once. Errors: one prepared by another scene, or added already.
+    Result<int> addPrepared(const std::shared_ptr<PreparedRegion>& region);
     // Detaches a region (its instance and its trees): seen after commit().
     // Errors: no live region with that id.
     Status removeRegion(int region);

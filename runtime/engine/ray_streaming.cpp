@@ -3,6 +3,8 @@
 
 namespace vista {
 
+StreamedRayScene::~StreamedRayScene() { _pager.reset(); }
+
 Result<std::unique_ptr<StreamedRayScene>> StreamedRayScene::follower(const PagedManifest& manifest,
                                                                      std::vector<SceneMesh> prototypes) {
     std::unique_ptr<StreamedRayScene> s(new StreamedRayScene());
@@ -26,18 +28,34 @@ Result<std::unique_ptr<StreamedRayScene>> StreamedRayScene::create(const PagedMa
                                                                    std::vector<SceneMesh> prototypes) {
     auto s = follower(manifest, std::move(prototypes));
     if (!s) return s.status();
-    (*s)->_pager = std::make_unique<RegionPager>(manifest, options);
+    RegionPagerOptions o = options;
+    const StreamedRayScene* self = s->get();
+    o.prepare = [self](SceneModel& model, int, bool) -> std::shared_ptr<void> { return self->prepare(model); };
+    (*s)->_pager = std::make_unique<RegionPager>(manifest, o);
     return s;
+}
+
+std::shared_ptr<RayScene::PreparedRegion> StreamedRayScene::prepare(SceneModel& model) const {
+    // Tree shapes the region model lacks: the city's.
+    if (model.prototypes.size() == _prototypes.size())
+        for (size_t p = 0; p < _prototypes.size(); ++p)
+            if (model.prototypes[p].indices.empty()) model.prototypes[p] = _prototypes[p];
+    auto r = _rays->prepareRegion(model);
+    return r ? *r : nullptr;
 }
 
 Result<RayStreamFrame> StreamedRayScene::advance(const glm::dvec3& eye, const glm::dvec3& velocity) {
     VISTA_CHECK(_pager != nullptr);
     _pager->update(eye, velocity);
     RegionPagerDelta d = _pager->collect();
-    return apply(d);
+    std::vector<std::shared_ptr<RayScene::PreparedRegion>> prepared;
+    for (const RegionArrival& a : d.arrived)
+        prepared.push_back(std::static_pointer_cast<RayScene::PreparedRegion>(a.prepared));
+    return apply(d, prepared);
 }
 
-Result<RayStreamFrame> StreamedRayScene::apply(RegionPagerDelta& d) {
+Result<RayStreamFrame> StreamedRayScene::apply(RegionPagerDelta& d,
+                                               const std::vector<std::shared_ptr<RayScene::PreparedRegion>>& prepared) {
     RayStreamFrame f;
     f.waited = d.waited;
     f.damaged = d.damaged;
@@ -48,12 +66,16 @@ Result<RayStreamFrame> StreamedRayScene::apply(RegionPagerDelta& d) {
         _ids.erase(it);
         ++f.dropped;
     }
-    for (RegionArrival& a : d.arrived) {
-        // Tree shapes the region model lacks: the city's.
-        if (a.model.prototypes.size() == _prototypes.size())
-            for (size_t p = 0; p < _prototypes.size(); ++p)
-                if (a.model.prototypes[p].indices.empty()) a.model.prototypes[p] = _prototypes[p];
-        auto id = _rays->addRegion(a.model);
+    for (size_t k = 0; k < d.arrived.size(); ++k) {
+        RegionArrival& a = d.arrived[k];
+        std::shared_ptr<RayScene::PreparedRegion> p = k < prepared.size() ? prepared[k] : nullptr;
+        if (!p) p = prepare(a.model);
+        if (!p) {
+            auto made = _rays->prepareRegion(a.model);  // fails again: its message
+            return Status::error("paged region " + std::to_string(a.region) + (a.coarse ? " (coarse)" : "") + ": " +
+                                 (made ? std::string("cannot be built") : made.status().message()));
+        }
+        auto id = _rays->addPrepared(p);
         if (!id)
             return Status::error("paged region " + std::to_string(a.region) + (a.coarse ? " (coarse)" : "") + ": " +
                                  id.status().message());

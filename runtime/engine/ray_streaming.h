@@ -4,7 +4,9 @@
 // camera and mirrors what it hands over: each dropped level's region is
 // removed, each arrived level added as one region (RayScene::addRegion of the
 // region's own model, freed right after), then the top level is committed
-// (only when something changed). The whole scene is never rebuilt.
+// (only when something changed). The whole scene is never rebuilt, and a
+// region's Embree scene is built on the pager's worker thread (prepare()):
+// the frame thread only instances it.
 //
 // With options.wait the pager blocks until the desired set is resident, so
 // every frame sees exactly the regions within reach of its camera: the scene
@@ -50,6 +52,7 @@ struct RayStreamFrame {
 
 class StreamedRayScene {
 public:
+    ~StreamedRayScene();  // stops the pager first: its workers use the scene
     // `manifest` must outlive the scene. With its own pager (advance()).
     static Result<std::unique_ptr<StreamedRayScene>> create(const PagedManifest& manifest,
                                                             const RegionPagerOptions& options,
@@ -60,9 +63,16 @@ public:
                                                               std::vector<SceneMesh> prototypes = {});
     // Own pager: update, collect, apply. Contract: made by create().
     Result<RayStreamFrame> advance(const glm::dvec3& eye, const glm::dvec3& velocity);
-    // Mirrors one pager delta: drops, then arrivals (their models' tree
-    // prototypes completed in place), then a commit if anything changed.
-    Result<RayStreamFrame> apply(RegionPagerDelta& delta);
+    // Worker side (thread-safe): completes the model's tree prototypes and
+    // builds its region (RayScene::prepareRegion); null when that fails
+    // (apply() then adds the model itself and reports the error).
+    std::shared_ptr<RayScene::PreparedRegion> prepare(SceneModel& model) const;
+    // Mirrors one pager delta: drops, then arrivals, then a commit if
+    // anything changed. prepared[i] (if given and not null) is arrival i's
+    // region from prepare(); an arrival without one is prepared here, on the
+    // calling thread.
+    Result<RayStreamFrame> apply(RegionPagerDelta& delta,
+                                 const std::vector<std::shared_ptr<RayScene::PreparedRegion>>& prepared = {});
     const RayScene& rays() const { return *_rays; }
     RayScene& rays() { return *_rays; }
     RegionPagerStats stats() const { return _pager ? _pager->stats() : RegionPagerStats(); }

@@ -80,9 +80,10 @@ struct RegionPagerOptions {
     bool wait = false;         // collect() blocks until the desired set is resident
     int workers = 1;
     // Optional: run on the worker thread right after a level loads (e.g. the
-    // near-field chunks of its graph); its result travels in
-    // RegionArrival::prepared. Must be thread-safe and must not throw.
-    std::function<std::shared_ptr<void>(const SceneModel& model, int region, bool coarse)> prepare;
+    // near-field chunks of its graph, its Embree scene); it may complete the
+    // model in place, and its result travels in RegionArrival::prepared.
+    // Must be thread-safe and must not throw.
+    std::function<std::shared_ptr<void>(SceneModel& model, int region, bool coarse)> prepare;
 };
 
 // One region level loaded on a worker thread.

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "runtime/engine/frame_raycast.h"
@@ -105,4 +106,42 @@ TEST(RayStreaming, WaitingFramesAreTheFramesOfTheRegionsWithinReach) {
     const vista::RegionPagerStats st = (*s)->stats();
     EXPECT_EQ(st.loads, arrived);
     EXPECT_EQ(st.unloads, dropped);
+}
+
+TEST(RayStreaming, ARegionPreparedOnAnotherThreadHitsAsAnAddedOne) {
+    TempDir tmp("vista_ray_prepared");
+    const std::string dir = tmp.file("city.paged");
+    const CliRun r = runVista("gen --size 1000 --seed 4 --detail 1 --region-size 500 -q -o " + dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    auto m = vista::readPagedManifest(dir);
+    ASSERT_TRUE(m.isOk()) << m.status().message();
+    auto first = vista::loadPagedRegion(*m, 0, false), second = vista::loadPagedRegion(*m, 3, false);
+    ASSERT_TRUE(first.isOk() && second.isOk());
+    const glm::dvec3 origin(m->params.origin_x, m->params.origin_y, 0.0);
+    auto a = vista::RayScene::empty(origin), b = vista::RayScene::empty(origin);
+    ASSERT_TRUE(a.isOk() && b.isOk());
+    ASSERT_TRUE((*a)->addRegion(*first).isOk());
+    ASSERT_TRUE((*a)->commit().isOk());
+    ASSERT_TRUE((*b)->addRegion(*first).isOk());
+    ASSERT_TRUE((*b)->addRegion(*second).isOk());
+    ASSERT_TRUE((*b)->commit().isOk());
+    const vista::Camera cam = walk(*m, 3)[1];
+    // Scene a is queried while another thread prepares the second region for it.
+    std::shared_ptr<vista::RayScene::PreparedRegion> prepared;
+    std::string error;
+    std::thread worker([&] {
+        auto p = (*a)->prepareRegion(*second);
+        if (p) prepared = *p;
+        else error = p.status().message();
+    });
+    for (int k = 0; k < 3; ++k) (void)frameOf(**a, cam);
+    worker.join();
+    ASSERT_TRUE(prepared) << error;
+    auto id = (*a)->addPrepared(prepared);
+    ASSERT_TRUE(id.isOk()) << id.status().message();
+    EXPECT_FALSE((*a)->addPrepared(prepared).isOk()) << "added once";
+    EXPECT_FALSE((*b)->addPrepared(prepared).isOk()) << "another scene's region";
+    ASSERT_TRUE((*a)->commit().isOk());
+    EXPECT_EQ((*a)->triangleCount(), (*b)->triangleCount());
+    EXPECT_TRUE(frameOf(**a, cam).rgba == frameOf(**b, cam).rgba);
 }
