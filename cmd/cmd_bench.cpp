@@ -215,6 +215,13 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
         cfg.stream.prefetchS = a.stream.prefetchS.value_or(kDefaultPagedPrefetchS);
         cfg.stream.wait = a.stream.wait;
         cfg.stream.budgetBytes = *budget;
+        if (!a.quiet)
+            std::fprintf(stderr,
+                         "%s: paged city: streaming its %d regions around the camera (full detail within %g m, coarse "
+                         "within %g m, %g s ahead%s%s)\n",
+                         kCmd, walk->manifest->nonEmpty(), cfg.stream.radius, cfg.stream.far, cfg.stream.prefetchS,
+                         cfg.stream.wait ? ", every frame waits for its regions" : "",
+                         cfg.stream.budgetBytes ? ", within the memory budget" : "");
     }
     cfg.runUpS = a.path.file.empty() ? a.pathOptions.runUp : -1.0;
     cfg.outDir = outDir;
