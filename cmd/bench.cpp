@@ -14,6 +14,7 @@
 #include "cmd/options.h"
 #include "foundation/timing.h"
 #include "foundation/units.h"
+#include "nodes/render/city_stream.h"
 #include "nodes/render/offscreen.h"
 #include "runtime/engine/metrics.h"
 #include "runtime/engine/ray_scene.h"
@@ -37,6 +38,7 @@ double loadAverage() {
 struct BenchRun {
     std::unique_ptr<OffscreenRenderer> renderer;
     std::unique_ptr<RayScene> rays;
+    std::unique_ptr<CityStream> stream;  // a streamed paged city: its graph and ray scene
     ModeContext ctx;
     ModeContext clearCtx;  // ctx without run-time effects (BenchConfig::alsoClear)
     std::vector<std::unique_ptr<RenderMode>> modes;
@@ -58,13 +60,25 @@ Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene
     const bool fxRays = effectsNeedRays(cfg.options.effects);
     const bool needRays = fxRays || std::any_of(cfg.modes.begin(), cfg.modes.end(),
                                                 [](const std::string& m) { return findRenderMode(m)->needsRays; });
+    if (cfg.streamManifest) {
+        // A streamed paged city: the graph and the ray scene follow the camera (advanceStream).
+        auto s = CityStream::create(*cfg.streamManifest, cfg.stream, needRays);
+        if (!s) return Status::error("setting up the streamed city failed: " + s.status().message());
+        run->stream = std::move(s.value());
+        run->ctx.streamedCity = run->stream->graph();
+        run->ctx.scene = run->stream->graph();
+    }
     if (needRays) {
         if (!city) return Status::error("modes that cast rays need a loaded city file (no city given)");
         Stopwatch sw;
-        auto r = RayScene::build(*city);
-        if (!r) return Status::error("building the Embree ray scene failed: " + r.status().message());
-        run->rays = std::move(r.value());
-        run->ctx.rays = run->rays.get();
+        if (cfg.streamManifest) {
+            run->ctx.rays = run->stream->rays();
+        } else {
+            auto r = RayScene::build(*city);
+            if (!r) return Status::error("building the Embree ray scene failed: " + r.status().message());
+            run->rays = std::move(r.value());
+            run->ctx.rays = run->rays.get();
+        }
         bvhMs = sw.ms();
         if (!cfg.quiet) std::fprintf(stderr, "ray scene built in %.0f ms\n", bvhMs);
     }
@@ -90,8 +104,34 @@ Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene
     return run;
 }
 
+// The camera's velocity at path sample i (metres per second; from the next
+// sample, or the previous one at the end; zero for a path of one sample).
+glm::dvec3 pathVelocity(const Path& path, size_t i) {
+    const auto& s = path.samples;
+    if (s.size() < 2) return glm::dvec3(0.0);
+    const size_t a = i + 1 < s.size() ? i : i - 1;
+    const double dt = s[a + 1].t - s[a].t;
+    return dt > 0 ? (s[a + 1].position - s[a].position) / dt : glm::dvec3(0.0);
+}
+
+// A streamed city: the ray scene follows the camera of path sample i
+// (arrivals and drops between frames); damaged files are warned about once.
+Status advanceStream(BenchRun& run, const Path& path, size_t i, const Camera& cam, BenchResult& result, int* arrived) {
+    *arrived = 0;
+    if (!run.stream) return Status::ok();
+    auto f = run.stream->advance(cam.eye, pathVelocity(path, i));
+    if (!f) return f.status();
+    for (const std::string& d : f->damaged) {
+        std::fprintf(stderr, "vista bench: warning: %s; the rest of the city streams\n", d.c_str());
+        result.streamDamaged.push_back(d);
+    }
+    *arrived = f->arrived;
+    return Status::ok();
+}
+
 Status warmUp(BenchRun& run, const Camera& camera) {
-    if (run.rays) VISTA_RETURN_IF_ERROR(run.rays->placeFrameNear(camera.eye));
+    RayScene* rays = run.stream ? run.stream->rays() : run.rays.get();
+    if (rays) VISTA_RETURN_IF_ERROR(rays->placeFrameNear(camera.eye));
     Image img;
     for (auto& m : run.modes) {
         FrameStats s;
@@ -245,15 +285,22 @@ Status renderFrames(BenchRun& run, const Path& path, const std::vector<size_t>& 
     std::vector<BenchFrameRecord> recs(n);
     for (size_t f = 0; f < idx.size(); ++f) {
         const Camera cam = path.camera(idx[f], base);
+        int arrived = 0;
+        VISTA_RETURN_IF_ERROR(advanceStream(run, path, idx[f], cam, result, &arrived));
+        result.framesWithArrivals += arrived > 0 ? 1 : 0;
         // Ray origins near the scene's frame origin: float precision anywhere in the city.
-        if (run.rays) VISTA_RETURN_IF_ERROR(run.rays->placeFrameNear(cam.eye));
+        RayScene* rays = run.stream ? run.stream->rays() : run.rays.get();
+        if (rays) VISTA_RETURN_IF_ERROR(rays->placeFrameNear(cam.eye));
         const double t = path.samples[idx[f]].t;
         const bool twinsFirst = plain < n && f % 2 == 1;
         if (twinsFirst) VISTA_RETURN_IF_ERROR(renderGroup(run, plain, n, f, idx[f], t, cam, cfg, recs, images, batch));
         VISTA_RETURN_IF_ERROR(renderGroup(run, 0, plain, f, idx[f], t, cam, cfg, recs, images, batch));
         if (!twinsFirst && plain < n)
             VISTA_RETURN_IF_ERROR(renderGroup(run, plain, n, f, idx[f], t, cam, cfg, recs, images, batch));
-        for (auto& rec : recs) result.frames.push_back(std::move(rec));
+        for (auto& rec : recs) {
+            rec.regionsArrived = arrived;
+            result.frames.push_back(std::move(rec));
+        }
         recs.assign(n, BenchFrameRecord{});
         reportProgress(cfg, f + 1, idx.size(), sw);
     }
@@ -324,12 +371,19 @@ Result<BenchResult> runBenchmark(const SceneModel* city, osg::Node* scene, const
     base.fovY = degToRad(cfg.fovYDeg);
     base.zNear = cfg.zNear;
     const std::vector<size_t> idx = path.frames(size_t(cfg.frames), cfg.sampleRuns);
+    result.streamed = (*run)->stream != nullptr;
+    if (result.streamed) {
+        // The first frame's regions before anything is timed (in wait mode as in every frame).
+        int arrived = 0;
+        VISTA_RETURN_IF_ERROR(advanceStream(**run, path, idx[0], path.camera(idx[0], base), result, &arrived));
+    }
     if (cfg.warmup) VISTA_RETURN_IF_ERROR(warmUp(**run, path.camera(idx[0], base)));
 
     result.loadAvgStart = loadAverage();
     FrameImages images(cfg, (*run)->modes.size(), batch);
     VISTA_RETURN_IF_ERROR(renderFrames(**run, path, idx, base, cfg, result, images, batch));
     result.memory.push_back(memoryPhase("frames"));
+    if (result.streamed) result.stream = (*run)->stream->stats();
     result.loadAvgEnd = loadAverage();
     result.glRenderer = (*run)->renderer->glRenderer();
     result.motion = pathMotion(path, idx);

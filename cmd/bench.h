@@ -30,6 +30,7 @@
 #include "foundation/status.h"
 #include "nodes/render/render_mode.h"
 #include "runtime/scene/paths.h"
+#include "runtime/scene/region_pager.h"
 
 namespace vista {
 
@@ -68,6 +69,14 @@ struct BenchConfig {
     // A paged city's load (summary.json "paged": regions_loaded, regions_total,
     // radius_m, bytes_loaded): JSON object, empty = a city file.
     std::string pagedJson;
+    // A paged city streamed (--paged-stream): its manifest (outlives the run)
+    // and the pager's options; the chunked city graph and the ray scene of
+    // the modes are then a CityStream (nodes/render/city_stream.h) advanced
+    // to every frame's camera (and its velocity along the path) before the
+    // frame, and `city` / `scene` are not drawn (only the modes of
+    // modeStreams()). Null: the modes draw `scene` and cast into `city`.
+    const PagedManifest* streamManifest = nullptr;
+    RegionPagerOptions stream;
 };
 // Checks sizes, frame count, fov, reference, modes and the mode options
 // (options.h ranges); messages name the command-line flag.
@@ -80,6 +89,7 @@ struct BenchFrameRecord {
     std::string mode;
     FrameStats stats;
     double psnrDb = 0, diffFraction = 0;
+    int regionsArrived = 0;  // streamed: region levels that finished loading and joined the scene before this frame
 };
 
 // One pixel class over the frames of a mode: percent of the frame's pixels
@@ -119,6 +129,12 @@ struct BenchResult {
     PathMotion motion;  // of the rendered frames
     double loadAvgStart = -1, loadAvgEnd = -1;
     std::vector<MemoryPhase> memory;  // load, setup (ray scene, modes), frames
+    // Streamed runs (BenchConfig::streamManifest): the pager's totals, the
+    // frames before which a region arrived, the damaged files (each once).
+    bool streamed = false;
+    RegionPagerStats stream;
+    int framesWithArrivals = 0;
+    std::vector<std::string> streamDamaged;
 };
 
 // The config with `full` moved to the front of the modes (the reference of

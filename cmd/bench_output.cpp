@@ -40,17 +40,19 @@ json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 std::string framesCsv(const BenchResult& result) {
     std::ostringstream csv;
     csv << "frame,path_index,t_s,mode,frame_ms,cull_ms,draw_ms,triangles,draw_calls,rays_cast,psnr_db,diff_fraction,"
-           "px_covered,px_horizon_culled,px_cache,px_ray_hit,px_ray_miss,px_interpolated,stages_ms,notes\n";
+           "px_covered,px_horizon_culled,px_cache,px_ray_hit,px_ray_miss,px_interpolated,regions_arrived,stages_ms,"
+           "notes\n";
     char buf[512];
     for (const auto& r : result.frames) {
         const FrameStats& s = r.stats;
         std::snprintf(buf, sizeof(buf),
-                      "%d,%zu,%.4f,%s,%.4f,%.4f,%.4f,%llu,%llu,%llu,%.3f,%.6f,%llu,%llu,%llu,%llu,%llu,%llu,", r.frame,
-                      r.pathIndex, r.t, r.mode.c_str(), s.frameMs, s.cullMs, s.drawMs, (unsigned long long)s.triangles,
-                      (unsigned long long)s.drawCalls, (unsigned long long)s.raysCast, r.psnrDb, r.diffFraction,
-                      (unsigned long long)s.pixels.covered, (unsigned long long)s.pixels.horizonCulled,
-                      (unsigned long long)s.pixels.cache, (unsigned long long)s.pixels.rayHit,
-                      (unsigned long long)s.pixels.rayMiss, (unsigned long long)s.pixels.interpolated);
+                      "%d,%zu,%.4f,%s,%.4f,%.4f,%.4f,%llu,%llu,%llu,%.3f,%.6f,%llu,%llu,%llu,%llu,%llu,%llu,%d,",
+                      r.frame, r.pathIndex, r.t, r.mode.c_str(), s.frameMs, s.cullMs, s.drawMs,
+                      (unsigned long long)s.triangles, (unsigned long long)s.drawCalls, (unsigned long long)s.raysCast,
+                      r.psnrDb, r.diffFraction, (unsigned long long)s.pixels.covered,
+                      (unsigned long long)s.pixels.horizonCulled, (unsigned long long)s.pixels.cache,
+                      (unsigned long long)s.pixels.rayHit, (unsigned long long)s.pixels.rayMiss,
+                      (unsigned long long)s.pixels.interpolated, r.regionsArrived);
         csv << buf;
         std::string st;
         s.stages.forEach([&](Stage stage, double ms) {
@@ -63,6 +65,31 @@ std::string framesCsv(const BenchResult& result) {
         csv << st << "," << notes << "\n";
     }
     return csv.str();
+}
+
+// summary.json paged.stream: the streamed ray scene's reach and the pager's totals.
+json streamJson(const BenchResult& r, const BenchConfig& cfg) {
+    const RegionPagerStats& s = r.stream;
+    const RegionPagerOptions& o = cfg.stream;
+    return {{"radius_m", o.radius},
+            {"far_m", o.far},
+            {"prefetch_s", o.prefetchS},
+            {"wait", o.wait},
+            {"frames_deterministic", o.wait},
+            {"budget_file_bytes", o.budgetBytes},
+            {"peak_resident_file_bytes", s.peakResidentBytes},
+            {"resident_file_bytes_end", s.residentBytes},
+            {"resident_full_end", s.residentFull},
+            {"resident_coarse_end", s.residentCoarse},
+            {"loads", s.loads},
+            {"unloads", s.unloads},
+            {"discarded", s.discarded},
+            {"bytes_read", s.bytesRead},
+            {"frames_waited", s.framesWaited},
+            {"wait_ms", s.waitMs},
+            {"frames_with_arrivals", r.framesWithArrivals},
+            {"budget_limited_updates", s.budgetLimited},
+            {"damaged", r.streamDamaged}};
 }
 
 json pixelClasses(const ModeSummary& s) {
@@ -115,6 +142,7 @@ json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneM
     j["city"] = cfg.cityLabel;
     j["city_triangles"] = city ? city->triangles : 0;
     if (!cfg.pagedJson.empty()) j["paged"] = json::parse(cfg.pagedJson);
+    if (result.streamed) j["paged"]["stream"] = streamJson(result, cfg);
     j["size"] = {cfg.width, cfg.height};
     j["frames"] = cfg.frames;
     j["sampling"] = samplingName(cfg.sampleRuns);

@@ -40,6 +40,7 @@ struct BenchArgs {
     BenchConfig cfg;
     PathOptions pathOptions;
     PagedReach paged;
+    PagedStreamFlags stream;
 };
 
 void declareFlags(CLI::App& app, BenchArgs& a) {
@@ -49,6 +50,7 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
                    "city scene file (.osgb), or a paged city directory (DIR.paged); not needed with --sweep");
     addPathFlags(app, a.path, true);
     addPagedFlags(app, a.paged);
+    addPagedStreamFlags(app, a.stream);
     addNumberOption(app, "--frames", a.cfg.frames, 1, 1000000,
                     "frames rendered, sampled from the path as --sampling says, 1 .. 1000000 (default 120)");
     app.add_option("--sampling", a.sampling,
@@ -125,6 +127,14 @@ Status configure(BenchArgs& a) {
     if (!po) return po.status();
     a.pathOptions = po.value();
     VISTA_RETURN_IF_ERROR(validatePagedReach(a.paged));
+    VISTA_RETURN_IF_ERROR(validatePagedStream(a.stream));
+    if (a.stream.stream && !a.sweep.empty())
+        return Status::error("--paged-stream: not with --sweep (the sweep benches city files, not paged cities)");
+    if (a.stream.stream)
+        for (const auto& m : a.cfg.modes)
+            if (!modeStreams(m))
+                return Status::error("--paged-stream: mode " + m +
+                                     " does not stream a paged city (modes that do: " + streamingModeNames() + ")");
     if (a.sweep.empty()) {
         if (a.city.empty()) return Status::error("missing the city file argument (or use --sweep)");
         if (!fs::exists(a.city)) return Status::error("city file '" + a.city + "' does not exist");
@@ -178,6 +188,7 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
     req.cmd = kCmd;
     req.quiet = a.quiet;
     req.paged = a.paged;
+    req.streamPaged = a.stream.stream;  // no region before the first frame: the stream brings them
     // A paged city: the walkthrough first (a CSV, or a seeded path on the
     // city's streets), then only the regions near it.
     req.pathNeedsStreets = a.path.file.empty();
@@ -196,6 +207,26 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
     const SceneModel& city = walk->city;
     cfg.loadMs = walk->cityLoadMs;
     cfg.pagedJson = walk->pagedJson;
+    if (a.stream.stream) {
+        if (!walk->manifest)
+            return reportBadInput(kCmd, Status::error("--paged-stream: '" + cityFile +
+                                                      "' is a city file; streaming needs a paged city (DIR.paged)"));
+        auto budget = streamBudgetFileBytes("--memory-budget", cfg.memoryBudgetGb, cfg.memoryEstimateMb, rays);
+        if (!budget) return reportBadInput(kCmd, budget.status());
+        cfg.streamManifest = walk->manifest.get();
+        cfg.stream.radius = a.paged.radius;
+        cfg.stream.far = a.paged.far;
+        cfg.stream.prefetchS = a.stream.prefetchS.value_or(kDefaultPagedPrefetchS);
+        cfg.stream.wait = a.stream.wait;
+        cfg.stream.budgetBytes = *budget;
+        if (!a.quiet)
+            std::fprintf(stderr,
+                         "%s: paged city: streaming its %d regions around the camera (full detail within %g m, coarse "
+                         "within %g m, %g s ahead%s%s)\n",
+                         kCmd, walk->manifest->nonEmpty(), cfg.stream.radius, cfg.stream.far, cfg.stream.prefetchS,
+                         cfg.stream.wait ? ", every frame waits for its regions" : "",
+                         cfg.stream.budgetBytes ? ", within the memory budget" : "");
+    }
     cfg.runUpS = a.path.file.empty() ? a.pathOptions.runUp : -1.0;
     cfg.outDir = outDir;
     cfg.cityLabel = fs::path(cityFile).filename().string();

@@ -49,6 +49,21 @@ Status checkMemoryBudget(const std::string& option, double budgetGb, double esti
     return Status::error(buf);
 }
 
+Result<uint64_t> streamBudgetFileBytes(const std::string& option, double budgetGb, double preloadMb, bool rayScene) {
+    if (budgetGb <= 0) return uint64_t(0);
+    const double leftMb = budgetGb * 1024.0 - preloadMb;
+    if (leftMb <= 0) {
+        char buf[320];
+        std::snprintf(buf, sizeof(buf),
+                      "option %s = %g GB: what is loaded before the first frame is estimated at %.2f GB, which leaves "
+                      "nothing for the streamed regions; give a larger budget",
+                      option.c_str(), budgetGb, preloadMb / 1024.0);
+        return Status::error(buf);
+    }
+    const double perFileByte = kSceneBytesPerFileByte + (rayScene ? kRaysBytesPerFileByte : 0.0);
+    return std::max<uint64_t>(1, uint64_t(leftMb * kMb / perFileByte));
+}
+
 double estimateGenMb(size_t storedTriangles) {
     return kGenFixedMb + kGenBytesPerStoredTriangle * double(storedTriangles) / kMb;
 }

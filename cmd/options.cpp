@@ -510,4 +510,29 @@ Status validatePagedReach(const PagedReach& reach) {
     return validatePagedRadius("--paged-far", reach.far);
 }
 
+void addPagedStreamFlags(CLI::App& app, PagedStreamFlags& f) {
+    app.add_flag("--paged-stream", f.stream,
+                 "with a paged city: stream it instead of loading the regions near the walkthrough before the first "
+                 "frame: regions load on a worker thread as the camera approaches and unload when it leaves "
+                 "(--paged-radius at full detail and --paged-far at the coarse level, around the camera); "
+                 "--memory-budget bounds what is resident; modes full, near and raycast");
+    app.add_flag("--paged-wait", f.wait,
+                 "with --paged-stream (implied): every frame waits until the regions within reach of its camera are "
+                 "resident, so frames do not depend on load timing");
+    std::ostringstream help;
+    help << "with --paged-stream: also load the regions within reach of where the camera will be this many seconds "
+            "ahead along its velocity, 0 .. "
+         << kMaxPagedPrefetchS << " (default " << kDefaultPagedPrefetchS << ")";
+    addNumberOption(app, "--paged-prefetch", f.prefetchS, RealRange::closed(0, kMaxPagedPrefetchS), help.str());
+}
+
+Status validatePagedStream(PagedStreamFlags& f) {
+    if (f.wait) f.stream = true;
+    if (f.prefetchS && !f.stream)
+        return Status::error(
+            "--paged-prefetch: needs --paged-stream (or --paged-wait): without streaming every region "
+            "near the walkthrough is loaded before the first frame");
+    return Status::ok();
+}
+
 }  // namespace vista

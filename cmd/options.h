@@ -31,6 +31,7 @@
 #include "nodes/render/render_mode.h"
 #include "runtime/scene/paged_walkthrough.h"
 #include "runtime/scene/paths.h"
+#include "runtime/scene/region_pager.h"
 
 namespace vista {
 
@@ -219,5 +220,23 @@ Status checkRunFiles(CommandFiles files, const std::string& city, const PathFlag
 void addPagedFlags(CLI::App& app, PagedReach& reach);
 // Both values within [kMinPagedRadiusM, kMaxPagedRadiusM]; errors name the option.
 Status validatePagedReach(const PagedReach& reach);
+
+// Streaming a paged city (bench): --paged-stream = the chunked city and the
+// ray scene follow the camera of each frame (nodes/render/city_stream.h, the
+// region pager of runtime/scene/region_pager.h) instead of holding the
+// regions loaded around the whole path (modes full, near, raycast); --paged-wait = each frame waits until the
+// regions within reach of its camera are resident (deterministic frames;
+// implies --paged-stream); --paged-prefetch S = seconds of lookahead along
+// the camera's velocity, 0 .. kMaxPagedPrefetchS (default
+// kDefaultPagedPrefetchS; needs streaming).
+struct PagedStreamFlags {
+    bool stream = false;
+    bool wait = false;
+    std::optional<double> prefetchS;
+};
+void addPagedStreamFlags(CLI::App& app, PagedStreamFlags& flags);
+// Resolves the implications; errors name the option (--paged-prefetch
+// without streaming).
+Status validatePagedStream(PagedStreamFlags& flags);
 
 }  // namespace vista

@@ -33,6 +33,7 @@ const NearFieldScene& ModeContext::nearField() {
 }
 
 osg::Group* ModeContext::chunkedCity() {
+    if (streamedCity) return streamedCity;
     if (!_chunked) {
         const NearFieldScene& nf = nearField();
         _chunked = new osg::Group;

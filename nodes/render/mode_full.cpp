@@ -9,7 +9,8 @@ public:
     explicit FullMode(ModeContext& ctx) : GraphMode(ctx) {
         _graph = ctx.chunkedCity();
         _setup.push_back({"chunking", ctx.chunkingMs()});
-        _raster.chunks = ctx.nearField().drawOrder;
+        // A streamed city is chunked region by region as it arrives (no chunk list of the whole).
+        if (!ctx.streamedCity) _raster.chunks = ctx.nearField().drawOrder;
     }
     std::string name() const override { return "full"; }
     const RasterSelection* lastRaster() const override { return &_raster; }

@@ -46,11 +46,18 @@ std::string renderModeNames() {
     return s;
 }
 
+bool modeStreams(const std::string& name) { return name == "full" || name == "near" || name == "raycast"; }
+
+std::string streamingModeNames() { return "full, near, raycast"; }
+
 bool effectsNeedRays(const FrameEffects& fx) { return fx.glass && fx.glassMarked && fx.rayBudget > 0; }
 
 Result<std::unique_ptr<RenderMode>> createRenderMode(const std::string& name, ModeContext& ctx) {
     const ModeInfo* m = findRenderMode(name);
     if (!m) return Status::error("unknown mode '" + name + "'; available modes: " + renderModeNames());
+    if (ctx.streamedCity && !modeStreams(name))
+        return Status::error("mode " + name + " does not stream a paged city (modes that do: " + streamingModeNames() +
+                             ")");
     if (!ctx.scene) return Status::error("mode " + name + " needs a scene graph, none was loaded");
     if (m->needsRays && !ctx.rays)
         return Status::error("mode " + name + " needs the city's ray scene, which is not available");

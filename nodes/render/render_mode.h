@@ -94,6 +94,11 @@ struct ModeContext {
     OffscreenRenderer* renderer = nullptr;  // bench: the GL context of renderFrame(); viewer: null
     bool labels = false;                    // nearField() also builds the label twins (vista render)
     const RayScene* rays = nullptr;         // built by the program for modes that need rays
+    // A streamed paged city (city_stream.h): the chunked city graph, updated
+    // between frames; chunkedCity() returns it and nearField() is not
+    // available (only the modes of modeStreams() are created). Null: the city
+    // is loaded.
+    osg::Group* streamedCity = nullptr;
     ModeOptions options;
 
     // The plain city: a baked root's tiles without its impostors, else `scene`.
@@ -103,7 +108,8 @@ struct ModeContext {
     const NearFieldScene& nearField();
     double chunkingMs() const { return _chunkingMs; }
     // Every chunk of nearField(), in its drawOrder, under one group with the
-    // city's root state: the chunked full city (full and near draw it).
+    // city's root state: the chunked full city (full and near draw it); the
+    // streamed graph when streamedCity is set.
     osg::Group* chunkedCity();
 
 private:
@@ -224,5 +230,9 @@ std::string renderModeNames();
 // reflections are on: effectsNeedRays()).
 Result<std::unique_ptr<RenderMode>> createRenderMode(const std::string& name, ModeContext& ctx);
 bool effectsNeedRays(const FrameEffects& fx);
+// The modes that draw a streamed paged city (ModeContext::streamedCity):
+// those drawing only the chunked city or rays (full, near, raycast).
+bool modeStreams(const std::string& name);
+std::string streamingModeNames();  // "full, near, raycast" (for messages)
 
 }  // namespace vista

@@ -23,9 +23,16 @@ Result<Walkthrough> loadWalkthrough(const WalkthroughRequest& req, ModeOptions& 
         if (!path) return path.status();
         w.path = std::move(*path);
         havePath = true;
-        auto city = loadPagedNear(*paged, w.path, req.paged, req.cmd, req.quiet, &w.pagedJson, req.beforePagedLoad);
-        if (!city) return city.status();
-        w.city = std::move(*city);
+        if (req.streamPaged) {
+            if (req.beforePagedLoad) VISTA_RETURN_IF_ERROR(req.beforePagedLoad(0));
+            w.city = std::move(paged->stub);
+            w.pagedJson = "{\"streamed\": true, \"regions_total\": " + std::to_string(paged->manifest.nonEmpty()) + "}";
+        } else {
+            auto city = loadPagedNear(*paged, w.path, req.paged, req.cmd, req.quiet, &w.pagedJson, req.beforePagedLoad);
+            if (!city) return city.status();
+            w.city = std::move(*city);
+        }
+        w.manifest = std::make_shared<const PagedManifest>(std::move(paged->manifest));
     } else {
         auto city = loadCityFile(req.city);
         if (!city) return city.status();

@@ -3,7 +3,9 @@
 //   1. the city: a city file (loadCityFile), or a paged city directory
 //      (paged_walkthrough.h: the manifest and the path first, then the
 //      regions within request.paged of the path; refused unless
-//      request.allowPaged);
+//      request.allowPaged; with request.streamPaged no region: the city is
+//      the stub with the params and the path streets, and the program
+//      streams the regions from Walkthrough::manifest);
 //   2. request.checkCity(city), if set (e.g. the channels a city must carry);
 //   3. the baked files the run's modes draw (loadPairedBakes);
 //   4. the walkthrough: request.makePath(city) (for a paged city it ran
@@ -30,6 +32,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -51,6 +54,7 @@ struct WalkthroughRequest {
     bool quiet = false;            // no notes on stderr (warnings stay)
     bool allowPaged = true;        // false: a directory is loaded as a city file (and refused by it)
     PagedReach paged;              // what a paged city loads around the path
+    bool streamPaged = false;      // a paged city is streamed: no region is loaded here (the stub and manifest only)
     bool pathNeedsStreets = true;  // the path is generated on the streets (not read from a CSV)
     std::function<Result<Path>(const SceneModel& city)> makePath;  // required
     std::function<Status(uint64_t bytes)> beforePagedLoad;  // paged: the selected files' bytes, before any is read
@@ -63,8 +67,9 @@ struct WalkthroughRequest {
 struct Walkthrough {
     SceneModel city;
     Path path;
-    double cityLoadMs = 0;  // step 1's wall time (with the path of a paged city)
-    std::string pagedJson;  // paged: the summary.json block of loadPagedNear(); else empty
+    double cityLoadMs = 0;                          // step 1's wall time (with the path of a paged city)
+    std::string pagedJson;                          // paged: the summary.json block of loadPagedNear(); else empty
+    std::shared_ptr<const PagedManifest> manifest;  // paged: the city's manifest (for a pager); else null
 };
 
 Result<Walkthrough> loadWalkthrough(const WalkthroughRequest& request, ModeOptions& options);

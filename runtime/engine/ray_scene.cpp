@@ -236,9 +236,16 @@ struct RayScene::Impl {
 
     Status initCity(const glm::dvec3& cityOrigin);
     Result<std::shared_ptr<PrototypeSet>> buildPrototypes(const SceneModel& model);
-    Status attachTrees(const SceneModel& model, const std::vector<uint32_t>& instances,
+    Status attachTrees(const std::vector<SceneInstance>& allInstances, const std::vector<SceneInstance>& allImpostors,
+                       size_t prototypeCount, const std::vector<uint32_t>& instances,
                        const std::vector<uint32_t>& impostors, const std::shared_ptr<PrototypeSet>& protos, int region,
                        std::vector<unsigned>* ids, size_t* tris);
+    Status buildRegionScene(const SceneModel& model, const std::vector<uint32_t>& meshes,
+                            const std::vector<uint32_t>& instances, const std::vector<uint32_t>& impostors,
+                            const glm::dvec3& frame, Region& r);
+    Result<int> attachRegion(Region r, const std::vector<SceneInstance>& allInstances,
+                             const std::vector<SceneInstance>& allImpostors, size_t prototypeCount,
+                             const std::vector<uint32_t>& instances, const std::vector<uint32_t>& impostors);
     Result<int> addRegionItems(const SceneModel& model, const std::vector<uint32_t>& meshes,
                                const std::vector<uint32_t>& instances, const std::vector<uint32_t>& impostors,
                                const std::shared_ptr<PrototypeSet>& protos);
@@ -373,20 +380,22 @@ Result<std::shared_ptr<PrototypeSet>> RayScene::Impl::buildPrototypes(const Scen
     return set;
 }
 
-// Attaches the trees (model.instances[instances], model.impostors[impostors])
-// to the top level; their ids go to `ids`.
-Status RayScene::Impl::attachTrees(const SceneModel& model, const std::vector<uint32_t>& instances,
-                                   const std::vector<uint32_t>& impostors, const std::shared_ptr<PrototypeSet>& protos,
-                                   int region, std::vector<unsigned>* ids, size_t* tris) {
+// Attaches the trees (allInstances[instances], allImpostors[impostors]) of a
+// model with `prototypeCount` prototypes to the top level; their ids go to `ids`.
+Status RayScene::Impl::attachTrees(const std::vector<SceneInstance>& allInstances,
+                                   const std::vector<SceneInstance>& allImpostors, size_t prototypeCount,
+                                   const std::vector<uint32_t>& instances, const std::vector<uint32_t>& impostors,
+                                   const std::shared_ptr<PrototypeSet>& protos, int region, std::vector<unsigned>* ids,
+                                   size_t* tris) {
     for (int pass = 0; pass < 2; ++pass) {
         const std::vector<uint32_t>& list = pass == 0 ? instances : impostors;
-        const std::vector<SceneInstance>& all = pass == 0 ? model.instances : model.impostors;
+        const std::vector<SceneInstance>& all = pass == 0 ? allInstances : allImpostors;
         for (uint32_t ii : list) {
             const SceneInstance& inst = all[ii];
-            if (inst.prototype >= model.prototypes.size())
+            if (inst.prototype >= prototypeCount)
                 return Status::error(std::string("ray scene: ") + (pass == 0 ? "instance " : "impostor ") +
                                      std::to_string(ii) + " refers to prototype " + std::to_string(inst.prototype) +
-                                     " (have " + std::to_string(model.prototypes.size()) + ")");
+                                     " (have " + std::to_string(prototypeCount) + ")");
             RTCScene child = protos->scenes[inst.prototype];
             if (!child) continue;
             float m[12];
@@ -429,30 +438,22 @@ void RayScene::Impl::dropRegion(Region& r) {
     r = Region();
 }
 
-Result<int> RayScene::Impl::addRegionItems(const SceneModel& model, const std::vector<uint32_t>& meshes,
-                                           const std::vector<uint32_t>& instances,
-                                           const std::vector<uint32_t>& impostors,
-                                           const std::shared_ptr<PrototypeSet>& protos) {
-    const int id = int(regions.size());
-    regions.emplace_back();
-    Region r;
-    r.live = true;
-    r.protos = protos;
+// The region's own Embree scene of `meshes` in r (r.origin on the lattice of
+// whole metres around `frame`, r.meshes, r.triangles): touches only the
+// device, so it may run on another thread while the scene is queried or
+// changed. On error r.scene may hold a partial scene (the caller releases it).
+Status RayScene::Impl::buildRegionScene(const SceneModel& model, const std::vector<uint32_t>& meshes,
+                                        const std::vector<uint32_t>& instances, const std::vector<uint32_t>& impostors,
+                                        const glm::dvec3& frame, Region& r) {
     // Anchor: the first mesh's origin (else the first tree's position).
-    glm::dvec3 anchor = origin;
+    glm::dvec3 anchor = frame;
     if (!meshes.empty()) anchor = model.meshes[meshes[0]].origin;
     else if (!instances.empty()) anchor = glm::dvec3(model.instances[instances[0]].transform[3]);
     else if (!impostors.empty()) anchor = glm::dvec3(model.impostors[impostors[0]].transform[3]);
-    r.origin = regionOrigin(origin, anchor);
-    auto fail = [&](Status st) -> Result<int> {
-        r.triangles = 0;  // not yet counted in the scene's total
-        regions[size_t(id)] = std::move(r);
-        dropRegion(regions[size_t(id)]);
-        return st;
-    };
+    r.origin = regionOrigin(frame, anchor);
     for (uint32_t mi : meshes) {
         const SceneMesh& m = model.meshes[mi];
-        if (!validMesh(m)) return fail(malformedMesh(mi));
+        if (!validMesh(m)) return malformedMesh(mi);
         if (!r.scene) {
             r.scene = rtcNewScene(device);
             rtcSetSceneFlags(r.scene, RTC_SCENE_FLAG_ROBUST);
@@ -460,8 +461,7 @@ Result<int> RayScene::Impl::addRegionItems(const SceneModel& model, const std::v
         }
         unsigned gid = 0;
         if (!addTriangles(device, r.scene, m.positions, m.indices, m.origin - r.origin, true, &gid)) {
-            Status st = checkDevice("building tile geometry");
-            if (!st.isOk()) return fail(st);
+            VISTA_RETURN_IF_ERROR(checkDevice("building tile geometry"));
             continue;
         }
         if (r.meshes.size() <= gid) r.meshes.resize(size_t(gid) + 1);
@@ -471,8 +471,27 @@ Result<int> RayScene::Impl::addRegionItems(const SceneModel& model, const std::v
     }
     if (r.scene) {
         rtcCommitScene(r.scene);
-        Status st = checkDevice("committing a region");
-        if (!st.isOk()) return fail(st);
+        VISTA_RETURN_IF_ERROR(checkDevice("committing a region"));
+    }
+    return Status::ok();
+}
+
+// Instances a region built by buildRegionScene into the top level, with its trees.
+Result<int> RayScene::Impl::attachRegion(Region r, const std::vector<SceneInstance>& allInstances,
+                                         const std::vector<SceneInstance>& allImpostors, size_t prototypeCount,
+                                         const std::vector<uint32_t>& instances,
+                                         const std::vector<uint32_t>& impostors) {
+    const int id = int(regions.size());
+    regions.emplace_back();
+    r.live = true;
+    const size_t meshTris = r.triangles;
+    auto fail = [&](Status st) -> Result<int> {
+        r.triangles = 0;  // not yet counted in the scene's total
+        regions[size_t(id)] = std::move(r);
+        dropRegion(regions[size_t(id)]);
+        return st;
+    };
+    if (r.scene) {
         const glm::dvec3 t = r.origin - origin;  // whole metres: exact in float
         const float m[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, float(t.x), float(t.y), float(t.z)};
         RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
@@ -489,8 +508,9 @@ Result<int> RayScene::Impl::addRegionItems(const SceneModel& model, const std::v
         tg.transform = glm::translate(glm::dmat4(1.0), r.origin);
     }
     size_t treeTris = 0;
-    Status st = attachTrees(model, instances, impostors, protos, id, &r.treeIds, &treeTris);
-    r.triangles += treeTris;
+    Status st = attachTrees(allInstances, allImpostors, prototypeCount, instances, impostors, r.protos, id, &r.treeIds,
+                            &treeTris);
+    r.triangles = meshTris + treeTris;
     if (!st.isOk()) return fail(st);
     st = checkDevice("adding a region");
     if (!st.isOk()) return fail(st);
@@ -498,6 +518,63 @@ Result<int> RayScene::Impl::addRegionItems(const SceneModel& model, const std::v
     regions[size_t(id)] = std::move(r);
     return id;
 }
+
+Result<int> RayScene::Impl::addRegionItems(const SceneModel& model, const std::vector<uint32_t>& meshes,
+                                           const std::vector<uint32_t>& instances,
+                                           const std::vector<uint32_t>& impostors,
+                                           const std::shared_ptr<PrototypeSet>& protos) {
+    Region r;
+    r.protos = protos;
+    Status st = buildRegionScene(model, meshes, instances, impostors, origin, r);
+    if (!st.isOk()) {
+        if (r.scene) rtcReleaseScene(r.scene);
+        return st;
+    }
+    return attachRegion(std::move(r), model.instances, model.impostors, model.prototypes.size(), instances, impostors);
+}
+
+namespace {
+
+// The meshes and instances of `tiles` of `model`, in tile order.
+Status tileItems(const SceneModel& model, const std::vector<uint32_t>& tiles, std::vector<uint32_t>& meshes,
+                 std::vector<uint32_t>& instances) {
+    for (uint32_t t : tiles) {
+        if (t >= model.tiles.size())
+            return Status::error("ray scene: tile " + std::to_string(t) + " out of range (the model has " +
+                                 std::to_string(model.tiles.size()) + " tiles)");
+        const SceneTile& tile = model.tiles[t];
+        for (uint32_t m : tile.meshes) {
+            if (m >= model.meshes.size())
+                return Status::error("ray scene: tile " + std::to_string(t) + " lists mesh " + std::to_string(m) +
+                                     " (the model has " + std::to_string(model.meshes.size()) + ")");
+            meshes.push_back(m);
+        }
+        for (uint32_t i : tile.instances) {
+            if (i >= model.instances.size())
+                return Status::error("ray scene: tile " + std::to_string(t) + " lists instance " + std::to_string(i) +
+                                     " (the model has " + std::to_string(model.instances.size()) + ")");
+            instances.push_back(i);
+        }
+    }
+    return Status::ok();
+}
+
+// The items of one paged region span (SceneModel::regions) of `model`.
+Status spanItems(const SceneModel& model, const SceneRegionSpan& span, std::vector<uint32_t>& meshes,
+                 std::vector<uint32_t>& instances, std::vector<uint32_t>& impostors) {
+    if (uint64_t(span.firstTile) + span.tileCount > model.tiles.size() ||
+        uint64_t(span.firstImpostor) + span.impostorCount > model.impostors.size())
+        return Status::error("ray scene: region span of region " + std::to_string(span.region) +
+                             " lies outside the model's tiles or impostors");
+    std::vector<uint32_t> tiles(span.tileCount);
+    for (uint32_t k = 0; k < span.tileCount; ++k) tiles[k] = span.firstTile + k;
+    VISTA_RETURN_IF_ERROR(tileItems(model, tiles, meshes, instances));
+    for (uint32_t k = span.firstImpostor; k < span.firstImpostor + span.impostorCount; ++k)
+        if (model.impostors[k].prototype < model.prototypes.size()) impostors.push_back(k);
+    return Status::ok();
+}
+
+}  // namespace
 
 Result<std::unique_ptr<RayScene>> RayScene::build(const SceneModel& city, const RaySceneOptions& options) {
     std::unique_ptr<RayScene> rs(new RayScene());
@@ -530,7 +607,16 @@ Result<std::unique_ptr<RayScene>> RayScene::build(const SceneModel& city, const 
         std::vector<uint32_t> all(city.instances.size());
         for (size_t k = 0; k < all.size(); ++k) all[k] = uint32_t(k);
         im.flatProtos = *protos;
-        VISTA_RETURN_IF_ERROR(im.attachTrees(city, all, impostors, im.flatProtos, -1, &im.flatTreeIds, &im.triangles));
+        VISTA_RETURN_IF_ERROR(im.attachTrees(city.instances, city.impostors, city.prototypes.size(), all, impostors,
+                                             im.flatProtos, -1, &im.flatTreeIds, &im.triangles));
+    } else if (!city.regions.empty()) {
+        // A merged paged city: one region per span, as the streamed scene adds them.
+        for (const SceneRegionSpan& span : city.regions) {
+            std::vector<uint32_t> meshes, instances, spanImpostors;
+            VISTA_RETURN_IF_ERROR(spanItems(city, span, meshes, instances, spanImpostors));
+            auto id = im.addRegionItems(city, meshes, instances, spanImpostors, *protos);
+            if (!id) return id.status();
+        }
     } else {
         // Regions: meshes by their origin, trees by their position, on a grid of
         // regionSizeM around the frame origin.
@@ -572,24 +658,7 @@ Result<int> RayScene::addRegion(const SceneModel& model, const std::vector<uint3
     Impl& im = *_impl;
     if (!im.city || im.flat) return Status::error("ray scene: regions can be added to a city scene of regions only");
     std::vector<uint32_t> meshes, instances, impostors;
-    for (uint32_t t : tiles) {
-        if (t >= model.tiles.size())
-            return Status::error("ray scene: tile " + std::to_string(t) + " out of range (the model has " +
-                                 std::to_string(model.tiles.size()) + " tiles)");
-        const SceneTile& tile = model.tiles[t];
-        for (uint32_t m : tile.meshes) {
-            if (m >= model.meshes.size())
-                return Status::error("ray scene: tile " + std::to_string(t) + " lists mesh " + std::to_string(m) +
-                                     " (the model has " + std::to_string(model.meshes.size()) + ")");
-            meshes.push_back(m);
-        }
-        for (uint32_t i : tile.instances) {
-            if (i >= model.instances.size())
-                return Status::error("ray scene: tile " + std::to_string(t) + " lists instance " + std::to_string(i) +
-                                     " (the model has " + std::to_string(model.instances.size()) + ")");
-            instances.push_back(i);
-        }
-    }
+    VISTA_RETURN_IF_ERROR(tileItems(model, tiles, meshes, instances));
     // Impostors belong to no tile: those within the tiles' xy bounds come with them.
     for (size_t k = 0; k < model.impostors.size(); ++k) {
         const glm::dvec3 p(model.impostors[k].transform[3]);
@@ -605,6 +674,59 @@ Result<int> RayScene::addRegion(const SceneModel& model, const std::vector<uint3
     auto protos = im.buildPrototypes(model);
     if (!protos) return protos.status();
     return im.addRegionItems(model, meshes, instances, impostors, *protos);
+}
+
+Result<int> RayScene::addRegion(const SceneModel& model) {
+    auto p = prepareRegion(model);
+    if (!p) return p.status();
+    return addPrepared(*p);
+}
+
+struct RayScene::PreparedRegion {
+    const Impl* owner = nullptr;
+    bool added = false;
+    Impl::Region region;  // scene built, not instanced
+    std::vector<SceneInstance> instances, impostors;
+    std::vector<uint32_t> instanceList, impostorList;
+    size_t prototypeCount = 0;
+    ~PreparedRegion() {
+        if (region.scene) rtcReleaseScene(region.scene);
+    }
+};
+
+Result<std::shared_ptr<RayScene::PreparedRegion>> RayScene::prepareRegion(const SceneModel& model) const {
+    // Only the device and the error sink are used (both thread-safe).
+    Impl& im = const_cast<Impl&>(*_impl);
+    if (!im.city || im.flat) return Status::error("ray scene: regions can be added to a city scene of regions only");
+    if (model.tiles.empty()) return Status::error("ray scene: a region model without tiles");
+    SceneRegionSpan whole;
+    whole.tileCount = uint32_t(model.tiles.size());
+    whole.impostorCount = uint32_t(model.impostors.size());
+    auto p = std::make_shared<PreparedRegion>();
+    std::vector<uint32_t> meshes;
+    VISTA_RETURN_IF_ERROR(spanItems(model, whole, meshes, p->instanceList, p->impostorList));
+    auto protos = im.buildPrototypes(model);
+    if (!protos) return protos.status();
+    p->owner = &im;
+    p->region.protos = *protos;
+    // Region origins lie on the lattice of whole metres around the build origin, as every frame origin does.
+    VISTA_RETURN_IF_ERROR(
+        im.buildRegionScene(model, meshes, p->instanceList, p->impostorList, im.buildOrigin, p->region));
+    p->instances = model.instances;
+    p->impostors = model.impostors;
+    p->prototypeCount = model.prototypes.size();
+    return p;
+}
+
+Result<int> RayScene::addPrepared(const std::shared_ptr<PreparedRegion>& p) {
+    Impl& im = *_impl;
+    if (!p || p->owner != &im) return Status::error("ray scene: a region prepared by another scene");
+    if (p->added) return Status::error("ray scene: a prepared region added twice");
+    p->added = true;
+    Impl::Region r = std::move(p->region);
+    p->region = Impl::Region();
+    return im.attachRegion(std::move(r), p->instances, p->impostors, p->prototypeCount, p->instanceList,
+                           p->impostorList);
 }
 
 Status RayScene::removeRegion(int region) {

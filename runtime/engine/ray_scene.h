@@ -17,6 +17,11 @@
 //    frame near the camera with placeFrameNear().
 //  - flat (`regionSizeM` = 0): every tile mesh is one triangle geometry of one
 //    scene, its vertices relative to frameOrigin.
+//  - paged (the model has SceneModel::regions spans, a paged city merged by
+//    loadPagedCity, and `regionSizeM` > 0): one region per span, in span
+//    order, as addRegion(region model) makes it from that region's own file,
+//    so a scene streamed region by region (in the same order) gives the same
+//    hits as this one.
 // Regions can be added and removed after the build (addRegion, removeRegion,
 // then commit: a commit of the top-level scene, the other regions' BVHs are
 // kept). Queries are const and thread-safe among themselves; addRegion,
@@ -145,6 +150,23 @@ public:
     // malformed mesh, an instance of a missing prototype, an Embree error;
     // the scene is then unchanged. Not for flat or soup scenes.
     Result<int> addRegion(const SceneModel& model, const std::vector<uint32_t>& tiles);
+    // The whole model as one region: every tile's meshes and trees and every
+    // impostor of a prototype the model has (a paged city's region file, full
+    // or coarse). The same errors; a model without tiles is an error.
+    Result<int> addRegion(const SceneModel& model);
+    // A region built off the frame thread: prepareRegion() makes it (on any
+    // thread), addPrepared() instances it (between frames).
+    struct PreparedRegion;
+    // Builds what addRegion(model) adds (the region's Embree scene and its
+    // tree prototypes) without changing this scene: it uses only the scene's
+    // Embree device, so it may run on another thread while the scene is
+    // queried or changed. The model is not kept (the trees' transforms are
+    // copied). Errors: those of addRegion(model).
+    Result<std::shared_ptr<PreparedRegion>> prepareRegion(const SceneModel& model) const;
+    // Instances a prepared region into the top level (seen after commit()),
+    // with the hits, ids and errors of addRegion(model). A prepared region is
+    // added once. Errors: one prepared by another scene, or added already.
+    Result<int> addPrepared(const std::shared_ptr<PreparedRegion>& region);
     // Detaches a region (its instance and its trees): seen after commit().
     // Errors: no live region with that id.
     Status removeRegion(int region);

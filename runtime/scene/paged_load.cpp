@@ -143,10 +143,9 @@ std::vector<int> selectCoarseRegions(const PagedManifest& m, const std::vector<g
     return out;
 }
 
-namespace {
-
-// Loads region `i`'s full or coarse file, checking its size against the manifest first.
-Result<SceneModel> loadRegion(const PagedManifest& m, int i, bool coarse) {
+Result<SceneModel> loadPagedRegion(const PagedManifest& m, int i, bool coarse) {
+    if (i < 0 || size_t(i) >= m.regions.size() || m.regions[size_t(i)].empty)
+        return Status::error("paged city '" + m.dir + "': no non-empty region " + std::to_string(i));
     const PagedRegionEntry& r = m.regions[size_t(i)];
     const std::string& name = coarse ? r.coarseFile : r.file;
     const uint64_t bytes = coarse ? r.coarseBytes : r.bytes;
@@ -161,6 +160,8 @@ Result<SceneModel> loadRegion(const PagedManifest& m, int i, bool coarse) {
                              " bytes, the manifest says " + std::to_string(bytes) + " (damaged or from another run)");
     return loadCityFile(path);
 }
+
+namespace {
 
 // Appends `b`'s streets to `a`, merging nodes by exact position and edges by end nodes.
 struct StreetUnion {
@@ -214,7 +215,7 @@ Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>&
         const auto [i, isCoarse] = order[k];
         if (i < 0 || size_t(i) >= m.regions.size() || m.regions[size_t(i)].empty) continue;
         const std::string& name = isCoarse ? m.regions[size_t(i)].coarseFile : m.regions[size_t(i)].file;
-        auto rm = loadRegion(m, i, isCoarse);
+        auto rm = loadPagedRegion(m, i, isCoarse);
         if (!rm) {
             // A damaged or missing region file: reported by name, the rest of the city loads;
             // a full region falls back to its coarse level.
@@ -255,6 +256,14 @@ Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>&
             for (SceneInstance& in : r.instances) in.prototype += base;
             for (SceneInstance& im : r.impostors) im.prototype += base;
         }
+        SceneRegionSpan span;
+        span.region = i;
+        span.coarse = isCoarse;
+        span.firstTile = uint32_t(out.tiles.size());
+        span.tileCount = uint32_t(r.tiles.size());
+        span.firstImpostor = uint32_t(out.impostors.size());
+        span.impostorCount = uint32_t(r.impostors.size());
+        out.regions.push_back(span);
         const uint32_t meshBase = uint32_t(out.meshes.size()), instBase = uint32_t(out.instances.size());
         for (SceneMesh& mesh : r.meshes) {
             mesh.ids.clear();

@@ -22,7 +22,8 @@
 // its size must match the manifest's), then each `coarse` region's coarse
 // file (the same checks), and merges them: tiles, meshes and tree instances
 // of every region in that order (the merged graph is a new "vista.city" root
-// over the regions' tile transforms, SceneTile::child indexes it), the root
+// over the regions' tile transforms, SceneTile::child indexes it; one
+// SceneModel::regions span per region read, in that order), the root
 // state and user values of the first full region; streets = the union of the
 // regions' street graphs (nodes merged by exact position, edges by their end
 // nodes, in first-seen order), a subgraph of the city's graph. Ground-truth
@@ -33,6 +34,12 @@
 // its coarse level, and the rest of the city loads. Errors: no region
 // selected (points far from the city, or none), or no full region readable
 // (the message names the radius or every damaged file).
+//
+// loadPagedRegion(): region `region`'s full file (or its coarse level),
+// after checking that the file exists and has the manifest's size; the
+// region's own SceneModel (loadCityFile). Errors name the file: missing,
+// another size than the manifest's, unreadable or corrupt; an empty region
+// or an index out of range. Thread-safe (reads the manifest only).
 //
 // pagedPathStreets(): the street graph that a path of a paged city made from
 // a seed runs on: the whole city's graph, grown again from the manifest's
@@ -108,6 +115,7 @@ std::vector<int> selectCoarseRegions(const PagedManifest& m, const std::vector<g
                                      const std::vector<int>& full);
 Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>& regions, double radiusM,
                                  PagedLoadReport* report = nullptr, const std::vector<int>& coarse = {});
+Result<SceneModel> loadPagedRegion(const PagedManifest& m, int region, bool coarse);
 Result<StreetGraph> pagedPathStreets(const PagedManifest& m);
 
 }  // namespace vista

@@ -53,6 +53,17 @@ struct SceneTile {
     size_t triangles = 0;  // rendered triangles (instances expanded)
 };
 
+// One region of a paged city inside a model merged from several
+// (paged_load.h loadPagedCity): its tiles and its tree impostors are the
+// ranges [firstTile, firstTile + tileCount) and [firstImpostor, firstImpostor +
+// impostorCount) of the model; its meshes and instances are those its tiles list.
+struct SceneRegionSpan {
+    int region = -1;      // index into the paged city's manifest regions
+    bool coarse = false;  // its coarse level (else its full file)
+    uint32_t firstTile = 0, tileCount = 0;
+    uint32_t firstImpostor = 0, impostorCount = 0;
+};
+
 struct SceneGraph;  // defined in runtime/scene/scene_graph.h (OSG side)
 
 struct SceneModel {
@@ -62,13 +73,14 @@ struct SceneModel {
     std::vector<SceneMesh> prototypes;  // tree prototypes (origin 0)
     std::vector<SceneInstance> instances;
     // Tree impostors (tree_impostor_graph.h; coarse levels of a paged city):
-    // drawn by the graph only, not ray-cast and in no tile's lists; their
-    // quads count in `triangles`.
+    // in no tile's lists; the graph draws them as quads (counted in
+    // `triangles`), the ray scene traces them as their prototype meshes.
     std::vector<SceneInstance> impostors;
-    std::vector<SceneTile> tiles;       // empty for hand-built models
-    size_t triangles = 0;               // rendered triangles (instances expanded)
-    bool labelled = false;              // the file carries ground-truth labels (vista.labels)
-    std::shared_ptr<SceneGraph> graph;  // the decoded OSG graph, or null
+    std::vector<SceneTile> tiles;          // empty for hand-built models
+    std::vector<SceneRegionSpan> regions;  // the paged regions merged into it, in merge order; empty for a city file
+    size_t triangles = 0;                  // rendered triangles (instances expanded)
+    bool labelled = false;                 // the file carries ground-truth labels (vista.labels)
+    std::shared_ptr<SceneGraph> graph;     // the decoded OSG graph, or null
 };
 
 // World xy bounds of a mesh / an instance (expanding lo/hi).

@@ -301,3 +301,106 @@ TEST_F(PagedLoad, BadInputExitsTwoNamingIt) {
         }
     }
 }
+
+TEST_F(PagedLoad, AStreamedBenchThatWaitsGivesThePreloadedFrames) {
+    // The radius covers the city: the preloaded run holds every region, and so does the stream at every frame.
+    const std::string run =
+        " --seed 4 --frames 4 --size 160x120 --modes raycast,near -q --save-frames --paged-radius 5000";
+    CliRun r = runVista("bench " + dir() + run + " --out " + tmp.file("pre"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = runVista("bench " + dir() + run + " --paged-wait --paged-prefetch 2 --out " + tmp.file("str"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (int f = 0; f < 4; ++f)
+        for (const char* mode : {"full", "near", "raycast"}) {
+            const std::string name = "frames/f000" + std::to_string(f) + "_" + mode + ".png";
+            ASSERT_TRUE(fs::exists(tmp.file("pre/" + name))) << name;
+            EXPECT_TRUE(readBytes(tmp.file("pre/" + name)) == readBytes(tmp.file("str/" + name))) << name;
+        }
+    const auto s = readJson(tmp.file("str/summary.json"));
+    ASSERT_TRUE(s["paged"].contains("stream")) << s.dump();
+    const auto& st = s["paged"]["stream"];
+    EXPECT_TRUE(st["wait"].get<bool>());
+    EXPECT_TRUE(st["frames_deterministic"].get<bool>());
+    EXPECT_EQ(st["loads"].get<int>(), 9);
+    EXPECT_EQ(st["unloads"].get<int>(), 0);
+    EXPECT_EQ(st["bytes_read"].get<uint64_t>(),
+              readJson(tmp.file("pre/summary.json"))["paged"]["bytes_loaded"].get<uint64_t>());
+    EXPECT_TRUE(s["paged"]["streamed"].get<bool>());
+    EXPECT_EQ(s["paged"]["regions_total"].get<int>(), 9);
+    EXPECT_EQ(st["peak_resident_file_bytes"].get<uint64_t>(), st["bytes_read"].get<uint64_t>());
+    EXPECT_GE(st["frames_waited"].get<int>(), 1);
+    EXPECT_FALSE(readJson(tmp.file("pre/summary.json"))["paged"].contains("stream"));
+}
+
+TEST_F(PagedLoad, AStreamedBenchLoadsAndUnloadsAlongThePath) {
+    const std::string run =
+        " --seed 4 --frames 12 --size 160x120 --modes raycast -q --paged-radius 100 --paged-far 400";
+    CliRun r = runVista("bench " + dir() + run + " --paged-stream --paged-prefetch 0 --out " + tmp.file("s"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto s = readJson(tmp.file("s/summary.json"));
+    const auto& st = s["paged"]["stream"];
+    EXPECT_FALSE(st["wait"].get<bool>());
+    EXPECT_FALSE(st["frames_deterministic"].get<bool>());
+    // No frame waits: what arrived by the end depends on the timing (the frames may all be drawn first).
+    EXPECT_EQ(st["frames_waited"].get<int>(), 0);
+    EXPECT_GT(st["peak_resident_file_bytes"].get<uint64_t>(), 0u) << "loads were queued";
+    // frames.csv marks the frames before which regions arrived (every mode's row of the frame).
+    const std::string csv = readBytes(tmp.file("s/frames.csv"));
+    EXPECT_NE(csv.find(",regions_arrived,"), std::string::npos);
+    // Two runs that wait give the same frames, whatever the load timing.
+    for (const char* out : {"w1", "w2"}) {
+        r = runVista("bench " + dir() + run + " --paged-wait --save-frames --out " + tmp.file(out));
+        ASSERT_EQ(r.code, 0) << r.err;
+    }
+    for (int f = 0; f < 12; ++f) {
+        char name[64];
+        std::snprintf(name, sizeof name, "/frames/f%04d_raycast.png", f);
+        EXPECT_TRUE(readBytes(tmp.file(std::string("w1") + name)) == readBytes(tmp.file(std::string("w2") + name)))
+            << name;
+    }
+    const auto w = readJson(tmp.file("w1/summary.json"))["paged"]["stream"];
+    EXPECT_GT(w["loads"].get<int>(), 3);
+    EXPECT_GT(w["unloads"].get<int>(), 0);
+    EXPECT_GE(w["bytes_read"].get<uint64_t>(), w["peak_resident_file_bytes"].get<uint64_t>());
+    EXPECT_GT(w["frames_with_arrivals"].get<int>(), 0);
+    // A budget that holds no full region (about 3.6 MB of region files after the fixed 200 MB): the
+    // coarse levels near the camera, never more than the budget.
+    r = runVista("bench " + dir() +
+                 " --seed 4 --frames 12 --size 160x120 --modes raycast -q --paged-radius 300 --paged-far 2000 "
+                 "--paged-wait --memory-budget 0.215 --out " +
+                 tmp.file("b"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto b = readJson(tmp.file("b/summary.json"))["paged"]["stream"];
+    const uint64_t budget = b["budget_file_bytes"].get<uint64_t>();
+    EXPECT_GT(budget, 3000000u);
+    EXPECT_LT(budget, 4000000u);
+    EXPECT_LE(b["peak_resident_file_bytes"].get<uint64_t>(), budget);
+    EXPECT_GT(b["budget_limited_updates"].get<int>(), 0);
+    EXPECT_EQ(b["resident_full_end"].get<int>(), 0);
+    EXPECT_GT(b["resident_coarse_end"].get<int>(), 0);
+}
+
+TEST_F(PagedLoad, StreamingOptionsOutOfRangeExitTwoNamingThem) {
+    CliRun r;
+    for (const char* v : {"-1", "601", "nan"}) {
+        r = runVista("bench " + dir() + kBench + " --paged-stream --paged-prefetch " + v + " --out " + tmp.file("o"));
+        EXPECT_EQ(r.code, 2) << v << ": " << r.err;
+        EXPECT_NE(r.err.find("--paged-prefetch"), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("600"), std::string::npos) << r.err;
+    }
+    r = runVista("bench " + dir() + kBench + " --paged-prefetch 2 --out " + tmp.file("o"));
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("--paged-prefetch: needs --paged-stream"), std::string::npos) << r.err;
+    // Modes that need the whole loaded city do not stream.
+    r = runVista("bench " + dir() + " --seed 4 --frames 2 --size 160x120 -q --modes hybrid --paged-stream --out " +
+                 tmp.file("o"));
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("--paged-stream: mode hybrid does not stream"), std::string::npos) << r.err;
+    // A city file does not stream.
+    const std::string one = tmp.file("one.osgb");
+    fs::copy_file(fs::path(dir()) / "region_0_0.osgb", one);
+    r = runVista("bench " + one + kBench + " --paged-stream --out " + tmp.file("o"));
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("--paged-stream"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(tmp.file("o/summary.json")));
+}

@@ -1,0 +1,65 @@
+// CityStream: a paged city streamed for the render modes (bench
+// --paged-stream). One RegionPager (runtime/scene/region_pager.h) feeds two
+// mirrors of the resident set, updated between frames by advance():
+//  - the chunked city graph (graph()): one group per resident region level
+//    holding that level's near-field chunks (buildNearFieldScene, built on
+//    the pager's worker thread) in their draw order, under a root with the
+//    regions' root state. Groups are kept in the order loadPagedCity()
+//    merges (full levels by region, then coarse levels by region), so the
+//    graph draws what ModeContext::chunkedCity() draws for a preloaded city
+//    of the same regions, in the same order;
+//  - the ray scene (rays(), when made with rays): a StreamedRayScene follower,
+//    each region's Embree scene built on the worker thread too (the frame
+//    thread instances it and commits the top level).
+// Modes that draw the chunked city (full, near) or cast rays (raycast) use
+// them through ModeContext (streamedCity, rays); the others need the whole
+// loaded city and do not stream (modeStreams()).
+//
+// Contract: the manifest outlives the stream; advance() runs between frames,
+// never while a frame is drawn or rays are cast. Errors: those of the ray
+// scene (an Embree error naming the region). A damaged region file is no
+// error: advance() returns its message once and the pager falls back.
+#pragma once
+#include <map>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <osg/Group>
+#include <osg/ref_ptr>
+
+#include "foundation/status.h"
+#include "runtime/engine/ray_streaming.h"
+#include "runtime/scene/region_pager.h"
+
+namespace vista {
+
+struct CityStreamFrame {
+    int arrived = 0, dropped = 0;  // region levels
+    bool waited = false;
+    std::vector<std::string> damaged;
+};
+
+class CityStream {
+public:
+    // prototypes: the city's tree prototypes for the ray scene (see
+    // StreamedRayScene; empty = read at set-up). rays = false: no ray scene.
+    ~CityStream();  // stops the pager first: its workers use the ray scene
+    static Result<std::unique_ptr<CityStream>> create(const PagedManifest& manifest, RegionPagerOptions options,
+                                                      bool rays, std::vector<SceneMesh> prototypes = {});
+    Result<CityStreamFrame> advance(const glm::dvec3& eye, const glm::dvec3& velocity);
+    osg::Group* graph() const { return _root.get(); }
+    RayScene* rays() { return _rays ? &_rays->rays() : nullptr; }
+    RegionPagerStats stats() const { return _pager->stats(); }
+
+private:
+    CityStream() = default;
+    std::unique_ptr<RegionPager> _pager;
+    std::unique_ptr<StreamedRayScene> _rays;
+    osg::ref_ptr<osg::Group> _root;
+    // (coarse, region) -> its chunk group under _root: ordered as loadPagedCity merges.
+    std::map<std::pair<bool, int>, osg::ref_ptr<osg::Group>> _groups;
+};
+
+}  // namespace vista

@@ -1,0 +1,371 @@
+// The streaming pager of a paged city. See region_pager.h.
+#include "runtime/scene/region_pager.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "foundation/timing.h"
+
+namespace vista {
+
+namespace {
+
+// 2D distance from `p` to the rectangle [lo, hi].
+double pointRect(const glm::dvec2& p, const glm::dvec2& lo, const glm::dvec2& hi) {
+    const double dx = std::max({lo.x - p.x, 0.0, p.x - hi.x});
+    const double dy = std::max({lo.y - p.y, 0.0, p.y - hi.y});
+    return std::sqrt(dx * dx + dy * dy);
+}
+
+double pointSegment(const glm::dvec2& p, const glm::dvec2& a, const glm::dvec2& b) {
+    const glm::dvec2 ab = b - a;
+    const double l2 = glm::dot(ab, ab);
+    const double t = l2 > 0 ? std::clamp(glm::dot(p - a, ab) / l2, 0.0, 1.0) : 0.0;
+    return glm::length(p - (a + t * ab));
+}
+
+// True when the segment [a, b] meets the rectangle [lo, hi] (slab test).
+bool segmentMeetsRect(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& lo, const glm::dvec2& hi) {
+    double t0 = 0, t1 = 1;
+    for (int k = 0; k < 2; ++k) {
+        const double d = b[k] - a[k];
+        if (d == 0) {
+            if (a[k] < lo[k] || a[k] > hi[k]) return false;
+            continue;
+        }
+        double u = (lo[k] - a[k]) / d, v = (hi[k] - a[k]) / d;
+        if (u > v) std::swap(u, v);
+        t0 = std::max(t0, u);
+        t1 = std::min(t1, v);
+        if (t0 > t1) return false;
+    }
+    return true;
+}
+
+// 2D distance from the segment [a, b] to the rectangle [lo, hi]: 0 when they
+// meet, else the least of the end points' distances to the rectangle and the
+// corners' distances to the segment (two disjoint convex sets are nearest at
+// a vertex of one of them).
+double segmentRect(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& lo, const glm::dvec2& hi) {
+    if (segmentMeetsRect(a, b, lo, hi)) return 0.0;
+    double d = std::min(pointRect(a, lo, hi), pointRect(b, lo, hi));
+    for (const glm::dvec2& c : {lo, hi, glm::dvec2(lo.x, hi.y), glm::dvec2(hi.x, lo.y)})
+        d = std::min(d, pointSegment(c, a, b));
+    return d;
+}
+
+bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+}  // namespace
+
+RegionPager::RegionPager(const PagedManifest& manifest, const RegionPagerOptions& options) : _m(manifest), _o(options) {
+    VISTA_CHECK(std::isfinite(_o.radius) && _o.radius >= 0);
+    VISTA_CHECK(std::isfinite(_o.far) && _o.far >= 0);
+    VISTA_CHECK(std::isfinite(_o.prefetchS) && _o.prefetchS >= 0);
+    VISTA_CHECK(_o.workers >= 1 && _o.workers <= 16);
+    const size_t n = _m.regions.size();
+    for (auto* v :
+         {&_desired, &_nearEye, &_holdFull, &_holdCoarse, &_flightFull, &_flightCoarse, &_failedFull, &_failedCoarse})
+        v->assign(n, 0);
+    _key.assign(n, 0.0);
+    for (int k = 0; k < _o.workers; ++k) _threads.emplace_back([this] { workerLoop(); });
+}
+
+RegionPager::~RegionPager() {
+    {
+        std::lock_guard<std::mutex> lock(_mutex);
+        _stop = true;
+        _queue.clear();
+    }
+    _work.notify_all();
+    for (std::thread& t : _threads) t.join();
+}
+
+void RegionPager::workerLoop() {
+    std::unique_lock<std::mutex> lock(_mutex);
+    for (;;) {
+        _work.wait(lock, [this] { return _stop || !_queue.empty(); });
+        if (_stop) return;
+        const Job job = _queue.front();
+        _queue.pop_front();
+        ++_busy;
+        lock.unlock();
+        Done done;
+        done.job = job;
+        done.model = loadPagedRegion(_m, job.region, job.coarse);
+        if (done.model && _o.prepare) done.prepared = _o.prepare(*done.model, job.region, job.coarse);
+        done.loader = std::this_thread::get_id();
+        lock.lock();
+        --_busy;
+        done.sequence = ++_finished;
+        _done.push_back(std::move(done));
+        _arrived.notify_all();
+    }
+}
+
+uint64_t RegionPager::levelBytes(int region, bool coarse) const {
+    const PagedRegionEntry& r = _m.regions[size_t(region)];
+    return coarse ? r.coarseBytes : r.bytes;
+}
+
+void RegionPager::computeDesired() {
+    const double farM = _o.far > _o.radius ? _o.far : -1.0;
+    uint64_t total = 0;
+    for (size_t i = 0; i < _m.regions.size(); ++i) {
+        const PagedRegionEntry& r = _m.regions[i];
+        _desired[i] = kNone;
+        _nearEye[i] = 0;
+        if (r.empty) continue;
+        const glm::dvec2 lo(r.lo), hi(r.hi);
+        const double dEye = pointRect(_eye, lo, hi);
+        const double d = segmentRect(_eye, _ahead, lo, hi);
+        _key[i] = 0.5 * (dEye + pointRect(_ahead, lo, hi));
+        uint8_t level = d <= _o.radius ? kFull : (d <= farM ? kCoarse : kNone);
+        if (level == kFull && _failedFull[i]) level = kCoarse;
+        if (level == kCoarse && _failedCoarse[i]) level = kNone;
+        _desired[i] = level;
+        _nearEye[i] = level == kFull ? dEye <= _o.radius : (level == kCoarse && dEye <= farM);
+        if (level != kNone) total += levelBytes(int(i), level == kCoarse);
+    }
+    if (_o.budgetBytes == 0 || total <= _o.budgetBytes) return;
+    // Over the budget: coarse levels go first, farthest first; then full
+    // regions, farthest first (the radius shrinks), each keeping its coarse
+    // level when that fits; then regions left out get their coarse level
+    // back, nearest first, while it fits.
+    ++_stats.budgetLimited;
+    auto byKey = [&](uint8_t level) {
+        std::vector<int> list;
+        for (size_t i = 0; i < _desired.size(); ++i)
+            if (_desired[i] == level) list.push_back(int(i));
+        std::sort(list.begin(), list.end(), [&](int x, int y) {
+            return _key[size_t(x)] != _key[size_t(y)] ? _key[size_t(x)] < _key[size_t(y)] : x < y;
+        });
+        return list;  // nearest first
+    };
+    std::vector<int> coarse = byKey(kCoarse), full = byKey(kFull), out;
+    while (total > _o.budgetBytes) {
+        if (!coarse.empty()) {
+            const int i = coarse.back();
+            coarse.pop_back();
+            total -= levelBytes(i, true);
+            _desired[size_t(i)] = kNone;
+            out.push_back(i);
+        } else if (!full.empty()) {
+            const int i = full.back();
+            full.pop_back();
+            total -= levelBytes(i, false);
+            _desired[size_t(i)] = kNone;
+            if (!_failedCoarse[size_t(i)]) {
+                _desired[size_t(i)] = kCoarse;
+                total += levelBytes(i, true);
+                coarse.push_back(i);
+            } else {
+                out.push_back(i);
+            }
+        } else {
+            break;
+        }
+    }
+    std::sort(out.begin(), out.end(), [&](int x, int y) {
+        return _key[size_t(x)] != _key[size_t(y)] ? _key[size_t(x)] < _key[size_t(y)] : x < y;
+    });
+    for (int i : out)
+        if (!_failedCoarse[size_t(i)] && total + levelBytes(i, true) <= _o.budgetBytes) {
+            _desired[size_t(i)] = kCoarse;
+            total += levelBytes(i, true);
+        }
+    for (size_t i = 0; i < _desired.size(); ++i)
+        if (_desired[i] == kNone) _nearEye[i] = 0;
+}
+
+void RegionPager::drop(int region, bool coarse, RegionPagerDelta* delta) {
+    (coarse ? _holdCoarse : _holdFull)[size_t(region)] = 0;
+    // Not handed to the caller yet: freed here.
+    auto& arrived = delta->arrived;
+    for (auto it = arrived.begin(); it != arrived.end(); ++it)
+        if (it->region == region && it->coarse == coarse) {
+            arrived.erase(it);
+            ++_stats.discarded;
+            return;
+        }
+    delta->dropped.push_back({region, coarse});
+    ++_stats.unloads;
+}
+
+void RegionPager::schedule(RegionPagerDelta* delta) {
+    const int n = int(_m.regions.size());
+    // Drop what is not wanted; a region changing level keeps its old level
+    // until the new one arrives (dropped below if the budget needs the room).
+    for (int i = 0; i < n; ++i) {
+        const uint8_t want = _desired[size_t(i)];
+        const bool hasWanted = (want == kFull && _holdFull[size_t(i)]) || (want == kCoarse && _holdCoarse[size_t(i)]);
+        if (_holdFull[size_t(i)] && want != kFull && (want == kNone || hasWanted)) drop(i, false, delta);
+        if (_holdCoarse[size_t(i)] && want != kCoarse && (want == kNone || hasWanted)) drop(i, true, delta);
+    }
+    // Cancel queued loads that are no longer wanted.
+    std::lock_guard<std::mutex> lock(_mutex);
+    for (auto it = _queue.begin(); it != _queue.end();) {
+        const uint8_t want = _desired[size_t(it->region)];
+        if (want != (it->coarse ? kCoarse : kFull)) {
+            (it->coarse ? _flightCoarse : _flightFull)[size_t(it->region)] = 0;
+            it = _queue.erase(it);
+        } else {
+            ++it;
+        }
+    }
+    // The loads still to start, most urgent first.
+    struct Want {
+        int region;
+        bool coarse;
+        int urgency;
+    };
+    std::vector<Want> wants;
+    for (int i = 0; i < n; ++i) {
+        const uint8_t want = _desired[size_t(i)];
+        if (want == kNone) continue;
+        const bool coarse = want == kCoarse;
+        if ((coarse ? _holdCoarse : _holdFull)[size_t(i)] || (coarse ? _flightCoarse : _flightFull)[size_t(i)])
+            continue;
+        wants.push_back({i, coarse, _nearEye[size_t(i)] ? (coarse ? 1 : 0) : 2});
+    }
+    std::sort(wants.begin(), wants.end(), [&](const Want& a, const Want& b) {
+        if (a.urgency != b.urgency) return a.urgency < b.urgency;
+        if (_key[size_t(a.region)] != _key[size_t(b.region)]) return _key[size_t(a.region)] < _key[size_t(b.region)];
+        return a.region < b.region;
+    });
+    // Queued loads in the same order: the queue is rebuilt, the new ones merged in.
+    std::vector<Job> queued(_queue.begin(), _queue.end());
+    _queue.clear();
+    uint64_t resident = stats().residentBytes;
+    for (const Want& w : wants) {
+        const uint64_t need = levelBytes(w.region, w.coarse);
+        if (_o.budgetBytes > 0 && resident + need > _o.budgetBytes) {
+            // The region's other level makes room, if it has one.
+            const bool other = !w.coarse;
+            if ((other ? _holdCoarse : _holdFull)[size_t(w.region)]) {
+                drop(w.region, other, delta);
+                resident -= levelBytes(w.region, other);
+            }
+            if (resident + need > _o.budgetBytes) continue;  // waits for room (an old level leaving)
+        }
+        (w.coarse ? _flightCoarse : _flightFull)[size_t(w.region)] = 1;
+        resident += need;
+        queued.push_back({w.region, w.coarse});
+    }
+    std::stable_sort(queued.begin(), queued.end(), [&](const Job& a, const Job& b) {
+        const int ua = _nearEye[size_t(a.region)] ? (a.coarse ? 1 : 0) : 2;
+        const int ub = _nearEye[size_t(b.region)] ? (b.coarse ? 1 : 0) : 2;
+        if (ua != ub) return ua < ub;
+        if (_key[size_t(a.region)] != _key[size_t(b.region)]) return _key[size_t(a.region)] < _key[size_t(b.region)];
+        return a.region < b.region;
+    });
+    _queue.assign(queued.begin(), queued.end());
+    _stats.peakResidentBytes = std::max(_stats.peakResidentBytes, resident);
+    _work.notify_all();
+}
+
+void RegionPager::update(const glm::dvec3& eye, const glm::dvec3& velocity) {
+    VISTA_CHECK(finite(eye) && finite(velocity));
+    _eye = glm::dvec2(eye);
+    _ahead = _eye + glm::dvec2(velocity) * _o.prefetchS;
+    _haveEye = true;
+    computeDesired();
+    schedule(&_pending);
+}
+
+void RegionPager::takeArrivals(std::deque<Done>& done, RegionPagerDelta* delta) {
+    bool failed = false;
+    for (Done& d : done) {
+        const int i = d.job.region;
+        const bool coarse = d.job.coarse;
+        (coarse ? _flightCoarse : _flightFull)[size_t(i)] = 0;
+        if (!d.model) {
+            (coarse ? _failedCoarse : _failedFull)[size_t(i)] = 1;
+            delta->damaged.push_back(d.model.status().message());
+            ++_stats.failed;
+            failed = true;
+            continue;
+        }
+        ++_stats.loads;
+        _stats.bytesRead += levelBytes(i, coarse);
+        if (_desired[size_t(i)] != (coarse ? kCoarse : kFull)) {
+            ++_stats.discarded;  // no longer wanted: freed with `done`
+            continue;
+        }
+        (coarse ? _holdCoarse : _holdFull)[size_t(i)] = 1;
+        RegionArrival a;
+        a.region = i;
+        a.coarse = coarse;
+        a.model = std::move(*d.model);
+        a.bytes = levelBytes(i, coarse);
+        a.loader = d.loader;
+        a.sequence = d.sequence;
+        a.prepared = std::move(d.prepared);
+        delta->arrived.push_back(std::move(a));
+    }
+    done.clear();
+    // A failed full file: its coarse level is wanted instead.
+    if (failed && _haveEye) computeDesired();
+    // Old levels of regions whose new level arrived go now.
+    schedule(delta);
+}
+
+RegionPagerDelta RegionPager::collect() {
+    RegionPagerDelta delta = std::move(_pending);
+    _pending = RegionPagerDelta();
+    std::deque<Done> done;
+    {
+        std::lock_guard<std::mutex> lock(_mutex);
+        done.swap(_done);
+    }
+    takeArrivals(done, &delta);
+    if (_o.wait) {
+        Stopwatch sw;
+        for (;;) {
+            bool inFlight = false;
+            for (size_t i = 0; i < _flightFull.size() && !inFlight; ++i) inFlight = _flightFull[i] || _flightCoarse[i];
+            if (!inFlight) break;
+            delta.waited = true;
+            {
+                std::unique_lock<std::mutex> lock(_mutex);
+                _arrived.wait(lock, [this] { return _queue.empty() && _busy == 0; });
+                done.swap(_done);
+            }
+            takeArrivals(done, &delta);
+        }
+        if (delta.waited) {
+            ++_stats.framesWaited;
+            _stats.waitMs += sw.ms();
+        }
+    }
+    std::sort(delta.dropped.begin(), delta.dropped.end(), [](const RegionDrop& a, const RegionDrop& b) {
+        return a.region != b.region ? a.region < b.region : a.coarse < b.coarse;
+    });
+    std::stable_sort(delta.arrived.begin(), delta.arrived.end(), [](const RegionArrival& a, const RegionArrival& b) {
+        return a.coarse != b.coarse ? !a.coarse : a.region < b.region;
+    });
+    return delta;
+}
+
+RegionPagerStats RegionPager::stats() const {
+    RegionPagerStats s = _stats;
+    s.residentBytes = 0;
+    s.residentFull = s.residentCoarse = 0;
+    for (size_t i = 0; i < _holdFull.size(); ++i) {
+        if (_m.regions[i].empty) continue;
+        if (_holdFull[i] || _flightFull[i]) s.residentBytes += _m.regions[i].bytes;
+        if (_holdCoarse[i] || _flightCoarse[i]) s.residentBytes += _m.regions[i].coarseBytes;
+        s.residentFull += _holdFull[i] ? 1 : 0;
+        s.residentCoarse += _holdCoarse[i] ? 1 : 0;
+    }
+    return s;
+}
+
+std::vector<uint8_t> RegionPager::held() const {
+    std::vector<uint8_t> out(_holdFull.size(), kNone);
+    for (size_t i = 0; i < out.size(); ++i) out[i] = _holdFull[i] ? kFull : (_holdCoarse[i] ? kCoarse : kNone);
+    return out;
+}
+
+}  // namespace vista

@@ -1,0 +1,194 @@
+// RegionPager: the streaming pager of a paged city (paged_load.h). It keeps
+// the regions near a moving camera resident, loading them on worker threads
+// ahead of the camera and dropping them behind it; the caller (the frame
+// thread) owns what was loaded and mirrors it into its own structures (a
+// RayScene's regions, a scene graph) between frames.
+//
+// The desired set, from the last update(eye, velocity): the lookahead segment
+// runs from the eye to eye + velocity * prefetchS (xy only). Every non-empty
+// region whose bounds (manifest `bounds`, 2D) come within `radius` of that
+// segment is desired at full detail; every other region within `far` of it at
+// its coarse level (far <= radius: none). With prefetchS = 0 and a resting
+// eye this is exactly what loadPagedNear() loads for a path of one sample
+// (selectPagedRegions / selectCoarseRegions of the eye). A region whose full
+// file failed to load is desired at its coarse level instead; one whose coarse
+// file failed too, not at all (each failure is reported once, never retried).
+//
+// Budget (budgetBytes > 0): the desired set's file bytes (manifest sizes of
+// the wanted level) are held at or under it: coarse regions go first, farthest
+// first, then full regions farthest first (the radius shrinks), each keeping
+// its coarse level if that fits; then regions left out get their coarse level
+// back, nearest first, while it fits (a budget below every full region keeps
+// the coarse levels near the eye). The resident
+// bytes (levels held by the caller plus loads in flight or not yet collected)
+// never exceed the budget either: a region changing level keeps its old level
+// until the new one arrives only when both fit, else the old level is dropped
+// first.
+//
+// Load order: by urgency, then by the mean of the region's distance to the
+// eye and to the end of the lookahead (so regions ahead of the heading come
+// before those behind at the same distance): full regions within reach of the
+// eye, coarse regions within reach of the eye, then regions wanted only for the
+// lookahead. Only loads not yet started are re-ordered or cancelled; a load in
+// flight whose region is no longer wanted is discarded when it arrives.
+//
+// Threads: update(), collect() and stats() are called from one thread (the
+// frame thread); loads (loadPagedRegion) run on `workers` worker threads and
+// never on the caller's. The destructor cancels queued loads and joins the
+// workers (a load in flight finishes first).
+//
+// collect(): what changed since the last call: regions that arrived (each
+// with its SceneModel, handed over: the pager keeps no copy) and levels to
+// drop (the caller frees them). Apply the drops before the arrivals: a region
+// changing level comes as a drop of one level and an arrival of the other.
+// Arrivals and drops are sorted (drops by region; arrivals full before coarse,
+// by region), so a run that waits (below) hands the same lists in the same
+// order whatever the timing. In wait mode (options.wait) collect() first
+// blocks until every desired level is resident or failed (a failed full file
+// then waits for its coarse fallback): the caller then holds exactly the
+// desired set, the same regions as a synchronous load of the same reach.
+//
+// Contract (VISTA_CHECK): radius and far finite and >= 0, prefetchS finite
+// and >= 0, budgetBytes >= 0, workers 1 .. 16, eye and velocity finite.
+#pragma once
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "runtime/scene/paged_load.h"
+#include "runtime/scene/scene_model.h"
+
+namespace vista {
+
+// Default lookahead of --paged-prefetch, seconds along the velocity.
+constexpr double kDefaultPagedPrefetchS = 4.0;
+constexpr double kMaxPagedPrefetchS = 600.0;
+
+struct RegionPagerOptions {
+    double radius = kDefaultPagedRadiusM;  // metres: full detail within
+    double far = kDefaultPagedFarM;        // metres: coarse level within (<= radius: none)
+    double prefetchS = kDefaultPagedPrefetchS;
+    uint64_t budgetBytes = 0;  // file bytes of the resident levels; 0 = no budget
+    bool wait = false;         // collect() blocks until the desired set is resident
+    int workers = 1;
+    // Optional: run on the worker thread right after a level loads (e.g. the
+    // near-field chunks of its graph, its Embree scene); it may complete the
+    // model in place, and its result travels in RegionArrival::prepared.
+    // Must be thread-safe and must not throw.
+    std::function<std::shared_ptr<void>(SceneModel& model, int region, bool coarse)> prepare;
+};
+
+// One region level loaded on a worker thread.
+struct RegionArrival {
+    int region = 0;  // index into the manifest's regions
+    bool coarse = false;
+    SceneModel model;
+    uint64_t bytes = 0;              // its file bytes (manifest)
+    std::thread::id loader;          // the worker thread that read it
+    uint64_t sequence = 0;           // 1, 2, ...: the order in which the pager's loads finished
+    std::shared_ptr<void> prepared;  // what options.prepare made of it (null without one)
+};
+
+struct RegionDrop {
+    int region = 0;
+    bool coarse = false;
+};
+
+struct RegionPagerDelta {
+    std::vector<RegionDrop> dropped;
+    std::vector<RegionArrival> arrived;
+    std::vector<std::string> damaged;  // one message per file that failed to load (it names the file)
+    bool waited = false;               // wait mode: collect() blocked for a load
+};
+
+struct RegionPagerStats {
+    uint64_t residentBytes = 0;                // levels held by the caller, in flight or not yet collected
+    uint64_t peakResidentBytes = 0;            // the most residentBytes has been
+    uint64_t bytesRead = 0;                    // file bytes of the successful loads
+    int loads = 0;                             // successful loads (discarded ones included)
+    int unloads = 0;                           // levels handed out as drops
+    int discarded = 0;                         // loads that arrived unwanted and were freed here
+    int failed = 0;                            // loads that failed (damaged or missing files)
+    int framesWaited = 0;                      // collect() calls that blocked (wait mode)
+    double waitMs = 0;                         // total time blocked in collect()
+    int budgetLimited = 0;                     // updates whose desired set the budget cut
+    int residentFull = 0, residentCoarse = 0;  // levels held by the caller now
+};
+
+class RegionPager {
+public:
+    // `manifest` must outlive the pager.
+    RegionPager(const PagedManifest& manifest, const RegionPagerOptions& options);
+    ~RegionPager();
+    RegionPager(const RegionPager&) = delete;
+    RegionPager& operator=(const RegionPager&) = delete;
+
+    // Decides the desired set for the eye (world metres) moving at `velocity`
+    // (metres per second), drops what is no longer wanted and queues the loads.
+    void update(const glm::dvec3& eye, const glm::dvec3& velocity);
+    RegionPagerDelta collect();
+    RegionPagerStats stats() const;
+
+    // The desired set of the last update(): per manifest region 0 (none), 1
+    // (coarse) or 2 (full).
+    const std::vector<uint8_t>& desired() const { return _desired; }
+    // What the caller holds now (after the last collect()): same coding.
+    std::vector<uint8_t> held() const;
+
+private:
+    struct Job {
+        int region = 0;
+        bool coarse = false;
+    };
+    struct Done {
+        Job job;
+        Result<SceneModel> model = Status::error("not loaded");
+        std::thread::id loader;
+        uint64_t sequence = 0;
+        std::shared_ptr<void> prepared;
+    };
+    enum Level : uint8_t { kNone = 0, kCoarse = 1, kFull = 2 };
+
+    void workerLoop();
+    void schedule(RegionPagerDelta* delta);
+    void computeDesired();
+    void drop(int region, bool coarse, RegionPagerDelta* delta);
+    void takeArrivals(std::deque<Done>& done, RegionPagerDelta* delta);
+    uint64_t levelBytes(int region, bool coarse) const;
+    double regionKey(int region) const;
+
+    const PagedManifest& _m;
+    RegionPagerOptions _o;
+    glm::dvec2 _eye{0.0}, _ahead{0.0};
+    bool _haveEye = false;
+
+    // Frame-thread state.
+    std::vector<uint8_t> _desired;
+    std::vector<uint8_t> _nearEye;                    // 1: wanted within reach of the eye itself
+    std::vector<uint8_t> _holdFull, _holdCoarse;      // held by the caller (or arrived, not yet collected)
+    std::vector<uint8_t> _flightFull, _flightCoarse;  // queued or loading
+    std::vector<uint8_t> _failedFull, _failedCoarse;
+    std::vector<double> _key;   // load order within an urgency (lower first)
+    RegionPagerDelta _pending;  // drops decided by update(), handed out by the next collect()
+    RegionPagerStats _stats;
+
+    // Shared with the workers (under _mutex).
+    mutable std::mutex _mutex;
+    std::condition_variable _work, _arrived;
+    std::deque<Job> _queue;
+    std::deque<Done> _done;
+    int _busy = 0;
+    uint64_t _finished = 0;
+    bool _stop = false;
+    std::vector<std::thread> _threads;
+};
+
+}  // namespace vista

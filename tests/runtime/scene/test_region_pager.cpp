@@ -1,0 +1,260 @@
+// The streaming pager of a paged city (runtime/scene/region_pager.h): the
+// desired set follows a moving eye, loads ahead of the heading come first,
+// regions left behind are dropped, the budget holds (coarse levels first),
+// wait mode holds what a synchronous load of the same reach loads, damaged
+// files fall back to the coarse level, and no load runs on the caller's thread.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "runtime/scene/paged_load.h"
+#include "runtime/scene/region_pager.h"
+#include "tests/common/run_vista.h"
+#include "tests/common/temp_dir.h"
+
+namespace fs = std::filesystem;
+using vista::RegionPager;
+using vista::RegionPagerOptions;
+using vista::test::CliRun;
+using vista::test::runVista;
+using vista::test::TempDir;
+
+namespace {
+
+// A 1.5 km city in 500 m regions (3 x 3, region 4 in the middle), facade detail 1 to keep it quick.
+const std::string kCity = "gen --size 1500 --seed 4 --detail 1 --region-size 500 -q";
+
+class Pager : public ::testing::Test {
+protected:
+    static void SetUpTestSuite() {
+        ref = new TempDir("vista_pager_ref");
+        const CliRun r = runVista(kCity + " -o " + ref->file("city.paged"));
+        ASSERT_EQ(r.code, 0) << r.err;
+    }
+    static void TearDownTestSuite() {
+        delete ref;
+        ref = nullptr;
+    }
+    void SetUp() override {
+        auto m = vista::readPagedManifest(ref->file("city.paged"));
+        ASSERT_TRUE(m.isOk()) << m.status().message();
+        manifest = *m;
+        ASSERT_EQ(manifest.regions.size(), 9u);
+        ASSERT_EQ(manifest.nonEmpty(), 9);
+    }
+    // The centre of region i's grid cell (world metres).
+    glm::dvec3 centre(int i) const {
+        const auto& r = manifest.regions[size_t(i)];
+        const double half = 0.5 * manifest.params.size_m, s = manifest.regionSizeM;
+        return glm::dvec3(manifest.params.origin_x - half + (r.ix + 0.5) * s,
+                          manifest.params.origin_y - half + (r.iy + 0.5) * s, 1.7);
+    }
+    // Applies a delta to `held` (region -> level) as a consumer does; checks the loader threads.
+    void apply(vista::RegionPagerDelta& d, std::map<int, int>& held) {
+        for (const auto& x : d.dropped) {
+            ASSERT_EQ(held.count(x.region), 1u) << "drop of a region not held: " << x.region;
+            ASSERT_EQ(held[x.region], x.coarse ? 1 : 2);
+            held.erase(x.region);
+        }
+        for (const auto& a : d.arrived) {
+            EXPECT_NE(a.loader, std::this_thread::get_id())
+                << "region " << a.region << " loaded on the caller's thread";
+            EXPECT_FALSE(a.model.tiles.empty());
+            if (held.count(a.region)) {
+                ADD_FAILURE() << "region " << a.region << " arrived while another level is held";
+            }
+            held[a.region] = a.coarse ? 1 : 2;
+        }
+    }
+    static std::map<int, int> asMap(const std::vector<uint8_t>& levels) {
+        std::map<int, int> m;
+        for (size_t i = 0; i < levels.size(); ++i)
+            if (levels[i]) m[int(i)] = levels[i];
+        return m;
+    }
+    static TempDir* ref;
+    vista::PagedManifest manifest;
+};
+TempDir* Pager::ref = nullptr;
+
+}  // namespace
+
+TEST_F(Pager, TheResidentSetFollowsAMovingEyeAndUnloadsBehindIt) {
+    RegionPagerOptions o;
+    o.radius = 0;
+    o.far = 0;
+    o.prefetchS = 0;
+    o.wait = true;
+    RegionPager pager(manifest, o);
+    std::map<int, int> held;
+    for (int step : {0, 1, 2, 5, 8}) {
+        pager.update(centre(step), glm::dvec3(0.0));
+        auto d = pager.collect();
+        apply(d, held);
+        EXPECT_EQ(held, (std::map<int, int>{{step, 2}})) << "eye in region " << step;
+        EXPECT_EQ(asMap(pager.held()), held);
+    }
+    const auto s = pager.stats();
+    EXPECT_EQ(s.loads, 5);
+    EXPECT_EQ(s.unloads, 4);
+    EXPECT_EQ(s.residentFull, 1);
+    EXPECT_EQ(s.residentBytes, manifest.regions[8].bytes);
+    EXPECT_GT(s.framesWaited, 0);
+    uint64_t read = 0;
+    for (int i : {0, 1, 2, 5, 8}) read += manifest.regions[size_t(i)].bytes;
+    EXPECT_EQ(s.bytesRead, read);
+}
+
+TEST_F(Pager, WaitModeHoldsWhatASynchronousLoadLoads) {
+    for (double radius : {0.0, 200.0, 600.0}) {
+        RegionPagerOptions o;
+        o.radius = radius;
+        o.far = 5000;
+        o.prefetchS = 0;
+        o.wait = true;
+        o.workers = 2;
+        RegionPager pager(manifest, o);
+        // A point off the grid's symmetry: inside region 0, towards region 1.
+        const glm::dvec3 eye = centre(0) + glm::dvec3(180.0, 40.0, 0.0);
+        pager.update(eye, glm::dvec3(3.0, 1.0, 0.0));  // prefetch 0: the velocity does not matter
+        auto d = pager.collect();
+        std::map<int, int> held;
+        apply(d, held);
+        const std::vector<int> full = vista::selectPagedRegions(manifest, {glm::dvec2(eye)}, radius);
+        const std::vector<int> coarse = vista::selectCoarseRegions(manifest, {glm::dvec2(eye)}, o.far, full);
+        std::map<int, int> expect;
+        for (int i : full) expect[i] = 2;
+        for (int i : coarse) expect[i] = 1;
+        EXPECT_EQ(held, expect) << "radius " << radius;
+        // The same triangles as the merged synchronous load of that set.
+        auto merged = vista::loadPagedCity(manifest, full, radius, nullptr, coarse);
+        ASSERT_TRUE(merged.isOk()) << merged.status().message();
+        size_t tris = 0;
+        for (const auto& a : d.arrived) tris += a.model.triangles;
+        EXPECT_EQ(tris, merged->triangles);
+        // Arrivals come sorted (full first, by region), whatever the load order.
+        for (size_t k = 1; k < d.arrived.size(); ++k) {
+            const auto &a = d.arrived[k - 1], &b = d.arrived[k];
+            EXPECT_TRUE(a.coarse < b.coarse || (a.coarse == b.coarse && a.region < b.region));
+        }
+    }
+}
+
+TEST_F(Pager, PrefetchLoadsAheadOfTheHeadingFirst) {
+    RegionPagerOptions o;
+    o.radius = 260;  // from the middle of region 4: itself and its four edge neighbours
+    o.far = 0;
+    o.prefetchS = 30;  // 10 m/s east: 300 m ahead
+    o.workers = 1;
+    RegionPager pager(manifest, o);
+    pager.update(centre(4), glm::dvec3(10.0, 0.0, 0.0));
+    // Grid: region = iy * 3 + ix; east of 4 is 5, west is 3, north-east 8, north-west 6.
+    const auto& want = pager.desired();
+    for (int i : {1, 3, 4, 5, 7}) EXPECT_EQ(want[size_t(i)], 2) << "region " << i;
+    EXPECT_EQ(want[2], 2) << "south-east: within reach of the lookahead";
+    EXPECT_EQ(want[8], 2) << "north-east: within reach of the lookahead";
+    EXPECT_EQ(want[0], 0) << "south-west: behind";
+    EXPECT_EQ(want[6], 0) << "north-west: behind";
+    std::map<int, uint64_t> seq;
+    std::map<int, int> held;
+    for (int tries = 0; tries < 20000 && seq.size() < 7; ++tries) {
+        auto d = pager.collect();
+        for (const auto& a : d.arrived) seq[a.region] = a.sequence;
+        apply(d, held);
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    ASSERT_EQ(seq.size(), 7u);
+    EXPECT_EQ(seq[4], 1u) << "the eye's own region first";
+    EXPECT_LT(seq[5], seq[3]) << "ahead (east) before behind (west)";
+    EXPECT_LT(seq[5], seq[1]);
+    EXPECT_LT(seq[5], seq[7]);
+    EXPECT_LT(seq[3], seq[2]) << "regions within reach of the eye before those wanted for the lookahead only";
+    EXPECT_LT(seq[3], seq[8]);
+    EXPECT_EQ(pager.stats().framesWaited, 0);
+}
+
+TEST_F(Pager, TheBudgetHoldsCoarseLevelsFirstThenTheRadiusShrinks) {
+    // Coarse first: the middle region at full detail, the others coarse, the budget short of two coarse levels.
+    {
+        uint64_t total = manifest.regions[4].bytes;
+        for (int i = 0; i < 9; ++i)
+            if (i != 4) total += manifest.regions[size_t(i)].coarseBytes;
+        RegionPagerOptions o;
+        o.radius = 0;
+        o.far = 5000;
+        o.prefetchS = 0;
+        o.wait = true;
+        o.budgetBytes = total - manifest.regions[0].coarseBytes / 2;
+        RegionPager pager(manifest, o);
+        pager.update(centre(4), glm::dvec3(0.0));
+        auto d = pager.collect();
+        std::map<int, int> held;
+        apply(d, held);
+        EXPECT_EQ(held[4], 2) << "the full region stays";
+        int coarse = 0;
+        for (const auto& [r, level] : held) coarse += level == 1 ? 1 : 0;
+        EXPECT_LT(coarse, 8) << "a coarse level went";
+        EXPECT_GE(coarse, 6);
+        EXPECT_LE(pager.stats().peakResidentBytes, o.budgetBytes);
+        EXPECT_GT(pager.stats().budgetLimited, 0);
+    }
+    // Then the radius: five full regions wanted, the budget one byte short of them; moving on keeps it.
+    {
+        uint64_t five = 0;
+        for (int i : {1, 3, 4, 5, 7}) five += manifest.regions[size_t(i)].bytes;
+        RegionPagerOptions o;
+        o.radius = 260;
+        o.far = 5000;
+        o.prefetchS = 0;
+        o.wait = true;
+        o.budgetBytes = five - 1;
+        RegionPager pager(manifest, o);
+        std::map<int, int> held;
+        for (int step : {4, 5, 2, 1, 0}) {
+            pager.update(centre(step), glm::dvec3(0.0));
+            auto d = pager.collect();
+            apply(d, held);
+            EXPECT_EQ(held[step], 2) << "the eye's region stays, step " << step;
+            uint64_t bytes = 0;
+            for (const auto& [r, level] : held)
+                bytes += level == 2 ? manifest.regions[size_t(r)].bytes : manifest.regions[size_t(r)].coarseBytes;
+            EXPECT_LE(bytes, o.budgetBytes);
+            EXPECT_LE(pager.stats().peakResidentBytes, o.budgetBytes) << "step " << step;
+        }
+        EXPECT_GT(pager.stats().unloads, 0);
+    }
+}
+
+TEST_F(Pager, ADamagedRegionFileFallsBackToItsCoarseLevel) {
+    TempDir tmp("vista_pager_damaged");
+    const std::string dir = tmp.file("city.paged");
+    fs::copy(ref->file("city.paged"), dir, fs::copy_options::recursive);
+    auto m = vista::readPagedManifest(dir);
+    ASSERT_TRUE(m.isOk()) << m.status().message();
+    const std::string bad = (fs::path(dir) / m->regions[4].file).string();
+    fs::resize_file(bad, m->regions[4].bytes / 2);
+    RegionPagerOptions o;
+    o.radius = 0;
+    o.far = 0;
+    o.prefetchS = 0;
+    o.wait = true;
+    RegionPager pager(*m, o);
+    pager.update(centre(4), glm::dvec3(0.0));
+    auto d = pager.collect();
+    ASSERT_EQ(d.damaged.size(), 1u);
+    EXPECT_NE(d.damaged[0].find(m->regions[4].file), std::string::npos) << d.damaged[0];
+    std::map<int, int> held;
+    apply(d, held);
+    EXPECT_EQ(held, (std::map<int, int>{{4, 1}}));
+    // Not tried again on the next frames.
+    pager.update(centre(4) + glm::dvec3(1.0, 0.0, 0.0), glm::dvec3(0.0));
+    auto again = pager.collect();
+    EXPECT_TRUE(again.damaged.empty());
+    EXPECT_TRUE(again.arrived.empty());
+    EXPECT_EQ(pager.stats().failed, 1);
+}
