@@ -180,27 +180,8 @@ Status configure(const RenderArgs& a, RenderPlan& p) {
 // The city (labelled when a label channel needs it), the walkthrough and the
 // path indices of the frames (`idx`), each frame inside the city.
 Result<Walkthrough> loadCityAndFrames(const RenderArgs& a, RenderPlan& p, std::vector<size_t>& idx) {
-    WalkthroughRequest req;
-    req.city = a.city;
-    req.cmd = kCmd;
-    req.quiet = true;
-    req.allowPaged = false;
-    req.pathNeedsStreets = a.path.file.empty();
-    req.checkCity = [&](const SceneModel& city) {
-        if ((p.channels & (kSemantic | kInstance)) && !city.labelled)
-            return Status::error("city file '" + a.city +
-                                 "' has no ground-truth labels (written by an older vista): regenerate the "
-                                 "city with this version (`vista gen`) for the semantic and instance channels");
-        return Status::ok();
-    };
-    req.makePath = [&](const SceneModel& city) -> Result<Path> {
-        auto path = walkthroughPath(a.path.file, p.path, city);
-        if (!path) return path;
-        if (path->samples.empty()) return Status::error("the walkthrough path has no samples");
-        idx = path->frames(size_t(a.frames), p.sampleRuns);
-        VISTA_RETURN_IF_ERROR(checkPathInCity(*path, idx, city));
-        return path;
-    };
+    const std::string labelsFor = (p.channels & (kSemantic | kInstance)) ? "the semantic and instance channels" : "";
+    WalkthroughRequest req = renderRequest(a.city, a.path.file, p.path, a.frames, p.sampleRuns, labelsFor, idx);
     req.bakedModes = {a.mode};
     req.effects = [](const Effects& declared) { return runTimeEffects(std::nullopt, declared, true, kCmd); };
     return loadWalkthrough(req, p.options);

@@ -122,28 +122,8 @@ Status configure(const RigRunRequest& a, RigPlan& p) {
 }
 
 Result<Walkthrough> loadCityAndFrames(const RigRunRequest& a, RigPlan& p) {
-    WalkthroughRequest req;
-    req.city = a.city;
-    req.cmd = kCmd;
-    req.quiet = true;
-    req.allowPaged = false;
-    req.pathNeedsStreets = a.path.file.empty();
-    req.checkCity = [&](const SceneModel& city) {
-        if (p.needsLabels() && !city.labelled)
-            return Status::error("city file '" + a.city +
-                                 "' has no ground-truth labels (written by an older vista): regenerate the city "
-                                 "with this version (`vista gen`) for LiDAR labels and the semantic, instance and "
-                                 "boxes channels");
-        return Status::ok();
-    };
-    req.makePath = [&](const SceneModel& city) -> Result<Path> {
-        auto path = walkthroughPath(a.path.file, p.path, city);
-        if (!path) return path;
-        if (path->samples.empty()) return Status::error("the walkthrough path has no samples");
-        p.idx = path->frames(size_t(a.frames), p.sampleRuns);
-        VISTA_RETURN_IF_ERROR(checkPathInCity(*path, p.idx, city));
-        return path;
-    };
+    const std::string labelsFor = p.needsLabels() ? "LiDAR labels and the semantic, instance and boxes channels" : "";
+    WalkthroughRequest req = renderRequest(a.city, a.path.file, p.path, a.frames, p.sampleRuns, labelsFor, p.idx);
     req.effects = [](const Effects& declared) { return runTimeEffects(std::nullopt, declared, true, kCmd); };
     auto w = loadWalkthrough(req, p.options);
     if (!w) return w;

@@ -114,4 +114,31 @@ nlohmann::json medianOf(const std::vector<double>& v) {
     return v.empty() ? nlohmann::json(nullptr) : nlohmann::json(median(v));
 }
 
+WalkthroughRequest renderRequest(const std::string& city, const std::string& pathFile, const PathOptions& pathOptions,
+                                 int frames, int sampleRuns, const std::string& labelsFor, std::vector<size_t>& idx) {
+    WalkthroughRequest req;
+    req.city = city;
+    req.cmd = "vista render";
+    req.quiet = true;
+    req.allowPaged = false;
+    req.pathNeedsStreets = pathFile.empty();
+    req.checkCity = [city, labelsFor](const SceneModel& model) {
+        if (!labelsFor.empty() && !model.labelled)
+            return Status::error("city file '" + city +
+                                 "' has no ground-truth labels (written by an older vista): regenerate the city "
+                                 "with this version (`vista gen`) for " +
+                                 labelsFor);
+        return Status::ok();
+    };
+    req.makePath = [pathFile, pathOptions, frames, sampleRuns, &idx](const SceneModel& model) -> Result<Path> {
+        auto path = walkthroughPath(pathFile, pathOptions, model);
+        if (!path) return path;
+        if (path->samples.empty()) return Status::error("the walkthrough path has no samples");
+        idx = path->frames(size_t(frames), sampleRuns);
+        VISTA_RETURN_IF_ERROR(checkPathInCity(*path, idx, model));
+        return path;
+    };
+    return req;
+}
+
 }  // namespace vista

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "foundation/status.h"
+#include "nodes/render/walkthrough.h"
 #include "runtime/scene/paths.h"
 #include "runtime/scene/scene_model.h"
 
@@ -34,6 +35,13 @@ std::string manifestNumber(double v);
 // Test hook (docs/formats.md): VISTA_RENDER_KILL_AFTER_FRAMES=N makes the run
 // kill itself with SIGKILL after it finished N frames, as an interruption would.
 long killAfterFrames();
+// The walkthrough request both kinds of render make: the city file (never
+// paged), notes off, the path from `pathFile` (a CSV) or `pathOptions` on the
+// city's streets, `frames` of it as `sampleRuns` says into `idx`, every frame
+// inside the city; a city without ground-truth labels is refused when
+// `labelsFor` (the channels that need them, for the message) is not empty.
+WalkthroughRequest renderRequest(const std::string& city, const std::string& pathFile, const PathOptions& pathOptions,
+                                 int frames, int sampleRuns, const std::string& labelsFor, std::vector<size_t>& idx);
 // The median of `v`, null when empty.
 nlohmann::json medianOf(const std::vector<double>& v);
 

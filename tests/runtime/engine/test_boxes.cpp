@@ -32,6 +32,7 @@
 #include "runtime/engine/ray_scene.h"
 #include "runtime/scene/city_file.h"
 #include "tests/common/temp_dir.h"
+#include "tests/runtime/engine/boxes_city.h"
 #include "tests/runtime/engine/fixtures.h"
 
 using namespace vista;
@@ -39,11 +40,7 @@ using namespace vista;
 namespace {
 
 // A small generated city with every object kind it can have (night: street lights; parked cars).
-struct TestCity {
-    SceneModel model;
-    std::unique_ptr<RayScene> rays;
-    CityBoxes boxes;
-};
+using TestCity = test::BoxesCity;
 
 const TestCity& testCity() {
     static TestCity* city = [] {
@@ -55,18 +52,7 @@ const TestCity& testCity() {
         p.origin_y = -1000.0;
         p.parked_car_share = 0.5;
         p.effects.enable(EffectId::Night);
-        auto generated = generateCity(p);
-        VISTA_CHECK(generated.isOk());
-        test::TempDir dir("vista_boxes");
-        VISTA_CHECK(writeCityFile(*generated, dir.file("city.osgb")).isOk());
-        auto model = loadCityFile(dir.file("city.osgb"));
-        VISTA_CHECK(model.isOk());
-        auto* c = new TestCity{std::move(*model), nullptr, {}};
-        auto rays = RayScene::build(c->model);
-        VISTA_CHECK(rays.isOk());
-        c->rays = std::move(*rays);
-        c->boxes = buildCityBoxes(c->model);
-        return c;
+        return test::makeBoxesCity(p, "vista_boxes");
     }();
     return *city;
 }

@@ -27,16 +27,13 @@
 #include "runtime/engine/rig_camera.h"
 #include "runtime/scene/city_file.h"
 #include "tests/common/temp_dir.h"
+#include "tests/runtime/engine/boxes_city.h"
 
 using namespace vista;
 
 namespace {
 
-struct TestCity {
-    SceneModel model;
-    std::unique_ptr<RayScene> rays;
-    CityBoxes boxes;
-};
+using TestCity = test::BoxesCity;
 
 const TestCity& testCity() {
     static TestCity* city = [] {
@@ -47,18 +44,7 @@ const TestCity& testCity() {
         p.origin_x = -3000.0;
         p.origin_y = 1500.0;
         p.parked_car_share = 0.6;
-        auto generated = generateCity(p);
-        VISTA_CHECK(generated.isOk());
-        test::TempDir dir("vista_rig_boxes");
-        VISTA_CHECK(writeCityFile(*generated, dir.file("city.osgb")).isOk());
-        auto model = loadCityFile(dir.file("city.osgb"));
-        VISTA_CHECK(model.isOk());
-        auto* c = new TestCity{std::move(*model), nullptr, {}};
-        auto rays = RayScene::build(c->model);
-        VISTA_CHECK(rays.isOk());
-        c->rays = std::move(*rays);
-        c->boxes = buildCityBoxes(c->model);
-        return c;
+        return test::makeBoxesCity(p, "vista_rig_boxes");
     }();
     return *city;
 }
