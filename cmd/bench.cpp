@@ -244,12 +244,18 @@ Status dumpRays(const RenderMode& m, const std::string& label, int f, const Came
     return writeRaySet(batch.stage((fs::path(cfg.dumpRaysDir) / (label + name)).string()), set);
 }
 
+// Images a frame renders into, kept across frames so that no mode allocates its image in a timed frame.
+struct FrameBuffers {
+    Image img, ref;
+};
+
 // Renders one frame in modes [begin, end) of the run (the first is `full`,
 // the reference of the others) and scores each; records go to recs[mi].
 Status renderGroup(BenchRun& run, size_t begin, size_t end, size_t f, size_t pathIndex, double t, const Camera& cam,
-                   const BenchConfig& cfg, std::vector<BenchFrameRecord>& recs, FrameImages& images,
-                   OutputBatch& batch) {
-    Image img, ref;
+                   const BenchConfig& cfg, std::vector<BenchFrameRecord>& recs, FrameImages& images, OutputBatch& batch,
+                   FrameBuffers& buf) {
+    Image& img = buf.img;
+    Image& ref = buf.ref;
     if (cfg.referenceSsaa >= 2) {
         auto r = supersampledReference(run, begin, cam, cfg.referenceSsaa);
         if (!r) return Status::error("reference, frame " + std::to_string(f) + ": " + r.status().message());
@@ -283,6 +289,7 @@ Status renderFrames(BenchRun& run, const Path& path, const std::vector<size_t>& 
     Stopwatch sw;
     const size_t n = run.modes.size(), plain = run.plainCount;
     std::vector<BenchFrameRecord> recs(n);
+    FrameBuffers buf;
     for (size_t f = 0; f < idx.size(); ++f) {
         const Camera cam = path.camera(idx[f], base);
         int arrived = 0;
@@ -293,10 +300,11 @@ Status renderFrames(BenchRun& run, const Path& path, const std::vector<size_t>& 
         if (rays) VISTA_RETURN_IF_ERROR(rays->placeFrameNear(cam.eye));
         const double t = path.samples[idx[f]].t;
         const bool twinsFirst = plain < n && f % 2 == 1;
-        if (twinsFirst) VISTA_RETURN_IF_ERROR(renderGroup(run, plain, n, f, idx[f], t, cam, cfg, recs, images, batch));
-        VISTA_RETURN_IF_ERROR(renderGroup(run, 0, plain, f, idx[f], t, cam, cfg, recs, images, batch));
+        if (twinsFirst)
+            VISTA_RETURN_IF_ERROR(renderGroup(run, plain, n, f, idx[f], t, cam, cfg, recs, images, batch, buf));
+        VISTA_RETURN_IF_ERROR(renderGroup(run, 0, plain, f, idx[f], t, cam, cfg, recs, images, batch, buf));
         if (!twinsFirst && plain < n)
-            VISTA_RETURN_IF_ERROR(renderGroup(run, plain, n, f, idx[f], t, cam, cfg, recs, images, batch));
+            VISTA_RETURN_IF_ERROR(renderGroup(run, plain, n, f, idx[f], t, cam, cfg, recs, images, batch, buf));
         for (auto& rec : recs) {
             rec.regionsArrived = arrived;
             result.frames.push_back(std::move(rec));
