@@ -308,3 +308,18 @@ TEST(ZeroedArray, LargeArraysAreZeroAlignedAndReusable) {
     a.reset(100);  // small again: an ordinary allocation
     EXPECT_EQ(a[99], 0u);
 }
+
+// zero(): every element back to zero in the same memory (a restart keeps its pages).
+TEST(ZeroedArray, ZeroKeepsTheMemory) {
+    const size_t n = (vista::kHugeBytes / sizeof(uint32_t)) + 77;
+    vista::ZeroedArray<uint32_t> a(n);
+    const uint32_t* before = a.begin();
+    for (size_t i = 0; i < n; i += 1000) a[i] = uint32_t(i + 1);
+    a[n - 1] = 9;
+    a.zero();
+    EXPECT_EQ(a.begin(), before);
+    EXPECT_EQ(a.size(), n);
+    uint64_t sum = 0;
+    for (uint32_t v : a) sum += v;
+    EXPECT_EQ(sum, 0u);
+}
