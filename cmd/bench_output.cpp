@@ -2,6 +2,7 @@
 // the keys are documented in docs/user-guide.md). All writes are atomic.
 #include "cmd/bench.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -14,6 +15,7 @@
 #include "cmd/options.h"
 #include "cmd/plot.h"
 #include "foundation/atomic_file.h"
+#include "foundation/statistics.h"
 #include "runtime/engine/metrics.h"
 #include "runtime/scene/scene_model.h"
 
@@ -71,25 +73,29 @@ std::string framesCsv(const BenchResult& result) {
 json streamJson(const BenchResult& r, const BenchConfig& cfg) {
     const RegionPagerStats& s = r.stream;
     const RegionPagerOptions& o = cfg.stream;
-    return {{"radius_m", o.radius},
-            {"far_m", o.far},
-            {"prefetch_s", o.prefetchS},
-            {"wait", o.wait},
-            {"frames_deterministic", o.wait},
-            {"budget_file_bytes", o.budgetBytes},
-            {"peak_resident_file_bytes", s.peakResidentBytes},
-            {"resident_file_bytes_end", s.residentBytes},
-            {"resident_full_end", s.residentFull},
-            {"resident_coarse_end", s.residentCoarse},
-            {"loads", s.loads},
-            {"unloads", s.unloads},
-            {"discarded", s.discarded},
-            {"bytes_read", s.bytesRead},
-            {"frames_waited", s.framesWaited},
-            {"wait_ms", s.waitMs},
-            {"frames_with_arrivals", r.framesWithArrivals},
-            {"budget_limited_updates", s.budgetLimited},
-            {"damaged", r.streamDamaged}};
+    return {
+        {"radius_m", o.radius},
+        {"far_m", o.far},
+        {"prefetch_s", o.prefetchS},
+        {"wait", o.wait},
+        {"frames_deterministic", o.wait},
+        {"budget_file_bytes", o.budgetBytes},
+        {"peak_resident_file_bytes", s.peakResidentBytes},
+        {"resident_file_bytes_end", s.residentBytes},
+        {"resident_full_end", s.residentFull},
+        {"resident_coarse_end", s.residentCoarse},
+        {"loads", s.loads},
+        {"unloads", s.unloads},
+        {"discarded", s.discarded},
+        {"bytes_read", s.bytesRead},
+        {"frames_waited", s.framesWaited},
+        {"wait_ms", s.waitMs},
+        {"frames_with_arrivals", r.framesWithArrivals},
+        {"advance_ms_median", num(percentile(r.advanceMs, 0.5))},
+        {"advance_ms_p99", num(percentile(r.advanceMs, 0.99))},
+        {"advance_ms_max", num(r.advanceMs.empty() ? 0.0 : *std::max_element(r.advanceMs.begin(), r.advanceMs.end()))},
+        {"budget_limited_updates", s.budgetLimited},
+        {"damaged", r.streamDamaged}};
 }
 
 json pixelClasses(const ModeSummary& s) {
@@ -108,6 +114,8 @@ json modeJson(const ModeSummary& s) {
     json m = {{"frame_ms_median", num(s.frameMsMedian)},
               {"frame_ms_p95", num(s.frameMsP95)},
               {"frame_ms_mean", num(s.frameMsMean)},
+              {"frame_ms_p99", num(s.frameMsP99)},
+              {"frame_ms_max", num(s.frameMsMax)},
               {"psnr_db_median", num(s.psnrDbMedian)},
               {"psnr_db_min", num(s.psnrDbMin)},
               {"diff_fraction_median", num(s.diffFractionMedian)},
@@ -118,6 +126,16 @@ json modeJson(const ModeSummary& s) {
               {"rays_per_frame_median", num(s.raysMedian)}};
     for (const auto& [base, v] : s.speedupMedianOfRatios) m["speedup_vs_" + base + "_median_of_ratios"] = num(v);
     if (s.hasPixels) m["pixels"] = pixelClasses(s);
+    if (s.streamed) {
+        auto times = [](const ModeSummary::FrameTimes& t) {
+            return json{{"frames", t.frames},
+                        {"frame_ms_median", num(t.medianMs)},
+                        {"frame_ms_p99", num(t.p99Ms)},
+                        {"frame_ms_max", num(t.maxMs)}};
+        };
+        m["frames_with_arrivals"] = times(s.withArrivals);
+        m["frames_without_arrivals"] = times(s.withoutArrivals);
+    }
     json stages = json::object(), runs = json::object(), setup = json::object();
     for (const auto& kv : s.stagesMsMean) stages[kv.first] = num(kv.second);
     for (const auto& kv : s.stageRuns) runs[kv.first] = kv.second;
