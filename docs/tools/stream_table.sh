@@ -189,7 +189,7 @@ for r in rows:
     per_km = read_mb / r["km"] if r["km"] > 0 else float("nan")
     b = medians.get((base, r["m"]))
     ratio = "—" if not b or b != b or r["med"] != r["med"] else f"{r['med'] / b:.2f}x"
-    print(f"| {km_side:g} | {km_side ** 2:g} | {r['m']} | {r['km']:.1f} | {r['modes']} | {fmt(r['rss'], 0)} "
+    print(f"| {km_side:g} | {km_side ** 2:g} | {r['m']} | {r['km']:.2f} | {r['modes']} | {fmt(r['rss'], 0)} "
           f"| {fmt(r['own'], 0)} | {fmt(st.get('peak_resident_file_bytes', float('nan')) / 1e6, 0)} "
           f"| {fmt(r['med'])} | {fmt(r['p99'])} | {fmt(r['p99a'])} ({r['n_a']}) | {fmt(r['p99r'])} | {ratio} "
           f"| {st.get('loads', '—')} | {st.get('unloads', '—')} | {fmt(read_mb, 0)} | {fmt(per_km, 1)} "
