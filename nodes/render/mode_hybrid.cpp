@@ -125,7 +125,11 @@ public:
     }
     void reset() override { _far->reset(); }
     // The ray scene changed (a streamed city): nothing traced in the old one is served again.
-    void sceneChanged() override { _far->reset(); }
+    // The near field's root state comes with the first region.
+    void sceneChanged() override {
+        _far->reset();
+        if (!_root->getStateSet() && _near.rootState) _root->setStateSet(_near.rootState.get());
+    }
     bool hazesRasterPixels() const override { return true; }  // FarFieldOptions::hazeCovered
     bool drawsSky() const override { return true; }  // the far field classifies and fills every uncovered pixel
     const std::vector<uint32_t>* lastTracedPixels() const override { return &_far->lastTraced(); }

@@ -55,6 +55,12 @@ std::string streamingModeNames() { return "full, near, raycast, hybrid, hybrid-f
 
 bool modeStreamsNearField(const std::string& name) { return name == "hybrid" || name == "hybrid-fixed"; }
 
+bool modeFollowsTimings(const std::string& name, const ModeOptions& o) {
+    if (name != "hybrid" && name != "hybrid-fixed") return false;
+    const bool autoSplit = name == "hybrid" && o.triangleBudget == 0 && o.nearDistance < 0;
+    return autoSplit || (o.cache && o.cacheAdaptive) || o.frameMsTarget > 0;
+}
+
 bool effectsNeedRays(const FrameEffects& fx) { return fx.glass && fx.glassMarked && fx.rayBudget > 0; }
 
 Result<std::unique_ptr<RenderMode>> createRenderMode(const std::string& name, ModeContext& ctx) {

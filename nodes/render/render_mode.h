@@ -254,5 +254,10 @@ bool modeStreams(const std::string& name);
 std::string streamingModeNames();  // "full, near, raycast, hybrid, hybrid-fixed" (for messages)
 // True for the modes that need the stream's near field (hybrid, hybrid-fixed).
 bool modeStreamsNearField(const std::string& name);
+// True when a mode's pictures follow measured times under these options, so
+// that two runs of the same frames may differ: hybrid with the adaptive split
+// (--near auto), the adaptive cache (on and not --cache-always) or a frame-time
+// target; hybrid-fixed with the latter two. Every other mode: false.
+bool modeFollowsTimings(const std::string& name, const ModeOptions& options);
 
 }  // namespace vista
