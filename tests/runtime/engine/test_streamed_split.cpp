@@ -138,7 +138,7 @@ TEST(SplitIndexBlocks, ASelectionVisitsTheSameWorkWhateverIsResident) {
         EXPECT_EQ(a.objects, b.objects) << d;
         EXPECT_LE(a.blocks, 9u);
         EXPECT_LE(b.blocks, 9u) << d;
-        if (d <= 300) EXPECT_LT(a.objects, 9u * 101u) << "only the cells within reach";
+        if (d <= 300) { EXPECT_LT(a.objects, 9u * 101u) << "only the cells within reach"; }
         EXPECT_EQ(few.index.within(eye, d), many.index.within(eye, d));
     }
     // Everything (+inf) does visit every block.
