@@ -281,7 +281,8 @@ private:
 
 Result<std::unique_ptr<RenderMode>> makeHybridMode(ModeContext& ctx) {
     if (!ctx.rays) return Status::error("mode hybrid needs the city's ray scene, which is not available");
-    if (!ctx.city) return Status::error("mode hybrid needs the loaded city (height grid), which is not available");
+    if (!ctx.city && !ctx.stream)
+        return Status::error("mode hybrid needs the loaded city (height grid), which is not available");
     if (!ctx.scene) return Status::error("mode hybrid needs a scene graph, none was loaded");
     if (ctx.options.horizonGrid < 0 || ctx.options.horizonGrid > 8192)
         return Status::error("option horizon grid = " + std::to_string(ctx.options.horizonGrid) +
