@@ -1,5 +1,5 @@
 // CityStream: a paged city streamed for the render modes (bench
-// --paged-stream). One RegionPager (runtime/scene/region_pager.h) feeds two
+// --paged-stream). One RegionPager (runtime/scene/region_pager.h) feeds the
 // mirrors of the resident set, updated between frames by advance():
 //  - the chunked city graph (graph()): one group per resident region level
 //    holding that level's near-field chunks (buildNearFieldScene, built on
