@@ -179,10 +179,17 @@ SplitIndex::SplitIndex(const std::vector<SplitObject>& objects, double blockCell
     VISTA_CHECK(blockCell > 0 && std::isfinite(blockCell));
 }
 
+namespace {
+
+// One key per (cx, cy) block cell (wraps only beyond 2^31 cells a side).
+int64_t cellKey(int64_t cx, int64_t cy) { return int64_t((uint64_t(cy) << 32) ^ uint64_t(uint32_t(cx))); }
+
+}  // namespace
+
 int64_t SplitIndex::blockCellOf(const Block& b) const {
     if (!std::isfinite(b.lo.x) || !std::isfinite(b.lo.y)) return std::numeric_limits<int64_t>::min();
     const int64_t cx = int64_t(std::floor(b.lo.x / _blockCell)), cy = int64_t(std::floor(b.lo.y / _blockCell));
-    return (cy << 32) ^ (cx & 0xffffffffLL);
+    return cellKey(cx, cy);
 }
 
 void SplitIndex::addBlock(uint64_t key, uint32_t first, std::shared_ptr<const Block> block) {
@@ -265,7 +272,7 @@ void SplitIndex::visit(const glm::dvec3& p, double d, F&& f, VisitCost* cost) co
     };
     visitCell(std::numeric_limits<int64_t>::min());
     for (int64_t cy = cy0; cy <= cy1; ++cy)
-        for (int64_t cx = cx0; cx <= cx1; ++cx) visitCell((cy << 32) ^ (cx & 0xffffffffLL));
+        for (int64_t cx = cx0; cx <= cx1; ++cx) visitCell(cellKey(cx, cy));
 }
 
 std::vector<uint32_t> SplitIndex::within(const glm::dvec3& p, double d) const {
