@@ -65,9 +65,14 @@ Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene
         auto s = CityStream::create(*cfg.streamManifest, cfg.stream, needRays);
         if (!s) return Status::error("setting up the streamed city failed: " + s.status().message());
         run->stream = std::move(s.value());
+        // hybrid: the stream keeps the near field, its split index and the horizon grid too.
+        if (needRays && std::any_of(cfg.modes.begin(), cfg.modes.end(), modeStreamsNearField))
+            run->stream->enableNearField(cfg.options.horizonGrid);
         run->ctx.streamedCity = run->stream->graph();
         run->ctx.scene = run->stream->graph();
+        run->ctx.stream = run->stream.get();
     }
+    run->ctx.paged = cfg.pagedManifest;
     if (needRays) {
         if (!city) return Status::error("modes that cast rays need a loaded city file (no city given)");
         Stopwatch sw;
@@ -126,6 +131,9 @@ Status advanceStream(BenchRun& run, const Path& path, size_t i, const Camera& ca
         result.streamDamaged.push_back(d);
     }
     *arrived = f->arrived;
+    // What the modes kept of the old scene (hybrid's panoramic cache) goes.
+    if (f->arrived > 0 || f->dropped > 0)
+        for (auto& m : run.modes) m->sceneChanged();
     return Status::ok();
 }
 

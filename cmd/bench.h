@@ -74,9 +74,14 @@ struct BenchConfig {
     // the modes are then a CityStream (nodes/render/city_stream.h) advanced
     // to every frame's camera (and its velocity along the path) before the
     // frame, and `city` / `scene` are not drawn (only the modes of
-    // modeStreams()). Null: the modes draw `scene` and cast into `city`.
+    // modeStreams(); hybrid's near field, split index and horizon grid are
+    // the stream's too, and the modes drop what they cached of the old scene
+    // whenever regions arrive or leave: RenderMode::sceneChanged). Null: the
+    // modes draw `scene` and cast into `city`.
     const PagedManifest* streamManifest = nullptr;
     RegionPagerOptions stream;
+    // A paged city, loaded or streamed: its manifest (ModeContext::paged; outlives the run).
+    const PagedManifest* pagedManifest = nullptr;
 };
 // Checks sizes, frame count, fov, reference, modes and the mode options
 // (options.h ranges); messages name the command-line flag.

@@ -73,12 +73,16 @@ std::string framesCsv(const BenchResult& result) {
 json streamJson(const BenchResult& r, const BenchConfig& cfg) {
     const RegionPagerStats& s = r.stream;
     const RegionPagerOptions& o = cfg.stream;
+    // Waiting makes the regions of a frame independent of load timing; a mode whose frames
+    // follow measured times (hybrid's adaptive split or cache pauses) still is not.
+    const bool timed = std::any_of(cfg.modes.begin(), cfg.modes.end(),
+                                   [&](const std::string& m) { return modeFollowsTimings(m, cfg.options); });
     return {
         {"radius_m", o.radius},
         {"far_m", o.far},
         {"prefetch_s", o.prefetchS},
         {"wait", o.wait},
-        {"frames_deterministic", o.wait},
+        {"frames_deterministic", o.wait && !timed},
         {"budget_file_bytes", o.budgetBytes},
         {"peak_resident_file_bytes", s.peakResidentBytes},
         {"resident_file_bytes_end", s.residentBytes},

@@ -207,6 +207,7 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
     const SceneModel& city = walk->city;
     cfg.loadMs = walk->cityLoadMs;
     cfg.pagedJson = walk->pagedJson;
+    cfg.pagedManifest = walk->manifest.get();
     if (a.stream.stream) {
         if (!walk->manifest)
             return reportBadInput(kCmd, Status::error("--paged-stream: '" + cityFile +

@@ -224,7 +224,8 @@ Status validatePagedReach(const PagedReach& reach);
 // Streaming a paged city (bench): --paged-stream = the chunked city and the
 // ray scene follow the camera of each frame (nodes/render/city_stream.h, the
 // region pager of runtime/scene/region_pager.h) instead of holding the
-// regions loaded around the whole path (modes full, near, raycast); --paged-wait = each frame waits until the
+// regions loaded around the whole path (modes full, near, raycast, hybrid,
+// hybrid-fixed); --paged-wait = each frame waits until the
 // regions within reach of its camera are resident (deterministic frames;
 // implies --paged-stream); --paged-prefetch S = seconds of lookahead along
 // the camera's velocity, 0 .. kMaxPagedPrefetchS (default

@@ -13,6 +13,7 @@ struct RegionChunks {
     osg::ref_ptr<osg::Group> group;
     osg::ref_ptr<osg::StateSet> rootState;
     std::shared_ptr<RayScene::PreparedRegion> rays;  // its Embree scene (null without rays)
+    std::shared_ptr<NearFieldRegion> nearField;      // its chunks, block and height patch (null without)
 };
 
 }  // namespace
@@ -30,11 +31,23 @@ Result<std::unique_ptr<CityStream>> CityStream::create(const PagedManifest& mani
     s->_root = new osg::Group;
     s->_root->setName("vista.streamed_city");
     const StreamedRayScene* rayScene = s->_rays.get();
-    options.prepare = [rayScene](SceneModel& model, int, bool) -> std::shared_ptr<void> {
+    const std::unique_ptr<StreamedNearField>* nearField = &s->_near;  // set before the first load, if at all
+    s->_manifest = &manifest;
+    options.prepare = [rayScene, nearField](SceneModel& model, int, bool) -> std::shared_ptr<void> {
         auto out = std::make_shared<RegionChunks>();
+        // The ray scene first: it completes the model's tree prototypes, which the height patch bounds too.
         if (rayScene) out->rays = rayScene->prepare(model);
         out->group = new osg::Group;
-        NearFieldScene nf = buildNearFieldScene(sceneRoot(model), kNearChunkSize, false);
+        osg::ref_ptr<osg::Node> root = sceneRoot(model);
+        if (*nearField) {
+            // The chunks serve both the graph and the near field.
+            out->nearField = (*nearField)->prepare(root.get(), model);
+            const NearFieldScene& nf = out->nearField->scene;
+            out->rootState = nf.rootState;
+            for (uint32_t i : nf.drawOrder) out->group->addChild(nf.chunks[i].get());
+            return out;
+        }
+        NearFieldScene nf = buildNearFieldScene(root.get(), kNearChunkSize, false);
         out->rootState = nf.rootState;
         for (uint32_t i : nf.drawOrder) out->group->addChild(nf.chunks[i].get());
         return out;
@@ -43,7 +56,15 @@ Result<std::unique_ptr<CityStream>> CityStream::create(const PagedManifest& mani
     return s;
 }
 
+void CityStream::enableNearField(int horizonCells) {
+    VISTA_CHECK(!_advanced && _rays && !_near);
+    _near =
+        std::make_unique<StreamedNearField>(_manifest->regionSizeM > 0 ? _manifest->regionSizeM : 2000.0,
+                                            pagedHeightLattice(*_manifest, _rays->rays().frameOrigin(), horizonCells));
+}
+
 Result<CityStreamFrame> CityStream::advance(const glm::dvec3& eye, const glm::dvec3& velocity) {
+    _advanced = true;
     _pager->update(eye, velocity);
     RegionPagerDelta d = _pager->collect();
     CityStreamFrame f;
@@ -62,6 +83,7 @@ Result<CityStreamFrame> CityStream::advance(const glm::dvec3& eye, const glm::dv
         if (it == _groups.end()) continue;
         _root->removeChild(it->second.get());
         _groups.erase(it);
+        if (_near) _near->remove(levelKey(x.region, x.coarse));
         ++f.dropped;
     }
     for (RegionArrival& a : d.arrived) {
@@ -73,8 +95,10 @@ Result<CityStreamFrame> CityStream::advance(const glm::dvec3& eye, const glm::dv
         auto next = std::next(it);
         const unsigned at = next == _groups.end() ? _root->getNumChildren() : _root->getChildIndex(next->second.get());
         _root->insertChild(at, chunks->group.get());
+        if (_near && chunks->nearField) _near->add(levelKey(a.region, a.coarse), *chunks->nearField);
         ++f.arrived;
     }
+    if (f.arrived > 0 || f.dropped > 0) ++_generation;
     return f;
 }
 

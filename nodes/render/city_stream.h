@@ -1,5 +1,5 @@
 // CityStream: a paged city streamed for the render modes (bench
-// --paged-stream). One RegionPager (runtime/scene/region_pager.h) feeds two
+// --paged-stream). One RegionPager (runtime/scene/region_pager.h) feeds the
 // mirrors of the resident set, updated between frames by advance():
 //  - the chunked city graph (graph()): one group per resident region level
 //    holding that level's near-field chunks (buildNearFieldScene, built on
@@ -10,10 +10,19 @@
 //    of the same regions, in the same order;
 //  - the ray scene (rays(), when made with rays): a StreamedRayScene follower,
 //    each region's Embree scene built on the worker thread too (the frame
-//    thread instances it and commits the top level).
-// Modes that draw the chunked city (full, near) or cast rays (raycast) use
-// them through ModeContext (streamedCity, rays); the others need the whole
-// loaded city and do not stream (modeStreams()).
+//    thread instances it and commits the top level). Coarse levels are
+//    traced with their coarse geometry and their tree impostors as the
+//    city's tree meshes;
+//  - the near field (nearField(), after enableNearField()): the resident
+//    levels' chunks, their split index and the horizon's height grid
+//    (StreamedNearField), cut on the worker thread and spliced here.
+// Modes that draw the chunked city (full, near), cast rays (raycast) or
+// split the two (hybrid, hybrid-fixed) use them through ModeContext
+// (streamedCity, rays, stream); the others need the whole loaded city and
+// do not stream (modeStreams()). generation() counts the advances that
+// changed the resident set: a mode that caches what it traced (hybrid's
+// panoramic cache) drops it when the generation moves (RenderMode::
+// sceneChanged, called by the program).
 //
 // Contract: the manifest outlives the stream; advance() runs between frames,
 // never while a frame is drawn or rays are cast. Errors: those of the ray
@@ -30,6 +39,7 @@
 #include <osg/ref_ptr>
 
 #include "foundation/status.h"
+#include "nodes/render/streamed_near_field.h"
 #include "runtime/engine/ray_streaming.h"
 #include "runtime/scene/region_pager.h"
 
@@ -48,15 +58,25 @@ public:
     ~CityStream();  // stops the pager first: its workers use the ray scene
     static Result<std::unique_ptr<CityStream>> create(const PagedManifest& manifest, RegionPagerOptions options,
                                                       bool rays, std::vector<SceneMesh> prototypes = {});
+    // The near field too (hybrid): chunks, split index and a horizon grid of horizonCells a
+    // side (0 = auto) on the paged city's lattice (pagedHeightLattice). Contract: before the
+    // first advance() and with rays.
+    void enableNearField(int horizonCells);
     Result<CityStreamFrame> advance(const glm::dvec3& eye, const glm::dvec3& velocity);
     osg::Group* graph() const { return _root.get(); }
     RayScene* rays() { return _rays ? &_rays->rays() : nullptr; }
+    StreamedNearField* nearField() { return _near.get(); }
+    uint64_t generation() const { return _generation; }
     RegionPagerStats stats() const { return _pager->stats(); }
 
 private:
     CityStream() = default;
     std::unique_ptr<RegionPager> _pager;
     std::unique_ptr<StreamedRayScene> _rays;
+    std::unique_ptr<StreamedNearField> _near;  // read by the workers' prepare once set
+    const PagedManifest* _manifest = nullptr;
+    uint64_t _generation = 0;
+    bool _advanced = false;
     osg::ref_ptr<osg::Group> _root;
     // (coarse, region) -> its chunk group under _root: ordered as loadPagedCity merges.
     std::map<std::pair<bool, int>, osg::ref_ptr<osg::Group>> _groups;

@@ -34,6 +34,7 @@ public:
         return Status::ok();
     }
     void reset() override { _inner->reset(); }
+    void sceneChanged() override { _inner->sceneChanged(); }
     const std::vector<uint32_t>* lastTracedPixels() const override { return _inner->lastTracedPixels(); }
     double lastRayStart() const override { return _inner->lastRayStart(); }
     const RasterSelection* lastRaster() const override { return _inner->lastRaster(); }

@@ -4,6 +4,7 @@
 
 #include "foundation/timing.h"
 #include "nodes/baked_file.h"
+#include "nodes/render/city_stream.h"
 #include "nodes/render/offscreen.h"
 #include "nodes/view_cell_switch.h"
 
@@ -24,6 +25,10 @@ osg::Node* ModeContext::plainScene() {
 }
 
 const NearFieldScene& ModeContext::nearField() {
+    if (stream) {
+        VISTA_CHECK(stream->nearField() != nullptr);
+        return stream->nearField()->scene();
+    }
     if (!_nearField) {
         Stopwatch sw;
         _nearField = std::make_shared<NearFieldScene>(buildNearFieldScene(plainScene(), kNearChunkSize, labels));

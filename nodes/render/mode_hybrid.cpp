@@ -8,6 +8,7 @@
 #include "foundation/timing.h"
 #include "nodes/far_field_node.h"
 #include "nodes/near_far_split.h"
+#include "nodes/render/city_stream.h"
 #include "nodes/render/effects_state.h"
 #include "nodes/render/offscreen.h"
 #include "runtime/engine/adaptive_split.h"
@@ -26,18 +27,34 @@ std::string nearAutoNote(double nearD) {
     return "near auto: " + std::to_string(int(std::lround(nearD))) + " m";
 }
 
+// The horizon's height grid: a streamed city's (it follows the resident
+// regions); else built from the loaded city into `own`, on the paged city's
+// lattice when it is one (the same cells as a streamed run of the same regions).
+const HeightGrid* hybridHeightGrid(ModeContext& ctx, HeightGrid& own) {
+    if (ctx.stream) return ctx.stream->nearField()->grid();
+    if (ctx.paged) {
+        own = pagedHeightLattice(*ctx.paged, ctx.rays->frameOrigin(), ctx.options.horizonGrid);
+        own.addPatch(0, std::make_shared<const HeightPatch>(own.patch(*ctx.city)));
+    } else {
+        own = HeightGrid::build(*ctx.city, ctx.rays->frameOrigin(), ctx.options.horizonGrid);
+    }
+    return &own;
+}
+
 class HybridMode : public RenderMode {
 public:
     HybridMode(ModeContext& ctx, bool fixedSplit) : _ctx(ctx), _near(ctx.nearField()), _fixedSplit(fixedSplit) {
         _setup.push_back({"chunking", ctx.chunkingMs()});
         Stopwatch sw;
-        _grid = HeightGrid::build(*ctx.city, ctx.rays->frameOrigin(), ctx.options.horizonGrid);
+        _heights = hybridHeightGrid(ctx, _grid);
         _setup.push_back({"height_grid", sw.ms()});
-        _far = std::make_unique<FarField>(*ctx.rays, &_grid, farOptions(ctx.options.fixedNearDistance(), 0.0));
+        _far = std::make_unique<FarField>(*ctx.rays, _heights, farOptions(ctx.options.fixedNearDistance(), 0.0));
         AdaptiveSplitOptions so;
         so.endTryEvery = 24;  // each kind of choice re-measured about every 24 frames of a walkthrough
         so.fixedDistance = ctx.options.fixedNearDistance();  // `hybrid-fixed`'s choice, a kind of its own
-        _adaptive = std::make_unique<AdaptiveSplit>(_near.objects, ctx.rays, so);
+        // A streamed city: the stream's index of the resident chunks (it follows the regions).
+        _adaptive = ctx.stream ? std::make_unique<AdaptiveSplit>(ctx.stream->nearField()->index(), ctx.rays, so)
+                               : std::make_unique<AdaptiveSplit>(_near.objects, ctx.rays, so);
         _root = new osg::Group;
         if (_near.rootState) _root->setStateSet(_near.rootState.get());
     }
@@ -50,7 +67,7 @@ public:
         const double nearD = chooseNear(camera);
         if (!byBudget() && (nearD <= 0 || std::isinf(nearD))) return endPointFrame(camera, nearD, sw, out, stats);
         std::vector<uint32_t> sel =
-            byBudget() ? selectNearFieldByBudget(_near.objects, camera.eye, _ctx.options.triangleBudget)
+            byBudget() ? selectNearFieldByBudget(_adaptive->index(), camera.eye, _ctx.options.triangleBudget)
                        : selectNearField(_adaptive->index(), camera.eye, nearD);
         _root->removeChildren(0, _root->getNumChildren());
         uint64_t tris = 0;
@@ -107,6 +124,12 @@ public:
         return Status::ok();
     }
     void reset() override { _far->reset(); }
+    // The ray scene changed (a streamed city): nothing traced in the old one is served again.
+    // The near field's root state comes with the first region.
+    void sceneChanged() override {
+        _far->reset();
+        if (!_root->getStateSet() && _near.rootState) _root->setStateSet(_near.rootState.get());
+    }
     bool hazesRasterPixels() const override { return true; }  // FarFieldOptions::hazeCovered
     bool drawsSky() const override { return true; }  // the far field classifies and fills every uncovered pixel
     const std::vector<uint32_t>* lastTracedPixels() const override { return &_far->lastTraced(); }
@@ -119,7 +142,7 @@ public:
             ho.nearDistance = _ctx.options.fixedNearDistance();
             ho.triangleBudget = _ctx.options.triangleBudget;
             ho.far = farOptions(ho.nearDistance, 0.0);
-            _viewer = buildHybridScene(_near, *_ctx.rays, _grid, ho, &_split, &_farNode);
+            _viewer = buildHybridScene(_near, *_ctx.rays, *_heights, ho, &_split, &_farNode);
         }
         return _viewer.get();
     }
@@ -237,8 +260,9 @@ private:
 
     ModeContext& _ctx;
     const NearFieldScene& _near;
-    const bool _fixedSplit;  // `hybrid-fixed`: always the fixed near distance, never the adaptive split
-    HeightGrid _grid;
+    const bool _fixedSplit;                // `hybrid-fixed`: always the fixed near distance, never the adaptive split
+    HeightGrid _grid;                      // built here (a loaded city)
+    const HeightGrid* _heights = nullptr;  // the horizon's grid: _grid, or a streamed city's
     std::unique_ptr<FarField> _far;
     std::unique_ptr<AdaptiveSplit> _adaptive;
     osg::ref_ptr<osg::Group> _root;
@@ -257,7 +281,8 @@ private:
 
 Result<std::unique_ptr<RenderMode>> makeHybridMode(ModeContext& ctx) {
     if (!ctx.rays) return Status::error("mode hybrid needs the city's ray scene, which is not available");
-    if (!ctx.city) return Status::error("mode hybrid needs the loaded city (height grid), which is not available");
+    if (!ctx.city && !ctx.stream)
+        return Status::error("mode hybrid needs the loaded city (height grid), which is not available");
     if (!ctx.scene) return Status::error("mode hybrid needs a scene graph, none was loaded");
     if (ctx.options.horizonGrid < 0 || ctx.options.horizonGrid > 8192)
         return Status::error("option horizon grid = " + std::to_string(ctx.options.horizonGrid) +

@@ -11,7 +11,14 @@
 // Options: nearDistance, triangleBudget, pixelBudget, horizonGrid, cache,
 // threads. Stats: pixel classes (Table 4.1), stages cull, near, opacity,
 // seam, horizon, cache, rays, composite; notes: skipped stages, auto choice.
-// Set-up: "chunking" (shared), "height_grid"; needs ctx.rays ("bvh").
+// Set-up: "chunking" (shared), "height_grid"; needs ctx.rays ("bvh"). The
+// height grid of a paged city lies on the paged city's lattice
+// (pagedHeightLattice).
+// A streamed paged city (ctx.stream, bench --paged-stream): the near field,
+// the split's index and the height grid are the stream's
+// (StreamedNearField: they follow the resident regions, spliced between
+// frames); sceneChanged() drops the far field's cache, last frame and
+// speculative rays whenever regions arrived or left.
 // Viewer: the same chunks under a NearFarSplit + a FarFieldNode
 // (buildHybridScene); beginViewerFrame() applies the same split and far
 // plane (auto: records the previous viewer frame's costs — near ms taken as
@@ -24,7 +31,8 @@
 // `hybrid-fixed`: the same mode at the fixed near distance (--near, 100 m
 // under --near auto), never the adaptive split: the split's middle fixed
 // choice, for side-by-side runs against `hybrid --near auto`.
-// Errors: missing ray scene / city, horizon grid out of 1 .. 8192.
+// Errors: missing ray scene / city (neither loaded nor streamed), horizon grid
+// out of 1 .. 8192.
 #pragma once
 #include <memory>
 

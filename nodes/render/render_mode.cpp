@@ -2,6 +2,7 @@
 // createRenderMode(), which wraps each in the run-time effects.
 #include "nodes/render/render_mode.h"
 
+#include "nodes/render/city_stream.h"
 #include "nodes/render/effects_mode.h"
 #include "nodes/render/mode_full.h"
 #include "nodes/render/mode_hybrid.h"
@@ -46,9 +47,19 @@ std::string renderModeNames() {
     return s;
 }
 
-bool modeStreams(const std::string& name) { return name == "full" || name == "near" || name == "raycast"; }
+bool modeStreams(const std::string& name) {
+    return name == "full" || name == "near" || name == "raycast" || modeStreamsNearField(name);
+}
 
-std::string streamingModeNames() { return "full, near, raycast"; }
+std::string streamingModeNames() { return "full, near, raycast, hybrid, hybrid-fixed"; }
+
+bool modeStreamsNearField(const std::string& name) { return name == "hybrid" || name == "hybrid-fixed"; }
+
+bool modeFollowsTimings(const std::string& name, const ModeOptions& o) {
+    if (name != "hybrid" && name != "hybrid-fixed") return false;
+    const bool autoSplit = name == "hybrid" && o.triangleBudget == 0 && o.nearDistance < 0;
+    return autoSplit || (o.cache && o.cacheAdaptive) || o.frameMsTarget > 0;
+}
 
 bool effectsNeedRays(const FrameEffects& fx) { return fx.glass && fx.glassMarked && fx.rayBudget > 0; }
 
@@ -58,6 +69,8 @@ Result<std::unique_ptr<RenderMode>> createRenderMode(const std::string& name, Mo
     if (ctx.streamedCity && !modeStreams(name))
         return Status::error("mode " + name + " does not stream a paged city (modes that do: " + streamingModeNames() +
                              ")");
+    if (ctx.streamedCity && modeStreamsNearField(name) && !(ctx.stream && ctx.stream->nearField()))
+        return Status::error("mode " + name + " needs the streamed city's near field, which is not kept");
     if (!ctx.scene) return Status::error("mode " + name + " needs a scene graph, none was loaded");
     if (m->needsRays && !ctx.rays)
         return Status::error("mode " + name + " needs the city's ray scene, which is not available");

@@ -44,8 +44,10 @@
 namespace vista {
 
 struct SceneModel;
+struct PagedManifest;
 class RayScene;
 class OffscreenRenderer;
+class CityStream;
 
 // The near distance of modes that need one when --near is auto (only hybrid
 // chooses per frame).
@@ -95,16 +97,25 @@ struct ModeContext {
     bool labels = false;                    // nearField() also builds the label twins (vista render)
     const RayScene* rays = nullptr;         // built by the program for modes that need rays
     // A streamed paged city (city_stream.h): the chunked city graph, updated
-    // between frames; chunkedCity() returns it and nearField() is not
-    // available (only the modes of modeStreams() are created). Null: the city
-    // is loaded.
+    // between frames; chunkedCity() returns it (only the modes of
+    // modeStreams() are created). Null: the city is loaded.
     osg::Group* streamedCity = nullptr;
+    // The stream itself (with streamedCity): nearField() is its near field
+    // when it keeps one (CityStream::enableNearField, for hybrid), which
+    // also holds the horizon's height grid.
+    CityStream* stream = nullptr;
+    // A paged city, loaded or streamed: its manifest. hybrid lays its horizon
+    // grid on the paged city's lattice (pagedHeightLattice), so a streamed
+    // run and a preloaded one of the same regions trace the same grid.
+    const PagedManifest* paged = nullptr;
     ModeOptions options;
 
     // The plain city: a baked root's tiles without its impostors, else `scene`.
     osg::Node* plainScene();
     // The plain city re-chunked (kNearChunkSize), built on the first call and
-    // shared by full, near, osglod and hybrid; its cost in chunkingMs().
+    // shared by full, near, osglod and hybrid; its cost in chunkingMs(). A
+    // streamed city: the stream's near field (it changes between frames;
+    // contract: the stream keeps one).
     const NearFieldScene& nearField();
     double chunkingMs() const { return _chunkingMs; }
     // Every chunk of nearField(), in its drawOrder, under one group with the
@@ -148,6 +159,12 @@ public:
     virtual Status renderFrame(const Camera& camera, Image& out, FrameStats& stats) = 0;
     // The walkthrough restarts or jumps: caches are dropped.
     virtual void reset() {}
+    // A streamed city's resident regions changed between frames (regions
+    // arrived or left the ray scene and the near field): what the mode kept
+    // of the old scene (hybrid: the panoramic cache, last frame's pixels and
+    // speculative rays) is dropped, so no pixel of a dropped region, and none
+    // hiding an arrived one, is served again.
+    virtual void sceneChanged() {}
     // Viewer face: the graph to draw (built on the first call, owned by the mode).
     virtual osg::Node* viewerScene() = 0;
     // Before every viewer frame, with the camera about to be drawn: returns
@@ -231,8 +248,16 @@ std::string renderModeNames();
 Result<std::unique_ptr<RenderMode>> createRenderMode(const std::string& name, ModeContext& ctx);
 bool effectsNeedRays(const FrameEffects& fx);
 // The modes that draw a streamed paged city (ModeContext::streamedCity):
-// those drawing only the chunked city or rays (full, near, raycast).
+// those drawing only the chunked city, rays or both split by distance (full,
+// near, raycast, hybrid, hybrid-fixed).
 bool modeStreams(const std::string& name);
-std::string streamingModeNames();  // "full, near, raycast" (for messages)
+std::string streamingModeNames();  // "full, near, raycast, hybrid, hybrid-fixed" (for messages)
+// True for the modes that need the stream's near field (hybrid, hybrid-fixed).
+bool modeStreamsNearField(const std::string& name);
+// True when a mode's pictures follow measured times under these options, so
+// that two runs of the same frames may differ: hybrid with the adaptive split
+// (--near auto), the adaptive cache (on and not --cache-always) or a frame-time
+// target; hybrid-fixed with the latter two. Every other mode: false.
+bool modeFollowsTimings(const std::string& name, const ModeOptions& options);
 
 }  // namespace vista

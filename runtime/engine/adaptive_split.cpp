@@ -7,7 +7,9 @@
 #include <numeric>
 #include <optional>
 #include <thread>
+#include <tuple>
 
+#include "foundation/status.h"
 #include "foundation/timing.h"
 #include "runtime/engine/far_field_rays.h"
 #include "runtime/engine/ray_scene.h"
@@ -114,84 +116,189 @@ std::vector<uint32_t> selectNearField(const std::vector<SplitObject>& objects, c
     return out;
 }
 
-SplitIndex::SplitIndex(const std::vector<SplitObject>& objects, double cell)
-    : _objects(objects), _cell(cell > 0 ? cell : 64.0) {
+std::shared_ptr<const SplitIndex::Block> SplitIndex::makeBlock(const SplitObject* objects, size_t count, double cell) {
+    auto out = std::make_shared<Block>();
+    Block& b = *out;
+    b.cell = cell > 0 ? cell : 64.0;
+    b.count = uint32_t(count);
     double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
-    for (const SplitObject& o : objects) {
-        _total += o.triangles;
+    b.lo = glm::dvec2(x0);
+    b.hi = glm::dvec2(-x0);
+    for (size_t i = 0; i < count; ++i) {
+        const SplitObject& o = objects[i];
+        b.triangles += o.triangles;
         x0 = std::min(x0, o.lo.x);
         y0 = std::min(y0, o.lo.y);
         x1 = std::max(x1, o.lo.x);
         y1 = std::max(y1, o.lo.y);
+        b.lo = glm::min(b.lo, glm::dvec2(o.lo));
+        b.hi = glm::max(b.hi, glm::dvec2(o.hi));
     }
-    if (objects.empty() || !std::isfinite(x0) || !std::isfinite(y0) || !std::isfinite(x1) || !std::isfinite(y1)) {
-        for (uint32_t i = 0; i < objects.size(); ++i) _wide.push_back(i);
-        return;
+    if (count == 0 || !std::isfinite(x0) || !std::isfinite(y0) || !std::isfinite(x1) || !std::isfinite(y1)) {
+        for (uint32_t i = 0; i < count; ++i) b.wide.push_back(i);
+        b.lo = glm::dvec2(-std::numeric_limits<double>::infinity());  // visited by every query
+        b.hi = glm::dvec2(std::numeric_limits<double>::infinity());
+        return out;
     }
-    _x0 = x0;
-    _y0 = y0;
+    b.x0 = x0;
+    b.y0 = y0;
     // At most 4096 cells a side (a 262 km city at 64 m); beyond, cells grow.
-    _cell = std::max(_cell, std::max(x1 - x0, y1 - y0) / 4095.0);
-    _nx = int((x1 - x0) / _cell) + 1;
-    _ny = int((y1 - y0) / _cell) + 1;
-    std::vector<int64_t> cellOf(objects.size(), -1);
-    _start.assign(size_t(_nx) * size_t(_ny) + 1, 0);
-    for (uint32_t i = 0; i < objects.size(); ++i) {
+    b.cell = std::max(b.cell, std::max(x1 - x0, y1 - y0) / 4095.0);
+    b.nx = int((x1 - x0) / b.cell) + 1;
+    b.ny = int((y1 - y0) / b.cell) + 1;
+    std::vector<int64_t> cellOf(count, -1);
+    b.start.assign(size_t(b.nx) * size_t(b.ny) + 1, 0);
+    for (uint32_t i = 0; i < count; ++i) {
         const SplitObject& o = objects[i];
-        if (!(o.hi.x - o.lo.x <= _cell) || !(o.hi.y - o.lo.y <= _cell)) {
-            _wide.push_back(i);
+        if (!(o.hi.x - o.lo.x <= b.cell) || !(o.hi.y - o.lo.y <= b.cell)) {
+            b.wide.push_back(i);
             continue;
         }
-        const int cx = std::clamp(int((o.lo.x - _x0) / _cell), 0, _nx - 1),
-                  cy = std::clamp(int((o.lo.y - _y0) / _cell), 0, _ny - 1);
-        cellOf[i] = int64_t(cy) * _nx + cx;
-        ++_start[size_t(cellOf[i]) + 1];
+        const int cx = std::clamp(int((o.lo.x - b.x0) / b.cell), 0, b.nx - 1),
+                  cy = std::clamp(int((o.lo.y - b.y0) / b.cell), 0, b.ny - 1);
+        cellOf[i] = int64_t(cy) * b.nx + cx;
+        ++b.start[size_t(cellOf[i]) + 1];
     }
-    for (size_t c = 1; c < _start.size(); ++c) _start[c] += _start[c - 1];
-    _items.resize(_start.back());
-    std::vector<uint32_t> fill(_start.begin(), _start.end() - 1);
-    for (uint32_t i = 0; i < objects.size(); ++i)
-        if (cellOf[i] >= 0) _items[fill[size_t(cellOf[i])]++] = i;  // ascending within a cell
+    for (size_t c = 1; c < b.start.size(); ++c) b.start[c] += b.start[c - 1];
+    b.items.resize(b.start.back());
+    std::vector<uint32_t> fill(b.start.begin(), b.start.end() - 1);
+    for (uint32_t i = 0; i < count; ++i)
+        if (cellOf[i] >= 0) b.items[fill[size_t(cellOf[i])]++] = i;  // ascending within a cell
+    return out;
+}
+
+SplitIndex::SplitIndex(const std::vector<SplitObject>& objects, double cell) : _objects(objects) {
+    auto b = makeBlock(objects.data(), objects.size(), cell);
+    _total = b->triangles;
+    _count = b->count;
+    _blocks[0] = {0, std::move(b)};
+}
+
+SplitIndex::SplitIndex(const std::vector<SplitObject>& objects, double blockCell, std::nullptr_t)
+    : _objects(objects), _blockCell(blockCell) {
+    VISTA_CHECK(blockCell > 0 && std::isfinite(blockCell));
+}
+
+namespace {
+
+// One key per (cx, cy) block cell (wraps only beyond 2^31 cells a side).
+int64_t cellKey(int64_t cx, int64_t cy) { return int64_t((uint64_t(cy) << 32) ^ uint64_t(uint32_t(cx))); }
+
+}  // namespace
+
+int64_t SplitIndex::blockCellOf(const Block& b) const {
+    if (!std::isfinite(b.lo.x) || !std::isfinite(b.lo.y)) return std::numeric_limits<int64_t>::min();
+    const int64_t cx = int64_t(std::floor(b.lo.x / _blockCell)), cy = int64_t(std::floor(b.lo.y / _blockCell));
+    return cellKey(cx, cy);
+}
+
+void SplitIndex::addBlock(uint64_t key, uint32_t first, std::shared_ptr<const Block> block) {
+    VISTA_CHECK(_blockCell > 0 && block && _blocks.count(key) == 0);
+    VISTA_CHECK(size_t(first) + block->count <= _objects.size());
+    _total += block->triangles;
+    _count += block->count;
+    if (std::isfinite(block->lo.x) && std::isfinite(block->hi.x) && block->hi.x >= block->lo.x)
+        _maxExtent = std::max({_maxExtent, block->hi.x - block->lo.x, block->hi.y - block->lo.y});
+    _blockCells[blockCellOf(*block)].push_back(key);
+    _blocks[key] = {first, std::move(block)};
+}
+
+void SplitIndex::removeBlock(uint64_t key) {
+    auto it = _blocks.find(key);
+    if (it == _blocks.end()) return;
+    const Block& b = *it->second.block;
+    _total -= b.triangles;
+    _count -= b.count;
+    if (_blockCell > 0) {
+        auto cell = _blockCells.find(blockCellOf(b));
+        if (cell != _blockCells.end()) {
+            auto& keys = cell->second;
+            keys.erase(std::remove(keys.begin(), keys.end(), key), keys.end());
+            if (keys.empty()) _blockCells.erase(cell);
+        }
+    }
+    _blocks.erase(it);
 }
 
 template <class F>
-void SplitIndex::visit(const glm::dvec3& p, double d, F&& f) const {
-    for (uint32_t i : _wide) f(i);
-    if (_nx == 0) return;
-    if (!(d < 1e15)) {  // +inf or huge: every cell
-        for (uint32_t i : _items) f(i);
+void SplitIndex::visit(const glm::dvec3& p, double d, F&& f, VisitCost* cost) const {
+    const bool everything = !(d < 1e15) || !std::isfinite(p.x) || !std::isfinite(p.y);
+    auto visitBlock = [&](uint64_t key, const Entry& e) {
+        const Block& b = *e.block;
+        if (cost) ++cost->blocks;
+        // The block's boxes all lie farther than d (2D distance to its bounds): nothing to visit.
+        if (!everything) {
+            const double dx = std::max({b.lo.x - p.x, 0.0, p.x - b.hi.x}),
+                         dy = std::max({b.lo.y - p.y, 0.0, p.y - b.hi.y});
+            if (dx * dx + dy * dy > d * d) return;
+        }
+        const uint32_t base = e.first;
+        auto g = [&](uint32_t local) {
+            if (cost) ++cost->objects;
+            f(key, base + local);
+        };
+        for (uint32_t i : b.wide) g(i);
+        if (b.nx == 0) return;
+        if (everything) {  // +inf or huge reach, or a NaN eye: every object (boxDistance decides)
+            for (uint32_t i : b.items) g(i);
+            return;
+        }
+        // A small object (extent <= cell) within d of p has its low corner in [p - d - cell, p + d].
+        auto cellOf = [&](double v, int n) { return int(std::clamp(std::floor(v / b.cell), -1.0, double(n))); };
+        const int cx0 = std::max(0, cellOf(p.x - d - b.cell - b.x0, b.nx)),
+                  cy0 = std::max(0, cellOf(p.y - d - b.cell - b.y0, b.ny));
+        const int cx1 = std::min(b.nx - 1, cellOf(p.x + d - b.x0, b.nx)),
+                  cy1 = std::min(b.ny - 1, cellOf(p.y + d - b.y0, b.ny));
+        for (int cy = cy0; cy <= cy1; ++cy) {
+            const size_t row = size_t(cy) * size_t(b.nx);
+            for (uint32_t k = b.start[row + size_t(cx0)]; cx0 <= cx1 && k < b.start[row + size_t(cx1) + 1]; ++k)
+                g(b.items[k]);
+        }
+    };
+    // A static index, a query of everything, or a reach wider than the blocks: every block.
+    const double reach = everything ? 0.0 : (2.0 * d + _maxExtent) / std::max(_blockCell, 1e-9) + 2.0;
+    if (_blockCell <= 0 || everything || reach * reach >= double(_blocks.size())) {
+        for (const auto& [key, e] : _blocks) visitBlock(key, e);
         return;
     }
-    // A small object (extent <= cell) within d of p has its low corner in [p - d - cell, p + d].
-    auto cellOf = [&](double v, int n) { return int(std::clamp(std::floor(v / _cell), -1.0, double(n))); };
-    const int cx0 = std::max(0, cellOf(p.x - d - _cell - _x0, _nx)),
-              cy0 = std::max(0, cellOf(p.y - d - _cell - _y0, _ny));
-    const int cx1 = std::min(_nx - 1, cellOf(p.x + d - _x0, _nx)), cy1 = std::min(_ny - 1, cellOf(p.y + d - _y0, _ny));
-    if (!std::isfinite(p.x) || !std::isfinite(p.y)) {  // a NaN eye: every object (boxDistance decides)
-        for (uint32_t i : _items) f(i);
-        return;
-    }
-    for (int cy = cy0; cy <= cy1; ++cy) {
-        const size_t row = size_t(cy) * size_t(_nx);
-        for (uint32_t k = _start[row + size_t(cx0)]; cx0 <= cx1 && k < _start[row + size_t(cx1) + 1]; ++k) f(_items[k]);
-    }
+    // The blocks whose low corner lies in [p - d - widest block, p + d], and those without bounds.
+    auto cellOf = [&](double v) { return int64_t(std::floor(v / _blockCell)); };
+    const int64_t cx0 = cellOf(p.x - d - _maxExtent), cx1 = cellOf(p.x + d);
+    const int64_t cy0 = cellOf(p.y - d - _maxExtent), cy1 = cellOf(p.y + d);
+    auto visitCell = [&](int64_t c) {
+        auto it = _blockCells.find(c);
+        if (it == _blockCells.end()) return;
+        for (uint64_t key : it->second) visitBlock(key, _blocks.at(key));
+    };
+    visitCell(std::numeric_limits<int64_t>::min());
+    for (int64_t cy = cy0; cy <= cy1; ++cy)
+        for (int64_t cx = cx0; cx <= cx1; ++cx) visitCell(cellKey(cx, cy));
 }
 
 std::vector<uint32_t> SplitIndex::within(const glm::dvec3& p, double d) const {
-    std::vector<uint32_t> out;
-    visit(p, d, [&](uint32_t i) {
-        if (boxDistance(_objects[i], p) <= d) out.push_back(i);
+    std::vector<std::pair<uint64_t, uint32_t>> hits;
+    visit(p, d, [&](uint64_t key, uint32_t i) {
+        if (boxDistance(_objects[i], p) <= d) hits.push_back({key, i});
     });
-    std::sort(out.begin(), out.end());
+    std::sort(hits.begin(), hits.end());
+    std::vector<uint32_t> out(hits.size());
+    for (size_t k = 0; k < hits.size(); ++k) out[k] = hits[k].second;
     return out;
 }
 
 void SplitIndex::distances(const glm::dvec3& p, double d, std::vector<std::pair<double, uint64_t>>& out) const {
     out.clear();
-    visit(p, d, [&](uint32_t i) {
+    visit(p, d, [&](uint64_t, uint32_t i) {
         const double t = boxDistance(_objects[i], p);
         if (t <= d) out.push_back({t, _objects[i].triangles});
     });
+}
+
+SplitIndex::VisitCost SplitIndex::cost(const glm::dvec3& p, double d) const {
+    VisitCost c;
+    visit(
+        p, d, [](uint64_t, uint32_t) {}, &c);
+    return c;
 }
 
 std::vector<uint32_t> selectNearField(const SplitIndex& index, const glm::dvec3& eye, double nearDistance) {
@@ -215,9 +322,49 @@ std::vector<uint32_t> selectNearFieldByBudget(const std::vector<SplitObject>& ob
     return out;
 }
 
+std::vector<uint32_t> selectNearFieldByBudget(const SplitIndex& index, const glm::dvec3& eye, uint64_t budget) {
+    // (distance, block key, index) of every object within the reach; the reach doubles until
+    // the objects in it hold more than the budget (then the nearest ones within it are exactly
+    // the nearest ones of all) or it holds every object.
+    std::vector<std::tuple<double, uint64_t, uint32_t>> byDist;
+    for (double reach = 64.0;; reach *= 2.0) {
+        if (reach > 1e14) reach = std::numeric_limits<double>::infinity();
+        byDist.clear();
+        uint64_t sum = 0;
+        index.visitKeyed(eye, reach, [&](uint64_t key, uint32_t i, double t) {
+            byDist.push_back({t, key, i});
+            sum += index.objects()[i].triangles;
+        });
+        if (sum > budget || byDist.size() >= index.size() || std::isinf(reach)) break;
+    }
+    std::sort(byDist.begin(), byDist.end(), [](const auto& a, const auto& b) {
+        return std::get<0>(a) != std::get<0>(b) ? std::get<0>(a) < std::get<0>(b) : std::get<2>(a) < std::get<2>(b);
+    });
+    std::vector<std::pair<uint64_t, uint32_t>> picked;
+    uint64_t sum = 0;
+    for (const auto& [t, key, i] : byDist) {
+        const uint64_t tris = index.objects()[i].triangles;
+        if (!picked.empty() && sum + tris > budget) break;
+        sum += tris;
+        picked.push_back({key, i});
+    }
+    std::sort(picked.begin(), picked.end());
+    std::vector<uint32_t> out(picked.size());
+    for (size_t k = 0; k < picked.size(); ++k) out[k] = picked[k].second;
+    return out;
+}
+
 AdaptiveSplit::AdaptiveSplit(const std::vector<SplitObject>& objects, const RayScene* rays,
                              const AdaptiveSplitOptions& o)
-    : _objects(objects), _index(objects), _rays(rays), _o(o), _current(o.initialDistance) {}
+    : _objects(objects),
+      _ownIndex(std::make_unique<SplitIndex>(objects)),
+      _index(*_ownIndex),
+      _rays(rays),
+      _o(o),
+      _current(o.initialDistance) {}
+
+AdaptiveSplit::AdaptiveSplit(const SplitIndex& index, const RayScene* rays, const AdaptiveSplitOptions& o)
+    : _objects(index.objects()), _index(index), _rays(rays), _o(o), _current(o.initialDistance) {}
 
 uint64_t AdaptiveSplit::predictedTriangles(const glm::dvec3& eye, double d) const {
     if (std::isinf(d)) return _index.totalTriangles();

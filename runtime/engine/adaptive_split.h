@@ -69,7 +69,11 @@
 // within `exploreRatio` of the best (else only every fourth time).
 // Not thread-safe; deterministic for given measurements (timeProbe off).
 #pragma once
+#include <cstddef>
 #include <cstdint>
+#include <map>
+#include <memory>
+#include <unordered_map>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -93,34 +97,90 @@ double boxDistance(const SplitObject& o, const glm::dvec3& p);
 // objects near a point are found by visiting the cells within reach, not
 // every object: a paged 32 km city has half a million 40 m chunks, and a
 // linear scan per frame cost 20 ms. Keeps a reference to `objects` (they must
-// outlive it and not change). within() returns exactly what the linear
-// selectNearField() returns (tested).
+// outlive it). within() returns exactly what the linear selectNearField()
+// returns (tested).
+//
+// Blocks (a streamed city): the index is a set of blocks, each a run of
+// objects[first, first + count) bucketed on its own grid (makeBlock(), built
+// from the run's objects alone on any thread, e.g. a pager's worker), added
+// and removed by key between queries (addBlock / removeBlock: no other block
+// is touched). A static index is one block of every object (key 0). A
+// streamed index (SplitIndex(objects, blockCell)) starts empty and finds the
+// blocks within reach through a grid of blockCell-metre cells (each block in
+// the cell of its low corner), so a query visits the blocks and cells near
+// the point, whatever the number of blocks resident. Objects outside every
+// block (free slots of a streamed list) are never visited. Queries order
+// their results by block key, then by index (for a static index: ascending).
+// Queries are const and thread-safe; addBlock/removeBlock are not (call them
+// between queries). The objects of a block must not change while it is in
+// the index.
 class SplitIndex {
 public:
+    // A run of objects bucketed on its own grid (local indices 0 .. count-1).
+    struct Block {
+        double cell = 64.0, x0 = 0, y0 = 0;
+        int nx = 0, ny = 0;
+        std::vector<uint32_t> start, items, wide;  // CSR cells: items[start[c] .. start[c+1])
+        glm::dvec2 lo{0.0}, hi{0.0};               // xy bounds of the run's boxes (lo > hi: empty)
+        uint32_t count = 0;
+        uint64_t triangles = 0;
+    };
+    static std::shared_ptr<const Block> makeBlock(const SplitObject* objects, size_t count, double cell = 64.0);
+
     explicit SplitIndex(const std::vector<SplitObject>& objects, double cell = 64.0);
-    // Every object whose box comes within d of p (boxDistance <= d), ascending; all for d = +inf.
+    // A streamed index: no block yet; blockCell (> 0, metres) = the cells that find blocks (a region's size).
+    SplitIndex(const std::vector<SplitObject>& objects, double blockCell, std::nullptr_t);
+    // objects[first, first + block->count) must hold the objects the block was made of. Contract:
+    // a streamed index, a key not in the index.
+    void addBlock(uint64_t key, uint32_t first, std::shared_ptr<const Block> block);
+    void removeBlock(uint64_t key);  // no such key: nothing
+
+    // Every object whose box comes within d of p (boxDistance <= d), in block order; all for d = +inf.
     std::vector<uint32_t> within(const glm::dvec3& p, double d) const;
     // (boxDistance, triangles) of every object within d of p, unsorted.
     void distances(const glm::dvec3& p, double d, std::vector<std::pair<double, uint64_t>>& out) const;
     // f(index, boxDistance) for every object within d of p, unordered.
     template <class F>
     void visitWithin(const glm::dvec3& p, double d, F&& f) const {
-        visit(p, d, [&](uint32_t i) {
+        visit(p, d, [&](uint64_t, uint32_t i) {
             const double t = boxDistance(_objects[i], p);
             if (t <= d) f(i, t);
         });
     }
+    // f(block key, index, boxDistance) for every object within d of p, unordered.
+    template <class F>
+    void visitKeyed(const glm::dvec3& p, double d, F&& f) const {
+        visit(p, d, [&](uint64_t key, uint32_t i) {
+            const double t = boxDistance(_objects[i], p);
+            if (t <= d) f(key, i, t);
+        });
+    }
+    // The work of a query within d of p: blocks whose bounds were tested, objects whose boxes were.
+    struct VisitCost {
+        size_t blocks = 0, objects = 0;
+    };
+    VisitCost cost(const glm::dvec3& p, double d) const;
     uint64_t totalTriangles() const { return _total; }
+    size_t size() const { return _count; }  // objects in the blocks
+    size_t blockCount() const { return _blocks.size(); }
     const std::vector<SplitObject>& objects() const { return _objects; }
 
 private:
+    struct Entry {
+        uint32_t first = 0;
+        std::shared_ptr<const Block> block;
+    };
+    // f(block key, index) for every object of the blocks whose bounds come within d of p.
     template <class F>
-    void visit(const glm::dvec3& p, double d, F&& f) const;
+    void visit(const glm::dvec3& p, double d, F&& f, VisitCost* cost = nullptr) const;
+    int64_t blockCellOf(const Block& b) const;
     const std::vector<SplitObject>& _objects;
-    double _cell, _x0 = 0, _y0 = 0;
-    int _nx = 0, _ny = 0;
-    std::vector<uint32_t> _start, _items, _wide;  // CSR cells: _items[_start[c] .. _start[c+1])
+    std::map<uint64_t, Entry> _blocks;
+    double _blockCell = 0;                                           // 0: every block is tested (a static index)
+    double _maxExtent = 0;                                           // widest block (x or y) ever added
+    std::unordered_map<int64_t, std::vector<uint64_t>> _blockCells;  // block cell -> keys
     uint64_t _total = 0;
+    size_t _count = 0;
 };
 
 // Returns the indices of the near-field objects (ascending).
@@ -129,6 +189,10 @@ std::vector<uint32_t> selectNearField(const std::vector<SplitObject>& objects, c
 std::vector<uint32_t> selectNearField(const SplitIndex& index, const glm::dvec3& eye, double nearDistance);
 std::vector<uint32_t> selectNearFieldByBudget(const std::vector<SplitObject>& objects, const glm::dvec3& eye,
                                               uint64_t triangleBudget);
+// The same through the index (only its blocks' objects; ordered as within()): the nearest
+// objects are found within a reach doubled from 64 m until the budget is reached or every
+// object is in reach, so a frame visits the objects near the eye, not every one.
+std::vector<uint32_t> selectNearFieldByBudget(const SplitIndex& index, const glm::dvec3& eye, uint64_t triangleBudget);
 
 struct AdaptiveSplitOptions {
     double minDistance = 15.0, maxDistance = 800.0;
@@ -159,6 +223,8 @@ struct AdaptiveSplitOptions {
 class AdaptiveSplit {
 public:
     AdaptiveSplit(const std::vector<SplitObject>& objects, const RayScene* rays, const AdaptiveSplitOptions& o = {});
+    // Over an index the caller keeps (a streamed near field: its blocks change between frames).
+    AdaptiveSplit(const SplitIndex& index, const RayScene* rays, const AdaptiveSplitOptions& o = {});
     // Near distance to use for this frame (0 and +infinity possible, see the options).
     double choose(const Camera& camera, int64_t pixelBudget);
     // Measurements of the frame just rendered: the near field's triangles and
@@ -193,7 +259,8 @@ public:
 private:
     void probe(const Camera& camera);
     const std::vector<SplitObject>& _objects;
-    SplitIndex _index;
+    std::unique_ptr<SplitIndex> _ownIndex;  // over a static object list (null: the caller's index)
+    const SplitIndex& _index;
     const RayScene* _rays;
     AdaptiveSplitOptions _o;
     double _a = 2e-5, _b = 5e-4, _f = 0, _bProbe = 0;       // priors: ms per triangle, ms per far pixel, fixed far ms

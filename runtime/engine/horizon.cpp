@@ -1,5 +1,6 @@
 // Horizon tracing: height grid + conservative 2D rays (see horizon.h).
 #include "runtime/engine/horizon.h"
+#include "foundation/status.h"
 #include "foundation/units.h"
 
 #include <algorithm>
@@ -154,6 +155,186 @@ HeightGrid HeightGrid::build(const SceneModel& city, const glm::dvec3& frameOrig
             g._blockMinZ[b] = std::min(g._blockMinZ[b], g._minZ[i]);
         }
     return g;
+}
+
+HeightGrid HeightGrid::lattice(const glm::dvec2& worldLo, const glm::dvec2& worldHi, const glm::dvec3& frameOrigin,
+                               int cells) {
+    VISTA_CHECK(std::isfinite(worldLo.x) && std::isfinite(worldLo.y) && std::isfinite(worldHi.x) &&
+                std::isfinite(worldHi.y) && worldLo.x <= worldHi.x && worldLo.y <= worldHi.y);
+    const bool automatic = cells <= 0;
+    cells = std::clamp(cells, 1, 8192);
+    HeightGrid g;
+    g._origin = frameOrigin;
+    const glm::dvec2 lo = worldLo - glm::dvec2(frameOrigin), hi = worldHi - glm::dvec2(frameOrigin);
+    g._boundsMin = glm::dvec3(kInf);  // no geometry yet
+    g._boundsMax = glm::dvec3(-kInf);
+    double extent = std::max(hi.x - lo.x, hi.y - lo.y) + 4 * kCellMargin;
+    extent = std::max(extent, 1e-3);
+    if (automatic) cells = autoCells(extent);
+    g._cells = cells;
+    g._cellSize = extent / cells;
+    g._min = lo - glm::dvec2(2 * kCellMargin);
+    const size_t n = size_t(cells) * size_t(cells);
+    g._maxZ.assign(n, -std::numeric_limits<float>::infinity());
+    g._minZ.assign(n, std::numeric_limits<float>::infinity());
+    g._blocks = (cells + kBlock - 1) / kBlock;
+    const size_t nb = size_t(g._blocks) * size_t(g._blocks);
+    g._blockMaxZ.assign(nb, -std::numeric_limits<float>::infinity());
+    g._blockMinZ.assign(nb, std::numeric_limits<float>::infinity());
+    return g;
+}
+
+HeightPatch HeightGrid::patch(const SceneModel& city) const {
+    HeightPatch p;
+    if (_cells == 0) return p;
+    const glm::dvec3 frameOrigin = _origin;
+    // Bounds (as build()): the referenced vertices and the instances' boxes.
+    Box2 all;
+    for (const SceneMesh& m : city.meshes) {
+        glm::dvec3 shift = m.origin - frameOrigin;
+        for (uint32_t i : m.indices)
+            if (i < m.positions.size()) all.add(glm::dvec3(m.positions[i]) + shift);
+    }
+    std::vector<Box2> protoBox(city.prototypes.size());
+    for (size_t k = 0; k < city.prototypes.size(); ++k) {
+        const SceneMesh& m = city.prototypes[k];
+        for (uint32_t i : m.indices)
+            if (i < m.positions.size()) protoBox[k].add(glm::dvec3(m.positions[i]) + m.origin);
+    }
+    std::vector<Box2> instBox(city.instances.size());
+    for (size_t k = 0; k < city.instances.size(); ++k) {
+        const SceneInstance& inst = city.instances[k];
+        if (inst.prototype >= protoBox.size() || !protoBox[inst.prototype].valid()) continue;
+        const Box2& pb = protoBox[inst.prototype];
+        for (int c = 0; c < 8; ++c) {
+            glm::dvec4 v((c & 1) ? pb.hi.x : pb.lo.x, (c & 2) ? pb.hi.y : pb.lo.y, (c & 4) ? pb.hi.z : pb.lo.z, 1.0);
+            glm::dvec4 w = inst.transform * v;
+            instBox[k].add(glm::dvec3(w) - frameOrigin);
+        }
+        all.add(instBox[k].lo);
+        all.add(instBox[k].hi);
+    }
+    if (!all.valid()) return p;
+    p.lo = all.lo;
+    p.hi = all.hi;
+    const int cells = _cells;
+    auto range = [&](double lo, double hi, double min, int* a, int* b) {
+        *a = std::clamp(int(std::floor((lo - kCellMargin - min) / _cellSize)), 0, cells - 1);
+        *b = std::clamp(int(std::floor((hi + kCellMargin - min) / _cellSize)), 0, cells - 1);
+    };
+    int x1 = 0, y1 = 0;
+    range(all.lo.x, all.hi.x, _min.x, &p.x0, &x1);
+    range(all.lo.y, all.hi.y, _min.y, &p.y0, &y1);
+    p.nx = x1 - p.x0 + 1;
+    p.ny = y1 - p.y0 + 1;
+    p.maxZ.assign(size_t(p.nx) * size_t(p.ny), -std::numeric_limits<float>::infinity());
+    p.minZ.assign(p.maxZ.size(), std::numeric_limits<float>::infinity());
+    // The same cells and heights as build()'s splat.
+    auto splat = [&](const glm::dvec3& lo, const glm::dvec3& hi) {
+        int ax = 0, bx = 0, ay = 0, by = 0;
+        range(lo.x, hi.x, _min.x, &ax, &bx);
+        range(lo.y, hi.y, _min.y, &ay, &by);
+        const float zmax = std::nextafter(float(hi.z), std::numeric_limits<float>::infinity());
+        const float zmin = std::nextafter(float(lo.z), -std::numeric_limits<float>::infinity());
+        for (int y = ay; y <= by; ++y)
+            for (int x = ax; x <= bx; ++x) {
+                const size_t i = size_t(y - p.y0) * size_t(p.nx) + size_t(x - p.x0);
+                p.maxZ[i] = std::max(p.maxZ[i], zmax);
+                p.minZ[i] = std::min(p.minZ[i], zmin);
+            }
+    };
+    for (const SceneMesh& m : city.meshes) {
+        glm::dvec3 shift = m.origin - frameOrigin;
+        for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+            Box2 b;
+            for (int k = 0; k < 3; ++k) {
+                uint32_t i = m.indices[t + size_t(k)];
+                if (i < m.positions.size()) b.add(glm::dvec3(m.positions[i]) + shift);
+            }
+            if (b.valid()) splat(b.lo, b.hi);
+        }
+    }
+    for (const Box2& b : instBox)
+        if (b.valid()) splat(b.lo, b.hi);
+    return p;
+}
+
+void HeightGrid::splicePatch(const HeightPatch& p) {
+    for (int y = 0; y < p.ny; ++y)
+        for (int x = 0; x < p.nx; ++x) {
+            const size_t i = size_t(y + p.y0) * size_t(_cells) + size_t(x + p.x0);
+            const size_t k = size_t(y) * size_t(p.nx) + size_t(x);
+            _maxZ[i] = std::max(_maxZ[i], p.maxZ[k]);
+            _minZ[i] = std::min(_minZ[i], p.minZ[k]);
+        }
+}
+
+void HeightGrid::updateBlocks(int x0, int y0, int x1, int y1) {
+    for (int by = y0 / kBlock; by <= y1 / kBlock; ++by)
+        for (int bx = x0 / kBlock; bx <= x1 / kBlock; ++bx) {
+            float hi = -std::numeric_limits<float>::infinity(), lo = std::numeric_limits<float>::infinity();
+            for (int y = by * kBlock; y < std::min(_cells, (by + 1) * kBlock); ++y)
+                for (int x = bx * kBlock; x < std::min(_cells, (bx + 1) * kBlock); ++x) {
+                    const size_t i = size_t(y) * size_t(_cells) + size_t(x);
+                    hi = std::max(hi, _maxZ[i]);
+                    lo = std::min(lo, _minZ[i]);
+                }
+            const size_t b = size_t(by) * size_t(_blocks) + size_t(bx);
+            _blockMaxZ[b] = hi;
+            _blockMinZ[b] = lo;
+        }
+}
+
+void HeightGrid::updateBounds() {
+    _boundsMin = glm::dvec3(kInf);
+    _boundsMax = glm::dvec3(-kInf);
+    for (const auto& [key, p] : _patches) {
+        if (p->nx == 0) continue;
+        _boundsMin = glm::min(_boundsMin, p->lo);
+        _boundsMax = glm::max(_boundsMax, p->hi);
+    }
+}
+
+void HeightGrid::addPatch(uint64_t key, std::shared_ptr<const HeightPatch> patch) {
+    VISTA_CHECK(patch && _patches.count(key) == 0);
+    VISTA_CHECK(patch->nx == 0 || (patch->x0 >= 0 && patch->y0 >= 0 && patch->x0 + patch->nx <= _cells &&
+                                   patch->y0 + patch->ny <= _cells));
+    const HeightPatch& p = *patch;
+    _patches[key] = std::move(patch);
+    if (p.nx == 0) return;
+    splicePatch(p);
+    updateBlocks(p.x0, p.y0, p.x0 + p.nx - 1, p.y0 + p.ny - 1);
+    _boundsMin = glm::min(_boundsMin, p.lo);
+    _boundsMax = glm::max(_boundsMax, p.hi);
+}
+
+void HeightGrid::removePatch(uint64_t key) {
+    auto it = _patches.find(key);
+    if (it == _patches.end()) return;
+    const std::shared_ptr<const HeightPatch> gone = it->second;
+    _patches.erase(it);
+    if (gone->nx == 0) return;
+    const int x0 = gone->x0, y0 = gone->y0, x1 = gone->x0 + gone->nx - 1, y1 = gone->y0 + gone->ny - 1;
+    for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) {
+            const size_t i = size_t(y) * size_t(_cells) + size_t(x);
+            _maxZ[i] = -std::numeric_limits<float>::infinity();
+            _minZ[i] = std::numeric_limits<float>::infinity();
+        }
+    // The other patches over the rectangle, re-splatted there.
+    for (const auto& [k, p] : _patches) {
+        const int ax = std::max(x0, p->x0), bx = std::min(x1, p->x0 + p->nx - 1);
+        const int ay = std::max(y0, p->y0), by = std::min(y1, p->y0 + p->ny - 1);
+        for (int y = ay; y <= by; ++y)
+            for (int x = ax; x <= bx; ++x) {
+                const size_t i = size_t(y) * size_t(_cells) + size_t(x);
+                const size_t s = size_t(y - p->y0) * size_t(p->nx) + size_t(x - p->x0);
+                _maxZ[i] = std::max(_maxZ[i], p->maxZ[s]);
+                _minZ[i] = std::min(_minZ[i], p->minZ[s]);
+            }
+    }
+    updateBlocks(x0, y0, x1, y1);
+    updateBounds();
 }
 
 double HeightGrid::rectBound(double x0, double x1, double y0, double y1, double zLo, double zHi, const glm::dvec3& eye,

@@ -8,6 +8,17 @@
 // enlarged, kCellMargin) xy bounding box overlaps it: conservative, so geometry
 // touching a cell border counts in both cells. Built once; immutable; thread-safe.
 //
+// A streamed city (regions arriving and leaving): lattice() lays the cells
+// over a fixed xy rectangle (a paged city's bounds, so the cells do not move
+// as regions come and go) with no geometry; patch() computes one model's
+// cells on that lattice (const: any thread, e.g. a pager's worker), and
+// addPatch() / removePatch() splice it in or out between frames: only the
+// cells and blocks of the patch's rectangle are touched (removal re-splats
+// the other patches that overlap it), never the whole grid. The cells after
+// any sequence of adds and removes are those of the patches present, the
+// same as one patch of their merged model. Geometry outside the lattice is
+// clamped into its border cells. Not thread-safe while it changes.
+//
 // traceHorizon(): for an upright camera (roll == 0, zenith and nadir outside
 // the view: |pitch| + fovY/2 < pi/2) casts 2D rays through the grid at
 // azimuth steps fine enough (spacing * farthest grid distance < cell size / 2)
@@ -33,6 +44,8 @@
 #pragma once
 #include <cstdint>
 #include <limits>
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -42,6 +55,15 @@
 #include "runtime/scene/scene_model.h"
 
 namespace vista {
+
+// One model's cells on a grid's lattice (HeightGrid::patch): the rectangle
+// [x0, x0 + nx) x [y0, y0 + ny) of cells, each cell's max / min z, and the
+// model's scene-local bounds. Empty (nx = 0) for a model without geometry.
+struct HeightPatch {
+    int x0 = 0, y0 = 0, nx = 0, ny = 0;
+    std::vector<float> maxZ, minZ;  // nx * ny, row-major
+    glm::dvec3 lo{0.0}, hi{0.0};
+};
 
 class HeightGrid {
 public:
@@ -60,8 +82,19 @@ public:
     // cells: 1..8192 (clamped), or <= 0: autoCells() of the geometry's xy extent.
     // frameOrigin: world position of the scene-local origin.
     static HeightGrid build(const SceneModel& city, const glm::dvec3& frameOrigin, int cells);
+    // A grid without geometry whose cells cover the world xy rectangle [worldLo, worldHi] (as
+    // build() lays them over a city's bounds; cells as there). Contract: finite, worldLo <= worldHi.
+    static HeightGrid lattice(const glm::dvec2& worldLo, const glm::dvec2& worldHi, const glm::dvec3& frameOrigin,
+                              int cells);
+    // `model`'s cells on this grid's lattice (its origin: frameOrigin()). Thread-safe.
+    HeightPatch patch(const SceneModel& model) const;
+    // Splices a patch in (key not present) or out (unknown key: nothing). Contract: a patch of
+    // this lattice.
+    void addPatch(uint64_t key, std::shared_ptr<const HeightPatch> patch);
+    void removePatch(uint64_t key);
+    size_t patchCount() const { return _patches.size(); }
 
-    bool empty() const { return _cells == 0; }  // no geometry at all
+    bool empty() const { return _cells == 0 || !(_boundsMin.x <= _boundsMax.x); }  // no geometry at all
     int cells() const { return _cells; }
     double cellSize() const { return _cellSize; }
     glm::dvec2 gridMin() const { return _min; }          // scene-local xy of cell (0,0)'s corner
@@ -103,8 +136,12 @@ private:
     glm::dvec2 _min{0.0};
     glm::dvec3 _boundsMin{0.0}, _boundsMax{0.0}, _origin{0.0};
     std::vector<float> _maxZ, _minZ;
-    int _blocks = 0;                            // blocks per side: ceil(cells / kBlock)
-    std::vector<float> _blockMaxZ, _blockMinZ;  // over each block's cells
+    int _blocks = 0;                                                  // blocks per side: ceil(cells / kBlock)
+    std::vector<float> _blockMaxZ, _blockMinZ;                        // over each block's cells
+    std::map<uint64_t, std::shared_ptr<const HeightPatch>> _patches;  // lattice(): the patches present
+    void splicePatch(const HeightPatch& p);                           // max / min into the cells
+    void updateBlocks(int x0, int y0, int x1, int y1);                // the blocks over cells [x0, x1] x [y0, y1]
+    void updateBounds();                                              // the union of the patches' bounds
 };
 
 struct HorizonOptions {

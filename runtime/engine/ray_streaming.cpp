@@ -3,8 +3,6 @@
 
 namespace vista {
 
-StreamedRayScene::~StreamedRayScene() { _pager.reset(); }
-
 Result<std::unique_ptr<StreamedRayScene>> StreamedRayScene::follower(const PagedManifest& manifest,
                                                                      std::vector<SceneMesh> prototypes) {
     std::unique_ptr<StreamedRayScene> s(new StreamedRayScene());
@@ -23,18 +21,6 @@ Result<std::unique_ptr<StreamedRayScene>> StreamedRayScene::follower(const Paged
     return s;
 }
 
-Result<std::unique_ptr<StreamedRayScene>> StreamedRayScene::create(const PagedManifest& manifest,
-                                                                   const RegionPagerOptions& options,
-                                                                   std::vector<SceneMesh> prototypes) {
-    auto s = follower(manifest, std::move(prototypes));
-    if (!s) return s.status();
-    RegionPagerOptions o = options;
-    const StreamedRayScene* self = s->get();
-    o.prepare = [self](SceneModel& model, int, bool) -> std::shared_ptr<void> { return self->prepare(model); };
-    (*s)->_pager = std::make_unique<RegionPager>(manifest, o);
-    return s;
-}
-
 std::shared_ptr<RayScene::PreparedRegion> StreamedRayScene::prepare(SceneModel& model) const {
     // Tree shapes the region model lacks: the city's.
     if (model.prototypes.size() == _prototypes.size())
@@ -42,16 +28,6 @@ std::shared_ptr<RayScene::PreparedRegion> StreamedRayScene::prepare(SceneModel& 
             if (model.prototypes[p].indices.empty()) model.prototypes[p] = _prototypes[p];
     auto r = _rays->prepareRegion(model);
     return r ? *r : nullptr;
-}
-
-Result<RayStreamFrame> StreamedRayScene::advance(const glm::dvec3& eye, const glm::dvec3& velocity) {
-    VISTA_CHECK(_pager != nullptr);
-    _pager->update(eye, velocity);
-    RegionPagerDelta d = _pager->collect();
-    std::vector<std::shared_ptr<RayScene::PreparedRegion>> prepared;
-    for (const RegionArrival& a : d.arrived)
-        prepared.push_back(std::static_pointer_cast<RayScene::PreparedRegion>(a.prepared));
-    return apply(d, prepared);
 }
 
 Result<RayStreamFrame> StreamedRayScene::apply(RegionPagerDelta& d,

@@ -1,14 +1,15 @@
 // StreamedRayScene: the ray scene of a paged city fed by a RegionPager
-// (runtime/scene/region_pager.h): it starts empty (RayScene::empty around the
-// city's origin) and, between frames, advance() moves the pager to the
-// camera and mirrors what it hands over: each dropped level's region is
-// removed, each arrived level added as one region (RayScene::addRegion of the
-// region's own model, freed right after), then the top level is committed
-// (only when something changed). The whole scene is never rebuilt, and a
-// region's Embree scene is built on the pager's worker thread (prepare()):
-// the frame thread only instances it.
+// (runtime/scene/region_pager.h) that the caller owns (CityStream, which
+// mirrors the same regions into the chunked graph and the near field): it
+// starts empty (RayScene::empty around the city's origin) and, between
+// frames, apply() mirrors what the pager handed over: each dropped level's
+// region is removed, each arrived level added as one region (the region's
+// own model, freed right after), then the top level is committed (only when
+// something changed). The whole scene is never rebuilt, and a region's
+// Embree scene is built on the pager's worker thread (prepare(), from the
+// pager's prepare hook): the frame thread only instances it.
 //
-// With options.wait the pager blocks until the desired set is resident, so
+// With the pager's wait option it blocks until the desired set is resident, so
 // every frame sees exactly the regions within reach of its camera: the scene
 // of a frame depends on the camera alone, and when the reach holds the same
 // regions as a preloaded run (RayScene::build of the merged model, whose
@@ -20,7 +21,8 @@
 // tree prototypes (`prototypes` of create(): those of a loaded full region,
 // the same for every region of a city; empty = read from the first full
 // region file that loads, at set-up, before the first frame), as
-// loadPagedCity() shares them in a merged model.
+// loadPagedCity() shares them in a merged model. So a coarse level is traced
+// with its coarse geometry and its tree impostors as the full trees' meshes.
 //
 // Errors: an Embree error while adding a region (a Status naming it; the
 // scene is then unchanged). A damaged region file is no error: its message
@@ -52,17 +54,10 @@ struct RayStreamFrame {
 
 class StreamedRayScene {
 public:
-    ~StreamedRayScene();  // stops the pager first: its workers use the scene
-    // `manifest` must outlive the scene. With its own pager (advance()).
-    static Result<std::unique_ptr<StreamedRayScene>> create(const PagedManifest& manifest,
-                                                            const RegionPagerOptions& options,
-                                                            std::vector<SceneMesh> prototypes = {});
-    // Without a pager: the caller's pager feeds it through apply() (a
-    // program that mirrors the same regions into other structures too).
+    // The caller's pager feeds it through apply(); the pager must be stopped before the scene
+    // is destroyed (its workers call prepare()).
     static Result<std::unique_ptr<StreamedRayScene>> follower(const PagedManifest& manifest,
                                                               std::vector<SceneMesh> prototypes = {});
-    // Own pager: update, collect, apply. Contract: made by create().
-    Result<RayStreamFrame> advance(const glm::dvec3& eye, const glm::dvec3& velocity);
     // Worker side (thread-safe): completes the model's tree prototypes and
     // builds its region (RayScene::prepareRegion); null when that fails
     // (apply() then adds the model itself and reports the error).
@@ -75,12 +70,10 @@ public:
                                  const std::vector<std::shared_ptr<RayScene::PreparedRegion>>& prepared = {});
     const RayScene& rays() const { return *_rays; }
     RayScene& rays() { return *_rays; }
-    RegionPagerStats stats() const { return _pager ? _pager->stats() : RegionPagerStats(); }
 
 private:
     StreamedRayScene() = default;
     std::unique_ptr<RayScene> _rays;
-    std::unique_ptr<RegionPager> _pager;
     std::vector<SceneMesh> _prototypes;        // the city's tree prototypes
     std::map<std::pair<int, bool>, int> _ids;  // (manifest region, coarse) -> RayScene region id
 };

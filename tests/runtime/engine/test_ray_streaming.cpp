@@ -1,5 +1,7 @@
-// The streamed ray scene of a paged city (runtime/engine/ray_streaming.h):
-// in wait mode every frame is the frame of a scene built at once from the
+// The streamed ray scene of a paged city (runtime/engine/ray_streaming.h),
+// fed by a region pager the way CityStream feeds it (the pager's prepare hook
+// builds each region's Embree scene on the worker, apply() instances it): in
+// wait mode every frame is the frame of a scene built at once from the
 // regions within reach of its camera (RayScene::build of the merged model),
 // to the byte, while regions arrive and leave along the walk.
 #include <gtest/gtest.h>
@@ -63,11 +65,20 @@ TEST(RayStreaming, WaitingFramesAreTheFramesOfTheRegionsWithinReach) {
     o.prefetchS = 0;  // the desired set is that of the eye alone
     o.wait = true;
     o.workers = 2;
-    auto s = vista::StreamedRayScene::create(*m, o);
+    auto s = vista::StreamedRayScene::follower(*m);
     ASSERT_TRUE(s.isOk()) << s.status().message();
+    const vista::StreamedRayScene* scene = s->get();
+    o.prepare = [scene](vista::SceneModel& model, int, bool) -> std::shared_ptr<void> { return scene->prepare(model); };
+    // Declared after the scene: stopped (its workers joined) before the scene goes.
+    vista::RegionPager pager(*m, o);
     int arrived = 0, dropped = 0;
     for (const vista::Camera& c : walk(*m, 7)) {
-        auto f = (*s)->advance(c.eye, glm::dvec3(8.0, 6.4, 0.0));
+        pager.update(c.eye, glm::dvec3(8.0, 6.4, 0.0));
+        vista::RegionPagerDelta d = pager.collect();
+        std::vector<std::shared_ptr<vista::RayScene::PreparedRegion>> prepared;
+        for (const vista::RegionArrival& a : d.arrived)
+            prepared.push_back(std::static_pointer_cast<vista::RayScene::PreparedRegion>(a.prepared));
+        auto f = (*s)->apply(d, prepared);
         ASSERT_TRUE(f.isOk()) << f.status().message();
         EXPECT_TRUE(f->damaged.empty());
         arrived += f->arrived;
@@ -103,7 +114,7 @@ TEST(RayStreaming, WaitingFramesAreTheFramesOfTheRegionsWithinReach) {
     EXPECT_GT(impostorHits, 10);
     EXPECT_GT(arrived, 4) << "regions arrive along the walk";
     EXPECT_GT(dropped, 0) << "and leave behind it";
-    const vista::RegionPagerStats st = (*s)->stats();
+    const vista::RegionPagerStats st = pager.stats();
     EXPECT_EQ(st.loads, arrived);
     EXPECT_EQ(st.unloads, dropped);
 }
