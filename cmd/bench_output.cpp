@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cmd/options.h"
+#include "cmd/paged_stream.h"
 #include "cmd/plot.h"
 #include "foundation/atomic_file.h"
 #include "runtime/engine/metrics.h"
@@ -67,31 +68,6 @@ std::string framesCsv(const BenchResult& result) {
     return csv.str();
 }
 
-// summary.json paged.stream: the streamed ray scene's reach and the pager's totals.
-json streamJson(const BenchResult& r, const BenchConfig& cfg) {
-    const RegionPagerStats& s = r.stream;
-    const RegionPagerOptions& o = cfg.stream;
-    return {{"radius_m", o.radius},
-            {"far_m", o.far},
-            {"prefetch_s", o.prefetchS},
-            {"wait", o.wait},
-            {"frames_deterministic", o.wait},
-            {"budget_file_bytes", o.budgetBytes},
-            {"peak_resident_file_bytes", s.peakResidentBytes},
-            {"resident_file_bytes_end", s.residentBytes},
-            {"resident_full_end", s.residentFull},
-            {"resident_coarse_end", s.residentCoarse},
-            {"loads", s.loads},
-            {"unloads", s.unloads},
-            {"discarded", s.discarded},
-            {"bytes_read", s.bytesRead},
-            {"frames_waited", s.framesWaited},
-            {"wait_ms", s.waitMs},
-            {"frames_with_arrivals", r.framesWithArrivals},
-            {"budget_limited_updates", s.budgetLimited},
-            {"damaged", r.streamDamaged}};
-}
-
 json pixelClasses(const ModeSummary& s) {
     auto cls = [](const PixelClassSummary& c) {
         return json{{"min_pct", num(c.minPct)},
@@ -142,7 +118,9 @@ json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneM
     j["city"] = cfg.cityLabel;
     j["city_triangles"] = city ? city->triangles : 0;
     if (!cfg.pagedJson.empty()) j["paged"] = json::parse(cfg.pagedJson);
-    if (result.streamed) j["paged"]["stream"] = streamJson(result, cfg);
+    if (result.streamed)
+        j["paged"]["stream"] =
+            pagedStreamJson(cfg.stream, result.stream, result.framesWithArrivals, result.streamDamaged);
     j["size"] = {cfg.width, cfg.height};
     j["frames"] = cfg.frames;
     j["sampling"] = samplingName(cfg.sampleRuns);

@@ -12,6 +12,8 @@ namespace {
 struct RegionChunks {
     osg::ref_ptr<osg::Group> group;
     osg::ref_ptr<osg::StateSet> rootState;
+    osg::ref_ptr<osg::Group> labels;  // the chunks' label twins (with labels only)
+    osg::ref_ptr<osg::StateSet> labelRootState;
     std::shared_ptr<RayScene::PreparedRegion> rays;  // its Embree scene (null without rays)
 };
 
@@ -20,7 +22,7 @@ struct RegionChunks {
 CityStream::~CityStream() { _pager.reset(); }
 
 Result<std::unique_ptr<CityStream>> CityStream::create(const PagedManifest& manifest, RegionPagerOptions options,
-                                                       bool rays, std::vector<SceneMesh> prototypes) {
+                                                       bool rays, std::vector<SceneMesh> prototypes, bool labels) {
     std::unique_ptr<CityStream> s(new CityStream());
     if (rays) {
         auto r = StreamedRayScene::follower(manifest, std::move(prototypes));
@@ -29,23 +31,56 @@ Result<std::unique_ptr<CityStream>> CityStream::create(const PagedManifest& mani
     }
     s->_root = new osg::Group;
     s->_root->setName("vista.streamed_city");
+    if (labels) {
+        s->_labelRoot = new osg::Group;
+        s->_labelRoot->setName("vista.streamed_city_labels");
+    }
     const StreamedRayScene* rayScene = s->_rays.get();
-    options.prepare = [rayScene](SceneModel& model, int, bool) -> std::shared_ptr<void> {
+    options.prepare = [rayScene, labels](SceneModel& model, int, bool) -> std::shared_ptr<void> {
         auto out = std::make_shared<RegionChunks>();
         if (rayScene) out->rays = rayScene->prepare(model);
         out->group = new osg::Group;
-        NearFieldScene nf = buildNearFieldScene(sceneRoot(model), kNearChunkSize, false);
+        NearFieldScene nf = buildNearFieldScene(sceneRoot(model), kNearChunkSize, labels);
         out->rootState = nf.rootState;
         for (uint32_t i : nf.drawOrder) out->group->addChild(nf.chunks[i].get());
+        if (labels) {
+            out->labels = new osg::Group;
+            out->labelRootState = nf.labelRootState;
+            for (uint32_t i : nf.drawOrder)
+                if (i < nf.labelChunks.size()) out->labels->addChild(nf.labelChunks[i].get());
+        }
         return out;
     };
     s->_pager = std::make_unique<RegionPager>(manifest, options);
     return s;
 }
 
-Result<CityStreamFrame> CityStream::advance(const glm::dvec3& eye, const glm::dvec3& velocity) {
+namespace {
+
+// Inserts `group` as (coarse, region)'s group under `root`, before the next group in merge order.
+void insertInMergeOrder(osg::Group* root, std::map<std::pair<bool, int>, osg::ref_ptr<osg::Group>>& groups,
+                        std::pair<bool, int> key, osg::Group* group) {
+    auto it = groups.emplace(key, group).first;
+    auto next = std::next(it);
+    const unsigned at = next == groups.end() ? root->getNumChildren() : root->getChildIndex(next->second.get());
+    root->insertChild(at, group);
+}
+
+// Removes (coarse, region)'s group from `root`; false when there is none.
+bool removeGroup(osg::Group* root, std::map<std::pair<bool, int>, osg::ref_ptr<osg::Group>>& groups,
+                 std::pair<bool, int> key) {
+    auto it = groups.find(key);
+    if (it == groups.end()) return false;
+    root->removeChild(it->second.get());
+    groups.erase(it);
+    return true;
+}
+
+}  // namespace
+
+Result<CityStreamFrame> CityStream::advance(const glm::dvec3& eye, const glm::dvec3& velocity, bool wait) {
     _pager->update(eye, velocity);
-    RegionPagerDelta d = _pager->collect();
+    RegionPagerDelta d = _pager->collect(wait);
     CityStreamFrame f;
     f.waited = d.waited;
     f.damaged = d.damaged;
@@ -58,21 +93,19 @@ Result<CityStreamFrame> CityStream::advance(const glm::dvec3& eye, const glm::dv
         VISTA_RETURN_IF_ERROR(_rays->apply(d, prepared).status());
     }
     for (const RegionDrop& x : d.dropped) {
-        auto it = _groups.find({x.coarse, x.region});
-        if (it == _groups.end()) continue;
-        _root->removeChild(it->second.get());
-        _groups.erase(it);
-        ++f.dropped;
+        if (_labelRoot) removeGroup(_labelRoot.get(), _labelGroups, {x.coarse, x.region});
+        if (removeGroup(_root.get(), _groups, {x.coarse, x.region})) ++f.dropped;
     }
     for (RegionArrival& a : d.arrived) {
         auto* chunks = static_cast<RegionChunks*>(a.prepared.get());
         if (!chunks) continue;
         if (!_root->getStateSet() && chunks->rootState) _root->setStateSet(chunks->rootState.get());
-        auto it = _groups.emplace(std::make_pair(a.coarse, a.region), chunks->group).first;
-        // Insert before the next group in merge order.
-        auto next = std::next(it);
-        const unsigned at = next == _groups.end() ? _root->getNumChildren() : _root->getChildIndex(next->second.get());
-        _root->insertChild(at, chunks->group.get());
+        insertInMergeOrder(_root.get(), _groups, {a.coarse, a.region}, chunks->group.get());
+        if (_labelRoot && chunks->labels) {
+            if (!_labelRoot->getStateSet() && chunks->labelRootState)
+                _labelRoot->setStateSet(chunks->labelRootState.get());
+            insertInMergeOrder(_labelRoot.get(), _labelGroups, {a.coarse, a.region}, chunks->labels.get());
+        }
         ++f.arrived;
     }
     return f;
