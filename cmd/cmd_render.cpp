@@ -184,6 +184,13 @@ Status configurePaged(const RenderArgs& a, RenderPlan& p) {
         return Status::error("--paged-stream: '" + a.city +
                              "' is a city file; streaming needs a paged city (DIR.paged from `vista gen`)");
     if (stream.stream) VISTA_RETURN_IF_ERROR(checkStreamingModes({a.mode}));
+    // Over a streamed city the label pass draws the stream's label twin of the
+    // whole city; far-field ray labels would need the regions' models.
+    if (stream.stream && (p.channels & kLabelChannels) && a.mode != "full")
+        return Status::error(
+            "--paged-stream: the depth, semantic and instance channels of a streamed city come from "
+            "mode full (the far field of mode " +
+            a.mode + " is labelled from the whole loaded city); give --channels rgb or --mode full");
     if (!p.paged || !(p.channels & kInstance)) return Status::ok();
     if (a.channelsGiven)
         return Status::error(
@@ -307,10 +314,10 @@ Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, c
 }
 
 // What the frames are drawn with: the renderer, the ray scene (when the
-// mode or the effects cast rays), the mode, and the root of the label pass.
-// Members are destroyed in reverse order: the mode before its context.
-// A streamed paged city: the stream (its graph, ray scene and label twin)
-// and what the frames saw of it.
+// mode or the effects cast rays) or the stream of a paged city (its graph,
+// ray scene and label twin), the mode, the root of the label pass, and what
+// the frames saw of the stream. Members are destroyed in reverse order: the
+// mode before its context and the stream.
 struct RenderSession {
     std::unique_ptr<OffscreenRenderer> renderer;
     std::unique_ptr<RayScene> rays;

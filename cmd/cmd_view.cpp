@@ -19,7 +19,6 @@
 // its full level has arrived (without a budget that forbids both). At exit a
 // line on stderr gives the stream's totals and the frames that drew a region
 // within --paged-radius of the eye below full detail.
-#include <algorithm>
 #include <filesystem>
 #include <cstdio>
 #include <cstdlib>
