@@ -1,8 +1,8 @@
 // Streaming a paged city in `vista render` and `vista view` (--paged-stream,
 // cmd/paged_stream.h): render's ground truth of a streamed city that waits
-// is the preloaded run's, byte for byte; a streamed render and a scripted
-// viewer drive load and unload regions along the path; bad combinations
-// exit 2 naming the flag. Rendering tests: run under `xvfb-run -a`.
+// is the preloaded run's, byte for byte, and resumes to the bytes of an
+// uninterrupted run; a streamed render and a scripted viewer drive load and
+// unload regions along the path; bad combinations exit 2 naming the flag. Rendering tests: run under `xvfb-run -a`.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -106,6 +106,27 @@ TEST_F(PagedStream, AStreamedRenderLoadsAndUnloadsAlongThePath) {
     const CliRun r = runVista("render " + dir() + run + " --paged-stream --out " + tmp.file("nw"));
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_FALSE(readJson(tmp.file("nw/summary.json"))["paged"]["stream"]["frames_deterministic"].get<bool>());
+}
+
+TEST_F(PagedStream, AStreamedRenderResumesToTheUninterruptedBytes) {
+    const std::string run = " --seed 4 --frames 6 --size 160x120 -q --channels rgb,depth --paged-wait" + kNear;
+    CliRun r = runVista("render " + dir() + run + " --out " + tmp.file("ref"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = runVista("render " + dir() + run + " --out " + tmp.file("res"), "VISTA_RENDER_KILL_AFTER_FRAMES=2");
+    ASSERT_NE(r.code, 0) << "the hook kills the run";
+    // The reach is part of the work directory's manifest: another one does not resume it.
+    r = runVista("render " + dir() + run + " --paged-prefetch 1 --out " + tmp.file("res"));
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("other parameters"), std::string::npos) << r.err;
+    r = runVista("render " + dir() + run + " --out " + tmp.file("res"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (int f = 0; f < 6; ++f) {
+        char name[32];
+        std::snprintf(name, sizeof name, "%06d", f);
+        for (const std::string& file : {std::string("rgb/") + name + ".png", std::string("depth/") + name + ".npy"})
+            EXPECT_TRUE(readBytes(tmp.file("ref/" + file)) == readBytes(tmp.file("res/" + file))) << file;
+    }
+    EXPECT_EQ(readJson(tmp.file("res/summary.json"))["frames_resumed"].get<int>(), 2);
 }
 
 TEST_F(PagedStream, AScriptedViewerDriveStreamsTheCity) {
