@@ -280,7 +280,9 @@ Status renderFrames(BenchRun& run, const Path& path, const std::vector<size_t>& 
     for (size_t f = 0; f < idx.size(); ++f) {
         const Camera cam = path.camera(idx[f], base);
         int arrived = 0;
+        Stopwatch advanceSw;
         VISTA_RETURN_IF_ERROR(advanceStream(run, path, idx[f], cam, result, &arrived));
+        if (run.stream) result.advanceMs.push_back(advanceSw.ms());
         result.framesWithArrivals += arrived > 0 ? 1 : 0;
         // Ray origins near the scene's frame origin: float precision anywhere in the city.
         RayScene* rays = run.stream ? run.stream->rays() : run.rays.get();

@@ -100,7 +100,15 @@ struct PixelClassSummary {
 
 struct ModeSummary {
     std::string mode;
-    double frameMsMedian = 0, frameMsP95 = 0, frameMsMean = 0;
+    double frameMsMedian = 0, frameMsP95 = 0, frameMsMean = 0, frameMsP99 = 0, frameMsMax = 0;
+    // Streamed runs: frame times of the frames before which a region level
+    // arrived (and was spliced in) against those of the other frames.
+    struct FrameTimes {
+        int frames = 0;
+        double medianMs = 0, p99Ms = 0, maxMs = 0;
+    };
+    bool streamed = false;
+    FrameTimes withArrivals, withoutArrivals;
     // Base mode -> median over frames f of base_ms[f] / mode_ms[f].
     std::map<std::string, double> speedupMedianOfRatios;
     double psnrDbMedian = 0, psnrDbMin = 0;
@@ -134,6 +142,10 @@ struct BenchResult {
     bool streamed = false;
     RegionPagerStats stream;
     int framesWithArrivals = 0;
+    // Per frame: the frame thread's time in the stream's advance() before it
+    // (pager update, collect, splicing arrivals into the graph and the ray
+    // scene; with --paged-wait the wait too), outside the frame's own time.
+    std::vector<double> advanceMs;
     std::vector<std::string> streamDamaged;
 };
 

@@ -2,6 +2,7 @@
 // the keys are documented in docs/user-guide.md). All writes are atomic.
 #include "cmd/bench.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -15,6 +16,7 @@
 #include "cmd/paged_stream.h"
 #include "cmd/plot.h"
 #include "foundation/atomic_file.h"
+#include "foundation/statistics.h"
 #include "runtime/engine/metrics.h"
 #include "runtime/scene/scene_model.h"
 
@@ -68,6 +70,16 @@ std::string framesCsv(const BenchResult& result) {
     return csv.str();
 }
 
+// summary.json paged.stream: the block every streamed run writes (paged_stream.h)
+// and the frame thread's splice times between frames.
+json streamJson(const BenchResult& r, const BenchConfig& cfg) {
+    json j = pagedStreamJson(cfg.stream, r.stream, r.framesWithArrivals, r.streamDamaged);
+    j["advance_ms_median"] = num(percentile(r.advanceMs, 0.5));
+    j["advance_ms_p99"] = num(percentile(r.advanceMs, 0.99));
+    j["advance_ms_max"] = num(r.advanceMs.empty() ? 0.0 : *std::max_element(r.advanceMs.begin(), r.advanceMs.end()));
+    return j;
+}
+
 json pixelClasses(const ModeSummary& s) {
     auto cls = [](const PixelClassSummary& c) {
         return json{{"min_pct", num(c.minPct)},
@@ -84,6 +96,8 @@ json modeJson(const ModeSummary& s) {
     json m = {{"frame_ms_median", num(s.frameMsMedian)},
               {"frame_ms_p95", num(s.frameMsP95)},
               {"frame_ms_mean", num(s.frameMsMean)},
+              {"frame_ms_p99", num(s.frameMsP99)},
+              {"frame_ms_max", num(s.frameMsMax)},
               {"psnr_db_median", num(s.psnrDbMedian)},
               {"psnr_db_min", num(s.psnrDbMin)},
               {"diff_fraction_median", num(s.diffFractionMedian)},
@@ -94,6 +108,16 @@ json modeJson(const ModeSummary& s) {
               {"rays_per_frame_median", num(s.raysMedian)}};
     for (const auto& [base, v] : s.speedupMedianOfRatios) m["speedup_vs_" + base + "_median_of_ratios"] = num(v);
     if (s.hasPixels) m["pixels"] = pixelClasses(s);
+    if (s.streamed) {
+        auto times = [](const ModeSummary::FrameTimes& t) {
+            return json{{"frames", t.frames},
+                        {"frame_ms_median", num(t.medianMs)},
+                        {"frame_ms_p99", num(t.p99Ms)},
+                        {"frame_ms_max", num(t.maxMs)}};
+        };
+        m["frames_with_arrivals"] = times(s.withArrivals);
+        m["frames_without_arrivals"] = times(s.withoutArrivals);
+    }
     json stages = json::object(), runs = json::object(), setup = json::object();
     for (const auto& kv : s.stagesMsMean) stages[kv.first] = num(kv.second);
     for (const auto& kv : s.stageRuns) runs[kv.first] = kv.second;
@@ -118,9 +142,7 @@ json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneM
     j["city"] = cfg.cityLabel;
     j["city_triangles"] = city ? city->triangles : 0;
     if (!cfg.pagedJson.empty()) j["paged"] = json::parse(cfg.pagedJson);
-    if (result.streamed)
-        j["paged"]["stream"] =
-            pagedStreamJson(cfg.stream, result.stream, result.framesWithArrivals, result.streamDamaged);
+    if (result.streamed) j["paged"]["stream"] = streamJson(result, cfg);
     j["size"] = {cfg.width, cfg.height};
     j["frames"] = cfg.frames;
     j["sampling"] = samplingName(cfg.sampleRuns);

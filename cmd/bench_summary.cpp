@@ -97,6 +97,24 @@ ModeSummary summariseMode(const BenchResult& r, const std::string& mode, const s
     }
     s.frameMsMedian = percentile(ms, 0.5);
     s.frameMsP95 = percentile(ms, 0.95);
+    s.frameMsP99 = percentile(ms, 0.99);
+    s.frameMsMax = *std::max_element(ms.begin(), ms.end());
+    if (r.streamed) {
+        s.streamed = true;
+        std::vector<double> with, without;
+        for (const BenchFrameRecord* f : frames) (f->regionsArrived > 0 ? with : without).push_back(f->stats.frameMs);
+        auto times = [](const std::vector<double>& v) {
+            ModeSummary::FrameTimes t;
+            t.frames = int(v.size());
+            if (v.empty()) return t;
+            t.medianMs = percentile(v, 0.5);
+            t.p99Ms = percentile(v, 0.99);
+            t.maxMs = *std::max_element(v.begin(), v.end());
+            return t;
+        };
+        s.withArrivals = times(with);
+        s.withoutArrivals = times(without);
+    }
     double sum = 0;
     for (double v : ms) sum += v;
     s.frameMsMean = sum / double(ms.size());

@@ -10,6 +10,7 @@
 #include "citygen/generate.h"
 #include "citygen/opendrive.h"
 #include "foundation/atomic_file.h"
+#include "foundation/format.h"
 #include "foundation/input_file.h"
 #include "foundation/number_text.h"
 #include "foundation/output_paths.h"
@@ -99,7 +100,7 @@ CLI::Option* declareFlags(CLI::App& app, GenArgs& a) {
     addNumberOption(
         app, "--shards", a.shards, 1, kMaxShards,
         "with --merge: N, 1 .. 100000, the shard count of the shards' --shard K/N; a merge that finds regions missing "
-        "then names the shards K/N to run again");
+        "then names the shards K/N to run again and the command that runs them");
     addNumberOption(
         app, "--memory-budget", a.budgetGb, kMemoryBudgetGbRange,
         "GB, (0, 65536]: refuse up front, before the meshes are made and with nothing written, a generation whose "
@@ -188,6 +189,22 @@ Result<CityParams> resolveParams(GenArgs& a) {
     return params;
 }
 
+// The command that runs one shard of this paged generation again: the flags
+// that decide the regions' bytes as given, the output, then `--shard` (the
+// merge's refusal appends K/N).
+std::string shardCommand(const GenArgs& a, const std::string& dir) {
+    std::string c = "vista gen";
+    auto add = [&](const char* flag, const std::string& v) { c += std::string(" ") + flag + " " + shellWord(v); };
+    if (!a.paramsFile.empty()) add("--params", a.paramsFile);
+    if (a.seed) add("--seed", std::to_string(*a.seed));
+    if (a.size) add("--size", exactDecimal(*a.size));
+    if (a.detail) add("--detail", std::to_string(*a.detail));
+    if (a.effects) add("--effects", *a.effects);
+    if (a.regionSize) add("--region-size", exactDecimal(*a.regionSize));
+    add("-o", dir);
+    return c + " --shard";
+}
+
 // The paged output's options, checked before anything is written.
 Result<PagedCityOptions> resolvePaged(const GenArgs& a, const CityParams& params) {
     PagedCityOptions o;
@@ -207,6 +224,7 @@ Result<PagedCityOptions> resolvePaged(const GenArgs& a, const CityParams& params
     if (a.shards) {
         if (!a.merge) return Status::error("option --shards: only with --merge (shards take --shard K/N)");
         o.mergeShards = *a.shards;
+        o.shardCommand = shardCommand(a, o.dir);
     }
     for (auto [opt, path] : {std::pair<const char*, const std::string*>{"--geojson", &a.geojsonFile},
                              {"--gltf", &a.gltfFile},

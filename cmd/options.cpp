@@ -386,6 +386,9 @@ void addPathFlags(CLI::App& app, PathFlags& f, bool timing) {
         ->excludes(path);
     app.add_option("--kind", f.kind, "path kind when made from --seed: walk, car, fly (default " + f.kind + ")");
     app.add_flag("--lht", f.lht, "car path made from --seed: left-hand traffic (lanes driven mirrored)");
+    app.add_option("--route", f.route,
+                   "path made from --seed: tour (default: toward far goals along shortest paths, a long drive keeps "
+                   "going across the city) or wander (a seeded random walk that prefers going straight on)");
     if (!timing) return;
     addNumberOption(app, "--duration", f.duration, path_range::duration,
                     "path duration in seconds when made from --seed, (0, 86400] (default 60)");
@@ -404,6 +407,9 @@ Result<PathOptions> parsePathFlags(const PathFlags& f) {
     po.duration = f.duration;
     po.runUp = f.runUp;
     po.leftHandTraffic = f.lht;
+    auto r = parseRouteStyle(f.route);
+    if (!r) return Status::error("--route: " + r.status().message());
+    po.route = r.value();
     VISTA_RETURN_IF_ERROR(validatePathOptions(po));
     return po;
 }

@@ -195,12 +195,12 @@ CLI::Option* addNumberOption(CLI::App& app, const std::string& name, std::option
 CLI::Option* addSeedOption(CLI::App& app, const std::string& name, uint64_t& seed, const std::string& help);
 
 struct PathFlags {
-    std::string file, kind = "car";
+    std::string file, kind = "car", route = routeStyleName(PathOptions().route);
     uint64_t seed = 1;
     double duration = 60.0, runUp = PathOptions().runUp;
     bool lht = false;
 };
-// Declares --path, --seed, --kind, --lht and, with `timing`, --duration and --run-up.
+// Declares --path, --seed, --kind, --lht, --route and, with `timing`, --duration and --run-up.
 void addPathFlags(CLI::App& app, PathFlags& flags, bool timing);
 // The path options of the flags (kind and ranges checked; messages name the flag).
 Result<PathOptions> parsePathFlags(const PathFlags& flags);

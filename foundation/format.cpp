@@ -20,4 +20,16 @@ std::string exactDecimal(double v) {
     return s.str();
 }
 
+std::string shellWord(const std::string& s) {
+    bool safe = !s.empty();
+    for (char c : s) {
+        const bool alnum = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');
+        if (!alnum && std::string("_-./:=,+@%").find(c) == std::string::npos) safe = false;
+    }
+    if (safe) return s;
+    std::string q = "'";
+    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
 }  // namespace vista

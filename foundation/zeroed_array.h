@@ -14,6 +14,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <type_traits>
 
@@ -43,6 +44,11 @@ public:
         _data = std::unique_ptr<T, Free>(static_cast<T*>(allocateZeroed(n * sizeof(T))), Free{n * sizeof(T)});
         VISTA_CHECK(_data != nullptr);
         _size = n;
+    }
+    // Every element back to zero bytes, in place: the pages stay mapped, so
+    // no later write pays their first touch (all of them are touched now).
+    void zero() {
+        if (_size) std::memset(static_cast<void*>(_data.get()), 0, _size * sizeof(T));
     }
     size_t size() const { return _size; }
     T& operator[](size_t i) { return _data.get()[i]; }

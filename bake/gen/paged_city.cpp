@@ -227,32 +227,39 @@ Json manifestJson(const CityParams& params, const RegionGrid& grid, double regio
     return m;
 }
 
-// The merge's refusal: how many regions are missing (the first few by
-// name) and which shards to run again: K/N for each, when the merge knows the
-// N the shards ran with, otherwise how regions map to shards.
+// The merge's refusal: how many regions are missing (the first few by name,
+// each with the shard K/N that owns it) and which shards to run again: K/N
+// for each and the command that runs them, when the merge knows the N the
+// shards ran with, otherwise how regions map to shards.
 Status missingRegionsError(const PagedCityOptions& o, const RegionGrid& grid, const std::vector<int>& missing) {
+    const int n = o.mergeShards;
+    auto shardName = [&](int k) { return std::to_string(k + 1) + "/" + std::to_string(n); };
     std::string names;
-    for (size_t i = 0; i < missing.size() && i < 8; ++i)
+    for (size_t i = 0; i < missing.size() && i < 8; ++i) {
         names += (i ? ", " : "") + regionFileName(grid.ix(missing[i]), grid.iy(missing[i]));
+        if (n >= 1) names += " (shard " + shardName(missing[i] % n) + ")";
+    }
     if (missing.size() > 8) names += ", ...";
     std::string msg = "--merge: " + std::to_string(missing.size()) + " of " + std::to_string(grid.count()) +
                       " regions of '" + o.dir + "' are missing, corrupt or from other parameters (" + names + "); ";
-    if (o.mergeShards < 1)
+    if (n < 1)
         return Status::error(msg + "run the shards that own them again (--shard K/N owns the regions whose index " +
                              "IY * " + std::to_string(grid.countX()) + " + IX satisfies index % N == K - 1; " +
                              "--merge --shards N names them)");
-    std::vector<bool> rerun(size_t(o.mergeShards), false);
-    for (int r : missing) rerun[size_t(r % o.mergeShards)] = true;
+    std::vector<bool> rerun(size_t(n), false);
+    for (int r : missing) rerun[size_t(r % n)] = true;
     std::string shards;
-    int count = 0;
-    for (int k = 0; k < o.mergeShards; ++k) {
+    int count = 0, first = -1;
+    for (int k = 0; k < n; ++k) {
         if (!rerun[size_t(k)]) continue;
-        if (++count <= 20)
-            shards += (count > 1 ? ", " : "") + std::to_string(k + 1) + "/" + std::to_string(o.mergeShards);
+        if (first < 0) first = k;
+        if (++count <= 20) shards += (count > 1 ? ", " : "") + shardName(k);
     }
     if (count > 20) shards += ", ...";
-    return Status::error(msg + "run " + (count == 1 ? "shard " : std::to_string(count) + " shards ") + shards +
-                         " again (--shard K/N with the same parameters), then the merge");
+    msg += "run " + (count == 1 ? std::string("shard ") : std::to_string(count) + " shards ") + shards + " again";
+    if (o.shardCommand.empty()) return Status::error(msg + " (--shard K/N with the same parameters), then the merge");
+    if (count == 1) return Status::error(msg + ": " + o.shardCommand + " " + shardName(first) + "; then the merge");
+    return Status::error(msg + ", each with: " + o.shardCommand + " K/" + std::to_string(n) + "; then the merge");
 }
 
 }  // namespace

@@ -50,6 +50,10 @@ struct PagedCityOptions {
     Shard shard;
     bool merge = false;
     int mergeShards = 0;  // with merge: the N of the shards' K/N (0: unknown)
+    // With merge: the command that runs one shard with the same parameters,
+    // ending in `--shard` (the refusal appends K/N and prints it for each
+    // shard to run again); empty: the refusal names the shards only.
+    std::string shardCommand;
     Progress* progress = nullptr;
     // Non-null: index.osgb and manifest.json are staged into this batch and
     // the caller commits them with its own outputs (--stats); null: they are

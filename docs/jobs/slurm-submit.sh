@@ -2,10 +2,13 @@
 # Submits a vista job array and its merge to Slurm:
 #   docs/jobs/slurm-submit.sh gen  N OUT.paged [vista gen args...]
 #   docs/jobs/slurm-submit.sh bake N OUT.baked.osgb CITY.osgb [vista bake args...]
-# OUT (and CITY) must be on storage every node sees. The array runs shard K/N
-# as task K; the merge (--dependency=afterany) starts once every task has
-# ended and names the shards that are not done. Logs go to OUT.logs/
-# (shard-ARRAYJOB_K.log, merge-JOBID.log). Prints the two job ids.
+# OUT (and CITY) must be on storage every node sees, and so must this
+# directory (the merge calls this script to submit missing shards again).
+# The array runs shard K/N as task K; the merge (--dependency=afterany)
+# starts once every task has ended, however it ended, and submits the shards
+# that are not done again with a new merge (VISTA_MAX_ROUNDS). Logs go to
+# OUT.logs/ (shard-ARRAYJOB_K.log, merge-JOBID.log), created here. Prints the
+# two job ids. To stop a run, cancel both: scancel ARRAYJOB MERGEJOB.
 #
 # Optional environment:
 #   VISTA_SBATCH_OPTS        more sbatch options for both jobs, split at white
@@ -16,7 +19,11 @@
 #   VISTA_MERGE_MEM          the merge's memory, as sbatch --mem takes it
 #                            (default gen: 1G; bake: 2 GB + 4 x the city file)
 #   VISTA_LOGS               the log directory (default OUT.logs)
+#   VISTA_MAX_ROUNDS         how often a merge submits missing shards again
+#                            (default 2; 0: never, it names them and exits 2)
 #   VISTA, VISTA_MAX_RESTARTS  passed to the jobs (see slurm-array.sbatch)
+# Slurm's own input variables (SBATCH_PARTITION, SBATCH_ACCOUNT,
+# SBATCH_TIMELIMIT, ...) apply too; VISTA_SBATCH_OPTS wins over them.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 usage="usage: $0 gen|bake N OUT [CITY] [vista args...]"
@@ -63,7 +70,7 @@ read -r -a opts <<<"${VISTA_SBATCH_OPTS:-}"
 read -r -a merge_opts <<<"${VISTA_MERGE_SBATCH_OPTS:-}"
 
 export VISTA_JOB="$job" VISTA_SHARDS="$n" VISTA_OUT="$out" VISTA_CITY="$city" VISTA_ARGS="$*"
-export VISTA_SUBMIT="$here/slurm-submit.sh"
+export VISTA_SUBMIT="$here/slurm-submit.sh" VISTA_ROUND="${VISTA_ROUND:-0}"
 array=$(sbatch --parsable --array="$tasks" --output="$logs/shard-%A_%a.log" --export=ALL \
   ${opts[@]+"${opts[@]}"} "$here/slurm-array.sbatch")
 array="${array%%;*}"

@@ -35,6 +35,7 @@ STEPS=(
   "generation|docs/measurements/generation.md (table in OUT/generation.md)|VISTA=\$BUILD/vista docs/tools/perf_table.sh 500 1000 2000 4000 8000 > \$OUT/generation.md"
   "paged-generation|docs/measurements/paging.md (table in OUT/paged-generation.md)|docs/tools/paged_rss_table.sh \$BUILD \$OUT/paged-generation 4000,8000,16000,32000 4000,8000 > \$OUT/paged-generation.md"
   "scale|docs/measurements/paging.md|docs/tools/scale_table.sh \$OUT/scale \$BUILD/vista"
+  "stream|docs/measurements/paging.md|docs/tools/stream_table.sh \$OUT/stream \$BUILD/vista"
   "paged-reach|docs/measurements/paging.md|docs/tools/paged_reach_table.sh \$OUT/scale/c8000.paged \$OUT/paged-reach \$BUILD"
   "raw-rays|docs/measurements/raw-rays.md|docs/tools/raw_rays.sh \$OUT/raw-rays \$BUILD/vista"
   "opendrive|docs/formats.md \"OpenDRIVE\" (table in OUT/opendrive.md)|docs/tools/opendrive_table.sh \$OUT/opendrive-work \$BUILD/vista > \$OUT/opendrive.md"

@@ -87,8 +87,9 @@ float PanoramaCache::decodeNear(uint32_t v) {
 }
 
 void PanoramaCache::clear() {
-    size_t n = size_t(_width) * size_t(_height);
-    _cells.reset(n);
+    const size_t n = size_t(_width) * size_t(_height);
+    if (_cells.size() == n) _cells.zero();  // a restart: the pages stay, so its first frames pay no page faults
+    else _cells.reset(n);
     _stamp = 0;
     _records.assign(1, Record{});
     _baseline.assign(1, INFINITY);

@@ -82,7 +82,10 @@ public:
     // Fractional map coordinates (column, row) of a direction (for tests).
     glm::dvec2 mapCoord(const glm::dvec3& worldDir) const;
 
-    // Drops every cached colour and record.
+    // Drops every cached colour and record. The cells are zeroed in place:
+    // every page of the map is then resident, so the frames after a restart
+    // (a walkthrough's first frames, after its warm-up) pay no first touch of
+    // a page inside the far field's cache stage.
     void clear();
     // Starts a frame for `camera`: picks or creates the current record.
     void beginFrame(const Camera& camera);

@@ -1,5 +1,6 @@
 // foundation/: hashing, atomic writes, units, RNG streams, stopwatch.
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <limits>
@@ -15,6 +16,7 @@
 
 #include "foundation/zeroed_array.h"
 #include "foundation/atomic_file.h"
+#include "foundation/format.h"
 #include "foundation/hash.h"
 #include "foundation/rng.h"
 #include "foundation/statistics.h"
@@ -307,4 +309,39 @@ TEST(ZeroedArray, LargeArraysAreZeroAlignedAndReusable) {
     EXPECT_EQ(a[0] + a[n - 1] + a[n / 2], 0u);
     a.reset(100);  // small again: an ordinary allocation
     EXPECT_EQ(a[99], 0u);
+}
+
+// zero(): every element back to zero in the same memory (a restart keeps its pages).
+TEST(ZeroedArray, ZeroKeepsTheMemory) {
+    const size_t n = (vista::kHugeBytes / sizeof(uint32_t)) + 77;
+    vista::ZeroedArray<uint32_t> a(n);
+    const uint32_t* before = a.begin();
+    for (size_t i = 0; i < n; i += 1000) a[i] = uint32_t(i + 1);
+    a[n - 1] = 9;
+    a.zero();
+    EXPECT_EQ(a.begin(), before);
+    EXPECT_EQ(a.size(), n);
+    uint64_t sum = 0;
+    for (uint32_t v : a) sum += v;
+    EXPECT_EQ(sum, 0u);
+}
+
+// A printed command pastes back as the same words: safe words unchanged,
+// others single-quoted with their quotes escaped, as sh reads them.
+TEST(Format, ShellWordQuotesOnlyWhatTheShellWouldSplitOrExpand) {
+    EXPECT_EQ(vista::shellWord("/shared/city.paged"), "/shared/city.paged");
+    EXPECT_EQ(vista::shellWord("--size=32000,a+b@c%d:e"), "--size=32000,a+b@c%d:e");
+    EXPECT_EQ(vista::shellWord(""), "''");
+    EXPECT_EQ(vista::shellWord("my city.paged"), "'my city.paged'");
+    EXPECT_EQ(vista::shellWord("$HOME*"), "'$HOME*'");
+    EXPECT_EQ(vista::shellWord("it's"), "'it'\\''s'");
+    // The shell itself reads the quoted word back as the original.
+    const std::string word = "a b'c$d\"e\\f";
+    const std::string cmd = "printf %s " + vista::shellWord(word);
+    FILE* p = ::popen(cmd.c_str(), "r");
+    ASSERT_NE(p, nullptr);
+    char buf[64] = {};
+    const size_t n = std::fread(buf, 1, sizeof buf - 1, p);
+    ::pclose(p);
+    EXPECT_EQ(std::string(buf, n), word);
 }

@@ -8,16 +8,20 @@
 # unless --open-mode=append),
 # SIGUSR1 to the batch shell before the time limit (--signal=B:USR1@...),
 # SIGTERM to the job's processes on scancel, requeued tasks run again with
-# SLURM_RESTART_COUNT, the merge after its afterany dependency.
+# SLURM_RESTART_COUNT, the merge after its afterany dependency. As in Slurm,
+# the last task of an array has the array's job id as its own, and
+# `scontrol requeue ARRAYJOB` requeues every task.
 #
 # The city: 1.5 km in 500 m regions (9 regions), 3 shards. Shard 1 reaches
-# its time limit, shard 2 fails after damaging a region file, shard 3 is
-# cancelled. The merge must name shard 3/3 and the command that runs it
-# again; that command, run as printed, finishes the city, and the result
-# must be byte for byte the single-machine run. Also checked: the scripts run
-# with VISTA_ARGS unset (set -u), logs land in OUT.logs (not the submit
+# its time limit, shard 2 is cancelled, shard 3 fails after damaging a region
+# file. Shards 1 and 3 requeue themselves (and nothing else); the merge finds
+# shard 2/3 missing (vista names it and the command that runs it) and submits
+# it again with a new merge, which finishes the city; the result must be byte
+# for byte the single-machine run. Also checked: the scripts run with
+# VISTA_ARGS unset (set -u), logs land in OUT.logs (not the submit
 # directory), VISTA_SBATCH_OPTS reach sbatch, the merge asks for a sized
-# amount of memory that covers its measured peak.
+# amount of memory that covers its measured peak, and a merge out of rounds
+# (VISTA_MAX_ROUNDS) or given bad input submits nothing and exits 2.
 #   tests/tools/test_slurm_jobs.sh VISTA SOURCE_DIR WORK_DIR
 set -euo pipefail
 for tool in /usr/bin/time setsid truncate; do
@@ -70,13 +74,38 @@ if [ "$parsable" = 1 ]; then echo "$id"; else echo "Submitted batch job $id"; fi
 EOF
 cat >"$W/bin/scontrol" <<'EOF'
 #!/usr/bin/env bash
-# Fake scontrol: `scontrol requeue JOBID...` asks the fake controller to run
-# these jobs again; nothing else is supported.
+# Fake scontrol: `scontrol requeue JOB...` asks the fake controller to run
+# these jobs again, recorded by their job ids: ARRAYJOB_K is task K; an
+# array's own job id is every task of it (as Slurm does); any other id is
+# that job. Nothing else is supported.
 set -euo pipefail
 [ "${1:-}" = requeue ] || { echo "fake scontrol: only 'requeue' is supported, not '$*'" >&2; exit 1; }
 shift
-for j in "$@"; do echo "$j" >>"$FAKE_SLURM/requeued"; done
+for j in "$@"; do
+  if [[ "$j" =~ ^([0-9]+)_([0-9]+)$ ]]; then
+    "$FAKE_SLURM/task_id" "${BASH_REMATCH[1]}" "${BASH_REMATCH[2]}" >>"$FAKE_SLURM/requeued"
+  elif [ -n "$(sed -n 's/^--array=//p' "$FAKE_SLURM/jobs/$j/options" 2>/dev/null)" ]; then
+    for k in $("$FAKE_SLURM/task_list" "$j"); do "$FAKE_SLURM/task_id" "$j" "$k" >>"$FAKE_SLURM/requeued"; done
+  else
+    echo "$j" >>"$FAKE_SLURM/requeued"
+  fi
+done
 EOF
+# task_list ARRAYJOB: its tasks ("1-3", "2,5" or "3-4" expanded);
+# task_id ARRAYJOB K: task K's job id (the last task: the array's own id).
+cat >"$S/task_list" <<'EOF'
+#!/usr/bin/env bash
+spec="$(sed -n 's/^--array=//p' "$FAKE_SLURM/jobs/$1/options" | tail -1)"
+for k in ${spec//,/ }; do
+  case "$k" in *-*) seq "${k%-*}" "${k#*-}" ;; *) echo "$k" ;; esac
+done
+EOF
+cat >"$S/task_id" <<'EOF'
+#!/usr/bin/env bash
+last="$("$FAKE_SLURM/task_list" "$1" | sort -n | tail -1)"
+if [ "$2" = "$last" ]; then echo "$1"; else echo $(($1 + $2)); fi
+EOF
+chmod +x "$S/task_list" "$S/task_id"
 cat >"$W/bin/srun" <<'EOF'
 #!/usr/bin/env bash
 # Fake srun: a job step is the command itself.
@@ -98,25 +127,19 @@ started() {
 
 opt() { sed -n "s/^--$2=//p" "$S/jobs/$1/options" | tail -1; }  # opt JOBID NAME: the value that applies
 
-# The array tasks of a job: "1-3", "2,5" or "3-4" expanded.
-tasks() {
-  local spec k
-  spec="$(opt "$1" array)"
-  for k in ${spec//,/ }; do
-    case "$k" in *-*) seq "${k%-*}" "${k#*-}" ;; *) echo "$k" ;; esac
-  done
-}
+tasks() { "$S/task_list" "$1"; }  # the array tasks of a job
+tid() { "$S/task_id" "$1" "$2"; }   # tid ARRAYJOB K: task K's job id
 
 # start JOBID [TASK]: starts the batch script as slurmd does; PID is its pid
 # (a process group of its own, so that a cancel reaches vista too). The
-# task's own job id is JOBID + TASK, its array job id JOBID.
+# task's own job id is tid JOBID TASK, its array job id JOBID.
 start() {
   local id=$1 k=${2:-} d="$S/jobs/$1" jid out restarts
   jid=$id
   local -a vars=(SLURM_JOB_ID="$id" SLURM_SUBMIT_DIR="$(cat "$d/cwd")" SLURM_JOB_NAME="$(opt "$id" job-name)")
   out="$(opt "$id" output)"
   if [ -n "$k" ]; then
-    jid=$((id + k))
+    jid=$(tid "$id" "$k")
     local -a ks
     mapfile -t ks < <(tasks "$id")
     vars=(SLURM_JOB_ID="$jid" SLURM_ARRAY_JOB_ID="$id" SLURM_ARRAY_TASK_ID="$k" SLURM_ARRAY_TASK_COUNT="${#ks[@]}"
@@ -181,7 +204,7 @@ ARGS=(--size 1500 --seed 3 --detail 1 --region-size 500)
 "$VISTA_BIN" gen "${ARGS[@]}" -q -o "$W/one.paged"
 
 # --- vista as the cluster sees it: shard 1 runs into its time limit, shard 2
-# --- fails after damaging a region file, shard 3 is cancelled; each only once.
+# --- is cancelled, shard 3 fails after damaging a region file; each only once.
 cat >"$W/bin/vista-cluster" <<EOF
 #!/usr/bin/env bash
 # Every run's peak RSS (KiB) and arguments go to $W/rss.
@@ -191,8 +214,8 @@ first="$W/first.\${shard%/*}"
 if [ -n "\$shard" ] && [ ! -e "\$first" ]; then
   : >"\$first"
   case "\$shard" in
-    1/3 | 3/3) exec sleep 600 ;;  # long: stopped by the time limit / cancelled
-    2/3)
+    1/3 | 2/3) exec sleep 600 ;;  # long: stopped by the time limit / cancelled
+    3/3)
       "$VISTA_BIN" "\$@" || exit
       out="\$(printf '%s\n' "\$@" | grep '\.paged\$')"
       region="\$(ls "\$out"/region_*.osgb | grep -v coarse | head -1)"
@@ -227,56 +250,63 @@ started 1
 kill -USR1 "$PID"
 rc=0
 wait "$PID" || rc=$?
-grep -qx "$((array + 1))" "$S/requeued" || fail "shard 1 did not requeue itself before the time limit (exit $rc)"
-# Shard 2: vista fails.
-run $array 2
-rc=$RC
-[ "$rc" = 137 ] || fail "shard 2's first run exited $rc"
-grep -qx "$((array + 2))" "$S/requeued" || fail "shard 2 did not requeue itself after vista failed"
-# Shard 3: scancel (SIGTERM to every process of the job).
-start $array 3
-started 3
+grep -qx "$(tid $array 1)" "$S/requeued" || fail "shard 1 did not requeue itself before the time limit (exit $rc)"
+# Shard 2: scancel (SIGTERM to every process of the job).
+start $array 2
+started 2
 kill -TERM -- "-$PID"
 wait "$PID" || true
-grep -qx "$((array + 3))" "$S/requeued" && fail "a cancelled shard requeued itself"
-ok "time limit and failure requeue the shard, a cancel does not"
+grep -qx "$(tid $array 2)" "$S/requeued" && fail "a cancelled shard requeued itself"
+# Shard 3, the last task, whose job id is the array's: vista fails.
+[ "$(tid $array 3)" = $array ] || fail "the fake controller gives task 3 the id $(tid $array 3)"
+run $array 3
+rc=$RC
+[ "$rc" = 137 ] || fail "shard 3's first run exited $rc"
+grep -qx "$array" "$S/requeued" || fail "shard 3 did not requeue itself after vista failed"
+[ "$(sort -u "$S/requeued" | tr '\n' ' ')" = "$(printf '%s\n' "$(tid $array 1)" $array | sort -u | tr '\n' ' ')" ] \
+  || fail "requeued $(tr '\n' ' ' <"$S/requeued"), not just shards 1 and 3 (a task requeued by the array's id?)"
+ok "time limit and failure requeue the shard (and only it), a cancel does not"
 
 # The controller runs the requeued tasks again.
-for k in 1 2; do
+for k in 1 3; do
   run $array $k
   rc=$RC
-  [ "$rc" = 0 ] || fail "shard $k/3 failed again (exit $rc): $(cat "$(cat "$S/jobs/$array/log.$((array + k))")")"
+  [ "$rc" = 0 ] || fail "shard $k/3 failed again (exit $rc): $(cat "$(cat "$S/jobs/$array/log.$(tid $array $k)")")"
 done
-grep -q "attempt 2" "$(cat "$S/jobs/$array/log.$((array + 2))")" || fail "shard 2's log lost a run (open-mode=append)"
-grep -q "requeueing" "$(cat "$S/jobs/$array/log.$((array + 2))")" || fail "shard 2's log does not say it requeued"
+grep -q "attempt 2" "$(cat "$S/jobs/$array/log.$array")" || fail "shard 3's log lost a run (open-mode=append)"
+grep -q "requeueing" "$(cat "$S/jobs/$array/log.$array")" || fail "shard 3's log does not say it requeued"
 
-# afterany: every task has ended, the merge runs and names shard 3/3.
+# afterany: every task has ended, the merge runs, finds shard 2/3 missing and
+# submits it again with a new merge.
 run $merge
 rc=$RC
 mlog="$(cat "$S/jobs/$merge/log.$merge")"
-[ "$rc" = 2 ] || fail "the merge with shard 3 missing exited $rc: $(cat "$mlog")"
-grep -q "run shard 3/3 again" "$mlog" || fail "the merge does not name shard 3/3: $(cat "$mlog")"
+[ "$rc" = 0 ] || fail "the merge with shard 2 missing exited $rc: $(cat "$mlog")"
+grep -q "region_1_0.osgb (shard 2/3)" "$mlog" || fail "vista does not name the region's shard: $(cat "$mlog")"
+grep -q "run shard 2/3 again: vista gen .* -o $W/arr.paged --shard 2/3; then the merge" "$mlog" \
+  || fail "vista does not print the command for shard 2/3: $(cat "$mlog")"
 [ ! -e "$W/arr.paged/index.osgb" ] || fail "a refused merge wrote the index"
-fix="$(grep -o 'VISTA_SHARD_LIST=3 .*slurm-submit.sh .*' "$mlog")" || fail "no command to run shard 3 again: $(cat "$mlog")"
-ok "the merge names shard 3/3 and prints: $fix"
-
-# Recovery, as printed: shard 3 alone, then a new merge.
-eval "$fix" >"$W/submit2.out"
 array2=1200 merge2=1300
-[ "$(opt $array2 array)" = 3 ] || fail "the rerun's array is '$(opt $array2 array)', not 3"
+[ "$(opt $array2 array)" = 2 ] || fail "the merge submitted --array=$(opt $array2 array), not 2: $(cat "$mlog")"
 [ "$(opt $merge2 dependency)" = "afterany:$array2" ] || fail "the new merge waits for '$(opt $merge2 dependency)'"
-run $array2 3
+grep -q "array job $array2 (shards 2 of 3), merge job $merge2" "$mlog" || fail "the merge does not name the new jobs"
+tr '\0' '\n' <"$S/jobs/$array2/env" | grep -qx VISTA_ROUND=1 || fail "the new jobs do not count the round"
+! tr '\0' '\n' <"$S/jobs/$array2/env" | grep -q '^SLURM_' || fail "the merge's SLURM_* variables reached the new jobs"
+grep -qx -- "--partition=debug" "$S/jobs/$array2/argv" || fail "VISTA_SBATCH_OPTS lost in the resubmission"
+ok "the merge submits shard 2/3 again with a new merge (round 1)"
+
+run $array2 2
 rc=$RC
-[ "$rc" = 0 ] || fail "shard 3 rerun exited $rc"
+[ "$rc" = 0 ] || fail "shard 2 rerun exited $rc"
 run $merge2
 rc=$RC
 [ "$rc" = 0 ] || fail "the second merge exited $rc: $(cat "$(cat "$S/jobs/$merge2/log.$merge2")")"
-diff -r "$W/one.paged" "$W/arr.paged" >/dev/null || fail "shards + requeues + merge differ from one run"
-ok "shards, requeues, a rerun and the merge = one run, byte for byte ($(find "$W/arr.paged" -type f | wc -l) files)"
+diff -r "$W/one.paged" "$W/arr.paged" >/dev/null || fail "shards + requeues + a resubmission + merge differ from one run"
+ok "shards, requeues, a resubmission and the merge = one run, byte for byte ($(find "$W/arr.paged" -type f | wc -l) files)"
 
 # Logs: in arr.paged.logs, one per task (appended over its runs) and merge; none in the submit directory.
-ls "$W/arr.paged.logs/shard-${array}_1.log" "$W/arr.paged.logs/shard-${array}_2.log" \
-  "$W/arr.paged.logs/shard-${array2}_3.log" "$W/arr.paged.logs/merge-$merge.log" >/dev/null \
+ls "$W/arr.paged.logs/shard-${array}_1.log" "$W/arr.paged.logs/shard-${array}_3.log" \
+  "$W/arr.paged.logs/shard-${array2}_2.log" "$W/arr.paged.logs/merge-$merge.log" >/dev/null \
   || fail "logs missing from arr.paged.logs: $(ls "$W/arr.paged.logs")"
 [ -z "$(ls -A "$W/submit")" ] || fail "files in the submit directory: $(ls -A "$W/submit")"
 ok "logs in OUT.logs, nothing in the submit directory"
@@ -292,4 +322,29 @@ VISTA="$W/bin/vista-argv" VISTA_SHARD_LIST=2-3 "$JOBS/slurm-submit.sh" bake 4 "$
 [ "$(opt 1500 mem)" = 2248M ] || fail "the bake merge of a 50 MB city asks for --mem=$(opt 1500 mem), not 2048 + 4 x 50 MB"
 [ "$(opt 1400 array)" = 2-3 ] || fail "VISTA_SHARD_LIST=2-3 gave --array=$(opt 1400 array)"
 ok "bake merge sized from the city file (2248M for 50 MB)"
+
+# A merge out of rounds names the shards and the command, submits nothing and
+# exits 2; so does one told VISTA_MAX_ROUNDS=0; bad input (exit 2 without
+# missing shards) is never submitted again.
+cat >"$W/bin/vista-missing" <<'EOF'
+#!/usr/bin/env bash
+echo "vista gen: --merge: 1 of 9 regions of 'x' are missing, corrupt or from other parameters (region_1_0.osgb (shard 2/4)); run shard 2/4 again: vista gen -o x --shard 2/4; then the merge" >&2
+exit 2
+EOF
+printf '#!/usr/bin/env bash\necho "vista gen: option --size: bad" >&2\nexit 2\n' >"$W/bin/vista-bad"
+chmod +x "$W/bin/vista-missing" "$W/bin/vista-bad"
+before=$(cat "$S/next_id")
+for env in "VISTA=$W/bin/vista-missing VISTA_ROUND=2" "VISTA=$W/bin/vista-missing VISTA_MAX_ROUNDS=0" \
+  "VISTA=$W/bin/vista-bad"; do
+  rc=0
+  env $env VISTA_JOB=gen VISTA_SHARDS=4 VISTA_OUT=/x/c.paged VISTA_SUBMIT="$JOBS/slurm-submit.sh" \
+    bash "$JOBS/slurm-merge.sbatch" 2>"$W/rounds.err" || rc=$?
+  [ "$rc" = 2 ] || fail "merge ($env) exited $rc: $(cat "$W/rounds.err")"
+  case "$env" in
+    *missing*) grep -q "VISTA_SHARD_LIST=2 $JOBS/slurm-submit.sh gen 4 /x/c.paged" "$W/rounds.err" \
+      || fail "merge ($env) does not print the command: $(cat "$W/rounds.err")" ;;
+  esac
+done
+[ "$(cat "$S/next_id")" = "$before" ] || fail "a merge out of rounds or given bad input submitted jobs"
+ok "a merge out of rounds or given bad input submits nothing, exits 2 and prints the command"
 echo "PASS"

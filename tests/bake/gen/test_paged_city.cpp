@@ -220,11 +220,19 @@ TEST_F(Paged, MergeRefusesMissingRegions) {
     EXPECT_EQ(named.code, 2);
     EXPECT_NE(named.err.find("run shard 2/2 again"), std::string::npos) << named.err;
     EXPECT_EQ(named.err.find("1/2"), std::string::npos) << "shard 1/2 is done: " << named.err;
+    // Each missing region names its shard, and the refusal gives the command
+    // that runs that shard: the same parameters and output, --shard 2/2.
+    const std::string kCityFlags = "--seed 4 --size 1500 --detail 1 --region-size 500";
+    EXPECT_NE(named.err.find("region_1_0.osgb (shard 2/2)"), std::string::npos) << named.err;
+    EXPECT_NE(named.err.find(": vista gen " + kCityFlags + " -o " + sh + " --shard 2/2; then the merge"),
+              std::string::npos)
+        << named.err;
     // Split in 4, regions 0..8 of the 3 x 3 grid: shard 1/2 wrote 0, 2, 4, 6, 8;
     // 1, 5 are shard 2/4's and 3, 7 shard 4/4's.
     const CliRun four = runVista(kCity + " --merge --shards 4 -o " + sh);
     EXPECT_EQ(four.code, 2);
-    EXPECT_NE(four.err.find("run 2 shards 2/4, 4/4 again"), std::string::npos) << four.err;
+    EXPECT_NE(four.err.find("run 2 shards 2/4, 4/4 again, each with: vista gen "), std::string::npos) << four.err;
+    EXPECT_NE(four.err.find(" --shard K/4; then the merge"), std::string::npos) << four.err;
     expectSameFiles(before, snapshot(sh), "a refused merge changes nothing");
 }
 

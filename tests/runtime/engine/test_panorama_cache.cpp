@@ -99,6 +99,33 @@ TEST(Panorama, AzimuthWrapsAtZeroAndTwoPi) {
     EXPECT_EQ(pc.index(glm::dvec3(NAN, 1, 0)), -1);
 }
 
+// clear() forgets every stored cell and record (what a walkthrough's restart asks).
+TEST(Panorama, ClearForgetsEveryCell) {
+    PanoramaCache pc(1000, 100, 1.0);
+    pc.beginFrame(cam(glm::dvec3(0, 0, 2), 0.3));
+    std::vector<int64_t> cells;
+    std::vector<glm::u8vec2> subs;
+    std::vector<glm::u8vec4> colors;
+    std::vector<float> nears;
+    for (int64_t c = 0; c < 1000 * 100; c += 997) {
+        cells.push_back(c);
+        subs.push_back(glm::u8vec2(10, 200));
+        colors.push_back(glm::u8vec4(1, 2, 3, 255));
+        nears.push_back(50.0f);
+    }
+    pc.store(cells, subs, colors, nears);
+    ASSERT_EQ(pc.record(cells[3]), pc.currentRecord());
+    ASSERT_GT(pc.recordCount(), 1u);
+    pc.clear();
+    EXPECT_EQ(pc.recordCount(), 1u);
+    EXPECT_EQ(pc.currentRecord(), 0u);
+    for (int64_t c = 0; c < 1000 * 100; ++c) {
+        ASSERT_EQ(pc.record(c), 0u) << c;
+        ASSERT_EQ(pc.color(c).w, 0) << c;
+        ASSERT_TRUE(std::isinf(pc.nearDistance(c))) << c;
+    }
+}
+
 TEST(Panorama, ErrorBoundAndBudgetRetraceTheWorstCells) {
     PanoramaCache pc(100, 10, 1.0);
     auto at = [](double x, double heading = 0.0) { return cam(glm::dvec3(x, 0, 1.7), heading); };

@@ -363,6 +363,17 @@ TEST_F(PagedLoad, AStreamedBenchLoadsAndUnloadsAlongThePath) {
     EXPECT_GT(w["unloads"].get<int>(), 0);
     EXPECT_GE(w["bytes_read"].get<uint64_t>(), w["peak_resident_file_bytes"].get<uint64_t>());
     EXPECT_GT(w["frames_with_arrivals"].get<int>(), 0);
+    // Per mode, the frames before which a region arrived against the others: they partition the
+    // mode's frames, and the arrival frames are those paged.stream counts.
+    const auto m = readJson(tmp.file("w1/summary.json"))["modes"]["raycast"];
+    const auto& with = m["frames_with_arrivals"];
+    const auto& without = m["frames_without_arrivals"];
+    EXPECT_EQ(with["frames"].get<int>(), w["frames_with_arrivals"].get<int>());
+    EXPECT_EQ(with["frames"].get<int>() + without["frames"].get<int>(), 12);
+    EXPECT_LE(with["frame_ms_median"].get<double>(), with["frame_ms_max"].get<double>());
+    EXPECT_LE(with["frame_ms_p99"].get<double>(), with["frame_ms_max"].get<double>());
+    EXPECT_LE(m["frame_ms_p99"].get<double>(), m["frame_ms_max"].get<double>());
+    EXPECT_GE(w["advance_ms_max"].get<double>(), w["advance_ms_median"].get<double>());
     // A budget that holds no full region (about 3.6 MB of region files after the fixed 200 MB): the
     // coarse levels near the camera, never more than the budget.
     r = runVista("bench " + dir() +

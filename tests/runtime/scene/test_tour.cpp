@@ -3,6 +3,7 @@
 // drive through a generated city keeps going instead of circling its start.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <deque>
@@ -11,6 +12,7 @@
 
 #include "citygen/params.h"
 #include "citygen/streets.h"
+#include "foundation/units.h"
 #include "runtime/scene/paths.h"
 #include "runtime/scene/tour.h"
 
@@ -158,4 +160,103 @@ TEST(Tour, LongCarDriveKeepsGoing) {
     EXPECT_LT(revisited(tour), 0.5) << "tour revisits " << revisited(tour);
     std::printf("tour: reach %.0f m, revisited %.2f; wander: reach %.0f m, revisited %.2f\n", reach(tour),
                 revisited(tour), reach(wander), revisited(wander));
+}
+
+namespace {
+
+// A street grid of n x n nodes `spacing` metres apart (two-way streets 8 m wide).
+StreetGraph streetGrid(int n, double spacing) {
+    StreetGraph g;
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) g.nodes.push_back({i * spacing, j * spacing});
+    auto add = [&](int a, int b) {
+        StreetEdge e;
+        e.a = uint32_t(a);
+        e.b = uint32_t(b);
+        e.width = 8.0f;
+        g.edges.push_back(e);
+    };
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            if (i + 1 < n) add(j * n + i, j * n + i + 1);
+            if (j + 1 < n) add(j * n + i, (j + 1) * n + i);
+        }
+    return g;
+}
+
+// How often each street edge was driven: a pass is a run of consecutive
+// samples in the middle fifth of the same edge (its nearest edge, the
+// projection between 40 % and 60 % of its length), so that the samples near
+// junctions, nearest to a crossing street, count for neither.
+std::vector<int> edgePasses(const StreetGraph& g, const Path& path) {
+    std::vector<int> passes(g.edges.size(), 0);
+    int last = -1;
+    for (const auto& s : path.samples) {
+        const glm::dvec2 p(s.position);
+        int best = -1;
+        double bestD = 1e300, bestT = 0;
+        for (size_t k = 0; k < g.edges.size(); ++k) {
+            const glm::dvec2 a = g.nodes[g.edges[k].a], b = g.nodes[g.edges[k].b];
+            const double t = std::clamp(glm::dot(p - a, b - a) / glm::dot(b - a, b - a), 0.0, 1.0);
+            const double d = glm::length(p - (a + t * (b - a)));
+            if (d < bestD) bestD = d, best = int(k), bestT = t;
+        }
+        const int mid = bestT >= 0.4 && bestT <= 0.6 ? best : -1;
+        if (mid >= 0 && mid != last) ++passes[size_t(mid)];
+        if (mid >= 0 || bestT < 0.3 || bestT > 0.7) last = mid;
+    }
+    return passes;
+}
+
+}  // namespace
+
+// On a large grid (8 km a side), a long car drive by tour keeps going: it
+// gets far from its start compared with the distance it drives, and drives
+// few street edges twice; the same seed gives the same bytes; the speed and
+// yaw-rate limits hold; the car drives its lanes (LaneRoute, lane positions).
+TEST(Tour, LongDriveOnALargeGridKeepsGoingWithinTheLimits) {
+    const StreetGraph g = streetGrid(41, 200.0);
+    CityParams p;
+    p.size_m = 8000;
+    p.hills_amplitude_m = 0.0;
+    PathOptions o;
+    o.seed = 7;
+    o.kind = PathKind::Car;
+    o.duration = 1200;
+    o.dt = 0.5;
+    o.route = RouteStyle::Tour;
+    auto a = generatePath(g, p, o), b = generatePath(g, p, o);
+    ASSERT_TRUE(a.isOk()) << a.status().message();
+    ASSERT_TRUE(b.isOk());
+    ASSERT_EQ(a->samples.size(), b->samples.size());
+    for (size_t i = 0; i < a->samples.size(); ++i) {
+        ASSERT_EQ(a->samples[i].position, b->samples[i].position) << i;
+        ASSERT_EQ(a->samples[i].heading, b->samples[i].heading) << i;
+    }
+    ASSERT_EQ(a->lanes.size(), a->samples.size()) << "the car does not drive its lanes";
+
+    double driven = 0, reach = 0;
+    const glm::dvec2 start(a->samples[0].position);
+    for (size_t i = 1; i < a->samples.size(); ++i) {
+        const auto &s = a->samples[i], &q = a->samples[i - 1];
+        const double step = glm::length(glm::dvec2(s.position - q.position));
+        EXPECT_LE(step / o.dt, o.maxSpeed + 1e-9) << i;
+        EXPECT_LE(std::abs(std::remainder(s.heading - q.heading, 2 * kPi)), o.maxYawRate * o.dt + 1e-9) << i;
+        driven += step;
+        reach = std::max(reach, glm::length(glm::dvec2(s.position) - start));
+    }
+    const std::vector<int> passes = edgePasses(g, *a);
+    int once = 0, twice = 0;
+    for (int n : passes) once += n >= 1, twice += n >= 2;
+    const double repeated = double(twice) / double(std::max(once, 1));
+    std::printf(
+        "tour on an 8 km grid: %.0f m driven, reach %.0f m (%.2f of the distance), %d edges driven, "
+        "%.3f of them more than once\n",
+        driven, reach, reach / driven, once, repeated);
+    // 20 minutes drive more than 10 km; goals far apart take the car most of
+    // the way across the city.
+    EXPECT_GT(driven, 10000.0);
+    EXPECT_GE(reach, 0.3 * std::min(driven, p.size_m));
+    EXPECT_GT(once, 50);
+    EXPECT_LT(repeated, 0.1);
 }
