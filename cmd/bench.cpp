@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "cmd/options.h"
+#include "cmd/paged_stream.h"
 #include "foundation/timing.h"
 #include "foundation/units.h"
 #include "nodes/render/city_stream.h"
@@ -109,27 +110,13 @@ Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene
     return run;
 }
 
-// The camera's velocity at path sample i (metres per second; from the next
-// sample, or the previous one at the end; zero for a path of one sample).
-glm::dvec3 pathVelocity(const Path& path, size_t i) {
-    const auto& s = path.samples;
-    if (s.size() < 2) return glm::dvec3(0.0);
-    const size_t a = i + 1 < s.size() ? i : i - 1;
-    const double dt = s[a + 1].t - s[a].t;
-    return dt > 0 ? (s[a + 1].position - s[a].position) / dt : glm::dvec3(0.0);
-}
-
 // A streamed city: the ray scene follows the camera of path sample i
 // (arrivals and drops between frames); damaged files are warned about once.
 Status advanceStream(BenchRun& run, const Path& path, size_t i, const Camera& cam, BenchResult& result, int* arrived) {
     *arrived = 0;
     if (!run.stream) return Status::ok();
-    auto f = run.stream->advance(cam.eye, pathVelocity(path, i));
+    auto f = advancePagedStream(*run.stream, "vista bench", cam.eye, pathVelocity(path, i), &result.streamDamaged);
     if (!f) return f.status();
-    for (const std::string& d : f->damaged) {
-        std::fprintf(stderr, "vista bench: warning: %s; the rest of the city streams\n", d.c_str());
-        result.streamDamaged.push_back(d);
-    }
     *arrived = f->arrived;
     // What the modes kept of the old scene (hybrid's panoramic cache) goes.
     if (f->arrived > 0 || f->dropped > 0)

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cmd/options.h"
+#include "cmd/paged_stream.h"
 #include "cmd/plot.h"
 #include "foundation/atomic_file.h"
 #include "foundation/statistics.h"
@@ -69,37 +70,19 @@ std::string framesCsv(const BenchResult& result) {
     return csv.str();
 }
 
-// summary.json paged.stream: the streamed ray scene's reach and the pager's totals.
+// summary.json paged.stream: the block every streamed run writes (paged_stream.h)
+// and the frame thread's splice times between frames.
 json streamJson(const BenchResult& r, const BenchConfig& cfg) {
-    const RegionPagerStats& s = r.stream;
-    const RegionPagerOptions& o = cfg.stream;
+    json j = pagedStreamJson(cfg.stream, r.stream, r.framesWithArrivals, r.streamDamaged);
     // Waiting makes the regions of a frame independent of load timing; a mode whose frames
     // follow measured times (hybrid's adaptive split or cache pauses) still is not.
     const bool timed = std::any_of(cfg.modes.begin(), cfg.modes.end(),
                                    [&](const std::string& m) { return modeFollowsTimings(m, cfg.options); });
-    return {
-        {"radius_m", o.radius},
-        {"far_m", o.far},
-        {"prefetch_s", o.prefetchS},
-        {"wait", o.wait},
-        {"frames_deterministic", o.wait && !timed},
-        {"budget_file_bytes", o.budgetBytes},
-        {"peak_resident_file_bytes", s.peakResidentBytes},
-        {"resident_file_bytes_end", s.residentBytes},
-        {"resident_full_end", s.residentFull},
-        {"resident_coarse_end", s.residentCoarse},
-        {"loads", s.loads},
-        {"unloads", s.unloads},
-        {"discarded", s.discarded},
-        {"bytes_read", s.bytesRead},
-        {"frames_waited", s.framesWaited},
-        {"wait_ms", s.waitMs},
-        {"frames_with_arrivals", r.framesWithArrivals},
-        {"advance_ms_median", num(percentile(r.advanceMs, 0.5))},
-        {"advance_ms_p99", num(percentile(r.advanceMs, 0.99))},
-        {"advance_ms_max", num(r.advanceMs.empty() ? 0.0 : *std::max_element(r.advanceMs.begin(), r.advanceMs.end()))},
-        {"budget_limited_updates", s.budgetLimited},
-        {"damaged", r.streamDamaged}};
+    j["frames_deterministic"] = cfg.stream.wait && !timed;
+    j["advance_ms_median"] = num(percentile(r.advanceMs, 0.5));
+    j["advance_ms_p99"] = num(percentile(r.advanceMs, 0.99));
+    j["advance_ms_max"] = num(r.advanceMs.empty() ? 0.0 : *std::max_element(r.advanceMs.begin(), r.advanceMs.end()));
+    return j;
 }
 
 json pixelClasses(const ModeSummary& s) {

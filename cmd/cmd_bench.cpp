@@ -16,6 +16,7 @@
 #include "cmd/cli.h"
 #include "cmd/commands.h"
 #include "cmd/options.h"
+#include "cmd/paged_stream.h"
 #include "cmd/plot.h"
 #include "foundation/atomic_file.h"
 #include "foundation/timing.h"
@@ -130,11 +131,7 @@ Status configure(BenchArgs& a) {
     VISTA_RETURN_IF_ERROR(validatePagedStream(a.stream));
     if (a.stream.stream && !a.sweep.empty())
         return Status::error("--paged-stream: not with --sweep (the sweep benches city files, not paged cities)");
-    if (a.stream.stream)
-        for (const auto& m : a.cfg.modes)
-            if (!modeStreams(m))
-                return Status::error("--paged-stream: mode " + m +
-                                     " does not stream a paged city (modes that do: " + streamingModeNames() + ")");
+    if (a.stream.stream) VISTA_RETURN_IF_ERROR(checkStreamingModes(a.cfg.modes));
     if (a.sweep.empty()) {
         if (a.city.empty()) return Status::error("missing the city file argument (or use --sweep)");
         if (!fs::exists(a.city)) return Status::error("city file '" + a.city + "' does not exist");
@@ -212,21 +209,11 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
         if (!walk->manifest)
             return reportBadInput(kCmd, Status::error("--paged-stream: '" + cityFile +
                                                       "' is a city file; streaming needs a paged city (DIR.paged)"));
-        auto budget = streamBudgetFileBytes("--memory-budget", cfg.memoryBudgetGb, cfg.memoryEstimateMb, rays);
-        if (!budget) return reportBadInput(kCmd, budget.status());
+        auto so = pagedStreamOptions(a.paged, a.stream, cfg.memoryBudgetGb, cfg.memoryEstimateMb, rays);
+        if (!so) return reportBadInput(kCmd, so.status());
         cfg.streamManifest = walk->manifest.get();
-        cfg.stream.radius = a.paged.radius;
-        cfg.stream.far = a.paged.far;
-        cfg.stream.prefetchS = a.stream.prefetchS.value_or(kDefaultPagedPrefetchS);
-        cfg.stream.wait = a.stream.wait;
-        cfg.stream.budgetBytes = *budget;
-        if (!a.quiet)
-            std::fprintf(stderr,
-                         "%s: paged city: streaming its %d regions around the camera (full detail within %g m, coarse "
-                         "within %g m, %g s ahead%s%s)\n",
-                         kCmd, walk->manifest->nonEmpty(), cfg.stream.radius, cfg.stream.far, cfg.stream.prefetchS,
-                         cfg.stream.wait ? ", every frame waits for its regions" : "",
-                         cfg.stream.budgetBytes ? ", within the memory budget" : "");
+        cfg.stream = *so;
+        if (!a.quiet) notePagedStream(kCmd, *walk->manifest, cfg.stream);
     }
     cfg.runUpS = a.path.file.empty() ? a.pathOptions.runUp : -1.0;
     cfg.outDir = outDir;

@@ -15,6 +15,15 @@
 // missing one without writing them, so that its panoramic cache holds what
 // an uninterrupted run's held); "<out>.partial/out" is renamed to <out> when
 // every frame is written.
+//
+// A paged city (DIR.paged) is either loaded around the whole path before the
+// first frame (--paged-radius, --paged-far) or streamed (--paged-stream, as
+// in `vista bench`: cmd/paged_stream.h): the mode's graph, its ray scene and
+// the label pass's twin follow the camera, loaded on a worker thread; with
+// --paged-wait every frame waits for the regions within reach of its camera,
+// so its files are those of a preloaded run of the same regions. Instance ids
+// of a paged city are numbered per region (docs/formats.md "Paged city"): the
+// instance channel is not written for one.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -35,7 +44,9 @@
 #include "foundation/format.h"
 #include "cmd/cli.h"
 #include "cmd/commands.h"
+#include "cmd/memory.h"
 #include "cmd/options.h"
+#include "cmd/paged_stream.h"
 #include "cmd/render_rig.h"
 #include "cmd/render_shared.h"
 #include "cmd/render_work_dir.h"
@@ -45,10 +56,12 @@
 #include "foundation/statistics.h"
 #include "foundation/timing.h"
 #include "foundation/units.h"
+#include "nodes/render/city_stream.h"
 #include "nodes/render/offscreen.h"
 #include "runtime/engine/ground_truth.h"
 #include "runtime/engine/ray_scene.h"
 #include "nodes/render/walkthrough.h"
+#include "runtime/scene/paged_load.h"
 #include "runtime/scene/scene_graph.h"
 
 namespace vista {
@@ -68,10 +81,12 @@ struct RenderArgs {
     std::string city, size = "640x480", mode = "full", out, channels = "rgb,depth,semantic,instance";
     std::string sampling = "spread", rig;
     int frames = 60;
-    double fov = 60;
-    bool stats = false, quiet = false, restart = false;
+    double fov = 60, memoryBudgetGb = 0;
+    bool stats = false, quiet = false, restart = false, channelsGiven = false;
     PathFlags path;
     ModeFlags modeFlags;
+    PagedReach paged;
+    PagedStreamFlags stream;
 };
 
 Result<unsigned> parseChannels(const std::string& s) {
@@ -148,8 +163,45 @@ struct RenderPlan {
     int sampleRuns = 0;
     ModeOptions options;
     PathOptions path;
+    bool paged = false;         // the city is a paged city directory
+    bool streamed = false;      // --paged-stream (or --paged-wait)
+    bool rays = false;          // the mode casts rays (the memory estimate's ray scene)
+    double estimateMb = 0;      // the memory estimate before the first frame
+    RegionPagerOptions stream;  // with --paged-stream
     bool labels() const { return (channels & kLabelChannels) != 0; }
 };
+
+// The paged-city options: streaming only for a paged city and a mode that
+// streams; no instance channel (ids are numbered per region), which the
+// default channels then leave out.
+Status configurePaged(const RenderArgs& a, RenderPlan& p) {
+    VISTA_RETURN_IF_ERROR(validatePagedReach(a.paged));
+    PagedStreamFlags stream = a.stream;
+    VISTA_RETURN_IF_ERROR(validatePagedStream(stream));
+    p.paged = isPagedCityPath(a.city);
+    p.streamed = stream.stream;
+    if (stream.stream && !p.paged)
+        return Status::error("--paged-stream: '" + a.city +
+                             "' is a city file; streaming needs a paged city (DIR.paged from `vista gen`)");
+    if (stream.stream) VISTA_RETURN_IF_ERROR(checkStreamingModes({a.mode}));
+    // Over a streamed city the label pass draws the stream's label twin of the
+    // whole city; far-field ray labels would need the regions' models.
+    if (stream.stream && (p.channels & kLabelChannels) && a.mode != "full")
+        return Status::error(
+            "--paged-stream: the depth, semantic and instance channels of a streamed city come from "
+            "mode full (the far field of mode " +
+            a.mode + " is labelled from the whole loaded city); give --channels rgb or --mode full");
+    if (!p.paged || !(p.channels & kInstance)) return Status::ok();
+    if (a.channelsGiven)
+        return Status::error(
+            "--channels: instance is not available for a paged city: its instance ids are numbered "
+            "per region (give rgb, depth, semantic)");
+    p.channels &= ~unsigned(kInstance);
+    if (!a.quiet)
+        std::fprintf(stderr, "%s: paged city: channels rgb, depth, semantic (instance ids are numbered per region)\n",
+                     kCmd);
+    return Status::ok();
+}
 
 // Every option checked before anything is loaded; errors name the flag.
 Status configure(const RenderArgs& a, RenderPlan& p) {
@@ -174,7 +226,15 @@ Status configure(const RenderArgs& a, RenderPlan& p) {
     if (!po) return po.status();
     p.path = *po;
     if (!fs::exists(a.city)) return Status::error("city file '" + a.city + "' does not exist");
-    return checkRunFiles(CommandFiles().output("--out", a.out), a.city, a.path, a.modeFlags);
+    VISTA_RETURN_IF_ERROR(configurePaged(a, p));
+    p.rays = findRenderMode(a.mode)->needsRays;
+    VISTA_RETURN_IF_ERROR(checkRunFiles(CommandFiles().output("--out", a.out), a.city, a.path, a.modeFlags));
+    if (p.paged) return Status::ok();  // estimated on the selected regions' bytes (loadCityAndFrames)
+    std::error_code ec;
+    const uint64_t bytes = fs::file_size(a.city, ec);
+    if (ec) return Status::ok();
+    p.estimateMb = estimateCityRunMb(bytes, p.rays);
+    return checkMemoryBudget("--memory-budget", a.memoryBudgetGb, p.estimateMb, bytes, p.rays);
 }
 
 // The city (labelled when a label channel needs it), the walkthrough and the
@@ -184,7 +244,32 @@ Result<Walkthrough> loadCityAndFrames(const RenderArgs& a, RenderPlan& p, std::v
     WalkthroughRequest req = renderRequest(a.city, a.path.file, p.path, a.frames, p.sampleRuns, labelsFor, idx);
     req.bakedModes = {a.mode};
     req.effects = [](const Effects& declared) { return runTimeEffects(std::nullopt, declared, true, kCmd); };
-    return loadWalkthrough(req, p.options);
+    if (p.paged) {
+        // The regions' files carry the labels; the merged model (or the
+        // streamed stub) is unlabelled by construction (paged_load.h).
+        req.allowPaged = true;
+        req.quiet = a.quiet;
+        req.paged = a.paged;
+        req.streamPaged = p.streamed;
+        req.checkCity = nullptr;
+        req.beforePagedLoad = [&a, &p](uint64_t bytes) {
+            p.estimateMb = estimateCityRunMb(bytes, p.rays);
+            return checkMemoryBudget("--memory-budget", a.memoryBudgetGb, p.estimateMb, bytes, p.rays);
+        };
+    }
+    auto w = loadWalkthrough(req, p.options);
+    if (!w || !p.streamed) return w;
+    auto so = pagedStreamOptions(a.paged, a.stream, a.memoryBudgetGb, p.estimateMb, p.rays);
+    if (!so) return so.status();
+    p.stream = *so;
+    if (!a.quiet) notePagedStream(kCmd, *w->manifest, p.stream);
+    return w;
+}
+
+// The content hash of the city: its file's bytes, or for a paged city its
+// manifest's (which holds every region file's size and content hash).
+Result<std::string> cityHash(const std::string& city, bool paged, uint64_t& bytes) {
+    return fileHash(paged ? (fs::path(city) / "manifest.json").string() : city, bytes);
 }
 
 // The work directory: new, or the one of an interrupted run with the same
@@ -193,25 +278,35 @@ Result<Walkthrough> loadCityAndFrames(const RenderArgs& a, RenderPlan& p, std::v
 Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, const std::vector<size_t>& idx,
                    RenderWorkDir& out) {
     uint64_t cityBytes = 0;
-    auto cityHash = fileHash(a.city, cityBytes);
-    if (!cityHash) return cityHash.status();
+    auto hash = cityHash(a.city, p.paged, cityBytes);
+    if (!hash) return hash.status();
     const ModeOptions& mo = p.options;
-    const nlohmann::json manifest = {{"city_hash", *cityHash},
-                                     {"city_bytes", cityBytes},
-                                     {"frames", idx.size()},
-                                     {"camera_poses_hash", posesHash(path, idx)},
-                                     {"size", std::to_string(p.size.width) + "x" + std::to_string(p.size.height)},
-                                     {"fov_deg", manifestNumber(p.fovDeg)},
-                                     {"mode", a.mode},
-                                     {"channels", channelList(p.channels)},
-                                     {"near", manifestNumber(mo.nearDistance)},
-                                     {"triangle_budget", mo.triangleBudget},
-                                     {"pixel_budget", mo.pixelBudget},
-                                     {"horizon_grid", mo.horizonGrid},
-                                     {"cache", mo.cache},
-                                     {"cache_error_px", manifestNumber(mo.cacheErrorPx)},
-                                     {"frame_ms", manifestNumber(mo.frameMsTarget)},
-                                     {"far_step", mo.farStep}};
+    nlohmann::json manifest = {{"city_hash", *hash},
+                               {"city_bytes", cityBytes},
+                               {"frames", idx.size()},
+                               {"camera_poses_hash", posesHash(path, idx)},
+                               {"size", std::to_string(p.size.width) + "x" + std::to_string(p.size.height)},
+                               {"fov_deg", manifestNumber(p.fovDeg)},
+                               {"mode", a.mode},
+                               {"channels", channelList(p.channels)},
+                               {"near", manifestNumber(mo.nearDistance)},
+                               {"triangle_budget", mo.triangleBudget},
+                               {"pixel_budget", mo.pixelBudget},
+                               {"horizon_grid", mo.horizonGrid},
+                               {"cache", mo.cache},
+                               {"cache_error_px", manifestNumber(mo.cacheErrorPx)},
+                               {"frame_ms", manifestNumber(mo.frameMsTarget)},
+                               {"far_step", mo.farStep}};
+    if (p.paged) {
+        // What decides the regions a frame sees.
+        const bool streamed = p.streamed;
+        manifest["paged"] = {{"radius", manifestNumber(a.paged.radius)},
+                             {"far", manifestNumber(a.paged.far)},
+                             {"stream", streamed},
+                             {"wait", streamed && p.stream.wait},
+                             {"prefetch", manifestNumber(streamed ? p.stream.prefetchS : 0.0)},
+                             {"budget_file_bytes", streamed ? p.stream.budgetBytes : 0}};
+    }
     VISTA_RETURN_IF_ERROR(out.open(manifest, a.restart));
     for (const auto& [bit, dir] : kChannelDirs)
         if (p.channels & bit) VISTA_RETURN_IF_ERROR(out.subdir(dir));
@@ -219,27 +314,44 @@ Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, c
 }
 
 // What the frames are drawn with: the renderer, the ray scene (when the
-// mode or the effects cast rays), the mode, and the root of the label pass.
-// Members are destroyed in reverse order: the mode before its context.
+// mode or the effects cast rays) or the stream of a paged city (its graph,
+// ray scene and label twin), the mode, the root of the label pass, and what
+// the frames saw of the stream. Members are destroyed in reverse order: the
+// mode before its context and the stream.
 struct RenderSession {
     std::unique_ptr<OffscreenRenderer> renderer;
     std::unique_ptr<RayScene> rays;
+    std::unique_ptr<CityStream> stream;  // streamed: the mode's graph, rays and label twin
     ModeContext ctx;
     std::unique_ptr<RenderMode> mode;
     osg::ref_ptr<osg::Group> labelRoot = new osg::Group;
+    int framesWithArrivals = 0;        // streamed: frames before which region levels arrived
+    std::vector<std::string> damaged;  // streamed: region files that failed to load
+    RayScene* activeRays() { return stream ? stream->rays() : rays.get(); }
 };
 
-Status setUp(const std::string& modeName, const RenderPlan& p, const SceneModel& city, RenderSession& s) {
+Status setUp(const std::string& modeName, const RenderPlan& p, const Walkthrough& w, RenderSession& s) {
     auto renderer = OffscreenRenderer::create(p.size.width, p.size.height);
     if (!renderer) return renderer.status();
     s.renderer = std::move(*renderer);
-    s.ctx.city = &city;
-    s.ctx.scene = sceneRoot(city);
+    s.ctx.city = &w.city;
+    s.ctx.scene = sceneRoot(w.city);
     s.ctx.renderer = s.renderer.get();
     s.ctx.options = p.options;
     s.ctx.labels = p.labels();
-    if (findRenderMode(modeName)->needsRays || effectsNeedRays(p.options.effects)) {
-        auto r = RayScene::build(city);
+    const bool rays = findRenderMode(modeName)->needsRays || effectsNeedRays(p.options.effects);
+    if (p.streamed) {
+        auto st = CityStream::create(*w.manifest, p.stream, rays, {}, p.labels());
+        if (!st) return Status::error("setting up the streamed city failed: " + st.status().message());
+        s.stream = std::move(*st);
+        // hybrid: the stream keeps the near field, its split index and the horizon grid too.
+        if (rays && modeStreamsNearField(modeName)) s.stream->enableNearField(p.options.horizonGrid);
+        s.ctx.stream = s.stream.get();
+        s.ctx.streamedCity = s.stream->graph();
+        s.ctx.scene = s.stream->graph();
+        s.ctx.rays = s.stream->rays();
+    } else if (rays) {
+        auto r = RayScene::build(w.city);
         if (!r) return Status::error("building the Embree ray scene failed: " + r.status().message());
         s.rays = std::move(r.value());
         s.ctx.rays = s.rays.get();
@@ -247,8 +359,19 @@ Status setUp(const std::string& modeName, const RenderPlan& p, const SceneModel&
     auto mode = createRenderMode(modeName, s.ctx);
     if (!mode) return mode.status();
     s.mode = std::move(*mode);
-    const NearFieldScene& nf = s.ctx.nearField();
-    if (p.labels()) s.labelRoot->setStateSet(nf.labelRootState.get());
+    if (p.labels() && !p.streamed) s.labelRoot->setStateSet(s.ctx.nearField().labelRootState.get());
+    return Status::ok();
+}
+
+// A streamed city follows the camera of path sample i (the first frame, and
+// every frame with --paged-wait, waits for the regions within its reach).
+Status advanceStream(RenderSession& s, const Path& path, size_t i, const Camera& cam, bool first) {
+    if (!s.stream) return Status::ok();
+    auto f = advancePagedStream(*s.stream, kCmd, cam.eye, pathVelocity(path, i), &s.damaged, first);
+    if (!f) return f.status();
+    s.framesWithArrivals += f->arrived > 0 ? 1 : 0;
+    // A mode that caches what it traced (hybrid's panoramic cache) drops it when regions change.
+    if ((f->arrived > 0 || f->dropped > 0) && s.mode) s.mode->sceneChanged();
     return Status::ok();
 }
 
@@ -305,17 +428,30 @@ Status frameLabels(const std::string& modeName, const Camera& cam, int threads, 
                    Timings& tm) {
     const RasterSelection* sel = s.mode->lastRaster();
     if (!sel) return Status::error("mode " + modeName + " reports no raster selection");
-    const NearFieldScene& nf = s.ctx.nearField();
-    s.labelRoot->removeChildren(0, s.labelRoot->getNumChildren());
-    for (uint32_t i : sel->chunks)
-        if (i < nf.labelChunks.size()) s.labelRoot->addChild(nf.labelChunks[i].get());
+    osg::Group* labelScene = s.labelRoot.get();
+    const bool castUncovered = modeName == "hybrid";
+    if (s.stream) {
+        // The stream's label twin holds every chunk of the streamed graph; the
+        // ray-cast labels of a far field need the regions' models, which a
+        // streamed ray scene does not keep.
+        if (!sel->wholeCity || castUncovered || sel->nearDistance < 1e299)
+            return Status::error("mode " + modeName +
+                                 ": ground-truth labels of a streamed city need a mode that rasterises the whole "
+                                 "city (full); use --channels rgb");
+        labelScene = s.stream->labelGraph();
+    } else {
+        const NearFieldScene& nf = s.ctx.nearField();
+        s.labelRoot->removeChildren(0, s.labelRoot->getNumChildren());
+        for (uint32_t i : sel->chunks)
+            if (i < nf.labelChunks.size()) s.labelRoot->addChild(nf.labelChunks[i].get());
+    }
     FrameStats ls;
-    VISTA_RETURN_IF_ERROR(s.renderer->renderLabels(s.labelRoot.get(), cam, sel->zFar, b.raster, ls));
+    VISTA_RETURN_IF_ERROR(s.renderer->renderLabels(labelScene, cam, sel->zFar, b.raster, ls));
     tm.labelRaster.push_back(ls.frameMs);
     Stopwatch sw;
     const RasterLabels raster{b.raster.ids.data(), b.raster.classes.data(), b.raster.depth.data()};
     const size_t cast =
-        mergeLabels(*s.ctx.city, s.ctx.rays, cam, raster, sel->nearDistance, modeName == "hybrid", b.gt, threads);
+        mergeLabels(*s.ctx.city, s.ctx.rays, cam, raster, sel->nearDistance, castUncovered, b.gt, threads);
     tm.labelRays.push_back(sw.ms());
     tm.farPixels.push_back(double(cast));
     tm.labels.push_back(tm.labelRaster.back() + tm.labelRays.back());
@@ -365,6 +501,7 @@ Status renderFrames(const RenderArgs& a, const RenderPlan& p, const Walkthrough&
     const Camera base = baseCamera(p);
     const glm::dvec3 offset(w.city.params.origin_x, w.city.params.origin_y, 0.0);
     FrameBuffers b;
+    bool streamStarted = false;
     for (size_t f = 0; f < idx.size(); ++f) {
         const Camera cam = w.path.camera(idx[f], base);
         const PathSample& ps = w.path.samples[idx[f]];
@@ -379,8 +516,10 @@ Status renderFrames(const RenderArgs& a, const RenderPlan& p, const Walkthrough&
         const bool finished = !done.records[f].is_null();
         if (finished && !(stateful && long(f) < done.lastMissing)) continue;
         FrameStats st;
+        VISTA_RETURN_IF_ERROR(advanceStream(s, w.path, idx[f], cam, !streamStarted));
+        streamStarted = true;
         // Ray origins near the scene's frame origin: float precision anywhere in the city.
-        if (s.rays) VISTA_RETURN_IF_ERROR(s.rays->placeFrameNear(cam.eye));
+        if (RayScene* rays = s.activeRays()) VISTA_RETURN_IF_ERROR(rays->placeFrameNear(cam.eye));
         if (Status e = s.mode->renderFrame(cam, b.img, st); !e)
             return Status::error("frame " + std::to_string(f) + ": " + e.message());
         if (finished) {  // hybrid warm-up: the state, not the image
@@ -404,7 +543,7 @@ Status renderFrames(const RenderArgs& a, const RenderPlan& p, const Walkthrough&
 // renamed to the output.
 Status writeMetadata(const RenderArgs& a, const RenderPlan& p, const std::string& command, const SceneModel& city,
                      const std::vector<size_t>& idx, const nlohmann::json& frames, const Timings& tm, size_t kept,
-                     const OffscreenRenderer& renderer, RenderWorkDir& out) {
+                     const nlohmann::json& paged, const OffscreenRenderer& renderer, RenderWorkDir& out) {
     const Camera base = baseCamera(p);
     const glm::dvec3 offset(city.params.origin_x, city.params.origin_y, 0.0);
     const double fy = 0.5 * base.height / std::tan(0.5 * base.fovY);
@@ -424,13 +563,13 @@ Status writeMetadata(const RenderArgs& a, const RenderPlan& p, const std::string
         {"world_offset", {offset.x, offset.y, offset.z}},
         {"depth", "float32 metres along the optical axis (camera z), +inf = sky"},
         {"frames", frames}};
-    const nlohmann::json summary = {
+    nlohmann::json summary = {
         {"command", command},
         {"mode", a.mode},
         {"frames", idx.size()},
         {"width", base.width},
         {"height", base.height},
-        {"channels", a.channels},
+        {"channels", channelList(p.channels)},
         {"gl_renderer", renderer.glRenderer()},
         {"median_ms",
          {{"rgb", medianOf(tm.rgb)},
@@ -447,6 +586,7 @@ Status writeMetadata(const RenderArgs& a, const RenderPlan& p, const std::string
          "depth, semantic and instance come from one label pass (+ far-field rays in hybrid): their cost is "
          "labels_total, shared; write_* is encoding and writing the files; medians over every frame, each timed "
          "by the run that rendered it (frames_resumed: frames an interrupted run had finished)"}};
+    if (!paged.is_null()) summary["paged"] = paged;
     for (const auto& [file, j] :
          {std::pair<const char*, const nlohmann::json*>{"cameras.json", &cameras}, {"summary.json", &summary}}) {
         VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(file), j->dump(2) + "\n"));
@@ -488,13 +628,20 @@ int run(const RenderArgs& a, const std::string& command) {
     if (Status s = openWorkDir(a, plan, walk->path, idx, out); !s) return reportBadInput(kCmd, s);
 
     RenderSession session;
-    if (Status s = setUp(a.mode, plan, walk->city, session); !s) return reportBadInput(kCmd, s);
+    if (Status s = setUp(a.mode, plan, *walk, session); !s) return reportBadInput(kCmd, s);
     Progressed done = finishedFrames(out, plan.channels, idx.size());
     nlohmann::json frames = nlohmann::json::array();
     if (Status s = renderFrames(a, plan, *walk, idx, session, out, done, frames); !s) return reportBadInput(kCmd, s);
     Timings tm;  // every frame's, whichever run rendered it
     for (const auto& r : done.records) tm.add(r);
-    if (Status s = writeMetadata(a, plan, command, walk->city, idx, frames, tm, done.kept, *session.renderer, out); !s)
+    nlohmann::json paged;  // summary.json paged: the regions loaded, or the stream's totals
+    if (!walk->pagedJson.empty()) paged = nlohmann::json::parse(walk->pagedJson);
+    if (session.stream)
+        paged["stream"] =
+            pagedStreamJson(plan.stream, session.stream->stats(), session.framesWithArrivals, session.damaged);
+    if (Status s =
+            writeMetadata(a, plan, command, walk->city, idx, frames, tm, done.kept, paged, *session.renderer, out);
+        !s)
         return reportBadInput(kCmd, s);
     printResult(a, plan, idx.size(), tm, out);
     return 0;
@@ -508,8 +655,19 @@ int runRender(int argc, char** argv) {
         "cameras.json and classes.json (docs/formats.md).",
         kCmd};
     RenderArgs a;
-    app.add_option("city", a.city, "city scene file (.osgb) from `vista gen`")->required();
+    app.add_option("city", a.city,
+                   "city scene file (.osgb) from `vista gen`, or a paged city directory (DIR.paged: the regions "
+                   "within --paged-radius of the path, or streamed with --paged-stream; channels rgb, depth, "
+                   "semantic)")
+        ->required();
     addPathFlags(app, a.path, true);
+    addPagedFlags(app, a.paged);
+    addPagedStreamFlags(app, a.stream);
+    addNumberOption(
+        app, "--memory-budget", a.memoryBudgetGb, kMemoryBudgetGbRange,
+        "GB, (0, 65536]: refuse up front a run whose estimated peak memory (from the city file's size, or the paged "
+        "regions' bytes) exceeds it; with --paged-stream the streamed regions are held within it (default: no "
+        "budget)");
     addNumberOption(app, "--frames", a.frames, 1, 1000000, "frames rendered, 1 .. 1000000 (default 60)");
     app.add_option("--sampling", a.sampling,
                    "which path samples are the frames: spread (default), consecutive or runs:K");
@@ -535,6 +693,7 @@ int runRender(int argc, char** argv) {
                  "stderr; also in OUT/summary.json)");
     app.add_flag("-q,--quiet", a.quiet, "no progress on stderr");
     if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;
+    a.channelsGiven = app.count("--channels") > 0;
     std::string command = kCmd;
     for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
     if (!a.rig.empty()) {
@@ -543,6 +702,15 @@ int runRender(int argc, char** argv) {
                 return reportBadInput(
                     kCmd, Status::error(std::string(flag) + " does not apply with --rig: the rig file gives each "
                                                             "sensor's model, size and channels"));
+        // A rig casts every sensor into one ray scene of the loaded city, its
+        // labels from the city's models: it takes a city file, not a paged city.
+        for (const char* flag :
+             {"--paged-stream", "--paged-wait", "--paged-prefetch", "--paged-radius", "--paged-far", "--memory-budget"})
+            if (app.count(flag))
+                return reportBadInput(
+                    kCmd, Status::error(std::string(flag) + " does not apply with --rig: a rig renders a city file, "
+                                                            "not a paged city (its sensors' labels come from the "
+                                                            "whole loaded city)"));
         RigRunRequest r;
         r.city = a.city, r.rig = a.rig, r.out = a.out, r.command = command, r.sampling = a.sampling;
         r.frames = a.frames, r.stats = a.stats, r.quiet = a.quiet, r.restart = a.restart;

@@ -6,6 +6,19 @@
 // notes), screenshots (key p, or --screenshot with --frames for headless
 // use). --step shows exactly the bench's frames of the path (the camera of
 // `vista bench --frames N`), so view and bench can be compared image to image.
+//
+// A paged city (DIR.paged) is loaded around the path before the first frame,
+// or streamed (--paged-stream): the viewer's graph and ray scene follow the
+// camera through the same CityStream as `vista bench` and `vista render`
+// (cmd/paged_stream.h). Between viewer frames, on the frame thread, the
+// stream is advanced to the camera with its velocity (the path's at --step,
+// else measured from the camera's motion), so regions ahead of the heading
+// load first; the loads run on the pager's worker and a frame never waits
+// for them (--paged-wait: every frame does), except the first, which waits
+// for the regions around the start. A region keeps its coarse level until
+// its full level has arrived (without a budget that forbids both). At exit a
+// line on stderr gives the stream's totals and the frames that drew a region
+// within --paged-radius of the eye below full detail.
 #include <filesystem>
 #include <cstdio>
 #include <cstdlib>
@@ -34,13 +47,16 @@
 #include "cmd/memory.h"
 #include "cmd/commands.h"
 #include "cmd/options.h"
+#include "cmd/paged_stream.h"
 #include "foundation/timing.h"
 #include "foundation/units.h"
 #include "nodes/far_field_node.h"
 #include "nodes/gl_readback.h"
+#include "nodes/render/city_stream.h"
 #include "nodes/render/offscreen.h"
 #include "nodes/render/walkthrough.h"
 #include "runtime/engine/ray_scene.h"
+#include "runtime/scene/paged_load.h"
 #include "runtime/scene/scene_graph.h"
 
 namespace vista {
@@ -63,6 +79,7 @@ struct ViewArgs {
     ImageSize window;
     double fovDeg = 60.0, memoryBudgetGb = 0;
     PagedReach paged;
+    PagedStreamFlags stream;
 };
 
 void declareFlags(CLI::App& app, ViewArgs& a) {
@@ -74,6 +91,7 @@ void declareFlags(CLI::App& app, ViewArgs& a) {
         ->required();
     addPathFlags(app, a.path, true);
     addPagedFlags(app, a.paged);
+    addPagedStreamFlags(app, a.stream);
     app.get_option("--seed")->description(
         "play back the path of this seed (key 5); default 0 = none, start where seed 1's path starts");
     app.add_option("--size", a.size, "window size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 1280x720)");
@@ -93,7 +111,8 @@ void declareFlags(CLI::App& app, ViewArgs& a) {
     addNumberOption(
         app, "--memory-budget", a.memoryBudgetGb, kMemoryBudgetGbRange,
         "GB, (0, 65536]: refuse up front when the estimated peak memory (from the city file's size, with the ray scene "
-        "every mode may need) exceeds it (default: no budget)");
+        "every mode may need) exceeds it; with --paged-stream the streamed regions are held within it (default: no "
+        "budget)");
     app.add_option("--effects", a.effects,
                    "run-time effects instead of the scene's: 'none', names (haze, glass, night) or a JSON object; "
                    "keys y / g / n toggle haze, glass reflections and the night sky");
@@ -114,6 +133,19 @@ Status configure(ViewArgs& a, ModeOptions& options) {
         checkRunFiles(CommandFiles().output("--screenshot", a.screenshot), a.city, a.path, a.modeFlags));
     if (!a.screenshot.empty()) VISTA_RETURN_IF_ERROR(checkWritablePath("--screenshot", a.screenshot));
     VISTA_RETURN_IF_ERROR(validatePagedReach(a.paged));
+    VISTA_RETURN_IF_ERROR(validatePagedStream(a.stream));
+    if (a.stream.stream) {
+        if (!isPagedCityPath(a.city))
+            return Status::error("--paged-stream: '" + a.city +
+                                 "' is a city file; streaming needs a paged city (DIR.paged from `vista gen`)");
+        VISTA_RETURN_IF_ERROR(checkStreamingModes({a.mode}));
+        // The viewer's hybrid graph (near/far split node and far-field node) is built once from
+        // a loaded near field; the streamed near field follows the bench's and render's frames only.
+        if (modeStreamsNearField(a.mode))
+            return Status::error("--paged-stream: mode " + a.mode +
+                                 " streams in `vista bench` and `vista render`, not in the viewer (here: full, near "
+                                 "or raycast)");
+    }
     return parseModeFlags(a.modeFlags, options);
 }
 
@@ -121,7 +153,8 @@ Status configure(ViewArgs& a, ModeOptions& options) {
 // scene too, when the mode needs one).
 class ViewModes {
 public:
-    explicit ViewModes(ModeContext& ctx) : _ctx(ctx) {}
+    // stream: a streamed paged city (its graph and ray scene are in ctx), or null.
+    ViewModes(ModeContext& ctx, CityStream* stream) : _ctx(ctx), _stream(stream) {}
     Result<RenderMode*> get(const std::string& name) {
         auto it = _modes.find(name);
         if (it != _modes.end()) return it->second.get();
@@ -137,8 +170,9 @@ public:
     // Moves the ray scene's frame next to the eye (RayScene::placeFrameNear),
     // between frames, when no ray is in flight.
     void placeFrameNear(const glm::dvec3& eye) {
-        if (!_rays) return;
-        if (Status st = _rays->placeFrameNear(eye); !st) std::fprintf(stderr, "%s: %s\n", kCmd, st.message().c_str());
+        RayScene* rays = _stream ? _stream->rays() : _rays.get();
+        if (!rays) return;
+        if (Status st = rays->placeFrameNear(eye); !st) std::fprintf(stderr, "%s: %s\n", kCmd, st.message().c_str());
     }
     // The mode after `current` that can be created (stays on `current` if none).
     std::string next(const std::string& current) {
@@ -157,6 +191,7 @@ public:
 private:
     Status buildRays() {
         if (_ctx.rays) return Status::ok();
+        if (_stream) return Status::error("the streamed city has no ray scene (start in a mode that casts rays)");
         if (!_raysError.empty()) return Status::error(_raysError);
         if (!_ctx.city) return Status::error("no city for the ray scene");
         auto r = RayScene::build(*_ctx.city);
@@ -169,6 +204,7 @@ private:
         return Status::ok();
     }
     ModeContext& _ctx;
+    CityStream* _stream = nullptr;
     std::unique_ptr<RayScene> _rays;  // before _modes: destroyed after them
     std::string _raysError;
     std::map<std::string, std::unique_ptr<RenderMode>> _modes;
@@ -340,6 +376,59 @@ Result<Path> viewPath(const ViewArgs& a, const SceneModel& city, bool& playback)
     return p;
 }
 
+// Speeds above this (m/s) are a jump of the camera (home, a manipulator
+// switch), not motion: the measured velocity is clamped to it.
+constexpr double kMaxViewSpeed = 100.0;
+
+// A streamed paged city in the viewer: the stream, the camera's measured
+// velocity and the totals printed at exit.
+struct ViewStream {
+    std::unique_ptr<CityStream> stream;
+    const PagedManifest* manifest = nullptr;
+    RegionPagerOptions options;
+    bool started = false;
+    glm::dvec3 lastEye{0.0}, velocity{0.0};
+    int frames = 0, framesWithArrivals = 0, framesShort = 0;
+    std::vector<std::string> damaged;
+
+    // Between frames: the stream follows the camera at `eye`, moving at
+    // `pathVelocity` (--step) or at the velocity measured over `dtS`
+    // seconds since the last frame. The first call waits for the regions
+    // around the camera. Counts the frames that will draw a region within the
+    // radius of the eye below full detail.
+    Status advance(const glm::dvec3& eye, const glm::dvec3* pathVelocity, double dtS) {
+        if (pathVelocity) {
+            velocity = *pathVelocity;
+        } else if (started && dtS > 0) {
+            velocity = 0.5 * velocity + 0.5 * (eye - lastEye) / dtS;
+            const double speed = glm::length(velocity);
+            if (speed > kMaxViewSpeed) velocity *= kMaxViewSpeed / speed;
+        }
+        auto f = advancePagedStream(*stream, kCmd, eye, velocity, &damaged, !started);
+        if (!f) return f.status();
+        started = true;
+        lastEye = eye;
+        ++frames;
+        framesWithArrivals += f->arrived > 0 ? 1 : 0;
+        const std::vector<uint8_t> held = stream->held();
+        for (int r : selectPagedRegions(*manifest, {glm::dvec2(eye)}, options.radius))
+            if (held[size_t(r)] != 2) {
+                ++framesShort;
+                break;
+            }
+        return Status::ok();
+    }
+    void report() const {
+        const RegionPagerStats st = stream->stats();
+        std::fprintf(stderr,
+                     "%s: paged stream: %d loads, %d unloads, %.1f MB of region files read, peak %.1f MB resident; "
+                     "%d of %d frames waited, %d had regions arriving, %d drew a region within %g m below full "
+                     "detail\n",
+                     kCmd, st.loads, st.unloads, double(st.bytesRead) / 1e6, double(st.peakResidentBytes) / 1e6,
+                     st.framesWaited, frames, framesWithArrivals, framesShort, options.radius);
+    }
+};
+
 struct ViewState {
     osgViewer::Viewer viewer;
     osg::ref_ptr<osg::Group> slot;  // the current mode's viewer scene
@@ -348,6 +437,7 @@ struct ViewState {
     osg::ref_ptr<Keys> keys;
     std::string mode;
     RenderMode* current = nullptr;
+    ViewStream* stream = nullptr;  // a streamed paged city, or null
 };
 
 Status setUpWindow(ViewState& v, const ViewArgs& a, osg::ref_ptr<osgGA::KeySwitchMatrixManipulator> manips) {
@@ -424,6 +514,13 @@ int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path,
                 c.roll = fromOsg.roll;
             }
         }
+        if (v.stream) {
+            const glm::dvec3 pv = a.step ? pathVelocity(path, stepFrames[size_t(n)]) : glm::dvec3(0.0);
+            if (Status st = v.stream->advance(c.eye, a.step ? &pv : nullptr, lastMs / 1000.0); !st) {
+                std::fprintf(stderr, "%s: %s\n", kCmd, st.message().c_str());
+                return 1;
+            }
+        }
         modes.placeFrameNear(c.eye);  // ray origins near the frame origin: float precision anywhere
         cam->setProjectionMatrix(toOsg(c.projection(v.current->beginViewerFrame(c))));
         if (v.keys->effects) v.sky->setNight(v.keys->effects->night);
@@ -437,8 +534,28 @@ int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path,
         lastMs = sw.lap();
         if (last) break;
     }
+    if (v.stream) v.stream->report();
     if (!a.screenshot.empty() && v.keys->capture->lastWritten != a.screenshot) return 1;
     return 0;
+}
+
+// --paged-stream: the stream of the city's regions (no region loaded yet),
+// into the modes' context. Errors name the flag or the ray scene.
+Status startStream(const ViewArgs& a, const Walkthrough& walk, ModeContext& ctx, ViewStream& vs) {
+    const bool rays = findRenderMode(a.mode)->needsRays || effectsNeedRays(ctx.options.effects) ||
+                      ctx.options.effects.glassMarked;  // ViewModes casts reflections for every mode then
+    auto so = pagedStreamOptions(a.paged, a.stream, a.memoryBudgetGb, estimateCityRunMb(0, rays), rays);
+    if (!so) return so.status();
+    vs.options = *so;
+    vs.manifest = walk.manifest.get();
+    auto st = CityStream::create(*walk.manifest, vs.options, rays);
+    if (!st) return Status::error("setting up the streamed city failed: " + st.status().message());
+    vs.stream = std::move(*st);
+    ctx.streamedCity = vs.stream->graph();
+    ctx.scene = vs.stream->graph();
+    ctx.rays = vs.stream->rays();
+    notePagedStream(kCmd, *walk.manifest, vs.options);
+    return Status::ok();
 }
 
 }  // namespace
@@ -469,6 +586,7 @@ int runView(int argc, char** argv) {
     req.city = a.city;
     req.cmd = kCmd;
     req.paged = a.paged;
+    req.streamPaged = a.stream.stream;
     req.pathNeedsStreets = a.path.file.empty();
     req.makePath = [&](const SceneModel& city) -> Result<Path> {
         auto p = viewPath(a, city, playback);
@@ -492,7 +610,10 @@ int runView(int argc, char** argv) {
     const Path& path = walk->path;
     ctx.city = &city;
     ctx.scene = sceneRoot(city);
-    ViewModes modes(ctx);
+    ViewStream stream;  // before the modes: they draw its graph
+    if (a.stream.stream)
+        if (Status s = startStream(a, *walk, ctx, stream); !s) return reportBadInput(kCmd, s);
+    ViewModes modes(ctx, stream.stream.get());
     auto start = modes.get(a.mode);
     if (!start) return reportBadInput(kCmd, Status::error("--mode " + a.mode + ": " + start.status().message()));
     ViewState v;
@@ -502,6 +623,7 @@ int runView(int argc, char** argv) {
     }
     v.keys->effects = &ctx.options.effects;
     v.keys->declared = FrameEffects::fromScene(city.params.effects);
+    v.stream = stream.stream ? &stream : nullptr;
     showMode(v, modes, a.mode);
     return runLoop(v, modes, a, path, playback);
 }

@@ -521,7 +521,8 @@ void addPagedStreamFlags(CLI::App& app, PagedStreamFlags& f) {
                  "with a paged city: stream it instead of loading the regions near the walkthrough before the first "
                  "frame: regions load on a worker thread as the camera approaches and unload when it leaves "
                  "(--paged-radius at full detail and --paged-far at the coarse level, around the camera); "
-                 "--memory-budget bounds what is resident; modes full, near, raycast, hybrid and hybrid-fixed");
+                 "--memory-budget bounds what is resident; modes " +
+                     streamingModeNames());
     app.add_flag("--paged-wait", f.wait,
                  "with --paged-stream (implied): every frame waits until the regions within reach of its camera are "
                  "resident, so frames do not depend on load timing");

@@ -211,7 +211,7 @@ Result<PathOptions> parsePathFlags(const PathFlags& flags);
 // file within kMaxPathCsvBytes, before anything is read or created.
 Status checkRunFiles(CommandFiles files, const std::string& city, const PathFlags& path, const ModeFlags& mode);
 
-// The paged-city reach (PagedReach, paged_walkthrough.h) of bench and view:
+// The paged-city reach (PagedReach, paged_walkthrough.h) of bench, view and render:
 // --paged-radius M = metres around the walkthrough within which regions are
 // loaded at full detail (default kDefaultPagedRadiusM); --paged-far M =
 // metres within which the other regions are loaded at their coarse level,
@@ -221,11 +221,10 @@ void addPagedFlags(CLI::App& app, PagedReach& reach);
 // Both values within [kMinPagedRadiusM, kMaxPagedRadiusM]; errors name the option.
 Status validatePagedReach(const PagedReach& reach);
 
-// Streaming a paged city (bench): --paged-stream = the chunked city and the
+// Streaming a paged city (bench, view, render; cmd/paged_stream.h): --paged-stream = the chunked city and the
 // ray scene follow the camera of each frame (nodes/render/city_stream.h, the
 // region pager of runtime/scene/region_pager.h) instead of holding the
-// regions loaded around the whole path (modes full, near, raycast, hybrid,
-// hybrid-fixed); --paged-wait = each frame waits until the
+// regions loaded around the whole path (the modes of modeStreams()); --paged-wait = each frame waits until the
 // regions within reach of its camera are resident (deterministic frames;
 // implies --paged-stream); --paged-prefetch S = seconds of lookahead along
 // the camera's velocity, 0 .. kMaxPagedPrefetchS (default

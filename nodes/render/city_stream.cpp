@@ -12,6 +12,8 @@ namespace {
 struct RegionChunks {
     osg::ref_ptr<osg::Group> group;
     osg::ref_ptr<osg::StateSet> rootState;
+    osg::ref_ptr<osg::Group> labels;  // the chunks' label twins (with labels only)
+    osg::ref_ptr<osg::StateSet> labelRootState;
     std::shared_ptr<RayScene::PreparedRegion> rays;  // its Embree scene (null without rays)
     std::shared_ptr<NearFieldRegion> nearField;      // its chunks, block and height patch (null without)
 };
@@ -21,7 +23,7 @@ struct RegionChunks {
 CityStream::~CityStream() { _pager.reset(); }
 
 Result<std::unique_ptr<CityStream>> CityStream::create(const PagedManifest& manifest, RegionPagerOptions options,
-                                                       bool rays, std::vector<SceneMesh> prototypes) {
+                                                       bool rays, std::vector<SceneMesh> prototypes, bool labels) {
     std::unique_ptr<CityStream> s(new CityStream());
     if (rays) {
         auto r = StreamedRayScene::follower(manifest, std::move(prototypes));
@@ -30,26 +32,37 @@ Result<std::unique_ptr<CityStream>> CityStream::create(const PagedManifest& mani
     }
     s->_root = new osg::Group;
     s->_root->setName("vista.streamed_city");
+    if (labels) {
+        s->_labelRoot = new osg::Group;
+        s->_labelRoot->setName("vista.streamed_city_labels");
+    }
     const StreamedRayScene* rayScene = s->_rays.get();
     const std::unique_ptr<StreamedNearField>* nearField = &s->_near;  // set before the first load, if at all
     s->_manifest = &manifest;
-    options.prepare = [rayScene, nearField](SceneModel& model, int, bool) -> std::shared_ptr<void> {
+    options.prepare = [rayScene, nearField, labels](SceneModel& model, int, bool) -> std::shared_ptr<void> {
         auto out = std::make_shared<RegionChunks>();
         // The ray scene first: it completes the model's tree prototypes, which the height patch bounds too.
         if (rayScene) out->rays = rayScene->prepare(model);
         out->group = new osg::Group;
         osg::ref_ptr<osg::Node> root = sceneRoot(model);
         if (*nearField) {
-            // The chunks serve both the graph and the near field.
+            // The chunks serve both the graph and the near field (no label twins: the label
+            // channels of a streamed city come from `full` only).
             out->nearField = (*nearField)->prepare(root.get(), model);
             const NearFieldScene& nf = out->nearField->scene;
             out->rootState = nf.rootState;
             for (uint32_t i : nf.drawOrder) out->group->addChild(nf.chunks[i].get());
             return out;
         }
-        NearFieldScene nf = buildNearFieldScene(root.get(), kNearChunkSize, false);
+        NearFieldScene nf = buildNearFieldScene(root.get(), kNearChunkSize, labels);
         out->rootState = nf.rootState;
         for (uint32_t i : nf.drawOrder) out->group->addChild(nf.chunks[i].get());
+        if (labels) {
+            out->labels = new osg::Group;
+            out->labelRootState = nf.labelRootState;
+            for (uint32_t i : nf.drawOrder)
+                if (i < nf.labelChunks.size()) out->labels->addChild(nf.labelChunks[i].get());
+        }
         return out;
     };
     s->_pager = std::make_unique<RegionPager>(manifest, options);
@@ -63,10 +76,33 @@ void CityStream::enableNearField(int horizonCells) {
                                             pagedHeightLattice(*_manifest, _rays->rays().frameOrigin(), horizonCells));
 }
 
-Result<CityStreamFrame> CityStream::advance(const glm::dvec3& eye, const glm::dvec3& velocity) {
+namespace {
+
+// Inserts `group` as (coarse, region)'s group under `root`, before the next group in merge order.
+void insertInMergeOrder(osg::Group* root, std::map<std::pair<bool, int>, osg::ref_ptr<osg::Group>>& groups,
+                        std::pair<bool, int> key, osg::Group* group) {
+    auto it = groups.emplace(key, group).first;
+    auto next = std::next(it);
+    const unsigned at = next == groups.end() ? root->getNumChildren() : root->getChildIndex(next->second.get());
+    root->insertChild(at, group);
+}
+
+// Removes (coarse, region)'s group from `root`; false when there is none.
+bool removeGroup(osg::Group* root, std::map<std::pair<bool, int>, osg::ref_ptr<osg::Group>>& groups,
+                 std::pair<bool, int> key) {
+    auto it = groups.find(key);
+    if (it == groups.end()) return false;
+    root->removeChild(it->second.get());
+    groups.erase(it);
+    return true;
+}
+
+}  // namespace
+
+Result<CityStreamFrame> CityStream::advance(const glm::dvec3& eye, const glm::dvec3& velocity, bool wait) {
     _advanced = true;
     _pager->update(eye, velocity);
-    RegionPagerDelta d = _pager->collect();
+    RegionPagerDelta d = _pager->collect(wait);
     CityStreamFrame f;
     f.waited = d.waited;
     f.damaged = d.damaged;
@@ -79,10 +115,8 @@ Result<CityStreamFrame> CityStream::advance(const glm::dvec3& eye, const glm::dv
         VISTA_RETURN_IF_ERROR(_rays->apply(d, prepared).status());
     }
     for (const RegionDrop& x : d.dropped) {
-        auto it = _groups.find({x.coarse, x.region});
-        if (it == _groups.end()) continue;
-        _root->removeChild(it->second.get());
-        _groups.erase(it);
+        if (_labelRoot) removeGroup(_labelRoot.get(), _labelGroups, {x.coarse, x.region});
+        if (!removeGroup(_root.get(), _groups, {x.coarse, x.region})) continue;
         if (_near) _near->remove(levelKey(x.region, x.coarse));
         ++f.dropped;
     }
@@ -90,11 +124,12 @@ Result<CityStreamFrame> CityStream::advance(const glm::dvec3& eye, const glm::dv
         auto* chunks = static_cast<RegionChunks*>(a.prepared.get());
         if (!chunks) continue;
         if (!_root->getStateSet() && chunks->rootState) _root->setStateSet(chunks->rootState.get());
-        auto it = _groups.emplace(std::make_pair(a.coarse, a.region), chunks->group).first;
-        // Insert before the next group in merge order.
-        auto next = std::next(it);
-        const unsigned at = next == _groups.end() ? _root->getNumChildren() : _root->getChildIndex(next->second.get());
-        _root->insertChild(at, chunks->group.get());
+        insertInMergeOrder(_root.get(), _groups, {a.coarse, a.region}, chunks->group.get());
+        if (_labelRoot && chunks->labels) {
+            if (!_labelRoot->getStateSet() && chunks->labelRootState)
+                _labelRoot->setStateSet(chunks->labelRootState.get());
+            insertInMergeOrder(_labelRoot.get(), _labelGroups, {a.coarse, a.region}, chunks->labels.get());
+        }
         if (_near && chunks->nearField) _near->add(levelKey(a.region, a.coarse), *chunks->nearField);
         ++f.arrived;
     }

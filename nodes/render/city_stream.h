@@ -13,6 +13,12 @@
 //    thread instances it and commits the top level). Coarse levels are
 //    traced with their coarse geometry and their tree impostors as the
 //    city's tree meshes;
+//  - the label twin of the graph (labelGraph(), when made with labels, for
+//    the ground truth of `vista render`): one group per resident region level
+//    holding the label twins of that level's chunks (NearFieldScene::
+//    labelChunks, built on the worker thread with the chunks) in the same
+//    order as graph(), under a root with the label pass's root state, so the
+//    label pass over it rasterises the pixels graph() draws;
 //  - the near field (nearField(), after enableNearField()): the resident
 //    levels' chunks, their split index and the horizon's height grid
 //    (StreamedNearField), cut on the worker thread and spliced here.
@@ -29,6 +35,7 @@
 // scene (an Embree error naming the region). A damaged region file is no
 // error: advance() returns its message once and the pager falls back.
 #pragma once
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
@@ -56,17 +63,26 @@ public:
     // prototypes: the city's tree prototypes for the ray scene (see
     // StreamedRayScene; empty = read at set-up). rays = false: no ray scene.
     ~CityStream();  // stops the pager first: its workers use the ray scene
+    // labels = true: also the label twin (labelGraph()).
     static Result<std::unique_ptr<CityStream>> create(const PagedManifest& manifest, RegionPagerOptions options,
-                                                      bool rays, std::vector<SceneMesh> prototypes = {});
+                                                      bool rays, std::vector<SceneMesh> prototypes = {},
+                                                      bool labels = false);
     // The near field too (hybrid): chunks, split index and a horizon grid of horizonCells a
     // side (0 = auto) on the paged city's lattice (pagedHeightLattice). Contract: before the
     // first advance() and with rays.
     void enableNearField(int horizonCells);
-    Result<CityStreamFrame> advance(const glm::dvec3& eye, const glm::dvec3& velocity);
+    // Moves the pager to the eye and mirrors what it hands over. wait = true:
+    // this call blocks until the desired set is resident, as every call does
+    // with options.wait (e.g. before a viewer's first frame).
+    Result<CityStreamFrame> advance(const glm::dvec3& eye, const glm::dvec3& velocity, bool wait = false);
     osg::Group* graph() const { return _root.get(); }
     RayScene* rays() { return _rays ? &_rays->rays() : nullptr; }
+    // The label twin of graph(); null unless made with labels.
+    osg::Group* labelGraph() const { return _labelRoot.get(); }
     StreamedNearField* nearField() { return _near.get(); }
     uint64_t generation() const { return _generation; }
+    // Per manifest region, the level held now (RegionPager::held()).
+    std::vector<uint8_t> held() const { return _pager->held(); }
     RegionPagerStats stats() const { return _pager->stats(); }
 
 private:
@@ -80,6 +96,8 @@ private:
     osg::ref_ptr<osg::Group> _root;
     // (coarse, region) -> its chunk group under _root: ordered as loadPagedCity merges.
     std::map<std::pair<bool, int>, osg::ref_ptr<osg::Group>> _groups;
+    osg::ref_ptr<osg::Group> _labelRoot;  // labels: the twins of _groups, same keys and order
+    std::map<std::pair<bool, int>, osg::ref_ptr<osg::Group>> _labelGroups;
 };
 
 }  // namespace vista

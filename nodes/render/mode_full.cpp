@@ -11,6 +11,7 @@ public:
         _setup.push_back({"chunking", ctx.chunkingMs()});
         // A streamed city is chunked region by region as it arrives (no chunk list of the whole).
         if (!ctx.streamedCity) _raster.chunks = ctx.nearField().drawOrder;
+        _raster.wholeCity = true;
     }
     std::string name() const override { return "full"; }
     const RasterSelection* lastRaster() const override { return &_raster; }

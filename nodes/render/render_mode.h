@@ -145,10 +145,14 @@ Result<ModeBake> loadBakeForMode(const ModeContext& ctx, const std::string& file
 // draw order), the far plane (metres, 0 = infinite) and the near distance
 // (metres from the eye) beyond which its pixels came from the far field
 // (+inf: every drawn pixel is final; uncovered pixels are far field or sky).
+// wholeCity: the mode drew every chunk of ModeContext::chunkedCity(); over a
+// streamed city (ModeContext::streamedCity) `chunks` is then empty and the
+// label pass draws the stream's label twin (CityStream::labelGraph()).
 struct RasterSelection {
     std::vector<uint32_t> chunks;
     double zFar = 0;
     double nearDistance = 1e300;
+    bool wholeCity = false;
 };
 
 class RenderMode {

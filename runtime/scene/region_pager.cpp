@@ -311,7 +311,7 @@ void RegionPager::takeArrivals(std::deque<Done>& done, RegionPagerDelta* delta) 
     schedule(delta);
 }
 
-RegionPagerDelta RegionPager::collect() {
+RegionPagerDelta RegionPager::collect(bool wait) {
     RegionPagerDelta delta = std::move(_pending);
     _pending = RegionPagerDelta();
     std::deque<Done> done;
@@ -320,7 +320,7 @@ RegionPagerDelta RegionPager::collect() {
         done.swap(_done);
     }
     takeArrivals(done, &delta);
-    if (_o.wait) {
+    if (_o.wait || wait) {
         Stopwatch sw;
         for (;;) {
             bool inFlight = false;

@@ -47,6 +47,7 @@
 // blocks until every desired level is resident or failed (a failed full file
 // then waits for its coarse fallback): the caller then holds exactly the
 // desired set, the same regions as a synchronous load of the same reach.
+// collect(true) waits so once without wait mode (a viewer's first frame).
 //
 // Contract (VISTA_CHECK): radius and far finite and >= 0, prefetchS finite
 // and >= 0, budgetBytes >= 0, workers 1 .. 16, eye and velocity finite.
@@ -134,7 +135,7 @@ public:
     // Decides the desired set for the eye (world metres) moving at `velocity`
     // (metres per second), drops what is no longer wanted and queues the loads.
     void update(const glm::dvec3& eye, const glm::dvec3& velocity);
-    RegionPagerDelta collect();
+    RegionPagerDelta collect(bool wait = false);
     RegionPagerStats stats() const;
 
     // The desired set of the last update(): per manifest region 0 (none), 1

@@ -1,0 +1,83 @@
+// Streaming a paged city in bench, view and render (paged_stream.h).
+#include "cmd/paged_stream.h"
+
+#include <cstdio>
+
+#include "cmd/memory.h"
+#include "nodes/render/render_mode.h"
+
+namespace vista {
+
+Result<RegionPagerOptions> pagedStreamOptions(const PagedReach& reach, const PagedStreamFlags& flags, double budgetGb,
+                                              double preloadMb, bool rays) {
+    auto budget = streamBudgetFileBytes("--memory-budget", budgetGb, preloadMb, rays);
+    if (!budget) return budget.status();
+    RegionPagerOptions o;
+    o.radius = reach.radius;
+    o.far = reach.far;
+    o.prefetchS = flags.prefetchS.value_or(kDefaultPagedPrefetchS);
+    o.wait = flags.wait;
+    o.budgetBytes = *budget;
+    return o;
+}
+
+Status checkStreamingModes(const std::vector<std::string>& modes) {
+    for (const auto& m : modes)
+        if (!modeStreams(m))
+            return Status::error("--paged-stream: mode " + m +
+                                 " does not stream a paged city (modes that do: " + streamingModeNames() + ")");
+    return Status::ok();
+}
+
+void notePagedStream(const char* cmd, const PagedManifest& manifest, const RegionPagerOptions& o) {
+    std::fprintf(stderr,
+                 "%s: paged city: streaming its %d regions around the camera (full detail within %g m, coarse "
+                 "within %g m, %g s ahead%s%s)\n",
+                 cmd, manifest.nonEmpty(), o.radius, o.far, o.prefetchS,
+                 o.wait ? ", every frame waits for its regions" : "",
+                 o.budgetBytes ? ", within the memory budget" : "");
+}
+
+Result<CityStreamFrame> advancePagedStream(CityStream& stream, const char* cmd, const glm::dvec3& eye,
+                                           const glm::dvec3& velocity, std::vector<std::string>* damaged, bool wait) {
+    auto f = stream.advance(eye, velocity, wait);
+    if (!f) return f.status();
+    for (const std::string& d : f->damaged) {
+        std::fprintf(stderr, "%s: warning: %s; the rest of the city streams\n", cmd, d.c_str());
+        if (damaged) damaged->push_back(d);
+    }
+    return f;
+}
+
+glm::dvec3 pathVelocity(const Path& path, size_t i) {
+    const auto& s = path.samples;
+    if (s.size() < 2) return glm::dvec3(0.0);
+    const size_t a = i + 1 < s.size() ? i : i - 1;
+    const double dt = s[a + 1].t - s[a].t;
+    return dt > 0 ? (s[a + 1].position - s[a].position) / dt : glm::dvec3(0.0);
+}
+
+nlohmann::json pagedStreamJson(const RegionPagerOptions& o, const RegionPagerStats& s, int framesWithArrivals,
+                               const std::vector<std::string>& damaged) {
+    return {{"radius_m", o.radius},
+            {"far_m", o.far},
+            {"prefetch_s", o.prefetchS},
+            {"wait", o.wait},
+            {"frames_deterministic", o.wait},
+            {"budget_file_bytes", o.budgetBytes},
+            {"peak_resident_file_bytes", s.peakResidentBytes},
+            {"resident_file_bytes_end", s.residentBytes},
+            {"resident_full_end", s.residentFull},
+            {"resident_coarse_end", s.residentCoarse},
+            {"loads", s.loads},
+            {"unloads", s.unloads},
+            {"discarded", s.discarded},
+            {"bytes_read", s.bytesRead},
+            {"frames_waited", s.framesWaited},
+            {"wait_ms", s.waitMs},
+            {"frames_with_arrivals", framesWithArrivals},
+            {"budget_limited_updates", s.budgetLimited},
+            {"damaged", damaged}};
+}
+
+}  // namespace vista

@@ -1,0 +1,53 @@
+// Streaming a paged city in the three walkthrough commands (`vista bench`,
+// `vista view`, `vista render` with --paged-stream): one set-up and one
+// per-frame step, so the commands stream alike. The streaming itself is a
+// CityStream (nodes/render/city_stream.h): one RegionPager feeding the
+// chunked city graph, the ray scene and (render) the label twin, advanced
+// between frames on the frame thread while the loads run on its worker.
+//
+// pagedStreamOptions(): the pager options of the flags: --paged-radius and
+// --paged-far around the camera, --paged-prefetch seconds ahead (default
+// kDefaultPagedPrefetchS), --paged-wait, and the budget: what --memory-budget
+// leaves after `preloadMb` (streamBudgetFileBytes; errors name
+// --memory-budget). checkStreamingModes(): every mode streams (modeStreams),
+// else an error naming --paged-stream and the modes that do.
+// notePagedStream(): the stderr note "CMD: paged city: streaming its N
+// regions around the camera (...)".
+//
+// advancePagedStream(): CityStream::advance for a camera at `eye` moving at
+// `velocity` (m/s); each damaged region file is a warning on stderr
+// ("CMD: warning: ...; the rest of the city streams") and is appended to
+// `damaged` (if not null). Errors: those of CityStream::advance.
+//
+// pathVelocity(): the camera's velocity at path sample i (metres per second;
+// towards the next sample, or from the previous one at the end; zero for a
+// path of one sample). pagedStreamJson(): the summary.json block
+// paged.stream (docs/formats.md) of a streamed run.
+#pragma once
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+#include "cmd/options.h"
+#include "foundation/status.h"
+#include "nodes/render/city_stream.h"
+#include "runtime/scene/paged_walkthrough.h"
+#include "runtime/scene/paths.h"
+#include "runtime/scene/region_pager.h"
+
+namespace vista {
+
+Result<RegionPagerOptions> pagedStreamOptions(const PagedReach& reach, const PagedStreamFlags& flags, double budgetGb,
+                                              double preloadMb, bool rays);
+Status checkStreamingModes(const std::vector<std::string>& modes);
+void notePagedStream(const char* cmd, const PagedManifest& manifest, const RegionPagerOptions& options);
+Result<CityStreamFrame> advancePagedStream(CityStream& stream, const char* cmd, const glm::dvec3& eye,
+                                           const glm::dvec3& velocity, std::vector<std::string>* damaged,
+                                           bool wait = false);
+glm::dvec3 pathVelocity(const Path& path, size_t i);
+nlohmann::json pagedStreamJson(const RegionPagerOptions& options, const RegionPagerStats& stats, int framesWithArrivals,
+                               const std::vector<std::string>& damaged);
+
+}  // namespace vista

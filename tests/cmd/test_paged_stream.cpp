@@ -1,0 +1,191 @@
+// Streaming a paged city in `vista render` and `vista view` (--paged-stream,
+// cmd/paged_stream.h): render's ground truth of a streamed city that waits
+// is the preloaded run's, byte for byte, and resumes to the bytes of an
+// uninterrupted run; a streamed render and a scripted viewer drive load and
+// unload regions along the path; bad combinations exit 2 naming the flag. Rendering tests: run under `xvfb-run -a`.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <regex>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "tests/common/run_vista.h"
+#include "tests/common/temp_dir.h"
+
+namespace fs = std::filesystem;
+using vista::test::CliRun;
+using vista::test::readBytes;
+using vista::test::runVista;
+using vista::test::TempDir;
+
+namespace {
+
+// A 1.5 km city in 500 m regions (3 x 3), facade detail 1 to keep it quick.
+const std::string kCity = "gen --size 1500 --seed 4 --detail 1 --region-size 500 -q";
+// A drive that leaves regions behind: full detail within 100 m, coarse within 400 m.
+const std::string kNear = " --paged-radius 100 --paged-far 400";
+
+nlohmann::json readJson(const std::string& path) { return nlohmann::json::parse(readBytes(path)); }
+
+class PagedStream : public ::testing::Test {
+protected:
+    static void SetUpTestSuite() {
+        ref = new TempDir("vista_pagedstream_ref");
+        const CliRun r = runVista(kCity + " -o " + ref->file("city.paged"));
+        ASSERT_EQ(r.code, 0) << r.err;
+    }
+    static void TearDownTestSuite() {
+        delete ref;
+        ref = nullptr;
+    }
+    static std::string dir() { return ref->file("city.paged"); }
+    static TempDir* ref;
+    TempDir tmp{"vista_pagedstream"};
+};
+TempDir* PagedStream::ref = nullptr;
+
+// The number before `what` in the viewer's "paged stream:" line (-1 if absent).
+int streamCount(const std::string& err, const std::string& what) {
+    std::smatch m;
+    if (!std::regex_search(err, m, std::regex("([0-9]+) " + what))) return -1;
+    return std::stoi(m[1]);
+}
+
+}  // namespace
+
+TEST_F(PagedStream, AStreamedRenderThatWaitsWritesThePreloadedGroundTruth) {
+    // Every region within reach of every frame: the streamed city holds the preloaded regions.
+    const std::string run = " --seed 4 --frames 3 --size 160x120 -q --paged-radius 5000";
+    CliRun r = runVista("render " + dir() + run + " --out " + tmp.file("pre"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = runVista("render " + dir() + run + " --paged-wait --paged-prefetch 2 --out " + tmp.file("str"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (int f = 0; f < 3; ++f) {
+        const std::string name = "00000" + std::to_string(f);
+        for (const std::string& file :
+             {"rgb/" + name + ".png", "depth/" + name + ".npy", "semantic/" + name + ".png"}) {
+            ASSERT_TRUE(fs::exists(tmp.file("pre/" + file))) << file;
+            EXPECT_TRUE(readBytes(tmp.file("pre/" + file)) == readBytes(tmp.file("str/" + file))) << file;
+        }
+        // Instance ids of a paged city are numbered per region: not written.
+        EXPECT_FALSE(fs::exists(tmp.file("str/instance/" + name + ".npy")));
+    }
+    EXPECT_TRUE(readBytes(tmp.file("pre/cameras.json")) == readBytes(tmp.file("str/cameras.json")));
+    const auto s = readJson(tmp.file("str/summary.json"));
+    ASSERT_TRUE(s["paged"].contains("stream")) << s.dump();
+    const auto& st = s["paged"]["stream"];
+    EXPECT_TRUE(st["frames_deterministic"].get<bool>());
+    EXPECT_EQ(st["loads"].get<int>(), 9);
+    EXPECT_EQ(st["unloads"].get<int>(), 0);
+    EXPECT_EQ(st["bytes_read"].get<uint64_t>(),
+              readJson(tmp.file("pre/summary.json"))["paged"]["bytes_loaded"].get<uint64_t>());
+    EXPECT_EQ(s["channels"].get<std::string>(), "rgb,depth,semantic");
+}
+
+// The streamed hybrid in render: with every region within reach, a waiting run draws what the
+// preloaded run draws (a fixed split and a cache that never pauses: no frame follows timings).
+TEST_F(PagedStream, AStreamedHybridRenderThatWaitsWritesThePreloadedFrames) {
+    const std::string run =
+        " --seed 4 --frames 3 --size 160x120 -q --channels rgb --paged-radius 5000 --mode hybrid --near 100 "
+        "--cache-always";
+    CliRun r = runVista("render " + dir() + run + " --out " + tmp.file("pre"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = runVista("render " + dir() + run + " --paged-wait --out " + tmp.file("str"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (int f = 0; f < 3; ++f) {
+        const std::string file = "rgb/00000" + std::to_string(f) + ".png";
+        ASSERT_TRUE(fs::exists(tmp.file("pre/" + file))) << file;
+        EXPECT_TRUE(readBytes(tmp.file("pre/" + file)) == readBytes(tmp.file("str/" + file))) << file;
+    }
+    EXPECT_EQ(readJson(tmp.file("str/summary.json"))["paged"]["stream"]["loads"].get<int>(), 9);
+}
+
+TEST_F(PagedStream, AStreamedRenderLoadsAndUnloadsAlongThePath) {
+    const std::string run = " --seed 4 --frames 12 --size 160x120 -q --channels rgb,depth" + kNear;
+    for (const char* out : {"w1", "w2"}) {
+        const CliRun r = runVista("render " + dir() + run + " --paged-wait --out " + tmp.file(out));
+        ASSERT_EQ(r.code, 0) << r.err;
+    }
+    // Frames that wait do not depend on the load timing.
+    for (int f = 0; f < 12; ++f) {
+        char name[32];
+        std::snprintf(name, sizeof name, "%06d", f);
+        for (const std::string& file : {std::string("rgb/") + name + ".png", std::string("depth/") + name + ".npy"})
+            EXPECT_TRUE(readBytes(tmp.file("w1/" + file)) == readBytes(tmp.file("w2/" + file))) << file;
+    }
+    const auto st = readJson(tmp.file("w1/summary.json"))["paged"]["stream"];
+    EXPECT_GT(st["loads"].get<int>(), 3);
+    EXPECT_GT(st["unloads"].get<int>(), 0);
+    EXPECT_GT(st["frames_with_arrivals"].get<int>(), 0);
+    EXPECT_GE(st["bytes_read"].get<uint64_t>(), st["peak_resident_file_bytes"].get<uint64_t>());
+    // Without waiting, the first frame still has its regions; the rest is timing.
+    const CliRun r = runVista("render " + dir() + run + " --paged-stream --out " + tmp.file("nw"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_FALSE(readJson(tmp.file("nw/summary.json"))["paged"]["stream"]["frames_deterministic"].get<bool>());
+}
+
+TEST_F(PagedStream, AStreamedRenderResumesToTheUninterruptedBytes) {
+    const std::string run = " --seed 4 --frames 6 --size 160x120 -q --channels rgb,depth --paged-wait" + kNear;
+    CliRun r = runVista("render " + dir() + run + " --out " + tmp.file("ref"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = runVista("render " + dir() + run + " --out " + tmp.file("res"), "VISTA_RENDER_KILL_AFTER_FRAMES=2");
+    ASSERT_NE(r.code, 0) << "the hook kills the run";
+    // The reach is part of the work directory's manifest: another one does not resume it.
+    r = runVista("render " + dir() + run + " --paged-prefetch 1 --out " + tmp.file("res"));
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("other parameters"), std::string::npos) << r.err;
+    r = runVista("render " + dir() + run + " --out " + tmp.file("res"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (int f = 0; f < 6; ++f) {
+        char name[32];
+        std::snprintf(name, sizeof name, "%06d", f);
+        for (const std::string& file : {std::string("rgb/") + name + ".png", std::string("depth/") + name + ".npy"})
+            EXPECT_TRUE(readBytes(tmp.file("ref/" + file)) == readBytes(tmp.file("res/" + file))) << file;
+    }
+    EXPECT_EQ(readJson(tmp.file("res/summary.json"))["frames_resumed"].get<int>(), 2);
+}
+
+TEST_F(PagedStream, AScriptedViewerDriveStreamsTheCity) {
+    const std::string run = " --seed 4 --step --frames 12 --size 160x120 --no-hud" + kNear;
+    CliRun r = runVista("view " + dir() + run + " --paged-wait");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("paged city: streaming its 9 regions"), std::string::npos) << r.err;
+    ASSERT_NE(r.err.find("paged stream:"), std::string::npos) << r.err;
+    EXPECT_GT(streamCount(r.err, "loads"), 3) << r.err;
+    EXPECT_GT(streamCount(r.err, "unloads"), 0) << r.err;
+    // Every frame waited for its regions: none drew a coarse level where full detail was wanted.
+    EXPECT_EQ(streamCount(r.err, "drew a region"), 0) << r.err;
+    // Without waiting the viewer drives on (the first frame waits for the start's regions).
+    r = runVista("view " + dir() + run + " --paged-stream --mode raycast --paged-prefetch 8");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_GT(streamCount(r.err, "loads"), 0) << r.err;
+    EXPECT_GE(streamCount(r.err, "of 12 frames waited"), 1) << r.err;
+}
+
+TEST_F(PagedStream, BadCombinationsExitTwoNamingTheFlag) {
+    const std::string one = tmp.file("one.osgb");
+    fs::copy_file(fs::path(dir()) / "region_0_0.osgb", one);
+    struct Case {
+        std::string args, flag;
+    };
+    const std::string r = " --seed 4 --frames 2 --size 160x120 -q --out " + tmp.file("o");
+    for (const Case& c : std::vector<Case>{
+             {"render " + one + r + " --paged-stream", "--paged-stream"},
+             {"render " + dir() + r + " --paged-prefetch 2", "--paged-prefetch"},
+             {"render " + dir() + r + " --channels rgb,instance", "--channels"},
+             {"render " + dir() + " --seed 4 -q --paged-stream --rig rig.json --out " + tmp.file("o"),
+              "--paged-stream"},
+             {"render " + dir() + r + " --paged-wait --paged-prefetch 601", "--paged-prefetch"},
+             {"view " + one + " --frames 1 --paged-stream", "--paged-stream"},
+             {"view " + dir() + " --frames 1 --paged-stream --mode osglod", "--paged-stream"},
+             {"view " + dir() + " --frames 1 --paged-prefetch 1", "--paged-prefetch"},
+             {"view " + dir() + " --frames 1 --paged-stream --mode hybrid", "--paged-stream"},
+         }) {
+        const CliRun run = runVista(c.args);
+        EXPECT_EQ(run.code, 2) << c.args << ": " << run.err;
+        EXPECT_NE(run.err.find(c.flag), std::string::npos) << c.args << ": " << run.err;
+    }
+    EXPECT_FALSE(fs::exists(tmp.file("o")));
+}
