@@ -25,6 +25,43 @@ struct Box2 {
     bool valid() const { return lo.x <= hi.x; }
 };
 
+// Scene-local bounds of a model: of the vertices its meshes' indices reference
+// and of its tree instances (each its prototype's box, transformed), and each
+// instance's own box (invalid when its prototype has no geometry).
+struct SceneBoxes {
+    Box2 all;
+    std::vector<Box2> instances;
+};
+
+SceneBoxes sceneBoxes(const SceneModel& city, const glm::dvec3& frameOrigin) {
+    SceneBoxes b;
+    for (const SceneMesh& m : city.meshes) {
+        const glm::dvec3 shift = m.origin - frameOrigin;
+        for (uint32_t i : m.indices)
+            if (i < m.positions.size()) b.all.add(glm::dvec3(m.positions[i]) + shift);
+    }
+    std::vector<Box2> protoBox(city.prototypes.size());
+    for (size_t p = 0; p < city.prototypes.size(); ++p) {
+        const SceneMesh& m = city.prototypes[p];
+        for (uint32_t i : m.indices)
+            if (i < m.positions.size()) protoBox[p].add(glm::dvec3(m.positions[i]) + m.origin);
+    }
+    b.instances.resize(city.instances.size());
+    for (size_t k = 0; k < city.instances.size(); ++k) {
+        const SceneInstance& inst = city.instances[k];
+        if (inst.prototype >= protoBox.size() || !protoBox[inst.prototype].valid()) continue;
+        const Box2& pb = protoBox[inst.prototype];
+        for (int c = 0; c < 8; ++c) {
+            const glm::dvec4 v((c & 1) ? pb.hi.x : pb.lo.x, (c & 2) ? pb.hi.y : pb.lo.y, (c & 4) ? pb.hi.z : pb.lo.z,
+                               1.0);
+            b.instances[k].add(glm::dvec3(inst.transform * v) - frameOrigin);
+        }
+        b.all.add(b.instances[k].lo);
+        b.all.add(b.instances[k].hi);
+    }
+    return b;
+}
+
 // A 2D DDA over square cells `unit` grid cells wide, starting in cell (x, y)
 // for the ray s0 + d * t (grid units); tMax = the ray parameter where it
 // leaves the current cell in x / y.
@@ -72,31 +109,9 @@ HeightGrid HeightGrid::build(const SceneModel& city, const glm::dvec3& frameOrig
     HeightGrid g;
     g._origin = frameOrigin;
     // Pass 1: bounds of everything (scene-local).
-    Box2 all;
-    for (const SceneMesh& m : city.meshes) {
-        glm::dvec3 shift = m.origin - frameOrigin;
-        for (uint32_t i : m.indices)
-            if (i < m.positions.size()) all.add(glm::dvec3(m.positions[i]) + shift);
-    }
-    std::vector<Box2> protoBox(city.prototypes.size());
-    for (size_t p = 0; p < city.prototypes.size(); ++p) {
-        const SceneMesh& m = city.prototypes[p];
-        for (uint32_t i : m.indices)
-            if (i < m.positions.size()) protoBox[p].add(glm::dvec3(m.positions[i]) + m.origin);
-    }
-    std::vector<Box2> instBox(city.instances.size());
-    for (size_t k = 0; k < city.instances.size(); ++k) {
-        const SceneInstance& inst = city.instances[k];
-        if (inst.prototype >= protoBox.size() || !protoBox[inst.prototype].valid()) continue;
-        const Box2& pb = protoBox[inst.prototype];
-        for (int c = 0; c < 8; ++c) {
-            glm::dvec4 v((c & 1) ? pb.hi.x : pb.lo.x, (c & 2) ? pb.hi.y : pb.lo.y, (c & 4) ? pb.hi.z : pb.lo.z, 1.0);
-            glm::dvec4 w = inst.transform * v;
-            instBox[k].add(glm::dvec3(w) - frameOrigin);
-        }
-        all.add(instBox[k].lo);
-        all.add(instBox[k].hi);
-    }
+    const SceneBoxes boxes = sceneBoxes(city, frameOrigin);
+    const Box2& all = boxes.all;
+    const std::vector<Box2>& instBox = boxes.instances;
     if (!all.valid()) return g;  // empty
     g._boundsMin = all.lo;
     g._boundsMax = all.hi;
@@ -189,31 +204,9 @@ HeightPatch HeightGrid::patch(const SceneModel& city) const {
     if (_cells == 0) return p;
     const glm::dvec3 frameOrigin = _origin;
     // Bounds (as build()): the referenced vertices and the instances' boxes.
-    Box2 all;
-    for (const SceneMesh& m : city.meshes) {
-        glm::dvec3 shift = m.origin - frameOrigin;
-        for (uint32_t i : m.indices)
-            if (i < m.positions.size()) all.add(glm::dvec3(m.positions[i]) + shift);
-    }
-    std::vector<Box2> protoBox(city.prototypes.size());
-    for (size_t k = 0; k < city.prototypes.size(); ++k) {
-        const SceneMesh& m = city.prototypes[k];
-        for (uint32_t i : m.indices)
-            if (i < m.positions.size()) protoBox[k].add(glm::dvec3(m.positions[i]) + m.origin);
-    }
-    std::vector<Box2> instBox(city.instances.size());
-    for (size_t k = 0; k < city.instances.size(); ++k) {
-        const SceneInstance& inst = city.instances[k];
-        if (inst.prototype >= protoBox.size() || !protoBox[inst.prototype].valid()) continue;
-        const Box2& pb = protoBox[inst.prototype];
-        for (int c = 0; c < 8; ++c) {
-            glm::dvec4 v((c & 1) ? pb.hi.x : pb.lo.x, (c & 2) ? pb.hi.y : pb.lo.y, (c & 4) ? pb.hi.z : pb.lo.z, 1.0);
-            glm::dvec4 w = inst.transform * v;
-            instBox[k].add(glm::dvec3(w) - frameOrigin);
-        }
-        all.add(instBox[k].lo);
-        all.add(instBox[k].hi);
-    }
+    const SceneBoxes boxes = sceneBoxes(city, frameOrigin);
+    const Box2& all = boxes.all;
+    const std::vector<Box2>& instBox = boxes.instances;
     if (!all.valid()) return p;
     p.lo = all.lo;
     p.hi = all.hi;

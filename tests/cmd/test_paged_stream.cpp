@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/common/run_vista.h"
+#include "tests/common/small_paged_city.h"
 #include "tests/common/temp_dir.h"
 
 namespace fs = std::filesystem;
@@ -22,29 +23,12 @@ using vista::test::TempDir;
 
 namespace {
 
-// A 1.5 km city in 500 m regions (3 x 3), facade detail 1 to keep it quick.
-const std::string kCity = "gen --size 1500 --seed 4 --detail 1 --region-size 500 -q";
 // A drive that leaves regions behind: full detail within 100 m, coarse within 400 m.
 const std::string kNear = " --paged-radius 100 --paged-far 400";
 
 nlohmann::json readJson(const std::string& path) { return nlohmann::json::parse(readBytes(path)); }
 
-class PagedStream : public ::testing::Test {
-protected:
-    static void SetUpTestSuite() {
-        ref = new TempDir("vista_pagedstream_ref");
-        const CliRun r = runVista(kCity + " -o " + ref->file("city.paged"));
-        ASSERT_EQ(r.code, 0) << r.err;
-    }
-    static void TearDownTestSuite() {
-        delete ref;
-        ref = nullptr;
-    }
-    static std::string dir() { return ref->file("city.paged"); }
-    static TempDir* ref;
-    TempDir tmp{"vista_pagedstream"};
-};
-TempDir* PagedStream::ref = nullptr;
+class PagedStream : public vista::test::SmallPagedCity {};
 
 // The number before `what` in the viewer's "paged stream:" line (-1 if absent).
 int streamCount(const std::string& err, const std::string& what) {

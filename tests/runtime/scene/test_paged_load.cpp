@@ -18,6 +18,7 @@
 #include "runtime/scene/paged_load.h"
 #include "runtime/scene/paths.h"
 #include "tests/common/run_vista.h"
+#include "tests/common/small_paged_city.h"
 #include "tests/common/temp_dir.h"
 
 namespace fs = std::filesystem;
@@ -28,28 +29,11 @@ using vista::test::TempDir;
 
 namespace {
 
-// A 1.5 km city in 500 m regions (3 x 3), facade detail 1 to keep it quick.
-const std::string kCity = "gen --size 1500 --seed 4 --detail 1 --region-size 500 -q";
 const std::string kBench = " --seed 4 --frames 2 --size 160x120 --modes full -q";
 
 nlohmann::json readJson(const std::string& path) { return nlohmann::json::parse(readBytes(path)); }
 
-class PagedLoad : public ::testing::Test {
-protected:
-    static void SetUpTestSuite() {
-        ref = new TempDir("vista_pagedload_ref");
-        const CliRun r = runVista(kCity + " -o " + ref->file("city.paged"));
-        ASSERT_EQ(r.code, 0) << r.err;
-    }
-    static void TearDownTestSuite() {
-        delete ref;
-        ref = nullptr;
-    }
-    static std::string dir() { return ref->file("city.paged"); }
-    static TempDir* ref;
-    TempDir tmp{"vista_pagedload"};
-};
-TempDir* PagedLoad::ref = nullptr;
+class PagedLoad : public vista::test::SmallPagedCity {};
 
 }  // namespace
 
