@@ -221,7 +221,11 @@ Status configure(const RenderArgs& a, RenderPlan& p) {
     if (!sampling) return sampling.status();
     p.sampleRuns = *sampling;
     VISTA_RETURN_IF_ERROR(parseModeFlags(a.modeFlags, p.options));
-    p.options.cacheAdaptive = false;  // ground truth: the cache never pauses on timings (frames stay deterministic)
+    // Ground truth follows no timing, so that a rerun or a resumed run writes the same bytes: the
+    // cache never pauses on measured reuse, and the hybrid's split is fixed (--near auto draws at
+    // the default near distance instead of choosing per frame from measured costs).
+    p.options.cacheAdaptive = false;
+    if (p.options.nearDistance < 0) p.options.nearDistance = kDefaultNearDistance;
     auto po = parsePathFlags(a.path);
     if (!po) return po.status();
     p.path = *po;
