@@ -62,6 +62,26 @@ SceneBoxes sceneBoxes(const SceneModel& city, const glm::dvec3& frameOrigin) {
     return b;
 }
 
+// Calls splat(lo, hi) with the scene-local box of every triangle of the
+// city's meshes, then with each valid instance box.
+template <class Splat>
+void splatScene(const SceneModel& city, const glm::dvec3& frameOrigin, const std::vector<Box2>& instBox,
+                Splat&& splat) {
+    for (const SceneMesh& m : city.meshes) {
+        const glm::dvec3 shift = m.origin - frameOrigin;
+        for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+            Box2 b;
+            for (int k = 0; k < 3; ++k) {
+                const uint32_t i = m.indices[t + size_t(k)];
+                if (i < m.positions.size()) b.add(glm::dvec3(m.positions[i]) + shift);
+            }
+            if (b.valid()) splat(b.lo, b.hi);
+        }
+    }
+    for (const Box2& b : instBox)
+        if (b.valid()) splat(b.lo, b.hi);
+}
+
 // A 2D DDA over square cells `unit` grid cells wide, starting in cell (x, y)
 // for the ray s0 + d * t (grid units); tMax = the ray parameter where it
 // leaves the current cell in x / y.
@@ -143,20 +163,8 @@ HeightGrid HeightGrid::build(const SceneModel& city, const glm::dvec3& frameOrig
                 g._minZ[i] = std::min(g._minZ[i], zmin);
             }
     };
-    for (const SceneMesh& m : city.meshes) {
-        glm::dvec3 shift = m.origin - frameOrigin;
-        for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
-            Box2 b;
-            for (int k = 0; k < 3; ++k) {
-                uint32_t i = m.indices[t + size_t(k)];
-                if (i < m.positions.size()) b.add(glm::dvec3(m.positions[i]) + shift);
-            }
-            if (b.valid()) splat(b.lo, b.hi);
-        }
-    }
-    // Instances: conservative per-instance bounding box (tree crowns are compact).
-    for (const Box2& b : instBox)
-        if (b.valid()) splat(b.lo, b.hi);
+    // Every triangle's box, then each instance's conservative box (tree crowns are compact).
+    splatScene(city, frameOrigin, instBox, splat);
     // Blocks: max / min over their cells.
     g._blocks = (cells + kBlock - 1) / kBlock;
     const size_t nb = size_t(g._blocks) * size_t(g._blocks);
@@ -236,19 +244,7 @@ HeightPatch HeightGrid::patch(const SceneModel& city) const {
                 p.minZ[i] = std::min(p.minZ[i], zmin);
             }
     };
-    for (const SceneMesh& m : city.meshes) {
-        glm::dvec3 shift = m.origin - frameOrigin;
-        for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
-            Box2 b;
-            for (int k = 0; k < 3; ++k) {
-                uint32_t i = m.indices[t + size_t(k)];
-                if (i < m.positions.size()) b.add(glm::dvec3(m.positions[i]) + shift);
-            }
-            if (b.valid()) splat(b.lo, b.hi);
-        }
-    }
-    for (const Box2& b : instBox)
-        if (b.valid()) splat(b.lo, b.hi);
+    splatScene(city, frameOrigin, instBox, splat);
     return p;
 }
 
