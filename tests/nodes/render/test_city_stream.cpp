@@ -16,16 +16,11 @@
 #include "runtime/scene/paged_load.h"
 #include "tests/common/run_vista.h"
 #include "tests/common/temp_dir.h"
+#include "tests/nodes/render/render_fixtures.h"
 
 using namespace vista;
 
 namespace {
-
-#define REQUIRE_DISPLAY()                                                                         \
-    do {                                                                                          \
-        const char* d = std::getenv("DISPLAY");                                                   \
-        if (!d || !*d) GTEST_SKIP() << "no X display: run the rendering tests under xvfb-run -a"; \
-    } while (0)
 
 struct Frame {
     Image image;
