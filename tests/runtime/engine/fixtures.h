@@ -6,6 +6,7 @@
 
 #include <glm/glm.hpp>
 
+#include "runtime/engine/adaptive_split.h"
 #include "runtime/scene/camera.h"
 #include "runtime/scene/city_file.h"
 
@@ -76,6 +77,15 @@ inline SceneModel randomCity(uint32_t seed, int boxes, double extent = 400.0, do
     city.meshes.push_back(b);
     city.triangles = (ground.indices.size() + b.indices.size()) / 3;
     return city;
+}
+
+// A split object (adaptive_split.h): the box lo .. hi holding `tris` triangles.
+inline SplitObject splitBox(glm::dvec3 lo, glm::dvec3 hi, uint64_t tris) {
+    SplitObject o;
+    o.lo = lo;
+    o.hi = hi;
+    o.triangles = tris;
+    return o;
 }
 
 }  // namespace vista::test

@@ -15,13 +15,6 @@ using namespace vista;
 using namespace vista::test;
 
 namespace {
-SplitObject box(glm::dvec3 lo, glm::dvec3 hi, uint64_t tris) {
-    SplitObject o;
-    o.lo = lo;
-    o.hi = hi;
-    o.triangles = tris;
-    return o;
-}
 // A random 800 m city of 150 boxes as a ray scene, and one split object over it.
 struct ProbeScene {
     std::unique_ptr<RayScene> rays;
@@ -30,14 +23,14 @@ struct ProbeScene {
 ProbeScene probeScene(uint32_t seed) {
     auto rs = RayScene::build(randomCity(seed, 150, 800.0));
     VISTA_CHECK(rs.isOk());
-    return ProbeScene{std::move(rs.value()), {box({-400, -400, 0}, {400, 400, 60}, 1000)}};
+    return ProbeScene{std::move(rs.value()), {splitBox({-400, -400, 0}, {400, 400, 60}, 1000)}};
 }
 // One object per 50 m square of an 800 m city, 1000 triangles each.
 std::vector<SplitObject> squareObjects() {
     std::vector<SplitObject> objs;
     for (int x = -8; x < 8; ++x)
         for (int y = -8; y < 8; ++y)
-            objs.push_back(box({x * 50.0, y * 50.0, 0}, {x * 50.0 + 50, y * 50.0 + 50, 60}, 1000));
+            objs.push_back(splitBox({x * 50.0, y * 50.0, 0}, {x * 50.0 + 50, y * 50.0 + 50, 60}, 1000));
     return objs;
 }
 // A 64x48 camera at `eye`, looking along +y.
@@ -59,10 +52,10 @@ AdaptiveSplitOptions measuredOnly() {
 
 TEST(Split, DistanceSelectionDrawsStraddlingObjectsWhole) {
     std::vector<SplitObject> objs = {
-        box({10, -1, 0}, {20, 1, 5}, 10),    // 10 m away
-        box({95, -1, 0}, {120, 1, 5}, 20),   // straddles 100 m
-        box({101, -1, 0}, {130, 1, 5}, 30),  // just beyond
-        box({-5, -5, 0}, {5, 5, 50}, 40),    // contains the eye
+        splitBox({10, -1, 0}, {20, 1, 5}, 10),    // 10 m away
+        splitBox({95, -1, 0}, {120, 1, 5}, 20),   // straddles 100 m
+        splitBox({101, -1, 0}, {130, 1, 5}, 30),  // just beyond
+        splitBox({-5, -5, 0}, {5, 5, 50}, 40),    // contains the eye
     };
     auto sel = selectNearField(objs, glm::dvec3(0, 0, 2), 100.0);
     EXPECT_EQ(sel, (std::vector<uint32_t>{0, 1, 3}));
@@ -265,7 +258,7 @@ TEST(Split, ProbeRateCapsOnlyTheFallbackToTheMean) {
 // off the line the other frames lie on (a least-squares fit would: it is
 // pulled towards the outliers' slope).
 TEST(Split, RasterCostFitIgnoresFramesSlowedByOtherWork) {
-    std::vector<SplitObject> objs = {box({0, 0, 0}, {10, 10, 10}, 1000)};
+    std::vector<SplitObject> objs = {splitBox({0, 0, 0}, {10, 10, 10}, 1000)};
     AdaptiveSplitOptions o;
     o.timeProbe = false;
     AdaptiveSplit clean(objs, nullptr, o), noisy(objs, nullptr, o);
@@ -302,9 +295,9 @@ TEST(Split, GridIndexSelectsExactlyWhatTheLinearScanSelects) {
         const glm::dvec3 lo(pos(rng), pos(rng), 0.0);
         const bool wide = i % 97 == 0, point = i % 89 == 0;
         const glm::dvec3 size = point ? glm::dvec3(0.0) : glm::dvec3(wide ? big(rng) : ext(rng), ext(rng), h(rng));
-        objs.push_back(box(lo, lo + size, uint64_t(1 + i % 13)));
+        objs.push_back(splitBox(lo, lo + size, uint64_t(1 + i % 13)));
     }
-    objs.push_back(box({40000, 40000, 0}, {40030, 40030, 10}, 5));
+    objs.push_back(splitBox({40000, 40000, 0}, {40030, 40030, 10}, 5));
     for (double cell : {16.0, 64.0, 500.0}) {
         SplitIndex index(objs, cell);
         uint64_t total = 0;

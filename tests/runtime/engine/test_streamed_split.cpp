@@ -13,21 +13,15 @@
 
 #include "runtime/engine/adaptive_split.h"
 #include "runtime/engine/horizon.h"
+#include "tests/runtime/engine/fixtures.h"
 
 using namespace vista;
+using vista::test::splitBox;
 
 namespace {
 
 constexpr double kRegion = 400.0;  // metres a region side
 constexpr double kChunk = 40.0;
-
-SplitObject box(glm::dvec3 lo, glm::dvec3 hi, uint64_t tris) {
-    SplitObject o;
-    o.lo = lo;
-    o.hi = hi;
-    o.triangles = tris;
-    return o;
-}
 
 // The objects of region (rx, ry): 40 m chunks of varying heights, one wider "large" chunk.
 std::vector<SplitObject> regionObjects(int rx, int ry) {
@@ -35,10 +29,10 @@ std::vector<SplitObject> regionObjects(int rx, int ry) {
     const glm::dvec3 o(rx * kRegion, ry * kRegion, 0.0);
     for (int y = 0; y < 10; ++y)
         for (int x = 0; x < 10; ++x)
-            out.push_back(box(o + glm::dvec3(x * kChunk, y * kChunk, 0.0),
-                              o + glm::dvec3((x + 1) * kChunk, (y + 1) * kChunk, 5.0 + (x * 7 + y * 3) % 40),
-                              uint64_t(100 + x + 10 * y)));
-    out.push_back(box(o + glm::dvec3(-5.0, 100.0, 0.0), o + glm::dvec3(kRegion + 5.0, 130.0, 1.0), 7));
+            out.push_back(splitBox(o + glm::dvec3(x * kChunk, y * kChunk, 0.0),
+                                   o + glm::dvec3((x + 1) * kChunk, (y + 1) * kChunk, 5.0 + (x * 7 + y * 3) % 40),
+                                   uint64_t(100 + x + 10 * y)));
+    out.push_back(splitBox(o + glm::dvec3(-5.0, 100.0, 0.0), o + glm::dvec3(kRegion + 5.0, 130.0, 1.0), 7));
     return out;
 }
 
@@ -58,8 +52,8 @@ struct Streamed {
     void remove(int rx, int ry) {
         const uint64_t key = uint64_t(ry) * 1000 + uint64_t(rx);
         index.removeBlock(key);
-        SplitObject none = box(glm::dvec3(std::numeric_limits<double>::infinity()),
-                               glm::dvec3(std::numeric_limits<double>::infinity()), 0);
+        SplitObject none = splitBox(glm::dvec3(std::numeric_limits<double>::infinity()),
+                                    glm::dvec3(std::numeric_limits<double>::infinity()), 0);
         for (uint32_t i = first[key]; i < first[key] + 101; ++i) objects[i] = none;  // a free run
         first.erase(key);
     }
