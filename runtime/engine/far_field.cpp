@@ -110,14 +110,19 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
     const bool seam = seamCheckApplies(f, _rays, _options);
     opacityStage(f, stats, seam ? seamListDepth(f, _options) : 2.0f);
     if (seam && f.covered > 0) seamStage(f, _rays, _options, stats);
-    if (_options.hazeCovered && _options.effects.haze && depth && f.covered > 0) hazeCoveredStage(f, _options, stats);
+    CoveredHaze haze;  // beside the stages below; done before the composite reads the frame
+    haze.start(f, _options);
     stats.pixels.covered += f.covered;
-    if (f.covered == f.pixelCount) return;  // no sky, no far field visible: nothing else runs
+    if (f.covered == f.pixelCount) {  // no sky, no far field visible: nothing else runs
+        haze.finish(stats);
+        return;
+    }
 
     f.sky = &skyImage(*_mem, f);
     if (!farGeometryExists(_rays, _grid, camera, _options)) {
         stats.notes.push_back("rays off: no far geometry beyond the near distance");
         cullAllPending(f, stats);
+        haze.finish(stats);
         compositeStage(f, *_mem, false, stats);
         return;
     }
@@ -178,6 +183,7 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
         const double perRay = (stats.stages.ms(Stage::Rays) - before) / double(f.trace.size());
         _mem->msPerRay = _mem->msPerRay > 0 ? 0.8 * _mem->msPerRay + 0.2 * perRay : perRay;
     }
+    haze.finish(stats);
     const double before = stats.stages.ms(Stage::Composite);
     // The last frame is the fallback of never-traced cells left out by a budget: kept only under one.
     compositeStage(f, *_mem, cacheRan, stats, cacheRan && budgeted);

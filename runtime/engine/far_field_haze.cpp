@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
 
 #include "foundation/timing.h"
 #include "runtime/engine/far_field_stages.h"
@@ -19,7 +20,7 @@
 namespace vista {
 
 const HazeKernels& hazeKernelsBaseline() {
-    static constexpr HazeKernels k{hazeCoveredKernel, hazeDepthKernel, transmittanceKernel};
+    static constexpr HazeKernels k{hazeWindowKernel, hazeDepthKernel, transmittanceKernel};
     return k;
 }
 
@@ -83,29 +84,72 @@ void hazeStage(const FrameEffects& fx, const uint32_t* pixels, size_t n, const f
     recordHaze(sw.ms(), stats);
 }
 
-void hazeCoveredStage(FarFrame& f, const FarFieldOptions& o, FrameStats& stats) {
-    if (!o.effects.haze || !f.depth) return;
-    Stopwatch sw;
-    const HazeParams h = hazeParams(o.effects);
-    const HazeKernels& kernels = hazeKernels();
+void hazeCoveredRows(const HazeKernels& k, PixelWord* px, const float* depth, size_t width, size_t y0, size_t y1,
+                     const uint32_t* skip, size_t nSkip, float na, float b, const HazeParams& h) {
+    const uint32_t* skipEnd = skip + nSkip;
+    const uint32_t* next = std::lower_bound(skip, skipEnd, uint32_t(y0 * width));
+    for (size_t y = y0; y < y1; ++y) {
+        const size_t row = y * width;
+        const float* d = depth + row;
+        PixelWord* p = px + row;
+        size_t covered = 0;
+        for (size_t x = 0; x < width; ++x) covered += d[x] < 1.0f ? 1u : 0u;  // vectorised count
+        const bool skipsHere = next != skipEnd && *next < row + width;
+        if (covered == 0) {
+            while (next != skipEnd && *next < row + width) ++next;
+            continue;
+        }
+        if (covered == width && !skipsHere) {
+            k.window(p, d, width, na, b, h);
+            continue;
+        }
+        // A row the skyline, a far object or a seam hit crosses: its covered runs one by one.
+        size_t x = 0;
+        while (x < width) {
+            while (x < width && !(d[x] < 1.0f && !(next != skipEnd && *next == row + x))) {
+                if (next != skipEnd && *next == row + x) ++next;
+                ++x;
+            }
+            const size_t start = x;
+            while (x < width && d[x] < 1.0f && !(next != skipEnd && *next == row + x)) ++x;
+            if (x > start) k.window(p + start, d + start, x - start, na, b, h);
+        }
+    }
+}
+
+void CoveredHaze::start(const FarFrame& f, const FarFieldOptions& o) {
+    if (!o.hazeCovered || !o.effects.haze || !f.depth || f.covered == 0) return;
+    _started = true;
+    _seamHits.clear();
+    for (const uint32_t i : f.seamCandidates)
+        if (f.cls[i] != kFarCovered) _seamHits.push_back(i);
     // Eye depth of window depth d: z = a / (b - d) (eyeDepthOfWindowDepth
     // rearranged; infinite far plane: a = n, b = 1), in float: its relative
     // error (1e-7) is far below an 8-bit step.
     const double zn = f.camera.zNear, zf = o.depthZFar;
     const float a = float(zf > 0 ? zn * zf / (zf - zn) : zn), b = float(zf > 0 ? zf / (zf - zn) : 1.0);
+    const HazeParams h = hazeParams(o.effects);
     const float na = -h.beta * a;
-    const size_t W = size_t(f.width);
+    const size_t W = size_t(f.width), H = size_t(f.height);
     PixelWord* px = reinterpret_cast<PixelWord*>(f.out.rgba.data());
-    const uint8_t* cls = f.cls.data();
     const float* depth = f.depth;
-    inArena(o.threads, [&] {
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, size_t(f.height), 32),
-                          [&](const tbb::blocked_range<size_t>& r) {
-                              kernels.covered(px + r.begin() * W, cls + r.begin() * W, depth + r.begin() * W,
-                                              (r.end() - r.begin()) * W, na, b, h);
-                          });
-    });
-    recordHaze(sw.ms(), stats);
+    auto body = [this, px, depth, W, H, na, b, h] {
+        Stopwatch sw;
+        const HazeKernels& kernels = hazeKernels();
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, H, 16), [&](const tbb::blocked_range<size_t>& r) {
+            hazeCoveredRows(kernels, px, depth, W, r.begin(), r.end(), _seamHits.data(), _seamHits.size(), na, b, h);
+        });
+        _ms = sw.ms();
+    };
+    if (o.threads > 0) inArena(o.threads, body);
+    else _group.run(body);
+}
+
+void CoveredHaze::finish(FrameStats& stats) {
+    if (!_started) return;
+    _group.wait();
+    _started = false;
+    recordHaze(_ms, stats);
 }
 
 }  // namespace vista

@@ -17,6 +17,7 @@
 
 #include <glm/glm.hpp>
 #include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 
 #include "runtime/engine/far_field.h"
 #include "runtime/engine/far_field_rays.h"
@@ -157,10 +158,33 @@ bool seamCheckApplies(const FarFrame& f, const RayScene& rays, const FarFieldOpt
 void seamStage(FarFrame& f, const RayScene& rays, const FarFieldOptions& o, FrameStats& stats);
 
 // Haze of the covered pixels (far_field_haze.cpp), run when o.hazeCovered,
-// haze is on and depth exists: every pixel still covered gets the haze of its
-// eye-plane depth (from depth, camera.zNear, o.depthZFar), the blend of
-// FrameEffects::applyHaze. Records Haze (stage and effect).
-void hazeCoveredStage(FarFrame& f, const FarFieldOptions& o, FrameStats& stats);
+// haze is on and depth exists: every pixel still covered after the seam stage
+// (window depth < 1, not a seam hit) gets the haze of its eye-plane depth
+// (from depth, camera.zNear, o.depthZFar), the blend of
+// FrameEffects::applyHaze. start(), after the seam stage (the last stage that
+// turns a covered pixel into another class), runs it as a task beside the
+// later stages: they write only pixels that are not covered, it writes only
+// covered ones, and it reads the depth buffer, which nothing writes, so the
+// work fills the cores the serial stages (opacity, horizon, the cache's
+// lookups) leave idle. finish() waits for it (before anything reads a covered
+// pixel's colour) and records Haze (stage and effect: the task's own wall
+// time). With o.threads > 0 (each stage in an arena of its own) it runs within
+// start(). The destructor waits.
+class CoveredHaze {
+public:
+    CoveredHaze() = default;
+    CoveredHaze(const CoveredHaze&) = delete;
+    CoveredHaze& operator=(const CoveredHaze&) = delete;
+    ~CoveredHaze() { _group.wait(); }
+    void start(const FarFrame& f, const FarFieldOptions& o);
+    void finish(FrameStats& stats);
+
+private:
+    tbb::task_group _group;
+    std::vector<uint32_t> _seamHits;  // ascending pixel indices
+    double _ms = 0;
+    bool _started = false;
+};
 
 // Horizon (far_field_horizon.cpp), run when o.horizon. In: grid,
 // columnNeeded, moving, camera. When horizon tracing applies, pending pixels

@@ -10,8 +10,10 @@
 // never stands in for the baseline's.
 //
 // Kernels (PixelWord: an RGBA8 pixel as a 32-bit word, red in byte 0):
-//   covered(px, cls, depth, n, na, b, p): pixels whose class is kFarCovered
-//     hazed at eye depth a / (b - depth) (window depth; na = -beta a).
+//   window(px, depth, n, na, b, p): every pixel of a span hazed at eye depth
+//     a / (b - depth) (window depth; na = -beta a). Writes those n pixels only,
+//     so spans of covered pixels can be hazed while other threads write the
+//     pixels between them.
 //   depth(px, depth, n, p): pixels hazed at eye depth depth[k] (+inf = sky, kept).
 //   transmittances(depth, n, beta, t): t[k] = exp(-beta depth[k]).
 #pragma once
@@ -30,14 +32,19 @@ struct HazeParams {
 };
 
 struct HazeKernels {
-    void (*covered)(PixelWord* px, const uint8_t* cls, const float* depth, size_t n, float na, float b,
-                    const HazeParams& p);
+    void (*window)(PixelWord* px, const float* depth, size_t n, float na, float b, const HazeParams& p);
     void (*depth)(PixelWord* px, const float* depth, size_t n, const HazeParams& p);
     void (*transmittances)(const float* depth, size_t n, float beta, float* t);
 };
 
 // The kernels for this CPU.
 const HazeKernels& hazeKernels();
+// The covered pixels of rows [y0, y1) of a frame `width` pixels wide, hazed by
+// k.window: the runs of window depth < 1 (the opacity stage's rule) less the
+// pixels listed in skip (ascending indices y * width + x). No other pixel is
+// read or written.
+void hazeCoveredRows(const HazeKernels& k, PixelWord* px, const float* depth, size_t width, size_t y0, size_t y1,
+                     const uint32_t* skip, size_t nSkip, float na, float b, const HazeParams& h);
 // The baseline kernels and, where built and supported by the CPU, the AVX2 ones (else null).
 const HazeKernels& hazeKernelsBaseline();
 const HazeKernels* hazeKernelsAvx2();
@@ -80,16 +87,11 @@ inline uint32_t hazeBlend(uint32_t p, float t, const HazeParams& h) {
     return uint32_t(r | (g << 8) | (b << 16)) | (p & 0xff000000u);
 }
 
-// Every pixel is computed and the covered ones (class 0) kept by a mask, so the loop vectorises.
-void hazeCoveredKernel(PixelWord* px, const uint8_t* cls, const float* depth, size_t n, float na, float b,
-                       const HazeParams& h) {
+void hazeWindowKernel(PixelWord* px, const float* depth, size_t n, float na, float b, const HazeParams& h) {
     for (size_t i = 0; i < n; ++i) {
-        const uint32_t p = px[i];
         float w = b - depth[i];
         w = w > 1e-30f ? w : 1e-30f;
-        const uint32_t q = hazeBlend(p, expNonPositive(na / w), h);
-        const uint32_t keep = uint32_t(cls[i] == 0) - 1u;  // all ones = not covered: unchanged
-        px[i] = (q & ~keep) | (p & keep);
+        px[i] = hazeBlend(px[i], expNonPositive(na / w), h);
     }
 }
 

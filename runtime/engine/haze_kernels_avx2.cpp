@@ -8,7 +8,7 @@
 namespace vista {
 
 namespace {
-constexpr HazeKernels kAvx2{hazeCoveredKernel, hazeDepthKernel, transmittanceKernel};
+constexpr HazeKernels kAvx2{hazeWindowKernel, hazeDepthKernel, transmittanceKernel};
 }  // namespace
 
 const HazeKernels* hazeKernelsAvx2Table() { return &kAvx2; }
