@@ -120,7 +120,7 @@ Status advanceStream(BenchRun& run, const Path& path, size_t i, const Camera& ca
     *arrived = f->arrived;
     // What the modes kept of the old scene (hybrid's panoramic cache) goes.
     if (f->arrived > 0 || f->dropped > 0)
-        for (auto& m : run.modes) m->sceneChanged();
+        for (auto& m : run.modes) m->sceneChanged(f->changed);
     return Status::ok();
 }
 

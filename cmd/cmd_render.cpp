@@ -375,7 +375,7 @@ Status advanceStream(RenderSession& s, const Path& path, size_t i, const Camera&
     if (!f) return f.status();
     s.framesWithArrivals += f->arrived > 0 ? 1 : 0;
     // A mode that caches what it traced (hybrid's panoramic cache) drops it when regions change.
-    if ((f->arrived > 0 || f->dropped > 0) && s.mode) s.mode->sceneChanged();
+    if ((f->arrived > 0 || f->dropped > 0) && s.mode) s.mode->sceneChanged(f->changed);
     return Status::ok();
 }
 

@@ -97,6 +97,13 @@ bool removeGroup(osg::Group* root, std::map<std::pair<bool, int>, osg::ref_ptr<o
     return true;
 }
 
+// A region's manifest bounds (its full and coarse levels' graphs), a metre wider on every side
+// for the ray scene's own copy of the geometry.
+std::pair<glm::dvec3, glm::dvec3> changedBox(const PagedManifest& m, int region) {
+    const PagedRegionEntry& e = m.regions[size_t(region)];
+    return {e.lo - glm::dvec3(1.0), e.hi + glm::dvec3(1.0)};
+}
+
 }  // namespace
 
 Result<CityStreamFrame> CityStream::advance(const glm::dvec3& eye, const glm::dvec3& velocity, bool wait) {
@@ -118,6 +125,7 @@ Result<CityStreamFrame> CityStream::advance(const glm::dvec3& eye, const glm::dv
         if (_labelRoot) removeGroup(_labelRoot.get(), _labelGroups, {x.coarse, x.region});
         if (!removeGroup(_root.get(), _groups, {x.coarse, x.region})) continue;
         if (_near) _near->remove(levelKey(x.region, x.coarse));
+        f.changed.push_back(changedBox(*_manifest, x.region));
         ++f.dropped;
     }
     for (RegionArrival& a : d.arrived) {
@@ -131,6 +139,7 @@ Result<CityStreamFrame> CityStream::advance(const glm::dvec3& eye, const glm::dv
             insertInMergeOrder(_labelRoot.get(), _labelGroups, {a.coarse, a.region}, chunks->labels.get());
         }
         if (_near && chunks->nearField) _near->add(levelKey(a.region, a.coarse), *chunks->nearField);
+        f.changed.push_back(changedBox(*_manifest, a.region));
         ++f.arrived;
     }
     if (f.arrived > 0 || f.dropped > 0) ++_generation;

@@ -54,6 +54,9 @@ namespace vista {
 
 struct CityStreamFrame {
     int arrived = 0, dropped = 0;  // region levels
+    // The world boxes (manifest bounds, both levels) of the levels that arrived or left, for
+    // RenderMode::sceneChanged.
+    std::vector<std::pair<glm::dvec3, glm::dvec3>> changed;
     bool waited = false;
     std::vector<std::string> damaged;
 };

@@ -124,10 +124,10 @@ public:
         return Status::ok();
     }
     void reset() override { _far->reset(); }
-    // The ray scene changed (a streamed city): nothing traced in the old one is served again.
-    // The near field's root state comes with the first region.
-    void sceneChanged() override {
-        _far->reset();
+    // The ray scene changed (a streamed city): nothing traced in the old one that could show a
+    // changed region is served again. The near field's root state comes with the first region.
+    void sceneChanged(const std::vector<std::pair<glm::dvec3, glm::dvec3>>& changed) override {
+        _far->sceneChanged(changed);
         if (!_root->getStateSet() && _near.rootState) _root->setStateSet(_near.rootState.get());
     }
     bool hazesRasterPixels() const override { return true; }  // FarFieldOptions::hazeCovered

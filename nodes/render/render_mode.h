@@ -164,11 +164,13 @@ public:
     // The walkthrough restarts or jumps: caches are dropped.
     virtual void reset() {}
     // A streamed city's resident regions changed between frames (regions
-    // arrived or left the ray scene and the near field): what the mode kept
-    // of the old scene (hybrid: the panoramic cache, last frame's pixels and
-    // speculative rays) is dropped, so no pixel of a dropped region, and none
-    // hiding an arrived one, is served again.
-    virtual void sceneChanged() {}
+    // arrived or left the ray scene and the near field; `changed` holds their
+    // world boxes): what the mode kept of the old scene that could show them
+    // (hybrid: the panoramic cache cells whose rays pass through a box,
+    // FarField::sceneChanged, its speculative rays and kept frame) is
+    // dropped, so no pixel of a dropped region, and none hiding an arrived
+    // one, is served again; the rest is kept.
+    virtual void sceneChanged(const std::vector<std::pair<glm::dvec3, glm::dvec3>>& changed) { (void)changed; }
     // Viewer face: the graph to draw (built on the first call, owned by the mode).
     virtual osg::Node* viewerScene() = 0;
     // Before every viewer frame, with the camera about to be drawn: returns

@@ -86,6 +86,16 @@ void FarField::reset() {
     _mem->lastFrameCached = false;
 }
 
+uint64_t FarField::sceneChanged(const std::vector<std::pair<glm::dvec3, glm::dvec3>>& boxes) {
+    _mem->spec.discard();
+    _mem->prev = Image();
+    _mem->lastFrameCached = false;  // the next frame's reuse is no verdict on the cache
+    uint64_t forgotten = 0;
+    if (_mem->cache)
+        for (const auto& [lo, hi] : boxes) forgotten += _mem->cache->invalidateBox(lo, hi, _mem->cacheReach);
+    return forgotten;
+}
+
 void FarField::render(const Camera& camera, const float* depth, Image& out, FrameStats& stats) {
     VISTA_CHECK(camera.width >= 1 && camera.height >= 1);
     if (out.width != camera.width || out.height != camera.height || !out.valid())

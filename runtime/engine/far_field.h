@@ -44,6 +44,7 @@
 #pragma once
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "runtime/engine/frame_effects.h"
@@ -181,6 +182,12 @@ public:
     void awaitSpeculation();
     // Drops the cache (walkthrough jump).
     void reset();
+    // Parts of the scene inside these world boxes arrived or left (a streamed
+    // city): the cache forgets the cells whose rays could pass through one
+    // (PanoramaCache::invalidateBox), the speculative rays cast into the old
+    // scene and the kept frame go; every other cell is served as before.
+    // Returns the number of cells forgotten.
+    uint64_t sceneChanged(const std::vector<std::pair<glm::dvec3, glm::dvec3>>& boxes);
     // Per pixel of the last frame: a FarPixelClass (0 covered, 1 horizon, 2 cache, 3 hit, 4 miss).
     const std::vector<uint8_t>& classification() const { return _class; }
     // The pixels the ray stage of the last frame cast (ascending indices

@@ -68,6 +68,7 @@ void cacheStage(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, FrameS
     policy.lowerDepth = o.nearIsDistance && o.nearDistance > 0 ? o.nearDistance : m.lastMinDepth;
     policy.windowPx = kCacheWindowPx;
     policy.budget = cacheBudget(f, m, o, spentMs);
+    m.cacheReach = PanoramaCache::reuseReach(policy);
     if (o.frameMsTarget > 0) stats.notes.push_back("cache budget " + std::to_string(policy.budget) + " rays");
     f.farDepth.resize(f.pixelCount);  // only pending pixels are read: cache ones below, traced ones by the ray stage
     std::vector<uint8_t>& trace = m.traceMarks;

@@ -86,6 +86,7 @@ constexpr size_t kSpeculativeChunk = 512;  // rays per chunk of SpeculativeRays
 struct FarFieldMemory {
     std::unique_ptr<PanoramaCache> cache;
     double cacheKey[4] = {0, 0, 0, 0};  // fovY, width, height, oversample of the cache
+    double cacheReach = 0;              // PanoramaCache::reuseReach of the last cache frame's policy
     Image prev;                         // last composited frame (cache mode)
     Image sky;                          // sky colours (depend on pitch, roll, fov, size only)
     double skyKey[5] = {1e300, 0, 0, 0, 0};

@@ -96,6 +96,64 @@ void PanoramaCache::clear() {
     _current = 0;
 }
 
+double PanoramaCache::reuseReach(const CachePolicy& p) {
+    return p.lowerDepth > 0 ? (p.maxErrorPx + p.windowPx) * p.radPerPixel * p.lowerDepth : 0.0;
+}
+
+uint64_t PanoramaCache::invalidateBox(const glm::dvec3& lo, const glm::dvec3& hi, double reach) {
+    if (_current == 0) return 0;  // nothing traced yet
+    const uint64_t all = uint64_t(_width) * uint64_t(_height);
+    auto forgetAll = [&] {
+        clear();
+        return all;
+    };
+    const glm::dvec3 eye = _records[_current].eye;
+    double b = 0;
+    for (size_t i = 1; i < _records.size(); ++i) {
+        const double d = glm::length(_records[i].eye - eye);
+        if (d > reach) _records[i].forgotten = true;
+        else if (!_records[i].forgotten) b = std::max(b, d);
+    }
+    // Horizontal distances from the eye to the box's footprint (nearest and farthest point).
+    const double dx = std::max({lo.x - eye.x, 0.0, eye.x - hi.x}), dy = std::max({lo.y - eye.y, 0.0, eye.y - hi.y});
+    const double hMin = std::hypot(dx, dy) - b;
+    if (!(hMin > 1e-6)) return forgetAll();
+    const double fx = std::max(std::abs(lo.x - eye.x), std::abs(hi.x - eye.x));
+    const double fy = std::max(std::abs(lo.y - eye.y), std::abs(hi.y - eye.y));
+    const double hMax = std::hypot(fx, fy) + b;
+    // Elevations (v = tan) the box spans from any record's eye.
+    const double zTop = hi.z - eye.z + b, zBottom = lo.z - eye.z - b;
+    const double vTop = zTop / (zTop > 0 ? hMin : hMax), vBottom = zBottom / (zBottom < 0 ? hMin : hMax);
+    if (vBottom > _vMax || vTop < -_vMax) return 0;
+    const int rowFirst = std::clamp(int(std::floor((_vMax - vTop) / (2.0 * _vMax) * _height)) - 1, 0, _height - 1);
+    const int rowLast = std::clamp(int(std::floor((_vMax - vBottom) / (2.0 * _vMax) * _height)) + 1, 0, _height - 1);
+    // Azimuths of the corners about the centre's (the box is outside the eye's reach: its span is under pi).
+    const double azC = std::atan2(0.5 * (lo.x + hi.x) - eye.x, 0.5 * (lo.y + hi.y) - eye.y);
+    double aMin = 0, aMax = 0;
+    for (const double x : {lo.x, hi.x})
+        for (const double y : {lo.y, hi.y}) {
+            double a = std::atan2(x - eye.x, y - eye.y) - azC;
+            a -= kTwoPi * std::floor((a + kPi) / kTwoPi);  // into [-pi, pi)
+            aMin = std::min(aMin, a);
+            aMax = std::max(aMax, a);
+        }
+    const double margin = std::asin(std::min(1.0, b / (hMin + b)));
+    const double perCell = double(_width) / kTwoPi;
+    const int64_t colFirst = int64_t(std::floor((azC + aMin - margin) * perCell)) - 1;
+    const int64_t colLast = int64_t(std::floor((azC + aMax + margin) * perCell)) + 1;
+    if (colLast - colFirst + 1 >= _width) {
+        for (int r = rowFirst; r <= rowLast; ++r)
+            std::fill_n(&_cells[size_t(r) * size_t(_width)], size_t(_width), Cell{});
+        return uint64_t(rowLast - rowFirst + 1) * uint64_t(_width);
+    }
+    for (int r = rowFirst; r <= rowLast; ++r)
+        for (int64_t c = colFirst; c <= colLast; ++c) {
+            const int64_t col = ((c % _width) + _width) % _width;
+            _cells[size_t(r) * size_t(_width) + size_t(col)] = Cell{};
+        }
+    return uint64_t(rowLast - rowFirst + 1) * uint64_t(colLast - colFirst + 1);
+}
+
 void PanoramaCache::beginFrame(const Camera& c) {
     const bool same = _current != 0 && [&] {
         const Record& r = _records[_current];
@@ -128,7 +186,7 @@ void PanoramaCache::compact() {
     if (_current) used[_current] = 1;
     std::vector<Record> kept(1);
     for (size_t i = 1; i < _records.size(); ++i)
-        if (used[i]) {
+        if (used[i] && !_records[i].forgotten) {
             remap[i] = uint32_t(kept.size());
             kept.push_back(_records[i]);
         }
@@ -146,7 +204,7 @@ void PanoramaCache::compact() {
 double PanoramaCache::error(int64_t cell, glm::u8vec2 sub, const CachePolicy& p) const {
     const Cell& c = _cells[size_t(cell)];
     const uint32_t r = c.record;
-    if (r == 0) return INFINITY;
+    if (r == 0 || _records[r].forgotten) return INFINITY;
     if (r == _current) return -1.0;  // traced by this very camera
     // Resampling: the angle between the cell's traced ray and this one. On the
     // cylinder a column step is 2 pi / width of azimuth (times cos elevation

@@ -87,6 +87,21 @@ public:
     // (a walkthrough's first frames, after its warm-up) pay no first touch of
     // a page inside the far field's cache stage.
     void clear();
+    // Forgets the cells whose ray, from the eye of any record, could pass
+    // through the box [lo, hi] (a part of the scene that arrived or left).
+    // Records whose eye lies more than `reach` metres from the current
+    // record's are forgotten whole (no memory touched; pass the largest
+    // baseline at which the policy still reuses a cell, e.g. reuseReach());
+    // of the others, the cells within the box's azimuth and elevation span
+    // seen from the current eye, widened by the largest distance b to their
+    // eyes (a point at distance d is seen from an eye b away at most
+    // asin(b / d) off) and by a cell. Every cell goes when the box comes
+    // within b of the current eye horizontally. Returns the number of cells
+    // zeroed (0 when nothing was traced yet).
+    uint64_t invalidateBox(const glm::dvec3& lo, const glm::dvec3& hi, double reach);
+    // The largest eye distance at which `policy` can still reuse a cell (metres; 0 = never:
+    // lowerDepth unknown): (maxErrorPx + windowPx) * radPerPixel * lowerDepth.
+    static double reuseReach(const CachePolicy& policy);
     // Starts a frame for `camera`: picks or creates the current record.
     void beginFrame(const Camera& camera);
     // The reprojection error (pixels) of reusing `cell` now for a ray at `sub` (see above); -1 = exact.
@@ -111,6 +126,7 @@ private:
         glm::dvec3 eye{0.0};
         double heading = 0, pitch = 0, roll = 0, fovY = 0;
         int width = 0, height = 0;
+        bool forgotten = false;  // invalidateBox: its cells count as never traced
     };
     void compact();
     int _width = 0, _height = 0;

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <random>
 
 #include "runtime/engine/far_field.h"
@@ -124,6 +125,89 @@ TEST(Panorama, ClearForgetsEveryCell) {
         ASSERT_EQ(pc.color(c).w, 0) << c;
         ASSERT_TRUE(std::isinf(pc.nearDistance(c))) << c;
     }
+}
+
+// A part of the scene arrived or left: every cell whose stored ray, from its
+// own record's eye, passes through the box (checked by a slab test on the ray
+// itself) counts as never traced; a record farther than the reach is
+// forgotten whole; most cells elsewhere are kept.
+TEST(Panorama, InvalidateBoxForgetsEveryCellWhoseRayCrossesTheBox) {
+    PanoramaCache pc(720, 200, 1.0);
+    const glm::dvec3 lo(40, 60, 0), hi(80, 120, 30);
+    auto crosses = [&](const glm::dvec3& o, const glm::dvec3& d) {
+        double t0 = 0, t1 = 1e30;
+        for (int k = 0; k < 3; ++k) {
+            if (std::abs(d[k]) < 1e-15) {
+                if (o[k] < lo[k] || o[k] > hi[k]) return false;
+                continue;
+            }
+            double a = (lo[k] - o[k]) / d[k], b = (hi[k] - o[k]) / d[k];
+            if (a > b) std::swap(a, b);
+            t0 = std::max(t0, a);
+            t1 = std::min(t1, b);
+        }
+        return t0 <= t1;
+    };
+    struct Sample {
+        glm::dvec3 eye, dir;
+        int64_t cell;
+        glm::u8vec2 sub;
+        bool far;
+    };
+    std::vector<Sample> samples;
+    std::map<int64_t, size_t> lastWriter;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> az(0.0, 2.0 * M_PI), v(-0.9, 0.9);
+    // The far record first, the current one (the origin) last.
+    const glm::dvec3 eyes[4] = {{100, 0, 2}, {1.0, 0.2, 2}, {0.5, 0, 2}, {0, 0, 2}};
+    for (int r = 0; r < 4; ++r) {
+        pc.beginFrame(cam(eyes[r], 0.1 * r));
+        std::vector<int64_t> cells;
+        std::vector<glm::u8vec2> subs;
+        std::vector<glm::u8vec4> colors;
+        std::vector<float> nears;
+        std::map<int64_t, int> inFrame;
+        for (int k = 0; k < 4000; ++k) {
+            const double a = az(rng);
+            const glm::dvec3 d = glm::normalize(glm::dvec3(std::sin(a), std::cos(a), v(rng)));
+            glm::u8vec2 sub;
+            const int64_t c = pc.index(d, &sub);
+            if (c < 0 || inFrame[c]++ > 0) continue;  // one ray per cell and frame
+            cells.push_back(c);
+            subs.push_back(sub);
+            colors.push_back(glm::u8vec4(9, 9, 9, 255));
+            nears.push_back(200.0f);
+            lastWriter[c] = samples.size();
+            samples.push_back({eyes[r], d, c, sub, r == 0});
+        }
+        pc.store(cells, subs, colors, nears);
+    }
+    CachePolicy p;
+    p.lowerDepth = 1e9;  // errors stay finite for every record kept
+    p.radPerPixel = 1e-3;
+    const uint64_t zeroed = pc.invalidateBox(lo, hi, /*reach=*/10.0);
+    EXPECT_GT(zeroed, 0u);
+    size_t crossing = 0, kept = 0, near = 0;
+    for (const auto& [cell, i] : lastWriter) {
+        const Sample& s = samples[i];
+        const double e = pc.error(cell, s.sub, p);
+        if (s.far) {
+            EXPECT_TRUE(std::isinf(e)) << "a record beyond the reach is forgotten whole";
+            continue;
+        }
+        ++near;
+        if (crosses(s.eye, s.dir)) {
+            ++crossing;
+            EXPECT_TRUE(std::isinf(e)) << "cell " << cell << " shows the box from " << s.eye.x;
+        } else if (!std::isinf(e)) {
+            ++kept;
+        }
+    }
+    EXPECT_GT(crossing, 20u) << "the test has rays through the box";
+    EXPECT_GT(kept, near * 3 / 4) << "cells away from the box are kept";
+    // Nothing traced yet: nothing to forget.
+    PanoramaCache fresh(720, 200, 1.0);
+    EXPECT_EQ(fresh.invalidateBox(lo, hi, 10.0), 0u);
 }
 
 TEST(Panorama, ErrorBoundAndBudgetRetraceTheWorstCells) {
