@@ -187,13 +187,13 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
         bypassCache(f);
     }
     _mem->lastFrameCached = cacheRan;
+    haze.finish(stats);  // the rays have both cores, and their timing prices a far pixel
     if (!f.trace.empty()) {
         const double before = stats.stages.ms(Stage::Rays);
         raysStage(f, *_mem, _rays, _options, stats);
         const double perRay = (stats.stages.ms(Stage::Rays) - before) / double(f.trace.size());
         _mem->msPerRay = _mem->msPerRay > 0 ? 0.8 * _mem->msPerRay + 0.2 * perRay : perRay;
     }
-    haze.finish(stats);
     const double before = stats.stages.ms(Stage::Composite);
     // The last frame is the fallback of never-traced cells left out by a budget: kept only under one.
     compositeStage(f, *_mem, cacheRan, stats, cacheRan && budgeted);
