@@ -175,7 +175,7 @@ public:
                 img,
                 _batch.stage((std::filesystem::path(_cfg.outDir) / "frames" / (name + rec.mode + ".png")).string())));
         }
-        if (_cfg.worstFrames <= 0 || isReference) return Status::ok();
+        if (_cfg.worstFrames <= 0 || isReference || _cfg.referenceSsaa == kNoReference) return Status::ok();
         auto& w = _worst[mi];
         if (int(w.size()) < _cfg.worstFrames || rec.psnrDb < w.back().psnr) {
             w.push_back({rec.psnrDb, rec.frame, rec.mode, img, ref});
@@ -267,10 +267,11 @@ Status renderGroup(BenchRun& run, size_t begin, size_t end, size_t f, size_t pat
         VISTA_RETURN_IF_ERROR(dumpRays(*run.modes[mi], rec.mode, int(f), cam, cfg, batch));
         if (!img.valid() || img.width != cfg.width || img.height != cfg.height)
             return Status::error("mode " + rec.mode + " returned an image of the wrong size");
-        const bool isReference = mi == begin && cfg.referenceSsaa < 2;
+        const bool scored = cfg.referenceSsaa != kNoReference;
+        const bool isReference = scored && mi == begin && cfg.referenceSsaa < 2;
         if (isReference) ref = img;
-        rec.psnrDb = lumaPsnr(img, ref);
-        rec.diffFraction = fractionDiffering(img, ref, cfg.diffThreshold);
+        rec.psnrDb = scored ? lumaPsnr(img, ref) : NAN;
+        rec.diffFraction = scored ? fractionDiffering(img, ref, cfg.diffThreshold) : NAN;
         VISTA_RETURN_IF_ERROR(images.add(mi, rec, img, ref, isReference));
     }
     return Status::ok();
@@ -316,6 +317,7 @@ Status renderFrames(BenchRun& run, const Path& path, const std::vector<size_t>& 
 
 // `full` first: the reference of every frame is rendered before the others.
 BenchConfig withFullFirst(BenchConfig cfg) {
+    if (cfg.referenceSsaa == kNoReference) return cfg;  // full runs only when listed
     cfg.modes.erase(std::remove(cfg.modes.begin(), cfg.modes.end(), "full"), cfg.modes.end());
     cfg.modes.insert(cfg.modes.begin(), "full");
     return cfg;
@@ -326,7 +328,7 @@ Status validateBenchConfig(const BenchConfig& c) {
     if (c.frames < 1 || c.frames > 1000000)
         return Status::error("--frames " + std::to_string(c.frames) + " out of range 1 .. 1000000");
     VISTA_RETURN_IF_ERROR(checkFov(c.fovYDeg));
-    if (c.referenceSsaa < 0 || c.referenceSsaa > kMaxReferenceSsaa)
+    if (c.referenceSsaa != kNoReference && (c.referenceSsaa < 0 || c.referenceSsaa > kMaxReferenceSsaa))
         return Status::error("--reference ssaa:" + std::to_string(c.referenceSsaa) + " out of range 2 .. 8");
     if (c.diffThreshold < 0 || c.diffThreshold > 255)
         return Status::error("--diff-threshold " + std::to_string(c.diffThreshold) + " out of range 0 .. 255");

@@ -10,12 +10,16 @@
 // Reference: every frame is compared with the `full` image of the same
 // camera (or, with referenceSsaa = k > 1, with the average of k x k
 // sub-pixel-jittered `full` renders = a box-filtered supersampled image).
+// With no reference (kNoReference: a long drive measured for its time and
+// memory alone) `full` runs only when listed, PSNR and differing fractions
+// are NaN (empty in frames.csv, null in summary.json), no worst frames or
+// quality plot are written, and speedups are against the bases that ran.
 // Metrics: luma PSNR (metrics.h, capped at 99 dB for identical images) and
 // the fraction of pixels differing by more than diffThreshold.
 // Timing: frame_ms per mode as reported by the mode (glFinish included).
 // Speedups: the median over frames of same-frame ratios base_ms[f] /
-// mode_ms[f] (never a ratio of medians), against `full` always and against
-// `near` and `raycast` when they ran (docs/user-guide.md).
+// mode_ms[f] (never a ratio of medians), against `full`, `near` and
+// `raycast` when they ran (`full` always runs but with no reference).
 // Errors: bad configuration or setup failures (no display, unknown mode,
 // Embree failure) return a Status; nothing throws.
 #pragma once
@@ -42,7 +46,7 @@ struct BenchConfig {
     double zNear = 0.3;
     std::vector<std::string> modes{"full", "near"};
     std::string outDir;       // created if missing; empty = write nothing
-    int referenceSsaa = 0;    // 0/1 = `full` image; k >= 2 = k x k supersampled full
+    int referenceSsaa = 0;    // 0/1 = `full` image; k >= 2 = k x k supersampled full; kNoReference = none
     int diffThreshold = 8;    // for the differing-pixel fraction (0..255)
     int worstFrames = 2;      // difference images for the N worst frames per mode
     bool saveFrames = false;  // every frame of every mode as frames/f<NNNN>_<mode>.png

@@ -48,14 +48,15 @@ std::string framesCsv(const BenchResult& result) {
     char buf[512];
     for (const auto& r : result.frames) {
         const FrameStats& s = r.stats;
-        std::snprintf(buf, sizeof(buf),
-                      "%d,%zu,%.4f,%s,%.4f,%.4f,%.4f,%llu,%llu,%llu,%.3f,%.6f,%llu,%llu,%llu,%llu,%llu,%llu,%d,",
-                      r.frame, r.pathIndex, r.t, r.mode.c_str(), s.frameMs, s.cullMs, s.drawMs,
-                      (unsigned long long)s.triangles, (unsigned long long)s.drawCalls, (unsigned long long)s.raysCast,
-                      r.psnrDb, r.diffFraction, (unsigned long long)s.pixels.covered,
-                      (unsigned long long)s.pixels.horizonCulled, (unsigned long long)s.pixels.cache,
-                      (unsigned long long)s.pixels.rayHit, (unsigned long long)s.pixels.rayMiss,
-                      (unsigned long long)s.pixels.interpolated, r.regionsArrived);
+        char score[64] = ",";  // no reference: both cells empty
+        if (!std::isnan(r.psnrDb)) std::snprintf(score, sizeof score, "%.3f,%.6f", r.psnrDb, r.diffFraction);
+        std::snprintf(
+            buf, sizeof(buf), "%d,%zu,%.4f,%s,%.4f,%.4f,%.4f,%llu,%llu,%llu,%s,%llu,%llu,%llu,%llu,%llu,%llu,%d,",
+            r.frame, r.pathIndex, r.t, r.mode.c_str(), s.frameMs, s.cullMs, s.drawMs, (unsigned long long)s.triangles,
+            (unsigned long long)s.drawCalls, (unsigned long long)s.raysCast, score,
+            (unsigned long long)s.pixels.covered, (unsigned long long)s.pixels.horizonCulled,
+            (unsigned long long)s.pixels.cache, (unsigned long long)s.pixels.rayHit,
+            (unsigned long long)s.pixels.rayMiss, (unsigned long long)s.pixels.interpolated, r.regionsArrived);
         csv << buf;
         std::string st;
         s.stages.forEach([&](Stage stage, double ms) {
@@ -171,7 +172,9 @@ json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneM
                              {"glass_reflections", fx.glass && fx.glassMarked},
                              {"reflection_ray_budget", fx.rayBudget},
                              {"night_sky", fx.night}};
-    j["reference"] = cfg.referenceSsaa >= 2 ? "ssaa:" + std::to_string(cfg.referenceSsaa) : std::string("full");
+    j["reference"] = cfg.referenceSsaa >= 2              ? "ssaa:" + std::to_string(cfg.referenceSsaa)
+                     : cfg.referenceSsaa == kNoReference ? std::string("none")
+                                                         : std::string("full");
     j["psnr_cap_db"] = kPsnrCapDb;
     j["diff_threshold"] = cfg.diffThreshold;
     j["path_samples"] = path.samples.size();
@@ -227,9 +230,10 @@ Status writePlots(const BenchResult& result, const BenchConfig& cfg, OutputBatch
             sq.y.push_back(r.psnrDb);
         }
         pt.series.push_back(st);
-        if (mi > 0 || cfg.referenceSsaa >= 2) pq.series.push_back(sq);
+        if (cfg.referenceSsaa != kNoReference && (mi > 0 || cfg.referenceSsaa >= 2)) pq.series.push_back(sq);
     }
     VISTA_RETURN_IF_ERROR(writePng(renderPlot(pt), batch.stage((fs::path(cfg.outDir) / "frame_time.png").string())));
+    if (cfg.referenceSsaa == kNoReference) return Status::ok();  // nothing scored: no quality plot
     return writePng(renderPlot(pq), batch.stage((fs::path(cfg.outDir) / "quality.png").string()));
 }
 

@@ -122,9 +122,13 @@ ModeSummary summariseMode(const BenchResult& r, const std::string& mode, const s
         const std::vector<double> baseMs = modeFrameTimes(r, base);
         if (baseMs.size() == ms.size()) s.speedupMedianOfRatios[base] = medianOfSameFrameRatios(baseMs, ms);
     }
-    s.psnrDbMedian = percentile(psnr, 0.5);
-    s.psnrDbMin = *std::min_element(psnr.begin(), psnr.end());
-    s.diffFractionMedian = percentile(diff, 0.5);
+    if (std::isnan(psnr.front())) {  // no reference (BenchConfig::referenceSsaa)
+        s.psnrDbMedian = s.psnrDbMin = s.diffFractionMedian = NAN;
+    } else {
+        s.psnrDbMedian = percentile(psnr, 0.5);
+        s.psnrDbMin = *std::min_element(psnr.begin(), psnr.end());
+        s.diffFractionMedian = percentile(diff, 0.5);
+    }
     s.trianglesMedian = percentile(tri, 0.5);
     s.drawCallsMedian = percentile(calls, 0.5);
     s.cullMsMedian = percentile(cull, 0.5);

@@ -154,11 +154,12 @@ std::string formatSplatSigma(double sigma) {
 }
 
 Result<int> parseReference(const std::string& s) {
-    const std::string shape = " (expected 'full' or 'ssaa:K')";
+    const std::string shape = " (expected 'full', 'ssaa:K' or 'none')";
     if (s == "full") return 0;
+    if (s == "none") return kNoReference;
     if (s.rfind("ssaa:", 0) != 0)
-        return Status::error("option --reference = '" + echoText(s) + "': expected 'full' or 'ssaa:K' with K in [2, " +
-                             std::to_string(kMaxReferenceSsaa) + "]");
+        return Status::error("option --reference = '" + echoText(s) + "': expected 'full', 'ssaa:K' with K in [2, " +
+                             std::to_string(kMaxReferenceSsaa) + "] or 'none'");
     auto k = parseUnsignedText("K", s.substr(5), 2, kMaxReferenceSsaa);
     if (!k) return Status::error("option --reference = '" + echoText(s) + "': " + k.status().message() + shape);
     return int(*k);

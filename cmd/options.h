@@ -44,6 +44,7 @@ constexpr int64_t kMaxPixelBudget = 1000000000;
 constexpr uint64_t kMaxTriangleBudget = 10000000000ull;
 constexpr double kMinFovDeg = 1.0, kMaxFovDeg = 179.0;
 constexpr int kMaxReferenceSsaa = 8;
+constexpr int kNoReference = -1;  // --reference none
 
 // --size WxH (x or X): each side 1 .. 8192 pixels.
 Result<ImageSize> parseImageSize(const std::string& s);
@@ -58,7 +59,7 @@ Status checkPixelBudget(int64_t rays);
 // (bench, render, view: addNumberOption with kFovRange).
 constexpr RealRange kFovRange = RealRange::open(kMinFovDeg, kMaxFovDeg);
 Status checkFov(double degrees);
-// --reference full|ssaa:K: 0 for `full`, else K in 2 .. 8.
+// --reference full|ssaa:K|none: 0 for `full`, K in 2 .. 8, kNoReference for `none`.
 Result<int> parseReference(const std::string& s);
 // --modes a,b,c: registered modes (render_mode.h), comma-separated, no duplicates.
 Result<std::vector<std::string>> parseModeList(const std::string& s);
