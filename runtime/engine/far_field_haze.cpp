@@ -71,17 +71,24 @@ void hazeStage(const FrameEffects& fx, const uint32_t* pixels, size_t n, const f
             });
         });
     } else {
-        // A pixel list: the transmittances in one vectorised pass, then the blend per pixel.
-        constexpr float kInf = std::numeric_limits<float>::infinity();
-        std::vector<float> t(n);
-        kernels.transmittances(depth, n, h.beta, t.data());
-        for (size_t k = 0; k < n; ++k) {
-            if (!(depth[k] < kInf)) continue;
-            PixelWord& p = px[pixels[k]];
-            p = hazeBlend(p, t[k], h);
-        }
+        hazeListed(fx, pixels, n, depth, out);
     }
     recordHaze(sw.ms(), stats);
+}
+
+void hazeListed(const FrameEffects& fx, const uint32_t* pixels, size_t n, const float* depth, Image& out) {
+    if (!fx.haze || n == 0) return;
+    // The transmittances in one vectorised pass, then the blend per pixel.
+    const HazeParams h = hazeParams(fx);
+    PixelWord* px = reinterpret_cast<PixelWord*>(out.rgba.data());
+    constexpr float kInf = std::numeric_limits<float>::infinity();
+    std::vector<float> t(n);
+    hazeKernels().transmittances(depth, n, h.beta, t.data());
+    for (size_t k = 0; k < n; ++k) {
+        if (!(depth[k] < kInf)) continue;
+        PixelWord& p = px[pixels[k]];
+        p = hazeBlend(p, t[k], h);
+    }
 }
 
 void hazeCoveredRows(const HazeKernels& k, PixelWord* px, const float* depth, size_t width, size_t y0, size_t y1,

@@ -23,5 +23,10 @@ namespace vista {
 
 void hazeStage(const FrameEffects& fx, const uint32_t* pixels, size_t n, const float* depth, Image& out,
                FrameStats& stats, int threads = 0);
+// The list pass of hazeStage without its records, for a caller that hazes
+// pixels as it writes them (castPrimaryRays with RayShading::haze): the n
+// pixels out[pixels[k]] hazed at eye depth depth[k] (+inf: left alone), on
+// the calling thread. Does nothing without fx.haze.
+void hazeListed(const FrameEffects& fx, const uint32_t* pixels, size_t n, const float* depth, Image& out);
 
 }  // namespace vista

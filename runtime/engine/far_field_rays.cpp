@@ -62,6 +62,7 @@ void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, con
     // Haze: nothing beyond hazeFar of eye-plane depth is traced (each ray
     // stops where its eye-plane depth reaches it; hits beyond show the sky).
     const double zMax = fx.haze ? fx.hazeFar() : 0.0;
+    const bool hazeAtWrite = shading.haze && fx.haze;
     const uint32_t W = uint32_t(camera.width);
     const glm::vec3 org(camera.eye - scene.frameOrigin());
     const size_t grain = std::max<size_t>(1, (kRaysPerTask * nRuns + n - 1) / n);
@@ -72,6 +73,8 @@ void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, con
             std::vector<glm::dvec3> ddirs;
             std::vector<float> tfars;
             std::vector<RayHit> res;
+            std::vector<uint32_t> hazedIdx;  // shading.haze: the task's shown pixels and their depths
+            std::vector<float> hazedZ;
             uint64_t nh = 0;
             for (size_t r = br.begin(); r != br.end(); ++r) {
                 const size_t b = runs[r], m = runs[r + 1] - b;
@@ -99,8 +102,13 @@ void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, con
                         shading.keys[b + k] = shown ? SurfaceKey{h.geomId, h.primId, h.instId} : SurfaceKey{};
                     if (hit) hit[b + k] = shown ? 1 : 0;
                     nh += shown ? 1 : 0;
+                    if (hazeAtWrite && shown) {
+                        hazedIdx.push_back(pixels[b + k]);
+                        hazedZ.push_back(float(z));
+                    }
                 }
             }
+            if (hazeAtWrite) hazeListed(fx, hazedIdx.data(), hazedIdx.size(), hazedZ.data(), out);
             hits.local() += nh;
         });
     });
@@ -279,6 +287,7 @@ void raysStage(FarFrame& f, FarFieldMemory& m, const RayScene& rays, const FarFi
         RayShading shading;
         shading.effects = f.fx;
         shading.tnear = farRayStart(o);
+        shading.haze = true;  // each task hazes what it writes (the speculative rays too)
         // The entries the speculative rays did not cast (all of them without speculation).
         const bool spec = m.spec.active();
         std::vector<uint32_t> left;
@@ -310,7 +319,10 @@ void raysStage(FarFrame& f, FarFieldMemory& m, const RayScene& rays, const FarFi
     stats.stages.add(Stage::Rays, sw.ms());
     if (!f.farDepth.empty())
         for (size_t j = 0; j < n; ++j) f.farDepth[f.trace[j]] = depth[j];
-    if (f.fx->haze) hazeStage(*f.fx, f.trace.data(), n, depth.data(), f.out, stats);
+    // The lattice blends its neighbours' unhazed colours, then hazes every entry at its depth; the
+    // other casts hazed what they wrote (their time is the stage's).
+    if (f.fx->haze && lattice) hazeStage(*f.fx, f.trace.data(), n, depth.data(), f.out, stats);
+    else if (f.fx->haze) stats.effects.add(EffectId::Haze, 0.0);
 }
 
 }  // namespace vista

@@ -101,6 +101,9 @@ struct RayShading {
     // Rays start at this distance (metres, >= 0): the far field sets the near distance, since a
     // pixel the near field left uncovered has no surface nearer than it (nodes/near_far_split.h).
     float tnear = 0.0f;
+    // castPrimaryRays: every pixel that shows a surface is hazed as it is written (hazeListed, at
+    // its eye-plane depth; needs effects with haze), so no pass over the list follows.
+    bool haze = false;
 };
 
 // Casts the rays of the n listed pixels (indices y * width + x) and writes

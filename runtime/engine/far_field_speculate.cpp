@@ -54,6 +54,7 @@ void startSpeculation(FarFieldMemory& m, const RayScene& rays, const Camera& cam
             RayShading sh;
             sh.effects = &s.effects;
             sh.tnear = s.tnear;
+            sh.haze = true;  // hazed here, on the cores the draw leaves idle
             while (!s.stopFlag.load(std::memory_order_relaxed)) {
                 const size_t c = s.next.fetch_add(1, std::memory_order_relaxed);
                 if (c >= s.chunks) break;
