@@ -300,58 +300,6 @@ TEST(BenchCli, BadInputExitsWithTwo) {
     fs::remove_all(dir);
 }
 
-// --reference none: a run timed alone. Only the listed modes run (no `full`),
-// nothing is scored (empty PSNR cells, null medians, no quality plot, no worst
-// frames) and the frame times are all there; with --sweep it is refused.
-TEST(BenchCli, NoReferenceRunsTheListedModesAlone) {
-    REQUIRE_DISPLAY();
-    ASSERT_TRUE(fs::exists(VISTA_BINARY)) << "the vista binary is a build dependency of this test";
-    std::string dir = tmpDir("noref"), out;
-    const std::string city = dir + "/tiny.osgb";
-    ASSERT_EQ(runVista("gen --size 300 --seed 3 -q -o " + city, &out), 0) << out;
-    ASSERT_EQ(runVista("bench " + city +
-                           " --seed 4 --frames 3 --size 96x64 -q --modes near,hybrid --reference none "
-                           "--out " +
-                           dir + "/b",
-                       &out),
-              0)
-        << out;
-    std::ifstream f(dir + "/b/summary.json");
-    const auto j = nlohmann::json::parse(f);
-    EXPECT_EQ(j["reference"], "none");
-    ASSERT_EQ(j["modes"].size(), 2u);
-    EXPECT_FALSE(j["modes"].contains("full"));
-    for (const char* m : {"near", "hybrid"}) {
-        EXPECT_TRUE(j["modes"][m]["psnr_db_median"].is_null()) << m;
-        EXPECT_GT(j["modes"][m]["frame_ms_median"].get<double>(), 0.0) << m;
-        EXPECT_FALSE(j["modes"][m].contains("speedup_vs_full_median_of_ratios")) << m;
-    }
-    EXPECT_TRUE(j["modes"]["hybrid"].contains("speedup_vs_near_median_of_ratios"));
-    EXPECT_FALSE(fs::exists(dir + "/b/quality.png"));
-    EXPECT_TRUE(fs::exists(dir + "/b/frame_time.png"));
-    std::ifstream csv(dir + "/b/frames.csv");
-    std::string line;
-    std::getline(csv, line);  // header: ...,rays_cast,psnr_db,diff_fraction,...
-    int rows = 0;
-    while (std::getline(csv, line)) {
-        ++rows;
-        std::vector<std::string> cells;
-        std::stringstream ss(line);
-        for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
-        ASSERT_GT(cells.size(), 11u) << line;
-        EXPECT_EQ(cells[10], "") << line;
-        EXPECT_EQ(cells[11], "") << line;
-    }
-    EXPECT_EQ(rows, 6);
-    for (const auto& e : fs::directory_iterator(dir + "/b/images"))
-        EXPECT_EQ(e.path().filename().string().rfind("worst", 0), std::string::npos) << e.path();
-    EXPECT_EQ(runVista("bench --sweep sizes=300 --reference none --out " + dir + "/s", &out), 2) << out;
-    EXPECT_NE(out.find("--reference none"), std::string::npos) << out;
-    EXPECT_EQ(runVista("bench " + city + " --reference nothing --out " + dir + "/o", &out), 2) << out;
-    EXPECT_NE(out.find("'none'"), std::string::npos) << out;
-    fs::remove_all(dir);
-}
-
 // End to end on a generated tiny city: gen -> path -> bench (every mode but
 // impostor), checking values: what each mode draws, traces and costs.
 TEST(BenchCli, TinyGeneratedCity) {

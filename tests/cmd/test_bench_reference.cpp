@@ -1,0 +1,69 @@
+// `vista bench --reference none` (cmd/bench.h): a run timed and sized alone,
+// scored against nothing.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "tests/common/run_vista.h"
+#include "tests/common/temp_dir.h"
+#include "tests/nodes/render/render_fixtures.h"
+
+using namespace vista;
+namespace fs = std::filesystem;
+
+// --reference none: a run timed alone. Only the listed modes run (no `full`),
+// nothing is scored (empty PSNR cells, null medians, no quality plot, no worst
+// frames) and the frame times are all there; with --sweep it is refused.
+TEST(BenchCli, NoReferenceRunsTheListedModesAlone) {
+    REQUIRE_DISPLAY();
+    ASSERT_TRUE(fs::exists(VISTA_BINARY)) << "the vista binary is a build dependency of this test";
+    test::TempDir tmp("vista_noref");
+    const std::string dir = tmp.path();
+    const std::string city = dir + "/tiny.osgb";
+    test::CliRun r = test::runVista("gen --size 300 --seed 3 -q -o " + city);
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = test::runVista("bench " + city +
+                       " --seed 4 --frames 3 --size 96x64 -q --modes near,hybrid --reference none --out " + dir + "/b");
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::ifstream f(dir + "/b/summary.json");
+    const auto j = nlohmann::json::parse(f);
+    EXPECT_EQ(j["reference"], "none");
+    ASSERT_EQ(j["modes"].size(), 2u);
+    EXPECT_FALSE(j["modes"].contains("full"));
+    for (const char* m : {"near", "hybrid"}) {
+        EXPECT_TRUE(j["modes"][m]["psnr_db_median"].is_null()) << m;
+        EXPECT_GT(j["modes"][m]["frame_ms_median"].get<double>(), 0.0) << m;
+        EXPECT_FALSE(j["modes"][m].contains("speedup_vs_full_median_of_ratios")) << m;
+    }
+    EXPECT_TRUE(j["modes"]["hybrid"].contains("speedup_vs_near_median_of_ratios"));
+    EXPECT_FALSE(fs::exists(dir + "/b/quality.png"));
+    EXPECT_TRUE(fs::exists(dir + "/b/frame_time.png"));
+    std::ifstream csv(dir + "/b/frames.csv");
+    std::string line;
+    std::getline(csv, line);  // header: ...,rays_cast,psnr_db,diff_fraction,...
+    int rows = 0;
+    while (std::getline(csv, line)) {
+        ++rows;
+        std::vector<std::string> cells;
+        std::stringstream ss(line);
+        for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+        ASSERT_GT(cells.size(), 11u) << line;
+        EXPECT_EQ(cells[10], "") << line;
+        EXPECT_EQ(cells[11], "") << line;
+    }
+    EXPECT_EQ(rows, 6);
+    for (const auto& e : fs::directory_iterator(dir + "/b/images"))
+        EXPECT_EQ(e.path().filename().string().rfind("worst", 0), std::string::npos) << e.path();
+    r = test::runVista("bench --sweep sizes=300 --reference none --out " + dir + "/s");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("--reference none"), std::string::npos) << r.err;
+    r = test::runVista("bench " + city + " --reference nothing --out " + dir + "/o");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("'none'"), std::string::npos) << r.err;
+}
