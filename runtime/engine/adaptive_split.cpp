@@ -483,16 +483,6 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
     const int frame = _frame++;
     if (_probeT.empty()) return _current;
     const int g = std::max(2, _o.candidates);
-    // The objects within the largest finite candidate that the view sees, sorted by distance
-    // once; then sweep the candidates. Triangles outside the view are culled by the renderer
-    // and cost no raster time, so prices (and the raster fit, chosenTriangles()) count only
-    // the triangles in view.
-    const ViewSides view(camera);
-    std::vector<std::pair<double, uint64_t>> byDist;
-    _index.visitWithin(camera.eye, _o.maxDistance, [&](uint32_t i, double t) {
-        if (view.sees(_objects[i])) byDist.push_back({t, _objects[i].triangles});
-    });
-    std::sort(byDist.begin(), byDist.end());
     std::vector<double> cand;
     // The ends are priced on measurements: ray casting once the probe is timed (its rate) or
     // the far cost measured; everything once the raster cost is measured. Before that
@@ -511,13 +501,22 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
     const bool everythingPriced = measured || !_kindFrames[2].empty();
     if (_o.everythingNear && (everythingPriced || rayPriced)) cand.push_back(std::numeric_limits<double>::infinity());
     const int n = int(cand.size());
+    // The triangles the view sees within the largest finite candidate, filed by the first
+    // candidate (ascending) whose distance reaches them: one visit, no sort; the sweep below adds
+    // them up. Triangles outside the view are culled by the renderer and cost no raster time,
+    // so prices (and the raster fit, chosenTriangles()) count only the triangles in view.
+    const ViewSides view(camera);
+    std::vector<uint64_t> reached(cand.size() + 1, 0);
+    _index.visitWithin(camera.eye, _o.maxDistance, [&](uint32_t i, double t) {
+        if (view.sees(_objects[i]))
+            reached[size_t(std::lower_bound(cand.begin(), cand.end(), t) - cand.begin())] += _objects[i].triangles;
+    });
     _pixels = int64_t(camera.width) * int64_t(camera.height);
     // The model's price of each candidate (see the header), then the learned correction of its kind.
     double corr[kSplitKinds];
     for (int kind = 0; kind < kSplitKinds; ++kind) corr[kind] = correctionMs(kind);
     std::vector<double> price(cand.size()), cost(cand.size()), candRays(cand.size());
     std::vector<uint64_t> candTris(cand.size());
-    size_t k = 0;
     uint64_t tris = 0;
     int bestI = -1;
     for (int i = 0; i < n; ++i) {
@@ -525,7 +524,7 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
         if (std::isinf(d)) {
             tris = _everythingTris;
         } else {
-            while (k < byDist.size() && byDist[k].first <= d) tris += byDist[k++].second;
+            tris += reached[size_t(i)];
         }
         const int kind = kindOf(d);
         candTris[size_t(i)] = kind == 0 ? 0 : tris;
