@@ -37,18 +37,22 @@ int64_t cacheBudget(const FarFrame& f, const FarFieldMemory& m, const FarFieldOp
     return budget;
 }
 
+PanoramaCache& ensureCache(FarFieldMemory& m, const Camera& camera, const FarFieldOptions& o) {
+    const double key[4] = {camera.fovY, double(camera.width), double(camera.height), o.cacheOversample};
+    if (!m.cache || !std::equal(key, key + 4, m.cacheKey)) {
+        m.cache = std::make_unique<PanoramaCache>(PanoramaCache::forCamera(camera, o.cacheOversample));
+        std::copy(key, key + 4, m.cacheKey);
+    }
+    return *m.cache;
+}
+
 void cacheStage(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, FrameStats& stats) {
     double spentMs = 0;
     stats.stages.forEach([&](Stage s, double ms) {
         if (s != Stage::Readback) spentMs += ms;  // readback is part of Near when both are set
     });
     Stopwatch sw;
-    const double key[4] = {f.camera.fovY, double(f.width), double(f.height), o.cacheOversample};
-    if (!m.cache || !std::equal(key, key + 4, m.cacheKey)) {
-        m.cache = std::make_unique<PanoramaCache>(PanoramaCache::forCamera(f.camera, o.cacheOversample));
-        std::copy(key, key + 4, m.cacheKey);
-    }
-    PanoramaCache& cache = *m.cache;
+    PanoramaCache& cache = ensureCache(m, f.camera, o);
     cache.beginFrame(f.camera);
     const uint32_t W = uint32_t(f.width);
     std::vector<CacheCandidate>& cand = m.cand;  // scratch kept across frames (no fresh pages per frame)

@@ -231,6 +231,10 @@ void listPending(FarFrame& f);
 // as they were and never read). Records Cache; with
 // a frame-time target, a note gives the budget.
 void cacheStage(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, FrameStats& stats);
+// The panorama for `camera` (resolution and oversample as o.cacheOversample
+// asks): kept when it fits, else made anew (its cells zero pages, not yet
+// resident).
+PanoramaCache& ensureCache(FarFieldMemory& m, const Camera& camera, const FarFieldOptions& o);
 // The pixel budget of this frame: o.pixelBudget, capped with a frame-time
 // target by what is left of it after spentMs at m.msPerRay (at least 1 % of
 // the pixels); < 0 = no cap.
