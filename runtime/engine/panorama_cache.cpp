@@ -125,8 +125,12 @@ uint64_t PanoramaCache::invalidateBox(const glm::dvec3& lo, const glm::dvec3& hi
     const double zTop = hi.z - eye.z + b, zBottom = lo.z - eye.z - b;
     const double vTop = zTop / (zTop > 0 ? hMin : hMax), vBottom = zBottom / (zBottom < 0 ? hMin : hMax);
     if (vBottom > _vMax || vTop < -_vMax) return 0;
-    const int rowFirst = std::clamp(int(std::floor((_vMax - vTop) / (2.0 * _vMax) * _height)) - 1, 0, _height - 1);
-    const int rowLast = std::clamp(int(std::floor((_vMax - vBottom) / (2.0 * _vMax) * _height)) + 1, 0, _height - 1);
+    // Rows clamped before the conversion: a box just beyond b gives tangents far outside the map.
+    auto rowOf = [&](double v) {
+        return int(std::clamp(std::floor((_vMax - v) / (2.0 * _vMax) * _height), -1.0, double(_height)));
+    };
+    const int rowFirst = std::clamp(rowOf(vTop) - 1, 0, _height - 1);
+    const int rowLast = std::clamp(rowOf(vBottom) + 1, 0, _height - 1);
     // Azimuths of the corners about the centre's (the box is outside the eye's reach: its span is under pi).
     const double azC = std::atan2(0.5 * (lo.x + hi.x) - eye.x, 0.5 * (lo.y + hi.y) - eye.y);
     double aMin = 0, aMax = 0;
