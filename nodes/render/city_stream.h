@@ -47,6 +47,7 @@
 
 #include "foundation/status.h"
 #include "nodes/render/streamed_near_field.h"
+#include "runtime/engine/panorama_cache.h"
 #include "runtime/engine/ray_streaming.h"
 #include "runtime/scene/region_pager.h"
 
@@ -56,7 +57,7 @@ struct CityStreamFrame {
     int arrived = 0, dropped = 0;  // region levels
     // The world boxes (manifest bounds, both levels) of the levels that arrived or left, for
     // RenderMode::sceneChanged.
-    std::vector<std::pair<glm::dvec3, glm::dvec3>> changed;
+    SceneBoxes changed;
     bool waited = false;
     std::vector<std::string> damaged;
 };

@@ -34,9 +34,7 @@ public:
         return Status::ok();
     }
     void reset() override { _inner->reset(); }
-    void sceneChanged(const std::vector<std::pair<glm::dvec3, glm::dvec3>>& changed) override {
-        _inner->sceneChanged(changed);
-    }
+    void sceneChanged(const SceneBoxes& changed) override { _inner->sceneChanged(changed); }
     const std::vector<uint32_t>* lastTracedPixels() const override { return _inner->lastTracedPixels(); }
     double lastRayStart() const override { return _inner->lastRayStart(); }
     const RasterSelection* lastRaster() const override { return _inner->lastRaster(); }

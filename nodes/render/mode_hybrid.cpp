@@ -126,7 +126,7 @@ public:
     void reset() override { _far->reset(); }
     // The ray scene changed (a streamed city): nothing traced in the old one that could show a
     // changed region is served again. The near field's root state comes with the first region.
-    void sceneChanged(const std::vector<std::pair<glm::dvec3, glm::dvec3>>& changed) override {
+    void sceneChanged(const SceneBoxes& changed) override {
         _far->sceneChanged(changed);
         if (!_root->getStateSet() && _near.rootState) _root->setStateSet(_near.rootState.get());
     }

@@ -39,6 +39,7 @@
 #include "runtime/engine/frame_effects.h"
 #include "runtime/engine/frame_stats.h"
 #include "runtime/engine/image.h"
+#include "runtime/engine/panorama_cache.h"
 #include "runtime/scene/camera.h"
 
 namespace vista {
@@ -170,7 +171,7 @@ public:
     // FarField::sceneChanged, its speculative rays and kept frame) is
     // dropped, so no pixel of a dropped region, and none hiding an arrived
     // one, is served again; the rest is kept.
-    virtual void sceneChanged(const std::vector<std::pair<glm::dvec3, glm::dvec3>>& changed) { (void)changed; }
+    virtual void sceneChanged(const SceneBoxes& changed) { (void)changed; }
     // Viewer face: the graph to draw (built on the first call, owned by the mode).
     virtual osg::Node* viewerScene() = 0;
     // Before every viewer frame, with the camera about to be drawn: returns

@@ -91,7 +91,7 @@ void FarField::reset() {
     _mem->lastFrameCached = false;
 }
 
-uint64_t FarField::sceneChanged(const std::vector<std::pair<glm::dvec3, glm::dvec3>>& boxes) {
+uint64_t FarField::sceneChanged(const SceneBoxes& boxes) {
     _mem->spec.discard();
     _mem->prev = Image();
     _mem->lastFrameCached = false;  // the next frame's reuse is no verdict on the cache

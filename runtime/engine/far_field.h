@@ -44,7 +44,6 @@
 #pragma once
 #include <cstdint>
 #include <memory>
-#include <utility>
 #include <vector>
 
 #include "runtime/engine/frame_effects.h"
@@ -52,6 +51,7 @@
 #include "runtime/scene/camera.h"
 #include "runtime/engine/horizon.h"
 #include "runtime/engine/image.h"
+#include "runtime/engine/panorama_cache.h"
 
 namespace vista {
 
@@ -187,7 +187,7 @@ public:
     // (PanoramaCache::invalidateBox), the speculative rays cast into the old
     // scene and the kept frame go; every other cell is served as before.
     // Returns the number of cells forgotten.
-    uint64_t sceneChanged(const std::vector<std::pair<glm::dvec3, glm::dvec3>>& boxes);
+    uint64_t sceneChanged(const SceneBoxes& boxes);
     // Per pixel of the last frame: a FarPixelClass (0 covered, 1 horizon, 2 cache, 3 hit, 4 miss).
     const std::vector<uint8_t>& classification() const { return _class; }
     // The pixels the ray stage of the last frame cast (ascending indices

@@ -41,6 +41,7 @@
 // direction) returns index -1.
 #pragma once
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "foundation/zeroed_array.h"
@@ -50,6 +51,10 @@
 #include "runtime/scene/camera.h"
 
 namespace vista {
+
+// World boxes (low and high corner) of parts of a scene that arrived or left (a streamed city's
+// region levels): what FarField::sceneChanged and RenderMode::sceneChanged take.
+using SceneBoxes = std::vector<std::pair<glm::dvec3, glm::dvec3>>;
 
 struct CacheCandidate {
     int64_t cell;               // panorama cell index, or -1 (not cacheable: always traced)
