@@ -69,6 +69,7 @@ Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene
         // hybrid: the stream keeps the near field, its split index and the horizon grid too.
         if (needRays && std::any_of(cfg.modes.begin(), cfg.modes.end(), modeStreamsNearField))
             run->stream->enableNearField(cfg.options.horizonGrid);
+        run->stream->setGraphLevels(streamGraphOf(cfg.modes));
         run->ctx.streamedCity = run->stream->graph();
         run->ctx.scene = run->stream->graph();
         run->ctx.stream = run->stream.get();

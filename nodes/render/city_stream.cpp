@@ -37,23 +37,37 @@ Result<std::unique_ptr<CityStream>> CityStream::create(const PagedManifest& mani
         s->_labelRoot->setName("vista.streamed_city_labels");
     }
     const StreamedRayScene* rayScene = s->_rays.get();
-    const std::unique_ptr<StreamedNearField>* nearField = &s->_near;  // set before the first load, if at all
+    // Set before the first load, if at all.
+    const std::unique_ptr<StreamedNearField>* nearField = &s->_near;
+    const StreamGraph* graphLevels = &s->_graphLevels;
     s->_manifest = &manifest;
-    options.prepare = [rayScene, nearField, labels](SceneModel& model, int, bool) -> std::shared_ptr<void> {
+    options.prepare = [rayScene, nearField, graphLevels, labels](SceneModel& model, int,
+                                                                 bool coarse) -> std::shared_ptr<void> {
         auto out = std::make_shared<RegionChunks>();
         // The ray scene first: it completes the model's tree prototypes, which the height patch bounds too.
         if (rayScene) out->rays = rayScene->prepare(model);
         out->group = new osg::Group;
+        const bool chunks = *graphLevels == StreamGraph::EveryLevel || (*graphLevels == StreamGraph::FullLevels && !coarse);
+        // What is made no longer needs the decoded model (unless its ray scene failed: the
+        // frame thread builds it again for the error's message).
+        struct FreeModel {
+            SceneModel& m;
+            bool keep;
+            ~FreeModel() {
+                if (!keep) m = SceneModel();
+            }
+        } freeModel{model, rayScene && !out->rays};
         osg::ref_ptr<osg::Node> root = sceneRoot(model);
         if (*nearField) {
             // The chunks serve both the graph and the near field (no label twins: the label
             // channels of a streamed city come from `full` only).
-            out->nearField = (*nearField)->prepare(root.get(), model);
+            out->nearField = (*nearField)->prepare(root.get(), model, chunks);
             const NearFieldScene& nf = out->nearField->scene;
             out->rootState = nf.rootState;
             for (uint32_t i : nf.drawOrder) out->group->addChild(nf.chunks[i].get());
             return out;
         }
+        if (!chunks) return out;
         NearFieldScene nf = buildNearFieldScene(root.get(), kNearChunkSize, labels);
         out->rootState = nf.rootState;
         for (uint32_t i : nf.drawOrder) out->group->addChild(nf.chunks[i].get());
@@ -74,6 +88,11 @@ void CityStream::enableNearField(int horizonCells) {
     _near =
         std::make_unique<StreamedNearField>(_manifest->regionSizeM > 0 ? _manifest->regionSizeM : 2000.0,
                                             pagedHeightLattice(*_manifest, _rays->rays().frameOrigin(), horizonCells));
+}
+
+void CityStream::setGraphLevels(StreamGraph levels) {
+    VISTA_CHECK(!_advanced);
+    _graphLevels = levels;
 }
 
 namespace {

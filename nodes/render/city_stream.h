@@ -22,6 +22,12 @@
 //  - the near field (nearField(), after enableNearField()): the resident
 //    levels' chunks, their split index and the horizon's height grid
 //    (StreamedNearField), cut on the worker thread and spliced here.
+// Which levels carry chunks (setGraphLevels): every level (the default), the
+// full levels only (the hybrid modes: their near field never reaches the
+// coarse levels, which only the far field traces; the horizon still gets
+// their height patches), or none (ray casting alone). A level's model is freed
+// on the worker as soon as what it feeds is made: nothing keeps a decoded
+// region beyond its chunks, its Embree scene and its height patch.
 // Modes that draw the chunked city (full, near), cast rays (raycast) or
 // split the two (hybrid, hybrid-fixed) use them through ModeContext
 // (streamedCity, rays, stream); the others need the whole loaded city and
@@ -53,6 +59,9 @@
 
 namespace vista {
 
+// The region levels that carry chunks in the graph and the near field (CityStream::setGraphLevels).
+enum class StreamGraph { EveryLevel, FullLevels, None };
+
 struct CityStreamFrame {
     int arrived = 0, dropped = 0;  // region levels
     // The world boxes (manifest bounds, both levels) of the levels that arrived or left, for
@@ -75,6 +84,9 @@ public:
     // side (0 = auto) on the paged city's lattice (pagedHeightLattice). Contract: before the
     // first advance() and with rays.
     void enableNearField(int horizonCells);
+    // Which levels get chunks (StreamGraph; default EveryLevel). Contract: before the first advance().
+    void setGraphLevels(StreamGraph levels);
+    StreamGraph graphLevels() const { return _graphLevels; }
     // Moves the pager to the eye and mirrors what it hands over. wait = true:
     // this call blocks until the desired set is resident, as every call does
     // with options.wait (e.g. before a viewer's first frame).
@@ -95,6 +107,7 @@ private:
     std::unique_ptr<StreamedRayScene> _rays;
     std::unique_ptr<StreamedNearField> _near;  // read by the workers' prepare once set
     const PagedManifest* _manifest = nullptr;
+    StreamGraph _graphLevels = StreamGraph::EveryLevel;  // read by the workers' prepare once loads start
     uint64_t _generation = 0;
     bool _advanced = false;
     osg::ref_ptr<osg::Group> _root;

@@ -52,6 +52,8 @@ public:
         AdaptiveSplitOptions so;
         so.endTryEvery = 24;  // each kind of choice re-measured about every 24 frames of a walkthrough
         so.fixedDistance = ctx.options.fixedNearDistance();  // `hybrid-fixed`'s choice, a kind of its own
+        // A stream whose coarse levels carry no chunks cannot draw the whole city: no "everything".
+        if (ctx.stream && ctx.stream->graphLevels() != StreamGraph::EveryLevel) so.everythingNear = false;
         // A streamed city: the stream's index of the resident chunks (it follows the regions).
         _adaptive = ctx.stream ? std::make_unique<AdaptiveSplit>(ctx.stream->nearField()->index(), ctx.rays, so)
                                : std::make_unique<AdaptiveSplit>(_near.objects, ctx.rays, so);

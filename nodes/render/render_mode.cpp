@@ -55,6 +55,15 @@ std::string streamingModeNames() { return "full, near, raycast, hybrid, hybrid-f
 
 bool modeStreamsNearField(const std::string& name) { return name == "hybrid" || name == "hybrid-fixed"; }
 
+StreamGraph streamGraphOf(const std::vector<std::string>& modes) {
+    bool nearField = false;
+    for (const std::string& m : modes) {
+        if (modeStreamsNearField(m)) nearField = true;
+        else if (m != "raycast") return StreamGraph::EveryLevel;
+    }
+    return nearField ? StreamGraph::FullLevels : StreamGraph::None;
+}
+
 bool modeFollowsTimings(const std::string& name, const ModeOptions& o) {
     if (name != "hybrid" && name != "hybrid-fixed") return false;
     const bool autoSplit = name == "hybrid" && o.triangleBudget == 0 && o.nearDistance < 0;

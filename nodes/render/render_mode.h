@@ -261,6 +261,11 @@ bool modeStreams(const std::string& name);
 std::string streamingModeNames();  // "full, near, raycast, hybrid, hybrid-fixed" (for messages)
 // True for the modes that need the stream's near field (hybrid, hybrid-fixed).
 bool modeStreamsNearField(const std::string& name);
+// The levels of a stream that the listed modes draw (CityStream::setGraphLevels): none for
+// ray casting alone, the full levels when the rest are hybrid modes (their near field stays
+// within AdaptiveSplitOptions::maxDistance, far inside the paged radius), else every level.
+enum class StreamGraph;
+StreamGraph streamGraphOf(const std::vector<std::string>& modes);
 // True when a mode's pictures follow measured times under these options, so
 // that two runs of the same frames may differ: hybrid with the adaptive split
 // (--near auto), the adaptive cache (on and not --cache-always) or a frame-time

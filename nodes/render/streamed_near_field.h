@@ -62,7 +62,9 @@ public:
     StreamedNearField& operator=(const StreamedNearField&) = delete;
 
     // Worker side: the level's chunks, block and patch (`root`: the level's graph).
-    std::shared_ptr<NearFieldRegion> prepare(osg::Node* root, const SceneModel& model) const;
+    // chunks = false: the level's height patch only (no chunks, an empty block): a level the
+    // near field never draws (CityStream::setGraphLevels).
+    std::shared_ptr<NearFieldRegion> prepare(osg::Node* root, const SceneModel& model, bool chunks = true) const;
     void add(uint64_t key, const NearFieldRegion& region);
     void remove(uint64_t key);
 
