@@ -69,7 +69,7 @@ Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene
         // hybrid: the stream keeps the near field, its split index and the horizon grid too.
         if (needRays && std::any_of(cfg.modes.begin(), cfg.modes.end(), modeStreamsNearField))
             run->stream->enableNearField(cfg.options.horizonGrid);
-        run->stream->setGraphLevels(streamGraphOf(cfg.modes));
+        run->stream->setGraphLevels(streamGraphOf(cfg.modes), streamNearBand(cfg.options));
         run->ctx.streamedCity = run->stream->graph();
         run->ctx.scene = run->stream->graph();
         run->ctx.stream = run->stream.get();
@@ -391,7 +391,10 @@ Result<BenchResult> runBenchmark(const SceneModel* city, osg::Node* scene, const
     FrameImages images(cfg, (*run)->modes.size(), batch);
     VISTA_RETURN_IF_ERROR(renderFrames(**run, path, idx, base, cfg, result, images, batch));
     result.memory.push_back(memoryPhase("frames"));
-    if (result.streamed) result.stream = (*run)->stream->stats();
+    if (result.streamed) {
+        result.stream = (*run)->stream->stats();
+        result.streamOptions = (*run)->stream->options();
+    }
     result.loadAvgEnd = loadAverage();
     result.glRenderer = (*run)->renderer->glRenderer();
     result.motion = pathMotion(path, idx);

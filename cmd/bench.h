@@ -150,6 +150,7 @@ struct BenchResult {
     // frames before which a region arrived, the damaged files (each once).
     bool streamed = false;
     RegionPagerStats stream;
+    RegionPagerOptions streamOptions;  // the stream's own (its chunk radius)
     int framesWithArrivals = 0;
     // Per frame: the frame thread's time in the stream's advance() before it
     // (pager update, collect, splicing arrivals into the graph and the ray

@@ -350,6 +350,8 @@ Status setUp(const std::string& modeName, const RenderPlan& p, const Walkthrough
         s.stream = std::move(*st);
         // hybrid: the stream keeps the near field, its split index and the horizon grid too.
         if (rays && modeStreamsNearField(modeName)) s.stream->enableNearField(p.options.horizonGrid);
+        // The label pass draws the whole streamed city; without it the mode's own levels suffice.
+        if (!p.labels()) s.stream->setGraphLevels(streamGraphOf({modeName}), streamNearBand(p.options));
         s.ctx.stream = s.stream.get();
         s.ctx.streamedCity = s.stream->graph();
         s.ctx.scene = s.stream->graph();
@@ -642,7 +644,7 @@ int run(const RenderArgs& a, const std::string& command) {
     if (!walk->pagedJson.empty()) paged = nlohmann::json::parse(walk->pagedJson);
     if (session.stream)
         paged["stream"] =
-            pagedStreamJson(plan.stream, session.stream->stats(), session.framesWithArrivals, session.damaged);
+            pagedStreamJson(session.stream->options(), session.stream->stats(), session.framesWithArrivals, session.damaged);
     if (Status s =
             writeMetadata(a, plan, command, walk->city, idx, frames, tm, done.kept, paged, *session.renderer, out);
         !s)

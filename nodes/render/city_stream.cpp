@@ -1,6 +1,8 @@
 // A paged city streamed for the render modes. See city_stream.h.
 #include "nodes/render/city_stream.h"
 
+#include <cmath>
+
 #include "nodes/near_field_chunks.h"
 #include "runtime/scene/scene_graph.h"
 
@@ -41,13 +43,13 @@ Result<std::unique_ptr<CityStream>> CityStream::create(const PagedManifest& mani
     const std::unique_ptr<StreamedNearField>* nearField = &s->_near;
     const StreamGraph* graphLevels = &s->_graphLevels;
     s->_manifest = &manifest;
-    options.prepare = [rayScene, nearField, graphLevels, labels](SceneModel& model, int,
-                                                                 bool coarse) -> std::shared_ptr<void> {
+    options.prepare = [rayScene, nearField, graphLevels, labels](SceneModel& model,
+                                                                 const RegionLoad& load) -> std::shared_ptr<void> {
         auto out = std::make_shared<RegionChunks>();
         // The ray scene first: it completes the model's tree prototypes, which the height patch bounds too.
-        if (rayScene) out->rays = rayScene->prepare(model);
+        if (rayScene && load.level) out->rays = rayScene->prepare(model);
         out->group = new osg::Group;
-        const bool chunks = *graphLevels == StreamGraph::EveryLevel || (*graphLevels == StreamGraph::FullLevels && !coarse);
+        const bool chunks = load.chunks && *graphLevels != StreamGraph::None;
         // What is made no longer needs the decoded model (unless its ray scene failed: the
         // frame thread builds it again for the error's message).
         struct FreeModel {
@@ -56,12 +58,12 @@ Result<std::unique_ptr<CityStream>> CityStream::create(const PagedManifest& mani
             ~FreeModel() {
                 if (!keep) m = SceneModel();
             }
-        } freeModel{model, rayScene && !out->rays};
+        } freeModel{model, rayScene && load.level && !out->rays};
         osg::ref_ptr<osg::Node> root = sceneRoot(model);
         if (*nearField) {
             // The chunks serve both the graph and the near field (no label twins: the label
             // channels of a streamed city come from `full` only).
-            out->nearField = (*nearField)->prepare(root.get(), model, chunks);
+            out->nearField = (*nearField)->prepare(root.get(), model, chunks, load.level);
             const NearFieldScene& nf = out->nearField->scene;
             out->rootState = nf.rootState;
             for (uint32_t i : nf.drawOrder) out->group->addChild(nf.chunks[i].get());
@@ -79,6 +81,7 @@ Result<std::unique_ptr<CityStream>> CityStream::create(const PagedManifest& mani
         }
         return out;
     };
+    s->_options = options;
     s->_pager = std::make_unique<RegionPager>(manifest, options);
     return s;
 }
@@ -90,25 +93,31 @@ void CityStream::enableNearField(int horizonCells) {
                                             pagedHeightLattice(*_manifest, _rays->rays().frameOrigin(), horizonCells));
 }
 
-void CityStream::setGraphLevels(StreamGraph levels) {
-    VISTA_CHECK(!_advanced);
+void CityStream::setGraphLevels(StreamGraph levels, double bandM) {
+    VISTA_CHECK(!_advanced && (levels != StreamGraph::NearBand || (std::isfinite(bandM) && bandM >= 0)));
     _graphLevels = levels;
+    // The pager loads nothing before its first update: made again with the band.
+    _pager.reset();
+    _options.chunkRadius = levels == StreamGraph::NearBand ? bandM : -1.0;
+    _pager = std::make_unique<RegionPager>(*_manifest, _options);
 }
 
 namespace {
 
-// Inserts `group` as (coarse, region)'s group under `root`, before the next group in merge order.
-void insertInMergeOrder(osg::Group* root, std::map<std::pair<bool, int>, osg::ref_ptr<osg::Group>>& groups,
-                        std::pair<bool, int> key, osg::Group* group) {
+// A group's key: CityStream::GroupKey.
+using GroupKey = std::tuple<bool, int, bool>;
+
+// Inserts `group` as `key`'s group under `root`, before the next group in merge order.
+void insertInMergeOrder(osg::Group* root, std::map<GroupKey, osg::ref_ptr<osg::Group>>& groups, GroupKey key,
+                        osg::Group* group) {
     auto it = groups.emplace(key, group).first;
     auto next = std::next(it);
     const unsigned at = next == groups.end() ? root->getNumChildren() : root->getChildIndex(next->second.get());
     root->insertChild(at, group);
 }
 
-// Removes (coarse, region)'s group from `root`; false when there is none.
-bool removeGroup(osg::Group* root, std::map<std::pair<bool, int>, osg::ref_ptr<osg::Group>>& groups,
-                 std::pair<bool, int> key) {
+// Removes `key`'s group from `root`; false when there is none.
+bool removeGroup(osg::Group* root, std::map<GroupKey, osg::ref_ptr<osg::Group>>& groups, GroupKey key) {
     auto it = groups.find(key);
     if (it == groups.end()) return false;
     root->removeChild(it->second.get());
@@ -141,24 +150,27 @@ Result<CityStreamFrame> CityStream::advance(const glm::dvec3& eye, const glm::dv
         VISTA_RETURN_IF_ERROR(_rays->apply(d, prepared).status());
     }
     for (const RegionDrop& x : d.dropped) {
-        if (_labelRoot) removeGroup(_labelRoot.get(), _labelGroups, {x.coarse, x.region});
-        if (!removeGroup(_root.get(), _groups, {x.coarse, x.region})) continue;
-        if (_near) _near->remove(levelKey(x.region, x.coarse));
-        f.changed.push_back(changedBox(*_manifest, x.region));
+        const GroupKey key{x.coarse, x.region, x.chunks};
+        if (_labelRoot) removeGroup(_labelRoot.get(), _labelGroups, key);
+        if (!removeGroup(_root.get(), _groups, key)) continue;
+        if (_near) _near->remove(x.chunks ? chunkPartKey(x.region) : levelKey(x.region, x.coarse));
+        if (!x.chunks) f.changed.push_back(changedBox(*_manifest, x.region));  // a chunk part is not traced
         ++f.dropped;
     }
     for (RegionArrival& a : d.arrived) {
         auto* chunks = static_cast<RegionChunks*>(a.prepared.get());
         if (!chunks) continue;
+        const GroupKey key{a.coarse, a.region, a.chunks};
         if (!_root->getStateSet() && chunks->rootState) _root->setStateSet(chunks->rootState.get());
-        insertInMergeOrder(_root.get(), _groups, {a.coarse, a.region}, chunks->group.get());
+        insertInMergeOrder(_root.get(), _groups, key, chunks->group.get());
         if (_labelRoot && chunks->labels) {
             if (!_labelRoot->getStateSet() && chunks->labelRootState)
                 _labelRoot->setStateSet(chunks->labelRootState.get());
-            insertInMergeOrder(_labelRoot.get(), _labelGroups, {a.coarse, a.region}, chunks->labels.get());
+            insertInMergeOrder(_labelRoot.get(), _labelGroups, key, chunks->labels.get());
         }
-        if (_near && chunks->nearField) _near->add(levelKey(a.region, a.coarse), *chunks->nearField);
-        f.changed.push_back(changedBox(*_manifest, a.region));
+        if (_near && chunks->nearField)
+            _near->add(a.chunks ? chunkPartKey(a.region) : levelKey(a.region, a.coarse), *chunks->nearField);
+        if (!a.chunks) f.changed.push_back(changedBox(*_manifest, a.region));
         ++f.arrived;
     }
     if (f.arrived > 0 || f.dropped > 0) ++_generation;

@@ -22,10 +22,13 @@
 //  - the near field (nearField(), after enableNearField()): the resident
 //    levels' chunks, their split index and the horizon's height grid
 //    (StreamedNearField), cut on the worker thread and spliced here.
-// Which levels carry chunks (setGraphLevels): every level (the default), the
-// full levels only (the hybrid modes: their near field never reaches the
-// coarse levels, which only the far field traces; the horizon still gets
-// their height patches), or none (ray casting alone). A level's model is freed
+// Which levels carry chunks (setGraphLevels): every level (the default); the
+// full regions within a band around the camera only, as the pager's chunk
+// parts (the hybrid modes: their near field reaches a few hundred metres;
+// farther full regions and every coarse level are only traced, and the
+// horizon still gets their height patches); or none (ray casting alone).
+// Without chunks for every level the graph is not the whole city, so the
+// hybrid does not offer "everything" then. A level's model is freed
 // on the worker as soon as what it feeds is made: nothing keeps a decoded
 // region beyond its chunks, its Embree scene and its height patch.
 // Modes that draw the chunked city (full, near), cast rays (raycast) or
@@ -45,6 +48,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -60,7 +64,7 @@
 namespace vista {
 
 // The region levels that carry chunks in the graph and the near field (CityStream::setGraphLevels).
-enum class StreamGraph { EveryLevel, FullLevels, None };
+enum class StreamGraph { EveryLevel, NearBand, None };
 
 struct CityStreamFrame {
     int arrived = 0, dropped = 0;  // region levels
@@ -84,8 +88,10 @@ public:
     // side (0 = auto) on the paged city's lattice (pagedHeightLattice). Contract: before the
     // first advance() and with rays.
     void enableNearField(int horizonCells);
-    // Which levels get chunks (StreamGraph; default EveryLevel). Contract: before the first advance().
-    void setGraphLevels(StreamGraph levels);
+    // Which levels get chunks (StreamGraph; default EveryLevel); NearBand: the full regions within
+    // bandM metres of the camera's lookahead (RegionPagerOptions::chunkRadius). Contract: before
+    // the first advance(); bandM finite and >= 0 for NearBand.
+    void setGraphLevels(StreamGraph levels, double bandM = 0);
     StreamGraph graphLevels() const { return _graphLevels; }
     // Moves the pager to the eye and mirrors what it hands over. wait = true:
     // this call blocks until the desired set is resident, as every call does
@@ -100,9 +106,14 @@ public:
     // Per manifest region, the level held now (RegionPager::held()).
     std::vector<uint8_t> held() const { return _pager->held(); }
     RegionPagerStats stats() const { return _pager->stats(); }
+    // The pager's options (with the chunk radius setGraphLevels chose).
+    const RegionPagerOptions& options() const { return _options; }
 
 private:
     CityStream() = default;
+    // A group's key: (coarse, region, chunk part), ordered as loadPagedCity merges levels.
+    using GroupKey = std::tuple<bool, int, bool>;
+    RegionPagerOptions _options;  // the pager's (setGraphLevels makes it again)
     std::unique_ptr<RegionPager> _pager;
     std::unique_ptr<StreamedRayScene> _rays;
     std::unique_ptr<StreamedNearField> _near;  // read by the workers' prepare once set
@@ -111,10 +122,9 @@ private:
     uint64_t _generation = 0;
     bool _advanced = false;
     osg::ref_ptr<osg::Group> _root;
-    // (coarse, region) -> its chunk group under _root: ordered as loadPagedCity merges.
-    std::map<std::pair<bool, int>, osg::ref_ptr<osg::Group>> _groups;
+    std::map<GroupKey, osg::ref_ptr<osg::Group>> _groups;  // each level's or part's chunk group under _root
     osg::ref_ptr<osg::Group> _labelRoot;  // labels: the twins of _groups, same keys and order
-    std::map<std::pair<bool, int>, osg::ref_ptr<osg::Group>> _labelGroups;
+    std::map<GroupKey, osg::ref_ptr<osg::Group>> _labelGroups;
 };
 
 }  // namespace vista

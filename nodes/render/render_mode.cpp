@@ -2,6 +2,8 @@
 // createRenderMode(), which wraps each in the run-time effects.
 #include "nodes/render/render_mode.h"
 
+#include <algorithm>
+
 #include "nodes/render/city_stream.h"
 #include "nodes/render/effects_mode.h"
 #include "nodes/render/mode_full.h"
@@ -12,6 +14,7 @@
 #include "nodes/render/mode_osgimpostor.h"
 #include "nodes/render/mode_osglod.h"
 #include "nodes/render/mode_raycast.h"
+#include "runtime/engine/adaptive_split.h"
 
 namespace vista {
 
@@ -61,7 +64,11 @@ StreamGraph streamGraphOf(const std::vector<std::string>& modes) {
         if (modeStreamsNearField(m)) nearField = true;
         else if (m != "raycast") return StreamGraph::EveryLevel;
     }
-    return nearField ? StreamGraph::FullLevels : StreamGraph::None;
+    return nearField ? StreamGraph::NearBand : StreamGraph::None;
+}
+
+double streamNearBand(const ModeOptions& o) {
+    return std::max({AdaptiveSplitOptions().maxDistance, o.fixedNearDistance(), o.nearDistance}) + kStreamBandMarginM;
 }
 
 bool modeFollowsTimings(const std::string& name, const ModeOptions& o) {

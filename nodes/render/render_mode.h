@@ -262,10 +262,14 @@ std::string streamingModeNames();  // "full, near, raycast, hybrid, hybrid-fixed
 // True for the modes that need the stream's near field (hybrid, hybrid-fixed).
 bool modeStreamsNearField(const std::string& name);
 // The levels of a stream that the listed modes draw (CityStream::setGraphLevels): none for
-// ray casting alone, the full levels when the rest are hybrid modes (their near field stays
-// within AdaptiveSplitOptions::maxDistance, far inside the paged radius), else every level.
+// ray casting alone, the near band when the rest are hybrid modes, else every level.
 enum class StreamGraph;
 StreamGraph streamGraphOf(const std::vector<std::string>& modes);
+// The near band of those modes (metres): the farthest near distance they draw (the adaptive
+// split's largest middle candidate, or the fixed distance) plus kStreamBandMarginM, the
+// distance over which a region's chunks load before the near field needs them.
+constexpr double kStreamBandMarginM = 250.0;
+double streamNearBand(const ModeOptions& options);
 // True when a mode's pictures follow measured times under these options, so
 // that two runs of the same frames may differ: hybrid with the adaptive split
 // (--near auto), the adaptive cache (on and not --cache-always) or a frame-time

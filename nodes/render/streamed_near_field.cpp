@@ -22,12 +22,12 @@ HeightGrid pagedHeightLattice(const PagedManifest& m, const glm::dvec3& frameOri
 StreamedNearField::StreamedNearField(double blockCell, HeightGrid grid)
     : _index(_scene.objects, blockCell, nullptr), _grid(std::move(grid)) {}
 
-std::shared_ptr<NearFieldRegion> StreamedNearField::prepare(osg::Node* root, const SceneModel& model,
-                                                           bool chunks) const {
+std::shared_ptr<NearFieldRegion> StreamedNearField::prepare(osg::Node* root, const SceneModel& model, bool chunks,
+                                                           bool heights) const {
     auto out = std::make_shared<NearFieldRegion>();
     if (chunks) out->scene = buildNearFieldScene(root, kNearChunkSize, false);
     out->block = SplitIndex::makeBlock(out->scene.objects.data(), out->scene.objects.size());
-    if (_grid.cells() > 0) out->heights = std::make_shared<const HeightPatch>(_grid.patch(model));
+    if (heights && _grid.cells() > 0) out->heights = std::make_shared<const HeightPatch>(_grid.patch(model));
     return out;
 }
 

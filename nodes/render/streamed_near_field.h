@@ -48,6 +48,8 @@ struct NearFieldRegion {
 
 // (coarse, region) as one key, in the order loadPagedCity() merges levels.
 inline uint64_t levelKey(int region, bool coarse) { return (uint64_t(coarse ? 1 : 0) << 32) | uint32_t(region); }
+// A full region's chunk part (RegionArrival::chunks): after every level, by region.
+inline uint64_t chunkPartKey(int region) { return (uint64_t(1) << 40) | uint32_t(region); }
 
 // The paged city's horizon lattice: its regions' bounds (the manifest's, non-empty regions),
 // cells as HeightGrid::build (0 = auto), in the frame of frameOrigin.
@@ -62,9 +64,11 @@ public:
     StreamedNearField& operator=(const StreamedNearField&) = delete;
 
     // Worker side: the level's chunks, block and patch (`root`: the level's graph).
-    // chunks = false: the level's height patch only (no chunks, an empty block): a level the
-    // near field never draws (CityStream::setGraphLevels).
-    std::shared_ptr<NearFieldRegion> prepare(osg::Node* root, const SceneModel& model, bool chunks = true) const;
+    // chunks = false: no chunks (an empty block): a level the near field never draws
+    // (CityStream::setGraphLevels); heights = false: no height patch (a chunk part, whose level
+    // brings it).
+    std::shared_ptr<NearFieldRegion> prepare(osg::Node* root, const SceneModel& model, bool chunks = true,
+                                             bool heights = true) const;
     void add(uint64_t key, const NearFieldRegion& region);
     void remove(uint64_t key);
 

@@ -36,6 +36,7 @@ Result<RayStreamFrame> StreamedRayScene::apply(RegionPagerDelta& d,
     f.waited = d.waited;
     f.damaged = d.damaged;
     for (const RegionDrop& x : d.dropped) {
+        if (x.chunks) continue;  // a chunk part: nothing of it is traced
         auto it = _ids.find({x.region, x.coarse});
         if (it == _ids.end()) continue;  // never added (it failed to add)
         VISTA_RETURN_IF_ERROR(_rays->removeRegion(it->second));
@@ -44,6 +45,7 @@ Result<RayStreamFrame> StreamedRayScene::apply(RegionPagerDelta& d,
     }
     for (size_t k = 0; k < d.arrived.size(); ++k) {
         RegionArrival& a = d.arrived[k];
+        if (a.chunks) continue;
         std::shared_ptr<RayScene::PreparedRegion> p = k < prepared.size() ? prepared[k] : nullptr;
         if (!p) p = prepare(a.model);
         if (!p) {

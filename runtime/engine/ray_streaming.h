@@ -5,7 +5,8 @@
 // frames, apply() mirrors what the pager handed over: each dropped level's
 // region is removed, each arrived level added as one region (the region's
 // own model, freed right after), then the top level is committed (only when
-// something changed). The whole scene is never rebuilt, and a region's
+// something changed). Chunk parts (RegionArrival::chunks) are not traced and
+// pass by. The whole scene is never rebuilt, and a region's
 // Embree scene is built on the pager's worker thread (prepare(), from the
 // pager's prepare hook): the frame thread only instances it.
 //

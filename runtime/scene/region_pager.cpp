@@ -65,8 +65,9 @@ RegionPager::RegionPager(const PagedManifest& manifest, const RegionPagerOptions
     VISTA_CHECK(std::isfinite(_o.prefetchS) && _o.prefetchS >= 0);
     VISTA_CHECK(_o.workers >= 1 && _o.workers <= 16);
     const size_t n = _m.regions.size();
-    for (auto* v :
-         {&_desired, &_nearEye, &_holdFull, &_holdCoarse, &_flightFull, &_flightCoarse, &_failedFull, &_failedCoarse})
+    VISTA_CHECK(std::isfinite(_o.chunkRadius));
+    for (auto* v : {&_desired, &_nearEye, &_holdFull, &_holdCoarse, &_flightFull, &_flightCoarse, &_failedFull,
+                    &_failedCoarse, &_desiredChunks, &_nearEyeChunks, &_holdChunks, &_flightChunks})
         v->assign(n, 0);
     _key.assign(n, 0.0);
     for (int k = 0; k < _o.workers; ++k) _threads.emplace_back([this] { workerLoop(); });
@@ -94,7 +95,14 @@ void RegionPager::workerLoop() {
         Done done;
         done.job = job;
         done.model = loadPagedRegion(_m, job.region, job.coarse);
-        if (done.model && _o.prepare) done.prepared = _o.prepare(*done.model, job.region, job.coarse);
+        if (done.model && _o.prepare) {
+            RegionLoad load;
+            load.region = job.region;
+            load.coarse = job.coarse;
+            load.level = !job.chunks;
+            load.chunks = job.chunks || _o.chunkRadius < 0;
+            done.prepared = _o.prepare(*done.model, load);
+        }
         done.loader = std::this_thread::get_id();
         lock.lock();
         --_busy;
@@ -128,7 +136,10 @@ void RegionPager::computeDesired() {
         _nearEye[i] = level == kFull ? dEye <= _o.radius : (level == kCoarse && dEye <= farM);
         if (level != kNone) total += levelBytes(int(i), level == kCoarse);
     }
-    if (_o.budgetBytes == 0 || total <= _o.budgetBytes) return;
+    if (_o.budgetBytes == 0 || total <= _o.budgetBytes) {
+        computeChunks(total);
+        return;
+    }
     // Over the budget: coarse levels go first, farthest first; then full
     // regions, farthest first (the radius shrinks), each keeping its coarse
     // level when that fits; then regions left out get their coarse level
@@ -177,19 +188,54 @@ void RegionPager::computeDesired() {
         }
     for (size_t i = 0; i < _desired.size(); ++i)
         if (_desired[i] == kNone) _nearEye[i] = 0;
+    computeChunks(total);
 }
 
-void RegionPager::drop(int region, bool coarse, RegionPagerDelta* delta) {
-    (coarse ? _holdCoarse : _holdFull)[size_t(region)] = 0;
+// The chunk parts wanted: the full regions within chunkRadius of the lookahead segment, nearest
+// first while the budget (after every level: `total` bytes) has room.
+void RegionPager::computeChunks(uint64_t total) {
+    std::fill(_desiredChunks.begin(), _desiredChunks.end(), 0);
+    std::fill(_nearEyeChunks.begin(), _nearEyeChunks.end(), 0);
+    if (_o.chunkRadius < 0) return;
+    std::vector<int> band;
+    for (size_t i = 0; i < _m.regions.size(); ++i) {
+        if (_desired[i] != kFull) continue;
+        const glm::dvec2 lo(_m.regions[i].lo), hi(_m.regions[i].hi);
+        if (segmentRect(_eye, _ahead, lo, hi) > _o.chunkRadius) continue;
+        band.push_back(int(i));
+        _nearEyeChunks[i] = pointRect(_eye, lo, hi) <= _o.chunkRadius;
+    }
+    std::sort(band.begin(), band.end(), [&](int x, int y) {
+        return _key[size_t(x)] != _key[size_t(y)] ? _key[size_t(x)] < _key[size_t(y)] : x < y;
+    });
+    for (int i : band) {
+        const uint64_t bytes = levelBytes(i, false);
+        if (_o.budgetBytes > 0 && total + bytes > _o.budgetBytes) {
+            _nearEyeChunks[size_t(i)] = 0;
+            continue;
+        }
+        _desiredChunks[size_t(i)] = 1;
+        total += bytes;
+    }
+}
+
+// 0: a full level or chunk part wanted near the eye itself; 1: a coarse one; 2: wanted only for the lookahead.
+int RegionPager::urgency(const Job& j) const {
+    const bool nearEye = j.chunks ? _nearEyeChunks[size_t(j.region)] != 0 : _nearEye[size_t(j.region)] != 0;
+    return nearEye ? (j.coarse ? 1 : 0) : 2;
+}
+
+void RegionPager::drop(int region, bool coarse, RegionPagerDelta* delta, bool chunks) {
+    hold(Job{region, coarse, chunks})[size_t(region)] = 0;
     // Not handed to the caller yet: freed here.
     auto& arrived = delta->arrived;
     for (auto it = arrived.begin(); it != arrived.end(); ++it)
-        if (it->region == region && it->coarse == coarse) {
+        if (it->region == region && it->coarse == coarse && it->chunks == chunks) {
             arrived.erase(it);
             ++_stats.discarded;
             return;
         }
-    delta->dropped.push_back({region, coarse});
+    delta->dropped.push_back({region, coarse, chunks});
     ++_stats.unloads;
 }
 
@@ -202,64 +248,57 @@ void RegionPager::schedule(RegionPagerDelta* delta) {
         const bool hasWanted = (want == kFull && _holdFull[size_t(i)]) || (want == kCoarse && _holdCoarse[size_t(i)]);
         if (_holdFull[size_t(i)] && want != kFull && (want == kNone || hasWanted)) drop(i, false, delta);
         if (_holdCoarse[size_t(i)] && want != kCoarse && (want == kNone || hasWanted)) drop(i, true, delta);
+        if (_holdChunks[size_t(i)] && !_desiredChunks[size_t(i)]) drop(i, false, delta, true);
     }
     // Cancel queued loads that are no longer wanted.
     std::lock_guard<std::mutex> lock(_mutex);
     for (auto it = _queue.begin(); it != _queue.end();) {
-        const uint8_t want = _desired[size_t(it->region)];
-        if (want != (it->coarse ? kCoarse : kFull)) {
-            (it->coarse ? _flightCoarse : _flightFull)[size_t(it->region)] = 0;
+        if (!wanted(*it)) {
+            flight(*it)[size_t(it->region)] = 0;
             it = _queue.erase(it);
         } else {
             ++it;
         }
     }
     // The loads still to start, most urgent first.
-    struct Want {
-        int region;
-        bool coarse;
-        int urgency;
+    // Levels before chunk parts at the same urgency and distance.
+    auto before = [&](const Job& a, const Job& b) {
+        const int ua = urgency(a), ub = urgency(b);
+        if (ua != ub) return ua < ub;
+        if (_key[size_t(a.region)] != _key[size_t(b.region)]) return _key[size_t(a.region)] < _key[size_t(b.region)];
+        if (a.region != b.region) return a.region < b.region;
+        return a.chunks < b.chunks;
     };
-    std::vector<Want> wants;
+    std::vector<Job> wants;
     for (int i = 0; i < n; ++i) {
         const uint8_t want = _desired[size_t(i)];
         if (want == kNone) continue;
-        const bool coarse = want == kCoarse;
-        if ((coarse ? _holdCoarse : _holdFull)[size_t(i)] || (coarse ? _flightCoarse : _flightFull)[size_t(i)])
-            continue;
-        wants.push_back({i, coarse, _nearEye[size_t(i)] ? (coarse ? 1 : 0) : 2});
+        const Job level{i, want == kCoarse, false};
+        if (!hold(level)[size_t(i)] && !flight(level)[size_t(i)]) wants.push_back(level);
+        const Job part{i, false, true};
+        if (_desiredChunks[size_t(i)] && !_holdChunks[size_t(i)] && !_flightChunks[size_t(i)]) wants.push_back(part);
     }
-    std::sort(wants.begin(), wants.end(), [&](const Want& a, const Want& b) {
-        if (a.urgency != b.urgency) return a.urgency < b.urgency;
-        if (_key[size_t(a.region)] != _key[size_t(b.region)]) return _key[size_t(a.region)] < _key[size_t(b.region)];
-        return a.region < b.region;
-    });
+    std::sort(wants.begin(), wants.end(), before);
     // Queued loads in the same order: the queue is rebuilt, the new ones merged in.
     std::vector<Job> queued(_queue.begin(), _queue.end());
     _queue.clear();
     uint64_t resident = stats().residentBytes;
-    for (const Want& w : wants) {
+    for (const Job& w : wants) {
         const uint64_t need = levelBytes(w.region, w.coarse);
         if (_o.budgetBytes > 0 && resident + need > _o.budgetBytes) {
             // The region's other level makes room, if it has one.
             const bool other = !w.coarse;
-            if ((other ? _holdCoarse : _holdFull)[size_t(w.region)]) {
+            if (!w.chunks && (other ? _holdCoarse : _holdFull)[size_t(w.region)]) {
                 drop(w.region, other, delta);
                 resident -= levelBytes(w.region, other);
             }
             if (resident + need > _o.budgetBytes) continue;  // waits for room (an old level leaving)
         }
-        (w.coarse ? _flightCoarse : _flightFull)[size_t(w.region)] = 1;
+        flight(w)[size_t(w.region)] = 1;
         resident += need;
-        queued.push_back({w.region, w.coarse});
+        queued.push_back(w);
     }
-    std::stable_sort(queued.begin(), queued.end(), [&](const Job& a, const Job& b) {
-        const int ua = _nearEye[size_t(a.region)] ? (a.coarse ? 1 : 0) : 2;
-        const int ub = _nearEye[size_t(b.region)] ? (b.coarse ? 1 : 0) : 2;
-        if (ua != ub) return ua < ub;
-        if (_key[size_t(a.region)] != _key[size_t(b.region)]) return _key[size_t(a.region)] < _key[size_t(b.region)];
-        return a.region < b.region;
-    });
+    std::stable_sort(queued.begin(), queued.end(), before);
     _queue.assign(queued.begin(), queued.end());
     _stats.peakResidentBytes = std::max(_stats.peakResidentBytes, resident);
     _work.notify_all();
@@ -279,24 +318,26 @@ void RegionPager::takeArrivals(std::deque<Done>& done, RegionPagerDelta* delta) 
     for (Done& d : done) {
         const int i = d.job.region;
         const bool coarse = d.job.coarse;
-        (coarse ? _flightCoarse : _flightFull)[size_t(i)] = 0;
+        flight(d.job)[size_t(i)] = 0;
         if (!d.model) {
-            (coarse ? _failedCoarse : _failedFull)[size_t(i)] = 1;
+            (coarse ? _failedCoarse : _failedFull)[size_t(i)] = 1;  // a chunk part reads the full file
             delta->damaged.push_back(d.model.status().message());
             ++_stats.failed;
             failed = true;
             continue;
         }
         ++_stats.loads;
+        _stats.chunkLoads += d.job.chunks ? 1 : 0;
         _stats.bytesRead += levelBytes(i, coarse);
-        if (_desired[size_t(i)] != (coarse ? kCoarse : kFull)) {
+        if (!wanted(d.job)) {
             ++_stats.discarded;  // no longer wanted: freed with `done`
             continue;
         }
-        (coarse ? _holdCoarse : _holdFull)[size_t(i)] = 1;
+        hold(d.job)[size_t(i)] = 1;
         RegionArrival a;
         a.region = i;
         a.coarse = coarse;
+        a.chunks = d.job.chunks;
         a.model = std::move(*d.model);
         a.bytes = levelBytes(i, coarse);
         a.loader = d.loader;
@@ -324,7 +365,8 @@ RegionPagerDelta RegionPager::collect(bool wait) {
         Stopwatch sw;
         for (;;) {
             bool inFlight = false;
-            for (size_t i = 0; i < _flightFull.size() && !inFlight; ++i) inFlight = _flightFull[i] || _flightCoarse[i];
+            for (size_t i = 0; i < _flightFull.size() && !inFlight; ++i)
+                inFlight = _flightFull[i] || _flightCoarse[i] || _flightChunks[i];
             if (!inFlight) break;
             delta.waited = true;
             {
@@ -340,10 +382,12 @@ RegionPagerDelta RegionPager::collect(bool wait) {
         }
     }
     std::sort(delta.dropped.begin(), delta.dropped.end(), [](const RegionDrop& a, const RegionDrop& b) {
-        return a.region != b.region ? a.region < b.region : a.coarse < b.coarse;
+        if (a.region != b.region) return a.region < b.region;
+        return a.coarse != b.coarse ? a.coarse < b.coarse : a.chunks < b.chunks;
     });
     std::stable_sort(delta.arrived.begin(), delta.arrived.end(), [](const RegionArrival& a, const RegionArrival& b) {
-        return a.coarse != b.coarse ? !a.coarse : a.region < b.region;
+        if (a.coarse != b.coarse) return !a.coarse;
+        return a.region != b.region ? a.region < b.region : a.chunks < b.chunks;
     });
     return delta;
 }
@@ -356,6 +400,8 @@ RegionPagerStats RegionPager::stats() const {
         if (_m.regions[i].empty) continue;
         if (_holdFull[i] || _flightFull[i]) s.residentBytes += _m.regions[i].bytes;
         if (_holdCoarse[i] || _flightCoarse[i]) s.residentBytes += _m.regions[i].coarseBytes;
+        if (_holdChunks[i] || _flightChunks[i]) s.residentBytes += _m.regions[i].bytes;
+        s.residentChunks += _holdChunks[i] ? 1 : 0;
         s.residentFull += _holdFull[i] ? 1 : 0;
         s.residentCoarse += _holdCoarse[i] ? 1 : 0;
     }

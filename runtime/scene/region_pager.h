@@ -25,6 +25,17 @@
 // until the new one arrives only when both fit, else the old level is dropped
 // first.
 //
+// Chunk parts (chunkRadius >= 0): a full level then loads without its
+// near-field chunks (RegionLoad::chunks false), and the chunks come as a part
+// of their own (RegionLoad::level false: the full file read again, prepared
+// for its chunks only) for the full regions within chunkRadius of the
+// lookahead segment: a near field that reaches a few hundred metres keeps
+// chunks for the few regions around the camera, not for every full region.
+// A part is dropped when its region leaves the band or its full level goes;
+// it counts in the resident bytes (its file's bytes) and, under a budget,
+// comes after every level (nearest first, while it fits). chunkRadius < 0:
+// every level comes with its chunks (one load, RegionLoad::chunks true).
+//
 // Load order: by urgency, then by the mean of the region's distance to the
 // eye and to the end of the lookahead (so regions ahead of the heading come
 // before those behind at the same distance): full regions within reach of the
@@ -73,8 +84,17 @@ namespace vista {
 constexpr double kDefaultPagedPrefetchS = 4.0;
 constexpr double kMaxPagedPrefetchS = 600.0;
 
+// What one load makes of a region's file (RegionPagerOptions::prepare).
+struct RegionLoad {
+    int region = 0;
+    bool coarse = false;
+    bool level = true;   // the level itself (false: a chunk part, see above)
+    bool chunks = true;  // its near-field chunks
+};
+
 struct RegionPagerOptions {
     double radius = kDefaultPagedRadiusM;  // metres: full detail within
+    double chunkRadius = -1;               // metres: chunk parts within (< 0: chunks come with every level)
     double far = kDefaultPagedFarM;        // metres: coarse level within (<= radius: none)
     double prefetchS = kDefaultPagedPrefetchS;
     uint64_t budgetBytes = 0;  // file bytes of the resident levels; 0 = no budget
@@ -84,13 +104,14 @@ struct RegionPagerOptions {
     // near-field chunks of its graph, its Embree scene); it may complete the
     // model in place, and its result travels in RegionArrival::prepared.
     // Must be thread-safe and must not throw.
-    std::function<std::shared_ptr<void>(SceneModel& model, int region, bool coarse)> prepare;
+    std::function<std::shared_ptr<void>(SceneModel& model, const RegionLoad& load)> prepare;
 };
 
 // One region level loaded on a worker thread.
 struct RegionArrival {
     int region = 0;  // index into the manifest's regions
     bool coarse = false;
+    bool chunks = false;  // a chunk part (of the full level), not a level
     SceneModel model;
     uint64_t bytes = 0;              // its file bytes (manifest)
     std::thread::id loader;          // the worker thread that read it
@@ -101,6 +122,7 @@ struct RegionArrival {
 struct RegionDrop {
     int region = 0;
     bool coarse = false;
+    bool chunks = false;  // a chunk part, not a level
 };
 
 struct RegionPagerDelta {
@@ -115,6 +137,7 @@ struct RegionPagerStats {
     uint64_t peakResidentBytes = 0;            // the most residentBytes has been
     uint64_t bytesRead = 0;                    // file bytes of the successful loads
     int loads = 0;                             // successful loads (discarded ones included)
+    int chunkLoads = 0;                        // ... of which chunk parts
     int unloads = 0;                           // levels handed out as drops
     int discarded = 0;                         // loads that arrived unwanted and were freed here
     int failed = 0;                            // loads that failed (damaged or missing files)
@@ -122,6 +145,7 @@ struct RegionPagerStats {
     double waitMs = 0;                         // total time blocked in collect()
     int budgetLimited = 0;                     // updates whose desired set the budget cut
     int residentFull = 0, residentCoarse = 0;  // levels held by the caller now
+    int residentChunks = 0;                    // chunk parts held by the caller now
 };
 
 class RegionPager {
@@ -148,6 +172,7 @@ private:
     struct Job {
         int region = 0;
         bool coarse = false;
+        bool chunks = false;  // a chunk part
     };
     struct Done {
         Job job;
@@ -161,7 +186,16 @@ private:
     void workerLoop();
     void schedule(RegionPagerDelta* delta);
     void computeDesired();
-    void drop(int region, bool coarse, RegionPagerDelta* delta);
+    void drop(int region, bool coarse, RegionPagerDelta* delta, bool chunks = false);
+    void computeChunks(uint64_t total);
+    int urgency(const Job& j) const;
+    std::vector<uint8_t>& hold(const Job& j) { return j.chunks ? _holdChunks : (j.coarse ? _holdCoarse : _holdFull); }
+    std::vector<uint8_t>& flight(const Job& j) {
+        return j.chunks ? _flightChunks : (j.coarse ? _flightCoarse : _flightFull);
+    }
+    bool wanted(const Job& j) const {
+        return j.chunks ? _desiredChunks[size_t(j.region)] != 0 : _desired[size_t(j.region)] == (j.coarse ? kCoarse : kFull);
+    }
     void takeArrivals(std::deque<Done>& done, RegionPagerDelta* delta);
     uint64_t levelBytes(int region, bool coarse) const;
     double regionKey(int region) const;
@@ -177,6 +211,8 @@ private:
     std::vector<uint8_t> _holdFull, _holdCoarse;      // held by the caller (or arrived, not yet collected)
     std::vector<uint8_t> _flightFull, _flightCoarse;  // queued or loading
     std::vector<uint8_t> _failedFull, _failedCoarse;
+    // Chunk parts (chunkRadius >= 0): wanted, near the eye itself, held, queued or loading.
+    std::vector<uint8_t> _desiredChunks, _nearEyeChunks, _holdChunks, _flightChunks;
     std::vector<double> _key;   // load order within an urgency (lower first)
     RegionPagerDelta _pending;  // drops decided by update(), handed out by the next collect()
     RegionPagerStats _stats;

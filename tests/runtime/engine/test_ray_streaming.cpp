@@ -68,7 +68,9 @@ TEST(RayStreaming, WaitingFramesAreTheFramesOfTheRegionsWithinReach) {
     auto s = vista::StreamedRayScene::follower(*m);
     ASSERT_TRUE(s.isOk()) << s.status().message();
     const vista::StreamedRayScene* scene = s->get();
-    o.prepare = [scene](vista::SceneModel& model, int, bool) -> std::shared_ptr<void> { return scene->prepare(model); };
+    o.prepare = [scene](vista::SceneModel& model, const vista::RegionLoad&) -> std::shared_ptr<void> {
+        return scene->prepare(model);
+    };
     // Declared after the scene: stopped (its workers joined) before the scene goes.
     vista::RegionPager pager(*m, o);
     int arrived = 0, dropped = 0;

@@ -7,7 +7,11 @@
 
 #include <filesystem>
 #include <fstream>
+#include <algorithm>
+#include <cmath>
 #include <map>
+#include <mutex>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -257,4 +261,71 @@ TEST_F(Pager, ADamagedRegionFileFallsBackToItsCoarseLevel) {
     EXPECT_TRUE(again.damaged.empty());
     EXPECT_TRUE(again.arrived.empty());
     EXPECT_EQ(pager.stats().failed, 1);
+}
+
+// Chunk parts (RegionPagerOptions::chunkRadius): a full level loads without its chunks, and the
+// full regions whose bounds come within the band of the eye get a chunk part of their own; a part
+// leaves when its region leaves the band. The band is checked against the manifest bounds here.
+TEST_F(Pager, ChunkPartsFollowTheBandAndLeaveWithIt) {
+    RegionPagerOptions o;
+    o.radius = 600;
+    o.far = 5000;
+    o.prefetchS = 0;
+    o.wait = true;
+    o.chunkRadius = 100;
+    std::mutex m;
+    std::vector<vista::RegionLoad> loads;
+    o.prepare = [&](vista::SceneModel&, const vista::RegionLoad& load) -> std::shared_ptr<void> {
+        std::lock_guard<std::mutex> lock(m);
+        loads.push_back(load);
+        return nullptr;
+    };
+    RegionPager pager(manifest, o);
+    auto band = [&](const glm::dvec3& eye) {
+        std::set<int> out;
+        for (int i : vista::selectPagedRegions(manifest, {glm::dvec2(eye)}, o.radius)) {
+            const auto& r = manifest.regions[size_t(i)];
+            const double dx = std::max({r.lo.x - eye.x, 0.0, eye.x - r.hi.x});
+            const double dy = std::max({r.lo.y - eye.y, 0.0, eye.y - r.hi.y});
+            if (std::hypot(dx, dy) <= o.chunkRadius) out.insert(i);
+        }
+        return out;
+    };
+    std::set<int> parts;
+    int partsLoaded = 0;
+    // From the middle of region 4 to 50 m short of its east edge, then into region 5's middle.
+    const double half = 0.5 * manifest.regionSizeM;
+    for (const glm::dvec3& eye : {centre(4), centre(4) + glm::dvec3(half - 50.0, 0.0, 0.0), centre(5)}) {
+        pager.update(eye, glm::dvec3(0.0));
+        auto d = pager.collect();
+        for (const auto& x : d.dropped)
+            if (x.chunks) {
+                EXPECT_FALSE(x.coarse);
+                EXPECT_EQ(parts.erase(x.region), 1u) << "drop of a chunk part not held: " << x.region;
+            }
+        for (const auto& a : d.arrived)
+            if (a.chunks) {
+                EXPECT_FALSE(a.coarse);
+                EXPECT_TRUE(parts.insert(a.region).second) << "chunk part " << a.region << " arrived twice";
+                ++partsLoaded;
+            }
+        const std::set<int> expect = band(eye);
+        ASSERT_FALSE(expect.empty());
+        EXPECT_EQ(parts, expect) << "eye at " << eye.x << ", " << eye.y;
+        EXPECT_EQ(pager.stats().residentChunks, int(expect.size()));
+    }
+    // Every level loaded without chunks; every part is a full file prepared for its chunks alone.
+    std::lock_guard<std::mutex> lock(m);
+    int levelLoads = 0;
+    for (const auto& l : loads) {
+        if (l.level) {
+            EXPECT_FALSE(l.chunks) << "region " << l.region << ": a level with its chunks";
+            ++levelLoads;
+        } else {
+            EXPECT_TRUE(l.chunks);
+            EXPECT_FALSE(l.coarse);
+        }
+    }
+    EXPECT_EQ(int(loads.size()) - levelLoads, partsLoaded);
+    EXPECT_EQ(pager.stats().loads, int(loads.size()));
 }
