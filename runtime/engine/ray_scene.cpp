@@ -132,6 +132,7 @@ struct RayScene::Impl {
     bool ftz = true;    // set FTZ/DAZ on casting threads (city scenes)
     bool city = false;  // a city scene (regions may be added)
     bool flat = false;  // flat layout (no regions)
+    bool compact = false;  // setCompactRegions
     RTCScene scene = nullptr;
     ErrorSink errors;
     glm::dvec3 origin{0.0};
@@ -456,7 +457,8 @@ Status RayScene::Impl::buildRegionScene(const SceneModel& model, const std::vect
         if (!validMesh(m)) return malformedMesh(mi);
         if (!r.scene) {
             r.scene = rtcNewScene(device);
-            rtcSetSceneFlags(r.scene, RTC_SCENE_FLAG_ROBUST);
+            rtcSetSceneFlags(r.scene, compact ? RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_COMPACT)
+                                              : RTC_SCENE_FLAG_ROBUST);
             rtcSetSceneBuildQuality(r.scene, RTC_BUILD_QUALITY_HIGH);
         }
         unsigned gid = 0;
@@ -693,6 +695,8 @@ struct RayScene::PreparedRegion {
         if (region.scene) rtcReleaseScene(region.scene);
     }
 };
+
+void RayScene::setCompactRegions(bool compact) { _impl->compact = compact; }
 
 Result<std::shared_ptr<RayScene::PreparedRegion>> RayScene::prepareRegion(const SceneModel& model) const {
     // Only the device and the error sink are used (both thread-safe).

@@ -18,6 +18,8 @@ Result<std::unique_ptr<StreamedRayScene>> StreamedRayScene::follower(const Paged
     auto rays = RayScene::empty(glm::dvec3(manifest.params.origin_x, manifest.params.origin_y, 0.0));
     if (!rays) return rays.status();
     s->_rays = std::move(*rays);
+    // What streaming bounds is memory: the regions' scenes in Embree's compact layout.
+    s->_rays->setCompactRegions(true);
     return s;
 }
 
