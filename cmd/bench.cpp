@@ -240,37 +240,50 @@ Status dumpRays(const RenderMode& m, const std::string& label, int f, const Came
     return writeRaySet(batch.stage((fs::path(cfg.dumpRaysDir) / (label + name)).string()), set);
 }
 
-// Images a frame renders into, kept across frames so that no mode allocates its image in a timed frame.
+// Images a frame renders into (one per mode), kept across frames so that no mode allocates its
+// image in a timed frame.
 struct FrameBuffers {
-    Image img, ref;
+    std::vector<Image> img;
+    Image ref;
 };
 
 // Renders one frame in modes [begin, end) of the run (the first is `full`,
-// the reference of the others) and scores each; records go to recs[mi].
+// the reference of the others) and scores each; records go to recs[mi]. The
+// modes run in an order that rotates frame by frame (frame f starts with the
+// mode f places after `begin`), so that no mode always runs first, right
+// after another frame's work, or last; they are scored in the listed order
+// once all have run.
 Status renderGroup(BenchRun& run, size_t begin, size_t end, size_t f, size_t pathIndex, double t, const Camera& cam,
                    const BenchConfig& cfg, std::vector<BenchFrameRecord>& recs, FrameImages& images, OutputBatch& batch,
-                   FrameBuffers& buf) {
-    Image& img = buf.img;
-    Image& ref = buf.ref;
+                   FrameBuffers& buf, int* slot) {
+    for (size_t mi = buf.img.size(); mi < end; ++mi) buf.img.emplace_back(cfg.width, cfg.height);
     if (cfg.referenceSsaa >= 2) {
         auto r = supersampledReference(run, begin, cam, cfg.referenceSsaa);
         if (!r) return Status::error("reference, frame " + std::to_string(f) + ": " + r.status().message());
-        ref = std::move(r.value());
+        buf.ref = std::move(r.value());
     }
-    for (size_t mi = begin; mi < end; ++mi) {
+    const size_t count = end - begin;
+    for (size_t k = 0; k < count; ++k) {
+        const size_t mi = begin + (k + f) % count;
         BenchFrameRecord& rec = recs[mi];
         rec.frame = int(f);
         rec.pathIndex = pathIndex;
         rec.t = t;
         rec.mode = run.labels[mi];
+        rec.runOrder = (*slot)++;
+        Image& img = buf.img[mi];
         Status st = run.modes[mi]->renderFrame(cam, img, rec.stats);
         if (!st) return Status::error("mode " + rec.mode + ", frame " + std::to_string(f) + ": " + st.message());
         VISTA_RETURN_IF_ERROR(dumpRays(*run.modes[mi], rec.mode, int(f), cam, cfg, batch));
         if (!img.valid() || img.width != cfg.width || img.height != cfg.height)
             return Status::error("mode " + rec.mode + " returned an image of the wrong size");
+    }
+    for (size_t mi = begin; mi < end; ++mi) {
+        BenchFrameRecord& rec = recs[mi];
+        const Image& img = buf.img[mi];
         const bool scored = cfg.referenceSsaa != kNoReference;
         const bool isReference = scored && mi == begin && cfg.referenceSsaa < 2;
-        if (isReference) ref = img;
+        const Image& ref = cfg.referenceSsaa >= 2 ? buf.ref : buf.img[begin];
         rec.psnrDb = scored ? lumaPsnr(img, ref) : NAN;
         rec.diffFraction = scored ? fractionDiffering(img, ref, cfg.diffThreshold) : NAN;
         VISTA_RETURN_IF_ERROR(images.add(mi, rec, img, ref, isReference));
@@ -299,11 +312,12 @@ Status renderFrames(BenchRun& run, const Path& path, const std::vector<size_t>& 
         if (rays) VISTA_RETURN_IF_ERROR(rays->placeFrameNear(cam.eye));
         const double t = path.samples[idx[f]].t;
         const bool twinsFirst = plain < n && f % 2 == 1;
+        int slot = 0;  // the next render's place in the frame
         if (twinsFirst)
-            VISTA_RETURN_IF_ERROR(renderGroup(run, plain, n, f, idx[f], t, cam, cfg, recs, images, batch, buf));
-        VISTA_RETURN_IF_ERROR(renderGroup(run, 0, plain, f, idx[f], t, cam, cfg, recs, images, batch, buf));
+            VISTA_RETURN_IF_ERROR(renderGroup(run, plain, n, f, idx[f], t, cam, cfg, recs, images, batch, buf, &slot));
+        VISTA_RETURN_IF_ERROR(renderGroup(run, 0, plain, f, idx[f], t, cam, cfg, recs, images, batch, buf, &slot));
         if (!twinsFirst && plain < n)
-            VISTA_RETURN_IF_ERROR(renderGroup(run, plain, n, f, idx[f], t, cam, cfg, recs, images, batch, buf));
+            VISTA_RETURN_IF_ERROR(renderGroup(run, plain, n, f, idx[f], t, cam, cfg, recs, images, batch, buf, &slot));
         for (auto& rec : recs) {
             rec.regionsArrived = arrived;
             result.frames.push_back(std::move(rec));

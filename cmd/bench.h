@@ -99,6 +99,7 @@ struct BenchFrameRecord {
     FrameStats stats;
     double psnrDb = 0, diffFraction = 0;
     int regionsArrived = 0;  // streamed: region levels that finished loading and joined the scene before this frame
+    int runOrder = 0;        // 0, 1, ...: when the mode ran within the frame (the order rotates frame by frame)
 };
 
 // One pixel class over the frames of a mode: percent of the frame's pixels

@@ -43,20 +43,21 @@ json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 std::string framesCsv(const BenchResult& result) {
     std::ostringstream csv;
     csv << "frame,path_index,t_s,mode,frame_ms,cull_ms,draw_ms,triangles,draw_calls,rays_cast,psnr_db,diff_fraction,"
-           "px_covered,px_horizon_culled,px_cache,px_ray_hit,px_ray_miss,px_interpolated,regions_arrived,stages_ms,"
-           "notes\n";
+           "px_covered,px_horizon_culled,px_cache,px_ray_hit,px_ray_miss,px_interpolated,regions_arrived,run_order,"
+           "stages_ms,notes\n";
     char buf[512];
     for (const auto& r : result.frames) {
         const FrameStats& s = r.stats;
         char score[64] = ",";  // no reference: both cells empty
         if (!std::isnan(r.psnrDb)) std::snprintf(score, sizeof score, "%.3f,%.6f", r.psnrDb, r.diffFraction);
-        std::snprintf(
-            buf, sizeof(buf), "%d,%zu,%.4f,%s,%.4f,%.4f,%.4f,%llu,%llu,%llu,%s,%llu,%llu,%llu,%llu,%llu,%llu,%d,",
-            r.frame, r.pathIndex, r.t, r.mode.c_str(), s.frameMs, s.cullMs, s.drawMs, (unsigned long long)s.triangles,
-            (unsigned long long)s.drawCalls, (unsigned long long)s.raysCast, score,
-            (unsigned long long)s.pixels.covered, (unsigned long long)s.pixels.horizonCulled,
-            (unsigned long long)s.pixels.cache, (unsigned long long)s.pixels.rayHit,
-            (unsigned long long)s.pixels.rayMiss, (unsigned long long)s.pixels.interpolated, r.regionsArrived);
+        std::snprintf(buf, sizeof(buf),
+                      "%d,%zu,%.4f,%s,%.4f,%.4f,%.4f,%llu,%llu,%llu,%s,%llu,%llu,%llu,%llu,%llu,%llu,%d,%d,", r.frame,
+                      r.pathIndex, r.t, r.mode.c_str(), s.frameMs, s.cullMs, s.drawMs, (unsigned long long)s.triangles,
+                      (unsigned long long)s.drawCalls, (unsigned long long)s.raysCast, score,
+                      (unsigned long long)s.pixels.covered, (unsigned long long)s.pixels.horizonCulled,
+                      (unsigned long long)s.pixels.cache, (unsigned long long)s.pixels.rayHit,
+                      (unsigned long long)s.pixels.rayMiss, (unsigned long long)s.pixels.interpolated, r.regionsArrived,
+                      r.runOrder);
         csv << buf;
         std::string st;
         s.stages.forEach([&](Stage stage, double ms) {

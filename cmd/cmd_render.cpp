@@ -643,8 +643,8 @@ int run(const RenderArgs& a, const std::string& command) {
     nlohmann::json paged;  // summary.json paged: the regions loaded, or the stream's totals
     if (!walk->pagedJson.empty()) paged = nlohmann::json::parse(walk->pagedJson);
     if (session.stream)
-        paged["stream"] =
-            pagedStreamJson(session.stream->options(), session.stream->stats(), session.framesWithArrivals, session.damaged);
+        paged["stream"] = pagedStreamJson(session.stream->options(), session.stream->stats(),
+                                          session.framesWithArrivals, session.damaged);
     if (Status s =
             writeMetadata(a, plan, command, walk->city, idx, frames, tm, done.kept, paged, *session.renderer, out);
         !s)

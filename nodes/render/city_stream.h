@@ -123,7 +123,7 @@ private:
     bool _advanced = false;
     osg::ref_ptr<osg::Group> _root;
     std::map<GroupKey, osg::ref_ptr<osg::Group>> _groups;  // each level's or part's chunk group under _root
-    osg::ref_ptr<osg::Group> _labelRoot;  // labels: the twins of _groups, same keys and order
+    osg::ref_ptr<osg::Group> _labelRoot;                   // labels: the twins of _groups, same keys and order
     std::map<GroupKey, osg::ref_ptr<osg::Group>> _labelGroups;
 };
 

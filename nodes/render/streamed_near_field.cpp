@@ -23,7 +23,7 @@ StreamedNearField::StreamedNearField(double blockCell, HeightGrid grid)
     : _index(_scene.objects, blockCell, nullptr), _grid(std::move(grid)) {}
 
 std::shared_ptr<NearFieldRegion> StreamedNearField::prepare(osg::Node* root, const SceneModel& model, bool chunks,
-                                                           bool heights) const {
+                                                            bool heights) const {
     auto out = std::make_shared<NearFieldRegion>();
     if (chunks) out->scene = buildNearFieldScene(root, kNearChunkSize, false);
     out->block = SplitIndex::makeBlock(out->scene.objects.data(), out->scene.objects.size());

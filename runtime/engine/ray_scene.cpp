@@ -129,9 +129,9 @@ struct PrototypeSet {
 
 struct RayScene::Impl {
     RTCDevice device = nullptr;
-    bool ftz = true;    // set FTZ/DAZ on casting threads (city scenes)
-    bool city = false;  // a city scene (regions may be added)
-    bool flat = false;  // flat layout (no regions)
+    bool ftz = true;       // set FTZ/DAZ on casting threads (city scenes)
+    bool city = false;     // a city scene (regions may be added)
+    bool flat = false;     // flat layout (no regions)
     bool compact = false;  // setCompactRegions
     RTCScene scene = nullptr;
     ErrorSink errors;

@@ -194,7 +194,8 @@ private:
         return j.chunks ? _flightChunks : (j.coarse ? _flightCoarse : _flightFull);
     }
     bool wanted(const Job& j) const {
-        return j.chunks ? _desiredChunks[size_t(j.region)] != 0 : _desired[size_t(j.region)] == (j.coarse ? kCoarse : kFull);
+        return j.chunks ? _desiredChunks[size_t(j.region)] != 0
+                        : _desired[size_t(j.region)] == (j.coarse ? kCoarse : kFull);
     }
     void takeArrivals(std::deque<Done>& done, RegionPagerDelta* delta);
     uint64_t levelBytes(int region, bool coarse) const;

@@ -1,9 +1,12 @@
-// `vista bench --reference none` (cmd/bench.h): a run timed and sized alone,
-// scored against nothing.
+// `vista bench` runs side by side: --reference none (a run timed and sized alone,
+// scored against nothing) and the order of the modes within a frame.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -66,4 +69,50 @@ TEST(BenchCli, NoReferenceRunsTheListedModesAlone) {
     r = test::runVista("bench " + city + " --reference nothing --out " + dir + "/o");
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_NE(r.err.find("'none'"), std::string::npos) << r.err;
+}
+
+// The modes run in an order that rotates frame by frame: frames.csv's run_order is, in every
+// frame, each place once, and over as many frames as modes each mode takes every place once.
+TEST(BenchCli, TheModesOrderRotatesFrameByFrame) {
+    REQUIRE_DISPLAY();
+    ASSERT_TRUE(fs::exists(VISTA_BINARY)) << "the vista binary is a build dependency of this test";
+    test::TempDir tmp("vista_order");
+    const std::string dir = tmp.path();
+    const std::string city = dir + "/tiny.osgb";
+    test::CliRun r = test::runVista("gen --size 300 --seed 3 -q -o " + city);
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = test::runVista("bench " + city +
+                       " --seed 4 --frames 3 --sampling consecutive --size 96x64 -q --modes near,raycast --out " + dir +
+                       "/b");
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::ifstream csv(dir + "/b/frames.csv");
+    std::string line;
+    std::getline(csv, line);
+    std::vector<std::string> header;
+    {
+        std::stringstream ss(line);
+        for (std::string c; std::getline(ss, c, ',');) header.push_back(c);
+    }
+    const auto col = [&](const std::string& name) {
+        return size_t(std::find(header.begin(), header.end(), name) - header.begin());
+    };
+    const size_t frameCol = col("frame"), modeCol = col("mode"), orderCol = col("run_order");
+    ASSERT_LT(orderCol, header.size()) << line;
+    std::map<int, std::set<int>> placesOfFrame;
+    std::map<std::string, std::set<int>> placesOfMode;
+    int rows = 0;
+    while (std::getline(csv, line)) {
+        std::vector<std::string> cells;
+        std::stringstream ss(line);
+        for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+        ASSERT_GT(cells.size(), orderCol) << line;
+        const int place = std::stoi(cells[orderCol]);
+        EXPECT_TRUE(placesOfFrame[std::stoi(cells[frameCol])].insert(place).second) << line;
+        placesOfMode[cells[modeCol]].insert(place);
+        ++rows;
+    }
+    EXPECT_EQ(rows, 9);  // full (the reference), near, raycast over 3 frames
+    for (const auto& [frame, places] : placesOfFrame) EXPECT_EQ(places, (std::set<int>{0, 1, 2})) << "frame " << frame;
+    ASSERT_EQ(placesOfMode.size(), 3u);
+    for (const auto& [mode, places] : placesOfMode) EXPECT_EQ(places, (std::set<int>{0, 1, 2})) << mode;
 }
