@@ -20,6 +20,18 @@
 using namespace vista;
 namespace fs = std::filesystem;
 
+namespace {
+
+// A 300 m city benched with ARGS (frames, size, modes...) into DIR/b; the run's exit status.
+test::CliRun benchTinyCity(const std::string& dir, const std::string& args) {
+    const std::string city = dir + "/tiny.osgb";
+    test::CliRun r = test::runVista("gen --size 300 --seed 3 -q -o " + city);
+    if (r.code != 0) return r;
+    return test::runVista("bench " + city + " --seed 4 --size 96x64 -q " + args + " --out " + dir + "/b");
+}
+
+}  // namespace
+
 // --reference none: a run timed alone. Only the listed modes run (no `full`),
 // nothing is scored (empty PSNR cells, null medians, no quality plot, no worst
 // frames) and the frame times are all there; with --sweep it is refused.
@@ -28,11 +40,7 @@ TEST(BenchCli, NoReferenceRunsTheListedModesAlone) {
     ASSERT_TRUE(fs::exists(VISTA_BINARY)) << "the vista binary is a build dependency of this test";
     test::TempDir tmp("vista_noref");
     const std::string dir = tmp.path();
-    const std::string city = dir + "/tiny.osgb";
-    test::CliRun r = test::runVista("gen --size 300 --seed 3 -q -o " + city);
-    ASSERT_EQ(r.code, 0) << r.err;
-    r = test::runVista("bench " + city +
-                       " --seed 4 --frames 3 --size 96x64 -q --modes near,hybrid --reference none --out " + dir + "/b");
+    test::CliRun r = benchTinyCity(dir, "--frames 3 --modes near,hybrid --reference none");
     ASSERT_EQ(r.code, 0) << r.err;
     std::ifstream f(dir + "/b/summary.json");
     const auto j = nlohmann::json::parse(f);
@@ -66,7 +74,7 @@ TEST(BenchCli, NoReferenceRunsTheListedModesAlone) {
     r = test::runVista("bench --sweep sizes=300 --reference none --out " + dir + "/s");
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_NE(r.err.find("--reference none"), std::string::npos) << r.err;
-    r = test::runVista("bench " + city + " --reference nothing --out " + dir + "/o");
+    r = test::runVista("bench " + dir + "/tiny.osgb --reference nothing --out " + dir + "/o");
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_NE(r.err.find("'none'"), std::string::npos) << r.err;
 }
@@ -78,12 +86,7 @@ TEST(BenchCli, TheModesOrderRotatesFrameByFrame) {
     ASSERT_TRUE(fs::exists(VISTA_BINARY)) << "the vista binary is a build dependency of this test";
     test::TempDir tmp("vista_order");
     const std::string dir = tmp.path();
-    const std::string city = dir + "/tiny.osgb";
-    test::CliRun r = test::runVista("gen --size 300 --seed 3 -q -o " + city);
-    ASSERT_EQ(r.code, 0) << r.err;
-    r = test::runVista("bench " + city +
-                       " --seed 4 --frames 3 --sampling consecutive --size 96x64 -q --modes near,raycast --out " + dir +
-                       "/b");
+    const test::CliRun r = benchTinyCity(dir, "--frames 3 --sampling consecutive --modes near,raycast");
     ASSERT_EQ(r.code, 0) << r.err;
     std::ifstream csv(dir + "/b/frames.csv");
     std::string line;
