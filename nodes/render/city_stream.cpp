@@ -81,8 +81,7 @@ Result<std::unique_ptr<CityStream>> CityStream::create(const PagedManifest& mani
         }
         return out;
     };
-    s->_options = options;
-    s->_pager = std::make_unique<RegionPager>(manifest, options);
+    s->_options = options;  // the pager starts with the first advance(), once setGraphLevels has had its say
     return s;
 }
 
@@ -96,11 +95,14 @@ void CityStream::enableNearField(int horizonCells) {
 void CityStream::setGraphLevels(StreamGraph levels, double bandM) {
     VISTA_CHECK(!_advanced && (levels != StreamGraph::NearBand || (std::isfinite(bandM) && bandM >= 0)));
     _graphLevels = levels;
-    // The pager loads nothing before its first update: made again with the band.
-    _pager.reset();
     _options.chunkRadius = levels == StreamGraph::NearBand ? bandM : -1.0;
-    _pager = std::make_unique<RegionPager>(*_manifest, _options);
 }
+
+std::vector<uint8_t> CityStream::held() const {
+    return _pager ? _pager->held() : std::vector<uint8_t>(_manifest->regions.size(), 0);
+}
+
+RegionPagerStats CityStream::stats() const { return _pager ? _pager->stats() : RegionPagerStats(); }
 
 namespace {
 
@@ -136,6 +138,7 @@ std::pair<glm::dvec3, glm::dvec3> changedBox(const PagedManifest& m, int region)
 
 Result<CityStreamFrame> CityStream::advance(const glm::dvec3& eye, const glm::dvec3& velocity, bool wait) {
     _advanced = true;
+    if (!_pager) _pager = std::make_unique<RegionPager>(*_manifest, _options);
     _pager->update(eye, velocity);
     RegionPagerDelta d = _pager->collect(wait);
     CityStreamFrame f;

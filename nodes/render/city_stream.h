@@ -104,8 +104,8 @@ public:
     StreamedNearField* nearField() { return _near.get(); }
     uint64_t generation() const { return _generation; }
     // Per manifest region, the level held now (RegionPager::held()).
-    std::vector<uint8_t> held() const { return _pager->held(); }
-    RegionPagerStats stats() const { return _pager->stats(); }
+    std::vector<uint8_t> held() const;
+    RegionPagerStats stats() const;
     // The pager's options (with the chunk radius setGraphLevels chose).
     const RegionPagerOptions& options() const { return _options; }
 
@@ -113,8 +113,8 @@ private:
     CityStream() = default;
     // A group's key: (coarse, region, chunk part), ordered as loadPagedCity merges levels.
     using GroupKey = std::tuple<bool, int, bool>;
-    RegionPagerOptions _options;  // the pager's (setGraphLevels makes it again)
-    std::unique_ptr<RegionPager> _pager;
+    RegionPagerOptions _options;          // the pager's (setGraphLevels makes it again)
+    std::unique_ptr<RegionPager> _pager;  // made by the first advance()
     std::unique_ptr<StreamedRayScene> _rays;
     std::unique_ptr<StreamedNearField> _near;  // read by the workers' prepare once set
     const PagedManifest* _manifest = nullptr;
