@@ -215,7 +215,7 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
         if (!walk->manifest)
             return reportBadInput(kCmd, Status::error("--paged-stream: '" + cityFile +
                                                       "' is a city file; streaming needs a paged city (DIR.paged)"));
-        auto so = pagedStreamOptions(a.paged, a.stream, cfg.memoryBudgetGb, cfg.memoryEstimateMb, rays);
+        auto so = pagedStreamOptions(a.paged, a.stream, cfg.memoryBudgetGb, cfg.memoryEstimateMb);
         if (!so) return reportBadInput(kCmd, so.status());
         cfg.streamManifest = walk->manifest.get();
         cfg.stream = *so;

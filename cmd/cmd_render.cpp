@@ -263,7 +263,7 @@ Result<Walkthrough> loadCityAndFrames(const RenderArgs& a, RenderPlan& p, std::v
     }
     auto w = loadWalkthrough(req, p.options);
     if (!w || !p.streamed) return w;
-    auto so = pagedStreamOptions(a.paged, a.stream, a.memoryBudgetGb, p.estimateMb, p.rays);
+    auto so = pagedStreamOptions(a.paged, a.stream, a.memoryBudgetGb, p.estimateMb);
     if (!so) return so.status();
     p.stream = *so;
     if (!a.quiet) notePagedStream(kCmd, *w->manifest, p.stream);
@@ -309,7 +309,7 @@ Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, c
                              {"stream", streamed},
                              {"wait", streamed && p.stream.wait},
                              {"prefetch", manifestNumber(streamed ? p.stream.prefetchS : 0.0)},
-                             {"budget_file_bytes", streamed ? p.stream.budgetBytes : 0}};
+                             {"budget_bytes", streamed ? p.stream.budgetBytes : 0}};
     }
     VISTA_RETURN_IF_ERROR(out.open(manifest, a.restart));
     for (const auto& [bit, dir] : kChannelDirs)

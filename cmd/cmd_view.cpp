@@ -16,7 +16,12 @@
 // load first; the loads run on the pager's worker and a frame never waits
 // for them (--paged-wait: every frame does), except the first, which waits
 // for the regions around the start. A region keeps its coarse level until
-// its full level has arrived (without a budget that forbids both). At exit a
+// its full level has arrived (without a budget that forbids both). Started in
+// a hybrid mode, the stream keeps the near field as the bench's does (chunks
+// only for the regions around the camera; the split node chooses among them
+// at each cull), and the modes that draw the whole graph are not offered;
+// every mode made so far drops what it kept of the old resident set when the
+// set changes (RenderMode::sceneChanged). At exit a
 // line on stderr gives the stream's totals and the frames that drew a region
 // within --paged-radius of the eye below full detail.
 #include <filesystem>
@@ -139,12 +144,6 @@ Status configure(ViewArgs& a, ModeOptions& options) {
             return Status::error("--paged-stream: '" + a.city +
                                  "' is a city file; streaming needs a paged city (DIR.paged from `vista gen`)");
         VISTA_RETURN_IF_ERROR(checkStreamingModes({a.mode}));
-        // The viewer's hybrid graph (near/far split node and far-field node) is built once from
-        // a loaded near field; the streamed near field follows the bench's and render's frames only.
-        if (modeStreamsNearField(a.mode))
-            return Status::error("--paged-stream: mode " + a.mode +
-                                 " streams in `vista bench` and `vista render`, not in the viewer (here: full, near "
-                                 "or raycast)");
     }
     return parseModeFlags(a.modeFlags, options);
 }
@@ -160,12 +159,23 @@ public:
         if (it != _modes.end()) return it->second.get();
         const ModeInfo* info = findRenderMode(name);
         if (!info) return Status::error("unknown mode '" + name + "'");
+        // A stream started in a hybrid mode keeps chunks only near the camera (CityStream::setGraphLevels).
+        if (_stream && modeStreams(name) && streamGraphOf({name}) == StreamGraph::EveryLevel &&
+            _stream->graphLevels() != StreamGraph::EveryLevel)
+            return Status::error(
+                "the streamed city keeps chunks only near the camera (started in a hybrid mode); "
+                "start in full or near to draw the whole city");
         if (info->needsRays || _ctx.options.effects.glassMarked) VISTA_RETURN_IF_ERROR(buildRays());
         Stopwatch sw;
         auto m = createRenderMode(name, _ctx);
         if (!m) return m.status();
         std::fprintf(stderr, "%s: mode %s set up in %.0f ms\n", kCmd, name.c_str(), sw.ms());
         return (_modes[name] = std::move(m.value())).get();
+    }
+    // The streamed city's resident set changed: every mode made so far forgets what it kept of the
+    // old one (RenderMode::sceneChanged).
+    void sceneChanged(const SceneBoxes& changed) {
+        for (auto& [name, m] : _modes) m->sceneChanged(changed);
     }
     // Moves the ray scene's frame next to the eye (RayScene::placeFrameNear),
     // between frames, when no ray is in flight.
@@ -396,7 +406,7 @@ struct ViewStream {
     // seconds since the last frame. The first call waits for the regions
     // around the camera. Counts the frames that will draw a region within the
     // radius of the eye below full detail.
-    Status advance(const glm::dvec3& eye, const glm::dvec3* pathVelocity, double dtS) {
+    Status advance(const glm::dvec3& eye, const glm::dvec3* pathVelocity, double dtS, ViewModes& modes) {
         if (pathVelocity) {
             velocity = *pathVelocity;
         } else if (started && dtS > 0) {
@@ -410,6 +420,7 @@ struct ViewStream {
         lastEye = eye;
         ++frames;
         framesWithArrivals += f->arrived > 0 ? 1 : 0;
+        if (f->arrived > 0 || f->dropped > 0) modes.sceneChanged(f->changed);
         const std::vector<uint8_t> held = stream->held();
         for (int r : selectPagedRegions(*manifest, {glm::dvec2(eye)}, options.radius))
             if (held[size_t(r)] != 2) {
@@ -418,14 +429,18 @@ struct ViewStream {
             }
         return Status::ok();
     }
-    void report() const {
+    // `last`: the last frame's statistics (a hybrid mode's near field: the triangles it drew).
+    void report(const std::string& mode, const FrameStats& last) const {
         const RegionPagerStats st = stream->stats();
+        std::string nearField;
+        if (modeStreamsNearField(mode))
+            nearField = "; the last frame's near field drew " + std::to_string(last.triangles) + " triangles";
         std::fprintf(stderr,
                      "%s: paged stream: %d loads, %d unloads, %.1f MB of region files read, peak %.1f MB resident; "
                      "%d of %d frames waited, %d had regions arriving, %d drew a region within %g m below full "
-                     "detail\n",
+                     "detail%s\n",
                      kCmd, st.loads, st.unloads, double(st.bytesRead) / 1e6, double(st.peakResidentBytes) / 1e6,
-                     st.framesWaited, frames, framesWithArrivals, framesShort, options.radius);
+                     st.framesWaited, frames, framesWithArrivals, framesShort, options.radius, nearField.c_str());
     }
 };
 
@@ -516,7 +531,7 @@ int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path,
         }
         if (v.stream) {
             const glm::dvec3 pv = a.step ? pathVelocity(path, stepFrames[size_t(n)]) : glm::dvec3(0.0);
-            if (Status st = v.stream->advance(c.eye, a.step ? &pv : nullptr, lastMs / 1000.0); !st) {
+            if (Status st = v.stream->advance(c.eye, a.step ? &pv : nullptr, lastMs / 1000.0, modes); !st) {
                 std::fprintf(stderr, "%s: %s\n", kCmd, st.message().c_str());
                 return 1;
             }
@@ -534,7 +549,7 @@ int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path,
         lastMs = sw.lap();
         if (last) break;
     }
-    if (v.stream) v.stream->report();
+    if (v.stream) v.stream->report(v.mode, v.current->lastViewerStats());
     if (!a.screenshot.empty() && v.keys->capture->lastWritten != a.screenshot) return 1;
     return 0;
 }
@@ -544,13 +559,21 @@ int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path,
 Status startStream(const ViewArgs& a, const Walkthrough& walk, ModeContext& ctx, ViewStream& vs) {
     const bool rays = findRenderMode(a.mode)->needsRays || effectsNeedRays(ctx.options.effects) ||
                       ctx.options.effects.glassMarked;  // ViewModes casts reflections for every mode then
-    auto so = pagedStreamOptions(a.paged, a.stream, a.memoryBudgetGb, estimateCityRunMb(0, rays), rays);
+    auto so = pagedStreamOptions(a.paged, a.stream, a.memoryBudgetGb, estimateCityRunMb(0, rays));
     if (!so) return so.status();
     vs.options = *so;
     vs.manifest = walk.manifest.get();
     auto st = CityStream::create(*walk.manifest, vs.options, rays);
     if (!st) return Status::error("setting up the streamed city failed: " + st.status().message());
     vs.stream = std::move(*st);
+    if (modeStreamsNearField(a.mode)) {
+        // hybrid: the stream keeps the near field, its split index and the horizon grid too, and
+        // chunks only for the regions around the camera; the modes that draw the whole graph
+        // are then not offered (ViewModes::get).
+        vs.stream->enableNearField(ctx.options.horizonGrid);
+        vs.stream->setGraphLevels(streamGraphOf({a.mode}), streamNearBand(ctx.options));
+    }
+    ctx.stream = vs.stream.get();
     ctx.streamedCity = vs.stream->graph();
     ctx.scene = vs.stream->graph();
     ctx.rays = vs.stream->rays();

@@ -49,7 +49,7 @@ Status checkMemoryBudget(const std::string& option, double budgetGb, double esti
     return Status::error(buf);
 }
 
-Result<uint64_t> streamBudgetFileBytes(const std::string& option, double budgetGb, double preloadMb, bool rayScene) {
+Result<uint64_t> streamBudgetBytes(const std::string& option, double budgetGb, double preloadMb) {
     if (budgetGb <= 0) return uint64_t(0);
     const double leftMb = budgetGb * 1024.0 - preloadMb;
     if (leftMb <= 0) {
@@ -60,8 +60,7 @@ Result<uint64_t> streamBudgetFileBytes(const std::string& option, double budgetG
                       option.c_str(), budgetGb, preloadMb / 1024.0);
         return Status::error(buf);
     }
-    const double perFileByte = kSceneBytesPerFileByte + (rayScene ? kRaysBytesPerFileByte : 0.0);
-    return std::max<uint64_t>(1, uint64_t(leftMb * kMb / perFileByte));
+    return std::max<uint64_t>(1, uint64_t(leftMb * kMb));
 }
 
 double estimateGenMb(size_t storedTriangles) {

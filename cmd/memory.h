@@ -35,13 +35,13 @@ double estimateCityRunMb(uint64_t fileBytes, bool rayScene);
 Status checkMemoryBudget(const std::string& option, double budgetGb, double estimateMb, uint64_t fileBytes,
                          bool rayScene);
 
-// The streamed regions' share of a budget (bench --paged-stream): what is
-// left of `budgetGb` after `preloadMb` (the estimate of what is held before
-// the first frame), as region file bytes at the resident cost per file byte
-// of a streamed region (its scene graph and chunks, 4.1, plus 1.7 for its
-// ray scene when `rayScene`): the pager's unit (region_pager.h budgetBytes).
-// 0 = no budget. An error naming the option when nothing is left.
-Result<uint64_t> streamBudgetFileBytes(const std::string& option, double budgetGb, double preloadMb, bool rayScene);
+// The streamed regions' share of a budget (--paged-stream): what is left of
+// `budgetGb` after `preloadMb` (the estimate of what is held before the first
+// frame), in bytes: the pager's unit (region_pager.h budgetBytes), which
+// weighs each load's file bytes by what the stream makes of them
+// (nodes/render/city_stream.h streamRegionCost). 0 = no budget. An error
+// naming the option when nothing is left.
+Result<uint64_t> streamBudgetBytes(const std::string& option, double budgetGb, double preloadMb);
 
 // `vista gen` to one file: peak about kGenBytesPerStoredTriangle per stored
 // triangle (measured 152 to 177 on the 0.5 to 8 km cities of

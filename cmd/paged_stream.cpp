@@ -9,8 +9,8 @@
 namespace vista {
 
 Result<RegionPagerOptions> pagedStreamOptions(const PagedReach& reach, const PagedStreamFlags& flags, double budgetGb,
-                                              double preloadMb, bool rays) {
-    auto budget = streamBudgetFileBytes("--memory-budget", budgetGb, preloadMb, rays);
+                                              double preloadMb) {
+    auto budget = streamBudgetBytes("--memory-budget", budgetGb, preloadMb);
     if (!budget) return budget.status();
     RegionPagerOptions o;
     o.radius = reach.radius;
@@ -64,7 +64,10 @@ nlohmann::json pagedStreamJson(const RegionPagerOptions& o, const RegionPagerSta
             {"prefetch_s", o.prefetchS},
             {"wait", o.wait},
             {"frames_deterministic", o.wait},
-            {"budget_file_bytes", o.budgetBytes},
+            {"budget_bytes", o.budgetBytes},
+            {"bytes_per_file_byte", {{"full", o.cost.full}, {"coarse", o.cost.coarse}, {"chunk_part", o.cost.chunks}}},
+            {"peak_resident_estimate_bytes", s.peakResidentCost},
+            {"resident_estimate_bytes_end", s.residentCost},
             {"peak_resident_file_bytes", s.peakResidentBytes},
             {"resident_file_bytes_end", s.residentBytes},
             {"resident_full_end", s.residentFull},

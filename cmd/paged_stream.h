@@ -8,7 +8,7 @@
 // pagedStreamOptions(): the pager options of the flags: --paged-radius and
 // --paged-far around the camera, --paged-prefetch seconds ahead (default
 // kDefaultPagedPrefetchS), --paged-wait, and the budget: what --memory-budget
-// leaves after `preloadMb` (streamBudgetFileBytes; errors name
+// leaves after `preloadMb` (streamBudgetBytes; errors name
 // --memory-budget). checkStreamingModes(): every mode streams (modeStreams),
 // else an error naming --paged-stream and the modes that do.
 // notePagedStream(): the stderr note "CMD: paged city: streaming its N
@@ -40,7 +40,7 @@
 namespace vista {
 
 Result<RegionPagerOptions> pagedStreamOptions(const PagedReach& reach, const PagedStreamFlags& flags, double budgetGb,
-                                              double preloadMb, bool rays);
+                                              double preloadMb);
 Status checkStreamingModes(const std::vector<std::string>& modes);
 void notePagedStream(const char* cmd, const PagedManifest& manifest, const RegionPagerOptions& options);
 Result<CityStreamFrame> advancePagedStream(CityStream& stream, const char* cmd, const glm::dvec3& eye,

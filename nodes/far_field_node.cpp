@@ -89,6 +89,11 @@ void FarFieldNode::beginFrame(const osg::Camera& cam) const {
     _far->beginFrame(c);
 }
 
+void FarFieldNode::sceneChanged(const SceneBoxes& changed) {
+    std::lock_guard<std::mutex> lock(_mutex);
+    if (_far) _far->sceneChanged(changed);
+}
+
 void FarFieldNode::drawFrame(osg::RenderInfo& ri, const Camera& c, const osg::Viewport& vp, double zFar) const {
     const int W = int(vp.width()), H = int(vp.height());
     if (!_far) _far = std::make_unique<FarField>(_rays, _grid, _options);

@@ -63,6 +63,8 @@ public:
     // (FarField::beginFrame), so that they overlap the near field's draw. The
     // draw takes them only when its camera is exactly that one.
     void beginFrame(const osg::Camera& camera) const;
+    // The ray scene changed (a streamed city, between frames): FarField::sceneChanged.
+    void sceneChanged(const SceneBoxes& changed);
 
 protected:
     ~FarFieldNode() override;

@@ -80,7 +80,16 @@ void NearFarSplit::refresh() {
     _dirty = false;
 }
 
+void NearFarSplit::setSource(const std::vector<osg::ref_ptr<osg::Node>>* chunks,
+                             const std::vector<SplitObject>* objects, const SplitIndex* index) {
+    _srcChunks = chunks;
+    _srcObjects = objects;
+    _srcIndex = index;
+    setCullingActive(!index);  // an empty group's bound would cull the streamed chunks
+}
+
 const std::vector<SplitObject>& NearFarSplit::objects() {
+    if (_srcIndex) return *_srcObjects;
     if (_dirty || _objects.size() != _children.size()) refresh();
     return _objects;
 }
@@ -94,11 +103,14 @@ void NearFarSplit::traverse(osg::NodeVisitor& nv) {
     const std::vector<SplitObject>& objs = objects();
     osg::Vec3 e = cv->getEyePoint();
     glm::dvec3 eye(e.x(), e.y(), e.z());
-    std::vector<uint32_t> sel = _triangleBudget > 0 ? selectNearFieldByBudget(objs, eye, _triangleBudget)
-                                                    : selectNearField(*_index, eye, _nearDistance);
+    const SplitIndex& index = _srcIndex ? *_srcIndex : *_index;
+    std::vector<uint32_t> sel = _triangleBudget > 0 ? selectNearFieldByBudget(index, eye, _triangleBudget)
+                                                    : selectNearField(index, eye, _nearDistance);
     uint64_t tris = 0;
     for (uint32_t i : sel) {
-        _children[i]->accept(nv);
+        osg::Node* n = _srcChunks ? (*_srcChunks)[i].get() : _children[i].get();
+        if (!n) continue;
+        n->accept(nv);
         tris += objs[i].triangles;
     }
     _lastCount = unsigned(sel.size());

@@ -12,8 +12,15 @@
 // point in this node's coordinate frame; put the node where the local frame is
 // the world frame (no transform above it), or the boxes are local too.
 //
+// A streamed near field (setSource): the chunks to choose from are not the
+// node's children but a NearFieldScene and its SplitIndex that follow the
+// resident regions (StreamedNearField), read at each cull: the chosen chunks
+// (non-null slots) are traversed in the index's order. The node then culls
+// nothing itself (its children's bounds are not the source's).
+//
 // Thread safety: OSG's single-threaded or CullDrawThreadPerContext models (one
 // cull at a time); lastNearCount()/lastNearTriangles() report the last cull.
+// A source changes only between frames.
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -38,6 +45,10 @@ public:
     void setTriangleBudget(uint64_t triangles) { _triangleBudget = triangles; }
     uint64_t getTriangleBudget() const { return _triangleBudget; }
 
+    // Chooses among `scene`'s chunks by `index` (both outlive the node), or among the children (null).
+    void setSource(const std::vector<osg::ref_ptr<osg::Node>>* chunks, const std::vector<SplitObject>* objects,
+                   const SplitIndex* index);
+
     void traverse(osg::NodeVisitor& nv) override;
 
     unsigned lastNearCount() const { return _lastCount; }
@@ -56,7 +67,10 @@ private:
     double _nearDistance = 100.0;
     uint64_t _triangleBudget = 0;
     std::vector<SplitObject> _objects;
-    std::unique_ptr<SplitIndex> _index;  // over _objects, rebuilt with them
+    std::unique_ptr<SplitIndex> _index;                                // over _objects, rebuilt with them
+    const std::vector<osg::ref_ptr<osg::Node>>* _srcChunks = nullptr;  // setSource
+    const std::vector<SplitObject>* _srcObjects = nullptr;
+    const SplitIndex* _srcIndex = nullptr;
     bool _dirty = true;
     unsigned _lastCount = 0;
     uint64_t _lastTriangles = 0;

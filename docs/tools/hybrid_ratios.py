@@ -1,19 +1,22 @@
 #!/usr/bin/env python3
 """Same-frame ratios of `vista bench` runs (frames.csv), for the hybrid's tables and its guard.
 
-  hybrid_ratios.py split LABEL=DIR ...           Markdown table: the hybrid (--near auto) against its
+  hybrid_ratios.py split LABEL=DIR[:DIR...] ...  Markdown table: the hybrid (--near auto) against its
                                                  fixed choices (raycast = 0 m, hybrid-fixed = the near
                                                  default, full = everything) in each bench DIR;
-                                                 LABEL is "city|path".
+                                                 LABEL is "city|path"; with several runs a frame's
+                                                 ratio is its median over them.
   hybrid_ratios.py effect LABEL=DIR[:DIR...] ...
                                                  Markdown table: the hybrid's frame with an effect
                                                  against the same frames without it, both from one
                                                  bench run with --also-clear (modes hybrid and
                                                  hybrid+clear, interleaved frame by frame); with
                                                  several runs a frame's ratio is its median over them.
-  hybrid_ratios.py guard --limit 1.05 split LABEL=DIR ... effect LABEL=DIR ...
+  hybrid_ratios.py guard [--limit 1.05] [--flagged] split LABEL=DIR ... effect LABEL=DIR ...
                                                  prints only the rows where the hybrid loses by more
                                                  than the limit; exit status 1 when any row prints.
+                                                 --flagged: prints only those rows' LABEL=DIR specs
+                                                 ("split SPEC" / "effect SPEC", one a line) and exits 0.
 
 A ratio is the median over frames f of (time of the hybrid on f) / (time of the other on f): the two
 measured on the same frame of the same path. Above 1 = the hybrid is slower.
@@ -66,15 +69,24 @@ SPLIT_OTHERS = [("raycast", "0 m (raycast)"), ("hybrid-fixed", "near default (hy
                 ("full", "everything (full)")]
 
 
+def runs_ratio(runs, mode, other):
+    """Median over frames of the median over runs of hybrid[f] / other[f] (one run: ratio())."""
+    frames = set.intersection(*(set(r[mode]) & set(r[other]) for r in runs))
+    if not frames:
+        raise SystemExit("no common frames")
+    return statistics.median(statistics.median(r[mode][f][0] / r[other][f][0] for r in runs) for f in frames)
+
+
 def split_rows(specs):
     rows = []
     for spec in specs:
-        label, d = spec.split("=", 1)
+        label, dirs = spec.split("=", 1)
         city, path = label.split("|")
-        m = load(d)
+        runs = [load(d) for d in dirs.split(":")]
+        m = runs[0]
         h = m["hybrid"]
-        r = {o: ratio(ms(h), ms(m[o])) for o, _ in SPLIT_OTHERS if o in m}
-        best_ms = {o: statistics.median(ms(m[o]).values()) for o in r}
+        r = {o: runs_ratio(runs, "hybrid", o) for o, _ in SPLIT_OTHERS if o in m}
+        best_ms = {o: statistics.median(v[0] for run in runs for v in run[o].values()) for o in r}
         best = min(best_ms, key=best_ms.get)
         psnr = statistics.median(v[1] for v in h.values())
         if path == "fly":
@@ -85,9 +97,9 @@ def split_rows(specs):
             better = min(("full", "raycast"), key=lambda o: best_ms[o])
             target, goal = r[better], 1 / 0.95
             goal_text = f"≥ 0.95× {better}"
-        rows.append(dict(city=city, path=path, h=statistics.median(ms(h).values()), others=best_ms, r=r, best=best,
-                         psnr=psnr, choices=choices(h), ok=target <= goal and psnr >= 40.0, goal=goal_text,
-                         target=target))
+        rows.append(dict(city=city, path=path, h=statistics.median(v[0] for run in runs for v in run["hybrid"].values()),
+                         others=best_ms, r=r, best=best, psnr=psnr, choices=choices(h),
+                         ok=target <= goal and psnr >= 40.0, goal=goal_text, target=target, spec=spec))
     return rows
 
 
@@ -121,7 +133,7 @@ def effect_rows(specs, mode="hybrid"):
             continue
         per_frame = {f: statistics.median(r[mode][f][0] / r[mode + "+clear"][f][0] for r in runs) for f in frames}
         haze = [v[3]["haze"] for r in runs for v in r[mode].values() if "haze" in v[3]]
-        rows.append(dict(label=label, on=statistics.median(r[mode][f][0] for r in runs for f in frames),
+        rows.append(dict(label=label, spec=spec, on=statistics.median(r[mode][f][0] for r in runs for f in frames),
                          off=statistics.median(r[mode + "+clear"][f][0] for r in runs for f in frames),
                          r=statistics.median(per_frame.values()), runs=len(runs),
                          stage=statistics.mean(haze) if haze else 0.0, frames=len(frames)))
@@ -148,10 +160,13 @@ def main(argv):
         header = "effect | path"
         sys.stdout.write(effect_table(effect_rows(argv[1:]), header))
     elif argv[0] == "guard":
-        limit = 1.05
+        limit, flagged = 1.05, False
         args = argv[1:]
-        if args[:1] == ["--limit"]:
-            limit, args = float(args[1]), args[2:]
+        while args[:1] in (["--limit"], ["--flagged"]):
+            if args[0] == "--limit":
+                limit, args = float(args[1]), args[2:]
+            else:
+                flagged, args = True, args[1:]
         split, effect, cur = [], [], None
         for a in args:
             if a in ("split", "effect"):
@@ -159,16 +174,24 @@ def main(argv):
             else:
                 cur.append(a)
         bad = 0
+        runs = lambda spec: len(spec.split("=", 1)[1].split(":"))
         for x in split_rows(split):
-            for o, name in SPLIT_OTHERS:
-                if o in x["r"] and x["r"][o] > limit:
-                    print(f"{x['city']} {x['path']}: hybrid is {x['r'][o]:.3f}x the frame time of {name}")
-                    bad += 1
+            losing = [(o, name) for o, name in SPLIT_OTHERS if o in x["r"] and x["r"][o] > limit]
+            if losing and flagged:
+                print(f"split {x['spec']}")
+            for o, name in losing if not flagged else []:
+                print(f"{x['city']} {x['path']}: hybrid is {x['r'][o]:.3f}x the frame time of {name} "
+                      f"({runs(x['spec'])} runs)")
+            bad += len(losing)
         for x in effect_rows(effect):
             if x["r"] > limit:
-                print(f"{x['label']}: hybrid with the effect is {x['r']:.3f}x its frame time without it")
+                if flagged:
+                    print(f"effect {x['spec']}")
+                else:
+                    print(f"{x['label']}: hybrid with the effect is {x['r']:.3f}x its frame time without it "
+                          f"({x['runs']} runs)")
                 bad += 1
-        return 1 if bad else 0
+        return 1 if bad and not flagged else 0
     else:
         raise SystemExit(__doc__)
     return 0

@@ -1,6 +1,7 @@
 // A paged city streamed for the render modes. See city_stream.h.
 #include "nodes/render/city_stream.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "nodes/near_field_chunks.h"
@@ -21,6 +22,20 @@ struct RegionChunks {
 };
 
 }  // namespace
+
+RegionCost streamRegionCost(bool rays, StreamGraph graph, bool labels) {
+    const double graphPerChunkByte = 1.0 + (labels ? kStreamLabelsPerChunkByte : 0.0);
+    const bool every = graph == StreamGraph::EveryLevel;
+    RegionCost c;
+    // A level that makes nothing (no rays, no chunks) still holds its decoded file until the frame
+    // thread takes it: one byte per file byte at the least.
+    c.full = std::max(
+        1.0, (rays ? kStreamRaysPerFileByte : 0.0) + (every ? kStreamChunksPerFileByte * graphPerChunkByte : 0.0));
+    c.coarse = std::max(1.0, (rays ? kStreamCoarseRaysPerFileByte : 0.0) +
+                                 (every ? kStreamCoarseChunksPerFileByte * graphPerChunkByte : 0.0));
+    c.chunks = kStreamChunksPerFileByte * graphPerChunkByte;
+    return c;
+}
 
 CityStream::~CityStream() { _pager.reset(); }
 
@@ -82,6 +97,7 @@ Result<std::unique_ptr<CityStream>> CityStream::create(const PagedManifest& mani
         return out;
     };
     s->_options = options;  // the pager starts with the first advance(), once setGraphLevels has had its say
+    s->updateCost();
     return s;
 }
 
@@ -90,12 +106,14 @@ void CityStream::enableNearField(int horizonCells) {
     _near =
         std::make_unique<StreamedNearField>(_manifest->regionSizeM > 0 ? _manifest->regionSizeM : 2000.0,
                                             pagedHeightLattice(*_manifest, _rays->rays().frameOrigin(), horizonCells));
+    updateCost();
 }
 
 void CityStream::setGraphLevels(StreamGraph levels, double bandM) {
     VISTA_CHECK(!_advanced && (levels != StreamGraph::NearBand || (std::isfinite(bandM) && bandM >= 0)));
     _graphLevels = levels;
     _options.chunkRadius = levels == StreamGraph::NearBand ? bandM : -1.0;
+    updateCost();
 }
 
 std::vector<uint8_t> CityStream::held() const {

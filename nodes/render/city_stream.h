@@ -66,6 +66,19 @@ namespace vista {
 // The region levels that carry chunks in the graph and the near field (CityStream::setGraphLevels).
 enum class StreamGraph { EveryLevel, NearBand, None };
 
+// Resident bytes per region file byte of what a stream's workers keep of a
+// load (measured with tests/bench/stream_memory on the middle regions of a
+// 1,024 km² city, docs/measurements/paging.md, rounded up): a level's Embree
+// scene (compact layout), full and coarse; its chunks in the graph (a chunk
+// part, or a level with chunks), full and coarse; their label twins, per byte
+// of chunks. A height patch is below the measurement's resolution.
+constexpr double kStreamRaysPerFileByte = 1.1, kStreamCoarseRaysPerFileByte = 1.6;
+constexpr double kStreamChunksPerFileByte = 1.2, kStreamCoarseChunksPerFileByte = 4.0;
+constexpr double kStreamLabelsPerChunkByte = 0.5;
+// The memory budget's weights (RegionPagerOptions::cost) of a stream that makes
+// ray scenes (rays), chunks on `graph`'s levels and their label twins (labels).
+RegionCost streamRegionCost(bool rays, StreamGraph graph, bool labels);
+
 struct CityStreamFrame {
     int arrived = 0, dropped = 0;  // region levels
     // The world boxes (manifest bounds, both levels) of the levels that arrived or left, for
@@ -106,11 +119,13 @@ public:
     // Per manifest region, the level held now (RegionPager::held()).
     std::vector<uint8_t> held() const;
     RegionPagerStats stats() const;
-    // The pager's options (with the chunk radius setGraphLevels chose).
+    // The pager's options (with the chunk radius setGraphLevels chose and the budget's weights of
+    // what this stream makes, streamRegionCost).
     const RegionPagerOptions& options() const { return _options; }
 
 private:
     CityStream() = default;
+    void updateCost() { _options.cost = streamRegionCost(_rays != nullptr, _graphLevels, _labelRoot.valid()); }
     // A group's key: (coarse, region, chunk part), ordered as loadPagedCity merges levels.
     using GroupKey = std::tuple<bool, int, bool>;
     RegionPagerOptions _options;          // the pager's (setGraphLevels makes it again)

@@ -130,7 +130,9 @@ public:
     // changed region is served again. The near field's root state comes with the first region.
     void sceneChanged(const SceneBoxes& changed) override {
         _far->sceneChanged(changed);
+        if (_farNode) _farNode->sceneChanged(changed);
         if (!_root->getStateSet() && _near.rootState) _root->setStateSet(_near.rootState.get());
+        if (_viewer && !_viewer->getStateSet() && _near.rootState) _viewer->setStateSet(_near.rootState.get());
     }
     bool hazesRasterPixels() const override { return true; }  // FarFieldOptions::hazeCovered
     bool drawsSky() const override { return true; }  // the far field classifies and fills every uncovered pixel
@@ -144,7 +146,14 @@ public:
             ho.nearDistance = _ctx.options.fixedNearDistance();
             ho.triangleBudget = _ctx.options.triangleBudget;
             ho.far = farOptions(ho.nearDistance, 0.0);
-            _viewer = buildHybridScene(_near, *_ctx.rays, *_heights, ho, &_split, &_farNode);
+            if (_ctx.stream) {
+                // A streamed city: the split chooses among the stream's resident chunks at each cull.
+                _viewer = buildHybridScene(NearFieldScene(), *_ctx.rays, *_heights, ho, &_split, &_farNode);
+                _split->setSource(&_near.chunks, &_near.objects, &_adaptive->index());
+                if (_near.rootState) _viewer->setStateSet(_near.rootState.get());
+            } else {
+                _viewer = buildHybridScene(_near, *_ctx.rays, *_heights, ho, &_split, &_farNode);
+            }
         }
         return _viewer.get();
     }
@@ -163,6 +172,7 @@ public:
     }
     FrameStats lastViewerStats() const override {
         FrameStats s = _farNode ? _farNode->lastStats() : FrameStats();
+        s.triangles = _split ? _split->lastNearTriangles() : 0;
         s.notes.push_back("near chunks drawn " + std::to_string(_split ? _split->lastNearCount() : 0u));
         if (autoSplit()) s.notes.push_back(nearAutoNote(_viewerNear));
         return s;

@@ -66,6 +66,7 @@ RegionPager::RegionPager(const PagedManifest& manifest, const RegionPagerOptions
     VISTA_CHECK(_o.workers >= 1 && _o.workers <= 16);
     const size_t n = _m.regions.size();
     VISTA_CHECK(std::isfinite(_o.chunkRadius));
+    for (double w : {_o.cost.full, _o.cost.coarse, _o.cost.chunks}) VISTA_CHECK(std::isfinite(w) && w > 0);
     for (auto* v : {&_desired, &_nearEye, &_holdFull, &_holdCoarse, &_flightFull, &_flightCoarse, &_failedFull,
                     &_failedCoarse, &_desiredChunks, &_nearEyeChunks, &_holdChunks, &_flightChunks})
         v->assign(n, 0);
@@ -117,9 +118,18 @@ uint64_t RegionPager::levelBytes(int region, bool coarse) const {
     return coarse ? r.coarseBytes : r.bytes;
 }
 
+uint64_t RegionPager::cost(int region, bool coarse, bool chunks) const {
+    const double w = chunks ? _o.cost.chunks : (coarse ? _o.cost.coarse : _o.cost.full);
+    return uint64_t(std::llround(double(levelBytes(region, coarse)) * w));
+}
+
 void RegionPager::computeDesired() {
     const double farM = _o.far > _o.radius ? _o.far : -1.0;
     uint64_t total = 0;
+    // Under a budget the chunk parts of the full regions in the band are reserved before any
+    // level is cut: the near field around the camera outranks the far city.
+    uint64_t reserved = 0;
+    std::vector<uint64_t> partCost(_m.regions.size(), 0);
     for (size_t i = 0; i < _m.regions.size(); ++i) {
         const PagedRegionEntry& r = _m.regions[i];
         _desired[i] = kNone;
@@ -134,12 +144,17 @@ void RegionPager::computeDesired() {
         if (level == kCoarse && _failedCoarse[i]) level = kNone;
         _desired[i] = level;
         _nearEye[i] = level == kFull ? dEye <= _o.radius : (level == kCoarse && dEye <= farM);
-        if (level != kNone) total += levelBytes(int(i), level == kCoarse);
+        if (level != kNone) total += cost(int(i), level == kCoarse);
+        if (level == kFull && _o.chunkRadius >= 0 && d <= _o.chunkRadius) {
+            partCost[i] = cost(int(i), false, true);
+            reserved += partCost[i];
+        }
     }
-    if (_o.budgetBytes == 0 || total <= _o.budgetBytes) {
+    if (_o.budgetBytes == 0 || total + reserved <= _o.budgetBytes) {
         computeChunks(total);
         return;
     }
+    total += reserved;
     // Over the budget: coarse levels go first, farthest first; then full
     // regions, farthest first (the radius shrinks), each keeping its coarse
     // level when that fits; then regions left out get their coarse level
@@ -159,17 +174,18 @@ void RegionPager::computeDesired() {
         if (!coarse.empty()) {
             const int i = coarse.back();
             coarse.pop_back();
-            total -= levelBytes(i, true);
+            total -= cost(i, true);
             _desired[size_t(i)] = kNone;
             out.push_back(i);
         } else if (!full.empty()) {
             const int i = full.back();
             full.pop_back();
-            total -= levelBytes(i, false);
+            total -= cost(i, false) + partCost[size_t(i)];
+            reserved -= partCost[size_t(i)];
             _desired[size_t(i)] = kNone;
             if (!_failedCoarse[size_t(i)]) {
                 _desired[size_t(i)] = kCoarse;
-                total += levelBytes(i, true);
+                total += cost(i, true);
                 coarse.push_back(i);
             } else {
                 out.push_back(i);
@@ -182,17 +198,17 @@ void RegionPager::computeDesired() {
         return _key[size_t(x)] != _key[size_t(y)] ? _key[size_t(x)] < _key[size_t(y)] : x < y;
     });
     for (int i : out)
-        if (!_failedCoarse[size_t(i)] && total + levelBytes(i, true) <= _o.budgetBytes) {
+        if (!_failedCoarse[size_t(i)] && total + cost(i, true) <= _o.budgetBytes) {
             _desired[size_t(i)] = kCoarse;
-            total += levelBytes(i, true);
+            total += cost(i, true);
         }
     for (size_t i = 0; i < _desired.size(); ++i)
         if (_desired[i] == kNone) _nearEye[i] = 0;
-    computeChunks(total);
+    computeChunks(total - reserved);
 }
 
 // The chunk parts wanted: the full regions within chunkRadius of the lookahead segment, nearest
-// first while the budget (after every level: `total` bytes) has room.
+// first while the budget (after every level: `total`, their cost) has room.
 void RegionPager::computeChunks(uint64_t total) {
     std::fill(_desiredChunks.begin(), _desiredChunks.end(), 0);
     std::fill(_nearEyeChunks.begin(), _nearEyeChunks.end(), 0);
@@ -209,7 +225,7 @@ void RegionPager::computeChunks(uint64_t total) {
         return _key[size_t(x)] != _key[size_t(y)] ? _key[size_t(x)] < _key[size_t(y)] : x < y;
     });
     for (int i : band) {
-        const uint64_t bytes = levelBytes(i, false);
+        const uint64_t bytes = cost(i, false, true);
         if (_o.budgetBytes > 0 && total + bytes > _o.budgetBytes) {
             _nearEyeChunks[size_t(i)] = 0;
             continue;
@@ -282,15 +298,15 @@ void RegionPager::schedule(RegionPagerDelta* delta) {
     // Queued loads in the same order: the queue is rebuilt, the new ones merged in.
     std::vector<Job> queued(_queue.begin(), _queue.end());
     _queue.clear();
-    uint64_t resident = stats().residentBytes;
+    uint64_t resident = stats().residentCost;
     for (const Job& w : wants) {
-        const uint64_t need = levelBytes(w.region, w.coarse);
+        const uint64_t need = cost(w.region, w.coarse, w.chunks);
         if (_o.budgetBytes > 0 && resident + need > _o.budgetBytes) {
             // The region's other level makes room, if it has one.
             const bool other = !w.coarse;
             if (!w.chunks && (other ? _holdCoarse : _holdFull)[size_t(w.region)]) {
                 drop(w.region, other, delta);
-                resident -= levelBytes(w.region, other);
+                resident -= cost(w.region, other);
             }
             if (resident + need > _o.budgetBytes) continue;  // waits for room (an old level leaving)
         }
@@ -300,7 +316,8 @@ void RegionPager::schedule(RegionPagerDelta* delta) {
     }
     std::stable_sort(queued.begin(), queued.end(), before);
     _queue.assign(queued.begin(), queued.end());
-    _stats.peakResidentBytes = std::max(_stats.peakResidentBytes, resident);
+    _stats.peakResidentCost = std::max(_stats.peakResidentCost, resident);
+    _stats.peakResidentBytes = std::max(_stats.peakResidentBytes, stats().residentBytes);
     _work.notify_all();
 }
 
@@ -394,13 +411,15 @@ RegionPagerDelta RegionPager::collect(bool wait) {
 
 RegionPagerStats RegionPager::stats() const {
     RegionPagerStats s = _stats;
-    s.residentBytes = 0;
+    s.residentBytes = s.residentCost = 0;
     s.residentFull = s.residentCoarse = 0;
     for (size_t i = 0; i < _holdFull.size(); ++i) {
         if (_m.regions[i].empty) continue;
-        if (_holdFull[i] || _flightFull[i]) s.residentBytes += _m.regions[i].bytes;
-        if (_holdCoarse[i] || _flightCoarse[i]) s.residentBytes += _m.regions[i].coarseBytes;
-        if (_holdChunks[i] || _flightChunks[i]) s.residentBytes += _m.regions[i].bytes;
+        const int r = int(i);
+        if (_holdFull[i] || _flightFull[i]) s.residentBytes += levelBytes(r, false), s.residentCost += cost(r, false);
+        if (_holdCoarse[i] || _flightCoarse[i]) s.residentBytes += levelBytes(r, true), s.residentCost += cost(r, true);
+        if (_holdChunks[i] || _flightChunks[i])
+            s.residentBytes += levelBytes(r, false), s.residentCost += cost(r, false, true);
         s.residentChunks += _holdChunks[i] ? 1 : 0;
         s.residentFull += _holdFull[i] ? 1 : 0;
         s.residentCoarse += _holdCoarse[i] ? 1 : 0;

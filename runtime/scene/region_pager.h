@@ -14,14 +14,15 @@
 // file failed to load is desired at its coarse level instead; one whose coarse
 // file failed too, not at all (each failure is reported once, never retried).
 //
-// Budget (budgetBytes > 0): the desired set's file bytes (manifest sizes of
-// the wanted level) are held at or under it: coarse regions go first, farthest
+// Budget (budgetBytes > 0): the desired set's cost (a load's file bytes,
+// manifest sizes, times its kind's weight in options.cost: the resident bytes
+// the caller's prepare makes of one file byte) is held at or under it: coarse regions go first, farthest
 // first, then full regions farthest first (the radius shrinks), each keeping
 // its coarse level if that fits; then regions left out get their coarse level
 // back, nearest first, while it fits (a budget below every full region keeps
 // the coarse levels near the eye). The resident
 // bytes (levels held by the caller plus loads in flight or not yet collected)
-// never exceed the budget either: a region changing level keeps its old level
+// (their cost) never exceed the budget either: a region changing level keeps its old level
 // until the new one arrives only when both fit, else the old level is dropped
 // first.
 //
@@ -32,8 +33,11 @@
 // lookahead segment: a near field that reaches a few hundred metres keeps
 // chunks for the few regions around the camera, not for every full region.
 // A part is dropped when its region leaves the band or its full level goes;
-// it counts in the resident bytes (its file's bytes) and, under a budget,
-// comes after every level (nearest first, while it fits). chunkRadius < 0:
+// it counts in the resident bytes (its file's bytes) and in the cost at its
+// own weight. Under a budget the parts of the full regions in the band are
+// counted before any level is cut (the near field around the camera
+// outranks the far city; a full region cut from the radius takes its part
+// with it), then given nearest first while they fit. chunkRadius < 0:
 // every level comes with its chunks (one load, RegionLoad::chunks true).
 //
 // Load order: by urgency, then by the mean of the region's distance to the
@@ -61,7 +65,8 @@
 // collect(true) waits so once without wait mode (a viewer's first frame).
 //
 // Contract (VISTA_CHECK): radius and far finite and >= 0, prefetchS finite
-// and >= 0, budgetBytes >= 0, workers 1 .. 16, eye and velocity finite.
+// and >= 0, budgetBytes >= 0, cost weights finite and > 0, workers 1 .. 16,
+// eye and velocity finite.
 #pragma once
 #include <condition_variable>
 #include <cstdint>
@@ -92,12 +97,19 @@ struct RegionLoad {
     bool chunks = true;  // its near-field chunks
 };
 
+// Resident bytes per file byte of each kind of load, as the caller's prepare
+// makes them (the budget's weights; 1 everywhere: the budget counts file bytes).
+struct RegionCost {
+    double full = 1.0, coarse = 1.0, chunks = 1.0;  // full level, coarse level, chunk part
+};
+
 struct RegionPagerOptions {
     double radius = kDefaultPagedRadiusM;  // metres: full detail within
     double chunkRadius = -1;               // metres: chunk parts within (< 0: chunks come with every level)
     double far = kDefaultPagedFarM;        // metres: coarse level within (<= radius: none)
     double prefetchS = kDefaultPagedPrefetchS;
-    uint64_t budgetBytes = 0;  // file bytes of the resident levels; 0 = no budget
+    uint64_t budgetBytes = 0;  // the resident loads' cost (bytes); 0 = no budget
+    RegionCost cost;           // the budget's weights
     bool wait = false;         // collect() blocks until the desired set is resident
     int workers = 1;
     // Optional: run on the worker thread right after a level loads (e.g. the
@@ -135,6 +147,8 @@ struct RegionPagerDelta {
 struct RegionPagerStats {
     uint64_t residentBytes = 0;                // levels held by the caller, in flight or not yet collected
     uint64_t peakResidentBytes = 0;            // the most residentBytes has been
+    uint64_t residentCost = 0;                 // the same loads' cost (options.cost): what the budget holds
+    uint64_t peakResidentCost = 0;             // the most residentCost has been
     uint64_t bytesRead = 0;                    // file bytes of the successful loads
     int loads = 0;                             // successful loads (discarded ones included)
     int chunkLoads = 0;                        // ... of which chunk parts
@@ -199,6 +213,7 @@ private:
     }
     void takeArrivals(std::deque<Done>& done, RegionPagerDelta* delta);
     uint64_t levelBytes(int region, bool coarse) const;
+    uint64_t cost(int region, bool coarse, bool chunks = false) const;  // levelBytes times the kind's weight
     double regionKey(int region) const;
 
     const PagedManifest& _m;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -437,18 +438,28 @@ TEST_F(PagedLoad, AStreamedBenchLoadsAndUnloadsAlongThePath) {
     EXPECT_LE(with["frame_ms_p99"].get<double>(), with["frame_ms_max"].get<double>());
     EXPECT_LE(m["frame_ms_p99"].get<double>(), m["frame_ms_max"].get<double>());
     EXPECT_GE(w["advance_ms_max"].get<double>(), w["advance_ms_median"].get<double>());
-    // A budget that holds no full region (about 3.6 MB of region files after the fixed 200 MB): the
-    // coarse levels near the camera, never more than the budget.
+    // A budget that holds no full region: what is left after the fixed 200 MB is 0.8 of the
+    // smallest full region's estimate (its file bytes times the stream's weight for a full level,
+    // as summary.json gives it): the coarse levels near the camera, never more than the budget.
+    auto manifest = vista::readPagedManifest(dir());
+    ASSERT_TRUE(manifest.isOk()) << manifest.status().message();
+    uint64_t smallest = UINT64_MAX;
+    for (const auto& e : manifest->regions)
+        if (!e.empty) smallest = std::min(smallest, e.bytes);
+    const double weight = w["bytes_per_file_byte"]["full"].get<double>();
+    EXPECT_GT(weight, 0.0);
+    const double leftMb = 0.8 * double(smallest) * weight / (1024.0 * 1024.0);
+    char gb[32];
+    std::snprintf(gb, sizeof gb, "%.6f", (200.0 + leftMb) / 1024.0);
     r = runVista("bench " + dir() +
                  " --seed 4 --frames 12 --size 160x120 --modes raycast -q --paged-radius 300 --paged-far 2000 "
-                 "--paged-wait --memory-budget 0.215 --out " +
-                 tmp.file("b"));
+                 "--paged-wait --memory-budget " +
+                 gb + " --out " + tmp.file("b"));
     ASSERT_EQ(r.code, 0) << r.err;
     const auto b = readJson(tmp.file("b/summary.json"))["paged"]["stream"];
-    const uint64_t budget = b["budget_file_bytes"].get<uint64_t>();
-    EXPECT_GT(budget, 3000000u);
-    EXPECT_LT(budget, 4000000u);
-    EXPECT_LE(b["peak_resident_file_bytes"].get<uint64_t>(), budget);
+    const uint64_t budget = b["budget_bytes"].get<uint64_t>();
+    EXPECT_NEAR(double(budget), leftMb * 1024.0 * 1024.0, 0.01 * leftMb * 1024.0 * 1024.0);
+    EXPECT_LE(b["peak_resident_estimate_bytes"].get<uint64_t>(), budget);
     EXPECT_GT(b["budget_limited_updates"].get<int>(), 0);
     EXPECT_EQ(b["resident_full_end"].get<int>(), 0);
     EXPECT_GT(b["resident_coarse_end"].get<int>(), 0);

@@ -234,6 +234,68 @@ TEST_F(Pager, TheBudgetHoldsCoarseLevelsFirstThenTheRadiusShrinks) {
     }
 }
 
+// The budget weighs each kind of load by the resident bytes the caller makes of a file byte
+// (RegionCost): what is held, priced here from the manifest's sizes, stays within it and is what
+// the pager reports as its cost; the same budget with unit weights (file bytes) holds it all.
+TEST_F(Pager, TheBudgetWeighsEachKindOfLoad) {
+    struct Held {
+        std::map<int, int> levels;
+        std::set<int> parts;
+        uint64_t fileBytes = 0, weighted = 0;
+        vista::RegionPagerStats stats;
+    };
+    auto run = [&](const vista::RegionCost& cost, uint64_t budget) {
+        RegionPagerOptions o;
+        o.radius = 260;
+        o.chunkRadius = 260;
+        o.far = 5000;
+        o.prefetchS = 0;
+        o.wait = true;
+        o.cost = cost;
+        o.budgetBytes = budget;
+        RegionPager pager(manifest, o);
+        pager.update(centre(4), glm::dvec3(0.0));
+        auto d = pager.collect();
+        Held h;
+        for (const auto& a : d.arrived) {
+            if (a.chunks) h.parts.insert(a.region);
+            else h.levels[a.region] = a.coarse ? 1 : 2;
+        }
+        for (const auto& x : d.dropped) {
+            if (x.chunks) h.parts.erase(x.region);
+            else h.levels.erase(x.region);
+        }
+        for (const auto& [r, level] : h.levels) {
+            const auto& e = manifest.regions[size_t(r)];
+            const uint64_t b = level == 2 ? e.bytes : e.coarseBytes;
+            h.fileBytes += b;
+            h.weighted += uint64_t(std::llround(double(b) * (level == 2 ? cost.full : cost.coarse)));
+        }
+        for (int r : h.parts) {
+            h.fileBytes += manifest.regions[size_t(r)].bytes;
+            h.weighted += uint64_t(std::llround(double(manifest.regions[size_t(r)].bytes) * cost.chunks));
+        }
+        h.stats = pager.stats();
+        return h;
+    };
+    const vista::RegionCost weights{3.0, 1.5, 3.0};
+    const Held all = run(weights, 0);
+    ASSERT_EQ(all.parts.size(), 5u) << "a chunk part for each full region in the band";
+    EXPECT_EQ(all.stats.residentCost, all.weighted);
+    const uint64_t budget = all.weighted / 2;
+    const Held cut = run(weights, budget);
+    EXPECT_EQ(cut.levels.at(4), 2) << "the eye's region stays at full detail";
+    EXPECT_EQ(cut.parts.count(4), 1u) << "with its chunks: the near field outranks the far city";
+    EXPECT_LE(cut.weighted, budget);
+    EXPECT_EQ(cut.stats.residentCost, cut.weighted);
+    EXPECT_LE(cut.stats.peakResidentCost, budget);
+    EXPECT_GT(cut.stats.budgetLimited, 0);
+    const Held unit = run(vista::RegionCost{}, budget);
+    EXPECT_EQ(unit.stats.budgetLimited, 0) << "in file bytes the same budget holds everything";
+    EXPECT_EQ(unit.fileBytes, all.fileBytes);
+    EXPECT_GT(unit.fileBytes, cut.fileBytes);
+}
+
 TEST_F(Pager, ADamagedRegionFileFallsBackToItsCoarseLevel) {
     TempDir tmp("vista_pager_damaged");
     const std::string dir = tmp.file("city.paged");
