@@ -18,6 +18,10 @@ namespace {
 constexpr double kSceneBytesPerFileByte = 4.1;  // measured: 4.03 (2 km city), 3.76 (8 km)
 constexpr double kRaysBytesPerFileByte = 1.7;   // measured: 1.63 (2 km), see docs/performance.md
 constexpr double kFixedMb = 200.0;
+// A streamed run's own memory beside its regions (GL context, frame buffers, the ray scene's
+// top level, the far field's cache and the paged city's height lattice): measured 375 to 420 MB
+// for a hybrid at 640x480 on llvmpipe (docs/measurements/paging.md, memory budget).
+constexpr double kStreamFixedMb = 500.0;
 constexpr double kMb = 1024.0 * 1024.0;
 
 double currentRssMb() {
@@ -51,6 +55,7 @@ Status checkMemoryBudget(const std::string& option, double budgetGb, double esti
 
 Result<uint64_t> streamBudgetBytes(const std::string& option, double budgetGb, double preloadMb) {
     if (budgetGb <= 0) return uint64_t(0);
+    preloadMb = std::max(preloadMb, kStreamFixedMb);
     const double leftMb = budgetGb * 1024.0 - preloadMb;
     if (leftMb <= 0) {
         char buf[320];

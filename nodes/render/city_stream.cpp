@@ -34,6 +34,7 @@ RegionCost streamRegionCost(bool rays, StreamGraph graph, bool labels) {
     c.coarse = std::max(1.0, (rays ? kStreamCoarseRaysPerFileByte : 0.0) +
                                  (every ? kStreamCoarseChunksPerFileByte * graphPerChunkByte : 0.0));
     c.chunks = kStreamChunksPerFileByte * graphPerChunkByte;
+    c.loading = kStreamLoadingPerFileByte;
     return c;
 }
 

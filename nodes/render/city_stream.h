@@ -75,6 +75,9 @@ enum class StreamGraph { EveryLevel, NearBand, None };
 constexpr double kStreamRaysPerFileByte = 1.1, kStreamCoarseRaysPerFileByte = 1.6;
 constexpr double kStreamChunksPerFileByte = 1.2, kStreamCoarseChunksPerFileByte = 4.0;
 constexpr double kStreamLabelsPerChunkByte = 0.5;
+// The passing peak of decoding and preparing a load on the worker, beyond what it keeps (the
+// budget holds back room for the largest region's; measured 1.8).
+constexpr double kStreamLoadingPerFileByte = 2.0;
 // The memory budget's weights (RegionPagerOptions::cost) of a stream that makes
 // ray scenes (rays), chunks on `graph`'s levels and their label twins (labels).
 RegionCost streamRegionCost(bool rays, StreamGraph graph, bool labels);

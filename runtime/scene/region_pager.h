@@ -16,7 +16,9 @@
 //
 // Budget (budgetBytes > 0): the desired set's cost (a load's file bytes,
 // manifest sizes, times its kind's weight in options.cost: the resident bytes
-// the caller's prepare makes of one file byte) is held at or under it: coarse regions go first, farthest
+// the caller's prepare makes of one file byte) is held at or under it, less
+// room for what the workers' loads pass through while they are prepared
+// (options.cost.loading times the largest full file, per worker): coarse regions go first, farthest
 // first, then full regions farthest first (the radius shrinks), each keeping
 // its coarse level if that fits; then regions left out get their coarse level
 // back, nearest first, while it fits (a budget below every full region keeps
@@ -65,7 +67,7 @@
 // collect(true) waits so once without wait mode (a viewer's first frame).
 //
 // Contract (VISTA_CHECK): radius and far finite and >= 0, prefetchS finite
-// and >= 0, budgetBytes >= 0, cost weights finite and > 0, workers 1 .. 16,
+// and >= 0, budgetBytes >= 0, cost weights finite and > 0 (loading >= 0), workers 1 .. 16,
 // eye and velocity finite.
 #pragma once
 #include <condition_variable>
@@ -101,6 +103,9 @@ struct RegionLoad {
 // makes them (the budget's weights; 1 everywhere: the budget counts file bytes).
 struct RegionCost {
     double full = 1.0, coarse = 1.0, chunks = 1.0;  // full level, coarse level, chunk part
+    // The passing peak of decoding and preparing a load, beyond what it keeps, per file byte:
+    // under a budget, room for each worker's largest load (the largest full file) is held back.
+    double loading = 0.0;
 };
 
 struct RegionPagerOptions {
@@ -149,6 +154,7 @@ struct RegionPagerStats {
     uint64_t peakResidentBytes = 0;            // the most residentBytes has been
     uint64_t residentCost = 0;                 // the same loads' cost (options.cost): what the budget holds
     uint64_t peakResidentCost = 0;             // the most residentCost has been
+    uint64_t loadingReserve = 0;               // of the budget, held back for the loads being prepared
     uint64_t bytesRead = 0;                    // file bytes of the successful loads
     int loads = 0;                             // successful loads (discarded ones included)
     int chunkLoads = 0;                        // ... of which chunk parts
@@ -214,6 +220,8 @@ private:
     void takeArrivals(std::deque<Done>& done, RegionPagerDelta* delta);
     uint64_t levelBytes(int region, bool coarse) const;
     uint64_t cost(int region, bool coarse, bool chunks = false) const;  // levelBytes times the kind's weight
+    uint64_t _reserve = 0;  // workers x the largest load's passing peak (cost.loading)
+    uint64_t _budget = 0;   // budgetBytes less _reserve: what the held and queued loads' cost may reach
     double regionKey(int region) const;
 
     const PagedManifest& _m;

@@ -21,8 +21,12 @@
 //                   graph-coarse-far as rays-coarse and rays-coarse-far
 //   graph-labels    every level's chunks and their label twins (`vista render` ground truth)
 //   every-hybrid    rays, near field and every level's chunks (hybrid beside full or near)
+//   largest-band    the largest region alone, its level and chunk part (band 0): the passing
+//                   peak of decoding and preparing a load, beyond what it keeps
+// The peak is the process's VmHWM, reset (clear_refs) before the loads.
 // Each prints one CSV line: config, full and coarse levels resident, chunk parts resident,
-// their file bytes (levels full, levels coarse, chunk parts), the RSS growth (MB). The
+// their file bytes (levels full, levels coarse, chunk parts), the RSS growth and the peak
+// growth (MB). The
 // last lines solve for the bytes per file byte of each kind.
 //   usage: stream_memory CITY.paged [RADIUS_M] [X Y]   (eye default: the middle of the city)
 #include <malloc.h>
@@ -51,26 +55,49 @@ double rssBytes() {
     return double(resident) * double(sysconf(_SC_PAGESIZE));
 }
 
+// The peak resident set since the last resetPeak() (VmHWM).
+double peakBytes() {
+    std::ifstream f("/proc/self/status");
+    std::string key;
+    while (f >> key) {
+        if (key == "VmHWM:") {
+            double kb = 0;
+            f >> kb;
+            return kb * 1024.0;
+        }
+        f.ignore(1 << 20, '\n');
+    }
+    return 0.0;
+}
+void resetPeak() { std::ofstream("/proc/self/clear_refs") << "5"; }
+
 struct Config {
     const char* name;
     bool rays, nearField, labels;
     vista::StreamGraph graph;
-    double radius, band;  // radius < 0: the driver's radius; band < 0: the driver's radius
-    double far = 1.0;     // coarse levels within far times the driver's radius (where radius is smaller)
+    double radius, band;   // radius < 0: the driver's radius; band < 0: the driver's radius
+    double far = 1.0;      // coarse levels within far times the driver's radius (where radius is smaller)
+    bool largest = false;  // the eye at the middle of the city's largest region (radius 0, no coarse)
 };
 
 struct Row {
-    double fullBytes = 0, coarseBytes = 0, chunkBytes = 0, growth = 0;
+    double fullBytes = 0, coarseBytes = 0, chunkBytes = 0, growth = 0, peak = 0;
 };
 
 // Runs one configuration in this (child) process and prints its line.
-int measure(const vista::PagedManifest& m, const Config& c, double radius, const glm::dvec3& eye) {
+int measure(const vista::PagedManifest& m, const Config& c, double radius, glm::dvec3 eye) {
     using namespace vista;
+    if (c.largest) {
+        size_t big = 0;
+        for (size_t i = 0; i < m.regions.size(); ++i)
+            if (!m.regions[i].empty && m.regions[i].bytes > m.regions[big].bytes) big = i;
+        eye = glm::dvec3(0.5 * (glm::dvec2(m.regions[big].lo) + glm::dvec2(m.regions[big].hi)), 0.0);
+    }
     RegionPagerOptions o;
     o.radius = c.radius < 0 ? radius : c.radius;
     o.far = c.far * radius;  // coarse levels only where the radius is smaller
     o.prefetchS = 0;
-    o.workers = 2;
+    o.workers = 1;  // as the commands stream
     auto s = CityStream::create(m, o, c.rays, {}, c.labels);
     if (!s) {
         std::fprintf(stderr, "stream_memory: %s\n", s.status().message().c_str());
@@ -79,7 +106,9 @@ int measure(const vista::PagedManifest& m, const Config& c, double radius, const
     if (c.nearField) (*s)->enableNearField(0);
     (*s)->setGraphLevels(c.graph, c.band < 0 ? radius : c.band);
     const double before = rssBytes();
+    resetPeak();
     auto f = (*s)->advance(eye, glm::dvec3(0.0), /*wait=*/true);
+    const double peak = peakBytes();
     if (!f) {
         std::fprintf(stderr, "stream_memory: %s\n", f.status().message().c_str());
         return 1;
@@ -94,8 +123,8 @@ int measure(const vista::PagedManifest& m, const Config& c, double radius, const
         if (held[i] == 1) coarse += double(m.regions[i].coarseBytes), ++nCoarse;
     }
     const double chunkBytes = double(st.residentBytes) - full - coarse;
-    std::printf("%s,%d,%d,%d,%.0f,%.0f,%.0f,%.1f\n", c.name, nFull, nCoarse, st.residentChunks, full, coarse,
-                chunkBytes, (after - before) / 1048576.0);
+    std::printf("%s,%d,%d,%d,%.0f,%.0f,%.0f,%.1f,%.1f\n", c.name, nFull, nCoarse, st.residentChunks, full, coarse,
+                chunkBytes, (after - before) / 1048576.0, (peak - before) / 1048576.0);
     std::fflush(stdout);
     return 0;
 }
@@ -137,10 +166,11 @@ int main(int argc, char** argv) {
         {"graph-coarse-far", false, false, false, StreamGraph::EveryLevel, 0, 0, 2.0},
         {"graph-labels", false, false, true, StreamGraph::EveryLevel, -1, 0},
         {"every-hybrid", true, true, false, StreamGraph::EveryLevel, -1, 0},
+        {"largest-band", true, true, false, StreamGraph::NearBand, 0, 0, 0.0, true},
     };
     std::printf(
         "config,full_levels,coarse_levels,chunk_parts,full_file_bytes,coarse_file_bytes,"
-        "chunk_part_file_bytes,rss_growth_mb\n");
+        "chunk_part_file_bytes,rss_growth_mb,peak_growth_mb\n");
     std::fflush(stdout);
     std::map<std::string, Row> rows;
     for (const Config& c : configs) {
@@ -169,8 +199,8 @@ int main(int argc, char** argv) {
         Row r;
         char name[64];
         int a, b, k;
-        if (std::sscanf(line.c_str(), "%63[^,],%d,%d,%d,%lf,%lf,%lf,%lf", name, &a, &b, &k, &r.fullBytes,
-                        &r.coarseBytes, &r.chunkBytes, &r.growth) == 8)
+        if (std::sscanf(line.c_str(), "%63[^,],%d,%d,%d,%lf,%lf,%lf,%lf,%lf", name, &a, &b, &k, &r.fullBytes,
+                        &r.coarseBytes, &r.chunkBytes, &r.growth, &r.peak) == 9)
             rows[c.name] = r;
     }
     // Bytes of resident memory per file byte, kind by kind.
@@ -191,12 +221,16 @@ int main(int argc, char** argv) {
     const Row& g = rows["graph"];
     const Row& gl = rows["graph-labels"];
     const Row& eh = rows["every-hybrid"];
+    // Loading: the peak above what the largest region's level and chunk part keep, per byte of its file.
+    const Row& lb = rows["largest-band"];
+    const double fLoading = per(lb.peak - lb.growth, lb.fullBytes);
     std::printf(
         "# bytes per file byte: full level, rays %.2f; coarse level, rays %.2f; hybrid level (rays and "
         "height patch) %.2f; chunk part %.2f; full level, graph %.2f; coarse level, graph %.2f; full level, "
-        "graph and labels %.2f; hybrid level with chunks %.2f\n",
+        "graph and labels %.2f; hybrid level with chunks %.2f; loading (the passing peak of decoding and "
+        "preparing the largest region, beyond what it keeps) %.2f\n",
         fRays, fCoarse, fBandLevel, fChunks, per(g.growth, g.fullBytes + g.coarseBytes),
         coarse(rows["graph-coarse"], rows["graph-coarse-far"]), per(gl.growth, gl.fullBytes + gl.coarseBytes),
-        per(eh.growth, eh.fullBytes + eh.coarseBytes));
+        per(eh.growth, eh.fullBytes + eh.coarseBytes), fLoading);
     return 0;
 }

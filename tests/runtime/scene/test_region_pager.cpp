@@ -236,7 +236,8 @@ TEST_F(Pager, TheBudgetHoldsCoarseLevelsFirstThenTheRadiusShrinks) {
 
 // The budget weighs each kind of load by the resident bytes the caller makes of a file byte
 // (RegionCost): what is held, priced here from the manifest's sizes, stays within it and is what
-// the pager reports as its cost; the same budget with unit weights (file bytes) holds it all.
+// the pager reports as its cost; the same budget with unit weights (file bytes) holds it all; room
+// for a load being prepared is held back from it.
 TEST_F(Pager, TheBudgetWeighsEachKindOfLoad) {
     struct Held {
         std::map<int, int> levels;
@@ -294,6 +295,17 @@ TEST_F(Pager, TheBudgetWeighsEachKindOfLoad) {
     EXPECT_EQ(unit.stats.budgetLimited, 0) << "in file bytes the same budget holds everything";
     EXPECT_EQ(unit.fileBytes, all.fileBytes);
     EXPECT_GT(unit.fileBytes, cut.fileBytes);
+    // Room for a load being prepared (the largest full file times `loading`, one worker) is held back.
+    vista::RegionCost withLoading = weights;
+    withLoading.loading = 0.5;
+    const Held reserved = run(withLoading, budget);
+    uint64_t largest = 0;
+    for (const auto& e : manifest.regions)
+        if (!e.empty) largest = std::max(largest, e.bytes);
+    EXPECT_EQ(reserved.stats.loadingReserve, uint64_t(std::llround(double(largest) * 0.5)));
+    EXPECT_LE(reserved.weighted, budget - reserved.stats.loadingReserve);
+    EXPECT_LE(reserved.stats.peakResidentCost, budget - reserved.stats.loadingReserve);
+    EXPECT_EQ(reserved.levels.at(4), 2) << "the eye's region stays at full detail";
 }
 
 TEST_F(Pager, ADamagedRegionFileFallsBackToItsCoarseLevel) {
