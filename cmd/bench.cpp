@@ -70,6 +70,7 @@ Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene
         if (needRays && std::any_of(cfg.modes.begin(), cfg.modes.end(), modeStreamsNearField))
             run->stream->enableNearField(cfg.options.horizonGrid);
         run->stream->setGraphLevels(streamGraphOf(cfg.modes), streamNearBand(cfg.options));
+        holdStreamUnder(*run->stream, cfg.memoryBudgetGb);
         run->ctx.streamedCity = run->stream->graph();
         run->ctx.scene = run->stream->graph();
         run->ctx.stream = run->stream.get();

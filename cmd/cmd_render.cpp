@@ -167,6 +167,7 @@ struct RenderPlan {
     bool streamed = false;      // --paged-stream (or --paged-wait)
     bool rays = false;          // the mode casts rays (the memory estimate's ray scene)
     double estimateMb = 0;      // the memory estimate before the first frame
+    double memoryBudgetGb = 0;  // --memory-budget (0 = none)
     RegionPagerOptions stream;  // with --paged-stream
     bool labels() const { return (channels & kLabelChannels) != 0; }
 };
@@ -266,6 +267,7 @@ Result<Walkthrough> loadCityAndFrames(const RenderArgs& a, RenderPlan& p, std::v
     auto so = pagedStreamOptions(a.paged, a.stream, a.memoryBudgetGb, p.estimateMb);
     if (!so) return so.status();
     p.stream = *so;
+    p.memoryBudgetGb = a.memoryBudgetGb;
     if (!a.quiet) notePagedStream(kCmd, *w->manifest, p.stream);
     return w;
 }
@@ -352,6 +354,7 @@ Status setUp(const std::string& modeName, const RenderPlan& p, const Walkthrough
         if (rays && modeStreamsNearField(modeName)) s.stream->enableNearField(p.options.horizonGrid);
         // The label pass draws the whole streamed city; without it the mode's own levels suffice.
         if (!p.labels()) s.stream->setGraphLevels(streamGraphOf({modeName}), streamNearBand(p.options));
+        holdStreamUnder(*s.stream, p.memoryBudgetGb);
         s.ctx.stream = s.stream.get();
         s.ctx.streamedCity = s.stream->graph();
         s.ctx.scene = s.stream->graph();

@@ -573,6 +573,7 @@ Status startStream(const ViewArgs& a, const Walkthrough& walk, ModeContext& ctx,
         vs.stream->enableNearField(ctx.options.horizonGrid);
         vs.stream->setGraphLevels(streamGraphOf({a.mode}), streamNearBand(ctx.options));
     }
+    holdStreamUnder(*vs.stream, a.memoryBudgetGb);
     ctx.stream = vs.stream.get();
     ctx.streamedCity = vs.stream->graph();
     ctx.scene = vs.stream->graph();

@@ -37,7 +37,7 @@ Status checkMemoryBudget(const std::string& option, double budgetGb, double esti
 
 // The streamed regions' share of a budget (--paged-stream): what is left of
 // `budgetGb` after `preloadMb` (the estimate of what is held before the first
-// frame) or the run's own fixed memory (kStreamFixedMb, 500 MB), the larger,
+// frame) or the run's own fixed memory (kStreamFixedMb, 700 MB), the larger,
 // in bytes: the pager's unit (region_pager.h budgetBytes), which
 // weighs each load's file bytes by what the stream makes of them
 // (nodes/render/city_stream.h streamRegionCost). 0 = no budget. An error

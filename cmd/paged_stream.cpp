@@ -21,6 +21,11 @@ Result<RegionPagerOptions> pagedStreamOptions(const PagedReach& reach, const Pag
     return o;
 }
 
+void holdStreamUnder(CityStream& stream, double budgetGb) {
+    if (budgetGb > 0 && stream.options().budgetBytes > 0)
+        stream.holdProcessUnder(uint64_t(budgetGb * 1024.0 * 1024.0 * 1024.0));
+}
+
 Status checkStreamingModes(const std::vector<std::string>& modes) {
     for (const auto& m : modes)
         if (!modeStreams(m))
@@ -71,6 +76,7 @@ nlohmann::json pagedStreamJson(const RegionPagerOptions& o, const RegionPagerSta
               {"chunk_part", o.cost.chunks},
               {"loading", o.cost.loading}}},
             {"loading_reserve_bytes", s.loadingReserve},
+            {"process_overhead_bytes", s.processOverhead},
             {"peak_resident_estimate_bytes", s.peakResidentCost},
             {"resident_estimate_bytes_end", s.residentCost},
             {"peak_resident_file_bytes", s.peakResidentBytes},

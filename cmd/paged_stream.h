@@ -41,6 +41,9 @@ namespace vista {
 
 Result<RegionPagerOptions> pagedStreamOptions(const PagedReach& reach, const PagedStreamFlags& flags, double budgetGb,
                                               double preloadMb);
+// --memory-budget GB held for the whole process (CityStream::holdProcessUnder) when the
+// stream has a budget; nothing otherwise.
+void holdStreamUnder(CityStream& stream, double budgetGb);
 Status checkStreamingModes(const std::vector<std::string>& modes);
 void notePagedStream(const char* cmd, const PagedManifest& manifest, const RegionPagerOptions& options);
 Result<CityStreamFrame> advancePagedStream(CityStream& stream, const char* cmd, const glm::dvec3& eye,

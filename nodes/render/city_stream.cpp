@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "foundation/process_memory.h"
 #include "nodes/near_field_chunks.h"
 #include "runtime/scene/scene_graph.h"
 
@@ -117,11 +118,21 @@ void CityStream::setGraphLevels(StreamGraph levels, double bandM) {
     updateCost();
 }
 
+void CityStream::holdProcessUnder(uint64_t bytes) {
+    VISTA_CHECK(_options.budgetBytes > 0 && _options.budgetBytes <= bytes);
+    _processBudget = bytes;
+    _overhead = _overheadFloor = bytes - _options.budgetBytes;
+}
+
 std::vector<uint8_t> CityStream::held() const {
     return _pager ? _pager->held() : std::vector<uint8_t>(_manifest->regions.size(), 0);
 }
 
-RegionPagerStats CityStream::stats() const { return _pager ? _pager->stats() : RegionPagerStats(); }
+RegionPagerStats CityStream::stats() const {
+    RegionPagerStats s = _pager ? _pager->stats() : RegionPagerStats();
+    s.processOverhead = _processBudget ? _overhead : 0;
+    return s;
+}
 
 namespace {
 
@@ -158,6 +169,17 @@ std::pair<glm::dvec3, glm::dvec3> changedBox(const PagedManifest& m, int region)
 Result<CityStreamFrame> CityStream::advance(const glm::dvec3& eye, const glm::dvec3& velocity, bool wait) {
     _advanced = true;
     if (!_pager) _pager = std::make_unique<RegionPager>(*_manifest, _options);
+    if (_processBudget > 0 && _pager->idle()) {
+        // Measured while no load is under way (a load being prepared is the pager's reserve;
+        // the worker hands free pages back after each load) and, after drops, once what they
+        // freed is handed back too: else the freed pages would count as the process's own,
+        // shrink the budget, and the next drops would shrink it further.
+        if (_dropsSinceMeasure) releaseFreeMemory();
+        _dropsSinceMeasure = false;
+        const uint64_t rss = residentSetBytes(), held = _pager->stats().heldCost;
+        _overhead = std::max(_overheadFloor, rss > held ? rss - held : 0);
+        _pager->setBudget(_processBudget > _overhead ? _processBudget - _overhead : 1);
+    }
     _pager->update(eye, velocity);
     RegionPagerDelta d = _pager->collect(wait);
     CityStreamFrame f;
@@ -196,6 +218,7 @@ Result<CityStreamFrame> CityStream::advance(const glm::dvec3& eye, const glm::dv
         ++f.arrived;
     }
     if (f.arrived > 0 || f.dropped > 0) ++_generation;
+    _dropsSinceMeasure = _dropsSinceMeasure || !d.dropped.empty();
     return f;
 }
 

@@ -109,6 +109,14 @@ public:
     // the first advance(); bandM finite and >= 0 for NearBand.
     void setGraphLevels(StreamGraph levels, double bandM = 0);
     StreamGraph graphLevels() const { return _graphLevels; }
+    // Holds the whole process under `bytes` (--memory-budget): before each advance the
+    // pager's budget becomes `bytes` less the process's own memory beside what its loads keep
+    // (its GL context, frame buffers and caches, and what the heap keeps between live blocks:
+    // the resident set less the held loads' cost, measured while no load is under way and
+    // after the heap's free pages are handed back), at least the part of `bytes` the options'
+    // budget left out.
+    // Contract: options.budgetBytes > 0 and <= bytes.
+    void holdProcessUnder(uint64_t bytes);
     // Moves the pager to the eye and mirrors what it hands over. wait = true:
     // this call blocks until the desired set is resident, as every call does
     // with options.wait (e.g. before a viewer's first frame).
@@ -139,6 +147,10 @@ private:
     StreamGraph _graphLevels = StreamGraph::EveryLevel;  // read by the workers' prepare once loads start
     uint64_t _generation = 0;
     bool _advanced = false;
+    uint64_t _processBudget = 0;  // holdProcessUnder; 0 = the options' budget as it is
+    uint64_t _overhead = 0;       // the process's own memory beside its loads (the last measured)
+    uint64_t _overheadFloor = 0;  // ... at least the part of the budget the options left out
+    bool _dropsSinceMeasure = false;
     osg::ref_ptr<osg::Group> _root;
     std::map<GroupKey, osg::ref_ptr<osg::Group>> _groups;  // each level's or part's chunk group under _root
     osg::ref_ptr<osg::Group> _labelRoot;                   // labels: the twins of _groups, same keys and order

@@ -5,10 +5,7 @@
 #include <cmath>
 #include <utility>
 
-#ifdef __GLIBC__
-#include <malloc.h>
-#endif
-
+#include "foundation/process_memory.h"
 #include "foundation/timing.h"
 
 namespace vista {
@@ -82,7 +79,7 @@ RegionPager::RegionPager(const PagedManifest& manifest, const RegionPagerOptions
     for (const PagedRegionEntry& r : _m.regions)
         if (!r.empty) largest = std::max(largest, r.bytes);
     _reserve = uint64_t(std::llround(double(largest) * _o.cost.loading)) * uint64_t(_o.workers);
-    _budget = _o.budgetBytes > _reserve ? _o.budgetBytes - _reserve : std::min<uint64_t>(_o.budgetBytes, 1);
+    setBudget(_o.budgetBytes);
     for (int k = 0; k < _o.workers; ++k) _threads.emplace_back([this] { workerLoop(); });
 }
 
@@ -116,13 +113,11 @@ void RegionPager::workerLoop() {
             load.chunks = job.chunks || _o.chunkRadius < 0;
             done.prepared = _o.prepare(*done.model, load);
         }
-#ifdef __GLIBC__
         // Under a budget, the heap's free pages (this load's decoding, the levels dropped since)
         // go back to the system: glibc keeps them resident otherwise, and a drive's resident set
         // would settle far above what it holds (measured: 2.4 against 1.3 GB at the end of a
         // 30-minute drive under 2 GB). On the worker, so no frame waits for it.
-        if (_o.budgetBytes > 0) malloc_trim(0);
-#endif
+        if (_o.budgetBytes > 0) releaseFreeMemory();
         done.loader = std::this_thread::get_id();
         lock.lock();
         --_busy;
@@ -428,10 +423,21 @@ RegionPagerDelta RegionPager::collect(bool wait) {
     return delta;
 }
 
+void RegionPager::setBudget(uint64_t bytes) {
+    _o.budgetBytes = bytes;
+    _budget = bytes > _reserve ? bytes - _reserve : std::min<uint64_t>(bytes, 1);
+}
+
+bool RegionPager::idle() const {
+    for (size_t i = 0; i < _flightFull.size(); ++i)
+        if (_flightFull[i] || _flightCoarse[i] || _flightChunks[i]) return false;
+    return true;
+}
+
 RegionPagerStats RegionPager::stats() const {
     RegionPagerStats s = _stats;
     s.loadingReserve = _reserve;
-    s.residentBytes = s.residentCost = 0;
+    s.residentBytes = s.residentCost = s.heldCost = 0;
     s.residentFull = s.residentCoarse = 0;
     for (size_t i = 0; i < _holdFull.size(); ++i) {
         if (_m.regions[i].empty) continue;
@@ -440,6 +446,8 @@ RegionPagerStats RegionPager::stats() const {
         if (_holdCoarse[i] || _flightCoarse[i]) s.residentBytes += levelBytes(r, true), s.residentCost += cost(r, true);
         if (_holdChunks[i] || _flightChunks[i])
             s.residentBytes += levelBytes(r, false), s.residentCost += cost(r, false, true);
+        s.heldCost += (_holdFull[i] ? cost(r, false) : 0) + (_holdCoarse[i] ? cost(r, true) : 0) +
+                      (_holdChunks[i] ? cost(r, false, true) : 0);
         s.residentChunks += _holdChunks[i] ? 1 : 0;
         s.residentFull += _holdFull[i] ? 1 : 0;
         s.residentCoarse += _holdCoarse[i] ? 1 : 0;

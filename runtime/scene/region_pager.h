@@ -150,20 +150,22 @@ struct RegionPagerDelta {
 };
 
 struct RegionPagerStats {
-    uint64_t residentBytes = 0;                // levels held by the caller, in flight or not yet collected
-    uint64_t peakResidentBytes = 0;            // the most residentBytes has been
-    uint64_t residentCost = 0;                 // the same loads' cost (options.cost): what the budget holds
-    uint64_t peakResidentCost = 0;             // the most residentCost has been
-    uint64_t loadingReserve = 0;               // of the budget, held back for the loads being prepared
-    uint64_t bytesRead = 0;                    // file bytes of the successful loads
-    int loads = 0;                             // successful loads (discarded ones included)
-    int chunkLoads = 0;                        // ... of which chunk parts
-    int unloads = 0;                           // levels handed out as drops
-    int discarded = 0;                         // loads that arrived unwanted and were freed here
-    int failed = 0;                            // loads that failed (damaged or missing files)
-    int framesWaited = 0;                      // collect() calls that blocked (wait mode)
-    double waitMs = 0;                         // total time blocked in collect()
-    int budgetLimited = 0;                     // updates whose desired set the budget cut
+    uint64_t residentBytes = 0;      // levels held by the caller, in flight or not yet collected
+    uint64_t peakResidentBytes = 0;  // the most residentBytes has been
+    uint64_t residentCost = 0;       // the same loads' cost (options.cost): what the budget holds
+    uint64_t heldCost = 0;           // ... of the loads held by the caller alone
+    uint64_t peakResidentCost = 0;   // the most residentCost has been
+    uint64_t loadingReserve = 0;     // of the budget, held back for the loads being prepared
+    uint64_t processOverhead = 0;    // set by CityStream::holdProcessUnder: the process's memory beside its loads
+    uint64_t bytesRead = 0;          // file bytes of the successful loads
+    int loads = 0;                   // successful loads (discarded ones included)
+    int chunkLoads = 0;              // ... of which chunk parts
+    int unloads = 0;                 // levels handed out as drops
+    int discarded = 0;               // loads that arrived unwanted and were freed here
+    int failed = 0;                  // loads that failed (damaged or missing files)
+    int framesWaited = 0;            // collect() calls that blocked (wait mode)
+    double waitMs = 0;               // total time blocked in collect()
+    int budgetLimited = 0;           // updates whose desired set the budget cut
     int residentFull = 0, residentCoarse = 0;  // levels held by the caller now
     int residentChunks = 0;                    // chunk parts held by the caller now
 };
@@ -181,6 +183,11 @@ public:
     void update(const glm::dvec3& eye, const glm::dvec3& velocity);
     RegionPagerDelta collect(bool wait = false);
     RegionPagerStats stats() const;
+    // Replaces the budget (options.budgetBytes; 0 = none) from the next update() on: for a
+    // caller that follows the process's measured memory (CityStream::holdProcessUnder).
+    void setBudget(uint64_t bytes);
+    // True when no load is queued, being prepared or waiting to be collected.
+    bool idle() const;
 
     // The desired set of the last update(): per manifest region 0 (none), 1
     // (coarse) or 2 (full).

@@ -308,6 +308,32 @@ TEST_F(Pager, TheBudgetWeighsEachKindOfLoad) {
     EXPECT_EQ(reserved.levels.at(4), 2) << "the eye's region stays at full detail";
 }
 
+// A budget set between updates (a caller following the process's measured memory) takes effect at
+// the next update: what is held then fits it. The pager is idle only once nothing is queued,
+// loading or waiting to be collected.
+TEST_F(Pager, ANewBudgetTakesEffectAtTheNextUpdate) {
+    RegionPagerOptions o;
+    o.radius = 260;
+    o.far = 5000;
+    o.prefetchS = 0;
+    o.budgetBytes = 1ull << 40;
+    RegionPager pager(manifest, o);
+    EXPECT_TRUE(pager.idle());
+    pager.update(centre(4), glm::dvec3(0.0));
+    EXPECT_FALSE(pager.idle()) << "loads are queued until collected";
+    pager.collect(true);
+    EXPECT_TRUE(pager.idle());
+    const uint64_t all = pager.stats().heldCost;
+    EXPECT_EQ(all, pager.stats().residentCost);
+    EXPECT_EQ(pager.stats().budgetLimited, 0);
+    pager.setBudget(all / 2);
+    pager.update(centre(4), glm::dvec3(0.0));
+    pager.collect(true);
+    EXPECT_GT(pager.stats().budgetLimited, 0);
+    EXPECT_LE(pager.stats().heldCost, all / 2);
+    EXPECT_EQ(pager.held()[4], 2) << "the eye's region stays at full detail";
+}
+
 TEST_F(Pager, ADamagedRegionFileFallsBackToItsCoarseLevel) {
     TempDir tmp("vista_pager_damaged");
     const std::string dir = tmp.file("city.paged");
