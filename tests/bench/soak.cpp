@@ -7,12 +7,10 @@
 //   usage: soak CITY.osgb [FRAMES] [WIDTHxHEIGHT]   (needs an X display: xvfb-run -a)
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <memory>
 #include <string>
 
-#include <unistd.h>
-
+#include "foundation/process_memory.h"
 #include "foundation/timing.h"
 #include "nodes/render/offscreen.h"
 #include "nodes/render/render_mode.h"
@@ -23,12 +21,7 @@
 
 namespace {
 
-double rssMb() {
-    std::ifstream f("/proc/self/statm");
-    long pages = 0, resident = 0;
-    f >> pages >> resident;
-    return double(resident) * double(sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
-}
+double rssMb() { return double(vista::residentSetBytes()) / (1024.0 * 1024.0); }
 
 }  // namespace
 

@@ -29,7 +29,6 @@
 // growth (MB). The
 // last lines solve for the bytes per file byte of each kind.
 //   usage: stream_memory CITY.paged [RADIUS_M] [X Y]   (eye default: the middle of the city)
-#include <malloc.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -40,6 +39,7 @@
 #include <string>
 #include <vector>
 
+#include "foundation/process_memory.h"
 #include "nodes/render/city_stream.h"
 #include "runtime/scene/paged_load.h"
 
@@ -48,11 +48,8 @@ namespace {
 // The resident set once the heap's free pages are handed back (malloc_trim): what the loads
 // keep, not the decoding's passing peak, whose freed pages would otherwise stay resident.
 double rssBytes() {
-    malloc_trim(0);
-    std::ifstream f("/proc/self/statm");
-    long pages = 0, resident = 0;
-    f >> pages >> resident;
-    return double(resident) * double(sysconf(_SC_PAGESIZE));
+    vista::releaseFreeMemory();
+    return double(vista::residentSetBytes());
 }
 
 // The peak resident set since the last resetPeak() (VmHWM).
