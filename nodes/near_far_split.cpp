@@ -104,8 +104,10 @@ void NearFarSplit::traverse(osg::NodeVisitor& nv) {
     osg::Vec3 e = cv->getEyePoint();
     glm::dvec3 eye(e.x(), e.y(), e.z());
     const SplitIndex& index = _srcIndex ? *_srcIndex : *_index;
-    std::vector<uint32_t> sel = _triangleBudget > 0 ? selectNearFieldByBudget(index, eye, _triangleBudget)
-                                                    : selectNearField(index, eye, _nearDistance);
+    std::vector<uint32_t> sel;
+    if (_triangleBudget == 0) sel = selectNearField(index, eye, _nearDistance);
+    else if (_srcIndex) sel = selectNearFieldByBudget(index, eye, _triangleBudget);  // free slots are in no block
+    else sel = selectNearFieldByBudget(objs, eye, _triangleBudget);
     uint64_t tris = 0;
     for (uint32_t i : sel) {
         osg::Node* n = _srcChunks ? (*_srcChunks)[i].get() : _children[i].get();

@@ -312,7 +312,8 @@ void RegionPager::schedule(RegionPagerDelta* delta) {
     // Queued loads in the same order: the queue is rebuilt, the new ones merged in.
     std::vector<Job> queued(_queue.begin(), _queue.end());
     _queue.clear();
-    uint64_t resident = stats().residentCost;
+    const RegionPagerStats now = stats();
+    uint64_t resident = now.residentCost, residentFiles = now.residentBytes;
     for (const Job& w : wants) {
         const uint64_t need = cost(w.region, w.coarse, w.chunks);
         if (_o.budgetBytes > 0 && resident + need > _budget) {
@@ -321,17 +322,19 @@ void RegionPager::schedule(RegionPagerDelta* delta) {
             if (!w.chunks && (other ? _holdCoarse : _holdFull)[size_t(w.region)]) {
                 drop(w.region, other, delta);
                 resident -= cost(w.region, other);
+                residentFiles -= levelBytes(w.region, other);
             }
             if (resident + need > _budget) continue;  // waits for room (an old level leaving)
         }
         flight(w)[size_t(w.region)] = 1;
         resident += need;
+        residentFiles += levelBytes(w.region, w.coarse);
         queued.push_back(w);
     }
     std::stable_sort(queued.begin(), queued.end(), before);
     _queue.assign(queued.begin(), queued.end());
     _stats.peakResidentCost = std::max(_stats.peakResidentCost, resident);
-    _stats.peakResidentBytes = std::max(_stats.peakResidentBytes, stats().residentBytes);
+    _stats.peakResidentBytes = std::max(_stats.peakResidentBytes, residentFiles);
     _work.notify_all();
 }
 
