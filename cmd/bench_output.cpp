@@ -162,6 +162,7 @@ json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneM
                     {"cache", o.cache},
                     {"cache_error_px", o.cacheErrorPx},
                     {"cache_adaptive", o.cacheAdaptive},
+                    {"horizon_adaptive", o.horizonAdaptive},
                     {"far_step", o.farStep},
                     {"point_splat_px", o.splatSigma > 0 ? json(o.splatSigma) : json("off")},
                     {"overlap", o.overlap},

@@ -223,9 +223,10 @@ Status configure(const RenderArgs& a, RenderPlan& p) {
     p.sampleRuns = *sampling;
     VISTA_RETURN_IF_ERROR(parseModeFlags(a.modeFlags, p.options));
     // Ground truth follows no timing, so that a rerun or a resumed run writes the same bytes: the
-    // cache never pauses on measured reuse, and the hybrid's split is fixed (--near auto draws at
+    // cache and the horizon never pause on measured times, and the hybrid's split is fixed (--near auto draws at
     // the default near distance instead of choosing per frame from measured costs).
     p.options.cacheAdaptive = false;
+    p.options.horizonAdaptive = false;
     if (p.options.nearDistance < 0) p.options.nearDistance = kDefaultNearDistance;
     auto po = parsePathFlags(a.path);
     if (!po) return po.status();

@@ -247,7 +247,8 @@ void addModeFlags(CLI::App& app, ModeFlags& f) {
     app.add_flag("--no-cache", f.noCache, "hybrid: panoramic image cache off (every far pixel traced)");
     app.add_flag("--cache-always", f.cacheAlways,
                  "hybrid: look up the cache in every frame, also while its measured reuse does not pay for its lookups "
-                 "(by default it then pauses for 8 moving frames and measures again)");
+                 "(by default it then pauses for 8 moving frames and measures again), and trace the horizon in every "
+                 "frame too: no pause follows measured times");
     app.add_flag("--no-overlap", f.noOverlap,
                  "hybrid: trace the horizon and last frame's far pixels after the near field is drawn instead of on "
                  "other threads "
@@ -312,6 +313,7 @@ Status parseModeFlags(const ModeFlags& f, ModeOptions& o) {
     o.horizonGrid = f.horizonGrid;
     o.cache = !f.noCache;
     o.cacheAdaptive = !f.cacheAlways;
+    o.horizonAdaptive = !f.cacheAlways;
     o.cacheErrorPx = f.cacheError;
     o.overlap = !f.noOverlap;
     o.frameMsTarget = f.frameMs;

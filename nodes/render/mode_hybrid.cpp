@@ -262,6 +262,7 @@ private:
         o.cache = _ctx.options.cache;
         o.cacheErrorPx = _ctx.options.cacheErrorPx;
         o.cacheAdaptive = _ctx.options.cacheAdaptive;
+        o.horizonAdaptive = _ctx.options.horizonAdaptive;
         o.rayStep = _ctx.options.farStep;
         o.frameMsTarget = _ctx.options.frameMsTarget;
         o.threads = _ctx.options.threads;

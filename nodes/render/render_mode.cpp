@@ -74,7 +74,7 @@ double streamNearBand(const ModeOptions& o) {
 bool modeFollowsTimings(const std::string& name, const ModeOptions& o) {
     if (name != "hybrid" && name != "hybrid-fixed") return false;
     const bool autoSplit = name == "hybrid" && o.triangleBudget == 0 && o.nearDistance < 0;
-    return autoSplit || (o.cache && o.cacheAdaptive) || o.frameMsTarget > 0;
+    return autoSplit || (o.cache && (o.cacheAdaptive || o.horizonAdaptive)) || o.frameMsTarget > 0;
 }
 
 bool effectsNeedRays(const FrameEffects& fx) { return fx.glass && fx.glassMarked && fx.rayBudget > 0; }

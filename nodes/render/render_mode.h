@@ -61,6 +61,10 @@ struct ModeOptions {
     int horizonGrid = 0;  // hybrid: horizon height-grid cells per side, 1 .. 8192, 0 = auto (HeightGrid::autoCells)
     bool cache = true;    // hybrid: panoramic image cache on/off
     bool cacheAdaptive = true;  // hybrid: pause the cache while it does not pay (FarFieldOptions::cacheAdaptive)
+    // hybrid: pause the horizon while it does not pay (FarFieldOptions::horizonAdaptive). With the
+    // cache on, a paused horizon changes which far pixels the cache serves, so frames that must
+    // not follow measured times (--cache-always, ground truth) turn it off with cacheAdaptive.
+    bool horizonAdaptive = true;
     double cacheErrorPx =
         0.25;             // hybrid: reuse a cached far pixel while its reprojection error is below this, 0 .. 100
     bool overlap = true;  // hybrid: trace the horizon on another thread while the near field is drawn
@@ -272,7 +276,8 @@ constexpr double kStreamBandMarginM = 250.0;
 double streamNearBand(const ModeOptions& options);
 // True when a mode's pictures follow measured times under these options, so
 // that two runs of the same frames may differ: hybrid with the adaptive split
-// (--near auto), the adaptive cache (on and not --cache-always) or a frame-time
+// (--near auto), the adaptive cache or horizon with the cache on (not
+// --cache-always) or a frame-time
 // target; hybrid-fixed with the latter two. Every other mode: false.
 bool modeFollowsTimings(const std::string& name, const ModeOptions& options);
 

@@ -36,8 +36,10 @@
 // Determinism: the image, classes and counts do not depend on thread count.
 // The pauses (cacheAdaptive, horizonAdaptive; default on) follow measured
 // times, so with them the classes and counts of a moving frame can differ
-// between runs; the horizon's pause leaves the image as it is, the cache's
-// within its error bound.
+// between runs, and its image within the cache's error bound: the cache's
+// pause changes which pixels it serves, and so does the horizon's with the
+// cache on (a culled pixel is neither looked up nor stored; a traced miss is
+// both). Without the cache the horizon's pause leaves the image as it is.
 // Ray casting runs in a tbb::task_arena with `threads` workers (0 = all cores);
 // FTZ/DAZ are set in every casting thread (RayScene). Not thread-safe itself;
 // nothing throws. Contract: depth (if not null) has width*height entries.
