@@ -242,36 +242,58 @@ Status dumpRays(const RenderMode& m, const std::string& label, int f, const Came
 }
 
 // Images a frame renders into (one per mode), kept across frames so that no mode allocates its
-// image in a timed frame.
+// image in a timed frame; a reference per group (the run's modes, their clear twins).
 struct FrameBuffers {
     std::vector<Image> img;
-    Image ref;
+    Image ref[2];
 };
 
-// Renders one frame in modes [begin, end) of the run (the first is `full`,
-// the reference of the others) and scores each; records go to recs[mi]. The
-// modes run in an order that rotates frame by frame (frame f starts with the
-// mode f places after `begin`), so that no mode always runs first, right
-// after another frame's work, or last; they are scored in the listed order
-// once all have run.
-Status renderGroup(BenchRun& run, size_t begin, size_t end, size_t f, size_t pathIndex, double t, const Camera& cam,
-                   const BenchConfig& cfg, std::vector<BenchFrameRecord>& recs, FrameImages& images, OutputBatch& batch,
-                   FrameBuffers& buf, int* slot) {
-    for (size_t mi = buf.img.size(); mi < end; ++mi) buf.img.emplace_back(cfg.width, cfg.height);
-    if (cfg.referenceSsaa >= 2) {
-        auto r = supersampledReference(run, begin, cam, cfg.referenceSsaa);
-        if (!r) return Status::error("reference, frame " + std::to_string(f) + ": " + r.status().message());
-        buf.ref = std::move(r.value());
+// The order in which frame f renders the run's n modes (the first `plain` are
+// the run's, the rest their clear twins in the same order). The modes rotate
+// frame by frame (frame f starts with the mode f places after the first), so
+// that no mode always runs first, right after another frame's work, or last.
+// With twins, each mode and its twin run one after the other, the twin first
+// on frames f with (f mod 2) xor (f / 4 mod 2): then, counted over frames,
+// a mode and its twin follow the same renders (a mode's predecessors with and
+// without effects swapped are its twin's), so neither side is the one that
+// more often runs on caches another render left warm or cold.
+std::vector<size_t> renderOrder(size_t f, size_t n, size_t plain) {
+    std::vector<size_t> order;
+    for (size_t k = 0; k < plain; ++k) {
+        const size_t mi = (k + f) % plain;
+        if (plain == n) {
+            order.push_back(mi);
+        } else if ((f % 2) ^ ((f / 4) % 2)) {
+            order.insert(order.end(), {plain + mi, mi});
+        } else {
+            order.insert(order.end(), {mi, plain + mi});
+        }
     }
-    const size_t count = end - begin;
-    for (size_t k = 0; k < count; ++k) {
-        const size_t mi = begin + (k + f) % count;
+    return order;
+}
+
+// Renders one frame in every mode of the run, in renderOrder, and scores each
+// against its group's reference (the group's first mode, `full`, or its
+// supersampled image); records go to recs[mi].
+Status renderFrame(BenchRun& run, size_t f, size_t pathIndex, double t, const Camera& cam, const BenchConfig& cfg,
+                   std::vector<BenchFrameRecord>& recs, FrameImages& images, OutputBatch& batch, FrameBuffers& buf) {
+    const size_t n = run.modes.size(), plain = run.plainCount;
+    for (size_t mi = buf.img.size(); mi < n; ++mi) buf.img.emplace_back(cfg.width, cfg.height);
+    const size_t groups = plain < n ? 2 : 1;
+    if (cfg.referenceSsaa >= 2)
+        for (size_t g = 0; g < groups; ++g) {
+            auto r = supersampledReference(run, g * plain, cam, cfg.referenceSsaa);
+            if (!r) return Status::error("reference, frame " + std::to_string(f) + ": " + r.status().message());
+            buf.ref[g] = std::move(r.value());
+        }
+    int slot = 0;  // the next render's place in the frame
+    for (const size_t mi : renderOrder(f, n, plain)) {
         BenchFrameRecord& rec = recs[mi];
         rec.frame = int(f);
         rec.pathIndex = pathIndex;
         rec.t = t;
         rec.mode = run.labels[mi];
-        rec.runOrder = (*slot)++;
+        rec.runOrder = slot++;
         Image& img = buf.img[mi];
         Status st = run.modes[mi]->renderFrame(cam, img, rec.stats);
         if (!st) return Status::error("mode " + rec.mode + ", frame " + std::to_string(f) + ": " + st.message());
@@ -279,12 +301,13 @@ Status renderGroup(BenchRun& run, size_t begin, size_t end, size_t f, size_t pat
         if (!img.valid() || img.width != cfg.width || img.height != cfg.height)
             return Status::error("mode " + rec.mode + " returned an image of the wrong size");
     }
-    for (size_t mi = begin; mi < end; ++mi) {
+    for (size_t mi = 0; mi < n; ++mi) {
+        const size_t begin = mi < plain ? 0 : plain;
         BenchFrameRecord& rec = recs[mi];
         const Image& img = buf.img[mi];
         const bool scored = cfg.referenceSsaa != kNoReference;
         const bool isReference = scored && mi == begin && cfg.referenceSsaa < 2;
-        const Image& ref = cfg.referenceSsaa >= 2 ? buf.ref : buf.img[begin];
+        const Image& ref = cfg.referenceSsaa >= 2 ? buf.ref[begin == 0 ? 0 : 1] : buf.img[begin];
         rec.psnrDb = scored ? lumaPsnr(img, ref) : NAN;
         rec.diffFraction = scored ? fractionDiffering(img, ref, cfg.diffThreshold) : NAN;
         VISTA_RETURN_IF_ERROR(images.add(mi, rec, img, ref, isReference));
@@ -292,13 +315,11 @@ Status renderGroup(BenchRun& run, size_t begin, size_t end, size_t f, size_t pat
     return Status::ok();
 }
 
-// Renders every frame in every mode (interleaved) and scores it. With the
-// clear twins, the modes with effects go first on even frames and the twins
-// on odd ones, so neither side is always the one that runs on warm caches.
+// Renders every frame in every mode (interleaved) and scores it.
 Status renderFrames(BenchRun& run, const Path& path, const std::vector<size_t>& idx, const Camera& base,
                     const BenchConfig& cfg, BenchResult& result, FrameImages& images, OutputBatch& batch) {
     Stopwatch sw;
-    const size_t n = run.modes.size(), plain = run.plainCount;
+    const size_t n = run.modes.size();
     std::vector<BenchFrameRecord> recs(n);
     FrameBuffers buf;
     for (size_t f = 0; f < idx.size(); ++f) {
@@ -312,13 +333,7 @@ Status renderFrames(BenchRun& run, const Path& path, const std::vector<size_t>& 
         RayScene* rays = run.stream ? run.stream->rays() : run.rays.get();
         if (rays) VISTA_RETURN_IF_ERROR(rays->placeFrameNear(cam.eye));
         const double t = path.samples[idx[f]].t;
-        const bool twinsFirst = plain < n && f % 2 == 1;
-        int slot = 0;  // the next render's place in the frame
-        if (twinsFirst)
-            VISTA_RETURN_IF_ERROR(renderGroup(run, plain, n, f, idx[f], t, cam, cfg, recs, images, batch, buf, &slot));
-        VISTA_RETURN_IF_ERROR(renderGroup(run, 0, plain, f, idx[f], t, cam, cfg, recs, images, batch, buf, &slot));
-        if (!twinsFirst && plain < n)
-            VISTA_RETURN_IF_ERROR(renderGroup(run, plain, n, f, idx[f], t, cam, cfg, recs, images, batch, buf, &slot));
+        VISTA_RETURN_IF_ERROR(renderFrame(run, f, idx[f], t, cam, cfg, recs, images, batch, buf));
         for (auto& rec : recs) {
             rec.regionsArrived = arrived;
             result.frames.push_back(std::move(rec));

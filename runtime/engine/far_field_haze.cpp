@@ -1,12 +1,15 @@
 // The haze stage (far_field_haze.h) and the haze of covered pixels
-// (far_field_stages.h): the transmittance evaluated per pixel in arithmetic
-// the compiler vectorises, blended on packed pixels.
+// (far_field_stages.h): the listed and whole-frame passes evaluate the
+// transmittance per pixel in arithmetic the compiler vectorises; the covered
+// pixels read it from a table over the reciprocal depth (HazeTableView).
 #include "runtime/engine/far_field_haze.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <vector>
 
 #include <tbb/parallel_for.h>
@@ -92,36 +95,63 @@ void hazeListed(const FrameEffects& fx, const uint32_t* pixels, size_t n, const 
 }
 
 void hazeCoveredRows(const HazeKernels& k, PixelWord* px, const float* depth, size_t width, size_t y0, size_t y1,
-                     const uint32_t* skip, size_t nSkip, float na, float b, const HazeParams& h) {
+                     const uint32_t* skip, size_t nSkip, float invA, float b, const HazeTableView& table,
+                     const HazeParams& h) {
     const uint32_t* skipEnd = skip + nSkip;
     const uint32_t* next = std::lower_bound(skip, skipEnd, uint32_t(y0 * width));
-    for (size_t y = y0; y < y1; ++y) {
-        const size_t row = y * width;
-        const float* d = depth + row;
-        PixelWord* p = px + row;
-        size_t covered = 0;
-        for (size_t x = 0; x < width; ++x) covered += d[x] < 1.0f ? 1u : 0u;  // vectorised count
-        const bool skipsHere = next != skipEnd && *next < row + width;
-        if (covered == 0) {
-            while (next != skipEnd && *next < row + width) ++next;
-            continue;
-        }
-        if (covered == width && !skipsHere) {
-            k.window(p, d, width, na, b, h);
-            continue;
-        }
-        // A row the skyline, a far object or a seam hit crosses: its covered runs one by one.
-        size_t x = 0;
-        while (x < width) {
-            while (x < width && !(d[x] < 1.0f && !(next != skipEnd && *next == row + x))) {
-                if (next != skipEnd && *next == row + x) ++next;
-                ++x;
-            }
-            const size_t start = x;
-            while (x < width && d[x] < 1.0f && !(next != skipEnd && *next == row + x)) ++x;
-            if (x > start) k.window(p + start, d + start, x - start, na, b, h);
-        }
+    const size_t from = y0 * width, to = y1 * width;
+    // The rows as one span, cut at each seam hit (the kernel leaves uncovered pixels alone).
+    size_t start = from;
+    for (; next != skipEnd && *next < to; ++next) {
+        if (*next > start) k.window(px + start, depth + start, *next - start, invA, b, table, h);
+        start = size_t(*next) + 1;
     }
+    if (to > start) k.window(px + start, depth + start, to - start, invA, b, table, h);
+}
+
+namespace {
+
+struct TableEntry {
+    float beta = 0;
+    std::vector<uint16_t> t;
+    HazeTableView view;
+};
+
+std::unique_ptr<TableEntry> makeTable(float beta) {
+    auto e = std::make_unique<TableEntry>();
+    e->beta = beta;
+    auto bitsOf = [](float u) {
+        uint32_t bits;
+        std::memcpy(&bits, &u, sizeof bits);
+        return int32_t(bits >> HazeTableView::kShift);
+    };
+    // From beta z = 12 (T = 0) to beta z = 2^-17 (T = 32767): about 20 binades.
+    const int32_t base = bitsOf(beta / 12.0f), top = bitsOf(beta * 131072.0f);
+    e->t.resize(size_t(top - base) + 2);
+    for (int32_t i = 0; i <= top - base; ++i) {
+        const uint32_t bits = (uint32_t(base + i) << HazeTableView::kShift) | (1u << (HazeTableView::kShift - 1));
+        float u;
+        std::memcpy(&u, &bits, sizeof u);
+        const double T = std::round(32768.0 * std::exp(-double(beta) / double(u)));
+        e->t[size_t(i)] = uint16_t(std::min(T, 32767.0));
+    }
+    e->t.back() = e->t[e->t.size() - 2];
+    e->view = HazeTableView{e->t.data(), base, top - base};
+    return e;
+}
+
+}  // namespace
+
+HazeTableView hazeTable(float beta) {
+    // A run uses one extinction, the viewer's haze slider a few: the last four are kept.
+    static std::mutex mutex;
+    static std::vector<std::unique_ptr<TableEntry>> tables;
+    std::lock_guard<std::mutex> lock(mutex);
+    for (const auto& e : tables)
+        if (e->beta == beta) return e->view;
+    if (tables.size() == 4) tables.erase(tables.begin());
+    tables.push_back(makeTable(beta));
+    return tables.back()->view;
 }
 
 void CoveredHaze::start(const FarFrame& f, const FarFieldOptions& o) {
@@ -136,15 +166,17 @@ void CoveredHaze::start(const FarFrame& f, const FarFieldOptions& o) {
     const double zn = f.camera.zNear, zf = o.depthZFar;
     const float a = float(zf > 0 ? zn * zf / (zf - zn) : zn), b = float(zf > 0 ? zf / (zf - zn) : 1.0);
     const HazeParams h = hazeParams(o.effects);
-    const float na = -h.beta * a;
+    const float invA = 1.0f / a;
+    const HazeTableView table = hazeTable(h.beta);
     const size_t W = size_t(f.width), H = size_t(f.height);
     PixelWord* px = reinterpret_cast<PixelWord*>(f.out.rgba.data());
     const float* depth = f.depth;
-    auto body = [this, px, depth, W, H, na, b, h] {
+    auto body = [this, px, depth, W, H, invA, b, table, h] {
         Stopwatch sw;
         const HazeKernels& kernels = hazeKernels();
         tbb::parallel_for(tbb::blocked_range<size_t>(0, H, 16), [&](const tbb::blocked_range<size_t>& r) {
-            hazeCoveredRows(kernels, px, depth, W, r.begin(), r.end(), _seamHits.data(), _seamHits.size(), na, b, h);
+            hazeCoveredRows(kernels, px, depth, W, r.begin(), r.end(), _seamHits.data(), _seamHits.size(), invA, b,
+                            table, h);
         });
         _ms = sw.ms();
     };

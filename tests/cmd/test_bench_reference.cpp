@@ -119,3 +119,74 @@ TEST(BenchCli, TheModesOrderRotatesFrameByFrame) {
     ASSERT_EQ(placesOfMode.size(), 3u);
     for (const auto& [mode, places] : placesOfMode) EXPECT_EQ(places, (std::set<int>{0, 1, 2})) << mode;
 }
+
+// With --also-clear each mode runs right next to its clear twin, and over the
+// frames a mode and its twin follow the same renders (the mode's predecessors,
+// with and without effects swapped, are its twin's; the first render of the
+// run has none): neither side of the same-frame ratio is the one that more
+// often runs after another mode's work.
+TEST(BenchCli, AModeAndItsClearTwinFollowTheSameRenders) {
+    REQUIRE_DISPLAY();
+    ASSERT_TRUE(fs::exists(VISTA_BINARY)) << "the vista binary is a build dependency of this test";
+    test::TempDir tmp("vista_twin_order");
+    const std::string dir = tmp.path();
+    const test::CliRun r =
+        benchTinyCity(dir, "--frames 8 --sampling consecutive --modes near --effects night --also-clear");
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::ifstream csv(dir + "/b/frames.csv");
+    std::string line;
+    std::getline(csv, line);
+    std::vector<std::string> header;
+    {
+        std::stringstream ss(line);
+        for (std::string c; std::getline(ss, c, ',');) header.push_back(c);
+    }
+    const auto col = [&](const std::string& name) {
+        return size_t(std::find(header.begin(), header.end(), name) - header.begin());
+    };
+    const size_t frameCol = col("frame"), modeCol = col("mode"), orderCol = col("run_order");
+    ASSERT_LT(orderCol, header.size()) << line;
+    std::map<std::pair<int, int>, std::string> renders;  // (frame, place) -> mode
+    while (std::getline(csv, line)) {
+        std::vector<std::string> cells;
+        std::stringstream ss(line);
+        for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+        ASSERT_GT(cells.size(), orderCol) << line;
+        renders[{std::stoi(cells[frameCol]), std::stoi(cells[orderCol])}] = cells[modeCol];
+    }
+    ASSERT_EQ(renders.size(), 32u);  // full, near and their twins over 8 frames
+    const std::string kTwin = "+clear";
+    const auto twinOf = [&](const std::string& m) {
+        const bool twin = m.size() > kTwin.size() && m.compare(m.size() - kTwin.size(), kTwin.size(), kTwin) == 0;
+        return twin ? m.substr(0, m.size() - kTwin.size()) : m + kTwin;
+    };
+    std::map<std::string, std::map<std::string, int>> predecessors;  // mode -> its predecessor's mode -> count
+    std::map<std::string, int> firstOfPair;
+    std::string previous;
+    for (const auto& [key, mode] : renders) {
+        if (!previous.empty()) ++predecessors[mode][previous];
+        if (!previous.empty() && previous != twinOf(mode)) ++firstOfPair[mode];
+        previous = mode;
+        // The twin is the render right before or right after this one, in the same frame.
+        const auto before = renders.find({key.first, key.second - 1}),
+                   after = renders.find({key.first, key.second + 1});
+        EXPECT_TRUE((before != renders.end() && before->second == twinOf(mode)) ||
+                    (after != renders.end() && after->second == twinOf(mode)))
+            << "frame " << key.first << ": " << mode << " not next to its twin";
+    }
+    for (const std::string mode : {"full", "near"}) {
+        std::map<std::string, int> swapped;
+        for (const auto& [p, n] : predecessors[mode]) swapped[twinOf(p)] += n;
+        const std::map<std::string, int>& twin = predecessors[twinOf(mode)];
+        std::set<std::string> all;
+        for (const auto& [p, n] : swapped) all.insert(p);
+        for (const auto& [p, n] : twin) all.insert(p);
+        for (const std::string& p : all) {
+            const int a = swapped.count(p) ? swapped.at(p) : 0, b = twin.count(p) ? twin.at(p) : 0;
+            EXPECT_LE(std::abs(a - b), 1) << mode << " after the twin of " << p << " " << a << " times, its twin after "
+                                          << p << " " << b << " times";
+        }
+    }
+    // Both sides go first in their pair about as often.
+    EXPECT_LE(std::abs(firstOfPair["near"] - firstOfPair["near" + kTwin]), 1);
+}

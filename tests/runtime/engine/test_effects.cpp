@@ -89,7 +89,7 @@ TEST(HazeKernels, BaselineMatchesApplyHazeAndAvx2MatchesTheBaselineByteForByte) 
         k.depth(reinterpret_cast<PixelWord*>(byDepth.data()), depth.data(), n, h);
         covered = pixels;
         hazeCoveredRows(k, reinterpret_cast<PixelWord*>(covered.data()), window.data(), width, 0, rows, skip.data(),
-                        skip.size(), -h.beta * zNear, 1.0f, h);
+                        skip.size(), 1.0f / zNear, 1.0f, hazeTable(h.beta), h);
     };
     std::vector<uint32_t> base, baseCovered;
     run(hazeKernelsBaseline(), base, baseCovered);
@@ -116,6 +116,64 @@ TEST(HazeKernels, BaselineMatchesApplyHazeAndAvx2MatchesTheBaselineByteForByte) 
     run(*avx2, wide, wideCovered);
     EXPECT_EQ(wide, base);
     EXPECT_EQ(wideCovered, baseCovered);
+}
+
+// The covered pixels' table (HazeTableView) against FrameEffects::applyHaze
+// (exp by the library, in double) over the whole range of the effect:
+// visibilities of 20 m to 1,000 km, eye depths from the near plane to 10^7 m
+// (log-spaced), finite and infinite far planes, colours at both ends of the
+// range: every channel within one level, alpha kept, on both builds of the kernel.
+TEST(HazeKernels, CoveredPixelsStayWithinALevelFrom20mTo1000kmOfVisibility) {
+    const glm::u8vec4 colours[] = {{0, 0, 0, 255}, {255, 255, 255, 0}, {10, 200, 30, 77}, {128, 64, 250, 129}};
+    const float zNear = 0.25f;
+    std::vector<const HazeKernels*> builds = {&hazeKernelsBaseline()};
+    if (hazeKernelsAvx2()) builds.push_back(hazeKernelsAvx2());
+    size_t checked = 0;
+    for (double visibility : {20.0, 150.0, 600.0, 3000.0, 5e4, 1e6}) {
+        FrameEffects fx;
+        fx.haze = true;
+        fx.visibility = visibility;
+        HazeParams h;
+        h.beta = float(fx.extinction());
+        for (int k = 0; k < 3; ++k) h.colour[k] = float(fx.hazeColor()[k]);
+        const HazeTableView table = hazeTable(h.beta);
+        for (double zFar : {0.0, 50.0, 600.0, 5000.0}) {
+            // The renderer's window depth d = b - a / z (infinite far plane: a = zNear, b = 1).
+            const double a = zFar > 0 ? zNear * zFar / (zFar - zNear) : zNear,
+                         b = zFar > 0 ? zFar / (zFar - zNear) : 1.0;
+            std::vector<float> window;
+            std::vector<uint32_t> pixels;
+            for (double z = zNear; z < 1e7; z *= 1.013) {
+                const float d = float(b - a / z);
+                if (!(d < 1.0f)) break;  // beyond the far plane or past float's resolution: not covered
+                for (const glm::u8vec4& c : colours) {
+                    window.push_back(d);
+                    uint32_t w;
+                    std::memcpy(&w, &c, 4);
+                    pixels.push_back(w);
+                }
+            }
+            ASSERT_GT(window.size(), 100u) << visibility << " " << zFar;
+            for (const HazeKernels* k : builds) {
+                std::vector<uint32_t> out = pixels;
+                hazeCoveredRows(*k, reinterpret_cast<PixelWord*>(out.data()), window.data(), window.size(), 0, 1,
+                                nullptr, 0, float(1.0 / a), float(b), table, h);
+                for (size_t i = 0; i < out.size(); ++i) {
+                    glm::u8vec4 src, got;
+                    std::memcpy(&src, &pixels[i], 4);
+                    std::memcpy(&got, &out[i], 4);
+                    const double z = a / (b - double(window[i]));  // the eye depth this window depth stands for
+                    const glm::u8vec4 want = fx.applyHaze(src, z);
+                    for (int c = 0; c < 3; ++c)
+                        ASSERT_LE(std::abs(int(got[c]) - int(want[c])), 1)
+                            << "visibility " << visibility << " zFar " << zFar << " z " << z << " channel " << c;
+                    ASSERT_EQ(got[3], src[3]);
+                    ++checked;
+                }
+            }
+        }
+    }
+    EXPECT_GT(checked, 10000u);
 }
 
 // A hand-built scene: a wall of glass (alpha kGlassAlpha) facing -y at y = 20
