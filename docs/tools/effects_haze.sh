@@ -4,18 +4,19 @@
 # it for its own copy): on the 2 km city (data/default.json, seed 1, glass
 # marked) the hybrid (--near auto) with haze at 600, 1500 and 3000 m, the
 # night sky, and glass, each against the same frames with no run-time effect,
-# on car, walk and fly paths (path seed 3, 40 frames, 640x480). Each row is one
-# bench run with --also-clear: the hybrid with the effect and without it
-# (hybrid+clear) render every frame one after the other, alternating which
-# goes first, so the machine's drift falls on both; the ratio is the median
-# over frames of (effect / none) on the same frame. Glass is compared on the
+# on car, walk and fly paths (path seed 3, FRAMES frames, default 150, 640x480).
+# Each row is one bench run with --also-clear: the hybrid with the effect and
+# without it (hybrid+clear) render every frame one after the other, alternating
+# which goes first, so the machine's drift falls on both; the ratio is the
+# median over frames of (effect / none) on the same frame. Glass is compared on the
 # frames where it is off-screen (no reflection pass ran): on-screen its pass is
 # the effect's own work (section 1).
 #
-# usage: docs/tools/effects_haze.sh [OUT_DIR] [VISTA_BIN]       (DOC=path to write another copy)
-# Needs python3 and, without a display, xvfb-run. About 8 minutes on 2 cores with llvmpipe.
+# usage: docs/tools/effects_haze.sh [OUT_DIR] [VISTA_BIN]       (FRAMES=150; DOC=path to write another copy)
+# Needs python3 and, without a display, xvfb-run. About 12 minutes on 2 cores with llvmpipe.
 set -euo pipefail
 DOC=${DOC:-docs/measurements/effects.md}
+FRAMES=${FRAMES:-150}
 source "$(dirname "$0")/lib.sh"
 doc_setup effects_haze.sh effects-haze 1280x1024x24 "$@"
 DOC_TMP_FILES=("$(dirname "$DOC")/.$(basename "$DOC").tmp")
@@ -24,7 +25,7 @@ city="$OUT/city.osgb"
 [ -s "$city" ] || "$VISTA" gen --params data/default.json --effects glass -o "$city" -q
 bench() {  # bench DIR KIND EFFECTS
   rm -rf "$1"
-  "${XVFB[@]}" "$VISTA" bench "$city" --seed 3 --kind "$2" --frames 40 --size 640x480 --near auto --modes hybrid \
+  "${XVFB[@]}" "$VISTA" bench "$city" --seed 3 --kind "$2" --frames "$FRAMES" --size 640x480 --near auto --modes hybrid \
     --effects "$3" --also-clear --out "$1" -q >/dev/null
 }
 SPECS=()
