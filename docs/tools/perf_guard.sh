@@ -13,7 +13,7 @@
 # runs; prints nothing and exits 0 when none does, exits 1 when a row prints.
 #
 # usage: docs/tools/perf_guard.sh [OUT_DIR] [VISTA_BIN]     (LIMIT=1.05 FRAMES=150 REPEATS=2 in the environment)
-# Needs python3 and, without a display, xvfb-run. About 10 minutes on 2 cores with llvmpipe, plus
+# Needs python3 and, without a display, xvfb-run. About 8 minutes on 2 cores with llvmpipe, plus
 # about 20 s per repeated row.
 # 150 frames a row: on llvmpipe one frame's draw varies by about a tenth from the next, so the
 # median of 60 same-frame ratios still moves by about 3 % from run to run; and the adaptive split
