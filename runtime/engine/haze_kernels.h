@@ -124,13 +124,15 @@ inline int32_t hazeTableIndex(float d, float invA, float b, const HazeTableView&
 }
 
 // colour + (haze - colour) (1 - T / 32768) in fixed point, rounded half up:
-// h + ((c - h) T + 2^14) >> 15 per channel (the AVX2 kernel's pmulhrsw);
-// alpha kept.
+// h + floor(((c - h) T + 2^14) / 2^15) per channel (the AVX2 kernel's
+// pmulhrsw), the floor taken on a non-negative sum (255 2^15 added, 255 taken
+// off after the shift) so that no negative number is shifted; alpha kept.
 inline uint32_t hazeBlendFixed(uint32_t p, int32_t T, const int32_t* h) {
     uint32_t q = p & 0xff000000u;
     for (int k = 0; k < 3; ++k) {
         const int32_t c = int32_t((p >> (8 * k)) & 255u);
-        q |= uint32_t(h[k] + (((c - h[k]) * T + 16384) >> 15)) << (8 * k);
+        const int32_t step = int32_t(uint32_t((c - h[k]) * T + 16384 + 255 * 32768) >> 15) - 255;
+        q |= uint32_t(h[k] + step) << (8 * k);
     }
     return q;
 }
