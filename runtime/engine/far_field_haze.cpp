@@ -1,13 +1,11 @@
 // The haze stage (far_field_haze.h) and the haze of covered pixels
-// (far_field_stages.h): the listed and whole-frame passes evaluate the
-// transmittance per pixel in arithmetic the compiler vectorises; the covered
-// pixels read it from a table over the reciprocal depth (HazeTableView).
+// (far_field_stages.h): every pass reads the transmittance from a table over
+// the reciprocal eye depth (HazeTableView) and blends in fixed point.
 #include "runtime/engine/far_field_haze.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <limits>
 #include <memory>
 #include <mutex>
 #include <vector>
@@ -17,13 +15,12 @@
 
 #include "foundation/timing.h"
 #include "runtime/engine/far_field_stages.h"
-#define VISTA_HAZE_KERNELS_DEFINE
-#include "runtime/engine/haze_kernels.h"
+#include "runtime/engine/haze_kernels_impl.h"
 
 namespace vista {
 
 const HazeKernels& hazeKernelsBaseline() {
-    static constexpr HazeKernels k{hazeWindowKernel, hazeDepthKernel, transmittanceKernel};
+    static constexpr HazeKernels k{hazeWindowKernel, hazeDepthKernel};
     return k;
 }
 
@@ -63,14 +60,15 @@ void hazeStage(const FrameEffects& fx, const uint32_t* pixels, size_t n, const f
                FrameStats& stats, int threads) {
     if (!fx.haze || n == 0) return;
     Stopwatch sw;
-    const HazeParams h = hazeParams(fx);
-    const HazeKernels& kernels = hazeKernels();
-    PixelWord* px = reinterpret_cast<PixelWord*>(out.rgba.data());
     if (!pixels) {
-        // The whole frame in order (the `raycast` mode): vectorised spans on the arena's threads.
+        // The whole frame in order: spans on the arena's threads.
+        const HazeParams h = hazeParams(fx);
+        const HazeTableView table = hazeTable(h.beta);
+        const HazeKernels& kernels = hazeKernels();
+        PixelWord* px = reinterpret_cast<PixelWord*>(out.rgba.data());
         inArena(threads, [&] {
             tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16384), [&](const tbb::blocked_range<size_t>& r) {
-                kernels.depth(px + r.begin(), depth + r.begin(), r.end() - r.begin(), h);
+                kernels.depth(px + r.begin(), depth + r.begin(), r.end() - r.begin(), table, h);
             });
         });
     } else {
@@ -79,18 +77,28 @@ void hazeStage(const FrameEffects& fx, const uint32_t* pixels, size_t n, const f
     recordHaze(sw.ms(), stats);
 }
 
+DepthHaze::DepthHaze(const FrameEffects& fx)
+    : _on(fx.haze),
+      _h(hazeParams(fx)),
+      _table(fx.haze ? hazeTable(_h.beta) : HazeTableView{}),
+      _kernels(&hazeKernels()) {}
+
+void DepthHaze::operator()(uint32_t* px, const float* depth, size_t n) const {
+    if (_on && n > 0) _kernels->depth(px, depth, n, _table, _h);
+}
+
 void hazeListed(const FrameEffects& fx, const uint32_t* pixels, size_t n, const float* depth, Image& out) {
     if (!fx.haze || n == 0) return;
-    // The transmittances in one vectorised pass, then the blend per pixel.
-    const HazeParams h = hazeParams(fx);
+    // Gathered into a block, hazed by the kernel, scattered back.
+    const DepthHaze haze(fx);
     PixelWord* px = reinterpret_cast<PixelWord*>(out.rgba.data());
-    constexpr float kInf = std::numeric_limits<float>::infinity();
-    std::vector<float> t(n);
-    hazeKernels().transmittances(depth, n, h.beta, t.data());
-    for (size_t k = 0; k < n; ++k) {
-        if (!(depth[k] < kInf)) continue;
-        PixelWord& p = px[pixels[k]];
-        p = hazeBlend(p, t[k], h);
+    constexpr size_t kBlock = 256;
+    uint32_t block[kBlock];
+    for (size_t b = 0; b < n; b += kBlock) {
+        const size_t m = std::min(kBlock, n - b);
+        for (size_t k = 0; k < m; ++k) block[k] = px[pixels[b + k]];
+        haze(block, depth + b, m);
+        for (size_t k = 0; k < m; ++k) px[pixels[b + k]] = block[k];
     }
 }
 

@@ -1,9 +1,9 @@
 // Haze stage: FrameEffects::applyHaze over pixels whose eye-plane depth is
-// known (the far field's traced pixels, the `raycast` mode's frame), with the
-// transmittance evaluated per pixel by a polynomial exp (relative error
-// < 2e-6, far below an 8-bit step; within one level of applyHaze). The whole
-// frame (a null list) is hazed in vectorised spans on `threads` workers (0 =
-// the caller's arena; bench_far_field's BM_HazeWholeFrame times it).
+// known (the far field's traced pixels, a frame of depths), with the
+// transmittance read from a table over the reciprocal depth (HazeTableView:
+// within one level of applyHaze). The whole frame (a null list) is hazed in
+// spans on `threads` workers (0 = the caller's arena; bench_far_field's
+// BM_HazeWholeFrame times it).
 //
 // hazeStage(): hazes the n listed pixels (indices y * width + x; a null list
 // = the first n pixels of the image in order) at their eye-plane depth
@@ -17,16 +17,33 @@
 
 #include "runtime/engine/frame_effects.h"
 #include "runtime/engine/frame_stats.h"
+#include "runtime/engine/haze_kernels.h"
 #include "runtime/engine/image.h"
 
 namespace vista {
 
 void hazeStage(const FrameEffects& fx, const uint32_t* pixels, size_t n, const float* depth, Image& out,
                FrameStats& stats, int threads = 0);
-// The list pass of hazeStage without its records, for a caller that hazes
-// pixels as it writes them (castPrimaryRays with RayShading::haze): the n
-// pixels out[pixels[k]] hazed at eye depth depth[k] (+inf: left alone), on
-// the calling thread. Does nothing without fx.haze.
+// The list pass of hazeStage without its records: the n pixels
+// out[pixels[k]] hazed at eye depth depth[k] (+inf: left alone), on the
+// calling thread. Does nothing without fx.haze.
 void hazeListed(const FrameEffects& fx, const uint32_t* pixels, size_t n, const float* depth, Image& out);
+
+// The haze of fx for a caller that hazes pixels as it writes them (the ray
+// casts with RayShading::haze): (px, depth, n) hazes the n RGBA8 words px[k]
+// at eye depth depth[k] (+inf: left alone) on the calling thread, as
+// hazeStage would. Made once per frame (it looks up the table); does nothing
+// without fx.haze.
+class DepthHaze {
+public:
+    explicit DepthHaze(const FrameEffects& fx);
+    void operator()(uint32_t* px, const float* depth, size_t n) const;
+
+private:
+    bool _on;
+    HazeParams _h;
+    HazeTableView _table;
+    const HazeKernels* _kernels;
+};
 
 }  // namespace vista

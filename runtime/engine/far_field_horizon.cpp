@@ -25,7 +25,7 @@ double culledRaysMs(const FarFrame& f, const RayScene& rays, const FarFieldOptio
             const glm::dvec3 d = f.rays.dir(int(i % W), int(i / W));
             orgs.push_back(org);
             dirs.push_back(glm::vec3(d));
-            tfars.push_back(zMax > 0 ? hazeTfar(d, fwd, zMax) : 1e30f);
+            tfars.push_back(zMax > 0 ? hazeTfar(dirs.back(), glm::vec3(fwd), float(zMax)) : 1e30f);
         }
     std::vector<RayHit> hits(dirs.size());
     Stopwatch sw;

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <vector>
 
@@ -62,7 +63,10 @@ void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, con
     // Haze: nothing beyond hazeFar of eye-plane depth is traced (each ray
     // stops where its eye-plane depth reaches it; hits beyond show the sky).
     const double zMax = fx.haze ? fx.hazeFar() : 0.0;
+    const glm::vec3 fwdF(fwd);
+    const float zMaxF = float(zMax);
     const bool hazeAtWrite = shading.haze && fx.haze;
+    const DepthHaze haze(hazeAtWrite ? fx : kNone);
     const uint32_t W = uint32_t(camera.width);
     const glm::vec3 org(camera.eye - scene.frameOrigin());
     const size_t grain = std::max<size_t>(1, (kRaysPerTask * nRuns + n - 1) / n);
@@ -73,8 +77,8 @@ void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, con
             std::vector<glm::dvec3> ddirs;
             std::vector<float> tfars;
             std::vector<RayHit> res;
-            std::vector<uint32_t> hazedIdx;  // shading.haze: the task's shown pixels and their depths
-            std::vector<float> hazedZ;
+            std::vector<uint32_t> cols;  // hazeAtWrite: the run's colours and eye depths, hazed before they are written
+            std::vector<float> zs;
             uint64_t nh = 0;
             for (size_t r = br.begin(); r != br.end(); ++r) {
                 const size_t b = runs[r], m = runs[r + 1] - b;
@@ -83,12 +87,17 @@ void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, con
                 ddirs.resize(m);
                 res.resize(m);
                 if (fx.haze) tfars.resize(m);
+                if (hazeAtWrite) {
+                    cols.resize(m);
+                    zs.resize(m);
+                }
                 for (size_t k = 0; k < m; ++k) {
                     const uint32_t i = pixels[b + k];
                     ddirs[k] = gen.dir(int(i % W), int(i / W));
                     dirs[k] = glm::vec3(ddirs[k]);
-                    if (fx.haze) tfars[k] = hazeTfar(ddirs[k], fwd, zMax);
                 }
+                if (fx.haze)  // apart, so the compiler vectorises it
+                    for (size_t k = 0; k < m; ++k) tfars[k] = hazeTfar(dirs[k], fwdF, zMaxF);
                 scene.intersectMany(orgs.data(), dirs.data(), int(m), res.data(), 1e30f,
                                     fx.haze ? tfars.data() : nullptr, shading.tnear);
                 for (size_t k = 0; k < m; ++k) {
@@ -96,19 +105,23 @@ void castRuns(const RayScene& scene, const Camera& camera, PixelList pixels, con
                     const double z = h.hit ? double(h.t) * glm::dot(ddirs[k], fwd) : 0.0;
                     const bool shown = h.hit && !(fx.haze && z > zMax);
                     const glm::u8vec4 c = shown ? h.color : fx.sky(ddirs[k]);
-                    std::copy_n(&c[0], 4, &out.rgba[size_t(pixels[b + k]) * 4]);
+                    if (hazeAtWrite) {
+                        std::memcpy(&cols[k], &c[0], 4);
+                        zs[k] = shown ? float(z) : INFINITY;
+                    } else {
+                        std::copy_n(&c[0], 4, &out.rgba[size_t(pixels[b + k]) * 4]);
+                    }
                     if (shading.depth) shading.depth[b + k] = shown ? float(z) : INFINITY;
                     if (shading.keys)
                         shading.keys[b + k] = shown ? SurfaceKey{h.geomId, h.primId, h.instId} : SurfaceKey{};
                     if (hit) hit[b + k] = shown ? 1 : 0;
                     nh += shown ? 1 : 0;
-                    if (hazeAtWrite && shown) {
-                        hazedIdx.push_back(pixels[b + k]);
-                        hazedZ.push_back(float(z));
-                    }
+                }
+                if (hazeAtWrite) {
+                    haze(cols.data(), zs.data(), m);
+                    for (size_t k = 0; k < m; ++k) std::memcpy(&out.rgba[size_t(pixels[b + k]) * 4], &cols[k], 4);
                 }
             }
-            if (hazeAtWrite) hazeListed(fx, hazedIdx.data(), hazedIdx.size(), hazedZ.data(), out);
             hits.local() += nh;
         });
     });
@@ -154,9 +167,8 @@ PrimaryRays primaryRays(const Camera& camera, const glm::dvec3& frameOrigin, con
     r.dirs.resize(n);
     r.tfars.assign(n, 1e30f);
     for (size_t k = 0; k < n; ++k) {
-        const glm::dvec3 d = gen.dir(int(pixels[k] % W), int(pixels[k] / W));
-        r.dirs[k] = glm::vec3(d);
-        if (hazeFar > 0) r.tfars[k] = hazeTfar(d, fwd, hazeFar);
+        r.dirs[k] = glm::vec3(gen.dir(int(pixels[k] % W), int(pixels[k] / W)));
+        if (hazeFar > 0) r.tfars[k] = hazeTfar(r.dirs[k], glm::vec3(fwd), float(hazeFar));
     }
     return r;
 }
@@ -276,7 +288,7 @@ void raysStage(FarFrame& f, FarFieldMemory& m, const RayScene& rays, const FarFi
     const size_t n = f.trace.size();
     std::vector<uint8_t> hit(n, 0);
     const bool lattice = o.rayStep >= 2;
-    std::vector<float> depth(lattice || f.fx->haze || !f.farDepth.empty() ? n : 0);
+    std::vector<float> depth(lattice || !f.farDepth.empty() ? n : 0);
     RayCounts counts;
     uint64_t blended = 0, hits = 0, misses = 0;
     if (lattice) {

@@ -101,8 +101,8 @@ struct RayShading {
     // Rays start at this distance (metres, >= 0): the far field sets the near distance, since a
     // pixel the near field left uncovered has no surface nearer than it (nodes/near_far_split.h).
     float tnear = 0.0f;
-    // castPrimaryRays: every pixel that shows a surface is hazed as it is written (hazeListed, at
-    // its eye-plane depth; needs effects with haze), so no pass over the list follows.
+    // Every pixel that shows a surface is hazed as it is written (DepthHaze, at its eye-plane
+    // depth; needs effects with haze), so no pass over the pixels follows.
     bool haze = false;
 };
 

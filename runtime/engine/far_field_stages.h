@@ -209,9 +209,11 @@ uint64_t horizonStage(FarFrame& f, const HeightGrid* grid, const FarFieldOptions
 double culledRaysMs(const FarFrame& f, const RayScene& rays, const FarFieldOptions& o, uint64_t culled,
                     size_t sample = 512);
 // Far limit of a ray (unit direction d) that stops at eye-plane depth zMax
-// (haze: nothing beyond the visibility is traced).
-inline float hazeTfar(const glm::dvec3& d, const glm::dvec3& fwd, double zMax) {
-    return float(zMax / std::max(glm::dot(d, fwd), 1e-6)) * (1.0f + 1e-6f);
+// (haze: nothing beyond the visibility is traced). In float, with a margin of
+// 4e-6 of itself over float's rounding: a hit short of zMax is never cut
+// (the caller compares the hit's depth with zMax in double).
+inline float hazeTfar(const glm::vec3& d, const glm::vec3& fwd, float zMax) {
+    return zMax / std::max(glm::dot(d, fwd), 1e-6f) * (1.0f + 4e-6f);
 }
 // The horizon options of a frame (near distance, haze depth, subsampling while moving).
 HorizonOptions horizonOptions(const FarFieldOptions& o, bool moving);

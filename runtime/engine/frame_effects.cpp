@@ -42,7 +42,8 @@ glm::u8vec4 FrameEffects::applyHaze(const glm::u8vec4& c, double z) const {
 }
 
 glm::u8vec4 FrameEffects::sky(const glm::dvec3& dir) const {
-    return skyColor(std::asin(std::clamp(dir.z, -1.0, 1.0)), night);
+    if (!(dir.z > 0.0)) return skyColor(0.0, night);  // at and below the horizon: its colour, no asin
+    return skyColor(std::asin(std::min(dir.z, 1.0)), night);
 }
 
 }  // namespace vista

@@ -5,7 +5,6 @@
 
 #include "foundation/status.h"
 #include "foundation/timing.h"
-#include "runtime/engine/far_field_haze.h"
 
 namespace vista {
 
@@ -23,16 +22,15 @@ void raycastFrame(const RayScene& scene, const Camera& camera, Image& out, Frame
                   const FrameEffects& fx) {
     Stopwatch sw;
     RayCounts counts;
-    std::vector<float> depth(fx.haze ? size_t(camera.width) * size_t(camera.height) : 0);
     RayShading shading;
     shading.effects = &fx;
-    shading.depth = depth.empty() ? nullptr : depth.data();
+    shading.haze = true;  // each ray's pixel hazed as it is written: no pass over the frame follows
     castFrame(scene, camera, out, counts, threads, shading);
     stats.pixels.rayHit += counts.hits;
     stats.pixels.rayMiss += counts.rays - counts.hits;
     stats.raysCast += counts.rays;
     stats.stages.set(Stage::Rays, sw.ms());
-    if (!depth.empty()) hazeStage(fx, nullptr, depth.size(), depth.data(), out, stats, threads);
+    if (fx.haze) stats.effects.add(EffectId::Haze, 0.0);  // its time is the rays'
 }
 
 }  // namespace vista

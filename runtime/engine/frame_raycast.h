@@ -11,9 +11,9 @@
 //
 // raycastFrame(): the `raycast` render mode's frame, also the hybrid's frame
 // when its split picks ray casting: castFrame with the run-time effects of
-// `fx` (haze clips the rays and hazes every pixel by its eye-plane depth:
-// the haze stage), into `out` (resized to the camera), and the pixel
-// classes (rayHit, rayMiss), raysCast and the stages rays (and haze) in
+// `fx` (haze clips the rays and hazes every pixel by its eye-plane depth as
+// it is written), into `out` (resized to the camera), and the pixel classes
+// (rayHit, rayMiss), raysCast, the rays stage and the effects that ran in
 // `stats`. One implementation, so the two frames are the same bytes.
 #pragma once
 #include "runtime/engine/far_field_rays.h"

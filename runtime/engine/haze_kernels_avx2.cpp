@@ -2,13 +2,12 @@
 // with -mavx2 on x86-64 only. Nothing here runs unless hazeKernels() found
 // AVX2 on the CPU (the table below is constant data: no code runs to make it).
 #ifdef __AVX2__
-#define VISTA_HAZE_KERNELS_DEFINE
-#include "runtime/engine/haze_kernels.h"
+#include "runtime/engine/haze_kernels_impl.h"
 
 namespace vista {
 
 namespace {
-constexpr HazeKernels kAvx2{hazeWindowKernel, hazeDepthKernel, transmittanceKernel};
+constexpr HazeKernels kAvx2{hazeWindowKernel, hazeDepthKernel};
 }  // namespace
 
 const HazeKernels* hazeKernelsAvx2Table() { return &kAvx2; }

@@ -344,7 +344,8 @@ TEST(Hybrid, EndPointsAreTheFramesOfTheirModes) {
         EXPECT_EQ(s0.pixels.covered, 0u);
         EXPECT_EQ(s0.raysCast, rs.raysCast);
         EXPECT_EQ(s0.pixels.rayHit, rs.pixels.rayHit);
-        EXPECT_EQ(s0.stages.ran(Stage::Haze), haze);
+        EXPECT_EQ(s0.effects.ran(EffectId::Haze), haze);
+        EXPECT_EQ(rs.effects.ran(EffectId::Haze), haze);
 
         // Everything near: the full frame.
         ctx.options.nearDistance = std::numeric_limits<double>::infinity();
