@@ -121,15 +121,19 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
     // The horizon beginFrame started is this frame's, used or not: consumed here (its
     // destructor waits for the task if no stage took it).
     std::future<HorizonResult> early = std::move(_mem->earlyHorizon);
+    CoveredHaze haze;  // beside the stages below, until the ray stage
+    haze.start(f, _options);
+    auto finishHaze = [&] {
+        haze.finish(stats);
+        writeSeamHits(f);
+    };
     // The seam check applies when something is covered: its candidates are listed by the opacity pass.
     const bool seam = seamCheckApplies(f, _rays, _options);
     opacityStage(f, stats, seam ? seamListDepth(f, _options) : 2.0f);
     if (seam && f.covered > 0) seamStage(f, _rays, _options, stats);
-    CoveredHaze haze;  // beside the stages below; done before the composite reads the frame
-    haze.start(f, _options);
     stats.pixels.covered += f.covered;
     if (f.covered == f.pixelCount) {  // no sky, no far field visible: nothing else runs
-        haze.finish(stats);
+        finishHaze();
         return;
     }
 
@@ -137,7 +141,7 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
     if (!farGeometryExists(_rays, _grid, camera, _options)) {
         stats.notes.push_back("rays off: no far geometry beyond the near distance");
         cullAllPending(f, stats);
-        haze.finish(stats);
+        finishHaze();
         compositeStage(f, *_mem, false, stats);
         return;
     }
@@ -192,7 +196,7 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
         bypassCache(f);
     }
     _mem->lastFrameCached = cacheRan;
-    haze.finish(stats);  // the rays have both cores, and their timing prices a far pixel
+    finishHaze();  // the rays have both cores, and their timing prices a far pixel
     if (!f.trace.empty()) {
         const double before = stats.stages.ms(Stage::Rays);
         raysStage(f, *_mem, _rays, _options, stats);

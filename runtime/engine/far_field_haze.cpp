@@ -103,18 +103,10 @@ void hazeListed(const FrameEffects& fx, const uint32_t* pixels, size_t n, const 
 }
 
 void hazeCoveredRows(const HazeKernels& k, PixelWord* px, const float* depth, size_t width, size_t y0, size_t y1,
-                     const uint32_t* skip, size_t nSkip, float invA, float b, const HazeTableView& table,
-                     const HazeParams& h) {
-    const uint32_t* skipEnd = skip + nSkip;
-    const uint32_t* next = std::lower_bound(skip, skipEnd, uint32_t(y0 * width));
-    const size_t from = y0 * width, to = y1 * width;
-    // The rows as one span, cut at each seam hit (the kernel leaves uncovered pixels alone).
-    size_t start = from;
-    for (; next != skipEnd && *next < to; ++next) {
-        if (*next > start) k.window(px + start, depth + start, *next - start, invA, b, table, h);
-        start = size_t(*next) + 1;
-    }
-    if (to > start) k.window(px + start, depth + start, to - start, invA, b, table, h);
+                     float invA, float b, const HazeTableView& table, const HazeParams& h) {
+    // The rows as one span (the kernel leaves uncovered pixels alone).
+    const size_t from = y0 * width;
+    k.window(px + from, depth + from, (y1 - y0) * width, invA, b, table, h);
 }
 
 namespace {
@@ -163,11 +155,8 @@ HazeTableView hazeTable(float beta) {
 }
 
 void CoveredHaze::start(const FarFrame& f, const FarFieldOptions& o) {
-    if (!o.hazeCovered || !o.effects.haze || !f.depth || f.covered == 0) return;
+    if (!o.hazeCovered || !o.effects.haze || !f.depth) return;
     _started = true;
-    _seamHits.clear();
-    for (const uint32_t i : f.seamCandidates)
-        if (f.cls[i] != kFarCovered) _seamHits.push_back(i);
     // Eye depth of window depth d: z = a / (b - d) (eyeDepthOfWindowDepth
     // rearranged; infinite far plane: a = n, b = 1), in float: its relative
     // error (1e-7) is far below an 8-bit step.
@@ -183,8 +172,7 @@ void CoveredHaze::start(const FarFrame& f, const FarFieldOptions& o) {
         Stopwatch sw;
         const HazeKernels& kernels = hazeKernels();
         tbb::parallel_for(tbb::blocked_range<size_t>(0, H, 16), [&](const tbb::blocked_range<size_t>& r) {
-            hazeCoveredRows(kernels, px, depth, W, r.begin(), r.end(), _seamHits.data(), _seamHits.size(), invA, b,
-                            table, h);
+            hazeCoveredRows(kernels, px, depth, W, r.begin(), r.end(), invA, b, table, h);
         });
         _ms = sw.ms();
     };

@@ -82,8 +82,8 @@ void seamStage(FarFrame& f, const RayScene& rays, const FarFieldOptions& o, Fram
             f.cls[i] = kFarRayHit;
             // Eye-plane depth of the hit for haze (the seam lies within the near distance).
             const glm::dvec3 d = f.rays.dir(int(i % W), int(i / W));
-            f.out.set(int(i % W), int(i / W),
-                      f.fx->applyHaze(res[k].color, double(res[k].t) * glm::dot(d, f.camera.forward())));
+            f.seamHits.emplace_back(i,
+                                    f.fx->applyHaze(res[k].color, double(res[k].t) * glm::dot(d, f.camera.forward())));
             ++replaced;
         }
         f.covered -= replaced;
@@ -91,6 +91,12 @@ void seamStage(FarFrame& f, const RayScene& rays, const FarFieldOptions& o, Fram
         stats.raysCast += check.size();
     }
     stats.stages.add(Stage::Seam, sw.ms());
+}
+
+void writeSeamHits(FarFrame& f) {
+    const uint32_t W = uint32_t(f.width);
+    for (const auto& [i, c] : f.seamHits) f.out.set(int(i % W), int(i / W), c);
+    f.seamHits.clear();
 }
 
 }  // namespace vista

@@ -13,6 +13,7 @@
 #include <future>
 #include <memory>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -130,10 +131,13 @@ struct FarFrame {
     std::vector<uint8_t> columnNeeded;     // per column: has a pending pixel (opacity)
     uint64_t covered = 0;                  // pixels of class covered (opacity, seam)
     std::vector<uint32_t> seamCandidates;  // covered pixels the seam check examines (opacity)
-    std::vector<uint32_t> pending;         // pending pixels after the horizon, ascending
-    std::vector<uint32_t> trace;           // pixels to trace this frame, ascending (cache)
-    std::vector<int64_t> traceCells;       // their panorama cells (cache stage only)
-    std::vector<glm::u8vec2> traceSubs;    // where their rays fall in those cells (cache stage only)
+    // The seam's hits and their hazed colours, written by writeSeamHits (the covered haze may
+    // still be reading and writing those pixels while the seam casts).
+    std::vector<std::pair<uint32_t, glm::u8vec4>> seamHits;
+    std::vector<uint32_t> pending;       // pending pixels after the horizon, ascending
+    std::vector<uint32_t> trace;         // pixels to trace this frame, ascending (cache)
+    std::vector<int64_t> traceCells;     // their panorama cells (cache stage only)
+    std::vector<glm::u8vec2> traceSubs;  // where their rays fall in those cells (cache stage only)
     std::vector<float>
         farDepth;  // cache mode: per pending pixel, eye-plane depth of its far colour (+inf = sky/none); others unset
 };
@@ -153,24 +157,26 @@ float seamListDepth(const FarFrame& f, const FarFieldOptions& o);
 bool seamCheckApplies(const FarFrame& f, const RayScene& rays, const FarFieldOptions& o);
 // In: seamCandidates, depth, o.nearDistance, o.depthZFar, camera.zNear. Every candidate
 // pixel whose surface lies beyond the near distance casts one ray with tfar =
-// that distance: a hit turns it rayHit (colour written, covered decremented,
-// pixels.rayHit counted), a miss leaves it covered. Every such ray, hit or
-// miss, is added to raysCast. Records Seam.
+// that distance: a hit turns it rayHit (covered decremented, pixels.rayHit
+// counted, its hazed colour listed in seamHits), a miss leaves it covered.
+// Every such ray, hit or miss, is added to raysCast. Records Seam.
 void seamStage(FarFrame& f, const RayScene& rays, const FarFieldOptions& o, FrameStats& stats);
+// Writes the seam's hits (seamHits) into out; after the covered haze is done.
+void writeSeamHits(FarFrame& f);
 
 // Haze of the covered pixels (far_field_haze.cpp), run when o.hazeCovered,
-// haze is on and depth exists: every pixel still covered after the seam stage
-// (window depth < 1, not a seam hit) gets the haze of its eye-plane depth
-// (from depth, camera.zNear, o.depthZFar), the blend of
-// FrameEffects::applyHaze. start(), after the seam stage (the last stage that
-// turns a covered pixel into another class), runs it as a task beside the
-// later stages: they write only pixels that are not covered, it writes only
-// covered ones, and it reads the depth buffer, which nothing writes, so the
-// work fills the cores the serial stages (opacity, horizon, the cache's
-// lookups) leave idle. finish() waits for it (before anything reads a covered
-// pixel's colour) and records Haze (stage and effect: the task's own wall
-// time). With o.threads > 0 (each stage in an arena of its own) it runs within
-// start(). The destructor waits.
+// haze is on and depth exists: every pixel the near field drew (window depth
+// < 1) gets the haze of its eye-plane depth (from depth, camera.zNear,
+// o.depthZFar), the blend of FrameEffects::applyHaze. start(), before the
+// opacity stage, runs it as a task beside the stages up to the ray stage:
+// they write only pixels that are not covered (the seam's hits wait in
+// seamHits), it writes only covered ones, and it reads the depth buffer,
+// which nothing writes, so the work fills the core the serial stages
+// (opacity, seam, horizon, the cache's lookups) leave idle. finish() waits
+// for it (before anything reads a covered pixel's colour or writes a seam
+// hit) and records Haze (stage and effect: the task's own wall time). With
+// o.threads > 0 (each stage in an arena of its own) it runs within start().
+// The destructor waits.
 class CoveredHaze {
 public:
     CoveredHaze() = default;
@@ -182,7 +188,6 @@ public:
 
 private:
     tbb::task_group _group;
-    std::vector<uint32_t> _seamHits;  // ascending pixel indices
     double _ms = 0;
     bool _started = false;
 };

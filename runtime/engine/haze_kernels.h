@@ -53,12 +53,11 @@ struct HazeKernels {
 // The kernels for this CPU.
 const HazeKernels& hazeKernels();
 // The covered pixels of rows [y0, y1) of a frame `width` pixels wide, hazed by
-// k.window: the pixels of window depth < 1 (the opacity stage's rule) less the
-// pixels listed in skip (ascending indices y * width + x). No other pixel is
-// read or written. Eye depth of window depth d: a / (b - d), invA = 1 / a.
+// k.window: the pixels of window depth < 1 (the opacity stage's rule). No
+// other pixel is read or written. Eye depth of window depth d: a / (b - d),
+// invA = 1 / a.
 void hazeCoveredRows(const HazeKernels& k, PixelWord* px, const float* depth, size_t width, size_t y0, size_t y1,
-                     const uint32_t* skip, size_t nSkip, float invA, float b, const HazeTableView& table,
-                     const HazeParams& h);
+                     float invA, float b, const HazeTableView& table, const HazeParams& h);
 // The table for extinction beta > 0 (1/m): made once per extinction and kept
 // (the last few); thread-safe.
 HazeTableView hazeTable(float beta);

@@ -18,6 +18,7 @@
 #include "citygen/lighting.h"
 #include "runtime/engine/far_field.h"
 #include "runtime/engine/far_field_rays.h"
+#include "runtime/engine/far_field_stages.h"
 #include "runtime/engine/frame_raycast.h"
 #include "runtime/engine/horizon.h"
 #include "runtime/engine/metrics.h"
@@ -385,6 +386,58 @@ TEST(FarFieldFrame, HazeOfCoveredPixelsMatchesTheFormulaAtTheirDepth) {
             if (ff.classification()[i] == kFarCovered) {
                 ASSERT_EQ(std::memcmp(&plain.rgba[i * 4], &in.rgba[i * 4], 4), 0);
             }
+    }
+}
+
+// Under haze the seam's hits show their own ray's colour hazed once at the
+// hit's eye depth, while the covered pixels around them are hazed by the
+// covered pass running beside the seam (task and calling-thread paths): no
+// seam hit keeps the near field's colour or is hazed twice.
+TEST(FarFieldFrame, HazedSeamHitsShowTheirRayHazedOnce) {
+    const TestCity t = testCity(3, 60);
+    ASSERT_TRUE(t.rays);
+    const Camera c = cam(glm::dvec3(0, -150, 1.7), 0.3);
+    const double nearD = 30.0, zFar = 80.0;
+    for (int threads : {0, 1}) {
+        Image in;
+        const std::vector<float> depth = fakeNearField(*t.rays, c, 70.0, zFar, in);
+        FarFieldOptions o;
+        o.nearDistance = nearD;
+        o.depthZFar = zFar;
+        o.hazeCovered = true;
+        o.threads = threads;
+        o.effects.haze = true;
+        o.effects.visibility = 150.0;
+        FarField ff(*t.rays, &t.grid, o);
+        Image out = in;
+        FrameStats st;
+        ff.render(c, depth.data(), out, st);
+        const glm::vec3 org(c.eye - t.rays->frameOrigin());
+        const glm::dvec3 fwd = c.forward();
+        uint64_t seamHits = 0, covered = 0;
+        for (int y = 0; y < c.height; ++y)
+            for (int x = 0; x < c.width; ++x) {
+                const size_t i = size_t(y) * size_t(c.width) + size_t(x);
+                if (!(depth[i] < 1.0f)) continue;
+                const glm::u8vec4 got = out.at(x, y);
+                glm::u8vec4 want;
+                if (ff.classification()[i] == kFarRayHit) {
+                    const glm::dvec3 d = c.rayDirection(x + 0.5, y + 0.5);
+                    const RayHit h = t.rays->intersect(org, glm::vec3(d));
+                    ASSERT_TRUE(h.hit);
+                    want = o.effects.applyHaze(h.color, double(h.t) * glm::dot(d, fwd));
+                    ++seamHits;
+                } else {
+                    ASSERT_EQ(ff.classification()[i], kFarCovered);
+                    want = o.effects.applyHaze(in.at(x, y), eyeDepthOfWindowDepth(double(depth[i]), c.zNear, zFar));
+                    ++covered;
+                }
+                for (int k = 0; k < 3; ++k)
+                    ASSERT_LE(std::abs(int(got[k]) - int(want[k])), 1)
+                        << "threads " << threads << " pixel " << x << "," << y << " channel " << k;
+            }
+        EXPECT_GT(seamHits, 20u) << threads;
+        EXPECT_GT(covered, 100u) << threads;
     }
 }
 
