@@ -106,7 +106,10 @@ Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene
     run->plainCount = run->modes.size();
     if (cfg.alsoClear) {
         run->clearCtx = run->ctx;  // shares the near field and the bakes the modes above built
+        // No run-time effect, as `--effects none` gives: the scene's glass marks are still in its
+        // pictures (and cleared there), so both sides pay for finding them.
         run->clearCtx.options.effects = FrameEffects{};
+        run->clearCtx.options.effects.glassMarked = run->ctx.options.effects.glassMarked;
         for (const auto& name : cfg.modes) VISTA_RETURN_IF_ERROR(add(name, run->clearCtx, clearTwinName(name)));
     }
     return run;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include <tbb/parallel_for.h>
@@ -19,6 +20,23 @@ namespace {
 
 bool marked(uint8_t a) { return a < 255 && a >= kGlassAlpha - 1; }
 float coverage(uint8_t a) { return std::min(1.0f, float(255 - a) / float(255 - kGlassAlpha)); }
+
+// marked() on a pixel's 32-bit word (alpha in the top byte), as one unsigned compare: the
+// loops over the frame's words vectorise.
+inline uint32_t markedWord(uint32_t w) {
+    return uint32_t((w >> 24) - uint32_t(kGlassAlpha - 1) < uint32_t(255 - (kGlassAlpha - 1)));
+}
+inline uint32_t wordAt(const Image& img, size_t i) {
+    uint32_t w;
+    std::memcpy(&w, &img.rgba[i * 4], 4);
+    return w;
+}
+
+size_t countMarks(const Image& img) {
+    size_t n = 0;
+    for (size_t i = 0, N = img.rgba.size() / 4; i < N; ++i) n += markedWord(wordAt(img, i));
+    return n;
+}
 
 void clearMarks(Image& img) {
     for (size_t i = 3; i < img.rgba.size(); i += 4) img.rgba[i] = 255;
@@ -37,25 +55,24 @@ size_t blocksAt(const std::vector<uint32_t>& glass, int W, int s) {
 
 }  // namespace
 
-bool hasGlassPixels(const Image& img) {
-    for (size_t i = 3; i < img.rgba.size(); i += 4)
-        if (marked(img.rgba[i])) return true;
-    return false;
-}
+bool hasGlassPixels(const Image& img) { return countMarks(img) > 0; }
 
 void reflectionStage(const RayScene* rays, const Camera& camera, const FrameEffects& fx, Image& img,
                      FrameStats& stats) {
     const int W = img.width, H = img.height;
-    std::vector<uint32_t> glass;
-    for (size_t i = 0, n = size_t(W) * size_t(H); i < n; ++i)
-        if (marked(img.rgba[i * 4 + 3])) glass.push_back(uint32_t(i));
-    if (glass.empty()) return;  // nothing of it on screen: costs nothing more
-    stats.glassPixels += glass.size();
+    // One vectorised count first: most frames of a run without reflections only clear the marks.
+    const size_t marks = countMarks(img);
+    if (marks == 0) return;  // nothing of it on screen: costs nothing more
+    stats.glassPixels += marks;
     if (!fx.glass || fx.rayBudget <= 0 || !rays || camera.width != W || camera.height != H) {
         clearMarks(img);
         if (fx.glass) stats.notes.push_back("reflections off: ray budget 0 or no ray scene");
         return;
     }
+    std::vector<uint32_t> glass;
+    glass.reserve(marks);
+    for (size_t i = 0, n = size_t(W) * size_t(H); i < n; ++i)
+        if (marked(img.rgba[i * 4 + 3])) glass.push_back(uint32_t(i));
     Stopwatch sw;
     // Every stride below sqrt(glass / budget) has more blocks than the budget
     // (a block holds at most s^2 pixels): start there, then step up.
