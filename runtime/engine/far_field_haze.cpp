@@ -57,23 +57,10 @@ void recordHaze(double ms, FrameStats& stats) {
 }  // namespace
 
 void hazeStage(const FrameEffects& fx, const uint32_t* pixels, size_t n, const float* depth, Image& out,
-               FrameStats& stats, int threads) {
+               FrameStats& stats) {
     if (!fx.haze || n == 0) return;
     Stopwatch sw;
-    if (!pixels) {
-        // The whole frame in order: spans on the arena's threads.
-        const HazeParams h = hazeParams(fx);
-        const HazeTableView table = hazeTable(h.beta);
-        const HazeKernels& kernels = hazeKernels();
-        PixelWord* px = reinterpret_cast<PixelWord*>(out.rgba.data());
-        inArena(threads, [&] {
-            tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16384), [&](const tbb::blocked_range<size_t>& r) {
-                kernels.depth(px + r.begin(), depth + r.begin(), r.end() - r.begin(), table, h);
-            });
-        });
-    } else {
-        hazeListed(fx, pixels, n, depth, out);
-    }
+    hazeListed(fx, pixels, n, depth, out);
     recordHaze(sw.ms(), stats);
 }
 

@@ -1,16 +1,13 @@
 // Haze stage: FrameEffects::applyHaze over pixels whose eye-plane depth is
-// known (the far field's traced pixels, a frame of depths), with the
-// transmittance read from a table over the reciprocal depth (HazeTableView:
-// within one level of applyHaze). The whole frame (a null list) is hazed in
-// spans on `threads` workers (0 = the caller's arena; bench_far_field's
-// BM_HazeWholeFrame times it).
+// known (the far field's lattice of traced pixels), with the transmittance
+// read from a table over the reciprocal depth (HazeTableView: within one
+// level of applyHaze) and blended in fixed point.
 //
-// hazeStage(): hazes the n listed pixels (indices y * width + x; a null list
-// = the first n pixels of the image in order) at their eye-plane depth
-// (depth[k] for entry k, metres; +inf = sky, left alone). Records
-// Stage::Haze and the haze effect when fx.haze and n > 0; else does nothing.
-// Contract: every listed index < out's pixel count. A list is hazed on the
-// calling thread; thread-safe for distinct outputs.
+// hazeStage(): hazes the n listed pixels (indices y * width + x) at their
+// eye-plane depth (depth[k] for entry k, metres; +inf = sky, left alone) on
+// the calling thread. Records Stage::Haze and the haze effect when fx.haze
+// and n > 0; else does nothing. Contract: every listed index < out's pixel
+// count. Thread-safe for distinct outputs.
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -23,7 +20,7 @@
 namespace vista {
 
 void hazeStage(const FrameEffects& fx, const uint32_t* pixels, size_t n, const float* depth, Image& out,
-               FrameStats& stats, int threads = 0);
+               FrameStats& stats);
 // The list pass of hazeStage without its records: the n pixels
 // out[pixels[k]] hazed at eye depth depth[k] (+inf: left alone), on the
 // calling thread. Does nothing without fx.haze.
@@ -32,8 +29,8 @@ void hazeListed(const FrameEffects& fx, const uint32_t* pixels, size_t n, const 
 // The haze of fx for a caller that hazes pixels as it writes them (the ray
 // casts with RayShading::haze): (px, depth, n) hazes the n RGBA8 words px[k]
 // at eye depth depth[k] (+inf: left alone) on the calling thread, as
-// hazeStage would. Made once per frame (it looks up the table); does nothing
-// without fx.haze.
+// hazeStage would (bench_far_field's BM_HazeAtDepth times it over a frame).
+// Made once per frame (it looks up the table); does nothing without fx.haze.
 class DepthHaze {
 public:
     explicit DepthHaze(const FrameEffects& fx);
