@@ -88,7 +88,12 @@ constexpr double kProbeMinRays = 300;
 // work on the machine do not move it, few enough that it follows the path.
 constexpr size_t kKindWindow = 8;
 
-double coreCount() { return double(std::max(1u, std::thread::hardware_concurrency())); }
+// Read once: std::thread::hardware_concurrency() reads a file of the system on every call
+// (about 6 us here), and the split prices ray casting with it several times a frame.
+double coreCount() {
+    static const double n = double(std::max(1u, std::thread::hardware_concurrency()));
+    return n;
+}
 
 void pushWindow(std::vector<std::pair<double, double>>& w, std::pair<double, double> s, int window) {
     w.push_back(s);
