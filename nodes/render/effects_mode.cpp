@@ -39,13 +39,12 @@ public:
     double lastRayStart() const override { return _inner->lastRayStart(); }
     const RasterSelection* lastRaster() const override { return _inner->lastRaster(); }
     bool hazesRasterPixels() const override { return _inner->hazesRasterPixels(); }
-    bool hazesViewerPixels() const override { return _inner->hazesViewerPixels(); }
     bool drawsSky() const override { return _inner->drawsSky(); }
     osg::Node* viewerScene() override {
         if (!_viewer) {
             _viewer = new osg::Group;
             _viewer->setName("vista.effects");
-            applyEffectsState(*_viewer->getOrCreateStateSet(), _ctx.options.effects, !_inner->hazesViewerPixels());
+            applyEffectsState(*_viewer->getOrCreateStateSet(), _ctx.options.effects, !_inner->hazesRasterPixels());
             _viewer->addChild(_inner->viewerScene());
             if (_ctx.options.effects.glassMarked) {
                 _reflect = new ReflectionDrawable(_ctx.rays, &_ctx.options.effects);
@@ -61,7 +60,7 @@ public:
     double beginViewerFrame(const Camera& camera) override {
         if (_viewer)
             applyEffectsState(*_viewer->getOrCreateStateSet(), _ctx.options.effects,
-                              !_inner->hazesViewerPixels());  // live toggles
+                              !_inner->hazesRasterPixels());  // live toggles
         return effectsFarPlane(_inner->beginViewerFrame(camera), _ctx.options.effects);
     }
     FrameStats lastViewerStats() const override {

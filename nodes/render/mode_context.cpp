@@ -5,10 +5,8 @@
 #include "foundation/timing.h"
 #include "nodes/baked_file.h"
 #include "nodes/render/city_stream.h"
-#include "nodes/render/effects_state.h"
 #include "nodes/render/offscreen.h"
 #include "nodes/view_cell_switch.h"
-#include "runtime/engine/far_field_haze.h"
 
 namespace vista {
 
@@ -56,17 +54,6 @@ Status GraphMode::renderFrame(const Camera& camera, Image& out, FrameStats& stat
     const double zFar = prepare(camera);
     VISTA_RETURN_IF_ERROR(_ctx.renderer->render(_graph.get(), camera, zFar, &out, nullptr, stats));
     describe(stats);
-    return Status::ok();
-}
-
-Status renderWholeCityHazed(ModeContext& ctx, const Camera& camera, Image& out, std::vector<float>& depth,
-                            FrameStats& stats) {
-    const FrameEffects& fx = ctx.options.effects;
-    ctx.renderer->setEffects(fx, /*hazeInRaster=*/false);
-    VISTA_RETURN_IF_ERROR(ctx.renderer->render(ctx.chunkedCity(), camera, 0.0, &out, &depth, stats));
-    // The projection the renderer used: its far plane is the haze's (effectsFarPlane).
-    stats.frameMs +=
-        hazeDrawnFrame(fx, camera.zNear, effectsFarPlane(0.0, fx), depth.data(), out, stats, ctx.options.threads);
     return Status::ok();
 }
 

@@ -15,17 +15,9 @@ public:
     }
     std::string name() const override { return "full"; }
     const RasterSelection* lastRaster() const override { return &_raster; }
-    // Haze: on the CPU from the read-back depth in the bench face, the haze program in the viewer.
-    Status renderFrame(const Camera& camera, Image& out, FrameStats& stats) override {
-        if (!_ctx.options.effects.haze || !_ctx.renderer) return GraphMode::renderFrame(camera, out, stats);
-        return renderWholeCityHazed(_ctx, camera, out, _depth, stats);
-    }
-    bool hazesRasterPixels() const override { return true; }
-    bool hazesViewerPixels() const override { return false; }
 
 private:
-    RasterSelection _raster;    // every chunk, infinite far plane
-    std::vector<float> _depth;  // read-back scratch under haze
+    RasterSelection _raster;  // every chunk, infinite far plane
 };
 
 }  // namespace

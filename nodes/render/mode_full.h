@@ -8,8 +8,6 @@
 // state, so the picture is the unchunked city's (tested: identical from the
 // street; depth ties of far coplanar surfaces may resolve otherwise, >= 50 dB
 // from 500 m above; see near_field_chunks.h).
-// Under haze the bench frame reads the depth back and hazes on the CPU
-// (renderWholeCityHazed), the viewer draws with the haze program.
 // Set-up: "chunking" (shared with near, osglod and hybrid). Viewer: the same
 // graph and far plane.
 #pragma once

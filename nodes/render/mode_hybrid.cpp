@@ -182,8 +182,7 @@ private:
     // The split's end points are the modes they stand for, at their cost: ray casting (0 m) is
     // the `raycast` frame (no GL pass, no read-back, no far-field stage: raycastFrame), and
     // everything near is the `full` frame (the chunked city in its draw order, infinite far
-    // plane but for haze, sky layer; under haze the depth read back and the drawn pixels hazed
-    // from it, renderWholeCityHazed; no far field).
+    // plane but for haze, sky layer, haze in the rasteriser; no read-back, no far field).
     Status endPointFrame(const Camera& camera, double nearD, Stopwatch& sw, Image& out, FrameStats& stats) {
         stats.stages.set(Stage::Cull, sw.ms());  // the split's decision
         const FrameEffects& fx = _ctx.options.effects;
@@ -195,11 +194,12 @@ private:
             _raster.zFar = 0.0;
             _raster.nearDistance = 0.0;
         } else {
+            if (fx.haze) _ctx.renderer->setEffects(fx, /*hazeInRaster=*/true);
             FrameStats ns;
-            VISTA_RETURN_IF_ERROR(fx.haze ? renderWholeCityHazed(_ctx, camera, out, _depth, ns)
-                                          : _ctx.renderer->render(_ctx.chunkedCity(), camera, 0.0, &out, nullptr, ns));
+            const Status s = _ctx.renderer->render(_ctx.chunkedCity(), camera, 0.0, &out, nullptr, ns);
+            if (fx.haze) _ctx.renderer->setEffects(fx, false);
+            VISTA_RETURN_IF_ERROR(s);
             ns.stages.forEach([&](Stage st, double ms) { stats.stages.set(st, ms); });
-            ns.effects.forEach([&](EffectId e, double ms) { stats.effects.add(e, ms); });
             stats.stages.set(Stage::Near, ns.frameMs);
             stats.cullMs = ns.cullMs;
             stats.drawMs = ns.drawMs;
@@ -215,11 +215,11 @@ private:
         stats.frameMs = sw.ms();
         if (autoSplit()) {
             stats.notes.push_back(nearAutoNote(nearD));
-            // Every whole-city frame joins the raster fit, with haze too (its time then holds the
-            // depth read-back and the haze pass): without these frames the fit sees only middle
-            // distances, its slope comes out low (0.041 against 0.069 ms per thousand triangles
-            // on one path) and the split drifts to larger near distances under haze than without
-            // it. The kind's correction learns the rest.
+            // Every whole-city frame joins the raster fit, with haze too (drawn with the haze
+            // program, which the near field's draw does not run): without these frames the fit
+            // sees only middle distances, its slope comes out low (0.041 against 0.069 ms per
+            // thousand triangles on one path) and the split drifts to larger near distances under
+            // haze than without it. The kind's correction learns the rest.
             if (rasterMs > 0) _adaptive->record(tris, rasterMs, 0, 0.0, 0.0);
             _adaptive->recordFrame(nearD, stats.frameMs);
         }

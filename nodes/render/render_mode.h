@@ -186,11 +186,9 @@ public:
     }
     // What the last viewer frame did (pixel classes, stage times, notes) for the HUD.
     virtual FrameStats lastViewerStats() const { return FrameStats(); }
-    // True when the mode hazes its drawn pixels itself in renderFrame(): the
+    // True when the mode hazes its drawn pixels itself (both faces): the
     // effects wrapper then keeps the haze program out of the rasteriser.
     virtual bool hazesRasterPixels() const { return false; }
-    // The same for the viewer face (its scene graph drawn in a window).
-    virtual bool hazesViewerPixels() const { return hazesRasterPixels(); }
     // True when the mode writes every pixel its GL pass leaves uncovered, sky
     // included (hybrid: every such pixel is classified and filled by the far
     // field): the sky layer under its GL pass is not drawn (both faces).
@@ -236,17 +234,6 @@ protected:
     ModeContext& _ctx;
     osg::ref_ptr<osg::Node> _graph;  // set by the mode's constructor
 };
-
-// The whole chunked city (ModeContext::chunkedCity(), sky layer, far plane at
-// infinity but for haze) with the run-time haze done on the CPU from the depth
-// read back (hazeDrawnFrame: one table for every hazed pixel) instead of the
-// haze program per fragment, which on a software rasteriser costs several
-// times as much: `full`'s frame and the hybrid's "everything" end point under
-// haze, one implementation, so the two are the same bytes. Leaves the
-// renderer's effects without the haze program; `depth` is scratch. The haze
-// time is part of stats.frameMs.
-Status renderWholeCityHazed(ModeContext& ctx, const Camera& camera, Image& out, std::vector<float>& depth,
-                            FrameStats& stats);
 
 // ---- the registry ------------------------------------------------------------
 using ModeFactory = Result<std::unique_ptr<RenderMode>> (*)(ModeContext& ctx);

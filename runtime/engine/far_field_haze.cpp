@@ -8,7 +8,6 @@
 #include <cstring>
 #include <memory>
 #include <mutex>
-#include <utility>
 #include <vector>
 
 #include <tbb/parallel_for.h>
@@ -63,39 +62,6 @@ void hazeStage(const FrameEffects& fx, const uint32_t* pixels, size_t n, const f
     Stopwatch sw;
     hazeListed(fx, pixels, n, depth, out);
     recordHaze(sw.ms(), stats);
-}
-
-namespace {
-
-// Eye depth of window depth d: z = a / (b - d) (eyeDepthOfWindowDepth
-// rearranged; infinite far plane: a = n, b = 1), in float: its relative
-// error (1e-7) is far below an 8-bit step. Returns (1 / a, b).
-std::pair<float, float> windowDepthToU(double zn, double zf) {
-    const float a = float(zf > 0 ? zn * zf / (zf - zn) : zn), b = float(zf > 0 ? zf / (zf - zn) : 1.0);
-    return {1.0f / a, b};
-}
-
-}  // namespace
-
-double hazeDrawnFrame(const FrameEffects& fx, double zNear, double zFar, const float* depth, Image& out,
-                      FrameStats& stats, int threads) {
-    if (!fx.haze) return 0.0;
-    Stopwatch sw;
-    const std::pair<float, float> ab = windowDepthToU(zNear, zFar);
-    const float invA = ab.first, b = ab.second;
-    const HazeParams h = hazeParams(fx);
-    const HazeTableView table = hazeTable(h.beta);
-    const HazeKernels& kernels = hazeKernels();
-    const size_t W = size_t(out.width), H = size_t(out.height);
-    PixelWord* px = reinterpret_cast<PixelWord*>(out.rgba.data());
-    inArena(threads, [&] {
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, H, 16), [&](const tbb::blocked_range<size_t>& r) {
-            hazeCoveredRows(kernels, px, depth, W, r.begin(), r.end(), invA, b, table, h);
-        });
-    });
-    const double ms = sw.ms();
-    recordHaze(ms, stats);
-    return ms;
 }
 
 DepthHaze::DepthHaze(const FrameEffects& fx)
@@ -178,9 +144,13 @@ HazeTableView hazeTable(float beta) {
 void CoveredHaze::start(const FarFrame& f, const FarFieldOptions& o) {
     if (!o.hazeCovered || !o.effects.haze || !f.depth) return;
     _started = true;
-    const std::pair<float, float> ab = windowDepthToU(f.camera.zNear, o.depthZFar);
-    const float invA = ab.first, b = ab.second;
+    // Eye depth of window depth d: z = a / (b - d) (eyeDepthOfWindowDepth
+    // rearranged; infinite far plane: a = n, b = 1), in float: its relative
+    // error (1e-7) is far below an 8-bit step.
+    const double zn = f.camera.zNear, zf = o.depthZFar;
+    const float a = float(zf > 0 ? zn * zf / (zf - zn) : zn), b = float(zf > 0 ? zf / (zf - zn) : 1.0);
     const HazeParams h = hazeParams(o.effects);
+    const float invA = 1.0f / a;
     const HazeTableView table = hazeTable(h.beta);
     const size_t W = size_t(f.width), H = size_t(f.height);
     PixelWord* px = reinterpret_cast<PixelWord*>(f.out.rgba.data());

@@ -26,15 +26,6 @@ void hazeStage(const FrameEffects& fx, const uint32_t* pixels, size_t n, const f
 // calling thread. Does nothing without fx.haze.
 void hazeListed(const FrameEffects& fx, const uint32_t* pixels, size_t n, const float* depth, Image& out);
 
-// The haze of a drawn frame: every pixel of window depth < 1 (from a
-// projection with near plane zNear and far plane zFar, 0 = infinite) hazed at
-// its eye depth, as the far field hazes its covered pixels; pixels of depth 1
-// (sky) are left alone. In spans on `threads` workers (0 = the caller's
-// arena). Records Stage::Haze and the haze effect; returns its time (ms).
-// Does nothing (0) without fx.haze. Contract: depth holds out's pixel count.
-double hazeDrawnFrame(const FrameEffects& fx, double zNear, double zFar, const float* depth, Image& out,
-                      FrameStats& stats, int threads = 0);
-
 // The haze of fx for a caller that hazes pixels as it writes them (the ray
 // casts with RayShading::haze): (px, depth, n) hazes the n RGBA8 words px[k]
 // at eye depth depth[k] (+inf: left alone) on the calling thread, as

@@ -447,7 +447,7 @@ TEST(ViewCli, EveryModeShowsTheBenchPicture) {
 
 // Haze in hybrid is applied to the read-back pixels (FarFieldOptions::
 // hazeCovered) in both faces: the viewer shows the bench's hazed picture, and
-// the hazed hybrid picture agrees with full.
+// the hazed hybrid picture agrees with full (which hazes in the rasteriser).
 TEST(ViewCli, HybridHazeShowsTheBenchPicture) {
     REQUIRE_DISPLAY();
     ASSERT_TRUE(fs::exists(VISTA_BINARY)) << "the vista binary is a build dependency of this test";

@@ -304,8 +304,8 @@ bool sameBytes(const Image& a, const Image& b) {
 // The split's ends are the modes they stand for: at 0 m the hybrid's frame is
 // the `raycast` frame (no GL pass, no read-back, no far-field stage) and at
 // "everything" the `full` frame (no read-back, no far-field stage), byte for
-// byte, in clear air and in haze (raycast hazes by the ray's depth, full from
-// the depth it reads back). Checked independently: ray casting vs rasterising the same
+// byte, in clear air and in haze (raycast hazes by the ray's depth, full in
+// the rasteriser). Checked independently: ray casting vs rasterising the same
 // frame agree to >= 30 dB (both ends are pictures of the city, not copies of
 // each other), and the two end frames differ from the middle choice's
 // classification (the hybrid at 20 m draws and casts).
@@ -376,43 +376,6 @@ TEST(Hybrid, EndPointsAreTheFramesOfTheirModes) {
         EXPECT_TRUE(anyFarFieldStage(sm));
         EXPECT_TRUE(sm.stages.ran(Stage::Near));
     }
-}
-
-// `full`'s bench frame under haze hazes from the depth it reads back
-// (renderWholeCityHazed); the viewer's `full` hazes per fragment in the haze
-// program. Checked against each other on the same frame: every channel within
-// two levels but on a sliver of edge pixels, so the bench and the viewer show
-// one picture; and against the clear frame, so the check can fail.
-TEST(Bench, FullHazedFromItsDepthMatchesTheHazeProgram) {
-    REQUIRE_DISPLAY();
-    TinyModes t;
-    ASSERT_TRUE(t.ready()) << t.error;
-    ModeContext& ctx = t.ctx;
-    ctx.options.effects.haze = true;
-    ctx.options.effects.visibility = 120.0;
-    auto full = createRenderMode("full", ctx);
-    ASSERT_TRUE(full.isOk()) << full.status().message();
-    EXPECT_FALSE(full.value()->hazesViewerPixels()) << "the viewer's full keeps the haze program";
-    Camera cam = testCamera(160, 120);
-    cam.eye = kWorld + glm::dvec3(-10, -40, 1.7);
-    cam.heading = 0.15;
-    Image cpu, program, clear;
-    FrameStats s;
-    ASSERT_TRUE(full.value()->renderFrame(cam, cpu, s).isOk());
-    EXPECT_TRUE(s.stages.ran(Stage::Haze));
-    // The same frame through the haze program (what the viewer draws).
-    FrameStats ps;
-    t.renderer->setEffects(ctx.options.effects, /*hazeInRaster=*/true);
-    ASSERT_TRUE(t.renderer->render(ctx.chunkedCity(), cam, 0.0, &program, nullptr, ps).isOk());
-    FrameEffects none;
-    t.renderer->setEffects(none, false);
-    ASSERT_TRUE(t.renderer->render(ctx.chunkedCity(), cam, 0.0, &clear, nullptr, ps).isOk());
-    size_t far = 0;
-    for (size_t i = 0; i < cpu.rgba.size(); i += 4)
-        for (int c = 0; c < 3; ++c) far += std::abs(int(cpu.rgba[i + c]) - int(program.rgba[i + c])) > 2 ? 1 : 0;
-    EXPECT_LE(double(far) / double(cpu.rgba.size() / 4), 0.01) << far << " channels differ by more than 2 levels";
-    EXPECT_GE(lumaPsnr(cpu, program), 40.0);
-    EXPECT_LT(lumaPsnr(cpu, clear), 30.0) << "120 m of visibility must change the picture";
 }
 
 // `hybrid-fixed` is the hybrid at the fixed near distance even when --near is auto: the
