@@ -328,6 +328,20 @@ TEST(FarFieldFrame, StagesRunOnlyWhenCalledFor) {
     EXPECT_FALSE(h.stages.ran(Stage::Horizon) || h.stages.ran(Stage::Rays) || h.stages.ran(Stage::Cache));
 }
 
+namespace {
+// The hybrid's far field under haze of `visibility` metres: it hazes the covered pixels of a depth
+// buffer projected with far plane zFar (0 = infinite).
+FarFieldOptions coveredHazeOptions(double nearDistance, double zFar, double visibility) {
+    FarFieldOptions o;
+    o.nearDistance = nearDistance;
+    o.depthZFar = zFar;
+    o.hazeCovered = true;
+    o.effects.haze = true;
+    o.effects.visibility = visibility;
+    return o;
+}
+}  // namespace
+
 // hazeCovered: covered pixels arrive unhazed and leave hazed for the eye depth
 // their window depth encodes (finite and infinite far plane), within one 8-bit
 // level of FrameEffects::applyHaze (exp evaluated directly); uncovered pixels
@@ -355,13 +369,8 @@ TEST(FarFieldFrame, HazeOfCoveredPixelsMatchesTheFormulaAtTheirDepth) {
             in.rgba[i * 4 + 2] = uint8_t(rng() % 256);
             in.rgba[i * 4 + 3] = i % 5 == 0 ? 128 : 255;
         }
-        FarFieldOptions o;
-        o.nearDistance = 400.0;
+        FarFieldOptions o = coveredHazeOptions(400.0, zFar, 300.0);
         o.verifySeam = false;
-        o.depthZFar = zFar;
-        o.hazeCovered = true;
-        o.effects.haze = true;
-        o.effects.visibility = 300.0;
         FarField ff(*t.rays, &t.grid, o);
         Image out = in;
         FrameStats st;
@@ -401,13 +410,8 @@ TEST(FarFieldFrame, HazedSeamHitsShowTheirRayHazedOnce) {
     for (int threads : {0, 1}) {
         Image in;
         const std::vector<float> depth = fakeNearField(*t.rays, c, 70.0, zFar, in);
-        FarFieldOptions o;
-        o.nearDistance = nearD;
-        o.depthZFar = zFar;
-        o.hazeCovered = true;
+        FarFieldOptions o = coveredHazeOptions(nearD, zFar, 150.0);
         o.threads = threads;
-        o.effects.haze = true;
-        o.effects.visibility = 150.0;
         FarField ff(*t.rays, &t.grid, o);
         Image out = in;
         FrameStats st;
