@@ -12,13 +12,12 @@ namespace vista {
 
 namespace {
 
+// Two-sided colour is never enabled, so only gl_FrontColor: an unused vertex
+// output still costs the rasteriser.
 const char* const kHazeVertexShader = R"(#version 120
-varying float vista_eye_depth;
 void main() {
     gl_Position = ftransform();
-    vista_eye_depth = -(gl_ModelViewMatrix * gl_Vertex).z;
     gl_FrontColor = gl_Color;
-    gl_BackColor = gl_Color;
 }
 )";
 
@@ -28,9 +27,7 @@ osg::Program* hazeProgram() {
         p->setName("vista.haze");
         p->addShader(new osg::Shader(osg::Shader::VERTEX, kHazeVertexShader));
         p->addShader(new osg::Shader(osg::Shader::FRAGMENT,
-                                     std::string(kHazeGlsl) +
-                                         "varying float vista_eye_depth;\n"
-                                         "void main() { gl_FragColor = vistaHaze(gl_Color, vista_eye_depth); }\n"));
+                                     std::string(kHazeGlsl) + "void main() { gl_FragColor = vistaHaze(gl_Color); }\n"));
         return p;
     }();
     return prog.get();

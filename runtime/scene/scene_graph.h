@@ -53,13 +53,13 @@ constexpr unsigned kLabelClassAttrib = 5;
 constexpr const char* kHazeDensityUniform = "vista_haze_density";
 constexpr const char* kHazeColorUniform = "vista_haze_color";
 // GLSL 1.20 fragment-stage haze shared by those shaders (declares the uniforms
-// and `vec4 vistaHaze(vec4 colour, float eyeDepth)`).
+// and `vec4 vistaHaze(vec4 colour)`, which takes the eye-plane depth from
+// gl_FragCoord.w: the shaders draw under perspective projections only).
 extern const char* const kHazeGlsl;
-// GLSL 1.20 vertex shader head of instanced drawing with haze: the four
-// per-instance matrix columns (vista_instance0..3), gl_Position and the eye
-// depth (varying vista_eye_depth), inside an open `void main() {`; the caller
-// appends its outputs and the closing brace.
-extern const char* const kInstancedHazeVertexHead;
+// GLSL 1.20 vertex shader head of instanced drawing: the four per-instance
+// matrix columns (vista_instance0..3) and gl_Position, inside an open
+// `void main() {`; the caller appends its outputs and the closing brace.
+extern const char* const kInstancedVertexHead;
 // The tile transform ("tile_IX_IY") if `node` is one, else null.
 osg::MatrixTransform* asCityTile(osg::Node* node);
 // The geometries with at least one primitive set under a tile transform, in

@@ -19,19 +19,18 @@ namespace vista {
 namespace {
 
 std::string vertexShader() {
-    return std::string(kInstancedHazeVertexHead) + "    gl_TexCoord[0] = gl_MultiTexCoord0;\n}\n";
+    return std::string(kInstancedVertexHead) + "    gl_TexCoord[0] = gl_MultiTexCoord0;\n}\n";
 }
 
 std::string fragmentShader() {
     return std::string(kHazeGlsl) +
            "uniform sampler2D vista_impostor_atlas;\n"
-           "varying float vista_eye_depth;\n"
            "void main() {\n"
            "    vec4 c = texture2D(vista_impostor_atlas, gl_TexCoord[0].st);\n"
            "    if (c.a < " +
            std::to_string(kImpostorAlphaRef) +
            ".0 / 255.0) discard;\n"
-           "    gl_FragColor = vistaHaze(vec4(c.rgb, 1.0), vista_eye_depth);\n"
+           "    gl_FragColor = vistaHaze(vec4(c.rgb, 1.0));\n"
            "}\n";
 }
 
