@@ -518,10 +518,11 @@ w("The hazy city benched on the same path in one run with `--also-clear`: each m
   "alternating. Same-frame ratio = median over frames of (haze / none) for the same frame, which cancels the path "
   "and the machine's drift.")
 w("")
-w("| city | path | hybrid rays/frame, mean: haze / none | far pixels hitting geometry, mean: haze / none "
+w("| city | path | hybrid rays/frame, mean: haze / none | hybrid triangles/frame, median: haze / none "
+  "| far pixels hitting geometry, mean: haze / none "
   "| hybrid `rays` + `horizon` stages ms: haze / none | hybrid `haze` stage ms | hybrid ms: haze / none (same-frame ratio) "
   "| full triangles/frame, median: haze / none | full ms: haze / none (same-frame ratio) | load |")
-w("|---|---|---|---|---|---|---|---|---|---|")
+w("|---|---|---|---|---|---|---|---|---|---|---|")
 # One run each with --also-clear: the modes with the city's haze and their clear twins (MODE+clear)
 # render every frame one right after the other, so the same-frame ratios share the machine's drift.
 HZ = [("2 km", "car", "haze2k_car"), ("2 km", "fly", "haze2k_fly"), ("4 km", "car", "haze4k_car"),
@@ -551,7 +552,8 @@ for city, kind, run in HZ:
     ton, toff = tri(run), tri(run, "full+clear")
     rs_on = hon["stages_ms"].get("rays", 0) + hon["stages_ms"].get("horizon", 0)
     rs_off = hoff["stages_ms"].get("rays", 0) + hoff["stages_ms"].get("horizon", 0)
-    w(f"| {city} | {kind} | {ron:.0f} / {roff:.0f} ({pct(ron, roff)}) | {hit_on:.0f} / {hit_off:.0f} "
+    w(f"| {city} | {kind} | {ron:.0f} / {roff:.0f} ({pct(ron, roff)}) "
+      f"| {tri(run, 'hybrid'):.0f} / {tri(run, 'hybrid+clear'):.0f} | {hit_on:.0f} / {hit_off:.0f} "
       f"| {rs_on:.1f} / {rs_off:.1f} | {hon['stages_ms'].get('haze', 0):.2f} "
       f"| {fm(run, 'hybrid'):.1f} / {fm(run, 'hybrid+clear'):.1f} ({f2(tr)}) | {ton:.0f} / {toff:.0f} ({pct(ton, toff)}) "
       f"| {fm(run):.1f} / {fm(run, 'full+clear'):.1f} ({f2(ftr)}) | {load_of(run):.1f} |")
@@ -559,6 +561,7 @@ for city, kind, run in HZ:
     tb = {r["frame"]: r["triangles"] for r in rows(run, "full+clear")}
     ndiff = sum(1 for k in ta if k in tb and ta[k] != tb[k])
     res3.append(dict(city=city, kind=kind, ron=ron, roff=roff, tr=tr, ftr=ftr, ton=ton, toff=toff,
+                     hton=tri(run, "hybrid"), htoff=tri(run, "hybrid+clear"),
                      hit_on=hit_on, hit_off=hit_off, ndiff=ndiff, n=len(ta)))
 w("")
 w("How the hybrid hazes: the far field's rays stop where their own eye-plane depth reaches the visibility and the "
@@ -567,21 +570,21 @@ w("How the hybrid hazes: the far field's rays stop where their own eye-plane dep
   "the pixels and depth the hybrid reads back anyway (`haze` stage), which costs less on a CPU rasteriser than a "
   "per-fragment program. `full` hazes in the rasteriser (a GLSL program) and its far plane stops at the visibility.")
 w("")
-ray_drop = [r for r in res3 if r["roff"] and r["ron"] < 0.99 * r["roff"]]
+w("**Rays.** Each side's split chooses its near distance from its own prices. With haze a far ray stops at the "
+  "visibility and the sky over what lies beyond needs none, so the rays per frame move both ways with the near "
+  "field: in (more rays, fewer triangles: " +
+  (", ".join(f"{r['city']} {r['kind']}" for r in res3 if r["ron"] > 1.01 * r["roff"] and r["hton"] < r["htoff"])
+   or "no run") + ") or out (fewer rays, more triangles: " +
+  (", ".join(f"{r['city']} {r['kind']}" for r in res3 if r["ron"] < 0.99 * r["roff"] and r["hton"] > r["htoff"])
+   or "no run") + "). Far pixels that hit geometry move by " +
+  ", ".join(f"{r['city']} {r['kind']} {r['hit_on'] - r['hit_off']:+.0f}" for r in res3) +
+  " per frame: hits beyond the visibility become haze, and the rest follow the near distance.")
+w("")
 # The band of a same-frame ratio: the A/A run's deviation, and never under 3 %.
 AA = twin_ratio("haze2k_car_aa", "hybrid", "frame_ms")
 TBAND = max(1.03, AA or 1.0, 1.0 / (AA or 1.0))
 faster = [r for r in res3 if r["tr"] is not None and r["tr"] * TBAND < 1]
 slower = [r for r in res3 if r["tr"] is not None and r["tr"] > TBAND]
-w("**Rays.** " + ("Hybrid rays per frame drop with haze on: " +
-                  ", ".join(f"{r['city']} {r['kind']} ({pct(r['ron'], r['roff'])})" for r in ray_drop) + ". "
-                  if ray_drop else "Hybrid rays per frame do not drop on any run. ") +
-  ("They do not move on " + ", ".join(f"{r['city']} {r['kind']}" for r in res3 if r not in ray_drop) +
-   ": there the far pixels' rays hit or leave the city within the visibility, so there is nothing beyond it "
-   "to skip; a ray is only cut short (hits beyond become haze: the far-pixel hit count moves by " +
-   ", ".join(f"{r['hit_off'] - r['hit_on']:.0f}" for r in res3 if r not in ray_drop) + " pixels per frame)."
-   if len(ray_drop) < len(res3) else ""))
-w("")
 w(f"**Time** (same-frame hybrid ratios haze / none; the same run with `--effects none` on the 2 km car path, an "
   f"A/A run, reads {f2(AA)}, and a ratio within {TBAND:.2f} either way of 1 counts as noise): " +
   ("faster beyond the noise on " + ", ".join(f"{r['city']} {r['kind']} ({f2(r['tr'])})" for r in faster) + "; "
