@@ -131,10 +131,11 @@ def mt(n):
     return f"{n / 1e6:.2f} M"
 
 
-def paired_median_ratio(a, b, mode, col):
-    """Median over frames of a[col]/b[col] for the same frame index (same path)."""
-    ra = {r["frame"]: float(r[col]) for r in rows(a, mode)}
-    rb = {r["frame"]: float(r[col]) for r in rows(b, mode)}
+def paired_median_ratio(a, mode_a, b, mode_b, col):
+    """Median over frames of a[col]/b[col] for the same frame index (same path): run a's mode_a
+    against run b's mode_b (one run's mode and its +clear twin, or two runs)."""
+    ra = {r["frame"]: float(r[col]) for r in rows(a, mode_a)}
+    rb = {r["frame"]: float(r[col]) for r in rows(b, mode_b)}
     v = [ra[k] / rb[k] for k in ra if k in rb and rb[k] > 0]
     return statistics.median(v) if v else None
 
@@ -535,11 +536,8 @@ def mean_rays(run, mode):
 
 
 def twin_ratio(run, mode, col):
-    """Median over frames of MODE[col] / (MODE+clear)[col] on the same frame of one run."""
-    ra = {r["frame"]: float(r[col]) for r in rows(run, mode)}
-    rb = {r["frame"]: float(r[col]) for r in rows(run, mode + "+clear")}
-    v = [ra[k] / rb[k] for k in ra if k in rb and rb[k] > 0]
-    return statistics.median(v) if v else None
+    """MODE against its clear twin (MODE+clear) on the same frames of one run."""
+    return paired_median_ratio(run, mode, run, mode + "+clear", col)
 
 
 res3 = []
@@ -550,10 +548,11 @@ for city, kind, run in HZ:
     tr = twin_ratio(run, "hybrid", "frame_ms")
     ftr = twin_ratio(run, "full", "frame_ms")
     ton, toff = tri(run), tri(run, "full+clear")
+    hton, htoff = tri(run, "hybrid"), tri(run, "hybrid+clear")
     rs_on = hon["stages_ms"].get("rays", 0) + hon["stages_ms"].get("horizon", 0)
     rs_off = hoff["stages_ms"].get("rays", 0) + hoff["stages_ms"].get("horizon", 0)
     w(f"| {city} | {kind} | {ron:.0f} / {roff:.0f} ({pct(ron, roff)}) "
-      f"| {tri(run, 'hybrid'):.0f} / {tri(run, 'hybrid+clear'):.0f} | {hit_on:.0f} / {hit_off:.0f} "
+      f"| {hton:.0f} / {htoff:.0f} | {hit_on:.0f} / {hit_off:.0f} "
       f"| {rs_on:.1f} / {rs_off:.1f} | {hon['stages_ms'].get('haze', 0):.2f} "
       f"| {fm(run, 'hybrid'):.1f} / {fm(run, 'hybrid+clear'):.1f} ({f2(tr)}) | {ton:.0f} / {toff:.0f} ({pct(ton, toff)}) "
       f"| {fm(run):.1f} / {fm(run, 'full+clear'):.1f} ({f2(ftr)}) | {load_of(run):.1f} |")
@@ -561,7 +560,7 @@ for city, kind, run in HZ:
     tb = {r["frame"]: r["triangles"] for r in rows(run, "full+clear")}
     ndiff = sum(1 for k in ta if k in tb and ta[k] != tb[k])
     res3.append(dict(city=city, kind=kind, ron=ron, roff=roff, tr=tr, ftr=ftr, ton=ton, toff=toff,
-                     hton=tri(run, "hybrid"), htoff=tri(run, "hybrid+clear"),
+                     hton=hton, htoff=htoff,
                      hit_on=hit_on, hit_off=hit_off, ndiff=ndiff, n=len(ta)))
 w("")
 w("How the hybrid hazes: the far field's rays stop where their own eye-plane depth reaches the visibility and the "

@@ -56,14 +56,6 @@ void recordHaze(double ms, FrameStats& stats) {
 
 }  // namespace
 
-void hazeStage(const FrameEffects& fx, const uint32_t* pixels, size_t n, const float* depth, Image& out,
-               FrameStats& stats) {
-    if (!fx.haze || n == 0) return;
-    Stopwatch sw;
-    hazeListed(fx, pixels, n, depth, out);
-    recordHaze(sw.ms(), stats);
-}
-
 DepthHaze::DepthHaze(const FrameEffects& fx)
     : _on(fx.haze),
       _h(hazeParams(fx)),
@@ -74,8 +66,10 @@ void DepthHaze::operator()(uint32_t* px, const float* depth, size_t n) const {
     if (_on && n > 0) _kernels->depth(px, depth, n, _table, _h);
 }
 
-void hazeListed(const FrameEffects& fx, const uint32_t* pixels, size_t n, const float* depth, Image& out) {
+void hazeStage(const FrameEffects& fx, const uint32_t* pixels, size_t n, const float* depth, Image& out,
+               FrameStats& stats) {
     if (!fx.haze || n == 0) return;
+    Stopwatch sw;
     // Gathered into a block, hazed by the kernel, scattered back.
     const DepthHaze haze(fx);
     PixelWord* px = reinterpret_cast<PixelWord*>(out.rgba.data());
@@ -87,6 +81,7 @@ void hazeListed(const FrameEffects& fx, const uint32_t* pixels, size_t n, const 
         haze(block, depth + b, m);
         for (size_t k = 0; k < m; ++k) px[pixels[b + k]] = block[k];
     }
+    recordHaze(sw.ms(), stats);
 }
 
 void hazeCoveredRows(const HazeKernels& k, PixelWord* px, const float* depth, size_t width, size_t y0, size_t y1,

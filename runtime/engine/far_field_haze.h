@@ -21,10 +21,6 @@ namespace vista {
 
 void hazeStage(const FrameEffects& fx, const uint32_t* pixels, size_t n, const float* depth, Image& out,
                FrameStats& stats);
-// The list pass of hazeStage without its records: the n pixels
-// out[pixels[k]] hazed at eye depth depth[k] (+inf: left alone), on the
-// calling thread. Does nothing without fx.haze.
-void hazeListed(const FrameEffects& fx, const uint32_t* pixels, size_t n, const float* depth, Image& out);
 
 // The haze of fx for a caller that hazes pixels as it writes them (the ray
 // casts with RayShading::haze): (px, depth, n) hazes the n RGBA8 words px[k]
