@@ -21,6 +21,7 @@ const Command kCommands[] = {
     {"bake", vista::runBake, "bake view cells and point impostors into city.baked.osgb"},
     {"export", vista::runExport, "export a scene file's road network (OpenDRIVE .xodr)"},
     {"render", vista::runRender, "ground truth per frame: rgb, depth, semantic, instance (+ cameras.json)"},
+    {"traffic", vista::runTraffic, "simulate vehicles and pedestrians on a city with SUMO (FCD + signal states)"},
 };
 
 void usage(FILE* f) {
