@@ -123,7 +123,7 @@ bool TrafficTracks::poseAt(uint32_t agent, double t, AgentPose* out) const {
     *out = *a;
     if (f + 1 >= times.size()) return true;
     const AgentPose* b = findIn(*this, f + 1, agent);
-    if (!b) return true;
+    if (!b) return t == times[f];  // gone after its last sample
     const float w = float((t - times[f]) / (times[f + 1] - times[f]));
     out->x = a->x + (b->x - a->x) * w;
     out->y = a->y + (b->y - a->y) * w;

@@ -13,7 +13,8 @@
 //   poses are sorted by agent number.
 // - poseAt() gives an agent's pose at any time inside the run, linear between
 //   the two enclosing samples (the heading along the shorter turn); false
-//   when the agent is not in the simulation at that time.
+//   when the agent is not in both samples (it departs or arrives between
+//   them) unless `t` is a sample's own time.
 // - readFcd() streams the file (expat). A file that is not FCD, is truncated
 //   or malformed, has times that do not increase, or a vehicle or person of a
 //   type vista does not know, is an error naming the file, the line and the
