@@ -14,6 +14,7 @@
 #include "foundation/progress.h"
 #include "runtime/scene/city_file.h"
 #include "runtime/scene/city_opendrive.h"
+#include "runtime/traffic/sumo_process.h"
 #include "runtime/traffic/traffic_run.h"
 
 namespace vista {
@@ -42,6 +43,8 @@ int runTraffic(int argc, char** argv) {
     if (Status s = checkTrafficOptions(opt); !s) return reportBadInput(cmd, s);
     if (Status s = CommandFiles().input("city", city).output("-o", out).check(); !s) return reportBadInput(cmd, s);
     if (Status s = checkWritableDirectory("-o", out); !s) return reportBadInput(cmd, s);
+    // SUMO is looked up before any work, so a missing install costs nothing.
+    if (auto tools = findSumo(); !tools) return reportBadInput(cmd, tools.status());
     auto model = loadCityFile(city);
     if (!model) return reportBadInput(cmd, model.status());
     auto xodr = cityOpenDrive(*model, city);

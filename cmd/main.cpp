@@ -26,8 +26,8 @@ const Command kCommands[] = {
 
 void usage(FILE* f) {
     std::fprintf(f, "usage: vista <command> [options]\n\ncommands:\n");
-    for (const auto& c : kCommands) std::fprintf(f, "  %-7s %s\n", c.name, c.summary);
-    std::fprintf(f, "  help    show this list, or `vista help <command>` for a command's options\n");
+    for (const auto& c : kCommands) std::fprintf(f, "  %-8s %s\n", c.name, c.summary);
+    std::fprintf(f, "  help     show this list, or `vista help <command>` for a command's options\n");
     std::fprintf(f, "\nRun `vista <command> --help` for the options of one command.\n");
 }
 

@@ -153,7 +153,8 @@ Status runAll(const std::string& xodrText, const TrafficOptions& opt, const std:
                                          {"--opendrive-files", "city.xodr", "--output-file", "city.net.xml",
                                           "--type-files", typeFiles,
                                           "--crossings.guess", "true", "--offset.disable-normalization", "true",
-                                          "--opendrive.internal-shapes", "true", "--no-warnings", "true"},
+                                          "--opendrive.internal-shapes", "true", "--opendrive.curve-resolution", "0.5",
+                                          "--no-turnarounds", "true", "--no-warnings", "true"},
                                          work, logs));
     VISTA_RETURN_IF_ERROR(stripGeneratedDate((w / "city.net.xml").string()));
     progress.end();

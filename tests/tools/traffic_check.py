@@ -9,8 +9,9 @@ vehicle sample, the distance to the nearest driving-lane centre line:
 
   on lane   at least --min-share of the vehicle samples lie within
             --tolerance metres of a lane centre line;
-  heading   of the samples on a lane of a road outside junctions, the same
-            share heads along that lane (SUMO's angle against the centre
+  heading   of the samples whose whole body is on a lane of a road outside
+            junctions (SUMO's lane and position along it, against the vehicle's
+            length), the same share heads along that lane (SUMO's angle against the centre
             line's direction, within --max-heading-deg, either direction
             of travel);
   agents    every agent has a known type and the file is well formed.
@@ -90,8 +91,19 @@ class SegmentGrid:
         return best, close
 
 
-def read_fcd(path, off_x, off_y):
-    """Vehicle samples (x, y, heading radians CCW from +x) and the count of persons."""
+def vehicle_lengths(path):
+    """{vType id: length} of the demand file."""
+    try:
+        root = ET.parse(path).getroot()
+    except (ET.ParseError, OSError) as e:
+        raise xodr_check.InputError(f"cannot read {path}: {e}")
+    return {t.get("id"): float(t.get("length", "5")) for t in root.iter("vType")}
+
+
+def read_fcd(path, off_x, off_y, lengths):
+    """Vehicle samples (x, y, heading radians CCW from +x, whole body on one road lane) and the
+    count of persons. The body is on one lane when SUMO reports a lane outside junctions
+    (not ':...') and a position along it of at least the vehicle's length."""
     samples, persons = [], 0
     try:
         for _, el in ET.iterparse(path, events=("end",)):
@@ -101,7 +113,8 @@ def read_fcd(path, off_x, off_y):
                     raise xodr_check.InputError(f"{path}: vehicle {el.get('id')} has the unknown type {vtype!r}")
                 x, y = float(el.get("x")) - off_x, float(el.get("y")) - off_y
                 heading = math.radians(90.0 - float(el.get("angle")))
-                samples.append((x, y, heading))
+                lane, pos = el.get("lane", ":"), float(el.get("pos", "0"))
+                samples.append((x, y, heading, not lane.startswith(":") and pos >= lengths.get(vtype, 0.0)))
                 el.clear()
             elif el.tag == "person":
                 persons += 1
@@ -124,9 +137,10 @@ def check(directory, tolerance, min_share, max_heading_deg):
     off_x, off_y = manifest.get("net_offset", [0.0, 0.0])
     net = xodr_check.load(os.path.join(directory, manifest["files"]["xodr"]))
     grid = SegmentGrid(lane_centres(net), max(tolerance, 1.0))
-    samples, persons = read_fcd(os.path.join(directory, manifest["files"]["fcd"]), off_x, off_y)
+    lengths = vehicle_lengths(os.path.join(directory, manifest["files"]["demand"]))
+    samples, persons = read_fcd(os.path.join(directory, manifest["files"]["fcd"]), off_x, off_y, lengths)
     within, on_roads, along, distances = 0, 0, 0, []
-    for x, y, heading in samples:
+    for x, y, heading, whole_body in samples:
         d, close = grid.near(x, y, tolerance)
         distances.append(d)
         if d > tolerance:
@@ -134,8 +148,8 @@ def check(directory, tolerance, min_share, max_heading_deg):
         within += 1
         # The heading is the body's (rear to front bumper): on a junction's
         # curve it differs from the lane's tangent at the front, so it is
-        # checked on the roads between junctions.
-        if any(junction for _, junction in close):
+        # checked where the whole body is on a road between junctions.
+        if not whole_body or any(junction for _, junction in close):
             continue
         on_roads += 1
         if any(math.degrees(abs(math.remainder(heading - direction, math.pi))) <= max_heading_deg
