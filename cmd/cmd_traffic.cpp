@@ -14,6 +14,8 @@
 #include "foundation/progress.h"
 #include "runtime/scene/city_file.h"
 #include "runtime/scene/city_opendrive.h"
+#include "runtime/scene/paged_load.h"
+#include "runtime/scene/paged_walkthrough.h"
 #include "runtime/traffic/sumo_process.h"
 #include "runtime/traffic/traffic_run.h"
 
@@ -27,7 +29,9 @@ int runTraffic(int argc, char** argv) {
     std::string city, out;
     TrafficOptions opt;
     bool quiet = false;
-    app.add_option("city", city, "input scene file (.osgb from 'vista gen' or 'vista bake')")->required();
+    app.add_option("city", city,
+                   "input scene file (.osgb from 'vista gen' or 'vista bake'), or a paged city directory (DIR.paged)")
+        ->required();
     app.add_option("-o,--out", out, "the traffic directory to write (must not exist)")->required();
     addSeedOption(app, "--seed", opt.demand.seed, "random seed of the demand and of SUMO (default 1)");
     addNumberOption(app, "--vehicles", opt.demand.vehicles, 0, kMaxTrafficAgents,
@@ -45,7 +49,14 @@ int runTraffic(int argc, char** argv) {
     if (Status s = checkWritableDirectory("-o", out); !s) return reportBadInput(cmd, s);
     // SUMO is looked up before any work, so a missing install costs nothing.
     if (auto tools = findSumo(); !tools) return reportBadInput(cmd, tools.status());
-    auto model = loadCityFile(city);
+    Result<SceneModel> model = Status::error("no city");
+    if (isPagedCityPath(city)) {  // a paged city: its street graph grown again from the manifest's params
+        auto paged = openPagedCity(city, true);
+        if (!paged) return reportBadInput(cmd, paged.status());
+        model = std::move(paged->stub);
+    } else {
+        model = loadCityFile(city);
+    }
     if (!model) return reportBadInput(cmd, model.status());
     auto xodr = cityOpenDrive(*model, city);
     if (!xodr) return reportBadInput(cmd, xodr.status());

@@ -11,7 +11,10 @@
 #include <unordered_map>
 
 #include "foundation/atomic_file.h"
+#include "foundation/input_file.h"
 #include "foundation/units.h"
+
+#include <nlohmann/json.hpp>
 
 namespace vista {
 
@@ -159,6 +162,28 @@ Result<TrafficTracks> readFcd(const std::string& path, double offsetX, double of
     }
     if (!r.sawRoot) return Status::error("floating-car data '" + path + "' is empty");
     return std::move(r.tracks);
+}
+
+Result<TrafficTracks> loadTrafficTracks(const std::string& dir) {
+    const std::string manifest = dir + "/traffic.json";
+    auto text = readInputFile("traffic manifest", manifest, kMaxManifestBytes);
+    if (!text) return Status::error("--traffic = '" + dir + "': " + text.status().message());
+    nlohmann::json j = nlohmann::json::parse(*text, nullptr, false);
+    if (j.is_discarded() || !j.is_object()) return Status::error("'" + manifest + "' is not a JSON object");
+    if (j.value("format", "") != "vista-traffic")
+        return Status::error("'" + manifest + "': format is not \"vista-traffic\" (not a `vista traffic` directory)");
+    if (!j["version"].is_number_integer() || j["version"].get<int64_t>() != 1)
+        return Status::error("'" + manifest + "': version must be 1");
+    const auto& off = j["net_offset"];
+    if (!off.is_array() || off.size() != 2 || !off[0].is_number() || !off[1].is_number() ||
+        !std::isfinite(off[0].get<double>()) || !std::isfinite(off[1].get<double>()))
+        return Status::error("'" + manifest + "': net_offset must be two finite numbers");
+    const auto& files = j["files"];
+    if (!files.is_object() || !files["fcd"].is_string()) return Status::error("'" + manifest + "': files.fcd is missing");
+    const std::string fcd = files["fcd"].get<std::string>();
+    if (fcd.empty() || fcd.find('/') != std::string::npos || fcd == "." || fcd == "..")
+        return Status::error("'" + manifest + "': files.fcd = '" + fcd + "' must name a file in the directory");
+    return readFcd(dir + "/" + fcd, off[0].get<double>(), off[1].get<double>());
 }
 
 }  // namespace vista

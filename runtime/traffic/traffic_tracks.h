@@ -51,4 +51,9 @@ struct TrafficTracks {
 
 Result<TrafficTracks> readFcd(const std::string& path, double offsetX, double offsetY);
 
+// The tracks of a traffic directory (`vista traffic`, docs/formats.md):
+// DIR/traffic.json (format "vista-traffic", version 1, its net_offset and
+// fcd file name) and the FCD it names. Errors name the directory and field.
+Result<TrafficTracks> loadTrafficTracks(const std::string& dir);
+
 }  // namespace vista

@@ -9,6 +9,8 @@
 #include <string>
 
 #include "foundation/units.h"
+#include "citygen/params.h"
+#include "runtime/traffic/ego_path.h"
 #include "runtime/traffic/sumo_net.h"
 #include "runtime/traffic/sumo_process.h"
 #include "runtime/traffic/traffic_demand.h"
@@ -342,4 +344,34 @@ TEST(SumoProcess, ErrorLinesAreTheLastErrors) {
     EXPECT_EQ(sumoErrorLines("Warning: w\nError: one\nok\nError: two\n"), "Error: one; Error: two");
     EXPECT_EQ(sumoErrorLines("Error: a\nError: b\nError: c\nError: d\n", 2), "Error: c; Error: d");
     EXPECT_EQ(sumoErrorLines("Loading...\nQuitting (on error).\n"), "Quitting (on error).");
+}
+
+TEST(EgoPath, RidesTheVehicleFromBehindItsFrontBumper) {
+    TempDir dir("vista_ego");
+    writeText(dir.file("fcd.xml"), kFcd);
+    auto t = readFcd(dir.file("fcd.xml"), 100.0, -50.0);
+    ASSERT_TRUE(t);
+    auto ego = chooseEgo(*t, "v1", 1);
+    ASSERT_TRUE(ego);
+    CityParams params;
+    auto path = egoPath(*t, *ego, params, 0.25, 60.0, 1.2);
+    ASSERT_TRUE(path) << path.status().message();
+    // v1 is present from 0 to 0.5 s: three samples at 0.25 s, never padded.
+    ASSERT_EQ(path->samples.size(), 3u);
+    const double back = kEgoEyeBack * agentTypeInfo(AgentType::Car).length;
+    for (size_t i = 0; i < 3; ++i) {
+        const PathSample& s = path->samples[i];
+        EXPECT_DOUBLE_EQ(s.t, 0.25 * double(i));
+        // Heading east (+x): the eye is `back` metres west of the bumper.
+        EXPECT_NEAR(s.position.x, 10.0 + 10.0 * s.t - back, 1e-4);
+        EXPECT_NEAR(s.position.y, 10.0, 1e-4);
+        EXPECT_NEAR(s.heading, kHalfPi, 1e-6);  // clockwise from north: east
+        EXPECT_DOUBLE_EQ(s.pitch, 0.0);
+    }
+    EXPECT_FALSE(chooseEgo(*t, "p1", 1));   // a pedestrian
+    EXPECT_FALSE(chooseEgo(*t, "v9", 1));   // unknown
+    // Without an id the seed picks a car: v1 is the only one.
+    auto picked = chooseEgo(*t, "", 42);
+    ASSERT_TRUE(picked);
+    EXPECT_EQ(t->agentIds[*picked], "v1");
 }
