@@ -24,6 +24,10 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kPartialMark = ".vista-traffic-partial";
+// The gap a pedestrian keeps to a vehicle (SUMO's default is 0.25 m, with
+// which a pedestrian steps onto a crossing behind a car still leaving it and
+// SUMO's junction check reports a collision).
+constexpr double kPedestrianGapToVehicleM = 2.0;
 
 std::string num(double v) {
     char buf[64];
@@ -61,6 +65,9 @@ std::string sumoConfig(const TrafficOptions& opt) {
            "        <collision.action value=\"warn\"/>\n"
            "        <collision.check-junctions value=\"true\"/>\n"
            "        <ignore-route-errors value=\"true\"/>\n"
+           "        <pedestrian.striping.mingap-to-vehicle value=\"" +
+           num(kPedestrianGapToVehicleM) +
+           "\"/>\n"
            "    </processing>\n"
            "    <random_number>\n"
            "        <seed value=\"" +
