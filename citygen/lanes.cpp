@@ -595,9 +595,10 @@ void LaneModelBuilder::connectLeftovers(size_t j) {
             for (uint32_t out : order(in, true)) {
                 const int nOut = end(out, v).away();
                 auto it = shiftOf.find({in, out});
-                int o = across(k, nIn, nOut, angleOf(in, out), it == shiftOf.end() ? nullptr : &it->second);
-                for (int d = 0, best = 1 << 30; d < nOut; ++d)  // the nearest outgoing lane nobody feeds
-                    if (!fed[out][size_t(d + 1)] && std::abs(d + 1 - o) < best) best = std::abs(d + 1 - o), o = d + 1;
+                const int target = across(k, nIn, nOut, angleOf(in, out), it == shiftOf.end() ? nullptr : &it->second);
+                int o = target;
+                for (int x = 1, best = 1 << 30; x <= nOut; ++x)  // the nearest outgoing lane nobody feeds
+                    if (!fed[out][size_t(x)] && std::abs(x - target) < best) best = std::abs(x - target), o = x;
                 if (addLaneTurn(j, in, out, k, o)) {
                     mark(m.links.back());
                     break;
