@@ -404,6 +404,7 @@ void Writer::linkRoad(size_t k) {
             o += "            <width sOffset=\"0\" " + smoothstepAttrs(l.w0, l.w1, len) + "/>\n";
             o += "            <roadMark sOffset=\"0\" type=\"none\" color=\"standard\"/>\n";
             if (!l.sidewalk) o += "            <speed sOffset=\"0\" max=\"" + num(speed) + "\" unit=\"km/h\"/>\n";
+            n.taperedLanes += !l.sidewalk && (l.w0 == 0 || l.w1 == 0);
             o += "          </lane>\n";
         }
     };
@@ -513,6 +514,7 @@ std::string openDriveCountsJson(const OpenDriveCounts& c) {
     j["dropped_turns"] = c.droppedTurns;
     j["unlinked_lanes"] = c.unlinkedLanes;
     j["unfed_lanes"] = c.unfedLanes;
+    j["tapered_lanes"] = c.taperedLanes;
     return j.dump();
 }
 

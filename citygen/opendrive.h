@@ -59,6 +59,7 @@ struct OpenDriveCounts {
     size_t droppedTurns = 0;   // LaneModel::droppedTurns
     size_t unlinkedLanes = 0;  // LaneModel::unlinkedLanes
     size_t unfedLanes = 0;     // LaneModel::unfedLanes
+    size_t taperedLanes = 0;   // driving lanes of link roads that start or end with width 0 inside them
 };
 
 // `blocks` (the city's, or extractBlocks() of the same graph and params)
@@ -68,7 +69,8 @@ Result<std::string> openDriveXml(const StreetGraph& g, const CityParams& params,
 
 // The counts as a JSON object (keys in snake_case: roads, connecting_roads,
 // junctions, transitions, driving_lanes, sidewalks, traffic_lights, signs,
-// crosswalks, sharp_corners, dropped_turns, unlinked_lanes, unfed_lanes).
+// crosswalks, sharp_corners, dropped_turns, unlinked_lanes, unfed_lanes,
+// tapered_lanes).
 std::string openDriveCountsJson(const OpenDriveCounts& counts);
 
 // The PROJ string written into <geoReference> (see above).

@@ -79,10 +79,24 @@ TEST(OpenDrive, GenStatsCountTheRoadNetwork) {
     std::string err;
     auto doc = parseXml(readBytes(x), &err);
     ASSERT_TRUE(doc) << err;
-    size_t roads = 0, connecting = 0, lights = 0, signs = 0;
+    size_t roads = 0, connecting = 0, lights = 0, signs = 0, tapered = 0;
     for (const Element* rd : doc->all("road")) {
         if (rd->str("junction") != "-1") ++connecting;
         else if (rd->str("name").rfind("transition", 0) != 0) ++roads;  // street roads, not transitions
+        if (rd->str("junction") != "-1" || rd->str("name").rfind("transition", 0) == 0) {
+            // Link-road driving lanes whose single width cubic is 0 at s = 0 or at s = length.
+            const double L = rd->num("length");
+            for (const Element* sec : rd->first("lanes")->all("laneSection"))
+                for (const char* side : {"left", "right"})
+                    if (const Element* lanes = sec->first(side))
+                        for (const Element* lane : lanes->all("lane")) {
+                            const Element* w = lane->first("width");
+                            if (lane->str("type") != "driving" || !w) continue;
+                            const double w0 = w->num("a"),
+                                         w1 = w0 + L * (w->num("b") + L * (w->num("c") + L * w->num("d")));
+                            tapered += std::abs(w0) < 1e-9 || std::abs(w1) < 1e-6;
+                        }
+        }
         if (const Element* s = rd->first("signals"))
             for (const Element* sg : s->all("signal")) ++(sg->str("dynamic") == "yes" ? lights : signs);
     }
@@ -93,6 +107,7 @@ TEST(OpenDrive, GenStatsCountTheRoadNetwork) {
     EXPECT_EQ(o["signs"].get<size_t>(), signs);
     EXPECT_EQ(o["unlinked_lanes"].get<size_t>(), 0u);
     EXPECT_EQ(o["unfed_lanes"].get<size_t>(), 0u);
+    EXPECT_EQ(o["tapered_lanes"].get<size_t>(), tapered);
     r = runVista("gen --size 300 --seed 4 --detail 0 -q -o " + dir.file("d.osgb") + " --stats " + dir.file("t.json"));
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_FALSE(nlohmann::json::parse(readBytes(dir.file("t.json"))).contains("opendrive"));
