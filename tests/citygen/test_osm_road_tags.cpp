@@ -228,12 +228,8 @@ TEST(OsmRoadTags, ImplausibleAndInconsistentTagsFallBackAndAreCounted) {
         EXPECT_EQ(st.lanes.fallback, c.lanesUsed ? 0u : 1u);
         EXPECT_EQ(st.lanesInconsistent, c.inconsistent ? 1u : 0u);
         // `lanes` agrees with the lanes written whenever the directions are known.
-        if (t.lanesForward >= 0) {
-            EXPECT_EQ(t.lanes, t.lanesForward + t.lanesBackward);
-        }
-        if (c.lanesUsed) {
-            EXPECT_EQ(t.lanes, std::stoi(c.tags.at("lanes")));
-        }
+        if (t.lanesForward >= 0) { EXPECT_EQ(t.lanes, t.lanesForward + t.lanesBackward); }
+        if (c.lanesUsed) { EXPECT_EQ(t.lanes, std::stoi(c.tags.at("lanes"))); }
     }
     // maxspeed=DE:zone99999999999999999999 is no limit of 250 km/h: the class default, counted.
     OsmRoadTagStats st;
@@ -272,9 +268,7 @@ TEST(OsmRoadTags, AnOverLongTagValueNamesTheTagAndTheWay) {
                            "<tag k=\"name\" v=\""
                         << amps << "\"/></way>\n</osm>\n";
     auto ok = importOsm(file, CityParams());
-    if (!ok) {
-        EXPECT_EQ(ok.status().message().find("limit of 1024"), std::string::npos) << ok.status().message();
-    }
+    if (!ok) { EXPECT_EQ(ok.status().message().find("limit of 1024"), std::string::npos) << ok.status().message(); }
 }
 
 TEST(OsmRoadTags, UnusableValuesFallBackAndAreCounted) {
