@@ -129,6 +129,8 @@ TEST_F(ValuesCli, FramesBeyondThePathsSamplesAreRefusedUnlessAsked) {
                       {"option --frames", count});
         expectRefused("view " + city + " --path " + pathCsv + " --step --frames " + std::to_string(n + 1),
                       {"option --frames", count});
+        expectRefused("view " + city + " --path " + pathCsv + " --frames 2 --allow-repeated-frames",
+                      {"option --allow-repeated-frames", "only with --step"});
     }
 }
 
