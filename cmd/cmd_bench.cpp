@@ -36,6 +36,7 @@ struct BenchArgs {
     std::string sampling = samplingName(kDefaultSampleRuns);
     std::vector<fs::path> createdOut;  // directories of --out made by this run, deepest first
     bool quiet = false;
+    bool repeats = false;  // --allow-repeated-frames
     PathFlags path;
     ModeFlags mode;
     BenchConfig cfg;
@@ -53,7 +54,9 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
     addPagedFlags(app, a.paged);
     addPagedStreamFlags(app, a.stream);
     addNumberOption(app, "--frames", a.cfg.frames, 1, 1000000,
-                    "frames rendered, sampled from the path as --sampling says, 1 .. 1000000 (default 120)");
+                    "frames rendered, sampled from the path as --sampling says, 1 .. 1000000 and at most the path's "
+                    "sample count (default 120)");
+    addRepeatedFramesFlag(app, a.repeats);
     app.add_option("--sampling", a.sampling,
                    "which path samples are the frames: 'spread' (evenly over the whole path), 'consecutive' (the first "
                    "N samples, as a simulator renders them) or 'runs:K' (K runs of consecutive samples, their starts "
@@ -195,7 +198,11 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
     // A paged city: the walkthrough first (a CSV, or a seeded path on the
     // city's streets), then only the regions near it.
     req.pathNeedsStreets = a.path.file.empty();
-    req.makePath = [&](const SceneModel& city) { return walkthroughPath(a.path.file, a.pathOptions, city); };
+    req.makePath = [&](const SceneModel& city) -> Result<Path> {
+        auto p = walkthroughPath(a.path.file, a.pathOptions, city);
+        if (p) VISTA_RETURN_IF_ERROR(checkFrameCount(cfg.frames, p->samples.size(), a.repeats));
+        return p;
+    };
     // The budget check of a city file, on the selected regions' bytes.
     req.beforePagedLoad = [&](uint64_t bytes) {
         cfg.memoryEstimateMb = estimateCityRunMb(bytes, rays);
@@ -328,7 +335,8 @@ int runBench(int argc, char** argv) {
     if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;
     a.cfg.command = commandLine(argc, argv);
     if (Status s = configure(a); !s) return reportBadInput(kCmd, s);
-    const int rc = a.sweep.empty() ? benchCity(a, a.city, a.out, nullptr) : runSweep(a);
+    int rc = requireDisplay(kCmd);
+    if (rc < 0) rc = a.sweep.empty() ? benchCity(a, a.city, a.out, nullptr) : runSweep(a);
     // A failed run leaves no empty output folder behind (one it made itself).
     std::error_code ec;
     if (rc != 0)

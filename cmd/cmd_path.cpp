@@ -108,6 +108,7 @@ int runPath(int argc, char** argv) {
     auto k = parsePathKind(kind);
     if (!k) return reportBadInput("vista path", Status::error("--kind: " + k.status().message()));
     o.kind = k.value();
+    if (Status s = checkLeftHandTraffic(o.leftHandTraffic, o.kind); !s) return reportBadInput("vista path", s);
     if (speed->count() == 0) o.maxSpeed = defaultSpeed(o.kind);
     auto r = parseRouteStyle(route);
     if (!r) return reportBadInput("vista path", Status::error("--route: " + r.status().message()));
@@ -135,6 +136,12 @@ int runPath(int argc, char** argv) {
     if (!c) return reportBadInput("vista path", c.status());
     auto p = generatePath(c->streets, c->params, o);
     if (!p) return reportBadInput("vista path", p.status());
+    if (!positions.empty() && p->lanes.size() != p->samples.size())
+        return reportBadInput("vista path",
+                              Status::error("option --xodr-positions = '" + positions +
+                                            "': this car path has no lane positions, so it follows the street centre "
+                                            "lines (" +
+                                            p->lanesMissing + "); leave out --xodr-positions to write that path"));
     // Both outputs or neither.
     OutputBatch batch;
     if (!positions.empty())

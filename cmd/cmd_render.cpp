@@ -82,6 +82,7 @@ struct RenderArgs {
     std::string sampling = "spread", rig;
     int frames = 60;
     double fov = 60, memoryBudgetGb = 0;
+    bool repeats = false;  // --allow-repeated-frames
     bool stats = false, quiet = false, restart = false, channelsGiven = false;
     PathFlags path;
     ModeFlags modeFlags;
@@ -247,7 +248,8 @@ Status configure(const RenderArgs& a, RenderPlan& p) {
 // path indices of the frames (`idx`), each frame inside the city.
 Result<Walkthrough> loadCityAndFrames(const RenderArgs& a, RenderPlan& p, std::vector<size_t>& idx) {
     const std::string labelsFor = (p.channels & (kSemantic | kInstance)) ? "the semantic and instance channels" : "";
-    WalkthroughRequest req = renderRequest(a.city, a.path.file, p.path, a.frames, p.sampleRuns, labelsFor, idx);
+    WalkthroughRequest req =
+        renderRequest(a.city, a.path.file, p.path, a.frames, p.sampleRuns, a.repeats, labelsFor, idx);
     req.bakedModes = {a.mode};
     req.effects = [](const Effects& declared) { return runTimeEffects(std::nullopt, declared, true, kCmd); };
     if (p.paged) {
@@ -623,15 +625,16 @@ void printResult(const RenderArgs& a, const RenderPlan& p, size_t frames, const 
     line("write instance", tm.writeInstance);
 }
 
-// The command's steps: options, city and path, work directory, set-up,
-// frames, metadata and commit; any failure (bad input, a write that fails,
-// no display) is a message and exit 2. Finished frames stay in OUT.partial
-// for the rerun.
+// The command's steps: options, display, city and path, work directory,
+// set-up, frames, metadata and commit; any failure (bad input, a write that
+// fails) is a message and exit 2, no display exit 1 before any work.
+// Finished frames stay in OUT.partial for the rerun.
 int run(const RenderArgs& a, const std::string& command) {
     RenderPlan plan;
     if (Status s = configure(a, plan); !s) return reportBadInput(kCmd, s);
     RenderWorkDir out;
     if (Status s = out.checkOut(a.out); !s) return reportBadInput(kCmd, s);
+    if (int rc = requireDisplay(kCmd); rc >= 0) return rc;
     std::vector<size_t> idx;
     auto walk = loadCityAndFrames(a, plan, idx);
     if (!walk) return reportBadInput(kCmd, walk.status());
@@ -678,7 +681,9 @@ int runRender(int argc, char** argv) {
         "GB, (0, 65536]: refuse up front a run whose estimated peak memory (from the city file's size, or the paged "
         "regions' bytes) exceeds it; with --paged-stream the streamed regions are held within it (default: no "
         "budget)");
-    addNumberOption(app, "--frames", a.frames, 1, 1000000, "frames rendered, 1 .. 1000000 (default 60)");
+    addNumberOption(app, "--frames", a.frames, 1, 1000000,
+                    "frames rendered, 1 .. 1000000 and at most the path's sample count (default 60)");
+    addRepeatedFramesFlag(app, a.repeats);
     app.add_option("--sampling", a.sampling,
                    "which path samples are the frames: spread (default), consecutive or runs:K");
     app.add_option("--size", a.size, "image size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 640x480)");
@@ -723,7 +728,7 @@ int runRender(int argc, char** argv) {
                                                             "whole loaded city)"));
         RigRunRequest r;
         r.city = a.city, r.rig = a.rig, r.out = a.out, r.command = command, r.sampling = a.sampling;
-        r.frames = a.frames, r.stats = a.stats, r.quiet = a.quiet, r.restart = a.restart;
+        r.frames = a.frames, r.repeats = a.repeats, r.stats = a.stats, r.quiet = a.quiet, r.restart = a.restart;
         r.path = a.path, r.modeFlags = a.modeFlags;
         return runRigRender(r);
     }

@@ -77,6 +77,7 @@ struct ViewArgs {
     std::optional<std::string> effects;  // unset: the scene's
     int frames = 0;
     bool step = false, noHud = false;
+    bool repeats = false;  // --allow-repeated-frames (with --step)
     std::string sampling = samplingName(kDefaultSampleRuns);
     int sampleRuns = kDefaultSampleRuns;
     PathFlags path;
@@ -111,6 +112,7 @@ void declareFlags(CLI::App& app, ViewArgs& a) {
                    "with --step: the path samples shown, as vista bench's --sampling: spread, consecutive or runs:K "
                    "(default " +
                        samplingName(kDefaultSampleRuns) + ")");
+    addRepeatedFramesFlag(app, a.repeats);
     app.add_flag("--no-hud", a.noHud, "no text overlay (for screenshots compared with `vista bench`)");
     app.add_option("--screenshot", a.screenshot, "write a PNG of the last frame (use with --frames)");
     addNumberOption(
@@ -134,6 +136,10 @@ Status configure(ViewArgs& a, ModeOptions& options) {
     a.sampleRuns = sampling.value();
     if (a.step && (a.frames < 1 || a.frames > 1000000 || (a.path.file.empty() && a.path.seed == 0)))
         return Status::error("--step needs --frames N in 1 .. 1000000 (as vista bench) and a path (--path or --seed)");
+    if (a.repeats && !a.step)
+        return Status::error(
+            "option --allow-repeated-frames: only with --step (without it --frames counts frames "
+            "drawn, not path samples)");
     VISTA_RETURN_IF_ERROR(
         checkRunFiles(CommandFiles().output("--screenshot", a.screenshot), a.city, a.path, a.modeFlags));
     if (!a.screenshot.empty()) VISTA_RETURN_IF_ERROR(checkWritablePath("--screenshot", a.screenshot));
@@ -615,6 +621,7 @@ int runView(int argc, char** argv) {
     req.makePath = [&](const SceneModel& city) -> Result<Path> {
         auto p = viewPath(a, city, playback);
         if (p && a.step && p->samples.empty()) return Status::error("--step: the path has no samples");
+        if (p && a.step) VISTA_RETURN_IF_ERROR(checkFrameCount(a.frames, p->samples.size(), a.repeats));
         return p;
     };
     req.beforePagedLoad = [&](uint64_t bytes) {
@@ -625,11 +632,7 @@ int runView(int argc, char** argv) {
     req.effects = [&](const Effects& declared) { return runTimeEffects(a.effects, declared, false, kCmd); };
     auto walk = loadWalkthrough(req, ctx.options);
     if (!walk) return reportBadInput(kCmd, walk.status());
-    const char* display = std::getenv("DISPLAY");
-    if (!display || !*display) {
-        std::fprintf(stderr, "%s: no X display (DISPLAY is not set); run under `xvfb-run -a` without a screen\n", kCmd);
-        return 1;
-    }
+    if (int rc = requireDisplay(kCmd); rc >= 0) return rc;
     const SceneModel& city = walk->city;
     const Path& path = walk->path;
     ctx.city = &city;

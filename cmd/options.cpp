@@ -400,9 +400,49 @@ void addPathFlags(CLI::App& app, PathFlags& f, bool timing) {
         "seconds driven before the path starts and dropped, so it starts at cruising speed, 0 .. 600 (default 8)");
 }
 
+Status checkLeftHandTraffic(bool lht, PathKind kind) {
+    if (!lht || kind == PathKind::Car) return Status::ok();
+    return Status::error(std::string("option --lht: applies to car paths (lanes driven on the left), not to --kind ") +
+                         pathKindName(kind) + " (a " + pathKindName(kind) + " path does not drive in lanes)");
+}
+
+Status checkFrameCount(int frames, size_t samples, bool repeats) {
+    if (repeats || frames < 0 || size_t(frames) <= samples) return Status::ok();
+    return Status::error("option --frames = " + std::to_string(frames) + ": the path has " + std::to_string(samples) +
+                         (samples == 1 ? " sample" : " samples") + ", so frames would repeat samples (allowed: 1 .. " +
+                         std::to_string(samples) +
+                         "; give --allow-repeated-frames to render repeated samples on purpose)");
+}
+
+void addRepeatedFramesFlag(CLI::App& app, bool& repeats) {
+    app.add_flag("--allow-repeated-frames", repeats,
+                 "allow --frames above the path's sample count: samples are then rendered more than once (by "
+                 "default such a run is refused, naming the sample count)");
+}
+
+Status refuseEmptyValues(const CLI::App& app) {
+    for (const CLI::Option* opt : app.get_options()) {
+        if (opt->get_type_size() == 0 || opt->count() == 0) continue;  // a flag, or not given
+        for (const std::string& v : opt->results())
+            if (v.empty()) {
+                const std::string name = opt->get_name();
+                return Status::error((name.rfind("-", 0) == 0 ? "option " : "argument ") + name +
+                                     " = '': empty (give a " + opt->get_type_name() +
+                                     " value, or leave the option out for its default)");
+            }
+    }
+    return Status::ok();
+}
+
 Result<PathOptions> parsePathFlags(const PathFlags& f) {
     auto k = parsePathKind(f.kind);
     if (!k) return Status::error("--kind: " + k.status().message());
+    if (f.lht && !f.file.empty())
+        return Status::error(
+            "option --lht: applies to car paths made from --seed (lanes driven on the left), not to "
+            "the recorded path of --path '" +
+            echoText(f.file) + "'");
+    VISTA_RETURN_IF_ERROR(checkLeftHandTraffic(f.lht, *k));
     PathOptions po;
     po.seed = f.seed;
     po.kind = k.value();

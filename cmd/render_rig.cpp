@@ -123,7 +123,8 @@ Status configure(const RigRunRequest& a, RigPlan& p) {
 
 Result<Walkthrough> loadCityAndFrames(const RigRunRequest& a, RigPlan& p) {
     const std::string labelsFor = p.needsLabels() ? "LiDAR labels and the semantic, instance and boxes channels" : "";
-    WalkthroughRequest req = renderRequest(a.city, a.path.file, p.path, a.frames, p.sampleRuns, labelsFor, p.idx);
+    WalkthroughRequest req =
+        renderRequest(a.city, a.path.file, p.path, a.frames, p.sampleRuns, a.repeats, labelsFor, p.idx);
     req.effects = [](const Effects& declared) { return runTimeEffects(std::nullopt, declared, true, kCmd); };
     auto w = loadWalkthrough(req, p.options);
     if (!w) return w;

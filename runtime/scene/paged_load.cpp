@@ -14,7 +14,9 @@
 #include <nlohmann/json.hpp>
 #include <osg/Group>
 
+#include "citygen/regions.h"
 #include "citygen/streets.h"
+#include "foundation/number_text.h"
 #include "foundation/input_file.h"
 #include "runtime/scene/city_file.h"
 #include "runtime/scene/scene_graph.h"
@@ -45,6 +47,87 @@ Status validatePagedRadius(const std::string& option, double value) {
     return Status::ok();
 }
 
+namespace {
+
+// Field checks of manifest.json: each names the field (with `where`, e.g.
+// "regions[3]: ") and the value as written, and states the allowed range.
+// JSON integers only for counts and sizes: -5 or 1e3 is refused, never cast.
+Status manifestField(const Json& obj, const char* field, const std::string& where) {
+    if (!obj.is_object() || !obj.contains(field)) return Status::error(where + "field '" + field + "' is missing");
+    return Status::ok();
+}
+
+Status manifestUnsigned(const Json& obj, const char* field, uint64_t lo, uint64_t hi, const std::string& where,
+                        uint64_t& out) {
+    VISTA_RETURN_IF_ERROR(manifestField(obj, field, where));
+    const Json& v = obj[field];
+    if (!v.is_number_unsigned() || v.get<uint64_t>() < lo || v.get<uint64_t>() > hi)
+        return Status::error(where + "field '" + field + "' = " + echoText(v.dump()) +
+                             " is out of range (an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                             "])");
+    out = v.get<uint64_t>();
+    return Status::ok();
+}
+
+Status manifestInt(const Json& obj, const char* field, int lo, int hi, const std::string& where, int& out) {
+    uint64_t v = 0;
+    VISTA_RETURN_IF_ERROR(manifestUnsigned(obj, field, uint64_t(lo), uint64_t(hi), where, v));
+    out = int(v);
+    return Status::ok();
+}
+
+Status manifestBool(const Json& obj, const char* field, const std::string& where, bool& out) {
+    VISTA_RETURN_IF_ERROR(manifestField(obj, field, where));
+    if (!obj[field].is_boolean())
+        return Status::error(where + "field '" + field + "' = " + echoText(obj[field].dump()) +
+                             " is not true or false");
+    out = obj[field].get<bool>();
+    return Status::ok();
+}
+
+// The grid, the regions' order and the regions' files against each other
+// (readPagedManifest has read each field within its range): the grid is the
+// one region_size_m makes of the city, region i is entry i at (i % regions_x,
+// i / regions_x), no file is listed twice, and at least one region is not empty.
+Status checkManifestRegions(const PagedManifest& m, const std::string& path) {
+    const RegionGrid grid(m.params, m.regionSizeM);
+    if (grid.countX() != m.regionsX || grid.countY() != m.regionsY)
+        return Status::error("'" + path + "': fields 'regions_x'/'regions_y' = " + std::to_string(m.regionsX) + "/" +
+                             std::to_string(m.regionsY) + " do not match region_size_m = " +
+                             shortNumber(m.regionSizeM) + " over size_m = " + shortNumber(m.params.size_m) +
+                             " (expected " + std::to_string(grid.countX()) + "/" + std::to_string(grid.countY()) + ")");
+    std::map<std::string, int> files;
+    for (size_t i = 0; i < m.regions.size(); ++i) {
+        const PagedRegionEntry& r = m.regions[i];
+        const std::string where = "'" + path + "': regions[" + std::to_string(i) + "]: ";
+        if (size_t(r.region) != i) {
+            const bool repeated = size_t(r.region) < i;
+            return Status::error(
+                where + "field 'region' = " + std::to_string(r.region) +
+                (repeated ? " repeats regions[" + std::to_string(r.region) + "]'s" : " is out of order") +
+                " (each region of the grid is listed once, in order: entry i is region i, 0 .. " +
+                std::to_string(m.regions.size() - 1) + ")");
+        }
+        if (r.ix != r.region % m.regionsX || r.iy != r.region / m.regionsX)
+            return Status::error(where + "fields 'ix'/'iy' = " + std::to_string(r.ix) + "/" + std::to_string(r.iy) +
+                                 " do not match region " + std::to_string(r.region) + " (expected " +
+                                 std::to_string(r.region % m.regionsX) + "/" + std::to_string(r.region / m.regionsX) +
+                                 ": region = iy x regions_x + ix)");
+        if (r.empty) continue;
+        for (const std::string& name : {r.file, r.coarseFile}) {
+            auto [it, added] = files.emplace(name, int(i));
+            if (!added)
+                return Status::error(where + "file '" + echoText(name) + "' is also listed by regions[" +
+                                     std::to_string(it->second) + "] (each region has files of its own)");
+        }
+    }
+    if (m.nonEmpty() == 0)
+        return Status::error("'" + path + "': every region is 'empty': the manifest lists no region to load");
+    return Status::ok();
+}
+
+}  // namespace
+
 Result<PagedManifest> readPagedManifest(const std::string& dir) {
     const std::string path = (fs::path(dir) / kPagedManifestFile).string();
     if (::access(path.c_str(), F_OK) != 0)
@@ -65,22 +148,27 @@ Result<PagedManifest> readPagedManifest(const std::string& dir) {
         auto params = parseParamsJson(j.at("params").dump(), path + " (params)");
         if (!params) return params.status();
         m.params = *params;
-        m.regionSizeM = j.at("region_size_m").get<double>();
-        m.regionsX = j.at("regions_x").get<int>();
-        m.regionsY = j.at("regions_y").get<int>();
-        if (m.regionsX < 1 || m.regionsY < 1 || m.regionsX > 4096 || m.regionsY > 4096)
-            return bad("fields 'regions_x'/'regions_y' = " + std::to_string(m.regionsX) + "/" +
-                       std::to_string(m.regionsY) + " out of range (1 .. 4096)");
+        VISTA_RETURN_IF_ERROR(manifestField(j, "region_size_m", "'" + path + "': "));
+        if (!j["region_size_m"].is_number())
+            return bad("field 'region_size_m' = " + echoText(j["region_size_m"].dump()) + " is not a number");
+        m.regionSizeM = j["region_size_m"].get<double>();
+        if (Status s = validateRegionSize(m.params, m.regionSizeM); !s) return bad(s.message());
+        VISTA_RETURN_IF_ERROR(
+            manifestInt(j, "regions_x", 1, kMaxManifestRegionsPerSide, "'" + path + "': ", m.regionsX));
+        VISTA_RETURN_IF_ERROR(
+            manifestInt(j, "regions_y", 1, kMaxManifestRegionsPerSide, "'" + path + "': ", m.regionsY));
         const Json& regions = j.at("regions");
         if (!regions.is_array() || regions.size() != size_t(m.regionsX) * size_t(m.regionsY))
             return bad("field 'regions' is not an array of regions_x * regions_y entries");
+        const int last = int(regions.size()) - 1;
         for (const Json& e : regions) {
             PagedRegionEntry r;
-            r.region = e.at("region").get<int>();
-            r.ix = e.at("ix").get<int>();
-            r.iy = e.at("iy").get<int>();
-            r.empty = e.at("empty").get<bool>();
-            r.triangles = e.at("triangles").get<uint64_t>();
+            const std::string at = "'" + path + "': regions[" + std::to_string(m.regions.size()) + "]: ";
+            VISTA_RETURN_IF_ERROR(manifestInt(e, "region", 0, last, at, r.region));
+            VISTA_RETURN_IF_ERROR(manifestInt(e, "ix", 0, m.regionsX - 1, at, r.ix));
+            VISTA_RETURN_IF_ERROR(manifestInt(e, "iy", 0, m.regionsY - 1, at, r.iy));
+            VISTA_RETURN_IF_ERROR(manifestBool(e, "empty", at, r.empty));
+            VISTA_RETURN_IF_ERROR(manifestUnsigned(e, "triangles", 0, kMaxManifestCount, at, r.triangles));
             const std::string where = "region " + std::to_string(r.region);
             if (!r.empty) {
                 const Json& b = e.at("bounds");
@@ -92,24 +180,40 @@ Result<PagedManifest> readPagedManifest(const std::string& dir) {
                 }
                 r.lo = glm::dvec3(v[0], v[1], v[2]);
                 r.hi = glm::dvec3(v[3], v[4], v[5]);
-                for (const Json& f : e.at("files")) {
-                    if (f.at("role") == "full") {
-                        r.file = f.at("name").get<std::string>();
-                        r.bytes = f.at("bytes").get<uint64_t>();
-                    } else if (f.at("role") == "coarse") {
-                        r.coarseFile = f.at("name").get<std::string>();
-                        r.coarseBytes = f.at("bytes").get<uint64_t>();
-                    }
+                if (!(r.lo.x <= r.hi.x && r.lo.y <= r.hi.y && r.lo.z <= r.hi.z))
+                    return bad(where + ": field 'bounds' = " + echoText(b.dump()) +
+                               " has a minimum above its maximum ([xmin, ymin, zmin, xmax, ymax, zmax])");
+                VISTA_RETURN_IF_ERROR(manifestField(e, "files", at));
+                if (!e["files"].is_array()) return bad(where + ": field 'files' is not a list");
+                for (size_t k = 0; k < e["files"].size(); ++k) {
+                    const Json& f = e["files"][k];
+                    const std::string fat = at + "files[" + std::to_string(k) + "]: ";
+                    VISTA_RETURN_IF_ERROR(manifestField(f, "role", fat));
+                    const bool full = f["role"] == "full", coarse = f["role"] == "coarse";
+                    if (!full && !coarse)
+                        return Status::error(fat + "field 'role' = " + echoText(f["role"].dump()) +
+                                             " is not \"full\" or \"coarse\"");
+                    if (!(full ? r.file : r.coarseFile).empty())
+                        return Status::error(fat + "a second file with role " + f["role"].dump());
+                    VISTA_RETURN_IF_ERROR(manifestField(f, "name", fat));
+                    if (!f["name"].is_string() || f["name"].get<std::string>().empty())
+                        return Status::error(fat + "field 'name' = " + echoText(f["name"].dump()) +
+                                             " is not a file name");
+                    (full ? r.file : r.coarseFile) = f["name"].get<std::string>();
+                    VISTA_RETURN_IF_ERROR(
+                        manifestUnsigned(f, "bytes", 1, kMaxRegionFileBytes, fat, full ? r.bytes : r.coarseBytes));
                 }
                 if (r.file.empty()) return bad(where + ": no file with role 'full'");
                 if (r.coarseFile.empty()) return bad(where + ": no file with role 'coarse'");
                 for (const std::string& name : {r.file, r.coarseFile})
-                    if (name.find('/') != std::string::npos || name.find('\\') != std::string::npos || name == "..")
+                    if (name.find('/') != std::string::npos || name.find('\\') != std::string::npos || name == ".." ||
+                        name == ".")
                         return bad(where + ": file name '" + name + "' is not a plain name inside the directory");
             }
             m.regions.push_back(std::move(r));
         }
     } catch (const std::exception& ex) { return bad(std::string("missing or mistyped field (") + ex.what() + ")"); }
+    VISTA_RETURN_IF_ERROR(checkManifestRegions(m, path));
     return m;
 }
 

@@ -3,10 +3,20 @@
 // so that `vista bench/view/path DIR.paged` fit a 32 or 64 km city in memory.
 //
 // readPagedManifest(): parses DIR/manifest.json (format "vista.paged_city",
-// version 1) into the region list. Errors name the file and the field:
-// missing or unreadable manifest, bad JSON, wrong format or version, a region
-// entry without ix/iy/bounds/files, bounds that are not 6 finite numbers, a
-// file name with a path separator.
+// version 1) into the region list. Errors name the file and the field, the
+// value as written and the allowed range (docs/formats.md "Paged city"):
+// missing or unreadable manifest, bad JSON, wrong format or version;
+// region_size_m outside validateRegionSize's range (citygen/regions.h);
+// regions_x/regions_y outside 1 .. kMaxManifestRegionsPerSide or other than
+// the grid region_size_m makes of the city; per region: region, ix, iy not
+// integers of the grid (entry i must be region i, at ix = i % regions_x, iy =
+// i / regions_x: a region listed twice is refused), empty not a boolean,
+// triangles not an integer in 0 .. kMaxManifestCount; for a non-empty
+// region, bounds that are not 6 finite numbers with min <= max, files
+// without exactly one "full" and one "coarse" entry, a role other than
+// those, a name that is empty, has a path separator or is listed by
+// another region, bytes not an integer in 1 .. kMaxRegionFileBytes; and a
+// manifest whose every region is empty.
 //
 // selectPagedRegions(): the non-empty regions whose world xy bounds
 // (manifest `bounds`) come within `radiusM` metres (2D distance to the
@@ -72,6 +82,11 @@ constexpr double kMinPagedRadiusM = 0.0;
 constexpr double kMaxPagedRadiusM = 100000.0;
 // Default reach of the coarse far city (--paged-far): every region of the largest city.
 constexpr double kDefaultPagedFarM = kMaxPagedRadiusM;
+// Ranges of manifest.json's fields (readPagedManifest): regions per side,
+// a region file's bytes, a region's triangle count.
+constexpr int kMaxManifestRegionsPerSide = 4096;
+constexpr uint64_t kMaxRegionFileBytes = uint64_t(1) << 40;  // 1 TiB
+constexpr uint64_t kMaxManifestCount = uint64_t(1) << 40;
 
 struct PagedRegionEntry {
     int region = 0, ix = 0, iy = 0;
