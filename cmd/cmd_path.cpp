@@ -25,8 +25,9 @@ int runEgoPath(const std::string& city, const std::string& out, const std::strin
     for (const char* flag : {"--kind", "--lht", "--route", "--speed", "--yaw-rate", "--fly-height", "--fly-pitch",
                              "--run-up", "--xodr-positions"})
         if (app.count(flag) > 0)
-            return reportBadInput(cmd, Status::error(std::string(flag) + ": not with --traffic (the path rides a "
-                                                                     "vehicle SUMO drove: a car at eye height 1.2 m)"));
+            return reportBadInput(cmd,
+                                  Status::error(std::string(flag) + ": not with --traffic (the path rides a "
+                                                                    "vehicle SUMO drove: a car at eye height 1.2 m)"));
     if (Status s = CommandFiles().input("city", city).input("--traffic", traffic).output("-o", out).check(); !s)
         return reportBadInput(cmd, s);
     if (Status s = checkWritablePath("--output", out); !s) return reportBadInput(cmd, s);
@@ -48,8 +49,8 @@ int runEgoPath(const std::string& city, const std::string& out, const std::strin
     auto p = egoPath(*tracks, *vehicle, c->params, o.dt, o.duration, car.eyeHeight());
     if (!p) return reportBadInput(cmd, p.status());
     if (Status s = savePathCsv(*p, out); !s) return reportBadInput(cmd, s);
-    std::fprintf(stderr, "vista path: %zu samples (%.1f s riding %s) -> %s\n", p->samples.size(),
-                 p->samples.back().t, tracks->agentIds[*vehicle].c_str(), out.c_str());
+    std::fprintf(stderr, "vista path: %zu samples (%.1f s riding %s) -> %s\n", p->samples.size(), p->samples.back().t,
+                 tracks->agentIds[*vehicle].c_str(), out.c_str());
     return 0;
 }
 

@@ -23,9 +23,10 @@ namespace vista {
 
 int runTraffic(int argc, char** argv) {
     const std::string cmd = "vista traffic";
-    CLI::App app{"Simulate traffic on a city with SUMO: vehicles (cars, vans, buses, trucks, bicycles) and "
-                 "pedestrians, kept as SUMO's floating-car data and traffic-light states in a directory.",
-                 cmd};
+    CLI::App app{
+        "Simulate traffic on a city with SUMO: vehicles (cars, vans, buses, trucks, bicycles) and "
+        "pedestrians, kept as SUMO's floating-car data and traffic-light states in a directory.",
+        cmd};
     std::string city, out;
     TrafficOptions opt;
     bool quiet = false;

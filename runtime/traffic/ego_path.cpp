@@ -34,8 +34,8 @@ Result<uint32_t> chooseEgo(const TrafficTracks& tracks, const std::string& id, u
     return cars[size_t(splitmix64(seed ^ 0x65676f) % n)];
 }
 
-Result<Path> egoPath(const TrafficTracks& tracks, uint32_t ego, const CityParams& params, double dt,
-                     double duration, double eyeHeight) {
+Result<Path> egoPath(const TrafficTracks& tracks, uint32_t ego, const CityParams& params, double dt, double duration,
+                     double eyeHeight) {
     VISTA_CHECK(ego < tracks.agentIds.size());
     double first = -1.0, last = -1.0;
     for (size_t f = 0; f < tracks.frames(); ++f) {

@@ -32,7 +32,7 @@ constexpr double kEgoEyeBack = 0.55;
 
 Result<uint32_t> chooseEgo(const TrafficTracks& tracks, const std::string& id, uint64_t seed);
 
-Result<Path> egoPath(const TrafficTracks& tracks, uint32_t ego, const CityParams& params, double dt,
-                     double duration, double eyeHeight);
+Result<Path> egoPath(const TrafficTracks& tracks, uint32_t ego, const CityParams& params, double dt, double duration,
+                     double eyeHeight);
 
 }  // namespace vista

@@ -20,8 +20,8 @@ struct ClassName {
     uint32_t bit;
 };
 constexpr ClassName kClassNames[] = {
-    {"passenger", kClassPassenger}, {"delivery", kClassDelivery},   {"bus", kClassBus},
-    {"truck", kClassTruck},         {"bicycle", kClassBicycle},     {"pedestrian", kClassPedestrian},
+    {"passenger", kClassPassenger}, {"delivery", kClassDelivery}, {"bus", kClassBus},
+    {"truck", kClassTruck},         {"bicycle", kClassBicycle},   {"pedestrian", kClassPedestrian},
 };
 
 uint32_t classesOf(const char* list) {
@@ -62,7 +62,8 @@ struct Reader {
     void start(const char* name, const XML_Char** atts) {
         ++depth;
         if (!sawRoot) {
-            if (std::strcmp(name, "net") != 0) return fail(std::string("the root element is <") + name + ">, not <net>");
+            if (std::strcmp(name, "net") != 0)
+                return fail(std::string("the root element is <") + name + ">, not <net>");
             sawRoot = true;
             return;
         }

@@ -82,10 +82,8 @@ std::string readAll(const std::string& path) {
 Result<SumoTools> findSumo() {
     SumoTools t;
     std::string pathList;
-    if (const char* bin = std::getenv("VISTA_SUMO_BIN"); bin && *bin)
-        pathList = bin;
-    else if (const char* path = std::getenv("PATH"))
-        pathList = path;
+    if (const char* bin = std::getenv("VISTA_SUMO_BIN"); bin && *bin) pathList = bin;
+    else if (const char* path = std::getenv("PATH")) pathList = path;
     t.netconvert = findOnPath("netconvert", pathList);
     t.sumo = findOnPath("sumo", pathList);
     if (t.sumo.empty() || t.netconvert.empty())
@@ -153,8 +151,8 @@ Status runSumoProgram(const SumoTools& tools, const std::string& program, const 
         if (errno != EINTR) return Status::error("waiting for " + name + ": " + errnoText());
     }
     if (WIFSIGNALED(status))
-        return Status::error(name + " was killed by signal " + std::to_string(WTERMSIG(status)) + "; it said: " +
-                             sumoErrorLines(readAll(logFile)));
+        return Status::error(name + " was killed by signal " + std::to_string(WTERMSIG(status)) +
+                             "; it said: " + sumoErrorLines(readAll(logFile)));
     if (WEXITSTATUS(status) != 0)
         return Status::error(name + " failed (exit " + std::to_string(WEXITSTATUS(status)) +
                              "); it said: " + sumoErrorLines(readAll(logFile)));

@@ -201,19 +201,20 @@ Result<std::string> makeDemandXml(const SumoNet& net, const TrafficDemandOptions
         if (needed) edges[size_t(t)] = tripEdges(net, kTypes[t].classBit);
     }
     if (opt.vehicles > 0 && edges[size_t(AgentType::Car)].size() < 2)
-        return Status::error("the SUMO network has no connected roads for cars (netconvert found no driving lanes "
-                             "linked through junctions in the city's OpenDRIVE): give --vehicles 0");
+        return Status::error(
+            "the SUMO network has no connected roads for cars (netconvert found no driving lanes "
+            "linked through junctions in the city's OpenDRIVE): give --vehicles 0");
     if (opt.pedestrians > 0 && edges[size_t(AgentType::Pedestrian)].size() < 2)
-        return Status::error("the SUMO network has no connected sidewalks (the city's OpenDRIVE has no sidewalk "
-                             "lanes netconvert could link): give --pedestrians 0");
+        return Status::error(
+            "the SUMO network has no connected sidewalks (the city's OpenDRIVE has no sidewalk "
+            "lanes netconvert could link): give --pedestrians 0");
     const double span = networkSpan(net);
     std::vector<Entry> entries;
     for (int i = 0; i < opt.vehicles; ++i) {
         Rng typeRng(opt.seed, uint64_t(i), kTypeStream);
         const double u = typeRng.uniform();
         int t = 0;
-        for (double acc = kDefaultMix[0]; t < 4 && u >= acc; acc += kDefaultMix[size_t(++t)]) {
-        }
+        for (double acc = kDefaultMix[0]; t < 4 && u >= acc; acc += kDefaultMix[size_t(++t)]) {}
         if (edges[size_t(t)].size() < 2) t = int(AgentType::Car), ++n.substituted;
         ++n.byType[size_t(t)];
         Rng tripRng(opt.seed, uint64_t(i), kTripStream);

@@ -37,9 +37,9 @@ enum class AgentType : uint8_t { Car, Van, Bus, Truck, Bicycle, Pedestrian };
 constexpr int kAgentTypeCount = 6;
 
 struct AgentTypeInfo {
-    const char* id;         // the vType id in SUMO's files ("car", ...)
-    const char* sumoClass;  // SUMO's vClass
-    uint32_t classBit;      // TrafficClass
+    const char* id;                // the vType id in SUMO's files ("car", ...)
+    const char* sumoClass;         // SUMO's vClass
+    uint32_t classBit;             // TrafficClass
     double length, width, height;  // metres
     double maxSpeed;               // m/s
 };

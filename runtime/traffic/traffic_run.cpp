@@ -112,7 +112,8 @@ Statistics readStatistics(const std::string& path) {
         if (std::strcmp(name, "vehicles") == 0) s->inserted = get("inserted");
         if (std::strcmp(name, "persons") == 0) s->persons = get("loaded");
         if (std::strcmp(name, "teleports") == 0) s->teleports = get("total");
-        if (std::strcmp(name, "safety") == 0) s->collisions = get("collisions"), s->emergencyStops = get("emergencyStops");
+        if (std::strcmp(name, "safety") == 0)
+            s->collisions = get("collisions"), s->emergencyStops = get("emergencyStops");
     });
     const std::string body = text.str();
     if (XML_Parse(p, body.data(), int(body.size()), 1) == XML_STATUS_ERROR) s.found = false;
@@ -156,13 +157,12 @@ Status runAll(const std::string& xodrText, const TrafficOptions& opt, const std:
     const std::string typeFiles = (maps / "opendriveNetconvert.typ.xml").string() + "," +
                                   (maps / "opendriveNetconvertPedestrians.typ.xml").string();
     progress.begin("traffic: network (netconvert)");
-    VISTA_RETURN_IF_ERROR(runSumoProgram(*tools, tools->netconvert,
-                                         {"--opendrive-files", "city.xodr", "--output-file", "city.net.xml",
-                                          "--type-files", typeFiles,
-                                          "--crossings.guess", "true", "--offset.disable-normalization", "true",
-                                          "--opendrive.internal-shapes", "true", "--opendrive.curve-resolution", "0.5",
-                                          "--no-turnarounds", "true", "--no-warnings", "true"},
-                                         work, logs));
+    VISTA_RETURN_IF_ERROR(runSumoProgram(
+        *tools, tools->netconvert,
+        {"--opendrive-files", "city.xodr", "--output-file", "city.net.xml", "--type-files", typeFiles,
+         "--crossings.guess", "true", "--offset.disable-normalization", "true", "--opendrive.internal-shapes", "true",
+         "--opendrive.curve-resolution", "0.5", "--no-turnarounds", "true", "--no-warnings", "true"},
+        work, logs));
     VISTA_RETURN_IF_ERROR(stripGeneratedDate((w / "city.net.xml").string()));
     progress.end();
 
@@ -206,11 +206,13 @@ Status runAll(const std::string& xodrText, const TrafficOptions& opt, const std:
     for (int t = 0; t < kAgentTypeCount; ++t) types[agentTypeInfo(AgentType(t)).id] = sum.demand.byType[size_t(t)];
     j["agents_by_type"] = types;
     j["substituted_vehicles"] = sum.demand.substituted;
-    j["sumo"] = {{"vehicles_inserted", sum.vehiclesInserted}, {"persons_loaded", sum.personsInserted},
-                 {"collisions", sum.collisions},         {"teleports", sum.teleports},
+    j["sumo"] = {{"vehicles_inserted", sum.vehiclesInserted},
+                 {"persons_loaded", sum.personsInserted},
+                 {"collisions", sum.collisions},
+                 {"teleports", sum.teleports},
                  {"emergency_stops", sum.emergencyStops}};
-    j["files"] = {{"xodr", "city.xodr"},         {"net", "city.net.xml"},     {"demand", "demand.rou.xml"},
-                  {"config", "traffic.sumocfg"}, {"fcd", "fcd.xml"},          {"signals", "signals.xml"},
+    j["files"] = {{"xodr", "city.xodr"},           {"net", "city.net.xml"}, {"demand", "demand.rou.xml"},
+                  {"config", "traffic.sumocfg"},   {"fcd", "fcd.xml"},      {"signals", "signals.xml"},
                   {"statistics", "statistics.xml"}};
     VISTA_RETURN_IF_ERROR(writeText((w / "traffic.json").string(), j.dump(2) + "\n"));
     std::error_code ec;
@@ -237,13 +239,13 @@ Status checkTrafficOptions(const TrafficOptions& opt) {
         return Status::error("--step = " + num(opt.stepS) + " s: allowed " + num(kMinTrafficStepS) + " to " +
                              num(kMaxTrafficStepS) + " s");
     if (std::fabs(std::round(d.durationS / opt.stepS) * opt.stepS - d.durationS) > 1e-6)
-        return Status::error("--duration = " + num(d.durationS) + " s is not a whole number of --step = " +
-                             num(opt.stepS) + " s");
+        return Status::error("--duration = " + num(d.durationS) +
+                             " s is not a whole number of --step = " + num(opt.stepS) + " s");
     return Status::ok();
 }
 
-Status makeTraffic(const std::string& xodrText, const TrafficOptions& opt, const std::string& dir,
-                   Progress& progress, TrafficRunSummary* summary) {
+Status makeTraffic(const std::string& xodrText, const TrafficOptions& opt, const std::string& dir, Progress& progress,
+                   TrafficRunSummary* summary) {
     VISTA_RETURN_IF_ERROR(checkTrafficOptions(opt));
     std::error_code ec;
     if (fs::exists(fs::symlink_status(dir, ec)))

@@ -51,7 +51,7 @@ constexpr double kMinTrafficStepS = 0.05, kMaxTrafficStepS = 2.0;
 // Names the option (--vehicles, --pedestrians, --duration, --step) and its range.
 Status checkTrafficOptions(const TrafficOptions& opt);
 
-Status makeTraffic(const std::string& xodrText, const TrafficOptions& opt, const std::string& dir,
-                   Progress& progress, TrafficRunSummary* summary);
+Status makeTraffic(const std::string& xodrText, const TrafficOptions& opt, const std::string& dir, Progress& progress,
+                   TrafficRunSummary* summary);
 
 }  // namespace vista

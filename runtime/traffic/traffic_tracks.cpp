@@ -100,7 +100,8 @@ struct Reader {
         auto first = tracks.poses.begin() + tracks.frameStart.back();
         std::sort(first, tracks.poses.end(), [](const AgentPose& a, const AgentPose& b) { return a.agent < b.agent; });
         for (auto it = first; it + 1 < tracks.poses.end(); ++it)
-            if (it->agent == (it + 1)->agent) return fail("agent '" + tracks.agentIds[it->agent] + "' twice in one step");
+            if (it->agent == (it + 1)->agent)
+                return fail("agent '" + tracks.agentIds[it->agent] + "' twice in one step");
     }
 };
 
@@ -179,7 +180,8 @@ Result<TrafficTracks> loadTrafficTracks(const std::string& dir) {
         !std::isfinite(off[0].get<double>()) || !std::isfinite(off[1].get<double>()))
         return Status::error("'" + manifest + "': net_offset must be two finite numbers");
     const auto& files = j["files"];
-    if (!files.is_object() || !files["fcd"].is_string()) return Status::error("'" + manifest + "': files.fcd is missing");
+    if (!files.is_object() || !files["fcd"].is_string())
+        return Status::error("'" + manifest + "': files.fcd is missing");
     const std::string fcd = files["fcd"].get<std::string>();
     if (fcd.empty() || fcd.find('/') != std::string::npos || fcd == "." || fcd == "..")
         return Status::error("'" + manifest + "': files.fcd = '" + fcd + "' must name a file in the directory");

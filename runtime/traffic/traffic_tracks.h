@@ -37,10 +37,10 @@ struct AgentPose {
 };
 
 struct TrafficTracks {
-    std::vector<std::string> agentIds;   // SUMO ids
-    std::vector<AgentType> agentTypes;   // per agent
-    std::vector<double> times;           // seconds, one per frame, increasing
-    std::vector<uint32_t> frameStart;    // frame f's poses: [frameStart[f], frameStart[f+1])
+    std::vector<std::string> agentIds;  // SUMO ids
+    std::vector<AgentType> agentTypes;  // per agent
+    std::vector<double> times;          // seconds, one per frame, increasing
+    std::vector<uint32_t> frameStart;   // frame f's poses: [frameStart[f], frameStart[f+1])
     std::vector<AgentPose> poses;
 
     size_t frames() const { return times.size(); }

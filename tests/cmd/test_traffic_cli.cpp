@@ -111,8 +111,8 @@ TEST(TrafficCli, AnExistingOutputAMissingCityAndAMissingSumoAreRefused) {
     EXPECT_FALSE(fs::exists(tmp.file("out1")));
 
     fs::create_directories(tmp.file("empty-bin"));
-    const auto noSumo = runVista("traffic " + smallCity() + " -o " + tmp.file("out2"),
-                                 "VISTA_SUMO_BIN=" + tmp.file("empty-bin"));
+    const auto noSumo =
+        runVista("traffic " + smallCity() + " -o " + tmp.file("out2"), "VISTA_SUMO_BIN=" + tmp.file("empty-bin"));
     EXPECT_EQ(noSumo.code, 2) << noSumo.err;
     EXPECT_NE(noSumo.err.find("SUMO is not installed"), std::string::npos) << noSumo.err;
     EXPECT_FALSE(fs::exists(tmp.file("out2")));
