@@ -75,7 +75,7 @@ std::string framesCsv(const BenchResult& result) {
 // summary.json paged.stream: the block every streamed run writes (paged_stream.h)
 // and the frame thread's splice times between frames.
 json streamJson(const BenchResult& r, const BenchConfig& cfg) {
-    json j = pagedStreamJson(r.streamOptions, r.stream, r.framesWithArrivals, r.streamDamaged);
+    json j = pagedStreamJson(r.streamOptions, r.stream, r.framesWithArrivals, r.streamDamaged, r.streamDetail);
     // Waiting makes the regions of a frame independent of load timing; a mode whose frames
     // follow measured times (hybrid's adaptive split or cache pauses) still is not.
     const bool timed = std::any_of(cfg.modes.begin(), cfg.modes.end(),
