@@ -445,8 +445,7 @@ Result<BenchResult> runBenchmark(const SceneModel* city, osg::Node* scene, const
     if (result.streamed) {
         // The first frame's regions before anything is timed: it always waits for them.
         int arrived = 0;
-        VISTA_RETURN_IF_ERROR(
-            advanceStream(**run, path, idx[0], path.camera(idx[0], base), result, &arrived, true));
+        VISTA_RETURN_IF_ERROR(advanceStream(**run, path, idx[0], path.camera(idx[0], base), result, &arrived, true));
     }
     if (cfg.warmup) VISTA_RETURN_IF_ERROR(warmUp(**run, path.camera(idx[0], base)));
 

@@ -187,9 +187,10 @@ Status configurePaged(const RenderArgs& a, RenderPlan& p) {
     std::string cannotStream;
     if (Status modes = checkStreamingModes({a.mode}); !modes) cannotStream = modes.message();
     else if ((p.channels & kLabelChannels) && a.mode != "full")
-        cannotStream = "the depth, semantic and instance channels of a streamed city come from mode full (the far "
-                       "field of mode " +
-                       a.mode + " is labelled from the whole loaded city); give --channels rgb or --mode full";
+        cannotStream =
+            "the depth, semantic and instance channels of a streamed city come from mode full (the far "
+            "field of mode " +
+            a.mode + " is labelled from the whole loaded city); give --channels rgb or --mode full";
     auto streamed = choosePagedStream(kCmd, stream, a.city, cannotStream, a.quiet);
     if (!streamed) return streamed.status();
     p.streamed = *streamed;
@@ -730,9 +731,8 @@ int runRender(int argc, char** argv) {
                                                             "sensor's model, size and channels"));
         // A rig casts every sensor into one ray scene of the loaded city, its
         // labels from the city's models: it takes a city file, not a paged city.
-        for (const char* flag :
-             {"--paged-stream", "--paged-preload", "--paged-wait", "--paged-prefetch", "--paged-radius", "--paged-far",
-              "--memory-budget"})
+        for (const char* flag : {"--paged-stream", "--paged-preload", "--paged-wait", "--paged-prefetch",
+                                 "--paged-radius", "--paged-far", "--memory-budget"})
             if (app.count(flag))
                 return reportBadInput(
                     kCmd, Status::error(std::string(flag) + " does not apply with --rig: a rig renders a city file, "

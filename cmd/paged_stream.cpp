@@ -29,14 +29,17 @@ void holdStreamUnder(CityStream& stream, double budgetGb) {
 Status checkStreamingModes(const std::vector<std::string>& modes) {
     for (const auto& m : modes)
         if (!modeStreams(m))
-            return Status::error("mode " + m +
-                                 " does not stream a paged city (modes that do: " + streamingModeNames() + ")");
+            return Status::error("mode " + m + " does not stream a paged city (modes that do: " + streamingModeNames() +
+                                 ")");
     return Status::ok();
 }
 
 Result<bool> choosePagedStream(const char* cmd, const PagedStreamFlags& f, const std::string& city,
                                const std::string& cannotStream, bool quiet) {
-    const char* asked = f.stream ? "--paged-stream" : f.wait ? "--paged-wait" : f.prefetchS ? "--paged-prefetch" : nullptr;
+    const char* asked = f.stream      ? "--paged-stream"
+                        : f.wait      ? "--paged-wait"
+                        : f.prefetchS ? "--paged-prefetch"
+                                      : nullptr;
     const bool paged = isPagedCityPath(city);
     if (!paged) {
         if (asked || f.preload)
@@ -90,8 +93,9 @@ Result<CityStreamFrame> advancePagedStream(CityStream& stream, const char* cmd, 
             if (damaged) damaged->push_back(d);
         }
         const bool foreign = why.find("another generation") != std::string::npos;
-        return Status::error(why + (foreign ? std::string() : " (generate the city again, or give --paged-preload to "
-                                                              "draw the rest of the city)"));
+        return Status::error(why + (foreign ? std::string()
+                                            : " (generate the city again, or give --paged-preload to "
+                                              "draw the rest of the city)"));
     }
     return f;
 }

@@ -194,8 +194,8 @@ osg::ref_ptr<osg::Node> buildIndex(const CityParams& params, const RegionGrid& g
     return root;
 }
 
-Json manifestJson(const CityParams& params, const RegionGrid& grid, double regionSize,
-                  const std::vector<Json>& records, const std::string& key) {
+Json manifestJson(const CityParams& params, const RegionGrid& grid, double regionSize, const std::vector<Json>& records,
+                  const std::string& key) {
     Json m;
     m["format"] = "vista.paged_city";
     m["version"] = kPagedFormatVersion;

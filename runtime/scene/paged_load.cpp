@@ -71,8 +71,7 @@ Result<PagedManifest> readPagedManifest(const std::string& dir) {
             !gen.at("seed").is_number_unsigned())
             return bad("field 'generation' is not {\"seed\": N, \"key\": \"16 hex digits\"}");
         m.generation = gen.at("key").get<std::string>();
-        if (m.generation.size() != 16 ||
-            m.generation.find_first_not_of("0123456789abcdef") != std::string::npos)
+        if (m.generation.size() != 16 || m.generation.find_first_not_of("0123456789abcdef") != std::string::npos)
             return bad("field 'generation.key' = \"" + m.generation + "\" is not 16 hex digits");
         if (gen.at("seed").get<uint64_t>() != m.params.seed)
             return bad("field 'generation.seed' = " + gen.at("seed").dump() + " is not the params' seed " +

@@ -183,9 +183,9 @@ struct RegionPagerStats {
 // RegionPager::cameraShortfall(): the budget cannot hold the regions at the camera.
 struct RegionShortfall {
     bool starved = false;
-    std::vector<int> regions;   // the regions at the camera (manifest indices)
-    uint64_t needCoarse = 0;    // their coarse levels' cost + the loading reserve
-    uint64_t needFull = 0;      // their full levels' (and chunk parts') cost + the loading reserve
+    std::vector<int> regions;  // the regions at the camera (manifest indices)
+    uint64_t needCoarse = 0;   // their coarse levels' cost + the loading reserve
+    uint64_t needFull = 0;     // their full levels' (and chunk parts') cost + the loading reserve
 };
 
 class RegionPager {
@@ -264,8 +264,8 @@ private:
     std::vector<uint8_t> _failedFull, _failedCoarse;
     // Chunk parts (chunkRadius >= 0): wanted, near the eye itself, held, queued or loading.
     std::vector<uint8_t> _desiredChunks, _nearEyeChunks, _holdChunks, _flightChunks;
-    std::vector<double> _key;   // load order within an urgency (lower first)
-    RegionPagerDelta _pending;  // drops decided by update(), handed out by the next collect()
+    std::vector<double> _key;    // load order within an urgency (lower first)
+    RegionPagerDelta _pending;   // drops decided by update(), handed out by the next collect()
     RegionShortfall _shortfall;  // of the last update()
     void computeShortfall();
     RegionPagerStats _stats;

@@ -374,8 +374,8 @@ TEST_F(GroundTruth, AResumeRendersDamagedFramesAgain) {
         bytes[bytes.size() - 3] = char(bytes[bytes.size() - 3] ^ 0x5a);
         std::ofstream(npy, std::ios::binary | std::ios::trunc) << bytes;
     };
-    expectResumeEqualsUninterrupted(city, "--path " + pathCsv + " --frames 4 --size 160x120",
-                                    dir->file("res_dmg_ref"), dir->file("res_dmg"), 3, 4, "", damage, 2);
+    expectResumeEqualsUninterrupted(city, "--path " + pathCsv + " --frames 4 --size 160x120", dir->file("res_dmg_ref"),
+                                    dir->file("res_dmg"), 3, 4, "", damage, 2);
 }
 
 TEST_F(GroundTruth, HybridResumesAfterKillByteIdentical) {

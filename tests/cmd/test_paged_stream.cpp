@@ -271,7 +271,8 @@ TEST_F(PagedStream, ABudgetThatCannotHoldTheRegionsAtTheCameraExitsTwo) {
     CliRun r = runVista("bench " + dir() + run + " --modes raycast --memory-budget " + gb + " --out " + tmp.file("b"));
     std::smatch m;
     ASSERT_TRUE(std::regex_search(r.err, m, std::regex("needs at least ([0-9.]+) GB"))) << r.err;
-    r = runVista("bench " + dir() + run + " --modes raycast --memory-budget " + m[1].str() + " --out " + tmp.file("b2"));
+    r = runVista("bench " + dir() + run + " --modes raycast --memory-budget " + m[1].str() + " --out " +
+                 tmp.file("b2"));
     EXPECT_EQ(r.code, 0) << r.err;
 }
 
@@ -311,18 +312,18 @@ TEST_F(PagedStream, ARegionOfAnotherGenerationIsRefused) {
     const std::string copy = tmp.file("copy.paged");
     fs::copy(dir(), copy, fs::copy_options::recursive);
     const fs::path region = fs::path(copy) / "region_1_1.osgb";
-    fs::copy_file(fs::path(tmp.file("other.paged")) / "region_1_1.osgb", region,
-                  fs::copy_options::overwrite_existing);
+    fs::copy_file(fs::path(tmp.file("other.paged")) / "region_1_1.osgb", region, fs::copy_options::overwrite_existing);
     auto manifest = readJson(copy + "/manifest.json");
     for (auto& e : manifest["regions"])
         for (auto& f : e["files"])
             if (f["name"] == "region_1_1.osgb") f["bytes"] = fs::file_size(region);
     std::ofstream(copy + "/manifest.json", std::ios::trunc) << manifest.dump(2);
     const std::string run = " --seed 4 --frames 2 --size 160x120 -q --paged-radius 5000";
-    for (const std::string& cmd : {"bench " + copy + run + " --modes raycast --out " + tmp.file("b"),
-                                   "bench " + copy + run + " --modes raycast --paged-preload --out " + tmp.file("p"),
-                                   "render " + copy + run + " --channels rgb --out " + tmp.file("r"),
-                                   "render " + copy + run + " --channels rgb --paged-preload --out " + tmp.file("rp")}) {
+    for (const std::string& cmd :
+         {"bench " + copy + run + " --modes raycast --out " + tmp.file("b"),
+          "bench " + copy + run + " --modes raycast --paged-preload --out " + tmp.file("p"),
+          "render " + copy + run + " --channels rgb --out " + tmp.file("r"),
+          "render " + copy + run + " --channels rgb --paged-preload --out " + tmp.file("rp")}) {
         r = runVista(cmd);
         EXPECT_EQ(r.code, 2) << cmd << ": " << r.err;
         EXPECT_NE(r.err.find("region_1_1.osgb"), std::string::npos) << cmd << ": " << r.err;

@@ -155,7 +155,8 @@ TEST_F(PagedLoad, BenchLoadsOnlyTheRegionsNearThePath) {
     EXPECT_TRUE(readBytes(tmp.file("p.csv")) == readBytes(tmp.file("one.csv")));
     // ... and bench follows that CSV (the same path as its --seed 4: the same regions).
     r = runVista("bench " + dir() + " --path " + tmp.file("p.csv") +
-                 " --paged-preload --frames 2 --size 160x120 --modes full -q --paged-radius 0 --out " + tmp.file("csv"));
+                 " --paged-preload --frames 2 --size 160x120 --modes full -q --paged-radius 0 --out " +
+                 tmp.file("csv"));
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_EQ(readJson(tmp.file("csv/summary.json"))["paged"]["regions_loaded"].get<int>(), near);
 }
@@ -205,7 +206,8 @@ TEST_F(PagedLoad, TheFarCityLoadsAtItsCoarseLevel) {
     auto s = readJson(tmp.file("far/summary.json"));
     const int near = s["paged"]["regions_loaded"].get<int>();
     EXPECT_EQ(near + s["paged"]["coarse_regions_loaded"].get<int>(), 9) << s["paged"].dump();
-    r = runVista("bench " + dir() + kBench + " --paged-preload --paged-radius 0 --paged-far 0 --out " + tmp.file("nofar"));
+    r = runVista("bench " + dir() + kBench + " --paged-preload --paged-radius 0 --paged-far 0 --out " +
+                 tmp.file("nofar"));
     ASSERT_EQ(r.code, 0) << r.err;
     s = readJson(tmp.file("nofar/summary.json"));
     EXPECT_EQ(s["paged"]["coarse_regions_loaded"].get<int>(), 0);
@@ -311,7 +313,8 @@ TEST_F(PagedLoad, BadInputExitsTwoNamingIt) {
     EXPECT_NE(r.err.find("manifest.json"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(tmp.file("p.csv")));
     // A memory budget below the estimate of the selected regions: refused before loading them.
-    r = runVista("bench " + dir() + kBench + " --paged-preload --paged-radius 5000 --memory-budget 0.01 --out " + tmp.file("o5"));
+    r = runVista("bench " + dir() + kBench + " --paged-preload --paged-radius 5000 --memory-budget 0.01 --out " +
+                 tmp.file("o5"));
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_NE(r.err.find("--memory-budget"), std::string::npos) << r.err;
     EXPECT_EQ(r.err.find("paged city: loaded"), std::string::npos) << r.err;
