@@ -181,6 +181,7 @@ json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneM
     j["diff_threshold"] = cfg.diffThreshold;
     j["path_samples"] = path.samples.size();
     j["path_run_up_s"] = cfg.runUpS >= 0 ? json(cfg.runUpS) : json(nullptr);
+    j["paced"] = cfg.pace;  // --pace: frames at the path's own speed
     const PathMotion& pm = result.motion;
     j["path_motion"] = {{"frames", pm.frames},
                         {"metres_per_frame_median", pm.metresMedian},

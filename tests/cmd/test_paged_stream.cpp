@@ -192,9 +192,12 @@ TEST_F(PagedStream, AScriptedViewerHybridDriveShowsTheStreamedFrames) {
 // every frame), and summary.json, stderr and the viewer's exit line count such frames.
 TEST_F(PagedStream, APagedCityStreamsByDefault) {
     const std::string run = " --seed 4 --frames 3 --size 160x120 --paged-radius 5000";
-    CliRun r = runVista("bench " + dir() + run + " -q --modes raycast --out " + tmp.file("b"));
+    // A drive at the path's own speed (--pace).
+    CliRun r =
+        runVista("bench " + dir() + run + " -q --modes raycast --sampling consecutive --pace --out " + tmp.file("b"));
     ASSERT_EQ(r.code, 0) << r.err;
     auto s = readJson(tmp.file("b/summary.json"));
+    EXPECT_TRUE(s["paced"].get<bool>());
     ASSERT_TRUE(s["paged"].contains("stream")) << s.dump();
     EXPECT_FALSE(s["paged"].contains("regions_loaded")) << "nothing preloaded";
     EXPECT_EQ(s["paged"]["stream"]["frames_below_detail"].get<int>(), 0) << s["paged"].dump();
