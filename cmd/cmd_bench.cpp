@@ -43,6 +43,7 @@ struct BenchArgs {
     PathOptions pathOptions;
     PagedReach paged;
     PagedStreamFlags stream;
+    bool streamed = false;  // a paged city that streams (choosePagedStream)
 };
 
 void declareFlags(CLI::App& app, BenchArgs& a) {
@@ -73,6 +74,9 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
                     "per-channel difference counted as a differing pixel, 0 .. 255 (default 8)");
     addNumberOption(app, "--worst", a.cfg.worstFrames, 0, 100,
                     "difference images for the N worst frames per mode, 0 .. 100 (default 2)");
+    app.add_flag("--pace", a.cfg.pace,
+                 "with --sampling consecutive: pace the frames at the path's own speed (frame f starts no earlier "
+                 "than its path time after the first frame's), a real-time drive");
     app.add_flag("--save-frames", a.cfg.saveFrames,
                  "also write every frame of every mode as OUT/frames/fNNNN_MODE.png");
     app.add_option(
@@ -83,8 +87,10 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
     app.add_option("--out", a.out, "output directory (created if missing)")->required();
     addNumberOption(
         app, "--memory-budget", a.cfg.memoryBudgetGb, kMemoryBudgetGbRange,
-        "GB, (0, 65536]: refuse up front a run whose estimated peak memory (from the city file's size) exceeds it; "
-        "summary.json reports the estimate and the measured peak per phase (default: no budget)");
+        "GB, (0, 65536]: refuse up front a run whose estimated peak memory (from the city file's size) exceeds it; a "
+        "streamed paged city's regions are held within it, and a budget that cannot hold the regions at the camera "
+        "is an error naming the budget they need; summary.json reports the estimate and the measured peak per phase "
+        "(default: no budget)");
     app.add_option("--effects", a.effects,
                    "run-time effects for this run instead of the scene's: 'none', names (haze, glass, night) or a JSON "
                    "object as in the params file; baked effects (sun_shadows, ambient_occlusion, materials, night's "
@@ -135,12 +141,18 @@ Status configure(BenchArgs& a) {
     VISTA_RETURN_IF_ERROR(validatePagedStream(a.stream));
     if (a.cfg.referenceSsaa == kNoReference && !a.sweep.empty())
         return Status::error("--reference none: not with --sweep (its table's speedups are against full)");
-    if (a.stream.stream && !a.sweep.empty())
-        return Status::error("--paged-stream: not with --sweep (the sweep benches city files, not paged cities)");
-    if (a.stream.stream) VISTA_RETURN_IF_ERROR(checkStreamingModes(a.cfg.modes));
+    if ((a.stream.stream || a.stream.preload) && !a.sweep.empty())
+        return Status::error(std::string(a.stream.stream ? "--paged-stream" : "--paged-preload") +
+                             ": not with --sweep (the sweep benches city files, not paged cities)");
+    if (a.cfg.pace && a.cfg.sampleRuns != 1)
+        return Status::error("--pace: needs --sampling consecutive (a drive at the path's own speed)");
     if (a.sweep.empty()) {
         if (a.city.empty()) return Status::error("missing the city file argument (or use --sweep)");
         if (!fs::exists(a.city)) return Status::error("city file '" + a.city + "' does not exist");
+        const Status modes = checkStreamingModes(a.cfg.modes);
+        auto streamed = choosePagedStream(kCmd, a.stream, a.city, modes ? std::string() : modes.message(), a.quiet);
+        if (!streamed) return streamed.status();
+        a.streamed = *streamed;
     }
     VISTA_RETURN_IF_ERROR(checkRunFiles(CommandFiles().output("--out", a.out).output("--dump-rays", a.cfg.dumpRaysDir),
                                         a.city, a.path, a.mode));
@@ -194,7 +206,7 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
     req.cmd = kCmd;
     req.quiet = a.quiet;
     req.paged = a.paged;
-    req.streamPaged = a.stream.stream;  // no region before the first frame: the stream brings them
+    req.streamPaged = a.streamed;  // no region before the first frame: the stream brings them
     // A paged city: the walkthrough first (a CSV, or a seeded path on the
     // city's streets), then only the regions near it.
     req.pathNeedsStreets = a.path.file.empty();
@@ -218,10 +230,7 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
     cfg.loadMs = walk->cityLoadMs;
     cfg.pagedJson = walk->pagedJson;
     cfg.pagedManifest = walk->manifest.get();
-    if (a.stream.stream) {
-        if (!walk->manifest)
-            return reportBadInput(kCmd, Status::error("--paged-stream: '" + cityFile +
-                                                      "' is a city file; streaming needs a paged city (DIR.paged)"));
+    if (a.streamed && walk->manifest) {
         auto so = pagedStreamOptions(a.paged, a.stream, cfg.memoryBudgetGb, cfg.memoryEstimateMb);
         if (!so) return reportBadInput(kCmd, so.status());
         cfg.streamManifest = walk->manifest.get();

@@ -541,14 +541,15 @@ Result<FrameEffects> runTimeEffects(const std::optional<std::string>& option, co
 
 void addPagedFlags(CLI::App& app, PagedReach& reach) {
     std::ostringstream help;
-    help << "with a paged city (a DIR.paged directory from `vista gen`): load only the regions within this many metres "
-            "of the walkthrough at full detail, "
+    help << "with a paged city (a DIR.paged directory from `vista gen`): the regions within this many metres of the "
+            "camera (streamed; of the walkthrough with --paged-preload) at full detail, "
          << kMinPagedRadiusM << " .. " << kMaxPagedRadiusM << " (default " << kDefaultPagedRadiusM << ")";
     const RealRange range = RealRange::closed(kMinPagedRadiusM, kMaxPagedRadiusM);
     addNumberOption(app, "--paged-radius", reach.radius, range, help.str());
     std::ostringstream far;
-    far << "with a paged city: load the other regions within this many metres of the walkthrough at their coarse level "
-           "(detail 0, no trees) for the far field, "
+    far << "with a paged city: the other regions within this many metres of the camera (of the walkthrough with "
+           "--paged-preload) at their coarse level "
+           "(detail 0, trees as impostors) for the far field, "
         << kMinPagedRadiusM << " .. " << kMaxPagedRadiusM << " (default " << kDefaultPagedFarM
         << " = the whole city; 0 = none: the city ends at --paged-radius)";
     addNumberOption(app, "--paged-far", reach.far, range, far.str());
@@ -561,27 +562,33 @@ Status validatePagedReach(const PagedReach& reach) {
 
 void addPagedStreamFlags(CLI::App& app, PagedStreamFlags& f) {
     app.add_flag("--paged-stream", f.stream,
-                 "with a paged city: stream it instead of loading the regions near the walkthrough before the first "
-                 "frame: regions load on a worker thread as the camera approaches and unload when it leaves "
-                 "(--paged-radius at full detail and --paged-far at the coarse level, around the camera); "
-                 "--memory-budget bounds what is resident; modes " +
+                 "with a paged city: stream it (the default): regions load on a worker thread as the camera "
+                 "approaches and unload when it leaves (--paged-radius at full detail and --paged-far at the coarse "
+                 "level, around the camera), the first frame waits for the regions at its camera; --memory-budget "
+                 "bounds what is resident. Given explicitly, a run that cannot stream is an error instead of "
+                 "preloading; modes " +
                      streamingModeNames());
+    app.add_flag("--paged-preload", f.preload,
+                 "with a paged city: load the regions near the whole walkthrough before the first frame instead of "
+                 "streaming (the city ends at --paged-far from the path)");
     app.add_flag("--paged-wait", f.wait,
-                 "with --paged-stream (implied): every frame waits until the regions within reach of its camera are "
+                 "with a streamed paged city: every frame waits until the regions within reach of its camera are "
                  "resident, so frames do not depend on load timing");
     std::ostringstream help;
-    help << "with --paged-stream: also load the regions within reach of where the camera will be this many seconds "
-            "ahead along its velocity, 0 .. "
+    help << "with a streamed paged city: also load the regions within reach of where the camera will be this many "
+            "seconds ahead along its velocity, 0 .. "
          << kMaxPagedPrefetchS << " (default " << kDefaultPagedPrefetchS << ")";
     addNumberOption(app, "--paged-prefetch", f.prefetchS, RealRange::closed(0, kMaxPagedPrefetchS), help.str());
 }
 
 Status validatePagedStream(PagedStreamFlags& f) {
-    if (f.wait) f.stream = true;
-    if (f.prefetchS && !f.stream)
-        return Status::error(
-            "--paged-prefetch: needs --paged-stream (or --paged-wait): without streaming every region "
-            "near the walkthrough is loaded before the first frame");
+    if (!f.preload) return Status::ok();
+    for (const auto& [given, flag] : {std::pair<bool, const char*>{f.stream, "--paged-stream"},
+                                      {f.wait, "--paged-wait"},
+                                      {f.prefetchS.has_value(), "--paged-prefetch"}})
+        if (given)
+            return Status::error(std::string("--paged-preload: not with ") + flag +
+                                 " (the preloaded city does not stream)");
     return Status::ok();
 }
 

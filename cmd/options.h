@@ -242,22 +242,25 @@ void addPagedFlags(CLI::App& app, PagedReach& reach);
 // Both values within [kMinPagedRadiusM, kMaxPagedRadiusM]; errors name the option.
 Status validatePagedReach(const PagedReach& reach);
 
-// Streaming a paged city (bench, view, render; cmd/paged_stream.h): --paged-stream = the chunked city and the
-// ray scene follow the camera of each frame (nodes/render/city_stream.h, the
-// region pager of runtime/scene/region_pager.h) instead of holding the
-// regions loaded around the whole path (the modes of modeStreams()); --paged-wait = each frame waits until the
-// regions within reach of its camera are resident (deterministic frames;
-// implies --paged-stream); --paged-prefetch S = seconds of lookahead along
-// the camera's velocity, 0 .. kMaxPagedPrefetchS (default
-// kDefaultPagedPrefetchS; needs streaming).
+// Streaming a paged city (bench, view, render; cmd/paged_stream.h): a paged
+// city streams by default: the chunked city and the ray scene follow the
+// camera of each frame (nodes/render/city_stream.h, the region pager of
+// runtime/scene/region_pager.h), the first frame waiting for the regions at
+// its camera. --paged-preload = the preloading loader instead: the regions
+// around the whole path are loaded before the first frame (and the city ends
+// there); --paged-stream = ask for the stream explicitly (an error where the
+// run cannot stream, instead of preloading); --paged-wait = each frame waits
+// until the regions within reach of its camera are resident (deterministic
+// frames); --paged-prefetch S = seconds of lookahead along the camera's
+// velocity, 0 .. kMaxPagedPrefetchS (default kDefaultPagedPrefetchS).
 struct PagedStreamFlags {
     bool stream = false;
+    bool preload = false;
     bool wait = false;
     std::optional<double> prefetchS;
 };
 void addPagedStreamFlags(CLI::App& app, PagedStreamFlags& flags);
-// Resolves the implications; errors name the option (--paged-prefetch
-// without streaming).
+// Errors name the option: --paged-preload with --paged-stream, --paged-wait or --paged-prefetch.
 Status validatePagedStream(PagedStreamFlags& flags);
 
 }  // namespace vista

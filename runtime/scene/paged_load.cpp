@@ -143,11 +143,22 @@ Result<PagedManifest> readPagedManifest(const std::string& dir) {
     try {
         if (!j.contains("format") || j.at("format") != "vista.paged_city")
             return bad("field 'format' is not \"vista.paged_city\"");
-        if (j.at("version").get<int>() != 1)
-            return bad("field 'version' = " + j.at("version").dump() + " is not supported (expected 1)");
+        if (j.at("version") != kPagedCityVersion)
+            return bad("field 'version' = " + j.at("version").dump() + " is not supported (expected " +
+                       std::to_string(kPagedCityVersion) + "; generate the city again with this vista)");
         auto params = parseParamsJson(j.at("params").dump(), path + " (params)");
         if (!params) return params.status();
         m.params = *params;
+        const Json& gen = j.at("generation");
+        if (!gen.is_object() || !gen.contains("seed") || !gen.contains("key") || !gen.at("key").is_string() ||
+            !gen.at("seed").is_number_unsigned())
+            return bad("field 'generation' is not {\"seed\": N, \"key\": \"16 hex digits\"}");
+        m.generation = gen.at("key").get<std::string>();
+        if (m.generation.size() != 16 || m.generation.find_first_not_of("0123456789abcdef") != std::string::npos)
+            return bad("field 'generation.key' = \"" + m.generation + "\" is not 16 hex digits");
+        if (gen.at("seed").get<uint64_t>() != m.params.seed)
+            return bad("field 'generation.seed' = " + gen.at("seed").dump() + " is not the params' seed " +
+                       std::to_string(m.params.seed));
         VISTA_RETURN_IF_ERROR(manifestField(j, "region_size_m", "'" + path + "': "));
         if (!j["region_size_m"].is_number())
             return bad("field 'region_size_m' = " + echoText(j["region_size_m"].dump()) + " is not a number");
@@ -247,7 +258,7 @@ std::vector<int> selectCoarseRegions(const PagedManifest& m, const std::vector<g
     return out;
 }
 
-Result<SceneModel> loadPagedRegion(const PagedManifest& m, int i, bool coarse) {
+Result<SceneModel> loadPagedRegion(const PagedManifest& m, int i, bool coarse, bool* foreign) {
     if (i < 0 || size_t(i) >= m.regions.size() || m.regions[size_t(i)].empty)
         return Status::error("paged city '" + m.dir + "': no non-empty region " + std::to_string(i));
     const PagedRegionEntry& r = m.regions[size_t(i)];
@@ -262,7 +273,23 @@ Result<SceneModel> loadPagedRegion(const PagedManifest& m, int i, bool coarse) {
     if (size != bytes)
         return Status::error("paged city '" + m.dir + "': region file '" + path + "' has " + std::to_string(size) +
                              " bytes, the manifest says " + std::to_string(bytes) + " (damaged or from another run)");
-    return loadCityFile(path);
+    auto model = loadCityFile(path);
+    if (!model) return model;
+    // The generation's identity: a file of another generation (two writers mixed in one
+    // directory) is refused, not drawn.
+    std::string key, seed;
+    const osg::Node* root = sceneRoot(*model);
+    if (!root || !root->getUserValue(kPagedGenerationKey, key)) key = "none";
+    if (!root || !root->getUserValue(kPagedSeedKey, seed)) seed = "none";
+    if (key != m.generation || seed != std::to_string(m.params.seed)) {
+        if (foreign) *foreign = true;
+        return Status::error("paged city '" + m.dir + "': region file '" + path + "' is of another generation (seed " +
+                             seed + ", key " + key + ") than its manifest '" +
+                             (fs::path(m.dir) / kPagedManifestFile).string() + "' (seed " +
+                             std::to_string(m.params.seed) + ", key " + m.generation +
+                             "): regions of different runs are mixed in the directory; generate the city again");
+    }
+    return model;
 }
 
 namespace {
@@ -304,14 +331,13 @@ Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>&
     osg::ref_ptr<osg::Group> root = new osg::Group;
     root->setName("vista.city");
     StreetUnion streets;
-    bool first = true;
+    bool first = true, foreign = false;
     std::vector<std::pair<int, bool>> order;  // (region, coarse): full regions first
     for (int i : regions) order.emplace_back(i, false);
     const size_t fullCount = order.size();
     for (size_t k = 0;; ++k) {
         if (k == fullCount) {
-            // Every full region has been tried (fallbacks of damaged ones queued
-            // after them): the far city follows, once at least one loaded.
+            // Every full region tried (damaged ones' fallbacks after them): then the far city, if one loaded.
             if (first) break;
             for (int i : coarse) order.emplace_back(i, true);
         }
@@ -319,7 +345,8 @@ Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>&
         const auto [i, isCoarse] = order[k];
         if (i < 0 || size_t(i) >= m.regions.size() || m.regions[size_t(i)].empty) continue;
         const std::string& name = isCoarse ? m.regions[size_t(i)].coarseFile : m.regions[size_t(i)].file;
-        auto rm = loadPagedRegion(m, i, isCoarse);
+        auto rm = loadPagedRegion(m, i, isCoarse, &foreign);
+        if (!rm && foreign) return rm.status();  // a region of another generation: the directory is refused
         if (!rm) {
             // A damaged or missing region file: reported by name, the rest of the city loads;
             // a full region falls back to its coarse level.
