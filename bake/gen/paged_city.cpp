@@ -303,7 +303,8 @@ Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedC
     const RegionGrid grid(params, o.regionSizeM);
     const std::string keyText = paramsToJson(params) + "\nregion_size_m=" + exactDecimal(o.regionSizeM) +
                                 "\nformat=" + std::to_string(kPagedFormatVersion) + "\ncoarse_trees=impostors" +
-                                "\nsignals=lane_model";  // regions of runs whose tiles had no signals are remade
+                                "\nsignals=lane_model" +  // regions of runs whose tiles had no signals are remade
+                                (o.inputKey.empty() ? std::string() : "\ninput=" + o.inputKey);
     const std::string key = hex64(hashBytes64(keyText.data(), keyText.size()));
     PagedCityReport rep;
     rep.regions = grid.count();
@@ -328,7 +329,7 @@ Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedC
         }
         if (!todo.empty()) {
             const auto tb = std::chrono::steady_clock::now();
-            auto b = RegionalCity::create(params, o.regionSizeM, pr);
+            auto b = RegionalCity::create(params, o.regionSizeM, pr, o.inputs);
             if (!b) return b.status();
             base.emplace(std::move(*b));
             baseSeconds = seconds(tb);

@@ -215,3 +215,9 @@ TEST(OpenDrive, NetconvertReadsOsmImport) { checkNet(osmCity("hard_cases.osm"), 
 // The synthetic town (tests/data/osm/town.osm: a 7 x 7 street grid with
 // building footprints): many junctions, blocks with sidewalks on both sides.
 TEST(OpenDrive, NetconvertReadsOsmTown) { checkNet(osmCity("town.osm"), "osm town.osm"); }
+
+// A dual carriageway of two one-way ways 10 m apart, crossed by side streets
+// (tests/data/osm/dual_carriageway.osm): one-way roads with lanes on one side.
+TEST(OpenDrive, NetconvertReadsOsmDualCarriageway) {
+    checkNet(osmCity("dual_carriageway.osm"), "osm dual_carriageway.osm");
+}
