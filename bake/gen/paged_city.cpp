@@ -378,8 +378,14 @@ Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedC
     OutputBatch own;
     OutputBatch& batch = o.batch ? *o.batch : own;
     VISTA_RETURN_IF_ERROR(writeSceneFile(*index, batch.stage((fs::path(o.dir) / kPagedIndexFile).string()), false));
-    VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage((fs::path(o.dir) / kPagedManifestFile).string()),
-                                          manifestJson(params, grid, o.regionSizeM, all).dump(2) + "\n"));
+    Json manifest = manifestJson(params, grid, o.regionSizeM, all);
+    if (o.inputs.streets) {  // readers cannot grow given streets again: the graph travels beside the regions
+        VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage((fs::path(o.dir) / kPagedStreetsFile).string()),
+                                              streetGraphToJson(*o.inputs.streets)));
+        manifest["streets"] = kPagedStreetsFile;
+    }
+    VISTA_RETURN_IF_ERROR(
+        writeFileAtomic(batch.stage((fs::path(o.dir) / kPagedManifestFile).string()), manifest.dump(2) + "\n"));
     if (!o.batch) VISTA_RETURN_IF_ERROR(own.commit());
     rep.indexWritten = true;
     rep.indexSeconds = seconds(ti);

@@ -7,7 +7,10 @@
 //                              the region file, relative names; ranges pagedRanges())
 //   region_IX_IY.osgb          a normal vista city file (city_file.h) of the region's tiles
 //   region_IX_IY.coarse.osgb   its coarse level (RegionalCity::coarse), also a city file
-//   manifest.json              params, region grid, per region: files, bytes, hashes, bounds, counts
+//   manifest.json              params, region grid, per region: files, bytes, hashes, bounds, counts;
+//                              `streets` names streets.json when the streets were given
+//   streets.json               the whole street graph (streetGraphToJson) of a city whose streets
+//                              were given (an OSM import), for readers that cannot grow it again
 //   records/region_IX_IY.json  one record per finished region (what resume checks)
 // Empty regions (no geometry) have a record and a manifest entry but no files and no PagedLOD.
 //

@@ -66,6 +66,12 @@ Result<PagedManifest> readPagedManifest(const std::string& dir) {
         if (!params) return params.status();
         m.params = *params;
         m.regionSizeM = j.at("region_size_m").get<double>();
+        if (j.contains("streets")) {
+            m.streetsFile = j.at("streets").get<std::string>();
+            if (m.streetsFile.empty() || m.streetsFile.find('/') != std::string::npos ||
+                m.streetsFile.find('\\') != std::string::npos || m.streetsFile == "..")
+                return bad("field 'streets' = '" + m.streetsFile + "' is not a plain name inside the directory");
+        }
         m.regionsX = j.at("regions_x").get<int>();
         m.regionsY = j.at("regions_y").get<int>();
         if (m.regionsX < 1 || m.regionsY < 1 || m.regionsX > 4096 || m.regionsY > 4096)
@@ -309,10 +315,21 @@ Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>&
     return out;
 }
 
+// The whole street graph of a paged city whose streets were given (JSON; a 64 km city's is tens of MB).
+constexpr uint64_t kMaxStreetsBytes = 1024 * kMiB;
+
 Result<StreetGraph> pagedPathStreets(const PagedManifest& m) {
-    // The street graph of a city depends only on its params (paged cities are
-    // never imported from OSM); growing it is cheap (the 64 km city: 21,475
-    // edges, about a second), so the path is the single-file city's path.
+    if (!m.streetsFile.empty()) {  // given streets (an OSM import): the graph as generated
+        const std::string path = (fs::path(m.dir) / m.streetsFile).string();
+        auto text = readInputFile("paged city streets", path, kMaxStreetsBytes);
+        if (!text) return Status::error("paged city '" + m.dir + "': " + text.status().message());
+        auto g = streetGraphFromJson(*text);
+        if (!g) return Status::error("'" + path + "': " + g.status().message());
+        return g;
+    }
+    // A grown city's street graph depends only on its params; growing it is
+    // cheap (the 64 km city: 21,475 edges, about a second), so the path is the
+    // single-file city's path.
     return growStreets(m.params, nullptr);
 }
 

@@ -509,6 +509,14 @@ TEST_F(Paged, OsmExtractPagesTheSingleFileCity) {
     EXPECT_EQ(m["totals"]["buildings"].get<size_t>(), one["buildings"].get<size_t>());
     EXPECT_GT(one["osm_buildings"]["imported"].get<size_t>(), 0u);
     EXPECT_EQ(paged["osm_roads"], one["osm_roads"]);
+    // The given streets travel beside the regions: a seeded path on the paged city is the
+    // single file's path (a grown graph would be another city's streets).
+    EXPECT_EQ(m["streets"], "streets.json");
+    r = runVista("path " + tmp.file("t.paged") + " --seed 3 -o " + tmp.file("paged.csv"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = runVista("path " + tmp.file("one.osgb") + " --seed 3 -o " + tmp.file("one.csv"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(readBytes(tmp.file("paged.csv")), readBytes(tmp.file("one.csv")));
     // The regions' records name the input: a rerun reuses them all.
     r = runVista("gen -q --detail 0 --osm " + town + " --region-size 500 -o " + tmp.file("t.paged") + " --stats " +
                  tmp.file("again.json"));
