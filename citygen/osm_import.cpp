@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <exception>
 #include <fcntl.h>
@@ -37,6 +38,7 @@
 #include "citygen/polygon.h"
 #include "citygen/street_geometry.h"
 #include "citygen/streets.h"
+#include "foundation/hash.h"
 #include "foundation/input_file.h"
 #include "foundation/number_text.h"
 #include "foundation/units.h"
@@ -558,7 +560,66 @@ StreetGraph segmentGraph(const std::vector<Way>& ways, size_t first, size_t last
 
 // ---- road tags onto the planar edges ---------------------------------------------
 
-// Gives every street edge the road tags (osm_road_tags.h) of the way it lies on: among the
+struct WaySeg {
+    glm::dvec2 p, q;
+    uint32_t way;
+};
+
+uint64_t gridKey(int64_t x, int64_t y) { return (uint64_t(x) << 32) ^ (uint64_t(y) & 0xffffffffull); }
+
+// Uniform grid of cell side `cell`: a segment is listed in the 3 x 3 cells around points every
+// `cell` along it, so every point within cell / 2 of it finds it in its own cell (gridKey).
+std::unordered_map<uint64_t, std::vector<uint32_t>> segmentGrid(const std::vector<WaySeg>& segs, double cell) {
+    std::unordered_map<uint64_t, std::vector<uint32_t>> grid;
+    for (uint32_t s = 0; s < segs.size(); ++s) {
+        const double len = glm::length(segs[s].q - segs[s].p);
+        const int steps = int(std::min(std::ceil(len / cell), 1e6));
+        for (int i = 0; i <= steps; ++i) {
+            const glm::dvec2 p = segs[s].p + (steps ? double(i) / steps : 0.0) * (segs[s].q - segs[s].p);
+            const int64_t cx = int64_t(std::floor(p.x / cell)), cy = int64_t(std::floor(p.y / cell));
+            for (int64_t dy = -1; dy <= 1; ++dy)
+                for (int64_t dx = -1; dx <= 1; ++dx) {
+                    auto& list = grid[gridKey(cx + dx, cy + dy)];
+                    if (list.empty() || list.back() != s) list.push_back(s);
+                }
+        }
+    }
+    return grid;
+}
+
+// The tags of way `w` (`t`, in the way's direction) in the direction a -> b of an edge on it:
+// the way's segment nearest to the edge's midpoint decides.
+OsmRoadTags tagsAlong(const Way& w, const OsmRoadTags& t, const glm::dvec2& a, const glm::dvec2& b) {
+    const glm::dvec2 mid = 0.5 * (a + b);
+    size_t nearest = 1;
+    double bestD = 1e300;
+    for (size_t k = 1; k < w.nodes.size(); ++k)
+        if (const double d = pointSegmentDistance(mid, w.nodes[k - 1].xy, w.nodes[k].xy); d < bestD)
+            bestD = d, nearest = k;
+    return glm::dot(b - a, w.nodes[nearest].xy - w.nodes[nearest - 1].xy) >= 0 ? t : t.reversed();
+}
+
+// Turns every one-way edge to run along its traffic (a and b, the directions' lanes and turn
+// lanes swapped where it ran against it) and, unless `widthTagged`, makes it as wide as its
+// lanes are at the class's lane width (roadWidth / roadLanes).
+void alignOneWayEdges(StreetGraph& g, const std::vector<char>& widthTagged) {
+    for (size_t i = 0; i < g.edges.size(); ++i) {
+        StreetEdge& e = g.edges[i];
+        const bool forwardOnly = e.lanesForward > 0 && e.lanesBackward == 0;
+        const bool backwardOnly = e.lanesBackward > 0 && e.lanesForward == 0;
+        if (!forwardOnly && !backwardOnly) continue;
+        if (backwardOnly) {
+            std::swap(e.a, e.b);
+            std::swap(e.lanesForward, e.lanesBackward);
+            std::swap(e.turnForward, e.turnBackward);
+        }
+        if (!widthTagged[i]) e.width = float(e.lanesForward * roadWidth(e.cls) / roadLanes(e.cls));
+    }
+}
+
+// Gives every street edge the road tags (osm_road_tags.h) of the way it lies on. An edge of a
+// one-way way's carriageway (planarize() keeps each one-way way apart; `carriageways`: per edge,
+// way index + 1, or 0) takes that way's tags. Any other edge: among the
 // ways of the edge's class, the one whose segments come closest to the points at 1/4, 1/2
 // and 3/4 of the edge (the largest of the three distances, at most `tol`: planarization moves
 // nodes by up to the snap radius and merges ends closer than the minimum segment). The way's
@@ -566,37 +627,19 @@ StreetGraph segmentGraph(const std::vector<Way>& ways, size_t first, size_t last
 // running against the way; ways whose segment there lies within 45 degrees of the edge come
 // before crossing ones. When that way is one-way and another way of the class within
 // `mergeTol` is one-way the other way round, both within 18 degrees of the edge (a dual
-// carriageway merged into one edge), each gives its direction.
-void assignRoadTags(StreetGraph& g, const std::vector<Way>& ways, const std::vector<OsmRoadTags>& tags, double tol,
-                    double mergeTol, OsmRoadTagStats& st) {
-    struct Seg {
-        glm::dvec2 p, q;
-        uint32_t way;
-    };
-    std::vector<Seg> segs;
+// carriageway whose two ways overlapped into one edge), each gives its direction.
+// Then alignOneWayEdges().
+void assignRoadTags(StreetGraph& g, const std::vector<uint32_t>& carriageways, const std::vector<Way>& ways,
+                    const std::vector<OsmRoadTags>& tags, double tol, double mergeTol, OsmRoadTagStats& st) {
+    std::vector<WaySeg> segs;
     for (size_t w = 0; w < ways.size(); ++w)
         for (size_t k = 1; k < ways[w].nodes.size(); ++k)
             segs.push_back({ways[w].nodes[k - 1].xy, ways[w].nodes[k].xy, uint32_t(w)});
-    // Uniform grid: a segment is listed in the 3 x 3 cells around points every `cell` along it, so
-    // every point within tol (= cell / 2) of it finds it in its own cell.
     const double cell = std::max(2.0 * tol, 1.0);
     auto cellOf = [&](const glm::dvec2& p) {
         return std::make_pair(int64_t(std::floor(p.x / cell)), int64_t(std::floor(p.y / cell)));
     };
-    auto key = [](int64_t x, int64_t y) { return (uint64_t(x) << 32) ^ (uint64_t(y) & 0xffffffffull); };
-    std::unordered_map<uint64_t, std::vector<uint32_t>> grid;
-    for (uint32_t s = 0; s < segs.size(); ++s) {
-        const double len = glm::length(segs[s].q - segs[s].p);
-        const int steps = int(std::min(std::ceil(len / cell), 1e6));
-        for (int i = 0; i <= steps; ++i) {
-            const auto [cx, cy] = cellOf(segs[s].p + (steps ? double(i) / steps : 0.0) * (segs[s].q - segs[s].p));
-            for (int64_t dy = -1; dy <= 1; ++dy)
-                for (int64_t dx = -1; dx <= 1; ++dx) {
-                    auto& list = grid[key(cx + dx, cy + dy)];
-                    if (list.empty() || list.back() != s) list.push_back(s);
-                }
-        }
-    }
+    const auto grid = segmentGrid(segs, cell);
     struct Cand {
         uint32_t way;
         double d[3];
@@ -605,14 +648,23 @@ void assignRoadTags(StreetGraph& g, const std::vector<Way>& ways, const std::vec
     };
     std::vector<Cand> cands;
     std::unordered_map<uint32_t, size_t> candOf;  // way -> index in cands
-    for (auto& e : g.edges) {
+    std::vector<char> widthTagged(g.edges.size(), 0);
+    for (size_t i = 0; i < g.edges.size(); ++i) {
+        StreetEdge& e = g.edges[i];
         const glm::dvec2 a = g.nodes[e.a], b = g.nodes[e.b];
+        if (i < carriageways.size() && carriageways[i] > 0 && carriageways[i] <= ways.size()) {
+            const Way& w = ways[carriageways[i] - 1];  // the edge's own one-way way
+            ++st.edgesMatched;
+            applyOsmRoadTags(tagsAlong(w, tags[w.tags], a, b), e);
+            widthTagged[i] = tags[w.tags].width > 0;
+            continue;
+        }
         cands.clear();
         candOf.clear();
         for (int k = 0; k < 3; ++k) {
             const glm::dvec2 p = a + 0.25 * (k + 1) * (b - a);
             const auto [cx, cy] = cellOf(p);
-            auto it = grid.find(key(cx, cy));
+            auto it = grid.find(gridKey(cx, cy));
             if (it == grid.end()) continue;
             for (uint32_t s : it->second) {
                 if (ways[segs[s].way].cls != e.cls) continue;
@@ -649,7 +701,7 @@ void assignRoadTags(StreetGraph& g, const std::vector<Way>& ways, const std::vec
         }
         ++st.edgesMatched;
         auto oriented = [&](const Cand& c) {
-            const Seg& s = segs[c.midSeg];
+            const WaySeg& s = segs[c.midSeg];
             const OsmRoadTags& t = tags[ways[c.way].tags];
             return glm::dot(b - a, s.q - s.p) >= 0 ? t : t.reversed();
         };
@@ -682,7 +734,9 @@ void assignRoadTags(StreetGraph& g, const std::vector<Way>& ways, const std::vec
             }
         }
         applyOsmRoadTags(t, e);
+        widthTagged[i] = t.width > 0;
     }
+    alignOneWayEdges(g, widthTagged);
 }
 
 // "74.3 m", "22.6 km".
@@ -694,8 +748,18 @@ std::string distance(double m) {
     return s.str();
 }
 
-// OSM imports are single-file cities (paged output does not take --osm).
-double maxExtent_m() { return kMaxSingleFileSizeM; }
+// The largest city vista gen builds (paged above kMaxSingleFileSizeM).
+double maxExtent_m() { return kMaxPagedSizeM; }
+
+// The side of the city square that holds the roads' bounding box [lo, hi]
+// (centred on the origin by placeFrame) with a margin: whole tiles, within
+// size_m's range.
+double extractCitySize(const OsmImport& out, const CityParams& params) {
+    const double need = std::max(out.extentX_m, out.extentY_m) + 2.0 * kOsmExtentMargin_m;
+    const double tile = std::isfinite(params.tile_size_m) && params.tile_size_m > 0 ? params.tile_size_m : 250.0;
+    const double side = std::ceil(need / tile - 1e-9) * tile;
+    return std::clamp(side, 100.0, kMaxPagedSizeM);
+}
 
 // ---- buildings ------------------------------------------------------------------
 
@@ -918,10 +982,20 @@ std::string OsmImport::dropSummary() const {
     std::string out;
     const size_t total = invalidNodes + missingNodes + outlierNodes;
     if (total) out = "dropped " + std::to_string(total) + (total == 1 ? " node (" : " nodes (") + nodes + ")";
-    if (clippedSegments)
-        out += (out.empty() ? "" : "; ") + std::string("clipped ") + std::to_string(clippedSegments) +
-               (clippedSegments == 1 ? " road segment" : " road segments") +
-               " at the city square's border (the extract is larger than size_m = " + distance(2.0 * clipHalf_m) + ")";
+    if (clippedSegments) {
+        auto km = [](double m) {
+            char b[32];
+            std::snprintf(b, sizeof b, m < 1000 ? "%.0f m" : "%.1f km", m < 1000 ? m : m / 1000.0);
+            return std::string(b);
+        };
+        char pct[32];
+        std::snprintf(pct, sizeof pct, "%.1f %%", roadLength_m > 0 ? 100.0 * keptLength_m / roadLength_m : 0.0);
+        out += (out.empty() ? "" : "; ") + std::string("clipped the roads to the city square of size_m = ") +
+               distance(2.0 * clipHalf_m) + ": kept " + km(keptLength_m) + " of " + km(roadLength_m) + " of road (" +
+               pct + "); " + std::to_string(clippedSegments) + " of " + std::to_string(roadSegments) +
+               " road segments cut or dropped, " + std::to_string(clippedWays) + " of " + std::to_string(roadWays) +
+               " ways wholly outside";
+    }
     if (tangledWays)
         out += (out.empty() ? "dropped " : "; dropped ") + std::to_string(tangledWays) +
                (tangledWays == 1 ? " way" : " ways") + " crossing itself more than " +
@@ -1102,34 +1176,61 @@ int clipToSquare(glm::dvec2& a, glm::dvec2& b, double half) {
 Status buildStreets(const std::vector<Way>& kept, const WayCollector& collector, const CityParams& params,
                     const std::string& path, OsmImport& out) {
     std::vector<RawSegment> segs;
-    const double half = 0.5 * params.size_m;
+    const double half = 0.5 * out.citySize_m;
     out.clipHalf_m = half;
-    for (const auto& w : kept)
+    out.roadWays = kept.size();
+    for (size_t i = 0; i < kept.size(); ++i) {
+        const Way& w = kept[i];
+        const OsmRoadTags& t = collector.roadTags[w.tags];
+        const uint32_t carriageway = t.onlyForward() || t.onlyBackward() ? uint32_t(i + 1) : 0u;
+        bool inside = false;
         for (size_t k = 1; k < w.nodes.size(); ++k) {
             glm::dvec2 a = w.nodes[k - 1].xy, b = w.nodes[k].xy;
+            ++out.roadSegments;
+            out.roadLength_m += glm::length(b - a);
             const int clip = clipToSquare(a, b, half);
             if (clip != 1) ++out.clippedSegments;
-            if (clip) segs.push_back({a, b, w.cls});
+            if (clip) {
+                segs.push_back({a, b, w.cls, carriageway});
+                out.keptLength_m += glm::length(b - a);
+                inside = true;
+            }
         }
+        out.clippedWays += inside ? 0 : 1;
+    }
     if (segs.empty())
         return Status::error("OSM file '" + path + "': no road lies inside the city square of size_m = " +
-                             distance(params.size_m) + " about the data's centre");
-    out.streets = planarize(segs, params.snap_radius_m, params.min_segment_m);
+                             distance(out.citySize_m) + " about the data's centre");
+    std::vector<uint32_t> carriageways;
+    out.streets = planarize(segs, params.snap_radius_m, params.min_segment_m, &carriageways);
     if (out.streets.edges.empty())
         return Status::error("OSM file '" + path + "' has highway ways but none longer than min_segment_m = " +
                              std::to_string(params.min_segment_m) + " m");
     out.roadTagStats = collector.roadStats;
     const double snap = std::isfinite(params.snap_radius_m) ? std::max(params.snap_radius_m, 0.0) : 0.0;
     const double minSeg = std::isfinite(params.min_segment_m) ? std::max(params.min_segment_m, 0.0) : 0.0;
-    assignRoadTags(out.streets, kept, collector.roadTags, snap + minSeg + 1.0, snap + 1.0, out.roadTagStats);
+    assignRoadTags(out.streets, carriageways, kept, collector.roadTags, snap + minSeg + 1.0, snap + 1.0,
+                   out.roadTagStats);
     return Status::ok();
 }
 
 }  // namespace
 
-Result<OsmImport> importOsm(const std::string& path, const CityParams& params, bool buildings) {
+Result<OsmImport> importOsm(const std::string& path, const CityParams& params, bool buildings, OsmExtent extent) {
     VISTA_RETURN_IF_ERROR(checkInputFile("OSM file", path, kMaxOsmFileBytes));
     OsmImport out;
+    {
+        std::ifstream in(path, std::ios::binary);
+        if (!in) return Status::error("OSM file '" + path + "' cannot be opened");
+        Hasher64 h;
+        std::vector<unsigned char> buf(size_t(1) << 20);
+        while (in) {
+            in.read(reinterpret_cast<char*>(buf.data()), std::streamsize(buf.size()));
+            if (in.gcount() > 0) h.update(buf.data(), size_t(in.gcount()));
+        }
+        if (in.bad()) return Status::error("OSM file '" + path + "' cannot be read");
+        out.fileHash = h.finish();
+    }
     const double limit = maxExtent_m();
     out.outlierRadius_m = limit * std::sqrt(2.0);
     WayCollector collector;
@@ -1152,11 +1253,12 @@ Result<OsmImport> importOsm(const std::string& path, const CityParams& params, b
     out.geo = ref;
     out.extentX_m = hi.x - lo.x;
     out.extentY_m = hi.y - lo.y;
-    if (Status extent = checkExtent(path, limit, out); !extent) return extent;
+    if (Status fits = checkExtent(path, limit, out); !fits) return fits;
+    out.citySize_m = extent == OsmExtent::Extract ? extractCitySize(out, params) : params.size_m;
 
     if (buildings)
         importBuildings(collector.buildingWays, relationCollector.relations,
-                        {ref, median, out.outlierRadius_m, 0.5 * params.size_m}, out);
+                        {ref, median, out.outlierRadius_m, 0.5 * out.citySize_m}, out);
 
     auto kept = untangleWays(ways, params, path, noRoads, out);
     if (!kept) return kept.status();

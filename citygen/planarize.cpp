@@ -2,9 +2,12 @@
 // cleanup in double precision (snap, contract short edges, dedup) that is
 // re-checked with exact predicates and repeated until the graph is planar;
 // a last-resort pass drops conflicting edges so the contract always holds.
+// Carriageways (streets.h) ride along as edge data through every step, so
+// each merge can ask which carriageways its two nodes lie on.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <map>
 #include <numeric>
 #include <tuple>
@@ -24,15 +27,25 @@ namespace {
 
 using Epeck = CGAL::Exact_predicates_exact_constructions_kernel;
 using SegTraits = CGAL::Arr_segment_traits_2<Epeck>;
-struct KeepHighestClass {
-    int operator()(int a, int b) const { return std::min(a, b); }
+// A segment's road class and carriageway; overlapping pieces keep the highest
+// class, and their carriageway only when both share it.
+struct SegData {
+    int cls = 2;
+    uint32_t carriageway = 0;
+    bool operator==(const SegData& o) const { return cls == o.cls && carriageway == o.carriageway; }
 };
-using Traits = CGAL::Arr_curve_data_traits_2<SegTraits, int, KeepHighestClass>;
+struct MergeSegData {
+    SegData operator()(const SegData& a, const SegData& b) const {
+        return {std::min(a.cls, b.cls), a.carriageway == b.carriageway ? a.carriageway : 0u};
+    }
+};
+using Traits = CGAL::Arr_curve_data_traits_2<SegTraits, SegData, MergeSegData>;
 using Arrangement = CGAL::Arrangement_2<Traits>;
 
 struct WorkEdge {
     uint32_t a, b;
     int cls;
+    uint32_t carriageway = 0;
 };
 struct WorkGraph {
     std::vector<glm::dvec2> nodes;
@@ -47,7 +60,8 @@ WorkGraph arrange(const std::vector<RawSegment>& segs) {
     curves.reserve(segs.size());
     for (const auto& s : segs) {
         if (s.a == s.b) continue;
-        curves.emplace_back(SegTraits::Curve_2(Epeck::Point_2(s.a.x, s.a.y), Epeck::Point_2(s.b.x, s.b.y)), int(s.cls));
+        curves.emplace_back(SegTraits::Curve_2(Epeck::Point_2(s.a.x, s.a.y), Epeck::Point_2(s.b.x, s.b.y)),
+                            SegData{int(s.cls), s.carriageway});
     }
     WorkGraph g;
     if (curves.empty()) return g;
@@ -61,7 +75,7 @@ WorkGraph arrange(const std::vector<RawSegment>& segs) {
     }
     for (auto e = arr.edges_begin(); e != arr.edges_end(); ++e) {
         uint32_t a = index[&*e->source()], b = index[&*e->target()];
-        g.edges.push_back({a, b, std::clamp(e->curve().data(), 0, 2)});
+        g.edges.push_back({a, b, std::clamp(e->curve().data().cls, 0, 2), e->curve().data().carriageway});
     }
     return g;
 }
@@ -81,24 +95,24 @@ struct UnionFind {
 // Applies a node mapping (old -> representative), removes self loops,
 // duplicates (keeping the highest class) and isolated nodes.
 void rebuild(WorkGraph& g, const std::vector<uint32_t>& rep) {
-    std::map<std::pair<uint32_t, uint32_t>, int> best;
+    std::map<std::pair<uint32_t, uint32_t>, SegData> best;
     for (const auto& e : g.edges) {
         uint32_t a = rep[e.a], b = rep[e.b];
         if (a == b) continue;
         auto key = std::make_pair(std::min(a, b), std::max(a, b));
         auto it = best.find(key);
-        if (it == best.end()) best.emplace(key, e.cls);
-        else it->second = std::min(it->second, e.cls);
+        if (it == best.end()) best.emplace(key, SegData{e.cls, e.carriageway});
+        else it->second = MergeSegData()(it->second, SegData{e.cls, e.carriageway});
     }
     std::vector<uint32_t> newIndex(g.nodes.size(), UINT32_MAX);
     WorkGraph out;
-    for (const auto& [key, cls] : best) {
+    for (const auto& [key, data] : best) {
         for (uint32_t v : {key.first, key.second})
             if (newIndex[v] == UINT32_MAX) {
                 newIndex[v] = uint32_t(out.nodes.size());
                 out.nodes.push_back(g.nodes[v]);
             }
-        out.edges.push_back({newIndex[key.first], newIndex[key.second], cls});
+        out.edges.push_back({newIndex[key.first], newIndex[key.second], data.cls, data.carriageway});
     }
     g = std::move(out);
 }
@@ -119,7 +133,36 @@ bool better(const WorkGraph& g, const std::vector<std::pair<int, int>>& rank, ui
     return lessPoint(g.nodes[a], g.nodes[b]);
 }
 
-// Merges nodes closer than `snap` onto the best-ranked node nearby.
+// The carriageways (sorted, distinct) of every node's incident edges.
+using Carriageways = std::vector<uint32_t>;
+std::vector<Carriageways> nodeCarriageways(const WorkGraph& g) {
+    std::vector<Carriageways> c(g.nodes.size());
+    for (const auto& e : g.edges)
+        if (e.carriageway)
+            for (uint32_t v : {e.a, e.b}) c[v].push_back(e.carriageway);
+    for (auto& v : c) {
+        std::sort(v.begin(), v.end());
+        v.erase(std::unique(v.begin(), v.end()), v.end());
+    }
+    return c;
+}
+
+// Two nodes `d` apart may become one: one's carriageways are among the
+// other's (so a way's own nodes and free nodes always may), or they are
+// closer than kCarriagewayMerge_m.
+bool mayMerge(const Carriageways& x, const Carriageways& y, double d) {
+    return d < kCarriagewayMerge_m || std::includes(x.begin(), x.end(), y.begin(), y.end()) ||
+           std::includes(y.begin(), y.end(), x.begin(), x.end());
+}
+
+void unite(Carriageways& into, const Carriageways& from) {
+    if (from.empty()) return;
+    Carriageways u;
+    std::set_union(into.begin(), into.end(), from.begin(), from.end(), std::back_inserter(u));
+    into = std::move(u);
+}
+
+// Merges nodes closer than `snap` onto the best-ranked node nearby that it may merge with.
 bool snapNodes(WorkGraph& g, double snap) {
     const size_t n = g.nodes.size();
     auto rank = nodeRank(g);
@@ -128,6 +171,7 @@ bool snapNodes(WorkGraph& g, double snap) {
     std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return better(g, rank, a, b); });
     std::vector<uint32_t> rep(n);
     std::iota(rep.begin(), rep.end(), 0u);
+    std::vector<Carriageways> cw = nodeCarriageways(g);  // of each representative: all it took in
     bool changed = false;
     const double cell = std::max(snap, 1e-9);
     std::unordered_map<uint64_t, std::vector<uint32_t>> grid;
@@ -144,7 +188,8 @@ bool snapNodes(WorkGraph& g, double snap) {
                 if (it == grid.end()) continue;
                 for (uint32_t r : it->second) {
                     double d = glm::length(g.nodes[r] - p);
-                    if (d <= snap && (found == UINT32_MAX || d < bestD || (d == bestD && better(g, rank, r, found)))) {
+                    if (d <= snap && mayMerge(cw[r], cw[v], d) &&
+                        (found == UINT32_MAX || d < bestD || (d == bestD && better(g, rank, r, found)))) {
                         found = r;
                         bestD = d;
                     }
@@ -152,6 +197,7 @@ bool snapNodes(WorkGraph& g, double snap) {
             }
         if (found != UINT32_MAX) {
             rep[v] = found;
+            unite(cw[found], cw[v]);
             changed = true;
         } else grid[key(cx, cy)].push_back(v);
     }
@@ -172,14 +218,17 @@ bool contractShort(WorkGraph& g, double minSegment) {
             return lx < ly || (lx == ly && x < y);
         });
         UnionFind uf(g.nodes.size());
+        std::vector<Carriageways> cw = nodeCarriageways(g);  // of each root: all it took in
         bool changed = false;
         for (uint32_t e : order) {
             if (len(e) >= minSegment) break;
             uint32_t a = uf.find(g.edges[e].a), b = uf.find(g.edges[e].b);
             if (a == b) continue;
-            if (glm::length(g.nodes[a] - g.nodes[b]) >= minSegment) continue;
+            const double d = glm::length(g.nodes[a] - g.nodes[b]);
+            if (d >= minSegment || !mayMerge(cw[a], cw[b], d)) continue;
             if (better(g, rank, b, a)) std::swap(a, b);
             uf.p[b] = a;  // a survives at its own position
+            unite(cw[a], cw[b]);
             changed = true;
         }
         if (!changed) break;
@@ -220,6 +269,7 @@ bool snapNodesToEdges(WorkGraph& g, double snap, double minSegment) {
             for (int64_t x = x0; x <= x1; ++x) grid[key(x, y)].push_back(i);
     }
     std::vector<std::vector<std::pair<double, uint32_t>>> splits(ne);
+    const std::vector<Carriageways> cw = nodeCarriageways(g);
     bool any = false;
     for (uint32_t v = 0; v < nn; ++v) {
         const glm::dvec2 p = g.nodes[v];
@@ -237,6 +287,7 @@ bool snapNodesToEdges(WorkGraph& g, double snap, double minSegment) {
             double t = glm::dot(p - a, d) / dd;
             if (t <= 0 || t >= 1) continue;
             double dist = glm::length(p - (a + t * d));
+            if (e.carriageway && !mayMerge(cw[v], Carriageways{e.carriageway}, dist)) continue;
             if (dist < bestD || (dist == bestD && best != UINT32_MAX && ei < best)) {
                 bestD = dist;
                 best = ei;
@@ -259,10 +310,10 @@ bool snapNodesToEdges(WorkGraph& g, double snap, double minSegment) {
         std::sort(splits[i].begin(), splits[i].end());
         uint32_t prev = e.a;
         for (auto [t, v] : splits[i]) {
-            if (v != prev) edges.push_back({prev, v, e.cls});
+            if (v != prev) edges.push_back({prev, v, e.cls, e.carriageway});
             prev = v;
         }
-        edges.push_back({prev, e.b, e.cls});
+        edges.push_back({prev, e.b, e.cls, e.carriageway});
     }
     g.edges = std::move(edges);
     std::vector<uint32_t> ident(g.nodes.size());
@@ -271,8 +322,9 @@ bool snapNodesToEdges(WorkGraph& g, double snap, double minSegment) {
     return true;
 }
 
-StreetGraph toStreetGraph(const WorkGraph& w) {
-    // Canonical order: nodes by (x, y), edges by (a, b) with a < b.
+// The street graph of `w` in canonical order (nodes by (x, y), edges by (a, b)
+// with a < b) and, when asked, each edge's carriageway.
+StreetGraph toStreetGraph(const WorkGraph& w, std::vector<uint32_t>* carriageways = nullptr) {
     std::vector<uint32_t> order(w.nodes.size());
     std::iota(order.begin(), order.end(), 0u);
     std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return lessPoint(w.nodes[a], w.nodes[b]); });
@@ -283,7 +335,8 @@ StreetGraph toStreetGraph(const WorkGraph& w) {
         newIndex[order[i]] = i;
         g.nodes.push_back(w.nodes[order[i]]);
     }
-    g.edges.reserve(w.edges.size());
+    std::vector<std::pair<StreetEdge, uint32_t>> edges;
+    edges.reserve(w.edges.size());
     for (const auto& e : w.edges) {
         StreetEdge se;
         se.a = std::min(newIndex[e.a], newIndex[e.b]);
@@ -291,23 +344,31 @@ StreetGraph toStreetGraph(const WorkGraph& w) {
         se.cls = RoadClass(uint8_t(e.cls));
         se.width = float(roadWidth(se.cls));
         se.lanes = uint8_t(roadLanes(se.cls));
-        g.edges.push_back(se);
+        edges.emplace_back(se, e.carriageway);
     }
-    std::sort(g.edges.begin(), g.edges.end(),
-              [](const StreetEdge& x, const StreetEdge& y) { return std::tie(x.a, x.b) < std::tie(y.a, y.b); });
+    std::sort(edges.begin(), edges.end(), [](const auto& x, const auto& y) {
+        return std::tie(x.first.a, x.first.b) < std::tie(y.first.a, y.first.b);
+    });
+    g.edges.reserve(edges.size());
+    if (carriageways) carriageways->clear();
+    for (const auto& [se, c] : edges) {
+        g.edges.push_back(se);
+        if (carriageways) carriageways->push_back(c);
+    }
     return g;
 }
 
 std::vector<RawSegment> toSegments(const WorkGraph& g) {
     std::vector<RawSegment> s;
     s.reserve(g.edges.size());
-    for (const auto& e : g.edges) s.push_back({g.nodes[e.a], g.nodes[e.b], RoadClass(uint8_t(e.cls))});
+    for (const auto& e : g.edges) s.push_back({g.nodes[e.a], g.nodes[e.b], RoadClass(uint8_t(e.cls)), e.carriageway});
     return s;
 }
 
 }  // namespace
 
-StreetGraph planarize(const std::vector<RawSegment>& segments, double snap, double minSegment) {
+StreetGraph planarize(const std::vector<RawSegment>& segments, double snap, double minSegment,
+                      std::vector<uint32_t>* carriageways) {
     if (!std::isfinite(snap) || snap < 0) snap = 0;
     if (!std::isfinite(minSegment) || minSegment < 0) minSegment = 0;
     // Input hygiene: finite, bounded coordinates; valid classes; zero-length dropped.
@@ -326,7 +387,7 @@ StreetGraph planarize(const std::vector<RawSegment>& segments, double snap, doub
             if (!ok(s.a) || !ok(s.b) || s.a == s.b) continue;
             // +0.0 canonicalises -0.0 so the map key matches.
             glm::dvec2 a(s.a.x + 0.0, s.a.y + 0.0), b(s.b.x + 0.0, s.b.y + 0.0);
-            g.edges.push_back({node(a), node(b), std::clamp(int(s.cls), 0, 2)});
+            g.edges.push_back({node(a), node(b), std::clamp(int(s.cls), 0, 2), s.carriageway});
         }
     }
     // Pre-snap input endpoints, so near-coincident ends meet before the exact arrangement.
@@ -344,13 +405,18 @@ StreetGraph planarize(const std::vector<RawSegment>& segments, double snap, doub
             bool c3 = contractShort(g, minSegment);
             if (!c1 && !c2 && !c3) break;
         }
-        StreetGraph sg = toStreetGraph(g);
-        if (findConflictingEdges(sg, 1).empty()) return sg;
+        std::vector<uint32_t> cw;
+        StreetGraph sg = toStreetGraph(g, &cw);
+        if (findConflictingEdges(sg, 1).empty()) {
+            if (carriageways) *carriageways = std::move(cw);
+            return sg;
+        }
     }
 
     // Last resort: drop conflicting edges (lowest class, then shortest) until planar.
     for (int guard = 0; guard < 1000; ++guard) {
-        StreetGraph sg = toStreetGraph(g);
+        std::vector<uint32_t> cw;
+        StreetGraph sg = toStreetGraph(g, &cw);
         auto bad = findConflictingEdges(sg, SIZE_MAX);
         if (bad.empty()) break;
         std::vector<char> drop(sg.edges.size(), 0);
@@ -362,7 +428,7 @@ StreetGraph planarize(const std::vector<RawSegment>& segments, double snap, doub
         WorkGraph w;
         w.nodes = sg.nodes;
         for (size_t i = 0; i < sg.edges.size(); ++i)
-            if (!drop[i]) w.edges.push_back({sg.edges[i].a, sg.edges[i].b, int(sg.edges[i].cls)});
+            if (!drop[i]) w.edges.push_back({sg.edges[i].a, sg.edges[i].b, int(sg.edges[i].cls), cw[i]});
         std::vector<uint32_t> ident(w.nodes.size());
         std::iota(ident.begin(), ident.end(), 0u);
         rebuild(w, ident);
@@ -376,7 +442,7 @@ StreetGraph planarize(const std::vector<RawSegment>& segments, double snap, doub
     std::vector<uint32_t> ident(w.nodes.size());
     std::iota(ident.begin(), ident.end(), 0u);
     rebuild(w, ident);
-    return toStreetGraph(w);
+    return toStreetGraph(w, carriageways);
 }
 
 }  // namespace vista

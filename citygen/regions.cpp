@@ -81,14 +81,19 @@ void RegionGrid::bounds(int region, glm::dvec2& lo, glm::dvec2& hi) const {
     hi = glm::min(lo + side, glm::dvec2(_half));
 }
 
-Result<RegionalCity> RegionalCity::create(const CityParams& params, double regionSizeM, Progress* progress) {
+Result<RegionalCity> RegionalCity::create(const CityParams& params, double regionSizeM, Progress* progress,
+                                          const RegionalInputs& inputs) {
     VISTA_RETURN_IF_ERROR(validateParams(params));
     VISTA_RETURN_IF_ERROR(validateRegionSize(params, regionSizeM));
     RegionalCity rc(params, regionSizeM);
     const auto limit = threadLimit(params);
     if (progress) progress->begin("streets");
-    rc._streets = growStreets(params, progress);
+    rc._streets = inputs.streets ? *inputs.streets : growStreets(params, progress);
     if (progress) progress->end();
+    if (inputs.osmBuildings) {
+        rc._osmStats.enabled = true;
+        rc._imported = resolveOsmBuildings(*inputs.osmBuildings, params, rc._osmStats);
+    }
     if (progress) progress->begin("blocks");
     rc._blocks = extractBlocks(rc._streets, params, progress);
     if (progress) progress->end();
@@ -98,6 +103,7 @@ Result<RegionalCity> RegionalCity::create(const CityParams& params, double regio
     const double half = 0.5 * params.size_m, side = grid.tilesPerRegion() * params.tile_size_m;
     rc._edgesNear.resize(size_t(grid.count()));
     rc._blocksNear.resize(size_t(grid.count()));
+    rc._importedNear.resize(size_t(grid.count()));
     const StreetGraph& g = rc._streets;
     for (uint32_t e = 0; e < g.edges.size(); ++e) {
         const glm::dvec2 a = g.nodes[g.edges[e].a], b = g.nodes[g.edges[e].b];
@@ -110,6 +116,13 @@ Result<RegionalCity> RegionalCity::create(const CityParams& params, double regio
         glm::dvec2 lo = o[0], hi = o[0];
         for (const auto& q : o) lo = glm::min(lo, q), hi = glm::max(hi, q);
         forRegionsNear(grid, half, side, lo, hi, [&](int r) { rc._blocksNear[size_t(r)].push_back(i); });
+    }
+    for (uint32_t i = 0; i < rc._imported.size(); ++i) {
+        const Polygon2& o = rc._imported[i].footprint;
+        if (o.empty()) continue;
+        glm::dvec2 lo = o[0], hi = o[0];
+        for (const auto& q : o) lo = glm::min(lo, q), hi = glm::max(hi, q);
+        forRegionsNear(grid, half, side, lo, hi, [&](int r) { rc._importedNear[size_t(r)].push_back(i); });
     }
     // Node -> incident edges.
     rc._nodeEdgeStart.assign(g.nodes.size() + 1, 0);
@@ -155,7 +168,11 @@ City RegionalCity::region(int r) const {
     for (uint32_t b : _blocksNear[size_t(r)]) c.blocks.push_back(_blocks[b]);
 
     c.lots = subdivideLots(c.blocks, _params, nullptr);
+    std::vector<Building> imported;
+    for (uint32_t i : _importedNear[size_t(r)]) imported.push_back(_imported[i]);
+    if (!imported.empty()) dropCoveredLots(c.lots, imported);
     c.buildings = placeBuildings(c.lots, c.blocks, _params, nullptr);
+    for (auto& b : imported) c.buildings.push_back(std::move(b));
     c.trees = placeTrees(c, nullptr);
     if (_params.effects.night) c.streetLights = placeStreetLights(c);
     if (_params.parked_car_share > 0) c.cars = placeParkedCars(c, buildLaneModel(c.streets, _params, &c.blocks));

@@ -7,15 +7,19 @@
 // tile grid (TileGrid), row-major from the south-west corner; the last row and
 // column are cut by the city border. Every tile belongs to exactly one region.
 //
-// RegionalCity: create() grows the street graph and extracts the blocks (with
-// their parks) of the whole city once, exactly as generateCity does, and
-// makes the tree prototypes. region(r) then generates one region:
+// RegionalCity: create() grows the street graph (or takes the given one, e.g.
+// an OSM import) and extracts the blocks (with their parks) of the whole city
+// once, exactly as generateCity does, completes the given OSM building
+// footprints into buildings (resolveOsmBuildings), and makes the tree
+// prototypes. region(r) then generates one region:
 //   - its street graph: the edges within kRegionHaloM of the region, plus
 //     every edge at their end nodes (so junctions and node degrees near the
 //     region are those of the whole city), re-indexed in global order;
 //   - the blocks within kRegionHaloM of the region (global order, parks kept);
 //     their lots and buildings (both seeded by position, so each is the
-//     building generateCity places on that lot), the trees (placed among the
+//     building generateCity places on that lot; lots overlapping an imported
+//     building within kRegionHaloM are dropped first, and those imported
+//     buildings join the region's, as generateCity does), the trees (placed among the
 //     halo's buildings and streets), street lights and parked cars;
 //   - it keeps the buildings, trees, lights and cars anchored in the region (tile
 //     of the footprint centroid / trunk base / pole base / car centre, the anchor of
@@ -45,6 +49,7 @@
 
 #include "citygen/city.h"
 #include "citygen/mesh_builder.h"
+#include "citygen/osm_buildings.h"
 #include "foundation/progress.h"
 #include "foundation/status.h"
 
@@ -81,13 +86,22 @@ private:
     int _tileCount, _k, _n;
 };
 
+// What a regional city takes as given instead of growing it (null: grown).
+struct RegionalInputs {
+    const StreetGraph* streets = nullptr;
+    const std::vector<OsmFootprint>* osmBuildings = nullptr;
+};
+
 class RegionalCity {
 public:
-    static Result<RegionalCity> create(const CityParams& params, double regionSizeM, Progress* progress);
+    static Result<RegionalCity> create(const CityParams& params, double regionSizeM, Progress* progress,
+                                       const RegionalInputs& inputs = {});
     const CityParams& params() const { return _params; }
     const RegionGrid& grid() const { return _grid; }
     const StreetGraph& streets() const { return _streets; }
     size_t blockCount() const { return _blocks.size(); }
+    // The completion counts of the imported buildings (enabled when given).
+    const OsmBuildingStats& osmBuildingStats() const { return _osmStats; }
     City region(int r) const;
     static City coarse(const City& region);
 
@@ -97,9 +111,11 @@ private:
     RegionGrid _grid;
     StreetGraph _streets;
     std::vector<Block> _blocks;
+    std::vector<Building> _imported;  // completed OSM buildings
+    OsmBuildingStats _osmStats;
     std::vector<TreePrototype> _prototypes;
-    std::vector<std::vector<uint32_t>> _edgesNear, _blocksNear;  // per region: within the halo
-    std::vector<uint32_t> _nodeEdgeStart, _nodeEdges;            // node -> incident edges (CSR)
+    std::vector<std::vector<uint32_t>> _edgesNear, _blocksNear, _importedNear;  // per region: within the halo
+    std::vector<uint32_t> _nodeEdgeStart, _nodeEdges;                           // node -> incident edges (CSR)
 };
 
 }  // namespace vista

@@ -1,4 +1,5 @@
 // vista gen: params -> city.osgb (+ optional GeoJSON streets, glTF, stats).
+#include <cmath>
 #include <cstdio>
 #include <functional>
 #include <fstream>
@@ -38,6 +39,7 @@ struct GenArgs {
     std::string osmBuildings = "on";
     std::optional<uint64_t> seed;
     std::optional<double> size;
+    bool sizeInParams = false;  // the params file sets size_m (with --osm: clips as --size does)
     std::optional<int> detail, threads;
     bool quiet = false, listParams = false;
     // Paged output (-o DIR.paged).
@@ -75,7 +77,8 @@ CLI::Option* declareFlags(CLI::App& app, GenArgs& a) {
                        ") or a JSON object as in the params file (see docs/params.md)");
     app.add_option("--osm", a.osmFile,
                    "take the streets (highway=* ways) and buildings (building=*, see --osm-buildings) from an "
-                   "OpenStreetMap extract (.osm/.osm.pbf)");
+                   "OpenStreetMap extract (.osm/.osm.pbf); the city covers the extract's extent (over 16 km: "
+                   "paged output only) unless --size (or size_m in --params) clips it to a square about its centre");
     app.add_option("--osm-buildings", a.osmBuildings,
                    "with --osm: 'on' (default) imports building=* footprints and keeps procedural lots only where the "
                    "data has no building; 'off' fills every block procedurally (docs/buildings.md)");
@@ -148,6 +151,9 @@ Result<CityParams> resolveParams(GenArgs& a) {
         auto r = loadParamsFile(a.paramsFile);
         if (!r) return r.status();
         params = *r;
+        std::ifstream in(a.paramsFile, std::ios::binary);
+        const auto j = nlohmann::json::parse(in, nullptr, false);
+        a.sizeInParams = j.is_object() && j.contains("size_m");
     }
     if (a.seed) params.seed = *a.seed;
     if (a.size) params.size_m = *a.size;
@@ -200,6 +206,8 @@ std::string shardCommand(const GenArgs& a, const std::string& dir) {
     if (a.size) add("--size", exactDecimal(*a.size));
     if (a.detail) add("--detail", std::to_string(*a.detail));
     if (a.effects) add("--effects", *a.effects);
+    if (!a.osmFile.empty()) add("--osm", a.osmFile);
+    if (!a.osmFile.empty() && a.osmBuildings != "on") add("--osm-buildings", a.osmBuildings);
     if (a.regionSize) add("--region-size", exactDecimal(*a.regionSize));
     add("-o", dir);
     return c + " --shard";
@@ -228,8 +236,7 @@ Result<PagedCityOptions> resolvePaged(const GenArgs& a, const CityParams& params
     }
     for (auto [opt, path] : {std::pair<const char*, const std::string*>{"--geojson", &a.geojsonFile},
                              {"--gltf", &a.gltfFile},
-                             {"--xodr", &a.xodrFile},
-                             {"--osm", &a.osmFile}})
+                             {"--xodr", &a.xodrFile}})
         if (!path->empty())
             return Status::error(std::string("option ") + opt + ": not supported with paged output (-o DIR.paged)");
     if (bakedLightingCalledFor(params))
@@ -242,9 +249,51 @@ Result<PagedCityOptions> resolvePaged(const GenArgs& a, const CityParams& params
     return o;
 }
 
-int runPaged(const GenArgs& a, const CityParams& params, const Stopwatch& total) {
+// The OSM import of --osm: the extract's own extent, or the square of
+// --size (or the params file's size_m) about its centre. Sets the params'
+// geo reference and size_m; prints what was dropped or clipped. A city larger
+// than a single file holds is refused unless the output is paged.
+Result<OsmImport> importForGen(const GenArgs& a, CityParams& params) {
+    const bool clip = a.size || a.sizeInParams;
+    auto g = importOsm(a.osmFile, params, a.osmBuildings == "on", clip ? OsmExtent::CitySquare : OsmExtent::Extract);
+    if (!g) return g.status();
+    if (!a.paged() && g->citySize_m > kMaxSingleFileSizeM)
+        return Status::error("option --osm = '" + a.osmFile + "': the extract's roads span " +
+                             exactDecimal(std::round(g->extentX_m)) + " m east-west by " +
+                             exactDecimal(std::round(g->extentY_m)) +
+                             " m north-south, a city of size_m = " + exactDecimal(g->citySize_m) +
+                             " m, more than a single file holds (size_m up to " + exactDecimal(kMaxSingleFileSizeM) +
+                             "): write a paged city (-o DIR.paged) or clip the extract with --size (100 .. " +
+                             exactDecimal(kMaxSingleFileSizeM) + ")");
+    if (std::string dropped = g->dropSummary(); !dropped.empty()) {
+        if (g->clippedSegments)
+            dropped += std::string(" (") + (a.size ? "--size" : "size_m in --params") +
+                       "; without it the city covers the whole extract)";
+        std::fprintf(stderr, "osm: %s\n", dropped.c_str());
+    }
+    params.geo = g->geo;
+    params.size_m = g->citySize_m;
+    if (a.osmBuildings == "on") {
+        const OsmBuildingStats& b = g->buildingStats;
+        if (const size_t skipped = b.candidates - b.imported)
+            std::fprintf(stderr, "osm: skipped %zu of %zu building footprints (see --stats osm_buildings.skipped)\n",
+                         skipped, b.candidates);
+    }
+    return g;
+}
+
+int runPaged(const GenArgs& a, CityParams params, const Stopwatch& total) {
     auto o = resolvePaged(a, params);
     if (!o) return reportBadInput(kCmd, o.status());
+    std::optional<OsmImport> osm;
+    if (!a.osmFile.empty()) {
+        auto g = importForGen(a, params);
+        if (!g) return reportBadInput(kCmd, g.status());
+        osm = std::move(*g);
+        o->inputs.streets = &osm->streets;
+        if (a.osmBuildings == "on") o->inputs.osmBuildings = &osm->buildings;
+        o->inputKey = "osm=" + hex64(osm->fileHash) + " osm_buildings=" + a.osmBuildings;
+    }
     const double estimateMb = estimatePagedGenMb(o->regionSizeM, params.detail);
     {
         char how[160];
@@ -288,6 +337,7 @@ int runPaged(const GenArgs& a, const CityParams& params, const Stopwatch& total)
         j["memory"] = {{"estimate_mb", estimateMb},
                        {"budget_gb", a.budgetGb > 0 ? nlohmann::json(a.budgetGb) : nlohmann::json(nullptr)}};
         j["threads"] = params.threads;
+        if (osm) j["osm_roads"] = nlohmann::ordered_json::parse(osmRoadTagStatsJson(osm->roadTagStats));
         if (Status s = writeFileAtomic(batch.stage(a.statsFile), j.dump(2) + "\n"); !s) return reportBadInput(kCmd, s);
     }
     if (Status s = batch.commit(); !s) return reportBadInput(kCmd, s);
@@ -430,22 +480,13 @@ int runGen(int argc, char** argv) {
     std::optional<OsmRoadTagStats> osmRoads;
     if (!a.osmFile.empty()) {
         Stopwatch osmTime;
-        auto g = importOsm(a.osmFile, *params, a.osmBuildings == "on");
+        auto g = importForGen(a, *params);
         if (!g) return reportBadInput(kCmd, g.status());
-        if (const std::string dropped = g->dropSummary(); !dropped.empty())
-            std::fprintf(stderr, "osm: %s\n", dropped.c_str());
-        params->geo = g->geo;
         opts.streets = std::move(g->streets);
         osmRoads = g->roadTagStats;
         if (a.osmBuildings == "on") {
-            const OsmBuildingStats& b = g->buildingStats;
-            const size_t skipped = b.candidates - b.imported;
-            if (skipped)
-                std::fprintf(stderr,
-                             "osm: skipped %zu of %zu building footprints (see --stats osm_buildings.skipped)\n",
-                             skipped, b.candidates);
             opts.osmBuildings = std::move(g->buildings);
-            opts.osmStats = b;
+            opts.osmStats = g->buildingStats;
         }
         osmSeconds = osmTime.ms() / 1000.0;
     }

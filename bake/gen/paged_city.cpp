@@ -313,7 +313,8 @@ Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedC
     const RegionGrid grid(params, o.regionSizeM);
     const std::string keyText = paramsToJson(params) + "\nregion_size_m=" + exactDecimal(o.regionSizeM) +
                                 "\nformat=" + std::to_string(kPagedFormatVersion) + "\ncoarse_trees=impostors" +
-                                "\nsignals=lane_model";  // regions of runs whose tiles had no signals are remade
+                                "\nsignals=lane_model" +  // regions of runs whose tiles had no signals are remade
+                                (o.inputKey.empty() ? std::string() : "\ninput=" + o.inputKey);
     const std::string key = hex64(hashBytes64(keyText.data(), keyText.size()));
     PagedCityReport rep;
     rep.regions = grid.count();
@@ -338,7 +339,7 @@ Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedC
         }
         if (!todo.empty()) {
             const auto tb = std::chrono::steady_clock::now();
-            auto b = RegionalCity::create(params, o.regionSizeM, pr);
+            auto b = RegionalCity::create(params, o.regionSizeM, pr, o.inputs);
             if (!b) return b.status();
             base.emplace(std::move(*b));
             baseSeconds = seconds(tb);
@@ -387,8 +388,14 @@ Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedC
     OutputBatch own;
     OutputBatch& batch = o.batch ? *o.batch : own;
     VISTA_RETURN_IF_ERROR(writeSceneFile(*index, batch.stage((fs::path(o.dir) / kPagedIndexFile).string()), false));
-    VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage((fs::path(o.dir) / kPagedManifestFile).string()),
-                                          manifestJson(params, grid, o.regionSizeM, all, key).dump(2) + "\n"));
+    Json manifest = manifestJson(params, grid, o.regionSizeM, all, key);
+    if (o.inputs.streets) {  // readers cannot grow given streets again: the graph travels beside the regions
+        VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage((fs::path(o.dir) / kPagedStreetsFile).string()),
+                                              streetGraphToJson(*o.inputs.streets)));
+        manifest["streets"] = kPagedStreetsFile;
+    }
+    VISTA_RETURN_IF_ERROR(
+        writeFileAtomic(batch.stage((fs::path(o.dir) / kPagedManifestFile).string()), manifest.dump(2) + "\n"));
     if (!o.batch) VISTA_RETURN_IF_ERROR(own.commit());
     rep.indexWritten = true;
     rep.indexSeconds = seconds(ti);

@@ -7,7 +7,10 @@
 //                              the region file, relative names; ranges pagedRanges())
 //   region_IX_IY.osgb          a normal vista city file (city_file.h) of the region's tiles
 //   region_IX_IY.coarse.osgb   its coarse level (RegionalCity::coarse), also a city file
-//   manifest.json              params, region grid, per region: files, bytes, hashes, bounds, counts
+//   manifest.json              params, region grid, per region: files, bytes, hashes, bounds, counts;
+//                              `streets` names streets.json when the streets were given
+//   streets.json               the whole street graph (streetGraphToJson) of a city whose streets
+//                              were given (an OSM import), for readers that cannot grow it again
 //   records/region_IX_IY.json  one record per finished region (what resume checks)
 // Empty regions (no geometry) have a record and a manifest entry but no files and no PagedLOD.
 //
@@ -20,7 +23,7 @@
 // once every region has a valid record; `merge` generates nothing and is an
 // error naming the missing regions when some are not done, and the shards
 // K/N to run again when `mergeShards` gives the N the shards ran with. The bytes of every
-// file depend only on params and the region size: the same for any thread
+// file depend only on params, the region size and the given inputs: the same for any thread
 // count, any split into shards and any number of interruptions. Shards of one
 // city may run concurrently in separate processes on the same directory.
 // Memory: the street graph and blocks of the whole city plus one region.
@@ -36,6 +39,7 @@
 #include <string>
 
 #include "citygen/params.h"
+#include "citygen/regions.h"
 #include "foundation/atomic_file.h"
 #include "foundation/progress.h"
 #include "foundation/shard.h"
@@ -55,6 +59,11 @@ struct PagedCityOptions {
     // shard to run again); empty: the refusal names the shards only.
     std::string shardCommand;
     Progress* progress = nullptr;
+    // Given instead of grown (an OSM import: vista gen --osm); `inputKey`
+    // identifies that input (e.g. a hash of the file and the import options)
+    // in every region record, so a resume with other input remakes the regions.
+    RegionalInputs inputs;
+    std::string inputKey;
     // Non-null: index.osgb and manifest.json are staged into this batch and
     // the caller commits them with its own outputs (--stats); null: they are
     // committed here.

@@ -168,6 +168,14 @@ Result<PagedManifest> readPagedManifest(const std::string& dir) {
             manifestInt(j, "regions_x", 1, kMaxManifestRegionsPerSide, "'" + path + "': ", m.regionsX));
         VISTA_RETURN_IF_ERROR(
             manifestInt(j, "regions_y", 1, kMaxManifestRegionsPerSide, "'" + path + "': ", m.regionsY));
+        if (j.contains("streets")) {
+            if (!j.at("streets").is_string())
+                return bad("field 'streets' = " + echoText(j.at("streets").dump()) + " is not a file name");
+            m.streetsFile = j.at("streets").get<std::string>();
+            if (m.streetsFile.empty() || m.streetsFile.find('/') != std::string::npos ||
+                m.streetsFile.find('\\') != std::string::npos || m.streetsFile == "." || m.streetsFile == "..")
+                return bad("field 'streets' = '" + m.streetsFile + "' is not a plain name inside the directory");
+        }
         const Json& regions = j.at("regions");
         if (!regions.is_array() || regions.size() != size_t(m.regionsX) * size_t(m.regionsY))
             return bad("field 'regions' is not an array of regions_x * regions_y entries");
@@ -440,10 +448,21 @@ Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>&
     return out;
 }
 
+// The whole street graph of a paged city whose streets were given (JSON; a 64 km city's is tens of MB).
+constexpr uint64_t kMaxStreetsBytes = 1024 * kMiB;
+
 Result<StreetGraph> pagedPathStreets(const PagedManifest& m) {
-    // The street graph of a city depends only on its params (paged cities are
-    // never imported from OSM); growing it is cheap (the 64 km city: 21,475
-    // edges, about a second), so the path is the single-file city's path.
+    if (!m.streetsFile.empty()) {  // given streets (an OSM import): the graph as generated
+        const std::string path = (fs::path(m.dir) / m.streetsFile).string();
+        auto text = readInputFile("paged city streets", path, kMaxStreetsBytes);
+        if (!text) return Status::error("paged city '" + m.dir + "': " + text.status().message());
+        auto g = streetGraphFromJson(*text);
+        if (!g) return Status::error("'" + path + "': " + g.status().message());
+        return g;
+    }
+    // A grown city's street graph depends only on its params; growing it is
+    // cheap (the 64 km city: 21,475 edges, about a second), so the path is the
+    // single-file city's path.
     return growStreets(m.params, nullptr);
 }
 

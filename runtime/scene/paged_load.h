@@ -67,10 +67,13 @@
 // (reads the manifest only).
 //
 // pagedPathStreets(): the street graph that a path of a paged city made from
-// a seed runs on: the whole city's graph, grown again from the manifest's
-// params (growStreets, as `vista gen` made it: paged cities are never OSM
-// imports; about a second for the 64 km city), so `--seed N` gives the same
-// path as on the single-file city of the same params. No region is read.
+// a seed runs on: the whole city's graph, read from the manifest's `streets`
+// file when it names one (a city whose streets were given, e.g. an OSM
+// import: kPagedStreetsFile, streetGraphToJson), else grown again from the
+// manifest's params (growStreets, as `vista gen` made it; about a second for
+// the 64 km city), so `--seed N` gives the same path as on the single-file
+// city of the same input. No region is read. A streets file that is missing,
+// corrupt or not a valid graph is an error naming it.
 // Radius: kMinPagedRadiusM .. kMaxPagedRadiusM (validatePagedRadius names
 // the option, the value and the range).
 #pragma once
@@ -96,6 +99,7 @@ constexpr int kPagedCityVersion = 2;
 // User values on every region file's root: the generation's identity (see above).
 constexpr const char* kPagedGenerationKey = "vista.generation";
 constexpr const char* kPagedSeedKey = "vista.seed";
+constexpr const char* kPagedStreetsFile = "streets.json";  // the whole street graph, when it was given
 
 constexpr double kDefaultPagedRadiusM = 3000.0;
 constexpr double kMinPagedRadiusM = 0.0;
@@ -126,6 +130,7 @@ struct PagedManifest {
     double regionSizeM = 0;
     int regionsX = 0, regionsY = 0;
     std::vector<PagedRegionEntry> regions;  // every region of the grid, empty ones included
+    std::string streetsFile;                // the manifest's `streets` (relative name), "" = grown from params
     int nonEmpty() const;
 };
 

@@ -65,8 +65,8 @@ inline GeoPoint destination(const GeoPoint& p, double bearingDeg, double dist) {
     return {f2 / kD2R, std::remainder(l2 / kD2R, 360.0)};
 }
 
-// The largest city an OSM import may span (a single-file city; paged output takes no --osm).
-inline double maxCitySize() { return kMaxSingleFileSizeM; }
+// The largest city an OSM import may span (a paged city).
+inline double maxCitySize() { return kMaxPagedSizeM; }
 
 // A synthetic .osm file; coordinates are written with 7 decimals (OSM's resolution) and
 // remembered as written.

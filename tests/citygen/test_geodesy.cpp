@@ -26,7 +26,7 @@ using namespace vista;
 // ---- geodesy ------------------------------------------------------------------
 
 TEST(Geodesy, ProjectedDistancesMatchVincentyAnywhere) {
-    // Points up to half the largest city's diagonal from the reference: pairs up to 22.6 km apart.
+    // Points up to half the largest city's diagonal from the reference: pairs up to 90.5 km apart.
     const double reach = 0.5 * std::sqrt(2.0) * maxCitySize();
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> bearing(0, 360), dist(0, reach);
@@ -43,9 +43,11 @@ TEST(Geodesy, ProjectedDistancesMatchVincentyAnywhere) {
                 const double projected = glm::length(projectToLocal(ref, pts[i]) - projectToLocal(ref, pts[j]));
                 worst = std::max(worst, std::abs(projected - geodesic) / geodesic);
             }
-        // 0.1 % is the contract; transverse Mercator is off by ~1e-6 at this size.
+        // 0.1 % is the contract; transverse Mercator's scale error at a distance d from its
+        // central meridian is about d^2 / 2R^2 (2.5e-5 at the reach).
+        const double R = 6371000.0, scaleError = reach * reach / (2 * R * R);
         EXPECT_LT(worst, 1e-3) << "reference " << ref.lat0_deg << ", " << ref.lon0_deg;
-        EXPECT_LT(worst, 1e-5) << "reference " << ref.lat0_deg << ", " << ref.lon0_deg;
+        EXPECT_LT(worst, 1.5 * scaleError) << "reference " << ref.lat0_deg << ", " << ref.lon0_deg;
     }
 }
 

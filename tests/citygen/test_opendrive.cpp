@@ -458,3 +458,53 @@ TEST(OpenDrive, SignalsAreReadableBySimulators) {
     }
     EXPECT_EQ(crosswalks, 4u);
 }
+
+// A dual carriageway mapped as two one-way ways 10 m apart
+// (tests/data/osm/dual_carriageway.osm): read back from the XML, every road
+// along either carriageway and along the one-way side street has driving
+// lanes on its right side only, as many as its way's lanes tag, and its
+// reference line runs along the way's traffic (oneway=-1: against the way's
+// drawing); no road there is written two-way.
+TEST(OpenDrive, OsmOneWayWaysAreOneWayRoads) {
+    const City city = osmCity("dual_carriageway.osm");
+    auto xodr = openDriveXml(city.streets, city.params, &city.blocks);
+    ASSERT_TRUE(xodr.isOk());
+    std::string err;
+    auto doc = parseXml(*xodr, &err);
+    ASSERT_TRUE(doc) << err;
+    int north = 0, south = 0, side = 0, twoWay = 0;
+    for (const Element* road : doc->all("road")) {
+        if (road->str("junction") != "-1" || road->str("name").rfind("transition", 0) == 0) continue;
+        const Element* geometry = road->first("planView")->first("geometry");
+        ASSERT_TRUE(geometry->first("line")) << "road " << road->str("id");
+        const double hdg = geometry->num("hdg"), half = 0.5 * road->num("length");
+        const double x = geometry->num("x") + half * std::cos(hdg) - city.params.origin_x;
+        const double y = geometry->num("y") + half * std::sin(hdg) - city.params.origin_y;
+        int right = 0, left = 0;
+        const Element* section = road->first("lanes")->first("laneSection");
+        for (const char* s : {"left", "right"}) {
+            if (!section->first(s)) continue;
+            for (const Element* lane : section->first(s)->all("lane"))
+                if (lane->str("type") == "driving") (std::string(s) == "left" ? left : right)++;
+        }
+        SCOPED_TRACE("road " + road->str("id") + " at (" + std::to_string(x) + ", " + std::to_string(y) + ")");
+        if (std::abs(x) < 300 && std::abs(y) > 0.5 && std::abs(y) < 6 && std::abs(std::sin(hdg)) < 0.2) {
+            const bool northern = y > 0;  // lanes=2 driven east; the south: lanes=3, oneway=-1, driven west
+            (northern ? north : south)++;
+            EXPECT_EQ(right, northern ? 2 : 3);
+            EXPECT_EQ(left, 0);
+            EXPECT_GT(northern ? std::cos(hdg) : -std::cos(hdg), 0.9);
+            twoWay += right > 0 && left > 0;
+        } else if (std::abs(x) < 0.5 && y > 5) {  // oneway=-1 drawn north: driven south
+            ++side;
+            EXPECT_EQ(right, 1);
+            EXPECT_EQ(left, 0);
+            EXPECT_LT(std::sin(hdg), -0.9);
+            twoWay += right > 0 && left > 0;
+        }
+    }
+    EXPECT_EQ(north, 6);
+    EXPECT_EQ(south, 6);
+    EXPECT_GE(side, 1);
+    EXPECT_EQ(twoWay, 0);
+}

@@ -246,3 +246,9 @@ TEST(OpenDrive, NetconvertReadsOsmTown) { checkNet(osmCity("town.osm"), "osm tow
 // The OSM lane-tag fixture (tests/data/osm/lanes.osm): lanes:forward/backward,
 // one-way and turn-lane tags give arms of unequal lane counts at junctions.
 TEST(OpenDrive, NetconvertReadsOsmLanes) { checkNet(osmCity("lanes.osm"), "osm lanes.osm"); }
+
+// A dual carriageway of two one-way ways 10 m apart, crossed by side streets
+// (tests/data/osm/dual_carriageway.osm): one-way roads with lanes on one side.
+TEST(OpenDrive, NetconvertReadsOsmDualCarriageway) {
+    checkNet(osmCity("dual_carriageway.osm"), "osm dual_carriageway.osm");
+}

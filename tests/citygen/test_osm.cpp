@@ -162,7 +162,7 @@ TEST(OsmImport, InvalidMissingAndOutlierNodesAreDroppedAndCounted) {
     EXPECT_EQ(r->missingNodes, 1u);
     EXPECT_EQ(r->outlierNodes, 1u);
     EXPECT_EQ(r->dropSummary(),
-              "dropped 8 nodes (6 with invalid coordinates, 1 missing from the file, 1 outlier farther than 22.6 km "
+              "dropped 8 nodes (6 with invalid coordinates, 1 missing from the file, 1 outlier farther than 90.5 km "
               "from the median position)");
     EXPECT_LT(std::max(r->extentX_m, r->extentY_m), 1100);  // the city, not 500 km
     EXPECT_TRUE(checkPlanarGraph(r->streets, CityParams().min_segment_m).isOk());
@@ -189,7 +189,7 @@ TEST(OsmImport, ExtentBeyondTheLargestCityIsRefused) {
         ASSERT_NE(at, std::string::npos) << m;
         // 1,000 m + 1.2 x limit on the sphere the test places points on; WGS84 at 60 N is 0.36 % wider.
         EXPECT_NEAR(std::stod(m.substr(at + 15)), (1000 + 1.2 * limit) * 1.0036 / 1000, 0.06) << m;
-        EXPECT_NE(m.find(" km east-west by 2.01 km north-south"), std::string::npos) << m;
+        EXPECT_NE(m.find(" km east-west by 2.0"), std::string::npos) << m;  // the 2 km grid (2.01-2.02 km)
         EXPECT_NE(m.find("size_m up to " + std::to_string(int(limit)) + " m"), std::string::npos) << m;
     }
     {  // The same place 2 x the limit away is an outlier (> sqrt(2) x limit): dropped, the city stays.
@@ -382,6 +382,49 @@ TEST(OsmImport, RoadsBeyondTheCitySquareAreClipped) {
     auto none = importOsm(off.write(dir, "off.osm"), p);
     ASSERT_FALSE(none.isOk());
     EXPECT_NE(none.status().message().find("city square"), std::string::npos) << none.status().message();
+}
+
+// By default (OsmExtent::Extract) the city is the extract's own extent: every road is kept and
+// the square holds the roads' bounding box with the margin, in whole tiles. With a city square
+// smaller than the extract, the summary says how much was kept: 4 of the 8 roads (3 km each,
+// 750 m apart) cross the 1 km square, each keeping 1 km; the other 4 lie wholly outside.
+TEST(OsmImport, ExtractExtentByDefaultAndTheClipSaysHowMuchWasCut) {
+    test::TempDir dir("vista_osm");
+    OsmWriter w;
+    w.grid({48.2, 16.37}, 3000, 4);
+    const std::string path = w.write(dir, "big.osm");
+    auto whole = importOsm(path, CityParams(), false, OsmExtent::Extract);
+    ASSERT_TRUE(whole.isOk()) << whole.status().message();
+    EXPECT_EQ(whole->clippedSegments, 0u);
+    EXPECT_EQ(whole->dropSummary(), "");
+    EXPECT_NEAR(whole->roadLength_m, 8 * 3000.0, 0.01 * 8 * 3000.0);
+    EXPECT_DOUBLE_EQ(whole->keptLength_m, whole->roadLength_m);
+    const double need = std::max(whole->extentX_m, whole->extentY_m) + 2 * kOsmExtentMargin_m;
+    EXPECT_GE(whole->citySize_m, need);
+    EXPECT_LT(whole->citySize_m, need + CityParams().tile_size_m);
+    EXPECT_DOUBLE_EQ(std::fmod(whole->citySize_m, CityParams().tile_size_m), 0.0);
+    size_t inner = 0;  // all 4 x 4 crossings
+    for (const auto& n : whole->streets.nodes) {
+        EXPECT_LE(std::max(std::abs(n.x), std::abs(n.y)), 0.5 * whole->citySize_m - kOsmExtentMargin_m + 1e-6);
+        inner += std::abs(n.x) < 1400 && std::abs(n.y) < 1400;
+    }
+    EXPECT_EQ(inner, 16u);
+
+    CityParams p;
+    p.size_m = 1000;
+    auto cut = importOsm(path, p);
+    ASSERT_TRUE(cut.isOk()) << cut.status().message();
+    EXPECT_DOUBLE_EQ(cut->citySize_m, 1000.0);
+    EXPECT_EQ(cut->roadSegments, 8u);
+    EXPECT_EQ(cut->clippedSegments, 8u);
+    EXPECT_EQ(cut->clippedWays, 4u);
+    EXPECT_NEAR(cut->keptLength_m, 4 * 1000.0, 1.0);
+    const std::string m = cut->dropSummary();
+    EXPECT_NE(m.find("clipped the roads to the city square of size_m = 1 km: kept 4.0 km of "), std::string::npos) << m;
+    const size_t pct = m.find(" of road (");
+    ASSERT_NE(pct, std::string::npos) << m;
+    EXPECT_NEAR(std::stod(m.substr(pct + 10)), 100.0 * 4000.0 / (8 * 3000.0), 0.3) << m;
+    EXPECT_NE(m.find("8 of 8 road segments cut or dropped, 4 of 8 ways wholly outside"), std::string::npos) << m;
 }
 
 TEST(OsmImport, MissingFileIsAnError) {

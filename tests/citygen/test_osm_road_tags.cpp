@@ -1,7 +1,7 @@
 // OSM road tags (osm_road_tags.h): the parsers, the per-way resolution of
 // lanes / oneway / turn lanes / maxspeed / width, their transfer onto the
 // planar edges of importOsm() (pieces of a split way, edges running against
-// their way, dual carriageways merged into one edge), the counts vista gen
+// their way, dual carriageways kept as two one-way edges), the counts vista gen
 // --stats reports for the fixture tests/data/osm/lanes.osm, and the street
 // graph JSON of the new edge fields (round trip, refusals, generated cities
 // without them).
@@ -331,11 +331,12 @@ struct WayExpect {
 const WayExpect kLanesWays[] = {
     {"main", {-200, 0}, {200, 0}, RoadClass::Highway, 3, 2, 1, "left|through;right", "", 50, 10.5f},
     {"102", {0, 150}, {0, -150}, RoadClass::Arterial, 3, 2, 1, "left|through", "through;right", 50, 13.0f},
-    {"103", {100, -150}, {100, 0}, RoadClass::Local, 1, 0, 1, "", "", kMaxspeedWalkKmh, 7.5f},
+    // One-way ways without a width tag: their lanes at the class's lane width (7.5 m / 2, 20 m / 6, 13 m / 4).
+    {"103", {100, -150}, {100, 0}, RoadClass::Local, 1, 0, 1, "", "", kMaxspeedWalkKmh, 3.75f},
     {"104", {-100, 0}, {-100, 150}, RoadClass::Local, 2, 2, 0, "left|through", "", 30 * kMph, float(24 * 0.3048)},
     {"107", {-100, 150}, {100, 150}, RoadClass::Local, 2, -1, -1, "", "", 0, 7.5f},
-    {"motorway", {200, -150}, {-200, -150}, RoadClass::Highway, 3, 3, 0, "", "", kMaxspeedNoneKmh, 20.0f},
-    {"108", {0, -75}, {100, -75}, RoadClass::Arterial, 2, 2, 0, "", "", 60, 13.0f},
+    {"motorway", {200, -150}, {-200, -150}, RoadClass::Highway, 3, 3, 0, "", "", kMaxspeedNoneKmh, 10.0f},
+    {"108", {0, -75}, {100, -75}, RoadClass::Arterial, 2, 2, 0, "", "", 60, 6.5f},
 };
 
 double pointLineDistance(const glm::dvec2& x, const glm::dvec2& p, const glm::dvec2& q) {
@@ -364,6 +365,9 @@ TEST(OsmRoadTags, FixtureEdgesCarryTheirWaysTagsInTheirDirection) {
         ++pieces[w->name];
         const bool along = glm::dot(b - a, w->q - w->p) > 0;
         against += !along;
+        if (w->forward == 0 || w->backward == 0) {  // one-way: the edge runs along its traffic
+            EXPECT_EQ(along, w->backward == 0) << w->name;
+        }
         SCOPED_TRACE(std::string("way ") + w->name + (along ? " (edge along the way)" : " (edge against the way)"));
         EXPECT_EQ(e.cls, w->cls);
         EXPECT_EQ(int(e.lanes), w->lanes);
@@ -379,8 +383,9 @@ TEST(OsmRoadTags, FixtureEdgesCarryTheirWaysTagsInTheirDirection) {
     EXPECT_EQ(pieces["102"], 3);
     EXPECT_EQ(pieces["motorway"], 3);
     EXPECT_EQ(pieces["103"], 2);
-    // The motorway is drawn east -> west, so its edges (a west of b) run against it.
-    EXPECT_GE(against, 3);
+    // Way 102 is drawn north -> south, so its edges (a south of b) run against it; so does 103
+    // (oneway=-1: its edges run along its traffic, against its drawing).
+    EXPECT_GE(against, 5);
     const OsmRoadTagStats& st = imp->roadTagStats;
     EXPECT_EQ(st.edgesMatched, 16u);
     EXPECT_EQ(st.edgesUnmatched, 0u);
@@ -456,9 +461,10 @@ Result<OsmImport> importText(const std::string& xml) {
 
 }  // namespace
 
-TEST(OsmRoadTags, OppositeOneWaysMergedIntoOneEdgeGiveOneDirectionEach) {
+TEST(OsmRoadTags, OppositeOneWaysStayTwoOneWayEdgesWithTheirOwnTags) {
     // A dual carriageway 8 m wide: two one-way ways sharing their end nodes, closer than the snap
-    // radius, so planarization merges them into single edges.
+    // radius and the minimum segment. Each stays its own edges, one-way along its traffic, with
+    // its own lanes, turn lanes and a width of its lanes (primary: 20 m / 6 lanes each).
     auto imp = importText(
         osmText({{-200, 0}, {-100, 4}, {100, 4}, {200, 0}, {100, -4}, {-100, -4}},
                 {{{1, 2, 3, 4},
@@ -467,15 +473,41 @@ TEST(OsmRoadTags, OppositeOneWaysMergedIntoOneEdgeGiveOneDirectionEach) {
                  {{4, 5, 6, 1}, R"(<tag k="highway" v="primary"/><tag k="oneway" v="yes"/><tag k="lanes" v="1"/>)"}}));
     ASSERT_TRUE(imp.isOk()) << imp.status().message();
     const StreetGraph& g = imp->streets;
+    ASSERT_EQ(g.edges.size(), 6u) << "the carriageways were merged";
+    int north = 0, south = 0;
+    for (const auto& e : g.edges) {
+        const glm::dvec2 a = g.nodes[e.a], b = g.nodes[e.b];
+        const bool northern = a.y + b.y > 0;  // way 1 (eastward); way 2 runs west on the south side
+        (northern ? north : south)++;
+        SCOPED_TRACE(northern ? "northern carriageway" : "southern carriageway");
+        EXPECT_EQ(b.x > a.x, northern) << "the edge does not run along its traffic";
+        EXPECT_EQ(int(e.lanesForward), northern ? 2 : 1);
+        EXPECT_EQ(int(e.lanesBackward), 0);
+        EXPECT_EQ(e.turnForward, northern ? "through|right" : "");
+        EXPECT_EQ(e.turnBackward, "");
+        EXPECT_EQ(int(e.lanes), northern ? 2 : 1);
+        EXPECT_NEAR(e.width, (northern ? 2 : 1) * 20.0 / 6.0, 1e-4);
+    }
+    EXPECT_EQ(north, 3);
+    EXPECT_EQ(south, 3);
+    EXPECT_EQ(imp->roadTagStats.edgesMergedOneWays, 0u);
+}
+
+TEST(OsmRoadTags, OppositeOneWaysOnTheSameLineGiveOneDirectionEach) {
+    // Two one-way ways drawn over the same nodes' positions (duplicated data, closer than
+    // kCarriagewayMerge_m): their segments overlap, so one edge carries both directions.
+    auto imp = importText(
+        osmText({{-200, 0}, {0, 0.5}, {200, 0}, {0, -0.5}},
+                {{{1, 2, 3}, R"(<tag k="highway" v="primary"/><tag k="oneway" v="yes"/><tag k="lanes" v="2"/>)"},
+                 {{3, 4, 1}, R"(<tag k="highway" v="primary"/><tag k="oneway" v="yes"/><tag k="lanes" v="1"/>)"}}));
+    ASSERT_TRUE(imp.isOk()) << imp.status().message();
+    const StreetGraph& g = imp->streets;
     ASSERT_FALSE(g.edges.empty());
-    ASSERT_LT(g.edges.size(), 5u) << "the carriageways were not merged";
+    ASSERT_LT(g.edges.size(), 4u) << "the duplicated ways were not merged";
     for (const auto& e : g.edges) {
         const bool eastward = g.nodes[e.b].x > g.nodes[e.a].x;  // way 1 runs east
         EXPECT_EQ(int(e.lanesForward), eastward ? 2 : 1);
         EXPECT_EQ(int(e.lanesBackward), eastward ? 1 : 2);
-        EXPECT_EQ(eastward ? e.turnForward : e.turnBackward, "through|right");
-        EXPECT_EQ(eastward ? e.turnBackward : e.turnForward, "");
-        EXPECT_EQ(int(e.lanes), 3);
     }
     EXPECT_EQ(imp->roadTagStats.edgesMergedOneWays, g.edges.size());
 }

@@ -228,6 +228,54 @@ TEST(Planarize, CrossingSplitsAndHighestClassWins) {
     EXPECT_EQ(highway, 2);
 }
 
+// A dual carriageway: two chains 8 m apart (closer than the snap radius) joined by a 8 m
+// cross street (shorter than the minimum segment). Without carriageways they snap into one
+// line; as two carriageways every node stays, the connector stays, and each output edge
+// names the carriageway it came from (the connector none).
+TEST(Planarize, CarriagewaysStayApart) {
+    auto segments = [](uint32_t north, uint32_t south) {
+        std::vector<RawSegment> s;
+        for (int k = 0; k < 4; ++k) {
+            s.push_back({{-150.0 + 100 * k, 4}, {-50.0 + 100 * k, 4}, RoadClass::Arterial, north});
+            s.push_back({{-50.0 + 100 * k, -4}, {-150.0 + 100 * k, -4}, RoadClass::Arterial, south});
+        }
+        s.push_back({{50, -4}, {50, 4}, RoadClass::Local, 0});
+        return s;
+    };
+    const StreetGraph merged = planarize(segments(0, 0), 14.0, 12.0);
+    EXPECT_TRUE(checkPlanarGraph(merged, 12.0).isOk()) << checkPlanarGraph(merged, 12.0).message();
+    EXPECT_LE(merged.edges.size(), 4u);
+
+    std::vector<uint32_t> cw;
+    const StreetGraph g = planarize(segments(1, 2), 14.0, 12.0, &cw);
+    EXPECT_TRUE(checkPlanarGraph(g, kCarriagewayMerge_m).isOk()) << checkPlanarGraph(g, kCarriagewayMerge_m).message();
+    ASSERT_EQ(cw.size(), g.edges.size());
+    EXPECT_EQ(g.nodes.size(), 10u);
+    int north = 0, south = 0, connector = 0;
+    for (size_t e = 0; e < g.edges.size(); ++e) {
+        const glm::dvec2 a = g.nodes[g.edges[e].a], b = g.nodes[g.edges[e].b];
+        if (std::abs(a.y - 4) < 1e-9 && std::abs(b.y - 4) < 1e-9) {
+            ++north;
+            EXPECT_EQ(cw[e], 1u);
+        } else if (std::abs(a.y + 4) < 1e-9 && std::abs(b.y + 4) < 1e-9) {
+            ++south;
+            EXPECT_EQ(cw[e], 2u);
+        } else {
+            ++connector;
+            EXPECT_EQ(cw[e], 0u);
+            EXPECT_NEAR(g.edgeLength(e), 8.0, 1e-9);
+        }
+    }
+    EXPECT_EQ(north, 4);
+    EXPECT_EQ(south, 4);
+    EXPECT_EQ(connector, 1);
+
+    // One carriageway and free segments: its nodes snap as before.
+    std::vector<uint32_t> one;
+    const StreetGraph h = planarize(segments(1, 0), 14.0, 12.0, &one);
+    EXPECT_LE(h.edges.size(), 4u);
+}
+
 TEST(Planarize, NearCoincidentAndDegenerateInput) {
     std::vector<RawSegment> segs;
     for (int k = 0; k < 20; ++k) {

@@ -1,6 +1,7 @@
 // `vista gen` end to end: bad input gives exit 2, a message naming the field, no output file.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -234,4 +235,52 @@ TEST_F(GenCli, MemoryBudgetRefusesUpFrontWithNothingWritten) {
     EXPECT_EQ(j.at("memory").at("budget_gb").get<double>(), 8.0);
     EXPECT_GT(estimate, peak / kPeakOverEstimateMax) << estimate << " vs " << peak;
     EXPECT_LT(estimate, peak * 2) << estimate << " vs " << peak;
+}
+
+// --osm: the city covers the extract's own extent unless --size clips it; the clip message says
+// how much was cut; an extract wider than a single file holds is refused for a single file
+// (naming the paged output and --size) with nothing written.
+TEST_F(GenCli, OsmExtractAtItsOwnExtentAndClippedOnlyBySize) {
+    const std::string town = std::string(VISTA_SOURCE_DIR) + "/tests/data/osm/town.osm";
+    CliRun r = runVista("gen -q --detail 0 --osm " + town + " -o " + file("a.osgb") + " --stats " + file("a.json"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.err.find("clipped"), std::string::npos) << r.err;
+    r = runVista("gen -q --detail 0 --osm " + town + " --size 16000 -o " + file("b.osgb") + " --stats " +
+                 file("b.json"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto a = nlohmann::json::parse(std::ifstream(file("a.json"))),
+               b = nlohmann::json::parse(std::ifstream(file("b.json")));
+    // The town spans 720 m: its own city is 1 km (720 m + 2 x 50 m margin in whole 250 m tiles), the same streets
+    // as in a city large enough to hold it all.
+    EXPECT_EQ(a["size_m"].get<double>(), 1000.0);
+    EXPECT_EQ(a["street_edges"], b["street_edges"]);
+    EXPECT_EQ(a["osm_roads"]["edges"], b["osm_roads"]["edges"]);
+
+    r = runVista("gen -q --detail 0 --osm " + town + " --osm-buildings off --size 300 -o " + file("c.osgb"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("clipped the roads to the city square of size_m = 300 m: kept "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("road segments cut or dropped"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("(--size; without it the city covers the whole extract)"), std::string::npos) << r.err;
+
+    // A cross of two 17 km roads: wider than a single file holds.
+    std::string osm = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<osm version=\"0.6\">\n";
+    const double dLat = 8500.0 / 111132.0, dLon = 8500.0 / (111320.0 * std::cos(48.2 * 3.14159265358979 / 180));
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  " <node id=\"1\" lat=\"%.7f\" lon=\"16.37\"/>\n <node id=\"2\" lat=\"%.7f\" lon=\"16.37\"/>\n"
+                  " <node id=\"3\" lat=\"48.2\" lon=\"%.7f\"/>\n <node id=\"4\" lat=\"48.2\" lon=\"%.7f\"/>\n",
+                  48.2 - dLat, 48.2 + dLat, 16.37 - dLon, 16.37 + dLon);
+    osm += buf;
+    osm +=
+        " <way id=\"1\"><nd ref=\"1\"/><nd ref=\"2\"/><tag k=\"highway\" v=\"primary\"/></way>\n"
+        " <way id=\"2\"><nd ref=\"3\"/><nd ref=\"4\"/><tag k=\"highway\" v=\"primary\"/></way>\n</osm>\n";
+    const std::string wide = file("wide.osm", osm);
+    r = runVista("gen -q --detail 0 --osm " + wide + " -o " + file("w.osgb"));
+    EXPECT_EQ(r.code, 2) << r.err;
+    for (const char* what : {"option --osm", "wide.osm", "m east-west by ", "-o DIR.paged", "--size"})
+        EXPECT_NE(r.err.find(what), std::string::npos) << what << ": " << r.err;
+    EXPECT_FALSE(fs::exists(file("w.osgb")));
+    r = runVista("gen -q --detail 0 --osm " + wide + " --size 1000 -o " + file("w.osgb"));
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("clipped"), std::string::npos) << r.err;
 }

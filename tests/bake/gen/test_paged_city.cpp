@@ -518,3 +518,38 @@ TEST_F(Paged, CoarseLevelDrawsTreesAsImpostors) {
     }
     EXPECT_GT(trees, 0u);
 }
+
+// An OSM extract written as a paged city (vista gen --osm X -o DIR.paged): the
+// city is the extract's own extent, and the regions hold the single file's
+// buildings (imported footprints and procedural lots beside them) once each.
+TEST_F(Paged, OsmExtractPagesTheSingleFileCity) {
+    const std::string town = std::string(VISTA_SOURCE_DIR) + "/tests/data/osm/town.osm";
+    CliRun r = runVista("gen -q --detail 0 --osm " + town + " -o " + tmp.file("one.osgb") + " --stats " +
+                        tmp.file("one.json"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = runVista("gen -q --detail 0 --osm " + town + " --region-size 500 -o " + tmp.file("t.paged") + " --stats " +
+                 tmp.file("paged.json"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto one = readJson(tmp.file("one.json")), paged = readJson(tmp.file("paged.json"));
+    const auto m = readJson(tmp.file("t.paged") + "/manifest.json");
+    EXPECT_EQ(m["params"]["size_m"], one["size_m"]);
+    EXPECT_TRUE(m["params"].contains("geo")) << m["params"].dump();
+    EXPECT_EQ(m["regions"].size(), 4u);  // 1 km in 500 m regions
+    EXPECT_EQ(paged["street_edges"], one["street_edges"]);
+    EXPECT_EQ(m["totals"]["buildings"].get<size_t>(), one["buildings"].get<size_t>());
+    EXPECT_GT(one["osm_buildings"]["imported"].get<size_t>(), 0u);
+    EXPECT_EQ(paged["osm_roads"], one["osm_roads"]);
+    // The given streets travel beside the regions: a seeded path on the paged city is the
+    // single file's path (a grown graph would be another city's streets).
+    EXPECT_EQ(m["streets"], "streets.json");
+    r = runVista("path " + tmp.file("t.paged") + " --seed 3 -o " + tmp.file("paged.csv"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = runVista("path " + tmp.file("one.osgb") + " --seed 3 -o " + tmp.file("one.csv"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(readBytes(tmp.file("paged.csv")), readBytes(tmp.file("one.csv")));
+    // The regions' records name the input: a rerun reuses them all.
+    r = runVista("gen -q --detail 0 --osm " + town + " --region-size 500 -o " + tmp.file("t.paged") + " --stats " +
+                 tmp.file("again.json"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(readJson(tmp.file("again.json"))["regions_reused"], 4);
+}
