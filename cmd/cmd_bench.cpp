@@ -42,6 +42,7 @@ struct BenchArgs {
     PathOptions pathOptions;
     PagedReach paged;
     PagedStreamFlags stream;
+    CommandFiles files;  // checked by configure; holds the outputs' locks for the run
 };
 
 void declareFlags(CLI::App& app, BenchArgs& a) {
@@ -135,12 +136,10 @@ Status configure(BenchArgs& a) {
     if (a.stream.stream && !a.sweep.empty())
         return Status::error("--paged-stream: not with --sweep (the sweep benches city files, not paged cities)");
     if (a.stream.stream) VISTA_RETURN_IF_ERROR(checkStreamingModes(a.cfg.modes));
-    if (a.sweep.empty()) {
-        if (a.city.empty()) return Status::error("missing the city file argument (or use --sweep)");
-        if (!fs::exists(a.city)) return Status::error("city file '" + a.city + "' does not exist");
-    }
-    VISTA_RETURN_IF_ERROR(checkRunFiles(CommandFiles().output("--out", a.out).output("--dump-rays", a.cfg.dumpRaysDir),
-                                        a.city, a.path, a.mode));
+    if (a.sweep.empty() && a.city.empty()) return Status::error("missing the city file argument (or use --sweep)");
+    VISTA_RETURN_IF_ERROR(checkRunFiles(
+        a.files.outputDirectory("--out", a.out).outputDirectory("--dump-rays", a.cfg.dumpRaysDir), a.city, a.path,
+        a.mode));
     VISTA_RETURN_IF_ERROR(checkWritableDirectory("--out", a.out));  // before any work, so a run never fails at its end
     if (!a.cfg.dumpRaysDir.empty()) {
         if (!a.sweep.empty()) return Status::error("--dump-rays is not supported with --sweep (one city per run)");

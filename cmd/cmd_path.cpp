@@ -67,8 +67,8 @@ int runPath(int argc, char** argv) {
     o.maxYawRate = yawDeg * kPi / 180.0;
     o.flyPitch = pitchDeg * kPi / 180.0;
     if (Status s = validatePathOptions(o); !s) return reportBadInput("vista path", s);
-    if (Status s = CommandFiles().input("city", city).output("-o", out).output("--xodr-positions", positions).check();
-        !s)
+    CommandFiles files;  // held until the outputs are written (the locks)
+    if (Status s = files.input("city", city).output("-o", out).output("--xodr-positions", positions).check(); !s)
         return reportBadInput("vista path", s);
     if (Status s = checkWritablePath("--output", out); !s) return reportBadInput("vista path", s);
     if (!positions.empty() && o.kind != PathKind::Car)

@@ -85,6 +85,7 @@ struct ViewArgs {
     double fovDeg = 60.0, memoryBudgetGb = 0;
     PagedReach paged;
     PagedStreamFlags stream;
+    CommandFiles files;  // checked by configure; holds the output's lock for the run
 };
 
 void declareFlags(CLI::App& app, ViewArgs& a) {
@@ -135,7 +136,7 @@ Status configure(ViewArgs& a, ModeOptions& options) {
     if (a.step && (a.frames < 1 || a.frames > 1000000 || (a.path.file.empty() && a.path.seed == 0)))
         return Status::error("--step needs --frames N in 1 .. 1000000 (as vista bench) and a path (--path or --seed)");
     VISTA_RETURN_IF_ERROR(
-        checkRunFiles(CommandFiles().output("--screenshot", a.screenshot), a.city, a.path, a.modeFlags));
+        checkRunFiles(a.files.output("--screenshot", a.screenshot), a.city, a.path, a.modeFlags));
     if (!a.screenshot.empty()) VISTA_RETURN_IF_ERROR(checkWritablePath("--screenshot", a.screenshot));
     VISTA_RETURN_IF_ERROR(validatePagedReach(a.paged));
     VISTA_RETURN_IF_ERROR(validatePagedStream(a.stream));
@@ -550,7 +551,8 @@ int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path,
         if (last) break;
     }
     if (v.stream) v.stream->report(v.mode, v.current->lastViewerStats());
-    if (!a.screenshot.empty() && v.keys->capture->lastWritten != a.screenshot) return 1;
+    // A --screenshot that could not be written (its cause is on stderr, e.g. a full device) is a failed output.
+    if (!a.screenshot.empty() && v.keys->capture->lastWritten != a.screenshot) return 2;
     return 0;
 }
 
