@@ -95,13 +95,7 @@ CommandFiles& CommandFiles::shareOutputs(bool shared) {
 }
 
 Status CommandFiles::check() & {
-    // 1. Every path resolves (outputs first: a run whose output cannot be
-    //    written is refused whatever its inputs).
-    for (const Named& o : _outputs)
-        VISTA_RETURN_IF_ERROR(o.directory ? checkWritableDirectory(o.option, o.path, o.parentMustExist)
-                                          : checkWritablePath(o.option, o.path));
-    for (const Named& in : _inputs) VISTA_RETURN_IF_ERROR(checkInputPath(in.option, in.path));
-    // 2. No output is an input or another output.
+    // 1. No output is an input or another output (the most telling refusal first).
     for (size_t i = 0; i < _outputs.size(); ++i) {
         const Named& o = _outputs[i];
         for (const Named& in : _inputs)
@@ -117,6 +111,12 @@ Status CommandFiles::check() & {
                                      echoText(o.path) + "': give each output its own path");
         }
     }
+    // 2. Every path resolves (outputs first: a run whose output cannot be
+    //    written is refused whatever its inputs).
+    for (const Named& o : _outputs)
+        VISTA_RETURN_IF_ERROR(o.directory ? checkWritableDirectory(o.option, o.path, o.parentMustExist)
+                                          : checkWritablePath(o.option, o.path));
+    for (const Named& in : _inputs) VISTA_RETURN_IF_ERROR(checkInputPath(in.option, in.path));
     // 3. One writer per output.
     if (!_made) _made = std::make_unique<CreatedDirectories>();
     for (const Named& o : _outputs) {

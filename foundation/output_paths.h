@@ -6,18 +6,18 @@
 // user gave them) in a CommandFiles and calls check() before it reads or
 // writes anything, keeping the object alive until it has written its
 // outputs. check() then, in this order:
-//  1. resolves every path once: an output file is checkWritablePath, an
-//     output directory checkWritableDirectory (atomic_file.h: symbolic link
-//     loops, dangling links, a missing or unreachable directory, a device
-//     or pipe where a directory is expected are refused); an input is
-//     checkInputPath below;
-//  2. the aliasing rule: two paths are the same file when, after symlinks,
+//  1. the aliasing rule: two paths are the same file when, after symlinks,
 //     "." and "..", they name the same directory entry: the real path of the
 //     parent directory plus the last component, or, when both exist, the
 //     same device and inode (hard links too). An error names both options
 //     and the path, e.g. "options -o and --stats name the same file
 //     'c.osgb': give each output its own path". Two outputs that are one
 //     character device (/dev/null twice) are allowed;
+//  2. resolves every path once: an output file is checkWritablePath, an
+//     output directory checkWritableDirectory (atomic_file.h: symbolic link
+//     loops, dangling links, a missing or unreachable directory, a device
+//     or pipe where a directory is expected are refused); an input is
+//     checkInputPath below;
 //  3. takes the lock of every output (output_lock.h), exclusive, or shared
 //     after shareOutputs(true) (the shards of one job), creating the missing
 //     parents of an output directory that the command creates anyway (they
