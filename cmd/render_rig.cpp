@@ -115,12 +115,11 @@ Status configure(const RigRunRequest& a, RigPlan& p) {
     auto po = parsePathFlags(a.path);
     if (!po) return po.status();
     p.path = *po;
-    VISTA_RETURN_IF_ERROR(
-        checkRunFiles(p.files.outputDirectory("--out", a.out, true).input("--rig", a.rig), a.city, a.path, a.modeFlags));
     auto rig = loadRigFile(a.rig);
     if (!rig) return Status::error("--rig: " + rig.status().message());
     p.rig = std::move(*rig);
-    return Status::ok();
+    return checkRunFiles(p.files.outputDirectory("--out", a.out, true).input("--rig", a.rig), a.city, a.path,
+                         a.modeFlags);
 }
 
 Result<Walkthrough> loadCityAndFrames(const RigRunRequest& a, RigPlan& p) {
