@@ -137,9 +137,9 @@ Status configure(BenchArgs& a) {
         return Status::error("--paged-stream: not with --sweep (the sweep benches city files, not paged cities)");
     if (a.stream.stream) VISTA_RETURN_IF_ERROR(checkStreamingModes(a.cfg.modes));
     if (a.sweep.empty() && a.city.empty()) return Status::error("missing the city file argument (or use --sweep)");
-    VISTA_RETURN_IF_ERROR(checkRunFiles(
-        a.files.outputDirectory("--out", a.out).outputDirectory("--dump-rays", a.cfg.dumpRaysDir), a.city, a.path,
-        a.mode));
+    VISTA_RETURN_IF_ERROR(
+        checkRunFiles(a.files.outputDirectory("--out", a.out).outputDirectory("--dump-rays", a.cfg.dumpRaysDir), a.city,
+                      a.path, a.mode));
     VISTA_RETURN_IF_ERROR(checkWritableDirectory("--out", a.out));  // before any work, so a run never fails at its end
     if (!a.cfg.dumpRaysDir.empty()) {
         if (!a.sweep.empty()) return Status::error("--dump-rays is not supported with --sweep (one city per run)");

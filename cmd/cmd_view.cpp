@@ -135,8 +135,7 @@ Status configure(ViewArgs& a, ModeOptions& options) {
     a.sampleRuns = sampling.value();
     if (a.step && (a.frames < 1 || a.frames > 1000000 || (a.path.file.empty() && a.path.seed == 0)))
         return Status::error("--step needs --frames N in 1 .. 1000000 (as vista bench) and a path (--path or --seed)");
-    VISTA_RETURN_IF_ERROR(
-        checkRunFiles(a.files.output("--screenshot", a.screenshot), a.city, a.path, a.modeFlags));
+    VISTA_RETURN_IF_ERROR(checkRunFiles(a.files.output("--screenshot", a.screenshot), a.city, a.path, a.modeFlags));
     if (!a.screenshot.empty()) VISTA_RETURN_IF_ERROR(checkWritablePath("--screenshot", a.screenshot));
     VISTA_RETURN_IF_ERROR(validatePagedReach(a.paged));
     VISTA_RETURN_IF_ERROR(validatePagedStream(a.stream));

@@ -382,7 +382,8 @@ Status checkDirectory(const std::string& option, const std::string& path, const 
     if (::stat(dir.c_str(), &st) != 0) {
         const int err = errno;
         struct stat lst {};
-        if (err == ENOENT && ::lstat(dir.c_str(), &lst) != 0) return Status::error(named(option, path) + ": " + missing);
+        if (err == ENOENT && ::lstat(dir.c_str(), &lst) != 0)
+            return Status::error(named(option, path) + ": " + missing);
         return Status::error(named(option, path) + ": directory '" + dir + "' " + unfollowable(dir, err));
     }
     if (!S_ISDIR(st.st_mode))
@@ -399,7 +400,8 @@ Status checkDirectory(const std::string& option, const std::string& path, const 
 Status checkWritablePath(const std::string& option, const std::string& path) {
     namespace fs = std::filesystem;
     if (path.empty()) return Status::error("option " + option + ": empty path");
-    struct stat lst {}, st{};
+    struct stat lst {
+    }, st{};
     if (::lstat(path.c_str(), &lst) == 0) {
         if (::stat(path.c_str(), &st) != 0) {
             const int err = errno;

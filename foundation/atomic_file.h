@@ -92,7 +92,7 @@ public:
 
 private:
     std::vector<std::pair<std::string, std::string>> _files;  // (staged, final)
-    std::vector<bool> _special;                                // per file: the final path is a device or FIFO
+    std::vector<bool> _special;                               // per file: the final path is a device or FIFO
     bool _committed = false;
 };
 

@@ -93,9 +93,7 @@ protected:
         EXPECT_EQ(r.code, 2) << args << "\n" << r.err;
         EXPECT_TRUE(has(r.err, "No space left on device") && has(r.err, dir.file(node))) << args << "\n" << r.err;
         EXPECT_TRUE(isDevice(dir.file(node), kFullMinor)) << args << ": " << node << " was replaced";
-        if (!absent.empty()) {
-            EXPECT_FALSE(fs::exists(dir.file(absent))) << args << ": " << absent << " written";
-        }
+        if (!absent.empty()) { EXPECT_FALSE(fs::exists(dir.file(absent))) << args << ": " << absent << " written"; }
     }
 };
 
@@ -132,8 +130,8 @@ TEST_F(OutputPlaces, GenWritesItsCityStatsRoadsAndStreetsIntoDevicesInPlace) {
         GTEST_SKIP() << kNoMknod;
     const std::string gen = "gen --size 300 --seed 3 -q ";
     // One null device for two outputs is no aliasing.
-    intoNull(gen + "-o " + dir.file("null.osgb") + " --xodr " + dir.file("null.xodr") + " --stats " +
-                 dir.file("null") + " --geojson " + dir.file("null"),
+    intoNull(gen + "-o " + dir.file("null.osgb") + " --xodr " + dir.file("null.xodr") + " --stats " + dir.file("null") +
+                 " --geojson " + dir.file("null"),
              "null.osgb");
     EXPECT_TRUE(isDevice(dir.file("null.xodr"), kNullMinor) && isDevice(dir.file("null"), kNullMinor));
     intoFull(gen + "-o " + dir.file("full.osgb"), "full.osgb");
@@ -195,8 +193,8 @@ TEST_F(OutputPlaces, EveryCommandRefusesAnOutputAnotherProcessIsWriting) {
          dir.file("s.json"), false},
         {"gen --size 1000 --region-size 500 -q -o " + dir.file("c.paged"), "-o", dir.file("c.paged"), false},
         {"bake -q " + city() + " -o " + dir.file("b.osgb"), "--output", dir.file("b.osgb"), false},
-        {"bake -q " + city() + " -o " + dir.file("b2.osgb") + " --work " + dir.file("work"), "--work",
-         dir.file("work"), false},
+        {"bake -q " + city() + " -o " + dir.file("b2.osgb") + " --work " + dir.file("work"), "--work", dir.file("work"),
+         false},
         {"bench " + city() + p + "--out " + dir.file("bench"), "--out", dir.file("bench"), true},
         {"render " + city() + p + "--out " + dir.file("gt"), "--out", dir.file("gt"), true},
         {"view " + city() + " --size 64x48 --frames 1 --screenshot " + dir.file("v.png"), "--screenshot",
@@ -209,7 +207,8 @@ TEST_F(OutputPlaces, EveryCommandRefusesAnOutputAnotherProcessIsWriting) {
         const CliRun r = runVista(c.args);
         EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
         EXPECT_TRUE(has(r.err, c.option) && has(r.err, "another vista process") && has(r.err, c.output + ".lock"))
-            << c.args << "\n" << r.err;
+            << c.args << "\n"
+            << r.err;
         EXPECT_EQ(listTree(dir.path()), std::set<std::string>{fs::path(c.output).filename().string() + ".lock"})
             << c.args;
     }
@@ -240,7 +239,8 @@ TEST_F(OutputPlaces, TwoPagedGensRacingOnOneDirectoryNeverMix) {
     const CliRun again = runVista("gen --size 2000 --detail 1 --region-size 500 --seed " + std::to_string(winner + 1) +
                                   " -o " + out + " --stats " + dir.file("again.json"));
     ASSERT_EQ(again.code, 0) << again.err;
-    EXPECT_TRUE(has(readBytes(dir.file("again.json")), "\"regions_generated\": 0")) << readBytes(dir.file("again.json"));
+    EXPECT_TRUE(has(readBytes(dir.file("again.json")), "\"regions_generated\": 0"))
+        << readBytes(dir.file("again.json"));
     EXPECT_FALSE(fs::exists(out + ".lock"));
 }
 
@@ -253,11 +253,12 @@ TEST_F(OutputPlaces, TwoRendersRacingOnOneOutExitAtOnceAndLeaveNoPartial) {
     std::thread t[2];
     for (int k = 0; k < 2; ++k)
         t[k] = std::thread([&, k] {
-            runs[k] = runVista("render " + city() + " --path " + pathCsv() + " --frames 12 --size 96x64 -q --out " + out);
+            runs[k] =
+                runVista("render " + city() + " --path " + pathCsv() + " --frames 12 --size 96x64 -q --out " + out);
         });
     for (auto& th : t) th.join();
-    ASSERT_EQ((runs[0].code == 0) + (runs[1].code == 0), 1)
-        << runs[0].code << " " << runs[0].err << "\n" << runs[1].code << " " << runs[1].err;
+    ASSERT_EQ((runs[0].code == 0) + (runs[1].code == 0), 1) << runs[0].code << " " << runs[0].err << "\n"
+                                                            << runs[1].code << " " << runs[1].err;
     const CliRun& loser = runs[0].code == 0 ? runs[1] : runs[0];
     EXPECT_EQ(loser.code, 2);
     EXPECT_TRUE(has(loser.err, "--out") && has(loser.err, "another vista process")) << loser.err;
@@ -308,7 +309,8 @@ TEST_F(OutputPlaces, EveryCommandRefusesLoopsDanglingLinksAndUnreachableOutputsB
     for (const Case& c : cases) {
         const CliRun r = runVista(c.args);
         EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
-        for (const std::string& part : c.parts) EXPECT_TRUE(has(r.err, part)) << c.args << ": '" << part << "' not in\n" << r.err;
+        for (const std::string& part : c.parts)
+            EXPECT_TRUE(has(r.err, part)) << c.args << ": '" << part << "' not in\n" << r.err;
         EXPECT_EQ(names(dir.path()), before) << c.args;
     }
 }
