@@ -225,7 +225,10 @@ private:
     void planTransitions();
     void applyTrims();
     void placeLinks();
+    bool addLaneTurn(size_t j, uint32_t in, uint32_t out, int k, int o);
+    void connectLeftovers(size_t j);
     void placeSignals();
+    void groupApproaches();
 
     const StreetGraph& g;
     const std::vector<Block>* blocks;
@@ -491,24 +494,16 @@ bool LaneModelBuilder::place(LinkRoad& r) const {
 void LaneModelBuilder::placeLinks() {
     for (size_t j = 0; j < m.junctions.size(); ++j) {
         Junction& J = m.junctions[j];
-        std::map<uint32_t, std::vector<bool>> taken;  // per incoming arm: lanes with a link
         for (const TurnPlan& t : plans[j]) {
             LinkRoad r = junctionRoad(int(j), t);
             if (!place(r)) {
                 ++m.droppedTurns;
                 continue;
             }
-            auto& k = taken[t.in];
-            k.resize(size_t(end(t.in, J.node).toward()) + 1, false);
-            for (int i = t.i0; i <= t.i1; ++i) k[size_t(i)] = true;
             J.links.push_back(uint32_t(m.links.size()));
             m.links.push_back(std::move(r));
         }
-        for (uint32_t e : J.arms) {
-            const int nIn = end(e, J.node).toward();
-            auto it = taken.find(e);
-            for (int i = 1; i <= nIn; ++i) m.unlinkedLanes += it == taken.end() || !it->second[size_t(i)];
-        }
+        connectLeftovers(j);
     }
     for (LinkRoad& r : transitions) {
         if (!place(r)) {
@@ -519,6 +514,115 @@ void LaneModelBuilder::placeLinks() {
         (g.edges[r.in].a == r.node ? m.edges[r.in].linkA : m.edges[r.in].linkB) = idx;
         (g.edges[r.out].a == r.node ? m.edges[r.out].linkA : m.edges[r.out].linkB) = idx;
         m.links.push_back(std::move(r));
+    }
+}
+
+// A turn of one lane (incoming lane k of `in` into outgoing lane o of
+// `out`) at junction j, placed with the trims the edges got; false when the
+// turn is sharper than kMaxTurn or its lane would reach the centre of
+// curvature.
+bool LaneModelBuilder::addLaneTurn(size_t j, uint32_t in, uint32_t out, int k, int o) {
+    Junction& J = m.junctions[j];
+    TurnPlan t;
+    t.in = in;
+    t.out = out;
+    t.angle = turnAngle(end(in, J.node).dirIn(), -end(out, J.node).dirIn());
+    if (std::abs(t.angle) > kMaxTurn) return false;
+    t.turn = t.angle < -kStraightTurn  ? LinkRoad::Turn::Right
+             : t.angle > kStraightTurn ? LinkRoad::Turn::Left
+                                       : LinkRoad::Turn::Straight;
+    t.i0 = t.i1 = k;
+    t.shift = k - o;
+    LinkRoad r = junctionRoad(int(j), t);
+    if (!place(r)) return false;
+    J.links.push_back(uint32_t(m.links.size()));
+    m.links.push_back(std::move(r));
+    return true;
+}
+
+// Full-width driving lanes the planned turns leave without a connection get
+// one of their own (lanes.h): every incoming lane that no placed turn takes
+// joins the exit its arm already turns into (else the straightest exit),
+// into an outgoing lane nobody feeds where there is one; then every outgoing
+// lane that no incoming lane feeds (tapered lanes appearing inside a turn do
+// not count) is fed from the approach that already turns into its arm (else
+// the straightest), from the lane on the same side of the road. Lanes left
+// without a connection (every candidate turn too sharp or unplaceable) are
+// counted in unlinkedLanes / unfedLanes.
+void LaneModelBuilder::connectLeftovers(size_t j) {
+    const Junction& J = m.junctions[j];
+    const uint32_t v = J.node;
+    std::map<uint32_t, std::vector<char>> taken, fed;  // per arm, by lane k (1 = innermost)
+    for (uint32_t e : J.arms) {
+        taken[e].assign(size_t(end(e, v).toward()) + 1, 0);
+        fed[e].assign(size_t(end(e, v).away()) + 1, 0);
+    }
+    std::map<std::pair<uint32_t, uint32_t>, int> shiftOf;  // placed turn in -> out: outgoing lane = k - shift
+    auto mark = [&](const LinkRoad& r) {
+        for (const LinkRoad::Lane& l : r.right) {
+            if (l.from) taken[r.in][size_t(std::abs(l.from))] = 1;
+            if (l.from && l.to) {
+                fed[r.out][size_t(std::abs(l.to))] = 1;
+                shiftOf.emplace(std::pair{r.in, r.out}, std::abs(l.from) - std::abs(l.to));
+            }
+        }
+    };
+    for (uint32_t k : J.links) mark(m.links[k]);
+    auto angleOf = [&](uint32_t in, uint32_t out) { return turnAngle(end(in, v).dirIn(), -end(out, v).dirIn()); };
+    // Candidate partner arms: those with a placed turn first, then by how straight the turn is.
+    auto order = [&](uint32_t arm, bool armIsIn) {
+        std::vector<uint32_t> c;
+        for (uint32_t x : J.arms)
+            if (x != arm && (armIsIn ? end(x, v).away() : end(x, v).toward()) > 0) c.push_back(x);
+        auto key = [&](uint32_t x) {
+            const auto pair = armIsIn ? std::pair{arm, x} : std::pair{x, arm};
+            return std::pair{shiftOf.count(pair) ? 0 : 1, std::abs(armIsIn ? angleOf(arm, x) : angleOf(x, arm))};
+        };
+        std::stable_sort(c.begin(), c.end(), [&](uint32_t a, uint32_t b) { return key(a) < key(b); });
+        return c;
+    };
+    // The lane of a road with n lanes that continues lane k of a road with nk
+    // lanes: through the placed turn's shift, else counted from the side the
+    // turn bends to (the outermost for right turns, the innermost otherwise).
+    auto across = [](int k, int nk, int n, double angle, const int* shift) {
+        int x = shift ? k - *shift : angle < -kStraightTurn ? n - (nk - k) : k;
+        return std::clamp(x, 1, n);
+    };
+    for (uint32_t in : J.arms) {
+        const int nIn = end(in, v).toward();
+        for (int k = 1; k <= nIn; ++k) {
+            if (taken[in][size_t(k)]) continue;
+            for (uint32_t out : order(in, true)) {
+                const int nOut = end(out, v).away();
+                auto it = shiftOf.find({in, out});
+                const int target = across(k, nIn, nOut, angleOf(in, out), it == shiftOf.end() ? nullptr : &it->second);
+                int o = target;
+                for (int x = 1, best = 1 << 30; x <= nOut; ++x)  // the nearest outgoing lane nobody feeds
+                    if (!fed[out][size_t(x)] && std::abs(x - target) < best) best = std::abs(x - target), o = x;
+                if (addLaneTurn(j, in, out, k, o)) {
+                    mark(m.links.back());
+                    break;
+                }
+            }
+            m.unlinkedLanes += !taken[in][size_t(k)];
+        }
+    }
+    for (uint32_t out : J.arms) {
+        const int nOut = end(out, v).away();
+        for (int o = 1; o <= nOut; ++o) {
+            if (fed[out][size_t(o)]) continue;
+            for (uint32_t in : order(out, false)) {
+                const int nIn = end(in, v).toward();
+                auto it = shiftOf.find({in, out});
+                const int minus = it == shiftOf.end() ? 0 : -it->second;
+                const int k = across(o, nOut, nIn, angleOf(in, out), it == shiftOf.end() ? nullptr : &minus);
+                if (addLaneTurn(j, in, out, k, o)) {
+                    mark(m.links.back());
+                    break;
+                }
+            }
+            m.unfedLanes += !fed[out][size_t(o)];
+        }
     }
 }
 
@@ -549,6 +653,37 @@ void LaneModelBuilder::placeSignals() {
             sp.position = L.start + L.dir * sp.s + L.normal() * sp.t;
             sp.facing = atB ? -L.dir : L.dir;
             m.signals.push_back(sp);
+        }
+    }
+    groupApproaches();
+}
+
+// Approach groups of the traffic lights per junction (SignalPlacement).
+void LaneModelBuilder::groupApproaches() {
+    std::map<int, std::vector<size_t>> byJunction;
+    for (size_t i = 0; i < m.signals.size(); ++i)
+        if (m.signals[i].kind == SignalPlacement::Kind::TrafficLight) byJunction[m.signals[i].junction].push_back(i);
+    for (auto& [j, lights] : byJunction) {
+        // Candidate pairs: arms within kOppositeArms of opposite, most opposite first.
+        std::vector<std::pair<double, std::pair<size_t, size_t>>> pairs;
+        for (size_t x = 0; x < lights.size(); ++x)
+            for (size_t y = x + 1; y < lights.size(); ++y) {
+                const glm::dvec2 a = m.signals[lights[x]].facing, b = m.signals[lights[y]].facing;
+                const double off = std::abs(std::atan2(a.x * b.y - a.y * b.x, -(a.x * b.x + a.y * b.y)));
+                if (off <= kOppositeArms) pairs.push_back({off, {x, y}});
+            }
+        std::stable_sort(pairs.begin(), pairs.end(),
+                         [](const auto& p, const auto& q) { return p.first < q.first; });
+        std::vector<size_t> partner(lights.size(), lights.size());
+        for (const auto& [off, xy] : pairs)
+            if (partner[xy.first] == lights.size() && partner[xy.second] == lights.size())
+                partner[xy.first] = xy.second, partner[xy.second] = xy.first;
+        int next = 0;
+        for (size_t x = 0; x < lights.size(); ++x) {
+            SignalPlacement& sp = m.signals[lights[x]];
+            if (sp.group >= 0) continue;
+            sp.group = next++;
+            if (partner[x] < lights.size()) m.signals[lights[partner[x]]].group = sp.group;
         }
     }
 }

@@ -49,6 +49,15 @@
 //   turn the innermost into the innermost; an incoming lane that no exit
 //   would take joins the nearest turn (and tapers out where the exit has
 //   fewer lanes).
+// - Every full-width driving lane at a junction has a connection: an
+//   incoming lane that no placed turn takes (its turn was dropped, or its
+//   arm's turns leave it out) gets a one-lane turn of its own into the exit
+//   its arm already turns into (else the straightest one within kMaxTurn),
+//   preferably into an outgoing lane nobody feeds; an outgoing lane that no
+//   incoming lane feeds gets a one-lane turn from the approach that already
+//   turns into its arm (else the straightest). A lane tapering in inside a
+//   turn (width 0 where it starts, no predecessor) does not count as fed.
+//   What no turn can connect is counted (unlinkedLanes, unfedLanes).
 // Edges with invalid node indices, non-finite coordinates or zero length are
 // kept with `valid = false` (no lanes written or drawn). Deterministic; pure.
 #pragma once
@@ -150,6 +159,12 @@ struct LinkRoad {
 // their local approaches; junctions of local streets get none (priority to
 // the right). The pole stands on the sidewalk (or 0.5 m past the
 // carriageway without one) by the stop line, on the right of the traffic.
+// The traffic lights of a junction form approach groups (one controller, one
+// phase each): two approaches whose arms point in opposite directions within
+// kOppositeArms share a group (pairs matched most-opposite first, each
+// approach in at most one pair); every other approach is a group of its own.
+// Groups are numbered 0.. per junction in the order of their first signal.
+constexpr double kOppositeArms = 0.5235987755982988;  // 30 degrees
 struct SignalPlacement {
     enum class Kind : uint8_t { TrafficLight, Stop, Yield };
     Kind kind = Kind::TrafficLight;
@@ -160,6 +175,7 @@ struct SignalPlacement {
     double s = 0, t = 0;       // road frame: s along the trimmed reference line from start, t left positive
     glm::dvec2 position{0.0};  // city frame
     glm::dvec2 facing{0.0};    // unit: toward the traffic it controls
+    int group = -1;            // traffic lights: approach group within the junction (see above); else -1
 };
 
 struct LaneModel {
@@ -173,6 +189,7 @@ struct LaneModel {
     size_t sharpCorners = 0;                       // degree-2 nodes left unlinked: too sharp for the lanes
     size_t droppedTurns = 0;                       // junction turns within kMaxTurn whose trims did not fit the edges
     size_t unlinkedLanes = 0;                      // incoming driving lanes at a junction that no turn takes
+    size_t unfedLanes = 0;                         // outgoing driving lanes at a junction that no incoming lane feeds
 };
 
 LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks = nullptr);

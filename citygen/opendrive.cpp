@@ -12,6 +12,8 @@
 #include "citygen/traffic_signals.h"
 #include "foundation/units.h"
 
+#include <nlohmann/json.hpp>
+
 namespace vista {
 
 namespace {
@@ -63,7 +65,8 @@ private:
     void linkRoad(size_t k);
     void junction(size_t j);
     void signals(uint32_t e);
-    void objects(uint32_t e);
+    void placeCrosswalks();
+    void objects(size_t k);
     std::string roadMarkCentre(RoadClass c) const;
     std::string roadType(double speedKmh) const;
     size_t linkRoadId(size_t k) const { return g.edges.size() + M.junctions.size() + k; }
@@ -76,15 +79,20 @@ private:
     LaneModel M;
     std::string o;
     OpenDriveCounts n;
-    size_t nextSignal = 0, nextObject = 0, nextPlacement = 0;
-    // Signals per junction and approach group (controllers of signalised junctions).
-    struct Group {
+    size_t nextObject = 0, nextPlacement = 0;
+    // A zebra crossing on a connecting road: object at s, outline u0..u1
+    // along the road's heading there, +-halfWidth across.
+    struct Crosswalk {
+        double s = 0, u0 = 0, u1 = 0, halfWidth = 0;
+    };
+    std::vector<std::vector<Crosswalk>> hosted;  // per link road
+    // A signalised junction's approach group: one <controller> (id = index).
+    struct Controller {
         size_t junction;
+        int group;
         std::vector<size_t> signals;
     };
-    std::vector<Group> groups;
-    std::vector<double> groupAxis;                    // per group: its approaches' direction modulo pi
-    std::vector<std::vector<size_t>> junctionGroups;  // per junction: indices into groups
+    std::vector<Controller> controllers;
 };
 
 std::string Writer::roadMarkCentre(RoadClass c) const {
@@ -209,64 +217,84 @@ void Writer::laneSide(uint32_t e, bool left) {
     (void)E;
 }
 
-// The lane model's signals on a street road (SignalPlacement), with a
-// controller per approach group at signalised junctions.
+// The lane model's signals on a street road (SignalPlacement); signal id =
+// placement index. Traffic lights are the generic OpenDRIVE code (country
+// "OpenDRIVE", type 1000001: a light with three lamps), stop and yield signs
+// the German codes 206 and 205. The validity names the lanes it controls
+// from the lowest id to the highest.
 void Writer::signals(uint32_t e) {
     std::string xml;
     for (; nextPlacement < M.signals.size() && M.signals[nextPlacement].edge == e; ++nextPlacement) {
         const SignalPlacement& sp = M.signals[nextPlacement];
-        const size_t id = nextSignal++;
+        const size_t id = nextPlacement;
         const bool light = sp.kind == SignalPlacement::Kind::TrafficLight;
+        const char* country = light ? "OpenDRIVE" : "DE";
         const char* type = light ? "1000001" : sp.kind == SignalPlacement::Kind::Stop ? "206" : "205";
         const char* name = light ? "traffic light" : sp.kind == SignalPlacement::Kind::Stop ? "stop" : "yield";
+        const int a = sp.atB ? -1 : 1, b = sp.atB ? -sp.lanes : sp.lanes;
         xml += "      <signal s=\"" + num(sp.s) + "\" t=\"" + num(sp.t) + "\" id=\"" + str(id) + "\" name=\"" + name +
                "\" dynamic=\"" + (light ? "yes" : "no") + "\" orientation=\"" + (sp.atB ? "+" : "-") + "\" zOffset=\"" +
-               num(light ? kTrafficLightBottom : kSignBottom) + "\" country=\"DE\" type=\"" + type +
+               num(light ? kTrafficLightBottom : kSignBottom) + "\" country=\"" + country + "\" type=\"" + type +
                "\" subtype=\"-1\" height=\"" + num(light ? kTrafficLightHeight : kSignSize) + "\" width=\"" +
                num(light ? kTrafficLightWidth : kSignSize) + "\">\n";
-        xml += "        <validity fromLane=\"" + str(sp.atB ? -1 : 1) + "\" toLane=\"" +
-               str(sp.atB ? -sp.lanes : sp.lanes) + "\"/>\n      </signal>\n";
-        if (!light) {
-            ++n.signs;
-            continue;
-        }
-        ++n.trafficLights;
-        // Approach groups: arms within 45 degrees of opposite share a phase.
-        auto& gs = junctionGroups[size_t(sp.junction)];
-        const glm::dvec2 d = -sp.facing;
-        const double axis = std::fmod(std::atan2(d.y, d.x) + 2 * kPi, kPi);  // direction modulo pi
-        size_t best = gs.size();
-        for (size_t x = 0; x < gs.size(); ++x) {
-            double da = std::abs(groupAxis[gs[x]] - axis);
-            if (std::min(da, kPi - da) < 0.25 * kPi) best = x;
-        }
-        if (best == gs.size()) {
-            gs.push_back(groups.size());
-            groups.push_back({size_t(sp.junction), {}});
-            groupAxis.push_back(axis);
-        }
-        groups[gs[best]].signals.push_back(id);
+        xml += "        <validity fromLane=\"" + str(std::min(a, b)) + "\" toLane=\"" + str(std::max(a, b)) +
+               "\"/>\n      </signal>\n";
+        ++(light ? n.trafficLights : n.signs);
     }
     if (!xml.empty()) o += "    <signals>\n" + xml + "    </signals>\n";
 }
 
-// Zebra crossings where the road meshes draw them (crossingBand), as
-// crosswalk objects outlined in the road's local frame.
-void Writer::objects(uint32_t e) {
-    const EdgeLanes& L = M.edges[e];
+// Zebra crossings where the road meshes draw them (crossingBand): in the
+// junction, on one of its connecting roads that starts or ends where the
+// crossing's street road meets it (the straightest that is long enough for
+// the band, else the longest, the band then cut to its length). Both roads'
+// reference lines meet there with the same heading or opposite ones, so the
+// band keeps its place: outlined in the connecting road's frame at that end.
+void Writer::placeCrosswalks() {
+    hosted.assign(M.links.size(), {});
+    for (uint32_t e = 0; e < M.edges.size(); ++e) {
+        const EdgeLanes& L = M.edges[e];
+        for (int atB = 0; atB < 2; ++atB) {
+            double s0 = 0, s1 = 0;
+            if (!crossingBand(L, atB != 0, s0, s1)) continue;
+            const uint32_t v = atB ? g.edges[e].b : g.edges[e].a;
+            const double anchor = atB ? L.length : 0.0;
+            const double u0 = s0 - anchor, u1 = s1 - anchor, need = std::max(std::abs(u0), std::abs(u1));
+            size_t best = M.links.size();
+            double bestKey = 1e300;
+            for (uint32_t k : M.nodeLinks[v]) {
+                const LinkRoad& r = M.links[k];
+                if (r.junction < 0 || (r.in != e && r.out != e)) continue;
+                const double key = r.length() >= need ? std::abs(r.angle) : 10.0 + 1.0 / (1.0 + r.length());
+                if (key < bestKey) bestKey = key, best = k;
+            }
+            if (best == M.links.size()) continue;
+            const LinkRoad& r = M.links[best];
+            const bool atStart = r.in == e;  // the band lies at the connecting road's start (else its end)
+            const bool flip = atStart ? !r.inEnd : !r.outStart;
+            Crosswalk c;
+            c.s = atStart ? 0.0 : r.length();
+            c.u0 = flip ? -u1 : u0;
+            c.u1 = flip ? -u0 : u1;
+            // Cut to the road's s-range.
+            if (atStart) c.u1 = std::min(c.u1, r.length());
+            else c.u0 = std::max(c.u0, -r.length());
+            c.halfWidth = L.halfWidth();
+            if (c.u1 - c.u0 > 0.1) hosted[best].push_back(c);
+        }
+    }
+}
+
+void Writer::objects(size_t k) {
     std::string xml;
-    for (int atB = 0; atB < 2; ++atB) {
-        double s0 = 0, s1 = 0;
-        if (!crossingBand(L, atB != 0, s0, s1)) continue;
-        const double anchor = atB ? L.length : 0.0;
-        const double u0 = s0 - anchor, u1 = s1 - anchor, hw = L.halfWidth();
+    for (const Crosswalk& c : hosted[k]) {
+        const double hw = c.halfWidth;
         xml += "      <object type=\"crosswalk\" name=\"zebra crossing\" id=\"" + str(nextObject++) + "\" s=\"" +
-               num(anchor) +
-               "\" t=\"0\" zOffset=\"0\" hdg=\"0\" pitch=\"0\" roll=\"0\" orientation=\"none\" length=\"" +
-               num(u1 - u0) + "\" width=\"" + num(2 * hw) +
+               num(c.s) + "\" t=\"0\" zOffset=\"0\" hdg=\"0\" pitch=\"0\" roll=\"0\" orientation=\"none\" length=\"" +
+               num(c.u1 - c.u0) + "\" width=\"" + num(2 * hw) +
                "\" height=\"0\">\n        <outlines>\n          <outline id=\"0\" "
                "outer=\"true\" closed=\"true\" laneType=\"driving\">\n";
-        for (auto [u, v] : {std::pair{u0, -hw}, {u1, -hw}, {u1, hw}, {u0, hw}})
+        for (auto [u, v] : {std::pair{c.u0, -hw}, {c.u1, -hw}, {c.u1, hw}, {c.u0, hw}})
             xml += "            <cornerLocal u=\"" + num(u) + "\" v=\"" + num(v) + "\" z=\"0\" height=\"0\"/>\n";
         xml += "          </outline>\n        </outlines>\n      </object>\n";
         ++n.crosswalks;
@@ -310,7 +338,6 @@ void Writer::road(uint32_t e) {
          roadMarkCentre(E.cls) + "\n          </lane>\n        </center>\n";
     laneSide(e, false);
     o += "      </laneSection>\n    </lanes>\n";
-    objects(e);
     signals(e);
     o += "  </road>\n";
     (void)E;
@@ -377,6 +404,7 @@ void Writer::linkRoad(size_t k) {
             o += "            <width sOffset=\"0\" " + smoothstepAttrs(l.w0, l.w1, len) + "/>\n";
             o += "            <roadMark sOffset=\"0\" type=\"none\" color=\"standard\"/>\n";
             if (!l.sidewalk) o += "            <speed sOffset=\"0\" max=\"" + num(speed) + "\" unit=\"km/h\"/>\n";
+            n.taperedLanes += !l.sidewalk && (l.w0 == 0 || l.w1 == 0);
             o += "          </lane>\n";
         }
     };
@@ -393,7 +421,9 @@ void Writer::linkRoad(size_t k) {
         lanesXml(r.right, -1);
         o += "        </right>\n";
     }
-    o += "      </laneSection>\n    </lanes>\n  </road>\n";
+    o += "      </laneSection>\n    </lanes>\n";
+    objects(k);
+    o += "  </road>\n";
     if (inJunction) ++n.connectingRoads;
     else ++n.transitions;
 }
@@ -412,8 +442,10 @@ void Writer::junction(size_t j) {
                 o += "      <laneLink from=\"" + str(r.right[i].from) + "\" to=\"" + str(-int(i) - 1) + "\"/>\n";
         o += "    </connection>\n";
     }
-    for (size_t x = 0; x < junctionGroups[j].size(); ++x)
-        o += "    <controller id=\"" + str(junctionGroups[j][x]) + "\" type=\"0\" sequence=\"" + str(x + 1) + "\"/>\n";
+    for (size_t x = 0; x < controllers.size(); ++x)
+        if (controllers[x].junction == j)
+            o += "    <controller id=\"" + str(x) + "\" type=\"0\" sequence=\"" + str(controllers[x].group + 1) +
+                 "\"/>\n";
     o += "  </junction>\n";
     ++n.junctions;
 }
@@ -430,7 +462,16 @@ Result<std::string> Writer::run(OpenDriveCounts* counts) {
         }
     }
     if (valid == 0) return Status::error("OpenDRIVE export: the street graph has no streets (no valid edge)");
-    junctionGroups.assign(M.junctions.size(), {});
+    // One controller per approach group of a signalised junction (SignalPlacement::group).
+    for (size_t j = 0; j < M.junctions.size(); ++j)
+        for (int grp = 0;; ++grp) {
+            Controller c{j, grp, {}};
+            for (size_t i = 0; i < M.signals.size(); ++i)
+                if (M.signals[i].junction == int(j) && M.signals[i].group == grp) c.signals.push_back(i);
+            if (c.signals.empty()) break;
+            controllers.push_back(std::move(c));
+        }
+    placeCrosswalks();
     o.reserve(valid * 6144);
     o += "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<OpenDRIVE>\n";
     o += "  <header revMajor=\"1\" revMinor=\"6\" name=\"vista city seed " + std::to_string(P.seed) +
@@ -440,10 +481,10 @@ Result<std::string> Writer::run(OpenDriveCounts* counts) {
     for (uint32_t e = 0; e < g.edges.size(); ++e)
         if (M.edges[e].valid) road(e);
     for (size_t k = 0; k < M.links.size(); ++k) linkRoad(k);
-    for (size_t x = 0; x < groups.size(); ++x) {
-        o += "  <controller id=\"" + str(x) + "\" name=\"junction " + str(junctionId(groups[x].junction)) + " phase " +
-             str(x) + "\">\n";
-        for (size_t s : groups[x].signals) o += "    <control signalId=\"" + str(s) + "\" type=\"0\"/>\n";
+    for (size_t x = 0; x < controllers.size(); ++x) {
+        o += "  <controller id=\"" + str(x) + "\" name=\"junction " + str(junctionId(controllers[x].junction)) +
+             " approach group " + str(controllers[x].group) + "\">\n";
+        for (size_t s : controllers[x].signals) o += "    <control signalId=\"" + str(s) + "\" type=\"0\"/>\n";
         o += "  </controller>\n";
     }
     for (size_t j = 0; j < M.junctions.size(); ++j) junction(j);
@@ -451,11 +492,31 @@ Result<std::string> Writer::run(OpenDriveCounts* counts) {
     n.sharpCorners = M.sharpCorners;
     n.droppedTurns = M.droppedTurns;
     n.unlinkedLanes = M.unlinkedLanes;
+    n.unfedLanes = M.unfedLanes;
     if (counts) *counts = n;
     return std::move(o);
 }
 
 }  // namespace
+
+std::string openDriveCountsJson(const OpenDriveCounts& c) {
+    nlohmann::ordered_json j;
+    j["roads"] = c.roads;
+    j["connecting_roads"] = c.connectingRoads;
+    j["junctions"] = c.junctions;
+    j["transitions"] = c.transitions;
+    j["driving_lanes"] = c.drivingLanes;
+    j["sidewalks"] = c.sidewalks;
+    j["traffic_lights"] = c.trafficLights;
+    j["signs"] = c.signs;
+    j["crosswalks"] = c.crosswalks;
+    j["sharp_corners"] = c.sharpCorners;
+    j["dropped_turns"] = c.droppedTurns;
+    j["unlinked_lanes"] = c.unlinkedLanes;
+    j["unfed_lanes"] = c.unfedLanes;
+    j["tapered_lanes"] = c.taperedLanes;
+    return j.dump();
+}
 
 std::string openDriveGeoReference(const CityParams& p) {
     const double lat0 = p.geo ? p.geo->lat0_deg : 0.0, lon0 = p.geo ? p.geo->lon0_deg : 0.0;

@@ -12,10 +12,11 @@
 //   laneSection: left/right driving lanes and type="sidewalk" lanes (on the
 //   sides that have a sidewalk mesh) with constant <width>, road marks on the
 //   centre lane and lane dividers, the speed limit on the road <type> and on
-//   every driving lane; crosswalk <object>s where the meshes draw zebra
-//   crossings; <signal>s at junction ends (traffic lights where three or more
-//   arms are highways or arterials, else stop signs at 4+ arms and yield signs
-//   at 3 arms on the local approaches of junctions with a major arm).
+//   every driving lane; <signal>s at junction ends (traffic lights where
+//   three or more arms are highways or arterials: country "OpenDRIVE", type
+//   1000001; else stop signs, DE 206, at 4+ arms and yield signs, DE 205, at
+//   3 arms on the local approaches of junctions with a major arm), each
+//   with a <validity> fromLane <= toLane over the lanes it controls.
 // - One road per link road of the lane model (lanes.h LinkRoad; ids follow
 //   the street roads and junctions): line, arc and line geometry, G1 with both
 //   roads; lane widths and laneOffset as smoothstep cubics; elevation a cubic
@@ -24,7 +25,9 @@
 //   (both directions' lanes); connecting roads belong to one <junction> per
 //   node of degree >= 3 (id = road count + junction index) with a
 //   <connection> and <laneLink>s per turn, and a <controller> per approach
-//   group (arms within 45 degrees of opposite) at signalised junctions.
+//   group (lanes.h SignalPlacement::group) at signalised junctions; crosswalk
+//   <object>s where the meshes draw zebra crossings, on a connecting road of
+//   the junction (the band lies in the junction, within that road's s-range).
 // - <header> with <geoReference>: the OSM import's transverse Mercator when
 //   params.geo is set, else a transverse Mercator at (0, 0); both with
 //   +x_0/+y_0 = the world offset, so PROJ maps the written coordinates.
@@ -55,12 +58,20 @@ struct OpenDriveCounts {
     size_t sharpCorners = 0;   // degree-2 nodes left unlinked (LaneModel::sharpCorners)
     size_t droppedTurns = 0;   // LaneModel::droppedTurns
     size_t unlinkedLanes = 0;  // LaneModel::unlinkedLanes
+    size_t unfedLanes = 0;     // LaneModel::unfedLanes
+    size_t taperedLanes = 0;   // driving lanes of link roads that start or end with width 0 inside them
 };
 
 // `blocks` (the city's, or extractBlocks() of the same graph and params)
 // decide on which sides sidewalk lanes are written (lanes.h); null: both.
 Result<std::string> openDriveXml(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks,
                                  OpenDriveCounts* counts = nullptr);
+
+// The counts as a JSON object (keys in snake_case: roads, connecting_roads,
+// junctions, transitions, driving_lanes, sidewalks, traffic_lights, signs,
+// crosswalks, sharp_corners, dropped_turns, unlinked_lanes, unfed_lanes,
+// tapered_lanes).
+std::string openDriveCountsJson(const OpenDriveCounts& counts);
 
 // The PROJ string written into <geoReference> (see above).
 std::string openDriveGeoReference(const CityParams& params);

@@ -38,6 +38,7 @@
 #include "citygen/street_geometry.h"
 #include "citygen/streets.h"
 #include "foundation/input_file.h"
+#include "foundation/number_text.h"
 #include "foundation/units.h"
 
 namespace vista {
@@ -109,6 +110,29 @@ struct CoordinateAttribute {
     int kind;
 };
 
+// Bytes of an XML attribute value once its references are replaced: a named
+// entity (&amp;) is one byte, a character reference (&#233; &#xE9;) the UTF-8
+// length of its code point (libosmium's limits count these bytes).
+size_t xmlDecodedBytes(std::string_view v) {
+    size_t n = 0;
+    for (size_t i = 0; i < v.size(); ++n) {
+        const size_t semi = v[i] == '&' ? v.find(';', i) : std::string_view::npos;
+        if (semi == std::string_view::npos) {
+            ++i;
+            continue;
+        }
+        const std::string_view ref = v.substr(i + 1, semi - i - 1);
+        i = semi + 1;
+        if (ref.empty() || ref[0] != '#') continue;
+        uint32_t cp = 0;
+        const bool hex = ref.size() > 1 && (ref[1] == 'x' || ref[1] == 'X');
+        const std::string_view digits = ref.substr(hex ? 2 : 1);
+        std::from_chars(digits.data(), digits.data() + digits.size(), cp, hex ? 16 : 10);
+        n += cp < 0x80 ? 0 : cp < 0x800 ? 1 : cp < 0x10000 ? 2 : 3;
+    }
+    return n;
+}
+
 // Blanks bad coordinate attributes in place; returns the ids of nodes that lost their location.
 Result<std::vector<NodeId>> sanitizeXml(std::string& xml, const std::string& path) {
     auto fail = [&](size_t at, const std::string& what) {
@@ -122,6 +146,7 @@ Result<std::vector<NodeId>> sanitizeXml(std::string& xml, const std::string& pat
         return fail(0, "UTF-16/UTF-32 XML is not supported (use UTF-8)");
     std::vector<NodeId> blanked;
     std::vector<CoordinateAttribute> coords;  // of the current tag
+    std::string owner = "the file's header";  // the node, way or relation whose <tag> elements follow
     size_t i = 0;
     while (true) {
         const size_t lt = xml.find('<', i);
@@ -150,7 +175,10 @@ Result<std::vector<NodeId>> sanitizeXml(std::string& xml, const std::string& pat
         // A start tag: name, then name="value" / name='value' pairs, then > or />.
         size_t p = lt + 1;
         while (p < n && !xmlSpace(xml[p]) && xml[p] != '>' && xml[p] != '/') ++p;
-        const bool isNode = std::string_view(xml).substr(lt + 1, p - lt - 1) == "node";
+        const std::string_view element = std::string_view(xml).substr(lt + 1, p - lt - 1);
+        const bool isNode = element == "node", isTag = element == "tag";
+        const bool isObject = isNode || element == "way" || element == "relation";
+        std::string_view idText, tagKey, tagValue;
         coords.clear();
         NodeId id = 0;
         bool hasId = false, closed = false;
@@ -186,12 +214,26 @@ Result<std::vector<NodeId>> sanitizeXml(std::string& xml, const std::string& pat
                 break;
             }
             p = valueEnd + 1;
+            const std::string_view value = std::string_view(xml).substr(valueBegin, valueEnd - valueBegin);
             if (int kind = coordinateKind(name)) coords.push_back({nameBegin, p, valueBegin, valueEnd, kind});
-            else if (isNode && name == "id")
+            else if (isObject && name == "id") idText = value;
+            else if (isTag && name == "k") tagKey = value;
+            else if (isTag && name == "v") tagValue = value;
+            if (isNode && name == "id")
                 hasId = std::from_chars(xml.data() + valueBegin, xml.data() + valueEnd, id).ec == std::errc();
         }
         // An unfinished tag at the end of the text: expat rejects it before reporting it.
         if (!closed) break;
+        if (isObject) owner = std::string(element) + " " + echoText(std::string(idText));
+        // A tag key or value beyond libosmium's limit: its reader would stop
+        // with a bare "too long"; name the tag and its owner instead.
+        if (isTag)
+            for (const auto& [what, text] : {std::pair{"key", tagKey}, std::pair{"value", tagValue}})
+                if (const size_t bytes = xmlDecodedBytes(text); bytes > osmium::max_osm_string_length)
+                    return fail(lt, owner + ": tag '" + echoText(std::string(tagKey)) + "' has a " + what + " of " +
+                                        std::to_string(bytes) + " bytes, more than the limit of " +
+                                        std::to_string(osmium::max_osm_string_length) +
+                                        " bytes (OSM allows 255 characters)");
         bool bad = false;
         for (const auto& c : coords)
             bad = bad || !saneCoordinate(std::string_view(xml).substr(c.valueBegin, c.valueEnd - c.valueBegin),

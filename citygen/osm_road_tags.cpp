@@ -41,9 +41,10 @@ bool leadingNumber(std::string_view& s, double& v) {
     return true;
 }
 
-std::optional<float> clampSpeed(double kmh) {
-    if (!(kmh > 0) || !std::isfinite(kmh)) return std::nullopt;
-    return std::clamp(float(kmh), kMinMaxspeedKmh, kMaxMaxspeedKmh);
+// A limit within [kMinMaxspeedKmh, kMaxMaxspeedKmh]; anything else is no usable value.
+std::optional<float> plausibleSpeed(double kmh) {
+    if (!(kmh >= kMinMaxspeedKmh && kmh <= kMaxMaxspeedKmh)) return std::nullopt;
+    return float(kmh);
 }
 
 struct CountrySpeeds {
@@ -103,7 +104,14 @@ std::optional<int> parseOsmLaneCount(std::string_view text) {
     if (s.empty() || s.size() > 6) return std::nullopt;
     int v = 0;
     auto r = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (r.ec != std::errc() || r.ptr != s.data() + s.size() || s.front() == '+' || v < 1) return std::nullopt;
+    if (r.ec != std::errc() || r.ptr != s.data() + s.size() || s.front() == '+' || v < 1 || v > kMaxLanesTotal)
+        return std::nullopt;
+    return v;
+}
+
+std::optional<int> parseOsmDirectionLaneCount(std::string_view text) {
+    auto v = parseOsmLaneCount(text);
+    if (v && *v > kMaxLanesPerDirection) return std::nullopt;
     return v;
 }
 
@@ -149,16 +157,16 @@ std::optional<float> parseOsmMaxspeed(std::string_view text) {
             if (!n.empty() && n.front() == ':') n.remove_prefix(1);
             double v = 0;
             if (!leadingNumber(n, v) || !n.empty()) return std::nullopt;
-            return clampSpeed(cc == "GB" ? v * kMph : v);
+            return plausibleSpeed(cc == "GB" ? v * kMph : v);
         }
         return osmCountrySpeed(cc, zone);
     }
     double v = 0;
     if (!leadingNumber(s, v)) return std::nullopt;
     s = trim(s);
-    if (s.empty() || s == "km/h" || s == "kmh" || s == "kph") return clampSpeed(v);
-    if (s == "mph") return clampSpeed(v * kMph);
-    if (s == "knots") return clampSpeed(v * kKnot);
+    if (s.empty() || s == "km/h" || s == "kmh" || s == "kph") return plausibleSpeed(v);
+    if (s == "mph") return plausibleSpeed(v * kMph);
+    if (s == "knots") return plausibleSpeed(v * kKnot);
     return std::nullopt;
 }
 
@@ -245,15 +253,14 @@ OsmRoadTags readOsmRoadTags(const OsmTagLookup& tag, RoadClass cls, OsmRoadTagSt
     ++st.ways;
     OsmRoadTags t;
     auto laneCount = [](std::string_view v) { return parseOsmLaneCount(v); };
+    auto directionCount = [](std::string_view v) { return parseOsmDirectionLaneCount(v); };
     auto turns = [](std::string_view v) { return parseOsmTurnLanes(v); };
-    const auto total = readTag<int>(tag, "lanes", laneCount, st.lanes);
-    const auto fwdTag = readTag<int>(tag, "lanes:forward", laneCount, st.lanesForward);
-    const auto bwdTag = readTag<int>(tag, "lanes:backward", laneCount, st.lanesBackward);
+    auto total = readTag<int>(tag, "lanes", laneCount, st.lanes);
+    const auto fwdTag = readTag<int>(tag, "lanes:forward", directionCount, st.lanesForward);
+    const auto bwdTag = readTag<int>(tag, "lanes:backward", directionCount, st.lanesBackward);
     const auto turnTag = readTag<OsmTurnLanes>(tag, "turn:lanes", turns, st.turnLanes);
     const auto turnFwd = readTag<OsmTurnLanes>(tag, "turn:lanes:forward", turns, st.turnLanesForward);
     const auto turnBwd = readTag<OsmTurnLanes>(tag, "turn:lanes:backward", turns, st.turnLanesBackward);
-    const int kMaxTotal = 2 * kMaxLanesPerDirection;
-    auto perDirection = [](int n) { return std::clamp(n, 1, kMaxLanesPerDirection); };
 
     const OsmOneway oneway = readOneway(tag, st);
 
@@ -268,22 +275,27 @@ OsmRoadTags readOsmRoadTags(const OsmTagLookup& tag, RoadClass cls, OsmRoadTagSt
     auto unused = [&](const std::optional<int>& v, OsmTagUse& u) {
         if (v) ++u.fallback;
     };
-    if (total) {
-        ++st.lanes.used;
-        fromTags = true;
-    }
+    // `lanes` set aside: beyond one direction's count on a one-way road
+    // (implausible), or contradicting the directional counts (inconsistent).
+    auto dropTotal = [&](bool inconsistent) {
+        ++st.lanes.fallback;
+        if (inconsistent) ++st.lanesInconsistent;
+        total.reset();
+    };
     if (oneway != OsmOneway::No) {
         const bool fwd = oneway == OsmOneway::Forward;
         const auto& dirTag = fwd ? fwdTag : bwdTag;
         const auto& otherTag = fwd ? bwdTag : fwdTag;
         use(dirTag, fwd ? st.lanesForward : st.lanesBackward);
         unused(otherTag, fwd ? st.lanesBackward : st.lanesForward);
+        if (total && *total > kMaxLanesPerDirection) dropTotal(false);
+        else if (total && dirTag && *total != *dirTag) dropTotal(true);
         // Turn lanes: the directional tag first, then turn:lanes; a differing second value is not used.
         const auto& dirTurn = fwd ? turnFwd : turnBwd;
         const auto& otherTurn = fwd ? turnBwd : turnFwd;
         OsmTagUse& dirTurnUse = fwd ? st.turnLanesForward : st.turnLanesBackward;
         if (otherTurn) ++(fwd ? st.turnLanesBackward : st.turnLanesForward).fallback;
-        int n = dirTag ? perDirection(*dirTag) : total ? perDirection(*total) : 0;
+        int n = dirTag ? *dirTag : total ? *total : 0;
         const OsmTurnLanes* turn = nullptr;
         for (auto [cand, u] : {std::pair{&dirTurn, &dirTurnUse}, std::pair{&turnTag, &st.turnLanes}}) {
             if (!*cand) continue;
@@ -303,12 +315,12 @@ OsmRoadTags readOsmRoadTags(const OsmTagLookup& tag, RoadClass cls, OsmRoadTagSt
         t.lanesForward = fwd ? n : 0;
         t.lanesBackward = fwd ? 0 : n;
         (fwd ? t.turnForward : t.turnBackward) = turn ? turn->value : "";
-        t.lanes = total ? std::min(*total, kMaxTotal) : n;
+        t.lanes = n;
     } else {
         if (turnTag) ++st.turnLanes.fallback;  // ambiguous on a two-way road
         use(fwdTag, st.lanesForward);
         use(bwdTag, st.lanesBackward);
-        int f = fwdTag ? perDirection(*fwdTag) : 0, b = bwdTag ? perDirection(*bwdTag) : 0;
+        int f = fwdTag ? *fwdTag : 0, b = bwdTag ? *bwdTag : 0;
         if (!f && turnFwd) {
             f = turnFwd->lanes;
             fromTags = true;
@@ -317,11 +329,17 @@ OsmRoadTags readOsmRoadTags(const OsmTagLookup& tag, RoadClass cls, OsmRoadTagSt
             b = turnBwd->lanes;
             fromTags = true;
         }
+        // The total must be forward + backward when both are known, and leave
+        // the other direction 1 .. kMaxLanesPerDirection lanes when one is.
+        if (total && (f || b)) {
+            const int other = *total - (f ? f : b);
+            if (f && b ? *total != f + b : (other < 1 || other > kMaxLanesPerDirection)) dropTotal(true);
+        }
         if (f || b) {
             // One direction known: the other from the total, else the derived split.
-            const int n = std::max(total ? std::min(*total, kMaxTotal) : roadLanes(cls), 2);
-            if (!f) f = total && *total - b >= 1 ? perDirection(*total - b) : (n + 1) / 2;
-            if (!b) b = total && *total - f >= 1 ? perDirection(*total - f) : n / 2;
+            const int n = std::max(total ? *total : roadLanes(cls), 2);
+            if (!f) f = total ? *total - b : (n + 1) / 2;
+            if (!b) b = total ? *total - f : n / 2;
             t.lanesForward = f;
             t.lanesBackward = b;
             for (auto [turn, count, out, u] : {std::tuple{&turnFwd, f, &t.turnForward, &st.turnLanesForward},
@@ -332,10 +350,14 @@ OsmRoadTags readOsmRoadTags(const OsmTagLookup& tag, RoadClass cls, OsmRoadTagSt
                     ++u->used;
                 } else ++u->fallback;
             }
-            t.lanes = total ? std::min(*total, kMaxTotal) : std::min(f + b, kMaxTotal);
+            t.lanes = total ? *total : std::min(f + b, kMaxLanesTotal);
         } else {
-            t.lanes = total ? std::min(*total, kMaxTotal) : 0;
+            t.lanes = total ? *total : 0;
         }
+    }
+    if (total) {
+        ++st.lanes.used;
+        fromTags = true;
     }
     if (!fromTags) ++st.defaultLanes;
     readSpeedAndWidth(tag, st, t);
@@ -356,6 +378,7 @@ std::string osmRoadTagStatsJson(const OsmRoadTagStats& s) {
     auto use = [](const OsmTagUse& u) { return nlohmann::ordered_json{{"used", u.used}, {"fallback", u.fallback}}; };
     nlohmann::ordered_json tags;
     tags["lanes"] = use(s.lanes);
+    tags["lanes"]["inconsistent"] = s.lanesInconsistent;
     tags["lanes:forward"] = use(s.lanesForward);
     tags["lanes:backward"] = use(s.lanesBackward);
     tags["oneway"] = use(s.oneway);

@@ -2,7 +2,7 @@
 #
 # Exports the rooms' libraries (static; vista_install_room in each room's
 # CMakeLists.txt) as vista::foundation, vista::citygen, vista::scene,
-# vista::engine, vista::nodes, vista::render, vista::bake, with vista::options
+# vista::traffic, vista::engine, vista::nodes, vista::render, vista::bake, with vista::options
 # (C++17, GLM definitions, the include directory include/vista). The static
 # archives carry their private dependencies as link-only entries, so the
 # config finds every package that the archives need at link time, not only

@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <chrono>
 #include <fstream>
+#include <thread>
 #include <memory>
 
 #include <tbb/global_control.h>
@@ -116,13 +118,18 @@ Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene
 }
 
 // A streamed city: the ray scene follows the camera of path sample i
-// (arrivals and drops between frames); damaged files are warned about once.
-Status advanceStream(BenchRun& run, const Path& path, size_t i, const Camera& cam, BenchResult& result, int* arrived) {
+// (arrivals and drops between frames); `first` waits for the regions within
+// reach and is not counted in the frames' detail. A stream that cannot stream
+// is an error (advancePagedStream).
+Status advanceStream(BenchRun& run, const Path& path, size_t i, const Camera& cam, BenchResult& result, int* arrived,
+                     bool first = false) {
     *arrived = 0;
     if (!run.stream) return Status::ok();
-    auto f = advancePagedStream(*run.stream, "vista bench", cam.eye, pathVelocity(path, i), &result.streamDamaged);
+    auto f =
+        advancePagedStream(*run.stream, "vista bench", cam.eye, pathVelocity(path, i), &result.streamDamaged, first);
     if (!f) return f.status();
     *arrived = f->arrived;
+    if (!first) result.streamDetail.add(*f, path.samples[i].t);
     // What the modes kept of the old scene (hybrid's panoramic cache) goes.
     if (f->arrived > 0 || f->dropped > 0)
         for (auto& m : run.modes) m->sceneChanged(f->changed);
@@ -340,7 +347,14 @@ Status renderFrames(BenchRun& run, const Path& path, const std::vector<size_t>& 
     const size_t n = run.modes.size();
     std::vector<BenchFrameRecord> recs(n);
     FrameBuffers buf;
+    Stopwatch paceClock;
     for (size_t f = 0; f < idx.size(); ++f) {
+        if (cfg.pace && f > 0) {
+            // A drive at the path's own speed: this frame starts at its path time after the first's.
+            const double dueMs = 1000.0 * (path.samples[idx[f]].t - path.samples[idx[0]].t) - paceClock.ms();
+            if (dueMs > 0) std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(dueMs));
+        }
+        if (f == 0) paceClock.restart();
         const Camera cam = path.camera(idx[f], base);
         int arrived = 0;
         Stopwatch advanceSw;
@@ -429,9 +443,9 @@ Result<BenchResult> runBenchmark(const SceneModel* city, osg::Node* scene, const
     const std::vector<size_t> idx = path.frames(size_t(cfg.frames), cfg.sampleRuns);
     result.streamed = (*run)->stream != nullptr;
     if (result.streamed) {
-        // The first frame's regions before anything is timed (in wait mode as in every frame).
+        // The first frame's regions before anything is timed: it always waits for them.
         int arrived = 0;
-        VISTA_RETURN_IF_ERROR(advanceStream(**run, path, idx[0], path.camera(idx[0], base), result, &arrived));
+        VISTA_RETURN_IF_ERROR(advanceStream(**run, path, idx[0], path.camera(idx[0], base), result, &arrived, true));
     }
     if (cfg.warmup) VISTA_RETURN_IF_ERROR(warmUp(**run, path.camera(idx[0], base)));
 
@@ -442,6 +456,7 @@ Result<BenchResult> runBenchmark(const SceneModel* city, osg::Node* scene, const
     if (result.streamed) {
         result.stream = (*run)->stream->stats();
         result.streamOptions = (*run)->stream->options();
+        noteStreamDetail("vista bench", result.streamDetail);
     }
     result.loadAvgEnd = loadAverage();
     result.glRenderer = (*run)->renderer->glRenderer();

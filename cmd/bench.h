@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "cmd/memory.h"
+#include "cmd/paged_stream.h"
 #include "foundation/atomic_file.h"
 #include "foundation/statistics.h"
 #include "foundation/status.h"
@@ -58,6 +59,9 @@ struct BenchConfig {
     int dumpRaysEvery = 1;  // 1 .. 1000000
     bool warmup = true;
     bool quiet = false;  // no progress on stderr
+    // Paced (--pace): frame f starts no earlier than its path time after the first frame's
+    // (t[f] - t[0] seconds of wall time): a drive at the path's own speed.
+    bool pace = false;
     // Every mode also runs without the run-time effects, on the same frames,
     // as "MODE+clear" (the two alternate which goes first from frame to
     // frame); its speedup against MODE is the effects' same-frame cost ratio.
@@ -73,7 +77,7 @@ struct BenchConfig {
     // A paged city's load (summary.json "paged": regions_loaded, regions_total,
     // radius_m, bytes_loaded): JSON object, empty = a city file.
     std::string pagedJson;
-    // A paged city streamed (--paged-stream): its manifest (outlives the run)
+    // A paged city streamed (the default, cmd/paged_stream.h): its manifest (outlives the run)
     // and the pager's options; the chunked city graph and the ray scene of
     // the modes are then a CityStream (nodes/render/city_stream.h) advanced
     // to every frame's camera (and its velocity along the path) before the
@@ -158,6 +162,7 @@ struct BenchResult {
     // scene; with --paged-wait the wait too), outside the frame's own time.
     std::vector<double> advanceMs;
     std::vector<std::string> streamDamaged;
+    StreamDetail streamDetail;  // frames that drew a region below the detail its distance asks for
 };
 
 // The config with `full` moved to the front of the modes (the reference of

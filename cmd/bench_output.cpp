@@ -75,7 +75,7 @@ std::string framesCsv(const BenchResult& result) {
 // summary.json paged.stream: the block every streamed run writes (paged_stream.h)
 // and the frame thread's splice times between frames.
 json streamJson(const BenchResult& r, const BenchConfig& cfg) {
-    json j = pagedStreamJson(r.streamOptions, r.stream, r.framesWithArrivals, r.streamDamaged);
+    json j = pagedStreamJson(r.streamOptions, r.stream, r.framesWithArrivals, r.streamDamaged, r.streamDetail);
     // Waiting makes the regions of a frame independent of load timing; a mode whose frames
     // follow measured times (hybrid's adaptive split or cache pauses) still is not.
     const bool timed = std::any_of(cfg.modes.begin(), cfg.modes.end(),
@@ -181,6 +181,7 @@ json summaryJson(const BenchResult& result, const BenchConfig& cfg, const SceneM
     j["diff_threshold"] = cfg.diffThreshold;
     j["path_samples"] = path.samples.size();
     j["path_run_up_s"] = cfg.runUpS >= 0 ? json(cfg.runUpS) : json(nullptr);
+    j["paced"] = cfg.pace;  // --pace: frames at the path's own speed
     const PathMotion& pm = result.motion;
     j["path_motion"] = {{"frames", pm.frames},
                         {"metres_per_frame_median", pm.metresMedian},

@@ -1,6 +1,9 @@
 #include "cmd/cli.h"
 
+#include "cmd/options.h"
+
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <sys/resource.h>
 #include <unistd.h>
@@ -21,12 +24,22 @@ int parseOrExit(CLI::App& app, int argc, char** argv) {
                      app.get_name().c_str());
         return 2;
     }
+    if (Status s = refuseEmptyValues(app); !s) return reportBadInput(app.get_name(), s);
     return -1;
 }
 
 int reportBadInput(const std::string& cmd, const Status& s) {
     std::fprintf(stderr, "%s: %s\n", cmd.c_str(), s.message().c_str());
     return 2;
+}
+
+int requireDisplay(const std::string& cmd) {
+    const char* display = std::getenv("DISPLAY");
+    if (display && *display) return -1;
+    std::fprintf(stderr,
+                 "%s: no X display (DISPLAY is not set); run under `xvfb-run -a` on a machine without a screen\n",
+                 cmd.c_str());
+    return 1;
 }
 
 double peakRssMb() {

@@ -36,12 +36,14 @@ struct BenchArgs {
     std::string sampling = samplingName(kDefaultSampleRuns);
     std::vector<fs::path> createdOut;  // directories of --out made by this run, deepest first
     bool quiet = false;
+    bool repeats = false;  // --allow-repeated-frames
     PathFlags path;
     ModeFlags mode;
     BenchConfig cfg;
     PathOptions pathOptions;
     PagedReach paged;
     PagedStreamFlags stream;
+    bool streamed = false;  // a paged city that streams (choosePagedStream)
     CommandFiles files;  // checked by configure; holds the outputs' locks for the run
 };
 
@@ -54,7 +56,9 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
     addPagedFlags(app, a.paged);
     addPagedStreamFlags(app, a.stream);
     addNumberOption(app, "--frames", a.cfg.frames, 1, 1000000,
-                    "frames rendered, sampled from the path as --sampling says, 1 .. 1000000 (default 120)");
+                    "frames rendered, sampled from the path as --sampling says, 1 .. 1000000 and at most the path's "
+                    "sample count (default 120)");
+    addRepeatedFramesFlag(app, a.repeats);
     app.add_option("--sampling", a.sampling,
                    "which path samples are the frames: 'spread' (evenly over the whole path), 'consecutive' (the first "
                    "N samples, as a simulator renders them) or 'runs:K' (K runs of consecutive samples, their starts "
@@ -71,6 +75,9 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
                     "per-channel difference counted as a differing pixel, 0 .. 255 (default 8)");
     addNumberOption(app, "--worst", a.cfg.worstFrames, 0, 100,
                     "difference images for the N worst frames per mode, 0 .. 100 (default 2)");
+    app.add_flag("--pace", a.cfg.pace,
+                 "with --sampling consecutive: pace the frames at the path's own speed (frame f starts no earlier "
+                 "than its path time after the first frame's), a real-time drive");
     app.add_flag("--save-frames", a.cfg.saveFrames,
                  "also write every frame of every mode as OUT/frames/fNNNN_MODE.png");
     app.add_option(
@@ -81,8 +88,10 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
     app.add_option("--out", a.out, "output directory (created if missing)")->required();
     addNumberOption(
         app, "--memory-budget", a.cfg.memoryBudgetGb, kMemoryBudgetGbRange,
-        "GB, (0, 65536]: refuse up front a run whose estimated peak memory (from the city file's size) exceeds it; "
-        "summary.json reports the estimate and the measured peak per phase (default: no budget)");
+        "GB, (0, 65536]: refuse up front a run whose estimated peak memory (from the city file's size) exceeds it; a "
+        "streamed paged city's regions are held within it, and a budget that cannot hold the regions at the camera "
+        "is an error naming the budget they need; summary.json reports the estimate and the measured peak per phase "
+        "(default: no budget)");
     app.add_option("--effects", a.effects,
                    "run-time effects for this run instead of the scene's: 'none', names (haze, glass, night) or a JSON "
                    "object as in the params file; baked effects (sun_shadows, ambient_occlusion, materials, night's "
@@ -133,13 +142,21 @@ Status configure(BenchArgs& a) {
     VISTA_RETURN_IF_ERROR(validatePagedStream(a.stream));
     if (a.cfg.referenceSsaa == kNoReference && !a.sweep.empty())
         return Status::error("--reference none: not with --sweep (its table's speedups are against full)");
-    if (a.stream.stream && !a.sweep.empty())
-        return Status::error("--paged-stream: not with --sweep (the sweep benches city files, not paged cities)");
-    if (a.stream.stream) VISTA_RETURN_IF_ERROR(checkStreamingModes(a.cfg.modes));
+    if ((a.stream.stream || a.stream.preload) && !a.sweep.empty())
+        return Status::error(std::string(a.stream.stream ? "--paged-stream" : "--paged-preload") +
+                             ": not with --sweep (the sweep benches city files, not paged cities)");
+    if (a.cfg.pace && a.cfg.sampleRuns != 1)
+        return Status::error("--pace: needs --sampling consecutive (a drive at the path's own speed)");
     if (a.sweep.empty() && a.city.empty()) return Status::error("missing the city file argument (or use --sweep)");
     VISTA_RETURN_IF_ERROR(
         checkRunFiles(a.files.outputDirectory("--out", a.out).outputDirectory("--dump-rays", a.cfg.dumpRaysDir), a.city,
                       a.path, a.mode));
+    if (a.sweep.empty()) {
+        const Status modes = checkStreamingModes(a.cfg.modes);
+        auto streamed = choosePagedStream(kCmd, a.stream, a.city, modes ? std::string() : modes.message(), a.quiet);
+        if (!streamed) return streamed.status();
+        a.streamed = *streamed;
+    }
     VISTA_RETURN_IF_ERROR(checkWritableDirectory("--out", a.out));  // before any work, so a run never fails at its end
     if (!a.cfg.dumpRaysDir.empty()) {
         if (!a.sweep.empty()) return Status::error("--dump-rays is not supported with --sweep (one city per run)");
@@ -190,11 +207,15 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
     req.cmd = kCmd;
     req.quiet = a.quiet;
     req.paged = a.paged;
-    req.streamPaged = a.stream.stream;  // no region before the first frame: the stream brings them
+    req.streamPaged = a.streamed;  // no region before the first frame: the stream brings them
     // A paged city: the walkthrough first (a CSV, or a seeded path on the
     // city's streets), then only the regions near it.
     req.pathNeedsStreets = a.path.file.empty();
-    req.makePath = [&](const SceneModel& city) { return walkthroughPath(a.path.file, a.pathOptions, city); };
+    req.makePath = [&](const SceneModel& city) -> Result<Path> {
+        auto p = walkthroughPath(a.path.file, a.pathOptions, city);
+        if (p) VISTA_RETURN_IF_ERROR(checkFrameCount(cfg.frames, p->samples.size(), a.repeats));
+        return p;
+    };
     // The budget check of a city file, on the selected regions' bytes.
     req.beforePagedLoad = [&](uint64_t bytes) {
         cfg.memoryEstimateMb = estimateCityRunMb(bytes, rays);
@@ -210,10 +231,7 @@ int benchCity(const BenchArgs& a, const std::string& cityFile, const std::string
     cfg.loadMs = walk->cityLoadMs;
     cfg.pagedJson = walk->pagedJson;
     cfg.pagedManifest = walk->manifest.get();
-    if (a.stream.stream) {
-        if (!walk->manifest)
-            return reportBadInput(kCmd, Status::error("--paged-stream: '" + cityFile +
-                                                      "' is a city file; streaming needs a paged city (DIR.paged)"));
+    if (a.streamed && walk->manifest) {
         auto so = pagedStreamOptions(a.paged, a.stream, cfg.memoryBudgetGb, cfg.memoryEstimateMb);
         if (!so) return reportBadInput(kCmd, so.status());
         cfg.streamManifest = walk->manifest.get();
@@ -327,7 +345,8 @@ int runBench(int argc, char** argv) {
     if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;
     a.cfg.command = commandLine(argc, argv);
     if (Status s = configure(a); !s) return reportBadInput(kCmd, s);
-    const int rc = a.sweep.empty() ? benchCity(a, a.city, a.out, nullptr) : runSweep(a);
+    int rc = requireDisplay(kCmd);
+    if (rc < 0) rc = a.sweep.empty() ? benchCity(a, a.city, a.out, nullptr) : runSweep(a);
     // A failed run leaves no empty output folder behind (one it made itself).
     std::error_code ec;
     if (rc != 0)

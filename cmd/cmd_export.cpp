@@ -59,9 +59,11 @@ int runExport(int argc, char** argv) {
         std::fprintf(stderr,
                      "wrote %s: %zu roads, %zu transitions, %zu junctions (%zu connecting roads), %zu driving lanes, "
                      "%zu sidewalks, %zu traffic lights, %zu signs, %zu crosswalks; %zu corners too sharp to link, "
-                     "%zu turns dropped, %zu incoming lanes without a turn\n",
+                     "%zu turns dropped, %zu incoming lanes without a connection, %zu outgoing lanes fed by none, %zu lanes "
+                     "tapering in or out inside a link road\n",
                      xodr.c_str(), n.roads, n.transitions, n.junctions, n.connectingRoads, n.drivingLanes, n.sidewalks,
-                     n.trafficLights, n.signs, n.crosswalks, n.sharpCorners, n.droppedTurns, n.unlinkedLanes);
+                     n.trafficLights, n.signs, n.crosswalks, n.sharpCorners, n.droppedTurns, n.unlinkedLanes,
+                     n.unfedLanes, n.taperedLanes);
     return 0;
 }
 

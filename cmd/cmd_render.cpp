@@ -16,12 +16,14 @@
 // an uninterrupted run's held); "<out>.partial/out" is renamed to <out> when
 // every frame is written.
 //
-// A paged city (DIR.paged) is either loaded around the whole path before the
-// first frame (--paged-radius, --paged-far) or streamed (--paged-stream, as
-// in `vista bench`: cmd/paged_stream.h): the mode's graph, its ray scene and
-// the label pass's twin follow the camera, loaded on a worker thread; with
-// --paged-wait every frame waits for the regions within reach of its camera,
-// so its files are those of a preloaded run of the same regions. Instance ids
+// A paged city (DIR.paged) is streamed (the default, as in `vista bench`:
+// cmd/paged_stream.h): the mode's graph, its ray scene and the label pass's
+// twin follow the camera, loaded on a worker thread, and every frame waits
+// for the regions within reach of its camera, so its files are those of a
+// preloaded run of the same regions and a resumed run writes the same bytes
+// (--paged-stream: a stream whose frames do not wait). --paged-preload, or a
+// run that cannot stream (hybrid with label channels), loads the regions
+// around the whole path before the first frame instead. Instance ids
 // of a paged city are numbered per region (docs/formats.md "Paged city"): the
 // instance channel is not written for one.
 #include <cmath>
@@ -82,6 +84,7 @@ struct RenderArgs {
     std::string sampling = "spread", rig;
     int frames = 60;
     double fov = 60, memoryBudgetGb = 0;
+    bool repeats = false;  // --allow-repeated-frames
     bool stats = false, quiet = false, restart = false, channelsGiven = false;
     PathFlags path;
     ModeFlags modeFlags;
@@ -164,11 +167,11 @@ struct RenderPlan {
     ModeOptions options;
     PathOptions path;
     bool paged = false;         // the city is a paged city directory
-    bool streamed = false;      // --paged-stream (or --paged-wait)
+    bool streamed = false;      // a streamed paged city (choosePagedStream)
     bool rays = false;          // the mode casts rays (the memory estimate's ray scene)
     double estimateMb = 0;      // the memory estimate before the first frame
     double memoryBudgetGb = 0;  // --memory-budget (0 = none)
-    RegionPagerOptions stream;  // with --paged-stream
+    RegionPagerOptions stream;  // streamed
     CommandFiles files;         // checked by configure; holds the output's lock for the run
     bool labels() const { return (channels & kLabelChannels) != 0; }
 };
@@ -181,18 +184,18 @@ Status configurePaged(const RenderArgs& a, RenderPlan& p) {
     PagedStreamFlags stream = a.stream;
     VISTA_RETURN_IF_ERROR(validatePagedStream(stream));
     p.paged = isPagedCityPath(a.city);
-    p.streamed = stream.stream;
-    if (stream.stream && !p.paged)
-        return Status::error("--paged-stream: '" + a.city +
-                             "' is a city file; streaming needs a paged city (DIR.paged from `vista gen`)");
-    if (stream.stream) VISTA_RETURN_IF_ERROR(checkStreamingModes({a.mode}));
     // Over a streamed city the label pass draws the stream's label twin of the
     // whole city; far-field ray labels would need the regions' models.
-    if (stream.stream && (p.channels & kLabelChannels) && a.mode != "full")
-        return Status::error(
-            "--paged-stream: the depth, semantic and instance channels of a streamed city come from "
-            "mode full (the far field of mode " +
-            a.mode + " is labelled from the whole loaded city); give --channels rgb or --mode full");
+    std::string cannotStream;
+    if (Status modes = checkStreamingModes({a.mode}); !modes) cannotStream = modes.message();
+    else if ((p.channels & kLabelChannels) && a.mode != "full")
+        cannotStream =
+            "the depth, semantic and instance channels of a streamed city come from mode full (the far "
+            "field of mode " +
+            a.mode + " is labelled from the whole loaded city); give --channels rgb or --mode full";
+    auto streamed = choosePagedStream(kCmd, stream, a.city, cannotStream, a.quiet);
+    if (!streamed) return streamed.status();
+    p.streamed = *streamed;
     if (!p.paged || !(p.channels & kInstance)) return Status::ok();
     if (a.channelsGiven)
         return Status::error(
@@ -247,7 +250,8 @@ Status configure(const RenderArgs& a, RenderPlan& p) {
 // path indices of the frames (`idx`), each frame inside the city.
 Result<Walkthrough> loadCityAndFrames(const RenderArgs& a, RenderPlan& p, std::vector<size_t>& idx) {
     const std::string labelsFor = (p.channels & (kSemantic | kInstance)) ? "the semantic and instance channels" : "";
-    WalkthroughRequest req = renderRequest(a.city, a.path.file, p.path, a.frames, p.sampleRuns, labelsFor, idx);
+    WalkthroughRequest req =
+        renderRequest(a.city, a.path.file, p.path, a.frames, p.sampleRuns, a.repeats, labelsFor, idx);
     req.bakedModes = {a.mode};
     req.effects = [](const Effects& declared) { return runTimeEffects(std::nullopt, declared, true, kCmd); };
     if (p.paged) {
@@ -265,7 +269,11 @@ Result<Walkthrough> loadCityAndFrames(const RenderArgs& a, RenderPlan& p, std::v
     }
     auto w = loadWalkthrough(req, p.options);
     if (!w || !p.streamed) return w;
-    auto so = pagedStreamOptions(a.paged, a.stream, a.memoryBudgetGb, p.estimateMb);
+    // Ground truth follows no load timing: unless --paged-stream asks for a stream that does not
+    // wait, every frame waits for the regions within reach of its camera.
+    PagedStreamFlags flags = a.stream;
+    if (!flags.stream) flags.wait = true;
+    auto so = pagedStreamOptions(a.paged, flags, a.memoryBudgetGb, p.estimateMb);
     if (!so) return so.status();
     p.stream = *so;
     p.memoryBudgetGb = a.memoryBudgetGb;
@@ -333,6 +341,7 @@ struct RenderSession {
     std::unique_ptr<RenderMode> mode;
     osg::ref_ptr<osg::Group> labelRoot = new osg::Group;
     int framesWithArrivals = 0;        // streamed: frames before which region levels arrived
+    StreamDetail detail;               // streamed: frames that drew a region below the detail asked for
     std::vector<std::string> damaged;  // streamed: region files that failed to load
     RayScene* activeRays() { return stream ? stream->rays() : rays.get(); }
 };
@@ -380,13 +389,15 @@ Status advanceStream(RenderSession& s, const Path& path, size_t i, const Camera&
     auto f = advancePagedStream(*s.stream, kCmd, cam.eye, pathVelocity(path, i), &s.damaged, first);
     if (!f) return f.status();
     s.framesWithArrivals += f->arrived > 0 ? 1 : 0;
+    s.detail.add(*f, path.samples[i].t);
     // A mode that caches what it traced (hybrid's panoramic cache) drops it when regions change.
     if ((f->arrived > 0 || f->dropped > 0) && s.mode) s.mode->sceneChanged(f->changed);
     return Status::ok();
 }
 
-// Frames an interrupted run finished (their record and every channel file
-// present) are kept. The hybrid mode carries state from frame to frame
+// Frames an interrupted run finished (their record, and every channel file
+// with the size and content hash the record gives) are kept; a damaged one is
+// rendered again. The hybrid mode carries state from frame to frame
 // (panoramic cache, adaptive split): it re-renders the finished frames before
 // the last missing one (rgb only, nothing written) so that every frame it
 // writes sees the state of an uninterrupted run.
@@ -396,18 +407,26 @@ struct Progressed {
     size_t kept = 0;
 };
 
+// The files of frame `name` for `channels`, relative to the output.
+std::vector<std::string> frameFiles(unsigned channels, const std::string& name) {
+    std::vector<std::string> files;
+    for (const auto& [bit, file] : {std::pair<unsigned, std::string>{kRgb, "rgb/" + name + ".png"},
+                                    {kDepth, "depth/" + name + ".npy"},
+                                    {kSemantic, "semantic/" + name + ".png"},
+                                    {kInstance, "instance/" + name + ".npy"}})
+        if (channels & bit) files.push_back(file);
+    return files;
+}
+
+// A finished frame is kept only when its files still have the sizes and hashes its record gives.
 Progressed finishedFrames(const RenderWorkDir& out, unsigned channels, size_t frames) {
     Progressed r;
     r.records.resize(frames);
     for (size_t f = 0; f < frames; ++f) {
         if (out.resumed()) {
             r.records[f] = out.frameRecord(f);
-            const std::string name = frameName(f);
-            for (const auto& [bit, file] : {std::pair<unsigned, std::string>{kRgb, "rgb/" + name + ".png"},
-                                            {kDepth, "depth/" + name + ".npy"},
-                                            {kSemantic, "semantic/" + name + ".png"},
-                                            {kInstance, "instance/" + name + ".npy"}})
-                if (!r.records[f].is_null() && (channels & bit) && !fs::exists(out.file(file))) r.records[f] = nullptr;
+            if (!r.records[f].is_null() && !out.frameIntact(r.records[f], frameFiles(channels, frameName(f))))
+                r.records[f] = nullptr;
         }
         if (r.records[f].is_null()) r.lastMissing = long(f);
         else ++r.kept;
@@ -541,7 +560,7 @@ Status renderFrames(const RenderArgs& a, const RenderPlan& p, const Walkthrough&
         if (p.labels()) VISTA_RETURN_IF_ERROR(frameLabels(a.mode, cam, p.options.threads, s, b, tm));
         VISTA_RETURN_IF_ERROR(writeFrameFiles(p.channels, frameName(f), b, out, tm));
         done.records[f] = Timings::record(tm);
-        VISTA_RETURN_IF_ERROR(out.finishFrame(f, done.records[f]));
+        VISTA_RETURN_IF_ERROR(out.finishFrame(f, done.records[f], frameFiles(p.channels, frameName(f))));
         if (killAfter > 0 && ++finishedNow == killAfter) std::raise(SIGKILL);
         if (progress) progress->update(double(f + 1) / double(idx.size()));
     }
@@ -623,15 +642,16 @@ void printResult(const RenderArgs& a, const RenderPlan& p, size_t frames, const 
     line("write instance", tm.writeInstance);
 }
 
-// The command's steps: options, city and path, work directory, set-up,
-// frames, metadata and commit; any failure (bad input, a write that fails,
-// no display) is a message and exit 2. Finished frames stay in OUT.partial
-// for the rerun.
+// The command's steps: options, display, city and path, work directory,
+// set-up, frames, metadata and commit; any failure (bad input, a write that
+// fails) is a message and exit 2, no display exit 1 before any work.
+// Finished frames stay in OUT.partial for the rerun.
 int run(const RenderArgs& a, const std::string& command) {
     RenderPlan plan;
     if (Status s = configure(a, plan); !s) return reportBadInput(kCmd, s);
     RenderWorkDir out;
     if (Status s = out.checkOut(a.out); !s) return reportBadInput(kCmd, s);
+    if (int rc = requireDisplay(kCmd); rc >= 0) return rc;
     std::vector<size_t> idx;
     auto walk = loadCityAndFrames(a, plan, idx);
     if (!walk) return reportBadInput(kCmd, walk.status());
@@ -648,7 +668,8 @@ int run(const RenderArgs& a, const std::string& command) {
     if (!walk->pagedJson.empty()) paged = nlohmann::json::parse(walk->pagedJson);
     if (session.stream)
         paged["stream"] = pagedStreamJson(session.stream->options(), session.stream->stats(),
-                                          session.framesWithArrivals, session.damaged);
+                                          session.framesWithArrivals, session.damaged, session.detail);
+    if (session.stream) noteStreamDetail(kCmd, session.detail);
     if (Status s =
             writeMetadata(a, plan, command, walk->city, idx, frames, tm, done.kept, paged, *session.renderer, out);
         !s)
@@ -666,9 +687,8 @@ int runRender(int argc, char** argv) {
         kCmd};
     RenderArgs a;
     app.add_option("city", a.city,
-                   "city scene file (.osgb) from `vista gen`, or a paged city directory (DIR.paged: the regions "
-                   "within --paged-radius of the path, or streamed with --paged-stream; channels rgb, depth, "
-                   "semantic)")
+                   "city scene file (.osgb) from `vista gen`, or a paged city directory (DIR.paged: streamed, "
+                   "every frame waiting for the regions within reach of its camera; channels rgb, depth, semantic)")
         ->required();
     addPathFlags(app, a.path, true);
     addPagedFlags(app, a.paged);
@@ -676,9 +696,11 @@ int runRender(int argc, char** argv) {
     addNumberOption(
         app, "--memory-budget", a.memoryBudgetGb, kMemoryBudgetGbRange,
         "GB, (0, 65536]: refuse up front a run whose estimated peak memory (from the city file's size, or the paged "
-        "regions' bytes) exceeds it; with --paged-stream the streamed regions are held within it (default: no "
-        "budget)");
-    addNumberOption(app, "--frames", a.frames, 1, 1000000, "frames rendered, 1 .. 1000000 (default 60)");
+        "regions' bytes) exceeds it; a streamed paged city's regions are held within it, and a budget that "
+        "cannot hold the regions at the camera is an error naming the budget they need (default: no budget)");
+    addNumberOption(app, "--frames", a.frames, 1, 1000000,
+                    "frames rendered, 1 .. 1000000 and at most the path's sample count (default 60)");
+    addRepeatedFramesFlag(app, a.repeats);
     app.add_option("--sampling", a.sampling,
                    "which path samples are the frames: spread (default), consecutive or runs:K");
     app.add_option("--size", a.size, "image size WIDTHxHEIGHT, 1x1 .. 8192x8192 (default 640x480)");
@@ -714,8 +736,8 @@ int runRender(int argc, char** argv) {
                                                             "sensor's model, size and channels"));
         // A rig casts every sensor into one ray scene of the loaded city, its
         // labels from the city's models: it takes a city file, not a paged city.
-        for (const char* flag :
-             {"--paged-stream", "--paged-wait", "--paged-prefetch", "--paged-radius", "--paged-far", "--memory-budget"})
+        for (const char* flag : {"--paged-stream", "--paged-preload", "--paged-wait", "--paged-prefetch",
+                                 "--paged-radius", "--paged-far", "--memory-budget"})
             if (app.count(flag))
                 return reportBadInput(
                     kCmd, Status::error(std::string(flag) + " does not apply with --rig: a rig renders a city file, "
@@ -723,7 +745,7 @@ int runRender(int argc, char** argv) {
                                                             "whole loaded city)"));
         RigRunRequest r;
         r.city = a.city, r.rig = a.rig, r.out = a.out, r.command = command, r.sampling = a.sampling;
-        r.frames = a.frames, r.stats = a.stats, r.quiet = a.quiet, r.restart = a.restart;
+        r.frames = a.frames, r.repeats = a.repeats, r.stats = a.stats, r.quiet = a.quiet, r.restart = a.restart;
         r.path = a.path, r.modeFlags = a.modeFlags;
         return runRigRender(r);
     }

@@ -7,8 +7,9 @@
 // use). --step shows exactly the bench's frames of the path (the camera of
 // `vista bench --frames N`), so view and bench can be compared image to image.
 //
-// A paged city (DIR.paged) is loaded around the path before the first frame,
-// or streamed (--paged-stream): the viewer's graph and ray scene follow the
+// A paged city (DIR.paged) is streamed (the default; --paged-preload loads the
+// regions around the path before the first frame instead, as does a start mode
+// that does not stream): the viewer's graph and ray scene follow the
 // camera through the same CityStream as `vista bench` and `vista render`
 // (cmd/paged_stream.h). Between viewer frames, on the frame thread, the
 // stream is advanced to the camera with its velocity (the path's at --step,
@@ -23,14 +24,19 @@
 // every mode made so far drops what it kept of the old resident set when the
 // set changes (RenderMode::sceneChanged). At exit a
 // line on stderr gives the stream's totals and the frames that drew a region
-// within --paged-radius of the eye below full detail.
+// below the detail its distance asks for (cmd/paged_stream.h StreamDetail). A
+// stream that cannot stream (unreadable region files, a budget that cannot
+// hold the regions at the camera) stops the viewer with exit 2. --pace with
+// --step shows each frame at its path time: a drive at the path's own speed.
 #include <filesystem>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 
 #include <osg/Camera>
 #include <osg/Geode>
@@ -77,6 +83,7 @@ struct ViewArgs {
     std::optional<std::string> effects;  // unset: the scene's
     int frames = 0;
     bool step = false, noHud = false;
+    bool repeats = false;  // --allow-repeated-frames (with --step)
     std::string sampling = samplingName(kDefaultSampleRuns);
     int sampleRuns = kDefaultSampleRuns;
     PathFlags path;
@@ -85,14 +92,15 @@ struct ViewArgs {
     double fovDeg = 60.0, memoryBudgetGb = 0;
     PagedReach paged;
     PagedStreamFlags stream;
+    bool streamed = false;  // a paged city that streams (choosePagedStream)
+    bool pace = false;      // --pace
     CommandFiles files;  // checked by configure; holds the output's lock for the run
 };
 
 void declareFlags(CLI::App& app, ViewArgs& a) {
     a.path.seed = 0;  // no playback unless asked
     app.add_option("city", a.city,
-                   "city scene file (.osgb), a paged city directory (DIR.paged: the regions within --paged-radius of "
-                   "the path), "
+                   "city scene file (.osgb), a paged city directory (DIR.paged: streamed around the camera), "
                    "or a baked file from 'vista bake' (adds the impostor mode; lodmesh for --representation mesh)")
         ->required();
     addPathFlags(app, a.path, true);
@@ -112,13 +120,17 @@ void declareFlags(CLI::App& app, ViewArgs& a) {
                    "with --step: the path samples shown, as vista bench's --sampling: spread, consecutive or runs:K "
                    "(default " +
                        samplingName(kDefaultSampleRuns) + ")");
+    addRepeatedFramesFlag(app, a.repeats);
+    app.add_flag("--pace", a.pace,
+                 "with --step and --sampling consecutive: show each frame no earlier than its path time after the "
+                 "first frame's, a drive at the path's own speed");
     app.add_flag("--no-hud", a.noHud, "no text overlay (for screenshots compared with `vista bench`)");
     app.add_option("--screenshot", a.screenshot, "write a PNG of the last frame (use with --frames)");
     addNumberOption(
         app, "--memory-budget", a.memoryBudgetGb, kMemoryBudgetGbRange,
         "GB, (0, 65536]: refuse up front when the estimated peak memory (from the city file's size, with the ray scene "
-        "every mode may need) exceeds it; with --paged-stream the streamed regions are held within it (default: no "
-        "budget)");
+        "every mode may need) exceeds it; a streamed paged city's regions are held within it, and a budget that "
+        "cannot hold the regions at the camera is an error naming the budget they need (default: no budget)");
     app.add_option("--effects", a.effects,
                    "run-time effects instead of the scene's: 'none', names (haze, glass, night) or a JSON object; "
                    "keys y / g / n toggle haze, glass reflections and the night sky");
@@ -135,16 +147,20 @@ Status configure(ViewArgs& a, ModeOptions& options) {
     a.sampleRuns = sampling.value();
     if (a.step && (a.frames < 1 || a.frames > 1000000 || (a.path.file.empty() && a.path.seed == 0)))
         return Status::error("--step needs --frames N in 1 .. 1000000 (as vista bench) and a path (--path or --seed)");
+    if (a.repeats && !a.step)
+        return Status::error(
+            "option --allow-repeated-frames: only with --step (without it --frames counts frames "
+            "drawn, not path samples)");
     VISTA_RETURN_IF_ERROR(checkRunFiles(a.files.output("--screenshot", a.screenshot), a.city, a.path, a.modeFlags));
     if (!a.screenshot.empty()) VISTA_RETURN_IF_ERROR(checkWritablePath("--screenshot", a.screenshot));
     VISTA_RETURN_IF_ERROR(validatePagedReach(a.paged));
     VISTA_RETURN_IF_ERROR(validatePagedStream(a.stream));
-    if (a.stream.stream) {
-        if (!isPagedCityPath(a.city))
-            return Status::error("--paged-stream: '" + a.city +
-                                 "' is a city file; streaming needs a paged city (DIR.paged from `vista gen`)");
-        VISTA_RETURN_IF_ERROR(checkStreamingModes({a.mode}));
-    }
+    if (a.pace && (!a.step || a.sampleRuns != 1))
+        return Status::error("--pace: needs --step and --sampling consecutive (a drive at the path's own speed)");
+    const Status modes = checkStreamingModes({a.mode});
+    auto streamed = choosePagedStream(kCmd, a.stream, a.city, modes ? std::string() : modes.message(), false);
+    if (!streamed) return streamed.status();
+    a.streamed = *streamed;
     return parseModeFlags(a.modeFlags, options);
 }
 
@@ -398,15 +414,16 @@ struct ViewStream {
     RegionPagerOptions options;
     bool started = false;
     glm::dvec3 lastEye{0.0}, velocity{0.0};
-    int frames = 0, framesWithArrivals = 0, framesShort = 0;
+    int framesWithArrivals = 0;
+    StreamDetail detail;  // frames that drew a region below the detail its distance asks for
     std::vector<std::string> damaged;
 
     // Between frames: the stream follows the camera at `eye`, moving at
     // `pathVelocity` (--step) or at the velocity measured over `dtS`
     // seconds since the last frame. The first call waits for the regions
-    // around the camera. Counts the frames that will draw a region within the
-    // radius of the eye below full detail.
-    Status advance(const glm::dvec3& eye, const glm::dvec3* pathVelocity, double dtS, ViewModes& modes) {
+    // around the camera. Counts the frames that will draw a region below the
+    // detail its distance from the eye asks for (`t`: the frame's time, s).
+    Status advance(const glm::dvec3& eye, const glm::dvec3* pathVelocity, double dtS, double t, ViewModes& modes) {
         if (pathVelocity) {
             velocity = *pathVelocity;
         } else if (started && dtS > 0) {
@@ -418,15 +435,9 @@ struct ViewStream {
         if (!f) return f.status();
         started = true;
         lastEye = eye;
-        ++frames;
+        detail.add(*f, t);
         framesWithArrivals += f->arrived > 0 ? 1 : 0;
         if (f->arrived > 0 || f->dropped > 0) modes.sceneChanged(f->changed);
-        const std::vector<uint8_t> held = stream->held();
-        for (int r : selectPagedRegions(*manifest, {glm::dvec2(eye)}, options.radius))
-            if (held[size_t(r)] != 2) {
-                ++framesShort;
-                break;
-            }
         return Status::ok();
     }
     // `last`: the last frame's statistics (a hybrid mode's near field: the triangles it drew).
@@ -437,10 +448,11 @@ struct ViewStream {
             nearField = "; the last frame's near field drew " + std::to_string(last.triangles) + " triangles";
         std::fprintf(stderr,
                      "%s: paged stream: %d loads, %d unloads, %.1f MB of region files read, peak %.1f MB resident; "
-                     "%d of %d frames waited, %d had regions arriving, %d drew a region within %g m below full "
-                     "detail%s\n",
+                     "%d of %d frames waited, %d had regions arriving, %d drew a region below the detail its "
+                     "distance asks for (%d after the first second)%s\n",
                      kCmd, st.loads, st.unloads, double(st.bytesRead) / 1e6, double(st.peakResidentBytes) / 1e6,
-                     st.framesWaited, frames, framesWithArrivals, framesShort, options.radius, nearField.c_str());
+                     st.framesWaited, detail.frames, framesWithArrivals, detail.belowDetail,
+                     detail.belowDetailAfterFirstSecond, nearField.c_str());
     }
 };
 
@@ -500,9 +512,16 @@ void showMode(ViewState& v, ViewModes& modes, const std::string& name) {
 int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path, bool playback) {
     osg::Camera* cam = v.viewer.getCamera();
     const std::vector<size_t> stepFrames = a.step ? path.frames(size_t(a.frames), a.sampleRuns) : std::vector<size_t>();
-    Stopwatch sw;
+    Stopwatch sw, clock;
     double lastMs = 0;
     for (int n = 0; !v.viewer.done(); ++n) {
+        if (a.pace && n > 0) {
+            // A drive at the path's own speed: this frame is shown at its path time after the first's.
+            const double dueMs =
+                1000.0 * (path.samples[stepFrames[size_t(n)]].t - path.samples[stepFrames[0]].t) - clock.ms();
+            if (dueMs > 0) std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(dueMs));
+        }
+        if (n == 0) clock.restart();
         if (v.keys->nextMode) {
             v.keys->nextMode = false;
             showMode(v, modes, modes.next(v.mode));
@@ -531,10 +550,9 @@ int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path,
         }
         if (v.stream) {
             const glm::dvec3 pv = a.step ? pathVelocity(path, stepFrames[size_t(n)]) : glm::dvec3(0.0);
-            if (Status st = v.stream->advance(c.eye, a.step ? &pv : nullptr, lastMs / 1000.0, modes); !st) {
-                std::fprintf(stderr, "%s: %s\n", kCmd, st.message().c_str());
-                return 1;
-            }
+            const double t = a.step ? path.samples[stepFrames[size_t(n)]].t : clock.ms() / 1000.0;
+            if (Status st = v.stream->advance(c.eye, a.step ? &pv : nullptr, lastMs / 1000.0, t, modes); !st)
+                return reportBadInput(kCmd, st);  // a stream that cannot stream: exit 2
         }
         modes.placeFrameNear(c.eye);  // ray origins near the frame origin: float precision anywhere
         cam->setProjectionMatrix(toOsg(c.projection(v.current->beginViewerFrame(c))));
@@ -555,7 +573,7 @@ int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path,
     return 0;
 }
 
-// --paged-stream: the stream of the city's regions (no region loaded yet),
+// A streamed paged city: the stream of the city's regions (no region loaded yet),
 // into the modes' context. Errors name the flag or the ray scene.
 Status startStream(const ViewArgs& a, const Walkthrough& walk, ModeContext& ctx, ViewStream& vs) {
     const bool rays = findRenderMode(a.mode)->needsRays || effectsNeedRays(ctx.options.effects) ||
@@ -611,11 +629,12 @@ int runView(int argc, char** argv) {
     req.city = a.city;
     req.cmd = kCmd;
     req.paged = a.paged;
-    req.streamPaged = a.stream.stream;
+    req.streamPaged = a.streamed;
     req.pathNeedsStreets = a.path.file.empty();
     req.makePath = [&](const SceneModel& city) -> Result<Path> {
         auto p = viewPath(a, city, playback);
         if (p && a.step && p->samples.empty()) return Status::error("--step: the path has no samples");
+        if (p && a.step) VISTA_RETURN_IF_ERROR(checkFrameCount(a.frames, p->samples.size(), a.repeats));
         return p;
     };
     req.beforePagedLoad = [&](uint64_t bytes) {
@@ -626,17 +645,13 @@ int runView(int argc, char** argv) {
     req.effects = [&](const Effects& declared) { return runTimeEffects(a.effects, declared, false, kCmd); };
     auto walk = loadWalkthrough(req, ctx.options);
     if (!walk) return reportBadInput(kCmd, walk.status());
-    const char* display = std::getenv("DISPLAY");
-    if (!display || !*display) {
-        std::fprintf(stderr, "%s: no X display (DISPLAY is not set); run under `xvfb-run -a` without a screen\n", kCmd);
-        return 1;
-    }
+    if (int rc = requireDisplay(kCmd); rc >= 0) return rc;
     const SceneModel& city = walk->city;
     const Path& path = walk->path;
     ctx.city = &city;
     ctx.scene = sceneRoot(city);
     ViewStream stream;  // before the modes: they draw its graph
-    if (a.stream.stream)
+    if (a.streamed && walk->manifest)
         if (Status s = startStream(a, *walk, ctx, stream); !s) return reportBadInput(kCmd, s);
     ViewModes modes(ctx, stream.stream.get());
     auto start = modes.get(a.mode);

@@ -17,5 +17,6 @@ int runExport(int argc, char** argv);
 // The --xodr path check shared by gen and export: ends in .xodr, writable.
 Status checkXodrPath(const std::string& option, const std::string& path);
 int runRender(int argc, char** argv);
+int runTraffic(int argc, char** argv);
 
 }  // namespace vista

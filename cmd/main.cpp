@@ -21,12 +21,13 @@ const Command kCommands[] = {
     {"bake", vista::runBake, "bake view cells and point impostors into city.baked.osgb"},
     {"export", vista::runExport, "export a scene file's road network (OpenDRIVE .xodr)"},
     {"render", vista::runRender, "ground truth per frame: rgb, depth, semantic, instance (+ cameras.json)"},
+    {"traffic", vista::runTraffic, "simulate vehicles and pedestrians on a city with SUMO (FCD + signal states)"},
 };
 
 void usage(FILE* f) {
     std::fprintf(f, "usage: vista <command> [options]\n\ncommands:\n");
-    for (const auto& c : kCommands) std::fprintf(f, "  %-7s %s\n", c.name, c.summary);
-    std::fprintf(f, "  help    show this list, or `vista help <command>` for a command's options\n");
+    for (const auto& c : kCommands) std::fprintf(f, "  %-8s %s\n", c.name, c.summary);
+    std::fprintf(f, "  help     show this list, or `vista help <command>` for a command's options\n");
     std::fprintf(f, "\nRun `vista <command> --help` for the options of one command.\n");
 }
 

@@ -400,9 +400,49 @@ void addPathFlags(CLI::App& app, PathFlags& f, bool timing) {
         "seconds driven before the path starts and dropped, so it starts at cruising speed, 0 .. 600 (default 8)");
 }
 
+Status checkLeftHandTraffic(bool lht, PathKind kind) {
+    if (!lht || kind == PathKind::Car) return Status::ok();
+    return Status::error(std::string("option --lht: applies to car paths (lanes driven on the left), not to --kind ") +
+                         pathKindName(kind) + " (a " + pathKindName(kind) + " path does not drive in lanes)");
+}
+
+Status checkFrameCount(int frames, size_t samples, bool repeats) {
+    if (repeats || frames < 0 || size_t(frames) <= samples) return Status::ok();
+    return Status::error("option --frames = " + std::to_string(frames) + ": the path has " + std::to_string(samples) +
+                         (samples == 1 ? " sample" : " samples") + ", so frames would repeat samples (allowed: 1 .. " +
+                         std::to_string(samples) +
+                         "; give --allow-repeated-frames to render repeated samples on purpose)");
+}
+
+void addRepeatedFramesFlag(CLI::App& app, bool& repeats) {
+    app.add_flag("--allow-repeated-frames", repeats,
+                 "allow --frames above the path's sample count: samples are then rendered more than once (by "
+                 "default such a run is refused, naming the sample count)");
+}
+
+Status refuseEmptyValues(const CLI::App& app) {
+    for (const CLI::Option* opt : app.get_options()) {
+        if (opt->get_type_size() == 0 || opt->count() == 0) continue;  // a flag, or not given
+        for (const std::string& v : opt->results())
+            if (v.empty()) {
+                const std::string name = opt->get_name();
+                return Status::error((name.rfind("-", 0) == 0 ? "option " : "argument ") + name +
+                                     " = '': empty (give a " + opt->get_type_name() +
+                                     " value, or leave the option out for its default)");
+            }
+    }
+    return Status::ok();
+}
+
 Result<PathOptions> parsePathFlags(const PathFlags& f) {
     auto k = parsePathKind(f.kind);
     if (!k) return Status::error("--kind: " + k.status().message());
+    if (f.lht && !f.file.empty())
+        return Status::error(
+            "option --lht: applies to car paths made from --seed (lanes driven on the left), not to "
+            "the recorded path of --path '" +
+            echoText(f.file) + "'");
+    VISTA_RETURN_IF_ERROR(checkLeftHandTraffic(f.lht, *k));
     PathOptions po;
     po.seed = f.seed;
     po.kind = k.value();
@@ -501,14 +541,15 @@ Result<FrameEffects> runTimeEffects(const std::optional<std::string>& option, co
 
 void addPagedFlags(CLI::App& app, PagedReach& reach) {
     std::ostringstream help;
-    help << "with a paged city (a DIR.paged directory from `vista gen`): load only the regions within this many metres "
-            "of the walkthrough at full detail, "
+    help << "with a paged city (a DIR.paged directory from `vista gen`): the regions within this many metres of the "
+            "camera (streamed; of the walkthrough with --paged-preload) at full detail, "
          << kMinPagedRadiusM << " .. " << kMaxPagedRadiusM << " (default " << kDefaultPagedRadiusM << ")";
     const RealRange range = RealRange::closed(kMinPagedRadiusM, kMaxPagedRadiusM);
     addNumberOption(app, "--paged-radius", reach.radius, range, help.str());
     std::ostringstream far;
-    far << "with a paged city: load the other regions within this many metres of the walkthrough at their coarse level "
-           "(detail 0, no trees) for the far field, "
+    far << "with a paged city: the other regions within this many metres of the camera (of the walkthrough with "
+           "--paged-preload) at their coarse level "
+           "(detail 0, trees as impostors) for the far field, "
         << kMinPagedRadiusM << " .. " << kMaxPagedRadiusM << " (default " << kDefaultPagedFarM
         << " = the whole city; 0 = none: the city ends at --paged-radius)";
     addNumberOption(app, "--paged-far", reach.far, range, far.str());
@@ -521,27 +562,33 @@ Status validatePagedReach(const PagedReach& reach) {
 
 void addPagedStreamFlags(CLI::App& app, PagedStreamFlags& f) {
     app.add_flag("--paged-stream", f.stream,
-                 "with a paged city: stream it instead of loading the regions near the walkthrough before the first "
-                 "frame: regions load on a worker thread as the camera approaches and unload when it leaves "
-                 "(--paged-radius at full detail and --paged-far at the coarse level, around the camera); "
-                 "--memory-budget bounds what is resident; modes " +
+                 "with a paged city: stream it (the default): regions load on a worker thread as the camera "
+                 "approaches and unload when it leaves (--paged-radius at full detail and --paged-far at the coarse "
+                 "level, around the camera), the first frame waits for the regions at its camera; --memory-budget "
+                 "bounds what is resident. Given explicitly, a run that cannot stream is an error instead of "
+                 "preloading; modes " +
                      streamingModeNames());
+    app.add_flag("--paged-preload", f.preload,
+                 "with a paged city: load the regions near the whole walkthrough before the first frame instead of "
+                 "streaming (the city ends at --paged-far from the path)");
     app.add_flag("--paged-wait", f.wait,
-                 "with --paged-stream (implied): every frame waits until the regions within reach of its camera are "
+                 "with a streamed paged city: every frame waits until the regions within reach of its camera are "
                  "resident, so frames do not depend on load timing");
     std::ostringstream help;
-    help << "with --paged-stream: also load the regions within reach of where the camera will be this many seconds "
-            "ahead along its velocity, 0 .. "
+    help << "with a streamed paged city: also load the regions within reach of where the camera will be this many "
+            "seconds ahead along its velocity, 0 .. "
          << kMaxPagedPrefetchS << " (default " << kDefaultPagedPrefetchS << ")";
     addNumberOption(app, "--paged-prefetch", f.prefetchS, RealRange::closed(0, kMaxPagedPrefetchS), help.str());
 }
 
 Status validatePagedStream(PagedStreamFlags& f) {
-    if (f.wait) f.stream = true;
-    if (f.prefetchS && !f.stream)
-        return Status::error(
-            "--paged-prefetch: needs --paged-stream (or --paged-wait): without streaming every region "
-            "near the walkthrough is loaded before the first frame");
+    if (!f.preload) return Status::ok();
+    for (const auto& [given, flag] : {std::pair<bool, const char*>{f.stream, "--paged-stream"},
+                                      {f.wait, "--paged-wait"},
+                                      {f.prefetchS.has_value(), "--paged-prefetch"}})
+        if (given)
+            return Status::error(std::string("--paged-preload: not with ") + flag +
+                                 " (the preloaded city does not stream)");
     return Status::ok();
 }
 

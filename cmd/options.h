@@ -203,8 +203,28 @@ struct PathFlags {
 };
 // Declares --path, --seed, --kind, --lht, --route and, with `timing`, --duration and --run-up.
 void addPathFlags(CLI::App& app, PathFlags& flags, bool timing);
-// The path options of the flags (kind and ranges checked; messages name the flag).
+// The path options of the flags (kind and ranges checked; messages name the
+// flag). --lht applies to car paths driven in lanes: with --kind walk or fly,
+// or with a --path file (a recorded path, not driven here), it is an error.
 Result<PathOptions> parsePathFlags(const PathFlags& flags);
+// --lht for a path of `kind`: an error unless the path is a car path (walk
+// and fly paths do not drive in lanes). `option` names the flag.
+Status checkLeftHandTraffic(bool lht, PathKind kind);
+
+// --frames N against a path of `samples` samples: more frames than samples
+// would render samples more than once (spread and runs sampling repeat them),
+// so N > samples is an error naming both unless `repeats`
+// (--allow-repeated-frames) says the repeats are wanted.
+Status checkFrameCount(int frames, size_t samples, bool repeats);
+// Declares --allow-repeated-frames on `app` (bench, render).
+void addRepeatedFramesFlag(CLI::App& app, bool& repeats);
+
+// Every value given on the command line for an option that takes a value
+// (flags excluded) must be non-empty: `--rig ""` or `--xodr-positions ""`
+// would otherwise read as "option not given" and run without it. The error
+// names the option and says to give a value or leave the option out.
+// parseOrExit() applies it to every command.
+Status refuseEmptyValues(const CLI::App& app);
 
 // The file rule of a walkthrough run (bench, render, view): `files` holds the
 // command's outputs; adds its inputs (the city, --path, --baked, --baked-mesh)
@@ -223,22 +243,25 @@ void addPagedFlags(CLI::App& app, PagedReach& reach);
 // Both values within [kMinPagedRadiusM, kMaxPagedRadiusM]; errors name the option.
 Status validatePagedReach(const PagedReach& reach);
 
-// Streaming a paged city (bench, view, render; cmd/paged_stream.h): --paged-stream = the chunked city and the
-// ray scene follow the camera of each frame (nodes/render/city_stream.h, the
-// region pager of runtime/scene/region_pager.h) instead of holding the
-// regions loaded around the whole path (the modes of modeStreams()); --paged-wait = each frame waits until the
-// regions within reach of its camera are resident (deterministic frames;
-// implies --paged-stream); --paged-prefetch S = seconds of lookahead along
-// the camera's velocity, 0 .. kMaxPagedPrefetchS (default
-// kDefaultPagedPrefetchS; needs streaming).
+// Streaming a paged city (bench, view, render; cmd/paged_stream.h): a paged
+// city streams by default: the chunked city and the ray scene follow the
+// camera of each frame (nodes/render/city_stream.h, the region pager of
+// runtime/scene/region_pager.h), the first frame waiting for the regions at
+// its camera. --paged-preload = the preloading loader instead: the regions
+// around the whole path are loaded before the first frame (and the city ends
+// there); --paged-stream = ask for the stream explicitly (an error where the
+// run cannot stream, instead of preloading); --paged-wait = each frame waits
+// until the regions within reach of its camera are resident (deterministic
+// frames); --paged-prefetch S = seconds of lookahead along the camera's
+// velocity, 0 .. kMaxPagedPrefetchS (default kDefaultPagedPrefetchS).
 struct PagedStreamFlags {
     bool stream = false;
+    bool preload = false;
     bool wait = false;
     std::optional<double> prefetchS;
 };
 void addPagedStreamFlags(CLI::App& app, PagedStreamFlags& flags);
-// Resolves the implications; errors name the option (--paged-prefetch
-// without streaming).
+// Errors name the option: --paged-preload with --paged-stream, --paged-wait or --paged-prefetch.
 Status validatePagedStream(PagedStreamFlags& flags);
 
 }  // namespace vista

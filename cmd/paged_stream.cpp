@@ -29,9 +29,45 @@ void holdStreamUnder(CityStream& stream, double budgetGb) {
 Status checkStreamingModes(const std::vector<std::string>& modes) {
     for (const auto& m : modes)
         if (!modeStreams(m))
-            return Status::error("--paged-stream: mode " + m +
-                                 " does not stream a paged city (modes that do: " + streamingModeNames() + ")");
+            return Status::error("mode " + m + " does not stream a paged city (modes that do: " + streamingModeNames() +
+                                 ")");
     return Status::ok();
+}
+
+Result<bool> choosePagedStream(const char* cmd, const PagedStreamFlags& f, const std::string& city,
+                               const std::string& cannotStream, bool quiet) {
+    const char* asked = f.stream      ? "--paged-stream"
+                        : f.wait      ? "--paged-wait"
+                        : f.prefetchS ? "--paged-prefetch"
+                                      : nullptr;
+    const bool paged = isPagedCityPath(city);
+    if (!paged) {
+        if (asked || f.preload)
+            return Status::error(std::string(asked ? asked : "--paged-preload") + ": '" + city +
+                                 "' is a city file; it applies to a paged city (DIR.paged from `vista gen`)");
+        return false;
+    }
+    if (f.preload) return false;
+    if (cannotStream.empty()) return true;
+    if (asked) return Status::error(std::string(asked) + ": " + cannotStream);
+    if (!quiet)
+        std::fprintf(stderr, "%s: paged city: preloading the regions around the path (%s)\n", cmd,
+                     cannotStream.c_str());
+    return false;
+}
+
+void StreamDetail::add(const CityStreamFrame& f, double t) {
+    if (frames++ == 0) t0 = t;
+    if (f.belowDetail <= 0) return;
+    ++belowDetail;
+    if (t - t0 > 1.0) ++belowDetailAfterFirstSecond;
+}
+
+void noteStreamDetail(const char* cmd, const StreamDetail& d) {
+    std::fprintf(stderr,
+                 "%s: paged stream: %d of %d frames drew a region below the detail its distance asks for (%d after "
+                 "the first second)\n",
+                 cmd, d.belowDetail, d.frames, d.belowDetailAfterFirstSecond);
 }
 
 void notePagedStream(const char* cmd, const PagedManifest& manifest, const RegionPagerOptions& o) {
@@ -45,11 +81,21 @@ void notePagedStream(const char* cmd, const PagedManifest& manifest, const Regio
 
 Result<CityStreamFrame> advancePagedStream(CityStream& stream, const char* cmd, const glm::dvec3& eye,
                                            const glm::dvec3& velocity, std::vector<std::string>* damaged, bool wait) {
+    (void)cmd;
     auto f = stream.advance(eye, velocity, wait);
     if (!f) return f.status();
-    for (const std::string& d : f->damaged) {
-        std::fprintf(stderr, "%s: warning: %s; the rest of the city streams\n", cmd, d.c_str());
-        if (damaged) damaged->push_back(d);
+    if (!f->shortfall.empty()) return Status::error("--memory-budget: " + f->shortfall);
+    if (!f->damaged.empty()) {
+        std::string why = "the stream cannot read " + std::to_string(f->damaged.size()) + " region file" +
+                          (f->damaged.size() == 1 ? "" : "s");
+        for (const std::string& d : f->damaged) {
+            why += "; " + d;
+            if (damaged) damaged->push_back(d);
+        }
+        const bool foreign = why.find("another generation") != std::string::npos;
+        return Status::error(why + (foreign ? std::string()
+                                            : " (generate the city again, or give --paged-preload to "
+                                              "draw the rest of the city)"));
     }
     return f;
 }
@@ -63,7 +109,7 @@ glm::dvec3 pathVelocity(const Path& path, size_t i) {
 }
 
 nlohmann::json pagedStreamJson(const RegionPagerOptions& o, const RegionPagerStats& s, int framesWithArrivals,
-                               const std::vector<std::string>& damaged) {
+                               const std::vector<std::string>& damaged, const StreamDetail& detail) {
     return {{"radius_m", o.radius},
             {"far_m", o.far},
             {"prefetch_s", o.prefetchS},
@@ -93,6 +139,8 @@ nlohmann::json pagedStreamJson(const RegionPagerOptions& o, const RegionPagerSta
             {"frames_waited", s.framesWaited},
             {"wait_ms", s.waitMs},
             {"frames_with_arrivals", framesWithArrivals},
+            {"frames_below_detail", detail.belowDetail},
+            {"frames_below_detail_after_first_second", detail.belowDetailAfterFirstSecond},
             {"budget_limited_updates", s.budgetLimited},
             {"damaged", damaged}};
 }

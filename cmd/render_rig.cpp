@@ -124,7 +124,8 @@ Status configure(const RigRunRequest& a, RigPlan& p) {
 
 Result<Walkthrough> loadCityAndFrames(const RigRunRequest& a, RigPlan& p) {
     const std::string labelsFor = p.needsLabels() ? "LiDAR labels and the semantic, instance and boxes channels" : "";
-    WalkthroughRequest req = renderRequest(a.city, a.path.file, p.path, a.frames, p.sampleRuns, labelsFor, p.idx);
+    WalkthroughRequest req =
+        renderRequest(a.city, a.path.file, p.path, a.frames, p.sampleRuns, a.repeats, labelsFor, p.idx);
     req.effects = [](const Effects& declared) { return runTimeEffects(std::nullopt, declared, true, kCmd); };
     auto w = loadWalkthrough(req, p.options);
     if (!w) return w;
@@ -163,7 +164,22 @@ Status openWorkDir(const RigRunRequest& a, const RigPlan& p, const Path& path, R
     return Status::ok();
 }
 
-// Frames an interrupted run finished: their record and every file of the sensors that fired.
+// The files of frame f: those of the sensors that fired, and its boxes.
+std::vector<std::string> frameFiles(const RigPlan& p, size_t f) {
+    std::vector<std::string> files;
+    const std::string name = frameName(f);
+    for (size_t k = 0; k < p.rig.cameras.size(); ++k)
+        if (p.camFire[k][f])
+            for (auto& s : cameraFiles(p.rig.cameras[k], k, name)) files.push_back(s);
+    for (size_t j = 0; j < p.rig.lidars.size(); ++j)
+        if (p.lidarFire[j][f])
+            for (auto& s : lidarFiles(j, name)) files.push_back(s);
+    if (p.hasBoxes()) files.push_back(std::string(kBoxes3dDir) + "/" + name + ".json");
+    return files;
+}
+
+// Frames an interrupted run finished: their record, and every file of the sensors that fired with the size
+// and content hash the record gives (a damaged one is rendered again).
 std::vector<nlohmann::json> finishedFrames(const RenderWorkDir& out, const RigPlan& p, size_t& kept) {
     std::vector<nlohmann::json> records(p.idx.size());
     kept = 0;
@@ -171,17 +187,7 @@ std::vector<nlohmann::json> finishedFrames(const RenderWorkDir& out, const RigPl
     for (size_t f = 0; f < records.size(); ++f) {
         records[f] = out.frameRecord(f);
         if (records[f].is_null()) continue;
-        std::vector<std::string> files;
-        const std::string name = frameName(f);
-        for (size_t k = 0; k < p.rig.cameras.size(); ++k)
-            if (p.camFire[k][f])
-                for (auto& s : cameraFiles(p.rig.cameras[k], k, name)) files.push_back(s);
-        for (size_t j = 0; j < p.rig.lidars.size(); ++j)
-            if (p.lidarFire[j][f])
-                for (auto& s : lidarFiles(j, name)) files.push_back(s);
-        if (p.hasBoxes()) files.push_back(std::string(kBoxes3dDir) + "/" + name + ".json");
-        for (const std::string& s : files)
-            if (!fs::exists(out.file(s))) records[f] = nullptr;
+        if (!out.frameIntact(records[f], frameFiles(p, f))) records[f] = nullptr;
         kept += records[f].is_null() ? 0 : 1;
     }
     return records;
@@ -310,7 +316,7 @@ Status renderFrames(const RigRunRequest& a, const RigPlan& p, const Walkthrough&
         if (!records[f].is_null()) continue;
         if (Status s = renderFrame(p, w, rays, f, out, p.hasBoxes() ? &cityBoxes : nullptr, im, records[f]); !s)
             return Status::error("frame " + std::to_string(f) + ": " + s.message());
-        VISTA_RETURN_IF_ERROR(out.finishFrame(f, records[f]));
+        VISTA_RETURN_IF_ERROR(out.finishFrame(f, records[f], frameFiles(p, f)));
         if (killAfter > 0 && ++finishedNow == killAfter) std::raise(SIGKILL);
         if (progress) progress->update(double(f + 1) / double(n));
     }

@@ -15,6 +15,7 @@ struct RigRunRequest {
     std::string city, rig, out, command;
     std::string sampling = "spread";
     int frames = 60;
+    bool repeats = false;  // --allow-repeated-frames
     bool stats = false, quiet = false, restart = false;
     PathFlags path;
     ModeFlags modeFlags;  // --threads only; checkRunFiles reads the baked-file flags

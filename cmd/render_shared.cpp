@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "citygen/labels.h"
+#include "cmd/options.h"
 #include "foundation/atomic_file.h"
 #include "foundation/format.h"
 #include "foundation/hash.h"
@@ -21,18 +22,18 @@ std::string frameName(size_t f) {
     return b;
 }
 
-// World xy of every frame inside the city square (params.origin +- size/2) grown by kPathMargin.
-Status checkPathInCity(const Path& path, const std::vector<size_t>& idx, const SceneModel& city) {
+// World xy of every path sample inside the city square (params.origin +- size/2) grown by kPathMargin.
+Status checkPathInCity(const Path& path, const SceneModel& city) {
     const double half = 0.5 * city.params.size_m + kPathMargin;
-    for (size_t f = 0; f < idx.size(); ++f) {
-        const glm::dvec3& p = path.samples[idx[f]].position;
-        const double x = p.x - city.params.origin_x, y = p.y - city.params.origin_y;
+    for (size_t i = 0; i < path.samples.size(); ++i) {
+        const PathSample& s = path.samples[i];
+        const double x = s.position.x - city.params.origin_x, y = s.position.y - city.params.origin_y;
         if (!(std::abs(x) <= half && std::abs(y) <= half)) {
-            char b[256];
+            char b[320];
             std::snprintf(b, sizeof b,
-                          "path sample %zu (frame %zu) at city-frame (%.1f, %.1f) m lies outside the city square (+ 50 "
-                          "m) [-%.0f, %.0f] m",
-                          idx[f], f, x, y, half, half);
+                          "path sample %zu (t = %.6g s) at city-frame (%.1f, %.1f) m lies outside the city square "
+                          "grown by %.0f m: x and y in [-%.0f, %.0f] m",
+                          i, s.t, x, y, kPathMargin, half, half);
             return Status::error(b);
         }
     }
@@ -115,7 +116,8 @@ nlohmann::json medianOf(const std::vector<double>& v) {
 }
 
 WalkthroughRequest renderRequest(const std::string& city, const std::string& pathFile, const PathOptions& pathOptions,
-                                 int frames, int sampleRuns, const std::string& labelsFor, std::vector<size_t>& idx) {
+                                 int frames, int sampleRuns, bool repeats, const std::string& labelsFor,
+                                 std::vector<size_t>& idx) {
     WalkthroughRequest req;
     req.city = city;
     req.cmd = "vista render";
@@ -130,12 +132,13 @@ WalkthroughRequest renderRequest(const std::string& city, const std::string& pat
                                  labelsFor);
         return Status::ok();
     };
-    req.makePath = [pathFile, pathOptions, frames, sampleRuns, &idx](const SceneModel& model) -> Result<Path> {
+    req.makePath = [pathFile, pathOptions, frames, sampleRuns, repeats, &idx](const SceneModel& model) -> Result<Path> {
         auto path = walkthroughPath(pathFile, pathOptions, model);
         if (!path) return path;
         if (path->samples.empty()) return Status::error("the walkthrough path has no samples");
+        VISTA_RETURN_IF_ERROR(checkFrameCount(frames, path->samples.size(), repeats));
         idx = path->frames(size_t(frames), sampleRuns);
-        VISTA_RETURN_IF_ERROR(checkPathInCity(*path, idx, model));
+        VISTA_RETURN_IF_ERROR(checkPathInCity(*path, model));
         return path;
     };
     return req;

@@ -18,11 +18,14 @@ namespace vista {
 
 // "000042": the name of frame 42's files.
 std::string frameName(size_t f);
-// A frame's eye may stand this far outside the city square (streets run up
+// A path sample may stand this far outside the city square (streets run up
 // to its border and a vehicle drives beside their centre line).
 constexpr double kPathMargin = 50.0;
-// World xy of every frame inside the city square (params.origin +- size/2) grown by kPathMargin.
-Status checkPathInCity(const Path& path, const std::vector<size_t>& idx, const SceneModel& city);
+// World xy of every path sample inside the city square (params.origin +-
+// size/2) grown by kPathMargin: the rendered frames, and the samples between
+// them too (a LiDAR sweep interpolates the vehicle's pose between samples).
+// The error names the sample (index and time), its position and the bounds.
+Status checkPathInCity(const Path& path, const SceneModel& city);
 // The class table and the instance encoding (classes.json).
 nlohmann::json classesJson();
 // Content hash of a file's bytes (hex), streamed; `bytes` receives its size.
@@ -37,11 +40,13 @@ std::string manifestNumber(double v);
 long killAfterFrames();
 // The walkthrough request both kinds of render make: the city file (never
 // paged), notes off, the path from `pathFile` (a CSV) or `pathOptions` on the
-// city's streets, `frames` of it as `sampleRuns` says into `idx`, every frame
-// inside the city; a city without ground-truth labels is refused when
-// `labelsFor` (the channels that need them, for the message) is not empty.
+// city's streets, `frames` of it as `sampleRuns` says into `idx` (more frames
+// than samples only with `repeats`, checkFrameCount), every sample inside the
+// city; a city without ground-truth labels is refused when `labelsFor` (the
+// channels that need them, for the message) is not empty.
 WalkthroughRequest renderRequest(const std::string& city, const std::string& pathFile, const PathOptions& pathOptions,
-                                 int frames, int sampleRuns, const std::string& labelsFor, std::vector<size_t>& idx);
+                                 int frames, int sampleRuns, bool repeats, const std::string& labelsFor,
+                                 std::vector<size_t>& idx);
 // The median of `v`, null when empty.
 nlohmann::json medianOf(const std::vector<double>& v);
 

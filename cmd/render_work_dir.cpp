@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "cmd/render_shared.h"
 #include "foundation/atomic_file.h"
 
 namespace vista {
@@ -150,11 +151,34 @@ nlohmann::json RenderWorkDir::frameRecord(size_t frame) const {
     return j.is_object() ? j : nlohmann::json();
 }
 
-Status RenderWorkDir::finishFrame(size_t frame, const nlohmann::json& record) {
+Status RenderWorkDir::finishFrame(size_t frame, nlohmann::json& record, const std::vector<std::string>& files) {
+    nlohmann::json list = nlohmann::json::object();
+    for (const std::string& rel : files) {
+        uint64_t bytes = 0;
+        auto hash = fileHash(file(rel), bytes);
+        if (!hash) return Status::error("--out: frame " + std::to_string(frame) + ": " + hash.status().message());
+        list[rel] = {{"bytes", bytes}, {"hash", *hash}};
+    }
+    record["files"] = std::move(list);
     if (Status s = writeFileAtomic((fs::path(_partialStr) / recordName(frame)).string(), record.dump() + "\n"); !s)
         return s;
     ++_finished;
     return Status::ok();
+}
+
+bool RenderWorkDir::frameIntact(const nlohmann::json& record, const std::vector<std::string>& files) const {
+    if (!record.is_object() || !record.contains("files") || !record["files"].is_object()) return false;
+    const nlohmann::json& list = record["files"];
+    if (list.size() != files.size()) return false;
+    for (const std::string& rel : files) {
+        if (!list.contains(rel) || !list[rel].is_object()) return false;
+        const nlohmann::json& e = list[rel];
+        uint64_t bytes = 0;
+        auto hash = fileHash(file(rel), bytes);
+        if (!hash || !e.contains("bytes") || !e.contains("hash") || e["bytes"] != bytes || e["hash"] != *hash)
+            return false;
+    }
+    return true;
 }
 
 Status RenderWorkDir::commit() {

@@ -4,9 +4,10 @@
 // Layout beside the output directory OUT:
 //   OUT.partial/manifest.json     the run's parameters that affect output bytes
 //   OUT.partial/lock              flock()ed while a run uses the directory
-//   OUT.partial/done/NNNNNN.json  per finished frame: its timings (written
-//                                 after the frame's channel files: the mark
-//                                 that the frame is complete)
+//   OUT.partial/done/NNNNNN.json  per finished frame: its timings and, under
+//                                 "files", each of its files' size and content
+//                                 hash (written after the frame's files: the
+//                                 mark that the frame is complete)
 //   OUT.partial/out/              the output tree (rgb/, depth/, ...)
 // commit() renames OUT.partial/out to OUT (one rename: OUT appears whole)
 // and removes OUT.partial.
@@ -22,11 +23,18 @@
 // killed writes ("*.tmp.*") under out/ are removed. If this object created
 // OUT.partial and no frame was finished when it is destroyed without
 // commit() (a failure before the first frame), it removes OUT.partial again.
+// finishFrame(): adds to `record` "files": {relative path: {"bytes": N,
+// "hash": 16 hex digits (hashBytes64 of the file)}} for each of `files`
+// (paths under out/, as written), then writes the record. frameIntact(): a
+// resumed frame is kept only when its record lists exactly `files` and each
+// has its recorded size and hash (a file damaged or truncated after the
+// record, or a record without hashes, means the frame is rendered again).
 // Errors are Status messages naming --out, the path and the reason.
 // Not thread-safe; one object per run.
 #pragma once
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -52,7 +60,8 @@ public:
     std::string file(const std::string& rel) const;
     // The frame's record, or null when the frame is not finished.
     nlohmann::json frameRecord(size_t frame) const;
-    Status finishFrame(size_t frame, const nlohmann::json& record);
+    Status finishFrame(size_t frame, nlohmann::json& record, const std::vector<std::string>& files);
+    bool frameIntact(const nlohmann::json& record, const std::vector<std::string>& files) const;
     Status commit();
 
 private:

@@ -31,7 +31,7 @@ using Json = nlohmann::ordered_json;
 
 namespace {
 
-constexpr int kPagedFormatVersion = 1;
+constexpr int kPagedFormatVersion = kPagedCityVersion;
 
 double seconds(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -101,7 +101,14 @@ Result<Json> fileEntry(const std::string& dir, const std::string& role, const st
 }
 
 // Generates region r, writes its files and then its record; returns the record.
-Result<Json> generateRegion(const RegionalCity& base, int r, const std::string& dir, const std::string& key) {
+// The generation's identity on a region file's root (paged_load.h checks it against the manifest).
+void markGeneration(osg::Node& scene, const CityParams& params, const std::string& key) {
+    scene.setUserValue(kPagedGenerationKey, key);
+    scene.setUserValue(kPagedSeedKey, std::to_string(params.seed));
+}
+
+Result<Json> generateRegion(const RegionalCity& base, int r, const std::string& dir, const std::string& key,
+                            const CityParams& params) {
     const RegionGrid& grid = base.grid();
     const int ix = grid.ix(r), iy = grid.iy(r);
     City c = base.region(r);
@@ -125,6 +132,7 @@ Result<Json> generateRegion(const RegionalCity& base, int r, const std::string& 
         osg::BoundingBox box;
         {
             osg::ref_ptr<osg::Node> scene = buildCityScene(c);
+            markGeneration(*scene, params, key);
             osg::ComputeBoundsVisitor cbv;
             scene->accept(cbv);
             box = cbv.getBoundingBox();
@@ -134,6 +142,7 @@ Result<Json> generateRegion(const RegionalCity& base, int r, const std::string& 
             City k = RegionalCity::coarse(c);
             c = City();
             osg::ref_ptr<osg::Node> scene = buildCityScene(k);
+            markGeneration(*scene, params, key);
             osg::ComputeBoundsVisitor cbv;  // the impostors' quads may reach beyond the trees' meshes
             scene->accept(cbv);
             box.expandBy(cbv.getBoundingBox());
@@ -185,11 +194,12 @@ osg::ref_ptr<osg::Node> buildIndex(const CityParams& params, const RegionGrid& g
     return root;
 }
 
-Json manifestJson(const CityParams& params, const RegionGrid& grid, double regionSize,
-                  const std::vector<Json>& records) {
+Json manifestJson(const CityParams& params, const RegionGrid& grid, double regionSize, const std::vector<Json>& records,
+                  const std::string& key) {
     Json m;
     m["format"] = "vista.paged_city";
     m["version"] = kPagedFormatVersion;
+    m["generation"] = {{"seed", params.seed}, {"key", key}};
     m["params"] = Json::parse(paramsToJson(params));
     m["region_size_m"] = regionSize;
     m["tile_size_m"] = params.tile_size_m;
@@ -336,7 +346,7 @@ Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedC
             rep.blocks = base->blockCount();
             if (pr) pr->begin("regions (" + std::to_string(todo.size()) + " of " + std::to_string(grid.count()) + ")");
             for (size_t k = 0; k < todo.size(); ++k) {
-                auto rec = generateRegion(*base, todo[k], o.dir, key);
+                auto rec = generateRegion(*base, todo[k], o.dir, key, params);
                 if (!rec) {
                     if (pr) pr->end();
                     return rec.status();
@@ -378,7 +388,7 @@ Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedC
     OutputBatch& batch = o.batch ? *o.batch : own;
     VISTA_RETURN_IF_ERROR(writeSceneFile(*index, batch.stage((fs::path(o.dir) / kPagedIndexFile).string()), false));
     VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage((fs::path(o.dir) / kPagedManifestFile).string()),
-                                          manifestJson(params, grid, o.regionSizeM, all).dump(2) + "\n"));
+                                          manifestJson(params, grid, o.regionSizeM, all, key).dump(2) + "\n"));
     if (!o.batch) VISTA_RETURN_IF_ERROR(own.commit());
     rep.indexWritten = true;
     rep.indexSeconds = seconds(ti);

@@ -8,7 +8,9 @@
 # adds its continuity columns (linked lane borders more than 1 cm apart in plan
 # or 2 cm in height, the worst plan gap, heading kinks over 0.5 degrees, lane
 # borders folding over their centre of curvature, driving lanes without a
-# successor) and the signal and object counts, and xmllint the errors against
+# successor or, leaving a junction, without a connecting lane into them;
+# signal failures: validity order, codes, controller grouping, crosswalk
+# outlines) and the signal and object counts, and xmllint the errors against
 # the ASAM OpenDRIVE 1.6 schema when VISTA_OPENDRIVE_XSD names
 # opendrive_16_core.xsd or its folder ("n/a" otherwise: the schema is not
 # shipped with vista). Prints the Markdown table on stdout.
@@ -63,18 +65,22 @@ nl = sum(len(e.findall("lane")) for e in ne)
 text = open(base + ".log").read()
 errors = len(re.findall(r"^Error", text, re.M))
 warnings = len(re.findall(r"^Warning", text, re.M))
+unconnected = re.findall(r"not connected (?:from any incoming|to any outgoing) edge at junction '([^']*)'", text)
+at_junctions = sum(1 for j in unconnected if re.fullmatch(r"\d+", j))
 c = json.load(open(base + ".check.json"))
 k = c["checks"]
 schema = open(base + ".schema.count").read().strip()
 with open(base + ".counts", "w") as f:
     f.write(f"| {name} | {len(street)} | {len(trans)} | {len(junctions)} | {len(conn)} | {lanes} | {walks} "
             f"| {len(lights)} at {len(lit)} | {len(signals) - len(lights)} | {c['counts']['objects']} "
-            f"| {len(nj)} | {len(ne)} | {nl} | {len(n.findall('tlLogic'))} | {errors} | {warnings} |\n")
+            f"| {len(nj)} | {len(ne)} | {nl} | {len(n.findall('tlLogic'))} | {errors} | {warnings} "
+            f"| {at_junctions} / {len(unconnected) - at_junctions} |\n")
 worst = k["gaps"]["worst"] or 0.0
 with open(base + ".checks", "w") as f:
     f.write(f"| {name} | {schema} | {k['gaps']['failures']} of {k['gaps']['checked']} | {worst * 1000:.1f} mm "
             f"| {k['kinks']['failures']} of {k['kinks']['checked']} | {k['folds']['failures']} "
-            f"| {k['unlinked']['failures']} of {k['unlinked']['checked']} | {k['references']['failures']} |\n")
+            f"| {k['unlinked']['failures']} of {k['unlinked']['checked']} | {k['references']['failures']} "
+            f"| {k['signals']['failures']} of {k['signals']['checked']} |\n")
 PY2
 }
 
@@ -84,7 +90,7 @@ city() {  # KEY LABEL GEN_ARGS...
   log "$label"
   rm -f "$OUT/$key.osgb" "$OUT/$key.xodr"
   "$VISTA" gen "$@" -q -o "$OUT/$key.osgb" --xodr "$OUT/$key.xodr"
-  netconvert --opendrive-files "$OUT/$key.xodr" -o "$OUT/$key.net.xml" >"$OUT/$key.log" 2>&1
+  netconvert --aggregate-warnings -1 --opendrive-files "$OUT/$key.xodr" -o "$OUT/$key.net.xml" >"$OUT/$key.log" 2>&1
   check "$key"
   row "$label" "$key"
 }
@@ -95,11 +101,11 @@ city town "OSM town (\`tests/data/osm/town.osm\`)" --osm tests/data/osm/town.osm
 city osm "OSM hard cases (\`tests/data/osm/hard_cases.osm\`)" --osm tests/data/osm/hard_cases.osm
 city lanes "OSM lane tags (\`tests/data/osm/lanes.osm\`)" --osm tests/data/osm/lanes.osm
 KEYS="default hilly town osm lanes"
-echo "| city | roads | transitions | junctions | connecting roads | driving lanes | sidewalk lanes | traffic lights (at junctions) | signs | crosswalks | netconvert junctions | netconvert edges | netconvert lanes | netconvert traffic lights | netconvert errors | netconvert warnings |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+echo "| city | roads | transitions | junctions | connecting roads | driving lanes | sidewalk lanes | traffic lights (at junctions) | signs | crosswalks | netconvert junctions | netconvert edges | netconvert lanes | netconvert traffic lights | netconvert errors | netconvert warnings | lanes "not connected" (at junctions / at transitions) |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 for k in $KEYS; do cat "$OUT/$k.counts"; done
 echo
-echo "| city | schema errors | linked lane borders > 1 cm apart | worst gap | heading kinks > 0.5 deg | folding borders | driving lanes without successor | broken references |"
-echo "|---|---|---|---|---|---|---|---|"
+echo "| city | schema errors | linked lane borders > 1 cm apart | worst gap | heading kinks > 0.5 deg | folding borders | driving lanes without a connection (incl. junction exits) | broken references | signal failures |"
+echo "|---|---|---|---|---|---|---|---|---|"
 for k in $KEYS; do cat "$OUT/$k.checks"; done
 log "done"

@@ -39,6 +39,7 @@ STEPS=(
   "paged-reach|docs/measurements/paging.md|docs/tools/paged_reach_table.sh \$OUT/scale/c8000.paged \$OUT/paged-reach \$BUILD"
   "raw-rays|docs/measurements/raw-rays.md|docs/tools/raw_rays.sh \$OUT/raw-rays \$BUILD/vista"
   "opendrive|docs/formats.md \"OpenDRIVE\" (table in OUT/opendrive.md)|docs/tools/opendrive_table.sh \$OUT/opendrive-work \$BUILD/vista > \$OUT/opendrive.md"
+  "traffic|docs/measurements/traffic.md|docs/tools/traffic_table.sh \$OUT/traffic \$BUILD/vista"
   "ground-truth|docs/measurements/ground-truth.md (costs in OUT/ground-truth.txt)|mkdir -p \$OUT/ground-truth && \$BUILD/vista gen --params data/default.json -o \$OUT/ground-truth/c.osgb -q && \$BUILD/vista path \$OUT/ground-truth/c.osgb --seed 3 -o \$OUT/ground-truth/p.csv && for m in full hybrid; do rm -rf \$OUT/ground-truth/gt_\$m; xvfb-run -a -s '-screen 0 1280x1024x24' \$BUILD/vista render \$OUT/ground-truth/c.osgb --path \$OUT/ground-truth/p.csv --frames 60 --mode \$m --out \$OUT/ground-truth/gt_\$m --stats -q; done > \$OUT/ground-truth.txt 2>&1"
   "reliability|docs/measurements/reliability.md|docs/tools/reliability.sh 3600 100000"
 )

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "foundation/process_memory.h"
 #include "nodes/near_field_chunks.h"
@@ -181,8 +182,30 @@ Result<CityStreamFrame> CityStream::advance(const glm::dvec3& eye, const glm::dv
         _pager->setBudget(_processBudget > _overhead ? _processBudget - _overhead : 1);
     }
     _pager->update(eye, velocity);
-    RegionPagerDelta d = _pager->collect(wait);
     CityStreamFrame f;
+    if (const RegionShortfall sf = _pager->cameraShortfall(); sf.starved) {
+        // Even the coarse levels of the regions at the camera do not fit: frames would draw nothing.
+        const uint64_t own = _processBudget > 0 ? _overhead : 0;
+        const uint64_t budget = _processBudget > 0 ? _processBudget : _options.budgetBytes;
+        // GB with two decimals; what is needed rounds up, so that the figure given is enough.
+        auto gb = [](uint64_t b, bool up = true) {
+            const double v = double(b) / double(1ull << 30) * 100.0;
+            char buf[32];
+            std::snprintf(buf, sizeof buf, "%.2f", (up ? std::ceil(v) : std::round(v)) / 100.0);
+            return std::string(buf);
+        };
+        std::string names;
+        for (size_t k = 0; k < sf.regions.size(); ++k) {
+            const PagedRegionEntry& r = _manifest->regions[size_t(sf.regions[k])];
+            names += (k ? ", " : "") + r.file;
+        }
+        f.shortfall = "a budget of " + gb(budget, false) + " GB cannot hold the regions at the camera (" + names +
+                      ") even at their coarse level; it needs at least " + gb(own + sf.needCoarse) + " GB (" +
+                      gb(own + sf.needFull) + " GB for their full detail; " + gb(own, false) +
+                      " GB of it the process's own memory beside the regions)";
+        return f;
+    }
+    RegionPagerDelta d = _pager->collect(wait);
     f.waited = d.waited;
     f.damaged = d.damaged;
     if (_rays) {
@@ -218,6 +241,7 @@ Result<CityStreamFrame> CityStream::advance(const glm::dvec3& eye, const glm::dv
         ++f.arrived;
     }
     if (f.arrived > 0 || f.dropped > 0) ++_generation;
+    f.belowDetail = _pager->belowDetail();
     _dropsSinceMeasure = _dropsSinceMeasure || !d.dropped.empty();
     return f;
 }

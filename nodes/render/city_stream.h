@@ -42,7 +42,9 @@
 // Contract: the manifest outlives the stream; advance() runs between frames,
 // never while a frame is drawn or rays are cast. Errors: those of the ray
 // scene (an Embree error naming the region). A damaged region file is no
-// error: advance() returns its message once and the pager falls back.
+// error: advance() returns its message once and the pager falls back; a
+// budget that cannot hold the regions at the camera is no error either:
+// advance() says so in CityStreamFrame::shortfall and the caller decides.
 #pragma once
 #include <cstdint>
 #include <map>
@@ -89,6 +91,12 @@ struct CityStreamFrame {
     SceneBoxes changed;
     bool waited = false;
     std::vector<std::string> damaged;
+    // The regions held below the detail their distance from the eye asks for (RegionPager::belowDetail).
+    int belowDetail = 0;
+    // Non-empty: the budget cannot hold even the coarse levels of the regions at the camera
+    // (RegionPager::cameraShortfall); the message names them and the budget they need (GB, the
+    // whole process's with holdProcessUnder). Nothing else of the frame is set then.
+    std::string shortfall;
 };
 
 class CityStream {

@@ -16,6 +16,15 @@
 
 namespace vista {
 
+double minFocalLength(const CameraModel& m, bool x) {
+    const double c = x ? m.cx : m.cy, size = x ? m.width : m.height;
+    // The image's farthest edge from the principal point (pixel centres are at
+    // integers, so the image covers [-0.5, size - 0.5]).
+    const double extent = std::max(c + 0.5, size - 0.5 - c);
+    const double maxAngle = m.fisheye() ? kPi : std::tan(0.5 * kMaxRigPinholeFovDeg * kPi / 180.0);
+    return extent / maxAngle;
+}
+
 namespace {
 
 using Json = nlohmann::json;
@@ -109,6 +118,22 @@ Status readMount(const FieldReader& r, const Json& s, const Where& w, SensorMoun
     return r.real(pose, p, "roll_deg", RealRange::closed(-180, 180), "degrees", m.rollDeg);
 }
 
+// fx and fy at least minFocalLength(): below it a pinhole image would span
+// kMaxRigPinholeFovDeg or more, a fisheye's edge would lie past straight
+// behind (the message says which and across which side).
+Status checkFocalLowerBound(const FieldReader& r, const Json& in, const Where& iw, CameraModel& m) {
+    for (const bool x : {true, false}) {
+        const double minF = minFocalLength(m, x);
+        const std::string why = "pixels; below " + shortNumber(minF) + " the image would span " +
+                                (m.fisheye() ? std::string("more than 360 degrees")
+                                             : "more than " + shortNumber(kMaxRigPinholeFovDeg) + " degrees") +
+                                " across its " + (x ? "width" : "height");
+        VISTA_RETURN_IF_ERROR(
+            r.real(in, iw, x ? "fx" : "fy", RealRange::closed(minF, kMaxFocalLength), why.c_str(), x ? m.fx : m.fy));
+    }
+    return Status::ok();
+}
+
 Status readCamera(const FieldReader& r, const Json& s, const Where& w, bool fisheye, RigCamera& c) {
     VISTA_RETURN_IF_ERROR(r.keys(s, w, {"name", "type", "pose", "rate_hz", "intrinsics", "channels"}));
     CameraModel& m = c.model;
@@ -121,13 +146,14 @@ Status readCamera(const FieldReader& r, const Json& s, const Where& w, bool fish
     else VISTA_RETURN_IF_ERROR(r.keys(in, iw, {"width", "height", "fx", "fy", "cx", "cy"}));
     VISTA_RETURN_IF_ERROR(r.integer(in, iw, "width", 1, 8192, m.width, true));
     VISTA_RETURN_IF_ERROR(r.integer(in, iw, "height", 1, 8192, m.height, true));
-    const RealRange focal = RealRange::openMin(0, 1e6);
+    const RealRange focal = RealRange::openMin(0, kMaxFocalLength);
     VISTA_RETURN_IF_ERROR(r.real(in, iw, "fx", focal, "pixels", m.fx, true));
     VISTA_RETURN_IF_ERROR(r.real(in, iw, "fy", focal, "pixels", m.fy, true));
     VISTA_RETURN_IF_ERROR(r.real(in, iw, "cx", RealRange::closed(0, m.width), "pixels", m.cx, true));
     VISTA_RETURN_IF_ERROR(r.real(in, iw, "cy", RealRange::closed(0, m.height), "pixels", m.cy, true));
     if (fisheye)
         VISTA_RETURN_IF_ERROR(r.real(in, iw, "max_fov_deg", RealRange::openMin(0, 360), "degrees", m.maxFovDeg, true));
+    VISTA_RETURN_IF_ERROR(checkFocalLowerBound(r, in, iw, m));
     const Where cw = w.key("channels");
     if (!s.contains("channels"))
         return r.error(cw, "is missing (a list of rgb, depth, semantic, instance, flow, boxes)");

@@ -32,7 +32,8 @@
 //            "pitch_deg": [-90, 90], "roll_deg": [-180, 180]} (each optional, 0);
 //   "rate_hz": (0, 1000] (optional, see Firing);
 // cameras: "intrinsics": {"width", "height": 1 .. 8192, "fx", "fy": (0, 1e6]
-//   pixels, "cx": [0, width], "cy": [0, height], fisheye also "max_fov_deg":
+//   pixels and at least minFocalLength() (a field-of-view limit, below),
+//   "cx": [0, width], "cy": [0, height], fisheye also "max_fov_deg":
 //   (0, 360]} and "channels": a non-empty list of "rgb", "depth", "semantic",
 //   "instance", "flow", "boxes" (no repeats; boxes: runtime/engine/rig_boxes.h);
 // LiDARs (LidarSpec): "beams": a list of 1 .. 256 elevations in [-90, 90]
@@ -62,6 +63,19 @@ namespace vista {
 constexpr uint64_t kMaxRigFileBytes = uint64_t(1) << 20;  // 1 MiB
 constexpr int kMaxRigSensors = 64;
 constexpr size_t kMaxLidarRays = size_t(1) << 22;  // beams x columns of one sweep
+constexpr double kMaxFocalLength = 1e6;            // pixels
+// The widest field of view a pinhole rig camera may span across its width or
+// height (the limit of --fov): near 180 degrees a pinhole image stretches
+// without bound, and a focal length like 1e-300 sends every pixel's ray 90
+// degrees off the axis (depth along the axis 0, or +inf after division).
+constexpr double kMaxRigPinholeFovDeg = 179.0;
+// The smallest focal length (pixels) along x (fx, width, cx) or y (fy, height,
+// cy) of camera `m` with its size and principal point: the image's farthest
+// edge from the principal point, e = max(c + 0.5, size - 0.5 - c), divided by
+// tan(kMaxRigPinholeFovDeg / 2) for a pinhole (each side of the principal
+// point then spans at most half of kMaxRigPinholeFovDeg) and by pi for an equidistant
+// fisheye (its edge at most 180 degrees off the axis: straight behind).
+double minFocalLength(const CameraModel& m, bool x);
 
 // Channels a rig camera writes (bit set).
 enum RigChannel : unsigned {

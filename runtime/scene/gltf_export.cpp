@@ -206,8 +206,8 @@ Status writeGltf(const City& city, const std::string& path) {
     while (jsonText.size() % 4) jsonText.push_back(' ');
     const uint64_t total = 12 + 8 + uint64_t(jsonText.size()) + (b.bin.empty() ? 0 : 8 + uint64_t(b.bin.size()));
     if (total > 0xFFFFFFFFull)
-        return Status::error("cannot write '" + path + "': the glTF would be " + std::to_string(total) +
-                             " bytes, above the 4 GiB limit of .glb; use a smaller --size");
+        return Status::error("option --gltf: the city as glTF would be " + std::to_string(total) +
+                             " bytes, above the 4 GiB limit of a .glb file; use a smaller --size");
     std::string out;
     out.reserve(size_t(total));
     out.append("glTF");

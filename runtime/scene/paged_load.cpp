@@ -14,7 +14,9 @@
 #include <nlohmann/json.hpp>
 #include <osg/Group>
 
+#include "citygen/regions.h"
 #include "citygen/streets.h"
+#include "foundation/number_text.h"
 #include "foundation/input_file.h"
 #include "runtime/scene/city_file.h"
 #include "runtime/scene/scene_graph.h"
@@ -45,6 +47,87 @@ Status validatePagedRadius(const std::string& option, double value) {
     return Status::ok();
 }
 
+namespace {
+
+// Field checks of manifest.json: each names the field (with `where`, e.g.
+// "regions[3]: ") and the value as written, and states the allowed range.
+// JSON integers only for counts and sizes: -5 or 1e3 is refused, never cast.
+Status manifestField(const Json& obj, const char* field, const std::string& where) {
+    if (!obj.is_object() || !obj.contains(field)) return Status::error(where + "field '" + field + "' is missing");
+    return Status::ok();
+}
+
+Status manifestUnsigned(const Json& obj, const char* field, uint64_t lo, uint64_t hi, const std::string& where,
+                        uint64_t& out) {
+    VISTA_RETURN_IF_ERROR(manifestField(obj, field, where));
+    const Json& v = obj[field];
+    if (!v.is_number_unsigned() || v.get<uint64_t>() < lo || v.get<uint64_t>() > hi)
+        return Status::error(where + "field '" + field + "' = " + echoText(v.dump()) +
+                             " is out of range (an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                             "])");
+    out = v.get<uint64_t>();
+    return Status::ok();
+}
+
+Status manifestInt(const Json& obj, const char* field, int lo, int hi, const std::string& where, int& out) {
+    uint64_t v = 0;
+    VISTA_RETURN_IF_ERROR(manifestUnsigned(obj, field, uint64_t(lo), uint64_t(hi), where, v));
+    out = int(v);
+    return Status::ok();
+}
+
+Status manifestBool(const Json& obj, const char* field, const std::string& where, bool& out) {
+    VISTA_RETURN_IF_ERROR(manifestField(obj, field, where));
+    if (!obj[field].is_boolean())
+        return Status::error(where + "field '" + field + "' = " + echoText(obj[field].dump()) +
+                             " is not true or false");
+    out = obj[field].get<bool>();
+    return Status::ok();
+}
+
+// The grid, the regions' order and the regions' files against each other
+// (readPagedManifest has read each field within its range): the grid is the
+// one region_size_m makes of the city, region i is entry i at (i % regions_x,
+// i / regions_x), no file is listed twice, and at least one region is not empty.
+Status checkManifestRegions(const PagedManifest& m, const std::string& path) {
+    const RegionGrid grid(m.params, m.regionSizeM);
+    if (grid.countX() != m.regionsX || grid.countY() != m.regionsY)
+        return Status::error("'" + path + "': fields 'regions_x'/'regions_y' = " + std::to_string(m.regionsX) + "/" +
+                             std::to_string(m.regionsY) + " do not match region_size_m = " +
+                             shortNumber(m.regionSizeM) + " over size_m = " + shortNumber(m.params.size_m) +
+                             " (expected " + std::to_string(grid.countX()) + "/" + std::to_string(grid.countY()) + ")");
+    std::map<std::string, int> files;
+    for (size_t i = 0; i < m.regions.size(); ++i) {
+        const PagedRegionEntry& r = m.regions[i];
+        const std::string where = "'" + path + "': regions[" + std::to_string(i) + "]: ";
+        if (size_t(r.region) != i) {
+            const bool repeated = size_t(r.region) < i;
+            return Status::error(
+                where + "field 'region' = " + std::to_string(r.region) +
+                (repeated ? " repeats regions[" + std::to_string(r.region) + "]'s" : " is out of order") +
+                " (each region of the grid is listed once, in order: entry i is region i, 0 .. " +
+                std::to_string(m.regions.size() - 1) + ")");
+        }
+        if (r.ix != r.region % m.regionsX || r.iy != r.region / m.regionsX)
+            return Status::error(where + "fields 'ix'/'iy' = " + std::to_string(r.ix) + "/" + std::to_string(r.iy) +
+                                 " do not match region " + std::to_string(r.region) + " (expected " +
+                                 std::to_string(r.region % m.regionsX) + "/" + std::to_string(r.region / m.regionsX) +
+                                 ": region = iy x regions_x + ix)");
+        if (r.empty) continue;
+        for (const std::string& name : {r.file, r.coarseFile}) {
+            auto [it, added] = files.emplace(name, int(i));
+            if (!added)
+                return Status::error(where + "file '" + echoText(name) + "' is also listed by regions[" +
+                                     std::to_string(it->second) + "] (each region has files of its own)");
+        }
+    }
+    if (m.nonEmpty() == 0)
+        return Status::error("'" + path + "': every region is 'empty': the manifest lists no region to load");
+    return Status::ok();
+}
+
+}  // namespace
+
 Result<PagedManifest> readPagedManifest(const std::string& dir) {
     const std::string path = (fs::path(dir) / kPagedManifestFile).string();
     if (::access(path.c_str(), F_OK) != 0)
@@ -60,27 +143,43 @@ Result<PagedManifest> readPagedManifest(const std::string& dir) {
     try {
         if (!j.contains("format") || j.at("format") != "vista.paged_city")
             return bad("field 'format' is not \"vista.paged_city\"");
-        if (j.at("version").get<int>() != 1)
-            return bad("field 'version' = " + j.at("version").dump() + " is not supported (expected 1)");
+        if (j.at("version") != kPagedCityVersion)
+            return bad("field 'version' = " + j.at("version").dump() + " is not supported (expected " +
+                       std::to_string(kPagedCityVersion) + "; generate the city again with this vista)");
         auto params = parseParamsJson(j.at("params").dump(), path + " (params)");
         if (!params) return params.status();
         m.params = *params;
-        m.regionSizeM = j.at("region_size_m").get<double>();
-        m.regionsX = j.at("regions_x").get<int>();
-        m.regionsY = j.at("regions_y").get<int>();
-        if (m.regionsX < 1 || m.regionsY < 1 || m.regionsX > 4096 || m.regionsY > 4096)
-            return bad("fields 'regions_x'/'regions_y' = " + std::to_string(m.regionsX) + "/" +
-                       std::to_string(m.regionsY) + " out of range (1 .. 4096)");
+        const Json& gen = j.at("generation");
+        if (!gen.is_object() || !gen.contains("seed") || !gen.contains("key") || !gen.at("key").is_string() ||
+            !gen.at("seed").is_number_unsigned())
+            return bad("field 'generation' is not {\"seed\": N, \"key\": \"16 hex digits\"}");
+        m.generation = gen.at("key").get<std::string>();
+        if (m.generation.size() != 16 || m.generation.find_first_not_of("0123456789abcdef") != std::string::npos)
+            return bad("field 'generation.key' = \"" + m.generation + "\" is not 16 hex digits");
+        if (gen.at("seed").get<uint64_t>() != m.params.seed)
+            return bad("field 'generation.seed' = " + gen.at("seed").dump() + " is not the params' seed " +
+                       std::to_string(m.params.seed));
+        VISTA_RETURN_IF_ERROR(manifestField(j, "region_size_m", "'" + path + "': "));
+        if (!j["region_size_m"].is_number())
+            return bad("field 'region_size_m' = " + echoText(j["region_size_m"].dump()) + " is not a number");
+        m.regionSizeM = j["region_size_m"].get<double>();
+        if (Status s = validateRegionSize(m.params, m.regionSizeM); !s) return bad(s.message());
+        VISTA_RETURN_IF_ERROR(
+            manifestInt(j, "regions_x", 1, kMaxManifestRegionsPerSide, "'" + path + "': ", m.regionsX));
+        VISTA_RETURN_IF_ERROR(
+            manifestInt(j, "regions_y", 1, kMaxManifestRegionsPerSide, "'" + path + "': ", m.regionsY));
         const Json& regions = j.at("regions");
         if (!regions.is_array() || regions.size() != size_t(m.regionsX) * size_t(m.regionsY))
             return bad("field 'regions' is not an array of regions_x * regions_y entries");
+        const int last = int(regions.size()) - 1;
         for (const Json& e : regions) {
             PagedRegionEntry r;
-            r.region = e.at("region").get<int>();
-            r.ix = e.at("ix").get<int>();
-            r.iy = e.at("iy").get<int>();
-            r.empty = e.at("empty").get<bool>();
-            r.triangles = e.at("triangles").get<uint64_t>();
+            const std::string at = "'" + path + "': regions[" + std::to_string(m.regions.size()) + "]: ";
+            VISTA_RETURN_IF_ERROR(manifestInt(e, "region", 0, last, at, r.region));
+            VISTA_RETURN_IF_ERROR(manifestInt(e, "ix", 0, m.regionsX - 1, at, r.ix));
+            VISTA_RETURN_IF_ERROR(manifestInt(e, "iy", 0, m.regionsY - 1, at, r.iy));
+            VISTA_RETURN_IF_ERROR(manifestBool(e, "empty", at, r.empty));
+            VISTA_RETURN_IF_ERROR(manifestUnsigned(e, "triangles", 0, kMaxManifestCount, at, r.triangles));
             const std::string where = "region " + std::to_string(r.region);
             if (!r.empty) {
                 const Json& b = e.at("bounds");
@@ -92,24 +191,40 @@ Result<PagedManifest> readPagedManifest(const std::string& dir) {
                 }
                 r.lo = glm::dvec3(v[0], v[1], v[2]);
                 r.hi = glm::dvec3(v[3], v[4], v[5]);
-                for (const Json& f : e.at("files")) {
-                    if (f.at("role") == "full") {
-                        r.file = f.at("name").get<std::string>();
-                        r.bytes = f.at("bytes").get<uint64_t>();
-                    } else if (f.at("role") == "coarse") {
-                        r.coarseFile = f.at("name").get<std::string>();
-                        r.coarseBytes = f.at("bytes").get<uint64_t>();
-                    }
+                if (!(r.lo.x <= r.hi.x && r.lo.y <= r.hi.y && r.lo.z <= r.hi.z))
+                    return bad(where + ": field 'bounds' = " + echoText(b.dump()) +
+                               " has a minimum above its maximum ([xmin, ymin, zmin, xmax, ymax, zmax])");
+                VISTA_RETURN_IF_ERROR(manifestField(e, "files", at));
+                if (!e["files"].is_array()) return bad(where + ": field 'files' is not a list");
+                for (size_t k = 0; k < e["files"].size(); ++k) {
+                    const Json& f = e["files"][k];
+                    const std::string fat = at + "files[" + std::to_string(k) + "]: ";
+                    VISTA_RETURN_IF_ERROR(manifestField(f, "role", fat));
+                    const bool full = f["role"] == "full", coarse = f["role"] == "coarse";
+                    if (!full && !coarse)
+                        return Status::error(fat + "field 'role' = " + echoText(f["role"].dump()) +
+                                             " is not \"full\" or \"coarse\"");
+                    if (!(full ? r.file : r.coarseFile).empty())
+                        return Status::error(fat + "a second file with role " + f["role"].dump());
+                    VISTA_RETURN_IF_ERROR(manifestField(f, "name", fat));
+                    if (!f["name"].is_string() || f["name"].get<std::string>().empty())
+                        return Status::error(fat + "field 'name' = " + echoText(f["name"].dump()) +
+                                             " is not a file name");
+                    (full ? r.file : r.coarseFile) = f["name"].get<std::string>();
+                    VISTA_RETURN_IF_ERROR(
+                        manifestUnsigned(f, "bytes", 1, kMaxRegionFileBytes, fat, full ? r.bytes : r.coarseBytes));
                 }
                 if (r.file.empty()) return bad(where + ": no file with role 'full'");
                 if (r.coarseFile.empty()) return bad(where + ": no file with role 'coarse'");
                 for (const std::string& name : {r.file, r.coarseFile})
-                    if (name.find('/') != std::string::npos || name.find('\\') != std::string::npos || name == "..")
+                    if (name.find('/') != std::string::npos || name.find('\\') != std::string::npos || name == ".." ||
+                        name == ".")
                         return bad(where + ": file name '" + name + "' is not a plain name inside the directory");
             }
             m.regions.push_back(std::move(r));
         }
     } catch (const std::exception& ex) { return bad(std::string("missing or mistyped field (") + ex.what() + ")"); }
+    VISTA_RETURN_IF_ERROR(checkManifestRegions(m, path));
     return m;
 }
 
@@ -143,7 +258,7 @@ std::vector<int> selectCoarseRegions(const PagedManifest& m, const std::vector<g
     return out;
 }
 
-Result<SceneModel> loadPagedRegion(const PagedManifest& m, int i, bool coarse) {
+Result<SceneModel> loadPagedRegion(const PagedManifest& m, int i, bool coarse, bool* foreign) {
     if (i < 0 || size_t(i) >= m.regions.size() || m.regions[size_t(i)].empty)
         return Status::error("paged city '" + m.dir + "': no non-empty region " + std::to_string(i));
     const PagedRegionEntry& r = m.regions[size_t(i)];
@@ -158,7 +273,23 @@ Result<SceneModel> loadPagedRegion(const PagedManifest& m, int i, bool coarse) {
     if (size != bytes)
         return Status::error("paged city '" + m.dir + "': region file '" + path + "' has " + std::to_string(size) +
                              " bytes, the manifest says " + std::to_string(bytes) + " (damaged or from another run)");
-    return loadCityFile(path);
+    auto model = loadCityFile(path);
+    if (!model) return model;
+    // The generation's identity: a file of another generation (two writers mixed in one
+    // directory) is refused, not drawn.
+    std::string key, seed;
+    const osg::Node* root = sceneRoot(*model);
+    if (!root || !root->getUserValue(kPagedGenerationKey, key)) key = "none";
+    if (!root || !root->getUserValue(kPagedSeedKey, seed)) seed = "none";
+    if (key != m.generation || seed != std::to_string(m.params.seed)) {
+        if (foreign) *foreign = true;
+        return Status::error("paged city '" + m.dir + "': region file '" + path + "' is of another generation (seed " +
+                             seed + ", key " + key + ") than its manifest '" +
+                             (fs::path(m.dir) / kPagedManifestFile).string() + "' (seed " +
+                             std::to_string(m.params.seed) + ", key " + m.generation +
+                             "): regions of different runs are mixed in the directory; generate the city again");
+    }
+    return model;
 }
 
 namespace {
@@ -200,14 +331,13 @@ Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>&
     osg::ref_ptr<osg::Group> root = new osg::Group;
     root->setName("vista.city");
     StreetUnion streets;
-    bool first = true;
+    bool first = true, foreign = false;
     std::vector<std::pair<int, bool>> order;  // (region, coarse): full regions first
     for (int i : regions) order.emplace_back(i, false);
     const size_t fullCount = order.size();
     for (size_t k = 0;; ++k) {
         if (k == fullCount) {
-            // Every full region has been tried (fallbacks of damaged ones queued
-            // after them): the far city follows, once at least one loaded.
+            // Every full region tried (damaged ones' fallbacks after them): then the far city, if one loaded.
             if (first) break;
             for (int i : coarse) order.emplace_back(i, true);
         }
@@ -215,7 +345,8 @@ Result<SceneModel> loadPagedCity(const PagedManifest& m, const std::vector<int>&
         const auto [i, isCoarse] = order[k];
         if (i < 0 || size_t(i) >= m.regions.size() || m.regions[size_t(i)].empty) continue;
         const std::string& name = isCoarse ? m.regions[size_t(i)].coarseFile : m.regions[size_t(i)].file;
-        auto rm = loadPagedRegion(m, i, isCoarse);
+        auto rm = loadPagedRegion(m, i, isCoarse, &foreign);
+        if (!rm && foreign) return rm.status();  // a region of another generation: the directory is refused
         if (!rm) {
             // A damaged or missing region file: reported by name, the rest of the city loads;
             // a full region falls back to its coarse level.

@@ -370,6 +370,7 @@ Result<Path> driveCar(const StreetGraph& g, const CityParams& params, const Path
 
 Result<Path> generatePath(const StreetGraph& g, const CityParams& params, const PathOptions& o) {
     VISTA_RETURN_IF_ERROR(validatePathOptions(o));
+    std::string lanesMissing = std::string("a ") + pathKindName(o.kind) + " path does not drive in lanes";
     if (g.edges.empty()) return Status::error("cannot make a path: the city has no streets (street graph has 0 edges)");
     for (const auto& e : g.edges)
         if (e.a >= g.nodes.size() || e.b >= g.nodes.size())
@@ -379,7 +380,9 @@ Result<Path> generatePath(const StreetGraph& g, const CityParams& params, const 
         // dead-end streets too short to turn in, one-way dead ends) still gets
         // a car path: along the street centre lines, as walk paths go, and
         // without lane positions (saveLanePositionsCsv then refuses).
-        if (auto car = driveCar(g, params, o)) return car;
+        auto car = driveCar(g, params, o);
+        if (car) return car;
+        lanesMissing = car.status().message();
     }
 
     Route route(g, o.seed, o.route);
@@ -394,6 +397,7 @@ Result<Path> generatePath(const StreetGraph& g, const CityParams& params, const 
     const glm::dvec2 origin(params.origin_x, params.origin_y);
 
     Path path;
+    path.lanesMissing = lanesMissing;
     path.samples.reserve(clock.samples);
     for (size_t j = 0; j < clock.steps(); ++j) {
         if (clock.kept(j)) {
@@ -463,9 +467,7 @@ Status savePathCsv(const Path& path, const std::string& file) {
 
 Status saveLanePositionsCsv(const Path& path, const std::string& file) {
     if (path.lanes.size() != path.samples.size() || path.lanes.empty())
-        return Status::error("lane positions for '" + file +
-                             "': the path has none (only car paths made from a city's "
-                             "streets carry them, not paths read from a CSV or walk and fly paths)");
+        return Status::error("lane positions: the path has none (" + path.lanesMissing + ")");
     std::string out = "t_s,road_id,lane_id,s_m,t_offset_m\n";
     char buf[160];
     for (size_t i = 0; i < path.samples.size(); ++i) {

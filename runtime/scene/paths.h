@@ -119,6 +119,10 @@ struct Path {
     // Car paths from generatePath: the OpenDRIVE position of each sample's eye
     // (lane_route.h); empty for other kinds and for paths read from a CSV.
     std::vector<LanePosition> lanes;
+    // Why `lanes` is empty, for messages: a walk or fly path, a car path whose
+    // lanes cannot be driven (the reason; it then follows the street centre
+    // lines), or a path read from a CSV.
+    std::string lanesMissing = "a path read from a CSV carries no lane positions";
     // Camera at sample i: eye/heading/pitch from the sample, the rest (fov,
     // size, zNear) from `base`.
     Camera camera(size_t i, const Camera& base) const;
@@ -154,7 +158,8 @@ PathMotion pathMotion(const Path& path, const std::vector<size_t>& frames);
 Result<Path> generatePath(const StreetGraph& streets, const CityParams& params, const PathOptions& options);
 
 Status savePathCsv(const Path& path, const std::string& file);
-// Errors: the path has no lane positions (not a generated car path); I/O.
+// Errors: the path has no lane positions (the message gives
+// Path::lanesMissing and names no file: `file` may be a staged name); I/O.
 Status saveLanePositionsCsv(const Path& path, const std::string& file);
 Result<Path> loadPathCsv(const std::string& file);
 

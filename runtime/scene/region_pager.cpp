@@ -344,7 +344,44 @@ void RegionPager::update(const glm::dvec3& eye, const glm::dvec3& velocity) {
     _ahead = _eye + glm::dvec2(velocity) * _o.prefetchS;
     _haveEye = true;
     computeDesired();
+    computeShortfall();
     schedule(&_pending);
+}
+
+void RegionPager::computeShortfall() {
+    _shortfall = RegionShortfall();
+    const double reach = std::max(_o.radius, _o.far);
+    int nearest = -1;
+    double best = 0;
+    for (size_t i = 0; i < _m.regions.size(); ++i) {
+        const PagedRegionEntry& r = _m.regions[i];
+        if (r.empty) continue;
+        const double d = pointRect(_eye, glm::dvec2(r.lo), glm::dvec2(r.hi));
+        if (d == 0) _shortfall.regions.push_back(int(i));
+        if (d <= reach && (nearest < 0 || d < best)) nearest = int(i), best = d;
+    }
+    if (_shortfall.regions.empty() && nearest >= 0) _shortfall.regions.push_back(nearest);
+    _shortfall.needCoarse = _shortfall.needFull = _reserve;
+    for (int i : _shortfall.regions) {
+        _shortfall.needCoarse += cost(i, true);
+        _shortfall.needFull += cost(i, false) + (_o.chunkRadius >= 0 ? cost(i, false, true) : 0);
+        // Left out by the budget: neither level wanted though neither file failed.
+        if (_o.budgetBytes > 0 && _desired[size_t(i)] == kNone && !_failedCoarse[size_t(i)]) _shortfall.starved = true;
+    }
+}
+
+int RegionPager::belowDetail() const {
+    if (!_haveEye) return 0;
+    const double farM = _o.far > _o.radius ? _o.far : -1.0;
+    int n = 0;
+    for (size_t i = 0; i < _m.regions.size(); ++i) {
+        const PagedRegionEntry& r = _m.regions[i];
+        if (r.empty) continue;
+        const double d = pointRect(_eye, glm::dvec2(r.lo), glm::dvec2(r.hi));
+        if (d <= _o.radius) n += _holdFull[i] ? 0 : 1;
+        else if (d <= farM) n += (_holdFull[i] || _holdCoarse[i]) ? 0 : 1;
+    }
+    return n;
 }
 
 void RegionPager::takeArrivals(std::deque<Done>& done, RegionPagerDelta* delta) {

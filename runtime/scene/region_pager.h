@@ -66,6 +66,16 @@
 // desired set, the same regions as a synchronous load of the same reach.
 // collect(true) waits so once without wait mode (a viewer's first frame).
 //
+// The regions at the camera: the non-empty regions whose bounds hold the eye
+// (2D), else the nearest non-empty one when it is within reach (radius or
+// far) of the eye. cameraShortfall(): after update(), whether the budget
+// left one of them out altogether (not even its coarse level fits: frames
+// there would draw nothing), with what they need (cost, as the budget counts
+// it, plus the loading reserve) at their coarse and at their full level.
+// belowDetail(): after collect(), the regions that the caller holds below
+// the detail their distance from the last eye asks for (full within radius,
+// at least coarse within far; a failed file counts).
+//
 // Contract (VISTA_CHECK): radius and far finite and >= 0, prefetchS finite
 // and >= 0, budgetBytes >= 0, cost weights finite and > 0 (loading >= 0), workers 1 .. 16,
 // eye and velocity finite.
@@ -170,6 +180,14 @@ struct RegionPagerStats {
     int residentChunks = 0;                    // chunk parts held by the caller now
 };
 
+// RegionPager::cameraShortfall(): the budget cannot hold the regions at the camera.
+struct RegionShortfall {
+    bool starved = false;
+    std::vector<int> regions;  // the regions at the camera (manifest indices)
+    uint64_t needCoarse = 0;   // their coarse levels' cost + the loading reserve
+    uint64_t needFull = 0;     // their full levels' (and chunk parts') cost + the loading reserve
+};
+
 class RegionPager {
 public:
     // `manifest` must outlive the pager.
@@ -188,6 +206,8 @@ public:
     void setBudget(uint64_t bytes);
     // True when no load is queued, being prepared or waiting to be collected.
     bool idle() const;
+    RegionShortfall cameraShortfall() const { return _shortfall; }
+    int belowDetail() const;
 
     // The desired set of the last update(): per manifest region 0 (none), 1
     // (coarse) or 2 (full).
@@ -244,8 +264,10 @@ private:
     std::vector<uint8_t> _failedFull, _failedCoarse;
     // Chunk parts (chunkRadius >= 0): wanted, near the eye itself, held, queued or loading.
     std::vector<uint8_t> _desiredChunks, _nearEyeChunks, _holdChunks, _flightChunks;
-    std::vector<double> _key;   // load order within an urgency (lower first)
-    RegionPagerDelta _pending;  // drops decided by update(), handed out by the next collect()
+    std::vector<double> _key;    // load order within an urgency (lower first)
+    RegionPagerDelta _pending;   // drops decided by update(), handed out by the next collect()
+    RegionShortfall _shortfall;  // of the last update()
+    void computeShortfall();
     RegionPagerStats _stats;
 
     // Shared with the workers (under _mutex).

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <set>
 
 #include "citygen/lanes.h"
@@ -278,4 +279,97 @@ TEST(Lanes, DirectionalLaneCounts) {
     EXPECT_DOUBLE_EQ(m.edges[0].speedKmh, 70.0);
     g.edges[0].maxspeedKmh = 0;
     EXPECT_DOUBLE_EQ(buildLaneModel(g, CityParams()).edges[0].speedKmh, classSpeedKmh(RoadClass::Arterial));
+}
+
+namespace {
+
+// Per junction arm, the incoming lanes (k = 1 innermost) that are the `from`
+// of a link road lane and the outgoing lanes that a link road lane with a
+// `from` (full width where it starts) leads into, from the link roads alone.
+struct Connections {
+    std::map<uint32_t, std::set<int>> in, out;  // by edge: |lane id|
+};
+Connections connections(const LaneModel& m) {
+    Connections c;
+    for (const LinkRoad& r : m.links) {
+        if (r.junction < 0) continue;
+        for (const LinkRoad::Lane& l : r.right) {
+            if (l.from && l.w0 > 0) c.in[r.in].insert(std::abs(l.from));
+            if (l.from && l.to && l.w0 > 0 && l.w1 > 0) c.out[r.out].insert(std::abs(l.to));
+        }
+    }
+    return c;
+}
+
+// Incoming and outgoing driving lanes of edge e at node v.
+int lanesToward(const LaneModel& m, const StreetGraph& g, uint32_t e, uint32_t v) {
+    return g.edges[e].b == v ? m.edges[e].right : m.edges[e].left;
+}
+int lanesAway(const LaneModel& m, const StreetGraph& g, uint32_t e, uint32_t v) {
+    return g.edges[e].b == v ? m.edges[e].left : m.edges[e].right;
+}
+
+}  // namespace
+
+// Every full-width lane at a junction has a connection in and out: a T whose
+// east arm leaves with three lanes (one lane back) gets from the west's one
+// straight lane and the south's right turn only lanes 1 and 3 of the plan;
+// lane 2 is fed by a one-lane turn of its own, and every incoming lane is
+// taken. Counted from the link roads, independently of the model's counters.
+TEST(Lanes, EveryJunctionLaneHasAConnectionInAndOut) {
+    StreetGraph g;
+    g.nodes = {{0, 0}, {-100, 0}, {100, 0}, {0, -100}, {0, 100}};
+    g.edges = {{1, 0, RoadClass::Local, 7.0f, 2}, {0, 2, RoadClass::Arterial, 14.0f, 4},
+               {3, 0, RoadClass::Local, 7.0f, 2}};
+    g.edges[1].lanesForward = 3;
+    g.edges[1].lanesBackward = 1;
+    for (int variant = 0; variant < 2; ++variant) {
+        if (variant == 1) {  // a fourth arm, one-way toward the junction with three lanes
+            g.edges.push_back({4, 0, RoadClass::Arterial, 10.5f, 3});
+            g.edges.back().lanesForward = 3;
+            g.edges.back().lanesBackward = 0;
+        }
+        const LaneModel m = buildLaneModel(g, CityParams());
+        ASSERT_EQ(m.junctions.size(), 1u);
+        Connections c = connections(m);
+        size_t lanesIn = 0, lanesOut = 0;
+        for (uint32_t e : m.junctions[0].arms) {
+            for (int k = 1; k <= lanesToward(m, g, e, 0); ++k, ++lanesIn)
+                EXPECT_TRUE(c.in[e].count(k)) << "variant " << variant << ": edge " << e << " incoming lane " << k;
+            for (int k = 1; k <= lanesAway(m, g, e, 0); ++k, ++lanesOut)
+                EXPECT_TRUE(c.out[e].count(k)) << "variant " << variant << ": edge " << e << " outgoing lane " << k;
+        }
+        EXPECT_EQ(lanesOut, 5u);  // east 3, west 1, south 1 (the fourth arm only arrives)
+        EXPECT_EQ(m.unlinkedLanes, 0u);
+        EXPECT_EQ(m.unfedLanes, 0u);
+        // Every added turn is a proper link road: tangent at both ends, lanes clear of the centre of curvature.
+        for (const LinkRoad& r : m.links) {
+            if (r.arcLength <= 0) continue;
+            const double R = 1.0 / std::abs(r.curvature);
+            for (double s = 0; s <= r.length(); s += 0.25) {
+                if (r.curvature > 0) EXPECT_LT(r.leftBorder(s), R - kCurvatureMargin + 1e-9);
+                else EXPECT_GT(r.rightBorder(s), -R + kCurvatureMargin - 1e-9);
+            }
+        }
+    }
+}
+
+// A lane that no turn can take (the only other arm is a hairpin away) is
+// counted, not hidden.
+TEST(Lanes, LanesNoTurnCanConnectAreCounted) {
+    StreetGraph g;
+    // Node 0 with a two-way arm to the west and two one-way arms leaving it:
+    // one east, one back toward the west (5 degrees off the west arm). The
+    // west arm's lane toward the junction goes straight on east.
+    g.nodes = {{0, 0}, {-100, 0}, {100, 5}, {-100, 8}};
+    g.edges = {{1, 0, RoadClass::Local, 7.0f, 2}, {0, 2, RoadClass::Local, 3.5f, 1}, {0, 3, RoadClass::Local, 3.5f, 1}};
+    g.edges[1].lanesForward = 1, g.edges[1].lanesBackward = 0;
+    g.edges[2].lanesForward = 1, g.edges[2].lanesBackward = 0;
+    const LaneModel m = buildLaneModel(g, CityParams());
+    ASSERT_EQ(m.junctions.size(), 1u);
+    // Edge 2 leaves almost back along the west arm (a turn of about 175 degrees
+    // from the west arm's traffic): no turn can feed it; the west arm's
+    // outgoing lane can be fed from nothing either (the other arms only leave).
+    EXPECT_EQ(m.unfedLanes, 2u);
+    EXPECT_EQ(m.unlinkedLanes, 0u);
 }

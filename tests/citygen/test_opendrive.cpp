@@ -26,6 +26,7 @@
 #include "citygen/lanes.h"
 #include "citygen/opendrive.h"
 #include "citygen/streets.h"
+#include "foundation/units.h"
 #include "tests/common/run_vista.h"
 #include "tests/common/temp_dir.h"
 #include "tests/citygen/opendrive_fixtures.h"
@@ -376,4 +377,84 @@ TEST(OpenDrive, OsmLaneAndSpeedTagsReachTheFile) {
     EXPECT_GT(checked, 10u);
     EXPECT_GT(tagged, 5u);
     EXPECT_GT(oneWay, 3u);
+}
+
+// Signals a simulator reads, on a junction of four arterials whose arms leave
+// at 7, 33, 74 and 215 degrees: traffic lights are the generic OpenDRIVE code,
+// every validity runs from the lower lane id to the higher, each controller
+// holds one approach or two whose arms are opposite within kOppositeArms
+// (here 33 and 215 degrees; 7 and 74 each alone: three controllers), all
+// computed from the arm angles given here; crosswalk outlines lie within the
+// s-range of the road that carries them.
+TEST(OpenDrive, SignalsAreReadableBySimulators) {
+    const double armDeg[4] = {7, 33, 74, 215};
+    StreetGraph g;
+    g.nodes.push_back({0, 0});
+    for (double a : armDeg) {
+        g.nodes.push_back(120.0 * glm::dvec2(std::cos(a * kPi / 180), std::sin(a * kPi / 180)));
+        g.edges.push_back({0, uint32_t(g.nodes.size() - 1), RoadClass::Arterial, 7.0f, 2});
+    }
+    CityParams p;
+    p.sidewalk_m = 2.5;
+    auto xml = openDriveXml(g, p, nullptr);
+    ASSERT_TRUE(xml.isOk());
+    std::string err;
+    auto doc = parseXml(*xml, &err);
+    ASSERT_TRUE(doc) << err;
+    std::map<std::string, std::string> signalRoad;  // signal id -> road id
+    size_t lights = 0;
+    std::map<std::string, const Element*> roads;
+    for (const Element* r : doc->all("road")) {
+        roads[r->str("id")] = r;
+        const Element* sigs = r->first("signals");
+        if (!sigs) continue;
+        for (const Element* s : sigs->all("signal")) {
+            signalRoad[s->str("id")] = r->str("id");
+            ASSERT_EQ(s->str("dynamic"), "yes");
+            EXPECT_EQ(s->str("country"), "OpenDRIVE");
+            EXPECT_EQ(s->str("type"), "1000001");
+            const Element* v = s->first("validity");
+            ASSERT_TRUE(v);
+            EXPECT_LE(std::stoi(v->str("fromLane")), std::stoi(v->str("toLane")));
+            ++lights;
+        }
+    }
+    EXPECT_EQ(lights, 4u);
+    // Road id = edge index; arm e points at armDeg[e] from the junction.
+    auto opposite = [&](const std::string& a, const std::string& b) {
+        double d = std::fmod(std::abs(armDeg[std::stoi(a)] - armDeg[std::stoi(b)]), 360.0);
+        return std::abs(180.0 - d) <= 30.0;
+    };
+    const auto controllers = doc->all("controller");
+    EXPECT_EQ(controllers.size(), 3u);
+    std::set<std::string> controlled;
+    for (const Element* c : controllers) {
+        const auto controls = c->all("control");
+        ASSERT_GE(controls.size(), 1u);
+        for (size_t x = 0; x < controls.size(); ++x) {
+            EXPECT_TRUE(controlled.insert(controls[x]->str("signalId")).second);
+            for (size_t y = x + 1; y < controls.size(); ++y)
+                EXPECT_TRUE(opposite(signalRoad[controls[x]->str("signalId")], signalRoad[controls[y]->str("signalId")]))
+                    << "controller " << c->str("id");
+        }
+    }
+    EXPECT_EQ(controlled.size(), lights);
+    size_t crosswalks = 0;
+    for (const auto& [id, r] : roads) {
+        const Element* objs = r->first("objects");
+        if (!objs) continue;
+        const double length = r->num("length");
+        for (const Element* o : objs->all("object")) {
+            if (o->str("type") != "crosswalk") continue;
+            ++crosswalks;
+            EXPECT_NE(r->str("junction"), "-1") << "crosswalk " << o->str("id") << " lies in the junction";
+            EXPECT_EQ(o->num("hdg"), 0.0);
+            for (const Element* corner : o->first("outlines")->first("outline")->all("cornerLocal")) {
+                const double s = o->num("s") + corner->num("u");
+                EXPECT_GE(s, -1e-9) << "road " << id << " crosswalk " << o->str("id");
+                EXPECT_LE(s, length + 1e-9) << "road " << id << " crosswalk " << o->str("id");
+            }
+        }
+    }
+    EXPECT_EQ(crosswalks, 4u);
 }

@@ -1,5 +1,6 @@
 // OpenDRIVE files read by SUMO netconvert (a reader vista did not write): generated, hilly,
-// odd-lane and OSM cities convert without errors and keep their roads and lanes.
+// odd-lane and OSM cities convert without errors and without a lane "not connected" from
+// any incoming edge or to any outgoing one at a junction, and keep their roads and lanes.
 #include <gtest/gtest.h>
 
 #include <expat.h>
@@ -56,9 +57,19 @@ std::string findNetconvert() {
     return path;
 }
 
+bool allDigits(const std::string& s) {
+    if (s.empty()) return false;
+    for (char c : s)
+        if (c < '0' || c > '9') return false;
+    return true;
+}
+
 struct NetCheck {
     int exitCode = -1;
     int errors = 0;
+    // "Lane ... is not connected from any incoming edge" / "... to any outgoing edge" warnings, at
+    // junctions (netconvert node id = the OpenDRIVE junction id, digits only) and elsewhere.
+    int notConnectedAtJunctions = 0, notConnectedElsewhere = 0;
     std::string log;
     std::unique_ptr<Element> net;
 };
@@ -71,23 +82,24 @@ NetCheck runNetconvert(const std::string& netconvert, const std::string& xodr, c
     NetCheck r;
     const std::string net = dir + "/city.net.xml", log = dir + "/netconvert.log";
     const int st = std::system(
-        ("env -u LD_PRELOAD " + netconvert + " --opendrive-files " + xodr + " -o " + net + " >" + log + " 2>&1")
+        ("env -u LD_PRELOAD " + netconvert + " --aggregate-warnings -1 --opendrive-files " + xodr + " -o " + net +
+         " >" + log + " 2>&1")
             .c_str());
     r.exitCode = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
     r.log = readBytes(log);
     for (size_t pos = 0; (pos = r.log.find("Error", pos)) != std::string::npos; ++pos)
         if (pos == 0 || r.log[pos - 1] == '\n') ++r.errors;
+    for (const char* what : {"not connected from any incoming edge", "not connected to any outgoing"})
+        for (size_t pos = 0; (pos = r.log.find(what, pos)) != std::string::npos; ++pos) {
+            const size_t at = r.log.find("at junction '", pos), eol = r.log.find('\n', pos);
+            std::string node;
+            if (at != std::string::npos && at < eol) node = r.log.substr(at + 13, r.log.find('\'', at + 13) - at - 13);
+            ++(allDigits(node) ? r.notConnectedAtJunctions : r.notConnectedElsewhere);
+        }
     std::string err;
     r.net = parseXml(readBytes(net), &err);
     EXPECT_TRUE(r.net) << "net.xml does not parse: " << err;
     return r;
-}
-
-bool allDigits(const std::string& s) {
-    if (s.empty()) return false;
-    for (char c : s)
-        if (c < '0' || c > '9') return false;
-    return true;
 }
 
 // netconvert's net against the graph: one junction (id = the OpenDRIVE
@@ -111,9 +123,23 @@ void checkNet(const City& city, const std::string& label) {
     NetCheck r = runNetconvert(netconvert, dir.file("city.xodr"), dir.path());
     EXPECT_EQ(r.exitCode, 0) << label << "\n" << r.log;
     EXPECT_EQ(r.errors, 0) << label << "\n" << r.log;
+    // Every full-width driving lane at a junction has a connection in and out.
+    EXPECT_EQ(r.notConnectedAtJunctions, 0) << label << "\n" << r.log;
+    EXPECT_EQ(n.unlinkedLanes, 0u) << label;
+    EXPECT_EQ(n.unfedLanes, 0u) << label;
     ASSERT_TRUE(r.net);
 
     const LaneModel M = buildLaneModel(city.streets, city.params, &city.blocks);
+    // Outside junctions netconvert warns only of lanes that taper in inside a transition (width 0
+    // where their traffic enters, no predecessor, as ASAM's zero_width_at_start rule asks):
+    // it keeps their first, narrow metres as a lane for emergency vehicles that nothing feeds.
+    int tapersIn = 0;
+    for (const LinkRoad& t : M.links) {
+        if (t.junction >= 0) continue;
+        for (const LinkRoad::Lane& l : t.right) tapersIn += !l.sidewalk && l.w0 == 0 && l.to;
+        for (const LinkRoad::Lane& l : t.left) tapersIn += !l.sidewalk && l.w1 == 0 && l.from;
+    }
+    EXPECT_LE(r.notConnectedElsewhere, tapersIn) << label << "\n" << r.log;
     size_t graphJunctions = 0;
     for (int d : M.degree) graphJunctions += d >= 3;
     // Road ends without a link: dead ends, and both roads at a corner too
@@ -193,9 +219,10 @@ void checkNet(const City& city, const std::string& label) {
     std::printf(
         "[ %s ] roads %zu, transitions %zu, junctions %zu (netconvert %zu), connecting roads %zu, driving lanes %zu, "
         "traffic lights %zu at %zu junctions (netconvert programs %zu), signs %zu, crosswalks %zu, "
-        "netconvert errors %d\n",
+        "netconvert errors %d, lanes not connected %d at junctions, %d at transitions (%d lanes taper in)\n",
         label.c_str(), n.roads, n.transitions, n.junctions, netJunctions, n.connectingRoads, n.drivingLanes,
-        n.trafficLights, lit.size(), r.net->all("tlLogic").size(), n.signs, n.crosswalks, r.errors);
+        n.trafficLights, lit.size(), r.net->all("tlLogic").size(), n.signs, n.crosswalks, r.errors,
+        r.notConnectedAtJunctions, r.notConnectedElsewhere, tapersIn);
 }
 
 }  // namespace
@@ -215,3 +242,7 @@ TEST(OpenDrive, NetconvertReadsOsmImport) { checkNet(osmCity("hard_cases.osm"), 
 // The synthetic town (tests/data/osm/town.osm: a 7 x 7 street grid with
 // building footprints): many junctions, blocks with sidewalks on both sides.
 TEST(OpenDrive, NetconvertReadsOsmTown) { checkNet(osmCity("town.osm"), "osm town.osm"); }
+
+// The OSM lane-tag fixture (tests/data/osm/lanes.osm): lanes:forward/backward,
+// one-way and turn-lane tags give arms of unequal lane counts at junctions.
+TEST(OpenDrive, NetconvertReadsOsmLanes) { checkNet(osmCity("lanes.osm"), "osm lanes.osm"); }

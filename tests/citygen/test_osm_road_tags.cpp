@@ -49,9 +49,13 @@ OsmRoadTags read(const std::map<std::string, std::string>& tags, RoadClass cls =
 TEST(OsmRoadTags, LaneCountsOnewayAndTurnLanesParse) {
     EXPECT_EQ(parseOsmLaneCount("2"), 2);
     EXPECT_EQ(parseOsmLaneCount(" 3 "), 3);
-    EXPECT_EQ(parseOsmLaneCount("12"), 12);  // clamping is the resolution's job
-    for (const char* bad : {"", "0", "-1", "two", "2;3", "2.5", "+2", "2 lanes", "99999999"})
+    EXPECT_EQ(parseOsmLaneCount("12"), 12);
+    EXPECT_EQ(parseOsmLaneCount("16"), kMaxLanesTotal);
+    for (const char* bad : {"", "0", "-1", "two", "2;3", "2.5", "+2", "2 lanes", "99999999", "17"})
         EXPECT_FALSE(parseOsmLaneCount(bad).has_value()) << bad;
+    EXPECT_EQ(parseOsmDirectionLaneCount("8"), kMaxLanesPerDirection);
+    EXPECT_FALSE(parseOsmDirectionLaneCount("9").has_value());
+    EXPECT_FALSE(parseOsmDirectionLaneCount("0").has_value());
 
     EXPECT_EQ(parseOsmOneway("yes"), OsmOneway::Forward);
     EXPECT_EQ(parseOsmOneway("true"), OsmOneway::Forward);
@@ -99,11 +103,30 @@ TEST(OsmRoadTags, MaxspeedUnitsWordsAndCountryCodes) {
     EXPECT_TRUE(near(parseOsmMaxspeed("GB:zone20"), 20 * 1.609344));
     EXPECT_TRUE(near(parseOsmMaxspeed("GB:nsl_single"), 60 * 1.609344));
     EXPECT_TRUE(near(parseOsmMaxspeed("DE:living_street"), kMaxspeedWalkKmh));
-    // Clamped to [5, 250].
-    EXPECT_TRUE(near(parseOsmMaxspeed("2"), kMinMaxspeedKmh));
-    EXPECT_TRUE(near(parseOsmMaxspeed("1000"), kMaxMaxspeedKmh));
-    for (const char* bad : {"", "0", "signals", "variable", "fast", "50;30", "50 km", "-30", "XX:urban", "de:urban",
-                            "DE:school", "DE:trunk", "DE:zone", "1e3", "50..5"})
+    // Plausible limits are [5, 250] km/h, both included; beyond them the value is not used.
+    EXPECT_TRUE(near(parseOsmMaxspeed("5"), kMinMaxspeedKmh));
+    EXPECT_TRUE(near(parseOsmMaxspeed("250"), kMaxMaxspeedKmh));
+    for (const char* bad : {"",
+                            "0",
+                            "signals",
+                            "variable",
+                            "fast",
+                            "50;30",
+                            "50 km",
+                            "-30",
+                            "XX:urban",
+                            "de:urban",
+                            "DE:school",
+                            "DE:trunk",
+                            "DE:zone",
+                            "1e3",
+                            "50..5",
+                            "2",
+                            "1000",
+                            "200 mph",
+                            "DE:zone99999999999999999999",
+                            "DE:zone:4",
+                            "GB:zone200"})
         EXPECT_FALSE(parseOsmMaxspeed(bad).has_value()) << bad;
 }
 
@@ -120,10 +143,10 @@ TEST(OsmRoadTags, DirectionsAndLaneCountsResolve) {
     t = read({{"lanes", "4"}, {"lanes:forward", "3"}});
     EXPECT_EQ(t.lanesForward, 3);
     EXPECT_EQ(t.lanesBackward, 1);
-    t = read({{"lanes", "2"}, {"lanes:forward", "3"}});
+    t = read({{"lanes", "2"}, {"lanes:forward", "3"}});  // inconsistent: lanes:forward wins (below)
     EXPECT_EQ(t.lanesForward, 3);
     EXPECT_EQ(t.lanesBackward, 1);
-    EXPECT_EQ(t.lanes, 2);                                     // the tagged total stays the total
+    EXPECT_EQ(t.lanes, 4);
     t = read({{"lanes:backward", "2"}}, RoadClass::Arterial);  // forward: the derived split of the class total 4
     EXPECT_EQ(t.lanesForward, 2);
     EXPECT_EQ(t.lanesBackward, 2);
@@ -134,11 +157,11 @@ TEST(OsmRoadTags, DirectionsAndLaneCountsResolve) {
     EXPECT_EQ(t.lanesForward, 1);
     EXPECT_EQ(t.turnBackward, "left|through|through;right");
     EXPECT_EQ(t.turnForward, "");
-    // Clamps: 8 per direction, 16 in total.
+    // Beyond 8 per direction or 16 in total: not used (the class default), never clamped.
     t = read({{"lanes", "20"}, {"lanes:forward", "12"}, {"lanes:backward", "9"}});
-    EXPECT_EQ(t.lanes, 16);
-    EXPECT_EQ(t.lanesForward, 8);
-    EXPECT_EQ(t.lanesBackward, 8);
+    EXPECT_EQ(t.lanes, 0);
+    EXPECT_EQ(t.lanesForward, -1);
+    EXPECT_EQ(t.lanesBackward, -1);
     // One-way along the way, against it, implied; oneway=no overrides the implication.
     t = read({{"oneway", "yes"}, {"lanes", "3"}});
     EXPECT_EQ(t.lanesForward, 3);
@@ -164,7 +187,88 @@ TEST(OsmRoadTags, DirectionsAndLaneCountsResolve) {
     EXPECT_EQ(t.lanesForward, 2);
     EXPECT_EQ(t.lanesBackward, 0);
     t = read({{"oneway", "yes"}, {"lanes:forward", "11"}});
-    EXPECT_EQ(t.lanesForward, 8);
+    EXPECT_EQ(t.lanesForward, 1);  // ceil(2 / 2): the class default
+    EXPECT_EQ(t.lanes, 1);
+    t = read({{"oneway", "yes"}, {"lanes", "12"}}, RoadClass::Arterial);  // more than one direction holds
+    EXPECT_EQ(t.lanesForward, 2);
+    EXPECT_EQ(t.lanes, 2);
+}
+
+// The lanes written (forward + backward, as the lane model and the .xodr
+// take them) against the `lanes` tag: a way counts `lanes` as used only when
+// the two agree; otherwise the directional tags win and the way is counted
+// as inconsistent. Implausible values (maxspeed beyond 250 km/h, lane counts
+// beyond 8 a direction) fall back to the class default and are counted.
+TEST(OsmRoadTags, ImplausibleAndInconsistentTagsFallBackAndAreCounted) {
+    struct Case {
+        std::map<std::string, std::string> tags;
+        int forward, backward;  // resolved; -1 = derived by the lane model
+        bool lanesUsed, inconsistent;
+    };
+    const Case cases[] = {
+        {{{"lanes", "1"}, {"lanes:forward", "5"}}, 5, 1, false, true},
+        {{{"oneway", "yes"}, {"lanes", "1"}, {"lanes:forward", "5"}}, 5, 0, false, true},
+        {{{"oneway", "-1"}, {"lanes", "3"}, {"lanes:backward", "2"}}, 0, 2, false, true},
+        {{{"lanes", "4"}, {"lanes:forward", "1"}, {"lanes:backward", "1"}}, 1, 1, false, true},
+        {{{"lanes", "16"}, {"lanes:forward", "1"}}, 1, 1, false, true},  // would leave 15 backward
+        {{{"lanes", "3"}, {"lanes:forward", "2"}, {"lanes:backward", "1"}}, 2, 1, true, false},
+        {{{"lanes", "4"}, {"lanes:forward", "3"}}, 3, 1, true, false},
+        {{{"oneway", "yes"}, {"lanes", "2"}, {"lanes:forward", "2"}}, 2, 0, true, false},
+        {{{"lanes", "5"}}, -1, -1, true, false},
+    };
+    for (const Case& c : cases) {
+        std::string what;
+        for (const auto& [k, v] : c.tags) what += k + "=" + v + " ";
+        SCOPED_TRACE(what);
+        OsmRoadTagStats st;
+        const OsmRoadTags t = read(c.tags, RoadClass::Local, st);
+        EXPECT_EQ(t.lanesForward, c.forward);
+        EXPECT_EQ(t.lanesBackward, c.backward);
+        EXPECT_EQ(st.lanes.used, c.lanesUsed ? 1u : 0u);
+        EXPECT_EQ(st.lanes.fallback, c.lanesUsed ? 0u : 1u);
+        EXPECT_EQ(st.lanesInconsistent, c.inconsistent ? 1u : 0u);
+        // `lanes` agrees with the lanes written whenever the directions are known.
+        if (t.lanesForward >= 0) { EXPECT_EQ(t.lanes, t.lanesForward + t.lanesBackward); }
+        if (c.lanesUsed) { EXPECT_EQ(t.lanes, std::stoi(c.tags.at("lanes"))); }
+    }
+    // maxspeed=DE:zone99999999999999999999 is no limit of 250 km/h: the class default, counted.
+    OsmRoadTagStats st;
+    const OsmRoadTags t = read({{"maxspeed", "DE:zone99999999999999999999"}}, RoadClass::Arterial, st);
+    EXPECT_EQ(t.maxspeedKmh, 0.0f);
+    EXPECT_EQ(st.maxspeed.fallback, 1u);
+    EXPECT_EQ(st.maxspeed.used, 0u);
+    EXPECT_EQ(st.defaultMaxspeed, 1u);
+    // The counts reach --stats.
+    st.lanesInconsistent = 3;
+    EXPECT_EQ(nlohmann::json::parse(osmRoadTagStatsJson(st))["tags"]["lanes"]["inconsistent"], 3);
+}
+
+// An over-long tag value names the tag and the way (libosmium alone says "OSM tag value is too long").
+TEST(OsmRoadTags, AnOverLongTagValueNamesTheTagAndTheWay) {
+    test::TempDir dir("vista_osm_long_tag");
+    const std::string file = dir.file("long.osm");
+    std::ofstream(file) << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<osm version=\"0.6\">\n"
+                           "<node id=\"1\" lat=\"48.2\" lon=\"16.37\"/><node id=\"2\" lat=\"48.2\" lon=\"16.376\"/>\n"
+                           "<way id=\"4242\"><nd ref=\"1\"/><nd ref=\"2\"/><tag k=\"highway\" v=\"primary\"/>"
+                           "<tag k=\"name\" v=\""
+                        << std::string(1100, 'x') << "\"/></way>\n</osm>\n";
+    auto r = importOsm(file, CityParams());
+    ASSERT_FALSE(r.isOk());
+    const std::string& m = r.status().message();
+    EXPECT_NE(m.find("way 4242"), std::string::npos) << m;
+    EXPECT_NE(m.find("tag 'name'"), std::string::npos) << m;
+    EXPECT_NE(m.find("1100 bytes"), std::string::npos) << m;
+    EXPECT_NE(m.find("1024"), std::string::npos) << m;
+    // References count as the bytes they stand for: 1000 x "&amp;" is 1000 bytes, within the limit.
+    std::string amps;
+    for (int i = 0; i < 1000; ++i) amps += "&amp;";
+    std::ofstream(file) << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<osm version=\"0.6\">\n"
+                           "<node id=\"1\" lat=\"48.2\" lon=\"16.37\"/><node id=\"2\" lat=\"48.2\" lon=\"16.376\"/>\n"
+                           "<way id=\"7\"><nd ref=\"1\"/><nd ref=\"2\"/><tag k=\"highway\" v=\"primary\"/>"
+                           "<tag k=\"name\" v=\""
+                        << amps << "\"/></way>\n</osm>\n";
+    auto ok = importOsm(file, CityParams());
+    if (!ok) { EXPECT_EQ(ok.status().message().find("limit of 1024"), std::string::npos) << ok.status().message(); }
 }
 
 TEST(OsmRoadTags, UnusableValuesFallBackAndAreCounted) {
@@ -231,7 +335,7 @@ const WayExpect kLanesWays[] = {
     {"104", {-100, 0}, {-100, 150}, RoadClass::Local, 2, 2, 0, "left|through", "", 30 * kMph, float(24 * 0.3048)},
     {"107", {-100, 150}, {100, 150}, RoadClass::Local, 2, -1, -1, "", "", 0, 7.5f},
     {"motorway", {200, -150}, {-200, -150}, RoadClass::Highway, 3, 3, 0, "", "", kMaxspeedNoneKmh, 20.0f},
-    {"108", {0, -75}, {100, -75}, RoadClass::Arterial, 12, 8, 0, "", "", 60, 13.0f},
+    {"108", {0, -75}, {100, -75}, RoadClass::Arterial, 2, 2, 0, "", "", 60, 13.0f},
 };
 
 double pointLineDistance(const glm::dvec2& x, const glm::dvec2& p, const glm::dvec2& q) {
@@ -299,17 +403,18 @@ TEST(OsmRoadTags, StatsReportTagUseAndFallbacks) {
         EXPECT_EQ(t[tag]["used"], used) << tag;
         EXPECT_EQ(t[tag]["fallback"], fallback) << tag;
     };
-    use("lanes", 4, 1);                    // 100, 103, 105, 108; "two"
-    use("lanes:forward", 2, 0);            // 100, 102
-    use("lanes:backward", 2, 1);           // 100, 102; on the one-way 108
-    use("oneway", 3, 1);                   // 103, 104, 108; "maybe"
-    EXPECT_EQ(t["oneway"]["implied"], 1);  // the motorway
-    use("turn:lanes", 1, 0);               // 104
-    use("turn:lanes:forward", 2, 1);       // 100, 102; "left|up"
-    use("turn:lanes:backward", 1, 0);      // 102
-    use("maxspeed", 6, 1);                 // all but 107 ("signals")
-    use("width", 2, 1);                    // 100, 104; "wide"
-    EXPECT_EQ(o["class_default"]["lanes"], 1);
+    use("lanes", 3, 2);  // 100, 103, 105; "two", 108's 12 on a one-way
+    EXPECT_EQ(t["lanes"]["inconsistent"], 0);
+    use("lanes:forward", 2, 0);                 // 100, 102
+    use("lanes:backward", 2, 1);                // 100, 102; on the one-way 108
+    use("oneway", 3, 1);                        // 103, 104, 108; "maybe"
+    EXPECT_EQ(t["oneway"]["implied"], 1);       // the motorway
+    use("turn:lanes", 1, 0);                    // 104
+    use("turn:lanes:forward", 2, 1);            // 100, 102; "left|up"
+    use("turn:lanes:backward", 1, 0);           // 102
+    use("maxspeed", 6, 1);                      // all but 107 ("signals")
+    use("width", 2, 1);                         // 100, 104; "wide"
+    EXPECT_EQ(o["class_default"]["lanes"], 2);  // 107, 108
     EXPECT_EQ(o["class_default"]["maxspeed"], 1);
     EXPECT_EQ(o["class_default"]["width"], 5);
     EXPECT_EQ(o["edges"]["matched"], j["street_edges"]);

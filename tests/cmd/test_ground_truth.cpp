@@ -10,6 +10,8 @@
 // (ctest runs under xvfb-run).
 #include <gtest/gtest.h>
 
+#include <functional>
+
 #include <sys/wait.h>
 
 #include <chrono>
@@ -313,10 +315,13 @@ std::map<std::string, std::string> outputFiles(const std::string& dir) {
 // frames, then rerun with the same arguments: the result equals an
 // uninterrupted run byte for byte (all but summary.json's timings).
 // `removeAfterKill`: a file of the killed run's output (under DIR.partial/out) removed before
-// the resume; its frame is rendered again.
+// the resume; its frame is rendered again. `damage` (if set): called with DIR.partial/out
+// before the resume; it damages `damagedFrames` finished frames' files, which are rendered again.
 void expectResumeEqualsUninterrupted(const std::string& city, const std::string& args, const std::string& ref,
                                      const std::string& out, int killAfter, int frames,
-                                     const std::string& removeAfterKill = "") {
+                                     const std::string& removeAfterKill = "",
+                                     const std::function<void(const std::string&)>& damage = nullptr,
+                                     int damagedFrames = 0) {
     auto r = runVista("render " + city + " " + args + " -q --out " + ref);
     ASSERT_EQ(r.code, 0) << r.err;
     r = runVista("render " + city + " " + args + " -q --out " + out,
@@ -329,6 +334,7 @@ void expectResumeEqualsUninterrupted(const std::string& city, const std::string&
     if (!removeAfterKill.empty()) {
         EXPECT_TRUE(fs::remove(out + ".partial/out/" + removeAfterKill)) << removeAfterKill;
     }
+    if (damage) damage(out + ".partial/out");
     r = runVista("render " + city + " " + args + " -q --out " + out);
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_FALSE(fs::exists(out + ".partial")) << "the work directory is gone after the final rename";
@@ -341,7 +347,7 @@ void expectResumeEqualsUninterrupted(const std::string& city, const std::string&
     }
     const auto summary = nlohmann::json::parse(test::readBytes(out + "/summary.json"));
     EXPECT_EQ(summary["frames"].get<int>(), frames);
-    EXPECT_EQ(summary["frames_resumed"].get<int>(), killAfter - (removeAfterKill.empty() ? 0 : 1));
+    EXPECT_EQ(summary["frames_resumed"].get<int>(), killAfter - (removeAfterKill.empty() ? 0 : 1) - damagedFrames);
     if (summary.contains("median_ms")) {
         EXPECT_FALSE(summary["median_ms"]["labels_total"].is_null()) << "timings cover the resumed frames too";
     } else {  // a rig run: every sensor's timings
@@ -353,6 +359,23 @@ void expectResumeEqualsUninterrupted(const std::string& city, const std::string&
 TEST_F(GroundTruth, FullResumesAfterKillByteIdentical) {
     expectResumeEqualsUninterrupted(city, "--path " + pathCsv + " --frames 5 --size 160x120", dir->file("res_full_ref"),
                                     dir->file("res_full"), 2, 5);
+}
+
+// A resume checks each finished frame's files against its record's sizes and hashes: a truncated
+// PNG and a depth file with one byte changed (same size) are rendered again, not shipped.
+TEST_F(GroundTruth, AResumeRendersDamagedFramesAgain) {
+    auto damage = [](const std::string& partialOut) {
+        const std::string png = partialOut + "/rgb/000000.png";
+        ASSERT_TRUE(fs::exists(png));
+        fs::resize_file(png, fs::file_size(png) / 2);
+        const std::string npy = partialOut + "/depth/000001.npy";
+        std::string bytes = test::readBytes(npy);
+        ASSERT_GT(bytes.size(), 200u);
+        bytes[bytes.size() - 3] = char(bytes[bytes.size() - 3] ^ 0x5a);
+        std::ofstream(npy, std::ios::binary | std::ios::trunc) << bytes;
+    };
+    expectResumeEqualsUninterrupted(city, "--path " + pathCsv + " --frames 4 --size 160x120", dir->file("res_dmg_ref"),
+                                    dir->file("res_dmg"), 3, 4, "", damage, 2);
 }
 
 TEST_F(GroundTruth, HybridResumesAfterKillByteIdentical) {

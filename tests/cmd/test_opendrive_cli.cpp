@@ -1,5 +1,5 @@
 // OpenDRIVE through the tool: `vista gen --xodr` and `vista export` write the same bytes;
-// bad input is exit 2 without a file.
+// `vista gen --xodr --stats` counts the road network; bad input is exit 2 without a file.
 #include <gtest/gtest.h>
 
 #include <expat.h>
@@ -14,6 +14,8 @@
 #include <set>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "citygen/generate.h"
 #include "citygen/lanes.h"
@@ -59,4 +61,54 @@ TEST(OpenDrive, ExportBadInputIsExit2WithoutFile) {
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("--xodr"), std::string::npos) << r.err;
     EXPECT_TRUE(vista::test::listTree(dir.path()).empty());
+}
+
+// `vista gen --xodr --stats` counts the road network in the stats (object
+// "opendrive"): its roads, junctions and signals are those of the file
+// (counted here from the XML), no junction lane is left without a
+// connection in or out, and without --xodr the object is absent.
+TEST(OpenDrive, GenStatsCountTheRoadNetwork) {
+    TempDir dir("vista_xodr_stats");
+    const std::string city = dir.file("c.osgb"), x = dir.file("c.xodr"), st = dir.file("s.json");
+    auto r = runVista("gen --osm " + std::string(VISTA_TEST_DATA) + "/osm/lanes.osm --detail 0 -q -o " + city +
+                      " --xodr " + x + " --stats " + st);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(readBytes(st));
+    ASSERT_TRUE(j.contains("opendrive")) << j.dump();
+    const nlohmann::json& o = j["opendrive"];
+    std::string err;
+    auto doc = parseXml(readBytes(x), &err);
+    ASSERT_TRUE(doc) << err;
+    size_t roads = 0, connecting = 0, lights = 0, signs = 0, tapered = 0;
+    for (const Element* rd : doc->all("road")) {
+        if (rd->str("junction") != "-1") ++connecting;
+        else if (rd->str("name").rfind("transition", 0) != 0) ++roads;  // street roads, not transitions
+        if (rd->str("junction") != "-1" || rd->str("name").rfind("transition", 0) == 0) {
+            // Link-road driving lanes whose single width cubic is 0 at s = 0 or at s = length.
+            const double L = rd->num("length");
+            for (const Element* sec : rd->first("lanes")->all("laneSection"))
+                for (const char* side : {"left", "right"})
+                    if (const Element* lanes = sec->first(side))
+                        for (const Element* lane : lanes->all("lane")) {
+                            const Element* w = lane->first("width");
+                            if (lane->str("type") != "driving" || !w) continue;
+                            const double w0 = w->num("a"),
+                                         w1 = w0 + L * (w->num("b") + L * (w->num("c") + L * w->num("d")));
+                            tapered += std::abs(w0) < 1e-9 || std::abs(w1) < 1e-6;
+                        }
+        }
+        if (const Element* s = rd->first("signals"))
+            for (const Element* sg : s->all("signal")) ++(sg->str("dynamic") == "yes" ? lights : signs);
+    }
+    EXPECT_EQ(o["roads"].get<size_t>(), roads);
+    EXPECT_EQ(o["connecting_roads"].get<size_t>(), connecting);
+    EXPECT_EQ(o["junctions"].get<size_t>(), doc->all("junction").size());
+    EXPECT_EQ(o["traffic_lights"].get<size_t>(), lights);
+    EXPECT_EQ(o["signs"].get<size_t>(), signs);
+    EXPECT_EQ(o["unlinked_lanes"].get<size_t>(), 0u);
+    EXPECT_EQ(o["unfed_lanes"].get<size_t>(), 0u);
+    EXPECT_EQ(o["tapered_lanes"].get<size_t>(), tapered);
+    r = runVista("gen --size 300 --seed 4 --detail 0 -q -o " + dir.file("d.osgb") + " --stats " + dir.file("t.json"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_FALSE(nlohmann::json::parse(readBytes(dir.file("t.json"))).contains("opendrive"));
 }

@@ -1,7 +1,8 @@
 // libFuzzer target: the sensor-rig file of `vista render --rig` (JSON).
 // Contract under test: parseRigJson returns a rig or a Status, never crashes,
 // throws or recurses without bound; an accepted rig has at least one sensor,
-// every camera at least one channel and a valid image size, every LiDAR a
+// every camera at least one channel, a valid image size and focal lengths
+// within the field-of-view limit (minFocalLength), every LiDAR a
 // sweep within kMaxLidarRays, and it survives its own canonical JSON.
 #include <cstdlib>
 #include <string>
@@ -15,7 +16,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (r->cameras.empty() && r->lidars.empty()) std::abort();
     if (r->order.size() != r->cameras.size() + r->lidars.size()) std::abort();
     for (const auto& c : r->cameras)
-        if (c.channels == 0 || c.model.width < 1 || c.model.height < 1) std::abort();
+        if (c.channels == 0 || c.model.width < 1 || c.model.height < 1 ||
+            !(c.model.fx >= vista::minFocalLength(c.model, true)) ||
+            !(c.model.fy >= vista::minFocalLength(c.model, false)))
+            std::abort();
     for (const auto& l : r->lidars)
         if (l.spec.elevationDeg.empty() || l.spec.elevationDeg.size() * size_t(l.spec.columns) > vista::kMaxLidarRays)
             std::abort();

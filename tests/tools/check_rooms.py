@@ -20,6 +20,7 @@ ROOMS = [
     ("foundation", "foundation/"),
     ("citygen", "citygen/"),
     ("scene", "runtime/scene/"),
+    ("traffic", "runtime/traffic/"),  # SUMO runs, demand, floating-car data as plain arrays
     ("engine", "runtime/engine/"),
     ("gen", "bake/gen/"),         # generation-time passes of `vista gen`: lighting bake, paged city writer
     ("nodes", "nodes/"),          # node types, chunker, baked-file loading, plugin
@@ -30,7 +31,7 @@ ROOMS = [
 # Headers of the scene room that expose OSG types (only OSG-side rooms include them).
 OSG_SCENE_HEADERS = {"runtime/scene/scene_graph.h", "runtime/scene/scene_file.h", "runtime/scene/tree_impostor_graph.h"}
 # Rooms that must not see OSG or GL at all (their headers and sources).
-NO_OSG_ROOMS = {"foundation", "citygen", "engine"}
+NO_OSG_ROOMS = {"foundation", "citygen", "traffic", "engine"}
 # Rooms whose headers must not include OSG (their .cpp files may, privately).
 NO_OSG_IN_HEADERS = {"scene", "gen"}
 # The bake does not draw: it may use node types but not the render modes.

@@ -18,7 +18,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import xodr_check as xc  # noqa: E402
 
-CHECKS = ("gaps", "kinks", "folds", "unlinked", "references", "planview")
+CHECKS = ("gaps", "kinks", "folds", "unlinked", "references", "planview", "signals")
 
 
 # ---------------------------------------------------------------------------
@@ -103,24 +103,27 @@ def arc_network(shift3=0.0, dz3=0.0, succ1=-1, succ2=-1, hdg3=0.0):
 
 
 SIGNALS = ('<objects><object id="o1" s="45.0" t="-4.0" zOffset="0" type="pole" height="3"/></objects>'
-           '<signals><signal id="s1" s="49.0" t="-3.5" zOffset="2" dynamic="yes" orientation="+" country="DE" '
+           '<signals><signal id="s1" s="49.0" t="-3.5" zOffset="2" dynamic="yes" orientation="+" country="OpenDRIVE" '
            'type="1000001" subtype="-1"><validity fromLane="-1" toLane="-1"/></signal>'
            '<signal id="s2" s="40.0" t="-3.5" zOffset="2" dynamic="no" orientation="+" country="DE" '
            'type="205" subtype="-1"/></signals>')
 
 
-def t_junction(incoming_a="1", signals=SIGNALS):
+def t_junction(incoming_a="1", signals=SIGNALS, unfed=(), arm2="", arm3="", controls=""):
     """Arms 1 (west, ends at the junction), 2 (east) and 3 (south), both starting
     at it; six connecting roads (100..105) of one right lane each, 3 m lanes,
     turns of radius 10 m; arm 1 carries a traffic light (controlled by c1), a
-    sign and a pole."""
+    sign and a pole. unfed: connecting roads whose lane has neither a lane
+    predecessor nor a laneLink; arm2/arm3: extra XML (<signals>) of arms 2
+    and 3; controls: extra <control>s of c1."""
     w = 3.0
     arms = (
         road(1, 50.0, [geom(-60.0, 0.0, 0.0, 50.0)], [section([lane(1, w)], [lane(-1, w)])], succ=("junction", 9),
              extra=signals) +
-        road(2, 50.0, [geom(10.0, 0.0, 0.0, 50.0)], [section([lane(1, w)], [lane(-1, w)])], pred=("junction", 9)) +
+        road(2, 50.0, [geom(10.0, 0.0, 0.0, 50.0)], [section([lane(1, w)], [lane(-1, w)])], pred=("junction", 9),
+             extra=arm2) +
         road(3, 50.0, [geom(0.0, -10.0, -0.5 * math.pi, 50.0)], [section([lane(1, w)], [lane(-1, w)])],
-             pred=("junction", 9)))
+             pred=("junction", 9), extra=arm3))
     quarter = 0.5 * math.pi * 10.0
     # (id, from road, its end, from lane, x, y, hdg, length, curvature, to road, its contact, to lane)
     conns = [
@@ -131,15 +134,17 @@ def t_junction(incoming_a="1", signals=SIGNALS):
         (104, 2, "start", 1, 10.0, 0.0, math.pi, quarter, 0.1, 3, "start", -1),
         (105, 3, "start", 1, 0.0, -10.0, 0.5 * math.pi, quarter, -0.1, 2, "start", -1),
     ]
-    body, junction = "", '<controller id="c1"><control signalId="s1"/></controller>\n<junction id="9" name="T">'
+    body = ""
+    junction = f'<controller id="c1"><control signalId="s1"/>{controls}</controller>\n<junction id="9" name="T">'
     for i, (rid, fr, fe, fl, x, y, h, length, k, to, te, tl) in enumerate(conns):
         kind = "<line/>" if k == 0 else f'<arc curvature="{k!r}"/>'
         body += road(rid, length, [geom(x, y, h, length, kind)],
-                     [section(right=[lane(-1, w, pred=fl, succ=tl)])],
+                     [section(right=[lane(-1, w, pred=None if rid in unfed else fl, succ=tl)])],
                      pred=("road", fr, fe), succ=("road", to, te), junction="9")
         inc = incoming_a if rid == 100 else str(fr)
+        link = "" if rid in unfed else f'<laneLink from="{fl}" to="-1"/>'
         junction += (f'<connection id="{i}" incomingRoad="{inc}" connectingRoad="{rid}" contactPoint="start">'
-                     f'<laneLink from="{fl}" to="-1"/></connection>')
+                     f'{link}</connection>')
     return doc(arms + body + junction + '<controller id="c1"/></junction>\n')
 
 
@@ -373,6 +378,15 @@ class BrokenFilesTest(unittest.TestCase):
         self.assertEqual(failing(c), ["unlinked"])
         self.assertIn("road 3 lane 1", c["unlinked"].offenders[0])
 
+    def test_junction_exit_lane_that_no_connecting_lane_feeds(self):
+        # arm 3's lane -1 leaves the junction, fed by connecting roads 102 and 104: cut both from their incoming lanes
+        c = check(t_junction(unfed=(102, 104)))
+        self.assertEqual(failing(c), ["unlinked"])
+        self.assertEqual(c["unlinked"].by_kind, {"junction exit": 1})
+        self.assertIn("road 3 lane -1 at its start", c["unlinked"].offenders[0])
+        # one of the two still fed: the lane is reached
+        self.assertEqual(failing(check(t_junction(unfed=(102,)))), [])
+
     def test_tapering_lane_and_dead_end_need_no_successor(self):
         # lane -2 narrows from 3 m to 0 at the end; the road's start has no link
         taper = [(0.0, 3.0, -0.15, 0.0, 0.0)]
@@ -440,10 +454,50 @@ class BrokenFilesTest(unittest.TestCase):
 
 
     def test_signal_off_its_road_and_validity_of_a_missing_lane(self):
-        for bad, words in (('s="49.0"', 's="51.0"'), ('toLane="-1"', 'toLane="-4"')):
+        for bad, words in (('s="49.0"', 's="51.0"'), ('fromLane="-1"', 'fromLane="-4"')):
             c = check(t_junction().replace(*((bad, words))))
             self.assertEqual(failing(c), ["references"], words)
             self.assertIn("s1", c["references"].offenders[0])
+
+    def test_signal_code_unknown_to_readers(self):
+        # the generic traffic light exists under the OpenDRIVE country only
+        c = check(t_junction().replace('country="OpenDRIVE"', 'country="DE"'))
+        self.assertEqual(failing(c), ["signals"])
+        self.assertEqual(c["signals"].by_kind, {"code": 1})
+        self.assertIn("s1", c["signals"].offenders[0])
+
+    def test_validity_from_lane_above_to_lane(self):
+        c = check(t_junction().replace('<validity fromLane="-1" toLane="-1"/>', '<validity fromLane="1" toLane="-1"/>'))
+        self.assertEqual(failing(c), ["signals"])
+        self.assertEqual(c["signals"].by_kind, {"validity": 1})
+
+    def test_controller_of_crossing_approaches(self):
+        def light(sid, s):  # a light on an arm starting at the junction, facing the traffic toward it (-s)
+            return (f'<signals><signal id="{sid}" s="{s}" t="3.5" zOffset="2" dynamic="yes" orientation="-" '
+                    f'country="OpenDRIVE" type="1000001" subtype="-1"><validity fromLane="1" toLane="1"/></signal>'
+                    f'</signals>')
+        # arm 2 (east) is opposite arm 1 (west): one phase
+        c = check(t_junction(arm2=light("s3", 1.0), controls='<control signalId="s3"/>'))
+        self.assertEqual(failing(c), [])
+        self.assertLess(c["signals"].worst, 1e-6)
+        # arm 3 (south) crosses arm 1's traffic at 90 degrees: not one phase
+        c = check(t_junction(arm3=light("s3", 1.0), controls='<control signalId="s3"/>'))
+        self.assertEqual(failing(c), ["signals"])
+        self.assertEqual(c["signals"].by_kind, {"controller": 1})
+        self.assertAlmostEqual(c["signals"].worst, 90.0, places=6)
+
+    def test_crosswalk_beyond_its_road_end(self):
+        def crosswalk(u0, u1):  # at road 1's end (s = 50), 6 m wide
+            corners = "".join(f'<cornerLocal u="{u}" v="{v}" z="0" height="0"/>'
+                              for u, v in ((u0, -3.0), (u1, -3.0), (u1, 3.0), (u0, 3.0)))
+            return (f'<objects><object id="o1" type="crosswalk" s="50.0" t="0" zOffset="0" hdg="0">'
+                    f'<outlines><outline id="0" closed="true">{corners}</outline></outlines></object></objects>'
+                    + SIGNALS.split("</objects>", 1)[1])
+        self.assertEqual(failing(check(t_junction(signals=crosswalk(-3.0, -0.3)))), [])
+        c = check(t_junction(signals=crosswalk(0.3, 3.0)))
+        self.assertEqual(failing(c), ["signals"])
+        self.assertEqual(c["signals"].by_kind, {"crosswalk": 1})
+        self.assertIn("3.000 m beyond", c["signals"].offenders[0])
 
     def test_connecting_road_not_linked_to_its_incoming_road(self):
         text = t_junction().replace('<predecessor elementType="road" elementId="2" contactPoint="start"/>'

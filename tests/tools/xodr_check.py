@@ -18,7 +18,20 @@ specification, and checks the continuity of the network:
   unlinked    every driving lane has a successor where its traffic leaves the
               road at a linked end (right-hand traffic: right lanes toward +s,
               left lanes toward -s; rule="LHT" swaps), unless its width there
-              is below --taper-width;
+              is below --taper-width; at a junction, every driving lane whose
+              traffic enters the junction is the `from` of a laneLink, and
+              every driving lane whose traffic leaves it is the successor of
+              a connecting road's driving lane that is itself reached from
+              an incoming road's lane (a laneLink or a lane predecessor) and
+              is at least --taper-width wide at both ends;
+  signals     every <validity> has fromLane <= toLane; every signal's
+              (country, type) is one that simulators' catalogues know
+              (KNOWN_SIGNALS); the signals of one controller face traffic
+              of one approach (one road, one direction) or of opposite
+              approaches (travel directions within --max-group-deg of
+              opposite); every crosswalk's
+              outline lies within its road's s-range (corners projected on
+              the reference line, --max-gap tolerance);
   references  every referenced road, junction, lane, controller, signal and
               object exists, ids are unique, road links are symmetric and
               junction connections name roads of that junction;
@@ -47,6 +60,16 @@ TWO_PI = 2.0 * math.pi
 # Lane types that carry motor traffic in one direction (OpenDRIVE 1.6 e_laneType).
 DRIVING_TYPES = {"driving", "entry", "exit", "onRamp", "offRamp", "connectingRamp",
                  "mwyEntry", "mwyExit", "bus", "taxi", "HOV"}
+
+# (country, type) of signals that simulators' catalogues know: the generic
+# OpenDRIVE signals (traffic lights 1000001-1000020 as esmini's
+# opendrive_traffic_signals catalogue lists them) and the German signs that
+# esmini, CARLA and the ASAM examples read (205 yield, 206 stop, 274 speed
+# limit, 301 right of way at the next junction, 306 priority road, 350 zebra
+# crossing).
+KNOWN_SIGNALS = ({("OpenDRIVE", str(1000000 + k)) for k in (1, 2, 3, 4, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17,
+                                                              18, 19, 20)} |
+                 {("DE", t) for t in ("205", "206", "274", "301", "306", "350")})
 
 # Gauss-Legendre nodes and weights on [-1, 1] (5 points, exact to degree 9).
 _GL_X = (-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640)
@@ -557,6 +580,7 @@ def check_network(net, opt):
     unlinked = Check("unlinked", opt.taper_width, "m", n)
     refs = Check("references", None, "", n)
     planview = Check("planview", opt.max_length_error, "m", n)
+    signals = Check("signals", opt.max_group_deg, "deg", n)
     roads = net.roads
 
     for d in net.duplicates:
@@ -913,7 +937,163 @@ def check_network(net, opt):
                     unlinked.fail(f"road {r.id} laneSection {k if toward_plus else k + 1} lane {lane.id}: "
                                   f"no lane to continue into at s={s1.s:.2f}", "laneSection")
 
-    return {c.name: c for c in (gaps, kinks, folds, unlinked, refs, planview)}
+    # lanes leaving a junction: reached by a connecting road lane that traffic reaches
+    def forward(road, lane_id):
+        return (lane_id < 0) == (road.rule == "RHT")
+
+    def wide(road, end, lane_id):
+        sec = road.end_section(end)
+        b = road.borders(sec, road.end_s(end)).get(lane_id)
+        return b is not None and abs(b[1] - b[0]) >= opt.taper_width
+
+    linked_into = {}  # (connecting road id, its end, lane id) -> fed by a laneLink
+    for jid, jel in net.junctions.items():
+        for con in jel.findall("connection"):
+            cp = con.get("contactPoint")
+            for ll in con.findall("laneLink"):
+                try:
+                    linked_into[(con.get("connectingRoad"), cp, int(ll.get("to")))] = True
+                except (TypeError, ValueError):
+                    pass
+    reached = set()  # (road id, end, lane id) that a fed connecting lane reaches
+    for c in roads.values():
+        if c.junction == "-1":
+            continue
+        for lane in c.sections[0].lanes.values():
+            if lane.id == 0 or lane.type not in DRIVING_TYPES:
+                continue
+            entry, exit_ = ("start", "end") if forward(c, lane.id) else ("end", "start")
+            entry_sec, exit_sec = c.end_section(entry), c.end_section(exit_)
+            if lane.id not in entry_sec.lanes or lane.id not in exit_sec.lanes:
+                continue
+            in_lane, out_lane = entry_sec.lanes[lane.id], exit_sec.lanes[lane.id]
+            fed = bool(in_lane.pred if entry == "start" else in_lane.succ) or (c.id, entry, lane.id) in linked_into
+            if not (fed and wide(c, entry, lane.id) and wide(c, exit_, lane.id)):
+                continue
+            link = c.link_at(exit_)
+            if link is None or link["type"] != "road":
+                continue
+            for target in (out_lane.succ if exit_ == "end" else out_lane.pred):
+                reached.add((link["id"], link["cp"], target))
+    for r in roads.values():
+        if r.junction != "-1":
+            continue
+        for end in ("start", "end"):
+            link = r.link_at(end)
+            if link is None or link["type"] != "junction":
+                continue
+            sec = r.end_section(end)
+            for lane in sec.lanes.values():
+                if lane.id == 0 or lane.type not in DRIVING_TYPES:
+                    continue
+                if (end == "start") != forward(r, lane.id):
+                    continue  # traffic arrives at the junction here (checked above)
+                if not wide(r, end, lane.id):
+                    continue
+                unlinked.checked += 1
+                if (r.id, end, lane.id) not in reached:
+                    unlinked.fail(f"road {r.id} lane {lane.id} at its {end}: no connecting road lane of junction "
+                                  f"{link['id']} leads into it", "junction exit")
+
+    check_signals(net, opt, signals)
+    return {c.name: c for c in (gaps, kinks, folds, unlinked, refs, planview, signals)}
+
+
+def point_beyond_road(road, x, y, tol):
+    """How far (x, y) lies before the start or beyond the end of the road's
+    reference line, along the line's heading there (0 when it projects onto
+    the line); the nearest reference-line sample decides which end."""
+    n = max(8, int(math.ceil(road.length / 0.25)))
+    best, best_s = None, 0.0
+    for i in range(n + 1):
+        s = road.length * i / n
+        rx, ry, _, _ = road.ref(s)
+        d = math.hypot(x - rx, y - ry)
+        if best is None or d < best:
+            best, best_s = d, s
+    if 0.0 < best_s < road.length:
+        return 0.0
+    rx, ry, h, _ = road.ref(best_s)
+    along = (x - rx) * math.cos(h) + (y - ry) * math.sin(h)
+    beyond = along if best_s >= road.length else -along
+    return max(0.0, beyond)
+
+
+def check_signals(net, opt, check):
+    roads = net.roads
+    info = {}  # signal id -> (road, travel heading of the traffic it faces)
+    for r in roads.values():
+        for sg in children(r.signals, "signal"):
+            sid = sg.get("id")
+            check.checked += 1
+            where = f"road {r.id} signal {sid}"
+            key = (sg.get("country"), sg.get("type"))
+            if key not in KNOWN_SIGNALS:
+                check.fail(f"{where}: country=\"{key[0]}\" type=\"{key[1]}\" is not a code readers know", "code")
+            for v in children(sg, "validity"):
+                try:
+                    a, b = int(v.get("fromLane")), int(v.get("toLane"))
+                except (TypeError, ValueError):
+                    check.fail(f"{where}: validity fromLane=\"{v.get('fromLane')}\" toLane=\"{v.get('toLane')}\" "
+                               f"are not lane ids", "validity")
+                    continue
+                if a > b:
+                    check.fail(f"{where}: validity fromLane={a} > toLane={b}", "validity")
+            try:
+                s = float(sg.get("s"))
+            except (TypeError, ValueError):
+                continue
+            h = r.ref(min(max(s, 0.0), r.length))[2]
+            if sg.get("orientation") == "-":
+                h += math.pi
+            info[sid] = (r.id, h)
+    tol = opt.max_group_deg
+    for cid, cel in net.controllers.items():
+        ids = [c.get("signalId") for c in cel.findall("control") if c.get("signalId") in info]
+        for i in range(len(ids)):
+            for k in range(i + 1, len(ids)):
+                (ra, ha), (rb, hb) = info[ids[i]], info[ids[k]]
+                d = abs(math.degrees(wrap_angle(ha - hb)))
+                if ra == rb and d <= tol:
+                    continue  # one approach
+                off = 180.0 - d  # from opposite travel directions
+                check.value(off, f"controller {cid} signals {ids[i]}, {ids[k]}")
+                check.checked += 1
+                if off > tol:
+                    check.fail(f"controller {cid}: signals {ids[i]} (road {ra}) and {ids[k]} (road {rb}) face "
+                               f"traffic {d:.1f} deg apart, not opposite approaches", "controller")
+    for r in roads.values():
+        for ob in children(r.objects, "object"):
+            if ob.get("type") != "crosswalk":
+                continue
+            check.checked += 1
+            try:
+                s, t = float(ob.get("s")), float(ob.get("t", "0"))
+                hdg = float(ob.get("hdg", "0"))
+            except (TypeError, ValueError):
+                check.fail(f"road {r.id} crosswalk {ob.get('id')}: s/t/hdg are not numbers", "crosswalk")
+                continue
+            x0, y0, h0, _ = r.ref(min(max(s, 0.0), r.length))
+            ox, oy = x0 - t * math.sin(h0), y0 + t * math.cos(h0)
+            worst = 0.0
+            for outline in children(ob.find("outlines"), "outline") + children(ob, "outline"):
+                for c in outline:
+                    try:
+                        if c.tag == "cornerLocal":
+                            u, v = float(c.get("u")), float(c.get("v"))
+                            a = h0 + hdg
+                            x, y = ox + u * math.cos(a) - v * math.sin(a), oy + u * math.sin(a) + v * math.cos(a)
+                            worst = max(worst, point_beyond_road(r, x, y, opt.max_gap))
+                        elif c.tag == "cornerRoad":
+                            cs = float(c.get("s"))
+                            worst = max(worst, -cs, cs - r.length)
+                    except (TypeError, ValueError):
+                        continue
+            if not (-1e-9 <= s <= r.length + 1e-9):
+                worst = max(worst, -s, s - r.length)
+            if worst > opt.max_gap:
+                check.fail(f"road {r.id} crosswalk {ob.get('id')}: outline lies {worst:.3f} m beyond the road's "
+                           f"s-range", "crosswalk")
 
 
 def count(net):
@@ -1055,6 +1235,8 @@ def options(argv=None):
     ap.add_argument("--fold-step", type=positive("--fold-step"), default=0.25, help="fold sampling step, m (0.25)")
     ap.add_argument("--taper-width", type=positive("--taper-width"), default=0.01,
                     help="lanes narrower than this at an end need no successor, m (0.01)")
+    ap.add_argument("--max-group-deg", type=positive("--max-group-deg"), default=30.0,
+                    help="signals of one controller: travel directions within this of equal or opposite, deg (30)")
     ap.add_argument("--max-length-error", type=positive("--max-length-error"), default=0.001,
                     help="planView s / road length mismatch limit, m (0.001)")
     ap.add_argument("--max-list", type=int, default=20, help="offenders listed per check (20)")
@@ -1071,6 +1253,7 @@ def main(argv=None):
         return 2
     res["limits"] = {"max_gap_m": opt.max_gap, "max_dz_m": opt.max_dz, "max_kink_deg": opt.max_kink_deg,
                      "fold_step_m": opt.fold_step, "taper_width_m": opt.taper_width,
+                     "max_group_deg": opt.max_group_deg,
                      "max_length_error_m": opt.max_length_error}
     if opt.json:
         with open(opt.json, "w") as f:

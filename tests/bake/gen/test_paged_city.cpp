@@ -151,6 +151,36 @@ TEST_F(Paged, LayoutAndManifest) {
     EXPECT_GT(buildings, 0u);
 }
 
+// The generation's identity: the manifest's generation is the params' seed and the key of every
+// region's record, and each region file (full and coarse) carries both on its root.
+TEST_F(Paged, EveryRegionFileCarriesTheManifestsGeneration) {
+    const std::string dir = ref->file("city.paged");
+    const auto m = readJson(dir + "/manifest.json");
+    EXPECT_EQ(m["version"], vista::kPagedCityVersion);
+    ASSERT_TRUE(m.contains("generation")) << m.dump();
+    const std::string key = m["generation"]["key"].get<std::string>();
+    EXPECT_EQ(m["generation"]["seed"], m["params"]["seed"]);
+    EXPECT_EQ(key.size(), 16u);
+    int files = 0;
+    for (const auto& r : m["regions"]) {
+        if (r["empty"].get<bool>()) continue;
+        const std::string record = dir + "/records/region_" + std::to_string(r["ix"].get<int>()) + "_" +
+                                   std::to_string(r["iy"].get<int>()) + ".json";
+        EXPECT_EQ(readJson(record)["key"].get<std::string>(), key) << record;
+        for (const auto& f : r["files"]) {
+            auto root = vista::readSceneFile(dir + "/" + f["name"].get<std::string>());
+            ASSERT_TRUE(root.isOk()) << root.status().message();
+            std::string gen, seed;
+            EXPECT_TRUE((*root)->getUserValue(vista::kPagedGenerationKey, gen)) << f["name"];
+            EXPECT_TRUE((*root)->getUserValue(vista::kPagedSeedKey, seed)) << f["name"];
+            EXPECT_EQ(gen, key) << f["name"];
+            EXPECT_EQ(seed, std::to_string(m["params"]["seed"].get<uint64_t>())) << f["name"];
+            ++files;
+        }
+    }
+    EXPECT_GT(files, 0);
+}
+
 // Every building of the city lies in exactly one region (anchor: footprint
 // centroid) and is the one the unpaged generator places on that lot, so the
 // union of the regions' buildings is the unpaged city's building count.

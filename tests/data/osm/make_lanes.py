@@ -12,8 +12,8 @@ Layout (metres east / north of the centre; every crossing shares a node):
   x = -100  residential, oneway=yes, turn:lanes left|through (2 lanes), 30 mph, 24'  (y = 0 -> 150)
   y = 150   residential with invalid lanes, oneway, maxspeed, width and turn:lanes:forward
   y = -150  motorway (implied one-way), 3 lanes, maxspeed none  (drawn east -> west)
-  y = -75   tertiary, oneway=yes, lanes=12 (8 per direction at most), lanes:backward=1 (contradicts
-            the one-way), 60 km/h  (x = 0 -> 100)
+  y = -75   tertiary, oneway=yes, lanes=12 (beyond 8 lanes a direction: not used, the class
+            default), lanes:backward=1 (contradicts the one-way), 60 km/h  (x = 0 -> 100)
 Deterministic: python3 make_lanes.py > lanes.osm
 """
 import math

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <sstream>
 #include <string>
@@ -97,6 +98,59 @@ TEST(Rig, BadRigFilesNameTheFieldAndRange) {
     auto missing = loadRigFile("/nonexistent/rig.json");
     ASSERT_FALSE(missing.isOk());
     EXPECT_NE(missing.status().message().find("rig file"), std::string::npos);
+}
+
+// A focal length passes (0, 1e6] yet may still be meaningless: fx = 1e-300
+// sends every pixel's ray 90 degrees off the axis. The lower bound follows
+// from the field of view: a pinhole spans at most 179 degrees (89.5 either side
+// of the principal point), a fisheye's edge lies at most 180 degrees off the axis.
+TEST(Rig, FocalLengthsHaveAFieldOfViewLowerBound) {
+    auto pinhole = [](const std::string& fx, const std::string& fy, const std::string& cx) {
+        return rigOf(R"({"name": "c", "type": "pinhole", "channels": ["depth"], "intrinsics": {"width": 64,
+              "height": 48, "fx": )" +
+                     fx + ", \"fy\": " + fy + ", \"cx\": " + cx + R"(, "cy": 23.5}})");
+    };
+    // Independent: the farther image edge from cx (pixel centres at integers) over tan(89.5 degrees).
+    const double tan895 = std::tan(89.5 * kPi / 180.0);
+    const double minCentred = 32.0 / tan895, minOffCentre = (64 - 0.5) / tan895;  // cx = 31.5, cx = 0
+    for (const auto& [text, field] : {std::pair{pinhole("1e-300", "50", "31.5"), "fx = 1e-300"},
+                                      std::pair{pinhole("50", "1e-300", "31.5"), "fy = 1e-300"},
+                                      std::pair{pinhole("0.27", "50", "31.5"), "fx = 0.27"}}) {
+        auto r = parseRigJson(text, "rig.json");
+        ASSERT_FALSE(r.isOk()) << text;
+        const std::string& m = r.status().message();
+        EXPECT_NE(m.find(std::string("sensors[0].intrinsics.") + field + " is out of range"), std::string::npos) << m;
+        EXPECT_NE(m.find("179 degrees"), std::string::npos) << m;
+    }
+    char ok[32], low[32];
+    std::snprintf(ok, sizeof ok, "%.6f", minCentred * 1.0001);
+    std::snprintf(low, sizeof low, "%.6f", minCentred * 0.9999);
+    EXPECT_TRUE(parseRigJson(pinhole(ok, "50", "31.5"), "rig.json").isOk()) << ok;
+    EXPECT_FALSE(parseRigJson(pinhole(low, "50", "31.5"), "rig.json").isOk()) << low;
+    // The bound moves with the principal point: the farther edge decides.
+    std::snprintf(ok, sizeof ok, "%.6f", minOffCentre * 1.0001);
+    std::snprintf(low, sizeof low, "%.6f", minOffCentre * 0.9999);
+    EXPECT_TRUE(parseRigJson(pinhole(ok, "50", "0"), "rig.json").isOk()) << ok;
+    EXPECT_FALSE(parseRigJson(pinhole(low, "50", "0"), "rig.json").isOk()) << low;
+    // Fisheye: theta = extent / f <= pi.
+    auto fisheye = [](double f) {
+        char b[64];
+        std::snprintf(b, sizeof b, "%.6f", f);
+        return rigOf(R"({"name": "f", "type": "fisheye", "channels": ["rgb"], "intrinsics": {"width": 64,
+              "height": 48, "fx": )" +
+                     std::string(b) + R"(, "fy": 20, "cx": 31.5, "cy": 23.5, "max_fov_deg": 190}})");
+    };
+    EXPECT_TRUE(parseRigJson(fisheye(32.0 / kPi * 1.0001), "rig.json").isOk());
+    auto f = parseRigJson(fisheye(32.0 / kPi * 0.9999), "rig.json");
+    ASSERT_FALSE(f.isOk());
+    EXPECT_NE(f.status().message().find("360 degrees"), std::string::npos) << f.status().message();
+    // An accepted pinhole's corner ray stays in front of the camera.
+    auto edge = parseRigJson(pinhole("0.3", "0.3", "31.5"), "rig.json");
+    ASSERT_TRUE(edge.isOk()) << edge.status().message();
+    glm::dvec3 dir;
+    ASSERT_TRUE(edge->cameras[0].model.pixelRay(-0.5, -0.5, dir));
+    EXPECT_GT(dir.z, 0.0);
+    EXPECT_TRUE(std::isfinite(dir.x) && std::isfinite(dir.y));
 }
 
 TEST(Rig, MountRotationFollowsYawPitchRoll) {

@@ -355,12 +355,62 @@ TEST_F(Pager, ADamagedRegionFileFallsBackToItsCoarseLevel) {
     std::map<int, int> held;
     apply(d, held);
     EXPECT_EQ(held, (std::map<int, int>{{4, 1}}));
-    // Not tried again on the next frames.
+    EXPECT_EQ(pager.belowDetail(), 1) << "the eye's region is drawn at its coarse level, full detail asked";
     pager.update(centre(4) + glm::dvec3(1.0, 0.0, 0.0), glm::dvec3(0.0));
     auto again = pager.collect();
     EXPECT_TRUE(again.damaged.empty());
     EXPECT_TRUE(again.arrived.empty());
     EXPECT_EQ(pager.stats().failed, 1);
+}
+
+// The regions at the camera (those whose bounds hold the eye): a budget that cannot hold even
+// their coarse levels says so with what they need; one that holds exactly that does not; a waiting
+// pager without a budget holds nothing below the detail each region's distance asks for.
+TEST_F(Pager, ABudgetThatCannotHoldTheRegionsAtTheCameraSaysWhatTheyNeed) {
+    const glm::dvec3 eye = centre(4);
+    std::set<int> atEye;
+    uint64_t coarse = 0, full = 0;
+    for (size_t i = 0; i < manifest.regions.size(); ++i) {
+        const auto& r = manifest.regions[i];
+        if (eye.x >= r.lo.x && eye.x <= r.hi.x && eye.y >= r.lo.y && eye.y <= r.hi.y) {
+            atEye.insert(int(i));
+            coarse += r.coarseBytes;
+            full += r.bytes;
+        }
+    }
+    ASSERT_EQ(atEye.count(4), 1u);
+    RegionPagerOptions o;
+    o.radius = 0;
+    o.far = 0;
+    o.prefetchS = 0;
+    o.wait = true;
+    o.budgetBytes = coarse - 1;
+    {
+        RegionPager pager(manifest, o);
+        pager.update(eye, glm::dvec3(0.0));
+        const vista::RegionShortfall sf = pager.cameraShortfall();
+        EXPECT_TRUE(sf.starved);
+        EXPECT_EQ(std::set<int>(sf.regions.begin(), sf.regions.end()), atEye);
+        EXPECT_EQ(sf.needCoarse, coarse);
+        EXPECT_EQ(sf.needFull, full);
+    }
+    o.budgetBytes = coarse;
+    {
+        RegionPager pager(manifest, o);
+        pager.update(eye, glm::dvec3(0.0));
+        EXPECT_FALSE(pager.cameraShortfall().starved);
+        pager.collect();
+        EXPECT_EQ(pager.belowDetail(), int(atEye.size())) << "every region at the eye drawn coarse";
+    }
+    o.budgetBytes = 0;
+    o.far = 5000;
+    {
+        RegionPager pager(manifest, o);
+        pager.update(eye, glm::dvec3(0.0));
+        EXPECT_FALSE(pager.cameraShortfall().starved);
+        pager.collect();
+        EXPECT_EQ(pager.belowDetail(), 0);
+    }
 }
 
 // Chunk parts (RegionPagerOptions::chunkRadius): a full level loads without its chunks, and the

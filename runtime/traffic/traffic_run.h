@@ -1,0 +1,57 @@
+// The traffic step: a city's OpenDRIVE → netconvert → a SUMO network;
+// seeded demand (traffic_demand.h) → sumo headless → floating-car data and
+// traffic-light states, kept as files in a traffic directory
+// (docs/formats.md "Traffic directory").
+//
+// Contract:
+// - makeTraffic() builds the directory under "<dir>.partial" and renames it
+//   to `dir` when every file is written, so `dir` appears whole or not at
+//   all; `dir` must not exist (outputs never overwrite), the ".partial"
+//   folder of an interrupted run is removed and rebuilt. The files: city.xodr
+//   (the input), city.net.xml (netconvert's network, sidewalks and crossings
+//   guessed where the city has sidewalks), demand.rou.xml, traffic.sumocfg
+//   (sumo -c traffic.sumocfg in the folder runs it again), fcd.xml (SUMO's
+//   FCD: every agent at every step), signals.xml (SUMO's traffic-light
+//   states at every switch), traffic.json (the manifest: options, SUMO
+//   version, network offset, counts and SUMO's statistics).
+// - The same xodr and options give the same bytes: SUMO runs single-threaded
+//   with the seed, and the wall-clock dates SUMO writes into its headers are
+//   removed (sumo_process.h).
+// - SUMO missing or failing is an error naming the program and what it
+//   said; the ".partial" folder is removed then. Progress stages: network,
+//   demand, simulation.
+// - Not thread-safe with another run on the same `dir`.
+#pragma once
+#include <string>
+
+#include "foundation/progress.h"
+#include "foundation/status.h"
+#include "runtime/traffic/traffic_demand.h"
+
+namespace vista {
+
+struct TrafficOptions {
+    TrafficDemandOptions demand;
+    double stepS = 0.5;  // SUMO's step and the FCD's sample interval, seconds
+};
+
+struct TrafficRunSummary {
+    TrafficDemandCounts demand;
+    int vehiclesInserted = 0, personsInserted = 0;
+    int collisions = 0, teleports = 0, emergencyStops = 0;
+    double netOffsetX = 0.0, netOffsetY = 0.0;
+    std::string sumoVersion;
+};
+
+// Ranges of the options (checked by checkTrafficOptions, named in messages).
+constexpr int kMaxTrafficAgents = 100000;
+constexpr double kMaxTrafficDurationS = 24.0 * 3600.0;
+constexpr double kMinTrafficStepS = 0.05, kMaxTrafficStepS = 2.0;
+
+// Names the option (--vehicles, --pedestrians, --duration, --step) and its range.
+Status checkTrafficOptions(const TrafficOptions& opt);
+
+Status makeTraffic(const std::string& xodrText, const TrafficOptions& opt, const std::string& dir, Progress& progress,
+                   TrafficRunSummary* summary);
+
+}  // namespace vista
