@@ -44,7 +44,7 @@ struct BenchArgs {
     PagedReach paged;
     PagedStreamFlags stream;
     bool streamed = false;  // a paged city that streams (choosePagedStream)
-    CommandFiles files;  // checked by configure; holds the outputs' locks for the run
+    CommandFiles files;     // checked by configure; holds the outputs' locks for the run
 };
 
 void declareFlags(CLI::App& app, BenchArgs& a) {

@@ -94,7 +94,7 @@ struct ViewArgs {
     PagedStreamFlags stream;
     bool streamed = false;  // a paged city that streams (choosePagedStream)
     bool pace = false;      // --pace
-    CommandFiles files;  // checked by configure; holds the output's lock for the run
+    CommandFiles files;     // checked by configure; holds the output's lock for the run
 };
 
 void declareFlags(CLI::App& app, ViewArgs& a) {
