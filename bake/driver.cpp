@@ -29,6 +29,22 @@
 
 namespace vista {
 
+namespace {
+
+// The job's files; the shards of one bake share the work directory and the
+// outputs (their locks are shared), an unsharded run or the merge holds them alone.
+CommandFiles bakeFiles(const BakeJob& j) {
+    CommandFiles files;
+    files.input("city", j.input)
+        .output("--output", j.output)
+        .output("--stats", j.statsFile)
+        .outputDirectory("--work", j.workDir.empty() ? j.output + ".work" : j.workDir)
+        .shareOutputs(j.shardN > 1 && !j.merge);
+    return files;
+}
+
+}  // namespace
+
 Status validateBakeJob(const BakeJob& j) {
     const BakeParams& p = j.params;
     auto range = [](const char* opt, double v, const RealRange& r) -> Status {
@@ -69,12 +85,8 @@ Status validateBakeJob(const BakeJob& j) {
         return Status::error("--shard " + std::to_string(j.shardK) + "/" + std::to_string(j.shardN) +
                              ": expected K/N with 1 <= K <= N");
     if (j.merge && j.shardN > 1) return Status::error("--merge and --shard exclude each other");
-    VISTA_RETURN_IF_ERROR(CommandFiles()
-                              .input("city", j.input)
-                              .output("--output", j.output)
-                              .output("--stats", j.statsFile)
-                              .output("--work", j.workDir.empty() ? j.output + ".work" : j.workDir)
-                              .check());
+    CommandFiles files = bakeFiles(j);
+    VISTA_RETURN_IF_ERROR(files.check());
     VISTA_RETURN_IF_ERROR(checkWritablePath("--output", j.output));
     if (!j.statsFile.empty()) VISTA_RETURN_IF_ERROR(checkWritablePath("--stats", j.statsFile));
     VISTA_RETURN_IF_ERROR(checkWritableDirectory("--work", j.workDir.empty() ? j.output + ".work" : j.workDir));
@@ -333,6 +345,8 @@ Status writeStatsFile(const BakeJob& job, const std::string& path, const BakeRep
 Result<BakeReport> runBakeJob(const BakeJob& job, Progress* progress,
                               const std::function<void(const std::string&)>& log) {
     VISTA_RETURN_IF_ERROR(validateBakeJob(job));
+    CommandFiles files = bakeFiles(job);  // held until the outputs are written (the locks)
+    VISTA_RETURN_IF_ERROR(files.check());
     const Stopwatch wall;
     BakeReport rep;
     rep.workDir = job.workDir.empty() ? job.output + ".work" : job.workDir;

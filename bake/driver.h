@@ -26,7 +26,9 @@
 // assembly, failed writes (with the cause, e.g. a full disk).
 // progress: begin/update (fraction of this run's cells; ETA)/end, called from
 // the calling thread. log: one line before baking (cells, already done,
-// skipped edges). One run per work directory at a time.
+// skipped edges). One writer per output: runBakeJob holds the locks of the
+// output, stats and work directory (foundation/output_lock.h) for the whole
+// run, shared among the shards of one bake; another bake of them exits at once.
 #pragma once
 #include <cstdint>
 #include <functional>

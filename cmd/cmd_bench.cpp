@@ -44,6 +44,7 @@ struct BenchArgs {
     PagedReach paged;
     PagedStreamFlags stream;
     bool streamed = false;  // a paged city that streams (choosePagedStream)
+    CommandFiles files;     // checked by configure; holds the outputs' locks for the run
 };
 
 void declareFlags(CLI::App& app, BenchArgs& a) {
@@ -146,16 +147,16 @@ Status configure(BenchArgs& a) {
                              ": not with --sweep (the sweep benches city files, not paged cities)");
     if (a.cfg.pace && a.cfg.sampleRuns != 1)
         return Status::error("--pace: needs --sampling consecutive (a drive at the path's own speed)");
+    if (a.sweep.empty() && a.city.empty()) return Status::error("missing the city file argument (or use --sweep)");
+    VISTA_RETURN_IF_ERROR(
+        checkRunFiles(a.files.outputDirectory("--out", a.out).outputDirectory("--dump-rays", a.cfg.dumpRaysDir), a.city,
+                      a.path, a.mode));
     if (a.sweep.empty()) {
-        if (a.city.empty()) return Status::error("missing the city file argument (or use --sweep)");
-        if (!fs::exists(a.city)) return Status::error("city file '" + a.city + "' does not exist");
         const Status modes = checkStreamingModes(a.cfg.modes);
         auto streamed = choosePagedStream(kCmd, a.stream, a.city, modes ? std::string() : modes.message(), a.quiet);
         if (!streamed) return streamed.status();
         a.streamed = *streamed;
     }
-    VISTA_RETURN_IF_ERROR(checkRunFiles(CommandFiles().output("--out", a.out).output("--dump-rays", a.cfg.dumpRaysDir),
-                                        a.city, a.path, a.mode));
     VISTA_RETURN_IF_ERROR(checkWritableDirectory("--out", a.out));  // before any work, so a run never fails at its end
     if (!a.cfg.dumpRaysDir.empty()) {
         if (!a.sweep.empty()) return Status::error("--dump-rays is not supported with --sweep (one city per run)");

@@ -41,9 +41,9 @@ int runExport(int argc, char** argv) {
     app.add_flag("-q,--quiet", quiet, "no summary on stderr");
     if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;
     if (xodr.empty()) return reportBadInput(cmd, Status::error("nothing to export: give --xodr FILE.xodr"));
-    if (Status s = CommandFiles().input("city", input).output("--xodr", xodr).check(); !s)
-        return reportBadInput(cmd, s);
     if (Status s = checkXodrPath("--xodr", xodr); !s) return reportBadInput(cmd, s);
+    CommandFiles files;  // held until the output is written (its lock)
+    if (Status s = files.input("city", input).output("--xodr", xodr).check(); !s) return reportBadInput(cmd, s);
     auto model = loadCityFile(input);
     if (!model) return reportBadInput(cmd, model.status());
     if (model->streets.edges.empty())

@@ -448,10 +448,15 @@ int runGen(int argc, char** argv) {
     }
     if (outOpt->count() == 0)
         return reportBadInput(kCmd, Status::error("option -o/--output is required (the .osgb to write)"));
-    if (Status s = CommandFiles()
-                       .input("--params", a.paramsFile)
+    CommandFiles files;  // held until the outputs are written (the locks)
+    if (a.paged()) {
+        auto shard = parseShard("--shard", a.shard.empty() ? "1/1" : a.shard);
+        files.outputDirectory("-o", a.out).shareOutputs(shard && shard->count > 1 && !a.merge);  // shards side by side
+    } else {
+        files.output("-o", a.out);
+    }
+    if (Status s = files.input("--params", a.paramsFile)
                        .input("--osm", a.osmFile)
-                       .output("-o", a.out)
                        .output("--stats", a.statsFile)
                        .output("--geojson", a.geojsonFile)
                        .output("--gltf", a.gltfFile)

@@ -28,7 +28,8 @@ int runEgoPath(const std::string& city, const std::string& out, const std::strin
             return reportBadInput(cmd,
                                   Status::error(std::string(flag) + ": not with --traffic (the path rides a "
                                                                     "vehicle SUMO drove: a car at eye height 1.2 m)"));
-    if (Status s = CommandFiles().input("city", city).input("--traffic", traffic).output("-o", out).check(); !s)
+    CommandFiles files;  // held until the output is written (its lock)
+    if (Status s = files.input("city", city).input("--traffic", traffic).output("-o", out).check(); !s)
         return reportBadInput(cmd, s);
     if (Status s = checkWritablePath("--output", out); !s) return reportBadInput(cmd, s);
     auto tracks = loadTrafficTracks(traffic);
@@ -117,8 +118,8 @@ int runPath(int argc, char** argv) {
     o.maxYawRate = yawDeg * kPi / 180.0;
     o.flyPitch = pitchDeg * kPi / 180.0;
     if (Status s = validatePathOptions(o); !s) return reportBadInput("vista path", s);
-    if (Status s = CommandFiles().input("city", city).output("-o", out).output("--xodr-positions", positions).check();
-        !s)
+    CommandFiles files;  // held until the outputs are written (the locks)
+    if (Status s = files.input("city", city).output("-o", out).output("--xodr-positions", positions).check(); !s)
         return reportBadInput("vista path", s);
     if (Status s = checkWritablePath("--output", out); !s) return reportBadInput("vista path", s);
     if (!positions.empty() && o.kind != PathKind::Car)

@@ -172,6 +172,7 @@ struct RenderPlan {
     double estimateMb = 0;      // the memory estimate before the first frame
     double memoryBudgetGb = 0;  // --memory-budget (0 = none)
     RegionPagerOptions stream;  // streamed
+    CommandFiles files;         // checked by configure; holds the output's lock for the run
     bool labels() const { return (channels & kLabelChannels) != 0; }
 };
 
@@ -234,10 +235,9 @@ Status configure(const RenderArgs& a, RenderPlan& p) {
     auto po = parsePathFlags(a.path);
     if (!po) return po.status();
     p.path = *po;
-    if (!fs::exists(a.city)) return Status::error("city file '" + a.city + "' does not exist");
+    VISTA_RETURN_IF_ERROR(checkRunFiles(p.files.outputDirectory("--out", a.out, true), a.city, a.path, a.modeFlags));
     VISTA_RETURN_IF_ERROR(configurePaged(a, p));
     p.rays = findRenderMode(a.mode)->needsRays;
-    VISTA_RETURN_IF_ERROR(checkRunFiles(CommandFiles().output("--out", a.out), a.city, a.path, a.modeFlags));
     if (p.paged) return Status::ok();  // estimated on the selected regions' bytes (loadCityAndFrames)
     std::error_code ec;
     const uint64_t bytes = fs::file_size(a.city, ec);

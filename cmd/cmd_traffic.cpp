@@ -46,7 +46,8 @@ int runTraffic(int argc, char** argv) {
     app.add_flag("-q,--quiet", quiet, "no progress or summary on stderr");
     if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;
     if (Status s = checkTrafficOptions(opt); !s) return reportBadInput(cmd, s);
-    if (Status s = CommandFiles().input("city", city).output("-o", out).check(); !s) return reportBadInput(cmd, s);
+    CommandFiles files;  // held until the directory is written (its lock)
+    if (Status s = files.input("city", city).outputDirectory("-o", out).check(); !s) return reportBadInput(cmd, s);
     if (Status s = checkWritableDirectory("-o", out); !s) return reportBadInput(cmd, s);
     // SUMO is looked up before any work, so a missing install costs nothing.
     if (auto tools = findSumo(); !tools) return reportBadInput(cmd, tools.status());

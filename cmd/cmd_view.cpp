@@ -94,6 +94,7 @@ struct ViewArgs {
     PagedStreamFlags stream;
     bool streamed = false;  // a paged city that streams (choosePagedStream)
     bool pace = false;      // --pace
+    CommandFiles files;     // checked by configure; holds the output's lock for the run
 };
 
 void declareFlags(CLI::App& app, ViewArgs& a) {
@@ -150,8 +151,7 @@ Status configure(ViewArgs& a, ModeOptions& options) {
         return Status::error(
             "option --allow-repeated-frames: only with --step (without it --frames counts frames "
             "drawn, not path samples)");
-    VISTA_RETURN_IF_ERROR(
-        checkRunFiles(CommandFiles().output("--screenshot", a.screenshot), a.city, a.path, a.modeFlags));
+    VISTA_RETURN_IF_ERROR(checkRunFiles(a.files.output("--screenshot", a.screenshot), a.city, a.path, a.modeFlags));
     if (!a.screenshot.empty()) VISTA_RETURN_IF_ERROR(checkWritablePath("--screenshot", a.screenshot));
     VISTA_RETURN_IF_ERROR(validatePagedReach(a.paged));
     VISTA_RETURN_IF_ERROR(validatePagedStream(a.stream));
@@ -568,7 +568,8 @@ int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path,
         if (last) break;
     }
     if (v.stream) v.stream->report(v.mode, v.current->lastViewerStats());
-    if (!a.screenshot.empty() && v.keys->capture->lastWritten != a.screenshot) return 1;
+    // A --screenshot that could not be written (its cause is on stderr, e.g. a full device) is a failed output.
+    if (!a.screenshot.empty() && v.keys->capture->lastWritten != a.screenshot) return 2;
     return 0;
 }
 

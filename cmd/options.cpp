@@ -457,7 +457,7 @@ Result<PathOptions> parsePathFlags(const PathFlags& f) {
     return po;
 }
 
-Status checkRunFiles(CommandFiles files, const std::string& city, const PathFlags& path, const ModeFlags& mode) {
+Status checkRunFiles(CommandFiles& files, const std::string& city, const PathFlags& path, const ModeFlags& mode) {
     VISTA_RETURN_IF_ERROR(files.input("city", city)
                               .input("--path", path.file)
                               .input("--baked", mode.baked)

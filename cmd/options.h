@@ -228,9 +228,10 @@ Status refuseEmptyValues(const CLI::App& app);
 
 // The file rule of a walkthrough run (bench, render, view): `files` holds the
 // command's outputs; adds its inputs (the city, --path, --baked, --baked-mesh)
-// and checks the rule (output_paths.h), and that a --path file is a regular
+// and checks the rule (output_paths.h: paths resolved, no aliasing, the
+// outputs locked while `files` lives), and that a --path file is a regular
 // file within kMaxPathCsvBytes, before anything is read or created.
-Status checkRunFiles(CommandFiles files, const std::string& city, const PathFlags& path, const ModeFlags& mode);
+Status checkRunFiles(CommandFiles& files, const std::string& city, const PathFlags& path, const ModeFlags& mode);
 
 // The paged-city reach (PagedReach, paged_walkthrough.h) of bench, view and render:
 // --paged-radius M = metres around the walkthrough within which regions are

@@ -90,6 +90,7 @@ struct RigPlan {
     std::vector<size_t> idx;                               // path sample of every frame
     std::vector<double> times;                             // its time
     std::vector<std::vector<uint8_t>> camFire, lidarFire;  // per sensor, per frame
+    CommandFiles files;                                    // checked by configure; holds the output's lock
     bool needsLabels() const {
         if (!rig.lidars.empty()) return true;
         for (const RigCamera& c : rig.cameras)
@@ -117,8 +118,8 @@ Status configure(const RigRunRequest& a, RigPlan& p) {
     auto rig = loadRigFile(a.rig);
     if (!rig) return Status::error("--rig: " + rig.status().message());
     p.rig = std::move(*rig);
-    if (!fs::exists(a.city)) return Status::error("city file '" + a.city + "' does not exist");
-    return checkRunFiles(CommandFiles().output("--out", a.out).input("--rig", a.rig), a.city, a.path, a.modeFlags);
+    return checkRunFiles(p.files.outputDirectory("--out", a.out, true).input("--rig", a.rig), a.city, a.path,
+                         a.modeFlags);
 }
 
 Result<Walkthrough> loadCityAndFrames(const RigRunRequest& a, RigPlan& p) {

@@ -3,6 +3,7 @@
 
 #include <signal.h>
 
+#include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -18,7 +19,141 @@ namespace vista {
 
 std::string errnoText() { return std::strerror(errno); }
 
-std::string tempPathFor(const std::string& path) { return path + ".tmp." + std::to_string(::getpid()); }
+namespace {
+
+std::atomic<unsigned> gSpecialTemps{0};
+
+bool isSpecialMode(mode_t m) { return S_ISCHR(m) || S_ISBLK(m) || S_ISFIFO(m) || S_ISSOCK(m); }
+
+Status writeError(const std::string& path, const std::string& why) {
+    return Status::error("cannot write '" + path + "': " + why);
+}
+
+// write(2) of every byte; SIGPIPE is blocked meanwhile in this thread, so a
+// pipe whose reader went away is the error EPIPE, not the end of the process.
+Status writeAll(int fd, const char* p, size_t n, const std::string& path) {
+    sigset_t pipeSet, old;
+    sigemptyset(&pipeSet);
+    sigaddset(&pipeSet, SIGPIPE);
+    sigset_t pending;
+    sigemptyset(&pending);
+    ::sigpending(&pending);
+    const bool wasPending = sigismember(&pending, SIGPIPE) == 1;
+    ::pthread_sigmask(SIG_BLOCK, &pipeSet, &old);
+    std::string why;
+    while (n > 0) {
+        const ssize_t w = ::write(fd, p, n);
+        if (w < 0 && errno == EINTR) continue;
+        if (w < 0) {
+            why = errnoText();
+            if (errno == EPIPE && !wasPending) {
+                const timespec zero{0, 0};
+                ::sigtimedwait(&pipeSet, nullptr, &zero);  // the SIGPIPE this write raised
+            }
+            break;
+        }
+        if (w == 0) {
+            why = "the device accepted no bytes";
+            break;
+        }
+        p += w;
+        n -= size_t(w);
+    }
+    ::pthread_sigmask(SIG_SETMASK, &old, nullptr);
+    return why.empty() ? Status::ok() : writeError(path, why);
+}
+
+// Opens an existing device or FIFO for writing in place (no create, no truncate).
+Result<int> openSpecial(const std::string& path) {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC | O_NOCTTY);
+    if (fd < 0) {
+        if (errno == ENXIO) return writeError(path, "it is a socket (vista writes files, devices and pipes)");
+        return writeError(path, errnoText());
+    }
+    struct stat st {};
+    if (::fstat(fd, &st) != 0 || !isSpecialMode(st.st_mode)) {
+        ::close(fd);
+        return writeError(path, "it is no longer a device or pipe");
+    }
+    return fd;
+}
+
+Status closeChecked(int fd, const std::string& path) {
+    if (::close(fd) != 0) return writeError(path, errnoText());
+    return Status::ok();
+}
+
+Status writeInPlace(const std::string& path, const std::string& bytes) {
+    auto fd = openSpecial(path);
+    if (!fd) return fd.status();
+    if (Status s = writeAll(*fd, bytes.data(), bytes.size(), path); !s) {
+        ::close(*fd);
+        return s;
+    }
+    return closeChecked(*fd, path);
+}
+
+// Copies the regular file `from` into the device or FIFO `path`.
+Status copyInto(const std::string& from, const std::string& path) {
+    const int in = ::open(from.c_str(), O_RDONLY | O_CLOEXEC);
+    if (in < 0) return writeError(path, "cannot read its staged file: " + errnoText());
+    auto fd = openSpecial(path);
+    if (!fd) {
+        ::close(in);
+        return fd.status();
+    }
+    std::vector<char> buf(size_t(1) << 20);
+    Status s = Status::ok();
+    for (;;) {
+        const ssize_t r = ::read(in, buf.data(), buf.size());
+        if (r < 0 && errno == EINTR) continue;
+        if (r < 0) {
+            s = writeError(path, "cannot read its staged file: " + errnoText());
+            break;
+        }
+        if (r == 0) break;
+        if (s = writeAll(*fd, buf.data(), size_t(r), path); !s) break;
+    }
+    ::close(in);
+    if (!s) {
+        ::close(*fd);
+        return s;
+    }
+    return closeChecked(*fd, path);
+}
+
+}  // namespace
+
+bool isSpecialFile(const std::string& path) {
+    struct stat st {};
+    return !path.empty() && ::stat(path.c_str(), &st) == 0 && isSpecialMode(st.st_mode);
+}
+
+std::string tempPathFor(const std::string& path) {
+    if (isSpecialFile(path)) {
+        std::error_code ec;
+        std::filesystem::path dir = std::filesystem::temp_directory_path(ec);
+        if (ec) dir = "/tmp";
+        return (dir / ("vista." + std::to_string(::getpid()) + "." + std::to_string(gSpecialTemps++) + "." +
+                       std::filesystem::path(path).filename().string()))
+            .string();
+    }
+    return path + ".tmp." + std::to_string(::getpid());
+}
+
+Status commitTempFile(const std::string& tmp, const std::string& path) {
+    if (isSpecialFile(path)) {
+        Status s = copyInto(tmp, path);
+        ::unlink(tmp.c_str());
+        return s;
+    }
+    if (::rename(tmp.c_str(), path.c_str()) != 0) {
+        const std::string e = errnoText();
+        ::unlink(tmp.c_str());
+        return writeError(path, "rename failed: " + e);
+    }
+    return Status::ok();
+}
 
 namespace {
 
@@ -90,9 +225,12 @@ OutputBatch::~OutputBatch() {
 }
 
 std::string OutputBatch::stage(const std::string& path) {
-    removeStaleTemps(path);
-    std::string staged = path + ".stage." + std::to_string(::getpid());  // not const: returned by move
+    const bool special = isSpecialFile(path);
+    if (!special) removeStaleTemps(path);
+    // not const: returned by move
+    std::string staged = special ? tempPathFor(path) : path + ".stage." + std::to_string(::getpid());
     _files.emplace_back(staged, path);
+    _special.push_back(special);
     return staged;
 }
 
@@ -100,6 +238,14 @@ Status OutputBatch::commit() {
     for (const auto& f : _files)
         if (::access(f.first.c_str(), F_OK) != 0)
             return Status::error("cannot write '" + f.second + "': its staged file is missing");
+    // Devices and pipes first: their writes cannot be undone, and a failed one
+    // (a full device) then leaves every regular output as it was.
+    for (size_t k = 0; k < _files.size(); ++k) {
+        if (!_special[k]) continue;
+        Status s = copyInto(_files[k].first, _files[k].second);
+        ::unlink(_files[k].first.c_str());
+        if (!s) return s;  // the destructor removes the other staged files
+    }
     // Each output that exists keeps a second name ("<path>.prev.<pid>", a hard
     // link) until every rename is done, so that a failed rename can put the
     // previous outputs back: all new outputs appear, or none.
@@ -108,15 +254,18 @@ Status OutputBatch::commit() {
     std::vector<bool> existed(_files.size(), false);
     auto undo = [&](size_t renamed) {
         for (size_t j = 0; j < renamed; ++j) {
+            if (_special[j]) continue;  // written in place; nothing was renamed
             if (!kept[j].empty()) ::rename(kept[j].c_str(), _files[j].second.c_str());
             else if (!existed[j]) ::unlink(_files[j].second.c_str());
         }
         for (size_t j = renamed; j < _files.size(); ++j) {
+            if (_special[j]) continue;
             if (!kept[j].empty()) ::unlink(kept[j].c_str());
             ::unlink(_files[j].first.c_str());  // the staged files not renamed
         }
     };
     for (size_t k = 0; k < _files.size(); ++k) {
+        if (_special[k]) continue;
         const std::string& target = _files[k].second;
         const std::string prev = target + ".prev." + pid;
         ::unlink(prev.c_str());
@@ -164,6 +313,7 @@ Status CreatedDirectories::create(const std::string& option, const std::string& 
 
 Status writeFileAtomic(const std::string& path, const std::string& bytes) {
     if (path.empty()) return Status::error("cannot write file: empty path");
+    if (isSpecialFile(path)) return writeInPlace(path, bytes);
     removeStaleTemps(path);
     const std::string tmp = tempPathFor(path);
     int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
@@ -201,37 +351,102 @@ Status writeFileAtomic(const std::string& path, const std::string& bytes) {
     return Status::ok();
 }
 
-Status checkWritablePath(const std::string& option, const std::string& path) {
-    namespace fs = std::filesystem;
-    if (path.empty()) return Status::error("option " + option + ": empty path");
+namespace {
+
+// Why the existing entry `path` (lstat succeeded, stat failed with `err`)
+// cannot be followed: a link that loops, dangles, or an unreachable target.
+std::string unfollowable(const std::string& path, int err) {
     std::error_code ec;
-    fs::path p(path);
-    if (fs::is_directory(p, ec))
-        return Status::error("option " + option + " = '" + path + "' is a directory, expected a file path");
-    fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
-    if (!fs::is_directory(dir, ec))
-        return Status::error("option " + option + " = '" + path + "': directory '" + dir.string() + "' does not exist");
-    if (access(dir.c_str(), W_OK) != 0)
-        return Status::error("option " + option + " = '" + path + "': directory '" + dir.string() +
-                             "' is not writable");
+    if (std::filesystem::is_symlink(path, ec)) {
+        if (err == ELOOP) return "is a symbolic link loop (too many levels of symbolic links)";
+        if (err == ENOENT) {
+            const std::string target = std::filesystem::read_symlink(path, ec).string();
+            return "is a dangling symbolic link (its target '" + target + "' does not exist)";
+        }
+    }
+    return "cannot be reached: " + std::string(std::strerror(err));
+}
+
+// lstat's errno for an entry that is not there: missing, or under a
+// component that is not a directory or loops (its parent then says which).
+bool missingEntry(int err) { return err == ENOENT || err == ENOTDIR || err == ELOOP; }
+
+std::string named(const std::string& option, const std::string& path) {
+    return "option " + option + " = '" + path + "'";
+}
+
+// `dir` is an existing, reachable, writable directory; `what` names it in messages ("directory 'd'").
+Status checkDirectory(const std::string& option, const std::string& path, const std::string& dir,
+                      const std::string& missing) {
+    struct stat st {};
+    if (::stat(dir.c_str(), &st) != 0) {
+        const int err = errno;
+        struct stat lst {};
+        if (err == ENOENT && ::lstat(dir.c_str(), &lst) != 0)
+            return Status::error(named(option, path) + ": " + missing);
+        return Status::error(named(option, path) + ": directory '" + dir + "' " + unfollowable(dir, err));
+    }
+    if (!S_ISDIR(st.st_mode))
+        return Status::error(named(option, path) + ": " +
+                             (missing.empty() ? "'" + dir + "' exists and is not a directory"
+                                              : missing + " ('" + dir + "' is not a directory)"));
+    if (::access(dir.c_str(), W_OK) != 0)
+        return Status::error(named(option, path) + ": directory '" + dir + "' is not writable");
     return Status::ok();
 }
 
-Status checkWritableDirectory(const std::string& option, const std::string& path) {
+}  // namespace
+
+Status checkWritablePath(const std::string& option, const std::string& path) {
     namespace fs = std::filesystem;
     if (path.empty()) return Status::error("option " + option + ": empty path");
-    std::error_code ec;
-    fs::path dir = fs::path(path).lexically_normal();  // up to the nearest existing ancestor
-    while (!fs::exists(fs::symlink_status(dir, ec)) && dir.has_parent_path() && dir.parent_path() != dir)
+    struct stat lst {
+    }, st{};
+    if (::lstat(path.c_str(), &lst) == 0) {
+        if (::stat(path.c_str(), &st) != 0) {
+            const int err = errno;
+            return Status::error(named(option, path) + " " + unfollowable(path, err) +
+                                 ": remove it or give another path");
+        }
+        if (S_ISDIR(st.st_mode)) return Status::error(named(option, path) + " is a directory, expected a file path");
+        if (S_ISSOCK(st.st_mode))
+            return Status::error(named(option, path) + " is a socket (vista writes files, devices and pipes)");
+        if (isSpecialMode(st.st_mode)) {  // a device or FIFO: written in place
+            if (::access(path.c_str(), W_OK) != 0)
+                return Status::error(named(option, path) + " is a device or pipe that is not writable");
+            return Status::ok();
+        }
+    } else if (!missingEntry(errno)) {
+        return Status::error(named(option, path) + " cannot be reached: " + errnoText());
+    }
+    fs::path p(path);
+    const std::string dir = p.has_parent_path() ? p.parent_path().string() : std::string(".");
+    return checkDirectory(option, path, dir, "directory '" + dir + "' does not exist");
+}
+
+Status checkWritableDirectory(const std::string& option, const std::string& path, bool parentMustExist) {
+    namespace fs = std::filesystem;
+    if (path.empty()) return Status::error("option " + option + ": empty path");
+    fs::path dir = fs::path(path).lexically_normal();
+    if (!dir.has_filename() && dir.has_parent_path()) dir = dir.parent_path();  // "out/" -> "out"
+    struct stat lst {};
+    if (::lstat(dir.c_str(), &lst) == 0) return checkDirectory(option, path, dir.string(), "");
+    if (!missingEntry(errno)) return Status::error(named(option, path) + " cannot be reached: " + errnoText());
+    if (parentMustExist) {
+        const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
+        return checkDirectory(option, path, parent.string(),
+                              "parent directory '" + parent.string() + "' does not exist (create it first)");
+    }
+    // Up to the nearest existing ancestor (the job creates the rest).
+    while (::lstat(dir.c_str(), &lst) != 0) {
+        if (!missingEntry(errno)) return Status::error(named(option, path) + " cannot be reached: " + errnoText());
+        if (!dir.has_parent_path() || dir.parent_path() == dir) {
+            dir = ".";
+            break;
+        }
         dir = dir.parent_path();
-    if (!fs::exists(fs::symlink_status(dir, ec))) dir = ".";
-    if (!fs::is_directory(dir, ec))
-        return Status::error("option " + option + " = '" + path + "': '" + dir.string() +
-                             "' exists and is not a directory");
-    if (access(dir.c_str(), W_OK) != 0)
-        return Status::error("option " + option + " = '" + path + "': directory '" + dir.string() +
-                             "' is not writable");
-    return Status::ok();
+    }
+    return checkDirectory(option, path, dir.string(), "");
 }
 
 }  // namespace vista

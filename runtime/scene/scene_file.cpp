@@ -65,7 +65,7 @@ Status writeSceneFile(const osg::Node& node, const std::string& path, bool compr
     if (path.empty()) return Status::error("cannot write scene file: empty path");
     osgDB::ReaderWriter* rw = osgbReaderWriter();
     if (!rw) return Status::error("cannot write '" + path + "': OpenSceneGraph osgb plugin not found");
-    removeStaleTemps(path);
+    if (!isSpecialFile(path)) removeStaleTemps(path);
     const std::string tmp = tempPathFor(path);
     auto fail = [&](const std::string& why) {
         ::unlink(tmp.c_str());
@@ -136,8 +136,7 @@ Status writeSceneFile(const osg::Node& node, const std::string& path, bool compr
         return fail("fsync failed: " + e);
     }
     if (::close(fd) != 0) return fail(errnoText());
-    if (::rename(tmp.c_str(), path.c_str()) != 0) return fail("rename failed: " + errnoText());
-    return Status::ok();
+    return commitTempFile(tmp, path);  // a rename; a copy into a device or FIFO (atomic_file.h)
 }
 
 Result<osg::ref_ptr<osg::Node>> readSceneFile(const std::string& path) {

@@ -13,7 +13,8 @@
 //
 // Contract: writeSceneFile() is atomic (temp file "<path>.tmp.<pid>" in the
 // same directory, then rename); on any error no file is created at `path` and
-// an existing file there is left untouched. Output bytes depend only on the
+// an existing file there is left untouched; a device or FIFO at `path` is
+// written in place (foundation/atomic_file.h), never replaced. Output bytes depend only on the
 // node graph. readSceneFile() returns an error naming the path for missing,
 // unreadable, non-osgb, truncated or corrupted files. Both are thread
 // compatible (no shared state besides osgDB's registry, which is locked).

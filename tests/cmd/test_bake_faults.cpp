@@ -132,12 +132,14 @@ TEST(BakeFaults, KillNineLeavesTheOldOutputOrTheWholeNewOneAndTheNextRunResumes)
             EXPECT_TRUE(now == ref) << "a run that was not killed (" << k.what << ") must leave the whole new output";
             std::ofstream(out, std::ios::binary | std::ios::trunc) << old;  // the old output again, for the next kill
         }
-        // Next to the output: only its work directory and the killed run's temporary or staged output.
+        // Next to the output: only its work directory and the killed run's temporary or staged output,
+        // and its lock files (empty; the next run takes them over and removes them).
         const std::string p = std::to_string(pid);
         for (const auto& e : fs::directory_iterator(dir.path())) {
             const std::string n = e.path().filename().string();
-            const bool killedRunsFile =
-                n == "out.osgb.tmp." + p || n == "out.osgb.stage." + p || n == "out.osgb.stage." + p + ".tmp." + p;
+            const bool killedRunsFile = n == "out.osgb.tmp." + p || n == "out.osgb.stage." + p ||
+                                        n == "out.osgb.stage." + p + ".tmp." + p || n == "out.osgb.lock" ||
+                                        n == "out.osgb.work.lock";
             const bool expected = n == "city.osgb" || n == "ref.osgb" || n == "ref1.osgb" || n == "out.osgb" ||
                                   n == "out.osgb.work" || (lastKilled && killedRunsFile);
             EXPECT_TRUE(expected) << k.what << ": " << n;
@@ -158,6 +160,7 @@ TEST(BakeFaults, KillNineLeavesTheOldOutputOrTheWholeNewOneAndTheNextRunResumes)
     for (const std::string& n : listTree(dir.path())) {
         EXPECT_EQ(n.find(".tmp."), std::string::npos) << n;
         EXPECT_EQ(n.find(".stage."), std::string::npos) << n;
+        EXPECT_EQ(n.find(".lock"), std::string::npos) << n;  // the killed runs' locks taken over and removed
     }
 }
 

@@ -134,14 +134,14 @@ TEST(OutputPaths, SameFileAfterDotDotSymlinksAndHardLinks) {
     EXPECT_FALSE(sameFile(dir.file("sub/a"), dir.file("sub/b")));
     EXPECT_FALSE(sameFile(dir.file("a"), dir.file("sub/a")));
 
-    Status s = CommandFiles().input("city", dir.file("sub/a")).output("-o", dir.file("link/a")).check();
+    CommandFiles a, b, c;
+    Status s = a.input("city", dir.file("sub/a")).output("-o", dir.file("link/a")).check();
     ASSERT_FALSE(s.isOk());
     EXPECT_TRUE(has(s.message(), "-o") && has(s.message(), "city")) << s.message();
-    s = CommandFiles().output("-o", dir.file("x")).output("--stats", dir.file("sub/../x")).check();
+    s = b.output("-o", dir.file("x")).output("--stats", dir.file("sub/../x")).check();
     ASSERT_FALSE(s.isOk());
     EXPECT_TRUE(has(s.message(), "-o") && has(s.message(), "--stats")) << s.message();
-    EXPECT_TRUE(CommandFiles()
-                    .input("city", dir.file("sub/a"))
+    EXPECT_TRUE(c.input("city", dir.file("sub/a"))
                     .output("-o", dir.file("x"))
                     .output("--stats", dir.file("y"))
                     .output("--gltf", "")
