@@ -304,9 +304,10 @@ int runPaged(const GenArgs& a, const CityParams& params, const Stopwatch& total)
 }
 
 // Every output of the command, or none: each is staged, then all renamed
-// together; `stats` (called once the others are staged) gives the stats JSON.
+// together; `stats` (called once the others are staged, with the OpenDRIVE
+// counts when --xodr was written, else null) gives the stats JSON.
 Status writeOutputs(const GenArgs& a, const City& city, const CityParams& params,
-                    const std::function<std::string()>& stats) {
+                    const std::function<std::string(const OpenDriveCounts*)>& stats) {
     OutputBatch batch;
     VISTA_RETURN_IF_ERROR(writeCityFile(city, batch.stage(a.out)));
     if (!a.geojsonFile.empty())
@@ -314,12 +315,15 @@ Status writeOutputs(const GenArgs& a, const City& city, const CityParams& params
             writeFileAtomic(batch.stage(a.geojsonFile),
                             streetGraphToGeoJson(city.streets, params.origin_x, params.origin_y, params.geo)));
     if (!a.gltfFile.empty()) VISTA_RETURN_IF_ERROR(writeGltf(city, batch.stage(a.gltfFile)));
+    OpenDriveCounts xodrCounts;
     if (!a.xodrFile.empty()) {
-        auto xodr = openDriveXml(city.streets, params, &city.blocks);
+        auto xodr = openDriveXml(city.streets, params, &city.blocks, &xodrCounts);
         if (!xodr) return Status::error("option --xodr = '" + a.xodrFile + "': " + xodr.status().message());
         VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage(a.xodrFile), *xodr));
     }
-    if (!a.statsFile.empty()) VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage(a.statsFile), stats()));
+    if (!a.statsFile.empty())
+        VISTA_RETURN_IF_ERROR(
+            writeFileAtomic(batch.stage(a.statsFile), stats(a.xodrFile.empty() ? nullptr : &xodrCounts)));
     return batch.commit();
 }
 
@@ -460,11 +464,12 @@ int runGen(int argc, char** argv) {
     Stopwatch write;
     const CityCounts n = countCity(*city);
     double totalSeconds = 0;
-    auto stats = [&] {
+    auto stats = [&](const OpenDriveCounts* xodr) {
         totalSeconds = total.ms() / 1000.0;
         auto j = statsJson(*city, *params, n, lighting, write.ms() / 1000.0, totalSeconds);
         if (a.budgetGb > 0) j["memory"] = {{"estimate_mb", estimateMb}, {"budget_gb", a.budgetGb}};
         if (osmRoads) j["osm_roads"] = nlohmann::ordered_json::parse(osmRoadTagStatsJson(*osmRoads));
+        if (xodr) j["opendrive"] = nlohmann::ordered_json::parse(openDriveCountsJson(*xodr));
         return j.dump(2) + "\n";
     };
     if (Status s = writeOutputs(a, *city, *params, stats); !s) return reportBadInput(kCmd, s);
