@@ -153,12 +153,22 @@ struct TurnPlan {
 };
 
 // Lateral extent of a link road on the side its turn bends to: how far the
-// lanes reach toward the centre of curvature (at the ends, where the
-// smoothstep blends make the borders monotone in between).
+// lanes reach toward the centre of curvature (at the ends, from the end
+// values, where the smoothstep blends make the borders monotone in between;
+// the geometry, and so the blend, may not be placed yet).
 double turnSideExtent(const LinkRoad& r) {
-    const double L = r.length();
-    if (r.angle < 0) return std::max({0.0, -r.rightBorder(0), -r.rightBorder(L)});
-    return std::max({0.0, r.leftBorder(0), r.leftBorder(L)});
+    double ext = 0.0;
+    for (int atEnd = 0; atEnd < 2; ++atEnd) {
+        double t = atEnd ? r.offset1 : r.offset0;
+        if (r.angle < 0) {
+            for (const LinkRoad::Lane& l : r.right) t -= atEnd ? l.w1 : l.w0;
+            ext = std::max(ext, -t);
+        } else {
+            for (const LinkRoad::Lane& l : r.left) t += atEnd ? l.w1 : l.w0;
+            ext = std::max(ext, t);
+        }
+    }
+    return ext;
 }
 
 // Line, arc and line from the incoming road's end (distance tIn before the
@@ -200,10 +210,10 @@ double radiusTrim(double angle, double extent, double radius) {
 // monotone in between; a lane of width 0 at an end counts with its border).
 double turnCentreExtent(const LinkRoad& r) {
     double ext = -1e300;
-    for (double s : {0.0, r.length()}) {
-        double t = r.laneOffset(s);
+    for (int atEnd = 0; atEnd < 2; ++atEnd) {
+        double t = atEnd ? r.offset1 : r.offset0;
         for (const LinkRoad::Lane& l : r.right) {
-            const double w = r.width(l, s);
+            const double w = atEnd ? l.w1 : l.w0;
             ext = std::max(ext, r.angle < 0 ? -(t - 0.5 * w) : t - 0.5 * w);
             t -= w;
         }

@@ -6,6 +6,10 @@
 // centre.
 #include <gtest/gtest.h>
 
+// Boost.Geometry's rescaling code trips GCC's maybe-uninitialized warning.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#define BOOST_GEOMETRY_NO_ROBUSTNESS
 #include <boost/geometry.hpp>
 #include <boost/geometry/geometries/point_xy.hpp>
 #include <boost/geometry/geometries/polygon.hpp>
@@ -316,6 +320,7 @@ double sharedArea(const BgPolygon& a, const BgPolygon& b) {
     for (const BgPolygon& p : out) area += bg::area(p);
     return area;
 }
+#pragma GCC diagnostic pop
 
 // The surface of a street road in the model: carriageway and the sidewalks
 // it has, between its trimmed ends.
