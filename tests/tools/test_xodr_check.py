@@ -512,6 +512,18 @@ class TurnsAndOverlapsTest(unittest.TestCase):
         self.assertEqual(failing(check(self.crossing(dx=13.0))), [])
         self.assertEqual(check(self.crossing(), overlap_step=0)["overlaps"].checked, 0)
 
+    def test_overlaps_reported_only_on_request(self):
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "cross.xodr")
+            with open(path, "w") as f:
+                f.write(self.crossing())
+            res = xc.run(path, xc.options([path]))
+            self.assertFalse(res["pass"])
+            res = xc.run(path, xc.options([path, "--overlap-report-only"]))
+            self.assertTrue(res["pass"])
+            self.assertEqual(res["checks"]["overlaps"]["failures"], 1)
+            self.assertIn("note overlaps", xc.summary(res))
+
     def test_connecting_roads_overlap_inside_their_junction_only(self):
         self.assertEqual(check(t_junction())["overlaps"].failures, 0)
         # connecting road 100 moved into a junction of its own: it crosses 102..105 of junction 9
