@@ -2,6 +2,7 @@
 #include "citygen/lanes.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <utility>
@@ -16,6 +17,12 @@ double carriagewayWidth(const StreetEdge& e) {
 }
 
 double classSpeedKmh(RoadClass c) { return c == RoadClass::Highway ? 80.0 : c == RoadClass::Arterial ? 50.0 : 30.0; }
+
+double minTurnRadius(RoadClass c) {
+    return c == RoadClass::Highway    ? kMinTurnRadiusHighway
+           : c == RoadClass::Arterial ? kMinTurnRadiusArterial
+                                      : kMinTurnRadiusLocal;
+}
 
 glm::dvec2 LinkRoad::point(double s) const {
     s = std::clamp(s, 0.0, length());
@@ -106,6 +113,9 @@ bool crossingBand(const EdgeLanes& L, bool atB, double& s0, double& s1) {
 namespace {
 
 constexpr double kStraightTurn = 0.6108652381980153;  // 35 degrees: gentler turns count as straight on
+constexpr double kRadiusSlack = 1e-3;                 // asked beyond a turning radius or margin, so rounding keeps it
+constexpr double kOutlineStep = 0.25;                 // sampling of link-road outlines for the crossing test (metres)
+constexpr double kOverlapSlack = 5e-3;  // outlines overlapping less deep than this count as apart (metres)
 
 // Signed angle (left positive) from direction a to direction b.
 double turnAngle(const glm::dvec2& a, const glm::dvec2& b) {
@@ -143,12 +153,22 @@ struct TurnPlan {
 };
 
 // Lateral extent of a link road on the side its turn bends to: how far the
-// lanes reach toward the centre of curvature (at the ends, where the
-// smoothstep blends make the borders monotone in between).
+// lanes reach toward the centre of curvature (at the ends, from the end
+// values, where the smoothstep blends make the borders monotone in between;
+// the geometry, and so the blend, may not be placed yet).
 double turnSideExtent(const LinkRoad& r) {
-    const double L = r.length();
-    if (r.angle < 0) return std::max({0.0, -r.rightBorder(0), -r.rightBorder(L)});
-    return std::max({0.0, r.leftBorder(0), r.leftBorder(L)});
+    double ext = 0.0;
+    for (int atEnd = 0; atEnd < 2; ++atEnd) {
+        double t = atEnd ? r.offset1 : r.offset0;
+        if (r.angle < 0) {
+            for (const LinkRoad::Lane& l : r.right) t -= atEnd ? l.w1 : l.w0;
+            ext = std::max(ext, -t);
+        } else {
+            for (const LinkRoad::Lane& l : r.left) t += atEnd ? l.w1 : l.w0;
+            ext = std::max(ext, t);
+        }
+    }
+    return ext;
 }
 
 // Line, arc and line from the incoming road's end (distance tIn before the
@@ -174,7 +194,133 @@ void filletGeometry(LinkRoad& r, const glm::dvec2& node, const glm::dvec2& d0, c
 // (plus the margin) from the centre of curvature.
 double filletTrim(double angle, double extent) {
     if (std::abs(angle) < 1e-9) return 0.0;
-    return (extent + kCurvatureMargin) * std::tan(0.5 * std::abs(angle));
+    return (extent + kCurvatureMargin + kRadiusSlack) * std::tan(0.5 * std::abs(angle));
+}
+
+// Length of the fillet's tangent that keeps every lane centre at least
+// `radius` metres from the centre of curvature, when the lane centres reach
+// `extent` metres toward it.
+double radiusTrim(double angle, double extent, double radius) {
+    if (std::abs(angle) < 1e-9) return 0.0;
+    return (extent + radius + kRadiusSlack) * std::tan(0.5 * std::abs(angle));
+}
+
+// How far the lane centres of a junction's link road reach toward the centre
+// of curvature (at the ends, where the smoothstep blends make each centre
+// monotone in between; a lane of width 0 at an end counts with its border).
+double turnCentreExtent(const LinkRoad& r) {
+    double ext = -1e300;
+    for (int atEnd = 0; atEnd < 2; ++atEnd) {
+        double t = atEnd ? r.offset1 : r.offset0;
+        for (const LinkRoad::Lane& l : r.right) {
+            const double w = atEnd ? l.w1 : l.w0;
+            ext = std::max(ext, r.angle < 0 ? -(t - 0.5 * w) : t - 0.5 * w);
+            t -= w;
+        }
+    }
+    return r.right.empty() ? 0.0 : ext;
+}
+
+// The surface of a street road leaving a junction node, as the rectangle of
+// its carriageway and sidewalks from `trim` to `length` along `dir`.
+struct ArmStrip {
+    glm::dvec2 node{0.0}, dir{1.0, 0.0};
+    double right = 0, left = 0;  // lateral extents (left of dir positive)
+    double length = 0;
+    std::array<glm::dvec2, 4> corners(double trim) const {
+        const glm::dvec2 n(-dir.y, dir.x);
+        return {node + dir * trim - n * right, node + dir * length - n * right, node + dir * length + n * left,
+                node + dir * trim + n * left};
+    }
+};
+
+using Quad = std::array<glm::dvec2, 4>;
+
+// True when two convex quadrilaterals overlap deeper than `slack` metres
+// (separating axis test; touching counts as apart).
+bool quadsOverlap(const Quad& a, const Quad& b, double slack = 1e-9) {
+    for (const Quad* q : {&a, &b}) {
+        for (size_t i = 0; i < 4; ++i) {
+            const glm::dvec2 e = (*q)[(i + 1) % 4] - (*q)[i];
+            const double len = glm::length(e);
+            if (!(len > 1e-12)) continue;
+            const glm::dvec2 axis(-e.y / len, e.x / len);
+            double a0 = 1e300, a1 = -1e300, b0 = 1e300, b1 = -1e300;
+            for (const glm::dvec2& p : a) a0 = std::min(a0, glm::dot(p, axis)), a1 = std::max(a1, glm::dot(p, axis));
+            for (const glm::dvec2& p : b) b0 = std::min(b0, glm::dot(p, axis)), b1 = std::max(b1, glm::dot(p, axis));
+            if (a1 <= b0 + slack || b1 <= a0 + slack) return false;
+        }
+    }
+    return true;
+}
+
+// The driving lanes of a link road as quadrilaterals between samples at most
+// kOutlineStep apart (and at the arc's ends).
+std::vector<Quad> linkOutline(const LinkRoad& r) {
+    const double L = r.length();
+    const int n = std::max(1, int(std::ceil(L / kOutlineStep)));
+    std::vector<double> ss;
+    for (int i = 0; i <= n; ++i) ss.push_back(L * i / n);
+    for (double s : {r.line0, r.line0 + r.arcLength})
+        if (s > 0 && s < L) ss.push_back(s);
+    std::sort(ss.begin(), ss.end());
+    std::vector<Quad> out;
+    glm::dvec2 pl(0.0), pr(0.0);
+    for (size_t i = 0; i < ss.size(); ++i) {
+        const double s = ss[i], h = r.heading(s);
+        double tl = r.laneOffset(s), tr = tl;
+        for (const LinkRoad::Lane& l : r.left) tl += l.sidewalk ? 0.0 : r.width(l, s);
+        for (const LinkRoad::Lane& l : r.right) tr -= l.sidewalk ? 0.0 : r.width(l, s);
+        const glm::dvec2 c = r.point(s), nl(-std::sin(h), std::cos(h));
+        const glm::dvec2 ql = c + nl * tl, qr = c + nl * tr;
+        if (i > 0 && ss[i] - ss[i - 1] > 1e-9) out.push_back({pr, qr, ql, pl});
+        pl = ql, pr = qr;
+    }
+    return out;
+}
+
+// Quadrilaterals by the cells of a uniform grid their bounding boxes touch.
+class ShapeGrid {
+public:
+    explicit ShapeGrid(double cell) : _cell(cell) {}
+    void insert(const Quad& q, uint32_t id) {
+        forCells(q, [&](long x, long y) { _cells[{x, y}].push_back(id); });
+    }
+    // Ids of the shapes sharing a cell with q (sorted, unique).
+    void query(const Quad& q, std::vector<uint32_t>& out) const {
+        out.clear();
+        forCells(q, [&](long x, long y) {
+            auto it = _cells.find({x, y});
+            if (it != _cells.end()) out.insert(out.end(), it->second.begin(), it->second.end());
+        });
+        std::sort(out.begin(), out.end());
+        out.erase(std::unique(out.begin(), out.end()), out.end());
+    }
+
+private:
+    template <class F>
+    void forCells(const Quad& q, F f) const {
+        glm::dvec2 lo(1e300), hi(-1e300);
+        for (const glm::dvec2& p : q) lo = glm::min(lo, p), hi = glm::max(hi, p);
+        if (!std::isfinite(lo.x + lo.y + hi.x + hi.y)) return;
+        for (long y = long(std::floor(lo.y / _cell)); y <= long(std::floor(hi.y / _cell)); ++y)
+            for (long x = long(std::floor(lo.x / _cell)); x <= long(std::floor(hi.x / _cell)); ++x) f(x, y);
+    }
+    double _cell;
+    std::map<std::pair<long, long>, std::vector<uint32_t>> _cells;
+};
+
+// Smallest trim (the same on both arms) beyond which two arms' strips share
+// no area, plus kArmClearance; `limit` when even that is not enough.
+double separatingTrim(const ArmStrip& a, const ArmStrip& b, double limit) {
+    if (!quadsOverlap(a.corners(0.0), b.corners(0.0))) return 0.0;
+    if (quadsOverlap(a.corners(limit), b.corners(limit))) return limit;
+    double lo = 0.0, hi = limit;
+    for (int it = 0; it < 40 && hi - lo > 1e-4; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (quadsOverlap(a.corners(mid), b.corners(mid)) ? lo : hi) = mid;
+    }
+    return std::min(limit, hi + kArmClearance);
 }
 
 // The steps of buildLaneModel, in order: lanes per edge, sidewalk sides,
@@ -216,6 +362,16 @@ private:
         w = std::max(w, t);
     }
     double trimAt(uint32_t e, uint32_t v) const { return g.edges[e].a == v ? m.edges[e].trimA : m.edges[e].trimB; }
+    // Smallest lane-centre radius of a turn between two street edges: the
+    // smaller of their classes' (the turn is taken at the slower road's pace).
+    double turnRadius(uint32_t in, uint32_t out) const {
+        return std::min(minTurnRadius(g.edges[in].cls), minTurnRadius(g.edges[out].cls));
+    }
+    ArmStrip strip(uint32_t e, uint32_t v) const;
+    void separateArms(size_t j);
+    bool meetsRadius(const LinkRoad& r) const;
+    std::vector<bool> crossingTurns(const std::vector<LinkRoad>& turns) const;
+    void fitTurns(size_t j, std::vector<LinkRoad>& turns, std::vector<TurnPlan>& turnPlans);
     LinkRoad junctionRoad(int j, const TurnPlan& t) const;
     bool place(LinkRoad& r) const;
     void edgeLanes();
@@ -239,6 +395,11 @@ private:
     std::vector<double> wantA, wantB;             // desired trims per edge at node a / b
     std::vector<std::vector<TurnPlan>> plans;     // per junction
     std::vector<LinkRoad> transitions;            // degree-2 nodes, before placing
+    struct ArmPair {
+        uint32_t a, b, node;
+        double trim;  // both arms need at least this trim at node
+    };
+    std::vector<ArmPair> armPairs;  // arm pairs whose surfaces overlap within their junction radius
 };
 
 // Lanes, widths, speed and direction of every valid edge; node degrees.
@@ -388,12 +549,45 @@ void LaneModelBuilder::planTurns() {
             }
             for (const TurnPlan& t : exits) {
                 const LinkRoad r = junctionRoad(int(j), t);
-                const double need = filletTrim(t.angle, turnSideExtent(r));
+                const double need = std::max(filletTrim(t.angle, turnSideExtent(r)),
+                                             radiusTrim(t.angle, turnCentreExtent(r), turnRadius(t.in, t.out)));
                 J.radius = std::max(J.radius, need);
                 plans[j].push_back(t);
             }
         }
         for (uint32_t e : J.arms) want(e, v, J.radius);
+        separateArms(j);
+    }
+}
+
+ArmStrip LaneModelBuilder::strip(uint32_t e, uint32_t v) const {
+    const EdgeLanes& L = m.edges[e];
+    const bool atA = g.edges[e].a == v;
+    const double left = L.halfWidth() + (L.hasWalk(1) ? L.sidewalk : 0.0);
+    const double right = L.halfWidth() + (L.hasWalk(-1) ? L.sidewalk : 0.0);
+    ArmStrip s;
+    s.node = g.nodes[v];
+    s.dir = atA ? L.dir : -L.dir;
+    s.left = atA ? left : right;
+    s.right = atA ? right : left;
+    s.length = L.length;
+    return s;
+}
+
+// Arms of junction j whose surfaces (carriageway and sidewalks) would share
+// area beyond the junction radius are both trimmed back until they do not.
+void LaneModelBuilder::separateArms(size_t j) {
+    const Junction& J = m.junctions[j];
+    for (size_t x = 0; x < J.arms.size(); ++x) {
+        for (size_t y = x + 1; y < J.arms.size(); ++y) {
+            const uint32_t a = J.arms[x], b = J.arms[y];
+            const ArmStrip sa = strip(a, J.node), sb = strip(b, J.node);
+            const double need = separatingTrim(sa, sb, std::min(sa.length, sb.length));
+            if (need <= J.radius) continue;
+            want(a, J.node, need);
+            want(b, J.node, need);
+            armPairs.push_back({a, b, J.node, need});
+        }
     }
 }
 
@@ -442,6 +636,11 @@ void LaneModelBuilder::planTransitions() {
              out.towardId(out.toward() + 1));
         r.offset0 = in.centreIn();
         r.offset1 = -out.centreIn();
+        // Both edges are cut back until their surfaces part, linked or not.
+        const ArmStrip sa = strip(inE, v), sb = strip(outE, v);
+        const double apart = separatingTrim(sa, sb, std::min(sa.length, sb.length));
+        want(inE, v, apart);
+        want(outE, v, apart);
         if (std::abs(r.angle) > kMaxTurn) {
             ++m.sharpCorners;
             continue;
@@ -449,8 +648,9 @@ void LaneModelBuilder::planTransitions() {
         bool taper = std::abs(r.offset0 - r.offset1) > 1e-9;
         for (const auto* side : {&r.right, &r.left})
             for (const LinkRoad::Lane& l : *side) taper = taper || std::abs(l.w0 - l.w1) > 1e-9;
-        const double need =
-            std::max({filletTrim(r.angle, turnSideExtent(r)), taper ? 0.5 * kTaperLength : 0.0, 0.5 * kMinLinkLength});
+        const double need = std::max({filletTrim(r.angle, turnSideExtent(r)),
+                                      radiusTrim(r.angle, turnCentreExtent(r), turnRadius(inE, outE)),
+                                      taper ? 0.5 * kTaperLength : 0.0, 0.5 * kMinLinkLength});
         want(inE, v, need);
         want(outE, v, need);
         transitions.push_back(std::move(r));
@@ -479,6 +679,8 @@ void LaneModelBuilder::applyTrims() {
         L.end = A + L.dir * (len - tb);
         L.length = len - ta - tb;
     }
+    for (const ArmPair& p : armPairs)
+        m.overlappingArms += trimAt(p.a, p.node) < p.trim - 1e-9 || trimAt(p.b, p.node) < p.trim - 1e-9;
 }
 
 // The fillet of a link road with the trims the edges got; false when its
@@ -487,23 +689,59 @@ bool LaneModelBuilder::place(LinkRoad& r) const {
     const NodeEnd in = end(r.in, r.node), out = end(r.out, r.node);
     filletGeometry(r, g.nodes[r.node], in.dirIn(), -out.dirIn(), trimAt(r.in, r.node), trimAt(r.out, r.node));
     if (r.arcLength <= 0) return r.length() > 1e-9;
-    return 1.0 / std::abs(r.curvature) > turnSideExtent(r) + 1e-6;
+    return 1.0 / std::abs(r.curvature) >= turnSideExtent(r) + kCurvatureMargin;
+}
+
+// True when every lane centre of a placed junction turn keeps its class's
+// turning radius (lanes.h).
+bool LaneModelBuilder::meetsRadius(const LinkRoad& r) const {
+    if (r.arcLength <= 0 || std::abs(r.curvature) < 1e-12) return true;
+    return 1.0 / std::abs(r.curvature) >= turnCentreExtent(r) + turnRadius(r.in, r.out) - 1e-6;
 }
 
 // Junction turns and transitions with their geometry; counts what is dropped.
 void LaneModelBuilder::placeLinks() {
+    std::vector<LinkRoad> turns;
+    std::vector<TurnPlan> turnPlans;
+    for (size_t j = 0; j < m.junctions.size(); ++j) fitTurns(j, turns, turnPlans);
+    // Turns crossing other roads go, unless one of their lanes has no other turn.
+    const std::vector<bool> crossing = crossingTurns(turns);
+    std::map<std::pair<int, uint32_t>, std::vector<int>> cover;  // (junction, incoming arm) -> turns per lane
+    for (size_t k = 0; k < turns.size(); ++k) {
+        auto& c = cover[{turns[k].junction, turnPlans[k].in}];
+        c.resize(size_t(end(turnPlans[k].in, turns[k].node).toward()) + 1, 0);
+        for (int i = turnPlans[k].i0; i <= turnPlans[k].i1; ++i) ++c[size_t(i)];
+    }
+    std::vector<bool> drop(turns.size(), false);
+    for (size_t k = 0; k < turns.size(); ++k) {
+        if (!crossing[k]) continue;
+        auto& c = cover[{turns[k].junction, turnPlans[k].in}];
+        bool last = false;
+        for (int i = turnPlans[k].i0; i <= turnPlans[k].i1; ++i) last = last || c[size_t(i)] == 1;
+        if (last) {
+            ++m.crossingTurnsKept;
+            continue;
+        }
+        for (int i = turnPlans[k].i0; i <= turnPlans[k].i1; ++i) --c[size_t(i)];
+        drop[k] = true;
+        ++m.crossingTurns;
+    }
+    size_t k = 0;
     for (size_t j = 0; j < m.junctions.size(); ++j) {
         Junction& J = m.junctions[j];
-        for (const TurnPlan& t : plans[j]) {
-            LinkRoad r = junctionRoad(int(j), t);
-            if (!place(r)) {
-                ++m.droppedTurns;
-                continue;
-            }
+        for (; k < turns.size() && turns[k].junction == int(j); ++k) {
+            if (drop[k]) continue;
             J.links.push_back(uint32_t(m.links.size()));
-            m.links.push_back(std::move(r));
+            m.links.push_back(std::move(turns[k]));
         }
         connectLeftovers(j);
+        for (uint32_t l : J.links) {
+            const LinkRoad& r = m.links[l];
+            if (r.arcLength > 0 && std::abs(r.curvature) > 1e-12) {
+                const double rad = 1.0 / std::abs(r.curvature) - turnCentreExtent(r);
+                m.minTurnRadius = m.minTurnRadius > 0 ? std::min(m.minTurnRadius, rad) : rad;
+            }
+        }
     }
     for (LinkRoad& r : transitions) {
         if (!place(r)) {
@@ -624,6 +862,128 @@ void LaneModelBuilder::connectLeftovers(size_t j) {
             m.unfedLanes += !fed[out][size_t(o)];
         }
     }
+}
+
+// The turns of junction j on the final trims, appended to turns/plans: a
+// turn whose lanes would fold or that misses its turning radius is dropped,
+// its lanes joining the nearest turn of their arm that still meets the
+// radius with them; a lane no such turn can take keeps its own turn below
+// the radius (counted in tightTurnsKept) so that it is not left without a
+// turn, unless that turn folds (the lane is then unlinked).
+void LaneModelBuilder::fitTurns(size_t j, std::vector<LinkRoad>& turns, std::vector<TurnPlan>& turnPlans) {
+    std::vector<TurnPlan> ps = plans[j];
+    std::vector<LinkRoad> rs;
+    enum State { Ok, Folds, Tight };
+    std::vector<State> state;
+    auto fit = [&](const TurnPlan& t, LinkRoad& r) {
+        r = junctionRoad(int(j), t);
+        return !place(r) ? Folds : !meetsRadius(r) ? Tight : Ok;
+    };
+    for (const TurnPlan& t : ps) {
+        rs.emplace_back();
+        state.push_back(fit(t, rs.back()));
+    }
+    for (size_t x = 0; x < ps.size(); ++x) {
+        if (state[x] == Ok) continue;
+        for (int lane = ps[x].i0; lane <= ps[x].i1; ++lane) {
+            auto covers = [&](size_t y) {
+                return state[y] == Ok && ps[y].in == ps[x].in && ps[y].i0 <= lane && lane <= ps[y].i1;
+            };
+            bool covered = false;
+            for (size_t y = 0; y < ps.size() && !covered; ++y) covered = covers(y);
+            if (covered) continue;
+            // Nearest turn of the same arm (by lane distance) that takes the lane and keeps its radius.
+            std::vector<std::pair<int, size_t>> order;
+            for (size_t y = 0; y < ps.size(); ++y)
+                if (state[y] == Ok && ps[y].in == ps[x].in)
+                    order.push_back({lane < ps[y].i0 ? ps[y].i0 - lane : lane - ps[y].i1, y});
+            std::stable_sort(order.begin(), order.end());
+            for (const auto& o : order) {
+                TurnPlan t = ps[o.second];
+                if (lane < t.i0) t.i0 = lane;
+                if (lane > t.i1) t.i1 = lane, t.appear = 0;
+                LinkRoad r;
+                if (fit(t, r) != Ok) continue;
+                ps[o.second] = t;
+                rs[o.second] = std::move(r);
+                covered = true;
+                break;
+            }
+            if (!covered) break;  // this turn stays: below its radius, but the lane's only way on
+        }
+        bool needed = false;
+        for (int lane = ps[x].i0; lane <= ps[x].i1; ++lane) {
+            bool covered = false;
+            for (size_t y = 0; y < ps.size() && !covered; ++y)
+                covered = state[y] == Ok && ps[y].in == ps[x].in && ps[y].i0 <= lane && lane <= ps[y].i1;
+            needed = needed || !covered;
+        }
+        if (state[x] == Folds) {
+            ++m.droppedTurns;  // no lane may fold: a lane no other turn takes is left unlinked
+        } else if (needed) {
+            state[x] = Ok;
+            ++m.tightTurnsKept;
+        } else {
+            ++m.tightTurns;
+        }
+    }
+    for (size_t x = 0; x < ps.size(); ++x) {
+        if (state[x] != Ok) continue;
+        turns.push_back(std::move(rs[x]));
+        turnPlans.push_back(ps[x]);
+    }
+}
+
+// Junction turns (placed, by junction) whose driving lanes would share area
+// with a street road other than the two they join, or with a kept turn of
+// another junction (the later of two such turns goes). Outlines: street
+// carriageways as rectangles, turns as quadrilaterals between samples
+// kOutlineStep apart; shapes closer than kOverlapSlack count as apart.
+std::vector<bool> LaneModelBuilder::crossingTurns(const std::vector<LinkRoad>& turns) const {
+    struct Shape {
+        Quad q;
+        long owner;  // >= 0: street edge; < 0: turn -(owner + 1)
+    };
+    std::vector<Shape> shapes;
+    for (size_t e = 0; e < m.edges.size(); ++e) {
+        const EdgeLanes& L = m.edges[e];
+        if (!L.valid) continue;
+        const glm::dvec2 n = L.normal() * L.halfWidth();
+        shapes.push_back({{L.start - n, L.end - n, L.end + n, L.start + n}, long(e)});
+    }
+    std::vector<std::pair<size_t, size_t>> turnShapes(turns.size());  // [begin, end) into shapes
+    for (size_t k = 0; k < turns.size(); ++k) {
+        turnShapes[k].first = shapes.size();
+        for (const Quad& q : linkOutline(turns[k])) shapes.push_back({q, -long(k) - 1});
+        turnShapes[k].second = shapes.size();
+    }
+    ShapeGrid grid(8.0);
+    for (size_t i = 0; i < shapes.size(); ++i) grid.insert(shapes[i].q, uint32_t(i));
+    std::vector<bool> drop(turns.size(), false);
+    std::vector<uint32_t> near;
+    for (int pass = 0; pass < 2; ++pass) {  // street roads first, then other junctions' turns
+        for (size_t k = 0; k < turns.size(); ++k) {
+            const LinkRoad& r = turns[k];
+            for (size_t i = turnShapes[k].first; i < turnShapes[k].second && !drop[k]; ++i) {
+                grid.query(shapes[i].q, near);
+                for (uint32_t o : near) {
+                    const Shape& s = shapes[o];
+                    if (pass == 0) {
+                        if (s.owner < 0 || s.owner == long(r.in) || s.owner == long(r.out)) continue;
+                    } else {
+                        if (s.owner >= 0) continue;
+                        const size_t d = size_t(-s.owner - 1);
+                        if (d >= k || drop[d] || turns[d].junction == r.junction) continue;
+                    }
+                    if (quadsOverlap(shapes[i].q, s.q, kOverlapSlack)) {
+                        drop[k] = true;
+                        break;
+                    }
+                }
+            }
+        }
+    }
+    return drop;
 }
 
 void LaneModelBuilder::placeSignals() {

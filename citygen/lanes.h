@@ -30,8 +30,36 @@
 // - Junction: one per node of degree >= 3; its arms are the incident edges in
 //   counter-clockwise angle order (angles in (-pi, pi]); radius = the largest
 //   of (half carriageway + sidewalk) over its arms and of the trims its turns
-//   need so that no lane border of a turn passes the turn's centre of
-//   curvature (turns sharper than kMaxTurn are not built).
+//   need so that no lane border of a turn comes within kCurvatureMargin of
+//   the turn's centre of curvature and every lane centre keeps the turn's
+//   minimum turning radius (turns sharper than kMaxTurn are not built).
+//   Junction footprint: each arm is trimmed by the radius, and further where
+//   two arms' surfaces (carriageway and sidewalks, straight along the edge)
+//   would still share area beyond it (acute arms): both arms of such a pair
+//   are cut back by the same length, the shortest that leaves the two
+//   surfaces apart, plus kArmClearance. Where an edge is too short for its
+//   trims (shrunk, see above) the pair may still overlap: counted in
+//   overlappingArms.
+// - Turning radius: the lane centres of a junction turn stay at least
+//   minTurnRadius() of the lower class of its two arms from the turn's centre
+//   of curvature (Local 5 m, a car's kerb-to-kerb turning radius, Arterial
+//   8 m, Highway 12 m); a turn whose arms could not be trimmed enough for that
+//   (short edges) is not built (counted in tightTurns): its lanes join the
+//   nearest turn of their arm that keeps the radius with them, and a lane no
+//   such turn can take keeps its own turn below the radius (counted in
+//   tightTurnsKept) rather than being left without a way on. Transitions at
+//   degree-2 nodes ask for the same trims but are kept with whatever radius
+//   the edges allow (their borders keep kCurvatureMargin, else the corner is
+//   left unlinked and counted in sharpCorners). The two edges at a degree-2
+//   node are cut back like acute junction arms, so that their surfaces part
+//   whether a transition joins them or not.
+// - No crossing: a junction turn whose driving lanes would share area with a
+//   street road other than the two it joins, or with a turn of another
+//   junction (the later of the two), is not built (counted in
+//   crossingTurns), unless it is the only turn of one of its lanes (kept,
+//   counted in crossingTurnsKept): road surfaces share area only inside
+//   their junction. Both kept counts come from clusters of junctions joined
+//   by edges shorter than their trims.
 // - Link roads (LinkRoad): every junction has one per allowed turn (ordered
 //   pair of distinct arms with lanes to give and take, |turn| <= kMaxTurn);
 //   every degree-2 node has one transition road joining its two edges, unless
@@ -75,11 +103,19 @@ constexpr double kMaxTurn = 2.356194490192345;  // 135 degrees: sharper turns ge
 constexpr double kCurvatureMargin = 0.3;        // lane borders stay this far from a turn's centre of curvature
 constexpr double kTaperLength = 12.0;           // transition length where lane counts or widths change
 constexpr double kMinLinkLength = 1.0;          // shortest transition (straight on, same lanes)
+constexpr double kArmClearance = 0.05;          // gap left between the surfaces of two acute arms
+// Smallest lane-centre radius of a junction turn by road class (metres);
+// Local is a car's kerb-to-kerb turning radius, the floor of all classes.
+constexpr double kMinTurnRadiusLocal = 5.0;
+constexpr double kMinTurnRadiusArterial = 8.0;
+constexpr double kMinTurnRadiusHighway = 12.0;
 
 // Carriageway width the road mesh draws for an edge.
 double carriagewayWidth(const StreetEdge& e);
 // Default speed limit (km/h) of a road class.
 double classSpeedKmh(RoadClass c);
+// Smallest lane-centre turning radius (metres) of a road class (kMinTurnRadius*).
+double minTurnRadius(RoadClass c);
 
 struct EdgeLanes {
     bool valid = false;
@@ -188,8 +224,17 @@ struct LaneModel {
     std::vector<SignalPlacement> signals;          // by edge, start before end
     size_t sharpCorners = 0;                       // degree-2 nodes left unlinked: too sharp for the lanes
     size_t droppedTurns = 0;                       // junction turns within kMaxTurn whose trims did not fit the edges
-    size_t unlinkedLanes = 0;                      // incoming driving lanes at a junction that no turn takes
-    size_t unfedLanes = 0;                         // outgoing driving lanes at a junction that no incoming lane feeds
+    size_t tightTurns = 0;                         // junction turns not built: lane-centre radius below the class floor
+    size_t tightTurnsKept = 0;                     // turns below the floor kept: the only way on for a lane
+    size_t overlappingArms = 0;                    // junction arm pairs whose surfaces still overlap (edges too short)
+    size_t crossingTurns = 0;      // junction turns not built: they would cross another road (see above)
+    size_t crossingTurnsKept = 0;  // crossing turns kept: the only way on for a lane
+    // Smallest lane-centre radius bound over the built junction turns: arc
+    // radius less the farthest reach of a lane centre toward its centre
+    // (metres; 0 when no turn has an arc).
+    double minTurnRadius = 0;
+    size_t unlinkedLanes = 0;      // incoming driving lanes at a junction that no turn takes
+    size_t unfedLanes = 0;         // outgoing driving lanes at a junction that no incoming lane feeds
 };
 
 LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks = nullptr);

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "citygen/lanes.h"
 #include "citygen/terrain.h"
 #include "citygen/traffic_signals.h"
@@ -491,30 +493,42 @@ Result<std::string> Writer::run(OpenDriveCounts* counts) {
     o += "</OpenDRIVE>\n";
     n.sharpCorners = M.sharpCorners;
     n.droppedTurns = M.droppedTurns;
+    n.tightTurns = M.tightTurns;
+    n.overlappingArms = M.overlappingArms;
+    n.crossingTurns = M.crossingTurns;
+    n.tightTurnsKept = M.tightTurnsKept;
+    n.crossingTurnsKept = M.crossingTurnsKept;
     n.unlinkedLanes = M.unlinkedLanes;
     n.unfedLanes = M.unfedLanes;
+    n.minTurnRadius = M.minTurnRadius;
     if (counts) *counts = n;
     return std::move(o);
 }
 
 }  // namespace
 
-std::string openDriveCountsJson(const OpenDriveCounts& c) {
+std::string openDriveCountsJson(const OpenDriveCounts& n) {
     nlohmann::ordered_json j;
-    j["roads"] = c.roads;
-    j["connecting_roads"] = c.connectingRoads;
-    j["junctions"] = c.junctions;
-    j["transitions"] = c.transitions;
-    j["driving_lanes"] = c.drivingLanes;
-    j["sidewalks"] = c.sidewalks;
-    j["traffic_lights"] = c.trafficLights;
-    j["signs"] = c.signs;
-    j["crosswalks"] = c.crosswalks;
-    j["sharp_corners"] = c.sharpCorners;
-    j["dropped_turns"] = c.droppedTurns;
-    j["unlinked_lanes"] = c.unlinkedLanes;
-    j["unfed_lanes"] = c.unfedLanes;
-    j["tapered_lanes"] = c.taperedLanes;
+    j["roads"] = n.roads;
+    j["transitions"] = n.transitions;
+    j["junctions"] = n.junctions;
+    j["connecting_roads"] = n.connectingRoads;
+    j["driving_lanes"] = n.drivingLanes;
+    j["sidewalks"] = n.sidewalks;
+    j["traffic_lights"] = n.trafficLights;
+    j["signs"] = n.signs;
+    j["crosswalks"] = n.crosswalks;
+    j["sharp_corners"] = n.sharpCorners;
+    j["dropped_turns"] = n.droppedTurns;
+    j["tight_turns"] = n.tightTurns;
+    j["overlapping_arms"] = n.overlappingArms;
+    j["crossing_turns"] = n.crossingTurns;
+    j["tight_turns_kept"] = n.tightTurnsKept;
+    j["crossing_turns_kept"] = n.crossingTurnsKept;
+    j["unlinked_lanes"] = n.unlinkedLanes;
+    j["unfed_lanes"] = n.unfedLanes;
+    j["tapered_lanes"] = n.taperedLanes;
+    j["min_turn_radius_m"] = n.minTurnRadius;
     return j.dump();
 }
 

@@ -49,18 +49,28 @@ struct OpenDriveCounts {
     size_t roads = 0;            // roads of street edges
     size_t connectingRoads = 0;  // roads inside junctions
     size_t junctions = 0;
-    size_t drivingLanes = 0;   // over the street-edge roads (both directions)
-    size_t sidewalks = 0;      // sidewalk lanes over the street-edge roads
-    size_t transitions = 0;    // link roads at degree-2 nodes
-    size_t trafficLights = 0;  // signals of type traffic light
-    size_t signs = 0;          // stop and yield signs
-    size_t crosswalks = 0;     // crosswalk objects
-    size_t sharpCorners = 0;   // degree-2 nodes left unlinked (LaneModel::sharpCorners)
-    size_t droppedTurns = 0;   // LaneModel::droppedTurns
-    size_t unlinkedLanes = 0;  // LaneModel::unlinkedLanes
-    size_t unfedLanes = 0;     // LaneModel::unfedLanes
-    size_t taperedLanes = 0;   // driving lanes of link roads that start or end with width 0 inside them
+    size_t drivingLanes = 0;       // over the street-edge roads (both directions)
+    size_t sidewalks = 0;          // sidewalk lanes over the street-edge roads
+    size_t transitions = 0;        // link roads at degree-2 nodes
+    size_t trafficLights = 0;      // signals of type traffic light
+    size_t signs = 0;              // stop and yield signs
+    size_t crosswalks = 0;         // crosswalk objects
+    size_t sharpCorners = 0;       // degree-2 nodes left unlinked (LaneModel::sharpCorners)
+    size_t droppedTurns = 0;       // LaneModel::droppedTurns
+    size_t tightTurns = 0;         // LaneModel::tightTurns
+    size_t overlappingArms = 0;    // LaneModel::overlappingArms
+    size_t crossingTurns = 0;      // LaneModel::crossingTurns
+    size_t tightTurnsKept = 0;     // LaneModel::tightTurnsKept
+    size_t crossingTurnsKept = 0;  // LaneModel::crossingTurnsKept
+    size_t unlinkedLanes = 0;      // LaneModel::unlinkedLanes
+    size_t unfedLanes = 0;         // LaneModel::unfedLanes
+    size_t taperedLanes = 0;       // driving lanes of link roads that start or end with width 0 inside them
+    double minTurnRadius = 0;      // smallest lane-centre radius over the connecting roads' arcs (m; 0: no arc)
 };
+
+// The counts as a JSON object (the "opendrive" section of `vista gen
+// --stats` and the stats of `vista export`; docs/formats.md).
+std::string openDriveCountsJson(const OpenDriveCounts& n);
 
 // `blocks` (the city's, or extractBlocks() of the same graph and params)
 // decide on which sides sidewalk lanes are written (lanes.h); null: both.

@@ -354,7 +354,8 @@ int runPaged(const GenArgs& a, CityParams params, const Stopwatch& total) {
 }
 
 // Every output of the command, or none: each is staged, then all renamed
-// together; `stats` (called once the others are staged) gives the stats JSON.
+// together; `stats` (called once the others are staged, with the OpenDRIVE
+// counts when --xodr was written, else null) gives the stats JSON.
 Status writeOutputs(const GenArgs& a, const City& city, const CityParams& params,
                     const std::function<std::string(const OpenDriveCounts*)>& stats) {
     OutputBatch batch;

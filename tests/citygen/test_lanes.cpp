@@ -1,7 +1,18 @@
 // The lane model (citygen/lanes.h) on hand-made graphs: lane split and widths,
 // laneOffset for odd counts, junction radius and trims (clamped on short
-// edges), arm order, sidewalk sides from blocks.
+// edges), arm order, sidewalk sides from blocks; acute arms cut back until
+// their surfaces (intersected here with Boost.Geometry) share no area; lane
+// centres of every turn at least the class's turning radius from the arc's
+// centre.
 #include <gtest/gtest.h>
+
+// Boost.Geometry's rescaling code trips GCC's maybe-uninitialized warning.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#define BOOST_GEOMETRY_NO_ROBUSTNESS
+#include <boost/geometry.hpp>
+#include <boost/geometry/geometries/point_xy.hpp>
+#include <boost/geometry/geometries/polygon.hpp>
 
 #include <cmath>
 #include <map>
@@ -61,7 +72,11 @@ TEST(Lanes, JunctionsAndTrims) {
     ASSERT_EQ(m.junctions.size(), 1u);
     const Junction& j = m.junctions[0];
     EXPECT_EQ(j.node, 0u);
-    EXPECT_DOUBLE_EQ(j.radius, 6.5 + 3.0);  // widest arm: 13 m / 2 + sidewalk
+    // The right turn east -> north keeps the local class's turning radius:
+    // its lane centre reaches 1.5 lanes of 3.25 m toward the centre.
+    const double radius = (1.5 * 3.25 + kMinTurnRadiusLocal + 1e-3) * std::tan(0.25 * 3.14159265358979323846);
+    EXPECT_NEAR(j.radius, radius, 1e-9);
+    EXPECT_GT(j.radius, 6.5 + 3.0);  // more than the widest arm: 13 m / 2 + sidewalk
     // Arms counter-clockwise by angle in (-pi, pi]: east (0), north (pi/2), west (pi).
     ASSERT_EQ(j.arms.size(), 3u);
     EXPECT_EQ(j.arms[0], 0u);
@@ -70,19 +85,23 @@ TEST(Lanes, JunctionsAndTrims) {
     EXPECT_EQ(m.degree[3], 2);
     EXPECT_EQ(m.nodeJunction[3], -1);
     // East arm starts at the junction: trimmed at a only.
-    EXPECT_DOUBLE_EQ(m.edges[0].trimA, 9.5);
+    EXPECT_NEAR(m.edges[0].trimA, radius, 1e-9);
     EXPECT_DOUBLE_EQ(m.edges[0].trimB, 0.0);
-    EXPECT_NEAR(m.edges[0].start.x, 9.5, 1e-12);
-    EXPECT_NEAR(m.edges[0].length, 90.5, 1e-12);
+    EXPECT_NEAR(m.edges[0].start.x, radius, 1e-9);
+    EXPECT_NEAR(m.edges[0].length, 100 - radius, 1e-9);
     EXPECT_EQ(m.edges[0].junctionA, 0);
     // West arm ends at the junction.
-    EXPECT_DOUBLE_EQ(m.edges[1].trimB, 9.5);
-    EXPECT_NEAR(m.edges[1].end.x, -9.5, 1e-12);
+    EXPECT_NEAR(m.edges[1].trimB, radius, 1e-9);
+    EXPECT_NEAR(m.edges[1].end.x, -radius, 1e-9);
     // The 6 m north arm: the trims (junction at a, transition at b) are
     // shrunk in proportion so that kMinRoadLength remains.
     EXPECT_NEAR(m.edges[2].length, kMinRoadLength, 1e-12);
     EXPECT_NEAR(m.edges[2].trimA + m.edges[2].trimB, 6.0 - kMinRoadLength, 1e-12);
-    EXPECT_NEAR(m.edges[2].trimA / m.edges[2].trimB, 9.5 / (0.5 * kTaperLength), 1e-9);
+    EXPECT_NEAR(m.edges[2].trimA / m.edges[2].trimB, radius / (0.5 * kTaperLength), 1e-9);
+    // Turns into or out of the shortened arm cannot keep their radius: the
+    // ones whose lanes another turn takes are dropped, none is left unlinked.
+    EXPECT_GT(m.tightTurns + m.tightTurnsKept, 0u);
+    EXPECT_EQ(m.unlinkedLanes, 0u);
     // The degree-2 node 3 (north arm to the north-east edge) is a transition:
     // the edge is trimmed there, a dead end is not.
     EXPECT_EQ(m.edges[3].trimB, 0.0);
@@ -309,6 +328,46 @@ int lanesAway(const LaneModel& m, const StreetGraph& g, uint32_t e, uint32_t v) 
     return g.edges[e].b == v ? m.edges[e].left : m.edges[e].right;
 }
 
+namespace bg = boost::geometry;
+using BgPoint = bg::model::d2::point_xy<double>;
+using BgPolygon = bg::model::polygon<BgPoint>;
+
+BgPolygon bgPolygon(const std::vector<glm::dvec2>& pts) {
+    BgPolygon poly;
+    for (const glm::dvec2& p : pts) bg::append(poly.outer(), BgPoint(p.x, p.y));
+    bg::append(poly.outer(), BgPoint(pts[0].x, pts[0].y));
+    bg::correct(poly);
+    return poly;
+}
+
+double sharedArea(const BgPolygon& a, const BgPolygon& b) {
+    std::vector<BgPolygon> out;
+    bg::intersection(a, b, out);
+    double area = 0;
+    for (const BgPolygon& p : out) area += bg::area(p);
+    return area;
+}
+#pragma GCC diagnostic pop
+
+// The surface of a street road in the model: carriageway and the sidewalks
+// it has, between its trimmed ends.
+BgPolygon streetSurface(const EdgeLanes& L) {
+    const glm::dvec2 n = L.normal();
+    const double left = L.halfWidth() + (L.hasWalk(1) ? L.sidewalk : 0.0);
+    const double right = L.halfWidth() + (L.hasWalk(-1) ? L.sidewalk : 0.0);
+    return bgPolygon({L.start - n * right, L.end - n * right, L.end + n * left, L.start + n * left});
+}
+
+// A junction at the origin with local arms east (0), at `acute` radians and
+// west, 80 m each; the middle arm an arterial.
+StreetGraph fork(double acute) {
+    StreetGraph g;
+    g.nodes = {{0, 0}, {80, 0}, {80 * std::cos(acute), 80 * std::sin(acute)}, {-80, 0}};
+    g.edges = {
+        {0, 1, RoadClass::Local, 7.5f, 2}, {0, 2, RoadClass::Arterial, 13.0f, 4}, {3, 0, RoadClass::Local, 7.5f, 2}};
+    return g;
+}
+
 }  // namespace
 
 // Every full-width lane at a junction has a connection in and out: a T whose
@@ -354,6 +413,43 @@ TEST(Lanes, EveryJunctionLaneHasAConnectionInAndOut) {
     }
 }
 
+// Arms meeting at acute angles are cut back until their surfaces share no
+// area outside the junction (Boost.Geometry intersection of the trimmed
+// rectangles); at a right angle the junction radius alone keeps them apart.
+TEST(Lanes, AcuteArmsShareNoSurface) {
+    for (double deg : {12.0, 20.0, 30.0, 45.0, 90.0}) {
+        CityParams p;
+        p.sidewalk_m = 2.5;
+        const LaneModel m = buildLaneModel(fork(deg * 3.14159265358979323846 / 180), p);
+        ASSERT_EQ(m.junctions.size(), 1u);
+        EXPECT_EQ(m.overlappingArms, 0u) << deg;
+        for (size_t a = 0; a < 3; ++a)
+            for (size_t b = a + 1; b < 3; ++b)
+                EXPECT_LT(sharedArea(streetSurface(m.edges[a]), streetSurface(m.edges[b])), 1e-6)
+                    << deg << " deg, edges " << a << ", " << b;
+        // No turn crosses the third arm: its driving lanes (sampled) share no area with it.
+        for (const LinkRoad& r : m.links) {
+            for (size_t e = 0; e < 3; ++e) {
+                if (e == r.in || e == r.out) continue;
+                const EdgeLanes& L = m.edges[e];
+                const glm::dvec2 n = L.normal();
+                const BgPolygon carriageway = bgPolygon({L.start - n * L.halfWidth(), L.end - n * L.halfWidth(),
+                                                         L.end + n * L.halfWidth(), L.start + n * L.halfWidth()});
+                for (double s = 0; s + 0.25 <= r.length(); s += 0.25) {
+                    auto corner = [&](double u, bool left) {
+                        const double h = r.heading(u);
+                        return r.point(u) +
+                               glm::dvec2(-std::sin(h), std::cos(h)) * (left ? r.leftBorder(u) : r.rightBorder(u));
+                    };
+                    const BgPolygon piece =
+                        bgPolygon({corner(s, false), corner(s + 0.25, false), corner(s + 0.25, true), corner(s, true)});
+                    EXPECT_LT(sharedArea(piece, carriageway), 1e-3) << deg << " deg, link " << r.in << "->" << r.out;
+                }
+            }
+        }
+    }
+}
+
 // A lane that no turn can take (the only other arm is a hairpin away) is
 // counted, not hidden.
 TEST(Lanes, LanesNoTurnCanConnectAreCounted) {
@@ -372,4 +468,39 @@ TEST(Lanes, LanesNoTurnCanConnectAreCounted) {
     // outgoing lane can be fed from nothing either (the other arms only leave).
     EXPECT_EQ(m.unfedLanes, 2u);
     EXPECT_EQ(m.unlinkedLanes, 0u);
+}
+
+// Every lane centre of a junction turn keeps the turning radius of the
+// lower class of its arms, |1/k - t| on the arc with t the lane centre's
+// offset (right turns at a local plus with no sidewalk had 1.9 m).
+TEST(Lanes, TurnsKeepTheClassTurningRadius) {
+    EXPECT_EQ(minTurnRadius(RoadClass::Local), kMinTurnRadiusLocal);
+    EXPECT_GE(kMinTurnRadiusLocal, 5.0);  // a car's kerb-to-kerb turning radius is the floor
+    EXPECT_GE(minTurnRadius(RoadClass::Arterial), minTurnRadius(RoadClass::Local));
+    EXPECT_GE(minTurnRadius(RoadClass::Highway), minTurnRadius(RoadClass::Arterial));
+    const int lanes[4] = {2, 4, 2, 3};
+    const double width[4] = {7.5, 13.0, 7.0, 9.0};
+    for (double corner : {0.0, 0.3, -0.9}) {
+        CityParams p;
+        p.sidewalk_m = 0;
+        const LaneModel m = buildLaneModel(plus(lanes, width, corner), p);
+        size_t arcs = 0;
+        double smallest = 1e300;
+        for (const LinkRoad& r : m.links) {
+            if (r.junction < 0 || r.arcLength <= 0) continue;
+            ++arcs;
+            for (double s = r.line0; s <= r.line0 + r.arcLength; s += 0.1) {
+                double t = r.laneOffset(s);
+                for (const LinkRoad::Lane& l : r.right) {
+                    const double w = r.width(l, s);
+                    if (w > 0.01) smallest = std::min(smallest, std::abs(1.0 / r.curvature - (t - 0.5 * w)));
+                    t -= w;
+                }
+            }
+        }
+        EXPECT_GT(arcs, 0u);
+        EXPECT_GE(smallest, kMinTurnRadiusLocal - 1e-9) << corner;
+        EXPECT_EQ(m.unlinkedLanes, 0u);
+        EXPECT_EQ(m.tightTurns + m.tightTurnsKept, 0u);  // 80 m arms leave room for every turn
+    }
 }

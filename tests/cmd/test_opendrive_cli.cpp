@@ -4,6 +4,8 @@
 
 #include <expat.h>
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -41,6 +43,32 @@ TEST(OpenDrive, GenAndExportWriteTheSameBytes) {
     const std::string x = readBytes(a);
     EXPECT_GT(x.size(), 1000u);
     EXPECT_EQ(x, readBytes(b));
+}
+
+// The network's counts: `gen --stats` carries them under "opendrive", `export
+// --stats` writes the same object; an output path given twice is exit 2.
+TEST(OpenDrive, GenAndExportCountTheSameNetwork) {
+    TempDir dir("vista_xodr_stats");
+    const std::string city = dir.file("c.osgb"), a = dir.file("a.xodr"), b = dir.file("b.xodr");
+    auto r = runVista("gen --size 300 --seed 4 --detail 0 -q -o " + city + " --xodr " + a + " --stats " +
+                      dir.file("gen.json"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = runVista("export " + city + " --xodr " + b + " --stats " + dir.file("export.json") + " -q");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto gen = nlohmann::json::parse(readBytes(dir.file("gen.json")));
+    const auto exp = nlohmann::json::parse(readBytes(dir.file("export.json")));
+    ASSERT_TRUE(gen.contains("opendrive"));
+    EXPECT_EQ(gen["opendrive"], exp);
+    for (const char* key :
+         {"roads", "junctions", "connecting_roads", "dropped_turns", "tight_turns", "tight_turns_kept",
+          "crossing_turns", "crossing_turns_kept", "overlapping_arms", "unlinked_lanes"})
+        EXPECT_TRUE(exp.contains(key)) << key;
+    EXPECT_GT(exp["roads"].get<int>(), 0);
+    EXPECT_GE(exp["min_turn_radius_m"].get<double>(), kMinTurnRadiusLocal);
+    const std::string c = dir.file("c2.xodr");
+    r = runVista("export " + city + " --xodr " + c + " --stats " + c + " -q");
+    EXPECT_EQ(r.code, 2);
+    EXPECT_FALSE(fs::exists(c));
 }
 
 TEST(OpenDrive, ExportBadInputIsExit2WithoutFile) {

@@ -18,7 +18,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import xodr_check as xc  # noqa: E402
 
-CHECKS = ("gaps", "kinks", "folds", "unlinked", "references", "planview", "signals")
+CHECKS = ("gaps", "kinks", "folds", "turn_radius", "overlaps", "unlinked", "references", "planview", "signals")
 
 
 # ---------------------------------------------------------------------------
@@ -507,6 +507,88 @@ class BrokenFilesTest(unittest.TestCase):
         c = check(text)
         self.assertIn("references", failing(c))
         self.assertTrue(any("does not link to incomingRoad 2" in o for o in c["references"].offenders))
+
+
+class TurnsAndOverlapsTest(unittest.TestCase):
+    """The lane-centre radius on connecting roads, the margin of lane borders
+    from their centre of curvature, and lane surfaces of different roads
+    sharing area."""
+
+    def test_clip_area_against_closed_forms(self):
+        sq = [(0.0, 0.0), (2.0, 0.0), (2.0, 2.0), (0.0, 2.0)]
+        moved = [(x + 1.0, y + 0.5) for x, y in sq]
+        self.assertAlmostEqual(xc.clip_area(sq, moved), 1.0 * 1.5, places=12)
+        diamond = [(1.0, -1.0), (3.0, 1.0), (1.0, 3.0), (-1.0, 1.0)]  # square of side 2*sqrt(2) around (1, 1)
+        self.assertAlmostEqual(xc.clip_area(sq, diamond), 4.0, places=12)  # the square is inscribed
+        tri = [(0.0, 0.0), (3.0, 0.0), (0.0, 3.0)]
+        self.assertAlmostEqual(xc.clip_area(tri, sq), 4.0 - 0.5, places=12)  # x + y <= 3 cuts the corner (2, 2)
+        self.assertEqual(xc.clip_area(sq, [(2.0, 0.0), (4.0, 0.0), (4.0, 2.0), (2.0, 2.0)]), 0.0)  # touching
+        self.assertEqual(xc.clip_area(sq, [(5.0, 5.0), (6.0, 5.0), (6.0, 6.0)]), 0.0)
+
+    def test_tight_connecting_road_fails_the_turn_radius(self):
+        # the 3-arm junction with the right turn 102 on a 4 m arc: lane -1's centre (t = -1.5) runs at 2.5 m
+        self.assertEqual(check(t_junction())["turn_radius"].failures, 0)
+        self.assertAlmostEqual(check(t_junction())["turn_radius"].worst, 10.0 - 1.5, places=9)
+        text = t_junction().replace('<arc curvature="-0.1"/>', '<arc curvature="-0.25"/>', 1)
+        c = check(text)
+        self.assertEqual(c["turn_radius"].failures, 1)
+        self.assertIn("road 102 laneSection 0 lane -1", c["turn_radius"].offenders[0])
+        self.assertAlmostEqual(c["turn_radius"].worst, 4.0 - 1.5, places=9)
+        self.assertEqual(check(text, min_turn_radius=2.4)["turn_radius"].failures, 0)
+
+    def test_border_closer_than_the_margin_to_its_centre_of_curvature(self):
+        # radius 4 m turning left, lanes 1 and 2 of 1.9 m: lane 2's border 0.2 m from the centre
+        text = doc(road(1, 10.0, [geom(0.0, 0.0, 0.0, 10.0, '<arc curvature="0.25"/>')],
+                        [section([lane(2, 1.9), lane(1, 1.9)], [lane(-1, 3.5)])]))
+        c = check(text)
+        self.assertEqual(failing(c), ["folds"])
+        self.assertIn("lane 2", c["folds"].offenders[0])
+        self.assertIn("0.200 m from the centre", c["folds"].offenders[0])
+        self.assertEqual(failing(check(text, fold_margin=0.1)), [])
+
+    def crossing(self, dx=0.0, junction2="-1"):
+        """Road 1 east along y = 0, road 2 north along x = 10 + dx; one 3 m lane each side."""
+        return doc(road(1, 20.0, [geom(0.0, 0.0, 0.0, 20.0)], [section([lane(1, 3.0)], [lane(-1, 3.0)])]) +
+                   road(2, 20.0, [geom(10.0 + dx, -10.0, 0.5 * math.pi, 20.0)],
+                        [section([lane(1, 3.0)], [lane(-1, 3.0)])], junction=junction2) +
+                   ("" if junction2 == "-1" else f'<junction id="{junction2}" name="j"/>'))
+
+    def test_crossing_roads_overlap_by_their_square(self):
+        c = check(self.crossing())
+        self.assertEqual(failing(c), ["overlaps"])
+        self.assertEqual(c["overlaps"].failures, 1)
+        self.assertAlmostEqual(c["overlaps"].worst, 6.0 * 6.0, places=6)
+        self.assertEqual(c["overlaps"].by_kind, {"street roads": 1})
+        self.assertEqual(check(self.crossing(junction2="9"))["overlaps"].by_kind, {"street road / connecting road": 1})
+        # 2.5 m of road 2's width over road 1's end: 2.5 x 6 m^2
+        self.assertAlmostEqual(check(self.crossing(dx=10.5))["overlaps"].worst, 2.5 * 6.0, places=6)
+        # touching ends share no area
+        self.assertEqual(failing(check(self.crossing(dx=13.0))), [])
+        self.assertEqual(check(self.crossing(), overlap_step=0)["overlaps"].checked, 0)
+
+    def test_overlaps_reported_only_on_request(self):
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "cross.xodr")
+            with open(path, "w") as f:
+                f.write(self.crossing())
+            res = xc.run(path, xc.options([path]))
+            self.assertFalse(res["pass"])
+            res = xc.run(path, xc.options([path, "--overlap-report-only"]))
+            self.assertTrue(res["pass"])
+            self.assertEqual(res["checks"]["overlaps"]["failures"], 1)
+            self.assertIn("note overlaps", xc.summary(res))
+
+    def test_connecting_roads_overlap_inside_their_junction_only(self):
+        self.assertEqual(check(t_junction())["overlaps"].failures, 0)
+        # connecting road 100 moved into a junction of its own: it crosses 102..105 of junction 9
+        text = t_junction().replace('<road name="r100" length="20.0" id="100" junction="9"',
+                                    '<road name="r100" length="20.0" id="100" junction="8"')
+        text = text.replace('<connection id="0" incomingRoad="1" connectingRoad="100" contactPoint="start">'
+                            '<laneLink from="-1" to="-1"/></connection>', "")
+        text = text.replace('<controller id="c1"><control', '<junction id="8" name="other"/><controller id="c1"><control')
+        c = check(text)
+        self.assertIn("overlaps", failing(c))
+        self.assertEqual(set(c["overlaps"].by_kind), {"connecting roads of different junctions"})
 
 
 class GeometryJoinsTest(unittest.TestCase):

@@ -571,12 +571,199 @@ class Network:
             self.controllers[cid] = el
 
 
+def section_samples(r, sec, step):
+    """Sorted s values covering lane section sec of road r: every `step` metres,
+    at every geometry, laneOffset and width/border record start, and just
+    before each of those."""
+    lo, hi = sec.s, sec.end
+    if hi <= lo:
+        return []
+    pts = set(g.s for g in r.geoms) | set(o[0] for o in r.offsets)
+    for lane in sec.lanes.values():
+        pts |= set(sec.s + w[0] for w in lane.widths) | set(sec.s + w[0] for w in lane.borders)
+    n_steps = max(1, int(math.ceil((hi - lo) / step)))
+    samples = {lo + (hi - lo) * i / n_steps for i in range(n_steps + 1)}
+    for p in pts:
+        if lo <= p <= hi:
+            samples.add(p)
+            if p - 1e-7 >= lo:
+                samples.add(p - 1e-7)
+    return sorted(samples)
+
+
+# ---------------------------------------------------------------------------
+# overlaps: lane polygons of different roads sharing area
+
+def clip_area(subject, clip):
+    """Area of the intersection of two convex counter-clockwise polygons
+    (Sutherland-Hodgman clipping of subject by each edge of clip; exact up to
+    floating point; touching polygons give 0)."""
+    out = subject
+    n = len(clip)
+    for i in range(n):
+        if len(out) < 3:
+            return 0.0
+        ax, ay = clip[i - 1]
+        bx, by = clip[i]
+        ex, ey = bx - ax, by - ay
+        inp, out = out, []
+        px, py = inp[-1]
+        dp = ex * (py - ay) - ey * (px - ax)
+        for cx, cy in inp:
+            dc = ex * (cy - ay) - ey * (cx - ax)
+            if dc >= 0.0:
+                if dp < 0.0:
+                    f = dp / (dp - dc)
+                    out.append((px + f * (cx - px), py + f * (cy - py)))
+                out.append((cx, cy))
+            elif dp > 0.0:
+                f = dp / (dp - dc)
+                out.append((px + f * (cx - px), py + f * (cy - py)))
+            px, py, dp = cx, cy, dc
+    if len(out) < 3:
+        return 0.0
+    a = 0.0
+    x0, y0 = out[-1]
+    for x1, y1 in out:
+        a += x0 * y1 - x1 * y0
+        x0, y0 = x1, y1
+    return 0.5 * a
+
+
+class RoadSurface:
+    """The lanes of one road as counter-clockwise triangles in plan, two per
+    sampled step of each lane (inner and outer border at consecutive s),
+    with their bounding boxes on a grid of `cell` metres. Triangles of one
+    road do not overlap each other unless the road folds (the folds check)."""
+
+    def __init__(self, r, step, cell, min_width):
+        self.road = r
+        self.cell = cell
+        self.tris = []   # (points, xmin, ymin, xmax, ymax, driving, lane id)
+        self.grid = {}
+        lo = [math.inf, math.inf]
+        hi = [-math.inf, -math.inf]
+        for sec in r.sections:
+            prev = None
+            for s in section_samples(r, sec, step):
+                x, y, h, _ = r.ref(s)
+                nx, ny = -math.sin(h), math.cos(h)
+                cur = {lid: ((x + ti * nx, y + ti * ny), (x + to * nx, y + to * ny), abs(to - ti))
+                       for lid, (ti, to) in r.borders(sec, s).items() if lid != 0}
+                if prev is not None:
+                    for lid, (i1, o1, w1) in cur.items():
+                        if lid not in prev:
+                            continue
+                        i0, o0, w0 = prev[lid]
+                        if w0 < min_width and w1 < min_width:
+                            continue
+                        driving = sec.lanes[lid].type in DRIVING_TYPES
+                        for tri in ((i0, o0, o1), (i0, o1, i1)):
+                            self.add(tri, driving, lid, lo, hi)
+                prev = cur
+        self.bbox = (lo[0], lo[1], hi[0], hi[1])
+
+    def add(self, tri, driving, lid, lo, hi):
+        (ax, ay), (bx, by), (cx, cy) = tri
+        area2 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+        if abs(area2) < 1e-12:
+            return
+        if area2 < 0:
+            tri = (tri[0], tri[2], tri[1])
+        xs, ys = (ax, bx, cx), (ay, by, cy)
+        t = (tri, min(xs), min(ys), max(xs), max(ys), driving, lid)
+        idx = len(self.tris)
+        self.tris.append(t)
+        lo[0], lo[1] = min(lo[0], t[1]), min(lo[1], t[2])
+        hi[0], hi[1] = max(hi[0], t[3]), max(hi[1], t[4])
+        c = self.cell
+        for gx in range(int(math.floor(t[1] / c)), int(math.floor(t[3] / c)) + 1):
+            for gy in range(int(math.floor(t[2] / c)), int(math.floor(t[4] / c)) + 1):
+                self.grid.setdefault((gx, gy), []).append(idx)
+
+    def overlap(self, other):
+        """(driving area, any-lane area) shared with another road's surface."""
+        drive = total = 0.0
+        c = self.cell
+        for tb, bx0, by0, bx1, by1, bdrive, _ in other.tris:
+            seen = set()
+            for gx in range(int(math.floor(bx0 / c)), int(math.floor(bx1 / c)) + 1):
+                for gy in range(int(math.floor(by0 / c)), int(math.floor(by1 / c)) + 1):
+                    seen.update(self.grid.get((gx, gy), ()))
+            for i in seen:
+                ta, ax0, ay0, ax1, ay1, adrive, _ = self.tris[i]
+                if ax0 >= bx1 or bx0 >= ax1 or ay0 >= by1 or by0 >= ay1:
+                    continue
+                a = clip_area(ta, tb)
+                if a > 0.0:
+                    total += a
+                    if adrive and bdrive:
+                        drive += a
+        return drive, total
+
+
+def check_overlaps(net, opt):
+    """Pairs of roads whose driving lanes share more than --max-overlap m^2
+    of plan area, except connecting roads of one junction (which overlap by
+    design inside it). Lane polygons are sampled every --overlap-step metres
+    from the XML; each pair's area is the sum of exact triangle-triangle
+    intersections. Failures by kind: between street roads, a street road and
+    a connecting road, connecting roads of different junctions."""
+    ch = Check("overlaps", opt.max_overlap, "m^2", opt.max_list)
+    ch.total_area = 0.0
+    ch.surface_pairs = 0  # pairs whose lanes of any type (sidewalks too) overlap
+    if opt.overlap_step <= 0:
+        return ch
+    cell = 4.0
+    surf = [RoadSurface(r, opt.overlap_step, cell, opt.taper_width) for r in net.roads.values()]
+    surf = [sf for sf in surf if sf.tris]
+    big = 64.0  # road bounding boxes on a coarse grid
+    grid = {}
+    for k, sf in enumerate(surf):
+        x0, y0, x1, y1 = sf.bbox
+        for gx in range(int(math.floor(x0 / big)), int(math.floor(x1 / big)) + 1):
+            for gy in range(int(math.floor(y0 / big)), int(math.floor(y1 / big)) + 1):
+                grid.setdefault((gx, gy), []).append(k)
+    pairs = set()
+    for members in grid.values():
+        for i in range(len(members)):
+            for j in range(i + 1, len(members)):
+                pairs.add((members[i], members[j]))
+    for i, j in sorted(pairs):
+        a, b = surf[i], surf[j]
+        ra, rb = a.road, b.road
+        if ra.junction != "-1" and ra.junction == rb.junction:
+            continue
+        if a.bbox[0] >= b.bbox[2] or b.bbox[0] >= a.bbox[2] or a.bbox[1] >= b.bbox[3] or b.bbox[1] >= a.bbox[3]:
+            continue
+        ch.checked += 1
+        if len(a.tris) < len(b.tris):
+            a, b = b, a
+        drive, total = a.overlap(b)
+        if total > opt.max_overlap:
+            ch.surface_pairs += 1
+        ch.value(drive, f"road {a.road.id} / road {b.road.id}")
+        if drive > opt.max_overlap:
+            ch.total_area += drive
+            ja, jb = a.road.junction, b.road.junction
+            kind = ("street roads" if ja == "-1" and jb == "-1" else
+                    "street road / connecting road" if ja == "-1" or jb == "-1" else
+                    "connecting roads of different junctions")
+            names = sorted((a.road, b.road), key=lambda r: r.id)
+            label = " / ".join(f"road {r.id}" + ("" if r.junction == "-1" else f" (junction {r.junction})")
+                               for r in names)
+            ch.fail(f"{label}: driving lanes share {drive:.3f} m^2", kind)
+    return ch
+
+
 def check_network(net, opt):
     n = opt.max_list
     gaps = Check("gaps", {"plan_m": opt.max_gap, "height_m": opt.max_dz}, "m", n)
     gaps.worst_dz = None
     kinks = Check("kinks", opt.max_kink_deg, "deg", n)
-    folds = Check("folds", 0.0, "1-k*t", n)
+    folds = Check("folds", {"1-k*t": 0.0, "margin_m": opt.fold_margin}, "1-k*t", n)
+    folds.worst_margin = None
+    turns = Check("turn_radius", opt.min_turn_radius, "m", n)
     unlinked = Check("unlinked", opt.taper_width, "m", n)
     refs = Check("references", None, "", n)
     planview = Check("planview", opt.max_length_error, "m", n)
@@ -861,35 +1048,40 @@ def check_network(net, opt):
                         pairs.append((t, lane.id))
             compare_lanes("laneSection", f"road {r.id} laneSection {k}->{k + 1}", r, s1.s, s0, r, s1.s, s1, pairs)
 
-    # -- folds
+    # -- folds (and the margin of every border from its centre of curvature),
+    # turn radii of the driving lanes on connecting roads
     for r in roads.values():
-        marks = set(g.s for g in r.geoms) | set(o[0] for o in r.offsets)
+        connecting = r.junction != "-1"
         for k, sec in enumerate(r.sections):
-            lo, hi = sec.s, sec.end
-            if hi <= lo:
-                continue
-            pts = set(marks)
-            for lane in sec.lanes.values():
-                pts |= set(sec.s + w[0] for w in lane.widths) | set(sec.s + w[0] for w in lane.borders)
-            n_steps = max(1, int(math.ceil((hi - lo) / opt.fold_step)))
-            samples = {lo + (hi - lo) * i / n_steps for i in range(n_steps + 1)}
-            for p in pts:
-                if lo <= p <= hi:
-                    samples.add(p)
-                    if p - 1e-7 >= lo:
-                        samples.add(p - 1e-7)
-            bad = {}
-            for s in sorted(samples):
+            bad, tight = {}, {}
+            samples = section_samples(r, sec, opt.fold_step)
+            for s in samples:
                 kappa = r.ref(s)[3]
-                for lid, (_, t_out) in r.borders(sec, s).items():
+                bd = r.borders(sec, s)
+                for lid, (t_in, t_out) in bd.items():
                     v = 1.0 - kappa * t_out
                     folds.value(v, f"road {r.id} lane {lid} s={s:.2f}", worse=lambda a, b: a < b)
-                    if v <= 0.0 and (lid not in bad or v < bad[lid][0]):
-                        bad[lid] = (v, s)
+                    # distance of the border from the centre of curvature (signed: < 0 past it)
+                    margin = v / abs(kappa) if abs(kappa) > 1e-12 else math.inf
+                    if folds.worst_margin is None or margin < folds.worst_margin[0]:
+                        folds.worst_margin = (margin, f"road {r.id} lane {lid} s={s:.2f}")
+                    if (v <= 0.0 or margin < opt.fold_margin) and (lid not in bad or v < bad[lid][0]):
+                        bad[lid] = (v, s, margin)
+                    lane = sec.lanes.get(lid)
+                    if not connecting or lane is None or lane.type not in DRIVING_TYPES or abs(kappa) <= 1e-12 \
+                            or abs(t_out - t_in) < opt.taper_width:
+                        continue
+                    radius = abs(1.0 / kappa - 0.5 * (t_in + t_out))
+                    turns.checked += 1
+                    turns.value(radius, f"road {r.id} lane {lid} s={s:.2f}", worse=lambda a, b: a < b)
+                    if radius < opt.min_turn_radius and (lid not in tight or radius < tight[lid][0]):
+                        tight[lid] = (radius, s)
             folds.checked += len(samples)
-            for lid, (v, s) in sorted(bad.items()):
-                folds.fail(f"road {r.id} laneSection {k} lane {lid}: 1-k*t={v:.3f} at s={s:.2f}",
-                           "road" if r.junction == "-1" else "connecting road")
+            for lid, (v, s, margin) in sorted(bad.items()):
+                folds.fail(f"road {r.id} laneSection {k} lane {lid}: 1-k*t={v:.3f}, {margin:.3f} m from the centre "
+                           f"of curvature at s={s:.2f}", "road" if r.junction == "-1" else "connecting road")
+            for lid, (radius, s) in sorted(tight.items()):
+                turns.fail(f"road {r.id} laneSection {k} lane {lid}: lane-centre radius {radius:.3f} m at s={s:.2f}")
 
     # -- unlinked driving lanes
     for r in roads.values():
@@ -996,7 +1188,8 @@ def check_network(net, opt):
                                   f"{link['id']} leads into it", "junction exit")
 
     check_signals(net, opt, signals)
-    return {c.name: c for c in (gaps, kinks, folds, unlinked, refs, planview, signals)}
+    overlaps = check_overlaps(net, opt)
+    return {c.name: c for c in (gaps, kinks, folds, turns, overlaps, unlinked, refs, planview, signals)}
 
 
 def point_beyond_road(road, x, y, tol):
@@ -1174,10 +1367,19 @@ def run(path, opt):
     g = checks["gaps"]
     result["checks"]["gaps"]["worst_height"] = g.worst_dz[0] if g.worst_dz else None
     result["checks"]["gaps"]["worst_height_at"] = g.worst_dz[1] if g.worst_dz else None
+    f = checks["folds"]
+    finite = f.worst_margin is not None and math.isfinite(f.worst_margin[0])
+    result["checks"]["folds"]["worst_margin_m"] = f.worst_margin[0] if finite else None
+    result["checks"]["folds"]["worst_margin_at"] = f.worst_margin[1] if finite else None
+    result["checks"]["overlaps"]["overlap_area_m2"] = checks["overlaps"].total_area
+    result["checks"]["overlaps"]["surface_pairs"] = checks["overlaps"].surface_pairs
     if opt.xsd:
         errs = schema_errors(path, opt.xsd)
         result["checks"]["schema"] = {"failures": len(errs), "checked": 1, "offenders": errs[:opt.max_list],
                                       "pass": not errs, "xsd": os.path.basename(opt.xsd)}
+    if opt.overlap_report_only:
+        result["checks"]["overlaps"]["pass"] = True
+        result["checks"]["overlaps"]["report_only"] = True
     result["pass"] = all(c["pass"] for c in result["checks"].values())
     return result
 
@@ -1190,6 +1392,8 @@ def summary(res):
            f"{c['controllers']} controllers, {c['objects']} objects {c['objects_by_type']}"]
     for name, ch in res["checks"].items():
         state = "ok  " if ch["pass"] else "FAIL"
+        if ch.get("report_only") and ch["failures"]:
+            state = "note"
         extra = ""
         if name == "gaps":
             extra = (f", worst plan {ch['worst'] or 0:.4f} m (limit {ch['limit']['plan_m']}), "
@@ -1197,7 +1401,16 @@ def summary(res):
         elif name == "kinks":
             extra = f", worst {ch['worst'] or 0:.3f} deg (limit {ch['limit']})"
         elif name == "folds":
-            extra = f", smallest 1-k*t {ch['worst'] if ch['worst'] is not None else 1:.4f} (must stay > 0)"
+            margin = "none curved" if ch["worst_margin_m"] is None else f"{ch['worst_margin_m']:.3f} m"
+            extra = (f", smallest 1-k*t {ch['worst'] if ch['worst'] is not None else 1:.4f} (must stay > 0), "
+                     f"closest border to its centre of curvature {margin} (limit {ch['limit']['margin_m']} m)")
+        elif name == "turn_radius":
+            worst = "none curved" if ch["worst"] is None else f"{ch['worst']:.3f} m"
+            extra = f", smallest lane-centre radius on connecting roads {worst} (limit {ch['limit']} m)"
+        elif name == "overlaps":
+            extra = (f" road pairs, {ch['overlap_area_m2']:.3f} m^2 shared by driving lanes outside a common junction "
+                     f"(limit {ch['limit']} m^2 a pair), largest {ch['worst'] or 0:.3f} m^2; "
+                     f"{ch['surface_pairs']} pairs overlap counting sidewalks")
         elif name == "planview":
             extra = f", worst {ch['worst'] or 0:.5f} m (limit {ch['limit']})"
         if ch.get("failures_by_kind"):
@@ -1233,6 +1446,17 @@ def options(argv=None):
     ap.add_argument("--max-kink-deg", type=positive("--max-kink-deg"), default=0.5,
                     help="heading jump limit, degrees (0.5)")
     ap.add_argument("--fold-step", type=positive("--fold-step"), default=0.25, help="fold sampling step, m (0.25)")
+    ap.add_argument("--fold-margin", type=positive("--fold-margin"), default=0.3,
+                    help="closest a lane border may come to its centre of curvature, m (0.3)")
+    ap.add_argument("--min-turn-radius", type=positive("--min-turn-radius"), default=5.0,
+                    help="smallest lane-centre radius of a driving lane on a connecting road, m (5.0: a car's "
+                         "kerb-to-kerb turning radius)")
+    ap.add_argument("--max-overlap", type=positive("--max-overlap"), default=0.01,
+                    help="plan area two roads' driving lanes may share outside a common junction, m^2 (0.01)")
+    ap.add_argument("--overlap-report-only", action="store_true",
+                    help="report the overlaps check without letting it fail the file")
+    ap.add_argument("--overlap-step", type=float, default=0.25,
+                    help="sampling step of the lane polygons of the overlaps check, m (0.25; 0 skips the check)")
     ap.add_argument("--taper-width", type=positive("--taper-width"), default=0.01,
                     help="lanes narrower than this at an end need no successor, m (0.01)")
     ap.add_argument("--max-group-deg", type=positive("--max-group-deg"), default=30.0,
@@ -1252,7 +1476,9 @@ def main(argv=None):
         print(f"xodr_check: {e}", file=sys.stderr)
         return 2
     res["limits"] = {"max_gap_m": opt.max_gap, "max_dz_m": opt.max_dz, "max_kink_deg": opt.max_kink_deg,
-                     "fold_step_m": opt.fold_step, "taper_width_m": opt.taper_width,
+                     "fold_step_m": opt.fold_step, "fold_margin_m": opt.fold_margin,
+                     "min_turn_radius_m": opt.min_turn_radius, "max_overlap_m2": opt.max_overlap,
+                     "overlap_step_m": opt.overlap_step, "taper_width_m": opt.taper_width,
                      "max_group_deg": opt.max_group_deg,
                      "max_length_error_m": opt.max_length_error}
     if opt.json:
