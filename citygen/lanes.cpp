@@ -1032,8 +1032,7 @@ void LaneModelBuilder::groupApproaches() {
                 const double off = std::abs(std::atan2(a.x * b.y - a.y * b.x, -(a.x * b.x + a.y * b.y)));
                 if (off <= kOppositeArms) pairs.push_back({off, {x, y}});
             }
-        std::stable_sort(pairs.begin(), pairs.end(),
-                         [](const auto& p, const auto& q) { return p.first < q.first; });
+        std::stable_sort(pairs.begin(), pairs.end(), [](const auto& p, const auto& q) { return p.first < q.first; });
         std::vector<size_t> partner(lights.size(), lights.size());
         for (const auto& [off, xy] : pairs)
             if (partner[xy.first] == lights.size() && partner[xy.second] == lights.size())

@@ -233,8 +233,8 @@ struct LaneModel {
     // radius less the farthest reach of a lane centre toward its centre
     // (metres; 0 when no turn has an arc).
     double minTurnRadius = 0;
-    size_t unlinkedLanes = 0;      // incoming driving lanes at a junction that no turn takes
-    size_t unfedLanes = 0;         // outgoing driving lanes at a junction that no incoming lane feeds
+    size_t unlinkedLanes = 0;  // incoming driving lanes at a junction that no turn takes
+    size_t unfedLanes = 0;     // outgoing driving lanes at a junction that no incoming lane feeds
 };
 
 LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks = nullptr);

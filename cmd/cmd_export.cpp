@@ -45,7 +45,8 @@ int runExport(int argc, char** argv) {
     if (xodr.empty()) return reportBadInput(cmd, Status::error("nothing to export: give --xodr FILE.xodr"));
     if (Status s = checkXodrPath("--xodr", xodr); !s) return reportBadInput(cmd, s);
     CommandFiles files;  // held until the output is written (its lock)
-    if (Status s = files.input("city", input).output("--xodr", xodr).output("--stats", statsFile).check(); !s) return reportBadInput(cmd, s);
+    if (Status s = files.input("city", input).output("--xodr", xodr).output("--stats", statsFile).check(); !s)
+        return reportBadInput(cmd, s);
     auto model = loadCityFile(input);
     if (!model) return reportBadInput(cmd, model.status());
     if (model->streets.edges.empty())

@@ -372,8 +372,7 @@ Status writeOutputs(const GenArgs& a, const City& city, const CityParams& params
         VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage(a.xodrFile), *xodr));
     }
     if (!a.statsFile.empty())
-        VISTA_RETURN_IF_ERROR(
-            writeFileAtomic(batch.stage(a.statsFile), stats(a.xodrFile.empty() ? nullptr : &roads)));
+        VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage(a.statsFile), stats(a.xodrFile.empty() ? nullptr : &roads)));
     return batch.commit();
 }
 

@@ -378,8 +378,8 @@ StreetGraph fork(double acute) {
 TEST(Lanes, EveryJunctionLaneHasAConnectionInAndOut) {
     StreetGraph g;
     g.nodes = {{0, 0}, {-100, 0}, {100, 0}, {0, -100}, {0, 100}};
-    g.edges = {{1, 0, RoadClass::Local, 7.0f, 2}, {0, 2, RoadClass::Arterial, 14.0f, 4},
-               {3, 0, RoadClass::Local, 7.0f, 2}};
+    g.edges = {
+        {1, 0, RoadClass::Local, 7.0f, 2}, {0, 2, RoadClass::Arterial, 14.0f, 4}, {3, 0, RoadClass::Local, 7.0f, 2}};
     g.edges[1].lanesForward = 3;
     g.edges[1].lanesBackward = 1;
     for (int variant = 0; variant < 2; ++variant) {

@@ -434,7 +434,8 @@ TEST(OpenDrive, SignalsAreReadableBySimulators) {
         for (size_t x = 0; x < controls.size(); ++x) {
             EXPECT_TRUE(controlled.insert(controls[x]->str("signalId")).second);
             for (size_t y = x + 1; y < controls.size(); ++y)
-                EXPECT_TRUE(opposite(signalRoad[controls[x]->str("signalId")], signalRoad[controls[y]->str("signalId")]))
+                EXPECT_TRUE(
+                    opposite(signalRoad[controls[x]->str("signalId")], signalRoad[controls[y]->str("signalId")]))
                     << "controller " << c->str("id");
         }
     }

@@ -81,10 +81,9 @@ struct NetCheck {
 NetCheck runNetconvert(const std::string& netconvert, const std::string& xodr, const std::string& dir) {
     NetCheck r;
     const std::string net = dir + "/city.net.xml", log = dir + "/netconvert.log";
-    const int st = std::system(
-        ("env -u LD_PRELOAD " + netconvert + " --aggregate-warnings -1 --opendrive-files " + xodr + " -o " + net +
-         " >" + log + " 2>&1")
-            .c_str());
+    const int st = std::system(("env -u LD_PRELOAD " + netconvert + " --aggregate-warnings -1 --opendrive-files " +
+                                xodr + " -o " + net + " >" + log + " 2>&1")
+                                   .c_str());
     r.exitCode = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
     r.log = readBytes(log);
     for (size_t pos = 0; (pos = r.log.find("Error", pos)) != std::string::npos; ++pos)
