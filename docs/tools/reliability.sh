@@ -20,7 +20,7 @@ XVFB=(xvfb-run -a -s "-screen 0 1280x1024x24")
 [ -n "${DISPLAY:-}" ] && XVFB=()
 
 echo "== regression tests of the findings" >&2
-"${XVFB[@]}" ctest --test-dir build -R 'Hostile|Huge|BadInput|Kill|Stale|OutputBatch|Malformed|BadScene|BadEffects|Unwritable|Osm|Geodesy|Params|Paths|CellResult|Damaged|Corrupt|Faults|LookingOut|KeepsTheReaderBusy|FaultSweep|CreatedDirectories|MemoryBudget|Netconvert|OutputRule|BoundedReads|NumbersAsWritten|NumberText|InputFile|OutputPaths|EffectsOption|BakedFlags|OsmLargerThanTheCity|Options.EffectsOptionRules|Options.SeedOptionNeverWraps|OsmRoadTags.GraphJson|ValuesCli|PagedManifest|FocalLengths' \
+"${XVFB[@]}" ctest --test-dir build -R 'Hostile|Huge|BadInput|Kill|Stale|OutputBatch|Malformed|BadScene|BadEffects|Unwritable|Osm|Geodesy|Params|Paths|CellResult|Damaged|Corrupt|Faults|LookingOut|KeepsTheReaderBusy|FaultSweep|CreatedDirectories|MemoryBudget|Netconvert|OutputRule|BoundedReads|NumbersAsWritten|NumberText|InputFile|OutputPaths|EffectsOption|BakedFlags|OsmLargerThanTheCity|Options.EffectsOptionRules|Options.SeedOptionNeverWraps|OsmRoadTags.GraphJson|ValuesCli|PagedManifest|FocalLengths|SpecialOutputs|OutputPlaces|OutputLocks|ResolvedPaths|PagedStream\.|TheManifestsGeneration|CarriesTheManifestsGeneration|AResumeRendersDamagedFramesAgain|CannotHoldTheRegionsAtTheCamera' \
   --output-on-failure -j2 > "$OUT/regression.txt" 2>&1 || true
 
 if [ -n "${FUZZ_TSV:-}" ]; then
