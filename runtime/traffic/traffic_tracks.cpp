@@ -20,6 +20,11 @@ namespace vista {
 
 namespace {
 
+constexpr double kMaxFcdTime = 1e9;          // s
+constexpr double kMaxFcdCoordinate = 2e7;    // m, world frame
+constexpr double kMaxFcdAngleDeg = 36000.0;  // degrees
+constexpr double kMaxFcdSpeed = 1000.0;      // m/s
+
 const char* attr(const XML_Char** atts, const char* name) {
     for (int i = 0; atts[i]; i += 2)
         if (std::strcmp(atts[i], name) == 0) return atts[i + 1];
@@ -56,6 +61,7 @@ struct Reader {
         if (std::strcmp(name, "timestep") == 0) {
             double t = 0.0;
             if (!number(attr(atts, "time"), &t)) return fail("a <timestep> has no numeric time");
+            if (std::abs(t) > kMaxFcdTime) return fail("time " + std::to_string(t) + " is outside [-1e9, 1e9] s");
             if (!tracks.times.empty() && t <= tracks.times.back())
                 return fail("time " + std::to_string(t) + " does not follow " + std::to_string(tracks.times.back()));
             tracks.times.push_back(t);
@@ -78,7 +84,18 @@ struct Reader {
         double x = 0, y = 0, angle = 0, speed = 0;
         if (!number(attr(atts, "x"), &x) || !number(attr(atts, "y"), &y) || !number(attr(atts, "angle"), &angle))
             return fail(std::string("agent '") + id + "' lacks a numeric x, y or angle");
-        number(attr(atts, "speed"), &speed);
+        if (attr(atts, "speed") && !number(attr(atts, "speed"), &speed))
+            return fail(std::string("agent '") + id + "' has a speed that is not a number");
+        // Ranges (the path CSV's): positions within 2e7 m of the origin once
+        // the network offset is removed, angles within 36000 degrees, speeds
+        // 0 .. 1000 m/s; beyond them a pose means nothing and would not fit a
+        // float.
+        if (std::abs(x - offsetX) > kMaxFcdCoordinate || std::abs(y - offsetY) > kMaxFcdCoordinate)
+            return fail(std::string("agent '") + id + "' stands outside |x|, |y| <= 2e7 m (world frame)");
+        if (std::abs(angle) > kMaxFcdAngleDeg)
+            return fail(std::string("agent '") + id + "' has an angle outside [-36000, 36000] degrees");
+        if (!(speed >= 0.0 && speed <= kMaxFcdSpeed))
+            return fail(std::string("agent '") + id + "' has a speed outside [0, 1000] m/s");
         auto [it, added] = agentIndex.try_emplace(id, uint32_t(tracks.agentIds.size()));
         if (added) {
             tracks.agentIds.push_back(id);

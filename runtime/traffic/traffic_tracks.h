@@ -17,8 +17,9 @@
 //   them) unless `t` is a sample's own time.
 // - readFcd() streams the file (expat). A file that is not FCD, is truncated
 //   or malformed, has times that do not increase, or a vehicle or person of a
-//   type vista does not know, is an error naming the file, the line and the
-//   reason. Thread-safe (const after reading).
+//   type vista does not know, or a value out of range (|time| <= 1e9 s,
+//   world |x|, |y| <= 2e7 m, |angle| <= 36000 degrees, speed 0 .. 1000 m/s),
+//   is an error naming the file, the line and the reason. Thread-safe (const after reading).
 #pragma once
 #include <cstdint>
 #include <string>

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <regex>
 #include <set>
@@ -323,6 +324,42 @@ TEST(TrafficTracks, BadFilesAreErrors) {
     EXPECT_NE(ty.status().message().find("'tank'"), std::string::npos);
     writeText(dir.file("root.xml"), "<net/>");
     EXPECT_FALSE(readFcd(dir.file("root.xml"), 0, 0));
+}
+
+// Values a pose cannot mean (and that would not fit its floats) are refused
+// naming the agent; the same values one step inside the ranges are read.
+TEST(TrafficTracks, ValuesOutOfRangeAreErrorsNamingTheAgent) {
+    TempDir dir("vista_fcd_range");
+    const std::string full = kFcd;
+    struct Case {
+        const char* from;
+        const char* to;
+        const char* says;
+    };
+    for (const Case& c : {Case{"x=\"115.00\"", "x=\"1e300\"", "outside |x|, |y|"},
+                          Case{"y=\"-40.00\" angle=\"90.00\" type=\"car\" speed=\"10.00\" lane=\"a_0\"/>\n    <person",
+                               "y=\"-3e7\" angle=\"90.00\" type=\"car\" speed=\"10.00\" lane=\"a_0\"/>\n    <person",
+                               "outside |x|, |y|"},
+                          Case{"angle=\"180.00\" type=\"bus\" speed=\"0.00\"",
+                               "angle=\"1e40\" type=\"bus\" speed=\"0.00\"", "angle outside"},
+                          Case{"speed=\"2.00\"", "speed=\"-2\"", "speed outside"},
+                          Case{"speed=\"2.00\"", "speed=\"fast\"", "not a number"},
+                          Case{"time=\"1.00\"", "time=\"2e9\"", "outside [-1e9, 1e9]"}}) {
+        std::string text = full;
+        ASSERT_NE(text.find(c.from), std::string::npos) << c.from;
+        text.replace(text.find(c.from), std::strlen(c.from), c.to);
+        writeText(dir.file("r.xml"), text);
+        auto r = readFcd(dir.file("r.xml"), 0, 0);
+        ASSERT_FALSE(r) << c.to;
+        EXPECT_NE(r.status().message().find(c.says), std::string::npos) << r.status().message();
+        EXPECT_NE(r.status().message().find("line "), std::string::npos) << r.status().message();
+    }
+    std::string edge = full;
+    const std::string at = "x=\"115.00\"";
+    edge.replace(edge.find(at), at.size(), "x=\"19999999\"");
+    writeText(dir.file("edge.xml"), edge);
+    auto e = readFcd(dir.file("edge.xml"), 0, 0);
+    EXPECT_TRUE(e) << e.status().message();
 }
 
 TEST(SumoProcess, TheGeneratedDateIsRemovedAndNothingElse) {
