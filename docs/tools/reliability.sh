@@ -8,7 +8,8 @@
 # display or xvfb-run; the full run takes about 2 hours on 2 cores: 7 fuzz
 # targets x FUZZ_SECONDS, a sanitizer build and test run, the fault sweep, the soak).
 # Reuse results of a step run separately (the doc says which were reused):
-#   FUZZ_TSV=summary.tsv (from .ci/fuzz.sh), SANITIZE_LOG=log (of .ci/sanitize.sh),
+#   FUZZ_TSV=summary.tsv (from .ci/fuzz.sh), SANITIZE_LOG=log (of .ci/sanitize.sh), RACE_TSV=race.tsv
+#   (of docs/tools/race_trials.sh),
 #   FAULT_TSV=tsv (of fault_sweep.sh --tsv), SOAK_CSV=csv (of soak).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -43,6 +44,13 @@ if [ -n "${FAULT_TSV:-}" ]; then
 else
   echo "== fault sweep: every write of every command fails once" >&2
   docs/tools/fault_sweep.sh --tsv "$OUT/faults.tsv" > "$OUT/faults.txt" 2>&1 || true
+fi
+
+if [ -n "${RACE_TSV:-}" ]; then
+  cp "$RACE_TSV" "$OUT/race.tsv"
+else
+  echo "== two writers racing on one output, 50 trials per command" >&2
+  docs/tools/race_trials.sh 50 build/vista > "$OUT/race.tsv" 2>"$OUT/race.txt" || true
 fi
 
 if [ -n "${SOAK_CSV:-}" ]; then
@@ -121,6 +129,17 @@ print()
 print("## Files, reads and numbers")
 print()
 print("One rule for every command's files, checked in one place (foundation/output_paths.h) before anything is read or written: no two outputs of a command are the same file, and no output is one of its inputs. Paths are compared after symlinks, `.` and `..` (the real path of the parent directory plus the name) and, where both exist, by device and inode. A refusal exits with code 2 and names both options. `vista gen` (city, GeoJSON, glTF, OpenDRIVE, stats), `vista bake` (baked file, stats) and `vista path` (CSV, lane positions) stage their outputs and rename them together: all appear, or none.")
+print()
+race = list(csv.DictReader(read("race.tsv").splitlines(), delimiter="\t"))
+if race:
+    print("Two writers racing on one output (`docs/tools/race_trials.sh 50`: two seeds started together into one output; right when exactly one exits 0, the other exits 2, and the output is the winner's alone):")
+    print()
+    print("| command | trials | one winner, its output whole | mixed outputs | other outcomes |")
+    print("|---|---|---|---|---|")
+    for r in race:
+        print(f"| {r['command']} | {r['trials']} | {r['one_winner']} | {r['mixed']} | {r['other']} |")
+else:
+    print("Two writers racing on one output: **not run** (no docs/tools/race_trials.sh table in this run).")
 print()
 print("Every reader of a user file reads through foundation/input_file.h, which refuses a directory ('is a directory, expected a file'), a device, pipe or socket ('is not a regular file') and a file above the limit of its kind:")
 print()
