@@ -112,13 +112,16 @@ struct Reader {
         tracks.poses.push_back(p);
     }
     void end(const char* name) {
-        if (std::strcmp(name, "timestep") != 0) return;
+        // A stopped parser may still report the end of the element it stopped
+        // in (a root <timestep>, say): only a step that started closes one.
+        if (std::strcmp(name, "timestep") != 0 || !inStep || !error.empty()) return;
         inStep = false;
-        auto first = tracks.poses.begin() + tracks.frameStart.back();
-        std::sort(first, tracks.poses.end(), [](const AgentPose& a, const AgentPose& b) { return a.agent < b.agent; });
-        for (auto it = first; it + 1 < tracks.poses.end(); ++it)
-            if (it->agent == (it + 1)->agent)
-                return fail("agent '" + tracks.agentIds[it->agent] + "' twice in one step");
+        const size_t first = tracks.frameStart.back();  // an empty step (before the first insertion) has no poses
+        std::sort(tracks.poses.begin() + first, tracks.poses.end(),
+                  [](const AgentPose& a, const AgentPose& b) { return a.agent < b.agent; });
+        for (size_t i = first; i + 1 < tracks.poses.size(); ++i)
+            if (tracks.poses[i].agent == tracks.poses[i + 1].agent)
+                return fail("agent '" + tracks.agentIds[tracks.poses[i].agent] + "' twice in one step");
     }
 };
 

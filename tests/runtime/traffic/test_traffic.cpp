@@ -281,6 +281,25 @@ TEST(TrafficTracks, ReadsAgentsInTheWorldFrame) {
     }
 }
 
+// SUMO writes steps before its first insertion with nobody in them: frames
+// without poses, read as such.
+TEST(TrafficTracks, EmptyStepsAreFramesWithoutPoses) {
+    TempDir dir("vista_fcd_empty");
+    std::string text = kFcd;
+    text.replace(text.find("  <timestep time=\"0.00\">"), 0,
+                 "  <timestep time=\"-1.00\"/>\n  <timestep time=\"-0.50\"></timestep>\n");
+    writeText(dir.file("fcd.xml"), text);
+    auto t = readFcd(dir.file("fcd.xml"), 0, 0);
+    ASSERT_TRUE(t) << t.status().message();
+    ASSERT_EQ(t->frames(), 5u);
+    EXPECT_EQ(t->frameStart[0], 0u);
+    EXPECT_EQ(t->frameStart[1], 0u);
+    EXPECT_EQ(t->frameStart[2], 0u);
+    EXPECT_EQ(t->poses.size(), 6u);
+    AgentPose p;
+    EXPECT_FALSE(t->poseAt(0, -0.75, &p));
+}
+
 TEST(TrafficTracks, PoseAtInterpolatesBetweenSamplesAndTurnsTheShortWay) {
     TempDir dir("vista_fcd_pose");
     writeText(dir.file("fcd.xml"), kFcd);
@@ -324,6 +343,11 @@ TEST(TrafficTracks, BadFilesAreErrors) {
     EXPECT_NE(ty.status().message().find("'tank'"), std::string::npos);
     writeText(dir.file("root.xml"), "<net/>");
     EXPECT_FALSE(readFcd(dir.file("root.xml"), 0, 0));
+    // A step as the root element: refused, not read as a step (found by fuzz_fcd).
+    writeText(dir.file("step_root.xml"), "<timestep time=\"0\"></timestep>");
+    auto sr = readFcd(dir.file("step_root.xml"), 0, 0);
+    ASSERT_FALSE(sr);
+    EXPECT_NE(sr.status().message().find("not <fcd-export>"), std::string::npos) << sr.status().message();
 }
 
 // Values a pose cannot mean (and that would not fit its floats) are refused
