@@ -428,8 +428,12 @@ public:
         : _city(std::move(city)) {
         if (mode != "full" && mode != "hybrid")
             throw py::value_error("mode = '" + mode + "': ground truth is rendered in full or hybrid");
-        check(checkImageSize(width, height));
-        check(checkFov(fov));
+        if (!checkImageSize(width, height))
+            throw py::value_error("size = (" + std::to_string(width) + ", " + std::to_string(height) +
+                                  "): each side 1 .. " + std::to_string(kMaxImageSide) + " pixels");
+        if (!checkFov(fov))
+            throw py::value_error("fov = " + std::to_string(fov) + ": the vertical field of view in degrees, (" +
+                                  std::to_string(int(kMinFovDeg)) + ", " + std::to_string(int(kMaxFovDeg)) + ")");
         for (const std::string& c : channels) {
             const unsigned bit = c == "rgb"        ? kRgb
                                  : c == "depth"    ? kDepth
@@ -541,7 +545,9 @@ PYBIND11_MODULE(_vista, m) {
         .def("trees", &trees)
         .def("stats", &stats)
         .def("opendrive", &opendrive);
-    py::class_<Pose>(m, "Pose", "A camera pose: time, world position (metres), heading and pitch (radians).")
+    py::class_<Pose>(m, "Pose",
+                     "A camera pose: time t (s), world position (metres: x east, y north, z up), heading (radians "
+                     "clockwise from north) and pitch (radians above the horizontal).")
         .def(py::init([](std::vector<double> position, double heading, double pitch, double t) {
                  if (position.size() != 3) throw py::value_error("position: give x, y, z (metres, world frame)");
                  return Pose{t, {position[0], position[1], position[2]}, heading, pitch};

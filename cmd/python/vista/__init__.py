@@ -139,7 +139,7 @@ class Path:
     """A walkthrough path: arrays of its samples and ``path[i]`` poses that :meth:`Renderer.render` takes.
 
     Arrays: ``t`` (N,) seconds, ``position`` (N, 3) world metres (the eye), ``orientation`` (N, 2)
-    heading and pitch in radians (heading counter-clockwise from east), ``heading``, ``pitch``; car
+    heading and pitch in radians (heading clockwise from north, pitch above the horizontal), ``heading``, ``pitch``; car
     paths that drive in lanes also ``road``, ``lane``, ``s``, ``t_offset`` (the OpenDRIVE position of
     each sample, as ``vista path --xodr-positions`` writes it), else None.
     """
@@ -158,6 +158,7 @@ class Path:
         self.t_offset = a.get("t_offset")
 
     def __len__(self):
+        """The number of samples."""
         return len(self._p)
 
     def __getitem__(self, i):
@@ -165,6 +166,7 @@ class Path:
         return self._p.pose(int(i))
 
     def __iter__(self):
+        """The poses of every sample, in order."""
         for i in range(len(self)):
             yield self._p.pose(i)
 

@@ -2,7 +2,8 @@
 
 Item ``i`` is frame ``NNNNNN`` (six digits): a dict with one entry per folder of the output that holds
 that frame, keyed by the folder's name: images (``rgb``, ``image_NN``, ``semantic``, ``semantic_NN``)
-as uint8 tensors (H, W, 3) or (H, W); ``.npy`` channels (``depth``, ``instance``, ``*_NN``) as stored;
+as uint8 tensors (H, W, 3) or (H, W); ``.npy`` channels (``depth``, ``*_NN``) as stored, instance ids (uint32 in the files) as int64, as torch
+has no uint32;
 ``velodyne*`` as float32 (N, 4) (x, y, z, intensity), ``labels`` and ``lidar_instance`` as int64 (N,)
 per point; ``boxes_*`` as the parsed JSON. A sensor that did not fire at a frame has no entry. torch is
 imported when the Dataset is created (Debian's python3-torch); without it, items are numpy arrays.
@@ -28,7 +29,7 @@ def _read_png(path):
     from PIL import Image  # Debian's python3-pil
 
     with Image.open(path) as im:
-        return np.asarray(im)
+        return np.array(im)
 
 
 def _read(path):
@@ -80,9 +81,11 @@ class RenderDataset(_dataset_base()):
         self._torch = _torch()
 
     def __len__(self):
+        """The number of frames (cameras.json or rig.json)."""
         return self.frames
 
     def __getitem__(self, i):
+        """Frame i's files, one entry per folder that holds it (see the module's docstring)."""
         if i < 0:
             i += self.frames
         if not 0 <= i < self.frames:
@@ -98,6 +101,8 @@ class RenderDataset(_dataset_base()):
                 if v is None:
                     continue
                 if isinstance(v, np.ndarray) and self._torch is not None:
-                    v = self._torch.from_numpy(np.ascontiguousarray(v))
+                    if v.dtype == np.uint32:  # torch has no uint32: instance ids as int64 (same values)
+                        v = v.astype(np.int64)
+                    v = self._torch.from_numpy(np.require(v, requirements=["C", "W"]))
                 item[d] = v
         return self.transform(item) if self.transform else item
