@@ -35,57 +35,12 @@
 #include "runtime/scene/paged_load.h"
 #include "runtime/scene/paths.h"
 #include "runtime/scene/scene_graph.h"
+#include "cmd/python/bindings.h"
 
 namespace py = pybind11;
 
 namespace vista {
 namespace {
-
-// A failed step's message as a ValueError (bad input: what the CLI reports with exit code 2).
-template <class T>
-T unwrap(Result<T> r) {
-    if (!r) throw py::value_error(r.status().message());
-    return std::move(*r);
-}
-void check(const Status& s) {
-    if (!s) throw py::value_error(s.message());
-}
-
-// A numpy array over `data` (moved to the heap and owned by a capsule: no copy).
-template <class T>
-py::array_t<T> ownedArray(std::vector<T>&& data, std::vector<py::ssize_t> shape,
-                          std::vector<py::ssize_t> strides = {}) {
-    auto* owned = new std::vector<T>(std::move(data));
-    py::capsule base(owned, [](void* p) { delete static_cast<std::vector<T>*>(p); });
-    if (strides.empty()) return py::array_t<T>(shape, owned->data(), base);
-    return py::array_t<T>(shape, strides, owned->data(), base);
-}
-
-// A structured array: `fields` (name, numpy format) of `n` records filled by `fill(i, record)`.
-py::array structured(const std::vector<std::pair<std::string, std::string>>& fields, size_t n,
-                     const std::function<void(size_t, py::list&)>& fill) {
-    py::list descr;
-    for (const auto& [name, fmt] : fields) descr.append(py::make_tuple(name, fmt));
-    py::module_ np = py::module_::import("numpy");
-    py::object dtype = np.attr("dtype")(descr);
-    py::list rows;
-    for (size_t i = 0; i < n; ++i) {
-        py::list rec;
-        fill(i, rec);
-        rows.append(py::tuple(rec));
-    }
-    return np.attr("array")(rows, py::arg("dtype") = dtype);
-}
-
-// A city: the decoded scene model every step reads, and for a generated city
-// the generated model (its bytes for save(), its buildings and counts).
-struct PyCity {
-    std::shared_ptr<SceneModel> model;
-    std::shared_ptr<City> generated;  // generate(): the whole city; load(): its layout once asked for
-    std::string source;               // load(): the file or directory
-    bool paged = false;
-    bool fromFile() const { return !source.empty(); }
-};
 
 // The laid-out city (streets, blocks, lots, buildings, trees; no meshes) of a
 // loaded city, grown again from its parameters (deterministic: the layout the
@@ -199,7 +154,11 @@ void save(const PyCity& c, const std::string& path) {
     check(s);
 }
 
+}  // namespace
+
 glm::dvec3 originOf(const PyCity& c) { return {c.model->params.origin_x, c.model->params.origin_y, 0.0}; }
+
+namespace {
 
 py::dict streets(const PyCity& c) {
     const StreetGraph& g = c.model->streets;
@@ -345,17 +304,6 @@ py::dict stats(PyCity& c) {
 std::string opendrive(const PyCity& c) {
     return unwrap(cityOpenDrive(*c.model, c.fromFile() ? c.source : "the generated city"));
 }
-
-// A pose: what one path sample gives a camera.
-struct Pose {
-    double t = 0;
-    glm::dvec3 position{0.0};
-    double heading = 0, pitch = 0;
-};
-
-struct PyPath {
-    Path path;
-};
 
 PyPath makePath(const PyCity& c, const std::string& kind, uint64_t seed, double duration, double dt,
                 std::optional<double> speed, double yawRateDeg, double flyHeight, std::optional<double> flyPitchDeg,
@@ -596,4 +544,5 @@ PYBIND11_MODULE(_vista, m) {
              py::arg("near"), py::arg("effects"), py::arg("threads"))
         .def("render", &Renderer::render, py::arg("pose"))
         .def("camera", &Renderer::camera);
+    bindRig(m);
 }

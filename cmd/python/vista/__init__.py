@@ -17,7 +17,7 @@ import json as _json
 from . import _vista
 from ._vista import Pose
 
-__all__ = ["City", "Path", "Pose", "Renderer", "generate", "load", "path", "load_path", "RenderDataset"]
+__all__ = ["City", "Path", "Pose", "Renderer", "Rig", "generate", "load", "path", "load_path", "RenderDataset"]
 
 
 class City:
@@ -234,6 +234,42 @@ class Renderer:
         time. The GIL is released while the frame renders. A pose outside the city raises ValueError.
         """
         return self._r.render(pose)
+
+
+class Rig:
+    """A sensor rig (the rig file of ``vista render --rig``: cameras, fisheyes, LiDARs, docs/formats.md
+    "Sensor rigs") on a city, fired at poses in-process: every sensor cast by Embree rays, as the
+    command casts it. threads: worker threads (0 = all). Needs no GL context. Raises ValueError for a
+    bad rig file (naming the sensor and field) or a city without labels.
+    """
+
+    def __init__(self, city, rig_file, threads=0):
+        self.city = city
+        self._r = _vista.Rig(city._c, str(rig_file), int(threads))
+
+    @property
+    def sensors(self):
+        """The sensors' names in rig-file order."""
+        return list(self._r.sensors())
+
+    def fire(self, pose, t=None, path=None, flow_dt=None):
+        """Fire every sensor with the vehicle at ``pose`` (the rig's vehicle frame: x forward, z up at the
+        pose; ``t`` defaults to ``pose.t``).
+
+        Returns a dict by sensor name. A camera: "rgb" uint8 (H, W, 3), "depth" float32 (H, W), "semantic"
+        uint8, "instance" uint32, "flow" float32 (H, W, 2), "boxes" a structured array (id, visible pixel box
+        u0 v0 u1 v1, pixels, visible_fraction, truncated, 3D box centre x y z, length, width, height, yaw in
+        the world), each as its channels ask. A LiDAR: "points" float32 (N, 4) x, y, z (sensor frame at
+        the firing time) and intensity, as KITTI's velodyne files; "time" float32 (N,) seconds since the
+        sweep's start; "semantic", "instance", "beam" per point; "misses". Without ``path`` the vehicle
+        stands at ``pose`` during the sweep and flow is that of a standing camera; with ``path`` (a
+        :class:`Path`) the vehicle moves along it from ``t`` and flow looks ``flow_dt`` seconds ahead
+        (default: the path's sample spacing), as ``vista render --rig`` does.
+        """
+        t = pose.t if t is None else t
+        if flow_dt is None:
+            flow_dt = float(path.t[1] - path.t[0]) if path is not None and len(path) > 1 else 0.0
+        return self._r.fire(pose, float(t), None if path is None else path._p, float(flow_dt))
 
 
 def __getattr__(name):
