@@ -21,6 +21,7 @@
 #include <pybind11/stl.h>
 
 #include "bake/gen/baked_lighting.h"
+#include "citygen/blocks.h"
 #include "citygen/generate.h"
 #include "citygen/lanes.h"
 #include "citygen/params.h"
@@ -187,7 +188,10 @@ py::dict streets(const PyCity& c) {
 
 // One record per driving lane of every street road: its centre line in the direction of travel.
 py::array lanes(PyCity& c) {
-    const LaneModel m = buildLaneModel(c.model->streets, c.model->params, c.generated ? &c.generated->blocks : nullptr);
+    // The blocks decide the sidewalk sides (and so the junction trims): derived from the street
+    // graph as the OpenDRIVE writer derives them for a loaded city (city_opendrive.h).
+    const std::vector<Block> blocks = extractBlocks(c.model->streets, c.model->params, nullptr);
+    const LaneModel m = buildLaneModel(c.model->streets, c.model->params, &blocks);
     const glm::dvec3 o = originOf(c);
     struct Row {
         uint32_t edge;

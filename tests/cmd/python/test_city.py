@@ -60,6 +60,17 @@ def test_arrays_of_a_loaded_city(cli_city, city):
     assert np.array_equal(g.trees, city.trees)
 
 
+def test_lanes_are_the_opendrive_roads(cli_city, city):
+    import re
+
+    lanes = city.lanes
+    assert np.array_equal(vista.generate(seed=SEED, size_m=SIZE).lanes, lanes)
+    xodr = (cli_city / "city.xodr").read_text()
+    roads = {int(r) for r in re.findall(r'<road [^>]*\bid="(\d+)"', xodr)}
+    assert set(lanes["road"].tolist()) <= roads
+    assert len(set(lanes["edge"].tolist())) == len(set(lanes["road"].tolist()))
+
+
 def test_lanes_lie_beside_their_street(city):
     lanes, nodes, edges = city.lanes, city.streets["nodes"], city.streets["edges"]
     assert len(lanes) >= len(edges)

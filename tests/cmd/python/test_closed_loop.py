@@ -37,4 +37,4 @@ def test_closed_loop_runs_300_steps(display, city):
     lanes = city.lanes
     dists = [distance_to_lanes(lanes, p) for p in xy]
     # On lane centres except across junctions (the lanes array holds the street roads, not the turns).
-    assert np.median(dists) < 0.5 and max(dists) < 6.0
+    assert np.median(dists) < 0.1 and max(dists) < 3.0
