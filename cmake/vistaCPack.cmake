@@ -2,7 +2,8 @@
 # vista_<version>_<arch>.deb with everything `cmake --install` installs, under
 # /usr: the `vista` tool, the osgDB plugin (lib/osgPlugins-<osg version>/,
 # where OSG looks for plugins), and the C++ package (static libraries,
-# headers under include/vista, lib/cmake/vista).
+# headers under include/vista, lib/cmake/vista), and the Python module
+# `vista` under lib/python3/dist-packages when pybind11 was found.
 #
 # Depends: the shared libraries the tool and the plugin load (found by
 # dpkg-shlibdeps), and the -dev packages whose CMake packages, headers and
@@ -29,5 +30,17 @@ if(VISTA_INSTALL_PACKAGE)
     "libopenscenegraph-dev, libembree-dev, libtbb-dev, libcgal-dev, libgmp-dev, libmpfr-dev, libglm-dev, \
 nlohmann-json3-dev, libpng-dev, zlib1g-dev, libbz2-dev, libexpat1-dev, libgl-dev, libopengl-dev")
   set(CPACK_DEBIAN_PACKAGE_SUGGESTS "cmake (>= 3.20)")
+endif()
+# The Python module (cmd/python, when built) is compiled against this Python's ABI and returns numpy arrays.
+if(TARGET vista_python)
+  if(CPACK_DEBIAN_PACKAGE_DEPENDS)
+    string(APPEND CPACK_DEBIAN_PACKAGE_DEPENDS ", ")
+  endif()
+  string(APPEND CPACK_DEBIAN_PACKAGE_DEPENDS
+    "python3 (>= ${Python3_VERSION_MAJOR}.${Python3_VERSION_MINOR}), python3 (<< ${Python3_VERSION_MAJOR}.${Python3_VERSION_MINOR}.99), python3-numpy")
+  if(CPACK_DEBIAN_PACKAGE_SUGGESTS)
+    string(APPEND CPACK_DEBIAN_PACKAGE_SUGGESTS ", ")
+  endif()
+  string(APPEND CPACK_DEBIAN_PACKAGE_SUGGESTS "python3-torch")
 endif()
 include(CPack)

@@ -59,6 +59,7 @@
 #include "foundation/timing.h"
 #include "foundation/units.h"
 #include "nodes/render/city_stream.h"
+#include "nodes/render/ground_truth_session.h"
 #include "nodes/render/offscreen.h"
 #include "runtime/engine/ground_truth.h"
 #include "runtime/engine/ray_scene.h"
@@ -328,70 +329,41 @@ Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, c
     return Status::ok();
 }
 
-// What the frames are drawn with: the renderer, the ray scene (when the
-// mode or the effects cast rays) or the stream of a paged city (its graph,
-// ray scene and label twin), the mode, the root of the label pass, and what
-// the frames saw of the stream. Members are destroyed in reverse order: the
-// mode before its context and the stream.
+// What the frames are drawn with (nodes/render/ground_truth_session.h) and
+// what the frames saw of the stream of a paged city.
 struct RenderSession {
-    std::unique_ptr<OffscreenRenderer> renderer;
-    std::unique_ptr<RayScene> rays;
-    std::unique_ptr<CityStream> stream;  // streamed: the mode's graph, rays and label twin
-    ModeContext ctx;
-    std::unique_ptr<RenderMode> mode;
-    osg::ref_ptr<osg::Group> labelRoot = new osg::Group;
+    GroundTruthSession gt;
     int framesWithArrivals = 0;        // streamed: frames before which region levels arrived
     StreamDetail detail;               // streamed: frames that drew a region below the detail asked for
     std::vector<std::string> damaged;  // streamed: region files that failed to load
-    RayScene* activeRays() { return stream ? stream->rays() : rays.get(); }
 };
 
 Status setUp(const std::string& modeName, const RenderPlan& p, const Walkthrough& w, RenderSession& s) {
-    auto renderer = OffscreenRenderer::create(p.size.width, p.size.height);
-    if (!renderer) return renderer.status();
-    s.renderer = std::move(*renderer);
-    s.ctx.city = &w.city;
-    s.ctx.scene = sceneRoot(w.city);
-    s.ctx.renderer = s.renderer.get();
-    s.ctx.options = p.options;
-    s.ctx.labels = p.labels();
-    const bool rays = findRenderMode(modeName)->needsRays || effectsNeedRays(p.options.effects);
+    GroundTruthSetup g;
+    g.mode = modeName;
+    g.width = p.size.width;
+    g.height = p.size.height;
+    g.options = p.options;
+    g.labels = p.labels();
     if (p.streamed) {
-        auto st = CityStream::create(*w.manifest, p.stream, rays, {}, p.labels());
-        if (!st) return Status::error("setting up the streamed city failed: " + st.status().message());
-        s.stream = std::move(*st);
-        // hybrid: the stream keeps the near field, its split index and the horizon grid too.
-        if (rays && modeStreamsNearField(modeName)) s.stream->enableNearField(p.options.horizonGrid);
-        // The label pass draws the whole streamed city; without it the mode's own levels suffice.
-        if (!p.labels()) s.stream->setGraphLevels(streamGraphOf({modeName}), streamNearBand(p.options));
-        holdStreamUnder(*s.stream, p.memoryBudgetGb);
-        s.ctx.stream = s.stream.get();
-        s.ctx.streamedCity = s.stream->graph();
-        s.ctx.scene = s.stream->graph();
-        s.ctx.rays = s.stream->rays();
-    } else if (rays) {
-        auto r = RayScene::build(w.city);
-        if (!r) return Status::error("building the Embree ray scene failed: " + r.status().message());
-        s.rays = std::move(r.value());
-        s.ctx.rays = s.rays.get();
+        g.streamed = w.manifest.get();
+        g.stream = p.stream;
+        const double budgetGb = p.memoryBudgetGb;
+        g.streamReady = [budgetGb](CityStream& stream) { holdStreamUnder(stream, budgetGb); };
     }
-    auto mode = createRenderMode(modeName, s.ctx);
-    if (!mode) return mode.status();
-    s.mode = std::move(*mode);
-    if (p.labels() && !p.streamed) s.labelRoot->setStateSet(s.ctx.nearField().labelRootState.get());
-    return Status::ok();
+    return s.gt.setUp(g, w.city);
 }
 
 // A streamed city follows the camera of path sample i (the first frame, and
 // every frame with --paged-wait, waits for the regions within its reach).
 Status advanceStream(RenderSession& s, const Path& path, size_t i, const Camera& cam, bool first) {
-    if (!s.stream) return Status::ok();
-    auto f = advancePagedStream(*s.stream, kCmd, cam.eye, pathVelocity(path, i), &s.damaged, first);
+    if (!s.gt.stream) return Status::ok();
+    auto f = advancePagedStream(*s.gt.stream, kCmd, cam.eye, pathVelocity(path, i), &s.damaged, first);
     if (!f) return f.status();
     s.framesWithArrivals += f->arrived > 0 ? 1 : 0;
     s.detail.add(*f, path.samples[i].t);
     // A mode that caches what it traced (hybrid's panoramic cache) drops it when regions change.
-    if ((f->arrived > 0 || f->dropped > 0) && s.mode) s.mode->sceneChanged(f->changed);
+    if ((f->arrived > 0 || f->dropped > 0) && s.gt.mode) s.gt.mode->sceneChanged(f->changed);
     return Status::ok();
 }
 
@@ -443,47 +415,16 @@ Camera baseCamera(const RenderPlan& p) {
     return base;
 }
 
-// Scratch buffers reused from frame to frame.
-struct FrameBuffers {
-    Image img;
-    LabelImage gt;
-    LabelFrame raster;
-};
+using FrameBuffers = GroundTruthBuffers;
 
-// The labels of the frame the mode just rendered: the label pass over the
-// chunks it rasterised, then rays for the pixels its far field filled
-// (mergeLabels). Costs into `tm`.
-Status frameLabels(const std::string& modeName, const Camera& cam, int threads, RenderSession& s, FrameBuffers& b,
-                   Timings& tm) {
-    const RasterSelection* sel = s.mode->lastRaster();
-    if (!sel) return Status::error("mode " + modeName + " reports no raster selection");
-    osg::Group* labelScene = s.labelRoot.get();
-    const bool castUncovered = modeName == "hybrid";
-    if (s.stream) {
-        // The stream's label twin holds every chunk of the streamed graph; the
-        // ray-cast labels of a far field need the regions' models, which a
-        // streamed ray scene does not keep.
-        if (!sel->wholeCity || castUncovered || sel->nearDistance < 1e299)
-            return Status::error("mode " + modeName +
-                                 ": ground-truth labels of a streamed city need a mode that rasterises the whole "
-                                 "city (full); use --channels rgb");
-        labelScene = s.stream->labelGraph();
-    } else {
-        const NearFieldScene& nf = s.ctx.nearField();
-        s.labelRoot->removeChildren(0, s.labelRoot->getNumChildren());
-        for (uint32_t i : sel->chunks)
-            if (i < nf.labelChunks.size()) s.labelRoot->addChild(nf.labelChunks[i].get());
-    }
-    FrameStats ls;
-    VISTA_RETURN_IF_ERROR(s.renderer->renderLabels(labelScene, cam, sel->zFar, b.raster, ls));
-    tm.labelRaster.push_back(ls.frameMs);
-    Stopwatch sw;
-    const RasterLabels raster{b.raster.ids.data(), b.raster.classes.data(), b.raster.depth.data()};
-    const size_t cast =
-        mergeLabels(*s.ctx.city, s.ctx.rays, cam, raster, sel->nearDistance, castUncovered, b.gt, threads);
-    tm.labelRays.push_back(sw.ms());
-    tm.farPixels.push_back(double(cast));
-    tm.labels.push_back(tm.labelRaster.back() + tm.labelRays.back());
+// The labels of the frame the mode just rendered (GroundTruthSession::renderLabels). Costs into `tm`.
+Status frameLabels(const Camera& cam, int threads, RenderSession& s, FrameBuffers& b, Timings& tm) {
+    LabelCosts c;
+    VISTA_RETURN_IF_ERROR(s.gt.renderLabels(cam, threads, b, c));
+    tm.labelRaster.push_back(c.rasterMs);
+    tm.labelRays.push_back(c.raysMs);
+    tm.farPixels.push_back(double(c.farPixels));
+    tm.labels.push_back(c.rasterMs + c.raysMs);
     return Status::ok();
 }
 
@@ -547,9 +488,7 @@ Status renderFrames(const RenderArgs& a, const RenderPlan& p, const Walkthrough&
         FrameStats st;
         VISTA_RETURN_IF_ERROR(advanceStream(s, w.path, idx[f], cam, !streamStarted));
         streamStarted = true;
-        // Ray origins near the scene's frame origin: float precision anywhere in the city.
-        if (RayScene* rays = s.activeRays()) VISTA_RETURN_IF_ERROR(rays->placeFrameNear(cam.eye));
-        if (Status e = s.mode->renderFrame(cam, b.img, st); !e)
+        if (Status e = s.gt.renderFrame(cam, b, st); !e)
             return Status::error("frame " + std::to_string(f) + ": " + e.message());
         if (finished) {  // hybrid warm-up: the state, not the image
             if (progress) progress->update(double(f + 1) / double(idx.size()));
@@ -557,7 +496,7 @@ Status renderFrames(const RenderArgs& a, const RenderPlan& p, const Walkthrough&
         }
         Timings tm;
         tm.rgb.push_back(st.frameMs);
-        if (p.labels()) VISTA_RETURN_IF_ERROR(frameLabels(a.mode, cam, p.options.threads, s, b, tm));
+        if (p.labels()) VISTA_RETURN_IF_ERROR(frameLabels(cam, p.options.threads, s, b, tm));
         VISTA_RETURN_IF_ERROR(writeFrameFiles(p.channels, frameName(f), b, out, tm));
         done.records[f] = Timings::record(tm);
         VISTA_RETURN_IF_ERROR(out.finishFrame(f, done.records[f], frameFiles(p.channels, frameName(f))));
@@ -666,12 +605,12 @@ int run(const RenderArgs& a, const std::string& command) {
     for (const auto& r : done.records) tm.add(r);
     nlohmann::json paged;  // summary.json paged: the regions loaded, or the stream's totals
     if (!walk->pagedJson.empty()) paged = nlohmann::json::parse(walk->pagedJson);
-    if (session.stream)
-        paged["stream"] = pagedStreamJson(session.stream->options(), session.stream->stats(),
+    if (session.gt.stream)
+        paged["stream"] = pagedStreamJson(session.gt.stream->options(), session.gt.stream->stats(),
                                           session.framesWithArrivals, session.damaged, session.detail);
-    if (session.stream) noteStreamDetail(kCmd, session.detail);
+    if (session.gt.stream) noteStreamDetail(kCmd, session.detail);
     if (Status s =
-            writeMetadata(a, plan, command, walk->city, idx, frames, tm, done.kept, paged, *session.renderer, out);
+            writeMetadata(a, plan, command, walk->city, idx, frames, tm, done.kept, paged, *session.gt.renderer, out);
         !s)
         return reportBadInput(kCmd, s);
     printResult(a, plan, idx.size(), tm, out);

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include <osg/GL>
+#include <osg/GLObjects>
 #include <osg/Geometry>
 #include <osg/Image>
 #include <osg/Texture>
@@ -234,6 +235,18 @@ struct OffscreenRenderer::Impl {
 OffscreenRenderer::OffscreenRenderer() : _impl(new Impl) {}
 OffscreenRenderer::~OffscreenRenderer() {
     if (_impl && _impl->viewer) {
+        // The graphs drawn here outlive the renderer (a city drawn again by a later
+        // renderer, whose context may get this one's id): their GL objects of this
+        // context are released while it is current, so no node keeps a name of a
+        // closed context.
+        osg::GraphicsContext* gc = _impl->viewer->getCamera()->getGraphicsContext();
+        if (gc && gc->valid() && gc->makeCurrent()) {
+            osg::State* state = gc->getState();
+            _impl->root->releaseGLObjects(state);
+            if (_impl->labelCam) _impl->labelCam->releaseGLObjects(state);
+            osg::flushAllDeletedGLObjects(state->getContextID());
+            gc->releaseContext();
+        }
         _impl->viewer->setSceneData(nullptr);
         _impl->viewer = nullptr;
     }
