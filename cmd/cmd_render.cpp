@@ -60,6 +60,7 @@
 #include "foundation/units.h"
 #include "nodes/render/city_stream.h"
 #include "nodes/render/offscreen.h"
+#include "nodes/render/traffic_scene.h"
 #include "runtime/engine/ground_truth.h"
 #include "runtime/engine/ray_scene.h"
 #include "nodes/render/walkthrough.h"
@@ -173,6 +174,7 @@ struct RenderPlan {
     double memoryBudgetGb = 0;  // --memory-budget (0 = none)
     RegionPagerOptions stream;  // streamed
     CommandFiles files;         // checked by configure; holds the output's lock for the run
+    std::shared_ptr<const TrafficTracks> traffic;  // --traffic (null: none)
     bool labels() const { return (channels & kLabelChannels) != 0; }
 };
 
@@ -237,6 +239,9 @@ Status configure(const RenderArgs& a, RenderPlan& p) {
     p.path = *po;
     VISTA_RETURN_IF_ERROR(checkRunFiles(p.files.outputDirectory("--out", a.out, true), a.city, a.path, a.modeFlags));
     VISTA_RETURN_IF_ERROR(configurePaged(a, p));
+    auto tracks = loadTrafficFlag(a.modeFlags.traffic);
+    if (!tracks) return tracks.status();
+    p.traffic = *tracks;
     p.rays = findRenderMode(a.mode)->needsRays;
     if (p.paged) return Status::ok();  // estimated on the selected regions' bytes (loadCityAndFrames)
     std::error_code ec;
@@ -312,6 +317,14 @@ Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, c
                                {"cache_error_px", manifestNumber(mo.cacheErrorPx)},
                                {"frame_ms", manifestNumber(mo.frameMsTarget)},
                                {"far_step", mo.farStep}};
+    if (p.traffic) {
+        // The agents' poses decide pixels: a resumed run must draw the same traffic.
+        const TrafficTracks& t = *p.traffic;
+        uint64_t h = hashBytes64(t.poses.data(), t.poses.size() * sizeof(AgentPose));
+        h = hashBytes64(t.times.data(), t.times.size() * sizeof(double), h);
+        h = hashBytes64(t.agentTypes.data(), t.agentTypes.size() * sizeof(AgentType), h);
+        manifest["traffic_hash"] = std::to_string(h);
+    }
     if (p.paged) {
         // What decides the regions a frame sees.
         const bool streamed = p.streamed;
@@ -337,6 +350,7 @@ struct RenderSession {
     std::unique_ptr<OffscreenRenderer> renderer;
     std::unique_ptr<RayScene> rays;
     std::unique_ptr<CityStream> stream;  // streamed: the mode's graph, rays and label twin
+    std::unique_ptr<TrafficScene> traffic;  // --traffic
     ModeContext ctx;
     std::unique_ptr<RenderMode> mode;
     osg::ref_ptr<osg::Group> labelRoot = new osg::Group;
@@ -374,6 +388,12 @@ Status setUp(const std::string& modeName, const RenderPlan& p, const Walkthrough
         if (!r) return Status::error("building the Embree ray scene failed: " + r.status().message());
         s.rays = std::move(r.value());
         s.ctx.rays = s.rays.get();
+    }
+    if (p.traffic) {
+        s.traffic = std::make_unique<TrafficScene>(p.traffic, w.city.params, p.labels());
+        if (RayScene* r = s.activeRays()) VISTA_RETURN_IF_ERROR(s.traffic->attachRays(r));
+        s.ctx.traffic = s.traffic.get();
+        s.renderer->setOverlay(s.traffic->node(), s.traffic->labelNode());
     }
     auto mode = createRenderMode(modeName, s.ctx);
     if (!mode) return mode.status();
