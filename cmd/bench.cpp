@@ -42,7 +42,7 @@ double loadAverage() {
 struct BenchRun {
     std::unique_ptr<OffscreenRenderer> renderer;
     std::unique_ptr<RayScene> rays;
-    std::unique_ptr<CityStream> stream;  // a streamed paged city: its graph and ray scene
+    std::unique_ptr<CityStream> stream;     // a streamed paged city: its graph and ray scene
     std::unique_ptr<TrafficScene> traffic;  // --traffic
     ModeContext ctx;
     ModeContext clearCtx;  // ctx without run-time effects (BenchConfig::alsoClear)

@@ -167,13 +167,13 @@ struct RenderPlan {
     int sampleRuns = 0;
     ModeOptions options;
     PathOptions path;
-    bool paged = false;         // the city is a paged city directory
-    bool streamed = false;      // a streamed paged city (choosePagedStream)
-    bool rays = false;          // the mode casts rays (the memory estimate's ray scene)
-    double estimateMb = 0;      // the memory estimate before the first frame
-    double memoryBudgetGb = 0;  // --memory-budget (0 = none)
-    RegionPagerOptions stream;  // streamed
-    CommandFiles files;         // checked by configure; holds the output's lock for the run
+    bool paged = false;                            // the city is a paged city directory
+    bool streamed = false;                         // a streamed paged city (choosePagedStream)
+    bool rays = false;                             // the mode casts rays (the memory estimate's ray scene)
+    double estimateMb = 0;                         // the memory estimate before the first frame
+    double memoryBudgetGb = 0;                     // --memory-budget (0 = none)
+    RegionPagerOptions stream;                     // streamed
+    CommandFiles files;                            // checked by configure; holds the output's lock for the run
     std::shared_ptr<const TrafficTracks> traffic;  // --traffic (null: none)
     bool labels() const { return (channels & kLabelChannels) != 0; }
 };
@@ -349,7 +349,7 @@ Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, c
 struct RenderSession {
     std::unique_ptr<OffscreenRenderer> renderer;
     std::unique_ptr<RayScene> rays;
-    std::unique_ptr<CityStream> stream;  // streamed: the mode's graph, rays and label twin
+    std::unique_ptr<CityStream> stream;     // streamed: the mode's graph, rays and label twin
     std::unique_ptr<TrafficScene> traffic;  // --traffic
     ModeContext ctx;
     std::unique_ptr<RenderMode> mode;

@@ -12,8 +12,8 @@
 // PathFlags: the walkthrough options (--path, --seed, --kind, --duration,
 // --run-up) of bench and view. ModeFlags: the render-mode options both `vista bench` and `vista view`
 // accept (--near, --triangle-budget, --budget, --horizon-grid, --no-cache,
-// --cache-error, --frame-ms, --no-overlap, --baked, --baked-mesh, --threads, --traffic), declared once by addModeFlags() and
-// turned into ModeOptions by parseModeFlags().
+// --cache-error, --frame-ms, --no-overlap, --baked, --baked-mesh, --threads, --traffic), declared once by
+// addModeFlags() and turned into ModeOptions by parseModeFlags().
 #pragma once
 #include <cstdint>
 #include <functional>

@@ -262,6 +262,7 @@ private:
         FarFieldOptions o;
         o.nearDistance = std::max(0.0, nearD);
         o.nearIsDistance = !byBudget();
+        o.movingHeight = _ctx.traffic ? _ctx.traffic->tallestAgent() : 0.0;
         o.pixelBudget = _ctx.options.pixelBudget;
         o.cache = _ctx.options.cache;
         o.cacheErrorPx = _ctx.options.cacheErrorPx;

@@ -17,7 +17,7 @@
 namespace vista {
 
 struct TrafficScene::Impl {
-    std::vector<osg::ref_ptr<osg::Geode>> protos;  // colour geometry per prototype
+    std::vector<osg::ref_ptr<osg::Geode>> protos;                 // colour geometry per prototype
     std::vector<osg::ref_ptr<osg::MatrixTransform>> xf, labelXf;  // per agent, made on first use
 };
 
@@ -128,6 +128,12 @@ Status TrafficScene::attachRays(RayScene* rays) {
     }
     VISTA_RETURN_IF_ERROR(_rays->setMoverPrototypes(protos));
     return apply();
+}
+
+double TrafficScene::tallestAgent() const {
+    double h = 0;
+    for (const AgentModel& m : _models.models) h = std::max(h, m.height);
+    return h;
 }
 
 Status TrafficScene::setFrame(double t, const glm::dvec3& eye) {

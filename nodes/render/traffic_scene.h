@@ -65,6 +65,7 @@ public:
     // The agents placed at the current time (agent number order).
     const std::vector<AgentPlacement>& placements() const { return _placed; }
     const AgentModels& models() const { return _models; }
+    double tallestAgent() const;                  // metres: the tallest model's height
     size_t drawnCount() const { return _drawn; }  // agents in GL this frame
     size_t castCount() const { return _cast; }    // agents in the ray scene this frame
 

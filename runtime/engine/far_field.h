@@ -80,6 +80,10 @@ struct FarFieldOptions {
     // and seam rays start at nearDistance. false when the near field is a triangle budget (then
     // rays start at the eye and the horizon skips nothing).
     bool nearIsDistance = true;
+    // The tallest moving object standing on the far geometry (metres, >= 0; a
+    // traffic run's agents, 0 = none): the horizon bounds every cell that much
+    // higher (HorizonOptions::lift), so no moving object is cut off as sky.
+    double movingHeight = 0;
     // Panoramic cache (panorama_cache.h): a cached far pixel is reused while
     // its estimated reprojection error is below cacheErrorPx (0 = only
     // pixels traced by this very camera), else re-traced, the worst first, up

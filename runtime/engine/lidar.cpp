@@ -65,7 +65,7 @@ float lidarReflectivity(uint8_t semanticClass) {
         case SemanticClass::TreeTrunk: return 0.3f;
         case SemanticClass::TreeLeaves: return 0.45f;
         case SemanticClass::Car:
-        case SemanticClass::Vehicle: return 0.5f;  // painted metal and glass
+        case SemanticClass::Vehicle: return 0.5f;     // painted metal and glass
         case SemanticClass::Pedestrian: return 0.3f;  // clothes
         default: return 0.2f;
     }

@@ -203,7 +203,7 @@ public:
     Status setMoverPrototypes(const std::vector<SceneMesh>& prototypes);
     Status placeMovers(const std::vector<MoverPlacement>& movers);
     size_t moverCount() const;  // objects of the last placeMovers()
-    int regionCount() const;  // live regions
+    int regionCount() const;    // live regions
     // Moves the scene-local frame (regions layout): frameOrigin() becomes
     // `frameOrigin` rounded to whole metres from the current one, every
     // top-level instance is re-placed and the top level committed (no region

@@ -110,15 +110,15 @@ AgentModel bicycleModel(const Lighting& light) {
     for (double x : {hl - r - 0.05, -hl + r + 0.05}) box(b, x - r, x + r, -0.02, 0.02, 0.0, 2 * r);
     b.setAlbedo(kFrame);
     box(b, -hl + r + 0.05, hl - r - 0.05, -0.025, 0.025, 0.50, 0.58);  // top tube
-    box(b, -0.10, 0.0, -0.025, 0.025, 0.30, 0.80);                      // seat tube
-    box(b, hl - r - 0.12, hl - r - 0.02, -0.30, 0.30, 0.95, 1.00);       // handlebar
-    b.setMaterial(Material::Vehicle);  // the rider is part of the vehicle (labels.h)
+    box(b, -0.10, 0.0, -0.025, 0.025, 0.30, 0.80);                     // seat tube
+    box(b, hl - r - 0.12, hl - r - 0.02, -0.30, 0.30, 0.95, 1.00);     // handlebar
+    b.setMaterial(Material::Vehicle);                                  // the rider is part of the vehicle (labels.h)
     b.setAlbedo(kTrousers);
     box(b, -0.20, 0.05, -0.14, 0.14, 0.80, 0.95);  // seat and thighs
     box(b, 0.05, 0.18, -0.14, -0.04, 0.25, 0.90);  // legs to the pedals
     box(b, -0.05, 0.08, 0.04, 0.14, 0.25, 0.90);
     b.setAlbedo(kShirts[1]);
-    box(b, -0.20, 0.10, -0.18, 0.18, 0.95, 1.45);  // torso, leaning
+    box(b, -0.20, 0.10, -0.18, 0.18, 0.95, 1.45);           // torso, leaning
     box(b, 0.10, hl - r - 0.10, -0.26, -0.18, 1.05, 1.15);  // arms to the bar
     box(b, 0.10, hl - r - 0.10, 0.18, 0.26, 1.05, 1.15);
     b.setAlbedo(kSkin);
@@ -194,7 +194,8 @@ std::vector<AgentPlacement> placeAgents(const TrafficTracks& tracks, const Agent
     std::vector<AgentPlacement> out;
     if (tracks.times.empty() || !(t >= tracks.times.front() && t <= tracks.times.back())) return out;
     const size_t f = tracks.frameAt(t);
-    const size_t b = tracks.frameStart[f], e = f + 1 < tracks.frameStart.size() ? tracks.frameStart[f + 1] : tracks.poses.size();
+    const size_t b = tracks.frameStart[f],
+                 e = f + 1 < tracks.frameStart.size() ? tracks.frameStart[f + 1] : tracks.poses.size();
     out.reserve(e - b);
     const glm::dvec2 origin(params.origin_x, params.origin_y);
     for (size_t i = b; i < e; ++i) {
