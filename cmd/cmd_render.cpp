@@ -319,11 +319,7 @@ Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, c
                                {"far_step", mo.farStep}};
     if (p.traffic) {
         // The agents' poses decide pixels: a resumed run must draw the same traffic.
-        const TrafficTracks& t = *p.traffic;
-        uint64_t h = hashBytes64(t.poses.data(), t.poses.size() * sizeof(AgentPose));
-        h = hashBytes64(t.times.data(), t.times.size() * sizeof(double), h);
-        h = hashBytes64(t.agentTypes.data(), t.agentTypes.size() * sizeof(AgentType), h);
-        manifest["traffic_hash"] = std::to_string(h);
+        manifest["traffic_hash"] = trafficHash(*p.traffic);
     }
     if (p.paged) {
         // What decides the regions a frame sees.

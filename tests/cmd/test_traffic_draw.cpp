@@ -7,6 +7,7 @@
 // traffic directories are refused with exit 2 naming --traffic.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -44,7 +45,7 @@ constexpr int kW = 320, kH = 200;
 
 // The city, its traffic and a path riding one of its cars, made once for the file.
 struct Fixture {
-    std::string city, traffic, path;
+    std::string city, traffic, path, ego;  // ego: the SUMO id of the vehicle the path rides
     bool ok = false;
 };
 const Fixture& fixture() {
@@ -61,6 +62,8 @@ const Fixture& fixture() {
         EXPECT_EQ(r.code, 0) << r.err;
         r = runVista("path " + f.city + " --traffic " + f.traffic + " --duration 40 -o " + f.path);
         EXPECT_EQ(r.code, 0) << r.err;
+        const size_t at = r.err.find("riding ");
+        if (at != std::string::npos) f.ego = r.err.substr(at + 7, r.err.find(')', at) - at - 7);
         f.ok = fs::exists(f.path);
     }
     return f;
@@ -184,6 +187,10 @@ TEST_F(TrafficDraw, RenderLabelsEveryAgentPixelOnItsAgentsBox) {
     EXPECT_GT(r.total, 500u);
     EXPECT_GE(r.agents.size(), 3u);
     EXPECT_EQ(r.wrongClass, 0u);
+    // The vehicle the path rides is not seen by its own camera.
+    const auto ego = std::find(tracks->agentIds.begin(), tracks->agentIds.end(), f.ego);
+    ASSERT_NE(ego, tracks->agentIds.end()) << "'" << f.ego << "'";
+    EXPECT_EQ(r.agents.count(uint32_t(ego - tracks->agentIds.begin())), 0u);
     // Pixels off their agent's box: only at silhouettes (depth mixing across an edge), at most 1 %.
     EXPECT_LE(double(r.offBox), 0.01 * double(r.total)) << r.offBox << " of " << r.total;
     // The classes file lists the moving agents' classes and kinds.
@@ -226,6 +233,36 @@ TEST_F(TrafficDraw, HybridRayCastsAgentsBeyondTheSplit) {
     }
     ASSERT_GT(either, 0u);
     EXPECT_GE(double(both) / double(either), 0.9) << both << " of " << either;
+}
+
+TEST_F(TrafficDraw, RigCamerasAndLidarSeeTheAgents) {
+    TempDir tmp("vista_traffic_draw_rig");
+    const auto& f = fixture();
+    const std::string out = tmp.file("rig");
+    const auto r = runVista("render " + f.city + " --path " + f.path + " --frames 6 --sampling consecutive -q --rig " +
+                            std::string(VISTA_SOURCE_DIR) + "/data/rigs/car_4cam_lidar64.json --traffic " + f.traffic +
+                            " --out " + out);
+    ASSERT_EQ(r.code, 0) << r.err;
+    size_t cameraAgents = 0, lidarAgents = 0;
+    for (const auto& e : fs::recursive_directory_iterator(out)) {
+        const std::string p = e.path().string();
+        const bool cam = p.find("/instance_0") != std::string::npos,
+                   lidar = p.find("/lidar_instance/") != std::string::npos;
+        if (!cam && !lidar) continue;
+        const auto ids = cam ? loadNpy<uint32_t>(p) : std::vector<uint32_t>();
+        std::vector<uint32_t> pts;
+        if (lidar) {
+            const std::string b = readBytes(p);
+            pts.resize(b.size() / 4);
+            std::memcpy(pts.data(), b.data(), pts.size() * 4);
+        }
+        for (uint32_t id : cam ? ids : pts) {
+            const InstanceKind k = instanceKind(id);
+            if (k == InstanceKind::Vehicle || k == InstanceKind::Pedestrian) ++(cam ? cameraAgents : lidarAgents);
+        }
+    }
+    EXPECT_GT(cameraAgents, 20u);
+    EXPECT_GT(lidarAgents, 10u);
 }
 
 TEST_F(TrafficDraw, FramesWithoutAgentsAreTheBytesOfARunWithoutTraffic) {
