@@ -174,6 +174,8 @@ struct RayScene::Impl {
     std::vector<unsigned> flatTreeIds;
     std::vector<Region> regions;
     std::shared_ptr<PrototypeSet> moverProtos;  // setMoverPrototypes
+    std::vector<glm::dvec4> moverBounds;        // per prototype: bounding sphere in its frame
+    std::vector<glm::dvec4> moverSpheres;       // per placed object: world bounding sphere
     std::vector<unsigned> moverGeoms;           // the pool of mover instances (top-level ids)
     size_t moversLive = 0;
 
@@ -759,6 +761,16 @@ Status RayScene::setMoverPrototypes(const std::vector<SceneMesh>& prototypes) {
     auto protos = im.buildPrototypes(model);
     if (!protos.isOk()) return protos.status();
     im.moverProtos = *protos;
+    im.moverBounds.clear();
+    for (const SceneMesh& p : prototypes) {
+        glm::dvec3 lo(1e300), hi(-1e300);
+        for (const glm::vec3& v : p.positions) {
+            lo = glm::min(lo, glm::dvec3(v) + p.origin);
+            hi = glm::max(hi, glm::dvec3(v) + p.origin);
+        }
+        const bool any = !p.positions.empty();
+        im.moverBounds.push_back(any ? glm::dvec4(0.5 * (lo + hi), 0.5 * glm::length(hi - lo)) : glm::dvec4(0.0));
+    }
     return Status::ok();
 }
 
@@ -769,6 +781,11 @@ Status RayScene::placeMovers(const std::vector<MoverPlacement>& movers) {
         if (p.prototype >= protoCount)
             return Status::error("ray scene: moving object of prototype " + std::to_string(p.prototype) + " (have " +
                                  std::to_string(protoCount) + ")");
+    im.moverSpheres.clear();
+    for (const MoverPlacement& p : movers) {
+        const glm::dvec4 b = im.moverBounds[p.prototype];
+        im.moverSpheres.push_back(glm::dvec4(glm::dvec3(p.transform * glm::dvec4(glm::dvec3(b), 1.0)), b.w));
+    }
     for (size_t i = 0; i < movers.size(); ++i) {
         const MoverPlacement& p = movers[i];
         RTCScene child = im.moverProtos->scenes[p.prototype];
@@ -813,6 +830,8 @@ Status RayScene::placeMovers(const std::vector<MoverPlacement>& movers) {
 }
 
 size_t RayScene::moverCount() const { return _impl->moversLive; }
+
+const std::vector<glm::dvec4>& RayScene::moverSpheres() const { return _impl->moverSpheres; }
 
 Status RayScene::setFrameOrigin(const glm::dvec3& frameOrigin) {
     Impl& im = *_impl;

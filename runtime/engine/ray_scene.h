@@ -203,7 +203,10 @@ public:
     Status setMoverPrototypes(const std::vector<SceneMesh>& prototypes);
     Status placeMovers(const std::vector<MoverPlacement>& movers);
     size_t moverCount() const;  // objects of the last placeMovers()
-    int regionCount() const;    // live regions
+    // World bounding spheres (centre xyz, radius w) of the last placeMovers()'s
+    // objects, in its order (the far field's cache keeps their pixels out).
+    const std::vector<glm::dvec4>& moverSpheres() const;
+    int regionCount() const;  // live regions
     // Moves the scene-local frame (regions layout): frameOrigin() becomes
     // `frameOrigin` rounded to whole metres from the current one, every
     // top-level instance is re-placed and the top level committed (no region
