@@ -294,6 +294,30 @@ TEST_F(TrafficDraw, AStreamedPagedCityDrawsTheSameAgents) {
     EXPECT_EQ(differ, 0u);
 }
 
+TEST_F(TrafficDraw, BenchDrawsTheAgentsAlikeInRasterAndRays) {
+    TempDir tmp("vista_traffic_draw_bench");
+    const auto& f = fixture();
+    // raycast traces every agent, full rasterises them: against full, a raycast frame with an
+    // agent missing would lose its pixels (a car is hundreds of pixels here).
+    const auto r = runVista("bench " + f.city + " --path " + f.path + " --traffic " + f.traffic +
+                            " --modes full,raycast,hybrid --frames 16 --sampling spread --size 320x200 -q --out " +
+                            tmp.file("bench"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::ifstream csv(tmp.file("bench/frames.csv"));
+    std::string line;
+    std::getline(csv, line);
+    int frames = 0;
+    while (std::getline(csv, line)) {
+        std::vector<std::string> cols;
+        size_t a = 0;
+        for (size_t b; (b = line.find(',', a)) != std::string::npos; a = b + 1) cols.push_back(line.substr(a, b - a));
+        if (cols.size() < 11 || cols[3] == "full") continue;
+        ++frames;
+        EXPECT_GE(std::stod(cols[10]), 40.0) << cols[3] << " frame " << cols[0];
+    }
+    EXPECT_EQ(frames, 32);
+}
+
 TEST_F(TrafficDraw, FramesWithoutAgentsAreTheBytesOfARunWithoutTraffic) {
     TempDir tmp("vista_traffic_draw_none");
     const auto& f = fixture();
