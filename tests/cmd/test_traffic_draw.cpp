@@ -4,8 +4,9 @@
 // model box of an agent present at that frame's time (back-projected from its
 // depth), the hybrid's ray-cast far field shows agents beyond the split, rig
 // cameras and LiDAR see them, a streamed paged city draws the same agent
-// pixels as the city file, frames without agents are the bytes of a run without --traffic, and bad
-// traffic directories are refused with exit 2 naming --traffic.
+// pixels as the city file, bench's ray-cast frames match full where agents
+// are, frames without agents are the bytes of a run without --traffic, and
+// bad traffic directories are refused with exit 2 naming --traffic.
 #include <gtest/gtest.h>
 
 #include <algorithm>
