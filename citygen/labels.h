@@ -9,7 +9,8 @@
 // index (sidewalk ring of the block; park lawn of a park block), street
 // light index (City::streetLights), signal index (LaneModel::signals of
 // lanes.h, for traffic lights and for stop and yield signs alike), parked car
-// index (City::cars). Ground
+// index (City::cars), moving vehicle and pedestrian: the agent's number in
+// the traffic run (TrafficTracks, stable over the run). Ground
 // (terrain) and sky are 0.
 // Tree prototype meshes are shared by all trees: their vertices carry the
 // Material of the part (Trunk, Leaves) instead; the tree's id comes from the
@@ -18,7 +19,9 @@
 // Semantic class (uint8): one per Material (semanticClass) plus sky = 0;
 // classes whose effect a city does not declare (street_light: night) simply
 // never occur; traffic_light and traffic_sign cover the whole signal, pole
-// included (as street_light covers its pole). Pure functions; thread-safe.
+// included (as street_light covers its pole); vehicle (every moving vehicle of
+// a traffic run, a bicycle with its rider included) and pedestrian are the
+// moving agents, apart from the parked cars (car). Pure functions; thread-safe.
 #pragma once
 #include <cstdint>
 
@@ -39,7 +42,9 @@ enum class InstanceKind : uint32_t {
     TrafficLight = 8,
     TrafficSign = 9,
     Car = 10,
-    Count = 11  // number of kinds (not a kind)
+    Vehicle = 11,
+    Pedestrian = 12,
+    Count = 13  // number of kinds (not a kind)
 };
 constexpr uint32_t kInstanceIndexBits = 28;
 constexpr uint32_t kInstanceIndexMask = (1u << kInstanceIndexBits) - 1u;
@@ -69,7 +74,9 @@ enum class SemanticClass : uint8_t {
     TrafficLight = 12,
     TrafficSign = 13,
     Car = 14,
-    Count = 15
+    Vehicle = 15,
+    Pedestrian = 16,
+    Count = 17
 };
 constexpr int kSemanticClassCount = int(SemanticClass::Count);
 SemanticClass semanticClass(Material m);         // Count (invalid) for Material::Count

@@ -37,6 +37,8 @@ glm::dvec3 materialAlbedo(Material m) {
         case Material::TrafficLight: return {0.06, 0.07, 0.06};
         case Material::TrafficSign: return {0.45, 0.46, 0.47};
         case Material::Car: return {0.45, 0.46, 0.47};
+        case Material::Vehicle: return {0.45, 0.46, 0.47};
+        case Material::Pedestrian: return {0.40, 0.32, 0.26};
         case Material::Count: break;
     }
     return {1, 0, 1};

@@ -5,8 +5,9 @@
 namespace vista {
 
 const char* materialName(Material m) {
-    static const char* kNames[] = {"ground", "road",  "marking", "sidewalk", "grass",         "wall",         "window",
-                                   "roof",   "trunk", "leaves",  "lamp",     "traffic_light", "traffic_sign", "car"};
+    static const char* kNames[] = {"ground",       "road", "marking", "sidewalk",  "grass", "wall",
+                                   "window",       "roof", "trunk",   "leaves",    "lamp",  "traffic_light",
+                                   "traffic_sign", "car",  "vehicle", "pedestrian"};
     static_assert(sizeof(kNames) / sizeof(kNames[0]) == size_t(kMaterialCount));
     int i = int(m);
     return i >= 0 && i < kMaterialCount ? kNames[i] : "unknown";

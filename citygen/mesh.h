@@ -21,6 +21,7 @@ namespace vista {
 // Lamp: street lights of the `night` effect (pole and emissive head); absent otherwise.
 // TrafficLight, TrafficSign: the lane model's signals (traffic_signals.h), pole and head.
 // Car: parked cars (parked_cars.h), every part of the car.
+// Vehicle, Pedestrian: the moving agents of a traffic run (drawn at run time, never in a tile).
 // Values are stable (tree prototypes store Trunk and Leaves by value): new ones go last.
 enum class Material : uint8_t {
     Ground,
@@ -37,6 +38,8 @@ enum class Material : uint8_t {
     TrafficLight,
     TrafficSign,
     Car,
+    Vehicle,
+    Pedestrian,
     Count
 };
 constexpr int kMaterialCount = int(Material::Count);

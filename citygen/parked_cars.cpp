@@ -374,9 +374,14 @@ std::vector<ParkedCar> placeParkedCars(const City& city, const LaneModel& lanes)
 void meshParkedCar(const ParkedCar& car, const glm::dvec3& origin, const Lighting& light, Mesh& mesh, uint32_t id) {
     if (!std::isfinite(car.position.x + car.position.y + car.position.z + car.yaw)) return;
     const CarModel& m = carModels()[std::min<size_t>(car.model, kCarModelCount - 1)];
-    const glm::dvec3 f(std::cos(car.yaw), std::sin(car.yaw), 0.0), l(-f.y, f.x, 0.0), up(0, 0, 1);
-    const auto at = [&](double x, double y, double z) { return car.position + f * x + l * y + up * z; };
-    MeshBuilder b(mesh, origin, Material::Car, light);
+    meshCarShape(m, carColour(car.colour), car.position, car.yaw, origin, light, Material::Car, mesh, id);
+}
+
+void meshCarShape(const CarModel& m, const glm::dvec3& bodyAlbedo, const glm::dvec3& position, double yaw,
+                  const glm::dvec3& origin, const Lighting& light, Material material, Mesh& mesh, uint32_t id) {
+    const glm::dvec3 f(std::cos(yaw), std::sin(yaw), 0.0), l(-f.y, f.x, 0.0), up(0, 0, 1);
+    const auto at = [&](double x, double y, double z) { return position + f * x + l * y + up * z; };
+    MeshBuilder b(mesh, origin, material, light);
     b.setId(id);
     // A box [x0, x1] x [y0, y1] x [z0, z1] in the car's frame, faces outward.
     const auto box = [&](double x0, double x1, double y0, double y1, double z0, double z1, bool top, bool bottom) {
@@ -397,7 +402,7 @@ void meshParkedCar(const ParkedCar& car, const glm::dvec3& origin, const Lightin
             box(x - 0.9 * r, x + 0.9 * r, std::min(yo, yi), std::max(yo, yi), 0.0, 2.0 * r, false, false);
         }
     // Body.
-    b.setAlbedo(carColour(car.colour));
+    b.setAlbedo(bodyAlbedo);
     box(-hl, hl, -hw, hw, m.clearance, m.belt, true, true);
     // Cabin: sloped windscreen and rear window, glass sides, a roof in the body colour.
     const double cw = hw - 0.05;

@@ -72,5 +72,11 @@ std::vector<glm::dvec2> carFootprint(const ParkedCar& car);
 
 std::vector<ParkedCar> placeParkedCars(const City& city, const LaneModel& lanes);
 void meshParkedCar(const ParkedCar& car, const glm::dvec3& origin, const Lighting& light, Mesh& mesh, uint32_t id);
+// The shape meshParkedCar() draws, for any model (the moving vehicles' vans,
+// buses and trucks too): body in `bodyAlbedo`, footprint centred on
+// `position` (ground level), front along `yaw`, every vertex of `material`
+// and label `id`, positions relative to `origin`.
+void meshCarShape(const CarModel& m, const glm::dvec3& bodyAlbedo, const glm::dvec3& position, double yaw,
+                  const glm::dvec3& origin, const Lighting& light, Material material, Mesh& mesh, uint32_t id);
 
 }  // namespace vista

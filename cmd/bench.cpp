@@ -19,6 +19,7 @@
 #include "foundation/units.h"
 #include "nodes/render/city_stream.h"
 #include "nodes/render/offscreen.h"
+#include "nodes/render/traffic_scene.h"
 #include "runtime/engine/metrics.h"
 #include "runtime/engine/ray_scene.h"
 #include "runtime/engine/ray_set.h"
@@ -41,7 +42,8 @@ double loadAverage() {
 struct BenchRun {
     std::unique_ptr<OffscreenRenderer> renderer;
     std::unique_ptr<RayScene> rays;
-    std::unique_ptr<CityStream> stream;  // a streamed paged city: its graph and ray scene
+    std::unique_ptr<CityStream> stream;     // a streamed paged city: its graph and ray scene
+    std::unique_ptr<TrafficScene> traffic;  // --traffic
     ModeContext ctx;
     ModeContext clearCtx;  // ctx without run-time effects (BenchConfig::alsoClear)
     std::vector<std::unique_ptr<RenderMode>> modes;
@@ -91,6 +93,14 @@ Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene
         }
         bvhMs = sw.ms();
         if (!cfg.quiet) std::fprintf(stderr, "ray scene built in %.0f ms\n", bvhMs);
+    }
+    if (cfg.traffic) {
+        if (!city) return Status::error("--traffic: needs the city's parameters (no city given)");
+        run->traffic = std::make_unique<TrafficScene>(cfg.traffic, city->params, false);
+        RayScene* rays = run->stream ? run->stream->rays() : run->rays.get();
+        if (rays) VISTA_RETURN_IF_ERROR(run->traffic->attachRays(rays));
+        run->ctx.traffic = run->traffic.get();
+        run->renderer->setOverlay(run->traffic->node(), nullptr);
     }
     auto add = [&](const std::string& name, ModeContext& ctx, const std::string& label) -> Status {
         auto m = createRenderMode(name, ctx);

@@ -25,6 +25,7 @@
 #pragma once
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,7 @@
 #include "nodes/render/render_mode.h"
 #include "runtime/scene/paths.h"
 #include "runtime/scene/region_pager.h"
+#include "runtime/traffic/traffic_tracks.h"
 
 namespace vista {
 
@@ -90,6 +92,9 @@ struct BenchConfig {
     RegionPagerOptions stream;
     // A paged city, loaded or streamed: its manifest (ModeContext::paged; outlives the run).
     const PagedManifest* pagedManifest = nullptr;
+    // --traffic: the agents every mode draws at each frame's path time
+    // (ModeContext::traffic); null = no traffic (nothing of it runs).
+    std::shared_ptr<const TrafficTracks> traffic;
 };
 // Checks sizes, frame count, fov, reference, modes and the mode options
 // (options.h ranges); messages name the command-line flag.

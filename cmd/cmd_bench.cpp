@@ -157,6 +157,12 @@ Status configure(BenchArgs& a) {
         if (!streamed) return streamed.status();
         a.streamed = *streamed;
     }
+    if (!a.mode.traffic.empty()) {
+        if (!a.sweep.empty()) return Status::error("--traffic: not with --sweep (the sweep makes its own cities)");
+        auto tracks = loadTrafficFlag(a.mode.traffic);
+        if (!tracks) return tracks.status();
+        a.cfg.traffic = *tracks;
+    }
     VISTA_RETURN_IF_ERROR(checkWritableDirectory("--out", a.out));  // before any work, so a run never fails at its end
     if (!a.cfg.dumpRaysDir.empty()) {
         if (!a.sweep.empty()) return Status::error("--dump-rays is not supported with --sweep (one city per run)");

@@ -50,8 +50,8 @@ int runEgoPath(const std::string& city, const std::string& out, const std::strin
     auto p = egoPath(*tracks, *vehicle, c->params, o.dt, o.duration, car.eyeHeight());
     if (!p) return reportBadInput(cmd, p.status());
     if (Status s = savePathCsv(*p, out); !s) return reportBadInput(cmd, s);
-    std::fprintf(stderr, "vista path: %zu samples (%.1f s riding %s) -> %s\n", p->samples.size(), p->samples.back().t,
-                 tracks->agentIds[*vehicle].c_str(), out.c_str());
+    std::fprintf(stderr, "vista path: %zu samples (%.1f s riding %s) -> %s\n", p->samples.size(),
+                 p->samples.back().t - p->samples.front().t, tracks->agentIds[*vehicle].c_str(), out.c_str());
     return 0;
 }
 

@@ -61,6 +61,7 @@
 #include "nodes/render/city_stream.h"
 #include "nodes/render/ground_truth_session.h"
 #include "nodes/render/offscreen.h"
+#include "nodes/render/traffic_scene.h"
 #include "runtime/engine/ground_truth.h"
 #include "runtime/engine/ray_scene.h"
 #include "nodes/render/walkthrough.h"
@@ -167,13 +168,14 @@ struct RenderPlan {
     int sampleRuns = 0;
     ModeOptions options;
     PathOptions path;
-    bool paged = false;         // the city is a paged city directory
-    bool streamed = false;      // a streamed paged city (choosePagedStream)
-    bool rays = false;          // the mode casts rays (the memory estimate's ray scene)
-    double estimateMb = 0;      // the memory estimate before the first frame
-    double memoryBudgetGb = 0;  // --memory-budget (0 = none)
-    RegionPagerOptions stream;  // streamed
-    CommandFiles files;         // checked by configure; holds the output's lock for the run
+    bool paged = false;                            // the city is a paged city directory
+    bool streamed = false;                         // a streamed paged city (choosePagedStream)
+    bool rays = false;                             // the mode casts rays (the memory estimate's ray scene)
+    double estimateMb = 0;                         // the memory estimate before the first frame
+    double memoryBudgetGb = 0;                     // --memory-budget (0 = none)
+    RegionPagerOptions stream;                     // streamed
+    CommandFiles files;                            // checked by configure; holds the output's lock for the run
+    std::shared_ptr<const TrafficTracks> traffic;  // --traffic (null: none)
     bool labels() const { return (channels & kLabelChannels) != 0; }
 };
 
@@ -238,6 +240,9 @@ Status configure(const RenderArgs& a, RenderPlan& p) {
     p.path = *po;
     VISTA_RETURN_IF_ERROR(checkRunFiles(p.files.outputDirectory("--out", a.out, true), a.city, a.path, a.modeFlags));
     VISTA_RETURN_IF_ERROR(configurePaged(a, p));
+    auto tracks = loadTrafficFlag(a.modeFlags.traffic);
+    if (!tracks) return tracks.status();
+    p.traffic = *tracks;
     p.rays = findRenderMode(a.mode)->needsRays;
     if (p.paged) return Status::ok();  // estimated on the selected regions' bytes (loadCityAndFrames)
     std::error_code ec;
@@ -313,6 +318,10 @@ Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, c
                                {"cache_error_px", manifestNumber(mo.cacheErrorPx)},
                                {"frame_ms", manifestNumber(mo.frameMsTarget)},
                                {"far_step", mo.farStep}};
+    if (p.traffic) {
+        // The agents' poses decide pixels: a resumed run must draw the same traffic.
+        manifest["traffic_hash"] = trafficHash(*p.traffic);
+    }
     if (p.paged) {
         // What decides the regions a frame sees.
         const bool streamed = p.streamed;
@@ -351,6 +360,7 @@ Status setUp(const std::string& modeName, const RenderPlan& p, const Walkthrough
         const double budgetGb = p.memoryBudgetGb;
         g.streamReady = [budgetGb](CityStream& stream) { holdStreamUnder(stream, budgetGb); };
     }
+    g.traffic = p.traffic;
     return s.gt.setUp(g, w.city);
 }
 

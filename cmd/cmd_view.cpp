@@ -65,6 +65,7 @@
 #include "nodes/gl_readback.h"
 #include "nodes/render/city_stream.h"
 #include "nodes/render/offscreen.h"
+#include "nodes/render/traffic_scene.h"
 #include "nodes/render/walkthrough.h"
 #include "runtime/engine/ray_scene.h"
 #include "runtime/scene/paged_load.h"
@@ -227,6 +228,7 @@ private:
         }
         _rays = std::move(r.value());
         _ctx.rays = _rays.get();
+        if (_ctx.traffic) return _ctx.traffic->attachRays(_rays.get());  // agents beyond a split are ray-cast
         return Status::ok();
     }
     ModeContext& _ctx;
@@ -464,7 +466,8 @@ struct ViewState {
     osg::ref_ptr<Keys> keys;
     std::string mode;
     RenderMode* current = nullptr;
-    ViewStream* stream = nullptr;  // a streamed paged city, or null
+    ViewStream* stream = nullptr;           // a streamed paged city, or null
+    const TrafficScene* traffic = nullptr;  // --traffic, or null
 };
 
 Status setUpWindow(ViewState& v, const ViewArgs& a, osg::ref_ptr<osgGA::KeySwitchMatrixManipulator> manips) {
@@ -496,6 +499,15 @@ Status setUpWindow(ViewState& v, const ViewArgs& a, osg::ref_ptr<osgGA::KeySwitc
     if (!v.viewer.isRealized())
         return Status::error("cannot open a window on display '" + std::string(std::getenv("DISPLAY")) + "'");
     return Status::ok();
+}
+
+// The traffic's time at `seconds` of wall time since the first frame when the
+// camera is driven by hand: the run's own clock from its first step, looping
+// over its span.
+double trafficClock(const TrafficScene* traffic, double seconds) {
+    if (!traffic || traffic->tracks().frames() == 0) return seconds;
+    const double t0 = traffic->tracks().times.front(), span = traffic->tracks().times.back() - t0;
+    return span > 0 ? t0 + std::fmod(seconds, span) : t0;
 }
 
 void showMode(ViewState& v, ViewModes& modes, const std::string& name) {
@@ -538,6 +550,7 @@ int runLoop(ViewState& v, ViewModes& modes, const ViewArgs& a, const Path& path,
             c = path.camera(stepFrames[size_t(n)], c);
             cam->setViewMatrix(toOsg(c.view()));
         } else {
+            c.time = trafficClock(v.traffic, clock.ms() / 1000.0);
             Camera fromOsg;
             double zf = 0;
             if (cameraFromOsg(cam->getViewMatrix(), toOsg(c.projection(0.0)), c.width, c.height, fromOsg,
@@ -615,6 +628,8 @@ int runView(int argc, char** argv) {
     if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;
     ModeContext ctx;
     if (Status s = configure(a, ctx.options); !s) return reportBadInput(kCmd, s);
+    auto tracks = loadTrafficFlag(a.modeFlags.traffic);
+    if (!tracks) return reportBadInput(kCmd, tracks.status());
     {
         std::error_code ec;
         const uint64_t bytes = std::filesystem::file_size(a.city, ec);
@@ -654,6 +669,13 @@ int runView(int argc, char** argv) {
     if (a.streamed && walk->manifest)
         if (Status s = startStream(a, *walk, ctx, stream); !s) return reportBadInput(kCmd, s);
     ViewModes modes(ctx, stream.stream.get());
+    std::unique_ptr<TrafficScene> traffic;  // after the modes' ray scene: released before it
+    if (*tracks) {
+        traffic = std::make_unique<TrafficScene>(*tracks, city.params, false);
+        ctx.traffic = traffic.get();
+        if (stream.stream && stream.stream->rays())
+            if (Status s = traffic->attachRays(stream.stream->rays()); !s) return reportBadInput(kCmd, s);
+    }
     auto start = modes.get(a.mode);
     if (!start) return reportBadInput(kCmd, Status::error("--mode " + a.mode + ": " + start.status().message()));
     ViewState v;
@@ -664,6 +686,7 @@ int runView(int argc, char** argv) {
     v.keys->effects = &ctx.options.effects;
     v.keys->declared = FrameEffects::fromScene(city.params.effects);
     v.stream = stream.stream ? &stream : nullptr;
+    v.traffic = traffic.get();
     showMode(v, modes, a.mode);
     return runLoop(v, modes, a, path, playback);
 }

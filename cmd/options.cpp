@@ -226,6 +226,9 @@ Result<std::vector<int>> parseSweep(const std::string& s) {
 }
 
 void addModeFlags(CLI::App& app, ModeFlags& f) {
+    app.add_option("--traffic", f.traffic,
+                   "a traffic directory (`vista traffic`): its vehicles and pedestrians move through every mode, "
+                   "placed at each frame's path time (near field drawn, far field ray-cast)");
     app.add_option("--near", f.near,
                    "near-field distance in metres, 1 .. 100000, or 'auto' (hybrid: adaptive split per frame among 0 = "
                    "ray casting, 15 .. 800 m and everything; the other "
@@ -462,11 +465,23 @@ Status checkRunFiles(CommandFiles& files, const std::string& city, const PathFla
                               .input("--path", path.file)
                               .input("--baked", mode.baked)
                               .input("--baked-mesh", mode.bakedMesh)
+                              .input("--traffic", mode.traffic)
                               .check());
     if (!path.file.empty())
         if (Status s = checkInputFile("path file", path.file, kMaxPathCsvBytes); !s)
             return Status::error("option --path: " + s.message());
     return Status::ok();
+}
+
+Result<std::shared_ptr<const TrafficTracks>> loadTrafficFlag(const std::string& dir) {
+    if (dir.empty()) return std::shared_ptr<const TrafficTracks>();
+    auto t = loadTrafficTracks(dir);
+    if (!t) {
+        const std::string& m = t.status().message();
+        return Status::error(m.rfind("--traffic", 0) == 0 ? m : "--traffic = '" + dir + "': " + m);
+    }
+    if (t->frames() == 0) return Status::error("--traffic = '" + dir + "': the floating-car data has no time step");
+    return std::shared_ptr<const TrafficTracks>(std::make_shared<TrafficTracks>(std::move(*t)));
 }
 
 Result<Effects> parseEffectsOption(const std::string& s, const Effects& base) {

@@ -12,11 +12,12 @@
 // PathFlags: the walkthrough options (--path, --seed, --kind, --duration,
 // --run-up) of bench and view. ModeFlags: the render-mode options both `vista bench` and `vista view`
 // accept (--near, --triangle-budget, --budget, --horizon-grid, --no-cache,
-// --cache-error, --frame-ms, --no-overlap, --baked, --baked-mesh, --threads), declared once by addModeFlags() and
-// turned into ModeOptions by parseModeFlags().
+// --cache-error, --frame-ms, --no-overlap, --baked, --baked-mesh, --threads, --traffic), declared once by
+// addModeFlags() and turned into ModeOptions by parseModeFlags().
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <type_traits>
@@ -32,6 +33,7 @@
 #include "runtime/scene/paged_walkthrough.h"
 #include "runtime/scene/paths.h"
 #include "runtime/scene/region_pager.h"
+#include "runtime/traffic/traffic_tracks.h"
 
 namespace vista {
 
@@ -111,11 +113,16 @@ struct ModeFlags {
     std::string bakedMesh;
     std::string pointSplat;  // "" = the default (ModeOptions::splatSigma)
     int threads = 0;
+    std::string traffic;  // --traffic DIR: a `vista traffic` directory drawn in every mode ("" = none)
 };
 // Declares the flags on `app`; the defaults shown are the values in `flags`.
 void addModeFlags(CLI::App& app, ModeFlags& flags);
 // Parses and range-checks the flags into `out`.
 Status parseModeFlags(const ModeFlags& flags, ModeOptions& out);
+
+// --traffic DIR: the agents' tracks (loadTrafficTracks), null for ""; errors
+// name --traffic and the directory.
+Result<std::shared_ptr<const TrafficTracks>> loadTrafficFlag(const std::string& dir);
 
 // Range checks of ModeOptions (for options set in code).
 Status checkModeOptions(const ModeOptions& o);

@@ -24,6 +24,7 @@
 #include "foundation/progress.h"
 #include "foundation/statistics.h"
 #include "foundation/timing.h"
+#include "nodes/render/traffic_scene.h"
 #include "nodes/render/walkthrough.h"
 #include "runtime/engine/boxes.h"
 #include "runtime/engine/ground_truth.h"
@@ -91,6 +92,8 @@ struct RigPlan {
     std::vector<double> times;                             // its time
     std::vector<std::vector<uint8_t>> camFire, lidarFire;  // per sensor, per frame
     CommandFiles files;                                    // checked by configure; holds the output's lock
+    std::shared_ptr<const TrafficTracks> traffic;          // --traffic (null: none)
+    TrafficScene* agents = nullptr;                        // its agents in the ray scene, placed per frame
     bool needsLabels() const {
         if (!rig.lidars.empty()) return true;
         for (const RigCamera& c : rig.cameras)
@@ -118,6 +121,9 @@ Status configure(const RigRunRequest& a, RigPlan& p) {
     auto rig = loadRigFile(a.rig);
     if (!rig) return Status::error("--rig: " + rig.status().message());
     p.rig = std::move(*rig);
+    auto tracks = loadTrafficFlag(a.modeFlags.traffic);
+    if (!tracks) return tracks.status();
+    p.traffic = *tracks;
     return checkRunFiles(p.files.outputDirectory("--out", a.out, true).input("--rig", a.rig), a.city, a.path,
                          a.modeFlags);
 }
@@ -147,12 +153,13 @@ Status openWorkDir(const RigRunRequest& a, const RigPlan& p, const Path& path, R
     uint64_t cityBytes = 0;
     auto cityHash = fileHash(a.city, cityBytes);
     if (!cityHash) return cityHash.status();
-    const nlohmann::json manifest = {{"kind", "rig"},
-                                     {"city_hash", *cityHash},
-                                     {"city_bytes", cityBytes},
-                                     {"frames", p.idx.size()},
-                                     {"camera_poses_hash", posesHash(path, p.idx)},
-                                     {"rig_hash", rigHash(p.rig)}};
+    nlohmann::json manifest = {{"kind", "rig"},
+                               {"city_hash", *cityHash},
+                               {"city_bytes", cityBytes},
+                               {"frames", p.idx.size()},
+                               {"camera_poses_hash", posesHash(path, p.idx)},
+                               {"rig_hash", rigHash(p.rig)}};
+    if (p.traffic) manifest["traffic_hash"] = trafficHash(*p.traffic);  // the agents decide pixels and points
     VISTA_RETURN_IF_ERROR(out.open(manifest, a.restart));
     for (size_t k = 0; k < p.rig.cameras.size(); ++k)
         for (const std::string& f : cameraFiles(p.rig.cameras[k], k, "x"))
@@ -253,6 +260,11 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
     const RigPose vehicle = vehiclePose(path.samples[p.idx[f]]);
     // Ray origins near the scene's frame origin: float precision anywhere in the city.
     VISTA_RETURN_IF_ERROR(rays.placeFrameNear(vehicle.position));
+    // The traffic at the frame's time, every agent in the ray scene (the vehicle's own excepted).
+    if (p.agents) {
+        VISTA_RETURN_IF_ERROR(p.agents->setFrame(p.times[f], vehicle.position));
+        VISTA_RETURN_IF_ERROR(p.agents->setSplit(0.0));
+    }
     const std::string name = frameName(f);
     const int threads = p.options.threads;
     nlohmann::json ms = nlohmann::json::object(), lidar = nlohmann::json::object();
@@ -485,6 +497,12 @@ int runRigRender(const RigRunRequest& a) {
     if (!rays)
         return reportBadInput(kCmd, Status::error("building the Embree ray scene failed: " + rays.status().message()));
     if (Status s = openWorkDir(a, plan, walk->path, out); !s) return reportBadInput(kCmd, s);
+    std::unique_ptr<TrafficScene> traffic;
+    if (plan.traffic) {
+        traffic = std::make_unique<TrafficScene>(plan.traffic, walk->city.params, false);
+        if (Status s = traffic->attachRays(rays->get()); !s) return reportBadInput(kCmd, s);
+        plan.agents = traffic.get();
+    }
     size_t kept = 0;
     std::vector<nlohmann::json> records = finishedFrames(out, plan, kept);
     if (Status s = renderFrames(a, plan, *walk, **rays, out, records, kept); !s) return reportBadInput(kCmd, s);

@@ -78,6 +78,13 @@ Result<std::string> fileHash(const std::string& path, uint64_t& bytes) {
 // Hash of the frames' camera poses (path index, time, eye, heading, pitch):
 // whatever chose them (--path file, --seed/--kind/--duration/--run-up,
 // --frames, --sampling), equal poses give equal frames.
+std::string trafficHash(const TrafficTracks& t) {
+    uint64_t h = hashBytes64(t.poses.data(), t.poses.size() * sizeof(AgentPose));
+    h = hashBytes64(t.times.data(), t.times.size() * sizeof(double), h);
+    h = hashBytes64(t.agentTypes.data(), t.agentTypes.size() * sizeof(AgentType), h);
+    return hex64(h);
+}
+
 std::string posesHash(const Path& path, const std::vector<size_t>& idx) {
     Hasher64 h;
     auto put = [&](uint64_t v) {

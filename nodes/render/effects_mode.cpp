@@ -6,6 +6,7 @@
 #include "nodes/render/effects_state.h"
 #include "nodes/render/offscreen.h"
 #include "nodes/render/reflection_drawable.h"
+#include "nodes/render/traffic_scene.h"
 #include "runtime/engine/reflections.h"
 
 namespace vista {
@@ -22,6 +23,7 @@ public:
     Status renderFrame(const Camera& camera, Image& out, FrameStats& stats) override {
         const FrameEffects& fx = _ctx.options.effects;
         if (_ctx.renderer) _ctx.renderer->setEffects(fx, !_inner->hazesRasterPixels());
+        if (_ctx.traffic) VISTA_RETURN_IF_ERROR(_ctx.traffic->setFrame(camera.time, camera.eye));
         VISTA_RETURN_IF_ERROR(_inner->renderFrame(camera, out, stats));
         if (fx.haze && !stats.effects.ran(EffectId::Haze)) {
             stats.effects.add(EffectId::Haze, 0.0);  // fog inside the rasteriser's draw
@@ -46,6 +48,7 @@ public:
             _viewer->setName("vista.effects");
             applyEffectsState(*_viewer->getOrCreateStateSet(), _ctx.options.effects, !_inner->hazesRasterPixels());
             _viewer->addChild(_inner->viewerScene());
+            if (_ctx.traffic) _viewer->addChild(_ctx.traffic->node());
             if (_ctx.options.effects.glassMarked) {
                 _reflect = new ReflectionDrawable(_ctx.rays, &_ctx.options.effects);
                 osg::ref_ptr<osg::Geode> g = new osg::Geode;
@@ -61,6 +64,7 @@ public:
         if (_viewer)
             applyEffectsState(*_viewer->getOrCreateStateSet(), _ctx.options.effects,
                               !_inner->hazesRasterPixels());  // live toggles
+        if (_ctx.traffic) (void)_ctx.traffic->setFrame(camera.time, camera.eye);
         return effectsFarPlane(_inner->beginViewerFrame(camera), _ctx.options.effects);
     }
     FrameStats lastViewerStats() const override {

@@ -12,6 +12,9 @@
 //               state (effects_state.h, refreshed every frame for live
 //               toggles), plus a ReflectionDrawable when the scene marks
 //               glass; the far plane of the haze (effectsFarPlane).
+// With a traffic run (ModeContext::traffic), both faces place its agents at
+// the camera's time before the inner mode runs (which may split them between
+// GL and rays); the viewer's group holds the agents' node.
 // Everything else (reset, traced pixels, raster selection, sky) is the inner
 // mode's. The effects are read from ctx.options.effects every frame; `ctx`
 // must outlive the mode.

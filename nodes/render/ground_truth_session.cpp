@@ -36,6 +36,12 @@ Status GroundTruthSession::setUp(const GroundTruthSetup& setup, const SceneModel
         rays = std::move(rs.value());
         ctx.rays = rays.get();
     }
+    if (setup.traffic) {
+        traffic = std::make_unique<TrafficScene>(setup.traffic, city.params, setup.labels);
+        if (RayScene* r = activeRays()) VISTA_RETURN_IF_ERROR(traffic->attachRays(r));
+        ctx.traffic = traffic.get();
+        renderer->setOverlay(traffic->node(), traffic->labelNode());
+    }
     auto m = createRenderMode(setup.mode, ctx);
     if (!m) return m.status();
     mode = std::move(*m);

@@ -6,8 +6,9 @@
 // equal bytes in both.
 //
 // setUp(): creates the renderer at setup.width x setup.height, the ray
-// scene or the stream, and the mode `setup.mode` (a name of the registry,
-// render_mode.h). Errors (no GL context, a ray scene that cannot be built,
+// scene or the stream, the traffic's agents (setup.traffic: drawn in the
+// near field and, where rays are cast, as moving ray instances) and the mode
+// `setup.mode` (a name of the registry, render_mode.h). Errors (no GL context, a ray scene that cannot be built,
 // an unknown mode) are returned, never thrown. `city` must outlive the
 // session. renderFrame(): the mode's colour image of `camera` (rgba, row 0 at
 // the top) and, with setup.labels, the labels (renderLabels: the label pass
@@ -27,6 +28,7 @@
 #include "nodes/render/city_stream.h"
 #include "nodes/render/offscreen.h"
 #include "nodes/render/render_mode.h"
+#include "nodes/render/traffic_scene.h"
 #include "runtime/engine/ground_truth.h"
 #include "runtime/engine/image.h"
 #include "runtime/engine/ray_scene.h"
@@ -45,6 +47,7 @@ struct GroundTruthSetup {
     const PagedManifest* streamed = nullptr;       // a streamed paged city (its manifest), else null
     RegionPagerOptions stream;                     // streamed: the pager's options
     std::function<void(CityStream&)> streamReady;  // streamed: called once the stream exists (e.g. a memory hold)
+    std::shared_ptr<const TrafficTracks> traffic;  // moving agents drawn at each camera's time (null: none)
 };
 
 // Scratch buffers of a frame, reused from frame to frame.
@@ -64,7 +67,8 @@ struct LabelCosts {
 struct GroundTruthSession {
     std::unique_ptr<OffscreenRenderer> renderer;
     std::unique_ptr<RayScene> rays;
-    std::unique_ptr<CityStream> stream;  // streamed: the mode's graph, rays and label twin
+    std::unique_ptr<CityStream> stream;     // streamed: the mode's graph, rays and label twin
+    std::unique_ptr<TrafficScene> traffic;  // setup.traffic: the agents' models, overlay and ray instances
     ModeContext ctx;
     std::unique_ptr<RenderMode> mode;
     osg::ref_ptr<osg::Group> labelRoot = new osg::Group;

@@ -11,6 +11,7 @@
 #include "nodes/render/city_stream.h"
 #include "nodes/render/effects_state.h"
 #include "nodes/render/offscreen.h"
+#include "nodes/render/traffic_scene.h"
 #include "runtime/engine/adaptive_split.h"
 #include "runtime/engine/far_field.h"
 #include "runtime/engine/frame_raycast.h"
@@ -67,6 +68,8 @@ public:
         Stopwatch sw;
         // Cull: the near/far split.
         const double nearD = chooseNear(camera);
+        // Agents: GL within the near distance, rays beyond (a triangle budget: GL alone).
+        if (_ctx.traffic) VISTA_RETURN_IF_ERROR(_ctx.traffic->setSplit(byBudget() ? 1e300 : nearD));
         if (!byBudget() && (nearD <= 0 || std::isinf(nearD))) return endPointFrame(camera, nearD, sw, out, stats);
         std::vector<uint32_t> sel =
             byBudget() ? selectNearFieldByBudget(_adaptive->index(), camera.eye, _ctx.options.triangleBudget)
@@ -166,6 +169,7 @@ public:
             recordCosts(_adaptive->chosenTriangles(), std::max(0.0, wallMs - farMs), fs);
         }
         _viewerNear = chooseNear(camera);
+        if (_ctx.traffic) (void)_ctx.traffic->setSplit(byBudget() ? 1e300 : _viewerNear);
         if (_split) _split->setNearDistance(_viewerNear);
         if (_farNode) _farNode->setOptions(farOptions(_viewerNear, 0.0));  // live effect toggles
         return farPlane(_viewerNear, camera);
@@ -258,6 +262,7 @@ private:
         FarFieldOptions o;
         o.nearDistance = std::max(0.0, nearD);
         o.nearIsDistance = !byBudget();
+        o.movingHeight = _ctx.traffic ? _ctx.traffic->tallestAgent() : 0.0;
         o.pixelBudget = _ctx.options.pixelBudget;
         o.cache = _ctx.options.cache;
         o.cacheErrorPx = _ctx.options.cacheErrorPx;

@@ -10,6 +10,7 @@
 
 #include "foundation/timing.h"
 #include "nodes/readback_drawable.h"
+#include "nodes/render/traffic_scene.h"
 #include "runtime/engine/frame_raycast.h"
 #include "runtime/engine/ray_scene.h"
 
@@ -56,6 +57,7 @@ public:
     std::string name() const override { return "raycast"; }
     Status renderFrame(const Camera& camera, Image& out, FrameStats& stats) override {
         Stopwatch sw;
+        if (_ctx.traffic) VISTA_RETURN_IF_ERROR(_ctx.traffic->setSplit(0.0));  // every agent ray-cast
         castEveryPixel(*_ctx.rays, camera, out, stats, _ctx.options.threads, _ctx.options.effects);
         stats.frameMs = sw.ms();
         stats.drawMs = stats.frameMs;
@@ -70,6 +72,11 @@ public:
             _viewer = geode;
         }
         return _viewer.get();
+    }
+    double beginViewerFrame(const Camera& camera) override {
+        (void)camera;
+        if (_ctx.traffic) (void)_ctx.traffic->setSplit(0.0);
+        return 0.0;
     }
     FrameStats lastViewerStats() const override { return _drawable ? _drawable->lastStats() : FrameStats(); }
 

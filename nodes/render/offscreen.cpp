@@ -154,6 +154,7 @@ struct OffscreenRenderer::Impl {
     int width = 0, height = 0;
     osg::ref_ptr<osgViewer::Viewer> viewer;
     osg::ref_ptr<osg::Group> root, slot;
+    osg::ref_ptr<osg::Node> overlay, labelOverlay;  // setOverlay
     std::unique_ptr<SkyBackground> sky;
     osg::ref_ptr<Readback> readback;
     std::vector<uint8_t> colorBuf;
@@ -196,9 +197,11 @@ struct OffscreenRenderer::Impl {
         osg::Matrixd proj = toOsg(camera.projection(effectsFarPlane(zFar, effects)));
         if (jx != 0 || jy != 0) proj = proj * osg::Matrixd::translate(-2.0 * jx / width, 2.0 * jy / height, 0.0);
         cam->setProjectionMatrix(proj);
-        if (slot->getNumChildren() != 1 || slot->getChild(0) != scene) {
+        const unsigned want = (scene ? 1u : 0u) + (overlay ? 1u : 0u);
+        if (slot->getNumChildren() != want || (scene && slot->getChild(0) != scene)) {
             slot->removeChildren(0, slot->getNumChildren());
             if (scene) slot->addChild(scene);
+            if (overlay) slot->addChild(overlay.get());
         }
         readback->color = color ? &colorBuf : nullptr;
         readback->depth = depth;
@@ -346,6 +349,12 @@ Status OffscreenRenderer::render(osg::Node* scene, const Camera& camera, double 
     return s;
 }
 
+void OffscreenRenderer::setOverlay(osg::Node* colour, osg::Node* labels) {
+    _impl->overlay = colour;
+    _impl->labelOverlay = labels;
+    _impl->slot->removeChildren(0, _impl->slot->getNumChildren());  // the next draw lays the slot out again
+}
+
 void OffscreenRenderer::setEffects(const FrameEffects& fx, bool hazeInRaster) {
     Impl& m = *_impl;
     m.effects = fx;
@@ -366,6 +375,7 @@ Status OffscreenRenderer::renderLabels(osg::Node* labelScene, const Camera& came
     m.labelCam->setProjectionMatrix(toOsg(camera.projection(zFar)));
     m.labelSlot->removeChildren(0, m.labelSlot->getNumChildren());
     if (labelScene) m.labelSlot->addChild(labelScene);
+    if (m.labelOverlay) m.labelSlot->addChild(m.labelOverlay.get());
     // Only the label camera draws: sky and colour scene masked off, no colour read-back.
     m.labelCam->setNodeMask(~0u);
     m.sky->node()->setNodeMask(0);

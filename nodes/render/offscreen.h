@@ -89,6 +89,11 @@ public:
     // Shifts the sample point of every pixel by (dx, dy) pixels (x right,
     // y down) for the following renders (jittered supersampling); sky included.
     void setSubpixelOffset(double dx, double dy);
+    // A node drawn with every render() after the scene (with the scene's
+    // effects) and one drawn with every renderLabels() after the label scene:
+    // what moves through every mode (a traffic run's agents,
+    // traffic_scene.h); null = none. The nodes must outlive their use.
+    void setOverlay(osg::Node* colour, osg::Node* labels);
     // Run-time effects of the following renders: haze (fog on the drawn
     // scene, far plane at fx.hazeFar()) and the night sky (effects_state.h);
     // hazeInRaster = false: far plane only, the caller hazes the pixels.

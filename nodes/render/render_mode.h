@@ -49,6 +49,7 @@ struct PagedManifest;
 class RayScene;
 class OffscreenRenderer;
 class CityStream;
+class TrafficScene;
 
 // The near distance of modes that need one when --near is auto (only hybrid
 // chooses per frame).
@@ -113,6 +114,13 @@ struct ModeContext {
     // grid on the paged city's lattice (pagedHeightLattice), so a streamed
     // run and a preloaded one of the same regions trace the same grid.
     const PagedManifest* paged = nullptr;
+    // A traffic run to draw (--traffic; traffic_scene.h), or null: every mode
+    // shows its agents at the camera's time (Camera::time). The effects
+    // wrapper places them before each frame (both faces) and draws them in GL
+    // (the renderer's overlay, the viewer scene); modes with a ray-cast far
+    // field split them (TrafficScene::setSplit: raycast all by rays, hybrid
+    // by its near distance). Its ray scene is the one the modes trace.
+    TrafficScene* traffic = nullptr;
     ModeOptions options;
 
     // The plain city: a baked root's tiles without its impostors, else `scene`.

@@ -178,6 +178,7 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
     const bool cacheRan = useCache && !f.pending.empty();
     if (cacheRan) {
         const double before = stats.stages.ms(Stage::Cache);
+        if (_options.cacheMovers) moverFootprint(f, _rays);
         const uint64_t reusedBefore = stats.pixels.cache;
         cacheStage(f, *_mem, _options, stats);
         const double lookupMs = stats.stages.ms(Stage::Cache) - before;

@@ -80,6 +80,10 @@ struct FarFieldOptions {
     // and seam rays start at nearDistance. false when the near field is a triangle budget (then
     // rays start at the eye and the horizon skips nothing).
     bool nearIsDistance = true;
+    // The tallest moving object standing on the far geometry (metres, >= 0; a
+    // traffic run's agents, 0 = none): the horizon bounds every cell that much
+    // higher (HorizonOptions::lift), so no moving object is cut off as sky.
+    double movingHeight = 0;
     // Panoramic cache (panorama_cache.h): a cached far pixel is reused while
     // its estimated reprojection error is below cacheErrorPx (0 = only
     // pixels traced by this very camera), else re-traced, the worst first, up
@@ -115,6 +119,13 @@ struct FarFieldOptions {
     bool overlap = true;
     int horizonSubsampleMoving = 1;  // >= 1: subsample factor of the horizon while the camera moves
     double cacheOversample = 1.5;
+    // Moving objects of the ray scene (RayScene::placeMovers, a traffic run's
+    // agents): every pending pixel within the screen footprint of one's
+    // bounding sphere now (plus kMoverMarginPx) is traced, never served from
+    // the cache, and its cell is not kept (PanoramaCache::forget), so no
+    // cached colour ever shows a moving object where it was, nor hides one
+    // where it is. false: the naive cache (measurements of its error only).
+    bool cacheMovers = true;
     // Pause the cache while it does not pay: after two consecutive cache
     // frames of a moving camera, if the share r of pending pixels the second
     // reused, times the measured ms per ray, is below the measured ms per

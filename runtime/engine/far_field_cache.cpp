@@ -8,6 +8,8 @@
 #include <tbb/parallel_for.h>
 
 #include "foundation/timing.h"
+#include "foundation/units.h"
+#include "runtime/engine/ray_scene.h"
 #include "runtime/engine/far_field_stages.h"
 
 namespace vista {
@@ -46,6 +48,39 @@ PanoramaCache& ensureCache(FarFieldMemory& m, const Camera& camera, const FarFie
     return *m.cache;
 }
 
+void moverFootprint(FarFrame& f, const RayScene& rays) {
+    const std::vector<glm::dvec4>& spheres = rays.moverSpheres();
+    f.moverMask.clear();
+    if (spheres.empty()) return;
+    f.moverMask.assign(f.pixelCount, 0);
+    const Camera& cam = f.camera;
+    const glm::dvec3 fwd = cam.forward(), right = cam.right(), up = cam.up();
+    const double focal = 0.5 * f.height / std::tan(0.5 * cam.fovY);
+    const double margin = kMoverMarginPx / focal;  // radians
+    for (const glm::dvec4& s : spheres) {
+        const glm::dvec3 v = glm::dvec3(s) - cam.eye;
+        const double d = glm::length(v), r = s.w, z = glm::dot(v, fwd);
+        if (z < -r) continue;  // behind the eye
+        int x0 = 0, x1 = f.width - 1, y0 = 0, y1 = f.height - 1;
+        if (d > r && z - r > 1e-3) {
+            // The sphere's image lies within this square around its centre's (each axis: |d x| <= r d / (z (z - r))).
+            const double cx = 0.5 * f.width + focal * glm::dot(v, right) / z;
+            const double cy = 0.5 * f.height - focal * glm::dot(v, up) / z;
+            const double half = focal * r * d / (z * (z - r)) + kMoverMarginPx + 1.0;
+            x0 = std::max(0, int(std::floor(cx - half)));
+            x1 = std::min(f.width - 1, int(std::ceil(cx + half)));
+            y0 = std::max(0, int(std::floor(cy - half)));
+            y1 = std::min(f.height - 1, int(std::ceil(cy + half)));
+        }
+        const double cosLimit = d > r ? std::cos(std::min(kPi, std::asin(r / d) + margin)) : -2.0;
+        const glm::dvec3 axis = d > 0 ? v / d : fwd;
+        for (int y = y0; y <= y1; ++y)
+            for (int x = x0; x <= x1; ++x)
+                if (glm::dot(f.rays.dir(x, y), axis) >= cosLimit)
+                    f.moverMask[size_t(y) * size_t(f.width) + size_t(x)] = 1;
+    }
+}
+
 void cacheStage(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, FrameStats& stats) {
     double spentMs = 0;
     stats.stages.forEach([&](Stage s, double ms) {
@@ -82,9 +117,10 @@ void cacheStage(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, FrameS
     f.traceSubs.clear();
     const bool havePrev = m.prev.width == f.width && m.prev.height == f.height;
     uint64_t fromCache = 0;
+    const bool movers = !f.moverMask.empty();
     for (size_t k = 0; k < f.pending.size(); ++k) {
         const uint32_t i = f.pending[k];
-        if (trace[k]) {
+        if (trace[k] || (movers && f.moverMask[i])) {
             f.trace.push_back(i);
             f.traceCells.push_back(cand[k].cell);
             f.traceSubs.push_back(cand[k].sub);

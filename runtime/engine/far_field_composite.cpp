@@ -53,6 +53,13 @@ void compositeStage(FarFrame& f, FarFieldMemory& m, bool cacheMode, FrameStats& 
                 nearest[j] = v;
             }
             m.cache->store(f.traceCells, f.traceSubs, traced, nearest);
+            if (!f.moverMask.empty()) {
+                // A moving object may be in these cells: they are traced again while it is there.
+                std::vector<int64_t> moving;
+                for (size_t j = 0; j < f.trace.size(); ++j)
+                    if (f.moverMask[f.trace[j]]) moving.push_back(f.traceCells[j]);
+                m.cache->forget(moving);
+            }
         }
         if (keepFrame) m.prev = f.out;  // fallback for never-traced cache cells next frame
         else m.prev = Image();

@@ -38,6 +38,7 @@ double culledRaysMs(const FarFrame& f, const RayScene& rays, const FarFieldOptio
 HorizonOptions horizonOptions(const FarFieldOptions& o, bool moving) {
     HorizonOptions ho;
     ho.nearDistance = o.nearIsDistance ? o.nearDistance : 0.0;
+    ho.lift = o.movingHeight;
     ho.subsample = moving ? std::max(1, o.horizonSubsampleMoving) : 1;
     if (o.effects.haze) ho.maxEyeDepth = o.effects.hazeFar();  // nothing beyond is traced
     return ho;

@@ -138,6 +138,8 @@ struct FarFrame {
     std::vector<uint32_t> trace;         // pixels to trace this frame, ascending (cache)
     std::vector<int64_t> traceCells;     // their panorama cells (cache stage only)
     std::vector<glm::u8vec2> traceSubs;  // where their rays fall in those cells (cache stage only)
+    // Per pixel: inside a moving object's screen footprint (moverFootprint); empty = none.
+    std::vector<uint8_t> moverMask;
     std::vector<float>
         farDepth;  // cache mode: per pending pixel, eye-plane depth of its far colour (+inf = sky/none); others unset
 };
@@ -237,7 +239,15 @@ void listPending(FarFrame& f);
 // nearest surface; the ray stage fills the traced ones; other pixels are left
 // as they were and never read). Records Cache; with
 // a frame-time target, a note gives the budget.
+// Pixels traced (trace) include every pending pixel of f.moverMask.
 void cacheStage(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, FrameStats& stats);
+// f.moverMask: the pixels whose centre ray passes within kMoverMarginPx
+// pixels (at the image centre's pixel angle) of a moving object's bounding
+// sphere (RayScene::moverSpheres); empty when the scene has none. Exact per
+// pixel inside each sphere's bounding square on screen; a sphere holding the
+// eye or crossing the eye plane marks every pixel.
+constexpr double kMoverMarginPx = 1.5;
+void moverFootprint(FarFrame& f, const RayScene& rays);
 // The panorama for `camera` (resolution and oversample as o.cacheOversample
 // asks): kept when it fits, else made anew (its cells zero pages, not yet
 // resident).

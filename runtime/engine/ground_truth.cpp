@@ -44,7 +44,10 @@ uint32_t triangleId(const SceneMesh& m, uint32_t prim) {
 PixelLabel rayLabel(const SceneModel& city, const RayScene& rays, const RayHit& hit) {
     PixelLabel out;
     const HitSource src = rays.source(hit);
-    if (src.mesh >= 0 && size_t(src.mesh) < city.meshes.size()) {
+    if (src.mover >= 0) {
+        out.id = src.moverId;
+        out.cls = src.moverClass;
+    } else if (src.mesh >= 0 && size_t(src.mesh) < city.meshes.size()) {
         const SceneMesh& m = city.meshes[size_t(src.mesh)];
         out.cls = classOf(m.material);
         out.id = triangleId(m, hit.primId);

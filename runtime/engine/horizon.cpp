@@ -602,7 +602,7 @@ HorizonResult traceHorizon(const HeightGrid& grid, const Camera& camera, const H
         return r;
     }
     const ColumnGeometry cg(camera);
-    const glm::dvec3 eye = camera.eye - grid.frameOrigin();
+    const glm::dvec3 eye = camera.eye - grid.frameOrigin() - glm::dvec3(0.0, 0.0, std::max(0.0, options.lift));
     // Azimuth range of each needed column (pixel centres, top and bottom rows).
     std::vector<double> lo(static_cast<size_t>(W)), hi(static_cast<size_t>(W));
     double relMin = kInf, relMax = -kInf;

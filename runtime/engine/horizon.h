@@ -153,6 +153,10 @@ struct HorizonOptions {
     double maxEyeDepth = std::numeric_limits<double>::infinity();
     int subsample = 1;                                   // >= 1
     const std::vector<uint8_t>* columnNeeded = nullptr;  // size camera.width, or null = all
+    // Metres added to every cell's top (>= 0): moving objects up to this tall
+    // standing on the grid's geometry (a traffic run's agents) stay below the
+    // horizon. Traced as an eye this much lower, which gives the same bound.
+    double lift = 0;
 };
 
 struct HorizonResult {

@@ -64,7 +64,9 @@ float lidarReflectivity(uint8_t semanticClass) {
         case SemanticClass::Roof: return 0.2f;
         case SemanticClass::TreeTrunk: return 0.3f;
         case SemanticClass::TreeLeaves: return 0.45f;
-        case SemanticClass::Car: return 0.5f;  // painted metal and glass
+        case SemanticClass::Car:
+        case SemanticClass::Vehicle: return 0.5f;     // painted metal and glass
+        case SemanticClass::Pedestrian: return 0.3f;  // clothes
         default: return 0.2f;
     }
 }

@@ -261,6 +261,11 @@ int64_t PanoramaCache::selectForTracing(const std::vector<CacheCandidate>& cand,
     return forced + int64_t(take);
 }
 
+void PanoramaCache::forget(const std::vector<int64_t>& cells) {
+    for (int64_t c : cells)
+        if (c >= 0) _cells[size_t(c)] = Cell{};
+}
+
 void PanoramaCache::store(const std::vector<int64_t>& cells, const std::vector<glm::u8vec2>& subs,
                           const std::vector<glm::u8vec4>& colors, const std::vector<float>& nearDistance) {
     VISTA_CHECK(cells.size() == colors.size() && cells.size() == nearDistance.size() && cells.size() == subs.size());

@@ -120,6 +120,9 @@ public:
     // metres, +inf = none); duplicates are reset to record 0.
     void store(const std::vector<int64_t>& cells, const std::vector<glm::u8vec2>& subs,
                const std::vector<glm::u8vec4>& colors, const std::vector<float>& nearDistance);
+    // Resets cells to never traced (a moving object may have been in them:
+    // FarFieldOptions::cacheMovers); -1 entries are skipped.
+    void forget(const std::vector<int64_t>& cells);
     glm::u8vec4 color(int64_t cell) const { return _cells[size_t(cell)].color; }
     float nearDistance(int64_t cell) const { return decodeNear(_cells[size_t(cell)].nearBits); }
     uint32_t record(int64_t cell) const { return _cells[size_t(cell)].record; }

@@ -157,20 +157,27 @@ struct RayScene::Impl {
     };
     // Per top-level geometry id: what it is.
     struct TopGeom {
-        enum class Kind { None, Mesh, Region, Tree } kind = Kind::None;
+        enum class Kind { None, Mesh, Region, Tree, Mover } kind = Kind::None;
         int index = -1;  // Mesh: flatMeshes; Region / Tree: regions (Tree: -1 in the flat layout)
         int prototype = -1;
         int instance = -1;  // Tree: index into the model's instances, or
         int impostor = -1;  // into its impostors
         const PrototypeSet* protos = nullptr;
         glm::mat3 normalMatrix{1.0f};
-        glm::dmat4 transform{1.0};  // Tree: prototype frame -> world; Region: translation to its origin
+        glm::dmat4 transform{1.0};  // Tree, Mover: prototype frame -> world; Region: translation to its origin
+        uint32_t moverId = 0;       // Mover: its label (instance: its index in the last placeMovers)
+        uint8_t moverClass = 0;
     };
     std::vector<TopGeom> geoms;
     std::vector<MeshInfo> flatMeshes;
     std::shared_ptr<PrototypeSet> flatProtos;  // trees of the flat layout
     std::vector<unsigned> flatTreeIds;
     std::vector<Region> regions;
+    std::shared_ptr<PrototypeSet> moverProtos;  // setMoverPrototypes
+    std::vector<glm::dvec4> moverBounds;        // per prototype: bounding sphere in its frame
+    std::vector<glm::dvec4> moverSpheres;       // per placed object: world bounding sphere
+    std::vector<unsigned> moverGeoms;           // the pool of mover instances (top-level ids)
+    size_t moversLive = 0;
 
     ~Impl() {
         for (Region& r : regions)
@@ -212,7 +219,7 @@ struct RayScene::Impl {
         if (const MeshInfo* m = meshOf(geomID, instID)) return &m->colors;
         if (instID == RTC_INVALID_GEOMETRY_ID || instID >= geoms.size()) return nullptr;
         const TopGeom& g = geoms[instID];
-        if (g.kind != TopGeom::Kind::Tree) return nullptr;
+        if (g.kind != TopGeom::Kind::Tree && g.kind != TopGeom::Kind::Mover) return nullptr;
         *tree = &g;
         return &g.protos->colors[size_t(g.prototype)];
     }
@@ -746,6 +753,86 @@ Status RayScene::commit() {
     return _impl->checkDevice("committing the scene");
 }
 
+Status RayScene::setMoverPrototypes(const std::vector<SceneMesh>& prototypes) {
+    Impl& im = *_impl;
+    if (!im.scene) return Status::error("ray scene: no scene for moving objects");
+    SceneModel model;
+    model.prototypes = prototypes;
+    auto protos = im.buildPrototypes(model);
+    if (!protos.isOk()) return protos.status();
+    im.moverProtos = *protos;
+    im.moverBounds.clear();
+    for (const SceneMesh& p : prototypes) {
+        glm::dvec3 lo(1e300), hi(-1e300);
+        for (const glm::vec3& v : p.positions) {
+            lo = glm::min(lo, glm::dvec3(v) + p.origin);
+            hi = glm::max(hi, glm::dvec3(v) + p.origin);
+        }
+        const bool any = !p.positions.empty();
+        im.moverBounds.push_back(any ? glm::dvec4(0.5 * (lo + hi), 0.5 * glm::length(hi - lo)) : glm::dvec4(0.0));
+    }
+    return Status::ok();
+}
+
+Status RayScene::placeMovers(const std::vector<MoverPlacement>& movers) {
+    Impl& im = *_impl;
+    const size_t protoCount = im.moverProtos ? im.moverProtos->scenes.size() : 0;
+    for (const MoverPlacement& p : movers)
+        if (p.prototype >= protoCount)
+            return Status::error("ray scene: moving object of prototype " + std::to_string(p.prototype) + " (have " +
+                                 std::to_string(protoCount) + ")");
+    im.moverSpheres.clear();
+    for (const MoverPlacement& p : movers) {
+        const glm::dvec4 b = im.moverBounds[p.prototype];
+        im.moverSpheres.push_back(glm::dvec4(glm::dvec3(p.transform * glm::dvec4(glm::dvec3(b), 1.0)), b.w));
+    }
+    for (size_t i = 0; i < movers.size(); ++i) {
+        const MoverPlacement& p = movers[i];
+        RTCScene child = im.moverProtos->scenes[p.prototype];
+        if (i == im.moverGeoms.size()) {
+            RTCGeometry g = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_INSTANCE);
+            rtcSetGeometryTimeStepCount(g, 1);
+            im.moverGeoms.push_back(rtcAttachGeometry(im.scene, g));
+            rtcReleaseGeometry(g);
+        }
+        const unsigned id = im.moverGeoms[i];
+        RTCGeometry g = rtcGetGeometry(im.scene, id);
+        Impl::TopGeom& tg = im.top(id);
+        if (!child) {  // an empty prototype: nothing to hit
+            rtcDisableGeometry(g);
+            tg.kind = Impl::TopGeom::Kind::None;
+            continue;
+        }
+        if (tg.kind != Impl::TopGeom::Kind::Mover || tg.prototype != int(p.prototype))
+            rtcSetGeometryInstancedScene(g, child);
+        float m[12];
+        embreeTransform(p.transform, im.origin, m);
+        rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, m);
+        rtcEnableGeometry(g);
+        rtcCommitGeometry(g);
+        tg.kind = Impl::TopGeom::Kind::Mover;
+        tg.index = -1;
+        tg.prototype = int(p.prototype);
+        tg.instance = int(i);
+        tg.protos = im.moverProtos.get();
+        tg.transform = p.transform;
+        tg.normalMatrix = glm::transpose(glm::inverse(glm::mat3(glm::dmat3(p.transform))));
+        tg.moverId = p.id;
+        tg.moverClass = p.cls;
+    }
+    for (size_t i = movers.size(); i < im.moversLive && i < im.moverGeoms.size(); ++i) {
+        rtcDisableGeometry(rtcGetGeometry(im.scene, im.moverGeoms[i]));
+        im.top(im.moverGeoms[i]).kind = Impl::TopGeom::Kind::None;
+    }
+    im.moversLive = movers.size();
+    rtcCommitScene(im.scene);
+    return im.checkDevice("placing moving objects");
+}
+
+size_t RayScene::moverCount() const { return _impl->moversLive; }
+
+const std::vector<glm::dvec4>& RayScene::moverSpheres() const { return _impl->moverSpheres; }
+
 Status RayScene::setFrameOrigin(const glm::dvec3& frameOrigin) {
     Impl& im = *_impl;
     if (!im.city || im.flat) return Status::error("ray scene: only a city scene of regions can move its frame");
@@ -756,7 +843,9 @@ Status RayScene::setFrameOrigin(const glm::dvec3& frameOrigin) {
     im.origin = next;
     for (size_t id = 0; id < im.geoms.size(); ++id) {
         const Impl::TopGeom& g = im.geoms[id];
-        if (g.kind != Impl::TopGeom::Kind::Region && g.kind != Impl::TopGeom::Kind::Tree) continue;
+        if (g.kind != Impl::TopGeom::Kind::Region && g.kind != Impl::TopGeom::Kind::Tree &&
+            g.kind != Impl::TopGeom::Kind::Mover)
+            continue;
         RTCGeometry geom = rtcGetGeometry(im.scene, unsigned(id));
         float m[12];
         embreeTransform(g.transform, im.origin, m);
@@ -838,6 +927,12 @@ HitSource RayScene::source(const RayHit& h) const {
     }
     if (instId == RTC_INVALID_GEOMETRY_ID || instId >= im.geoms.size()) return s;
     const Impl::TopGeom& g = im.geoms[instId];
+    if (g.kind == Impl::TopGeom::Kind::Mover) {
+        s.mover = g.instance;
+        s.moverId = g.moverId;
+        s.moverClass = g.moverClass;
+        return s;
+    }
     if (g.kind != Impl::TopGeom::Kind::Tree) return s;
     s.instance = g.instance;
     s.impostor = g.impostor;

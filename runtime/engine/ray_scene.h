@@ -78,11 +78,26 @@ struct TriangleSoup {
 // lies in (the index build() gave it or the id addRegion() returned; -1 for
 // flat and soup scenes); mesh, instance and impostor index the SceneModel that
 // region was made from (build(): the city).
+// mover: a moving object placed by placeMovers() (its index in that list),
+// with the label given there (moverId, moverClass); -1 otherwise.
 struct HitSource {
     int mesh = -1;
     int instance = -1;
     int impostor = -1;
     int region = -1;
+    int mover = -1;
+    uint32_t moverId = 0;
+    uint8_t moverClass = 0;
+};
+
+// One moving object of a frame (placeMovers): a prototype of
+// setMoverPrototypes() placed by `transform` (prototype frame -> world), with
+// its ground-truth label (citygen/labels.h instance id and semantic class).
+struct MoverPlacement {
+    uint32_t prototype = 0;
+    glm::dmat4 transform{1.0};
+    uint32_t id = 0;
+    uint8_t cls = 0;
 };
 
 enum class RayBuildQuality { Low, Medium, High };
@@ -176,6 +191,21 @@ public:
     Status removeRegion(int region);
     // Commits the top-level scene (only its instance BVH is rebuilt).
     Status commit();
+    // Moving objects (a traffic run's agents, city scenes): the prototype
+    // meshes (SceneMesh positions relative to their origin, in the
+    // prototype frame; colours per vertex) become Embree scenes once;
+    // placeMovers() then shows exactly the given objects, one top-level
+    // instance each, re-placed or hidden (rtcDisableGeometry) from a pool of
+    // instances, and commits the top level only (no prototype or region BVH
+    // is rebuilt). Hits report the object's index and label (HitSource).
+    // Errors: a malformed prototype, an unknown prototype index, an Embree
+    // error. A scene without placeMovers() calls has no mover in it.
+    Status setMoverPrototypes(const std::vector<SceneMesh>& prototypes);
+    Status placeMovers(const std::vector<MoverPlacement>& movers);
+    size_t moverCount() const;  // objects of the last placeMovers()
+    // World bounding spheres (centre xyz, radius w) of the last placeMovers()'s
+    // objects, in its order (the far field's cache keeps their pixels out).
+    const std::vector<glm::dvec4>& moverSpheres() const;
     int regionCount() const;  // live regions
     // Moves the scene-local frame (regions layout): frameOrigin() becomes
     // `frameOrigin` rounded to whole metres from the current one, every

@@ -20,6 +20,7 @@ struct Camera {
     double fovY = 0.7853981633974483;  // 45 degrees
     int width = 640, height = 480;
     double zNear = 0.3;  // metres
+    double time = 0.0;   // seconds on the walkthrough's clock (path sample time): what moving agents show
 
     // Unit vectors of the view frame in world coordinates.
     glm::dvec3 forward() const;

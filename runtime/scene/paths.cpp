@@ -235,6 +235,7 @@ Camera Path::camera(size_t i, const Camera& base) const {
     c.eye = samples[i].position;
     c.heading = samples[i].heading;
     c.pitch = samples[i].pitch;
+    c.time = samples[i].t;
     return c;
 }
 

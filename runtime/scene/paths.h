@@ -123,7 +123,7 @@ struct Path {
     // lanes cannot be driven (the reason; it then follows the street centre
     // lines), or a path read from a CSV.
     std::string lanesMissing = "a path read from a CSV carries no lane positions";
-    // Camera at sample i: eye/heading/pitch from the sample, the rest (fov,
+    // Camera at sample i: eye/heading/pitch and time from the sample, the rest (fov,
     // size, zNear) from `base`.
     Camera camera(size_t i, const Camera& base) const;
     // Indices of n samples spread evenly over the whole path (first and last

@@ -60,7 +60,7 @@ Result<Path> egoPath(const TrafficTracks& tracks, uint32_t ego, const CityParams
         const glm::dvec2 eye = front - kEgoEyeBack * length * glm::dvec2(std::cos(p.heading), std::sin(p.heading));
         const glm::dvec2 local = eye - glm::dvec2(params.origin_x, params.origin_y);
         PathSample s;
-        s.t = double(i) * dt;
+        s.t = t;  // the traffic's clock: --traffic draws the others as they were then
         s.position = glm::dvec3(eye, terrainHeight(params, local) + eyeHeight);
         s.heading = std::remainder(kHalfPi - double(p.heading), kTwoPi);
         s.pitch = 0.0;

@@ -10,7 +10,9 @@
 //   without cars is an error naming the id / the traffic.
 // - egoPath(): samples every `dt` seconds from the ego's first sample for
 //   `duration` seconds (or until it leaves, whichever is first: the path is
-//   then shorter, never padded), t from 0. The eye sits kEgoEyeBack of the
+//   then shorter, never padded), t on the traffic's clock (the FCD time of
+//   each sample, from the ego's first), so that a walkthrough of the path
+//   with --traffic shows the other agents as they were at that instant. The eye sits kEgoEyeBack of the
 //   vehicle's length behind its front bumper along its heading, at the
 //   terrain height (citygen/terrain.h) plus `eyeHeight`; the camera heading
 //   is the vehicle's (radians clockwise from north), pitch 0. Positions are

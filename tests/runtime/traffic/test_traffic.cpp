@@ -11,6 +11,10 @@
 
 #include "foundation/units.h"
 #include "citygen/params.h"
+#include "citygen/labels.h"
+#include "citygen/lighting.h"
+#include "citygen/terrain.h"
+#include "runtime/traffic/agent_models.h"
 #include "runtime/traffic/ego_path.h"
 #include "runtime/traffic/sumo_net.h"
 #include "runtime/traffic/sumo_process.h"
@@ -440,4 +444,56 @@ TEST(EgoPath, RidesTheVehicleFromBehindItsFrontBumper) {
     auto picked = chooseEgo(*t, "", 42);
     ASSERT_TRUE(picked);
     EXPECT_EQ(t->agentIds[*picked], "v1");
+}
+
+TEST(EgoPath, KeepsTheTrafficsClock) {
+    TempDir dir("vista_ego_clock");
+    writeText(dir.file("fcd.xml"), kFcd);
+    auto t = readFcd(dir.file("fcd.xml"), 100.0, -50.0);
+    ASSERT_TRUE(t);
+    auto ego = chooseEgo(*t, "v2", 1);  // present from 0.5 s to 1 s
+    ASSERT_TRUE(ego) << ego.status().message();
+    auto path = egoPath(*t, *ego, CityParams(), 0.25, 60.0, 1.2);
+    ASSERT_TRUE(path) << path.status().message();
+    ASSERT_EQ(path->samples.size(), 3u);
+    for (size_t i = 0; i < 3; ++i) EXPECT_DOUBLE_EQ(path->samples[i].t, 0.5 + 0.25 * double(i));
+}
+
+TEST(AgentModels, PlacementsStandBehindTheFrontBumperOnTheTerrain) {
+    TempDir dir("vista_agents");
+    writeText(dir.file("fcd.xml"), kFcd);
+    auto t = readFcd(dir.file("fcd.xml"), 100.0, -50.0);
+    ASSERT_TRUE(t);
+    CityParams params;
+    params.hills_amplitude_m = 8.0;  // a terrain that is not flat
+    const AgentModels models = agentModels(Lighting(params));
+    for (const AgentModel& m : models.models) {
+        EXPECT_FALSE(m.mesh.empty());
+        // The footprint's centre at the origin, standing on z = 0.
+        glm::vec3 lo(1e9f), hi(-1e9f);
+        for (const glm::vec3& p : m.mesh.positions) {
+            lo = glm::min(lo, p);
+            hi = glm::max(hi, p);
+        }
+        EXPECT_NEAR(lo.z, 0.0f, 1e-4f);
+        EXPECT_NEAR(hi.z, float(m.height), 0.05f);
+        EXPECT_NEAR(0.5f * (lo.x + hi.x), 0.0f, 0.05f);
+        // A vehicle's front bumper (the reference point) is half its length ahead of the centre.
+        if (m.type != AgentType::Pedestrian && m.type != AgentType::Bicycle) {
+            EXPECT_NEAR(hi.x, 0.5f * float(m.length), 0.01f);
+        }
+    }
+    // At 0.75 s: v2 (a bus heading south, bumper at (-100, 49.5) then) and nobody else (v1 and p1 left at 0.5 s).
+    const auto placed = placeAgents(*t, models, params, 0.75);
+    ASSERT_EQ(placed.size(), 1u);
+    const AgentPlacement& a = placed[0];
+    EXPECT_EQ(t->agentIds[a.agent], "v2");
+    const double L = models.models[a.prototype].length;
+    EXPECT_NEAR(a.centre.x, -100.0, 1e-4);
+    EXPECT_NEAR(a.centre.y, 50.0 - 0.5 + 0.5 * L, 1e-4);  // half a length behind (north of) the bumper
+    EXPECT_NEAR(a.centre.z, terrainHeight(params, glm::dvec2(a.centre)), 1e-9);
+    EXPECT_NEAR(a.transform[0].y, -1.0, 1e-6);  // the model's +x along the heading (south)
+    EXPECT_EQ(agentLabel(AgentType::Bus, a.agent) >> 28, uint32_t(InstanceKind::Vehicle));
+    EXPECT_EQ(agentLabel(AgentType::Pedestrian, 7) >> 28, uint32_t(InstanceKind::Pedestrian));
+    EXPECT_TRUE(placeAgents(*t, models, params, 5.0).empty());  // after the run
 }

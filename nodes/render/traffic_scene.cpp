@@ -1,0 +1,213 @@
+// A traffic run's agents in the near field and the ray scene (traffic_scene.h).
+#include "nodes/render/traffic_scene.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <osg/CullFace>
+#include <osg/Geode>
+#include <osg/Geometry>
+#include <osg/MatrixTransform>
+
+#include "citygen/lighting.h"
+#include "nodes/label_pass.h"
+#include "runtime/engine/ray_scene.h"
+#include "runtime/scene/scene_graph.h"
+
+namespace vista {
+
+struct TrafficScene::Impl {
+    std::vector<osg::ref_ptr<osg::Geode>> protos;                 // colour geometry per prototype
+    std::vector<osg::ref_ptr<osg::MatrixTransform>> xf, labelXf;  // per agent, made on first use
+};
+
+namespace {
+
+osg::ref_ptr<osg::Geometry> protoGeometry(const Mesh& m) {
+    osg::ref_ptr<osg::Vec3Array> v = new osg::Vec3Array;
+    osg::ref_ptr<osg::Vec3Array> n = new osg::Vec3Array;
+    osg::ref_ptr<osg::Vec4ubArray> c = new osg::Vec4ubArray;
+    for (size_t i = 0; i < m.positions.size(); ++i) {
+        v->push_back(osg::Vec3(m.positions[i].x, m.positions[i].y, m.positions[i].z));
+        const glm::vec3 nn = i < m.normals.size() ? m.normals[i] : glm::vec3(0, 0, 1);
+        n->push_back(osg::Vec3(nn.x, nn.y, nn.z));
+        c->push_back(osg::Vec4ub(m.colors[i].x, m.colors[i].y, m.colors[i].z, m.colors[i].w));
+    }
+    osg::ref_ptr<osg::Geometry> g = new osg::Geometry;
+    g->setUseDisplayList(false);
+    g->setUseVertexBufferObjects(true);
+    g->setVertexArray(v.get());
+    g->setNormalArray(n.get(), osg::Array::BIND_PER_VERTEX);
+    g->setColorArray(c.get(), osg::Array::BIND_PER_VERTEX);
+    g->addPrimitiveSet(new osg::DrawElementsUInt(GL_TRIANGLES, m.indices.begin(), m.indices.end()));
+    return g;
+}
+
+osg::ref_ptr<osg::Geode> labelGeode(const osg::Geometry& colour, uint32_t id, uint8_t cls) {
+    osg::ref_ptr<osg::Geometry> g = new osg::Geometry;
+    g->setUseDisplayList(false);
+    g->setUseVertexBufferObjects(true);
+    g->setVertexArray(const_cast<osg::Array*>(colour.getVertexArray()));
+    g->addPrimitiveSet(const_cast<osg::PrimitiveSet*>(colour.getPrimitiveSet(0)));
+    const unsigned nv = colour.getVertexArray()->getNumElements();
+    osg::ref_ptr<osg::UIntArray> ids = new osg::UIntArray(nv), classes = new osg::UIntArray(nv);
+    std::fill(ids->begin(), ids->end(), GLuint(id));
+    std::fill(classes->begin(), classes->end(), GLuint(cls));
+    for (osg::UIntArray* a : {ids.get(), classes.get()}) {
+        a->setPreserveDataType(true);
+        a->setBinding(osg::Array::BIND_PER_VERTEX);
+    }
+    g->setVertexAttribArray(kLabelAttrib, ids.get(), osg::Array::BIND_PER_VERTEX);
+    g->setVertexAttribArray(kLabelClassAttrib, classes.get(), osg::Array::BIND_PER_VERTEX);
+    osg::ref_ptr<osg::Geode> geode = new osg::Geode;
+    geode->addDrawable(g.get());
+    return geode;
+}
+
+// True when the eye is inside the agent's body (grown by kCarrierMargin): the
+// vehicle an ego path rides, which its own cameras do not see.
+constexpr double kCarrierMargin = 0.3;
+bool carries(const AgentPlacement& a, const AgentModel& m, const glm::dvec3& eye) {
+    const glm::dvec3 d = eye - a.centre;
+    const glm::dvec3 fwd(a.transform[0]), left(a.transform[1]);
+    return std::abs(glm::dot(d, fwd)) <= 0.5 * m.length + kCarrierMargin &&
+           std::abs(glm::dot(d, left)) <= 0.5 * m.width + kCarrierMargin && d.z >= -kCarrierMargin &&
+           d.z <= m.height + kCarrierMargin;
+}
+
+osg::Matrixd toOsg(const glm::dmat4& m) {
+    osg::Matrixd o;
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r) o(c, r) = m[c][r];
+    return o;
+}
+
+}  // namespace
+
+TrafficScene::TrafficScene(std::shared_ptr<const TrafficTracks> tracks, const CityParams& params, bool labels)
+    : _tracks(std::move(tracks)), _params(params), _labels(labels), _impl(new Impl) {
+    _models = agentModels(Lighting(params));
+    _node = new osg::Group;
+    _node->setName("vista.traffic");
+    _node->setDataVariance(osg::Object::DYNAMIC);
+    osg::StateSet* ss = _node->getOrCreateStateSet();
+    ss->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
+    ss->setAttributeAndModes(new osg::CullFace(osg::CullFace::BACK), osg::StateAttribute::ON);
+    for (const AgentModel& m : _models.models) {
+        osg::ref_ptr<osg::Geode> g = new osg::Geode;
+        g->addDrawable(protoGeometry(m.mesh).get());
+        _impl->protos.push_back(g);
+    }
+    if (_labels) {
+        _labelNode = new osg::Group;
+        _labelNode->setName("vista.traffic.labels");
+        _labelNode->setDataVariance(osg::Object::DYNAMIC);
+        _labelNode->setStateSet(labelRootState().get());
+    }
+}
+
+TrafficScene::~TrafficScene() {
+    if (_rays && _cast > 0) (void)_rays->placeMovers({});
+}
+
+Status TrafficScene::attachRays(RayScene* rays) {
+    if (_rays && _rays != rays && _cast > 0) VISTA_RETURN_IF_ERROR(_rays->placeMovers({}));
+    _castAgents.clear();
+    _castTransforms.clear();
+    _cast = 0;
+    _rays = rays;
+    if (!_rays) return apply();
+    std::vector<SceneMesh> protos;
+    for (const AgentModel& m : _models.models) {
+        SceneMesh s;
+        s.material = m.type == AgentType::Pedestrian ? Material::Pedestrian : Material::Vehicle;
+        s.positions = m.mesh.positions;
+        s.colors = m.mesh.colors;
+        s.indices = m.mesh.indices;
+        protos.push_back(std::move(s));
+    }
+    VISTA_RETURN_IF_ERROR(_rays->setMoverPrototypes(protos));
+    return apply();
+}
+
+double TrafficScene::tallestAgent() const {
+    double h = 0;
+    for (const AgentModel& m : _models.models) h = std::max(h, m.height);
+    return h;
+}
+
+Status TrafficScene::setFrame(double t, const glm::dvec3& eye) {
+    const bool moved = !_placedValid || t != _t;
+    _t = t;
+    _eye = eye;
+    _split = 1e300;
+    if (moved) {
+        _placed = placeAgents(*_tracks, _models, _params, t);
+        _placedValid = true;
+    }
+    return apply();
+}
+
+Status TrafficScene::setSplit(double nearDistance) {
+    _split = nearDistance;
+    return apply();
+}
+
+Status TrafficScene::apply() {
+    Impl& im = *_impl;
+    _node->removeChildren(0, _node->getNumChildren());
+    if (_labelNode) _labelNode->removeChildren(0, _labelNode->getNumChildren());
+    std::vector<uint32_t> castAgents;
+    std::vector<glm::dmat4> castXf;
+    std::vector<MoverPlacement> movers;
+    _drawn = 0;
+    for (const AgentPlacement& a : _placed) {
+        if (carries(a, _models.models[a.prototype], _eye)) continue;  // the camera's own vehicle
+        const double d = glm::length(a.centre - _eye);
+        const bool gl = _split > 0 && d - a.radius <= _split;
+        const bool rays = d + a.radius > _split;
+        if (rays) {
+            castAgents.push_back(a.agent);
+            castXf.push_back(a.transform);
+            const AgentType type = _tracks->agentTypes[a.agent];
+            movers.push_back({a.prototype, a.transform, agentLabel(type, a.agent), agentClass(type)});
+        }
+        if (!gl) continue;
+        if (im.xf.size() <= a.agent) {
+            im.xf.resize(size_t(a.agent) + 1);
+            im.labelXf.resize(size_t(a.agent) + 1);
+        }
+        osg::ref_ptr<osg::MatrixTransform>& x = im.xf[a.agent];
+        if (!x) {
+            x = new osg::MatrixTransform;
+            x->setDataVariance(osg::Object::DYNAMIC);
+            x->addChild(im.protos[a.prototype].get());
+        }
+        x->setMatrix(toOsg(a.transform));
+        _node->addChild(x.get());
+        if (_labelNode) {
+            osg::ref_ptr<osg::MatrixTransform>& lx = im.labelXf[a.agent];
+            if (!lx) {
+                lx = new osg::MatrixTransform;
+                lx->setDataVariance(osg::Object::DYNAMIC);
+                const AgentType type = _tracks->agentTypes[a.agent];
+                auto* geo = static_cast<osg::Geometry*>(im.protos[a.prototype]->getDrawable(0));
+                lx->addChild(labelGeode(*geo, agentLabel(type, a.agent), agentClass(type)).get());
+            }
+            lx->setMatrix(toOsg(a.transform));
+            _labelNode->addChild(lx.get());
+        }
+        ++_drawn;
+    }
+    if (!_rays) {
+        _cast = 0;
+        return Status::ok();
+    }
+    if (castAgents == _castAgents && castXf == _castTransforms) return Status::ok();
+    _castAgents = std::move(castAgents);
+    _castTransforms = std::move(castXf);
+    _cast = movers.size();
+    return _rays->placeMovers(movers);
+}
+
+}  // namespace vista

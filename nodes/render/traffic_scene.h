@@ -1,0 +1,93 @@
+// TrafficScene: a traffic run's moving agents (runtime/traffic) drawn in a
+// walkthrough: in the near field as OSG geometry and in the ray-cast far
+// field as Embree instances (RayScene::placeMovers), one frame time at a time.
+//
+// Contract:
+// - The agent meshes (agent_models.h) become one shared osg::Geometry per
+//   prototype (VBOs, prelit colours, lighting off, back faces culled, as the
+//   city root); each agent present at the frame's time gets an
+//   osg::MatrixTransform (double: model frame -> world) over its prototype,
+//   made when the agent first appears and kept for the run. With labels, a
+//   label twin per agent (the same vertex arrays; per-vertex attributes
+//   kLabelAttrib = the agent's instance id, kLabelClassAttrib = its class,
+//   nodes/label_pass.h) under labelNode().
+// - setFrame(t, eye) places the agents of time t (placeAgents) and draws
+//   every one of them in GL (node(), labelNode()); setSplit(d) then keeps in
+//   GL only the agents whose bounding sphere reaches within d metres of the
+//   eye (none for d <= 0) and hands to the attached ray scene those whose
+//   sphere reaches beyond d (d = 0: every agent ray-cast, +inf: none). An
+//   agent wholly inside the near field is never ray-cast; one straddling d
+//   is in both, as a straddling chunk is: GL draws it up to the far plane
+//   at d and the far field's rays, which start there, the rest. Without an
+//   attached ray scene the agents beyond d are simply not drawn. A call that
+//   changes nothing does no work; the ray scene's top level is committed only
+//   when its set of instances changes.
+// - An agent whose body (its model's box grown by 0.3 m) holds the eye is
+//   the camera's carrier (the vehicle `vista path --traffic` rides) and is
+//   drawn nowhere: a vehicle's cameras do not see it from inside.
+// - The same time gives the same placements in every mode, face and run.
+// Not thread-safe: the frame thread calls it between frames (no ray query
+// may run meanwhile).
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <osg/Group>
+#include <osg/ref_ptr>
+
+#include "citygen/params.h"
+#include "foundation/status.h"
+#include "runtime/traffic/agent_models.h"
+#include "runtime/traffic/traffic_tracks.h"
+
+namespace vista {
+
+class RayScene;
+
+class TrafficScene {
+public:
+    // labels: also build the label twins (vista render).
+    TrafficScene(std::shared_ptr<const TrafficTracks> tracks, const CityParams& params, bool labels);
+    ~TrafficScene();
+    // The ray scene that shows the agents beyond the split (its prototypes are
+    // added now); null detaches. Errors: those of RayScene::setMoverPrototypes.
+    Status attachRays(RayScene* rays);
+    RayScene* rays() const { return _rays; }
+    Status setFrame(double t, const glm::dvec3& eye);
+    Status setSplit(double nearDistance);
+    double time() const { return _t; }
+    osg::Group* node() const { return _node.get(); }
+    osg::Group* labelNode() const { return _labelNode.get(); }
+    const TrafficTracks& tracks() const { return *_tracks; }
+    // The agents placed at the current time (agent number order).
+    const std::vector<AgentPlacement>& placements() const { return _placed; }
+    const AgentModels& models() const { return _models; }
+    double tallestAgent() const;                  // metres: the tallest model's height
+    size_t drawnCount() const { return _drawn; }  // agents in GL this frame
+    size_t castCount() const { return _cast; }    // agents in the ray scene this frame
+
+private:
+    Status apply();
+    std::shared_ptr<const TrafficTracks> _tracks;
+    CityParams _params;
+    bool _labels;
+    AgentModels _models;
+    RayScene* _rays = nullptr;
+    double _t = -1e300;
+    glm::dvec3 _eye{0.0};
+    double _split = 1e300;
+    bool _placedValid = false;
+    std::vector<AgentPlacement> _placed;
+    std::vector<uint8_t> _inGl;  // per placement: drawn by GL (after apply)
+    size_t _drawn = 0, _cast = 0;
+    std::vector<uint32_t> _castAgents;  // agents in the ray scene, in order (change detection)
+    std::vector<glm::dmat4> _castTransforms;
+    struct Impl;
+    std::unique_ptr<Impl> _impl;
+    osg::ref_ptr<osg::Group> _node, _labelNode;
+};
+
+}  // namespace vista
