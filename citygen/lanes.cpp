@@ -392,8 +392,11 @@ public:
     // joined: per node, the first node of the junction it is joined into
     // (empty: no junction joined).
     LaneModelBuilder(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks,
-                     const std::vector<uint32_t>& joined)
-        : g(g),
+                     const std::vector<uint32_t>& joined, const std::vector<double>& minTrimA,
+                     const std::vector<double>& minTrimB)
+        : growTrimA(minTrimA),
+          growTrimB(minTrimB),
+          g(g),
           blocks(blocks),
           N(g.nodes.size()),
           sw(params.sidewalk_m > 0.01 ? params.sidewalk_m : 0.0),
@@ -414,6 +417,8 @@ public:
     // j kept as a lane's only way on crosses a street road ending at k or a
     // turn of k (j == k: a road of its own).
     LaneModel build(std::vector<std::pair<int, int>>& conflicts) {
+        growTrimA.resize(g.edges.size(), 0.0);
+        growTrimB.resize(g.edges.size(), 0.0);
         edgeLanes();
         joinEdges();
         sidewalkSides();
@@ -433,6 +438,10 @@ public:
         conflicts = std::move(keptCrossings);
         return std::move(m);
     }
+
+    // Per edge, the trim at node a / b that a kept crossing asks for (at
+    // least the minimum trims given): the next round's minimum trims.
+    std::vector<double> growTrimA, growTrimB;
 
 private:
     // True when edge e meets node v (or v's joined junction) with its end b.
@@ -454,7 +463,8 @@ private:
     ArmStrip strip(uint32_t e, uint32_t v) const;
     void separateArms(size_t j);
     bool meetsRadius(const LinkRoad& r) const;
-    std::vector<bool> crossingTurns(const std::vector<LinkRoad>& turns, std::vector<std::vector<int>>& crossed) const;
+    std::vector<bool> crossingTurns(const std::vector<LinkRoad>& turns, std::vector<long>& crossed) const;
+    void noteKeptCrossing(const LinkRoad& r, long owner);
     void fitTurns(size_t j, std::vector<LinkRoad>& turns, std::vector<TurnPlan>& turnPlans);
     LinkRoad junctionRoad(int j, const TurnPlan& t) const;
     bool place(LinkRoad& r) const;
@@ -784,7 +794,7 @@ void LaneModelBuilder::applyTrims() {
         const StreetEdge& E = g.edges[e];
         L.junctionA = m.nodeJunction[E.a];
         L.junctionB = m.nodeJunction[E.b];
-        double ta = wantA[e], tb = wantB[e];
+        double ta = std::max(wantA[e], growTrimA[e]), tb = std::max(wantB[e], growTrimB[e]);
         const double len = L.length, room = std::max(0.0, len - kMinRoadLength);
         if (ta + tb > room) {
             const double f = ta + tb > 0 ? room / (ta + tb) : 0.0;
@@ -826,7 +836,7 @@ void LaneModelBuilder::placeLinks() {
     std::vector<TurnPlan> turnPlans;
     for (size_t j = 0; j < m.junctions.size(); ++j) fitTurns(j, turns, turnPlans);
     // Turns crossing other roads go, unless one of their lanes has no other turn.
-    std::vector<std::vector<int>> crossed;
+    std::vector<long> crossed;
     const std::vector<bool> crossing = crossingTurns(turns, crossed);
     std::map<std::pair<int, uint32_t>, std::vector<int>> cover;  // (junction, incoming arm) -> turns per lane
     for (size_t k = 0; k < turns.size(); ++k) {
@@ -842,7 +852,7 @@ void LaneModelBuilder::placeLinks() {
         for (int i = turnPlans[k].i0; i <= turnPlans[k].i1; ++i) last = last || c[size_t(i)] == 1;
         if (last) {
             ++m.crossingTurnsKept;
-            for (int o : crossed[k]) keptCrossings.emplace_back(turns[k].junction, o);
+            noteKeptCrossing(turns[k], crossed[k]);
             continue;
         }
         for (int i = turnPlans[k].i0; i <= turnPlans[k].i1; ++i) --c[size_t(i)];
@@ -903,12 +913,7 @@ bool LaneModelBuilder::addLaneTurn(size_t j, uint32_t in, uint32_t out, int k, i
     if (const long o = cross.crossed(r); o != CrossIndex::kNone) {
         if (!mayCross) return false;
         ++m.crossingTurnsKept;
-        if (o >= 0) {
-            for (int x : {m.edges[size_t(o)].junctionA, m.edges[size_t(o)].junctionB})
-                if (x >= 0) keptCrossings.emplace_back(int(j), x);
-        } else {
-            keptCrossings.emplace_back(int(j), int(-o - 1));
-        }
+        noteKeptCrossing(r, o);
     }
     cross.addTurn(r);
     J.links.push_back(uint32_t(m.links.size()));
@@ -1075,13 +1080,40 @@ void LaneModelBuilder::fitTurns(size_t j, std::vector<LinkRoad>& turns, std::vec
     }
 }
 
+// A turn kept as a lane's only way on although its driving lanes cross
+// `owner` (CrossIndex::crossed): the junction pair goes to keptCrossings
+// (junction joining); a street road that is an arm of the turn's own
+// junction asks to be cut back past the turn (growTrimA/B, next round).
+void LaneModelBuilder::noteKeptCrossing(const LinkRoad& r, long owner) {
+    if (owner == CrossIndex::kNone) return;
+    if (owner < 0) {
+        keptCrossings.emplace_back(r.junction, int(-owner - 1));
+        return;
+    }
+    const uint32_t e = uint32_t(owner);
+    const EdgeLanes& L = m.edges[e];
+    for (int x : {L.junctionA, L.junctionB})
+        if (x >= 0) keptCrossings.emplace_back(r.junction, x);
+    const uint32_t v = m.junctions[size_t(r.junction)].node;
+    if (L.junctionA != r.junction && L.junctionB != r.junction) return;
+    const bool atB = meetsAtB(e, v);
+    const glm::dvec2 node = g.nodes[nodeOf(e, v)], d = atB ? -L.dir : L.dir, n(-d.y, d.x);
+    const double half = L.halfWidth() + kOverlapSlack;
+    double need = 0.0;
+    for (const Quad& q : linkOutline(r))
+        for (const glm::dvec2& p : q)
+            if (std::abs(glm::dot(p - node, n)) < half) need = std::max(need, glm::dot(p - node, d) + kArmClearance);
+    double& grow = atB ? growTrimB[e] : growTrimA[e];
+    grow = std::max(grow, need);
+}
+
 // Junction turns (placed, by junction) whose driving lanes would share area
 // with a street road other than the two they join, or with a kept turn of
 // another junction (the later of two such turns goes). Outlines: street
 // carriageways as rectangles, turns as quadrilaterals between samples
 // kOutlineStep apart; shapes closer than kOverlapSlack count as apart.
 std::vector<bool> LaneModelBuilder::crossingTurns(const std::vector<LinkRoad>& turns,
-                                                  std::vector<std::vector<int>>& crossed) const {
+                                                  std::vector<long>& crossed) const {
     struct Shape {
         Quad q;
         long owner;  // >= 0: street edge; < 0: turn -(owner + 1)
@@ -1102,7 +1134,7 @@ std::vector<bool> LaneModelBuilder::crossingTurns(const std::vector<LinkRoad>& t
     ShapeGrid grid(8.0);
     for (size_t i = 0; i < shapes.size(); ++i) grid.insert(shapes[i].q, uint32_t(i));
     std::vector<bool> drop(turns.size(), false);
-    crossed.assign(turns.size(), {});
+    crossed.assign(turns.size(), CrossIndex::kNone);
     std::vector<uint32_t> near;
     for (int pass = 0; pass < 2; ++pass) {  // street roads first, then other junctions' turns
         for (size_t k = 0; k < turns.size(); ++k) {
@@ -1120,12 +1152,7 @@ std::vector<bool> LaneModelBuilder::crossingTurns(const std::vector<LinkRoad>& t
                     }
                     if (quadsOverlap(shapes[i].q, s.q, kOverlapSlack)) {
                         drop[k] = true;
-                        if (s.owner >= 0) {
-                            for (int j : {m.edges[size_t(s.owner)].junctionA, m.edges[size_t(s.owner)].junctionB})
-                                if (j >= 0) crossed[k].push_back(j);
-                        } else {
-                            crossed[k].push_back(turns[size_t(-s.owner - 1)].junction);
-                        }
+                        crossed[k] = s.owner >= 0 ? s.owner : -long(turns[size_t(-s.owner - 1)].junction) - 1;
                         break;
                     }
                 }
@@ -1257,9 +1284,21 @@ constexpr int kJoinPasses = 4;  // joining rounds (a joined junction may need jo
 LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks) {
     std::vector<uint32_t> rep;
     std::vector<std::pair<int, int>> conflicts;
-    LaneModel m = LaneModelBuilder(g, params, blocks, rep).build(conflicts);
-    for (int pass = 0; pass < kJoinPasses && joinConflicts(g, m, conflicts, rep); ++pass)
-        m = LaneModelBuilder(g, params, blocks, rep).build(conflicts);
+    const std::vector<double> none(g.edges.size(), 0.0);
+    LaneModelBuilder first(g, params, blocks, rep, none, none);
+    LaneModel m = first.build(conflicts);
+    std::vector<double> trimA = first.growTrimA, trimB = first.growTrimB, askedA = none, askedB = none;
+    for (int pass = 0; pass < kJoinPasses; ++pass) {
+        const bool joined = joinConflicts(g, m, conflicts, rep);
+        bool grown = false;  // an arm asks for more than the last round gave it
+        for (size_t e = 0; e < g.edges.size() && !grown; ++e)
+            grown = trimA[e] > askedA[e] + 1e-6 || trimB[e] > askedB[e] + 1e-6;
+        if (!joined && !grown) break;
+        askedA = trimA, askedB = trimB;
+        LaneModelBuilder next(g, params, blocks, rep, trimA, trimB);
+        m = next.build(conflicts);
+        trimA = next.growTrimA, trimB = next.growTrimB;
+    }
     return m;
 }
 

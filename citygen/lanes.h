@@ -70,8 +70,15 @@
 //   junction (the later of the two), is not built (counted in
 //   crossingTurns), unless it is the only turn of one of its lanes (kept,
 //   counted in crossingTurnsKept): road surfaces share area only inside
-//   their junction. Both kept counts come from clusters of junctions joined
-//   by edges shorter than their trims.
+//   their junction. The one-lane turns that connect leftover lanes (below)
+//   avoid crossings where another exit serves. Where a kept crossing turn
+//   crosses an arm of its own junction, that arm is cut back past the turn
+//   (kArmClearance beyond the turn's farthest point within the arm's
+//   carriageway) and the model is built again; where it crosses a road or
+//   turn of a junction that an edge too short for its trims joins to its
+//   own, the two junctions are joined (above) and the model is built again
+//   (at most four such rounds). Both kept counts come from clusters of
+//   junctions joined by edges shorter than their trims.
 // - Link roads (LinkRoad): every junction has one per allowed turn (ordered
 //   pair of distinct arms with lanes to give and take, |turn| <= kMaxTurn);
 //   every degree-2 node has one transition road joining its two edges, unless

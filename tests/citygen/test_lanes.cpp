@@ -597,3 +597,41 @@ TEST(Lanes, JunctionsCloserThanTheirFootprintsAreJoined) {
                 EXPECT_TRUE(out.count(atB ? k : -k)) << "junction " << j << " edge " << e << " outgoing lane " << k;
         }
 }
+
+// A highway junction 33 m from the next one (a junction of the generated
+// city, seed 11): a lane whose only turn cuts the corner across a local arm
+// of its own junction gets that arm cut back past the turn, so no connecting
+// road shares driving-lane area with a street road other than its two
+// (Boost.Geometry on the model's outlines).
+TEST(Lanes, ArmsAreCutBackPastTheTurnsThatMustCrossThem) {
+    StreetGraph g;
+    g.nodes = {
+        {0, 0},           {31.930, 9.302}, {-61.939, 20.345}, {-47.597, -13.866}, {-13.571, 59.568}, {57.612, -80.648},
+        {111.456, 32.469}};
+    g.edges = {{2, 0, RoadClass::Local, 7.5f, 2}, {3, 0, RoadClass::Highway, 20.0f, 6},
+               {4, 0, RoadClass::Local, 7.5f, 2}, {0, 1, RoadClass::Highway, 20.0f, 6},
+               {1, 5, RoadClass::Local, 7.5f, 2}, {1, 6, RoadClass::Highway, 20.0f, 6}};
+    for (double sidewalk : {0.0, 3.0}) {
+        CityParams p;
+        p.sidewalk_m = sidewalk;
+        const LaneModel m = buildLaneModel(g, p);
+        EXPECT_EQ(m.unlinkedLanes + m.unfedLanes, 0u) << sidewalk;
+        size_t links = 0;
+        for (const LinkRoad& r : m.links) {
+            if (r.junction < 0) continue;
+            ++links;
+            const std::vector<BgPolygon> pieces = linkPieces(r);
+            for (uint32_t e = 0; e < m.edges.size(); ++e) {
+                const EdgeLanes& L = m.edges[e];
+                if (!L.valid || e == r.in || e == r.out) continue;
+                const glm::dvec2 n = L.normal() * L.halfWidth();
+                const BgPolygon street = bgPolygon({L.start - n, L.end - n, L.end + n, L.start + n});
+                double shared = 0;
+                for (const BgPolygon& q : pieces) shared += sharedArea(q, street);
+                EXPECT_LT(shared, 1e-2) << "sidewalk " << sidewalk << ": turn " << r.in << "->" << r.out
+                                        << " of junction " << r.junction << " crosses edge " << e;
+            }
+        }
+        EXPECT_GT(links, 0u);
+    }
+}
