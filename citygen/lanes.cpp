@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <utility>
 
@@ -171,23 +172,44 @@ double turnSideExtent(const LinkRoad& r) {
     return ext;
 }
 
-// Line, arc and line from the incoming road's end (distance tIn before the
-// node) to the outgoing road's start (tOut after it), tangent to both.
-void filletGeometry(LinkRoad& r, const glm::dvec2& node, const glm::dvec2& d0, const glm::dvec2& d1, double tIn,
-                    double tOut) {
-    r.start = node - d0 * tIn;
+double cross2(const glm::dvec2& a, const glm::dvec2& b) { return a.x * b.y - a.y * b.x; }
+
+// Line, arc and line from the incoming road's end (distance tIn before its
+// node nodeIn) to the outgoing road's start (tOut after its node nodeOut),
+// tangent to both. Where the two nodes differ (a joined junction) the corner
+// is the point where the two roads' lines meet; false when it does not lie
+// ahead of both ends (or, for parallel roads, the two lines differ), or lies
+// farther than the two trims and the nodes' distance allow.
+bool filletGeometry(LinkRoad& r, const glm::dvec2& nodeIn, const glm::dvec2& d0, const glm::dvec2& nodeOut,
+                    const glm::dvec2& d1, double tIn, double tOut) {
+    r.start = nodeIn - d0 * tIn;
     r.hdg = std::atan2(d0.y, d0.x);
     r.angle = turnAngle(d0, d1);
+    if (nodeIn != nodeOut) {
+        const glm::dvec2 w = nodeOut + d1 * tOut - r.start;
+        const double reach = 2.0 * (tIn + tOut + glm::length(nodeOut - nodeIn));
+        if (std::abs(r.angle) < 1e-9) {
+            if (std::abs(cross2(d0, w)) > 1e-6 || !(glm::dot(w, d0) > 0)) return false;
+            r.line0 = glm::dot(w, d0);
+            r.arcLength = r.curvature = r.line1 = 0;
+            return true;
+        }
+        const double den = cross2(d0, d1);
+        tIn = cross2(w, d1) / den;
+        tOut = cross2(d0, w) / den;
+        if (!(tIn >= 0 && tOut >= 0 && tIn + tOut <= reach)) return false;
+    }
     if (std::abs(r.angle) < 1e-9) {
         r.line0 = tIn + tOut;
         r.arcLength = r.curvature = r.line1 = 0;
-        return;
+        return true;
     }
     const double t = std::min(tIn, tOut), R = t / std::tan(0.5 * std::abs(r.angle));
     r.line0 = tIn - t;
     r.line1 = tOut - t;
     r.arcLength = R * std::abs(r.angle);
     r.curvature = (r.angle > 0 ? 1.0 : -1.0) / R;
+    return true;
 }
 
 // Length of the fillet's tangent that keeps the lanes `extent` metres
@@ -310,6 +332,45 @@ private:
     std::map<std::pair<long, long>, std::vector<uint32_t>> _cells;
 };
 
+// Street carriageways and placed junction turns, for the crossing test of
+// the turns connectLeftovers adds.
+class CrossIndex {
+public:
+    void addStreet(const EdgeLanes& L, uint32_t e) {
+        const glm::dvec2 n = L.normal() * L.halfWidth();
+        add({L.start - n, L.end - n, L.end + n, L.start + n}, long(e));
+    }
+    void addTurn(const LinkRoad& r) {
+        for (const Quad& q : linkOutline(r)) add(q, -long(r.junction) - 1);
+    }
+    // The first road r's driving lanes would cross (shapes closer than
+    // kOverlapSlack count as apart): a street edge other than r.in and r.out
+    // (>= 0), a turn of another junction (-(junction + 1)), or none (kNone).
+    static constexpr long kNone = std::numeric_limits<long>::min();
+    long crossed(const LinkRoad& r) const {
+        std::vector<uint32_t> near;
+        for (const Quad& q : linkOutline(r)) {
+            _grid.query(q, near);
+            for (uint32_t i : near) {
+                const long o = _owner[i];
+                if (o == long(r.in) || o == long(r.out) || o == -long(r.junction) - 1) continue;
+                if (quadsOverlap(q, _quads[i], kOverlapSlack)) return o;
+            }
+        }
+        return kNone;
+    }
+
+private:
+    void add(const Quad& q, long owner) {
+        _grid.insert(q, uint32_t(_quads.size()));
+        _quads.push_back(q);
+        _owner.push_back(owner);
+    }
+    std::vector<Quad> _quads;
+    std::vector<long> _owner;
+    ShapeGrid _grid{8.0};
+};
+
 // Smallest trim (the same on both arms) beyond which two arms' strips share
 // no area, plus kArmClearance; `limit` when even that is not enough.
 double separatingTrim(const ArmStrip& a, const ArmStrip& b, double limit) {
@@ -328,20 +389,38 @@ double separatingTrim(const ArmStrip& a, const ArmStrip& b, double limit) {
 // nodes, trims, link-road geometry (dropping what would fold), signals.
 class LaneModelBuilder {
 public:
-    LaneModelBuilder(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks)
-        : g(g),
+    // joined: per node, the first node of the junction it is joined into
+    // (empty: no junction joined).
+    LaneModelBuilder(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks,
+                     const std::vector<uint32_t>& joined, const std::vector<double>& minTrimA,
+                     const std::vector<double>& minTrimB)
+        : growTrimA(minTrimA),
+          growTrimB(minTrimB),
+          g(g),
           blocks(blocks),
           N(g.nodes.size()),
           sw(params.sidewalk_m > 0.01 ? params.sidewalk_m : 0.0),
           incident(g.nodes.size()),
+          rep(joined),
+          nodeRadius(g.nodes.size(), 0.0),
           wantA(g.edges.size(), 0.0),
           wantB(g.edges.size(), 0.0) {
         m.degree.assign(N, 0);
         m.nodeJunction.assign(N, -1);
         m.edges.resize(g.edges.size());
+        if (rep.size() != N) {
+            rep.resize(N);
+            for (uint32_t v = 0; v < N; ++v) rep[v] = v;
+        }
     }
-    LaneModel build() {
+    // The model; `conflicts` receives the junction pairs (j, k) where a turn of
+    // j kept as a lane's only way on crosses a street road ending at k or a
+    // turn of k (j == k: a road of its own).
+    LaneModel build(std::vector<std::pair<int, int>>& conflicts) {
+        growTrimA.resize(g.edges.size(), 0.0);
+        growTrimB.resize(g.edges.size(), 0.0);
         edgeLanes();
+        joinEdges();
         sidewalkSides();
         junctions();
         planTurns();
@@ -350,18 +429,32 @@ public:
         placeLinks();
         placeSignals();
         m.nodeLinks.assign(N, {});
-        for (size_t k = 0; k < m.links.size(); ++k) m.nodeLinks[m.links[k].node].push_back(uint32_t(k));
+        for (size_t k = 0; k < m.links.size(); ++k) {
+            const LinkRoad& r = m.links[k];
+            if (r.junction < 0) m.nodeLinks[r.node].push_back(uint32_t(k));
+            else
+                for (uint32_t v : m.junctions[size_t(r.junction)].nodes) m.nodeLinks[v].push_back(uint32_t(k));
+        }
+        conflicts = std::move(keptCrossings);
         return std::move(m);
     }
 
+    // Per edge, the trim at node a / b that a kept crossing asks for (at
+    // least the minimum trims given): the next round's minimum trims.
+    std::vector<double> growTrimA, growTrimB;
+
 private:
-    NodeEnd end(uint32_t e, uint32_t v) const { return NodeEnd{&m.edges[e], g.edges[e].b == v}; }
+    // True when edge e meets node v (or v's joined junction) with its end b.
+    bool meetsAtB(uint32_t e, uint32_t v) const { return rep[g.edges[e].b] == rep[v]; }
+    // The node of edge e at v's (joined) junction.
+    uint32_t nodeOf(uint32_t e, uint32_t v) const { return meetsAtB(e, v) ? g.edges[e].b : g.edges[e].a; }
+    NodeEnd end(uint32_t e, uint32_t v) const { return NodeEnd{&m.edges[e], meetsAtB(e, v)}; }
     // Desired trim of edge e at node v: at least t.
     void want(uint32_t e, uint32_t v, double t) {
-        double& w = g.edges[e].a == v ? wantA[e] : wantB[e];
+        double& w = meetsAtB(e, v) ? wantB[e] : wantA[e];
         w = std::max(w, t);
     }
-    double trimAt(uint32_t e, uint32_t v) const { return g.edges[e].a == v ? m.edges[e].trimA : m.edges[e].trimB; }
+    double trimAt(uint32_t e, uint32_t v) const { return meetsAtB(e, v) ? m.edges[e].trimB : m.edges[e].trimA; }
     // Smallest lane-centre radius of a turn between two street edges: the
     // smaller of their classes' (the turn is taken at the slower road's pace).
     double turnRadius(uint32_t in, uint32_t out) const {
@@ -370,18 +463,20 @@ private:
     ArmStrip strip(uint32_t e, uint32_t v) const;
     void separateArms(size_t j);
     bool meetsRadius(const LinkRoad& r) const;
-    std::vector<bool> crossingTurns(const std::vector<LinkRoad>& turns) const;
+    std::vector<bool> crossingTurns(const std::vector<LinkRoad>& turns, std::vector<long>& crossed) const;
+    void noteKeptCrossing(const LinkRoad& r, long owner);
     void fitTurns(size_t j, std::vector<LinkRoad>& turns, std::vector<TurnPlan>& turnPlans);
     LinkRoad junctionRoad(int j, const TurnPlan& t) const;
     bool place(LinkRoad& r) const;
     void edgeLanes();
     void sidewalkSides();
+    void joinEdges();
     void junctions();
     void planTurns();
     void planTransitions();
     void applyTrims();
     void placeLinks();
-    bool addLaneTurn(size_t j, uint32_t in, uint32_t out, int k, int o);
+    bool addLaneTurn(size_t j, uint32_t in, uint32_t out, int k, int o, bool mayCross);
     void connectLeftovers(size_t j);
     void placeSignals();
     void groupApproaches();
@@ -392,6 +487,8 @@ private:
     const double sw;  // sidewalk width, 0 = none
     LaneModel m;
     std::vector<std::vector<uint32_t>> incident;  // per node: its valid edges
+    std::vector<uint32_t> rep;                    // per node: the first node of its joined junction (itself if none)
+    std::vector<double> nodeRadius;               // per junction node: the radius of its own arms
     std::vector<double> wantA, wantB;             // desired trims per edge at node a / b
     std::vector<std::vector<TurnPlan>> plans;     // per junction
     std::vector<LinkRoad> transitions;            // degree-2 nodes, before placing
@@ -399,7 +496,9 @@ private:
         uint32_t a, b, node;
         double trim;  // both arms need at least this trim at node
     };
-    std::vector<ArmPair> armPairs;  // arm pairs whose surfaces overlap within their junction radius
+    std::vector<ArmPair> armPairs;                   // arm pairs whose surfaces overlap within their junction radius
+    std::vector<std::pair<int, int>> keptCrossings;  // see build()
+    CrossIndex cross;                                // streets and placed turns (placeLinks)
 };
 
 // Lanes, widths, speed and direction of every valid edge; node degrees.
@@ -451,20 +550,46 @@ void LaneModelBuilder::sidewalkSides() {
     }
 }
 
-// One junction per node of degree >= 3, arms counter-clockwise.
+// Edges between two nodes of one joined junction carry no lanes.
+void LaneModelBuilder::joinEdges() {
+    for (size_t e = 0; e < g.edges.size(); ++e) {
+        EdgeLanes& L = m.edges[e];
+        if (L.valid && rep[g.edges[e].a] == rep[g.edges[e].b]) {
+            L.valid = false;
+            ++m.joinedEdges;
+        }
+    }
+}
+
+// One junction per node of degree >= 3 or joined group of them, arms
+// counter-clockwise.
 void LaneModelBuilder::junctions() {
+    m.junctions.clear();
+    m.nodeJunction.assign(N, -1);
+    std::vector<std::vector<uint32_t>> members(N);
+    for (uint32_t v = 0; v < N; ++v)
+        if (rep[v] != v) members[rep[v]].push_back(v);
     for (uint32_t v = 0; v < N; ++v) {
-        if (m.degree[v] < 3) continue;
+        if (rep[v] != v || (members[v].empty() && m.degree[v] < 3)) continue;
         Junction J;
         J.node = v;
-        J.arms = incident[v];
-        for (uint32_t e : J.arms) J.radius = std::max(J.radius, m.edges[e].halfWidth() + sw);
+        J.nodes.push_back(v);
+        J.nodes.insert(J.nodes.end(), members[v].begin(), members[v].end());
+        for (uint32_t u : J.nodes) {
+            nodeRadius[u] = 0.0;
+            for (uint32_t e : incident[u]) {
+                if (!m.edges[e].valid) continue;  // joined into this junction
+                J.arms.push_back(e);
+                nodeRadius[u] = std::max(nodeRadius[u], m.edges[e].halfWidth() + sw);
+            }
+            J.radius = std::max(J.radius, nodeRadius[u]);
+        }
         auto angle = [&](uint32_t e) {
             const glm::dvec2 d = -end(e, v).dirIn();
             return std::atan2(d.y + 0.0, d.x + 0.0);  // + 0.0: no -0, so west is +pi, not -pi
         };
         std::stable_sort(J.arms.begin(), J.arms.end(), [&](uint32_t x, uint32_t y) { return angle(x) < angle(y); });
-        m.nodeJunction[v] = int(m.junctions.size());
+        for (uint32_t u : J.nodes) m.nodeJunction[u] = int(m.junctions.size());
         m.junctions.push_back(std::move(J));
     }
 }
@@ -551,22 +676,26 @@ void LaneModelBuilder::planTurns() {
                 const LinkRoad r = junctionRoad(int(j), t);
                 const double need = std::max(filletTrim(t.angle, turnSideExtent(r)),
                                              radiusTrim(t.angle, turnCentreExtent(r), turnRadius(t.in, t.out)));
-                J.radius = std::max(J.radius, need);
+                // A turn between two nodes of a joined junction bends where
+                // its arms' lines meet, not at a node: fitTurns decides.
+                const uint32_t u = nodeOf(t.in, v);
+                if (u == nodeOf(t.out, v)) nodeRadius[u] = std::max(nodeRadius[u], need);
                 plans[j].push_back(t);
             }
         }
-        for (uint32_t e : J.arms) want(e, v, J.radius);
+        for (uint32_t u : J.nodes) J.radius = std::max(J.radius, nodeRadius[u]);
+        for (uint32_t e : J.arms) want(e, v, nodeRadius[nodeOf(e, v)]);
         separateArms(j);
     }
 }
 
 ArmStrip LaneModelBuilder::strip(uint32_t e, uint32_t v) const {
     const EdgeLanes& L = m.edges[e];
-    const bool atA = g.edges[e].a == v;
+    const bool atA = !meetsAtB(e, v);
     const double left = L.halfWidth() + (L.hasWalk(1) ? L.sidewalk : 0.0);
     const double right = L.halfWidth() + (L.hasWalk(-1) ? L.sidewalk : 0.0);
     ArmStrip s;
-    s.node = g.nodes[v];
+    s.node = g.nodes[nodeOf(e, v)];
     s.dir = atA ? L.dir : -L.dir;
     s.left = atA ? left : right;
     s.right = atA ? right : left;
@@ -583,7 +712,7 @@ void LaneModelBuilder::separateArms(size_t j) {
             const uint32_t a = J.arms[x], b = J.arms[y];
             const ArmStrip sa = strip(a, J.node), sb = strip(b, J.node);
             const double need = separatingTrim(sa, sb, std::min(sa.length, sb.length));
-            if (need <= J.radius) continue;
+            if (need <= std::min(nodeRadius[nodeOf(a, J.node)], nodeRadius[nodeOf(b, J.node)])) continue;
             want(a, J.node, need);
             want(b, J.node, need);
             armPairs.push_back({a, b, J.node, need});
@@ -665,7 +794,7 @@ void LaneModelBuilder::applyTrims() {
         const StreetEdge& E = g.edges[e];
         L.junctionA = m.nodeJunction[E.a];
         L.junctionB = m.nodeJunction[E.b];
-        double ta = wantA[e], tb = wantB[e];
+        double ta = std::max(wantA[e], growTrimA[e]), tb = std::max(wantB[e], growTrimB[e]);
         const double len = L.length, room = std::max(0.0, len - kMinRoadLength);
         if (ta + tb > room) {
             const double f = ta + tb > 0 ? room / (ta + tb) : 0.0;
@@ -687,7 +816,9 @@ void LaneModelBuilder::applyTrims() {
 // lanes would reach the centre of curvature.
 bool LaneModelBuilder::place(LinkRoad& r) const {
     const NodeEnd in = end(r.in, r.node), out = end(r.out, r.node);
-    filletGeometry(r, g.nodes[r.node], in.dirIn(), -out.dirIn(), trimAt(r.in, r.node), trimAt(r.out, r.node));
+    if (!filletGeometry(r, g.nodes[nodeOf(r.in, r.node)], in.dirIn(), g.nodes[nodeOf(r.out, r.node)], -out.dirIn(),
+                        trimAt(r.in, r.node), trimAt(r.out, r.node)))
+        return false;
     if (r.arcLength <= 0) return r.length() > 1e-9;
     return 1.0 / std::abs(r.curvature) >= turnSideExtent(r) + kCurvatureMargin;
 }
@@ -705,7 +836,8 @@ void LaneModelBuilder::placeLinks() {
     std::vector<TurnPlan> turnPlans;
     for (size_t j = 0; j < m.junctions.size(); ++j) fitTurns(j, turns, turnPlans);
     // Turns crossing other roads go, unless one of their lanes has no other turn.
-    const std::vector<bool> crossing = crossingTurns(turns);
+    std::vector<long> crossed;
+    const std::vector<bool> crossing = crossingTurns(turns, crossed);
     std::map<std::pair<int, uint32_t>, std::vector<int>> cover;  // (junction, incoming arm) -> turns per lane
     for (size_t k = 0; k < turns.size(); ++k) {
         auto& c = cover[{turns[k].junction, turnPlans[k].in}];
@@ -720,12 +852,17 @@ void LaneModelBuilder::placeLinks() {
         for (int i = turnPlans[k].i0; i <= turnPlans[k].i1; ++i) last = last || c[size_t(i)] == 1;
         if (last) {
             ++m.crossingTurnsKept;
+            noteKeptCrossing(turns[k], crossed[k]);
             continue;
         }
         for (int i = turnPlans[k].i0; i <= turnPlans[k].i1; ++i) --c[size_t(i)];
         drop[k] = true;
         ++m.crossingTurns;
     }
+    for (size_t e = 0; e < m.edges.size(); ++e)
+        if (m.edges[e].valid) cross.addStreet(m.edges[e], uint32_t(e));
+    for (size_t t = 0; t < turns.size(); ++t)
+        if (!drop[t]) cross.addTurn(turns[t]);
     size_t k = 0;
     for (size_t j = 0; j < m.junctions.size(); ++j) {
         Junction& J = m.junctions[j];
@@ -759,7 +896,7 @@ void LaneModelBuilder::placeLinks() {
 // `out`) at junction j, placed with the trims the edges got; false when the
 // turn is sharper than kMaxTurn or its lane would reach the centre of
 // curvature.
-bool LaneModelBuilder::addLaneTurn(size_t j, uint32_t in, uint32_t out, int k, int o) {
+bool LaneModelBuilder::addLaneTurn(size_t j, uint32_t in, uint32_t out, int k, int o, bool mayCross) {
     Junction& J = m.junctions[j];
     TurnPlan t;
     t.in = in;
@@ -773,6 +910,12 @@ bool LaneModelBuilder::addLaneTurn(size_t j, uint32_t in, uint32_t out, int k, i
     t.shift = k - o;
     LinkRoad r = junctionRoad(int(j), t);
     if (!place(r)) return false;
+    if (const long o = cross.crossed(r); o != CrossIndex::kNone) {
+        if (!mayCross) return false;
+        ++m.crossingTurnsKept;
+        noteKeptCrossing(r, o);
+    }
+    cross.addTurn(r);
     J.links.push_back(uint32_t(m.links.size()));
     m.links.push_back(std::move(r));
     return true;
@@ -829,17 +972,19 @@ void LaneModelBuilder::connectLeftovers(size_t j) {
     for (uint32_t in : J.arms) {
         const int nIn = end(in, v).toward();
         for (int k = 1; k <= nIn; ++k) {
-            if (taken[in][size_t(k)]) continue;
-            for (uint32_t out : order(in, true)) {
-                const int nOut = end(out, v).away();
-                auto it = shiftOf.find({in, out});
-                const int target = across(k, nIn, nOut, angleOf(in, out), it == shiftOf.end() ? nullptr : &it->second);
-                int o = target;
-                for (int x = 1, best = 1 << 30; x <= nOut; ++x)  // the nearest outgoing lane nobody feeds
-                    if (!fed[out][size_t(x)] && std::abs(x - target) < best) best = std::abs(x - target), o = x;
-                if (addLaneTurn(j, in, out, k, o)) {
-                    mark(m.links.back());
-                    break;
+            for (int mayCross = 0; mayCross < 2 && !taken[in][size_t(k)]; ++mayCross) {
+                for (uint32_t out : order(in, true)) {
+                    const int nOut = end(out, v).away();
+                    auto it = shiftOf.find({in, out});
+                    const int target =
+                        across(k, nIn, nOut, angleOf(in, out), it == shiftOf.end() ? nullptr : &it->second);
+                    int o = target;
+                    for (int x = 1, best = 1 << 30; x <= nOut; ++x)  // the nearest outgoing lane nobody feeds
+                        if (!fed[out][size_t(x)] && std::abs(x - target) < best) best = std::abs(x - target), o = x;
+                    if (addLaneTurn(j, in, out, k, o, mayCross != 0)) {
+                        mark(m.links.back());
+                        break;
+                    }
                 }
             }
             m.unlinkedLanes += !taken[in][size_t(k)];
@@ -848,15 +993,16 @@ void LaneModelBuilder::connectLeftovers(size_t j) {
     for (uint32_t out : J.arms) {
         const int nOut = end(out, v).away();
         for (int o = 1; o <= nOut; ++o) {
-            if (fed[out][size_t(o)]) continue;
-            for (uint32_t in : order(out, false)) {
-                const int nIn = end(in, v).toward();
-                auto it = shiftOf.find({in, out});
-                const int minus = it == shiftOf.end() ? 0 : -it->second;
-                const int k = across(o, nOut, nIn, angleOf(in, out), it == shiftOf.end() ? nullptr : &minus);
-                if (addLaneTurn(j, in, out, k, o)) {
-                    mark(m.links.back());
-                    break;
+            for (int mayCross = 0; mayCross < 2 && !fed[out][size_t(o)]; ++mayCross) {
+                for (uint32_t in : order(out, false)) {
+                    const int nIn = end(in, v).toward();
+                    auto it = shiftOf.find({in, out});
+                    const int minus = it == shiftOf.end() ? 0 : -it->second;
+                    const int k = across(o, nOut, nIn, angleOf(in, out), it == shiftOf.end() ? nullptr : &minus);
+                    if (addLaneTurn(j, in, out, k, o, mayCross != 0)) {
+                        mark(m.links.back());
+                        break;
+                    }
                 }
             }
             m.unfedLanes += !fed[out][size_t(o)];
@@ -934,12 +1080,40 @@ void LaneModelBuilder::fitTurns(size_t j, std::vector<LinkRoad>& turns, std::vec
     }
 }
 
+// A turn kept as a lane's only way on although its driving lanes cross
+// `owner` (CrossIndex::crossed): the junction pair goes to keptCrossings
+// (junction joining); a street road that is an arm of the turn's own
+// junction asks to be cut back past the turn (growTrimA/B, next round).
+void LaneModelBuilder::noteKeptCrossing(const LinkRoad& r, long owner) {
+    if (owner == CrossIndex::kNone) return;
+    if (owner < 0) {
+        keptCrossings.emplace_back(r.junction, int(-owner - 1));
+        return;
+    }
+    const uint32_t e = uint32_t(owner);
+    const EdgeLanes& L = m.edges[e];
+    for (int x : {L.junctionA, L.junctionB})
+        if (x >= 0) keptCrossings.emplace_back(r.junction, x);
+    const uint32_t v = m.junctions[size_t(r.junction)].node;
+    if (L.junctionA != r.junction && L.junctionB != r.junction) return;
+    const bool atB = meetsAtB(e, v);
+    const glm::dvec2 node = g.nodes[nodeOf(e, v)], d = atB ? -L.dir : L.dir, n(-d.y, d.x);
+    const double half = L.halfWidth() + kOverlapSlack;
+    double need = 0.0;
+    for (const Quad& q : linkOutline(r))
+        for (const glm::dvec2& p : q)
+            if (std::abs(glm::dot(p - node, n)) < half) need = std::max(need, glm::dot(p - node, d) + kArmClearance);
+    double& grow = atB ? growTrimB[e] : growTrimA[e];
+    grow = std::max(grow, need);
+}
+
 // Junction turns (placed, by junction) whose driving lanes would share area
 // with a street road other than the two they join, or with a kept turn of
 // another junction (the later of two such turns goes). Outlines: street
 // carriageways as rectangles, turns as quadrilaterals between samples
 // kOutlineStep apart; shapes closer than kOverlapSlack count as apart.
-std::vector<bool> LaneModelBuilder::crossingTurns(const std::vector<LinkRoad>& turns) const {
+std::vector<bool> LaneModelBuilder::crossingTurns(const std::vector<LinkRoad>& turns,
+                                                  std::vector<long>& crossed) const {
     struct Shape {
         Quad q;
         long owner;  // >= 0: street edge; < 0: turn -(owner + 1)
@@ -960,6 +1134,7 @@ std::vector<bool> LaneModelBuilder::crossingTurns(const std::vector<LinkRoad>& t
     ShapeGrid grid(8.0);
     for (size_t i = 0; i < shapes.size(); ++i) grid.insert(shapes[i].q, uint32_t(i));
     std::vector<bool> drop(turns.size(), false);
+    crossed.assign(turns.size(), CrossIndex::kNone);
     std::vector<uint32_t> near;
     for (int pass = 0; pass < 2; ++pass) {  // street roads first, then other junctions' turns
         for (size_t k = 0; k < turns.size(); ++k) {
@@ -977,6 +1152,7 @@ std::vector<bool> LaneModelBuilder::crossingTurns(const std::vector<LinkRoad>& t
                     }
                     if (quadsOverlap(shapes[i].q, s.q, kOverlapSlack)) {
                         drop[k] = true;
+                        crossed[k] = s.owner >= 0 ? s.owner : -long(turns[size_t(-s.owner - 1)].junction) - 1;
                         break;
                     }
                 }
@@ -1049,8 +1225,81 @@ void LaneModelBuilder::groupApproaches() {
 
 }  // namespace
 
+namespace {
+
+// Junction joining (lanes.h) where a turn kept as a lane's only way on
+// crosses a road: the two junctions of each such conflict, when an edge too
+// short for both their trims (shrunk to kMinRoadLength) joins them, become
+// one in `rep` (per node: the first node of its junction), unless fewer than
+// three arms would remain. True when anything was joined.
+bool joinConflicts(const StreetGraph& g, const LaneModel& m, const std::vector<std::pair<int, int>>& conflicts,
+                   std::vector<uint32_t>& rep) {
+    const size_t N = g.nodes.size();
+    if (rep.size() != N) {
+        rep.resize(N);
+        for (uint32_t v = 0; v < N; ++v) rep[v] = v;
+    }
+    std::vector<std::pair<int, int>> pairs;
+    for (const auto& [a, b] : conflicts)
+        if (a != b) pairs.emplace_back(std::min(a, b), std::max(a, b));
+    std::sort(pairs.begin(), pairs.end());
+    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+    std::vector<std::vector<uint32_t>> members(N);  // by first node: the nodes of its junction
+    for (uint32_t v = 0; v < N; ++v) members[rep[v]].push_back(v);
+    std::vector<std::vector<uint32_t>> incident(N);
+    for (uint32_t e = 0; e < g.edges.size(); ++e)
+        if (m.edges[e].valid) incident[g.edges[e].a].push_back(e), incident[g.edges[e].b].push_back(e);
+    bool joined = false;
+    for (uint32_t e = 0; e < g.edges.size(); ++e) {
+        const EdgeLanes& L = m.edges[e];
+        if (!L.valid || L.junctionA < 0 || L.junctionB < 0 || L.junctionA == L.junctionB) continue;
+        if (L.length > kMinRoadLength + 1e-9) continue;
+        const std::pair<int, int> p{std::min(L.junctionA, L.junctionB), std::max(L.junctionA, L.junctionB)};
+        if (!std::binary_search(pairs.begin(), pairs.end(), p)) continue;
+        const uint32_t a = g.edges[e].a, b = g.edges[e].b;
+        if (rep[a] == rep[b]) continue;
+        const uint32_t ra = std::min(rep[a], rep[b]), rb = std::max(rep[a], rep[b]);
+        std::vector<uint32_t> both = members[ra];
+        both.insert(both.end(), members[rb].begin(), members[rb].end());
+        size_t arms = 0;
+        for (uint32_t u : both)
+            for (uint32_t x : incident[u]) {
+                const uint32_t o = g.edges[x].a == u ? g.edges[x].b : g.edges[x].a;
+                arms += rep[o] != ra && rep[o] != rb;
+            }
+        if (arms < 3) continue;
+        for (uint32_t u : members[rb]) rep[u] = ra;
+        std::sort(both.begin(), both.end());
+        members[ra] = std::move(both);
+        members[rb].clear();
+        joined = true;
+    }
+    return joined;
+}
+
+constexpr int kJoinPasses = 4;  // joining rounds (a joined junction may need joining again)
+
+}  // namespace
+
 LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks) {
-    return LaneModelBuilder(g, params, blocks).build();
+    std::vector<uint32_t> rep;
+    std::vector<std::pair<int, int>> conflicts;
+    const std::vector<double> none(g.edges.size(), 0.0);
+    LaneModelBuilder first(g, params, blocks, rep, none, none);
+    LaneModel m = first.build(conflicts);
+    std::vector<double> trimA = first.growTrimA, trimB = first.growTrimB, askedA = none, askedB = none;
+    for (int pass = 0; pass < kJoinPasses; ++pass) {
+        const bool joined = joinConflicts(g, m, conflicts, rep);
+        bool grown = false;  // an arm asks for more than the last round gave it
+        for (size_t e = 0; e < g.edges.size() && !grown; ++e)
+            grown = trimA[e] > askedA[e] + 1e-6 || trimB[e] > askedB[e] + 1e-6;
+        if (!joined && !grown) break;
+        askedA = trimA, askedB = trimB;
+        LaneModelBuilder next(g, params, blocks, rep, trimA, trimB);
+        m = next.build(conflicts);
+        trimA = next.growTrimA, trimB = next.growTrimB;
+    }
+    return m;
 }
 
 }  // namespace vista

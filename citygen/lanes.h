@@ -28,7 +28,19 @@
 //   has a sidewalk when the point a metre past the sidewalk at the edge's
 //   midpoint lies inside a block outline; without blocks, both sides.
 // - Junction: one per node of degree >= 3; its arms are the incident edges in
-//   counter-clockwise angle order (angles in (-pi, pi]); radius = the largest
+//   counter-clockwise angle order (angles in (-pi, pi]). Junction joining:
+//   two junction nodes whose connecting edge is shorter than their two
+//   footprints need (the trims of both ends plus kMinRoadLength) form one
+//   junction, as netconvert joins junctions: the joined edges carry no lanes
+//   (valid = false), the junction's arms are the other edges of all its nodes
+//   (each measured from its own node), and its turns run from arm to arm
+//   across the joined area (line, arc and line through the point where the
+//   two arms' lines meet; a pair of arms whose lines do not meet ahead of
+//   both trimmed ends gets no turn). Nodes are not joined where fewer than
+//   three arms would remain. Each arm's radius is that of its own node: the
+//   largest of (half carriageway + sidewalk) over the node's arms and of the
+//   trims the node's own turns need (below); the junction's radius is the
+//   largest over its nodes. Radius = the largest
 //   of (half carriageway + sidewalk) over its arms and of the trims its turns
 //   need so that no lane border of a turn comes within kCurvatureMargin of
 //   the turn's centre of curvature and every lane centre keeps the turn's
@@ -58,8 +70,15 @@
 //   junction (the later of the two), is not built (counted in
 //   crossingTurns), unless it is the only turn of one of its lanes (kept,
 //   counted in crossingTurnsKept): road surfaces share area only inside
-//   their junction. Both kept counts come from clusters of junctions joined
-//   by edges shorter than their trims.
+//   their junction. The one-lane turns that connect leftover lanes (below)
+//   avoid crossings where another exit serves. Where a kept crossing turn
+//   crosses an arm of its own junction, that arm is cut back past the turn
+//   (kArmClearance beyond the turn's farthest point within the arm's
+//   carriageway) and the model is built again; where it crosses a road or
+//   turn of a junction that an edge too short for its trims joins to its
+//   own, the two junctions are joined (above) and the model is built again
+//   (at most four such rounds). Both kept counts come from clusters of
+//   junctions joined by edges shorter than their trims.
 // - Link roads (LinkRoad): every junction has one per allowed turn (ordered
 //   pair of distinct arms with lanes to give and take, |turn| <= kMaxTurn);
 //   every degree-2 node has one transition road joining its two edges, unless
@@ -144,7 +163,8 @@ struct EdgeLanes {
 };
 
 struct Junction {
-    uint32_t node = 0;
+    uint32_t node = 0;            // its node (the first of `nodes`)
+    std::vector<uint32_t> nodes;  // the street nodes it joins (one unless joined), ascending
     double radius = 0;
     std::vector<uint32_t> arms;   // incident edge indices, counter-clockwise by angle
     std::vector<uint32_t> links;  // its link roads (indices into LaneModel::links)
@@ -161,7 +181,7 @@ struct LinkRoad {
         bool sidewalk = false;
     };
     int junction = -1;
-    uint32_t node = 0;
+    uint32_t node = 0;         // the degree-2 node, or the junction's node (Junction::node)
     uint32_t in = 0, out = 0;  // street edges
     bool inEnd = true;         // `in` meets the node with its end (b == node), else with its start
     bool outStart = true;      // `out` leaves the node with its start (a == node), else with its end
@@ -215,20 +235,22 @@ struct SignalPlacement {
 };
 
 struct LaneModel {
-    std::vector<EdgeLanes> edges;                  // one per street edge
-    std::vector<Junction> junctions;               // nodes of degree >= 3, by node index
-    std::vector<int> nodeJunction;                 // per node: junction index or -1
-    std::vector<int> degree;                       // per node
-    std::vector<LinkRoad> links;                   // junctions' connecting roads, then transitions, by node index
-    std::vector<std::vector<uint32_t>> nodeLinks;  // per node: its link roads
-    std::vector<SignalPlacement> signals;          // by edge, start before end
-    size_t sharpCorners = 0;                       // degree-2 nodes left unlinked: too sharp for the lanes
-    size_t droppedTurns = 0;                       // junction turns within kMaxTurn whose trims did not fit the edges
-    size_t tightTurns = 0;                         // junction turns not built: lane-centre radius below the class floor
-    size_t tightTurnsKept = 0;                     // turns below the floor kept: the only way on for a lane
-    size_t overlappingArms = 0;                    // junction arm pairs whose surfaces still overlap (edges too short)
-    size_t crossingTurns = 0;      // junction turns not built: they would cross another road (see above)
-    size_t crossingTurnsKept = 0;  // crossing turns kept: the only way on for a lane
+    std::vector<EdgeLanes> edges;     // one per street edge
+    std::vector<Junction> junctions;  // nodes of degree >= 3, by node index
+    std::vector<int> nodeJunction;    // per node: junction index or -1 (every node of a joined junction)
+    std::vector<int> degree;          // per node
+    std::vector<LinkRoad> links;      // junctions' connecting roads, then transitions, by node index
+    std::vector<std::vector<uint32_t>>
+        nodeLinks;                         // per node: its link roads (a joined junction's under each of its nodes)
+    size_t joinedEdges = 0;                // edges inside joined junctions (no lanes)
+    std::vector<SignalPlacement> signals;  // by edge, start before end
+    size_t sharpCorners = 0;               // degree-2 nodes left unlinked: too sharp for the lanes
+    size_t droppedTurns = 0;               // junction turns within kMaxTurn whose trims did not fit the edges
+    size_t tightTurns = 0;                 // junction turns not built: lane-centre radius below the class floor
+    size_t tightTurnsKept = 0;             // turns below the floor kept: the only way on for a lane
+    size_t overlappingArms = 0;            // junction arm pairs whose surfaces still overlap (edges too short)
+    size_t crossingTurns = 0;              // junction turns not built: they would cross another road (see above)
+    size_t crossingTurnsKept = 0;          // crossing turns kept: the only way on for a lane
     // Smallest lane-centre radius bound over the built junction turns: arc
     // radius less the farthest reach of a lane centre toward its centre
     // (metres; 0 when no turn has an arc).

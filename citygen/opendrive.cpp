@@ -498,6 +498,7 @@ Result<std::string> Writer::run(OpenDriveCounts* counts) {
     n.crossingTurns = M.crossingTurns;
     n.tightTurnsKept = M.tightTurnsKept;
     n.crossingTurnsKept = M.crossingTurnsKept;
+    n.joinedEdges = M.joinedEdges;
     n.unlinkedLanes = M.unlinkedLanes;
     n.unfedLanes = M.unfedLanes;
     n.minTurnRadius = M.minTurnRadius;
@@ -525,6 +526,7 @@ std::string openDriveCountsJson(const OpenDriveCounts& n) {
     j["crossing_turns"] = n.crossingTurns;
     j["tight_turns_kept"] = n.tightTurnsKept;
     j["crossing_turns_kept"] = n.crossingTurnsKept;
+    j["joined_edges"] = n.joinedEdges;
     j["unlinked_lanes"] = n.unlinkedLanes;
     j["unfed_lanes"] = n.unfedLanes;
     j["tapered_lanes"] = n.taperedLanes;

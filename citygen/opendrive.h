@@ -62,6 +62,7 @@ struct OpenDriveCounts {
     size_t crossingTurns = 0;      // LaneModel::crossingTurns
     size_t tightTurnsKept = 0;     // LaneModel::tightTurnsKept
     size_t crossingTurnsKept = 0;  // LaneModel::crossingTurnsKept
+    size_t joinedEdges = 0;        // LaneModel::joinedEdges
     size_t unlinkedLanes = 0;      // LaneModel::unlinkedLanes
     size_t unfedLanes = 0;         // LaneModel::unfedLanes
     size_t taperedLanes = 0;       // driving lanes of link roads that start or end with width 0 inside them

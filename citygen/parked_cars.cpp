@@ -248,7 +248,8 @@ public:
             if (lanes.degree[E.b] >= 2) radius[E.b] = std::max(radius[E.b], L.trimB + L.halfWidth());
         }
         for (const Junction& j : lanes.junctions)
-            if (j.node < radius.size()) radius[j.node] = std::max(radius[j.node], j.radius);
+            for (uint32_t v : j.nodes)
+                if (v < radius.size()) radius[v] = std::max(radius[v], j.radius);
         for (size_t n = 0; n < g.nodes.size(); ++n)
             if (radius[n] > 0) addDisc(g.nodes[n], radius[n] + kCarClearance);
         for (const SignalPlacement& s : lanes.signals) addDisc(s.position, kPoleRadius);

@@ -504,3 +504,134 @@ TEST(Lanes, TurnsKeepTheClassTurningRadius) {
         EXPECT_EQ(m.tightTurns + m.tightTurnsKept, 0u);  // 80 m arms leave room for every turn
     }
 }
+
+namespace {
+
+// Driving-lane outline of a link road as quadrilaterals 0.25 m long.
+std::vector<BgPolygon> linkPieces(const LinkRoad& r) {
+    std::vector<BgPolygon> out;
+    auto corner = [&](double u, bool left) {
+        const double h = r.heading(u);
+        double t = r.laneOffset(u);
+        for (const LinkRoad::Lane& l : left ? r.left : r.right)
+            t += (l.sidewalk ? 0.0 : r.width(l, u)) * (left ? 1.0 : -1.0);
+        return r.point(u) + glm::dvec2(-std::sin(h), std::cos(h)) * t;
+    };
+    const int n = std::max(1, int(std::ceil(r.length() / 0.25)));
+    for (int i = 0; i < n; ++i) {
+        const double s0 = r.length() * i / n, s1 = r.length() * (i + 1) / n;
+        out.push_back(bgPolygon({corner(s0, false), corner(s1, false), corner(s1, true), corner(s0, true)}));
+    }
+    return out;
+}
+
+}  // namespace
+
+// Three junctions of local streets joined by edges of 17 and 18 m, shorter
+// than the trims both their ends want (a cluster of the default city): the
+// short edges are joined into the junction, so that no road surface shares
+// driving-lane area with another outside a common junction (Boost.Geometry
+// on the model's outlines: street carriageways and connecting roads sampled
+// every 0.25 m), and every lane entering or leaving the joined junction
+// still has a connecting road, counted from the link roads.
+TEST(Lanes, JunctionsCloserThanTheirFootprintsAreJoined) {
+    StreetGraph g;
+    g.nodes = {{-5.606, 16.073},   {0, 0},
+               {15.748, 8.890},    {-100.995, 24.901},
+               {-90.740, -51.226}, {-42.332, 121.376},
+               {20.088, -59.565},  {22.558, 94.010},
+               {73.104, 41.270}};
+    const std::pair<uint32_t, uint32_t> ends[] = {{3, 0}, {4, 1}, {5, 0}, {0, 1}, {1, 2}, {1, 7}, {2, 6}, {2, 8}};
+    for (const auto& [a, b] : ends) g.edges.push_back({a, b, RoadClass::Local, 7.5f, 2});
+    CityParams p;
+    p.sidewalk_m = 3.0;
+    const LaneModel m = buildLaneModel(g, p);
+    EXPECT_GT(m.joinedEdges, 0u);
+    EXPECT_EQ(m.crossingTurnsKept, 0u);
+    // Surfaces: street roads as carriageway rectangles, link roads as pieces.
+    struct Surface {
+        int junction;      // link road: its junction; street road: -1
+        uint32_t in, out;  // link road: the street roads it joins; street road: itself twice
+        std::vector<BgPolygon> pieces;
+    };
+    std::vector<Surface> roads;
+    for (uint32_t e = 0; e < m.edges.size(); ++e) {
+        const EdgeLanes& L = m.edges[e];
+        if (!L.valid) continue;
+        const glm::dvec2 n = L.normal() * L.halfWidth();
+        roads.push_back({-1, e, e, {bgPolygon({L.start - n, L.end - n, L.end + n, L.start + n})}});
+    }
+    for (const LinkRoad& r : m.links) roads.push_back({r.junction, r.in, r.out, linkPieces(r)});
+    size_t pairs = 0;
+    for (size_t x = 0; x < roads.size(); ++x)
+        for (size_t y = x + 1; y < roads.size(); ++y) {
+            const Surface &a = roads[x], &b = roads[y];
+            if (a.junction >= 0 && a.junction == b.junction) continue;  // inside their common junction
+            if (a.junction < 0 && b.junction < 0) continue;             // street roads: AcuteArmsShareNoSurface
+            const Surface& street = a.junction < 0 ? a : b;
+            const Surface& link = a.junction < 0 ? b : a;
+            if (street.junction < 0 && (street.in == link.in || street.in == link.out)) continue;  // its own ends
+            double shared = 0;
+            for (const BgPolygon& p : a.pieces)
+                for (const BgPolygon& q : b.pieces) shared += sharedArea(p, q);
+            ++pairs;
+            EXPECT_LT(shared, 1e-3) << "road pair " << x << ", " << y;
+        }
+    EXPECT_GT(pairs, 0u);
+    // Every driving lane entering or leaving a junction has a connecting road.
+    for (size_t j = 0; j < m.junctions.size(); ++j)
+        for (uint32_t e : m.junctions[j].arms) {
+            const EdgeLanes& L = m.edges[e];
+            const bool atB = L.junctionB == int(j);
+            std::set<int> in, out;
+            for (const LinkRoad& r : m.links) {
+                if (r.junction != int(j)) continue;
+                for (const LinkRoad::Lane& l : r.right) {
+                    if (r.in == e && r.inEnd == atB && l.from && l.w0 > 0) in.insert(l.from);
+                    if (r.out == e && r.outStart == !atB && l.from && l.to && l.w0 > 0 && l.w1 > 0) out.insert(l.to);
+                }
+            }
+            for (int k = 1; k <= (atB ? L.right : L.left); ++k)
+                EXPECT_TRUE(in.count(atB ? -k : k)) << "junction " << j << " edge " << e << " incoming lane " << k;
+            for (int k = 1; k <= (atB ? L.left : L.right); ++k)
+                EXPECT_TRUE(out.count(atB ? k : -k)) << "junction " << j << " edge " << e << " outgoing lane " << k;
+        }
+}
+
+// A highway junction 33 m from the next one (a junction of the generated
+// city, seed 11): a lane whose only turn cuts the corner across a local arm
+// of its own junction gets that arm cut back past the turn, so no connecting
+// road shares driving-lane area with a street road other than its two
+// (Boost.Geometry on the model's outlines).
+TEST(Lanes, ArmsAreCutBackPastTheTurnsThatMustCrossThem) {
+    StreetGraph g;
+    g.nodes = {
+        {0, 0},           {31.930, 9.302}, {-61.939, 20.345}, {-47.597, -13.866}, {-13.571, 59.568}, {57.612, -80.648},
+        {111.456, 32.469}};
+    g.edges = {{2, 0, RoadClass::Local, 7.5f, 2}, {3, 0, RoadClass::Highway, 20.0f, 6},
+               {4, 0, RoadClass::Local, 7.5f, 2}, {0, 1, RoadClass::Highway, 20.0f, 6},
+               {1, 5, RoadClass::Local, 7.5f, 2}, {1, 6, RoadClass::Highway, 20.0f, 6}};
+    for (double sidewalk : {0.0, 3.0}) {
+        CityParams p;
+        p.sidewalk_m = sidewalk;
+        const LaneModel m = buildLaneModel(g, p);
+        EXPECT_EQ(m.unlinkedLanes + m.unfedLanes, 0u) << sidewalk;
+        size_t links = 0;
+        for (const LinkRoad& r : m.links) {
+            if (r.junction < 0) continue;
+            ++links;
+            const std::vector<BgPolygon> pieces = linkPieces(r);
+            for (uint32_t e = 0; e < m.edges.size(); ++e) {
+                const EdgeLanes& L = m.edges[e];
+                if (!L.valid || e == r.in || e == r.out) continue;
+                const glm::dvec2 n = L.normal() * L.halfWidth();
+                const BgPolygon street = bgPolygon({L.start - n, L.end - n, L.end + n, L.start + n});
+                double shared = 0;
+                for (const BgPolygon& q : pieces) shared += sharedArea(q, street);
+                EXPECT_LT(shared, 1e-2) << "sidewalk " << sidewalk << ": turn " << r.in << "->" << r.out
+                                        << " of junction " << r.junction << " crosses edge " << e;
+            }
+        }
+        EXPECT_GT(links, 0u);
+    }
+}

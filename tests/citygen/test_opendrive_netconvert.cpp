@@ -102,7 +102,8 @@ NetCheck runNetconvert(const std::string& netconvert, const std::string& xodr, c
 }
 
 // netconvert's net against the graph: one junction (id = the OpenDRIVE
-// junction id, digits only) per node of degree >= 3; road ends without a
+// junction id, digits only) per node of degree >= 3 or group of them joined
+// by edges without lanes; road ends without a
 // link become "<road>.begin"/"<road>.end" nodes, each transition road two
 // "<road>.<road>" nodes; one traffic-light program per signalised junction;
 // "internal" junctions are netconvert's own (inside junctions). Every road
@@ -139,8 +140,22 @@ void checkNet(const City& city, const std::string& label) {
         for (const LinkRoad::Lane& l : t.left) tapersIn += !l.sidewalk && l.w1 == 0 && l.from;
     }
     EXPECT_LE(r.notConnectedElsewhere, tapersIn) << label << "\n" << r.log;
+    // Junctions: nodes of degree >= 3, those joined by an edge without lanes
+    // between two of them counted once (junction joining, lanes.h).
+    std::vector<size_t> group(M.degree.size());
+    for (size_t v = 0; v < group.size(); ++v) group[v] = v;
+    auto root = [&](size_t v) {
+        while (group[v] != v) v = group[v] = group[group[v]];
+        return v;
+    };
     size_t graphJunctions = 0;
     for (int d : M.degree) graphJunctions += d >= 3;
+    for (size_t e = 0; e < M.edges.size(); ++e) {
+        const StreetEdge& E = city.streets.edges[e];
+        if (M.edges[e].valid || E.a == E.b || M.degree[E.a] < 3 || M.degree[E.b] < 3) continue;
+        const size_t a = root(E.a), b = root(E.b);
+        if (a != b) group[a] = b, --graphJunctions;
+    }
     // Road ends without a link: dead ends, and both roads at a corner too
     // sharp for a transition (LaneModel::sharpCorners).
     size_t openEnds = 0;

@@ -61,7 +61,7 @@ TEST(OpenDrive, GenAndExportCountTheSameNetwork) {
     EXPECT_EQ(gen["opendrive"], exp);
     for (const char* key :
          {"roads", "junctions", "connecting_roads", "dropped_turns", "tight_turns", "tight_turns_kept",
-          "crossing_turns", "crossing_turns_kept", "overlapping_arms", "unlinked_lanes"})
+          "crossing_turns", "crossing_turns_kept", "joined_edges", "overlapping_arms", "unlinked_lanes"})
         EXPECT_TRUE(exp.contains(key)) << key;
     EXPECT_GT(exp["roads"].get<int>(), 0);
     EXPECT_GE(exp["min_turn_radius_m"].get<double>(), kMinTurnRadiusLocal);

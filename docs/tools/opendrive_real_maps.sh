@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Measures the OpenDRIVE export on real OpenStreetMap extracts: each EXTRACT
+# (an .osm/.osm.pbf, optionally followed by :SIZE to clip a SIZE-metre square
+# about the extract's centre) is imported with `vista gen --osm --xodr
+# --stats`, checked by the independent checker tests/tools/xodr_check.py
+# (road pairs whose driving lanes overlap outside a common junction, driving
+# lanes without a link, lane-centre radii on connecting roads under 5 m,
+# folds, gaps) and read by SUMO netconvert (errors, "not connected" lane
+# warnings). Prints one Markdown table row per extract on stdout.
+# Usage: docs/tools/opendrive_real_maps.sh OUT_DIR VISTA_BINARY EXTRACT[:SIZE]...
+set -euo pipefail
+[ $# -ge 3 ] || { echo "usage: $0 OUT_DIR VISTA_BINARY EXTRACT[:SIZE]..." >&2; exit 2; }
+OUT=$1 VISTA=$2
+shift 2
+command -v netconvert >/dev/null || { echo "netconvert (Debian package sumo) is needed" >&2; exit 2; }
+export SUMO_HOME=${SUMO_HOME:-/usr/share/sumo}
+CHECK=$(dirname "${BASH_SOURCE[0]}")/../../tests/tools/xodr_check.py
+mkdir -p "$OUT"
+echo "| extract | window | roads | junctions | joined edges | overlapping pairs | unlinked lanes | radii < 5 m | folds | gaps | netconvert errors | not connected |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
+for arg in "$@"; do
+  src=${arg%%:*} size=""
+  [ "$arg" != "$src" ] && size=${arg#*:}
+  name=$(basename "$src")
+  name=${name%%.*}${size:+_$size}
+  "$VISTA" gen --osm "$src" ${size:+--size "$size"} --detail 0 -q -o "$OUT/$name.osgb" --xodr "$OUT/$name.xodr" \
+    --stats "$OUT/$name.stats.json"
+  rc=0
+  python3 "$CHECK" "$OUT/$name.xodr" --json "$OUT/$name.check.json" -q >/dev/null || rc=$?
+  [ "$rc" -le 1 ] || { echo "xodr_check.py could not read $OUT/$name.xodr" >&2; exit 1; }
+  netconvert --opendrive-files "$OUT/$name.xodr" -o "$OUT/$name.net.xml" >"$OUT/$name.netconvert.log" 2>&1 || true
+  python3 - "$(basename "$src")" "${size:-whole}" "$OUT/$name" <<'PY'
+import json, sys
+src, window, base = sys.argv[1:4]
+c = json.load(open(base + ".check.json"))["checks"]
+s = json.load(open(base + ".stats.json"))["opendrive"]
+log = open(base + ".netconvert.log", errors="replace").read().splitlines()
+errors = sum(1 for l in log if l.startswith("Error"))
+loose = sum(1 for l in log if "not connected" in l)
+print(f"| {src} | {window} | {s['roads']} | {s['junctions']} | {s['joined_edges']} | {c['overlaps']['failures']} | "
+      f"{c['unlinked']['failures']} | {c['turn_radius']['failures']} | {c['folds']['failures']} | "
+      f"{c['gaps']['failures']} | {errors} | {loose} |")
+PY
+done
