@@ -6,7 +6,8 @@
 #  2. `cpack -G DEB`; the .deb's contents and Depends are checked, it is
 #     unpacked with dpkg-deb -x into a clean directory, the consumer is built
 #     against that tree, and the packaged `vista gen` writes a tiny city with
-#     the packaged osgDB plugin on OSG's plugin path.
+#     the packaged osgDB plugin on OSG's plugin path, and the packaged Python
+#     module imports and generates a city.
 # Nothing is installed on the machine; everything goes to a temporary directory.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -67,4 +68,14 @@ if ldd "$ROOT/$plugin" | grep -q 'not found'; then ldd "$ROOT/$plugin"; fail "th
 OSG_LIBRARY_PATH="$plugin_dir" "$ROOT/usr/bin/vista" gen --size 300 --seed 3 -o "$WORK/city.osgb" --quiet \
   || fail "the packaged vista gen"
 [ -s "$WORK/city.osgb" ] || fail "the packaged vista gen wrote no $WORK/city.osgb"
+step "the packaged Python module"
+pydir="$(cd "$ROOT" && find . -path "*/dist-packages/vista/__init__.py" | head -n1)"
+[ -n "$pydir" ] || fail "no Python package vista in the unpacked .deb"
+PYTHONPATH="$ROOT/$(dirname "$(dirname "$pydir")")" OSG_LIBRARY_PATH="$plugin_dir" /usr/bin/python3 -c '
+import vista
+city = vista.generate(seed=3, size_m=300)
+edges = len(city.streets["edges"])
+assert edges > 0, "no street edges"
+print("package: the packaged module generated a city of", edges, "street edges")
+' || fail "importing the packaged Python module and generating a city"
 step "ok: $(basename "$DEB") ($(du -h "$DEB" | cut -f1)), city.osgb $(du -h "$WORK/city.osgb" | cut -f1)"
