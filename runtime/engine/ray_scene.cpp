@@ -761,13 +761,6 @@ Status RayScene::setMoverPrototypes(const std::vector<SceneMesh>& prototypes) {
     auto protos = im.buildPrototypes(model);
     if (!protos.isOk()) return protos.status();
     im.moverProtos = *protos;
-    // The top level is rebuilt every frame the objects move: Embree's fast
-    // builder for dynamic scenes (morton, low quality) builds a top level of
-    // thousands of instances (regions, trees, objects) in a fraction of the
-    // high-quality build's time, and the instances' own scenes keep their
-    // high-quality BVHs.
-    rtcSetSceneFlags(im.scene, RTCSceneFlags(rtcGetSceneFlags(im.scene) | RTC_SCENE_FLAG_DYNAMIC));
-    rtcSetSceneBuildQuality(im.scene, RTC_BUILD_QUALITY_LOW);
     im.moverBounds.clear();
     for (const SceneMesh& p : prototypes) {
         glm::dvec3 lo(1e300), hi(-1e300);
