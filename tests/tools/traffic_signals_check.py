@@ -133,7 +133,7 @@ def check_ego(path_csv, stops):
     if len(rows) < 2:
         raise InputError(f"the path {path_csv} has fewer than two samples")
     t_first = min(a for spans in stops.values() for a, _ in spans) if stops else None
-    # The path's t = 0 is the ego's first FCD sample: callers pass stop times relative to it.
+    # The path's t_s is the traffic's clock (the FCD's time), as the stop times are.
     moved = []
     for tl, spans in stops.items():
         for a, b in spans:
@@ -170,8 +170,7 @@ def main(argv=None):
         if opt.ego:
             if not opt.path:
                 raise InputError("--ego needs --path")
-            first = tracks.get(opt.ego, [(0.0,)])[0][0]
-            stops = {tl: [(a - first, b - first) for a, b in spans] for tl, spans in red_stops.get(opt.ego, {}).items()}
+            stops = red_stops.get(opt.ego, {})
             res["ego"] = check_ego(opt.path, stops)
             res["pass"] = res["pass"] and res["ego"]["pass"]
     except (InputError, KeyError, OSError, ValueError) as e:
