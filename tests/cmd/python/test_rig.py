@@ -41,8 +41,10 @@ def test_rig_fires_what_vista_render_rig_writes(cli_city, city, tmp_path):
             assert [int(b["u0"]), int(b["v0"]), int(b["u1"]), int(b["v1"])] == visible[int(b["id"])]
         velodyne = np.fromfile(out / "velodyne" / f"{name}.bin", dtype="<f4").reshape(-1, 4)
         assert lidar["points"].dtype == np.float32 and np.array_equal(lidar["points"], velodyne)
-        labels = np.fromfile(out / "labels" / f"{name}.label", dtype="<u4")
+        labels = np.fromfile(out / "labels_vista" / f"{name}.label", dtype="<u4")
         assert np.array_equal(lidar["semantic"].astype(np.uint32), labels)
+        times = np.fromfile(out / "velodyne_time" / f"{name}.bin", dtype="<f4")
+        assert np.array_equal(lidar["time"].astype(np.float32), times)
         assert np.all(np.diff(lidar["time"][lidar["beam"] == 0]) >= 0)  # per-point times along the sweep
         assert lidar["time"].max() < 0.1 + 1e-6  # one revolution at 10 Hz
 
