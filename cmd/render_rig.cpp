@@ -277,7 +277,8 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
         if (c.channels & kRigFlow) shot.next = sensorPose(vehiclePoseAt(path, nextShotTime(p, path, k, f)), c.mount);
         castRigCamera(w.city, rays, shot, im, threads);
         VISTA_RETURN_IF_ERROR(writeCamera(c, k, name, im, out));
-        if (c.channels & kRigBoxes) VISTA_RETURN_IF_ERROR(writeCameraBoxes(p, w, k, vehicle, shot.pose, name, im, out, boxes));
+        if (c.channels & kRigBoxes)
+            VISTA_RETURN_IF_ERROR(writeCameraBoxes(p, w, k, vehicle, shot.pose, name, im, out, boxes));
         ms[c.name] = sw.ms();
     }
     for (size_t j = 0; j < p.rig.lidars.size(); ++j) {

@@ -98,8 +98,7 @@ std::string kittiRigLabels(const std::vector<FrameBox>& boxes, const RigPose& re
         const glm::dvec3 loc = u * mid.x + w * mid.z + glm::dvec3(0.0, hi.y, 0.0);  // bottom: largest y
         const double alpha = wrapTurn(ry - std::atan2(loc.x, loc.z));
         const int occluded = f.visibleFraction >= 0.8 ? 0 : f.visibleFraction >= 0.4 ? 1 : 2;
-        std::snprintf(line, sizeof line,
-                      "%s %.2f %d %.2f %.2f %.2f %.2f %.2f %.3f %.3f %.3f %.3f %.3f %.3f %.3f %u\n",
+        std::snprintf(line, sizeof line, "%s %.2f %d %.2f %.2f %.2f %.2f %.2f %.3f %.3f %.3f %.3f %.3f %.3f %.3f %u\n",
                       kittiType(instanceKind(f.id)), f.truncated, occluded, alpha, double(f.visibleU0),
                       double(f.visibleV0), double(f.visibleU1), double(f.visibleV1), size.y, size.z, size.x, loc.x,
                       loc.y, loc.z, ry, unsigned(f.id));

@@ -102,12 +102,11 @@ struct SkClass {
     const char* name;
     int b, g, r;
 };
-constexpr SkClass kSkClasses[] = {{0, "unlabeled", 0, 0, 0},          {10, "car", 245, 150, 100},
-                                  {40, "road", 255, 0, 255},           {48, "sidewalk", 75, 0, 75},
-                                  {50, "building", 0, 200, 255},       {60, "lane-marking", 170, 255, 150},
-                                  {70, "vegetation", 0, 175, 0},       {71, "trunk", 0, 60, 135},
-                                  {72, "terrain", 80, 240, 150},       {80, "pole", 150, 240, 255},
-                                  {81, "traffic-sign", 0, 0, 255}};
+constexpr SkClass kSkClasses[] = {
+    {0, "unlabeled", 0, 0, 0},     {10, "car", 245, 150, 100},     {40, "road", 255, 0, 255},
+    {48, "sidewalk", 75, 0, 75},   {50, "building", 0, 200, 255},  {60, "lane-marking", 170, 255, 150},
+    {70, "vegetation", 0, 175, 0}, {71, "trunk", 0, 60, 135},      {72, "terrain", 80, 240, 150},
+    {80, "pole", 150, 240, 255},   {81, "traffic-sign", 0, 0, 255}};
 // By vista class (citygen/labels.h SemanticClass order).
 constexpr uint16_t kVistaToSk[kSemanticClassCount] = {0, 72, 40, 60, 48, 72, 50, 50, 50, 71, 70, 80, 80, 81, 10};
 
@@ -215,7 +214,7 @@ std::string kittiCalib(const Rig& rig) {
         out += r0 + "\n";
     }
     // A LiDAR's frame (the vehicle frame without one) to the reference camera's.
-    const auto veloToCam = [&](const glm::dmat3& rot, const glm::dvec3& pos, double (&T)[12]) {
+    const auto veloToCam = [&](const glm::dmat3& rot, const glm::dvec3& pos, double(&T)[12]) {
         rowsOf(glm::transpose(refRot) * rot, glm::transpose(refRot) * (pos - refPos), T);
     };
     double T[12], I[12];
