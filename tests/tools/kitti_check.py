@@ -21,7 +21,7 @@ SemanticKITTI API's label layout), not from vista's writer:
   and instance_NN/*.npy / depth_NN/*.npy: the camera's instance ids and
   z-depth (vista's documented encoding: kind = id >> 28).
 
-With --vista it generates a small city, renders a rig of four pinhole
+With --vista it generates a small city (flat, then hilly), renders a rig of four pinhole
 cameras pitched +-10 degrees and rolled +-5 degrees (and a fisheye) with a
 LiDAR, and checks: calib's line order and meaning; every label box of every
 camera holds >= 95 % of its instance's LiDAR points (instances with at
@@ -319,7 +319,7 @@ def check_run(run):
     return 1 if fails.items else 0
 
 
-def render(vista, d, seed=2):
+def render(vista, d, gen_args=("--size", 400, "--seed", 11), seed=2):
     def run(*args):
         r = subprocess.run([vista, *map(str, args)], capture_output=True, text=True)
         if r.returncode != 0:
@@ -327,7 +327,7 @@ def render(vista, d, seed=2):
     city, path, rig, out = (os.path.join(d, n) for n in ("city.osgb", "path.csv", "rig.json", "out"))
     with open(rig, "w") as f:
         json.dump(RIG, f)
-    run("gen", "--size", 400, "--seed", 11, "-q", "-o", city)
+    run("gen", *gen_args, "-q", "-o", city)
     run("path", city, "--seed", seed, "--duration", 6, "-o", path)
     # Consecutive path samples (1/30 s): rig.json's poses cover every sweep (10 Hz, every third frame).
     run("render", city, "--path", path, "--frames", 10, "--sampling", "consecutive", "--rig", rig, "--out", out, "-q")
@@ -343,8 +343,13 @@ def main():
         return check_run(a.run)
     if not a.vista:
         ap.error("give --vista or --run")
-    with tempfile.TemporaryDirectory() as d:
-        return check_run(render(a.vista, d))
+    # A flat generated city, and a hilly one (the path climbs and descends 25 m hills).
+    hilly = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "xodr_hilly.json")
+    rc = 0
+    for gen_args in (("--size", 400, "--seed", 11), ("--params", hilly, "--size", 400)):
+        with tempfile.TemporaryDirectory() as d:
+            rc |= check_run(render(a.vista, d, gen_args))
+    return rc
 
 
 if __name__ == "__main__":
