@@ -31,7 +31,10 @@ class of every LiDAR point that a camera sees (its depth within 2 % of the
 camera's depth image) agrees with the kind of the camera's instance id at
 that pixel (>= 95 %), and the upper 16 bits name each object instance
 with one id, distinct between instances; every point has a time within
-the sweep. With --run DIR it checks an existing run. Exit 0 when every
+the sweep; road and junction surfaces, which overlap where a junction
+meets its roads, are the same one for the LiDAR and the cameras (at most
+0.1 % of those points see the other surface with no agreeing pixel within
+one pixel of their projection). With --run DIR it checks an existing run. Exit 0 when every
 check passes, 1 otherwise, 77 without numpy.
 """
 import argparse
@@ -246,10 +249,20 @@ def check_frame(run, name, calib, cams, sk_names, fails, stats, motion=None):
                 stats["projected_checked"] += 1
                 fails.check(ok, f"{label_file}: instance {lab['id']} projected box "
                             f"[{u.min():.1f} {v.min():.1f} {u.max():.1f} {v.max():.1f}] does not enclose bbox {b}")
-        check_classes_in_camera(run, name, k, P, rect, sk_class, sk_inst, sk_names, fails, stats)
+        check_classes_in_camera(run, name, k, P, rect, sk_class, sk_inst, sk_names, fails, stats, inst)
 
 
-def check_classes_in_camera(run, name, k, P, rect, sk_class, sk_inst, sk_names, fails, stats):
+def check_road_junction(ids, u, v, pix_kinds, point_kinds, stats):
+    """Road (kind 3) and junction (kind 4) points whose pixel and its 8 neighbours all name the other surface."""
+    both = np.isin(pix_kinds, [3, 4]) & np.isin(point_kinds, [3, 4])
+    stats["road_junction_points"] += int(both.sum())
+    h, w = ids.shape
+    for i in np.nonzero(both & (pix_kinds != point_kinds))[0]:
+        nb = ids[max(v[i] - 1, 0):v[i] + 2, max(u[i] - 1, 0):u[i] + 2].astype(np.int64) >> 28
+        stats["road_junction_flips"] += int(not (nb == point_kinds[i]).any())
+
+
+def check_classes_in_camera(run, name, k, P, rect, sk_class, sk_inst, sk_names, fails, stats, inst):
     ids = np.load(os.path.join(run, f"instance_{k:02d}", name + ".npy"))
     depth = np.load(os.path.join(run, f"depth_{k:02d}", name + ".npy"))
     h, w = ids.shape
@@ -268,6 +281,7 @@ def check_classes_in_camera(run, name, k, P, rect, sk_class, sk_inst, sk_names, 
         return
     pix = ids[v[seen], u[seen]].astype(np.int64)
     kinds = pix >> 28
+    check_road_junction(ids, u[seen], v[seen], kinds, inst[seen].astype(np.int64) >> 28, stats)
     names = [sk_names.get(int(c), "?") for c in sk_class[seen]]
     agree = np.array([nm in ALLOWED.get(int(kd), set()) for nm, kd in zip(names, kinds)])
     stats["points_compared"] += len(seen)
@@ -295,7 +309,7 @@ def check_classes_in_camera(run, name, k, P, rect, sk_class, sk_inst, sk_names, 
 def check_run(run):
     fails = Failures()
     stats = {"boxes_checked": 0, "projected_checked": 0, "worst_fraction": 1.0, "points_compared": 0,
-             "instances_compared": 0, "frames": 0}
+             "instances_compared": 0, "frames": 0, "road_junction_points": 0, "road_junction_flips": 0}
     rig = json.load(open(os.path.join(run, "rig.json")))
     calib, order, mm = read_calib(os.path.join(run, "calib.txt"))
     check_calib(run, calib, order, mm, rig, fails)
@@ -313,6 +327,11 @@ def check_run(run):
         check_frame(run, f["name"], calib, cams, sk_names, fails, stats, motion)
     fails.check(stats["boxes_checked"] >= 8, f"only {stats['boxes_checked']} label boxes had 10 LiDAR points")
     fails.check(stats["points_compared"] >= 1000, f"only {stats['points_compared']} LiDAR points seen by a camera")
+    # Coplanar road and junction surfaces: the camera and the LiDAR pick the same one (a point on
+    # the boundary may see the other within a pixel; a flip is one with no agreeing neighbour).
+    flips, rj = stats["road_junction_flips"], stats["road_junction_points"]
+    fails.check(rj >= 1000 and flips <= 0.001 * rj, f"{flips} of {rj} road and junction points flip between "
+                "the LiDAR and the cameras (at most 0.1 %)")
     print("kitti_check:", json.dumps(stats))
     for m in fails.items[:40]:
         print("FAIL:", m)
