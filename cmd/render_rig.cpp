@@ -1,6 +1,7 @@
 // `vista render --rig` (render_rig.h): options and rig file, city and path,
 // work directory, the frames (every sensor that fires, cast and written),
-// then rig.json, calib.txt, times.txt, classes.json and summary.json.
+// then rig.json, calib.txt, times.txt, classes.json, semantic-kitti.yaml and
+// summary.json.
 #include "cmd/render_rig.h"
 
 #include <unistd.h>
