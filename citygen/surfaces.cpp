@@ -24,12 +24,13 @@ namespace vista {
 
 namespace {
 
-constexpr double kRoadLift = 0.02;      // carriageway above ground
-constexpr double kMarkingLift = 0.03;   // markings above ground
-constexpr double kGrassLift = 0.05;     // park lawn above ground
-constexpr double kSidewalkLift = 0.12;  // sidewalk top above ground
-constexpr double kMaxPiece = 50.0;      // longest road piece
-constexpr double kMinArea = 1e-6;       // smallest triangle emitted (m^2)
+constexpr double kRoadLift = 0.02;       // carriageway above ground
+constexpr double kJunctionLift = 0.025;  // junction polygons above the carriageways they overlap
+constexpr double kMarkingLift = 0.03;    // markings above ground
+constexpr double kGrassLift = 0.05;      // park lawn above ground
+constexpr double kSidewalkLift = 0.12;   // sidewalk top above ground
+constexpr double kMaxPiece = 50.0;       // longest road piece
+constexpr double kMinArea = 1e-6;        // smallest triangle emitted (m^2)
 // Markings (metres): line width, dashes, stop lines, zebra crossings.
 constexpr double kLineWidth = 0.15;  // as the OpenDRIVE road marks
 constexpr double kDashPeriod = 9.0, kDash = 3.0;
@@ -90,6 +91,21 @@ public:
     static void tri(MeshBuilder& b, const glm::dvec3& a, const glm::dvec3& c1, const glm::dvec3& c2) {
         if (!(glm::length(glm::cross(c1 - a, c2 - a)) > 2 * kMinArea)) return;
         b.triangle(a, c1, c2);
+    }
+    // A junction fan triangle at kJunctionLift, split on hills into sub-triangles no longer than
+    // `step` (the carriageways' sampling), so that it follows the ground as closely as they do and
+    // stays above them where the two overlap.
+    void fanTriangle(MeshBuilder& b, const glm::dvec2& c, const glm::dvec2& p, const glm::dvec2& q) const {
+        const double longest = std::max({glm::length(p - c), glm::length(q - c), glm::length(q - p)});
+        const int n = flat ? 1 : std::max(1, int(std::ceil(longest / step)));
+        auto P = [&](int i, int j) {
+            return at(c + (p - c) * (double(i) / n) + (q - c) * (double(j) / n), kJunctionLift);
+        };
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; i + j < n; ++j) {
+                tri(b, P(i, j), P(i + 1, j), P(i, j + 1));
+                if (i + j < n - 1) tri(b, P(i + 1, j), P(i + 1, j + 1), P(i, j + 1));
+            }
     }
     static void quad(MeshBuilder& b, const glm::dvec3& a, const glm::dvec3& c1, const glm::dvec3& c2,
                      const glm::dvec3& c3) {
@@ -346,9 +362,8 @@ void SurfaceContext::roads() {
             road.setId(makeInstanceId(InstanceKind::Junction, node));
             glm::dvec2 m(0.0);
             for (const auto& q : hull) m += q;
-            glm::dvec3 centre = at(m / double(hull.size()), kRoadLift);
-            for (size_t k = 0; k < hull.size(); ++k)
-                tri(road, centre, at(hull[k], kRoadLift), at(hull[(k + 1) % hull.size()], kRoadLift));
+            const glm::dvec2 centre = m / double(hull.size());
+            for (size_t k = 0; k < hull.size(); ++k) fanTriangle(road, centre, hull[k], hull[(k + 1) % hull.size()]);
         }
         i = j;
     }

@@ -1,6 +1,7 @@
 // `vista render --rig` (render_rig.h): options and rig file, city and path,
 // work directory, the frames (every sensor that fires, cast and written),
-// then rig.json, calib.txt, times.txt, classes.json and summary.json.
+// then rig.json, calib.txt, times.txt, classes.json, semantic-kitti.yaml and
+// summary.json.
 #include "cmd/render_rig.h"
 
 #include <unistd.h>
@@ -57,12 +58,13 @@ CameraDirs cameraDirs(size_t k) {
 }
 const char* const kBoxes3dDir = "boxes_3d";
 struct LidarDirs {
-    std::string points, labels, instances;
+    std::string points, times, labels, vistaLabels, instances;
 };
 LidarDirs lidarDirs(size_t j) {
     const std::string s = j == 0 ? std::string() : "_" + std::to_string(j);
-    return {"velodyne" + s, "labels" + s, "lidar_instance" + s};
+    return {"velodyne" + s, "velodyne_time" + s, "labels" + s, "labels_vista" + s, "lidar_instance" + s};
 }
+const char* const kSemanticKittiYaml = "semantic-kitti.yaml";
 
 // The files a sensor writes when it fires at frame `name` (paths under out/).
 std::vector<std::string> cameraFiles(const RigCamera& c, size_t k, const std::string& name) {
@@ -79,7 +81,8 @@ std::vector<std::string> cameraFiles(const RigCamera& c, size_t k, const std::st
 }
 std::vector<std::string> lidarFiles(size_t j, const std::string& name) {
     const LidarDirs d = lidarDirs(j);
-    return {d.points + "/" + name + ".bin", d.labels + "/" + name + ".label", d.instances + "/" + name + ".bin"};
+    return {d.points + "/" + name + ".bin", d.times + "/" + name + ".bin", d.labels + "/" + name + ".label",
+            d.vistaLabels + "/" + name + ".label", d.instances + "/" + name + ".bin"};
 }
 
 // The parsed run: rig, path options, frames and who fires when.
@@ -213,8 +216,9 @@ struct FrameBoxState {
 };
 
 // Camera k's 2D boxes from its instance image: boxes_NN/ and, for a pinhole, KITTI lines in label_NN/.
-Status writeCameraBoxes(const RigPlan& p, const Walkthrough& w, size_t k, const RigPose& pose, const std::string& name,
-                        const CameraImages& im, const RenderWorkDir& out, FrameBoxState& boxes) {
+Status writeCameraBoxes(const RigPlan& p, const Walkthrough& w, size_t k, const RigPose& vehicle, const RigPose& pose,
+                        const std::string& name, const CameraImages& im, const RenderWorkDir& out,
+                        FrameBoxState& boxes) {
     const RigCamera& c = p.rig.cameras[k];
     const BoxCamera cam = rigBoxCamera(c.model, pose);
     FrameBoxOptions o;
@@ -226,7 +230,8 @@ Status writeCameraBoxes(const RigPlan& p, const Walkthrough& w, size_t k, const 
     VISTA_RETURN_IF_ERROR(
         writeFileAtomic(out.file(d.boxes + "/" + name + ".json"), frameBoxesJson(fb, cam, offset, c.name)));
     if (c.model.fisheye()) return Status::ok();
-    return writeFileAtomic(out.file(d.labels + "/" + name + ".txt"), kittiLabels(fb, cam));
+    return writeFileAtomic(out.file(d.labels + "/" + name + ".txt"),
+                           kittiRigLabels(fb, sensorPose(vehicle, kittiRectifiedMount(p.rig))));
 }
 
 Status writeCamera(const RigCamera& c, size_t k, const std::string& name, const CameraImages& im,
@@ -248,8 +253,10 @@ Status writeCamera(const RigCamera& c, size_t k, const std::string& name, const 
 Status writeLidar(const LidarSweep& s, size_t j, const std::string& name, const RenderWorkDir& out) {
     const std::vector<std::string> files = lidarFiles(j, name);
     VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(files[0]), velodyneBytes(s)));
-    VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(files[1]), lidarLabelBytes(s)));
-    return writeFileAtomic(out.file(files[2]), lidarInstanceBytes(s));
+    VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(files[1]), lidarTimeBytes(s)));
+    VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(files[2]), semanticKittiLabelBytes(s)));
+    VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(files[3]), vistaLabelBytes(s)));
+    return writeFileAtomic(out.file(files[4]), lidarInstanceBytes(s));
 }
 
 // One rig frame: every sensor that fires, cast and written (each timed,
@@ -283,7 +290,8 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
         if (c.channels & kRigFlow) shot.next = sensorPose(vehiclePoseAt(path, nextShotTime(p, path, k, f)), c.mount);
         castRigCamera(w.city, rays, shot, im, threads);
         VISTA_RETURN_IF_ERROR(writeCamera(c, k, name, im, out));
-        if (c.channels & kRigBoxes) VISTA_RETURN_IF_ERROR(writeCameraBoxes(p, w, k, shot.pose, name, im, out, boxes));
+        if (c.channels & kRigBoxes)
+            VISTA_RETURN_IF_ERROR(writeCameraBoxes(p, w, k, vehicle, shot.pose, name, im, out, boxes));
         ms[c.name] = sw.ms();
     }
     for (size_t j = 0; j < p.rig.lidars.size(); ++j) {
@@ -370,7 +378,12 @@ nlohmann::json rigManifest(const RigPlan& p, const Walkthrough& w) {
         const RigLidar& l = p.rig.lidars[j];
         sensors.push_back({{"name", l.name},
                            {"index", j},
-                           {"dirs", {{"points", d.points}, {"labels", d.labels}, {"instances", d.instances}}},
+                           {"dirs",
+                            {{"points", d.points},
+                             {"times", d.times},
+                             {"labels", d.labels},
+                             {"vista_labels", d.vistaLabels},
+                             {"instances", d.instances}}},
                            {"sensor_to_vehicle",
                             matrixJson(poseToWorld({l.mount.position, mountRotation(l.mount)}, glm::dvec3(0.0)))}});
     }
@@ -463,6 +476,8 @@ Status writeMetadata(const RigRunRequest& a, const RigPlan& p, const Walkthrough
     }
     VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file("times.txt"), times));
     VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file("classes.json"), classesJson().dump(2) + "\n"));
+    if (!p.rig.lidars.empty())
+        VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(kSemanticKittiYaml), semanticKittiYaml()));
     summary = rigSummary(a, p, records, kept);
     VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file("summary.json"), summary.dump(2) + "\n"));
     return out.commit();

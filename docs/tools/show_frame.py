@@ -13,7 +13,7 @@ wherever python3 does.
 --run reads one frame of a `vista render --rig` run for camera NN:
 image_NN/FRAME.png, boxes_NN/FRAME.json and, when the first LiDAR fired at
 that frame, velodyne/FRAME.bin projected with calib.txt's PNN and
-Tr_velo_to_cam (a pinhole camera; a fisheye has no PNN line, so its boxes
+Tr_velo_to_cam (a pinhole camera; a fisheye's PNN is only its pinhole equivalent, so its boxes
 are drawn without points).
 
 Boxes: the visible extent (solid, the colour of the instance kind) and the
@@ -266,8 +266,10 @@ def rig_frame_files(run, frame, camera):
     if os.path.exists(calib):
         with open(calib) as f:
             has_p = any(line.split(":", 1)[0].strip() == p_name for line in f if ":" in line)
-    if not (has_p and os.path.exists(lidar)):
-        lidar = None
+    with open(boxes) as f:
+        pinhole = json.load(f).get("model", "pinhole") == "pinhole"
+    if not (has_p and pinhole and os.path.exists(lidar)):
+        lidar = None  # a fisheye's P line is its pinhole equivalent, exact on the axis only
     return image, boxes, lidar, calib, p_name
 
 

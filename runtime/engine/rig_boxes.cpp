@@ -67,6 +67,46 @@ void addLidarSightings(FrameSightings& s, const std::string& lidar, const LidarS
     }
 }
 
+namespace {
+
+double wrapTurn(double a) {  // into (-pi, pi]
+    while (a > kPi) a -= kTwoPi;
+    while (a <= -kPi) a += kTwoPi;
+    return a;
+}
+
+}  // namespace
+
+std::string kittiRigLabels(const std::vector<FrameBox>& boxes, const RigPose& rectified) {
+    // The rectified frame's OpenCV axes (x right, y down, z forward) in the world.
+    const glm::dmat3 axes(-rectified.rotation[1], -rectified.rotation[2], rectified.rotation[0]);
+    const glm::dmat3 toRect = glm::transpose(axes);
+    std::string out;
+    char line[512];
+    for (const FrameBox& f : boxes) {
+        const glm::dvec3 l = toRect * f.box.lengthAxis();
+        const double ry = wrapTurn(std::atan2(-l.z, l.x));
+        const glm::dvec3 u(std::cos(ry), 0.0, -std::sin(ry)), w(std::sin(ry), 0.0, std::cos(ry));
+        glm::dvec3 lo(1e300), hi(-1e300);  // along u, y, w
+        for (const glm::dvec3& c : f.box.corners()) {
+            const glm::dvec3 p = toRect * (c - rectified.position);
+            const glm::dvec3 q(glm::dot(p, u), p.y, glm::dot(p, w));
+            lo = glm::min(lo, q), hi = glm::max(hi, q);
+        }
+        const glm::dvec3 size = hi - lo;  // length, height, width
+        const glm::dvec3 mid = 0.5 * (lo + hi);
+        const glm::dvec3 loc = u * mid.x + w * mid.z + glm::dvec3(0.0, hi.y, 0.0);  // bottom: largest y
+        const double alpha = wrapTurn(ry - std::atan2(loc.x, loc.z));
+        const int occluded = f.visibleFraction >= 0.8 ? 0 : f.visibleFraction >= 0.4 ? 1 : 2;
+        std::snprintf(line, sizeof line, "%s %.2f %d %.2f %.2f %.2f %.2f %.2f %.3f %.3f %.3f %.3f %.3f %.3f %.3f %u\n",
+                      kittiType(instanceKind(f.id)), f.truncated, occluded, alpha, double(f.visibleU0),
+                      double(f.visibleV0), double(f.visibleU1), double(f.visibleV1), size.y, size.z, size.x, loc.x,
+                      loc.y, loc.z, ry, unsigned(f.id));
+        out += line;
+    }
+    return out;
+}
+
 std::string frameBoxes3dJson(const CityBoxes& boxes, const FrameSightings& seen, const RigPose& vehicle,
                              const glm::dvec3& worldOffset, const std::string& frame, double t) {
     nlohmann::json list = nlohmann::json::array();

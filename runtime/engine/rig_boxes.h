@@ -28,6 +28,23 @@
 // `seen_by`, `lidar_points`, `world` {center (minus world_offset), size,
 // yaw} and `vehicle` {center, size, yaw} (boxInPoseFrame of the frame's
 // vehicle pose); positions and yaws rounded to 0.001.
+//
+// kittiRigLabels(): KITTI object label lines (one per box, '\n'-terminated)
+// in the rig's rectified frame (rig_dataset.h kittiCalib) at `rectified`,
+// its world pose (sensorPose of the vehicle and kittiRectifiedMount; x
+// forward, y left, z up; its OpenCV axes are (-y, -z, x)): type,
+// truncated, occluded (0: visibleFraction >= 0.8, 1: >= 0.4, 2: less),
+// alpha, bbox (the visible extent in the labelling camera, inclusive pixel
+// indices), dimensions (height, width, length), location (bottom centre),
+// rotation_y, then a 16th column: the instance id (labels.h, the id of the
+// instance images and lidar_instance/). The box is the smallest one upright
+// in the rectified frame (rotated about its y axis only), with rotation_y =
+// the world box's length axis projected onto the frame's x-z plane, that
+// contains the world box's 8 corners: the world box itself when the vehicle
+// is level (the rectified frame's y is the world's -z), a box enclosing it
+// otherwise. rotation_y = atan2(-l.z, l.x) of the length axis l, as the
+// KITTI devkit builds corners (length along x rotated by rotation_y);
+// alpha = rotation_y - atan2(x, z) of the location, in (-pi, pi].
 // Pure; thread-safe for distinct outputs.
 #pragma once
 #include <cstdint>
@@ -54,6 +71,8 @@ using FrameSightings = std::map<uint32_t, BoxSighting>;  // by instance id
 
 void addCameraSightings(FrameSightings& s, const std::string& camera, const std::vector<FrameBox>& boxes);
 void addLidarSightings(FrameSightings& s, const std::string& lidar, const LidarSweep& sweep, const CityBoxes& boxes);
+
+std::string kittiRigLabels(const std::vector<FrameBox>& boxes, const RigPose& rectified);
 
 std::string frameBoxes3dJson(const CityBoxes& boxes, const FrameSightings& seen, const RigPose& vehicle,
                              const glm::dvec3& worldOffset, const std::string& frame, double t);

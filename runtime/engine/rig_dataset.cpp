@@ -1,8 +1,12 @@
 // The files of a rig run (rig_dataset.h).
 #include "runtime/engine/rig_dataset.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
+
+#include "citygen/labels.h"
+#include "runtime/engine/boxes.h"
 
 namespace vista {
 
@@ -68,10 +72,71 @@ std::string velodyneBytes(const LidarSweep& sweep) {
     return s;
 }
 
-std::string lidarLabelBytes(const LidarSweep& sweep) {
+std::string semanticKittiLabelBytes(const LidarSweep& sweep) {
+    std::string s;
+    s.reserve(sweep.points.size() * 4);
+    for (const LidarPoint& p : sweep.points)
+        put(s, uint32_t(semanticKittiInstance(p.instance)) << 16 | uint32_t(semanticKittiClass(p.semantic)));
+    return s;
+}
+
+std::string vistaLabelBytes(const LidarSweep& sweep) {
     std::string s;
     s.reserve(sweep.points.size() * 4);
     for (const LidarPoint& p : sweep.points) put(s, uint32_t(p.semantic));
+    return s;
+}
+
+std::string lidarTimeBytes(const LidarSweep& sweep) {
+    std::string s;
+    s.reserve(sweep.points.size() * 4);
+    for (const LidarPoint& p : sweep.points) put(s, p.time);
+    return s;
+}
+
+namespace {
+
+// SemanticKITTI's ids, names and BGR colours (semantic-kitti.yaml) for the classes vista writes.
+struct SkClass {
+    uint16_t id;
+    const char* name;
+    int b, g, r;
+};
+constexpr SkClass kSkClasses[] = {
+    {0, "unlabeled", 0, 0, 0},     {10, "car", 245, 150, 100},     {40, "road", 255, 0, 255},
+    {48, "sidewalk", 75, 0, 75},   {50, "building", 0, 200, 255},  {60, "lane-marking", 170, 255, 150},
+    {70, "vegetation", 0, 175, 0}, {71, "trunk", 0, 60, 135},      {72, "terrain", 80, 240, 150},
+    {80, "pole", 150, 240, 255},   {81, "traffic-sign", 0, 0, 255}};
+// By vista class (citygen/labels.h SemanticClass order).
+constexpr uint16_t kVistaToSk[kSemanticClassCount] = {0, 72, 40, 60, 48, 72, 50, 50, 50, 71, 70, 80, 80, 81, 10};
+
+}  // namespace
+
+uint16_t semanticKittiClass(uint8_t vistaClass) {
+    return vistaClass < kSemanticClassCount ? kVistaToSk[vistaClass] : 0;
+}
+
+uint16_t semanticKittiInstance(uint32_t id) {
+    if (id == 0 || !isObjectKind(instanceKind(id))) return 0;
+    return uint16_t((11u * uint64_t(instanceIndex(id)) + uint32_t(instanceKind(id))) % 65535u + 1u);
+}
+
+std::string semanticKittiYaml() {
+    std::string s =
+        "# SemanticKITTI label mapping of a vista rig run: labels/*.label hold these ids (lower 16 bits)\n"
+        "# and the instance (upper 16 bits); keys as in the SemanticKITTI API's semantic-kitti.yaml.\n"
+        "labels:\n";
+    char b[96];
+    for (const SkClass& c : kSkClasses) std::snprintf(b, sizeof b, "  %u: \"%s\"\n", unsigned(c.id), c.name), s += b;
+    s += "color_map: # bgr\n";
+    for (const SkClass& c : kSkClasses)
+        std::snprintf(b, sizeof b, "  %u: [%d, %d, %d]\n", unsigned(c.id), c.b, c.g, c.r), s += b;
+    s += "vista_to_semantic_kitti:\n";
+    for (int i = 0; i < kSemanticClassCount; ++i)
+        std::snprintf(b, sizeof b, "  %d: %u\n", i, unsigned(kVistaToSk[i])), s += b;
+    s += "vista_classes:\n";
+    for (int i = 0; i < kSemanticClassCount; ++i)
+        std::snprintf(b, sizeof b, "  %d: \"%s\"\n", i, semanticClassName(SemanticClass(i))), s += b;
     return s;
 }
 
@@ -90,47 +155,85 @@ RowMajor4 cameraToWorld(const RigPose& pose, const glm::dvec3& offset) {
     return rows(pose.rotation * cvInBody(), pose.position - offset);
 }
 
-std::string kittiCalib(const Rig& rig) {
-    const RigCamera* ref = nullptr;
-    for (const RigCamera& c : rig.cameras)
-        if (!c.model.fisheye()) {
-            ref = &c;
-            break;
-        }
-    if (!ref) return "";
-    // Everything in the vehicle frame; the reference camera's cv frame: Rref^T (p - tref).
-    const glm::dmat3 refRot = mountRotation(ref->mount) * cvInBody();
-    const glm::dvec3 refPos = ref->mount.position;
-    std::string out;
-    for (size_t k = 0; k < rig.cameras.size(); ++k) {
-        const RigCamera& c = rig.cameras[k];
-        if (c.model.fisheye()) continue;
-        const glm::dmat3 rot = mountRotation(c.mount) * cvInBody();
-        // ref cv -> vehicle -> camera k cv.
-        const glm::dmat3 R = glm::transpose(rot) * refRot;
-        const glm::dvec3 t = glm::transpose(rot) * (refPos - c.mount.position);
-        const CameraModel& m = c.model;
-        const double K[3][3] = {{m.fx, 0, m.cx}, {0, m.fy, m.cy}, {0, 0, 1}};
-        double P[12];
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 4; ++j) {
-                double v = 0;
-                for (int l = 0; l < 3; ++l) v += K[i][l] * (j < 3 ? R[j][l] : t[l]);
-                P[i * 4 + j] = v;
-            }
-        out += line(("P" + std::to_string(k)).c_str(), P);
+SensorMount kittiRectifiedMount(const Rig& rig) {
+    VISTA_CHECK(!rig.cameras.empty());
+    SensorMount m;
+    m.position = rig.cameras.front().mount.position;
+    m.yawDeg = rig.cameras.front().mount.yawDeg;
+    return m;
+}
+
+namespace {
+
+// Rows of a 3x4 [R | t] (R given column-major, as glm stores it).
+void rowsOf(const glm::dmat3& R, const glm::dvec3& t, double (&out)[12]) {
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) out[i * 4 + j] = R[j][i];
+        out[i * 4 + 3] = t[i];
     }
-    if (!rig.lidars.empty()) {
-        const RigLidar& l = rig.lidars.front();
-        // lidar body -> vehicle -> reference cv.
-        const glm::dmat3 R = glm::transpose(refRot) * mountRotation(l.mount);
-        const glm::dvec3 t = glm::transpose(refRot) * (l.mount.position - refPos);
-        double T[12];
-        for (int i = 0; i < 3; ++i) {
-            for (int j = 0; j < 3; ++j) T[i * 4 + j] = R[j][i];
-            T[i * 4 + 3] = t[i];
+}
+
+// Camera k's P: K [R | t] with [R | t] the rectified frame to camera k's OpenCV frame.
+void projection(const RigCamera& c, const glm::dmat3& rectRot, const glm::dvec3& rectPos, double (&P)[12]) {
+    const glm::dmat3 rot = mountRotation(c.mount) * cvInBody();
+    double Rt[12];
+    rowsOf(glm::transpose(rot) * rectRot, glm::transpose(rot) * (rectPos - c.mount.position), Rt);
+    const CameraModel& m = c.model;
+    const double K[3][3] = {{m.fx, 0, m.cx}, {0, m.fy, m.cy}, {0, 0, 1}};
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 4; ++j) {
+            double v = 0;
+            for (int l = 0; l < 3; ++l) v += K[i][l] * Rt[l * 4 + j];
+            P[i * 4 + j] = v;
         }
-        out += line("Tr_velo_to_cam", T);
+}
+
+}  // namespace
+
+std::string kittiCalib(const Rig& rig) {
+    if (rig.cameras.empty()) return "";
+    // Everything in the vehicle frame. Reference camera: camera 0; rectified frame: it, levelled.
+    const SensorMount rect = kittiRectifiedMount(rig);
+    const glm::dmat3 rectRot = mountRotation(rect) * cvInBody();
+    const glm::dmat3 refRot = mountRotation(rig.cameras.front().mount) * cvInBody();
+    const glm::dvec3 refPos = rect.position;
+    std::string out;
+    const size_t nP = std::max<size_t>(4, rig.cameras.size());
+    std::string extraP;
+    for (size_t k = 0; k < nP; ++k) {
+        double P[12] = {};
+        if (k < rig.cameras.size()) projection(rig.cameras[k], rectRot, refPos, P);
+        (k < 4 ? out : extraP) += line(("P" + std::to_string(k)).c_str(), P);
+    }
+    {
+        const glm::dmat3 R = glm::transpose(rectRot) * refRot;
+        std::string r0 = "R0_rect:";
+        char b[32];
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) std::snprintf(b, sizeof b, " %.12e", R[j][i]), r0 += b;
+        out += r0 + "\n";
+    }
+    // A LiDAR's frame (the vehicle frame without one) to the reference camera's.
+    const auto veloToCam = [&](const glm::dmat3& rot, const glm::dvec3& pos, double(&T)[12]) {
+        rowsOf(glm::transpose(refRot) * rot, glm::transpose(refRot) * (pos - refPos), T);
+    };
+    double T[12], I[12];
+    if (rig.lidars.empty()) {
+        veloToCam(glm::dmat3(1.0), glm::dvec3(0.0), T);
+        rowsOf(glm::dmat3(1.0), glm::dvec3(0.0), I);
+    } else {
+        const SensorMount& l = rig.lidars.front().mount;
+        const glm::dmat3 lr = mountRotation(l);
+        veloToCam(lr, l.position, T);
+        rowsOf(glm::transpose(lr), -(glm::transpose(lr) * l.position), I);
+    }
+    out += line("Tr_velo_to_cam", T);
+    out += line("Tr_imu_to_velo", I);
+    out += extraP;
+    for (size_t j = 1; j < rig.lidars.size(); ++j) {
+        const SensorMount& l = rig.lidars[j].mount;
+        veloToCam(mountRotation(l), l.position, T);
+        out += line(("Tr_velo_" + std::to_string(j) + "_to_cam").c_str(), T);
     }
     return out;
 }

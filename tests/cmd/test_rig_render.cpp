@@ -93,16 +93,23 @@ TEST_F(RigRender, SensorsWriteAtTheirRatesInTheKittiLayout) {
         EXPECT_EQ(bin.size() % 16, 0u);
         EXPECT_EQ(label.size() * 4, bin.size()) << "one label per point";
         EXPECT_EQ(test::readBytes(out + "/lidar_instance/" + name + ".bin").size(), label.size());
+        EXPECT_EQ(test::readBytes(out + "/labels_vista/" + name + ".label").size(), label.size());
+        EXPECT_EQ(test::readBytes(out + "/velodyne_time/" + name + ".bin").size(), label.size()) << "a time per point";
         const std::string flo = test::readBytes(out + "/flow_00/" + name + ".flo");
         EXPECT_EQ(flo.size(), 12u + 64u * 48u * 8u);
         EXPECT_EQ(flo.substr(0, 4), "PIEH");
     }
-    for (const char* f : {"calib.txt", "times.txt", "classes.json", "rig.json", "summary.json"})
+    for (const char* f : {"calib.txt", "times.txt", "classes.json", "semantic-kitti.yaml", "rig.json", "summary.json"})
         EXPECT_TRUE(fs::exists(out + "/" + f)) << f;
     const std::string calib = test::readBytes(out + "/calib.txt");
-    EXPECT_EQ(calib.rfind("P0: ", 0), 0u) << calib;
-    EXPECT_NE(calib.find("Tr_velo_to_cam: "), std::string::npos);
-    EXPECT_EQ(calib.find("P1:"), std::string::npos) << "no P line for a fisheye";
+    // KITTI's seven lines in mmdetection3d's order; the fisheye's P1 is its pinhole equivalent, P2 and P3
+    // (no such cameras) are zeros.
+    std::vector<std::string> keys;
+    std::istringstream lines(calib);
+    for (std::string l; std::getline(lines, l);) keys.push_back(l.substr(0, l.find(':')));
+    EXPECT_EQ(keys, (std::vector<std::string>{"P0", "P1", "P2", "P3", "R0_rect", "Tr_velo_to_cam", "Tr_imu_to_velo"}))
+        << calib;
+    EXPECT_NE(calib.find("P2: 0.000000000000e+00 0.000000000000e+00"), std::string::npos) << calib;
     const auto summary = nlohmann::json::parse(test::readBytes(out + "/summary.json"));
     EXPECT_EQ(summary["sensors"]["front"]["firings"].get<int>(), 3);
     EXPECT_EQ(summary["sensors"]["left"]["firings"].get<int>(), 7);

@@ -4,7 +4,8 @@ Item ``i`` is frame ``NNNNNN`` (six digits): a dict with one entry per folder of
 that frame, keyed by the folder's name: images (``rgb``, ``image_NN``, ``semantic``, ``semantic_NN``)
 as uint8 tensors (H, W, 3) or (H, W); ``.npy`` channels (``depth``, ``*_NN``) as stored, instance ids (uint32 in the files) as int64, as torch
 has no uint32;
-``velodyne*`` as float32 (N, 4) (x, y, z, intensity), ``labels`` and ``lidar_instance`` as int64 (N,)
+``velodyne*`` as float32 (N, 4) (x, y, z, intensity), ``velodyne_time*`` as float32 (N,) (seconds since
+the sweep's start), ``labels`` (SemanticKITTI), ``labels_vista`` and ``lidar_instance`` as int64 (N,)
 per point; ``boxes_*`` as the parsed JSON. A sensor that did not fire at a frame has no entry. torch is
 imported when the Dataset is created (Debian's python3-torch); without it, items are numpy arrays.
 """
@@ -39,6 +40,8 @@ def _read(path):
         return _read_png(path)
     if ext == ".npy":
         return np.load(path)
+    if ext == ".bin" and folder.startswith("velodyne_time"):
+        return np.fromfile(path, dtype="<f4")
     if ext == ".bin" and folder.startswith("velodyne"):
         return np.fromfile(path, dtype="<f4").reshape(-1, 4)
     if ext in (".bin", ".label"):

@@ -41,8 +41,10 @@ def test_rig_fires_what_vista_render_rig_writes(cli_city, city, tmp_path):
             assert [int(b["u0"]), int(b["v0"]), int(b["u1"]), int(b["v1"])] == visible[int(b["id"])]
         velodyne = np.fromfile(out / "velodyne" / f"{name}.bin", dtype="<f4").reshape(-1, 4)
         assert lidar["points"].dtype == np.float32 and np.array_equal(lidar["points"], velodyne)
-        labels = np.fromfile(out / "labels" / f"{name}.label", dtype="<u4")
+        labels = np.fromfile(out / "labels_vista" / f"{name}.label", dtype="<u4")
         assert np.array_equal(lidar["semantic"].astype(np.uint32), labels)
+        times = np.fromfile(out / "velodyne_time" / f"{name}.bin", dtype="<f4")
+        assert np.array_equal(lidar["time"].astype(np.float32), times)
         assert np.all(np.diff(lidar["time"][lidar["beam"] == 0]) >= 0)  # per-point times along the sweep
         assert lidar["time"].max() < 0.1 + 1e-6  # one revolution at 10 Hz
 
@@ -61,3 +63,19 @@ def test_bad_rig_file_raises_naming_the_field(city, tmp_path):
     (tmp_path / "bad.json").write_text(json.dumps(bad))
     with pytest.raises(ValueError, match=r"rate_hz.*\(0, 1000\]"):
         vista.Rig(city, tmp_path / "bad.json")
+
+
+def test_dataset_reads_the_per_point_lidar_files(cli_city, tmp_path):
+    (tmp_path / "rig.json").write_text(json.dumps(RIG))
+    out = tmp_path / "out"
+    run_vista("render", cli_city / "city.osgb", "--rig", tmp_path / "rig.json", "--frames", 1, "--out", out, "-q")
+    item = vista.RenderDataset(out)[0]
+    n = len(np.fromfile(out / "velodyne" / "000000.bin", dtype="<f4")) // 4
+    times = np.asarray(item["velodyne_time"])
+    assert times.shape == (n,) and times.dtype == np.float32 and 0 <= times.min() and times.max() < 0.1
+    sk = np.asarray(item["labels"])
+    vista_classes = np.asarray(item["labels_vista"])
+    assert sk.shape == vista_classes.shape == (n,)
+    # Road points (vista class 2) are SemanticKITTI road (40) with no instance.
+    road = vista_classes == 2
+    assert road.any() and np.all(sk[road] == 40)

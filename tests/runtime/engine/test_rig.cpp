@@ -12,6 +12,7 @@
 #include <sstream>
 #include <string>
 
+#include "citygen/labels.h"
 #include "foundation/input_file.h"
 #include "foundation/units.h"
 #include "runtime/engine/rig.h"
@@ -225,9 +226,11 @@ TEST(Rig, KittiCalibMapsLidarPointsToThePixelsOfThePoses) {
         double v;
         while (l >> v) m[key].push_back(v);
     }
-    ASSERT_EQ(m.size(), 3u) << calib;  // P0, P1 (pinholes), Tr_velo_to_cam; no fisheye lines
-    ASSERT_TRUE(m.count("P0:") && m.count("P1:") && m.count("Tr_velo_to_cam:")) << calib;
-    // A point in the LiDAR frame -> reference camera -> P1 pixel equals its pixel through the poses.
+    ASSERT_EQ(m.size(), 7u) << calib;  // P0 .. P3, R0_rect, Tr_velo_to_cam, Tr_imu_to_velo
+    for (const char* k : {"P0:", "P1:", "P2:", "P3:", "Tr_velo_to_cam:", "Tr_imu_to_velo:"})
+        ASSERT_EQ(m[k].size(), 12u) << k << calib;
+    ASSERT_EQ(m["R0_rect:"].size(), 9u) << calib;
+    // A point in the LiDAR frame -> reference camera -> rectified -> P1 pixel equals its pixel through the poses.
     const RigPose vehicle = vehiclePose({0, {0, 0, 0}, 0.0, 0.0});
     const RigPose lidar = sensorPose(vehicle, rig->lidars[0].mount);
     const RigPose cam1 = sensorPose(vehicle, rig->cameras[1].mount);
@@ -236,13 +239,50 @@ TEST(Rig, KittiCalibMapsLidarPointsToThePixelsOfThePoses) {
     glm::dvec2 want;
     ASSERT_TRUE(projectWorld(rig->cameras[1].model, cam1, world, want));
     const auto& T = m["Tr_velo_to_cam:"];
+    const auto& R0 = m["R0_rect:"];
     const auto& P = m["P1:"];
-    double c[4] = {0, 0, 0, 1};
+    double c[3], r[3];
     for (int i = 0; i < 3; ++i) c[i] = T[i * 4] * pl.x + T[i * 4 + 1] * pl.y + T[i * 4 + 2] * pl.z + T[i * 4 + 3];
+    for (int i = 0; i < 3; ++i) r[i] = R0[i * 3] * c[0] + R0[i * 3 + 1] * c[1] + R0[i * 3 + 2] * c[2];
     double q[3];
-    for (int i = 0; i < 3; ++i) q[i] = P[i * 4] * c[0] + P[i * 4 + 1] * c[1] + P[i * 4 + 2] * c[2] + P[i * 4 + 3];
+    for (int i = 0; i < 3; ++i) q[i] = P[i * 4] * r[0] + P[i * 4 + 1] * r[1] + P[i * 4 + 2] * r[2] + P[i * 4 + 3];
     EXPECT_NEAR(q[0] / q[2], want.x, 1e-6);
     EXPECT_NEAR(q[1] / q[2], want.y, 1e-6);
+}
+
+TEST(Rig, KittiRectifiedFrameIsTheFirstCameraLevelled) {
+    // Camera 0 pitched and rolled: R0_rect turns its frame into one whose y is the vehicle's down
+    // and whose z is camera 0's heading in the vehicle's ground plane.
+    auto rig = parseRigJson(R"({"sensors": [
+      {"name": "c", "type": "pinhole", "pose": {"x": 1, "yaw_deg": 30, "pitch_deg": -10, "roll_deg": 5},
+       "intrinsics": {"width": 64, "height": 48, "fx": 50, "fy": 50, "cx": 31.5, "cy": 23.5}, "channels": ["rgb"]}]})",
+                            "rig.json");
+    ASSERT_TRUE(rig.isOk()) << rig.status().message();
+    const std::string calib = kittiCalib(*rig);
+    std::istringstream in(calib);
+    std::map<std::string, std::vector<double>> m;
+    for (std::string line; std::getline(in, line);) {
+        std::istringstream l(line);
+        std::string key;
+        l >> key;
+        for (double v; l >> v;) m[key].push_back(v);
+    }
+    ASSERT_EQ(m["R0_rect:"].size(), 9u) << calib;
+    // Without a LiDAR, Tr_velo_to_cam maps the vehicle frame: its rotation then R0_rect.
+    const auto& T = m["Tr_velo_to_cam:"];
+    const auto& R0 = m["R0_rect:"];
+    auto rectOf = [&](const glm::dvec3& v) {
+        double c[3], r[3];
+        for (int i = 0; i < 3; ++i) c[i] = T[i * 4] * v.x + T[i * 4 + 1] * v.y + T[i * 4 + 2] * v.z;
+        for (int i = 0; i < 3; ++i) r[i] = R0[i * 3] * c[0] + R0[i * 3 + 1] * c[1] + R0[i * 3 + 2] * c[2];
+        return glm::dvec3(r[0], r[1], r[2]);
+    };
+    const glm::dvec3 down = rectOf({0, 0, -1}), ahead = rectOf({std::cos(kPi / 6), std::sin(kPi / 6), 0});
+    EXPECT_NEAR(down.x, 0.0, 1e-9);
+    EXPECT_NEAR(down.y, 1.0, 1e-9);
+    EXPECT_NEAR(down.z, 0.0, 1e-9);
+    EXPECT_NEAR(ahead.z, 1.0, 1e-9);
+    EXPECT_NEAR(m["P1:"][0], 0.0, 0.0) << "no camera 1: zeros";
 }
 
 TEST(Rig, FileLayouts) {
@@ -262,7 +302,10 @@ TEST(Rig, FileLayouts) {
     p.semantic = 14;
     p.instance = (10u << 28) | 7u;
     s.points = {p, p};
-    const std::string bin = velodyneBytes(s), label = lidarLabelBytes(s), inst = lidarInstanceBytes(s);
+    p.time = 0.025f;
+    s.points = {p, p};
+    const std::string bin = velodyneBytes(s), label = vistaLabelBytes(s), inst = lidarInstanceBytes(s);
+    const std::string sk = semanticKittiLabelBytes(s), times = lidarTimeBytes(s);
     ASSERT_EQ(bin.size(), 32u);
     float xyzi[4];
     std::memcpy(xyzi, bin.data() + 16, 16);
@@ -273,4 +316,18 @@ TEST(Rig, FileLayouts) {
     std::memcpy(&i, inst.data() + 4, 4);
     EXPECT_EQ(l, 14u);
     EXPECT_EQ(i, p.instance);
+    // SemanticKITTI: car = 10 in the lower 16 bits; the instance ((11 * 7 + 10) mod 65535) + 1 above.
+    ASSERT_EQ(sk.size(), 8u);
+    std::memcpy(&l, sk.data() + 4, 4);
+    EXPECT_EQ(l & 0xFFFFu, 10u);
+    EXPECT_EQ(l >> 16, 88u);
+    float t = 0;
+    ASSERT_EQ(times.size(), 8u);
+    std::memcpy(&t, times.data() + 4, 4);
+    EXPECT_EQ(t, 0.025f);
+    // A road point: class 40, no instance.
+    EXPECT_EQ(semanticKittiClass(uint8_t(SemanticClass::Road)), 40u);
+    EXPECT_EQ(semanticKittiInstance((3u << 28) | 5u), 0u);
+    EXPECT_EQ(semanticKittiClass(200), 0u);
+    EXPECT_NE(semanticKittiYaml().find("  10: \"car\""), std::string::npos);
 }

@@ -8,13 +8,17 @@
 // visible pixel centre and every vertex inside the image circle projected
 // here, and the unoccluded pixel counts agree with rays cast here at the
 // instance alone; a box in the vehicle frame is the world box through the inverse of
-// the pose's 4x4 matrix, in the file too; sightings merge cameras and LiDARs.
+// the pose's 4x4 matrix, in the file too; sightings merge cameras and LiDARs;
+// KITTI label lines read back with the devkit's corners hold the world box
+// (equal to it for a level vehicle) and carry the instance id.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <memory>
+#include <sstream>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
@@ -311,4 +315,66 @@ TEST(RigBoxes, VehicleFrameBoxesAreTheWorldBoxesThroughThePose) {
         EXPECT_NEAR(fromFile[i], c[i], 2e-3);
     }
     EXPECT_NEAR(jb["vehicle"]["yaw"].get<double>(), yaw, 1e-3);
+}
+
+// KITTI label lines of a rig (kittiRigLabels) read back the KITTI devkit's way: corners of length
+// along x turned by rotation_y about y, height up (-y), width along z, from the bottom centre.
+TEST(RigBoxes, KittiLabelsAreUprightInTheRectifiedFrameAndHoldTheWorldBox) {
+    OrientedBox b;
+    b.center = {12.0, 31.0, 0.9};
+    b.size = {4.4, 1.8, 1.5};
+    b.yaw = -0.7;
+    FrameBox f;
+    f.id = makeInstanceId(InstanceKind::Car, 7);
+    f.box = b;
+    f.visibleFraction = 0.5;
+    for (double pitch : {0.0, 0.06}) {
+        PathSample s;
+        s.position = {2.0, 3.0, 1.2};
+        s.heading = 1.1;
+        s.pitch = pitch;
+        SensorMount rect;
+        rect.position = {0.3, 0.1, 0.4};
+        rect.yawDeg = 20;
+        const RigPose pose = sensorPose(vehiclePose(s), rect);
+        const std::string text = kittiRigLabels({f}, pose);
+        std::istringstream in(text);
+        std::string type;
+        double trunc, alpha, bb[4], h, w, l, x, y, z, ry;
+        int occluded;
+        uint32_t id = 0;
+        in >> type >> trunc >> occluded >> alpha >> bb[0] >> bb[1] >> bb[2] >> bb[3] >> h >> w >> l >> x >> y >> z >>
+            ry >> id;
+        ASSERT_FALSE(in.fail()) << text;
+        EXPECT_EQ(type, "Car");
+        EXPECT_EQ(occluded, 1);
+        EXPECT_EQ(id, f.id) << "the 16th column is the instance id";
+        // The world box's corners in the rectified frame (OpenCV axes of the pose: -y, -z, x).
+        const glm::dmat3 axes(-pose.rotation[1], -pose.rotation[2], pose.rotation[0]);
+        const double c = std::cos(ry), sn = std::sin(ry);
+        double worst = 0, nearest = 0;
+        for (const glm::dvec3& corner : b.corners()) {
+            const glm::dvec3 p = glm::transpose(axes) * (corner - pose.position) - glm::dvec3(x, y, z);
+            // Into the label box's frame: R_y^T p.
+            const glm::dvec3 q(c * p.x - sn * p.z, p.y, sn * p.x + c * p.z);
+            worst = std::max({worst, std::abs(q.x) - l / 2, q.y, -h - q.y, std::abs(q.z) - w / 2});
+            // Distance to the nearest label corner (the devkit's corners, in the same box frame).
+            double best = 1e9;
+            for (double sx : {-0.5, 0.5})
+                for (double sy : {0.0, -1.0})
+                    for (double sz : {-0.5, 0.5})
+                        best = std::min(best, glm::length(q - glm::dvec3(sx * l, sy * h, sz * w)));
+            nearest = std::max(nearest, best);
+        }
+        EXPECT_LE(worst, 2e-3) << "every world corner inside the label box, pitch " << pitch;
+        if (pitch == 0.0) {
+            EXPECT_NEAR(h, 1.5, 1e-3);
+            EXPECT_NEAR(w, 1.8, 1e-3);
+            EXPECT_NEAR(l, 4.4, 1e-3);
+            EXPECT_LE(nearest, 3e-3) << "a level vehicle: the label box is the world box";
+        } else {
+            EXPECT_GT(h * w * l, 1.5 * 1.8 * 4.4) << "a pitched vehicle: a box around the tilted one";
+            EXPECT_LT(h * w * l, 1.3 * 1.5 * 1.8 * 4.4);
+        }
+    }
 }
