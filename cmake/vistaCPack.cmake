@@ -32,12 +32,13 @@ nlohmann-json3-dev, libpng-dev, zlib1g-dev, libbz2-dev, libexpat1-dev, libgl-dev
   set(CPACK_DEBIAN_PACKAGE_SUGGESTS "cmake (>= 3.20)")
 endif()
 # The Python module (cmd/python, when built) is compiled against this Python's ABI and returns numpy arrays.
-if(TARGET vista_python)
+get_property(_vista_py GLOBAL PROPERTY VISTA_PYTHON_VERSION)
+if(TARGET vista_python AND _vista_py)
   if(CPACK_DEBIAN_PACKAGE_DEPENDS)
     string(APPEND CPACK_DEBIAN_PACKAGE_DEPENDS ", ")
   endif()
   string(APPEND CPACK_DEBIAN_PACKAGE_DEPENDS
-    "python3 (>= ${Python3_VERSION_MAJOR}.${Python3_VERSION_MINOR}), python3 (<< ${Python3_VERSION_MAJOR}.${Python3_VERSION_MINOR}.99), python3-numpy")
+    "python3 (>= ${_vista_py}), python3 (<< ${_vista_py}.99), python3-numpy")
   if(CPACK_DEBIAN_PACKAGE_SUGGESTS)
     string(APPEND CPACK_DEBIAN_PACKAGE_SUGGESTS ", ")
   endif()
