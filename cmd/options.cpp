@@ -591,7 +591,7 @@ void addPagedStreamFlags(CLI::App& app, PagedStreamFlags& f) {
                  "resident, so frames do not depend on load timing");
     std::ostringstream help;
     help << "with a streamed paged city: also load the regions within reach of where the camera will be this many "
-            "seconds ahead along its velocity, 0 .. "
+            "seconds ahead along its velocity (at least: longer where loading is slower), 0 .. "
          << kMaxPagedPrefetchS << " (default " << kDefaultPagedPrefetchS << ")";
     addNumberOption(app, "--paged-prefetch", f.prefetchS, RealRange::closed(0, kMaxPagedPrefetchS), help.str());
 }

@@ -113,6 +113,8 @@ nlohmann::json pagedStreamJson(const RegionPagerOptions& o, const RegionPagerSta
     return {{"radius_m", o.radius},
             {"far_m", o.far},
             {"prefetch_s", o.prefetchS},
+            {"lookahead_s_max", s.peakLookaheadS},
+            {"full_load_s_max", s.fullLoadSMax},
             {"wait", o.wait},
             {"frames_deterministic", o.wait},
             {"budget_bytes", o.budgetBytes},

@@ -2,6 +2,7 @@
 #include "runtime/scene/region_pager.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <utility>
 
@@ -104,6 +105,7 @@ void RegionPager::workerLoop() {
         lock.unlock();
         Done done;
         done.job = job;
+        const auto start = std::chrono::steady_clock::now();
         done.model = loadPagedRegion(_m, job.region, job.coarse);
         if (done.model && _o.prepare) {
             RegionLoad load;
@@ -119,7 +121,13 @@ void RegionPager::workerLoop() {
         // 30-minute drive under 2 GB). On the worker, so no frame waits for it.
         if (_o.budgetBytes > 0) releaseFreeMemory();
         done.loader = std::this_thread::get_id();
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         lock.lock();
+        if (!job.coarse && !job.chunks && done.model) {
+            _fullLoadS.push_back(seconds);
+            if (_fullLoadS.size() > size_t(kLoadTimesKept)) _fullLoadS.pop_front();
+            _fullLoadSMax = std::max(_fullLoadSMax, seconds);
+        }
         --_busy;
         done.sequence = ++_finished;
         _done.push_back(std::move(done));
@@ -341,7 +349,16 @@ void RegionPager::schedule(RegionPagerDelta* delta) {
 void RegionPager::update(const glm::dvec3& eye, const glm::dvec3& velocity) {
     VISTA_CHECK(finite(eye) && finite(velocity));
     _eye = glm::dvec2(eye);
-    _ahead = _eye + glm::dvec2(velocity) * _o.prefetchS;
+    double lookahead = _o.prefetchS;
+    if (!_o.wait) {
+        std::lock_guard<std::mutex> lock(_mutex);
+        for (double s : _fullLoadS) lookahead = std::max(lookahead, kLookaheadLoads * s);
+        _stats.fullLoadSMax = _fullLoadSMax;
+    }
+    lookahead = std::min(lookahead, std::max(_o.prefetchS, kMaxPagedPrefetchS));
+    _stats.lookaheadS = lookahead;
+    _stats.peakLookaheadS = std::max(_stats.peakLookaheadS, lookahead);
+    _ahead = _eye + glm::dvec2(velocity) * lookahead;
     _haveEye = true;
     computeDesired();
     computeShortfall();

@@ -5,7 +5,13 @@
 // RayScene's regions, a scene graph) between frames.
 //
 // The desired set, from the last update(eye, velocity): the lookahead segment
-// runs from the eye to eye + velocity * prefetchS (xy only). Every non-empty
+// runs from the eye to eye + velocity * lookahead (xy only). The lookahead is
+// prefetchS, or longer where loading is slower: outside wait mode it is at
+// least kLookaheadLoads times the longest of the last kLoadTimesKept full-level
+// loads (read and prepare, wall time on the worker), so a region comes within
+// reach of the lookahead while there is still time to load it and the one
+// queued before it (stats().lookaheadS). Wait mode keeps prefetchS, so its
+// frames do not depend on load timing. Every non-empty
 // region whose bounds (manifest `bounds`, 2D) come within `radius` of that
 // segment is desired at full detail; every other region within `far` of it at
 // its coarse level (far <= radius: none). With prefetchS = 0 and a resting
@@ -100,6 +106,9 @@ namespace vista {
 // Default lookahead of --paged-prefetch, seconds along the velocity.
 constexpr double kDefaultPagedPrefetchS = 4.0;
 constexpr double kMaxPagedPrefetchS = 600.0;
+// The adaptive lookahead (above): loads of time it covers, and how many recent full loads it remembers.
+constexpr double kLookaheadLoads = 2.0;
+constexpr int kLoadTimesKept = 8;
 
 // What one load makes of a region's file (RegionPagerOptions::prepare).
 struct RegionLoad {
@@ -178,6 +187,9 @@ struct RegionPagerStats {
     int budgetLimited = 0;           // updates whose desired set the budget cut
     int residentFull = 0, residentCoarse = 0;  // levels held by the caller now
     int residentChunks = 0;                    // chunk parts held by the caller now
+    double lookaheadS = 0;                     // the last update()'s lookahead (seconds)
+    double peakLookaheadS = 0;                 // the longest lookahead of any update()
+    double fullLoadSMax = 0;                   // the longest full-level load (read and prepare), seconds
 };
 
 // RegionPager::cameraShortfall(): the budget cannot hold the regions at the camera.
@@ -275,6 +287,8 @@ private:
     std::condition_variable _work, _arrived;
     std::deque<Job> _queue;
     std::deque<Done> _done;
+    std::deque<double> _fullLoadS;  // the last kLoadTimesKept full-level loads, seconds
+    double _fullLoadSMax = 0;
     int _busy = 0;
     uint64_t _finished = 0;
     bool _stop = false;

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -180,6 +181,52 @@ TEST_F(Pager, PrefetchLoadsAheadOfTheHeadingFirst) {
     EXPECT_LT(seq[3], seq[2]) << "regions within reach of the eye before those wanted for the lookahead only";
     EXPECT_LT(seq[3], seq[8]);
     EXPECT_EQ(pager.stats().framesWaited, 0);
+}
+
+// Slow loads lengthen the lookahead (at least kLookaheadLoads times the longest recent full load),
+// so regions come within reach of it early enough; wait mode keeps --paged-prefetch.
+TEST_F(Pager, SlowLoadsLengthenTheLookahead) {
+    const double sleepS = 0.1;
+    for (bool wait : {false, true}) {
+        RegionPagerOptions o;
+        o.radius = 260;     // from the middle of region 4: itself and its four edge neighbours
+        o.far = 0;
+        o.prefetchS = 0.01;  // 1000 m/s east: 10 m ahead, short of the corner regions 2 and 8
+        o.workers = 1;
+        o.wait = wait;
+        o.prepare = [&](vista::SceneModel&, const vista::RegionLoad&) -> std::shared_ptr<void> {
+            std::this_thread::sleep_for(std::chrono::duration<double>(sleepS));
+            return nullptr;
+        };
+        RegionPager pager(manifest, o);
+        const glm::dvec3 v(1000.0, 0.0, 0.0);
+        pager.update(centre(4), v);
+        EXPECT_EQ(pager.desired()[8], 0) << "wait " << wait << ": no load measured yet";
+        EXPECT_EQ(pager.desired()[2], 0) << "wait " << wait;
+        std::map<int, int> held;
+        for (int tries = 0; tries < 20000 && !held.count(4); ++tries) {
+            auto d = pager.collect();
+            apply(d, held);
+            if (!held.count(4)) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        }
+        ASSERT_EQ(held.count(4), 1u);
+        pager.update(centre(4), v);
+        const auto s = pager.stats();
+        if (wait) {
+            EXPECT_DOUBLE_EQ(s.lookaheadS, o.prefetchS);
+            EXPECT_EQ(pager.desired()[8], 0);
+        } else {
+            // The corner of region 8 is (250, 250) m from the eye: within 260 m of the lookahead's
+            // end once it reaches 179 m, which 2 x 0.1 s at 1000 m/s (200 m) does.
+            EXPECT_GE(s.fullLoadSMax, sleepS);
+            EXPECT_GE(s.lookaheadS, vista::kLookaheadLoads * sleepS);
+            EXPECT_LE(s.lookaheadS, vista::kMaxPagedPrefetchS);
+            EXPECT_EQ(pager.desired()[8], 2) << "north-east: within reach of the longer lookahead";
+            EXPECT_EQ(pager.desired()[2], 2) << "south-east: within reach of the longer lookahead";
+            EXPECT_EQ(pager.desired()[6], 0) << "north-west: behind";
+        }
+        EXPECT_GE(s.peakLookaheadS, s.lookaheadS);
+    }
 }
 
 TEST_F(Pager, TheBudgetHoldsCoarseLevelsFirstThenTheRadiusShrinks) {
