@@ -189,7 +189,7 @@ TEST_F(Pager, SlowLoadsLengthenTheLookahead) {
     const double sleepS = 0.1;
     for (bool wait : {false, true}) {
         RegionPagerOptions o;
-        o.radius = 260;     // from the middle of region 4: itself and its four edge neighbours
+        o.radius = 260;  // from the middle of region 4: itself and its four edge neighbours
         o.far = 0;
         o.prefetchS = 0.01;  // 1000 m/s east: 10 m ahead, short of the corner regions 2 and 8
         o.workers = 1;
