@@ -26,6 +26,14 @@
 // around the whole path before the first frame instead. Instance ids
 // of a paged city are numbered per region (docs/formats.md "Paged city"): the
 // instance channel is not written for one.
+//
+// Past one machine (docs/formats.md "Shards", "Dataset manifest"): --shard K/N
+// renders a contiguous block of the frames (shardRange) into OUT.shards/K-of-N
+// with a record of its inputs and files (cmd/render_shards.h); hybrid first
+// renders the frames before its block without writing them, as a resume does.
+// --merge --shards N checks every shard and writes OUT. --dataset M.json
+// renders a drive per (city, path, rig) of a dataset manifest
+// (runtime/scene/dataset_manifest.h), sharded by whole drives.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
