@@ -12,7 +12,7 @@ cd "$(dirname "$0")/.."
 BUILD="${VISTA_FUZZ_BUILD_DIR:-build-fuzz}"
 SECONDS_EACH="${FUZZ_SECONDS:-60}"
 OUT="${FUZZ_OUT:-$BUILD/fuzz-results}"
-ALL="fuzz_params fuzz_street_graph fuzz_path_csv fuzz_cell_result fuzz_osm fuzz_scene_file fuzz_baked_file fuzz_ray_set fuzz_rig fuzz_fcd fuzz_paged_manifest"
+ALL="fuzz_params fuzz_street_graph fuzz_path_csv fuzz_cell_result fuzz_osm fuzz_scene_file fuzz_baked_file fuzz_ray_set fuzz_rig fuzz_fcd fuzz_paged_manifest fuzz_dataset_manifest"
 TARGETS="${*:-$ALL}"
 command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ not found (apt-get install clang)" >&2; exit 2; }
 cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \

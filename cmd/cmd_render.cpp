@@ -26,11 +26,22 @@
 // around the whole path before the first frame instead. Instance ids
 // of a paged city are numbered per region (docs/formats.md "Paged city"): the
 // instance channel is not written for one.
+//
+// Past one machine (docs/formats.md "Shards", "Dataset manifest"): --shard K/N
+// renders a contiguous block of the frames (shardRange) into OUT.shards/K-of-N
+// with a record of its inputs and files (cmd/render_shards.h); hybrid first
+// renders the frames before its block without writing them, as a resume does.
+// --merge --shards N checks every shard and writes OUT. --dataset M.json
+// renders a drive per (city, path, rig) of a dataset manifest
+// (runtime/scene/dataset_manifest.h), sharded by whole drives.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <memory>
+#include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -50,11 +61,15 @@
 #include "cmd/options.h"
 #include "cmd/paged_stream.h"
 #include "cmd/render_rig.h"
+#include "cmd/render_shards.h"
 #include "cmd/render_shared.h"
 #include "cmd/render_work_dir.h"
 #include "foundation/atomic_file.h"
+#include "foundation/format.h"
 #include "foundation/hash.h"
+#include "foundation/number_text.h"
 #include "foundation/progress.h"
+#include "foundation/shard.h"
 #include "foundation/statistics.h"
 #include "foundation/timing.h"
 #include "foundation/units.h"
@@ -65,7 +80,10 @@
 #include "runtime/engine/ground_truth.h"
 #include "runtime/engine/ray_scene.h"
 #include "nodes/render/walkthrough.h"
+#include "runtime/scene/dataset_manifest.h"
 #include "runtime/scene/paged_load.h"
+#include "runtime/scene/paths.h"
+#include "runtime/engine/rig.h"
 #include "runtime/scene/scene_graph.h"
 
 namespace vista {
@@ -88,6 +106,12 @@ struct RenderArgs {
     double fov = 60, memoryBudgetGb = 0;
     bool repeats = false;  // --allow-repeated-frames
     bool stats = false, quiet = false, restart = false, channelsGiven = false;
+    // --shard K/N: this run renders frames shardRange(frames, shard) into
+    // shardDir(out, shard); --merge --shards N assembles the N shards into out.
+    std::string shard;
+    std::optional<int> shards;
+    bool merge = false;
+    std::string dataset;  // --dataset M.json
     PathFlags path;
     ModeFlags modeFlags;
     PagedReach paged;
@@ -140,6 +164,17 @@ struct Timings {
             put("far_label_pixels", t.farPixels);
         return r;
     }
+    // summary.json's median_ms.
+    static nlohmann::json medians(const Timings& t) {
+        return {{"rgb", medianOf(t.rgb)},
+                {"labels_raster_pass", medianOf(t.labelRaster)},
+                {"labels_far_rays", medianOf(t.labelRays)},
+                {"labels_total", medianOf(t.labels)},
+                {"write_rgb", medianOf(t.writeRgb)},
+                {"write_depth", medianOf(t.writeDepth)},
+                {"write_semantic", medianOf(t.writeSemantic)},
+                {"write_instance", medianOf(t.writeInstance)}};
+    }
     void add(const nlohmann::json& r) {
         auto get = [&](const char* k, std::vector<double>& v) {
             if (r.contains(k) && r[k].is_number()) v.push_back(r[k].get<double>());
@@ -175,6 +210,8 @@ struct RenderPlan {
     double memoryBudgetGb = 0;                     // --memory-budget (0 = none)
     RegionPagerOptions stream;                     // streamed
     CommandFiles files;                            // checked by configure; holds the output's lock for the run
+    std::optional<Shard> shard;                    // --shard K/N
+    std::string outDir;                            // where this run publishes: --out, or the shard's directory
     std::shared_ptr<const TrafficTracks> traffic;  // --traffic (null: none)
     bool labels() const { return (channels & kLabelChannels) != 0; }
 };
@@ -238,7 +275,17 @@ Status configure(const RenderArgs& a, RenderPlan& p) {
     auto po = parsePathFlags(a.path);
     if (!po) return po.status();
     p.path = *po;
-    VISTA_RETURN_IF_ERROR(checkRunFiles(p.files.outputDirectory("--out", a.out, true), a.city, a.path, a.modeFlags));
+    p.outDir = a.out;
+    if (!a.shard.empty()) {
+        auto sh = parseShard("--shard", a.shard);
+        if (!sh) return sh.status();
+        p.shard = *sh;
+        VISTA_RETURN_IF_ERROR(RenderWorkDir::checkParent(a.out));
+        p.outDir = shardDir(a.out, *sh);
+    }
+    // A shard's directory sits in OUT.shards, which the first shard creates.
+    VISTA_RETURN_IF_ERROR(
+        checkRunFiles(p.files.outputDirectory("--out", p.outDir, !p.shard), a.city, a.path, a.modeFlags));
     VISTA_RETURN_IF_ERROR(configurePaged(a, p));
     auto tracks = loadTrafficFlag(a.modeFlags.traffic);
     if (!tracks) return tracks.status();
@@ -293,20 +340,12 @@ Result<std::string> cityHash(const std::string& city, bool paged, uint64_t& byte
     return fileHash(paged ? (fs::path(city) / "manifest.json").string() : city, bytes);
 }
 
-// The work directory: new, or the one of an interrupted run with the same
-// parameters (the manifest: city bytes, camera poses, every option that
-// changes a pixel), with a folder per channel.
-Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, const std::vector<size_t>& idx,
-                   RenderWorkDir& out) {
-    uint64_t cityBytes = 0;
-    auto hash = cityHash(a.city, p.paged, cityBytes);
-    if (!hash) return hash.status();
+// What decides the bytes besides the city and the path: every option that
+// changes a pixel (and the traffic's tracks). A merge compares it with the
+// shards' inputs without loading the city.
+nlohmann::json optionsManifest(const RenderArgs& a, const RenderPlan& p) {
     const ModeOptions& mo = p.options;
-    nlohmann::json manifest = {{"city_hash", *hash},
-                               {"city_bytes", cityBytes},
-                               {"frames", idx.size()},
-                               {"camera_poses_hash", posesHash(path, idx)},
-                               {"size", std::to_string(p.size.width) + "x" + std::to_string(p.size.height)},
+    nlohmann::json manifest = {{"size", std::to_string(p.size.width) + "x" + std::to_string(p.size.height)},
                                {"fov_deg", manifestNumber(p.fovDeg)},
                                {"mode", a.mode},
                                {"channels", channelList(p.channels)},
@@ -322,6 +361,23 @@ Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, c
         // The agents' poses decide pixels: a resumed run must draw the same traffic.
         manifest["traffic_hash"] = trafficHash(*p.traffic);
     }
+    return manifest;
+}
+
+// The work directory: new, or the one of an interrupted run with the same
+// parameters (the manifest: city bytes, camera poses, every option that
+// changes a pixel; a shard's K/N), with a folder per channel. `inputs`
+// receives the manifest without the shard (a shard's record carries it).
+Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, const std::vector<size_t>& idx,
+                   RenderWorkDir& out, nlohmann::json& inputs) {
+    uint64_t cityBytes = 0;
+    auto hash = cityHash(a.city, p.paged, cityBytes);
+    if (!hash) return hash.status();
+    nlohmann::json manifest = optionsManifest(a, p);
+    manifest["city_hash"] = *hash;
+    manifest["city_bytes"] = cityBytes;
+    manifest["frames"] = idx.size();
+    manifest["camera_poses_hash"] = posesHash(path, idx);
     if (p.paged) {
         // What decides the regions a frame sees.
         const bool streamed = p.streamed;
@@ -332,6 +388,8 @@ Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, c
                              {"prefetch", manifestNumber(streamed ? p.stream.prefetchS : 0.0)},
                              {"budget_bytes", streamed ? p.stream.budgetBytes : 0}};
     }
+    inputs = manifest;
+    if (p.shard) manifest["shard"] = shardText(*p.shard);
     VISTA_RETURN_IF_ERROR(out.open(manifest, a.restart));
     for (const auto& [bit, dir] : kChannelDirs)
         if (p.channels & bit) VISTA_RETURN_IF_ERROR(out.subdir(dir));
@@ -401,10 +459,11 @@ std::vector<std::string> frameFiles(unsigned channels, const std::string& name) 
 }
 
 // A finished frame is kept only when its files still have the sizes and hashes its record gives.
-Progressed finishedFrames(const RenderWorkDir& out, unsigned channels, size_t frames) {
+// Frames outside `range` (another shard's) stay null and are not missing.
+Progressed finishedFrames(const RenderWorkDir& out, unsigned channels, size_t frames, ShardRange range) {
     Progressed r;
     r.records.resize(frames);
-    for (size_t f = 0; f < frames; ++f) {
+    for (size_t f = range.begin; f < range.end; ++f) {
         if (out.resumed()) {
             r.records[f] = out.frameRecord(f);
             if (!r.records[f].is_null() && !out.frameIntact(r.records[f], frameFiles(channels, frameName(f))))
@@ -468,8 +527,10 @@ Status writeFrameFiles(unsigned channels, const std::string& name, const FrameBu
 // Renders every frame still missing (and hybrid's warm-up frames), writes
 // its files and record; `frames` receives every frame's camera entry of
 // cameras.json.
+// A shard writes the frames of `range` only; hybrid renders the frames before
+// it too (its warm-up), so that its cache holds what one whole run's held.
 Status renderFrames(const RenderArgs& a, const RenderPlan& p, const Walkthrough& w, const std::vector<size_t>& idx,
-                    RenderSession& s, RenderWorkDir& out, Progressed& done, nlohmann::json& frames) {
+                    ShardRange range, RenderSession& s, RenderWorkDir& out, Progressed& done, nlohmann::json& frames) {
     std::unique_ptr<Progress> progress;
     if (!a.quiet) progress = std::make_unique<StderrProgress>(isatty(2));
     const bool stateful = a.mode == "hybrid";
@@ -493,7 +554,7 @@ Status renderFrames(const RenderArgs& a, const RenderPlan& p, const Walkthrough&
                           {"heading_deg", radToDeg(ps.heading)},
                           {"pitch_deg", radToDeg(ps.pitch)},
                           {"camera_from_world", cameraFromWorld(cam, offset)}});
-        const bool finished = !done.records[f].is_null();
+        const bool finished = !range.contains(f) || !done.records[f].is_null();
         if (finished && !(stateful && long(f) < done.lastMissing)) continue;
         FrameStats st;
         VISTA_RETURN_IF_ERROR(advanceStream(s, w.path, idx[f], cam, !streamStarted));
@@ -517,8 +578,8 @@ Status renderFrames(const RenderArgs& a, const RenderPlan& p, const Walkthrough&
     return Status::ok();
 }
 
-// cameras.json, summary.json and classes.json, then the work directory
-// renamed to the output.
+// cameras.json, summary.json and classes.json (every shard writes the
+// cameras of every frame).
 Status writeMetadata(const RenderArgs& a, const RenderPlan& p, const std::string& command, const SceneModel& city,
                      const std::vector<size_t>& idx, const nlohmann::json& frames, const Timings& tm, size_t kept,
                      const nlohmann::json& paged, const OffscreenRenderer& renderer, RenderWorkDir& out) {
@@ -549,15 +610,7 @@ Status writeMetadata(const RenderArgs& a, const RenderPlan& p, const std::string
         {"height", base.height},
         {"channels", channelList(p.channels)},
         {"gl_renderer", renderer.glRenderer()},
-        {"median_ms",
-         {{"rgb", medianOf(tm.rgb)},
-          {"labels_raster_pass", medianOf(tm.labelRaster)},
-          {"labels_far_rays", medianOf(tm.labelRays)},
-          {"labels_total", medianOf(tm.labels)},
-          {"write_rgb", medianOf(tm.writeRgb)},
-          {"write_depth", medianOf(tm.writeDepth)},
-          {"write_semantic", medianOf(tm.writeSemantic)},
-          {"write_instance", medianOf(tm.writeInstance)}}},
+        {"median_ms", Timings::medians(tm)},
         {"median_far_label_pixels", medianOf(tm.farPixels)},
         {"frames_resumed", kept},
         {"note",
@@ -570,7 +623,7 @@ Status writeMetadata(const RenderArgs& a, const RenderPlan& p, const std::string
         VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(file), j->dump(2) + "\n"));
     }
     VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file("classes.json"), classesJson().dump(2) + "\n"));
-    return out.commit();
+    return Status::ok();
 }
 
 void printResult(const RenderArgs& a, const RenderPlan& p, size_t frames, const Timings& tm, const RenderWorkDir& out) {
@@ -591,26 +644,70 @@ void printResult(const RenderArgs& a, const RenderPlan& p, size_t frames, const 
     line("write instance", tm.writeInstance);
 }
 
+// A shard's directory that is already published: true (nothing to do) when
+// its record checks; a damaged one, or any with --restart, is removed and
+// rendered again. A directory without a record is left to checkOut.
+Result<bool> publishedShard(const std::string& dir, const Shard& shard, bool restart, bool quiet) {
+    std::error_code ec;
+    if (!fs::exists(fs::path(dir) / kShardRecordFile, ec)) return false;
+    auto r = readShardRecord(dir, shard);
+    if (r && !restart) return true;
+    if (!quiet)
+        std::fprintf(stderr, "%s: shard %s in '%s': %s; rendering it again\n", kCmd, shardText(shard).c_str(),
+                     dir.c_str(), r ? "--restart" : r.status().message().c_str());
+    fs::remove_all(dir, ec);
+    if (ec) return Status::error("--out: cannot remove '" + dir + "': " + ec.message());
+    return false;
+}
+
+// The record of a finished shard (render_shards.h): its inputs, its frames
+// [begin, end) and their records (timings, for the merged summary.json).
+Status writeFrameShardRecord(const RenderWorkDir& out, const Shard& shard, const nlohmann::json& inputs,
+                             ShardRange range, const Progressed& done) {
+    nlohmann::json records = nlohmann::json::array();
+    for (size_t f = range.begin; f < range.end; ++f) {
+        nlohmann::json r = done.records[f];
+        if (r.is_object()) r.erase("files");
+        records.push_back(r);
+    }
+    return writeShardRecord(out.file(""), shard,
+                            {{"inputs", inputs}, {"frames", {range.begin, range.end}}, {"frame_records", records}});
+}
+
 // The command's steps: options, display, city and path, work directory,
 // set-up, frames, metadata and commit; any failure (bad input, a write that
 // fails) is a message and exit 2, no display exit 1 before any work.
-// Finished frames stay in OUT.partial for the rerun.
+// Finished frames stay in OUT.partial for the rerun. A shard (--shard K/N)
+// writes its frames and its record into OUT.shards/K-of-N the same way.
 int run(const RenderArgs& a, const std::string& command) {
     RenderPlan plan;
     if (Status s = configure(a, plan); !s) return reportBadInput(kCmd, s);
+    if (plan.shard) {
+        auto published = publishedShard(plan.outDir, *plan.shard, a.restart, a.quiet);
+        if (!published) return reportBadInput(kCmd, published.status());
+        if (*published) {
+            if (!a.quiet)
+                std::fprintf(stderr, "%s: shard %s is done (%s)\n", kCmd, shardText(*plan.shard).c_str(),
+                             plan.outDir.c_str());
+            return 0;
+        }
+    }
     RenderWorkDir out;
-    if (Status s = out.checkOut(a.out); !s) return reportBadInput(kCmd, s);
+    if (Status s = out.checkOut(plan.outDir); !s) return reportBadInput(kCmd, s);
     if (int rc = requireDisplay(kCmd); rc >= 0) return rc;
     std::vector<size_t> idx;
     auto walk = loadCityAndFrames(a, plan, idx);
     if (!walk) return reportBadInput(kCmd, walk.status());
-    if (Status s = openWorkDir(a, plan, walk->path, idx, out); !s) return reportBadInput(kCmd, s);
+    nlohmann::json inputs;
+    if (Status s = openWorkDir(a, plan, walk->path, idx, out, inputs); !s) return reportBadInput(kCmd, s);
 
     RenderSession session;
     if (Status s = setUp(a.mode, plan, *walk, session); !s) return reportBadInput(kCmd, s);
-    Progressed done = finishedFrames(out, plan.channels, idx.size());
+    const ShardRange range = plan.shard ? shardRange(idx.size(), *plan.shard) : ShardRange{0, idx.size()};
+    Progressed done = finishedFrames(out, plan.channels, idx.size(), range);
     nlohmann::json frames = nlohmann::json::array();
-    if (Status s = renderFrames(a, plan, *walk, idx, session, out, done, frames); !s) return reportBadInput(kCmd, s);
+    if (Status s = renderFrames(a, plan, *walk, idx, range, session, out, done, frames); !s)
+        return reportBadInput(kCmd, s);
     Timings tm;  // every frame's, whichever run rendered it
     for (const auto& r : done.records) tm.add(r);
     nlohmann::json paged;  // summary.json paged: the regions loaded, or the stream's totals
@@ -623,7 +720,278 @@ int run(const RenderArgs& a, const std::string& command) {
             writeMetadata(a, plan, command, walk->city, idx, frames, tm, done.kept, paged, *session.gt.renderer, out);
         !s)
         return reportBadInput(kCmd, s);
-    printResult(a, plan, idx.size(), tm, out);
+    if (plan.shard)
+        if (Status s = writeFrameShardRecord(out, *plan.shard, inputs, range, done); !s)
+            return reportBadInput(kCmd, s);
+    if (Status s = out.commit(); !s) return reportBadInput(kCmd, s);
+    printResult(a, plan, range.size(), tm, out);
+    return 0;
+}
+
+// "key: A in shard 1/4, B in shard 3/4": the first field where two shards' inputs differ, "" if none.
+std::string inputsDifference(const nlohmann::json& a, const std::string& aName, const nlohmann::json& b,
+                             const std::string& bName) {
+    if (!a.is_object() || !b.is_object()) return "inputs: not an object";
+    auto shown = [](const nlohmann::json& o, const std::string& k) {
+        return o.contains(k) ? (o[k].is_string() ? o[k].get<std::string>() : o[k].dump()) : std::string("(none)");
+    };
+    for (const auto* o : {&a, &b})
+        for (const auto& [key, value] : o->items())
+            if (!a.contains(key) || !b.contains(key) || a[key] != b[key])
+                return key + ": " + shown(a, key) + " " + aName + ", " + shown(b, key) + " " + bName;
+    return "";
+}
+
+// The last step of a sharded render: `vista render CITY ... --out OUT --merge
+// --shards N` checks every shard (present, intact, the inputs the merge's own
+// arguments give, the frames its share) and writes OUT: the shards' files
+// and summary.json with every frame's timings.
+int runMerge(const RenderArgs& a, int count, const std::string& command, const std::string& rerun) {
+    RenderPlan plan;
+    if (Status s = configure(a, plan); !s) return reportBadInput(kCmd, s);
+    RenderWorkDir out;
+    if (Status s = out.checkOut(a.out); !s) return reportBadInput(kCmd, s);
+    uint64_t cityBytes = 0;
+    auto hash = cityHash(a.city, plan.paged, cityBytes);
+    if (!hash) return reportBadInput(kCmd, hash.status());
+    nlohmann::json expect = optionsManifest(a, plan);
+    expect["city_hash"] = *hash;
+    expect["city_bytes"] = cityBytes;
+    nlohmann::json first;  // the first good shard's inputs: frames, poses and the paged reach agree with it
+    std::string firstName;
+    auto differ = [&](const Shard& s, const nlohmann::json& r) -> std::string {
+        const nlohmann::json& in = r["inputs"];
+        if (!in.is_object() || !in.contains("frames") || !in["frames"].is_number_unsigned())
+            return "its inputs are not a render manifest";
+        nlohmann::json mine = nlohmann::json::object();
+        for (const auto& [key, value] : expect.items()) mine[key] = in.contains(key) ? in[key] : nlohmann::json();
+        if (std::string d = inputsDifference(mine, "in the shard", expect, "now"); !d.empty()) return d;
+        const ShardRange range = shardRange(in["frames"].get<size_t>(), s);
+        if (r["frames"] != nlohmann::json{range.begin, range.end} || !r.contains("frame_records") ||
+            r["frame_records"].size() != range.size())
+            return "frames " + r["frames"].dump() + ", not its share [" + std::to_string(range.begin) + ", " +
+                   std::to_string(range.end) + ")";
+        if (first.is_null()) first = in, firstName = "in shard " + shardText(s);
+        return inputsDifference(first, firstName, in, "in this shard");
+    };
+    auto records = readShards(a.out, count, differ, rerun);
+    if (!records) return reportBadInput(kCmd, records.status());
+    if (Status s = out.open({{"merge_shards", count}, {"inputs", first}}, true); !s) return reportBadInput(kCmd, s);
+    if (Status s = assembleShards(a.out, *records, out.file(""), {"summary.json"}); !s) return reportBadInput(kCmd, s);
+    // summary.json: the first shard's, with every frame's timings.
+    const std::string firstSummary = shardDir(a.out, Shard{0, count}) + "/summary.json";
+    std::ifstream in(firstSummary, std::ios::binary);
+    nlohmann::json summary = nlohmann::json::parse(in, nullptr, false);
+    if (summary.is_discarded() || !summary.is_object())
+        return reportBadInput(kCmd, Status::error("--merge: '" + firstSummary + "' is not a summary.json"));
+    Timings tm;
+    for (const auto& r : *records)
+        for (const auto& f : r["frame_records"]) tm.add(f);
+    summary["command"] = command;
+    summary["median_ms"] = Timings::medians(tm);
+    summary["median_far_label_pixels"] = medianOf(tm.farPixels);
+    summary["frames_resumed"] = 0;
+    summary["shards"] = count;
+    if (Status s = writeFileAtomic(out.file("summary.json"), summary.dump(2) + "\n"); !s)
+        return reportBadInput(kCmd, s);
+    if (Status s = out.commit(); !s) return reportBadInput(kCmd, s);
+    if (!a.quiet || a.stats)
+        std::printf("%s: merged %d shards, %zu frames -> %s\n", kCmd, count, first["frames"].get<size_t>(),
+                    out.outPath().c_str());
+    return 0;
+}
+
+// --- datasets (--dataset M.json) ---------------------------------------------
+
+PathFlags datasetPathFlags(const DatasetPath& p) {
+    PathFlags f;
+    f.file = p.file;
+    if (p.seed) f.seed = *p.seed;
+    if (p.kind) f.kind = *p.kind;
+    if (p.route) f.route = *p.route;
+    if (p.duration) f.duration = *p.duration;
+    if (p.runUp) f.runUp = *p.runUp;
+    if (p.lht) f.lht = *p.lht;
+    return f;
+}
+
+// The values whose ranges the render flags own, checked before any drive
+// renders; each error names the manifest's field.
+Status checkDatasetValues(const DatasetManifest& m, const std::string& source) {
+    auto err = [&](const std::string& field, const std::string& why) {
+        return Status::error("dataset '" + source + "': " + field + ": " + why);
+    };
+    for (size_t i = 0; i < m.paths.size(); ++i) {
+        const DatasetPath& p = m.paths[i];
+        const std::string field = "paths[" + std::to_string(i) + "]";
+        if (p.duration && !path_range::duration.contains(*p.duration))
+            return err(field + ".duration", shortNumber(*p.duration) + " out of range " + path_range::duration.text());
+        if (p.runUp && !path_range::runUp.contains(*p.runUp))
+            return err(field + ".run_up", shortNumber(*p.runUp) + " out of range " + path_range::runUp.text());
+        auto po = parsePathFlags(datasetPathFlags(p));
+        if (!po) return err(field, po.status().message());
+    }
+    for (size_t i = 0; i < m.rigs.size(); ++i) {
+        const DatasetRig& r = m.rigs[i];
+        const std::string field = "rigs[" + std::to_string(i) + "]";
+        if (!r.file.empty()) {
+            if (auto rig = loadRigFile(r.file); !rig) return err(field + ".file", rig.status().message());
+            continue;
+        }
+        if (r.size)
+            if (auto size = parseImageSize(*r.size); !size) return err(field + ".size", size.status().message());
+        if (r.fov)
+            if (Status s = checkFov(*r.fov); !s) return err(field + ".fov", s.message());
+        if (r.mode && *r.mode != "full" && *r.mode != "hybrid")
+            return err(field + ".mode", "'" + *r.mode + "': ground truth is rendered in full or hybrid");
+        if (r.channels)
+            if (auto c = parseChannels(*r.channels); !c) return err(field + ".channels", c.status().message());
+    }
+    if (m.options.sampling)
+        if (auto sm = parseSampling(*m.options.sampling); !sm) return err("options.sampling", sm.status().message());
+    return Status::ok();
+}
+
+// What decides a dataset's bytes: the manifest's content and every file it
+// names (a paged city: its manifest.json), keyed by the manifest's field.
+Result<nlohmann::json> datasetInputs(const std::string& file, const DatasetManifest& m) {
+    uint64_t bytes = 0;
+    auto h = fileHash(file, bytes);
+    if (!h) return Status::error("--dataset: " + h.status().message());
+    nlohmann::json in = {{"manifest_hash", *h}};
+    auto add = [&](const std::string& key, const std::string& path) -> Status {
+        auto fh = cityHash(path, isPagedCityPath(path), bytes);
+        if (!fh) return Status::error("dataset '" + file + "': " + key + ": " + fh.status().message());
+        in[key] = *fh;
+        return Status::ok();
+    };
+    for (size_t i = 0; i < m.cities.size(); ++i)
+        VISTA_RETURN_IF_ERROR(add("cities[" + std::to_string(i) + "].file", m.cities[i].file));
+    for (size_t i = 0; i < m.paths.size(); ++i)
+        if (!m.paths[i].file.empty())
+            VISTA_RETURN_IF_ERROR(add("paths[" + std::to_string(i) + "].file", m.paths[i].file));
+    for (size_t i = 0; i < m.rigs.size(); ++i)
+        if (!m.rigs[i].file.empty()) VISTA_RETURN_IF_ERROR(add("rigs[" + std::to_string(i) + "].file", m.rigs[i].file));
+    return in;
+}
+
+// One drive: a camera (run) or a sensor rig (runRigRender) into `out`, resumable as either is.
+int renderDrive(const RenderArgs& base, const DatasetManifest& m, const DatasetDrive& d, const std::string& out,
+                const std::string& command) {
+    const DatasetRig& rig = m.rigs[d.rig];
+    const DatasetOptions& o = m.options;
+    const std::string cmd = command + " (drive " + d.name + ")";
+    if (!rig.file.empty()) {
+        RigRunRequest r;
+        r.city = m.cities[d.city].file, r.rig = rig.file, r.out = out, r.command = cmd;
+        r.sampling = o.sampling.value_or(r.sampling), r.frames = o.frames.value_or(r.frames);
+        r.repeats = o.allowRepeatedFrames, r.stats = base.stats, r.quiet = base.quiet;
+        r.path = datasetPathFlags(m.paths[d.path]);
+        return runRigRender(r);
+    }
+    RenderArgs a;
+    a.city = m.cities[d.city].file, a.out = out, a.path = datasetPathFlags(m.paths[d.path]);
+    a.frames = o.frames.value_or(a.frames), a.sampling = o.sampling.value_or(a.sampling);
+    a.repeats = o.allowRepeatedFrames, a.stats = base.stats, a.quiet = base.quiet;
+    a.size = rig.size.value_or(a.size), a.fov = rig.fov.value_or(a.fov), a.mode = rig.mode.value_or(a.mode);
+    a.channels = rig.channels.value_or(a.channels), a.channelsGiven = rig.channels.has_value();
+    return run(a, cmd);
+}
+
+std::vector<std::string> driveNames(const std::vector<DatasetDrive>& drives, ShardRange range) {
+    std::vector<std::string> names;
+    for (size_t i = range.begin; i < range.end; ++i) names.push_back(drives[i].name);
+    return names;
+}
+
+// OUT from the dataset's shards: every drive's folder, and dataset.json.
+int mergeDataset(const RenderArgs& a, const DatasetManifest& m, const std::vector<DatasetDrive>& drives,
+                 const nlohmann::json& inputs, int count, const std::string& command, const std::string& rerun) {
+    RenderWorkDir out;
+    if (Status s = out.checkOut(a.out); !s) return reportBadInput(kCmd, s);
+    auto differ = [&](const Shard& s, const nlohmann::json& r) -> std::string {
+        if (std::string d = inputsDifference(r["inputs"], "in the shard", inputs, "now"); !d.empty()) return d;
+        const nlohmann::json expected = driveNames(drives, shardRange(drives.size(), s));
+        if (r.value("drives", nlohmann::json()) != expected)
+            return "drives " + r.value("drives", nlohmann::json()).dump() + ", not its share " + expected.dump();
+        return "";
+    };
+    auto records = readShards(a.out, count, differ, rerun);
+    if (!records) return reportBadInput(kCmd, records.status());
+    if (Status s = out.open({{"dataset_merge_shards", count}, {"inputs", inputs}}, true); !s)
+        return reportBadInput(kCmd, s);
+    if (Status s = assembleShards(a.out, *records, out.file(""), {}); !s) return reportBadInput(kCmd, s);
+    nlohmann::json list = nlohmann::json::array();
+    for (const DatasetDrive& d : drives)
+        list.push_back({{"name", d.name},
+                        {"city", m.cities[d.city].name},
+                        {"path", m.paths[d.path].name},
+                        {"rig", m.rigs[d.rig].name}});
+    const nlohmann::json dataset = {{"format", "vista dataset 1"}, {"inputs", inputs}, {"drives", list}};
+    if (Status s = writeFileAtomic(out.file("dataset.json"), dataset.dump(2) + "\n"); !s)
+        return reportBadInput(kCmd, s);
+    if (Status s = out.commit(); !s) return reportBadInput(kCmd, s);
+    if (!a.quiet || a.stats)
+        std::printf("%s: dataset of %zu drives from %d shard%s -> %s\n", kCmd, drives.size(), count,
+                    count == 1 ? "" : "s", out.outPath().c_str());
+    return 0;
+}
+
+// `vista render --dataset M.json --out OUT [--shard K/N | --merge --shards N]`:
+// shard K renders the drives shardRange(drives, K/N) (whole drives, each
+// resumable) into OUT.shards/K-of-N and records them; the merge assembles
+// OUT; without --shard the run is shard 1/1 and its merge, and the shard's
+// directory is removed once OUT is written.
+int runDataset(const RenderArgs& a, const std::string& command, const std::string& rerun) {
+    auto m = loadDatasetManifest(a.dataset);
+    if (!m) return reportBadInput(kCmd, m.status());
+    if (Status s = checkDatasetValues(*m, a.dataset); !s) return reportBadInput(kCmd, s);
+    if (Status s = RenderWorkDir::checkParent(a.out); !s) return reportBadInput(kCmd, s);
+    auto inputs = datasetInputs(a.dataset, *m);
+    if (!inputs) return reportBadInput(kCmd, inputs.status());
+    const std::vector<DatasetDrive> drives = m->drives();
+    if (a.merge) return mergeDataset(a, *m, drives, *inputs, *a.shards, command, rerun);
+    Shard shard;
+    if (!a.shard.empty()) {
+        auto sh = parseShard("--shard", a.shard);
+        if (!sh) return reportBadInput(kCmd, sh.status());
+        shard = *sh;
+    } else if (RenderWorkDir probe; Status s = probe.checkOut(a.out)) {
+    } else {
+        return reportBadInput(kCmd, s);
+    }
+    const std::string dir = shardDir(a.out, shard);
+    std::error_code ec;
+    if (a.restart) fs::remove_all(dir, ec);
+    auto published = publishedShard(dir, shard, false, a.quiet);
+    if (!published) return reportBadInput(kCmd, published.status());
+    const ShardRange range = shardRange(drives.size(), shard);
+    if (!*published) {
+        fs::create_directories(dir, ec);
+        if (ec) return reportBadInput(kCmd, Status::error("--out: cannot create '" + dir + "': " + ec.message()));
+        for (size_t i = range.begin; i < range.end; ++i) {
+            const std::string out = (fs::path(dir) / drives[i].name).string();
+            if (fs::exists(out, ec) && !fs::is_empty(out, ec)) continue;  // published by an earlier run
+            fs::create_directories(fs::path(out).parent_path(), ec);
+            if (ec) return reportBadInput(kCmd, Status::error("--out: cannot create '" + out + "': " + ec.message()));
+            if (int rc = renderDrive(a, *m, drives[i], out, command); rc != 0) {
+                std::fprintf(stderr, "%s: --dataset: drive %s (%zu of %zu, shard %s) failed; the same command resumes it\n",
+                             kCmd, drives[i].name.c_str(), i + 1, drives.size(), shardText(shard).c_str());
+                return rc;
+            }
+        }
+        if (Status s = writeShardRecord(dir, shard, {{"inputs", *inputs}, {"drives", driveNames(drives, range)}}); !s)
+            return reportBadInput(kCmd, s);
+    }
+    if (!a.shard.empty()) {
+        if (!a.quiet)
+            std::fprintf(stderr, "%s: shard %s: %zu of %zu drives in %s\n", kCmd, shardText(shard).c_str(),
+                         range.size(), drives.size(), dir.c_str());
+        return 0;
+    }
+    if (int rc = mergeDataset(a, *m, drives, *inputs, 1, command, rerun); rc != 0) return rc;
+    fs::remove_all(dir, ec);
+    fs::remove(fs::path(dir).parent_path(), ec);  // OUT.shards, when empty
     return 0;
 }
 
@@ -637,8 +1005,8 @@ int runRender(int argc, char** argv) {
     RenderArgs a;
     app.add_option("city", a.city,
                    "city scene file (.osgb) from `vista gen`, or a paged city directory (DIR.paged: streamed, "
-                   "every frame waiting for the regions within reach of its camera; channels rgb, depth, semantic)")
-        ->required();
+                   "every frame waiting for the regions within reach of its camera; channels rgb, depth, semantic); "
+                   "required unless --dataset");
     addPathFlags(app, a.path, true);
     addPagedFlags(app, a.paged);
     addPagedStreamFlags(app, a.stream);
@@ -672,11 +1040,54 @@ int runRender(int argc, char** argv) {
     app.add_flag("--stats", a.stats,
                  "print the median per-channel costs (with --rig: per-sensor ms and rig frames per second, on "
                  "stderr; also in OUT/summary.json)");
+    app.add_option("--dataset", a.dataset,
+                   "dataset manifest (JSON: cities x paths x rigs, plus options; docs/formats.md): renders a drive "
+                   "per (city, path, rig) into OUT/CITY/PATH/RIG and OUT/dataset.json; with --shard K/N, shard K "
+                   "renders its share of whole drives; no CITY and no flags but --out, --shard, --merge, --shards, "
+                   "--restart, --stats, -q");
+    app.add_option("--shard", a.shard,
+                   "shard K of N (K/N, 1 <= K <= N <= 100000): render only a contiguous block of the frames (of the "
+                   "drives, with --dataset) into OUT.shards/K-of-N (resumable); then --merge --shards N writes OUT");
+    app.add_flag("--merge", a.merge,
+                 "with --shards N and the shards' other arguments: check every shard in OUT.shards (present, intact, "
+                 "same inputs) and write OUT, the bytes of one unsharded run (summary.json aside)");
+    addNumberOption(app, "--shards", a.shards, 1, kMaxShards,
+                    "with --merge: N, 1 .. 100000, the shard count of the shards' --shard K/N; a merge that finds a "
+                    "shard missing, damaged or of other inputs names it and the command that runs it again");
     app.add_flag("-q,--quiet", a.quiet, "no progress on stderr");
     if (int rc = parseOrExit(app, argc, argv); rc >= 0) return rc;
     a.channelsGiven = app.count("--channels") > 0;
     std::string command = kCmd;
     for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
+    // The command that runs one shard again (the merge's arguments without --merge --shards N).
+    std::string rerun = kCmd;
+    for (int i = 1; i < argc; ++i) {
+        const std::string w = argv[i];
+        if (w == "--merge" || w.rfind("--shards=", 0) == 0) continue;
+        if (w == "--shards") {
+            ++i;
+            continue;
+        }
+        rerun += " " + shellWord(w);
+    }
+    rerun += " --shard";
+    if (a.merge && !a.shard.empty())
+        return reportBadInput(kCmd, Status::error("option --merge: not with --shard (the merge covers every shard)"));
+    if (a.merge && !a.shards)
+        return reportBadInput(kCmd, Status::error("option --merge: needs --shards N (the shards' --shard K/N)"));
+    if (a.shards && !a.merge)
+        return reportBadInput(kCmd, Status::error("option --shards: only with --merge (shards take --shard K/N)"));
+    if (!a.dataset.empty()) {
+        const std::set<std::string> allowed = {"--dataset", "--out", "--shard", "--merge", "--shards",
+                                               "--restart", "--stats", "--quiet"};
+        for (const CLI::Option* o : app.get_options())
+            if (o->count() > 0 && !allowed.count(o->get_name()))
+                return reportBadInput(kCmd, Status::error("option " + o->get_name() +
+                                                          " does not apply with --dataset: the manifest gives the "
+                                                          "cities, paths, rigs and options"));
+        return runDataset(a, command, rerun);
+    }
+    if (a.city.empty()) return reportBadInput(kCmd, Status::error("city: a city file is required (or --dataset)"));
     if (!a.rig.empty()) {
         for (const char* flag : {"--size", "--fov", "--mode", "--channels"})
             if (app.count(flag))
@@ -692,12 +1103,17 @@ int runRender(int argc, char** argv) {
                     kCmd, Status::error(std::string(flag) + " does not apply with --rig: a rig renders a city file, "
                                                             "not a paged city (its sensors' labels come from the "
                                                             "whole loaded city)"));
+        if (!a.shard.empty() || a.merge)
+            return reportBadInput(kCmd, Status::error(std::string(a.merge ? "--merge" : "--shard") +
+                                                      " does not apply with --rig: shard a dataset of rig drives "
+                                                      "(--dataset) by whole drives"));
         RigRunRequest r;
         r.city = a.city, r.rig = a.rig, r.out = a.out, r.command = command, r.sampling = a.sampling;
         r.frames = a.frames, r.repeats = a.repeats, r.stats = a.stats, r.quiet = a.quiet, r.restart = a.restart;
         r.path = a.path, r.modeFlags = a.modeFlags;
         return runRigRender(r);
     }
+    if (a.merge) return runMerge(a, *a.shards, command, rerun);
     return run(a, command);
 }
 

@@ -60,16 +60,11 @@ RenderWorkDir::~RenderWorkDir() {
     if (_lockFd >= 0) ::close(_lockFd);
 }
 
-Status RenderWorkDir::checkOut(const std::string& dir) {
+Status RenderWorkDir::checkParent(const std::string& dir) {
     fs::path out = fs::path(dir).lexically_normal();
     if (!out.has_filename()) out = out.parent_path();
     if (out.empty() || out == "." || out == "..") return Status::error("--out '" + dir + "': not a directory name");
     std::error_code ec;
-    if (fs::exists(out, ec)) {
-        if (!fs::is_directory(out, ec)) return Status::error("--out '" + dir + "' exists and is not a directory");
-        if (!fs::is_empty(out, ec))
-            return Status::error("--out '" + dir + "' exists and is not empty (choose a new directory)");
-    }
     const fs::path parent = out.has_parent_path() ? out.parent_path() : fs::path(".");
     if (!fs::exists(parent, ec))
         return Status::error("--out '" + dir + "': parent directory '" + parent.string() +
@@ -78,6 +73,19 @@ Status RenderWorkDir::checkOut(const std::string& dir) {
         return Status::error("--out '" + dir + "': parent '" + parent.string() + "' is not a directory");
     if (::access(parent.c_str(), W_OK) != 0)
         return Status::error("--out '" + dir + "': parent directory '" + parent.string() + "' is not writable");
+    return Status::ok();
+}
+
+Status RenderWorkDir::checkOut(const std::string& dir) {
+    VISTA_RETURN_IF_ERROR(checkParent(dir));
+    fs::path out = fs::path(dir).lexically_normal();
+    if (!out.has_filename()) out = out.parent_path();
+    std::error_code ec;
+    if (fs::exists(out, ec)) {
+        if (!fs::is_directory(out, ec)) return Status::error("--out '" + dir + "' exists and is not a directory");
+        if (!fs::is_empty(out, ec))
+            return Status::error("--out '" + dir + "' exists and is not empty (choose a new directory)");
+    }
     _outStr = out.string();
     _partialStr = _outStr + ".partial";
     return Status::ok();

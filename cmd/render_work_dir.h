@@ -50,6 +50,8 @@ public:
     ~RenderWorkDir();
 
     Status checkOut(const std::string& out);
+    // The part of checkOut() about OUT's parent (exists, a directory, writable).
+    static Status checkParent(const std::string& out);
     Status open(const nlohmann::json& manifest, bool restart);
     bool resumed() const { return _resumed; }
     const std::string& partialPath() const { return _partialStr; }

@@ -1,6 +1,8 @@
 // Shard "K/N" parsing (see shard.h).
 #include "foundation/shard.h"
 
+#include <cstdint>
+
 #include "foundation/number_text.h"
 
 namespace vista {
@@ -17,6 +19,13 @@ Result<Shard> parseShard(const std::string& option, const std::string& text) {
     auto k = parseUnsignedText("K", text.substr(0, slash), 1, *n);
     if (!k) return bad(k.status().message());
     return Shard{int(*k) - 1, int(*n)};
+}
+
+std::string shardText(const Shard& shard) { return std::to_string(shard.k()) + "/" + std::to_string(shard.count); }
+
+ShardRange shardRange(size_t total, const Shard& shard) {
+    const auto at = [&](int i) { return size_t(uint64_t(total) * uint64_t(i) / uint64_t(shard.count)); };
+    return {at(shard.index), at(shard.index + 1)};
 }
 
 }  // namespace vista

@@ -2,6 +2,7 @@
 # Submits a vista job array and its merge to Slurm:
 #   docs/jobs/slurm-submit.sh gen  N OUT.paged [vista gen args...]
 #   docs/jobs/slurm-submit.sh bake N OUT.baked.osgb CITY.osgb [vista bake args...]
+#   docs/jobs/slurm-submit.sh render N OUT --dataset M.json   (or: CITY [vista render args...])
 # OUT (and CITY) must be on storage every node sees, and so must this
 # directory (the merge calls this script to submit missing shards again).
 # The array runs shard K/N as task K; the merge (--dependency=afterany)
@@ -17,7 +18,7 @@
 #   VISTA_SHARD_LIST         the shards to run (again), as sbatch --array takes
 #                            them ("2,5", "3-4"; default 1-N); the merge waits for them
 #   VISTA_MERGE_MEM          the merge's memory, as sbatch --mem takes it
-#                            (default gen: 1G; bake: 2 GB + 4 x the city file)
+#                            (default gen and render: 1G; bake: 2 GB + 4 x the city file)
 #   VISTA_LOGS               the log directory (default OUT.logs)
 #   VISTA_MAX_ROUNDS         how often a merge submits missing shards again
 #                            (default 2; 0: never, it names them and exits 2)
@@ -26,7 +27,7 @@
 # SBATCH_TIMELIMIT, ...) apply too; VISTA_SBATCH_OPTS wins over them.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
-usage="usage: $0 gen|bake N OUT [CITY] [vista args...]"
+usage="usage: $0 gen|bake|render N OUT [CITY] [vista args...]"
 [ $# -ge 3 ] || { echo "$usage" >&2; exit 2; }
 job=$1 n=$2 out=$3
 shift 3
@@ -34,14 +35,14 @@ case "$n" in '' | *[!0-9]*) echo "slurm-submit: N='$n' is not a whole number >= 
 [ "$n" -ge 1 ] || { echo "slurm-submit: N=$n out of range (>= 1)" >&2; exit 2; }
 city=""
 case "$job" in
-  gen) ;;
+  gen | render) ;;
   bake)
     [ $# -ge 1 ] || { echo "slurm-submit: bake needs CITY ($usage)" >&2; exit 2; }
     city=$1
     shift
     [ -f "$city" ] || { echo "slurm-submit: CITY='$city' is not a file" >&2; exit 2; }
     ;;
-  *) echo "slurm-submit: job '$job' (expected gen or bake)" >&2; exit 2 ;;
+  *) echo "slurm-submit: job '$job' (expected gen, bake or render)" >&2; exit 2 ;;
 esac
 tasks="${VISTA_SHARD_LIST:-1-$n}"
 if ! [[ "$tasks" =~ ^[0-9]+(-[0-9]+)?(,[0-9]+(-[0-9]+)?)*$ ]]; then

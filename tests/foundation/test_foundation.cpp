@@ -19,6 +19,7 @@
 #include "foundation/format.h"
 #include "foundation/hash.h"
 #include "foundation/rng.h"
+#include "foundation/shard.h"
 #include "foundation/statistics.h"
 #include "foundation/timing.h"
 #include "foundation/units.h"
@@ -345,3 +346,28 @@ TEST(Format, ShellWordQuotesOnlyWhatTheShellWouldSplitOrExpand) {
     ::pclose(p);
     EXPECT_EQ(std::string(buf, n), word);
 }
+
+namespace vista {
+// Every item falls into exactly one shard's range, in order, and the shares
+// differ by at most one (checked by counting, not by the formula).
+TEST(Shard, RangesTileTheItemsInOrderAndBalance) {
+    for (size_t total : {size_t(0), size_t(1), size_t(3), size_t(4), size_t(7), size_t(100), size_t(1000003)})
+        for (int n : {1, 2, 3, 4, 7, 64}) {
+            size_t next = 0, smallest = total, largest = 0;
+            for (int k = 0; k < n; ++k) {
+                const ShardRange r = shardRange(total, Shard{k, n});
+                ASSERT_EQ(r.begin, next) << total << " items, shard " << k + 1 << "/" << n;
+                ASSERT_LE(r.begin, r.end);
+                next = r.end;
+                smallest = std::min(smallest, r.size());
+                largest = std::max(largest, r.size());
+                if (r.size()) {
+                    EXPECT_TRUE(r.contains(r.begin) && !r.contains(r.end));
+                }
+            }
+            EXPECT_EQ(next, total) << total << " items in " << n << " shards";
+            EXPECT_LE(largest - smallest, 1u) << total << " items in " << n << " shards";
+        }
+    EXPECT_EQ(shardText(Shard{2, 4}), "3/4");
+}
+}  // namespace vista
