@@ -96,7 +96,7 @@ public:
             tris += _near.objects[i].triangles;
         }
         stats.stages.set(Stage::Cull, sw.ms());
-        stats.notes.push_back(splitNote(nearD, double(tris)));
+        stats.notes.push_back(splitNote(nearD));
         if (autoSplit()) {
             stats.notes.push_back(nearAutoNote(nearD, _reason));
             char model[160];
@@ -236,7 +236,7 @@ private:
             _raster.nearDistance = 1e300;
         }
         stats.frameMs = sw.ms();
-        stats.notes.push_back(splitNote(nearD, double(nearD <= 0 ? 0 : stats.triangles)));
+        stats.notes.push_back(splitNote(nearD));
         if (autoSplit()) {
             stats.notes.push_back(nearAutoNote(nearD, _reason));
             // Every whole-city frame joins the raster fit, with haze too (drawn with the haze
@@ -252,10 +252,12 @@ private:
     }
 
     // The split's note of a frame (bench: frames.csv's split_* columns, see bench-output.md):
-    // "split: near_m=D reason=R model_ms=M rays_predicted=P", D "inf" for everything, empty under
-    // a triangle budget; M (the cost model's price of what the frame drew, before the correction
-    // by measured frames) and P (the probe's far pixels) only with --near auto.
-    std::string splitNote(double nearD, double tris) const {
+    // "split: near_m=D reason=R [model_ms=M] [rays_predicted=P]", D "inf" for everything, empty
+    // under a triangle budget; with --near auto P (the probe's far pixels at D) and, for a middle
+    // distance or everything the split chose, M: the split's cost model's price of its triangles
+    // in view and predicted far pixels, before the correction by measured frames (ray casting is
+    // priced by the probe's timed rate, which the note leaves out).
+    std::string splitNote(double nearD) const {
         char buf[200];
         std::snprintf(buf, sizeof buf, "%.2f", nearD);
         const std::string near = byBudget() ? "" : std::isinf(nearD) ? "inf" : buf;
@@ -263,17 +265,17 @@ private:
                            (autoSplit()  ? _reason
                             : byBudget() ? "budget"
                                          : "fixed");
-        if (autoSplit()) {
-            const double rays = std::isinf(nearD) ? 0.0 : _adaptive->predictedRays(std::max(0.0, nearD));
-            double ms = 0;
-            if (nearD <= 0) ms = _adaptive->msPerRay() * rays;
-            else
-                ms = (tris > 0 ? _adaptive->rasterFixedMs() + _adaptive->msPerTriangle() * tris : 0.0) +
-                     (std::isinf(nearD) ? 0.0 : _adaptive->msPerRay() * rays + _adaptive->farFixedMs());
-            std::snprintf(buf, sizeof buf, " model_ms=%.4f rays_predicted=%.0f", ms, rays);
+        if (!autoSplit()) return note;
+        const double rays = std::isinf(nearD) ? 0.0 : _adaptive->predictedRays(std::max(0.0, nearD));
+        if (nearD > 0 && nearD == _adaptive->current()) {
+            const double tris = double(_adaptive->chosenTriangles());
+            const double raster = tris > 0 ? _adaptive->rasterFixedMs() + _adaptive->msPerTriangle() * tris : 0.0;
+            const double far = std::isinf(nearD) ? 0.0 : _adaptive->msPerRay() * rays + _adaptive->farFixedMs();
+            std::snprintf(buf, sizeof buf, " model_ms=%.4f", raster + far);
             note += buf;
         }
-        return note;
+        std::snprintf(buf, sizeof buf, " rays_predicted=%.0f", rays);
+        return note + buf;
     }
     // The viewer's overlay line: the split's choice, why, the near field's triangles drawn and
     // the frame's rays.

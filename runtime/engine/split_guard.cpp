@@ -51,6 +51,13 @@ double SplitGuard::filter(double chosen) {
 void SplitGuard::record(double nearD, double frameMs) {
     if (!(frameMs >= 0) || std::isnan(nearD) || nearD != _last) return;
     const int frame = _frame - 1;
+    // The first frame of the middle and of everything pays one-time costs (the first draw of the
+    // chunks, the far field's first frame): not counted. Ray casting draws nothing: counted.
+    const int kind = nearD <= 0 ? 0 : std::isinf(nearD) ? 2 : 1;
+    if (kind != 0 && !_seen[kind]) {
+        _seen[kind] = true;
+        return;
+    }
     if (nearD <= 0 || std::isinf(nearD)) {
         const int end = nearD <= 0 ? 0 : 1;
         _end[end].push_back(frameMs);

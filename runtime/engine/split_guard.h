@@ -7,6 +7,8 @@
 // as the probe predicts), it can keep a middle distance that costs more than
 // ray casting or drawing everything. The guard looks at measured frame times
 // only, not at the model:
+//   The first frame of the middle and of everything is not counted (one-time
+//   costs: the first draw of the chunks, the far field's first frame).
 //   - the end points: ray casting (near distance 0, the `raycast` frame) and
 //     everything (+infinity, the `full` frame). An end point's measured cost
 //     is the median of its last `endWindow` frames' ms, while its newest
@@ -76,6 +78,7 @@ private:
     int _overridden = 0;
     double _last = 0;  // what filter() returned last
     int _trips = 0;
+    bool _seen[3] = {false, false, false};  // per kind (0, middle, everything): its first frame was recorded
 };
 
 }  // namespace vista

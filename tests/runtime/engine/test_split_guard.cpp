@@ -61,7 +61,8 @@ TEST(SplitGuard, MiddleCostlierThanAnEndPointIsAbandonedWithinAFewFrames) {
     const Drawn r = drive(
         g, 400, [](int) { return 100.0; }, machine);
     const size_t measured = r.first(0);
-    ASSERT_LE(measured, size_t(o.strikes)) << "ray casting is measured once the middle has `strikes` frames";
+    ASSERT_LE(measured, size_t(o.strikes + 1))
+        << "ray casting is measured once the middle has `strikes` frames counted";
     ASSERT_GT(g.trips(), 0);
     // The guard's first hold: the first ray-casting frame after the measurement.
     const size_t held = r.first(0, measured + 1);
@@ -104,15 +105,16 @@ TEST(SplitGuard, EverythingIsAnEndPointWhileItsMeasurementIsRecent) {
     EXPECT_EQ(r.first(0), r.drawn.size()) << "ray casting is off";
     EXPECT_LE(r.middle(10), 30);
 
-    // Everything measured once (30 ms, frame 2); the middle costs 20 ms, then 40 ms from frame 150,
-    // when that measurement is 148 frames old: no yardstick, no trip.
+    // Everything measured once (30 ms, frame 3: its first frame, 2, is not counted); the middle
+    // costs 20 ms, then 40 ms from frame 150, when that measurement is 147 frames old: no
+    // yardstick, no trip.
     SplitGuard stale(o);
     drive(
-        stale, 200, [](int f) { return f == 2 ? kInf : 100.0; },
+        stale, 200, [](int f) { return f == 2 || f == 3 ? kInf : 100.0; },
         [](double d, int f) { return std::isinf(d) ? 30.0
                                      : f < 150     ? 20.0
                                                    : 40.0; });
-    EXPECT_EQ(stale.endMs(1), -1.0) << "measured once, 197 frames ago";
+    EXPECT_EQ(stale.endMs(1), -1.0) << "measured once, 196 frames ago";
     EXPECT_EQ(stale.trips(), 0);
 }
 
