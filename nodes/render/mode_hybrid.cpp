@@ -282,7 +282,7 @@ private:
     std::string overlayLine(double nearD, const FrameStats& s) const {
         const std::string near = byBudget()          ? "budget"
                                  : std::isinf(nearD) ? "everything"
-                                 : nearD <= 0        ? "0 m (rays)"
+                                 : nearD <= 0        ? "0 m"
                                                      : std::to_string(int(std::lround(nearD))) + " m";
         const char* why = autoSplit() ? _reason : byBudget() ? "budget" : "fixed";
         return "split " + near + " (" + why + "): " + shortCount(double(s.triangles)) + " tris, " +
