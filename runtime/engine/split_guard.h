@@ -6,9 +6,9 @@
 // distance (on fly-overs, far rays that do not fall with the near distance
 // as the probe predicts), it can keep a middle distance that costs more than
 // ray casting or drawing everything. The guard looks at measured frame times
-// only, not at the model:
-//   The first frame of the middle and of everything is not counted (one-time
-//   costs: the first draw of the chunks, the far field's first frame).
+// only, not at the model (the first frame of the middle and of everything is
+// not counted: one-time costs, the first draw of the chunks, the far field's
+// first frame):
 //   - the end points: ray casting (near distance 0, the `raycast` frame) and
 //     everything (+infinity, the `full` frame). An end point's measured cost
 //     is the median of its last `endWindow` frames' ms, while its newest
