@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -40,11 +41,29 @@ std::string cpuModel() {
 
 json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
+// The hybrid's split note ("split: near_m=D reason=R [model_ms=M rays_predicted=P]", mode_hybrid.cpp)
+// as the four split_* cells (empty for a frame without one); the other notes go to `rest`.
+std::string splitCells(const std::vector<std::string>& notes, std::vector<std::string>& rest) {
+    std::string cells[4];
+    const char* keys[4] = {"near_m=", "reason=", "model_ms=", "rays_predicted="};
+    for (const auto& n : notes) {
+        if (n.rfind("split: ", 0) != 0) {
+            rest.push_back(n);
+            continue;
+        }
+        std::istringstream words(n.substr(7));
+        for (std::string w; words >> w;)
+            for (int k = 0; k < 4; ++k)
+                if (w.rfind(keys[k], 0) == 0) cells[k] = w.substr(std::strlen(keys[k]));
+    }
+    return cells[0] + "," + cells[1] + "," + cells[2] + "," + cells[3];
+}
+
 std::string framesCsv(const BenchResult& result) {
     std::ostringstream csv;
     csv << "frame,path_index,t_s,mode,frame_ms,cull_ms,draw_ms,triangles,draw_calls,rays_cast,psnr_db,diff_fraction,"
            "px_covered,px_horizon_culled,px_cache,px_ray_hit,px_ray_miss,px_interpolated,regions_arrived,run_order,"
-           "stages_ms,notes\n";
+           "split_near_m,split_reason,split_model_ms,split_rays_predicted,stages_ms,notes\n";
     char buf[512];
     for (const auto& r : result.frames) {
         const FrameStats& s = r.stats;
@@ -59,15 +78,17 @@ std::string framesCsv(const BenchResult& result) {
                       (unsigned long long)s.pixels.rayMiss, (unsigned long long)s.pixels.interpolated, r.regionsArrived,
                       r.runOrder);
         csv << buf;
+        std::vector<std::string> notes;
+        csv << splitCells(s.notes, notes) << ",";
         std::string st;
         s.stages.forEach([&](Stage stage, double ms) {
             std::snprintf(buf, sizeof(buf), "%s%s=%.3f", st.empty() ? "" : ";", stageName(stage), ms);
             st += buf;
         });
-        std::string notes;
-        for (const auto& n : s.notes) notes += (notes.empty() ? "" : ";") + n;
-        std::replace(notes.begin(), notes.end(), ',', ' ');
-        csv << st << "," << notes << "\n";
+        std::string noteCell;
+        for (const auto& n : notes) noteCell += (noteCell.empty() ? "" : ";") + n;
+        std::replace(noteCell.begin(), noteCell.end(), ',', ' ');
+        csv << st << "," << noteCell << "\n";
     }
     return csv.str();
 }

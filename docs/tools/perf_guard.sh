@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The hybrid's performance guard, run before stopping work on the renderer (it
-# measures, so it is not a test): on three small cities no test uses (seeds 101,
-# 202, 303, 800 m, with glass declared) and their car, walk and fly paths, the
+# measures, so it is not a test): on five small cities no test uses (800 m, with
+# glass declared) and their car, walk and fly paths, city and path seeds drawn at
+# run time (printed; SEEDS="S1 .. S5" PATH_SEED=N repeat a run), the
 # hybrid (--near auto) side by side with its end points (`raycast` = 0 m, `full`
 # = everything) and its near default (`hybrid-fixed`), and the hybrid with and
 # without each run-time effect (haze at 600, 1,500 and 3,000 m, night sky, and
@@ -13,7 +14,7 @@
 # runs; prints nothing and exits 0 when none does, exits 1 when a row prints.
 #
 # usage: docs/tools/perf_guard.sh [OUT_DIR] [VISTA_BIN]     (LIMIT=1.05 FRAMES=150 REPEATS=2 in the environment)
-# Needs python3 and, without a display, xvfb-run. About 8 minutes on 2 cores with llvmpipe, plus
+# Needs python3 and, without a display, xvfb-run. About 14 minutes on 2 cores with llvmpipe, plus
 # about 20 s per repeated row.
 # 150 frames a row: on llvmpipe one frame's draw varies by about a tenth from the next, so the
 # median of 60 same-frame ratios still moves by about 3 % from run to run; and the adaptive split
@@ -26,6 +27,13 @@ doc_setup perf_guard.sh perf-guard 1280x1024x24 "$@"
 LIMIT=${LIMIT:-1.05}
 FRAMES=${FRAMES:-150}
 REPEATS=${REPEATS:-2}
+draw() { python3 -c "import random; print(' '.join(str(random.randrange(1000, 1000000)) for _ in range($1)))"; }
+SEEDS=${SEEDS:-$(draw 5)}
+PATH_SEED=${PATH_SEED:-$(draw 1)}
+for s in $SEEDS $PATH_SEED; do
+  [[ $s =~ ^[0-9]+$ ]] || { echo "perf_guard.sh: SEEDS and PATH_SEED take non-negative integers, got '$s'" >&2; exit 2; }
+done
+log "city seeds: $SEEDS; path seed: $PATH_SEED (repeat with SEEDS=\"$SEEDS\" PATH_SEED=$PATH_SEED)"
 mkdir -p "$OUT"
 declare -A ARGS  # bench directory -> its arguments, for the repeats
 bench() {  # bench DIR CITY KIND MODES [flags...]
@@ -33,11 +41,11 @@ bench() {  # bench DIR CITY KIND MODES [flags...]
   ARGS[$d]=$(printf '%q ' "$@")
   shift 4
   rm -rf "$d"
-  "${XVFB[@]}" "$VISTA" bench "$city" --seed 7 --kind "$kind" --frames "$FRAMES" --size 640x480 --near auto \
+  "${XVFB[@]}" "$VISTA" bench "$city" --seed "$PATH_SEED" --kind "$kind" --frames "$FRAMES" --size 640x480 --near auto \
     --modes "$modes" --out "$d" -q "$@" >/dev/null
 }
 SPLIT=() EFFECT=()
-for seed in 101 202 303; do
+for seed in $SEEDS; do
   city="$OUT/city$seed.osgb"
   [ -s "$city" ] || "$VISTA" gen --params data/default.json --seed "$seed" --size 800 --effects glass -o "$city" -q
   for kind in car walk fly; do

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 #include "foundation/timing.h"
 #include "nodes/far_field_node.h"
@@ -17,15 +18,26 @@
 #include "runtime/engine/frame_raycast.h"
 #include "runtime/engine/horizon.h"
 #include "runtime/engine/ray_scene.h"
+#include "runtime/engine/split_guard.h"
 
 namespace vista {
 
 namespace {
 
-std::string nearAutoNote(double nearD) {
-    if (!std::isfinite(nearD)) return "near auto: everything (no far field)";
-    if (nearD <= 0) return "near auto: 0 m (ray casting)";
-    return "near auto: " + std::to_string(int(std::lround(nearD))) + " m";
+std::string nearAutoNote(double nearD, const char* reason) {
+    const std::string by = std::string(" by ") + reason;
+    if (!std::isfinite(nearD)) return "near auto: everything (no far field)" + by;
+    if (nearD <= 0) return "near auto: 0 m (ray casting)" + by;
+    return "near auto: " + std::to_string(int(std::lround(nearD))) + " m" + by;
+}
+
+// A count for the overlay line: 74.5k, 1.2M.
+std::string shortCount(double v) {
+    char buf[32];
+    if (v >= 1e6) std::snprintf(buf, sizeof buf, "%.1fM", v / 1e6);
+    else if (v >= 1e3) std::snprintf(buf, sizeof buf, "%.1fk", v / 1e3);
+    else std::snprintf(buf, sizeof buf, "%.0f", v);
+    return buf;
 }
 
 // The horizon's height grid: a streamed city's (it follows the resident
@@ -58,6 +70,9 @@ public:
         // A streamed city: the stream's index of the resident chunks (it follows the regions).
         _adaptive = ctx.stream ? std::make_unique<AdaptiveSplit>(ctx.stream->nearField()->index(), ctx.rays, so)
                                : std::make_unique<AdaptiveSplit>(_near.objects, ctx.rays, so);
+        SplitGuardOptions go;
+        go.everything = so.everythingNear;
+        _guard = SplitGuard(go);
         _root = new osg::Group;
         if (_near.rootState) _root->setStateSet(_near.rootState.get());
     }
@@ -81,8 +96,9 @@ public:
             tris += _near.objects[i].triangles;
         }
         stats.stages.set(Stage::Cull, sw.ms());
+        stats.notes.push_back(splitNote(nearD));
         if (autoSplit()) {
-            stats.notes.push_back(nearAutoNote(nearD));
+            stats.notes.push_back(nearAutoNote(nearD, _reason));
             char model[160];
             std::snprintf(model, sizeof model,
                           "split model: %.3g ms/k triangles, %.3g ms/k far pixels, %.2f ms far fixed",
@@ -123,8 +139,9 @@ public:
         _far->render(camera, haveDepth ? _depth.data() : nullptr, out, stats);
         stats.frameMs = sw.ms();
         if (autoSplit()) {
-            recordCosts(_adaptive->chosenTriangles(), ns.frameMs, stats);
+            if (nearD == _adaptive->current()) recordCosts(_adaptive->chosenTriangles(), ns.frameMs, stats);
             _adaptive->recordFrame(nearD, stats.frameMs);
+            _guard.record(nearD, stats.frameMs);
         }
         return Status::ok();
     }
@@ -166,7 +183,9 @@ public:
             const FrameStats fs = _farNode->lastStats();
             double farMs = 0;
             fs.stages.forEach([&](Stage, double ms) { farMs += ms; });
-            recordCosts(_adaptive->chosenTriangles(), std::max(0.0, wallMs - farMs), fs);
+            if (_viewerNear == _adaptive->current())
+                recordCosts(_adaptive->chosenTriangles(), std::max(0.0, wallMs - farMs), fs);
+            _guard.record(_viewerNear, wallMs);
         }
         _viewerNear = chooseNear(camera);
         if (_ctx.traffic) (void)_ctx.traffic->setSplit(byBudget() ? 1e300 : _viewerNear);
@@ -178,7 +197,7 @@ public:
         FrameStats s = _farNode ? _farNode->lastStats() : FrameStats();
         s.triangles = _split ? _split->lastNearTriangles() : 0;
         s.notes.push_back("near chunks drawn " + std::to_string(_split ? _split->lastNearCount() : 0u));
-        if (autoSplit()) s.notes.push_back(nearAutoNote(_viewerNear));
+        s.notes.push_back(overlayLine(_viewerNear, s));
         return s;
     }
 
@@ -217,17 +236,57 @@ private:
             _raster.nearDistance = 1e300;
         }
         stats.frameMs = sw.ms();
+        stats.notes.push_back(splitNote(nearD));
         if (autoSplit()) {
-            stats.notes.push_back(nearAutoNote(nearD));
+            stats.notes.push_back(nearAutoNote(nearD, _reason));
             // Every whole-city frame joins the raster fit, with haze too (drawn with the haze
             // program, which the near field's draw does not run): without these frames the fit
             // sees only middle distances, its slope comes out low (0.041 against 0.069 ms per
             // thousand triangles on one path) and the split drifts to larger near distances under
             // haze than without it. The kind's correction learns the rest.
-            if (rasterMs > 0) _adaptive->record(tris, rasterMs, 0, 0.0, 0.0);
+            if (rasterMs > 0 && nearD == _adaptive->current()) _adaptive->record(tris, rasterMs, 0, 0.0, 0.0);
             _adaptive->recordFrame(nearD, stats.frameMs);
+            _guard.record(nearD, stats.frameMs);
         }
         return Status::ok();
+    }
+
+    // The split's note of a frame (bench: frames.csv's split_* columns, see bench-output.md):
+    // "split: near_m=D reason=R [model_ms=M] [rays_predicted=P]", D "inf" for everything, empty
+    // under a triangle budget; with --near auto P (the probe's far pixels at D) and, for a middle
+    // distance or everything the split chose, M: the split's cost model's price of its triangles
+    // in view and predicted far pixels, before the correction by measured frames (ray casting is
+    // priced by the probe's timed rate, which the note leaves out).
+    std::string splitNote(double nearD) const {
+        char buf[200];
+        std::snprintf(buf, sizeof buf, "%.2f", nearD);
+        const std::string near = byBudget() ? "" : std::isinf(nearD) ? "inf" : buf;
+        std::string note = "split: near_m=" + near + " reason=" +
+                           (autoSplit()  ? _reason
+                            : byBudget() ? "budget"
+                                         : "fixed");
+        if (!autoSplit()) return note;
+        const double rays = std::isinf(nearD) ? 0.0 : _adaptive->predictedRays(std::max(0.0, nearD));
+        if (nearD > 0 && nearD == _adaptive->current()) {
+            const double tris = double(_adaptive->chosenTriangles());
+            const double raster = tris > 0 ? _adaptive->rasterFixedMs() + _adaptive->msPerTriangle() * tris : 0.0;
+            const double far = std::isinf(nearD) ? 0.0 : _adaptive->msPerRay() * rays + _adaptive->farFixedMs();
+            std::snprintf(buf, sizeof buf, " model_ms=%.4f", raster + far);
+            note += buf;
+        }
+        std::snprintf(buf, sizeof buf, " rays_predicted=%.0f", rays);
+        return note + buf;
+    }
+    // The viewer's overlay line: the split's choice, why, the near field's triangles drawn and
+    // the frame's rays.
+    std::string overlayLine(double nearD, const FrameStats& s) const {
+        const std::string near = byBudget()          ? "budget"
+                                 : std::isinf(nearD) ? "everything"
+                                 : nearD <= 0        ? "0 m"
+                                                     : std::to_string(int(std::lround(nearD))) + " m";
+        const char* why = autoSplit() ? _reason : byBudget() ? "budget" : "fixed";
+        return "split " + near + " (" + why + "): " + shortCount(double(s.triangles)) + " tris, " +
+               shortCount(double(s.raysCast)) + " rays";
     }
 
     // The adaptive split's cost model: far pixels (cached or traced) against the stages that
@@ -251,7 +310,9 @@ private:
         if (byBudget()) return 0.0;
         if (autoSplit()) {
             _adaptive->setHazeFar(_ctx.options.effects.hazeFar());
-            return _adaptive->choose(camera, _ctx.options.pixelBudget);
+            const double d = _guard.filter(_adaptive->choose(camera, _ctx.options.pixelBudget));
+            _reason = _guard.overridden() == 1 ? "guard" : _guard.overridden() == 2 ? "measure" : "model";
+            return d;
         }
         return _fixedSplit ? _ctx.options.fixedNearDistance() : _ctx.options.nearDistance;
     }
@@ -285,6 +346,8 @@ private:
     const HeightGrid* _heights = nullptr;  // the horizon's grid: _grid, or a streamed city's
     std::unique_ptr<FarField> _far;
     std::unique_ptr<AdaptiveSplit> _adaptive;
+    SplitGuard _guard;              // keeps the split from a middle dearer than a measured end point
+    const char* _reason = "model";  // why the last auto choice: "model", "guard", "measure"
     osg::ref_ptr<osg::Group> _root;
     std::vector<float> _depth;
     RasterSelection _raster;

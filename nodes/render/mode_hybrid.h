@@ -5,7 +5,13 @@
 // Near field: the city re-chunked (ModeContext::nearField, 40 m chunks).
 //   By distance (default): chunks whose box comes within the near distance,
 //   drawn with the far plane at max(nearD, 4 zNear); --near auto: the
-//   AdaptiveSplit picks nearD per frame (note "near auto: N m").
+//   AdaptiveSplit picks nearD per frame, and a SplitGuard (split_guard.h)
+//   holds an end point (0 m or everything) while the middle's measured
+//   frames cost more than that end point's (note "near auto: N m by REASON",
+//   REASON model, guard or measure). Every frame notes its split as
+//   "split: near_m=D reason=R [model_ms=M rays_predicted=P]" (the bench's
+//   frames.csv split_* columns); the viewer's HUD gets an overlay line
+//   "split D (R): T tris, N rays".
 //   By triangle budget (ModeOptions::triangleBudget > 0): the nearest chunks
 //   up to the budget, infinite far plane, no horizon skipping.
 // Options: nearDistance, triangleBudget, pixelBudget, horizonGrid, cache,

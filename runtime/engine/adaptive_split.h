@@ -23,13 +23,13 @@
 // of the view's four side planes is culled by the renderer and costs no
 // raster time (for everything, counted at each probe, and every triangle on
 // a city of more than 200,000 objects; with haze, only objects within it).
-// Each kind's price is corrected by what its own frames measured: the lower
-// quartile over its last 8 frames (recordFrame()) of (whole frame ms, the
-// decision included) minus (the current model's price of what that frame
-// drew and traced), re-priced as the model learns, so a residual taken
-// against the first frames' priors does not outlive them, and frames slowed
-// by other work on the machine (which only ever slows) do not price a kind
-// out of reach. So costs the model does not see (the probe, the cull, the
+// Each kind's price is corrected by what its own frames measured: the lower quartile over its last 8 frames
+// (recordFrame()) of (whole frame ms, the decision included) minus (the current model's price of what that frame
+// drew and traced); a middle distance by those middle frames nearest to its triangles in view and far pixels (log
+// scale, within 1.1x of the nearest: one offset for every middle distance priced the model's favourite below every
+// frame where its slope over the distance is wrong, on fly-overs). Re-priced as the model learns, so a residual taken
+// against the first frames' priors does not outlive them, and frames slowed by other work (which only slows) do not
+// price a kind out of reach. So costs the model does not see (the probe, the cull, the
 // sky layer, haze in the rasteriser, the ray stage's task start-up) are
 // learned online for each alternative instead of tuned. Until a kind has run
 // its correction is 0; each kind is tried now and then (its cheapest

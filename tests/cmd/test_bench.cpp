@@ -243,6 +243,66 @@ TEST(Bench, SyntheticSceneSmokeRun) {
     fs::remove_all(cfg.outDir);
 }
 
+// frames.csv carries the hybrid's near/far split of each frame: split_near_m, split_reason,
+// split_model_ms and split_rays_predicted (--near auto), the fixed distance and "fixed" for
+// hybrid-fixed, empty cells for a mode without a split; the split's note is not repeated in notes.
+TEST(Bench, FramesCsvCarriesTheSplitOfEachHybridFrame) {
+    REQUIRE_DISPLAY();
+    SceneModel city = tinyCity();
+    Path path;
+    for (int i = 0; i < 4; ++i) {
+        PathSample s;
+        s.t = i;
+        s.position = kWorld + glm::dvec3(0, -30.0 + 5 * i, 1.7);
+        path.samples.push_back(s);
+    }
+    BenchConfig cfg;
+    cfg.width = 96;
+    cfg.height = 72;
+    cfg.frames = 4;
+    cfg.modes = {"raycast", "hybrid-fixed", "hybrid"};
+    cfg.options.nearDistance = -1;  // auto
+    cfg.outDir = tmpDir("split_columns");
+    cfg.quiet = true;
+    auto r = runBenchmark(&city, sceneRoot(city), path, cfg);
+    ASSERT_TRUE(r.isOk()) << r.status().message();
+    const auto rows = readCsv(cfg.outDir + "/frames.csv");
+    ASSERT_GT(rows.size(), 1u);
+    const auto& h = rows[0];
+    auto col = [&](const char* name) {
+        const size_t c = size_t(std::find(h.begin(), h.end(), name) - h.begin());
+        EXPECT_LT(c, h.size()) << name;
+        return c;
+    };
+    const size_t mode = col("mode"), nearM = col("split_near_m"), reason = col("split_reason"),
+                 model = col("split_model_ms"), rays = col("split_rays_predicted"), notes = col("notes");
+    int hybrid = 0;
+    for (size_t i = 1; i < rows.size(); ++i) {
+        const auto& row = rows[i];
+        ASSERT_GT(row.size(), rays);
+        const std::string note = notes < row.size() ? row[notes] : "";  // an empty last cell is not read
+        EXPECT_EQ(note.find("split: "), std::string::npos) << note;
+        if (row[mode] == "hybrid-fixed") {
+            EXPECT_EQ(row[nearM], "100.00");
+            EXPECT_EQ(row[reason], "fixed");
+            EXPECT_EQ(row[model], "");
+        } else if (row[mode] == "hybrid") {
+            ++hybrid;
+            EXPECT_TRUE(row[reason] == "model" || row[reason] == "guard" || row[reason] == "measure") << row[reason];
+            const double d = std::stod(row[nearM]);  // "inf" for everything
+            EXPECT_GE(d, 0.0);
+            if (d > 0) EXPECT_GE(std::stod(row[model]), 0.0);  // ray casting: priced by the probe's rate, left out
+            else EXPECT_EQ(row[model], "");
+            EXPECT_GE(std::stod(row[rays]), 0.0);
+            EXPECT_NE(note.find("near auto: "), std::string::npos) << note;
+        } else {
+            for (size_t c : {nearM, reason, model, rays}) EXPECT_EQ(row[c], "") << row[mode];
+        }
+    }
+    EXPECT_EQ(hybrid, 4);
+    fs::remove_all(cfg.outDir);
+}
+
 TEST(Bench, SupersampledReferenceIsCloserToItselfThanAliasedFrames) {
     REQUIRE_DISPLAY();
     SceneModel city = tinyCity();

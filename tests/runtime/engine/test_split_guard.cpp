@@ -1,0 +1,140 @@
+// The split's guard (split_guard.h) on synthetic machines: each frame costs what the test's cost
+// function says for the near distance drawn; no timing.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <vector>
+
+#include "runtime/engine/split_guard.h"
+
+using namespace vista;
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+int kindOf(double d) { return d <= 0 ? 0 : std::isinf(d) ? 2 : 1; }
+
+struct Drawn {
+    std::vector<double> drawn;
+    int middle(size_t from = 0) const {
+        int n = 0;
+        for (size_t f = from; f < drawn.size(); ++f) n += kindOf(drawn[f]) == 1;
+        return n;
+    }
+    int switches(size_t from = 0) const {
+        int n = 0;
+        for (size_t f = from + 1; f < drawn.size(); ++f) n += kindOf(drawn[f]) != kindOf(drawn[f - 1]);
+        return n;
+    }
+    size_t first(int kind, size_t from = 0) const {
+        for (size_t f = from; f < drawn.size(); ++f)
+            if (kindOf(drawn[f]) == kind) return f;
+        return drawn.size();
+    }
+};
+
+// The split chooses split(f); the guard filters it; the frame costs machine(drawn, f).
+Drawn drive(SplitGuard& g, int frames, const std::function<double(int)>& split,
+            const std::function<double(double, int)>& machine) {
+    Drawn r;
+    for (int f = 0; f < frames; ++f) {
+        const double d = g.filter(split(f));
+        r.drawn.push_back(d);
+        g.record(d, machine(d, f));
+    }
+    return r;
+}
+
+}  // namespace
+
+// The split keeps 100 m (its model underprices it); the middle's frames cost 28, 32 and 30 ms in
+// turn against 25 ms for ray casting. The guard measures ray casting, abandons the middle within
+// `strikes` middle frames of that, and over 400 frames draws the middle on few frames in few
+// switches: each return after a hold that trips again doubles the hold (no oscillation).
+TEST(SplitGuard, MiddleCostlierThanAnEndPointIsAbandonedWithinAFewFrames) {
+    const SplitGuardOptions o;
+    SplitGuard g(o);
+    auto machine = [](double d, int f) { return d <= 0 ? 25.0 : 28.0 + 2.0 * (f % 3); };
+    const Drawn r = drive(
+        g, 400, [](int) { return 100.0; }, machine);
+    const size_t measured = r.first(0);
+    ASSERT_LE(measured, size_t(o.strikes + 1))
+        << "ray casting is measured once the middle has `strikes` frames counted";
+    ASSERT_GT(g.trips(), 0);
+    // The guard's first hold: the first ray-casting frame after the measurement.
+    const size_t held = r.first(0, measured + 1);
+    EXPECT_LE(r.middle(measured) - r.middle(held), o.strikes + 1) << "middle frames before the fallback";
+    EXPECT_LE(r.middle(held), 20) << "the middle returns only briefly after each hold";
+    EXPECT_LE(r.switches(held), 2 * g.trips() + 2) << "no oscillation";
+    EXPECT_LE(g.trips(), 6) << "holds of 24, 48, 96, 192, 192 frames";
+    EXPECT_NEAR(g.endMs(0), 25.0, 1e-12);
+}
+
+// A middle cheaper than the end point is kept (ray casting only measured now and then); one
+// within the margin (2 % dearer) is kept too: the margin is the hysteresis. 6 % dearer trips.
+TEST(SplitGuard, CheaperMiddleIsKeptAndTheMarginIsTheHysteresis) {
+    for (const double middle : {15.0, 25.5, 26.5}) {
+        SplitGuard g;
+        const Drawn r = drive(
+            g, 200, [](int) { return 100.0; }, [&](double d, int) { return d <= 0 ? 25.0 : middle; });
+        if (middle < 26.0) {
+            EXPECT_EQ(g.trips(), 0) << middle;
+            EXPECT_GE(r.middle(), 195) << middle;
+            EXPECT_LE(r.switches(), 8) << middle;
+        } else {
+            EXPECT_GE(g.trips(), 1) << middle;
+            EXPECT_LE(r.middle(), 30) << middle;
+        }
+    }
+}
+
+// Everything as the end point: measured when the split tries it (every 24th frame here) or the
+// guard holds it; a middle dearer than it is abandoned; without a recent measurement (older than
+// endMaxAge frames) it is no yardstick.
+TEST(SplitGuard, EverythingIsAnEndPointWhileItsMeasurementIsRecent) {
+    SplitGuardOptions o;
+    o.rayCasting = false;
+    SplitGuard g(o);
+    const Drawn r = drive(
+        g, 200, [](int f) { return f % 24 == 5 ? kInf : 100.0; },
+        [](double d, int) { return std::isinf(d) ? 30.0 : 40.0; });
+    EXPECT_GE(g.trips(), 1);
+    EXPECT_EQ(r.first(0), r.drawn.size()) << "ray casting is off";
+    EXPECT_LE(r.middle(10), 30);
+
+    // Everything measured once (30 ms, frame 3: its first frame, 2, is not counted); the middle
+    // costs 20 ms, then 40 ms from frame 150, when that measurement is 147 frames old: no
+    // yardstick, no trip.
+    SplitGuard stale(o);
+    drive(
+        stale, 200, [](int f) { return f == 2 || f == 3 ? kInf : 100.0; },
+        [](double d, int f) { return std::isinf(d) ? 30.0
+                                     : f < 150     ? 20.0
+                                                   : 40.0; });
+    EXPECT_EQ(stale.endMs(1), -1.0) << "measured once, 196 frames ago";
+    EXPECT_EQ(stale.trips(), 0);
+}
+
+// Deterministic: the same choices and measured times give the same frames; strikes 0 turns the
+// guard off (the split's choice passes).
+TEST(SplitGuard, SameTimesSameFramesAndOffMeansOff) {
+    auto split = [](int f) { return f % 17 == 3 ? 0.0 : 60.0 + f % 3; };
+    auto machine = [](double d, int f) { return d <= 0 ? 25.0 : 20.0 + 13.0 * ((f * 7) % 5); };
+    SplitGuard a, b;
+    EXPECT_EQ(drive(a, 300, split, machine).drawn, drive(b, 300, split, machine).drawn);
+    EXPECT_GE(a.trips(), 1);
+    SplitGuardOptions off;
+    off.strikes = 0;
+    SplitGuard c(off);
+    const Drawn r = drive(c, 100, split, machine);
+    for (int f = 0; f < 100; ++f) EXPECT_EQ(r.drawn[size_t(f)], split(f));
+    // Bad times are ignored.
+    SplitGuard d;
+    d.filter(0.0);
+    d.record(0.0, std::nan(""));
+    d.record(0.0, -1.0);
+    EXPECT_EQ(d.endMs(0), -1.0);
+}
