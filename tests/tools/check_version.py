@@ -11,7 +11,10 @@ Against it:
 3. the build's CPack configuration (the .deb's Version) and the CMake package's
    vistaConfigVersion.cmake carry VERSION;
 4. the Python module's vista.__version__ is VERSION (when --python-dir is given
-   and holds the module).
+   and holds the module);
+5. every find_package(vista X.Y ...) in examples/ and docs/ asks for VERSION's
+   major.minor (the CMake package accepts only its own minor version, so an
+   older request fails to configure).
 
 Prints every disagreement and exits 1 if there is one.
 
@@ -92,6 +95,28 @@ def reported_problems(version, reported):
     return problems
 
 
+FIND_PACKAGE_RE = re.compile(r"find_package\(\s*vista\s+(\d+(?:\.\d+)*)")
+
+
+def find_package_problems(root, version):
+    """find_package(vista X.Y) requests in examples/ and docs/ that ask for another minor version."""
+    want = version.split(".")[:2]
+    problems = []
+    for top in ("examples", "docs"):
+        for base, dirs, names in os.walk(os.path.join(root, top)):
+            dirs.sort()
+            for name in sorted(names):
+                if not (name == "CMakeLists.txt" or name.endswith((".cmake", ".md"))):
+                    continue
+                path = os.path.join(base, name)
+                for i, line in enumerate(read(path).split("\n")):
+                    for m in FIND_PACKAGE_RE.finditer(line):
+                        if m.group(1).split(".")[:2] != want:
+                            problems.append(f"{os.path.relpath(path, root)}:{i + 1}: find_package(vista "
+                                            f"{m.group(1)}) asks for another minor version than {version}")
+    return problems
+
+
 def read(path):
     with open(path, encoding="utf-8") as f:
         return f.read()
@@ -109,6 +134,7 @@ def check(root, vista, build, python_dir):
     if version is None:
         return None, ["CMakeLists.txt: no project(vista VERSION MAJOR.MINOR.PATCH)"]
     problems = changelog_problems(read(os.path.join(root, "CHANGELOG.md")), version)
+    problems += find_package_problems(root, version)
     out = subprocess.run([vista, "--version"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                          text=True, timeout=60).stdout.strip()
     m = re.fullmatch(r"vista " + SEMVER, out)
@@ -155,11 +181,20 @@ def self_test():
     for what, got in {"other version": "2.3.5", "unreadable": None}.items():
         if len(reported_problems("2.3.4", {"place": got})) != 1:
             failures.append(f"planted {what} report: not found")
+    import tempfile
+    with tempfile.TemporaryDirectory() as tmp:
+        os.makedirs(os.path.join(tmp, "examples", "app"))
+        with open(os.path.join(tmp, "examples", "app", "CMakeLists.txt"), "w") as f:
+            f.write("find_package(vista 2.3 CONFIG REQUIRED)\n")
+        if find_package_problems(tmp, "2.3.4"):
+            failures.append(f"an agreeing find_package flagged: {find_package_problems(tmp, '2.3.4')}")
+        if len(find_package_problems(tmp, "2.4.0")) != 1:
+            failures.append("planted older find_package(vista 2.3) not found against 2.4.0")
     for f in failures:
         print(f"check_version self-test: {f}")
     if failures:
         return 1
-    print(f"check_version self-test: {len(planted) + 2} planted disagreements found, the agreeing set passes")
+    print(f"check_version self-test: {len(planted) + 3} planted disagreements found, the agreeing set passes")
     return 0
 
 
@@ -182,7 +217,8 @@ def main():
         print(f"check_version: {len(problems)} disagreement(s) with CMake's project VERSION {version}")
         return 1
     print(f"check_version: CMake, `vista --version`, CHANGELOG.md, the .deb's CPack version, the CMake "
-          f"package{', the Python module' if args.python_dir else ''} all say {version}")
+          f"package, the find_package requests{', the Python module' if args.python_dir else ''} all say "
+          f"{version}")
     return 0
 
 
