@@ -65,6 +65,7 @@ AWAITING_REGENERATION = {
     ("docs/measurements/bake.md", "whole-bake-seed2"): _QUIET,
     ("docs/measurements/bake.md", "splat-table"): _QUIET,
     ("docs/measurements/bake.md", "splat-table-seed2"): _QUIET,
+    ("docs/measurements/effects.md", "effects"): _QUIET,
     ("docs/measurements/effects.md", "effects-haze"): _QUIET,
     ("docs/measurements/far-field.md", "far-field-table"): _QUIET,
     ("docs/measurements/farfield-compare.md", "farfield-compare"): _QUIET,
