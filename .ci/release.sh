@@ -86,6 +86,7 @@ if [ -n "$pyinit" ]; then
   pyver="$(PYTHONPATH="$ROOT/$(dirname "$(dirname "$pyinit")")" /usr/bin/python3 -c 'import vista; print(vista.__version__)')" \
     || fail "the packaged Python module does not import"
   [ "$pyver" = "$VERSION" ] || fail "the packaged Python module's __version__ is '$pyver', expected $VERSION"
+  echo "release: the unpacked vista --version and the packaged Python module say $VERSION"
 elif [ -e "$BUILD/python/vista/__init__.py" ]; then
   fail "the build has the Python module but the .deb does not"
 fi
