@@ -29,7 +29,8 @@ exits 0 with a one-line summary otherwise.
 Usage: check_docs.py --root SOURCE_DIR --vista VISTA_BINARY
        check_docs.py --self-test --vista VISTA_BINARY
   (--self-test writes a small broken docs tree into a temporary directory and
-   fails unless the check finds each planted problem, then checks a clean one)
+   fails unless the check finds each planted problem, then checks a clean one;
+   it also runs docs/tools/lib.sh's doc_stamp and reads its lines back)
 """
 import argparse
 import os
@@ -400,6 +401,27 @@ def check(root, vista, awaiting=None):
     return docs, commands, problems
 
 
+def stamp_writer_agrees(vista):
+    """docs/tools/lib.sh's doc_stamp, run with the built tool at a quiet and at a busy start, writes
+    lines STAMP_RE reads, with the tool's version, marked under load only when busy."""
+    lib = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "docs", "tools", "lib.sh")
+    version = subprocess.run([vista, "--version"], stdout=subprocess.PIPE, text=True).stdout.split()[-1]
+    failures = []
+    for load, busy in (("0.10 0.20 0.30", False), ("3.50 2.00 1.00", True)):
+        r = subprocess.run(["bash", "-c", 'set -euo pipefail; source "$0"; DOC_NAME=self-test; VISTA="$1"; '
+                            'REPO="$(dirname "$0")/../.."; DOC_START_LOAD="$2"; doc_stamp', lib, vista, load],
+                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        line = r.stdout.strip()
+        m = STAMP_RE.match(line)
+        if r.returncode != 0 or not m:
+            failures.append(f"doc_stamp at load {load} wrote {line!r}, which STAMP_RE does not read")
+        elif ".".join(m.groups()) != version:
+            failures.append(f"doc_stamp names version {'.'.join(m.groups())}, the tool says {version}")
+        elif line.startswith("**Measured under load**") != busy:
+            failures.append(f"doc_stamp at load {load}: under-load mark {'missing' if busy else 'wrong'}: {line!r}")
+    return failures
+
+
 def self_test(vista):
     """The check must find each planted problem and pass a clean tree."""
     commands, _ = vista_help(vista)
@@ -473,6 +495,7 @@ def self_test(vista):
         _, _, problems = check(tmp, vista, awaiting={("docs/measurements/m.md", "s"): "listed"})
         if problems:
             failures.append(f"a stale block listed as awaiting regeneration: expected no problem, got {problems}")
+    failures += stamp_writer_agrees(vista)
     for f in failures:
         print(f"check_docs self-test: {f}")
     if failures:
