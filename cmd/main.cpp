@@ -4,6 +4,7 @@
 #include <string>
 
 #include "cmd/commands.h"
+#include "foundation/version.h"
 
 namespace {
 
@@ -53,7 +54,7 @@ int main(int argc, char** argv) {
         return 0;
     }
     if (cmd == "--version") {
-        std::printf("vista 0.1.0\n");
+        std::printf("vista %s\n", vista::version());
         return 0;
     }
     for (const auto& c : kCommands)

@@ -30,6 +30,7 @@
 #include "cmd/render_shared.h"
 #include "foundation/atomic_file.h"
 #include "foundation/units.h"
+#include "foundation/version.h"
 #include "nodes/render/ground_truth_session.h"
 #include "runtime/scene/city_file.h"
 #include "runtime/scene/city_opendrive.h"
@@ -484,6 +485,7 @@ PYBIND11_MODULE(_vista, m) {
     m.doc() =
         "Native part of the vista module: the library steps behind `vista gen`, `vista path` and "
         "`vista render`. Use the `vista` package, which wraps these.";
+    m.attr("__version__") = vista::version();
     py::class_<PyCity>(m, "City", "A generated or loaded city (see vista.City).")
         .def_property_readonly("paged", [](const PyCity& c) { return c.paged; })
         .def_property_readonly("source", [](const PyCity& c) { return c.source; })

@@ -135,7 +135,7 @@ drop plain
 
 log "measurements done; writing the report"
 ELAPSED=$((SECONDS - START))
-python3 docs/tools/effects_report.py --out "$OUT" --psnr "$IMAGE_PSNR" \
+python3 docs/tools/effects_report.py --out "$OUT" --psnr "$IMAGE_PSNR" --stamp "$(doc_stamp)" \
   --invocation "$INVOCATION" --elapsed "$ELAPSED" --md "$OUT/effects.md" --img "$OUT/img"
 
 # 6. Haze per path kind (hybrid, 600 / 1500 / 3000 m vs clear), into the report's own block.

@@ -21,6 +21,8 @@ ap.add_argument("--md", required=True)
 ap.add_argument("--img", required=True)
 ap.add_argument("--invocation", default="docs/tools/effects.sh")
 ap.add_argument("--elapsed", type=float, default=float("nan"))
+ap.add_argument("--stamp", required=True,
+                help="the block's first line: docs/tools/lib.sh doc_stamp (version, commit, machine, load average)")
 A = ap.parse_args()
 
 BENCH = os.path.join(A.out, "bench")
@@ -307,6 +309,9 @@ w("")
 w("```sh")
 w("docs/tools/effects.sh [OUT_DIR] [VISTA_BIN]      # defaults: a temp dir (removed afterwards), build/vista")
 w("```")
+w("")
+w("<!-- effects:begin -->")
+w(A.stamp)
 w("")
 w(f"This run: `{A.invocation}`; {A.elapsed / 60.0:.1f} min of measurements. "
   f"Machine (summary.json): {mach.get('cpu', '?')}, {threads} hardware threads, "
@@ -683,6 +688,7 @@ w("The hybrid (`--near auto`) with each run-time effect against the same frames 
   "(`build/tests/bench/bench_far_field --benchmark_filter=HazeCovered` times it alone); the traced far pixels are "
   "hazed inside the ray tasks as they are written. Regenerated with the rest of this page, or alone by "
   "`docs/tools/effects_haze.sh [OUT_DIR] [VISTA_BIN]` (150 frames a row).")
+w("<!-- effects:end -->")
 w("")
 w("<!-- effects-haze:begin -->")
 w("<!-- effects-haze:end -->")

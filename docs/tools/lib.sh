@@ -9,6 +9,17 @@
 # writes (paths relative to the repository) go into DOC_TMP_FILES: they are
 # removed at exit, so a failed run never leaves one behind.
 # die MSG: error and exit 1. log MSG: progress with the seconds since START.
+#
+# Every generated block starts with a stamp (doc_stamp): the vista version and
+# commit measured, the machine (CPU model, cores, RAM) and the load average at
+# the start of the run (DOC_START_LOAD: read by doc_setup, or set by
+# regenerate_all.sh for the step) and at its end. A 1-minute load average at
+# the start above DOC_LOAD_LIMIT marks the block "Measured under load": other
+# work shared the cores, and its times are not the machine's.
+# tests/tools/check_docs.py reads the stamp (keep its STAMP_RE in step).
+
+# The 1-minute load average above which a block is marked as measured under load.
+DOC_LOAD_LIMIT=0.5
 
 die() { echo "$DOC_NAME: error: $*" >&2; exit 1; }
 log() { printf '[%s %4ds] %s\n' "$DOC_NAME" $((SECONDS - START)) "$*" >&2; }
@@ -24,6 +35,7 @@ doc_setup() {
   local prefix=$2 screen=$3
   shift 3
   START=$SECONDS
+  DOC_START_LOAD=${DOC_START_LOAD:-$(cut -d' ' -f1-3 /proc/loadavg)}
   KEEP_OUT=1
   if [ -n "${1:-}" ]; then OUT=$(realpath -m "$1"); else OUT=$(mktemp -d "/tmp/vista-$prefix.XXXXXX"); KEEP_OUT=0; fi
   VISTA=$(realpath -m "${2:-build/vista}")
@@ -41,24 +53,52 @@ doc_setup() {
   fi
 }
 
+# doc_stamp: prints the stamp line of a generated block (one line, Markdown):
+#   [**Measured under load** (...): ]Measured with vista X.Y.Z (commit C) on CPU,
+#   N cores, M GB RAM; load average at start L1, L5, L15 (1, 5, 15 min), at the end ...
+# The version is what $VISTA --version prints; the commit is the repository's
+# HEAD, "+ local changes" when files outside docs/ differ from it.
+doc_stamp() {
+  local version commit cpu cores ram start end load1 under=""
+  version=$("$VISTA" --version 2>/dev/null | sed -n 's/^vista \([0-9][0-9.]*\)$/\1/p')
+  [ -n "$version" ] || die "$VISTA --version printed no version"
+  commit=$(git -C "$REPO" rev-parse --short=10 HEAD 2>/dev/null || echo "unknown")
+  if [ "$commit" != unknown ] && ! git -C "$REPO" diff --quiet HEAD -- . ':(exclude)docs' 2>/dev/null; then
+    commit="$commit + local changes"
+  fi
+  cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n1)
+  cores=$(nproc)
+  ram=$(awk '/^MemTotal:/ {printf "%.0f GB", $2 / 1048576}' /proc/meminfo)
+  start=${DOC_START_LOAD:-?}
+  end=$(cut -d' ' -f1-3 /proc/loadavg)
+  load1=${start%% *}
+  if [ "$load1" != "?" ] && awk -v l="$load1" -v m="$DOC_LOAD_LIMIT" 'BEGIN { exit !(l > m) }'; then
+    under="**Measured under load** (1-minute load average $load1 at the start, above $DOC_LOAD_LIMIT: other work shared the cores, so the times run high): "
+  fi
+  echo "${under}Measured with vista $version (commit $commit) on ${cpu:-an unknown CPU}, $cores cores, $ram RAM;" \
+       "load average at the start ${start// /, } (1, 5, 15 min), at the end ${end// /, }."
+}
+
 # doc_replace_block DOC MARKER TABLE: replaces the block between
 # <!-- MARKER:begin --> and <!-- MARKER:end --> of DOC (a path relative to the
-# repository) with "Load average at the end of the run: ..." and TABLE's text,
-# through DOC's directory/.NAME.tmp (list it in DOC_TMP_FILES) and a rename, so a failure leaves
-# DOC as it was.
+# repository) with the stamp (doc_stamp) and TABLE's text, through DOC's
+# directory/.NAME.tmp (list it in DOC_TMP_FILES) and a rename, so a failure
+# leaves DOC as it was.
 doc_replace_block() {
   local doc=$1 marker=$2 table=$3
-  local tmp
+  local tmp stamp
   tmp="$(dirname "$doc")/.$(basename "$doc").tmp"
   grep -q "<!-- $marker:begin -->" "$doc" || die "$doc has no <!-- $marker:begin --> marker"
-  python3 - "$doc" "$marker" "$table" "$(cut -d' ' -f1-3 /proc/loadavg)" > "$tmp" <<'PYEOF'
+  [ -s "$table" ] || die "the table for $doc ($marker) is empty: $table"
+  stamp=$(doc_stamp)
+  python3 - "$doc" "$marker" "$table" "$stamp" > "$tmp" <<'PYEOF'
 import sys
-doc, marker, table, load = sys.argv[1:5]
+doc, marker, table, stamp = sys.argv[1:5]
 text = open(doc).read()
 begin, end = f"<!-- {marker}:begin -->", f"<!-- {marker}:end -->"
 head, rest = text.split(begin, 1)
 _, tail = rest.split(end, 1)
-body = f"Load average at the end of the run: {load}.\n\n" + open(table).read()
+body = stamp + "\n\n" + open(table).read().rstrip("\n") + "\n"
 print(head + begin + "\n" + body + end + tail, end="")
 PYEOF
   mv "$tmp" "$doc"

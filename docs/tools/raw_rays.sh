@@ -67,7 +67,7 @@ done
 cat /proc/loadavg > "$OUT/load_end.txt"
 
 log "writing docs/measurements/raw-rays.md"
-python3 - "$OUT" "$INVOCATION" "$REPS" "$MIN_TIME" "$FRAMES" "$VISTA" "$RAW" > "$REPO/docs/measurements/.raw-rays.md.tmp" <<'PY'
+DOC_STAMP=$(doc_stamp) python3 - "$OUT" "$INVOCATION" "$REPS" "$MIN_TIME" "$FRAMES" "$VISTA" "$RAW" > "$REPO/docs/measurements/.raw-rays.md.tmp" <<'PY'
 import csv, json, os, sys
 out, invocation, reps, min_time, frames, vista, raw = sys.argv[1:8]
 kinds = ["car", "walk", "fly"]
@@ -104,8 +104,6 @@ def err_line(kind, prefix):
 
 data = {k: medians(k) for k in kinds}
 ctx = data["car"][0]
-load0 = open(f"{out}/load_start.txt").read().split()[0]
-load1 = open(f"{out}/load_end.txt").read().split()[0]
 one = {k: data[k][1]["Interleaved"] for k in kinds}  # counters <Variant>_ns: CPU ns per ray, one core
 P = print
 P("# The ray stage against raw Embree")
@@ -136,10 +134,11 @@ P("variants see the same machine load; medians over repetitions. *All threads*: 
 P("the default arena (every core: what the frame uses), wall time, repetitions interleaved at random by Google")
 P(f"Benchmark in the same process; medians. {reps} repetitions, at least {min_time} s each.")
 P()
-P(f"**The machine was loaded** while this ran (other jobs on its {ctx['num_cpus']} cores: load average "
-  f"{load0} at the start, {load1} at the end), so absolute rays/s are low and the *all threads* table")
-P("(wall time) shares its cores with them; the ratios measured side by side are what count, and the one-thread")
-P("ratios are the steadier ones.")
+P("<!-- raw-rays:begin -->")
+P(os.environ["DOC_STAMP"])
+P()
+P("The *all threads* table (wall time) shares the cores with whatever else runs (the load average above); the")
+P("ratios measured side by side are what count, and the one-thread ratios are the steadier ones.")
 P()
 P(f"Machine: {cpu_model()}, {ctx['num_cpus']} cores; Embree 3; city `data/default.json` (2 km); "
   f"paths `--seed 11`, 640x480, {frames} frames per path")
@@ -249,6 +248,8 @@ P("Sanity check (bench_raw_rays, before timing): every variant traces the same r
 P()
 for k in kinds:
     P(f"- {k}: {err_line(k, 'hits')}")
+P()
+P("<!-- raw-rays:end -->")
 P()
 P("## Commands")
 P()

@@ -17,6 +17,9 @@ import json as _json
 from . import _vista
 from ._vista import Pose
 
+#: vista's version (MAJOR.MINOR.PATCH), the same as ``vista --version`` and the Debian package's.
+__version__ = _vista.__version__
+
 __all__ = ["City", "Path", "Pose", "Renderer", "Rig", "generate", "load", "path", "load_path", "RenderDataset"]
 
 

@@ -8,6 +8,8 @@ import numpy.typing as npt
 
 _PathLike = Union[str, "os.PathLike[str]"]
 
+__version__: str
+
 class Pose:
     """A camera pose: time, world position (metres), heading and pitch (radians)."""
     def __init__(self, position: Sequence[float], heading: float = ..., pitch: float = ..., t: float = ...) -> None: ...

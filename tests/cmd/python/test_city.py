@@ -8,6 +8,12 @@ import vista
 from conftest import SEED, SIZE, run_vista
 
 
+def test_version_is_the_tools():
+    out = run_vista("--version").stdout.strip()
+    assert out == f"vista {vista.__version__}"
+    assert len(vista.__version__.split(".")) == 3
+
+
 def test_generate_saves_the_bytes_of_vista_gen(cli_city, tmp_path):
     c = vista.generate(seed=SEED, size_m=SIZE)
     c.save(tmp_path / "py.osgb")
