@@ -276,8 +276,7 @@ struct RayScene::Impl {
         }
         rtcIntersect8(valid, movers, &ctx, &m);
         for (int k = 0; k < 8; ++k) {
-            if (!valid[k] || m.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID || !(m.ray.tfar[k] < rh.ray.tfar[k]))
-                continue;
+            if (!valid[k] || m.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID || !(m.ray.tfar[k] < rh.ray.tfar[k])) continue;
             rh.ray.tfar[k] = m.ray.tfar[k];
             rh.hit.Ng_x[k] = m.hit.Ng_x[k];
             rh.hit.Ng_y[k] = m.hit.Ng_y[k];

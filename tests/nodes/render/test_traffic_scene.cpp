@@ -119,7 +119,10 @@ TEST(TrafficScene, FramesMoveTheSameNodesAndSplitThemBetweenGlAndRays) {
             EXPECT_EQ(x->getNodeMask() != 0u, gl) << "agent " << a.agent << " t " << t;
             EXPECT_EQ(ts.labelNode()->getChild(a.agent)->getNodeMask() != 0u, gl);
             if (gl) {
-                EXPECT_NEAR(pos.x(), 10.0 + 15.0 * a.agent + kSpeed * t - (a.agent % 2 == 0 ? 0.5 * ts.models().models[a.prototype].length : 0.0), 1e-4);
+                EXPECT_NEAR(pos.x(),
+                            10.0 + 15.0 * a.agent + kSpeed * t -
+                                (a.agent % 2 == 0 ? 0.5 * ts.models().models[a.prototype].length : 0.0),
+                            1e-4);
                 ++shown;
             }
             if (far) {

@@ -179,7 +179,7 @@ TEST(RayMovers, QueriesSeeTheCityAndTheMoversAsOneScene) {
         MoverPlacement p;
         p.prototype = uint32_t(i % 3);
         p.transform = glm::rotate(glm::translate(glm::dmat4(1.0), glm::dvec3(5000.0 + pos(rng), -3000.0 + pos(rng),
-                                                                              unit(rng) < 0.2 ? 10.0 * unit(rng) : 0.0)),
+                                                                             unit(rng) < 0.2 ? 10.0 * unit(rng) : 0.0)),
                                   yaw(rng), glm::dvec3(0, 0, 1));
         p.id = 1000u + uint32_t(i);
         p.cls = uint8_t(i % 2 ? 15 : 16);
@@ -197,11 +197,12 @@ TEST(RayMovers, QueriesSeeTheCityAndTheMoversAsOneScene) {
     std::vector<float> tfars;
     for (int i = 0; i < n; ++i) {
         // Eye-height and roof-height origins, mostly near-horizontal rays (the far field's), some down.
-        const glm::dvec3 o(5000.0 + pos(rng), -3000.0 + pos(rng), unit(rng) < 0.7 ? 1.0 + 2.0 * unit(rng) : 40.0 * unit(rng));
+        const glm::dvec3 o(5000.0 + pos(rng), -3000.0 + pos(rng),
+                           unit(rng) < 0.7 ? 1.0 + 2.0 * unit(rng) : 40.0 * unit(rng));
         const double h = yaw(rng), p = unit(rng) < 0.7 ? -0.1 * unit(rng) : -1.5 * unit(rng);
         orgs.push_back(glm::vec3(o - frame));
-        dirs.push_back(glm::normalize(glm::vec3(float(std::cos(h) * std::cos(p)), float(std::sin(h) * std::cos(p)),
-                                                float(std::sin(p)))));
+        dirs.push_back(glm::normalize(
+            glm::vec3(float(std::cos(h) * std::cos(p)), float(std::sin(h) * std::cos(p)), float(std::sin(p)))));
         tfars.push_back(float(300.0 * unit(rng)));
     }
     std::vector<RayHit> many(n);
@@ -265,9 +266,7 @@ TEST(RayMovers, QueriesSeeTheCityAndTheMoversAsOneScene) {
         if (b.hit && (b.edge < 1e-4 || b.second - b.t < 1e-3)) continue;
         const RayHit h = s.intersect(orgs[i], dirs[i]);
         ASSERT_EQ(h.hit, b.hit) << "ray " << i;
-        if (b.hit) {
-            EXPECT_EQ(s.source(h).mover, -1);
-        }
+        if (b.hit) { EXPECT_EQ(s.source(h).mover, -1); }
     }
 }
 
