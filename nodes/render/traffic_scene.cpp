@@ -16,9 +16,22 @@
 
 namespace vista {
 
+// The GL side: one MatrixTransform per agent (and its label twin), made
+// when the agent is first drawn and a child of node() (labelNode()) from
+// then on, in agent-number order; an agent not drawn this frame has node
+// mask 0. A frame therefore changes masks and matrices, never the children.
 struct TrafficScene::Impl {
     std::vector<osg::ref_ptr<osg::Geode>> protos;                 // colour geometry per prototype
     std::vector<osg::ref_ptr<osg::MatrixTransform>> xf, labelXf;  // per agent, made on first use
+    std::vector<uint32_t> children;                               // agents of node()'s children, in order
+    std::vector<uint32_t> shown;                                  // agents whose node mask is on
+    std::vector<uint8_t> isShown;                                 // per agent: in `shown`
+    size_t made = 0;                                              // MatrixTransforms made (colour and label)
+    // Scratch of apply(), kept across frames.
+    std::vector<uint32_t> castAgents;
+    std::vector<glm::dmat4> castXf;
+    std::vector<MoverPlacement> movers;
+    std::vector<uint32_t> nextShown;
 };
 
 namespace {
@@ -153,61 +166,89 @@ Status TrafficScene::setSplit(double nearDistance) {
     return apply();
 }
 
+size_t TrafficScene::nodesMade() const { return _impl->made; }
+
+// The agent's nodes (made and inserted among node()'s children in agent order
+// on its first use), shown at `transform`.
+void TrafficScene::show(uint32_t agent, uint32_t prototype, const glm::dmat4& transform) {
+    Impl& im = *_impl;
+    if (im.xf.size() <= agent) {
+        im.xf.resize(size_t(agent) + 1);
+        im.labelXf.resize(size_t(agent) + 1);
+        im.isShown.resize(size_t(agent) + 1, 0);
+    }
+    osg::ref_ptr<osg::MatrixTransform>& x = im.xf[agent];
+    osg::ref_ptr<osg::MatrixTransform>& lx = im.labelXf[agent];
+    if (!x) {
+        x = new osg::MatrixTransform;
+        x->setDataVariance(osg::Object::DYNAMIC);
+        x->addChild(im.protos[prototype].get());
+        ++im.made;
+        const size_t at = size_t(std::lower_bound(im.children.begin(), im.children.end(), agent) - im.children.begin());
+        im.children.insert(im.children.begin() + std::ptrdiff_t(at), agent);
+        _node->insertChild(unsigned(at), x.get());
+        if (_labelNode) {
+            lx = new osg::MatrixTransform;
+            lx->setDataVariance(osg::Object::DYNAMIC);
+            const AgentType type = _tracks->agentTypes[agent];
+            auto* geo = static_cast<osg::Geometry*>(im.protos[prototype]->getDrawable(0));
+            lx->addChild(labelGeode(*geo, agentLabel(type, agent), agentClass(type)).get());
+            ++im.made;
+            _labelNode->insertChild(unsigned(at), lx.get());
+        }
+    }
+    const osg::Matrixd m = toOsg(transform);
+    if (x->getMatrix() != m) {
+        x->setMatrix(m);
+        if (lx) lx->setMatrix(m);
+    }
+    if (!im.isShown[agent]) {
+        x->setNodeMask(~0u);
+        if (lx) lx->setNodeMask(~0u);
+    }
+}
+
 Status TrafficScene::apply() {
     Impl& im = *_impl;
-    _node->removeChildren(0, _node->getNumChildren());
-    if (_labelNode) _labelNode->removeChildren(0, _labelNode->getNumChildren());
-    std::vector<uint32_t> castAgents;
-    std::vector<glm::dmat4> castXf;
-    std::vector<MoverPlacement> movers;
+    im.castAgents.clear();
+    im.castXf.clear();
+    im.movers.clear();
+    im.nextShown.clear();
     _drawn = 0;
     for (const AgentPlacement& a : _placed) {
         if (carries(a, _models.models[a.prototype], _eye)) continue;  // the camera's own vehicle
         const double d = glm::length(a.centre - _eye);
         const bool gl = _split > 0 && d - a.radius <= _split;
         const bool rays = d + a.radius > _split;
-        if (rays) {
-            castAgents.push_back(a.agent);
-            castXf.push_back(a.transform);
+        if (rays && _rays) {
+            im.castAgents.push_back(a.agent);
+            im.castXf.push_back(a.transform);
             const AgentType type = _tracks->agentTypes[a.agent];
-            movers.push_back({a.prototype, a.transform, agentLabel(type, a.agent), agentClass(type)});
+            im.movers.push_back({a.prototype, a.transform, agentLabel(type, a.agent), agentClass(type)});
         }
         if (!gl) continue;
-        if (im.xf.size() <= a.agent) {
-            im.xf.resize(size_t(a.agent) + 1);
-            im.labelXf.resize(size_t(a.agent) + 1);
-        }
-        osg::ref_ptr<osg::MatrixTransform>& x = im.xf[a.agent];
-        if (!x) {
-            x = new osg::MatrixTransform;
-            x->setDataVariance(osg::Object::DYNAMIC);
-            x->addChild(im.protos[a.prototype].get());
-        }
-        x->setMatrix(toOsg(a.transform));
-        _node->addChild(x.get());
-        if (_labelNode) {
-            osg::ref_ptr<osg::MatrixTransform>& lx = im.labelXf[a.agent];
-            if (!lx) {
-                lx = new osg::MatrixTransform;
-                lx->setDataVariance(osg::Object::DYNAMIC);
-                const AgentType type = _tracks->agentTypes[a.agent];
-                auto* geo = static_cast<osg::Geometry*>(im.protos[a.prototype]->getDrawable(0));
-                lx->addChild(labelGeode(*geo, agentLabel(type, a.agent), agentClass(type)).get());
-            }
-            lx->setMatrix(toOsg(a.transform));
-            _labelNode->addChild(lx.get());
-        }
+        show(a.agent, a.prototype, a.transform);
+        im.nextShown.push_back(a.agent);
         ++_drawn;
     }
+    // Hide the agents drawn before and not now; mark the shown ones.
+    for (uint32_t agent : im.shown) im.isShown[agent] = 0;
+    for (uint32_t agent : im.nextShown) im.isShown[agent] = 1;
+    for (uint32_t agent : im.shown)
+        if (!im.isShown[agent]) {
+            im.xf[agent]->setNodeMask(0u);
+            if (im.labelXf[agent]) im.labelXf[agent]->setNodeMask(0u);
+        }
+    std::swap(im.shown, im.nextShown);
     if (!_rays) {
         _cast = 0;
         return Status::ok();
     }
-    if (castAgents == _castAgents && castXf == _castTransforms) return Status::ok();
-    _castAgents = std::move(castAgents);
-    _castTransforms = std::move(castXf);
-    _cast = movers.size();
-    return _rays->placeMovers(movers);
+    if (im.castAgents == _castAgents && im.castXf == _castTransforms) return Status::ok();
+    std::swap(_castAgents, im.castAgents);
+    std::swap(_castTransforms, im.castXf);
+    _cast = im.movers.size();
+    return _rays->placeMovers(im.movers);
 }
 
 }  // namespace vista

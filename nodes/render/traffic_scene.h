@@ -5,12 +5,14 @@
 // Contract:
 // - The agent meshes (agent_models.h) become one shared osg::Geometry per
 //   prototype (VBOs, prelit colours, lighting off, back faces culled, as the
-//   city root); each agent present at the frame's time gets an
-//   osg::MatrixTransform (double: model frame -> world) over its prototype,
-//   made when the agent first appears and kept for the run. With labels, a
-//   label twin per agent (the same vertex arrays; per-vertex attributes
-//   kLabelAttrib = the agent's instance id, kLabelClassAttrib = its class,
-//   nodes/label_pass.h) under labelNode().
+//   city root); each agent drawn in GL gets an osg::MatrixTransform (double:
+//   model frame -> world) over its prototype, made when the agent is first
+//   drawn and kept for the run as a child of node() (children in agent-number
+//   order); an agent not drawn at a frame has node mask 0, so a frame sets
+//   masks and the matrices that changed, and never rebuilds the children.
+//   With labels, a label twin per agent (the same vertex arrays; per-vertex
+//   attributes kLabelAttrib = the agent's instance id, kLabelClassAttrib =
+//   its class, nodes/label_pass.h) under labelNode(), shown alike.
 // - setFrame(t, eye) places the agents of time t (placeAgents) and draws
 //   every one of them in GL (node(), labelNode()); setSplit(d) then keeps in
 //   GL only the agents whose bounding sphere reaches within d metres of the
@@ -68,9 +70,12 @@ public:
     double tallestAgent() const;                  // metres: the tallest model's height
     size_t drawnCount() const { return _drawn; }  // agents in GL this frame
     size_t castCount() const { return _cast; }    // agents in the ray scene this frame
+    // MatrixTransforms made so far (an agent's and its label twin's, once per run).
+    size_t nodesMade() const;
 
 private:
     Status apply();
+    void show(uint32_t agent, uint32_t prototype, const glm::dmat4& transform);
     std::shared_ptr<const TrafficTracks> _tracks;
     CityParams _params;
     bool _labels;

@@ -13,6 +13,14 @@
 // (docs/measurements/raw-rays.md: the colour fetch was the wrapper's largest cost).
 // A soup scene: one triangle geometry on a device shared by all soup scenes
 // (so the bake does not create a device per impostor); no robust flag.
+// Moving objects (placeMovers): instances in a scene of their own beside the
+// top level, committed per frame; the top level of regions and trees (often
+// thousands of instances) is never rebuilt for them. Every query traces the
+// top level first and then, when objects are placed, the movers' scene with
+// the far limit at the first hit: the nearer hit wins (the top level's at an
+// equal distance), occlusion is either. A mover's hit carries its instance
+// id in the movers' scene with kMoverInstBit set, so hit ids (SurfaceKey)
+// never collide with the top level's.
 #include "runtime/engine/ray_scene.h"
 
 #include "runtime/engine/ray_packet.h"
@@ -70,6 +78,10 @@ void errorCallback(void* userPtr, RTCError code, const char* str) {
 struct TriColors {
     glm::u8vec4 c[3];
 };
+
+// Marks RayHit::instId of a hit in the movers' scene (never a top-level id:
+// Embree's ids are dense from 0).
+constexpr uint32_t kMoverInstBit = 0x80000000u;
 
 std::vector<TriColors> triangleColors(const std::vector<glm::u8vec4>& colors, const std::vector<uint32_t>& indices) {
     std::vector<TriColors> t(indices.size() / 3);
@@ -176,12 +188,16 @@ struct RayScene::Impl {
     std::shared_ptr<PrototypeSet> moverProtos;  // setMoverPrototypes
     std::vector<glm::dvec4> moverBounds;        // per prototype: bounding sphere in its frame
     std::vector<glm::dvec4> moverSpheres;       // per placed object: world bounding sphere
-    std::vector<unsigned> moverGeoms;           // the pool of mover instances (top-level ids)
+    RTCScene movers = nullptr;                  // the movers' scene (setMoverPrototypes makes it)
+    std::vector<TopGeom> moverTops;             // per geometry id of `movers`
+    std::vector<unsigned> moverGeoms;           // the pool of mover instances (ids in `movers`)
     size_t moversLive = 0;
+    bool moversOn = false;  // some mover instance is enabled: queries trace `movers` too
 
     ~Impl() {
         for (Region& r : regions)
             if (r.scene) rtcReleaseScene(r.scene);
+        if (movers) rtcReleaseScene(movers);
         if (scene) rtcReleaseScene(scene);
         regions.clear();
         flatProtos.reset();
@@ -202,8 +218,20 @@ struct RayScene::Impl {
         return geoms[id];
     }
 
-    // The mesh a hit of (geomID, instID) struck, or null for a tree.
+    // What instance id `instID` (RTC_INVALID_GEOMETRY_ID: none) of a hit names:
+    // a mover (kMoverInstBit) or a top-level geometry; null when out of range.
+    const TopGeom* instanceOf(unsigned instID) const {
+        if (instID == RTC_INVALID_GEOMETRY_ID) return nullptr;
+        if (instID & kMoverInstBit) {
+            const unsigned m = instID & ~kMoverInstBit;
+            return m < moverTops.size() ? &moverTops[m] : nullptr;
+        }
+        return instID < geoms.size() ? &geoms[instID] : nullptr;
+    }
+
+    // The mesh a hit of (geomID, instID) struck, or null for a tree or a mover.
     const MeshInfo* meshOf(unsigned geomID, unsigned instID) const {
+        if (instID != RTC_INVALID_GEOMETRY_ID && (instID & kMoverInstBit)) return nullptr;
         const unsigned t = instID != RTC_INVALID_GEOMETRY_ID ? instID : geomID;
         if (t >= geoms.size()) return nullptr;
         const TopGeom& g = geoms[t];
@@ -217,11 +245,65 @@ struct RayScene::Impl {
     const std::vector<TriColors>* colorsOf(unsigned geomID, unsigned instID, const TopGeom** tree) const {
         *tree = nullptr;
         if (const MeshInfo* m = meshOf(geomID, instID)) return &m->colors;
-        if (instID == RTC_INVALID_GEOMETRY_ID || instID >= geoms.size()) return nullptr;
-        const TopGeom& g = geoms[instID];
-        if (g.kind != TopGeom::Kind::Tree && g.kind != TopGeom::Kind::Mover) return nullptr;
-        *tree = &g;
-        return &g.protos->colors[size_t(g.prototype)];
+        const TopGeom* g = instanceOf(instID);
+        if (!g || (g->kind != TopGeom::Kind::Tree && g->kind != TopGeom::Kind::Mover)) return nullptr;
+        *tree = g;
+        return &g->protos->colors[size_t(g->prototype)];
+    }
+
+    // One ray: the top level, then the movers nearer than its hit. rh as
+    // rtcIntersect1 leaves it; a mover's hit has kMoverInstBit in instID[0].
+    void intersect1(RTCIntersectContext& ctx, RTCRayHit& rh) const {
+        rtcIntersect1(scene, &ctx, &rh);
+        if (!moversOn) return;
+        RTCRayHit m = rh;
+        m.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        m.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(movers, &ctx, &m);
+        if (m.hit.geomID == RTC_INVALID_GEOMETRY_ID || !(m.ray.tfar < rh.ray.tfar)) return;
+        m.hit.instID[0] |= kMoverInstBit;
+        rh = m;
+    }
+    // A packet of 8, as intersect1 per lane.
+    void intersect8(const int* valid, RTCIntersectContext& ctx, RTCRayHit8& rh) const {
+        rtcIntersect8(valid, scene, &ctx, &rh);
+        if (!moversOn) return;
+        alignas(32) RTCRayHit8 m;
+        m.ray = rh.ray;  // tfar: the top level's hit where there is one
+        for (int k = 0; k < 8; ++k) {
+            m.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+            m.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect8(valid, movers, &ctx, &m);
+        for (int k = 0; k < 8; ++k) {
+            if (!valid[k] || m.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID || !(m.ray.tfar[k] < rh.ray.tfar[k])) continue;
+            rh.ray.tfar[k] = m.ray.tfar[k];
+            rh.hit.Ng_x[k] = m.hit.Ng_x[k];
+            rh.hit.Ng_y[k] = m.hit.Ng_y[k];
+            rh.hit.Ng_z[k] = m.hit.Ng_z[k];
+            rh.hit.u[k] = m.hit.u[k];
+            rh.hit.v[k] = m.hit.v[k];
+            rh.hit.primID[k] = m.hit.primID[k];
+            rh.hit.geomID[k] = m.hit.geomID[k];
+            rh.hit.instID[0][k] = m.hit.instID[0][k] | kMoverInstBit;
+        }
+    }
+    // Occlusion of one ray: the top level, then (not occluded there) the movers.
+    void occluded1(RTCIntersectContext& ctx, RTCRay& r) const {
+        rtcOccluded1(scene, &ctx, &r);
+        if (moversOn && !(r.tfar < 0.0f)) rtcOccluded1(movers, &ctx, &r);
+    }
+    // A packet of 8, as occluded1 per lane (valid: the lanes to test; changed).
+    void occluded8(int* valid, RTCIntersectContext& ctx, RTCRay8& r) const {
+        rtcOccluded8(valid, scene, &ctx, &r);
+        if (!moversOn) return;
+        alignas(32) int rest[8];
+        bool any = false;
+        for (int k = 0; k < 8; ++k) {
+            rest[k] = valid[k] && !(r.tfar[k] < 0.0f) ? -1 : 0;
+            any = any || rest[k];
+        }
+        if (any) rtcOccluded8(rest, movers, &ctx, &r);
     }
 
     void fill(RayHit& h, unsigned geomID, unsigned primID, unsigned instID, float u, float v, float t, float nx,
@@ -760,6 +842,23 @@ Status RayScene::setMoverPrototypes(const std::vector<SceneMesh>& prototypes) {
     model.prototypes = prototypes;
     auto protos = im.buildPrototypes(model);
     if (!protos.isOk()) return protos.status();
+    if (!im.movers) {
+        // Small and rebuilt per frame: the quick build; robust traversal as the top level.
+        im.movers = rtcNewScene(im.device);
+        rtcSetSceneFlags(im.movers, RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_DYNAMIC));
+        rtcSetSceneBuildQuality(im.movers, RTC_BUILD_QUALITY_LOW);
+        rtcCommitScene(im.movers);
+        VISTA_RETURN_IF_ERROR(im.checkDevice("making the scene of moving objects"));
+    }
+    // Placed objects of the old prototypes are hidden (their scenes are released with the old set).
+    for (size_t i = 0; i < im.moversLive && i < im.moverGeoms.size(); ++i) {
+        rtcDisableGeometry(rtcGetGeometry(im.movers, im.moverGeoms[i]));
+        im.moverTops[im.moverGeoms[i]] = Impl::TopGeom();
+    }
+    if (im.moversLive > 0) rtcCommitScene(im.movers);
+    im.moversLive = 0;
+    im.moversOn = false;
+    im.moverSpheres.clear();
     im.moverProtos = *protos;
     im.moverBounds.clear();
     for (const SceneMesh& p : prototypes) {
@@ -781,35 +880,41 @@ Status RayScene::placeMovers(const std::vector<MoverPlacement>& movers) {
         if (p.prototype >= protoCount)
             return Status::error("ray scene: moving object of prototype " + std::to_string(p.prototype) + " (have " +
                                  std::to_string(protoCount) + ")");
+    if (!im.movers) return Status::ok();  // no prototypes, so nothing to place (movers is empty)
     im.moverSpheres.clear();
     for (const MoverPlacement& p : movers) {
         const glm::dvec4 b = im.moverBounds[p.prototype];
         im.moverSpheres.push_back(glm::dvec4(glm::dvec3(p.transform * glm::dvec4(glm::dvec3(b), 1.0)), b.w));
     }
+    bool on = false;
     for (size_t i = 0; i < movers.size(); ++i) {
         const MoverPlacement& p = movers[i];
         RTCScene child = im.moverProtos->scenes[p.prototype];
         if (i == im.moverGeoms.size()) {
             RTCGeometry g = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_INSTANCE);
             rtcSetGeometryTimeStepCount(g, 1);
-            im.moverGeoms.push_back(rtcAttachGeometry(im.scene, g));
+            const unsigned id = rtcAttachGeometry(im.movers, g);
             rtcReleaseGeometry(g);
+            im.moverGeoms.push_back(id);
+            if (im.moverTops.size() <= id) im.moverTops.resize(size_t(id) + 1);
         }
         const unsigned id = im.moverGeoms[i];
-        RTCGeometry g = rtcGetGeometry(im.scene, id);
-        Impl::TopGeom& tg = im.top(id);
+        RTCGeometry g = rtcGetGeometry(im.movers, id);
+        Impl::TopGeom& tg = im.moverTops[id];
         if (!child) {  // an empty prototype: nothing to hit
             rtcDisableGeometry(g);
             tg.kind = Impl::TopGeom::Kind::None;
             continue;
         }
-        if (tg.kind != Impl::TopGeom::Kind::Mover || tg.prototype != int(p.prototype))
+        if (tg.kind != Impl::TopGeom::Kind::Mover || tg.prototype != int(p.prototype) ||
+            tg.protos != im.moverProtos.get())
             rtcSetGeometryInstancedScene(g, child);
         float m[12];
         embreeTransform(p.transform, im.origin, m);
         rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, m);
         rtcEnableGeometry(g);
         rtcCommitGeometry(g);
+        on = true;
         tg.kind = Impl::TopGeom::Kind::Mover;
         tg.index = -1;
         tg.prototype = int(p.prototype);
@@ -821,11 +926,12 @@ Status RayScene::placeMovers(const std::vector<MoverPlacement>& movers) {
         tg.moverClass = p.cls;
     }
     for (size_t i = movers.size(); i < im.moversLive && i < im.moverGeoms.size(); ++i) {
-        rtcDisableGeometry(rtcGetGeometry(im.scene, im.moverGeoms[i]));
-        im.top(im.moverGeoms[i]).kind = Impl::TopGeom::Kind::None;
+        rtcDisableGeometry(rtcGetGeometry(im.movers, im.moverGeoms[i]));
+        im.moverTops[im.moverGeoms[i]].kind = Impl::TopGeom::Kind::None;
     }
     im.moversLive = movers.size();
-    rtcCommitScene(im.scene);
+    rtcCommitScene(im.movers);  // the movers' scene alone: the top level is left as it is
+    im.moversOn = on;
     return im.checkDevice("placing moving objects");
 }
 
@@ -843,9 +949,7 @@ Status RayScene::setFrameOrigin(const glm::dvec3& frameOrigin) {
     im.origin = next;
     for (size_t id = 0; id < im.geoms.size(); ++id) {
         const Impl::TopGeom& g = im.geoms[id];
-        if (g.kind != Impl::TopGeom::Kind::Region && g.kind != Impl::TopGeom::Kind::Tree &&
-            g.kind != Impl::TopGeom::Kind::Mover)
-            continue;
+        if (g.kind != Impl::TopGeom::Kind::Region && g.kind != Impl::TopGeom::Kind::Tree) continue;
         RTCGeometry geom = rtcGetGeometry(im.scene, unsigned(id));
         float m[12];
         embreeTransform(g.transform, im.origin, m);
@@ -853,6 +957,18 @@ Status RayScene::setFrameOrigin(const glm::dvec3& frameOrigin) {
         rtcCommitGeometry(geom);
     }
     rtcCommitScene(im.scene);
+    if (im.movers) {
+        for (size_t id = 0; id < im.moverTops.size(); ++id) {
+            const Impl::TopGeom& g = im.moverTops[id];
+            if (g.kind != Impl::TopGeom::Kind::Mover) continue;
+            RTCGeometry geom = rtcGetGeometry(im.movers, unsigned(id));
+            float m[12];
+            embreeTransform(g.transform, im.origin, m);
+            rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, m);
+            rtcCommitGeometry(geom);
+        }
+        rtcCommitScene(im.movers);
+    }
     return im.checkDevice("moving the frame origin");
 }
 
@@ -925,8 +1041,9 @@ HitSource RayScene::source(const RayHit& h) const {
         if (instId != RTC_INVALID_GEOMETRY_ID) s.region = im.geoms[instId].index;
         return s;
     }
-    if (instId == RTC_INVALID_GEOMETRY_ID || instId >= im.geoms.size()) return s;
-    const Impl::TopGeom& g = im.geoms[instId];
+    const Impl::TopGeom* gp = im.instanceOf(instId);
+    if (!gp) return s;
+    const Impl::TopGeom& g = *gp;
     if (g.kind == Impl::TopGeom::Kind::Mover) {
         s.mover = g.instance;
         s.moverId = g.moverId;
@@ -960,7 +1077,7 @@ RayHit RayScene::intersect(const glm::vec3& org, const glm::vec3& dir, float tne
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     RayHit out;
     if (!(tnear <= tfar)) return out;
-    rtcIntersect1(_impl->scene, &ctx, &rh);
+    _impl->intersect1(ctx, rh);
     if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
         _impl->fill(out, rh.hit.geomID, rh.hit.primID, rh.hit.instID[0], rh.hit.u, rh.hit.v, rh.ray.tfar, rh.hit.Ng_x,
                     rh.hit.Ng_y, rh.hit.Ng_z);
@@ -986,7 +1103,7 @@ void RayScene::intersectMany(const glm::vec3* org, const glm::vec3* dir, int n, 
                              const float* tfars, float tnear) const {
     forPackets8(_impl->ftz, n, [&](RTCIntersectContext& ctx, RTCRayHit8& rh, int* valid, int base, int m) {
         fillPacket8(rh, valid, org, dir, tfars, tfar, size_t(base), m, tnear);
-        rtcIntersect8(valid, _impl->scene, &ctx, &rh);
+        _impl->intersect8(valid, ctx, rh);
         for (int k = 0; k < m; ++k) {
             RayHit& h = out[base + k];
             h = RayHit();
@@ -1003,7 +1120,7 @@ void RayScene::occludedMany(const glm::vec3* org, const glm::vec3* dir, int n, c
         fillPacket8(rh, valid, org, dir, tfars, 0.0f, size_t(base), m, tnear);
         for (int k = 0; k < m; ++k)
             if (!(rh.ray.tnear[k] <= rh.ray.tfar[k])) valid[k] = 0;  // empty interval: not occluded
-        rtcOccluded8(valid, _impl->scene, &ctx, &rh.ray);
+        _impl->occluded8(valid, ctx, rh.ray);
         for (int k = 0; k < m; ++k) out[base + k] = valid[k] && rh.ray.tfar[k] < 0.0f ? 1 : 0;
     });
 }
@@ -1024,7 +1141,7 @@ bool RayScene::occluded(const glm::vec3& org, const glm::vec3& dir, float tnear,
     r.tnear = tnear;
     r.tfar = tfar;
     r.mask = 0xFFFFFFFFu;
-    rtcOccluded1(_impl->scene, &ctx, &r);
+    _impl->occluded1(ctx, r);
     return r.tfar < 0.0f;  // Embree sets tfar = -inf on occlusion
 }
 
@@ -1061,7 +1178,7 @@ void RayScene::allHitsMany(const glm::vec3* org, const glm::vec3* dir, int n, co
                 if (k < m) rh.ray.tnear[k] = t0[k];
             }
             if (!any) break;
-            rtcIntersect8(valid, _impl->scene, &ctx, &rh);
+            _impl->intersect8(valid, ctx, rh);
             for (int k = 0; k < m; ++k) {
                 if (!live[k]) continue;
                 if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) {
@@ -1094,5 +1211,7 @@ glm::vec3 RayScene::hitColor(const RayHit& h) const {
 size_t RayScene::triangleCount() const { return _impl->triangles; }
 
 RTCSceneTy* RayScene::embreeScene() const { return _impl->scene; }
+
+RTCSceneTy* RayScene::embreeMoverScene() const { return _impl->movers; }
 
 }  // namespace vista

@@ -58,6 +58,8 @@ struct RayHit {
     float t = 0;             // distance along the (unit) ray direction, metres
     glm::u8vec4 color{0};    // prelit colour at the hit
     glm::vec3 normal{0.0f};  // geometric normal, scene-local frame
+    // Embree's ids of the hit; instId 0xFFFFFFFF: none; a moving object's hit
+    // (placeMovers) has the top bit of instId set (ids unique across both scenes).
     uint32_t geomId = 0, primId = 0, instId = 0xFFFFFFFFu;
     float u = 0, v = 0;  // barycentric coordinates of the hit in its triangle
 };
@@ -193,13 +195,18 @@ public:
     Status commit();
     // Moving objects (a traffic run's agents, city scenes): the prototype
     // meshes (SceneMesh positions relative to their origin, in the
-    // prototype frame; colours per vertex) become Embree scenes once;
-    // placeMovers() then shows exactly the given objects, one top-level
-    // instance each, re-placed or hidden (rtcDisableGeometry) from a pool of
-    // instances, and commits the top level only (no prototype or region BVH
-    // is rebuilt). Hits report the object's index and label (HitSource).
-    // Errors: a malformed prototype, an unknown prototype index, an Embree
-    // error. A scene without placeMovers() calls has no mover in it.
+    // prototype frame; colours per vertex) become Embree scenes once, and the
+    // first call makes the movers' scene: a small instance scene beside the
+    // top level (which is never rebuilt for movers). placeMovers() then shows
+    // exactly the given objects, one instance each in the movers' scene,
+    // re-placed or hidden (rtcDisableGeometry) from a pool of instances, and
+    // commits that scene alone. Every query sees both scenes as one: the
+    // nearer hit (the top level's at an equal distance), occluded by either;
+    // while no object is placed, queries trace the top level alone. Hits
+    // report the object's index and label (HitSource). A new prototype set
+    // hides the objects placed before. Errors: a malformed prototype, an
+    // unknown prototype index, an Embree error. A scene without
+    // setMoverPrototypes() has no movers' scene and no mover in it.
     Status setMoverPrototypes(const std::vector<SceneMesh>& prototypes);
     Status placeMovers(const std::vector<MoverPlacement>& movers);
     size_t moverCount() const;  // objects of the last placeMovers()
@@ -220,10 +227,14 @@ public:
     // Within 710 m of the eye the float step of a ray origin is 61 um at
     // most. No-op for flat and soup scenes. Not while another thread queries.
     Status placeFrameNear(const glm::dvec3& eye);
-    // The committed Embree scene (RTCScene), for timing raw Embree on the same
+    // The committed top-level Embree scene (RTCScene; the moving objects are
+    // in embreeMoverScene()), for timing raw Embree on the same
     // BVH (tests/bench/bench_raw_rays.cpp). Read-only queries only; owned
     // here (never release or modify it); the caller sets FTZ/DAZ itself.
     RTCSceneTy* embreeScene() const;
+    // The movers' Embree scene (setMoverPrototypes), null when there is none;
+    // the same terms as embreeScene().
+    RTCSceneTy* embreeMoverScene() const;
 
 private:
     RayScene();
