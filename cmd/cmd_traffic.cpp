@@ -69,10 +69,12 @@ int runTraffic(int argc, char** argv) {
         return reportBadInput(cmd, s);
     if (!quiet)
         std::fprintf(stderr,
-                     "wrote %s: %d vehicles inserted, %d pedestrians, over %g s (SUMO %s): %d collisions, %d "
-                     "teleports, %d emergency stops\n",
+                     "wrote %s: %d vehicles inserted, %d pedestrians, over %g s (SUMO %s): %d collisions (%d "
+                     "vehicle-pedestrian, %d vehicle-vehicle records in collisions.xml), %d teleports, %d "
+                     "emergency stops\n",
                      out.c_str(), sum.vehiclesInserted, sum.personsInserted, opt.demand.durationS,
-                     sum.sumoVersion.c_str(), sum.collisions, sum.teleports, sum.emergencyStops);
+                     sum.sumoVersion.c_str(), sum.collisions, sum.collisionEvents.withPedestrians,
+                     sum.collisionEvents.betweenVehicles, sum.teleports, sum.emergencyStops);
     return 0;
 }
 

@@ -3,7 +3,9 @@
 # its defaults (300 vehicles, 300 pedestrians, 600 s, 0.5 s steps) on the
 # default 2 km city and the OSM town (tests/data/osm/town.osm), seeds 1 to 3.
 # Per run: the seconds of each stage (netconvert, demand, sumo; from the
-# progress lines), SUMO's collisions and teleports, the share of vehicle
+# progress lines), SUMO's collisions (statistics.xml) and its collision records
+# by victim (collisions.xml: vehicle-pedestrian, vehicle-vehicle) and
+# teleports, the share of vehicle
 # samples within 10 cm of a lane centre evaluated from the .xodr
 # (tests/tools/traffic_check.py), red-light crossings and stops
 # (tests/tools/traffic_signals_check.py) and whether a second run with the
@@ -23,8 +25,8 @@ DOC_TMP_FILES+=("docs/measurements/.traffic.md.tmp")
 
 table="$OUT/table.md"
 {
-  echo "| city | seed | netconvert (s) | demand (s) | sumo (s) | vehicles | pedestrians | collisions | teleports | samples within 10 cm | red crossings | red stops | same bytes |"
-  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+  echo "| city | seed | netconvert (s) | demand (s) | sumo (s) | vehicles | pedestrians | collisions | records veh–ped | records veh–veh | teleports | samples within 10 cm | red crossings | red stops | same bytes |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 } >"$table"
 for city in default town; do
   for seed in 1 2 3; do
@@ -48,8 +50,10 @@ t = json.load(open(run + "/traffic.json"))
 lanes = json.load(open(run + ".lanes.json"))
 sig = json.load(open(run + ".signals.json"))
 s = t["sumo"]
+ev = s.get("collision_events", {})
 print(f"| {city} | {seed} | {stage('network')} | {stage('demand')} | {stage('simulation')} | "
-      f"{s['vehicles_inserted']} | {s['persons_loaded']} | {s['collisions']} | {s['teleports']} | "
+      f"{s['vehicles_inserted']} | {s['persons_loaded']} | {s['collisions']} | {ev.get('vehicle_pedestrian', '?')} | "
+      f"{ev.get('vehicle_vehicle', '?')} | {s['teleports']} | "
       f"{100 * lanes['share_within']:.2f} % | {sig['red_crossings']} | {sig['red_stop_events']} | {same} |")
 PYEOF
   done

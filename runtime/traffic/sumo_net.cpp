@@ -2,6 +2,9 @@
 
 #include <expat.h>
 
+#include <algorithm>
+#include <tuple>
+
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -50,6 +53,13 @@ struct Reader {
         int fromLane, toLane;
     };
     std::vector<PendingConnection> pending;
+    std::unordered_map<std::string, std::vector<uint32_t>> laneSignals;  // internal lane id -> signal ids
+    struct PendingLink {
+        std::string via, tl;
+        int linkIndex;
+    };
+    std::vector<PendingLink> pendingLinks;
+    std::string currentLane;  // the <lane> being read (its <param>s follow)
     bool sawRoot = false;
     int edgeDepth = -1, depth = 0;
     std::string error;
@@ -85,6 +95,7 @@ struct Reader {
             if (const char* i = attr(atts, "index")) l.index = std::atoi(i);
             if (const char* len = attr(atts, "length")) l.length = std::atof(len);
             l.allow = sumoPermissions(attr(atts, "allow"), attr(atts, "disallow"));
+            if (const char* id = attr(atts, "id")) currentLane = id;
             SumoEdge& e = net.edges.back();
             if (e.lanes.empty())
                 if (const char* shape = attr(atts, "shape")) middleOf(shape, &e.x, &e.y);
@@ -94,11 +105,25 @@ struct Reader {
             const char *fl = attr(atts, "fromLane"), *tl = attr(atts, "toLane");
             if (!from || !to || !fl || !tl) return fail("a <connection> lacks from, to, fromLane or toLane");
             pending.push_back({from, to, std::atoi(fl), std::atoi(tl)});
+            const char *via = attr(atts, "via"), *light = attr(atts, "tl"), *index = attr(atts, "linkIndex");
+            if (via && light && index) pendingLinks.push_back({via, light, std::atoi(index)});
+        } else if (std::strcmp(name, "param") == 0 && edgeDepth >= 0 && depth == edgeDepth + 2 &&
+                   !currentLane.empty()) {
+            const char *key = attr(atts, "key"), *value = attr(atts, "value");
+            if (key && value && std::strcmp(key, "signalID") == 0) {
+                char* end = nullptr;
+                const unsigned long id = std::strtoul(value, &end, 10);
+                if (end == value || *end != '\0' || id > 0xffffffffull)
+                    return fail(std::string("<param key=\"signalID\" value=\"") + value +
+                                "\"> is not an unsigned integer");
+                laneSignals[currentLane].push_back(uint32_t(id));
+            }
         } else if (std::strcmp(name, "tlLogic") == 0 && depth == 2) {
             if (const char* id = attr(atts, "id")) net.trafficLights.push_back(id);
         }
     }
     void end() {
+        if (edgeDepth >= 0 && depth == edgeDepth + 1) currentLane.clear();
         if (depth == edgeDepth) edgeDepth = -1;
         --depth;
     }
@@ -156,6 +181,23 @@ Result<SumoNet> readSumoNet(const std::string& path) {
                                  (from == r.edgeIndex.end() ? c.from : c.to) + "'");
         r.net.connections.push_back({from->second, to->second, c.fromLane, c.toLane});
     }
+    std::unordered_map<std::string, uint32_t> lightIndex;
+    for (size_t i = 0; i < r.net.trafficLights.size(); ++i) lightIndex[r.net.trafficLights[i]] = uint32_t(i);
+    for (const auto& l : r.pendingLinks) {
+        auto signals = r.laneSignals.find(l.via);
+        if (signals == r.laneSignals.end()) continue;
+        auto light = lightIndex.find(l.tl);
+        if (light == lightIndex.end())
+            return Status::error("SUMO network '" + path + "': a <connection> names the unknown traffic light '" +
+                                 l.tl + "'");
+        for (uint32_t id : signals->second) r.net.signalLinks.push_back({id, light->second, l.linkIndex});
+    }
+    auto key = [](const SumoSignalLink& a) { return std::make_tuple(a.signalId, a.light, a.linkIndex); };
+    std::sort(r.net.signalLinks.begin(), r.net.signalLinks.end(),
+              [&](const SumoSignalLink& a, const SumoSignalLink& b) { return key(a) < key(b); });
+    r.net.signalLinks.erase(std::unique(r.net.signalLinks.begin(), r.net.signalLinks.end(),
+                                        [&](const SumoSignalLink& a, const SumoSignalLink& b) { return key(a) == key(b); }),
+                            r.net.signalLinks.end());
     return std::move(r.net);
 }
 

@@ -9,6 +9,11 @@
 // - A lane's permissions are the classes of its `allow` list, or every class
 //   not in its `disallow` list, or every class (neither given), restricted
 //   to the classes vista's demand uses (TrafficClass).
+// - signalLinks: every junction link a traffic-light signal of the input
+//   OpenDRIVE controls: netconvert keeps the <signal id> on the link's
+//   internal lane (<param key="signalID">), and the <connection> through
+//   that lane names the light (tl) and the link's index in its state
+//   string. Sorted by (signalId, linkIndex), without repeats.
 // - readSumoNet() streams the file (expat); a file that is not a SUMO
 //   network, is truncated or malformed is an error naming the file, the line
 //   and the reason. Pure, thread-safe.
@@ -56,11 +61,18 @@ struct SumoConnection {
     int fromLane = 0, toLane = 0;
 };
 
+struct SumoSignalLink {
+    uint32_t signalId = 0;  // the OpenDRIVE <signal id> (vista: the LaneModel::signals index)
+    uint32_t light = 0;     // index into SumoNet::trafficLights
+    int linkIndex = 0;      // the link's letter in the light's state string
+};
+
 struct SumoNet {
     double offsetX = 0.0, offsetY = 0.0;  // <location netOffset>
     std::vector<SumoEdge> edges;
     std::vector<SumoConnection> connections;
     std::vector<std::string> trafficLights;  // tlLogic ids, in file order
+    std::vector<SumoSignalLink> signalLinks;
 };
 
 Result<SumoNet> readSumoNet(const std::string& path);

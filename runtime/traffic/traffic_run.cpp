@@ -51,6 +51,7 @@ std::string sumoConfig(const TrafficOptions& opt) {
            "    <output>\n"
            "        <fcd-output value=\"fcd.xml\"/>\n"
            "        <statistic-output value=\"statistics.xml\"/>\n"
+           "        <collision-output value=\"collisions.xml\"/>\n"
            "    </output>\n"
            "    <time>\n"
            "        <begin value=\"0\"/>\n"
@@ -120,6 +121,54 @@ Statistics readStatistics(const std::string& path) {
     return s;
 }
 
+}  // namespace
+
+Result<CollisionCounts> readCollisions(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return Status::error("cannot read SUMO's collision output '" + path + "': " + errnoText());
+    std::stringstream text;
+    text << in.rdbuf();
+    struct State {
+        CollisionCounts counts;
+        bool sawRoot = false;
+        std::string error;
+        XML_Parser parser = nullptr;
+    } st;
+    XML_Parser p = XML_ParserCreate(nullptr);
+    std::unique_ptr<XML_ParserStruct, void (*)(XML_Parser)> guard(p, &XML_ParserFree);
+    st.parser = p;
+    XML_SetUserData(p, &st);
+    XML_SetStartElementHandler(p, [](void* u, const XML_Char* name, const XML_Char** a) {
+        auto* st = static_cast<State*>(u);
+        if (!st->sawRoot) {
+            st->sawRoot = true;
+            if (std::strcmp(name, "collisions") != 0) {
+                st->error = std::string("the root element is <") + name + ">, not <collisions>";
+                XML_StopParser(st->parser, XML_FALSE);
+            }
+            return;
+        }
+        if (std::strcmp(name, "collision") != 0) return;
+        const char* victimType = nullptr;
+        for (int i = 0; a[i]; i += 2)
+            if (std::strcmp(a[i], "victimType") == 0) victimType = a[i + 1];
+        CollisionCounts& c = st->counts;
+        ++c.events;
+        if (victimType && std::strcmp(victimType, "pedestrian") == 0) ++c.withPedestrians;
+        else ++c.betweenVehicles;
+    });
+    const std::string body = text.str();
+    if (XML_Parse(p, body.data(), int(body.size()), 1) == XML_STATUS_ERROR || !st.error.empty()) {
+        const std::string why = st.error.empty() ? XML_ErrorString(XML_GetErrorCode(p)) : st.error;
+        return Status::error("SUMO's collision output '" + path + "', line " +
+                             std::to_string(XML_GetCurrentLineNumber(p)) + ": " + why);
+    }
+    if (!st.sawRoot) return Status::error("SUMO's collision output '" + path + "' is empty");
+    return st.counts;
+}
+
+namespace {
+
 Status writeText(const std::string& path, const std::string& text) { return writeFileAtomic(path, text); }
 
 // "<dir>.partial": created empty with its mark; an interrupted run's
@@ -180,7 +229,7 @@ Status runAll(const std::string& xodrText, const TrafficOptions& opt, const std:
 
     progress.begin("traffic: simulation (sumo)");
     VISTA_RETURN_IF_ERROR(runSumoProgram(*tools, tools->sumo, {"-c", "traffic.sumocfg"}, work, logs));
-    for (const char* out : {"fcd.xml", "signals.xml", "statistics.xml"})
+    for (const char* out : {"fcd.xml", "signals.xml", "statistics.xml", "collisions.xml"})
         VISTA_RETURN_IF_ERROR(stripGeneratedDate((w / out).string()));
     const Statistics st = readStatistics((w / "statistics.xml").string());
     if (!st.found) return Status::error("sumo wrote no readable statistics ('statistics.xml')");
@@ -189,6 +238,9 @@ Status runAll(const std::string& xodrText, const TrafficOptions& opt, const std:
     sum.collisions = st.collisions;
     sum.teleports = st.teleports;
     sum.emergencyStops = st.emergencyStops;
+    auto collisions = readCollisions((w / "collisions.xml").string());
+    if (!collisions) return collisions.status();
+    sum.collisionEvents = *collisions;
     progress.end();
 
     nlohmann::ordered_json j;
@@ -209,11 +261,15 @@ Status runAll(const std::string& xodrText, const TrafficOptions& opt, const std:
     j["sumo"] = {{"vehicles_inserted", sum.vehiclesInserted},
                  {"persons_loaded", sum.personsInserted},
                  {"collisions", sum.collisions},
+                 {"collision_events",
+                  {{"total", sum.collisionEvents.events},
+                   {"vehicle_pedestrian", sum.collisionEvents.withPedestrians},
+                   {"vehicle_vehicle", sum.collisionEvents.betweenVehicles}}},
                  {"teleports", sum.teleports},
                  {"emergency_stops", sum.emergencyStops}};
     j["files"] = {{"xodr", "city.xodr"},           {"net", "city.net.xml"}, {"demand", "demand.rou.xml"},
                   {"config", "traffic.sumocfg"},   {"fcd", "fcd.xml"},      {"signals", "signals.xml"},
-                  {"statistics", "statistics.xml"}};
+                  {"statistics", "statistics.xml"}, {"collisions", "collisions.xml"}};
     VISTA_RETURN_IF_ERROR(writeText((w / "traffic.json").string(), j.dump(2) + "\n"));
     std::error_code ec;
     fs::remove(logs, ec);

@@ -12,7 +12,8 @@
 //   guessed where the city has sidewalks), demand.rou.xml, traffic.sumocfg
 //   (sumo -c traffic.sumocfg in the folder runs it again), fcd.xml (SUMO's
 //   FCD: every agent at every step), signals.xml (SUMO's traffic-light
-//   states at every switch), traffic.json (the manifest: options, SUMO
+//   states at every switch), collisions.xml (SUMO's collision output: one
+//   <collision> per step and pair in contact), traffic.json (the manifest: options, SUMO
 //   version, network offset, counts and SUMO's statistics).
 // - The same xodr and options give the same bytes: SUMO runs single-threaded
 //   with the seed, and the wall-clock dates SUMO writes into its headers are
@@ -35,10 +36,25 @@ struct TrafficOptions {
     double stepS = 0.5;  // SUMO's step and the FCD's sample interval, seconds
 };
 
+// The <collision> records of SUMO's collision output. SUMO writes one
+// record per step in which a pair is in contact, so a contact lasting two
+// steps is two events (statistics.xml counts it once).
+struct CollisionCounts {
+    int events = 0;
+    int withPedestrians = 0;  // the victim is a pedestrian (on a crossing or walking area)
+    int betweenVehicles = 0;  // every other record (vehicle on vehicle, on a lane or in a junction)
+};
+
+// Reads SUMO's collision output (collisions.xml). A missing, truncated or
+// malformed file, or one whose root is not <collisions>, is an error naming
+// the file and the line. Pure, thread-safe.
+Result<CollisionCounts> readCollisions(const std::string& path);
+
 struct TrafficRunSummary {
     TrafficDemandCounts demand;
     int vehiclesInserted = 0, personsInserted = 0;
     int collisions = 0, teleports = 0, emergencyStops = 0;
+    CollisionCounts collisionEvents;
     double netOffsetX = 0.0, netOffsetY = 0.0;
     std::string sumoVersion;
 };
