@@ -6,7 +6,8 @@
 // between the two shots (from its FCD poses) seen by the moving camera,
 // within 0.05 px; the boxes carry the agent's class and a velocity that
 // agrees with SUMO's speed and heading; the KITTI tracking files name each
-// agent by one track id whose tracks.json entry is its SUMO id; every LiDAR
+// agent by one track id whose tracks.json entry is its SUMO id, and a
+// resumed run writes them byte for byte as an uninterrupted one; every LiDAR
 // point on an agent lies on that agent's box where the agent is at the
 // point's firing time (a slow 2 Hz LiDAR: agents move far during a sweep).
 #include <gtest/gtest.h>
@@ -61,7 +62,7 @@ const char* const kRig = R"({"sensors": [
 
 // The city, its traffic, a path riding one of its cars and the rig run, made once for the file.
 struct Fixture {
-    std::string city, traffic, path, out;
+    std::string city, traffic, path, rig, out;
     bool ok = false;
 };
 const Fixture& fixture() {
@@ -72,8 +73,8 @@ const Fixture& fixture() {
         f.traffic = dir->file("traffic");
         f.path = dir->file("ego.csv");
         f.out = dir->file("rig");
-        const std::string rig = dir->file("rig.json");
-        std::ofstream(rig) << kRig;
+        f.rig = dir->file("rig.json");
+        std::ofstream(f.rig) << kRig;
         auto r = runVista("gen --size 700 --detail 0 --seed 5 -q -o " + f.city);
         EXPECT_EQ(r.code, 0) << r.err;
         r = runVista("traffic " + f.city + " --vehicles 300 --pedestrians 30 --duration 120 --seed 4 -q -o " +
@@ -81,7 +82,7 @@ const Fixture& fixture() {
         EXPECT_EQ(r.code, 0) << r.err;
         r = runVista("path " + f.city + " --traffic " + f.traffic + " --seed 4 --duration 10 --dt 0.1 -o " + f.path);
         EXPECT_EQ(r.code, 0) << r.err;
-        r = runVista("render " + f.city + " --path " + f.path + " --rig " + rig + " --traffic " + f.traffic +
+        r = runVista("render " + f.city + " --path " + f.path + " --rig " + f.rig + " --traffic " + f.traffic +
                      " --frames " + std::to_string(kFrames) + " --sampling consecutive -q --out " + f.out);
         EXPECT_EQ(r.code, 0) << r.err;
         f.ok = r.code == 0;
@@ -234,6 +235,24 @@ TEST_F(TrafficDataset, AgentBoxesCarryClassAndVelocity) {
     }
     EXPECT_GT(agents, 0u);
     EXPECT_GT(straight, 0u) << "vehicles driving straight";
+}
+
+// A run killed after 7 frames and resumed writes the tracking files of the
+// uninterrupted run byte for byte (they are rebuilt from every frame's labels).
+TEST_F(TrafficDataset, ResumedRunWritesTheSameTrackingFiles) {
+    const auto& f = fixture();
+    TempDir tmp("vista_traffic_dataset_resume");
+    const std::string out = tmp.file("rig");
+    const std::string args = "render " + f.city + " --path " + f.path + " --rig " + f.rig + " --traffic " + f.traffic +
+                             " --frames " + std::to_string(kFrames) + " --sampling consecutive -q --out " + out;
+    auto r = runVista(args, "VISTA_RENDER_KILL_AFTER_FRAMES=7");
+    ASSERT_NE(r.code, 0) << "the run kills itself after 7 frames";
+    ASSERT_FALSE(fs::exists(out));
+    r = runVista(args);
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (const std::string rel : {"tracking/label_00/0000.txt", "tracking/label_01/0000.txt", "tracking/tracks.json"})
+        EXPECT_EQ(readBytes(out + "/" + rel), readBytes(f.out + "/" + rel)) << rel;
+    EXPECT_FALSE(readBytes(out + "/tracking/label_00/0000.txt").empty());
 }
 
 // tracking/label_NN/0000.txt: KITTI tracking lines (17 columns, integer
