@@ -36,10 +36,10 @@ SemanticClass semanticClass(Material m) {
 }
 
 const char* semanticClassName(SemanticClass c) {
-    static const char* kNames[] = {"sky",         "terrain",       "road",          "lane_marking", "sidewalk",
-                                   "grass",       "building_wall", "window",        "roof",         "tree_trunk",
-                                   "tree_leaves", "street_light",  "traffic_light", "traffic_sign", "car",
-                                   "vehicle",     "pedestrian"};
+    static const char* kNames[] = {
+        "sky",    "terrain", "road",       "lane_marking", "sidewalk",     "grass",         "building_wall",
+        "window", "roof",    "tree_trunk", "tree_leaves",  "street_light", "traffic_light", "traffic_sign",
+        "car",    "vehicle", "pedestrian", "van",          "bus",          "truck",         "bicycle"};
     static_assert(sizeof(kNames) / sizeof(kNames[0]) == size_t(kSemanticClassCount));
     const int i = int(c);
     return i >= 0 && i < kSemanticClassCount ? kNames[i] : "unknown";
@@ -49,7 +49,8 @@ void semanticClassColor(SemanticClass c, uint8_t rgb[3]) {
     static const uint8_t kColors[kSemanticClassCount][3] = {
         {70, 130, 180}, {152, 251, 152}, {128, 64, 128}, {255, 255, 255}, {244, 35, 232}, {107, 142, 35},
         {70, 70, 70},   {0, 130, 200},   {180, 60, 50},  {120, 80, 40},   {0, 160, 0},    {250, 170, 30},
-        {255, 100, 0},  {220, 220, 0},   {0, 0, 142},    {0, 60, 100},    {220, 20, 60}};
+        {255, 100, 0},  {220, 220, 0},   {0, 0, 142},    {0, 60, 100},    {220, 20, 60},  {0, 0, 110},
+        {0, 60, 100},   {0, 0, 70},      {119, 11, 32}};
     const int i = int(c) < kSemanticClassCount ? int(c) : 0;  // unsigned underlying type: never negative
     for (int k = 0; k < 3; ++k) rgb[k] = int(c) == i ? kColors[i][k] : 0;
 }

@@ -19,9 +19,13 @@
 // Semantic class (uint8): one per Material (semanticClass) plus sky = 0;
 // classes whose effect a city does not declare (street_light: night) simply
 // never occur; traffic_light and traffic_sign cover the whole signal, pole
-// included (as street_light covers its pole); vehicle (every moving vehicle of
-// a traffic run, a bicycle with its rider included) and pedestrian are the
-// moving agents, apart from the parked cars (car). Pure functions; thread-safe.
+// included (as street_light covers its pole). The moving agents of a traffic
+// run take the class of their SUMO type (agent_models.h agentClass): car (as
+// the parked cars; the instance kind tells a parked car from a moving one),
+// van, bus, truck, bicycle (the bicycle with its rider) and pedestrian;
+// vehicle is a moving vehicle of no other class (geometry of
+// Material::Vehicle drawn without an agent's class). Pure functions;
+// thread-safe.
 #pragma once
 #include <cstdint>
 
@@ -76,7 +80,11 @@ enum class SemanticClass : uint8_t {
     Car = 14,
     Vehicle = 15,
     Pedestrian = 16,
-    Count = 17
+    Van = 17,
+    Bus = 18,
+    Truck = 19,
+    Bicycle = 20,
+    Count = 21
 };
 constexpr int kSemanticClassCount = int(SemanticClass::Count);
 SemanticClass semanticClass(Material m);         // Count (invalid) for Material::Count

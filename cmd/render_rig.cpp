@@ -1,7 +1,7 @@
 // `vista render --rig` (render_rig.h): options and rig file, city and path,
 // work directory, the frames (every sensor that fires, cast and written),
-// then rig.json, calib.txt, times.txt, classes.json, semantic-kitti.yaml and
-// summary.json.
+// then rig.json, the traffic's tracking files, calib.txt, times.txt,
+// classes.json, semantic-kitti.yaml and summary.json.
 #include "cmd/render_rig.h"
 
 #include <unistd.h>
@@ -22,9 +22,11 @@
 #include "foundation/atomic_file.h"
 #include "foundation/format.h"
 #include "foundation/hash.h"
+#include "foundation/input_file.h"
 #include "foundation/progress.h"
 #include "foundation/statistics.h"
 #include "foundation/timing.h"
+#include "nodes/render/agent_truth.h"
 #include "nodes/render/traffic_scene.h"
 #include "nodes/render/walkthrough.h"
 #include "runtime/engine/boxes.h"
@@ -57,6 +59,11 @@ CameraDirs cameraDirs(size_t k) {
     return {"image_" + n, "depth_" + n, "semantic_" + n, "instance_" + n, "flow_" + n, "boxes_" + n, "label_" + n};
 }
 const char* const kBoxes3dDir = "boxes_3d";
+// KITTI tracking files of a run with traffic: tracking/label_NN/0000.txt per
+// pinhole camera with boxes (one sequence) and tracking/tracks.json.
+const char* const kTrackingDir = "tracking";
+std::string trackingFile(size_t k) { return std::string(kTrackingDir) + "/label_" + twoDigits(k) + "/0000.txt"; }
+bool tracksCamera(const RigCamera& c) { return (c.channels & kRigBoxes) && !c.model.fisheye(); }
 struct LidarDirs {
     std::string points, times, labels, vistaLabels, instances;
 };
@@ -171,6 +178,10 @@ Status openWorkDir(const RigRunRequest& a, const RigPlan& p, const Path& path, R
         for (const std::string& f : lidarFiles(j, "x"))
             VISTA_RETURN_IF_ERROR(out.subdir(fs::path(f).parent_path().string()));
     if (p.hasBoxes()) VISTA_RETURN_IF_ERROR(out.subdir(kBoxes3dDir));
+    if (p.traffic)
+        for (size_t k = 0; k < p.rig.cameras.size(); ++k)
+            if (tracksCamera(p.rig.cameras[k]))
+                VISTA_RETURN_IF_ERROR(out.subdir(fs::path(trackingFile(k)).parent_path().string()));
     return Status::ok();
 }
 
@@ -211,7 +222,8 @@ double nextShotTime(const RigPlan& p, const Path& path, size_t k, size_t f) {
 
 // A frame's boxes: the city's 3D boxes and the sightings of the sensors that fired.
 struct FrameBoxState {
-    const CityBoxes* city = nullptr;  // null: no camera asks for boxes
+    const CityBoxes* city = nullptr;   // null: no camera asks for boxes
+    std::vector<MovingObject> movers;  // the traffic's agents at the frame's time (sorted by id)
     FrameSightings seen;
 };
 
@@ -223,7 +235,7 @@ Status writeCameraBoxes(const RigPlan& p, const Walkthrough& w, size_t k, const 
     const BoxCamera cam = rigBoxCamera(c.model, pose);
     FrameBoxOptions o;
     o.threads = p.options.threads;
-    const std::vector<FrameBox> fb = frameBoxes(w.city, *boxes.city, cam, im.ids, o);
+    const std::vector<FrameBox> fb = frameBoxes(w.city, *boxes.city, boxes.movers, cam, im.ids, o);
     addCameraSightings(boxes.seen, c.name, fb);
     const CameraDirs d = cameraDirs(k);
     const glm::dvec3 offset(w.city.params.origin_x, w.city.params.origin_y, 0.0);
@@ -277,6 +289,9 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
     nlohmann::json ms = nlohmann::json::object(), lidar = nlohmann::json::object();
     FrameBoxState boxes;
     boxes.city = cityBoxes;
+    if (p.agents && cityBoxes)
+        boxes.movers = agentObjects(p.agents->tracks(), p.agents->models(), w.city.params, p.times[f]);
+    std::vector<ObjectMotion> motions;
     Stopwatch frame;
     for (size_t k = 0; k < p.rig.cameras.size(); ++k) {
         if (!p.camFire[k][f]) continue;
@@ -287,7 +302,15 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
         shot.pose = sensorPose(vehicle, c.mount);
         shot.channels = c.channels;
         shot.fx = &p.options.effects;
-        if (c.channels & kRigFlow) shot.next = sensorPose(vehiclePoseAt(path, nextShotTime(p, path, k, f)), c.mount);
+        if (c.channels & kRigFlow) {
+            const double next = nextShotTime(p, path, k, f);
+            shot.next = sensorPose(vehiclePoseAt(path, next), c.mount);
+            // The agents move between the two shots too: their flow follows their own motion.
+            if (p.agents) {
+                motions = agentMotions(p.agents->tracks(), p.agents->models(), w.city.params, p.times[f], next);
+                shot.motions = &motions;
+            }
+        }
         castRigCamera(w.city, rays, shot, im, threads);
         VISTA_RETURN_IF_ERROR(writeCamera(c, k, name, im, out));
         if (c.channels & kRigBoxes)
@@ -299,17 +322,26 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
         Stopwatch sw;
         const RigLidar& l = p.rig.lidars[j];
         const LidarPoseAt poseAt = [&](double t) { return lidarPoseOf(sensorPose(vehiclePoseAt(path, t), l.mount)); };
-        const LidarSweep sweep = castLidarSweep(w.city, rays, l.spec, poseAt, p.times[f], threads);
+        // The agents move during the sweep: each column sees them where they are when it fires.
+        LidarMovers movers;
+        if (p.agents)
+            movers.place = [&](double t) {
+                VISTA_RETURN_IF_ERROR(p.agents->setFrame(t, vehiclePoseAt(path, t).position));
+                return p.agents->setSplit(0.0);
+            };
+        auto cast = castLidarSweep(w.city, rays, l.spec, poseAt, p.times[f], movers, threads);
+        if (!cast) return cast.status();
+        const LidarSweep& sweep = *cast;
         VISTA_RETURN_IF_ERROR(writeLidar(sweep, j, name, out));
-        if (boxes.city) addLidarSightings(boxes.seen, l.name, sweep, *boxes.city);
+        if (boxes.city) addLidarSightings(boxes.seen, l.name, sweep, *boxes.city, boxes.movers);
         ms[l.name] = sw.ms();
         lidar[l.name] = {{"points", sweep.points.size()}, {"misses", sweep.misses}};
     }
     if (boxes.city) {
         const glm::dvec3 offset(w.city.params.origin_x, w.city.params.origin_y, 0.0);
-        VISTA_RETURN_IF_ERROR(
-            writeFileAtomic(out.file(std::string(kBoxes3dDir) + "/" + name + ".json"),
-                            frameBoxes3dJson(*boxes.city, boxes.seen, vehicle, offset, name, p.times[f])));
+        VISTA_RETURN_IF_ERROR(writeFileAtomic(
+            out.file(std::string(kBoxes3dDir) + "/" + name + ".json"),
+            frameBoxes3dJson(*boxes.city, boxes.seen, vehicle, offset, name, p.times[f], boxes.movers)));
     }
     record = {{"frame_ms", frame.ms()}, {"sensor_ms", ms}, {"lidar", lidar}};
     return Status::ok();
@@ -417,6 +449,13 @@ nlohmann::json rigManifest(const RigPlan& p, const Walkthrough& w) {
         {"sensors", sensors},
         {"frames", frames}};
     if (p.hasBoxes()) doc["boxes_3d"] = kBoxes3dDir;
+    if (p.traffic) {
+        nlohmann::json files = nlohmann::json::object();
+        for (size_t k = 0; k < p.rig.cameras.size(); ++k)
+            if (tracksCamera(p.rig.cameras[k])) files[p.rig.cameras[k].name] = trackingFile(k);
+        if (!files.empty())
+            doc["tracking"] = {{"tracks", std::string(kTrackingDir) + "/tracks.json"}, {"labels", files}};
+    }
     return doc;
 }
 
@@ -462,10 +501,42 @@ nlohmann::json rigSummary(const RigRunRequest& a, const RigPlan& p, const std::v
              "(frames_resumed: frames an interrupted run had finished)"}};
 }
 
+// The traffic's tracking files, from every frame's KITTI labels (rendered now or by an interrupted run).
+Status writeTracking(const RigPlan& p, const RenderWorkDir& out) {
+    bool any = false;
+    for (size_t k = 0; k < p.rig.cameras.size(); ++k) {
+        if (!tracksCamera(p.rig.cameras[k])) continue;
+        any = true;
+        std::vector<std::pair<size_t, std::string>> labels;
+        for (size_t f = 0; f < p.idx.size(); ++f) {
+            if (!p.camFire[k][f]) continue;
+            auto text = readInputFile("label file", out.file(cameraDirs(k).labels + "/" + frameName(f) + ".txt"),
+                                      kMaxPathCsvBytes);
+            if (!text) return Status::error("--out: " + text.status().message());
+            labels.emplace_back(f, std::move(*text));
+        }
+        VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(trackingFile(k)), kittiTrackingLines(labels)));
+    }
+    if (!any) return Status::ok();
+    nlohmann::json tracks = nlohmann::json::array();
+    const TrafficTracks& t = *p.traffic;
+    for (size_t a = 0; a < t.agentIds.size(); ++a) {
+        const AgentType type = a < t.agentTypes.size() ? t.agentTypes[a] : AgentType::Car;
+        const uint32_t id = agentLabel(type, uint32_t(a));
+        tracks.push_back({{"track_id", a},
+                          {"sumo_id", t.agentIds[a]},
+                          {"class", semanticClassName(SemanticClass(agentClass(type)))},
+                          {"instance_id", id}});
+    }
+    const nlohmann::json doc = {{"format", "vista.tracks"}, {"version", 1}, {"tracks", tracks}};
+    return writeFileAtomic(out.file(std::string(kTrackingDir) + "/tracks.json"), doc.dump(1) + "\n");
+}
+
 Status writeMetadata(const RigRunRequest& a, const RigPlan& p, const Walkthrough& w,
                      const std::vector<nlohmann::json>& records, size_t kept, RenderWorkDir& out,
                      nlohmann::json& summary) {
     VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file("rig.json"), rigManifest(p, w).dump(2) + "\n"));
+    if (p.traffic) VISTA_RETURN_IF_ERROR(writeTracking(p, out));
     const std::string calib = kittiCalib(p.rig);
     if (!calib.empty()) VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file("calib.txt"), calib));
     std::string times;

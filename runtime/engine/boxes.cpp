@@ -26,7 +26,9 @@ bool isObjectKind(InstanceKind k) {
         case InstanceKind::StreetLight:
         case InstanceKind::TrafficLight:
         case InstanceKind::TrafficSign:
-        case InstanceKind::Car: return true;
+        case InstanceKind::Car:
+        case InstanceKind::Vehicle:
+        case InstanceKind::Pedestrian: return true;
         default: return false;
     }
 }
@@ -561,22 +563,39 @@ double truncation(const PixelBox& whole, const PixelBox& inside) {
 
 }  // namespace
 
+const MovingObject* findMover(const std::vector<MovingObject>& movers, uint32_t id) {
+    auto it =
+        std::lower_bound(movers.begin(), movers.end(), id, [](const MovingObject& m, uint32_t v) { return m.id < v; });
+    return it != movers.end() && it->id == id ? &*it : nullptr;
+}
+
 std::vector<FrameBox> frameBoxes(const SceneModel& city, const CityBoxes& boxes, const BoxCamera& camera,
+                                 const std::vector<uint32_t>& ids, const FrameBoxOptions& options) {
+    return frameBoxes(city, boxes, {}, camera, ids, options);
+}
+
+std::vector<FrameBox> frameBoxes(const SceneModel& city, const CityBoxes& boxes,
+                                 const std::vector<MovingObject>& movers, const BoxCamera& camera,
                                  const std::vector<uint32_t>& ids, const FrameBoxOptions& options) {
     const int W = camera.model.width, H = camera.model.height;
     VISTA_CHECK(W > 0 && H > 0 && ids.size() == size_t(W) * size_t(H));
     std::vector<FrameBox> out;
     std::vector<const InstanceBox*> src;
+    std::vector<const MovingObject*> moving;
     for (const VisibleStats& s : visibleStats(ids, W, H)) {
-        const InstanceBox* ib = s.count >= options.minPixels ? boxes.find(s.id) : nullptr;
-        if (!ib) continue;
+        if (s.count < options.minPixels) continue;
+        const InstanceBox* ib = boxes.find(s.id);
+        const MovingObject* mo = ib ? nullptr : findMover(movers, s.id);
+        if (!ib && !mo) continue;
         FrameBox f;
         f.id = s.id;
-        f.box = ib->box;
+        f.box = ib ? ib->box : mo->box;
+        if (mo) f.semantic = mo->semantic, f.velocity = mo->velocity;
         f.visibleU0 = s.u0, f.visibleV0 = s.v0, f.visibleU1 = s.u1, f.visibleV1 = s.v1;
         f.pixels = s.count;
         out.push_back(f);
         src.push_back(ib);
+        moving.push_back(mo);
     }
     const Projector pr(camera);
     tbb::enumerable_thread_specific<std::vector<uint32_t>> stamps(size_t(W) * size_t(H), 0xFFFFFFFFu);
@@ -584,9 +603,16 @@ std::vector<FrameBox> frameBoxes(const SceneModel& city, const CityBoxes& boxes,
         tbb::parallel_for(size_t(0), out.size(), [&](size_t i) {
             FrameBox& f = out[i];
             MaskRaster r(pr, W, H, stamps.local(), uint32_t(i));
-            forEachTriangle(city, boxes, *src[i], [&](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
-                r.triangle(a, b, c);
-            });
+            if (src[i]) {
+                forEachTriangle(
+                    city, boxes, *src[i],
+                    [&](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) { r.triangle(a, b, c); });
+            } else if (const Mesh* m = moving[i]->mesh) {
+                const glm::dmat4& T = moving[i]->toWorld;
+                auto world = [&](uint32_t v) { return glm::dvec3(T * glm::dvec4(glm::dvec3(m->positions[v]), 1.0)); };
+                for (size_t t = 0; t + 2 < m->indices.size(); t += 3)
+                    r.triangle(world(m->indices[t]), world(m->indices[t + 1]), world(m->indices[t + 2]));
+            }
             f.full = clipToImage(r.full, W, H);
             f.truncated = truncation(r.full, f.full);
             f.boxExtent = clipToImage(projectedBox(camera, f.box), W, H);
@@ -650,6 +676,7 @@ std::string frameBoxesJson(const std::vector<FrameBox>& boxes, const BoxCamera& 
                         {"unoccluded_pixels", f.unoccludedPixels},
                         {"visible_fraction", round3(f.visibleFraction)},
                         {"truncated", round3(f.truncated)},
+                        {"velocity", vec3Json(f.velocity)},
                         {"box",
                          {{"center", vec3Json(f.box.center - worldOffset)},
                           {"size", vec3Json(f.box.size)},
@@ -693,6 +720,19 @@ const char* kittiType(InstanceKind k) {
     }
 }
 
+const char* kittiType(const FrameBox& box) {
+    if (box.semantic == 255) return kittiType(instanceKind(box.id));
+    switch (SemanticClass(box.semantic)) {
+        case SemanticClass::Car: return "Car";
+        case SemanticClass::Van: return "Van";
+        case SemanticClass::Truck: return "Truck";
+        case SemanticClass::Bus: return "Bus";
+        case SemanticClass::Bicycle: return "Cyclist";
+        case SemanticClass::Pedestrian: return "Pedestrian";
+        default: return "Misc";
+    }
+}
+
 std::string kittiLabels(const std::vector<FrameBox>& boxes, const BoxCamera& camera) {
     std::string out;
     char line[512];
@@ -701,9 +741,9 @@ std::string kittiLabels(const std::vector<FrameBox>& boxes, const BoxCamera& cam
         const CameraYaw cy = cameraYaw(camera, f.box, loc);
         const int occluded = f.visibleFraction >= 0.8 ? 0 : f.visibleFraction >= 0.4 ? 1 : 2;
         std::snprintf(line, sizeof line, "%s %.2f %d %.2f %.2f %.2f %.2f %.2f %.2f %.2f %.2f %.2f %.2f %.2f %.2f\n",
-                      kittiType(instanceKind(f.id)), f.truncated, occluded, cy.alpha, double(f.visibleU0),
-                      double(f.visibleV0), double(f.visibleU1), double(f.visibleV1), f.box.size.z, f.box.size.y,
-                      f.box.size.x, loc.x, loc.y, loc.z, cy.rotationY);
+                      kittiType(f), f.truncated, occluded, cy.alpha, double(f.visibleU0), double(f.visibleV0),
+                      double(f.visibleU1), double(f.visibleV1), f.box.size.z, f.box.size.y, f.box.size.x, loc.x, loc.y,
+                      loc.z, cy.rotationY);
         out += line;
     }
     return out;

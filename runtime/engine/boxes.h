@@ -9,8 +9,17 @@
 // tile meshes, and the tree instances (their prototype mesh through the
 // instance's transform; coarse-level impostors only for trees without a full
 // instance). Only object kinds get boxes (isObjectKind: buildings, trees,
-// street lights, traffic lights, traffic signs, parked cars); roads,
-// junctions, sidewalks and parks are surfaces and get none.
+// street lights, traffic lights, traffic signs, parked cars, and the moving
+// vehicles and pedestrians of a traffic run); roads, junctions, sidewalks and
+// parks are surfaces and get none.
+//
+// Moving objects (MovingObject): the agents of a traffic run are not part of
+// the city; a frame passes them in, each with its instance id, class, world
+// box and velocity at the frame's time and its mesh (model frame) with the
+// model -> world transform. frameBoxes() boxes an id of the instance image
+// from the city's boxes or, when the city has none, from the moving objects
+// (sorted by id), rasterising the moving object's mesh for its unoccluded
+// pixels as it does a city instance's triangles.
 //
 // 3D box (OrientedBox), world frame (x east, y north, z up, metres, double):
 // upright, z extent = the instance's vertices' z range; in plan the rectangle
@@ -86,6 +95,7 @@
 #include <glm/glm.hpp>
 
 #include "citygen/labels.h"
+#include "citygen/mesh.h"
 #include "runtime/engine/lidar.h"
 #include "runtime/scene/camera.h"
 #include "runtime/scene/camera_model.h"
@@ -186,6 +196,18 @@ PixelBox projectedBox(const Camera& camera, const OrientedBox& box);
 PixelBox clipToImage(const PixelBox& b, int width, int height);
 PixelBox clipToImage(const PixelBox& b, const Camera& camera);
 
+// A moving object at one frame's time (see above).
+struct MovingObject {
+    uint32_t id = 0;             // instance id (labels.h)
+    uint8_t semantic = 0;        // its SemanticClass
+    OrientedBox box;             // world frame
+    glm::dvec3 velocity{0.0};    // of the box centre, world frame, m/s
+    const Mesh* mesh = nullptr;  // model frame; not owned (outlives the frame's boxes)
+    glm::dmat4 toWorld{1.0};     // model frame -> world
+};
+// The moving object with `id` in `movers` (sorted by id), null when none.
+const MovingObject* findMover(const std::vector<MovingObject>& movers, uint32_t id);
+
 struct FrameBox {
     uint32_t id = 0;
     OrientedBox box;                                                   // world frame
@@ -196,6 +218,8 @@ struct FrameBox {
     uint32_t unoccludedPixels = 0;                                     // the instance's mask alone
     double visibleFraction = 0;                                        // pixels / unoccludedPixels in [0, 1]
     double truncated = 0;                                              // 0 .. 1
+    uint8_t semantic = 255;    // a moving object's class; 255: a city instance (type by its kind)
+    glm::dvec3 velocity{0.0};  // world m/s (0 for city instances)
 };
 
 struct FrameBoxOptions {
@@ -207,6 +231,10 @@ struct FrameBoxOptions {
 // pixels in `ids` (the instance image: width * height ids of the camera's
 // model, row 0 at the top), sorted by id.
 std::vector<FrameBox> frameBoxes(const SceneModel& city, const CityBoxes& boxes, const BoxCamera& camera,
+                                 const std::vector<uint32_t>& ids, const FrameBoxOptions& options = {});
+// The same with the frame's moving objects (sorted by id) boxed too.
+std::vector<FrameBox> frameBoxes(const SceneModel& city, const CityBoxes& boxes,
+                                 const std::vector<MovingObject>& movers, const BoxCamera& camera,
                                  const std::vector<uint32_t>& ids, const FrameBoxOptions& options = {});
 std::vector<FrameBox> frameBoxes(const SceneModel& city, const CityBoxes& boxes, const Camera& camera,
                                  const std::vector<uint32_t>& ids, const FrameBoxOptions& options = {});
@@ -227,6 +255,10 @@ std::string frameBoxesJson(const std::vector<FrameBox>& boxes, const Camera& cam
 std::string kittiLabels(const std::vector<FrameBox>& boxes, const BoxCamera& camera);
 std::string kittiLabels(const std::vector<FrameBox>& boxes, const Camera& camera);
 const char* kittiType(InstanceKind k);  // "Car", "Building", "Tree", ...
+// A box's KITTI type: of its class for a moving object (car "Car", van "Van",
+// truck "Truck", bus "Bus", bicycle "Cyclist", pedestrian "Pedestrian", other
+// vehicles "Misc"), else of its instance kind.
+const char* kittiType(const FrameBox& box);
 
 // A KITTI calibration file: P0..P3 = the camera's pinhole matrix, R0_rect =
 // identity, Tr_velo_to_cam = the LiDAR (pose `lidar`, x forward, y left,

@@ -87,4 +87,19 @@ glm::dmat3 lidarToWorld(const LidarPose& pose);
 LidarSweep castLidarSweep(const SceneModel& city, const RayScene& rays, const LidarSpec& spec,
                           const LidarPoseAt& poseAt, double t0, int threads = 0);
 
+// Moving objects seen where they are when each column fires: the sweep's
+// columns are cast in time slices of at most `stepS` seconds (at least one
+// column each), and before each slice place(t) moves the ray scene's
+// moving objects to time t, the slice's middle column time (t0-based, as
+// poseAt). An object moving at speed v is then seen within v * stepS / 2 of
+// where it is at its points' firing times. place() runs on the calling
+// thread between slices (no ray query meanwhile); its error ends the sweep
+// and is returned. No place(): the sweep of the function above.
+struct LidarMovers {
+    std::function<Status(double t)> place;
+    double stepS = 0.001;  // seconds, > 0
+};
+Result<LidarSweep> castLidarSweep(const SceneModel& city, const RayScene& rays, const LidarSpec& spec,
+                                  const LidarPoseAt& poseAt, double t0, const LidarMovers& movers, int threads = 0);
+
 }  // namespace vista

@@ -15,7 +15,8 @@
 // (exact when the frame is level; the box is upright in the world), as
 // boxInVehicleFrame does for a LidarPose.
 //
-// Sightings: per instance with a city box, the sensors that saw it in one
+// Sightings: per instance with a city box or a moving object's box (boxes.h
+// MovingObject, `movers` sorted by id), the sensors that saw it in one
 // rig frame (a camera: the instance has an entry in its 2D boxes; a LiDAR:
 // at least one of its points hit the instance), cameras first and then
 // LiDARs as they were added, and its LiDAR points summed over the frame's
@@ -26,15 +27,20 @@
 // `world_offset`, `vehicle_to_world` (4x4 row-major, world minus the
 // offset), and per seen instance (sorted by id) `id`, `kind`, `index`,
 // `seen_by`, `lidar_points`, `world` {center (minus world_offset), size,
-// yaw} and `vehicle` {center, size, yaw} (boxInPoseFrame of the frame's
-// vehicle pose); positions and yaws rounded to 0.001.
+// yaw, velocity} and `vehicle` {center, size, yaw, velocity} (boxInPoseFrame
+// of the frame's vehicle pose); positions, yaws and velocities rounded to
+// 0.001. velocity: the box centre's velocity over the ground in m/s (0 for
+// the city's instances; a moving object's MovingObject::velocity), in the
+// vehicle's axes under `vehicle` (the same vector, not relative to the
+// vehicle's own motion). A moving object also carries `class` (its semantic
+// class name).
 //
 // kittiRigLabels(): KITTI object label lines (one per box, '\n'-terminated)
 // in the rig's rectified frame (rig_dataset.h kittiCalib) at `rectified`,
 // its world pose (sensorPose of the vehicle and kittiRectifiedMount; x
 // forward, y left, z up; its OpenCV axes are (-y, -z, x)): type,
 // truncated, occluded (0: visibleFraction >= 0.8, 1: >= 0.4, 2: less),
-// alpha, bbox (the visible extent in the labelling camera, inclusive pixel
+// alpha (type: boxes.h kittiType of the box), bbox (the visible extent in the labelling camera, inclusive pixel
 // indices), dimensions (height, width, length), location (bottom centre),
 // rotation_y, then a 16th column: the instance id (labels.h, the id of the
 // instance images and lidar_instance/). The box is the smallest one upright
@@ -49,6 +55,7 @@
 #pragma once
 #include <cstdint>
 #include <map>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -70,11 +77,26 @@ struct BoxSighting {
 using FrameSightings = std::map<uint32_t, BoxSighting>;  // by instance id
 
 void addCameraSightings(FrameSightings& s, const std::string& camera, const std::vector<FrameBox>& boxes);
-void addLidarSightings(FrameSightings& s, const std::string& lidar, const LidarSweep& sweep, const CityBoxes& boxes);
+void addLidarSightings(FrameSightings& s, const std::string& lidar, const LidarSweep& sweep, const CityBoxes& boxes,
+                       const std::vector<MovingObject>& movers = {});
 
 std::string kittiRigLabels(const std::vector<FrameBox>& boxes, const RigPose& rectified);
 
+// KITTI tracking lines of one camera (the devkit's label_02/NNNN.txt of one
+// sequence): from the object lines of each frame that the camera labelled
+// (kittiRigLabels text, with the frame's number), every moving agent's line
+// (instance kind vehicle or pedestrian, 16th column) as "frame track_id
+// type truncated occluded alpha left top right bottom h w l x y z
+// rotation_y": track_id = the agent's number (instanceIndex of its id; the
+// same agent keeps it in every frame, camera and run of the same traffic),
+// truncated the tracking benchmark's level (an integer: 0 when the object
+// line's share is below 0.01, 1 below 0.5, else 2), the other columns those
+// of the object line; frames in the order given.
+// Lines that are not 16 columns are skipped.
+std::string kittiTrackingLines(const std::vector<std::pair<size_t, std::string>>& frameLabels);
+
 std::string frameBoxes3dJson(const CityBoxes& boxes, const FrameSightings& seen, const RigPose& vehicle,
-                             const glm::dvec3& worldOffset, const std::string& frame, double t);
+                             const glm::dvec3& worldOffset, const std::string& frame, double t,
+                             const std::vector<MovingObject>& movers = {});
 
 }  // namespace vista

@@ -1,6 +1,7 @@
 // A rig camera's image by ray casting (rig_camera.h).
 #include "runtime/engine/rig_camera.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -56,6 +57,19 @@ bool projectWorld(const CameraModel& model, const RigPose& pose, const glm::dvec
     return model.project(bodyToCv(glm::transpose(pose.rotation) * (world - pose.position)), uv);
 }
 
+namespace {
+
+// The motion of the mover a hit lies on, null for the static scene or a mover without one.
+const ObjectMotion* motionOf(const std::vector<ObjectMotion>& motions, const RayScene& rays, const RayHit& h) {
+    const HitSource src = rays.source(h);
+    if (src.mover < 0) return nullptr;
+    auto it = std::lower_bound(motions.begin(), motions.end(), src.moverId,
+                               [](const ObjectMotion& m, uint32_t v) { return m.id < v; });
+    return it != motions.end() && it->id == src.moverId ? &*it : nullptr;
+}
+
+}  // namespace
+
 void castRigCamera(const SceneModel& city, const RayScene& rays, const CameraShot& s, CameraImages& out, int threads) {
     VISTA_CHECK(s.model.width >= 1 && s.model.height >= 1 && s.channels != 0);
     resizeChannels(s, out);
@@ -107,11 +121,18 @@ void castRigCamera(const SceneModel& city, const RayScene& rays, const CameraSho
                         if (wantIds) out.ids[p] = l.id;
                     }
                     if (wantFlow) {
-                        // The hit point, or the direction of a point at infinity (sky).
-                        const glm::dvec3 q =
-                            h.hit ? nextInv * (s.pose.position + double(h.t) * d - s.next.position) : nextInv * d;
+                        // The hit point (moved with its object), or the direction of a point at infinity (sky).
+                        glm::dvec3 hitAt = s.pose.position + double(h.t) * d;
+                        bool known = true;
+                        if (h.hit && s.motions) {
+                            if (const ObjectMotion* m = motionOf(*s.motions, rays, h)) {
+                                known = m->known;
+                                hitAt = glm::dvec3(m->motion * glm::dvec4(hitAt, 1.0));
+                            }
+                        }
+                        const glm::dvec3 q = h.hit ? nextInv * (hitAt - s.next.position) : nextInv * d;
                         glm::dvec2 uv;
-                        const bool ok = s.model.project(bodyToCv(q), uv);
+                        const bool ok = known && s.model.project(bodyToCv(q), uv);
                         out.flow[2 * p] = ok ? float(uv.x - x) : kUnknownFlow;
                         out.flow[2 * p + 1] = ok ? float(uv.y - y) : kUnknownFlow;
                     }

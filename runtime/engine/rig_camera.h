@@ -20,8 +20,13 @@
 // - flow (float32 pairs du, dv, pixels): where the surface point (or, for
 //   sky, the point at infinity in the ray's direction) seen at pixel (u, v)
 //   projects in the camera at pose `next`, minus (u, v): exact forward flow
-//   of a static scene. kUnknownFlow where it has no projection (pinhole:
-//   behind the next camera).
+//   of a static scene. A point on a moving object of the ray scene (a mover,
+//   ray_scene.h) whose instance id has an entry in `motions` moves with the
+//   object first (ObjectMotion::motion, the object's rigid motion from the
+//   shot's time to the next one), so the flow is exact for it too; one whose
+//   entry is not `known` (the object is gone by then) gets kUnknownFlow; a
+//   mover without an entry is taken as standing still. kUnknownFlow where it
+//   has no projection (pinhole: behind the next camera).
 // Fisheye pixels outside the image circle cast nothing: rgb black, depth
 // NaN, class 255, instance 0, flow kUnknownFlow.
 // Resizes the asked channels of `out` and frees the others. Parallel over
@@ -52,12 +57,21 @@ struct CameraImages {
     std::vector<float> flow;  // 2 per pixel: du, dv
 };
 
+// A moving object's rigid motion over a flow's time step: world point at the
+// shot's time -> the same body point at the next time.
+struct ObjectMotion {
+    uint32_t id = 0;         // instance id (labels.h)
+    glm::dmat4 motion{1.0};  // world -> world
+    bool known = false;      // false: the object is gone at the next time
+};
+
 struct CameraShot {
     CameraModel model;
     RigPose pose;
     unsigned channels = 0;
-    RigPose next;                      // flow only
-    const FrameEffects* fx = nullptr;  // sky colour; null = the default sky
+    RigPose next;                                        // flow only
+    const std::vector<ObjectMotion>* motions = nullptr;  // flow only: sorted by id; null = none
+    const FrameEffects* fx = nullptr;                    // sky colour; null = the default sky
 };
 
 // The camera's world ray direction of pixel (u, v), false outside a fisheye's image circle.

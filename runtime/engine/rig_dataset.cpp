@@ -103,12 +103,15 @@ struct SkClass {
     int b, g, r;
 };
 constexpr SkClass kSkClasses[] = {
-    {0, "unlabeled", 0, 0, 0},     {10, "car", 245, 150, 100},     {40, "road", 255, 0, 255},
-    {48, "sidewalk", 75, 0, 75},   {50, "building", 0, 200, 255},  {60, "lane-marking", 170, 255, 150},
-    {70, "vegetation", 0, 175, 0}, {71, "trunk", 0, 60, 135},      {72, "terrain", 80, 240, 150},
-    {80, "pole", 150, 240, 255},   {81, "traffic-sign", 0, 0, 255}};
+    {0, "unlabeled", 0, 0, 0},       {10, "car", 245, 150, 100},          {13, "bus", 250, 80, 100},
+    {18, "truck", 180, 30, 80},      {20, "other-vehicle", 255, 0, 0},    {30, "person", 30, 30, 255},
+    {31, "bicyclist", 200, 40, 255}, {40, "road", 255, 0, 255},           {48, "sidewalk", 75, 0, 75},
+    {50, "building", 0, 200, 255},   {60, "lane-marking", 170, 255, 150}, {70, "vegetation", 0, 175, 0},
+    {71, "trunk", 0, 60, 135},       {72, "terrain", 80, 240, 150},       {80, "pole", 150, 240, 255},
+    {81, "traffic-sign", 0, 0, 255}};
 // By vista class (citygen/labels.h SemanticClass order).
-constexpr uint16_t kVistaToSk[kSemanticClassCount] = {0, 72, 40, 60, 48, 72, 50, 50, 50, 71, 70, 80, 80, 81, 10};
+constexpr uint16_t kVistaToSk[kSemanticClassCount] = {0,  72, 40, 60, 48, 72, 50, 50, 50, 71, 70,
+                                                      80, 80, 81, 10, 20, 30, 10, 13, 18, 31};
 
 }  // namespace
 

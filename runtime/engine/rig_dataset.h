@@ -24,7 +24,11 @@
 // 72 (terrain), road 40, lane marking 60, sidewalk 48, building wall,
 // window and roof 50 (building), tree trunk 71 (trunk), leaves 70
 // (vegetation), street light and traffic light 80 (pole: the class of
-// lamp posts and signal poles), traffic sign 81, car 10; 0 out of range.
+// lamp posts and signal poles), traffic sign 81, car and van 10 (SemanticKITTI's
+// car includes vans), bus 13, truck 18, vehicle 20 (other-vehicle),
+// pedestrian 30 (person), bicycle 31 (bicyclist: vista's bicycle carries its
+// rider); 0 out of range. Moving agents keep these static ids (SemanticKITTI's
+// single-scan classes; the moving-* ids are not written).
 // semanticKittiInstance(): ((11 index + kind) mod 65535) + 1 of an object
 // instance id (labels.h), 0 for a surface or no instance: stable across
 // frames and runs, and distinct for distinct instances whose indices are

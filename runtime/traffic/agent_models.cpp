@@ -186,7 +186,15 @@ uint32_t agentLabel(AgentType type, uint32_t agent) {
 }
 
 uint8_t agentClass(AgentType type) {
-    return uint8_t(type == AgentType::Pedestrian ? SemanticClass::Pedestrian : SemanticClass::Vehicle);
+    switch (type) {
+        case AgentType::Car: return uint8_t(SemanticClass::Car);
+        case AgentType::Van: return uint8_t(SemanticClass::Van);
+        case AgentType::Bus: return uint8_t(SemanticClass::Bus);
+        case AgentType::Truck: return uint8_t(SemanticClass::Truck);
+        case AgentType::Bicycle: return uint8_t(SemanticClass::Bicycle);
+        case AgentType::Pedestrian: break;
+    }
+    return uint8_t(SemanticClass::Pedestrian);
 }
 
 std::vector<AgentPlacement> placeAgents(const TrafficTracks& tracks, const AgentModels& models,

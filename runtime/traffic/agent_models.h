@@ -17,7 +17,8 @@
 // - agentPrototype(type, agent): the prototype an agent is drawn with (a
 //   function of its type and number alone: stable over a run).
 // - agentLabel(type, agent): its instance id (citygen/labels.h: kind vehicle
-//   or pedestrian, index = the agent's number); agentClass(type) its class.
+//   or pedestrian, index = the agent's number); agentClass(type) its class
+//   (labels.h: car, van, bus, truck, bicycle or pedestrian by type).
 // - placeAgents(tracks, models, params, t): every agent present at time t
 //   (TrafficTracks::poseAt) with its world transform (model frame -> world):
 //   SUMO's reference point is the middle of a vehicle's front bumper and a

@@ -98,6 +98,15 @@ struct AgentPixels {
     std::set<uint32_t> agents;
 };
 
+// The class of an agent's SUMO type (labels.h).
+SemanticClass expectedClass(AgentType type) {
+    static const std::map<AgentType, SemanticClass> kClass = {
+        {AgentType::Car, SemanticClass::Car},         {AgentType::Van, SemanticClass::Van},
+        {AgentType::Bus, SemanticClass::Bus},         {AgentType::Truck, SemanticClass::Truck},
+        {AgentType::Bicycle, SemanticClass::Bicycle}, {AgentType::Pedestrian, SemanticClass::Pedestrian}};
+    return kClass.at(type);
+}
+
 // Back-projects every agent pixel of every frame of `out` (cameras.json) and
 // checks it against the agent boxes computed here from the FCD: SUMO's
 // reference point (front bumper) half a model length ahead of the box centre.
@@ -130,9 +139,8 @@ AgentPixels checkAgentPixels(const std::string& out, const TrafficTracks& tracks
                 ++r.total;
                 const uint32_t agent = instanceIndex(ids[i]);
                 r.agents.insert(agent);
-                const uint8_t want =
-                    uint8_t(kind == InstanceKind::Vehicle ? SemanticClass::Vehicle : SemanticClass::Pedestrian);
-                if (sem[i] != want) ++r.wrongClass;
+                if (agent < tracks.agentTypes.size() && sem[i] != uint8_t(expectedClass(tracks.agentTypes[agent])))
+                    ++r.wrongClass;
                 const double z = depth[i];
                 if (z > split) ++r.beyond;
                 const glm::dvec3 p =

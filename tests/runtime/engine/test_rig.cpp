@@ -6,6 +6,8 @@
 // LiDAR point to the pixel its pose gives; the file encoders' layouts.
 #include <gtest/gtest.h>
 
+#include <map>
+
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -330,4 +332,33 @@ TEST(Rig, FileLayouts) {
     EXPECT_EQ(semanticKittiInstance((3u << 28) | 5u), 0u);
     EXPECT_EQ(semanticKittiClass(200), 0u);
     EXPECT_NE(semanticKittiYaml().find("  10: \"car\""), std::string::npos);
+}
+
+// The moving agents' classes in SemanticKITTI's ids (semantic-kitti.yaml of
+// the SemanticKITTI API): vans are cars there, a bicycle with its rider a
+// bicyclist; every class has a name in the mapping file and agents an instance.
+TEST(Rig, AgentClassesMapToSemanticKitti) {
+    const std::map<SemanticClass, std::pair<unsigned, std::string>> want = {
+        {SemanticClass::Car, {10, "car"}},
+        {SemanticClass::Van, {10, "car"}},
+        {SemanticClass::Bus, {13, "bus"}},
+        {SemanticClass::Truck, {18, "truck"}},
+        {SemanticClass::Vehicle, {20, "other-vehicle"}},
+        {SemanticClass::Bicycle, {31, "bicyclist"}},
+        {SemanticClass::Pedestrian, {30, "person"}}};
+    const std::string yaml = semanticKittiYaml();
+    for (const auto& [cls, sk] : want) {
+        EXPECT_EQ(semanticKittiClass(uint8_t(cls)), sk.first) << semanticClassName(cls);
+        EXPECT_NE(yaml.find("  " + std::to_string(sk.first) + ": \"" + sk.second + "\""), std::string::npos)
+            << sk.second;
+    }
+    for (int c = 0; c < kSemanticClassCount; ++c) {
+        const unsigned id = semanticKittiClass(uint8_t(c));
+        EXPECT_NE(yaml.find("\n  " + std::to_string(id) + ": \""), std::string::npos) << "class " << c;
+        EXPECT_STRNE(semanticClassName(SemanticClass(c)), "unknown");
+    }
+    EXPECT_NE(semanticKittiInstance(makeInstanceId(InstanceKind::Vehicle, 4)), 0u);
+    EXPECT_NE(semanticKittiInstance(makeInstanceId(InstanceKind::Pedestrian, 4)), 0u);
+    EXPECT_NE(semanticKittiInstance(makeInstanceId(InstanceKind::Vehicle, 4)),
+              semanticKittiInstance(makeInstanceId(InstanceKind::Pedestrian, 4)));
 }

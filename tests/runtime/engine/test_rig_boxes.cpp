@@ -20,6 +20,7 @@
 #include <sstream>
 #include <string>
 
+#include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
 #include "citygen/generate.h"
@@ -377,4 +378,81 @@ TEST(RigBoxes, KittiLabelsAreUprightInTheRectifiedFrameAndHoldTheWorldBox) {
             EXPECT_LT(h * w * l, 1.3 * 1.5 * 1.8 * 4.4);
         }
     }
+}
+
+// A moving object's box: found by id where the city has none, its class and
+// velocity carried, its unoccluded pixels those of its own mesh (through its
+// transform), its KITTI type that of its class; KITTI tracking lines keep the
+// agents only, with the agent's number as track id and a truncation level.
+TEST(RigBoxes, MovingObjectsAreBoxedFromTheirMeshAndTracked) {
+    // A 2 m cube (12 outward triangles) in model frame, placed 10 m ahead of a camera looking along +x.
+    Mesh cube;
+    for (int i = 0; i < 8; ++i) cube.positions.push_back({i & 1 ? 1.f : -1.f, i & 2 ? 1.f : -1.f, i & 4 ? 2.f : 0.f});
+    const uint32_t faces[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                                   {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+    for (const auto& f : faces) cube.indices.insert(cube.indices.end(), {f[0], f[1], f[2]});
+    MovingObject m;
+    m.id = makeInstanceId(InstanceKind::Vehicle, 42);
+    m.semantic = uint8_t(SemanticClass::Bicycle);
+    m.mesh = &cube;
+    m.toWorld = glm::translate(glm::dmat4(1.0), glm::dvec3(10.0, 0.0, 0.0));
+    m.box.center = {10.0, 0.0, 1.0};
+    m.box.size = {2.0, 2.0, 2.0};
+    m.velocity = {3.0, -1.0, 0.0};
+    CameraModel model;
+    model.width = 64, model.height = 48, model.fx = model.fy = 40, model.cx = 31.5, model.cy = 23.5;
+    RigPose pose;
+    pose.position = {0.0, 0.0, 1.0};
+    const BoxCamera cam = rigBoxCamera(model, pose);
+    // The instance image: the cube's left half visible (an occluder covers the rest).
+    std::vector<uint32_t> ids(size_t(model.width * model.height), 0u);
+    int full = 0;
+    for (int v = 0; v < model.height; ++v)
+        for (int u = 0; u < model.width; ++u) {
+            const bool on =
+                std::abs(u - model.cx) <= 0.9 / 9.0 * model.fx && std::abs(v - model.cy) <= 0.9 / 9.0 * model.fy;
+            full += on;
+            if (on && u < model.cx) ids[size_t(v * model.width + u)] = m.id;
+        }
+    SceneModel city;
+    CityBoxes none;
+    const std::vector<FrameBox> fb = frameBoxes(city, none, {m}, cam, ids);
+    ASSERT_EQ(fb.size(), 1u);
+    EXPECT_EQ(fb[0].id, m.id);
+    EXPECT_EQ(fb[0].semantic, m.semantic);
+    EXPECT_EQ(fb[0].velocity, m.velocity);
+    EXPECT_EQ(fb[0].box.center, m.box.center);
+    // The front face (x = 9 m, 2 m square) covers about (2 / 9 * 40)^2 pixels.
+    EXPECT_NEAR(double(fb[0].unoccludedPixels), std::pow(2.0 / 9.0 * 40.0, 2.0), 40.0);
+    EXPECT_NEAR(fb[0].visibleFraction, 0.5, 0.1);
+    EXPECT_STREQ(kittiType(fb[0]), "Cyclist");
+    EXPECT_TRUE(frameBoxes(city, none, cam, ids).empty()) << "without the moving objects: no box";
+    // The KITTI object line, then the tracking line of it.
+    const std::string objects = kittiRigLabels(fb, pose);
+    const std::string parked = "Car 0.00 0 0.10 1.00 2.00 3.00 4.00 1.50 1.80 4.40 1.000 2.000 3.000 0.100 " +
+                               std::to_string(makeInstanceId(InstanceKind::Car, 3)) + "\n";
+    const std::string truncated = "Pedestrian 0.60 2 0.10 1.00 2.00 3.00 4.00 1.70 0.60 0.60 1.000 2.000 3.000 0.100 " +
+                                  std::to_string(makeInstanceId(InstanceKind::Pedestrian, 7)) + "\n";
+    const std::string tracking = kittiTrackingLines({{5, objects + parked}, {9, truncated + "bad line\n"}});
+    std::istringstream in(tracking);
+    std::vector<std::vector<std::string>> rows;
+    for (std::string line; std::getline(in, line);) {
+        std::istringstream cols(line);
+        rows.emplace_back();
+        for (std::string w; cols >> w;) rows.back().push_back(w);
+    }
+    ASSERT_EQ(rows.size(), 2u) << tracking;
+    ASSERT_EQ(rows[0].size(), 17u);
+    EXPECT_EQ(rows[0][0], "5");
+    EXPECT_EQ(rows[0][1], "42");
+    EXPECT_EQ(rows[0][2], "Cyclist");
+    EXPECT_EQ(rows[0][3], "0");
+    std::istringstream obj(objects);
+    std::vector<std::string> o;
+    for (std::string w; obj >> w;) o.push_back(w);
+    ASSERT_EQ(o.size(), 16u);
+    for (size_t i = 2; i < 15; ++i) EXPECT_EQ(rows[0][i + 2], o[i]) << "column " << i;
+    EXPECT_EQ(rows[1][0], "9");
+    EXPECT_EQ(rows[1][1], "7");
+    EXPECT_EQ(rows[1][3], "2") << "a share of 0.6 is truncation level 2";
 }
