@@ -721,8 +721,7 @@ int run(const RenderArgs& a, const std::string& command) {
         !s)
         return reportBadInput(kCmd, s);
     if (plan.shard)
-        if (Status s = writeFrameShardRecord(out, *plan.shard, inputs, range, done); !s)
-            return reportBadInput(kCmd, s);
+        if (Status s = writeFrameShardRecord(out, *plan.shard, inputs, range, done); !s) return reportBadInput(kCmd, s);
     if (Status s = out.commit(); !s) return reportBadInput(kCmd, s);
     printResult(a, plan, range.size(), tm, out);
     return 0;
@@ -975,7 +974,8 @@ int runDataset(const RenderArgs& a, const std::string& command, const std::strin
             fs::create_directories(fs::path(out).parent_path(), ec);
             if (ec) return reportBadInput(kCmd, Status::error("--out: cannot create '" + out + "': " + ec.message()));
             if (int rc = renderDrive(a, *m, drives[i], out, command); rc != 0) {
-                std::fprintf(stderr, "%s: --dataset: drive %s (%zu of %zu, shard %s) failed; the same command resumes it\n",
+                std::fprintf(stderr,
+                             "%s: --dataset: drive %s (%zu of %zu, shard %s) failed; the same command resumes it\n",
                              kCmd, drives[i].name.c_str(), i + 1, drives.size(), shardText(shard).c_str());
                 return rc;
             }
@@ -1078,8 +1078,8 @@ int runRender(int argc, char** argv) {
     if (a.shards && !a.merge)
         return reportBadInput(kCmd, Status::error("option --shards: only with --merge (shards take --shard K/N)"));
     if (!a.dataset.empty()) {
-        const std::set<std::string> allowed = {"--dataset", "--out", "--shard", "--merge", "--shards",
-                                               "--restart", "--stats", "--quiet"};
+        const std::set<std::string> allowed = {"--dataset", "--out",     "--shard", "--merge",
+                                               "--shards",  "--restart", "--stats", "--quiet"};
         for (const CLI::Option* o : app.get_options())
             if (o->count() > 0 && !allowed.count(o->get_name()))
                 return reportBadInput(kCmd, Status::error("option " + o->get_name() +

@@ -91,8 +91,8 @@ Result<nlohmann::json> readShardRecord(const std::string& dir, const Shard& shar
 }
 
 Result<std::vector<nlohmann::json>> readShards(
-    const std::string& out, int count, const std::function<std::string(const Shard&, const nlohmann::json&)>& inputsDiffer,
-    const std::string& rerun) {
+    const std::string& out, int count,
+    const std::function<std::string(const Shard&, const nlohmann::json&)>& inputsDiffer, const std::string& rerun) {
     std::vector<nlohmann::json> records;
     std::string why, list;
     int bad = 0, first = -1;

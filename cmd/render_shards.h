@@ -51,8 +51,8 @@ Result<nlohmann::json> readShardRecord(const std::string& dir, const Shard& shar
 // the whole read an error (see the header comment); `rerun` is the command
 // that runs one shard, without its K/N ("vista render ... --out OUT --shard").
 Result<std::vector<nlohmann::json>> readShards(
-    const std::string& out, int count, const std::function<std::string(const Shard&, const nlohmann::json&)>& inputsDiffer,
-    const std::string& rerun);
+    const std::string& out, int count,
+    const std::function<std::string(const Shard&, const nlohmann::json&)>& inputsDiffer, const std::string& rerun);
 
 // Links every shard's files into `dest` (created as needed), skipping the
 // relative paths in `skip`: a file in several shards must have the same hash

@@ -147,7 +147,8 @@ Status parsePaths(const Fields& f, const Json& root, const std::string& baseDir,
         const std::string field = "paths[" + std::to_string(i) + "]";
         const Json& o = root["paths"][i];
         if (!o.is_object()) return f.error(field, "expected an object, got " + Fields::shown(o));
-        VISTA_RETURN_IF_ERROR(f.onlyKnown(o, field, {"name", "file", "seed", "kind", "route", "duration", "run_up", "lht"}));
+        VISTA_RETURN_IF_ERROR(
+            f.onlyKnown(o, field, {"name", "file", "seed", "kind", "route", "duration", "run_up", "lht"}));
         DatasetPath p;
         std::optional<std::string> file;
         VISTA_RETURN_IF_ERROR(f.string(o, field, "file", file));
@@ -241,9 +242,9 @@ Result<DatasetManifest> parseDatasetManifest(const std::string& text, const std:
     VISTA_RETURN_IF_ERROR(parseOptions(f, root, m));
     const double drives = double(m.cities.size()) * double(m.paths.size()) * double(m.rigs.size());
     if (drives > double(kMaxDatasetDrives))
-        return f.error("cities, paths, rigs",
-                       std::to_string(m.cities.size()) + " x " + std::to_string(m.paths.size()) + " x " +
-                           std::to_string(m.rigs.size()) + " drives, more than " + std::to_string(kMaxDatasetDrives));
+        return f.error("cities, paths, rigs", std::to_string(m.cities.size()) + " x " + std::to_string(m.paths.size()) +
+                                                  " x " + std::to_string(m.rigs.size()) + " drives, more than " +
+                                                  std::to_string(kMaxDatasetDrives));
     return m;
 }
 

@@ -195,9 +195,10 @@ Result<SumoNet> readSumoNet(const std::string& path) {
     auto key = [](const SumoSignalLink& a) { return std::make_tuple(a.signalId, a.light, a.linkIndex); };
     std::sort(r.net.signalLinks.begin(), r.net.signalLinks.end(),
               [&](const SumoSignalLink& a, const SumoSignalLink& b) { return key(a) < key(b); });
-    r.net.signalLinks.erase(std::unique(r.net.signalLinks.begin(), r.net.signalLinks.end(),
-                                        [&](const SumoSignalLink& a, const SumoSignalLink& b) { return key(a) == key(b); }),
-                            r.net.signalLinks.end());
+    r.net.signalLinks.erase(
+        std::unique(r.net.signalLinks.begin(), r.net.signalLinks.end(),
+                    [&](const SumoSignalLink& a, const SumoSignalLink& b) { return key(a) == key(b); }),
+        r.net.signalLinks.end());
     return std::move(r.net);
 }
 

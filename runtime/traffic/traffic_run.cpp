@@ -267,9 +267,14 @@ Status runAll(const std::string& xodrText, const TrafficOptions& opt, const std:
                    {"vehicle_vehicle", sum.collisionEvents.betweenVehicles}}},
                  {"teleports", sum.teleports},
                  {"emergency_stops", sum.emergencyStops}};
-    j["files"] = {{"xodr", "city.xodr"},           {"net", "city.net.xml"}, {"demand", "demand.rou.xml"},
-                  {"config", "traffic.sumocfg"},   {"fcd", "fcd.xml"},      {"signals", "signals.xml"},
-                  {"statistics", "statistics.xml"}, {"collisions", "collisions.xml"}};
+    j["files"] = {{"xodr", "city.xodr"},
+                  {"net", "city.net.xml"},
+                  {"demand", "demand.rou.xml"},
+                  {"config", "traffic.sumocfg"},
+                  {"fcd", "fcd.xml"},
+                  {"signals", "signals.xml"},
+                  {"statistics", "statistics.xml"},
+                  {"collisions", "collisions.xml"}};
     VISTA_RETURN_IF_ERROR(writeText((w / "traffic.json").string(), j.dump(2) + "\n"));
     std::error_code ec;
     fs::remove(logs, ec);

@@ -235,16 +235,15 @@ TEST_F(RenderShards, BadDatasetsAndFlagsExitTwoNamingTheField) {
     refuse("{" + cities + R"(, "rigs": [{"name": "c", "mode": "fast"}]})", "rigs[0].mode:");
     refuse(R"({"cities": ["a.osgb"], "paths": [{"name": "p", "duration": 0}], "rigs": [{"name": "c"}]})",
            "paths[0].duration: 0 out of range");
-    refuse(R"({"cities": ["a.osgb"], "paths": [{"name": "p", "kind": "swim"}], "rigs": [{"name": "c"}]})",
-           "paths[0]:");
+    refuse(R"({"cities": ["a.osgb"], "paths": [{"name": "p", "kind": "swim"}], "rigs": [{"name": "c"}]})", "paths[0]:");
     refuse(R"({"cities": ["nowhere.osgb"], "paths": [{"name": "p"}], "rigs": [{"name": "c"}]})",
            "cities[0].file: '" + dir->file("nowhere.osgb") + "' does not exist");
     refuse("{" + cities + R"(, "rigs": [{"name": "c"}]})", "option --size does not apply with --dataset",
            " --size 64x48");
     refuse("{" + cities + R"(, "rigs": [{"name": "c"}]})", "option --merge: needs --shards", " --merge");
     refuse("{" + cities + R"(, "rigs": [{"name": "c"}]})", "option --shard = '5/4'", " --shard 5/4");
-    const auto r = runVista("render " + dir->file("a.osgb") + " --rig " + dir->file("lidar.json") +
-                            " -q --out " + out + " --shard 1/2");
+    const auto r = runVista("render " + dir->file("a.osgb") + " --rig " + dir->file("lidar.json") + " -q --out " + out +
+                            " --shard 1/2");
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("--shard does not apply with --rig"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out + ".shards"));

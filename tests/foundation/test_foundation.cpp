@@ -361,9 +361,7 @@ TEST(Shard, RangesTileTheItemsInOrderAndBalance) {
                 next = r.end;
                 smallest = std::min(smallest, r.size());
                 largest = std::max(largest, r.size());
-                if (r.size()) {
-                    EXPECT_TRUE(r.contains(r.begin) && !r.contains(r.end));
-                }
+                if (r.size()) { EXPECT_TRUE(r.contains(r.begin) && !r.contains(r.end)); }
             }
             EXPECT_EQ(next, total) << total << " items in " << n << " shards";
             EXPECT_LE(largest - smallest, 1u) << total << " items in " << n << " shards";

@@ -21,8 +21,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     auto unique = [](const auto& list) {
         std::set<std::string> names;
         for (const auto& e : list)
-            if (e.name.empty() || e.name.size() > 64 || e.name[0] == '.' ||
-                e.name.find('/') != std::string::npos || !names.insert(e.name).second)
+            if (e.name.empty() || e.name.size() > 64 || e.name[0] == '.' || e.name.find('/') != std::string::npos ||
+                !names.insert(e.name).second)
                 std::abort();
     };
     unique(m->cities), unique(m->paths), unique(m->rigs);

@@ -460,8 +460,8 @@ std::string signalNet() {
                "_0\" index=\"0\" length=\"5.00\" shape=\"0,0 5,0\">\n      <param key=\"signalID\" value=\"" + signal +
                "\"/>\n    </lane>\n  </edge>\n";
     };
-    return "<?xml version=\"1.0\"?>\n<net version=\"1.9\">\n  <location netOffset=\"0,0\"/>\n" +
-           internal(":J_0", "7") + internal(":J_1", "7") + internal(":J_2", "9") +
+    return "<?xml version=\"1.0\"?>\n<net version=\"1.9\">\n  <location netOffset=\"0,0\"/>\n" + internal(":J_0", "7") +
+           internal(":J_1", "7") + internal(":J_2", "9") +
            "  <edge id=\"a\">\n    <lane id=\"a_0\" index=\"0\" length=\"50.00\"/>\n  </edge>\n"
            "  <edge id=\"b\">\n    <lane id=\"b_0\" index=\"0\" length=\"50.00\"/>\n  </edge>\n"
            "  <edge id=\"c\">\n    <lane id=\"c_0\" index=\"0\" length=\"50.00\"/>\n  </edge>\n"
