@@ -307,10 +307,12 @@ Status TrafficScene::apply() {
     const size_t agentsCast = im.movers.size();
     _headsDrawn = 0;
     const uint32_t lampProto0 = uint32_t(_models.models.size());
+    // Outside the run's time span SUMO had no state: the static lamps show.
+    const bool live = !_tracks->times.empty() && _t >= _tracks->times.front() && _t <= _tracks->times.back();
     for (size_t i = 0; i < _heads.size(); ++i) {
         const double d = glm::length(im.headCentre[i] - _eye);
-        const bool gl = _split > 0 && d - kLampOverlayRadius <= _split;
-        const bool rays = d + kLampOverlayRadius > _split;
+        const bool gl = live && _split > 0 && d - kLampOverlayRadius <= _split;
+        const bool rays = live && d + kLampOverlayRadius > _split;
         const unsigned mask = gl ? ~0u : 0u;
         if (im.headXf[i]->getNodeMask() != mask) im.headXf[i]->setNodeMask(mask);
         _headsDrawn += gl ? 1 : 0;

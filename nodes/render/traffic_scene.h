@@ -36,8 +36,11 @@
 //   split treats a head as an agent (its sphere: lampOverlayCentre(),
 //   kLampOverlayRadius): within d in GL, beyond d a mover of the ray scene
 //   (prototype after the agents' ones, labelled as the head's static
-//   geometry: InstanceKind::TrafficLight, class TrafficLight). The label
-//   pass draws no overlay (the static head under it carries the label).
+//   geometry: InstanceKind::TrafficLight, class TrafficLight). At a time
+//   outside the run (before the tracks' first or after their last time) no
+//   overlay is shown or cast: the static lamps show, as without traffic.
+//   The label pass draws no overlay (the static head under it carries the
+//   label).
 //   Without signal states nothing of this exists (signalNode() is null).
 // - The same time gives the same placements in every mode, face and run.
 // Not thread-safe: the frame thread calls it between frames (no ray query

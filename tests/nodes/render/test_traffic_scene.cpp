@@ -197,9 +197,9 @@ Result<SignalStates> states(const std::string& dir) {
     const std::string path = dir + "/signals.xml";
     std::ofstream(path) << "<tlsStates>\n"
                            "  <tlsState time=\"0.00\" id=\"J0\" programID=\"0\" phase=\"0\" state=\"Gr\"/>\n"
-                           "  <tlsState time=\"10.00\" id=\"J0\" programID=\"0\" phase=\"1\" state=\"yr\"/>\n"
-                           "  <tlsState time=\"13.00\" id=\"J0\" programID=\"0\" phase=\"2\" state=\"ru\"/>\n"
-                           "  <tlsState time=\"15.00\" id=\"J0\" programID=\"0\" phase=\"3\" state=\"rG\"/>\n"
+                           "  <tlsState time=\"4.00\" id=\"J0\" programID=\"0\" phase=\"1\" state=\"yr\"/>\n"
+                           "  <tlsState time=\"6.00\" id=\"J0\" programID=\"0\" phase=\"2\" state=\"ru\"/>\n"
+                           "  <tlsState time=\"8.00\" id=\"J0\" programID=\"0\" phase=\"3\" state=\"rG\"/>\n"
                            "</tlsStates>\n";
     return readSignalStates(net, path);
 }
@@ -259,10 +259,10 @@ TEST(TrafficScene, SignalHeadsShowSumosLampAtTheFrameTime) {
         std::vector<bool> litA, litB;
     };
     const std::vector<Case> cases = {
-        {5.0, LampState::Green, LampState::Red, {false, false, true}, {true, false, false}},
-        {11.0, LampState::Amber, LampState::Red, {false, true, false}, {true, false, false}},
-        {14.0, LampState::Red, LampState::RedAmber, {true, false, false}, {true, true, false}},
-        {16.5, LampState::Red, LampState::Green, {true, false, false}, {false, false, true}},
+        {2.0, LampState::Green, LampState::Red, {false, false, true}, {true, false, false}},
+        {4.5, LampState::Amber, LampState::Red, {false, true, false}, {true, false, false}},
+        {7.0, LampState::Red, LampState::RedAmber, {true, false, false}, {true, true, false}},
+        {9.5, LampState::Red, LampState::Green, {true, false, false}, {false, false, true}},
     };
     for (const Case& c : cases) {
         ASSERT_TRUE(ts.setFrame(c.t, eye));
@@ -301,9 +301,18 @@ TEST(TrafficScene, SignalHeadsShowSumosLampAtTheFrameTime) {
         }
     }
     // Everything in GL (full): no head in the ray scene.
-    ASSERT_TRUE(ts.setFrame(16.5, eye));
+    ASSERT_TRUE(ts.setFrame(9.5, eye));
     EXPECT_EQ(ts.headsDrawn(), 2u);
     EXPECT_EQ(ts.headsCast(), 0u);
+    // After the run (tracks end at 10 s): no overlay anywhere, the static lamps show.
+    for (double split : {1e300, 40.0, 0.0}) {
+        ASSERT_TRUE(ts.setFrame(12.0, eye));
+        ASSERT_TRUE(ts.setSplit(split));
+        EXPECT_EQ(ts.headsDrawn(), 0u);
+        EXPECT_EQ(ts.headsCast(), 0u);
+        for (unsigned i = 0; i < ts.signalNode()->getNumChildren(); ++i)
+            EXPECT_EQ(ts.signalNode()->getChild(i)->getNodeMask(), 0u);
+    }
 }
 
 TEST(TrafficScene, WithoutSignalStatesNoHeadNodeExists) {
