@@ -96,7 +96,8 @@ LampState SignalStates::lampAt(uint32_t signalId, double t) const {
     for (const SumoSignalLink& l : linksOf(signalId)) {
         const auto& list = _records[l.light];
         // The last record at or before t.
-        auto after = std::upper_bound(list.begin(), list.end(), t, [](double v, const Record& r) { return v < r.time; });
+        auto after =
+            std::upper_bound(list.begin(), list.end(), t, [](double v, const Record& r) { return v < r.time; });
         if (after == list.begin()) continue;
         const std::string& state = std::prev(after)->state;
         if (l.linkIndex >= 0 && size_t(l.linkIndex) < state.size()) letters += state[size_t(l.linkIndex)];

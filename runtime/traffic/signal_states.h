@@ -50,9 +50,9 @@ private:
         double time;
         std::string state;
     };
-    std::vector<std::string> _lights;             // SUMO light ids (SumoNet::trafficLights)
-    std::vector<std::vector<Record>> _records;    // per light, by time
-    std::vector<SumoSignalLink> _links;           // sorted by signalId
+    std::vector<std::string> _lights;           // SUMO light ids (SumoNet::trafficLights)
+    std::vector<std::vector<Record>> _records;  // per light, by time
+    std::vector<SumoSignalLink> _links;         // sorted by signalId
 };
 
 Result<SignalStates> readSignalStates(const SumoNet& net, const std::string& signalsPath);
