@@ -103,7 +103,7 @@ osg::Matrixd toOsg(const glm::dmat4& m) {
 }  // namespace
 
 TrafficScene::TrafficScene(std::shared_ptr<const TrafficTracks> tracks, const CityParams& params, bool labels,
-                           const StreetGraph* streets)
+                           const SceneModel* city)
     : _tracks(std::move(tracks)), _params(params), _labels(labels), _impl(new Impl) {
     _models = agentModels(Lighting(params));
     _node = new osg::Group;
@@ -123,7 +123,8 @@ TrafficScene::TrafficScene(std::shared_ptr<const TrafficTracks> tracks, const Ci
         _labelNode->setDataVariance(osg::Object::DYNAMIC);
         _labelNode->setStateSet(labelRootState().get());
     }
-    if (_tracks->signals && streets) (void)setSignalHeads(_tracks->signals, signalHeads(*streets, _params));
+    if (_tracks->signals && city && city->regions.empty())
+        (void)setSignalHeads(_tracks->signals, signalHeads(city->streets, _params));
 }
 
 Status TrafficScene::setSignalHeads(std::shared_ptr<const SignalStates> states, std::vector<SignalHead> heads) {

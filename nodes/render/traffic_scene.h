@@ -28,7 +28,7 @@
 //   the camera's carrier (the vehicle `vista path --traffic` rides) and is
 //   drawn nowhere: a vehicle's cameras do not see it from inside.
 // - Traffic-light heads (signal_heads.h): with the tracks' signal states
-//   (TrafficTracks::signals) and the city's street graph, or after
+//   (TrafficTracks::signals) and a city file's street graph, or after
 //   setSignalHeads(), every head gets a MatrixTransform (head frame ->
 //   world) over one of the shared lamp overlays (lampOverlay(), one per
 //   LampState) under signalNode(), the last child of node(); setFrame(t)
@@ -57,8 +57,8 @@
 
 #include "citygen/params.h"
 #include "foundation/status.h"
-#include "citygen/street_graph.h"
 #include "nodes/render/signal_heads.h"
+#include "runtime/scene/scene_model.h"
 #include "runtime/traffic/agent_models.h"
 #include "runtime/traffic/traffic_tracks.h"
 
@@ -68,11 +68,13 @@ class RayScene;
 
 class TrafficScene {
 public:
-    // labels: also build the label twins (vista render). streets: the city's
-    // street graph, whose traffic-light heads show tracks->signals (none
-    // when either is missing).
+    // labels: also build the label twins (vista render). city: the city whose
+    // traffic-light heads show tracks->signals (signalHeads() of its street
+    // graph); none when either is missing or the city is merged from paged
+    // regions (their street graph's order is not the lane model's that
+    // numbered the heads of the traffic's OpenDRIVE).
     TrafficScene(std::shared_ptr<const TrafficTracks> tracks, const CityParams& params, bool labels,
-                 const StreetGraph* streets = nullptr);
+                 const SceneModel* city = nullptr);
     ~TrafficScene();
     // The ray scene that shows the agents beyond the split (its prototypes are
     // added now); null detaches. Errors: those of RayScene::setMoverPrototypes.

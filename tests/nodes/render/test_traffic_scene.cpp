@@ -318,7 +318,7 @@ TEST(TrafficScene, SignalHeadsShowSumosLampAtTheFrameTime) {
 TEST(TrafficScene, WithoutSignalStatesNoHeadNodeExists) {
     CityParams params;
     auto tr = tracks();  // no signals
-    StreetGraph none;
+    SceneModel none;
     TrafficScene ts(tr, params, /*labels=*/false, &none);
     EXPECT_EQ(ts.signalNode(), nullptr);
     EXPECT_TRUE(ts.heads().empty());
