@@ -96,7 +96,7 @@ Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene
     }
     if (cfg.traffic) {
         if (!city) return Status::error("--traffic: needs the city's parameters (no city given)");
-        run->traffic = std::make_unique<TrafficScene>(cfg.traffic, city->params, false);
+        run->traffic = std::make_unique<TrafficScene>(cfg.traffic, city->params, false, city);
         RayScene* rays = run->stream ? run->stream->rays() : run->rays.get();
         if (rays) VISTA_RETURN_IF_ERROR(run->traffic->attachRays(rays));
         run->ctx.traffic = run->traffic.get();

@@ -671,7 +671,7 @@ int runView(int argc, char** argv) {
     ViewModes modes(ctx, stream.stream.get());
     std::unique_ptr<TrafficScene> traffic;  // after the modes' ray scene: released before it
     if (*tracks) {
-        traffic = std::make_unique<TrafficScene>(*tracks, city.params, false);
+        traffic = std::make_unique<TrafficScene>(*tracks, city.params, false, &city);
         ctx.traffic = traffic.get();
         if (stream.stream && stream.stream->rays())
             if (Status s = traffic->attachRays(stream.stream->rays()); !s) return reportBadInput(kCmd, s);

@@ -3,11 +3,13 @@
 
 #include "foundation/input_file.h"
 #include "foundation/number_text.h"
+#include "runtime/traffic/signal_states.h"
 
 #include <algorithm>
 #include <cstdio>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <sstream>
 #include <unistd.h>
 
@@ -481,7 +483,14 @@ Result<std::shared_ptr<const TrafficTracks>> loadTrafficFlag(const std::string& 
         return Status::error(m.rfind("--traffic", 0) == 0 ? m : "--traffic = '" + dir + "': " + m);
     }
     if (t->frames() == 0) return Status::error("--traffic = '" + dir + "': the floating-car data has no time step");
-    return std::shared_ptr<const TrafficTracks>(std::make_shared<TrafficTracks>(std::move(*t)));
+    auto tracks = std::make_shared<TrafficTracks>(std::move(*t));
+    // The heads' lamps: SUMO's signal states, when the run recorded them.
+    if (std::filesystem::exists(std::filesystem::path(dir) / "signals.xml")) {
+        auto s = loadSignalStates(dir);
+        if (!s) return Status::error("--traffic = '" + dir + "': " + s.status().message());
+        tracks->signals = std::make_shared<SignalStates>(std::move(*s));
+    }
+    return std::shared_ptr<const TrafficTracks>(std::move(tracks));
 }
 
 Result<Effects> parseEffectsOption(const std::string& s, const Effects& base) {

@@ -585,7 +585,7 @@ int runRigRender(const RigRunRequest& a) {
     if (Status s = openWorkDir(a, plan, walk->path, out); !s) return reportBadInput(kCmd, s);
     std::unique_ptr<TrafficScene> traffic;
     if (plan.traffic) {
-        traffic = std::make_unique<TrafficScene>(plan.traffic, walk->city.params, false);
+        traffic = std::make_unique<TrafficScene>(plan.traffic, walk->city.params, false, &walk->city);
         if (Status s = traffic->attachRays(rays->get()); !s) return reportBadInput(kCmd, s);
         plan.agents = traffic.get();
     }

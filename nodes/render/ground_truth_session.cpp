@@ -37,7 +37,7 @@ Status GroundTruthSession::setUp(const GroundTruthSetup& setup, const SceneModel
         ctx.rays = rays.get();
     }
     if (setup.traffic) {
-        traffic = std::make_unique<TrafficScene>(setup.traffic, city.params, setup.labels);
+        traffic = std::make_unique<TrafficScene>(setup.traffic, city.params, setup.labels, &city);
         if (RayScene* r = activeRays()) VISTA_RETURN_IF_ERROR(traffic->attachRays(r));
         ctx.traffic = traffic.get();
         renderer->setOverlay(traffic->node(), traffic->labelNode());

@@ -9,6 +9,7 @@
 #include <osg/Geometry>
 #include <osg/MatrixTransform>
 
+#include "citygen/labels.h"
 #include "citygen/lighting.h"
 #include "nodes/label_pass.h"
 #include "runtime/engine/ray_scene.h"
@@ -32,6 +33,10 @@ struct TrafficScene::Impl {
     std::vector<glm::dmat4> castXf;
     std::vector<MoverPlacement> movers;
     std::vector<uint32_t> nextShown;
+    // Traffic-light heads: the lamp overlay per LampState, a transform per head.
+    std::vector<osg::ref_ptr<osg::Geode>> lampProtos;
+    std::vector<osg::ref_ptr<osg::MatrixTransform>> headXf;
+    std::vector<glm::dvec3> headCentre;  // world centre of each head's overlay sphere
 };
 
 namespace {
@@ -97,7 +102,8 @@ osg::Matrixd toOsg(const glm::dmat4& m) {
 
 }  // namespace
 
-TrafficScene::TrafficScene(std::shared_ptr<const TrafficTracks> tracks, const CityParams& params, bool labels)
+TrafficScene::TrafficScene(std::shared_ptr<const TrafficTracks> tracks, const CityParams& params, bool labels,
+                           const SceneModel* city)
     : _tracks(std::move(tracks)), _params(params), _labels(labels), _impl(new Impl) {
     _models = agentModels(Lighting(params));
     _node = new osg::Group;
@@ -117,17 +123,64 @@ TrafficScene::TrafficScene(std::shared_ptr<const TrafficTracks> tracks, const Ci
         _labelNode->setDataVariance(osg::Object::DYNAMIC);
         _labelNode->setStateSet(labelRootState().get());
     }
+    if (_tracks->signals && city && city->regions.empty())
+        (void)setSignalHeads(_tracks->signals, signalHeads(city->streets, _params));
+}
+
+Status TrafficScene::setSignalHeads(std::shared_ptr<const SignalStates> states, std::vector<SignalHead> heads) {
+    Impl& im = *_impl;
+    if (_signalNode) _node->removeChild(_signalNode.get());
+    _signalNode = nullptr;
+    im.headXf.clear();
+    im.headCentre.clear();
+    _signals = std::move(states);
+    _heads = _signals ? std::move(heads) : std::vector<SignalHead>();
+    _lamps.assign(_heads.size(), LampState::Off);
+    if (!_heads.empty()) {
+        if (im.lampProtos.empty())
+            for (int k = 0; k < kLampStates; ++k) {
+                osg::ref_ptr<osg::Geode> g = new osg::Geode;
+                g->addDrawable(protoGeometry(lampOverlay(LampState(k))).get());
+                im.lampProtos.push_back(g);
+            }
+        _signalNode = new osg::Group;
+        _signalNode->setName("vista.traffic.signals");
+        _signalNode->setDataVariance(osg::Object::DYNAMIC);
+        for (const SignalHead& h : _heads) {
+            osg::ref_ptr<osg::MatrixTransform> x = new osg::MatrixTransform(toOsg(h.frame));
+            x->setDataVariance(osg::Object::DYNAMIC);
+            x->addChild(im.lampProtos[0].get());
+            _signalNode->addChild(x.get());
+            im.headXf.push_back(x);
+            im.headCentre.push_back(glm::dvec3(h.frame * glm::dvec4(lampOverlayCentre(), 1.0)));
+        }
+        _node->addChild(_signalNode.get());  // the last child: agents insert before it
+        updateLamps();
+    }
+    if (_rays) return attachRays(_rays);  // the lamp prototypes join the movers'
+    return apply();
+}
+
+void TrafficScene::updateLamps() {
+    Impl& im = *_impl;
+    for (size_t i = 0; i < _heads.size(); ++i) {
+        const LampState l = _signals->lampAt(_heads[i].signal, _t);
+        if (l == _lamps[i] && im.headXf[i]->getChild(0) == im.lampProtos[size_t(l)].get()) continue;
+        _lamps[i] = l;
+        im.headXf[i]->setChild(0, im.lampProtos[size_t(l)].get());
+    }
 }
 
 TrafficScene::~TrafficScene() {
-    if (_rays && _cast > 0) (void)_rays->placeMovers({});
+    if (_rays && _cast + _headsCast > 0) (void)_rays->placeMovers({});
 }
 
 Status TrafficScene::attachRays(RayScene* rays) {
-    if (_rays && _rays != rays && _cast > 0) VISTA_RETURN_IF_ERROR(_rays->placeMovers({}));
+    if (_rays && _rays != rays && _cast + _headsCast > 0) VISTA_RETURN_IF_ERROR(_rays->placeMovers({}));
     _castAgents.clear();
     _castTransforms.clear();
     _cast = 0;
+    _headsCast = 0;
     _rays = rays;
     if (!_rays) return apply();
     std::vector<SceneMesh> protos;
@@ -139,6 +192,16 @@ Status TrafficScene::attachRays(RayScene* rays) {
         s.indices = m.mesh.indices;
         protos.push_back(std::move(s));
     }
+    if (!_heads.empty())
+        for (int k = 0; k < kLampStates; ++k) {  // prototypes models.size() + LampState
+            const Mesh m = lampOverlay(LampState(k));
+            SceneMesh s;
+            s.material = Material::TrafficLight;
+            s.positions = m.positions;
+            s.colors = m.colors;
+            s.indices = m.indices;
+            protos.push_back(std::move(s));
+        }
     VISTA_RETURN_IF_ERROR(_rays->setMoverPrototypes(protos));
     return apply();
 }
@@ -157,6 +220,7 @@ Status TrafficScene::setFrame(double t, const glm::dvec3& eye) {
     if (moved) {
         _placed = placeAgents(*_tracks, _models, _params, t);
         _placedValid = true;
+        if (!_heads.empty()) updateLamps();
     }
     return apply();
 }
@@ -240,14 +304,37 @@ Status TrafficScene::apply() {
             if (im.labelXf[agent]) im.labelXf[agent]->setNodeMask(0u);
         }
     std::swap(im.shown, im.nextShown);
+    // Heads: GL within the split, movers beyond (encoded with their lamp for change detection).
+    const size_t agentsCast = im.movers.size();
+    _headsDrawn = 0;
+    const uint32_t lampProto0 = uint32_t(_models.models.size());
+    // Outside the run's time span SUMO had no state: the static lamps show.
+    const bool live = !_tracks->times.empty() && _t >= _tracks->times.front() && _t <= _tracks->times.back();
+    for (size_t i = 0; i < _heads.size(); ++i) {
+        const double d = glm::length(im.headCentre[i] - _eye);
+        const bool gl = live && _split > 0 && d - kLampOverlayRadius <= _split;
+        const bool rays = live && d + kLampOverlayRadius > _split;
+        const unsigned mask = gl ? ~0u : 0u;
+        if (im.headXf[i]->getNodeMask() != mask) im.headXf[i]->setNodeMask(mask);
+        _headsDrawn += gl ? 1 : 0;
+        if (!rays || !_rays) continue;
+        const uint32_t lamp = uint32_t(_lamps[i]);
+        im.castAgents.push_back(0x80000000u | uint32_t(i * kLampStates + lamp));
+        im.castXf.push_back(_heads[i].frame);
+        im.movers.push_back({lampProto0 + lamp, _heads[i].frame,
+                             makeInstanceId(InstanceKind::TrafficLight, _heads[i].signal),
+                             uint8_t(semanticClass(Material::TrafficLight))});
+    }
     if (!_rays) {
         _cast = 0;
+        _headsCast = 0;
         return Status::ok();
     }
+    _headsCast = im.movers.size() - agentsCast;
     if (im.castAgents == _castAgents && im.castXf == _castTransforms) return Status::ok();
     std::swap(_castAgents, im.castAgents);
     std::swap(_castTransforms, im.castXf);
-    _cast = im.movers.size();
+    _cast = agentsCast;
     return _rays->placeMovers(im.movers);
 }
 

@@ -27,6 +27,21 @@
 // - An agent whose body (its model's box grown by 0.3 m) holds the eye is
 //   the camera's carrier (the vehicle `vista path --traffic` rides) and is
 //   drawn nowhere: a vehicle's cameras do not see it from inside.
+// - Traffic-light heads (signal_heads.h): with the tracks' signal states
+//   (TrafficTracks::signals) and a city file's street graph, or after
+//   setSignalHeads(), every head gets a MatrixTransform (head frame ->
+//   world) over one of the shared lamp overlays (lampOverlay(), one per
+//   LampState) under signalNode(), the last child of node(); setFrame(t)
+//   switches each head's overlay to SignalStates::lampAt(head, t), and the
+//   split treats a head as an agent (its sphere: lampOverlayCentre(),
+//   kLampOverlayRadius): within d in GL, beyond d a mover of the ray scene
+//   (prototype after the agents' ones, labelled as the head's static
+//   geometry: InstanceKind::TrafficLight, class TrafficLight). At a time
+//   outside the run (before the tracks' first or after their last time) no
+//   overlay is shown or cast: the static lamps show, as without traffic.
+//   The label pass draws no overlay (the static head under it carries the
+//   label).
+//   Without signal states nothing of this exists (signalNode() is null).
 // - The same time gives the same placements in every mode, face and run.
 // Not thread-safe: the frame thread calls it between frames (no ray query
 // may run meanwhile).
@@ -42,6 +57,8 @@
 
 #include "citygen/params.h"
 #include "foundation/status.h"
+#include "nodes/render/signal_heads.h"
+#include "runtime/scene/scene_model.h"
 #include "runtime/traffic/agent_models.h"
 #include "runtime/traffic/traffic_tracks.h"
 
@@ -51,8 +68,13 @@ class RayScene;
 
 class TrafficScene {
 public:
-    // labels: also build the label twins (vista render).
-    TrafficScene(std::shared_ptr<const TrafficTracks> tracks, const CityParams& params, bool labels);
+    // labels: also build the label twins (vista render). city: the city whose
+    // traffic-light heads show tracks->signals (signalHeads() of its street
+    // graph); none when either is missing or the city is merged from paged
+    // regions (their street graph's order is not the lane model's that
+    // numbered the heads of the traffic's OpenDRIVE).
+    TrafficScene(std::shared_ptr<const TrafficTracks> tracks, const CityParams& params, bool labels,
+                 const SceneModel* city = nullptr);
     ~TrafficScene();
     // The ray scene that shows the agents beyond the split (its prototypes are
     // added now); null detaches. Errors: those of RayScene::setMoverPrototypes.
@@ -60,6 +82,15 @@ public:
     RayScene* rays() const { return _rays; }
     Status setFrame(double t, const glm::dvec3& eye);
     Status setSplit(double nearDistance);
+    // Shows `heads` lit from `states` (replacing any heads before; null
+    // states or no heads: none). Errors: those of attachRays().
+    Status setSignalHeads(std::shared_ptr<const SignalStates> states, std::vector<SignalHead> heads);
+    osg::Group* signalNode() const { return _signalNode.get(); }
+    const std::vector<SignalHead>& heads() const { return _heads; }
+    // The lamp each head shows at the current time (heads() order).
+    const std::vector<LampState>& lamps() const { return _lamps; }
+    size_t headsDrawn() const { return _headsDrawn; }  // heads in GL this frame
+    size_t headsCast() const { return _headsCast; }    // heads in the ray scene this frame
     double time() const { return _t; }
     osg::Group* node() const { return _node.get(); }
     osg::Group* labelNode() const { return _labelNode.get(); }
@@ -92,7 +123,12 @@ private:
     std::vector<glm::dmat4> _castTransforms;
     struct Impl;
     std::unique_ptr<Impl> _impl;
-    osg::ref_ptr<osg::Group> _node, _labelNode;
+    osg::ref_ptr<osg::Group> _node, _labelNode, _signalNode;
+    std::shared_ptr<const SignalStates> _signals;
+    std::vector<SignalHead> _heads;
+    std::vector<LampState> _lamps;
+    size_t _headsDrawn = 0, _headsCast = 0;
+    void updateLamps();
 };
 
 }  // namespace vista

@@ -22,6 +22,7 @@
 //   is an error naming the file, the line and the reason. Thread-safe (const after reading).
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,8 @@
 #include "runtime/traffic/traffic_demand.h"
 
 namespace vista {
+
+class SignalStates;  // signal_states.h
 
 struct AgentPose {
     uint32_t agent = 0;
@@ -43,6 +46,9 @@ struct TrafficTracks {
     std::vector<double> times;          // seconds, one per frame, increasing
     std::vector<uint32_t> frameStart;   // frame f's poses: [frameStart[f], frameStart[f+1])
     std::vector<AgentPose> poses;
+    // The run's traffic-light states (signal_states.h) when loaded with the
+    // tracks (the CLI's --traffic), else null: heads keep their static lamps.
+    std::shared_ptr<const SignalStates> signals;
 
     size_t frames() const { return times.size(); }
     // Index of the last frame at or before `t` (0 before the first).

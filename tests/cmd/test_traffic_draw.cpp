@@ -5,8 +5,9 @@
 // depth), the hybrid's ray-cast far field shows agents beyond the split, rig
 // cameras and LiDAR see them, a streamed paged city draws the same agent
 // pixels as the city file, bench's ray-cast frames match full where agents
-// are, frames without agents are the bytes of a run without --traffic, and
-// bad traffic directories are refused with exit 2 naming --traffic.
+// are, frames without agents are the bytes of a run without --traffic,
+// traffic-light heads show SUMO's lamp, and bad traffic directories are
+// refused with exit 2 naming --traffic.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -25,10 +26,13 @@
 #include "citygen/labels.h"
 #include "citygen/lighting.h"
 #include "citygen/terrain.h"
+#include "citygen/traffic_signals.h"
+#include "nodes/render/signal_heads.h"
 #include "runtime/engine/image.h"
 #include "runtime/scene/city_file.h"
 #include "runtime/scene/paths.h"
 #include "runtime/traffic/agent_models.h"
+#include "runtime/traffic/signal_states.h"
 #include "runtime/traffic/traffic_tracks.h"
 #include "tests/common/run_vista.h"
 #include "tests/common/temp_dir.h"
@@ -362,7 +366,13 @@ TEST_F(TrafficDraw, BadTrafficDirectoriesExitTwoNamingTheOption) {
     fs::copy_file(f.traffic + "/traffic.json", tmp.file("cut/traffic.json"));
     const std::string fcd = readBytes(f.traffic + "/fcd.xml");
     std::ofstream(tmp.file("cut/fcd.xml")) << fcd.substr(0, fcd.size() / 2);
-    for (const std::string& dir : {tmp.file("missing"), tmp.file("empty"), tmp.file("cut")}) {
+    // Whole tracks, signal states cut short.
+    fs::create_directories(tmp.file("cutsignals"));
+    for (const char* name : {"traffic.json", "fcd.xml", "city.net.xml"})
+        fs::copy_file(f.traffic + "/" + name, tmp.file(std::string("cutsignals/") + name));
+    const std::string signals = readBytes(f.traffic + "/signals.xml");
+    std::ofstream(tmp.file("cutsignals/signals.xml")) << signals.substr(0, signals.size() / 2);
+    for (const std::string& dir : {tmp.file("missing"), tmp.file("empty"), tmp.file("cut"), tmp.file("cutsignals")}) {
         const std::string out = tmp.file("out");
         const std::string cmds[] = {
             "render " + f.city + " --path " + f.path + " --frames 2 --size 64x48 --out " + out,
@@ -375,4 +385,114 @@ TEST_F(TrafficDraw, BadTrafficDirectoriesExitTwoNamingTheOption) {
             EXPECT_FALSE(fs::exists(out)) << cmd;
         }
     }
+}
+
+// Traffic-light heads (--traffic): a camera 2 m in front of a head of the
+// city, at the height of its amber lamp, at a time SUMO has the head's links
+// red and at one it has them green; in full (GL) and hybrid with the head
+// beyond its near distance (rays) the pixel at each lamp's projected centre
+// belongs to that head (instance id), and the lamp SignalStates gives is the
+// bright one there, the others dark. Heads hidden behind a tree from that
+// camera (the instance image says so) are skipped for the next one.
+TEST_F(TrafficDraw, HeadsShowSumosLampInGlAndRays) {
+    TempDir tmp("vista_traffic_draw_heads");
+    const auto& f = fixture();
+    auto city = loadCityFile(f.city);
+    ASSERT_TRUE(city) << city.status().message();
+    auto tracks = loadTrafficTracks(f.traffic);
+    ASSERT_TRUE(tracks) << tracks.status().message();
+    auto states = loadSignalStates(f.traffic);
+    ASSERT_TRUE(states) << states.status().message();
+    const std::vector<SignalHead> heads = signalHeads(city->streets, city->params);
+    ASSERT_FALSE(heads.empty());
+    const auto steady = [&](uint32_t s, double t, LampState l) {
+        for (double dt : {-0.5, 0.0, 0.5})
+            if (states->lampAt(s, t + dt) != l) return false;
+        return true;
+    };
+    // Renders `head` at its red and green times in `mode`; counts the lamp
+    // pixels that are not the head's (occluded) and checks the colours of the others.
+    const auto check = [&](const SignalHead& head, double tRed, double tGreen, const std::string& mode,
+                           const std::string& out, bool expectColours) -> size_t {
+        const glm::dvec3 w(head.frame[2]), base(head.frame[3]);
+        const glm::dvec3 centre(head.frame * glm::dvec4(lampOverlayCentre(), 1.0));
+        const glm::dvec3 eye = glm::dvec3(base.x, base.y, centre.z) + 2.0 * w;
+        const double headingDeg = std::atan2(-w.x, -w.y) * 180.0 / 3.14159265358979323846;
+        {
+            std::ofstream csv(out + ".csv");
+            csv << "t_s,x_m,y_m,z_m,heading_deg,pitch_deg\n";
+            for (double t : {std::min(tRed, tGreen), std::max(tRed, tGreen)})
+                csv << t << "," << eye.x << "," << eye.y << "," << eye.z << "," << headingDeg << ",0\n";
+        }
+        const auto r = runVista("render " + f.city + " --path " + out + ".csv --size 160x100 --frames 2 -q --mode " +
+                                mode + " --traffic " + f.traffic + " --out " + out);
+        EXPECT_EQ(r.code, 0) << r.err;
+        if (r.code != 0) return 1;
+        const uint32_t id = makeInstanceId(InstanceKind::TrafficLight, head.signal);
+        const auto cams = nlohmann::json::parse(readBytes(out + "/cameras.json"));
+        const double fx = cams["fx"], fy = cams["fy"], cx = cams["cx"], cy = cams["cy"];
+        const glm::dvec3 offset(cams["world_offset"][0], cams["world_offset"][1], cams["world_offset"][2]);
+        size_t hidden = 0;
+        for (const auto& fr : cams["frames"]) {
+            const std::string name = fr["name"];
+            glm::dmat4 T(1.0);
+            for (int row = 0; row < 4; ++row)
+                for (int col = 0; col < 4; ++col) T[col][row] = fr["camera_from_world"][row][col].get<double>();
+            const double t = fr["t_s"];
+            const LampState want = states->lampAt(head.signal, t);
+            EXPECT_TRUE(want == LampState::Red || want == LampState::Green) << t;
+            auto img = readPng(out + "/rgb/" + name + ".png");
+            EXPECT_TRUE(img) << img.status().message();
+            if (!img) return 1;
+            const auto ids = loadNpy<uint32_t>(out + "/instance/" + name + ".npy");
+            EXPECT_EQ(ids.size(), size_t(img->width) * size_t(img->height));
+            if (ids.size() != size_t(img->width) * size_t(img->height)) return 1;
+            for (int k = 0; k < 3; ++k) {  // red, amber, green from the top
+                const glm::dvec3 lamp = centre + glm::dvec3(0, 0, (1 - k) * kTrafficLightHeight / 3.0);
+                const glm::dvec3 p(T * glm::dvec4(lamp - offset, 1.0));
+                EXPECT_GT(p.z, 0.5);
+                const int u = int(std::lround(cx + fx * p.x / p.z)), v = int(std::lround(cy + fy * p.y / p.z));
+                EXPECT_TRUE(u >= 0 && v >= 0 && u < img->width && v < img->height) << u << "," << v;
+                if (!(u >= 0 && v >= 0 && u < img->width && v < img->height)) return 1;
+                if (ids[size_t(v) * size_t(img->width) + size_t(u)] != id) {
+                    ++hidden;
+                    continue;
+                }
+                if (!expectColours) continue;
+                const glm::u8vec4 px = img->at(u, v);
+                const int c[3] = {px.x, px.y, px.z};
+                const bool lit = (k == 0 && want == LampState::Red) || (k == 2 && want == LampState::Green);
+                const int hi = std::max({c[0], c[1], c[2]});
+                if (!lit) {
+                    EXPECT_LT(hi, 110) << mode << " t " << t << " lamp " << k << " should be dark";
+                } else if (k == 0) {
+                    EXPECT_GT(c[0], 200) << mode << " t " << t;
+                    EXPECT_LT(c[1], 100) << mode << " t " << t;
+                } else {
+                    EXPECT_GT(c[1], 200) << mode << " t " << t;
+                    EXPECT_LT(c[0], 120) << mode << " t " << t;
+                }
+            }
+        }
+        return hidden;
+    };
+    // The first heads with a steady red and a steady green inside the run (away from its ends).
+    int tried = 0;
+    bool seen = false;
+    for (const SignalHead& h : heads) {
+        double tRed = -1, tGreen = -1;
+        for (double t = tracks->times.front() + 1.0; t < tracks->times.back() - 1.0; t += 0.5) {
+            if (tRed < 0 && steady(h.signal, t, LampState::Red)) tRed = t;
+            if (tGreen < 0 && steady(h.signal, t, LampState::Green)) tGreen = t;
+        }
+        if (tRed < 0 || tGreen < 0) continue;
+        if (++tried > 8) break;
+        const std::string dir = tmp.file("head" + std::to_string(h.signal));
+        if (check(h, tRed, tGreen, "full", dir + "_probe", false) != 0) continue;  // behind a tree
+        seen = true;
+        EXPECT_EQ(check(h, tRed, tGreen, "full", dir + "_full", true), 0u);
+        EXPECT_EQ(check(h, tRed, tGreen, "hybrid --near 1", dir + "_hybrid", true), 0u);
+        break;
+    }
+    EXPECT_TRUE(seen) << "every head tried is hidden from 2 m in front of it";
 }

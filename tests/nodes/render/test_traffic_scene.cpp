@@ -11,7 +11,17 @@
 #include <memory>
 #include <vector>
 
+#include <fstream>
+
+#include <osg/Geode>
+#include <osg/Geometry>
 #include <osg/MatrixTransform>
+
+#include "citygen/labels.h"
+#include "citygen/traffic_signals.h"
+#include "nodes/render/signal_heads.h"
+#include "runtime/traffic/signal_states.h"
+#include "tests/common/temp_dir.h"
 
 #include "nodes/render/traffic_scene.h"
 #include "runtime/engine/ray_scene.h"
@@ -159,4 +169,164 @@ TEST(TrafficScene, WithoutRaysTheAgentsBeyondTheSplitAreNotDrawn) {
     ASSERT_TRUE(ts.setSplit(1e300));
     EXPECT_EQ(ts.drawnCount(), size_t(kAgents));
     EXPECT_EQ(ts.nodesMade(), size_t(kAgents));
+}
+
+// Traffic-light heads: two hand-placed heads facing an eye at the origin, lit
+// from a hand-written signals.xml of one light whose two links are the heads'
+// (SumoNet::signalLinks), walked through its switches in GL and in the ray scene.
+namespace {
+
+constexpr uint32_t kHeadA = 7, kHeadB = 9;  // OpenDRIVE signal ids
+
+// A head at (x, y) on flat ground, facing -x (toward the origin).
+SignalHead headAt(uint32_t signal, double x, double y) {
+    SignalHead h;
+    h.signal = signal;
+    h.frame[0] = glm::dvec4(0, -1, 0, 0);  // x: the right hand of traffic looking along +x at it
+    h.frame[1] = glm::dvec4(0, 0, 1, 0);
+    h.frame[2] = glm::dvec4(-1, 0, 0, 0);
+    h.frame[3] = glm::dvec4(x, y, 0, 1);
+    return h;
+}
+
+// The light "J0": link 0 is head A's, link 1 head B's.
+Result<SignalStates> states(const std::string& dir) {
+    SumoNet net;
+    net.trafficLights = {"J0"};
+    net.signalLinks = {{kHeadA, 0, 0}, {kHeadB, 0, 1}};
+    const std::string path = dir + "/signals.xml";
+    std::ofstream(path) << "<tlsStates>\n"
+                           "  <tlsState time=\"0.00\" id=\"J0\" programID=\"0\" phase=\"0\" state=\"Gr\"/>\n"
+                           "  <tlsState time=\"4.00\" id=\"J0\" programID=\"0\" phase=\"1\" state=\"yr\"/>\n"
+                           "  <tlsState time=\"6.00\" id=\"J0\" programID=\"0\" phase=\"2\" state=\"ru\"/>\n"
+                           "  <tlsState time=\"8.00\" id=\"J0\" programID=\"0\" phase=\"3\" state=\"rG\"/>\n"
+                           "</tlsStates>\n";
+    return readSignalStates(net, path);
+}
+
+// Which of the three discs (0 red at the top, 1 amber, 2 green) of a head's
+// overlay geometry are lit: a disc is lit when its brightest channel is
+// above 200 (the dark ones stay below 80), read from the drawn vertex colours.
+std::vector<bool> litDiscs(const osg::MatrixTransform& head) {
+    const auto* geode = dynamic_cast<const osg::Geode*>(head.getChild(0));
+    EXPECT_NE(geode, nullptr);
+    const auto* g = geode ? dynamic_cast<const osg::Geometry*>(geode->getDrawable(0)) : nullptr;
+    EXPECT_NE(g, nullptr);
+    if (!g) return {};
+    const auto* v = static_cast<const osg::Vec3Array*>(g->getVertexArray());
+    const auto* c = static_cast<const osg::Vec4ubArray*>(g->getColorArray());
+    // Disc by height: the discs' centres are 0.3 m apart, the top one highest
+    // (its top vertex about 0.1 m above its centre).
+    float top = -1e9f;
+    for (const osg::Vec3& p : *v) top = std::max(top, p.y());
+    std::vector<int> bright(3, 0), dark(3, 0);
+    for (size_t i = 0; i < v->size(); ++i) {
+        const int disc = std::clamp(int(std::lround((top - (*v)[i].y() - 0.1f) / 0.3f)), 0, 2);
+        const osg::Vec4ub& col = (*c)[i];
+        const int m = std::max({int(col.r()), int(col.g()), int(col.b())});
+        if (m > 200) ++bright[size_t(disc)];
+        else if (m < 80) ++dark[size_t(disc)];
+    }
+    std::vector<bool> lit(3);
+    for (int k = 0; k < 3; ++k) {
+        EXPECT_TRUE(bright[size_t(k)] == 0 || dark[size_t(k)] == 0) << "disc " << k << " half lit";
+        lit[size_t(k)] = bright[size_t(k)] > 0;
+    }
+    return lit;
+}
+
+}  // namespace
+
+TEST(TrafficScene, SignalHeadsShowSumosLampAtTheFrameTime) {
+    vista::test::TempDir tmp("vista_traffic_heads");
+    auto st = states(tmp.path());
+    ASSERT_TRUE(st) << st.status().message();
+    auto signals = std::make_shared<SignalStates>(std::move(*st));
+    auto rs = RayScene::build(ground());
+    ASSERT_TRUE(rs.isOk()) << rs.status().message();
+    RayScene& rays = **rs;
+    CityParams params;
+    TrafficScene ts(tracks(), params, /*labels=*/false);
+    ASSERT_TRUE(ts.attachRays(&rays));
+    ASSERT_TRUE(ts.setSignalHeads(signals, {headAt(kHeadA, 20.0, 0.0), headAt(kHeadB, 60.0, 0.0)}));
+    ASSERT_NE(ts.signalNode(), nullptr);
+    ASSERT_EQ(ts.signalNode()->getNumChildren(), 2u);
+    // The heads' group is node()'s last child whatever agents appear.
+    const glm::dvec3 eye(0.0, 0.0, 1.5);
+    struct Case {
+        double t;
+        LampState a, b;
+        std::vector<bool> litA, litB;
+    };
+    const std::vector<Case> cases = {
+        {2.0, LampState::Green, LampState::Red, {false, false, true}, {true, false, false}},
+        {4.5, LampState::Amber, LampState::Red, {false, true, false}, {true, false, false}},
+        {7.0, LampState::Red, LampState::RedAmber, {true, false, false}, {true, true, false}},
+        {9.5, LampState::Red, LampState::Green, {true, false, false}, {false, false, true}},
+    };
+    for (const Case& c : cases) {
+        ASSERT_TRUE(ts.setFrame(c.t, eye));
+        ASSERT_TRUE(ts.setSplit(40.0));  // head A in GL, head B beyond (a mover)
+        EXPECT_EQ(ts.node()->getChild(ts.node()->getNumChildren() - 1), ts.signalNode());
+        ASSERT_EQ(ts.lamps().size(), 2u);
+        EXPECT_EQ(ts.lamps()[0], c.a) << "t " << c.t;
+        EXPECT_EQ(ts.lamps()[1], c.b) << "t " << c.t;
+        // The lamp from SUMO's letters, read a second way: the link's letter at t.
+        EXPECT_EQ(ts.lamps()[0], signals->lampAt(kHeadA, c.t));
+        auto* a = dynamic_cast<osg::MatrixTransform*>(ts.signalNode()->getChild(0));
+        auto* b = dynamic_cast<osg::MatrixTransform*>(ts.signalNode()->getChild(1));
+        ASSERT_TRUE(a && b);
+        EXPECT_EQ(litDiscs(*a), c.litA) << "t " << c.t;
+        EXPECT_EQ(litDiscs(*b), c.litB) << "t " << c.t;
+        EXPECT_NE(a->getNodeMask(), 0u);
+        EXPECT_EQ(b->getNodeMask(), 0u);
+        EXPECT_EQ(ts.headsDrawn(), 1u);
+        EXPECT_EQ(ts.headsCast(), 1u);
+        // The far head in the ray scene: a ray from the eye to its lit lamp's
+        // centre meets the overlay, coloured as that lamp is lit.
+        const int litLamp = c.b == LampState::Green ? 2 : 0;
+        const glm::dvec3 target(60.0 - 0.5 * kSignalPoleWidth - kTrafficLightDepth - 0.01, 0.0,
+                                kTrafficLightBottom + kTrafficLightHeight - (litLamp + 0.5) * kTrafficLightHeight / 3);
+        const glm::dvec3 dir = glm::normalize(target - eye);
+        const RayHit h = rays.intersect(glm::vec3(eye - rays.frameOrigin()), glm::vec3(dir));
+        ASSERT_TRUE(h.hit) << "t " << c.t;
+        EXPECT_NEAR(h.t, glm::length(target - eye), 0.05);
+        EXPECT_EQ(rays.source(h).moverId, makeInstanceId(InstanceKind::TrafficLight, kHeadB));
+        if (litLamp == 2) {
+            EXPECT_GT(int(h.color.y), 200);
+            EXPECT_LT(int(h.color.x), 100);
+        } else {
+            EXPECT_GT(int(h.color.x), 200);
+            EXPECT_LT(int(h.color.y), 100);
+        }
+    }
+    // Everything in GL (full): no head in the ray scene.
+    ASSERT_TRUE(ts.setFrame(9.5, eye));
+    EXPECT_EQ(ts.headsDrawn(), 2u);
+    EXPECT_EQ(ts.headsCast(), 0u);
+    // After the run (tracks end at 10 s): no overlay anywhere, the static lamps show.
+    for (double split : {1e300, 40.0, 0.0}) {
+        ASSERT_TRUE(ts.setFrame(12.0, eye));
+        ASSERT_TRUE(ts.setSplit(split));
+        EXPECT_EQ(ts.headsDrawn(), 0u);
+        EXPECT_EQ(ts.headsCast(), 0u);
+        for (unsigned i = 0; i < ts.signalNode()->getNumChildren(); ++i)
+            EXPECT_EQ(ts.signalNode()->getChild(i)->getNodeMask(), 0u);
+    }
+}
+
+TEST(TrafficScene, WithoutSignalStatesNoHeadNodeExists) {
+    CityParams params;
+    auto tr = tracks();  // no signals
+    SceneModel none;
+    TrafficScene ts(tr, params, /*labels=*/false, &none);
+    EXPECT_EQ(ts.signalNode(), nullptr);
+    EXPECT_TRUE(ts.heads().empty());
+    ASSERT_TRUE(ts.setFrame(6.0, glm::dvec3(0, 0, 1.5)));
+    EXPECT_EQ(ts.node()->getNumChildren(), size_t(kAgents));
+    EXPECT_EQ(ts.headsDrawn(), 0u);
+    // States without heads: none either.
+    ASSERT_TRUE(ts.setSignalHeads(nullptr, {headAt(kHeadA, 20.0, 0.0)}));
+    EXPECT_EQ(ts.signalNode(), nullptr);
+    EXPECT_EQ(ts.node()->getNumChildren(), size_t(kAgents));
 }
