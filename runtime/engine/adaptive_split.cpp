@@ -100,6 +100,32 @@ void pushWindow(std::vector<std::pair<double, double>>& w, std::pair<double, dou
     if (int(w.size()) > std::max(2, window)) w.erase(w.begin());
 }
 
+// A middle candidate is corrected by the frames that drew and traced about what it does: those
+// of the middle's last counted frames nearest to its triangles in view and far pixels (the
+// larger of the two log ratios, within a factor 1.1 of the nearest; a distance that ran finds
+// its own frames). One offset for every middle distance (the lower quartile of frames at
+// several distances) would price the distance the model favours most below what any middle
+// frame costs wherever the model's slope over the distance is wrong (far rays that do not fall
+// with the near distance as the probe predicts on a fly-over, a raster that costs by the
+// fragment as much as by the triangle): that distance would keep winning at a cost above ray
+// casting's.
+// `frames` are the middle kind's last counted frames; `price(frame)` is the model's price of one.
+template <class Frames, class Price>
+double nearestFramesCorrection(const Frames& frames, uint64_t tris, double rays, Price price) {
+    if (frames.empty()) return 0.0;
+    auto gap = [&](const auto& k) {
+        return std::max(std::abs(std::log((k.tris + 1.0) / (double(tris) + 1.0))),
+                        std::abs(std::log((k.rays + 1.0) / (rays + 1.0))));
+    };
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const auto& k : frames) nearest = std::min(nearest, gap(k));
+    std::vector<double> r;
+    for (const auto& k : frames)
+        if (gap(k) <= nearest + std::log(1.1)) r.push_back(k.frameMs - price(k));
+    const size_t q = (r.size() - 1) / 4;
+    std::nth_element(r.begin(), r.begin() + long(q), r.end());
+    return r[q];
+}
 }  // namespace
 
 double boxDistance(const SplitObject& o, const glm::dvec3& p) {
@@ -520,31 +546,6 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
     // The model's price of each candidate (see the header), then the learned correction of its kind.
     double corr[kSplitKinds];
     for (int kind = 0; kind < kSplitKinds; ++kind) corr[kind] = correctionMs(kind);
-    // A middle candidate is corrected by the frames that drew and traced about what it does: those
-    // of the middle's last counted frames nearest to its triangles in view and far pixels (the
-    // larger of the two log ratios, within a factor 1.1 of the nearest; a distance that ran finds
-    // its own frames). One offset for every middle distance, the lower quartile of
-    // frames at several distances, priced the distance the model favours most below what any
-    // middle frame cost wherever the model's slope over the distance is wrong (far rays that do
-    // not fall with the near distance as the probe predicts on a fly-over, a raster that costs by
-    // the fragment as much as by the triangle): that distance kept winning at a cost above ray
-    // casting's.
-    auto middleCorrection = [&](uint64_t tris, double rays) {
-        const std::vector<KindFrame>& w = _kindFrames[1];
-        if (w.empty()) return 0.0;
-        auto gap = [&](const KindFrame& k) {
-            return std::max(std::abs(std::log((k.tris + 1.0) / (double(tris) + 1.0))),
-                            std::abs(std::log((k.rays + 1.0) / (rays + 1.0))));
-        };
-        double nearest = std::numeric_limits<double>::infinity();
-        for (const KindFrame& k : w) nearest = std::min(nearest, gap(k));
-        std::vector<double> r;
-        for (const KindFrame& k : w)
-            if (gap(k) <= nearest + std::log(1.1)) r.push_back(k.frameMs - priceOf(1, k.tris, k.rays, k.pixels));
-        const size_t q = (r.size() - 1) / 4;
-        std::nth_element(r.begin(), r.begin() + long(q), r.end());
-        return r[q];
-    };
     std::vector<double> price(cand.size()), cost(cand.size()), candRays(cand.size());
     std::vector<uint64_t> candTris(cand.size());
     uint64_t tris = 0;
@@ -560,9 +561,12 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
         candTris[size_t(i)] = kind == 0 ? 0 : tris;
         candRays[size_t(i)] = kind == 2 ? 0.0 : predictedRays(kind == 0 ? 0.0 : d);
         price[size_t(i)] = priceOf(kind, double(candTris[size_t(i)]), candRays[size_t(i)], double(_pixels));
-        cost[size_t(i)] =
-            std::max(0.0, price[size_t(i)] +
-                              (kind == 1 ? middleCorrection(candTris[size_t(i)], candRays[size_t(i)]) : corr[kind]));
+        cost[size_t(i)] = std::max(
+            0.0, price[size_t(i)] +
+                     (kind == 1
+                          ? nearestFramesCorrection(_kindFrames[1], candTris[size_t(i)], candRays[size_t(i)],
+                                                    [&](const auto& k) { return priceOf(1, k.tris, k.rays, k.pixels); })
+                          : corr[kind]));
         const bool tryOnly = kind == 2 && !everythingPriced;
         if (!tryOnly && (bestI < 0 || cost[size_t(i)] < cost[size_t(bestI)])) bestI = i;
     }

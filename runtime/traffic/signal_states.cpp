@@ -12,6 +12,7 @@
 #include <unordered_map>
 
 #include "foundation/atomic_file.h"
+#include "runtime/traffic/xml_feed.h"
 
 namespace vista {
 
@@ -119,18 +120,7 @@ Result<SignalStates> readSignalStates(const SumoNet& net, const std::string& sig
     XML_SetUserData(r.parser, &r);
     XML_SetStartElementHandler(
         r.parser, [](void* u, const XML_Char* n, const XML_Char** a) { static_cast<Reader*>(u)->start(n, a); });
-    std::vector<char> buf(1 << 16);
-    for (;;) {
-        const size_t n = std::fread(buf.data(), 1, buf.size(), f.get());
-        const bool last = n < buf.size();
-        if (XML_Parse(r.parser, buf.data(), int(n), last) == XML_STATUS_ERROR) {
-            if (r.error.empty())
-                r.error = "line " + std::to_string(XML_GetCurrentLineNumber(r.parser)) + ": " +
-                          XML_ErrorString(XML_GetErrorCode(r.parser));
-            return Status::error("traffic-light states '" + signalsPath + "', " + r.error);
-        }
-        if (last) break;
-    }
+    if (Status st = feedXml(r.parser, f.get(), r.error, "traffic-light states", signalsPath); !st.isOk()) return st;
     if (!r.sawRoot) return Status::error("traffic-light states '" + signalsPath + "' is empty");
     SignalStates s;
     s._lights = net.trafficLights;

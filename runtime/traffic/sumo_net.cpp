@@ -13,6 +13,7 @@
 #include <unordered_map>
 
 #include "foundation/atomic_file.h"
+#include "runtime/traffic/xml_feed.h"
 
 namespace vista {
 
@@ -161,18 +162,7 @@ Result<SumoNet> readSumoNet(const std::string& path) {
     XML_SetElementHandler(
         r.parser, [](void* u, const XML_Char* n, const XML_Char** a) { static_cast<Reader*>(u)->start(n, a); },
         [](void* u, const XML_Char*) { static_cast<Reader*>(u)->end(); });
-    std::vector<char> buf(1 << 16);
-    for (;;) {
-        const size_t n = std::fread(buf.data(), 1, buf.size(), f.get());
-        const bool last = n < buf.size();
-        if (XML_Parse(r.parser, buf.data(), int(n), last) == XML_STATUS_ERROR) {
-            if (r.error.empty())
-                r.error = "line " + std::to_string(XML_GetCurrentLineNumber(r.parser)) + ": " +
-                          XML_ErrorString(XML_GetErrorCode(r.parser));
-            return Status::error("SUMO network '" + path + "', " + r.error);
-        }
-        if (last) break;
-    }
+    if (Status st = feedXml(r.parser, f.get(), r.error, "SUMO network", path); !st.isOk()) return st;
     if (!r.sawRoot) return Status::error("SUMO network '" + path + "' is empty");
     for (const auto& c : r.pending) {
         auto from = r.edgeIndex.find(c.from), to = r.edgeIndex.find(c.to);

@@ -13,6 +13,7 @@
 #include "foundation/atomic_file.h"
 #include "foundation/input_file.h"
 #include "foundation/units.h"
+#include "runtime/traffic/xml_feed.h"
 
 #include <nlohmann/json.hpp>
 
@@ -169,18 +170,7 @@ Result<TrafficTracks> readFcd(const std::string& path, double offsetX, double of
     XML_SetElementHandler(
         r.parser, [](void* u, const XML_Char* n, const XML_Char** a) { static_cast<Reader*>(u)->start(n, a); },
         [](void* u, const XML_Char* n) { static_cast<Reader*>(u)->end(n); });
-    std::vector<char> buf(1 << 16);
-    for (;;) {
-        const size_t n = std::fread(buf.data(), 1, buf.size(), f.get());
-        const bool last = n < buf.size();
-        if (XML_Parse(r.parser, buf.data(), int(n), last) == XML_STATUS_ERROR) {
-            if (r.error.empty())
-                r.error = "line " + std::to_string(XML_GetCurrentLineNumber(r.parser)) + ": " +
-                          XML_ErrorString(XML_GetErrorCode(r.parser));
-            return Status::error("floating-car data '" + path + "', " + r.error);
-        }
-        if (last) break;
-    }
+    if (Status st = feedXml(r.parser, f.get(), r.error, "floating-car data", path); !st.isOk()) return st;
     if (!r.sawRoot) return Status::error("floating-car data '" + path + "' is empty");
     return std::move(r.tracks);
 }
