@@ -23,10 +23,10 @@ bool haveSumo() { return std::system("command -v sumo >/dev/null 2>&1 && command
 
 // One small city for every test of this file (generated once).
 const std::string& smallCity() {
-    static TempDir* dir = new TempDir("vista_traffic_city");  // lives for the whole run
+    static TempDir dir("vista_traffic_city");  // lives for the whole run, removed at exit
     static std::string city;
     if (city.empty()) {
-        city = dir->file("city.osgb");
+        city = dir.file("city.osgb");
         const auto r = runVista("gen --size 700 --detail 0 --seed 5 -q -o " + city);
         EXPECT_EQ(r.code, 0) << r.err;
     }

@@ -66,14 +66,14 @@ struct Fixture {
     bool ok = false;
 };
 const Fixture& fixture() {
-    static TempDir* dir = new TempDir("vista_traffic_dataset");  // lives for the whole run
+    static TempDir dir("vista_traffic_dataset");  // lives for the whole run, removed at exit
     static Fixture f;
     if (f.city.empty()) {
-        f.city = dir->file("city.osgb");
-        f.traffic = dir->file("traffic");
-        f.path = dir->file("ego.csv");
-        f.out = dir->file("rig");
-        f.rig = dir->file("rig.json");
+        f.city = dir.file("city.osgb");
+        f.traffic = dir.file("traffic");
+        f.path = dir.file("ego.csv");
+        f.out = dir.file("rig");
+        f.rig = dir.file("rig.json");
         std::ofstream(f.rig) << kRig;
         auto r = runVista("gen --size 700 --detail 0 --seed 5 -q -o " + f.city);
         EXPECT_EQ(r.code, 0) << r.err;

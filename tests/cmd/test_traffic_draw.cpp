@@ -55,12 +55,12 @@ struct Fixture {
     bool ok = false;
 };
 const Fixture& fixture() {
-    static TempDir* dir = new TempDir("vista_traffic_draw");  // lives for the whole run
+    static TempDir dir("vista_traffic_draw");  // lives for the whole run, removed at exit
     static Fixture f;
     if (f.city.empty()) {
-        f.city = dir->file("city.osgb");
-        f.traffic = dir->file("traffic");
-        f.path = dir->file("ego.csv");
+        f.city = dir.file("city.osgb");
+        f.traffic = dir.file("traffic");
+        f.path = dir.file("ego.csv");
         auto r = runVista("gen --size 700 --detail 0 --seed 5 -q -o " + f.city);
         EXPECT_EQ(r.code, 0) << r.err;
         r = runVista("traffic " + f.city + " --vehicles 60 --pedestrians 60 --duration 120 --seed 4 -q -o " +
