@@ -98,8 +98,7 @@ private:
 }  // namespace
 
 bool crossingBand(const EdgeLanes& L, bool atB, double& s0, double& s1) {
-    if (!L.valid || (atB ? L.junctionB : L.junctionA) < 0 || !(L.length > 2 * (kStopSetback + kStopDepth)))
-        return false;
+    if (!L.valid || !stopLine(L, atB) || !(L.length > 2 * (kStopSetback + kStopDepth))) return false;
     const double depth = L.sidewalk > 0 ? L.sidewalk : kCrossingDepth;
     if (atB) {
         s0 = L.length + kCrossingGap;
@@ -471,6 +470,7 @@ private:
     void edgeLanes();
     void sidewalkSides();
     void joinEdges();
+    bool lanesAppear(uint32_t v) const;
     void junctions();
     void planTurns();
     void planTransitions();
@@ -561,8 +561,23 @@ void LaneModelBuilder::joinEdges() {
     }
 }
 
-// One junction per node of degree >= 3 or joined group of them, arms
-// counter-clockwise.
+// True when, at degree-2 node v, more lanes leave than arrive in a direction
+// of travel that has lanes arriving (a lane appears that a lane before it can
+// feed), every direction with lanes leaving has lanes arriving (a junction
+// cannot feed lanes that start where nothing arrives), and the road runs
+// straight on (|turn| <= kStraightTurn: a connecting road at a sharper bend
+// would have to keep a junction turn's radius, which a transition need not):
+// a through junction (lanes.h).
+bool LaneModelBuilder::lanesAppear(uint32_t v) const {
+    if (incident[v].size() != 2) return false;
+    const NodeEnd a = end(incident[v][0], v), b = end(incident[v][1], v);
+    const bool appear = (b.away() > a.toward() && a.toward() > 0) || (a.away() > b.toward() && b.toward() > 0);
+    const bool deadStart = (b.away() > 0 && a.toward() == 0) || (a.away() > 0 && b.toward() == 0);
+    return appear && !deadStart && std::abs(turnAngle(a.dirIn(), -b.dirIn())) <= kStraightTurn;
+}
+
+// One junction per node of degree >= 3, joined group of them or through
+// junction, arms counter-clockwise.
 void LaneModelBuilder::junctions() {
     m.junctions.clear();
     m.nodeJunction.assign(N, -1);
@@ -570,9 +585,11 @@ void LaneModelBuilder::junctions() {
     for (uint32_t v = 0; v < N; ++v)
         if (rep[v] != v) members[rep[v]].push_back(v);
     for (uint32_t v = 0; v < N; ++v) {
-        if (rep[v] != v || (members[v].empty() && m.degree[v] < 3)) continue;
+        const bool through = members[v].empty() && m.degree[v] == 2 && lanesAppear(v);
+        if (rep[v] != v || (members[v].empty() && m.degree[v] < 3 && !through)) continue;
         Junction J;
         J.node = v;
+        J.through = through;
         J.nodes.push_back(v);
         J.nodes.insert(J.nodes.end(), members[v].begin(), members[v].end());
         for (uint32_t u : J.nodes) {
@@ -723,7 +740,7 @@ void LaneModelBuilder::separateArms(size_t j) {
 void LaneModelBuilder::planTransitions() {
     // Transitions at degree-2 nodes.
     for (uint32_t v = 0; v < N; ++v) {
-        if (m.degree[v] != 2) continue;
+        if (m.degree[v] != 2 || m.nodeJunction[v] >= 0) continue;  // through junctions have turns
         const uint32_t inE = incident[v][0], outE = incident[v][1];
         const NodeEnd in = end(inE, v), out = end(outE, v);
         LinkRoad r;
@@ -794,6 +811,8 @@ void LaneModelBuilder::applyTrims() {
         const StreetEdge& E = g.edges[e];
         L.junctionA = m.nodeJunction[E.a];
         L.junctionB = m.nodeJunction[E.b];
+        L.throughA = L.junctionA >= 0 && m.junctions[size_t(L.junctionA)].through;
+        L.throughB = L.junctionB >= 0 && m.junctions[size_t(L.junctionB)].through;
         double ta = std::max(wantA[e], growTrimA[e]), tb = std::max(wantB[e], growTrimB[e]);
         const double len = L.length, room = std::max(0.0, len - kMinRoadLength);
         if (ta + tb > room) {
@@ -1170,7 +1189,7 @@ void LaneModelBuilder::placeSignals() {
         for (int atB = 0; atB < 2; ++atB) {
             const int j = atB ? L.junctionB : L.junctionA;
             const int lanes = atB ? L.right : L.left;
-            if (j < 0 || lanes < 1 || m.junctions[size_t(j)].links.empty()) continue;
+            if (j < 0 || lanes < 1 || m.junctions[size_t(j)].links.empty() || m.junctions[size_t(j)].through) continue;
             const Junction& J = m.junctions[size_t(j)];
             int major = 0;
             for (uint32_t a : J.arms) major += g.edges[a].cls != RoadClass::Local;
