@@ -392,9 +392,10 @@ public:
     // (empty: no junction joined).
     LaneModelBuilder(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks,
                      const std::vector<uint32_t>& joined, const std::vector<double>& minTrimA,
-                     const std::vector<double>& minTrimB)
+                     const std::vector<double>& minTrimB, const std::vector<uint8_t>& noThrough)
         : growTrimA(minTrimA),
           growTrimB(minTrimB),
+          noThrough(noThrough),
           g(g),
           blocks(blocks),
           N(g.nodes.size()),
@@ -441,6 +442,11 @@ public:
     // Per edge, the trim at node a / b that a kept crossing asks for (at
     // least the minimum trims given): the next round's minimum trims.
     std::vector<double> growTrimA, growTrimB;
+    // Per node: 1 = no through junction there (its turns did not fit before).
+    std::vector<uint8_t> noThrough;
+    // Nodes of through junctions a turn of which folds or misses its radius:
+    // the next round links them by a transition.
+    std::vector<uint32_t> failedThrough;
 
 private:
     // True when edge e meets node v (or v's joined junction) with its end b.
@@ -564,16 +570,17 @@ void LaneModelBuilder::joinEdges() {
 // True when, at degree-2 node v, more lanes leave than arrive in a direction
 // of travel that has lanes arriving (a lane appears that a lane before it can
 // feed), every direction with lanes leaving has lanes arriving (a junction
-// cannot feed lanes that start where nothing arrives), and the road runs
-// straight on (|turn| <= kStraightTurn: a connecting road at a sharper bend
-// would have to keep a junction turn's radius, which a transition need not):
-// a through junction (lanes.h).
+// cannot feed lanes that start where nothing arrives), the corner is one a
+// link road can take (|turn| <= kMaxTurn) and no earlier round found its
+// turns folding or below their radius (noThrough): a through junction
+// (lanes.h).
 bool LaneModelBuilder::lanesAppear(uint32_t v) const {
     if (incident[v].size() != 2) return false;
     const NodeEnd a = end(incident[v][0], v), b = end(incident[v][1], v);
     const bool appear = (b.away() > a.toward() && a.toward() > 0) || (a.away() > b.toward() && b.toward() > 0);
     const bool deadStart = (b.away() > 0 && a.toward() == 0) || (a.away() > 0 && b.toward() == 0);
-    return appear && !deadStart && std::abs(turnAngle(a.dirIn(), -b.dirIn())) <= kStraightTurn;
+    return appear && !deadStart && !(v < noThrough.size() && noThrough[v]) &&
+           std::abs(turnAngle(a.dirIn(), -b.dirIn())) <= kMaxTurn;
 }
 
 // One junction per node of degree >= 3, joined group of them or through
@@ -1050,6 +1057,7 @@ void LaneModelBuilder::fitTurns(size_t j, std::vector<LinkRoad>& turns, std::vec
     }
     for (size_t x = 0; x < ps.size(); ++x) {
         if (state[x] == Ok) continue;
+        if (m.junctions[j].through) failedThrough.push_back(m.junctions[j].node);
         for (int lane = ps[x].i0; lane <= ps[x].i1; ++lane) {
             auto covers = [&](size_t y) {
                 return state[y] == Ok && ps[y].in == ps[x].in && ps[y].i0 <= lane && lane <= ps[y].i1;
@@ -1296,7 +1304,8 @@ bool joinConflicts(const StreetGraph& g, const LaneModel& m, const std::vector<s
     return joined;
 }
 
-constexpr int kJoinPasses = 4;  // joining rounds (a joined junction may need joining again)
+constexpr int kJoinPasses = 4;     // joining rounds (a joined junction may need joining again)
+constexpr int kThroughRounds = 3;  // rounds that turn failed through junctions back into transitions
 
 }  // namespace
 
@@ -1304,9 +1313,18 @@ LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const s
     std::vector<uint32_t> rep;
     std::vector<std::pair<int, int>> conflicts;
     const std::vector<double> none(g.edges.size(), 0.0);
-    LaneModelBuilder first(g, params, blocks, rep, none, none);
-    LaneModel m = first.build(conflicts);
-    std::vector<double> trimA = first.growTrimA, trimB = first.growTrimB, askedA = none, askedB = none;
+    // Through junctions whose turns fold or miss their radius are links by
+    // transitions instead (lanes.h), decided in up to kThroughRounds rounds.
+    std::vector<uint8_t> noThrough(g.nodes.size(), 0);
+    LaneModel m;
+    std::vector<double> trimA, trimB, askedA = none, askedB = none;
+    for (int round = 0; round < kThroughRounds; ++round) {
+        LaneModelBuilder first(g, params, blocks, rep, none, none, noThrough);
+        m = first.build(conflicts);
+        trimA = first.growTrimA, trimB = first.growTrimB;
+        if (first.failedThrough.empty()) break;
+        for (uint32_t v : first.failedThrough) noThrough[v] = 1;
+    }
     for (int pass = 0; pass < kJoinPasses; ++pass) {
         const bool joined = joinConflicts(g, m, conflicts, rep);
         bool grown = false;  // an arm asks for more than the last round gave it
@@ -1314,7 +1332,7 @@ LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const s
             grown = trimA[e] > askedA[e] + 1e-6 || trimB[e] > askedB[e] + 1e-6;
         if (!joined && !grown) break;
         askedA = trimA, askedB = trimB;
-        LaneModelBuilder next(g, params, blocks, rep, trimA, trimB);
+        LaneModelBuilder next(g, params, blocks, rep, trimA, trimB, noThrough);
         m = next.build(conflicts);
         trimA = next.growTrimA, trimB = next.growTrimB;
     }

@@ -30,16 +30,18 @@
 // - Junction: one per node of degree >= 3, and one per degree-2 node where a
 //   lane appears: more lanes leave it than arrive in a direction of travel
 //   that has lanes arriving, every direction with lanes leaving has lanes
-//   arriving, and the road runs straight on (within 35 degrees; a sharper
-//   bend keeps its transition, whose radius is what the edges allow) (a
-//   through junction, Junction::through). The lane that appears is then fed by a one-lane turn
+//   arriving, and the corner is within kMaxTurn (a through junction,
+//   Junction::through); a node whose through junction has a turn that folds
+//   or misses its turning radius (below) keeps its transition instead (the
+//   model is built again, at most three rounds). The lane that appears is then fed by a one-lane turn
 //   of full width (below), so that every lane has a lane before it, as SUMO
 //   netconvert asks (a lane tapering in inside a transition has none: ASAM's
 //   road.lane.link.zero_width_at_start wants no predecessor on a lane of
 //   width 0 at its start). Through junctions get no signals, stop lines or
 //   crossings. Lanes that only end at a degree-2 node, and lanes that appear
-//   at a bend or where one direction has lanes leaving but none arriving (a
-//   two-way street going on one-way), change width inside its transition. Arms are the incident edges in
+//   where a through junction's turns would not fit or where one direction
+//   has lanes leaving but none arriving (a two-way street going on one-way),
+//   change width inside its transition. Arms are the incident edges in
 //   counter-clockwise angle order (angles in (-pi, pi]). Junction joining:
 //   two junction nodes whose connecting edge is shorter than their two
 //   footprints need (the trims of both ends plus kMinRoadLength) form one

@@ -133,9 +133,8 @@ void checkNet(const City& city, const std::string& label) {
     // Elsewhere netconvert warns only of lanes that taper in inside a transition beside lanes
     // that arrive (width 0 where their traffic enters, no predecessor, as ASAM's
     // zero_width_at_start rule asks: netconvert keeps their first, narrow metres as a lane
-    // that nothing feeds), and those are left only at bends sharper than 35 degrees and where
-    // one direction has lanes leaving but none arriving: elsewhere a lane appears at a
-    // through junction instead (lanes.h).
+    // that nothing feeds); on a straight road (within 35 degrees) a lane appears at a through
+    // junction instead (lanes.h), unless one direction has lanes leaving but none arriving.
     const double straight = 35.0 * 3.14159265358979323846 / 180;
     int tapersIn = 0, tapersInStraight = 0;
     for (const LinkRoad& t : M.links) {
