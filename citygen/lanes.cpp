@@ -98,8 +98,7 @@ private:
 }  // namespace
 
 bool crossingBand(const EdgeLanes& L, bool atB, double& s0, double& s1) {
-    if (!L.valid || (atB ? L.junctionB : L.junctionA) < 0 || !(L.length > 2 * (kStopSetback + kStopDepth)))
-        return false;
+    if (!L.valid || !stopLine(L, atB) || !(L.length > 2 * (kStopSetback + kStopDepth))) return false;
     const double depth = L.sidewalk > 0 ? L.sidewalk : kCrossingDepth;
     if (atB) {
         s0 = L.length + kCrossingGap;
@@ -393,9 +392,10 @@ public:
     // (empty: no junction joined).
     LaneModelBuilder(const StreetGraph& g, const CityParams& params, const std::vector<Block>* blocks,
                      const std::vector<uint32_t>& joined, const std::vector<double>& minTrimA,
-                     const std::vector<double>& minTrimB)
+                     const std::vector<double>& minTrimB, const std::vector<uint8_t>& noThrough)
         : growTrimA(minTrimA),
           growTrimB(minTrimB),
+          noThrough(noThrough),
           g(g),
           blocks(blocks),
           N(g.nodes.size()),
@@ -442,6 +442,11 @@ public:
     // Per edge, the trim at node a / b that a kept crossing asks for (at
     // least the minimum trims given): the next round's minimum trims.
     std::vector<double> growTrimA, growTrimB;
+    // Per node: 1 = no through junction there (its turns did not fit before).
+    std::vector<uint8_t> noThrough;
+    // Nodes of through junctions a turn of which folds or misses its radius:
+    // the next round links them by a transition.
+    std::vector<uint32_t> failedThrough;
 
 private:
     // True when edge e meets node v (or v's joined junction) with its end b.
@@ -471,6 +476,7 @@ private:
     void edgeLanes();
     void sidewalkSides();
     void joinEdges();
+    bool lanesAppear(uint32_t v) const;
     void junctions();
     void planTurns();
     void planTransitions();
@@ -561,8 +567,24 @@ void LaneModelBuilder::joinEdges() {
     }
 }
 
-// One junction per node of degree >= 3 or joined group of them, arms
-// counter-clockwise.
+// True when, at degree-2 node v, more lanes leave than arrive in a direction
+// of travel that has lanes arriving (a lane appears that a lane before it can
+// feed), every direction with lanes leaving has lanes arriving (a junction
+// cannot feed lanes that start where nothing arrives), the corner is one a
+// link road can take (|turn| <= kMaxTurn) and no earlier round found its
+// turns folding or below their radius (noThrough): a through junction
+// (lanes.h).
+bool LaneModelBuilder::lanesAppear(uint32_t v) const {
+    if (incident[v].size() != 2) return false;
+    const NodeEnd a = end(incident[v][0], v), b = end(incident[v][1], v);
+    const bool appear = (b.away() > a.toward() && a.toward() > 0) || (a.away() > b.toward() && b.toward() > 0);
+    const bool deadStart = (b.away() > 0 && a.toward() == 0) || (a.away() > 0 && b.toward() == 0);
+    return appear && !deadStart && !(v < noThrough.size() && noThrough[v]) &&
+           std::abs(turnAngle(a.dirIn(), -b.dirIn())) <= kMaxTurn;
+}
+
+// One junction per node of degree >= 3, joined group of them or through
+// junction, arms counter-clockwise.
 void LaneModelBuilder::junctions() {
     m.junctions.clear();
     m.nodeJunction.assign(N, -1);
@@ -570,9 +592,11 @@ void LaneModelBuilder::junctions() {
     for (uint32_t v = 0; v < N; ++v)
         if (rep[v] != v) members[rep[v]].push_back(v);
     for (uint32_t v = 0; v < N; ++v) {
-        if (rep[v] != v || (members[v].empty() && m.degree[v] < 3)) continue;
+        const bool through = members[v].empty() && m.degree[v] == 2 && lanesAppear(v);
+        if (rep[v] != v || (members[v].empty() && m.degree[v] < 3 && !through)) continue;
         Junction J;
         J.node = v;
+        J.through = through;
         J.nodes.push_back(v);
         J.nodes.insert(J.nodes.end(), members[v].begin(), members[v].end());
         for (uint32_t u : J.nodes) {
@@ -723,7 +747,7 @@ void LaneModelBuilder::separateArms(size_t j) {
 void LaneModelBuilder::planTransitions() {
     // Transitions at degree-2 nodes.
     for (uint32_t v = 0; v < N; ++v) {
-        if (m.degree[v] != 2) continue;
+        if (m.degree[v] != 2 || m.nodeJunction[v] >= 0) continue;  // through junctions have turns
         const uint32_t inE = incident[v][0], outE = incident[v][1];
         const NodeEnd in = end(inE, v), out = end(outE, v);
         LinkRoad r;
@@ -794,6 +818,8 @@ void LaneModelBuilder::applyTrims() {
         const StreetEdge& E = g.edges[e];
         L.junctionA = m.nodeJunction[E.a];
         L.junctionB = m.nodeJunction[E.b];
+        L.throughA = L.junctionA >= 0 && m.junctions[size_t(L.junctionA)].through;
+        L.throughB = L.junctionB >= 0 && m.junctions[size_t(L.junctionB)].through;
         double ta = std::max(wantA[e], growTrimA[e]), tb = std::max(wantB[e], growTrimB[e]);
         const double len = L.length, room = std::max(0.0, len - kMinRoadLength);
         if (ta + tb > room) {
@@ -1031,6 +1057,7 @@ void LaneModelBuilder::fitTurns(size_t j, std::vector<LinkRoad>& turns, std::vec
     }
     for (size_t x = 0; x < ps.size(); ++x) {
         if (state[x] == Ok) continue;
+        if (m.junctions[j].through) failedThrough.push_back(m.junctions[j].node);
         for (int lane = ps[x].i0; lane <= ps[x].i1; ++lane) {
             auto covers = [&](size_t y) {
                 return state[y] == Ok && ps[y].in == ps[x].in && ps[y].i0 <= lane && lane <= ps[y].i1;
@@ -1170,7 +1197,7 @@ void LaneModelBuilder::placeSignals() {
         for (int atB = 0; atB < 2; ++atB) {
             const int j = atB ? L.junctionB : L.junctionA;
             const int lanes = atB ? L.right : L.left;
-            if (j < 0 || lanes < 1 || m.junctions[size_t(j)].links.empty()) continue;
+            if (j < 0 || lanes < 1 || m.junctions[size_t(j)].links.empty() || m.junctions[size_t(j)].through) continue;
             const Junction& J = m.junctions[size_t(j)];
             int major = 0;
             for (uint32_t a : J.arms) major += g.edges[a].cls != RoadClass::Local;
@@ -1277,7 +1304,8 @@ bool joinConflicts(const StreetGraph& g, const LaneModel& m, const std::vector<s
     return joined;
 }
 
-constexpr int kJoinPasses = 4;  // joining rounds (a joined junction may need joining again)
+constexpr int kJoinPasses = 4;     // joining rounds (a joined junction may need joining again)
+constexpr int kThroughRounds = 3;  // rounds that turn failed through junctions back into transitions
 
 }  // namespace
 
@@ -1285,9 +1313,18 @@ LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const s
     std::vector<uint32_t> rep;
     std::vector<std::pair<int, int>> conflicts;
     const std::vector<double> none(g.edges.size(), 0.0);
-    LaneModelBuilder first(g, params, blocks, rep, none, none);
-    LaneModel m = first.build(conflicts);
-    std::vector<double> trimA = first.growTrimA, trimB = first.growTrimB, askedA = none, askedB = none;
+    // Through junctions whose turns fold or miss their radius are links by
+    // transitions instead (lanes.h), decided in up to kThroughRounds rounds.
+    std::vector<uint8_t> noThrough(g.nodes.size(), 0);
+    LaneModel m;
+    std::vector<double> trimA, trimB, askedA = none, askedB = none;
+    for (int round = 0; round < kThroughRounds; ++round) {
+        LaneModelBuilder first(g, params, blocks, rep, none, none, noThrough);
+        m = first.build(conflicts);
+        trimA = first.growTrimA, trimB = first.growTrimB;
+        if (first.failedThrough.empty()) break;
+        for (uint32_t v : first.failedThrough) noThrough[v] = 1;
+    }
     for (int pass = 0; pass < kJoinPasses; ++pass) {
         const bool joined = joinConflicts(g, m, conflicts, rep);
         bool grown = false;  // an arm asks for more than the last round gave it
@@ -1295,7 +1332,7 @@ LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const s
             grown = trimA[e] > askedA[e] + 1e-6 || trimB[e] > askedB[e] + 1e-6;
         if (!joined && !grown) break;
         askedA = trimA, askedB = trimB;
-        LaneModelBuilder next(g, params, blocks, rep, trimA, trimB);
+        LaneModelBuilder next(g, params, blocks, rep, trimA, trimB, noThrough);
         m = next.build(conflicts);
         trimA = next.growTrimA, trimB = next.growTrimB;
     }

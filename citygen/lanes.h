@@ -27,7 +27,21 @@
 //   (the sidewalk mesh runs along block outlines): with `blocks` given, a side
 //   has a sidewalk when the point a metre past the sidewalk at the edge's
 //   midpoint lies inside a block outline; without blocks, both sides.
-// - Junction: one per node of degree >= 3; its arms are the incident edges in
+// - Junction: one per node of degree >= 3, and one per degree-2 node where a
+//   lane appears: more lanes leave it than arrive in a direction of travel
+//   that has lanes arriving, every direction with lanes leaving has lanes
+//   arriving, and the corner is within kMaxTurn (a through junction,
+//   Junction::through); a node whose through junction has a turn that folds
+//   or misses its turning radius (below) keeps its transition instead (the
+//   model is built again, at most three rounds). The lane that appears is then fed by a one-lane turn
+//   of full width (below), so that every lane has a lane before it, as SUMO
+//   netconvert asks (a lane tapering in inside a transition has none: ASAM's
+//   road.lane.link.zero_width_at_start wants no predecessor on a lane of
+//   width 0 at its start). Through junctions get no signals, stop lines or
+//   crossings. Lanes that only end at a degree-2 node, and lanes that appear
+//   where a through junction's turns would not fit or where one direction
+//   has lanes leaving but none arriving (a two-way street going on one-way),
+//   change width inside its transition. Arms are the incident edges in
 //   counter-clockwise angle order (angles in (-pi, pi]). Junction joining:
 //   two junction nodes whose connecting edge is shorter than their two
 //   footprints need (the trims of both ends plus kMinRoadLength) form one
@@ -81,7 +95,7 @@
 //   junctions joined by edges shorter than their trims.
 // - Link roads (LinkRoad): every junction has one per allowed turn (ordered
 //   pair of distinct arms with lanes to give and take, |turn| <= kMaxTurn);
-//   every degree-2 node has one transition road joining its two edges, unless
+//   every other degree-2 node has one transition road joining its two edges, unless
 //   the corner is too sharp for the lanes to turn inside the edges (counted
 //   in sharpCorners; both ends are then dead ends). A link road's reference
 //   line is a line, a circular arc and a line, tangent to both street roads
@@ -152,8 +166,9 @@ struct EdgeLanes {
     // lanes span exactly the carriageway [-w/2, w/2] for odd lane counts too
     // (OpenDRIVE <laneOffset>).
     double offset = 0;
-    int junctionA = -1, junctionB = -1;  // index into LaneModel::junctions, -1 = none
-    int linkA = -1, linkB = -1;          // transition at a degree-2 node a / b: index into LaneModel::links
+    int junctionA = -1, junctionB = -1;       // index into LaneModel::junctions, -1 = none
+    bool throughA = false, throughB = false;  // that junction is a through junction (Junction::through)
+    int linkA = -1, linkB = -1;               // transition at a degree-2 node a / b: index into LaneModel::links
     glm::dvec2 normal() const { return {-dir.y, dir.x}; }  // left of a -> b
     bool hasWalk(int side) const { return sidewalk > 0 && (side > 0 ? walkLeft : walkRight); }
     double halfWidth() const { return 0.5 * laneWidth * (right + left); }
@@ -168,6 +183,9 @@ struct Junction {
     double radius = 0;
     std::vector<uint32_t> arms;   // incident edge indices, counter-clockwise by angle
     std::vector<uint32_t> links;  // its link roads (indices into LaneModel::links)
+    // A through junction: a degree-2 node where the lane count changes (see
+    // the contract above); no signals, stop lines or crossings.
+    bool through = false;
 };
 
 // A road between two street roads: a junction's connecting road (junction
@@ -269,6 +287,12 @@ LaneModel buildLaneModel(const StreetGraph& g, const CityParams& params, const s
 constexpr double kStopSetback = 0.5, kStopDepth = 0.4;
 constexpr double kCrossingDepth = 3.0;
 constexpr double kCrossingGap = 0.3;
+
+// True when the road meets a junction at its end b (atB) or start that
+// stops its traffic (a stop line there): any junction but a through junction.
+inline bool stopLine(const EdgeLanes& L, bool atB) {
+    return (atB ? L.junctionB : L.junctionA) >= 0 && !(atB ? L.throughB : L.throughA);
+}
 
 // The s range [s0, s1] (along the edge's trimmed reference line, from
 // L.start; negative before it, beyond L.length after it) of the zebra

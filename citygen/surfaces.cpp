@@ -303,7 +303,7 @@ void SurfaceContext::edgeMarkings(MeshBuilder& mark, size_t e, const glm::dvec2&
     };
     const double Lr = ln.length, lw = ln.laneWidth, off = ln.offset, hw = ln.halfWidth();
     const double lineHw = 0.5 * kLineWidth;
-    const bool jA = ln.junctionA >= 0, jB = ln.junctionB >= 0;
+    const bool jA = stopLine(ln, false), jB = stopLine(ln, true);
     const auto& deg = lanes->degree;
     // Lines stop behind the stop lines at junctions and short of a dead end's cap.
     double s0 = jA ? kStopSetback + kStopDepth : (deg[E.a] == 1 ? hw : 0.0);

@@ -413,6 +413,60 @@ TEST(Lanes, EveryJunctionLaneHasAConnectionInAndOut) {
     }
 }
 
+// Where a street's lane count changes at a degree-2 node (2 -> 4 lanes
+// straight on, 4 -> 2 lanes at a 30 degree bend), the node is a through
+// junction: no transition road, every full-width lane in and out has a
+// connecting road of full width, no signals, stop lines or crossings; where
+// the counts agree the node keeps its transition.
+TEST(Lanes, LaneCountChangesAtThroughJunctions) {
+    const double bend = 30.0 * 3.14159265358979323846 / 180;
+    StreetGraph g;
+    g.nodes = {{0, 0},
+               {100, 0},
+               {200, 0},
+               {200 + 100 * std::cos(bend), 100 * std::sin(bend)},
+               {200 + 200 * std::cos(bend), 200 * std::sin(bend)}};
+    g.edges = {{0, 1, RoadClass::Local, 7.0f, 2},  // a local arm: signs if it were a junction
+               {1, 2, RoadClass::Arterial, 14.0f, 4},
+               {2, 3, RoadClass::Arterial, 7.0f, 2},
+               {3, 4, RoadClass::Arterial, 7.0f, 2}};
+    CityParams p;
+    p.sidewalk_m = 2.5;
+    const LaneModel m = buildLaneModel(g, p);
+    ASSERT_EQ(m.junctions.size(), 2u);
+    Connections c = connections(m);
+    for (const Junction& J : m.junctions) {
+        EXPECT_TRUE(J.through);
+        EXPECT_EQ(J.arms.size(), 2u);
+        for (uint32_t e : J.arms) {
+            for (int k = 1; k <= lanesToward(m, g, e, J.node); ++k)
+                EXPECT_TRUE(c.in[e].count(k)) << "node " << J.node << " edge " << e << " incoming lane " << k;
+            for (int k = 1; k <= lanesAway(m, g, e, J.node); ++k)
+                EXPECT_TRUE(c.out[e].count(k)) << "node " << J.node << " edge " << e << " outgoing lane " << k;
+        }
+    }
+    EXPECT_EQ(m.nodeJunction[1], 0);
+    EXPECT_EQ(m.nodeJunction[2], 1);
+    EXPECT_EQ(m.nodeJunction[3], -1);  // 2 -> 2 lanes: a transition
+    size_t transitions = 0;
+    for (const LinkRoad& r : m.links) {
+        if (r.junction >= 0) continue;
+        ++transitions;
+        EXPECT_EQ(r.node, 3u);
+    }
+    EXPECT_EQ(transitions, 1u);
+    EXPECT_TRUE(m.signals.empty());
+    EXPECT_EQ(m.unlinkedLanes, 0u);
+    EXPECT_EQ(m.unfedLanes, 0u);
+    double s0 = 0, s1 = 0;
+    EXPECT_FALSE(stopLine(m.edges[1], false));
+    EXPECT_FALSE(stopLine(m.edges[1], true));
+    EXPECT_FALSE(crossingBand(m.edges[1], false, s0, s1));
+    EXPECT_FALSE(crossingBand(m.edges[1], true, s0, s1));
+    EXPECT_EQ(m.edges[1].junctionA, 0);
+    EXPECT_EQ(m.edges[1].junctionB, 1);
+}
+
 // Arms meeting at acute angles are cut back until their surfaces share no
 // area outside the junction (Boost.Geometry intersection of the trimmed
 // rectangles); at a right angle the junction radius alone keeps them apart.

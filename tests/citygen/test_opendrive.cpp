@@ -252,7 +252,8 @@ TEST(OpenDrive, MarkingsFollowTheLaneModel) {
         if (!L.valid || L.length < 8) continue;
         auto at = [&](double s, double t) { return L.start + L.dir * s + L.normal() * t; };
         const double lw = L.laneWidth, off = L.offset;
-        if (L.junctionB >= 0) {
+        // Stop lines and crossings at every junction end but a through junction's (lanes.h).
+        if (stopLine(L, true)) {
             EXPECT_TRUE(marks.covers(at(L.length - 0.7, L.laneCentre(-1)))) << "stop line, edge " << e;
             ++stops;
             if (L.trimB > 2.5) {
@@ -264,7 +265,7 @@ TEST(OpenDrive, MarkingsFollowTheLaneModel) {
                 ++crossings;
             }
         }
-        if (L.junctionA >= 0) {
+        if (stopLine(L, false)) {
             EXPECT_TRUE(marks.covers(at(0.7, L.laneCentre(1)))) << "stop line, edge " << e;
             ++stops;
         }

@@ -130,15 +130,31 @@ void checkNet(const City& city, const std::string& label) {
     ASSERT_TRUE(r.net);
 
     const LaneModel M = buildLaneModel(city.streets, city.params, &city.blocks);
-    // Outside junctions netconvert warns only of lanes that taper in inside a transition (width 0
-    // where their traffic enters, no predecessor, as ASAM's zero_width_at_start rule asks):
-    // it keeps their first, narrow metres as a lane for emergency vehicles that nothing feeds.
-    int tapersIn = 0;
+    // Elsewhere netconvert warns only of lanes that taper in inside a transition beside lanes
+    // that arrive (width 0 where their traffic enters, no predecessor, as ASAM's
+    // zero_width_at_start rule asks: netconvert keeps their first, narrow metres as a lane
+    // that nothing feeds); on a straight road (within 35 degrees) a lane appears at a through
+    // junction instead (lanes.h), unless one direction has lanes leaving but none arriving.
+    const double straight = 35.0 * 3.14159265358979323846 / 180;
+    int tapersIn = 0, tapersInStraight = 0;
     for (const LinkRoad& t : M.links) {
         if (t.junction >= 0) continue;
-        for (const LinkRoad::Lane& l : t.right) tapersIn += !l.sidewalk && l.w0 == 0 && l.to;
-        for (const LinkRoad::Lane& l : t.left) tapersIn += !l.sidewalk && l.w1 == 0 && l.from;
+        int n = 0;
+        bool deadStart = false;              // a side with lanes leaving and none arriving
+        bool arrive = false, leave = false;  // lanes arrive at / leave from the side's entering end
+        for (const LinkRoad::Lane& l : t.right) arrive = arrive || (!l.sidewalk && l.from);
+        for (const LinkRoad::Lane& l : t.right) leave = leave || (!l.sidewalk && l.to);
+        for (const LinkRoad::Lane& l : t.right) n += arrive && !l.sidewalk && l.w0 == 0 && l.to;
+        deadStart = leave && !arrive;
+        arrive = leave = false;
+        for (const LinkRoad::Lane& l : t.left) arrive = arrive || (!l.sidewalk && l.to);
+        for (const LinkRoad::Lane& l : t.left) leave = leave || (!l.sidewalk && l.from);
+        for (const LinkRoad::Lane& l : t.left) n += arrive && !l.sidewalk && l.w1 == 0 && l.from;
+        deadStart = deadStart || (leave && !arrive);
+        tapersIn += n;
+        if (std::abs(t.angle) <= straight && !deadStart) tapersInStraight += n;
     }
+    EXPECT_EQ(tapersInStraight, 0) << label;
     EXPECT_LE(r.notConnectedElsewhere, tapersIn) << label << "\n" << r.log;
     // Junctions: nodes of degree >= 3, those joined by an edge without lanes
     // between two of them counted once (junction joining, lanes.h).
@@ -150,6 +166,7 @@ void checkNet(const City& city, const std::string& label) {
     };
     size_t graphJunctions = 0;
     for (int d : M.degree) graphJunctions += d >= 3;
+    for (const Junction& J : M.junctions) graphJunctions += J.through;
     for (size_t e = 0; e < M.edges.size(); ++e) {
         const StreetEdge& E = city.streets.edges[e];
         if (M.edges[e].valid || E.a == E.b || M.degree[E.a] < 3 || M.degree[E.b] < 3) continue;
@@ -157,14 +174,16 @@ void checkNet(const City& city, const std::string& label) {
         if (a != b) group[a] = b, --graphJunctions;
     }
     // Road ends without a link: dead ends, and both roads at a corner too
-    // sharp for a transition (LaneModel::sharpCorners).
+    // sharp for a transition (LaneModel::sharpCorners; a through junction
+    // links its two).
     size_t openEnds = 0;
     for (size_t e = 0; e < M.edges.size(); ++e) {
         const EdgeLanes& L = M.edges[e];
         if (!L.valid) continue;
         for (uint32_t v : {city.streets.edges[e].a, city.streets.edges[e].b}) {
             const int link = v == city.streets.edges[e].a ? L.linkA : L.linkB;
-            openEnds += M.degree[size_t(v)] == 1 || (M.degree[size_t(v)] == 2 && link < 0);
+            const int junction = v == city.streets.edges[e].a ? L.junctionA : L.junctionB;
+            openEnds += M.degree[size_t(v)] == 1 || (M.degree[size_t(v)] == 2 && link < 0 && junction < 0);
         }
     }
     EXPECT_EQ(graphJunctions, M.junctions.size());
@@ -263,6 +282,18 @@ TEST(OpenDrive, NetconvertReadsOsmLanes) { checkNet(osmCity("lanes.osm"), "osm l
 
 // A dual carriageway of two one-way ways 10 m apart, crossed by side streets
 // (tests/data/osm/dual_carriageway.osm): one-way roads with lanes on one side.
+// A street whose lane count changes where two ways meet (tests/data/osm/lane_change.osm):
+// 2 -> 4 lanes straight on, 4 -> 2 at a bend (a lane appears in each: through junctions),
+// two-way -> one-way (a transition); every lane netconvert builds is fed from a lane before it.
+TEST(OpenDrive, NetconvertReadsOsmLaneChanges) {
+    const City city = osmCity("lane_change.osm");
+    const LaneModel M = buildLaneModel(city.streets, city.params, &city.blocks);
+    size_t through = 0;
+    for (const Junction& J : M.junctions) through += J.through;
+    EXPECT_EQ(through, 2u);  // where lanes appear; two-way -> one-way stays a transition
+    checkNet(city, "osm lane_change.osm");
+}
+
 TEST(OpenDrive, NetconvertReadsOsmDualCarriageway) {
     checkNet(osmCity("dual_carriageway.osm"), "osm dual_carriageway.osm");
 }
