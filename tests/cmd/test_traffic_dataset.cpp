@@ -33,11 +33,13 @@
 #include "runtime/scene/paths.h"
 #include "runtime/traffic/agent_models.h"
 #include "runtime/traffic/traffic_tracks.h"
+#include "tests/common/npy.h"
 #include "tests/common/run_vista.h"
 #include "tests/common/temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace vista;
+using test::loadNpy;
 using test::readBytes;
 using test::runVista;
 using test::TempDir;
@@ -88,16 +90,6 @@ const Fixture& fixture() {
         f.ok = r.code == 0;
     }
     return f;
-}
-
-template <class T>
-std::vector<T> loadNpy(const std::string& path) {
-    const std::string b = readBytes(path);
-    if (b.size() < 10) return {};
-    const size_t hl = uint8_t(b[8]) | size_t(uint8_t(b[9])) << 8;
-    std::vector<T> v((b.size() - 10 - hl) / sizeof(T));
-    std::memcpy(v.data(), b.data() + 10 + hl, v.size() * sizeof(T));
-    return v;
 }
 
 // A Middlebury .flo file: its (du, dv) pairs.
