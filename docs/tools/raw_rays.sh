@@ -22,7 +22,7 @@
 # only when every step succeeded.
 set -euo pipefail
 
-INVOCATION="docs/tools/raw_rays.sh${1:+ $1}${2:+ $2}"
+INVOCATION="docs/tools/raw_rays.sh OUT build/vista"  # the page names the command, not this run's paths
 source "$(dirname "$0")/lib.sh"
 doc_setup raw_rays.sh rawrays 1280x1024x24 "$@"
 DOC_TMP_FILES=(docs/measurements/.raw-rays.md.tmp)
