@@ -22,6 +22,11 @@ Over README.md, CHANGELOG.md and every docs/**/*.md:
 5. No internal notes: none of REJECTED_PHRASES (notes to the team, diary
    wording, binaries of one machine) appears; "this machine" is rejected in the
    guide, whose reader's machine is not the one the docs were measured on.
+6. One source for the cities' sizes: a line outside
+   docs/measurements/generation.md (and outside generated blocks and code)
+   that gives a generated city's size (`--size S` or "S km") does not also
+   state its triangle count; it links generation.md, whose table measures it,
+   so two pages never quote two counts for one city.
 
 Prints every problem as FILE:LINE: message and exits 1 if there is one;
 exits 0 with a one-line summary otherwise.
@@ -297,6 +302,31 @@ def check_phrases(doc, rel, problems):
                 problems.append(f"{rel}:{i + 1}: \"{m.group(0)}\": {why}")
 
 
+CITY_SIZE_RE = re.compile(r"--size\s+\d+|\b\d+(?:\.\d+)?\s?km\b(?!\s?²)")
+TRIANGLE_COUNT_RE = re.compile(r"\b\d+(?:\.\d+)?\s?M\s+(?:rendered\s+|stored\s+)?triangles\b")
+SIZES_PAGE = "docs/measurements/generation.md"
+
+
+def check_quoted_sizes(doc, rel, problems):
+    """A city's triangle count is measured once (SIZES_PAGE); other pages link it."""
+    if rel.replace(os.sep, "/") in (SIZES_PAGE, "CHANGELOG.md"):
+        return
+    in_block = set()
+    for _, start, body in blocks(doc)[0]:
+        in_block.update(range(start, start + len(body)))
+    fence = False
+    for i, line in enumerate(doc.lines):
+        if FENCE_RE.match(line):
+            fence = not fence
+            continue
+        if fence or i in in_block:
+            continue
+        count = TRIANGLE_COUNT_RE.search(line)
+        if count and CITY_SIZE_RE.search(line):
+            problems.append(f"{rel}:{i + 1}: states a city's triangle count ({count.group(0)}) beside its size: "
+                            f"link {SIZES_PAGE}, which measures it, instead of quoting a second figure")
+
+
 def project_minor(root):
     """(major, minor) of CMake's project VERSION, or None."""
     path = os.path.join(root, "CMakeLists.txt")
@@ -393,6 +423,7 @@ def check(root, vista, awaiting=None):
         check_headings(doc, rel, problems)
         check_commands(doc, rel, commands, top_flags, problems)
         check_phrases(doc, rel, problems)
+        check_quoted_sizes(doc, rel, problems)
     measured = [d for d in docs
                 if os.path.relpath(d.path, root).startswith(os.path.join("docs", "measurements") + os.sep)]
     check_blocks(measured, root, awaiting, problems)
@@ -445,6 +476,7 @@ def self_test(vista):
         "stale block": (measured, "<!-- s:begin -->\n" + stamp.replace("3.4.0", "3.3.9") + "\n\n| a |\n<!-- s:end -->"),
         "stamp only": (measured, "<!-- o:begin -->\n" + stamp + "\n<!-- o:end -->"),
         "unbalanced block": (measured, "<!-- b:begin -->\n| a |"),
+        "a city's size quoted twice": (guide, "The 2 km city (`vista gen --size 2000`): 6.73 M rendered triangles."),
     }
     clean = {
         index: (f"# Title\n\n[ok](other.md#a-heading) [self](#title) `vista {cmd} {flag}`\n\n"
