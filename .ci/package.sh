@@ -9,6 +9,9 @@
 #     the packaged osgDB plugin on OSG's plugin path, and the packaged Python
 #     module imports and generates a city.
 # Nothing is installed on the machine; everything goes to a temporary directory.
+# With VISTA_CI_DEB_DIR set (an existing directory; .ci/run sets it) the .deb is
+# also copied there, and .ci/release.sh checks that one instead of packaging the
+# same build a second time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SRC="$(pwd)"
@@ -42,6 +45,7 @@ step "cpack -G DEB"
 debs=("$WORK"/deb/vista_*.deb)
 [ "${#debs[@]}" -eq 1 ] && [ -f "${debs[0]}" ] || fail "expected one vista_*.deb in $WORK/deb"
 DEB="${debs[0]}"
+if [ -n "${VISTA_CI_DEB_DIR:-}" ]; then cp "$DEB" "$VISTA_CI_DEB_DIR/" || fail "copying the .deb to VISTA_CI_DEB_DIR"; fi
 dpkg-deb -f "$DEB" Package Version Architecture Depends
 depends="$(dpkg-deb -f "$DEB" Depends)"
 for p in libopenscenegraph-dev libembree-dev libtbb-dev libcgal-dev libc6; do

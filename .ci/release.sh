@@ -18,7 +18,9 @@
 #   OUT  a new (or empty) directory that receives vista_VERSION_ARCH.deb,
 #        vista-VERSION.tar.gz and SHA256SUMS; without it the artefacts are
 #        checked in a temporary directory and removed (what CI runs).
-# Environment: VISTA_BUILD_DIR (default build), VISTA_RELEASE_BUILD=1 (see 3).
+# Environment: VISTA_BUILD_DIR (default build), VISTA_RELEASE_BUILD=1 (see 3),
+# VISTA_CI_DEB_DIR (a directory holding the one .deb that .ci/package.sh made
+# from this build, newer than its `vista`: checked instead of running cpack again).
 # Exit codes: 0 all checks passed, 1 a check failed, 2 bad usage (OUT not
 # empty, not a git checkout, no build). Nothing is installed on the machine and
 # nothing is left in OUT when a check fails.
@@ -56,8 +58,16 @@ newest="$(sed -n 's/^## \([0-9]\+\.[0-9]\+\.[0-9]\+\)\( .*\)\?$/\1/p' CHANGELOG.
 [ "$newest" = "$VERSION" ] || fail "CHANGELOG.md's newest version heading is '$newest', expected $VERSION"
 echo "release: version $VERSION"
 
-step "the Debian package (cpack -G DEB)"
-(cd "$BUILD" && cpack -G DEB -B "$WORK/deb" >"$WORK/cpack.log" 2>&1) || { cat "$WORK/cpack.log"; fail "cpack -G DEB"; }
+made=()
+[ -n "${VISTA_CI_DEB_DIR:-}" ] && made=("$VISTA_CI_DEB_DIR"/vista_*.deb)
+if [ "${#made[@]}" -eq 1 ] && [ -f "${made[0]}" ] && [ "${made[0]}" -nt "$BUILD/vista" ]; then
+  step "the Debian package (.ci/package.sh's cpack -G DEB of this build)"
+  mkdir -p "$WORK/deb"
+  cp "${made[0]}" "$WORK/deb/"
+else
+  step "the Debian package (cpack -G DEB)"
+  (cd "$BUILD" && cpack -G DEB -B "$WORK/deb" >"$WORK/cpack.log" 2>&1) || { cat "$WORK/cpack.log"; fail "cpack -G DEB"; }
+fi
 debs=("$WORK"/deb/vista_*.deb)
 [ "${#debs[@]}" -eq 1 ] && [ -f "${debs[0]}" ] || fail "expected one vista_*.deb in $WORK/deb"
 DEB="${debs[0]}"

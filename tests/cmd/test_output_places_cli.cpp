@@ -217,14 +217,15 @@ TEST_F(OutputPlaces, EveryCommandRefusesAnOutputAnotherProcessIsWriting) {
 
 // Two paged generations of different seeds into one directory at the same
 // time: exactly one runs, the other exits 2 before doing any work; the city
-// left is the winner's alone, whole.
+// left is the winner's alone, whole (2 x 2 regions at facade detail 1: a run
+// lasts seconds, long beyond both processes' start).
 TEST_F(OutputPlaces, TwoPagedGensRacingOnOneDirectoryNeverMix) {
     const std::string out = dir.file("race.paged");
     CliRun runs[2];
     std::thread t[2];
     for (int k = 0; k < 2; ++k)
         t[k] = std::thread([&, k] {
-            runs[k] = runVista("gen --size 2000 --detail 1 --region-size 500 -q --seed " + std::to_string(k + 1) +
+            runs[k] = runVista("gen --size 1000 --detail 1 --region-size 500 -q --seed " + std::to_string(k + 1) +
                                " -o " + out);
         });
     for (auto& th : t) th.join();
@@ -236,7 +237,7 @@ TEST_F(OutputPlaces, TwoPagedGensRacingOnOneDirectoryNeverMix) {
     EXPECT_TRUE(has(loser.err, "another vista process") && has(loser.err, out + ".lock")) << loser.err;
     EXPECT_TRUE(has(readBytes(out + "/manifest.json"), "\"seed\": " + std::to_string(winner + 1)));
     // Every region the manifest lists checks out: a rerun of the winner's seed reuses them all.
-    const CliRun again = runVista("gen --size 2000 --detail 1 --region-size 500 --seed " + std::to_string(winner + 1) +
+    const CliRun again = runVista("gen --size 1000 --detail 1 --region-size 500 --seed " + std::to_string(winner + 1) +
                                   " -o " + out + " --stats " + dir.file("again.json"));
     ASSERT_EQ(again.code, 0) << again.err;
     EXPECT_TRUE(has(readBytes(dir.file("again.json")), "\"regions_generated\": 0"))

@@ -308,10 +308,13 @@ TEST_F(PagedStream, UnreadableRegionFilesStopAStreamNamingThem) {
 
 // A region file of another generation (another seed's city of the same grid) swapped into the
 // directory, its size written into the manifest as a racing writer's would be: every reader
-// refuses the directory, naming the region file and the manifest.
+// refuses the directory, naming the region file and the manifest. The other city is generated
+// in part: its shard 4/4 of 2 x 2 regions is region 3, region_1_1 alone.
 TEST_F(PagedStream, ARegionOfAnotherGenerationIsRefused) {
-    CliRun r = runVista("gen --size 1000 --seed 5 --detail 1 --region-size 500 -q -o " + tmp.file("other.paged"));
+    CliRun r =
+        runVista("gen --size 1000 --seed 5 --detail 1 --region-size 500 -q --shard 4/4 -o " + tmp.file("other.paged"));
     ASSERT_EQ(r.code, 0) << r.err;
+    ASSERT_TRUE(fs::exists(tmp.file("other.paged/region_1_1.osgb")));
     const std::string copy = tmp.file("copy.paged");
     fs::copy(dir(), copy, fs::copy_options::recursive);
     const fs::path region = fs::path(copy) / "region_1_1.osgb";

@@ -29,6 +29,7 @@
 #include "runtime/scene/scene_graph.h"
 #include "runtime/scene/tree_impostor_graph.h"
 #include "tests/common/run_vista.h"
+#include "tests/common/small_paged_city.h"
 #include "tests/common/temp_dir.h"
 
 namespace fs = std::filesystem;
@@ -40,8 +41,8 @@ using vista::test::TempDir;
 
 namespace {
 
-// A 1.5 km city in 500 m regions (3 x 3), facade detail 1 to keep it quick.
-const std::string kCity = "gen --size 1500 --seed 4 --detail 1 --region-size 500 -q";
+// The shared city's parameters (tests/common/small_paged_city.h): 1.5 km in 500 m regions (3 x 3).
+const std::string kCity = std::string("gen ") + vista::test::kSmallPagedCityArgs + " -q";
 
 // Every file under `dir` (relative name -> bytes), temporaries included.
 std::map<std::string, std::string> snapshot(const std::string& dir) {
@@ -64,25 +65,20 @@ nlohmann::json readJson(const std::string& path) { return nlohmann::json::parse(
 
 class Paged : public ::testing::Test {
 protected:
-    // One reference run shared by the tests (threads 1).
+    // One reference run shared by the tests (threads 1): tests/common/small_paged_city.h.
     static void SetUpTestSuite() {
-        ref = new TempDir("vista_paged_ref");
-        const CliRun r =
-            runVista(kCity + " --threads 1 -o " + ref->file("city.paged") + " --stats " + ref->file("stats.json"));
-        ASSERT_EQ(r.code, 0) << r.err;
-        files = new std::map<std::string, std::string>(snapshot(ref->file("city.paged")));
+        files = new std::map<std::string, std::string>(snapshot(refDir()));
+        ASSERT_TRUE(files->count("manifest.json")) << refDir();
     }
     static void TearDownTestSuite() {
         delete files;
-        delete ref;
         files = nullptr;
-        ref = nullptr;
     }
-    static TempDir* ref;
+    static std::string refDir() { return vista::test::smallPagedCity().dir; }
+    static std::string refStats() { return vista::test::smallPagedCity().stats; }
     static std::map<std::string, std::string>* files;
     TempDir tmp{"vista_paged"};
 };
-TempDir* Paged::ref = nullptr;
 std::map<std::string, std::string>* Paged::files = nullptr;
 
 }  // namespace
@@ -126,7 +122,7 @@ TEST(RegionGrid, RegionSizeValidated) {
 }
 
 TEST_F(Paged, LayoutAndManifest) {
-    const std::string dir = ref->file("city.paged");
+    const std::string dir = refDir();
     const auto m = readJson(dir + "/manifest.json");
     EXPECT_EQ(m["format"], "vista.paged_city");
     EXPECT_EQ(m["regions_x"], 3);
@@ -154,7 +150,7 @@ TEST_F(Paged, LayoutAndManifest) {
 // The generation's identity: the manifest's generation is the params' seed and the key of every
 // region's record, and each region file (full and coarse) carries both on its root.
 TEST_F(Paged, EveryRegionFileCarriesTheManifestsGeneration) {
-    const std::string dir = ref->file("city.paged");
+    const std::string dir = refDir();
     const auto m = readJson(dir + "/manifest.json");
     EXPECT_EQ(m["version"], vista::kPagedCityVersion);
     ASSERT_TRUE(m.contains("generation")) << m.dump();
@@ -189,9 +185,9 @@ TEST_F(Paged, BuildingCountsEqualTheUnpagedCity) {
                               tmp.file("one.json"));
     ASSERT_EQ(r.code, 0) << r.err;
     const auto one = readJson(tmp.file("one.json"));
-    const auto m = readJson(ref->file("city.paged") + "/manifest.json");
+    const auto m = readJson(refDir() + "/manifest.json");
     EXPECT_EQ(m["totals"]["buildings"].get<size_t>(), one["buildings"].get<size_t>());
-    const auto stats = readJson(ref->file("stats.json"));
+    const auto stats = readJson(refStats());
     EXPECT_EQ(stats["buildings"].get<size_t>(), one["buildings"].get<size_t>());
     EXPECT_EQ(stats["street_edges"].get<size_t>(), one["street_edges"].get<size_t>());
     EXPECT_EQ(stats["blocks"].get<size_t>(), one["blocks"].get<size_t>());
@@ -268,7 +264,7 @@ TEST_F(Paged, MergeRefusesMissingRegions) {
 
 TEST_F(Paged, ResumeRegeneratesOnlyDamagedRegions) {
     const std::string dir = tmp.file("city.paged");
-    fs::copy(ref->file("city.paged"), dir, fs::copy_options::recursive);
+    fs::copy(refDir(), dir, fs::copy_options::recursive);
     fs::remove(dir + "/index.osgb");
     fs::remove(dir + "/manifest.json");
     fs::remove(dir + "/region_0_0.osgb");             // missing
@@ -314,7 +310,7 @@ TEST_F(Paged, KillNineThenResumeGivesTheSameBytes) {
 // per non-empty region naming its coarse and full files, whose bounding
 // sphere contains the region's geometry; full detail nearer than the coarse level.
 TEST_F(Paged, IndexHasOnePagedLodPerRegion) {
-    const std::string dir = ref->file("city.paged");
+    const std::string dir = refDir();
     const auto m = readJson(dir + "/manifest.json");
     auto root = vista::readSceneFile(dir + "/index.osgb");
     ASSERT_TRUE(root.isOk()) << root.status().message();
@@ -372,7 +368,7 @@ TEST_F(Paged, IndexHasOnePagedLodPerRegion) {
 // no crash for the stock one (the pager of osgviewer reads with it).
 TEST_F(Paged, DamagedRegionFilesDoNotCrashReaders) {
     const std::string dir = tmp.file("city.paged");
-    fs::copy(ref->file("city.paged"), dir, fs::copy_options::recursive);
+    fs::copy(refDir(), dir, fs::copy_options::recursive);
     fs::remove(dir + "/region_0_0.osgb");
     fs::resize_file(dir + "/region_1_1.osgb", fs::file_size(dir + "/region_1_1.osgb") / 2);
     auto missing = vista::loadCityFile(dir + "/region_0_0.osgb");
@@ -428,7 +424,7 @@ TEST_F(Paged, BadInputExitsTwoAndLeavesNothing) {
 TEST_F(Paged, StockViewerPagesTheNearRegionIn) {
     const char* display = std::getenv("DISPLAY");
     if (!display || !*display) GTEST_SKIP() << "no DISPLAY: run the tests under xvfb-run -a";
-    const std::string dir = ref->file("city.paged");
+    const std::string dir = refDir();
     osg::ref_ptr<osg::Node> index = osgDB::readNodeFile(dir + "/index.osgb");
     ASSERT_TRUE(index.valid());
     osg::PagedLOD *near = nullptr, *far = nullptr;
@@ -492,7 +488,7 @@ struct FindImpostors : osg::NodeVisitor {
 // prototype mesh, and the impostor geometries carry their atlas inline (the
 // stock reader sees it too).
 TEST_F(Paged, CoarseLevelDrawsTreesAsImpostors) {
-    const std::string dir = ref->file("city.paged");
+    const std::string dir = refDir();
     size_t trees = 0;
     const auto manifest = readJson(dir + "/manifest.json");
     for (const auto& r : manifest["regions"]) {

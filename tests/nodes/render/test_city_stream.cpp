@@ -15,8 +15,7 @@
 #include "nodes/render/render_mode.h"
 #include "runtime/engine/ray_scene.h"
 #include "runtime/scene/paged_load.h"
-#include "tests/common/run_vista.h"
-#include "tests/common/temp_dir.h"
+#include "tests/common/small_paged_city.h"
 #include "tests/nodes/render/render_fixtures.h"
 
 using namespace vista;
@@ -47,11 +46,8 @@ size_t differing(const Image& a, const Image& b) {
 
 TEST(CityStream, HybridTracesADroppedRegionsPixelsAgain) {
     REQUIRE_DISPLAY();
-    test::TempDir tmp("vista_city_stream");
-    const std::string dir = tmp.file("city.paged");
-    const test::CliRun r = test::runVista("gen --size 1500 --seed 4 --detail 1 --region-size 500 -q -o " + dir);
-    ASSERT_EQ(r.code, 0) << r.err;
-    auto m = readPagedManifest(dir);
+    // The shared 1.5 km city in 500 m regions (3 x 3), read in place.
+    auto m = readPagedManifest(test::smallPagedCity().dir);
     ASSERT_TRUE(m.isOk()) << m.status().message();
     RegionPagerOptions po;
     po.radius = 600;

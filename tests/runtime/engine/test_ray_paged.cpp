@@ -7,20 +7,11 @@
 
 #include "runtime/engine/ray_scene.h"
 #include "runtime/scene/paged_load.h"
-#include "tests/common/run_vista.h"
-#include "tests/common/temp_dir.h"
-
-using vista::test::CliRun;
-using vista::test::runVista;
-using vista::test::TempDir;
+#include "tests/common/small_paged_city.h"
 
 TEST(RayPaged, CoarseRegionsTraceTheirTrees) {
-    TempDir tmp("vista_ray_paged");
-    const std::string dir = tmp.file("city.paged");
-    // A 1.5 km city in 500 m regions (3 x 3), facade detail 1 to keep it quick.
-    const CliRun r = runVista("gen --size 1500 --seed 4 --detail 1 --region-size 500 -q -o " + dir);
-    ASSERT_EQ(r.code, 0) << r.err;
-    auto m = vista::readPagedManifest(dir);
+    // The shared 1.5 km city in 500 m regions (3 x 3), read in place.
+    auto m = vista::readPagedManifest(vista::test::smallPagedCity().dir);
     ASSERT_TRUE(m.isOk()) << m.status().message();
     const glm::dvec2 centre(m->params.origin_x, m->params.origin_y);
     const std::vector<int> full = vista::selectPagedRegions(*m, {centre}, 0.0);

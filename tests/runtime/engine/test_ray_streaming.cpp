@@ -16,6 +16,7 @@
 #include "runtime/engine/ray_streaming.h"
 #include "runtime/scene/paged_load.h"
 #include "tests/common/run_vista.h"
+#include "tests/common/small_paged_city.h"
 #include "tests/common/temp_dir.h"
 
 using vista::test::CliRun;
@@ -52,11 +53,8 @@ vista::Image frameOf(const vista::RayScene& rays, const vista::Camera& c) {
 }  // namespace
 
 TEST(RayStreaming, WaitingFramesAreTheFramesOfTheRegionsWithinReach) {
-    TempDir tmp("vista_ray_streaming");
-    const std::string dir = tmp.file("city.paged");
-    const CliRun r = runVista("gen --size 1500 --seed 4 --detail 1 --region-size 500 -q -o " + dir);
-    ASSERT_EQ(r.code, 0) << r.err;
-    auto m = vista::readPagedManifest(dir);
+    // The shared 1.5 km city in 500 m regions (3 x 3), read in place.
+    auto m = vista::readPagedManifest(vista::test::smallPagedCity().dir);
     ASSERT_TRUE(m.isOk()) << m.status().message();
 
     vista::RegionPagerOptions o;

@@ -19,34 +19,23 @@
 
 #include "runtime/scene/paged_load.h"
 #include "runtime/scene/region_pager.h"
-#include "tests/common/run_vista.h"
+#include "tests/common/small_paged_city.h"
 #include "tests/common/temp_dir.h"
 
 namespace fs = std::filesystem;
 using vista::RegionPager;
 using vista::RegionPagerOptions;
-using vista::test::CliRun;
-using vista::test::runVista;
 using vista::test::TempDir;
 
 namespace {
 
-// A 1.5 km city in 500 m regions (3 x 3, region 4 in the middle), facade detail 1 to keep it quick.
-const std::string kCity = "gen --size 1500 --seed 4 --detail 1 --region-size 500 -q";
-
+// The shared 1.5 km city in 500 m regions (3 x 3, region 4 in the middle): tests/common/small_paged_city.h.
 class Pager : public ::testing::Test {
 protected:
-    static void SetUpTestSuite() {
-        ref = new TempDir("vista_pager_ref");
-        const CliRun r = runVista(kCity + " -o " + ref->file("city.paged"));
-        ASSERT_EQ(r.code, 0) << r.err;
-    }
-    static void TearDownTestSuite() {
-        delete ref;
-        ref = nullptr;
-    }
+    static void SetUpTestSuite() { vista::test::smallPagedCity(); }
+    static std::string cityDir() { return vista::test::smallPagedCity().dir; }
     void SetUp() override {
-        auto m = vista::readPagedManifest(ref->file("city.paged"));
+        auto m = vista::readPagedManifest(cityDir());
         ASSERT_TRUE(m.isOk()) << m.status().message();
         manifest = *m;
         ASSERT_EQ(manifest.regions.size(), 9u);
@@ -82,10 +71,8 @@ protected:
             if (levels[i]) m[int(i)] = levels[i];
         return m;
     }
-    static TempDir* ref;
     vista::PagedManifest manifest;
 };
-TempDir* Pager::ref = nullptr;
 
 }  // namespace
 
@@ -384,7 +371,7 @@ TEST_F(Pager, ANewBudgetTakesEffectAtTheNextUpdate) {
 TEST_F(Pager, ADamagedRegionFileFallsBackToItsCoarseLevel) {
     TempDir tmp("vista_pager_damaged");
     const std::string dir = tmp.file("city.paged");
-    fs::copy(ref->file("city.paged"), dir, fs::copy_options::recursive);
+    fs::copy(cityDir(), dir, fs::copy_options::recursive);
     auto m = vista::readPagedManifest(dir);
     ASSERT_TRUE(m.isOk()) << m.status().message();
     const std::string bad = (fs::path(dir) / m->regions[4].file).string();
