@@ -39,6 +39,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
 #include <set>
@@ -340,10 +341,31 @@ Result<std::string> cityHash(const std::string& city, bool paged, uint64_t& byte
     return fileHash(paged ? (fs::path(city) / "manifest.json").string() : city, bytes);
 }
 
-// What decides the bytes besides the city and the path: every option that
-// changes a pixel (and the traffic's tracks). A merge compares it with the
-// shards' inputs without loading the city.
-nlohmann::json optionsManifest(const RenderArgs& a, const RenderPlan& p) {
+// The path without loading the city: the --path file's content hash, or the
+// flags that make the path on the city's streets. A merge compares it (with
+// the city's hash, --frames and --sampling) to the shards' inputs, so a shard
+// rendered along another path is refused.
+Result<std::string> pathInput(const RenderArgs& a) {
+    std::string path;
+    if (!a.path.file.empty()) {
+        uint64_t bytes = 0;
+        auto h = fileHash(a.path.file, bytes);
+        if (!h) return Status::error("--path: " + h.status().message());
+        path = "file " + *h;
+    } else {
+        const PathFlags& f = a.path;
+        path = "seed " + std::to_string(f.seed) + ", kind " + f.kind + ", route " + f.route + ", duration " +
+               manifestNumber(f.duration) + ", run-up " + manifestNumber(f.runUp) + (f.lht ? ", lht" : "");
+    }
+    return path;
+}
+
+// What decides the bytes, from the arguments alone: the city's content, the
+// path (pathInput) and the frames taken from it, every option that changes a pixel, the traffic's tracks
+// and lamps, and for a paged city the reach of a frame. The work directory's
+// manifest adds the frames' count and poses; a merge compares this with the
+// shards' inputs.
+Result<nlohmann::json> runInputs(const RenderArgs& a, const RenderPlan& p) {
     const ModeOptions& mo = p.options;
     nlohmann::json manifest = {{"size", std::to_string(p.size.width) + "x" + std::to_string(p.size.height)},
                                {"fov_deg", manifestNumber(p.fovDeg)},
@@ -358,26 +380,20 @@ nlohmann::json optionsManifest(const RenderArgs& a, const RenderPlan& p) {
                                {"frame_ms", manifestNumber(mo.frameMsTarget)},
                                {"far_step", mo.farStep}};
     if (p.traffic) {
-        // The agents' poses decide pixels: a resumed run must draw the same traffic.
-        manifest["traffic_hash"] = trafficHash(*p.traffic);
+        // The agents' poses and the heads' lamps decide pixels: a resumed run must draw the same traffic.
+        auto traffic = trafficHash(*p.traffic, a.modeFlags.traffic);
+        if (!traffic) return traffic.status();
+        manifest["traffic_hash"] = *traffic;
     }
-    return manifest;
-}
-
-// The work directory: new, or the one of an interrupted run with the same
-// parameters (the manifest: city bytes, camera poses, every option that
-// changes a pixel; a shard's K/N), with a folder per channel. `inputs`
-// receives the manifest without the shard (a shard's record carries it).
-Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, const std::vector<size_t>& idx,
-                   RenderWorkDir& out, nlohmann::json& inputs) {
     uint64_t cityBytes = 0;
     auto hash = cityHash(a.city, p.paged, cityBytes);
     if (!hash) return hash.status();
-    nlohmann::json manifest = optionsManifest(a, p);
     manifest["city_hash"] = *hash;
     manifest["city_bytes"] = cityBytes;
-    manifest["frames"] = idx.size();
-    manifest["camera_poses_hash"] = posesHash(path, idx);
+    auto path = pathInput(a);
+    if (!path) return path.status();
+    manifest["path"] = *path;
+    manifest["sampling"] = std::to_string(a.frames) + " frames, " + a.sampling;
     if (p.paged) {
         // What decides the regions a frame sees.
         const bool streamed = p.streamed;
@@ -388,6 +404,20 @@ Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, c
                              {"prefetch", manifestNumber(streamed ? p.stream.prefetchS : 0.0)},
                              {"budget_bytes", streamed ? p.stream.budgetBytes : 0}};
     }
+    return manifest;
+}
+
+// The work directory: new, or the one of an interrupted run with the same
+// parameters (the manifest: runInputs, the frames' count and camera poses; a
+// shard's K/N), with a folder per channel. `inputs` receives the manifest
+// without the shard (a shard's record carries it).
+Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, const std::vector<size_t>& idx,
+                   RenderWorkDir& out, nlohmann::json& inputs) {
+    auto run = runInputs(a, p);
+    if (!run) return run.status();
+    nlohmann::json manifest = std::move(*run);
+    manifest["frames"] = idx.size();
+    manifest["camera_poses_hash"] = posesHash(path, idx);
     inputs = manifest;
     if (p.shard) manifest["shard"] = shardText(*p.shard);
     VISTA_RETURN_IF_ERROR(out.open(manifest, a.restart));
@@ -727,7 +757,34 @@ int run(const RenderArgs& a, const std::string& command) {
     return 0;
 }
 
-// "key: A in shard 1/4, B in shard 3/4": the first field where two shards' inputs differ, "" if none.
+// The option (or argument) that sets an input of runInputs, for messages.
+std::string inputOption(const std::string& key) {
+    static const std::map<std::string, std::string> options = {{"size", "--size"},
+                                                               {"fov_deg", "--fov"},
+                                                               {"mode", "--mode"},
+                                                               {"channels", "--channels"},
+                                                               {"near", "--near"},
+                                                               {"triangle_budget", "--triangle-budget"},
+                                                               {"pixel_budget", "--budget"},
+                                                               {"horizon_grid", "--horizon-grid"},
+                                                               {"cache", "--no-cache"},
+                                                               {"cache_error_px", "--cache-error"},
+                                                               {"frame_ms", "--frame-ms"},
+                                                               {"far_step", "--far-step"},
+                                                               {"traffic_hash", "--traffic"},
+                                                               {"city_hash", "the city file"},
+                                                               {"city_bytes", "the city file"},
+                                                               {"path", "--path"},
+                                                               {"camera_poses_hash", "--path"},
+                                                               {"frames", "--frames"},
+                                                               {"sampling", "--frames, --sampling"},
+                                                               {"paged", "--paged-*"}};
+    auto it = options.find(key);
+    return it == options.end() ? "" : " (" + it->second + ")";
+}
+
+// "key (--option): A in shard 1/4, B in shard 3/4": the first field where two
+// shards' inputs differ, "" if none.
 std::string inputsDifference(const nlohmann::json& a, const std::string& aName, const nlohmann::json& b,
                              const std::string& bName) {
     if (!a.is_object() || !b.is_object()) return "inputs: not an object";
@@ -737,7 +794,7 @@ std::string inputsDifference(const nlohmann::json& a, const std::string& aName, 
     for (const auto* o : {&a, &b})
         for (const auto& [key, value] : o->items())
             if (!a.contains(key) || !b.contains(key) || a[key] != b[key])
-                return key + ": " + shown(a, key) + " " + aName + ", " + shown(b, key) + " " + bName;
+                return key + inputOption(key) + ": " + shown(a, key) + " " + aName + ", " + shown(b, key) + " " + bName;
     return "";
 }
 
@@ -750,13 +807,10 @@ int runMerge(const RenderArgs& a, int count, const std::string& command, const s
     if (Status s = configure(a, plan); !s) return reportBadInput(kCmd, s);
     RenderWorkDir out;
     if (Status s = out.checkOut(a.out); !s) return reportBadInput(kCmd, s);
-    uint64_t cityBytes = 0;
-    auto hash = cityHash(a.city, plan.paged, cityBytes);
-    if (!hash) return reportBadInput(kCmd, hash.status());
-    nlohmann::json expect = optionsManifest(a, plan);
-    expect["city_hash"] = *hash;
-    expect["city_bytes"] = cityBytes;
-    nlohmann::json first;  // the first good shard's inputs: frames, poses and the paged reach agree with it
+    auto inputs = runInputs(a, plan);
+    if (!inputs) return reportBadInput(kCmd, inputs.status());
+    const nlohmann::json& expect = *inputs;
+    nlohmann::json first;  // the first good shard's inputs: its frames and poses agree with it
     std::string firstName;
     auto differ = [&](const Shard& s, const nlohmann::json& r) -> std::string {
         const nlohmann::json& in = r["inputs"];
