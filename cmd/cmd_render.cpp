@@ -1104,7 +1104,8 @@ int runRender(int argc, char** argv) {
                    "drives, with --dataset) into OUT.shards/K-of-N (resumable); then --merge --shards N writes OUT");
     app.add_flag("--merge", a.merge,
                  "with --shards N and the shards' other arguments: check every shard in OUT.shards (present, intact, "
-                 "same inputs) and write OUT, the bytes of one unsharded run (summary.json aside)");
+                 "same inputs: city, path, frames, options, traffic; a difference is named with its option) and "
+                 "write OUT, the bytes of one unsharded run (summary.json aside)");
     addNumberOption(app, "--shards", a.shards, 1, kMaxShards,
                     "with --merge: N, 1 .. 100000, the shard count of the shards' --shard K/N; a merge that finds a "
                     "shard missing, damaged or of other inputs names it and the command that runs it again");
