@@ -85,6 +85,8 @@
 #include "runtime/scene/paged_load.h"
 #include "runtime/scene/paths.h"
 #include "runtime/engine/rig.h"
+#include "runtime/engine/traffic_light_labels.h"
+#include "runtime/traffic/signal_states.h"
 #include "runtime/scene/scene_graph.h"
 
 namespace vista {
@@ -95,6 +97,9 @@ namespace fs = std::filesystem;
 const char* const kCmd = "vista render";
 
 enum Channel : unsigned { kRgb = 1, kDepth = 2, kSemantic = 4, kInstance = 8 };
+// Not a channel one asks for: the traffic-light labels a run with --traffic
+// writes beside the instance channel (RenderPlan::written).
+constexpr unsigned kTrafficLights = 16;
 constexpr unsigned kLabelChannels = kDepth | kSemantic | kInstance;
 // The output folder of each channel, in output order.
 const std::pair<unsigned, const char*> kChannelDirs[] = {
@@ -215,6 +220,11 @@ struct RenderPlan {
     std::string outDir;                            // where this run publishes: --out, or the shard's directory
     std::shared_ptr<const TrafficTracks> traffic;  // --traffic (null: none)
     bool labels() const { return (channels & kLabelChannels) != 0; }
+    // The files each frame writes: the channels, and traffic_lights/ when
+    // the instance channel is written with traffic that recorded its lights.
+    unsigned written() const {
+        return channels | ((channels & kInstance) && traffic && traffic->signals ? kTrafficLights : 0u);
+    }
 };
 
 // The paged-city options: streaming only for a paged city and a mode that
@@ -423,6 +433,7 @@ Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, c
     VISTA_RETURN_IF_ERROR(out.open(manifest, a.restart));
     for (const auto& [bit, dir] : kChannelDirs)
         if (p.channels & bit) VISTA_RETURN_IF_ERROR(out.subdir(dir));
+    if (p.written() & kTrafficLights) VISTA_RETURN_IF_ERROR(out.subdir("traffic_lights"));
     return Status::ok();
 }
 
@@ -483,7 +494,8 @@ std::vector<std::string> frameFiles(unsigned channels, const std::string& name) 
     for (const auto& [bit, file] : {std::pair<unsigned, std::string>{kRgb, "rgb/" + name + ".png"},
                                     {kDepth, "depth/" + name + ".npy"},
                                     {kSemantic, "semantic/" + name + ".png"},
-                                    {kInstance, "instance/" + name + ".npy"}})
+                                    {kInstance, "instance/" + name + ".npy"},
+                                    {kTrafficLights, "traffic_lights/" + name + ".txt"}})
         if (channels & bit) files.push_back(file);
     return files;
 }
@@ -554,6 +566,16 @@ Status writeFrameFiles(unsigned channels, const std::string& name, const FrameBu
     return Status::ok();
 }
 
+// The frame's traffic-light labels (traffic_light_labels.h) from its
+// instance image: each head's lamp at the frame's time `t`.
+Status writeTrafficLights(const RenderPlan& p, const std::string& name, const LabelImage& gt, double t,
+                          const RenderWorkDir& out) {
+    const SignalStates& lamps = *p.traffic->signals;
+    auto lamp = [&](uint32_t head) { return std::string(lampStateName(lamps.lampAt(head, t))); };
+    return writeFileAtomic(out.file("traffic_lights/" + name + ".txt"),
+                           trafficLightLabels(trafficLightBoxes(gt.ids, gt.width, gt.height), lamp));
+}
+
 // Renders every frame still missing (and hybrid's warm-up frames), writes
 // its files and record; `frames` receives every frame's camera entry of
 // cameras.json.
@@ -599,8 +621,9 @@ Status renderFrames(const RenderArgs& a, const RenderPlan& p, const Walkthrough&
         tm.rgb.push_back(st.frameMs);
         if (p.labels()) VISTA_RETURN_IF_ERROR(frameLabels(cam, p.options.threads, s, b, tm));
         VISTA_RETURN_IF_ERROR(writeFrameFiles(p.channels, frameName(f), b, out, tm));
+        if (p.written() & kTrafficLights) VISTA_RETURN_IF_ERROR(writeTrafficLights(p, frameName(f), b.gt, ps.t, out));
         done.records[f] = Timings::record(tm);
-        VISTA_RETURN_IF_ERROR(out.finishFrame(f, done.records[f], frameFiles(p.channels, frameName(f))));
+        VISTA_RETURN_IF_ERROR(out.finishFrame(f, done.records[f], frameFiles(p.written(), frameName(f))));
         if (killAfter > 0 && ++finishedNow == killAfter) std::raise(SIGKILL);
         if (progress) progress->update(double(f + 1) / double(idx.size()));
     }
@@ -734,7 +757,7 @@ int run(const RenderArgs& a, const std::string& command) {
     RenderSession session;
     if (Status s = setUp(a.mode, plan, *walk, session); !s) return reportBadInput(kCmd, s);
     const ShardRange range = plan.shard ? shardRange(idx.size(), *plan.shard) : ShardRange{0, idx.size()};
-    Progressed done = finishedFrames(out, plan.channels, idx.size(), range);
+    Progressed done = finishedFrames(out, plan.written(), idx.size(), range);
     nlohmann::json frames = nlohmann::json::array();
     if (Status s = renderFrames(a, plan, *walk, idx, range, session, out, done, frames); !s)
         return reportBadInput(kCmd, s);

@@ -16,6 +16,12 @@
 // A head whose instance has no pixel in the image (out of view or hidden by
 // nearer geometry) has no box and so no line; a frame without a visible
 // head gives "". Pure; thread-safe when lampName is.
+//
+// trafficLightBoxes(): the boxes of the traffic-light instances of an
+// instance image (`ids`: width * height instance ids, row 0 at the top), for
+// a run without city boxes (the one-camera `vista render`): per id of kind
+// TrafficLight, sorted by id, only `id`, the visible extent and `pixels` set.
+// VISTA_CHECKs ids.size() == width * height.
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -28,5 +34,7 @@ namespace vista {
 
 std::string trafficLightLabels(const std::vector<FrameBox>& boxes,
                                const std::function<std::string(uint32_t head)>& lampName);
+
+std::vector<FrameBox> trafficLightBoxes(const std::vector<uint32_t>& ids, int width, int height);
 
 }  // namespace vista

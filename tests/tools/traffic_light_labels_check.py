@@ -27,10 +27,12 @@ time; every traffic-light id in an instance image has a line (and so a head
 out of view or hidden has none: lines and visible heads are the same set);
 at least --min-labels lines, --min-states different states, and a head
 labelled in one frame and absent (no pixel, no line) in another. With --vista
-it makes the run first (a generated city, `vista traffic` with SUMO, a path
-riding a car that stops at a red light, a rig of two cameras), and checks that the same rig
-without --traffic writes no traffic-light labels. Exit 0 when every check
-passes, 1 otherwise, 77 without SUMO. Python's standard library only.
+it makes the runs first (a generated city, `vista traffic` with SUMO, a path
+riding a car that stops at a red light, a rig of two cameras, and a one-camera
+`vista render --channels instance` along the same path: traffic_lights/ and
+cameras.json instead of rig.json), and checks that the same rig without
+--traffic writes no traffic-light labels. Exit 0 when every check
+passes, 1 otherwise, 77 without SUMO (or without a display and xvfb-run). Python's standard library only.
 """
 import argparse
 import array
@@ -145,30 +147,39 @@ def light_extents(image):
     return out
 
 
+def views(run, fails):
+    """(camera, labels folder, instance folder, [(frame, name, t_s)]) of a rig run (rig.json: each
+    camera listing boxes) or of a one-camera run (cameras.json: traffic_lights/ beside instance/)."""
+    if os.path.exists(os.path.join(run, "rig.json")):
+        rig = json.load(open(os.path.join(run, "rig.json")))
+        out = []
+        for s in rig["sensors"]:
+            if "boxes" not in s.get("channels", []):
+                continue
+            dirs = s.get("dirs", {})
+            if not fails.check(dirs.get("traffic_lights") is not None,
+                               f"{s['name']}: lists boxes but has no traffic_lights folder"):
+                continue
+            frames = [(f["frame"], f["name"], f["t_s"]) for f in rig["frames"] if s["name"] in f["sensors"]]
+            out.append((s["name"], dirs["traffic_lights"], dirs["instance"], frames))
+        return out
+    cams = json.load(open(os.path.join(run, "cameras.json")))
+    return [("camera", "traffic_lights", "instance", [(f["frame"], f["name"], f["t_s"]) for f in cams["frames"]])]
+
+
 def check_run(run, traffic, min_labels, min_states):
     fails = Failures()
     heads, lights = read_heads(traffic), read_states(traffic)
-    rig = json.load(open(os.path.join(run, "rig.json")))
     labels, states = 0, {}
-    seen = {}  # head -> frames with a line
-    shown = {}  # head -> frames where the camera could have shown it (any camera, any frame)
+    seen = {}  # head -> (camera, frame) with a line
     frames_checked = set()
-    for s in rig["sensors"]:
-        dirs = s.get("dirs", {})
-        if "boxes" not in s.get("channels", []):
-            continue
-        lights_dir, inst_dir = dirs.get("traffic_lights"), dirs.get("instance")
-        if not fails.check(lights_dir is not None, f"{s['name']}: lists boxes but has no traffic_lights folder"):
-            continue
-        for fr in rig["frames"]:
-            if s["name"] not in fr["sensors"]:
-                continue
-            name, t = fr["name"], fr["t_s"]
+    for cam, lights_dir, inst_dir, frames in views(run, fails):
+        for frame, name, t in frames:
             path = os.path.join(run, lights_dir, name + ".txt")
             if not fails.check(os.path.exists(path), f"{path} is missing"):
                 continue
             visible = light_extents(load_npy_u32(os.path.join(run, inst_dir, name + ".npy")))
-            frames_checked.add((s["name"], fr["frame"]))
+            frames_checked.add((cam, frame))
             listed = set()
             for n, line in enumerate(open(path), 1):
                 c = line.split()
@@ -191,11 +202,9 @@ def check_run(run, traffic, min_labels, min_states):
                 want = lamp(heads, lights, head, t)
                 fails.check(state == want, f"{where}: head {head} at t={t}: {state}, SUMO's files say {want}")
                 states[state] = states.get(state, 0) + 1
-                seen.setdefault(head, set()).add((s["name"], fr["frame"]))
+                seen.setdefault(head, set()).add((cam, frame))
             for iid in visible:
                 fails.check(iid in listed, f"{path}: head {iid & ((1 << 28) - 1)} has pixels but no line")
-            for iid in visible:
-                shown.setdefault(iid & ((1 << 28) - 1), set()).add((s["name"], fr["frame"]))
     fails.check(labels >= min_labels, f"{labels} labels, expected at least {min_labels}")
     fails.check(len(states) >= min_states, f"states seen {sorted(states)}, expected at least {min_states} kinds")
     # A head labelled in some frame and absent from another frame of the same camera has no line there.
@@ -209,8 +218,10 @@ def check_run(run, traffic, min_labels, min_states):
     return 1 if fails.items else 0
 
 
-def run_vista(vista, *args):
-    r = subprocess.run([vista, *map(str, args)], capture_output=True, text=True)
+def run_vista(vista, *args, display=False):
+    """Runs vista; `display`: the command draws with OpenGL (under xvfb-run -a when DISPLAY is not set)."""
+    prefix = ["xvfb-run", "-a"] if display and not os.environ.get("DISPLAY") else []
+    r = subprocess.run([*prefix, vista, *map(str, args)], capture_output=True, text=True)
     if r.returncode != 0:
         raise SystemExit(f"vista {' '.join(map(str, args))} failed ({r.returncode}): {r.stderr}")
 
@@ -236,10 +247,14 @@ def render(vista, d, frames):
     out = os.path.join(d, "out")
     run_vista(vista, "render", city, "--path", path, "--rig", rig, "--traffic", traffic, "--frames",
               min(frames, samples), "--sampling", "consecutive", "-q", "--out", out)
+    camera = os.path.join(d, "camera")
+    run_vista(vista, "render", city, "--path", path, "--traffic", traffic, "--frames", min(frames, samples),
+              "--sampling", "consecutive", "--size", "160x100", "--channels", "instance", "-q", "--out", camera,
+              display=True)
     plain = os.path.join(d, "plain")
     run_vista(vista, "render", city, "--path", path, "--rig", rig, "--frames", 2, "--sampling", "consecutive", "-q",
               "--out", plain)
-    return out, traffic, plain
+    return out, camera, traffic, plain
 
 
 def check_plain(plain):
@@ -271,9 +286,13 @@ def main():
     if not (shutil.which("sumo") and shutil.which("netconvert")):
         print("traffic_light_labels_check: SUMO is not installed; skipped")
         return 77
+    if not os.environ.get("DISPLAY") and not shutil.which("xvfb-run"):
+        print("traffic_light_labels_check: no DISPLAY and no xvfb-run for the one-camera render; skipped")
+        return 77
     with tempfile.TemporaryDirectory() as d:
-        out, traffic, plain = render(a.vista, d, a.frames)
-        return check_run(out, traffic, a.min_labels, a.min_states) | check_plain(plain)
+        out, camera, traffic, plain = render(a.vista, d, a.frames)
+        return (check_run(out, traffic, a.min_labels, a.min_states) |
+                check_run(camera, traffic, a.min_labels, a.min_states) | check_plain(plain))
 
 
 if __name__ == "__main__":

@@ -1,7 +1,9 @@
 // Traffic-light state labels (traffic_light_labels.h) from hand-made frame
 // boxes: only traffic-light instances with pixels get a line, in id order,
 // with the head's lamp from the caller, its visible extent, pixel count and
-// instance id; other kinds and an empty frame give no line.
+// instance id; other kinds and an empty frame give no line. The boxes of an
+// instance image are the extents and counts of its traffic-light ids,
+// counted here pixel by pixel.
 #include <gtest/gtest.h>
 
 #include <map>
@@ -48,6 +50,33 @@ TEST(TrafficLightLabels, OneLinePerVisibleHeadWithItsLamp) {
     EXPECT_EQ(lines[1], "17 red-amber 40 5 44 20 52 " + std::to_string(id17));
     EXPECT_EQ(text.back(), '\n');
     EXPECT_EQ(trafficLightLabels({boxes[0], boxes[4]}, [](uint32_t) { return std::string("green"); }), "");
+}
+
+TEST(TrafficLightLabels, BoxesOfAnInstanceImageAreItsTrafficLightPixels) {
+    const int w = 7, h = 5;
+    const uint32_t light3 = makeInstanceId(InstanceKind::TrafficLight, 3);
+    const uint32_t light1 = makeInstanceId(InstanceKind::TrafficLight, 1);
+    const uint32_t wall = makeInstanceId(InstanceKind::Building, 3);
+    std::vector<uint32_t> ids(size_t(w * h), wall);
+    ids[size_t(1 * w + 5)] = light3, ids[size_t(3 * w + 2)] = light3, ids[size_t(2 * w + 4)] = light3;
+    ids[size_t(4 * w + 0)] = light1;
+    const std::vector<FrameBox> boxes = trafficLightBoxes(ids, w, h);
+    ASSERT_EQ(boxes.size(), 2u);
+    EXPECT_EQ(boxes[0].id, light1);  // sorted by id
+    EXPECT_EQ(boxes[0].visibleU0, 0);
+    EXPECT_EQ(boxes[0].visibleU1, 0);
+    EXPECT_EQ(boxes[0].visibleV0, 4);
+    EXPECT_EQ(boxes[0].visibleV1, 4);
+    EXPECT_EQ(boxes[0].pixels, 1u);
+    EXPECT_EQ(boxes[1].id, light3);
+    EXPECT_EQ(boxes[1].visibleU0, 2);
+    EXPECT_EQ(boxes[1].visibleU1, 5);
+    EXPECT_EQ(boxes[1].visibleV0, 1);
+    EXPECT_EQ(boxes[1].visibleV1, 3);
+    EXPECT_EQ(boxes[1].pixels, 3u);
+    EXPECT_EQ(trafficLightLabels(boxes, [](uint32_t) { return std::string("off"); }),
+              "1 off 0 4 0 4 1 " + std::to_string(light1) + "\n3 off 2 1 5 3 3 " + std::to_string(light3) + "\n");
+    EXPECT_TRUE(trafficLightBoxes(std::vector<uint32_t>(size_t(w * h), wall), w, h).empty());
 }
 
 }  // namespace
