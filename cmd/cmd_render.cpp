@@ -39,6 +39,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
 #include <set>
@@ -84,6 +85,8 @@
 #include "runtime/scene/paged_load.h"
 #include "runtime/scene/paths.h"
 #include "runtime/engine/rig.h"
+#include "runtime/engine/traffic_light_labels.h"
+#include "runtime/traffic/signal_states.h"
 #include "runtime/scene/scene_graph.h"
 
 namespace vista {
@@ -94,6 +97,9 @@ namespace fs = std::filesystem;
 const char* const kCmd = "vista render";
 
 enum Channel : unsigned { kRgb = 1, kDepth = 2, kSemantic = 4, kInstance = 8 };
+// Not a channel one asks for: the traffic-light labels a run with --traffic
+// writes beside the instance channel (RenderPlan::written).
+constexpr unsigned kTrafficLights = 16;
 constexpr unsigned kLabelChannels = kDepth | kSemantic | kInstance;
 // The output folder of each channel, in output order.
 const std::pair<unsigned, const char*> kChannelDirs[] = {
@@ -214,6 +220,11 @@ struct RenderPlan {
     std::string outDir;                            // where this run publishes: --out, or the shard's directory
     std::shared_ptr<const TrafficTracks> traffic;  // --traffic (null: none)
     bool labels() const { return (channels & kLabelChannels) != 0; }
+    // The files each frame writes: the channels, and traffic_lights/ when
+    // the instance channel is written with traffic that recorded its lights.
+    unsigned written() const {
+        return channels | ((channels & kInstance) && traffic && traffic->signals ? kTrafficLights : 0u);
+    }
 };
 
 // The paged-city options: streaming only for a paged city and a mode that
@@ -340,10 +351,31 @@ Result<std::string> cityHash(const std::string& city, bool paged, uint64_t& byte
     return fileHash(paged ? (fs::path(city) / "manifest.json").string() : city, bytes);
 }
 
-// What decides the bytes besides the city and the path: every option that
-// changes a pixel (and the traffic's tracks). A merge compares it with the
-// shards' inputs without loading the city.
-nlohmann::json optionsManifest(const RenderArgs& a, const RenderPlan& p) {
+// The path without loading the city: the --path file's content hash, or the
+// flags that make the path on the city's streets. A merge compares it (with
+// the city's hash, --frames and --sampling) to the shards' inputs, so a shard
+// rendered along another path is refused.
+Result<std::string> pathInput(const RenderArgs& a) {
+    std::string path;
+    if (!a.path.file.empty()) {
+        uint64_t bytes = 0;
+        auto h = fileHash(a.path.file, bytes);
+        if (!h) return Status::error("--path: " + h.status().message());
+        path = "file " + *h;
+    } else {
+        const PathFlags& f = a.path;
+        path = "seed " + std::to_string(f.seed) + ", kind " + f.kind + ", route " + f.route + ", duration " +
+               manifestNumber(f.duration) + ", run-up " + manifestNumber(f.runUp) + (f.lht ? ", lht" : "");
+    }
+    return path;
+}
+
+// What decides the bytes, from the arguments alone: the city's content, the
+// path (pathInput) and the frames taken from it, every option that changes a pixel, the traffic's tracks
+// and lamps, and for a paged city the reach of a frame. The work directory's
+// manifest adds the frames' count and poses; a merge compares this with the
+// shards' inputs.
+Result<nlohmann::json> runInputs(const RenderArgs& a, const RenderPlan& p) {
     const ModeOptions& mo = p.options;
     nlohmann::json manifest = {{"size", std::to_string(p.size.width) + "x" + std::to_string(p.size.height)},
                                {"fov_deg", manifestNumber(p.fovDeg)},
@@ -358,26 +390,20 @@ nlohmann::json optionsManifest(const RenderArgs& a, const RenderPlan& p) {
                                {"frame_ms", manifestNumber(mo.frameMsTarget)},
                                {"far_step", mo.farStep}};
     if (p.traffic) {
-        // The agents' poses decide pixels: a resumed run must draw the same traffic.
-        manifest["traffic_hash"] = trafficHash(*p.traffic);
+        // The agents' poses and the heads' lamps decide pixels: a resumed run must draw the same traffic.
+        auto traffic = trafficHash(*p.traffic, a.modeFlags.traffic);
+        if (!traffic) return traffic.status();
+        manifest["traffic_hash"] = *traffic;
     }
-    return manifest;
-}
-
-// The work directory: new, or the one of an interrupted run with the same
-// parameters (the manifest: city bytes, camera poses, every option that
-// changes a pixel; a shard's K/N), with a folder per channel. `inputs`
-// receives the manifest without the shard (a shard's record carries it).
-Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, const std::vector<size_t>& idx,
-                   RenderWorkDir& out, nlohmann::json& inputs) {
     uint64_t cityBytes = 0;
     auto hash = cityHash(a.city, p.paged, cityBytes);
     if (!hash) return hash.status();
-    nlohmann::json manifest = optionsManifest(a, p);
     manifest["city_hash"] = *hash;
     manifest["city_bytes"] = cityBytes;
-    manifest["frames"] = idx.size();
-    manifest["camera_poses_hash"] = posesHash(path, idx);
+    auto path = pathInput(a);
+    if (!path) return path.status();
+    manifest["path"] = *path;
+    manifest["sampling"] = std::to_string(a.frames) + " frames, " + a.sampling;
     if (p.paged) {
         // What decides the regions a frame sees.
         const bool streamed = p.streamed;
@@ -388,11 +414,26 @@ Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, c
                              {"prefetch", manifestNumber(streamed ? p.stream.prefetchS : 0.0)},
                              {"budget_bytes", streamed ? p.stream.budgetBytes : 0}};
     }
+    return manifest;
+}
+
+// The work directory: new, or the one of an interrupted run with the same
+// parameters (the manifest: runInputs, the frames' count and camera poses; a
+// shard's K/N), with a folder per channel. `inputs` receives the manifest
+// without the shard (a shard's record carries it).
+Status openWorkDir(const RenderArgs& a, const RenderPlan& p, const Path& path, const std::vector<size_t>& idx,
+                   RenderWorkDir& out, nlohmann::json& inputs) {
+    auto run = runInputs(a, p);
+    if (!run) return run.status();
+    nlohmann::json manifest = std::move(*run);
+    manifest["frames"] = idx.size();
+    manifest["camera_poses_hash"] = posesHash(path, idx);
     inputs = manifest;
     if (p.shard) manifest["shard"] = shardText(*p.shard);
     VISTA_RETURN_IF_ERROR(out.open(manifest, a.restart));
     for (const auto& [bit, dir] : kChannelDirs)
         if (p.channels & bit) VISTA_RETURN_IF_ERROR(out.subdir(dir));
+    if (p.written() & kTrafficLights) VISTA_RETURN_IF_ERROR(out.subdir("traffic_lights"));
     return Status::ok();
 }
 
@@ -453,7 +494,8 @@ std::vector<std::string> frameFiles(unsigned channels, const std::string& name) 
     for (const auto& [bit, file] : {std::pair<unsigned, std::string>{kRgb, "rgb/" + name + ".png"},
                                     {kDepth, "depth/" + name + ".npy"},
                                     {kSemantic, "semantic/" + name + ".png"},
-                                    {kInstance, "instance/" + name + ".npy"}})
+                                    {kInstance, "instance/" + name + ".npy"},
+                                    {kTrafficLights, "traffic_lights/" + name + ".txt"}})
         if (channels & bit) files.push_back(file);
     return files;
 }
@@ -524,6 +566,16 @@ Status writeFrameFiles(unsigned channels, const std::string& name, const FrameBu
     return Status::ok();
 }
 
+// The frame's traffic-light labels (traffic_light_labels.h) from its
+// instance image: each head's lamp at the frame's time `t`.
+Status writeTrafficLights(const RenderPlan& p, const std::string& name, const LabelImage& gt, double t,
+                          const RenderWorkDir& out) {
+    const SignalStates& lamps = *p.traffic->signals;
+    auto lamp = [&](uint32_t head) { return std::string(lampStateName(lamps.lampAt(head, t))); };
+    return writeFileAtomic(out.file("traffic_lights/" + name + ".txt"),
+                           trafficLightLabels(trafficLightBoxes(gt.ids, gt.width, gt.height), lamp));
+}
+
 // Renders every frame still missing (and hybrid's warm-up frames), writes
 // its files and record; `frames` receives every frame's camera entry of
 // cameras.json.
@@ -569,8 +621,9 @@ Status renderFrames(const RenderArgs& a, const RenderPlan& p, const Walkthrough&
         tm.rgb.push_back(st.frameMs);
         if (p.labels()) VISTA_RETURN_IF_ERROR(frameLabels(cam, p.options.threads, s, b, tm));
         VISTA_RETURN_IF_ERROR(writeFrameFiles(p.channels, frameName(f), b, out, tm));
+        if (p.written() & kTrafficLights) VISTA_RETURN_IF_ERROR(writeTrafficLights(p, frameName(f), b.gt, ps.t, out));
         done.records[f] = Timings::record(tm);
-        VISTA_RETURN_IF_ERROR(out.finishFrame(f, done.records[f], frameFiles(p.channels, frameName(f))));
+        VISTA_RETURN_IF_ERROR(out.finishFrame(f, done.records[f], frameFiles(p.written(), frameName(f))));
         if (killAfter > 0 && ++finishedNow == killAfter) std::raise(SIGKILL);
         if (progress) progress->update(double(f + 1) / double(idx.size()));
     }
@@ -704,7 +757,7 @@ int run(const RenderArgs& a, const std::string& command) {
     RenderSession session;
     if (Status s = setUp(a.mode, plan, *walk, session); !s) return reportBadInput(kCmd, s);
     const ShardRange range = plan.shard ? shardRange(idx.size(), *plan.shard) : ShardRange{0, idx.size()};
-    Progressed done = finishedFrames(out, plan.channels, idx.size(), range);
+    Progressed done = finishedFrames(out, plan.written(), idx.size(), range);
     nlohmann::json frames = nlohmann::json::array();
     if (Status s = renderFrames(a, plan, *walk, idx, range, session, out, done, frames); !s)
         return reportBadInput(kCmd, s);
@@ -727,7 +780,34 @@ int run(const RenderArgs& a, const std::string& command) {
     return 0;
 }
 
-// "key: A in shard 1/4, B in shard 3/4": the first field where two shards' inputs differ, "" if none.
+// The option (or argument) that sets an input of runInputs, for messages.
+std::string inputOption(const std::string& key) {
+    static const std::map<std::string, std::string> options = {{"size", "--size"},
+                                                               {"fov_deg", "--fov"},
+                                                               {"mode", "--mode"},
+                                                               {"channels", "--channels"},
+                                                               {"near", "--near"},
+                                                               {"triangle_budget", "--triangle-budget"},
+                                                               {"pixel_budget", "--budget"},
+                                                               {"horizon_grid", "--horizon-grid"},
+                                                               {"cache", "--no-cache"},
+                                                               {"cache_error_px", "--cache-error"},
+                                                               {"frame_ms", "--frame-ms"},
+                                                               {"far_step", "--far-step"},
+                                                               {"traffic_hash", "--traffic"},
+                                                               {"city_hash", "the city file"},
+                                                               {"city_bytes", "the city file"},
+                                                               {"path", "--path"},
+                                                               {"camera_poses_hash", "--path"},
+                                                               {"frames", "--frames"},
+                                                               {"sampling", "--frames, --sampling"},
+                                                               {"paged", "--paged-*"}};
+    auto it = options.find(key);
+    return it == options.end() ? "" : " (" + it->second + ")";
+}
+
+// "key (--option): A in shard 1/4, B in shard 3/4": the first field where two
+// shards' inputs differ, "" if none.
 std::string inputsDifference(const nlohmann::json& a, const std::string& aName, const nlohmann::json& b,
                              const std::string& bName) {
     if (!a.is_object() || !b.is_object()) return "inputs: not an object";
@@ -737,7 +817,7 @@ std::string inputsDifference(const nlohmann::json& a, const std::string& aName, 
     for (const auto* o : {&a, &b})
         for (const auto& [key, value] : o->items())
             if (!a.contains(key) || !b.contains(key) || a[key] != b[key])
-                return key + ": " + shown(a, key) + " " + aName + ", " + shown(b, key) + " " + bName;
+                return key + inputOption(key) + ": " + shown(a, key) + " " + aName + ", " + shown(b, key) + " " + bName;
     return "";
 }
 
@@ -750,13 +830,10 @@ int runMerge(const RenderArgs& a, int count, const std::string& command, const s
     if (Status s = configure(a, plan); !s) return reportBadInput(kCmd, s);
     RenderWorkDir out;
     if (Status s = out.checkOut(a.out); !s) return reportBadInput(kCmd, s);
-    uint64_t cityBytes = 0;
-    auto hash = cityHash(a.city, plan.paged, cityBytes);
-    if (!hash) return reportBadInput(kCmd, hash.status());
-    nlohmann::json expect = optionsManifest(a, plan);
-    expect["city_hash"] = *hash;
-    expect["city_bytes"] = cityBytes;
-    nlohmann::json first;  // the first good shard's inputs: frames, poses and the paged reach agree with it
+    auto inputs = runInputs(a, plan);
+    if (!inputs) return reportBadInput(kCmd, inputs.status());
+    const nlohmann::json& expect = *inputs;
+    nlohmann::json first;  // the first good shard's inputs: its frames and poses agree with it
     std::string firstName;
     auto differ = [&](const Shard& s, const nlohmann::json& r) -> std::string {
         const nlohmann::json& in = r["inputs"];
@@ -1050,7 +1127,8 @@ int runRender(int argc, char** argv) {
                    "drives, with --dataset) into OUT.shards/K-of-N (resumable); then --merge --shards N writes OUT");
     app.add_flag("--merge", a.merge,
                  "with --shards N and the shards' other arguments: check every shard in OUT.shards (present, intact, "
-                 "same inputs) and write OUT, the bytes of one unsharded run (summary.json aside)");
+                 "same inputs: city, path, frames, options, traffic; a difference is named with its option) and "
+                 "write OUT, the bytes of one unsharded run (summary.json aside)");
     addNumberOption(app, "--shards", a.shards, 1, kMaxShards,
                     "with --merge: N, 1 .. 100000, the shard count of the shards' --shard K/N; a merge that finds a "
                     "shard missing, damaged or of other inputs names it and the command that runs it again");

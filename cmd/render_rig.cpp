@@ -37,6 +37,8 @@
 #include "runtime/engine/rig_boxes.h"
 #include "runtime/engine/rig_camera.h"
 #include "runtime/engine/rig_dataset.h"
+#include "runtime/engine/traffic_light_labels.h"
+#include "runtime/traffic/signal_states.h"
 
 namespace vista {
 
@@ -116,7 +118,14 @@ struct RigPlan {
             if (c.channels & kRigBoxes) return true;
         return false;
     }
+    // Camera k writes traffic-light state labels (traffic_lights_NN/): it
+    // asks for boxes and the traffic recorded its lights' states.
+    bool labelsLights(size_t k) const { return (rig.cameras[k].channels & kRigBoxes) && traffic && traffic->signals; }
 };
+
+// Camera k's traffic-light labels folder, and its file of frame `name`.
+std::string lightsDir(size_t k) { return "traffic_lights_" + twoDigits(k); }
+std::string lightsFile(size_t k, const std::string& name) { return lightsDir(k) + "/" + name + ".txt"; }
 
 Status configure(const RigRunRequest& a, RigPlan& p) {
     if (a.frames < 1 || a.frames > 1000000)
@@ -169,11 +178,17 @@ Status openWorkDir(const RigRunRequest& a, const RigPlan& p, const Path& path, R
                                {"frames", p.idx.size()},
                                {"camera_poses_hash", posesHash(path, p.idx)},
                                {"rig_hash", rigHash(p.rig)}};
-    if (p.traffic) manifest["traffic_hash"] = trafficHash(*p.traffic);  // the agents decide pixels and points
+    if (p.traffic) {  // the agents decide pixels and points, the lamps the traffic-light labels
+        auto traffic = trafficHash(*p.traffic, a.modeFlags.traffic);
+        if (!traffic) return traffic.status();
+        manifest["traffic_hash"] = *traffic;
+    }
     VISTA_RETURN_IF_ERROR(out.open(manifest, a.restart));
-    for (size_t k = 0; k < p.rig.cameras.size(); ++k)
+    for (size_t k = 0; k < p.rig.cameras.size(); ++k) {
         for (const std::string& f : cameraFiles(p.rig.cameras[k], k, "x"))
             VISTA_RETURN_IF_ERROR(out.subdir(fs::path(f).parent_path().string()));
+        if (p.labelsLights(k)) VISTA_RETURN_IF_ERROR(out.subdir(lightsDir(k)));
+    }
     for (size_t j = 0; j < p.rig.lidars.size(); ++j)
         for (const std::string& f : lidarFiles(j, "x"))
             VISTA_RETURN_IF_ERROR(out.subdir(fs::path(f).parent_path().string()));
@@ -190,8 +205,10 @@ std::vector<std::string> frameFiles(const RigPlan& p, size_t f) {
     std::vector<std::string> files;
     const std::string name = frameName(f);
     for (size_t k = 0; k < p.rig.cameras.size(); ++k)
-        if (p.camFire[k][f])
+        if (p.camFire[k][f]) {
             for (auto& s : cameraFiles(p.rig.cameras[k], k, name)) files.push_back(s);
+            if (p.labelsLights(k)) files.push_back(lightsFile(k, name));
+        }
     for (size_t j = 0; j < p.rig.lidars.size(); ++j)
         if (p.lidarFire[j][f])
             for (auto& s : lidarFiles(j, name)) files.push_back(s);
@@ -225,6 +242,7 @@ struct FrameBoxState {
     const CityBoxes* city = nullptr;   // null: no camera asks for boxes
     std::vector<MovingObject> movers;  // the traffic's agents at the frame's time (sorted by id)
     FrameSightings seen;
+    double t = 0;  // the frame's time: the traffic lights' lamps
 };
 
 // Camera k's 2D boxes from its instance image: boxes_NN/ and, for a pinhole, KITTI lines in label_NN/.
@@ -241,6 +259,11 @@ Status writeCameraBoxes(const RigPlan& p, const Walkthrough& w, size_t k, const 
     const glm::dvec3 offset(w.city.params.origin_x, w.city.params.origin_y, 0.0);
     VISTA_RETURN_IF_ERROR(
         writeFileAtomic(out.file(d.boxes + "/" + name + ".json"), frameBoxesJson(fb, cam, offset, c.name)));
+    if (p.labelsLights(k)) {
+        const SignalStates& lamps = *p.traffic->signals;
+        auto lamp = [&](uint32_t head) { return std::string(lampStateName(lamps.lampAt(head, boxes.t))); };
+        VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(lightsFile(k, name)), trafficLightLabels(fb, lamp)));
+    }
     if (c.model.fisheye()) return Status::ok();
     return writeFileAtomic(out.file(d.labels + "/" + name + ".txt"),
                            kittiRigLabels(fb, sensorPose(vehicle, kittiRectifiedMount(p.rig))));
@@ -289,6 +312,7 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
     nlohmann::json ms = nlohmann::json::object(), lidar = nlohmann::json::object();
     FrameBoxState boxes;
     boxes.city = cityBoxes;
+    boxes.t = p.times[f];
     if (p.agents && cityBoxes)
         boxes.movers = agentObjects(p.agents->tracks(), p.agents->models(), w.city.params, p.times[f]);
     std::vector<ObjectMotion> motions;
@@ -404,6 +428,7 @@ nlohmann::json rigManifest(const RigPlan& p, const Walkthrough& w) {
                            {"channels", rigChannelList(c.channels)},
                            {"sensor_to_vehicle",
                             matrixJson(poseToWorld({c.mount.position, mountRotation(c.mount)}, glm::dvec3(0.0)))}});
+        if (p.labelsLights(k)) sensors.back()["dirs"]["traffic_lights"] = lightsDir(k);
     }
     for (size_t j = 0; j < p.rig.lidars.size(); ++j) {
         const LidarDirs d = lidarDirs(j);

@@ -47,7 +47,7 @@ Result<nlohmann::json> readShardRecord(const std::string& dir, const Shard& shar
 
 // Reads the records of shards 1 .. N of OUT. `inputsDiffer(shard, record)`
 // returns "" when the shard's inputs are those the merge expects, else the
-// first difference ("city_hash: a in the shard, b now"). Any bad shard makes
+// first difference ("size (--size): 96x72 in the shard, 80x60 now"). Any bad shard makes
 // the whole read an error (see the header comment); `rerun` is the command
 // that runs one shard, without its K/N ("vista render ... --out OUT --shard").
 Result<std::vector<nlohmann::json>> readShards(

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <vector>
 
 #include "citygen/labels.h"
@@ -75,16 +76,20 @@ Result<std::string> fileHash(const std::string& path, uint64_t& bytes) {
     return hex64(h.finish());
 }
 
-// Hash of the frames' camera poses (path index, time, eye, heading, pitch):
-// whatever chose them (--path file, --seed/--kind/--duration/--run-up,
-// --frames, --sampling), equal poses give equal frames.
-std::string trafficHash(const TrafficTracks& t) {
+Result<std::string> trafficHash(const TrafficTracks& t, const std::string& trafficDir) {
     uint64_t h = hashBytes64(t.poses.data(), t.poses.size() * sizeof(AgentPose));
     h = hashBytes64(t.times.data(), t.times.size() * sizeof(double), h);
     h = hashBytes64(t.agentTypes.data(), t.agentTypes.size() * sizeof(AgentType), h);
-    return hex64(h);
+    if (!t.signals) return hex64(h);
+    uint64_t bytes = 0;
+    auto signals = fileHash((std::filesystem::path(trafficDir) / "signals.xml").string(), bytes);
+    if (!signals) return Status::error("--traffic = '" + trafficDir + "': " + signals.status().message());
+    return hex64(hashBytes64(signals->data(), signals->size(), h));
 }
 
+// Hash of the frames' camera poses (path index, time, eye, heading, pitch):
+// whatever chose them (--path file, --seed/--kind/--duration/--run-up,
+// --frames, --sampling), equal poses give equal frames.
 std::string posesHash(const Path& path, const std::vector<size_t>& idx) {
     Hasher64 h;
     auto put = [&](uint64_t v) {

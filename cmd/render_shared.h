@@ -34,9 +34,11 @@ Result<std::string> fileHash(const std::string& path, uint64_t& bytes);
 // Hash of the frames' poses (path index, time, eye, heading, pitch):
 // whatever chose them, equal poses give equal frames.
 std::string posesHash(const Path& path, const std::vector<size_t>& idx);
-// A hash of a traffic run's tracks (times, types, poses): a resumed run with
-// --traffic must draw the same agents (the work directory's manifest).
-std::string trafficHash(const TrafficTracks& tracks);
+// A hash of a traffic run's tracks (times, types, poses) and, when the
+// tracks carry signal states, of `trafficDir`/signals.xml's bytes: a resumed
+// run or a merged shard with --traffic must draw the same agents and lamps
+// (and write the same traffic-light labels).
+Result<std::string> trafficHash(const TrafficTracks& tracks, const std::string& trafficDir);
 // A double as the manifest writes it (17 significant digits).
 std::string manifestNumber(double v);
 // Test hook (docs/formats.md): VISTA_RENDER_KILL_AFTER_FRAMES=N makes the run

@@ -5,7 +5,8 @@
 // carries state from frame to frame) merge to the bytes of one run; a shard
 // killed mid-way and run again gives the same bytes; the merge refuses a
 // missing, damaged, corrupt or mismatched shard naming it and the command
-// that runs it, writing nothing; a bad manifest exits 2 naming the field and
+// that runs it, writing nothing (a shard of another --path, or a merge given
+// another path than its shards, names --path); a bad manifest exits 2 naming the field and
 // leaves nothing behind. summary.json (timings, the command) is the one file
 // compared by its fields only. Rendering: needs DISPLAY (ctest runs under xvfb-run).
 #include <gtest/gtest.h>
@@ -204,11 +205,11 @@ TEST_F(RenderShards, TheMergeRefusesABadShardNamingIt) {
     refused("shard 2/3: shard.json is corrupt");
     std::ofstream(record, std::ios::binary | std::ios::trunc) << recordBytes;
     // Other inputs: the merge's arguments differ from the shards' (a field named with both values).
-    refused("from other inputs: size: 96x72 in the shard, 80x60 now", "80x60");
+    refused("from other inputs: size (--size): 96x72 in the shard, 80x60 now", "80x60");
     // A shard rendered with other arguments than its siblings.
     fs::remove_all(sh + ".shards/3-of-3");
     ASSERT_EQ(runVista(hybrid(sh, "96x72", "60") + " --shard 3/3").code, 0);
-    refused("shard 3/3: from other inputs: near: 60 in the shard, 40 now");
+    refused("shard 3/3: from other inputs: near (--near): 60 in the shard, 40 now");
     // A damaged shard run again renders itself again; then the merge succeeds.
     std::ofstream(png, std::ios::binary | std::ios::trunc) << changed;
     ASSERT_EQ(runVista(hybrid(sh) + " --shard 2/3").code, 0);
@@ -216,6 +217,53 @@ TEST_F(RenderShards, TheMergeRefusesABadShardNamingIt) {
     const auto r = runVista(hybrid(sh) + " --merge --shards 3");
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_EQ(test::readBytes(sh + "/rgb/000001.png"), bytes);
+}
+
+TEST_F(RenderShards, TheMergeRefusesShardsOfAnotherPath) {
+    const std::string q = dir->file("q.csv");
+    ASSERT_EQ(runVista("path " + dir->file("a.osgb") + " --seed 3 --duration 3 -o " + q).code, 0);
+    const std::string sh = dir->file("path_sh");
+    auto render = [&](const std::string& path) {
+        return "render " + dir->file("a.osgb") + " --path " + path +
+               " --frames 4 --sampling consecutive --size 48x36 --channels rgb -q --out " + sh;
+    };
+    auto refused = [&](const std::string& path, const std::string& expected) {
+        const auto r = runVista(render(path) + " --merge --shards 2");
+        EXPECT_EQ(r.code, 2) << r.err;
+        EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+        EXPECT_FALSE(fs::exists(sh)) << "a refused merge writes nothing";
+        EXPECT_FALSE(fs::exists(sh + ".partial"));
+    };
+    // Shard 2 rendered along another path than shard 1 and the merge.
+    ASSERT_EQ(runVista(render(dir->file("p.csv")) + " --shard 1/2").code, 0);
+    ASSERT_EQ(runVista(render(q) + " --shard 2/2").code, 0);
+    refused(dir->file("p.csv"), "shard 2/2: from other inputs: path (--path): file ");
+    // Both shards along p.csv, the merge given q.csv: every shard is refused, naming --path.
+    ASSERT_EQ(runVista(render(dir->file("p.csv")) + " --shard 2/2 --restart").code, 0);
+    refused(q, "shard 1/2: from other inputs: path (--path): file ");
+    refused(q, "shard 2/2: from other inputs: path (--path): file ");
+    // A path made from flags: its seed is the differing input.
+    const std::string seeded = dir->file("a.osgb") + " --seed 2 --duration 3 --frames 4 --sampling consecutive";
+    fs::remove_all(sh + ".shards");
+    ASSERT_EQ(runVista("render " + seeded + " --size 48x36 --channels rgb -q --out " + sh + " --shard 1/1").code, 0);
+    auto r = runVista("render " + dir->file("a.osgb") + " --seed 5 --duration 3 --frames 4 --sampling consecutive" +
+                      " --size 48x36 --channels rgb -q --out " + sh + " --merge --shards 1");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("path (--path): seed 2, kind car"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(sh));
+    // Other frames of the same path: --frames is the differing input.
+    r = runVista("render " + dir->file("a.osgb") + " --seed 2 --duration 3 --frames 3 --sampling consecutive" +
+                 " --size 48x36 --channels rgb -q --out " + sh + " --merge --shards 1");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(
+        r.err.find("sampling (--frames, --sampling): 4 frames, consecutive in the shard, 3 frames, consecutive now"),
+        std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(sh));
+    // The same arguments merge.
+    EXPECT_EQ(runVista("render " + seeded + " --size 48x36 --channels rgb -q --out " + sh + " --merge --shards 1").code,
+              0);
+    EXPECT_TRUE(fs::exists(sh + "/rgb/000003.png"));
 }
 
 TEST_F(RenderShards, BadDatasetsAndFlagsExitTwoNamingTheField) {

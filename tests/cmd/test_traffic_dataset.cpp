@@ -9,7 +9,9 @@
 // agent by one track id whose tracks.json entry is its SUMO id, and a
 // resumed run writes them byte for byte as an uninterrupted one; every LiDAR
 // point on an agent lies on that agent's box where the agent is at the
-// point's firing time (a slow 2 Hz LiDAR: agents move far during a sweep).
+// point's firing time (a slow 2 Hz LiDAR: agents move far during a sweep);
+// the traffic-light labels resume byte for byte, and a resume with other
+// lamps (signals.xml) is refused.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -245,6 +247,38 @@ TEST_F(TrafficDataset, ResumedRunWritesTheSameTrackingFiles) {
     for (const std::string rel : {"tracking/label_00/0000.txt", "tracking/label_01/0000.txt", "tracking/tracks.json"})
         EXPECT_EQ(readBytes(out + "/" + rel), readBytes(f.out + "/" + rel)) << rel;
     EXPECT_FALSE(readBytes(out + "/tracking/label_00/0000.txt").empty());
+    // The traffic-light labels of every frame and camera, too.
+    for (const std::string nn : {"00", "01"})
+        for (int fr = 0; fr < kFrames; ++fr) {
+            char name[40];
+            std::snprintf(name, sizeof name, "traffic_lights_%s/%06d.txt", nn.c_str(), fr);
+            ASSERT_TRUE(fs::exists(out + "/" + name)) << name;
+            EXPECT_EQ(readBytes(out + "/" + name), readBytes(f.out + "/" + name)) << name;
+        }
+}
+
+// The lamps decide the traffic-light labels: a run resumed with a traffic
+// directory whose signals.xml changed is refused, naming traffic_hash.
+TEST_F(TrafficDataset, AResumeWithOtherLampsIsRefused) {
+    const auto& f = fixture();
+    TempDir tmp("vista_traffic_dataset_lamps");
+    const std::string traffic = tmp.file("traffic"), out = tmp.file("rig");
+    fs::copy(f.traffic, traffic, fs::copy_options::recursive);
+    const std::string args = "render " + f.city + " --path " + f.path + " --rig " + f.rig + " --traffic " + traffic +
+                             " --frames " + std::to_string(kFrames) + " --sampling consecutive -q --out " + out;
+    auto r = runVista(args, "VISTA_RENDER_KILL_AFTER_FRAMES=3");
+    ASSERT_NE(r.code, 0) << "the run kills itself after 3 frames";
+    // One link of the first recorded state switched between green and red.
+    std::string signals = readBytes(traffic + "/signals.xml");
+    const size_t at = signals.find("state=\"");
+    ASSERT_NE(at, std::string::npos);
+    char& letter = signals[at + 7];
+    letter = letter == 'G' ? 'r' : 'G';
+    std::ofstream(traffic + "/signals.xml", std::ios::binary | std::ios::trunc) << signals;
+    r = runVista(args);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("traffic_hash"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
 }
 
 // tracking/label_NN/0000.txt: KITTI tracking lines (17 columns, integer
