@@ -274,8 +274,9 @@ Status writeLidar(const LidarSweep& s, size_t j, const std::string& name, const 
     return writeFileAtomic(out.file(files[4]), lidarInstanceBytes(s));
 }
 
-// One rig frame: every sensor that fires, cast and written (each timed,
-// cast, boxes and write together, into the record), then the frame's 3D boxes.
+// One rig frame: every sensor that fires, cast and written (each stage timed
+// into the record: cast, write, boxes), then the frame's 3D boxes. Runs in
+// the caller's task arena; its casts, boxes and writing tasks share it.
 Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_t f, const RenderWorkDir& out,
                    const CityBoxes* cityBoxes, const std::vector<CameraRayTable>& pixelRays,
                    std::vector<CameraImages>& ims, nlohmann::json& record) {
