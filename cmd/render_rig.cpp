@@ -10,11 +10,13 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <numeric>
 #include <vector>
 
 #include <nlohmann/json.hpp>
+#include <tbb/task_group.h>
 
 #include "cmd/cli.h"
 #include "cmd/render_shared.h"
@@ -30,6 +32,7 @@
 #include "nodes/render/traffic_scene.h"
 #include "nodes/render/walkthrough.h"
 #include "runtime/engine/boxes.h"
+#include "runtime/engine/far_field_stages.h"
 #include "runtime/engine/ground_truth.h"
 #include "runtime/engine/lidar.h"
 #include "runtime/engine/ray_scene.h"
@@ -245,16 +248,16 @@ struct FrameBoxState {
     double t = 0;  // the frame's time: the traffic lights' lamps
 };
 
-// Camera k's 2D boxes from its instance image: boxes_NN/ and, for a pinhole, KITTI lines in label_NN/.
+// Camera k's 2D boxes from its instance image (into `fb`): boxes_NN/ and, for a pinhole, KITTI lines in label_NN/.
 Status writeCameraBoxes(const RigPlan& p, const Walkthrough& w, size_t k, const RigPose& vehicle, const RigPose& pose,
-                        const std::string& name, const CameraImages& im, const RenderWorkDir& out,
-                        FrameBoxState& boxes) {
+                        const std::string& name, const CameraImages& im, const CameraRayTable& rays,
+                        const RenderWorkDir& out, const FrameBoxState& boxes, std::vector<FrameBox>& fb) {
     const RigCamera& c = p.rig.cameras[k];
     const BoxCamera cam = rigBoxCamera(c.model, pose);
     FrameBoxOptions o;
-    o.threads = p.options.threads;
-    const std::vector<FrameBox> fb = frameBoxes(w.city, *boxes.city, boxes.movers, cam, im.ids, o);
-    addCameraSightings(boxes.seen, c.name, fb);
+    o.threads = 0;  // the frame's arena (renderFrames)
+    o.rays = &rays;
+    fb = frameBoxes(w.city, *boxes.city, boxes.movers, cam, im.ids, o);
     const CameraDirs d = cameraDirs(k);
     const glm::dvec3 offset(w.city.params.origin_x, w.city.params.origin_y, 0.0);
     VISTA_RETURN_IF_ERROR(
@@ -294,10 +297,12 @@ Status writeLidar(const LidarSweep& s, size_t j, const std::string& name, const 
     return writeFileAtomic(out.file(files[4]), lidarInstanceBytes(s));
 }
 
-// One rig frame: every sensor that fires, cast and written (each timed,
-// cast, boxes and write together, into the record), then the frame's 3D boxes.
+// One rig frame: every sensor that fires, cast and written (each stage timed
+// into the record: cast, write, boxes), then the frame's 3D boxes. Runs in
+// the caller's task arena; its casts, boxes and writing tasks share it.
 Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_t f, const RenderWorkDir& out,
-                   const CityBoxes* cityBoxes, CameraImages& im, nlohmann::json& record) {
+                   const CityBoxes* cityBoxes, const std::vector<CameraRayTable>& pixelRays,
+                   std::vector<CameraImages>& ims, nlohmann::json& record) {
     const Path& path = w.path;
     const RigPose vehicle = vehiclePose(path.samples[p.idx[f]]);
     // Ray origins near the scene's frame origin: float precision anywhere in the city.
@@ -308,24 +313,35 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
         VISTA_RETURN_IF_ERROR(p.agents->setSplit(0.0));
     }
     const std::string name = frameName(f);
-    const int threads = p.options.threads;
-    nlohmann::json ms = nlohmann::json::object(), lidar = nlohmann::json::object();
+    const int threads = 0;  // the caller's arena: renderFrames runs each frame in one of --threads workers
     FrameBoxState boxes;
     boxes.city = cityBoxes;
     boxes.t = p.times[f];
     if (p.agents && cityBoxes)
         boxes.movers = agentObjects(p.agents->tracks(), p.agents->models(), w.city.params, p.times[f]);
     std::vector<ObjectMotion> motions;
+    // A sensor's files (and a camera's boxes) are written by a task while the next sensor casts: the
+    // task reads only that sensor's images or sweep and the frame's boxes, never the ray scene (which
+    // the casts, and a LiDAR's moving agents, change). Sightings join in sensor order after the wait.
+    struct Firing {
+        bool fired = false;
+        double castMs = 0, writeMs = 0, boxesMs = 0;
+        Status status;
+        std::vector<FrameBox> boxes;
+    };
+    std::vector<Firing> cams(p.rig.cameras.size()), lidars(p.rig.lidars.size());
+    std::vector<LidarSweep> sweeps(p.rig.lidars.size());
+    tbb::task_group writers;
     Stopwatch frame;
     for (size_t k = 0; k < p.rig.cameras.size(); ++k) {
         if (!p.camFire[k][f]) continue;
-        Stopwatch sw;
         const RigCamera& c = p.rig.cameras[k];
         CameraShot shot;
         shot.model = c.model;
         shot.pose = sensorPose(vehicle, c.mount);
         shot.channels = c.channels;
         shot.fx = &p.options.effects;
+        shot.rays = &pixelRays[k];
         if (c.channels & kRigFlow) {
             const double next = nextShotTime(p, path, k, f);
             shot.next = sensorPose(vehiclePoseAt(path, next), c.mount);
@@ -335,15 +351,22 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
                 shot.motions = &motions;
             }
         }
-        castRigCamera(w.city, rays, shot, im, threads);
-        VISTA_RETURN_IF_ERROR(writeCamera(c, k, name, im, out));
-        if (c.channels & kRigBoxes)
-            VISTA_RETURN_IF_ERROR(writeCameraBoxes(p, w, k, vehicle, shot.pose, name, im, out, boxes));
-        ms[c.name] = sw.ms();
+        Stopwatch cast;
+        castRigCamera(w.city, rays, shot, ims[k], threads);
+        cams[k].fired = true;
+        cams[k].castMs = cast.ms();
+        writers.run([&, k, pose = shot.pose] {
+            Firing& o = cams[k];
+            Stopwatch stage;
+            o.status = writeCamera(p.rig.cameras[k], k, name, ims[k], out);
+            o.writeMs = stage.lap();
+            if (o.status && (p.rig.cameras[k].channels & kRigBoxes))
+                o.status = writeCameraBoxes(p, w, k, vehicle, pose, name, ims[k], pixelRays[k], out, boxes, o.boxes);
+            o.boxesMs = stage.lap();
+        });
     }
     for (size_t j = 0; j < p.rig.lidars.size(); ++j) {
         if (!p.lidarFire[j][f]) continue;
-        Stopwatch sw;
         const RigLidar& l = p.rig.lidars[j];
         const LidarPoseAt poseAt = [&](double t) { return lidarPoseOf(sensorPose(vehiclePoseAt(path, t), l.mount)); };
         // The agents move during the sweep: each column sees them where they are when it fires.
@@ -353,21 +376,55 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
                 VISTA_RETURN_IF_ERROR(p.agents->setFrame(t, vehiclePoseAt(path, t).position));
                 return p.agents->setSplit(0.0);
             };
-        auto cast = castLidarSweep(w.city, rays, l.spec, poseAt, p.times[f], movers, threads);
-        if (!cast) return cast.status();
-        const LidarSweep& sweep = *cast;
-        VISTA_RETURN_IF_ERROR(writeLidar(sweep, j, name, out));
-        if (boxes.city) addLidarSightings(boxes.seen, l.name, sweep, *boxes.city, boxes.movers);
-        ms[l.name] = sw.ms();
-        lidar[l.name] = {{"points", sweep.points.size()}, {"misses", sweep.misses}};
+        Stopwatch cast;
+        auto sweep = castLidarSweep(w.city, rays, l.spec, poseAt, p.times[f], movers, threads);
+        if (!sweep) {
+            writers.wait();
+            return sweep.status();
+        }
+        sweeps[j] = std::move(*sweep);
+        lidars[j].fired = true;
+        lidars[j].castMs = cast.ms();
+        writers.run([&, j] {
+            Stopwatch stage;
+            lidars[j].status = writeLidar(sweeps[j], j, name, out);
+            lidars[j].writeMs = stage.ms();
+        });
     }
+    writers.wait();
+    nlohmann::json ms = nlohmann::json::object(), stages = nlohmann::json::object(), lidar = nlohmann::json::object();
+    for (size_t k = 0; k < cams.size(); ++k) {
+        if (!cams[k].fired) continue;
+        VISTA_RETURN_IF_ERROR(cams[k].status);
+        const std::string& sensor = p.rig.cameras[k].name;
+        addCameraSightings(boxes.seen, sensor, cams[k].boxes);
+        ms[sensor] = cams[k].castMs + cams[k].writeMs + cams[k].boxesMs;
+        stages[sensor] = {{"cast", cams[k].castMs}, {"write", cams[k].writeMs}, {"boxes", cams[k].boxesMs}};
+    }
+    for (size_t j = 0; j < lidars.size(); ++j) {
+        if (!lidars[j].fired) continue;
+        VISTA_RETURN_IF_ERROR(lidars[j].status);
+        const RigLidar& l = p.rig.lidars[j];
+        Stopwatch stage;
+        if (boxes.city) addLidarSightings(boxes.seen, l.name, sweeps[j], *boxes.city, boxes.movers);
+        lidars[j].boxesMs = stage.ms();
+        ms[l.name] = lidars[j].castMs + lidars[j].writeMs + lidars[j].boxesMs;
+        stages[l.name] = {{"cast", lidars[j].castMs}, {"write", lidars[j].writeMs}, {"boxes", lidars[j].boxesMs}};
+        lidar[l.name] = {{"points", sweeps[j].points.size()}, {"misses", sweeps[j].misses}};
+    }
+    Stopwatch boxes3d;
     if (boxes.city) {
         const glm::dvec3 offset(w.city.params.origin_x, w.city.params.origin_y, 0.0);
         VISTA_RETURN_IF_ERROR(writeFileAtomic(
             out.file(std::string(kBoxes3dDir) + "/" + name + ".json"),
             frameBoxes3dJson(*boxes.city, boxes.seen, vehicle, offset, name, p.times[f], boxes.movers)));
     }
-    record = {{"frame_ms", frame.ms()}, {"sensor_ms", ms}, {"lidar", lidar}};
+    record = {{"frame_ms", frame.ms()},
+              {"sensor_ms", ms},
+              {"stage_ms", stages},
+              {"boxes_3d_ms", boxes3d.ms()},
+              {"sensors_fired", ms.size()},
+              {"lidar", lidar}};
     return Status::ok();
 }
 
@@ -378,6 +435,10 @@ Status renderFrames(const RigRunRequest& a, const RigPlan& p, const Walkthrough&
     const bool anyLeft =
         std::any_of(records.begin(), records.end(), [](const nlohmann::json& r) { return r.is_null(); });
     if (p.hasBoxes() && anyLeft) cityBoxes = buildCityBoxes(w.city, p.options.threads);
+    // Every camera's pixel rays once per run: its casts and its fisheye masks read them.
+    std::vector<CameraRayTable> pixelRays;
+    if (anyLeft)
+        for (const RigCamera& c : p.rig.cameras) pixelRays.emplace_back(c.model, p.options.threads);
     std::unique_ptr<Progress> progress;
     if (!a.quiet) progress = std::make_unique<StderrProgress>(isatty(2));
     const long killAfter = killAfterFrames();
@@ -387,11 +448,15 @@ Status renderFrames(const RigRunRequest& a, const RigPlan& p, const Walkthrough&
         progress->begin("render " + std::to_string(n) + " rig frames (" +
                         std::to_string(p.rig.cameras.size() + p.rig.lidars.size()) + " sensors)" +
                         (kept ? ", resuming: " + std::to_string(kept) + " done" : std::string()));
-    CameraImages im;
+    std::vector<CameraImages> ims(p.rig.cameras.size());  // one per camera: a camera's files are written while the next casts
     for (size_t f = 0; f < n; ++f) {
         if (!records[f].is_null()) continue;
-        if (Status s = renderFrame(p, w, rays, f, out, p.hasBoxes() ? &cityBoxes : nullptr, im, records[f]); !s)
-            return Status::error("frame " + std::to_string(f) + ": " + s.message());
+        Status s;
+        // The frame's casts and writing tasks share one arena of --threads workers.
+        inArena(p.options.threads, [&] {
+            s = renderFrame(p, w, rays, f, out, p.hasBoxes() ? &cityBoxes : nullptr, pixelRays, ims, records[f]);
+        });
+        if (!s) return Status::error("frame " + std::to_string(f) + ": " + s.message());
         VISTA_RETURN_IF_ERROR(out.finishFrame(f, records[f], frameFiles(p, f)));
         if (killAfter > 0 && ++finishedNow == killAfter) std::raise(SIGKILL);
         if (progress) progress->update(double(f + 1) / double(n));
@@ -490,14 +555,27 @@ nlohmann::json rigSummary(const RigRunRequest& a, const RigPlan& p, const std::v
                           size_t kept) {
     nlohmann::json sensors = nlohmann::json::object();
     double totalMs = 0;
-    for (const auto& r : records)
+    std::vector<double> fired, boxes3d;
+    for (const auto& r : records) {
         if (r.contains("frame_ms") && r["frame_ms"].is_number()) totalMs += r["frame_ms"].get<double>();
+        if (r.contains("sensor_ms") && r["sensor_ms"].is_object()) fired.push_back(double(r["sensor_ms"].size()));
+        if (r.contains("boxes_3d_ms") && r["boxes_3d_ms"].is_number()) boxes3d.push_back(r["boxes_3d_ms"].get<double>());
+    }
     for (const std::string& name : p.rig.order) {
         std::vector<double> ms;
+        std::map<std::string, std::vector<double>> stageMs;  // cast, write, boxes
+        std::vector<double> boxesShare;                      // per firing: boxes / the whole firing
         uint64_t points = 0, misses = 0;
         for (const auto& r : records) {
             if (r.contains("sensor_ms") && r["sensor_ms"].contains(name))
                 ms.push_back(r["sensor_ms"][name].get<double>());
+            if (r.contains("stage_ms") && r["stage_ms"].contains(name)) {
+                for (const auto& [stage, v] : r["stage_ms"][name].items())
+                    if (v.is_number()) stageMs[stage].push_back(v.get<double>());
+                const double whole = r["sensor_ms"][name].get<double>();
+                if (r["stage_ms"][name].contains("boxes") && whole > 0)
+                    boxesShare.push_back(r["stage_ms"][name]["boxes"].get<double>() / whole);
+            }
             if (r.contains("lidar") && r["lidar"].contains(name)) {
                 points += r["lidar"][name]["points"].get<uint64_t>();
                 misses += r["lidar"][name]["misses"].get<uint64_t>();
@@ -508,6 +586,10 @@ nlohmann::json rigSummary(const RigRunRequest& a, const RigPlan& p, const std::v
             {"median_ms", medianOf(ms)},
             {"mean_ms", ms.empty() ? nlohmann::json(nullptr)
                                    : nlohmann::json(std::accumulate(ms.begin(), ms.end(), 0.0) / double(ms.size()))}};
+        nlohmann::json stages = nlohmann::json::object();
+        for (const auto& [stage, v] : stageMs) stages[stage] = medianOf(v);
+        s["stage_median_ms"] = stages;
+        s["boxes_share_median"] = medianOf(boxesShare);
         bool isLidar = false;
         for (const RigLidar& l : p.rig.lidars) isLidar = isLidar || l.name == name;
         if (isLidar) s["points"] = points, s["misses"] = misses;
@@ -520,8 +602,15 @@ nlohmann::json rigSummary(const RigRunRequest& a, const RigPlan& p, const std::v
             {"rig_frames_per_second",
              totalMs > 0 ? nlohmann::json(double(records.size()) * 1000.0 / totalMs) : nlohmann::json(nullptr)},
             {"sensors", sensors},
+            {"sensors_fired_per_frame",
+             fired.empty() ? nlohmann::json(nullptr)
+                           : nlohmann::json(std::accumulate(fired.begin(), fired.end(), 0.0) / double(fired.size()))},
+            {"boxes_3d_median_ms", medianOf(boxes3d)},
             {"note",
-             "per sensor: ray casting, its boxes and writing its files, in ms per firing; rig_frames_per_second: "
+             "per sensor: ray casting, its boxes and writing its files, in ms per firing (stage_median_ms: the "
+             "median of each stage: cast, write of the images or points, boxes with their files; boxes_share_median: "
+             "the median over firings of the boxes stage's share of the firing); "
+             "sensors_fired_per_frame: the mean over the frames; rig_frames_per_second: "
              "frames divided by the sum of every frame's wall time, each timed by the run that rendered it "
              "(frames_resumed: frames an interrupted run had finished)"}};
 }
@@ -587,8 +676,12 @@ void printStats(const RigRunRequest& a, const RigPlan& p, const nlohmann::json& 
     for (const std::string& name : p.rig.order) {
         const auto& s = summary["sensors"][name];
         if (s["median_ms"].is_null()) continue;
-        std::fprintf(stderr, "  %-24s %8.2f ms median, %8.2f ms mean over %d firings\n", name.c_str(),
+        std::fprintf(stderr, "  %-24s %8.2f ms median, %8.2f ms mean over %d firings", name.c_str(),
                      s["median_ms"].get<double>(), s["mean_ms"].get<double>(), s["firings"].get<int>());
+        for (const char* stage : {"cast", "write", "boxes"})
+            if (s["stage_median_ms"].contains(stage) && s["stage_median_ms"][stage].is_number())
+                std::fprintf(stderr, "; %s %.2f", stage, s["stage_median_ms"][stage].get<double>());
+        std::fprintf(stderr, "\n");
     }
     if (!summary["rig_frames_per_second"].is_null())
         std::fprintf(stderr, "  %-24s %8.3f\n", "rig frames per second",

@@ -328,6 +328,17 @@ struct Projector {
         const double rho = std::hypot(p.x, p.y);
         return (rho > 0.0 || p.z > 0.0) && std::atan2(rho, p.z) <= thetaMax;
     }
+    // Fisheye: inCone(p) and, when it holds, uv = fisheyePixel(p), from one
+    // hypot and one atan2 (the same expressions as inCone and project).
+    bool conePixel(const glm::dvec3& p, glm::dvec2& uv) const {
+        const double rho = std::hypot(p.x, p.y);
+        if (!(rho > 0.0 || p.z > 0.0)) return false;
+        const double theta = std::atan2(rho, p.z);
+        if (!(theta <= thetaMax)) return false;
+        if (rho == 0.0) uv = {m.cx, m.cy};
+        else uv = {m.cx + m.fx * theta * p.x / rho, m.cy + m.fy * theta * p.y / rho};
+        return true;
+    }
     // Fisheye: the pixel of a camera point (not the origin).
     glm::dvec2 fisheyePixel(const glm::dvec3& p) const {
         glm::dvec2 uv(m.cx, m.cy);
@@ -351,24 +362,96 @@ void fisheyeEdge(const Projector& pr, const glm::dvec3& a, const glm::dvec3& b, 
     const double angle = la > 0 && lb > 0 ? std::acos(std::clamp(glm::dot(a, b) / (la * lb), -1.0, 1.0)) : kPi;
     const int n = int(std::clamp(std::ceil(angle * std::max(pr.m.fx, pr.m.fy)), 1.0, 4096.0));
     glm::dvec3 prev = a;
-    bool prevIn = pr.inCone(a);
-    if (prevIn) extend(out, pr.fisheyePixel(a));
+    glm::dvec2 uv;
+    bool prevIn = pr.conePixel(a, uv);
+    if (prevIn) extend(out, uv);
     for (int k = 1; k <= n; ++k) {
         const glm::dvec3 p = a + (double(k) / n) * (b - a);
-        const bool in = pr.inCone(p);
+        const bool in = pr.conePixel(p, uv);
+        if (in) extend(out, uv);
         if (in != prevIn) extend(out, pr.fisheyePixel(coneCrossing(pr, prev, p, prevIn)));
-        if (in) extend(out, pr.fisheyePixel(p));
         prev = p, prevIn = in;
     }
 }
 
+// A triangle (camera coordinates) with the cross products that decide
+// whether a ray from the origin passes through it (rayThroughTriangle),
+// computed once for the many pixels a fill tests.
+struct RayTriangle {
+    glm::dvec3 n0, n1, n2;  // p1 x p2, p2 x p0, p0 x p1
+    double det;             // p0 . (p1 x p2)
+    explicit RayTriangle(const glm::dvec3* p)
+        : n0(glm::cross(p[1], p[2])), n1(glm::cross(p[2], p[0])), n2(glm::cross(p[0], p[1])), det(glm::dot(p[0], n0)) {}
+    bool hit(const glm::dvec3& d) const {
+        if (det == 0.0) return false;
+        const double a = glm::dot(d, n0), b = glm::dot(d, n1), c = glm::dot(d, n2);
+        return det > 0 ? a >= 0 && b >= 0 && c >= 0 : a <= 0 && b <= 0 && c <= 0;
+    }
+};
+
 // True when the ray from the origin along d passes through triangle p0 p1 p2 (edges included).
-bool rayThroughTriangle(const glm::dvec3& d, const glm::dvec3* p) {
-    const double det = glm::dot(p[0], glm::cross(p[1], p[2]));
-    if (det == 0.0) return false;
-    const double a = glm::dot(d, glm::cross(p[1], p[2])), b = glm::dot(d, glm::cross(p[2], p[0])),
-                 c = glm::dot(d, glm::cross(p[0], p[1]));
-    return det > 0 ? a >= 0 && b >= 0 && c >= 0 : a <= 0 && b <= 0 && c <= 0;
+bool rayThroughTriangle(const glm::dvec3& d, const glm::dvec3* p) { return RayTriangle(p).hit(d); }
+
+// A bound of the fisheye image of a triangle (camera coordinates) within the
+// cone, without sampling its edges: the triangle's directions lie in the cap
+// around their mean direction c whose radius r is the largest angle from c to
+// a vertex (a cap narrower than a hemisphere is a convex cone, so it holds
+// the whole triangle); the cap's points have theta in [theta_c - r, theta_c +
+// r] (clamped to [0, thetaMax]) and, when the cap holds neither pole, an
+// azimuth within asin(sin r / sin theta_c) of c's; u - cx = fx theta cos(phi)
+// and v - cy = fy theta sin(phi) over that polar rectangle take their extremes
+// at its corners (theta >= 0), the cosine and sine ranges including their
+// extremes inside the azimuth interval. False (no bound) for a degenerate
+// triangle or a cap of 87 degrees or more; an invalid box when the cap lies
+// outside the image circle. Padded so that rounding never makes it too small.
+bool fisheyeTriangleBound(const Projector& pr, const glm::dvec3* p, PixelBox& out) {
+    glm::dvec3 n[3];
+    for (int i = 0; i < 3; ++i) {
+        const double l = glm::length(p[i]);
+        if (!(l > 0.0)) return false;
+        n[i] = p[i] / l;
+    }
+    const glm::dvec3 sum = n[0] + n[1] + n[2];
+    const double ls = glm::length(sum);
+    if (!(ls > 0.0)) return false;
+    const glm::dvec3 c = sum / ls;
+    const double cosR = std::min({glm::dot(c, n[0]), glm::dot(c, n[1]), glm::dot(c, n[2])});
+    if (!(cosR > 0.05)) return false;
+    const double r = std::acos(std::min(1.0, cosR)) + 1e-9;
+    const double rhoC = std::hypot(c.x, c.y), thetaC = std::atan2(rhoC, c.z);
+    const double lo = std::max(0.0, thetaC - r), hi = std::min(pr.thetaMax, thetaC + r);
+    if (lo > hi) {
+        out = PixelBox{};
+        return true;
+    }
+    double cLo = -1, cHi = 1, sLo = -1, sHi = 1;
+    if (lo > 0.0 && thetaC + r < kPi) {
+        const double half = std::asin(std::min(1.0, std::sin(r) / std::sin(thetaC))) + 1e-9;
+        if (half < kHalfPi) {
+            const double phi = std::atan2(c.y, c.x), a = phi - half, b = phi + half;
+            cLo = std::min(std::cos(a), std::cos(b)), cHi = std::max(std::cos(a), std::cos(b));
+            sLo = std::min(std::sin(a), std::sin(b)), sHi = std::max(std::sin(a), std::sin(b));
+            // Extremes inside [a, b]: cos at multiples of pi, sin at pi/2 + multiples of pi.
+            auto contains = [&](double x) { return std::ceil((a - x) / kTwoPi) <= std::floor((b - x) / kTwoPi); };
+            if (contains(0.0)) cHi = 1;
+            if (contains(kPi)) cLo = -1;
+            if (contains(kHalfPi)) sHi = 1;
+            if (contains(-kHalfPi)) sLo = -1;
+        }
+    }
+    const double uLo = std::min({lo * cLo, lo * cHi, hi * cLo, hi * cHi}),
+                 uHi = std::max({lo * cLo, lo * cHi, hi * cLo, hi * cHi});
+    const double vLo = std::min({lo * sLo, lo * sHi, hi * sLo, hi * sHi}),
+                 vHi = std::max({lo * sLo, lo * sHi, hi * sLo, hi * sHi});
+    const double pad = 1e-6;
+    out = {pr.m.cx + pr.m.fx * uLo - pad, pr.m.cy + pr.m.fy * vLo - pad, pr.m.cx + pr.m.fx * uHi + pad,
+           pr.m.cy + pr.m.fy * vHi + pad};
+    return true;
+}
+
+bool within(const PixelBox& inner, const PixelBox& outer) {
+    return outer.valid() && (!inner.valid() || (inner.u0 >= outer.u0 && inner.v0 >= outer.v0 &&
+                                                inner.u1 <= outer.u1 && inner.v1 <= outer.v1));
 }
 
 // The fisheye image of a triangle (camera coordinates) within the cone: its
@@ -475,8 +558,9 @@ std::vector<VisibleStats> visibleStats(const std::vector<uint32_t>& ids, int wid
 // cover (marked with `mark` in `stamp`, so each pixel counts once).
 class MaskRaster {
 public:
-    MaskRaster(const Projector& pr, int width, int height, std::vector<uint32_t>& stamp, uint32_t mark)
-        : _pr(pr), _w(width), _h(height), _stamp(stamp), _mark(mark) {}
+    MaskRaster(const Projector& pr, const CameraRayTable* rays, int width, int height, std::vector<uint32_t>& stamp,
+               uint32_t mark)
+        : _pr(pr), _rays(rays), _w(width), _h(height), _stamp(stamp), _mark(mark) {}
     PixelBox full;
     uint32_t covered = 0;
 
@@ -486,6 +570,13 @@ public:
         // seen from the eye (the origin) is a front face.
         const bool front = glm::dot(glm::cross(p[1] - p[0], p[2] - p[0]), p[0]) < 0;
         if (_pr.m.fisheye()) {
+            // A triangle whose bound lies within the extent so far cannot widen
+            // it: its edges are not sampled, and its pixels are sought in the bound.
+            PixelBox bound;
+            if (full.valid() && fisheyeTriangleBound(_pr, p, bound) && within(bound, full)) {
+                if (front && bound.valid()) fillSphere(p, bound);
+                return;
+            }
             const PixelBox e = fisheyeTriangleExtent(_pr, p);
             extend(full, e);
             if (front && e.valid()) fillSphere(p, e);
@@ -536,15 +627,18 @@ private:
                   x1 = int(std::min(double(_w - 1), std::ceil(e.u1) + 1));
         const int y0 = int(std::max(0.0, std::floor(e.v0) - 1)),
                   y1 = int(std::min(double(_h - 1), std::ceil(e.v1) + 1));
+        const RayTriangle tri(p);
         for (int y = y0; y <= y1; ++y) {
-            uint32_t* row = &_stamp[size_t(y) * size_t(_w)];
+            const size_t at = size_t(y) * size_t(_w);
+            uint32_t* row = &_stamp[at];
             for (int x = x0; x <= x1; ++x) {
-                glm::dvec3 d;
-                if (row[x] != _mark && _pr.m.pixelRay(x, y, d) && rayThroughTriangle(d, p)) row[x] = _mark, ++covered;
+                const size_t q = at + size_t(x);
+                if (row[x] != _mark && _rays->inside(q) && tri.hit(_rays->dir(q))) row[x] = _mark, ++covered;
             }
         }
     }
     const Projector& _pr;
+    const CameraRayTable* _rays;  // fisheye: the model's pixel rays
     int _w, _h;
     std::vector<uint32_t>& _stamp;
     uint32_t _mark;
@@ -598,11 +692,18 @@ std::vector<FrameBox> frameBoxes(const SceneModel& city, const CityBoxes& boxes,
         moving.push_back(mo);
     }
     const Projector pr(camera);
+    // Fisheye masks test pixel rays: the caller's table of this model, else one built here.
+    CameraRayTable own;
+    const CameraRayTable* rays = options.rays;
+    if (camera.model.fisheye() && !out.empty() && !(rays && rays->matches(camera.model))) {
+        own = CameraRayTable(camera.model, options.threads);
+        rays = &own;
+    }
     tbb::enumerable_thread_specific<std::vector<uint32_t>> stamps(size_t(W) * size_t(H), 0xFFFFFFFFu);
     inArena(options.threads, [&] {
         tbb::parallel_for(size_t(0), out.size(), [&](size_t i) {
             FrameBox& f = out[i];
-            MaskRaster r(pr, W, H, stamps.local(), uint32_t(i));
+            MaskRaster r(pr, rays, W, H, stamps.local(), uint32_t(i));
             if (src[i]) {
                 forEachTriangle(
                     city, boxes, *src[i],

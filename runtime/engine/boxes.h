@@ -70,9 +70,13 @@
 // through the triangle: the image of a triangle within the cone is bounded
 // by those edge pieces and arcs of the circle, and an arc's extent is its
 // end points' or the circle's extreme points'. The sampling of an edge's
-// curved image errs by well under 0.1 px (inside). The fisheye mask tests
-// each pixel centre of a front-facing triangle's extent: its ray
-// (pixelRay) passes through the triangle. The projected 3D box is the
+// curved image errs by well under 0.1 px (inside). A triangle whose
+// conservative bound (the image of a cap around its directions, computed
+// without sampling) lies within the extent of the instance's triangles so
+// far cannot widen it and is not sampled. The fisheye mask tests each pixel
+// centre of a front-facing triangle's extent (or that bound): its ray
+// (pixelRay, from FrameBoxOptions::rays when given) passes through the
+// triangle. The projected 3D box is the
 // extent of its 12 triangles.
 //
 // Vehicle frame (boxInVehicleFrame): x forward, y left, z up (LidarPose's
@@ -97,6 +101,7 @@
 #include "citygen/labels.h"
 #include "citygen/mesh.h"
 #include "runtime/engine/lidar.h"
+#include "runtime/engine/camera_ray_table.h"
 #include "runtime/scene/camera.h"
 #include "runtime/scene/camera_model.h"
 #include "runtime/scene/scene_model.h"
@@ -225,6 +230,11 @@ struct FrameBox {
 struct FrameBoxOptions {
     uint32_t minPixels = 1;  // instances with fewer visible pixels get no box
     int threads = 0;
+    // The camera model's pixel rays (camera_ray_table.h), shared across frames: the
+    // fisheye masks read them instead of calling pixelRay per tested pixel
+    // (the same directions, so the same boxes). Null, or a table of another
+    // model: frameBoxes builds one for the call.
+    const CameraRayTable* rays = nullptr;
 };
 
 // The 2D boxes of one frame: every object instance with at least minPixels

@@ -79,6 +79,7 @@ void castRigCamera(const SceneModel& city, const RayScene& rays, const CameraSho
     const bool wantCls = (s.channels & kRigSemantic) != 0, wantIds = (s.channels & (kRigInstance | kRigBoxes)) != 0;
     const bool wantFlow = (s.channels & kRigFlow) != 0;
     const glm::dmat3 nextInv = glm::transpose(s.next.rotation);
+    const CameraRayTable* table = s.rays && s.rays->matches(s.model) ? s.rays : nullptr;
     inArena(threads, [&] {
         tbb::parallel_for(tbb::blocked_range<int>(0, H, int(kRowsPerTask)), [&](const tbb::blocked_range<int>& br) {
             std::vector<glm::vec3> orgs, dirs;
@@ -90,7 +91,9 @@ void castRigCamera(const SceneModel& city, const RayScene& rays, const CameraSho
                 for (int x = 0; x < W; ++x) {
                     const size_t p = size_t(y) * size_t(W) + size_t(x);
                     glm::dvec3 d;
-                    if (shotRay(s, x, y, d)) {
+                    const bool inside = table ? table->inside(p) : shotRay(s, x, y, d);
+                    if (table && inside) d = s.pose.rotation * cvToBody(table->dir(p));
+                    if (inside) {
                         orgs.push_back(org);
                         dirs.push_back(glm::vec3(d));
                         ddirs.push_back(d);

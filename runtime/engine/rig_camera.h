@@ -38,6 +38,7 @@
 
 #include "runtime/engine/frame_effects.h"
 #include "runtime/engine/image.h"
+#include "runtime/engine/camera_ray_table.h"
 #include "runtime/engine/rig.h"
 #include "runtime/scene/scene_model.h"
 
@@ -72,6 +73,10 @@ struct CameraShot {
     RigPose next;                                        // flow only
     const std::vector<ObjectMotion>* motions = nullptr;  // flow only: sorted by id; null = none
     const FrameEffects* fx = nullptr;                    // sky colour; null = the default sky
+    // The model's pixel rays (camera_ray_table.h), shared across firings: the same
+    // rays as pixelRay's, without its trigonometry per pixel. Null, or a
+    // table of another model: pixelRay per pixel.
+    const CameraRayTable* rays = nullptr;
 };
 
 // The camera's world ray direction of pixel (u, v), false outside a fisheye's image circle.

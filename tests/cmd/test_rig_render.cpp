@@ -1,7 +1,8 @@
 // `vista render --rig` through the CLI on a small generated city: every
 // sensor writes its files at its own rate in the KITTI-style layout
 // (image_NN/, velodyne/, labels/, calib.txt, times.txt) with rig.json and
-// summary.json (per-sensor costs, LiDAR misses counted, rig frames per
+// summary.json (per-sensor costs and their stages, sensors fired per frame,
+// LiDAR misses counted, rig frames per
 // second); a fisheye depth pixel equals an independent ray's distance; bad
 // rig files and flags that do not apply exit with code 2 naming the field,
 // with nothing written; the boxes channel writes per firing the 2D boxes
@@ -121,6 +122,21 @@ TEST_F(RigRender, SensorsWriteAtTheirRatesInTheKittiLayout) {
     ASSERT_EQ(manifest["frames"].size(), 7u);
     EXPECT_TRUE(manifest["frames"][3]["sensors"].contains("top"));
     EXPECT_FALSE(manifest["frames"][4]["sensors"].contains("top"));
+    // Sensors fired per frame: the mean count of rig.json's per-frame sensors; every sensor has the
+    // median of each stage (cast, write, boxes), none above the sensor's total time over its firings.
+    double fired = 0;
+    for (const auto& fr : manifest["frames"]) fired += double(fr["sensors"].size());
+    EXPECT_NEAR(summary["sensors_fired_per_frame"].get<double>(), fired / 7.0, 1e-9);
+    for (const char* sensor : {"front", "left", "top"}) {
+        const auto& st = summary["sensors"][sensor]["stage_median_ms"];
+        for (const char* stage : {"cast", "write", "boxes"}) {
+            ASSERT_TRUE(st.contains(stage) && st[stage].is_number()) << sensor << " " << stage;
+            EXPECT_GE(st[stage].get<double>(), 0.0);
+            const auto& sum = summary["sensors"][sensor];
+            EXPECT_LE(st[stage].get<double>(), sum["mean_ms"].get<double>() * sum["firings"].get<double>() + 1e-9);
+        }
+        EXPECT_GT(st["cast"].get<double>(), 0.0) << sensor;
+    }
 
     // A fisheye depth pixel is the distance of an independent ray through it.
     auto model = loadCityFile(city);

@@ -7,7 +7,8 @@
 // visible boxes equal the mask's extents, the full extents hold every
 // visible pixel centre and every vertex inside the image circle projected
 // here, and the unoccluded pixel counts agree with rays cast here at the
-// instance alone; a box in the vehicle frame is the world box through the inverse of
+// instance alone, and the fast fisheye masks count exactly the pixels of
+// every pixel ray tested against every front triangle; a box in the vehicle frame is the world box through the inverse of
 // the pose's 4x4 matrix, in the file too; sightings merge cameras and LiDARs;
 // KITTI label lines read back with the devkit's corners hold the world box
 // (equal to it for a level vehicle) and carry the instance id.
@@ -245,6 +246,76 @@ TEST(RigBoxes, FisheyeBoxesHoldTheVisiblePixelsAndTheVerticesInsideTheImageCircl
     EXPECT_GT(compared, 30u);
     EXPECT_GT(vertices, 1000u);
     EXPECT_GT(aloneChecked, 4u);
+}
+
+// The fisheye masks' pixel count, written out here the slow way: every pixel
+// inside the image circle (pixelRay) against every front-facing triangle of
+// the instance (camera coordinates; a ray from the origin passes through a
+// triangle when the three triple products have the sign of its determinant).
+uint32_t fisheyeMaskEveryPixel(const CameraModel& m, const BoxCamera& cam, const std::vector<glm::dvec3>& tris) {
+    const size_t W = size_t(m.width), H = size_t(m.height);
+    std::vector<glm::dvec3> ray(W * H);
+    std::vector<uint8_t> inside(W * H), covered(W * H, 0);
+    for (size_t v = 0; v < H; ++v)
+        for (size_t u = 0; u < W; ++u) inside[v * W + u] = m.pixelRay(double(u), double(v), ray[v * W + u]) ? 1 : 0;
+    for (size_t t = 0; t + 2 < tris.size(); t += 3) {
+        const glm::dvec3 p0 = cam.toCamera(tris[t]), p1 = cam.toCamera(tris[t + 1]), p2 = cam.toCamera(tris[t + 2]);
+        if (!(glm::dot(glm::cross(p1 - p0, p2 - p0), p0) < 0)) continue;  // back face
+        const glm::dvec3 n0 = glm::cross(p1, p2), n1 = glm::cross(p2, p0), n2 = glm::cross(p0, p1);
+        const double det = glm::dot(p0, n0);
+        if (det == 0.0) continue;
+        for (size_t q = 0; q < W * H; ++q) {
+            if (!inside[q] || covered[q]) continue;
+            const double a = glm::dot(ray[q], n0), b = glm::dot(ray[q], n1), c = glm::dot(ray[q], n2);
+            if (det > 0 ? a >= 0 && b >= 0 && c >= 0 : a <= 0 && b <= 0 && c <= 0) covered[q] = 1;
+        }
+    }
+    uint32_t n = 0;
+    for (uint8_t c : covered) n += c;
+    return n;
+}
+
+// The fast fisheye masks (a shared ray table, triangles bounded before their
+// edges are sampled) count the pixels of the slow way exactly, and a run with
+// or without a shared table gives the same boxes.
+TEST(RigBoxes, FisheyeMasksCountThePixelsOfEveryPixelTestedAgainstEveryTriangle) {
+    const TestCity& c = testCity();
+    CameraModel model;
+    model.kind = CameraModel::Kind::Fisheye;
+    model.width = 96, model.height = 72;
+    model.fx = 23.0, model.fy = 25.0, model.cx = 47.5, model.cy = 36.0;
+    model.maxFovDeg = 190.0;
+    const CameraRayTable table(model);
+    size_t compared = 0, nonEmpty = 0;
+    for (size_t e = 3; e < c.model.streets.edges.size() && compared < 30; e += 9) {
+        const RigPose pose = cameraPose(c, e, 0.5, e % 2 ? 90.0 : -90.0);
+        const CameraImages im = castBoxes(c, model, pose);
+        const BoxCamera cam = rigBoxCamera(model, pose);
+        const std::vector<FrameBox> own = frameBoxes(c.model, c.boxes, cam, im.ids);
+        FrameBoxOptions o;
+        o.rays = &table;
+        const std::vector<FrameBox> shared = frameBoxes(c.model, c.boxes, cam, im.ids, o);
+        ASSERT_EQ(own.size(), shared.size());
+        for (size_t i = 0; i < own.size(); ++i) {
+            const FrameBox &a = own[i], &b = shared[i];
+            EXPECT_EQ(a.id, b.id);
+            EXPECT_EQ(a.unoccludedPixels, b.unoccludedPixels);
+            EXPECT_EQ(a.full.u0, b.full.u0);
+            EXPECT_EQ(a.full.v0, b.full.v0);
+            EXPECT_EQ(a.full.u1, b.full.u1);
+            EXPECT_EQ(a.full.v1, b.full.v1);
+            EXPECT_EQ(a.boxExtent.u0, b.boxExtent.u0);
+            EXPECT_EQ(a.boxExtent.v1, b.boxExtent.v1);
+            if (compared >= 30) continue;
+            const std::vector<glm::dvec3> pts = instancePoints(c.model, c.boxes, *c.boxes.find(a.id));
+            EXPECT_EQ(a.unoccludedPixels, fisheyeMaskEveryPixel(model, cam, pts))
+                << instanceKindName(instanceKind(a.id)) << " " << a.id;
+            ++compared;
+            nonEmpty += a.unoccludedPixels > 20 ? 1 : 0;
+        }
+    }
+    EXPECT_GE(compared, 30u);
+    EXPECT_GT(nonEmpty, 10u);
 }
 
 TEST(RigBoxes, VehicleFrameBoxesAreTheWorldBoxesThroughThePose) {

@@ -3,10 +3,12 @@
 // distance of an independent Embree ray within 1 cm and a pinhole's its
 // z-depth; forward flow equals the flow of independent rays (the pixel's ray
 // cast, its hit projected with the next pose by formulas written here)
-// within 0.05 px; channels nobody asked for are not computed.
+// within 0.05 px; channels nobody asked for are not computed; a shared ray
+// table (camera_ray_table.h) gives the same bytes as pixelRay per pixel.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 
 #include "runtime/engine/ray_scene.h"
 #include "runtime/engine/rig_camera.h"
@@ -231,3 +233,38 @@ void expectFlowMatchesRays(const CameraModel& model) {
 
 TEST(RigCamera, PinholeFlowMatchesIndependentRays) { expectFlowMatchesRays(pinhole()); }
 TEST(RigCamera, FisheyeFlowMatchesIndependentRays) { expectFlowMatchesRays(fisheye(190.0)); }
+
+// A shared CameraRayTable gives the bytes of pixelRay per pixel, in every
+// channel, for both models; a table of another model is not used.
+TEST(RigCamera, RayTableGivesTheBytesOfPixelRayPerPixel) {
+    const SceneModel city = test::randomCity(11, 60, 300.0);
+    auto rays = RayScene::build(city);
+    ASSERT_TRUE(rays.isOk());
+    for (const CameraModel& model : {pinhole(), fisheye(190.0)}) {
+        CameraShot shot;
+        shot.model = model;
+        shot.pose = uprightPose({1.5, -2.0, 1.6}, 0.7);
+        shot.next = uprightPose(shot.pose.position + 0.8 * shot.pose.rotation[0], 0.72);
+        shot.channels = kRigRgb | kRigDepth | kRigSemantic | kRigInstance | kRigFlow;
+        CameraImages slow, fast, other;
+        castRigCamera(city, **rays, shot, slow, 2);
+        const CameraRayTable table(model, 2);
+        ASSERT_TRUE(table.matches(model));
+        shot.rays = &table;
+        castRigCamera(city, **rays, shot, fast, 2);
+        EXPECT_EQ(fast.rgb.rgba, slow.rgb.rgba);
+        EXPECT_EQ(0, std::memcmp(fast.depth.data(), slow.depth.data(), slow.depth.size() * sizeof(float)));
+        EXPECT_EQ(fast.classes, slow.classes);
+        EXPECT_EQ(fast.ids, slow.ids);
+        EXPECT_EQ(0, std::memcmp(fast.flow.data(), slow.flow.data(), slow.flow.size() * sizeof(float)));
+        // A table of another model (fx differs) is ignored: the same bytes again.
+        CameraModel wider = model;
+        wider.fx *= 0.9;
+        const CameraRayTable stale(wider, 2);
+        EXPECT_FALSE(stale.matches(model));
+        shot.rays = &stale;
+        castRigCamera(city, **rays, shot, other, 2);
+        EXPECT_EQ(other.ids, slow.ids);
+        EXPECT_EQ(other.rgb.rgba, slow.rgb.rgba);
+    }
+}
