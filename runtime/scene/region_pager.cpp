@@ -192,7 +192,7 @@ void RegionPager::computeDesired() {
     computeChunks(total - reserved);
 }
 
-// The chunk parts wanted: the full regions within chunkRadius of the lookahead segment, nearest
+// The chunk parts wanted: the full regions within chunkRadius of the lookahead's reach, nearest
 // first while the budget (after every level: `total`, their cost) has room.
 void RegionPager::computeChunks(uint64_t total) {
     std::fill(_desiredChunks.begin(), _desiredChunks.end(), 0);
