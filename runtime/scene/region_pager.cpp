@@ -20,43 +20,6 @@ double pointRect(const glm::dvec2& p, const glm::dvec2& lo, const glm::dvec2& hi
     return std::sqrt(dx * dx + dy * dy);
 }
 
-double pointSegment(const glm::dvec2& p, const glm::dvec2& a, const glm::dvec2& b) {
-    const glm::dvec2 ab = b - a;
-    const double l2 = glm::dot(ab, ab);
-    const double t = l2 > 0 ? std::clamp(glm::dot(p - a, ab) / l2, 0.0, 1.0) : 0.0;
-    return glm::length(p - (a + t * ab));
-}
-
-// True when the segment [a, b] meets the rectangle [lo, hi] (slab test).
-bool segmentMeetsRect(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& lo, const glm::dvec2& hi) {
-    double t0 = 0, t1 = 1;
-    for (int k = 0; k < 2; ++k) {
-        const double d = b[k] - a[k];
-        if (d == 0) {
-            if (a[k] < lo[k] || a[k] > hi[k]) return false;
-            continue;
-        }
-        double u = (lo[k] - a[k]) / d, v = (hi[k] - a[k]) / d;
-        if (u > v) std::swap(u, v);
-        t0 = std::max(t0, u);
-        t1 = std::min(t1, v);
-        if (t0 > t1) return false;
-    }
-    return true;
-}
-
-// 2D distance from the segment [a, b] to the rectangle [lo, hi]: 0 when they
-// meet, else the least of the end points' distances to the rectangle and the
-// corners' distances to the segment (two disjoint convex sets are nearest at
-// a vertex of one of them).
-double segmentRect(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& lo, const glm::dvec2& hi) {
-    if (segmentMeetsRect(a, b, lo, hi)) return 0.0;
-    double d = std::min(pointRect(a, lo, hi), pointRect(b, lo, hi));
-    for (const glm::dvec2& c : {lo, hi, glm::dvec2(lo.x, hi.y), glm::dvec2(hi.x, lo.y)})
-        d = std::min(d, pointSegment(c, a, b));
-    return d;
-}
-
 bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 }  // namespace
@@ -159,7 +122,7 @@ void RegionPager::computeDesired() {
         if (r.empty) continue;
         const glm::dvec2 lo(r.lo), hi(r.hi);
         const double dEye = pointRect(_eye, lo, hi);
-        const double d = segmentRect(_eye, _ahead, lo, hi);
+        const double d = reachDistance(dEye);
         _key[i] = 0.5 * (dEye + pointRect(_ahead, lo, hi));
         uint8_t level = d <= _o.radius ? kFull : (d <= farM ? kCoarse : kNone);
         if (level == kFull && _failedFull[i]) level = kCoarse;
@@ -229,7 +192,7 @@ void RegionPager::computeDesired() {
     computeChunks(total - reserved);
 }
 
-// The chunk parts wanted: the full regions within chunkRadius of the lookahead segment, nearest
+// The chunk parts wanted: the full regions within chunkRadius of the lookahead's reach, nearest
 // first while the budget (after every level: `total`, their cost) has room.
 void RegionPager::computeChunks(uint64_t total) {
     std::fill(_desiredChunks.begin(), _desiredChunks.end(), 0);
@@ -239,7 +202,7 @@ void RegionPager::computeChunks(uint64_t total) {
     for (size_t i = 0; i < _m.regions.size(); ++i) {
         if (_desired[i] != kFull) continue;
         const glm::dvec2 lo(_m.regions[i].lo), hi(_m.regions[i].hi);
-        if (segmentRect(_eye, _ahead, lo, hi) > _o.chunkRadius) continue;
+        if (reachDistance(pointRect(_eye, lo, hi)) > _o.chunkRadius) continue;
         band.push_back(int(i));
         _nearEyeChunks[i] = pointRect(_eye, lo, hi) <= _o.chunkRadius;
     }
@@ -359,6 +322,7 @@ void RegionPager::update(const glm::dvec3& eye, const glm::dvec3& velocity) {
     _stats.lookaheadS = lookahead;
     _stats.peakLookaheadS = std::max(_stats.peakLookaheadS, lookahead);
     _ahead = _eye + glm::dvec2(velocity) * lookahead;
+    _reach = glm::length(glm::dvec2(velocity)) * lookahead;
     _haveEye = true;
     computeDesired();
     computeShortfall();

@@ -4,8 +4,12 @@
 // thread) owns what was loaded and mirrors it into its own structures (a
 // RayScene's regions, a scene graph) between frames.
 //
-// The desired set, from the last update(eye, velocity): the lookahead segment
-// runs from the eye to eye + velocity * lookahead (xy only). The lookahead is
+// The desired set, from the last update(eye, velocity): the lookahead's reach
+// is every point the camera can get to within the lookahead at its speed,
+// whichever way it turns: the disc of radius |velocity| * lookahead around the
+// eye (xy only). A reach along the heading alone misses a turn: a camera that
+// leaves a region's radius by a few metres and turns back at a corner needs
+// the region again sooner than a load takes. The lookahead is
 // prefetchS, or longer where loading is slower: outside wait mode it is at
 // least kLookaheadLoads times the longest of the last kLoadTimesKept full-level
 // loads (read and prepare, wall time on the worker), so a region comes within
@@ -13,7 +17,7 @@
 // queued before it (stats().lookaheadS). Wait mode keeps prefetchS, so its
 // frames do not depend on load timing. Every non-empty
 // region whose bounds (manifest `bounds`, 2D) come within `radius` of that
-// segment is desired at full detail; every other region within `far` of it at
+// reach is desired at full detail; every other region within `far` of it at
 // its coarse level (far <= radius: none). With prefetchS = 0 and a resting
 // eye this is exactly what loadPagedNear() loads for a path of one sample
 // (selectPagedRegions / selectCoarseRegions of the eye). A region whose full
@@ -38,7 +42,7 @@
 // near-field chunks (RegionLoad::chunks false), and the chunks come as a part
 // of their own (RegionLoad::level false: the full file read again, prepared
 // for its chunks only) for the full regions within chunkRadius of the
-// lookahead segment: a near field that reaches a few hundred metres keeps
+// lookahead's reach: a near field that reaches a few hundred metres keeps
 // chunks for the few regions around the camera, not for every full region.
 // A part is dropped when its region leaves the band or its full level goes;
 // it counts in the resident bytes (its file's bytes) and in the cost at its
@@ -49,7 +53,8 @@
 // every level comes with its chunks (one load, RegionLoad::chunks true).
 //
 // Load order: by urgency, then by the mean of the region's distance to the
-// eye and to the end of the lookahead (so regions ahead of the heading come
+// eye and to the end of the lookahead along the heading (eye + velocity *
+// lookahead; so regions ahead of the heading come
 // before those behind at the same distance): full regions within reach of the
 // eye, coarse regions within reach of the eye, then regions wanted only for the
 // lookahead. Only loads not yet started are re-ordered or cancelled; a load in
@@ -86,6 +91,7 @@
 // and >= 0, budgetBytes >= 0, cost weights finite and > 0 (loading >= 0), workers 1 .. 16,
 // eye and velocity finite.
 #pragma once
+#include <algorithm>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -266,6 +272,10 @@ private:
     const PagedManifest& _m;
     RegionPagerOptions _o;
     glm::dvec2 _eye{0.0}, _ahead{0.0};
+    double _reach = 0;  // metres the camera covers in the lookahead at its speed
+    // The distance from the lookahead's reach (the disc of radius _reach around the eye) to a
+    // region at `eyeDistance` metres from the eye.
+    double reachDistance(double eyeDistance) const { return std::max(0.0, eyeDistance - _reach); }
     bool _haveEye = false;
 
     // Frame-thread state.
