@@ -599,8 +599,8 @@ void addPagedStreamFlags(CLI::App& app, PagedStreamFlags& f) {
                  "with a streamed paged city: every frame waits until the regions within reach of its camera are "
                  "resident, so frames do not depend on load timing");
     std::ostringstream help;
-    help << "with a streamed paged city: also load the regions within reach of where the camera will be this many "
-            "seconds ahead along its velocity (at least: longer where loading is slower), 0 .. "
+    help << "with a streamed paged city: also load the regions within reach of anywhere the camera can get to in "
+            "this many seconds at its speed, those ahead first (at least: longer where loading is slower), 0 .. "
          << kMaxPagedPrefetchS << " (default " << kDefaultPagedPrefetchS << ")";
     addNumberOption(app, "--paged-prefetch", f.prefetchS, RealRange::closed(0, kMaxPagedPrefetchS), help.str());
 }

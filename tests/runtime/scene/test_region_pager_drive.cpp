@@ -20,14 +20,10 @@
 
 #include "runtime/scene/paged_load.h"
 #include "runtime/scene/region_pager.h"
-#include "tests/common/run_vista.h"
-#include "tests/common/temp_dir.h"
+#include "tests/common/small_paged_city.h"
 
 using vista::RegionPager;
 using vista::RegionPagerOptions;
-using vista::test::CliRun;
-using vista::test::runVista;
-using vista::test::TempDir;
 
 namespace {
 
@@ -107,19 +103,9 @@ struct DriveResult {
 
 class PagerDrive : public ::testing::Test {
 protected:
-    static void SetUpTestSuite() {
-        ref = new TempDir("vista_pager_drive");
-        // A 1.5 km city in 500 m regions (3 x 3, region 4 in the middle), facade detail 1.
-        const CliRun r = runVista("gen --size 1500 --seed 4 --detail 1 --region-size 500 -q -o " +
-                                  ref->file("city.paged"));
-        ASSERT_EQ(r.code, 0) << r.err;
-    }
-    static void TearDownTestSuite() {
-        delete ref;
-        ref = nullptr;
-    }
     void SetUp() override {
-        auto m = vista::readPagedManifest(ref->file("city.paged"));
+        // The shared small paged city (1.5 km in 500 m regions: 3 x 3, region 4 in the middle), read in place.
+        auto m = vista::readPagedManifest(vista::test::smallPagedCity().dir);
         ASSERT_TRUE(m.isOk()) << m.status().message();
         manifest = *m;
         ASSERT_EQ(manifest.regions.size(), 9u);
@@ -188,10 +174,8 @@ protected:
         return out;
     }
 
-    static TempDir* ref;
     vista::PagedManifest manifest;
 };
-TempDir* PagerDrive::ref = nullptr;
 
 }  // namespace
 
