@@ -156,6 +156,7 @@ public:
     }
     bool hazesRasterPixels() const override { return true; }  // FarFieldOptions::hazeCovered
     bool drawsSky() const override { return true; }  // the far field classifies and fills every uncovered pixel
+    bool splitsTraffic() const override { return true; }  // setSplit in both faces
     const std::vector<uint32_t>* lastTracedPixels() const override { return &_far->lastTraced(); }
     double lastRayStart() const override { return _far->lastRayStart(); }
     const RasterSelection* lastRaster() const override { return &_raster; }
