@@ -99,7 +99,8 @@ void moverFootprint(FarFrame& f, const RayScene& rays) {
         const glm::dvec3 axis = d > 0 ? v / d : fwd;
         for (int y = y0; y <= y1; ++y)
             for (int x = x0; x <= x1; ++x)
-                if (glm::dot(f.rays.dir(x, y), axis) >= cosLimit) f.moverMask[size_t(y) * size_t(f.width) + size_t(x)] |= bit;
+                if (glm::dot(f.rays.dir(x, y), axis) >= cosLimit)
+                    f.moverMask[size_t(y) * size_t(f.width) + size_t(x)] |= bit;
     };
     for (const glm::dvec4& s : spheres) mark(s, kFootprintMover);
     for (const glm::dvec4& s : f.changedStills) mark(s, kFootprintStill);

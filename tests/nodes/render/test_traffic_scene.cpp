@@ -395,14 +395,10 @@ TEST(TrafficScene, AFramePlacesTheMoversOnceAndTheHeadsOnlyWhenALampChanges) {
             EXPECT_EQ(rays.moverCommits(), commits + 1) << "t " << t;  // the agents moved
             EXPECT_EQ(ts.headsCast(), 1u);
             const bool changed = !before.empty() && before[1] != ts.lamps()[1];
-            if (!before.empty()) {
-                EXPECT_EQ(rays.stillSerial() != serial, changed) << "t " << t;
-            }
+            if (!before.empty()) { EXPECT_EQ(rays.stillSerial() != serial, changed) << "t " << t; }
             lampChanges += changed ? 1 : 0;
             before = ts.lamps();
         }
-        if (splits) {
-            EXPECT_EQ(lampChanges, 2);
-        }
+        if (splits) { EXPECT_EQ(lampChanges, 2); }
     }
 }

@@ -185,7 +185,8 @@ TEST(FarFieldStill, TheCacheServesAStillObjectUntilItChangesAndTracesItOnThatFra
         size_t fromCache = 0;
         for (size_t i : head) fromCache += cached.classification()[i] == kFarCache ? 1 : 0;
         EXPECT_EQ(fromCache, head.size()) << "frame " << frame;
-        for (size_t i : head) ASSERT_EQ(glm::u8vec4(img.rgba[4 * i], img.rgba[4 * i + 1], img.rgba[4 * i + 2], 255), red);
+        for (size_t i : head)
+            ASSERT_EQ(glm::u8vec4(img.rgba[4 * i], img.rgba[4 * i + 1], img.rgba[4 * i + 2], 255), red);
     }
     // The lamp turns green: on this frame every pixel of the head is traced and shows green,
     // and the frame equals an uncached trace.
