@@ -309,7 +309,7 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
     VISTA_RETURN_IF_ERROR(rays.placeFrameNear(vehicle.position));
     // The traffic at the frame's time, every agent in the ray scene (the vehicle's own excepted).
     if (p.agents) {
-        VISTA_RETURN_IF_ERROR(p.agents->setFrame(p.times[f], vehicle.position));
+        VISTA_RETURN_IF_ERROR(p.agents->setFrame(p.times[f], vehicle.position, /*splitFollows=*/true));
         VISTA_RETURN_IF_ERROR(p.agents->setSplit(0.0));
     }
     const std::string name = frameName(f);
@@ -373,7 +373,7 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
         LidarMovers movers;
         if (p.agents)
             movers.place = [&](double t) {
-                VISTA_RETURN_IF_ERROR(p.agents->setFrame(t, vehiclePoseAt(path, t).position));
+                VISTA_RETURN_IF_ERROR(p.agents->setFrame(t, vehiclePoseAt(path, t).position, /*splitFollows=*/true));
                 return p.agents->setSplit(0.0);
             };
         Stopwatch cast;

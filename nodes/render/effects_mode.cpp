@@ -23,7 +23,8 @@ public:
     Status renderFrame(const Camera& camera, Image& out, FrameStats& stats) override {
         const FrameEffects& fx = _ctx.options.effects;
         if (_ctx.renderer) _ctx.renderer->setEffects(fx, !_inner->hazesRasterPixels());
-        if (_ctx.traffic) VISTA_RETURN_IF_ERROR(_ctx.traffic->setFrame(camera.time, camera.eye));
+        if (_ctx.traffic)
+            VISTA_RETURN_IF_ERROR(_ctx.traffic->setFrame(camera.time, camera.eye, _inner->splitsTraffic()));
         VISTA_RETURN_IF_ERROR(_inner->renderFrame(camera, out, stats));
         if (fx.haze && !stats.effects.ran(EffectId::Haze)) {
             stats.effects.add(EffectId::Haze, 0.0);  // fog inside the rasteriser's draw
@@ -42,6 +43,7 @@ public:
     const RasterSelection* lastRaster() const override { return _inner->lastRaster(); }
     bool hazesRasterPixels() const override { return _inner->hazesRasterPixels(); }
     bool drawsSky() const override { return _inner->drawsSky(); }
+    bool splitsTraffic() const override { return _inner->splitsTraffic(); }
     osg::Node* viewerScene() override {
         if (!_viewer) {
             _viewer = new osg::Group;
@@ -64,7 +66,7 @@ public:
         if (_viewer)
             applyEffectsState(*_viewer->getOrCreateStateSet(), _ctx.options.effects,
                               !_inner->hazesRasterPixels());  // live toggles
-        if (_ctx.traffic) (void)_ctx.traffic->setFrame(camera.time, camera.eye);
+        if (_ctx.traffic) (void)_ctx.traffic->setFrame(camera.time, camera.eye, _inner->splitsTraffic());
         return effectsFarPlane(_inner->beginViewerFrame(camera), _ctx.options.effects);
     }
     FrameStats lastViewerStats() const override {

@@ -156,6 +156,8 @@ public:
     }
     bool hazesRasterPixels() const override { return true; }  // FarFieldOptions::hazeCovered
     bool drawsSky() const override { return true; }  // the far field classifies and fills every uncovered pixel
+    // Both faces split the traffic at the near distance (setSplit).
+    bool splitsTraffic() const override { return true; }
     const std::vector<uint32_t>* lastTracedPixels() const override { return &_far->lastTraced(); }
     double lastRayStart() const override { return _far->lastRayStart(); }
     const RasterSelection* lastRaster() const override { return &_raster; }

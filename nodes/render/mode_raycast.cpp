@@ -79,6 +79,7 @@ public:
         return 0.0;
     }
     FrameStats lastViewerStats() const override { return _drawable ? _drawable->lastStats() : FrameStats(); }
+    bool splitsTraffic() const override { return true; }  // setSplit in both faces
 
 private:
     ModeContext& _ctx;

@@ -119,7 +119,9 @@ struct ModeContext {
     // wrapper places them before each frame (both faces) and draws them in GL
     // (the renderer's overlay, the viewer scene); modes with a ray-cast far
     // field split them (TrafficScene::setSplit: raycast all by rays, hybrid
-    // by its near distance). Its ray scene is the one the modes trace.
+    // by its near distance; RenderMode::splitsTraffic: then the wrapper only
+    // moves it to the frame's time and the mode's split places it, once a
+    // frame). Its ray scene is the one the modes trace.
     TrafficScene* traffic = nullptr;
     ModeOptions options;
 
@@ -210,6 +212,11 @@ public:
     // The raster part of the last renderFrame() (full, hybrid), or null for
     // modes whose picture is not the chunked near field plus rays.
     virtual const RasterSelection* lastRaster() const { return nullptr; }
+    // True when both faces (renderFrame, beginViewerFrame) split the traffic
+    // themselves (TrafficScene::setSplit: hybrid, raycast): the effects
+    // wrapper then moves the traffic to the frame's time without placing it
+    // (TrafficScene::setFrame's splitFollows), so a frame places it once.
+    virtual bool splitsTraffic() const { return false; }
     const SetupTimes& setupMs() const { return _setup; }
 
 protected:

@@ -32,7 +32,10 @@ struct TrafficScene::Impl {
     std::vector<uint32_t> castAgents;
     std::vector<glm::dmat4> castXf;
     std::vector<MoverPlacement> movers;
+    std::vector<StillPlacement> stills;  // per head: its slot among the ray scene's still objects
     std::vector<uint32_t> nextShown;
+    // Per head: what its still slot shows (0 hidden, 1 + LampState cast; kUnplaced: not placed yet).
+    std::vector<uint32_t> headKeys;
     // Traffic-light heads: the lamp overlay per LampState, a transform per head.
     std::vector<osg::ref_ptr<osg::Geode>> lampProtos;
     std::vector<osg::ref_ptr<osg::MatrixTransform>> headXf;
@@ -92,6 +95,8 @@ bool carries(const AgentPlacement& a, const AgentModel& m, const glm::dvec3& eye
            std::abs(glm::dot(d, left)) <= 0.5 * m.width + kCarrierMargin && d.z >= -kCarrierMargin &&
            d.z <= m.height + kCarrierMargin;
 }
+
+constexpr uint32_t kUnplaced = ~0u;
 
 osg::Matrixd toOsg(const glm::dmat4& m) {
     osg::Matrixd o;
@@ -172,11 +177,14 @@ void TrafficScene::updateLamps() {
 }
 
 TrafficScene::~TrafficScene() {
-    if (_rays && _cast + _headsCast > 0) (void)_rays->placeMovers({});
+    const std::vector<StillPlacement> none;
+    if (_rays && _cast + _headsCast > 0) (void)_rays->placeMovers({}, &none);
 }
 
 Status TrafficScene::attachRays(RayScene* rays) {
-    if (_rays && _rays != rays && _cast + _headsCast > 0) VISTA_RETURN_IF_ERROR(_rays->placeMovers({}));
+    const std::vector<StillPlacement> none;
+    if (_rays && _rays != rays && _cast + _headsCast > 0) VISTA_RETURN_IF_ERROR(_rays->placeMovers({}, &none));
+    _impl->headKeys.assign(_heads.size(), kUnplaced);
     _castAgents.clear();
     _castTransforms.clear();
     _cast = 0;
@@ -212,7 +220,7 @@ double TrafficScene::tallestAgent() const {
     return h;
 }
 
-Status TrafficScene::setFrame(double t, const glm::dvec3& eye) {
+Status TrafficScene::setFrame(double t, const glm::dvec3& eye, bool splitFollows) {
     const bool moved = !_placedValid || t != _t;
     _t = t;
     _eye = eye;
@@ -222,7 +230,7 @@ Status TrafficScene::setFrame(double t, const glm::dvec3& eye) {
         _placedValid = true;
         if (!_heads.empty()) updateLamps();
     }
-    return apply();
+    return splitFollows ? Status::ok() : apply();
 }
 
 Status TrafficScene::setSplit(double nearDistance) {
@@ -304,38 +312,44 @@ Status TrafficScene::apply() {
             if (im.labelXf[agent]) im.labelXf[agent]->setNodeMask(0u);
         }
     std::swap(im.shown, im.nextShown);
-    // Heads: GL within the split, movers beyond (encoded with their lamp for change detection).
-    const size_t agentsCast = im.movers.size();
+    // Heads: GL within the split, beyond it the ray scene's still objects (one slot per head,
+    // re-placed only when its lamp or side of the split changes).
     _headsDrawn = 0;
+    _headsCast = 0;
     const uint32_t lampProto0 = uint32_t(_models.models.size());
     // Outside the run's time span SUMO had no state: the static lamps show.
     const bool live = !_tracks->times.empty() && _t >= _tracks->times.front() && _t <= _tracks->times.back();
+    bool headsChanged = false;
+    im.headKeys.resize(_heads.size(), kUnplaced);
+    im.stills.resize(_heads.size());
     for (size_t i = 0; i < _heads.size(); ++i) {
         const double d = glm::length(im.headCentre[i] - _eye);
         const bool gl = live && _split > 0 && d - kLampOverlayRadius <= _split;
-        const bool rays = live && d + kLampOverlayRadius > _split;
+        const bool rays = live && d + kLampOverlayRadius > _split && _rays;
         const unsigned mask = gl ? ~0u : 0u;
         if (im.headXf[i]->getNodeMask() != mask) im.headXf[i]->setNodeMask(mask);
         _headsDrawn += gl ? 1 : 0;
-        if (!rays || !_rays) continue;
+        _headsCast += rays ? 1 : 0;
         const uint32_t lamp = uint32_t(_lamps[i]);
-        im.castAgents.push_back(0x80000000u | uint32_t(i * kLampStates + lamp));
-        im.castXf.push_back(_heads[i].frame);
-        im.movers.push_back({lampProto0 + lamp, _heads[i].frame,
-                             makeInstanceId(InstanceKind::TrafficLight, _heads[i].signal),
-                             uint8_t(semanticClass(Material::TrafficLight))});
+        const uint32_t key = rays ? 1 + lamp : 0;
+        if (key == im.headKeys[i]) continue;
+        im.headKeys[i] = key;
+        headsChanged = true;
+        StillPlacement& sp = im.stills[i];
+        sp.shown = rays;
+        sp.object = {lampProto0 + lamp, _heads[i].frame, makeInstanceId(InstanceKind::TrafficLight, _heads[i].signal),
+                     uint8_t(semanticClass(Material::TrafficLight))};
     }
     if (!_rays) {
         _cast = 0;
-        _headsCast = 0;
         return Status::ok();
     }
-    _headsCast = im.movers.size() - agentsCast;
-    if (im.castAgents == _castAgents && im.castXf == _castTransforms) return Status::ok();
+    _cast = im.movers.size();
+    const bool agentsChanged = im.castAgents != _castAgents || im.castXf != _castTransforms;
+    if (!agentsChanged && !headsChanged) return Status::ok();
     std::swap(_castAgents, im.castAgents);
     std::swap(_castTransforms, im.castXf);
-    _cast = agentsCast;
-    return _rays->placeMovers(im.movers);
+    return _rays->placeMovers(im.movers, headsChanged ? &im.stills : nullptr);
 }
 
 }  // namespace vista

@@ -22,8 +22,11 @@
 //   is in both, as a straddling chunk is: GL draws it up to the far plane
 //   at d and the far field's rays, which start there, the rest. Without an
 //   attached ray scene the agents beyond d are simply not drawn. A call that
-//   changes nothing does no work; the ray scene's top level is committed only
-//   when its set of instances changes.
+//   changes nothing does no work; the ray scene's movers are placed (one
+//   RayScene::placeMovers call) only when what it shows changes.
+//   setFrame(t, eye, splitFollows = true) only moves the agents and lamps to
+//   time t: the GL masks and the ray scene wait for the setSplit(d) that the
+//   caller makes next (a frame with a split: one placement, not two).
 // - An agent whose body (its model's box grown by 0.3 m) holds the eye is
 //   the camera's carrier (the vehicle `vista path --traffic` rides) and is
 //   drawn nowhere: a vehicle's cameras do not see it from inside.
@@ -34,9 +37,13 @@
 //   LampState) under signalNode(), the last child of node(); setFrame(t)
 //   switches each head's overlay to SignalStates::lampAt(head, t), and the
 //   split treats a head as an agent (its sphere: lampOverlayCentre(),
-//   kLampOverlayRadius): within d in GL, beyond d a mover of the ray scene
-//   (prototype after the agents' ones, labelled as the head's static
-//   geometry: InstanceKind::TrafficLight, class TrafficLight). At a time
+//   kLampOverlayRadius): within d in GL, beyond d a still object of the ray
+//   scene (RayScene::placeMovers' `still` list, slot = head index; prototype
+//   after the agents' ones, labelled as the head's static geometry:
+//   InstanceKind::TrafficLight, class TrafficLight). A head's slot is
+//   re-placed only when its lamp or its side of the split changes, so the
+//   far field's cache serves its pixels on the other frames (far_field.h,
+//   FarFieldOptions::cacheMovers). At a time
 //   outside the run (before the tracks' first or after their last time) no
 //   overlay is shown or cast: the static lamps show, as without traffic.
 //   The label pass draws no overlay (the static head under it carries the
@@ -80,7 +87,7 @@ public:
     // added now); null detaches. Errors: those of RayScene::setMoverPrototypes.
     Status attachRays(RayScene* rays);
     RayScene* rays() const { return _rays; }
-    Status setFrame(double t, const glm::dvec3& eye);
+    Status setFrame(double t, const glm::dvec3& eye, bool splitFollows = false);
     Status setSplit(double nearDistance);
     // Shows `heads` lit from `states` (replacing any heads before; null
     // states or no heads: none). Errors: those of attachRays().

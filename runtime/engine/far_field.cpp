@@ -121,6 +121,9 @@ void FarField::renderStages(FarFrame& f, const float* depth, FrameStats& stats) 
     // The horizon beginFrame started is this frame's, used or not: consumed here (its
     // destructor waits for the task if no stage took it).
     std::future<HorizonResult> early = std::move(_mem->earlyHorizon);
+    // Still objects that changed since the last frame: their cells are forgotten now, whichever
+    // stages run, and their pixels traced in this frame's cache stage.
+    if (_options.cacheMovers) stillChanges(f, *_mem, _rays);
     CoveredHaze haze;  // beside the stages below, until the ray stage
     haze.start(f, _options);
     auto finishHaze = [&] {

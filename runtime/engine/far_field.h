@@ -124,7 +124,15 @@ struct FarFieldOptions {
     // bounding sphere now (plus kMoverMarginPx) is traced, never served from
     // the cache, and its cell is not kept (PanoramaCache::forget), so no
     // cached colour ever shows a moving object where it was, nor hides one
-    // where it is. false: the naive cache (measurements of its error only).
+    // where it is. Still objects of the ray scene (placeMovers' `still` list, a
+    // traffic run's lamp overlays) are cached as the city is: on a frame where
+    // one changed (its StillState::version differs from the one the cache last
+    // saw: another lamp, shown or hidden), the cells whose rays could pass
+    // through its old and new bounding boxes are forgotten
+    // (PanoramaCache::invalidateBox) and its screen footprint is traced that
+    // frame, so the change shows on that very frame; on the other frames its
+    // pixels are served from the cache. false: the naive cache (measurements
+    // of its error only).
     bool cacheMovers = true;
     // Pause the cache while it does not pay: after two consecutive cache
     // frames of a moving camera, if the share r of pending pixels the second

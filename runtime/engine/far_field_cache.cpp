@@ -48,19 +48,42 @@ PanoramaCache& ensureCache(FarFieldMemory& m, const Camera& camera, const FarFie
     return *m.cache;
 }
 
+uint64_t stillChanges(FarFrame& f, FarFieldMemory& m, const RayScene& rays) {
+    f.changedStills.clear();
+    const uint64_t serial = rays.stillSerial();
+    if (serial == m.stillSerial) return 0;
+    m.stillSerial = serial;
+    const std::vector<StillState>& now = rays.stillObjects();
+    if (m.stillSeen.size() < now.size()) m.stillSeen.resize(now.size());  // new slots: hidden so far
+    uint64_t forgotten = 0;
+    for (size_t i = 0; i < now.size(); ++i) {
+        if (now[i].version == m.stillSeen[i].version) continue;
+        const StillState* states[2] = {&m.stillSeen[i], &now[i]};
+        for (const StillState* s : states) {
+            if (!s->shown) continue;
+            f.changedStills.push_back(s->sphere);
+            if (!m.cache) continue;
+            const glm::dvec3 c(s->sphere), r(s->sphere.w);
+            forgotten += m.cache->invalidateBox(c - r, c + r, m.cacheReach);
+        }
+        m.stillSeen[i] = now[i];
+    }
+    return forgotten;
+}
+
 void moverFootprint(FarFrame& f, const RayScene& rays) {
     const std::vector<glm::dvec4>& spheres = rays.moverSpheres();
     f.moverMask.clear();
-    if (spheres.empty()) return;
+    if (spheres.empty() && f.changedStills.empty()) return;
     f.moverMask.assign(f.pixelCount, 0);
     const Camera& cam = f.camera;
     const glm::dvec3 fwd = cam.forward(), right = cam.right(), up = cam.up();
     const double focal = 0.5 * f.height / std::tan(0.5 * cam.fovY);
     const double margin = kMoverMarginPx / focal;  // radians
-    for (const glm::dvec4& s : spheres) {
+    auto mark = [&](const glm::dvec4& s, uint8_t bit) {
         const glm::dvec3 v = glm::dvec3(s) - cam.eye;
         const double d = glm::length(v), r = s.w, z = glm::dot(v, fwd);
-        if (z < -r) continue;  // behind the eye
+        if (z < -r) return;  // behind the eye
         int x0 = 0, x1 = f.width - 1, y0 = 0, y1 = f.height - 1;
         if (d > r && z - r > 1e-3) {
             // The sphere's image lies within this square around its centre's (each axis: |d x| <= r d / (z (z - r))).
@@ -77,8 +100,10 @@ void moverFootprint(FarFrame& f, const RayScene& rays) {
         for (int y = y0; y <= y1; ++y)
             for (int x = x0; x <= x1; ++x)
                 if (glm::dot(f.rays.dir(x, y), axis) >= cosLimit)
-                    f.moverMask[size_t(y) * size_t(f.width) + size_t(x)] = 1;
-    }
+                    f.moverMask[size_t(y) * size_t(f.width) + size_t(x)] |= bit;
+    };
+    for (const glm::dvec4& s : spheres) mark(s, kFootprintMover);
+    for (const glm::dvec4& s : f.changedStills) mark(s, kFootprintStill);
 }
 
 void cacheStage(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, FrameStats& stats) {

@@ -57,7 +57,7 @@ void compositeStage(FarFrame& f, FarFieldMemory& m, bool cacheMode, FrameStats& 
                 // A moving object may be in these cells: they are traced again while it is there.
                 std::vector<int64_t> moving;
                 for (size_t j = 0; j < f.trace.size(); ++j)
-                    if (f.moverMask[f.trace[j]]) moving.push_back(f.traceCells[j]);
+                    if (f.moverMask[f.trace[j]] & kFootprintMover) moving.push_back(f.traceCells[j]);
                 m.cache->forget(moving);
             }
         }

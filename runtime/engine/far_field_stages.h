@@ -23,6 +23,7 @@
 #include "runtime/engine/far_field.h"
 #include "runtime/engine/far_field_rays.h"
 #include "runtime/engine/panorama_cache.h"
+#include "runtime/engine/ray_scene.h"
 
 namespace vista {
 
@@ -110,6 +111,10 @@ struct FarFieldMemory {
     std::vector<float> farDepth;    // swapped into FarFrame::farDepth for the frame
     std::vector<uint32_t> raySlot;  // ray stage (rayStep 2): per pixel, ~0 between frames
     SpeculativeRays spec;           // FarField::beginFrame (o.speculate)
+    // Still objects (RayScene::stillObjects): per slot, the state the cache last accounted for,
+    // and the scene's stillSerial() then.
+    std::vector<StillState> stillSeen;
+    uint64_t stillSerial = 0;
 };
 
 // Radius (pixels) of the screen window whose nearest far surface a cached cell records.
@@ -138,8 +143,12 @@ struct FarFrame {
     std::vector<uint32_t> trace;         // pixels to trace this frame, ascending (cache)
     std::vector<int64_t> traceCells;     // their panorama cells (cache stage only)
     std::vector<glm::u8vec2> traceSubs;  // where their rays fall in those cells (cache stage only)
-    // Per pixel: inside a moving object's screen footprint (moverFootprint); empty = none.
+    // Per pixel: kFootprintMover inside a moving object's screen footprint, kFootprintStill inside
+    // that of a still object that changed this frame (moverFootprint); empty = none.
     std::vector<uint8_t> moverMask;
+    // World bounding spheres of the still objects that changed since the last frame, where they
+    // were and where they are (stillChanges).
+    std::vector<glm::dvec4> changedStills;
     std::vector<float>
         farDepth;  // cache mode: per pending pixel, eye-plane depth of its far colour (+inf = sky/none); others unset
 };
@@ -243,11 +252,23 @@ void listPending(FarFrame& f);
 void cacheStage(FarFrame& f, FarFieldMemory& m, const FarFieldOptions& o, FrameStats& stats);
 // f.moverMask: the pixels whose centre ray passes within kMoverMarginPx
 // pixels (at the image centre's pixel angle) of a moving object's bounding
-// sphere (RayScene::moverSpheres); empty when the scene has none. Exact per
+// sphere (RayScene::moverSpheres: kFootprintMover) or of a sphere of
+// f.changedStills (kFootprintStill); empty when there is none. Exact per
 // pixel inside each sphere's bounding square on screen; a sphere holding the
-// eye or crossing the eye plane marks every pixel.
+// eye or crossing the eye plane marks every pixel. The cache stage traces
+// every marked pixel; the composite forgets the cells of kFootprintMover
+// pixels only (a still object's new look is kept).
 constexpr double kMoverMarginPx = 1.5;
+constexpr uint8_t kFootprintMover = 1, kFootprintStill = 2;
 void moverFootprint(FarFrame& f, const RayScene& rays);
+// Still objects (RayScene::stillObjects; FarFieldOptions::cacheMovers): every
+// slot whose version differs from m.stillSeen's changed since the last
+// frame. Its old sphere (if it was shown) and new one (if it is) go to
+// f.changedStills, and the cache (if any) forgets the cells whose rays could
+// pass through their bounding boxes (PanoramaCache::invalidateBox with
+// m.cacheReach); m.stillSeen takes the new states. Nothing when
+// stillSerial() is unchanged. Returns the number of cells forgotten.
+uint64_t stillChanges(FarFrame& f, FarFieldMemory& m, const RayScene& rays);
 // The panorama for `camera` (resolution and oversample as o.cacheOversample
 // asks): kept when it fits, else made anew (its cells zero pages, not yet
 // resident).

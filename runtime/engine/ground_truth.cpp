@@ -44,7 +44,7 @@ uint32_t triangleId(const SceneMesh& m, uint32_t prim) {
 PixelLabel rayLabel(const SceneModel& city, const RayScene& rays, const RayHit& hit) {
     PixelLabel out;
     const HitSource src = rays.source(hit);
-    if (src.mover >= 0) {
+    if (src.mover >= 0 || src.still >= 0) {
         out.id = src.moverId;
         out.cls = src.moverClass;
     } else if (src.mesh >= 0 && size_t(src.mesh) < city.meshes.size()) {

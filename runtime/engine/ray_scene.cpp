@@ -137,6 +137,9 @@ struct PrototypeSet {
     }
 };
 
+// Column-major 3x4 float matrix of `xf` with `shift` subtracted from its translation (defined below).
+void embreeTransform(const glm::dmat4& xf, const glm::dvec3& shift, float m[12]);
+
 }  // namespace
 
 struct RayScene::Impl {
@@ -179,6 +182,7 @@ struct RayScene::Impl {
         glm::dmat4 transform{1.0};  // Tree, Mover: prototype frame -> world; Region: translation to its origin
         uint32_t moverId = 0;       // Mover: its label (instance: its index in the last placeMovers)
         uint8_t moverClass = 0;
+        int still = -1;  // Mover: its still slot (then instance is -1), or -1 for a moving one
     };
     std::vector<TopGeom> geoms;
     std::vector<MeshInfo> flatMeshes;
@@ -193,6 +197,59 @@ struct RayScene::Impl {
     std::vector<unsigned> moverGeoms;           // the pool of mover instances (ids in `movers`)
     size_t moversLive = 0;
     bool moversOn = false;  // some mover instance is enabled: queries trace `movers` too
+    // Still objects (placeMovers' `still` list): per slot what it shows, its instance in
+    // `movers` and its state for the far field's cache.
+    std::vector<StillPlacement> stills;
+    std::vector<unsigned> stillGeoms;
+    std::vector<StillState> stillStates;
+    uint64_t stillSerial = 0;
+    size_t stillsOn = 0;  // slots whose instance is enabled
+    uint64_t moverCommits = 0;
+
+    // A new instance geometry in `movers` (disabled until placed); returns its id.
+    unsigned newMoverInstance() {
+        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+        rtcSetGeometryTimeStepCount(g, 1);
+        const unsigned id = rtcAttachGeometry(movers, g);
+        rtcReleaseGeometry(g);
+        rtcDisableGeometry(rtcGetGeometry(movers, id));
+        if (moverTops.size() <= id) moverTops.resize(size_t(id) + 1);
+        return id;
+    }
+    // Shows prototype p.prototype at p.transform on instance `id` of `movers`; false (and the
+    // instance disabled) for an empty prototype. Labels and bookkeeping in moverTops[id].
+    bool placeMoverInstance(unsigned id, const MoverPlacement& p, int instance, int still) {
+        RTCScene child = moverProtos->scenes[p.prototype];
+        RTCGeometry g = rtcGetGeometry(movers, id);
+        TopGeom& tg = moverTops[id];
+        if (!child) {  // an empty prototype: nothing to hit
+            rtcDisableGeometry(g);
+            tg.kind = TopGeom::Kind::None;
+            return false;
+        }
+        if (tg.kind != TopGeom::Kind::Mover || tg.prototype != int(p.prototype) || tg.protos != moverProtos.get())
+            rtcSetGeometryInstancedScene(g, child);
+        float m[12];
+        embreeTransform(p.transform, origin, m);
+        rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, m);
+        rtcEnableGeometry(g);
+        rtcCommitGeometry(g);
+        tg.kind = TopGeom::Kind::Mover;
+        tg.index = -1;
+        tg.prototype = int(p.prototype);
+        tg.instance = instance;
+        tg.still = still;
+        tg.protos = moverProtos.get();
+        tg.transform = p.transform;
+        tg.normalMatrix = glm::transpose(glm::inverse(glm::mat3(glm::dmat3(p.transform))));
+        tg.moverId = p.id;
+        tg.moverClass = p.cls;
+        return true;
+    }
+    glm::dvec4 worldSphere(const MoverPlacement& p) const {
+        const glm::dvec4 b = moverBounds[p.prototype];
+        return glm::dvec4(glm::dvec3(p.transform * glm::dvec4(glm::dvec3(b), 1.0)), b.w);
+    }
 
     ~Impl() {
         for (Region& r : regions)
@@ -855,8 +912,21 @@ Status RayScene::setMoverPrototypes(const std::vector<SceneMesh>& prototypes) {
         rtcDisableGeometry(rtcGetGeometry(im.movers, im.moverGeoms[i]));
         im.moverTops[im.moverGeoms[i]] = Impl::TopGeom();
     }
-    if (im.moversLive > 0) rtcCommitScene(im.movers);
+    // Still slots likewise: each shown one changes (hidden).
+    bool stillChanged = false;
+    for (size_t i = 0; i < im.stills.size(); ++i) {
+        rtcDisableGeometry(rtcGetGeometry(im.movers, im.stillGeoms[i]));
+        im.moverTops[im.stillGeoms[i]] = Impl::TopGeom();
+        if (!im.stills[i].shown) continue;
+        im.stills[i].shown = false;
+        if (!stillChanged) ++im.stillSerial;
+        stillChanged = true;
+        im.stillStates[i].shown = false;
+        im.stillStates[i].version = im.stillSerial;
+    }
+    if (im.moversLive > 0 || im.stillsOn > 0) rtcCommitScene(im.movers);
     im.moversLive = 0;
+    im.stillsOn = 0;
     im.moversOn = false;
     im.moverSpheres.clear();
     im.moverProtos = *protos;
@@ -873,71 +943,82 @@ Status RayScene::setMoverPrototypes(const std::vector<SceneMesh>& prototypes) {
     return Status::ok();
 }
 
-Status RayScene::placeMovers(const std::vector<MoverPlacement>& movers) {
+Status RayScene::placeMovers(const std::vector<MoverPlacement>& movers, const std::vector<StillPlacement>* still) {
     Impl& im = *_impl;
     const size_t protoCount = im.moverProtos ? im.moverProtos->scenes.size() : 0;
+    auto bad = [&](uint32_t proto) {
+        return Status::error("ray scene: moving object of prototype " + std::to_string(proto) + " (have " +
+                             std::to_string(protoCount) + ")");
+    };
     for (const MoverPlacement& p : movers)
-        if (p.prototype >= protoCount)
-            return Status::error("ray scene: moving object of prototype " + std::to_string(p.prototype) + " (have " +
-                                 std::to_string(protoCount) + ")");
+        if (p.prototype >= protoCount) return bad(p.prototype);
+    if (still)
+        for (const StillPlacement& p : *still)
+            if (p.shown && p.object.prototype >= protoCount) return bad(p.object.prototype);
     if (!im.movers) return Status::ok();  // no prototypes, so nothing to place (movers is empty)
     im.moverSpheres.clear();
-    for (const MoverPlacement& p : movers) {
-        const glm::dvec4 b = im.moverBounds[p.prototype];
-        im.moverSpheres.push_back(glm::dvec4(glm::dvec3(p.transform * glm::dvec4(glm::dvec3(b), 1.0)), b.w));
-    }
+    for (const MoverPlacement& p : movers) im.moverSpheres.push_back(im.worldSphere(p));
     bool on = false;
     for (size_t i = 0; i < movers.size(); ++i) {
-        const MoverPlacement& p = movers[i];
-        RTCScene child = im.moverProtos->scenes[p.prototype];
-        if (i == im.moverGeoms.size()) {
-            RTCGeometry g = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_INSTANCE);
-            rtcSetGeometryTimeStepCount(g, 1);
-            const unsigned id = rtcAttachGeometry(im.movers, g);
-            rtcReleaseGeometry(g);
-            im.moverGeoms.push_back(id);
-            if (im.moverTops.size() <= id) im.moverTops.resize(size_t(id) + 1);
-        }
-        const unsigned id = im.moverGeoms[i];
-        RTCGeometry g = rtcGetGeometry(im.movers, id);
-        Impl::TopGeom& tg = im.moverTops[id];
-        if (!child) {  // an empty prototype: nothing to hit
-            rtcDisableGeometry(g);
-            tg.kind = Impl::TopGeom::Kind::None;
-            continue;
-        }
-        if (tg.kind != Impl::TopGeom::Kind::Mover || tg.prototype != int(p.prototype) ||
-            tg.protos != im.moverProtos.get())
-            rtcSetGeometryInstancedScene(g, child);
-        float m[12];
-        embreeTransform(p.transform, im.origin, m);
-        rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, m);
-        rtcEnableGeometry(g);
-        rtcCommitGeometry(g);
-        on = true;
-        tg.kind = Impl::TopGeom::Kind::Mover;
-        tg.index = -1;
-        tg.prototype = int(p.prototype);
-        tg.instance = int(i);
-        tg.protos = im.moverProtos.get();
-        tg.transform = p.transform;
-        tg.normalMatrix = glm::transpose(glm::inverse(glm::mat3(glm::dmat3(p.transform))));
-        tg.moverId = p.id;
-        tg.moverClass = p.cls;
+        if (i == im.moverGeoms.size()) im.moverGeoms.push_back(im.newMoverInstance());
+        on = im.placeMoverInstance(im.moverGeoms[i], movers[i], int(i), -1) || on;
     }
     for (size_t i = movers.size(); i < im.moversLive && i < im.moverGeoms.size(); ++i) {
         rtcDisableGeometry(rtcGetGeometry(im.movers, im.moverGeoms[i]));
         im.moverTops[im.moverGeoms[i]].kind = Impl::TopGeom::Kind::None;
     }
     im.moversLive = movers.size();
+    if (still) {
+        // Only the slots whose entry differs from what they show are re-placed.
+        bool changed = false;
+        const size_t slots = std::max(still->size(), im.stills.size());
+        for (size_t i = 0; i < slots; ++i) {
+            const StillPlacement want = i < still->size() ? (*still)[i] : StillPlacement{MoverPlacement(), false};
+            if (i == im.stills.size()) {
+                im.stills.push_back(StillPlacement{MoverPlacement(), false});
+                im.stillGeoms.push_back(im.newMoverInstance());
+                im.stillStates.push_back(StillState());
+            }
+            StillPlacement& have = im.stills[i];
+            const bool same = want.shown == have.shown &&
+                              (!want.shown || (want.object.prototype == have.object.prototype &&
+                                               want.object.transform == have.object.transform &&
+                                               want.object.id == have.object.id && want.object.cls == have.object.cls));
+            if (same) continue;
+            const unsigned id = im.stillGeoms[i];
+            const bool wasOn = im.moverTops[id].kind == Impl::TopGeom::Kind::Mover;
+            bool nowOn = false;
+            if (want.shown) {
+                nowOn = im.placeMoverInstance(id, want.object, -1, int(i));
+            } else {
+                rtcDisableGeometry(rtcGetGeometry(im.movers, id));
+                im.moverTops[id].kind = Impl::TopGeom::Kind::None;
+            }
+            im.stillsOn = im.stillsOn - (wasOn ? 1 : 0) + (nowOn ? 1 : 0);
+            if (!changed) ++im.stillSerial;
+            changed = true;
+            have = want;
+            StillState& st = im.stillStates[i];
+            if (want.shown) st.sphere = im.worldSphere(want.object);
+            st.shown = want.shown;
+            st.version = im.stillSerial;
+        }
+    }
     rtcCommitScene(im.movers);  // the movers' scene alone: the top level is left as it is
-    im.moversOn = on;
+    ++im.moverCommits;
+    im.moversOn = on || im.stillsOn > 0;
     return im.checkDevice("placing moving objects");
 }
 
 size_t RayScene::moverCount() const { return _impl->moversLive; }
 
 const std::vector<glm::dvec4>& RayScene::moverSpheres() const { return _impl->moverSpheres; }
+
+const std::vector<StillState>& RayScene::stillObjects() const { return _impl->stillStates; }
+
+uint64_t RayScene::stillSerial() const { return _impl->stillSerial; }
+
+uint64_t RayScene::moverCommits() const { return _impl->moverCommits; }
 
 Status RayScene::setFrameOrigin(const glm::dvec3& frameOrigin) {
     Impl& im = *_impl;
@@ -1046,6 +1127,7 @@ HitSource RayScene::source(const RayHit& h) const {
     const Impl::TopGeom& g = *gp;
     if (g.kind == Impl::TopGeom::Kind::Mover) {
         s.mover = g.instance;
+        s.still = g.still;
         s.moverId = g.moverId;
         s.moverClass = g.moverClass;
         return s;

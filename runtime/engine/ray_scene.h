@@ -81,13 +81,16 @@ struct TriangleSoup {
 // flat and soup scenes); mesh, instance and impostor index the SceneModel that
 // region was made from (build(): the city).
 // mover: a moving object placed by placeMovers() (its index in that list),
-// with the label given there (moverId, moverClass); -1 otherwise.
+// with the label given there (moverId, moverClass); -1 otherwise. still: a
+// still object of placeMovers()'s `still` list (its slot), labelled the same
+// way (moverId, moverClass); -1 otherwise.
 struct HitSource {
     int mesh = -1;
     int instance = -1;
     int impostor = -1;
     int region = -1;
     int mover = -1;
+    int still = -1;
     uint32_t moverId = 0;
     uint8_t moverClass = 0;
 };
@@ -100,6 +103,24 @@ struct MoverPlacement {
     glm::dmat4 transform{1.0};
     uint32_t id = 0;
     uint8_t cls = 0;
+};
+
+// One slot of placeMovers()'s still objects: an object that stands where it
+// is from call to call (a traffic light's lamp overlay) and only sometimes
+// changes what it shows (its prototype) or is hidden.
+struct StillPlacement {
+    MoverPlacement object;
+    bool shown = true;
+};
+
+// What the far field's cache needs of a still slot (RayScene::stillObjects):
+// its world bounding sphere (centre xyz, radius w; the last one it had when
+// hidden), whether it is shown, and `version`: the value of stillSerial() at
+// its last change (appeared, hidden, another prototype, transform or label).
+struct StillState {
+    glm::dvec4 sphere{0.0};
+    bool shown = false;
+    uint64_t version = 0;
 };
 
 enum class RayBuildQuality { Low, Medium, High };
@@ -207,12 +228,27 @@ public:
     // hides the objects placed before. Errors: a malformed prototype, an
     // unknown prototype index, an Embree error. A scene without
     // setMoverPrototypes() has no movers' scene and no mover in it.
+    // still (optional; null = as they are): the still objects, one slot per
+    // entry (slot i = entry i; slots beyond the list are hidden). They share
+    // the movers' scene and its commit, but only a slot whose entry differs
+    // from what it shows is re-placed, and each such change advances
+    // stillSerial() and the slot's StillState::version; they are not in
+    // moverSpheres() (the far field's cache keeps their pixels and forgets
+    // them only when they change: far_field.h). A new prototype set hides
+    // every slot (a change of each shown one).
     Status setMoverPrototypes(const std::vector<SceneMesh>& prototypes);
-    Status placeMovers(const std::vector<MoverPlacement>& movers);
+    Status placeMovers(const std::vector<MoverPlacement>& movers, const std::vector<StillPlacement>* still = nullptr);
     size_t moverCount() const;  // objects of the last placeMovers()
     // World bounding spheres (centre xyz, radius w) of the last placeMovers()'s
     // objects, in its order (the far field's cache keeps their pixels out).
     const std::vector<glm::dvec4>& moverSpheres() const;
+    // Per still slot (every slot placed so far, shown or hidden): see StillState.
+    const std::vector<StillState>& stillObjects() const;
+    // Advances with every change of a still slot (0 = none yet).
+    uint64_t stillSerial() const;
+    // placeMovers() calls that placed objects and committed the movers' scene (a counter for tests
+    // and the frame's bookkeeping: a caller that re-places nothing does not call).
+    uint64_t moverCommits() const;
     int regionCount() const;  // live regions
     // Moves the scene-local frame (regions layout): frameOrigin() becomes
     // `frameOrigin` rounded to whole metres from the current one, every

@@ -23,6 +23,8 @@
 #include "runtime/traffic/signal_states.h"
 #include "tests/common/temp_dir.h"
 
+#include "nodes/render/effects_mode.h"
+#include "nodes/render/render_mode.h"
 #include "nodes/render/traffic_scene.h"
 #include "runtime/engine/ray_scene.h"
 #include "runtime/traffic/agent_models.h"
@@ -329,4 +331,74 @@ TEST(TrafficScene, WithoutSignalStatesNoHeadNodeExists) {
     ASSERT_TRUE(ts.setSignalHeads(nullptr, {headAt(kHeadA, 20.0, 0.0)}));
     EXPECT_EQ(ts.signalNode(), nullptr);
     EXPECT_EQ(ts.node()->getNumChildren(), size_t(kAgents));
+}
+
+// A frame places the ray scene's movers once: the effects wrapper only moves
+// the traffic to the frame's time when the mode splits it (hybrid, raycast),
+// and the mode's setSplit places it. The heads' still slots change only on
+// the frames where a lamp changes (or a head crosses the split).
+namespace {
+
+// A mode that splits the traffic at 40 m, as hybrid does at its near distance.
+class SplittingMode : public RenderMode {
+public:
+    SplittingMode(ModeContext& ctx, bool splits) : _ctx(ctx), _splits(splits) {}
+    std::string name() const override { return "splitting"; }
+    Status renderFrame(const Camera&, Image&, FrameStats&) override {
+        return _splits ? _ctx.traffic->setSplit(40.0) : Status::ok();
+    }
+    osg::Node* viewerScene() override { return nullptr; }
+    bool splitsTraffic() const override { return _splits; }
+
+private:
+    ModeContext& _ctx;
+    bool _splits;
+};
+
+}  // namespace
+
+TEST(TrafficScene, AFramePlacesTheMoversOnceAndTheHeadsOnlyWhenALampChanges) {
+    vista::test::TempDir tmp("vista_traffic_place_once");
+    auto st = states(tmp.path());
+    ASSERT_TRUE(st) << st.status().message();
+    auto signals = std::make_shared<SignalStates>(std::move(*st));
+    auto rs = RayScene::build(ground());
+    ASSERT_TRUE(rs.isOk()) << rs.status().message();
+    RayScene& rays = **rs;
+    CityParams params;
+    TrafficScene ts(tracks(), params, /*labels=*/false);
+    ASSERT_TRUE(ts.attachRays(&rays));
+    ASSERT_TRUE(ts.setSignalHeads(signals, {headAt(kHeadA, 20.0, 0.0), headAt(kHeadB, 60.0, 0.0)}));
+    for (const bool splits : {true, false}) {
+        ModeContext ctx;
+        ctx.traffic = &ts;
+        std::unique_ptr<RenderMode> mode = withEffects(std::make_unique<SplittingMode>(ctx, splits), ctx);
+        Camera c;
+        c.eye = glm::dvec3(0.0, 0.0, 1.5);
+        c.width = c.height = 16;
+        Image img(16, 16);
+        int lampChanges = 0;
+        std::vector<LampState> before;
+        // Frames 0.5 s apart through the run: the agents move every frame; head B (beyond 40 m)
+        // changes its lamp at 6 s (red to red-amber) and 8 s (green).
+        for (double t = 0.25; t < 10.0; t += 0.5) {
+            c.time = t;
+            const uint64_t commits = rays.moverCommits(), serial = rays.stillSerial();
+            FrameStats fs;
+            ASSERT_TRUE(mode->renderFrame(c, img, fs));
+            EXPECT_LE(rays.moverCommits(), commits + 1) << "t " << t;
+            if (!splits) {
+                EXPECT_EQ(ts.headsCast(), 0u);  // everything in GL: nothing of the heads in the ray scene
+                EXPECT_EQ(ts.castCount(), 0u);
+                continue;
+            }
+            EXPECT_EQ(rays.moverCommits(), commits + 1) << "t " << t;  // the agents moved
+            EXPECT_EQ(ts.headsCast(), 1u);
+            const bool changed = !before.empty() && before[1] != ts.lamps()[1];
+            if (!before.empty()) { EXPECT_EQ(rays.stillSerial() != serial, changed) << "t " << t; }
+            lampChanges += changed ? 1 : 0;
+            before = ts.lamps();
+        }
+        if (splits) { EXPECT_EQ(lampChanges, 2); }
+    }
 }

@@ -6,6 +6,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "foundation/units.h"
 #include "tests/runtime/engine/far_field_fixtures.h"
 
 namespace {
@@ -101,4 +102,163 @@ TEST(FarFieldMovers, TheCacheNeverServesAMovingObjectsPixels) {
     // Turning, the cache reuses static pixels within its error bound (0.25 px): colours may
     // differ at static edges as they do without any object, and nowhere else.
     EXPECT_LE(fixedMoving, staticTurning + 3);
+}
+
+// Still objects (RayScene::placeMovers' `still` list, a traffic run's lamp
+// overlays): the cache serves their pixels while they do not change, and
+// traces them on the very frame they change (on screen), or forgets their
+// cells (off screen) so that the change shows when they come into view.
+namespace {
+
+SceneMesh lampBox(glm::u8vec4 colour) {
+    SceneMesh m;
+    addBox(m, {-1.0f, -1.0f, 0}, {1.0f, 1.0f, 3.0f}, colour);
+    return m;
+}
+
+std::vector<StillPlacement> lampAt(uint32_t prototype, glm::dvec3 p) {
+    StillPlacement s;
+    s.object = at(p.x, p.y, p.z);
+    s.object.prototype = prototype;
+    s.object.id = 77;
+    return {s};
+}
+
+// Places the still object alone (slot 0).
+bool placeLamp(TestCity& t, uint32_t prototype, glm::dvec3 p) {
+    const std::vector<StillPlacement> lamp = lampAt(prototype, p);
+    return bool(t.rays->placeMovers({}, &lamp));
+}
+
+// Pixels of a frame that show the still object: an uncached trace with it and one without it differ there.
+std::vector<size_t> footprint(TestCity& t, const Camera& c, const std::vector<StillPlacement>& lamp) {
+    FarField plain(*t.rays, &t.grid, options(false, true));
+    Image with(c.width, c.height), without(c.width, c.height);
+    FrameStats s;
+    EXPECT_TRUE(t.rays->placeMovers({}, &lamp));
+    plain.render(c, nullptr, with, s);
+    const std::vector<StillPlacement> none;
+    EXPECT_TRUE(t.rays->placeMovers({}, &none));
+    plain.render(c, nullptr, without, s);
+    std::vector<size_t> out;
+    for (size_t i = 0; i < size_t(c.width) * size_t(c.height); ++i)
+        if (channelDiff(with, without, i) > 1) out.push_back(i);
+    return out;
+}
+
+Image uncached(TestCity& t, const Camera& c) {
+    FarField plain(*t.rays, &t.grid, options(false, true));
+    Image img(c.width, c.height);
+    FrameStats s;
+    plain.render(c, nullptr, img, s);
+    return img;
+}
+
+}  // namespace
+
+TEST(FarFieldStill, TheCacheServesAStillObjectUntilItChangesAndTracesItOnThatFrame) {
+    TestCity t = testCity(7, 50);
+    ASSERT_TRUE(t.rays);
+    const glm::u8vec4 red{230, 20, 20, 255}, green{20, 230, 60, 255};
+    ASSERT_TRUE(t.rays->setMoverPrototypes({lampBox(red), lampBox(green)}));
+    const Camera view = cam(glm::dvec3(0, -190, 1.7), 0.0, -0.05, 240, 160);
+    const glm::dvec3 p(-4, -165, 0);
+    const std::vector<size_t> head = footprint(t, view, lampAt(0, p));
+    ASSERT_GT(head.size(), 30u);
+
+    FarField cached(*t.rays, &t.grid, options(true, true));
+    Image img(view.width, view.height);
+    const uint64_t serial0 = t.rays->stillSerial();
+    ASSERT_TRUE(placeLamp(t, 0, p));  // red
+    EXPECT_GT(t.rays->stillSerial(), serial0);
+    EXPECT_TRUE(t.rays->moverSpheres().empty());  // a still object is no mover
+    FrameStats s1;
+    cached.render(view, nullptr, img, s1);
+    // Frames without a change (the same placement passed again, or none passed): served from the cache.
+    const uint64_t serial1 = t.rays->stillSerial();
+    ASSERT_TRUE(placeLamp(t, 0, p));
+    ASSERT_TRUE(t.rays->placeMovers({}));
+    EXPECT_EQ(t.rays->stillSerial(), serial1);
+    for (int frame = 0; frame < 2; ++frame) {
+        FrameStats s;
+        cached.render(view, nullptr, img, s);
+        size_t fromCache = 0;
+        for (size_t i : head) fromCache += cached.classification()[i] == kFarCache ? 1 : 0;
+        EXPECT_EQ(fromCache, head.size()) << "frame " << frame;
+        for (size_t i : head)
+            ASSERT_EQ(glm::u8vec4(img.rgba[4 * i], img.rgba[4 * i + 1], img.rgba[4 * i + 2], 255), red);
+    }
+    // The lamp turns green: on this frame every pixel of the head is traced and shows green,
+    // and the frame equals an uncached trace.
+    ASSERT_TRUE(placeLamp(t, 1, p));
+    const std::vector<StillState>& st = t.rays->stillObjects();
+    ASSERT_EQ(st.size(), 1u);
+    EXPECT_EQ(st[0].version, t.rays->stillSerial());
+    FrameStats s2;
+    cached.render(view, nullptr, img, s2);
+    for (size_t i : head) {
+        EXPECT_TRUE(cached.classification()[i] == kFarRayHit) << "pixel " << i;
+        ASSERT_EQ(glm::u8vec4(img.rgba[4 * i], img.rgba[4 * i + 1], img.rgba[4 * i + 2], 255), green);
+    }
+    EXPECT_EQ(differing(img, uncached(t, view)), 0u);
+    // The next frame serves the green head from the cache again.
+    FrameStats s3;
+    cached.render(view, nullptr, img, s3);
+    size_t fromCache = 0;
+    for (size_t i : head) fromCache += cached.classification()[i] == kFarCache ? 1 : 0;
+    EXPECT_EQ(fromCache, head.size());
+    EXPECT_EQ(differing(img, uncached(t, view)), 0u);
+
+    // Off screen: the camera looks away while the lamp turns red and is hidden and shown; when
+    // it looks back, the head shows its lamp now (no cached colour of before).
+    Camera away = view;
+    away.heading += kPi;
+    for (uint32_t proto : {0u, 1u, 0u}) {
+        ASSERT_TRUE(placeLamp(t, proto, p));
+        FrameStats s;
+        cached.render(away, nullptr, img, s);
+    }
+    FrameStats s4;
+    cached.render(view, nullptr, img, s4);
+    for (size_t i : head)
+        ASSERT_EQ(glm::u8vec4(img.rgba[4 * i], img.rgba[4 * i + 1], img.rgba[4 * i + 2], 255), red) << "pixel " << i;
+    EXPECT_EQ(differing(img, uncached(t, view)), 0u);
+    // Hidden while looked away: the city behind it shows again (its cells were forgotten).
+    const std::vector<StillPlacement> none;
+    ASSERT_TRUE(t.rays->placeMovers({}, &none));
+    cached.render(away, nullptr, img, s4);
+    cached.render(view, nullptr, img, s4);
+    EXPECT_EQ(differing(img, uncached(t, view)), 0u);
+}
+
+TEST(FarFieldStill, ATurningCameraReusesTheStillObjectsPixels) {
+    TestCity t = testCity(7, 50);
+    ASSERT_TRUE(t.rays);
+    ASSERT_TRUE(t.rays->setMoverPrototypes({lampBox({230, 20, 20, 255})}));
+    const Camera view = cam(glm::dvec3(0, -190, 1.7), 0.0, -0.05, 240, 160);
+    const glm::dvec3 p(-4, -165, 0);
+    Camera turned = view;
+    turned.heading += 0.03;
+    const std::vector<size_t> head = footprint(t, turned, lampAt(0, p));
+    ASSERT_GT(head.size(), 30u);
+    ASSERT_TRUE(placeLamp(t, 0, p));
+    FarField cached(*t.rays, &t.grid, options(true, true));
+    Image img(view.width, view.height);
+    FrameStats s1, s2;
+    cached.render(view, nullptr, img, s1);
+    cached.render(turned, nullptr, img, s2);
+    size_t fromCache = 0;
+    for (size_t i : head) fromCache += cached.classification()[i] == kFarCache ? 1 : 0;
+    // Cells are world directions: the head's are reused within the cache's error bound, as the
+    // static city's are (a moving object's would all be traced).
+    EXPECT_GT(fromCache, head.size() / 2);
+    const size_t withHead = differing(img, uncached(t, turned));
+    // The static scene's own resampling error on the same turn, the head hidden.
+    const std::vector<StillPlacement> none;
+    ASSERT_TRUE(t.rays->placeMovers({}, &none));
+    FarField bare(*t.rays, &t.grid, options(true, true));
+    bare.render(view, nullptr, img, s1);
+    bare.render(turned, nullptr, img, s2);
+    const size_t staticTurning = differing(img, uncached(t, turned));
+    EXPECT_LE(withHead, staticTurning + 3 + head.size() / 10);
 }

@@ -296,3 +296,76 @@ TEST(RayMovers, TheTopLevelIsNotRebuiltForMovers) {
     const glm::vec3 org(glm::dvec3(5000, 0, 50) - s.frameOrigin());
     EXPECT_NEAR(s.intersect(org, {0, 0, -1}).t, 48.5f, 1e-3f);
 }
+
+// Still objects (placeMovers' `still` list): hit with their labels beside the
+// moving ones, re-placed only where a slot's entry changed (each change
+// advances stillSerial() and that slot's version), hidden by a shorter list.
+TEST(RayMovers, StillSlotsChangeOnlyWhereTheirEntryChanged) {
+    auto rs = RayScene::build(ground());
+    ASSERT_TRUE(rs.isOk()) << rs.status().message();
+    RayScene& s = **rs;
+    const glm::vec3 down(0, 0, -1);
+    SceneMesh tall;
+    addBox(tall, {-1, -1, 0}, {1, 1, 4}, {200, 20, 20, 255});
+    ASSERT_TRUE(s.setMoverPrototypes({carBox(), tall}));
+    auto slot = [](uint32_t proto, double x, uint32_t id) {
+        StillPlacement p;
+        p.object = {proto, placed(x, 0, 0.0), id, 9};
+        return p;
+    };
+    std::vector<StillPlacement> still = {slot(1, -30, 0xC0000001u), slot(1, -60, 0xC0000002u)};
+    const uint64_t commits = s.moverCommits();
+    ASSERT_TRUE(s.placeMovers({{0, placed(30, 0, 0.0), 5u, 15}}, &still));
+    EXPECT_EQ(s.moverCommits(), commits + 1);
+    EXPECT_EQ(s.moverSpheres().size(), 1u);  // the moving one only
+    ASSERT_EQ(s.stillObjects().size(), 2u);
+    const uint64_t v0 = s.stillSerial();
+    EXPECT_GT(v0, 0u);
+    for (const StillState& st : s.stillObjects()) {
+        EXPECT_TRUE(st.shown);
+        EXPECT_EQ(st.version, v0);
+    }
+    EXPECT_NEAR(s.stillObjects()[1].sphere.x, -60.0, 1e-9);
+    RayHit h = s.intersect({-60, 0, 50}, down);
+    ASSERT_TRUE(h.hit);
+    EXPECT_NEAR(h.t, 46.0f, 1e-3f);  // the tall box's roof at 4 m
+    HitSource src = s.source(h);
+    EXPECT_EQ(src.still, 1);
+    EXPECT_EQ(src.mover, -1);
+    EXPECT_EQ(src.moverId, 0xC0000002u);
+    EXPECT_EQ(src.moverClass, 9);
+    EXPECT_EQ(s.source(s.intersect({30, 0, 50}, down)).mover, 0);
+    // The moving one moves, the still ones are passed unchanged: no still change.
+    ASSERT_TRUE(s.placeMovers({{0, placed(35, 0, 0.0), 5u, 15}}, &still));
+    EXPECT_EQ(s.stillSerial(), v0);
+    ASSERT_TRUE(s.placeMovers({{0, placed(40, 0, 0.0), 5u, 15}}));  // still list not passed: as they are
+    EXPECT_EQ(s.stillSerial(), v0);
+    EXPECT_EQ(s.source(s.intersect({-30, 0, 50}, down)).still, 0);
+    // Slot 0 shows another prototype: only its version advances.
+    still[0].object.prototype = 0;
+    ASSERT_TRUE(s.placeMovers({}, &still));
+    const uint64_t v1 = s.stillSerial();
+    EXPECT_GT(v1, v0);
+    EXPECT_EQ(s.stillObjects()[0].version, v1);
+    EXPECT_EQ(s.stillObjects()[1].version, v0);
+    EXPECT_NEAR(s.intersect({-30, 0, 50}, down).t, 48.5f, 1e-3f);  // the car box's roof
+    EXPECT_EQ(s.moverCount(), 0u);
+    // A shorter list hides slot 1; the slot keeps its last sphere, not shown.
+    still.resize(1);
+    ASSERT_TRUE(s.placeMovers({}, &still));
+    EXPECT_GT(s.stillSerial(), v1);
+    EXPECT_FALSE(s.stillObjects()[1].shown);
+    EXPECT_EQ(s.stillObjects()[0].version, v1);
+    EXPECT_NEAR(s.stillObjects()[1].sphere.x, -60.0, 1e-9);
+    EXPECT_NEAR(s.intersect({-60, 0, 50}, down).t, 60.0f, 1e-3f);  // the ground again
+    // A still slot of an unknown prototype is an error; nothing changes.
+    const uint64_t v2 = s.stillSerial();
+    std::vector<StillPlacement> bad = {slot(7, -30, 1u)};
+    EXPECT_FALSE(s.placeMovers({}, &bad));
+    EXPECT_EQ(s.stillSerial(), v2);
+    // A new prototype set hides every slot (a change of the shown one).
+    ASSERT_TRUE(s.setMoverPrototypes({carBox()}));
+    EXPECT_GT(s.stillSerial(), v2);
+    EXPECT_FALSE(s.stillObjects()[0].shown);
+    EXPECT_NEAR(s.intersect({-30, 0, 50}, down).t, 60.0f, 1e-3f);
+}
