@@ -470,6 +470,7 @@ private:
     bool meetsRadius(const LinkRoad& r) const;
     std::vector<bool> crossingTurns(const std::vector<LinkRoad>& turns, std::vector<long>& crossed) const;
     void noteKeptCrossing(const LinkRoad& r, long owner);
+    void noteShortArm(int j, uint32_t e);
     void fitTurns(size_t j, std::vector<LinkRoad>& turns, std::vector<TurnPlan>& turnPlans);
     LinkRoad junctionRoad(int j, const TurnPlan& t) const;
     bool place(LinkRoad& r) const;
@@ -482,7 +483,7 @@ private:
     void planTransitions();
     void applyTrims();
     void placeLinks();
-    bool addLaneTurn(size_t j, uint32_t in, uint32_t out, int k, int o, bool mayCross);
+    bool addLaneTurn(size_t j, uint32_t in, uint32_t out, int k, int o, bool mayCross, bool mayBeTight);
     void connectLeftovers(size_t j);
     void placeSignals();
     void groupApproaches();
@@ -920,9 +921,11 @@ void LaneModelBuilder::placeLinks() {
 
 // A turn of one lane (incoming lane k of `in` into outgoing lane o of
 // `out`) at junction j, placed with the trims the edges got; false when the
-// turn is sharper than kMaxTurn or its lane would reach the centre of
-// curvature.
-bool LaneModelBuilder::addLaneTurn(size_t j, uint32_t in, uint32_t out, int k, int o, bool mayCross) {
+// turn is sharper than kMaxTurn, its lane would reach the centre of
+// curvature, it misses its turning radius (unless mayBeTight: then kept and
+// counted in tightTurnsKept) or it crosses another road (unless mayCross).
+bool LaneModelBuilder::addLaneTurn(size_t j, uint32_t in, uint32_t out, int k, int o, bool mayCross,
+                                   bool mayBeTight) {
     Junction& J = m.junctions[j];
     TurnPlan t;
     t.in = in;
@@ -936,10 +939,17 @@ bool LaneModelBuilder::addLaneTurn(size_t j, uint32_t in, uint32_t out, int k, i
     t.shift = k - o;
     LinkRoad r = junctionRoad(int(j), t);
     if (!place(r)) return false;
+    const bool tight = !meetsRadius(r);
+    if (tight && !mayBeTight) return false;
     if (const long o = cross.crossed(r); o != CrossIndex::kNone) {
         if (!mayCross) return false;
         ++m.crossingTurnsKept;
         noteKeptCrossing(r, o);
+    }
+    if (tight) {
+        ++m.tightTurnsKept;
+        noteShortArm(int(j), in);
+        noteShortArm(int(j), out);
     }
     cross.addTurn(r);
     J.links.push_back(uint32_t(m.links.size()));
@@ -953,7 +963,9 @@ bool LaneModelBuilder::addLaneTurn(size_t j, uint32_t in, uint32_t out, int k, i
 // into an outgoing lane nobody feeds where there is one; then every outgoing
 // lane that no incoming lane feeds (tapered lanes appearing inside a turn do
 // not count) is fed from the approach that already turns into its arm (else
-// the straightest), from the lane on the same side of the road. Lanes left
+// the straightest), from the lane on the same side of the road. Turns that
+// keep their turning radius and cross no other road come first, then those
+// that cross one, then those below the radius (counted in tightTurnsKept). Lanes left
 // without a connection (every candidate turn too sharp or unplaceable) are
 // counted in unlinkedLanes / unfedLanes.
 void LaneModelBuilder::connectLeftovers(size_t j) {
@@ -998,7 +1010,7 @@ void LaneModelBuilder::connectLeftovers(size_t j) {
     for (uint32_t in : J.arms) {
         const int nIn = end(in, v).toward();
         for (int k = 1; k <= nIn; ++k) {
-            for (int mayCross = 0; mayCross < 2 && !taken[in][size_t(k)]; ++mayCross) {
+            for (int pass = 0; pass < 4 && !taken[in][size_t(k)]; ++pass) {
                 for (uint32_t out : order(in, true)) {
                     const int nOut = end(out, v).away();
                     auto it = shiftOf.find({in, out});
@@ -1007,31 +1019,35 @@ void LaneModelBuilder::connectLeftovers(size_t j) {
                     int o = target;
                     for (int x = 1, best = 1 << 30; x <= nOut; ++x)  // the nearest outgoing lane nobody feeds
                         if (!fed[out][size_t(x)] && std::abs(x - target) < best) best = std::abs(x - target), o = x;
-                    if (addLaneTurn(j, in, out, k, o, mayCross != 0)) {
+                    if (addLaneTurn(j, in, out, k, o, pass & 1, pass >= 2)) {
                         mark(m.links.back());
                         break;
                     }
                 }
             }
             m.unlinkedLanes += !taken[in][size_t(k)];
+            if (!taken[in][size_t(k)])
+                for (uint32_t e : J.arms) noteShortArm(int(j), e);
         }
     }
     for (uint32_t out : J.arms) {
         const int nOut = end(out, v).away();
         for (int o = 1; o <= nOut; ++o) {
-            for (int mayCross = 0; mayCross < 2 && !fed[out][size_t(o)]; ++mayCross) {
+            for (int pass = 0; pass < 4 && !fed[out][size_t(o)]; ++pass) {
                 for (uint32_t in : order(out, false)) {
                     const int nIn = end(in, v).toward();
                     auto it = shiftOf.find({in, out});
                     const int minus = it == shiftOf.end() ? 0 : -it->second;
                     const int k = across(o, nOut, nIn, angleOf(in, out), it == shiftOf.end() ? nullptr : &minus);
-                    if (addLaneTurn(j, in, out, k, o, mayCross != 0)) {
+                    if (addLaneTurn(j, in, out, k, o, pass & 1, pass >= 2)) {
                         mark(m.links.back());
                         break;
                     }
                 }
             }
             m.unfedLanes += !fed[out][size_t(o)];
+            if (!fed[out][size_t(o)])
+                for (uint32_t e : J.arms) noteShortArm(int(j), e);
         }
     }
 }
@@ -1096,6 +1112,8 @@ void LaneModelBuilder::fitTurns(size_t j, std::vector<LinkRoad>& turns, std::vec
         } else if (needed) {
             state[x] = Ok;
             ++m.tightTurnsKept;
+            noteShortArm(int(j), ps[x].in);
+            noteShortArm(int(j), ps[x].out);
         } else {
             ++m.tightTurns;
         }
@@ -1132,6 +1150,16 @@ void LaneModelBuilder::noteKeptCrossing(const LinkRoad& r, long owner) {
             if (std::abs(glm::dot(p - node, n)) < half) need = std::max(need, glm::dot(p - node, d) + kArmClearance);
     double& grow = atB ? growTrimB[e] : growTrimA[e];
     grow = std::max(grow, need);
+}
+
+// Junction j failed a lane across arm e (a turn kept below its radius, a lane
+// left without a connection): when e is shrunk to kMinRoadLength between j and
+// another junction, that pair goes to keptCrossings (joined like a crossing).
+void LaneModelBuilder::noteShortArm(int j, uint32_t e) {
+    const EdgeLanes& L = m.edges[e];
+    if (!L.valid || L.length > kMinRoadLength + 1e-9) return;
+    for (int x : {L.junctionA, L.junctionB})
+        if (x >= 0 && x != j) keptCrossings.emplace_back(j, x);
 }
 
 // Junction turns (placed, by junction) whose driving lanes would share area

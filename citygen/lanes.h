@@ -91,8 +91,12 @@
 //   carriageway) and the model is built again; where it crosses a road or
 //   turn of a junction that an edge too short for its trims joins to its
 //   own, the two junctions are joined (above) and the model is built again
-//   (at most four such rounds). Both kept counts come from clusters of
-//   junctions joined by edges shorter than their trims.
+//   (at most four such rounds). The same joining applies where a junction
+//   keeps a turn below its radius or leaves a lane without a connection and
+//   one of its arms is an edge shrunk to kMinRoadLength between it and another
+//   junction (a small roundabout mapped as a ring of short ways). Both kept
+//   counts come from clusters of junctions joined by edges shorter than
+//   their trims.
 // - Link roads (LinkRoad): every junction has one per allowed turn (ordered
 //   pair of distinct arms with lanes to give and take, |turn| <= kMaxTurn);
 //   every other degree-2 node has one transition road joining its two edges, unless
@@ -116,7 +120,10 @@
 //   its arm already turns into (else the straightest one within kMaxTurn),
 //   preferably into an outgoing lane nobody feeds; an outgoing lane that no
 //   incoming lane feeds gets a one-lane turn from the approach that already
-//   turns into its arm (else the straightest). A lane tapering in inside a
+//   turns into its arm (else the straightest). Such a turn is one that keeps
+//   its turning radius and crosses no other road where there is one, else one
+//   that crosses a road (crossingTurnsKept), else one below the radius
+//   (tightTurnsKept). A lane tapering in inside a
 //   turn (width 0 where it starts, no predecessor) does not count as fed.
 //   What no turn can connect is counted (unlinkedLanes, unfedLanes).
 // Edges with invalid node indices, non-finite coordinates or zero length are

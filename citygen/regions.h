@@ -100,6 +100,8 @@ public:
     const RegionGrid& grid() const { return _grid; }
     const StreetGraph& streets() const { return _streets; }
     size_t blockCount() const { return _blocks.size(); }
+    // The whole city's blocks (extractBlocks of streets(), as generateCity's).
+    const std::vector<Block>& blocks() const { return _blocks; }
     // The completion counts of the imported buildings (enabled when given).
     const OsmBuildingStats& osmBuildingStats() const { return _osmStats; }
     City region(int r) const;

@@ -85,7 +85,8 @@ CLI::Option* declareFlags(CLI::App& app, GenArgs& a) {
     app.add_option("--geojson", a.geojsonFile, "also write the street graph as GeoJSON");
     app.add_option("--gltf", a.gltfFile, "also write the city as binary glTF 2.0 (.glb)");
     app.add_option("--xodr", a.xodrFile,
-                   "also write the road network as ASAM OpenDRIVE 1.6 (.xodr, see docs/formats.md)");
+                   "also write the road network as ASAM OpenDRIVE 1.6 (.xodr, see docs/formats.md); with paged "
+                   "output one file for the whole city, written with the index (not by a --shard)");
     app.add_option("--stats", a.statsFile, "write statistics (counts, timings, peak memory) as JSON");
     auto* out = app.add_option("-o,--output", a.out,
                                "output: a scene file (.osgb), or a paged city directory (DIR.paged: one city file per "
@@ -235,10 +236,17 @@ Result<PagedCityOptions> resolvePaged(const GenArgs& a, const CityParams& params
         o.shardCommand = shardCommand(a, o.dir);
     }
     for (auto [opt, path] : {std::pair<const char*, const std::string*>{"--geojson", &a.geojsonFile},
-                             {"--gltf", &a.gltfFile},
-                             {"--xodr", &a.xodrFile}})
+                             {"--gltf", &a.gltfFile}})
         if (!path->empty())
             return Status::error(std::string("option ") + opt + ": not supported with paged output (-o DIR.paged)");
+    if (!a.xodrFile.empty()) {
+        if (o.shard.count > 1)
+            return Status::error("option --xodr: not with --shard (a shard writes its regions only; give --xodr to "
+                                 "the --merge, which writes the whole road network)");
+        VISTA_RETURN_IF_ERROR(checkXodrPath("--xodr", a.xodrFile));
+        VISTA_RETURN_IF_ERROR(checkWritablePath("--xodr", a.xodrFile));
+        o.xodr = a.xodrFile;
+    }
     if (bakedLightingCalledFor(params))
         return Status::error(
             "parameter 'effects' = " + params.effects.list() +
@@ -337,6 +345,10 @@ int runPaged(const GenArgs& a, CityParams params, const Stopwatch& total) {
         j["memory"] = {{"estimate_mb", estimateMb},
                        {"budget_gb", a.budgetGb > 0 ? nlohmann::json(a.budgetGb) : nlohmann::json(nullptr)}};
         j["threads"] = params.threads;
+        if (rep->xodrWritten) {
+            j["seconds"]["stages"]["opendrive"] = rep->xodrSeconds;
+            j["opendrive"] = nlohmann::ordered_json::parse(openDriveCountsJson(rep->roads));
+        }
         if (osm) j["osm_roads"] = nlohmann::ordered_json::parse(osmRoadTagStatsJson(osm->roadTagStats));
         if (Status s = writeFileAtomic(batch.stage(a.statsFile), j.dump(2) + "\n"); !s) return reportBadInput(kCmd, s);
     }
@@ -350,6 +362,9 @@ int runPaged(const GenArgs& a, CityParams params, const Stopwatch& total) {
             rep->triangles / 1e6, rep->bytes / 1e6,
             rep->indexWritten ? "index written" : "no index (shard: run --merge when every shard is done)",
             totalSeconds, peakRssMb());
+    if (!a.quiet && rep->xodrWritten)
+        std::fprintf(stderr, "wrote %s: %zu roads, %zu junctions, %zu connecting roads\n", a.xodrFile.c_str(),
+                     rep->roads.roads, rep->roads.junctions, rep->roads.connectingRoads);
     return 0;
 }
 

@@ -18,6 +18,7 @@
 #include <osg/PagedLOD>
 
 #include "citygen/generate.h"
+#include "citygen/opendrive.h"
 #include "citygen/regions.h"
 #include "foundation/atomic_file.h"
 #include "foundation/hash.h"
@@ -396,9 +397,22 @@ Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedC
     }
     VISTA_RETURN_IF_ERROR(
         writeFileAtomic(batch.stage((fs::path(o.dir) / kPagedManifestFile).string()), manifest.dump(2) + "\n"));
+    rep.indexSeconds = seconds(ti);
+    if (!o.xodr.empty()) {  // the whole road network; a run that reused every region grows the streets again
+        const auto tx = std::chrono::steady_clock::now();
+        if (!base) {
+            auto b = RegionalCity::create(params, o.regionSizeM, pr, o.inputs);
+            if (!b) return b.status();
+            base.emplace(std::move(*b));
+        }
+        auto text = openDriveXml(base->streets(), params, &base->blocks(), &rep.roads);
+        if (!text) return Status::error("option --xodr = '" + o.xodr + "': " + text.status().message());
+        VISTA_RETURN_IF_ERROR(writeFileAtomic(batch.stage(o.xodr), *text));
+        rep.xodrWritten = true;
+        rep.xodrSeconds = seconds(tx);
+    }
     if (!o.batch) VISTA_RETURN_IF_ERROR(own.commit());
     rep.indexWritten = true;
-    rep.indexSeconds = seconds(ti);
     if (o.merge) {  // totals over the whole city
         rep.emptyRegions = 0;
         rep.buildings = rep.trees = rep.triangles = rep.bytes = 0;

@@ -12,6 +12,10 @@
 //   streets.json               the whole street graph (streetGraphToJson) of a city whose streets
 //                              were given (an OSM import), for readers that cannot grow it again
 //   records/region_IX_IY.json  one record per finished region (what resume checks)
+// and, when `xodr` names a file (beside or outside DIR), the road network of the whole
+// city as one OpenDRIVE file (openDriveXml of the whole street graph and blocks: the bytes
+// `vista gen --xodr` writes for the single-file city of the same streets), written with the
+// index (staged into the same batch).
 // Empty regions (no geometry) have a record and a manifest entry but no files and no PagedLOD.
 //
 // generatePagedCity(): generates every region of `options.shard` (region index
@@ -26,7 +30,8 @@
 // file depend only on params, the region size and the given inputs: the same for any thread
 // count, any split into shards and any number of interruptions. Shards of one
 // city may run concurrently in separate processes on the same directory.
-// Memory: the street graph and blocks of the whole city plus one region.
+// Memory: the street graph and blocks of the whole city plus one region; with
+// `xodr`, also the lane model and the OpenDRIVE text of the whole road network.
 //
 // Contract: params valid (validateParams; size_m up to kMaxPagedSizeM),
 // region size validateRegionSize, shard 0 <= index < count; otherwise an error
@@ -38,6 +43,7 @@
 #include <cstdint>
 #include <string>
 
+#include "citygen/opendrive.h"
 #include "citygen/params.h"
 #include "citygen/regions.h"
 #include "foundation/atomic_file.h"
@@ -68,6 +74,9 @@ struct PagedCityOptions {
     // the caller commits them with its own outputs (--stats); null: they are
     // committed here.
     OutputBatch* batch = nullptr;
+    // Non-empty: write the whole road network as OpenDRIVE to this path when the
+    // index is written (unsharded or merge; a shard writes none).
+    std::string xodr;
 };
 
 struct PagedCityReport {
@@ -77,10 +86,12 @@ struct PagedCityReport {
     int regenerated = 0;   // of `generated`: had a record or files that did not check out
     int emptyRegions = 0;  // of those this run generated or reused
     bool indexWritten = false;
+    bool xodrWritten = false;
+    OpenDriveCounts roads;  // of the OpenDRIVE file, when xodrWritten
     size_t streetEdges = 0, blocks = 0;  // of the whole city (0 if nothing was generated)
     // Totals over the regions this run generated or reused.
     size_t buildings = 0, trees = 0, triangles = 0, bytes = 0;
-    double baseSeconds = 0, regionSeconds = 0, indexSeconds = 0;
+    double baseSeconds = 0, regionSeconds = 0, indexSeconds = 0, xodrSeconds = 0;
 };
 
 // `dir` does not exist (its nearest existing ancestor is a writable directory)

@@ -140,3 +140,34 @@ TEST(OpenDrive, GenStatsCountTheRoadNetwork) {
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_FALSE(nlohmann::json::parse(readBytes(dir.file("t.json"))).contains("opendrive"));
 }
+
+// Paged output writes the whole road network as one .xodr with the index: the
+// bytes of the single-file city (same streets), its counts in --stats; a run
+// that reuses every region writes it again; a shard is refused (exit 2,
+// naming --xodr, nothing written).
+TEST(OpenDrive, PagedOutputWritesTheWholeNetwork) {
+    TempDir dir("vista_xodr_paged");
+    const std::string single = dir.file("single.xodr"), paged = dir.file("paged.xodr"), st = dir.file("s.json");
+    auto r = runVista("gen --size 500 --seed 4 --detail 0 -q -o " + dir.file("c.osgb") + " --xodr " + single);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const std::string city = " --size 500 --seed 4 --detail 0 --region-size 250 -q -o " + dir.file("c.paged");
+    r = runVista("gen" + city + " --xodr " + paged + " --stats " + st);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const std::string bytes = readBytes(paged);
+    EXPECT_GT(bytes.size(), 1000u);
+    EXPECT_EQ(bytes, readBytes(single));
+    const nlohmann::json j = nlohmann::json::parse(readBytes(st));
+    ASSERT_TRUE(j.contains("opendrive")) << j.dump();
+    EXPECT_GT(j["opendrive"]["roads"].get<int>(), 0);
+    fs::remove(paged);
+    r = runVista("gen" + city + " --xodr " + paged);  // every region reused
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(readBytes(paged), bytes);
+    const std::string shard = dir.file("shard.xodr");
+    r = runVista("gen --size 500 --seed 4 --detail 0 --region-size 250 -q -o " + dir.file("s.paged") +
+                 " --shard 1/2 --xodr " + shard);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--xodr"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(shard));
+    EXPECT_FALSE(fs::exists(dir.file("s.paged")));
+}
