@@ -68,7 +68,7 @@ Result<size_t> forbidJunctionLaneChanges(const std::string& netPath) {
             } else if (s->internalEdgeDepth >= 0 && s->depth == s->internalEdgeDepth + 1 &&
                        std::strcmp(name, "lane") == 0 && !hasAttr(atts, "changeLeft") &&
                        !hasAttr(atts, "changeRight")) {
-                s->insertAt.push_back(size_t(XML_GetCurrentByteIndex(s->parser)) + std::strlen("<lane"));
+                s->insertAt.push_back(size_t(XML_GetCurrentByteIndex(s->parser)));
             }
         },
         [](void* u, const XML_Char*) {
@@ -83,13 +83,24 @@ Result<size_t> forbidJunctionLaneChanges(const std::string& netPath) {
     }
     if (!scan.sawRoot) return Status::error("SUMO network '" + netPath + "' is empty");
 
+    // The marks go at the end of each <lane ...> start tag (before "/>" or
+    // ">"), so the tag still begins with its id as netconvert wrote it.
     static const char kMark[] = " changeLeft=\"ignoring\" changeRight=\"ignoring\"";
     std::string out;
     out.reserve(text.size() + scan.insertAt.size() * (sizeof kMark - 1));
     size_t from = 0;
-    for (size_t at : scan.insertAt) {
-        if (at > text.size() || text.compare(at - 5, 5, "<lane") != 0)
+    for (size_t tag : scan.insertAt) {
+        size_t at = tag;
+        char quote = 0;
+        for (; at < text.size(); ++at) {
+            const char c = text[at];
+            if (quote) quote = c == quote ? 0 : quote;
+            else if (c == '"' || c == '\'') quote = c;
+            else if (c == '>') break;
+        }
+        if (at >= text.size() || text.compare(tag, 5, "<lane") != 0)
             return Status::error("SUMO network '" + netPath + "': a <lane> tag is not where the parser put it");
+        if (text[at - 1] == '/') --at;
         out.append(text, from, at - from);
         out += kMark;
         from = at;

@@ -13,7 +13,8 @@
 //
 // Contract:
 // - Each <lane> child of an internal <edge> gains changeLeft="ignoring" and
-//   changeRight="ignoring" (SUMO's lane-change permissions: only the class
+//   changeRight="ignoring" at the end of its start tag (SUMO's lane-change
+//   permissions: only the class
 //   `ignoring`, which vista's demand never uses, may change); a lane that
 //   already carries either attribute keeps its own. Nothing else of the file
 //   changes (same bytes elsewhere), so the result is deterministic.
