@@ -178,9 +178,11 @@ double cross2(const glm::dvec2& a, const glm::dvec2& b) { return a.x * b.y - a.y
 // tangent to both. Where the two nodes differ (a joined junction) the corner
 // is the point where the two roads' lines meet; false when it does not lie
 // ahead of both ends (or, for parallel roads, the two lines differ), or lies
-// farther than the two trims and the nodes' distance allow.
+// farther than the two trims and the nodes' distance allow. The arc starts
+// and ends at least `lead` from the two ends (false when the trims leave no
+// arc then).
 bool filletGeometry(LinkRoad& r, const glm::dvec2& nodeIn, const glm::dvec2& d0, const glm::dvec2& nodeOut,
-                    const glm::dvec2& d1, double tIn, double tOut) {
+                    const glm::dvec2& d1, double tIn, double tOut, double lead) {
     r.start = nodeIn - d0 * tIn;
     r.hdg = std::atan2(d0.y, d0.x);
     r.angle = turnAngle(d0, d1);
@@ -203,7 +205,9 @@ bool filletGeometry(LinkRoad& r, const glm::dvec2& nodeIn, const glm::dvec2& d0,
         r.arcLength = r.curvature = r.line1 = 0;
         return true;
     }
-    const double t = std::min(tIn, tOut), R = t / std::tan(0.5 * std::abs(r.angle));
+    const double t = std::min(tIn, tOut) - lead;
+    if (!(t > 1e-9)) return false;
+    const double R = t / std::tan(0.5 * std::abs(r.angle));
     r.line0 = tIn - t;
     r.line1 = tOut - t;
     r.arcLength = R * std::abs(r.angle);
@@ -700,7 +704,8 @@ void LaneModelBuilder::planTurns() {
             for (const TurnPlan& t : exits) {
                 const LinkRoad r = junctionRoad(int(j), t);
                 const double need = std::max(filletTrim(t.angle, turnSideExtent(r)),
-                                             radiusTrim(t.angle, turnCentreExtent(r), turnRadius(t.in, t.out)));
+                                             radiusTrim(t.angle, turnCentreExtent(r), turnRadius(t.in, t.out))) +
+                                    kCrossingLeadIn;
                 // A turn between two nodes of a joined junction bends where
                 // its arms' lines meet, not at a node: fitTurns decides.
                 const uint32_t u = nodeOf(t.in, v);
@@ -843,11 +848,17 @@ void LaneModelBuilder::applyTrims() {
 // lanes would reach the centre of curvature.
 bool LaneModelBuilder::place(LinkRoad& r) const {
     const NodeEnd in = end(r.in, r.node), out = end(r.out, r.node);
-    if (!filletGeometry(r, g.nodes[nodeOf(r.in, r.node)], in.dirIn(), g.nodes[nodeOf(r.out, r.node)], -out.dirIn(),
-                        trimAt(r.in, r.node), trimAt(r.out, r.node)))
-        return false;
-    if (r.arcLength <= 0) return r.length() > 1e-9;
-    return 1.0 / std::abs(r.curvature) >= turnSideExtent(r) + kCurvatureMargin;
+    auto fillet = [&](double lead) {
+        if (!filletGeometry(r, g.nodes[nodeOf(r.in, r.node)], in.dirIn(), g.nodes[nodeOf(r.out, r.node)], -out.dirIn(),
+                            trimAt(r.in, r.node), trimAt(r.out, r.node), lead))
+            return false;
+        if (r.arcLength <= 0) return r.length() > 1e-9;
+        return 1.0 / std::abs(r.curvature) >= turnSideExtent(r) + kCurvatureMargin;
+    };
+    // A junction turn runs straight for kCrossingLeadIn at both ends where
+    // the trims allow it with its turning radius kept (lanes.h).
+    if (r.junction >= 0 && fillet(kCrossingLeadIn) && meetsRadius(r)) return true;
+    return fillet(0.0);
 }
 
 // True when every lane centre of a placed junction turn keeps its class's

@@ -104,7 +104,13 @@
 //   in sharpCorners; both ends are then dead ends). A link road's reference
 //   line is a line, a circular arc and a line, tangent to both street roads
 //   (G1), starting at the incoming road's trimmed end and ending at the
-//   outgoing road's trimmed start; its lane widths and lane offset run from
+//   outgoing road's trimmed start. At junctions each arm is trimmed
+//   kCrossingLeadIn further than its turns need, and a turn's lines are at
+//   least kCrossingLeadIn long where the trims allow it with the turning
+//   radius kept (else it turns as soon as the trims let it): the crosswalk at
+//   the arm's end lies across the straight part, so a vehicle crosses it
+//   heading along the arm, not turning (a turning vehicle's body sweeps
+//   beyond its path, back over a crosswalk it has passed). Its lane widths and lane offset run from
 //   the values of the road it leaves to those of the road it enters along a
 //   smoothstep (zero slope at both ends), so linked lane borders meet. A lane
 //   that exists on one side only appears or ends with width 0 there.
@@ -144,6 +150,7 @@ constexpr double kCurvatureMargin = 0.3;        // lane borders stay this far fr
 constexpr double kTaperLength = 12.0;           // transition length where lane counts or widths change
 constexpr double kMinLinkLength = 1.0;          // shortest transition (straight on, same lanes)
 constexpr double kArmClearance = 0.05;          // gap left between the surfaces of two acute arms
+constexpr double kCrossingLeadIn = 5.0;  // straight start and end of a junction turn: a crosswalk's depth and a margin
 // Smallest lane-centre radius of a junction turn by road class (metres);
 // Local is a car's kerb-to-kerb turning radius, the floor of all classes.
 constexpr double kMinTurnRadiusLocal = 5.0;

@@ -14,6 +14,7 @@
 #include "foundation/atomic_file.h"
 #include "foundation/hash.h"
 #include "foundation/format.h"
+#include "runtime/traffic/junction_lanes.h"
 #include "runtime/traffic/sumo_net.h"
 #include "runtime/traffic/sumo_process.h"
 
@@ -213,6 +214,9 @@ Status runAll(const std::string& xodrText, const TrafficOptions& opt, const std:
          "--opendrive.curve-resolution", "0.5", "--no-turnarounds", "true", "--no-warnings", "true"},
         work, logs));
     VISTA_RETURN_IF_ERROR(stripGeneratedDate((w / "city.net.xml").string()));
+    // No lane changes inside junctions (a vehicle moved sideways there onto a
+    // pedestrian waiting on a crossing): junction_lanes.h.
+    if (auto marked = forbidJunctionLaneChanges((w / "city.net.xml").string()); !marked) return marked.status();
     progress.end();
 
     progress.begin("traffic: demand");

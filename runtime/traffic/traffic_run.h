@@ -9,7 +9,8 @@
 //   all; `dir` must not exist (outputs never overwrite), the ".partial"
 //   folder of an interrupted run is removed and rebuilt. The files: city.xodr
 //   (the input), city.net.xml (netconvert's network, sidewalks and crossings
-//   guessed where the city has sidewalks), demand.rou.xml, traffic.sumocfg
+//   guessed where the city has sidewalks; no lane changes on its junctions'
+//   internal lanes, junction_lanes.h), demand.rou.xml, traffic.sumocfg
 //   (sumo -c traffic.sumocfg in the folder runs it again), fcd.xml (SUMO's
 //   FCD: every agent at every step), signals.xml (SUMO's traffic-light
 //   states at every switch), collisions.xml (SUMO's collision output: one

@@ -66,8 +66,10 @@ TEST(Lanes, JunctionsAndTrims) {
     EXPECT_EQ(j.node, 0u);
     // The right turn east -> north keeps the local class's turning radius:
     // its lane centre reaches 1.5 lanes of 3.25 m toward the centre.
+    // Each arm is trimmed kCrossingLeadIn further, the turn's straight start.
     const double radius = (1.5 * 3.25 + kMinTurnRadiusLocal + 1e-3) * std::tan(0.25 * 3.14159265358979323846);
-    EXPECT_NEAR(j.radius, radius, 1e-9);
+    const double trim = radius + kCrossingLeadIn;
+    EXPECT_NEAR(j.radius, trim, 1e-9);
     EXPECT_GT(j.radius, 6.5 + 3.0);  // more than the widest arm: 13 m / 2 + sidewalk
     // Arms counter-clockwise by angle in (-pi, pi]: east (0), north (pi/2), west (pi).
     ASSERT_EQ(j.arms.size(), 3u);
@@ -77,19 +79,19 @@ TEST(Lanes, JunctionsAndTrims) {
     EXPECT_EQ(m.degree[3], 2);
     EXPECT_EQ(m.nodeJunction[3], -1);
     // East arm starts at the junction: trimmed at a only.
-    EXPECT_NEAR(m.edges[0].trimA, radius, 1e-9);
+    EXPECT_NEAR(m.edges[0].trimA, trim, 1e-9);
     EXPECT_DOUBLE_EQ(m.edges[0].trimB, 0.0);
-    EXPECT_NEAR(m.edges[0].start.x, radius, 1e-9);
-    EXPECT_NEAR(m.edges[0].length, 100 - radius, 1e-9);
+    EXPECT_NEAR(m.edges[0].start.x, trim, 1e-9);
+    EXPECT_NEAR(m.edges[0].length, 100 - trim, 1e-9);
     EXPECT_EQ(m.edges[0].junctionA, 0);
     // West arm ends at the junction.
-    EXPECT_NEAR(m.edges[1].trimB, radius, 1e-9);
-    EXPECT_NEAR(m.edges[1].end.x, -radius, 1e-9);
+    EXPECT_NEAR(m.edges[1].trimB, trim, 1e-9);
+    EXPECT_NEAR(m.edges[1].end.x, -trim, 1e-9);
     // The 6 m north arm: the trims (junction at a, transition at b) are
     // shrunk in proportion so that kMinRoadLength remains.
     EXPECT_NEAR(m.edges[2].length, kMinRoadLength, 1e-12);
     EXPECT_NEAR(m.edges[2].trimA + m.edges[2].trimB, 6.0 - kMinRoadLength, 1e-12);
-    EXPECT_NEAR(m.edges[2].trimA / m.edges[2].trimB, radius / (0.5 * kTaperLength), 1e-9);
+    EXPECT_NEAR(m.edges[2].trimA / m.edges[2].trimB, trim / (0.5 * kTaperLength), 1e-9);
     // Turns into or out of the shortened arm cannot keep their radius: the
     // ones whose lanes another turn takes are dropped, none is left unlinked.
     EXPECT_GT(m.tightTurns + m.tightTurnsKept, 0u);

@@ -9,6 +9,7 @@
 
 #include "citygen/mesh_builder.h"
 #include "citygen/polygon.h"
+#include "citygen/lanes.h"
 #include "citygen/surfaces.h"
 #include "citygen/terrain.h"
 #include "citygen/trees.h"
@@ -329,7 +330,8 @@ TEST(Surfaces, RoadPiecesDrawnExactlyOnceAcrossTiles) {
     // Analytic: carriageway pieces sum to length x width. A junction polygon
     // contains the first stretch of its widest arm (half width r, length
     // r + sidewalk along the arm, both sides: >= 2 r^2) and lies within the
-    // disc through the corners a sidewalk further along: pi ((r + sw)^2 + r^2).
+    // disc through the corners a sidewalk and a turn's straight lead-in
+    // (lanes.h kCrossingLeadIn) further along: pi ((r + sw + lead)^2 + r^2).
     double pieces = 0;
     for (size_t e = 0; e < many.streets.edges.size(); ++e)
         pieces += many.streets.edgeLength(e) * many.streets.edges[e].width;
@@ -340,7 +342,8 @@ TEST(Surfaces, RoadPiecesDrawnExactlyOnceAcrossTiles) {
     }
     const double swj = many.params.sidewalk_m;
     double jLo = 0, jHi = 0;
-    for (double x : r) jLo += 2 * x * x, jHi += M_PI * ((x + swj) * (x + swj) + x * x);
+    const double lead = kCrossingLeadIn;
+    for (double x : r) jLo += 2 * x * x, jHi += M_PI * ((x + swj + lead) * (x + swj + lead) + x * x);
     EXPECT_GE(aMany, pieces + jLo - 1e-3 * pieces);
     EXPECT_LE(aMany, pieces + jHi + 1e-3 * pieces);
     // Ground covers the city square exactly once.
