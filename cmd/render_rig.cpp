@@ -300,6 +300,20 @@ Status writeLidar(const LidarSweep& s, size_t j, const std::string& name, const 
 // One rig frame: every sensor that fires, cast and written (each stage timed
 // into the record: cast, write, boxes), then the frame's 3D boxes. Runs in
 // the caller's task arena; its casts, boxes and writing tasks share it.
+// The traffic at time t, every agent in the ray scene (the split at 0: all of them are rays' business).
+Status placeAgents(const RigPlan& p, double t, const glm::dvec3& eye) {
+    VISTA_RETURN_IF_ERROR(p.agents->setFrame(t, eye, /*splitFollows=*/true));
+    return p.agents->setSplit(0.0);
+}
+
+// The frame's 3D boxes file: every object some sensor saw, in the city's own coordinates.
+Status writeFrameBoxes3d(const Walkthrough& w, const FrameBoxState& boxes, const RigPose& vehicle,
+                         const std::string& name, const RenderWorkDir& out) {
+    const glm::dvec3 offset(w.city.params.origin_x, w.city.params.origin_y, 0.0);
+    return writeFileAtomic(out.file(std::string(kBoxes3dDir) + "/" + name + ".json"),
+                           frameBoxes3dJson(*boxes.city, boxes.seen, vehicle, offset, name, boxes.t, boxes.movers));
+}
+
 Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_t f, const RenderWorkDir& out,
                    const CityBoxes* cityBoxes, const std::vector<CameraRayTable>& pixelRays,
                    std::vector<CameraImages>& ims, nlohmann::json& record) {
@@ -308,10 +322,7 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
     // Ray origins near the scene's frame origin: float precision anywhere in the city.
     VISTA_RETURN_IF_ERROR(rays.placeFrameNear(vehicle.position));
     // The traffic at the frame's time, every agent in the ray scene (the vehicle's own excepted).
-    if (p.agents) {
-        VISTA_RETURN_IF_ERROR(p.agents->setFrame(p.times[f], vehicle.position, /*splitFollows=*/true));
-        VISTA_RETURN_IF_ERROR(p.agents->setSplit(0.0));
-    }
+    if (p.agents) VISTA_RETURN_IF_ERROR(placeAgents(p, p.times[f], vehicle.position));
     const std::string name = frameName(f);
     const int threads = 0;  // the caller's arena: renderFrames runs each frame in one of --threads workers
     FrameBoxState boxes;
@@ -371,11 +382,7 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
         const LidarPoseAt poseAt = [&](double t) { return lidarPoseOf(sensorPose(vehiclePoseAt(path, t), l.mount)); };
         // The agents move during the sweep: each column sees them where they are when it fires.
         LidarMovers movers;
-        if (p.agents)
-            movers.place = [&](double t) {
-                VISTA_RETURN_IF_ERROR(p.agents->setFrame(t, vehiclePoseAt(path, t).position, /*splitFollows=*/true));
-                return p.agents->setSplit(0.0);
-            };
+        if (p.agents) movers.place = [&](double t) { return placeAgents(p, t, vehiclePoseAt(path, t).position); };
         Stopwatch cast;
         auto sweep = castLidarSweep(w.city, rays, l.spec, poseAt, p.times[f], movers, threads);
         if (!sweep) {
@@ -413,18 +420,9 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
         lidar[l.name] = {{"points", sweeps[j].points.size()}, {"misses", sweeps[j].misses}};
     }
     Stopwatch boxes3d;
-    if (boxes.city) {
-        const glm::dvec3 offset(w.city.params.origin_x, w.city.params.origin_y, 0.0);
-        VISTA_RETURN_IF_ERROR(writeFileAtomic(
-            out.file(std::string(kBoxes3dDir) + "/" + name + ".json"),
-            frameBoxes3dJson(*boxes.city, boxes.seen, vehicle, offset, name, p.times[f], boxes.movers)));
-    }
-    record = {{"frame_ms", frame.ms()},
-              {"sensor_ms", ms},
-              {"stage_ms", stages},
-              {"boxes_3d_ms", boxes3d.ms()},
-              {"sensors_fired", ms.size()},
-              {"lidar", lidar}};
+    if (boxes.city) VISTA_RETURN_IF_ERROR(writeFrameBoxes3d(w, boxes, vehicle, name, out));
+    record = {{"frame_ms", frame.ms()},     {"sensor_ms", ms}, {"stage_ms", stages}, {"boxes_3d_ms", boxes3d.ms()},
+              {"sensors_fired", ms.size()}, {"lidar", lidar}};
     return Status::ok();
 }
 
@@ -448,7 +446,8 @@ Status renderFrames(const RigRunRequest& a, const RigPlan& p, const Walkthrough&
         progress->begin("render " + std::to_string(n) + " rig frames (" +
                         std::to_string(p.rig.cameras.size() + p.rig.lidars.size()) + " sensors)" +
                         (kept ? ", resuming: " + std::to_string(kept) + " done" : std::string()));
-    std::vector<CameraImages> ims(p.rig.cameras.size());  // one per camera: a camera's files are written while the next casts
+    std::vector<CameraImages> ims(
+        p.rig.cameras.size());  // one per camera: a camera's files are written while the next casts
     for (size_t f = 0; f < n; ++f) {
         if (!records[f].is_null()) continue;
         Status s;
@@ -559,7 +558,8 @@ nlohmann::json rigSummary(const RigRunRequest& a, const RigPlan& p, const std::v
     for (const auto& r : records) {
         if (r.contains("frame_ms") && r["frame_ms"].is_number()) totalMs += r["frame_ms"].get<double>();
         if (r.contains("sensor_ms") && r["sensor_ms"].is_object()) fired.push_back(double(r["sensor_ms"].size()));
-        if (r.contains("boxes_3d_ms") && r["boxes_3d_ms"].is_number()) boxes3d.push_back(r["boxes_3d_ms"].get<double>());
+        if (r.contains("boxes_3d_ms") && r["boxes_3d_ms"].is_number())
+            boxes3d.push_back(r["boxes_3d_ms"].get<double>());
     }
     for (const std::string& name : p.rig.order) {
         std::vector<double> ms;

@@ -299,6 +299,15 @@ Status checkPagedOutput(const std::string& option, const std::string& dir) {
     return checkWritableDirectory(option, dir);
 }
 
+// Adds one region record's counts (empty, buildings, trees, triangles, file bytes) to the report.
+static void addRegionTotals(PagedCityReport& rep, const Json& rec) {
+    rep.emptyRegions += rec.at("empty").get<bool>() ? 1 : 0;
+    rep.buildings += rec.at("buildings").get<size_t>();
+    rep.trees += rec.at("trees").get<size_t>();
+    rep.triangles += rec.at("triangles").get<size_t>();
+    for (const Json& f : rec.at("files")) rep.bytes += f.at("bytes").get<size_t>();
+}
+
 Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedCityOptions& o) {
     VISTA_RETURN_IF_ERROR(validateParams(params));
     VISTA_RETURN_IF_ERROR(validateRegionSize(params, o.regionSizeM));
@@ -362,14 +371,8 @@ Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedC
     }
     rep.baseSeconds = baseSeconds;
     rep.regionSeconds = seconds(t0) - baseSeconds;
-    for (const auto& rec : records) {
-        if (!rec) continue;
-        rep.emptyRegions += (*rec).at("empty").get<bool>() ? 1 : 0;
-        rep.buildings += (*rec).at("buildings").get<size_t>();
-        rep.trees += (*rec).at("trees").get<size_t>();
-        rep.triangles += (*rec).at("triangles").get<size_t>();
-        for (const Json& f : (*rec).at("files")) rep.bytes += f.at("bytes").get<size_t>();
-    }
+    for (const auto& rec : records)
+        if (rec) addRegionTotals(rep, *rec);
     made.keep();
     if (o.shard.count > 1 && !o.merge) return rep;
 
@@ -416,13 +419,7 @@ Result<PagedCityReport> generatePagedCity(const CityParams& params, const PagedC
     if (o.merge) {  // totals over the whole city
         rep.emptyRegions = 0;
         rep.buildings = rep.trees = rep.triangles = rep.bytes = 0;
-        for (const Json& rec : all) {
-            rep.emptyRegions += rec.at("empty").get<bool>() ? 1 : 0;
-            rep.buildings += rec.at("buildings").get<size_t>();
-            rep.trees += rec.at("trees").get<size_t>();
-            rep.triangles += rec.at("triangles").get<size_t>();
-            for (const Json& f : rec.at("files")) rep.bytes += f.at("bytes").get<size_t>();
-        }
+        for (const Json& rec : all) addRegionTotals(rep, rec);
     }
     return rep;
 }
