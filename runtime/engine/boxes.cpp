@@ -440,29 +440,35 @@ bool rayThroughTriangle(const glm::dvec3& d, const glm::dvec3* p) { return RayTr
 // A bound of the fisheye image within the cone of the cap of directions
 // around the unit vector c with half angle r (r < pi/2): the cap's points
 // have theta in [theta_c - r, theta_c + r] (clamped to [0, thetaMax]) and,
-// when the cap holds neither pole, an azimuth within asin(sin r / sin
-// theta_c) of c's; u - cx = fx theta cos(phi) and v - cy = fy theta sin(phi)
-// over that polar rectangle take their extremes at its corners (theta >= 0),
-// the cosine and sine ranges including their extremes inside the azimuth
-// interval. An invalid box when the cap lies outside the image circle.
-// Padded so that rounding never makes it too small.
+// when the cap holds neither pole, an azimuth within h of c's azimuth phi,
+// sin h = sin r / sin theta_c; u - cx = fx theta cos(phi) and v - cy = fy
+// theta sin(phi) over that polar rectangle take their extremes at its
+// corners (theta >= 0), the cosine and sine ranges including their extremes
+// inside the azimuth interval (azimuth x lies within h of phi when cos(x -
+// phi) >= cos h). The azimuths' cosines and sines come from c's components
+// (sin theta_c = |c.xy|) by the angle-sum rules, without a trigonometric
+// call. An invalid box when the cap lies outside the image circle. Padded
+// (1e-9 on the cosines and sines, 1e-6 px) so that rounding never makes it
+// too small.
 PixelBox fisheyeCapBound(const Projector& pr, const glm::dvec3& c, double r) {
-    const double rhoC = std::hypot(c.x, c.y), thetaC = std::atan2(rhoC, c.z);
+    const double rhoC = std::sqrt(c.x * c.x + c.y * c.y), thetaC = std::atan2(rhoC, c.z);
     const double lo = std::max(0.0, thetaC - r), hi = std::min(pr.thetaMax, thetaC + r);
     if (lo > hi) return PixelBox{};
     double cLo = -1, cHi = 1, sLo = -1, sHi = 1;
-    if (lo > 0.0 && thetaC + r < kPi) {
-        const double half = std::asin(std::min(1.0, std::sin(r) / std::sin(thetaC))) + 1e-9;
-        if (half < kHalfPi) {
-            const double phi = std::atan2(c.y, c.x), a = phi - half, b = phi + half;
-            cLo = std::min(std::cos(a), std::cos(b)), cHi = std::max(std::cos(a), std::cos(b));
-            sLo = std::min(std::sin(a), std::sin(b)), sHi = std::max(std::sin(a), std::sin(b));
-            // Extremes inside [a, b]: cos at multiples of pi, sin at pi/2 + multiples of pi.
-            auto contains = [&](double x) { return std::ceil((a - x) / kTwoPi) <= std::floor((b - x) / kTwoPi); };
-            if (contains(0.0)) cHi = 1;
-            if (contains(kPi)) cLo = -1;
-            if (contains(kHalfPi)) sHi = 1;
-            if (contains(-kHalfPi)) sLo = -1;
+    if (lo > 0.0 && thetaC + r < kPi && rhoC > 0.0) {
+        constexpr double kEps = 1e-9;
+        const double sinH = std::sin(r) / rhoC;
+        if (sinH < 1.0 - 1e-6) {
+            const double cosH = std::sqrt(1.0 - sinH * sinH), cp = c.x / rhoC, sp = c.y / rhoC;
+            const double ca = cp * cosH + sp * sinH, sa = sp * cosH - cp * sinH;  // azimuth phi - h
+            const double cb = cp * cosH - sp * sinH, sb = sp * cosH + cp * sinH;  // azimuth phi + h
+            cLo = std::max(-1.0, std::min(ca, cb) - kEps), cHi = std::min(1.0, std::max(ca, cb) + kEps);
+            sLo = std::max(-1.0, std::min(sa, sb) - kEps), sHi = std::min(1.0, std::max(sa, sb) + kEps);
+            // Extremes inside the interval: cos at azimuth 0 and pi, sin at pi/2 and -pi/2.
+            if (cp >= cosH - kEps) cHi = 1;
+            if (-cp >= cosH - kEps) cLo = -1;
+            if (sp >= cosH - kEps) sHi = 1;
+            if (-sp >= cosH - kEps) sLo = -1;
         }
     }
     const double uLo = std::min({lo * cLo, lo * cHi, hi * cLo, hi * cHi}),
@@ -700,6 +706,7 @@ private:
                 if (row[x] != _mark) row[x] = _mark, ++covered;
         }
     }
+    static constexpr int kDirectFill = 48;  // pixels; fewer are tested one by one
     // Marks the pixels of extent e (grown by a pixel for the sampling of
     // curved edges) whose ray passes through the triangle p. Tile by tile
     // (CameraRayTable tiles): a tile whose cap lies beyond one of the
@@ -707,7 +714,8 @@ private:
     // skipped, one whose cap lies within all three by more than the margin
     // is marked whole (its pixels inside the circle), the others test each
     // pixel; the margin (1e-9 of a unit direction) dwarfs the rounding of
-    // the per-pixel test, so the marked pixels are those the test marks.
+    // the per-pixel test, so the marked pixels are those the test marks. An
+    // extent of a few pixels is tested pixel by pixel.
     void fillSphere(const glm::dvec3* p, const PixelBox& e) {
         const int x0 = int(std::max(0.0, std::floor(e.u0) - 1)),
                   x1 = int(std::min(double(_w - 1), std::ceil(e.u1) + 1));
@@ -715,6 +723,17 @@ private:
                   y1 = int(std::min(double(_h - 1), std::ceil(e.v1) + 1));
         const RayTriangle tri(p);
         if (tri.det == 0.0) return;
+        if ((x1 - x0 + 1) * (y1 - y0 + 1) <= kDirectFill) {  // a few pixels: no tile tests
+            for (int y = y0; y <= y1; ++y) {
+                const size_t at = size_t(y) * size_t(_w);
+                uint32_t* row = &_stamp[at];
+                for (int x = x0; x <= x1; ++x) {
+                    const size_t q = at + size_t(x);
+                    if (row[x] != _mark && _rays->inside(q) && tri.hit(_rays->dir(q))) row[x] = _mark, ++covered;
+                }
+            }
+            return;
+        }
         // The planes as unit normals m with the triangle's directions on m . d <= 0.
         const double side = tri.det > 0 ? -1.0 : 1.0;
         glm::dvec3 m[3] = {tri.n0, tri.n1, tri.n2};
