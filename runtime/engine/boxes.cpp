@@ -644,6 +644,16 @@ public:
     PixelBox full;
     uint32_t covered = 0;
 
+    // Fisheye: extends `full` by the vertices' pixels (those inside the cone).
+    // Every vertex is the first sample of an edge of its triangle, so seeding
+    // the extent with some of them first changes no extent, while the bounds
+    // and runs of the triangles that follow fall within it more often.
+    void seed(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+        glm::dvec2 uv;
+        for (const glm::dvec3* w : {&a, &b, &c})
+            if (_pr.conePixel(_pr.toCamera(*w), uv)) extend(full, uv);
+    }
+
     void triangle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
         const glm::dvec3 p[3] = {_pr.toCamera(a), _pr.toCamera(b), _pr.toCamera(c)};
         // Camera coordinates are a rotation of the world's: counter-clockwise
@@ -780,6 +790,8 @@ private:
     uint32_t _mark;
 };
 
+constexpr uint32_t kSeedStride = 4;
+
 // The share of `whole` outside `inside` (per axis, so a zero-width extent counts too).
 double truncation(const PixelBox& whole, const PixelBox& inside) {
     if (!whole.valid()) return 0.0;
@@ -842,6 +854,12 @@ std::vector<FrameBox> frameBoxes(const SceneModel& city, const CityBoxes& boxes,
         tbb::parallel_for(size_t(0), out.size(), [&](size_t i) {
             FrameBox& f = out[i];
             MaskRaster r(pr, rays, W, H, stamps.local(), uint32_t(i));
+            if (pr.m.fisheye() && src[i]) {  // the vertices of every kSeedStride-th triangle first
+                uint32_t k = 0;
+                forEachTriangle(city, boxes, *src[i], [&](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+                    if (k++ % kSeedStride == 0) r.seed(a, b, c);
+                });
+            }
             if (src[i]) {
                 forEachTriangle(
                     city, boxes, *src[i],
