@@ -348,8 +348,8 @@ struct Projector {
 };
 
 bool within(const PixelBox& inner, const PixelBox& outer) {
-    return outer.valid() && (!inner.valid() || (inner.u0 >= outer.u0 && inner.v0 >= outer.v0 &&
-                                                inner.u1 <= outer.u1 && inner.v1 <= outer.v1));
+    return outer.valid() && (!inner.valid() || (inner.u0 >= outer.u0 && inner.v0 >= outer.v0 && inner.u1 <= outer.u1 &&
+                                                inner.v1 <= outer.v1));
 }
 
 // The point where p moves into or out of the cone between a (inside == aIn) and b.
@@ -503,7 +503,6 @@ bool fisheyeTriangleBound(const Projector& pr, const glm::dvec3* p, PixelBox& ou
     out = fisheyeCapBound(pr, c, std::acos(std::min(1.0, cosR)) + 1e-9);
     return true;
 }
-
 
 // The fisheye image of a triangle (camera coordinates) within the cone: its
 // edges and the image circle's extreme points its area covers.
@@ -767,7 +766,7 @@ private:
                     whole = true;
                     for (const glm::dvec3& n : m) {
                         const double c = glm::dot(n, cap.axis), s = std::sqrt(std::max(0.0, 1.0 - c * c));
-                        if (c * cap.cosR - s * cap.sinR > kMargin) outside = true;  // the cap's least m . d
+                        if (c * cap.cosR - s * cap.sinR > kMargin) outside = true;     // the cap's least m . d
                         if (!(c * cap.cosR + s * cap.sinR < -kMargin)) whole = false;  // its greatest
                     }
                     if (outside) continue;
@@ -856,9 +855,10 @@ std::vector<FrameBox> frameBoxes(const SceneModel& city, const CityBoxes& boxes,
             MaskRaster r(pr, rays, W, H, stamps.local(), uint32_t(i));
             if (pr.m.fisheye() && src[i]) {  // the vertices of every kSeedStride-th triangle first
                 uint32_t k = 0;
-                forEachTriangle(city, boxes, *src[i], [&](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
-                    if (k++ % kSeedStride == 0) r.seed(a, b, c);
-                });
+                forEachTriangle(city, boxes, *src[i],
+                                [&](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+                                    if (k++ % kSeedStride == 0) r.seed(a, b, c);
+                                });
             }
             if (src[i]) {
                 forEachTriangle(

@@ -76,7 +76,9 @@
 // image of a cap around its directions, computed without sampling) lies
 // within the extent of the instance's triangles so far is not sampled, and
 // a run of 32 samples of an edge whose cap lies inside the cone and whose
-// image lies within the extent so far is not sampled. The fisheye mask
+// image lies within the extent so far is not sampled; the extent starts
+// from the in-cone vertices of every fourth triangle (each vertex is its
+// edge's first sample). The fisheye mask
 // tests each pixel centre of a front-facing triangle's extent (or that
 // bound, when samples were skipped): its ray (pixelRay, from
 // FrameBoxOptions::rays when given) passes through the triangle; tile by

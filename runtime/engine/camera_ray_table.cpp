@@ -42,7 +42,8 @@ CameraRayTable::CameraRayTable(const CameraModel& model, int threads) : _model(m
                 double cosMin = 1.0;
                 for (size_t v = v0; v < v1; ++v)
                     for (size_t u = u0; u < u1; ++u)
-                        if (_inside[v * w + u]) cosMin = std::min(cosMin, glm::dot(t.axis, glm::normalize(_dir[v * w + u])));
+                        if (_inside[v * w + u])
+                            cosMin = std::min(cosMin, glm::dot(t.axis, glm::normalize(_dir[v * w + u])));
                 const double r = std::acos(std::clamp(cosMin, -1.0, 1.0)) + 1e-7;
                 if (!(r < 1.5)) continue;
                 t.cosR = std::cos(r), t.sinR = std::sin(r), t.hasCap = true;

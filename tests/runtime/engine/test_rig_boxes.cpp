@@ -11,10 +11,9 @@
 // every pixel ray tested against every front triangle, also for large
 // cuboids around the camera (whole tiles, skipped runs of edge samples),
 // whose extents equal every edge sample taken the plain way; visible
-// extents of a tall image counted in bands equal those counted here; a box in the vehicle frame is the world box through the inverse of
-// the pose's 4x4 matrix, in the file too; sightings merge cameras and LiDARs;
-// KITTI label lines read back with the devkit's corners hold the world box
-// (equal to it for a level vehicle) and carry the instance id.
+// extents of a tall image counted in bands equal those counted here; a box in the vehicle frame is the world box
+// through the inverse of the pose's 4x4 matrix, in the file too; sightings merge cameras and LiDARs; KITTI label lines
+// read back with the devkit's corners hold the world box (equal to it for a level vehicle) and carry the instance id.
 #include <gtest/gtest.h>
 
 #include <algorithm>
