@@ -347,6 +347,11 @@ struct Projector {
     }
 };
 
+bool within(const PixelBox& inner, const PixelBox& outer) {
+    return outer.valid() && (!inner.valid() || (inner.u0 >= outer.u0 && inner.v0 >= outer.v0 && inner.u1 <= outer.u1 &&
+                                                inner.v1 <= outer.v1));
+}
+
 // The point where p moves into or out of the cone between a (inside == aIn) and b.
 glm::dvec3 coneCrossing(const Projector& pr, glm::dvec3 a, glm::dvec3 b, bool aIn) {
     for (int i = 0; i < 40; ++i) {
@@ -356,8 +361,32 @@ glm::dvec3 coneCrossing(const Projector& pr, glm::dvec3 a, glm::dvec3 b, bool aI
     return aIn ? a : b;
 }
 
-// The fisheye image of segment a-b within the cone, sampled at most about 1 px apart.
-void fisheyeEdge(const Projector& pr, const glm::dvec3& a, const glm::dvec3& b, PixelBox& out) {
+PixelBox fisheyeCapBound(const Projector& pr, const glm::dvec3& c, double r);
+
+// The cap of the directions of segment a-b (camera coordinates): around the
+// mean of its end directions, half the angle between them (padded); false
+// when an end is the origin or the cap is not narrower than 80 degrees.
+bool segmentCap(const glm::dvec3& a, const glm::dvec3& b, glm::dvec3& c, double& r) {
+    const double la = glm::length(a), lb = glm::length(b);
+    if (!(la > 0.0 && lb > 0.0)) return false;
+    const glm::dvec3 na = a / la, nb = b / lb, sum = na + nb;
+    const double ls = glm::length(sum);
+    if (!(ls > 0.0)) return false;
+    c = sum / ls;
+    const double cosR = std::min(glm::dot(c, na), glm::dot(c, nb));
+    if (!(cosR > 0.2)) return false;
+    r = std::acos(std::min(1.0, cosR)) + 1e-9;
+    return true;
+}
+
+// The fisheye image of segment a-b within the cone, sampled at most about 1
+// px apart. With `known` (an extent the result is merged into): a run of
+// kEdgeRun samples whose segment's cap lies wholly inside the cone and whose
+// image (fisheyeCapBound) lies within `known` and the extent so far cannot
+// widen the merged extent and is not sampled; `skipped` is then set.
+constexpr int kEdgeRun = 32;
+void fisheyeEdge(const Projector& pr, const glm::dvec3& a, const glm::dvec3& b, PixelBox& out,
+                 const PixelBox* known = nullptr, bool* skipped = nullptr) {
     const double la = glm::length(a), lb = glm::length(b);
     const double angle = la > 0 && lb > 0 ? std::acos(std::clamp(glm::dot(a, b) / (la * lb), -1.0, 1.0)) : kPi;
     const int n = int(std::clamp(std::ceil(angle * std::max(pr.m.fx, pr.m.fy)), 1.0, 4096.0));
@@ -366,6 +395,22 @@ void fisheyeEdge(const Projector& pr, const glm::dvec3& a, const glm::dvec3& b, 
     bool prevIn = pr.conePixel(a, uv);
     if (prevIn) extend(out, uv);
     for (int k = 1; k <= n; ++k) {
+        if (known && prevIn && k + kEdgeRun - 1 <= n) {
+            // Samples k .. k + kEdgeRun - 1 lie on the segment from prev (inside the cone) to the run's last.
+            const int last = k + kEdgeRun - 1;
+            const glm::dvec3 q = a + (double(last) / n) * (b - a);
+            glm::dvec3 c;
+            double r;
+            if (segmentCap(prev, q, c, r) && std::atan2(std::hypot(c.x, c.y), c.z) + r < pr.thetaMax - 1e-9) {
+                PixelBox merged = *known;
+                extend(merged, out);
+                if (within(fisheyeCapBound(pr, c, r), merged)) {
+                    prev = q, prevIn = true, k = last;
+                    *skipped = true;
+                    continue;
+                }
+            }
+        }
         const glm::dvec3 p = a + (double(k) / n) * (b - a);
         const bool in = pr.conePixel(p, uv);
         if (in) extend(out, uv);
@@ -392,18 +437,56 @@ struct RayTriangle {
 // True when the ray from the origin along d passes through triangle p0 p1 p2 (edges included).
 bool rayThroughTriangle(const glm::dvec3& d, const glm::dvec3* p) { return RayTriangle(p).hit(d); }
 
+// A bound of the fisheye image within the cone of the cap of directions
+// around the unit vector c with half angle r (r < pi/2): the cap's points
+// have theta in [theta_c - r, theta_c + r] (clamped to [0, thetaMax]) and,
+// when the cap holds neither pole, an azimuth within h of c's azimuth phi,
+// sin h = sin r / sin theta_c; u - cx = fx theta cos(phi) and v - cy = fy
+// theta sin(phi) over that polar rectangle take their extremes at its
+// corners (theta >= 0), the cosine and sine ranges including their extremes
+// inside the azimuth interval (azimuth x lies within h of phi when cos(x -
+// phi) >= cos h). The azimuths' cosines and sines come from c's components
+// (sin theta_c = |c.xy|) by the angle-sum rules, without a trigonometric
+// call. An invalid box when the cap lies outside the image circle. Padded
+// (1e-9 on the cosines and sines, 1e-6 px) so that rounding never makes it
+// too small.
+PixelBox fisheyeCapBound(const Projector& pr, const glm::dvec3& c, double r) {
+    const double rhoC = std::sqrt(c.x * c.x + c.y * c.y), thetaC = std::atan2(rhoC, c.z);
+    const double lo = std::max(0.0, thetaC - r), hi = std::min(pr.thetaMax, thetaC + r);
+    if (lo > hi) return PixelBox{};
+    double cLo = -1, cHi = 1, sLo = -1, sHi = 1;
+    if (lo > 0.0 && thetaC + r < kPi && rhoC > 0.0) {
+        constexpr double kEps = 1e-9;
+        const double sinH = std::sin(r) / rhoC;
+        if (sinH < 1.0 - 1e-6) {
+            const double cosH = std::sqrt(1.0 - sinH * sinH), cp = c.x / rhoC, sp = c.y / rhoC;
+            const double ca = cp * cosH + sp * sinH, sa = sp * cosH - cp * sinH;  // azimuth phi - h
+            const double cb = cp * cosH - sp * sinH, sb = sp * cosH + cp * sinH;  // azimuth phi + h
+            cLo = std::max(-1.0, std::min(ca, cb) - kEps), cHi = std::min(1.0, std::max(ca, cb) + kEps);
+            sLo = std::max(-1.0, std::min(sa, sb) - kEps), sHi = std::min(1.0, std::max(sa, sb) + kEps);
+            // Extremes inside the interval: cos at azimuth 0 and pi, sin at pi/2 and -pi/2.
+            if (cp >= cosH - kEps) cHi = 1;
+            if (-cp >= cosH - kEps) cLo = -1;
+            if (sp >= cosH - kEps) sHi = 1;
+            if (-sp >= cosH - kEps) sLo = -1;
+        }
+    }
+    const double uLo = std::min({lo * cLo, lo * cHi, hi * cLo, hi * cHi}),
+                 uHi = std::max({lo * cLo, lo * cHi, hi * cLo, hi * cHi});
+    const double vLo = std::min({lo * sLo, lo * sHi, hi * sLo, hi * sHi}),
+                 vHi = std::max({lo * sLo, lo * sHi, hi * sLo, hi * sHi});
+    const double pad = 1e-6;
+    return {pr.m.cx + pr.m.fx * uLo - pad, pr.m.cy + pr.m.fy * vLo - pad, pr.m.cx + pr.m.fx * uHi + pad,
+            pr.m.cy + pr.m.fy * vHi + pad};
+}
+
 // A bound of the fisheye image of a triangle (camera coordinates) within the
 // cone, without sampling its edges: the triangle's directions lie in the cap
 // around their mean direction c whose radius r is the largest angle from c to
 // a vertex (a cap narrower than a hemisphere is a convex cone, so it holds
-// the whole triangle); the cap's points have theta in [theta_c - r, theta_c +
-// r] (clamped to [0, thetaMax]) and, when the cap holds neither pole, an
-// azimuth within asin(sin r / sin theta_c) of c's; u - cx = fx theta cos(phi)
-// and v - cy = fy theta sin(phi) over that polar rectangle take their extremes
-// at its corners (theta >= 0), the cosine and sine ranges including their
-// extremes inside the azimuth interval. False (no bound) for a degenerate
-// triangle or a cap of 87 degrees or more; an invalid box when the cap lies
-// outside the image circle. Padded so that rounding never makes it too small.
+// the whole triangle), bounded by fisheyeCapBound. False (no bound) for a
+// degenerate triangle or a cap of 87 degrees or more; an invalid box when the
+// cap lies outside the image circle.
 bool fisheyeTriangleBound(const Projector& pr, const glm::dvec3* p, PixelBox& out) {
     glm::dvec3 n[3];
     for (int i = 0; i < 3; ++i) {
@@ -417,48 +500,16 @@ bool fisheyeTriangleBound(const Projector& pr, const glm::dvec3* p, PixelBox& ou
     const glm::dvec3 c = sum / ls;
     const double cosR = std::min({glm::dot(c, n[0]), glm::dot(c, n[1]), glm::dot(c, n[2])});
     if (!(cosR > 0.05)) return false;
-    const double r = std::acos(std::min(1.0, cosR)) + 1e-9;
-    const double rhoC = std::hypot(c.x, c.y), thetaC = std::atan2(rhoC, c.z);
-    const double lo = std::max(0.0, thetaC - r), hi = std::min(pr.thetaMax, thetaC + r);
-    if (lo > hi) {
-        out = PixelBox{};
-        return true;
-    }
-    double cLo = -1, cHi = 1, sLo = -1, sHi = 1;
-    if (lo > 0.0 && thetaC + r < kPi) {
-        const double half = std::asin(std::min(1.0, std::sin(r) / std::sin(thetaC))) + 1e-9;
-        if (half < kHalfPi) {
-            const double phi = std::atan2(c.y, c.x), a = phi - half, b = phi + half;
-            cLo = std::min(std::cos(a), std::cos(b)), cHi = std::max(std::cos(a), std::cos(b));
-            sLo = std::min(std::sin(a), std::sin(b)), sHi = std::max(std::sin(a), std::sin(b));
-            // Extremes inside [a, b]: cos at multiples of pi, sin at pi/2 + multiples of pi.
-            auto contains = [&](double x) { return std::ceil((a - x) / kTwoPi) <= std::floor((b - x) / kTwoPi); };
-            if (contains(0.0)) cHi = 1;
-            if (contains(kPi)) cLo = -1;
-            if (contains(kHalfPi)) sHi = 1;
-            if (contains(-kHalfPi)) sLo = -1;
-        }
-    }
-    const double uLo = std::min({lo * cLo, lo * cHi, hi * cLo, hi * cHi}),
-                 uHi = std::max({lo * cLo, lo * cHi, hi * cLo, hi * cHi});
-    const double vLo = std::min({lo * sLo, lo * sHi, hi * sLo, hi * sHi}),
-                 vHi = std::max({lo * sLo, lo * sHi, hi * sLo, hi * sHi});
-    const double pad = 1e-6;
-    out = {pr.m.cx + pr.m.fx * uLo - pad, pr.m.cy + pr.m.fy * vLo - pad, pr.m.cx + pr.m.fx * uHi + pad,
-           pr.m.cy + pr.m.fy * vHi + pad};
+    out = fisheyeCapBound(pr, c, std::acos(std::min(1.0, cosR)) + 1e-9);
     return true;
-}
-
-bool within(const PixelBox& inner, const PixelBox& outer) {
-    return outer.valid() && (!inner.valid() || (inner.u0 >= outer.u0 && inner.v0 >= outer.v0 &&
-                                                inner.u1 <= outer.u1 && inner.v1 <= outer.v1));
 }
 
 // The fisheye image of a triangle (camera coordinates) within the cone: its
 // edges and the image circle's extreme points its area covers.
-PixelBox fisheyeTriangleExtent(const Projector& pr, const glm::dvec3* p) {
+PixelBox fisheyeTriangleExtent(const Projector& pr, const glm::dvec3* p, const PixelBox* known = nullptr,
+                               bool* skipped = nullptr) {
     PixelBox out;
-    for (int i = 0; i < 3; ++i) fisheyeEdge(pr, p[i], p[(i + 1) % 3], out);
+    for (int i = 0; i < 3; ++i) fisheyeEdge(pr, p[i], p[(i + 1) % 3], out, known, skipped);
     const double st = std::sin(pr.thetaMax), ct = std::cos(pr.thetaMax);
     const double r[4][2] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}};  // azimuth 0, 90, 180, 270 degrees
     for (const auto& q : r)
@@ -501,7 +552,8 @@ PixelBox projectedBox(const BoxCamera& camera, const OrientedBox& box) {
         for (const auto& f : kFaces) {
             const glm::dvec3 p[3] = {pr.toCamera(c[size_t(f[0])]), pr.toCamera(c[size_t(f[1])]),
                                      pr.toCamera(c[size_t(f[2])])};
-            extend(out, fisheyeTriangleExtent(pr, p));
+            bool skipped = false;  // runs within the faces' extent so far cannot widen it
+            extend(out, fisheyeTriangleExtent(pr, p, &out, &skipped));
         }
         return out;
     }
@@ -529,12 +581,13 @@ struct VisibleStats {
     uint32_t count;
 };
 
-std::vector<VisibleStats> visibleStats(const std::vector<uint32_t>& ids, int width, int height) {
+// The stats of rows [y0, y1) (in the order of their first pixel).
+std::vector<VisibleStats> visibleRows(const std::vector<uint32_t>& ids, int width, int y0, int y1) {
     std::unordered_map<uint32_t, size_t> at;
     std::vector<VisibleStats> s;
     uint32_t lastId = 0;
     size_t last = 0;
-    for (int y = 0; y < height; ++y)
+    for (int y = y0; y < y1; ++y)
         for (int x = 0; x < width; ++x) {
             const uint32_t id = ids[size_t(y) * size_t(width) + size_t(x)];
             if (id == 0) continue;
@@ -547,6 +600,32 @@ std::vector<VisibleStats> visibleStats(const std::vector<uint32_t>& ids, int wid
             VisibleStats& v = s[last];
             v.u0 = std::min(v.u0, x), v.v0 = std::min(v.v0, y), v.u1 = std::max(v.u1, x), v.v1 = std::max(v.v1, y);
             ++v.count;
+        }
+    return s;
+}
+
+// Bands of rows in parallel (in the caller's arena), merged: extents and
+// counts combine exactly, so the result does not depend on the split.
+std::vector<VisibleStats> visibleStats(const std::vector<uint32_t>& ids, int width, int height) {
+    constexpr int kBand = 32;
+    const int bands = (height + kBand - 1) / kBand;
+    std::vector<std::vector<VisibleStats>> part(size_t(std::max(bands, 0)));
+    tbb::parallel_for(0, bands, [&](int b) {
+        part[size_t(b)] = visibleRows(ids, width, b * kBand, std::min(height, (b + 1) * kBand));
+    });
+    std::unordered_map<uint32_t, size_t> at;
+    std::vector<VisibleStats> s;
+    for (const std::vector<VisibleStats>& p : part)
+        for (const VisibleStats& v : p) {
+            auto [it, fresh] = at.emplace(v.id, s.size());
+            if (fresh) {
+                s.push_back(v);
+                continue;
+            }
+            VisibleStats& w = s[it->second];
+            w.u0 = std::min(w.u0, v.u0), w.v0 = std::min(w.v0, v.v0), w.u1 = std::max(w.u1, v.u1),
+            w.v1 = std::max(w.v1, v.v1);
+            w.count += v.count;
         }
     std::sort(s.begin(), s.end(), [](const VisibleStats& a, const VisibleStats& b) { return a.id < b.id; });
     return s;
@@ -564,6 +643,16 @@ public:
     PixelBox full;
     uint32_t covered = 0;
 
+    // Fisheye: extends `full` by the vertices' pixels (those inside the cone).
+    // Every vertex is the first sample of an edge of its triangle, so seeding
+    // the extent with some of them first changes no extent, while the bounds
+    // and runs of the triangles that follow fall within it more often.
+    void seed(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+        glm::dvec2 uv;
+        for (const glm::dvec3* w : {&a, &b, &c})
+            if (_pr.conePixel(_pr.toCamera(*w), uv)) extend(full, uv);
+    }
+
     void triangle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
         const glm::dvec3 p[3] = {_pr.toCamera(a), _pr.toCamera(b), _pr.toCamera(c)};
         // Camera coordinates are a rotation of the world's: counter-clockwise
@@ -571,15 +660,21 @@ public:
         const bool front = glm::dot(glm::cross(p[1] - p[0], p[2] - p[0]), p[0]) < 0;
         if (_pr.m.fisheye()) {
             // A triangle whose bound lies within the extent so far cannot widen
-            // it: its edges are not sampled, and its pixels are sought in the bound.
+            // it: its edges are not sampled, and its pixels are sought in the
+            // bound. With a bound, runs of edge samples that cannot widen the
+            // extent are not sampled either, and when some were skipped the
+            // triangle's extent is partial: its pixels are sought in the bound.
             PixelBox bound;
-            if (full.valid() && fisheyeTriangleBound(_pr, p, bound) && within(bound, full)) {
+            const bool bounded = fisheyeTriangleBound(_pr, p, bound);
+            if (bounded && full.valid() && within(bound, full)) {
                 if (front && bound.valid()) fillSphere(p, bound);
                 return;
             }
-            const PixelBox e = fisheyeTriangleExtent(_pr, p);
+            bool skipped = false;
+            const PixelBox e = fisheyeTriangleExtent(_pr, p, bounded ? &full : nullptr, &skipped);
             extend(full, e);
-            if (front && e.valid()) fillSphere(p, e);
+            const PixelBox& seek = skipped ? bound : e;
+            if (front && seek.valid()) fillSphere(p, seek);
             return;
         }
         glm::dvec3 poly[4];
@@ -620,22 +715,72 @@ private:
                 if (row[x] != _mark) row[x] = _mark, ++covered;
         }
     }
+    static constexpr int kDirectFill = 48;  // pixels; fewer are tested one by one
     // Marks the pixels of extent e (grown by a pixel for the sampling of
-    // curved edges) whose ray passes through the triangle p.
+    // curved edges) whose ray passes through the triangle p. Tile by tile
+    // (CameraRayTable tiles): a tile whose cap lies beyond one of the
+    // triangle's three planes through the eye by more than a margin is
+    // skipped, one whose cap lies within all three by more than the margin
+    // is marked whole (its pixels inside the circle), the others test each
+    // pixel; the margin (1e-9 of a unit direction) dwarfs the rounding of
+    // the per-pixel test, so the marked pixels are those the test marks. An
+    // extent of a few pixels is tested pixel by pixel.
     void fillSphere(const glm::dvec3* p, const PixelBox& e) {
         const int x0 = int(std::max(0.0, std::floor(e.u0) - 1)),
                   x1 = int(std::min(double(_w - 1), std::ceil(e.u1) + 1));
         const int y0 = int(std::max(0.0, std::floor(e.v0) - 1)),
                   y1 = int(std::min(double(_h - 1), std::ceil(e.v1) + 1));
         const RayTriangle tri(p);
-        for (int y = y0; y <= y1; ++y) {
-            const size_t at = size_t(y) * size_t(_w);
-            uint32_t* row = &_stamp[at];
-            for (int x = x0; x <= x1; ++x) {
-                const size_t q = at + size_t(x);
-                if (row[x] != _mark && _rays->inside(q) && tri.hit(_rays->dir(q))) row[x] = _mark, ++covered;
+        if (tri.det == 0.0) return;
+        if ((x1 - x0 + 1) * (y1 - y0 + 1) <= kDirectFill) {  // a few pixels: no tile tests
+            for (int y = y0; y <= y1; ++y) {
+                const size_t at = size_t(y) * size_t(_w);
+                uint32_t* row = &_stamp[at];
+                for (int x = x0; x <= x1; ++x) {
+                    const size_t q = at + size_t(x);
+                    if (row[x] != _mark && _rays->inside(q) && tri.hit(_rays->dir(q))) row[x] = _mark, ++covered;
+                }
             }
+            return;
         }
+        // The planes as unit normals m with the triangle's directions on m . d <= 0.
+        const double side = tri.det > 0 ? -1.0 : 1.0;
+        glm::dvec3 m[3] = {tri.n0, tri.n1, tri.n2};
+        bool planes = true;
+        for (glm::dvec3& n : m) {
+            const double l = glm::length(n);
+            if (!(l > 1e-200)) planes = false;
+            else n *= side / l;
+        }
+        const int T = CameraRayTable::kTile;
+        for (int ty = y0 / T; ty <= y1 / T; ++ty)
+            for (int tx = x0 / T; tx <= x1 / T; ++tx) {
+                const CameraRayTable::TileCap& cap = _rays->tile(tx, ty);
+                if (!cap.anyInside) continue;
+                const int u0 = std::max(x0, tx * T), u1 = std::min(x1, tx * T + T - 1);
+                const int v0 = std::max(y0, ty * T), v1 = std::min(y1, ty * T + T - 1);
+                bool whole = false;
+                if (planes && cap.hasCap) {
+                    constexpr double kMargin = 1e-9;
+                    bool outside = false;
+                    whole = true;
+                    for (const glm::dvec3& n : m) {
+                        const double c = glm::dot(n, cap.axis), s = std::sqrt(std::max(0.0, 1.0 - c * c));
+                        if (c * cap.cosR - s * cap.sinR > kMargin) outside = true;     // the cap's least m . d
+                        if (!(c * cap.cosR + s * cap.sinR < -kMargin)) whole = false;  // its greatest
+                    }
+                    if (outside) continue;
+                }
+                for (int y = v0; y <= v1; ++y) {
+                    const size_t at = size_t(y) * size_t(_w);
+                    uint32_t* row = &_stamp[at];
+                    for (int x = u0; x <= u1; ++x) {
+                        const size_t q = at + size_t(x);
+                        if (row[x] != _mark && _rays->inside(q) && (whole || tri.hit(_rays->dir(q))))
+                            row[x] = _mark, ++covered;
+                    }
+                }
+            }
     }
     const Projector& _pr;
     const CameraRayTable* _rays;  // fisheye: the model's pixel rays
@@ -643,6 +788,8 @@ private:
     std::vector<uint32_t>& _stamp;
     uint32_t _mark;
 };
+
+constexpr uint32_t kSeedStride = 4;
 
 // The share of `whole` outside `inside` (per axis, so a zero-width extent counts too).
 double truncation(const PixelBox& whole, const PixelBox& inside) {
@@ -676,7 +823,9 @@ std::vector<FrameBox> frameBoxes(const SceneModel& city, const CityBoxes& boxes,
     std::vector<FrameBox> out;
     std::vector<const InstanceBox*> src;
     std::vector<const MovingObject*> moving;
-    for (const VisibleStats& s : visibleStats(ids, W, H)) {
+    std::vector<VisibleStats> stats;
+    inArena(options.threads, [&] { stats = visibleStats(ids, W, H); });
+    for (const VisibleStats& s : stats) {
         if (s.count < options.minPixels) continue;
         const InstanceBox* ib = boxes.find(s.id);
         const MovingObject* mo = ib ? nullptr : findMover(movers, s.id);
@@ -704,6 +853,13 @@ std::vector<FrameBox> frameBoxes(const SceneModel& city, const CityBoxes& boxes,
         tbb::parallel_for(size_t(0), out.size(), [&](size_t i) {
             FrameBox& f = out[i];
             MaskRaster r(pr, rays, W, H, stamps.local(), uint32_t(i));
+            if (pr.m.fisheye() && src[i]) {  // the vertices of every kSeedStride-th triangle first
+                uint32_t k = 0;
+                forEachTriangle(city, boxes, *src[i],
+                                [&](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+                                    if (k++ % kSeedStride == 0) r.seed(a, b, c);
+                                });
+            }
             if (src[i]) {
                 forEachTriangle(
                     city, boxes, *src[i],

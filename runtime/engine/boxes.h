@@ -70,14 +70,23 @@
 // through the triangle: the image of a triangle within the cone is bounded
 // by those edge pieces and arcs of the circle, and an arc's extent is its
 // end points' or the circle's extreme points'. The sampling of an edge's
-// curved image errs by well under 0.1 px (inside). A triangle whose
-// conservative bound (the image of a cap around its directions, computed
-// without sampling) lies within the extent of the instance's triangles so
-// far cannot widen it and is not sampled. The fisheye mask tests each pixel
-// centre of a front-facing triangle's extent (or that bound): its ray
-// (pixelRay, from FrameBoxOptions::rays when given) passes through the
-// triangle. The projected 3D box is the
-// extent of its 12 triangles.
+// curved image errs by well under 0.1 px (inside). Shortcuts that keep the
+// result to the bit (extents are minima and maxima, so points within the
+// extent so far change nothing): a triangle whose conservative bound (the
+// image of a cap around its directions, computed without sampling) lies
+// within the extent of the instance's triangles so far is not sampled, and
+// a run of 32 samples of an edge whose cap lies inside the cone and whose
+// image lies within the extent so far is not sampled; the extent starts
+// from the in-cone vertices of every fourth triangle (each vertex is its
+// edge's first sample). The fisheye mask
+// tests each pixel centre of a front-facing triangle's extent (or that
+// bound, when samples were skipped): its ray (pixelRay, from
+// FrameBoxOptions::rays when given) passes through the triangle; tile by
+// tile (camera_ray_table.h), a tile whose directions all lie beyond one of
+// the triangle's planes by a margin far above rounding is skipped, and one
+// whose directions all lie within the three is marked whole, so the marked
+// pixels are those of the per-pixel test. The projected 3D box is the
+// extent of its 12 triangles (with the same shortcuts).
 //
 // Vehicle frame (boxInVehicleFrame): x forward, y left, z up (LidarPose's
 // convention, KITTI's velodyne frame). The centre is exact for any pose;
@@ -85,8 +94,10 @@
 // plane (exact for a level vehicle; the box is upright in the world).
 //
 // Thread safety: pure functions on const inputs; CityBoxes is immutable
-// after build and may be shared. Parallel over `threads` workers (0 = all);
-// the results do not depend on the thread count. Contract violations
+// after build and may be shared. Parallel over `threads` workers (0 = all):
+// frameBoxes counts the instance image's pixels in bands of rows and
+// rasterises the instances in parallel; the results do not depend on the
+// thread count. Contract violations
 // (an instance image whose size differs from the camera's, a pinhole
 // zNear <= 0) are VISTA_CHECKs.
 #pragma once

@@ -8,16 +8,19 @@
 // visible pixel centre and every vertex inside the image circle projected
 // here, and the unoccluded pixel counts agree with rays cast here at the
 // instance alone, and the fast fisheye masks count exactly the pixels of
-// every pixel ray tested against every front triangle; a box in the vehicle frame is the world box through the inverse of
-// the pose's 4x4 matrix, in the file too; sightings merge cameras and LiDARs;
-// KITTI label lines read back with the devkit's corners hold the world box
-// (equal to it for a level vehicle) and carry the instance id.
+// every pixel ray tested against every front triangle, also for large
+// cuboids around the camera (whole tiles, skipped runs of edge samples),
+// whose extents equal every edge sample taken the plain way; visible
+// extents of a tall image counted in bands equal those counted here; a box in the vehicle frame is the world box
+// through the inverse of the pose's 4x4 matrix, in the file too; sightings merge cameras and LiDARs; KITTI label lines
+// read back with the devkit's corners hold the world box (equal to it for a level vehicle) and carry the instance id.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <memory>
+#include <random>
 #include <sstream>
 #include <string>
 
@@ -151,6 +154,71 @@ uint32_t fisheyeRaysAtInstanceAlone(const CameraModel& m, const RigPose& pose, c
             n += (*scene)->intersect(glm::vec3(0.0f), glm::vec3(d)).hit ? 1u : 0u;
         }
     return n;
+}
+
+// The fisheye extent of triangles (world points, 3 per triangle) the plain
+// way boxes.h states: every edge sampled at ceil(angle * max(fx, fy))
+// even steps, each sample inside the image circle's cone projected, the
+// cone crossings found by bisection (40 halvings), and the circle's four
+// extreme points whose ray passes through the triangle; no shortcut.
+PixelBox fisheyeExtentEverySample(const CameraModel& m, const BoxCamera& cam, const std::vector<glm::dvec3>& tris) {
+    const double thetaMax = std::min(kPi, 0.5 * m.maxFovDeg * kPi / 180.0);
+    PixelBox out;
+    auto add = [&](double u, double v) {
+        if (!out.valid()) out = {u, v, u, v};
+        out.u0 = std::min(out.u0, u), out.v0 = std::min(out.v0, v);
+        out.u1 = std::max(out.u1, u), out.v1 = std::max(out.v1, v);
+    };
+    auto inCone = [&](const glm::dvec3& p) {
+        const double rho = std::hypot(p.x, p.y);
+        return (rho > 0.0 || p.z > 0.0) && std::atan2(rho, p.z) <= thetaMax;
+    };
+    auto addPoint = [&](const glm::dvec3& p) {
+        const double rho = std::hypot(p.x, p.y), theta = std::atan2(rho, p.z);
+        if (rho == 0.0) add(m.cx, m.cy);
+        else add(m.cx + m.fx * theta * p.x / rho, m.cy + m.fy * theta * p.y / rho);
+    };
+    const glm::dmat3 toCam = glm::transpose(cam.axes);
+    for (size_t t = 0; t + 2 < tris.size(); t += 3) {
+        const glm::dvec3 p[3] = {toCam * (tris[t] - cam.eye), toCam * (tris[t + 1] - cam.eye),
+                                 toCam * (tris[t + 2] - cam.eye)};
+        for (int i = 0; i < 3; ++i) {
+            const glm::dvec3 &a = p[i], &b = p[(i + 1) % 3];
+            const double la = glm::length(a), lb = glm::length(b);
+            const double angle = la > 0 && lb > 0 ? std::acos(std::clamp(glm::dot(a, b) / (la * lb), -1.0, 1.0)) : kPi;
+            const int n = int(std::clamp(std::ceil(angle * std::max(m.fx, m.fy)), 1.0, 4096.0));
+            glm::dvec3 prev = a;
+            bool prevIn = inCone(a);
+            if (prevIn) addPoint(a);
+            for (int k = 1; k <= n; ++k) {
+                const glm::dvec3 q = a + (double(k) / n) * (b - a);
+                const bool in = inCone(q);
+                if (in) addPoint(q);
+                if (in != prevIn) {
+                    glm::dvec3 lo = prev, hi = q;  // lo on prev's side
+                    for (int h = 0; h < 40; ++h) {
+                        const glm::dvec3 mid = 0.5 * (lo + hi);
+                        (inCone(mid) == prevIn ? lo : hi) = mid;
+                    }
+                    glm::dvec2 uv(m.cx, m.cy);
+                    m.project(prevIn ? lo : hi, uv);
+                    add(uv.x, uv.y);
+                }
+                prev = q, prevIn = in;
+            }
+        }
+        const glm::dvec3 n0 = glm::cross(p[1], p[2]), n1 = glm::cross(p[2], p[0]), n2 = glm::cross(p[0], p[1]);
+        const double det = glm::dot(p[0], n0);
+        const double st = std::sin(thetaMax), ct = std::cos(thetaMax);
+        const double r[4][2] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}};
+        for (const auto& q : r) {
+            const glm::dvec3 d(st * q[0], st * q[1], ct);
+            const double x = glm::dot(d, n0), y = glm::dot(d, n1), z = glm::dot(d, n2);
+            if (det != 0.0 && (det > 0 ? x >= 0 && y >= 0 && z >= 0 : x <= 0 && y <= 0 && z <= 0))
+                add(m.cx + m.fx * thetaMax * q[0], m.cy + m.fy * thetaMax * q[1]);
+        }
+    }
+    return out;
 }
 
 }  // namespace
@@ -316,6 +384,111 @@ TEST(RigBoxes, FisheyeMasksCountThePixelsOfEveryPixelTestedAgainstEveryTriangle)
     }
     EXPECT_GE(compared, 30u);
     EXPECT_GT(nonEmpty, 10u);
+}
+
+// A cuboid mesh (a moving object's, identity transform) whose corners and
+// faces are those projectedBox samples: its `full` extent and its 3D box's
+// extent, made with the fisheye shortcuts (whole tiles, skipped runs of edge
+// samples), are the extent of every sample taken the plain way, exactly; and its
+// unoccluded pixels are those of every pixel ray tested against every
+// triangle. The boxes lie around the camera at 1 to 6 m, large in a
+// 320x240 fisheye, the camera turned every way.
+TEST(RigBoxes, FisheyeShortcutsGiveTheExtentAndPixelsOfTheUnshortenedWay) {
+    CameraModel model;
+    model.kind = CameraModel::Kind::Fisheye;
+    model.width = 320, model.height = 240;
+    model.fx = 75.0, model.fy = 78.0, model.cx = 159.5, model.cy = 118.0;
+    model.maxFovDeg = 190.0;
+    const CameraRayTable table(model);
+    static const uint32_t kFaces[12][3] = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                                           {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+    const SceneModel city;
+    const CityBoxes none;
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> turn(-kPi, kPi);
+    std::uniform_int_distribution<int> halfMetres(-12, 12), sizeHalves(2, 14);
+    size_t compared = 0, large = 0;
+    for (int k = 0; k < 40; ++k) {
+        OrientedBox box;  // corners at multiples of 0.25 m: exact as floats
+        box.center = {0.5 * halfMetres(rng), 0.5 * halfMetres(rng), 0.5 * halfMetres(rng)};
+        box.size = {0.5 * sizeHalves(rng), 0.5 * sizeHalves(rng), 0.5 * sizeHalves(rng)};
+        if (box.contains(glm::dvec3(0.0), 0.3)) continue;  // the camera is not inside the box
+        const std::array<glm::dvec3, 8> corners = box.corners();
+        Mesh mesh;
+        for (const glm::dvec3& c : corners) {
+            mesh.positions.push_back(glm::vec3(c));
+            ASSERT_EQ(glm::dvec3(mesh.positions.back()), c);
+        }
+        std::vector<glm::dvec3> tris;
+        for (const auto& f : kFaces)
+            for (uint32_t v : f) mesh.indices.push_back(v), tris.push_back(corners[v]);
+        MovingObject mo;
+        mo.id = 7;
+        mo.box = box;
+        mo.mesh = &mesh;
+        BoxCamera cam;
+        cam.model = model;
+        cam.axes = glm::dmat3(glm::rotate(glm::dmat4(1.0), turn(rng), glm::dvec3(0, 0, 1)) *
+                              glm::rotate(glm::dmat4(1.0), turn(rng), glm::dvec3(1, 0, 0)) *
+                              glm::rotate(glm::dmat4(1.0), turn(rng), glm::dvec3(0, 1, 0)));
+        std::vector<uint32_t> ids(size_t(model.width) * size_t(model.height), 0u);
+        ids[size_t(model.width) * 120 + 160] = mo.id;  // one visible pixel: the box gets an entry
+        FrameBoxOptions o;
+        o.rays = &table;
+        const std::vector<FrameBox> fb = frameBoxes(city, none, {mo}, cam, ids, o);
+        ASSERT_EQ(fb.size(), 1u);
+        const FrameBox& f = fb[0];
+        const PixelBox want = clipToImage(fisheyeExtentEverySample(model, cam, tris), model.width, model.height);
+        if (!want.valid()) {  // the box lies outside the image circle's cone
+            EXPECT_FALSE(f.full.valid()) << k;
+            EXPECT_EQ(f.unoccludedPixels, 0u) << k;
+            continue;
+        }
+        for (const PixelBox& got : {f.full, f.boxExtent}) {
+            EXPECT_EQ(got.u0, want.u0) << k;
+            EXPECT_EQ(got.v0, want.v0) << k;
+            EXPECT_EQ(got.u1, want.u1) << k;
+            EXPECT_EQ(got.v1, want.v1) << k;
+        }
+        EXPECT_EQ(f.unoccludedPixels, fisheyeMaskEveryPixel(model, cam, tris)) << k;
+        ++compared;
+        large += f.unoccludedPixels > 5000 ? 1 : 0;
+    }
+    EXPECT_GE(compared, 25u);
+    EXPECT_GE(large, 5u);
+}
+
+// The visible extents and pixel counts of an instance image made of bands
+// of rows (every id in several bands) are those counted here, with any
+// number of threads.
+TEST(RigBoxes, VisibleExtentsOfATallImageAreThoseCountedHere) {
+    CameraModel model;
+    model.width = 50, model.height = 203;
+    model.fx = model.fy = 60.0, model.cx = 24.5, model.cy = 101.0;
+    std::mt19937 rng(3);
+    std::uniform_int_distribution<uint32_t> pick(0, 9);
+    std::vector<uint32_t> ids(size_t(model.width) * size_t(model.height));
+    for (uint32_t& id : ids) id = pick(rng) < 3 ? 0u : 100u + pick(rng) % 7;
+    std::vector<MovingObject> movers;
+    for (uint32_t id = 100; id < 107; ++id) movers.push_back(MovingObject{id, 0, {}, {}, nullptr, glm::dmat4(1.0)});
+    std::map<uint32_t, Mask> want;
+    for (int y = 0; y < model.height; ++y)
+        for (int x = 0; x < model.width; ++x) {
+            const uint32_t id = ids[size_t(y) * size_t(model.width) + size_t(x)];
+            if (id == 0) continue;
+            Mask& m = want[id];
+            m.u0 = std::min(m.u0, x), m.v0 = std::min(m.v0, y), m.u1 = std::max(m.u1, x), m.v1 = std::max(m.v1, y);
+            ++m.n;
+        }
+    BoxCamera cam;
+    cam.model = model;
+    for (int threads : {1, 2, 0}) {
+        FrameBoxOptions o;
+        o.threads = threads;
+        const std::vector<FrameBox> fb = frameBoxes(SceneModel{}, CityBoxes{}, movers, cam, ids, o);
+        ASSERT_EQ(fb.size(), want.size());
+        for (const FrameBox& f : fb) expectVisibleEqualsMask(f, want.at(f.id));
+    }
 }
 
 TEST(RigBoxes, VehicleFrameBoxesAreTheWorldBoxesThroughThePose) {
