@@ -935,8 +935,7 @@ void LaneModelBuilder::placeLinks() {
 // turn is sharper than kMaxTurn, its lane would reach the centre of
 // curvature, it misses its turning radius (unless mayBeTight: then kept and
 // counted in tightTurnsKept) or it crosses another road (unless mayCross).
-bool LaneModelBuilder::addLaneTurn(size_t j, uint32_t in, uint32_t out, int k, int o, bool mayCross,
-                                   bool mayBeTight) {
+bool LaneModelBuilder::addLaneTurn(size_t j, uint32_t in, uint32_t out, int k, int o, bool mayCross, bool mayBeTight) {
     Junction& J = m.junctions[j];
     TurnPlan t;
     t.in = in;

@@ -235,14 +235,15 @@ Result<PagedCityOptions> resolvePaged(const GenArgs& a, const CityParams& params
         o.mergeShards = *a.shards;
         o.shardCommand = shardCommand(a, o.dir);
     }
-    for (auto [opt, path] : {std::pair<const char*, const std::string*>{"--geojson", &a.geojsonFile},
-                             {"--gltf", &a.gltfFile}})
+    for (auto [opt, path] :
+         {std::pair<const char*, const std::string*>{"--geojson", &a.geojsonFile}, {"--gltf", &a.gltfFile}})
         if (!path->empty())
             return Status::error(std::string("option ") + opt + ": not supported with paged output (-o DIR.paged)");
     if (!a.xodrFile.empty()) {
         if (o.shard.count > 1)
-            return Status::error("option --xodr: not with --shard (a shard writes its regions only; give --xodr to "
-                                 "the --merge, which writes the whole road network)");
+            return Status::error(
+                "option --xodr: not with --shard (a shard writes its regions only; give --xodr to "
+                "the --merge, which writes the whole road network)");
         VISTA_RETURN_IF_ERROR(checkXodrPath("--xodr", a.xodrFile));
         VISTA_RETURN_IF_ERROR(checkWritablePath("--xodr", a.xodrFile));
         o.xodr = a.xodrFile;

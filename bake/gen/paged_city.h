@@ -87,7 +87,7 @@ struct PagedCityReport {
     int emptyRegions = 0;  // of those this run generated or reused
     bool indexWritten = false;
     bool xodrWritten = false;
-    OpenDriveCounts roads;  // of the OpenDRIVE file, when xodrWritten
+    OpenDriveCounts roads;               // of the OpenDRIVE file, when xodrWritten
     size_t streetEdges = 0, blocks = 0;  // of the whole city (0 if nothing was generated)
     // Totals over the regions this run generated or reused.
     size_t buildings = 0, trees = 0, triangles = 0, bytes = 0;

@@ -245,7 +245,7 @@ TEST_F(TrafficDraw, RigCamerasAndLidarSeeTheAgents) {
     TempDir tmp("vista_traffic_draw_rig");
     const auto& f = fixture();
     const std::string out = tmp.file("rig");
-    const auto r = runVista("render " + f.city + " --path " + f.path + " --frames 6 --sampling consecutive -q --rig " +
+    const auto r = runVista("render " + f.city + " --path " + f.path + " --frames 6 --sampling spread -q --rig " +
                             std::string(VISTA_SOURCE_DIR) + "/data/rigs/car_4cam_lidar64.json --traffic " + f.traffic +
                             " --out " + out);
     ASSERT_EQ(r.code, 0) << r.err;

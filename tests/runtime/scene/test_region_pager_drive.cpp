@@ -43,9 +43,15 @@ public:
         _cv.wait(lock, [this] { return _stop || _frame >= _due; });
         _blocked = false;
     }
-    void start() { set([this] { _on = true; }); }
-    void frame(int f) { set([this, f] { _frame = f; }); }
-    void stop() { set([this] { _stop = true; }); }
+    void start() {
+        set([this] { _on = true; });
+    }
+    void frame(int f) {
+        set([this, f] { _frame = f; });
+    }
+    void stop() {
+        set([this] { _stop = true; });
+    }
     // True when the worker waits on a load that is not due yet.
     bool holding() const {
         std::lock_guard<std::mutex> lock(_m);
