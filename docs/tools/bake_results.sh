@@ -87,7 +87,7 @@ for i in "${!VARIANTS[@]}"; do
     label=${VARIANTS[$i]%%|*}
     opts=${VARIANTS[$i]#*|}
     # shellcheck disable=SC2086
-    [ -f "var_$i.json" ] || "$VISTA" bake city.osgb -o "var_$i.osgb" --cells 3 --jobs 2 --stats "var_$i.json" -q $opts
+    [ -f "var_$i.json" ] || "$VISTA" bake city.osgb -o "var_$i.osgb" --cells 3 --storage-budget off --jobs 2 --stats "var_$i.json" -q $opts
     files+=("var_$i.osgb")
     labels+=("$label")
 done
