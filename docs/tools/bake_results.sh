@@ -94,7 +94,7 @@ done
 [ -f var_report.json ] || "$REPORT" --cell 3 --frames 10 --ssaa 4 --baked "${files[@]}" --label "${labels[@]}" --json var_report.json > /dev/null
 echo "### What accuracy costs (cell 3)"
 echo
-echo "Commands: \`vista bake city.osgb -o var_K.osgb --cells 3 --jobs 2 --stats var_K.json [option]\` per row, then"
+echo "Commands: \`vista bake city.osgb -o var_K.osgb --cells 3 --storage-budget off --jobs 2 --stats var_K.json [option]\` per row, then"
 echo "\`xvfb-run -a vista_bake_report --cell 3 --frames 10 --ssaa 4 --baked var_0.osgb ... --json var_report.json\`."
 echo "PSNR: median over 13 views (8 corners, 4 edge midpoints, centre) against the 4x4 supersampled replaced geometry."
 echo
