@@ -9,6 +9,7 @@
 #include <string>
 
 #include "tests/common/run_vista.h"
+#include "tests/common/sumo_city.h"
 #include "tests/common/temp_dir.h"
 
 namespace fs = std::filesystem;
@@ -19,15 +20,13 @@ using vista::test::TempDir;
 
 namespace {
 
-bool haveSumo() { return std::system("command -v sumo >/dev/null 2>&1 && command -v netconvert >/dev/null 2>&1") == 0; }
-
 // One small city for every test of this file (generated once).
 const std::string& smallCity() {
     static TempDir dir("vista_traffic_city");  // lives for the whole run, removed at exit
     static std::string city;
     if (city.empty()) {
         city = dir.file("city.osgb");
-        const auto r = runVista("gen --size 700 --detail 0 --seed 5 -q -o " + city);
+        const auto r = vista::test::genTrafficCity(city);
         EXPECT_EQ(r.code, 0) << r.err;
     }
     return city;
@@ -36,7 +35,7 @@ const std::string& smallCity() {
 }  // namespace
 
 TEST(TrafficCli, SameSeedSameBytesAndTheManifestCountsTheAgents) {
-    if (!haveSumo()) GTEST_SKIP() << "SUMO (sumo, netconvert) is not installed; .ci/setup.sh installs it";
+    VISTA_SKIP_WITHOUT_SUMO();
     TempDir tmp("vista_traffic_run");
     const std::string args = " --vehicles 30 --pedestrians 30 --duration 90 --seed 4 -q -o ";
     const auto a = runVista("traffic " + smallCity() + args + tmp.file("a"));

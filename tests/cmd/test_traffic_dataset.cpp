@@ -37,6 +37,7 @@
 #include "runtime/traffic/traffic_tracks.h"
 #include "tests/common/npy.h"
 #include "tests/common/run_vista.h"
+#include "tests/common/sumo_city.h"
 #include "tests/common/temp_dir.h"
 
 namespace fs = std::filesystem;
@@ -47,8 +48,6 @@ using test::runVista;
 using test::TempDir;
 
 namespace {
-
-bool haveSumo() { return std::system("command -v sumo >/dev/null 2>&1 && command -v netconvert >/dev/null 2>&1") == 0; }
 
 constexpr int kW = 200, kH = 120;
 constexpr double kFx = 110, kFy = 110, kCx = 99.5, kCy = 59.5;
@@ -79,7 +78,7 @@ const Fixture& fixture() {
         f.out = dir.file("rig");
         f.rig = dir.file("rig.json");
         std::ofstream(f.rig) << kRig;
-        auto r = runVista("gen --size 700 --detail 0 --seed 5 -q -o " + f.city);
+        auto r = test::genTrafficCity(f.city);
         EXPECT_EQ(r.code, 0) << r.err;
         r = runVista("traffic " + f.city + " --vehicles 300 --pedestrians 30 --duration 120 --seed 4 -q -o " +
                      f.traffic);
@@ -113,7 +112,7 @@ glm::dmat4 matrixOf(const nlohmann::json& rows) {
 class TrafficDataset : public ::testing::Test {
 protected:
     void SetUp() override {
-        if (!haveSumo()) GTEST_SKIP() << "SUMO (sumo, netconvert) is not installed; .ci/setup.sh installs it";
+        VISTA_SKIP_WITHOUT_SUMO();
         if (!fixture().ok) GTEST_FAIL() << "the traffic dataset fixture could not be made";
     }
 };

@@ -36,6 +36,7 @@
 #include "runtime/traffic/traffic_tracks.h"
 #include "tests/common/npy.h"
 #include "tests/common/run_vista.h"
+#include "tests/common/sumo_city.h"
 #include "tests/common/temp_dir.h"
 
 namespace fs = std::filesystem;
@@ -46,8 +47,6 @@ using test::runVista;
 using test::TempDir;
 
 namespace {
-
-bool haveSumo() { return std::system("command -v sumo >/dev/null 2>&1 && command -v netconvert >/dev/null 2>&1") == 0; }
 
 constexpr int kW = 320, kH = 200;
 
@@ -63,7 +62,7 @@ const Fixture& fixture() {
         f.city = dir.file("city.osgb");
         f.traffic = dir.file("traffic");
         f.path = dir.file("ego.csv");
-        auto r = runVista("gen --size 700 --detail 0 --seed 5 -q -o " + f.city);
+        auto r = test::genTrafficCity(f.city);
         EXPECT_EQ(r.code, 0) << r.err;
         r = runVista("traffic " + f.city + " --vehicles 60 --pedestrians 60 --duration 120 --seed 4 -q -o " +
                      f.traffic);
@@ -166,7 +165,7 @@ AgentPixels checkAgentPixels(const std::string& out, const TrafficTracks& tracks
 class TrafficDraw : public ::testing::Test {
 protected:
     void SetUp() override {
-        if (!haveSumo()) GTEST_SKIP() << "SUMO (sumo, netconvert) is not installed; .ci/setup.sh installs it";
+        VISTA_SKIP_WITHOUT_SUMO();
         if (!fixture().ok) GTEST_FAIL() << "the traffic fixture could not be made";
     }
     std::string render(const std::string& out, const std::string& extra) {

@@ -25,6 +25,7 @@
 #include "foundation/progress.h"
 #include "runtime/traffic/signal_states.h"
 #include "runtime/traffic/traffic_run.h"
+#include "tests/common/sumo_city.h"
 #include "tests/common/temp_dir.h"
 
 using namespace vista;
@@ -42,17 +43,10 @@ std::vector<std::string> lines(const std::string& path) {
 }  // namespace
 
 TEST(SignalStatesSumo, HeadsShowTheStateSumoHadForTheirLinks) {
-    if (std::system("command -v sumo >/dev/null 2>&1 && command -v netconvert >/dev/null 2>&1") != 0)
-        GTEST_SKIP() << "SUMO (sumo, netconvert) is not installed; .ci/setup.sh installs it";
-    CityParams params;
-    params.size_m = 800.0;
-    params.seed = 11;
-    params.detail = 0;
-    auto city = generateCity(params);
-    ASSERT_TRUE(city) << city.status().message();
-    const std::vector<Block> blocks = extractBlocks(city->streets, params, nullptr);
-    auto xodr = openDriveXml(city->streets, params, &blocks);
-    ASSERT_TRUE(xodr) << xodr.status().message();
+    VISTA_SKIP_WITHOUT_SUMO();
+    auto made = test::xodrCity(test::sumoCityParams());
+    ASSERT_TRUE(made) << made.status().message();
+    const std::string* xodr = &made->xodr;
     TempDir tmp("vista_signal_states_sumo");
     TrafficOptions opt;
     opt.demand.vehicles = 40;

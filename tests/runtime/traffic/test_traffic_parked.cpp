@@ -17,6 +17,7 @@
 #include "foundation/progress.h"
 #include "runtime/traffic/traffic_run.h"
 #include "runtime/traffic/traffic_tracks.h"
+#include "tests/common/sumo_city.h"
 #include "tests/common/temp_dir.h"
 
 using namespace vista;
@@ -51,22 +52,17 @@ Poly body(glm::dvec2 front, double heading, double length, double width) {
 }  // namespace
 
 TEST(TrafficParked, NoMovingVehicleDrivesThroughAParkedCar) {
-    if (std::system("command -v sumo >/dev/null 2>&1 && command -v netconvert >/dev/null 2>&1") != 0)
-        GTEST_SKIP() << "SUMO (sumo, netconvert) is not installed; .ci/setup.sh installs it";
+    VISTA_SKIP_WITHOUT_SUMO();
     // The overlap test itself: two bodies side by side touch nothing, nose to tail overlap.
     ASSERT_FALSE(overlap(body({0, 0}, 0.0, 4.0, 2.0), body({0, 2.5}, 0.0, 4.0, 2.0)));
     ASSERT_TRUE(overlap(body({0, 0}, 0.0, 4.0, 2.0), body({3, 0.5}, 0.3, 4.0, 2.0)));
-    CityParams params;
-    params.size_m = 800.0;
-    params.seed = 11;
-    params.detail = 0;
+    CityParams params = test::sumoCityParams();
     params.parked_car_share = 0.6;
-    auto city = generateCity(params);
-    ASSERT_TRUE(city) << city.status().message();
+    auto made = test::xodrCity(params);
+    ASSERT_TRUE(made) << made.status().message();
+    const City* city = &made->city;
+    const std::string* xodr = &made->xodr;
     ASSERT_GT(city->cars.size(), 20u);
-    const std::vector<Block> blocks = extractBlocks(city->streets, params, nullptr);
-    auto xodr = openDriveXml(city->streets, params, &blocks);
-    ASSERT_TRUE(xodr) << xodr.status().message();
 
     TempDir tmp("vista_traffic_parked");
     TrafficOptions opt;
