@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "citygen/polygon.h"
+#include "citygen/shape_grid.h"
 
 namespace vista {
 
@@ -259,8 +260,6 @@ struct ArmStrip {
     }
 };
 
-using Quad = std::array<glm::dvec2, 4>;
-
 // True when two convex quadrilaterals overlap deeper than `slack` metres
 // (separating axis test; touching counts as apart).
 bool quadsOverlap(const Quad& a, const Quad& b, double slack = 1e-9) {
@@ -304,37 +303,6 @@ std::vector<Quad> linkOutline(const LinkRoad& r) {
     return out;
 }
 
-// Quadrilaterals by the cells of a uniform grid their bounding boxes touch.
-class ShapeGrid {
-public:
-    explicit ShapeGrid(double cell) : _cell(cell) {}
-    void insert(const Quad& q, uint32_t id) {
-        forCells(q, [&](long x, long y) { _cells[{x, y}].push_back(id); });
-    }
-    // Ids of the shapes sharing a cell with q (sorted, unique).
-    void query(const Quad& q, std::vector<uint32_t>& out) const {
-        out.clear();
-        forCells(q, [&](long x, long y) {
-            auto it = _cells.find({x, y});
-            if (it != _cells.end()) out.insert(out.end(), it->second.begin(), it->second.end());
-        });
-        std::sort(out.begin(), out.end());
-        out.erase(std::unique(out.begin(), out.end()), out.end());
-    }
-
-private:
-    template <class F>
-    void forCells(const Quad& q, F f) const {
-        glm::dvec2 lo(1e300), hi(-1e300);
-        for (const glm::dvec2& p : q) lo = glm::min(lo, p), hi = glm::max(hi, p);
-        if (!std::isfinite(lo.x + lo.y + hi.x + hi.y)) return;
-        for (long y = long(std::floor(lo.y / _cell)); y <= long(std::floor(hi.y / _cell)); ++y)
-            for (long x = long(std::floor(lo.x / _cell)); x <= long(std::floor(hi.x / _cell)); ++x) f(x, y);
-    }
-    double _cell;
-    std::map<std::pair<long, long>, std::vector<uint32_t>> _cells;
-};
-
 // Street carriageways and placed junction turns, for the crossing test of
 // the turns connectLeftovers adds.
 class CrossIndex {
@@ -352,13 +320,14 @@ public:
     static constexpr long kNone = std::numeric_limits<long>::min();
     long crossed(const LinkRoad& r) const {
         std::vector<uint32_t> near;
+        auto other = [&](uint32_t i) {
+            const long o = _owner[i];
+            return o != long(r.in) && o != long(r.out) && o != -long(r.junction) - 1;
+        };
         for (const Quad& q : linkOutline(r)) {
-            _grid.query(q, near);
-            for (uint32_t i : near) {
-                const long o = _owner[i];
-                if (o == long(r.in) || o == long(r.out) || o == -long(r.junction) - 1) continue;
-                if (quadsOverlap(q, _quads[i], kOverlapSlack)) return o;
-            }
+            _grid.query(q, 0, std::numeric_limits<uint32_t>::max(), other, near);
+            for (uint32_t i : near)
+                if (quadsOverlap(q, _quads[i], kOverlapSlack)) return _owner[i];
         }
         return kNone;
     }
@@ -1196,25 +1165,34 @@ std::vector<bool> LaneModelBuilder::crossingTurns(const std::vector<LinkRoad>& t
         for (const Quad& q : linkOutline(turns[k])) shapes.push_back({q, -long(k) - 1});
         turnShapes[k].second = shapes.size();
     }
+    const uint32_t streets = uint32_t(turnShapes.empty() ? shapes.size() : turnShapes[0].first);
     ShapeGrid grid(8.0);
     for (size_t i = 0; i < shapes.size(); ++i) grid.insert(shapes[i].q, uint32_t(i));
+    // Turns come by junction: the turns of other junctions before turn k are those before its junction's first.
+    std::vector<uint32_t> junctionFirst(turns.size());
+    for (size_t k = 0; k < turns.size(); ++k)
+        junctionFirst[k] = uint32_t(k > 0 && turns[k].junction == turns[k - 1].junction ? junctionFirst[k - 1]
+                                                                                         : turnShapes[k].first);
     std::vector<bool> drop(turns.size(), false);
     crossed.assign(turns.size(), CrossIndex::kNone);
     std::vector<uint32_t> near;
     for (int pass = 0; pass < 2; ++pass) {  // street roads first, then other junctions' turns
         for (size_t k = 0; k < turns.size(); ++k) {
             const LinkRoad& r = turns[k];
+            // Street roads other than the turn's own two (pass 0); turns
+            // before this one, of other junctions, still kept (pass 1).
+            auto candidate = [&](uint32_t o) {
+                const long owner = shapes[o].owner;
+                if (pass == 0) return owner >= 0 && owner != long(r.in) && owner != long(r.out);
+                if (owner >= 0) return false;
+                const size_t d = size_t(-owner - 1);
+                return d < k && !drop[d] && turns[d].junction != r.junction;
+            };
+            const uint32_t first = pass == 0 ? 0 : streets, last = pass == 0 ? streets : junctionFirst[k];
             for (size_t i = turnShapes[k].first; i < turnShapes[k].second && !drop[k]; ++i) {
-                grid.query(shapes[i].q, near);
+                grid.query(shapes[i].q, first, last, candidate, near);
                 for (uint32_t o : near) {
                     const Shape& s = shapes[o];
-                    if (pass == 0) {
-                        if (s.owner < 0 || s.owner == long(r.in) || s.owner == long(r.out)) continue;
-                    } else {
-                        if (s.owner >= 0) continue;
-                        const size_t d = size_t(-s.owner - 1);
-                        if (d >= k || drop[d] || turns[d].junction == r.junction) continue;
-                    }
                     if (quadsOverlap(shapes[i].q, s.q, kOverlapSlack)) {
                         drop[k] = true;
                         crossed[k] = s.owner >= 0 ? s.owner : -long(turns[size_t(-s.owner - 1)].junction) - 1;
