@@ -1171,8 +1171,8 @@ std::vector<bool> LaneModelBuilder::crossingTurns(const std::vector<LinkRoad>& t
     // Turns come by junction: the turns of other junctions before turn k are those before its junction's first.
     std::vector<uint32_t> junctionFirst(turns.size());
     for (size_t k = 0; k < turns.size(); ++k)
-        junctionFirst[k] = uint32_t(k > 0 && turns[k].junction == turns[k - 1].junction ? junctionFirst[k - 1]
-                                                                                         : turnShapes[k].first);
+        junctionFirst[k] =
+            uint32_t(k > 0 && turns[k].junction == turns[k - 1].junction ? junctionFirst[k - 1] : turnShapes[k].first);
     std::vector<bool> drop(turns.size(), false);
     crossed.assign(turns.size(), CrossIndex::kNone);
     std::vector<uint32_t> near;

@@ -14,14 +14,15 @@
 #include <vector>
 
 #include "citygen/shape_grid.h"
+#include "foundation/units.h"
 
 using namespace vista;
 
 namespace {
 
 Quad randomQuad(std::mt19937_64& rng, double maxHalfLength) {
-    std::uniform_real_distribution<double> pos(-80.0, 80.0), angle(0.0, 6.283185307179586),
-        half(0.05, maxHalfLength), side(0.05, 4.0);
+    std::uniform_real_distribution<double> pos(-80.0, 80.0), angle(0.0, kTwoPi), half(0.05, maxHalfLength),
+        side(0.05, 4.0);
     const glm::dvec2 c(pos(rng), pos(rng));
     const double a = angle(rng), hu = half(rng), hv = side(rng);
     const glm::dvec2 u(std::cos(a), std::sin(a)), v(-u.y, u.x);
@@ -113,7 +114,8 @@ TEST(ShapeGrid, QueryReadsOnlyItsRangeOfACell) {
     EXPECT_EQ(out, (std::vector<uint32_t>{990, 991, 992, 993, 994}));
     EXPECT_EQ(calls, 5u);
     calls = 0;
-    grid.query(piece, 0, 1000, [&](uint32_t id) { return ++calls, id % 100 == 0; }, out);
+    grid.query(
+        piece, 0, 1000, [&](uint32_t id) { return ++calls, id % 100 == 0; }, out);
     EXPECT_EQ(out.size(), 10u);
     EXPECT_EQ(calls, 1000u);
 }
