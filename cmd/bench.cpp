@@ -96,9 +96,10 @@ Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene
     }
     if (cfg.traffic) {
         if (!city) return Status::error("--traffic: needs the city's parameters (no city given)");
-        run->traffic = std::make_unique<TrafficScene>(cfg.traffic, city->params, false, city);
+        run->traffic = std::make_unique<TrafficScene>(cfg.traffic, city->params, false);
         RayScene* rays = run->stream ? run->stream->rays() : run->rays.get();
         if (rays) VISTA_RETURN_IF_ERROR(run->traffic->attachRays(rays));
+        VISTA_RETURN_IF_ERROR(run->traffic->showCitySignals(*city, cfg.pagedManifest));
         run->ctx.traffic = run->traffic.get();
         run->renderer->setOverlay(run->traffic->node(), nullptr);
     }

@@ -460,6 +460,7 @@ Status setUp(const std::string& modeName, const RenderPlan& p, const Walkthrough
         g.streamReady = [budgetGb](CityStream& stream) { holdStreamUnder(stream, budgetGb); };
     }
     g.traffic = p.traffic;
+    g.paged = w.manifest.get();
     return s.gt.setUp(g, w.city);
 }
 

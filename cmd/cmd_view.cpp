@@ -671,10 +671,11 @@ int runView(int argc, char** argv) {
     ViewModes modes(ctx, stream.stream.get());
     std::unique_ptr<TrafficScene> traffic;  // after the modes' ray scene: released before it
     if (*tracks) {
-        traffic = std::make_unique<TrafficScene>(*tracks, city.params, false, &city);
+        traffic = std::make_unique<TrafficScene>(*tracks, city.params, false);
         ctx.traffic = traffic.get();
         if (stream.stream && stream.stream->rays())
             if (Status s = traffic->attachRays(stream.stream->rays()); !s) return reportBadInput(kCmd, s);
+        if (Status s = traffic->showCitySignals(city, walk->manifest.get()); !s) return reportBadInput(kCmd, s);
     }
     auto start = modes.get(a.mode);
     if (!start) return reportBadInput(kCmd, Status::error("--mode " + a.mode + ": " + start.status().message()));

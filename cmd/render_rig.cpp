@@ -703,8 +703,9 @@ int runRigRender(const RigRunRequest& a) {
     if (Status s = openWorkDir(a, plan, walk->path, out); !s) return reportBadInput(kCmd, s);
     std::unique_ptr<TrafficScene> traffic;
     if (plan.traffic) {
-        traffic = std::make_unique<TrafficScene>(plan.traffic, walk->city.params, false, &walk->city);
+        traffic = std::make_unique<TrafficScene>(plan.traffic, walk->city.params, false);
         if (Status s = traffic->attachRays(rays->get()); !s) return reportBadInput(kCmd, s);
+        if (Status s = traffic->showCitySignals(walk->city, walk->manifest.get()); !s) return reportBadInput(kCmd, s);
         plan.agents = traffic.get();
     }
     size_t kept = 0;

@@ -37,8 +37,9 @@ Status GroundTruthSession::setUp(const GroundTruthSetup& setup, const SceneModel
         ctx.rays = rays.get();
     }
     if (setup.traffic) {
-        traffic = std::make_unique<TrafficScene>(setup.traffic, city.params, setup.labels, &city);
+        traffic = std::make_unique<TrafficScene>(setup.traffic, city.params, setup.labels);
         if (RayScene* r = activeRays()) VISTA_RETURN_IF_ERROR(traffic->attachRays(r));
+        VISTA_RETURN_IF_ERROR(traffic->showCitySignals(city, setup.paged));
         ctx.traffic = traffic.get();
         renderer->setOverlay(traffic->node(), traffic->labelNode());
     }

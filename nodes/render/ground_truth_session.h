@@ -45,6 +45,7 @@ struct GroundTruthSetup {
     ModeOptions options;
     bool labels = false;                           // the depth, semantic and instance channels are drawn
     const PagedManifest* streamed = nullptr;       // a streamed paged city (its manifest), else null
+    const PagedManifest* paged = nullptr;          // a paged city, loaded or streamed (its manifest), else null
     RegionPagerOptions stream;                     // streamed: the pager's options
     std::function<void(CityStream&)> streamReady;  // streamed: called once the stream exists (e.g. a memory hold)
     std::shared_ptr<const TrafficTracks> traffic;  // moving agents drawn at each camera's time (null: none)

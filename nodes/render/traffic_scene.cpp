@@ -107,8 +107,7 @@ osg::Matrixd toOsg(const glm::dmat4& m) {
 
 }  // namespace
 
-TrafficScene::TrafficScene(std::shared_ptr<const TrafficTracks> tracks, const CityParams& params, bool labels,
-                           const SceneModel* city)
+TrafficScene::TrafficScene(std::shared_ptr<const TrafficTracks> tracks, const CityParams& params, bool labels)
     : _tracks(std::move(tracks)), _params(params), _labels(labels), _impl(new Impl) {
     _models = agentModels(Lighting(params));
     _node = new osg::Group;
@@ -128,8 +127,14 @@ TrafficScene::TrafficScene(std::shared_ptr<const TrafficTracks> tracks, const Ci
         _labelNode->setDataVariance(osg::Object::DYNAMIC);
         _labelNode->setStateSet(labelRootState().get());
     }
-    if (_tracks->signals && city && city->regions.empty())
-        (void)setSignalHeads(_tracks->signals, signalHeads(city->streets, _params));
+}
+
+Status TrafficScene::showCitySignals(const SceneModel& city, const PagedManifest* paged) {
+    if (!_tracks->signals) return Status::ok();
+    if (!paged) return setSignalHeads(_tracks->signals, signalHeads(city.streets, _params));
+    auto streets = pagedPathStreets(*paged);
+    if (!streets) return Status::error("--traffic: the traffic-light heads: " + streets.status().message());
+    return setSignalHeads(_tracks->signals, signalHeads(*streets, _params));
 }
 
 Status TrafficScene::setSignalHeads(std::shared_ptr<const SignalStates> states, std::vector<SignalHead> heads) {

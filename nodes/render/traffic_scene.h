@@ -31,8 +31,8 @@
 //   the camera's carrier (the vehicle `vista path --traffic` rides) and is
 //   drawn nowhere: a vehicle's cameras do not see it from inside.
 // - Traffic-light heads (signal_heads.h): with the tracks' signal states
-//   (TrafficTracks::signals) and a city file's street graph, or after
-//   setSignalHeads(), every head gets a MatrixTransform (head frame ->
+//   (TrafficTracks::signals), after showCitySignals() or setSignalHeads(),
+//   every head gets a MatrixTransform (head frame ->
 //   world) over one of the shared lamp overlays (lampOverlay(), one per
 //   LampState) under signalNode(), the last child of node(); setFrame(t)
 //   switches each head's overlay to SignalStates::lampAt(head, t), and the
@@ -65,6 +65,7 @@
 #include "citygen/params.h"
 #include "foundation/status.h"
 #include "nodes/render/signal_heads.h"
+#include "runtime/scene/paged_load.h"
 #include "runtime/scene/scene_model.h"
 #include "runtime/traffic/agent_models.h"
 #include "runtime/traffic/traffic_tracks.h"
@@ -75,14 +76,19 @@ class RayScene;
 
 class TrafficScene {
 public:
-    // labels: also build the label twins (vista render). city: the city whose
-    // traffic-light heads show tracks->signals (signalHeads() of its street
-    // graph); none when either is missing or the city is merged from paged
-    // regions (their street graph's order is not the lane model's that
-    // numbered the heads of the traffic's OpenDRIVE).
-    TrafficScene(std::shared_ptr<const TrafficTracks> tracks, const CityParams& params, bool labels,
-                 const SceneModel* city = nullptr);
+    // labels: also build the label twins (vista render). No traffic-light
+    // head is shown until showCitySignals() or setSignalHeads().
+    TrafficScene(std::shared_ptr<const TrafficTracks> tracks, const CityParams& params, bool labels);
     ~TrafficScene();
+    // Shows the heads of `city` lit from the tracks' signal states (none
+    // without them): signalHeads() of the street graph whose lane model
+    // numbered the heads of the traffic's OpenDRIVE (`vista traffic`). That
+    // is a city file's own graph; for a paged city (`paged`: its manifest,
+    // loaded or streamed) the whole city's graph of pagedPathStreets(), as
+    // `vista traffic` reads it: the graph merged from the loaded regions is
+    // ordered otherwise, and a streamed city's model may hold no streets.
+    // Errors: those of pagedPathStreets() and attachRays().
+    Status showCitySignals(const SceneModel& city, const PagedManifest* paged);
     // The ray scene that shows the agents beyond the split (its prototypes are
     // added now); null detaches. Errors: those of RayScene::setMoverPrototypes.
     Status attachRays(RayScene* rays);

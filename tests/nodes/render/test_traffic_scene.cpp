@@ -21,6 +21,10 @@
 #include "citygen/traffic_signals.h"
 #include "nodes/render/signal_heads.h"
 #include "runtime/traffic/signal_states.h"
+#include "runtime/scene/city_file.h"
+#include "runtime/scene/paged_load.h"
+#include "tests/common/run_vista.h"
+#include "tests/common/small_paged_city.h"
 #include "tests/common/temp_dir.h"
 
 #include "nodes/render/effects_mode.h"
@@ -321,7 +325,8 @@ TEST(TrafficScene, WithoutSignalStatesNoHeadNodeExists) {
     CityParams params;
     auto tr = tracks();  // no signals
     SceneModel none;
-    TrafficScene ts(tr, params, /*labels=*/false, &none);
+    TrafficScene ts(tr, params, /*labels=*/false);
+    ASSERT_TRUE(ts.showCitySignals(none, nullptr));
     EXPECT_EQ(ts.signalNode(), nullptr);
     EXPECT_TRUE(ts.heads().empty());
     ASSERT_TRUE(ts.setFrame(6.0, glm::dvec3(0, 0, 1.5)));
@@ -400,5 +405,53 @@ TEST(TrafficScene, AFramePlacesTheMoversOnceAndTheHeadsOnlyWhenALampChanges) {
             before = ts.lamps();
         }
         if (splits) { EXPECT_EQ(lampChanges, 2); }
+    }
+}
+
+// A paged city's heads are those of the single-file city of the same input,
+// whose lane model numbers the signals of the traffic's OpenDRIVE (`vista
+// traffic`): the same ids at the same places, whether the walkthrough's model
+// is merged from the regions (their street graph has another order) or is a
+// streamed city's stub without streets.
+TEST(PagedTrafficHeads, HaveTheIdsAndPlacesOfTheSingleFileCitysHeads) {
+    const auto& paged = vista::test::smallPagedCity();
+    auto m = readPagedManifest(paged.dir);
+    ASSERT_TRUE(m) << m.status().message();
+    vista::test::TempDir tmp("vista_paged_heads");
+    // The single-file city of the small paged city's size and seed (its streets do not depend on the detail).
+    const vista::test::CliRun gen =
+        vista::test::runVista("gen --size 1500 --seed 4 --detail 0 -q -o " + tmp.path() + "/city.osgb");
+    ASSERT_EQ(gen.code, 0) << gen.err;
+    auto single = loadCityFile(tmp.path() + "/city.osgb");
+    ASSERT_TRUE(single) << single.status().message();
+    auto st = states(tmp.path());
+    ASSERT_TRUE(st) << st.status().message();
+    auto tr = tracks();
+    tr->signals = std::make_shared<SignalStates>(std::move(*st));
+    auto byId = [](std::vector<SignalHead> h) {
+        std::sort(h.begin(), h.end(), [](const SignalHead& a, const SignalHead& b) { return a.signal < b.signal; });
+        return h;
+    };
+    TrafficScene reference(tr, single->params, false);
+    ASSERT_TRUE(reference.showCitySignals(*single, nullptr));
+    const std::vector<SignalHead> expect = byId(reference.heads());
+    ASSERT_GT(expect.size(), 3u) << "the small paged city has signalised junctions";
+
+    std::vector<int> all(m->regions.size());
+    for (size_t i = 0; i < all.size(); ++i) all[i] = int(i);
+    auto merged = loadPagedCity(*m, all, kMaxPagedRadiusM);
+    ASSERT_TRUE(merged) << merged.status().message();
+    ASSERT_FALSE(merged->regions.empty());
+    SceneModel stub;  // a streamed city with a path from a CSV file: params, no streets
+    stub.params = m->params;
+    for (const SceneModel* city : {&*merged, &stub}) {
+        TrafficScene ts(tr, m->params, false);
+        ASSERT_TRUE(ts.showCitySignals(*city, &*m));
+        const std::vector<SignalHead> got = byId(ts.heads());
+        ASSERT_EQ(got.size(), expect.size()) << (city == &stub ? "stub" : "merged");
+        for (size_t i = 0; i < got.size(); ++i) {
+            EXPECT_EQ(got[i].signal, expect[i].signal) << i;
+            EXPECT_LT(glm::length(glm::dvec3(got[i].frame[3]) - glm::dvec3(expect[i].frame[3])), 1e-6) << i;
+        }
     }
 }
