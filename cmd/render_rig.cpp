@@ -13,6 +13,7 @@
 #include <map>
 #include <memory>
 #include <numeric>
+#include <optional>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -22,6 +23,7 @@
 #include "cmd/render_shared.h"
 #include "cmd/render_work_dir.h"
 #include "foundation/atomic_file.h"
+#include "foundation/file_write_queue.h"
 #include "foundation/format.h"
 #include "foundation/hash.h"
 #include "foundation/input_file.h"
@@ -77,6 +79,8 @@ LidarDirs lidarDirs(size_t j) {
     return {"velodyne" + s, "velodyne_time" + s, "labels" + s, "labels_vista" + s, "lidar_instance" + s};
 }
 const char* const kSemanticKittiYaml = "semantic-kitti.yaml";
+// Threads writing a run's files: several, so that the fsyncs of a frame's files overlap.
+constexpr int kWriterThreads = 4;
 
 // The files a sensor writes when it fires at frame `name` (paths under out/).
 std::vector<std::string> cameraFiles(const RigCamera& c, size_t k, const std::string& name) {
@@ -251,7 +255,8 @@ struct FrameBoxState {
 // Camera k's 2D boxes from its instance image (into `fb`): boxes_NN/ and, for a pinhole, KITTI lines in label_NN/.
 Status writeCameraBoxes(const RigPlan& p, const Walkthrough& w, size_t k, const RigPose& vehicle, const RigPose& pose,
                         const std::string& name, const CameraImages& im, const CameraRayTable& rays,
-                        const RenderWorkDir& out, const FrameBoxState& boxes, std::vector<FrameBox>& fb) {
+                        const RenderWorkDir& out, FileWriteQueue& io, const FrameBoxState& boxes,
+                        std::vector<FrameBox>& fb) {
     const RigCamera& c = p.rig.cameras[k];
     const BoxCamera cam = rigBoxCamera(c.model, pose);
     FrameBoxOptions o;
@@ -260,46 +265,51 @@ Status writeCameraBoxes(const RigPlan& p, const Walkthrough& w, size_t k, const 
     fb = frameBoxes(w.city, *boxes.city, boxes.movers, cam, im.ids, o);
     const CameraDirs d = cameraDirs(k);
     const glm::dvec3 offset(w.city.params.origin_x, w.city.params.origin_y, 0.0);
-    VISTA_RETURN_IF_ERROR(
-        writeFileAtomic(out.file(d.boxes + "/" + name + ".json"), frameBoxesJson(fb, cam, offset, c.name)));
+    io.write(out.file(d.boxes + "/" + name + ".json"), frameBoxesJson(fb, cam, offset, c.name));
     if (p.labelsLights(k)) {
         const SignalStates& lamps = *p.traffic->signals;
         auto lamp = [&](uint32_t head) { return std::string(lampStateName(lamps.lampAt(head, boxes.t))); };
-        VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(lightsFile(k, name)), trafficLightLabels(fb, lamp)));
+        io.write(out.file(lightsFile(k, name)), trafficLightLabels(fb, lamp));
     }
     if (c.model.fisheye()) return Status::ok();
-    return writeFileAtomic(out.file(d.labels + "/" + name + ".txt"),
-                           kittiRigLabels(fb, sensorPose(vehicle, kittiRectifiedMount(p.rig))));
-}
-
-Status writeCamera(const RigCamera& c, size_t k, const std::string& name, const CameraImages& im,
-                   const RenderWorkDir& out) {
-    const std::vector<std::string> files = cameraFiles(c, k, name);
-    size_t i = 0;
-    if (c.channels & kRigRgb) VISTA_RETURN_IF_ERROR(writePngRgb(im.rgb, out.file(files[i++])));
-    if (c.channels & kRigDepth)
-        VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(files[i++]), npyBytes(im.depth.data(), im.width, im.height)));
-    if (c.channels & kRigSemantic)
-        VISTA_RETURN_IF_ERROR(writePngGray8(im.classes, im.width, im.height, out.file(files[i++])));
-    if (c.channels & kRigInstance)
-        VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(files[i++]), npyBytes(im.ids.data(), im.width, im.height)));
-    if (c.channels & kRigFlow)
-        VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(files[i++]), floBytes(im.flow.data(), im.width, im.height)));
+    io.write(out.file(d.labels + "/" + name + ".txt"),
+             kittiRigLabels(fb, sensorPose(vehicle, kittiRectifiedMount(p.rig))));
     return Status::ok();
 }
 
-Status writeLidar(const LidarSweep& s, size_t j, const std::string& name, const RenderWorkDir& out) {
-    const std::vector<std::string> files = lidarFiles(j, name);
-    VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(files[0]), velodyneBytes(s)));
-    VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(files[1]), lidarTimeBytes(s)));
-    VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(files[2]), semanticKittiLabelBytes(s)));
-    VISTA_RETURN_IF_ERROR(writeFileAtomic(out.file(files[3]), vistaLabelBytes(s)));
-    return writeFileAtomic(out.file(files[4]), lidarInstanceBytes(s));
+// A camera's image files: encoded here, written by the queue `io`.
+Status writeCamera(const RigCamera& c, size_t k, const std::string& name, const CameraImages& im,
+                   const RenderWorkDir& out, FileWriteQueue& io) {
+    const std::vector<std::string> files = cameraFiles(c, k, name);
+    size_t i = 0;
+    if (c.channels & kRigRgb) {
+        const std::string path = out.file(files[i++]);
+        auto png = pngRgbBytes(im.rgb, path);
+        if (!png) return png.status();
+        io.write(path, std::move(*png));
+    }
+    if (c.channels & kRigDepth) io.write(out.file(files[i++]), npyBytes(im.depth.data(), im.width, im.height));
+    if (c.channels & kRigSemantic) {
+        const std::string path = out.file(files[i++]);
+        auto png = pngGray8Bytes(im.classes, im.width, im.height, path);
+        if (!png) return png.status();
+        io.write(path, std::move(*png));
+    }
+    if (c.channels & kRigInstance) io.write(out.file(files[i++]), npyBytes(im.ids.data(), im.width, im.height));
+    if (c.channels & kRigFlow) io.write(out.file(files[i++]), floBytes(im.flow.data(), im.width, im.height));
+    return Status::ok();
 }
 
-// One rig frame: every sensor that fires, cast and written (each stage timed
-// into the record: cast, write, boxes), then the frame's 3D boxes. Runs in
-// the caller's task arena; its casts, boxes and writing tasks share it.
+// A sweep's files: encoded here, written by the queue `io`.
+void writeLidar(const LidarSweep& s, size_t j, const std::string& name, const RenderWorkDir& out, FileWriteQueue& io) {
+    const std::vector<std::string> files = lidarFiles(j, name);
+    io.write(out.file(files[0]), velodyneBytes(s));
+    io.write(out.file(files[1]), lidarTimeBytes(s));
+    io.write(out.file(files[2]), semanticKittiLabelBytes(s));
+    io.write(out.file(files[3]), vistaLabelBytes(s));
+    io.write(out.file(files[4]), lidarInstanceBytes(s));
+}
+
 // The traffic at time t, every agent in the ray scene (the split at 0: all of them are rays' business).
 Status placeAgents(const RigPlan& p, double t, const glm::dvec3& eye) {
     VISTA_RETURN_IF_ERROR(p.agents->setFrame(t, eye, /*splitFollows=*/true));
@@ -307,16 +317,21 @@ Status placeAgents(const RigPlan& p, double t, const glm::dvec3& eye) {
 }
 
 // The frame's 3D boxes file: every object some sensor saw, in the city's own coordinates.
-Status writeFrameBoxes3d(const Walkthrough& w, const FrameBoxState& boxes, const RigPose& vehicle,
-                         const std::string& name, const RenderWorkDir& out) {
+void writeFrameBoxes3d(const Walkthrough& w, const FrameBoxState& boxes, const RigPose& vehicle,
+                       const std::string& name, const RenderWorkDir& out, FileWriteQueue& io) {
     const glm::dvec3 offset(w.city.params.origin_x, w.city.params.origin_y, 0.0);
-    return writeFileAtomic(out.file(std::string(kBoxes3dDir) + "/" + name + ".json"),
-                           frameBoxes3dJson(*boxes.city, boxes.seen, vehicle, offset, name, boxes.t, boxes.movers));
+    io.write(out.file(std::string(kBoxes3dDir) + "/" + name + ".json"),
+             frameBoxes3dJson(*boxes.city, boxes.seen, vehicle, offset, name, boxes.t, boxes.movers));
 }
 
+// One rig frame: every sensor that fires, cast and its files encoded (each
+// stage timed into the record: cast, write, boxes), then the frame's 3D
+// boxes; the files go to `io`, which writes them after the call returns
+// (renderFrames waits for them). Runs in the caller's task arena; its casts,
+// boxes and encoding tasks share it.
 Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_t f, const RenderWorkDir& out,
                    const CityBoxes* cityBoxes, const std::vector<CameraRayTable>& pixelRays,
-                   std::vector<CameraImages>& ims, nlohmann::json& record) {
+                   std::vector<CameraImages>& ims, FileWriteQueue& io, nlohmann::json& record) {
     const Path& path = w.path;
     const RigPose vehicle = vehiclePose(path.samples[p.idx[f]]);
     // Ray origins near the scene's frame origin: float precision anywhere in the city.
@@ -369,10 +384,11 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
         writers.run([&, k, pose = shot.pose] {
             Firing& o = cams[k];
             Stopwatch stage;
-            o.status = writeCamera(p.rig.cameras[k], k, name, ims[k], out);
+            o.status = writeCamera(p.rig.cameras[k], k, name, ims[k], out, io);
             o.writeMs = stage.lap();
             if (o.status && (p.rig.cameras[k].channels & kRigBoxes))
-                o.status = writeCameraBoxes(p, w, k, vehicle, pose, name, ims[k], pixelRays[k], out, boxes, o.boxes);
+                o.status =
+                    writeCameraBoxes(p, w, k, vehicle, pose, name, ims[k], pixelRays[k], out, io, boxes, o.boxes);
             o.boxesMs = stage.lap();
         });
     }
@@ -387,6 +403,7 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
         auto sweep = castLidarSweep(w.city, rays, l.spec, poseAt, p.times[f], movers, threads);
         if (!sweep) {
             writers.wait();
+            (void)io.wait();  // the frame is not finished: its files are left for a rerun to replace
             return sweep.status();
         }
         sweeps[j] = std::move(*sweep);
@@ -394,7 +411,7 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
         lidars[j].castMs = cast.ms();
         writers.run([&, j] {
             Stopwatch stage;
-            lidars[j].status = writeLidar(sweeps[j], j, name, out);
+            writeLidar(sweeps[j], j, name, out, io);
             lidars[j].writeMs = stage.ms();
         });
     }
@@ -420,7 +437,8 @@ Status renderFrame(const RigPlan& p, const Walkthrough& w, RayScene& rays, size_
         lidar[l.name] = {{"points", sweeps[j].points.size()}, {"misses", sweeps[j].misses}};
     }
     Stopwatch boxes3d;
-    if (boxes.city) VISTA_RETURN_IF_ERROR(writeFrameBoxes3d(w, boxes, vehicle, name, out));
+    if (boxes.city) writeFrameBoxes3d(w, boxes, vehicle, name, out, io);
+    // frame_ms: the casts and encoding; renderFrames adds the wait for the files (io_wait_ms).
     record = {{"frame_ms", frame.ms()},     {"sensor_ms", ms}, {"stage_ms", stages}, {"boxes_3d_ms", boxes3d.ms()},
               {"sensors_fired", ms.size()}, {"lidar", lidar}};
     return Status::ok();
@@ -448,18 +466,38 @@ Status renderFrames(const RigRunRequest& a, const RigPlan& p, const Walkthrough&
                         (kept ? ", resuming: " + std::to_string(kept) + " done" : std::string()));
     std::vector<CameraImages> ims(
         p.rig.cameras.size());  // one per camera: a camera's files are written while the next casts
-    for (size_t f = 0; f < n; ++f) {
-        if (!records[f].is_null()) continue;
-        Status s;
-        // The frame's casts and writing tasks share one arena of --threads workers.
-        inArena(p.options.threads, [&] {
-            s = renderFrame(p, w, rays, f, out, p.hasBoxes() ? &cityBoxes : nullptr, pixelRays, ims, records[f]);
-        });
+    // The frames' files are written by threads that are not the casts' workers (file_write_queue.h),
+    // a frame's while the next one casts: a queue per frame parity. A frame is finished (its record
+    // written) once its files are; the wait for them counts in its wall time (so the frames' times
+    // still add up to the run's), as io_wait_ms.
+    FileWriteQueue evenFrames(kWriterThreads), oddFrames(kWriterThreads);
+    auto queueOf = [&](size_t f) -> FileWriteQueue& { return f % 2 ? oddFrames : evenFrames; };
+    auto finish = [&](size_t f) -> Status {
+        Stopwatch wait;
+        const Status s = queueOf(f).wait();
+        const double waitMs = wait.ms();
         if (!s) return Status::error("frame " + std::to_string(f) + ": " + s.message());
+        records[f]["io_wait_ms"] = waitMs;
+        records[f]["frame_ms"] = records[f]["frame_ms"].get<double>() + waitMs;
         VISTA_RETURN_IF_ERROR(out.finishFrame(f, records[f], frameFiles(p, f)));
         if (killAfter > 0 && ++finishedNow == killAfter) std::raise(SIGKILL);
         if (progress) progress->update(double(f + 1) / double(n));
+        return Status::ok();
+    };
+    std::optional<size_t> writing;  // the frame whose files are on their way
+    for (size_t f = 0; f < n; ++f) {
+        if (!records[f].is_null()) continue;
+        Status s;
+        // The frame's casts and encoding tasks share one arena of --threads workers.
+        inArena(p.options.threads, [&] {
+            s = renderFrame(p, w, rays, f, out, p.hasBoxes() ? &cityBoxes : nullptr, pixelRays, ims, queueOf(f),
+                            records[f]);
+        });
+        if (!s) return Status::error("frame " + std::to_string(f) + ": " + s.message());
+        if (writing) VISTA_RETURN_IF_ERROR(finish(*writing));
+        writing = f;
     }
+    if (writing) VISTA_RETURN_IF_ERROR(finish(*writing));
     if (progress) progress->end();
     return Status::ok();
 }
@@ -554,12 +592,13 @@ nlohmann::json rigSummary(const RigRunRequest& a, const RigPlan& p, const std::v
                           size_t kept) {
     nlohmann::json sensors = nlohmann::json::object();
     double totalMs = 0;
-    std::vector<double> fired, boxes3d;
+    std::vector<double> fired, boxes3d, ioWait;
     for (const auto& r : records) {
         if (r.contains("frame_ms") && r["frame_ms"].is_number()) totalMs += r["frame_ms"].get<double>();
         if (r.contains("sensor_ms") && r["sensor_ms"].is_object()) fired.push_back(double(r["sensor_ms"].size()));
         if (r.contains("boxes_3d_ms") && r["boxes_3d_ms"].is_number())
             boxes3d.push_back(r["boxes_3d_ms"].get<double>());
+        if (r.contains("io_wait_ms") && r["io_wait_ms"].is_number()) ioWait.push_back(r["io_wait_ms"].get<double>());
     }
     for (const std::string& name : p.rig.order) {
         std::vector<double> ms;
@@ -606,10 +645,14 @@ nlohmann::json rigSummary(const RigRunRequest& a, const RigPlan& p, const std::v
              fired.empty() ? nlohmann::json(nullptr)
                            : nlohmann::json(std::accumulate(fired.begin(), fired.end(), 0.0) / double(fired.size()))},
             {"boxes_3d_median_ms", medianOf(boxes3d)},
+            {"io_wait_median_ms", medianOf(ioWait)},
             {"note",
              "per sensor: ray casting, its boxes and writing its files, in ms per firing (stage_median_ms: the "
-             "median of each stage: cast, write of the images or points, boxes with their files; boxes_share_median: "
-             "the median over firings of the boxes stage's share of the firing); "
+             "median of each stage: cast (the rays alone; a LiDAR's sweep), write (encoding the images or points "
+             "and handing them to the file writers), boxes with their files; boxes_share_median: "
+             "the median over firings of the boxes stage's share of the firing); io_wait_median_ms: the median "
+             "over the frames of the wait, at a frame's end, for its files to reach the disk (written by threads "
+             "of their own while the sensors cast); "
              "sensors_fired_per_frame: the mean over the frames; rig_frames_per_second: "
              "frames divided by the sum of every frame's wall time, each timed by the run that rendered it "
              "(frames_resumed: frames an interrupted run had finished)"}};

@@ -363,6 +363,16 @@ glm::dvec3 coneCrossing(const Projector& pr, glm::dvec3 a, glm::dvec3 b, bool aI
 
 PixelBox fisheyeCapBound(const Projector& pr, const glm::dvec3& c, double r);
 
+// An upper bound of acos(c) for c in [0, 1] without the call: with x = 1 - c,
+// acos(c) / sqrt(2 x) is a series in x with positive coefficients (convex,
+// 1 at x = 0, pi / (2 sqrt 2) = 1.11072... at x = 1), so it lies below the
+// chord 1 + 0.1108 x. Within a few parts in 10^4 of acos for the small caps
+// of a triangle's or an edge run's directions.
+double acosAbove(double c) {
+    const double x = 1.0 - std::min(1.0, c);
+    return std::sqrt(2.0 * x) * (1.0 + 0.1108 * x);
+}
+
 // The cap of the directions of segment a-b (camera coordinates): around the
 // mean of its end directions, half the angle between them (padded); false
 // when an end is the origin or the cap is not narrower than 80 degrees.
@@ -375,7 +385,7 @@ bool segmentCap(const glm::dvec3& a, const glm::dvec3& b, glm::dvec3& c, double&
     c = sum / ls;
     const double cosR = std::min(glm::dot(c, na), glm::dot(c, nb));
     if (!(cosR > 0.2)) return false;
-    r = std::acos(std::min(1.0, cosR)) + 1e-9;
+    r = acosAbove(cosR) + 1e-9;
     return true;
 }
 
@@ -500,7 +510,7 @@ bool fisheyeTriangleBound(const Projector& pr, const glm::dvec3* p, PixelBox& ou
     const glm::dvec3 c = sum / ls;
     const double cosR = std::min({glm::dot(c, n[0]), glm::dot(c, n[1]), glm::dot(c, n[2])});
     if (!(cosR > 0.05)) return false;
-    out = fisheyeCapBound(pr, c, std::acos(std::min(1.0, cosR)) + 1e-9);
+    out = fisheyeCapBound(pr, c, acosAbove(cosR) + 1e-9);
     return true;
 }
 
@@ -634,12 +644,23 @@ std::vector<VisibleStats> visibleStats(const std::vector<uint32_t>& ids, int wid
 // One instance's triangles through the camera: `full` = the extent of every
 // triangle clipped against the near plane (pinhole) or the image circle's
 // cone (fisheye); `covered` = the pixels whose centres its front faces
-// cover (marked with `mark` in `stamp`, so each pixel counts once).
+// cover (marked with `mark` in `stamp`, so each pixel counts once). A
+// fisheye tile (camera_ray_table.h) whose pixels inside the image circle
+// are all marked is marked in `tileStamp`, and later triangles skip it.
+struct MaskStamps {
+    std::vector<uint32_t> pixels, tiles;  // a mark per pixel, per ray-table tile
+};
 class MaskRaster {
 public:
-    MaskRaster(const Projector& pr, const CameraRayTable* rays, int width, int height, std::vector<uint32_t>& stamp,
+    MaskRaster(const Projector& pr, const CameraRayTable* rays, int width, int height, MaskStamps& stamps,
                uint32_t mark)
-        : _pr(pr), _rays(rays), _w(width), _h(height), _stamp(stamp), _mark(mark) {}
+        : _pr(pr),
+          _rays(rays),
+          _w(width),
+          _h(height),
+          _stamp(stamps.pixels),
+          _tileStamp(stamps.tiles),
+          _mark(mark) {}
     PixelBox full;
     uint32_t covered = 0;
 
@@ -667,14 +688,14 @@ public:
             PixelBox bound;
             const bool bounded = fisheyeTriangleBound(_pr, p, bound);
             if (bounded && full.valid() && within(bound, full)) {
-                if (front && bound.valid()) fillSphere(p, bound);
+                if (front && bound.valid()) fillSphere(p, bound, true);
                 return;
             }
             bool skipped = false;
             const PixelBox e = fisheyeTriangleExtent(_pr, p, bounded ? &full : nullptr, &skipped);
             extend(full, e);
             const PixelBox& seek = skipped ? bound : e;
-            if (front && seek.valid()) fillSphere(p, seek);
+            if (front && seek.valid()) fillSphere(p, seek, skipped);
             return;
         }
         glm::dvec3 poly[4];
@@ -716,8 +737,11 @@ private:
         }
     }
     static constexpr int kDirectFill = 48;  // pixels; fewer are tested one by one
-    // Marks the pixels of extent e (grown by a pixel for the sampling of
-    // curved edges) whose ray passes through the triangle p. Tile by tile
+    // Marks the pixels of extent e whose ray passes through the triangle p:
+    // the pixels whose centre lies in e when e is a bound of the triangle's
+    // image (`bounding`: fisheyeTriangleBound, which holds every direction
+    // of the triangle), else e grown by a pixel for the sampling of curved
+    // edges. Tile by tile
     // (CameraRayTable tiles): a tile whose cap lies beyond one of the
     // triangle's three planes through the eye by more than a margin is
     // skipped, one whose cap lies within all three by more than the margin
@@ -725,11 +749,12 @@ private:
     // pixel; the margin (1e-9 of a unit direction) dwarfs the rounding of
     // the per-pixel test, so the marked pixels are those the test marks. An
     // extent of a few pixels is tested pixel by pixel.
-    void fillSphere(const glm::dvec3* p, const PixelBox& e) {
-        const int x0 = int(std::max(0.0, std::floor(e.u0) - 1)),
-                  x1 = int(std::min(double(_w - 1), std::ceil(e.u1) + 1));
-        const int y0 = int(std::max(0.0, std::floor(e.v0) - 1)),
-                  y1 = int(std::min(double(_h - 1), std::ceil(e.v1) + 1));
+    void fillSphere(const glm::dvec3* p, const PixelBox& e, bool bounding) {
+        const int x0 = int(std::max(0.0, bounding ? std::ceil(e.u0) : std::floor(e.u0) - 1)),
+                  x1 = int(std::min(double(_w - 1), bounding ? std::floor(e.u1) : std::ceil(e.u1) + 1));
+        const int y0 = int(std::max(0.0, bounding ? std::ceil(e.v0) : std::floor(e.v0) - 1)),
+                  y1 = int(std::min(double(_h - 1), bounding ? std::floor(e.v1) : std::ceil(e.v1) + 1));
+        if (x0 > x1 || y0 > y1) return;
         const RayTriangle tri(p);
         if (tri.det == 0.0) return;
         if ((x1 - x0 + 1) * (y1 - y0 + 1) <= kDirectFill) {  // a few pixels: no tile tests
@@ -757,6 +782,8 @@ private:
             for (int tx = x0 / T; tx <= x1 / T; ++tx) {
                 const CameraRayTable::TileCap& cap = _rays->tile(tx, ty);
                 if (!cap.anyInside) continue;
+                uint32_t& tileMark = _tileStamp[size_t(ty) * size_t(_rays->tilesX()) + size_t(tx)];
+                if (tileMark == _mark) continue;  // every pixel of it is marked already
                 const int u0 = std::max(x0, tx * T), u1 = std::min(x1, tx * T + T - 1);
                 const int v0 = std::max(y0, ty * T), v1 = std::min(y1, ty * T + T - 1);
                 bool whole = false;
@@ -771,21 +798,27 @@ private:
                     }
                     if (outside) continue;
                 }
+                // The whole tile lies in the extent: it is done when all its pixels inside the circle are marked.
+                bool all = u0 == tx * T && v0 == ty * T && u1 == std::min(_w - 1, tx * T + T - 1) &&
+                           v1 == std::min(_h - 1, ty * T + T - 1);
                 for (int y = v0; y <= v1; ++y) {
                     const size_t at = size_t(y) * size_t(_w);
                     uint32_t* row = &_stamp[at];
                     for (int x = u0; x <= u1; ++x) {
                         const size_t q = at + size_t(x);
-                        if (row[x] != _mark && _rays->inside(q) && (whole || tri.hit(_rays->dir(q))))
-                            row[x] = _mark, ++covered;
+                        if (row[x] == _mark || !_rays->inside(q)) continue;
+                        if (whole || tri.hit(_rays->dir(q))) row[x] = _mark, ++covered;
+                        else all = false;
                     }
                 }
+                if (all) tileMark = _mark;
             }
     }
     const Projector& _pr;
     const CameraRayTable* _rays;  // fisheye: the model's pixel rays
     int _w, _h;
     std::vector<uint32_t>& _stamp;
+    std::vector<uint32_t>& _tileStamp;
     uint32_t _mark;
 };
 
@@ -848,7 +881,10 @@ std::vector<FrameBox> frameBoxes(const SceneModel& city, const CityBoxes& boxes,
         own = CameraRayTable(camera.model, options.threads);
         rays = &own;
     }
-    tbb::enumerable_thread_specific<std::vector<uint32_t>> stamps(size_t(W) * size_t(H), 0xFFFFFFFFu);
+    MaskStamps blank;
+    blank.pixels.assign(size_t(W) * size_t(H), 0xFFFFFFFFu);
+    if (rays) blank.tiles.assign(size_t(rays->tilesX()) * size_t(rays->tilesY()), 0xFFFFFFFFu);
+    tbb::enumerable_thread_specific<MaskStamps> stamps(blank);
     inArena(options.threads, [&] {
         tbb::parallel_for(size_t(0), out.size(), [&](size_t i) {
             FrameBox& f = out[i];

@@ -83,9 +83,11 @@
 // bound, when samples were skipped): its ray (pixelRay, from
 // FrameBoxOptions::rays when given) passes through the triangle; tile by
 // tile (camera_ray_table.h), a tile whose directions all lie beyond one of
-// the triangle's planes by a margin far above rounding is skipped, and one
-// whose directions all lie within the three is marked whole, so the marked
-// pixels are those of the per-pixel test. The projected 3D box is the
+// the triangle's planes by a margin far above rounding is skipped, one
+// whose directions all lie within the three is marked whole, and one whose
+// pixels inside the circle are all marked already (by the instance's
+// earlier triangles) is skipped, so the marked pixels are those of the
+// per-pixel test. The projected 3D box is the
 // extent of its 12 triangles (with the same shortcuts).
 //
 // Vehicle frame (boxInVehicleFrame): x forward, y left, z up (LidarPose's

@@ -45,11 +45,12 @@ void pngFlushNothing(png_structp) {}
 
 namespace {
 
-// PNG bytes of 8-bit rows (`channels` 1 = gray, 3 = RGB, 4 = RGBA), written atomically to `path`.
-Status writePngRows(const uint8_t* data, int width, int height, int channels, const std::string& path) {
+// PNG bytes of 8-bit rows (`channels` 1 = gray, 3 = RGB, 4 = RGBA); `what`
+// names the output in an error.
+Result<std::string> encodePngRows(const uint8_t* data, int width, int height, int channels, const std::string& what) {
     PngErr err;
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &err, pngErrorFn, pngWarnFn);
-    if (!png) return Status::error("writePng '" + path + "': libpng init failed");
+    if (!png) return Status::error("writePng '" + what + "': libpng init failed");
     png_infop info = png_create_info_struct(png);
     std::vector<png_bytep> rows(static_cast<size_t>(height));
     for (int y = 0; y < height; ++y)
@@ -74,8 +75,13 @@ Status writePngRows(const uint8_t* data, int width, int height, int channels, co
         png_write_end(png, nullptr);
     }
     png_destroy_write_struct(&png, &info);
-    if (failed) return Status::error("writePng '" + path + "': encoding failed: " + err.message);
-    return writeFileAtomic(path, bytes);
+    if (failed) return Status::error("writePng '" + what + "': encoding failed: " + err.message);
+    return bytes;
+}
+
+Status writeBytes(const Result<std::string>& bytes, const std::string& path) {
+    if (!bytes) return bytes.status();
+    return writeFileAtomic(path, bytes.value());
 }
 
 }  // namespace
@@ -84,23 +90,29 @@ Status writePng(const Image& img, const std::string& path) {
     if (!img.valid())
         return Status::error("writePng '" + path + "': invalid image " + std::to_string(img.width) + "x" +
                              std::to_string(img.height));
-    return writePngRows(img.rgba.data(), img.width, img.height, 4, path);
+    return writeBytes(encodePngRows(img.rgba.data(), img.width, img.height, 4, path), path);
 }
 
-Status writePngRgb(const Image& img, const std::string& path) {
+Result<std::string> pngRgbBytes(const Image& img, const std::string& what) {
     if (!img.valid())
-        return Status::error("writePngRgb '" + path + "': invalid image " + std::to_string(img.width) + "x" +
+        return Status::error("writePngRgb '" + what + "': invalid image " + std::to_string(img.width) + "x" +
                              std::to_string(img.height));
     std::vector<uint8_t> rgb(size_t(img.width) * size_t(img.height) * 3);
     for (size_t i = 0, n = rgb.size() / 3; i < n; ++i) std::copy_n(&img.rgba[4 * i], 3, &rgb[3 * i]);
-    return writePngRows(rgb.data(), img.width, img.height, 3, path);
+    return encodePngRows(rgb.data(), img.width, img.height, 3, what);
+}
+
+Status writePngRgb(const Image& img, const std::string& path) { return writeBytes(pngRgbBytes(img, path), path); }
+
+Result<std::string> pngGray8Bytes(const std::vector<uint8_t>& pixels, int width, int height, const std::string& what) {
+    if (width < 1 || height < 1 || pixels.size() != size_t(width) * size_t(height))
+        return Status::error("writePngGray8 '" + what + "': " + std::to_string(pixels.size()) + " pixels for " +
+                             std::to_string(width) + "x" + std::to_string(height));
+    return encodePngRows(pixels.data(), width, height, 1, what);
 }
 
 Status writePngGray8(const std::vector<uint8_t>& pixels, int width, int height, const std::string& path) {
-    if (width < 1 || height < 1 || pixels.size() != size_t(width) * size_t(height))
-        return Status::error("writePngGray8 '" + path + "': " + std::to_string(pixels.size()) + " pixels for " +
-                             std::to_string(width) + "x" + std::to_string(height));
-    return writePngRows(pixels.data(), width, height, 1, path);
+    return writeBytes(pngGray8Bytes(pixels, width, height, path), path);
 }
 
 Result<Image> readPng(const std::string& path) {

@@ -3,6 +3,9 @@
 // Contract: rgba.size() == width * height * 4 for a valid image. writePng is
 // atomic (temp + rename) and returns an error naming the path; readPng
 // rejects missing/corrupt/truncated files with an error, never crashes.
+// pngRgbBytes and pngGray8Bytes are the bytes writePngRgb and writePngGray8
+// write (for a caller that writes them itself); `what` names the output in
+// an error.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -39,6 +42,8 @@ Status writePng(const Image& img, const std::string& path);
 Status writePngRgb(const Image& img, const std::string& path);
 // 8-bit grayscale PNG of width x height pixels (row 0 at the top); atomic.
 Status writePngGray8(const std::vector<uint8_t>& pixels, int width, int height, const std::string& path);
+Result<std::string> pngRgbBytes(const Image& img, const std::string& what);
+Result<std::string> pngGray8Bytes(const std::vector<uint8_t>& pixels, int width, int height, const std::string& what);
 Result<Image> readPng(const std::string& path);
 
 }  // namespace vista

@@ -118,6 +118,9 @@ TEST_F(RigRender, SensorsWriteAtTheirRatesInTheKittiLayout) {
     EXPECT_EQ(top["points"].get<uint64_t>() + top["misses"].get<uint64_t>(), 3u * 16u * 360u);
     EXPECT_GT(top["misses"].get<uint64_t>(), 0u) << "upward beams see sky: misses counted, not written";
     EXPECT_GT(summary["rig_frames_per_second"].get<double>(), 0.0);
+    // The frames' files are written by the file writers: a frame's end waits for them, and says how long.
+    ASSERT_TRUE(summary.contains("io_wait_median_ms") && summary["io_wait_median_ms"].is_number()) << summary.dump();
+    EXPECT_GE(summary["io_wait_median_ms"].get<double>(), 0.0);
     const auto manifest = nlohmann::json::parse(test::readBytes(out + "/rig.json"));
     ASSERT_EQ(manifest["frames"].size(), 7u);
     EXPECT_TRUE(manifest["frames"][3]["sensors"].contains("top"));
