@@ -606,9 +606,15 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
 }
 
 void AdaptiveSplit::recordFrame(double nearD, double frameMs) {
-    if (!(nearD == _current) || !(frameMs >= 0)) return;
-    _frameMs = _frameMs > 0 ? (1 - _o.smoothing) * _frameMs + _o.smoothing * frameMs : frameMs;
     const int kind = kindOf(nearD);
+    // An end point drawn instead of the choice (a guard's hold or measurement) is a frame of that
+    // kind all the same: what it drew and traced is the kind's own (no triangles and every pixel
+    // for ray casting; everything's triangles in view at the last probe).
+    const bool chosen = nearD == _current;
+    const bool endPoint = !chosen && (nearD == 0.0 || (std::isinf(nearD) && nearD > 0));
+    if (!(chosen || endPoint) || !(frameMs >= 0)) return;
+    _frameMs = _frameMs > 0 ? (1 - _o.smoothing) * _frameMs + _o.smoothing * frameMs : frameMs;
+    if (endPoint) _lastKindFrame[kind] = _frame - 1;  // it ran: no try needed to measure it
     // A kind's first frame pays one-time costs (the first draw of the chunks, the far field's
     // first frame): not counted. Ray casting draws nothing, and once a frame has run its casters'
     // threads are warm: its first frame counts, so that a price resting on the probe's one-thread
@@ -620,7 +626,9 @@ void AdaptiveSplit::recordFrame(double nearD, double frameMs) {
     }
     _kindSeen[kind] = true;
     std::vector<KindFrame>& w = _kindFrames[kind];
-    w.push_back({double(_chosenTris), _chosenRays, double(_pixels), frameMs});
+    if (chosen) w.push_back({double(_chosenTris), _chosenRays, double(_pixels), frameMs});
+    else if (kind == 0) w.push_back({0.0, predictedRays(0.0), double(_pixels), frameMs});
+    else w.push_back({double(_everythingTris), 0.0, double(_pixels), frameMs});
     if (w.size() > kKindWindow) w.erase(w.begin());
 }
 

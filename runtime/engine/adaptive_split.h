@@ -23,7 +23,8 @@
 // of the view's four side planes is culled by the renderer and costs no
 // raster time (for everything, counted at each probe, and every triangle on
 // a city of more than 200,000 objects; with haze, only objects within it).
-// Each kind's price is corrected by what its own frames measured: the lower quartile over its last 8 frames
+// Each kind's price is corrected by what its own frames measured (an end point's frames drawn
+// by a guard instead of the choice count too: recordFrame()): the lower quartile over its last 8 frames
 // (recordFrame()) of (whole frame ms, the decision included) minus (the current model's price of what that frame
 // drew and traced); a middle distance by those middle frames nearest to its triangles in view and far pixels (log
 // scale, within 1.1x of the nearest: one offset for every middle distance priced the model's favourite below every
@@ -233,8 +234,11 @@ public:
     // stages that scale with them (cache + rays); the far field's other
     // stages' ms (fixedMs; 0 when the frame had no far field).
     void record(uint64_t triangles, double rasterMs, uint64_t farPixels, double farMs, double fixedMs = 0);
-    // The whole frame's ms (decision included) of a frame rendered at nearD, the distance
-    // choose() returned last (other values are ignored): corrects that kind's price.
+    // The whole frame's ms (decision included) of a frame rendered at nearD: the distance
+    // choose() returned last, or an end point (0, +infinity) drawn instead of it (a guard held or
+    // measured it, split_guard.h); other values are ignored. Corrects that kind's price: an end
+    // point's price rests on every frame drawn at it, not only on the split's rare tries (one
+    // or two frames in 24, whose noise then priced it against eight frames of the middle).
     void recordFrame(double nearD, double frameMs);
     // Haze: nothing beyond this eye-plane depth (metres) is traced; 0 = no haze.
     void setHazeFar(double zMax) { _hazeFar = zMax; }

@@ -38,8 +38,14 @@ double SplitGuard::filter(double chosen) {
         }
     }
     const bool middle = std::isfinite(chosen) && chosen > 0;
-    if (middle && _o.rayCasting && _o.measureEvery > 0 && endMs(0) < 0 && frame - _lastMeasure >= _o.measureEvery &&
-        int(_middle.size()) >= _o.strikes) {
+    // Ray casting's yardstick: measured while there is none, and again while the middle is close
+    // enough to it that one frame's noise could decide (see the header).
+    const double rayCost = endMs(0), middleCost = middleMs();
+    const int every = rayCost < 0 ? _o.measureEvery
+                      : middleCost >= 0 && middleCost >= _o.doubt * rayCost
+                          ? _o.remeasureEvery * int(std::max<size_t>(1, _end[0].size()))
+                          : 0;
+    if (middle && _o.rayCasting && every > 0 && frame - _lastMeasure >= every && int(_middle.size()) >= _o.strikes) {
         _lastMeasure = frame;
         _overridden = 2;
         _last = 0.0;

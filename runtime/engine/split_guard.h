@@ -26,8 +26,21 @@
 //     no comparable cost (never measured, or older than endMaxAge frames),
 //     filter() returns 0 for one frame every `measureEvery` frames (0 = never),
 //     so that the yardstick exists where the model prices ray casting out of
-//     reach. Ray casting's cost is bounded by the pixels; everything is
-//     measured only when the split chooses or tries it.
+//     reach. While it has one and the middle is in doubt (its median at least
+//     `doubt` times that cost, not yet above the margin), ray casting is
+//     measured again, remeasureEvery times the frames its cost rests on (at
+//     most endWindow) frames after its newest frame (0 = never): one
+//     ray-casting frame, slowed or sped by other work on the machine, must not
+//     stand as the yardstick for endMaxAge frames (a frame's time varies by a
+//     factor of up to 1.5 on a loaded machine: against one slow frame a middle
+//     10 % dearer than ray casting would be kept for endMaxAge frames, a whole
+//     bench run), and the end point's cost follows the path. The interval
+//     grows as the median gathers frames, so a middle that stays in doubt pays
+//     one measuring frame in endWindow * remeasureEvery, each at most
+//     1 / doubt times a middle frame; a middle clearly cheaper (below doubt
+//     times ray casting, a street view) is not interrupted. Ray casting's cost
+//     is bounded by the pixels; everything is measured only when the split
+//     chooses or tries it.
 // Call filter() once per frame with the split's choice and draw what it
 // returns, then record() that frame's whole ms. Deterministic: the same
 // choices and measured times give the same results. Not thread-safe. Bad
@@ -45,6 +58,8 @@ struct SplitGuardOptions {
     int endWindow = 4;       // an end point's cost: the median of its last endWindow frames
     int endMaxAge = 96;      // ... while its newest frame is at most this many frames old
     int measureEvery = 48;   // ray casting measured once per this many frames while it has no cost (0 = never)
+    int remeasureEvery = 8;  // ... and again, this many x its frames on, while the middle is in doubt (0 = never)
+    double doubt = 0.7;      // in doubt: the middle's median at least this times ray casting's cost
     bool rayCasting = true;  // ray casting (0) may be held / measured
     bool everything = true;  // everything (+inf) may be held
 };
@@ -55,7 +70,8 @@ public:
     // The near distance to draw this frame: `chosen` (the split's choice), or an end point the
     // guard holds or measures.
     double filter(double chosen);
-    // Why filter() overrode the choice last: 0 = it did not, 1 = holding an end point, 2 = measuring ray casting.
+    // Why filter() overrode the choice last: 0 = it did not, 1 = holding an end point, 2 = measuring ray casting
+    // (no comparable cost, or the middle within `doubt` of it).
     int overridden() const { return _overridden; }
     // The whole frame's ms of the frame drawn at nearD (what filter() returned last).
     void record(double nearD, double frameMs);

@@ -10,6 +10,7 @@
 #include "foundation/status.h"
 #include "runtime/engine/adaptive_split.h"
 #include "runtime/engine/ray_scene.h"
+#include "runtime/engine/split_guard.h"
 #include "tests/runtime/engine/fixtures.h"
 
 using namespace vista;
@@ -510,6 +511,60 @@ TEST(Split, AMiddleDistanceIsCorrectedByFramesThatDrewAboutAsMuch) {
         s.recordFrame(d, d <= 0 ? 25.0 : 30.0);
     }
     EXPECT_LE(middle, 40) << "of the last 300 frames, the middle's (30 ms against ray casting's 25 ms)";
+}
+
+}  // namespace
+}  // namespace vista
+
+namespace vista {
+namespace {
+
+// The split and its guard together on a synthetic machine (no timing): every middle distance
+// costs `middleMs`, ray casting 25 ms; the model prices ray casting far above the middle (rays
+// dear) and the split never tries it on its own (no end tries, no exploration). The guard's
+// ray-casting frames are frames of that kind all the same and correct its price: where the
+// middle is dearer (30 ms), the split itself chooses ray casting within a few frames of the
+// guard's first measurement (drawn for the guard's hold, they were once ignored by the split,
+// which kept choosing the middle through every hold); where it is cheaper (20 ms) the middle is
+// kept.
+TEST(Split, EndPointFramesTheGuardDrewCorrectTheSplitsPrice) {
+    ProbeScene ps = probeScene(12);
+    const std::vector<SplitObject> objs = squareObjects();
+    const Camera c = smallCamera(glm::dvec3(0, -350, 1.7));
+    for (const double middleMs : {30.0, 20.0}) {
+        AdaptiveSplitOptions o = measuredOnly();
+        o.endTryEvery = 0;
+        o.everythingNear = false;
+        AdaptiveSplit s(objs, ps.rays.get(), o);
+        for (int i = 0; i < 10; ++i) {
+            const double tris = 20000 + 4000 * i;
+            s.record(uint64_t(tris), 1.0 + 1e-5 * tris, 5000, 5000 * 3e-2);  // ray casting: about 90 ms
+        }
+        SplitGuard g;
+        int firstRay = -1, splitRay = 0, drawnMiddle = 0;
+        for (int f = 0; f < 200; ++f) {
+            const double chosen = s.choose(c, -1);
+            const double d = g.filter(chosen);
+            if (d <= 0 && firstRay < 0) firstRay = f;
+            if (f >= 100) {
+                splitRay += chosen <= 0;
+                drawnMiddle += d > 0;
+            }
+            const double ms = d <= 0 ? 25.0 : middleMs;
+            s.recordFrame(d, ms);
+            g.record(d, ms);
+        }
+        ASSERT_GE(firstRay, 0) << "the guard measures ray casting";
+        if (middleMs > 25.0) {
+            EXPECT_LE(firstRay, 6);
+            EXPECT_GE(splitRay, 99) << "of the last 100 choices, the split's own for ray casting";
+            EXPECT_EQ(drawnMiddle, 0);
+        } else {
+            EXPECT_EQ(splitRay, 0);
+            EXPECT_GE(drawnMiddle, 95) << "the cheaper middle is kept (ray casting measured now and then)";
+            EXPECT_EQ(g.trips(), 0);
+        }
+    }
 }
 
 }  // namespace
