@@ -188,6 +188,7 @@ public:
             if (_viewerNear == _adaptive->current())
                 recordCosts(_adaptive->chosenTriangles(), std::max(0.0, wallMs - farMs), fs);
             _guard.record(_viewerNear, wallMs);
+            _adaptive->recordFrame(_viewerNear, wallMs);  // the split's per-kind corrections, as in bench
         }
         _viewerNear = chooseNear(camera);
         if (_ctx.traffic) (void)_ctx.traffic->setSplit(byBudget() ? 1e300 : _viewerNear);
