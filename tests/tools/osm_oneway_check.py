@@ -9,10 +9,12 @@ the header's <geoReference> (+proj=tmerc on WGS84, the ellipsoidal series of
 Snyder, "Map Projections: A Working Manual", eqs. 8-9 to 8-11), and evaluates
 the .xodr's roads with the independent evaluator of xodr_check.py.
 
-A road outside junctions lies on an OSM way when, at every sample of its
-reference line (--samples points evenly inside its length), the nearest way
-segment running parallel to it (within --max-angle-deg, either direction) is
-within --max-dist metres and belongs to that way. A way is one-way as OSM
+A road outside junctions lies on an OSM way when, at more than half of the
+samples of its reference line (--samples points evenly inside its length),
+the nearest way segment running parallel to it (within --max-angle-deg,
+either direction) is within --max-dist metres, belongs to that way and runs
+the same way along the road (a road may reach a little onto the way before
+or after, or beside it). A way is one-way as OSM
 says: oneway=yes/true/1 along the way, -1/reverse against it, no/false/0
 two-way; without a valid value highway=motorway and junction=roundabout or
 circular are one-way along the way. Ways whose highway value vista does not
@@ -386,7 +388,7 @@ def run(osm_path, xodr_path, opt):
     for rid, road in sorted(net.roads.items()):
         if road.junction != "-1":
             continue
-        match = None
+        votes = {}  # (way index, +1 along / -1 against the way's nodes) -> samples
         for k in range(opt.samples):
             s = road.length * (k + 1) / (opt.samples + 1)
             x, y, h, _ = road.ref(s)
@@ -401,11 +403,10 @@ def run(osm_path, xodr_path, opt):
                 d = point_segment(x, y, seg)
                 if d <= opt.max_dist and (best is None or d < best[0]):
                     best = (d, seg[4], 1 if cosang > 0 else -1)
-            if best is None or (match is not None and best[1:] != match):
-                match = None
-                break
-            match = best[1:]
-        if match is None:
+            if best is not None:
+                votes[best[1:]] = votes.get(best[1:], 0) + 1
+        match = max(votes, key=lambda m: (votes[m], -m[0], m[1]), default=None)
+        if match is None or 2 * votes[match] <= opt.samples:
             continue
         roads_matched += 1
         w, along = match
@@ -459,7 +460,7 @@ def options(argv=None):
                     help="farthest a road's reference line may lie from its way, m (2.0)")
     ap.add_argument("--max-angle-deg", type=xodr_check.positive("--max-angle-deg"), default=20.0,
                     help="largest angle between a road and the way segment it lies on, degrees (20)")
-    ap.add_argument("--samples", type=int, default=3, help="reference-line samples per road (3, at least 1)")
+    ap.add_argument("--samples", type=int, default=5, help="reference-line samples per road (5, at least 1)")
     ap.add_argument("--taper-width", type=xodr_check.positive("--taper-width"), default=0.01,
                     help="lanes never wider than this do not count, m (0.01)")
     ap.add_argument("--max-list", type=int, default=20, help="offenders listed per check (20)")
