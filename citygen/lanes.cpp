@@ -377,7 +377,9 @@ public:
           rep(joined),
           nodeRadius(g.nodes.size(), 0.0),
           wantA(g.edges.size(), 0.0),
-          wantB(g.edges.size(), 0.0) {
+          wantB(g.edges.size(), 0.0),
+          leastA(g.edges.size(), 0.0),
+          leastB(g.edges.size(), 0.0) {
         m.degree.assign(N, 0);
         m.nodeJunction.assign(N, -1);
         m.edges.resize(g.edges.size());
@@ -470,8 +472,11 @@ private:
     std::vector<uint32_t> rep;                    // per node: the first node of its joined junction (itself if none)
     std::vector<double> nodeRadius;               // per junction node: the radius of its own arms
     std::vector<double> wantA, wantB;             // desired trims per edge at node a / b
-    std::vector<std::vector<TurnPlan>> plans;     // per junction
-    std::vector<LinkRoad> transitions;            // degree-2 nodes, before placing
+    // Per edge, the least trim the transition at node a / b can do with (its
+    // fillet clear of folding, the two edges' surfaces apart); 0: no transition.
+    std::vector<double> leastA, leastB;
+    std::vector<std::vector<TurnPlan>> plans;  // per junction
+    std::vector<LinkRoad> transitions;         // degree-2 nodes, before placing
     struct ArmPair {
         uint32_t a, b, node;
         double trim;  // both arms need at least this trim at node
@@ -781,6 +786,11 @@ void LaneModelBuilder::planTransitions() {
                                       taper ? 0.5 * kTaperLength : 0.0, 0.5 * kMinLinkLength});
         want(inE, v, need);
         want(outE, v, need);
+        const double least = std::max({filletTrim(r.angle, turnSideExtent(r)), apart, 0.5 * kMinLinkLength});
+        for (uint32_t e : {inE, outE}) {
+            double& l = meetsAtB(e, v) ? leastB[e] : leastA[e];
+            l = std::max(l, least);
+        }
         transitions.push_back(std::move(r));
     }
 }
@@ -798,9 +808,19 @@ void LaneModelBuilder::applyTrims() {
         double ta = std::max(wantA[e], growTrimA[e]), tb = std::max(wantB[e], growTrimB[e]);
         const double len = L.length, room = std::max(0.0, len - kMinRoadLength);
         if (ta + tb > room) {
-            const double f = ta + tb > 0 ? room / (ta + tb) : 0.0;
-            ta *= f;
-            tb *= f;
+            // A junction end keeps its trim, up to what the transition at the
+            // other end needs at least (lanes.h); else both shrink in proportion.
+            if (L.junctionA >= 0 && leastB[e] > 0 && room > leastB[e]) {
+                tb = std::max(leastB[e], room - ta);
+                ta = room - tb;
+            } else if (L.junctionB >= 0 && leastA[e] > 0 && room > leastA[e]) {
+                ta = std::max(leastA[e], room - tb);
+                tb = room - ta;
+            } else {
+                const double f = ta + tb > 0 ? room / (ta + tb) : 0.0;
+                ta *= f;
+                tb *= f;
+            }
         }
         L.trimA = ta;
         L.trimB = tb;

@@ -10,9 +10,14 @@
 // - Per edge e (index = edge index): the reference line runs from node a to
 //   node b along the straight centre line, trimmed at each end that is a
 //   junction (node of degree >= 3) by that junction's radius and at each
-//   degree-2 node by the length its transition needs (see below); both trims
-//   are shrunk in proportion when less than kMinRoadLength of the edge would
-//   remain. Dead ends (degree 1) start/end exactly at the node.
+//   degree-2 node by the length its transition needs (see below); when less
+//   than kMinRoadLength of the edge would remain, an edge between a junction
+//   and a transition gives the junction end its trim and the transition end
+//   the rest, but at least the least its transition needs (its fillet clear
+//   of folding, the two edges' surfaces apart; the junction end gets what
+//   that leaves when the edge is shorter still); an edge too short for that
+//   least, and every other edge, shrinks both trims in proportion. Dead
+//   ends (degree 1) start/end exactly at the node.
 // - Driving lanes: `right` lanes drive a -> b (right of the reference line),
 //   `left` lanes drive b -> a: the edge's lanesForward/lanesBackward when set
 //   (OSM lanes:forward/backward, oneway), else right = ceil(n/2),

@@ -1,6 +1,6 @@
 // The lane model (citygen/lanes.h) on hand-made graphs: lane split and widths,
-// laneOffset for odd counts, junction radius and trims (clamped on short
-// edges), arm order, sidewalk sides from blocks, link roads tangent to their
+// laneOffset for odd counts, junction radius and trims (on short edges the
+// junction's first, the transition's least kept), arm order, sidewalk sides from blocks, link roads tangent to their
 // roads, turning lanes, directional lane counts; lane centres of every turn at
 // least the class's turning radius from the arc's centre. Junction connections
 // and surfaces: test_lane_junctions.cpp.
@@ -87,11 +87,26 @@ TEST(Lanes, JunctionsAndTrims) {
     // West arm ends at the junction.
     EXPECT_NEAR(m.edges[1].trimB, trim, 1e-9);
     EXPECT_NEAR(m.edges[1].end.x, -trim, 1e-9);
-    // The 6 m north arm: the trims (junction at a, transition at b) are
-    // shrunk in proportion so that kMinRoadLength remains.
+    // The 6 m north arm (junction at a, transition at b) is too short for
+    // both trims: kMinRoadLength remains, the transition at b keeps at least
+    // the tangent of its 45 degree fillet that holds its lanes kCurvatureMargin
+    // from the centre of curvature (they reach 7.5 m toward it: the 1.5 m lane
+    // offset, two 3 m lanes and the 3 m sidewalk), less than the taper it
+    // would like, and the junction gets the rest.
     EXPECT_NEAR(m.edges[2].length, kMinRoadLength, 1e-12);
     EXPECT_NEAR(m.edges[2].trimA + m.edges[2].trimB, 6.0 - kMinRoadLength, 1e-12);
-    EXPECT_NEAR(m.edges[2].trimA / m.edges[2].trimB, trim / (0.5 * kTaperLength), 1e-9);
+    const double least = (7.5 + kCurvatureMargin) * std::tan(0.125 * 3.14159265358979323846);
+    EXPECT_GE(m.edges[2].trimB, least - 1e-9);
+    EXPECT_LT(m.edges[2].trimB, 0.5 * kTaperLength);
+    EXPECT_GT(m.edges[2].trimA, 0.0);
+    // So the transition is built, its fillet clear of folding.
+    const LinkRoad* bend = nullptr;
+    for (const LinkRoad& r : m.links)
+        if (r.junction < 0 && r.node == 3) bend = &r;
+    ASSERT_NE(bend, nullptr);
+    ASSERT_GT(bend->arcLength, 0.0);
+    EXPECT_GE(1.0 / std::abs(bend->curvature), 7.5 + kCurvatureMargin - 1e-6);
+    EXPECT_EQ(m.sharpCorners, 0u);
     // Turns into or out of the shortened arm cannot keep their radius: the
     // ones whose lanes another turn takes are dropped, none is left unlinked.
     EXPECT_GT(m.tightTurns + m.tightTurnsKept, 0u);
