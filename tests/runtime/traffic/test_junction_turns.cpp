@@ -2,8 +2,8 @@
 // of a sampled arc with straight ends, the turning need against the sagitta
 // written out, and the net edit closing exactly the lanes and classes whose
 // need exceeds the radius, every other byte kept; bad files are errors that
-// leave the file as it was. Demand: a type whose network is a small part of
-// the cars' becomes cars, and trips never need a closed junction turn.
+// leave the file as it was. Demand: a type whose part of the network
+// (through the turns open to it) is under half the cars' becomes cars.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -161,4 +161,48 @@ TEST(JunctionTurns, BadFilesAreErrorsAndLeaveTheFileAsItWas) {
         EXPECT_NE(bad.status().message().find(c.why), std::string::npos) << bad.status().message();
         EXPECT_EQ(readBytes(path), c.body) << c.name;
     }
+}
+
+// Five roads in a ring a→b→c→d→e→a and a pair a↔b, every connection through
+// an internal lane; the lane of c→d is closed to buses. Cars reach all five
+// roads, buses only a and b through the open turns (fewer than half the
+// cars'): buses become cars; with c→d open they take part.
+TEST(JunctionTurns, DemandKeepsClassesToTheTurnsOpenToThem) {
+    SumoNet net;
+    auto addEdge = [&](const std::string& id, const std::string& function, uint32_t allow) {
+        SumoEdge e;
+        e.id = id;
+        e.function = function;
+        e.lanes.push_back({0, 50.0, allow});
+        e.x = double(net.edges.size()) * 100.0;
+        net.edges.push_back(e);
+        return uint32_t(net.edges.size() - 1);
+    };
+    const uint32_t vehicles = kAllTrafficClasses & ~uint32_t(kClassPedestrian);
+    std::vector<uint32_t> road;
+    for (const char* id : {"a", "b", "c", "d", "e"}) road.push_back(addEdge(id, "", vehicles));
+    const std::pair<int, int> links[] = {{0, 1}, {1, 2}, {2, 3}, {3, 4}, {4, 0}, {1, 0}};
+    for (const auto& [f, t] : links) {
+        const bool closed = f == 2 && t == 3;
+        const uint32_t via = addEdge(":J" + std::to_string(f) + std::to_string(t), "internal",
+                                     closed ? vehicles & ~uint32_t(kClassBus) : vehicles);
+        SumoConnection c{road[size_t(f)], road[size_t(t)], 0, 0};
+        c.viaEdge = via;
+        net.connections.push_back(c);
+    }
+    TrafficDemandOptions opt;
+    opt.vehicles = 400;
+    opt.pedestrians = 0;
+    TrafficDemandCounts counts;
+    auto xml = makeDemandXml(net, opt, &counts);
+    ASSERT_TRUE(xml) << xml.status().message();
+    EXPECT_EQ(counts.byType[size_t(AgentType::Bus)], 0);
+    EXPECT_GT(counts.byType[size_t(AgentType::Truck)], 0);  // trucks keep every turn here
+    EXPECT_GT(counts.substituted, 0);
+    EXPECT_EQ(xml->find("type=\"bus\" depart"), std::string::npos);
+    // The same ring with c→d open: buses take part.
+    net.edges[net.connections[2].viaEdge].lanes[0].allow = vehicles;
+    auto open = makeDemandXml(net, opt, &counts);
+    ASSERT_TRUE(open);
+    EXPECT_GT(counts.byType[size_t(AgentType::Bus)], 0);
 }
