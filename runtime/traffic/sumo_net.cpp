@@ -52,8 +52,10 @@ struct Reader {
     struct PendingConnection {
         std::string from, to;
         int fromLane, toLane;
+        std::string via;
     };
     std::vector<PendingConnection> pending;
+    std::unordered_map<std::string, std::pair<uint32_t, int>> laneIndex;  // lane id -> (edge, lane index)
     std::unordered_map<std::string, std::vector<uint32_t>> laneSignals;  // internal lane id -> signal ids
     struct PendingLink {
         std::string via, tl;
@@ -96,8 +98,11 @@ struct Reader {
             if (const char* i = attr(atts, "index")) l.index = std::atoi(i);
             if (const char* len = attr(atts, "length")) l.length = std::atof(len);
             l.allow = sumoPermissions(attr(atts, "allow"), attr(atts, "disallow"));
-            if (const char* id = attr(atts, "id")) currentLane = id;
             SumoEdge& e = net.edges.back();
+            if (const char* id = attr(atts, "id")) {
+                currentLane = id;
+                laneIndex[currentLane] = {uint32_t(net.edges.size() - 1), l.index};
+            }
             if (e.lanes.empty())
                 if (const char* shape = attr(atts, "shape")) middleOf(shape, &e.x, &e.y);
             e.lanes.push_back(l);
@@ -105,8 +110,8 @@ struct Reader {
             const char *from = attr(atts, "from"), *to = attr(atts, "to");
             const char *fl = attr(atts, "fromLane"), *tl = attr(atts, "toLane");
             if (!from || !to || !fl || !tl) return fail("a <connection> lacks from, to, fromLane or toLane");
-            pending.push_back({from, to, std::atoi(fl), std::atoi(tl)});
             const char *via = attr(atts, "via"), *light = attr(atts, "tl"), *index = attr(atts, "linkIndex");
+            pending.push_back({from, to, std::atoi(fl), std::atoi(tl), via ? via : ""});
             if (via && light && index) pendingLinks.push_back({via, light, std::atoi(index)});
         } else if (std::strcmp(name, "param") == 0 && edgeDepth >= 0 && depth == edgeDepth + 2 &&
                    !currentLane.empty()) {
@@ -169,7 +174,16 @@ Result<SumoNet> readSumoNet(const std::string& path) {
         if (from == r.edgeIndex.end() || to == r.edgeIndex.end())
             return Status::error("SUMO network '" + path + "': a <connection> names the unknown edge '" +
                                  (from == r.edgeIndex.end() ? c.from : c.to) + "'");
-        r.net.connections.push_back({from->second, to->second, c.fromLane, c.toLane});
+        SumoConnection conn{from->second, to->second, c.fromLane, c.toLane};
+        if (!c.via.empty()) {
+            auto via = r.laneIndex.find(c.via);
+            if (via == r.laneIndex.end())
+                return Status::error("SUMO network '" + path + "': a <connection> names the unknown via lane '" +
+                                     c.via + "'");
+            conn.viaEdge = via->second.first;
+            conn.viaLane = via->second.second;
+        }
+        r.net.connections.push_back(conn);
     }
     std::unordered_map<std::string, uint32_t> lightIndex;
     for (size_t i = 0; i < r.net.trafficLights.size(); ++i) lightIndex[r.net.trafficLights[i]] = uint32_t(i);

@@ -9,6 +9,9 @@
 // - A lane's permissions are the classes of its `allow` list, or every class
 //   not in its `disallow` list, or every class (neither given), restricted
 //   to the classes vista's demand uses (TrafficClass).
+// - A connection's `via` lane (the internal lane a vehicle drives through
+//   the junction) is kept as its edge and lane index, so that the lane's
+//   permissions apply to the connection too.
 // - signalLinks: every junction link a traffic-light signal of the input
 //   OpenDRIVE controls: netconvert keeps the <signal id> on the link's
 //   internal lane (<param key="signalID">), and the <connection> through
@@ -59,6 +62,8 @@ struct SumoEdge {
 struct SumoConnection {
     uint32_t from = 0, to = 0;  // edge indices
     int fromLane = 0, toLane = 0;
+    int64_t viaEdge = -1;  // the internal edge of its `via` lane (edge index), -1 without one
+    int viaLane = 0;       // that lane's index
 };
 
 struct SumoSignalLink {

@@ -110,6 +110,7 @@ std::vector<uint32_t> tripEdges(const SumoNet& net, uint32_t cls) {
         const SumoEdge &a = net.edges[c.from], &b = net.edges[c.to];
         if (!walk && (!a.normal() || !b.normal())) continue;
         if (!laneAllows(a, c.fromLane, cls) || !laneAllows(b, c.toLane, cls)) continue;
+        if (!walk && c.viaEdge >= 0 && !laneAllows(net.edges[size_t(c.viaEdge)], c.viaLane, cls)) continue;
         adj[c.from].push_back(c.to);
         if (walk) adj[c.to].push_back(c.from);
     }
@@ -172,6 +173,13 @@ std::string fixed2(double v) {
     return buf;
 }
 
+// A vehicle type takes part where its trip edges (its connected part, through
+// the junction turns open to it) are at least kMinNetworkShare of the cars'.
+bool typeHasNetwork(const std::array<std::vector<uint32_t>, kAgentTypeCount>& edges, AgentType t) {
+    const size_t own = edges[size_t(t)].size(), cars = edges[size_t(AgentType::Car)].size();
+    return own >= 2 && double(own) >= kMinNetworkShare * double(cars);
+}
+
 struct Entry {
     double depart;
     int order;  // vehicles before pedestrians at equal times, then by index
@@ -215,7 +223,7 @@ Result<std::string> makeDemandXml(const SumoNet& net, const TrafficDemandOptions
         const double u = typeRng.uniform();
         int t = 0;
         for (double acc = kDefaultMix[0]; t < 4 && u >= acc; acc += kDefaultMix[size_t(++t)]) {}
-        if (edges[size_t(t)].size() < 2) t = int(AgentType::Car), ++n.substituted;
+        if (!typeHasNetwork(edges, AgentType(t))) t = int(AgentType::Car), ++n.substituted;
         ++n.byType[size_t(t)];
         Rng tripRng(opt.seed, uint64_t(i), kTripStream);
         const auto [from, to] = drawTrip(net, edges[size_t(t)], tripRng, span / 3.0, 1e300);

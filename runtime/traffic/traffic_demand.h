@@ -6,11 +6,13 @@
 // - Agent types (agentTypeInfo): car, van, bus, truck, bicycle (SUMO classes
 //   passenger, delivery, bus, truck, bicycle) and pedestrian, with the
 //   dimensions vista draws them at. Vehicles are drawn from kDefaultMix; a
-//   type whose class has no connected network is replaced by a car (counted
-//   in TrafficDemandCounts::substituted).
+//   type whose class has no connected network, or one with fewer trip edges
+//   than kMinNetworkShare of the cars' (long vehicles kept off a town's tight
+//   junction turns, junction_turns.h), is replaced by a car (counted in
+//   TrafficDemandCounts::substituted).
 // - Every trip starts and ends on normal edges at least kMinTripEdgeM long
 //   that lie in the largest strongly connected part of the network for its
-//   class (pedestrians: the largest connected part of the walkable network,
+//   class (through the junctions' connections whose internal lane allows it) (pedestrians: the largest connected part of the walkable network,
 //   sidewalks, walking areas and crossings), so sumo can route every one.
 //   Origins and destinations are kept at least a third of the network's
 //   extent apart (vehicles) or 80 to 600 m apart (pedestrians) where the
@@ -50,6 +52,7 @@ bool agentTypeFromId(const std::string& id, AgentType* t);
 // Shares of the vehicle types (car, van, bus, truck, bicycle); sum 1.
 constexpr std::array<double, 5> kDefaultMix = {0.70, 0.10, 0.05, 0.05, 0.10};
 constexpr double kMinTripEdgeM = 20.0;
+constexpr double kMinNetworkShare = 0.5;
 constexpr int kTripTries = 16;
 
 struct TrafficDemandOptions {

@@ -15,6 +15,7 @@
 #include "foundation/hash.h"
 #include "foundation/format.h"
 #include "runtime/traffic/junction_lanes.h"
+#include "runtime/traffic/junction_turns.h"
 #include "runtime/traffic/sumo_net.h"
 #include "runtime/traffic/sumo_process.h"
 
@@ -217,6 +218,15 @@ Status runAll(const std::string& xodrText, const TrafficOptions& opt, const std:
     // No lane changes inside junctions (a vehicle moved sideways there onto a
     // pedestrian waiting on a crossing): junction_lanes.h.
     if (auto marked = forbidJunctionLaneChanges((w / "city.net.xml").string()); !marked) return marked.status();
+    // Long vehicles keep off turns tighter than SUMO's straight box between
+    // their front and back can take (junction_turns.h).
+    std::vector<TurnClass> turnClasses;
+    for (int t = 0; t < kAgentTypeCount; ++t)
+        if (AgentType(t) != AgentType::Pedestrian)
+            turnClasses.push_back({agentTypeInfo(AgentType(t)).sumoClass, agentTypeInfo(AgentType(t)).length});
+    auto closed = restrictTightTurns((w / "city.net.xml").string(), turnClasses);
+    if (!closed) return closed.status();
+    for (size_t i = 0; i < turnClasses.size(); ++i) sum.turnsClosed.push_back({turnClasses[i].sumoClass, (*closed)[i]});
     progress.end();
 
     progress.begin("traffic: demand");
@@ -262,6 +272,9 @@ Status runAll(const std::string& xodrText, const TrafficOptions& opt, const std:
     for (int t = 0; t < kAgentTypeCount; ++t) types[agentTypeInfo(AgentType(t)).id] = sum.demand.byType[size_t(t)];
     j["agents_by_type"] = types;
     j["substituted_vehicles"] = sum.demand.substituted;
+    nlohmann::ordered_json turns;
+    for (const auto& [cls, n] : sum.turnsClosed) turns[cls] = n;
+    j["junction_turns_closed"] = turns;
     j["sumo"] = {{"vehicles_inserted", sum.vehiclesInserted},
                  {"persons_loaded", sum.personsInserted},
                  {"collisions", sum.collisions},

@@ -10,7 +10,8 @@
 //   folder of an interrupted run is removed and rebuilt. The files: city.xodr
 //   (the input), city.net.xml (netconvert's network, sidewalks and crossings
 //   guessed where the city has sidewalks; no lane changes on its junctions'
-//   internal lanes, junction_lanes.h), demand.rou.xml, traffic.sumocfg
+//   internal lanes, junction_lanes.h; long vehicles kept off tight junction
+//   turns, junction_turns.h), demand.rou.xml, traffic.sumocfg
 //   (sumo -c traffic.sumocfg in the folder runs it again), fcd.xml (SUMO's
 //   FCD: every agent at every step), signals.xml (SUMO's traffic-light
 //   states at every switch), collisions.xml (SUMO's collision output: one
@@ -25,6 +26,8 @@
 // - Not thread-safe with another run on the same `dir`.
 #pragma once
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "foundation/progress.h"
 #include "foundation/status.h"
@@ -58,6 +61,8 @@ struct TrafficRunSummary {
     CollisionCounts collisionEvents;
     double netOffsetX = 0.0, netOffsetY = 0.0;
     std::string sumoVersion;
+    // Per SUMO vehicle class: the junction turns closed to it (junction_turns.h).
+    std::vector<std::pair<std::string, size_t>> turnsClosed;
 };
 
 // Ranges of the options (checked by checkTrafficOptions, named in messages).
