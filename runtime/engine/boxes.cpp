@@ -654,13 +654,7 @@ class MaskRaster {
 public:
     MaskRaster(const Projector& pr, const CameraRayTable* rays, int width, int height, MaskStamps& stamps,
                uint32_t mark)
-        : _pr(pr),
-          _rays(rays),
-          _w(width),
-          _h(height),
-          _stamp(stamps.pixels),
-          _tileStamp(stamps.tiles),
-          _mark(mark) {}
+        : _pr(pr), _rays(rays), _w(width), _h(height), _stamp(stamps.pixels), _tileStamp(stamps.tiles), _mark(mark) {}
     PixelBox full;
     uint32_t covered = 0;
 

@@ -155,8 +155,8 @@ Result<std::vector<size_t>> restrictTightTurns(const std::string& netPath, const
                 for (size_t c = 0; c < s->classes->size(); ++c) {
                     const std::string& cls = (*s->classes)[c].sumoClass;
                     if (!(s->needs[c] > radius)) continue;
-                    const bool permitted = allow ? (contains(allowed, cls) || contains(allowed, "all"))
-                                                 : !contains(denied, cls);
+                    const bool permitted =
+                        allow ? (contains(allowed, cls) || contains(allowed, "all")) : !contains(denied, cls);
                     if (!permitted) continue;
                     if (allow && !contains(allowed, cls)) {
                         s->error = "an internal lane allows 'all': its classes cannot be listed";

@@ -56,7 +56,7 @@ struct Reader {
     };
     std::vector<PendingConnection> pending;
     std::unordered_map<std::string, std::pair<uint32_t, int>> laneIndex;  // lane id -> (edge, lane index)
-    std::unordered_map<std::string, std::vector<uint32_t>> laneSignals;  // internal lane id -> signal ids
+    std::unordered_map<std::string, std::vector<uint32_t>> laneSignals;   // internal lane id -> signal ids
     struct PendingLink {
         std::string via, tl;
         int linkIndex;

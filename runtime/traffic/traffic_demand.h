@@ -12,11 +12,10 @@
 //   TrafficDemandCounts::substituted).
 // - Every trip starts and ends on normal edges at least kMinTripEdgeM long
 //   that lie in the largest strongly connected part of the network for its
-//   class (through the junctions' connections whose internal lane allows it) (pedestrians: the largest connected part of the walkable network,
-//   sidewalks, walking areas and crossings), so sumo can route every one.
-//   Origins and destinations are kept at least a third of the network's
-//   extent apart (vehicles) or 80 to 600 m apart (pedestrians) where the
-//   network allows (the best of kTripTries draws otherwise).
+//   class (through the junctions' connections whose internal lane allows it) (pedestrians: the largest connected part
+//   of the walkable network, sidewalks, walking areas and crossings), so sumo can route every one. Origins and
+//   destinations are kept at least a third of the network's extent apart (vehicles) or 80 to 600 m apart (pedestrians)
+//   where the network allows (the best of kTripTries draws otherwise).
 // - Departures are spread evenly over [0, duration): agent i of n departs in
 //   the i-th of n equal slots at a seeded offset; the file lists vehicles
 //   and pedestrians merged by departure time, as sumo requires.

@@ -49,7 +49,7 @@ TEST(FileWriteQueue, AFailedFileIsReportedOnceAndTheOthersAreStillWritten) {
         const Status s = io.wait();
         ASSERT_FALSE(s.isOk());
         EXPECT_NE(s.message().find(bad), std::string::npos) << s.message();
-        EXPECT_TRUE(io.wait().isOk());  // reported once
+        EXPECT_TRUE(io.wait().isOk());     // reported once
         io.write(dir.file("c"), "third");  // given without a wait: the destructor writes it
     }
     EXPECT_EQ(test::readBytes(dir.file("a")), "first");

@@ -81,26 +81,32 @@ TEST(JunctionTurns, RadiusOfASampledArcAndNeedFromTheSagitta) {
 
 TEST(JunctionTurns, ClosesTightTurnsToLongClassesAndNothingElseChanges) {
     const std::string tight = quarterTurn(6.5), wide = quarterTurn(30.0);
-    const std::string net = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<net version=\"1.9\">\n"
-                            "    <edge id=\":J_0\" function=\"internal\">\n"
-                            "        <lane id=\":J_0_0\" index=\"0\" disallow=\"pedestrian tram\" length=\"20.00\" shape=\"" +
-                            tight +
-                            "\" changeLeft=\"ignoring\"/>\n"
-                            "        <lane id=\":J_0_1\" index=\"1\" allow=\"passenger bus truck\" shape=\"" + tight +
-                            "\"/>\n"
-                            "        <lane id=\":J_0_2\" index=\"2\" shape=\"" + tight +
-                            "\"/>\n"
-                            "        <lane id=\":J_0_3\" index=\"3\" disallow=\"bus\" shape=\"" + tight +
-                            "\"/>\n"
-                            "    </edge>\n"
-                            "    <edge id=\":J_1\" function=\"internal\">\n"
-                            "        <lane id=\":J_1_0\" index=\"0\" disallow=\"pedestrian\" shape=\"" + wide +
-                            "\"/>\n"
-                            "    </edge>\n"
-                            "    <edge id=\"a\">\n"
-                            "        <lane id=\"a_0\" index=\"0\" length=\"50.00\" shape=\"" + tight +
-                            "\"/>\n"
-                            "    </edge>\n</net>\n";
+    const std::string net =
+        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<net version=\"1.9\">\n"
+        "    <edge id=\":J_0\" function=\"internal\">\n"
+        "        <lane id=\":J_0_0\" index=\"0\" disallow=\"pedestrian tram\" length=\"20.00\" shape=\"" +
+        tight +
+        "\" changeLeft=\"ignoring\"/>\n"
+        "        <lane id=\":J_0_1\" index=\"1\" allow=\"passenger bus truck\" shape=\"" +
+        tight +
+        "\"/>\n"
+        "        <lane id=\":J_0_2\" index=\"2\" shape=\"" +
+        tight +
+        "\"/>\n"
+        "        <lane id=\":J_0_3\" index=\"3\" disallow=\"bus\" shape=\"" +
+        tight +
+        "\"/>\n"
+        "    </edge>\n"
+        "    <edge id=\":J_1\" function=\"internal\">\n"
+        "        <lane id=\":J_1_0\" index=\"0\" disallow=\"pedestrian\" shape=\"" +
+        wide +
+        "\"/>\n"
+        "    </edge>\n"
+        "    <edge id=\"a\">\n"
+        "        <lane id=\"a_0\" index=\"0\" length=\"50.00\" shape=\"" +
+        tight +
+        "\"/>\n"
+        "    </edge>\n</net>\n";
     TempDir tmp("vista_junction_turns");
     const std::string path = tmp.file("n.net.xml");
     writeText(path, net);
@@ -141,8 +147,9 @@ TEST(JunctionTurns, BadFilesAreErrorsAndLeaveTheFileAsItWas) {
     auto missing = restrictTightTurns(tmp.file("missing.net.xml"), classes);
     ASSERT_FALSE(missing);
     EXPECT_NE(missing.status().message().find("missing.net.xml"), std::string::npos);
-    const std::string net = "<net>\n  <edge id=\":J_0\" function=\"internal\">\n    <lane id=\":J_0_0\" index=\"0\" shape=\"" +
-                            quarterTurn(6.5) + "\"/>\n  </edge>\n</net>\n";
+    const std::string net =
+        "<net>\n  <edge id=\":J_0\" function=\"internal\">\n    <lane id=\":J_0_0\" index=\"0\" shape=\"" +
+        quarterTurn(6.5) + "\"/>\n  </edge>\n</net>\n";
     const struct {
         const char* name;
         std::string body;
