@@ -254,10 +254,8 @@ private:
         osg::ref_ptr<osg::Vec3Array> verts = new osg::Vec3Array(unsigned(flat.moved.size()));
         for (size_t i = 0; i < flat.moved.size(); ++i)
             (*verts)[unsigned(i)] = osg::Vec3(flat.moved[i].x, flat.moved[i].y, flat.moved[i].z);
-        osg::ref_ptr<osg::Vec4ubArray> colors = new osg::Vec4ubArray(cb.colors->begin(), cb.colors->end());
-        colors->setNormalize(true);
         g->setVertexArray(verts.get());
-        g->setColorArray(colors.get(), osg::Array::BIND_PER_VERTEX);
+        g->setColorArray(cb.colors.get(), osg::Array::BIND_PER_VERTEX);  // the chunk's own colours, shared
         std::vector<GLuint> idx;
         idx.reserve(cb.indices.size());
         for (size_t t = 0; t < flat.jamb.size(); ++t)

@@ -55,7 +55,7 @@ class TrafficScene;
 // chooses per frame).
 constexpr double kDefaultNearDistance = 100.0;
 // The default screen-space error bound of hybrid's flattened near-field chunks (pixels).
-constexpr double kDefaultNearDetailPx = 1.0;
+constexpr double kDefaultNearDetailPx = 0.0;
 
 struct ModeOptions {
     double nearDistance = kDefaultNearDistance;  // metres, 1 .. 100000; < 0 = auto (hybrid: adaptive split)

@@ -155,8 +155,7 @@ TEST(NearDetail, ScreenDeviationBoundsTheProjectedDisplacement) {
 // hybrid on a car drive: nearest-first order changes no pixel of consequence
 // and draws fewer fragments; a 4-pixel bound flattens the farther chunks'
 // recesses (fewer triangles) at >= 35 dB against `full` (jamb strips up to 4
-// pixels wide go: 37 to 61 dB on these frames); the default (1 pixel) stays
-// >= 45 dB.
+// pixels wide go: 37 to 61 dB on these frames); the default stays >= 45 dB.
 TEST(NearDetail, HybridOrderAndCoarseLevelAgainstFull) {
     const char* disp = std::getenv("DISPLAY");
     if (!disp || !*disp) GTEST_SKIP() << "no X display: run the rendering tests under xvfb-run -a";
