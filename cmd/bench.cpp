@@ -57,6 +57,7 @@ Result<std::unique_ptr<BenchRun>> setUp(const SceneModel* city, osg::Node* scene
     auto renderer = OffscreenRenderer::create(cfg.width, cfg.height);
     if (!renderer) return renderer.status();
     run->renderer = std::move(renderer.value());
+    run->renderer->setCountFragments(cfg.countFragments);
     run->ctx.city = city;
     run->ctx.scene = scene;
     run->ctx.renderer = run->renderer.get();

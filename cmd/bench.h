@@ -48,11 +48,12 @@ struct BenchConfig {
     double fovYDeg = 60.0;
     double zNear = 0.3;
     std::vector<std::string> modes{"full", "near"};
-    std::string outDir;       // created if missing; empty = write nothing
-    int referenceSsaa = 0;    // 0/1 = `full` image; k >= 2 = k x k supersampled full; kNoReference = none
-    int diffThreshold = 8;    // for the differing-pixel fraction (0..255)
-    int worstFrames = 2;      // difference images for the N worst frames per mode
-    bool saveFrames = false;  // every frame of every mode as frames/f<NNNN>_<mode>.png
+    std::string outDir;           // created if missing; empty = write nothing
+    int referenceSsaa = 0;        // 0/1 = `full` image; k >= 2 = k x k supersampled full; kNoReference = none
+    int diffThreshold = 8;        // for the differing-pixel fraction (0..255)
+    int worstFrames = 2;          // difference images for the N worst frames per mode
+    bool countFragments = false;  // notes each GL frame's fragments that pass the depth test (setCountFragments)
+    bool saveFrames = false;      // every frame of every mode as frames/f<NNNN>_<mode>.png
     // Non-empty: every dumpRaysEvery-th frame (0, N, 2N, ...) of every mode
     // with a far-field ray stage (RenderMode::lastTracedPixels: hybrid) is
     // written as <dir>/<mode>_f<NNNN>.rays (RaySet, runtime/engine/ray_set.h),

@@ -78,6 +78,9 @@ void declareFlags(CLI::App& app, BenchArgs& a) {
     app.add_flag("--pace", a.cfg.pace,
                  "with --sampling consecutive: pace the frames at the path's own speed (frame f starts no earlier "
                  "than its path time after the first frame's), a real-time drive");
+    app.add_flag("--count-fragments", a.cfg.countFragments,
+                 "count every frame's fragments that pass the depth test (a GL query; costs time) into the notes of "
+                 "frames.csv: 'fragments: N (F per pixel)'");
     app.add_flag("--save-frames", a.cfg.saveFrames,
                  "also write every frame of every mode as OUT/frames/fNNNN_MODE.png");
     app.add_option(

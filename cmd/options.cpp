@@ -270,6 +270,13 @@ void addModeFlags(CLI::App& app, ModeFlags& f) {
         app, "--far-step", f.farStep, 1, 2,
         "hybrid: far-field ray spacing, 1 or 2: 2 = rays on every other pixel and row first, pixels between "
         "lattice pixels that showed one triangle (or sky) blended from them (lossy: PSNR in the bench) (default 1)");
+    addNumberOption(
+        app, "--near-detail", f.nearDetail, RealRange::closed(0, 100),
+        "hybrid: draw a near-field chunk with its window recesses flattened where that moves its surface by at most "
+        "this many pixels on screen, 0 .. 100 (0 = off: every chunk at full detail) (default " +
+            formatSplatSigma(f.nearDetail) + ")");
+    app.add_flag("--no-front-to-back", f.noFrontToBack,
+                 "hybrid: draw the near field's chunks in the city's order instead of nearest first");
     app.add_option("--baked", f.baked, "impostor: the baked file of this city (from `vista bake`)");
     app.add_option(
         "--baked-mesh", f.bakedMesh,
@@ -298,6 +305,9 @@ Status checkModeOptions(const ModeOptions& o) {
                              " out of range 0 .. 10000 ms (0 = no target)");
     if (o.farStep < 1 || o.farStep > 2)
         return Status::error("--far-step " + std::to_string(o.farStep) + " out of range 1 .. 2 pixels");
+    if (!(o.nearDetailPx >= 0 && o.nearDetailPx <= 100))
+        return Status::error("--near-detail " + std::to_string(o.nearDetailPx) +
+                             " out of range 0 .. 100 pixels (0 = off)");
     if (o.threads < 0 || o.threads > 1024)
         return Status::error("--threads " + std::to_string(o.threads) + " out of range 0 .. 1024 (0 = all cores)");
     return checkSplatSigma(o.splatSigma);
@@ -323,6 +333,8 @@ Status parseModeFlags(const ModeFlags& f, ModeOptions& o) {
     o.overlap = !f.noOverlap;
     o.frameMsTarget = f.frameMs;
     o.farStep = f.farStep;
+    o.nearDetailPx = f.nearDetail;
+    o.nearFrontToBack = !f.noFrontToBack;
     o.bakedFile = f.baked;
     o.bakedMeshFile = f.bakedMesh;
     o.threads = f.threads;

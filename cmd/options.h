@@ -109,6 +109,8 @@ struct ModeFlags {
     bool noCache = false, noOverlap = false, cacheAlways = false;
     double cacheError = 0.25, frameMs = 0.0;
     int farStep = 1;
+    double nearDetail = kDefaultNearDetailPx;  // --near-detail: pixels, 0 = off
+    bool noFrontToBack = false;
     std::string baked;
     std::string bakedMesh;
     std::string pointSplat;  // "" = the default (ModeOptions::splatSigma)

@@ -1,6 +1,9 @@
 // NearFarSplit cull node (see near_far_split.h).
 #include "nodes/near_far_split.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include <osg/ComputeBoundsVisitor>
 #include <osg/Geode>
 #include <osg/Geometry>
@@ -108,12 +111,34 @@ void NearFarSplit::traverse(osg::NodeVisitor& nv) {
     if (_triangleBudget == 0) sel = selectNearField(index, eye, _nearDistance);
     else if (_srcIndex) sel = selectNearFieldByBudget(index, eye, _triangleBudget);  // free slots are in no block
     else sel = selectNearFieldByBudget(objs, eye, _triangleBudget);
+    std::vector<double> dist(sel.size());
+    for (size_t k = 0; k < sel.size(); ++k) dist[k] = boxDistance(objs[sel[k]], eye);
+    std::vector<size_t> order(sel.size());
+    for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+    if (_frontToBack)
+        std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return dist[a] < dist[b]; });
+    // Flat twins: the bench face's rule with this cull's projection and viewport.
+    const NearFieldScene* ds = _detailScene;
+    const bool twins = ds && _detailPx > 0 && ds->coarseChunks.size() == objs.size() && cv->getViewport();
+    double fovY = 0;
+    int w = 0, h = 0;
+    if (twins) {
+        fovY = 2.0 * std::atan(1.0 / cv->getProjectionMatrix()->operator()(1, 1));
+        w = int(cv->getViewport()->width());
+        h = int(cv->getViewport()->height());
+    }
     uint64_t tris = 0;
-    for (uint32_t i : sel) {
+    for (size_t k : order) {
+        const uint32_t i = sel[k];
         osg::Node* n = _srcChunks ? (*_srcChunks)[i].get() : _children[i].get();
         if (!n) continue;
+        uint64_t t = objs[i].triangles;
+        if (twins && ds->coarseChunks[i] && screenDeviationPx(ds->coarseError[i], dist[k], fovY, w, h) <= _detailPx) {
+            n = ds->coarseChunks[i].get();
+            t = ds->coarseTriangles[i];
+        }
         n->accept(nv);
-        tris += objs[i].triangles;
+        tris += t;
     }
     _lastCount = unsigned(sel.size());
     _lastTriangles = tris;

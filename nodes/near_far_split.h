@@ -18,6 +18,12 @@
 // (non-null slots) are traversed in the index's order. The node then culls
 // nothing itself (its children's bounds are not the source's).
 //
+// Near detail (setNearDetail, the hybrid's viewer face): the chosen chunks
+// are traversed nearest first (box distance), and a chunk of the given
+// NearFieldScene with a flat twin is traversed as its twin where the twin's
+// deviation projects to at most detailPx pixels (screenDeviationPx with the
+// cull visitor's projection and viewport) — the bench face's choice.
+//
 // Thread safety: OSG's single-threaded or CullDrawThreadPerContext models (one
 // cull at a time); lastNearCount()/lastNearTriangles() report the last cull.
 // A source changes only between frames.
@@ -29,6 +35,7 @@
 #include <osg/Group>
 #include <osg/NodeVisitor>
 
+#include "nodes/near_field_chunks.h"
 #include "runtime/engine/adaptive_split.h"
 
 namespace vista {
@@ -48,6 +55,13 @@ public:
     // Chooses among `scene`'s chunks by `index` (both outlive the node), or among the children (null).
     void setSource(const std::vector<osg::ref_ptr<osg::Node>>* chunks, const std::vector<SplitObject>* objects,
                    const SplitIndex* index);
+
+    // scene: whose chunks the split chooses among (children or source), for its twins; null = none.
+    void setNearDetail(const NearFieldScene* scene, bool frontToBack, double detailPx) {
+        _detailScene = scene;
+        _frontToBack = frontToBack;
+        _detailPx = detailPx;
+    }
 
     void traverse(osg::NodeVisitor& nv) override;
 
@@ -71,6 +85,9 @@ private:
     const std::vector<osg::ref_ptr<osg::Node>>* _srcChunks = nullptr;  // setSource
     const std::vector<SplitObject>* _srcObjects = nullptr;
     const SplitIndex* _srcIndex = nullptr;
+    const NearFieldScene* _detailScene = nullptr;  // setNearDetail
+    bool _frontToBack = false;
+    double _detailPx = 0;
     bool _dirty = true;
     unsigned _lastCount = 0;
     uint64_t _lastTriangles = 0;

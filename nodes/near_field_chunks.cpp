@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <tuple>
 
@@ -13,6 +14,7 @@
 #include <osg/MatrixTransform>
 
 #include "citygen/labels.h"
+#include "citygen/recess_flatten.h"
 #include "nodes/label_pass.h"
 #include "runtime/scene/scene_graph.h"
 #include "runtime/scene/tree_impostor_graph.h"
@@ -33,7 +35,9 @@ struct ChunkBuild {
     osg::ref_ptr<osg::Vec4ubArray> colors = new osg::Vec4ubArray;
     osg::ref_ptr<osg::UIntArray> labelIds, labelClasses;  // labels only: per vertex
     std::vector<GLuint> indices;
+    std::vector<Material> triMaterial;  // per triangle of `indices`
     std::map<osg::Geometry*, TreeBatch> trees;
+    uint64_t treeTriangles = 0;
     glm::dvec3 lo{1e300}, hi{-1e300};
     uint64_t triangles = 0;
     void expand(const glm::dvec3& p) {
@@ -60,7 +64,7 @@ struct InstancesBound : public osg::Drawable::ComputeBoundingBoxCallback {
 // then materialised as nodes.
 class Chunker {
 public:
-    Chunker(double chunk, bool labels) : _chunk(chunk), _labels(labels) {
+    Chunker(double chunk, bool labels, bool coarse) : _chunk(chunk), _labels(labels), _coarse(coarse) {
         if (labels) _treeLabelState = labelTreeState();
     }
 
@@ -93,6 +97,7 @@ public:
                 cb.expand(tileOrigin + glm::dvec3(glm::dmat4(m) * glm::dvec4(v.x(), v.y(), v.z(), 1.0)));
             }
             cb.triangles += protoTris;
+            cb.treeTriangles += protoTris;
         }
     }
 
@@ -102,7 +107,8 @@ public:
         auto* colors = dynamic_cast<osg::Vec4ubArray*>(g->getColorArray());
         auto* de = dynamic_cast<osg::DrawElements*>(g->getPrimitiveSet(0));
         auto* ids = _labels ? dynamic_cast<osg::UIntArray*>(g->getVertexAttribArray(kLabelAttrib)) : nullptr;
-        const GLuint cls = GLuint(semanticClass(materialFromName(g->getName().c_str())));
+        const Material material = materialFromName(g->getName().c_str());
+        const GLuint cls = GLuint(semanticClass(material));
         const unsigned ni = de->getNumIndices();
         std::vector<std::pair<ChunkKey, unsigned>> tris;
         tris.reserve(ni / 3);
@@ -145,6 +151,7 @@ public:
                     }
                     cb.indices.push_back(GLuint(remap[vi]));
                 }
+                cb.triMaterial.push_back(material);
                 ++cb.triangles;
             }
             for (unsigned vi : touched) remap[vi] = -1;
@@ -161,6 +168,12 @@ public:
         for (auto& [key, cb] : _chunks) {
             if (cb.triangles == 0) continue;
             osg::ref_ptr<osg::Geode> geode = new osg::Geode, labelGeode = _labels ? new osg::Geode : nullptr;
+            const RecessFlattening flat = flatten(cb);
+            NearKindCounts kinds = meshKinds(cb);
+            kinds[size_t(NearKind::Facade)] -= flat.jambTriangles;
+            kinds[size_t(NearKind::Recess)] += flat.jambTriangles;
+            kinds[size_t(NearKind::Tree)] += cb.treeTriangles;
+            out.chunkKinds.push_back(kinds);
             if (!cb.indices.empty()) {
                 auto g = meshGeometry(cb);
                 geode->addDrawable(g.get());
@@ -175,6 +188,11 @@ public:
             xf->setDataVariance(osg::Object::DYNAMIC);
             xf->setMatrix(osg::Matrixd::translate(cb.origin.x, cb.origin.y, cb.origin.z));
             xf->addChild(geode.get());
+            if (_coarse) {
+                out.coarseChunks.push_back(flat.jambTriangles ? coarseNode(cb, flat, *geode) : nullptr);
+                out.coarseTriangles.push_back(cb.triangles - flat.jambTriangles);
+                out.coarseError.push_back(float(flat.maxRecessDepth));
+            }
             if (_labels) {
                 osg::ref_ptr<osg::MatrixTransform> lx = new osg::MatrixTransform;
                 lx->setDataVariance(osg::Object::DYNAMIC);
@@ -198,6 +216,61 @@ public:
     }
 
 private:
+    static NearKind kindOf(Material m) {
+        switch (m) {
+            case Material::Ground:
+            case Material::Road:
+            case Material::Marking:
+            case Material::Sidewalk:
+            case Material::Grass: return NearKind::Ground;
+            case Material::Wall:
+            case Material::Roof: return NearKind::Facade;
+            case Material::Window: return NearKind::Window;
+            case Material::Car: return NearKind::Car;
+            case Material::Trunk:
+            case Material::Leaves: return NearKind::Tree;
+            default: return NearKind::Other;
+        }
+    }
+    static NearKindCounts meshKinds(const ChunkBuild& cb) {
+        NearKindCounts k{};
+        for (Material m : cb.triMaterial) ++k[size_t(kindOf(m))];
+        return k;
+    }
+    static RecessFlattening flatten(const ChunkBuild& cb) {
+        std::vector<glm::vec3> pos(cb.verts->size());
+        for (size_t i = 0; i < pos.size(); ++i) {
+            const osg::Vec3& p = (*cb.verts)[unsigned(i)];
+            pos[i] = glm::vec3(p.x(), p.y(), p.z());
+        }
+        return flattenRecesses(pos, std::vector<uint32_t>(cb.indices.begin(), cb.indices.end()), cb.triMaterial);
+    }
+    // The chunk's flattened twin: moved glass, no jambs, the same colours and
+    // the fine geode's trees (its drawables after the mesh, shared).
+    static osg::ref_ptr<osg::Node> coarseNode(const ChunkBuild& cb, const RecessFlattening& flat, osg::Geode& fine) {
+        osg::ref_ptr<osg::Geometry> g = new osg::Geometry;
+        g->setUseDisplayList(false);
+        g->setUseVertexBufferObjects(true);
+        osg::ref_ptr<osg::Vec3Array> verts = new osg::Vec3Array(unsigned(flat.moved.size()));
+        for (size_t i = 0; i < flat.moved.size(); ++i)
+            (*verts)[unsigned(i)] = osg::Vec3(flat.moved[i].x, flat.moved[i].y, flat.moved[i].z);
+        g->setVertexArray(verts.get());
+        g->setColorArray(cb.colors.get(), osg::Array::BIND_PER_VERTEX);  // the chunk's own colours, shared
+        std::vector<GLuint> idx;
+        idx.reserve(cb.indices.size());
+        for (size_t t = 0; t < flat.jamb.size(); ++t)
+            if (!flat.jamb[t])
+                idx.insert(idx.end(), cb.indices.begin() + long(3 * t), cb.indices.begin() + long(3 * t + 3));
+        g->addPrimitiveSet(new osg::DrawElementsUInt(GL_TRIANGLES, idx.begin(), idx.end()));
+        osg::ref_ptr<osg::Geode> geode = new osg::Geode;
+        geode->addDrawable(g.get());
+        for (unsigned d = 1; d < fine.getNumDrawables(); ++d) geode->addDrawable(fine.getDrawable(d));
+        osg::ref_ptr<osg::MatrixTransform> xf = new osg::MatrixTransform;
+        xf->setDataVariance(osg::Object::DYNAMIC);
+        xf->setMatrix(osg::Matrixd::translate(cb.origin.x, cb.origin.y, cb.origin.z));
+        xf->addChild(geode.get());
+        return xf;
+    }
     int64_t cell(double worldCoordinate) const { return int64_t(std::floor(worldCoordinate / _chunk)); }
     ChunkBuild& chunkFor(const ChunkKey& key, const glm::dvec3& origin) {
         auto it = _chunks.find(key);
@@ -314,13 +387,14 @@ private:
     std::vector<int32_t> _tileChild;
     double _chunk;
     bool _labels = false;
+    bool _coarse = false;
     osg::ref_ptr<osg::StateSet> _treeLabelState;
     std::map<ChunkKey, ChunkBuild> _chunks;
     osg::ref_ptr<InstancesBound> _instancesBound = new InstancesBound;
 };
 
 // An unknown layout: one chunk with OSG's bound.
-void keepWhole(osg::Node* n, NearFieldScene& out, int32_t child) {
+void keepWhole(osg::Node* n, NearFieldScene& out, int32_t child, bool coarse) {
     const osg::BoundingSphere& bs = n->getBound();
     if (!bs.valid()) return;
     SplitObject o;
@@ -329,28 +403,48 @@ void keepWhole(osg::Node* n, NearFieldScene& out, int32_t child) {
     out.objects.push_back(o);
     out.chunks.push_back(n);
     out.chunkTile.push_back(child);
+    out.chunkKinds.push_back(NearKindCounts{});
+    if (coarse) {
+        out.coarseChunks.push_back(nullptr);
+        out.coarseTriangles.push_back(0);
+        out.coarseError.push_back(0.0f);
+    }
     if (out.labelRootState) out.labelChunks.push_back(new osg::Group);  // unknown layout: no labels
 }
 
 }  // namespace
 
-NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk, bool labels) {
+const char* nearKindName(NearKind kind) {
+    static const char* const names[kNearKindCount] = {"ground", "facade", "recess", "window", "car", "tree", "other"};
+    return size_t(kind) < kNearKindCount ? names[size_t(kind)] : "?";
+}
+
+double screenDeviationPx(double deviation, double distance, double fovY, int width, int height) {
+    if (!(distance > 0)) return std::numeric_limits<double>::infinity();
+    const double t = std::tan(0.5 * fovY);
+    const double f = 0.5 * double(height) / t;  // focal length in pixels
+    const double aspect = double(width) / double(height);
+    const double tanCorner2 = t * t * (1.0 + aspect * aspect);  // tan^2 of the corner's angle
+    return deviation * f * (1.0 + tanCorner2) / distance;       // 1 / cos^2 = 1 + tan^2
+}
+
+NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunk, bool labels, bool coarse) {
     NearFieldScene out;
     if (!cityScene) return out;
     out.rootState = cityScene->getStateSet();
     if (labels) out.labelRootState = labelRootState();
     osg::Group* root = cityScene->asGroup();
     if (!root) {
-        keepWhole(cityScene, out, -1);
+        keepWhole(cityScene, out, -1, coarse);
         out.drawOrder.assign(out.chunks.size(), 0);
         return out;
     }
-    Chunker chunker(chunk > 0 ? chunk : kNearChunkSize, labels);
+    Chunker chunker(chunk > 0 ? chunk : kNearChunkSize, labels, coarse);
     int64_t tileId = 0;
     for (unsigned ci = 0; ci < root->getNumChildren(); ++ci) {
         osg::MatrixTransform* xf = asCityTile(root->getChild(ci));
         if (!xf) {
-            keepWhole(root->getChild(ci), out, int32_t(ci));
+            keepWhole(root->getChild(ci), out, int32_t(ci), coarse);
             continue;
         }
         ++tileId;

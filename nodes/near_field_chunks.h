@@ -15,11 +15,22 @@
 // which shows: a few pixels of a frame (tested: street views identical,
 // elevated >= 50 dB).
 //
+// Kinds: every chunk counts its triangles by kind (NearKind: ground, facade,
+// window recess jambs, window glass, parked cars, trees, other), so a frame can
+// say where its near-field triangles go.
+//
+// Coarse level (coarse = true): a chunk with recessed windows also gets a
+// flattened twin (citygen/recess_flatten.h: glass on the facade plane, jambs
+// dropped) whose every point lies within coarseError[i] metres of the chunk's
+// surface; the hybrid draws it where that deviation projects to at most its
+// screen-space error bound (screenDeviationPx).
+//
 // Contract: buildNearFieldScene() keeps the vertices, colours and state of the
 // graph it is given. Chunks and objects are index-aligned: chunks[i] is drawn
 // iff objects[i] is selected. Pure (builds new nodes; the input graph is not
 // modified); the output does not depend on timing or threads.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -32,6 +43,22 @@
 namespace vista {
 
 constexpr double kNearChunkSize = 40.0;  // metres
+
+// Kinds of near-field triangles (by the city's materials; Recess = the jambs
+// of recessed windows, Window = glass).
+enum class NearKind : uint8_t { Ground, Facade, Recess, Window, Car, Tree, Other, Count };
+constexpr size_t kNearKindCount = size_t(NearKind::Count);
+const char* nearKindName(NearKind kind);  // "ground", "facade", "recess", "window", "car", "tree", "other"
+using NearKindCounts = std::array<uint64_t, kNearKindCount>;
+
+// The largest screen-space displacement, in pixels, of a point moved by at
+// most `deviation` metres when the point is at least `distance` metres from
+// the eye of a pinhole camera (vertical field of view fovY radians, width x
+// height pixels): deviation * f / (distance * cos^2 a), f = the focal length
+// in pixels, a = the angle of the frame's corner from the optical axis (the
+// first-order bound |d(u,v)| <= f |dp| r / z^2 over the frustum). +inf for
+// distance <= 0.
+double screenDeviationPx(double deviation, double distance, double fovY, int width, int height);
 
 // The city re-chunked for a fine near/far split: chunks[i] is drawn iff
 // objects[i] is selected. rootState = the city root's state set.
@@ -50,6 +77,14 @@ struct NearFieldScene {
     // chunk with it (ViewCellSwitch::setNearChunks).
     std::vector<int32_t> chunkTile;
     uint64_t triangles = 0;
+    // Index-aligned with chunks: each chunk's triangles by kind.
+    std::vector<NearKindCounts> chunkKinds;
+    // Built with coarse = true (else empty): index-aligned with chunks, the
+    // flattened twin (null: the chunk has nothing to flatten), its triangles
+    // and its deviation from the chunk in metres (its deepest recess).
+    std::vector<osg::ref_ptr<osg::Node>> coarseChunks;
+    std::vector<uint64_t> coarseTriangles;
+    std::vector<float> coarseError;
     // Built with labels only (else empty / null): labelChunks[i] is the label
     // twin of chunks[i] (nodes/label_pass.h: the same vertex arrays, primitive
     // sets and transform, drawn with the label programs under labelRootState);
@@ -62,6 +97,8 @@ struct NearFieldScene {
 // OSG), so any scene works, only more coarsely.
 // labels: also build the label twins (a city file with vista.labels; other
 // files get id 0 and the class of their geometry's material name).
-NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunkSize = kNearChunkSize, bool labels = false);
+// coarse: also build the flattened twins (coarseChunks).
+NearFieldScene buildNearFieldScene(osg::Node* cityScene, double chunkSize = kNearChunkSize, bool labels = false,
+                                   bool coarse = false);
 
 }  // namespace vista

@@ -42,6 +42,7 @@ STEPS=(
   "farfield-compare|farfield-compare|30|docs/tools/farfield_compare.sh \$OUT/farfield-compare \$BUILD/vista"
   "modes|modes|20|docs/tools/sweep.sh \$BUILD/vista \$OUT/modes > \$OUT/modes.md && $W docs/measurements/modes.md modes-sweep \$OUT/modes.md \$BUILD/vista"
   "hybrid-split|modes|10|docs/tools/hybrid_split.sh \$OUT/hybrid-split \$BUILD/vista"
+  "near-detail|modes|40|docs/tools/near_detail.sh \$OUT/near-detail \$BUILD/vista"
   "effects|effects|30|docs/tools/effects.sh \$OUT/effects \$BUILD/vista"
   "whole-bake|bake|55|docs/tools/whole_bake.sh \$OUT/whole-bake \$BUILD/vista"
   "whole-bake-seed2|bake|55|CITY_SEED=2 MARKER=whole-bake-seed2 docs/tools/whole_bake.sh \$OUT/whole-bake-seed2 \$BUILD/vista"

@@ -31,7 +31,8 @@ const NearFieldScene& ModeContext::nearField() {
     }
     if (!_nearField) {
         Stopwatch sw;
-        _nearField = std::make_shared<NearFieldScene>(buildNearFieldScene(plainScene(), kNearChunkSize, labels));
+        _nearField = std::make_shared<NearFieldScene>(
+            buildNearFieldScene(plainScene(), kNearChunkSize, labels, !labels && options.nearDetailPx > 0));
         _chunkingMs = sw.ms();
     }
     return *_nearField;

@@ -90,11 +90,7 @@ public:
             byBudget() ? selectNearFieldByBudget(_adaptive->index(), camera.eye, _ctx.options.triangleBudget)
                        : selectNearField(_adaptive->index(), camera.eye, nearD);
         _root->removeChildren(0, _root->getNumChildren());
-        uint64_t tris = 0;
-        for (uint32_t i : sel) {
-            _root->addChild(_near.chunks[i].get());
-            tris += _near.objects[i].triangles;
-        }
+        const uint64_t tris = addNearChunks(camera, sel, stats);
         stats.stages.set(Stage::Cull, sw.ms());
         stats.notes.push_back(splitNote(nearD));
         if (autoSplit()) {
@@ -128,7 +124,8 @@ public:
             VISTA_RETURN_IF_ERROR(
                 _ctx.renderer->render(_root.get(), camera, zFar, &out, &_depth, ns, /*skyLayer=*/false));
             stats.stages.set(Stage::Near, ns.frameMs);
-            stats.stages.set(Stage::Readback, ns.stages.ms(Stage::Readback));  // part of Near
+            stats.stages.set(Stage::Readback, ns.stages.ms(Stage::Readback));         // part of Near
+            stats.notes.insert(stats.notes.end(), ns.notes.begin(), ns.notes.end());  // e.g. fragments
         }
         stats.cullMs = ns.cullMs;
         stats.drawMs = ns.drawMs;
@@ -176,6 +173,7 @@ public:
             } else {
                 _viewer = buildHybridScene(_near, *_ctx.rays, *_heights, ho, &_split, &_farNode);
             }
+            if (_split) _split->setNearDetail(&_near, _ctx.options.nearFrontToBack, _ctx.options.nearDetailPx);
         }
         return _viewer.get();
     }
@@ -205,6 +203,57 @@ public:
     }
 
 private:
+    // The selected chunks into _root: nearest first (ModeOptions::nearFrontToBack: the depth
+    // test then rejects hidden fragments before they are shaded), each as its flattened twin
+    // where that deviates from the chunk by at most ModeOptions::nearDetailPx pixels
+    // (screenDeviationPx at the chunk box's distance). Notes the triangles by kind and the
+    // coarse chunks (both of the chosen chunks, before the renderer's frustum culling); `sel`
+    // ends up in draw order. Returns the chosen chunks' triangles.
+    uint64_t addNearChunks(const Camera& camera, std::vector<uint32_t>& sel, FrameStats& stats) {
+        const std::vector<SplitObject>& objs = _adaptive->index().objects();
+        std::vector<std::pair<double, uint32_t>> byDistance;
+        byDistance.reserve(sel.size());
+        for (uint32_t i : sel) byDistance.push_back({boxDistance(objs[i], camera.eye), i});
+        if (_ctx.options.nearFrontToBack)
+            std::stable_sort(byDistance.begin(), byDistance.end(),
+                             [](const auto& a, const auto& b) { return a.first < b.first; });
+        const bool coarse = _ctx.options.nearDetailPx > 0 && _near.coarseChunks.size() == _near.chunks.size();
+        const bool kinds = _near.chunkKinds.size() == _near.chunks.size();
+        NearKindCounts counts{};
+        uint64_t tris = 0, coarseCount = 0, saved = 0;
+        for (size_t k = 0; k < byDistance.size(); ++k) {
+            const auto [d, i] = byDistance[k];
+            sel[k] = i;
+            osg::Node* node = _near.chunks[i].get();
+            uint64_t t = objs[i].triangles;
+            const bool flat = coarse && _near.coarseChunks[i] &&
+                              screenDeviationPx(_near.coarseError[i], d, camera.fovY, camera.width, camera.height) <=
+                                  _ctx.options.nearDetailPx;
+            if (flat) {
+                node = _near.coarseChunks[i].get();
+                saved += t - _near.coarseTriangles[i];
+                t = _near.coarseTriangles[i];
+                ++coarseCount;
+            }
+            if (kinds) {
+                for (size_t c = 0; c < kNearKindCount; ++c) counts[c] += _near.chunkKinds[i][c];
+                if (flat) counts[size_t(NearKind::Recess)] -= _near.chunkKinds[i][size_t(NearKind::Recess)];
+            }
+            _root->addChild(node);
+            tris += t;
+        }
+        if (kinds) {
+            std::string note = "near kinds:";
+            for (size_t c = 0; c < kNearKindCount; ++c)
+                note += std::string(" ") + nearKindName(NearKind(c)) + "=" + std::to_string(counts[c]);
+            stats.notes.push_back(note);
+        }
+        if (coarse)
+            stats.notes.push_back("near coarse: " + std::to_string(coarseCount) + " of " + std::to_string(sel.size()) +
+                                  " chunks flattened, " + std::to_string(saved) + " triangles fewer");
+        return tris;
+    }
+
     // The split's end points are the modes they stand for, at their cost: ray casting (0 m) is
     // the `raycast` frame (no GL pass, no read-back, no far-field stage: raycastFrame), and
     // everything near is the `full` frame (the chunked city in its draw order, infinite far
@@ -226,6 +275,7 @@ private:
             if (fx.haze) _ctx.renderer->setEffects(fx, false);
             VISTA_RETURN_IF_ERROR(s);
             ns.stages.forEach([&](Stage st, double ms) { stats.stages.set(st, ms); });
+            stats.notes.insert(stats.notes.end(), ns.notes.begin(), ns.notes.end());
             stats.stages.set(Stage::Near, ns.frameMs);
             stats.cullMs = ns.cullMs;
             stats.drawMs = ns.drawMs;

@@ -14,8 +14,13 @@
 //   "split D (R): T tris, N rays".
 //   By triangle budget (ModeOptions::triangleBudget > 0): the nearest chunks
 //   up to the budget, infinite far plane, no horizon skipping.
+// Near-field draw: the chosen chunks nearest first (nearFrontToBack), each
+// as its flat twin (window recesses flattened, NearFieldScene::coarseChunks)
+// where the twin deviates from it by at most nearDetailPx pixels on screen;
+// notes "near kinds: ..." (the chosen chunks' triangles by kind) and "near
+// coarse: ..." (docs/reference/far-field.md "The near field's cost").
 // Options: nearDistance, triangleBudget, pixelBudget, horizonGrid, cache,
-// threads. Stats: pixel classes (Table 4.1), stages cull, near, opacity,
+// threads, nearFrontToBack, nearDetailPx. Stats: pixel classes (Table 4.1), stages cull, near, opacity,
 // seam, horizon, cache, rays, composite; notes: skipped stages, auto choice.
 // Set-up: "chunking" (shared), "height_grid"; needs ctx.rays ("bvh"). The
 // height grid of a paged city lies on the paged city's lattice

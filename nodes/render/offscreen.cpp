@@ -6,11 +6,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <thread>
 
 #include <osg/GL>
+#include <osg/GLExtensions>
 #include <osg/GLObjects>
 #include <osg/Geometry>
 #include <osg/Image>
@@ -40,7 +42,20 @@ struct Readback : public osg::Camera::DrawCallback {
     mutable double readMs = 0;
     mutable std::string renderer;
     mutable std::vector<uint32_t> depthBits, colorBits;  // scratch of the reads
-    void operator()(osg::RenderInfo&) const override {
+    // setCountFragments: the query FragmentQueryBegin started, its result.
+    bool countFragments = false;
+    mutable GLuint query = 0;
+    mutable bool queryOpen = false;
+    mutable uint64_t fragments = 0;
+    void operator()(osg::RenderInfo& info) const override {
+        if (queryOpen) {
+            const osg::GLExtensions* ext = info.getState()->get<osg::GLExtensions>();
+            ext->glEndQuery(GL_SAMPLES_PASSED_ARB);
+            GLuint64 n = 0;
+            ext->glGetQueryObjectui64v(query, GL_QUERY_RESULT_ARB, &n);
+            fragments = uint64_t(n);
+            queryOpen = false;
+        }
         glFinish();
         finishedMs = frame ? frame->ms() : 0.0;
         Stopwatch read;
@@ -57,6 +72,19 @@ struct Readback : public osg::Camera::DrawCallback {
         }
         if (depth) readDepthTopDown(0, 0, width, height, depthBits, *depth);  // row 0 at top
         readMs = read.ms();
+    }
+};
+
+// Initial draw callback: starts the frame's samples-passed query (Readback ends it).
+struct FragmentQueryBegin : public osg::Camera::DrawCallback {
+    const Readback* readback = nullptr;
+    void operator()(osg::RenderInfo& info) const override {
+        if (!readback->countFragments) return;
+        const osg::GLExtensions* ext = info.getState()->get<osg::GLExtensions>();
+        if (!ext->glGenQueries || !ext->glBeginQuery || !ext->glGetQueryObjectui64v) return;
+        if (!readback->query) ext->glGenQueries(1, &readback->query);
+        ext->glBeginQuery(GL_SAMPLES_PASSED_ARB, readback->query);
+        readback->queryOpen = true;
     }
 };
 
@@ -320,6 +348,9 @@ Result<std::unique_ptr<OffscreenRenderer>> OffscreenRenderer::create(int width, 
     m.readback->width = width;
     m.readback->height = height;
     cam->setFinalDrawCallback(m.readback.get());
+    osg::ref_ptr<FragmentQueryBegin> begin = new FragmentQueryBegin;
+    begin->readback = m.readback.get();
+    cam->setInitialDrawCallback(begin.get());
 
     m.sky = std::make_unique<SkyBackground>(width, height);
 
@@ -344,10 +375,22 @@ Status OffscreenRenderer::render(osg::Node* scene, const Camera& camera, double 
     m.sky->node()->setNodeMask(skyLayer ? ~0u : 0u);
     if (skyLayer) m.sky->showSky(camera, m.jx, m.jy);
     const double skyMs = sw.ms();
+    m.readback->fragments = 0;
     Status s = m.draw(scene, camera, zFar, color, depth, stats);
     stats.frameMs += skyMs;
+    if (s.isOk() && m.readback->countFragments) {
+        // The sky layer (no depth test) passes one sample per pixel: not the scene's.
+        const uint64_t sky = skyLayer ? uint64_t(m.width) * uint64_t(m.height) : 0;
+        const uint64_t f = m.readback->fragments > sky ? m.readback->fragments - sky : 0;
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "fragments: %llu (%.3f per pixel)", static_cast<unsigned long long>(f),
+                      double(f) / (double(m.width) * double(m.height)));
+        stats.notes.push_back(buf);
+    }
     return s;
 }
+
+void OffscreenRenderer::setCountFragments(bool on) { _impl->readback->countFragments = on; }
 
 void OffscreenRenderer::setOverlay(osg::Node* colour, osg::Node* labels) {
     _impl->overlay = colour;

@@ -98,6 +98,11 @@ public:
     // scene, far plane at fx.hazeFar()) and the night sky (effects_state.h);
     // hazeInRaster = false: far plane only, the caller hazes the pixels.
     void setEffects(const FrameEffects& fx, bool hazeInRaster = true);
+    // Counts the fragments of the following render()s that pass the depth
+    // test (a GL_SAMPLES_PASSED query around the frame; the sky layer's one
+    // per pixel left out) and notes them in the frame's stats:
+    // "fragments: N (F per pixel)". Off by default (the query costs time).
+    void setCountFragments(bool on);
     // GL_RENDERER / GL_VERSION strings of the context (for result files).
     std::string glRenderer() const;
 

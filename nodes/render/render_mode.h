@@ -54,6 +54,8 @@ class TrafficScene;
 // The near distance of modes that need one when --near is auto (only hybrid
 // chooses per frame).
 constexpr double kDefaultNearDistance = 100.0;
+// The default screen-space error bound of hybrid's flattened near-field chunks (pixels).
+constexpr double kDefaultNearDetailPx = 0.0;
 
 struct ModeOptions {
     double nearDistance = kDefaultNearDistance;  // metres, 1 .. 100000; < 0 = auto (hybrid: adaptive split)
@@ -72,6 +74,12 @@ struct ModeOptions {
     double frameMsTarget =
         0.0;          // hybrid: > 0 = the ray budget adapts so the frame takes about this long (ms), 0 .. 10000
     int farStep = 1;  // hybrid: far-field ray spacing, 1 (a ray per pixel) or 2 (FarFieldOptions::rayStep)
+    // hybrid: the near field's chunks drawn nearest first (early depth rejection of hidden fragments).
+    bool nearFrontToBack = true;
+    // hybrid: a near-field chunk is drawn as its flattened twin (window recesses flat,
+    // NearFieldScene::coarseChunks) where the twin deviates from it by at most this many
+    // pixels on screen (screenDeviationPx), 0 .. 100; 0 = off (no twins built).
+    double nearDetailPx = kDefaultNearDetailPx;
     int threads = 0;  // ray-casting threads; 0 = all cores
     double splatSigma =
         kDefaultSplatSigma;     // impostor: splat Gaussian sigma in output pixels (PointImpostor), 0 = 1-pixel points
