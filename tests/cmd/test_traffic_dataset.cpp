@@ -35,6 +35,7 @@
 #include "runtime/scene/paths.h"
 #include "runtime/traffic/agent_models.h"
 #include "runtime/traffic/traffic_tracks.h"
+#include "tests/common/busy_ride.h"
 #include "tests/common/npy.h"
 #include "tests/common/run_vista.h"
 #include "tests/common/sumo_city.h"
@@ -83,7 +84,10 @@ const Fixture& fixture() {
         r = runVista("traffic " + f.city + " --vehicles 300 --pedestrians 30 --duration 120 --seed 4 -q -o " +
                      f.traffic);
         EXPECT_EQ(r.code, 0) << r.err;
-        r = runVista("path " + f.city + " --traffic " + f.traffic + " --seed 3 --duration 10 --dt 0.1 -o " + f.path);
+        const std::string ride = test::busiestRide(f.traffic, 10.0);
+        EXPECT_FALSE(ride.empty()) << "no car of the traffic rides for 10 s";
+        r = runVista("path " + f.city + " --traffic " + f.traffic + " --ego " + ride + " --duration 10 --dt 0.1 -o " +
+                     f.path);
         EXPECT_EQ(r.code, 0) << r.err;
         r = runVista("render " + f.city + " --path " + f.path + " --rig " + f.rig + " --traffic " + f.traffic +
                      " --frames " + std::to_string(kFrames) + " --sampling consecutive -q --out " + f.out);

@@ -34,6 +34,7 @@
 #include "runtime/traffic/agent_models.h"
 #include "runtime/traffic/signal_states.h"
 #include "runtime/traffic/traffic_tracks.h"
+#include "tests/common/busy_ride.h"
 #include "tests/common/npy.h"
 #include "tests/common/run_vista.h"
 #include "tests/common/sumo_city.h"
@@ -67,7 +68,9 @@ const Fixture& fixture() {
         r = runVista("traffic " + f.city + " --vehicles 60 --pedestrians 60 --duration 120 --seed 4 -q -o " +
                      f.traffic);
         EXPECT_EQ(r.code, 0) << r.err;
-        r = runVista("path " + f.city + " --traffic " + f.traffic + " --duration 40 -o " + f.path);
+        const std::string ride = test::busiestRide(f.traffic, 40.0);
+        EXPECT_FALSE(ride.empty()) << "no car of the traffic rides for 40 s";
+        r = runVista("path " + f.city + " --traffic " + f.traffic + " --ego " + ride + " --duration 40 -o " + f.path);
         EXPECT_EQ(r.code, 0) << r.err;
         const size_t at = r.err.find("riding ");
         if (at != std::string::npos) f.ego = r.err.substr(at + 7, r.err.find(')', at) - at - 7);

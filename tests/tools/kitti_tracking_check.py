@@ -36,6 +36,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import xml.etree.ElementTree as ET
 
 TYPES = {"Car", "Van", "Truck", "Bus", "Pedestrian", "Person_sitting", "Cyclist", "Tram", "Misc", "DontCare"}
 KIND_VEHICLE, KIND_PEDESTRIAN = 11, 12
@@ -206,6 +207,25 @@ def check_run(run, min_frames):
     return 1 if fails.items else 0
 
 
+def busiest_ride(fcd, seconds, radius=60.0):
+    """The car (type "car" in SUMO's FCD) present for at least `seconds` from its first sample
+    with the most other agents within `radius` metres over those seconds (ties by id): a ride
+    that sees traffic, whatever the demand's mix. None when no car qualifies."""
+    first, last, company = {}, {}, {}
+    for step in ET.parse(fcd).getroot():
+        t = float(step.get("time"))
+        agents = [(a.get("id"), a.get("type"), float(a.get("x")), float(a.get("y"))) for a in step]
+        for aid, kind, x, y in agents:
+            first.setdefault(aid, t)
+            last[aid] = t
+            if kind != "car" or t > first[aid] + seconds:
+                continue
+            company[aid] = company.get(aid, 0) + sum(
+                1 for bid, _, bx, by in agents if bid != aid and math.hypot(bx - x, by - y) < radius)
+    rides = [a for a in company if last[a] - first[a] >= seconds]
+    return min(rides, key=lambda a: (-company[a], a)) if rides else None
+
+
 def render(vista, d, frames, seed):
     def run(*args):
         r = subprocess.run([vista, *map(str, args)], capture_output=True, text=True)
@@ -216,7 +236,14 @@ def render(vista, d, frames, seed):
         json.dump(RIG, f)
     run("gen", "--size", 700, "--detail", 0, "--seed", 5, "-q", "-o", city)
     run("traffic", city, "--vehicles", 300, "--pedestrians", 30, "--duration", 120, "--seed", 4, "-q", "-o", traffic)
-    run("path", city, "--traffic", traffic, "--seed", seed, "--duration", frames / 10 + 1, "--dt", 0.1, "-o", path)
+    if seed is None:
+        ride = busiest_ride(os.path.join(traffic, "fcd.xml"), frames / 10 + 1)
+        if ride is None:
+            raise SystemExit(f"no car of the traffic rides for {frames / 10 + 1} s")
+        seed_or_ego = ["--ego", ride]
+    else:
+        seed_or_ego = ["--seed", seed]
+    run("path", city, "--traffic", traffic, *seed_or_ego, "--duration", frames / 10 + 1, "--dt", 0.1, "-o", path)
     run("render", city, "--path", path, "--rig", rig, "--traffic", traffic, "--frames", frames,
         "--sampling", "consecutive", "-q", "--out", out)
     return out
@@ -228,7 +255,7 @@ def main():
     ap.add_argument("--run", help="check an existing rig run with traffic")
     ap.add_argument("--min-frames", type=int, default=50, help="consecutive frames a vehicle must be followed over")
     ap.add_argument("--frames", type=int, default=60, help="with --vista: frames rendered (10 Hz)")
-    ap.add_argument("--seed", type=int, default=3, help="with --vista: picks the car the path rides (3: one that follows other cars for over 5 s)")
+    ap.add_argument("--seed", type=int, help="with --vista: picks the car the path rides (default: the car with the most agents around it)")
     a = ap.parse_args()
     if a.run:
         return check_run(a.run, a.min_frames)
