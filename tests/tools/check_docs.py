@@ -85,7 +85,6 @@ AWAITING_REGENERATION = {
     ("docs/measurements/paging.md", "stream-table"): _QUIET,
     ("docs/measurements/paging.md", "stream-budget"): _QUIET,
     ("docs/measurements/paging.md", "paged-reach"): "empty: needs the 8 km paged city of the scale step",
-    ("docs/measurements/traffic.md", "traffic"): _QUIET,
 }
 
 # Internal notes a reader should not see: (regex, scope, why). Scope "all" is
