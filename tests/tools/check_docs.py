@@ -75,8 +75,6 @@ AWAITING_REGENERATION = {
     ("docs/measurements/effects.md", "effects-haze"): _QUIET,
     ("docs/measurements/far-field.md", "far-field-table"): _QUIET,
     ("docs/measurements/farfield-compare.md", "farfield-compare"): _QUIET,
-    ("docs/measurements/modes.md", "near-detail"): "empty: the near field's reductions were never timed on a "
-                                                   "quiet machine; about 40 minutes",
     ("docs/measurements/modes.md", "modes-sweep"): "empty: the sweep's tables were printed, never written to the page",
     ("docs/measurements/bake.md", "table-5-1"): "empty: Table 5.1 was printed, never written to the page",
     ("docs/measurements/paging.md", "paged-generation"): _QUIET,
