@@ -236,6 +236,12 @@ TEST_F(PagedStream, FramesBelowTheAskedDetailAreCounted) {
     ASSERT_EQ(r.code, 0) << r.err;
     const auto w = readJson(tmp.file("w/summary.json"))["paged"]["stream"];
     EXPECT_EQ(w["frames_below_detail"].get<int>(), 0) << w.dump();
+#if defined(__SANITIZE_ADDRESS__)
+    // The rest sets a budget 700 MB above the regions' room, the process's own memory a normal
+    // build stays under; AddressSanitizer's shadow memory and quarantine put a sanitized
+    // process above it, so that budget could not hold even the coarse levels.
+    GTEST_SKIP() << "the tight-budget half needs a process under 700 MB of its own, which a sanitized one is not";
+#endif
     // A budget that holds the coarse levels at the camera but no full region: every frame is below.
     auto manifest = vista::readPagedManifest(dir());
     ASSERT_TRUE(manifest.isOk()) << manifest.status().message();
@@ -270,6 +276,12 @@ TEST_F(PagedStream, ABudgetThatCannotHoldTheRegionsAtTheCameraExitsTwo) {
     }
     EXPECT_FALSE(fs::exists(tmp.file("b/summary.json")));
     EXPECT_FALSE(fs::exists(tmp.file("r")));
+#if defined(__SANITIZE_ADDRESS__)
+    // The figure the message names is one measurement of the process's own memory; a sanitized
+    // process's own memory is above the 700 MB a normal build is held to and varies from run to
+    // run by more than the regions' room, so the next run may need more than it named.
+    GTEST_SKIP() << "a sanitized process's own memory varies by more than the regions' room";
+#endif
     // The budget the message names holds them.
     CliRun r = runVista("bench " + dir() + run + " --modes raycast --memory-budget " + gb + " --out " + tmp.file("b"));
     std::smatch m;

@@ -486,6 +486,13 @@ TEST_F(PagedLoad, AStreamedBenchLoadsAndUnloadsAlongThePath) {
     EXPECT_LE(with["frame_ms_p99"].get<double>(), with["frame_ms_max"].get<double>());
     EXPECT_LE(m["frame_ms_p99"].get<double>(), m["frame_ms_max"].get<double>());
     EXPECT_GE(w["advance_ms_max"].get<double>(), w["advance_ms_median"].get<double>());
+#if defined(__SANITIZE_ADDRESS__)
+    // The rest sets a budget 700 MB above the regions' room, the process's own memory a normal
+    // build stays under. AddressSanitizer's shadow memory and quarantine of freed blocks put a
+    // sanitized process's own resident set above that (about 0.7 GB with nothing loaded), so the
+    // budget could not hold even the coarse levels and the run rightly refuses it.
+    GTEST_SKIP() << "the tight-budget half needs a process under 700 MB of its own, which a sanitized one is not";
+#endif
     // A budget that holds no full region: what is left after the run's own 700 MB is the room
     // held back for a load being prepared (as summary.json gives it) and 0.8 of the smallest full
     // region's estimate (its file bytes times the stream's weight for a full level): the coarse
