@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "foundation/status.h"
 #include "foundation/units.h"
@@ -305,12 +306,14 @@ struct Projector {
     CameraModel m;
     double zNear;
     double thetaMax;  // fisheye: the image circle's half angle
+    double cosMax;    // its cosine
     explicit Projector(const BoxCamera& c)
         : eye(c.eye),
           toCam(glm::transpose(c.axes)),
           m(c.model),
           zNear(c.zNear),
-          thetaMax(std::min(kPi, 0.5 * c.model.maxFovDeg * kPi / 180.0)) {
+          thetaMax(std::min(kPi, 0.5 * c.model.maxFovDeg * kPi / 180.0)),
+          cosMax(std::cos(thetaMax)) {
         VISTA_CHECK(m.fisheye() || zNear > 0.0);
     }
     glm::dvec3 toCamera(const glm::dvec3& w) const { return toCam * (w - eye); }
@@ -323,8 +326,19 @@ struct Projector {
         p.z = zNear;
         return p;
     }
-    // Fisheye: true when the direction of p lies within the image circle's cone.
+    // Fisheye: true when the direction of p lies within the image circle's
+    // cone, atan2(|p.xy|, p.z) <= thetaMax. Where the cosine of p's angle to
+    // the axis lies more than 1e-12 from cosMax it decides (an angle differs
+    // from thetaMax by at least as much as its cosine from cosMax, and both
+    // sides round by some 1e-16), without the arc tangent; the answer is the
+    // same.
     bool inCone(const glm::dvec3& p) const {
+        const double l2 = p.x * p.x + p.y * p.y + p.z * p.z;
+        if (l2 > 1e-200 && l2 < 1e200) {
+            const double c = p.z / std::sqrt(l2);
+            if (c > cosMax + 1e-12) return true;
+            if (c < cosMax - 1e-12) return false;
+        }
         const double rho = std::hypot(p.x, p.y);
         return (rho > 0.0 || p.z > 0.0) && std::atan2(rho, p.z) <= thetaMax;
     }
@@ -391,10 +405,12 @@ bool segmentCap(const glm::dvec3& a, const glm::dvec3& b, glm::dvec3& c, double&
 
 // The fisheye image of segment a-b within the cone, sampled at most about 1
 // px apart. With `known` (an extent the result is merged into): a run of
-// kEdgeRun samples whose segment's cap lies wholly inside the cone and whose
-// image (fisheyeCapBound) lies within `known` and the extent so far cannot
-// widen the merged extent and is not sampled; `skipped` is then set.
-constexpr int kEdgeRun = 32;
+// kEdgeRun samples (or the last kMinRun or more of the edge) whose segment's
+// cap lies wholly inside the cone and whose image (fisheyeCapBound) lies
+// within `known` and the extent so far cannot widen the merged extent and is
+// not sampled; `skipped` is then set. A run that fails the test is sampled
+// and not tested again.
+constexpr int kEdgeRun = 32, kMinRun = 4;
 void fisheyeEdge(const Projector& pr, const glm::dvec3& a, const glm::dvec3& b, PixelBox& out,
                  const PixelBox* known = nullptr, bool* skipped = nullptr) {
     const double la = glm::length(a), lb = glm::length(b);
@@ -404,10 +420,12 @@ void fisheyeEdge(const Projector& pr, const glm::dvec3& a, const glm::dvec3& b, 
     glm::dvec2 uv;
     bool prevIn = pr.conePixel(a, uv);
     if (prevIn) extend(out, uv);
+    int nextTest = 1;  // the first sample of the next run to test
     for (int k = 1; k <= n; ++k) {
-        if (known && prevIn && k + kEdgeRun - 1 <= n) {
-            // Samples k .. k + kEdgeRun - 1 lie on the segment from prev (inside the cone) to the run's last.
-            const int last = k + kEdgeRun - 1;
+        if (known && prevIn && k >= nextTest && n - k + 1 >= kMinRun) {
+            // Samples k .. last lie on the segment from prev (inside the cone) to the run's last.
+            const int last = std::min(n, k + kEdgeRun - 1);
+            nextTest = last + 1;
             const glm::dvec3 q = a + (double(last) / n) * (b - a);
             glm::dvec3 c;
             double r;
@@ -451,7 +469,7 @@ bool rayThroughTriangle(const glm::dvec3& d, const glm::dvec3* p) { return RayTr
 // around the unit vector c with half angle r (r < pi/2): the cap's points
 // have theta in [theta_c - r, theta_c + r] (clamped to [0, thetaMax]) and,
 // when the cap holds neither pole, an azimuth within h of c's azimuth phi,
-// sin h = sin r / sin theta_c; u - cx = fx theta cos(phi) and v - cy = fy
+// sin h = sin r / sin theta_c (r in place of sin r, which is no larger); u - cx = fx theta cos(phi) and v - cy = fy
 // theta sin(phi) over that polar rectangle take their extremes at its
 // corners (theta >= 0), the cosine and sine ranges including their extremes
 // inside the azimuth interval (azimuth x lies within h of phi when cos(x -
@@ -467,7 +485,7 @@ PixelBox fisheyeCapBound(const Projector& pr, const glm::dvec3& c, double r) {
     double cLo = -1, cHi = 1, sLo = -1, sHi = 1;
     if (lo > 0.0 && thetaC + r < kPi && rhoC > 0.0) {
         constexpr double kEps = 1e-9;
-        const double sinH = std::sin(r) / rhoC;
+        const double sinH = r / rhoC;  // r >= sin r: a wider interval, never a narrower one
         if (sinH < 1.0 - 1e-6) {
             const double cosH = std::sqrt(1.0 - sinH * sinH), cp = c.x / rhoC, sp = c.y / rhoC;
             const double ca = cp * cosH + sp * sinH, sa = sp * cosH - cp * sinH;  // azimuth phi - h
@@ -851,7 +869,11 @@ std::vector<FrameBox> frameBoxes(const SceneModel& city, const CityBoxes& boxes,
     std::vector<const InstanceBox*> src;
     std::vector<const MovingObject*> moving;
     std::vector<VisibleStats> stats;
-    inArena(options.threads, [&] { stats = visibleStats(ids, W, H); });
+    // Isolated: a rig run boxes one camera while the next one casts in the
+    // same arena, and a thread waiting here for the boxes' tasks takes none of
+    // the caller's other work, so the boxes end when their own work does.
+    auto isolated = [&](const auto& body) { inArena(options.threads, [&] { tbb::this_task_arena::isolate(body); }); };
+    isolated([&] { stats = visibleStats(ids, W, H); });
     for (const VisibleStats& s : stats) {
         if (s.count < options.minPixels) continue;
         const InstanceBox* ib = boxes.find(s.id);
@@ -879,8 +901,27 @@ std::vector<FrameBox> frameBoxes(const SceneModel& city, const CityBoxes& boxes,
     blank.pixels.assign(size_t(W) * size_t(H), 0xFFFFFFFFu);
     if (rays) blank.tiles.assign(size_t(rays->tilesX()) * size_t(rays->tilesY()), 0xFFFFFFFFu);
     tbb::enumerable_thread_specific<MaskStamps> stamps(blank);
-    inArena(options.threads, [&] {
-        tbb::parallel_for(size_t(0), out.size(), [&](size_t i) {
+    // The instances with the most triangles first, so that the workers end together.
+    std::vector<size_t> order(out.size());
+    std::vector<size_t> weight(out.size());
+    for (size_t i = 0; i < out.size(); ++i) {
+        order[i] = i;
+        if (const InstanceBox* ib = src[i]) {
+            weight[i] = ib->triangleCount;
+            for (uint32_t t : ib->trees)
+                if (city.instances[t].prototype < city.prototypes.size())
+                    weight[i] += city.prototypes[city.instances[t].prototype].indices.size() / 3;
+            for (uint32_t t : ib->impostors)
+                if (city.impostors[t].prototype < city.prototypes.size())
+                    weight[i] += city.prototypes[city.impostors[t].prototype].indices.size() / 3;
+        } else if (moving[i]->mesh) {
+            weight[i] = moving[i]->mesh->indices.size() / 3;
+        }
+    }
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return weight[a] > weight[b]; });
+    isolated([&] {
+        tbb::parallel_for(size_t(0), out.size(), [&](size_t j) {
+            const size_t i = order[j];
             FrameBox& f = out[i];
             MaskRaster r(pr, rays, W, H, stamps.local(), uint32_t(i));
             if (pr.m.fisheye() && src[i]) {  // the vertices of every kSeedStride-th triangle first

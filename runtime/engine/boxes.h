@@ -75,8 +75,11 @@
 // extent so far change nothing): a triangle whose conservative bound (the
 // image of a cap around its directions, computed without sampling) lies
 // within the extent of the instance's triangles so far is not sampled, and
-// a run of 32 samples of an edge whose cap lies inside the cone and whose
-// image lies within the extent so far is not sampled; the extent starts
+// a run of up to 32 samples of an edge (at least 4: the edge's last ones)
+// whose cap lies inside the cone and whose image lies within the extent so
+// far is not sampled (a run that fails the test is sampled and not tested
+// again); the cone test decides by cosines where they differ by far more
+// than rounding, else by the angle; the extent starts
 // from the in-cone vertices of every fourth triangle (each vertex is its
 // edge's first sample). The fisheye mask
 // tests each pixel centre of a front-facing triangle's extent (or that
@@ -98,8 +101,11 @@
 // Thread safety: pure functions on const inputs; CityBoxes is immutable
 // after build and may be shared. Parallel over `threads` workers (0 = all):
 // frameBoxes counts the instance image's pixels in bands of rows and
-// rasterises the instances in parallel; the results do not depend on the
-// thread count. Contract violations
+// rasterises the instances in parallel (those with the most triangles
+// first), isolated (tbb::this_task_arena::isolate): a thread waiting for
+// these tasks runs none of the caller's other work, such as the next
+// camera's casting in a rig run; the results do not depend on the thread
+// count. Contract violations
 // (an instance image whose size differs from the camera's, a pinhole
 // zNear <= 0) are VISTA_CHECKs.
 #pragma once
