@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
-"""Writes short_arm_slight_bend.osm: a crossing of two secondary streets (13 m carriageways) whose north
-arm is two ways meeting end to end 18 m from the crossing, the second turning 3 degrees east, for the tests
-that such a node is dropped (citygen/short_bends.h): the arm is one straight road from the
-crossing, no transition 18 m from it that the junction's footprint would reach over.
+"""Writes short_arm_slight_bend.osm: a crossing of two secondary streets (13 m carriageways)
+whose north arm is two ways meeting end to end 18 m from the crossing, the second turning 3
+degrees east, for the tests that such a node is dropped (citygen/short_bends.h): the arm is one
+straight road from the crossing, no transition 18 m from it that the junction's footprint would
+reach over.
 
 Layout (metres east / north of the centre):
   y = 0      x -100 .. 100: secondary (one way through the crossing at the origin)
