@@ -36,6 +36,8 @@
 #include "citygen/footprint_repair.h"
 #include "citygen/osm_road_tags.h"
 #include "citygen/polygon.h"
+#include "citygen/short_bends.h"
+#include "citygen/side_by_side.h"
 #include "citygen/street_geometry.h"
 #include "citygen/streets.h"
 #include "foundation/hash.h"
@@ -1211,6 +1213,8 @@ Status buildStreets(const std::vector<Way>& kept, const WayCollector& collector,
     const double minSeg = std::isfinite(params.min_segment_m) ? std::max(params.min_segment_m, 0.0) : 0.0;
     assignRoadTags(out.streets, carriageways, kept, collector.roadTags, snap + minSeg + 1.0, snap + 1.0,
                    out.roadTagStats);
+    straightenShortBends(out.streets);
+    narrowSideBySide(out.streets);
     return Status::ok();
 }
 

@@ -47,6 +47,14 @@
 //    lanes are forward lanes, right lanes in OpenDRIVE) and, without a width
 //    tag, is as wide as its lanes at the class's lane width (roadWidth /
 //    roadLanes).
+// 7. Slight bends next to a junction (short_bends.h): a degree-2 node on a
+//    junction arm of at most kShortBendArm where the same road turns by at
+//    most kShortBendAngle is dropped when the straight edge passes within
+//    kShortBendDeviation of it and of nodes dropped before.
+// 8. Side-by-side edges (side_by_side.h): nearly parallel edges sharing no
+//    node whose carriageways share area (a divided road's two one-way ways a
+//    few metres apart) are narrowed until they part, dropping lanes that
+//    would be narrower than kMinLaneWidth; one-way edges stay one-way.
 // Unreadable, corrupt, unsupported (DOCTYPE, UTF-16, other formats) or
 // road-less files return an error naming the file. Every drop is counted in
 // the result; dropSummary() words them ("" when nothing was dropped).

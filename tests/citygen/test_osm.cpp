@@ -22,6 +22,7 @@
 #include "citygen/geodesy.h"
 #include "citygen/osm_buildings.h"
 #include "citygen/polygon.h"
+#include "citygen/short_bends.h"
 #include "citygen/streets.h"
 #include "tests/common/temp_dir.h"
 #include "tests/citygen/osm_fixtures.h"
@@ -318,10 +319,16 @@ TEST(OsmImport, SimplificationKeepsJunctionsAndShape) {
         if (glm::length(n - centre) > 200) { EXPECT_NEAR(glm::length(n - centre), 300.0, 0.05); }
     }
     EXPECT_TRUE(junctionFound);
+    // Edge midpoints stay within the tolerance too; an arm of the junction may run straight
+    // over a slight bend next to it, within kShortBendDeviation of the nodes it drops
+    // (short_bends.h), which lie on the circle.
     for (size_t e = 0; e < r->streets.edges.size(); ++e) {
-        const glm::dvec2 mid =
-            0.5 * (r->streets.nodes[r->streets.edges[e].a] + r->streets.nodes[r->streets.edges[e].b]);
-        if (glm::length(mid - centre) > 200) { EXPECT_GT(glm::length(mid - centre), 300.0 - 0.6); }
+        const StreetEdge& E = r->streets.edges[e];
+        const glm::dvec2 mid = 0.5 * (r->streets.nodes[E.a] + r->streets.nodes[E.b]);
+        const bool arm = glm::length(r->streets.nodes[E.a] - junction) < 0.01 ||
+                         glm::length(r->streets.nodes[E.b] - junction) < 0.01;
+        const double tolerance = arm ? kShortBendDeviation + 0.05 : 0.6;
+        if (glm::length(mid - centre) > 200) { EXPECT_GT(glm::length(mid - centre), 300.0 - tolerance); }
     }
 }
 

@@ -513,10 +513,11 @@ TEST(OsmRoadTags, OppositeOneWaysOnTheSameLineGiveOneDirectionEach) {
 }
 
 TEST(OsmRoadTags, ShortEdgeAtAJunctionKeepsItsOwnWayNotTheCrossingOne) {
-    // One-way A runs east through a junction, bending 15 m after it; one-way B crosses at the
-    // junction at 63 degrees, its part near that 15 m piece running the other way along x.
+    // One-way A runs east through a junction, bending by 13 degrees 15 m after it (too much for
+    // the bend to be straightened, short_bends.h); one-way B crosses at the junction at 63
+    // degrees, its part near that 15 m piece running the other way along x.
     auto imp = importText(osmText(
-        {{-100, 0}, {0, 0}, {15, 0}, {100, 10}, {40, -80}, {-40, 80}},
+        {{-100, 0}, {0, 0}, {15, 0}, {100, 20}, {40, -80}, {-40, 80}},
         {{{1, 2, 3, 4}, R"(<tag k="highway" v="residential"/><tag k="oneway" v="yes"/><tag k="maxspeed" v="30"/>)"},
          {{5, 2, 6}, R"(<tag k="highway" v="residential"/><tag k="oneway" v="yes"/><tag k="lanes" v="2"/>)"}}));
     ASSERT_TRUE(imp.isOk()) << imp.status().message();
