@@ -14,6 +14,7 @@
 #include "foundation/atomic_file.h"
 #include "foundation/hash.h"
 #include "foundation/format.h"
+#include "runtime/traffic/junction_conflicts.h"
 #include "runtime/traffic/junction_lanes.h"
 #include "runtime/traffic/junction_turns.h"
 #include "runtime/traffic/sumo_net.h"
@@ -227,6 +228,18 @@ Status runAll(const std::string& xodrText, const TrafficOptions& opt, const std:
     auto closed = restrictTightTurns((w / "city.net.xml").string(), turnClasses);
     if (!closed) return closed.status();
     for (size_t i = 0; i < turnClasses.size(); ++i) sum.turnsClosed.push_back({turnClasses[i].sumoClass, (*closed)[i]});
+    // A vehicle counts as past a crossing only once its body has left the
+    // crossing lane's vehicles, also where the lanes cross at a slant
+    // (junction_conflicts.h).
+    std::vector<ConflictClass> conflictClasses;
+    for (int t = 0; t < kAgentTypeCount; ++t)
+        if (AgentType(t) != AgentType::Pedestrian) {
+            const AgentTypeInfo& info = agentTypeInfo(AgentType(t));
+            conflictClasses.push_back({info.sumoClass, info.length, info.width});
+        }
+    auto widened = widenConflictLanes((w / "city.net.xml").string(), conflictClasses);
+    if (!widened) return widened.status();
+    sum.conflictLanesWidened = *widened;
     progress.end();
 
     progress.begin("traffic: demand");
@@ -275,6 +288,7 @@ Status runAll(const std::string& xodrText, const TrafficOptions& opt, const std:
     nlohmann::ordered_json turns;
     for (const auto& [cls, n] : sum.turnsClosed) turns[cls] = n;
     j["junction_turns_closed"] = turns;
+    j["junction_lanes_widened"] = sum.conflictLanesWidened;
     j["sumo"] = {{"vehicles_inserted", sum.vehiclesInserted},
                  {"persons_loaded", sum.personsInserted},
                  {"collisions", sum.collisions},
