@@ -126,8 +126,8 @@ bool permits(const std::vector<std::string>& allow, bool hasAllow, const std::ve
 
 struct InternalLane {
     Line line{{}};
-    double width = 3.2;         // SUMO's default lane width
-    double lengthFactor = 1.0;  // the lane's length over its shape's length
+    double width = 3.2;           // SUMO's default lane width
+    double lengthFactor = 1.0;    // the lane's length over its shape's length
     std::vector<size_t> classes;  // indices into the classes it allows
 };
 
@@ -137,6 +137,8 @@ struct JunctionReader {
     XML_Parser parser = nullptr;
     std::vector<std::pair<std::string, std::string>> pairs;
     std::vector<std::string> intLanes;  // of the <junction> being read
+    std::vector<Polyline2> crossings;   // the pedestrian crossings' lane shapes
+    bool inCrossing = false;            // inside an <edge function="crossing">
     bool sawRoot = false;
     std::string error;
 
@@ -154,7 +156,13 @@ struct JunctionReader {
             }
             return;
         }
-        if (std::strcmp(name, "junction") == 0) {
+        if (std::strcmp(name, "edge") == 0) {
+            const char* function = attr(atts, "function");
+            inCrossing = function && std::strcmp(function, "crossing") == 0;
+        } else if (std::strcmp(name, "lane") == 0 && inCrossing) {
+            if (const char* shape = attr(atts, "shape")) crossings.push_back(parseShape(shape));
+        } else if (std::strcmp(name, "junction") == 0) {
+            inCrossing = false;
             intLanes = words(attr(atts, "intLanes"));
             const char* type = attr(atts, "type");
             if (type && std::strcmp(type, "internal") == 0) {
@@ -177,21 +185,20 @@ struct JunctionReader {
     }
 };
 
-Result<std::vector<std::pair<std::string, std::string>>> readFoePairs(const std::string& netPath,
-                                                                      const std::string& text) {
+Result<JunctionReader> readJunctions(const std::string& netPath, const std::string& text) {
     JunctionReader r;
     r.parser = XML_ParserCreate(nullptr);
     std::unique_ptr<XML_ParserStruct, void (*)(XML_Parser)> guard(r.parser, &XML_ParserFree);
     XML_SetUserData(r.parser, &r);
-    XML_SetStartElementHandler(r.parser, [](void* u, const XML_Char* n, const XML_Char** a) {
-        static_cast<JunctionReader*>(u)->start(n, a);
-    });
+    XML_SetStartElementHandler(
+        r.parser, [](void* u, const XML_Char* n, const XML_Char** a) { static_cast<JunctionReader*>(u)->start(n, a); });
     if (XML_Parse(r.parser, text.data(), int(text.size()), 1) == XML_STATUS_ERROR || !r.error.empty()) {
         const std::string why = r.error.empty() ? XML_ErrorString(XML_GetErrorCode(r.parser)) : r.error;
         return Status::error("SUMO network '" + netPath + "', line " +
                              std::to_string(XML_GetCurrentLineNumber(r.parser)) + ": " + why);
     }
-    return std::move(r.pairs);
+    r.parser = nullptr;
+    return r;
 }
 
 bool samePoint(const Point& a, const Point& b) { return std::hypot(a.first - b.first, a.second - b.second) < 0.1; }
@@ -264,17 +271,18 @@ Result<size_t> widenConflictLanes(const std::string& netPath, const std::vector<
         return true;
     });
     if (!net) return net.status();
-    auto pairs = readFoePairs(netPath, net->text);
-    if (!pairs) return pairs.status();
+    auto junctions = readJunctions(netPath, net->text);
+    if (!junctions) return junctions.status();
 
     std::vector<double> widths(lanes.size());
     for (size_t i = 0; i < lanes.size(); ++i) widths[i] = lanes[i].width;
-    for (const auto& [egoId, foeId] : *pairs) {
+    for (const auto& [egoId, foeId] : junctions->pairs) {
         auto ei = index.find(egoId), fi = index.find(foeId);
         if (ei == index.end() || fi == index.end()) continue;
         const InternalLane &ego = lanes[ei->second], &foe = lanes[fi->second];
         if (ego.line.pts.size() < 2 || foe.line.pts.size() < 2 || ego.classes.empty()) continue;
-        if (samePoint(ego.line.pts.front(), foe.line.pts.front()) || samePoint(ego.line.pts.back(), foe.line.pts.back()))
+        if (samePoint(ego.line.pts.front(), foe.line.pts.front()) ||
+            samePoint(ego.line.pts.back(), foe.line.pts.back()))
             continue;
         double egoWidth = 0.0;
         for (size_t c : ego.classes) egoWidth = std::max(egoWidth, classes[c].widthM);
@@ -291,12 +299,20 @@ Result<size_t> widenConflictLanes(const std::string& netPath, const std::vector<
     std::vector<bool> changed(lanes.size());
     for (size_t i = 0; i < lanes.size(); ++i) {
         widths[i] = std::ceil(widths[i] * 100.0 - 1e-6) / 100.0;
+        // SUMO places a vehicle lane on a pedestrian crossing at its
+        // crossing point less half its width, clamped to the crossing's
+        // start: kept within, pedestrians and vehicles see each other where
+        // they are, whatever the width.
+        for (const Polyline2& crossing : junctions->crossings) {
+            if (crossing.size() < 2 || lanes[i].line.pts.size() < 2) continue;
+            const double at = lastCrossingAlong(lanes[i].line, Line(crossing));
+            if (at >= 0.0) widths[i] = std::min(widths[i], std::floor(2.0 * at * 100.0) / 100.0);
+        }
         changed[i] = widths[i] > lanes[i].width + 1e-9;
         widened += changed[i] ? 1 : 0;
     }
-    VISTA_RETURN_IF_ERROR(rewriteLaneTags(netPath, *net, [&](size_t i, const std::string& tag) {
-        return changed[i] ? withWidth(tag, widths[i]) : tag;
-    }));
+    VISTA_RETURN_IF_ERROR(rewriteLaneTags(
+        netPath, *net, [&](size_t i, const std::string& tag) { return changed[i] ? withWidth(tag, widths[i]) : tag; }));
     return widened;
 }
 

@@ -39,7 +39,13 @@
 //   which SUMO's test (back past the crossing by half the width, positions
 //   scaled by the foe lane's length over its shape's length) holds only once
 //   the foe has cleared, when that exceeds its width, capped at
-//   kMaxConflictWidthM; the `width` value is replaced (or added, 2 decimals).
+//   kMaxConflictWidthM and at twice the distance from the start of each
+//   pedestrian crossing (<edge function="crossing">) the lane crosses to
+//   that crossing point (SUMO places a vehicle lane on a crossing at its
+//   crossing point less half its width, clamped to the crossing's start;
+//   within the cap, what pedestrians and vehicles see of each other does
+//   not depend on the width); a lane never narrows. The `width` value is
+//   replaced (or added, 2 decimals).
 //   Nothing else of the file changes (same bytes elsewhere), so the result
 //   is deterministic. Returns the number of lanes widened.
 // - The file is replaced atomically; a file that is not a SUMO network, is
