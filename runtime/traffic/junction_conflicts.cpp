@@ -301,12 +301,12 @@ Result<size_t> widenConflictLanes(const std::string& netPath, const std::vector<
         widths[i] = std::ceil(widths[i] * 100.0 - 1e-6) / 100.0;
         // SUMO places a vehicle lane on a pedestrian crossing at its
         // crossing point less half its width, clamped to the crossing's
-        // start, and shifts where vehicles and pedestrians look for each
-        // other by what the clamp cuts: kept within kCrossingShiftM.
+        // start: kept within, pedestrians and vehicles see each other where
+        // they are, whatever the width.
         for (const Polyline2& crossing : junctions->crossings) {
             if (crossing.size() < 2 || lanes[i].line.pts.size() < 2) continue;
             const double at = lastCrossingAlong(lanes[i].line, Line(crossing));
-            if (at >= 0.0) widths[i] = std::min(widths[i], std::floor(2.0 * (at + kCrossingShiftM) * 100.0) / 100.0);
+            if (at >= 0.0) widths[i] = std::min(widths[i], std::floor(2.0 * at * 100.0) / 100.0);
         }
         changed[i] = widths[i] > lanes[i].width + 1e-9;
         widened += changed[i] ? 1 : 0;

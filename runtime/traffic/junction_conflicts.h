@@ -39,15 +39,14 @@
 //   which SUMO's test (back past the crossing by half the width, positions
 //   scaled by the foe lane's length over its shape's length) holds only once
 //   the foe has cleared, when that exceeds its width, capped at
-//   kMaxConflictWidthM and at twice kCrossingShiftM more than the distance
-//   from the start of each pedestrian crossing (<edge function="crossing">)
-//   the lane crosses to that crossing point. SUMO places a vehicle lane on a
-//   crossing at its crossing point less half its width, clamped to the
-//   crossing's start, so where a vehicle looks for pedestrians and where
-//   pedestrians see it shift by what the clamp cuts; kCrossingShiftM is half
-//   SUMO's safety gap around a vehicle on a crossing (1 m), so the shifted
-//   footprint still covers the vehicle's body. A lane never narrows. The
-//   `width` value is replaced (or added, 2 decimals).
+//   kMaxConflictWidthM and at twice the distance from the start of each
+//   pedestrian crossing (<edge function="crossing">) the lane crosses to
+//   that crossing point. SUMO places a vehicle lane on a crossing at its
+//   crossing point less half its width, clamped to the crossing's start, so
+//   beyond the cap a vehicle would look for pedestrians (and pedestrians see
+//   it) away from where it is; within it, what they see of each other does
+//   not depend on the width. A lane never narrows. The `width` value is
+//   replaced (or added, 2 decimals).
 //   Nothing else of the file changes (same bytes elsewhere), so the result
 //   is deterministic. Returns the number of lanes widened.
 // - The file is replaced atomically; a file that is not a SUMO network, is
@@ -65,7 +64,6 @@ namespace vista {
 
 constexpr double kConflictStepM = 0.05;
 constexpr double kMaxConflictWidthM = 12.0;
-constexpr double kCrossingShiftM = 0.5;
 
 struct ConflictClass {
     std::string sumoClass;  // SUMO's vClass name ("passenger", ...)

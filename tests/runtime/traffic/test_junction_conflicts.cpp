@@ -94,8 +94,8 @@ namespace {
 // Junction J: the straight lane :J_0_0 along x, the lane :J_1_0 crossing it
 // at atan(3 / 4) (foes both ways; both 20 m long), and :J_2_0 starting where :J_0_0 starts
 // (one source: never widened by it). A crossing lane is listed as a foe too.
-// The pedestrian crossing :J_c1_0 meets :J_0_0 2.5 m from its start: :J_0_0
-// may grow to 2 (2.5 + kCrossingShiftM) = 6 m at most; :J_c0_0 meets both lanes over 11 m from its
+// The pedestrian crossing :J_c1_0 meets :J_0_0 3 m from its start: :J_0_0
+// may grow to 6 m at most; :J_c0_0 meets both lanes over 11 m from its
 // start.
 const char* kNet =
     "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
@@ -118,7 +118,7 @@ const char* kNet =
     "    </edge>\n"
     "    <edge id=\":J_c1\" function=\"crossing\" crossingEdges=\"b\">\n"
     "        <lane id=\":J_c1_0\" index=\"0\" allow=\"pedestrian\" length=\"6.00\" width=\"4.00\" "
-    "shape=\"19.00,-2.50 19.00,3.50\"/>\n"
+    "shape=\"19.00,-3.00 19.00,3.00\"/>\n"
     "    </edge>\n"
     "    <junction id=\"J\" type=\"priority\" x=\"0\" y=\"0\" incLanes=\"a_0\" "
     "intLanes=\":J_0_0 :J_1_0 :J_2_0 :J_c0_0\" shape=\"\">\n"
