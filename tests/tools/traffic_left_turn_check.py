@@ -201,11 +201,13 @@ def run_case(traci, net, case, workdir):
     try:
         traci.simulation.step()
         traci.vehicle.setMaxSpeed("A", 0.5)
+        traci.vehicle.setLaneChangeMode("A", 0)  # keeps the lane of its link
         target_back = case["cross"] + case["last"] - 0.45
         held = False
         collisions = 0
         b_near = False
         b_passed = False
+        b_on_e = False
         for _ in range(500):
             traci.simulation.step()
             collisions += traci.simulation.getCollidingVehiclesNumber()
@@ -218,16 +220,18 @@ def run_case(traci, net, case, workdir):
                     traci.vehicle.add("B", "rb", typeID="car", departLane=ce.get("fromLane"),
                                       departPos="%.2f" % max(0.0, case["len_from_e"] - 60.0), departSpeed="max")
                     traci.vehicle.setMaxSpeed("B", 4.0)
+                    traci.vehicle.setLaneChangeMode("B", 0)
             if "B" in ids:
                 lane = traci.vehicle.getLaneID("B")
                 if lane == case["e"] or (lane.startswith(ce.get("from") + "_")
                                          and case["len_from_e"] - traci.vehicle.getLanePosition("B") < 30.0):
                     b_near = True
+                b_on_e = b_on_e or lane == case["e"]
                 if lane.startswith(ce.get("to") + "_"):
                     b_passed = True
             if held and "A" in ids:
                 back = traci.vehicle.getLanePosition("A") - CAR_LENGTH
-        return dict(held=held, back=back if held else None, collisions=collisions, b_near=b_near, b_passed=b_passed)
+        return dict(held=held, back=back if held else None, collisions=collisions, b_near=b_near, b_passed=b_passed and b_on_e)
     finally:
         traci.close()
 
@@ -284,7 +288,7 @@ def main():
                 failures += 0 if ok else 1
             state = ("ok  " if ok else "FAIL") if c["covered"] else "not covered:"
             print("%s %s (turn) against %s (straight, %.2f m wide): crossing at %.1f deg, body over the lane until"
-                  " %.2f m past the crossing; A held with its back %s m past; B near: %s, passed: %s; collisions: %d"
+                  " %.2f m past the crossing; A held with its back %s m past; B near: %s, passed it: %s; collisions: %d"
                   % (state, c["f"], c["e"], 2 * c["half"], c["angle"], c["last"],
                      "%.2f" % (r["back"] - c["cross"]) if r["back"] is not None else "-", r["b_near"],
                      r["b_passed"], r["collisions"]))
