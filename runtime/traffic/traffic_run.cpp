@@ -14,6 +14,7 @@
 #include "foundation/atomic_file.h"
 #include "foundation/hash.h"
 #include "foundation/format.h"
+#include "runtime/traffic/junction_conflicts.h"
 #include "runtime/traffic/junction_lanes.h"
 #include "runtime/traffic/junction_turns.h"
 #include "runtime/traffic/sumo_net.h"
@@ -190,6 +191,36 @@ Result<std::string> freshWorkDir(const std::string& dir) {
     return work;
 }
 
+// The net edits that keep SUMO's junction model within what its collision
+// check sees: lane changes, tight turns, slanted crossings.
+Status adaptJunctionLanes(const std::string& netPath, TrafficRunSummary& sum) {
+    // No lane changes inside junctions (a vehicle moved sideways there onto a
+    // pedestrian waiting on a crossing): junction_lanes.h.
+    if (auto marked = forbidJunctionLaneChanges(netPath); !marked) return marked.status();
+    // Long vehicles keep off turns tighter than SUMO's straight box between
+    // their front and back can take (junction_turns.h).
+    std::vector<TurnClass> turnClasses;
+    for (int t = 0; t < kAgentTypeCount; ++t)
+        if (AgentType(t) != AgentType::Pedestrian)
+            turnClasses.push_back({agentTypeInfo(AgentType(t)).sumoClass, agentTypeInfo(AgentType(t)).length});
+    auto closed = restrictTightTurns(netPath, turnClasses);
+    if (!closed) return closed.status();
+    for (size_t i = 0; i < turnClasses.size(); ++i) sum.turnsClosed.push_back({turnClasses[i].sumoClass, (*closed)[i]});
+    // A vehicle counts as past a crossing only once its body has left the
+    // crossing lane's vehicles, also where the lanes cross at a slant
+    // (junction_conflicts.h).
+    std::vector<ConflictClass> conflictClasses;
+    for (int t = 0; t < kAgentTypeCount; ++t)
+        if (AgentType(t) != AgentType::Pedestrian) {
+            const AgentTypeInfo& info = agentTypeInfo(AgentType(t));
+            conflictClasses.push_back({info.sumoClass, info.length, info.width});
+        }
+    auto widened = widenConflictLanes(netPath, conflictClasses);
+    if (!widened) return widened.status();
+    sum.conflictLanesWidened = *widened;
+    return Status::ok();
+}
+
 Status runAll(const std::string& xodrText, const TrafficOptions& opt, const std::string& work, Progress& progress,
               TrafficRunSummary& sum) {
     auto tools = findSumo();
@@ -215,18 +246,7 @@ Status runAll(const std::string& xodrText, const TrafficOptions& opt, const std:
          "--opendrive.curve-resolution", "0.5", "--no-turnarounds", "true", "--no-warnings", "true"},
         work, logs));
     VISTA_RETURN_IF_ERROR(stripGeneratedDate((w / "city.net.xml").string()));
-    // No lane changes inside junctions (a vehicle moved sideways there onto a
-    // pedestrian waiting on a crossing): junction_lanes.h.
-    if (auto marked = forbidJunctionLaneChanges((w / "city.net.xml").string()); !marked) return marked.status();
-    // Long vehicles keep off turns tighter than SUMO's straight box between
-    // their front and back can take (junction_turns.h).
-    std::vector<TurnClass> turnClasses;
-    for (int t = 0; t < kAgentTypeCount; ++t)
-        if (AgentType(t) != AgentType::Pedestrian)
-            turnClasses.push_back({agentTypeInfo(AgentType(t)).sumoClass, agentTypeInfo(AgentType(t)).length});
-    auto closed = restrictTightTurns((w / "city.net.xml").string(), turnClasses);
-    if (!closed) return closed.status();
-    for (size_t i = 0; i < turnClasses.size(); ++i) sum.turnsClosed.push_back({turnClasses[i].sumoClass, (*closed)[i]});
+    VISTA_RETURN_IF_ERROR(adaptJunctionLanes((w / "city.net.xml").string(), sum));
     progress.end();
 
     progress.begin("traffic: demand");
@@ -275,6 +295,7 @@ Status runAll(const std::string& xodrText, const TrafficOptions& opt, const std:
     nlohmann::ordered_json turns;
     for (const auto& [cls, n] : sum.turnsClosed) turns[cls] = n;
     j["junction_turns_closed"] = turns;
+    j["junction_lanes_widened"] = sum.conflictLanesWidened;
     j["sumo"] = {{"vehicles_inserted", sum.vehiclesInserted},
                  {"persons_loaded", sum.personsInserted},
                  {"collisions", sum.collisions},

@@ -63,6 +63,8 @@ struct TrafficRunSummary {
     std::string sumoVersion;
     // Per SUMO vehicle class: the junction turns closed to it (junction_turns.h).
     std::vector<std::pair<std::string, size_t>> turnsClosed;
+    // Internal lanes widened to their crossing conflict (junction_conflicts.h).
+    size_t conflictLanesWidened = 0;
 };
 
 // Ranges of the options (checked by checkTrafficOptions, named in messages).
