@@ -569,3 +569,61 @@ TEST(Split, EndPointFramesTheGuardDrewCorrectTheSplitsPrice) {
 
 }  // namespace
 }  // namespace vista
+
+namespace vista {
+namespace {
+
+// The split and its guard with the near default as a reference, on a synthetic machine (no
+// timing): the near default (123 m) costs 20 ms, any other middle distance `middleMs`, ray
+// casting 60 ms; the model (rays dear) prices the largest distances cheapest and the split never
+// tries another kind on its own (no end tries, no exploration). The guard measures the near
+// default; its frames are frames of that kind for the split and correct its price: where the
+// other middle distances are dearer (30 ms), the split itself chooses the near default within a
+// few frames of the guard's first measurement; where they are cheaper (15 ms) they are kept.
+TEST(Split, NearDefaultFramesTheGuardDrewCorrectTheSplitsPrice) {
+    ProbeScene ps = probeScene(12);
+    const std::vector<SplitObject> objs = squareObjects();
+    const Camera c = smallCamera(glm::dvec3(0, -350, 1.7));
+    constexpr double kFixed = 123.0;
+    for (const double middleMs : {30.0, 15.0}) {
+        AdaptiveSplitOptions o = measuredOnly();
+        o.endTryEvery = 0;
+        o.everythingNear = false;
+        o.fixedDistance = kFixed;
+        AdaptiveSplit s(objs, ps.rays.get(), o);
+        for (int i = 0; i < 10; ++i) {
+            const double tris = 20000 + 4000 * i;
+            s.record(uint64_t(tris), 1.0 + 1e-5 * tris, 5000, 5000 * 3e-2);
+        }
+        SplitGuardOptions go;
+        go.fixedDistance = kFixed;
+        SplitGuard g(go);
+        int firstFixed = -1, splitFixed = 0, drawnMiddle = 0, splitMiddle = 0;
+        for (int f = 0; f < 200; ++f) {
+            const double chosen = g.holding() ? s.current() : s.choose(c, -1);
+            const double d = g.filter(chosen);
+            if (d == kFixed && firstFixed < 0) firstFixed = f;
+            if (f >= 100) {
+                splitFixed += chosen == kFixed;
+                splitMiddle += chosen > 0 && chosen != kFixed;
+                drawnMiddle += d > 0 && d != kFixed;
+            }
+            const double ms = d <= 0 ? 60.0 : d == kFixed ? 20.0 : middleMs;
+            s.recordFrame(d, ms);
+            g.record(d, ms);
+        }
+        ASSERT_GE(firstFixed, 0) << "the guard measures the near default";
+        if (middleMs > 20.0) {
+            EXPECT_LE(firstFixed, 6);
+            EXPECT_GE(splitFixed, 99) << "of the last 100 choices, the split's own for the near default";
+            EXPECT_EQ(drawnMiddle, 0);
+        } else {
+            EXPECT_GE(splitMiddle, 99) << "the cheaper middle is kept";
+            EXPECT_GE(drawnMiddle, 90) << "the near default measured now and then";
+            EXPECT_EQ(g.trips(), 0);
+        }
+    }
+}
+
+}  // namespace
+}  // namespace vista
