@@ -627,3 +627,42 @@ TEST(Split, NearDefaultFramesTheGuardDrewCorrectTheSplitsPrice) {
 
 }  // namespace
 }  // namespace vista
+
+namespace vista {
+namespace {
+
+// Hysteresis: a change of the near distance costs the frames after it what no price holds (the
+// band between the two distances is in neither the cache nor the last frame's traced pixels), so
+// the split keeps its last choice unless another is priced lower by more than switchMargin. A
+// walk of 200 frames, 0.5 m a frame, whose frames cost the same wherever the split puts the near
+// distance (10 ms, spread by +-4 % as on a busy machine): without the margin the choice follows
+// every crossing of two candidates' prices and every wobble of the correction; with it the split
+// changes its distance far less often.
+TEST(Split, TheLastChoiceIsKeptWithinTheSwitchMargin) {
+    ProbeScene ps = probeScene(12);
+    const std::vector<SplitObject> objs = squareObjects();
+    int changes[2] = {0, 0};
+    for (const int withMargin : {0, 1}) {
+        AdaptiveSplitOptions o = measuredOnly();
+        o.rayCastOnly = o.everythingNear = false;
+        o.endTryEvery = 0;
+        if (!withMargin) o.switchMargin = 0;
+        AdaptiveSplit s(objs, ps.rays.get(), o);
+        for (int i = 0; i < 10; ++i) {
+            const double tris = 20000 + 4000 * i;
+            s.record(uint64_t(tris), 1.0 + 1e-5 * tris, 5000, 5000 * 1e-3);
+        }
+        double last = -1;
+        for (int f = 0; f < 200; ++f) {
+            const double d = s.choose(smallCamera(glm::dvec3(0, -350 + 0.5 * f, 1.7)), -1);
+            if (f > 0 && d != last) ++changes[withMargin];
+            last = d;
+            s.recordFrame(d, 10.0 * (1.0 + 0.04 * std::sin(2.3 * f)));
+        }
+    }
+    EXPECT_GE(changes[0], 4) << "without the margin the choice changes at every crossing";
+    EXPECT_LE(2 * changes[1], changes[0]) << "the margin keeps the last choice";
+}
+
+}  // namespace
+}  // namespace vista
