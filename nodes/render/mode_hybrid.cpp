@@ -72,6 +72,7 @@ public:
                                : std::make_unique<AdaptiveSplit>(_near.objects, ctx.rays, so);
         SplitGuardOptions go;
         go.everything = so.everythingNear;
+        go.fixedDistance = so.fixedDistance;  // the near default is a yardstick too
         _guard = SplitGuard(go);
         _root = new osg::Group;
         if (_near.rootState) _root->setStateSet(_near.rootState.get());
@@ -363,7 +364,11 @@ private:
         if (byBudget()) return 0.0;
         if (autoSplit()) {
             _adaptive->setHazeFar(_ctx.options.effects.hazeFar());
-            const double d = _guard.filter(_adaptive->choose(camera, _ctx.options.pixelBudget));
+            // While the guard holds a reference the split's choice is not drawn: none is made (no probe,
+            // no pricing), so a held frame costs what the reference's own mode costs.
+            const double chosen =
+                _guard.holding() ? _adaptive->current() : _adaptive->choose(camera, _ctx.options.pixelBudget);
+            const double d = _guard.filter(chosen);
             _reason = _guard.overridden() == 1 ? "guard" : _guard.overridden() == 2 ? "measure" : "model";
             return d;
         }
@@ -399,7 +404,7 @@ private:
     const HeightGrid* _heights = nullptr;  // the horizon's grid: _grid, or a streamed city's
     std::unique_ptr<FarField> _far;
     std::unique_ptr<AdaptiveSplit> _adaptive;
-    SplitGuard _guard;              // keeps the split from a middle dearer than a measured end point
+    SplitGuard _guard;              // keeps the split from a middle dearer than a measured reference
     const char* _reason = "model";  // why the last auto choice: "model", "guard", "measure"
     osg::ref_ptr<osg::Group> _root;
     std::vector<float> _depth;

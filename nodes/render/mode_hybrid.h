@@ -6,8 +6,9 @@
 //   By distance (default): chunks whose box comes within the near distance,
 //   drawn with the far plane at max(nearD, 4 zNear); --near auto: the
 //   AdaptiveSplit picks nearD per frame, and a SplitGuard (split_guard.h)
-//   holds an end point (0 m or everything) while the middle's measured
-//   frames cost more than that end point's (note "near auto: N m by REASON",
+//   holds a reference (0 m, everything or the near default of `hybrid-fixed`)
+//   while the middle's measured frames cost more than that reference's; the
+//   split makes no choice (no probe) on held frames (note "near auto: N m by REASON",
 //   REASON model, guard or measure). Every frame notes its split as
 //   "split: near_m=D reason=R [model_ms=M rays_predicted=P]" (the bench's
 //   frames.csv split_* columns); the viewer's HUD gets an overlay line

@@ -79,9 +79,9 @@ constexpr int kFirstTryFrame = 3;
 constexpr double kFirstTryRatio = 1.5;
 
 // The probe's far-ray timing casts at most this many of its rays again.
-constexpr size_t kProbeFarTimed = 1000;
+constexpr size_t kProbeFarTimed = 500;
 // The probe's share of a frame's time (its rays fewer on cheap frames), and its fewest rays.
-constexpr double kProbeFrameShare = 0.05;
+constexpr double kProbeFrameShare = 0.025;
 constexpr double kProbeMinRays = 300;
 
 // Frames of a kind its correction is the lower quartile over: enough that frames slowed by other
@@ -561,17 +561,38 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
         candTris[size_t(i)] = kind == 0 ? 0 : tris;
         candRays[size_t(i)] = kind == 2 ? 0.0 : predictedRays(kind == 0 ? 0.0 : d);
         price[size_t(i)] = priceOf(kind, double(candTris[size_t(i)]), candRays[size_t(i)], double(_pixels));
+        // A middle distance, and the fixed distance before its own frames ran (it is a middle distance all
+        // the same: pricing it by the model alone, against middle distances corrected by their frames, kept the
+        // split from it where the model's middle does not pay), are corrected by the middle frames like them.
+        const bool byMiddle = kind == 1 || (kind == 3 && _kindFrames[3].empty());
         cost[size_t(i)] = std::max(
-            0.0, price[size_t(i)] +
-                     (kind == 1
-                          ? nearestFramesCorrection(_kindFrames[1], candTris[size_t(i)], candRays[size_t(i)],
+            0.0, price[size_t(i)] + (byMiddle ? nearestFramesCorrection(
+                                                    _kindFrames[1], candTris[size_t(i)], candRays[size_t(i)],
                                                     [&](const auto& k) { return priceOf(1, k.tris, k.rays, k.pixels); })
-                          : corr[kind]));
+                                              : corr[kind]));
+        if (kind == 3) {
+            _fixedTris = candTris[size_t(i)];
+            _fixedRays = candRays[size_t(i)];
+        }
         const bool tryOnly = kind == 2 && !everythingPriced;
         if (!tryOnly && (bestI < 0 || cost[size_t(i)] < cost[size_t(bestI)])) bestI = i;
     }
+    // Hysteresis: the last choice is kept unless another is cheaper by more than switchMargin. A
+    // change of the near distance costs the frames after it what no price holds (the band between
+    // the two distances is in neither the cache nor the last frame's traced pixels; the near
+    // field's new chunks): measured, a frame at the near default right after a change cost 1.11
+    // times `hybrid-fixed`'s same frame, one after a frame at the same distance 1.02 times.
+    for (int i = 0; i < n; ++i)
+        if (cand[size_t(i)] == _current && i != bestI && !(kindOf(_current) == 2 && !everythingPriced) &&
+            cost[size_t(i)] <= (1.0 + _o.switchMargin) * cost[size_t(bestI)]) {
+            bestI = i;
+            break;
+        }
     const double best = cost[size_t(bestI)];
-    if (_o.exploreEvery > 0 && frame % _o.exploreEvery == _o.exploreEvery - 1) {
+    // Exploration feeds the fits varied triangle counts and far pixels; once both fits are well
+    // conditioned the walk's own views vary them, and each exploration is two changes of distance.
+    const bool fitted = _haveA && _bFitted;
+    if (!fitted && _o.exploreEvery > 0 && frame % _o.exploreEvery == _o.exploreEvery - 1) {
         const int slot = frame / _o.exploreEvery;
         const int j = std::clamp(bestI + (slot % 2 ? 1 : -1), 0, n - 1);
         if (cost[size_t(j)] <= _o.exploreRatio * best || slot % 4 == 3) bestI = j;
@@ -607,19 +628,24 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
 
 void AdaptiveSplit::recordFrame(double nearD, double frameMs) {
     const int kind = kindOf(nearD);
-    // An end point drawn instead of the choice (a guard's hold or measurement) is a frame of that
-    // kind all the same: what it drew and traced is the kind's own (no triangles and every pixel
-    // for ray casting; everything's triangles in view at the last probe).
+    // An end point or the fixed distance drawn instead of the choice (a guard's hold or
+    // measurement) is a frame of that kind all the same: what it drew and traced is the kind's own
+    // (no triangles and every pixel for ray casting; everything's triangles in view at the last
+    // probe; the fixed distance's triangles in view and far pixels at the last choice).
     const bool chosen = nearD == _current;
-    const bool endPoint = !chosen && (nearD == 0.0 || (std::isinf(nearD) && nearD > 0));
-    if (!(chosen || endPoint) || !(frameMs >= 0)) return;
+    const bool reference = !chosen && (nearD == 0.0 || (std::isinf(nearD) && nearD > 0) ||
+                                       (_o.fixedDistance > 0 && nearD == _o.fixedDistance));
+    if (!(chosen || reference) || !(frameMs >= 0)) return;
     _frameMs = _frameMs > 0 ? (1 - _o.smoothing) * _frameMs + _o.smoothing * frameMs : frameMs;
-    if (endPoint) _lastKindFrame[kind] = _frame - 1;  // it ran: no try needed to measure it
+    if (reference) _lastKindFrame[kind] = _frame - 1;  // it ran: no try needed to measure it
     // A kind's first frame pays one-time costs (the first draw of the chunks, the far field's
     // first frame): not counted. Ray casting draws nothing, and once a frame has run its casters'
     // threads are warm: its first frame counts, so that a price resting on the probe's one-thread
-    // rate (which overprices the coherent rows of a ray-cast frame) is corrected by one try.
-    const bool oneTimeCosts = kind != 0 || _frame <= 1;
+    // rate (which overprices the coherent rows of a ray-cast frame) is corrected by one try. The
+    // middle and the fixed distance share the far field: the first frame of the two is not
+    // counted, the other's first frame is (one try then prices the fixed distance).
+    const bool farFieldRan = (kind == 1 && _kindSeen[3]) || (kind == 3 && _kindSeen[1]);
+    const bool oneTimeCosts = (kind != 0 || _frame <= 1) && !farFieldRan;
     if (!_kindSeen[kind] && oneTimeCosts) {
         _kindSeen[kind] = true;
         return;
@@ -628,6 +654,7 @@ void AdaptiveSplit::recordFrame(double nearD, double frameMs) {
     std::vector<KindFrame>& w = _kindFrames[kind];
     if (chosen) w.push_back({double(_chosenTris), _chosenRays, double(_pixels), frameMs});
     else if (kind == 0) w.push_back({0.0, predictedRays(0.0), double(_pixels), frameMs});
+    else if (kind == 3) w.push_back({double(_fixedTris), _fixedRays, double(_pixels), frameMs});
     else w.push_back({double(_everythingTris), 0.0, double(_pixels), frameMs});
     if (w.size() > kKindWindow) w.erase(w.begin());
 }

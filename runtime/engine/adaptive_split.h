@@ -17,14 +17,16 @@
 //     an empty near field needs no GL pass) + b * rays(d) + F.
 //   +infinity (everything): the `full` frame, c + a * all triangles.
 //   the fixed distance (AdaptiveSplitOptions::fixedDistance, `hybrid-fixed`'s
-//     choice): priced as a middle distance, corrected by its own frames, so
-//     that the split falls back to it where the model's middle does not pay.
+//     choice): priced as a middle distance, corrected by its own frames (until
+//     they ran, by the middle frames like it, as a middle distance), so that
+//     the split falls back to it where the model's middle does not pay.
 // Triangles are counted in view: an object whose box lies wholly outside one
 // of the view's four side planes is culled by the renderer and costs no
 // raster time (for everything, counted at each probe, and every triangle on
 // a city of more than 200,000 objects; with haze, only objects within it).
-// Each kind's price is corrected by what its own frames measured (an end point's frames drawn
-// by a guard instead of the choice count too: recordFrame()): the lower quartile over its last 8 frames
+// Each kind's price is corrected by what its own frames measured (an end point's or the fixed
+// distance's frames drawn by a guard instead of the choice count too: recordFrame()): the lower quartile over
+// its last 8 frames
 // (recordFrame()) of (whole frame ms, the decision included) minus (the current model's price of what that frame
 // drew and traced); a middle distance by those middle frames nearest to its triangles in view and far pixels (log
 // scale, within 1.1x of the nearest: one offset for every middle distance priced the model's favourite below every
@@ -56,7 +58,7 @@
 // read-back), predicted triangles(d) from the objects' boxes (exact) and
 // predicted rays(d) from a sparse probe of the view (every `probeStride`-th
 // pixel, sparser so that a large image gets about `probeRays` probe rays,
-// fewer on frames so cheap that the probe would cost more than 5 % of one,
+// fewer on frames so cheap that the probe would cost more than 2.5 % of one,
 // cast once per `probeInterval` frames and at once when the view jumped (eye
 // moved more than minDistance, heading or pitch more than 0.1 rad since the
 // probe): a pixel whose first hit lies beyond d, or that misses below the
@@ -64,10 +66,15 @@
 // and a surface beyond it counts as a miss: sky above the horizon costs no
 // ray). rays(d) is not capped by the pixel budget: the aim is the lowest
 // frame time at full accuracy (a budget-capped model would always pick the
-// smallest near field and let the cache's error grow). Every
-// `exploreEvery`-th choice steps one candidate up or down from the optimum so
-// that the fit sees varied triangle counts, when that neighbour's price is
-// within `exploreRatio` of the best (else only every fourth time).
+// smallest near field and let the cache's error grow). The last choice is
+// kept unless another is priced lower by more than `switchMargin` (a change
+// of distance costs the frames after it: the band between the two distances
+// is in neither the cache nor the last frame's traced pixels). While the two
+// fits are not both well conditioned, every `exploreEvery`-th choice steps
+// one candidate up or down from the optimum so that the fit sees varied
+// triangle counts, when that neighbour's price is within `exploreRatio` of
+// the best (else only every fourth time); once they are, the walk's views
+// vary the counts.
 // Not thread-safe; deterministic for given measurements (timeProbe off).
 #pragma once
 #include <cstddef>
@@ -203,11 +210,13 @@ struct AdaptiveSplitOptions {
     int probeInterval = 10;  // frames between probes
     double smoothing = 0.2;  // EMA weight of a new measurement
     double initialDistance = 100.0;
-    int window = 60;            // frames in the raster-cost fit
-    int exploreEvery = 7;       // every n-th choice explores a neighbouring candidate (0 = never)
-    double exploreRatio = 1.2;  // ... when its price is within this factor of the best (else every 4th time)
-    int endTryEvery = 40;       // a kind (0, middle, everything) not chosen for this many frames is tried ...
-    double endTryRatio = 1.3;   // ... when its price is within this factor of the best (0 = never)
+    int window = 60;             // frames in the raster-cost fit
+    int exploreEvery = 7;        // every n-th choice explores a neighbouring candidate while the fits are not
+                                 // both well conditioned (0 = never)
+    double exploreRatio = 1.2;   // ... when its price is within this factor of the best (else every 4th time)
+    double switchMargin = 0.05;  // the last choice is kept unless another is priced lower by more than this share
+    int endTryEvery = 40;        // a kind (0, middle, everything) not chosen for this many frames is tried ...
+    double endTryRatio = 1.3;    // ... when its price is within this factor of the best (0 = never)
     // Two more candidates at the ends: 0 (ray casting: the `raycast` frame) and
     // +infinity (everything rasterised: the `full` frame). Ray casting is
     // offered once both costs have been measured or the probe is timed (its
@@ -235,10 +244,13 @@ public:
     // stages' ms (fixedMs; 0 when the frame had no far field).
     void record(uint64_t triangles, double rasterMs, uint64_t farPixels, double farMs, double fixedMs = 0);
     // The whole frame's ms (decision included) of a frame rendered at nearD: the distance
-    // choose() returned last, or an end point (0, +infinity) drawn instead of it (a guard held or
-    // measured it, split_guard.h); other values are ignored. Corrects that kind's price: an end
-    // point's price rests on every frame drawn at it, not only on the split's rare tries (one
-    // or two frames in 24, whose noise then priced it against eight frames of the middle).
+    // choose() returned last, or an end point (0, +infinity) or the fixed distance drawn instead
+    // of it (a guard held or measured it, split_guard.h; the fixed distance's frame is priced with
+    // its triangles in view and far pixels at the last choice); other values are ignored.
+    // Corrects that kind's price: a reference's price rests on every frame drawn at it, not only
+    // on the split's rare tries (one or two frames in 24, whose noise then priced it against
+    // eight frames of the middle). The first frame of the middle or the fixed distance, whichever
+    // runs first, is not counted (the far field's one-time costs); the other's first frame is.
     void recordFrame(double nearD, double frameMs);
     // Haze: nothing beyond this eye-plane depth (metres) is traced; 0 = no haze.
     void setHazeFar(double zMax) { _hazeFar = zMax; }
@@ -295,6 +307,8 @@ private:
     uint64_t _chosenTris = 0;                                    // the last choice's triangles in view
     double _chosenRays = 0;                                      // ... and its predicted far rays
     uint64_t _everythingTris = 0;                                // every object's triangles in view at the last probe
+    uint64_t _fixedTris = 0;                                     // the fixed distance's triangles in view ...
+    double _fixedRays = 0;                                       // ... and predicted far rays, at the last choice
     int _lastKindFrame[kSplitKinds] = {0, 0, 0, 0};              // per kind: the frame it was last chosen or tried
     int _farFrames = 0;                                          // frames recorded with a far field
     int64_t _pixels = 0;                                         // the camera's pixel count at the last choice

@@ -1,4 +1,4 @@
-// The split's guard against a middle choice dearer than an end point (split_guard.h).
+// The split's guard against a middle choice dearer than a reference (split_guard.h).
 #include "runtime/engine/split_guard.h"
 
 #include <algorithm>
@@ -16,12 +16,30 @@ double SplitGuard::median(std::vector<double> v) {
     return *mid;
 }
 
+int SplitGuard::referenceOf(double nearD) const {
+    if (nearD <= 0) return kRayCasting;
+    if (std::isinf(nearD)) return kEverything;
+    return _o.fixedDistance > 0 && nearD == _o.fixedDistance ? kFixed : -1;
+}
+
+bool SplitGuard::allowed(int ref) const {
+    return ref == kRayCasting   ? _o.rayCasting
+           : ref == kEverything ? _o.everything
+                                : _o.fixedDistance > 0 && std::isfinite(_o.fixedDistance);
+}
+
+double SplitGuard::valueOf(int ref) const {
+    return ref == kRayCasting ? 0.0 : ref == kEverything ? std::numeric_limits<double>::infinity() : _o.fixedDistance;
+}
+
 double SplitGuard::endMs(int end) const {
-    if (end < 0 || end > 1 || _end[end].empty() || _frame - _endFrame[end] > _o.endMaxAge) return -1.0;
+    if (end < 0 || end >= kRefs || _end[end].empty() || _frame - _endFrame[end] > _o.endMaxAge) return -1.0;
     return median(_end[end]);
 }
 
 double SplitGuard::middleMs() const { return median(_middle); }
+
+bool SplitGuard::holding() const { return _o.strikes > 0 && _holdLeft > 0 && allowed(_holdEnd); }
 
 double SplitGuard::filter(double chosen) {
     const int frame = _frame++;
@@ -30,65 +48,60 @@ double SplitGuard::filter(double chosen) {
     if (_o.strikes <= 0) return chosen;
     if (_holdLeft > 0) {
         --_holdLeft;
-        const bool ok = _holdEnd == 0 ? _o.rayCasting : _o.everything;
-        if (ok) {
+        if (allowed(_holdEnd)) {
             _overridden = 1;
-            _last = _holdEnd == 0 ? 0.0 : std::numeric_limits<double>::infinity();
+            _last = valueOf(_holdEnd);
             return _last;
         }
     }
-    const bool middle = std::isfinite(chosen) && chosen > 0;
-    // Ray casting's yardstick: measured while there is none, and again while the middle is close
-    // enough to it that one frame's noise could decide (see the header).
-    const double rayCost = endMs(0), middleCost = middleMs();
-    const int every = rayCost < 0 ? _o.measureEvery
-                      : middleCost >= 0 && middleCost >= _o.doubt * rayCost
-                          ? _o.remeasureEvery * int(std::max<size_t>(1, _end[0].size()))
-                          : 0;
-    if (middle && _o.rayCasting && every > 0 && frame - _lastMeasure >= every && int(_middle.size()) >= _o.strikes) {
-        _lastMeasure = frame;
-        _overridden = 2;
-        _last = 0.0;
-        return 0.0;
+    if (!(std::isfinite(chosen) && chosen > 0)) return chosen;
+    // The split's middle choice: a middle distance, or the fixed distance itself (then compared with the end
+    // points only). Its cost: the median of its last `strikes` frames.
+    const bool atFixed = referenceOf(chosen) == kFixed;
+    double chosenCost = middleMs();
+    size_t chosenFrames = _middle.size();
+    if (atFixed) {
+        const size_t n = std::min(_end[kFixed].size(), size_t(_o.strikes));
+        chosenCost = median(std::vector<double>(_end[kFixed].end() - long(n), _end[kFixed].end()));
+        chosenFrames = n;
     }
-    return chosen;
+    if (int(chosenFrames) < std::min(_o.strikes, atFixed ? std::max(1, _o.endWindow) : _o.strikes)) return chosen;
+    // The yardsticks: measured while there is none, and again while the middle is close enough to one that one
+    // frame's noise could decide (see the header). Of two due, the one measured longer ago (the fixed distance
+    // on a tie).
+    int due = -1;
+    for (const int ref : {kFixed, kRayCasting}) {
+        if (!allowed(ref) || (ref == kFixed && atFixed)) continue;
+        const double cost = endMs(ref);
+        const int every = cost < 0 ? _o.measureEvery
+                          : chosenCost >= 0 && chosenCost >= _o.doubt * cost
+                              ? _o.remeasureEvery * int(std::max<size_t>(1, _end[ref].size()))
+                              : 0;
+        if (every > 0 && frame - _lastMeasure[ref] >= every && (due < 0 || _lastMeasure[ref] < _lastMeasure[due]))
+            due = ref;
+    }
+    if (due < 0) return chosen;
+    _lastMeasure[due] = frame;
+    _overridden = 2;
+    _last = valueOf(due);
+    return _last;
 }
 
-void SplitGuard::record(double nearD, double frameMs) {
-    if (!(frameMs >= 0) || std::isnan(nearD) || nearD != _last) return;
-    const int frame = _frame - 1;
-    // The first frame of the middle and of everything pays one-time costs (the first draw of the
-    // chunks, the far field's first frame): not counted. Ray casting draws nothing: counted.
-    const int kind = nearD <= 0 ? 0 : std::isinf(nearD) ? 2 : 1;
-    if (kind != 0 && !_seen[kind]) {
-        _seen[kind] = true;
-        return;
-    }
-    if (nearD <= 0 || std::isinf(nearD)) {
-        const int end = nearD <= 0 ? 0 : 1;
-        _end[end].push_back(frameMs);
-        if (int(_end[end].size()) > std::max(1, _o.endWindow)) _end[end].erase(_end[end].begin());
-        _endFrame[end] = frame;
-        if (end == 0) _lastMeasure = frame;
-        return;
-    }
-    if (_o.strikes <= 0) return;
-    _middle.push_back(frameMs);
-    if (int(_middle.size()) > _o.strikes) _middle.erase(_middle.begin());
+void SplitGuard::compare(double cost, int exclude) {
     if (++_middleSinceTrip < _o.strikes) return;
-    // The cheaper comparable end point.
+    // The cheapest comparable reference.
     int end = -1;
     double endCost = 0;
-    for (int e = 0; e < 2; ++e) {
+    for (int e = 0; e < kRefs; ++e) {
         const double c = endMs(e);
-        if (c < 0 || !(e == 0 ? _o.rayCasting : _o.everything)) continue;
+        if (e == exclude || c < 0 || !allowed(e)) continue;
         if (end < 0 || c < endCost) {
             end = e;
             endCost = c;
         }
     }
     if (end < 0) return;
-    if (middleMs() > (1.0 + _o.margin) * endCost) {
+    if (cost > (1.0 + _o.margin) * endCost) {
         const int hold = std::max(1, _nextHold > 0 ? _nextHold : _o.hold);
         _holdLeft = hold;
         _holdEnd = end;
@@ -98,6 +111,36 @@ void SplitGuard::record(double nearD, double frameMs) {
     } else {
         _nextHold = 0;  // the middle held its own: the next trip holds for `hold` again
     }
+}
+
+void SplitGuard::record(double nearD, double frameMs) {
+    if (!(frameMs >= 0) || std::isnan(nearD) || nearD != _last) return;
+    const int frame = _frame - 1;
+    const int ref = referenceOf(nearD);
+    // The first frame of the middle (or the fixed distance: the same far field) and of everything pays
+    // one-time costs (the first draw of the chunks, the far field's first frame): not counted. Ray casting
+    // draws nothing: counted.
+    const int kind = ref == kRayCasting ? 0 : ref == kEverything ? 2 : 1;
+    if (kind != 0 && !_seen[kind]) {
+        _seen[kind] = true;
+        return;
+    }
+    if (ref >= 0) {
+        _end[ref].push_back(frameMs);
+        if (int(_end[ref].size()) > std::max(1, _o.endWindow)) _end[ref].erase(_end[ref].begin());
+        _endFrame[ref] = frame;
+        _lastMeasure[ref] = frame;
+        // The fixed distance the split chose is its middle choice: compared with the end points.
+        if (ref == kFixed && _overridden == 0 && _o.strikes > 0) {
+            const size_t n = std::min(_end[kFixed].size(), size_t(_o.strikes));
+            compare(median(std::vector<double>(_end[kFixed].end() - long(n), _end[kFixed].end())), kFixed);
+        }
+        return;
+    }
+    if (_o.strikes <= 0) return;
+    _middle.push_back(frameMs);
+    if (int(_middle.size()) > _o.strikes) _middle.erase(_middle.begin());
+    compare(middleMs(), -1);
 }
 
 }  // namespace vista

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <random>
 #include <vector>
 
 #include "runtime/engine/split_guard.h"
@@ -176,4 +177,160 @@ TEST(SplitGuard, OneSlowEndPointFrameIsMeasuredAgainWhileTheMiddleIsClose) {
             EXPECT_GE(r.middle(), 85);
         }
     }
+}
+
+namespace {
+
+constexpr double kFixed = 100.0;  // the near default in the tests below
+
+// The near default as a reference: the guard's options with fixedDistance set.
+SplitGuardOptions withFixed() {
+    SplitGuardOptions o;
+    o.fixedDistance = kFixed;
+    return o;
+}
+
+int count(const Drawn& r, double d, size_t from = 0) {
+    int n = 0;
+    for (size_t f = from; f < r.drawn.size(); ++f) n += r.drawn[f] == d;
+    return n;
+}
+
+// Frames drawn at a distance that is neither an end point nor the fixed distance.
+int middleOnly(const Drawn& r, size_t from = 0) {
+    int n = 0;
+    for (size_t f = from; f < r.drawn.size(); ++f) n += kindOf(r.drawn[f]) == 1 && r.drawn[f] != kFixed;
+    return n;
+}
+
+// Changes of what is drawn (0, the fixed distance, another middle, everything) from frame `from` on.
+int changes(const Drawn& r, size_t from = 0) {
+    auto cls = [](double d) { return d == kFixed ? 3 : kindOf(d); };
+    int n = 0;
+    for (size_t f = from + 1; f < r.drawn.size(); ++f) n += cls(r.drawn[f]) != cls(r.drawn[f - 1]);
+    return n;
+}
+
+}  // namespace
+
+// The split keeps 150 m (its model underprices it) at 22 ms a frame; the near default (100 m)
+// costs 20 ms, ray casting 60 ms, everything 80 ms. The guard measures the near default as it
+// measures ray casting, abandons the dearer middle within a few frames of that measurement and
+// holds the near default, doubling the hold each time the middle trips again: over 400 frames
+// the middle is drawn on few frames, in few changes. Ray casting (the middle far below it) is
+// measured only when its measurement has expired (endMaxAge).
+TEST(SplitGuard, MiddleDearerThanTheNearDefaultIsAbandonedWithinAFewFrames) {
+    const SplitGuardOptions o = withFixed();
+    SplitGuard g(o);
+    auto machine = [](double d, int) { return d <= 0 ? 60.0 : std::isinf(d) ? 80.0 : d == kFixed ? 20.0 : 22.0; };
+    const Drawn r = drive(
+        g, 400, [](int) { return 150.0; }, machine);
+    size_t measured = 0;
+    while (measured < r.drawn.size() && r.drawn[measured] != kFixed) ++measured;
+    ASSERT_LT(measured, r.drawn.size());
+    ASSERT_LT(measured, r.first(0)) << "the near default is the first yardstick measured";
+    ASSERT_LE(measured, size_t(o.strikes + 1)) << "measured once the middle has `strikes` frames counted";
+    ASSERT_GT(g.trips(), 0);
+    EXPECT_EQ(g.heldEnd(), SplitGuard::kFixed);
+    EXPECT_NEAR(g.endMs(SplitGuard::kFixed), 20.0, 1e-12);
+    // The first hold starts within a few frames of the measurement.
+    size_t held = measured + 1;
+    while (held < r.drawn.size() && r.drawn[held] != kFixed) ++held;
+    EXPECT_LE(held, measured + size_t(o.strikes) + 2) << "the dearer middle is abandoned within a few frames";
+    EXPECT_LE(middleOnly(r, held), 20) << "the middle returns only briefly after each hold";
+    EXPECT_LE(changes(r, held), 2 * g.trips() + 4) << "no flapping";
+    EXPECT_LE(count(r, 0.0), 400 / o.endMaxAge + 1)
+        << "ray casting, far dearer than the middle, is measured only as its measurement expires";
+}
+
+// A middle cheaper than the near default is kept (18 ms against 20 ms: in doubt, so the near
+// default is measured again now and then, on few frames); one within the margin (20.4 ms, 2 %
+// dearer) is kept too; 6 % dearer trips. A middle clearly cheaper (12 ms, below `doubt` times
+// the near default) is interrupted only when the references' measurements expire (endMaxAge).
+TEST(SplitGuard, MiddleCheaperThanTheNearDefaultIsKept) {
+    const SplitGuardOptions o = withFixed();
+    for (const double middle : {12.0, 18.0, 20.4, 21.2}) {
+        SplitGuard g(o);
+        const Drawn r = drive(
+            g, 200, [](int) { return 150.0; },
+            [&](double d, int) {
+                return d <= 0 ? 60.0 : std::isinf(d) ? 80.0 : d == kFixed ? 20.0 : middle;
+            });
+        if (middle < 20.0 * (1 + o.margin)) {
+            EXPECT_EQ(g.trips(), 0) << middle;
+            EXPECT_GE(middleOnly(r), middle < o.doubt * 20.0 ? 193 : 186) << middle;
+            EXPECT_LE(size_t(changes(r)), 2 * (r.drawn.size() - size_t(middleOnly(r)))) << middle;
+        } else {
+            EXPECT_GE(g.trips(), 1) << middle;
+            EXPECT_LE(middleOnly(r), 30) << middle;
+        }
+    }
+}
+
+// Frame times spread by other work on the machine (each frame x 0.85 .. 1.25, a fixed seed):
+// a middle 12 % dearer than the near default is still abandoned for most frames, and the
+// holds' doubling keeps the draw from flapping; a middle 12 % cheaper is kept on most frames.
+TEST(SplitGuard, NoisyFramesDoNotMakeTheSplitFlap) {
+    for (const double middle : {22.4, 17.6}) {
+        const SplitGuardOptions o = withFixed();
+        SplitGuard g(o);
+        std::mt19937 rng(7);
+        std::uniform_real_distribution<double> noise(0.85, 1.25);
+        const Drawn r = drive(
+            g, 400, [](int) { return 150.0; },
+            [&](double d, int) {
+                const double ms = d <= 0 ? 60.0 : std::isinf(d) ? 80.0 : d == kFixed ? 20.0 : middle;
+                return ms * noise(rng);
+            });
+        if (middle > 20.0) {
+            EXPECT_LE(middleOnly(r), 60) << "of 400 frames, the dearer middle's";
+        } else {
+            EXPECT_GE(middleOnly(r), 300) << "of 400 frames, the cheaper middle's";
+        }
+        EXPECT_LE(changes(r), 40) << middle << ": no flapping";
+    }
+}
+
+// The split itself chooses the near default: its frames are the split's middle choice, compared
+// with the end points (28 ms against ray casting's 25 ms: ray casting is held), never with
+// themselves, and the near default is not measured as a yardstick beside them.
+TEST(SplitGuard, TheNearDefaultChosenIsComparedWithTheEndPoints) {
+    const SplitGuardOptions o = withFixed();
+    SplitGuard g(o);
+    const Drawn r = drive(
+        g, 200, [](int) { return kFixed; }, [](double d, int) { return d <= 0          ? 25.0
+                                                                       : std::isinf(d) ? 80.0
+                                                                                       : 28.0; });
+    ASSERT_LE(r.first(0), size_t(o.endWindow + 2)) << "ray casting measured";
+    EXPECT_GE(g.trips(), 1);
+    EXPECT_EQ(g.heldEnd(), SplitGuard::kRayCasting);
+    EXPECT_LE(count(r, kFixed, 20), 30) << "the dearer near default returns only briefly after each hold";
+
+    // A near default cheaper than the end points is kept, and no other distance is drawn.
+    SplitGuard cheap(o);
+    const Drawn k = drive(
+        cheap, 200, [](int) { return kFixed; },
+        [](double d, int) { return d <= 0          ? 60.0
+                                   : std::isinf(d) ? 80.0
+                                                   : 20.0; });
+    EXPECT_EQ(cheap.trips(), 0);
+    EXPECT_GE(count(k, kFixed), 196) << "ray casting measured once per endMaxAge frames";
+}
+
+// holding() says that the next filter() returns a held reference, whatever the split chose (a
+// caller then skips choosing: the split's probe and pricing cost the held frame nothing).
+TEST(SplitGuard, HoldingMeansTheChoiceIsIgnored) {
+    SplitGuard g(withFixed());
+    int held = 0;
+    for (int f = 0; f < 200; ++f) {
+        const bool holding = g.holding();
+        const double d = g.filter(holding ? std::nan("") : 150.0);
+        if (holding) {
+            ++held;
+            EXPECT_EQ(g.overridden(), 1);
+            EXPECT_FALSE(std::isnan(d));
+        }
+        g.record(d, d <= 0 ? 60.0 : std::isinf(d) ? 80.0 : d == kFixed ? 20.0 : 24.0);
+    }
+    EXPECT_GE(held, 150);
 }
