@@ -34,7 +34,7 @@ double cross(const glm::dvec2& a, const glm::dvec2& b) { return a.x * b.y - a.y 
 // True when p lies inside or on triangle a, b, c.
 bool inTriangle(const glm::dvec2& p, const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c) {
     const double d0 = cross(b - a, p - a), d1 = cross(c - b, p - b), d2 = cross(a - c, p - c);
-    const bool neg = d0 < 0 || d1 < 0 || d2 < 0, pos = d0 > 0 || d1 > 0 || d2 > 0;
+    const bool neg = d0 < 0 || d1 < 0 || d2<0, pos = d0> 0 || d1 > 0 || d2 > 0;
     return !(neg && pos);
 }
 
@@ -47,7 +47,8 @@ size_t straightenShortBends(StreetGraph& g) {
     for (const glm::dvec2& p : g.nodes)
         if (!std::isfinite(p.x + p.y)) return 0;
     std::vector<std::vector<uint32_t>> incident(N);
-    for (uint32_t k = 0; k < g.edges.size(); ++k) incident[g.edges[k].a].push_back(k), incident[g.edges[k].b].push_back(k);
+    for (uint32_t k = 0; k < g.edges.size(); ++k)
+        incident[g.edges[k].a].push_back(k), incident[g.edges[k].b].push_back(k);
     std::vector<char> removedEdge(g.edges.size(), 0), removedNode(N, 0);
     std::vector<std::vector<glm::dvec2>> dropped(g.edges.size());  // nodes dropped inside each edge
     const double cosMax = std::cos(kShortBendAngle);
@@ -69,7 +70,8 @@ size_t straightenShortBends(StreetGraph& g) {
                 if (!sameRoad(e, f)) continue;
                 bool ok = pointSegmentDistance(T, J, X) <= kShortBendDeviation;
                 for (uint32_t k : {ei, fi})
-                    for (const glm::dvec2& p : dropped[k]) ok = ok && pointSegmentDistance(p, J, X) <= kShortBendDeviation;
+                    for (const glm::dvec2& p : dropped[k])
+                        ok = ok && pointSegmentDistance(p, J, X) <= kShortBendDeviation;
                 for (uint32_t k : incident[j]) {
                     const uint32_t o = g.edges[k].a == j ? g.edges[k].b : g.edges[k].a;
                     ok = ok && o != x;

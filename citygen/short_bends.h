@@ -28,9 +28,9 @@
 
 namespace vista {
 
-constexpr double kShortBendArm = 25.0;                   // longest junction arm whose bend may be straightened
-constexpr double kShortBendAngle = 0.2617993877991494;   // 15 degrees
-constexpr double kShortBendDeviation = 1.5;              // farthest a dropped node lies off the straight edge
+constexpr double kShortBendArm = 25.0;                  // longest junction arm whose bend may be straightened
+constexpr double kShortBendAngle = 0.2617993877991494;  // 15 degrees
+constexpr double kShortBendDeviation = 1.5;             // farthest a dropped node lies off the straight edge
 
 size_t straightenShortBends(StreetGraph& g);
 

@@ -502,6 +502,18 @@ void AdaptiveSplit::probe(const Camera& camera) {
     _probeScale = dirs.empty() ? 0.0 : double(camera.width) * camera.height / double(dirs.size());
 }
 
+namespace {
+
+// The index of the candidate `current` when its cost is within (1 + margin) of the best's, else best.
+int keptWithinMargin(const std::vector<double>& cand, const std::vector<double>& cost, int best, double current,
+                     double margin) {
+    for (size_t i = 0; i < cand.size(); ++i)
+        if (cand[i] == current && int(i) != best && cost[i] <= (1.0 + margin) * cost[size_t(best)]) return int(i);
+    return best;
+}
+
+}  // namespace
+
 double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
     (void)pixelBudget;  // see the header: the model aims at full accuracy
     // Probe every probeInterval frames, and at once when the view jumped (a
@@ -582,12 +594,8 @@ double AdaptiveSplit::choose(const Camera& camera, int64_t pixelBudget) {
     // the two distances is in neither the cache nor the last frame's traced pixels; the near
     // field's new chunks): measured, a frame at the near default right after a change cost 1.11
     // times `hybrid-fixed`'s same frame, one after a frame at the same distance 1.02 times.
-    for (int i = 0; i < n; ++i)
-        if (cand[size_t(i)] == _current && i != bestI && !(kindOf(_current) == 2 && !everythingPriced) &&
-            cost[size_t(i)] <= (1.0 + _o.switchMargin) * cost[size_t(bestI)]) {
-            bestI = i;
-            break;
-        }
+    if (!(kindOf(_current) == 2 && !everythingPriced))
+        bestI = keptWithinMargin(cand, cost, bestI, _current, _o.switchMargin);
     const double best = cost[size_t(bestI)];
     // Exploration feeds the fits varied triangle counts and far pixels; once both fits are well
     // conditioned the walk's own views vary them, and each exploration is two changes of distance.
