@@ -35,11 +35,11 @@
 namespace vista {
 
 constexpr double kSideBySideAngle = 0.5235987755982988;  // 30 degrees: closer to parallel counts as side by side
-constexpr double kSideBySideClearance = 0.05;           // gap left between two side-by-side carriageways
-constexpr double kMinLaneWidth = 2.5;                   // narrowest driving lane before a lane is dropped
+constexpr double kSideBySideClearance = 0.05;            // gap left between two side-by-side carriageways
+constexpr double kMinLaneWidth = 2.5;                    // narrowest driving lane before a lane is dropped
 
 struct SideBySideStats {
-    size_t pairs = 0;         // side-by-side edge pairs whose carriageways shared area
+    size_t pairs = 0;          // side-by-side edge pairs whose carriageways shared area
     size_t edgesNarrowed = 0;  // edges given a narrower carriageway
     size_t lanesDropped = 0;   // driving lanes dropped to keep kMinLaneWidth
 };
