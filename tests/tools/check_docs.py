@@ -75,7 +75,6 @@ AWAITING_REGENERATION = {
     ("docs/measurements/effects.md", "effects-haze"): _QUIET,
     ("docs/measurements/far-field.md", "far-field-table"): _QUIET,
     ("docs/measurements/farfield-compare.md", "farfield-compare"): _QUIET,
-    ("docs/measurements/modes.md", "modes-sweep"): "empty: the sweep's tables were printed, never written to the page",
     ("docs/measurements/paging.md", "paged-generation"): _QUIET,
     ("docs/measurements/paging.md", "scale-table"): "empty: the 4-64 km cities were never measured "
                                                      "with the current paging; about an hour",
