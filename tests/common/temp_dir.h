@@ -1,6 +1,6 @@
 // Test helpers shared by the test executables: a private temporary directory
 // (removed with everything in it, read-only entries included), whole-file reads
-// and the list of entries under a directory.
+// and writes, and the list of entries under a directory.
 #pragma once
 #include <filesystem>
 #include <fstream>
@@ -19,6 +19,12 @@ inline std::string readBytes(const std::string& path) {
     std::stringstream ss;
     ss << in.rdbuf();
     return ss.str();
+}
+
+// Writes `text` to `path` as it is (binary), replacing what was there.
+inline void writeText(const std::string& path, const std::string& text) {
+    std::ofstream out(path, std::ios::binary);
+    out << text;
 }
 
 // Every entry under `dir`, relative to it ("sub/file"); empty when `dir` does not exist.

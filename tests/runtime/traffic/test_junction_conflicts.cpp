@@ -18,13 +18,9 @@
 using namespace vista;
 using vista::test::readBytes;
 using vista::test::TempDir;
+using vista::test::writeText;
 
 namespace {
-
-void writeText(const std::string& path, const std::string& text) {
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-}
 
 // A straight foe lane through (10, 0) at `deg` degrees to the ego lane (the
 // x axis from 0 to 20), 10 m either side of the crossing.

@@ -27,13 +27,9 @@
 using namespace vista;
 using vista::test::readBytes;
 using vista::test::TempDir;
+using vista::test::writeText;
 
 namespace {
-
-void writeText(const std::string& path, const std::string& text) {
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-}
 
 const char* kNet =
     "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"

@@ -20,13 +20,9 @@
 using namespace vista;
 using vista::test::readBytes;
 using vista::test::TempDir;
+using vista::test::writeText;
 
 namespace {
-
-void writeText(const std::string& path, const std::string& text) {
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-}
 
 // A quarter turn of radius r sampled every 0.5 m, with 5 m straight ends,
 // as netconvert writes a shape.

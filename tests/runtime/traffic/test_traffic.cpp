@@ -27,13 +27,9 @@
 using namespace vista;
 using vista::test::readBytes;
 using vista::test::TempDir;
+using vista::test::writeText;
 
 namespace {
-
-void writeText(const std::string& path, const std::string& text) {
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-}
 
 // A ring of four two-lane edges a→b→c→d→a (strongly connected for cars),
 // a dead-end spur e that leaves the ring (no way back), sidewalks on a and c
